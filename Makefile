@@ -1,0 +1,55 @@
+# hlvs-runner: two set-up commands on a fresh machine.
+#   make scrimmage   set up what is missing, then play a match between two teams of stub robots
+#   make test        set up what is missing, then run the whole test suite
+# Each step is idempotent and skipped when its inputs have not changed.
+
+PYTHON ?= python3
+VENV   := .venv
+PY     := $(VENV)/bin/python
+HLVS   := $(VENV)/bin/hlvs
+BUILD  := .build
+PYTEST_ARGS ?=
+
+.PHONY: scrimmage test setup venv system engine images lint typecheck clean-build
+
+scrimmage: setup
+	$(HLVS) scrimmage --out matches/scrimmage
+
+test: setup
+	$(PY) -m pytest $(PYTEST_ARGS)
+
+setup: venv system engine images
+
+venv: $(VENV)/.installed
+
+$(VENV)/.installed: pyproject.toml
+	@echo "==> virtual environment in $(VENV)"
+	test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e '.[dev]'
+	touch $@
+
+# Host packages (Docker engine, registry, sshd, ffmpeg, OSMesa, debootstrap) on Debian/Ubuntu as root.
+system: $(BUILD)/system.ok
+
+$(BUILD)/system.ok: scripts/setup-system.sh
+	@mkdir -p $(BUILD)
+	bash scripts/setup-system.sh
+	touch $@
+
+# A Docker engine that answers; started here when installed but not running.
+engine:
+	@bash scripts/ensure-docker.sh
+
+# Content-tagged images: rebuilt only when their inputs change.
+images: venv engine
+	$(HLVS) images build
+
+lint:
+	$(VENV)/bin/ruff check orchestrator simulator referee tests
+
+typecheck:
+	$(VENV)/bin/mypy
+
+clean-build:
+	rm -rf $(BUILD)

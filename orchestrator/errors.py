@@ -1,0 +1,116 @@
+"""Errors of the orchestrator package. Every error carries data and builds its own message.
+
+Tree::
+
+    OrchestratorError
+    ├── ConfigError              a configuration file is invalid (carries every problem found)
+    ├── InfrastructureError      the Docker engine, a network or the host failed us
+    │   └── EngineUnavailable    no Docker engine answers
+    ├── ImageError               an image cannot be used for a robot
+    │   ├── ImagePullError       pull failed (auth, unknown tag, unreachable registry)
+    │   └── ImageTooLarge        over the size limit
+    ├── MatchFailed              a match ended in a typed failure (see results.FailureClass)
+    ├── DeliveryError            a log set could not be delivered (auth, host key, bucket, path, unreachable)
+    └── ScheduleError            the schedule file or its state is unusable
+
+The CLI maps these to exit codes: 2 for ConfigError, 3 for InfrastructureError, 1 otherwise.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+class OrchestratorError(Exception):
+    """Root of every error the orchestrator package raises."""
+
+    exit_code = 1
+
+
+@dataclass(frozen=True, slots=True)
+class Problem:
+    """One problem in one file: printed as ``file: pointer: message (expected ...; did you mean ...)``."""
+
+    file: str
+    pointer: str
+    message: str
+    expected: str = ""
+    suggestion: str = ""
+    severity: str = "error"  # or "warning"
+
+    def __str__(self) -> str:
+        text = f"{self.file}: {self.pointer or '/'}: {self.message}"
+        extras = []
+        if self.expected:
+            extras.append(f"expected {self.expected}")
+        if self.suggestion:
+            extras.append(f"did you mean {self.suggestion}?")
+        if extras:
+            text += f" ({'; '.join(extras)})"
+        if self.severity == "warning":
+            text = "warning: " + text
+        return text
+
+
+class ConfigError(OrchestratorError):
+    exit_code = 2
+
+    def __init__(self, problems: list[Problem]) -> None:
+        self.problems = list(problems)
+        super().__init__("\n".join(str(p) for p in self.problems))
+
+
+class InfrastructureError(OrchestratorError):
+    exit_code = 3
+
+
+class EngineUnavailable(InfrastructureError):
+    def __init__(self, *, endpoint: str, reason: str) -> None:
+        self.endpoint = endpoint
+        self.reason = reason
+        super().__init__(
+            f"no Docker engine answers at {endpoint}: {reason}. "
+            "Start one (make setup starts the local engine) or set DOCKER_HOST."
+        )
+
+
+class ImageError(OrchestratorError):
+    def __init__(self, *, image: str, reason: str) -> None:
+        self.image = image
+        self.reason = reason
+        super().__init__(f"image {image}: {reason}")
+
+
+class ImagePullError(ImageError):
+    pass
+
+
+class ImageTooLarge(ImageError):
+    def __init__(self, *, image: str, size_bytes: int, limit_bytes: int) -> None:
+        self.size_bytes = size_bytes
+        self.limit_bytes = limit_bytes
+        super().__init__(
+            image=image,
+            reason=f"{size_bytes / 1e9:.2f} GB is over the limit of {limit_bytes / 1e9:.2f} GB",
+        )
+
+
+class MatchFailed(OrchestratorError):
+    def __init__(self, *, match_id: str, failure_class: str, cause: str) -> None:
+        self.match_id = match_id
+        self.failure_class = failure_class
+        self.cause = cause
+        super().__init__(f"match {match_id} failed ({failure_class}): {cause}")
+
+
+class DeliveryError(OrchestratorError):
+    def __init__(self, *, team: str, target: str, kind: str, reason: str) -> None:
+        self.team = team
+        self.target = target
+        self.kind = kind  # auth, host_key, bucket, access_denied, path, unreachable, transient
+        self.reason = reason
+        super().__init__(f"log delivery for {team} to {target} failed ({kind}): {reason}")
+
+
+class ScheduleError(OrchestratorError):
+    pass

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Installs the host packages the runner and its tests use, when missing, on Debian/Ubuntu as root.
+set -euo pipefail
+need=()
+have() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "ok installed"; }
+for pkg in docker.io docker-compose docker-registry apache2-utils debootstrap libosmesa6 ffmpeg openssh-server iproute2; do
+  have "$pkg" || need+=("$pkg")
+done
+if [ ${#need[@]} -eq 0 ]; then
+  echo "==> host packages present"
+  exit 0
+fi
+if [ "$(id -u)" != 0 ] || ! command -v apt-get >/dev/null; then
+  echo "hlvs setup: missing host packages: ${need[*]}" >&2
+  echo "hlvs setup: install them with your package manager (Debian/Ubuntu: apt-get install ${need[*]})," >&2
+  echo "hlvs setup: or run as root on Debian/Ubuntu so that 'make' installs them." >&2
+  exit 1
+fi
+echo "==> installing host packages: ${need[*]} (log: /var/log/hlvs/apt.log)"
+mkdir -p /var/log/hlvs
+export DEBIAN_FRONTEND=noninteractive
+apt-get update -qq >>/var/log/hlvs/apt.log 2>&1
+apt-get install -y -qq --no-install-recommends "${need[@]}" >>/var/log/hlvs/apt.log 2>&1 || {
+  echo "hlvs setup: apt-get install failed; see /var/log/hlvs/apt.log" >&2; exit 1; }
+# The Debian registry and sshd packages start services we do not use; tests start their own.
+systemctl disable --now docker-registry ssh >/dev/null 2>&1 || true

@@ -1,0 +1,43 @@
+"""Errors of the simulator package.
+
+Tree::
+
+    SimulatorError
+    ├── SpecError            match_spec.json that does not describe a match
+    ├── UnknownModelError    a robot model name we do not ship (lists the known ones)
+    ├── PhysicsDivergence    MuJoCo reported instability (carries its warning and the policy)
+    └── ApiError             robot API misuse on the simulator side
+"""
+
+from __future__ import annotations
+
+
+class SimulatorError(Exception):
+    """Root of every error the simulator package raises."""
+
+
+class SpecError(SimulatorError):
+    def __init__(self, *, source: str, pointer: str, reason: str) -> None:
+        self.source = source
+        self.pointer = pointer
+        self.reason = reason
+        super().__init__(f"{source}: {pointer or '/'}: {reason}")
+
+
+class UnknownModelError(SimulatorError):
+    def __init__(self, *, name: str, known: list[str]) -> None:
+        self.name = name
+        self.known = sorted(known)
+        super().__init__(f"unknown robot model {name!r}; known models: {', '.join(self.known)}")
+
+
+class PhysicsDivergence(SimulatorError):
+    def __init__(self, *, sim_time_ms: int, warning: str, policy: str) -> None:
+        self.sim_time_ms = sim_time_ms
+        self.warning = warning
+        self.policy = policy
+        super().__init__(f"physics diverged at {sim_time_ms} ms: {warning} (policy: {policy})")
+
+
+class ApiError(SimulatorError):
+    """Robot API error on the simulator side."""
