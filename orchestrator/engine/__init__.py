@@ -1,0 +1,36 @@
+"""The Docker adapter package: the only code that imports ``docker``.
+
+``connect()`` gives a client or raises :class:`EngineUnavailable`; ``containers`` and ``networks``
+hold the match's container and network calls, ``images`` the build, pull, push and inspect calls.
+Everything the runner creates carries :data:`LABEL_PROJECT` plus the match id label, so cleanup
+finds it after a crash.
+"""
+
+from __future__ import annotations
+
+import os
+
+import docker
+import docker.errors
+
+from orchestrator.errors import EngineUnavailable
+
+LABEL_PROJECT = "org.hlvs-runner"  # value: "1" on everything we create
+LABEL_MATCH = "org.hlvs-runner.match"  # value: match id
+LABEL_ROLE = "org.hlvs-runner.role"  # simulator | robot | network | helper
+LABEL_TEAM = "org.hlvs-runner.team"  # red | blue
+LABEL_ROBOT = "org.hlvs-runner.robot"  # player number
+
+
+def connect(*, timeout_s: float = 60.0) -> docker.DockerClient:
+    """A client for the engine at ``DOCKER_HOST`` (or the local socket) that answered a ping."""
+    endpoint = os.environ.get("DOCKER_HOST", "unix:///var/run/docker.sock")
+    try:
+        client = docker.DockerClient(base_url=endpoint, timeout=int(timeout_s))
+        client.ping()
+    except (docker.errors.DockerException, OSError) as exc:
+        raise EngineUnavailable(endpoint=endpoint, reason=str(exc)) from exc
+    return client
+
+
+__all__ = ["LABEL_MATCH", "LABEL_PROJECT", "LABEL_ROBOT", "LABEL_ROLE", "LABEL_TEAM", "connect"]
