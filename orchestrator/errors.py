@@ -10,7 +10,7 @@ Tree::
     │   ├── ImagePullError       pull failed (auth, unknown tag, unreachable registry)
     │   └── ImageTooLarge        over the size limit
     ├── MatchFailed              a match ended in a typed failure (see results.FailureClass)
-    ├── DeliveryError            a log set could not be delivered (auth, host key, bucket, path, unreachable)
+    ├── DeliveryError            a log set could not be delivered (auth, host key, bucket, ...)
     └── ScheduleError            the schedule file or its state is unusable
 
 The CLI maps these to exit codes: 2 for ConfigError, 3 for InfrastructureError, 1 otherwise.
@@ -29,7 +29,10 @@ class OrchestratorError(Exception):
 
 @dataclass(frozen=True, slots=True)
 class Problem:
-    """One problem in one file: printed as ``file: pointer: message (expected ...; did you mean ...)``."""
+    """One problem in one file.
+
+    Printed as ``file: pointer: message (expected ...; did you mean ...?)``.
+    """
 
     file: str
     pointer: str
