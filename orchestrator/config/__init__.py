@@ -7,6 +7,8 @@ cross-file rules) and returns frozen dataclasses; every problem found is raised 
 
 from __future__ import annotations
 
+from orchestrator.config.game import default_match_id, default_seed
+from orchestrator.config.loader import check_game, check_team, load_game, load_team
 from orchestrator.config.model import (
     COLORS,
     DEFAULT_MODEL,
@@ -49,4 +51,10 @@ __all__ = [
     "TeamConfig",
     "TeamRef",
     "Timing",
+    "check_game",
+    "check_team",
+    "default_match_id",
+    "default_seed",
+    "load_game",
+    "load_team",
 ]

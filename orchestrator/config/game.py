@@ -1,0 +1,232 @@
+"""game.json: schema, per-file rules, and the GameConfig it becomes.
+
+Team files are not read here (see :mod:`orchestrator.config.loader`); this module checks what
+game.json alone can tell: required fields, legacy names, GameController arguments, port clashes,
+referenced files.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import re
+from pathlib import Path
+from typing import Any
+
+from orchestrator.config.model import COLORS, Color, GameConfig, Limits, TeamRef, Timing
+from orchestrator.config.problems import Collector, pointer
+from orchestrator.config.schema import validate
+
+LEGACY_RTF = ("minimum_real_time_factor", "real_time_factor")
+BASIC_TIME_STEP_S = 0.008
+_GC_DURATION_OPTIONS = {
+    "--halftimeduration": "half_duration_s",
+    "-d": "half_duration_s",
+    "--overtimeduration": "overtime_half_duration_s",
+    "-o": "overtime_half_duration_s",
+}
+
+
+def default_match_id(source: Path, red_id: int, blue_id: int) -> str:
+    """``<file stem>-<red id>-vs-<blue id>``, reduced to the characters a match id allows."""
+    stem = re.sub(r"[^A-Za-z0-9_.-]+", "-", source.stem).strip("-._") or "match"
+    return f"{stem[:40]}-{red_id}-vs-{blue_id}"
+
+
+def default_seed(match_id: str) -> int:
+    """A 32-bit seed derived from the match id (the same id always gives the same seed)."""
+    return int.from_bytes(hashlib.sha256(match_id.encode("utf-8")).digest()[:4], "big")
+
+
+def team_id(raw: Any) -> int:
+    return int(raw)
+
+
+def build_game(document: Any, where: Collector, *, source: Path) -> GameConfig | None:
+    """Validate one game document; the GameConfig when it has no error (problems in ``where``)."""
+    if not validate("game", document, where):
+        return None
+    before = len(where.errors)
+    base = source.parent
+    rtf = _real_time_factor(document, where)
+    timing = _timing(document, where)
+    _check_physics_dt(document, where)
+    _check_record(document, where)
+    _check_team_ids(document, where)
+    _check_ports(document, where)
+    teams = {color: _team_ref(color, document[color], base, where) for color in COLORS}
+    public_logs = _existing(document.get("public_logs"), base, "/public_logs", where)
+    if len(where.errors) > before or rtf is None:
+        return None
+    red, blue = teams["red"], teams["blue"]
+    match_id = document.get("match_id") or default_match_id(source, red.team_id, blue.team_id)
+    seed = document.get("seed", document.get("random_seed"))
+    if "seed" not in document and "random_seed" in document:
+        where.warn("/random_seed", "legacy field: used as the match seed", expected='"seed"')
+    return GameConfig(
+        source=source,
+        match_id=match_id,
+        seed=seed if seed is not None else default_seed(match_id),
+        game_type=document["type"],
+        field_class=document["class"],
+        host=document["host"],
+        maximum_real_time_factor=rtf,
+        red=red,
+        blue=blue,
+        side_left=document.get("side_left", "random"),
+        kickoff=document.get("kickoff", "random"),
+        press_a_key_to_terminate=document.get("press_a_key_to_terminate", False),
+        use_bouncing_server=document.get("use_bouncing_server", False),
+        record_simulation=document.get("record_simulation"),
+        game_controller_extra_args=tuple(document.get("game_controller_extra_args", ())),
+        texture_seed=document.get("texture_seed"),
+        supervisor=document.get("supervisor"),
+        stepping=document.get("stepping", "async"),
+        physics_dt_s=float(document.get("physics_dt_s", 0.002)),
+        lockstep_deadline_ms=float(document.get("lockstep_deadline_ms", 50.0)),
+        lockstep_time_bank_ms=float(document.get("lockstep_time_bank_ms", 5000.0)),
+        limits=_limits(document.get("limits", {})),
+        timing=timing,
+        allow_internet=document.get("allow_internet", False),
+        public_logs=public_logs,
+    )
+
+
+def _real_time_factor(document: dict[str, Any], where: Collector) -> float | None:
+    legacy = [name for name in LEGACY_RTF if name in document]
+    if "maximum_real_time_factor" in document:
+        for name in legacy:
+            where.warn(
+                pointer(name), "legacy field: ignored", expected='"maximum_real_time_factor"'
+            )
+        return float(document["maximum_real_time_factor"])
+    if legacy:
+        name = legacy[0]
+        where.warn(
+            pointer(name),
+            "legacy field: read as maximum_real_time_factor",
+            expected='"maximum_real_time_factor"',
+        )
+        return float(document[name])
+    where.error(
+        "/maximum_real_time_factor",
+        "required field is missing",
+        expected="a number (<= 0: as fast as possible)",
+    )
+    return None
+
+
+def _timing(document: dict[str, Any], where: Collector) -> Timing:
+    written: dict[str, Any] = dict(document.get("timing", {}))
+    from_gc: dict[str, float] = {}
+    args = list(document.get("game_controller_extra_args", ()))
+    index = 0
+    while index < len(args):
+        arg = args[index]
+        at = pointer("game_controller_extra_args", index)
+        option, _, inline = arg.partition("=")
+        if option not in _GC_DURATION_OPTIONS:
+            where.warn(at, f'GameController argument "{arg}" is ignored')
+            index += 1
+            continue
+        if inline:
+            value = inline
+        elif index + 1 < len(args):
+            value = args[index + 1]
+            index += 1
+            at = pointer("game_controller_extra_args", index)
+        else:
+            where.error(at, f"{option} without a value", expected="a number of seconds after it")
+            break
+        try:
+            seconds = float(value)
+        except ValueError:
+            seconds = -1.0
+        if not seconds > 0 or seconds == float("inf"):
+            where.error(at, f'invalid duration "{value}" for {option}', expected="seconds > 0")
+        else:
+            from_gc[_GC_DURATION_OPTIONS[option]] = seconds
+        index += 1
+    for name, seconds in from_gc.items():
+        if name in written and float(written[name]) != seconds:
+            where.error(
+                pointer("timing", name),
+                f"{written[name]} conflicts with {seconds:g} from game_controller_extra_args",
+                expected="one value",
+            )
+        written[name] = seconds
+    durations: dict[str, float] = {k: float(v) for k, v in written.items()}
+    max_duration = document.get("max_duration")
+    return Timing(
+        **durations, max_duration_s=float(max_duration) if max_duration is not None else None
+    )
+
+
+def _limits(raw: dict[str, Any]) -> Limits:
+    values: dict[str, Any] = {k: (int(v) if k == "pids" else float(v)) for k, v in raw.items()}
+    return Limits(**values)
+
+
+def _check_physics_dt(document: dict[str, Any], where: Collector) -> None:
+    dt = float(document.get("physics_dt_s", 0.002))
+    substeps = round(BASIC_TIME_STEP_S / dt)
+    if substeps < 1 or abs(substeps * dt - BASIC_TIME_STEP_S) > 1e-9:
+        where.error(
+            "/physics_dt_s",
+            f"{dt:g} s does not divide the 8 ms basic time step",
+            expected="0.008 / n, e.g. 0.002 or 0.004",
+        )
+
+
+def _check_record(document: dict[str, Any], where: Collector) -> None:
+    record = document.get("record_simulation")
+    if isinstance(record, str) and record.endswith(".html"):
+        where.warn(
+            "/record_simulation",
+            "HTML animations are not produced (the replay file is always written)",
+            expected="a path ending in .mp4 for a movie",
+        )
+
+
+def _check_team_ids(document: dict[str, Any], where: Collector) -> None:
+    red_id, blue_id = team_id(document["red"]["id"]), team_id(document["blue"]["id"])
+    if red_id == blue_id:
+        where.error("/blue/id", f"team id {blue_id} is also the red team's id", expected="two ids")
+    for color in COLORS:
+        if isinstance(document[color]["id"], str):
+            where.warn(
+                pointer(color, "id"), "a string: converted to a number", expected="an integer"
+            )
+
+
+def _check_ports(document: dict[str, Any], where: Collector) -> None:
+    used: dict[int, str] = {}
+    for color in COLORS:
+        for index, port in enumerate(document[color]["ports"]):
+            at = pointer(color, "ports", index)
+            if port in used:
+                where.error(
+                    at, f"port {port} is already used at {used[port]}", expected="a free port"
+                )
+            else:
+                used[port] = at
+
+
+def _team_ref(color: Color, raw: dict[str, Any], base: Path, where: Collector) -> TeamRef:
+    config = base / raw["config"]
+    return TeamRef(
+        color=color,
+        team_id=team_id(raw["id"]),
+        config=config,
+        hosts=tuple(raw["hosts"]),
+        ports=tuple(raw["ports"]),
+        credentials=_existing(raw.get("credentials"), base, pointer(color, "credentials"), where),
+    )
+
+
+def _existing(raw: str | None, base: Path, at: str, where: Collector) -> Path | None:
+    if raw is None:
+        return None
+    path = base / raw
+    if not path.is_file():
+        where.error(at, f"file not found: {path}", expected="a path relative to this file")
+    return path

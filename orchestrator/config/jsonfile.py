@@ -1,0 +1,108 @@
+"""Reading a JSON file into Python values with one clean problem line for every failure."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+from orchestrator.config.problems import Collector
+from orchestrator.errors import ConfigError
+
+MAX_FILE_BYTES = 16 * 1024 * 1024
+
+
+def read_text(path: Path) -> str:
+    """The UTF-8 text of a configuration file; ConfigError for anything that is not one."""
+    where = Collector(str(path))
+    try:
+        if path.is_dir():
+            where.error("", "is a directory", expected="a file")
+            raise ConfigError(where.problems)
+        data = path.read_bytes()
+    except FileNotFoundError:
+        where.error("", "file not found")
+        raise ConfigError(where.problems) from None
+    except PermissionError:
+        where.error("", "permission denied")
+        raise ConfigError(where.problems) from None
+    except OSError as exc:
+        where.error("", f"cannot read: {exc.strerror or exc}")
+        raise ConfigError(where.problems) from None
+    if len(data) > MAX_FILE_BYTES:
+        where.error("", f"file is too large ({len(data)} bytes)", expected="a configuration file")
+        raise ConfigError(where.problems)
+    if not data.strip():
+        where.error("", "file is empty", expected="a JSON object")
+        raise ConfigError(where.problems)
+    if b"\x00" in data:
+        where.error("", "binary file", expected="a UTF-8 text file")
+        raise ConfigError(where.problems)
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        where.error("", f"not UTF-8 text (byte {exc.start})", expected="a UTF-8 text file")
+        raise ConfigError(where.problems) from None
+
+
+def parse_json(text: str, *, file: str) -> Any:
+    """Parse JSON text; invalid JSON becomes a problem with line and column."""
+    try:
+        return json.loads(text, parse_constant=_reject_constant, parse_float=_finite_float)
+    except json.JSONDecodeError as exc:
+        where = Collector(file)
+        where.error("", f"invalid JSON at line {exc.lineno} column {exc.colno}: {exc.msg}")
+        raise ConfigError(where.problems) from None
+    except _NonStandardNumber as exc:
+        where = Collector(file)
+        where.error("", f"invalid JSON: {exc.constant} is not a finite number")
+        raise ConfigError(where.problems) from None
+    except RecursionError:
+        where = Collector(file)
+        where.error("", "invalid JSON: nested too deeply")
+        raise ConfigError(where.problems) from None
+
+
+def read_json(path: Path) -> Any:
+    return parse_json(read_text(path), file=str(path))
+
+
+def read_json_object(path: Path) -> dict[str, Any]:
+    value = read_json(path)
+    if not isinstance(value, dict):
+        where = Collector(str(path))
+        where.error("", f"the top level is {json_type(value)}", expected="a JSON object")
+        raise ConfigError(where.problems)
+    return value
+
+
+def json_type(value: Any) -> str:
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "a boolean"
+    if isinstance(value, int | float):
+        return "a number"
+    if isinstance(value, str):
+        return "a string"
+    if isinstance(value, list):
+        return "an array"
+    return "an object"
+
+
+class _NonStandardNumber(ValueError):
+    def __init__(self, constant: str) -> None:
+        self.constant = constant
+        super().__init__(constant)
+
+
+def _reject_constant(constant: str) -> Any:
+    raise _NonStandardNumber(constant)
+
+
+def _finite_float(text: str) -> float:
+    value = float(text)
+    if not math.isfinite(value):
+        raise _NonStandardNumber(text)
+    return value

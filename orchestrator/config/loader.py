@@ -1,0 +1,160 @@
+"""Loading game.json with its team files, or one team file, into validated dataclasses.
+
+``load_*`` raise one :class:`ConfigError` listing every problem found (warnings included);
+``check_*`` return the problems instead, for ``hlvs check``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from orchestrator.config.game import build_game
+from orchestrator.config.jsonfile import read_json
+from orchestrator.config.model import (
+    COLORS,
+    FieldClass,
+    GameConfig,
+    LoadedGame,
+    LoadedTeam,
+    TeamConfig,
+)
+from orchestrator.config.problems import Collector, pointer, raise_if_errors
+from orchestrator.config.team import build_team
+from orchestrator.errors import ConfigError, Problem
+
+
+def load_game(path: str | Path, *, images_required: bool = False) -> LoadedGame:
+    """game.json and the two team files it references, validated.
+
+    Args:
+        path: the game.json file; team ``config`` paths are relative to its folder.
+        images_required: every player must name an image (``image`` + ``dockerTag``), as a
+            match needs; otherwise a missing image is a warning.
+
+    Returns:
+        The game, both teams, and the warnings (the caller shows them).
+
+    Raises:
+        ConfigError: with every problem found in game.json and in both team files.
+    """
+    loaded, problems = _game(Path(path), images_required=images_required)
+    raise_if_errors(problems)
+    assert loaded is not None
+    return loaded
+
+
+def load_team(
+    path: str | Path, *, field_class: FieldClass | None = None, images_required: bool = False
+) -> LoadedTeam:
+    """One team_config.json, validated (pose rules for ``field_class`` when given)."""
+    team, problems = _team(Path(path), field_class=field_class, images_required=images_required)
+    raise_if_errors(problems)
+    assert team is not None
+    return LoadedTeam(team=team, warnings=tuple(problems))
+
+
+def check_game(path: str | Path, *, images_required: bool = False) -> list[Problem]:
+    """Every problem (errors and warnings) in game.json and the team files it references."""
+    return _game(Path(path), images_required=images_required)[1]
+
+
+def check_team(
+    path: str | Path, *, field_class: FieldClass | None = None, images_required: bool = False
+) -> list[Problem]:
+    return _team(Path(path), field_class=field_class, images_required=images_required)[1]
+
+
+def _game(path: Path, *, images_required: bool) -> tuple[LoadedGame | None, list[Problem]]:
+    where = Collector(str(path))
+    try:
+        document = read_json(path)
+    except ConfigError as exc:
+        return None, exc.problems
+    game = build_game(document, where, source=path)
+    problems = list(where.problems)
+    teams: dict[str, TeamConfig | None] = {}
+    field_class = _field_class(document)
+    for color in COLORS:
+        config = _team_path(document, color, path.parent)
+        if config is None:
+            teams[color] = None
+            continue
+        if not config.is_file():
+            what = "is a directory" if config.is_dir() else "file not found"
+            problems.append(
+                Problem(
+                    str(path),
+                    pointer(color, "config"),
+                    f"{what}: {config}",
+                    expected="a team_config.json path relative to this file",
+                )
+            )
+            teams[color] = None
+            continue
+        team, team_problems = _team(
+            config, field_class=field_class, images_required=images_required
+        )
+        problems.extend(team_problems)
+        teams[color] = team
+        if team is not None and game is not None:
+            problems.extend(_cross_checks(game, color, team))
+    red, blue = teams.get("red"), teams.get("blue")
+    if game is None or red is None or blue is None or _has_errors(problems):
+        return None, problems
+    warnings = tuple(p for p in problems if p.severity == "warning")
+    return LoadedGame(game=game, red=red, blue=blue, warnings=warnings), problems
+
+
+def _team(
+    path: Path, *, field_class: FieldClass | None, images_required: bool
+) -> tuple[TeamConfig | None, list[Problem]]:
+    where = Collector(str(path))
+    try:
+        document = read_json(path)
+    except ConfigError as exc:
+        return None, exc.problems
+    team = build_team(
+        document,
+        where,
+        source=path,
+        field_class=field_class,
+        images_required=images_required,
+    )
+    return team, where.problems
+
+
+def _cross_checks(game: GameConfig, color: str, team: TeamConfig) -> list[Problem]:
+    """Rules that need game.json and a team file together."""
+    ref = game.red if color == "red" else game.blue
+    where = Collector(str(game.source))
+    if len(team.players) > len(ref.ports):
+        where.error(
+            pointer(color, "ports"),
+            f"{len(ref.ports)} ports for the {len(team.players)} players of {team.source}",
+            expected="one port per player",
+        )
+    return where.problems
+
+
+def _team_path(document: object, color: str, base: Path) -> Path | None:
+    if not isinstance(document, dict):
+        return None
+    side = document.get(color)
+    if not isinstance(side, dict) or not isinstance(side.get("config"), str):
+        return None
+    config: str = side["config"]
+    return base / config if config else None
+
+
+def _field_class(document: object) -> FieldClass | None:
+    if isinstance(document, dict):
+        value = document.get("class")
+        if value == "KID":
+            return "KID"
+        if value == "ADULT":
+            return "ADULT"
+    return None
+
+
+def _has_errors(problems: list[Problem]) -> bool:
+    return any(p.severity == "error" for p in problems)

@@ -1,0 +1,420 @@
+"""Tournament schedule files (YAML or JSON): teams, matches or fixtures, timing, simulator slots.
+
+``load_schedule(path)`` validates the file against ``schemas/schedule.schema.json`` and the
+cross-references (team names, match ids, bracket size) and returns a frozen :class:`Schedule`.
+Stream times may be absolute (ISO 8601 with a time zone) or offsets from ``start`` (``+90s``,
+``+15m``, ``+2h``); :meth:`Schedule.plan` turns them into absolute times once the tournament's
+reference time is known (``start: now`` is fixed at the first run and kept in the state file).
+"""
+
+from __future__ import annotations
+
+import difflib
+import json
+import re
+from dataclasses import dataclass
+from datetime import UTC, datetime, timedelta
+from importlib import resources
+from pathlib import Path
+from typing import Any, Literal
+
+import jsonschema
+import yaml
+
+from orchestrator.errors import ConfigError, Problem
+
+MatchKind = Literal["round_robin", "knockout"]
+_OFFSET = re.compile(r"^\+(\d+(?:\.\d+)?)([smhd])$")
+_UNIT_S = {"s": 1.0, "m": 60.0, "h": 3600.0, "d": 86400.0}
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ScheduleTiming:
+    pull_lead_round_robin_s: float = 4 * 3600.0
+    pull_lead_knockout_s: float = 7 * 3600.0
+    play_after_pull_s: float = 600.0
+    deliver_after_stream_s: float = 0.0
+    retry_s: float = 300.0
+
+    def pull_lead_s(self, kind: MatchKind) -> float:
+        return self.pull_lead_knockout_s if kind == "knockout" else self.pull_lead_round_robin_s
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ScheduledTeam:
+    name: str
+    team_id: int
+    config: Path
+    credentials: Path | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class Slot:
+    """A side of a match: a team name, or the winner / loser of an earlier match."""
+
+    team: str | None = None
+    winner_of: str | None = None
+    loser_of: str | None = None
+
+    def __str__(self) -> str:
+        if self.team is not None:
+            return self.team
+        return f"winner of {self.winner_of}" if self.winner_of else f"loser of {self.loser_of}"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ScheduledMatch:
+    id: str
+    red: Slot
+    blue: Slot
+    field_class: Literal["KID", "ADULT"]
+    kind: MatchKind
+    stream_start: str  # ISO 8601 or "+<n><unit>" offset from the schedule's start
+    stream_length_s: float
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class PlannedMatch:
+    """A match with absolute times (UTC)."""
+
+    match: ScheduledMatch
+    pull_at: datetime
+    play_at: datetime
+    stream_start: datetime
+    stream_end: datetime
+    deliver_at: datetime
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Schedule:
+    source: Path
+    name: str
+    start: str | None
+    output_dir: Path
+    log_store: Path
+    public_logs: Path | None
+    simulator_slots: int
+    timing: ScheduleTiming
+    game_defaults: dict[str, Any]
+    teams: tuple[ScheduledTeam, ...]
+    matches: tuple[ScheduledMatch, ...]
+
+    def team(self, name: str) -> ScheduledTeam:
+        for team in self.teams:
+            if team.name == name:
+                return team
+        raise KeyError(name)
+
+    def match(self, match_id: str) -> ScheduledMatch:
+        for match in self.matches:
+            if match.id == match_id:
+                return match
+        raise KeyError(match_id)
+
+    def plan(self, reference: datetime) -> list[PlannedMatch]:
+        """Absolute times of every match, relative offsets counted from ``reference``."""
+        planned = []
+        for match in self.matches:
+            stream_start = resolve_time(match.stream_start, reference)
+            pull_at = stream_start - timedelta(seconds=self.timing.pull_lead_s(match.kind))
+            play_at = pull_at + timedelta(seconds=self.timing.play_after_pull_s)
+            stream_end = stream_start + timedelta(seconds=match.stream_length_s)
+            deliver_at = stream_end + timedelta(seconds=self.timing.deliver_after_stream_s)
+            planned.append(
+                PlannedMatch(
+                    match=match,
+                    pull_at=pull_at,
+                    play_at=min(play_at, stream_start),
+                    stream_start=stream_start,
+                    stream_end=stream_end,
+                    deliver_at=deliver_at,
+                )
+            )
+        return planned
+
+
+def resolve_time(text: str, reference: datetime) -> datetime:
+    match = _OFFSET.match(text)
+    if match:
+        return reference + timedelta(seconds=float(match.group(1)) * _UNIT_S[match.group(2)])
+    parsed = datetime.fromisoformat(text)
+    if parsed.tzinfo is None:
+        raise ValueError(f"time {text!r} has no time zone")
+    return parsed.astimezone(UTC)
+
+
+def _schema() -> dict[str, Any]:
+    text = resources.files("orchestrator.config.schemas").joinpath("schedule.schema.json")
+    loaded: dict[str, Any] = json.loads(text.read_text(encoding="utf-8"))
+    return loaded
+
+
+def _pointer(parts: Any) -> str:
+    return "".join(f"/{p}" for p in parts)
+
+
+def _read(path: Path) -> Any:
+    try:
+        raw = path.read_bytes()
+    except FileNotFoundError:
+        raise ConfigError([Problem(str(path), "", "file not found")]) from None
+    except OSError as exc:
+        raise ConfigError([Problem(str(path), "", f"cannot read: {exc.strerror}")]) from None
+    if not raw.strip():
+        raise ConfigError([Problem(str(path), "", "empty file", expected="a YAML schedule")])
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError:
+        raise ConfigError(
+            [Problem(str(path), "", "not a text file (invalid UTF-8)", expected="a YAML schedule")]
+        ) from None
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        problem = getattr(exc, "problem", None) or str(exc)
+        raise ConfigError([Problem(str(path), "", f"invalid YAML{where}: {problem}")]) from None
+
+
+def _schema_problems(path: Path, data: Any) -> list[Problem]:
+    validator = jsonschema.Draft202012Validator(_schema())
+    problems = []
+    for error in sorted(validator.iter_errors(data), key=lambda e: list(e.absolute_path)):
+        pointer = _pointer(error.absolute_path)
+        suggestion = ""
+        if error.validator == "additionalProperties" and isinstance(error.instance, dict):
+            allowed = list(error.schema.get("properties", {}))
+            extra = [k for k in error.instance if k not in allowed]
+            if extra:
+                pointer = f"{pointer}/{extra[0]}"
+                close = difflib.get_close_matches(str(extra[0]), allowed, n=1)
+                suggestion = f'"{close[0]}"' if close else ""
+                problems.append(
+                    Problem(
+                        str(path),
+                        pointer,
+                        "unknown key",
+                        expected=", ".join(allowed),
+                        suggestion=suggestion,
+                    )
+                )
+                continue
+        problems.append(Problem(str(path), pointer, error.message))
+    return problems
+
+
+def load_schedule(path: str | Path) -> Schedule:
+    """Validate and load a schedule file; raises ConfigError listing every problem."""
+    path = Path(path)
+    data = _read(path)
+    problems = _schema_problems(path, data)
+    if problems:
+        raise ConfigError(problems)
+    base = path.resolve().parent
+    teams = tuple(
+        ScheduledTeam(
+            name=t["name"],
+            team_id=int(t["id"]),
+            config=(base / t["config"]).resolve(),
+            credentials=(base / t["credentials"]).resolve() if t.get("credentials") else None,
+        )
+        for t in data["teams"]
+    )
+    matches = [_match(m) for m in data.get("matches", [])]
+    fixtures = data.get("fixtures", {})
+    if "round_robin" in fixtures:
+        matches += round_robin_fixtures(fixtures["round_robin"])
+    if "knockout" in fixtures:
+        matches += knockout_fixtures(fixtures["knockout"])
+    output_dir = (base / data.get("output_dir", "tournament")).resolve()
+    schedule = Schedule(
+        source=path.resolve(),
+        name=data["name"],
+        start=data.get("start"),
+        output_dir=output_dir,
+        log_store=(base / data["log_store"]).resolve()
+        if "log_store" in data
+        else output_dir / "log-store",
+        public_logs=(base / data["public_logs"]).resolve() if "public_logs" in data else None,
+        simulator_slots=int(data.get("simulator_slots", 1)),
+        timing=ScheduleTiming(**{k: float(v) for k, v in data.get("timing", {}).items()}),
+        game_defaults=dict(data.get("game_defaults", {})),
+        teams=teams,
+        matches=tuple(matches),
+    )
+    problems = _cross_problems(path, schedule, data)
+    if problems:
+        raise ConfigError(problems)
+    return schedule
+
+
+def _slot(value: Any) -> Slot:
+    if isinstance(value, str):
+        return Slot(team=value)
+    return Slot(winner_of=value.get("winner_of"), loser_of=value.get("loser_of"))
+
+
+def _match(m: dict[str, Any]) -> ScheduledMatch:
+    return ScheduledMatch(
+        id=m["id"],
+        red=_slot(m["red"]),
+        blue=_slot(m["blue"]),
+        field_class=m.get("class", "KID"),
+        kind=m.get("kind", "round_robin"),
+        stream_start=m["stream_start"],
+        stream_length_s=float(m.get("stream_length_s", 1800.0)),
+    )
+
+
+def _stream_time(first: str, index: int, interval_s: float) -> str:
+    """The i-th stream start after ``first`` (an offset or an ISO time), in the same style."""
+    offset = _OFFSET.match(first)
+    if offset:
+        seconds = float(offset.group(1)) * _UNIT_S[offset.group(2)] + index * interval_s
+        return f"+{seconds:g}s"
+    start = datetime.fromisoformat(first)
+    return (start + timedelta(seconds=index * interval_s)).isoformat()
+
+
+def round_robin_fixtures(spec: dict[str, Any]) -> list[ScheduledMatch]:
+    """Every pair once, in rounds (circle method), one stream after another."""
+    teams: list[str | None] = list(spec["teams"])
+    if len(teams) % 2:
+        teams.append(None)  # bye
+    n = len(teams)
+    pairs: list[tuple[str, str]] = []
+    for rnd in range(n - 1):
+        for i in range(n // 2):
+            a, b = teams[i], teams[n - 1 - i]
+            if a is not None and b is not None:
+                pairs.append((a, b) if rnd % 2 == 0 else (b, a))
+        teams = [teams[0], teams[-1], *teams[1:-1]]
+    interval = float(spec.get("interval_s", 3600.0))
+    return [
+        ScheduledMatch(
+            id=f"rr-{k + 1}",
+            red=Slot(team=red),
+            blue=Slot(team=blue),
+            field_class=spec.get("class", "KID"),
+            kind="round_robin",
+            stream_start=_stream_time(spec["first_stream"], k, interval),
+            stream_length_s=float(spec.get("stream_length_s", 1800.0)),
+        )
+        for k, (red, blue) in enumerate(pairs)
+    ]
+
+
+def knockout_fixtures(spec: dict[str, Any]) -> list[ScheduledMatch]:
+    """A single-elimination bracket: seeds paired in order, winners advance to the next round."""
+    seeds = list(spec["seeds"])
+    interval = float(spec.get("interval_s", 3600.0))
+    matches: list[ScheduledMatch] = []
+    current: list[Slot] = [Slot(team=s) for s in seeds]
+    rnd = 1
+    while len(current) > 1:
+        nxt: list[Slot] = []
+        for i in range(0, len(current), 2):
+            match_id = f"ko-r{rnd}-{i // 2 + 1}"
+            matches.append(
+                ScheduledMatch(
+                    id=match_id,
+                    red=current[i],
+                    blue=current[i + 1],
+                    field_class=spec.get("class", "KID"),
+                    kind="knockout",
+                    stream_start=_stream_time(spec["first_stream"], len(matches), interval),
+                    stream_length_s=float(spec.get("stream_length_s", 1800.0)),
+                )
+            )
+            nxt.append(Slot(winner_of=match_id))
+        current = nxt
+        rnd += 1
+    return matches
+
+
+def _cross_problems(path: Path, schedule: Schedule, data: dict[str, Any]) -> list[Problem]:
+    file = str(path)
+    problems: list[Problem] = []
+    names = [t.name for t in schedule.teams]
+    for i, name in enumerate(names):
+        if names.index(name) != i:
+            problems.append(Problem(file, f"/teams/{i}/name", f"team {name!r} listed twice"))
+    ids = [t.team_id for t in schedule.teams]
+    for i, team_id in enumerate(ids):
+        if ids.index(team_id) != i:
+            problems.append(Problem(file, f"/teams/{i}/id", f"team id {team_id} used twice"))
+    for i, team in enumerate(schedule.teams):
+        if not team.config.is_file():
+            problems.append(Problem(file, f"/teams/{i}/config", f"file not found: {team.config}"))
+        if team.credentials is not None and not team.credentials.is_file():
+            problems.append(
+                Problem(file, f"/teams/{i}/credentials", f"file not found: {team.credentials}")
+            )
+    if "knockout" in data.get("fixtures", {}):
+        n = len(data["fixtures"]["knockout"]["seeds"])
+        if n & (n - 1):
+            problems.append(
+                Problem(
+                    file,
+                    "/fixtures/knockout/seeds",
+                    f"{n} teams",
+                    expected="a power of two (2, 4, 8, ...)",
+                )
+            )
+    for key, field_name in (("round_robin", "teams"), ("knockout", "seeds")):
+        listed = data.get("fixtures", {}).get(key, {}).get(field_name, [])
+        for j, name in enumerate(listed):
+            if name not in names:
+                close = difflib.get_close_matches(name, names, n=1)
+                problems.append(
+                    Problem(
+                        file,
+                        f"/fixtures/{key}/{field_name}/{j}",
+                        f"unknown team {name!r}",
+                        expected="a name from /teams",
+                        suggestion=f'"{close[0]}"' if close else "",
+                    )
+                )
+    ids_seen: list[str] = []
+    reference = datetime(2000, 1, 1, tzinfo=UTC)
+    for i, match in enumerate(schedule.matches):
+        pointer = f"/matches/{i}" if i < len(data.get("matches", [])) else f"(fixture {match.id})"
+        if match.id in ids_seen:
+            problems.append(Problem(file, f"{pointer}/id", f"match id {match.id!r} used twice"))
+        for color, slot in (("red", match.red), ("blue", match.blue)):
+            if slot.team is not None and slot.team not in names:
+                close = difflib.get_close_matches(slot.team, names, n=1)
+                problems.append(
+                    Problem(
+                        file,
+                        f"{pointer}/{color}",
+                        f"unknown team {slot.team!r}",
+                        expected="a name from /teams",
+                        suggestion=f'"{close[0]}"' if close else "",
+                    )
+                )
+            ref = slot.winner_of or slot.loser_of
+            if ref is not None and ref not in ids_seen:
+                problems.append(
+                    Problem(
+                        file,
+                        f"{pointer}/{color}",
+                        f"refers to match {ref!r}, which is not listed before it",
+                    )
+                )
+        if match.red.team is not None and match.red.team == match.blue.team:
+            problems.append(Problem(file, pointer, f"team {match.red.team!r} plays itself"))
+        try:
+            resolve_time(match.stream_start, reference)
+        except ValueError as exc:
+            problems.append(
+                Problem(
+                    file,
+                    f"{pointer}/stream_start",
+                    str(exc),
+                    expected="ISO 8601 with a time zone or an offset like +90s",
+                )
+            )
+        ids_seen.append(match.id)
+    return problems

@@ -1,0 +1,216 @@
+"""team_config.json: schema, per-file rules, and the TeamConfig it becomes."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from orchestrator.config.model import (
+    DEFAULT_MODEL,
+    MAX_PLAYERS,
+    EcrAuth,
+    FieldClass,
+    PlayerConfig,
+    RegistryAuth,
+    StartingPose,
+    TeamConfig,
+)
+from orchestrator.config.problems import Collector, pointer
+from orchestrator.config.schema import validate
+
+POSE_KEYS = {
+    "halfTimeStartingPose": "half_time_pose",
+    "reentryStartingPose": "reentry_pose",
+    "shootoutStartingPose": "shootout_pose",
+    "goalKeeperStartingPose": "goalkeeper_pose",
+}
+
+
+@dataclass(frozen=True, slots=True)
+class FieldBox:
+    """The few field numbers the pose rules need (rule book, KidSize / AdultSize)."""
+
+    half_length_m: float
+    half_width_m: float
+    border_m: float
+    penalty_area_length_m: float
+    penalty_area_width_m: float
+
+
+FIELDS: dict[str, FieldBox] = {
+    "KID": FieldBox(4.5, 3.0, 1.0, 2.0, 5.0),
+    "ADULT": FieldBox(7.0, 4.5, 1.0, 3.0, 6.0),
+}
+
+
+def build_team(
+    document: Any,
+    where: Collector,
+    *,
+    source: Path,
+    field_class: FieldClass | None,
+    images_required: bool,
+) -> TeamConfig | None:
+    """Validate one team document; the TeamConfig when it has no error (problems in ``where``)."""
+    if not validate("team", document, where):
+        return None
+    before = len(where.errors)
+    numbers = _check_numbers(document["players"], where, field_class)
+    players = []
+    for number in numbers:
+        raw = document["players"][str(number)]
+        poses = {attr: _pose(raw[key]) for key, attr in POSE_KEYS.items()}
+        for key in POSE_KEYS:
+            _check_pose(raw[key], pointer("players", str(number), key), key, where, field_class)
+        players.append(
+            PlayerConfig(
+                number=number,
+                model=raw.get("model", DEFAULT_MODEL[field_class or "KID"]),
+                proto=raw.get("proto"),
+                image_repository=raw.get("image", document.get("image")),
+                docker_tag=raw.get("dockerTag"),
+                docker_cmd=raw.get("dockerCmd"),
+                **poses,
+            )
+        )
+    if not numbers:
+        where.warn(
+            "/players", "the team has no players: it plays without robots (like HLVS Invisibles)"
+        )
+    if images_required:
+        for player in players:
+            _check_image(player, where)
+    elif players and any(p.image_repository is None or p.docker_tag is None for p in players):
+        where.warn(
+            "/image",
+            "not every player names an image (image + dockerTag): needed to play a match",
+            expected='"image" at the top level or in each player, and "dockerTag"',
+        )
+    if len(where.errors) > before:
+        return None
+    return TeamConfig(
+        source=source,
+        name=document["name"],
+        players=tuple(players),
+        image=document.get("image"),
+        registry_auth=_registry_auth(document.get("registry_auth")),
+    )
+
+
+def _check_numbers(
+    players: dict[str, Any], where: Collector, field_class: FieldClass | None
+) -> list[int]:
+    numbers = sorted(int(key) for key in players)
+    limit = MAX_PLAYERS[field_class] if field_class else max(MAX_PLAYERS.values())
+    for index, number in enumerate(numbers, start=1):
+        if number != index:
+            where.error(
+                pointer("players", str(number)),
+                f'player "{number}" without player "{index}"',
+                expected=f'players numbered "1".."{len(numbers)}" consecutively',
+            )
+            return []
+    if len(numbers) > limit:
+        klass = f"{field_class} class" if field_class else "any class"
+        where.error(
+            pointer("players", str(numbers[limit])),
+            f"{len(numbers)} players: too many for {klass}",
+            expected=f"at most {limit} players",
+        )
+        return []
+    return numbers
+
+
+def _pose(raw: dict[str, Any]) -> StartingPose:
+    t = raw["translation"]
+    r = raw["rotation"]
+    return StartingPose(
+        translation=(float(t[0]), float(t[1]), float(t[2])),
+        rotation=(float(r[0]), float(r[1]), float(r[2]), float(r[3])),
+    )
+
+
+def _check_pose(
+    raw: dict[str, Any], at: str, key: str, where: Collector, field_class: FieldClass | None
+) -> None:
+    x, y, _ = (float(v) for v in raw["translation"])
+    ax, ay, az, angle = (float(v) for v in raw["rotation"])
+    norm = math.sqrt(ax * ax + ay * ay + az * az)
+    if not all(math.isfinite(v) for v in (x, y, ax, ay, az, angle)):
+        where.error(at, "not a finite number", expected="finite numbers")
+        return
+    if norm == 0.0 and angle != 0.0:
+        where.error(at + "/rotation", "rotation axis is zero", expected="a non-zero axis")
+    elif norm > 0.0 and math.hypot(ax, ay) > 1e-3 * norm and abs(angle) > 1e-6:
+        where.warn(
+            at + "/rotation",
+            "rotation axis is not vertical: only the heading is used",
+            expected="an axis [0, 0, +-1]",
+        )
+    if key == "halfTimeStartingPose" and x >= 0.0:
+        where.error(
+            at + "/translation/0",
+            f"x = {x:g} is not on the team's own half",
+            expected="x < 0 (poses are written as if the team played on the left half)",
+        )
+    if field_class is None:
+        if key == "goalKeeperStartingPose" and x >= 0.0:
+            where.error(
+                at + "/translation/0",
+                f"x = {x:g}: the goalkeeper is not near the own goal",
+                expected="x < 0, near the own goal line",
+            )
+        return
+    box = FIELDS[field_class]
+    x_max, y_max = box.half_length_m + box.border_m, box.half_width_m + box.border_m
+    if abs(x) > x_max or abs(y) > y_max:
+        where.error(
+            at + "/translation",
+            f"({x:g}, {y:g}) is off the turf of the {field_class} field",
+            expected=f"|x| <= {x_max:g} and |y| <= {y_max:g}",
+        )
+    elif key == "goalKeeperStartingPose":
+        x_limit = -(box.half_length_m - box.penalty_area_length_m)
+        y_limit = box.penalty_area_width_m / 2
+        if x > x_limit or abs(y) > y_limit:
+            where.error(
+                at + "/translation",
+                f"({x:g}, {y:g}): the goalkeeper is not near the own goal",
+                expected=f"inside the own penalty area: x <= {x_limit:g} and |y| <= {y_limit:g}",
+            )
+
+
+def _check_image(player: PlayerConfig, where: Collector) -> None:
+    at = pointer("players", str(player.number))
+    if player.image_repository is None:
+        where.error(
+            at + "/image",
+            "no image named for this player",
+            expected='"image" at the top level or in the player, and "dockerTag"',
+        )
+    elif player.docker_tag is None:
+        where.error(
+            at + "/dockerTag", "no dockerTag for this player", expected="a tag, e.g. latest"
+        )
+
+
+def _registry_auth(raw: dict[str, Any] | None) -> RegistryAuth | None:
+    if raw is None:
+        return None
+    ecr = raw.get("ecr")
+    return RegistryAuth(
+        username=raw.get("username"),
+        password=raw.get("password"),
+        password_env=raw.get("password_env"),
+        ecr=(
+            EcrAuth(
+                region=ecr["region"],
+                access_id=ecr.get("access_id"),
+                access_secret=ecr.get("access_secret"),
+            )
+            if ecr is not None
+            else None
+        ),
+    )
