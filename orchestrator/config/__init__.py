@@ -30,6 +30,7 @@ from orchestrator.config.model import (
     TeamRef,
     Timing,
 )
+from orchestrator.config.spec import resolve_sides, to_match_spec
 
 __all__ = [
     "COLORS",
@@ -57,4 +58,6 @@ __all__ = [
     "default_seed",
     "load_game",
     "load_team",
+    "resolve_sides",
+    "to_match_spec",
 ]

@@ -18,6 +18,8 @@ from orchestrator.config.schema import validate
 
 LEGACY_RTF = ("minimum_real_time_factor", "real_time_factor")
 BASIC_TIME_STEP_S = 0.008
+FAST_WAIT_BEFORE_FIRST_READY_S = 5.0
+FAST_HALF_TIME_BREAK_S = 2.0
 _GC_DURATION_OPTIONS = {
     "--halftimeduration": "half_duration_s",
     "-d": "half_duration_s",
@@ -48,7 +50,7 @@ def build_game(document: Any, where: Collector, *, source: Path) -> GameConfig |
     before = len(where.errors)
     base = source.parent
     rtf = _real_time_factor(document, where)
-    timing = _timing(document, where)
+    timing = _timing(document, where, fast=rtf is not None and rtf <= 0)
     _check_physics_dt(document, where)
     _check_record(document, where)
     _check_team_ids(document, where)
@@ -115,8 +117,16 @@ def _real_time_factor(document: dict[str, Any], where: Collector) -> float | Non
     return None
 
 
-def _timing(document: dict[str, Any], where: Collector) -> Timing:
+def _timing(document: dict[str, Any], where: Collector, *, fast: bool) -> Timing:
+    """Timing from ``timing`` and the GameController arguments.
+
+    As in HLVS, a game run as fast as possible (maximum_real_time_factor <= 0) waits only 5 s
+    before the first READY and 2 s at half time unless ``timing`` says otherwise.
+    """
     written: dict[str, Any] = dict(document.get("timing", {}))
+    if fast:
+        written.setdefault("wait_before_first_ready_s", FAST_WAIT_BEFORE_FIRST_READY_S)
+        written.setdefault("half_time_break_s", FAST_HALF_TIME_BREAK_S)
     from_gc: dict[str, float] = {}
     args = list(document.get("game_controller_extra_args", ()))
     index = 0
