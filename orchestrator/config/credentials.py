@@ -1,8 +1,8 @@
 """credentials.json: where a team's (or the public) match logs are delivered.
 
 The league's format is ``{"type": "sftp" | "s3", "credentials": {...}}``. The file is checked
-against ``configs/schemas/credentials.schema.json`` (shape), then field by field (a numeric port,
-an existing key file, a well-formed pinned host key). Every problem found is raised at once in
+against ``orchestrator/config/schemas/credentials.schema.json`` (shape), then field by field (a
+numeric port, an existing key file, a well-formed pinned host key). Every problem found is raised at once in
 one :class:`~orchestrator.errors.ConfigError`. Secrets live in fields with ``repr=False`` and are
 never printed or logged.
 """
@@ -18,6 +18,7 @@ import stat
 import struct
 from dataclasses import dataclass, field
 from functools import cache
+from importlib import resources
 from pathlib import Path
 from typing import Any, Literal
 
@@ -35,9 +36,7 @@ __all__ = [
 
 log = logging.getLogger(__name__)
 
-SCHEMA_PATH = (
-    Path(__file__).resolve().parents[2] / "configs" / "schemas" / ("credentials.schema.json")
-)
+SCHEMA_FILE = "credentials.schema.json"  # in orchestrator/config/schemas/
 DEFAULT_SFTP_PORT = 22
 DEFAULT_S3_REGION = "us-east-1"
 HOST_KEY_TYPES = (
@@ -98,8 +97,12 @@ Credentials = SftpCredentials | S3Credentials
 
 @cache
 def _schema() -> dict[str, Any]:
-    with SCHEMA_PATH.open(encoding="utf-8") as handle:
-        schema: dict[str, Any] = json.load(handle)
+    text = (
+        resources.files("orchestrator.config.schemas")
+        .joinpath(SCHEMA_FILE)
+        .read_text(encoding="utf-8")
+    )
+    schema: dict[str, Any] = json.loads(text)
     return schema
 
 

@@ -1,0 +1,53 @@
+"""Delivery of match logs to the teams' (and the public) SFTP or S3 targets.
+
+``enqueue_match_logs`` turns a finished match's logs into pending sets in a local store,
+``deliver_pending`` uploads them (files, then ``MANIFEST.json`` last), ``pending_status`` lists
+what is waiting. Uploaders (``sftp``, ``s3``) sit behind the :class:`Uploader` protocol;
+:class:`FakeUploader` stands in for them in unit tests.
+"""
+
+from __future__ import annotations
+
+from orchestrator.delivery.deliver import (
+    KEEP_UNDELIVERED,
+    MANIFEST_NAME,
+    PUBLIC_TEAM,
+    DeliveryOutcome,
+    Opener,
+    RetryPolicy,
+    deliver_pending,
+    deliver_set,
+    enqueue_match_logs,
+    pending_status,
+)
+from orchestrator.delivery.store import FileEntry, PendingSet, SetError
+from orchestrator.delivery.targets import open_uploader
+from orchestrator.delivery.uploader import (
+    ERROR_KINDS,
+    TRANSIENT_KINDS,
+    FakeUploader,
+    Uploader,
+    is_transient,
+)
+
+__all__ = [
+    "deliver_pending",
+    "deliver_set",
+    "DeliveryOutcome",
+    "enqueue_match_logs",
+    "ERROR_KINDS",
+    "FakeUploader",
+    "FileEntry",
+    "is_transient",
+    "KEEP_UNDELIVERED",
+    "MANIFEST_NAME",
+    "open_uploader",
+    "Opener",
+    "pending_status",
+    "PendingSet",
+    "PUBLIC_TEAM",
+    "RetryPolicy",
+    "SetError",
+    "TRANSIENT_KINDS",
+    "Uploader",
+]

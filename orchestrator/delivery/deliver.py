@@ -1,0 +1,346 @@
+"""Delivering log sets: enqueue a match's logs, upload pending sets, report their status.
+
+A set is uploaded under ``<match_id>/<team>/`` of its target: every file not already there with
+the same size, then ``MANIFEST.json`` (names, sizes, SHA-256) last, so a manifest on the server
+means the set is complete. Transient failures (connection lost, timeouts, 5xx, server not
+answering) are retried with exponential backoff, reconnecting each time; anything else fails at
+once. A failed set stays in the store with its typed cause; a delivered set is deleted. Of the
+undelivered sets of a team only the :data:`KEEP_UNDELIVERED` newest are kept.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import logging
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, TypeVar
+
+from orchestrator.config.credentials import Credentials, load_credentials
+from orchestrator.delivery import store as st
+from orchestrator.delivery.targets import open_uploader
+from orchestrator.delivery.uploader import Uploader, is_transient
+from orchestrator.errors import ConfigError, DeliveryError
+
+__all__ = [
+    "KEEP_UNDELIVERED",
+    "MANIFEST_NAME",
+    "PUBLIC_TEAM",
+    "DeliveryOutcome",
+    "Opener",
+    "RetryPolicy",
+    "deliver_pending",
+    "deliver_set",
+    "enqueue_match_logs",
+    "pending_status",
+]
+
+log = logging.getLogger(__name__)
+
+KEEP_UNDELIVERED = 3
+MANIFEST_NAME = "MANIFEST.json"
+PUBLIC_TEAM = "public"
+TEAMS_FOLDER = "teams"
+
+Opener = Callable[[Credentials, str], Uploader]  # (credentials, team) -> open uploader
+T = TypeVar("T")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RetryPolicy:
+    """Exponential backoff for transient errors: ``attempts`` tries per operation."""
+
+    attempts: int = 4
+    initial_delay_s: float = 1.0
+    factor: float = 2.0
+    max_delay_s: float = 30.0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class DeliveryOutcome:
+    set_id: str
+    match_id: str
+    team: str
+    target: str
+    delivered: bool
+    uploaded_files: int = 0
+    skipped_files: int = 0
+    uploaded_bytes: int = 0
+    seconds: float = 0.0
+    error: DeliveryError | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        data = {k: getattr(self, k) for k in self.__dataclass_fields__ if k != "error"}
+        data["error_kind"] = self.error.kind if self.error else None
+        data["error_reason"] = self.error.reason if self.error else None
+        return data
+
+
+def enqueue_match_logs(
+    match_dir: Path,
+    *,
+    match_id: str,
+    teams: Mapping[str, tuple[str, Path | None]],
+    public_target: Path | None,
+    store: Path,
+    move_team_logs: bool = True,
+) -> list[st.PendingSet]:
+    """Turn a finished match's logs into pending sets.
+
+    Args:
+        match_dir: the match output; ``teams/<color>/`` holds each team's logs.
+        teams: color -> (team name, credentials.json of the team or None).
+        public_target: the operator's credentials.json for the public logs (everything in
+            ``match_dir`` outside ``teams/``), or None to keep them local only.
+        move_team_logs: move team files into the store (they leave ``match_dir``) instead of
+            linking them.
+    """
+    created = []
+    with st.locked(store):
+        for color, (team, credentials) in sorted(teams.items()):
+            folder = match_dir / TEAMS_FOLDER / color
+            if not folder.is_dir():
+                log.warning(
+                    "match %s: no logs of team %s (%s) in %s", match_id, team, color, folder
+                )
+            sources = _files_under(folder, exclude=None)
+            created.append(
+                st.create_set(
+                    store,
+                    match_id=match_id,
+                    team=team,
+                    kind="team",
+                    credentials=credentials,
+                    sources=sources,
+                    move=move_team_logs,
+                )
+            )
+            log.info("match %s: queued %d log files of team %s", match_id, len(sources), team)
+            _prune(store, team)
+        if public_target is not None:
+            sources = _files_under(match_dir, exclude=match_dir / TEAMS_FOLDER)
+            created.append(
+                st.create_set(
+                    store,
+                    match_id=match_id,
+                    team=PUBLIC_TEAM,
+                    kind="public",
+                    credentials=public_target,
+                    sources=sources,
+                    move=False,
+                )
+            )
+            log.info("match %s: queued %d public log files", match_id, len(sources))
+    return created
+
+
+def deliver_pending(
+    store: Path,
+    *,
+    team: str | None = None,
+    retry: RetryPolicy | None = None,
+    opener: Opener | None = None,
+    sleep: Callable[[float], None] = time.sleep,
+) -> list[DeliveryOutcome]:
+    """Try every pending set (of ``team`` only, if given), oldest first."""
+    outcomes = []
+    with st.locked(store):
+        for pending in st.list_sets(store):
+            if team is None or pending.team == team:
+                outcomes.append(
+                    deliver_set(pending, retry=retry or RetryPolicy(), opener=opener, sleep=sleep)
+                )
+    return outcomes
+
+
+def pending_status(store: Path) -> list[st.PendingSet]:
+    """The sets waiting in the store, oldest first, with attempts and the last error."""
+    return st.list_sets(store)
+
+
+def deliver_set(
+    pending: st.PendingSet,
+    *,
+    retry: RetryPolicy,
+    opener: Opener | None = None,
+    sleep: Callable[[float], None] = time.sleep,
+) -> DeliveryOutcome:
+    """Upload one set; on success delete it locally, on failure record the cause in it."""
+    started = time.monotonic()
+    target = str(pending.credentials) if pending.credentials else "(no credentials)"
+    session: _Session | None = None
+    uploaded = skipped = uploaded_bytes = 0
+    try:
+        credentials = _credentials_of(pending)
+        target = credentials.describe()
+        session = _Session(credentials, pending.team, opener or open_uploader, retry, sleep)
+        base = f"{pending.match_id}/{pending.team}"
+        for entry in pending.files:
+            remote = f"{base}/{entry.path}"
+            local = pending.files_dir / entry.path
+            if session.run(functools.partial(_exists, remote=remote, size=entry.size)):
+                skipped += 1
+                continue
+            session.run(functools.partial(_upload, local=local, remote=remote))
+            uploaded += 1
+            uploaded_bytes += entry.size
+        manifest = _write_manifest(pending)
+        session.run(functools.partial(_upload, local=manifest, remote=f"{base}/{MANIFEST_NAME}"))
+    except DeliveryError as exc:
+        error = DeliveryError(team=pending.team, target=target, kind=exc.kind, reason=exc.reason)
+        st.save_set(
+            pending,
+            attempts=pending.attempts + 1,
+            last_error=st.SetError(error.kind, error.reason, time.time()),
+        )
+        log.warning("match %s: %s", pending.match_id, error)
+        return DeliveryOutcome(
+            set_id=pending.set_id,
+            match_id=pending.match_id,
+            team=pending.team,
+            target=target,
+            delivered=False,
+            uploaded_files=uploaded,
+            skipped_files=skipped,
+            uploaded_bytes=uploaded_bytes,
+            seconds=time.monotonic() - started,
+            error=error,
+        )
+    finally:
+        if session is not None:
+            session.close()
+    st.remove_set(pending)
+    seconds = time.monotonic() - started
+    log.info(
+        "match %s: delivered the logs of %s to %s (%d files uploaded, %d already there, "
+        "%.1f MB in %.1f s)",
+        pending.match_id,
+        pending.team,
+        target,
+        uploaded,
+        skipped,
+        uploaded_bytes / 1e6,
+        seconds,
+    )
+    return DeliveryOutcome(
+        set_id=pending.set_id,
+        match_id=pending.match_id,
+        team=pending.team,
+        target=target,
+        delivered=True,
+        uploaded_files=uploaded,
+        skipped_files=skipped,
+        uploaded_bytes=uploaded_bytes,
+        seconds=seconds,
+    )
+
+
+class _Session:
+    """An uploader that reconnects and retries transient failures with backoff."""
+
+    def __init__(
+        self,
+        credentials: Credentials,
+        team: str,
+        opener: Opener,
+        retry: RetryPolicy,
+        sleep: Callable[[float], None],
+    ) -> None:
+        self._credentials = credentials
+        self._team = team
+        self._opener = opener
+        self._retry = retry
+        self._sleep = sleep
+        self._uploader: Uploader | None = None
+
+    def run(self, action: Callable[[Uploader], T]) -> T:
+        delay = self._retry.initial_delay_s
+        for attempt in range(1, self._retry.attempts + 1):
+            try:
+                if self._uploader is None:
+                    self._uploader = self._opener(self._credentials, self._team)
+                return action(self._uploader)
+            except DeliveryError as exc:
+                if not is_transient(exc) or attempt >= self._retry.attempts:
+                    raise
+                log.warning(
+                    "%s (attempt %d of %d, retrying in %.1f s)",
+                    exc,
+                    attempt,
+                    self._retry.attempts,
+                    delay,
+                )
+                self.close()
+                self._sleep(delay)
+                delay = min(delay * self._retry.factor, self._retry.max_delay_s)
+        raise AssertionError("unreachable: the loop returns or raises")
+
+    def close(self) -> None:
+        if self._uploader is not None:
+            uploader, self._uploader = self._uploader, None
+            uploader.close()
+
+
+def _exists(uploader: Uploader, *, remote: str, size: int) -> bool:
+    return uploader.exists(remote, size)
+
+
+def _upload(uploader: Uploader, *, local: Path, remote: str) -> None:
+    uploader.upload(local, remote)
+
+
+def _credentials_of(pending: st.PendingSet) -> Credentials:
+    if pending.credentials is None:
+        raise DeliveryError(
+            team=pending.team,
+            target="(none)",
+            kind="config",
+            reason="the team gave no credentials.json",
+        )
+    try:
+        return load_credentials(pending.credentials)
+    except ConfigError as exc:
+        raise DeliveryError(
+            team=pending.team, target=str(pending.credentials), kind="config", reason=str(exc)
+        ) from exc
+
+
+def _write_manifest(pending: st.PendingSet) -> Path:
+    manifest = {
+        "match_id": pending.match_id,
+        "team": pending.team,
+        "files": [{"path": e.path, "size": e.size, "sha256": e.sha256} for e in pending.files],
+    }
+    path = pending.root / MANIFEST_NAME
+    path.write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
+    return path
+
+
+def _files_under(folder: Path, *, exclude: Path | None) -> list[tuple[Path, str]]:
+    if not folder.is_dir():
+        return []
+    found = []
+    for path in sorted(folder.rglob("*")):
+        if exclude is not None and path.is_relative_to(exclude):
+            continue
+        if path.is_file() and not path.is_symlink():
+            found.append((path, path.relative_to(folder).as_posix()))
+    return found
+
+
+def _prune(store: Path, team: str) -> None:
+    sets = [s for s in st.list_sets(store) if s.team == team and s.kind == "team"]
+    for old in sets[: max(0, len(sets) - KEEP_UNDELIVERED)]:
+        st.remove_set(old)
+        log.warning(
+            "match %s: deleted the undelivered logs of %s (%d files, %.1f MB): more "
+            "than %d sets were waiting",
+            old.match_id,
+            team,
+            len(old.files),
+            old.total_bytes / 1e6,
+            KEEP_UNDELIVERED,
+        )
