@@ -1,10 +1,10 @@
 """credentials.json: where a team's (or the public) match logs are delivered.
 
 The league's format is ``{"type": "sftp" | "s3", "credentials": {...}}``. The file is checked
-against ``orchestrator/config/schemas/credentials.schema.json`` (shape), then field by field (a
-numeric port, an existing key file, a well-formed pinned host key). Every problem found is raised at once in
-one :class:`~orchestrator.errors.ConfigError`. Secrets live in fields with ``repr=False`` and are
-never printed or logged.
+against ``orchestrator/config/schemas/credentials.schema.json`` (shape), then field by field
+(a numeric port, an existing key file, a well-formed pinned host key). Every problem found is
+raised at once in one :class:`~orchestrator.errors.ConfigError`. Secrets live in fields with
+``repr=False`` and are never printed or logged.
 """
 
 from __future__ import annotations
