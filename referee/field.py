@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from enum import Enum
 
 
-class FieldClass(str, Enum):
+class FieldClass(str, Enum):  # noqa: UP042 (str() stays the qualified name)
     KID = "kid"
     ADULT = "adult"
 
@@ -117,5 +117,6 @@ ADULT_FIELD = FieldGeometry(
 
 def field_for(field_class: FieldClass | str) -> FieldGeometry:
     """The geometry of ``"kid"`` or ``"adult"`` (case-insensitive, ``"KID"`` as in game.json)."""
-    value = FieldClass(str(field_class.value if isinstance(field_class, FieldClass) else field_class).lower())
+    raw = field_class.value if isinstance(field_class, FieldClass) else field_class
+    value = FieldClass(str(raw).lower())
     return KID_FIELD if value is FieldClass.KID else ADULT_FIELD

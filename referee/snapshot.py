@@ -14,7 +14,7 @@ Vec3 = tuple[float, float, float]
 Vec2 = tuple[float, float]
 
 
-class TeamColor(str, Enum):
+class TeamColor(str, Enum):  # noqa: UP042
     RED = "red"
     BLUE = "blue"
 
@@ -23,7 +23,7 @@ class TeamColor(str, Enum):
         return TeamColor.BLUE if self is TeamColor.RED else TeamColor.RED
 
 
-class BodyPart(str, Enum):
+class BodyPart(str, Enum):  # noqa: UP042
     """Tags of robot solids, as the HLVS referee's ``[hand]``, ``[foot]``, ``[arm]`` suffixes."""
 
     FOOT = "foot"

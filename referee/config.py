@@ -1,0 +1,124 @@
+"""Referee configuration: everything the referee needs, resolved, as frozen dataclasses.
+
+The simulator runtime maps its ``MatchSpec`` onto :class:`RefereeConfig`. Poses are given as in
+HLVS team files: as if the team played on the left half (x < 0); the referee mirrors them for
+the team on the right.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from enum import StrEnum
+
+from referee.field import FieldClass, FieldGeometry, field_for
+from referee.snapshot import RobotId, TeamColor
+
+
+class GameType(StrEnum):
+    NORMAL = "NORMAL"  # round robin: two halves, draws allowed
+    KNOCKOUT = "KNOCKOUT"  # play-off: overtime 2 x 300 s, then a penalty shoot-out
+    PENALTY = "PENALTY"  # starts with the penalty shoot-out
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Pose:
+    x_m: float
+    y_m: float
+    yaw_rad: float
+
+    def mirrored(self) -> Pose:
+        """The pose for the team playing on the right (x > 0): HLVS ``flip_pose``, a reflection
+        across the centre line (x -> -x, heading -> pi - heading)."""
+        return Pose(x_m=-self.x_m, y_m=self.y_m, yaw_rad=_wrap(math.pi - self.yaw_rad))
+
+
+def _wrap(angle: float) -> float:
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class PlayerConfig:
+    number: int
+    half_time_pose: Pose
+    reentry_pose: Pose
+    shootout_pose: Pose
+    goalkeeper_pose: Pose
+    goalkeeper: bool = False
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TeamConfig:
+    team_id: int  # GameController team number
+    name: str
+    players: tuple[PlayerConfig, ...]
+    robot_addresses: tuple[str, ...] = ()  # robot n at index n-1: RGme target, mirror member
+
+    def player(self, number: int) -> PlayerConfig:
+        for player in self.players:
+            if player.number == number:
+                return player
+        raise KeyError(number)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TimingConfig:
+    """``*_real_s`` are wall-clock waits; everything else is simulated time."""
+
+    half_duration_s: float = 600.0
+    overtime_half_duration_s: float = 300.0
+    ready_duration_s: float = 45.0
+    set_to_play_s: float = 5.0
+    shootout_set_to_play_s: float = 15.0
+    wait_before_first_ready_real_s: float = 120.0
+    half_time_break_real_s: float = 15.0
+    removal_penalty_s: float = 10.0
+    end_of_game_real_s: float = 5.0
+    kickoff_blocked_s: float = 10.0  # ball in play after this or a 5 cm move
+    set_play_phase0_s: float = 5.0  # robots still, ball placed
+    set_play_ready_s: float = 15.0  # phase 1: robots position (penalty kick: twice this)
+    set_play_prepare_s: float = 5.0  # phase 2: robots freeze
+    dropped_ball_s: float = 120.0
+    fallen_s: float = 20.0
+    outside_turf_s: float = 20.0
+    inactive_goalkeeper_s: float = 20.0
+    shootout_kick_s: float = 60.0
+    status_period_real_s: float = 20.0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class NetworkConfig:
+    bind_host: str = "0.0.0.0"
+    gc_data_port: int = 3838
+    gc_return_port: int = 3939
+    mirror_port: int = 3737
+    send_rate_hz: float = 2.0
+    mirror_max_bytes: int = 1024
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RefereeConfig:
+    red: TeamConfig
+    blue: TeamConfig
+    game_type: GameType = GameType.NORMAL
+    field_class: FieldClass = FieldClass.KID
+    side_left: TeamColor = TeamColor.RED  # team on x < 0 in the first half
+    kickoff: TeamColor = TeamColor.RED  # first kick-off (and first shooter in PENALTY games)
+    timing: TimingConfig = field(default_factory=TimingConfig)
+    network: NetworkConfig = field(default_factory=NetworkConfig)
+    match_id: str = "match"
+    seed: int = 0  # coin toss after an undecided extended shoot-out
+
+    @property
+    def field(self) -> FieldGeometry:
+        return field_for(self.field_class)
+
+    def team(self, color: TeamColor) -> TeamConfig:
+        return self.red if color is TeamColor.RED else self.blue
+
+    def robot_ids(self) -> tuple[RobotId, ...]:
+        return tuple(
+            RobotId(color, player.number)
+            for color in (TeamColor.RED, TeamColor.BLUE)
+            for player in self.team(color).players
+        )

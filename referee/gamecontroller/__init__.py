@@ -1,0 +1,27 @@
+"""The GameController: state machine on simulated time and its wire values."""
+
+from __future__ import annotations
+
+from referee.gamecontroller.machine import GameController, RobotInfo, SetPlay, TeamInfo, Tick
+from referee.gamecontroller.packet import game_control_data
+from referee.gamecontroller.states import (
+    DROPBALL_TEAM,
+    Card,
+    GameState,
+    Penalty,
+    SecondaryState,
+)
+
+__all__ = [
+    "DROPBALL_TEAM",
+    "Card",
+    "GameController",
+    "GameState",
+    "Penalty",
+    "RobotInfo",
+    "SecondaryState",
+    "SetPlay",
+    "TeamInfo",
+    "Tick",
+    "game_control_data",
+]

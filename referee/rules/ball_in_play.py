@@ -1,0 +1,34 @@
+"""The ball is in play after a kick-off or a set play once it moved 5 cm or 10 s passed."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from referee.rules.base import BallInPlay, Decision, GameView
+from referee.snapshot import Vec3, WorldSnapshot
+
+MOVE_M = 0.05
+
+
+@dataclass(frozen=True, slots=True)
+class BallInPlayMemory:
+    start_ms: int | None = None  # None: not armed (ball in play or game stopped)
+    origin: Vec3 = (0.0, 0.0, 0.0)
+
+
+def arm(snapshot: WorldSnapshot) -> BallInPlayMemory:
+    return BallInPlayMemory(start_ms=snapshot.sim_time_ms, origin=snapshot.ball.position)
+
+
+def judge(
+    snapshot: WorldSnapshot, game: GameView, memory: BallInPlayMemory
+) -> tuple[list[Decision], BallInPlayMemory]:
+    if memory.start_ms is None or game.ball_in_play or game.set_play is not None:
+        return [], memory
+    x, y, z = snapshot.ball.position
+    ox, oy, oz = memory.origin
+    if ((x - ox) ** 2 + (y - oy) ** 2 + (z - oz) ** 2) ** 0.5 >= MOVE_M:
+        return [BallInPlay("ball moved")], BallInPlayMemory()
+    if snapshot.sim_time_ms - memory.start_ms >= game.timing.kickoff_blocked_s * 1000.0:
+        return [BallInPlay(f"{game.timing.kickoff_blocked_s:g} s elapsed")], BallInPlayMemory()
+    return [], memory

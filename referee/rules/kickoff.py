@@ -1,0 +1,59 @@
+"""Kick-off positions and the kick-off before the ball is in play.
+
+At SET (checked once, when SET begins) every robot must be inside the field, in its own half,
+and robots of the defending team (all robots after a dropped ball) outside the centre circle;
+illegally placed robots are removed (INCAPABLE). Until the ball is in play, a defending robot
+that enters the centre circle or touches the ball is removed too.
+"""
+
+from __future__ import annotations
+
+from referee.gamecontroller.states import Penalty
+from referee.rules.base import Decision, GameView, PenalizeRobot, distance2d
+from referee.snapshot import RobotState, WorldSnapshot
+
+TOLERANCE_M = 0.05  # a line's width: standing on the line counts as inside
+
+
+def _illegal_position(robot: RobotState, game: GameView) -> str | None:
+    field = game.field
+    x, y = robot.position[0], robot.position[1]
+    if abs(x) > field.half_length_m + TOLERANCE_M or abs(y) > field.half_width_m + TOLERANCE_M:
+        return "outside the field at kick-off"
+    if x * game.side_sign(robot.id.team) < -TOLERANCE_M:
+        return "in the opponents' half at kick-off"
+    defending = game.kickoff_team is None or robot.id.team is not game.kickoff_team
+    if defending and distance2d(robot.position, (0.0, 0.0)) < field.centre_circle_radius_m:
+        return "inside the centre circle at the opponents' kick-off"
+    return None
+
+
+def judge_set(snapshot: WorldSnapshot, game: GameView) -> list[Decision]:
+    """Called once when SET begins (kick-off or dropped ball)."""
+    decisions: list[Decision] = []
+    for robot in snapshot.robots:
+        if not game.active(robot):
+            continue
+        reason = _illegal_position(robot, game)
+        if reason is not None:
+            decisions.append(PenalizeRobot(robot.id, Penalty.PICKUP_OR_INCAPABLE, reason))
+    return decisions
+
+
+def judge_before_in_play(snapshot: WorldSnapshot, game: GameView) -> list[Decision]:
+    """PLAYING after a kick-off, until the ball is in play."""
+    if not game.running or game.ball_in_play or game.kickoff_team is None:
+        return []
+    decisions: list[Decision] = []
+    radius = game.field.centre_circle_radius_m
+    for robot in snapshot.robots:
+        if robot.id.team is game.kickoff_team or not game.active(robot):
+            continue
+        if robot.ball_contacts:
+            reason = "touched the ball before it was in play"
+        elif distance2d(robot.position, (0.0, 0.0)) < radius:
+            reason = "entered the centre circle before the ball was in play"
+        else:
+            continue
+        decisions.append(PenalizeRobot(robot.id, Penalty.PICKUP_OR_INCAPABLE, reason))
+    return decisions

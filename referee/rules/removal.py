@@ -1,0 +1,69 @@
+"""Removal of a penalised robot and its re-entry.
+
+A removed robot is placed at its re-entry pose: x on the penalty-mark line of its own half, y at
+the touch line on the side opposite to the ball (the y of its ``reentryStartingPose``, sign
+chosen away from the ball), shifted along the line by the penalty offset when another robot
+stands there. It is made limp (actuators off) until the GameController's penalty time is over,
+then its actuators are re-enabled and it walks back in by itself. A red card removes the robot
+from the world.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+from referee.config import Pose
+from referee.field import FieldGeometry
+from referee.snapshot import (
+    RemoveRobot,
+    RobotId,
+    SetLimp,
+    TeleportRobot,
+    Vec2,
+    WorldCommand,
+)
+
+
+def reentry_pose(
+    *,
+    template: Pose,
+    side_sign: float,
+    ball_y_m: float,
+    occupied: Sequence[Vec2],
+    field: FieldGeometry,
+) -> Pose:
+    """``template`` as in the team file (as if playing left); ``side_sign`` -1 left, +1 right."""
+    y_abs = abs(template.y_m) if template.y_m != 0 else field.half_width_m
+    if ball_y_m > 0:
+        y = -y_abs
+    elif ball_y_m < 0:
+        y = y_abs
+    else:
+        y = math.copysign(y_abs, template.y_m) if template.y_m != 0 else -y_abs
+    yaw = math.pi / 2.0 if y < 0 else -math.pi / 2.0  # facing into the field
+    base_x = side_sign * field.penalty_mark_x_m
+    step = field.penalty_offset_m
+    for k in range(0, 20):
+        offset = (k + 1) // 2 * step * (1 if k % 2 else -1)  # 0, +s, -s, +2s, ...
+        x = base_x + side_sign * offset
+        if abs(x) > field.half_length_m:
+            continue
+        if all(math.hypot(x - ox, y - oy) >= step for ox, oy in occupied):
+            return Pose(x_m=x, y_m=y, yaw_rad=yaw)
+    return Pose(x_m=base_x, y_m=y, yaw_rad=yaw)
+
+
+def removal_commands(robot: RobotId, pose: Pose) -> list[WorldCommand]:
+    return [
+        TeleportRobot(robot=robot, x_m=pose.x_m, y_m=pose.y_m, yaw_rad=pose.yaw_rad),
+        SetLimp(robot=robot, limp=True),
+    ]
+
+
+def return_commands(robot: RobotId) -> list[WorldCommand]:
+    return [SetLimp(robot=robot, limp=False)]
+
+
+def red_card_commands(robot: RobotId) -> list[WorldCommand]:
+    return [RemoveRobot(robot=robot)]
