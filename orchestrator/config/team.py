@@ -75,7 +75,7 @@ def build_team(
                 **poses,
             )
         )
-    if not numbers:
+    if not document["players"]:
         where.warn(
             "/players", "the team has no players: it plays without robots (like HLVS Invisibles)"
         )
