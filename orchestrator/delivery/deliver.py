@@ -13,6 +13,7 @@ from __future__ import annotations
 import functools
 import json
 import logging
+import shutil
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -118,6 +119,8 @@ def enqueue_match_logs(
                     move=move_team_logs,
                 )
             )
+            if move_team_logs and folder.is_dir():
+                shutil.rmtree(folder)  # only empty folders are left
             log.info("match %s: queued %d log files of team %s", match_id, len(sources), team)
             _prune(store, team)
         if public_target is not None:
