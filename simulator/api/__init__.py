@@ -1,0 +1,33 @@
+"""The HLVS robot API: protobuf messages, framing, the per-robot TCP server and its benchmark."""
+
+from __future__ import annotations
+
+from simulator.api.cameras import RenderWorker
+from simulator.api.devices import DeviceWorld, FakeCameraRenderer, FakeDeviceWorld, robot_key
+from simulator.api.endpoints import PlayerEndpoint, endpoints_from_spec
+from simulator.api.framing import MAX_FRAME_BYTES, FrameDecoder, FramingError, encode_frame
+from simulator.api.lockstep import wait_lockstep
+from simulator.api.quota import NetworkQuota
+from simulator.api.server import ApiServer, LockstepSettings, PortUnavailable
+from simulator.api.session import RobotSession, rendering_bandwidth_mb_s
+
+__all__ = [
+    "MAX_FRAME_BYTES",
+    "ApiServer",
+    "DeviceWorld",
+    "FakeCameraRenderer",
+    "FakeDeviceWorld",
+    "FrameDecoder",
+    "FramingError",
+    "LockstepSettings",
+    "NetworkQuota",
+    "PlayerEndpoint",
+    "PortUnavailable",
+    "RenderWorker",
+    "RobotSession",
+    "encode_frame",
+    "endpoints_from_spec",
+    "rendering_bandwidth_mb_s",
+    "robot_key",
+    "wait_lockstep",
+]

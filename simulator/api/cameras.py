@@ -1,0 +1,111 @@
+"""Camera images rendered off the step thread.
+
+The step thread captures the world state of the step a camera image is due for
+(``capture()``, e.g. a copy of MuJoCo's ``qpos``) and hands it with the jobs to one worker
+thread, which owns the OpenGL context (``make_render()`` is called inside the worker; OSMesa and
+EGL contexts are bound to the thread that created them). Physics and the measurements of robots
+without cameras never wait for rendering; the camera robot's measurements wait, in order.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import queue
+import threading
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from referee.snapshot import RobotId
+from simulator.api.session import CameraJob
+
+log = logging.getLogger(__name__)
+
+RenderFn = Callable[[Any, RobotId, int, int], bytes]
+
+
+@dataclass(slots=True)
+class _Batch:
+    state: Any
+    jobs: list[CameraJob]
+
+
+class RenderWorker:
+    """One rendering thread; completed jobs are collected with :meth:`completed`."""
+
+    def __init__(self, *, capture: Callable[[], Any], make_render: Callable[[], RenderFn]) -> None:
+        self._capture = capture
+        self._make_render = make_render
+        self._inbox: queue.Queue[_Batch | None] = queue.Queue()
+        self._done: queue.Queue[tuple[CameraJob, bytes]] = queue.Queue()
+        self._read_fd, self._write_fd = os.pipe()
+        os.set_blocking(self._read_fd, False)
+        os.set_blocking(self._write_fd, False)
+        self._thread: threading.Thread | None = None
+        self.error: BaseException | None = None
+        self.frames = 0
+        self.render_s = 0.0
+
+    @property
+    def wake_fd(self) -> int:
+        """Readable when completed jobs are waiting."""
+        return self._read_fd
+
+    def submit(self, jobs: Sequence[CameraJob]) -> None:
+        if self._thread is None:
+            self._thread = threading.Thread(target=self._run, name="camera-render", daemon=True)
+            self._thread.start()
+        self._inbox.put(_Batch(self._capture(), list(jobs)))
+
+    def completed(self) -> list[tuple[CameraJob, bytes]]:
+        try:
+            os.read(self._read_fd, 4096)
+        except BlockingIOError:
+            pass
+        done: list[tuple[CameraJob, bytes]] = []
+        while True:
+            try:
+                done.append(self._done.get_nowait())
+            except queue.Empty:
+                return done
+
+    def _run(self) -> None:
+        import time
+
+        try:
+            render = self._make_render()
+        except BaseException as exc:  # reported to the step thread through .error
+            log.error("camera renderer could not start: %s", exc)
+            self.error = exc
+            render = None
+        while True:
+            batch = self._inbox.get()
+            if batch is None:
+                return
+            for job in batch.jobs:
+                if render is None:
+                    image = bytes(job.width * job.height * 3)
+                else:
+                    started = time.perf_counter()
+                    try:
+                        image = render(batch.state, job.robot, job.width, job.height)
+                    except BaseException as exc:  # reported, then black frames
+                        log.error("camera rendering failed for %s: %s", job.robot, exc)
+                        self.error = exc
+                        render = None
+                        image = bytes(job.width * job.height * 3)
+                    self.render_s += time.perf_counter() - started
+                    self.frames += 1
+                self._done.put((job, image))
+                try:
+                    os.write(self._write_fd, b"x")
+                except BlockingIOError:
+                    pass  # the pipe is full of wake-ups already
+
+    def close(self) -> None:
+        if self._thread is not None:
+            self._inbox.put(None)
+            self._thread.join(timeout=5.0)
+        os.close(self._read_fd)
+        os.close(self._write_fd)

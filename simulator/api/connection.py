@@ -1,0 +1,164 @@
+"""One accepted robot API client: non-blocking reads and writes with a bounded send queue."""
+
+from __future__ import annotations
+
+import logging
+import socket
+import time
+from collections import deque
+
+from google.protobuf.message import DecodeError
+
+from simulator.api import messages_pb2 as pb
+from simulator.api.framing import FrameDecoder, FramingError
+from simulator.api.stats import RobotStats
+
+log = logging.getLogger(__name__)
+
+RECV_CHUNK = 1 << 16
+
+
+class ClientClosed(Exception):
+    """Internal signal: the client must be dropped; ``reason`` says why (logged once)."""
+
+    def __init__(self, reason: str) -> None:
+        self.reason = reason
+        super().__init__(reason)
+
+
+class Connection:
+    """The connected client of one robot port.
+
+    ``answered`` is the lockstep flag: a request arrived after the last measurement was queued
+    (a new connection owes its first request). Requests are decoded on arrival and kept until the
+    step loop applies them.
+    """
+
+    def __init__(
+        self,
+        *,
+        sock: socket.socket,
+        peer: str,
+        key: str,
+        stats: RobotStats,
+        queue_limit: int,
+        time_bank_s: float,
+    ) -> None:
+        self.sock = sock
+        self.peer = peer
+        self.key = key
+        self.stats = stats
+        self.queue_limit = max(1, queue_limit)
+        self.decoder = FrameDecoder()
+        self.requests: list[pb.ActuatorRequests] = []
+        self.outbox: deque[bytes] = deque()
+        self._partial: memoryview | None = None
+        self.answered = False
+        self.answered_at = 0.0
+        self.last_sent_at: float | None = None
+        self.slow = False
+        self.bank_s = time_bank_s
+        self.want_write = False
+
+    def fileno(self) -> int:
+        return self.sock.fileno()
+
+    # --- reading ----------------------------------------------------------------------------
+
+    def read(self, now: float) -> int:
+        """Read everything available; returns the number of requests decoded.
+
+        Raises:
+            ClientClosed: on EOF, a socket error, a framing error or an undecodable message.
+        """
+        count = 0
+        while True:
+            try:
+                data = self.sock.recv(RECV_CHUNK)
+            except (BlockingIOError, InterruptedError):
+                break
+            except OSError as exc:
+                raise ClientClosed(f"receive failed: {exc}") from exc
+            if not data:
+                raise ClientClosed("client disconnected")
+            self.stats.bytes_in += len(data)
+            try:
+                frames = self.decoder.feed(data)
+            except FramingError as exc:
+                self.stats.bad_frames += 1
+                raise ClientClosed(f"out of sync: {exc}") from exc
+            for frame in frames:
+                request = pb.ActuatorRequests()
+                try:
+                    request.ParseFromString(frame)
+                except DecodeError as exc:
+                    self.stats.decode_errors += 1
+                    raise ClientClosed(
+                        f"undecodable ActuatorRequests ({len(frame)} bytes)"
+                    ) from exc
+                self.requests.append(request)
+                count += 1
+            if len(data) < RECV_CHUNK:
+                break
+        if count:
+            self.stats.messages_in += count
+            self.answered = True
+            self.answered_at = now
+            if self.last_sent_at is not None:
+                self.stats.round_trip_s.append(now - self.last_sent_at)
+                self.last_sent_at = None
+        return count
+
+    # --- writing ----------------------------------------------------------------------------
+
+    def enqueue(self, frame: bytes, now: float) -> None:
+        """Queue one framed measurement; the oldest queued ones are dropped when full."""
+        outbox = self.outbox
+        while len(outbox) >= self.queue_limit:
+            outbox.popleft()
+            self.stats.dropped_out += 1
+        outbox.append(frame)
+        self.answered = False
+        self.last_sent_at = now
+
+    def flush(self) -> bool:
+        """Write as much as the socket takes; True when everything queued was written.
+
+        Raises:
+            ClientClosed: on a fatal send error.
+        """
+        sock = self.sock
+        while True:
+            if self._partial is None:
+                if not self.outbox:
+                    self.want_write = False
+                    return True
+                frame = self.outbox.popleft()
+                self.stats.messages_out += 1
+                self._partial = memoryview(frame)
+            try:
+                sent = sock.send(self._partial)
+            except (BlockingIOError, InterruptedError):
+                self.want_write = True
+                return False
+            except OSError as exc:
+                raise ClientClosed(f"send failed: {exc}") from exc
+            self.stats.bytes_out += sent
+            if sent == len(self._partial):
+                self._partial = None
+            else:
+                self._partial = self._partial[sent:]
+
+    @property
+    def idle(self) -> bool:
+        return self._partial is None and not self.outbox
+
+    def close(self) -> None:
+        try:
+            self.sock.close()
+        except OSError:  # already gone; nothing left to release
+            pass
+
+
+def monotonic() -> float:
+    return time.monotonic()

@@ -1,0 +1,66 @@
+"""Robot API framing: 4-byte big-endian length, then a serialized protobuf message.
+
+The decoder is fed arbitrary byte chunks as they arrive on a socket and yields complete
+payloads; a partial frame stays buffered until the rest arrives. An announced length of 0 or
+above :data:`MAX_FRAME_BYTES` (the reference client's ``max_answer_size``) means the stream is
+out of sync: :class:`FramingError` is raised and the connection must be closed.
+"""
+
+from __future__ import annotations
+
+import struct
+
+from simulator.errors import ApiError
+
+HEADER = struct.Struct(">I")
+MAX_FRAME_BYTES = 1920 * 1080 * 3 + 1000
+WELCOME = b"Welcome\0"
+REFUSED = b"Refused\0"
+
+
+class FramingError(ApiError):
+    """The byte stream does not follow the length-prefixed framing."""
+
+    def __init__(self, *, length: int, limit: int) -> None:
+        self.length = length
+        self.limit = limit
+        super().__init__(f"announced frame length {length} is out of range 1..{limit}")
+
+
+def encode_frame(payload: bytes) -> bytes:
+    return HEADER.pack(len(payload)) + payload
+
+
+class FrameDecoder:
+    """Incremental frame decoder. Not thread-safe; one per connection."""
+
+    __slots__ = ("_buffer", "_limit")
+
+    def __init__(self, *, limit: int = MAX_FRAME_BYTES) -> None:
+        self._buffer = bytearray()
+        self._limit = limit
+
+    @property
+    def buffered(self) -> int:
+        return len(self._buffer)
+
+    def feed(self, data: bytes) -> list[bytes]:
+        """Add received bytes; return the payloads of every frame now complete, in order."""
+        buffer = self._buffer
+        buffer += data
+        frames: list[bytes] = []
+        offset = 0
+        size = len(buffer)
+        while size - offset >= 4:
+            (length,) = HEADER.unpack_from(buffer, offset)
+            if length == 0 or length > self._limit:
+                del buffer[:offset]
+                raise FramingError(length=length, limit=self._limit)
+            end = offset + 4 + length
+            if end > size:
+                break
+            frames.append(bytes(buffer[offset + 4 : end]))
+            offset = end
+        if offset:
+            del buffer[:offset]
+        return frames

@@ -1,0 +1,68 @@
+"""Lockstep waiting: each step waits for one request from every connected, non-slow client.
+
+A client's answer within ``deadline_s`` of the start of the wait is free; time beyond it is
+taken from the client's time bank (a chess clock with a per-move allowance). A client whose bank
+runs out is marked slow (logged, counted) and the step goes on without it; it is waited for
+again, with a full bank, once it has answered the latest measurement and its send queue is empty.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+
+from simulator.api.server import ApiServer, LockstepSettings
+
+log = logging.getLogger(__name__)
+
+
+def wait_lockstep(server: ApiServer, settings: LockstepSettings) -> float:
+    """Block until every awaited client has answered (or ran out of time); returns seconds."""
+    start = time.monotonic()
+    deadline = settings.deadline_s
+    missed: set[str] = set()
+    while not server.stop_requested:
+        now = time.monotonic()
+        elapsed = now - start
+        waiting = []
+        next_event = deadline - elapsed if elapsed < deadline else float("inf")
+        for slot in server.slots.values():
+            conn = slot.conn
+            if conn is None:
+                continue
+            if conn.slow:
+                if conn.answered and conn.idle:
+                    conn.slow = False
+                    conn.bank_s = settings.time_bank_s
+                    log.info("%s: caught up, lockstep waits for it again", slot.session.key)
+                continue
+            if conn.answered:
+                continue
+            over = elapsed - deadline
+            if over > 0:
+                if slot.session.key not in missed:
+                    missed.add(slot.session.key)
+                    slot.stats.missed_deadlines += 1
+                if over >= conn.bank_s:
+                    conn.bank_s = 0.0
+                    conn.slow = True
+                    slot.stats.slow_periods += 1
+                    log.warning(
+                        "%s: too slow for lockstep (time bank of %.1f s used up), "
+                        "the simulation goes on without it",
+                        slot.session.key, settings.time_bank_s,
+                    )  # fmt: skip
+                    continue
+                next_event = min(next_event, conn.bank_s - over)
+            waiting.append(conn)
+        if not waiting:
+            break
+        server.poll(max(0.0, min(next_event, 0.05)))
+    end = time.monotonic()
+    for slot in server.slots.values():
+        conn = slot.conn
+        if conn is not None and not conn.slow and conn.answered:
+            late = conn.answered_at - start - deadline
+            if late > 0:
+                conn.bank_s = max(0.0, conn.bank_s - late)
+    return end - start

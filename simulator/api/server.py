@@ -1,0 +1,397 @@
+"""The robot API server: one TCP port per robot, multiplexed with ``selectors``.
+
+All socket I/O is non-blocking and runs on the step thread at three points of each step
+(:meth:`ApiServer.poll` while waiting or pacing, :meth:`ApiServer.apply_requests` before the
+physics step, :meth:`ApiServer.publish` after it), so the world is only touched by one thread and
+a client can never block the step (except with ``blocking_send``, the HLVS behaviour).
+
+Per step: every complete request received is applied (later ones override earlier targets),
+then one ``SensorMeasurements`` per connected robot is queued. Lockstep: :meth:`wait_lockstep`
+waits for one request per connected, non-slow client (see :mod:`simulator.api.lockstep`).
+"""
+
+from __future__ import annotations
+
+import logging
+import selectors
+import socket
+import time
+from collections import deque
+from collections.abc import Callable, Sequence
+from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import dataclass, field
+from typing import Any
+
+from referee.snapshot import RobotId
+from simulator.api import messages_pb2 as pb
+from simulator.api.cameras import RenderWorker
+from simulator.api.connection import ClientClosed, Connection
+from simulator.api.devices import DeviceWorld
+from simulator.api.endpoints import PlayerEndpoint, peer_allowed_by_name
+from simulator.api.framing import HEADER, REFUSED, WELCOME
+from simulator.api.quota import NetworkQuota
+from simulator.api.session import ERROR, RobotSession
+from simulator.api.stats import RobotStats
+from simulator.errors import ApiError
+from simulator.spec import NetworkSpec
+
+log = logging.getLogger(__name__)
+
+
+class PortUnavailable(ApiError):
+    def __init__(self, *, host: str, port: int, reason: str) -> None:
+        self.host = host
+        self.port = port
+        self.reason = reason
+        super().__init__(f"cannot listen on {host}:{port}: {reason}")
+
+
+@dataclass(slots=True)
+class _Pending:
+    """A measurement waiting for camera images (and the ones queued behind it)."""
+
+    msg: pb.SensorMeasurements
+    missing: int
+
+
+@dataclass(slots=True, eq=False)
+class RobotSlot:
+    endpoint: PlayerEndpoint
+    session: RobotSession
+    quota: NetworkQuota
+    stats: RobotStats
+    listener: socket.socket | None = None
+    conn: Connection | None = None
+    checking: tuple[socket.socket, str, Future[bool]] | None = None
+    pending: deque[_Pending] = field(default_factory=deque)
+    mask: int = 0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class LockstepSettings:
+    deadline_s: float
+    time_bank_s: float
+
+
+class ApiServer:
+    """Robot API server of a match. Use as a context manager (closes every socket)."""
+
+    def __init__(
+        self,
+        *,
+        world: DeviceWorld,
+        endpoints: Sequence[PlayerEndpoint],
+        network: NetworkSpec,
+        lockstep: LockstepSettings | None = None,
+        cameras: RenderWorker | None = None,
+        unix_ms: Callable[[], int] = lambda: int(time.time() * 1000),
+    ) -> None:
+        self._world = world
+        self._network = network
+        self._lockstep = lockstep
+        self._cameras = cameras
+        self._unix_ms = unix_ms
+        self._selector = selectors.DefaultSelector()
+        self._lookups: ThreadPoolExecutor | None = None
+        self.stop_requested = False
+        self.slots: dict[RobotId, RobotSlot] = {}
+        for endpoint in endpoints:
+            team_size = max(1, endpoint.team_size)
+            session = RobotSession(
+                robot=endpoint.robot,
+                world=world,
+                rendering_quota_mb_s=network.rendering_quota_mb_s / team_size,
+                clock_ms=unix_ms,
+            )
+            self.slots[endpoint.robot] = RobotSlot(
+                endpoint=endpoint,
+                session=session,
+                quota=NetworkQuota(quota_mb_s=network.team_quota_mb_s / team_size),
+                stats=RobotStats(),
+            )
+        if cameras is not None:
+            self._selector.register(cameras.wake_fd, selectors.EVENT_READ, "cameras")
+
+    # --- lifecycle --------------------------------------------------------------------------
+
+    def start(self) -> None:
+        host = self._network.api_bind_host
+        for slot in self.slots.values():
+            sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            try:
+                sock.bind((host, slot.endpoint.port))
+                sock.listen(4)
+            except OSError as exc:
+                sock.close()
+                self.close()
+                raise PortUnavailable(host=host, port=slot.endpoint.port, reason=str(exc)) from exc
+            sock.setblocking(False)
+            slot.listener = sock
+            self._selector.register(sock, selectors.EVENT_READ, ("accept", slot))
+            log.info(
+                "robot API for %s listening on %s:%d", slot.session.key, host, slot.endpoint.port
+            )
+
+    def close(self) -> None:
+        for slot in self.slots.values():
+            if slot.conn is not None:
+                self._drop(slot, "server shutting down")
+            if slot.checking is not None:
+                slot.checking[0].close()
+                slot.checking = None
+            if slot.listener is not None:
+                self._selector.unregister(slot.listener)
+                slot.listener.close()
+                slot.listener = None
+        if self._lookups is not None:
+            self._lookups.shutdown(wait=False, cancel_futures=True)
+        self._selector.close()
+
+    def __enter__(self) -> ApiServer:
+        self.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # --- queries ----------------------------------------------------------------------------
+
+    def connected(self) -> list[str]:
+        return [slot.session.key for slot in self.slots.values() if slot.conn is not None]
+
+    def statistics(self) -> dict[str, dict[str, Any]]:
+        return {slot.session.key: slot.stats.to_dict() for slot in self.slots.values()}
+
+    def connection(self, robot: RobotId) -> Connection | None:
+        return self.slots[robot].conn
+
+    # --- I/O --------------------------------------------------------------------------------
+
+    def poll(self, timeout_s: float = 0.0) -> None:
+        """Serve sockets: accept, handshake, read requests, write queued measurements."""
+        now = time.monotonic()
+        for key, events in self._selector.select(max(0.0, timeout_s)):
+            data = key.data
+            if data == "cameras":
+                self._camera_results()
+                continue
+            kind, slot = data
+            if kind == "accept":
+                self._accept(slot)
+            elif slot.conn is not None and key.fileobj is slot.conn.sock:
+                if events & selectors.EVENT_READ:
+                    self._read(slot, now)
+                if slot.conn is not None and events & selectors.EVENT_WRITE:
+                    self._flush(slot)
+        self._finish_lookups()
+
+    def _accept(self, slot: RobotSlot) -> None:
+        assert slot.listener is not None
+        while True:
+            try:
+                sock, address = slot.listener.accept()
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError as exc:
+                log.warning("%s: accept failed: %s", slot.session.key, exc)
+                return
+            peer = f"{address[0]}:{address[1]}"
+            if slot.conn is not None or slot.checking is not None:
+                slot.stats.refused += 1
+                log.warning(
+                    "%s: refused %s: a client is already connected on port %d",
+                    slot.session.key, peer, slot.endpoint.port,
+                )  # fmt: skip
+                _refuse(sock)
+                continue
+            ip = address[0]
+            if ip in slot.endpoint.allowed_ips:
+                self._welcome(slot, sock, peer)
+            elif slot.endpoint.allowed_names:
+                if self._lookups is None:
+                    self._lookups = ThreadPoolExecutor(max_workers=1, thread_name_prefix="api-dns")
+                names = sorted(slot.endpoint.allowed_names)
+                future = self._lookups.submit(peer_allowed_by_name, ip, names)
+                slot.checking = (sock, peer, future)
+            else:
+                self._refuse_host(slot, sock, peer)
+
+    def _finish_lookups(self) -> None:
+        for slot in self.slots.values():
+            if slot.checking is None or not slot.checking[2].done():
+                continue
+            sock, peer, future = slot.checking
+            slot.checking = None
+            if future.result():
+                self._welcome(slot, sock, peer)
+            else:
+                self._refuse_host(slot, sock, peer)
+
+    def _refuse_host(self, slot: RobotSlot, sock: socket.socket, peer: str) -> None:
+        slot.stats.refused += 1
+        log.warning(
+            "%s: refused %s: not in the team's hosts %s",
+            slot.session.key, peer, list(slot.endpoint.hosts),
+        )  # fmt: skip
+        _refuse(sock)
+
+    def _welcome(self, slot: RobotSlot, sock: socket.socket, peer: str) -> None:
+        try:
+            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            sock.sendall(WELCOME)
+        except OSError as exc:
+            log.warning("%s: handshake with %s failed: %s", slot.session.key, peer, exc)
+            sock.close()
+            return
+        sock.setblocking(False)
+        bank = self._lockstep.time_bank_s if self._lockstep else 0.0
+        slot.conn = Connection(
+            sock=sock,
+            peer=peer,
+            key=slot.session.key,
+            stats=slot.stats,
+            queue_limit=self._network.send_queue_messages,
+            time_bank_s=bank,
+        )
+        slot.pending.clear()
+        slot.stats.connects.append(time.time())
+        slot.mask = selectors.EVENT_READ
+        self._selector.register(sock, slot.mask, ("conn", slot))
+        log.info(
+            "%s: client %s connected on port %d (sim time %d ms)",
+            slot.session.key, peer, slot.endpoint.port, self._world.sim_time_ms,
+        )  # fmt: skip
+
+    def _read(self, slot: RobotSlot, now: float) -> None:
+        assert slot.conn is not None
+        try:
+            slot.conn.read(now)
+        except ClientClosed as exc:
+            self._drop(slot, exc.reason)
+
+    def _flush(self, slot: RobotSlot) -> None:
+        conn = slot.conn
+        assert conn is not None
+        try:
+            conn.flush()
+        except ClientClosed as exc:
+            self._drop(slot, exc.reason)
+            return
+        mask = selectors.EVENT_READ | (selectors.EVENT_WRITE if conn.want_write else 0)
+        if mask != slot.mask:
+            slot.mask = mask
+            self._selector.modify(conn.sock, mask, ("conn", slot))
+
+    def _drop(self, slot: RobotSlot, reason: str) -> None:
+        conn = slot.conn
+        if conn is None:
+            return
+        slot.conn = None
+        slot.pending.clear()
+        try:
+            self._selector.unregister(conn.sock)
+        except (KeyError, ValueError):
+            pass  # never registered or selector closed
+        conn.close()
+        slot.stats.disconnects.append(time.time())
+        slot.stats.disconnect_reasons.append(reason)
+        log.info("%s: client %s dropped: %s", slot.session.key, conn.peer, reason)
+
+    # --- the step ---------------------------------------------------------------------------
+
+    def apply_requests(self, step_time_ms: int) -> None:
+        """Read what is available, then apply every received request in arrival order."""
+        self.poll(0.0)
+        for slot in self.slots.values():
+            slot.session.update_limp()
+            conn = slot.conn
+            if conn is None or not conn.requests:
+                continue
+            for request in conn.requests:
+                slot.session.apply(request, step_time_ms=step_time_ms)
+            conn.requests.clear()
+
+    def publish(self, time_ms: int) -> None:
+        """Queue the measurement of the step that ended at ``time_ms`` for every client."""
+        jobs_all = []
+        now = time.monotonic()
+        for slot in self.slots.values():
+            conn = slot.conn
+            if conn is None:
+                continue
+            msg, jobs = slot.session.measure(time_ms)
+            conn.answered = False
+            if jobs:
+                jobs_all.extend(jobs)
+                slot.pending.append(_Pending(msg, len(jobs)))
+            elif slot.pending:
+                slot.pending.append(_Pending(msg, 0))
+            else:
+                self._send(slot, conn, msg, now)
+        if jobs_all:
+            assert self._cameras is not None, "camera enabled without a render worker"
+            self._cameras.submit(jobs_all)
+        self._flush_all()
+
+    def _send(
+        self, slot: RobotSlot, conn: Connection, msg: pb.SensorMeasurements, now: float
+    ) -> None:
+        size = msg.ByteSize()
+        real_time = msg.real_time
+        if not slot.quota.allows(size, real_time):
+            slot.stats.quota_errors += 1
+            time_ms = msg.time
+            msg = pb.SensorMeasurements(time=time_ms, real_time=real_time)
+            msg.messages.add(message_type=ERROR, text=slot.quota.error_text)
+            size = msg.ByteSize()
+        slot.quota.record(size, real_time)
+        if msg.messages:
+            slot.stats.warnings_sent += len(msg.messages)
+        conn.enqueue(HEADER.pack(size) + msg.SerializeToString(), now)
+
+    def _flush_all(self) -> None:
+        blocking = self._network.blocking_send
+        for slot in self.slots.values():
+            if slot.conn is None or slot.conn.idle:
+                continue
+            self._flush(slot)
+            if blocking:
+                self._flush_blocking(slot)
+
+    def _flush_blocking(self, slot: RobotSlot) -> None:
+        """HLVS behaviour: wait until the client has taken everything (stalls the step)."""
+        while slot.conn is not None and not slot.conn.idle and not self.stop_requested:
+            conn = slot.conn
+            with selectors.DefaultSelector() as one:
+                one.register(conn.sock, selectors.EVENT_WRITE)
+                one.select(0.1)
+            self._flush(slot)
+
+    def _camera_results(self) -> None:
+        assert self._cameras is not None
+        touched: set[RobotId] = set()
+        for job, image in self._cameras.completed():
+            slot = self.slots[job.robot]
+            job.measurement.image = image
+            for pending in slot.pending:
+                if pending.msg.time == job.time_ms and pending.missing:
+                    pending.missing -= 1
+                    break
+            touched.add(job.robot)
+        now = time.monotonic()
+        for robot in touched:
+            slot = self.slots[robot]
+            while slot.pending and slot.pending[0].missing == 0 and slot.conn is not None:
+                self._send(slot, slot.conn, slot.pending.popleft().msg, now)
+        self._flush_all()
+
+
+def _refuse(sock: socket.socket) -> None:
+    try:
+        sock.setblocking(False)
+        sock.send(REFUSED)
+    except OSError:
+        pass  # the peer is gone already; nothing to tell it
+    finally:
+        sock.close()

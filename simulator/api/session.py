@@ -1,0 +1,245 @@
+"""One robot's side of the robot API: commands in, sensor measurements out (HLVS semantics).
+
+A :class:`RobotSession` outlives connections: enabled sensors stay enabled after a disconnect,
+as in HLVS. It applies :class:`ActuatorRequests` to the world (warnings for unknown devices and
+bad periods are queued for the next measurement), caches motor commands while the robot is limp
+and re-applies them when it is released, and builds the :class:`SensorMeasurements` of a step.
+Camera images are filled in later by the caller (see :mod:`simulator.api.cameras`).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from referee.snapshot import RobotId
+from simulator.api import messages_pb2 as pb
+from simulator.api.devices import (
+    ACCELEROMETER,
+    CAMERA,
+    FORCE,
+    GYRO,
+    MOTOR,
+    POSITION_SENSOR,
+    SENSOR_KINDS,
+    DeviceWorld,
+    kind_name,
+    robot_key,
+)
+
+log = logging.getLogger(__name__)
+
+BASIC_TIME_STEP_MS = 8
+CAMERA_MIN_TIME_STEP_MS = 16
+WARNING = pb.Message.WARNING_MESSAGE
+ERROR = pb.Message.ERROR_MESSAGE
+
+
+def rendering_bandwidth_mb_s(width: int, height: int, period_ms: int) -> float:
+    """HLVS rendering bandwidth of one camera: w*h*3 bytes per period, in MB/s (2^20)."""
+    return width * height * 3 * 1000.0 / period_ms / 2**20
+
+
+@dataclass(slots=True)
+class CameraJob:
+    """A camera image owed to a measurement of this robot."""
+
+    robot: RobotId
+    name: str
+    width: int
+    height: int
+    time_ms: int
+    measurement: pb.CameraMeasurement
+
+
+@dataclass(slots=True)
+class _MotorCommand:
+    position: float = math.nan
+    velocity: float = math.nan
+    torque: float = math.nan
+
+
+class RobotSession:
+    """Sensor enabling, command application and measurement building for one robot."""
+
+    def __init__(
+        self,
+        *,
+        robot: RobotId,
+        world: DeviceWorld,
+        rendering_quota_mb_s: float,
+        clock_ms: Callable[[], int],
+    ) -> None:
+        self.robot = robot
+        self.key = robot_key(robot)
+        self._world = world
+        self._rendering_quota_mb_s = rendering_quota_mb_s
+        self._clock_ms = clock_ms
+        self._kinds = {name: kind_name(kind) for name, kind in world.devices(robot).items()}
+        self._sensors: dict[str, int] = {}  # name -> period ms
+        self._new_sensors: set[str] = set()  # enabled during this step, reported from the next
+        self._enabled_at: dict[str, int] = {}
+        self._motors: dict[str, _MotorCommand] = {}
+        self._pending: list[tuple[int, str]] = []
+        self._limp = False
+        self._camera_size: tuple[int, int] | None = None
+        if CAMERA in self._kinds.values():
+            width, height, _fov = world.camera_info(robot)
+            self._camera_size = (width, height)
+
+    # --- commands ---------------------------------------------------------------------------
+
+    def warn(self, text: str, *, kind: int = WARNING) -> None:
+        self._pending.append((kind, text))
+
+    def apply(self, request: pb.ActuatorRequests, *, step_time_ms: int) -> None:
+        """Apply one request; ``step_time_ms`` is the time of the measurement this step sends."""
+        if self._world.is_removed(self.robot):
+            return
+        world, robot, kinds = self._world, self.robot, self._kinds
+        active = not self._world.is_limp(robot)
+        for mp in request.motor_positions:
+            if kinds.get(mp.name) != MOTOR:
+                self.warn(f'Motor "{mp.name}" not found, position command ignored.')
+                continue
+            self._motor(mp.name).position = mp.position
+            if active:
+                world.set_motor_position(robot, mp.name, mp.position)
+        for mv in request.motor_velocities:
+            if kinds.get(mv.name) != MOTOR:
+                self.warn(f'Motor "{mv.name}" not found, velocity command ignored.')
+                continue
+            self._motor(mv.name).velocity = mv.velocity
+            if active:
+                world.set_motor_velocity(robot, mv.name, mv.velocity)
+        for label, items in (("force", request.motor_forces), ("torque", request.motor_torques)):
+            for item in items:
+                value = item.force if label == "force" else item.torque
+                if kinds.get(item.name) != MOTOR:
+                    self.warn(f'Motor "{item.name}" not found, {label} command ignored.')
+                    continue
+                self._motor(item.name).torque = value
+                if active:
+                    world.set_motor_torque(robot, item.name, value)
+        for pid in request.motor_pids:
+            if kinds.get(pid.name) != MOTOR:
+                self.warn(f'Motor "{pid.name}" not found, PID command ignored.')
+                continue
+            world.set_motor_pid(robot, pid.name, pid.PID.X, pid.PID.Y, pid.PID.Z)
+        for quality in request.camera_qualities:
+            if kinds.get(quality.name) == CAMERA:
+                self.warn("CameraQuality is not yet implemented, ignored.")
+            else:
+                self.warn(f'Camera "{quality.name}" not found, quality command ignored.')
+        for exposure in request.camera_exposures:
+            if kinds.get(exposure.name) != CAMERA:
+                self.warn(f'Camera "{exposure.name}" not found, exposure command ignored.')
+        for step in request.sensor_time_steps:
+            self._time_step(step.name, step.timeStep, step_time_ms)
+
+    def _motor(self, name: str) -> _MotorCommand:
+        command = self._motors.get(name)
+        if command is None:
+            command = self._motors[name] = _MotorCommand()
+        return command
+
+    def _time_step(self, name: str, period: int, now_ms: int) -> None:
+        kind = self._kinds.get(name)
+        if kind is None:
+            self.warn(f'Device "{name}" not found, time step command, ignored.')
+            return
+        if kind not in SENSOR_KINDS:
+            self.warn(f'Device "{name}" is not supported, time step command, ignored.')
+            return
+        minimum = CAMERA_MIN_TIME_STEP_MS if kind == CAMERA else BASIC_TIME_STEP_MS
+        if period == 0:
+            self._sensors.pop(name, None)
+            self._new_sensors.discard(name)
+            return
+        if period < minimum:
+            self.warn(
+                f'Time step for "{name}" should be greater or equal to {minimum}, '
+                f"ignoring {period} value."
+            )
+            return
+        if period % BASIC_TIME_STEP_MS:
+            self.warn(
+                f'Time step for "{name}" should be a multiple of {BASIC_TIME_STEP_MS}, '
+                f"ignoring {period} value."
+            )
+            return
+        if kind == CAMERA and self._camera_size is not None:
+            width, height = self._camera_size
+            requested = rendering_bandwidth_mb_s(width, height, period)
+            if requested > self._rendering_quota_mb_s:
+                self.warn(
+                    "requested rendering bandwidth is above the limit "
+                    f"({round(requested)}MB/s > {round(self._rendering_quota_mb_s)}MB/s)"
+                )
+                return
+        if name not in self._sensors:
+            self._new_sensors.add(name)
+        elif self._sensors[name] == period:
+            return
+        self._sensors[name] = period
+        self._enabled_at[name] = now_ms
+        log.debug("%s: %s enabled every %d ms", self.key, name, period)
+
+    def update_limp(self) -> None:
+        """Follow the world's limp flag; re-apply cached commands when the robot is released."""
+        limp = self._world.is_limp(self.robot)
+        if limp == self._limp:
+            return
+        self._limp = limp
+        if limp:
+            return
+        world, robot = self._world, self.robot
+        for name, command in self._motors.items():
+            if not math.isnan(command.position):
+                world.set_motor_position(robot, name, command.position)
+            if not math.isnan(command.velocity):
+                world.set_motor_velocity(robot, name, command.velocity)
+            if not math.isnan(command.torque):
+                world.set_motor_torque(robot, name, command.torque)
+
+    # --- measurements -----------------------------------------------------------------------
+
+    @property
+    def enabled(self) -> dict[str, int]:
+        return dict(self._sensors)
+
+    def measure(self, time_ms: int) -> tuple[pb.SensorMeasurements, list[CameraJob]]:
+        """The measurement of the step that ended at ``time_ms`` (camera images still empty)."""
+        msg = pb.SensorMeasurements(time=time_ms, real_time=self._clock_ms())
+        jobs: list[CameraJob] = []
+        for message_type, text in self._pending:
+            msg.messages.add(message_type=message_type, text=text)
+        self._pending.clear()
+        world, robot = self._world, self.robot
+        if world.is_removed(robot):
+            self._sensors.clear()
+            self._new_sensors.clear()
+            return msg, jobs
+        new = self._new_sensors
+        for name, period in self._sensors.items():
+            if name in new or (time_ms - self._enabled_at[name]) % period:
+                continue
+            kind = self._kinds[name]
+            if kind == POSITION_SENSOR:
+                msg.position_sensors.add(name=name, value=world.read_position(robot, name))
+            elif kind == ACCELEROMETER:
+                x, y, z = world.read_accelerometer(robot)
+                msg.accelerometers.add(name=name).value.CopyFrom(pb.Vector3(X=x, Y=y, Z=z))
+            elif kind == GYRO:
+                x, y, z = world.read_gyro(robot)
+                msg.gyros.add(name=name).value.CopyFrom(pb.Vector3(X=x, Y=y, Z=z))
+            elif kind == FORCE:
+                msg.forces.add(name=name, value=world.read_force(robot, name))
+            elif kind == CAMERA and self._camera_size is not None:
+                width, height = self._camera_size
+                camera = msg.cameras.add(name=name, width=width, height=height, quality=-1)
+                jobs.append(CameraJob(robot, name, width, height, time_ms, camera))
+        new.clear()
+        return msg, jobs

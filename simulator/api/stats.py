@@ -1,0 +1,64 @@
+"""Per-robot statistics of the robot API, reported in ``sim_result.json``."""
+
+from __future__ import annotations
+
+from array import array
+from dataclasses import dataclass, field
+from typing import Any
+
+
+def percentile(sorted_values: list[float], q: float) -> float:
+    """Nearest-rank percentile of already sorted values (q in 0..100)."""
+    if not sorted_values:
+        return float("nan")
+    rank = max(0, min(len(sorted_values) - 1, round(q / 100.0 * (len(sorted_values) - 1))))
+    return sorted_values[rank]
+
+
+@dataclass(slots=True)
+class RobotStats:
+    """Counters of one robot over the whole match (all its connections)."""
+
+    connects: list[float] = field(default_factory=list)  # unix s
+    disconnects: list[float] = field(default_factory=list)
+    disconnect_reasons: list[str] = field(default_factory=list)
+    refused: int = 0
+    messages_in: int = 0
+    bytes_in: int = 0
+    messages_out: int = 0
+    bytes_out: int = 0
+    dropped_out: int = 0
+    quota_errors: int = 0
+    bad_frames: int = 0
+    decode_errors: int = 0
+    missed_deadlines: int = 0
+    slow_periods: int = 0
+    warnings_sent: int = 0
+    round_trip_s: array[float] = field(default_factory=lambda: array("d"))
+
+    def to_dict(self) -> dict[str, Any]:
+        latencies = sorted(self.round_trip_s)
+        ms = {
+            f"p{q}": round(percentile(latencies, q) * 1000.0, 3) if latencies else None
+            for q in (50, 90, 99)
+        }
+        ms["max"] = round(latencies[-1] * 1000.0, 3) if latencies else None
+        return {
+            "connects": [round(t, 3) for t in self.connects],
+            "disconnects": [round(t, 3) for t in self.disconnects],
+            "disconnect_reasons": list(self.disconnect_reasons),
+            "refused_connections": self.refused,
+            "messages_in": self.messages_in,
+            "bytes_in": self.bytes_in,
+            "messages_out": self.messages_out,
+            "bytes_out": self.bytes_out,
+            "dropped_out": self.dropped_out,
+            "quota_errors": self.quota_errors,
+            "bad_frames": self.bad_frames,
+            "decode_errors": self.decode_errors,
+            "missed_deadlines": self.missed_deadlines,
+            "slow_periods": self.slow_periods,
+            "warnings_sent": self.warnings_sent,
+            "round_trip_ms": ms,
+            "round_trip_samples": len(latencies),
+        }
