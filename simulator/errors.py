@@ -6,7 +6,8 @@ Tree::
     ├── SpecError            match_spec.json that does not describe a match
     ├── UnknownModelError    a robot model name we do not ship (lists the known ones)
     ├── PhysicsDivergence    MuJoCo reported instability (carries its warning and the policy)
-    └── ApiError             robot API misuse on the simulator side
+    ├── ApiError             robot API misuse on the simulator side
+    └── UnknownDeviceError   a device name a robot does not have (world device access)
 """
 
 from __future__ import annotations
@@ -41,3 +42,14 @@ class PhysicsDivergence(SimulatorError):
 
 class ApiError(SimulatorError):
     """Robot API error on the simulator side."""
+
+
+class UnknownDeviceError(SimulatorError):
+    """A device name (or robot) the world does not have; the API answers with a warning."""
+
+    def __init__(self, *, robot: str, name: str, kind: str) -> None:
+        self.robot = robot
+        self.name = name
+        self.kind = kind
+        what = f"{kind} {name!r}" if name else kind
+        super().__init__(f"{robot}: no such {what}")

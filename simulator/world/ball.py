@@ -1,0 +1,46 @@
+"""The ball entity: the HLVS ball (size and mass per field class), bouncy on grass, rolling to rest.
+
+Contact with the turf uses the ball's parameters (higher geom priority): restitution about 0.76
+(``solref`` as time constant and damping ratio), sliding friction 0.5 and rolling friction that
+stops a rolling ball. Linear damping on the free joint plays the part of HLVS's air / grass drag.
+"""
+
+from __future__ import annotations
+
+from referee.field import FieldGeometry
+
+BALL_BODY = "ball"
+BALL_JOINT = "ball/root"
+BALL_GEOM = "ball:geom"
+BALL_SOLREF = (0.005, 0.06)  # time constant s, damping ratio -> restitution ~0.76 on the turf
+BALL_FRICTION = (0.5, 0.005, 0.0025)  # sliding, torsional, rolling (m)
+BALL_LINEAR_DAMPING_PER_KG = 0.6  # N s/m per kg of ball: v decays ~ exp(-0.6 t / 1.4) rolling
+BALL_ANGULAR_DAMPING = 0.0
+
+
+def ball_assets() -> str:
+    return (
+        '<texture name="ball" type="cube" builtin="checker" rgb1="1 1 1" rgb2="0.1 0.1 0.1" '
+        'width="64" height="64"/>'
+        '<material name="ball" texture="ball"/>'
+    )
+
+
+def ball_body(f: FieldGeometry, *, bits: tuple[int, int]) -> str:
+    contype, conaffinity = bits
+    r = f.ball_radius_m
+    return (
+        f'<body name="{BALL_BODY}" pos="0 0 {r:.6g}">'
+        f'<freejoint name="{BALL_JOINT}"/>'
+        f'<geom name="{BALL_GEOM}" type="sphere" size="{r:.6g}" mass="{f.ball_mass_kg:.6g}" '
+        f'material="ball" condim="6" priority="2" '
+        f'friction="{" ".join(str(v) for v in BALL_FRICTION)}" '
+        f'solref="{BALL_SOLREF[0]} {BALL_SOLREF[1]}" contype="{contype}" '
+        f'conaffinity="{conaffinity}"/>'
+        f"</body>"
+    )
+
+
+def ball_damping(f: FieldGeometry) -> tuple[float, float]:
+    """(linear, angular) damping of the ball's free joint, set on the compiled model."""
+    return BALL_LINEAR_DAMPING_PER_KG * f.ball_mass_kg, BALL_ANGULAR_DAMPING

@@ -1,0 +1,124 @@
+"""Robot devices for the robot API: motors, position sensors, IMU, foot forces, camera info.
+
+Names are HLVS device names (``Neck``, ``NeckS``, ``Accelerometer``, ``Gyro``, ``Camera``,
+``llb``...). Unknown names raise :class:`simulator.errors.UnknownDeviceError`. Batch forms:
+:meth:`DeviceAccess.read_positions` (name -> rad) and :meth:`DeviceAccess.read_position_array`
+(numpy array in ``motor_names(robot)`` order).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import mujoco
+import numpy as np
+import numpy.typing as npt
+
+from referee.snapshot import RobotId, Vec3
+from simulator.errors import UnknownDeviceError
+from simulator.world.types import DeviceKind
+
+if TYPE_CHECKING:
+    from simulator.world.indices import RobotIndex, WorldIndex
+    from simulator.world.motors import MotorBank
+
+
+class DeviceAccess:
+    """Device methods of :class:`simulator.world.World` (mixed in)."""
+
+    index: WorldIndex
+    motors: MotorBank
+    data: mujoco.MjData
+    limp: list[bool]
+    removed: list[bool]
+
+    def _robot(self, robot: RobotId) -> RobotIndex:
+        try:
+            return self.index.by_id[robot]
+        except KeyError:
+            raise UnknownDeviceError(robot=str(robot), name="", kind="robot") from None
+
+    def _actuator(self, robot: RobotId, name: str) -> int:
+        r = self._robot(robot)
+        slot = r.motor_slot.get(name)
+        if slot is None:
+            raise UnknownDeviceError(robot=str(robot), name=name, kind="motor")
+        return int(r.actuators[slot])
+
+    def devices(self, robot: RobotId) -> dict[str, DeviceKind]:
+        r = self._robot(robot)
+        out = {name: DeviceKind.MOTOR for name in r.model.motor_names}
+        out.update({f"{name}S": DeviceKind.POSITION_SENSOR for name in r.model.motor_names})
+        out["Accelerometer"] = DeviceKind.ACCELEROMETER
+        out["Gyro"] = DeviceKind.GYRO
+        out[r.model.camera.name] = DeviceKind.CAMERA
+        out.update({name: DeviceKind.FORCE for name in r.model.force_sensors})
+        return out
+
+    def motor_names(self, robot: RobotId) -> tuple[str, ...]:
+        return self._robot(robot).model.motor_names
+
+    def set_motor_position(self, robot: RobotId, name: str, rad: float) -> None:
+        """Target position (clamped to the joint range); leaves torque mode."""
+        self.motors.set_position(self._actuator(robot, name), float(rad))
+
+    def set_motor_velocity(self, robot: RobotId, name: str, rad_s: float) -> None:
+        """Maximum velocity of the position controller (clamped to the motor's maximum)."""
+        self.motors.set_velocity(self._actuator(robot, name), float(rad_s))
+
+    def set_motor_torque(self, robot: RobotId, name: str, nm: float) -> None:
+        """Switch the motor to torque control with this torque (clamped to its range)."""
+        self.motors.set_torque(self._actuator(robot, name), float(nm))
+
+    def set_motor_pid(self, robot: RobotId, name: str, p: float, i: float, d: float) -> None:
+        self.motors.set_pid(self._actuator(robot, name), float(p), float(i), float(d))
+
+    def read_position(self, robot: RobotId, sensor_name: str) -> float:
+        """Joint angle (rad) of ``<motor>S`` (the motor name alone is accepted too)."""
+        r = self._robot(robot)
+        motor = sensor_name[:-1] if sensor_name.endswith("S") else sensor_name
+        slot = r.motor_slot.get(motor)
+        if slot is None:
+            raise UnknownDeviceError(robot=str(robot), name=sensor_name, kind="position sensor")
+        return float(self.data.qpos[r.motor_qpos[slot]])
+
+    def read_position_array(self, robot: RobotId) -> npt.NDArray[np.float64]:
+        """Every joint angle (rad) in ``motor_names(robot)`` order."""
+        return np.asarray(self.data.qpos[self._robot(robot).motor_qpos], dtype=np.float64)
+
+    def read_positions(self, robot: RobotId) -> dict[str, float]:
+        """``{"NeckS": rad, ...}`` for every position sensor."""
+        r = self._robot(robot)
+        values = self.data.qpos[r.motor_qpos].tolist()
+        return {f"{n}S": v for n, v in zip(r.model.motor_names, values, strict=True)}
+
+    def _vec3(self, adr: int) -> Vec3:
+        x, y, z = self.data.sensordata[adr : adr + 3].tolist()
+        return (x, y, z)
+
+    def read_accelerometer(self, robot: RobotId) -> Vec3:
+        """Proper acceleration in the torso frame, m/s^2 (+9.81 on z when standing still)."""
+        return self._vec3(self._robot(robot).accelerometer)
+
+    def read_gyro(self, robot: RobotId) -> Vec3:
+        """Angular velocity in the torso frame, rad/s."""
+        return self._vec3(self._robot(robot).gyro)
+
+    def read_force(self, robot: RobotId, name: str) -> float:
+        """Normal force (N) on one sole corner (``llb`` ... ``rrb``)."""
+        r = self._robot(robot)
+        adr = r.forces.get(name)
+        if adr is None:
+            raise UnknownDeviceError(robot=str(robot), name=name, kind="force sensor")
+        return float(self.data.sensordata[adr])
+
+    def camera_info(self, robot: RobotId) -> tuple[int, int, float]:
+        """(width, height, horizontal field of view in rad) of the head camera."""
+        cam = self._robot(robot).model.camera
+        return cam.width, cam.height, cam.fov_rad
+
+    def is_limp(self, robot: RobotId) -> bool:
+        return self.limp[self._robot(robot).number]
+
+    def is_removed(self, robot: RobotId) -> bool:
+        return self.removed[self._robot(robot).number]

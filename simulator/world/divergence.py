@@ -1,0 +1,50 @@
+"""Physics divergence detection: MuJoCo's instability warnings, counted per step.
+
+MuJoCo resets the whole state itself when it finds a non-finite or huge position, velocity or
+acceleration (and records a warning whose ``lastinfo`` is the offending degree of freedom). We
+compare the warning counters after every basic step.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+
+WATCHED = (
+    mujoco.mjtWarning.mjWARN_BADQPOS,
+    mujoco.mjtWarning.mjWARN_BADQVEL,
+    mujoco.mjtWarning.mjWARN_BADQACC,
+    mujoco.mjtWarning.mjWARN_BADCTRL,
+)
+_TEXT = {
+    mujoco.mjtWarning.mjWARN_BADQPOS: "NaN, Inf or huge value in qpos",
+    mujoco.mjtWarning.mjWARN_BADQVEL: "NaN, Inf or huge value in qvel",
+    mujoco.mjtWarning.mjWARN_BADQACC: "NaN, Inf or huge value in qacc",
+    mujoco.mjtWarning.mjWARN_BADCTRL: "NaN, Inf or huge value in ctrl",
+}
+
+
+@dataclass(frozen=True, slots=True)
+class Divergence:
+    warning: mujoco.mjtWarning
+    info: int  # the DOF (or actuator for BADCTRL) MuJoCo reported
+
+    def text(self, name_of_dof: str) -> str:
+        return f"{self.warning.name}: {_TEXT[self.warning]} at {name_of_dof}"
+
+
+class DivergenceWatch:
+    def __init__(self, data: mujoco.MjData) -> None:
+        self._counts = [int(data.warning[w].number) for w in WATCHED]
+
+    def check(self, data: mujoco.MjData) -> Divergence | None:
+        """The first new instability warning since the last call, or None."""
+        found: Divergence | None = None
+        for i, w in enumerate(WATCHED):
+            number = int(data.warning[w].number)
+            if number != self._counts[i]:
+                self._counts[i] = number
+                if found is None:
+                    found = Divergence(warning=w, info=int(data.warning[w].lastinfo))
+        return found

@@ -1,0 +1,106 @@
+"""Motor control state of every actuator: position targets with a velocity limit, torque mode,
+PID gains, limp robots. Applied to MuJoCo's ``ctrl`` and actuator gains once per basic step.
+
+A position actuator produces ``kp * (ctrl - q) - kv * qdot`` (clipped to the motor's torque
+range). Torque mode sets gain 1 and no bias so ``ctrl`` is the torque. Limp robots get zero gain
+and bias (only passive joint damping remains). Webots-style PID: ``P`` scales the stiffness
+relative to the default ``P = 10`` (``kp = model_kp * P / 10``), ``D`` adds damping
+``kv = model_kp * D / 10`` (N m s/rad); ``I`` is stored but has no effect.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import numpy.typing as npt
+
+from simulator.world.indices import WorldIndex
+
+FloatArray = npt.NDArray[np.float64]
+DEFAULT_P = 10.0
+
+
+class MotorBank:
+    def __init__(self, model: mujoco.MjModel, index: WorldIndex, step_s: float) -> None:
+        self._model = model
+        self._step_s = step_s
+        nu = model.nu
+        self.default_kp = np.zeros(nu)
+        self.max_torque = np.zeros(nu)
+        self.max_velocity = np.zeros(nu)
+        self.lower = np.zeros(nu)
+        self.upper = np.zeros(nu)
+        for robot in index.robots:
+            for slot, spec in enumerate(robot.model.motors):
+                a = robot.actuators[slot]
+                self.default_kp[a] = spec.kp_nm_per_rad
+                self.max_torque[a] = spec.max_torque_nm
+                self.max_velocity[a] = spec.max_velocity_rad_s
+                self.lower[a] = spec.lower_rad
+                self.upper[a] = spec.upper_rad
+        self.kp = self.default_kp.copy()
+        self.kv = np.zeros(nu)
+        self.ki = np.zeros(nu)
+        self.velocity_limit = self.max_velocity.copy()
+        self.target = np.zeros(nu)
+        self.effective = np.zeros(nu)
+        self.torque = np.zeros(nu)
+        self.torque_mode = np.zeros(nu, dtype=bool)
+        self.limp = np.zeros(nu, dtype=bool)
+        self._dirty = True
+
+    # --- commands ----------------------------------------------------------------------------
+
+    def set_position(self, actuator: int, rad: float) -> None:
+        self.target[actuator] = min(max(rad, self.lower[actuator]), self.upper[actuator])
+        if self.torque_mode[actuator]:
+            self.torque_mode[actuator] = False
+            self._dirty = True
+
+    def set_velocity(self, actuator: int, rad_s: float) -> None:
+        self.velocity_limit[actuator] = min(abs(rad_s), self.max_velocity[actuator])
+
+    def set_torque(self, actuator: int, nm: float) -> None:
+        limit = self.max_torque[actuator]
+        self.torque[actuator] = min(max(nm, -limit), limit)
+        if not self.torque_mode[actuator]:
+            self.torque_mode[actuator] = True
+            self._dirty = True
+
+    def set_pid(self, actuator: int, p: float, i: float, d: float) -> None:
+        base = self.default_kp[actuator] / DEFAULT_P
+        self.kp[actuator] = max(p, 0.0) * base
+        self.ki[actuator] = i
+        self.kv[actuator] = max(d, 0.0) * base
+        self._dirty = True
+
+    def set_limp(self, actuators: npt.NDArray[np.int64], limp: bool) -> None:
+        self.limp[actuators] = limp
+        self._dirty = True
+
+    def hold(self, actuators: npt.NDArray[np.int64], positions: FloatArray) -> None:
+        """Position mode at ``positions`` immediately (no ramp): after a teleport or restore."""
+        self.target[actuators] = positions
+        self.effective[actuators] = positions
+        if self.torque_mode[actuators].any():
+            self.torque_mode[actuators] = False
+            self._dirty = True
+
+    # --- per step ----------------------------------------------------------------------------
+
+    def apply(self, data: mujoco.MjData) -> None:
+        """Advance the velocity-limited targets by one basic step and write ``ctrl``."""
+        reach = self.velocity_limit * self._step_s
+        np.clip(self.target, self.effective - reach, self.effective + reach, out=self.effective)
+        if self._dirty:
+            self._write_gains()
+        data.ctrl[:] = np.where(self.torque_mode, self.torque, self.effective)
+
+    def _write_gains(self) -> None:
+        active = ~self.limp
+        position = active & ~self.torque_mode
+        gain = np.where(self.torque_mode, 1.0, self.kp) * active
+        self._model.actuator_gainprm[:, 0] = gain
+        self._model.actuator_biasprm[:, 1] = -self.kp * position
+        self._model.actuator_biasprm[:, 2] = -self.kv * position
+        self._dirty = False

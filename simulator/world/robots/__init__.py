@@ -1,0 +1,102 @@
+"""Registry of the built-in robot models (``kid-default``, ``adult-default``)."""
+
+from __future__ import annotations
+
+from simulator.errors import UnknownModelError
+from simulator.world.robots.geometry import (
+    ADULT_GEOMETRY,
+    ADULT_SCALE,
+    KID_GEOMETRY,
+    HumanoidGeometry,
+)
+from simulator.world.robots.model import (
+    FORCE_SENSORS,
+    MOTOR_NAMES,
+    CameraSpec,
+    MotorSpec,
+    RobotMjcf,
+    RobotModel,
+)
+
+# (lower, upper) rad, kp N m/rad, max torque N m, max velocity rad/s for the kid model.
+_KID_MOTORS: dict[str, tuple[float, float, float, float, float]] = {
+    "Neck": (-2.0, 2.0, 8.0, 6.0, 6.0),
+    "Head": (-0.8, 1.2, 8.0, 6.0, 6.0),
+    "Shoulder": (-3.1, 3.1, 20.0, 6.0, 6.0),
+    "ArmUpperL": (-0.3, 2.8, 20.0, 6.0, 6.0),
+    "ArmUpperR": (-2.8, 0.3, 20.0, 6.0, 6.0),
+    "ArmLower": (-0.1, 2.6, 15.0, 6.0, 6.0),
+    "PelvY": (-0.9, 0.9, 40.0, 8.0, 6.0),
+    "Pelv": (-0.6, 0.6, 80.0, 10.0, 6.0),
+    "LegUpper": (-1.0, 2.2, 80.0, 10.0, 6.0),
+    "LegLower": (-0.05, 2.6, 80.0, 10.0, 6.0),
+    "Ankle": (-1.2, 1.2, 80.0, 10.0, 6.0),
+    "Foot": (-0.6, 0.6, 80.0, 10.0, 6.0),
+}
+
+
+def _motors(scale: float) -> tuple[MotorSpec, ...]:
+    torque_scale = scale**4  # torque ~ mass x length ~ scale^4
+    motors = []
+    for name in MOTOR_NAMES:
+        key = name if name in _KID_MOTORS else name[:-1]
+        lower, upper, kp, torque, velocity = _KID_MOTORS[key]
+        motors.append(
+            MotorSpec(
+                name=name,
+                lower_rad=lower,
+                upper_rad=upper,
+                kp_nm_per_rad=kp * torque_scale,
+                max_torque_nm=torque * torque_scale,
+                max_velocity_rad_s=velocity / scale**0.5,
+            )
+        )
+    return tuple(motors)
+
+
+KID_DEFAULT = RobotModel(
+    name="kid-default",
+    field_class="kid",
+    geometry=KID_GEOMETRY,
+    motors=_motors(1.0),
+    joint_damping=0.3,
+    joint_armature=0.01,
+)
+ADULT_DEFAULT = RobotModel(
+    name="adult-default",
+    field_class="adult",
+    geometry=ADULT_GEOMETRY,
+    motors=_motors(ADULT_SCALE),
+    joint_damping=0.3 * ADULT_SCALE**4,
+    joint_armature=0.01 * ADULT_SCALE**5,
+)
+
+_MODELS = {model.name: model for model in (KID_DEFAULT, ADULT_DEFAULT)}
+
+
+def known_models() -> tuple[str, ...]:
+    """Names of the built-in robot models, sorted."""
+    return tuple(sorted(_MODELS))
+
+
+def robot_model(name: str) -> RobotModel:
+    """The built-in model called ``name``; :class:`UnknownModelError` lists the known ones."""
+    try:
+        return _MODELS[name]
+    except KeyError:
+        raise UnknownModelError(name=name, known=list(_MODELS)) from None
+
+
+__all__ = [
+    "ADULT_DEFAULT",
+    "FORCE_SENSORS",
+    "KID_DEFAULT",
+    "MOTOR_NAMES",
+    "CameraSpec",
+    "HumanoidGeometry",
+    "MotorSpec",
+    "RobotMjcf",
+    "RobotModel",
+    "known_models",
+    "robot_model",
+]

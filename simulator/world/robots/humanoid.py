@@ -1,0 +1,224 @@
+"""MJCF of our humanoid (primitive geoms only), parameterised by :class:`HumanoidGeometry`.
+
+Geom names carry their body part for contact reporting: ``<prefix>/<part>:<label>`` where part is
+a :class:`referee.snapshot.BodyPart` value (foot, hand, arm, head, torso, leg). Visual-only geoms
+(markers) use the part ``visual`` and never collide.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+from simulator.world.robots.model import RobotMjcf
+
+if TYPE_CHECKING:
+    from simulator.world.robots.model import RobotModel
+
+LIMB_RGBA = "0.3 0.3 0.33 1"
+FOOT_RGBA = "0.12 0.12 0.12 1"
+HEAD_RGBA = "0.85 0.85 0.85 1"
+
+
+def _f(*values: float) -> str:
+    return " ".join(f"{v:.6g}" for v in values)
+
+
+def _inertial(mass: float, radius: float) -> str:
+    i = 0.4 * mass * radius * radius
+    return f'<inertial pos="0 0 0" mass="{mass:.6g}" diaginertia="{_f(i, i, i)}"/>'
+
+
+class _Writer:
+    def __init__(self, model: RobotModel, prefix: str, contype: int, conaffinity: int) -> None:
+        self.model = model
+        self.p = prefix
+        self.col = f'contype="{contype}" conaffinity="{conaffinity}"'
+
+    def joint(self, motor: str, axis: tuple[float, float, float]) -> str:
+        spec = self.model.motor(motor)
+        return (
+            f'<joint name="{self.p}/{motor}" type="hinge" axis="{_f(*axis)}" '
+            f'range="{_f(spec.lower_rad, spec.upper_rad)}" damping="{self.model.joint_damping}" '
+            f'armature="{self.model.joint_armature}"/>'
+        )
+
+    def geom(self, part: str, label: str, attrs: str, rgba: str, mass: float) -> str:
+        return (
+            f'<geom name="{self.p}/{part}:{label}" {attrs} rgba="{rgba}" mass="{mass:.6g}" '
+            f"{self.col}/>"
+        )
+
+    def visual(self, label: str, attrs: str, rgba: str) -> str:
+        return (
+            f'<geom name="{self.p}/visual:{label}" {attrs} rgba="{rgba}" mass="0" '
+            f'contype="0" conaffinity="0" group="1"/>'
+        )
+
+
+def _leg(w: _Writer, side: str) -> str:
+    g = w.model.geometry
+    sign = 1.0 if side == "L" else -1.0
+    small = _inertial(g.joint_link_kg, g.foot_half_width_m / 2)
+    r_thigh = g.foot_half_width_m * 0.65
+    hl, hw, ht = g.foot_half_length_m, g.foot_half_width_m, g.foot_half_thickness_m
+    fx, sole = g.foot_forward_m, -g.ankle_height_m
+    foot_z = sole + ht
+    sites = []
+    letter = side.lower()
+    for ny, y_name in ((1.0, "l"), (-1.0, "r")):
+        for nx, x_name in ((-1.0, "b"), (1.0, "f")):
+            name = f"{letter}{y_name}{x_name}"
+            sites.append(
+                f'<site name="{w.p}/site:{name}" type="box" group="4" '
+                f'pos="{_f(fx + nx * hl / 2, ny * hw / 2, sole)}" '
+                f'size="{_f(hl / 2 + 1e-3, hw / 2 + 1e-3, ht * 1.5)}"/>'
+            )
+    thigh = w.geom(
+        "leg",
+        "thigh_" + side,
+        f'type="capsule" fromto="{_f(0, 0, -r_thigh, 0, 0, -g.thigh_m)}" size="{r_thigh:.6g}"',
+        LIMB_RGBA,
+        g.thigh_kg,
+    )
+    shank = w.geom(
+        "leg",
+        "shank_" + side,
+        f'type="capsule" fromto="{_f(0, 0, 0, 0, 0, -g.shank_m)}" size="{r_thigh * 0.9:.6g}"',
+        LIMB_RGBA,
+        g.shank_kg,
+    )
+    foot = w.geom(
+        "foot",
+        "sole_" + side,
+        f'type="box" pos="{_f(fx, 0, foot_z)}" size="{_f(hl, hw, ht)}"',
+        FOOT_RGBA,
+        g.foot_kg,
+    )
+    return f"""
+<body name="{w.p}/hip_yaw_{side}" pos="{_f(0, sign * g.hip_y_m, g.hip_z_m)}">
+ {small}{w.joint("PelvY" + side, (0, 0, 1))}
+ <body name="{w.p}/hip_roll_{side}">
+  {small}{w.joint("Pelv" + side, (1, 0, 0))}
+  <body name="{w.p}/thigh_{side}">
+   {w.joint("LegUpper" + side, (0, -1, 0))}
+   {thigh}
+   <body name="{w.p}/shank_{side}" pos="{_f(0, 0, -g.thigh_m)}">
+    {w.joint("LegLower" + side, (0, 1, 0))}
+    {shank}
+    <body name="{w.p}/ankle_{side}" pos="{_f(0, 0, -g.shank_m)}">
+     {small}{w.joint("Ankle" + side, (0, -1, 0))}
+     <body name="{w.p}/foot_{side}">
+      {w.joint("Foot" + side, (1, 0, 0))}
+      {foot}
+      {"".join(sites)}
+     </body>
+    </body>
+   </body>
+  </body>
+ </body>
+</body>"""
+
+
+def _arm(w: _Writer, side: str) -> str:
+    g = w.model.geometry
+    sign = 1.0 if side == "L" else -1.0
+    r = g.foot_half_width_m * 0.45
+    upper = w.geom(
+        "arm",
+        "upper_arm_" + side,
+        f'type="capsule" fromto="{_f(0, 0, -r, 0, 0, -g.upper_arm_m)}" size="{r:.6g}"',
+        LIMB_RGBA,
+        g.upper_arm_kg,
+    )
+    fore = w.geom(
+        "arm",
+        "forearm_" + side,
+        f'type="capsule" fromto="{_f(0, 0, 0, 0, 0, -g.forearm_m + r)}" size="{r * 0.9:.6g}"',
+        LIMB_RGBA,
+        g.forearm_kg * 0.7,
+    )
+    hand = w.geom(
+        "hand", "hand_" + side, f'type="sphere" size="{r * 1.1:.6g}"', LIMB_RGBA, g.forearm_kg * 0.3
+    )
+    return f"""
+<body name="{w.p}/shoulder_{side}" pos="{_f(0, sign * g.shoulder_y_m, g.shoulder_z_m)}">
+ {_inertial(g.joint_link_kg, r)}{w.joint("Shoulder" + side, (0, -1, 0))}
+ <body name="{w.p}/upper_arm_{side}">
+  {w.joint("ArmUpper" + side, (1, 0, 0))}
+  {upper}
+  <body name="{w.p}/forearm_{side}" pos="{_f(0, 0, -g.upper_arm_m)}">
+   {w.joint("ArmLower" + side, (0, -1, 0))}
+   {fore}
+   <body name="{w.p}/hand_{side}" pos="{_f(0, 0, -g.forearm_m)}">
+    {hand}
+   </body>
+  </body>
+ </body>
+</body>"""
+
+
+def build_humanoid(
+    model: RobotModel,
+    *,
+    prefix: str,
+    rgba: str,
+    contype: int,
+    conaffinity: int,
+    pose: tuple[float, float, float],
+) -> RobotMjcf:
+    """The robot's body tree (root ``<prefix>/torso`` with a free joint, standing at ``pose`` =
+    (x, y, yaw) in the world frame), its actuators and sensors."""
+    w = _Writer(model, prefix, contype, conaffinity)
+    x, y, yaw = pose
+    g = model.geometry
+    p = prefix
+    tx, ty, tz = g.torso_half_size_m
+    cam = model.camera
+    fovy_deg = math.degrees(2 * math.atan(math.tan(cam.fov_rad / 2) * cam.height / cam.width))
+    hr = g.head_radius_m
+    cz = g.torso_centre_z_m
+    torso = w.geom(
+        "torso", "torso", f'type="box" pos="0 0 {cz:.6g}" size="{_f(tx, ty, tz)}"', rgba, g.torso_kg
+    )
+    chest = w.visual(
+        "chest",
+        f'type="box" pos="{_f(tx, 0, cz + tz * 0.3)}" size="{_f(tx * 0.05, ty * 0.6, tz * 0.35)}"',
+        "1 1 1 1",
+    )
+    marker = w.visual(
+        "marker",
+        f'type="cylinder" pos="0 0 {hr * 0.95:.6g}" size="{_f(hr * 0.6, hr * 0.08)}"',
+        rgba,
+    )
+    camera = (
+        f'<camera name="{p}/{cam.name}" pos="{_f(hr * 0.92, 0, 0)}" xyaxes="0 -1 0 0 0 1" '
+        f'fovy="{fovy_deg:.6g}"/>'
+    )
+    body = f"""
+<body name="{p}/torso" pos="{_f(x, y, g.standing_height_m)}" euler="0 0 {yaw:.9g}">
+ <freejoint name="{p}/root"/>
+ {torso}{chest}
+ <site name="{p}/site:imu" pos="0 0 {g.torso_centre_z_m:.6g}" size="0.01"/>
+ {_leg(w, "L")}{_leg(w, "R")}{_arm(w, "L")}{_arm(w, "R")}
+ <body name="{p}/neck" pos="0 0 {g.neck_z_m:.6g}">
+  {_inertial(g.joint_link_kg, hr / 3)}{w.joint("Neck", (0, 0, 1))}
+  <body name="{p}/head" pos="0 0 {g.head_centre_z_m:.6g}">
+   {w.joint("Head", (0, 1, 0))}
+   {w.geom("head", "head", f'type="sphere" size="{hr:.6g}"', HEAD_RGBA, g.head_kg)}
+   {marker}{camera}
+  </body>
+ </body>
+</body>"""
+    actuators = "".join(
+        f'<position name="{p}/{m.name}" joint="{p}/{m.name}" kp="{m.kp_nm_per_rad:.6g}" '
+        f'forcerange="{_f(-m.max_torque_nm, m.max_torque_nm)}" ctrllimited="false"/>'
+        for m in model.motors
+    )
+    sensors = (
+        f'<accelerometer name="{p}/Accelerometer" site="{p}/site:imu"/>'
+        f'<gyro name="{p}/Gyro" site="{p}/site:imu"/>'
+        f'<subtreelinvel name="{p}/com_velocity" body="{p}/torso"/>'
+        + "".join(f'<touch name="{p}/{n}" site="{p}/site:{n}"/>' for n in model.force_sensors)
+    )
+    return RobotMjcf(body=body, actuators=actuators, sensors=sensors)

@@ -1,0 +1,88 @@
+"""Robot model descriptions: motors, sensors and the MJCF they produce."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from simulator.world.robots.geometry import HumanoidGeometry
+
+FORCE_SENSORS = ("llb", "llf", "lrf", "lrb", "rlb", "rlf", "rrf", "rrb")
+"""Sole corner force sensors: first letter foot (l/r), then side (l/r), then back/front."""
+
+MOTOR_NAMES = (
+    "Neck", "Head", "ShoulderL", "ArmUpperL", "ArmLowerL", "PelvYL", "PelvL", "LegUpperL",
+    "LegLowerL", "AnkleL", "FootL", "PelvYR", "PelvR", "LegUpperR", "LegLowerR", "AnkleR", "FootR",
+    "ShoulderR", "ArmUpperR", "ArmLowerR",
+)  # fmt: skip
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class MotorSpec:
+    """One position-controlled motor (a hinge joint and its actuator)."""
+
+    name: str
+    lower_rad: float
+    upper_rad: float
+    kp_nm_per_rad: float
+    max_torque_nm: float
+    max_velocity_rad_s: float
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class CameraSpec:
+    name: str = "Camera"
+    width: int = 320
+    height: int = 240
+    fov_rad: float = 1.04  # horizontal
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RobotMjcf:
+    """MJCF fragments of one robot, to be placed in the matching sections of the world."""
+
+    body: str
+    actuators: str
+    sensors: str
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RobotModel:
+    """A built-in robot model: its shape, motors and sensors."""
+
+    name: str
+    field_class: str  # "kid" | "adult"
+    geometry: HumanoidGeometry
+    motors: tuple[MotorSpec, ...]
+    joint_damping: float
+    joint_armature: float
+    camera: CameraSpec = CameraSpec()
+    force_sensors: tuple[str, ...] = FORCE_SENSORS
+
+    @property
+    def standing_height_m(self) -> float:
+        return self.geometry.standing_height_m
+
+    @property
+    def motor_names(self) -> tuple[str, ...]:
+        return tuple(m.name for m in self.motors)
+
+    def motor(self, name: str) -> MotorSpec:
+        for motor in self.motors:
+            if motor.name == name:
+                return motor
+        raise KeyError(name)
+
+    def mjcf(
+        self,
+        *,
+        prefix: str,
+        rgba: str,
+        contype: int,
+        conaffinity: int,
+        pose: tuple[float, float, float],
+    ) -> RobotMjcf:
+        from simulator.world.robots.humanoid import build_humanoid
+
+        return build_humanoid(
+            self, prefix=prefix, rgba=rgba, contype=contype, conaffinity=conaffinity, pose=pose
+        )

@@ -1,0 +1,96 @@
+"""Assembles the world MJCF from its entities (field, goals, ball, robots) and compiles it.
+
+Collision filtering: each robot ``i`` gets its own bit ``1 << i`` as ``contype`` and every other
+bit as ``conaffinity``, so a robot's parts never collide with each other but do collide with
+other robots, the ball, the turf and the goals. Static geoms and the ball have bits of their own.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import mujoco
+import numpy as np
+
+from referee.field import FieldGeometry
+from referee.snapshot import TeamColor
+from simulator.world.ball import BALL_JOINT, ball_assets, ball_body, ball_damping
+from simulator.world.field import field_assets, field_bodies
+from simulator.world.goal import goal_bodies
+from simulator.world.robots import robot_model
+from simulator.world.types import RobotPlacement, robot_prefix
+
+STATIC_BIT = 1 << 30
+BALL_BIT = 1 << 29
+MAX_ROBOTS = 29
+TEAM_RGBA = {TeamColor.RED: "0.85 0.12 0.1 1", TeamColor.BLUE: "0.1 0.25 0.9 1"}
+
+
+def scene_xml(
+    field: FieldGeometry, robots: Sequence[RobotPlacement], *, physics_dt_s: float
+) -> str:
+    """The world MJCF. Raises UnknownModelError for a model name we do not ship."""
+    if len(robots) > MAX_ROBOTS:
+        raise ValueError(f"at most {MAX_ROBOTS} robots, got {len(robots)}")
+    robot_bits = (1 << len(robots)) - 1
+    static = (STATIC_BIT, BALL_BIT | robot_bits)
+    ball = (BALL_BIT, STATIC_BIT | robot_bits)
+    bodies = [
+        field_bodies(field, static_bits=static),
+        goal_bodies(field, sign=-1.0, name="goal_left", static_bits=static),
+        goal_bodies(field, sign=1.0, name="goal_right", static_bits=static),
+        ball_body(field, bits=ball),
+    ]
+    actuators = []
+    sensors = []
+    for i, placement in enumerate(robots):
+        model = robot_model(placement.model)
+        bit = 1 << i
+        parts = model.mjcf(
+            prefix=robot_prefix(placement.id),
+            rgba=TEAM_RGBA[placement.id.team],
+            contype=bit,
+            conaffinity=(robot_bits & ~bit) | STATIC_BIT | BALL_BIT,
+            pose=(placement.x_m, placement.y_m, placement.yaw_rad),
+        )
+        bodies.append(parts.body)
+        actuators.append(parts.actuators)
+        sensors.append(parts.sensors)
+    return f"""<mujoco model="hlvs-{field.field_class.value}">
+<compiler angle="radian" autolimits="true"/>
+<option timestep="{physics_dt_s!r}" integrator="implicitfast" cone="pyramidal"/>
+<visual>
+ <global offwidth="1920" offheight="1080"/>
+ <quality shadowsize="2048"/>
+ <headlight ambient="0.35 0.35 0.35" diffuse="0.3 0.3 0.3" specular="0 0 0"/>
+ <map znear="0.01" zfar="100"/>
+</visual>
+<asset>{field_assets()}{ball_assets()}</asset>
+<worldbody>{"".join(bodies)}</worldbody>
+<actuator>{"".join(actuators)}</actuator>
+<sensor>{"".join(sensors)}</sensor>
+</mujoco>"""
+
+
+def compile_scene(
+    field: FieldGeometry, robots: Sequence[RobotPlacement], *, physics_dt_s: float
+) -> mujoco.MjModel:
+    """Compile the world model, with the ball's per-axis damping applied."""
+    model = mujoco.MjModel.from_xml_string(scene_xml(field, robots, physics_dt_s=physics_dt_s))
+    linear, angular = ball_damping(field)
+    adr = int(model.joint(BALL_JOINT).dofadr[0])
+    model.dof_damping[adr : adr + 3] = linear
+    model.dof_damping[adr + 3 : adr + 6] = angular
+    return model
+
+
+def body_names(model: mujoco.MjModel) -> list[str]:
+    return [model.body(i).name for i in range(model.nbody)]
+
+
+def geom_names(model: mujoco.MjModel) -> list[str]:
+    return [model.geom(i).name for i in range(model.ngeom)]
+
+
+def as_int_array(values: Sequence[int]) -> np.ndarray:
+    return np.asarray(values, dtype=np.int64)

@@ -1,0 +1,220 @@
+"""The soccer world: MuJoCo model and state, stepping, snapshots, referee commands, devices.
+
+Order of work in one basic step (``step_ms``, default 8 ms = 4 physics substeps of 2 ms):
+motors write ``ctrl`` (velocity-limited targets, torque mode, limp), MuJoCo steps, removed robots
+are held at their parking spots, divergence is checked (policy ``fail`` raises
+:class:`PhysicsDivergence`, ``reset_robot`` restores the previous state and resets the offending
+robot), and the last ball toucher is updated.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Sequence
+
+import mujoco
+import numpy as np
+
+from referee.field import FieldGeometry, field_for
+from referee.snapshot import RobotId, TeamColor, WorldCommand, WorldSnapshot
+from simulator.errors import PhysicsDivergence
+from simulator.spec import MatchSpec
+from simulator.world import commands
+from simulator.world.devices import DeviceAccess
+from simulator.world.divergence import DivergenceWatch
+from simulator.world.indices import build_index
+from simulator.world.motors import MotorBank
+from simulator.world.robots import robot_model
+from simulator.world.scene import compile_scene
+from simulator.world.snapshot import ball_toucher, build_snapshot
+from simulator.world.types import DivergencePolicy, FieldClassName, RobotPlacement
+
+logger = logging.getLogger(__name__)
+
+
+class World(DeviceAccess):
+    """Create with :meth:`create` or :meth:`from_spec`; step, snapshot, apply commands."""
+
+    def __init__(
+        self,
+        *,
+        field: FieldGeometry,
+        placements: Sequence[RobotPlacement],
+        seed: int,
+        physics_dt_s: float,
+        step_ms: int,
+        divergence_policy: DivergencePolicy,
+        initial_joint_noise_rad: float,
+    ) -> None:
+        substeps = step_ms / 1000.0 / physics_dt_s
+        if physics_dt_s <= 0 or step_ms <= 0 or abs(substeps - round(substeps)) > 1e-6:
+            raise ValueError(
+                f"step_ms ({step_ms}) must be a positive multiple of physics_dt_s ({physics_dt_s})"
+            )
+        if divergence_policy not in ("fail", "reset_robot"):
+            raise ValueError(
+                f"divergence_policy must be 'fail' or 'reset_robot', not {divergence_policy!r}"
+            )
+        ids = [p.id for p in placements]
+        if len(set(ids)) != len(ids):
+            raise ValueError(f"robot ids must be unique: {[str(i) for i in ids]}")
+        self.field = field
+        self.placements = tuple(placements)
+        self.seed = seed
+        self.physics_dt_s = physics_dt_s
+        self.step_ms = step_ms
+        self.substeps = int(round(substeps))
+        self.divergence_policy: DivergencePolicy = divergence_policy
+        self.rng = np.random.default_rng(seed)
+        self.model = compile_scene(field, placements, physics_dt_s=physics_dt_s)
+        self.data = mujoco.MjData(self.model)
+        self.index = build_index(self.model, placements)
+        self.robot_ids: tuple[RobotId, ...] = tuple(ids)
+        self.motors = MotorBank(self.model, self.index, step_ms / 1000.0)
+        self.limp = [False] * len(ids)
+        self.removed = [False] * len(ids)
+        self.parked_qpos: dict[int, np.ndarray] = {}
+        self.sim_time_ms = 0
+        self.last_ball_toucher: RobotId | None = None
+        self.last_ball_touch_ms: int | None = None
+        if initial_joint_noise_rad > 0:
+            for robot in self.index.robots:
+                noise = self.rng.uniform(
+                    -initial_joint_noise_rad, initial_joint_noise_rad, size=robot.motor_qpos.size
+                )
+                self.data.qpos[robot.motor_qpos] = noise
+                self.motors.hold(robot.actuators, noise)
+        mujoco.mj_forward(self.model, self.data)
+        self._watch = DivergenceWatch(self.data)
+        self._saved = self._save()
+
+    @classmethod
+    def create(
+        cls,
+        *,
+        field_class: FieldClassName,
+        robots: Sequence[RobotPlacement],
+        seed: int,
+        physics_dt_s: float = 0.002,
+        step_ms: int = 8,
+        divergence_policy: DivergencePolicy = "fail",
+        initial_joint_noise_rad: float = 0.0,
+    ) -> World:
+        """A world on the ``field_class`` pitch with ``robots`` standing at their poses (world
+        frame), the ball on the centre spot. Unknown model names raise UnknownModelError."""
+        for placement in robots:
+            robot_model(placement.model)
+        return cls(
+            field=field_for(field_class),
+            placements=robots,
+            seed=seed,
+            physics_dt_s=physics_dt_s,
+            step_ms=step_ms,
+            divergence_policy=divergence_policy,
+            initial_joint_noise_rad=initial_joint_noise_rad,
+        )
+
+    @classmethod
+    def from_spec(cls, spec: MatchSpec, *, divergence_policy: DivergencePolicy = "fail") -> World:
+        """Every player of both teams at its ``half_time_pose``; the team playing on the right
+        (not ``spec.side_left``) is mirrored: ``x -> -x``, ``yaw -> pi - yaw``."""
+        placements = []
+        for color in (TeamColor.RED, TeamColor.BLUE):
+            team = spec.red if color is TeamColor.RED else spec.blue
+            mirror = spec.side_left != color.value
+            for player in team.players:
+                pose = player.half_time_pose
+                x, yaw = (-pose.x_m, math.pi - pose.yaw_rad) if mirror else (pose.x_m, pose.yaw_rad)
+                yaw = math.atan2(math.sin(yaw), math.cos(yaw))
+                placements.append(
+                    RobotPlacement(
+                        id=RobotId(color, player.number),
+                        model=player.model,
+                        x_m=x,
+                        y_m=pose.y_m,
+                        yaw_rad=yaw,
+                    )
+                )
+        return cls.create(
+            field_class=spec.field_class,
+            robots=placements,
+            seed=spec.seed,
+            physics_dt_s=spec.physics_dt_s,
+            divergence_policy=divergence_policy,
+        )
+
+    # --- stepping ------------------------------------------------------------------------------
+
+    def step(self) -> None:
+        """Advance one basic step (``step_ms`` of simulated time)."""
+        self._saved = self._save()
+        self.motors.apply(self.data)
+        mujoco.mj_step(self.model, self.data, nstep=self.substeps)
+        if self.parked_qpos:
+            commands.hold_parked(self)
+        divergence = self._watch.check(self.data)
+        self.sim_time_ms += self.step_ms
+        if divergence is not None:
+            self._diverged(divergence.text(self._dof_name(divergence.info)), divergence.info)
+        toucher = ball_toucher(self.data, self.index)
+        if toucher >= 0:
+            self.last_ball_toucher = self.robot_ids[toucher]
+            self.last_ball_touch_ms = self.sim_time_ms
+
+    def snapshot(self) -> WorldSnapshot:
+        return build_snapshot(
+            data=self.data,
+            index=self.index,
+            robot_ids=self.robot_ids,
+            sim_time_ms=self.sim_time_ms,
+            limp=self.limp,
+            removed=self.removed,
+            last_toucher=self.last_ball_toucher,
+            last_touch_ms=self.last_ball_touch_ms,
+        )
+
+    def apply(self, command: WorldCommand) -> None:
+        """Apply a referee command now (before the next step)."""
+        commands.apply(self, command)
+
+    # --- divergence ----------------------------------------------------------------------------
+
+    def _save(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+        d = self.data
+        return d.qpos.copy(), d.qvel.copy(), d.qacc_warmstart.copy(), float(d.time)
+
+    def _dof_name(self, dof: int) -> str:
+        if 0 <= dof < self.model.nv:
+            joint = self.model.joint(int(self.model.dof_jntid[dof])).name
+            return f"DOF {dof} (joint {joint!r})"
+        return f"DOF {dof}"
+
+    def _diverged(self, text: str, dof: int) -> None:
+        if self.divergence_policy == "fail":
+            raise PhysicsDivergence(sim_time_ms=self.sim_time_ms, warning=text, policy="fail")
+        qpos, qvel, warm, time = self._saved
+        self.data.qpos[:] = qpos
+        self.data.qvel[:] = qvel
+        self.data.qacc_warmstart[:] = warm
+        self.data.time = time
+        offender = int(self.index.dof_robot[dof]) if 0 <= dof < self.model.nv else -1
+        if offender < 0:
+            speeds = [
+                float(np.abs(qvel[r.dof_range[0] : r.dof_range[1]]).max())
+                for r in self.index.robots
+            ]
+            offender = int(np.argmax(speeds)) if speeds else -1
+        if offender >= 0 and not self.removed[offender]:
+            robot = self.index.robots[offender]
+            x, y = (float(v) for v in qpos[robot.root_qpos : robot.root_qpos + 2])
+            if not (math.isfinite(x) and math.isfinite(y)):
+                x, y = 0.0, 0.0
+            commands.teleport(self, robot.number, x, y, self.snapshot().robots[offender].yaw_rad)
+            logger.warning(
+                "physics diverged at %d ms (%s); reset %s", self.sim_time_ms, text, robot.id
+            )
+        else:
+            commands.place_ball(self, (0.0, 0.0, self.field.ball_radius_m), (0.0, 0.0, 0.0))
+            logger.warning("physics diverged at %d ms (%s); reset the ball", self.sim_time_ms, text)
+        mujoco.mj_forward(self.model, self.data)
