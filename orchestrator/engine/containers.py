@@ -1,0 +1,242 @@
+"""Docker adapter for the match: containers (and, through ``networks``, networks).
+
+:class:`DockerRuntime` implements :class:`orchestrator.match.runtime.ContainerRuntime`.
+Docker SDK errors become orchestrator errors in :func:`translate` and nowhere else.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import docker
+import docker.errors
+import requests.exceptions
+
+from orchestrator.engine import LABEL_MATCH, LABEL_PROJECT
+from orchestrator.engine import networks as _networks
+from orchestrator.errors import InfrastructureError
+from orchestrator.match.runtime import (
+    ContainerRequest,
+    ContainerState,
+    NetworkInfo,
+    NetworkRequest,
+    ObjectNotFound,
+    ProjectObject,
+    StatsSample,
+)
+
+log = logging.getLogger(__name__)
+
+_WAIT_TIMEOUTS = (requests.exceptions.ConnectionError, requests.exceptions.Timeout)
+
+
+@contextlib.contextmanager
+def translate(kind: str, name: str) -> Iterator[None]:
+    """Turn Docker SDK and transport errors into :mod:`orchestrator.errors`."""
+    try:
+        yield
+    except docker.errors.NotFound as exc:
+        raise ObjectNotFound(kind=kind, name=name) from exc
+    except docker.errors.APIError as exc:
+        detail = exc.explanation or str(exc)
+        raise InfrastructureError(f"Docker engine refused on {kind} {name}: {detail}") from exc
+    except (docker.errors.DockerException, requests.exceptions.RequestException, OSError) as exc:
+        raise InfrastructureError(f"Docker engine failed on {kind} {name}: {exc}") from exc
+
+
+class DockerRuntime:
+    """The real container runtime on a Docker engine (``client`` from ``engine.connect()``)."""
+
+    def __init__(self, client: docker.DockerClient) -> None:
+        self._client = client
+
+    # networks -------------------------------------------------------------------------------
+    def create_network(self, request: NetworkRequest) -> NetworkInfo:
+        with translate("network", request.name):
+            return _networks.create_network(self._client, request)
+
+    def remove_network(self, name: str) -> None:
+        with translate("network", name):
+            _networks.remove_network(self._client, name)
+
+    # containers -----------------------------------------------------------------------------
+    def create_container(self, request: ContainerRequest) -> str:
+        host_config: dict[str, Any] = {
+            "cap_drop": list(request.cap_drop) or None,
+            "cap_add": list(request.cap_add) or None,
+            "security_opt": list(request.security_opt) or None,
+            "privileged": False,
+            "binds": {
+                str(m.source): {"bind": m.target, "mode": "ro" if m.read_only else "rw"}
+                for m in request.mounts
+            }
+            or None,
+            "nano_cpus": request.nano_cpus,
+            "mem_limit": request.mem_bytes,
+            "memswap_limit": request.mem_bytes,
+            "pids_limit": request.pids_limit,
+            "network_mode": request.network_mode
+            or (request.networks[0].network if request.networks else "none"),
+        }
+        api = self._client.api
+        networking = None
+        if request.networks and not request.network_mode:
+            first = request.networks[0]
+            networking = api.create_networking_config(
+                {
+                    first.network: api.create_endpoint_config(
+                        ipv4_address=first.ipv4_address, aliases=list(first.aliases) or None
+                    )
+                }
+            )
+        with translate("container", request.name):
+            created = api.create_container(
+                image=request.image,
+                command=list(request.command) if request.command is not None else None,
+                entrypoint=list(request.entrypoint) if request.entrypoint is not None else None,
+                environment=dict(request.environment),
+                labels=dict(request.labels),
+                name=request.name,
+                hostname=request.hostname,
+                working_dir=request.working_dir,
+                host_config=api.create_host_config(
+                    **{k: v for k, v in host_config.items() if v is not None}
+                ),
+                networking_config=networking,
+            )
+            container_id = str(created["Id"])
+            for extra in request.networks[1:]:
+                api.connect_container_to_network(
+                    container_id,
+                    extra.network,
+                    ipv4_address=extra.ipv4_address,
+                    aliases=list(extra.aliases) or None,
+                )
+        log.debug("created container %s (%s)", request.name, request.image)
+        return container_id
+
+    def start(self, container_id: str) -> None:
+        with translate("container", container_id):
+            self._client.api.start(container_id)
+
+    def stop(self, container_id: str, *, timeout_s: float) -> None:
+        with translate("container", container_id):
+            self._client.api.stop(container_id, timeout=max(0, round(timeout_s)))
+
+    def kill(self, container_id: str) -> None:
+        with translate("container", container_id):
+            try:
+                self._client.api.kill(container_id)
+            except docker.errors.APIError as exc:
+                if exc.status_code != 409:  # 409: not running
+                    raise
+
+    def remove(self, container_id: str) -> None:
+        with translate("container", container_id):
+            self._client.api.remove_container(container_id, force=True, v=True)
+
+    def inspect(self, container_id: str) -> ContainerState:
+        with translate("container", container_id):
+            data = self._client.api.inspect_container(container_id)
+        state = data.get("State", {})
+        status = str(state.get("Status", ""))
+        ran = bool(state.get("StartedAt", "").strip("0-:TZ."))
+        finished = status in ("exited", "dead") and ran
+        return ContainerState(
+            id=str(data["Id"]),
+            name=str(data.get("Name", "")).lstrip("/"),
+            status=status,
+            running=bool(state.get("Running")),
+            exit_code=int(state.get("ExitCode", 0)) if finished else None,
+            oom_killed=bool(state.get("OOMKilled")),
+            restart_count=int(data.get("RestartCount", 0)),
+            pid=int(state.get("Pid", 0)),
+            error=str(state.get("Error", "")),
+            started_at=str(state.get("StartedAt", "")),
+            finished_at=str(state.get("FinishedAt", "")),
+        )
+
+    def wait(self, container_id: str, *, timeout_s: float) -> int | None:
+        """Exit code, or None when the container still runs after ``timeout_s``."""
+        try:
+            with translate("container", container_id):
+                result = self._client.api.wait(container_id, timeout=timeout_s)
+        except InfrastructureError as exc:
+            if isinstance(exc.__cause__, _WAIT_TIMEOUTS):
+                return None
+            raise
+        return int(result.get("StatusCode", -1))
+
+    def stats_stream(self, container_id: str) -> Iterator[StatsSample]:
+        """Samples about once a second until the container stops."""
+        with translate("container", container_id):
+            for raw in self._client.api.stats(container_id, stream=True, decode=True):
+                sample = _sample(raw)
+                if sample is not None:
+                    yield sample
+
+    def save_logs(self, container_id: str, *, stdout: Path, stderr: Path) -> None:
+        with translate("container", container_id):
+            for path, out, err in ((stdout, True, False), (stderr, False, True)):
+                path.parent.mkdir(parents=True, exist_ok=True)
+                with path.open("wb") as handle:
+                    for chunk in self._client.api.logs(
+                        container_id, stdout=out, stderr=err, stream=True, follow=False
+                    ):
+                        handle.write(chunk)
+
+    def image_digest(self, image: str) -> str | None:
+        """The image id (``sha256:...``) when the image is present locally, else None."""
+        try:
+            with translate("image", image):
+                data = self._client.api.inspect_image(image)
+        except ObjectNotFound:
+            return None
+        digests = data.get("RepoDigests") or []
+        return str(digests[0]) if digests else str(data["Id"])
+
+    def list_project(self, *, match_id: str | None = None) -> list[ProjectObject]:
+        labels = [f"{LABEL_PROJECT}=1"]
+        if match_id is not None:
+            labels.append(f"{LABEL_MATCH}={match_id}")
+        found: list[ProjectObject] = []
+        with translate("containers", "labelled " + ",".join(labels)):
+            for c in self._client.api.containers(all=True, filters={"label": labels}):
+                name = (c.get("Names") or ["/?"])[0].lstrip("/")
+                found.append(
+                    ProjectObject(
+                        kind="container", id=str(c["Id"]), name=name, labels=c["Labels"] or {}
+                    )
+                )
+            for n in self._client.api.networks(filters={"label": labels}):
+                found.append(
+                    ProjectObject(
+                        kind="network", id=str(n["Id"]), name=str(n["Name"]),
+                        labels=n.get("Labels") or {},
+                    )
+                )
+        return found
+
+
+def _sample(raw: dict[str, Any]) -> StatsSample | None:
+    cpu = raw.get("cpu_stats", {})
+    pre = raw.get("precpu_stats", {})
+    mem = raw.get("memory_stats", {})
+    try:
+        total = cpu["cpu_usage"]["total_usage"] - pre["cpu_usage"]["total_usage"]
+        system = cpu["system_cpu_usage"] - pre["system_cpu_usage"]
+        online = cpu.get("online_cpus") or len(cpu["cpu_usage"].get("percpu_usage") or [1])
+    except (KeyError, TypeError):
+        total, system, online = 0, 0, 1
+    percent = (total / system) * online * 100.0 if system > 0 and total > 0 else 0.0
+    usage = int(mem.get("max_usage") or mem.get("usage") or 0)
+    if not raw.get("read", "").strip("0-:TZ."):
+        return None
+    return StatsSample(cpu_percent=percent, memory_bytes=usage)
+
+
+__all__ = ["DockerRuntime", "translate"]

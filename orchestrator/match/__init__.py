@@ -1,0 +1,44 @@
+"""One match in real containers: plan, lifecycle, runner, results, cleanup.
+
+Domain code: it talks to the engine only through :class:`ContainerRuntime` and to the host only
+through :class:`Host`; ``orchestrator.commands.match`` wires the real implementations.
+"""
+
+from __future__ import annotations
+
+from orchestrator.match.cleanup import CleanupReport, cleanup
+from orchestrator.match.host import Host, HostControl
+from orchestrator.match.plan import MatchPlan, RobotPlan, TeamPlan, plan_from_game
+from orchestrator.match.results import Failure, FailureClass, RobotRecord
+from orchestrator.match.runner import (
+    ImageResolver,
+    MatchOutcome,
+    MatchRunner,
+    RunOptions,
+    local_images,
+)
+from orchestrator.match.runtime import ContainerRuntime
+from orchestrator.match.state import IllegalTransition, Lifecycle, MatchState
+
+__all__ = [
+    "CleanupReport",
+    "ContainerRuntime",
+    "Failure",
+    "FailureClass",
+    "Host",
+    "HostControl",
+    "IllegalTransition",
+    "ImageResolver",
+    "Lifecycle",
+    "MatchOutcome",
+    "MatchPlan",
+    "MatchRunner",
+    "MatchState",
+    "RobotPlan",
+    "RobotRecord",
+    "RunOptions",
+    "TeamPlan",
+    "cleanup",
+    "local_images",
+    "plan_from_game",
+]

@@ -1,0 +1,218 @@
+"""STOPPING and COLLECTING: grace period, logs, public files, teardown, results, report.
+
+Every teardown step runs even when an earlier one failed; a teardown failure makes the match an
+``infrastructure`` failure only when nothing else failed first. ``report.json`` is written last.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import shutil
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+from functools import partial
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from orchestrator.errors import OrchestratorError
+from orchestrator.match.results import (
+    FailureClass,
+    build_results,
+    write_report,
+    write_results,
+)
+from orchestrator.match.state import MatchState
+
+if TYPE_CHECKING:
+    from orchestrator.match.runner import MatchRunner
+
+log = logging.getLogger(__name__)
+
+PUBLIC_FILES = (
+    "sim_result.json",
+    "replay.hlvsrec",
+    "referee.log",
+    "referee_events.jsonl",
+    "gamecontroller.log",
+    "match.mp4",
+)
+
+
+def read_sim_result(runner: MatchRunner) -> dict[str, Any] | None:
+    match_dir = runner.started.match_dir
+    if match_dir is None:
+        return None
+    path = match_dir / "out" / "sim_result.json"
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return data if isinstance(data, dict) else None
+
+
+def simulator_stderr_tail(runner: MatchRunner) -> str:
+    sim_id = runner.started.simulator_id
+    match_dir = runner.started.match_dir
+    if sim_id is None or match_dir is None:
+        return ""
+    try:
+        runner.runtime.save_logs(sim_id, stdout=match_dir / "stdout.log",
+                                 stderr=match_dir / "stderr.log")
+        lines = (match_dir / "stderr.log").read_text(errors="replace").strip().splitlines()
+    except (OrchestratorError, OSError):
+        return ""
+    return lines[-1][:300] if lines else ""
+
+
+def _guarded(runner: MatchRunner, what: str, step: Callable[[], object]) -> None:
+    try:
+        step()
+    except (OrchestratorError, OSError) as exc:
+        log.error("match %s: %s failed: %s", runner.plan.match_id, what, exc)
+        runner._fail(FailureClass.INFRASTRUCTURE, f"{what}: {exc}")
+
+
+def _stop_robots(runner: MatchRunner) -> None:
+    grace = runner.plan.grace_period_s
+    ids = runner.started.robot_ids
+
+    def stop(item: tuple[str, str]) -> None:
+        key, container_id = item
+        _guarded(runner, f"stopping robot {key}",
+                 lambda: runner.runtime.stop(container_id, timeout_s=grace))
+
+    if ids:
+        log.info("match %s: stopping %d robots (grace %.0f s)", runner.plan.match_id, len(ids),
+                 grace)
+        with ThreadPoolExecutor(max_workers=min(8, len(ids))) as pool:
+            list(pool.map(stop, ids.items()))
+
+
+def _read_counters(runner: MatchRunner) -> None:
+    for key, applied in runner.started.shaping.items():
+        record = runner.records[key]
+        try:
+            counters = runner.host.counters(applied)
+        except OrchestratorError as exc:
+            log.warning("match %s: no traffic counters for %s: %s", runner.plan.match_id, key, exc)
+            continue
+        record.sent_bytes = counters.sent_bytes
+        record.received_bytes = counters.received_bytes
+
+
+def _collect_robot(runner: MatchRunner, key: str, container_id: str) -> None:
+    record = runner.records[key]
+    folder = runner.options.out_dir / "teams" / record.color / str(record.number)
+    state = runner.runtime.inspect(container_id)
+    record.exit_code = state.exit_code
+    record.oom_killed = record.oom_killed or state.oom_killed
+    record.restarts = state.restart_count
+    peaks = runner.monitor.peaks(key)
+    record.cpu_peak_percent = peaks.cpu_percent
+    record.memory_peak_bytes = peaks.memory_bytes
+    runner.runtime.save_logs(container_id, stdout=folder / "stdout.log",
+                             stderr=folder / "stderr.log")
+
+
+def _copy_public(runner: MatchRunner) -> None:
+    match_dir = runner.started.match_dir
+    public = runner.options.out_dir / "public"
+    public.mkdir(parents=True, exist_ok=True)
+    if match_dir is None:
+        return
+    for name in PUBLIC_FILES:
+        source = match_dir / "out" / name
+        if source.is_file():
+            shutil.copy2(source, public / name)
+
+
+def _teardown(runner: MatchRunner) -> None:
+    started = runner.started
+    runtime = runner.runtime
+    for key, container_id in list(started.robot_ids.items()) + list(started.holder_ids.items()):
+        _guarded(runner, f"removing container of {key}", partial(runtime.remove, container_id))
+    if started.simulator_id is not None:
+        sim_id = started.simulator_id
+        _guarded(runner, "removing the simulator", lambda: runtime.remove(sim_id))
+    for key, folder in started.log_folders.items():
+        record = runner.records[key]
+        target = runner.options.out_dir / "teams" / record.color / str(record.number)
+        _guarded(runner, f"collecting /robocup-logs of {key}",
+                 partial(runner.host.collect_logs, folder, target / "robocup-logs"))
+    for network in started.networks.values():
+        _guarded(runner, f"removing network {network.name}",
+                 partial(runtime.remove_network, network.name))
+    _guarded(runner, "removing host firewall rules",
+             lambda: runner.host.remove_isolation(match_id=runner.plan.match_id))
+
+
+def finish(runner: MatchRunner) -> dict[str, Any]:
+    """Run STOPPING and COLLECTING from wherever the match got to; returns the results."""
+    lifecycle = runner.lifecycle
+    if lifecycle.state in (MatchState.PULLING, MatchState.STARTING, MatchState.WAITING,
+                           MatchState.PLAYING):
+        runner._advance(MatchState.STOPPING)
+    started = runner.started
+    if lifecycle.state is MatchState.STOPPING:
+        _stop_robots(runner)
+        _read_counters(runner)
+        if started.simulator_id is not None:
+            _guarded(runner, "stopping the simulator", partial(
+                runner.runtime.stop, started.simulator_id,
+                timeout_s=runner.options.simulator_stop_s))
+        for key, holder_id in started.holder_ids.items():
+            _guarded(runner, f"stopping the network holder of {key}",
+                     partial(runner.runtime.kill, holder_id))
+        runner._advance(MatchState.COLLECTING)
+    if runner.telemetry is not None:
+        runner.telemetry.close()
+    runner.monitor.join(timeout_s=2.0)
+    for key, container_id in started.robot_ids.items():
+        _guarded(runner, f"collecting logs of {key}",
+                 partial(_collect_robot, runner, key, container_id))
+    if started.simulator_id is not None and started.match_dir is not None:
+        sim_id, match_dir = started.simulator_id, started.match_dir
+        _guarded(runner, "collecting simulator logs", lambda: runner.runtime.save_logs(
+            sim_id, stdout=match_dir / "stdout.log", stderr=match_dir / "stderr.log"))
+    _guarded(runner, "copying public files", lambda: _copy_public(runner))
+    _teardown(runner)
+    return _write(runner)
+
+
+def _write(runner: MatchRunner) -> dict[str, Any]:
+    out: Path = runner.options.out_dir
+    plan = runner.plan
+    limits = plan.limits
+    results = build_results(
+        match_id=plan.match_id,
+        seed=plan.seed,
+        sim_result=read_sim_result(runner),
+        robots=list(runner.records.values()),
+        forfeit=runner.forfeit,
+        limits={
+            "cpus": limits.cpus, "memory_gb": limits.memory_gb, "pids": limits.pids,
+            "log_folder_gb": limits.log_folder_gb, "team_api_mb_s": limits.team_api_mb_s,
+            "team_comm_mb_s": limits.team_comm_mb_s, "grace_period_s": plan.grace_period_s,
+            "allow_internet": plan.allow_internet,
+        },
+        versions=dict(plan.versions),
+        timings_s=dict(runner.lifecycle.timings_s),
+        failure=runner.failure,
+    )
+    results["bringup_s"] = runner.bringup_s
+    write_results(out, results)
+    lifecycle = runner.lifecycle
+    if lifecycle.state is MatchState.COLLECTING:
+        runner._advance(MatchState.FAILED if runner.failure else MatchState.DONE)
+    elif lifecycle.state is MatchState.PENDING:
+        runner._advance(MatchState.FAILED)
+    results["timings_s"] = dict(lifecycle.timings_s)
+    write_results(out, results)
+    write_report(out, runner.failure)
+    log.info("match %s: %s, results in %s", plan.match_id,
+             "failed" if runner.failure else "done", out)
+    return results
+
+
+__all__ = ["PUBLIC_FILES", "finish", "read_sim_result", "simulator_stderr_tail"]

@@ -1,0 +1,86 @@
+"""Host-side controls of a match: firewall, bandwidth and size-capped log folders.
+
+:class:`HostControl` is the real implementation (root on Linux); ``FakeHost`` in
+``orchestrator.match.fake`` records calls for unit tests. Each feature can be turned off (the
+result then records that it was not applied).
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Protocol
+
+from orchestrator import bandwidth
+from orchestrator.bandwidth import AppliedShaping, RobotShaping, TrafficCounters
+from orchestrator.engine import networks
+from orchestrator.match import logfs
+from orchestrator.match.logfs import LogFolder
+
+log = logging.getLogger(__name__)
+
+
+class Host(Protocol):
+    def isolate_bridge(self, bridge_name: str, *, match_id: str) -> bool: ...
+
+    def remove_isolation(self, *, match_id: str | None) -> int: ...
+
+    def shape(self, pid: int, shaping: RobotShaping) -> AppliedShaping | None: ...
+
+    def counters(self, applied: AppliedShaping) -> TrafficCounters: ...
+
+    def log_folder(self, *, match_id: str, name: str, cap_bytes: int, fallback: Path
+                   ) -> LogFolder: ...
+
+    def collect_logs(self, folder: LogFolder, destination: Path) -> None: ...
+
+    def cleanup(self, *, match_id: str | None) -> int: ...
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class HostControl:
+    firewall: bool = True
+    shaping: bool = True
+    capped_logs: bool = True
+
+    def isolate_bridge(self, bridge_name: str, *, match_id: str) -> bool:
+        if not self.firewall:
+            return False
+        if not networks.firewall_available():
+            log.warning("iptables not found: host services stay reachable from %s", bridge_name)
+            return False
+        networks.isolate_bridge(bridge_name, match_id=match_id)
+        return True
+
+    def remove_isolation(self, *, match_id: str | None) -> int:
+        return networks.remove_isolation(match_id=match_id) if self.firewall else 0
+
+    def shape(self, pid: int, shaping: RobotShaping) -> AppliedShaping | None:
+        if not self.shaping:
+            return None
+        return bandwidth.apply(pid, shaping)
+
+    def counters(self, applied: AppliedShaping) -> TrafficCounters:
+        return bandwidth.read_counters(applied)
+
+    def log_folder(self, *, match_id: str, name: str, cap_bytes: int, fallback: Path
+                   ) -> LogFolder:
+        if not self.capped_logs:
+            fallback.mkdir(parents=True, exist_ok=True)
+            fallback.chmod(0o777)
+            return LogFolder(path=fallback, cap_bytes=None)
+        return logfs.create(match_id=match_id, name=name, cap_bytes=cap_bytes,
+                            fallback_dir=fallback)
+
+    def collect_logs(self, folder: LogFolder, destination: Path) -> None:
+        logfs.collect(folder, destination)
+
+    def cleanup(self, *, match_id: str | None) -> int:
+        removed = self.remove_isolation(match_id=match_id)
+        if self.capped_logs:
+            removed += logfs.cleanup(match_id=match_id)
+        return removed
+
+
+__all__ = ["Host", "HostControl"]

@@ -1,0 +1,197 @@
+"""Names, addresses and container requests of one match (pure functions, no I/O).
+
+Networks: one bridge per team (``<prefix>-red``, ``<prefix>-blue``, internal unless the game
+allows the internet) and one internal control network. Each is a /24 from 10.213.0.0/16, chosen
+at run time (a subnet in use is skipped). In every subnet: .1 the host's gateway, .2 the
+simulator, .10+n robot n of the team.
+
+Each robot is two containers: a *holder* that owns the robot's network namespace (fixed IP,
+hostname) and runs nothing but ``sleep``, and the robot container itself, started in the holder's
+namespace (``network_mode=container:<holder>``) once the bandwidth limits are in place.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import ipaddress
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+from orchestrator.config import Limits
+from orchestrator.engine import (
+    LABEL_MATCH,
+    LABEL_PROJECT,
+    LABEL_ROBOT,
+    LABEL_ROLE,
+    LABEL_TEAM,
+)
+from orchestrator.match.plan import MatchPlan, RobotPlan
+from orchestrator.match.runtime import (
+    Attachment,
+    BindMount,
+    ContainerRequest,
+    NetworkRequest,
+)
+
+SIMULATOR_HOST = 2
+ROBOT_HOST_BASE = 10
+TELEMETRY_PORT = 7447
+LOGS_TARGET = "/robocup-logs"
+MATCH_TARGET = "/match"
+SIMULATOR_COMMAND = (
+    "python3", "-m", "simulator", "run", "--spec", "/match/match_spec.json", "--out", "/match/out"
+)
+
+
+def short_token(match_id: str, salt: str) -> str:
+    return hashlib.sha256(f"{match_id}/{salt}".encode()).hexdigest()[:8]
+
+
+def labels(match_id: str, role: str, **extra: str) -> dict[str, str]:
+    found = {LABEL_PROJECT: "1", LABEL_MATCH: match_id, LABEL_ROLE: role}
+    if "team" in extra:
+        found[LABEL_TEAM] = extra["team"]
+    if "robot" in extra:
+        found[LABEL_ROBOT] = extra["robot"]
+    for key, value in extra.items():
+        if "." in key:
+            found[key] = value
+    return found
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Subnet:
+    network: ipaddress.IPv4Network
+
+    def host(self, n: int) -> str:
+        return str(self.network.network_address + n)
+
+    @property
+    def gateway(self) -> str:
+        return self.host(1)
+
+    @property
+    def simulator(self) -> str:
+        return self.host(SIMULATOR_HOST)
+
+    def robot(self, number: int) -> str:
+        return self.host(ROBOT_HOST_BASE + number)
+
+
+def candidate_subnets(seed: str) -> list[Subnet]:
+    """Every 10.213.x.0/24, starting at a place derived from ``seed``."""
+    start = int(hashlib.sha256(seed.encode()).hexdigest(), 16) % 256
+    return [
+        Subnet(network=ipaddress.IPv4Network(f"10.213.{(start + i) % 256}.0/24"))
+        for i in range(256)
+    ]
+
+
+def network_request(
+    *, prefix: str, role: str, subnet: Subnet, internal: bool, match_id: str,
+    extra_labels: Mapping[str, str],
+) -> NetworkRequest:
+    return NetworkRequest(
+        name=f"{prefix}-{role}",
+        subnet=str(subnet.network),
+        gateway=subnet.gateway,
+        internal=internal,
+        bridge_name=f"hl{short_token(match_id, prefix)}{role[0]}",
+        labels={**labels(match_id, "network", **({"team": role} if role != "control" else {})),
+                **extra_labels},
+    )
+
+
+def robot_environment(
+    robot: RobotPlan, *, team_net: Subnet, player_count: int, gamecontroller_ip: str | None
+) -> dict[str, str]:
+    env = {
+        "ROBOCUP_ROBOT_ID": str(robot.number),
+        "ROBOCUP_TEAM_COLOR": robot.color,
+        "ROBOCUP_SIMULATOR_ADDR": f"{team_net.simulator}:{robot.port}",
+        "ROBOCUP_MIRROR_SERVER_IP": team_net.simulator,
+    }
+    for n in range(1, player_count + 1):
+        env[f"ROBOCUP_TEAM_PLAYER{n}_IP"] = team_net.robot(n)
+    if gamecontroller_ip is not None:
+        env["ROBOCUP_GAMECONTROLLER_IP"] = gamecontroller_ip
+    return env
+
+
+def holder_request(
+    robot: RobotPlan, *, prefix: str, image: str, network: str, team_net: Subnet, match_id: str,
+    extra_labels: Mapping[str, str],
+) -> ContainerRequest:
+    return ContainerRequest(
+        name=f"{prefix}-{robot.key}-net",
+        image=image,
+        entrypoint=("sleep",),
+        command=("infinity",),
+        labels={**labels(match_id, "netns", team=robot.color, robot=str(robot.number)),
+                **extra_labels},
+        networks=(Attachment(network=network, ipv4_address=team_net.robot(robot.number),
+                             aliases=(robot.key,)),),
+        hostname=robot.key,
+        mem_bytes=32 * 1024 * 1024,
+        pids_limit=8,
+        cap_drop=("ALL",),
+        security_opt=("no-new-privileges",),
+    )
+
+
+def robot_request(
+    robot: RobotPlan, *, prefix: str, holder_id: str, environment: Mapping[str, str],
+    logs_dir: Path, limits: Limits, match_id: str, extra_labels: Mapping[str, str],
+) -> ContainerRequest:
+    assert robot.image is not None
+    return ContainerRequest(
+        name=f"{prefix}-{robot.key}",
+        image=robot.image,
+        command=robot.command,
+        environment=dict(environment),
+        labels={**labels(match_id, "robot", team=robot.color, robot=str(robot.number)),
+                **extra_labels},
+        network_mode=f"container:{holder_id}",
+        mounts=(BindMount(source=logs_dir, target=LOGS_TARGET),),
+        nano_cpus=int(limits.cpus * 1e9),
+        mem_bytes=int(limits.memory_gb * 1e9),
+        pids_limit=limits.pids,
+        cap_drop=("ALL",),
+        security_opt=("no-new-privileges",),
+    )
+
+
+def simulator_request(
+    plan: MatchPlan, *, prefix: str, image: str, match_dir: Path,
+    attachments: tuple[Attachment, ...], extra_labels: Mapping[str, str],
+    command: tuple[str, ...] = SIMULATOR_COMMAND,
+) -> ContainerRequest:
+    return ContainerRequest(
+        name=f"{prefix}-simulator",
+        image=image,
+        command=command,
+        environment={"PYTHONUNBUFFERED": "1", "HLVS_MATCH_ID": plan.match_id},
+        labels={**labels(plan.match_id, "simulator"), **extra_labels},
+        networks=attachments,
+        mounts=(BindMount(source=match_dir, target=MATCH_TARGET),),
+        hostname="simulator",
+        cap_drop=("ALL",),
+        security_opt=("no-new-privileges",),
+    )
+
+
+__all__ = [
+    "LOGS_TARGET",
+    "SIMULATOR_COMMAND",
+    "Subnet",
+    "TELEMETRY_PORT",
+    "candidate_subnets",
+    "holder_request",
+    "labels",
+    "network_request",
+    "robot_environment",
+    "robot_request",
+    "short_token",
+    "simulator_request",
+]

@@ -1,0 +1,116 @@
+"""Size-capped ``/robocup-logs`` folders: one loop-mounted ext4 file system per robot.
+
+A robot that writes more than its cap gets ENOSPC in its own folder and fills nothing else. The
+image files are sparse (a 10 GB cap costs nothing until written). They live under
+``$HLVS_STATE_DIR`` (default ``/var/lib/hlvs-runner``) in ``logfs/<match_id>/``, so that
+:func:`cleanup` finds the mounts of a match after a crash. Needs root (mkfs, mount); without root
+a plain folder without a cap is used and the result says so.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import shutil
+import subprocess
+from dataclasses import dataclass
+from pathlib import Path
+
+from orchestrator.errors import InfrastructureError
+
+log = logging.getLogger(__name__)
+
+
+def state_dir() -> Path:
+    return Path(os.environ.get("HLVS_STATE_DIR", "/var/lib/hlvs-runner"))
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class LogFolder:
+    path: Path  # the folder bind-mounted at /robocup-logs
+    cap_bytes: int | None  # None: no cap could be applied
+    image: Path | None = None  # the ext4 image file when capped
+
+
+def _run(*args: str) -> None:
+    result = subprocess.run(list(args), capture_output=True, text=True, check=False, timeout=60)
+    if result.returncode != 0:
+        raise InfrastructureError(
+            f"{' '.join(args)} failed ({result.returncode}): {result.stderr.strip()}"
+        )
+
+
+def can_cap() -> bool:
+    return os.geteuid() == 0 and shutil.which("mkfs.ext4") is not None
+
+
+def create(*, match_id: str, name: str, cap_bytes: int, fallback_dir: Path) -> LogFolder:
+    """A folder for one robot's logs, capped at ``cap_bytes`` when possible."""
+    if not can_cap():
+        fallback_dir.mkdir(parents=True, exist_ok=True)
+        fallback_dir.chmod(0o777)
+        log.warning("no root: %s has no size cap", fallback_dir)
+        return LogFolder(path=fallback_dir, cap_bytes=None)
+    base = state_dir() / "logfs" / match_id
+    base.mkdir(parents=True, exist_ok=True)
+    image = base / f"{name}.img"
+    mountpoint = base / name
+    mountpoint.mkdir(exist_ok=True)
+    with image.open("wb") as handle:
+        handle.truncate(cap_bytes)
+    _run("mkfs.ext4", "-q", "-F", "-m", "0", "-E", "lazy_itable_init=1,root_owner=0:0", str(image))
+    _run("mount", "-o", "loop,nosuid,nodev,noexec", str(image), str(mountpoint))
+    mountpoint.chmod(0o777)
+    lost = mountpoint / "lost+found"
+    if lost.is_dir():
+        shutil.rmtree(lost, ignore_errors=True)
+    log.info("log folder %s mounted (%d MB cap)", mountpoint, cap_bytes // 1_000_000)
+    return LogFolder(path=mountpoint, cap_bytes=cap_bytes, image=image)
+
+
+def collect(folder: LogFolder, destination: Path) -> None:
+    """Copy the folder's content to ``destination`` and release the folder."""
+    destination.mkdir(parents=True, exist_ok=True)
+    if folder.path.resolve() != destination.resolve():
+        shutil.copytree(folder.path, destination, dirs_exist_ok=True, symlinks=True)
+    if folder.image is not None:
+        release(folder)
+
+
+def release(folder: LogFolder) -> None:
+    if folder.image is None:
+        return
+    if _is_mounted(folder.path):
+        _run("umount", str(folder.path))
+    folder.image.unlink(missing_ok=True)
+    shutil.rmtree(folder.path, ignore_errors=True)
+
+
+def _mounts() -> list[str]:
+    try:
+        lines = Path("/proc/mounts").read_text().splitlines()
+    except OSError:
+        return []
+    return [line.split()[1].replace("\\040", " ") for line in lines if len(line.split()) > 1]
+
+
+def _is_mounted(path: Path) -> bool:
+    return str(path) in _mounts()
+
+
+def cleanup(*, match_id: str | None = None) -> int:
+    """Unmount and delete what crashed runs left (of one match, or all); returns the count."""
+    root = state_dir() / "logfs"
+    if match_id is not None:
+        root = root / match_id
+    count = 0
+    for mountpoint in _mounts():
+        if mountpoint.startswith(str(root) + "/"):
+            _run("umount", "-l", mountpoint)
+            count += 1
+    if root.is_dir():
+        shutil.rmtree(root, ignore_errors=True)
+    return count
+
+
+__all__ = ["LogFolder", "can_cap", "cleanup", "collect", "create", "release", "state_dir"]

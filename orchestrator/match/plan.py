@@ -1,0 +1,195 @@
+"""What one match runs: teams, robots, images, limits, and how to write the simulator's spec.
+
+:func:`plan_from_game` builds a :class:`MatchPlan` from a validated
+:class:`orchestrator.config.LoadedGame`; tests and ``hlvs scrimmage`` build it the same way from
+the files they write.
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+import random
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from orchestrator.config import Limits, LoadedGame, PlayerConfig
+
+SpecBuilder = Callable[[Mapping[str, tuple[str, ...]], str | None], dict[str, Any]]
+"""(robot addresses per color, telemetry endpoint or None) -> match_spec.json content."""
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RobotPlan:
+    color: str  # red | blue
+    number: int  # 1..N
+    port: int  # robot API port on the simulator
+    image: str | None  # None: no image named (the robot is spawned without a controller)
+    command: tuple[str, ...] | None = None  # None: the image's default command
+
+    @property
+    def key(self) -> str:
+        return f"{self.color}-{self.number}"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TeamPlan:
+    color: str
+    name: str
+    robots: tuple[RobotPlan, ...]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class MatchPlan:
+    match_id: str
+    seed: int
+    red: TeamPlan
+    blue: TeamPlan
+    spec_builder: SpecBuilder
+    limits: Limits = field(default_factory=Limits)
+    allow_internet: bool = False
+    grace_period_s: float = 120.0
+    telemetry: bool = True  # ask the simulator for zenoh telemetry on the control network
+    telemetry_silence_s: float = 30.0  # fail the match when telemetry stays silent this long
+    mirror_port: int = 3737
+    versions: Mapping[str, str] = field(default_factory=dict)
+
+    @property
+    def teams(self) -> tuple[TeamPlan, TeamPlan]:
+        return (self.red, self.blue)
+
+    @property
+    def robots(self) -> tuple[RobotPlan, ...]:
+        return self.red.robots + self.blue.robots
+
+
+def _robot(color: str, player: PlayerConfig, port: int) -> RobotPlan:
+    args = player.docker_cmd_args
+    return RobotPlan(
+        color=color, number=player.number, port=port, image=player.image,
+        command=args if args else None,
+    )
+
+
+def plan_from_game(loaded: LoadedGame, *, grace_period_s: float | None = None) -> MatchPlan:
+    game = loaded.game
+    teams = []
+    for color in ("red", "blue"):
+        ref = game.team(color)
+        cfg = loaded.team(color)
+        robots = tuple(_robot(color, p, ref.port(p.number)) for p in cfg.players)
+        teams.append(TeamPlan(color=color, name=cfg.display_name, robots=robots))
+
+    def build(addresses: Mapping[str, tuple[str, ...]], telemetry: str | None) -> dict[str, Any]:
+        return spec_dict(loaded, addresses, telemetry)
+
+    return MatchPlan(
+        match_id=game.match_id,
+        seed=game.seed,
+        red=teams[0],
+        blue=teams[1],
+        spec_builder=build,
+        limits=game.limits,
+        allow_internet=game.allow_internet,
+        grace_period_s=game.timing.grace_period_s if grace_period_s is None else grace_period_s,
+    )
+
+
+def spec_dict(
+    loaded: LoadedGame, addresses: Mapping[str, tuple[str, ...]], telemetry: str | None
+) -> dict[str, Any]:
+    """match_spec.json content: the config layer's ``to_match_spec`` when it is available,
+    with the addresses of this run (hosts, robot addresses, telemetry) filled in."""
+    try:
+        module = importlib.import_module("orchestrator.config.spec")
+    except ImportError:
+        spec = _fallback_spec(loaded)
+    else:
+        spec = module.to_match_spec(
+            loaded, robot_addresses={c: list(a) for c, a in addresses.items()},
+            telemetry_listen=telemetry,
+        )
+    for color in ("red", "blue"):
+        spec[color]["hosts"] = list(addresses.get(color, ()))
+        spec[color]["robot_addresses"] = list(addresses.get(color, ()))
+    network = spec.setdefault("network", {})
+    network["telemetry_listen"] = telemetry
+    network["api_bind_host"] = "0.0.0.0"
+    return spec
+
+
+def _pose(pose: Any) -> dict[str, float]:
+    return {"x_m": pose.x_m, "y_m": pose.y_m, "yaw_rad": pose.yaw_rad}
+
+
+def _fallback_spec(loaded: LoadedGame) -> dict[str, Any]:
+    game = loaded.game
+    rng = random.Random(game.seed)
+    side = game.side_left if game.side_left != "random" else rng.choice(["red", "blue"])
+    kickoff = game.kickoff if game.kickoff != "random" else rng.choice(["red", "blue"])
+    teams: dict[str, Any] = {}
+    for color in ("red", "blue"):
+        ref = game.team(color)
+        cfg = loaded.team(color)
+        teams[color] = {
+            "color": color,
+            "team_id": ref.team_id,
+            "name": cfg.display_name,
+            "hosts": list(ref.hosts),
+            "players": [
+                {
+                    "number": p.number,
+                    "model": p.model,
+                    "port": ref.port(p.number),
+                    "half_time_pose": _pose(p.half_time_pose),
+                    "reentry_pose": _pose(p.reentry_pose),
+                    "shootout_pose": _pose(p.shootout_pose),
+                    "goalkeeper_pose": _pose(p.goalkeeper_pose),
+                    "goalkeeper": p.number == 1,
+                }
+                for p in cfg.players
+            ],
+        }
+    timing = game.timing
+    return {
+        "match_id": game.match_id,
+        "seed": game.seed,
+        "game_type": game.game_type,
+        "field_class": game.field_class.lower(),
+        "side_left": side,
+        "kickoff": kickoff,
+        "red": teams["red"],
+        "blue": teams["blue"],
+        "stepping": game.stepping,
+        "maximum_real_time_factor": game.maximum_real_time_factor,
+        "physics_dt_s": game.physics_dt_s,
+        "lockstep_deadline_ms": game.lockstep_deadline_ms,
+        "lockstep_time_bank_ms": game.lockstep_time_bank_ms,
+        "timing": {
+            "half_duration_s": timing.half_duration_s,
+            "overtime_half_duration_s": timing.overtime_half_duration_s,
+            "ready_duration_s": timing.ready_duration_s,
+            "wait_before_first_ready_real_s": timing.wait_before_first_ready_s,
+            "half_time_break_real_s": timing.half_time_break_s,
+            "removal_penalty_s": timing.removal_penalty_s,
+            "max_duration_real_s": timing.max_duration_s,
+        },
+        "network": {"team_quota_mb_s": game.limits.team_api_mb_s},
+        "record_video": None,
+    }
+
+
+def per_robot_rate_mb_s(team_rate_mb_s: float, n_robots: int) -> float:
+    return team_rate_mb_s / max(1, n_robots) if math.isfinite(team_rate_mb_s) else team_rate_mb_s
+
+
+__all__ = [
+    "MatchPlan",
+    "RobotPlan",
+    "SpecBuilder",
+    "TeamPlan",
+    "per_robot_rate_mb_s",
+    "plan_from_game",
+    "spec_dict",
+]

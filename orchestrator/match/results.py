@@ -1,0 +1,160 @@
+"""What a match leaves behind: ``results.json`` and, written last, ``report.json``.
+
+``report.json`` is ``{"status": "success"}`` or ``{"status": "failed", "failure_class": ...,
+"cause": ...}``; a reader that finds it knows every other file of the match folder is complete.
+
+Failure classes:
+
+- ``infrastructure``: the engine, a network, the host firewall or a mount failed us;
+- ``image_pull``: no robot of either team has a usable image;
+- ``team_startup``: the containers of a team's robots could not be created or started;
+- ``team_crash``: reserved for a team whose robots break the match (a robot that exits or is
+  OOM-killed mid-game does *not* fail the match; it is recorded per robot);
+- ``simulator``: the simulator container exited without FINISHED, or its telemetry was silent;
+- ``referee``: the simulator ran to its end but the game did not reach FINISHED;
+- ``interrupted``: the orchestrator was asked to stop (SIGINT / SIGTERM).
+"""
+
+from __future__ import annotations
+
+import enum
+import json
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+
+class FailureClass(enum.Enum):
+    INFRASTRUCTURE = "infrastructure"
+    IMAGE_PULL = "image_pull"
+    TEAM_STARTUP = "team_startup"
+    TEAM_CRASH = "team_crash"
+    SIMULATOR = "simulator"
+    REFEREE = "referee"
+    INTERRUPTED = "interrupted"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Failure:
+    failure_class: FailureClass
+    cause: str
+
+
+@dataclass(slots=True, kw_only=True)
+class RobotRecord:
+    """Everything recorded about one robot during the match (filled in as the match runs)."""
+
+    key: str
+    color: str
+    number: int
+    image: str | None
+    digest: str | None = None
+    image_error: str | None = None
+    container: str | None = None  # container name when one was started
+    startup_error: str | None = None
+    exit_code: int | None = None
+    oom_killed: bool = False
+    restarts: int = 0
+    exited_during_game: bool = False
+    cpu_peak_percent: float = 0.0
+    memory_peak_bytes: int = 0
+    sent_bytes: int | None = None
+    received_bytes: int | None = None
+    limits: dict[str, Any] = field(default_factory=dict)
+
+    def to_json(self, api: dict[str, Any] | None) -> dict[str, Any]:
+        return {
+            "image": self.image,
+            "digest": self.digest,
+            "image_error": self.image_error,
+            "container": self.container,
+            "startup_error": self.startup_error,
+            "exit_code": self.exit_code,
+            "oom_killed": self.oom_killed,
+            "restarts": self.restarts,
+            "exited_during_game": self.exited_during_game,
+            "cpu_peak_percent": round(self.cpu_peak_percent, 1),
+            "memory_peak_bytes": self.memory_peak_bytes,
+            "sent_bytes": self.sent_bytes,
+            "received_bytes": self.received_bytes,
+            "limits": self.limits,
+            "api": api,
+        }
+
+
+def _write_json(path: Path, data: dict[str, Any]) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(path.suffix + ".tmp")
+    tmp.write_text(json.dumps(data, indent=2, sort_keys=True) + "\n", encoding="utf-8")
+    os.replace(tmp, path)
+
+
+def build_results(
+    *,
+    match_id: str,
+    seed: int,
+    sim_result: dict[str, Any] | None,
+    robots: list[RobotRecord],
+    forfeit: dict[str, Any] | None,
+    limits: dict[str, Any],
+    versions: dict[str, Any],
+    timings_s: dict[str, float],
+    failure: Failure | None,
+) -> dict[str, Any]:
+    sim = sim_result or {}
+    api_stats: dict[str, Any] = sim.get("robots") or {}
+    score = sim.get("score")
+    winner = sim.get("winner")
+    if forfeit is not None:
+        score = forfeit.get("score", score)
+        winner = forfeit.get("winner")
+    return {
+        "match_id": match_id,
+        "seed": seed,
+        "status": "failed" if failure else "success",
+        "failure": None
+        if failure is None
+        else {"class": failure.failure_class.value, "cause": failure.cause},
+        "forfeit": forfeit,
+        "final_state": sim.get("final_state", sim.get("state")),
+        "score": score,
+        "winner": winner,
+        "events_summary": sim.get("events_summary", {}),
+        "sim_time_ms": sim.get("sim_time_ms"),
+        "real_time_factor": sim.get("real_time_factor"),
+        "robots": {r.key: r.to_json(api_stats.get(r.key)) for r in robots},
+        "limits": limits,
+        "versions": {**versions, "simulator": sim.get("versions")},
+        "timings_s": timings_s,
+    }
+
+
+def write_results(out_dir: Path, results: dict[str, Any]) -> Path:
+    path = out_dir / "results.json"
+    _write_json(path, results)
+    return path
+
+
+def write_report(out_dir: Path, failure: Failure | None) -> Path:
+    """Written last: its presence means the match folder is complete."""
+    report: dict[str, Any] = {"status": "success"}
+    if failure is not None:
+        report = {
+            "status": "failed",
+            "failure_class": failure.failure_class.value,
+            "cause": failure.cause,
+        }
+    path = out_dir / "report.json"
+    _write_json(path, report)
+    return path
+
+
+__all__ = [
+    "Failure",
+    "FailureClass",
+    "RobotRecord",
+    "build_results",
+    "write_report",
+    "write_results",
+]

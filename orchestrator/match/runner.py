@@ -1,0 +1,255 @@
+"""Runs one match from a :class:`MatchPlan` to a complete output folder.
+
+Phases (see :mod:`orchestrator.match.state`): images are resolved (PULLING); networks, the
+simulator and the robots are started (STARTING); the runner waits for the game to leave INITIAL
+(WAITING) and watches the simulator, its telemetry and the robots (PLAYING) until the simulator
+exits; robots get their grace period (STOPPING); logs and results are collected and every object
+removed (COLLECTING). ``report.json`` is written last, whatever happened.
+
+Bandwidth limits are in place before a robot can send anything: each robot's network namespace
+belongs to a holder container that is started and shaped first; the robot container is then
+started inside that namespace.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from orchestrator.errors import OrchestratorError
+from orchestrator.match import collection, startup
+from orchestrator.match.host import Host
+from orchestrator.match.layout import SIMULATOR_COMMAND
+from orchestrator.match.monitor import StatsMonitor
+from orchestrator.match.plan import MatchPlan
+from orchestrator.match.results import Failure, FailureClass, RobotRecord
+from orchestrator.match.runtime import ContainerRuntime
+from orchestrator.match.state import Lifecycle, MatchState
+from orchestrator.telemetry import TelemetrySource
+
+log = logging.getLogger(__name__)
+
+TelemetryFactory = Callable[[str, str], TelemetrySource]  # (endpoint, match_id)
+ImageResolver = Callable[[MatchPlan], Mapping[str, tuple[str | None, str | None]]]
+"""plan -> {robot key: (digest, error)}; a robot with an error has no usable image."""
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RunOptions:
+    out_dir: Path
+    simulator_image: str
+    simulator_command: tuple[str, ...] = SIMULATOR_COMMAND
+    holder_image: str | None = None  # default: the simulator image (needs ``sleep``)
+    extra_labels: Mapping[str, str] = field(default_factory=dict)
+    poll_s: float = 0.5
+    simulator_stop_s: float = 10.0
+    progress: Callable[[str, dict[str, Any] | None], None] | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class MatchOutcome:
+    match_id: str
+    failure: Failure | None
+    out_dir: Path
+    results: dict[str, Any]
+    bringup_s: float | None  # start of STARTING -> every robot connected (from telemetry)
+
+    @property
+    def ok(self) -> bool:
+        return self.failure is None
+
+
+def local_images(runtime: ContainerRuntime) -> ImageResolver:
+    """Images as they are on the engine: present -> its digest; missing -> an error."""
+
+    def resolve(plan: MatchPlan) -> dict[str, tuple[str | None, str | None]]:
+        found: dict[str, tuple[str | None, str | None]] = {}
+        for robot in plan.robots:
+            if robot.image is None:
+                found[robot.key] = (None, "no image named for this player")
+                continue
+            digest = runtime.image_digest(robot.image)
+            found[robot.key] = (digest, None if digest else f"image {robot.image} not found")
+        return found
+
+    return resolve
+
+
+class MatchRunner:
+    def __init__(
+        self,
+        plan: MatchPlan,
+        *,
+        runtime: ContainerRuntime,
+        host: Host,
+        options: RunOptions,
+        images: ImageResolver | None = None,
+        telemetry: TelemetryFactory | None = None,
+        stop_event: threading.Event | None = None,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self.plan = plan
+        self.runtime = runtime
+        self.host = host
+        self.options = options
+        self.images = images or local_images(runtime)
+        self.telemetry_factory = telemetry
+        self.stop_event = stop_event or threading.Event()
+        self.clock = clock
+        self.lifecycle = Lifecycle(plan.match_id, clock=clock)
+        self.records = {
+            r.key: RobotRecord(key=r.key, color=r.color, number=r.number, image=r.image)
+            for r in plan.robots
+        }
+        self.monitor = StatsMonitor(runtime)
+        self.started = startup.Started()
+        self.failure: Failure | None = None
+        self.forfeit: dict[str, Any] | None = None
+        self.bringup_s: float | None = None
+        self.telemetry: TelemetrySource | None = None
+
+    # public -------------------------------------------------------------------------------
+    def run(self) -> MatchOutcome:
+        out = self.options.out_dir
+        out.mkdir(parents=True, exist_ok=True)
+        try:
+            self._advance(MatchState.PULLING)
+            self._resolve_images()
+            if self.failure is None and self.forfeit is None:
+                self._advance(MatchState.STARTING)
+                started_at = self.clock()
+                startup.start(self, started_at)
+                self._advance(MatchState.WAITING)
+                self._watch(started_at)
+        except OrchestratorError as exc:
+            log.error("match %s: %s", self.plan.match_id, exc)
+            self._fail(FailureClass.INFRASTRUCTURE, str(exc))
+        except KeyboardInterrupt:
+            self._fail(FailureClass.INTERRUPTED, "interrupted")
+        results = collection.finish(self)
+        return MatchOutcome(
+            match_id=self.plan.match_id, failure=self.failure, out_dir=out, results=results,
+            bringup_s=self.bringup_s,
+        )
+
+    # helpers used by startup / collection ------------------------------------------------
+    def _advance(self, target: MatchState) -> None:
+        self.lifecycle.advance(target)
+        self._progress(None)
+
+    def _progress(self, state: dict[str, Any] | None) -> None:
+        if self.options.progress is not None:
+            self.options.progress(self.lifecycle.state.value, state)
+
+    def _fail(self, failure_class: FailureClass, cause: str) -> None:
+        if self.failure is None:
+            self.failure = Failure(failure_class=failure_class, cause=cause)
+            log.error("match %s failed (%s): %s", self.plan.match_id, failure_class.value, cause)
+
+    def _resolve_images(self) -> None:
+        resolved = self.images(self.plan)
+        usable: dict[str, int] = {"red": 0, "blue": 0}
+        for key, (digest, error) in resolved.items():
+            record = self.records[key]
+            record.digest = digest
+            record.image_error = error
+            if error is None:
+                usable[record.color] += 1
+            else:
+                log.warning("match %s: robot %s has no usable image: %s",
+                            self.plan.match_id, key, error)
+        forfeiting = [c for c in ("red", "blue") if usable[c] == 0]
+        if len(forfeiting) == 2:
+            self._fail(FailureClass.IMAGE_PULL, "neither team has a usable image")
+        elif forfeiting:
+            loser = forfeiting[0]
+            winner = "blue" if loser == "red" else "red"
+            self.forfeit = {
+                "team": loser,
+                "winner": winner,
+                "reason": f"no robot of {loser} has a usable image",
+                "score": {winner: 0, loser: 0},
+            }
+            log.info("match %s: %s forfeits (no usable image)", self.plan.match_id, loser)
+
+    def _watch(self, started_at: float) -> None:
+        """Poll the simulator, its telemetry and the robots until the simulator exits."""
+        sim_id = self.started.simulator_id
+        assert sim_id is not None
+        last_robot_poll = 0.0
+        while True:
+            if self.stop_event.is_set():
+                self._fail(FailureClass.INTERRUPTED, "the orchestrator was asked to stop")
+                return
+            state = self.runtime.inspect(sim_id)
+            if state.exited:
+                self._on_simulator_exit(state.exit_code)
+                return
+            now = self.clock()
+            if now - last_robot_poll >= 2.0:
+                self._poll_robots()
+                last_robot_poll = now
+            latest = self.telemetry.latest() if self.telemetry else None
+            if self.lifecycle.state is MatchState.WAITING and (
+                self.telemetry is None
+                or (latest is not None and latest.get("state") not in (None, "INITIAL"))
+            ):
+                self._advance(MatchState.PLAYING)
+            if self.bringup_s is None and latest is not None:
+                expected = {k for k in self.started.robot_ids}
+                if expected and expected <= set(latest.get("connected") or []):
+                    self.bringup_s = now - started_at
+                    log.info("match %s: all %d robots connected after %.2f s",
+                             self.plan.match_id, len(expected), self.bringup_s)
+            if self.telemetry is not None:
+                heard = self.telemetry.last_message_at() or self.started.simulator_started_at
+                if now - heard > self.plan.telemetry_silence_s:
+                    self._fail(FailureClass.SIMULATOR,
+                               f"telemetry silent for {now - heard:.0f} s")
+                    return
+            self._progress(latest)
+            self.stop_event.wait(self.options.poll_s)
+
+    def _poll_robots(self) -> None:
+        for key, container_id in self.started.robot_ids.items():
+            record = self.records[key]
+            if record.exited_during_game:
+                continue
+            try:
+                state = self.runtime.inspect(container_id)
+            except OrchestratorError as exc:
+                log.warning("match %s: cannot inspect robot %s: %s", self.plan.match_id, key, exc)
+                continue
+            if state.exited:
+                record.exited_during_game = True
+                record.exit_code = state.exit_code
+                record.oom_killed = state.oom_killed
+                log.info(
+                    "match %s: robot %s exited during the game (code %s%s); the game goes on",
+                    self.plan.match_id, key, state.exit_code,
+                    ", OOM-killed" if state.oom_killed else "",
+                )
+
+    def _on_simulator_exit(self, exit_code: int | None) -> None:
+        log.info("match %s: simulator exited with code %s", self.plan.match_id, exit_code)
+        if exit_code != 0:
+            tail = collection.simulator_stderr_tail(self)
+            self._fail(FailureClass.SIMULATOR,
+                       f"simulator exited with code {exit_code}" + (f": {tail}" if tail else ""))
+            return
+        sim_result = collection.read_sim_result(self)
+        final = None if sim_result is None else sim_result.get(
+            "final_state", sim_result.get("state"))
+        if sim_result is None:
+            self._fail(FailureClass.SIMULATOR, "simulator exited 0 without sim_result.json")
+        elif final is not None and final != "FINISHED":
+            self._fail(FailureClass.REFEREE, f"the game ended in state {final}, not FINISHED")
+
+
+__all__ = ["ImageResolver", "MatchOutcome", "MatchRunner", "RunOptions", "TelemetryFactory",
+           "local_images"]

@@ -1,0 +1,159 @@
+"""The container runtime boundary: what the match runner asks of a container engine.
+
+The real implementation is :class:`orchestrator.engine.containers.DockerRuntime` (the only code
+that imports ``docker``); :class:`orchestrator.match.fake.FakeRuntime` stands in for unit tests.
+Every method raises :class:`orchestrator.errors.InfrastructureError` (or a subclass) when the
+engine fails; ``NotFound`` is reported as :class:`ObjectNotFound`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Protocol
+
+from orchestrator.errors import InfrastructureError
+
+
+class ObjectNotFound(InfrastructureError):
+    """A container or network the runner refers to does not exist (any more)."""
+
+    def __init__(self, *, kind: str, name: str) -> None:
+        self.kind = kind
+        self.name = name
+        super().__init__(f"{kind} {name} does not exist")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class NetworkRequest:
+    name: str
+    subnet: str  # e.g. "10.213.4.0/24"
+    gateway: str  # e.g. "10.213.4.1"
+    internal: bool
+    bridge_name: str  # host interface name (at most 15 characters)
+    labels: Mapping[str, str] = field(default_factory=dict)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class NetworkInfo:
+    id: str
+    name: str
+    subnet: str
+    gateway: str
+    bridge_name: str
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Attachment:
+    network: str  # network name
+    ipv4_address: str
+    aliases: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class BindMount:
+    source: Path  # on the host
+    target: str  # in the container
+    read_only: bool = False
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ContainerRequest:
+    """Everything needed to create one container. ``network_mode`` ("container:<id>") excludes
+    ``networks``; the first attachment is made at creation, the others before start."""
+
+    name: str
+    image: str
+    command: tuple[str, ...] | None = None  # None: the image's default
+    entrypoint: tuple[str, ...] | None = None
+    environment: Mapping[str, str] = field(default_factory=dict)
+    labels: Mapping[str, str] = field(default_factory=dict)
+    networks: tuple[Attachment, ...] = ()
+    network_mode: str | None = None
+    mounts: tuple[BindMount, ...] = ()
+    hostname: str | None = None
+    nano_cpus: int | None = None
+    mem_bytes: int | None = None  # memory and memory+swap (no swap)
+    pids_limit: int | None = None
+    cap_drop: tuple[str, ...] = ()
+    cap_add: tuple[str, ...] = ()
+    security_opt: tuple[str, ...] = ()
+    working_dir: str | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ContainerState:
+    id: str
+    name: str
+    status: str  # created, running, paused, restarting, exited, dead
+    running: bool
+    exit_code: int | None  # None while it has not run to an end
+    oom_killed: bool
+    restart_count: int
+    pid: int  # 0 when not running
+    error: str = ""
+    started_at: str = ""
+    finished_at: str = ""
+
+    @property
+    def exited(self) -> bool:
+        return self.status in ("exited", "dead")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class StatsSample:
+    cpu_percent: float  # 100 = one full core
+    memory_bytes: int
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ProjectObject:
+    """A container or network found by its project label (for cleanup)."""
+
+    kind: str  # "container" | "network"
+    id: str
+    name: str
+    labels: Mapping[str, str]
+
+
+class ContainerRuntime(Protocol):
+    def create_network(self, request: NetworkRequest) -> NetworkInfo: ...
+
+    def remove_network(self, name: str) -> None: ...
+
+    def create_container(self, request: ContainerRequest) -> str: ...
+
+    def start(self, container_id: str) -> None: ...
+
+    def stop(self, container_id: str, *, timeout_s: float) -> None: ...
+
+    def kill(self, container_id: str) -> None: ...
+
+    def remove(self, container_id: str) -> None: ...
+
+    def inspect(self, container_id: str) -> ContainerState: ...
+
+    def wait(self, container_id: str, *, timeout_s: float) -> int | None: ...
+
+    def stats_stream(self, container_id: str) -> Iterator[StatsSample]: ...
+
+    def save_logs(self, container_id: str, *, stdout: Path, stderr: Path) -> None: ...
+
+    def image_digest(self, image: str) -> str | None: ...
+
+    def list_project(self, *, match_id: str | None = None) -> list[ProjectObject]: ...
+
+
+__all__ = [
+    "Attachment",
+    "BindMount",
+    "ContainerRequest",
+    "ContainerRuntime",
+    "ContainerState",
+    "NetworkInfo",
+    "NetworkRequest",
+    "ObjectNotFound",
+    "ProjectObject",
+    "StatsSample",
+]

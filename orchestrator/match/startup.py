@@ -1,0 +1,189 @@
+"""STARTING: networks, host firewall, match spec, simulator, then the robots in parallel."""
+
+from __future__ import annotations
+
+import json
+import logging
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from orchestrator.bandwidth import AppliedShaping, RobotShaping, mb_s_to_bit
+from orchestrator.engine.networks import SubnetInUse
+from orchestrator.errors import InfrastructureError, OrchestratorError
+from orchestrator.match import layout
+from orchestrator.match.layout import Subnet
+from orchestrator.match.logfs import LogFolder
+from orchestrator.match.plan import RobotPlan, per_robot_rate_mb_s
+from orchestrator.match.results import FailureClass
+from orchestrator.match.runtime import Attachment, NetworkInfo
+
+if TYPE_CHECKING:
+    from orchestrator.match.runner import MatchRunner
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(slots=True)
+class Started:
+    """Everything created so far, so that teardown removes exactly that."""
+
+    prefix: str = ""
+    networks: dict[str, NetworkInfo] = field(default_factory=dict)  # role -> network
+    subnets: dict[str, Subnet] = field(default_factory=dict)
+    simulator_id: str | None = None
+    simulator_started_at: float = 0.0
+    holder_ids: dict[str, str] = field(default_factory=dict)  # robot key -> holder id
+    robot_ids: dict[str, str] = field(default_factory=dict)  # robot key -> container id
+    shaping: dict[str, AppliedShaping] = field(default_factory=dict)
+    log_folders: dict[str, LogFolder] = field(default_factory=dict)
+    match_dir: Path | None = None
+
+
+def _create_network(runner: MatchRunner, role: str, internal: bool) -> None:
+    plan = runner.plan
+    started = runner.started
+    taken = {str(s.network) for s in started.subnets.values()}
+    for subnet in layout.candidate_subnets(f"{plan.match_id}/{role}"):
+        if str(subnet.network) in taken:
+            continue
+        request = layout.network_request(
+            prefix=started.prefix, role=role, subnet=subnet, internal=internal,
+            match_id=plan.match_id, extra_labels=runner.options.extra_labels,
+        )
+        try:
+            started.networks[role] = runner.runtime.create_network(request)
+        except SubnetInUse:
+            continue
+        started.subnets[role] = subnet
+        return
+    raise InfrastructureError(f"no free /24 in 10.213.0.0/16 for the {role} network")
+
+
+def start(runner: MatchRunner, started_at: float) -> None:
+    plan = runner.plan
+    started = runner.started
+    started.prefix = f"hlvs-{plan.match_id}"
+    for role, internal in (("control", True), ("red", not plan.allow_internet),
+                           ("blue", not plan.allow_internet)):
+        _create_network(runner, role, internal)
+    for color in ("red", "blue"):
+        runner.host.isolate_bridge(started.networks[color].bridge_name, match_id=plan.match_id)
+
+    addresses = {
+        team.color: tuple(started.subnets[team.color].robot(r.number) for r in team.robots)
+        for team in plan.teams
+    }
+    control = started.subnets["control"]
+    endpoint = f"tcp/{control.simulator}:{layout.TELEMETRY_PORT}" if plan.telemetry else None
+    match_dir = runner.options.out_dir / "simulator"
+    (match_dir / "out").mkdir(parents=True, exist_ok=True)
+    for folder in (match_dir, match_dir / "out"):
+        folder.chmod(0o777)
+    started.match_dir = match_dir
+    spec = plan.spec_builder(addresses, endpoint)
+    (match_dir / "match_spec.json").write_text(json.dumps(spec, indent=2, sort_keys=True) + "\n")
+
+    attachments = tuple(
+        Attachment(
+            network=started.networks[role].name,
+            ipv4_address=started.subnets[role].simulator,
+            aliases=("simulator",),
+        )
+        for role in ("control", "red", "blue")
+    )
+    request = layout.simulator_request(
+        plan, prefix=started.prefix, image=runner.options.simulator_image, match_dir=match_dir,
+        attachments=attachments, extra_labels=runner.options.extra_labels,
+        command=runner.options.simulator_command,
+    )
+    started.simulator_id = runner.runtime.create_container(request)
+    runner.runtime.start(started.simulator_id)
+    started.simulator_started_at = runner.clock()
+    log.info("match %s: simulator container %s started (%s)", plan.match_id, request.name,
+             request.image)
+    runner.monitor.watch("simulator", started.simulator_id)
+    if endpoint is not None and runner.telemetry_factory is not None:
+        runner.telemetry = runner.telemetry_factory(endpoint, plan.match_id)
+
+    robots = [r for r in plan.robots if runner.records[r.key].image_error is None]
+    with ThreadPoolExecutor(max_workers=max(1, min(8, len(robots)))) as pool:
+        list(pool.map(lambda robot: _start_robot(runner, robot), robots))
+    for team in plan.teams:
+        tried = [r for r in team.robots if runner.records[r.key].image_error is None]
+        failed = [r for r in tried if runner.records[r.key].startup_error is not None]
+        if tried and len(failed) == len(tried):
+            runner._fail(FailureClass.TEAM_STARTUP, f"no robot of {team.color} could be started: "
+                         f"{runner.records[failed[0].key].startup_error}")
+    log.info("match %s: %d robot containers started in %.2f s", plan.match_id,
+             len(started.robot_ids), runner.clock() - started_at)
+
+
+def _start_robot(runner: MatchRunner, robot: RobotPlan) -> None:
+    plan = runner.plan
+    started = runner.started
+    record = runner.records[robot.key]
+    team = plan.red if robot.color == "red" else plan.blue
+    subnet = started.subnets[robot.color]
+    network = started.networks[robot.color].name
+    n_robots = len([r for r in team.robots if runner.records[r.key].image_error is None])
+    limits = plan.limits
+    try:
+        holder = layout.holder_request(
+            robot, prefix=started.prefix,
+            image=runner.options.holder_image or runner.options.simulator_image,
+            network=network, team_net=subnet, match_id=plan.match_id,
+            extra_labels=runner.options.extra_labels,
+        )
+        holder_id = runner.runtime.create_container(holder)
+        started.holder_ids[robot.key] = holder_id
+        runner.runtime.start(holder_id)
+        pid = runner.runtime.inspect(holder_id).pid
+        shaping = RobotShaping(
+            api_rate_bit=mb_s_to_bit(per_robot_rate_mb_s(limits.team_api_mb_s, n_robots)),
+            comm_rate_bit=mb_s_to_bit(per_robot_rate_mb_s(limits.team_comm_mb_s, n_robots)),
+            simulator_ip=subnet.simulator,
+            teammate_ips=tuple(subnet.robot(r.number) for r in team.robots if r != robot),
+            mirror_port=plan.mirror_port,
+        )
+        applied = runner.host.shape(pid, shaping)
+        if applied is not None:
+            started.shaping[robot.key] = applied
+        folder = runner.host.log_folder(
+            match_id=plan.match_id, name=robot.key, cap_bytes=int(limits.log_folder_gb * 1e9),
+            fallback=runner.options.out_dir / "teams" / robot.color / str(robot.number)
+            / "robocup-logs",
+        )
+        started.log_folders[robot.key] = folder
+        record.limits = {
+            "nano_cpus": int(limits.cpus * 1e9),
+            "memory_bytes": int(limits.memory_gb * 1e9),
+            "pids": limits.pids,
+            "log_folder_bytes": folder.cap_bytes,
+            "api_rate_bit_s": applied.api_rate_bit if applied else None,
+            "comm_rate_bit_s": applied.comm_rate_bit if applied else None,
+            "shaping_applied_ms": round(applied.applied_ms, 1) if applied else None,
+        }
+        environment = layout.robot_environment(
+            robot, team_net=subnet, player_count=len(team.robots),
+            gamecontroller_ip=subnet.simulator,
+        )
+        request = layout.robot_request(
+            robot, prefix=started.prefix, holder_id=holder_id, environment=environment,
+            logs_dir=folder.path, limits=limits, match_id=plan.match_id,
+            extra_labels=runner.options.extra_labels,
+        )
+        container_id = runner.runtime.create_container(request)
+        started.robot_ids[robot.key] = container_id
+        record.container = request.name
+        runner.runtime.start(container_id)
+        runner.monitor.watch(robot.key, container_id)
+        log.info("match %s: robot %s started (%s, %s)", plan.match_id, robot.key, robot.image,
+                 subnet.robot(robot.number))
+    except OrchestratorError as exc:
+        record.startup_error = str(exc)
+        log.warning("match %s: robot %s could not be started: %s", plan.match_id, robot.key, exc)
+
+
+__all__ = ["Started", "start"]

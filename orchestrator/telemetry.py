@@ -1,0 +1,167 @@
+"""Match telemetry from the simulator (the only orchestrator module importing zenoh) and the
+terminal view of a running match.
+
+The simulator publishes ``hlvs/<match_id>/state`` (JSON, about 5 Hz) and ``hlvs/<match_id>/events``
+(one RefereeEvent per message) on its control-network address; :class:`ZenohTelemetry` connects
+there as a zenoh peer with multicast scouting and shared memory off and keeps the latest state.
+:class:`LiveView` shows it with ``rich`` when stdout is a terminal, else as plain progress lines.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import sys
+import threading
+import time
+from collections.abc import Callable
+from typing import Any, Protocol, TextIO
+
+import zenoh
+from rich.console import Console
+from rich.live import Live
+from rich.table import Table
+
+from orchestrator.errors import InfrastructureError
+
+log = logging.getLogger(__name__)
+
+
+class TelemetrySource(Protocol):
+    def latest(self) -> dict[str, Any] | None: ...
+
+    def last_message_at(self) -> float | None: ...  # time.monotonic() of the last message
+
+    def events(self) -> list[dict[str, Any]]: ...
+
+    def close(self) -> None: ...
+
+
+class ZenohTelemetry:
+    """Subscribes to one match's telemetry at ``endpoint`` (e.g. ``tcp/10.213.7.2:7447``)."""
+
+    def __init__(self, *, endpoint: str, match_id: str, clock: Callable[[], float] = time.monotonic
+                 ) -> None:
+        self._clock = clock
+        self._lock = threading.Lock()
+        self._latest: dict[str, Any] | None = None
+        self._last_at: float | None = None
+        self._events: list[dict[str, Any]] = []
+        config = zenoh.Config()
+        config.insert_json5("mode", '"peer"')
+        config.insert_json5("scouting/multicast/enabled", "false")
+        config.insert_json5("scouting/gossip/enabled", "false")
+        config.insert_json5("transport/shared_memory/enabled", "false")
+        config.insert_json5("connect/endpoints", json.dumps([endpoint]))
+        try:
+            self._session = zenoh.open(config)
+            self._subs = [
+                self._session.declare_subscriber(f"hlvs/{match_id}/state", self._on_state),
+                self._session.declare_subscriber(f"hlvs/{match_id}/events", self._on_event),
+            ]
+        except zenoh.ZError as exc:
+            raise InfrastructureError(
+                f"cannot subscribe to telemetry at {endpoint}: {exc}"
+            ) from exc
+        log.info("telemetry: subscribed to hlvs/%s/* at %s", match_id, endpoint)
+
+    def _decode(self, sample: Any) -> dict[str, Any] | None:
+        try:
+            value = json.loads(sample.payload.to_string())
+        except ValueError:
+            log.warning("telemetry: undecodable message on %s", sample.key_expr)
+            return None
+        return value if isinstance(value, dict) else None
+
+    def _on_state(self, sample: Any) -> None:
+        value = self._decode(sample)
+        with self._lock:
+            self._last_at = self._clock()
+            if value is not None:
+                self._latest = value
+
+    def _on_event(self, sample: Any) -> None:
+        value = self._decode(sample)
+        with self._lock:
+            self._last_at = self._clock()
+            if value is not None:
+                self._events.append(value)
+
+    def latest(self) -> dict[str, Any] | None:
+        with self._lock:
+            return self._latest
+
+    def last_message_at(self) -> float | None:
+        with self._lock:
+            return self._last_at
+
+    def events(self) -> list[dict[str, Any]]:
+        with self._lock:
+            return list(self._events)
+
+    def close(self) -> None:
+        for sub in self._subs:
+            sub.undeclare()  # type: ignore[no-untyped-call]
+        self._session.close()  # type: ignore[no-untyped-call]
+
+
+def describe(state: dict[str, Any]) -> str:
+    """One progress line for a telemetry state."""
+    score = state.get("score") or {}
+    secondary = state.get("secondary_state")
+    return (
+        f"{state.get('state', '?')}"
+        + (f"/{secondary}" if secondary and secondary != "NORMAL" else "")
+        + f" half {state.get('half', '?')} {state.get('secs_remaining', '?')} s left"
+        + f" score red {score.get('red', '?')} - {score.get('blue', '?')} blue"
+        + f" sim {float(state.get('sim_time_ms', 0)) / 1000:.1f} s"
+        + f" rtf {float(state.get('real_time_factor', 0)):.2f}"
+        + f" connected {','.join(state.get('connected') or []) or '-'}"
+    )
+
+
+class LiveView:
+    """Shows the match phase and the latest telemetry; ``update`` is cheap to call often."""
+
+    def __init__(self, *, match_id: str, stream: TextIO | None = None) -> None:
+        self._stream = stream or sys.stdout
+        self._match_id = match_id
+        self._tty = self._stream.isatty()
+        self._phase = "pending"
+        self._last_line = ""
+        self._live: Live | None = None
+        if self._tty:
+            self._live = Live(self._table(None), console=Console(file=self._stream),
+                              refresh_per_second=4, transient=False)
+            self._live.start()
+
+    def _table(self, state: dict[str, Any] | None) -> Table:
+        table = Table(title=f"match {self._match_id}", show_header=False)
+        table.add_row("phase", self._phase)
+        if state is not None:
+            score = state.get("score") or {}
+            table.add_row("game", f"{state.get('state')} ({state.get('secondary_state')}), "
+                          f"half {state.get('half')}, {state.get('secs_remaining')} s left")
+            table.add_row("score", f"red {score.get('red')} - {score.get('blue')} blue")
+            table.add_row("sim time", f"{float(state.get('sim_time_ms', 0)) / 1000:.1f} s")
+            table.add_row("real-time factor", f"{float(state.get('real_time_factor', 0)):.2f}")
+            table.add_row("connected", ", ".join(state.get("connected") or []) or "-")
+        return table
+
+    def update(self, *, phase: str, state: dict[str, Any] | None) -> None:
+        self._phase = phase
+        if self._live is not None:
+            self._live.update(self._table(state))
+            return
+        line = f"[{phase}] " + (describe(state) if state else "")
+        if line != self._last_line:
+            self._stream.write(line + "\n")
+            self._stream.flush()
+            self._last_line = line
+
+    def close(self) -> None:
+        if self._live is not None:
+            self._live.stop()
+
+
+__all__ = ["LiveView", "TelemetrySource", "ZenohTelemetry", "describe"]
