@@ -1,11 +1,152 @@
-"""`hlvs schedule` (being written)."""
+"""``hlvs schedule run|list|status|cancel|standings``: a tournament from one schedule file."""
 
 from __future__ import annotations
 
 import argparse
+import json
+from datetime import UTC, datetime
 from typing import Any
+
+from orchestrator.errors import ScheduleError
 
 
 def register(sub: Any) -> None:
-    parser: argparse.ArgumentParser = sub.add_parser("schedule", help="(not yet available)")
-    parser.set_defaults(func=lambda args: 1)
+    parser: argparse.ArgumentParser = sub.add_parser(
+        "schedule", help="run a tournament from a schedule file (pull, play, deliver)"
+    )
+    verbs = parser.add_subparsers(dest="verb", metavar="VERB")
+    verbs.required = True
+
+    run = verbs.add_parser("run", help="run the schedule; survives restarts")
+    run.add_argument("schedule", help="schedule file (YAML)")
+    run.add_argument("--state", required=True, help="SQLite state file (jobs and ledger)")
+    run.add_argument("--exit-when-done", action="store_true", help="stop when every match is final")
+    run.add_argument("--services", help="module:factory of the pull/play/deliver services (tests)")
+    run.set_defaults(func=_run)
+
+    plan = verbs.add_parser("list", help="what is planned, with absolute times")
+    plan.add_argument("schedule")
+    plan.add_argument("--state", help="use the reference time recorded in this state file")
+    plan.add_argument("--json", action="store_true")
+    plan.set_defaults(func=_list)
+
+    status = verbs.add_parser("status", help="state of every match")
+    status.add_argument("--state", required=True)
+    status.add_argument("--json", action="store_true")
+    status.set_defaults(func=_status)
+
+    cancel = verbs.add_parser("cancel", help="cancel a match that is not played yet")
+    cancel.add_argument("match_id")
+    cancel.add_argument("--state", required=True)
+    cancel.set_defaults(func=_cancel)
+
+    table = verbs.add_parser("standings", help="points, goal difference and goals")
+    table.add_argument("--state", required=True)
+    table.add_argument("--json", action="store_true")
+    table.set_defaults(func=_standings)
+
+
+def _ledger(path: str) -> Any:
+    from pathlib import Path
+
+    from orchestrator.schedule.state import Ledger
+
+    if not Path(path).is_file():
+        raise ScheduleError(f"{path}: no such state file (start it with 'hlvs schedule run')")
+    return Ledger(Path(path))
+
+
+def _run(args: argparse.Namespace) -> int:
+    from orchestrator.schedule.runner import run_schedule
+
+    return run_schedule(
+        args.schedule, args.state, services=args.services, exit_when_done=args.exit_when_done
+    )
+
+
+def _list(args: argparse.Namespace) -> int:
+    from orchestrator.config.schedule import load_schedule, resolve_time
+
+    schedule = load_schedule(args.schedule)
+    now = datetime.now(UTC)
+    reference = now
+    if args.state:
+        recorded = _ledger(args.state).get_meta("reference")
+        reference = datetime.fromisoformat(recorded) if recorded else now
+    elif schedule.start not in (None, "now"):
+        reference = resolve_time(str(schedule.start), now)
+    rows = [
+        {
+            "id": p.match.id,
+            "kind": p.match.kind,
+            "class": p.match.field_class,
+            "red": str(p.match.red),
+            "blue": str(p.match.blue),
+            "pull_at": p.pull_at.isoformat(timespec="seconds"),
+            "play_at": p.play_at.isoformat(timespec="seconds"),
+            "stream_start": p.stream_start.isoformat(timespec="seconds"),
+            "deliver_at": p.deliver_at.isoformat(timespec="seconds"),
+        }
+        for p in schedule.plan(reference)
+    ]
+    if args.json:
+        print(json.dumps(rows, indent=2))
+    else:
+        for r in rows:
+            print(
+                f"{r['id']:<12} {r['kind']:<11} {r['red']} v {r['blue']}: pull {r['pull_at']},"
+                f" play {r['play_at']}, stream {r['stream_start']}"
+            )
+    return 0
+
+
+def _status(args: argparse.Namespace) -> int:
+    rows = _ledger(args.state).rows()
+    if args.json:
+        print(json.dumps([r.as_dict() for r in rows], indent=2))
+        return 0
+    for r in rows:
+        score = ""
+        if r.result and r.result.get("score", {}).get("red") is not None:
+            score = f" {r.result['score']['red']}-{r.result['score']['blue']}"
+        print(f"{r.id:<12} {r.state.value:<12} {r.red} v {r.blue}{score}  {r.note}".rstrip())
+    return 0
+
+
+def _cancel(args: argparse.Namespace) -> int:
+    from orchestrator.schedule.state import MatchState
+
+    ledger = _ledger(args.state)
+    not_started = (MatchState.PLANNED, MatchState.PULLING, MatchState.PULLED)
+    if not ledger.transition(args.match_id, not_started, MatchState.CANCELLED, note="cancelled"):
+        try:
+            state = ledger.row(args.match_id).state.value
+        except KeyError:
+            raise ScheduleError(f"no match {args.match_id!r} in {args.state}") from None
+        raise ScheduleError(
+            f"match {args.match_id} is {state}; only matches not yet played can be cancelled"
+        )
+    print(f"{args.match_id}: CANCELLED")
+    return 0
+
+
+def _standings(args: argparse.Namespace) -> int:
+    from orchestrator.config.schedule import load_schedule
+    from orchestrator.schedule.standings import standings
+
+    ledger = _ledger(args.state)
+    schedule_path = ledger.get_meta("schedule")
+    teams = [t.name for t in load_schedule(schedule_path).teams] if schedule_path else []
+    table = standings(ledger.rows(), teams)
+    if args.json:
+        print(json.dumps([s.as_dict() for s in table], indent=2))
+        return 0
+    print(
+        f"{'team':<16} {'P':>3} {'W':>3} {'D':>3} {'L':>3} {'GF':>4} {'GA':>4} {'GD':>4} {'Pts':>4}"
+    )
+    for s in table:
+        print(
+            f"{s.team:<16} {s.played:>3} {s.won:>3} {s.drawn:>3} {s.lost:>3} {s.goals_for:>4}"
+            f" {s.goals_against:>4} {s.goal_difference:>4} {s.points:>4}"
+        )
+    return 0

@@ -1,0 +1,32 @@
+"""Tournament scheduling: pull, play and deliver every match on time, across restarts."""
+
+from __future__ import annotations
+
+from orchestrator.schedule.runner import init_state, recover_interrupted, run_schedule
+from orchestrator.schedule.services import (
+    MatchContext,
+    MatchServices,
+    PlayOutcome,
+    TournamentServices,
+    read_outcome,
+    write_game_file,
+)
+from orchestrator.schedule.standings import Standing, standings
+from orchestrator.schedule.state import Ledger, MatchRow, MatchState
+
+__all__ = [
+    "Ledger",
+    "MatchContext",
+    "MatchRow",
+    "MatchServices",
+    "MatchState",
+    "PlayOutcome",
+    "Standing",
+    "TournamentServices",
+    "init_state",
+    "read_outcome",
+    "recover_interrupted",
+    "run_schedule",
+    "standings",
+    "write_game_file",
+]

@@ -1,0 +1,198 @@
+"""``hlvs schedule run``: APScheduler with its jobs in the SQLite state file, and the ledger.
+
+On every start the runner (1) records the schedule and fixes the tournament's reference time in
+the state file the first time, (2) adds new matches to the ledger, (3) puts back the steps a
+killed run left half done (PULLING -> PLANNED, PLAYING -> PULLED, DELIVERING -> PLAYED), and
+(4) keeps one APScheduler job for the next step of every unfinished match. Jobs whose time passed
+while no scheduler ran fire once at start (coalesced) and decide themselves whether they are
+still useful (a match whose stream started is marked MISSED with the reason).
+"""
+
+from __future__ import annotations
+
+import logging
+import signal
+import threading
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+from apscheduler.events import EVENT_JOB_ERROR, EVENT_JOB_EXECUTED, JobExecutionEvent
+from apscheduler.executors.pool import ThreadPoolExecutor
+from apscheduler.jobstores.sqlalchemy import SQLAlchemyJobStore
+from apscheduler.schedulers.background import BackgroundScheduler
+
+from orchestrator.config.schedule import Schedule, load_schedule, resolve_time
+from orchestrator.errors import ScheduleError
+from orchestrator.schedule.state import Ledger, MatchState
+
+log = logging.getLogger(__name__)
+S = MatchState
+
+JOB_FUNCTIONS = {
+    "pull": "orchestrator.schedule.jobs:pull_job",
+    "play": "orchestrator.schedule.jobs:play_job",
+    "deliver": "orchestrator.schedule.jobs:deliver_job",
+}
+NEXT_STEP = {
+    S.PLANNED: ("pull", "pull_at"),
+    S.PULLED: ("play", "play_at"),
+    S.PLAYED: ("deliver", "deliver_at"),
+}
+INTERRUPTED = {S.PULLING: S.PLANNED, S.PLAYING: S.PULLED, S.DELIVERING: S.PLAYED}
+
+
+def init_state(
+    schedule_path: str | Path,
+    state_path: str | Path,
+    *,
+    services: str | None = None,
+    now: datetime | None = None,
+) -> tuple[Schedule, Ledger]:
+    """Open (or create) the state file of a schedule and add its matches to the ledger."""
+    schedule = load_schedule(schedule_path)
+    ledger = Ledger(Path(state_path))
+    recorded = ledger.get_meta("schedule")
+    if recorded is not None and Path(recorded) != schedule.source:
+        raise ScheduleError(
+            f"{state_path} belongs to the schedule {recorded}, not {schedule.source}; "
+            "use another --state file"
+        )
+    ledger.set_meta("schedule", str(schedule.source))
+    reference_text = ledger.get_meta("reference")
+    if reference_text is None:
+        now = now or datetime.now(UTC)
+        if schedule.start in (None, "now"):
+            reference = now
+        else:
+            reference = resolve_time(str(schedule.start), now)
+        ledger.set_meta("reference", reference.isoformat())
+    else:
+        reference = datetime.fromisoformat(reference_text)
+    if services is not None:
+        ledger.set_meta("services", services)
+    for planned in schedule.plan(reference):
+        added = ledger.ensure(
+            {
+                "id": planned.match.id,
+                "kind": planned.match.kind,
+                "red": str(planned.match.red),
+                "blue": str(planned.match.blue),
+                "pull_at": planned.pull_at.isoformat(),
+                "play_at": planned.play_at.isoformat(),
+                "stream_start": planned.stream_start.isoformat(),
+                "stream_end": planned.stream_end.isoformat(),
+                "deliver_at": planned.deliver_at.isoformat(),
+            }
+        )
+        if added:
+            log.info(
+                "match %s planned: pull %s, stream %s",
+                planned.match.id,
+                planned.pull_at.isoformat(timespec="seconds"),
+                planned.stream_start.isoformat(timespec="seconds"),
+            )
+    return schedule, ledger
+
+
+def recover_interrupted(ledger: Ledger) -> list[str]:
+    """Put back the steps that a killed scheduler left half done; returns the match ids."""
+    recovered = []
+    for row in ledger.rows():
+        back = INTERRUPTED.get(row.state)
+        if back is not None and ledger.transition(
+            row.id, (row.state,), back, note=f"{row.state.value} interrupted by a restart"
+        ):
+            log.warning("match %s: %s was interrupted; back to %s", row.id, row.state, back)
+            recovered.append(row.id)
+    return recovered
+
+
+def reconcile(scheduler: Any, ledger: Ledger, state_path: str) -> None:
+    """One job for the next step of every unfinished match (none while a step runs)."""
+    for row in ledger.rows():
+        step = NEXT_STEP.get(row.state)
+        if step is None:
+            continue
+        kind, attr = step
+        job_id = f"{kind}:{row.id}"
+        if scheduler.get_job(job_id) is not None:
+            continue
+        run_at: datetime = getattr(row, attr)
+        if row.not_before is not None and row.not_before > run_at:
+            run_at = row.not_before
+        scheduler.add_job(
+            JOB_FUNCTIONS[kind],
+            "date",
+            run_date=run_at,
+            args=[state_path, row.id],
+            id=job_id,
+            name=f"{kind} {row.id}",
+            executor="play" if kind == "play" else "default",
+            misfire_grace_time=None,
+            coalesce=True,
+            replace_existing=True,
+        )
+
+
+def run_schedule(
+    schedule_path: str | Path,
+    state_path: str | Path,
+    *,
+    services: str | None = None,
+    exit_when_done: bool = False,
+    poll_s: float = 1.0,
+    stop: threading.Event | None = None,
+) -> int:
+    """Run the tournament until every match is final (with ``exit_when_done``) or a signal."""
+    state = str(Path(state_path).resolve())
+    schedule, ledger = init_state(schedule_path, state, services=services)
+    recover_interrupted(ledger)
+    stop = stop or threading.Event()
+    wake = threading.Event()
+    if threading.current_thread() is threading.main_thread():
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(sig, lambda *_: (stop.set(), wake.set()))
+    scheduler = BackgroundScheduler(
+        jobstores={"default": SQLAlchemyJobStore(url=f"sqlite:///{state}")},
+        executors={
+            "default": ThreadPoolExecutor(2),
+            "play": ThreadPoolExecutor(schedule.simulator_slots),
+        },
+        timezone=UTC,
+    )
+
+    def job_done(event: JobExecutionEvent) -> None:
+        if event.exception is not None:
+            log.error("job %s failed: %r", event.job_id, event.exception)
+        wake.set()  # its match may have a next step now
+
+    scheduler.add_listener(job_done, EVENT_JOB_EXECUTED | EVENT_JOB_ERROR)
+    scheduler.start()
+    log.info(
+        "schedule %s: %d matches, %d simulator slot(s), state in %s",
+        schedule.name,
+        len(schedule.matches),
+        schedule.simulator_slots,
+        state,
+    )
+    last: dict[str, str] = {}
+    try:
+        while not stop.is_set():
+            reconcile(scheduler, ledger, state)
+            rows = ledger.rows()
+            for row in rows:
+                if last.get(row.id) != row.state.value:
+                    last[row.id] = row.state.value
+                    print(
+                        f"{datetime.now(UTC).isoformat(timespec='seconds')} {row.id}: "
+                        f"{row.state.value} {row.note}".rstrip(),
+                        flush=True,
+                    )
+            if exit_when_done and all(row.state.final for row in rows):
+                break
+            wake.wait(poll_s)
+            wake.clear()
+    finally:
+        scheduler.shutdown(wait=not stop.is_set())
+    return 0

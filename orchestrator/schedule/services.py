@@ -1,0 +1,208 @@
+"""What a tournament does with a match: pull its images, play it, deliver its logs.
+
+:class:`TournamentServices` is the boundary the scheduler's jobs call; :class:`MatchServices`
+is the real implementation (images through :mod:`orchestrator.pull`, the match through
+``hlvs match`` in a child process that dies with the scheduler, logs through
+:mod:`orchestrator.delivery`). Tests may plug in their own through a ``module:function`` factory.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import importlib
+import json
+import logging
+import os
+import signal
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Protocol
+
+from orchestrator.config.schedule import PlannedMatch, Schedule, ScheduledTeam
+from orchestrator.errors import ScheduleError
+
+log = logging.getLogger(__name__)
+
+DEFAULT_SERVICES = "orchestrator.schedule.services:MatchServices"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class MatchContext:
+    schedule: Schedule
+    planned: PlannedMatch
+    red: ScheduledTeam
+    blue: ScheduledTeam
+    out_dir: Path
+
+    @property
+    def match_id(self) -> str:
+        return self.planned.match.id
+
+    @property
+    def game_path(self) -> Path:
+        return self.out_dir / "game.json"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class PlayOutcome:
+    """What the scheduler keeps of a played match (stored as the ledger's result)."""
+
+    status: str  # "success" or the failure class of report.json
+    score_red: int | None
+    score_blue: int | None
+    winner: str | None  # "red" | "blue" | "draw" | None
+    cause: str = ""
+
+    def as_dict(self, ctx: MatchContext) -> dict[str, Any]:
+        team = {"red": ctx.red.name, "blue": ctx.blue.name}
+        return {
+            "status": self.status,
+            "score": {"red": self.score_red, "blue": self.score_blue},
+            "winner": self.winner,
+            "red_team": ctx.red.name,
+            "blue_team": ctx.blue.name,
+            "winner_team": team.get(self.winner or ""),
+            "cause": self.cause,
+            "out_dir": str(ctx.out_dir),
+        }
+
+
+class TournamentServices(Protocol):
+    def pull(self, ctx: MatchContext) -> str:
+        """Pull the match's images; returns a one-line summary. Raises OrchestratorError."""
+
+    def play(self, ctx: MatchContext) -> PlayOutcome:
+        """Play the match into ``ctx.out_dir``."""
+
+    def deliver(self, ctx: MatchContext) -> str:
+        """Deliver the match's logs; a summary. Raises DeliveryError when sets stay pending."""
+
+
+def load_services(ref: str, schedule: Schedule) -> TournamentServices:
+    """Build the services from a ``module:callable`` reference (called with the schedule)."""
+    module_name, _, attr = ref.partition(":")
+    try:
+        factory = getattr(importlib.import_module(module_name), attr)
+    except (ImportError, AttributeError) as exc:
+        raise ScheduleError(f"services {ref!r} cannot be loaded: {exc}") from exc
+    services: TournamentServices = factory(schedule)
+    return services
+
+
+def write_game_file(ctx: MatchContext) -> Path:
+    """The match's game.json: HLVS fields, the schedule's game defaults, both teams."""
+    match = ctx.planned.match
+    game: dict[str, Any] = {
+        "type": "KNOCKOUT" if match.kind == "knockout" else "NORMAL",
+        "class": match.field_class,
+        "host": "127.0.0.1",
+        "maximum_real_time_factor": 0,
+        "match_id": ctx.match_id,
+    }
+    game.update(ctx.schedule.game_defaults)
+    for color, team, base in (("red", ctx.red, 10000), ("blue", ctx.blue, 10020)):
+        side: dict[str, Any] = {
+            "id": team.team_id,
+            "config": str(team.config),
+            "hosts": ["127.0.0.1"],
+            "ports": [base + n for n in range(1, 5 if match.field_class == "KID" else 4)],
+        }
+        if team.credentials is not None:
+            side["credentials"] = str(team.credentials)
+        game[color] = side
+    ctx.out_dir.mkdir(parents=True, exist_ok=True)
+    ctx.game_path.write_text(json.dumps(game, indent=2) + "\n", encoding="utf-8")
+    return ctx.game_path
+
+
+def _die_with_parent() -> None:  # pragma: no cover - runs in the child before exec
+    """Linux: the match process gets SIGTERM (and cleans up) if the scheduler dies."""
+    libc = ctypes.CDLL("libc.so.6", use_errno=True)
+    libc.prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+
+
+def read_outcome(out_dir: Path) -> PlayOutcome:
+    """The outcome of a finished ``hlvs match`` from its report.json and results.json."""
+    report_path, results_path = out_dir / "report.json", out_dir / "results.json"
+    if not report_path.is_file():
+        return PlayOutcome(
+            status="infrastructure",
+            score_red=None,
+            score_blue=None,
+            winner=None,
+            cause=f"{report_path} was not written",
+        )
+    report = json.loads(report_path.read_text(encoding="utf-8"))
+    results: dict[str, Any] = {}
+    if results_path.is_file():
+        results = json.loads(results_path.read_text(encoding="utf-8"))
+    score = results.get("score") or {}
+    return PlayOutcome(
+        status=str(report.get("status", "infrastructure")),
+        score_red=score.get("red"),
+        score_blue=score.get("blue"),
+        winner=results.get("winner"),
+        cause=str(report.get("cause", "")),
+    )
+
+
+class MatchServices:
+    """The real thing: registry pulls, a match in Docker, log delivery to the teams' targets."""
+
+    def __init__(self, schedule: Schedule) -> None:
+        self.schedule = schedule
+
+    def pull(self, ctx: MatchContext) -> str:
+        from orchestrator.pull import pull_game_images
+
+        game = write_game_file(ctx)
+        return str(pull_game_images(game))
+
+    def play(self, ctx: MatchContext) -> PlayOutcome:
+        game = write_game_file(ctx)
+        out = ctx.out_dir / "match"
+        cmd = [sys.executable, "-m", "orchestrator.cli", "match", str(game), "--out", str(out)]
+        log.info("match %s: %s", ctx.match_id, " ".join(cmd))
+        with open(ctx.out_dir / "match.log", "ab") as sink:
+            proc = subprocess.run(
+                cmd,
+                stdout=sink,
+                stderr=subprocess.STDOUT,
+                preexec_fn=_die_with_parent if sys.platform == "linux" else None,
+                env=os.environ.copy(),
+                check=False,
+            )
+        outcome = read_outcome(out)
+        log.info(
+            "match %s: exit %d, %s %s-%s",
+            ctx.match_id,
+            proc.returncode,
+            outcome.status,
+            outcome.score_red,
+            outcome.score_blue,
+        )
+        return outcome
+
+    def deliver(self, ctx: MatchContext) -> str:
+        from orchestrator.delivery import deliver_pending, enqueue_match_logs
+
+        teams = {
+            "red": (ctx.red.name, ctx.red.credentials),
+            "blue": (ctx.blue.name, ctx.blue.credentials),
+        }
+        store = self.schedule.log_store
+        enqueue_match_logs(
+            ctx.out_dir / "match",
+            match_id=ctx.match_id,
+            teams=teams,
+            public_target=self.schedule.public_logs,
+            store=store,
+        )
+        outcomes = [
+            outcome
+            for team in (ctx.red.name, ctx.blue.name)
+            for outcome in deliver_pending(store, team=team)
+        ]
+        return f"{len(outcomes)} log set(s) handled"

@@ -1,0 +1,246 @@
+"""The tournament ledger: one row per match in the SQLite state file, beside APScheduler's jobs.
+
+The ledger is the truth about what happened; APScheduler only says when to look. Each job moves
+its match through the states below with a compare-and-set update, so a job that fires twice (or
+again after a restart) finds the match already past its step and does nothing:
+
+    PLANNED -> PULLING -> PULLED -> PLAYING -> PLAYED -> DELIVERING -> DELIVERED
+    DELIVERING -> LOGS_PENDING (a target refused; the sets stay in the log store)
+    any non-final state -> MISSED (its window closed) | FAILED (a typed failure) | CANCELLED
+"""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from enum import StrEnum
+from pathlib import Path
+from typing import Any
+
+
+class MatchState(StrEnum):
+    PLANNED = "PLANNED"
+    PULLING = "PULLING"
+    PULLED = "PULLED"
+    PLAYING = "PLAYING"
+    PLAYED = "PLAYED"
+    DELIVERING = "DELIVERING"
+    DELIVERED = "DELIVERED"
+    LOGS_PENDING = "LOGS_PENDING"  # played; some log sets wait in the store (hlvs logs deliver)
+    MISSED = "MISSED"
+    FAILED = "FAILED"
+    CANCELLED = "CANCELLED"
+
+    @property
+    def final(self) -> bool:
+        return self in (
+            MatchState.DELIVERED,
+            MatchState.LOGS_PENDING,
+            MatchState.MISSED,
+            MatchState.FAILED,
+            MatchState.CANCELLED,
+        )
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class MatchRow:
+    id: str
+    state: MatchState
+    kind: str
+    red: str  # team name, or "winner of X" until resolved
+    blue: str
+    pull_at: datetime
+    play_at: datetime
+    stream_start: datetime
+    stream_end: datetime
+    deliver_at: datetime
+    attempts: int
+    note: str
+    result: dict[str, Any] | None
+    updated_at: datetime
+    not_before: datetime | None = None  # a deferred step waits until then
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "id": self.id,
+            "state": self.state.value,
+            "kind": self.kind,
+            "red": self.red,
+            "blue": self.blue,
+            "pull_at": self.pull_at.isoformat(),
+            "play_at": self.play_at.isoformat(),
+            "stream_start": self.stream_start.isoformat(),
+            "stream_end": self.stream_end.isoformat(),
+            "deliver_at": self.deliver_at.isoformat(),
+            "attempts": self.attempts,
+            "note": self.note,
+            "result": self.result,
+        }
+
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS hlvs_meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS hlvs_matches (
+    id TEXT PRIMARY KEY, state TEXT NOT NULL, kind TEXT NOT NULL, red TEXT NOT NULL,
+    blue TEXT NOT NULL, pull_at TEXT NOT NULL, play_at TEXT NOT NULL, stream_start TEXT NOT NULL,
+    stream_end TEXT NOT NULL, deliver_at TEXT NOT NULL, attempts INTEGER NOT NULL DEFAULT 0,
+    note TEXT NOT NULL DEFAULT '', result TEXT, updated_at TEXT NOT NULL,
+    not_before TEXT);
+CREATE TABLE IF NOT EXISTS hlvs_history (
+    at TEXT NOT NULL, match_id TEXT NOT NULL, from_state TEXT, to_state TEXT NOT NULL,
+    note TEXT NOT NULL DEFAULT '');
+"""
+
+
+def _now() -> str:
+    return datetime.now(UTC).isoformat()
+
+
+class Ledger:
+    """Access to the match table; every method opens a short transaction (threads share it)."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = Path(path)
+        db = sqlite3.connect(self.path, timeout=30.0)
+        try:
+            db.execute("PRAGMA journal_mode=WAL")
+            db.executescript(_SCHEMA)
+        finally:
+            db.close()
+
+    @contextmanager
+    def _connect(self) -> Iterator[sqlite3.Connection]:
+        db = sqlite3.connect(self.path, timeout=30.0, isolation_level=None)
+        try:
+            db.execute("BEGIN IMMEDIATE")
+            yield db
+            db.execute("COMMIT")
+        except BaseException:
+            if db.in_transaction:
+                db.execute("ROLLBACK")
+            raise
+        finally:
+            db.close()
+
+    def get_meta(self, key: str) -> str | None:
+        with self._connect() as db:
+            row = db.execute("SELECT value FROM hlvs_meta WHERE key=?", (key,)).fetchone()
+        return None if row is None else str(row[0])
+
+    def set_meta(self, key: str, value: str) -> None:
+        with self._connect() as db:
+            db.execute("INSERT OR REPLACE INTO hlvs_meta(key, value) VALUES (?, ?)", (key, value))
+
+    def ensure(self, row: dict[str, Any]) -> bool:
+        """Add a planned match unless it is already in the ledger; True when added."""
+        with self._connect() as db:
+            cur = db.execute(
+                "INSERT OR IGNORE INTO hlvs_matches(id, state, kind, red, blue, pull_at, play_at,"
+                " stream_start, stream_end, deliver_at, updated_at)"
+                " VALUES (?, 'PLANNED', ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                (
+                    row["id"],
+                    row["kind"],
+                    row["red"],
+                    row["blue"],
+                    row["pull_at"],
+                    row["play_at"],
+                    row["stream_start"],
+                    row["stream_end"],
+                    row["deliver_at"],
+                    _now(),
+                ),
+            )
+            return cur.rowcount == 1
+
+    def transition(
+        self,
+        match_id: str,
+        allowed_from: tuple[MatchState, ...],
+        to: MatchState,
+        *,
+        note: str = "",
+        result: dict[str, Any] | None = None,
+        count_attempt: bool = False,
+        teams: tuple[str, str] | None = None,
+    ) -> bool:
+        """Compare-and-set: move the match to ``to`` only if it is in ``allowed_from``."""
+        with self._connect() as db:
+            row = db.execute("SELECT state FROM hlvs_matches WHERE id=?", (match_id,)).fetchone()
+            if row is None or MatchState(row[0]) not in allowed_from:
+                return False
+            sets = ["state=?", "note=?", "updated_at=?"]
+            args: list[Any] = [to.value, note, _now()]
+            if result is not None:
+                sets.append("result=?")
+                args.append(json.dumps(result, sort_keys=True))
+            if count_attempt:
+                sets.append("attempts=attempts+1")
+            if teams is not None:
+                sets += ["red=?", "blue=?"]
+                args += list(teams)
+            db.execute(f"UPDATE hlvs_matches SET {', '.join(sets)} WHERE id=?", (*args, match_id))
+            db.execute(
+                "INSERT INTO hlvs_history(at, match_id, from_state, to_state, note)"
+                " VALUES (?, ?, ?, ?, ?)",
+                (_now(), match_id, row[0], to.value, note),
+            )
+            return True
+
+    def defer(self, match_id: str, until: datetime, note: str) -> None:
+        """The next step of the match waits until ``until`` (e.g. teams of a knockout slot)."""
+        with self._connect() as db:
+            db.execute(
+                "UPDATE hlvs_matches SET not_before=?, note=?, updated_at=? WHERE id=?",
+                (until.isoformat(), note, _now(), match_id),
+            )
+
+    def rows(self) -> list[MatchRow]:
+        with self._connect() as db:
+            rows = db.execute(
+                "SELECT id, state, kind, red, blue, pull_at, play_at, stream_start, stream_end,"
+                " deliver_at, attempts, note, result, updated_at, not_before FROM hlvs_matches"
+                " ORDER BY stream_start, id"
+            ).fetchall()
+        return [_row(r) for r in rows]
+
+    def row(self, match_id: str) -> MatchRow:
+        for row in self.rows():
+            if row.id == match_id:
+                return row
+        raise KeyError(match_id)
+
+    def history(self, match_id: str | None = None) -> list[tuple[str, str, str | None, str, str]]:
+        with self._connect() as db:
+            if match_id is None:
+                return list(db.execute("SELECT * FROM hlvs_history ORDER BY rowid").fetchall())
+            return list(
+                db.execute(
+                    "SELECT * FROM hlvs_history WHERE match_id=? ORDER BY rowid", (match_id,)
+                ).fetchall()
+            )
+
+
+def _row(r: tuple[Any, ...]) -> MatchRow:
+    ts = datetime.fromisoformat
+    return MatchRow(
+        id=r[0],
+        state=MatchState(r[1]),
+        kind=r[2],
+        red=r[3],
+        blue=r[4],
+        pull_at=ts(r[5]),
+        play_at=ts(r[6]),
+        stream_start=ts(r[7]),
+        stream_end=ts(r[8]),
+        deliver_at=ts(r[9]),
+        attempts=int(r[10]),
+        note=r[11],
+        result=json.loads(r[12]) if r[12] else None,
+        updated_at=ts(r[13]),
+        not_before=ts(r[14]) if r[14] else None,
+    )

@@ -1,0 +1,247 @@
+"""The scheduler with services that need no Docker: timing, exactly-once, restarts, standings."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from datetime import UTC, datetime
+from pathlib import Path
+
+import pytest
+
+from orchestrator.config.schedule import load_schedule, round_robin_fixtures
+from orchestrator.errors import ConfigError
+from orchestrator.schedule import Ledger, MatchState, run_schedule, standings
+from tests.unit.schedule.fake_services import goals
+
+FAKE = "tests.unit.schedule.fake_services:FakeServices"
+TEAMS = ["alpha", "bravo", "charlie", "delta"]
+
+
+def write_schedule(tmp: Path, body: str) -> Path:
+    for name in TEAMS:
+        (tmp / f"{name}.json").write_text(json.dumps({"name": name, "players": {}}))
+    teams = "\n".join(
+        f"  - {{name: {n}, id: {i + 1}, config: {n}.json}}" for i, n in enumerate(TEAMS)
+    )
+    path = tmp / "schedule.yaml"
+    path.write_text(f"name: test cup\noutput_dir: out\nteams:\n{teams}\n{body}")
+    return path
+
+
+COMPRESSED = """
+timing: {pull_lead_round_robin_s: 1.0, pull_lead_knockout_s: 1.5, play_after_pull_s: 0.2,
+         deliver_after_stream_s: 0.2, retry_s: 0.2}
+simulator_slots: 1
+"""
+
+
+def services_log(schedule: Path) -> list[tuple[str, str, datetime]]:
+    path = schedule.parent / "out" / "services.log"
+    if not path.exists():
+        return []
+    out = []
+    for line in path.read_text().splitlines():
+        what, match_id, at = line.split()
+        out.append((what, match_id, datetime.fromisoformat(at)))
+    return out
+
+
+def test_round_robin_fixtures_pair_every_team_once() -> None:
+    matches = round_robin_fixtures({"teams": TEAMS, "first_stream": "+10s", "interval_s": 5})
+    pairs = {frozenset((m.red.team, m.blue.team)) for m in matches}
+    assert len(matches) == 6 and len(pairs) == 6
+    assert [m.stream_start for m in matches[:3]] == ["+10s", "+15s", "+20s"]
+
+
+def test_schedule_errors_name_the_field(tmp_path: Path) -> None:
+    path = write_schedule(
+        tmp_path,
+        "matches:\n  - {id: m1, red: alpah, blue: bravo, stream_start: '+1s'}\n"
+        "  - {id: m2, red: {winner_of: m9}, blue: bravo, stream_start: 'tomorrow'}\n",
+    )
+    with pytest.raises(ConfigError) as info:
+        load_schedule(path)
+    text = str(info.value)
+    assert "/matches/0/red: unknown team 'alpah'" in text and 'did you mean "alpha"' in text
+    assert "/matches/1/red: refers to match 'm9'" in text
+    assert "/matches/1/stream_start" in text
+
+
+def test_tournament_plays_each_match_once_in_its_window(tmp_path: Path) -> None:
+    path = write_schedule(
+        tmp_path,
+        COMPRESSED
+        + "fixtures:\n  round_robin: {teams: [alpha, bravo, charlie], first_stream: '+1.5s',"
+        " interval_s: 1.0, stream_length_s: 0.5}\n",
+    )
+    state = tmp_path / "state.sqlite"
+    done = threading.Event()
+    thread = threading.Thread(
+        target=run_schedule,
+        args=(path, state),
+        kwargs={"services": FAKE, "exit_when_done": True, "poll_s": 0.1, "stop": None},
+    )
+    thread.start()
+    thread.join(timeout=60)
+    done.set()
+    assert not thread.is_alive(), "the schedule did not finish"
+    ledger = Ledger(state)
+    rows = {r.id: r for r in ledger.rows()}
+    assert set(rows) == {"rr-1", "rr-2", "rr-3"}
+    assert all(r.state is MatchState.DELIVERED for r in rows.values()), rows
+    log = services_log(path)
+    for match_id, row in rows.items():
+        steps = [(what, at) for what, mid, at in log if mid == match_id]
+        kinds = [w for w, _ in steps]
+        assert kinds == ["pull", "play-start", "play-end", "deliver"], (match_id, kinds)
+        at = dict(steps)
+        assert row.pull_at <= at["pull"] < row.stream_start
+        assert at["play-start"] >= row.play_at and at["play-end"] <= row.stream_start
+        assert at["deliver"] >= row.deliver_at
+    table = standings(ledger.rows(), ["alpha", "bravo", "charlie"])
+    assert sum(s.played for s in table) == 6
+    alpha = next(s for s in table if s.team == "alpha")
+    assert alpha.goals_for == 2 * goals("alpha")
+    assert [s.points for s in table] == sorted((s.points for s in table), reverse=True)
+
+
+def test_knockout_winners_advance(tmp_path: Path) -> None:
+    path = write_schedule(
+        tmp_path,
+        COMPRESSED
+        + "fixtures:\n  knockout: {seeds: [alpha, bravo, charlie, delta], first_stream: '+2s',"
+        " interval_s: 1.0, stream_length_s: 0.3}\n",
+    )
+    state = tmp_path / "state.sqlite"
+    assert run_schedule(path, state, services=FAKE, exit_when_done=True, poll_s=0.1) == 0
+    rows = {r.id: r for r in Ledger(state).rows()}
+    final = rows["ko-r2-1"]
+    assert final.state is MatchState.DELIVERED, final
+    semi_winners = {rows[m].result["winner_team"] for m in ("ko-r1-1", "ko-r1-2")}  # type: ignore[index]
+    assert {final.red, final.blue} == semi_winners
+
+
+def test_missed_match_is_marked_with_a_reason(tmp_path: Path) -> None:
+    path = write_schedule(
+        tmp_path,
+        COMPRESSED + "matches:\n  - {id: late, red: alpha, blue: bravo, stream_start: '+0.5s'}\n",
+    )
+    state = tmp_path / "state.sqlite"
+    from orchestrator.schedule import init_state
+
+    init_state(path, state, services=FAKE)
+    time.sleep(0.7)  # the scheduler was down past the stream start
+    run_schedule(path, state, services=FAKE, exit_when_done=True, poll_s=0.1)
+    row = Ledger(state).row("late")
+    assert row.state is MatchState.MISSED and "window" in row.note
+    assert not [e for e in services_log(path) if e[0].startswith("play")]
+
+
+def test_cancel_and_status_cli(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from orchestrator.cli import main
+    from orchestrator.schedule import init_state
+
+    path = write_schedule(
+        tmp_path, "matches:\n  - {id: m1, red: alpha, blue: bravo, stream_start: '+2h'}\n"
+    )
+    state = tmp_path / "state.sqlite"
+    init_state(path, state)
+    assert main(["schedule", "cancel", "m1", "--state", str(state)]) == 0
+    assert main(["schedule", "cancel", "m1", "--state", str(state)]) == 1
+    assert main(["schedule", "status", "--state", str(state), "--json"]) == 0
+    out = capsys.readouterr().out
+    status = json.loads(out[out.index("[") :])
+    assert status[0]["state"] == "CANCELLED"
+
+
+def test_sigkill_mid_tournament_then_restart_plays_every_match_once(tmp_path: Path) -> None:
+    path = write_schedule(
+        tmp_path,
+        COMPRESSED.replace("retry_s: 0.2", "retry_s: 0.2")
+        + "fixtures:\n  round_robin: {teams: [alpha, bravo, charlie, delta], first_stream: '+2s',"
+        " interval_s: 2.0, stream_length_s: 0.2}\n",
+    )
+    state = tmp_path / "state.sqlite"
+    cmd = [
+        sys.executable,
+        "-m",
+        "orchestrator.cli",
+        "schedule",
+        "run",
+        str(path),
+        "--state",
+        str(state),
+        "--exit-when-done",
+        "--services",
+        FAKE,
+    ]
+    env = {**os.environ, "HLVS_FAKE_PLAY_S": "1.2"}
+    first = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 60
+    playing = None
+    while time.monotonic() < deadline:  # kill it while a match after the first is being played
+        log = services_log(path)
+        started = [m for w, m, _ in log if w == "play-start"]
+        ended = {m for w, m, _ in log if w == "play-end"}
+        if ended and started and started[-1] not in ended:
+            playing = started[-1]
+            break
+        time.sleep(0.02)
+    else:
+        first.kill()
+        pytest.fail("the second match never started")
+    first.send_signal(signal.SIGKILL)
+    first.wait()
+    assert playing is not None
+    assert Ledger(state).row(playing).state is MatchState.PLAYING
+    second = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=120)
+    assert second.returncode == 0, second.stderr
+    rows = Ledger(state).rows()
+    assert len(rows) == 6
+    log = services_log(path)
+    for row in rows:
+        ends = [m for w, m, _ in log if w == "play-end" and m == row.id]
+        if row.state is MatchState.MISSED:
+            assert ends == [] and "window" in row.note
+        else:
+            assert row.state is MatchState.DELIVERED, row
+            assert len(ends) == 1, (row.id, ends)
+    assert Ledger(state).row(playing).state is MatchState.DELIVERED
+    history = [h for h in Ledger(state).history(playing) if "interrupted" in h[4]]
+    assert history, "the interrupted match was not recorded as such"
+    assert sum(1 for w, *_ in log if w == "deliver") == sum(
+        1 for r in rows if r.state is MatchState.DELIVERED
+    )
+
+
+def test_state_file_of_another_schedule_is_refused(tmp_path: Path) -> None:
+    from orchestrator.errors import ScheduleError
+    from orchestrator.schedule import init_state
+
+    a = write_schedule(tmp_path, "matches: []\n")
+    other = tmp_path / "b"
+    other.mkdir()
+    b = write_schedule(other, "matches: []\n")
+    state = tmp_path / "state.sqlite"
+    init_state(a, state)
+    with pytest.raises(ScheduleError, match="belongs to the schedule"):
+        init_state(b, state)
+
+
+def test_reference_time_is_fixed_at_first_run(tmp_path: Path) -> None:
+    from orchestrator.schedule import init_state
+
+    path = write_schedule(
+        tmp_path, "matches:\n  - {id: m1, red: alpha, blue: bravo, stream_start: '+1h'}\n"
+    )
+    state = tmp_path / "state.sqlite"
+    _, ledger = init_state(path, state, now=datetime(2030, 1, 1, tzinfo=UTC))
+    first = ledger.row("m1").stream_start
+    _, ledger = init_state(path, state, now=datetime(2031, 1, 1, tzinfo=UTC))
+    assert ledger.row("m1").stream_start == first == datetime(2030, 1, 1, 1, tzinfo=UTC)
