@@ -135,6 +135,11 @@ def reconcile(scheduler: Any, ledger: Ledger, state_path: str) -> None:
         )
 
 
+def _stop_now(stop: threading.Event, wake: threading.Event) -> None:
+    stop.set()
+    wake.set()
+
+
 def run_schedule(
     schedule_path: str | Path,
     state_path: str | Path,
@@ -152,7 +157,7 @@ def run_schedule(
     wake = threading.Event()
     if threading.current_thread() is threading.main_thread():
         for sig in (signal.SIGINT, signal.SIGTERM):
-            signal.signal(sig, lambda *_: (stop.set(), wake.set()))
+            signal.signal(sig, lambda *_: _stop_now(stop, wake))
     scheduler = BackgroundScheduler(
         jobstores={"default": SQLAlchemyJobStore(url=f"sqlite:///{state}")},
         executors={
