@@ -87,7 +87,7 @@ def _list(args: argparse.Namespace) -> int:
             "stream_start": p.stream_start.isoformat(timespec="seconds"),
             "deliver_at": p.deliver_at.isoformat(timespec="seconds"),
         }
-        for p in schedule.plan(reference)
+        for p in sorted(schedule.plan(reference), key=lambda p: (p.stream_start, p.match.id))
     ]
     if args.json:
         print(json.dumps(rows, indent=2))
