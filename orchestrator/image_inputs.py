@@ -1,0 +1,205 @@
+"""The inputs of a project image build, prepared on the host.
+
+- Base images made without any container registry: ``debootstrap`` a Debian root file system
+  and ``docker import`` it, cached by the debootstrap parameters
+  (``hlvs-runner/base:<flavour>-<suite>-<hash>``).
+- Python wheels downloaded once with ``pip download`` (cached by the pinned requirement list), so
+  the image build installs them with ``--no-index`` and no network.
+- The build context folder: Dockerfile, requirements, wheels and the project's package sources.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import logging
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from importlib import metadata
+from pathlib import Path
+
+from orchestrator.errors import ImageError
+
+log = logging.getLogger(__name__)
+
+BASE_REPOSITORY = "hlvs-runner/base"
+IMAGE_PYTHON_VERSION = "3.11"  # Debian bookworm's python3, and python:3.11-slim
+_SKIP_DIRS = {"__pycache__", ".mypy_cache", ".pytest_cache", ".ruff_cache"}
+_SKIP_SUFFIXES = {".pyc", ".pyo"}
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class BaseRecipe:
+    """A Debian root file system made by debootstrap; its parameters are its cache key."""
+
+    flavour: str  # "robot" or "sim"
+    suite: str = "bookworm"
+    variant: str = "minbase"
+    packages: tuple[str, ...] = ("python3", "python3-venv", "ca-certificates")
+    mirror: str = "http://deb.debian.org/debian"
+
+    def key(self) -> str:
+        text = "|".join((self.suite, self.variant, ",".join(self.packages), self.mirror))
+        return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+    @property
+    def tag(self) -> str:
+        return f"{self.flavour}-{self.suite}-{self.key()}"
+
+    @property
+    def reference(self) -> str:
+        return f"{BASE_REPOSITORY}:{self.tag}"
+
+
+def debootstrap_rootfs(recipe: BaseRecipe, *, work_dir: Path, log_path: Path) -> Path:
+    """Run debootstrap for ``recipe`` and return a tarball of the root file system."""
+    if shutil.which("debootstrap") is None:
+        raise ImageError(
+            image=recipe.reference,
+            reason="debootstrap is not installed (Debian/Ubuntu: apt-get install debootstrap); "
+            "or pass --base with an image that has python3 3.11 and python3-venv",
+        )
+    work_dir.mkdir(parents=True, exist_ok=True)
+    root = Path(tempfile.mkdtemp(prefix=f"rootfs-{recipe.flavour}-", dir=work_dir))
+    tarball = work_dir / f"{recipe.tag}.tar"
+    command = [
+        "debootstrap",
+        f"--variant={recipe.variant}",
+        f"--include={','.join(recipe.packages)}",
+        recipe.suite,
+        str(root),
+        recipe.mirror,
+    ]
+    log.info("base %s: debootstrap (about a minute; log: %s)", recipe.tag, log_path)
+    try:
+        _run_logged(command, log_path=log_path, image=recipe.reference)
+        for cache in ("var/cache/apt/archives", "var/lib/apt/lists"):
+            for entry in (root / cache).glob("*.deb" if "archives" in cache else "*_*"):
+                entry.unlink()
+        _run_logged(
+            ["tar", "-C", str(root), "-cf", str(tarball), "."],
+            log_path=log_path,
+            image=recipe.reference,
+        )
+    finally:
+        shutil.rmtree(root, ignore_errors=True)
+    return tarball
+
+
+def _run_logged(command: Sequence[str], *, log_path: Path, image: str) -> None:
+    log_path.parent.mkdir(parents=True, exist_ok=True)
+    with log_path.open("a", encoding="utf-8") as out:
+        out.write(f"$ {' '.join(command)}\n")
+        out.flush()
+        result = subprocess.run(command, stdout=out, stderr=subprocess.STDOUT, check=False)
+    if result.returncode != 0:
+        raise ImageError(
+            image=image,
+            reason=f"{command[0]} exited with {result.returncode} (log: {log_path})",
+        )
+
+
+def pinned_requirements(distributions: Sequence[str]) -> tuple[str, ...]:
+    """``name==version`` for each distribution, pinned to what this environment runs."""
+    pins = []
+    for name in distributions:
+        try:
+            pins.append(f"{name}=={metadata.version(name)}")
+        except metadata.PackageNotFoundError as exc:
+            raise ImageError(
+                image="(wheels)",
+                reason=f"{name} is not installed on the host; run make setup (pip install -e .)",
+            ) from exc
+    return tuple(pins)
+
+
+def ensure_wheels(requirements: Sequence[str], *, cache_dir: Path) -> Path:
+    """A folder holding wheels for ``requirements`` and their dependencies (downloaded once)."""
+    key = hashlib.sha256("\n".join(sorted(requirements)).encode()).hexdigest()[:12]
+    target = cache_dir / key
+    marker = target / ".complete"
+    if marker.exists():
+        return target
+    partial = cache_dir / f"{key}.partial"
+    shutil.rmtree(partial, ignore_errors=True)
+    partial.mkdir(parents=True)
+    log_path = cache_dir / f"{key}.log"
+    log.info("wheels: pip download %s (log: %s)", " ".join(requirements), log_path)
+    command = [
+        sys.executable,
+        "-m",
+        "pip",
+        "download",
+        "--quiet",
+        "--only-binary=:all:",
+        f"--python-version={IMAGE_PYTHON_VERSION}",
+        "-d",
+        str(partial),
+        *requirements,
+    ]
+    _run_logged(command, log_path=log_path, image="(wheels)")
+    (partial / "requirements.txt").write_text("\n".join(requirements) + "\n", encoding="utf-8")
+    (partial / ".complete").write_text("ok\n", encoding="utf-8")
+    shutil.rmtree(target, ignore_errors=True)
+    os.replace(partial, target)
+    return target
+
+
+def wheel_names(wheel_dir: Path) -> tuple[str, ...]:
+    return tuple(sorted(p.name for p in wheel_dir.glob("*.whl")))
+
+
+def source_files(repo_root: Path, packages: Sequence[str]) -> Iterator[Path]:
+    """Every file of the given package folders, sorted, without caches and bytecode."""
+    for package in packages:
+        top = repo_root / package
+        if not (top / "__init__.py").is_file():
+            raise ImageError(image="(sources)", reason=f"package folder {top} is missing")
+        for path in sorted(top.rglob("*")):
+            parts = set(path.relative_to(repo_root).parts)
+            if path.is_file() and not parts & _SKIP_DIRS and path.suffix not in _SKIP_SUFFIXES:
+                yield path
+
+
+def assemble_context(
+    *,
+    context_dir: Path,
+    dockerfile: Path,
+    wheel_dir: Path,
+    repo_root: Path,
+    sources: Sequence[Path],
+) -> None:
+    """Fill ``context_dir`` with the Dockerfile, wheels/, requirements.txt and src/."""
+    shutil.rmtree(context_dir, ignore_errors=True)
+    (context_dir / "wheels").mkdir(parents=True)
+    shutil.copy2(dockerfile, context_dir / "Dockerfile")
+    shutil.copy2(wheel_dir / "requirements.txt", context_dir / "requirements.txt")
+    for wheel in wheel_dir.glob("*.whl"):
+        _link_or_copy(wheel, context_dir / "wheels" / wheel.name)
+    for path in sources:
+        target = context_dir / "src" / path.relative_to(repo_root)
+        target.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(path, target)
+
+
+def _link_or_copy(source: Path, target: Path) -> None:
+    try:
+        os.link(source, target)
+    except OSError:
+        shutil.copy2(source, target)
+
+
+__all__ = [
+    "BASE_REPOSITORY",
+    "BaseRecipe",
+    "assemble_context",
+    "debootstrap_rootfs",
+    "ensure_wheels",
+    "pinned_requirements",
+    "source_files",
+    "wheel_names",
+]

@@ -1,0 +1,289 @@
+"""The project's own images, tagged by the hash of everything that goes into them.
+
+``hlvs-runner/<name>:<hash>`` where the hash covers the Dockerfile, every source file copied in,
+the pinned requirements, the wheel file names, the base image id and the build arguments. An
+image whose tag exists is never rebuilt, so ``project_image()`` costs a few inspect calls when
+nothing changed. Without a base image given, the base is made locally with debootstrap
+(no container registry needed) and cached by its debootstrap parameters.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import hashlib
+import logging
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from orchestrator import image_inputs
+from orchestrator.engine import LABEL_PROJECT, connect
+from orchestrator.engine import images as engine_images
+from orchestrator.errors import ConfigError, ImageError, Problem
+
+if TYPE_CHECKING:
+    from docker import DockerClient
+
+log = logging.getLogger(__name__)
+
+REPO_ROOT = Path(__file__).resolve().parents[1]
+IMAGES_DIR = REPO_ROOT / "images"
+BUILD_DIR = REPO_ROOT / ".build"
+LABEL_IMAGE = "org.hlvs-runner.image"  # simulator | stub | team-base | base
+LABEL_CONTENT = "org.hlvs-runner.content"  # the content hash
+
+ROBOT_BASE = image_inputs.BaseRecipe(flavour="robot")
+SIM_BASE = image_inputs.BaseRecipe(
+    flavour="sim",
+    packages=("python3", "python3-venv", "ca-certificates", "libosmesa6", "ffmpeg"),
+)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ImageRecipe:
+    name: str
+    base: image_inputs.BaseRecipe  # used when no base image is given
+    requirements: tuple[str, ...]  # distributions, pinned to the host's versions
+    packages: tuple[str, ...] = ("simulator", "referee")  # copied to /opt/hlvs/src
+
+    @property
+    def dockerfile(self) -> Path:
+        return IMAGES_DIR / self.name / "Dockerfile"
+
+    @property
+    def repository(self) -> str:
+        return f"hlvs-runner/{self.name}"
+
+
+RECIPES: dict[str, ImageRecipe] = {
+    "simulator": ImageRecipe(
+        name="simulator",
+        base=SIM_BASE,
+        requirements=("mujoco", "numpy", "eclipse-zenoh", "protobuf"),
+    ),
+    "stub": ImageRecipe(name="stub", base=ROBOT_BASE, requirements=("numpy", "protobuf")),
+    "team-base": ImageRecipe(
+        name="team-base", base=ROBOT_BASE, requirements=("numpy", "protobuf")
+    ),
+}
+IMAGE_NAMES = tuple(RECIPES)
+KEEP_VERSIONS = 3  # older content tags of a project image are removed once unused
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class BuiltImage:
+    """One project image after :func:`ensure_image`: its tag, size and whether it was built."""
+
+    name: str
+    reference: str  # hlvs-runner/<name>:<hash>
+    image_id: str
+    size_bytes: int
+    rebuilt: bool
+    seconds: float
+    build_log: Path | None  # set when it was built
+
+    def as_json(self) -> dict[str, object]:
+        return {
+            "name": self.name,
+            "tag": self.reference,
+            "id": self.image_id,
+            "size_bytes": self.size_bytes,
+            "rebuilt": self.rebuilt,
+            "seconds": round(self.seconds, 2),
+            "build_log": str(self.build_log) if self.build_log else None,
+        }
+
+
+def project_image(name: str, *, base: str | None = None) -> str:
+    """The tag of the current build of project image ``name``, building it when missing."""
+    return ensure_image(name, base=base).reference
+
+
+def ensure_image(
+    name: str, *, base: str | None = None, client: DockerClient | None = None
+) -> BuiltImage:
+    """Make sure ``hlvs-runner/<name>:<content hash>`` exists; build it (and its base) if not."""
+    recipe = _recipe(name)
+    client = client or connect()
+    started = time.monotonic()
+    with _build_lock():
+        base_ref, base_id, network_mode = _ensure_base(client, recipe, base)
+        wheel_dir = image_inputs.ensure_wheels(
+            image_inputs.pinned_requirements(recipe.requirements), cache_dir=BUILD_DIR / "wheels"
+        )
+        sources = list(image_inputs.source_files(REPO_ROOT, recipe.packages))
+        build_args = {"BASE_IMAGE": base_ref}
+        content = content_hash(recipe, sources, wheel_dir, base_id, build_args)
+        reference = f"{recipe.repository}:{content}"
+        existing = engine_images.inspect(client, reference)
+        if existing is not None:
+            return BuiltImage(
+                name=name,
+                reference=reference,
+                image_id=existing.id,
+                size_bytes=existing.size_bytes,
+                rebuilt=False,
+                seconds=time.monotonic() - started,
+                build_log=None,
+            )
+        context_dir = BUILD_DIR / "context" / name
+        image_inputs.assemble_context(
+            context_dir=context_dir,
+            dockerfile=recipe.dockerfile,
+            wheel_dir=wheel_dir,
+            repo_root=REPO_ROOT,
+            sources=sources,
+        )
+        log_path = BUILD_DIR / "logs" / f"{name}-{content}.log"
+        log.info("building %s (build log: %s)", reference, log_path)
+        info = engine_images.build(
+            client,
+            context_dir=context_dir,
+            tag=reference,
+            build_args=build_args,
+            labels={LABEL_PROJECT: "1", LABEL_IMAGE: name, LABEL_CONTENT: content},
+            log_path=log_path,
+            network_mode=network_mode,
+            on_step=lambda line: log.info("%s: %s", name, line),
+        )
+        seconds = time.monotonic() - started
+        log.info("built %s in %.1f s (%.0f MB)", reference, seconds, info.size_bytes / 1e6)
+        _prune_old_versions(client, recipe)
+        return BuiltImage(
+            name=name,
+            reference=reference,
+            image_id=info.id,
+            size_bytes=info.size_bytes,
+            rebuilt=True,
+            seconds=seconds,
+            build_log=log_path,
+        )
+
+
+def build_all(*, base: str | None = None, client: DockerClient | None = None) -> list[BuiltImage]:
+    """Ensure every project image, in a fixed order."""
+    client = client or connect()
+    return [ensure_image(name, base=base, client=client) for name in IMAGE_NAMES]
+
+
+def content_hash(
+    recipe: ImageRecipe,
+    sources: list[Path],
+    wheel_dir: Path,
+    base_id: str,
+    build_args: dict[str, str],
+) -> str:
+    """12 hex digits over every input of the build."""
+    digest = hashlib.sha256()
+
+    def feed(label: str, data: bytes) -> None:
+        digest.update(f"{label}\0{len(data)}\0".encode())
+        digest.update(data)
+
+    feed("recipe", recipe.name.encode())
+    feed("Dockerfile", recipe.dockerfile.read_bytes())
+    for path in sources:
+        feed(str(path.relative_to(REPO_ROOT)), path.read_bytes())
+    feed("requirements", (wheel_dir / "requirements.txt").read_bytes())
+    feed("wheels", "\n".join(image_inputs.wheel_names(wheel_dir)).encode())
+    feed("base", base_id.encode())
+    feed("args", repr(sorted(build_args.items())).encode())
+    return digest.hexdigest()[:12]
+
+
+def _recipe(name: str) -> ImageRecipe:
+    if name not in RECIPES:
+        raise ConfigError(
+            [
+                Problem(
+                    file="(command line)",
+                    pointer="image",
+                    message=f"unknown project image {name!r}",
+                    expected=" | ".join(IMAGE_NAMES),
+                )
+            ]
+        )
+    if not recipe_dockerfile_exists(RECIPES[name]):
+        raise ImageError(image=name, reason=f"missing {RECIPES[name].dockerfile}")
+    return RECIPES[name]
+
+
+def recipe_dockerfile_exists(recipe: ImageRecipe) -> bool:
+    return recipe.dockerfile.is_file()
+
+
+def _ensure_base(
+    client: DockerClient, recipe: ImageRecipe, base: str | None
+) -> tuple[str, str, str | None]:
+    """(reference, image id, build network mode) of the base image, made when missing."""
+    if base:
+        info = engine_images.inspect(client, base)
+        if info is None:
+            repository, _, tag_name = base.rpartition(":")
+            if not repository or "/" in tag_name:
+                repository, tag_name = base, "latest"
+            info = engine_images.pull(client, repository, tag_name, auth=None)
+        return base, info.id, None  # a foreign base may need the network for system packages
+    base_recipe = recipe.base
+    info = engine_images.inspect(client, base_recipe.reference)
+    if info is None:
+        started = time.monotonic()
+        work_dir = BUILD_DIR / "rootfs"
+        log_path = BUILD_DIR / "logs" / f"base-{base_recipe.tag}.log"
+        tarball = image_inputs.debootstrap_rootfs(base_recipe, work_dir=work_dir, log_path=log_path)
+        try:
+            info = engine_images.import_rootfs(
+                client,
+                tarball=tarball,
+                repository=image_inputs.BASE_REPOSITORY,
+                tag=base_recipe.tag,
+                changes=[
+                    f'LABEL {LABEL_PROJECT}="1" {LABEL_IMAGE}="base"',
+                    "ENV LANG=C.UTF-8",
+                    'CMD ["/bin/bash"]',
+                ],
+            )
+        finally:
+            tarball.unlink(missing_ok=True)
+        log.info(
+            "base %s ready in %.0f s (%.0f MB)",
+            base_recipe.reference,
+            time.monotonic() - started,
+            info.size_bytes / 1e6,
+        )
+    return base_recipe.reference, info.id, "none"
+
+
+def _prune_old_versions(client: DockerClient, recipe: ImageRecipe) -> None:
+    versions = engine_images.list_labelled(client, {LABEL_PROJECT: "1", LABEL_IMAGE: recipe.name})
+    for info in versions[KEEP_VERSIONS:]:
+        for reference in info.tags or (info.id,):
+            if reference.startswith(recipe.repository + ":"):
+                engine_images.remove_unused(client, reference)
+
+
+@contextmanager
+def _build_lock() -> Iterator[None]:
+    """One build at a time across processes (tests and make may ask concurrently)."""
+    BUILD_DIR.mkdir(parents=True, exist_ok=True)
+    with (BUILD_DIR / "images.lock").open("w") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
+
+
+__all__ = [
+    "IMAGE_NAMES",
+    "RECIPES",
+    "BuiltImage",
+    "ImageRecipe",
+    "build_all",
+    "content_hash",
+    "ensure_image",
+    "project_image",
+]
