@@ -39,24 +39,52 @@ def default_seed(match_id: str) -> int:
     return int.from_bytes(hashlib.sha256(match_id.encode("utf-8")).digest()[:4], "big")
 
 
+def _overlaps(bad: str, part: str) -> bool:
+    """True when a problem at ``bad`` makes the value at ``part`` unusable."""
+    return bad in ("", part) or bad.startswith(part + "/") or part.startswith(bad + "/")
+
+
 def team_id(raw: Any) -> int:
     return int(raw)
 
 
 def build_game(document: Any, where: Collector, *, source: Path) -> GameConfig | None:
-    """Validate one game document; the GameConfig when it has no error (problems in ``where``)."""
-    if not validate("game", document, where):
-        return None
+    """Validate one game document; the GameConfig when it has no error (problems in ``where``).
+
+    The rules after the schema run on every part the schema found sound, so one pass reports
+    as many problems as possible.
+    """
     before = len(where.errors)
+    validate("game", document, where)
+    if not isinstance(document, dict):
+        return None
+    broken = [p.pointer for p in where.errors[before:]]
+
+    def sound(*parts: str) -> bool:
+        return not any(_overlaps(bad, part) for bad in broken for part in parts)
+
     base = source.parent
-    rtf = _real_time_factor(document, where)
-    timing = _timing(document, where, fast=rtf is not None and rtf <= 0)
-    _check_physics_dt(document, where)
+    rtf = None
+    if sound("/maximum_real_time_factor", *(pointer(n) for n in LEGACY_RTF)):
+        rtf = _real_time_factor(document, where)
+    timing = Timing()
+    if sound("/timing", "/game_controller_extra_args", "/max_duration"):
+        timing = _timing(document, where, fast=rtf is not None and rtf <= 0)
+    if sound("/physics_dt_s"):
+        _check_physics_dt(document, where)
     _check_record(document, where)
-    _check_team_ids(document, where)
-    _check_ports(document, where)
-    teams = {color: _team_ref(color, document[color], base, where) for color in COLORS}
-    public_logs = _existing(document.get("public_logs"), base, "/public_logs", where)
+    if sound("/red/id", "/blue/id"):
+        _check_team_ids(document, where)
+    if sound("/red/ports", "/blue/ports"):
+        _check_ports(document, where)
+    teams = {
+        color: _team_ref(color, document[color], base, where)
+        for color in COLORS
+        if sound(pointer(color))
+    }
+    public_logs = None
+    if sound("/public_logs"):
+        public_logs = _existing(document.get("public_logs"), base, "/public_logs", where)
     if len(where.errors) > before or rtf is None:
         return None
     red, blue = teams["red"], teams["blue"]

@@ -53,28 +53,32 @@ def build_team(
     field_class: FieldClass | None,
     images_required: bool,
 ) -> TeamConfig | None:
-    """Validate one team document; the TeamConfig when it has no error (problems in ``where``)."""
-    if not validate("team", document, where):
-        return None
+    """Validate one team document; the TeamConfig when it has no error (problems in ``where``).
+
+    The numbering and pose rules also run on the parts the schema found sound, so one pass
+    reports as many problems as possible.
+    """
     before = len(where.errors)
-    numbers = _check_numbers(document["players"], where, field_class)
-    players = []
+    valid = validate("team", document, where)
+    broken = [p.pointer for p in where.errors[before:]]
+    players_raw = document.get("players") if isinstance(document, dict) else None
+    if not isinstance(players_raw, dict) or not all(
+        isinstance(k, str) and k.isascii() and k.isdigit() and not k.startswith("0")
+        for k in players_raw
+    ):
+        return None
+    numbers = _check_numbers(players_raw, where, field_class)
     for number in numbers:
-        raw = document["players"][str(number)]
-        poses = {attr: _pose(raw[key]) for key, attr in POSE_KEYS.items()}
         for key in POSE_KEYS:
-            _check_pose(raw[key], pointer("players", str(number), key), key, where, field_class)
-        players.append(
-            PlayerConfig(
-                number=number,
-                model=raw.get("model", DEFAULT_MODEL[field_class or "KID"]),
-                proto=raw.get("proto"),
-                image_repository=raw.get("image", document.get("image")),
-                docker_tag=raw.get("dockerTag"),
-                docker_cmd=raw.get("dockerCmd"),
-                **poses,
-            )
-        )
+            at = pointer("players", str(number), key)
+            if not any(
+                bad == at or at.startswith(bad + "/") or bad.startswith(at) for bad in broken
+            ):
+                raw_pose = players_raw[str(number)][key]
+                _check_pose(raw_pose, at, key, where, field_class)
+    if not valid:
+        return None
+    players = [_player(number, document, field_class) for number in numbers]
     if not document["players"]:
         where.warn(
             "/players", "the team has no players: it plays without robots (like HLVS Invisibles)"
@@ -96,6 +100,19 @@ def build_team(
         players=tuple(players),
         image=document.get("image"),
         registry_auth=_registry_auth(document.get("registry_auth")),
+    )
+
+
+def _player(number: int, document: dict[str, Any], field_class: FieldClass | None) -> PlayerConfig:
+    raw = document["players"][str(number)]
+    return PlayerConfig(
+        number=number,
+        model=raw.get("model", DEFAULT_MODEL[field_class or "KID"]),
+        proto=raw.get("proto"),
+        image_repository=raw.get("image", document.get("image")),
+        docker_tag=raw.get("dockerTag"),
+        docker_cmd=raw.get("dockerCmd"),
+        **{attr: _pose(raw[key]) for key, attr in POSE_KEYS.items()},
     )
 
 
