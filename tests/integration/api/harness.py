@@ -1,0 +1,126 @@
+"""A robot API server on 127.0.0.1 driven by a background step loop (fake or real world)."""
+
+from __future__ import annotations
+
+import socket
+import threading
+import time
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
+from typing import Any
+
+from referee.snapshot import RobotId, TeamColor
+from simulator.api import (
+    ApiServer,
+    FakeCameraRenderer,
+    FakeDeviceWorld,
+    LockstepSettings,
+    PlayerEndpoint,
+    RenderWorker,
+    wait_lockstep,
+)
+from simulator.spec import NetworkSpec
+
+RED1 = RobotId(TeamColor.RED, 1)
+RED2 = RobotId(TeamColor.RED, 2)
+BLUE1 = RobotId(TeamColor.BLUE, 1)
+
+
+def free_ports(count: int) -> list[int]:
+    socks = [socket.socket() for _ in range(count)]
+    try:
+        for s in socks:
+            s.bind(("127.0.0.1", 0))
+        return [s.getsockname()[1] for s in socks]
+    finally:
+        for s in socks:
+            s.close()
+
+
+def wait_until(predicate: Callable[[], Any], timeout_s: float = 10.0) -> Any:
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        value = predicate()
+        if value:
+            return value
+        time.sleep(0.005)
+    raise AssertionError("condition not reached in time")
+
+
+class Driver:
+    """Runs steps in a thread: [lockstep wait] -> apply requests -> world.step -> publish."""
+
+    def __init__(
+        self, server: ApiServer, world: Any, lockstep: LockstepSettings | None, pause_s: float
+    ) -> None:
+        self.server = server
+        self.world = world
+        self.lockstep = lockstep
+        self.pause_s = pause_s
+        self.stop = threading.Event()
+        self.error: BaseException | None = None
+        self.steps = 0
+        self.max_steps: int | None = None
+        self.thread = threading.Thread(target=self._run, daemon=True)
+
+    def _run(self) -> None:
+        try:
+            while not self.stop.is_set():
+                if self.max_steps is not None and self.steps >= self.max_steps:
+                    self.server.poll(0.01)
+                    continue
+                if self.lockstep is not None:
+                    wait_lockstep(self.server, self.lockstep)
+                self.server.apply_requests(self.world.sim_time_ms + 8)
+                self.world.step()
+                self.server.publish(self.world.sim_time_ms)
+                self.steps += 1
+                self.server.poll(self.pause_s)
+        except BaseException as exc:  # reported to the test
+            self.error = exc
+            raise
+
+
+@contextmanager
+def running_server(
+    *,
+    robots: Sequence[RobotId] = (RED1, RED2, BLUE1),
+    hosts: tuple[str, ...] = ("127.0.0.1",),
+    network: NetworkSpec | None = None,
+    lockstep: LockstepSettings | None = None,
+    world: Any = None,
+    cameras: bool = False,
+    pause_s: float = 0.002,
+    team_size: int = 4,
+    hold: bool = False,
+) -> Iterator[tuple[Driver, dict[RobotId, int]]]:
+    world = world if world is not None else FakeDeviceWorld(robots)
+    ports = dict(zip(robots, free_ports(len(robots)), strict=True))
+    endpoints = [
+        PlayerEndpoint(robot=r, port=p, hosts=hosts, team_size=team_size) for r, p in ports.items()
+    ]
+    network = network or NetworkSpec(api_bind_host="127.0.0.1")
+    worker = None
+    if cameras:
+        worker = RenderWorker(
+            capture=lambda: None,
+            make_render=lambda: lambda _s, r, w, h: FakeCameraRenderer(None, w, h).render(r),
+        )
+    server = ApiServer(
+        world=world, endpoints=endpoints, network=network, lockstep=lockstep, cameras=worker
+    )
+    server.start()
+    driver = Driver(server, world, lockstep, pause_s)
+    if hold:
+        driver.max_steps = 0
+    driver.thread.start()
+    try:
+        yield driver, ports
+    finally:
+        driver.stop.set()
+        driver.thread.join(timeout=10)
+        server.close()
+        if worker is not None:
+            worker.close()
+    if driver.error is not None:
+        raise driver.error

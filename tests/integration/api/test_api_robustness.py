@@ -1,0 +1,94 @@
+"""A never-reading client, lockstep waiting and slowness, fuzzed bytes on the read path."""
+
+from __future__ import annotations
+
+import socket
+import time
+
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from simulator.api import LockstepSettings
+from simulator.client import RobotClient
+from simulator.spec import NetworkSpec
+from tests.integration.api.harness import BLUE1, RED1, RED2, running_server, wait_until
+
+
+def _client(port: int) -> RobotClient:
+    return RobotClient("127.0.0.1", port, retries=3, retry_interval_s=0.1).connect()
+
+
+def test_never_reading_client_does_not_stall_the_others() -> None:
+    network = NetworkSpec(api_bind_host="127.0.0.1", send_queue_messages=8)
+    with running_server(network=network, pause_s=0.0) as (driver, ports):
+        stalled = socket.create_connection(("127.0.0.1", ports[RED2]), timeout=5)
+        stalled.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+        assert stalled.recv(8) == b"Welcome\0"
+        with _client(ports[RED1]) as reader:
+            reader.enable_many({f"{m}S": 8 for m in ("Neck", "Head", "PelvL", "PelvR")})
+            steps_before = driver.steps
+            wait_until(lambda: driver.server.statistics()["red-2"]["dropped_out"] > 0, 30)
+            first = reader.receive(timeout=5).time
+            for _ in range(50):
+                last = reader.receive(timeout=5).time
+            assert last == first + 50 * 8
+            assert driver.steps > steps_before + 50
+        stalled.close()
+
+
+def test_lockstep_waits_for_each_client_then_marks_a_silent_one_slow() -> None:
+    lockstep = LockstepSettings(deadline_s=0.02, time_bank_s=0.5)
+    with running_server(lockstep=lockstep, pause_s=0.0, hold=True) as (driver, ports):
+        with _client(ports[RED1]) as client:
+            client.enable("NeckS", 8)
+            wait_until(lambda: driver.server.connected())
+            driver.max_steps = None
+            for _ in range(30):  # answer every measurement: exactly one step per answer
+                msg = client.receive(timeout=5)
+                client.set_positions({"Neck": msg.time / 1000.0})
+            client.receive(timeout=5)  # the step after the last answer
+            time.sleep(0.01)
+            steps = driver.steps
+            time.sleep(0.05)
+            assert driver.steps == steps  # not answered yet: within deadline + bank
+            wait_until(lambda: driver.server.statistics()["red-1"]["slow_periods"] == 1, 5)
+            stats = driver.server.statistics()["red-1"]
+            assert stats["missed_deadlines"] >= 1
+            wait_until(lambda: driver.steps > steps + 20)  # goes on without the slow client
+
+
+def test_lockstep_is_deterministic_with_a_deterministic_client() -> None:
+    def run() -> list[tuple[int, float]]:
+        lockstep = LockstepSettings(deadline_s=1.0, time_bank_s=5.0)
+        with running_server(lockstep=lockstep, pause_s=0.0, hold=True) as (driver, ports):
+            with _client(ports[RED1]) as client:
+                client.enable("NeckS", 8)
+                wait_until(lambda: driver.server.connected())
+                driver.max_steps = 60
+                trace = []
+                for _ in range(59):
+                    msg = client.receive(timeout=5)
+                    value = msg.position_sensors[0].value if msg.position_sensors else 0.0
+                    trace.append((msg.time, round(value, 9)))
+                    client.set_positions({"Neck": value + 0.01 * (msg.time % 24)})
+                return trace
+
+    assert run() == run()
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(chunks=st.lists(st.binary(min_size=1, max_size=64), min_size=1, max_size=6))
+def test_arbitrary_bytes_never_break_the_server(chunks: list[bytes]) -> None:
+    with running_server(robots=(RED1, BLUE1)) as (driver, ports):
+        raw = socket.create_connection(("127.0.0.1", ports[RED1]), timeout=5)
+        assert raw.recv(8) == b"Welcome\0"
+        for chunk in chunks:
+            try:
+                raw.sendall(chunk)
+            except OSError:
+                break  # the server closed us: fine
+        raw.close()
+        with _client(ports[BLUE1]) as other:
+            t0 = other.receive(timeout=5).time
+            assert other.receive(timeout=5).time == t0 + 8
+        assert driver.error is None
