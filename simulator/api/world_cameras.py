@@ -1,0 +1,53 @@
+"""Camera rendering for the real MuJoCo world, off the step thread.
+
+``capture`` (step thread) copies the joint positions of the step an image is due for; the
+worker thread owns its own ``MjData`` and renderers, sets those positions, recomputes the
+kinematics and renders with the world's :class:`~simulator.world.CameraRenderer`. The physics
+state is never shared between threads.
+"""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+from typing import TYPE_CHECKING, Any
+
+from referee.snapshot import RobotId
+from simulator.api.cameras import RenderFn, RenderWorker
+
+if TYPE_CHECKING:
+    from simulator.world import World
+
+
+def world_render_worker(world: World) -> RenderWorker:
+    def capture() -> Any:
+        return (world.data.qpos.copy(), world.data.mocap_pos.copy(), world.data.mocap_quat.copy())
+
+    def make_render() -> RenderFn:
+        import mujoco
+
+        from simulator.world import CameraRenderer
+
+        model = world.model
+        data = mujoco.MjData(model)
+        view = SimpleNamespace(model=model, data=data, index=world.index)
+        renderers: dict[tuple[int, int], CameraRenderer] = {}
+        current: list[Any] = [None]
+
+        def render(state: Any, robot: RobotId, width: int, height: int) -> bytes:
+            if state is not current[0]:
+                qpos, mocap_pos, mocap_quat = state
+                data.qpos[:] = qpos
+                data.mocap_pos[:] = mocap_pos
+                data.mocap_quat[:] = mocap_quat
+                mujoco.mj_kinematics(model, data)
+                mujoco.mj_camlight(model, data)
+                current[0] = state
+            renderer = renderers.get((width, height))
+            if renderer is None:
+                renderer = CameraRenderer(view, width, height)  # type: ignore[arg-type]
+                renderers[(width, height)] = renderer
+            return renderer.render(robot)
+
+        return render
+
+    return RenderWorker(capture=capture, make_render=make_render)

@@ -1,0 +1,209 @@
+"""The simulator's step loop: requests -> physics -> referee -> measurements -> record.
+
+One basic step (8 ms of simulated time)::
+
+    [lockstep: wait for one request per client]  ->  apply requests  ->  world.step()
+    -> snapshot -> referee.step -> apply its commands -> publish measurements
+    -> recorder / telemetry -> pacing (async: maximum_real_time_factor)
+
+While the referee waits for wall-clock time (before the first READY, between halves) an async
+match keeps stepping, as in HLVS; a lockstep match holds (no steps, connections still served) so
+its result does not depend on machine speed.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import asdict, dataclass
+from typing import Any, Protocol
+
+from referee.snapshot import RefereeEvent, WorldCommand, WorldSnapshot
+from simulator.api import ApiServer, LockstepSettings, wait_lockstep
+from simulator.telemetry import STATE_PERIOD_S, Telemetry
+
+log = logging.getLogger(__name__)
+
+
+class RefereeLike(Protocol):
+    @property
+    def finished(self) -> bool: ...
+
+    @property
+    def waiting_for_wall_clock(self) -> bool: ...
+
+    @property
+    def game_state(self) -> dict[str, object]: ...
+
+    events: list[RefereeEvent]
+
+    def step(self, snapshot: WorldSnapshot) -> list[WorldCommand]: ...
+
+
+class WorldLike(Protocol):
+    sim_time_ms: int
+    step_ms: int
+
+    def step(self) -> None: ...
+
+    def snapshot(self) -> WorldSnapshot: ...
+
+    def apply(self, command: WorldCommand) -> None: ...
+
+
+class RecorderLike(Protocol):
+    def record(self, world: Any, game_state: dict[str, Any]) -> None: ...
+
+    def event(self, event: dict[str, Any]) -> None: ...
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class LoopSettings:
+    stepping: str  # "async" | "lockstep"
+    maximum_real_time_factor: float
+    lockstep: LockstepSettings
+    end_of_game_real_s: float
+    max_duration_real_s: float | None
+
+
+def event_dict(event: RefereeEvent) -> dict[str, Any]:
+    data = asdict(event)
+    data["team"] = event.team.value if event.team is not None else None
+    return data
+
+
+class MatchLoop:
+    """Runs a match until FINISHED (+ the end-of-game wait), the time limit or a stop request."""
+
+    def __init__(
+        self,
+        *,
+        world: WorldLike,
+        referee: RefereeLike,
+        server: ApiServer,
+        recorder: RecorderLike | None,
+        telemetry: Telemetry,
+        settings: LoopSettings,
+    ) -> None:
+        self.world = world
+        self.referee = referee
+        self.server = server
+        self.recorder = recorder
+        self.telemetry = telemetry
+        self.settings = settings
+        self.stop_requested = False
+        self.stop_reason = ""
+        self.steps = 0
+        self.held_s = 0.0
+        self.real_time_s = 0.0
+        self._events_seen = 0
+        self._next_state_s = 0.0
+        self._rtf_window: tuple[float, int] = (0.0, 0)
+        self._rtf = 0.0
+
+    def request_stop(self, reason: str) -> None:
+        self.stop_requested = True
+        self.stop_reason = reason
+        self.server.stop_requested = True
+
+    @property
+    def lockstep(self) -> bool:
+        return self.settings.stepping == "lockstep"
+
+    def run(self) -> str:
+        """Play; returns why the loop ended: finished, max_duration or the stop reason."""
+        start = time.monotonic()
+        self._rtf_window = (start, self.world.sim_time_ms)
+        pace_origin = (start, self.world.sim_time_ms)
+        max_rtf = self.settings.maximum_real_time_factor
+        limit = self.settings.max_duration_real_s
+        finished_at: float | None = None
+        self._referee_step(self.world.snapshot())  # starting poses, ball on the centre spot
+        while not self.stop_requested:
+            now = time.monotonic()
+            if limit is not None and now - start >= limit:
+                self.stop_reason = "max_duration"
+                log.warning("stopping: maximum duration of %.0f s (wall) reached", limit)
+                break
+            if self.referee.finished:
+                if finished_at is None:
+                    finished_at = now
+                    log.info("game finished at %d ms of simulated time", self.world.sim_time_ms)
+                if now - finished_at >= self.settings.end_of_game_real_s:
+                    self.stop_reason = "finished"
+                    break
+            if self.lockstep and (self.referee.waiting_for_wall_clock or finished_at is not None):
+                self._hold(0.02)
+                pace_origin = (time.monotonic(), self.world.sim_time_ms)
+                continue
+            self._one_step()
+            if max_rtf > 0:
+                origin_s, origin_ms = pace_origin
+                due = origin_s + (self.world.sim_time_ms - origin_ms) / 1000.0 / max_rtf
+                wait = due - time.monotonic()
+                if wait > 0:
+                    self.server.poll(wait)
+                elif wait < -1.0:  # far behind: do not try to catch up in a burst
+                    pace_origin = (time.monotonic(), self.world.sim_time_ms)
+        self.real_time_s = time.monotonic() - start
+        self._publish_state(force=True)
+        return self.stop_reason
+
+    def _hold(self, seconds: float) -> None:
+        began = time.monotonic()
+        self.server.poll(seconds)
+        self._referee_step(self.world.snapshot())  # lets the referee see its wait is over
+        self._publish_state()
+        self.held_s += time.monotonic() - began
+
+    def _one_step(self) -> None:
+        world, server = self.world, self.server
+        if self.lockstep:
+            wait_lockstep(server, self.settings.lockstep)
+        server.apply_requests(world.sim_time_ms + world.step_ms)
+        world.step()
+        self._referee_step(world.snapshot())
+        server.publish(world.sim_time_ms)
+        self.steps += 1
+        if self.recorder is not None:
+            self.recorder.record(world, dict(self.referee.game_state))
+        self._publish_state()
+
+    def _referee_step(self, snapshot: WorldSnapshot) -> None:
+        for command in self.referee.step(snapshot):
+            self.world.apply(command)
+        events = self.referee.events
+        while self._events_seen < len(events):
+            payload = event_dict(events[self._events_seen])
+            self._events_seen += 1
+            if self.recorder is not None:
+                self.recorder.event(payload)
+            self.telemetry.event(payload)
+
+    def real_time_factor(self) -> float:
+        now = time.monotonic()
+        since, sim_ms = self._rtf_window
+        if now - since >= 1.0:
+            self._rtf = (self.world.sim_time_ms - sim_ms) / 1000.0 / (now - since)
+            self._rtf_window = (now, self.world.sim_time_ms)
+        return self._rtf
+
+    def _publish_state(self, *, force: bool = False) -> None:
+        now = time.monotonic()
+        if not force and now < self._next_state_s:
+            return
+        self._next_state_s = now + STATE_PERIOD_S
+        game = self.referee.game_state
+        self.telemetry.state(
+            {
+                "sim_time_ms": self.world.sim_time_ms,
+                "real_time_factor": round(self.real_time_factor(), 3),
+                "state": game.get("state"),
+                "secondary_state": game.get("secondary_state"),
+                "half": game.get("half"),
+                "secs_remaining": game.get("secs_remaining"),
+                "score": game.get("score"),
+                "connected": self.server.connected(),
+                "stepping": self.settings.stepping,
+            }
+        )

@@ -1,0 +1,229 @@
+"""``python -m simulator run --spec match_spec.json --out DIR``: the simulator process.
+
+Wires the world, the robot API server, the referee (GameController, mirror, AutoRef), the
+recorder and telemetry, runs :class:`simulator.match_loop.MatchLoop` and writes into ``--out``:
+``sim_result.json``, ``replay.hlvsrec``, ``referee.log``, ``referee_events.jsonl``,
+``gamecontroller.log`` and the video when the spec asks for one. Exit codes: 0 the game reached
+FINISHED, 1 it did not (time limit, physics divergence), 2 invalid spec, 3 infrastructure (a port
+or the telemetry endpoint unavailable), 130 stopped by SIGTERM / SIGINT (results still written).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import platform
+import signal
+import sys
+import time
+from contextlib import ExitStack
+from pathlib import Path
+from types import FrameType
+from typing import Any
+
+from simulator.api import ApiServer, LockstepSettings, endpoints_from_spec
+from simulator.errors import PhysicsDivergence, SimulatorError, SpecError
+from simulator.match_loop import LoopSettings, MatchLoop
+from simulator.match_setup import referee_config
+from simulator.spec import MatchSpec
+from simulator.telemetry import TelemetryError, open_telemetry
+
+log = logging.getLogger(__name__)
+
+RESULT_FILE = "sim_result.json"
+REPLAY_FILE = "replay.hlvsrec"
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="python -m simulator run")
+    parser.add_argument("--spec", required=True, help="match_spec.json written by the orchestrator")
+    parser.add_argument("--out", required=True, help="output folder")
+    parser.add_argument("--log-level", default="INFO")
+    parser.add_argument(
+        "--no-gc-network",
+        action="store_true",
+        help="do not open the GameController UDP ports and the team mirror",
+    )
+    return parser
+
+
+def versions() -> dict[str, str]:
+    from importlib.metadata import PackageNotFoundError, version
+
+    out = {"python": platform.python_version()}
+    for name in ("hlvs-runner", "mujoco", "protobuf", "eclipse-zenoh"):
+        try:
+            out[name] = version(name)
+        except PackageNotFoundError:
+            out[name] = "unknown"
+    return out
+
+
+def main(argv: list[str]) -> int:
+    args = _parser().parse_args(argv)
+    logging.basicConfig(
+        level=args.log_level.upper(),
+        stream=sys.stderr,
+        format="%(asctime)s %(levelname)s %(name)s: %(message)s",
+    )
+    try:
+        spec = MatchSpec.load(args.spec)
+    except SpecError as exc:
+        log.error("invalid match spec: %s", exc)
+        return 2
+    out = Path(args.out)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        log.error("cannot create the output folder %s: %s", out, exc)
+        return 3
+    try:
+        return run_match(spec, out, gc_network=not args.no_gc_network)
+    except TelemetryError as exc:
+        log.error("%s", exc)
+        return 3
+    except OSError as exc:
+        log.error("infrastructure failure: %s", exc)
+        return 3
+    except SimulatorError as exc:
+        log.error("%s", exc)
+        return 3
+
+
+def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
+    """Play the match of ``spec``, writing every output file into ``out``; returns the exit code."""
+    from referee.autoref import Referee
+    from simulator.api.world_cameras import world_render_worker
+    from simulator.recorder import Recorder
+    from simulator.world import World
+
+    log.info(
+        "match %s: %s %s, seed %d, %s stepping, max real-time factor %g",
+        spec.match_id, spec.game_type, spec.field_class, spec.seed, spec.stepping,
+        spec.maximum_real_time_factor,
+    )  # fmt: skip
+    world = World.from_spec(spec)
+    lockstep = LockstepSettings(
+        deadline_s=spec.lockstep_deadline_ms / 1000.0,
+        time_bank_s=spec.lockstep_time_bank_ms / 1000.0,
+    )
+    started = time.time()
+    exit_code = 1
+    with ExitStack() as stack:
+        referee = Referee(config=referee_config(spec), log_dir=out)
+        stack.callback(referee.close)
+        cameras = world_render_worker(world)
+        stack.callback(cameras.close)
+        server = ApiServer(
+            world=world,
+            endpoints=endpoints_from_spec(spec),
+            network=spec.network,
+            lockstep=lockstep if spec.stepping == "lockstep" else None,
+            cameras=cameras,
+        )
+        server.start()
+        stack.callback(server.close)
+        if gc_network:
+            referee.start_network()
+        recorder = Recorder(
+            out / REPLAY_FILE, world, match_id=spec.match_id, rate_hz=spec.recorder_rate_hz
+        )
+        telemetry = open_telemetry(match_id=spec.match_id, listen=spec.network.telemetry_listen)
+        stack.callback(telemetry.close)
+        loop = MatchLoop(
+            world=world,
+            referee=referee,
+            server=server,
+            recorder=recorder,
+            telemetry=telemetry,
+            settings=LoopSettings(
+                stepping=spec.stepping,
+                maximum_real_time_factor=spec.maximum_real_time_factor,
+                lockstep=lockstep,
+                end_of_game_real_s=spec.timing.end_of_game_real_s,
+                max_duration_real_s=spec.timing.max_duration_real_s,
+            ),
+        )
+        stack.enter_context(_stop_on_signals(loop))
+        error = ""
+        try:
+            reason = loop.run()
+        except PhysicsDivergence as exc:
+            reason = "physics_divergence"
+            error = str(exc)
+            log.error("%s", exc)
+        recorder.close(world)
+        if reason == "finished":
+            exit_code = 0
+        elif reason in ("SIGTERM", "SIGINT"):
+            exit_code = 130
+        result = {
+            "match_id": spec.match_id,
+            "seed": spec.seed,
+            **referee.result(),
+            "stop_reason": reason,
+            "error": error,
+            "stepping": spec.stepping,
+            "sim_time_ms": world.sim_time_ms,
+            "real_time_s": round(loop.real_time_s, 3),
+            "held_real_s": round(loop.held_s, 3),
+            "real_time_factor": _rtf(world.sim_time_ms, loop.real_time_s - loop.held_s),
+            "robots": server.statistics(),
+            "cameras": {"frames": cameras.frames, "render_s": round(cameras.render_s, 3)},
+            "started_unix_s": round(started, 3),
+            "versions": versions(),
+        }
+    _write_json(out / RESULT_FILE, result)
+    log.info(
+        "match %s ended (%s): %s, score %s, %d ms simulated in %.1f s",
+        spec.match_id, reason, result["state"], result["score"], world.sim_time_ms,
+        loop.real_time_s,
+    )  # fmt: skip
+    if spec.record_video:
+        _render_video(out / REPLAY_FILE, out / spec.record_video)
+    return exit_code
+
+
+def _rtf(sim_ms: int, real_s: float) -> float:
+    return round(sim_ms / 1000.0 / real_s, 3) if real_s > 0 else 0.0
+
+
+def _write_json(path: Path, data: dict[str, Any]) -> None:
+    tmp = path.with_suffix(".tmp")
+    tmp.write_text(json.dumps(data, indent=2, sort_keys=True, default=str), encoding="utf-8")
+    tmp.replace(path)
+
+
+def _render_video(replay: Path, output: Path) -> None:
+    from simulator.render import render_video
+
+    started = time.monotonic()
+    try:
+        render_video(replay, output)
+    except (OSError, SimulatorError) as exc:
+        log.error("video %s not rendered: %s", output, exc)
+        return
+    log.info("video %s rendered in %.1f s", output, time.monotonic() - started)
+
+
+class _stop_on_signals:  # noqa: N801 (used like a context-manager function)
+    """SIGTERM / SIGINT ask the loop to stop cleanly; the previous handlers come back after."""
+
+    def __init__(self, loop: MatchLoop) -> None:
+        self._loop = loop
+        self._previous: dict[int, Any] = {}
+
+    def _handle(self, signum: int, _frame: FrameType | None) -> None:
+        name = signal.Signals(signum).name
+        log.warning("%s received: stopping the match and writing the results", name)
+        self._loop.request_stop(name)
+
+    def __enter__(self) -> _stop_on_signals:
+        for signum in (signal.SIGTERM, signal.SIGINT):
+            self._previous[signum] = signal.signal(signum, self._handle)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        for signum, handler in self._previous.items():
+            signal.signal(signum, handler)
