@@ -24,6 +24,13 @@ def suggest(word: str, choices: Iterable[str]) -> str:
     return quote(lowered[matches[0]]) if matches else ""
 
 
+def printable(text: str) -> str:
+    """``text`` with control characters escaped, so that a problem stays on one line."""
+    if text.isprintable():
+        return text
+    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode() for c in text)
+
+
 def quote(value: object) -> str:
     return f'"{value}"' if isinstance(value, str) else str(value)
 
@@ -40,19 +47,20 @@ class Collector:
     problems: list[Problem] = field(default_factory=list)
 
     def error(self, where: str, message: str, *, expected: str = "", suggestion: str = "") -> None:
-        self.problems.append(
-            Problem(self.file, where, message, expected=expected, suggestion=suggestion)
-        )
+        self._add(where, message, expected, suggestion, "error")
 
     def warn(self, where: str, message: str, *, expected: str = "", suggestion: str = "") -> None:
+        self._add(where, message, expected, suggestion, "warning")
+
+    def _add(self, where: str, message: str, expected: str, suggestion: str, severity: str) -> None:
         self.problems.append(
             Problem(
                 self.file,
-                where,
-                message,
-                expected=expected,
-                suggestion=suggestion,
-                severity="warning",
+                printable(where),
+                printable(message),
+                expected=printable(expected),
+                suggestion=printable(suggestion),
+                severity=severity,
             )
         )
 

@@ -1,0 +1,80 @@
+"""to_match_spec writes what simulator.spec.MatchSpec reads, with random choices from the seed."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from orchestrator.config import load_game, resolve_sides, to_match_spec
+from simulator.spec import MatchSpec
+from tests.unit.config.conftest import EXAMPLES, GameFiles
+
+
+@pytest.mark.parametrize("example", ["kid_4v4_official", "scrimmage_1v1", "adult_3v3"])
+def test_round_trip_through_match_spec(example: str) -> None:
+    loaded = load_game(EXAMPLES / example / "game.json")
+    addresses = {
+        "red": [f"172.30.1.{n}" for n in range(1, len(loaded.red.players) + 1)],
+        "blue": [f"172.30.2.{n}" for n in range(1, len(loaded.blue.players) + 1)],
+    }
+    data = to_match_spec(loaded, robot_addresses=addresses, telemetry_listen="tcp/172.30.0.2:7447")
+    spec = MatchSpec.from_dict(json.loads(json.dumps(data)))
+    game = loaded.game
+    assert (spec.match_id, spec.seed, spec.game_type) == (game.match_id, game.seed, game.game_type)
+    assert spec.field_class == game.field_class.lower()
+    assert spec.stepping == game.stepping
+    assert spec.network.telemetry_listen == "tcp/172.30.0.2:7447"
+    assert spec.timing.half_duration_s == game.timing.half_duration_s
+    assert spec.timing.wait_before_first_ready_real_s == game.timing.wait_before_first_ready_s
+    for color in ("red", "blue"):
+        team = spec.team(color)  # type: ignore[arg-type]
+        ref = game.team(color)  # type: ignore[arg-type]
+        config = loaded.team(color)  # type: ignore[arg-type]
+        assert team.team_id == ref.team_id
+        assert team.robot_addresses == tuple(addresses[color])
+        assert set(addresses[color]) <= set(team.hosts)
+        assert [p.port for p in team.players] == list(ref.ports[: len(config.players)])
+        for player, source in zip(team.players, config.players, strict=True):
+            assert player.model == source.model
+            assert player.half_time_pose.x_m == source.half_time_pose.x_m
+            assert player.half_time_pose.yaw_rad == pytest.approx(source.half_time_pose.yaw_rad)
+            assert player.goalkeeper == (player.number == 1)
+
+
+def test_video_only_for_mp4(game_files: GameFiles) -> None:
+    game_files.game["record_simulation"] = "/tmp/anything.mp4"
+    loaded = load_game(game_files.write())
+    data = to_match_spec(loaded, robot_addresses={}, telemetry_listen=None)
+    assert MatchSpec.from_dict(data).record_video == "match.mp4"
+    game_files.game["record_simulation"] = "recording.html"
+    loaded = load_game(game_files.write())
+    assert to_match_spec(loaded, robot_addresses={}, telemetry_listen=None)["record_video"] is None
+
+
+def test_random_sides_follow_the_seed(game_files: GameFiles) -> None:
+    outcomes = set()
+    for seed in range(40):
+        game_files.game["seed"] = seed
+        loaded = load_game(game_files.write())
+        first = resolve_sides(loaded)
+        assert resolve_sides(loaded) == first  # same seed, same choice
+        data = to_match_spec(loaded, robot_addresses={}, telemetry_listen=None)
+        assert (data["side_left"], data["kickoff"]) == first
+        outcomes.add(first)
+    assert len(outcomes) == 4  # every combination happens for some seed
+
+
+def test_fixed_sides_are_kept(game_files: GameFiles) -> None:
+    game_files.game["side_left"] = "blue"
+    game_files.game["kickoff"] = "red"
+    loaded = load_game(game_files.write())
+    assert resolve_sides(loaded) == ("blue", "red")
+
+
+def test_spec_module_does_not_import_the_simulator() -> None:
+    code = "import sys, orchestrator.config.spec; print('simulator' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
