@@ -167,7 +167,7 @@ def finish(runner: MatchRunner) -> dict[str, Any]:
         runner._advance(MatchState.COLLECTING)
     if runner.telemetry is not None:
         runner.telemetry.close()
-    runner.monitor.join(timeout_s=2.0)
+    runner.monitor.join(timeout_s=1.0)
     for key, container_id in started.robot_ids.items():
         _guarded(runner, f"collecting logs of {key}",
                  partial(_collect_robot, runner, key, container_id))

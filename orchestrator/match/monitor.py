@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import logging
 import threading
+import time
 from dataclasses import dataclass
 
 from orchestrator.errors import InfrastructureError
@@ -53,9 +54,11 @@ class StatsMonitor:
             found = self._peaks.get(key, Peaks())
             return Peaks(found.cpu_percent, found.memory_bytes, found.samples)
 
-    def join(self, timeout_s: float = 3.0) -> None:
+    def join(self, timeout_s: float = 1.0) -> None:
+        """Wait at most ``timeout_s`` in total for the threads (they are daemons)."""
+        deadline = time.monotonic() + timeout_s
         for thread in self._threads:
-            thread.join(timeout=timeout_s)
+            thread.join(timeout=max(0.0, deadline - time.monotonic()))
 
 
 __all__ = ["Peaks", "StatsMonitor"]

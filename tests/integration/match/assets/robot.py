@@ -1,0 +1,119 @@
+"""Test robot controller: one behaviour per command-line word (runs inside a test container)."""
+
+import json
+import os
+import signal
+import socket
+import sys
+import time
+
+LOGS = "/robocup-logs"
+
+
+def log(name, data):
+    with open(os.path.join(LOGS, name), "w") as handle:
+        json.dump(data, handle)
+
+
+def sim_addr():
+    host, port = os.environ["ROBOCUP_SIMULATOR_ADDR"].rsplit(":", 1)
+    return host, int(port)
+
+
+def try_connect(host, port, timeout=1.0):
+    sock = socket.socket()
+    sock.settimeout(timeout)
+    try:
+        sock.connect((host, port))
+        return "connected"
+    except OSError as exc:
+        return f"failed: {exc}"
+    finally:
+        sock.close()
+
+
+def wait_forever():
+    while True:
+        time.sleep(1)
+
+
+def main(argv):
+    mode = argv[1] if len(argv) > 1 else "env"
+    print(f"robot {os.environ.get('ROBOCUP_TEAM_COLOR')}-{os.environ.get('ROBOCUP_ROBOT_ID')} "
+          f"mode {mode}", flush=True)
+    if mode == "env":
+        env = {k: v for k, v in os.environ.items() if k.startswith("ROBOCUP_")}
+        log("env.json", {"env": env, "hostname": socket.gethostname(), "uid": os.getuid()})
+        reach = {}
+        for target in argv[2:]:
+            host, port = target.rsplit(":", 1)
+            reach[target] = try_connect(host, int(port))
+        reach["simulator"] = try_connect(*sim_addr())
+        log("reach.json", reach)
+        print("env written", flush=True)
+        wait_forever()
+    if mode == "listen":
+        server = socket.socket()
+        server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        server.bind(("0.0.0.0", 5000))
+        server.listen(8)
+        while True:
+            conn, _ = server.accept()
+            conn.close()
+    if mode == "probe":
+        path = os.path.join(LOGS, "targets.json")
+        deadline = time.monotonic() + 30
+        while not os.path.exists(path) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        time.sleep(0.2)
+        targets = json.load(open(path))
+        reach = {name: try_connect(host, port) for name, (host, port) in targets.items()}
+        log("reach.json", reach)
+        print("probe done", flush=True)
+        wait_forever()
+    if mode == "sigterm":
+        def on_term(signum, frame):
+            with open(os.path.join(LOGS, "term.txt"), "w") as handle:
+                handle.write("got SIGTERM\n")
+            time.sleep(1.0)
+            with open(os.path.join(LOGS, "term.txt"), "a") as handle:
+                handle.write("flushed\n")
+            sys.exit(0)
+        signal.signal(signal.SIGTERM, on_term)
+        wait_forever()
+    if mode == "oom":
+        hog = []
+        while True:
+            hog.append(bytearray(8 * 1024 * 1024))
+            time.sleep(0.01)
+    if mode == "fill":
+        written = 0
+        error = ""
+        try:
+            with open(os.path.join(LOGS, "big.bin"), "wb") as handle:
+                chunk = b"x" * (1024 * 1024)
+                while written < 200 * 1024 * 1024:
+                    handle.write(chunk)
+                    handle.flush()
+                    written += len(chunk)
+        except OSError as exc:
+            error = str(exc)
+        print(json.dumps({"written": written, "error": error}), flush=True)
+        wait_forever()
+    if mode == "send":
+        seconds = float(argv[2]) if len(argv) > 2 else 3.0
+        sock = socket.create_connection(sim_addr(), timeout=10)
+        chunk = b"\0" * 65536
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            sock.sendall(chunk)
+        sock.close()
+        print("sent", flush=True)
+        wait_forever()
+    if mode == "exit":
+        sys.exit(3)
+    raise SystemExit(f"unknown mode {mode}")
+
+
+if __name__ == "__main__":
+    main(sys.argv)

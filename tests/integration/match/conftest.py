@@ -1,0 +1,158 @@
+"""Fixtures for match integration tests: a real Docker engine, a small test image with a test
+robot controller and a stand-in simulator, and a runner that cleans up by label."""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import tarfile
+import uuid
+from collections.abc import Callable, Iterator, Mapping
+from pathlib import Path
+from typing import Any
+
+import docker
+import pytest
+
+from orchestrator.config import Limits
+from orchestrator.errors import OrchestratorError
+from orchestrator.match import (
+    HostControl,
+    MatchOutcome,
+    MatchPlan,
+    MatchRunner,
+    RobotPlan,
+    RunOptions,
+    TeamPlan,
+    cleanup,
+)
+from tests.conftest import TEST_LABEL
+
+ASSETS = Path(__file__).parent / "assets"
+LOCAL_BASES = ("hlvs-runner/base:bookworm", "hlvs-runner-test/e-base:bookworm")
+
+
+def _base_image(client: docker.DockerClient) -> str:
+    try:
+        from orchestrator.images import project_image  # type: ignore[attr-defined]
+
+        return str(project_image("team-base"))
+    except (ImportError, AttributeError, OrchestratorError):
+        pass
+    for name in LOCAL_BASES:
+        try:
+            client.images.get(name)
+            return name
+        except docker.errors.ImageNotFound:
+            continue
+    pytest.skip("no base image with python3 (run `hlvs images build`)")
+
+
+@pytest.fixture(scope="session")
+def docker_client() -> Iterator[docker.DockerClient]:
+    try:
+        client = docker.from_env()
+        client.ping()
+    except docker.errors.DockerException as exc:
+        pytest.skip(f"no Docker engine: {exc}")
+    yield client
+    client.close()
+
+
+@pytest.fixture(scope="session")
+def runtime(docker_client: docker.DockerClient) -> Any:
+    from orchestrator.engine.containers import DockerRuntime
+
+    return DockerRuntime(docker_client)
+
+
+@pytest.fixture(scope="session")
+def test_image(docker_client: docker.DockerClient) -> str:
+    base = _base_image(docker_client)
+    files = {p.name: p.read_bytes() for p in sorted(ASSETS.glob("*.py"))}
+    dockerfile = f"FROM {base}\nCOPY *.py /opt/t/\nCMD [\"python3\", \"/opt/t/robot.py\"]\n"
+    digest = hashlib.sha256(dockerfile.encode())
+    for name, data in files.items():
+        digest.update(name.encode() + data)
+    tag = f"hlvs-runner-test/match:{digest.hexdigest()[:12]}"
+    try:
+        docker_client.images.get(tag)
+        return tag
+    except docker.errors.ImageNotFound:
+        pass
+    buffer = io.BytesIO()
+    with tarfile.open(fileobj=buffer, mode="w") as tar:
+        for name, data in {**files, "Dockerfile": dockerfile.encode()}.items():
+            info = tarfile.TarInfo(name)
+            info.size = len(data)
+            tar.addfile(info, io.BytesIO(data))
+    buffer.seek(0)
+    docker_client.images.build(fileobj=buffer, custom_context=True, tag=tag, rm=True,
+                               network_mode="none", labels={TEST_LABEL: "1"})
+    return tag
+
+
+def spec_builder(match_id: str, red: list[RobotPlan], blue: list[RobotPlan]) -> Any:
+    def build(addresses: Mapping[str, tuple[str, ...]], telemetry: str | None) -> dict[str, Any]:
+        return {
+            "match_id": match_id,
+            "seed": 7,
+            "red": {"players": [{"number": r.number, "port": r.port} for r in red],
+                    "hosts": list(addresses["red"])},
+            "blue": {"players": [{"number": r.number, "port": r.port} for r in blue],
+                     "hosts": list(addresses["blue"])},
+            "network": {"telemetry_listen": telemetry},
+        }
+
+    return build
+
+
+def robots(color: str, image: str | None, commands: list[list[str] | None]) -> list[RobotPlan]:
+    base = 10000 + (20 if color == "blue" else 0)
+    return [
+        RobotPlan(color=color, number=n, port=base + n, image=image,
+                  command=("python3", "/opt/t/robot.py", *cmd) if cmd is not None else None)
+        for n, cmd in enumerate(commands, start=1)
+    ]
+
+
+MatchFactory = Callable[..., MatchOutcome]
+
+
+@pytest.fixture
+def play(runtime: Any, test_image: str, tmp_path: Path) -> Iterator[MatchFactory]:
+    """``play(red=[cmd...], blue=[cmd...], sim=("3",), limits=..., ...) -> MatchOutcome``."""
+    match_ids: list[str] = []
+    host = HostControl()
+
+    def factory(
+        *, red: list[list[str] | None], blue: list[list[str] | None],
+        sim: tuple[str, ...] = ("3",), limits: Limits | None = None, grace_s: float = 2.0,
+        red_image: str | None = "", blue_image: str | None = "", out: Path | None = None,
+        runner_hook: Callable[[MatchRunner], None] | None = None,
+    ) -> MatchOutcome:
+        match_id = f"t{uuid.uuid4().hex[:8]}"
+        match_ids.append(match_id)
+        red_plan = robots("red", test_image if red_image == "" else red_image, red)
+        blue_plan = robots("blue", test_image if blue_image == "" else blue_image, blue)
+        plan = MatchPlan(
+            match_id=match_id, seed=7,
+            red=TeamPlan(color="red", name="Red", robots=tuple(red_plan)),
+            blue=TeamPlan(color="blue", name="Blue", robots=tuple(blue_plan)),
+            spec_builder=spec_builder(match_id, red_plan, blue_plan),
+            limits=limits or Limits(cpus=1.0, memory_gb=0.5, log_folder_gb=0.05),
+            grace_period_s=grace_s, telemetry=False,
+        )
+        options = RunOptions(
+            out_dir=out or tmp_path / match_id, simulator_image=test_image,
+            simulator_command=("python3", "/opt/t/fakesim.py", *sim),
+            extra_labels={TEST_LABEL: "1"}, poll_s=0.2,
+        )
+        runner = MatchRunner(plan, runtime=runtime, host=host, options=options)
+        if runner_hook is not None:
+            runner_hook(runner)
+        return runner.run()
+
+    yield factory
+    for match_id in match_ids:
+        cleanup(runtime, host, match_id=match_id)
