@@ -103,7 +103,9 @@ def test_sigterm_stops_cleanly_with_results(tmp_path: Path) -> None:
     spec = short_spec(stepping="async", maximum_real_time_factor=1.0)
     spec = replace(spec, timing=replace(spec.timing, half_duration_s=600.0))
     proc = _spawn(spec, tmp_path / "out")
-    with RobotClient("127.0.0.1", spec.red.players[0].port, retries=200, retry_interval_s=0.05) as c:
+    with RobotClient(
+        "127.0.0.1", spec.red.players[0].port, retries=200, retry_interval_s=0.05
+    ) as c:
         c.receive(timeout=30)
         proc.send_signal(signal.SIGTERM)
         with pytest.raises(ConnectionClosed):
@@ -129,6 +131,7 @@ def test_telemetry_state_and_events_over_zenoh(tmp_path: Path) -> None:
     events: list[dict[str, object]] = []
     session = None
     try:
+
         def connect() -> object:
             try:
                 return zenoh.open(zenoh_config(connect=f"tcp/127.0.0.1:{port}", mode="client"))
@@ -138,9 +141,11 @@ def test_telemetry_state_and_events_over_zenoh(tmp_path: Path) -> None:
 
         session = wait_until(connect, 30)
         session.declare_subscriber(  # type: ignore[attr-defined]
-            "hlvs/test-match/state", lambda s: states.append(json.loads(s.payload.to_bytes())))
+            "hlvs/test-match/state", lambda s: states.append(json.loads(s.payload.to_bytes()))
+        )
         session.declare_subscriber(  # type: ignore[attr-defined]
-            "hlvs/test-match/events", lambda s: events.append(json.loads(s.payload.to_bytes())))
+            "hlvs/test-match/events", lambda s: events.append(json.loads(s.payload.to_bytes()))
+        )
         wait_until(lambda: any(s["state"] == "PLAYING" for s in states), 60)
         wait_until(lambda: events, 30)
     finally:
@@ -148,7 +153,16 @@ def test_telemetry_state_and_events_over_zenoh(tmp_path: Path) -> None:
         if session is not None:
             session.close()  # type: ignore[attr-defined]
     sample = states[-1]
-    assert set(sample) >= {"sim_time_ms", "real_time_factor", "state", "secondary_state",
-                           "half", "secs_remaining", "score", "connected", "stepping"}
+    assert set(sample) >= {
+        "sim_time_ms",
+        "real_time_factor",
+        "state",
+        "secondary_state",
+        "half",
+        "secs_remaining",
+        "score",
+        "connected",
+        "stepping",
+    }
     assert sample["stepping"] == "async"
     assert {"type", "sim_time_ms"} <= set(events[0])
