@@ -53,9 +53,10 @@ def _update(snapshot: WorldSnapshot, game: GameView, memory: GoalMemory) -> Goal
 def judge(
     snapshot: WorldSnapshot, game: GameView, memory: GoalMemory
 ) -> tuple[list[Decision], GoalMemory]:
-    memory = _update(snapshot, game, memory)
+    before, memory = memory, _update(snapshot, game, memory)
     if not game.running or not in_goal(snapshot.ball.position, game.field):
         return [], memory
+    memory = before  # the restriction as it stood while the ball was still on the field
     goal_sign = -1.0 if snapshot.ball.position[0] < 0 else 1.0
     defending = game.team_on_side(goal_sign)
     toucher = snapshot.last_ball_toucher

@@ -1,0 +1,601 @@
+"""The automatic referee: drives the GameController from world snapshots and applies the rules.
+
+:class:`Referee` is the facade the simulator runtime uses: ``step(snapshot)`` every basic step
+(8 ms of simulated time) returns the world commands to apply before the next step. The game
+clock runs on simulated time; the league's wall-clock waits (before the first READY, between
+periods) use the injected clock and are visible as ``waiting_for_wall_clock``.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections import Counter
+from collections.abc import Callable
+from pathlib import Path
+
+from referee.clock import Clock, SystemClock
+from referee.config import Pose, RefereeConfig
+from referee.gamecontroller import (
+    GameController,
+    GameState,
+    SecondaryState,
+    Tick,
+    game_control_data,
+)
+from referee.judgement import apply_decisions
+from referee.logs import RefereeLog
+from referee.mirror import TeamMirror
+from referee.net import GameControllerNetwork
+from referee.rules import (
+    ball_holding,
+    ball_in_play,
+    dropped_ball,
+    end_of_game,
+    fallen,
+    goal,
+    goalkeeper,
+    kickoff,
+    outside_turf,
+    pushing,
+)
+from referee.rules.ball_out import judge as judge_ball_out
+from referee.rules.base import Decision, GameView
+from referee.shootout import Shootout
+from referee.snapshot import (
+    PlaceBall,
+    RefereeEvent,
+    RobotId,
+    SetLimp,
+    TeamColor,
+    TeleportRobot,
+    WorldCommand,
+    WorldSnapshot,
+)
+from referee.wire import encode_game_state
+
+logger = logging.getLogger(__name__)
+
+PUBLISH_PERIOD_REAL_S = 0.1  # refresh the packet the sender thread sends at 2 Hz
+
+Action = Callable[[WorldSnapshot], list[WorldCommand]]
+
+
+class Referee:
+    def __init__(
+        self, *, config: RefereeConfig, clock: Clock | None = None, log_dir: Path | None = None
+    ) -> None:
+        self.config = config
+        self.field = config.field
+        self._clock: Clock = clock or SystemClock()
+        self.log = RefereeLog(clock=self._clock, log_dir=log_dir)
+        self._log_dir = log_dir
+        keepers = {
+            color: next((p.number for p in config.team(color).players if p.goalkeeper), None)
+            for color in (TeamColor.RED, TeamColor.BLUE)
+        }
+        self.gc = GameController(
+            game_type=config.game_type,
+            players={
+                color: tuple(p.number for p in config.team(color).players)
+                for color in (TeamColor.RED, TeamColor.BLUE)
+            },
+            kickoff=config.kickoff,
+            timing=config.timing,
+            goalkeepers={c: n for c, n in keepers.items() if n is not None},
+        )
+        self.left_team = config.side_left
+        self.events: list[RefereeEvent] = []
+        self.limp: set[RobotId] = set()
+        self.red_carded: set[RobotId] = set()
+        self._started = False
+        self._last_ms: int | None = None
+        self._wait_until_s: float | None = None
+        self._after_wait: Action | None = None
+        self._finished = False
+        self._winner: TeamColor | None = None
+        self._coin_toss = False
+        self._set_since_ms: int | None = None
+        self._shootout: Shootout | None = None
+        self.ball_in_play = False
+        self.reset_memories()
+        self._network: GameControllerNetwork | None = None
+        self._mirror: TeamMirror | None = None
+        self._packet_number = 0
+        self._signature: tuple[object, ...] = ()
+        self._published_real_s = float("-inf")
+        self._status_real_s = self._clock.monotonic()
+        self._status_sim_ms = 0
+
+    # --- public surface ------------------------------------------------------------------
+
+    @property
+    def finished(self) -> bool:
+        return self._finished
+
+    @property
+    def waiting_for_wall_clock(self) -> bool:
+        return self._wait_until_s is not None
+
+    @property
+    def game_state(self) -> dict[str, object]:
+        gc = self.gc
+        penalties = {
+            f"{robot.team.value}-{robot.number}": {
+                "penalty": gc.robot(robot).penalty.name,
+                "secs_till_unpenalised": int(round(gc.robot(robot).secs_till_unpenalised)),
+            }
+            for robot in gc.penalised()
+        }
+        return {
+            "state": gc.state.name,
+            "secondary_state": gc.secondary_state.name,
+            "set_play": None
+            if gc.set_play is None
+            else {"team": gc.set_play.team.value, "sub_phase": gc.set_play.sub_phase},
+            "half": gc.half,
+            "phase": gc.phase.name,
+            "secs_remaining": int(round(gc.secs_remaining)),
+            "kickoff": gc.kickoff_team.value if gc.kickoff_team is not None else "dropped_ball",
+            "left_team": self.left_team.value,
+            "score": {"red": gc.score(TeamColor.RED), "blue": gc.score(TeamColor.BLUE)},
+            "penalties": penalties,
+            "waiting_for_wall_clock": self.waiting_for_wall_clock,
+        }
+
+    def result(self) -> dict[str, object]:
+        winner: str | None
+        if not self._finished:
+            winner = None
+        else:
+            winner = self._winner.value if self._winner is not None else "draw"
+        summary = Counter(event.type for event in self.events)
+        result: dict[str, object] = {
+            "state": self.gc.state.name,
+            "score": {"red": self.gc.score(TeamColor.RED), "blue": self.gc.score(TeamColor.BLUE)},
+            "winner": winner,
+            "events_summary": dict(sorted(summary.items())),
+        }
+        if self._shootout is not None:
+            result["shootout"] = {
+                color.value: {
+                    "kicks": self.gc.teams[color].penalty_shots,
+                    "scored": bin(self.gc.teams[color].single_shots).count("1"),
+                }
+                for color in (TeamColor.RED, TeamColor.BLUE)
+            }
+            result["coin_toss"] = self._coin_toss
+        return result
+
+    def start_network(self) -> None:
+        """Start the GameController sender / receiver and the team mirror (UDP)."""
+        net = self.config.network
+        addresses = {
+            color: tuple(self.config.team(color).robot_addresses)
+            for color in (TeamColor.RED, TeamColor.BLUE)
+        }
+        self._network = GameControllerNetwork(
+            bind_host=net.bind_host,
+            data_port=net.gc_data_port,
+            return_port=net.gc_return_port,
+            targets=addresses[TeamColor.RED] + addresses[TeamColor.BLUE],
+            team_numbers={self.config.team(c).team_id: c for c in addresses},
+            send_rate_hz=net.send_rate_hz,
+            clock=self._clock,
+        )
+        self._mirror = TeamMirror(
+            bind_host=net.bind_host,
+            port=net.mirror_port,
+            teams=addresses,
+            max_bytes=net.mirror_max_bytes,
+            log_dir=self._log_dir,
+        )
+        self._network.start()
+        self._mirror.start()
+        self._publish(force=True)
+
+    @property
+    def network(self) -> GameControllerNetwork | None:
+        return self._network
+
+    @property
+    def mirror(self) -> TeamMirror | None:
+        return self._mirror
+
+    def close(self) -> None:
+        sim_ms = self._last_ms or 0
+        if self._network is not None:
+            stats = self._network.stats()
+            self.log.gamecontroller(
+                sim_ms,
+                f"packets sent: {stats.packets_sent} ({stats.datagrams_sent} datagrams), "
+                f"returns received: {stats.returns_received}, garbage: {stats.garbage}",
+            )
+            self._network.close()
+            self._network = None
+        if self._mirror is not None:
+            self._mirror.close()
+            self._mirror = None
+        self.log.close()
+
+    def __enter__(self) -> Referee:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def step(self, snapshot: WorldSnapshot) -> list[WorldCommand]:
+        commands: list[WorldCommand] = []
+        now = snapshot.sim_time_ms
+        if not self._started:
+            commands += self._start(snapshot)
+        dt_s = 0.0 if self._last_ms is None else max(0, now - self._last_ms) / 1000.0
+        self._last_ms = now
+        self._status(snapshot)
+        self._goalkeeper_claims()
+        if self._finished:
+            return commands
+        if self._wait_until_s is not None:
+            if self._clock.monotonic() < self._wait_until_s:
+                self._publish()
+                return commands
+            action, self._after_wait, self._wait_until_s = self._after_wait, None, None
+            if action is not None:
+                commands += action(snapshot)
+        tick = self.gc.advance(dt_s)
+        commands += self._on_tick(tick, snapshot)
+        if not self._finished and self._wait_until_s is None:
+            if self.gc.phase is SecondaryState.PENALTYSHOOT:
+                commands += self._shootout_step(snapshot)
+            else:
+                commands += self._play_step(snapshot)
+        self._publish()
+        return commands
+
+    # --- flow ----------------------------------------------------------------------------
+
+    def reset_memories(self) -> None:
+        self.goal_memory = goal.GoalMemory()
+        self.in_play_memory = ball_in_play.BallInPlayMemory()
+        self.fallen_memory = fallen.FallenMemory()
+        self.turf_memory = outside_turf.OutsideTurfMemory()
+        self.holding_memory = ball_holding.BallHoldingMemory()
+        self.pushing_memory = pushing.PushingMemory()
+        self.keeper_memory = goalkeeper.GoalkeeperMemory()
+        self.dropped_memory = dropped_ball.DroppedBallMemory()
+
+    def view(self) -> GameView:
+        gc = self.gc
+        keepers = frozenset(
+            RobotId(color, n)
+            for color in (TeamColor.RED, TeamColor.BLUE)
+            if (n := gc.goalkeeper(color)) is not None
+        )
+        return GameView(
+            state=gc.state,
+            phase=gc.phase,
+            set_play=gc.set_play,
+            half=gc.half,
+            kickoff_team=gc.kickoff_team,
+            left_team=self.left_team,
+            ball_in_play=self.ball_in_play,
+            penalised=frozenset(gc.penalised()),
+            goalkeepers=keepers,
+            field=self.field,
+            timing=self.config.timing,
+        )
+
+    def pose_on_side(self, team: TeamColor, pose: Pose) -> Pose:
+        return pose if team is self.left_team else pose.mirrored()
+
+    def ball_at(self, x_m: float, y_m: float) -> PlaceBall:
+        return PlaceBall(position=(x_m, y_m, self.field.ball_radius_m))
+
+    def emit(self, event: RefereeEvent) -> None:
+        self.events.append(event)
+        self.log.event(event)
+
+    def _wait(self, seconds: float, action: Action, why: str, sim_ms: int) -> None:
+        self._wait_until_s = self._clock.monotonic() + seconds
+        self._after_wait = action
+        self.log.info(sim_ms, f"Waiting {seconds:g} s of real time {why}.")
+
+    def _start(self, snapshot: WorldSnapshot) -> list[WorldCommand]:
+        self._started = True
+        self.reset_memories()
+        cfg = self.config
+        self.log.info(
+            snapshot.sim_time_ms,
+            f"Game type {cfg.game_type.value}, {cfg.field_class.value} field: "
+            f"red {cfg.red.name} ({cfg.red.team_id}) vs blue {cfg.blue.name} ({cfg.blue.team_id}),"
+            f" {self.left_team.value} on the left, kick-off {cfg.kickoff.value}.",
+        )
+        commands = self._starting_positions()
+        if cfg.game_type.value == "PENALTY":
+            self._wait(cfg.timing.wait_before_first_ready_real_s, self._begin_shootout,
+                       "before the penalty shoot-out", snapshot.sim_time_ms)
+        else:
+            self._wait(cfg.timing.wait_before_first_ready_real_s, self._to_ready,
+                       "before the first READY", snapshot.sim_time_ms)
+        return commands
+
+    def _starting_positions(self) -> list[WorldCommand]:
+        commands: list[WorldCommand] = []
+        for color in (TeamColor.RED, TeamColor.BLUE):
+            for player in self.config.team(color).players:
+                robot = RobotId(color, player.number)
+                if robot in self.red_carded:
+                    continue
+                pose = self.pose_on_side(color, player.half_time_pose)
+                commands.append(
+                    TeleportRobot(robot=robot, x_m=pose.x_m, y_m=pose.y_m, yaw_rad=pose.yaw_rad)
+                )
+                if robot in self.limp:
+                    commands.append(SetLimp(robot=robot, limp=False))
+        self.limp.clear()
+        commands.append(self.ball_at(0.0, 0.0))
+        return commands
+
+    def _to_ready(self, snapshot: WorldSnapshot) -> list[WorldCommand]:
+        self.gc.transition(GameState.READY)
+        self.state_event(snapshot, "READY")
+        return []
+
+    def state_event(self, snapshot: WorldSnapshot, what: str, **details: object) -> None:
+        gc = self.gc
+        kick = gc.kickoff_team.value if gc.kickoff_team is not None else "dropped ball"
+        self.log.info(snapshot.sim_time_ms, f"State {what} (half {gc.half}, kick-off {kick}).")
+        self.emit(
+            RefereeEvent(
+                sim_time_ms=snapshot.sim_time_ms, type="state", team=gc.kickoff_team,
+                reason=what, details={"half": gc.half, "phase": gc.phase.name, **details},
+            )
+        )
+
+    def _on_tick(self, tick: Tick, snapshot: WorldSnapshot) -> list[WorldCommand]:
+        commands: list[WorldCommand] = []
+        now = snapshot.sim_time_ms
+        for robot in tick.unpenalised:
+            if robot in self.limp:
+                self.limp.discard(robot)
+                commands.append(SetLimp(robot=robot, limp=False))
+            self.log.info(now, f"Penalty of {robot} is over.")
+            self.emit(RefereeEvent(sim_time_ms=now, type="unpenalised", team=robot.team,
+                                   player=robot.number))
+        if tick.auto_set:
+            self._set_since_ms = now
+            self.state_event(snapshot, "SET")
+            commands += self._apply(kickoff.judge_set(snapshot, self.view()), snapshot)
+        if tick.set_play_phase is not None and self.gc.set_play is not None:
+            play = self.gc.set_play
+            self.log.info(now, f"{play.kind.name} for {play.team.value}: phase {play.sub_phase}.")
+        if tick.set_play_executed is not None:
+            play = tick.set_play_executed
+            self.log.info(now, f"{play.kind.name} for {play.team.value}: execute.")
+            self.in_play_memory = ball_in_play.arm(snapshot)
+            restriction = {
+                SecondaryState.THROW_IN: goal.Restriction.THROW_IN,
+                SecondaryState.INDIRECT_FREEKICK: goal.Restriction.INDIRECT_FREE_KICK,
+            }.get(play.kind)
+            self.goal_memory = goal.restart(restriction)
+        if tick.period_over and self.gc.phase is not SecondaryState.PENALTYSHOOT:
+            commands += self._end_period(snapshot)
+        return commands
+
+    def _play_step(self, snapshot: WorldSnapshot) -> list[WorldCommand]:
+        gc = self.gc
+        now = snapshot.sim_time_ms
+        commands: list[WorldCommand] = []
+        if gc.state is GameState.SET and self._set_since_ms is not None:
+            if now - self._set_since_ms >= self.config.timing.set_to_play_s * 1000.0:
+                gc.transition(GameState.PLAYING)
+                self._set_since_ms = None
+                self.ball_in_play = False
+                self.in_play_memory = ball_in_play.arm(snapshot)
+                restriction = goal.Restriction.KICKOFF if gc.kickoff_team is not None else None
+                self.goal_memory = goal.restart(restriction)
+                self.state_event(snapshot, "PLAYING")
+        if gc.state not in (GameState.READY, GameState.SET, GameState.PLAYING):
+            return commands
+        decisions: list[Decision] = []
+        view = self.view()
+        found, self.in_play_memory = ball_in_play.judge(snapshot, view, self.in_play_memory)
+        decisions += found
+        found, self.goal_memory = goal.judge(snapshot, view, self.goal_memory)
+        decisions += found or judge_ball_out(snapshot, view)
+        decisions += kickoff.judge_before_in_play(snapshot, view)
+        found, self.fallen_memory = fallen.judge(snapshot, view, self.fallen_memory)
+        decisions += found
+        found, self.turf_memory = outside_turf.judge(snapshot, view, self.turf_memory)
+        decisions += found
+        found, self.holding_memory = ball_holding.judge(snapshot, view, self.holding_memory)
+        decisions += found
+        found, self.pushing_memory = pushing.judge(snapshot, view, self.pushing_memory)
+        decisions += found
+        found, self.keeper_memory = goalkeeper.judge(snapshot, view, self.keeper_memory)
+        decisions += found
+        found, self.dropped_memory = dropped_ball.judge(snapshot, view, self.dropped_memory)
+        decisions += found
+        return commands + self._apply(decisions, snapshot)
+
+    def _apply(self, decisions: list[Decision], snapshot: WorldSnapshot) -> list[WorldCommand]:
+        return apply_decisions(self, decisions, snapshot) if decisions else []
+
+    def _end_period(self, snapshot: WorldSnapshot) -> list[WorldCommand]:
+        gc = self.gc
+        if gc.state is not GameState.FINISHED:
+            gc.transition(GameState.FINISHED)
+        score = {c: gc.score(c) for c in (TeamColor.RED, TeamColor.BLUE)}
+        following = end_of_game.after_period(
+            game_type=self.config.game_type, phase=gc.phase, half=gc.half, score=score
+        )
+        self.ball_in_play = False
+        self._set_since_ms = None
+        self.state_event(snapshot, "FINISHED", next=following.value)
+        commands: list[WorldCommand] = [
+            SetLimp(robot=r, limp=False) for r in sorted(self.limp, key=str)
+        ]
+        self.limp.clear()
+        if following is end_of_game.Next.FINISHED:
+            self._finish(snapshot, end_of_game.winner(score))
+        else:
+            self._wait(self.config.timing.half_time_break_real_s, self._next_period,
+                       f"before the {following.value}", snapshot.sim_time_ms)
+        return commands
+
+    def _next_period(self, snapshot: WorldSnapshot) -> list[WorldCommand]:
+        phase = self.gc.next_period()
+        self.reset_memories()
+        if phase is SecondaryState.PENALTYSHOOT:
+            return self._begin_shootout(snapshot)
+        self.left_team = self.left_team.opponent
+        self.log.info(snapshot.sim_time_ms, f"Sides changed: {self.left_team.value} on the left.")
+        commands = self._starting_positions()
+        self.gc.transition(GameState.READY)
+        self.state_event(snapshot, "READY")
+        return commands
+
+    def _finish(self, snapshot: WorldSnapshot, winner: TeamColor | None) -> None:
+        self._finished = True
+        self._winner = winner
+        red, blue = self.gc.score(TeamColor.RED), self.gc.score(TeamColor.BLUE)
+        self.log.info(snapshot.sim_time_ms, f"FINAL SCORE: {red}-{blue}")
+        if winner is None:
+            self.log.info(snapshot.sim_time_ms, "The game ended in a draw.")
+        else:
+            self.log.info(snapshot.sim_time_ms, f"The winner is the {winner.value} team.")
+        self.emit(
+            RefereeEvent(
+                sim_time_ms=snapshot.sim_time_ms, type="game_over", team=winner,
+                reason="draw" if winner is None else "winner",
+                details={"score": {"red": red, "blue": blue}, "coin_toss": self._coin_toss},
+            )
+        )
+
+    # --- penalty shoot-out ---------------------------------------------------------------
+
+    def _begin_shootout(self, snapshot: WorldSnapshot) -> list[WorldCommand]:
+        self._shootout = Shootout(config=self.config, first=self.config.kickoff)
+        self.log.info(snapshot.sim_time_ms, "Penalty shoot-out begins.")
+        return self._setup_kick(snapshot)
+
+    def _setup_kick(self, snapshot: WorldSnapshot) -> list[WorldCommand]:
+        assert self._shootout is not None
+        shootout = self._shootout
+        self.left_team = shootout.attacker
+        self.gc.kickoff_team = shootout.attacker
+        self.gc.secs_remaining = self.config.timing.shootout_kick_s
+        self.gc.transition(GameState.SET)
+        self._set_since_ms = snapshot.sim_time_ms
+        commands: list[WorldCommand] = [
+            SetLimp(robot=r, limp=False) for r in sorted(self.limp, key=str)
+        ]
+        self.limp.clear()
+        commands += shootout.setup_kick(snapshot, self.red_carded)
+        self.state_event(snapshot, "SET", kicker=str(shootout.kicker))
+        return commands
+
+    def _shootout_step(self, snapshot: WorldSnapshot) -> list[WorldCommand]:
+        if self._shootout is None:
+            return []
+        gc = self.gc
+        now = snapshot.sim_time_ms
+        if gc.state is GameState.SET and self._set_since_ms is not None:
+            if now - self._set_since_ms >= self.config.timing.shootout_set_to_play_s * 1000.0:
+                gc.transition(GameState.PLAYING)
+                self._set_since_ms = None
+                self.state_event(snapshot, "PLAYING")
+            return []
+        if gc.state is not GameState.PLAYING:
+            return []
+        outcome = self._shootout.judge(snapshot, gc.secs_remaining)
+        if outcome is None:
+            return []
+        gc.shootout_kick(outcome.team, outcome.scored)
+        kicks = gc.teams[outcome.team].penalty_shots
+        verdict = "scored" if outcome.scored else f"missed ({outcome.reason})"
+        self.log.info(now, f"Penalty shoot-out: {outcome.kicker} kick {kicks} {verdict}.")
+        self.emit(
+            RefereeEvent(
+                sim_time_ms=now, type="shootout_kick", team=outcome.team,
+                player=outcome.kicker.number, reason=outcome.reason,
+                details={"scored": outcome.scored, "kick": kicks},
+            )
+        )
+        status = end_of_game.shootout_status(
+            taken={c: gc.teams[c].penalty_shots for c in (TeamColor.RED, TeamColor.BLUE)},
+            scored={
+                c: bin(gc.teams[c].single_shots).count("1")
+                for c in (TeamColor.RED, TeamColor.BLUE)
+            },
+            seed=self.config.seed,
+        )
+        if status.decided:
+            gc.transition(GameState.FINISHED)
+            self._coin_toss = status.coin_toss
+            self._finish(snapshot, status.winner)
+            return []
+        self._shootout.attacker = self._shootout.attacker.opponent
+        return self._setup_kick(snapshot)
+
+    # --- outputs -------------------------------------------------------------------------
+
+    def _goalkeeper_claims(self) -> None:
+        if self._network is None:
+            return
+        for robot in self._network.take_goalkeeper_claims():
+            if robot.number in self.gc.teams[robot.team].robots:
+                self.gc.set_goalkeeper(robot)
+                self.log.info(self._last_ms or 0, f"{robot} declared itself goalkeeper.")
+
+    def _publish(self, *, force: bool = False) -> None:
+        gc = self.gc
+        signature = (
+            gc.state, gc.secondary_state, gc.set_play, gc.half, gc.kickoff_team,
+            gc.score(TeamColor.RED), gc.score(TeamColor.BLUE), gc.penalised(),
+        )
+        changed = signature != self._signature
+        if changed:
+            self._signature = signature
+            self.log.gamecontroller(
+                self._last_ms or 0,
+                f"state {gc.state.name} secondary {gc.secondary_state.name} half {gc.half} "
+                f"score red {signature[5]} blue {signature[6]} penalised "
+                f"{[str(r) for r in signature[7]]}",
+            )
+        if self._network is None:
+            return
+        real = self._clock.monotonic()
+        if changed or force or real - self._published_real_s >= PUBLISH_PERIOD_REAL_S:
+            self._published_real_s = real
+            self._network.publish(self.packet(), changed=changed or force)
+
+    def packet(self) -> bytes:
+        """The current ``RGme`` datagram (each call takes the next packet number)."""
+        self._packet_number = (self._packet_number + 1) & 0xFF
+        data = game_control_data(
+            self.gc,
+            team_numbers={c: self.config.team(c).team_id for c in (TeamColor.RED, TeamColor.BLUE)},
+            players_per_team=self.field.players_per_team,
+            packet_number=self._packet_number,
+        )
+        return encode_game_state(data)
+
+    def _status(self, snapshot: WorldSnapshot) -> None:
+        real = self._clock.monotonic()
+        period = self.config.timing.status_period_real_s
+        if real - self._status_real_s < period:
+            return
+        elapsed = real - self._status_real_s
+        factor = (snapshot.sim_time_ms - self._status_sim_ms) / 1000.0 / elapsed
+        self.log.info(
+            snapshot.sim_time_ms,
+            f"STATUS: Avg speed factor: {factor:.3f} (over last {elapsed:.2f} seconds)",
+        )
+        self.log.info(
+            snapshot.sim_time_ms,
+            f"STATUS: state: STATE_{self.gc.state.name}, remaining time: "
+            f"{int(round(self.gc.secs_remaining))}",
+        )
+        self._status_real_s = real
+        self._status_sim_ms = snapshot.sim_time_ms
+

@@ -1,0 +1,188 @@
+"""Applying the rules' decisions: GameController updates, world commands, log lines, events.
+
+At most one game stoppage (goal, set play, dropped ball) is applied per step, the first in rule
+order; removals and cards are all applied, each robot at most once.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+from referee.config import RefereeConfig
+from referee.field import FieldGeometry
+from referee.gamecontroller import Card, GameController, GameState, Penalty
+from referee.logs import RefereeLog
+from referee.rules import removal
+from referee.rules.base import (
+    AwardSetPlay,
+    BallInPlay,
+    Decision,
+    DropBall,
+    GiveCard,
+    Goal,
+    PenalizeRobot,
+)
+from referee.snapshot import (
+    PlaceBall,
+    RefereeEvent,
+    RobotId,
+    TeamColor,
+    Vec2,
+    WorldCommand,
+    WorldSnapshot,
+)
+
+PENALTY_NAMES = {
+    Penalty.PICKUP_OR_INCAPABLE: "INCAPABLE",
+    Penalty.PHYSICAL_CONTACT: "PHYSICAL_CONTACT",
+    Penalty.BALL_MANIPULATION: "BALL_MANIPULATION",
+}
+
+
+class RefereeCore(Protocol):
+    config: RefereeConfig
+    field: FieldGeometry
+    gc: GameController
+    log: RefereeLog
+    limp: set[RobotId]
+    red_carded: set[RobotId]
+    ball_in_play: bool
+    left_team: TeamColor
+
+    def emit(self, event: RefereeEvent) -> None: ...
+
+    def ball_at(self, x_m: float, y_m: float) -> PlaceBall: ...
+
+    def state_event(self, snapshot: WorldSnapshot, what: str, **details: object) -> None: ...
+
+
+def apply_decisions(
+    ref: RefereeCore, decisions: list[Decision], snapshot: WorldSnapshot
+) -> list[WorldCommand]:
+    commands: list[WorldCommand] = []
+    stopped = False
+    occupied: list[Vec2] = [(r.position[0], r.position[1]) for r in snapshot.robots]
+    for decision in decisions:
+        if isinstance(decision, BallInPlay):
+            if not ref.ball_in_play:
+                ref.ball_in_play = True
+                ref.log.info(snapshot.sim_time_ms, f"Ball in play: {decision.reason}.")
+                ref.emit(RefereeEvent(sim_time_ms=snapshot.sim_time_ms, type="ball_in_play",
+                                      reason=decision.reason))
+        elif isinstance(decision, PenalizeRobot):
+            commands += _penalize(ref, decision, snapshot, occupied)
+        elif isinstance(decision, GiveCard):
+            commands += _card(ref, decision, snapshot)
+        elif stopped or ref.gc.state is not GameState.PLAYING:
+            continue
+        elif isinstance(decision, Goal):
+            stopped = True
+            commands += _goal(ref, decision, snapshot)
+        elif isinstance(decision, AwardSetPlay):
+            stopped = True
+            commands += _set_play(ref, decision, snapshot)
+        elif isinstance(decision, DropBall):
+            stopped = True
+            ref.gc.dropped_ball()
+            ref.ball_in_play = False
+            ref.log.info(snapshot.sim_time_ms, f"Dropped ball: {decision.reason}.")
+            ref.emit(RefereeEvent(sim_time_ms=snapshot.sim_time_ms, type="dropped_ball",
+                                  reason=decision.reason, placement=(0.0, 0.0, 0.0)))
+            ref.state_event(snapshot, "READY")
+            commands.append(ref.ball_at(0.0, 0.0))
+    return commands
+
+
+def _goal(ref: RefereeCore, goal: Goal, snapshot: WorldSnapshot) -> list[WorldCommand]:
+    defending = goal.scoring.opponent
+    ref.gc.goal(goal.scoring)
+    ref.ball_in_play = False
+    by = f" by {goal.scorer}" if goal.scorer is not None else ""
+    own = " (own goal)" if goal.own_goal else ""
+    ref.log.info(snapshot.sim_time_ms, f"Score in {defending.value} goal{by}{own}")
+    ref.emit(
+        RefereeEvent(
+            sim_time_ms=snapshot.sim_time_ms, type="goal", team=goal.scoring,
+            player=goal.scorer.number if goal.scorer is not None else None,
+            reason="own goal" if goal.own_goal else "goal",
+            placement=snapshot.ball.position,
+            details={
+                "own_goal": goal.own_goal,
+                "scorer_team": goal.scorer.team.value if goal.scorer is not None else None,
+                "score": {"red": ref.gc.score(TeamColor.RED), "blue": ref.gc.score(TeamColor.BLUE)},
+            },
+        )
+    )
+    ref.state_event(snapshot, "READY")
+    return [ref.ball_at(0.0, 0.0)]
+
+
+def _set_play(ref: RefereeCore, play: AwardSetPlay, snapshot: WorldSnapshot) -> list[WorldCommand]:
+    ref.gc.begin_set_play(play.kind, play.team)
+    ref.ball_in_play = False
+    x, y = play.position
+    ref.log.info(
+        snapshot.sim_time_ms,
+        f"{play.kind.name} for the {play.team.value} team at ({x:.2f}, {y:.2f}): {play.reason}.",
+    )
+    ref.emit(
+        RefereeEvent(
+            sim_time_ms=snapshot.sim_time_ms, type=play.kind.name.lower(), team=play.team,
+            reason=play.reason, placement=(x, y, ref.field.ball_radius_m),
+        )
+    )
+    return [ref.ball_at(x, y)]
+
+
+def _penalize(
+    ref: RefereeCore, decision: PenalizeRobot, snapshot: WorldSnapshot, occupied: list[Vec2]
+) -> list[WorldCommand]:
+    robot = decision.robot
+    info = ref.gc.robot(robot)
+    if info.penalty is not Penalty.NONE or robot in ref.red_carded:
+        return []
+    ref.gc.penalize(robot, decision.penalty)
+    player = ref.config.team(robot.team).player(robot.number)
+    others = [r.position for r in snapshot.robots if r.id != robot]
+    taken = [(p[0], p[1]) for p in others] + occupied[len(snapshot.robots) :]
+    pose = removal.reentry_pose(
+        template=player.reentry_pose,
+        side_sign=-1.0 if robot.team is ref.left_team else 1.0,
+        ball_y_m=snapshot.ball.position[1],
+        occupied=taken,
+        field=ref.field,
+    )
+    occupied.append((pose.x_m, pose.y_m))
+    ref.limp.add(robot)
+    name = PENALTY_NAMES.get(decision.penalty, decision.penalty.name)
+    ref.log.info(snapshot.sim_time_ms, f"{name} penalty for {robot}: {decision.reason}.")
+    ref.emit(
+        RefereeEvent(
+            sim_time_ms=snapshot.sim_time_ms, type="penalty", team=robot.team,
+            player=robot.number, reason=decision.reason,
+            placement=(pose.x_m, pose.y_m, 0.0),
+            details={"penalty": decision.penalty.name, "code": int(decision.penalty),
+                     "seconds": ref.config.timing.removal_penalty_s},
+        )
+    )
+    return removal.removal_commands(robot, pose)
+
+
+def _card(ref: RefereeCore, decision: GiveCard, snapshot: WorldSnapshot) -> list[WorldCommand]:
+    robot = decision.robot
+    if robot in ref.red_carded:
+        return []
+    given = ref.gc.card(robot, decision.card)
+    ref.log.info(snapshot.sim_time_ms, f"{given.value.capitalize()} card for {robot}: "
+                 f"{decision.reason}.")
+    ref.emit(
+        RefereeEvent(
+            sim_time_ms=snapshot.sim_time_ms, type="card", team=robot.team, player=robot.number,
+            reason=decision.reason, details={"card": given.value},
+        )
+    )
+    if given is not Card.RED:
+        return []
+    ref.red_carded.add(robot)
+    ref.limp.discard(robot)
+    return removal.red_card_commands(robot)

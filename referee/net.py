@@ -1,0 +1,198 @@
+"""GameController network: ``RGme`` to every robot on UDP 3838, ``RGrt`` from robots on 3939.
+
+One background thread sends the latest packet to every robot address at 2 Hz (configurable)
+and immediately when the game state changed, and receives return packets: per robot it tracks
+the last alive time (wall clock), goalkeeper claims, manual penalise / unpenalise requests and
+game-interruption-ready messages. Datagrams that do not decode are ignored and counted.
+"""
+
+from __future__ import annotations
+
+import logging
+import selectors
+import socket
+import threading
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+from referee.clock import Clock
+from referee.errors import ProtocolError
+from referee.snapshot import RobotId, TeamColor
+from referee.wire import ReturnMessage, decode_return
+
+logger = logging.getLogger(__name__)
+
+
+@dataclass(slots=True)
+class RobotLink:
+    """What one robot told the GameController (times from the wall clock)."""
+
+    address: str | None = None
+    alive_s: float | None = None
+    messages: int = 0
+    goalkeeper_claim: bool = False
+    manual_penalise: int = 0
+    manual_unpenalise: int = 0
+    ready_s: float | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class NetworkStats:
+    packets_sent: int
+    datagrams_sent: int
+    returns_received: int
+    garbage: int
+    unknown: int
+
+
+class GameControllerNetwork:
+    def __init__(
+        self,
+        *,
+        bind_host: str,
+        data_port: int,
+        return_port: int,
+        targets: Sequence[str],
+        team_numbers: dict[int, TeamColor],
+        send_rate_hz: float,
+        clock: Clock,
+    ) -> None:
+        self._targets = tuple(targets)
+        self._data_port = data_port
+        self._team_numbers = dict(team_numbers)
+        self._period_s = 1.0 / send_rate_hz
+        self._clock = clock
+        self._lock = threading.Lock()
+        self._packet: bytes | None = None
+        self._changed = threading.Event()
+        self._stop = threading.Event()
+        self._links: dict[RobotId, RobotLink] = {}
+        self._claims: list[RobotId] = []
+        self._packets_sent = 0
+        self._datagrams_sent = 0
+        self._returns = 0
+        self._garbage = 0
+        self._unknown = 0
+        self._send = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self._recv = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self._recv.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        self._recv.bind((bind_host, return_port))
+        self._recv.setblocking(False)
+        self.return_address: tuple[str, int] = self._recv.getsockname()
+        self._thread = threading.Thread(target=self._run, name="gamecontroller-net", daemon=True)
+
+    def start(self) -> None:
+        self._thread.start()
+
+    def close(self) -> None:
+        self._stop.set()
+        self._changed.set()
+        if self._thread.is_alive():
+            self._thread.join(timeout=5.0)
+        self._send.close()
+        self._recv.close()
+
+    def __enter__(self) -> GameControllerNetwork:
+        self.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def publish(self, packet: bytes, *, changed: bool) -> None:
+        with self._lock:
+            self._packet = packet
+        if changed:
+            self._changed.set()
+
+    def links(self) -> dict[RobotId, RobotLink]:
+        with self._lock:
+            return {robot: replace(link) for robot, link in self._links.items()}
+
+    def take_goalkeeper_claims(self) -> list[RobotId]:
+        with self._lock:
+            claims, self._claims = self._claims, []
+        return claims
+
+    def stats(self) -> NetworkStats:
+        with self._lock:
+            return NetworkStats(
+                self._packets_sent, self._datagrams_sent, self._returns, self._garbage,
+                self._unknown,
+            )
+
+    # --- thread ----------------------------------------------------------------------------
+
+    def _run(self) -> None:
+        selector = selectors.DefaultSelector()
+        selector.register(self._recv, selectors.EVENT_READ)
+        next_send = self._clock.monotonic()
+        try:
+            while not self._stop.is_set():
+                now = self._clock.monotonic()
+                if now >= next_send or self._changed.is_set():
+                    self._changed.clear()
+                    self._send_packet()
+                    next_send = now + self._period_s
+                timeout = max(0.0, min(0.02, next_send - self._clock.monotonic()))
+                if selector.select(timeout):
+                    self._receive_all()
+        finally:
+            selector.close()
+
+    def _send_packet(self) -> None:
+        with self._lock:
+            packet = self._packet
+        if packet is None:
+            return
+        sent = 0
+        for address in self._targets:
+            try:
+                self._send.sendto(packet, (address, self._data_port))
+                sent += 1
+            except OSError as exc:
+                logger.debug("RGme to %s:%d failed: %s", address, self._data_port, exc)
+        with self._lock:
+            self._packets_sent += 1
+            self._datagrams_sent += sent
+
+    def _receive_all(self) -> None:
+        while True:
+            try:
+                raw, (host, port) = self._recv.recvfrom(2048)
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError as exc:
+                logger.debug("RGrt receive failed: %s", exc)
+                return
+            self._handle(raw, f"{host}:{port}", host)
+
+    def _handle(self, raw: bytes, peer: str, host: str) -> None:
+        try:
+            data = decode_return(raw, peer=peer)
+        except ProtocolError as exc:
+            with self._lock:
+                self._garbage += 1
+            logger.debug("ignored datagram: %s", exc)
+            return
+        color = self._team_numbers.get(data.team)
+        with self._lock:
+            if color is None:
+                self._unknown += 1
+                return
+            self._returns += 1
+            robot = RobotId(color, data.player)
+            link = self._links.setdefault(robot, RobotLink())
+            now = self._clock.monotonic()
+            link.address = host
+            link.alive_s = now
+            link.messages += 1
+            if data.message is ReturnMessage.GOALKEEPER and not link.goalkeeper_claim:
+                link.goalkeeper_claim = True
+                self._claims.append(robot)
+            elif data.message is ReturnMessage.MAN_PENALISE:
+                link.manual_penalise += 1
+            elif data.message is ReturnMessage.MAN_UNPENALISE:
+                link.manual_unpenalise += 1
+            elif data.message is ReturnMessage.GAME_INTERRUPTION_READY:
+                link.ready_s = now
