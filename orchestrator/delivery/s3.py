@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import logging
 from pathlib import Path
+from typing import Any
 
 import boto3
 import botocore.config
@@ -20,7 +21,7 @@ from boto3.s3.transfer import TransferConfig
 from orchestrator.config.credentials import S3Credentials
 from orchestrator.errors import DeliveryError
 
-__all__ = ["S3Uploader"]
+__all__ = ["S3Uploader", "create_bucket"]
 
 log = logging.getLogger(__name__)
 
@@ -44,7 +45,7 @@ _BUCKET_CODES = frozenset({"NoSuchBucket", "404", "NotFound", "InvalidBucketName
 class S3Uploader:
     """A boto3 S3 client bound to one bucket and prefix; use :meth:`connect`."""
 
-    def __init__(self, *, client: object, credentials: S3Credentials, team: str) -> None:
+    def __init__(self, *, client: Any, credentials: S3Credentials, team: str) -> None:
         self._client = client
         self._credentials = credentials
         self._team = team
@@ -60,20 +61,7 @@ class S3Uploader:
 
     @classmethod
     def connect(cls, credentials: S3Credentials, *, team: str) -> S3Uploader:
-        config = botocore.config.Config(
-            connect_timeout=CONNECT_TIMEOUT_S,
-            read_timeout=READ_TIMEOUT_S,
-            retries={"total_max_attempts": 1},  # deliver.py retries with its own backoff
-            s3={"addressing_style": "path" if credentials.endpoint_url else "auto"},
-        )
-        client = boto3.client(
-            "s3",
-            aws_access_key_id=credentials.access_id,
-            aws_secret_access_key=credentials.access_secret,
-            region_name=credentials.region,
-            endpoint_url=credentials.endpoint_url,
-            config=config,
-        )
+        client = _client(credentials)
         uploader = cls(client=client, credentials=credentials, team=team)
         uploader._check_bucket()
         log.info("team %s: connected to %s", team, uploader.target)
@@ -82,7 +70,7 @@ class S3Uploader:
     def upload(self, local_path: Path, remote_rel_path: str) -> None:
         key = self._key(remote_rel_path)
         try:
-            self._client.upload_file(  # type: ignore[attr-defined]
+            self._client.upload_file(
                 str(local_path), self._credentials.bucket, key, Config=self._transfer
             )
         except S3UploadFailedError as exc:
@@ -94,9 +82,7 @@ class S3Uploader:
     def exists(self, remote_rel_path: str, size: int) -> bool:
         key = self._key(remote_rel_path)
         try:
-            head = self._client.head_object(  # type: ignore[attr-defined]
-                Bucket=self._credentials.bucket, Key=key
-            )
+            head = self._client.head_object(Bucket=self._credentials.bucket, Key=key)
         except botocore.exceptions.ClientError as exc:
             if _code(exc) in _BUCKET_CODES | _DENIED_CODES:
                 return False  # missing, or we may not look: upload it (again)
@@ -106,7 +92,7 @@ class S3Uploader:
         return int(head.get("ContentLength", -1)) == size
 
     def close(self) -> None:
-        self._client.close()  # type: ignore[attr-defined]
+        self._client.close()
 
     def _key(self, remote_rel_path: str) -> str:
         prefix = self._credentials.prefix
@@ -114,7 +100,7 @@ class S3Uploader:
 
     def _check_bucket(self) -> None:
         try:
-            self._client.head_bucket(Bucket=self._credentials.bucket)  # type: ignore[attr-defined]
+            self._client.head_bucket(Bucket=self._credentials.bucket)
         except botocore.exceptions.ClientError as exc:
             if _code(exc) in _DENIED_CODES:
                 return  # a PutObject-only account may not look at the bucket
@@ -144,6 +130,33 @@ class S3Uploader:
             elif 400 <= status < 500:
                 kind, reason = "path", f"{where} was refused: {code} {exc}"
         return DeliveryError(team=self._team, target=self.target, kind=kind, reason=reason)
+
+
+def create_bucket(credentials: S3Credentials) -> None:
+    """Create the bucket of ``credentials`` (for local test servers and the benchmark)."""
+    client = _client(credentials)
+    try:
+        client.create_bucket(Bucket=credentials.bucket)
+    finally:
+        client.close()
+
+
+def _client(credentials: S3Credentials) -> Any:
+    config = botocore.config.Config(
+        connect_timeout=CONNECT_TIMEOUT_S,
+        read_timeout=READ_TIMEOUT_S,
+        retries={"total_max_attempts": 1},  # deliver.py retries with its own backoff
+        s3={"addressing_style": "path" if credentials.endpoint_url else "auto"},
+        max_pool_connections=16,
+    )
+    return boto3.client(
+        "s3",
+        aws_access_key_id=credentials.access_id,
+        aws_secret_access_key=credentials.access_secret,
+        region_name=credentials.region,
+        endpoint_url=credentials.endpoint_url,
+        config=config,
+    )
 
 
 def _code(exc: botocore.exceptions.ClientError) -> str:

@@ -139,13 +139,21 @@ class SftpUploader:
             self._mkdir_p(posixpath.dirname(folder))
             try:
                 self._client.mkdir(folder)
-            except OSError:
-                if not stat.S_ISDIR(self._client.stat(folder).st_mode or 0):
-                    raise
+            except OSError as exc:
+                if not self._is_dir(folder):  # not created meanwhile by someone else
+                    raise PermissionError(
+                        exc.errno or errno.EACCES, f"cannot create folder: {exc}", folder
+                    ) from exc
         else:
             if not stat.S_ISDIR(attributes.st_mode or 0):
                 raise NotADirectoryError(errno.ENOTDIR, "not a folder", folder)
         self._made.add(folder)
+
+    def _is_dir(self, folder: str) -> bool:
+        try:
+            return stat.S_ISDIR(self._client.stat(folder).st_mode or 0)
+        except FileNotFoundError:
+            return False
 
     def _remove_if_present(self, remote: str) -> None:
         try:
