@@ -20,7 +20,11 @@ def read_text(path: Path) -> str:
         if path.is_dir():
             where.error("", "is a directory", expected="a file")
             raise ConfigError(where.problems)
-        data = path.read_bytes()
+        if path.exists() and not path.is_file():
+            where.error("", "not a regular file", expected="a file")
+            raise ConfigError(where.problems)
+        with path.open("rb") as stream:
+            data = stream.read(MAX_FILE_BYTES + 1)
     except FileNotFoundError:
         where.error("", "file not found")
         raise ConfigError(where.problems) from None
@@ -31,7 +35,7 @@ def read_text(path: Path) -> str:
         where.error("", f"cannot read: {exc.strerror or exc}")
         raise ConfigError(where.problems) from None
     if len(data) > MAX_FILE_BYTES:
-        where.error("", f"file is too large ({len(data)} bytes)", expected="a configuration file")
+        where.error("", "file is too large", expected=f"at most {MAX_FILE_BYTES} bytes")
         raise ConfigError(where.problems)
     if not data.strip():
         where.error("", "file is empty", expected="a JSON object")

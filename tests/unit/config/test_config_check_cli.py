@@ -100,3 +100,9 @@ def test_schedule_file_is_checked(tmp_path: Path, hlvs_check: Any) -> None:
     assert run.code == 2
     assert str(bad) in run.out
     assert "Traceback" not in run.out
+
+
+def test_device_file_is_not_read(hlvs_check: Any) -> None:
+    run = hlvs_check("/dev/zero")
+    assert run.code == 2
+    assert run.out.splitlines() == ["/dev/zero: /: not a regular file (expected a file)"]

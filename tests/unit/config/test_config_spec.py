@@ -30,9 +30,9 @@ def test_round_trip_through_match_spec(example: str) -> None:
     assert spec.timing.half_duration_s == game.timing.half_duration_s
     assert spec.timing.wait_before_first_ready_real_s == game.timing.wait_before_first_ready_s
     for color in ("red", "blue"):
-        team = spec.team(color)  # type: ignore[arg-type]
-        ref = game.team(color)  # type: ignore[arg-type]
-        config = loaded.team(color)  # type: ignore[arg-type]
+        team = spec.team(color)
+        ref = game.team(color)
+        config = loaded.team(color)
         assert team.team_id == ref.team_id
         assert team.robot_addresses == tuple(addresses[color])
         assert set(addresses[color]) <= set(team.hosts)

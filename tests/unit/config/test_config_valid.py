@@ -34,7 +34,7 @@ def test_every_example_loads_for_a_match(path: Path, hlvs_check: Any) -> None:
     loaded = load_game(path, images_required=True)
     assert loaded.warnings == ()
     for color in ("red", "blue"):
-        for player in loaded.team(color).players:  # type: ignore[arg-type]
+        for player in loaded.team(color).players:
             assert player.image and ":" in player.image
     run = hlvs_check(path, "--require-images")
     assert run.code == 0, run.out
