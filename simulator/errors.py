@@ -7,7 +7,9 @@ Tree::
     ├── UnknownModelError    a robot model name we do not ship (lists the known ones)
     ├── PhysicsDivergence    MuJoCo reported instability (carries its warning and the policy)
     ├── ApiError             robot API misuse on the simulator side
-    └── UnknownDeviceError   a device name a robot does not have (world device access)
+    ├── UnknownDeviceError   a device name a robot does not have (world device access)
+    ├── ReplayError          a replay file that cannot be read
+    └── RenderError          a video that could not be produced (ffmpeg missing or failing)
 """
 
 from __future__ import annotations
@@ -53,3 +55,21 @@ class UnknownDeviceError(SimulatorError):
         self.kind = kind
         what = f"{kind} {name!r}" if name else kind
         super().__init__(f"{robot}: no such {what}")
+
+
+class ReplayError(SimulatorError):
+    """A replay file that cannot be read (names the file and what was wrong)."""
+
+    def __init__(self, *, path: str, reason: str) -> None:
+        self.path = path
+        self.reason = reason
+        super().__init__(f"{path}: {reason}")
+
+
+class RenderError(SimulatorError):
+    """A video that could not be produced."""
+
+    def __init__(self, *, output: str, reason: str) -> None:
+        self.output = output
+        self.reason = reason
+        super().__init__(f"{output}: {reason}")

@@ -14,8 +14,8 @@ CIRCLE_SEGMENTS = 48
 
 def _box(name: str, x: float, y: float, half_x: float, half_y: float, yaw: float = 0.0) -> str:
     return (
-        f'<geom name="line:{name}" type="box" pos="{x:.6g} {y:.6g} {LINE_HEIGHT_M}" '
-        f'size="{half_x:.6g} {half_y:.6g} {LINE_HEIGHT_M}" euler="0 0 {yaw:.6g}" '
+        f'<geom name="line:{name}" type="box" pos="{x:.9g} {y:.9g} {LINE_HEIGHT_M}" '
+        f'size="{half_x:.9g} {half_y:.9g} {LINE_HEIGHT_M}" euler="0 0 {yaw:.9g}" '
         f'rgba="{LINE_RGBA}" contype="0" conaffinity="0" group="1" mass="0"/>'
     )
 
@@ -65,7 +65,7 @@ def field_bodies(f: FieldGeometry, *, static_bits: tuple[int, int]) -> str:
     """Turf, lines, lights and the overview camera (children of the world body)."""
     contype, conaffinity = static_bits
     tx, ty = f.turf_half_length_m, f.turf_half_width_m
-    distance = ty + 3.0 * (tx / 5.5)
+    distance = ty + 2.3 * (tx / 5.5)
     height = 0.75 * distance
     norm = math.hypot(distance, height)
     parts = [
@@ -73,7 +73,7 @@ def field_bodies(f: FieldGeometry, *, static_bits: tuple[int, int]) -> str:
         f'friction="{TURF_FRICTION} 0.005 0.0001" priority="1" contype="{contype}" '
         f'conaffinity="{conaffinity}"/>',
         '<light name="sun" directional="true" pos="0 0 10" dir="0.2 0.3 -1" '
-        'diffuse="0.7 0.7 0.7" castshadow="true"/>',
+        'diffuse="0.7 0.7 0.7" castshadow="false"/>',
         '<light name="fill" directional="true" pos="0 0 10" dir="-0.2 -0.3 -1" '
         'diffuse="0.3 0.3 0.3" castshadow="false"/>',
         f'<camera name="overview" pos="0 {-distance:.6g} {height:.6g}" '

@@ -61,7 +61,7 @@ def scene_xml(
 <option timestep="{physics_dt_s!r}" integrator="implicitfast" cone="pyramidal"/>
 <visual>
  <global offwidth="1920" offheight="1080"/>
- <quality shadowsize="2048"/>
+ <quality shadowsize="2048" offsamples="0"/>
  <headlight ambient="0.35 0.35 0.35" diffuse="0.3 0.3 0.3" specular="0 0 0"/>
  <map znear="0.01" zfar="100"/>
 </visual>

@@ -1,0 +1,151 @@
+"""Videos from replays: ``python -m simulator render REPLAY -o match.mp4 [--width --height --fps]``.
+
+The world model is rebuilt from the replay header; each frame's body poses are turned into geom
+poses (no physics) and drawn offscreen from the ``overview`` camera, and the raw RGB frames are
+piped to ffmpeg (libx264, yuv420p). Needs ``MUJOCO_GL=osmesa`` (or ``egl``) without a display.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import os
+import shutil
+import subprocess
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import numpy.typing as npt
+
+from simulator.errors import RenderError, ReplayError
+from simulator.recorder import Replay, load_replay
+
+logger = logging.getLogger(__name__)
+
+Array = npt.NDArray[np.float64]
+
+
+def _quat_to_mat(q: Array) -> Array:
+    """(n, 4) w x y z -> (n, 3, 3) rotation matrices."""
+    q = q / np.linalg.norm(q, axis=1, keepdims=True)
+    w, x, y, z = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    return np.stack(
+        [
+            1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+            2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+            2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y),
+        ],
+        axis=1,
+    ).reshape(-1, 3, 3)  # fmt: skip
+
+
+def _frames_for(replay: Replay, fps: float) -> Iterator[int]:
+    """Index of the replay frame to show for each video frame at ``fps``."""
+    frames = replay.frames
+    if not frames:
+        return
+    end_ms = frames[-1].sim_time_ms
+    k, i = 0, 0
+    while k * 1000.0 / fps <= end_ms + 1e-6:
+        t = k * 1000.0 / fps
+        while i + 1 < len(frames) and frames[i + 1].sim_time_ms <= t + 1e-6:
+            i += 1
+        yield i
+        k += 1
+
+
+def render_video(
+    replay_path: str | Path,
+    output: str | Path,
+    *,
+    width: int = 1280,
+    height: int = 720,
+    fps: float = 25.0,
+) -> Path:
+    """Render a replay file to an MP4 video; returns the output path."""
+    import mujoco
+
+    from referee.field import field_for
+    from simulator.world.scene import compile_scene
+
+    output = Path(output)
+    ffmpeg = shutil.which("ffmpeg")
+    if ffmpeg is None:
+        raise RenderError(output=str(output), reason="ffmpeg not found on PATH")
+    replay = load_replay(replay_path)
+    header = replay.header
+    model = compile_scene(
+        field_for(header.field_class), header.robots, physics_dt_s=header.physics_dt_s
+    )
+    if model.nbody != len(header.body_names):
+        raise ReplayError(
+            path=str(replay_path),
+            reason=f"{len(header.body_names)} bodies recorded, the rebuilt model has {model.nbody}",
+        )
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    geom_body = model.geom_bodyid.copy()
+    geom_pos = model.geom_pos.copy()
+    geom_rot = _quat_to_mat(model.geom_quat.copy())
+    renderer = mujoco.Renderer(model, height=height, width=width)
+    renderer.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = False
+    renderer.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = False
+    option = mujoco.MjvOption()
+    option.geomgroup[4] = 0
+    command = [
+        ffmpeg, "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24",
+        "-s", f"{width}x{height}", "-r", f"{fps:g}", "-i", "-",
+        "-c:v", "libx264", "-preset", "veryfast", "-pix_fmt", "yuv420p", str(output),
+    ]  # fmt: skip
+    proc = subprocess.Popen(command, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
+    assert proc.stdin is not None
+    count = 0
+    try:
+        for i in _frames_for(replay, fps):
+            poses = replay.frames[i].poses.astype(np.float64)
+            body_rot = _quat_to_mat(poses[:, 3:7])
+            rot = body_rot[geom_body]
+            data.xpos[:] = poses[:, 0:3]
+            data.xmat[:] = body_rot.reshape(-1, 9)
+            data.geom_xpos[:] = poses[geom_body, 0:3] + np.einsum("nij,nj->ni", rot, geom_pos)
+            data.geom_xmat[:] = np.matmul(rot, geom_rot).reshape(-1, 9)
+            renderer.update_scene(data, camera="overview", scene_option=option)
+            proc.stdin.write(renderer.render().tobytes())
+            count += 1
+        proc.stdin.close()
+    except BrokenPipeError:
+        pass
+    finally:
+        renderer.close()
+    stderr = proc.stderr.read().decode(errors="replace") if proc.stderr else ""
+    code = proc.wait()
+    if code != 0:
+        raise RenderError(output=str(output), reason=f"ffmpeg exited {code}: {stderr.strip()}")
+    logger.info("rendered %d frames of %s to %s", count, replay_path, output)
+    return output
+
+
+def main(argv: list[str]) -> int:
+    parser = argparse.ArgumentParser(prog="python -m simulator render")
+    parser.add_argument("replay", type=Path)
+    parser.add_argument("-o", "--output", type=Path, default=Path("match.mp4"))
+    parser.add_argument("--width", type=int, default=1280)
+    parser.add_argument("--height", type=int, default=720)
+    parser.add_argument("--fps", type=float, default=25.0)
+    args = parser.parse_args(argv)
+    os.environ.setdefault("MUJOCO_GL", "osmesa")
+    logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
+    if args.width <= 0 or args.height <= 0 or args.fps <= 0:
+        print("error: --width, --height and --fps must be positive", file=sys.stderr)
+        return 2
+    try:
+        render_video(args.replay, args.output, width=args.width, height=args.height, fps=args.fps)
+    except ReplayError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except RenderError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
+    return 0

@@ -1,0 +1,116 @@
+"""Ball and robot physics: bounce, roll to rest, standing, falling, determinism, divergence."""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from referee.snapshot import BodyPart, PlaceBall, RobotId, TeamColor
+from simulator.errors import PhysicsDivergence
+from simulator.recorder import Recorder
+from simulator.world import RobotPlacement, World
+from tests.unit.world.conftest import RED_1, eight_robots, run_steps
+
+
+def test_dropped_ball_bounces_then_rolls_to_rest() -> None:
+    world = World.create(field_class="kid", robots=[], seed=1)
+    r = world.field.ball_radius_m
+    world.apply(PlaceBall(position=(0.0, 0.0, 1.0 + r), velocity=(0.0, 0.0, 0.0)))
+    heights = []
+    for _ in range(250):
+        world.step()
+        heights.append(world.snapshot().ball.position[2] - r)
+    first_contact = next(i for i, h in enumerate(heights) if h < 0.005)
+    apex = max(heights[first_contact : first_contact + 100])
+    assert 0.45 < apex < 0.75  # restitution about 0.76 (sqrt of the height ratio)
+    world.apply(PlaceBall(position=(-2.0, 0.0, r), velocity=(4.0, 0.0, 0.0)))
+    run_steps(world, 1000)  # 8 s
+    ball = world.snapshot().ball
+    assert 3.0 < ball.position[0] + 2.0 < 9.0  # rolled several metres
+    assert math.hypot(ball.velocity[0], ball.velocity[1]) < 0.02  # and stopped
+    assert ball.position[2] == pytest.approx(r, abs=0.005)
+
+
+@pytest.mark.parametrize("model", ["kid-default", "adult-default"])
+def test_robot_with_motors_at_zero_stands_ten_seconds(model: str) -> None:
+    placement = RobotPlacement(id=RED_1, model=model, x_m=-1.0, y_m=0.5, yaw_rad=0.3)
+    world = World.create(field_class="kid" if model == "kid-default" else "adult",
+                         robots=[placement], seed=1)  # fmt: skip
+    start = world.snapshot().robots[0]
+    run_steps(world, 1250)
+    robot = world.snapshot().robots[0]
+    assert not robot.fallen
+    assert robot.ground_contacts == frozenset({BodyPart.FOOT})
+    assert robot.position[2] == pytest.approx(start.position[2], abs=0.01)
+    assert math.dist(robot.position[:2], start.position[:2]) < 0.01
+    assert robot.yaw_rad == pytest.approx(0.3, abs=0.01)
+
+
+def test_pushed_robot_is_reported_fallen(one_robot_world: World) -> None:
+    world = one_robot_world
+    torso = world.model.body("red_1/torso").id
+    world.data.xfrc_applied[torso, 0] = 40.0  # N, 0.2 s push forward
+    run_steps(world, 25)
+    world.data.xfrc_applied[:] = 0.0
+    run_steps(world, 300)
+    robot = world.snapshot().robots[0]
+    assert robot.fallen
+    assert robot.touches_ground_outside_feet
+    assert robot.position[2] < 0.2
+
+
+def _record(tmp: Path, seed: int) -> bytes:
+    world = World.create(field_class="kid", robots=eight_robots(), seed=seed,
+                         initial_joint_noise_rad=0.02)  # fmt: skip
+    world.apply(PlaceBall(position=(0.0, 0.0, 0.07), velocity=(1.5, 0.5, 0.0)))
+    path = tmp / f"run-{seed}-{len(list(tmp.iterdir()))}.hlvsrec"
+    with Recorder(path, world, match_id="determinism") as recorder:
+        for step in range(250):
+            world.set_motor_position(RED_1, "LegUpperL", 0.3 * math.sin(step / 20))
+            world.step()
+            recorder.record(world, {"state": "PLAYING", "secs_remaining": 600 - step // 125})
+    return path.read_bytes()
+
+
+def test_same_seed_same_inputs_give_identical_recordings(tmp_path: Path) -> None:
+    first = _record(tmp_path, seed=11)
+    second = _record(tmp_path, seed=11)
+    other = _record(tmp_path, seed=12)
+    assert hashlib.sha256(first).digest() == hashlib.sha256(second).digest()
+    assert first != other  # the seed drives the initial joint noise
+
+
+def test_divergence_fails_with_the_typed_error(one_robot_world: World) -> None:
+    world = one_robot_world
+    dof = world.model.joint("red_1/Neck").dofadr[0]
+    world.data.qvel[dof] = np.inf
+    with pytest.raises(PhysicsDivergence) as caught:
+        world.step()
+    assert caught.value.policy == "fail"
+    assert "red_1/Neck" in caught.value.warning
+    assert caught.value.sim_time_ms == 8
+
+
+def test_divergence_reset_robot_policy_keeps_running() -> None:
+    robots = [
+        RobotPlacement(id=RED_1, model="kid-default", x_m=-1.0, y_m=0.0, yaw_rad=0.0),
+        RobotPlacement(id=RobotId(TeamColor.BLUE, 2), model="kid-default", x_m=1.0,
+                       y_m=1.0, yaw_rad=0.0),
+    ]  # fmt: skip
+    world = World.create(field_class="kid", robots=robots, seed=3, divergence_policy="reset_robot")
+    world.apply(PlaceBall(position=(0.5, -1.0, 0.07), velocity=(0.0, 0.0, 0.0)))
+    run_steps(world, 10)
+    dof = world.model.joint("blue_2/Head").dofadr[0]
+    world.data.qvel[dof] = np.nan
+    run_steps(world, 50)
+    snap = world.snapshot()
+    assert world.sim_time_ms == 60 * 8
+    assert snap.ball.position[0] == pytest.approx(0.5, abs=0.01)  # the rest was not reset
+    blue = snap.robot(RobotId(TeamColor.BLUE, 2))
+    assert blue.position[:2] == pytest.approx((1.0, 1.0), abs=0.02)
+    assert not blue.fallen
+    assert np.isfinite(world.data.qpos).all()
