@@ -2,9 +2,10 @@
 
 Contacts of the ball use the ball's parameters (higher geom priority): restitution about 0.76
 (``solref`` in MuJoCo's direct form, -stiffness and -damping: a 1 m drop bounces back to about
-0.53 m with the drag; the time-constant form gains energy at these damping ratios), sliding friction 0.5 and
-rolling friction that brings a rolling ball to rest. Linear damping on the free joint plays the
-part of HLVS's grass drag: a ball kicked at 4 m/s rolls about 7 m and stops within 6 s.
+0.53 m with the drag; the time-constant form gains energy at these damping ratios), sliding
+friction 0.5 and rolling friction that brings a rolling ball to rest. Linear damping on the free
+joint plays the part of HLVS's grass drag: a ball kicked at 4 m/s rolls about 7 m and stops
+within 6 s.
 """
 
 from __future__ import annotations
