@@ -169,14 +169,17 @@ def assemble_context(
     *,
     context_dir: Path,
     dockerfile: Path,
+    extra_files: Sequence[Path],
     wheel_dir: Path,
     repo_root: Path,
     sources: Sequence[Path],
 ) -> None:
-    """Fill ``context_dir`` with the Dockerfile, wheels/, requirements.txt and src/."""
+    """Fill ``context_dir`` with the Dockerfile, extra files, wheels/, requirements.txt, src/."""
     shutil.rmtree(context_dir, ignore_errors=True)
     (context_dir / "wheels").mkdir(parents=True)
     shutil.copy2(dockerfile, context_dir / "Dockerfile")
+    for path in extra_files:
+        shutil.copy2(path, context_dir / path.name)
     shutil.copy2(wheel_dir / "requirements.txt", context_dir / "requirements.txt")
     for wheel in wheel_dir.glob("*.whl"):
         _link_or_copy(wheel, context_dir / "wheels" / wheel.name)

@@ -54,6 +54,11 @@ class ImageRecipe:
         return IMAGES_DIR / self.name / "Dockerfile"
 
     @property
+    def build_files(self) -> tuple[Path, ...]:
+        """Files copied to the top of the build context next to the Dockerfile."""
+        return (IMAGES_DIR / "entrypoint.sh",)
+
+    @property
     def repository(self) -> str:
         return f"hlvs-runner/{self.name}"
 
@@ -133,6 +138,7 @@ def ensure_image(
         image_inputs.assemble_context(
             context_dir=context_dir,
             dockerfile=recipe.dockerfile,
+            extra_files=recipe.build_files,
             wheel_dir=wheel_dir,
             repo_root=REPO_ROOT,
             sources=sources,
@@ -185,6 +191,8 @@ def content_hash(
 
     feed("recipe", recipe.name.encode())
     feed("Dockerfile", recipe.dockerfile.read_bytes())
+    for path in recipe.build_files:
+        feed(path.name, path.read_bytes())
     for path in sources:
         feed(str(path.relative_to(REPO_ROOT)), path.read_bytes())
     feed("requirements", (wheel_dir / "requirements.txt").read_bytes())
