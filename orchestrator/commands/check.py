@@ -106,6 +106,7 @@ def _check(
 ) -> tuple[Kind | None, list[Problem]]:
     text = read_text(path)  # missing, directory, empty, binary: one clean problem each
     kind = kind or kind_by_name(path)
+    document: Any = None
     if kind is None or kind in ("game", "team", "credentials"):
         document = parse_json(text, file=str(path))
         kind = kind or kind_by_content(document)
@@ -118,10 +119,28 @@ def _check(
         )
         return None, [problem]
     if kind == "game":
-        return kind, check_game(path, images_required=images_required)
+        problems = check_game(path, images_required=images_required)
+        for credentials in _referenced_credentials(path, document):
+            problems.extend(_check_optional("credentials", credentials))
+        return kind, problems
     if kind == "team":
         return kind, check_team(path, field_class=field_class, images_required=images_required)
     return kind, _check_optional(kind, path)
+
+
+def _referenced_credentials(path: Path, document: Any) -> list[Path]:
+    """The credentials.json files a game document names that exist (missing ones are reported
+    by the game check)."""
+    if not isinstance(document, dict):
+        return []
+    names = [document.get("public_logs")]
+    names += [
+        side.get("credentials")
+        for side in (document.get("red"), document.get("blue"))
+        if isinstance(side, dict)
+    ]
+    paths = [path.parent / name for name in names if isinstance(name, str) and name]
+    return [p for p in dict.fromkeys(paths) if p.is_file()]
 
 
 def _check_optional(kind: Kind, path: Path) -> list[Problem]:
@@ -135,6 +154,9 @@ def _check_optional(kind: Kind, path: Path) -> list[Problem]:
             )
         ]
     try:
+        text = read_text(path)
+        if kind == "credentials":
+            parse_json(text, file=str(path))
         loaded = getattr(module, function)(path)
     except ConfigError as exc:
         return exc.problems

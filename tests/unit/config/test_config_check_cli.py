@@ -106,3 +106,17 @@ def test_device_file_is_not_read(hlvs_check: Any) -> None:
     run = hlvs_check("/dev/zero")
     assert run.code == 2
     assert run.out.splitlines() == ["/dev/zero: /: not a regular file (expected a file)"]
+
+
+def test_game_check_includes_referenced_credentials(game_files: GameFiles, hlvs_check: Any) -> None:
+    pytest.importorskip("orchestrator.config.credentials")
+    creds = game_files.folder / "red_credentials.json"
+    creds.write_text(json.dumps({"type": "s3", "credentials": {}}), encoding="utf-8")
+    game_files.game["red"]["credentials"] = "red_credentials.json"
+    run = hlvs_check(game_files.write())
+    assert run.code == 2
+    assert f"{creds}: /credentials" in run.out
+    creds.write_bytes(b"\xff\xfe\x00binary")
+    run = hlvs_check(game_files.write())
+    assert run.code == 2
+    assert f"{creds}: /: binary file" in run.out
