@@ -125,6 +125,7 @@ def ensure_image(
         reference = f"{recipe.repository}:{content}"
         existing = engine_images.inspect(client, reference)
         if existing is not None:
+            _tag_latest(client, recipe, reference, existing)
             return BuiltImage(
                 name=name,
                 reference=reference,
@@ -157,7 +158,8 @@ def ensure_image(
         )
         seconds = time.monotonic() - started
         log.info("built %s in %.1f s (%.0f MB)", reference, seconds, info.size_bytes / 1e6)
-        _prune_old_versions(client, recipe)
+        _tag_latest(client, recipe, reference, info)
+        _prune_old_versions(client, recipe, keep_id=info.id)
         return BuiltImage(
             name=name,
             reference=reference,
@@ -265,9 +267,19 @@ def _ensure_base(
     return base_recipe.reference, info.id, "none"
 
 
-def _prune_old_versions(client: DockerClient, recipe: ImageRecipe) -> None:
+def _tag_latest(
+    client: DockerClient, recipe: ImageRecipe, reference: str, info: engine_images.ImageInfo
+) -> None:
+    """``hlvs-runner/<name>:latest`` follows the current build (for hand-written configs)."""
+    if f"{recipe.repository}:latest" not in info.tags:
+        engine_images.tag(client, reference, recipe.repository, "latest")
+
+
+def _prune_old_versions(client: DockerClient, recipe: ImageRecipe, *, keep_id: str) -> None:
     versions = engine_images.list_labelled(client, {LABEL_PROJECT: "1", LABEL_IMAGE: recipe.name})
     for info in versions[KEEP_VERSIONS:]:
+        if info.id == keep_id:
+            continue
         for reference in info.tags or (info.id,):
             if reference.startswith(recipe.repository + ":"):
                 engine_images.remove_unused(client, reference)
