@@ -69,7 +69,8 @@ class Replay:
 class Recorder:
     """Writes a replay while a match runs: call :meth:`record` after every step (it writes a
     frame when one is due at ``rate_hz`` of simulated time), :meth:`event` for referee events
-    (stored with the next frame) and :meth:`close` at the end."""
+    (stored with the next frame) and :meth:`close` at the end. The first frame, written on
+    creation, holds the initial state with an empty game state."""
 
     def __init__(
         self, path: str | Path, world: World, *, match_id: str, rate_hz: float = 25.0
@@ -108,6 +109,7 @@ class Recorder:
         }
         blob = _dumps(header)
         self._out.write(MAGIC + _U32.pack(len(blob)) + blob)
+        self.record(world, {})  # the initial state
 
     @property
     def frames_written(self) -> int:
