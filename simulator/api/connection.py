@@ -56,6 +56,7 @@ class Connection:
         self.answered = False
         self.answered_at = 0.0
         self.last_sent_at: float | None = None
+        self.enqueued_at = 0.0  # monotonic time the latest measurement was queued
         self.slow = False
         self.bank_s = time_bank_s
         self.want_write = False
@@ -120,6 +121,7 @@ class Connection:
         outbox.append(frame)
         self.answered = False
         self.last_sent_at = now
+        self.enqueued_at = now
 
     def flush(self) -> bool:
         """Write as much as the socket takes; True when everything queued was written.

@@ -1,6 +1,7 @@
 """Lockstep waiting: each step waits for one request from every connected, non-slow client.
 
-A client's answer within ``deadline_s`` of the start of the wait is free; time beyond it is
+A client's answer within ``deadline_s`` of the start of the wait (or of the moment its
+measurement was queued, when a camera image delayed it) is free; time beyond it is
 taken from the client's time bank (a chess clock with a per-move allowance). A client whose bank
 runs out is marked slow (logged, counted) and the step goes on without it; it is waited for
 again, with a full bank, once it has answered the latest measurement and its send queue is empty.
@@ -23,9 +24,8 @@ def wait_lockstep(server: ApiServer, settings: LockstepSettings) -> float:
     missed: set[str] = set()
     while not server.stop_requested:
         now = time.monotonic()
-        elapsed = now - start
         waiting = []
-        next_event = deadline - elapsed if elapsed < deadline else float("inf")
+        next_event = float("inf")
         for slot in server.slots.values():
             conn = slot.conn
             if conn is None:
@@ -38,7 +38,10 @@ def wait_lockstep(server: ApiServer, settings: LockstepSettings) -> float:
                 continue
             if conn.answered:
                 continue
-            over = elapsed - deadline
+            if slot.pending:  # its measurement still waits for a camera image: not its fault
+                waiting.append(conn)  # the render worker's wake-up ends the poll
+                continue
+            over = now - max(start, conn.enqueued_at) - deadline
             if over > 0:
                 if slot.session.key not in missed:
                     missed.add(slot.session.key)
@@ -54,6 +57,8 @@ def wait_lockstep(server: ApiServer, settings: LockstepSettings) -> float:
                     )  # fmt: skip
                     continue
                 next_event = min(next_event, conn.bank_s - over)
+            else:
+                next_event = min(next_event, -over)
             waiting.append(conn)
         if not waiting:
             break
@@ -62,7 +67,7 @@ def wait_lockstep(server: ApiServer, settings: LockstepSettings) -> float:
     for slot in server.slots.values():
         conn = slot.conn
         if conn is not None and not conn.slow and conn.answered:
-            late = conn.answered_at - start - deadline
+            late = conn.answered_at - max(start, conn.enqueued_at) - deadline
             if late > 0:
                 conn.bank_s = max(0.0, conn.bank_s - late)
     return end - start

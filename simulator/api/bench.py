@@ -1,0 +1,258 @@
+"""``python -m simulator bench api``: real-time factor of the world with the robot API in use.
+
+Starts the world and the API server in this process and N client processes (one per robot)
+that enable every joint sensor and the IMU at 8 ms (and the camera when asked) and send 20
+joint targets for every measurement. Prints one JSON line with the API run's real-time factor,
+the world-only real-time factor of the same world (``World.step`` + ``snapshot``, what
+``bench sim`` measures) and their ratio. ``--stalled-client`` adds a run in which one more
+client connects and never reads, and reports both runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import multiprocessing as mp
+import os
+import sys
+import time
+from typing import Any
+
+from referee.snapshot import RobotId, TeamColor
+
+MOTORS = (
+    "Neck", "Head", "ShoulderL", "ArmUpperL", "ArmLowerL", "PelvYL", "PelvL", "LegUpperL",
+    "LegLowerL", "AnkleL", "FootL", "PelvYR", "PelvR", "LegUpperR", "LegLowerR", "AnkleR",
+    "FootR", "ShoulderR", "ArmUpperR", "ArmLowerR",
+)  # fmt: skip
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="python -m simulator bench api")
+    parser.add_argument("--robots", type=int, default=8)
+    parser.add_argument("--mode", choices=("lockstep", "async"), default="lockstep")
+    parser.add_argument("--camera", default="", help="WxH@PERIOD, e.g. 320x240@32")
+    parser.add_argument("--sim-seconds", type=float, default=10.0)
+    parser.add_argument("--physics-dt", type=float, default=0.002)
+    parser.add_argument(
+        "--camera-robots", type=int, default=0, help="robots that enable the camera (0 = all)"
+    )
+    parser.add_argument("--stalled-client", action="store_true")
+    parser.add_argument("--json", action="store_true", help="print only the JSON line")
+    return parser
+
+
+def _client(port: int, camera_period: int, stalled: bool) -> None:
+    """Client process body (also the stalled client: connects, then never reads)."""
+    from simulator.api import messages_pb2 as pb
+    from simulator.client import ConnectionClosed, RobotClient
+
+    client = RobotClient("127.0.0.1", port, retries=120, retry_interval_s=0.25).connect()
+    if stalled:
+        while True:
+            time.sleep(3600)
+    periods = {f"{m}S": 8 for m in MOTORS} | {"Accelerometer": 8, "Gyro": 8}
+    if camera_period:
+        periods["Camera"] = camera_period
+    client.enable_many(periods)
+    request = pb.ActuatorRequests()
+    targets = [request.motor_positions.add(name=m) for m in MOTORS]
+    try:
+        for msg in client:
+            phase = msg.time / 1000.0
+            for i, target in enumerate(targets):
+                target.position = 0.05 * math.sin(phase + i)
+            client.send(request)
+    except ConnectionClosed:
+        pass
+    os._exit(0)
+
+
+def _robots(count: int) -> list[RobotId]:
+    red = (count + 1) // 2
+    return [RobotId(TeamColor.RED, n) for n in range(1, red + 1)] + [
+        RobotId(TeamColor.BLUE, n) for n in range(1, count - red + 1)
+    ]
+
+
+def _world(robots: list[RobotId], physics_dt: float) -> Any:
+    from simulator.world import RobotPlacement, World
+
+    placements = [
+        RobotPlacement(
+            id=r,
+            model="kid-default",
+            x_m=(-1.0 if r.team is TeamColor.RED else 1.0) * (0.8 + 0.8 * r.number),
+            y_m=0.8 * (r.number - 2.5),
+            yaw_rad=0.0 if r.team is TeamColor.RED else math.pi,
+        )
+        for r in robots
+    ]
+    return World.create(field_class="kid", robots=placements, seed=1, physics_dt_s=physics_dt)
+
+
+def _world_only_rtf(robots: list[RobotId], physics_dt: float, sim_seconds: float) -> float:
+    world = _world(robots, physics_dt)
+    steps = int(sim_seconds * 1000 / world.step_ms)
+    started = time.perf_counter()
+    for _ in range(steps):
+        world.step()
+        world.snapshot()
+    return float(steps * world.step_ms / 1000.0 / (time.perf_counter() - started))
+
+
+def _api_run(
+    args: argparse.Namespace, camera: tuple[int, int, int] | None, stalled: bool
+) -> dict[str, Any]:
+    from simulator.api import (
+        ApiServer,
+        LockstepSettings,
+        PlayerEndpoint,
+        wait_lockstep,
+    )
+    from simulator.api.world_cameras import world_render_worker
+    from simulator.spec import NetworkSpec
+
+    robots = _robots(args.robots)
+    world = _world(robots, args.physics_dt)
+    if camera is not None:
+        world_camera = world.camera_info(robots[0])
+        if world_camera[:2] != camera[:2]:
+            raise SystemExit(f"--camera: the robot camera is {world_camera[0]}x{world_camera[1]}")
+    lockstep = LockstepSettings(deadline_s=0.05, time_bank_s=1.0)
+    ports = _free_ports(len(robots))
+    endpoints = [
+        PlayerEndpoint(robot=r, port=p, hosts=("127.0.0.1",), team_size=4)
+        for r, p in zip(robots, ports, strict=True)
+    ]
+    stalled_robot = robots[-1] if stalled else None
+    cameras = world_render_worker(world)
+    server = ApiServer(
+        world=world,
+        endpoints=endpoints,
+        network=NetworkSpec(api_bind_host="127.0.0.1"),
+        lockstep=lockstep if args.mode == "lockstep" else None,
+        cameras=cameras,
+    )
+    server.start()
+    ctx = mp.get_context("fork")
+    camera_robots = args.camera_robots or len(endpoints)
+    procs = [
+        ctx.Process(
+            target=_client,
+            args=(
+                e.port,
+                camera[2] if camera and i < camera_robots else 0,
+                e.robot == stalled_robot,
+            ),
+            daemon=True,
+        )
+        for i, e in enumerate(endpoints)
+    ]
+    for proc in procs:
+        proc.start()
+    try:
+        deadline = time.monotonic() + 120
+        while len(server.connected()) < len(endpoints) and time.monotonic() < deadline:
+            server.poll(0.05)
+        for _ in range(50):  # warm-up: sensors enabled, caches hot
+            if args.mode == "lockstep":
+                wait_lockstep(server, lockstep)
+            server.apply_requests(world.sim_time_ms + world.step_ms)
+            world.step()
+            world.snapshot()
+            server.publish(world.sim_time_ms)
+        steps = int(args.sim_seconds * 1000 / world.step_ms)
+        start_ms = world.sim_time_ms
+        started = time.perf_counter()
+        for _ in range(steps):
+            if args.mode == "lockstep":
+                wait_lockstep(server, lockstep)
+            server.apply_requests(world.sim_time_ms + world.step_ms)
+            world.step()
+            world.snapshot()
+            server.publish(world.sim_time_ms)
+        wall = time.perf_counter() - started
+        stats = server.statistics()
+    finally:
+        server.close()
+        cameras.close()
+        for proc in procs:
+            proc.kill()
+            proc.join(timeout=5)
+    rtts = [s["round_trip_ms"]["p50"] for s in stats.values() if s["round_trip_ms"]["p50"]]
+    return {
+        "real_time_factor": round((world.sim_time_ms - start_ms) / 1000.0 / wall, 3),
+        "connected": len(stats),
+        "dropped_out": sum(s["dropped_out"] for s in stats.values()),
+        "slow_periods": sum(s["slow_periods"] for s in stats.values()),
+        "round_trip_p50_ms": round(sorted(rtts)[len(rtts) // 2], 3) if rtts else None,
+        "camera_frames": cameras.frames,
+        "render_ms_per_frame": round(cameras.render_s * 1000 / cameras.frames, 2)
+        if cameras.frames
+        else None,
+    }
+
+
+def _free_ports(count: int) -> list[int]:
+    import socket
+
+    socks = [socket.socket() for _ in range(count)]
+    try:
+        for s in socks:
+            s.bind(("127.0.0.1", 0))
+        return [s.getsockname()[1] for s in socks]
+    finally:
+        for s in socks:
+            s.close()
+
+
+def _camera(text: str) -> tuple[int, int, int] | None:
+    if not text:
+        return None
+    try:
+        size, period = text.split("@")
+        width, height = size.lower().split("x")
+        return int(width), int(height), int(period)
+    except ValueError:
+        raise SystemExit(f"--camera {text!r}: expected WxH@PERIOD, e.g. 320x240@32") from None
+
+
+def main(argv: list[str]) -> int:
+    args = _parser().parse_args(argv)
+    os.environ.setdefault("MUJOCO_GL", "osmesa")
+    camera = _camera(args.camera)
+    robots = _robots(args.robots)
+    world_rtf = _world_only_rtf(robots, args.physics_dt, min(args.sim_seconds, 10.0))
+    api = _api_run(args, camera, stalled=False)
+    result: dict[str, Any] = {
+        "bench": "api",
+        "robots": args.robots,
+        "mode": args.mode,
+        "camera": args.camera or None,
+        "sim_seconds": args.sim_seconds,
+        "physics_dt_s": args.physics_dt,
+        "real_time_factor": api["real_time_factor"],
+        "world_only_real_time_factor": round(world_rtf, 3),
+        "ratio": round(api["real_time_factor"] / world_rtf, 3),
+        "round_trip_p50_ms": api["round_trip_p50_ms"],
+        "camera_frames": api["camera_frames"],
+        "camera_robots": (args.camera_robots or args.robots) if camera else 0,
+        "render_ms_per_frame": api["render_ms_per_frame"],
+        "slow_periods": api["slow_periods"],
+    }
+    if args.stalled_client:
+        stalled = _api_run(args, camera, stalled=True)
+        result["stalled_client"] = {
+            "real_time_factor": stalled["real_time_factor"],
+            "real_time_factor_without": api["real_time_factor"],
+            "ratio": round(stalled["real_time_factor"] / api["real_time_factor"], 3),
+            "dropped_out": stalled["dropped_out"],
+        }
+    print(json.dumps(result, sort_keys=True), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
