@@ -1,11 +1,66 @@
-"""`hlvs compose` (being written)."""
+"""``hlvs compose GAME.json -o docker-compose.yml``: the match as a docker-compose project.
+
+Writes the compose file, ``match_spec.json`` next to it, and the ``out/`` and ``logs/`` folders;
+``docker-compose up --abort-on-container-exit --exit-code-from simulator`` then plays the match.
+"""
 
 from __future__ import annotations
 
 import argparse
+import ipaddress
+from pathlib import Path
 from typing import Any
+
+from orchestrator.errors import ConfigError, Problem
 
 
 def register(sub: Any) -> None:
-    parser: argparse.ArgumentParser = sub.add_parser("compose", help="(not yet available)")
-    parser.set_defaults(func=lambda args: 1)
+    parser: argparse.ArgumentParser = sub.add_parser(
+        "compose", help="write a docker-compose file that plays the match of a game.json"
+    )
+    parser.add_argument("game", type=Path, help="game.json (its team files are read too)")
+    parser.add_argument(
+        "-o", "--output", type=Path, default=Path("docker-compose.yml"), help="compose file"
+    )
+    parser.add_argument(
+        "--simulator-image",
+        metavar="IMAGE",
+        help="simulator image (default: the current hlvs-runner/simulator build)",
+    )
+    parser.add_argument(
+        "--subnet-start",
+        metavar="A.B.C.0",
+        help="first of three consecutive /24 subnets for red, blue and control "
+        "(default: in 10.214.0.0/16, derived from the match id)",
+    )
+    parser.set_defaults(func=_compose)
+
+
+def _compose(args: argparse.Namespace) -> int:
+    from orchestrator.compose import Subnets, write_compose
+    from orchestrator.config import load_game
+
+    subnets = None
+    if args.subnet_start:
+        try:
+            subnets = Subnets.starting_at(ipaddress.IPv4Network(f"{args.subnet_start}/24"))
+        except ValueError as exc:
+            raise ConfigError(
+                [Problem("(command line)", "--subnet-start", str(exc), "an address like 10.9.0.0")]
+            ) from exc
+    loaded = load_game(args.game, images_required=True)
+    for warning in loaded.warnings:
+        print(warning)
+    if args.simulator_image:
+        image = args.simulator_image
+    else:
+        from orchestrator.images import project_image
+
+        image = project_image("simulator")
+    spec = write_compose(loaded, args.output, simulator_image=image, subnets=subnets)
+    print(f"wrote {args.output} and {spec}")
+    print(
+        f"play it: cd {args.output.parent} && docker-compose -f {args.output.name} up "
+        "--abort-on-container-exit --exit-code-from simulator"
+    )
+    return 0
