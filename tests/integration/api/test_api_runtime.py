@@ -115,6 +115,7 @@ def test_sigterm_stops_cleanly_with_results(tmp_path: Path) -> None:
     assert proc.returncode == 130, stderr[-2000:]
     result = json.loads((tmp_path / "out" / "sim_result.json").read_text())
     assert result["stop_reason"] == "SIGTERM" and result["winner"] is None
+    assert 0 < result["real_time_factor"] <= 1.1  # paced by maximum_real_time_factor 1.0
     assert (tmp_path / "out" / "replay.hlvsrec").stat().st_size > 0
 
 
