@@ -121,14 +121,21 @@ def describe(state: dict[str, Any]) -> str:
 
 
 class LiveView:
-    """Shows the match phase and the latest telemetry; ``update`` is cheap to call often."""
+    """Shows the match phase and the latest telemetry; ``update`` is cheap to call often.
+
+    Without a terminal, a line is printed when the phase, game state, half, score or connected
+    robots change, and at least every ``PLAIN_PERIOD_S`` seconds.
+    """
+
+    PLAIN_PERIOD_S = 10.0
 
     def __init__(self, *, match_id: str, stream: TextIO | None = None) -> None:
         self._stream = stream or sys.stdout
         self._match_id = match_id
         self._tty = self._stream.isatty()
         self._phase = "pending"
-        self._last_line = ""
+        self._last_key: object = None
+        self._last_print = 0.0
         self._live: Live | None = None
         if self._tty:
             self._live = Live(self._table(None), console=Console(file=self._stream),
@@ -153,11 +160,16 @@ class LiveView:
         if self._live is not None:
             self._live.update(self._table(state))
             return
-        line = f"[{phase}] " + (describe(state) if state else "")
-        if line != self._last_line:
+        key = (phase, None if state is None else (
+            state.get("state"), state.get("half"), json.dumps(state.get("score"), sort_keys=True),
+            tuple(state.get("connected") or ())))
+        now = time.monotonic()
+        if key != self._last_key or now - self._last_print >= self.PLAIN_PERIOD_S:
+            line = f"[{phase}] " + (describe(state) if state else "")
             self._stream.write(line + "\n")
             self._stream.flush()
-            self._last_line = line
+            self._last_key = key
+            self._last_print = now
 
     def close(self) -> None:
         if self._live is not None:

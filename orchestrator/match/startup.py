@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 import logging
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -170,7 +170,8 @@ def _start_robot(runner: MatchRunner, robot: RobotPlan) -> None:
             gamecontroller_ip=subnet.simulator,
         )
         request = layout.robot_request(
-            robot, prefix=started.prefix, holder_id=holder_id, environment=environment,
+            replace(robot, image=record.digest or robot.image),
+            prefix=started.prefix, holder_id=holder_id, environment=environment,
             logs_dir=folder.path, limits=limits, match_id=plan.match_id,
             extra_labels=runner.options.extra_labels,
         )

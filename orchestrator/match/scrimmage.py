@@ -1,0 +1,119 @@
+"""``hlvs scrimmage``: a short match between two teams of stub robots, from generated files.
+
+The files (game.json, team_red.json, team_blue.json) are written into the output folder and then
+played exactly like ``hlvs match`` would play them, so a team can rerun or edit them.
+Defaults: 1 player per team, two halves of 30 s simulated, lockstep stepping, 3 s before READY.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import uuid
+from pathlib import Path
+from typing import Any
+
+POSES_KID = {  # as if playing on the left (x < 0)
+    1: (-4.0, -3.1, 1.57),
+    2: (-1.0, -3.1, 1.57),
+    3: (-2.0, -3.1, 1.57),
+    4: (-3.0, -3.1, 1.57),
+}
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--out", type=Path, default=Path("matches/scrimmage"),
+                        help="output folder (default: matches/scrimmage)")
+    parser.add_argument("--red-image", default=None,
+                        help="image of the red robots (default: the project's stub image)")
+    parser.add_argument("--blue-image", default=None,
+                        help="image of the blue robots (default: the project's stub image)")
+    parser.add_argument("--players", type=int, default=1, choices=(1, 2, 3, 4),
+                        help="robots per team (default 1)")
+    parser.add_argument("--half-duration", type=float, default=30.0,
+                        help="simulated seconds per half (default 30)")
+    parser.add_argument("--wait-before-ready", type=float, default=3.0,
+                        help="wall seconds between robot start and the first READY (default 3)")
+    parser.add_argument("--grace", type=float, default=5.0,
+                        help="seconds robots get to stop after the game (default 5)")
+    parser.add_argument("--match-id", default=None, help="default: scrimmage-<random>")
+    parser.add_argument("--seed", type=int, default=42)
+    parser.add_argument("--stub", action="store_true",
+                        help="accepted for compatibility: stub robots are the default")
+
+
+def _pose(x: float, y: float, yaw: float) -> dict[str, Any]:
+    return {"translation": [x, y, 0.43], "rotation": [0, 0, 1, yaw]}
+
+
+def team_file(name: str, image: str, players: int, *, goalie_first: bool) -> dict[str, Any]:
+    repository, _, tag = image.rpartition(":") if ":" in image.split("/")[-1] else (image, "", "")
+    entries: dict[str, Any] = {}
+    for n in range(1, players + 1):
+        x, y, yaw = POSES_KID[n]
+        role = "goalie" if (n == 1 and goalie_first) else "striker"
+        entries[str(n)] = {
+            "dockerCmd": role,
+            "halfTimeStartingPose": _pose(x, y, yaw),
+            "reentryStartingPose": _pose(x, y, yaw),
+            "shootoutStartingPose": _pose(2.6, 0.0, 0.0),
+            "goalKeeperStartingPose": _pose(-4.45, 0.0, 0.0),
+        }
+        if tag:
+            entries[str(n)]["dockerTag"] = tag
+    return {"name": name, "image": repository or image, "players": entries}
+
+
+def game_file(args: argparse.Namespace, match_id: str) -> dict[str, Any]:
+    players = args.players
+    return {
+        "type": "NORMAL",
+        "class": "KID",
+        "host": "127.0.0.1",
+        "maximum_real_time_factor": 0,
+        "side_left": "red",
+        "kickoff": "red",
+        "match_id": match_id,
+        "seed": args.seed,
+        "stepping": "lockstep",
+        "lockstep_deadline_ms": 200,
+        "lockstep_time_bank_ms": 10000,
+        "red": {"id": 1, "config": "team_red.json", "hosts": ["127.0.0.1"],
+                "ports": [10000 + n for n in range(1, players + 1)]},
+        "blue": {"id": 2, "config": "team_blue.json", "hosts": ["127.0.0.1"],
+                 "ports": [10020 + n for n in range(1, players + 1)]},
+        "timing": {
+            "half_duration_s": args.half_duration,
+            "wait_before_first_ready_s": args.wait_before_ready,
+            "half_time_break_s": 1,
+            "grace_period_s": args.grace,
+        },
+        "limits": {"cpus": 1, "memory_gb": 1, "pids": 256, "log_folder_gb": 1},
+    }
+
+
+def write_files(args: argparse.Namespace, folder: Path, *, stub_image: str | None = None
+                ) -> Path:
+    """Write game.json and the two team files into ``folder``; returns the game.json path."""
+    if args.red_image is None or args.blue_image is None:
+        if stub_image is None:
+            from orchestrator.images import project_image
+
+            stub_image = project_image("stub")
+    red_image = args.red_image or stub_image
+    blue_image = args.blue_image or stub_image
+    assert red_image is not None and blue_image is not None
+    match_id = args.match_id or f"scrimmage-{uuid.uuid4().hex[:6]}"
+    folder.mkdir(parents=True, exist_ok=True)
+    files = {
+        "game.json": game_file(args, match_id),
+        "team_red.json": team_file("Stub Red", red_image, args.players,
+                                   goalie_first=args.players > 1),
+        "team_blue.json": team_file("Stub Blue", blue_image, args.players, goalie_first=True),
+    }
+    for name, content in files.items():
+        (folder / name).write_text(json.dumps(content, indent=2) + "\n", encoding="utf-8")
+    return folder / "game.json"
+
+
+__all__ = ["add_arguments", "game_file", "team_file", "write_files"]

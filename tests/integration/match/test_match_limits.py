@@ -1,0 +1,104 @@
+"""Limits of robot containers: bandwidth, CPU/memory/pids as the engine sees them, OOM, log cap,
+grace period."""
+
+from __future__ import annotations
+
+import json
+
+import docker
+import pytest
+
+from orchestrator.config import Limits
+from orchestrator.match import MatchRunner
+from tests.integration.match.conftest import MatchFactory
+
+pytestmark = [pytest.mark.docker, pytest.mark.root]
+
+
+def test_robot_to_simulator_throughput_is_held_to_the_configured_rate(
+    play: MatchFactory,
+) -> None:
+    limits = Limits(cpus=1.0, memory_gb=0.5, log_folder_gb=0.05, team_api_mb_s=5.0)  # 40 Mbit/s
+    outcome = play(red=[["send", "4"]], blue=[["listen"]], sim=("7",), limits=limits)
+    results = json.loads((outcome.out_dir / "results.json").read_text())
+    red = results["robots"]["red-1"]
+    assert red["limits"]["api_rate_bit_s"] == 40_000_000
+    rate = red["api"]["rate_bit_s"]
+    assert rate is not None, red
+    assert 0.9 * 40e6 <= rate <= 1.02 * 40e6, rate
+    assert red["sent_bytes"] >= red["api"]["bytes"]
+
+
+def test_limits_are_visible_in_docker_inspect(
+    play: MatchFactory, docker_client: docker.DockerClient
+) -> None:
+    seen: dict[str, object] = {}
+
+    def capture(runner: MatchRunner) -> None:
+        original = runner.runtime.start
+
+        def start(container_id: str) -> None:
+            original(container_id)
+            attrs = docker_client.api.inspect_container(container_id)
+            if attrs["Config"]["Labels"].get("org.hlvs-runner.role") == "robot":
+                seen[attrs["Name"]] = attrs["HostConfig"]
+
+        runner.runtime = type("Spy", (), {})()  # delegate everything, spy on start
+        for name in ("create_network", "remove_network", "create_container", "stop", "kill",
+                     "remove", "inspect", "wait", "stats_stream", "save_logs", "image_digest",
+                     "list_project"):
+            setattr(runner.runtime, name, getattr(original.__self__, name))
+        runner.runtime.start = start
+        runner.monitor._runtime = runner.runtime
+
+    limits = Limits(cpus=1.5, memory_gb=0.25, pids=64, log_folder_gb=0.02)
+    outcome = play(red=[["env"]], blue=[["env"]], sim=("2",), limits=limits,
+                   runner_hook=capture)
+    assert outcome.ok
+    assert len(seen) == 2
+    for host_config in seen.values():
+        assert host_config["NanoCpus"] == 1_500_000_000
+        assert host_config["Memory"] == 250_000_000
+        assert host_config["MemorySwap"] == 250_000_000
+        assert host_config["PidsLimit"] == 64
+        assert host_config["CapDrop"] == ["ALL"]
+        assert host_config["SecurityOpt"] == ["no-new-privileges"]
+        assert host_config["Privileged"] is False
+        assert host_config["NetworkMode"].startswith("container:")
+        binds = host_config["Binds"]
+        assert len(binds) == 1 and binds[0].endswith(":/robocup-logs:rw")
+
+
+def test_oom_killed_robot_is_recorded_and_the_game_goes_on(play: MatchFactory) -> None:
+    limits = Limits(cpus=1.0, memory_gb=0.06, log_folder_gb=0.02)
+    outcome = play(red=[["oom"]], blue=[["env"]], sim=("5",), limits=limits)
+    results = json.loads((outcome.out_dir / "results.json").read_text())
+    assert outcome.ok, results["failure"]
+    red = results["robots"]["red-1"]
+    assert red["oom_killed"] is True
+    assert red["exit_code"] == 137
+    assert red["exited_during_game"] is True
+    assert results["final_state"] == "FINISHED"
+
+
+def test_robot_writing_past_its_log_cap_fills_only_its_folder(play: MatchFactory) -> None:
+    outcome = play(red=[["fill"]], blue=[["env"]], sim=("5",),
+                   limits=Limits(cpus=1.0, memory_gb=0.5, log_folder_gb=0.02))
+    assert outcome.ok
+    line = (outcome.out_dir / "teams/red/1/stdout.log").read_text().splitlines()[-1]
+    report = json.loads(line)
+    assert "No space left on device" in report["error"]
+    assert 10 * 2**20 <= report["written"] <= 20_000_000
+    size = (outcome.out_dir / "teams/red/1/robocup-logs/big.bin").stat().st_size
+    assert size <= 20_000_000
+
+
+def test_sigterm_handling_robot_gets_its_grace_period(play: MatchFactory) -> None:
+    outcome = play(red=[["sigterm"]], blue=[["env"]], sim=("2",), grace_s=4.0)
+    assert outcome.ok
+    text = (outcome.out_dir / "teams/red/1/robocup-logs/term.txt").read_text()
+    assert text == "got SIGTERM\nflushed\n"
+    results = json.loads((outcome.out_dir / "results.json").read_text())
+    assert results["robots"]["red-1"]["exit_code"] == 0
+    assert results["robots"]["blue-1"]["exit_code"] == 137  # ignores SIGTERM: killed after grace
+    assert results["timings_s"]["stopping"] >= 3.5
