@@ -90,6 +90,7 @@ def running_server(
     lockstep: LockstepSettings | None = None,
     world: Any = None,
     cameras: bool = False,
+    worker: RenderWorker | None = None,
     pause_s: float = 0.002,
     team_size: int = 4,
     hold: bool = False,
@@ -100,7 +101,6 @@ def running_server(
         PlayerEndpoint(robot=r, port=p, hosts=hosts, team_size=team_size) for r, p in ports.items()
     ]
     network = network or NetworkSpec(api_bind_host="127.0.0.1")
-    worker = None
     if cameras:
         worker = RenderWorker(
             capture=lambda: None,
