@@ -164,7 +164,8 @@ def _check_state(run: Run, exp: Expectation, snap: WorldSnapshot) -> None:
     for key, want in exp.checks.items():
         if key in ("event", "no_event"):
             continue
-        if key in ("state", "secondary_state", "half", "score", "left_team"):
+        if key in ("state", "secondary_state", "half", "score", "left_team", "phase",
+                   "secs_remaining"):
             if gs[key] != want:
                 fail(key, want, gs[key])
         elif key == "kickoff":

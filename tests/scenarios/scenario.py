@@ -55,6 +55,8 @@ STATE_KEYS = {
     "robot_near",
     "cards",
     "removed",
+    "phase",
+    "secs_remaining",
 }
 ACTIONS = {"place_ball", "teleport", "push", "fall", "kick"}
 
