@@ -223,12 +223,20 @@ class RobotSession:
             self._new_sensors.clear()
             return msg, jobs
         new = self._new_sensors
+        positions: dict[str, float] | None = None
+        batch = getattr(world, "read_positions", None)  # one call for every joint, if offered
         for name, period in self._sensors.items():
             if name in new or (time_ms - self._enabled_at[name]) % period:
                 continue
             kind = self._kinds[name]
             if kind == POSITION_SENSOR:
-                msg.position_sensors.add(name=name, value=world.read_position(robot, name))
+                if batch is not None:
+                    if positions is None:
+                        positions = batch(robot)
+                    value = positions[name]
+                else:
+                    value = world.read_position(robot, name)
+                msg.position_sensors.add(name=name, value=value)
             elif kind == ACCELEROMETER:
                 x, y, z = world.read_accelerometer(robot)
                 msg.accelerometers.add(name=name).value.CopyFrom(pb.Vector3(X=x, Y=y, Z=z))

@@ -201,15 +201,17 @@ def test_limp_robot_caches_commands_and_removed_robot_gets_time_only() -> None:
         client.enable("NeckS", 8)
         _next_with(client, lambda m: bool(m.position_sensors))
         world.limp.add(RED1)
+        received = driver.server.statistics()["red-1"]["messages_in"]
         client.set_positions({"Neck": 1.2})
-        t_sent = client.receive(timeout=5).time
-        msg = _next_with(client, lambda m: m.time > t_sent + 16)
+        wait_until(lambda: driver.server.statistics()["red-1"]["messages_in"] > received)
+        t_sent = world.sim_time_ms  # applied (ignored) at the next step
+        msg = _next_with(client, lambda m: m.time > t_sent + 24)
         assert msg.position_sensors  # sensors still sent while limp
         assert ("position", RED1, "Neck", (1.2,)) not in world.calls
         world.limp.discard(RED1)
         wait_until(lambda: ("position", RED1, "Neck", (1.2,)) in world.calls)
         world.removed.add(RED1)
-        t_removed = client.receive(timeout=5).time
-        msg = _next_with(client, lambda m: m.time > t_removed + 8)
+        t_removed = world.sim_time_ms  # measurements already queued may predate the removal
+        msg = _next_with(client, lambda m: m.time > t_removed + 16)
         assert msg.time > 0 and msg.real_time > 0
         assert not msg.position_sensors and not msg.messages
