@@ -23,7 +23,7 @@ from types import FrameType
 from typing import Any
 
 from simulator.api import ApiServer, LockstepSettings, endpoints_from_spec
-from simulator.errors import PhysicsDivergence, SimulatorError, SpecError
+from simulator.errors import PhysicsDivergence, SimulatorError, SpecError, UnknownModelError
 from simulator.match_loop import LoopSettings, MatchLoop
 from simulator.match_setup import referee_config
 from simulator.spec import MatchSpec
@@ -80,6 +80,9 @@ def main(argv: list[str]) -> int:
         return 3
     try:
         return run_match(spec, out, gc_network=not args.no_gc_network)
+    except UnknownModelError as exc:
+        log.error("invalid match spec %s: %s", args.spec, exc)
+        return 2
     except TelemetryError as exc:
         log.error("%s", exc)
         return 3

@@ -167,3 +167,18 @@ def test_telemetry_state_and_events_over_zenoh(tmp_path: Path) -> None:
     }
     assert sample["stepping"] == "async"
     assert {"type", "sim_time_ms"} <= set(events[0])
+
+
+def test_invalid_spec_exits_2_naming_file_and_field(tmp_path: Path) -> None:
+    data = json.loads(short_spec().to_json())
+    data["stepping"] = "fast"
+    spec_path = tmp_path / "bad_spec.json"
+    spec_path.write_text(json.dumps(data))
+    proc = subprocess.run(
+        [sys.executable, "-m", "simulator", "run", "--spec", str(spec_path), "--out",
+         str(tmp_path / "out")],
+        capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert proc.returncode == 2
+    assert str(spec_path) in proc.stderr and "/stepping" in proc.stderr
+    assert "Traceback" not in proc.stderr
