@@ -20,20 +20,11 @@ import subprocess
 import docker
 
 from orchestrator.errors import InfrastructureError
-from orchestrator.match.runtime import NetworkInfo, NetworkRequest
+from orchestrator.match.runtime import NetworkInfo, NetworkRequest, SubnetInUse
 
 log = logging.getLogger(__name__)
 
 COMMENT_PREFIX = "hlvs-runner:"
-
-
-class SubnetInUse(InfrastructureError):
-    """The requested subnet overlaps a network that already exists; pick another one."""
-
-    def __init__(self, *, subnet: str, reason: str) -> None:
-        self.subnet = subnet
-        self.reason = reason
-        super().__init__(f"subnet {subnet} is in use: {reason}")
 
 
 def create_network(client: docker.DockerClient, request: NetworkRequest) -> NetworkInfo:

@@ -25,6 +25,15 @@ class ObjectNotFound(InfrastructureError):
         super().__init__(f"{kind} {name} does not exist")
 
 
+class SubnetInUse(InfrastructureError):
+    """The requested subnet overlaps a network that already exists; pick another one."""
+
+    def __init__(self, *, subnet: str, reason: str) -> None:
+        self.subnet = subnet
+        self.reason = reason
+        super().__init__(f"subnet {subnet} is in use: {reason}")
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class NetworkRequest:
     name: str
@@ -156,4 +165,5 @@ __all__ = [
     "ObjectNotFound",
     "ProjectObject",
     "StatsSample",
+    "SubnetInUse",
 ]

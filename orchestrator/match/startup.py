@@ -10,14 +10,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from orchestrator.bandwidth import AppliedShaping, RobotShaping, mb_s_to_bit
-from orchestrator.engine.networks import SubnetInUse
 from orchestrator.errors import InfrastructureError, OrchestratorError
 from orchestrator.match import layout
 from orchestrator.match.layout import Subnet
 from orchestrator.match.logfs import LogFolder
 from orchestrator.match.plan import RobotPlan, per_robot_rate_mb_s
 from orchestrator.match.results import FailureClass
-from orchestrator.match.runtime import Attachment, NetworkInfo
+from orchestrator.match.runtime import Attachment, NetworkInfo, SubnetInUse
 
 if TYPE_CHECKING:
     from orchestrator.match.runner import MatchRunner

@@ -1,0 +1,90 @@
+"""After the orchestrator is killed with SIGKILL mid-match, ``hlvs cleanup`` removes what it left:
+containers, networks, host firewall rules and log mounts (found by labels and names)."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+import uuid
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from orchestrator.cli import main as hlvs
+from orchestrator.match.logfs import state_dir
+
+pytestmark = [pytest.mark.docker, pytest.mark.root]
+
+REPO = Path(__file__).resolve().parents[3]
+
+SCRIPT = textwrap.dedent(
+    """
+    import sys
+    from pathlib import Path
+    from orchestrator.config import Limits
+    from orchestrator.engine import connect
+    from orchestrator.engine.containers import DockerRuntime
+    from orchestrator.match import HostControl, MatchPlan, MatchRunner, RunOptions, TeamPlan
+    from tests.integration.match.conftest import robots, spec_builder
+
+    match_id, image, out = sys.argv[1], sys.argv[2], Path(sys.argv[3])
+    red, blue = robots("red", image, [["env"]]), robots("blue", image, [["env"]])
+    plan = MatchPlan(
+        match_id=match_id, seed=1, red=TeamPlan(color="red", name="R", robots=tuple(red)),
+        blue=TeamPlan(color="blue", name="B", robots=tuple(blue)),
+        spec_builder=spec_builder(match_id, red, blue), telemetry=False,
+        limits=Limits(cpus=1.0, memory_gb=0.5, log_folder_gb=0.02), grace_period_s=1.0,
+    )
+    options = RunOptions(out_dir=out, simulator_image=image,
+                         simulator_command=("python3", "/opt/t/fakesim.py", "120"),
+                         extra_labels={"org.hlvs-runner.test": "1"})
+    MatchRunner(plan, runtime=DockerRuntime(connect()), host=HostControl(), options=options).run()
+    """
+)
+
+
+def _leftovers(runtime: Any, match_id: str) -> tuple[int, bool, bool]:
+    rules = subprocess.run(["iptables", "-S", "INPUT"], capture_output=True, text=True).stdout
+    mounts = Path("/proc/mounts").read_text()
+    return (
+        len(runtime.list_project(match_id=match_id)),
+        f"hlvs-runner:{match_id}" in rules,
+        str(state_dir() / "logfs" / match_id) in mounts,
+    )
+
+
+def test_cleanup_after_kill_9(runtime: Any, test_image: str, tmp_path: Path) -> None:
+    match_id = f"k{uuid.uuid4().hex[:8]}"
+    process = subprocess.Popen(
+        [sys.executable, "-c", SCRIPT, match_id, test_image, str(tmp_path / "out")],
+        cwd=REPO, env={**os.environ, "PYTHONPATH": str(REPO)},
+        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+    )
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:
+            roles = [o.labels.get("org.hlvs-runner.role")
+                     for o in runtime.list_project(match_id=match_id)]
+            if roles.count("robot") == 2:
+                break
+            if process.poll() is not None:
+                pytest.fail(f"the match process ended early: {process.communicate()[1][-2000:]}")
+            time.sleep(0.2)
+        else:
+            pytest.fail("the robots did not start")
+        time.sleep(0.5)
+        os.kill(process.pid, signal.SIGKILL)
+        process.wait(timeout=10)
+        containers, rule, mount = _leftovers(runtime, match_id)
+        assert containers == 8 and rule and mount  # simulator, 2 holders, 2 robots, 3 networks
+        assert hlvs(["cleanup", "--match", match_id]) == 0
+        assert _leftovers(runtime, match_id) == (0, False, False)
+    finally:
+        if process.poll() is None:
+            process.kill()
+        hlvs(["cleanup", "--match", match_id])
