@@ -145,6 +145,8 @@ class SeaweedServer:
             "-master.telemetry=false",
             "-master.volumeSizeLimitMB=128",
             "-volume.max=30",
+            "-master.electionTimeout=1s",
+            "-master.heartbeatInterval=200ms",
             f"-master.port={p['master']}",
             f"-master.port.grpc={p['master.grpc']}",
             f"-volume.port={p['volume']}",
