@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import os
 import platform
 import signal
 import sys
@@ -62,6 +63,9 @@ def versions() -> dict[str, str]:
 
 def main(argv: list[str]) -> int:
     args = _parser().parse_args(argv)
+    if not os.environ.get("DISPLAY"):  # offscreen rendering (cameras, video) without a display
+        os.environ.setdefault("MUJOCO_GL", "osmesa")
+        os.environ.setdefault("PYOPENGL_PLATFORM", os.environ["MUJOCO_GL"])
     logging.basicConfig(
         level=args.log_level.upper(),
         stream=sys.stderr,
@@ -199,12 +203,14 @@ def _write_json(path: Path, data: dict[str, Any]) -> None:
 
 
 def _render_video(replay: Path, output: Path) -> None:
+    import mujoco
+
     from simulator.render import render_video
 
     started = time.monotonic()
     try:
         render_video(replay, output)
-    except (OSError, SimulatorError) as exc:
+    except (OSError, SimulatorError, mujoco.FatalError) as exc:
         log.error("video %s not rendered: %s", output, exc)
         return
     log.info("video %s rendered in %.1f s", output, time.monotonic() - started)
