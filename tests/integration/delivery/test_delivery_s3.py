@@ -8,7 +8,6 @@ from typing import Any
 
 import boto3
 import botocore.exceptions
-import pytest
 
 from orchestrator.config.credentials import S3Credentials
 from orchestrator.delivery import (
@@ -152,7 +151,6 @@ def test_retention_keeps_the_three_newest_then_delivers_them(
     assert {k.split("/")[0] for k in remote} == {"r2", "r3", "r4"}
 
 
-@pytest.mark.slow
 def test_seaweedfs_checks_keys_and_permissions(seaweed: SeaweedServer, tmp_path: Path) -> None:
     url = seaweed.endpoint_url
     ensure_bucket(url, seaweed.admin, "team-logs")
@@ -181,7 +179,6 @@ def test_seaweedfs_checks_keys_and_permissions(seaweed: SeaweedServer, tmp_path:
     assert not any(k.startswith("sw-read_only_account/") for k in remote)
 
 
-@pytest.mark.slow
 def test_seaweedfs_dies_and_comes_back(seaweed: SeaweedServer, tmp_path: Path) -> None:
     url = seaweed.endpoint_url
     ensure_bucket(url, seaweed.admin, "crash-logs")
