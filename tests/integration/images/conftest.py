@@ -116,8 +116,10 @@ def registry(tmp_path: Path, docker_client: docker.DockerClient) -> Iterator[Reg
 
 
 def _remove_images_of(client: docker.DockerClient, host: str) -> None:
-    for image in client.images.list():
-        for tag in image.tags:
+    # The raw listing: images.list() inspects each image and fails when another process removes
+    # one meanwhile.
+    for image in client.api.images():
+        for tag in image.get("RepoTags") or ():
             if tag.startswith(host + "/"):
                 try:
                     client.images.remove(tag, force=True)
