@@ -75,7 +75,8 @@ RECIPES: dict[str, ImageRecipe] = {
     ),
 }
 IMAGE_NAMES = tuple(RECIPES)
-KEEP_VERSIONS = 3  # older content tags of a project image are removed once unused
+KEEP_VERSIONS = 3  # older content tags of a project image are removed once unused ...
+KEEP_RECENT_S = 3600.0  # ... and older than this (a test or match may be about to start one)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -278,7 +279,7 @@ def _tag_latest(
 def _prune_old_versions(client: DockerClient, recipe: ImageRecipe, *, keep_id: str) -> None:
     versions = engine_images.list_labelled(client, {LABEL_PROJECT: "1", LABEL_IMAGE: recipe.name})
     for info in versions[KEEP_VERSIONS:]:
-        if info.id == keep_id:
+        if info.id == keep_id or time.time() - info.created_unix < KEEP_RECENT_S:
             continue
         for reference in info.tags or (info.id,):
             if reference.startswith(recipe.repository + ":"):

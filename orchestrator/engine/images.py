@@ -10,7 +10,7 @@ from __future__ import annotations
 import logging
 import re
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -33,6 +33,7 @@ class ImageInfo:
     repo_digests: tuple[str, ...]  # repo@sha256:... (present once pushed or pulled)
     size_bytes: int
     labels: Mapping[str, str]
+    created_unix: int = 0  # filled by list_labelled
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -155,8 +156,12 @@ def list_labelled(client: docker.DockerClient, labels: Mapping[str, str]) -> lis
     except docker.errors.APIError as exc:
         raise InfrastructureError(f"cannot list images: {exc.explanation}") from exc
     found.sort(key=lambda item: int(item.get("Created") or 0), reverse=True)
-    infos = (inspect(client, str(item["Id"])) for item in found)
-    return [info for info in infos if info is not None]
+    result = []
+    for item in found:
+        info = inspect(client, str(item["Id"]))
+        if info is not None:
+            result.append(replace(info, created_unix=int(item.get("Created") or 0)))
+    return result
 
 
 def remove_unused(client: docker.DockerClient, reference: str) -> bool:
