@@ -20,6 +20,10 @@ PARTS: tuple[BodyPart, ...] = tuple(BodyPart)
 PART_BIT = {part: 1 << i for i, part in enumerate(PARTS)}
 FOOT_BIT = PART_BIT[BodyPart.FOOT]
 HULL_BODIES = ("hand_L", "hand_R", "foot_L", "foot_R")
+# what a robot geom can touch, for contact classification (0: anything else)
+KIND_TURF, KIND_BALL, KIND_ROBOT = 1, 2, 3
+KINDS = 4
+PART_SLOTS = 8  # parts padded to one byte, so packbits turns a row of flags into part bits
 
 
 @dataclass(frozen=True, slots=True)
@@ -54,6 +58,10 @@ class WorldIndex:
     by_id: dict[RobotId, RobotIndex]
     geom_robot: IntArray  # geom -> robot number or -1
     geom_part_bit: IntArray  # geom -> PART_BIT or 0
+    geom_part_index: IntArray  # geom -> position in PARTS (0 for non-robot geoms)
+    geom_kind: IntArray  # geom -> KIND_TURF / KIND_BALL / KIND_ROBOT or 0
+    geom_code: IntArray  # robot geom -> robot * KINDS * PART_SLOTS + part index; others -1
+    geom_kind_code: IntArray  # geom -> kind * PART_SLOTS
     dof_robot: IntArray  # dof -> robot number or -1
     turf_geom: int
     ball_geom: int
@@ -65,6 +73,7 @@ class WorldIndex:
     hull_bodies: IntArray  # (n, 4)
     com_velocity: IntArray  # (n, 3) sensordata indices
     actuator_robot: IntArray  # actuator -> robot number
+    ball_touch: IntArray  # (n,) sensordata index: contacts of robot n with the ball
 
 
 def _robot_index(
@@ -133,11 +142,20 @@ def build_index(model: mujoco.MjModel, placements: Sequence[RobotPlacement]) -> 
         dof_robot[robot.dof_range[0] : robot.dof_range[1]] = robot.number
         actuator_robot[robot.actuators] = robot.number
     ball_joint = model.joint(BALL_JOINT)
+    geom_kind = np.where(geom_robot >= 0, KIND_ROBOT, 0).astype(np.int64)
+    geom_kind[model.geom("turf").id] = KIND_TURF
+    geom_kind[model.geom(BALL_GEOM).id] = KIND_BALL
+    part_index = np.array([max(int(b).bit_length() - 1, 0) for b in geom_part], dtype=np.int64)
+    geom_code = np.where(geom_robot >= 0, geom_robot * KINDS * PART_SLOTS + part_index, -1)
     return WorldIndex(
         robots=robots,
         by_id={r.id: r for r in robots},
         geom_robot=geom_robot,
         geom_part_bit=geom_part,
+        geom_kind=geom_kind,
+        geom_code=geom_code,
+        geom_kind_code=geom_kind * PART_SLOTS,
+        geom_part_index=part_index,
         dof_robot=dof_robot,
         turf_geom=model.geom("turf").id,
         ball_geom=model.geom(BALL_GEOM).id,
@@ -149,4 +167,7 @@ def build_index(model: mujoco.MjModel, placements: Sequence[RobotPlacement]) -> 
         hull_bodies=np.array([r.hull_bodies for r in robots], dtype=np.int64).reshape(-1, 4),
         com_velocity=_table([r.com_velocity for r in robots], 3),
         actuator_robot=actuator_robot,
+        ball_touch=np.array(
+            [int(model.sensor(f"{r.prefix}/ball_touch").adr[0]) for r in robots], dtype=np.int64
+        ),
     )

@@ -10,11 +10,16 @@ relative to the default ``P = 10`` (``kp = model_kp * P / 10``), ``D`` adds damp
 
 from __future__ import annotations
 
+import logging
+import math
+
 import mujoco
 import numpy as np
 import numpy.typing as npt
 
 from simulator.world.indices import WorldIndex
+
+logger = logging.getLogger(__name__)
 
 FloatArray = npt.NDArray[np.float64]
 DEFAULT_P = 10.0
@@ -47,27 +52,44 @@ class MotorBank:
         self.torque = np.zeros(nu)
         self.torque_mode = np.zeros(nu, dtype=bool)
         self.limp = np.zeros(nu, dtype=bool)
-        self._dirty = True
+        self._dirty = True  # gains must be written
+        self._ctrl_dirty = True  # ctrl must be written
+        self._ramping = True  # some effective target still moves towards its command
 
     # --- commands ----------------------------------------------------------------------------
 
     def set_position(self, actuator: int, rad: float) -> None:
+        if not math.isfinite(rad):
+            logger.debug("ignored non-finite position %r for actuator %d", rad, actuator)
+            return
         self.target[actuator] = min(max(rad, self.lower[actuator]), self.upper[actuator])
+        self._ramping = True
         if self.torque_mode[actuator]:
             self.torque_mode[actuator] = False
             self._dirty = True
 
     def set_velocity(self, actuator: int, rad_s: float) -> None:
+        if not math.isfinite(rad_s):
+            logger.debug("ignored non-finite velocity %r for actuator %d", rad_s, actuator)
+            return
         self.velocity_limit[actuator] = min(abs(rad_s), self.max_velocity[actuator])
+        self._ramping = True
 
     def set_torque(self, actuator: int, nm: float) -> None:
+        if not math.isfinite(nm):
+            logger.debug("ignored non-finite torque %r for actuator %d", nm, actuator)
+            return
         limit = self.max_torque[actuator]
         self.torque[actuator] = min(max(nm, -limit), limit)
+        self._ctrl_dirty = True
         if not self.torque_mode[actuator]:
             self.torque_mode[actuator] = True
             self._dirty = True
 
     def set_pid(self, actuator: int, p: float, i: float, d: float) -> None:
+        if not all(math.isfinite(v) for v in (p, i, d)):
+            logger.debug("ignored non-finite PID for actuator %d", actuator)
+            return
         base = self.default_kp[actuator] / DEFAULT_P
         self.kp[actuator] = max(p, 0.0) * base
         self.ki[actuator] = i
@@ -82,19 +104,31 @@ class MotorBank:
         """Position mode at ``positions`` immediately (no ramp): after a teleport or restore."""
         self.target[actuators] = positions
         self.effective[actuators] = positions
+        self._ctrl_dirty = True
         if self.torque_mode[actuators].any():
             self.torque_mode[actuators] = False
             self._dirty = True
 
     # --- per step ----------------------------------------------------------------------------
 
+    def invalidate(self) -> None:
+        """Write gains and ``ctrl`` again at the next step (after MuJoCo reset its state)."""
+        self._dirty = True
+        self._ctrl_dirty = True
+
     def apply(self, data: mujoco.MjData) -> None:
-        """Advance the velocity-limited targets by one basic step and write ``ctrl``."""
-        reach = self.velocity_limit * self._step_s
-        np.clip(self.target, self.effective - reach, self.effective + reach, out=self.effective)
+        """Advance the velocity-limited targets by one basic step and write ``ctrl`` (only when
+        something changed: the common case of robots holding a posture costs nothing)."""
+        if self._ramping:
+            reach = self.velocity_limit * self._step_s
+            np.clip(self.target, self.effective - reach, self.effective + reach, out=self.effective)
+            self._ramping = not np.array_equal(self.effective, self.target)
+            self._ctrl_dirty = True
         if self._dirty:
             self._write_gains()
-        data.ctrl[:] = np.where(self.torque_mode, self.torque, self.effective)
+        if self._ctrl_dirty:
+            data.ctrl[:] = np.where(self.torque_mode, self.torque, self.effective)
+            self._ctrl_dirty = False
 
     def _write_gains(self) -> None:
         active = ~self.limp

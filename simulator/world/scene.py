@@ -14,7 +14,7 @@ import numpy as np
 
 from referee.field import FieldGeometry
 from referee.snapshot import TeamColor
-from simulator.world.ball import BALL_JOINT, ball_assets, ball_body, ball_damping
+from simulator.world.ball import BALL_GEOM, BALL_JOINT, ball_assets, ball_body, ball_damping
 from simulator.world.field import field_assets, field_bodies
 from simulator.world.goal import goal_bodies
 from simulator.world.robots import robot_model
@@ -24,6 +24,11 @@ STATIC_BIT = 1 << 30
 BALL_BIT = 1 << 29
 MAX_ROBOTS = 29
 TEAM_RGBA = {TeamColor.RED: "0.85 0.12 0.1 1", TeamColor.BLUE: "0.1 0.25 0.9 1"}
+
+
+def ball_touch_sensor(placement: RobotPlacement) -> str:
+    """Name of the sensor counting a robot's contacts with the ball (computed by MuJoCo)."""
+    return f"{robot_prefix(placement.id)}/ball_touch"
 
 
 def scene_xml(
@@ -56,6 +61,10 @@ def scene_xml(
         bodies.append(parts.body)
         actuators.append(parts.actuators)
         sensors.append(parts.sensors)
+        sensors.append(
+            f'<contact name="{ball_touch_sensor(placement)}" subtree1="{robot_prefix(placement.id)}'
+            f'/torso" geom2="{BALL_GEOM}" data="found" num="1"/>'
+        )
     return f"""<mujoco model="hlvs-{field.field_class.value}">
 <compiler angle="radian" autolimits="true"/>
 <option timestep="{physics_dt_s!r}" integrator="implicitfast" cone="pyramidal"/>

@@ -8,15 +8,26 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import mujoco
 import numpy as np
 import numpy.typing as npt
 
 from referee.snapshot import BallState, BodyPart, RobotId, RobotState, WorldSnapshot
-from simulator.world.indices import FOOT_BIT, PARTS, WorldIndex
+from simulator.world.indices import (
+    FOOT_BIT,
+    KIND_BALL,
+    KIND_ROBOT,
+    KIND_TURF,
+    KINDS,
+    PART_SLOTS,
+    PARTS,
+    WorldIndex,
+)
 
 FALLEN_TILT_COS = 0.5  # torso z axis more than 60 degrees from vertical
+_NOBODY: frozenset[RobotId] = frozenset()
 _PART_SETS: tuple[frozenset[BodyPart], ...] = tuple(
     frozenset(p for i, p in enumerate(PARTS) if mask & (1 << i)) for mask in range(1 << len(PARTS))
 )
@@ -24,49 +35,44 @@ _PART_SETS: tuple[frozenset[BodyPart], ...] = tuple(
 
 @dataclass(frozen=True, slots=True)
 class Contacts:
-    ground: npt.NDArray[np.int64]  # per robot: part bits touching the turf
-    ball: npt.NDArray[np.int64]  # per robot: part bits touching the ball
+    ground: npt.NDArray[Any]  # per robot: part bits touching the turf
+    ball: npt.NDArray[Any]  # per robot: part bits touching the ball
     pairs: list[tuple[int, int]]  # robot numbers in contact (each pair once, sorted)
 
 
 def classify_contacts(data: mujoco.MjData, index: WorldIndex, n_robots: int) -> Contacts:
-    ground = np.zeros(n_robots, dtype=np.int64)
-    ball = np.zeros(n_robots, dtype=np.int64)
+    """One pass over the contact list: each side of a contact that is a robot geom gets the code
+    (robot, kind of the geom on the other side: turf, ball, robot; part), counted by bincount."""
     ncon = data.ncon
     if ncon == 0 or n_robots == 0:
-        return Contacts(ground=ground, ball=ball, pairs=[])
+        zeros = np.zeros(n_robots, dtype=np.int64)
+        return Contacts(ground=zeros, ball=zeros.copy(), pairs=[])
     geom = data.contact.geom[:ncon]
-    g1, g2 = geom[:, 0], geom[:, 1]
-    r1, r2 = index.geom_robot[g1], index.geom_robot[g2]
-    b1, b2 = index.geom_part_bit[g1], index.geom_part_bit[g2]
-    for other, robots, bits in ((g2, r1, b1), (g1, r2, b2)):
-        on_turf = (other == index.turf_geom) & (robots >= 0)
-        if on_turf.any():
-            np.bitwise_or.at(ground, robots[on_turf], bits[on_turf])
-        on_ball = (other == index.ball_geom) & (robots >= 0)
-        if on_ball.any():
-            np.bitwise_or.at(ball, robots[on_ball], bits[on_ball])
-    between = (r1 >= 0) & (r2 >= 0) & (r1 != r2)
+    mine = index.geom_code[geom.ravel()]
+    other = index.geom_kind_code[geom[:, ::-1].ravel()]
+    valid = (mine >= 0) & (other > 0)
+    counts = np.bincount(mine[valid] + other[valid], minlength=n_robots * KINDS * PART_SLOTS)
+    bits = np.packbits(
+        counts.reshape(n_robots, KINDS, PART_SLOTS) > 0, axis=-1, bitorder="little"
+    ).reshape(n_robots, KINDS)
     pairs: list[tuple[int, int]] = []
-    if between.any():
-        lo = np.minimum(r1[between], r2[between])
-        hi = np.maximum(r1[between], r2[between])
-        pairs = sorted({(int(a), int(b)) for a, b in zip(lo.tolist(), hi.tolist(), strict=True)})
-    return Contacts(ground=ground, ball=ball, pairs=pairs)
+    if bits[:, KIND_ROBOT].any():
+        robots = index.geom_robot[geom]
+        between = (robots[:, 0] >= 0) & (robots[:, 1] >= 0) & (robots[:, 0] != robots[:, 1])
+        pairs = sorted({(int(a), int(b)) for a, b in np.sort(robots[between], axis=1).tolist()})
+    return Contacts(ground=bits[:, KIND_TURF], ball=bits[:, KIND_BALL], pairs=pairs)
 
 
 def ball_toucher(data: mujoco.MjData, index: WorldIndex) -> int:
-    """Robot number touching the ball in the current contacts (lowest number), or -1."""
-    ncon = data.ncon
-    if ncon == 0:
+    """Robot number touching the ball in the last substep (lowest number), or -1.
+
+    Reads one contact sensor per robot (MuJoCo counts the contacts in C), which is much cheaper
+    than scanning the contact list in Python every step.
+    """
+    if index.ball_touch.size == 0:
         return -1
-    geom = data.contact.geom[:ncon]
-    hit = (geom[:, 0] == index.ball_geom) | (geom[:, 1] == index.ball_geom)
-    if not hit.any():
-        return -1
-    robots = index.geom_robot[geom[hit].ravel()]
-    robots = robots[robots >= 0]
-    return int(robots.min()) if robots.size else -1
+    touching = np.flatnonzero(data.sensordata[index.ball_touch])
+    return int(touching[0]) if touching.size else -1
 
 
 def build_snapshot(
@@ -89,37 +95,40 @@ def build_snapshot(
     )
     if n == 0:
         return WorldSnapshot(sim_time_ms=sim_time_ms, ball=ball, robots=())
-    qpos = data.qpos
-    pos = qpos[index.root_xyz].tolist()
-    quat = qpos[index.root_quat]
-    w, x, y, z = quat[:, 0], quat[:, 1], quat[:, 2], quat[:, 3]
-    yaw = np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)).tolist()
-    upright = (1.0 - 2.0 * (x * x + y * y)).tolist()
-    com = data.subtree_com[index.torso_bodies].tolist()
-    com_vel = data.sensordata[index.com_velocity].tolist()
-    hull = data.xpos[index.hull_bodies][:, :, :2].tolist()
+    # one (n, 21) table, one tolist: x y z | yaw upright | com xyz | com velocity xyz | hull 4 x xy
+    table = np.empty((n, 21))
+    table[:, 0:3] = data.qpos[index.root_xyz]
+    rot = data.xmat[index.torso_bodies]  # row-major 3x3
+    table[:, 3] = np.arctan2(rot[:, 3], rot[:, 0])
+    table[:, 4] = rot[:, 8]  # z of the torso's up axis
+    table[:, 5:8] = data.subtree_com[index.torso_bodies]
+    table[:, 8:11] = data.sensordata[index.com_velocity]
+    table[:, 11:21] = 0.0
+    table[:, 11:19] = data.xpos[index.hull_bodies][:, :, :2].reshape(n, 8)
+    rows = table.tolist()
     contacts = classify_contacts(data, index, n)
     ground = contacts.ground.tolist()
     ball_bits = contacts.ball.tolist()
-    touching: list[set[RobotId]] = [set() for _ in range(n)]
+    touching: list[frozenset[RobotId]] = [_NOBODY] * n
     for a, b in contacts.pairs:
-        touching[a].add(robot_ids[b])
-        touching[b].add(robot_ids[a])
+        touching[a] = touching[a] | {robot_ids[b]}
+        touching[b] = touching[b] | {robot_ids[a]}
     robots = []
     for i, robot_id in enumerate(robot_ids):
+        r = rows[i]
         gbits = ground[i]
         robots.append(
             RobotState(
                 id=robot_id,
-                position=tuple(pos[i]),
-                yaw_rad=yaw[i],
-                center_of_mass=tuple(com[i]),
-                velocity=tuple(com_vel[i]),
+                position=(r[0], r[1], r[2]),
+                yaw_rad=r[3],
+                center_of_mass=(r[5], r[6], r[7]),
+                velocity=(r[8], r[9], r[10]),
                 ground_contacts=_PART_SETS[gbits],
                 ball_contacts=_PART_SETS[ball_bits[i]],
-                robot_contacts=frozenset(touching[i]),
-                hull_points=tuple(tuple(p) for p in hull[i]),
-                fallen=bool(gbits & ~FOOT_BIT) or upright[i] < FALLEN_TILT_COS,
+                robot_contacts=touching[i],
+                hull_points=((r[11], r[12]), (r[13], r[14]), (r[15], r[16]), (r[17], r[18])),
+                fallen=bool(gbits & ~FOOT_BIT) or r[4] < FALLEN_TILT_COS,
                 limp=limp[i],
                 removed=removed[i],
             )

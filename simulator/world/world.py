@@ -148,13 +148,14 @@ class World(DeviceAccess):
 
     def step(self) -> None:
         """Advance one basic step (``step_ms`` of simulated time)."""
-        self._saved = self._save()
+        if self.divergence_policy == "reset_robot":
+            self._saved = self._save()
         self.motors.apply(self.data)
         mujoco.mj_step(self.model, self.data, nstep=self.substeps)
         if self.parked_qpos:
             commands.hold_parked(self)
-        divergence = self._watch.check(self.data)
         self.sim_time_ms += self.step_ms
+        divergence = self._watch.check(self.data)
         if divergence is not None:
             self._diverged(divergence.text(self._dof_name(divergence.info)), divergence.info)
         toucher = ball_toucher(self.data, self.index)
@@ -198,6 +199,7 @@ class World(DeviceAccess):
         self.data.qvel[:] = qvel
         self.data.qacc_warmstart[:] = warm
         self.data.time = time
+        self.motors.invalidate()
         offender = int(self.index.dof_robot[dof]) if 0 <= dof < self.model.nv else -1
         if offender < 0:
             speeds = [
