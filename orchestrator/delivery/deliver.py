@@ -180,7 +180,7 @@ def deliver_set(
         credentials = _credentials_of(pending)
         target = credentials.describe()
         session = _Session(credentials, pending.team, opener or open_uploader, retry, sleep)
-        base = f"{pending.match_id}/{pending.team}"
+        base = f"{_folder_name(pending.match_id)}/{_folder_name(pending.team)}"
         for entry in pending.files:
             remote = f"{base}/{entry.path}"
             local = pending.files_dir / entry.path
@@ -285,6 +285,12 @@ class _Session:
         if self._uploader is not None:
             uploader, self._uploader = self._uploader, None
             uploader.close()
+
+
+def _folder_name(name: str) -> str:
+    """One remote path component: no separators, no dot-only names."""
+    safe = name.replace("/", "_").replace("\\", "_").strip()
+    return safe if safe.strip(".") else "_"
 
 
 def _exists(uploader: Uploader, *, remote: str, size: int) -> bool:

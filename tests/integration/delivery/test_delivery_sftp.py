@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import threading
 import time
@@ -187,3 +188,33 @@ def test_asyncssh_server_password_and_host_key_mismatch(
     (tmp_path / "bad").mkdir()
     outcome, _ = deliver_one(tmp_path / "bad", sftp_body(asyncssh_server, host_key=OTHER_KEY))
     assert outcome.error is not None and outcome.error.kind == "host_key"
+
+
+def test_cli_status_and_deliver(
+    asyncssh_server: AsyncsshServer, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from orchestrator.cli import main
+
+    creds = write_credentials(tmp_path, "sftp", sftp_body(asyncssh_server))
+    bad = write_credentials(
+        tmp_path, "sftp", sftp_body(asyncssh_server, password="wrong"), "bad.json"
+    )
+    store = tmp_path / "store"
+    for match_id, target in (("cli-1", creds), ("cli-2", bad)):
+        enqueue_match_logs(
+            make_match(tmp_path, match_id, robot_files()),
+            match_id=match_id,
+            teams={"red": ("Alpha", target)},
+            public_target=None,
+            store=store,
+        )
+    assert main(["logs", "status", "--store", str(store)]) == 0
+    out = capsys.readouterr().out
+    assert "cli-1 Alpha: 5 files" in out and "cli-2 Alpha" in out
+    assert main(["logs", "deliver", "--store", str(store)]) == 1
+    out = capsys.readouterr().out
+    assert "delivered cli-1 Alpha" in out
+    assert "FAILED cli-2 Alpha" in out and "(auth:" in out and "wrong" not in out
+    assert main(["logs", "status", "--store", str(store), "--json"]) == 0
+    [left] = json.loads(capsys.readouterr().out)
+    assert left["match_id"] == "cli-2" and left["last_error"]["kind"] == "auth"
