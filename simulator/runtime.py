@@ -66,6 +66,8 @@ def main(argv: list[str]) -> int:
     if not os.environ.get("DISPLAY"):  # offscreen rendering (cameras, video) without a display
         os.environ.setdefault("MUJOCO_GL", "osmesa")
         os.environ.setdefault("PYOPENGL_PLATFORM", os.environ["MUJOCO_GL"])
+    # Mesa's CPU rasteriser on one thread: camera rendering takes one core, physics keeps another.
+    os.environ.setdefault("LP_NUM_THREADS", "1")
     logging.basicConfig(
         level=args.log_level.upper(),
         stream=sys.stderr,

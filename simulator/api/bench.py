@@ -222,6 +222,7 @@ def _camera(text: str) -> tuple[int, int, int] | None:
 def main(argv: list[str]) -> int:
     args = _parser().parse_args(argv)
     os.environ.setdefault("MUJOCO_GL", "osmesa")
+    os.environ.setdefault("LP_NUM_THREADS", "1")  # rendering on one core, physics on another
     camera = _camera(args.camera)
     robots = _robots(args.robots)
     world_rtf = _world_only_rtf(robots, args.physics_dt, min(args.sim_seconds, 10.0))

@@ -4,7 +4,9 @@ The step thread captures the world state of the step a camera image is due for
 (``capture()``, e.g. a copy of MuJoCo's ``qpos``) and hands it with the jobs to one worker
 thread, which owns the OpenGL context (``make_render()`` is called inside the worker; OSMesa and
 EGL contexts are bound to the thread that created them). Physics and the measurements of robots
-without cameras never wait for rendering; the camera robot's measurements wait, in order.
+without cameras do not wait for an image; the camera robot's measurements wait, in order. At most
+:data:`MAX_IN_FLIGHT` batches are queued: when rendering cannot keep up with the requested
+periods, the step loop waits for it (the real-time factor drops, memory and latency stay bounded).
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from simulator.api.session import CameraJob
 log = logging.getLogger(__name__)
 
 RenderFn = Callable[[Any, RobotId, int, int], bytes]
+MAX_IN_FLIGHT = 2
 
 
 @dataclass(slots=True)
@@ -46,6 +49,8 @@ class RenderWorker:
         self.error: BaseException | None = None
         self.frames = 0
         self.render_s = 0.0
+        self._submitted = 0
+        self._finished = 0  # written by the worker only
 
     @property
     def wake_fd(self) -> int:
@@ -56,7 +61,13 @@ class RenderWorker:
         if self._thread is None:
             self._thread = threading.Thread(target=self._run, name="camera-render", daemon=True)
             self._thread.start()
+        self._submitted += 1
         self._inbox.put(_Batch(self._capture(), list(jobs)))
+
+    @property
+    def in_flight(self) -> int:
+        """Batches submitted and not completely rendered yet."""
+        return self._submitted - self._finished
 
     def completed(self) -> list[tuple[CameraJob, bytes]]:
         try:
@@ -98,10 +109,11 @@ class RenderWorker:
                     self.render_s += time.perf_counter() - started
                     self.frames += 1
                 self._done.put((job, image))
-                try:
-                    os.write(self._write_fd, b"x")
-                except BlockingIOError:
-                    pass  # the pipe is full of wake-ups already
+            self._finished += 1
+            try:
+                os.write(self._write_fd, b"x")
+            except BlockingIOError:
+                pass  # the pipe is full of wake-ups already
 
     def close(self) -> None:
         if self._thread is not None:

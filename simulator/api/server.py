@@ -24,7 +24,7 @@ from typing import Any
 
 from referee.snapshot import RobotId
 from simulator.api import messages_pb2 as pb
-from simulator.api.cameras import RenderWorker
+from simulator.api.cameras import MAX_IN_FLIGHT, RenderWorker
 from simulator.api.connection import ClientClosed, Connection
 from simulator.api.devices import DeviceWorld
 from simulator.api.endpoints import PlayerEndpoint, peer_allowed_by_name
@@ -332,6 +332,8 @@ class ApiServer:
         if jobs_all:
             assert self._cameras is not None, "camera enabled without a render worker"
             self._cameras.submit(jobs_all)
+            while self._cameras.in_flight > MAX_IN_FLIGHT and not self.stop_requested:
+                self.poll(0.05)  # rendering is behind: let it catch up (results end the poll)
         self._flush_all()
 
     def _send(
