@@ -1,0 +1,94 @@
+"""``hlvs bench bringup``: seconds from the start of a match to every robot connected.
+
+Starts a scrimmage of stub robots (images cached; building them is not timed), measures from the
+moment the runner enters STARTING (networks, simulator, holders, bandwidth limits, robots) until
+the simulator's telemetry lists every robot as connected, then stops the match. Prints one JSON
+line: ``{"bench": "bringup", "robots": 8, "bringup_s": ..., "containers_s": ..., ...}``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import tempfile
+import threading
+import time
+from collections.abc import Sequence
+from pathlib import Path
+
+from orchestrator.config.loader import load_game
+from orchestrator.errors import OrchestratorError
+from orchestrator.match import HostControl, MatchRunner, RunOptions, cleanup, plan_from_game
+from orchestrator.match.scrimmage import add_arguments, write_files
+
+log = logging.getLogger(__name__)
+
+TARGET_S = 10.0
+
+
+def _parse(argv: Sequence[str]) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(prog="hlvs bench bringup", description=__doc__)
+    parser.add_argument("--robots", type=int, default=8, choices=(2, 4, 6, 8))
+    parser.add_argument("--json", action="store_true", help="print only the JSON line")
+    parser.add_argument("--timeout", type=float, default=90.0)
+    parser.add_argument("--keep", type=Path, default=None, help="keep the match folder here")
+    return parser.parse_args(list(argv))
+
+
+def measure(*, robots: int, out: Path, timeout_s: float) -> dict[str, object]:
+    from orchestrator.engine import connect
+    from orchestrator.engine.containers import DockerRuntime
+    from orchestrator.images import project_image
+    from orchestrator.telemetry import ZenohTelemetry
+
+    scrim = argparse.ArgumentParser()
+    add_arguments(scrim)
+    args = scrim.parse_args(["--players", str(robots // 2), "--half-duration", "60",
+                             "--wait-before-ready", "60", "--grace", "1",
+                             "--match-id", f"bringup-{int(time.time())}"])
+    stub = project_image("stub")
+    simulator = project_image("simulator")
+    plan = plan_from_game(load_game(write_files(args, out / "config", stub_image=stub)),
+                          grace_period_s=1.0)
+    runtime = DockerRuntime(connect())
+    runner = MatchRunner(
+        plan, runtime=runtime, host=HostControl(),
+        options=RunOptions(out_dir=out, simulator_image=simulator, poll_s=0.05),
+        telemetry=lambda endpoint, match_id: ZenohTelemetry(endpoint=endpoint, match_id=match_id),
+    )
+    thread = threading.Thread(target=runner.run, name="bringup-match", daemon=True)
+    thread.start()
+    deadline = time.monotonic() + timeout_s
+    while runner.bringup_s is None and thread.is_alive() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    runner.stop_event.set()
+    thread.join(timeout=120)
+    cleanup(runtime, HostControl(), match_id=plan.match_id)
+    bringup = runner.bringup_s
+    return {
+        "bench": "bringup",
+        "robots": robots,
+        "bringup_s": None if bringup is None else round(bringup, 3),
+        "containers_s": runner.lifecycle.timings_s.get("starting"),
+        "target_s": TARGET_S,
+        "ok": bringup is not None and bringup <= TARGET_S,
+    }
+
+
+def main(argv: Sequence[str]) -> int:
+    args = _parse(argv)
+    try:
+        if args.keep is not None:
+            result = measure(robots=args.robots, out=args.keep, timeout_s=args.timeout)
+        else:
+            with tempfile.TemporaryDirectory(prefix="hlvs-bringup-") as folder:
+                result = measure(robots=args.robots, out=Path(folder), timeout_s=args.timeout)
+    except OrchestratorError as exc:
+        print(json.dumps({"bench": "bringup", "error": str(exc)}))
+        return exc.exit_code
+    print(json.dumps(result))
+    return 0 if result["bringup_s"] is not None else 1
+
+
+__all__ = ["main", "measure"]
