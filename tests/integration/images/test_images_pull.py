@@ -11,6 +11,7 @@ import pytest
 from orchestrator.config import Limits, PlayerConfig, RegistryAuth, StartingPose, TeamConfig
 from orchestrator.errors import ImagePullError, ImageTooLarge
 from orchestrator.pull import resolve_team_images
+from tests.conftest import TEST_LABEL
 from tests.integration.images.conftest import MakeImage, Registry, free_port, push
 
 pytestmark = pytest.mark.docker
@@ -47,13 +48,24 @@ def alpha_login(registry: Registry, password: str | None = None) -> RegistryAuth
 
 
 @pytest.mark.slow
-def test_team_pushes_team_base_and_the_match_pins_its_digest(
-    registry: Registry, docker_client: docker.DockerClient
+def test_team_image_on_team_base_is_pushed_pulled_pinned_and_runs(
+    registry: Registry, docker_client: docker.DockerClient, tmp_path: Path
 ) -> None:
     from orchestrator.images import project_image
 
+    # The team's side, as images/README.md tells it: build FROM team-base, push.
+    (tmp_path / "robot.py").write_text(
+        "import os, simulator.client\n"
+        "print(os.environ['ROBOCUP_TEAM_COLOR'], os.environ['ROBOCUP_ROBOT_ID'], 'client ok')\n"
+    )
+    (tmp_path / "Dockerfile").write_text(
+        f"FROM {project_image('team-base')}\nCOPY robot.py /robot/robot.py\n"
+        'CMD ["python", "/robot/robot.py"]\n'
+    )
     repository = f"{registry.host}/alpha/robot"
-    docker_client.api.tag(project_image("team-base"), repository, "v1")
+    docker_client.images.build(
+        path=str(tmp_path), tag=f"{repository}:v1", network_mode="none", labels={TEST_LABEL: "1"}
+    )
     pushed = push(docker_client, f"{repository}:v1", "alpha", registry.users["alpha"])
     docker_client.images.remove(f"{repository}:v1")  # the match host starts from nothing
 
@@ -68,7 +80,14 @@ def test_team_pushes_team_base_and_the_match_pins_its_digest(
         assert image.reference == f"{repository}:v1"
         assert image.digest == f"{repository}@{pushed}"
         assert image.size_bytes > 100_000_000
-    assert docker_client.images.get(resolved[1].digest).id == resolved[1].image_id
+    output = docker_client.containers.run(
+        resolved[1].digest,
+        environment={"ROBOCUP_TEAM_COLOR": "red", "ROBOCUP_ROBOT_ID": "1"},
+        network_mode="none",
+        remove=True,
+        labels={TEST_LABEL: "1"},
+    )
+    assert output.decode().strip() == "red 1 client ok"
 
 
 def test_pull_of_a_small_image_pins_digest(
