@@ -48,10 +48,25 @@ def _client(port: int, camera_period: int, stalled: bool) -> None:
     from simulator.api import messages_pb2 as pb
     from simulator.client import ConnectionClosed, RobotClient
 
-    client = RobotClient("127.0.0.1", port, retries=120, retry_interval_s=0.25).connect()
-    if stalled:
+    if stalled:  # a small receive window, and it never reads: the server's queue overflows
+        import socket
+
+        raw = socket.socket()
+        raw.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+        for _ in range(120):
+            try:
+                raw.connect(("127.0.0.1", port))
+                break
+            except OSError:
+                time.sleep(0.25)
+        enable = pb.ActuatorRequests()
+        for name in [f"{m}S" for m in MOTORS] + ["Accelerometer", "Gyro"]:
+            enable.sensor_time_steps.add(name=name, timeStep=8)
+        payload = enable.SerializeToString()
+        raw.sendall(len(payload).to_bytes(4, "big") + payload)
         while True:
             time.sleep(3600)
+    client = RobotClient("127.0.0.1", port, retries=120, retry_interval_s=0.25).connect()
     periods = {f"{m}S": 8 for m in MOTORS} | {"Accelerometer": 8, "Gyro": 8}
     if camera_period:
         periods["Camera"] = camera_period
