@@ -151,11 +151,19 @@ def deliver_pending(
     """Try every pending set (of ``team`` only, if given), oldest first."""
     outcomes = []
     with st.locked(store):
-        for pending in st.list_sets(store):
-            if team is None or pending.team == team:
-                outcomes.append(
-                    deliver_set(pending, retry=retry or RetryPolicy(), opener=opener, sleep=sleep)
+        candidates = [s for s in st.list_sets(store) if team is None or s.team == team]
+    for pending in candidates:
+        with st.claimed(pending) as mine:
+            if not mine:
+                log.info(
+                    "match %s: the logs of %s are being delivered by another process",
+                    pending.match_id,
+                    pending.team,
                 )
+                continue
+            outcomes.append(
+                deliver_set(pending, retry=retry or RetryPolicy(), opener=opener, sleep=sleep)
+            )
     return outcomes
 
 
@@ -171,7 +179,10 @@ def deliver_set(
     opener: Opener | None = None,
     sleep: Callable[[float], None] = time.sleep,
 ) -> DeliveryOutcome:
-    """Upload one set; on success delete it locally, on failure record the cause in it."""
+    """Upload one set; on success delete it locally, on failure record the cause in it.
+
+    The caller holds the set's claim (:func:`store.claimed`), as :func:`deliver_pending` does.
+    """
     started = time.monotonic()
     target = str(pending.credentials) if pending.credentials else "(no credentials)"
     session: _Session | None = None
@@ -343,7 +354,10 @@ def _files_under(folder: Path, *, exclude: Path | None) -> list[tuple[Path, str]
 def _prune(store: Path, team: str) -> None:
     sets = [s for s in st.list_sets(store) if s.team == team and s.kind == "team"]
     for old in sets[: max(0, len(sets) - KEEP_UNDELIVERED)]:
-        st.remove_set(old)
+        with st.claimed(old) as mine:
+            if not mine:
+                continue  # being delivered right now
+            st.remove_set(old)
         log.warning(
             "match %s: deleted the undelivered logs of %s (%d files, %.1f MB): more "
             "than %d sets were waiting",

@@ -2,7 +2,8 @@
 
 Layout::
 
-    <store>/.lock                   held while sets are created, delivered or pruned
+    <store>/.lock                   held while sets are created, listed or pruned
+    <store>/sets/<set_id>/.claim    held while the set is delivered or deleted
     <store>/sets/<set_id>/set.json  the set's state (team, target file, files with SHA-256,
                                     attempts, last error); rewritten atomically
     <store>/sets/<set_id>/files/    the files, as they will appear under <match_id>/<team>/
@@ -31,6 +32,7 @@ __all__ = [
     "FileEntry",
     "PendingSet",
     "SetError",
+    "claimed",
     "create_set",
     "list_sets",
     "locked",
@@ -104,6 +106,30 @@ def locked(store: Path) -> Iterator[None]:
         fcntl.flock(handle, fcntl.LOCK_EX)
         try:
             yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
+
+
+@contextmanager
+def claimed(pending: PendingSet) -> Iterator[bool]:
+    """Take the set for delivery or removal without waiting (an flock on ``<set>/.claim``).
+
+    Yields False when another process holds it or the set is gone; the store lock is not
+    needed (and should not be held during a long upload).
+    """
+    try:
+        handle = (pending.root / ".claim").open("a")
+    except FileNotFoundError:
+        yield False
+        return
+    with handle:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            yield False
+            return
+        try:
+            yield (pending.root / "set.json").is_file()
         finally:
             fcntl.flock(handle, fcntl.LOCK_UN)
 

@@ -195,3 +195,33 @@ def test_only_the_three_newest_undelivered_sets_of_a_team_are_kept(
     outcomes = deliver_pending(store, team="Beta", opener=Opener(FakeUploader()), retry=FAST)
     assert [o.match_id for o in outcomes] == ["m2", "m3", "m4"]
     assert {s.team for s in pending_status(store)} == {"Alpha"}
+
+
+def test_a_set_being_delivered_elsewhere_is_skipped_and_not_pruned(
+    tmp_path: Path, creds: Path
+) -> None:
+    from orchestrator.delivery.store import claimed
+
+    store = tmp_path / "store"
+    enqueue_match_logs(
+        make_match(tmp_path, "m0"),
+        match_id="m0",
+        teams={"red": ("Alpha", creds)},
+        public_target=None,
+        store=store,
+    )
+    [busy] = pending_status(store)
+    with claimed(busy) as mine:
+        assert mine
+        assert deliver_pending(store, opener=Opener(FakeUploader()), retry=FAST) == []
+        for i in range(1, KEEP_UNDELIVERED + 2):
+            enqueue_match_logs(
+                make_match(tmp_path, f"m{i}"),
+                match_id=f"m{i}",
+                teams={"red": ("Alpha", creds)},
+                public_target=None,
+                store=store,
+            )
+        assert "m0" in [s.match_id for s in pending_status(store)]
+    outcomes = deliver_pending(store, opener=Opener(FakeUploader()), retry=FAST)
+    assert "m0" in [o.match_id for o in outcomes if o.delivered]
