@@ -1,0 +1,182 @@
+"""The runner's flow against in-memory fakes of the engine, the host and telemetry."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from orchestrator.config import Limits
+from orchestrator.match import (
+    FailureClass,
+    MatchPlan,
+    MatchRunner,
+    MatchState,
+    RobotPlan,
+    RunOptions,
+    TeamPlan,
+)
+from orchestrator.match.fake import FakeHost, FakeRuntime, FakeTelemetry
+
+
+def _plan(*, red_image: str = "team/red:1", blue_image: str = "team/blue:1", n: int = 2,
+          telemetry: bool = False, silence_s: float = 30.0) -> MatchPlan:
+    def robots(color: str, image: str) -> tuple[RobotPlan, ...]:
+        base = 10000 if color == "red" else 10020
+        return tuple(RobotPlan(color=color, number=i, port=base + i, image=image,
+                               command=("start", str(i))) for i in range(1, n + 1))
+
+    return MatchPlan(
+        match_id="u1", seed=3,
+        red=TeamPlan(color="red", name="R", robots=robots("red", red_image)),
+        blue=TeamPlan(color="blue", name="B", robots=robots("blue", blue_image)),
+        spec_builder=lambda addresses, telemetry: {"hosts": {k: list(v) for k, v in
+                                                             addresses.items()},
+                                                   "telemetry": telemetry},
+        limits=Limits(cpus=2.0, memory_gb=1.0, team_api_mb_s=10.0, team_comm_mb_s=1.0),
+        grace_period_s=3.0, telemetry=telemetry, telemetry_silence_s=silence_s,
+    )
+
+
+def _run(tmp_path: Path, plan: MatchPlan, runtime: FakeRuntime, **kwargs: Any
+         ) -> tuple[MatchRunner, Any]:
+    runner = MatchRunner(plan, runtime=runtime, host=FakeHost(),
+                         options=RunOptions(out_dir=tmp_path, simulator_image="sim:1",
+                                            poll_s=0.0), **kwargs)
+    return runner, runner.run()
+
+
+def test_success_writes_results_and_report_last(tmp_path: Path) -> None:
+    runtime = FakeRuntime()
+    runner, outcome = _run(tmp_path, _plan(), runtime)
+    assert outcome.ok
+    assert runner.lifecycle.history[-1] is MatchState.DONE
+    assert json.loads((tmp_path / "report.json").read_text()) == {"status": "success"}
+    results = json.loads((tmp_path / "results.json").read_text())
+    assert results["score"] == {"red": 2, "blue": 1}
+    robot = results["robots"]["red-2"]
+    assert robot["limits"]["api_rate_bit_s"] == 40_000_000  # 10 MB/s over 2 robots
+    assert robot["limits"]["comm_rate_bit_s"] == 4_000_000
+    assert robot["sent_bytes"] == 110 and robot["received_bytes"] == 220
+    assert robot["cpu_peak_percent"] == 150.0
+    assert (tmp_path / "public/replay.hlvsrec").read_text() == "replay"
+    assert (tmp_path / "teams/red/2/stdout.log").read_text().startswith("hlvs-u1-red-2")
+    assert runtime.containers == {} and runtime.networks == {}
+    spec = json.loads((tmp_path / "simulator/match_spec.json").read_text())
+    assert spec["hosts"]["red"][1].endswith(".12")
+    created = [name for call, name in runtime.calls if call == "create_container"]
+    assert len(created) == 9 and created[0] == "hlvs-u1-simulator"
+    for key in ("red-1", "red-2", "blue-1", "blue-2"):  # shaped namespace before the robot
+        assert created.index(f"hlvs-u1-{key}-net") < created.index(f"hlvs-u1-{key}")
+
+
+def test_busy_subnets_are_skipped(tmp_path: Path) -> None:
+    from orchestrator.match.layout import candidate_subnets
+
+    first = str(candidate_subnets("u1/control")[0].network)
+    runtime = FakeRuntime(busy_subnets=(first,))
+    _, outcome = _run(tmp_path, _plan(), runtime)
+    assert outcome.ok
+    assert [c for c in runtime.calls if c == ("create_network", "hlvs-u1-control")] != []
+
+
+def test_robot_requests_carry_environment_limits_and_no_privileges(tmp_path: Path) -> None:
+    runtime = FakeRuntime()
+    seen: list[Any] = []
+    runtime.on_start = lambda c: seen.append(c.request)
+    _run(tmp_path, _plan(), runtime)
+    robot = next(r for r in seen if r.name == "hlvs-u1-blue-2")
+    env = robot.environment
+    assert env["ROBOCUP_ROBOT_ID"] == "2" and env["ROBOCUP_TEAM_COLOR"] == "blue"
+    assert env["ROBOCUP_SIMULATOR_ADDR"] == f"{env['ROBOCUP_MIRROR_SERVER_IP']}:10022"
+    assert set(k for k in env if k.startswith("ROBOCUP_TEAM_PLAYER")) == {
+        "ROBOCUP_TEAM_PLAYER1_IP", "ROBOCUP_TEAM_PLAYER2_IP"}
+    assert robot.command == ("start", "2")
+    assert robot.nano_cpus == 2_000_000_000 and robot.mem_bytes == 1_000_000_000
+    assert robot.cap_drop == ("ALL",) and robot.security_opt == ("no-new-privileges",)
+    assert robot.network_mode is not None and robot.network_mode.startswith("container:")
+    assert [m.target for m in robot.mounts] == ["/robocup-logs"]
+
+
+def test_forfeit_when_a_team_has_no_usable_image(tmp_path: Path) -> None:
+    runtime = FakeRuntime(missing_images=("team/blue:1",))
+    runner, outcome = _run(tmp_path, _plan(), runtime)
+    assert outcome.ok
+    assert outcome.results["forfeit"]["team"] == "blue"
+    assert outcome.results["winner"] == "red"
+    assert not [c for c in runtime.calls if c[0] == "create_container"]
+    assert runner.lifecycle.history == [MatchState.PENDING, MatchState.PULLING,
+                                        MatchState.STOPPING, MatchState.COLLECTING,
+                                        MatchState.DONE]
+
+
+def test_simulator_crash_is_a_simulator_failure(tmp_path: Path) -> None:
+    runtime = FakeRuntime(simulator_exit_code=2)
+    runner, outcome = _run(tmp_path, _plan(), runtime)
+    assert outcome.failure is not None
+    assert outcome.failure.failure_class is FailureClass.SIMULATOR
+    assert "code 2" in outcome.failure.cause
+    report = json.loads((tmp_path / "report.json").read_text())
+    assert report["failure_class"] == "simulator"
+    assert runner.lifecycle.state is MatchState.FAILED
+    assert runtime.containers == {}
+
+
+def test_game_not_finished_is_a_referee_failure(tmp_path: Path) -> None:
+    runtime = FakeRuntime(sim_result={"final_state": "PLAYING", "robots": {}})
+    _, outcome = _run(tmp_path, _plan(), runtime)
+    assert outcome.failure is not None
+    assert outcome.failure.failure_class is FailureClass.REFEREE
+
+
+def test_silent_telemetry_fails_the_match(tmp_path: Path) -> None:
+    runtime = FakeRuntime(simulator_exit_code=None)
+    now = [0.0]
+
+    def clock() -> float:
+        now[0] += 1.0
+        return now[0]
+
+    telemetry = FakeTelemetry([], clock=clock, silent=True)
+    _, outcome = _run(tmp_path, _plan(telemetry=True, silence_s=5.0), runtime,
+                      telemetry=lambda endpoint, match_id: telemetry, clock=clock)
+    assert outcome.failure is not None
+    assert outcome.failure.failure_class is FailureClass.SIMULATOR
+    assert "telemetry silent" in outcome.failure.cause
+    assert telemetry.closed
+
+
+def test_telemetry_moves_waiting_to_playing_and_measures_bringup(tmp_path: Path) -> None:
+    runtime = FakeRuntime(simulator_polls=6)
+    clock_now = [0.0]
+
+    def clock() -> float:
+        clock_now[0] += 0.5
+        return clock_now[0]
+
+    states = [{"state": "INITIAL", "connected": ["red-1"]},
+              {"state": "INITIAL", "connected": ["red-1", "red-2", "blue-1", "blue-2"]},
+              {"state": "READY", "connected": ["red-1", "red-2", "blue-1", "blue-2"]}]
+    telemetry = FakeTelemetry(states, clock=clock)
+    runner, outcome = _run(tmp_path, _plan(telemetry=True), runtime,
+                           telemetry=lambda endpoint, match_id: telemetry, clock=clock)
+    assert outcome.ok
+    assert outcome.bringup_s is not None and outcome.bringup_s > 0
+    assert MatchState.PLAYING in runner.lifecycle.history
+    spec = json.loads((tmp_path / "simulator/match_spec.json").read_text())
+    assert spec["telemetry"].startswith("tcp/10.213.") and spec["telemetry"].endswith(":7447")
+
+
+def test_robot_exit_mid_game_is_recorded_and_the_game_goes_on(tmp_path: Path) -> None:
+    runtime = FakeRuntime(simulator_polls=8)
+
+    def crash_red_1(container: Any) -> None:
+        if container.request.name == "hlvs-u1-red-1":
+            runtime.exit(container.state.id, 137, oom=True)
+
+    runtime.on_start = crash_red_1
+    _, outcome = _run(tmp_path, _plan(), runtime)
+    assert outcome.ok
+    robot = outcome.results["robots"]["red-1"]
+    assert robot["oom_killed"] is True and robot["exit_code"] == 137
+    assert outcome.results["robots"]["red-2"]["oom_killed"] is False

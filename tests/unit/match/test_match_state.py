@@ -1,0 +1,53 @@
+from __future__ import annotations
+
+import logging
+
+import pytest
+
+from orchestrator.match import IllegalTransition, Lifecycle, MatchState
+
+
+class Clock:
+    def __init__(self) -> None:
+        self.now = 0.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+def test_full_lifecycle_records_time_per_state_and_logs(caplog: pytest.LogCaptureFixture) -> None:
+    clock = Clock()
+    life = Lifecycle("m1", clock=clock)
+    caplog.set_level(logging.INFO, logger="orchestrator.match.state")
+    for step, state in enumerate([MatchState.PULLING, MatchState.STARTING, MatchState.WAITING,
+                                  MatchState.PLAYING, MatchState.STOPPING, MatchState.COLLECTING,
+                                  MatchState.DONE], start=1):
+        clock.now = float(step)
+        life.advance(state)
+    assert life.state is MatchState.DONE
+    assert life.timings_s["pending"] == 1.0 and life.timings_s["collecting"] == 1.0
+    assert len([r for r in caplog.records if "->" in r.getMessage()]) == 7
+    assert "match m1: COLLECTING -> DONE" in caplog.records[-1].getMessage()
+
+
+@pytest.mark.parametrize(
+    ("path", "target"),
+    [
+        ([], MatchState.PLAYING),
+        ([MatchState.PULLING], MatchState.DONE),
+        ([MatchState.PULLING, MatchState.STARTING], MatchState.COLLECTING),
+        ([MatchState.FAILED], MatchState.PULLING),
+        ([MatchState.PULLING, MatchState.STOPPING, MatchState.COLLECTING, MatchState.DONE],
+         MatchState.FAILED),
+    ],
+)
+def test_illegal_transitions_are_rejected(path: list[MatchState], target: MatchState) -> None:
+    life = Lifecycle("m2")
+    for state in path:
+        life.advance(state)
+    before = life.state
+    with pytest.raises(IllegalTransition) as info:
+        life.advance(target)
+    assert info.value.source is before and info.value.target is target
+    assert "m2" in str(info.value) and "allowed from" in str(info.value)
+    assert life.state is before

@@ -1,0 +1,59 @@
+"""ZenohTelemetry against a real zenoh publisher on loopback; the plain progress view."""
+
+from __future__ import annotations
+
+import io
+import json
+import socket
+import time
+
+import zenoh
+
+from orchestrator.telemetry import LiveView, ZenohTelemetry, describe
+
+
+def _free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return int(sock.getsockname()[1])
+
+
+def test_subscriber_receives_state_and_events_from_a_listening_publisher() -> None:
+    endpoint = f"tcp/127.0.0.1:{_free_port()}"
+    watcher = ZenohTelemetry(endpoint=endpoint, match_id="tm1")  # before the publisher exists
+    config = zenoh.Config()
+    config.insert_json5("mode", '"peer"')
+    config.insert_json5("scouting/multicast/enabled", "false")
+    config.insert_json5("listen/endpoints", json.dumps([endpoint]))
+    publisher = zenoh.open(config)
+    try:
+        state = {"state": "READY", "half": 1, "score": {"red": 0, "blue": 0},
+                 "connected": ["red-1"], "sim_time_ms": 1200, "real_time_factor": 1.0}
+        deadline = time.monotonic() + 20
+        while watcher.latest() is None and time.monotonic() < deadline:
+            publisher.put("hlvs/tm1/state", json.dumps(state))
+            publisher.put("hlvs/other/state", json.dumps({"state": "PLAYING"}))
+            publisher.put("hlvs/tm1/events", json.dumps({"type": "GOAL"}))
+            time.sleep(0.1)
+        assert watcher.latest() == state
+        assert watcher.last_message_at() is not None
+        deadline = time.monotonic() + 5
+        while not watcher.events() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert watcher.events()[0] == {"type": "GOAL"}
+    finally:
+        watcher.close()
+        publisher.close()
+
+
+def test_plain_view_prints_changes_only() -> None:
+    out = io.StringIO()
+    view = LiveView(match_id="m", stream=out)
+    state = {"state": "PLAYING", "half": 1, "score": {"red": 1, "blue": 0}, "connected": []}
+    view.update(phase="playing", state=state)
+    view.update(phase="playing", state={**state, "sim_time_ms": 500})
+    view.update(phase="playing", state={**state, "score": {"red": 2, "blue": 0}})
+    lines = out.getvalue().splitlines()
+    assert len(lines) == 2
+    assert "score red 2 - 0 blue" in lines[1]
+    assert describe(state).startswith("PLAYING half 1")
