@@ -187,6 +187,21 @@ def assemble_context(
         target = context_dir / "src" / path.relative_to(repo_root)
         target.parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(path, target)
+    # Distribution metadata, so importlib.metadata.version("hlvs-runner") works in the image.
+    info_dir = context_dir / "src" / f"hlvs_runner-{project_version()}.dist-info"
+    info_dir.mkdir(parents=True, exist_ok=True)
+    (info_dir / "METADATA").write_text(
+        f"Metadata-Version: 2.1\nName: hlvs-runner\nVersion: {project_version()}\n",
+        encoding="utf-8",
+    )
+
+
+def project_version() -> str:
+    """The version of the hlvs-runner distribution installed on the host."""
+    try:
+        return metadata.version("hlvs-runner")
+    except metadata.PackageNotFoundError:
+        return "0"
 
 
 def _link_or_copy(source: Path, target: Path) -> None:
@@ -203,6 +218,7 @@ __all__ = [
     "debootstrap_rootfs",
     "ensure_wheels",
     "pinned_requirements",
+    "project_version",
     "source_files",
     "wheel_names",
 ]

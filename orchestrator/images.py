@@ -200,6 +200,7 @@ def content_hash(
         feed(str(path.relative_to(REPO_ROOT)), path.read_bytes())
     feed("requirements", (wheel_dir / "requirements.txt").read_bytes())
     feed("wheels", "\n".join(image_inputs.wheel_names(wheel_dir)).encode())
+    feed("version", image_inputs.project_version().encode())
     feed("base", base_id.encode())
     feed("args", repr(sorted(build_args.items())).encode())
     return digest.hexdigest()[:12]
