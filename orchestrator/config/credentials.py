@@ -126,7 +126,10 @@ def load_credentials(path: Path | str) -> Credentials:
         problem = Problem(name, "", f"not valid JSON: {exc.msg} at line {exc.lineno}", "JSON")
         raise ConfigError([problem]) from exc
     warnings = _permission_warnings(path)
-    credentials = parse_credentials(document, source=path, warnings=warnings)
+    try:
+        credentials = parse_credentials(document, source=path, warnings=warnings)
+    except ConfigError as exc:
+        raise ConfigError([*exc.problems, *warnings]) from None
     for warning in credentials.warnings:
         log.warning("%s", warning)
     return credentials
