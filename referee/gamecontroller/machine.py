@@ -23,6 +23,8 @@ from referee.snapshot import RobotId, TeamColor
 
 logger = logging.getLogger(__name__)
 
+EPSILON_S = 1e-6  # timers are sums of 8 ms steps in floating point
+
 
 @dataclass(slots=True)
 class RobotInfo:
@@ -244,14 +246,14 @@ class GameController:
         if not shootout or self.state is GameState.PLAYING:
             before = self.secs_remaining
             self.secs_remaining -= dt_s  # no added time: READY and SET count as played
-            period_over = before > 0 >= self.secs_remaining
+            period_over = before > EPSILON_S >= self.secs_remaining
         unpenalised = []
         for color, team in self.teams.items():
             for number, info in sorted(team.robots.items()):
                 if info.penalty is Penalty.NONE or info.red_cards:
                     continue
                 info.secs_till_unpenalised -= dt_s
-                if info.secs_till_unpenalised <= 0:
+                if info.secs_till_unpenalised <= EPSILON_S:
                     info.penalty = Penalty.NONE
                     info.secs_till_unpenalised = 0.0
                     unpenalised.append(RobotId(color, number))
@@ -259,10 +261,10 @@ class GameController:
         auto_set = False
         phase: int | None = None
         executed: SetPlay | None = None
-        if self.state is GameState.READY and self.secondary_time <= 0:
+        if self.state is GameState.READY and self.secondary_time <= EPSILON_S:
             self.transition(GameState.SET)
             auto_set = True
-        elif self.set_play is not None and self.secondary_time <= 0:
+        elif self.set_play is not None and self.secondary_time <= EPSILON_S:
             play = self.set_play
             if play.sub_phase == 0:
                 phase = 1

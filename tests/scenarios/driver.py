@@ -177,7 +177,9 @@ def _check_state(run: Run, exp: Expectation, snap: WorldSnapshot) -> None:
             if got != want:
                 fail(key, want, got)
         elif key in ("penalised", "not_penalised"):
-            penalised = set(gs["penalties"])  # type: ignore[arg-type]
+            penalties = gs["penalties"]
+            assert isinstance(penalties, dict)
+            penalised = set(penalties)
             for name in want:
                 if (name in penalised) != (key == "penalised"):
                     fail(key, name, sorted(penalised))

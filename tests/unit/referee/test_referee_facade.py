@@ -1,0 +1,96 @@
+"""The Referee facade: start-up placement, wall-clock waits, logs, game state and result."""
+
+from __future__ import annotations
+
+import json
+import re
+from dataclasses import replace
+from pathlib import Path
+
+from referee import FakeClock, PlaceBall, Referee, SetLimp, TeleportRobot
+from referee.config import GameType
+from tests.unit.referee.referee_helpers import FAST_TIMING, RED, make_config, robot, snapshot
+
+LINE = re.compile(r"^\[\d{4}\.\d{3}\|\d{4}\.\d{3}\] (Info|Warning|Error): .+$")
+STILL = (robot(RED, 1, -2.0, 0.5), robot(RED, 2, -1.0, -0.5))
+
+
+def test_start_teleports_to_half_time_poses_and_places_ball() -> None:
+    ref = Referee(config=make_config(side_left=RED), clock=FakeClock())
+    commands = ref.step(snapshot(0, STILL))
+    teleports = [c for c in commands if isinstance(c, TeleportRobot)]
+    assert len(teleports) == 4
+    red1 = next(t for t in teleports if str(t.robot) == "red player 1")
+    blue1 = next(t for t in teleports if str(t.robot) == "blue player 1")
+    assert (red1.x_m, red1.y_m) == (-1.5, -3.1)
+    assert (blue1.x_m, blue1.y_m) == (1.5, -3.1)  # mirrored for the right side
+    assert PlaceBall(position=(0.0, 0.0, 0.07)) in commands
+
+
+def test_wall_clock_wait_before_first_ready() -> None:
+    clock = FakeClock()
+    timing = replace(FAST_TIMING, wait_before_first_ready_real_s=120.0)
+    ref = Referee(config=make_config(timing=timing), clock=clock)
+    ms = 0
+    for _ in range(50):
+        ref.step(snapshot(ms, STILL))
+        ms += 8
+    assert ref.waiting_for_wall_clock and ref.game_state["state"] == "INITIAL"
+    clock.advance(119.0)
+    ref.step(snapshot(ms, STILL))
+    assert ref.waiting_for_wall_clock
+    clock.advance(1.0)
+    ref.step(snapshot(ms + 8, STILL))
+    assert not ref.waiting_for_wall_clock and ref.game_state["state"] == "READY"
+    assert ref.game_state["secs_remaining"] == 60  # the clock did not run while waiting
+
+
+def _play(ref: Referee, clock: FakeClock, robots: tuple[object, ...], limit_ms: int) -> int:
+    ms = 0
+    while not ref.finished and ms < limit_ms:
+        for command in ref.step(snapshot(ms, robots)):  # type: ignore[arg-type]
+            assert isinstance(command, TeleportRobot | PlaceBall | SetLimp)
+        ms += 8
+        clock.advance(0.008)
+    return ms
+
+
+def test_logs_and_result(tmp_path: Path) -> None:
+    clock = FakeClock()
+    timing = replace(FAST_TIMING, half_duration_s=30.0, status_period_real_s=20.0)
+    ref = Referee(config=make_config(timing=timing), clock=clock, log_dir=tmp_path)
+    _play(ref, clock, STILL, 100_000)
+    ref.close()
+    assert ref.finished
+    result = ref.result()
+    assert result["winner"] == "draw" and result["score"] == {"red": 0, "blue": 0}
+    assert result["events_summary"]["game_over"] == 1  # type: ignore[index]
+    human = (tmp_path / "referee.log").read_text().splitlines()
+    assert human and all(LINE.match(line) for line in human), human[:3]
+    assert any("STATUS: Avg speed factor: 1.000" in line for line in human)
+    assert any(line.endswith("FINAL SCORE: 0-0") for line in human)
+    events = [json.loads(x) for x in (tmp_path / "referee_events.jsonl").read_text().splitlines()]
+    assert {"time", "type", "team", "player", "reason", "placement"} <= set(events[0])
+    assert len(events) == len(ref.events)
+    assert "state PLAYING" in (tmp_path / "gamecontroller.log").read_text()
+
+
+def test_game_state_dict_for_telemetry() -> None:
+    ref = Referee(config=make_config(), clock=FakeClock())
+    ref.step(snapshot(0, STILL))
+    state = ref.game_state
+    assert {"state", "secondary_state", "half", "secs_remaining", "score", "penalties"} <= set(
+        state
+    )
+    assert state["state"] == "READY" and state["score"] == {"red": 0, "blue": 0}
+
+
+def test_penalty_game_result_has_shootout() -> None:
+    clock = FakeClock()
+    ref = Referee(config=make_config(game_type=GameType.PENALTY), clock=clock)
+    _play(ref, clock, STILL, 200_000)
+    result = ref.result()
+    assert ref.finished and result["winner"] in ("red", "blue")
+    assert result["coin_toss"] is True
+    kicks = {"kicks": 10, "scored": 0}
+    assert result["shootout"] == {"red": kicks, "blue": kicks}

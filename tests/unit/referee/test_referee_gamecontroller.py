@@ -1,0 +1,173 @@
+"""The GameController state machine on simulated time."""
+
+from __future__ import annotations
+
+import pytest
+
+from referee import IllegalTransition
+from referee.config import GameType, TimingConfig
+from referee.gamecontroller import (
+    Card,
+    GameController,
+    GameState,
+    Penalty,
+    SecondaryState,
+    Tick,
+)
+from referee.snapshot import RobotId, TeamColor
+
+RED, BLUE = TeamColor.RED, TeamColor.BLUE
+
+
+def make(game_type: GameType = GameType.NORMAL, **timing: float) -> GameController:
+    return GameController(
+        game_type=game_type,
+        players={RED: (1, 2, 3, 4), BLUE: (1, 2, 3, 4)},
+        kickoff=RED,
+        timing=TimingConfig(**timing),
+    )
+
+
+def run(gc: GameController, seconds: float, dt: float = 0.008) -> list[Tick]:
+    ticks: list[Tick] = []
+    for _ in range(round(seconds / dt)):
+        ticks.append(gc.advance(dt))
+    return ticks
+
+
+@pytest.mark.parametrize(
+    ("path", "bad"),
+    [
+        ((), GameState.PLAYING),
+        ((), GameState.FINISHED),
+        ((GameState.READY,), GameState.PLAYING),
+        ((GameState.READY, GameState.SET), GameState.READY),
+        ((GameState.READY, GameState.SET, GameState.PLAYING), GameState.INITIAL),
+    ],
+)
+def test_illegal_transitions_are_rejected(path: tuple[GameState, ...], bad: GameState) -> None:
+    gc = make()
+    for state in path:
+        gc.transition(state)
+    with pytest.raises(IllegalTransition) as info:
+        gc.transition(bad)
+    assert info.value.requested == bad.name and info.value.current == gc.state.name
+
+
+def test_ready_lasts_45_s_then_set_and_clock_counts_ready() -> None:
+    gc = make(half_duration_s=600.0)
+    gc.transition(GameState.READY)
+    assert gc.secondary_time == 45.0
+    ticks = run(gc, 44.9)
+    assert gc.state is GameState.READY and not any(t.auto_set for t in ticks)
+    run(gc, 0.2)
+    assert gc.state.name == "SET"
+    assert 554.8 < gc.secs_remaining < 555.0  # no added time
+
+
+def test_clock_stands_still_in_initial_and_finished() -> None:
+    gc = make(half_duration_s=10.0)
+    run(gc, 5.0)
+    assert gc.secs_remaining == 10.0
+    for state in (GameState.READY, GameState.SET, GameState.PLAYING):
+        gc.transition(state)
+    ticks = run(gc, 10.0)
+    assert any(t.period_over for t in ticks)
+    gc.transition(GameState.FINISHED)
+    before = gc.secs_remaining
+    run(gc, 3.0)
+    assert gc.secs_remaining == before
+
+
+def test_goal_scores_gives_kickoff_to_the_conceding_team() -> None:
+    gc = make()
+    for state in (GameState.READY, GameState.SET, GameState.PLAYING):
+        gc.transition(state)
+    gc.goal(RED)
+    assert gc.score(RED) == 1 and gc.kickoff_team is BLUE and gc.state is GameState.READY
+
+
+def test_penalty_timer_and_unpenalise() -> None:
+    gc = make(removal_penalty_s=10.0)
+    for state in (GameState.READY, GameState.SET, GameState.PLAYING):
+        gc.transition(state)
+    robot = RobotId(BLUE, 3)
+    gc.penalize(robot, Penalty.PHYSICAL_CONTACT)
+    assert gc.penalised() == (robot,)
+    ticks = run(gc, 9.9)
+    assert not any(t.unpenalised for t in ticks)
+    ticks = run(gc, 0.2)
+    assert any(t.unpenalised == (robot,) for t in ticks)
+    assert gc.robot(robot).penalty is Penalty.NONE
+
+
+def test_cards_escalate() -> None:
+    gc = make()
+    robot = RobotId(RED, 2)
+    assert gc.card(robot, Card.WARNING) is Card.WARNING
+    assert gc.card(robot, Card.WARNING) is Card.YELLOW
+    assert (gc.robot(robot).warnings, gc.robot(robot).yellow_cards) == (0, 1)
+    assert gc.card(robot, Card.YELLOW) is Card.RED
+    info = gc.robot(robot)
+    assert info.red_cards == 1 and info.penalty is Penalty.SUBSTITUTE
+    gc.unpenalize(robot)
+    assert gc.robot(robot).penalty is Penalty.SUBSTITUTE  # a red card stays
+
+
+def test_set_play_sub_phases_and_timing() -> None:
+    gc = make(set_play_phase0_s=5.0, set_play_ready_s=15.0, set_play_prepare_s=5.0)
+    for state in (GameState.READY, GameState.SET, GameState.PLAYING):
+        gc.transition(state)
+    gc.begin_set_play(SecondaryState.PENALTYKICK, BLUE)
+    assert gc.secondary_state is SecondaryState.PENALTYKICK and gc.set_play.sub_phase == 0  # type: ignore[union-attr]
+    run(gc, 5.01)
+    assert gc.set_play is not None and gc.set_play.sub_phase == 1
+    assert gc.secondary_time == pytest.approx(30.0, abs=0.02)  # penalty kick: twice the time
+    run(gc, 30.0)
+    assert gc.set_play is not None and gc.set_play.sub_phase == 2
+    ticks = run(gc, 5.0)
+    executed = [t.set_play_executed for t in ticks if t.set_play_executed]
+    assert len(executed) == 1 and gc.secondary_state.name == "NORMAL"
+
+
+def test_set_play_only_while_playing() -> None:
+    gc = make()
+    with pytest.raises(IllegalTransition):
+        gc.begin_set_play(SecondaryState.THROW_IN, RED)
+    with pytest.raises(ValueError):
+        gc.begin_set_play(SecondaryState.OVERTIME, RED)
+
+
+def test_periods_of_a_knockout_game() -> None:
+    gc = make(GameType.KNOCKOUT, half_duration_s=600.0, overtime_half_duration_s=300.0)
+    seen = []
+    for _ in range(4):
+        for state in (GameState.READY, GameState.SET, GameState.PLAYING, GameState.FINISHED):
+            gc.transition(state)
+        phase = gc.next_period()
+        seen.append((phase, gc.half, gc.secs_remaining, gc.kickoff_team))
+    assert seen == [
+        (SecondaryState.NORMAL, 2, 600.0, BLUE),
+        (SecondaryState.OVERTIME, 1, 300.0, RED),
+        (SecondaryState.OVERTIME, 2, 300.0, BLUE),
+        (SecondaryState.PENALTYSHOOT, 1, 60.0, RED),
+    ]
+
+
+def test_penalty_game_starts_with_the_shootout() -> None:
+    gc = make(GameType.PENALTY)
+    assert gc.phase is SecondaryState.PENALTYSHOOT
+    gc.transition(GameState.SET)
+    gc.transition(GameState.PLAYING)
+    gc.shootout_kick(RED, True)
+    gc.shootout_kick(RED, False)
+    gc.shootout_kick(RED, True)
+    assert gc.teams[RED].single_shots == 0b101 and gc.teams[RED].penalty_shots == 3
+    assert gc.score(RED) == 2
+
+
+def test_goalkeeper_flag_moves() -> None:
+    gc = make()
+    assert gc.goalkeeper(RED) == 1
+    gc.set_goalkeeper(RobotId(RED, 3))
+    assert gc.goalkeeper(RED) == 3 and not gc.robot(RobotId(RED, 1)).goalkeeper

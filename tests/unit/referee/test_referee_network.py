@@ -1,0 +1,188 @@
+"""GameController UDP (RGme out, RGrt in) and the team mirror, over real sockets on 127.x."""
+
+from __future__ import annotations
+
+import socket
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pytest
+
+from referee import FakeClock, Referee, SystemClock, TeamMirror
+from referee.config import NetworkConfig
+from referee.net import GameControllerNetwork
+from referee.snapshot import RobotId, TeamColor
+from referee.wire import ReturnData, ReturnMessage, decode_game_state, encode_return
+from tests.unit.referee.referee_helpers import BLUE, RED, make_config, robot, snapshot
+
+
+def free_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+def udp(host: str, port: int) -> socket.socket:
+    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    sock.bind((host, port))
+    sock.settimeout(0.05)
+    return sock
+
+
+def wait_for(condition: Callable[[], bool], timeout_s: float = 5.0) -> bool:
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        if condition():
+            return True
+        time.sleep(0.01)
+    return condition()
+
+
+def receive_all(sock: socket.socket, duration_s: float) -> list[tuple[bytes, tuple[str, int]]]:
+    got = []
+    deadline = time.monotonic() + duration_s
+    while time.monotonic() < deadline:
+        try:
+            got.append(sock.recvfrom(4096))
+        except TimeoutError:
+            continue
+    return got
+
+
+@pytest.fixture
+def robots() -> Iterator[dict[str, socket.socket]]:
+    port = free_port()
+    sockets = {host: udp(host, port) for host in ("127.0.0.2", "127.0.0.3", "127.0.0.4")}
+    yield sockets
+    for sock in sockets.values():
+        sock.close()
+
+
+def test_rgme_sent_to_every_robot_at_2_hz_and_on_change(robots: dict[str, socket.socket]) -> None:
+    port = robots["127.0.0.2"].getsockname()[1]
+    net = GameControllerNetwork(
+        bind_host="127.0.0.1", data_port=port, return_port=0, targets=list(robots),
+        team_numbers={8: RED, 25: BLUE}, send_rate_hz=2.0, clock=SystemClock(),
+    )
+    config = make_config()
+    ref = Referee(config=config, clock=FakeClock())
+    with net:
+        net.publish(ref.packet(), changed=True)
+        got = receive_all(robots["127.0.0.3"], 1.6)
+        assert 3 <= len(got) <= 5, len(got)  # first at once, then every 0.5 s
+        data = decode_game_state(got[0][0], peer="test")
+        assert data.teams[0].team_number == 25 and data.teams[1].team_number == 8
+        assert got[0][1][0] == "127.0.0.1"
+        ref.step(snapshot(0, (robot(RED, 1, -1, 0),)))  # INITIAL -> READY (no wait)
+        started = time.monotonic()
+        net.publish(ref.packet(), changed=True)
+        first = robots["127.0.0.4"].recvfrom(4096)
+        assert time.monotonic() - started < 0.3  # a change is sent at once
+        assert decode_game_state(first[0]).state in (0, 1)
+        assert wait_for(lambda: net.stats().packets_sent >= 5)
+        assert net.stats().datagrams_sent >= 3 * 5
+
+
+def test_rgrt_tracking_and_garbage() -> None:
+    net = GameControllerNetwork(
+        bind_host="127.0.0.1", data_port=free_port(), return_port=0, targets=[],
+        team_numbers={8: RED, 25: BLUE}, send_rate_hz=2.0, clock=SystemClock(),
+    )
+    address = net.return_address
+    with net, udp("127.0.0.5", 0) as sender:
+        sender.sendto(encode_return(ReturnData(8, 2, ReturnMessage.ALIVE)), address)
+        sender.sendto(encode_return(ReturnData(8, 2, ReturnMessage.GOALKEEPER)), address)
+        sender.sendto(encode_return(ReturnData(25, 1, ReturnMessage.MAN_PENALISE)), address)
+        sender.sendto(encode_return(ReturnData(25, 1, ReturnMessage.MAN_UNPENALISE)), address)
+        sender.sendto(encode_return(ReturnData(25, 1, ReturnMessage.GAME_INTERRUPTION_READY)),
+                      address)
+        sender.sendto(encode_return(ReturnData(99, 1, ReturnMessage.ALIVE)), address)
+        sender.sendto(b"hello robots", address)
+        sender.sendto(b"RGrt\x07\x08\x01\x02", address)
+        assert wait_for(lambda: net.stats().garbage == 2 and net.stats().unknown == 1)
+        links = net.links()
+        red2, blue1 = links[RobotId(RED, 2)], links[RobotId(BLUE, 1)]
+        assert red2.messages == 2 and red2.goalkeeper_claim and red2.address == "127.0.0.5"
+        assert red2.alive_s is not None
+        assert (blue1.manual_penalise, blue1.manual_unpenalise) == (1, 1)
+        assert blue1.ready_s is not None
+        assert net.take_goalkeeper_claims() == [RobotId(RED, 2)]
+        assert net.take_goalkeeper_claims() == []
+        assert net.stats().returns_received == 5
+
+
+def test_referee_network_end_to_end(tmp_path: Path, robots: dict[str, socket.socket]) -> None:
+    """Referee.start_network: RGme to the robots, a goalkeeper claim reaches the GameController,
+    the mirror relays team messages."""
+    port = robots["127.0.0.2"].getsockname()[1]
+    config = make_config(addresses={RED: ("127.0.0.2", "127.0.0.3"), BLUE: ("127.0.0.4",)})
+    from dataclasses import replace
+
+    config = replace(
+        config,
+        network=NetworkConfig(bind_host="127.0.0.1", gc_data_port=port, gc_return_port=0,
+                              mirror_port=port),
+    )
+    ref = Referee(config=config, clock=SystemClock(), log_dir=tmp_path)
+    ref.start_network()
+    try:
+        assert ref.network is not None and ref.mirror is not None
+        got = receive_all(robots["127.0.0.4"], 0.3)
+        assert got and decode_game_state(got[0][0]).teams[1].team_number == 8
+        claim = encode_return(ReturnData(8, 2, ReturnMessage.GOALKEEPER))
+        robots["127.0.0.3"].sendto(claim, ref.network.return_address)
+        assert wait_for(lambda: RobotId(RED, 2) in ref.network.links())  # type: ignore[union-attr]
+        ref.step(snapshot(0, (robot(RED, 1, -1, 0),)))
+        assert ref.gc.goalkeeper(RED) == 2
+        robots["127.0.0.2"].sendto(b"team talk", ref.mirror.address)
+        deadline = time.monotonic() + 3
+        relayed = None
+        while relayed is None and time.monotonic() < deadline:
+            for payload, source in receive_all(robots["127.0.0.3"], 0.1):
+                if payload == b"team talk":
+                    relayed = source
+        assert relayed is not None and relayed[1] == port
+    finally:
+        ref.close()
+    assert "packets sent" in (tmp_path / "gamecontroller.log").read_text()
+
+
+def test_mirror_relays_to_teammates_only(tmp_path: Path) -> None:
+    port = free_port()
+    hosts = {RED: ["127.0.0.2", "127.0.0.3", "127.0.0.4"], BLUE: ["127.0.0.5", "127.0.0.6"]}
+    sockets = {h: udp(h, port) for team in hosts.values() for h in team}
+    stranger = udp("127.0.0.9", port)
+    try:
+        with TeamMirror(bind_host="127.0.0.1", port=port, teams=hosts, log_dir=tmp_path) as mirror:
+            sockets["127.0.0.2"].sendto(b"x" * 1024, mirror.address)
+            sockets["127.0.0.2"].sendto(b"y" * 1025, mirror.address)
+            stranger.sendto(b"spy", mirror.address)
+            sockets["127.0.0.6"].sendto(b"blue plan", mirror.address)
+            assert wait_for(lambda: mirror.stats().received == 4)
+            assert wait_for(lambda: mirror.stats().forwarded == 3)
+            received = {h: [p for p, _ in receive_all(s, 0.3)] for h, s in sockets.items()}
+            assert received["127.0.0.3"] == [b"x" * 1024] == received["127.0.0.4"]
+            assert received["127.0.0.2"] == []  # not back to the sender
+            assert received["127.0.0.5"] == [b"blue plan"] and received["127.0.0.6"] == []
+            assert receive_all(stranger, 0.1) == []
+            stats = mirror.stats()
+            assert (stats.oversized, stats.unknown) == (1, 1)
+        log = (tmp_path / "bouncing_log.txt").read_text()
+        assert "Dropped 1025 bytes from red 127.0.0.2" in log
+        assert "Ignored 3 bytes from unknown host 127.0.0.9" in log
+        assert "Bounced 9 bytes from blue 127.0.0.6 to 1 teammates" in log
+    finally:
+        for sock in [*sockets.values(), stranger]:
+            sock.close()
+
+
+def test_mirror_ignores_address_listed_for_both_teams() -> None:
+    port = free_port()
+    hosts = {TeamColor.RED: ["127.0.0.1", "127.0.0.2"], TeamColor.BLUE: ["127.0.0.1", "127.0.0.3"]}
+    with udp("127.0.0.3", port) as blue, udp("127.0.0.2", port) as red:
+        with TeamMirror(bind_host="127.0.0.7", port=port, teams=hosts) as mirror:
+            with udp("127.0.0.1", port) as shared:
+                shared.sendto(b"who am i", mirror.address)
+                assert wait_for(lambda: mirror.stats().unknown == 1)
+            assert receive_all(blue, 0.1) == [] and receive_all(red, 0.1) == []

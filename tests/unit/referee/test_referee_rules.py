@@ -1,0 +1,333 @@
+"""AutoRef rules as pure functions on hand-made snapshots."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from referee.config import GameType, Pose, TimingConfig
+from referee.field import KID_FIELD
+from referee.gamecontroller import Card, GameState, Penalty, SecondaryState
+from referee.gamecontroller.machine import SetPlay
+from referee.rules import (
+    ball_holding,
+    ball_out,
+    dropped_ball,
+    end_of_game,
+    fallen,
+    goal,
+    goalkeeper,
+    kickoff,
+    outside_turf,
+    pushing,
+    removal,
+)
+from referee.rules.base import AwardSetPlay, DropBall, GameView, GiveCard, Goal, PenalizeRobot
+from referee.snapshot import RobotId
+from tests.unit.referee.referee_helpers import BLUE, RED, robot, snapshot
+
+R1, R2, B1, B2 = RobotId(RED, 1), RobotId(RED, 2), RobotId(BLUE, 1), RobotId(BLUE, 2)
+
+
+def view(**changes: object) -> GameView:
+    values: dict[str, object] = dict(
+        state=GameState.PLAYING,
+        phase=SecondaryState.NORMAL,
+        set_play=None,
+        half=1,
+        kickoff_team=RED,
+        left_team=RED,
+        ball_in_play=True,
+        penalised=frozenset(),
+        goalkeepers=frozenset({R1, B1}),
+        field=KID_FIELD,
+        timing=TimingConfig(),
+    )
+    values.update(changes)
+    return GameView(**values)  # type: ignore[arg-type]
+
+
+# --- goal -----------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("ball", "scoring"),
+    [((4.58, 0.0, 0.07), RED), ((-4.58, 1.2, 0.07), BLUE), ((4.58, -1.29, 1.1), RED)],
+)
+def test_goal_when_fully_over_the_line(ball: tuple[float, float, float], scoring: object) -> None:
+    decisions, _ = goal.judge(snapshot(100, ball=ball, toucher=R1), view(), goal.GoalMemory())
+    assert decisions and isinstance(decisions[0], Goal) and decisions[0].scoring is scoring
+
+
+@pytest.mark.parametrize(
+    "ball",
+    [(4.55, 0.0, 0.07), (4.6, 1.31, 0.07), (4.6, 0.0, 1.25)],
+    ids=["on the line", "outside the post", "over the bar"],
+)
+def test_no_goal(ball: tuple[float, float, float]) -> None:
+    decisions, _ = goal.judge(snapshot(100, ball=ball, toucher=R1), view(), goal.GoalMemory())
+    assert not any(isinstance(d, Goal) for d in decisions)
+
+
+def test_own_goal_counts_for_the_other_team() -> None:
+    decisions, _ = goal.judge(
+        snapshot(100, ball=(-4.6, 0.0, 0.07), toucher=R2), view(), goal.GoalMemory()
+    )
+    assert decisions == [Goal(BLUE, R2, True)]
+
+
+def test_second_half_sides() -> None:
+    decisions, _ = goal.judge(
+        snapshot(100, ball=(-4.6, 0.0, 0.07), toucher=R2), view(left_team=BLUE), goal.GoalMemory()
+    )
+    assert decisions == [Goal(RED, R2, False)]
+
+
+def test_no_goal_directly_from_indirect_free_kick_until_another_robot_touches() -> None:
+    memory = goal.restart(goal.Restriction.INDIRECT_FREE_KICK)
+    taker = robot(RED, 1, 3.0, 0.0, ball_contact=True)
+    _, memory = goal.judge(snapshot(10, (taker,), ball=(3.1, 0.0, 0.07)), view(), memory)
+    assert memory.taker == R1 and not memory.cleared
+    decisions, memory = goal.judge(
+        snapshot(20, ball=(4.6, 0.2, 0.07), toucher=R1), view(), memory
+    )
+    assert len(decisions) == 1 and isinstance(decisions[0], AwardSetPlay)
+    assert decisions[0].kind is SecondaryState.GOAL_KICK and decisions[0].team is BLUE
+    other = robot(RED, 2, 3.5, 0.0, ball_contact=True)
+    _, memory = goal.judge(snapshot(30, (other,), ball=(3.6, 0.0, 0.07)), view(), memory)
+    assert memory.cleared
+    decisions, _ = goal.judge(snapshot(40, ball=(4.6, 0.2, 0.07), toucher=R2), view(), memory)
+    assert decisions == [Goal(RED, R2, False)]
+
+
+def test_throw_in_into_own_goal_gives_corner() -> None:
+    memory = goal.restart(goal.Restriction.THROW_IN)
+    decisions, _ = goal.judge(snapshot(20, ball=(-4.6, 0.3, 0.07), toucher=R1), view(), memory)
+    assert isinstance(decisions[0], AwardSetPlay)
+    assert decisions[0].kind is SecondaryState.CORNER_KICK and decisions[0].team is BLUE
+
+
+# --- ball out -------------------------------------------------------------------------------
+
+
+def test_throw_in_placement_at_exit_x() -> None:
+    decisions = ball_out.judge(snapshot(1, ball=(1.25, -3.08, 0.07), toucher=B1), view())
+    assert decisions == [
+        AwardSetPlay(SecondaryState.THROW_IN, RED, (1.25, -3.0), "ball over the touch line")
+    ]
+
+
+def test_corner_and_goal_kick_spots() -> None:
+    corner = ball_out.judge(snapshot(1, ball=(-4.6, 2.0, 0.07), toucher=R1), view())
+    assert corner[0] == AwardSetPlay(
+        SecondaryState.CORNER_KICK, BLUE, (-4.5, 3.0), "ball over the goal line"
+    )
+    kick = ball_out.judge(snapshot(1, ball=(-4.6, -2.0, 0.07), toucher=B1), view())
+    assert kick[0] == AwardSetPlay(
+        SecondaryState.GOAL_KICK, RED, (-3.5, -1.5), "ball over the goal line"
+    )
+
+
+def test_ball_out_not_judged_during_set_play() -> None:
+    play = SetPlay(SecondaryState.THROW_IN, RED, 0)
+    assert ball_out.judge(snapshot(1, ball=(1.0, 3.2, 0.07)), view(set_play=play)) == []
+
+
+# --- kick-off -------------------------------------------------------------------------------
+
+
+def test_kickoff_positions() -> None:
+    robots = (
+        robot(RED, 1, -0.3, 0.0),  # kicking team may be in the circle
+        robot(RED, 2, 0.4, 1.0),  # opponents' half
+        robot(BLUE, 1, 0.6, 0.0),  # defender in the circle
+        robot(BLUE, 2, 2.0, 3.3),  # outside the field
+    )
+    decisions = kickoff.judge_set(snapshot(1, robots), view(state=GameState.SET))
+    penalised = {d.robot for d in decisions if isinstance(d, PenalizeRobot)}
+    assert penalised == {R2, B1, B2}
+
+
+# --- timers ---------------------------------------------------------------------------------
+
+
+def test_fallen_after_timeout_only() -> None:
+    memory = fallen.FallenMemory()
+    timing = TimingConfig(fallen_s=20.0)
+    down = (robot(BLUE, 2, 1.0, 1.0, fallen=True),)
+    for ms in range(0, 20_001, 8):
+        decisions, memory = fallen.judge(snapshot(ms, down), view(timing=timing), memory)
+        assert decisions == []
+    decisions, memory = fallen.judge(snapshot(20_008, down), view(timing=timing), memory)
+    assert decisions == [PenalizeRobot(B2, Penalty.PICKUP_OR_INCAPABLE, "fallen down")]
+
+
+def test_penalised_robots_are_not_judged_fallen() -> None:
+    down = (robot(BLUE, 2, 1.0, 1.0, fallen=True),)
+    game = view(penalised=frozenset({B2}), timing=TimingConfig(fallen_s=0.0))
+    memory = fallen.FallenMemory()
+    for ms in (0, 8, 16):
+        decisions, memory = fallen.judge(snapshot(ms, down), game, memory)
+        assert decisions == []
+
+
+def test_outside_turf() -> None:
+    game = view(timing=TimingConfig(outside_turf_s=1.0))
+    memory = outside_turf.OutsideTurfMemory()
+    out = (robot(RED, 1, 5.6, 0.0), robot(RED, 2, 5.4, 0.0))
+    decisions, memory = outside_turf.judge(snapshot(0, out), game, memory)
+    decisions, memory = outside_turf.judge(snapshot(1008, out), game, memory)
+    assert [d.robot for d in decisions if isinstance(d, PenalizeRobot)] == [R1]
+
+
+def test_dropped_ball() -> None:
+    game = view(timing=TimingConfig(dropped_ball_s=120.0))
+    memory = dropped_ball.DroppedBallMemory()
+    decisions, memory = dropped_ball.judge(snapshot(0, ball=(1.0, 1.0, 0.07)), game, memory)
+    decisions, memory = dropped_ball.judge(snapshot(119_000, ball=(1.04, 1.0, 0.07)), game, memory)
+    assert decisions == []
+    decisions, memory = dropped_ball.judge(snapshot(120_000, ball=(1.0, 1.0, 0.07)), game, memory)
+    assert len(decisions) == 1 and isinstance(decisions[0], DropBall)
+
+
+def test_inactive_goalkeeper_progress_resets() -> None:
+    game = view(timing=TimingConfig(inactive_goalkeeper_s=20.0))
+    memory = goalkeeper.GoalkeeperMemory()
+    keeper = (robot(RED, 1, -4.2, 0.0),)
+    _, memory = goalkeeper.judge(snapshot(0, keeper, ball=(-3.8, 0.0, 0.07)), game, memory)
+    closer = (robot(RED, 1, -4.1, 0.0),)
+    _, memory = goalkeeper.judge(snapshot(15_000, closer, ball=(-3.8, 0.0, 0.07)), game, memory)
+    decisions, memory = goalkeeper.judge(
+        snapshot(25_000, closer, ball=(-3.8, 0.0, 0.07)), game, memory
+    )
+    assert decisions == []
+    decisions, _ = goalkeeper.judge(snapshot(35_100, closer, ball=(-3.8, 0.0, 0.07)), game, memory)
+    assert decisions == [PenalizeRobot(R1, Penalty.PICKUP_OR_INCAPABLE, "inactive goalkeeper")]
+
+
+# --- ball holding ---------------------------------------------------------------------------
+
+
+def test_convex_hull_and_circle() -> None:
+    hull = ball_holding.convex_hull([(0, 0), (1, 0), (1, 1), (0, 1), (0.5, 0.5)])
+    assert len(hull) == 4
+    assert ball_holding.circle_meets_hull((0.5, 0.5), 0.01, hull)
+    assert ball_holding.circle_meets_hull((1.02, 0.5), 0.03, hull)
+    assert not ball_holding.circle_meets_hull((1.1, 0.5), 0.03, hull)
+    segment = ball_holding.convex_hull([(0.0, -0.2), (0.0, 0.2)])
+    assert ball_holding.circle_meets_hull((0.01, 0.0), 0.02, segment)
+
+
+def test_ball_holding_more_than_half_of_five_seconds() -> None:
+    robots = (robot(RED, 1, 1.0, 0.15), robot(RED, 2, 1.0, -0.15))
+    memory = ball_holding.BallHoldingMemory()
+    found = []
+    for ms in range(0, 2600, 8):
+        decisions, memory = ball_holding.judge(
+            snapshot(ms, robots, ball=(1.0, 0.0, 0.07)), view(), memory
+        )
+        found += [(ms, d) for d in decisions]
+    assert len(found) == 1 and 2500 < found[0][0] <= 2516
+    play = found[0][1]
+    assert isinstance(play, AwardSetPlay) and play.kind is SecondaryState.DIRECT_FREEKICK
+    assert play.team is BLUE and play.position == (1.0, 0.0)
+
+
+# --- pushing --------------------------------------------------------------------------------
+
+
+def test_sustained_contact_pusher_is_farther_from_ball() -> None:
+    a = robot(RED, 1, 0.0, 1.5, contacts=(B1,))
+    b = robot(BLUE, 1, 0.0, 1.2, contacts=(R1,))
+    memory = pushing.PushingMemory()
+    out = []
+    for ms in range(0, 1100, 8):
+        decisions, memory = pushing.judge(snapshot(ms, (a, b)), view(ball_in_play=False), memory)
+        out += decisions
+    assert GiveCard(R1, Card.WARNING, "pushing blue player 1") in out
+    assert PenalizeRobot(R1, Penalty.PHYSICAL_CONTACT, "pushing blue player 1") in out
+
+
+def test_charging_near_ball_gives_free_kick() -> None:
+    a = robot(BLUE, 2, 0.0, 0.6, velocity=(0.0, -0.8, 0.0))
+    b = robot(RED, 2, 0.0, 0.3)
+    memory = pushing.PushingMemory()
+    _, memory = pushing.judge(snapshot(0, (a, b), ball=(0.5, 0.5, 0.07)), view(), memory)
+    a2 = robot(BLUE, 2, 0.0, 0.6, velocity=(0.0, -0.8, 0.0), contacts=(R2,))
+    decisions, _ = pushing.judge(snapshot(8, (a2, b), ball=(0.5, 0.5, 0.07)), view(), memory)
+    kicks = [d for d in decisions if isinstance(d, AwardSetPlay)]
+    assert kicks and kicks[0].kind is SecondaryState.DIRECT_FREEKICK and kicks[0].team is RED
+
+
+# --- removal and end of game ----------------------------------------------------------------
+
+
+def test_reentry_pose_side_and_shift() -> None:
+    template = Pose(x_m=-3.0, y_m=-3.1, yaw_rad=1.57)
+    pose = removal.reentry_pose(
+        template=template, side_sign=1.0, ball_y_m=-1.0, occupied=[], field=KID_FIELD
+    )
+    assert (pose.x_m, pose.y_m) == (3.0, 3.1) and pose.yaw_rad == pytest.approx(-math.pi / 2)
+    shifted = removal.reentry_pose(
+        template=template, side_sign=-1.0, ball_y_m=1.0, occupied=[(-3.0, -3.1)],
+        field=KID_FIELD,
+    )
+    assert (shifted.x_m, shifted.y_m) == pytest.approx((-3.6, -3.1))
+
+
+@pytest.mark.parametrize(
+    ("game_type", "phase", "half", "score", "expected"),
+    [
+        (GameType.NORMAL, SecondaryState.NORMAL, 1, (0, 0), end_of_game.Next.SECOND_HALF),
+        (GameType.NORMAL, SecondaryState.NORMAL, 2, (1, 1), end_of_game.Next.FINISHED),
+        (GameType.KNOCKOUT, SecondaryState.NORMAL, 2, (1, 1), end_of_game.Next.OVERTIME),
+        (GameType.KNOCKOUT, SecondaryState.NORMAL, 2, (2, 1), end_of_game.Next.FINISHED),
+        (GameType.KNOCKOUT, SecondaryState.OVERTIME, 1, (1, 1),
+         end_of_game.Next.OVERTIME_SECOND_HALF),
+        (GameType.KNOCKOUT, SecondaryState.OVERTIME, 2, (1, 1), end_of_game.Next.SHOOTOUT),
+    ],
+)
+def test_after_period(
+    game_type: GameType, phase: SecondaryState, half: int, score: tuple[int, int],
+    expected: end_of_game.Next,
+) -> None:
+    got = end_of_game.after_period(
+        game_type=game_type, phase=phase, half=half, score={RED: score[0], BLUE: score[1]}
+    )
+    assert got is expected
+
+
+@pytest.mark.parametrize(
+    ("taken", "scored", "decided", "winner"),
+    [
+        ((3, 3), (3, 0), True, RED),  # blue cannot catch up with 2 left
+        ((3, 2), (3, 0), False, None),
+        ((5, 5), (2, 2), False, None),  # extended
+        ((6, 5), (3, 2), False, None),
+        ((6, 6), (3, 2), True, RED),
+        ((5, 4), (4, 4), False, None),
+        ((5, 5), (4, 5), True, BLUE),
+    ],
+)
+def test_shootout_status(
+    taken: tuple[int, int], scored: tuple[int, int], decided: bool, winner: object
+) -> None:
+    status = end_of_game.shootout_status(
+        taken={RED: taken[0], BLUE: taken[1]}, scored={RED: scored[0], BLUE: scored[1]}
+    )
+    assert (status.decided, status.winner) == (decided, winner)
+
+
+def test_shootout_coin_toss_is_seeded() -> None:
+    results = {
+        end_of_game.shootout_status(
+            taken={RED: 10, BLUE: 10}, scored={RED: 1, BLUE: 1}, seed=seed
+        ).winner
+        for seed in range(20)
+    }
+    assert results == {RED, BLUE}
+    again = end_of_game.shootout_status(taken={RED: 10, BLUE: 10}, scored={RED: 1, BLUE: 1}, seed=4)
+    assert again.coin_toss and again.winner is end_of_game.shootout_status(
+        taken={RED: 10, BLUE: 10}, scored={RED: 1, BLUE: 1}, seed=4
+    ).winner
