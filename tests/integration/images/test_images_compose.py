@@ -168,3 +168,60 @@ def _stand_ins(compose_path: Path, image: str, subnets: Subnets) -> None:
     for network in document["networks"].values():
         network["labels"].update(project_label)
     compose_path.write_text(yaml.safe_dump(document, sort_keys=False))
+
+
+def _game_copy(tmp_path: Path, *, robot_image: str, robot_cmd: str | None) -> Path:
+    """The 1 v 1 example with short halves and the given robot image and command."""
+    source = EXAMPLE.parent
+    game = json.loads((source / "game.json").read_text())
+    game["match_id"] = f"compose-{uuid.uuid4().hex[:6]}"
+    game["timing"].update({"half_duration_s": 10, "grace_period_s": 1})
+    (tmp_path / "game.json").write_text(json.dumps(game))
+    for name in ("team_red.json", "team_blue.json"):
+        team = json.loads((source / name).read_text())
+        repository, _, tag = robot_image.rpartition(":")
+        team["image"] = repository
+        for player in team["players"].values():
+            player["dockerTag"] = tag
+            if robot_cmd is not None:
+                player["dockerCmd"] = robot_cmd
+        (tmp_path / name).write_text(json.dumps(team))
+    return tmp_path / "game.json"
+
+
+def _compose_up(folder: Path, compose_path: Path) -> subprocess.CompletedProcess[str]:
+    project = f"hlvs-test-{uuid.uuid4().hex[:8]}"
+    command = ["docker-compose", "-p", project, "-f", str(compose_path)]
+    try:
+        return subprocess.run(
+            [*command, "up", "--abort-on-container-exit", "--exit-code-from", "simulator"],
+            cwd=folder, capture_output=True, text=True, timeout=300,
+        )  # fmt: skip
+    finally:
+        subprocess.run([*command, "down", "-v", "-t", "1"], cwd=folder, capture_output=True)
+
+
+@pytest.mark.slow
+def test_compose_up_plays_the_match_with_the_simulator_image(tmp_path: Path) -> None:
+    """The real simulator image plays a short match to the end; the robots run no controller."""
+    if shutil.which("docker-compose") is None:
+        pytest.skip("docker-compose is not installed")
+    game = _game_copy(tmp_path, robot_image=project_image("team-base"), robot_cmd="sleep 600")
+    loaded = load_game(game, images_required=True)
+    third = random.Random().randrange(0, 80) * 3
+    subnets = Subnets.starting_at(ipaddress.IPv4Network(f"10.216.{third}.0/24"))
+    compose_path = tmp_path / "run" / "docker-compose.yml"
+    write_compose(
+        loaded, compose_path, simulator_image=project_image("simulator"), subnets=subnets
+    )
+
+    up = _compose_up(compose_path.parent, compose_path)
+
+    assert up.returncode == 0, up.stdout[-3000:] + up.stderr[-2000:]
+    result = json.loads((compose_path.parent / "out" / "sim_result.json").read_text())
+    assert result["match_id"] == loaded.game.match_id
+    assert result["state"] == "FINISHED"
+    assert result["seed"] == loaded.game.seed
+    assert set(result["robots"]) == {"red-1", "blue-1"}
+    for name in ("replay.hlvsrec", "referee.log", "gamecontroller.log"):
+        assert (compose_path.parent / "out" / name).stat().st_size > 0
