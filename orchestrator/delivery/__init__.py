@@ -9,17 +9,15 @@ what is waiting. Uploaders (``sftp``, ``s3``) sit behind the :class:`Uploader` p
 from __future__ import annotations
 
 from orchestrator.delivery.deliver import (
-    KEEP_UNDELIVERED,
     MANIFEST_NAME,
-    PUBLIC_TEAM,
     DeliveryOutcome,
     Opener,
     RetryPolicy,
     deliver_pending,
     deliver_set,
-    enqueue_match_logs,
     pending_status,
 )
+from orchestrator.delivery.enqueue import KEEP_UNDELIVERED, PUBLIC_TEAM, enqueue_match_logs
 from orchestrator.delivery.store import FileEntry, PendingSet, SetError
 from orchestrator.delivery.targets import open_uploader
 from orchestrator.delivery.uploader import (

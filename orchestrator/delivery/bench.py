@@ -19,7 +19,8 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from orchestrator.delivery.deliver import RetryPolicy, deliver_pending, enqueue_match_logs
+from orchestrator.delivery.deliver import RetryPolicy, deliver_pending
+from orchestrator.delivery.enqueue import enqueue_match_logs
 from orchestrator.delivery.local_s3 import MotoServer, SeaweedServer, weed_binary
 from orchestrator.delivery.local_sftp import AsyncsshServer, SshdServer
 

@@ -1,11 +1,10 @@
-"""Delivering log sets: enqueue a match's logs, upload pending sets, report their status.
+"""Delivering log sets: upload pending sets and report their status.
 
 A set is uploaded under ``<match_id>/<team>/`` of its target: every file not already there with
 the same size, then ``MANIFEST.json`` (names, sizes, SHA-256) last, so a manifest on the server
 means the set is complete. Transient failures (connection lost, timeouts, 5xx, server not
 answering) are retried with exponential backoff, reconnecting each time; anything else fails at
-once. A failed set stays in the store with its typed cause; a delivered set is deleted. Of the
-undelivered sets of a team only the :data:`KEEP_UNDELIVERED` newest are kept.
+once. A failed set stays in the store with its typed cause; a delivered set is deleted.
 """
 
 from __future__ import annotations
@@ -13,9 +12,8 @@ from __future__ import annotations
 import functools
 import json
 import logging
-import shutil
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TypeVar
@@ -27,24 +25,18 @@ from orchestrator.delivery.uploader import Uploader, is_transient
 from orchestrator.errors import ConfigError, DeliveryError
 
 __all__ = [
-    "KEEP_UNDELIVERED",
     "MANIFEST_NAME",
-    "PUBLIC_TEAM",
     "DeliveryOutcome",
     "Opener",
     "RetryPolicy",
     "deliver_pending",
     "deliver_set",
-    "enqueue_match_logs",
     "pending_status",
 ]
 
 log = logging.getLogger(__name__)
 
-KEEP_UNDELIVERED = 3
 MANIFEST_NAME = "MANIFEST.json"
-PUBLIC_TEAM = "public"
-TEAMS_FOLDER = "teams"
 
 Opener = Callable[[Credentials, str], Uploader]  # (credentials, team) -> open uploader
 T = TypeVar("T")
@@ -78,66 +70,6 @@ class DeliveryOutcome:
         data["error_kind"] = self.error.kind if self.error else None
         data["error_reason"] = self.error.reason if self.error else None
         return data
-
-
-def enqueue_match_logs(
-    match_dir: Path,
-    *,
-    match_id: str,
-    teams: Mapping[str, tuple[str, Path | None]],
-    public_target: Path | None,
-    store: Path,
-    move_team_logs: bool = True,
-) -> list[st.PendingSet]:
-    """Turn a finished match's logs into pending sets.
-
-    Args:
-        match_dir: the match output; ``teams/<color>/`` holds each team's logs.
-        teams: color -> (team name, credentials.json of the team or None).
-        public_target: the operator's credentials.json for the public logs (everything in
-            ``match_dir`` outside ``teams/``), or None to keep them local only.
-        move_team_logs: move team files into the store (they leave ``match_dir``) instead of
-            linking them.
-    """
-    created = []
-    with st.locked(store):
-        for color, (team, credentials) in sorted(teams.items()):
-            folder = match_dir / TEAMS_FOLDER / color
-            if not folder.is_dir():
-                log.warning(
-                    "match %s: no logs of team %s (%s) in %s", match_id, team, color, folder
-                )
-            sources = _files_under(folder, exclude=None)
-            created.append(
-                st.create_set(
-                    store,
-                    match_id=match_id,
-                    team=team,
-                    kind="team",
-                    credentials=credentials,
-                    sources=sources,
-                    move=move_team_logs,
-                )
-            )
-            if move_team_logs and folder.is_dir():
-                shutil.rmtree(folder)  # only empty folders are left
-            log.info("match %s: queued %d log files of team %s", match_id, len(sources), team)
-            _prune(store, team)
-        if public_target is not None:
-            sources = _files_under(match_dir, exclude=match_dir / TEAMS_FOLDER)
-            created.append(
-                st.create_set(
-                    store,
-                    match_id=match_id,
-                    team=PUBLIC_TEAM,
-                    kind="public",
-                    credentials=public_target,
-                    sources=sources,
-                    move=False,
-                )
-            )
-            log.info("match %s: queued %d public log files", match_id, len(sources))
-    return created
 
 
 def deliver_pending(
@@ -337,33 +269,3 @@ def _write_manifest(pending: st.PendingSet) -> Path:
     path = pending.root / MANIFEST_NAME
     path.write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
     return path
-
-
-def _files_under(folder: Path, *, exclude: Path | None) -> list[tuple[Path, str]]:
-    if not folder.is_dir():
-        return []
-    found = []
-    for path in sorted(folder.rglob("*")):
-        if exclude is not None and path.is_relative_to(exclude):
-            continue
-        if path.is_file() and not path.is_symlink():
-            found.append((path, path.relative_to(folder).as_posix()))
-    return found
-
-
-def _prune(store: Path, team: str) -> None:
-    sets = [s for s in st.list_sets(store) if s.team == team and s.kind == "team"]
-    for old in sets[: max(0, len(sets) - KEEP_UNDELIVERED)]:
-        with st.claimed(old) as mine:
-            if not mine:
-                continue  # being delivered right now
-            st.remove_set(old)
-        log.warning(
-            "match %s: deleted the undelivered logs of %s (%d files, %.1f MB): more "
-            "than %d sets were waiting",
-            old.match_id,
-            team,
-            len(old.files),
-            old.total_bytes / 1e6,
-            KEEP_UNDELIVERED,
-        )
