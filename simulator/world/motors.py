@@ -4,8 +4,9 @@ PID gains, limp robots. Applied to MuJoCo's ``ctrl`` and actuator gains once per
 A position actuator produces ``kp * (ctrl - q) - kv * qdot`` (clipped to the motor's torque
 range). Torque mode sets gain 1 and no bias so ``ctrl`` is the torque. Limp robots get zero gain
 and bias (only passive joint damping remains). Webots-style PID: ``P`` scales the stiffness
-relative to the default ``P = 10`` (``kp = model_kp * P / 10``), ``D`` adds damping
-``kv = model_kp * D / 10`` (N m s/rad); ``I`` is stored but has no effect.
+relative to the default ``P = 10`` (``kp = model_kp * P / 10``), ``D`` sets the damping
+``kv = model_kp * D / 10`` (N m s/rad; the model's default kv corresponds to ``D = 0.05``);
+``I`` is stored but has no effect.
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ class MotorBank:
         self._step_s = step_s
         nu = model.nu
         self.default_kp = np.zeros(nu)
+        self.default_kv = np.zeros(nu)
         self.max_torque = np.zeros(nu)
         self.max_velocity = np.zeros(nu)
         self.lower = np.zeros(nu)
@@ -39,12 +41,13 @@ class MotorBank:
             for slot, spec in enumerate(robot.model.motors):
                 a = robot.actuators[slot]
                 self.default_kp[a] = spec.kp_nm_per_rad
+                self.default_kv[a] = spec.kv_nm_s_per_rad
                 self.max_torque[a] = spec.max_torque_nm
                 self.max_velocity[a] = spec.max_velocity_rad_s
                 self.lower[a] = spec.lower_rad
                 self.upper[a] = spec.upper_rad
         self.kp = self.default_kp.copy()
-        self.kv = np.zeros(nu)
+        self.kv = self.default_kv.copy()
         self.ki = np.zeros(nu)
         self.velocity_limit = self.max_velocity.copy()
         self.target = np.zeros(nu)

@@ -19,20 +19,23 @@ from simulator.world.robots.model import (
 )
 
 # (lower, upper) rad, kp N m/rad, max torque N m, max velocity rad/s for the kid model.
+# Stiff, damped servos (kv = KV_TIME_S * kp): with the softer kp / 2 and no damping the
+# open-loop gait of simulator.motion drifts and falls within seconds.
 _KID_MOTORS: dict[str, tuple[float, float, float, float, float]] = {
-    "Neck": (-2.0, 2.0, 8.0, 6.0, 6.0),
-    "Head": (-0.8, 1.2, 8.0, 6.0, 6.0),
-    "Shoulder": (-3.1, 3.1, 20.0, 6.0, 6.0),
-    "ArmUpperL": (-0.3, 2.8, 20.0, 6.0, 6.0),
-    "ArmUpperR": (-2.8, 0.3, 20.0, 6.0, 6.0),
-    "ArmLower": (-0.1, 2.6, 15.0, 6.0, 6.0),
-    "PelvY": (-0.9, 0.9, 40.0, 8.0, 6.0),
-    "Pelv": (-0.6, 0.6, 80.0, 10.0, 6.0),
-    "LegUpper": (-1.0, 2.2, 80.0, 10.0, 6.0),
-    "LegLower": (-0.05, 2.6, 80.0, 10.0, 6.0),
-    "Ankle": (-1.2, 1.2, 80.0, 10.0, 6.0),
-    "Foot": (-0.6, 0.6, 80.0, 10.0, 6.0),
+    "Neck": (-2.0, 2.0, 16.0, 6.0, 6.0),
+    "Head": (-0.8, 1.2, 16.0, 6.0, 6.0),
+    "Shoulder": (-3.1, 3.1, 40.0, 6.0, 6.0),
+    "ArmUpperL": (-0.3, 2.8, 40.0, 6.0, 6.0),
+    "ArmUpperR": (-2.8, 0.3, 40.0, 6.0, 6.0),
+    "ArmLower": (-0.1, 2.6, 30.0, 6.0, 6.0),
+    "PelvY": (-0.9, 0.9, 80.0, 8.0, 6.0),
+    "Pelv": (-0.6, 0.6, 160.0, 10.0, 6.0),
+    "LegUpper": (-1.0, 2.2, 160.0, 10.0, 6.0),
+    "LegLower": (-0.05, 2.6, 160.0, 10.0, 6.0),
+    "Ankle": (-1.2, 1.2, 160.0, 10.0, 6.0),
+    "Foot": (-0.6, 0.6, 160.0, 10.0, 6.0),
 }
+KV_TIME_S = 0.005
 
 
 def _motors(scale: float) -> tuple[MotorSpec, ...]:
@@ -47,6 +50,7 @@ def _motors(scale: float) -> tuple[MotorSpec, ...]:
                 lower_rad=lower,
                 upper_rad=upper,
                 kp_nm_per_rad=kp * torque_scale,
+                kv_nm_s_per_rad=kp * torque_scale * KV_TIME_S * scale**0.5,
                 max_torque_nm=torque * torque_scale,
                 max_velocity_rad_s=velocity / scale**0.5,
             )

@@ -212,6 +212,7 @@ def build_humanoid(
 </body>"""
     actuators = "".join(
         f'<position name="{p}/{m.name}" joint="{p}/{m.name}" kp="{m.kp_nm_per_rad:.6g}" '
+        f'kv="{m.kv_nm_s_per_rad:.6g}" '
         f'forcerange="{_f(-m.max_torque_nm, m.max_torque_nm)}" ctrllimited="false"/>'
         for m in model.motors
     )

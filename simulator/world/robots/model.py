@@ -24,6 +24,7 @@ class MotorSpec:
     lower_rad: float
     upper_rad: float
     kp_nm_per_rad: float
+    kv_nm_s_per_rad: float  # velocity feedback of the position controller
     max_torque_nm: float
     max_velocity_rad_s: float
 
