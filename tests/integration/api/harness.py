@@ -1,7 +1,12 @@
-"""A robot API server on 127.0.0.1 driven by a background step loop (fake or real world)."""
+"""A robot API server on 127.0.0.1 driven by a background step loop.
+
+The world is the real MuJoCo world unless a test passes ``world=`` (the fake device world is for
+tests that inspect the calls the server makes or flip limp / removed flags from the test thread).
+"""
 
 from __future__ import annotations
 
+import math
 import socket
 import threading
 import time
@@ -13,7 +18,6 @@ from referee.snapshot import RobotId, TeamColor
 from simulator.api import (
     ApiServer,
     FakeCameraRenderer,
-    FakeDeviceWorld,
     LockstepSettings,
     PlayerEndpoint,
     RenderWorker,
@@ -24,6 +28,22 @@ from simulator.spec import NetworkSpec
 RED1 = RobotId(TeamColor.RED, 1)
 RED2 = RobotId(TeamColor.RED, 2)
 BLUE1 = RobotId(TeamColor.BLUE, 1)
+
+
+def real_world(robots: Sequence[RobotId]) -> Any:
+    from simulator.world import RobotPlacement, World
+
+    placements = [
+        RobotPlacement(
+            id=r,
+            model="kid-default",
+            x_m=(-1.0 if r.team is TeamColor.RED else 1.0) * r.number,
+            y_m=0.0,
+            yaw_rad=0.0 if r.team is TeamColor.RED else math.pi,
+        )
+        for r in robots
+    ]
+    return World.create(field_class="kid", robots=placements, seed=11)
 
 
 def free_ports(count: int) -> list[int]:
@@ -95,7 +115,7 @@ def running_server(
     team_size: int = 4,
     hold: bool = False,
 ) -> Iterator[tuple[Driver, dict[RobotId, int]]]:
-    world = world if world is not None else FakeDeviceWorld(robots)
+    world = world if world is not None else real_world(robots)
     ports = dict(zip(robots, free_ports(len(robots)), strict=True))
     endpoints = [
         PlayerEndpoint(robot=r, port=p, hosts=hosts, team_size=team_size) for r, p in ports.items()

@@ -8,6 +8,7 @@ import time
 
 import pytest
 
+from simulator.api import FakeDeviceWorld
 from simulator.api import messages_pb2 as pb
 from simulator.client import HandshakeRefused, RobotClient
 from simulator.spec import NetworkSpec
@@ -112,7 +113,8 @@ def test_warnings_use_hlvs_texts() -> None:
 
 
 def test_positions_reach_the_world_and_later_requests_override() -> None:
-    with running_server() as (driver, ports), _client(ports[RED1]) as client:
+    world = FakeDeviceWorld((RED1, RED2, BLUE1))
+    with running_server(world=world) as (driver, ports), _client(ports[RED1]) as client:
         client.set_positions({"Neck": 0.3, "Head": 0.1})
         client.set_positions({"Neck": 0.7})
         client.enable("NeckS", 8)
@@ -196,7 +198,8 @@ def test_half_frame_then_disconnect_and_reconnect_keeps_sensors() -> None:
 
 
 def test_limp_robot_caches_commands_and_removed_robot_gets_time_only() -> None:
-    with running_server() as (driver, ports), _client(ports[RED1]) as client:
+    fake = FakeDeviceWorld((RED1, RED2, BLUE1))
+    with running_server(world=fake) as (driver, ports), _client(ports[RED1]) as client:
         world = driver.world
         client.enable("NeckS", 8)
         _next_with(client, lambda m: bool(m.position_sensors))

@@ -8,7 +8,7 @@ import time
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from simulator.api import LockstepSettings
+from simulator.api import FakeDeviceWorld, LockstepSettings
 from simulator.client import RobotClient
 from simulator.spec import NetworkSpec
 from tests.integration.api.harness import BLUE1, RED1, RED2, running_server, wait_until
@@ -20,7 +20,8 @@ def _client(port: int) -> RobotClient:
 
 def test_never_reading_client_does_not_stall_the_others() -> None:
     network = NetworkSpec(api_bind_host="127.0.0.1", send_queue_messages=8)
-    with running_server(network=network, pause_s=0.0) as (driver, ports):
+    world = FakeDeviceWorld((RED1, RED2, BLUE1))  # thousands of steps per second
+    with running_server(network=network, pause_s=0.0, world=world) as (driver, ports):
         stalled = socket.create_connection(("127.0.0.1", ports[RED2]), timeout=5)
         stalled.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
         assert stalled.recv(8) == b"Welcome\0"
@@ -79,7 +80,8 @@ def test_lockstep_is_deterministic_with_a_deterministic_client() -> None:
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(chunks=st.lists(st.binary(min_size=1, max_size=64), min_size=1, max_size=6))
 def test_arbitrary_bytes_never_break_the_server(chunks: list[bytes]) -> None:
-    with running_server(robots=(RED1, BLUE1)) as (driver, ports):
+    world = FakeDeviceWorld((RED1, BLUE1))
+    with running_server(robots=(RED1, BLUE1), world=world) as (driver, ports):
         raw = socket.create_connection(("127.0.0.1", ports[RED1]), timeout=5)
         assert raw.recv(8) == b"Welcome\0"
         for chunk in chunks:
