@@ -163,12 +163,10 @@ class SeaweedServer:
             f"-s3.port.lance={p['s3.lance']}",
             f"-s3.config={self.home / 'identities.json'}",
         ]
-        self.process = subprocess.Popen(
-            args,
-            stdout=subprocess.DEVNULL,
-            stderr=(self.home / "weed.log").open("ab"),
-            start_new_session=True,
-        )
+        with (self.home / "weed.log").open("ab") as log_file:
+            self.process = subprocess.Popen(
+                args, stdout=subprocess.DEVNULL, stderr=log_file, start_new_session=True
+            )
         try:
             wait_for_http(self.endpoint_url + "/", timeout_s)
         except TimeoutError:

@@ -1,7 +1,7 @@
 """SFTP servers on 127.0.0.1 for integration tests and the delivery benchmark.
 
 * :class:`SshdServer` (root): OpenSSH ``sshd`` with its own config, a chroot and an SFTP-only
-  system user created for it (``hlvs-sftp-<pid>``) and removed by :meth:`SshdServer.stop`.
+  system user created for it (``hlvs-sftp-<pid>-<random>``) and removed by :meth:`SshdServer.stop`.
   Everything lives under ``/srv/hlvs-test/`` (sshd wants root-owned chroot and key paths, not
   under /tmp). The chroot holds ``upload/`` (writable by the user) and ``readonly/`` (not).
 * :class:`AsyncsshServer` (any user): asyncssh's SFTP server in a thread, chrooted to a folder.
@@ -101,8 +101,20 @@ class SshdServer(SftpServer):
 
     @classmethod
     def start(cls) -> SshdServer:
-        home = SRV_ROOT / f"sshd-{os.getpid()}-{secrets.token_hex(3)}"
-        username = f"hlvs-sftp-{os.getpid()}"
+        token = secrets.token_hex(2)
+        home = SRV_ROOT / f"sshd-{os.getpid()}-{token}"
+        username = f"hlvs-sftp-{os.getpid()}-{token}"
+        try:
+            server = cls._prepare(home, username)
+            server.start_again()
+        except BaseException:
+            subprocess.run(["userdel", username], check=False, capture_output=True)
+            shutil.rmtree(home, ignore_errors=True)
+            raise
+        return server
+
+    @classmethod
+    def _prepare(cls, home: Path, username: str) -> SshdServer:
         password = secrets.token_urlsafe(12)
         chroot = home / "chroot"
         (chroot / "readonly").mkdir(parents=True)
@@ -119,7 +131,7 @@ class SshdServer(SftpServer):
         port = free_port()
         (home / "sshd_config").write_text(_sshd_config(home, port, username))
         Path("/run/sshd").mkdir(mode=0o755, exist_ok=True)
-        server = cls(
+        return cls(
             port=port,
             username=username,
             password=password,
@@ -128,16 +140,15 @@ class SshdServer(SftpServer):
             root=chroot,
             home=home,
         )
-        server.start_again()
-        return server
 
     def start_again(self) -> None:
-        self.process = subprocess.Popen(
-            [SSHD, "-D", "-e", "-f", str(self.home / "sshd_config")],
-            stdout=subprocess.DEVNULL,
-            stderr=(self.home / "sshd.log").open("ab"),
-            start_new_session=True,
-        )
+        with (self.home / "sshd.log").open("ab") as log_file:
+            self.process = subprocess.Popen(
+                [SSHD, "-D", "-e", "-f", str(self.home / "sshd_config")],
+                stdout=subprocess.DEVNULL,
+                stderr=log_file,
+                start_new_session=True,
+            )
         wait_for_port(self.port)
 
     def kill(self) -> None:

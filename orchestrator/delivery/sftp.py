@@ -79,6 +79,8 @@ class SftpUploader:
         except OSError as exc:
             raise fail("unreachable", f"cannot connect: {exc.strerror or exc}") from exc
         transport = paramiko.Transport(sock, default_window_size=WINDOW_BYTES)
+        transport.banner_timeout = CONNECT_TIMEOUT_S
+        transport.auth_timeout = CONNECT_TIMEOUT_S
         try:
             known = _expected_keys(credentials)
             if known:

@@ -16,7 +16,6 @@ from orchestrator.delivery.local_s3 import MotoServer, SeaweedServer, weed_binar
 from orchestrator.delivery.local_sftp import AsyncsshServer, SshdServer
 
 FAST_RETRY = RetryPolicy(attempts=2, initial_delay_s=0.1, factor=2.0, max_delay_s=1.0)
-needs_root = pytest.mark.skipif(os.geteuid() != 0, reason="sshd with a chroot needs root")
 
 
 @pytest.fixture(scope="module")

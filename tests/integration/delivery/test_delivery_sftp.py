@@ -218,3 +218,29 @@ def test_cli_status_and_deliver(
     assert main(["logs", "status", "--store", str(store), "--json"]) == 0
     [left] = json.loads(capsys.readouterr().out)
     assert left["match_id"] == "cli-2" and left["last_error"]["kind"] == "auth"
+
+
+def test_a_server_that_never_answers_times_out_and_is_retried(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import socket
+
+    from orchestrator.delivery import sftp
+
+    monkeypatch.setattr(sftp, "CONNECT_TIMEOUT_S", 0.5)
+    with socket.socket() as silent:  # accepts connections (backlog) but never speaks
+        silent.bind(("127.0.0.1", 0))
+        silent.listen(8)
+        server = SftpServer(
+            port=silent.getsockname()[1],
+            username="u",
+            password="p",
+            host_key=OTHER_KEY,
+            client_key="",
+            root=tmp_path,
+        )
+        started = time.monotonic()
+        outcome, store = deliver_one(tmp_path, sftp_body(server))
+    assert outcome.error is not None and outcome.error.kind == "transient"
+    assert 1.0 <= time.monotonic() - started < 10  # two attempts of 0.5 s each
+    assert pending_status(store)[0].last_error.kind == "transient"  # type: ignore[union-attr]
