@@ -138,12 +138,12 @@ def test_rendering_quota_refuses_camera_with_hlvs_warning() -> None:
     network = NetworkSpec(api_bind_host="127.0.0.1", rendering_quota_mb_s=20.0)
     with running_server(network=network, team_size=2, cameras=True) as (_d, ports):
         with _client(ports[RED1]) as client:
-            client.enable("Camera", 16)  # 320x240x3 @ 16 ms = 14.06 MB/s > 10 MB/s
+            client.enable("Camera", 16)  # 320x240x3 @ 16 ms = 13.7 MB/s > 10 MB/s
             msg = _next_with(client, lambda m: bool(m.messages))
             assert _texts(msg) == [
                 "requested rendering bandwidth is above the limit (14MB/s > 10MB/s)"
             ]
-            client.enable("Camera", 32)  # 7.03 MB/s fits
+            client.enable("Camera", 32)  # 6.9 MB/s fits
             image = _next_with(client, lambda m: bool(m.cameras)).cameras[0]
             assert (image.width, image.height, image.quality) == (320, 240, -1)
             assert image.image[:3] == bytes((1, 0, 255))  # B, G, R of the fake red-1 image

@@ -1,0 +1,81 @@
+"""Session and quota rules without sockets (fake device world)."""
+
+from __future__ import annotations
+
+import pytest
+
+from referee.snapshot import RobotId, TeamColor
+from simulator.api import FakeDeviceWorld, NetworkQuota, RobotSession, rendering_bandwidth_mb_s
+from simulator.api import messages_pb2 as pb
+
+RED1 = RobotId(TeamColor.RED, 1)
+
+
+def _session(world: FakeDeviceWorld, quota: float = 87.5) -> RobotSession:
+    return RobotSession(robot=RED1, world=world, rendering_quota_mb_s=quota, clock_ms=lambda: 42)
+
+
+def _enable(session: RobotSession, t_ms: int, **periods: int) -> None:
+    request = pb.ActuatorRequests()
+    for name, period in periods.items():
+        request.sensor_time_steps.add(name=name, timeStep=period)
+    session.apply(request, step_time_ms=t_ms)
+
+
+def test_sensor_reported_one_period_after_enabling_then_every_period() -> None:
+    world = FakeDeviceWorld([RED1])
+    session = _session(world)
+    _enable(session, 16, NeckS=8, Gyro=24)
+    times = {}
+    for t in range(16, 120, 8):
+        msg, jobs = session.measure(t)
+        assert not jobs and msg.real_time == 42 and msg.time == t
+        times[t] = (bool(msg.position_sensors), bool(msg.gyros))
+    assert times[16] == (False, False)  # not in the step it was enabled
+    assert [t for t, (neck, _) in times.items() if neck] == list(range(24, 120, 8))
+    assert [t for t, (_, gyro) in times.items() if gyro] == [40, 64, 88, 112]
+    _enable(session, 120, NeckS=8)  # same period again: no re-synchronisation
+    assert session.measure(120)[0].position_sensors
+
+
+def test_camera_jobs_and_rendering_quota() -> None:
+    world = FakeDeviceWorld([RED1])
+    assert rendering_bandwidth_mb_s(1920, 1080, 16) == pytest.approx(370.8, abs=0.1)
+    session = _session(world, quota=7.0)
+    _enable(session, 8, Camera=16)  # 13.7 MB/s > 7 MB/s
+    msg, jobs = session.measure(8)
+    assert [m.text for m in msg.messages] == [
+        "requested rendering bandwidth is above the limit (14MB/s > 7MB/s)"
+    ]
+    _enable(session, 16, Camera=32)  # 6.9 MB/s fits
+    assert not session.measure(16)[0].messages
+    _enable(session, 24, Camera=64)
+    session.measure(24)
+    jobs = [job for t in range(32, 160, 8) for job in session.measure(t)[1]]
+    assert [job.time_ms for job in jobs] == [88, 152]
+    assert (jobs[0].width, jobs[0].height) == (320, 240)
+
+
+def test_limp_caches_and_reapplies_every_command_kind() -> None:
+    world = FakeDeviceWorld([RED1])
+    session = _session(world)
+    world.limp.add(RED1)
+    session.update_limp()
+    request = pb.ActuatorRequests()
+    request.motor_positions.add(name="Neck", position=0.4)
+    request.motor_velocities.add(name="Neck", velocity=2.0)
+    request.motor_torques.add(name="Head", torque=0.5)
+    session.apply(request, step_time_ms=8)
+    assert world.calls == []
+    world.limp.discard(RED1)
+    session.update_limp()
+    assert sorted(call[0] for call in world.calls) == ["position", "torque", "velocity"]
+
+
+def test_quota_window_slides() -> None:
+    quota = NetworkQuota(quota_mb_s=1.0 / 1024)  # 1024 bytes per second
+    assert quota.error_text == "0.000977 MB/s quota exceeded."
+    assert quota.allows(1000, 0)
+    quota.record(1000, 0)
+    assert not quota.allows(100, 500)
+    assert quota.allows(100, 1000)  # the first message left the 1 s window
