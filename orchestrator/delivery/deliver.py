@@ -130,6 +130,7 @@ def deliver_set(
             if session.run(functools.partial(_exists, remote=remote, size=entry.size)):
                 skipped += 1
                 continue
+            _check_local(pending, local, entry.size)
             session.run(functools.partial(_upload, local=local, remote=remote))
             uploaded += 1
             uploaded_bytes += entry.size
@@ -242,6 +243,19 @@ def _exists(uploader: Uploader, *, remote: str, size: int) -> bool:
 
 def _upload(uploader: Uploader, *, local: Path, remote: str) -> None:
     uploader.upload(local, remote)
+
+
+def _check_local(pending: st.PendingSet, local: Path, size: int) -> None:
+    try:
+        actual = local.stat().st_size
+    except OSError as exc:
+        reason = f"{local} is missing from the local store: {exc.strerror}"
+        raise DeliveryError(
+            team=pending.team, target="(local store)", kind="store", reason=reason
+        ) from exc
+    if actual != size:
+        reason = f"{local} changed in the local store ({actual} bytes, {size} when queued)"
+        raise DeliveryError(team=pending.team, target="(local store)", kind="store", reason=reason)
 
 
 def _credentials_of(pending: st.PendingSet) -> Credentials:

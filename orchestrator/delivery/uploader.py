@@ -34,6 +34,7 @@ ERROR_KINDS = {
     "unreachable": "no server answers at that address",
     "transient": "the connection broke or the server had an internal error",
     "config": "the credentials file is missing or invalid",
+    "store": "a file of the set is missing or changed in the local store",
 }
 TRANSIENT_KINDS = frozenset({"transient", "unreachable"})
 

@@ -225,3 +225,19 @@ def test_a_set_being_delivered_elsewhere_is_skipped_and_not_pruned(
         assert "m0" in [s.match_id for s in pending_status(store)]
     outcomes = deliver_pending(store, opener=Opener(FakeUploader()), retry=FAST)
     assert "m0" in [o.match_id for o in outcomes if o.delivered]
+
+
+def test_a_file_lost_from_the_local_store_is_a_typed_failure(tmp_path: Path, creds: Path) -> None:
+    store = tmp_path / "store"
+    [pending] = enqueue_match_logs(
+        make_match(tmp_path, "m1"),
+        match_id="m1",
+        teams={"red": ("Alpha", creds)},
+        public_target=None,
+        store=store,
+    )
+    (pending.files_dir / "red-1" / "stdout.log").unlink()
+    fake = FakeUploader()
+    [outcome] = deliver_pending(store, opener=Opener(fake), retry=FAST)
+    assert outcome.error is not None and outcome.error.kind == "store"
+    assert f"m1/Alpha/{MANIFEST_NAME}" not in fake.files
