@@ -9,10 +9,10 @@ periods) use the injected clock and are visible as ``waiting_for_wall_clock``.
 from __future__ import annotations
 
 import logging
-from collections import Counter
 from collections.abc import Callable
 from pathlib import Path
 
+from referee import reporting
 from referee.clock import Clock, SystemClock
 from referee.config import Pose, RefereeConfig
 from referee.gamecontroller import (
@@ -20,25 +20,14 @@ from referee.gamecontroller import (
     GameState,
     SecondaryState,
     Tick,
-    game_control_data,
 )
 from referee.judgement import apply_decisions
 from referee.logs import RefereeLog
 from referee.mirror import TeamMirror
 from referee.net import GameControllerNetwork
-from referee.rules import (
-    ball_holding,
-    ball_in_play,
-    dropped_ball,
-    end_of_game,
-    fallen,
-    goal,
-    goalkeeper,
-    kickoff,
-    outside_turf,
-    pushing,
-)
-from referee.rules.ball_out import judge as judge_ball_out
+from referee.publisher import Publisher
+from referee.rulebook import RuleBook
+from referee.rules import end_of_game, goal, kickoff
 from referee.rules.base import Decision, GameView
 from referee.shootout import Shootout
 from referee.snapshot import (
@@ -51,11 +40,8 @@ from referee.snapshot import (
     WorldCommand,
     WorldSnapshot,
 )
-from referee.wire import encode_game_state
 
 logger = logging.getLogger(__name__)
-
-PUBLISH_PERIOD_REAL_S = 0.1  # refresh the packet the sender thread sends at 2 Hz
 
 Action = Callable[[WorldSnapshot], list[WorldCommand]]
 
@@ -100,9 +86,13 @@ class Referee:
         self.reset_memories()
         self._network: GameControllerNetwork | None = None
         self._mirror: TeamMirror | None = None
-        self._packet_number = 0
-        self._signature: tuple[object, ...] = ()
-        self._published_real_s = float("-inf")
+        self._publisher = Publisher(
+            gc=self.gc,
+            team_numbers={c: config.team(c).team_id for c in (TeamColor.RED, TeamColor.BLUE)},
+            players_per_team=self.field.players_per_team,
+            log=self.log,
+            clock=self._clock,
+        )
         self._status_real_s = self._clock.monotonic()
         self._status_sim_ms = 0
 
@@ -118,53 +108,18 @@ class Referee:
 
     @property
     def game_state(self) -> dict[str, object]:
-        gc = self.gc
-        penalties = {
-            f"{robot.team.value}-{robot.number}": {
-                "penalty": gc.robot(robot).penalty.name,
-                "secs_till_unpenalised": int(round(gc.robot(robot).secs_till_unpenalised)),
-            }
-            for robot in gc.penalised()
-        }
-        return {
-            "state": gc.state.name,
-            "secondary_state": gc.secondary_state.name,
-            "set_play": None
-            if gc.set_play is None
-            else {"team": gc.set_play.team.value, "sub_phase": gc.set_play.sub_phase},
-            "half": gc.half,
-            "phase": gc.phase.name,
-            "secs_remaining": int(round(gc.secs_remaining)),
-            "kickoff": gc.kickoff_team.value if gc.kickoff_team is not None else "dropped_ball",
-            "left_team": self.left_team.value,
-            "score": {"red": gc.score(TeamColor.RED), "blue": gc.score(TeamColor.BLUE)},
-            "penalties": penalties,
-            "waiting_for_wall_clock": self.waiting_for_wall_clock,
-        }
+        """The telemetry state dict: state, secondary_state, half, secs_remaining, score,
+        penalties (and set_play, phase, kickoff, left_team, waiting_for_wall_clock)."""
+        return reporting.game_state(
+            self.gc, left_team=self.left_team, waiting=self.waiting_for_wall_clock
+        )
 
     def result(self) -> dict[str, object]:
-        winner: str | None
-        if not self._finished:
-            winner = None
-        else:
-            winner = self._winner.value if self._winner is not None else "draw"
-        summary = Counter(event.type for event in self.events)
-        result: dict[str, object] = {
-            "state": self.gc.state.name,
-            "score": {"red": self.gc.score(TeamColor.RED), "blue": self.gc.score(TeamColor.BLUE)},
-            "winner": winner,
-            "events_summary": dict(sorted(summary.items())),
-        }
-        if self._shootout is not None:
-            result["shootout"] = {
-                color.value: {
-                    "kicks": self.gc.teams[color].penalty_shots,
-                    "scored": bin(self.gc.teams[color].single_shots).count("1"),
-                }
-                for color in (TeamColor.RED, TeamColor.BLUE)
-            }
-            result["coin_toss"] = self._coin_toss
-        return result
+        """score, winner (red, blue, draw; None before the end), events_summary {type: count}."""
+        return reporting.result(
+            self.gc, self.events, finished=self._finished, winner=self._winner,
+            shootout=self._shootout is not None, coin_toss=self._coin_toss,
+        )
 
     def start_network(self) -> None:
         """Start the GameController sender / receiver and the team mirror (UDP)."""
@@ -189,6 +144,7 @@ class Referee:
             max_bytes=net.mirror_max_bytes,
             log_dir=self._log_dir,
         )
+        self._publisher.network = self._network
         self._network.start()
         self._mirror.start()
         self._publish(force=True)
@@ -212,6 +168,7 @@ class Referee:
             )
             self._network.close()
             self._network = None
+            self._publisher.network = None
         if self._mirror is not None:
             self._mirror.close()
             self._mirror = None
@@ -254,14 +211,7 @@ class Referee:
     # --- flow ----------------------------------------------------------------------------
 
     def reset_memories(self) -> None:
-        self.goal_memory = goal.GoalMemory()
-        self.in_play_memory = ball_in_play.BallInPlayMemory()
-        self.fallen_memory = fallen.FallenMemory()
-        self.turf_memory = outside_turf.OutsideTurfMemory()
-        self.holding_memory = ball_holding.BallHoldingMemory()
-        self.pushing_memory = pushing.PushingMemory()
-        self.keeper_memory = goalkeeper.GoalkeeperMemory()
-        self.dropped_memory = dropped_ball.DroppedBallMemory()
+        self.rules = RuleBook()
 
     def view(self) -> GameView:
         gc = self.gc
@@ -371,12 +321,11 @@ class Referee:
         if tick.set_play_executed is not None:
             play = tick.set_play_executed
             self.log.info(now, f"{play.kind.name} for {play.team.value}: execute.")
-            self.in_play_memory = ball_in_play.arm(snapshot)
             restriction = {
                 SecondaryState.THROW_IN: goal.Restriction.THROW_IN,
                 SecondaryState.INDIRECT_FREEKICK: goal.Restriction.INDIRECT_FREE_KICK,
             }.get(play.kind)
-            self.goal_memory = goal.restart(restriction)
+            self.rules.restart(snapshot, restriction)
         if tick.period_over and self.gc.phase is not SecondaryState.PENALTYSHOOT:
             commands += self._end_period(snapshot)
         return commands
@@ -390,31 +339,12 @@ class Referee:
                 gc.transition(GameState.PLAYING)
                 self._set_since_ms = None
                 self.ball_in_play = False
-                self.in_play_memory = ball_in_play.arm(snapshot)
                 restriction = goal.Restriction.KICKOFF if gc.kickoff_team is not None else None
-                self.goal_memory = goal.restart(restriction)
+                self.rules.restart(snapshot, restriction)
                 self.state_event(snapshot, "PLAYING")
         if gc.state not in (GameState.READY, GameState.SET, GameState.PLAYING):
             return commands
-        decisions: list[Decision] = []
-        view = self.view()
-        found, self.in_play_memory = ball_in_play.judge(snapshot, view, self.in_play_memory)
-        decisions += found
-        found, self.goal_memory = goal.judge(snapshot, view, self.goal_memory)
-        decisions += found or judge_ball_out(snapshot, view)
-        decisions += kickoff.judge_before_in_play(snapshot, view)
-        found, self.fallen_memory = fallen.judge(snapshot, view, self.fallen_memory)
-        decisions += found
-        found, self.turf_memory = outside_turf.judge(snapshot, view, self.turf_memory)
-        decisions += found
-        found, self.holding_memory = ball_holding.judge(snapshot, view, self.holding_memory)
-        decisions += found
-        found, self.pushing_memory = pushing.judge(snapshot, view, self.pushing_memory)
-        decisions += found
-        found, self.keeper_memory = goalkeeper.judge(snapshot, view, self.keeper_memory)
-        decisions += found
-        found, self.dropped_memory = dropped_ball.judge(snapshot, view, self.dropped_memory)
-        decisions += found
+        decisions = self.rules.judge(snapshot, self.view())
         return commands + self._apply(decisions, snapshot)
 
     def _apply(self, decisions: list[Decision], snapshot: WorldSnapshot) -> list[WorldCommand]:
@@ -548,37 +478,11 @@ class Referee:
                 self.log.info(self._last_ms or 0, f"{robot} declared itself goalkeeper.")
 
     def _publish(self, *, force: bool = False) -> None:
-        gc = self.gc
-        signature = (
-            gc.state, gc.secondary_state, gc.set_play, gc.half, gc.kickoff_team,
-            gc.score(TeamColor.RED), gc.score(TeamColor.BLUE), gc.penalised(),
-        )
-        changed = signature != self._signature
-        if changed:
-            self._signature = signature
-            self.log.gamecontroller(
-                self._last_ms or 0,
-                f"state {gc.state.name} secondary {gc.secondary_state.name} half {gc.half} "
-                f"score red {signature[5]} blue {signature[6]} penalised "
-                f"{[str(r) for r in signature[7]]}",
-            )
-        if self._network is None:
-            return
-        real = self._clock.monotonic()
-        if changed or force or real - self._published_real_s >= PUBLISH_PERIOD_REAL_S:
-            self._published_real_s = real
-            self._network.publish(self.packet(), changed=changed or force)
+        self._publisher.publish(self._last_ms or 0, force=force)
 
     def packet(self) -> bytes:
         """The current ``RGme`` datagram (each call takes the next packet number)."""
-        self._packet_number = (self._packet_number + 1) & 0xFF
-        data = game_control_data(
-            self.gc,
-            team_numbers={c: self.config.team(c).team_id for c in (TeamColor.RED, TeamColor.BLUE)},
-            players_per_team=self.field.players_per_team,
-            packet_number=self._packet_number,
-        )
-        return encode_game_state(data)
+        return self._publisher.packet()
 
     def _status(self, snapshot: WorldSnapshot) -> None:
         real = self._clock.monotonic()
@@ -587,15 +491,8 @@ class Referee:
             return
         elapsed = real - self._status_real_s
         factor = (snapshot.sim_time_ms - self._status_sim_ms) / 1000.0 / elapsed
-        self.log.info(
-            snapshot.sim_time_ms,
-            f"STATUS: Avg speed factor: {factor:.3f} (over last {elapsed:.2f} seconds)",
-        )
-        self.log.info(
-            snapshot.sim_time_ms,
-            f"STATUS: state: STATE_{self.gc.state.name}, remaining time: "
-            f"{int(round(self.gc.secs_remaining))}",
-        )
+        for line in reporting.status_lines(self.gc, speed_factor=factor, elapsed_s=elapsed):
+            self.log.info(snapshot.sim_time_ms, line)
         self._status_real_s = real
         self._status_sim_ms = snapshot.sim_time_ms
 

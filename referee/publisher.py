@@ -1,0 +1,72 @@
+"""Hands the GameController's state to the network and logs its changes.
+
+Every change of state, secondary state, set play, half, kick-off team, score or penalties is
+one line in ``gamecontroller.log`` and an immediate ``RGme`` send; otherwise the packet handed
+to the sender thread is refreshed every 0.1 s of wall time (the thread sends it at 2 Hz).
+"""
+
+from __future__ import annotations
+
+from referee.clock import Clock
+from referee.gamecontroller import GameController, game_control_data
+from referee.logs import RefereeLog
+from referee.net import GameControllerNetwork
+from referee.snapshot import TeamColor
+from referee.wire import encode_game_state
+
+REFRESH_PERIOD_REAL_S = 0.1
+
+
+class Publisher:
+    def __init__(
+        self,
+        *,
+        gc: GameController,
+        team_numbers: dict[TeamColor, int],
+        players_per_team: int,
+        log: RefereeLog,
+        clock: Clock,
+    ) -> None:
+        self._gc = gc
+        self._team_numbers = dict(team_numbers)
+        self._players_per_team = players_per_team
+        self._log = log
+        self._clock = clock
+        self._packet_number = 0
+        self._signature: tuple[object, ...] = ()
+        self._published_real_s = float("-inf")
+        self.network: GameControllerNetwork | None = None
+
+    def packet(self) -> bytes:
+        """The current ``RGme`` datagram (each call takes the next packet number)."""
+        self._packet_number = (self._packet_number + 1) & 0xFF
+        data = game_control_data(
+            self._gc,
+            team_numbers=self._team_numbers,
+            players_per_team=self._players_per_team,
+            packet_number=self._packet_number,
+        )
+        return encode_game_state(data)
+
+    def publish(self, sim_time_ms: int, *, force: bool = False) -> None:
+        gc = self._gc
+        red, blue = gc.score(TeamColor.RED), gc.score(TeamColor.BLUE)
+        penalised = gc.penalised()
+        signature = (
+            gc.state, gc.secondary_state, gc.set_play, gc.half, gc.kickoff_team, red, blue,
+            penalised,
+        )
+        changed = signature != self._signature
+        if changed:
+            self._signature = signature
+            self._log.gamecontroller(
+                sim_time_ms,
+                f"state {gc.state.name} secondary {gc.secondary_state.name} half {gc.half} "
+                f"score red {red} blue {blue} penalised {[str(r) for r in penalised]}",
+            )
+        if self.network is None:
+            return
+        real = self._clock.monotonic()
+        if changed or force or real - self._published_real_s >= REFRESH_PERIOD_REAL_S:
+            self._published_real_s = real
+            self.network.publish(self.packet(), changed=changed or force)

@@ -1,0 +1,78 @@
+"""What the referee reports: the telemetry state dict, the match result, STATUS lines."""
+
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Sequence
+
+from referee.gamecontroller import GameController
+from referee.snapshot import RefereeEvent, TeamColor
+
+COLORS = (TeamColor.RED, TeamColor.BLUE)
+
+
+def score(gc: GameController) -> dict[str, int]:
+    return {color.value: gc.score(color) for color in COLORS}
+
+
+def game_state(gc: GameController, *, left_team: TeamColor, waiting: bool) -> dict[str, object]:
+    """The state dict of the telemetry contract (plus set play, phase, kick-off, sides)."""
+    penalties = {
+        f"{robot.team.value}-{robot.number}": {
+            "penalty": gc.robot(robot).penalty.name,
+            "secs_till_unpenalised": int(round(gc.robot(robot).secs_till_unpenalised)),
+        }
+        for robot in gc.penalised()
+    }
+    play = gc.set_play
+    return {
+        "state": gc.state.name,
+        "secondary_state": gc.secondary_state.name,
+        "set_play": None
+        if play is None
+        else {"team": play.team.value, "sub_phase": play.sub_phase},
+        "half": gc.half,
+        "phase": gc.phase.name,
+        "secs_remaining": int(round(gc.secs_remaining)),
+        "kickoff": gc.kickoff_team.value if gc.kickoff_team is not None else "dropped_ball",
+        "left_team": left_team.value,
+        "score": score(gc),
+        "penalties": penalties,
+        "waiting_for_wall_clock": waiting,
+    }
+
+
+def result(
+    gc: GameController,
+    events: Sequence[RefereeEvent],
+    *,
+    finished: bool,
+    winner: TeamColor | None,
+    shootout: bool,
+    coin_toss: bool,
+) -> dict[str, object]:
+    """``winner`` is ``"red"``, ``"blue"``, ``"draw"`` or None while the game is not over."""
+    summary = Counter(event.type for event in events)
+    out: dict[str, object] = {
+        "state": gc.state.name,
+        "score": score(gc),
+        "winner": (winner.value if winner is not None else "draw") if finished else None,
+        "events_summary": dict(sorted(summary.items())),
+    }
+    if shootout:
+        out["shootout"] = {
+            color.value: {
+                "kicks": gc.teams[color].penalty_shots,
+                "scored": bin(gc.teams[color].single_shots).count("1"),
+            }
+            for color in COLORS
+        }
+        out["coin_toss"] = coin_toss
+    return out
+
+
+def status_lines(gc: GameController, *, speed_factor: float, elapsed_s: float) -> list[str]:
+    return [
+        f"STATUS: Avg speed factor: {speed_factor:.3f} (over last {elapsed_s:.2f} seconds)",
+        f"STATUS: state: STATE_{gc.state.name}, remaining time: {int(round(gc.secs_remaining))}",
+    ]

@@ -1,0 +1,61 @@
+"""The rules in the order the referee applies them, with their memories.
+
+Order: ball in play, goal (else ball out), kick-off, fallen, outside turf, ball holding,
+pushing, inactive goalkeeper, dropped ball. Each rule is a pure function; this class only
+keeps each rule's memory from one step to the next.
+"""
+
+from __future__ import annotations
+
+from referee.rules import (
+    ball_holding,
+    ball_in_play,
+    ball_out,
+    dropped_ball,
+    fallen,
+    goal,
+    goalkeeper,
+    kickoff,
+    outside_turf,
+    pushing,
+)
+from referee.rules.base import Decision, GameView
+from referee.snapshot import WorldSnapshot
+
+
+class RuleBook:
+    def __init__(self) -> None:
+        self.goal = goal.GoalMemory()
+        self.in_play = ball_in_play.BallInPlayMemory()
+        self.fallen = fallen.FallenMemory()
+        self.turf = outside_turf.OutsideTurfMemory()
+        self.holding = ball_holding.BallHoldingMemory()
+        self.pushing = pushing.PushingMemory()
+        self.keeper = goalkeeper.GoalkeeperMemory()
+        self.dropped = dropped_ball.DroppedBallMemory()
+
+    def restart(self, snapshot: WorldSnapshot, restriction: goal.Restriction | None) -> None:
+        """The ball is about to be in play again (kick-off or set play executed)."""
+        self.in_play = ball_in_play.arm(snapshot)
+        self.goal = goal.restart(restriction)
+
+    def judge(self, snapshot: WorldSnapshot, view: GameView) -> list[Decision]:
+        decisions: list[Decision] = []
+        found, self.in_play = ball_in_play.judge(snapshot, view, self.in_play)
+        decisions += found
+        found, self.goal = goal.judge(snapshot, view, self.goal)
+        decisions += found or ball_out.judge(snapshot, view)
+        decisions += kickoff.judge_before_in_play(snapshot, view)
+        found, self.fallen = fallen.judge(snapshot, view, self.fallen)
+        decisions += found
+        found, self.turf = outside_turf.judge(snapshot, view, self.turf)
+        decisions += found
+        found, self.holding = ball_holding.judge(snapshot, view, self.holding)
+        decisions += found
+        found, self.pushing = pushing.judge(snapshot, view, self.pushing)
+        decisions += found
+        found, self.keeper = goalkeeper.judge(snapshot, view, self.keeper)
+        decisions += found
+        found, self.dropped = dropped_ball.judge(snapshot, view, self.dropped)
+        decisions += found
+        return decisions
