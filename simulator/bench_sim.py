@@ -3,6 +3,8 @@
 Measures ``World.step`` + ``World.snapshot`` with N robots holding the standing posture, and a bare
 ``mujoco.mj_step`` loop on the same model with the same physics time step. The two are run in
 alternating one-second (simulated) chunks so that load from other processes affects both alike;
+The world evaluates sensors only in the last physics substep of a basic step (they are read
+once per step), the bare loop in every substep, as a plain ``mj_step`` loop does.
 ``cpu_ratio`` compares thread CPU time instead of wall time (steadier on a busy machine) and
 ``snapshot_us`` is the CPU time of one snapshot. Prints one JSON line with ``--json``::
 

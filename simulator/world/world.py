@@ -1,7 +1,8 @@
 """The soccer world: MuJoCo model and state, stepping, snapshots, referee commands, devices.
 
 Order of work in one basic step (``step_ms``, default 8 ms = 4 physics substeps of 2 ms):
-motors write ``ctrl`` (velocity-limited targets, torque mode, limp), MuJoCo steps, removed robots
+motors write ``ctrl`` (velocity-limited targets, torque mode, limp), MuJoCo steps (sensors are
+evaluated in the last substep only, since they are read once per basic step), removed robots
 are held at their parking spots, divergence is checked (policy ``fail`` raises
 :class:`PhysicsDivergence`, ``reset_robot`` restores the previous state and resets the offending
 robot), and the last ball toucher is updated.
@@ -31,6 +32,8 @@ from simulator.world.snapshot import ball_toucher, build_snapshot
 from simulator.world.types import DivergencePolicy, FieldClassName, RobotPlacement
 
 logger = logging.getLogger(__name__)
+
+_SENSOR_OFF = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
 
 
 class World(DeviceAccess):
@@ -151,7 +154,13 @@ class World(DeviceAccess):
         if self.divergence_policy == "reset_robot":
             self._saved = self._save()
         self.motors.apply(self.data)
-        mujoco.mj_step(self.model, self.data, nstep=self.substeps)
+        if self.substeps > 1:
+            # Sensors are read once per basic step: skip them in all but the last substep.
+            opt = self.model.opt
+            opt.disableflags |= _SENSOR_OFF
+            mujoco.mj_step(self.model, self.data, nstep=self.substeps - 1)
+            opt.disableflags &= ~_SENSOR_OFF
+        mujoco.mj_step(self.model, self.data)
         if self.parked_qpos:
             commands.hold_parked(self)
         self.sim_time_ms += self.step_ms
