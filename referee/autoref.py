@@ -27,7 +27,7 @@ from referee.mirror import TeamMirror
 from referee.net import GameControllerNetwork
 from referee.publisher import Publisher
 from referee.rulebook import RuleBook
-from referee.rules import end_of_game, goal, kickoff
+from referee.rules import end_of_game, goal, kickoff, set_play
 from referee.rules.base import Decision, GameView
 from referee.shootout import Shootout
 from referee.snapshot import (
@@ -321,6 +321,7 @@ class Referee:
         if tick.set_play_executed is not None:
             play = tick.set_play_executed
             self.log.info(now, f"{play.kind.name} for {play.team.value}: execute.")
+            commands += self._apply(set_play.judge_execute(snapshot, self.view(), play), snapshot)
             restriction = {
                 SecondaryState.THROW_IN: goal.Restriction.THROW_IN,
                 SecondaryState.INDIRECT_FREEKICK: goal.Restriction.INDIRECT_FREE_KICK,

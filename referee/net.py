@@ -74,6 +74,7 @@ class GameControllerNetwork:
         self._garbage = 0
         self._unknown = 0
         self._send = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self._send.bind((bind_host, 0))  # RGme leaves from the configured interface
         self._recv = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self._recv.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         self._recv.bind((bind_host, return_port))

@@ -1,8 +1,9 @@
 """The rules in the order the referee applies them, with their memories.
 
 Order: ball in play, goal (else ball out), kick-off, fallen, outside turf, ball holding,
-pushing, inactive goalkeeper, dropped ball. Each rule is a pure function; this class only
-keeps each rule's memory from one step to the next.
+pushing, inactive goalkeeper, dropped ball. (Kick-off positions at SET and set-play compliance
+at EXECUTE are judged once, when the GameController enters those phases.) Each rule is a pure
+function; this class only keeps each rule's memory from one step to the next.
 """
 
 from __future__ import annotations
