@@ -93,6 +93,14 @@ def apply_decisions(
     return commands
 
 
+def _known(ref: RefereeCore, robot: RobotId, snapshot: WorldSnapshot) -> bool:
+    """Robots of the world that the configuration does not list are not judged."""
+    if robot.number in ref.gc.teams[robot.team].robots:
+        return True
+    ref.log.warning(snapshot.sim_time_ms, f"{robot} is not in the team configuration; ignored.")
+    return False
+
+
 def _goal(ref: RefereeCore, goal: Goal, snapshot: WorldSnapshot) -> list[WorldCommand]:
     defending = goal.scoring.opponent
     ref.gc.goal(goal.scoring)
@@ -138,6 +146,8 @@ def _penalize(
     ref: RefereeCore, decision: PenalizeRobot, snapshot: WorldSnapshot, occupied: list[Vec2]
 ) -> list[WorldCommand]:
     robot = decision.robot
+    if not _known(ref, robot, snapshot):
+        return []
     info = ref.gc.robot(robot)
     if info.penalty is not Penalty.NONE or robot in ref.red_carded:
         return []
@@ -170,7 +180,7 @@ def _penalize(
 
 def _card(ref: RefereeCore, decision: GiveCard, snapshot: WorldSnapshot) -> list[WorldCommand]:
     robot = decision.robot
-    if robot in ref.red_carded:
+    if robot in ref.red_carded or not _known(ref, robot, snapshot):
         return []
     given = ref.gc.card(robot, decision.card)
     ref.log.info(snapshot.sim_time_ms, f"{given.value.capitalize()} card for {robot}: "

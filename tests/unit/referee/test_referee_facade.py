@@ -94,3 +94,17 @@ def test_penalty_game_result_has_shootout() -> None:
     assert result["coin_toss"] is True
     kicks = {"kicks": 10, "scored": 0}
     assert result["shootout"] == {"red": kicks, "blue": kicks}
+
+
+def test_robot_missing_from_the_configuration_is_not_judged(tmp_path: Path) -> None:
+    clock = FakeClock()
+    timing = replace(FAST_TIMING, fallen_s=0.5)
+    ref = Referee(config=make_config(timing=timing), clock=clock, log_dir=tmp_path)
+    stranger = robot(RED, 9, -1.0, 0.0, fallen=True)
+    for ms in range(0, 10_000, 8):
+        ref.step(snapshot(ms, (*STILL, stranger)))
+    ref.close()
+    assert not [e for e in ref.events if e.type == "penalty" and e.player == 9]
+    assert "red player 9 is not in the team configuration" in (
+        tmp_path / "referee.log"
+    ).read_text()
