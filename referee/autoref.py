@@ -73,6 +73,7 @@ class Referee:
         self.events: list[RefereeEvent] = []
         self.limp: set[RobotId] = set()
         self.red_carded: set[RobotId] = set()
+        self.ignored_robots: set[RobotId] = set()
         self._started = False
         self._last_ms: int | None = None
         self._wait_until_s: float | None = None

@@ -46,6 +46,7 @@ class RefereeCore(Protocol):
     log: RefereeLog
     limp: set[RobotId]
     red_carded: set[RobotId]
+    ignored_robots: set[RobotId]
     ball_in_play: bool
     left_team: TeamColor
 
@@ -97,7 +98,11 @@ def _known(ref: RefereeCore, robot: RobotId, snapshot: WorldSnapshot) -> bool:
     """Robots of the world that the configuration does not list are not judged."""
     if robot.number in ref.gc.teams[robot.team].robots:
         return True
-    ref.log.warning(snapshot.sim_time_ms, f"{robot} is not in the team configuration; ignored.")
+    if robot not in ref.ignored_robots:
+        ref.ignored_robots.add(robot)
+        ref.log.warning(
+            snapshot.sim_time_ms, f"{robot} is not in the team configuration; ignored."
+        )
     return False
 
 

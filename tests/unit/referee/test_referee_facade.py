@@ -105,6 +105,5 @@ def test_robot_missing_from_the_configuration_is_not_judged(tmp_path: Path) -> N
         ref.step(snapshot(ms, (*STILL, stranger)))
     ref.close()
     assert not [e for e in ref.events if e.type == "penalty" and e.player == 9]
-    assert "red player 9 is not in the team configuration" in (
-        tmp_path / "referee.log"
-    ).read_text()
+    log = (tmp_path / "referee.log").read_text()
+    assert log.count("red player 9 is not in the team configuration") == 1
