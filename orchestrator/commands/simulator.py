@@ -2,7 +2,7 @@
 
 The orchestrator does not import the simulator; these commands run ``python -m simulator`` in a
 child process with the same interpreter, so ``hlvs`` stays the one entry point for users.
-``hlvs bench bringup`` is the orchestrator's own benchmark (see ``commands/match.py``).
+``hlvs bench bringup`` and ``hlvs bench delivery`` are the orchestrator's own benchmarks.
 """
 
 from __future__ import annotations
@@ -31,10 +31,10 @@ def register(sub: Any) -> None:
 
     bench = sub.add_parser(
         "bench",
-        help="benchmarks that print JSON: sim, api, stub, bringup",
+        help="benchmarks that print JSON: sim, api, stub, bringup, delivery",
         add_help=False,
     )
-    bench.add_argument("kind", choices=(*SIMULATOR_BENCHES, "bringup"))
+    bench.add_argument("kind", choices=(*SIMULATOR_BENCHES, "bringup", "delivery"))
     bench.add_argument("rest", nargs=argparse.REMAINDER)
     bench.set_defaults(func=_bench)
 
@@ -42,6 +42,10 @@ def register(sub: Any) -> None:
 def _bench(args: argparse.Namespace) -> int:
     if args.kind in SIMULATOR_BENCHES:
         return _exec_simulator(["bench", args.kind, *args.rest])
+    if args.kind == "delivery":
+        from orchestrator.delivery.bench import main as delivery_main
+
+        return int(delivery_main(list(args.rest)))
     from orchestrator.bringup import main as bringup_main
 
-    return bringup_main(list(args.rest))
+    return int(bringup_main(list(args.rest)))
