@@ -30,7 +30,7 @@ from simulator.api.devices import DeviceWorld
 from simulator.api.endpoints import PlayerEndpoint, peer_allowed_by_name
 from simulator.api.framing import HEADER, REFUSED, WELCOME
 from simulator.api.quota import NetworkQuota
-from simulator.api.session import ERROR, RobotSession
+from simulator.api.session import ERROR, Measurement, RobotSession
 from simulator.api.stats import RobotStats
 from simulator.errors import ApiError
 from simulator.spec import NetworkSpec
@@ -50,7 +50,7 @@ class PortUnavailable(ApiError):
 class _Pending:
     """A measurement waiting for camera images (and the ones queued behind it)."""
 
-    msg: pb.SensorMeasurements
+    measurement: Measurement
     missing: int
 
 
@@ -320,15 +320,16 @@ class ApiServer:
             conn = slot.conn
             if conn is None:
                 continue
-            msg, jobs = slot.session.measure(time_ms)
+            measurement = slot.session.measure(time_ms)
+            jobs = measurement.jobs
             conn.answered = False
             if jobs:
                 jobs_all.extend(jobs)
-                slot.pending.append(_Pending(msg, len(jobs)))
+                slot.pending.append(_Pending(measurement, len(jobs)))
             elif slot.pending:
-                slot.pending.append(_Pending(msg, 0))
+                slot.pending.append(_Pending(measurement, 0))
             else:
-                self._send(slot, conn, msg, now)
+                self._send(slot, conn, measurement, now)
         if jobs_all:
             assert self._cameras is not None, "camera enabled without a render worker"
             self._cameras.submit(jobs_all)
@@ -337,20 +338,20 @@ class ApiServer:
         self._flush_all()
 
     def _send(
-        self, slot: RobotSlot, conn: Connection, msg: pb.SensorMeasurements, now: float
+        self, slot: RobotSlot, conn: Connection, measurement: Measurement, now: float
     ) -> None:
-        size = msg.ByteSize()
-        real_time = msg.real_time
-        if not slot.quota.allows(size, real_time):
+        header = measurement.header
+        payload = header.SerializeToString() + measurement.sensors
+        real_time = header.real_time
+        if not slot.quota.allows(len(payload), real_time):
             slot.stats.quota_errors += 1
-            time_ms = msg.time
-            msg = pb.SensorMeasurements(time=time_ms, real_time=real_time)
-            msg.messages.add(message_type=ERROR, text=slot.quota.error_text)
-            size = msg.ByteSize()
-        slot.quota.record(size, real_time)
-        if msg.messages:
-            slot.stats.warnings_sent += len(msg.messages)
-        conn.enqueue(HEADER.pack(size) + msg.SerializeToString(), now)
+            header = pb.SensorMeasurements(time=header.time, real_time=real_time)
+            header.messages.add(message_type=ERROR, text=slot.quota.error_text)
+            payload = header.SerializeToString()
+        slot.quota.record(len(payload), real_time)
+        if header.messages:
+            slot.stats.warnings_sent += len(header.messages)
+        conn.enqueue(HEADER.pack(len(payload)) + payload, now)
 
     def _flush_all(self) -> None:
         blocking = self._network.blocking_send
@@ -377,7 +378,7 @@ class ApiServer:
             slot = self.slots[job.robot]
             job.measurement.image = image
             for pending in slot.pending:
-                if pending.msg.time == job.time_ms and pending.missing:
+                if pending.measurement.header.time == job.time_ms and pending.missing:
                     pending.missing -= 1
                     break
             touched.add(job.robot)
@@ -385,7 +386,7 @@ class ApiServer:
         for robot in touched:
             slot = self.slots[robot]
             while slot.pending and slot.pending[0].missing == 0 and slot.conn is not None:
-                self._send(slot, slot.conn, slot.pending.popleft().msg, now)
+                self._send(slot, slot.conn, slot.pending.popleft().measurement, now)
         self._flush_all()
 
 

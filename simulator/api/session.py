@@ -10,7 +10,6 @@ Camera images are filled in later by the caller (see :mod:`simulator.api.cameras
 from __future__ import annotations
 
 import logging
-import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -27,6 +26,13 @@ from simulator.api.devices import (
     DeviceWorld,
     kind_name,
     robot_key,
+)
+from simulator.api.encode import (
+    ACCELEROMETERS,
+    FORCES,
+    GYROS,
+    POSITION_SENSORS,
+    SensorEncoder,
 )
 
 log = logging.getLogger(__name__)
@@ -55,10 +61,24 @@ class CameraJob:
 
 
 @dataclass(slots=True)
-class _MotorCommand:
-    position: float = math.nan
-    velocity: float = math.nan
-    torque: float = math.nan
+class Measurement:
+    """One step's measurement: ``header`` (time, messages, cameras) + encoded ``sensors``."""
+
+    header: pb.SensorMeasurements
+    sensors: bytes
+    jobs: list[CameraJob]
+
+    def size(self) -> int:
+        return int(self.header.ByteSize()) + len(self.sensors)
+
+    def payload(self) -> bytes:
+        return bytes(self.header.SerializeToString()) + self.sensors
+
+    def parsed(self) -> pb.SensorMeasurements:
+        """The whole measurement as a message (for tests and tools; slow path)."""
+        msg = pb.SensorMeasurements()
+        msg.ParseFromString(self.payload())
+        return msg
 
 
 class RobotSession:
@@ -81,7 +101,12 @@ class RobotSession:
         self._sensors: dict[str, int] = {}  # name -> period ms
         self._new_sensors: set[str] = set()  # enabled during this step, reported from the next
         self._enabled_at: dict[str, int] = {}
-        self._motors: dict[str, _MotorCommand] = {}
+        self._motor_names = frozenset(n for n, k in self._kinds.items() if k == MOTOR)
+        self._positions: dict[str, float] = {}  # last commands, re-applied after a penalty
+        self._velocities: dict[str, float] = {}
+        self._torques: dict[str, float] = {}
+        self._encoder = SensorEncoder()
+        self._batch_positions = getattr(world, "read_positions", None)
         self._pending: list[tuple[int, str]] = []
         self._limp = False
         self._camera_size: tuple[int, int] | None = None
@@ -96,38 +121,43 @@ class RobotSession:
 
     def apply(self, request: pb.ActuatorRequests, *, step_time_ms: int) -> None:
         """Apply one request; ``step_time_ms`` is the time of the measurement this step sends."""
-        if self._world.is_removed(self.robot):
+        world, robot = self._world, self.robot
+        if world.is_removed(robot):
             return
-        world, robot, kinds = self._world, self.robot, self._kinds
-        active = not self._world.is_limp(robot)
-        for mp in request.motor_positions:
-            if kinds.get(mp.name) != MOTOR:
-                self.warn(f'Motor "{mp.name}" not found, position command ignored.')
-                continue
-            self._motor(mp.name).position = mp.position
-            if active:
-                world.set_motor_position(robot, mp.name, mp.position)
+        motors = self._motor_names
+        active = not world.is_limp(robot)
+        if request.motor_positions:
+            cache, setter = self._positions, world.set_motor_position
+            for mp in request.motor_positions:
+                name, value = mp.name, mp.position
+                if name not in motors:
+                    self.warn(f'Motor "{name}" not found, position command ignored.')
+                    continue
+                cache[name] = value
+                if active:
+                    setter(robot, name, value)
         for mv in request.motor_velocities:
-            if kinds.get(mv.name) != MOTOR:
+            if mv.name not in motors:
                 self.warn(f'Motor "{mv.name}" not found, velocity command ignored.')
                 continue
-            self._motor(mv.name).velocity = mv.velocity
+            self._velocities[mv.name] = mv.velocity
             if active:
                 world.set_motor_velocity(robot, mv.name, mv.velocity)
         for label, items in (("force", request.motor_forces), ("torque", request.motor_torques)):
             for item in items:
                 value = item.force if label == "force" else item.torque
-                if kinds.get(item.name) != MOTOR:
+                if item.name not in motors:
                     self.warn(f'Motor "{item.name}" not found, {label} command ignored.')
                     continue
-                self._motor(item.name).torque = value
+                self._torques[item.name] = value
                 if active:
                     world.set_motor_torque(robot, item.name, value)
         for pid in request.motor_pids:
-            if kinds.get(pid.name) != MOTOR:
+            if pid.name not in motors:
                 self.warn(f'Motor "{pid.name}" not found, PID command ignored.')
                 continue
             world.set_motor_pid(robot, pid.name, pid.PID.X, pid.PID.Y, pid.PID.Z)
+        kinds = self._kinds
         for quality in request.camera_qualities:
             if kinds.get(quality.name) == CAMERA:
                 self.warn("CameraQuality is not yet implemented, ignored.")
@@ -138,12 +168,6 @@ class RobotSession:
                 self.warn(f'Camera "{exposure.name}" not found, exposure command ignored.')
         for step in request.sensor_time_steps:
             self._time_step(step.name, step.timeStep, step_time_ms)
-
-    def _motor(self, name: str) -> _MotorCommand:
-        command = self._motors.get(name)
-        if command is None:
-            command = self._motors[name] = _MotorCommand()
-        return command
 
     def _time_step(self, name: str, period: int, now_ms: int) -> None:
         kind = self._kinds.get(name)
@@ -196,13 +220,12 @@ class RobotSession:
         if limp:
             return
         world, robot = self._world, self.robot
-        for name, command in self._motors.items():
-            if not math.isnan(command.position):
-                world.set_motor_position(robot, name, command.position)
-            if not math.isnan(command.velocity):
-                world.set_motor_velocity(robot, name, command.velocity)
-            if not math.isnan(command.torque):
-                world.set_motor_torque(robot, name, command.torque)
+        for name, position in self._positions.items():
+            world.set_motor_position(robot, name, position)
+        for name, velocity in self._velocities.items():
+            world.set_motor_velocity(robot, name, velocity)
+        for name, torque in self._torques.items():
+            world.set_motor_torque(robot, name, torque)
 
     # --- measurements -----------------------------------------------------------------------
 
@@ -210,7 +233,7 @@ class RobotSession:
     def enabled(self) -> dict[str, int]:
         return dict(self._sensors)
 
-    def measure(self, time_ms: int) -> tuple[pb.SensorMeasurements, list[CameraJob]]:
+    def measure(self, time_ms: int) -> Measurement:
         """The measurement of the step that ended at ``time_ms`` (camera images still empty)."""
         msg = pb.SensorMeasurements(time=time_ms, real_time=self._clock_ms())
         jobs: list[CameraJob] = []
@@ -221,10 +244,14 @@ class RobotSession:
         if world.is_removed(robot):
             self._sensors.clear()
             self._new_sensors.clear()
-            return msg, jobs
-        new = self._new_sensors
+            return Measurement(msg, b"", jobs)
+        new, encoder = self._new_sensors, self._encoder
         positions: dict[str, float] | None = None
-        batch = getattr(world, "read_positions", None)  # one call for every joint, if offered
+        batch = self._batch_positions
+        accelerometers: list[bytes] = []
+        forces: list[bytes] = []
+        gyros: list[bytes] = []
+        joints: list[bytes] = []
         for name, period in self._sensors.items():
             if name in new or (time_ms - self._enabled_at[name]) % period:
                 continue
@@ -236,18 +263,19 @@ class RobotSession:
                     value = positions[name]
                 else:
                     value = world.read_position(robot, name)
-                msg.position_sensors.add(name=name, value=value)
+                joints.append(encoder.scalar(POSITION_SENSORS, name, value))
             elif kind == ACCELEROMETER:
                 x, y, z = world.read_accelerometer(robot)
-                msg.accelerometers.add(name=name).value.CopyFrom(pb.Vector3(X=x, Y=y, Z=z))
+                accelerometers.append(encoder.vector(ACCELEROMETERS, name, x, y, z))
             elif kind == GYRO:
                 x, y, z = world.read_gyro(robot)
-                msg.gyros.add(name=name).value.CopyFrom(pb.Vector3(X=x, Y=y, Z=z))
+                gyros.append(encoder.vector(GYROS, name, x, y, z))
             elif kind == FORCE:
-                msg.forces.add(name=name, value=world.read_force(robot, name))
+                forces.append(encoder.scalar(FORCES, name, world.read_force(robot, name)))
             elif kind == CAMERA and self._camera_size is not None:
                 width, height = self._camera_size
                 camera = msg.cameras.add(name=name, width=width, height=height, quality=-1)
                 jobs.append(CameraJob(robot, name, width, height, time_ms, camera))
         new.clear()
-        return msg, jobs
+        sensors = b"".join(accelerometers + forces + gyros + joints)  # in field-number order
+        return Measurement(msg, sensors, jobs)

@@ -9,6 +9,7 @@ import time
 import pytest
 
 from referee.snapshot import RobotId, TeamColor
+from simulator.api import FakeDeviceWorld
 from simulator.api.world_cameras import world_render_worker
 from simulator.client import RobotClient
 from simulator.spec import NetworkSpec
@@ -61,7 +62,9 @@ def test_host_names_are_accepted_by_reverse_lookup() -> None:
 
 def test_blocking_send_restores_the_hlvs_stall() -> None:
     network = NetworkSpec(api_bind_host="127.0.0.1", blocking_send=True)
-    with running_server(network=network, pause_s=0.0) as (driver, ports):
+    fake = FakeDeviceWorld((RED1, RobotId(TeamColor.BLUE, 1)))  # thousands of steps per second
+    robots = fake.robot_ids
+    with running_server(robots=robots, network=network, pause_s=0.0, world=fake) as (driver, ports):
         raw = socket.socket()
         raw.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
         raw.connect(("127.0.0.1", ports[RED1]))

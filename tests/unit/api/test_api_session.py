@@ -28,14 +28,15 @@ def test_sensor_reported_one_period_after_enabling_then_every_period() -> None:
     _enable(session, 16, NeckS=8, Gyro=24)
     times = {}
     for t in range(16, 120, 8):
-        msg, jobs = session.measure(t)
+        measurement = session.measure(t)
+        msg, jobs = measurement.parsed(), measurement.jobs
         assert not jobs and msg.real_time == 42 and msg.time == t
         times[t] = (bool(msg.position_sensors), bool(msg.gyros))
     assert times[16] == (False, False)  # not in the step it was enabled
     assert [t for t, (neck, _) in times.items() if neck] == list(range(24, 120, 8))
     assert [t for t, (_, gyro) in times.items() if gyro] == [40, 64, 88, 112]
     _enable(session, 120, NeckS=8)  # same period again: no re-synchronisation
-    assert session.measure(120)[0].position_sensors
+    assert session.measure(120).parsed().position_sensors
 
 
 def test_camera_jobs_and_rendering_quota() -> None:
@@ -43,15 +44,15 @@ def test_camera_jobs_and_rendering_quota() -> None:
     assert rendering_bandwidth_mb_s(1920, 1080, 16) == pytest.approx(370.8, abs=0.1)
     session = _session(world, quota=7.0)
     _enable(session, 8, Camera=16)  # 13.7 MB/s > 7 MB/s
-    msg, jobs = session.measure(8)
+    msg = session.measure(8).parsed()
     assert [m.text for m in msg.messages] == [
         "requested rendering bandwidth is above the limit (14MB/s > 7MB/s)"
     ]
     _enable(session, 16, Camera=32)  # 6.9 MB/s fits
-    assert not session.measure(16)[0].messages
+    assert not session.measure(16).header.messages
     _enable(session, 24, Camera=64)
     session.measure(24)
-    jobs = [job for t in range(32, 160, 8) for job in session.measure(t)[1]]
+    jobs = [job for t in range(32, 160, 8) for job in session.measure(t).jobs]
     assert [job.time_ms for job in jobs] == [88, 152]
     assert (jobs[0].width, jobs[0].height) == (320, 240)
 

@@ -74,3 +74,31 @@ def test_out_of_range_length_is_a_framing_error(length: int) -> None:
         FrameDecoder().feed(struct.pack(">I", length) + b"xx")
     assert info.value.length == length
     assert info.value.limit == MAX_FRAME_BYTES
+
+
+def test_hand_encoded_sensors_parse_like_protobuf() -> None:
+    from simulator.api.encode import ACCELEROMETERS, GYROS, POSITION_SENSORS, SensorEncoder
+
+    encoder = SensorEncoder()
+    header = pb.SensorMeasurements(time=16, real_time=5)
+    header.messages.add(message_type=pb.Message.WARNING_MESSAGE, text="w")
+    sensors = (
+        encoder.vector(ACCELEROMETERS, "Accelerometer", 0.1, -0.2, 9.81)
+        + encoder.vector(GYROS, "Gyro", 0.0, 0.0, 0.0)
+        + encoder.scalar(POSITION_SENSORS, "NeckS", 0.25)
+        + encoder.scalar(POSITION_SENSORS, "HeadS", -1.5)
+    )
+    assert encoder.scalar(POSITION_SENSORS, "NeckS", 0.5) == (
+        b"\x5a\x10\x0a\x05NeckS\x11" + struct.pack("<d", 0.5)
+    )
+    parsed = pb.SensorMeasurements()
+    parsed.ParseFromString(header.SerializeToString() + sensors)
+    expected = pb.SensorMeasurements(time=16, real_time=5)
+    expected.messages.add(message_type=pb.Message.WARNING_MESSAGE, text="w")
+    expected.accelerometers.add(name="Accelerometer").value.CopyFrom(
+        pb.Vector3(X=0.1, Y=-0.2, Z=9.81)
+    )
+    expected.gyros.add(name="Gyro").value.CopyFrom(pb.Vector3())
+    expected.position_sensors.add(name="NeckS", value=0.25)
+    expected.position_sensors.add(name="HeadS", value=-1.5)
+    assert parsed == expected
