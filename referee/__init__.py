@@ -1,4 +1,18 @@
-"""GameController, team mirror and automatic referee of hlvs-runner (stdlib and numpy only)."""
+"""GameController, team mirror and automatic referee of hlvs-runner (stdlib and numpy only).
+
+Use::
+
+    referee = Referee(config=RefereeConfig(...), log_dir=out)   # clock: SystemClock by default
+    referee.start_network()          # optional: RGme on 3838, RGrt on 3939, team mirror on 3737
+    for each 8 ms step:              # the world applies the commands before the next step
+        commands = referee.step(world.snapshot())
+    referee.game_state, referee.finished, referee.result(), referee.events
+    referee.close()
+
+``referee.waiting_for_wall_clock`` is True during the league's real-time waits (before the first
+READY, between periods), so a lockstep runtime can hold instead of stepping. Rules live in
+``referee.rules`` (one module per rule); scenarios in ``tests/scenarios/<rule>/<case>.yaml``.
+"""
 
 from __future__ import annotations
 

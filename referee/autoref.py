@@ -74,6 +74,8 @@ class Referee:
         self.limp: set[RobotId] = set()
         self.red_carded: set[RobotId] = set()
         self.ignored_robots: set[RobotId] = set()
+        self._last_toucher: RobotId | None = None
+        self._last_touch_ms: int | None = None
         self._started = False
         self._last_ms: int | None = None
         self._wait_until_s: float | None = None
@@ -94,8 +96,9 @@ class Referee:
             log=self.log,
             clock=self._clock,
         )
-        self._status_real_s = self._clock.monotonic()
-        self._status_sim_ms = 0
+        self._status = reporting.StatusReporter(
+            clock=self._clock, period_s=config.timing.status_period_real_s
+        )
 
     # --- public surface ------------------------------------------------------------------
 
@@ -188,7 +191,9 @@ class Referee:
             commands += self._start(snapshot)
         dt_s = 0.0 if self._last_ms is None else max(0, now - self._last_ms) / 1000.0
         self._last_ms = now
-        self._status(snapshot)
+        for line in self._status.lines(self.gc, snapshot.sim_time_ms):
+            self.log.info(snapshot.sim_time_ms, line)
+        self._ball_touch(snapshot)
         self._goalkeeper_claims()
         if self._finished:
             return commands
@@ -260,7 +265,7 @@ class Referee:
             f"red {cfg.red.name} ({cfg.red.team_id}) vs blue {cfg.blue.name} ({cfg.blue.team_id}),"
             f" {self.left_team.value} on the left, kick-off {cfg.kickoff.value}.",
         )
-        commands = self._starting_positions()
+        commands = self._starting_positions(snapshot.sim_time_ms)
         if cfg.game_type.value == "PENALTY":
             self._wait(cfg.timing.wait_before_first_ready_real_s, self._begin_shootout,
                        "before the penalty shoot-out", snapshot.sim_time_ms)
@@ -269,7 +274,7 @@ class Referee:
                        "before the first READY", snapshot.sim_time_ms)
         return commands
 
-    def _starting_positions(self) -> list[WorldCommand]:
+    def _starting_positions(self, sim_time_ms: int) -> list[WorldCommand]:
         commands: list[WorldCommand] = []
         for color in (TeamColor.RED, TeamColor.BLUE):
             for player in self.config.team(color).players:
@@ -277,6 +282,11 @@ class Referee:
                 if robot in self.red_carded:
                     continue
                 pose = self.pose_on_side(color, player.half_time_pose)
+                self.log.info(
+                    sim_time_ms,
+                    f"{robot} at halfTimeStartingPose ({pose.x_m:.2f}, {pose.y_m:.2f}, "
+                    f"{pose.yaw_rad:.2f}).",
+                )
                 commands.append(
                     TeleportRobot(robot=robot, x_m=pose.x_m, y_m=pose.y_m, yaw_rad=pose.yaw_rad)
                 )
@@ -381,7 +391,7 @@ class Referee:
             return self._begin_shootout(snapshot)
         self.left_team = self.left_team.opponent
         self.log.info(snapshot.sim_time_ms, f"Sides changed: {self.left_team.value} on the left.")
-        commands = self._starting_positions()
+        commands = self._starting_positions(snapshot.sim_time_ms)
         self.gc.transition(GameState.READY)
         self.state_event(snapshot, "READY")
         return commands
@@ -442,7 +452,7 @@ class Referee:
         outcome = self._shootout.judge(snapshot, gc.secs_remaining)
         if outcome is None:
             return []
-        gc.shootout_kick(outcome.team, outcome.scored)
+        status = self._shootout.record(gc, outcome, seed=self.config.seed)
         kicks = gc.teams[outcome.team].penalty_shots
         verdict = "scored" if outcome.scored else f"missed ({outcome.reason})"
         self.log.info(now, f"Penalty shoot-out: {outcome.kicker} kick {kicks} {verdict}.")
@@ -453,14 +463,6 @@ class Referee:
                 details={"scored": outcome.scored, "kick": kicks},
             )
         )
-        status = end_of_game.shootout_status(
-            taken={c: gc.teams[c].penalty_shots for c in (TeamColor.RED, TeamColor.BLUE)},
-            scored={
-                c: bin(gc.teams[c].single_shots).count("1")
-                for c in (TeamColor.RED, TeamColor.BLUE)
-            },
-            seed=self.config.seed,
-        )
         if status.decided:
             gc.transition(GameState.FINISHED)
             self._coin_toss = status.coin_toss
@@ -470,6 +472,14 @@ class Referee:
         return self._setup_kick(snapshot)
 
     # --- outputs -------------------------------------------------------------------------
+
+    def _ball_touch(self, snapshot: WorldSnapshot) -> None:
+        toucher = snapshot.last_ball_toucher
+        if toucher is not None and snapshot.last_ball_touch_ms != self._last_touch_ms:
+            if toucher != self._last_toucher or self._last_touch_ms is None:
+                self.log.info(snapshot.sim_time_ms, f"Ball touched by {toucher}.")
+            self._last_toucher = toucher
+            self._last_touch_ms = snapshot.last_ball_touch_ms
 
     def _goalkeeper_claims(self) -> None:
         if self._network is None:
@@ -485,16 +495,3 @@ class Referee:
     def packet(self) -> bytes:
         """The current ``RGme`` datagram (each call takes the next packet number)."""
         return self._publisher.packet()
-
-    def _status(self, snapshot: WorldSnapshot) -> None:
-        real = self._clock.monotonic()
-        period = self.config.timing.status_period_real_s
-        if real - self._status_real_s < period:
-            return
-        elapsed = real - self._status_real_s
-        factor = (snapshot.sim_time_ms - self._status_sim_ms) / 1000.0 / elapsed
-        for line in reporting.status_lines(self.gc, speed_factor=factor, elapsed_s=elapsed):
-            self.log.info(snapshot.sim_time_ms, line)
-        self._status_real_s = real
-        self._status_sim_ms = snapshot.sim_time_ms
-

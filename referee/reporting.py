@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Sequence
 
+from referee.clock import Clock
 from referee.gamecontroller import GameController
 from referee.snapshot import RefereeEvent, TeamColor
 
@@ -71,8 +72,24 @@ def result(
     return out
 
 
-def status_lines(gc: GameController, *, speed_factor: float, elapsed_s: float) -> list[str]:
-    return [
-        f"STATUS: Avg speed factor: {speed_factor:.3f} (over last {elapsed_s:.2f} seconds)",
-        f"STATUS: state: STATE_{gc.state.name}, remaining time: {int(round(gc.secs_remaining))}",
-    ]
+class StatusReporter:
+    """STATUS lines (speed factor, state, remaining time) every ``period_s`` of wall time."""
+
+    def __init__(self, *, clock: Clock, period_s: float) -> None:
+        self._clock = clock
+        self._period_s = period_s
+        self._real_s = clock.monotonic()
+        self._sim_ms = 0
+
+    def lines(self, gc: GameController, sim_time_ms: int) -> list[str]:
+        real = self._clock.monotonic()
+        elapsed = real - self._real_s
+        if elapsed < self._period_s or elapsed <= 0:
+            return []
+        factor = (sim_time_ms - self._sim_ms) / 1000.0 / elapsed
+        self._real_s, self._sim_ms = real, sim_time_ms
+        return [
+            f"STATUS: Avg speed factor: {factor:.3f} (over last {elapsed:.2f} seconds)",
+            f"STATUS: state: STATE_{gc.state.name}, remaining time: "
+            f"{int(round(gc.secs_remaining))}",
+        ]

@@ -14,8 +14,10 @@ import math
 from dataclasses import dataclass
 
 from referee.config import Pose, RefereeConfig
+from referee.gamecontroller import GameController
 from referee.rules.ball_out import in_goal, over_goal_line, over_touch_line
 from referee.rules.base import ball_speed, distance2d
+from referee.rules.end_of_game import ShootoutStatus, shootout_status
 from referee.snapshot import (
     PlaceBall,
     RobotId,
@@ -100,3 +102,13 @@ class Shootout:
         if time_left_s <= 0 or math.isnan(time_left_s):
             return KickOutcome(self.attacker, self.kicker, False, "time over")
         return None
+
+    def record(self, gc: GameController, outcome: KickOutcome, *, seed: int) -> ShootoutStatus:
+        """Count the kick on the GameController; is the shoot-out decided?"""
+        gc.shootout_kick(outcome.team, outcome.scored)
+        colors = (TeamColor.RED, TeamColor.BLUE)
+        return shootout_status(
+            taken={c: gc.teams[c].penalty_shots for c in colors},
+            scored={c: bin(gc.teams[c].single_shots).count("1") for c in colors},
+            seed=seed,
+        )
