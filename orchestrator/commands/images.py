@@ -1,6 +1,9 @@
-"""``hlvs images build [--base IMAGE] [--json]``: build project images whose inputs changed.
+"""``hlvs images build|pull``: the project images, and a team's images before a match.
 
-Prints one line per image (tag, size, rebuilt or cached), or one JSON object with ``--json``.
+``build [--base IMAGE] [--json]`` builds project images whose inputs changed and prints one line
+per image (tag, size, rebuilt or cached). ``pull TEAM_CONFIG [--image-limit-gb GB] [--json]``
+pulls every player's image with the team's registry login, pins it by digest and checks its size,
+as the runner does before a match; it exits 1 when a player has no usable image.
 """
 
 from __future__ import annotations
@@ -8,6 +11,7 @@ from __future__ import annotations
 import argparse
 import json
 import time
+from pathlib import Path
 from typing import Any
 
 
@@ -26,6 +30,13 @@ def register(sub: Any) -> None:
     )
     build.add_argument("--json", action="store_true", help="print one JSON object")
     build.set_defaults(func=_build)
+    pull = actions.add_parser(
+        "pull", help="pull and pin a team's images as a match would (reports each player)"
+    )
+    pull.add_argument("team_config", type=Path, help="team_config.json")
+    pull.add_argument("--image-limit-gb", type=float, default=10.0, metavar="GB")
+    pull.add_argument("--json", action="store_true", help="print one JSON object")
+    pull.set_defaults(func=_pull)
 
 
 def _build(args: argparse.Namespace) -> int:
@@ -47,3 +58,34 @@ def _build(args: argparse.Namespace) -> int:
         print(f"{image.reference}  {image.size_bytes / 1e6:8.1f} MB  {state}")
     print(f"images ready in {total_s:.1f} s")
     return 0
+
+
+def _pull(args: argparse.Namespace) -> int:
+    from orchestrator.config import Limits, load_team
+    from orchestrator.engine import connect
+    from orchestrator.pull import resolve_team_images
+
+    loaded = load_team(args.team_config, images_required=True)
+    for warning in loaded.warnings:
+        print(warning)
+    resolved = resolve_team_images(
+        connect(), loaded.team, limits=Limits(image_gb=args.image_limit_gb)
+    )
+    if args.json:
+        players = {
+            str(number): {
+                "reference": image.reference,
+                "digest": image.digest,
+                "size_bytes": image.size_bytes,
+                "error": image.error.reason if image.error else None,
+            }
+            for number, image in sorted(resolved.items())
+        }
+        print(json.dumps({"team": loaded.team.name, "players": players}, sort_keys=True))
+    else:
+        for number, image in sorted(resolved.items()):
+            if image.error is None:
+                print(f"player {number}: {image.digest} ({image.size_bytes / 1e6:.1f} MB)")
+            else:
+                print(f"player {number}: {image.error}")
+    return 0 if all(image.error is None for image in resolved.values()) else 1

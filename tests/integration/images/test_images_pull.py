@@ -205,3 +205,38 @@ def test_player_without_image(docker_client: docker.DockerClient) -> None:
     resolved = resolve_team_images(docker_client, team(None, None, None), limits=Limits())
     assert resolved[1].error is not None
     assert "no image named for player 1" in str(resolved[1].error)
+
+
+def test_hlvs_images_pull_reports_each_player(
+    registry: Registry,
+    docker_client: docker.DockerClient,
+    make_image: MakeImage,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    import json
+
+    from orchestrator.cli import main
+
+    repository = f"{registry.host}/alpha/robot"
+    make_image(f"{repository}:v1", 1000)
+    pushed = push(docker_client, f"{repository}:v1", "alpha", registry.users["alpha"])
+    example = Path(__file__).parents[3] / "configs" / "examples" / "scrimmage_1v1"
+    document = json.loads((example / "team_red.json").read_text())
+    document["image"] = repository
+    document["players"]["1"]["dockerTag"] = "v1"
+    document["registry_auth"] = {"username": "alpha", "password_env": "HLVS_TEST_ALPHA_PASSWORD"}
+    config = tmp_path / "team_config.json"
+    config.write_text(json.dumps(document))
+
+    monkeypatch.setenv("HLVS_TEST_ALPHA_PASSWORD", registry.users["alpha"])
+    assert main(["images", "pull", str(config), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["players"]["1"]["digest"] == f"{repository}@{pushed}"
+    assert report["players"]["1"]["error"] is None
+
+    monkeypatch.setenv("HLVS_TEST_ALPHA_PASSWORD", "wrong")
+    assert main(["images", "pull", str(config), "--json"]) == 1
+    error = json.loads(capsys.readouterr().out)["players"]["1"]["error"]
+    assert error.startswith(f"authentication failed for {registry.host} (user alpha)")
