@@ -162,6 +162,10 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
             reason = "physics_divergence"
             error = str(exc)
             log.error("%s", exc)
+        except Exception as exc:  # process boundary: the results still record the state reached
+            reason = "internal_error"
+            error = f"{type(exc).__name__}: {exc}"
+            log.exception("match loop failed")
         recorder.close(world)
         if reason == "finished":
             exit_code = 0
