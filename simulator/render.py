@@ -2,7 +2,8 @@
 
 The world model is rebuilt from the replay header; each frame's body poses are turned into geom
 poses (no physics) and drawn offscreen from the ``overview`` camera, and the raw RGB frames are
-piped to ffmpeg (libx264, yuv420p). Needs ``MUJOCO_GL=osmesa`` (or ``egl``) without a display.
+piped to ffmpeg (libx264, yuv420p). The game state of the frames (state, half, time left, score)
+becomes a subtitle track. Needs ``MUJOCO_GL=osmesa`` (or ``egl``) without a display.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import subprocess
 import sys
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -56,6 +58,43 @@ def _frames_for(replay: Replay, fps: float) -> Iterator[int]:
         k += 1
 
 
+def caption(game: dict[str, Any]) -> str:
+    """One line about a frame's game state: ``PLAYING  1st half  09:58  red 1 : 0 blue``."""
+    parts = []
+    if game.get("state"):
+        parts.append(str(game["state"]))
+    if game.get("half") in (1, 2):
+        parts.append("1st half" if game["half"] == 1 else "2nd half")
+    secs = game.get("secs_remaining")
+    if isinstance(secs, int | float):
+        parts.append(f"{int(secs) // 60:02d}:{int(secs) % 60:02d}")
+    score = game.get("score")
+    if isinstance(score, dict) and "red" in score and "blue" in score:
+        parts.append(f"red {score['red']} : {score['blue']} blue")
+    return "  ".join(parts)
+
+
+def _srt_time(seconds: float) -> str:
+    ms = int(round(seconds * 1000))
+    return f"{ms // 3600000:02d}:{ms // 60000 % 60:02d}:{ms // 1000 % 60:02d},{ms % 1000:03d}"
+
+
+def _subtitles(replay: Replay, indices: list[int], fps: float) -> str:
+    """SRT cues of the captions, one per run of video frames with the same caption."""
+    cues: list[str] = []
+    start = 0
+    for k in range(1, len(indices) + 1):
+        text = caption(replay.frames[indices[start]].game)
+        if k < len(indices) and caption(replay.frames[indices[k]].game) == text:
+            continue
+        if text:
+            cues.append(
+                f"{len(cues) + 1}\n{_srt_time(start / fps)} --> {_srt_time(k / fps)}\n{text}\n"
+            )
+        start = k
+    return "\n".join(cues)
+
+
 def render_video(
     replay_path: str | Path,
     output: str | Path,
@@ -94,16 +133,22 @@ def render_video(
     renderer.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = False
     option = mujoco.MjvOption()
     option.geomgroup[4] = 0
+    indices = list(_frames_for(replay, fps))
     command = [
         ffmpeg, "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24",
         "-s", f"{width}x{height}", "-r", f"{fps:g}", "-i", "-",
-        "-c:v", "libx264", "-preset", "veryfast", "-pix_fmt", "yuv420p", str(output),
     ]  # fmt: skip
+    subtitles = _subtitles(replay, indices, fps)
+    srt = output.with_name(output.name + ".srt")
+    if subtitles:
+        srt.write_text(subtitles, encoding="utf-8")
+        command += ["-i", str(srt), "-map", "0:v", "-map", "1:s", "-c:s", "mov_text"]
+    command += ["-c:v", "libx264", "-preset", "veryfast", "-pix_fmt", "yuv420p", str(output)]
     proc = subprocess.Popen(command, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
     assert proc.stdin is not None
     count = 0
     try:
-        for i in _frames_for(replay, fps):
+        for i in indices:
             poses = replay.frames[i].poses.astype(np.float64)
             body_rot = _quat_to_mat(poses[:, 3:7])
             rot = body_rot[geom_body]
@@ -121,6 +166,7 @@ def render_video(
         renderer.close()
     stderr = proc.stderr.read().decode(errors="replace") if proc.stderr else ""
     code = proc.wait()
+    srt.unlink(missing_ok=True)
     if code != 0:
         raise RenderError(output=str(output), reason=f"ffmpeg exited {code}: {stderr.strip()}")
     logger.info("rendered %d frames of %s to %s", count, replay_path, output)

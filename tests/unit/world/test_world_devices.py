@@ -33,6 +33,8 @@ def test_every_contract_device_exists(one_robot_world: World) -> None:
         assert devices[name] is DeviceKind.FORCE
     assert len(devices) == 20 + 20 + 3 + 8
     assert one_robot_world.camera_info(RED_1) == (320, 240, pytest.approx(1.04))
+    fovy = math.radians(float(one_robot_world.model.camera("red_1/Camera").fovy[0]))
+    assert 2 * math.atan(math.tan(fovy / 2) * 320 / 240) == pytest.approx(1.04, abs=1e-4)
 
 
 def test_standing_robot_sensors_read_like_a_real_imu(one_robot_world: World) -> None:

@@ -14,6 +14,7 @@ import pytest
 from referee.snapshot import PlaceBall
 from simulator.errors import ReplayError
 from simulator.recorder import Recorder, load_replay
+from simulator.render import caption
 from simulator.world import World
 from tests.unit.world.conftest import eight_robots
 
@@ -26,7 +27,10 @@ def _record(path: Path, seconds: float, robots: int = 8) -> World:
             world.step()
             if step == 10:
                 recorder.event({"type": "goal", "team": "red", "sim_time_ms": world.sim_time_ms})
-            recorder.record(world, {"state": "PLAYING", "score": {"red": 1, "blue": 0}})
+            game = {"state": "PLAYING", "score": {"red": 1, "blue": 0}}
+            if robots == 8:
+                game.update(half=1, secs_remaining=600 - world.sim_time_ms // 1000)
+            recorder.record(world, game)
     return world
 
 
@@ -78,15 +82,23 @@ def test_ten_second_video_of_eight_robots(tmp_path: Path) -> None:
     )  # fmt: skip
     assert done.returncode == 0, done.stderr
     probe = subprocess.run(
-        ["ffprobe", "-v", "error", "-select_streams", "v:0", "-show_entries",
-         "stream=width,height,codec_name,pix_fmt:format=duration", "-of", "json", str(video)],
+        ["ffprobe", "-v", "error", "-show_entries",
+         "stream=codec_type,width,height,codec_name,pix_fmt:format=duration", "-of", "json",
+         str(video)],
         capture_output=True, text=True, check=True,
     )  # fmt: skip
     info = json.loads(probe.stdout)
     stream = info["streams"][0]
+    assert [s["codec_type"] for s in info["streams"]] == ["video", "subtitle"]
     assert (stream["width"], stream["height"]) == (320, 180)
     assert stream["codec_name"] == "h264" and stream["pix_fmt"] == "yuv420p"
     assert float(info["format"]["duration"]) == pytest.approx(10.0, abs=0.3)
+
+
+def test_captions_follow_the_game_state() -> None:
+    game = {"state": "PLAYING", "half": 2, "secs_remaining": 125.4, "score": {"red": 2, "blue": 3}}
+    assert caption(game) == "PLAYING  2nd half  02:05  red 2 : 3 blue"
+    assert caption({}) == ""
 
 
 def test_render_cli_rejects_a_bad_replay(tmp_path: Path) -> None:
