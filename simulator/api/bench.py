@@ -107,14 +107,29 @@ def _world(robots: list[RobotId], physics_dt: float) -> Any:
     return World.create(field_class="kid", robots=placements, seed=1, physics_dt_s=physics_dt)
 
 
-def _world_only_rtf(robots: list[RobotId], physics_dt: float, sim_seconds: float) -> float:
+def _world_only(
+    robots: list[RobotId], physics_dt: float, sim_seconds: float
+) -> tuple[float, float]:
+    """(real-time factor, CPU seconds per simulated second) of World.step + snapshot."""
     world = _world(robots, physics_dt)
     steps = int(sim_seconds * 1000 / world.step_ms)
-    started = time.perf_counter()
+    started, started_cpu = time.perf_counter(), time.thread_time()
     for _ in range(steps):
         world.step()
         world.snapshot()
-    return float(steps * world.step_ms / 1000.0 / (time.perf_counter() - started))
+    simulated = steps * world.step_ms / 1000.0
+    wall, cpu = time.perf_counter() - started, time.thread_time() - started_cpu
+    return simulated / wall, cpu / simulated
+
+
+def _bench_sim(robots: int, physics_dt: float, sim_seconds: float) -> dict[str, Any] | None:
+    """The world engineer's ``bench sim`` numbers for the same setup, when it is available."""
+    try:
+        from simulator.bench_sim import run
+    except ImportError:
+        return None
+    result = run(robots=robots, sim_seconds=sim_seconds, physics_dt_s=physics_dt, field_class="kid")
+    return {k: result[k] for k in ("real_time_factor", "bare_real_time_factor") if k in result}
 
 
 def _api_run(
@@ -180,7 +195,7 @@ def _api_run(
             server.publish(world.sim_time_ms)
         steps = int(args.sim_seconds * 1000 / world.step_ms)
         start_ms = world.sim_time_ms
-        started = time.perf_counter()
+        started, started_cpu = time.perf_counter(), time.thread_time()
         for _ in range(steps):
             if args.mode == "lockstep":
                 wait_lockstep(server, lockstep)
@@ -188,7 +203,7 @@ def _api_run(
             world.step()
             world.snapshot()
             server.publish(world.sim_time_ms)
-        wall = time.perf_counter() - started
+        wall, cpu = time.perf_counter() - started, time.thread_time() - started_cpu
         stats = server.statistics()
     finally:
         server.close()
@@ -199,6 +214,7 @@ def _api_run(
     rtts = [s["round_trip_ms"]["p50"] for s in stats.values() if s["round_trip_ms"]["p50"]]
     return {
         "real_time_factor": round((world.sim_time_ms - start_ms) / 1000.0 / wall, 3),
+        "cpu_s_per_sim_s": cpu / ((world.sim_time_ms - start_ms) / 1000.0),
         "connected": len(stats),
         "dropped_out": sum(s["dropped_out"] for s in stats.values()),
         "slow_periods": sum(s["slow_periods"] for s in stats.values()),
@@ -240,7 +256,7 @@ def main(argv: list[str]) -> int:
     os.environ.setdefault("LP_NUM_THREADS", "1")  # rendering on one core, physics on another
     camera = _camera(args.camera)
     robots = _robots(args.robots)
-    world_rtf = _world_only_rtf(robots, args.physics_dt, min(args.sim_seconds, 10.0))
+    world_rtf, world_cpu = _world_only(robots, args.physics_dt, min(args.sim_seconds, 10.0))
     api = _api_run(args, camera, stalled=False)
     result: dict[str, Any] = {
         "bench": "api",
@@ -252,6 +268,9 @@ def main(argv: list[str]) -> int:
         "real_time_factor": api["real_time_factor"],
         "world_only_real_time_factor": round(world_rtf, 3),
         "ratio": round(api["real_time_factor"] / world_rtf, 3),
+        # load-independent: simulator-thread CPU per simulated second, world only vs with the API
+        "cpu_ratio": round(world_cpu / api["cpu_s_per_sim_s"], 3),
+        "bench_sim": _bench_sim(args.robots, args.physics_dt, min(args.sim_seconds, 5.0)),
         "round_trip_p50_ms": api["round_trip_p50_ms"],
         "camera_frames": api["camera_frames"],
         "camera_robots": (args.camera_robots or args.robots) if camera else 0,
