@@ -13,9 +13,10 @@ import logging
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING
 
-from orchestrator.config import Limits, RegistryAuth, TeamConfig
+from orchestrator.config import COLORS, Limits, RegistryAuth, TeamConfig
 from orchestrator.ecr import ecr_login
 from orchestrator.engine import images as engine_images
 from orchestrator.errors import ImageError, ImagePullError, ImageTooLarge
@@ -75,6 +76,52 @@ def resolve_team_images(
             size_bytes=resolved.size_bytes,
             error=resolved.error,
         )
+    return result
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class GamePull:
+    """Both teams' images of one game, pulled ahead of the match (the scheduler's pull step)."""
+
+    game: Path
+    teams: Mapping[str, Mapping[int, ResolvedImage]]  # "red" / "blue" -> player -> image
+
+    @property
+    def ok(self) -> bool:
+        return all(image.ok for team in self.teams.values() for image in team.values())
+
+    def __str__(self) -> str:
+        parts = []
+        for color, team in self.teams.items():
+            pinned = sum(1 for image in team.values() if image.ok)
+            errors = sorted({str(image.error) for image in team.values() if image.error})
+            text = f"{color}: {pinned}/{len(team)} images pinned"
+            parts.append(text + (f" ({'; '.join(errors)})" if errors else ""))
+        return "; ".join(parts)
+
+
+def pull_game_images(
+    game: Path | str,
+    *,
+    engine: DockerClient | None = None,
+    environ: Mapping[str, str] | None = None,
+) -> GamePull:
+    """Pull and pin both teams' images of ``game`` (a game.json); bad images are reported, not
+    raised, since the match still plays (robots without a valid image spawn without a controller).
+    """
+    from orchestrator.config import load_game
+    from orchestrator.engine import connect
+
+    loaded = load_game(game, images_required=False)
+    engine = engine or connect()
+    teams: dict[str, Mapping[int, ResolvedImage]] = {
+        color: resolve_team_images(
+            engine, loaded.team(color), limits=loaded.game.limits, environ=environ
+        )
+        for color in COLORS
+    }
+    result = GamePull(game=Path(game), teams=teams)
+    log.info("pulled the images of %s: %s", game, result)
     return result
 
 
@@ -165,4 +212,10 @@ def _failed(number: int, reference: str, error: ImageError) -> ResolvedImage:
     )
 
 
-__all__ = ["ResolvedImage", "resolve_team_images", "split_reference"]
+__all__ = [
+    "GamePull",
+    "ResolvedImage",
+    "pull_game_images",
+    "resolve_team_images",
+    "split_reference",
+]

@@ -240,3 +240,19 @@ def test_hlvs_images_pull_reports_each_player(
     assert main(["images", "pull", str(config), "--json"]) == 1
     error = json.loads(capsys.readouterr().out)["players"]["1"]["error"]
     assert error.startswith(f"authentication failed for {registry.host} (user alpha)")
+
+
+def test_pull_game_images_pins_both_teams(docker_client: docker.DockerClient) -> None:
+    from orchestrator.images import project_image
+    from orchestrator.pull import pull_game_images
+
+    project_image("stub")  # also tags hlvs-runner/stub:latest, which the example names
+    game = Path(__file__).parents[3] / "configs" / "examples" / "scrimmage_1v1" / "game.json"
+
+    pulled = pull_game_images(game, engine=docker_client)
+
+    assert pulled.ok
+    assert str(pulled) == "red: 1/1 images pinned; blue: 1/1 images pinned"
+    image_id = pulled.teams["red"][1].image_id
+    assert pulled.teams["blue"][1].image_id == image_id
+    assert docker_client.images.get(image_id).labels["org.hlvs-runner.image"] == "stub"
