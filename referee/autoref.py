@@ -162,14 +162,8 @@ class Referee:
         return self._mirror
 
     def close(self) -> None:
-        sim_ms = self._last_ms or 0
         if self._network is not None:
-            stats = self._network.stats()
-            self.log.gamecontroller(
-                sim_ms,
-                f"packets sent: {stats.packets_sent} ({stats.datagrams_sent} datagrams), "
-                f"returns received: {stats.returns_received}, garbage: {stats.garbage}",
-            )
+            self._publisher.log_counts(self._last_ms or 0)
             self._network.close()
             self._network = None
             self._publisher.network = None
@@ -193,6 +187,8 @@ class Referee:
         self._last_ms = now
         for line in self._status.lines(self.gc, snapshot.sim_time_ms):
             self.log.info(snapshot.sim_time_ms, line)
+            if line.startswith("STATUS: state"):
+                self._publisher.log_counts(snapshot.sim_time_ms)
         self._ball_touch(snapshot)
         self._goalkeeper_claims()
         if self._finished:
@@ -432,7 +428,8 @@ class Referee:
             SetLimp(robot=r, limp=False) for r in sorted(self.limp, key=str)
         ]
         self.limp.clear()
-        commands += shootout.setup_kick(snapshot, self.red_carded)
+        keeper = self.gc.goalkeeper(shootout.attacker.opponent)
+        commands += shootout.setup_kick(snapshot, self.red_carded, keeper=keeper)
         self.state_event(snapshot, "SET", kicker=str(shootout.kicker))
         return commands
 

@@ -70,3 +70,14 @@ class Publisher:
         if changed or force or real - self._published_real_s >= REFRESH_PERIOD_REAL_S:
             self._published_real_s = real
             self.network.publish(self.packet(), changed=changed or force)
+
+    def log_counts(self, sim_time_ms: int) -> None:
+        if self.network is None:
+            return
+        stats = self.network.stats()
+        self._log.gamecontroller(
+            sim_time_ms,
+            f"packets sent: {stats.packets_sent} ({stats.datagrams_sent} datagrams), "
+            f"returns received: {stats.returns_received}, garbage: {stats.garbage}, "
+            f"unknown teams: {stats.unknown}",
+        )

@@ -51,7 +51,10 @@ class Shootout:
         self.kicker: RobotId | None = None
         self._ball_origin: Vec3 = (0.0, 0.0, 0.0)
 
-    def setup_kick(self, snapshot: WorldSnapshot, red_carded: set[RobotId]) -> list[WorldCommand]:
+    def setup_kick(
+        self, snapshot: WorldSnapshot, red_carded: set[RobotId], *, keeper: int | None = None
+    ) -> list[WorldCommand]:
+        """``keeper``: the defending goalkeeper's number (GameController flag)."""
         field = self._config.field
         commands: list[WorldCommand] = []
         attacking = self._config.team(self.attacker)
@@ -60,9 +63,11 @@ class Shootout:
             p for p in attacking.players if RobotId(self.attacker, p.number) not in red_carded
         ]
         self.kicker = RobotId(self.attacker, candidates[0].number) if candidates else None
-        keeper = next((p for p in defending.players if p.goalkeeper), None)
-        if keeper is None and defending.players:
-            keeper = defending.players[0]
+        keeper_player = next((p for p in defending.players if p.number == keeper), None)
+        if keeper_player is None:
+            keeper_player = next((p for p in defending.players if p.goalkeeper), None)
+        if keeper_player is None and defending.players:
+            keeper_player = defending.players[0]
         for player in attacking.players:
             robot = RobotId(self.attacker, player.number)
             if robot in red_carded:
@@ -73,7 +78,7 @@ class Shootout:
             robot = RobotId(self.attacker.opponent, player.number)
             if robot in red_carded:
                 continue
-            is_keeper = keeper is not None and player.number == keeper.number
+            is_keeper = keeper_player is not None and player.number == keeper_player.number
             pose = player.goalkeeper_pose if is_keeper else player.half_time_pose
             commands.append(_teleport(robot, pose.mirrored()))
         self._ball_origin = (field.penalty_mark_x_m, 0.0, field.ball_radius_m)
