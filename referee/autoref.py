@@ -14,7 +14,7 @@ from pathlib import Path
 
 from referee import reporting
 from referee.clock import Clock, SystemClock
-from referee.config import Pose, RefereeConfig
+from referee.config import GameType, Pose, RefereeConfig
 from referee.gamecontroller import (
     GameController,
     GameState,
@@ -262,7 +262,7 @@ class Referee:
             f" {self.left_team.value} on the left, kick-off {cfg.kickoff.value}.",
         )
         commands = self._starting_positions(snapshot.sim_time_ms)
-        if cfg.game_type.value == "PENALTY":
+        if cfg.game_type is GameType.PENALTY:
             self._wait(cfg.timing.wait_before_first_ready_real_s, self._begin_shootout,
                        "before the penalty shoot-out", snapshot.sim_time_ms)
         else:
