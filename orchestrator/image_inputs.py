@@ -149,10 +149,6 @@ def ensure_wheels(requirements: Sequence[str], *, cache_dir: Path) -> Path:
     return target
 
 
-def wheel_names(wheel_dir: Path) -> tuple[str, ...]:
-    return tuple(sorted(p.name for p in wheel_dir.glob("*.whl")))
-
-
 def source_files(repo_root: Path, packages: Sequence[str]) -> Iterator[Path]:
     """Every file of the given package folders, sorted, without caches and bytecode."""
     for package in packages:
@@ -220,5 +216,4 @@ __all__ = [
     "pinned_requirements",
     "project_version",
     "source_files",
-    "wheel_names",
 ]

@@ -120,9 +120,19 @@ def ensure_image(
         wheel_dir = image_inputs.ensure_wheels(
             image_inputs.pinned_requirements(recipe.requirements), cache_dir=BUILD_DIR / "wheels"
         )
-        sources = list(image_inputs.source_files(REPO_ROOT, recipe.packages))
+        # The hash is taken over the assembled context, so the tag names exactly what is built
+        # even when sources change meanwhile.
+        context_dir = BUILD_DIR / "context" / name
+        image_inputs.assemble_context(
+            context_dir=context_dir,
+            dockerfile=recipe.dockerfile,
+            extra_files=recipe.build_files,
+            wheel_dir=wheel_dir,
+            repo_root=REPO_ROOT,
+            sources=list(image_inputs.source_files(REPO_ROOT, recipe.packages)),
+        )
         build_args = {"BASE_IMAGE": base_ref}
-        content = content_hash(recipe, sources, wheel_dir, base_id, build_args)
+        content = content_hash(recipe.name, context_dir, base_id, build_args)
         reference = f"{recipe.repository}:{content}"
         existing = engine_images.inspect(client, reference)
         if existing is not None:
@@ -136,15 +146,6 @@ def ensure_image(
                 seconds=time.monotonic() - started,
                 build_log=None,
             )
-        context_dir = BUILD_DIR / "context" / name
-        image_inputs.assemble_context(
-            context_dir=context_dir,
-            dockerfile=recipe.dockerfile,
-            extra_files=recipe.build_files,
-            wheel_dir=wheel_dir,
-            repo_root=REPO_ROOT,
-            sources=sources,
-        )
         log_path = BUILD_DIR / "logs" / f"{name}-{content}.log"
         log.info("building %s (build log: %s)", reference, log_path)
         info = engine_images.build(
@@ -178,29 +179,20 @@ def build_all(*, base: str | None = None, client: DockerClient | None = None) ->
     return [ensure_image(name, base=base, client=client) for name in IMAGE_NAMES]
 
 
-def content_hash(
-    recipe: ImageRecipe,
-    sources: list[Path],
-    wheel_dir: Path,
-    base_id: str,
-    build_args: dict[str, str],
-) -> str:
-    """12 hex digits over every input of the build."""
+def content_hash(name: str, context_dir: Path, base_id: str, build_args: dict[str, str]) -> str:
+    """12 hex digits over every file of the build context (wheels by name), the base image id
+    and the build arguments."""
     digest = hashlib.sha256()
 
     def feed(label: str, data: bytes) -> None:
         digest.update(f"{label}\0{len(data)}\0".encode())
         digest.update(data)
 
-    feed("recipe", recipe.name.encode())
-    feed("Dockerfile", recipe.dockerfile.read_bytes())
-    for path in recipe.build_files:
-        feed(path.name, path.read_bytes())
-    for path in sources:
-        feed(str(path.relative_to(REPO_ROOT)), path.read_bytes())
-    feed("requirements", (wheel_dir / "requirements.txt").read_bytes())
-    feed("wheels", "\n".join(image_inputs.wheel_names(wheel_dir)).encode())
-    feed("version", image_inputs.project_version().encode())
+    feed("recipe", name.encode())
+    for path in sorted(p for p in context_dir.rglob("*") if p.is_file()):
+        relative = path.relative_to(context_dir)
+        pinned_by_name = relative.parts[0] == "wheels"  # wheel names carry their versions
+        feed(str(relative), b"" if pinned_by_name else path.read_bytes())
     feed("base", base_id.encode())
     feed("args", repr(sorted(build_args.items())).encode())
     return digest.hexdigest()[:12]

@@ -9,7 +9,7 @@ import pytest
 
 from orchestrator.engine.images import RegistryAuth, _classify, registry_of
 from orchestrator.errors import ImagePullError
-from orchestrator.images import RECIPES, content_hash
+from orchestrator.images import content_hash
 from orchestrator.pull import split_reference
 from orchestrator.registry import RegistryImage, TeamRule, _next_link, plan_enforcement
 
@@ -94,19 +94,31 @@ def test_classify_engine_messages() -> None:
 
 
 def test_content_hash_follows_every_input(tmp_path: Path) -> None:
-    recipe = RECIPES["team-base"]
-    wheels = tmp_path / "wheels"
-    wheels.mkdir()
-    (wheels / "requirements.txt").write_text("numpy==2.0\n")
-    (wheels / "numpy-2.0-cp311.whl").write_bytes(b"")
-    source = Path(__file__)
-    base = content_hash(recipe, [source], wheels, "sha256:base", {"BASE_IMAGE": "b"})
-    assert base == content_hash(recipe, [source], wheels, "sha256:base", {"BASE_IMAGE": "b"})
-    assert base != content_hash(recipe, [], wheels, "sha256:base", {"BASE_IMAGE": "b"})
-    assert base != content_hash(recipe, [source], wheels, "sha256:other", {"BASE_IMAGE": "b"})
-    assert base != content_hash(recipe, [source], wheels, "sha256:base", {"BASE_IMAGE": "c"})
-    (wheels / "requirements.txt").write_text("numpy==2.1\n")
-    assert base != content_hash(recipe, [source], wheels, "sha256:base", {"BASE_IMAGE": "b"})
+    context = tmp_path / "context"
+    (context / "wheels").mkdir(parents=True)
+    (context / "src" / "simulator").mkdir(parents=True)
+    (context / "Dockerfile").write_text("FROM x\n")
+    (context / "src" / "simulator" / "a.py").write_text("A = 1\n")
+    (context / "wheels" / "numpy-2.0-cp311.whl").write_bytes(b"zip")
+
+    def current(base: str = "sha256:base", arg: str = "b") -> str:
+        return content_hash("stub", context, base, {"BASE_IMAGE": arg})
+
+    first = current()
+    assert first == current() and len(first) == 12
+    assert first != content_hash("team-base", context, "sha256:base", {"BASE_IMAGE": "b"})
+    assert first != current(base="sha256:other")
+    assert first != current(arg="c")
+    (context / "wheels" / "numpy-2.0-cp311.whl").write_bytes(b"same name, other bytes")
+    assert current() == first, "wheels count by name (their versions are pinned)"
+    (context / "wheels" / "numpy-2.0-cp311.whl").rename(context / "wheels" / "numpy-2.1-cp311.whl")
+    second = current()
+    assert second != first
+    (context / "src" / "simulator" / "a.py").write_text("A = 2\n")
+    third = current()
+    assert third != second
+    (context / "Dockerfile").write_text("FROM y\n")
+    assert current() != third
 
 
 def test_ecr_login_decodes_the_token(monkeypatch: pytest.MonkeyPatch) -> None:
