@@ -11,6 +11,7 @@ registry frees disk space only after its garbage collector runs
 from __future__ import annotations
 
 import base64
+import hashlib
 import json
 import logging
 import random
@@ -95,7 +96,8 @@ class RegistryClient:
             f"/v2/{repository}/manifests/{reference}",
             accept=", ".join(MANIFEST_TYPES),
         )
-        digest = headers.get("Docker-Content-Digest", "")
+        computed = f"sha256:{hashlib.sha256(body).hexdigest()}"
+        digest = headers.get("Docker-Content-Digest") or computed
         document = json.loads(body)
         if document.get("mediaType") in _INDEX_TYPES or "manifests" in document:
             size = sum(self.manifest(repository, m["digest"])[1] for m in document["manifests"])
