@@ -31,26 +31,35 @@ MAX_IN_FLIGHT = 2
 @dataclass(slots=True)
 class _Batch:
     state: Any
-    jobs: list[CameraJob]
+    remaining: int
 
 
 class RenderWorker:
-    """One rendering thread; completed jobs are collected with :meth:`completed`."""
+    """Rendering threads (``threads``, each with its own GL context); completed jobs are
+    collected on the step thread with :meth:`completed` when :attr:`wake_fd` is readable."""
 
-    def __init__(self, *, capture: Callable[[], Any], make_render: Callable[[], RenderFn]) -> None:
+    def __init__(
+        self,
+        *,
+        capture: Callable[[], Any],
+        make_render: Callable[[], RenderFn],
+        threads: int = 1,
+    ) -> None:
         self._capture = capture
         self._make_render = make_render
-        self._inbox: queue.Queue[_Batch | None] = queue.Queue()
+        self._count = max(1, threads)
+        self._inbox: queue.Queue[tuple[_Batch, CameraJob] | None] = queue.Queue()
         self._done: queue.Queue[tuple[CameraJob, bytes]] = queue.Queue()
         self._read_fd, self._write_fd = os.pipe()
         os.set_blocking(self._read_fd, False)
         os.set_blocking(self._write_fd, False)
-        self._thread: threading.Thread | None = None
+        self._threads: list[threading.Thread] = []
+        self._lock = threading.Lock()
         self.error: BaseException | None = None
         self.frames = 0
         self.render_s = 0.0
         self._submitted = 0
-        self._finished = 0  # written by the worker only
+        self._finished = 0  # batches, updated under the lock by the render threads
 
     @property
     def wake_fd(self) -> int:
@@ -58,16 +67,21 @@ class RenderWorker:
         return self._read_fd
 
     def submit(self, jobs: Sequence[CameraJob]) -> None:
-        if self._thread is None:
-            self._thread = threading.Thread(target=self._run, name="camera-render", daemon=True)
-            self._thread.start()
+        if not self._threads:
+            for n in range(self._count):
+                thread = threading.Thread(target=self._run, name=f"camera-render-{n}", daemon=True)
+                thread.start()
+                self._threads.append(thread)
+        batch = _Batch(self._capture(), len(jobs))
         self._submitted += 1
-        self._inbox.put(_Batch(self._capture(), list(jobs)))
+        for job in jobs:
+            self._inbox.put((batch, job))
 
     @property
     def in_flight(self) -> int:
         """Batches submitted and not completely rendered yet."""
-        return self._submitted - self._finished
+        with self._lock:
+            return self._submitted - self._finished
 
     def completed(self) -> list[tuple[CameraJob, bytes]]:
         try:
@@ -85,39 +99,41 @@ class RenderWorker:
         import time
 
         try:
-            render = self._make_render()
+            render: RenderFn | None = self._make_render()
         except BaseException as exc:  # reported to the step thread through .error
             log.error("camera renderer could not start: %s", exc)
             self.error = exc
             render = None
         while True:
-            batch = self._inbox.get()
-            if batch is None:
+            item = self._inbox.get()
+            if item is None:
                 return
-            for job in batch.jobs:
-                if render is None:
-                    image = bytes(job.width * job.height * 3)
-                else:
-                    started = time.perf_counter()
-                    try:
-                        image = render(batch.state, job.robot, job.width, job.height)
-                    except BaseException as exc:  # reported, then black frames
-                        log.error("camera rendering failed for %s: %s", job.robot, exc)
-                        self.error = exc
-                        render = None
-                        image = bytes(job.width * job.height * 3)
-                    self.render_s += time.perf_counter() - started
-                    self.frames += 1
-                self._done.put((job, image))
-            self._finished += 1
+            batch, job = item
+            started = time.perf_counter()
+            image = bytes(job.width * job.height * 3)
+            if render is not None:
+                try:
+                    image = render(batch.state, job.robot, job.width, job.height)
+                except BaseException as exc:  # reported, then black frames
+                    log.error("camera rendering failed for %s: %s", job.robot, exc)
+                    self.error = exc
+                    render = None
+            with self._lock:
+                self.render_s += time.perf_counter() - started
+                self.frames += 1
+                batch.remaining -= 1
+                if batch.remaining == 0:
+                    self._finished += 1
+            self._done.put((job, image))
             try:
                 os.write(self._write_fd, b"x")
             except BlockingIOError:
                 pass  # the pipe is full of wake-ups already
 
     def close(self) -> None:
-        if self._thread is not None:
+        for _ in self._threads:
             self._inbox.put(None)
-            self._thread.join(timeout=5.0)
+        for thread in self._threads:
+            thread.join(timeout=5.0)
         os.close(self._read_fd)
         os.close(self._write_fd)
