@@ -80,3 +80,29 @@ def test_quota_window_slides() -> None:
     quota.record(1000, 0)
     assert not quota.allows(100, 500)
     assert quota.allows(100, 1000)  # the first message left the 1 s window
+
+
+def test_render_worker_threads_complete_every_job() -> None:
+    import select
+
+    from simulator.api import FakeCameraRenderer, RenderWorker
+    from simulator.api.session import CameraJob
+
+    worker = RenderWorker(
+        capture=lambda: None,
+        make_render=lambda: lambda _s, r, w, h: FakeCameraRenderer(None, w, h).render(r),
+        threads=2,
+    )
+    robots = [RobotId(TeamColor.BLUE, n) for n in (1, 2, 3)]
+    for t in (8, 16):
+        worker.submit([CameraJob(r, "Camera", 4, 2, t, pb.CameraMeasurement()) for r in robots])
+    done = []
+    while len(done) < 6:
+        assert select.select([worker.wake_fd], [], [], 5.0)[0], "no render completed in time"
+        done += worker.completed()
+    worker.close()
+    assert worker.in_flight == 0 and worker.frames == 6
+    assert sorted((job.time_ms, image[0]) for job, image in done) == [
+        (t, n) for t in (8, 16) for n in (1, 2, 3)
+    ]
+    assert all(len(image) == 4 * 2 * 3 for _, image in done)
