@@ -33,10 +33,15 @@ def _parse(argv: Sequence[str]) -> argparse.Namespace:
     parser.add_argument("--json", action="store_true", help="print only the JSON line")
     parser.add_argument("--timeout", type=float, default=90.0)
     parser.add_argument("--keep", type=Path, default=None, help="keep the match folder here")
+    parser.add_argument("--robot-image", default=None,
+                        help="image of every robot (default: the project's stub image)")
+    parser.add_argument("--robot-command", default=None,
+                        help="dockerCmd of every robot (default: the stub's goalie / striker)")
     return parser.parse_args(list(argv))
 
 
-def measure(*, robots: int, out: Path, timeout_s: float) -> dict[str, object]:
+def measure(*, robots: int, out: Path, timeout_s: float, robot_image: str | None = None,
+            robot_command: str | None = None) -> dict[str, object]:
     from orchestrator.engine import connect
     from orchestrator.engine.containers import DockerRuntime
     from orchestrator.images import project_image
@@ -46,8 +51,9 @@ def measure(*, robots: int, out: Path, timeout_s: float) -> dict[str, object]:
     add_arguments(scrim)
     args = scrim.parse_args(["--players", str(robots // 2), "--half-duration", "60",
                              "--wait-before-ready", "60", "--grace", "1",
-                             "--match-id", f"bringup-{int(time.time())}"])
-    stub = project_image("stub")
+                             "--match-id", f"bringup-{int(time.time())}"]
+                            + (["--robot-command", robot_command] if robot_command else []))
+    stub = robot_image or project_image("stub")
     simulator = project_image("simulator")
     plan = plan_from_game(load_game(write_files(args, out / "config", stub_image=stub)),
                           grace_period_s=1.0)
@@ -80,10 +86,12 @@ def main(argv: Sequence[str]) -> int:
     args = _parse(argv)
     try:
         if args.keep is not None:
-            result = measure(robots=args.robots, out=args.keep, timeout_s=args.timeout)
+            result = measure(robots=args.robots, out=args.keep, timeout_s=args.timeout,
+                             robot_image=args.robot_image, robot_command=args.robot_command)
         else:
             with tempfile.TemporaryDirectory(prefix="hlvs-bringup-") as folder:
-                result = measure(robots=args.robots, out=Path(folder), timeout_s=args.timeout)
+                result = measure(robots=args.robots, out=Path(folder), timeout_s=args.timeout,
+                                 robot_image=args.robot_image, robot_command=args.robot_command)
     except OrchestratorError as exc:
         print(json.dumps({"bench": "bringup", "error": str(exc)}))
         return exc.exit_code

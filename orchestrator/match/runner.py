@@ -124,8 +124,9 @@ class MatchRunner:
                 self._advance(MatchState.STARTING)
                 started_at = self.clock()
                 startup.start(self, started_at)
-                self._advance(MatchState.WAITING)
-                self._watch(started_at)
+                if self.failure is None:
+                    self._advance(MatchState.WAITING)
+                    self._watch(started_at)
         except OrchestratorError as exc:
             log.error("match %s: %s", self.plan.match_id, exc)
             self._fail(FailureClass.INFRASTRUCTURE, str(exc))

@@ -36,6 +36,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="wall seconds between robot start and the first READY (default 3)")
     parser.add_argument("--grace", type=float, default=5.0,
                         help="seconds robots get to stop after the game (default 5)")
+    parser.add_argument("--robot-command", default=None,
+                        help="dockerCmd of every robot (default: goalie / striker for the stub)")
     parser.add_argument("--match-id", default=None, help="default: scrimmage-<random>")
     parser.add_argument("--seed", type=int, default=42)
     parser.add_argument("--stub", action="store_true",
@@ -46,14 +48,15 @@ def _pose(x: float, y: float, yaw: float) -> dict[str, Any]:
     return {"translation": [x, y, 0.43], "rotation": [0, 0, 1, yaw]}
 
 
-def team_file(name: str, image: str, players: int, *, goalie_first: bool) -> dict[str, Any]:
+def team_file(name: str, image: str, players: int, *, goalie_first: bool,
+              command: str | None = None) -> dict[str, Any]:
     repository, _, tag = image.rpartition(":") if ":" in image.split("/")[-1] else (image, "", "")
     entries: dict[str, Any] = {}
     for n in range(1, players + 1):
         x, y, yaw = POSES_KID[n]
         role = "goalie" if (n == 1 and goalie_first) else "striker"
         entries[str(n)] = {
-            "dockerCmd": role,
+            "dockerCmd": command or role,
             "halfTimeStartingPose": _pose(x, y, yaw),
             "reentryStartingPose": _pose(x, y, yaw),
             "shootoutStartingPose": _pose(2.6, 0.0, 0.0),
@@ -108,8 +111,9 @@ def write_files(args: argparse.Namespace, folder: Path, *, stub_image: str | Non
     files = {
         "game.json": game_file(args, match_id),
         "team_red.json": team_file("Stub Red", red_image, args.players,
-                                   goalie_first=args.players > 1),
-        "team_blue.json": team_file("Stub Blue", blue_image, args.players, goalie_first=True),
+                                   goalie_first=args.players > 1, command=args.robot_command),
+        "team_blue.json": team_file("Stub Blue", blue_image, args.players, goalie_first=True,
+                                    command=args.robot_command),
     }
     for name, content in files.items():
         (folder / name).write_text(json.dumps(content, indent=2) + "\n", encoding="utf-8")

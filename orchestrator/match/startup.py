@@ -16,7 +16,7 @@ from orchestrator.match.layout import Subnet
 from orchestrator.match.logfs import LogFolder
 from orchestrator.match.plan import RobotPlan, per_robot_rate_mb_s
 from orchestrator.match.results import FailureClass
-from orchestrator.match.runtime import Attachment, NetworkInfo, SubnetInUse
+from orchestrator.match.runtime import Attachment, ContainerRequest, NetworkInfo, SubnetInUse
 
 if TYPE_CHECKING:
     from orchestrator.match.runner import MatchRunner
@@ -97,15 +97,9 @@ def start(runner: MatchRunner, started_at: float) -> None:
         attachments=attachments, extra_labels=runner.options.extra_labels,
         command=runner.options.simulator_command,
     )
-    started.simulator_id = runner.runtime.create_container(request)
-    runner.runtime.start(started.simulator_id)
-    started.simulator_started_at = runner.clock()
-    log.info("match %s: simulator container %s started (%s)", plan.match_id, request.name,
-             request.image)
-    runner.monitor.watch("simulator", started.simulator_id)
+    _start_simulator(runner, request)  # first: it boots while the robots start
     if endpoint is not None and runner.telemetry_factory is not None:
         runner.telemetry = runner.telemetry_factory(endpoint, plan.match_id)
-
     robots = [r for r in plan.robots if runner.records[r.key].image_error is None]
     with ThreadPoolExecutor(max_workers=max(1, min(8, len(robots)))) as pool:
         list(pool.map(lambda robot: _start_robot(runner, robot), robots))
@@ -117,6 +111,17 @@ def start(runner: MatchRunner, started_at: float) -> None:
                          f"{runner.records[failed[0].key].startup_error}")
     log.info("match %s: %d robot containers started in %.2f s", plan.match_id,
              len(started.robot_ids), runner.clock() - started_at)
+
+
+def _start_simulator(runner: MatchRunner, request: ContainerRequest) -> None:
+    """Started before the robots, so that it boots while they start (robot clients retry)."""
+    started = runner.started
+    started.simulator_id = runner.runtime.create_container(request)
+    runner.runtime.start(started.simulator_id)
+    started.simulator_started_at = runner.clock()
+    log.info("match %s: simulator container %s started (%s)", runner.plan.match_id,
+             request.name, request.image)
+    runner.monitor.watch("simulator", started.simulator_id)
 
 
 def _start_robot(runner: MatchRunner, robot: RobotPlan) -> None:

@@ -65,7 +65,7 @@ def test_success_writes_results_and_report_last(tmp_path: Path) -> None:
     spec = json.loads((tmp_path / "simulator/match_spec.json").read_text())
     assert spec["hosts"]["red"][1].endswith(".12")
     created = [name for call, name in runtime.calls if call == "create_container"]
-    assert len(created) == 9 and created[0] == "hlvs-u1-simulator"
+    assert len(created) == 9 and "hlvs-u1-simulator" in created
     for key in ("red-1", "red-2", "blue-1", "blue-2"):  # shaped namespace before the robot
         assert created.index(f"hlvs-u1-{key}-net") < created.index(f"hlvs-u1-{key}")
 
