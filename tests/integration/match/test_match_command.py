@@ -1,0 +1,115 @@
+"""``hlvs match GAME.json`` through the CLI: config loading, image resolution (local images are
+pinned by id), the real simulator, results; and a config error exits 2 without a traceback."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from orchestrator.cli import main as hlvs
+from orchestrator.errors import OrchestratorError
+from orchestrator.match.scrimmage import add_arguments, write_files
+
+pytestmark = [pytest.mark.docker, pytest.mark.root]
+
+
+def test_match_command_plays_a_game_file(tmp_path: Path, test_image: str, runtime: Any,
+                                         capsys: pytest.CaptureFixture[str]) -> None:
+    try:
+        from orchestrator.images import project_image
+
+        project_image("simulator")
+    except (ImportError, OrchestratorError) as exc:
+        pytest.skip(f"simulator image unavailable: {exc}")
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    args = parser.parse_args([
+        "--players", "2", "--half-duration", "3", "--wait-before-ready", "1",
+        "--match-id", "cmd-test", "--red-image", test_image, "--blue-image", test_image,
+        "--robot-command", "python3 /opt/t/robot.py env",
+    ])
+    game = write_files(args, tmp_path / "config")
+    out = tmp_path / "out"
+    try:
+        code = hlvs(["match", str(game), "--out", str(out), "--grace", "1"])
+    finally:
+        hlvs(["cleanup", "--match", "cmd-test"])
+    printed = capsys.readouterr()
+    assert code == 0, printed.err[-3000:]
+    results = json.loads((out / "results.json").read_text())
+    assert results["final_state"] == "FINISHED"
+    robot = results["robots"]["blue-2"]
+    assert robot["digest"] and robot["image_error"] is None
+    env = json.loads((out / "teams/blue/2/robocup-logs/env.json").read_text())["env"]
+    assert env["ROBOCUP_ROBOT_ID"] == "2" and env["ROBOCUP_TEAM_COLOR"] == "blue"
+    assert results["limits"]["grace_period_s"] == 1.0
+    assert runtime.list_project(match_id="cmd-test") == []
+
+
+def test_match_command_reports_a_bad_game_file(tmp_path: Path,
+                                               capsys: pytest.CaptureFixture[str]) -> None:
+    game = tmp_path / "game.json"
+    game.write_text('{"type": "NORMAL"}')
+    assert hlvs(["match", str(game), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert str(game) in err and "Traceback" not in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_sigterm_to_hlvs_match_stops_everything_and_exits_130(
+    tmp_path: Path, test_image: str, runtime: Any
+) -> None:
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    try:
+        from orchestrator.images import project_image
+
+        project_image("simulator")
+    except (ImportError, OrchestratorError) as exc:
+        pytest.skip(f"simulator image unavailable: {exc}")
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    args = parser.parse_args([
+        "--half-duration", "600", "--wait-before-ready", "60", "--match-id", "sig-test",
+        "--red-image", test_image, "--blue-image", test_image,
+        "--robot-command", "python3 /opt/t/robot.py sigterm",
+    ])
+    game = write_files(args, tmp_path / "config")
+    out = tmp_path / "out"
+    repo = Path(__file__).resolve().parents[3]
+    process = subprocess.Popen(
+        [sys.executable, "-m", "orchestrator", "match", str(game), "--out", str(out),
+         "--grace", "5"],
+        cwd=repo, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:
+            roles = [o.labels.get("org.hlvs-runner.role")
+                     for o in runtime.list_project(match_id="sig-test")]
+            if roles.count("robot") == 2:
+                break
+            if process.poll() is not None:
+                pytest.fail(f"hlvs match ended early: {process.communicate()[1][-2000:]}")
+            time.sleep(0.2)
+        time.sleep(1.0)
+        os.kill(process.pid, signal.SIGTERM)
+        _, err = process.communicate(timeout=60)
+        assert process.returncode == 130, err[-2000:]
+        report = json.loads((out / "report.json").read_text())
+        assert report["failure_class"] == "interrupted"
+        term = (out / "teams/red/1/robocup-logs/term.txt").read_text()
+        assert term == "got SIGTERM\nflushed\n"
+        assert runtime.list_project(match_id="sig-test") == []
+    finally:
+        if process.poll() is None:
+            process.kill()
+        hlvs(["cleanup", "--match", "sig-test"])
