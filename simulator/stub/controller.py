@@ -1,0 +1,215 @@
+"""The stub robot's control loop body: one call per sensor measurement, motor targets out.
+
+Wires the motion engines (walk, kick, get-up), the IMU attitude filter, the ball detector and
+the behaviour. It never sees ground truth: only joint angles, accelerometer, gyro and the head
+camera image, exactly what the robot API delivers.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from simulator.motion import AttitudeFilter, GetUpMotion, KickMotion, WalkEngine, kinematics
+from simulator.motion.keyframes import KeyframeMotion
+from simulator.motion.walk import default_walk_params
+from simulator.stub.behaviour import Action, Field, GameInfo, Role, decide
+from simulator.stub.perception import CameraPose, find_ball_blobs, ground_point
+from simulator.stub.world_model import Pose2D, WorldModel
+
+logger = logging.getLogger(__name__)
+
+Vec3 = tuple[float, float, float]
+FALL_TILT_RAD = 0.9
+FALL_CONFIRM_S = 0.25
+BALL_MEMORY_MS = 4000
+SCAN = [(-0.9, 0.45), (-0.45, 0.5), (0.0, 0.55), (0.45, 0.5), (0.9, 0.45), (0.45, 0.95),
+        (0.0, 1.0), (-0.45, 0.95)]  # fmt: skip
+SCAN_DWELL_S = 0.35
+FIELD_HALF_LENGTH_M = {"kid": 4.5, "adult": 7.0}
+BALL_RADIUS_M = {"kid": 0.07, "adult": 0.1125}
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Sensors:
+    time_ms: int
+    joints: dict[str, float]  # motor name -> rad
+    accel: Vec3 | None = None
+    gyro: Vec3 | None = None
+    image_bgr: npt.NDArray[np.uint8] | None = None  # height x width x 3
+
+
+@dataclass(slots=True)
+class Stats:
+    falls: int = 0
+    kicks: int = 0
+    get_ups: int = 0
+    ball_sightings: int = 0
+
+
+class StubController:
+    def __init__(
+        self,
+        *,
+        role: Role,
+        start_pose: Pose2D,
+        model: str = "kid-default",
+        field_class: str = "kid",
+    ) -> None:
+        self.role = role
+        self.model = model
+        self.kin = kinematics(model)
+        self.walk = WalkEngine(model=model)
+        self.world = WorldModel(start_pose)
+        self.attitude = AttitudeFilter()
+        self.stats = Stats()
+        walk = default_walk_params(model)
+        self._pelvis_height_m = walk.hip_height_m + self.kin.camera.hip_below_pelvis_m
+        self._ball_radius_m = BALL_RADIUS_M[field_class]
+        self.field = Field(
+            half_length_m=FIELD_HALF_LENGTH_M[field_class],
+            foot_y_m=self.kin.leg.hip_offset_y_m + walk.foot_y_offset_m,
+            kick_x_m=0.165 * self.kin.leg.thigh_m / 0.16,
+        )
+        self._last_ms: int | None = None
+        self._tilted_s = 0.0
+        self._motion: KeyframeMotion | None = None
+        self._motion_kind = ""
+        self._last_targets: dict[str, float] = {}
+        self._missing_since_ms: int | None = None
+        self._scan_s = 0.0
+        self.last_action: Action | None = None
+
+    @property
+    def busy(self) -> str:
+        """ "kick", "get-up" or "" (walking or standing)."""
+        return self._motion_kind if self._motion is not None else ""
+
+    def reset_pose(self, pose: Pose2D) -> None:
+        self.world.reset_pose(pose)
+
+    def tick(self, sensors: Sensors, game: GameInfo) -> dict[str, float]:
+        dt = 0.008 if self._last_ms is None else max(sensors.time_ms - self._last_ms, 1) / 1000.0
+        self._last_ms = sensors.time_ms
+        if sensors.accel is not None and sensors.gyro is not None:
+            self.attitude.update(dt, sensors.accel, sensors.gyro)
+        att = self.attitude.attitude
+        upright = att.tilt_rad < 0.5
+        self.world.integrate(
+            dt,
+            self.walk.velocity if upright else (0.0, 0.0, 0.0),
+            sensors.gyro[2] if sensors.gyro is not None and upright else None,
+        )
+        if sensors.image_bgr is not None and upright and self._motion is None:
+            self._look(sensors)
+        if self._motion is not None:
+            targets = self._motion.step(dt)
+            if self._motion.done:
+                self._finish_motion()
+            return self._remember(targets)
+        if self._fallen(dt, att.tilt_rad):
+            side = "front" if att.pitch_rad > 0 else "back"
+            self.stats.falls += 1
+            logger.info("fallen on the %s; getting up", side)
+            self._start(GetUpMotion(side, model=self.model, start=sensors.joints), "get-up")
+            return self._remember(self._motion.step(dt) if self._motion else {})
+        ball = self.world.ball_relative(sensors.time_ms, max_age_ms=BALL_MEMORY_MS)
+        if ball is None:
+            if self._missing_since_ms is None:
+                self._missing_since_ms = sensors.time_ms
+        else:
+            self._missing_since_ms = None
+        searching_s = (
+            0.0
+            if self._missing_since_ms is None
+            else (sensors.time_ms - self._missing_since_ms) / 1000.0
+        )
+        action = decide(
+            role=self.role,
+            game=game,
+            pose=self.world.pose,
+            ball=ball,
+            field=self.field,
+            searching_s=searching_s,
+        )
+        self.last_action = action
+        if action.kick_foot is not None:
+            if self.walk.walking:
+                targets = self.walk.step(dt, 0.0, 0.0, 0.0, accel=sensors.accel, gyro=sensors.gyro)
+            else:
+                self.stats.kicks += 1
+                logger.info("kicking with the %s foot", action.kick_foot)
+                kick = KickMotion(foot=action.kick_foot, model=self.model, start=self._last_targets)
+                self._start(kick, "kick")
+                return self._remember(kick.step(dt))
+        else:
+            targets = self.walk.step(dt, *action.walk, accel=sensors.accel, gyro=sensors.gyro)
+        targets.update(self._head(dt, ball, action, att.pitch_rad))
+        return self._remember(targets)
+
+    # --- parts ---------------------------------------------------------------------------------
+
+    def _look(self, sensors: Sensors) -> None:
+        image = sensors.image_bgr
+        assert image is not None
+        att = self.attitude.attitude
+        pose = CameraPose(
+            neck_yaw_rad=sensors.joints.get(self.kin.neck_motor, 0.0),
+            head_pitch_rad=self.kin.head_down_sign * sensors.joints.get(self.kin.head_motor, 0.0),
+            torso_roll_rad=att.roll_rad,
+            torso_pitch_rad=att.pitch_rad,
+            pelvis_height_m=self._pelvis_height_m,
+        )
+        height, width = image.shape[0], image.shape[1]
+        for blob in find_ball_blobs(image):
+            seen = ground_point(
+                blob,
+                pose,
+                self.kin.camera,
+                width_px=width,
+                height_px=height,
+                ball_radius_m=self._ball_radius_m,
+            )
+            if seen is not None and seen.distance_m < 8.0:
+                self.world.see_ball(sensors.time_ms, seen.x_m, seen.y_m)
+                self.stats.ball_sightings += 1
+                return
+
+    def _head(
+        self, dt: float, ball: tuple[float, float] | None, action: Action, torso_pitch: float
+    ) -> dict[str, float]:
+        if ball is not None and not action.search:
+            self._scan_s = 0.0
+            distance = math.hypot(*ball)
+            camera_height = self._pelvis_height_m + self.kin.camera.neck_height_m
+            down = math.atan2(camera_height - self._ball_radius_m, distance) - torso_pitch
+            yaw = max(-1.2, min(1.2, math.atan2(ball[1], ball[0])))
+            return self.kin.head_targets(yaw, max(0.2, min(1.15, down)))
+        self._scan_s += dt
+        yaw, pitch = SCAN[int(self._scan_s / SCAN_DWELL_S) % len(SCAN)]
+        return self.kin.head_targets(yaw, pitch)
+
+    def _fallen(self, dt: float, tilt_rad: float) -> bool:
+        self._tilted_s = self._tilted_s + dt if tilt_rad > FALL_TILT_RAD else 0.0
+        return self._tilted_s >= FALL_CONFIRM_S
+
+    def _start(self, motion: KeyframeMotion, kind: str) -> None:
+        self._motion = motion
+        self._motion_kind = kind
+        self.walk.reset()
+
+    def _finish_motion(self) -> None:
+        if self._motion_kind == "get-up":
+            self.stats.get_ups += 1
+        self._motion = None
+        self._motion_kind = ""
+        self._tilted_s = 0.0
+        self.walk.reset()
+
+    def _remember(self, targets: dict[str, float]) -> dict[str, float]:
+        self._last_targets.update(targets)
+        return dict(self._last_targets)

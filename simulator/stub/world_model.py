@@ -1,0 +1,70 @@
+"""What the stub robot believes: its pose on the field (odometry) and where the ball is.
+
+Frame: the team's own frame as in HLVS team files (the team defends the goal at x < 0 and
+attacks the goal at x > 0), metres and radians. The pose starts from a known starting pose and
+is integrated from the gait's velocity and the gyro's yaw rate; it drifts, which the behaviour
+tolerates (it only needs a rough idea of where the opponent goal is).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+Vec3 = tuple[float, float, float]
+
+
+@dataclass(frozen=True, slots=True)
+class Pose2D:
+    x_m: float
+    y_m: float
+    yaw_rad: float
+
+    def to_relative(self, x_m: float, y_m: float) -> tuple[float, float]:
+        """A field point in the robot frame (x forward, y left)."""
+        dx, dy = x_m - self.x_m, y_m - self.y_m
+        c, s = math.cos(self.yaw_rad), math.sin(self.yaw_rad)
+        return c * dx + s * dy, -s * dx + c * dy
+
+    def to_field(self, x_m: float, y_m: float) -> tuple[float, float]:
+        """A robot-frame point on the field."""
+        c, s = math.cos(self.yaw_rad), math.sin(self.yaw_rad)
+        return self.x_m + c * x_m - s * y_m, self.y_m + s * x_m + c * y_m
+
+
+class WorldModel:
+    def __init__(self, start: Pose2D) -> None:
+        self.pose = start
+        self.ball_field: tuple[float, float] | None = None
+        self.ball_seen_ms: int | None = None
+
+    def reset_pose(self, pose: Pose2D) -> None:
+        self.pose = pose
+        self.ball_field = None
+        self.ball_seen_ms = None
+
+    def integrate(self, dt_s: float, velocity: Vec3, yaw_rate_rad_s: float | None) -> None:
+        """Dead reckoning: gait velocity (vx, vy, vyaw) in the robot frame, gyro yaw rate."""
+        vx, vy, vyaw = velocity
+        yaw_rate = vyaw if yaw_rate_rad_s is None else yaw_rate_rad_s
+        c, s = math.cos(self.pose.yaw_rad), math.sin(self.pose.yaw_rad)
+        yaw = math.atan2(
+            math.sin(self.pose.yaw_rad + yaw_rate * dt_s),
+            math.cos(self.pose.yaw_rad + yaw_rate * dt_s),
+        )
+        self.pose = Pose2D(
+            self.pose.x_m + (c * vx - s * vy) * dt_s,
+            self.pose.y_m + (s * vx + c * vy) * dt_s,
+            yaw,
+        )
+
+    def see_ball(self, time_ms: int, x_rel_m: float, y_rel_m: float) -> None:
+        self.ball_field = self.pose.to_field(x_rel_m, y_rel_m)
+        self.ball_seen_ms = time_ms
+
+    def ball_relative(self, time_ms: int, *, max_age_ms: int) -> tuple[float, float] | None:
+        if self.ball_field is None or self.ball_seen_ms is None:
+            return None
+        if time_ms - self.ball_seen_ms > max_age_ms:
+            return None
+        return self.pose.to_relative(*self.ball_field)
