@@ -31,6 +31,7 @@ class GameInfo:
     phase: Phase
     penalised: bool = False
     our_kick_off: bool = True
+    first_half: bool = True
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -33,6 +33,8 @@ class StubOptions:
     crash_after_s: float | None = None
     fill_cap_bytes: int | None = None  # None: until the disk is full
     start_pose: tuple[float, float, float] | None = None  # own-half frame x, y, yaw
+    gc_data_port: int = 3838
+    gc_return_port: int = 3939
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -56,6 +58,8 @@ def parse_args(argv: list[str]) -> StubOptions:
     parser.add_argument("seconds", nargs="?", type=float, default=None)
     parser.add_argument("--fill-cap-bytes", type=int, default=None)
     parser.add_argument("--start-pose", nargs=3, type=float, metavar=("X", "Y", "YAW"))
+    parser.add_argument("--gc-data-port", type=int, default=3838)
+    parser.add_argument("--gc-return-port", type=int, default=3939)
     try:
         ns, unknown = parser.parse_known_args(argv)
     except (argparse.ArgumentError, SystemExit) as exc:
@@ -78,6 +82,8 @@ def parse_args(argv: list[str]) -> StubOptions:
         crash_after_s=ns.seconds,
         fill_cap_bytes=ns.fill_cap_bytes,
         start_pose=pose,
+        gc_data_port=ns.gc_data_port,
+        gc_return_port=ns.gc_return_port,
     )
 
 

@@ -1,0 +1,79 @@
+"""A one-robot MuJoCo world for the motion tests (the real world of simulator.world)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+
+from referee.snapshot import PlaceBall, RobotId, TeamColor
+from simulator.motion import standing_posture
+from simulator.world import RobotPlacement, World
+
+RED1 = RobotId(TeamColor.RED, 1)
+
+
+class OneRobot:
+    def __init__(self, *, x_m: float = 0.0, y_m: float = 0.0, yaw_rad: float = 0.0) -> None:
+        self.world = World.create(
+            field_class="kid",
+            robots=[
+                RobotPlacement(id=RED1, model="kid-default", x_m=x_m, y_m=y_m, yaw_rad=yaw_rad)
+            ],
+            seed=3,
+        )
+        self.torso = self.world.model.body("red_1/torso").id
+        self.ball = self.world.model.body("ball").id
+        self.place_ball(x_m + 3.0, y_m + 3.0)  # out of the way
+
+    def command(self, targets: dict[str, float]) -> None:
+        for name, value in targets.items():
+            self.world.set_motor_position(RED1, name, value)
+
+    def stand(self, seconds: float = 1.0) -> None:
+        posture = standing_posture()
+        for _ in range(int(seconds / 0.008)):
+            self.command(posture)
+            self.world.step()
+
+    def run(self, seconds: float, targets: Callable[[], dict[str, float]]) -> bool:
+        """Steps ``seconds``; False as soon as the robot falls."""
+        for _ in range(int(seconds / 0.008)):
+            self.command(targets())
+            self.world.step()
+            if self.up < 0.5:
+                return False
+        return True
+
+    @property
+    def accel(self) -> tuple[float, float, float]:
+        return self.world.read_accelerometer(RED1)
+
+    @property
+    def gyro(self) -> tuple[float, float, float]:
+        return self.world.read_gyro(RED1)
+
+    @property
+    def position(self) -> np.ndarray:
+        return self.world.data.xpos[self.torso].copy()
+
+    @property
+    def yaw(self) -> float:
+        m = self.world.data.xmat[self.torso].reshape(3, 3)
+        return math.atan2(m[1, 0], m[0, 0])
+
+    @property
+    def up(self) -> float:
+        return float(self.world.data.xmat[self.torso].reshape(3, 3)[2, 2])
+
+    @property
+    def ball_position(self) -> np.ndarray:
+        return self.world.data.xpos[self.ball].copy()
+
+    def place_ball(self, x_m: float, y_m: float) -> None:
+        self.world.apply(PlaceBall(position=(x_m, y_m, 0.07)))
+
+    def sole(self, side: str) -> np.ndarray:
+        geom = self.world.model.geom(f"red_1/foot:sole_{side}").id
+        return self.world.data.geom_xpos[geom].copy()

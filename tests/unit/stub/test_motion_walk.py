@@ -1,0 +1,73 @@
+"""The walk engine on the real MuJoCo robot: forward, turning, sideways, no fall."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from simulator.motion import WalkEngine
+from simulator.motion.ik import FootTarget, leg_fk, leg_ik
+from simulator.motion.models import kinematics
+
+from .motion_world import OneRobot
+
+
+def walker(robot: OneRobot, engine: WalkEngine, vx: float, vy: float, vyaw: float):  # type: ignore[no-untyped-def]
+    return lambda: engine.step(0.008, vx, vy, vyaw, accel=robot.accel, gyro=robot.gyro)
+
+
+def test_leg_ik_round_trip() -> None:
+    leg = kinematics("kid-default").leg
+    for target in (FootTarget(0.03, 0.02, -0.3, 0.2), FootTarget(-0.05, -0.03, -0.28, -0.3)):
+        back = leg_fk(leg, leg_ik(leg, target))
+        assert back.x_m == pytest.approx(target.x_m, abs=1e-6)
+        assert back.y_m == pytest.approx(target.y_m, abs=1e-6)
+        assert back.z_m == pytest.approx(target.z_m, abs=1e-6)
+
+
+def test_walks_forward_for_10_s_without_falling() -> None:
+    robot = OneRobot()
+    robot.stand()
+    start = robot.position
+    engine = WalkEngine(model="kid-default")
+    assert robot.run(10.0, walker(robot, engine, 0.15, 0.0, 0.0)), "fell while walking"
+    moved = robot.position - start
+    assert moved[0] >= 1.0  # >= 0.1 m/s
+    assert abs(moved[1]) < 0.5 * moved[0]
+
+
+def test_turns_on_the_spot() -> None:
+    robot = OneRobot()
+    robot.stand()
+    engine = WalkEngine(model="kid-default")
+    turned = 0.0
+    previous = robot.yaw
+
+    def step() -> dict[str, float]:
+        nonlocal turned, previous
+        turned += math.remainder(robot.yaw - previous, 2 * math.pi)
+        previous = robot.yaw
+        return engine.step(0.008, 0.0, 0.0, 0.5, accel=robot.accel, gyro=robot.gyro)
+
+    assert robot.run(8.0, step)
+    assert turned >= 2.5  # about 0.5 rad/s
+
+
+def test_walks_sideways_a_little() -> None:
+    robot = OneRobot()
+    robot.stand()
+    start = robot.position
+    engine = WalkEngine(model="kid-default")
+    assert robot.run(10.0, walker(robot, engine, 0.0, 0.05, 0.0))
+    assert robot.position[1] - start[1] >= 0.2
+
+
+@pytest.mark.slow
+def test_walks_60_s_on_flat_ground_without_falling() -> None:
+    robot = OneRobot(x_m=-3.0)
+    robot.stand()
+    engine = WalkEngine(model="kid-default")
+    commands = [(0.15, 0.0, 0.0), (0.05, 0.0, 0.5), (0.0, 0.05, 0.0), (0.1, 0.0, -0.3)]
+    for vx, vy, vyaw in commands:
+        assert robot.run(15.0, walker(robot, engine, vx, vy, vyaw)), (vx, vy, vyaw)

@@ -1,0 +1,56 @@
+"""Ball detection in real head-camera images rendered by the world (offscreen)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from simulator.motion import kinematics, standing_posture
+from simulator.stub.perception import CameraPose, find_ball_blobs, ground_point
+from simulator.world import CameraRenderer
+
+from .motion_world import RED1, OneRobot
+
+
+@pytest.mark.parametrize(("ball_x", "ball_y", "head"), [(0.8, 0.1, 0.6), (0.3, -0.05, 1.0)])
+def test_sees_the_ball_where_it_is(ball_x: float, ball_y: float, head: float) -> None:
+    robot = OneRobot()
+    robot.place_ball(robot.position[0] + ball_x, ball_y)
+    posture = standing_posture()
+    posture["Head"] = head
+    robot.run(0.6, lambda: posture)
+    with CameraRenderer(robot.world, 320, 240) as camera:
+        image = np.frombuffer(camera.render(RED1), np.uint8).reshape(240, 320, 3)
+    blobs = find_ball_blobs(image)
+    assert blobs, "no ball found"
+    m = robot.world.data.xmat[robot.torso].reshape(3, 3)
+    pose = CameraPose(
+        neck_yaw_rad=0.0,
+        head_pitch_rad=robot.world.read_positions(RED1)["HeadS"],
+        torso_roll_rad=float(np.arctan2(m[2, 1], m[2, 2])),
+        torso_pitch_rad=float(np.arcsin(-m[2, 0])),
+        pelvis_height_m=float(robot.position[2]),
+    )
+    seen = ground_point(
+        blobs[0],
+        pose,
+        kinematics("kid-default").camera,
+        width_px=320,
+        height_px=240,
+        ball_radius_m=0.07,
+    )
+    assert seen is not None
+    true_x = robot.ball_position[0] - robot.position[0]
+    assert seen.x_m == pytest.approx(true_x, abs=0.1 * true_x + 0.03)
+    assert seen.y_m == pytest.approx(ball_y, abs=0.05)
+
+
+def test_no_ball_in_an_empty_field_image() -> None:
+    robot = OneRobot()
+    robot.place_ball(5.0, 4.0)  # behind the robot's view
+    posture = standing_posture()
+    posture["Head"] = 0.6
+    robot.run(0.3, lambda: posture)
+    with CameraRenderer(robot.world, 320, 240) as camera:
+        image = np.frombuffer(camera.render(RED1), np.uint8).reshape(240, 320, 3)
+    assert find_ball_blobs(image) == []
