@@ -2,10 +2,12 @@
 
 Starts the world and the API server in this process and N client processes (one per robot)
 that enable every joint sensor and the IMU at 8 ms (and the camera when asked) and send 20
-joint targets for every measurement. Prints one JSON line with the API run's real-time factor,
-the world-only real-time factor of the same world (``World.step`` + ``snapshot``, what
-``bench sim`` measures) and their ratio. ``--stalled-client`` adds a run in which one more
-client connects and never reads, and reports both runs.
+joint targets for every measurement (pre-encoded, measurements are framed but not decoded: the
+clients share the machine's cores with the server being measured). Prints one JSON line with
+the API run's real-time factor, the world-only real-time factor of the same world
+(``World.step`` + ``snapshot``, what ``bench sim`` measures) and their ratio.
+``--stalled-client`` adds a run in which one more client connects and never reads, and reports
+both runs.
 """
 
 from __future__ import annotations
@@ -15,17 +17,20 @@ import json
 import math
 import multiprocessing as mp
 import os
+import socket
 import sys
 import time
 from typing import Any
 
 from referee.snapshot import RobotId, TeamColor
+from simulator.api.framing import WELCOME
 
 MOTORS = (
     "Neck", "Head", "ShoulderL", "ArmUpperL", "ArmLowerL", "PelvYL", "PelvL", "LegUpperL",
     "LegLowerL", "AnkleL", "FootL", "PelvYR", "PelvR", "LegUpperR", "LegLowerR", "AnkleR",
     "FootR", "ShoulderR", "ArmUpperR", "ArmLowerR",
 )  # fmt: skip
+CYCLE_STEPS = 125  # pre-encoded requests of the bench clients: one second of targets
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -43,14 +48,41 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _connect(port: int) -> socket.socket:
+    """Connect with retries (the server may still be starting) and take the greeting."""
+    for _ in range(240):
+        try:
+            sock = socket.create_connection(("127.0.0.1", port), timeout=30.0)
+        except OSError:
+            time.sleep(0.25)
+            continue
+        greeting = b""
+        while len(greeting) < 8:
+            chunk = sock.recv(8 - len(greeting))
+            if not chunk:
+                break
+            greeting += chunk
+        if greeting == WELCOME:
+            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            sock.settimeout(None)
+            return sock
+        sock.close()
+        time.sleep(0.25)
+    raise SystemExit(f"bench client: no session on port {port}")
+
+
+def _frame(request: Any) -> bytes:
+    payload = request.SerializeToString()
+    return len(payload).to_bytes(4, "big") + payload
+
+
 def _client(port: int, camera_period: int, stalled: bool) -> None:
-    """Client process body (also the stalled client: connects, then never reads)."""
+    """Client process body: enables the sensors, then answers every measurement with 20 joint
+    targets (a 1 s cycle of pre-encoded requests: the bench measures the server, so the clients
+    sharing its cores skip decoding). The stalled client connects, enables, and never reads."""
     from simulator.api import messages_pb2 as pb
-    from simulator.client import ConnectionClosed, RobotClient
 
     if stalled:  # a small receive window, and it never reads: the server's queue overflows
-        import socket
-
         raw = socket.socket()
         raw.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
         for _ in range(120):
@@ -62,24 +94,41 @@ def _client(port: int, camera_period: int, stalled: bool) -> None:
         enable = pb.ActuatorRequests()
         for name in [f"{m}S" for m in MOTORS] + ["Accelerometer", "Gyro"]:
             enable.sensor_time_steps.add(name=name, timeStep=8)
-        payload = enable.SerializeToString()
-        raw.sendall(len(payload).to_bytes(4, "big") + payload)
+        raw.sendall(_frame(enable))
         while True:
             time.sleep(3600)
-    client = RobotClient("127.0.0.1", port, retries=120, retry_interval_s=0.25).connect()
+    sock = _connect(port)
+    enable = pb.ActuatorRequests()
     periods = {f"{m}S": 8 for m in MOTORS} | {"Accelerometer": 8, "Gyro": 8}
     if camera_period:
         periods["Camera"] = camera_period
-    client.enable_many(periods)
-    request = pb.ActuatorRequests()
-    targets = [request.motor_positions.add(name=m) for m in MOTORS]
+    for name, period in periods.items():
+        enable.sensor_time_steps.add(name=name, timeStep=period)
+    sock.sendall(_frame(enable))
+    cycle = []
+    for k in range(CYCLE_STEPS):
+        request = pb.ActuatorRequests()
+        for i, motor in enumerate(MOTORS):
+            request.motor_positions.add(name=motor, position=0.05 * math.sin(k * 0.008 + i))
+        cycle.append(_frame(request))
+    buffer = bytearray()
+    answered = 0
     try:
-        for msg in client:
-            phase = msg.time / 1000.0
-            for i, target in enumerate(targets):
-                target.position = 0.05 * math.sin(phase + i)
-            client.send(request)
-    except ConnectionClosed:
+        while True:
+            data = sock.recv(1 << 20)
+            if not data:
+                break
+            buffer += data
+            start = 0
+            while len(buffer) - start >= 4:
+                end = start + 4 + int.from_bytes(buffer[start : start + 4], "big")
+                if end > len(buffer):
+                    break
+                start = end
+                sock.sendall(cycle[answered % CYCLE_STEPS])
+                answered += 1
+            del buffer[:start]
+    except OSError:
         pass
     os._exit(0)
 
@@ -227,8 +276,6 @@ def _api_run(
 
 
 def _free_ports(count: int) -> list[int]:
-    import socket
-
     socks = [socket.socket() for _ in range(count)]
     try:
         for s in socks:

@@ -12,6 +12,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 from referee.snapshot import RobotId
 from simulator.api import messages_pb2 as pb
@@ -32,12 +33,16 @@ from simulator.api.encode import (
     FORCES,
     GYROS,
     POSITION_SENSORS,
-    SensorEncoder,
+    SensorLayout,
 )
 
 log = logging.getLogger(__name__)
 
 BASIC_TIME_STEP_MS = 8
+MAX_LAYOUTS = 64
+# protobuf field and number of values of each regular sensor kind (cameras are separate)
+_FIELDS = {ACCELEROMETER: (ACCELEROMETERS, 3), FORCE: (FORCES, 1), GYRO: (GYROS, 3)}
+_FIELDS[POSITION_SENSOR] = (POSITION_SENSORS, 1)
 CAMERA_MIN_TIME_STEP_MS = 16
 WARNING = pb.Message.WARNING_MESSAGE
 ERROR = pb.Message.ERROR_MESSAGE
@@ -105,8 +110,10 @@ class RobotSession:
         self._positions: dict[str, float] = {}  # last commands, re-applied after a penalty
         self._velocities: dict[str, float] = {}
         self._torques: dict[str, float] = {}
-        self._encoder = SensorEncoder()
-        self._batch_positions = getattr(world, "read_positions", None)
+        # batch forms of the world (simulator.world.World has them; a fake world may not)
+        self._read_sensors = getattr(world, "read_sensors", None)
+        self._set_positions = getattr(world, "set_motor_positions", None)
+        self._layouts: dict[tuple[str, ...], tuple[tuple[str, ...], SensorLayout]] = {}
         self._pending: list[tuple[int, str]] = []
         self._limp = False
         self._camera_size: tuple[int, int] | None = None
@@ -127,15 +134,17 @@ class RobotSession:
         motors = self._motor_names
         active = not world.is_limp(robot)
         if request.motor_positions:
-            cache, setter = self._positions, world.set_motor_position
+            cache = self._positions
+            targets: dict[str, float] = {}
             for mp in request.motor_positions:
-                name, value = mp.name, mp.position
+                name = mp.name
                 if name not in motors:
                     self.warn(f'Motor "{name}" not found, position command ignored.')
                     continue
-                cache[name] = value
-                if active:
-                    setter(robot, name, value)
+                targets[name] = mp.position
+            cache.update(targets)
+            if active and targets:
+                self._apply_positions(targets)
         for mv in request.motor_velocities:
             if mv.name not in motors:
                 self.warn(f'Motor "{mv.name}" not found, velocity command ignored.')
@@ -168,6 +177,13 @@ class RobotSession:
                 self.warn(f'Camera "{exposure.name}" not found, exposure command ignored.')
         for step in request.sensor_time_steps:
             self._time_step(step.name, step.timeStep, step_time_ms)
+
+    def _apply_positions(self, targets: dict[str, float]) -> None:
+        if self._set_positions is not None:
+            self._set_positions(self.robot, list(targets), list(targets.values()))
+        else:
+            for name, value in targets.items():
+                self._world.set_motor_position(self.robot, name, value)
 
     def _time_step(self, name: str, period: int, now_ms: int) -> None:
         kind = self._kinds.get(name)
@@ -220,8 +236,8 @@ class RobotSession:
         if limp:
             return
         world, robot = self._world, self.robot
-        for name, position in self._positions.items():
-            world.set_motor_position(robot, name, position)
+        if self._positions:
+            self._apply_positions(self._positions)
         for name, velocity in self._velocities.items():
             world.set_motor_velocity(robot, name, velocity)
         for name, torque in self._torques.items():
@@ -245,37 +261,54 @@ class RobotSession:
             self._sensors.clear()
             self._new_sensors.clear()
             return Measurement(msg, b"", jobs)
-        new, encoder = self._new_sensors, self._encoder
-        positions: dict[str, float] | None = None
-        batch = self._batch_positions
-        accelerometers: list[bytes] = []
-        forces: list[bytes] = []
-        gyros: list[bytes] = []
-        joints: list[bytes] = []
+        new, kinds, enabled_at = self._new_sensors, self._kinds, self._enabled_at
+        due: list[str] = []
         for name, period in self._sensors.items():
-            if name in new or (time_ms - self._enabled_at[name]) % period:
+            if name in new or (time_ms - enabled_at[name]) % period:
                 continue
-            kind = self._kinds[name]
-            if kind == POSITION_SENSOR:
-                if batch is not None:
-                    if positions is None:
-                        positions = batch(robot)
-                    value = positions[name]
-                else:
-                    value = world.read_position(robot, name)
-                joints.append(encoder.scalar(POSITION_SENSORS, name, value))
-            elif kind == ACCELEROMETER:
-                x, y, z = world.read_accelerometer(robot)
-                accelerometers.append(encoder.vector(ACCELEROMETERS, name, x, y, z))
-            elif kind == GYRO:
-                x, y, z = world.read_gyro(robot)
-                gyros.append(encoder.vector(GYROS, name, x, y, z))
-            elif kind == FORCE:
-                forces.append(encoder.scalar(FORCES, name, world.read_force(robot, name)))
-            elif kind == CAMERA and self._camera_size is not None:
+            if kinds[name] != CAMERA:
+                due.append(name)
+            elif self._camera_size is not None:
                 width, height = self._camera_size
                 camera = msg.cameras.add(name=name, width=width, height=height, quality=-1)
                 jobs.append(CameraJob(robot, name, width, height, time_ms, camera))
         new.clear()
-        sensors = b"".join(accelerometers + forces + gyros + joints)  # in field-number order
-        return Measurement(msg, sensors, jobs)
+        if not due:
+            return Measurement(msg, b"", jobs)
+        key = tuple(due)
+        plan = self._layouts.get(key)
+        if plan is None:
+            plan = self._layout(due)
+        names, layout = plan
+        return Measurement(msg, layout.encode(self._read(names)), jobs)
+
+    def _layout(self, due: list[str]) -> tuple[tuple[str, ...], SensorLayout]:
+        """Due sensors in field-number order (the order of the message) and their layout."""
+        if len(self._layouts) >= MAX_LAYOUTS:
+            self._layouts.clear()
+        kinds = self._kinds
+        names = tuple(sorted(due, key=lambda n: _FIELDS[kinds[n]][0]))  # stable within a kind
+        entries = []
+        for name in names:
+            field, width = _FIELDS[kinds[name]]
+            entries.append((field, name, width))
+        layout = SensorLayout(entries)
+        plan = self._layouts[tuple(due)] = (names, layout)
+        return plan
+
+    def _read(self, names: tuple[str, ...]) -> Any:
+        if self._read_sensors is not None:
+            return self._read_sensors(self.robot, names)
+        world, robot, kinds = self._world, self.robot, self._kinds
+        values: list[float] = []
+        for name in names:
+            kind = kinds[name]
+            if kind == POSITION_SENSOR:
+                values.append(world.read_position(robot, name))
+            elif kind == ACCELEROMETER:
+                values.extend(world.read_accelerometer(robot))
+            elif kind == GYRO:
+                values.extend(world.read_gyro(robot))
+            else:
+                values.append(world.read_force(robot, name))
+        return values

@@ -2,12 +2,15 @@
 
 Names are HLVS device names (``Neck``, ``NeckS``, ``Accelerometer``, ``Gyro``, ``Camera``,
 ``llb``...). Unknown names raise :class:`simulator.errors.UnknownDeviceError`. Batch forms:
-:meth:`DeviceAccess.read_positions` (name -> rad) and :meth:`DeviceAccess.read_position_array`
-(numpy array in ``motor_names(robot)`` order).
+:meth:`DeviceAccess.read_positions` (name -> rad), :meth:`DeviceAccess.read_position_array`
+(numpy array in ``motor_names(robot)`` order), :meth:`DeviceAccess.set_motor_positions` (many
+targets in one vectorised write) and :meth:`DeviceAccess.read_sensors` (the values of named
+sensors as one array, index arrays cached per name list: what the robot API reads each step).
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 import mujoco
@@ -22,6 +25,8 @@ if TYPE_CHECKING:
     from simulator.world.indices import RobotIndex, WorldIndex
     from simulator.world.motors import MotorBank
 
+MAX_PLANS = 256
+
 
 class DeviceAccess:
     """Device methods of :class:`simulator.world.World` (mixed in)."""
@@ -31,6 +36,7 @@ class DeviceAccess:
     data: mujoco.MjData
     limp: list[bool]
     removed: list[bool]
+    _device_plans: dict[tuple[str, RobotId, tuple[str, ...]], tuple[npt.NDArray[np.int64], ...]]
 
     def _robot(self, robot: RobotId) -> RobotIndex:
         try:
@@ -62,6 +68,27 @@ class DeviceAccess:
         """Target position (clamped to the joint range); leaves torque mode."""
         self.motors.set_position(self._actuator(robot, name), float(rad))
 
+    def set_motor_positions(
+        self, robot: RobotId, names: Sequence[str], rads: Sequence[float]
+    ) -> None:
+        """Several targets at once (same result as :meth:`set_motor_position` for each pair in
+        order; a name given twice keeps its last value)."""
+        if len(names) != len(rads):
+            raise ValueError(f"{len(names)} motor names for {len(rads)} positions")
+        key = ("set", robot, tuple(names))
+        plans = self._plans()
+        plan = plans.get(key)
+        if plan is None:
+            last = {name: i for i, name in enumerate(names)}  # the last value of a repeated name
+            chosen = [self._actuator(robot, name) for name in last]
+            plan = (np.array(chosen, dtype=np.int64), np.array(list(last.values())))
+            plans[key] = plan
+        actuators, picks = plan
+        values = np.asarray(rads, dtype=np.float64)
+        if len(picks) != len(values):
+            values = values[picks]
+        self.motors.set_positions(actuators, values)
+
     def set_motor_velocity(self, robot: RobotId, name: str, rad_s: float) -> None:
         """Maximum velocity of the position controller (clamped to the motor's maximum)."""
         self.motors.set_velocity(self._actuator(robot, name), float(rad_s))
@@ -91,6 +118,58 @@ class DeviceAccess:
         r = self._robot(robot)
         values = self.data.qpos[r.motor_qpos].tolist()
         return {f"{n}S": v for n, v in zip(r.model.motor_names, values, strict=True)}
+
+    def read_sensors(self, robot: RobotId, names: Sequence[str]) -> npt.NDArray[np.float64]:
+        """The values of ``names`` in order, flat: one per position (``<motor>S``) and force
+        sensor, three per ``Accelerometer`` and ``Gyro`` (x, y, z)."""
+        key = ("read", robot, tuple(names))
+        plans = self._plans()
+        plan = plans.get(key)
+        if plan is None:
+            plan = self._sensor_plan(robot, names)
+            plans[key] = plan
+        out_q, src_q, out_s, src_s = plan
+        out = np.empty(len(out_q) + len(out_s))
+        out[out_q] = self.data.qpos[src_q]
+        out[out_s] = self.data.sensordata[src_s]
+        return out
+
+    def _sensor_plan(
+        self, robot: RobotId, names: Sequence[str]
+    ) -> tuple[npt.NDArray[np.int64], ...]:
+        r = self._robot(robot)
+        out_q: list[int] = []
+        src_q: list[int] = []
+        out_s: list[int] = []
+        src_s: list[int] = []
+        for name in names:
+            at = len(out_q) + len(out_s)
+            if name in ("Accelerometer", "Gyro"):
+                adr = r.accelerometer if name == "Accelerometer" else r.gyro
+                out_s.extend((at, at + 1, at + 2))
+                src_s.extend((adr, adr + 1, adr + 2))
+            elif name in r.forces:
+                out_s.append(at)
+                src_s.append(r.forces[name])
+            else:
+                slot = r.motor_slot.get(name[:-1] if name.endswith("S") else name)
+                if slot is None:
+                    raise UnknownDeviceError(robot=str(robot), name=name, kind="sensor")
+                out_q.append(at)
+                src_q.append(int(r.motor_qpos[slot]))
+        return tuple(np.array(v, dtype=np.int64) for v in (out_q, src_q, out_s, src_s))
+
+    def _plans(
+        self,
+    ) -> dict[tuple[str, RobotId, tuple[str, ...]], tuple[npt.NDArray[np.int64], ...]]:
+        """Index arrays per (operation, robot, names), built on first use."""
+        try:
+            plans = self._device_plans
+        except AttributeError:
+            plans = self._device_plans = {}
+        if len(plans) > MAX_PLANS:  # clients choose the name lists: keep the cache bounded
+            plans.clear()
+        return plans
 
     def _vec3(self, adr: int) -> Vec3:
         x, y, z = self.data.sensordata[adr : adr + 3].tolist()

@@ -71,6 +71,20 @@ class MotorBank:
             self.torque_mode[actuator] = False
             self._dirty = True
 
+    def set_positions(self, actuators: npt.NDArray[np.int64], rads: FloatArray) -> None:
+        """:meth:`set_position` for distinct ``actuators`` at once (non-finite values ignored)."""
+        finite = np.isfinite(rads)
+        if not finite.all():
+            logger.debug("ignored non-finite positions for actuators %s", actuators[~finite])
+            actuators, rads = actuators[finite], rads[finite]
+        self.target[actuators] = np.minimum(
+            np.maximum(rads, self.lower[actuators]), self.upper[actuators]
+        )
+        self._ramping = True
+        if self.torque_mode[actuators].any():
+            self.torque_mode[actuators] = False
+            self._dirty = True
+
     def set_velocity(self, actuator: int, rad_s: float) -> None:
         if not math.isfinite(rad_s):
             logger.debug("ignored non-finite velocity %r for actuator %d", rad_s, actuator)
