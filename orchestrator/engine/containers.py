@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import tarfile
+import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -40,7 +42,7 @@ def translate(kind: str, name: str) -> Iterator[None]:
     try:
         yield
     except docker.errors.NotFound as exc:
-        raise ObjectNotFound(kind=kind, name=name) from exc
+        raise ObjectNotFound(kind=kind, name=name, detail=str(exc.explanation or "")) from exc
     except docker.errors.APIError as exc:
         detail = exc.explanation or str(exc)
         raise InfrastructureError(f"Docker engine refused on {kind} {name}: {detail}") from exc
@@ -188,6 +190,18 @@ class DockerRuntime:
                         container_id, stdout=out, stderr=err, stream=True, follow=False
                     ):
                         handle.write(chunk)
+
+    def copy_out(self, container_id: str, path: str, destination: Path) -> None:
+        """Copy ``path`` (a file or a folder) out of the container into ``destination``."""
+        destination.mkdir(parents=True, exist_ok=True)
+        with translate("container", f"{container_id}:{path}"):
+            stream, _ = self._client.api.get_archive(container_id, path)
+            with tempfile.TemporaryFile() as buffer:
+                for chunk in stream:
+                    buffer.write(chunk)
+                buffer.seek(0)
+                with tarfile.open(fileobj=buffer) as archive:
+                    archive.extractall(destination, filter="data")
 
     def image_digest(self, image: str) -> str | None:
         """The image id (``sha256:...``) when the image is present locally, else None."""

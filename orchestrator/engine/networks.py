@@ -73,27 +73,32 @@ def remove_network(client: docker.DockerClient, name: str) -> None:
 
 # host firewall ------------------------------------------------------------------------------
 
+IPTABLES = ("iptables", "ip6tables")  # IPv6 is off in our containers; the rule is kept anyway
+
 
 def firewall_available() -> bool:
     return shutil.which("iptables") is not None
 
 
-def _iptables(*args: str) -> subprocess.CompletedProcess[str]:
+def _run(tool: str, *args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        ["iptables", "-w", "5", *args], capture_output=True, text=True, check=False, timeout=30
+        [tool, "-w", "5", *args], capture_output=True, text=True, check=False, timeout=30
     )
 
 
 def isolate_bridge(bridge_name: str, *, match_id: str) -> None:
     """Drop everything a container on ``bridge_name`` sends to the host itself."""
     comment = f"{COMMENT_PREFIX}{match_id}"[:250]
-    for chain in ("INPUT",):
-        result = _iptables(
-            "-I", chain, "1", "-i", bridge_name, "-m", "comment", "--comment", comment, "-j", "DROP"
+    for tool in IPTABLES:
+        if shutil.which(tool) is None:
+            continue
+        result = _run(
+            tool, "-I", "INPUT", "1", "-i", bridge_name, "-m", "comment", "--comment", comment,
+            "-j", "DROP",
         )
         if result.returncode != 0:
             raise InfrastructureError(
-                f"cannot add the host firewall rule for bridge {bridge_name}: "
+                f"cannot add the host firewall rule ({tool}) for bridge {bridge_name}: "
                 f"{result.stderr.strip() or result.stdout.strip()}"
             )
     log.info("host services closed to bridge %s (match %s)", bridge_name, match_id)
@@ -101,9 +106,15 @@ def isolate_bridge(bridge_name: str, *, match_id: str) -> None:
 
 def remove_isolation(*, match_id: str | None = None) -> int:
     """Delete our INPUT rules (of one match, or all of them); returns how many were removed."""
-    if not firewall_available():
-        return 0
-    listed = _iptables("-S", "INPUT")
+    removed = 0
+    for tool in IPTABLES:
+        if shutil.which(tool) is not None:
+            removed += _remove(tool, match_id)
+    return removed
+
+
+def _remove(tool: str, match_id: str | None) -> int:
+    listed = _run(tool, "-S", "INPUT")
     if listed.returncode != 0:
         raise InfrastructureError(f"cannot list host firewall rules: {listed.stderr.strip()}")
     removed = 0
@@ -112,11 +123,10 @@ def remove_isolation(*, match_id: str | None = None) -> int:
         if not line.startswith("-A INPUT") or "--comment" not in line:
             continue
         comment = line.split("--comment", 1)[1].split()[0].strip('"')
-        if match_id is not None and comment != wanted or not comment.startswith(COMMENT_PREFIX):
+        if not comment.startswith(COMMENT_PREFIX) or (match_id is not None and comment != wanted):
             continue
-        spec = line.split()[2:]
-        spec = [part.strip('"') for part in spec]
-        result = _iptables("-D", "INPUT", *spec)
+        spec = [part.strip('"') for part in line.split()[2:]]
+        result = _run(tool, "-D", "INPUT", *spec)
         if result.returncode == 0:
             removed += 1
         else:

@@ -6,6 +6,7 @@ Every teardown step runs even when an earlier one failed; a teardown failure mak
 
 from __future__ import annotations
 
+import importlib.metadata
 import json
 import logging
 import shutil
@@ -180,6 +181,13 @@ def finish(runner: MatchRunner) -> dict[str, Any]:
     return _write(runner)
 
 
+def _version() -> str:
+    try:
+        return importlib.metadata.version("hlvs-runner")
+    except importlib.metadata.PackageNotFoundError:
+        return "unknown"
+
+
 def _write(runner: MatchRunner) -> dict[str, Any]:
     out: Path = runner.options.out_dir
     plan = runner.plan
@@ -196,7 +204,7 @@ def _write(runner: MatchRunner) -> dict[str, Any]:
             "team_comm_mb_s": limits.team_comm_mb_s, "grace_period_s": plan.grace_period_s,
             "allow_internet": plan.allow_internet,
         },
-        versions=dict(plan.versions),
+        versions={"hlvs-runner": _version(), **plan.versions},
         timings_s=dict(runner.lifecycle.timings_s),
         failure=runner.failure,
     )

@@ -143,6 +143,11 @@ class FakeRuntime:
             path.parent.mkdir(parents=True, exist_ok=True)
             path.write_text(f"{found.request.name} {path.stem}\n")
 
+    def copy_out(self, container_id: str, path: str, destination: Path) -> None:
+        self._get(container_id)
+        destination.mkdir(parents=True, exist_ok=True)
+        (destination / Path(path).name).write_text(f"copied from {container_id}:{path}\n")
+
     def image_digest(self, image: str) -> str | None:
         return None if image in self.missing_images else f"sha256:{abs(hash(image)):x}"
 

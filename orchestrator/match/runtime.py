@@ -19,10 +19,11 @@ from orchestrator.errors import InfrastructureError
 class ObjectNotFound(InfrastructureError):
     """A container or network the runner refers to does not exist (any more)."""
 
-    def __init__(self, *, kind: str, name: str) -> None:
+    def __init__(self, *, kind: str, name: str, detail: str = "") -> None:
         self.kind = kind
         self.name = name
-        super().__init__(f"{kind} {name} does not exist")
+        self.detail = detail
+        super().__init__(f"{kind} {name}: not found" + (f" ({detail})" if detail else ""))
 
 
 class SubnetInUse(InfrastructureError):
@@ -148,6 +149,8 @@ class ContainerRuntime(Protocol):
     def stats_stream(self, container_id: str) -> Iterator[StatsSample]: ...
 
     def save_logs(self, container_id: str, *, stdout: Path, stderr: Path) -> None: ...
+
+    def copy_out(self, container_id: str, path: str, destination: Path) -> None: ...
 
     def image_digest(self, image: str) -> str | None: ...
 

@@ -12,6 +12,7 @@ import pytest
 
 from orchestrator.cli import main as hlvs
 from orchestrator.errors import OrchestratorError
+from orchestrator.match.logfs import state_dir
 from orchestrator.match.scrimmage import add_arguments, write_files
 
 pytestmark = [pytest.mark.docker, pytest.mark.root]
@@ -91,16 +92,13 @@ def test_sigterm_to_hlvs_match_stops_everything_and_exits_130(
         cwd=repo, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )
     try:
+        ready = state_dir() / "logfs" / "sig-test" / "red-1" / "ready.txt"
         deadline = time.monotonic() + 60
-        while time.monotonic() < deadline:
-            roles = [o.labels.get("org.hlvs-runner.role")
-                     for o in runtime.list_project(match_id="sig-test")]
-            if roles.count("robot") == 2:
-                break
+        while time.monotonic() < deadline and not ready.exists():
             if process.poll() is not None:
                 pytest.fail(f"hlvs match ended early: {process.communicate()[1][-2000:]}")
-            time.sleep(0.2)
-        time.sleep(1.0)
+            time.sleep(0.1)
+        assert ready.exists(), "the robot did not get ready"
         os.kill(process.pid, signal.SIGTERM)
         _, err = process.communicate(timeout=60)
         assert process.returncode == 130, err[-2000:]

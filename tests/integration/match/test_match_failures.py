@@ -21,8 +21,9 @@ pytestmark = [pytest.mark.docker, pytest.mark.root]
 
 def _nothing_left(runtime: Any, match_id: str) -> None:
     assert runtime.list_project(match_id=match_id) == []
-    rules = subprocess.run(["iptables", "-S", "INPUT"], capture_output=True, text=True).stdout
-    assert f"hlvs-runner:{match_id}" not in rules
+    for tool in ("iptables", "ip6tables"):
+        rules = subprocess.run([tool, "-S", "INPUT"], capture_output=True, text=True).stdout
+        assert f"hlvs-runner:{match_id}" not in rules
     assert str(state_dir() / "logfs" / match_id) not in Path("/proc/mounts").read_text()
 
 
@@ -69,7 +70,8 @@ def test_stop_request_stops_everything_cleanly(play: MatchFactory, runtime: Any)
     def interrupt_when_playing() -> None:
         deadline = time.monotonic() + 60
         while time.monotonic() < deadline:
-            if holder and len(holder[0].started.robot_ids) == 2:
+            folders = holder[0].started.log_folders if holder else {}
+            if "red-1" in folders and (Path(folders["red-1"].path) / "ready.txt").exists():
                 holder[0].stop_event.set()
                 return
             time.sleep(0.05)

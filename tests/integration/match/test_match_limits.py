@@ -94,7 +94,7 @@ def test_robot_writing_past_its_log_cap_fills_only_its_folder(play: MatchFactory
 
 
 def test_sigterm_handling_robot_gets_its_grace_period(play: MatchFactory) -> None:
-    outcome = play(red=[["sigterm"]], blue=[["env"]], sim=("2",), grace_s=4.0)
+    outcome = play(red=[["sigterm"]], blue=[["env"]], sim=("4",), grace_s=4.0)
     assert outcome.ok
     text = (outcome.out_dir / "teams/red/1/robocup-logs/term.txt").read_text()
     assert text == "got SIGTERM\nflushed\n"

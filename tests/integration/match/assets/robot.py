@@ -80,6 +80,7 @@ def main(argv):
                 handle.write("flushed\n")
             sys.exit(0)
         signal.signal(signal.SIGTERM, on_term)
+        open(os.path.join(LOGS, "ready.txt"), "w").close()
         wait_forever()
     if mode == "oom":
         hog = []
