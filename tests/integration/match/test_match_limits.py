@@ -102,3 +102,20 @@ def test_sigterm_handling_robot_gets_its_grace_period(play: MatchFactory) -> Non
     assert results["robots"]["red-1"]["exit_code"] == 0
     assert results["robots"]["blue-1"]["exit_code"] == 137  # ignores SIGTERM: killed after grace
     assert results["timings_s"]["stopping"] >= 3.5
+
+
+def test_simulator_to_robot_and_teammate_traffic_are_held_to_their_rates(
+    play: MatchFactory,
+) -> None:
+    # red: 2 robots, API 2.5 MB/s each, team comm 0.5 MB/s each (4 Mbit/s); blue: 1 robot, 5 MB/s
+    limits = Limits(cpus=1.0, memory_gb=0.5, log_folder_gb=0.02, team_api_mb_s=5.0,
+                    team_comm_mb_s=1.0)
+    outcome = play(red=[["sink"], ["sendmate", "4"]], blue=[["recv", "4"]], sim=("8",),
+                   limits=limits)
+    out = outcome.out_dir
+    download = json.loads((out / "teams/blue/1/robocup-logs/recv.json").read_text())["rate_bit_s"]
+    assert 0.9 * 40e6 <= download <= 1.02 * 40e6, download
+    mates = json.loads((out / "teams/red/1/robocup-logs/sink.json").read_text())["rate_bit_s"]
+    assert 0.9 * 4e6 <= mates <= 1.02 * 4e6, mates
+    results = json.loads((out / "results.json").read_text())
+    assert results["robots"]["blue-1"]["received_bytes"] >= 4 * 0.9 * 40e6 / 8 * 0.8

@@ -28,6 +28,19 @@ def serve(key, port):
 
 
 def count(key, conn, peer):
+    head = conn.recv(64, socket.MSG_PEEK)
+    if head.startswith(b"DOWNLOAD"):
+        seconds = float(conn.recv(64).split()[1])
+        chunk = b"\0" * 65536
+        end = time.monotonic() + seconds
+        sent = 0
+        while time.monotonic() < end:
+            conn.sendall(chunk)
+            sent += len(chunk)
+        conn.close()
+        with lock:
+            stats[key] = {"peer": peer[0], "bytes": 0, "sent": sent, "rate_bit_s": None}
+        return
     total = 0
     first = last = None
     marks = []

@@ -32,6 +32,22 @@ def try_connect(host, port, timeout=1.0):
         sock.close()
 
 
+def measure(sock):
+    """Receive until EOF; the rate in bit/s after the first 0.5 s (token bucket burst)."""
+    marks = []
+    total = 0
+    while True:
+        data = sock.recv(262144)
+        if not data:
+            break
+        total += len(data)
+        marks.append((time.monotonic(), total))
+    if len(marks) < 2 or marks[-1][0] - marks[0][0] < 1.0:
+        return None
+    start = next(m for m in marks if m[0] >= marks[0][0] + 0.5)
+    return (total - start[1]) * 8 / (marks[-1][0] - start[0])
+
+
 def wait_forever():
     while True:
         time.sleep(1)
@@ -110,6 +126,38 @@ def main(argv):
             sock.sendall(chunk)
         sock.close()
         print("sent", flush=True)
+        wait_forever()
+    if mode == "recv":  # ask the simulator for data, measure the rate that arrives
+        seconds = float(argv[2]) if len(argv) > 2 else 3.0
+        sock = socket.create_connection(sim_addr(), timeout=10)
+        sock.sendall(f"DOWNLOAD {seconds}\n".encode())
+        log("recv.json", {"rate_bit_s": measure(sock)})
+        wait_forever()
+    if mode == "sink":  # teammates send here (port 5001)
+        server = socket.socket()
+        server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        server.bind(("0.0.0.0", 5001))
+        server.listen(1)
+        conn, _ = server.accept()
+        log("sink.json", {"rate_bit_s": measure(conn)})
+        wait_forever()
+    if mode == "sendmate":
+        seconds = float(argv[2]) if len(argv) > 2 else 3.0
+        target = os.environ["ROBOCUP_TEAM_PLAYER1_IP"]
+        deadline = time.monotonic() + 20
+        while True:
+            try:
+                sock = socket.create_connection((target, 5001), timeout=2)
+                break
+            except OSError:
+                if time.monotonic() > deadline:
+                    raise
+                time.sleep(0.1)
+        chunk = b"\0" * 16384
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            sock.sendall(chunk)
+        sock.close()
         wait_forever()
     if mode == "exit":
         sys.exit(3)
