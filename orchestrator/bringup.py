@@ -59,7 +59,7 @@ def measure(*, robots: int, out: Path, timeout_s: float, robot_image: str | None
                           grace_period_s=1.0)
     runtime = DockerRuntime(connect())
     runner = MatchRunner(
-        plan, runtime=runtime, host=HostControl(),
+        plan, runtime=runtime, host=HostControl.for_current_user(),
         options=RunOptions(out_dir=out, simulator_image=simulator, poll_s=0.05),
         telemetry=lambda endpoint, match_id: ZenohTelemetry(endpoint=endpoint, match_id=match_id),
     )
@@ -70,7 +70,7 @@ def measure(*, robots: int, out: Path, timeout_s: float, robot_image: str | None
         time.sleep(0.05)
     runner.stop_event.set()
     thread.join(timeout=120)
-    cleanup(runtime, HostControl(), match_id=plan.match_id)
+    cleanup(runtime, HostControl.for_current_user(), match_id=plan.match_id)
     bringup = runner.bringup_s
     return {
         "bench": "bringup",

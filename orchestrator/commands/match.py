@@ -106,7 +106,7 @@ def play(
 
     client = connect()
     runtime = DockerRuntime(client)
-    host = HostControl()
+    host = HostControl.for_current_user()
     leftovers = cleanup(runtime, host, match_id=plan.match_id)
     if leftovers.containers or leftovers.networks:
         log.info("removed %d containers and %d networks left by an earlier run of %s",
@@ -176,7 +176,8 @@ def run_cleanup_command(args: argparse.Namespace) -> int:
     from orchestrator.engine import connect
     from orchestrator.engine.containers import DockerRuntime
 
-    report = cleanup(DockerRuntime(connect()), HostControl(), match_id=args.match)
+    host = HostControl.for_current_user()
+    report = cleanup(DockerRuntime(connect()), host, match_id=args.match)
     print(json.dumps({
         "containers": list(report.containers), "networks": list(report.networks),
         "host_objects": report.host_objects, "errors": list(report.errors),

@@ -181,6 +181,11 @@ def finish(runner: MatchRunner) -> dict[str, Any]:
     return _write(runner)
 
 
+def _host_controls(runner: MatchRunner) -> dict[str, bool] | None:
+    describe = getattr(runner.host, "describe", None)
+    return describe() if callable(describe) else None
+
+
 def _version() -> str:
     try:
         return importlib.metadata.version("hlvs-runner")
@@ -203,6 +208,7 @@ def _write(runner: MatchRunner) -> dict[str, Any]:
             "log_folder_gb": limits.log_folder_gb, "team_api_mb_s": limits.team_api_mb_s,
             "team_comm_mb_s": limits.team_comm_mb_s, "grace_period_s": plan.grace_period_s,
             "allow_internet": plan.allow_internet,
+            "host_controls": _host_controls(runner),
         },
         versions={"hlvs-runner": _version(), **plan.versions},
         timings_s=dict(runner.lifecycle.timings_s),

@@ -8,6 +8,7 @@ result then records that it was not applied).
 from __future__ import annotations
 
 import logging
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
@@ -43,6 +44,23 @@ class HostControl:
     firewall: bool = True
     shaping: bool = True
     capped_logs: bool = True
+
+    @classmethod
+    def for_current_user(cls) -> HostControl:
+        """Everything on as root; without root (traffic control, iptables and mount need it)
+        everything off, with a warning: the match still plays, and results.json records which
+        limits were not applied."""
+        if os.geteuid() == 0:
+            return cls()
+        log.warning(
+            "not running as root: no bandwidth limits, no host firewall rules and no size cap "
+            "on /robocup-logs for this match"
+        )
+        return cls(firewall=False, shaping=False, capped_logs=False)
+
+    def describe(self) -> dict[str, bool]:
+        return {"firewall": self.firewall, "shaping": self.shaping,
+                "capped_logs": self.capped_logs}
 
     def isolate_bridge(self, bridge_name: str, *, match_id: str) -> bool:
         if not self.firewall:
