@@ -57,3 +57,20 @@ def test_plain_view_prints_changes_only() -> None:
     assert len(lines) == 2
     assert "score red 2 - 0 blue" in lines[1]
     assert describe(state).startswith("PLAYING half 1")
+
+
+class _Terminal(io.StringIO):
+    def isatty(self) -> bool:
+        return True
+
+
+def test_terminal_view_renders_a_table() -> None:
+    out = _Terminal()
+    view = LiveView(match_id="m9", stream=out)
+    view.update(phase="playing", state={"state": "SET", "secondary_state": "NORMAL", "half": 2,
+                                        "secs_remaining": 12, "score": {"red": 3, "blue": 1},
+                                        "sim_time_ms": 4500, "real_time_factor": 1.5,
+                                        "connected": ["red-1", "blue-1"]})
+    view.close()
+    text = out.getvalue()
+    assert "match m9" in text and "red 3 - 1 blue" in text and "red-1, blue-1" in text
