@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 import os
+import re
 import shutil
 import subprocess
 from dataclasses import dataclass
@@ -19,6 +20,12 @@ from pathlib import Path
 from orchestrator.errors import InfrastructureError
 
 log = logging.getLogger(__name__)
+
+
+def safe_name(text: str) -> str:
+    """``text`` usable as a Docker object name part and as one path component."""
+    cleaned = re.sub(r"[^A-Za-z0-9_.-]", "-", text).lstrip(".-") or "match"
+    return cleaned[:100]
 
 
 def state_dir() -> Path:
@@ -51,7 +58,7 @@ def create(*, match_id: str, name: str, cap_bytes: int, fallback_dir: Path) -> L
         fallback_dir.chmod(0o777)
         log.warning("no root: %s has no size cap", fallback_dir)
         return LogFolder(path=fallback_dir, cap_bytes=None)
-    base = state_dir() / "logfs" / match_id
+    base = state_dir() / "logfs" / safe_name(match_id)
     base.mkdir(parents=True, exist_ok=True)
     image = base / f"{name}.img"
     mountpoint = base / name
@@ -102,7 +109,7 @@ def cleanup(*, match_id: str | None = None) -> int:
     """Unmount and delete what crashed runs left (of one match, or all); returns the count."""
     root = state_dir() / "logfs"
     if match_id is not None:
-        root = root / match_id
+        root = root / safe_name(match_id)
     count = 0
     for mountpoint in _mounts():
         if mountpoint.startswith(str(root) + "/"):
@@ -113,4 +120,6 @@ def cleanup(*, match_id: str | None = None) -> int:
     return count
 
 
-__all__ = ["LogFolder", "can_cap", "cleanup", "collect", "create", "release", "state_dir"]
+__all__ = [
+    "LogFolder", "can_cap", "cleanup", "collect", "create", "release", "safe_name", "state_dir",
+]

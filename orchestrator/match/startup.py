@@ -13,7 +13,7 @@ from orchestrator.bandwidth import AppliedShaping, RobotShaping, mb_s_to_bit
 from orchestrator.errors import InfrastructureError, OrchestratorError
 from orchestrator.match import layout
 from orchestrator.match.layout import Subnet
-from orchestrator.match.logfs import LogFolder
+from orchestrator.match.logfs import LogFolder, safe_name
 from orchestrator.match.plan import RobotPlan, per_robot_rate_mb_s
 from orchestrator.match.results import FailureClass
 from orchestrator.match.runtime import Attachment, ContainerRequest, NetworkInfo, SubnetInUse
@@ -63,7 +63,7 @@ def _create_network(runner: MatchRunner, role: str, internal: bool) -> None:
 def start(runner: MatchRunner, started_at: float) -> None:
     plan = runner.plan
     started = runner.started
-    started.prefix = f"hlvs-{plan.match_id}"
+    started.prefix = f"hlvs-{safe_name(plan.match_id)}"
     for role, internal in (("control", True), ("red", not plan.allow_internet),
                            ("blue", not plan.allow_internet)):
         _create_network(runner, role, internal)

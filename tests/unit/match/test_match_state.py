@@ -51,3 +51,16 @@ def test_illegal_transitions_are_rejected(path: list[MatchState], target: MatchS
     assert info.value.source is before and info.value.target is target
     assert "m2" in str(info.value) and "allowed from" in str(info.value)
     assert life.state is before
+
+
+def test_safe_names_and_bandwidth_keys() -> None:
+    from orchestrator.bandwidth import _ip_key, _udp_port_key, mb_s_to_bit
+    from orchestrator.match.logfs import safe_name
+
+    assert safe_name("round 1/a:b") == "round-1-a-b"
+    assert safe_name("../x") == "x"
+    assert mb_s_to_bit(350 / 4) == 700_000_000
+    assert mb_s_to_bit(1.0) == 8_000_000
+    assert _ip_key("10.213.4.12", 16) == "0x0ad5040c/0xffffffff+16"
+    assert _udp_port_key(3737, source=False) == "0x00000e99/0x0000ffff+20"
+    assert _udp_port_key(3737, source=True) == "0x0e990000/0xffff0000+20"
