@@ -165,7 +165,7 @@ class LiveView:
             tuple(state.get("connected") or ())))
         now = time.monotonic()
         if key != self._last_key or now - self._last_print >= self.PLAIN_PERIOD_S:
-            line = f"[{phase}] " + (describe(state) if state else "")
+            line = f"[{phase}]" + (f" {describe(state)}" if state else "")
             self._stream.write(line + "\n")
             self._stream.flush()
             self._last_key = key

@@ -165,15 +165,21 @@ class MatchRunner:
                 log.warning("match %s: robot %s has no usable image: %s",
                             self.plan.match_id, key, error)
         forfeiting = [c for c in ("red", "blue") if usable[c] == 0]
+        first_error = {
+            color: next((f"{r.key}: {r.image_error}" for r in self.records.values()
+                         if r.color == color and r.image_error), "no players")
+            for color in forfeiting
+        }
         if len(forfeiting) == 2:
-            self._fail(FailureClass.IMAGE_PULL, "neither team has a usable image")
+            self._fail(FailureClass.IMAGE_PULL, "neither team has a usable image ("
+                       + "; ".join(first_error.values()) + ")")
         elif forfeiting:
             loser = forfeiting[0]
             winner = "blue" if loser == "red" else "red"
             self.forfeit = {
                 "team": loser,
                 "winner": winner,
-                "reason": f"no robot of {loser} has a usable image",
+                "reason": f"no robot of {loser} has a usable image ({first_error[loser]})",
                 "score": {winner: 0, loser: 0},
             }
             log.info("match %s: %s forfeits (no usable image)", self.plan.match_id, loser)
