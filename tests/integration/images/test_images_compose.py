@@ -202,11 +202,11 @@ def _compose_up(folder: Path, compose_path: Path) -> subprocess.CompletedProcess
 
 
 @pytest.mark.slow
-def test_compose_up_plays_the_match_with_the_simulator_image(tmp_path: Path) -> None:
-    """The real simulator image plays a short match to the end; the robots run no controller."""
+def test_compose_up_plays_a_stub_match(tmp_path: Path) -> None:
+    """The simulator and stub images play a short 1 v 1 match to the end under docker-compose."""
     if shutil.which("docker-compose") is None:
         pytest.skip("docker-compose is not installed")
-    game = _game_copy(tmp_path, robot_image=project_image("team-base"), robot_cmd="sleep 600")
+    game = _game_copy(tmp_path, robot_image=project_image("stub"), robot_cmd=None)
     loaded = load_game(game, images_required=True)
     third = random.Random().randrange(0, 80) * 3
     subnets = Subnets.starting_at(ipaddress.IPv4Network(f"10.216.{third}.0/24"))
@@ -222,6 +222,11 @@ def test_compose_up_plays_the_match_with_the_simulator_image(tmp_path: Path) -> 
     assert result["match_id"] == loaded.game.match_id
     assert result["state"] == "FINISHED"
     assert result["seed"] == loaded.game.seed
-    assert set(result["robots"]) == {"red-1", "blue-1"}
+    for robot in ("red-1", "blue-1"):
+        stats = result["robots"][robot]
+        assert len(stats["connects"]) >= 1, stats  # the stub reached its API port
+        assert stats["messages_in"] > 0 and stats["messages_out"] > 0
+        robot_logs = list((compose_path.parent / "logs" / robot).iterdir())
+        assert robot_logs and all(p.stat().st_size > 0 for p in robot_logs)
     for name in ("replay.hlvsrec", "referee.log", "gamecontroller.log"):
         assert (compose_path.parent / "out" / name).stat().st_size > 0
