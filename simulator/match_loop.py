@@ -141,10 +141,11 @@ class MatchLoop:
                 origin_s, origin_ms = pace_origin
                 due = origin_s + (self.world.sim_time_ms - origin_ms) / 1000.0 / max_rtf
                 wait = due - time.monotonic()
-                if wait > 0:
-                    self.server.poll(wait)
-                elif wait < -1.0:  # far behind: do not try to catch up in a burst
+                if wait < -1.0:  # far behind: do not try to catch up in a burst
                     pace_origin = (time.monotonic(), self.world.sim_time_ms)
+                while wait > 0:  # a socket event ends a poll early: wait until due
+                    self.server.poll(wait)
+                    wait = due - time.monotonic()
         self.real_time_s = time.monotonic() - start
         self._publish_state(force=True)
         return self.stop_reason

@@ -72,7 +72,7 @@ def _connect(port: int) -> socket.socket:
 
 
 def _frame(request: Any) -> bytes:
-    payload = request.SerializeToString()
+    payload: bytes = request.SerializeToString()
     return len(payload).to_bytes(4, "big") + payload
 
 
@@ -189,8 +189,8 @@ def _api_run(
         LockstepSettings,
         PlayerEndpoint,
         wait_lockstep,
+        world_cameras,
     )
-    from simulator.api.world_cameras import world_render_worker
     from simulator.spec import NetworkSpec
 
     robots = _robots(args.robots)
@@ -206,7 +206,7 @@ def _api_run(
         for r, p in zip(robots, ports, strict=True)
     ]
     stalled_robot = robots[-1] if stalled else None
-    cameras = world_render_worker(world)
+    cameras = world_cameras.world_render_worker(world)
     server = ApiServer(
         world=world,
         endpoints=endpoints,

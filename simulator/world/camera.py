@@ -1,11 +1,16 @@
 """Robot head cameras rendered offscreen (``MUJOCO_GL=osmesa`` or ``egl`` without a display).
 
 Images are raw B,G,R bytes, rows top to bottom, as the HLVS robot API sends them. Shadows and
-reflections are off: they cost about twice the time of a frame on a CPU renderer.
+reflections are off: they cost about twice the time of a frame on a CPU renderer. Spheres,
+capsules and cylinders are tessellated more coarsely than MuJoCo's defaults (12 slices, 6
+stacks instead of 28 and 16; planes and boxes in one quad): on a software renderer that cuts a
+320x240 frame from about 10 ms to 4.5 ms with no visible difference at robot camera resolution.
+The match video keeps the model's own quality.
 """
 
 from __future__ import annotations
 
+import copy
 from typing import TYPE_CHECKING
 
 import mujoco
@@ -16,6 +21,18 @@ from simulator.errors import UnknownDeviceError
 
 if TYPE_CHECKING:
     from simulator.world.world import World
+
+# (numslices, numstacks, numquads) of the robot cameras' render context
+ROBOT_CAMERA_QUALITY = (12, 6, 1)
+
+
+def robot_camera_model(model: mujoco.MjModel) -> mujoco.MjModel:
+    """A copy of ``model`` with :data:`ROBOT_CAMERA_QUALITY` tessellation (read by MuJoCo when
+    the render context is made; the copy has the same layout, so the world's data fits it)."""
+    cheap = copy.copy(model)
+    quality = cheap.vis.quality
+    quality.numslices, quality.numstacks, quality.numquads = ROBOT_CAMERA_QUALITY
+    return cheap
 
 
 class CameraRenderer:
@@ -29,7 +46,9 @@ class CameraRenderer:
         self._world = world
         self.width = width
         self.height = height
-        self._renderer = mujoco.Renderer(world.model, height=height, width=width)
+        self._renderer = mujoco.Renderer(
+            robot_camera_model(world.model), height=height, width=width
+        )
         self._option = mujoco.MjvOption()
         self._option.geomgroup[4] = 0  # sites and helper geoms stay invisible
         scene = self._renderer.scene
