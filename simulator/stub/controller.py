@@ -30,6 +30,7 @@ BALL_MEMORY_MS = 4000
 SCAN = [(-0.9, 0.45), (-0.45, 0.5), (0.0, 0.55), (0.45, 0.5), (0.9, 0.45), (0.45, 0.95),
         (0.0, 1.0), (-0.45, 0.95)]  # fmt: skip
 SCAN_DWELL_S = 0.35
+SETTLE_S = 1.0  # stand still this long after start and after getting up
 FIELD_HALF_LENGTH_M = {"kid": 4.5, "adult": 7.0}
 BALL_RADIUS_M = {"kid": 0.07, "adult": 0.1125}
 
@@ -76,6 +77,7 @@ class StubController:
             kick_x_m=0.165 * self.kin.leg.thigh_m / 0.16,
         )
         self._last_ms: int | None = None
+        self._settle_until_ms: int | None = None
         self._tilted_s = 0.0
         self._motion: KeyframeMotion | None = None
         self._motion_kind = ""
@@ -94,6 +96,8 @@ class StubController:
 
     def tick(self, sensors: Sensors, game: GameInfo) -> dict[str, float]:
         dt = 0.008 if self._last_ms is None else max(sensors.time_ms - self._last_ms, 1) / 1000.0
+        if self._settle_until_ms is None:
+            self._settle_until_ms = sensors.time_ms + int(SETTLE_S * 1000)
         self._last_ms = sensors.time_ms
         if sensors.accel is not None and sensors.gyro is not None:
             self.attitude.update(dt, sensors.accel, sensors.gyro)
@@ -136,6 +140,8 @@ class StubController:
             field=self.field,
             searching_s=searching_s,
         )
+        if sensors.time_ms < self._settle_until_ms:
+            action = Action(search=action.search)  # settle into the stance first
         self.last_action = action
         if action.kick_foot is not None:
             if self.walk.walking:
@@ -203,8 +209,11 @@ class StubController:
         self.walk.reset()
 
     def _finish_motion(self) -> None:
+        if self._motion_kind == "kick":
+            self.world.forget_ball()  # look again: it should be far away now
         if self._motion_kind == "get-up":
             self.stats.get_ups += 1
+            self._settle_until_ms = (self._last_ms or 0) + int(SETTLE_S * 1000)
         self._motion = None
         self._motion_kind = ""
         self._tilted_s = 0.0

@@ -58,6 +58,10 @@ class WorldModel:
             yaw,
         )
 
+    def forget_ball(self) -> None:
+        self.ball_field = None
+        self.ball_seen_ms = None
+
     def see_ball(self, time_ms: int, x_rel_m: float, y_rel_m: float) -> None:
         self.ball_field = self.pose.to_field(x_rel_m, y_rel_m)
         self.ball_seen_ms = time_ms
