@@ -7,14 +7,13 @@ the files they write.
 
 from __future__ import annotations
 
-import importlib
 import math
-import random
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 from orchestrator.config import Limits, LoadedGame, PlayerConfig
+from orchestrator.config.spec import to_match_spec
 
 SpecBuilder = Callable[[Mapping[str, tuple[str, ...]], str | None], dict[str, Any]]
 """(robot addresses per color, telemetry endpoint or None) -> match_spec.json content."""
@@ -99,85 +98,16 @@ def plan_from_game(loaded: LoadedGame, *, grace_period_s: float | None = None) -
 def spec_dict(
     loaded: LoadedGame, addresses: Mapping[str, tuple[str, ...]], telemetry: str | None
 ) -> dict[str, Any]:
-    """match_spec.json content: the config layer's ``to_match_spec`` when it is available,
-    with the addresses of this run (hosts, robot addresses, telemetry) filled in."""
-    try:
-        module = importlib.import_module("orchestrator.config.spec")
-    except ImportError:
-        spec = _fallback_spec(loaded)
-    else:
-        spec = module.to_match_spec(
-            loaded, robot_addresses={c: list(a) for c, a in addresses.items()},
-            telemetry_listen=telemetry,
-        )
+    """match_spec.json content from the config layer, with this run's addresses: the robots'
+    fixed IPs are the team's allowed hosts and GameController targets."""
+    spec = to_match_spec(
+        loaded, robot_addresses={c: list(a) for c, a in addresses.items()},
+        telemetry_listen=telemetry,
+    )
     for color in ("red", "blue"):
         spec[color]["hosts"] = list(addresses.get(color, ()))
         spec[color]["robot_addresses"] = list(addresses.get(color, ()))
-    network = spec.setdefault("network", {})
-    network["telemetry_listen"] = telemetry
-    network["api_bind_host"] = "0.0.0.0"
     return spec
-
-
-def _pose(pose: Any) -> dict[str, float]:
-    return {"x_m": pose.x_m, "y_m": pose.y_m, "yaw_rad": pose.yaw_rad}
-
-
-def _fallback_spec(loaded: LoadedGame) -> dict[str, Any]:
-    game = loaded.game
-    rng = random.Random(game.seed)
-    side = game.side_left if game.side_left != "random" else rng.choice(["red", "blue"])
-    kickoff = game.kickoff if game.kickoff != "random" else rng.choice(["red", "blue"])
-    teams: dict[str, Any] = {}
-    for color in ("red", "blue"):
-        ref = game.team(color)
-        cfg = loaded.team(color)
-        teams[color] = {
-            "color": color,
-            "team_id": ref.team_id,
-            "name": cfg.display_name,
-            "hosts": list(ref.hosts),
-            "players": [
-                {
-                    "number": p.number,
-                    "model": p.model,
-                    "port": ref.port(p.number),
-                    "half_time_pose": _pose(p.half_time_pose),
-                    "reentry_pose": _pose(p.reentry_pose),
-                    "shootout_pose": _pose(p.shootout_pose),
-                    "goalkeeper_pose": _pose(p.goalkeeper_pose),
-                    "goalkeeper": p.number == 1,
-                }
-                for p in cfg.players
-            ],
-        }
-    timing = game.timing
-    return {
-        "match_id": game.match_id,
-        "seed": game.seed,
-        "game_type": game.game_type,
-        "field_class": game.field_class.lower(),
-        "side_left": side,
-        "kickoff": kickoff,
-        "red": teams["red"],
-        "blue": teams["blue"],
-        "stepping": game.stepping,
-        "maximum_real_time_factor": game.maximum_real_time_factor,
-        "physics_dt_s": game.physics_dt_s,
-        "lockstep_deadline_ms": game.lockstep_deadline_ms,
-        "lockstep_time_bank_ms": game.lockstep_time_bank_ms,
-        "timing": {
-            "half_duration_s": timing.half_duration_s,
-            "overtime_half_duration_s": timing.overtime_half_duration_s,
-            "ready_duration_s": timing.ready_duration_s,
-            "wait_before_first_ready_real_s": timing.wait_before_first_ready_s,
-            "half_time_break_real_s": timing.half_time_break_s,
-            "removal_penalty_s": timing.removal_penalty_s,
-            "max_duration_real_s": timing.max_duration_s,
-        },
-        "network": {"team_quota_mb_s": game.limits.team_api_mb_s},
-        "record_video": None,
-    }
 
 
 def per_robot_rate_mb_s(team_rate_mb_s: float, n_robots: int) -> float:
