@@ -23,7 +23,22 @@ def test_match_writes_complete_results_and_each_robot_sees_its_environment(
     assert set(results["robots"]) == {"red-1", "red-2", "blue-1"}
     for name in ("replay.hlvsrec", "referee.log", "gamecontroller.log", "sim_result.json"):
         assert (out / "public" / name).is_file(), name
-    env = json.loads((out / "teams/red/2/robocup-logs/env.json").read_text())["env"]
+    seen = json.loads((out / "teams/red/2/robocup-logs/env.json").read_text())
+    env = seen["env"]
+    assert set(env) == {
+        "ROBOCUP_ROBOT_ID", "ROBOCUP_TEAM_COLOR", "ROBOCUP_SIMULATOR_ADDR",
+        "ROBOCUP_MIRROR_SERVER_IP", "ROBOCUP_GAMECONTROLLER_IP", "ROBOCUP_TEAM_PLAYER1_IP",
+        "ROBOCUP_TEAM_PLAYER2_IP",
+    }
+    assert seen["hostname"] == "red-2"
+    assert seen["cap_eff"] == "0000000000000000" and seen["no_new_privs"] == "1"
+    host_mounts = [m for m in seen["mounts"] if not m.startswith(("/proc", "/sys", "/dev"))]
+    assert sorted(host_mounts) == [
+        "/", "/etc/hostname", "/etc/hosts", "/etc/resolv.conf", "/robocup-logs"]
+    blue = json.loads((out / "teams/blue/1/robocup-logs/env.json").read_text())["env"]
+    assert blue["ROBOCUP_TEAM_COLOR"] == "blue"
+    assert blue["ROBOCUP_SIMULATOR_ADDR"].endswith(":10021")
+    assert "ROBOCUP_TEAM_PLAYER2_IP" not in blue
     sim_ip = env["ROBOCUP_MIRROR_SERVER_IP"]
     assert env["ROBOCUP_ROBOT_ID"] == "2"
     assert env["ROBOCUP_TEAM_COLOR"] == "red"

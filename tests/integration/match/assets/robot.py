@@ -59,7 +59,11 @@ def main(argv):
           f"mode {mode}", flush=True)
     if mode == "env":
         env = {k: v for k, v in os.environ.items() if k.startswith("ROBOCUP_")}
-        log("env.json", {"env": env, "hostname": socket.gethostname(), "uid": os.getuid()})
+        mounts = sorted({line.split()[4] for line in open("/proc/self/mountinfo")})
+        status = dict(line.split(":", 1) for line in open("/proc/self/status") if ":" in line)
+        log("env.json", {"env": env, "hostname": socket.gethostname(), "uid": os.getuid(),
+                         "mounts": mounts, "cap_eff": status["CapEff"].strip(),
+                         "no_new_privs": status.get("NoNewPrivs", "").strip()})
         reach = {}
         for target in argv[2:]:
             host, port = target.rsplit(":", 1)
