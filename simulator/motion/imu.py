@@ -37,8 +37,10 @@ class AttitudeFilter:
     Readings whose magnitude is far from gravity (impacts, falls) are not used for correction.
     """
 
-    def __init__(self, *, time_constant_s: float = 0.5) -> None:
+    def __init__(self, *, time_constant_s: float = 0.5, warm_up_s: float = 1.0) -> None:
         self._tau = time_constant_s
+        self._warm_up_s = warm_up_s  # converge faster (time constant / 5) this long at start
+        self._elapsed_s = 0.0
         self._attitude: Attitude | None = None
 
     @property
@@ -47,17 +49,23 @@ class AttitudeFilter:
 
     def reset(self) -> None:
         self._attitude = None
+        self._elapsed_s = 0.0
 
     def update(self, dt_s: float, accel: Vec3, gyro: Vec3) -> Attitude:
         measured = accel_attitude(accel)
+        norm = math.sqrt(sum(a * a for a in accel))
+        trusted = abs(norm - GRAVITY_M_S2) < 0.3 * GRAVITY_M_S2
         if self._attitude is None:
+            if not trusted:  # e.g. an all-zero first reading: wait for a sane one
+                return self.attitude
             self._attitude = measured
             return measured
         roll = self._attitude.roll_rad + gyro[0] * dt_s
         pitch = self._attitude.pitch_rad + gyro[1] * dt_s
-        norm = math.sqrt(sum(a * a for a in accel))
-        if abs(norm - GRAVITY_M_S2) < 0.3 * GRAVITY_M_S2:
-            weight = dt_s / (self._tau + dt_s)
+        self._elapsed_s += dt_s
+        if trusted:
+            tau = self._tau / 5.0 if self._elapsed_s < self._warm_up_s else self._tau
+            weight = dt_s / (tau + dt_s)
             roll += weight * _wrap(measured.roll_rad - roll)
             pitch += weight * (measured.pitch_rad - pitch)
         self._attitude = Attitude(_wrap(roll), pitch)

@@ -147,8 +147,9 @@ class WalkEngine:
             angles = leg_ik(leg, target)
             angles["hip_pitch"] -= p.torso_pitch_rad
             angles["hip_roll"] += sign * p.hip_roll_comp_rad * other_lift * self._gait
-            if tilt is not None:
-                roll_err, pitch_err = tilt[0], tilt[1] - p.torso_pitch_rad
+            if tilt is not None:  # balance feedback while stepping only
+                roll_err = tilt[0] * self._gait
+                pitch_err = (tilt[1] - p.torso_pitch_rad) * self._gait
                 angles["ankle_pitch"] += p.tilt_pitch_ankle_gain * pitch_err
                 angles["hip_pitch"] += p.tilt_pitch_hip_gain * pitch_err
                 angles["ankle_roll"] += p.tilt_roll_ankle_gain * roll_err

@@ -71,3 +71,14 @@ def test_walks_60_s_on_flat_ground_without_falling() -> None:
     commands = [(0.15, 0.0, 0.0), (0.05, 0.0, 0.5), (0.0, 0.05, 0.0), (0.1, 0.0, -0.3)]
     for vx, vy, vyaw in commands:
         assert robot.run(15.0, walker(robot, engine, vx, vy, vyaw)), (vx, vy, vyaw)
+
+
+def test_attitude_filter_ignores_an_all_zero_first_reading() -> None:
+    from simulator.motion import AttitudeFilter
+
+    f = AttitudeFilter()
+    f.update(0.008, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+    att = f.update(0.008, (0.0, 0.0, 9.81), (0.0, 0.0, 0.0))
+    assert abs(att.roll_rad) < 1e-6 and abs(att.pitch_rad) < 1e-6
+    leaning = f.update(0.008, (-9.81 * math.sin(0.3), 0.0, 9.81 * math.cos(0.3)), (0.0, 0.3, 0.0))
+    assert leaning.pitch_rad > 0  # leaning forward, both from the gyro and the accelerometer
