@@ -114,6 +114,11 @@ class RobotSession:
         self._read_sensors = getattr(world, "read_sensors", None)
         self._set_positions = getattr(world, "set_motor_positions", None)
         self._layouts: dict[tuple[str, ...], tuple[tuple[str, ...], SensorLayout]] = {}
+        self._valid_names: set[tuple[str, ...]] = set()  # motor name lists known to be fine
+        # sensors by (period, start): (period, start, names, positions in enabling order)
+        self._groups: list[tuple[int, int, tuple[str, ...], list[int]]] | None = None
+        self._order: list[str] = []
+        self._camera_sensors: list[tuple[str, int, int]] = []
         self._pending: list[tuple[int, str]] = []
         self._limp = False
         self._camera_size: tuple[int, int] | None = None
@@ -133,18 +138,20 @@ class RobotSession:
             return
         motors = self._motor_names
         active = not world.is_limp(robot)
+        present = len(request.ListFields())
         if request.motor_positions:
-            cache = self._positions
-            targets: dict[str, float] = {}
-            for mp in request.motor_positions:
-                name = mp.name
-                if name not in motors:
-                    self.warn(f'Motor "{name}" not found, position command ignored.')
-                    continue
-                targets[name] = mp.position
-            cache.update(targets)
-            if active and targets:
-                self._apply_positions(targets)
+            present -= 1
+            positions = list(request.motor_positions)  # one wrapper per item, read twice
+            names = tuple([mp.name for mp in positions])
+            if names in self._valid_names:  # the usual case: the same distinct, known motors
+                values = [mp.position for mp in positions]
+                self._positions.update(zip(names, values, strict=True))
+                if active:
+                    self._set_many(names, values)
+            else:
+                self._apply_checked(positions, names, active)
+        if not present:  # nothing but position targets (the usual request)
+            return
         for mv in request.motor_velocities:
             if mv.name not in motors:
                 self.warn(f'Motor "{mv.name}" not found, velocity command ignored.')
@@ -178,11 +185,27 @@ class RobotSession:
         for step in request.sensor_time_steps:
             self._time_step(step.name, step.timeStep, step_time_ms)
 
-    def _apply_positions(self, targets: dict[str, float]) -> None:
+    def _apply_checked(self, positions: Any, names: tuple[str, ...], active: bool) -> None:
+        """Position targets with unknown or repeated names (the later target wins)."""
+        motors = self._motor_names
+        targets: dict[str, float] = {}
+        for mp in positions:
+            name = mp.name
+            if name not in motors:
+                self.warn(f'Motor "{name}" not found, position command ignored.')
+                continue
+            targets[name] = mp.position
+        if len(targets) == len(names) and len(self._valid_names) < MAX_LAYOUTS:
+            self._valid_names.add(names)
+        self._positions.update(targets)
+        if active and targets:
+            self._set_many(tuple(targets), list(targets.values()))
+
+    def _set_many(self, names: tuple[str, ...], values: list[float]) -> None:
         if self._set_positions is not None:
-            self._set_positions(self.robot, list(targets), list(targets.values()))
+            self._set_positions(self.robot, names, values)
         else:
-            for name, value in targets.items():
+            for name, value in zip(names, values, strict=True):
                 self._world.set_motor_position(self.robot, name, value)
 
     def _time_step(self, name: str, period: int, now_ms: int) -> None:
@@ -197,6 +220,7 @@ class RobotSession:
         if period == 0:
             self._sensors.pop(name, None)
             self._new_sensors.discard(name)
+            self._groups = None
             return
         if period < minimum:
             self.warn(
@@ -225,6 +249,7 @@ class RobotSession:
             return
         self._sensors[name] = period
         self._enabled_at[name] = now_ms
+        self._groups = None
         log.debug("%s: %s enabled every %d ms", self.key, name, period)
 
     def update_limp(self) -> None:
@@ -237,7 +262,7 @@ class RobotSession:
             return
         world, robot = self._world, self.robot
         if self._positions:
-            self._apply_positions(self._positions)
+            self._set_many(tuple(self._positions), list(self._positions.values()))
         for name, velocity in self._velocities.items():
             world.set_motor_velocity(robot, name, velocity)
         for name, torque in self._torques.items():
@@ -260,7 +285,58 @@ class RobotSession:
         if world.is_removed(robot):
             self._sensors.clear()
             self._new_sensors.clear()
+            self._groups = None
             return Measurement(msg, b"", jobs)
+        if self._new_sensors:
+            due = self._due_slow(msg, time_ms, jobs)
+        else:
+            due = self._due(msg, time_ms, jobs)
+        if not due:
+            return Measurement(msg, b"", jobs)
+        plan = self._layouts.get(due)
+        if plan is None:
+            plan = self._layout(due)
+        names, layout = plan
+        return Measurement(msg, layout.encode(self._read(names)), jobs)
+
+    def _due(
+        self, msg: pb.SensorMeasurements, time_ms: int, jobs: list[CameraJob]
+    ) -> tuple[str, ...]:
+        """Due regular sensors (in enabling order); camera jobs added. Sensors sharing a period
+        and a start are checked as one group."""
+        if self._groups is None:
+            self._group_sensors()
+        assert self._groups is not None
+        due = [group for group in self._groups if not (time_ms - group[1]) % group[0]]
+        for name, period, start in self._camera_sensors:
+            if not (time_ms - start) % period:
+                self._camera_job(msg, name, time_ms, jobs)
+        if len(due) == 1:
+            return due[0][2]
+        if not due:
+            return ()
+        order = self._order
+        return tuple([order[i] for i in sorted(i for group in due for i in group[3])])
+
+    def _group_sensors(self) -> None:
+        groups: dict[tuple[int, int], list[int]] = {}
+        self._order = list(self._sensors)
+        self._camera_sensors = []
+        for i, (name, period) in enumerate(self._sensors.items()):
+            start = self._enabled_at[name]
+            if self._kinds[name] == CAMERA:
+                self._camera_sensors.append((name, period, start))
+            else:
+                groups.setdefault((period, start), []).append(i)
+        self._groups = [
+            (period, start, tuple(self._order[i] for i in members), members)
+            for (period, start), members in groups.items()
+        ]
+
+    def _due_slow(
+        self, msg: pb.SensorMeasurements, time_ms: int, jobs: list[CameraJob]
+    ) -> tuple[str, ...]:
+        """:meth:`_due` in a step that enabled sensors (those are not reported in it)."""
         new, kinds, enabled_at = self._new_sensors, self._kinds, self._enabled_at
         due: list[str] = []
         for name, period in self._sensors.items():
@@ -268,21 +344,20 @@ class RobotSession:
                 continue
             if kinds[name] != CAMERA:
                 due.append(name)
-            elif self._camera_size is not None:
-                width, height = self._camera_size
-                camera = msg.cameras.add(name=name, width=width, height=height, quality=-1)
-                jobs.append(CameraJob(robot, name, width, height, time_ms, camera))
+            else:
+                self._camera_job(msg, name, time_ms, jobs)
         new.clear()
-        if not due:
-            return Measurement(msg, b"", jobs)
-        key = tuple(due)
-        plan = self._layouts.get(key)
-        if plan is None:
-            plan = self._layout(due)
-        names, layout = plan
-        return Measurement(msg, layout.encode(self._read(names)), jobs)
+        return tuple(due)
 
-    def _layout(self, due: list[str]) -> tuple[tuple[str, ...], SensorLayout]:
+    def _camera_job(
+        self, msg: pb.SensorMeasurements, name: str, time_ms: int, jobs: list[CameraJob]
+    ) -> None:
+        if self._camera_size is not None:
+            width, height = self._camera_size
+            camera = msg.cameras.add(name=name, width=width, height=height, quality=-1)
+            jobs.append(CameraJob(self.robot, name, width, height, time_ms, camera))
+
+    def _layout(self, due: tuple[str, ...]) -> tuple[tuple[str, ...], SensorLayout]:
         """Due sensors in field-number order (the order of the message) and their layout."""
         if len(self._layouts) >= MAX_LAYOUTS:
             self._layouts.clear()
@@ -293,7 +368,7 @@ class RobotSession:
             field, width = _FIELDS[kinds[name]]
             entries.append((field, name, width))
         layout = SensorLayout(entries)
-        plan = self._layouts[tuple(due)] = (names, layout)
+        plan = self._layouts[due] = (names, layout)
         return plan
 
     def _read(self, names: tuple[str, ...]) -> Any:

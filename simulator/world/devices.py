@@ -11,7 +11,7 @@ sensors as one array, index arrays cached per name list: what the robot API read
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import mujoco
 import numpy as np
@@ -28,6 +28,13 @@ if TYPE_CHECKING:
 MAX_PLANS = 256
 
 
+def _slice_or_array(indices: list[int]) -> slice | npt.NDArray[np.int64]:
+    """A slice for consecutive ascending indices (much faster to index with), else an array."""
+    if indices and indices == list(range(indices[0], indices[0] + len(indices))):
+        return slice(indices[0], indices[0] + len(indices))
+    return np.array(indices, dtype=np.int64)
+
+
 class DeviceAccess:
     """Device methods of :class:`simulator.world.World` (mixed in)."""
 
@@ -36,7 +43,7 @@ class DeviceAccess:
     data: mujoco.MjData
     limp: list[bool]
     removed: list[bool]
-    _device_plans: dict[tuple[str, RobotId, tuple[str, ...]], tuple[npt.NDArray[np.int64], ...]]
+    _device_plans: dict[tuple[str, RobotId, tuple[str, ...]], tuple[Any, ...]]
 
     def _robot(self, robot: RobotId) -> RobotIndex:
         try:
@@ -81,13 +88,11 @@ class DeviceAccess:
         if plan is None:
             last = {name: i for i, name in enumerate(names)}  # the last value of a repeated name
             chosen = [self._actuator(robot, name) for name in last]
-            plan = (np.array(chosen, dtype=np.int64), np.array(list(last.values())))
-            plans[key] = plan
+            plan = plans[key] = (_slice_or_array(chosen), list(last.values()))
         actuators, picks = plan
-        values = np.asarray(rads, dtype=np.float64)
-        if len(picks) != len(values):
-            values = values[picks]
-        self.motors.set_positions(actuators, values)
+        if len(picks) != len(rads):
+            rads = [rads[i] for i in picks]
+        self.motors.set_positions(actuators, rads)
 
     def set_motor_velocity(self, robot: RobotId, name: str, rad_s: float) -> None:
         """Maximum velocity of the position controller (clamped to the motor's maximum)."""
@@ -161,7 +166,7 @@ class DeviceAccess:
 
     def _plans(
         self,
-    ) -> dict[tuple[str, RobotId, tuple[str, ...]], tuple[npt.NDArray[np.int64], ...]]:
+    ) -> dict[tuple[str, RobotId, tuple[str, ...]], tuple[Any, ...]]:
         """Index arrays per (operation, robot, names), built on first use."""
         try:
             plans = self._device_plans

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import logging
 import math
+from collections.abc import Sequence
 
 import mujoco
 import numpy as np
@@ -54,6 +55,7 @@ class MotorBank:
         self.effective = np.zeros(nu)
         self.torque = np.zeros(nu)
         self.torque_mode = np.zeros(nu, dtype=bool)
+        self._any_torque = False  # some actuator is in torque mode
         self.limp = np.zeros(nu, dtype=bool)
         self._dirty = True  # gains must be written
         self._ctrl_dirty = True  # ctrl must be written
@@ -71,18 +73,25 @@ class MotorBank:
             self.torque_mode[actuator] = False
             self._dirty = True
 
-    def set_positions(self, actuators: npt.NDArray[np.int64], rads: FloatArray) -> None:
-        """:meth:`set_position` for distinct ``actuators`` at once (non-finite values ignored)."""
-        finite = np.isfinite(rads)
-        if not finite.all():
-            logger.debug("ignored non-finite positions for actuators %s", actuators[~finite])
-            actuators, rads = actuators[finite], rads[finite]
+    def set_positions(
+        self, actuators: slice | npt.NDArray[np.int64], rads: Sequence[float] | FloatArray
+    ) -> None:
+        """:meth:`set_position` for distinct ``actuators`` (a slice or an index array) at once;
+        non-finite values are ignored."""
+        if not math.isfinite(sum(rads)):  # a NaN or infinity somewhere (or a huge sum)
+            values = np.asarray(rads, dtype=np.float64)
+            finite = np.isfinite(values)
+            chosen = np.arange(len(self.target))[actuators]
+            if not finite.all():
+                logger.debug("ignored non-finite positions for actuators %s", chosen[~finite])
+            actuators, rads = chosen[finite], values[finite]
         self.target[actuators] = np.minimum(
             np.maximum(rads, self.lower[actuators]), self.upper[actuators]
         )
         self._ramping = True
-        if self.torque_mode[actuators].any():
+        if self._any_torque and self.torque_mode[actuators].any():
             self.torque_mode[actuators] = False
+            self._any_torque = bool(self.torque_mode.any())
             self._dirty = True
 
     def set_velocity(self, actuator: int, rad_s: float) -> None:
@@ -101,6 +110,7 @@ class MotorBank:
         self._ctrl_dirty = True
         if not self.torque_mode[actuator]:
             self.torque_mode[actuator] = True
+            self._any_torque = True
             self._dirty = True
 
     def set_pid(self, actuator: int, p: float, i: float, d: float) -> None:
