@@ -132,6 +132,10 @@ class MatchRunner:
             self._fail(FailureClass.INFRASTRUCTURE, str(exc))
         except KeyboardInterrupt:
             self._fail(FailureClass.INTERRUPTED, "interrupted")
+        except Exception as exc:  # a bug: still stop and remove everything, then re-raise
+            self._fail(FailureClass.INFRASTRUCTURE, f"internal error: {exc!r}")
+            collection.finish(self)
+            raise
         results = collection.finish(self)
         return MatchOutcome(
             match_id=self.plan.match_id, failure=self.failure, out_dir=out, results=results,

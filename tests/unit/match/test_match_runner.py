@@ -180,3 +180,20 @@ def test_robot_exit_mid_game_is_recorded_and_the_game_goes_on(tmp_path: Path) ->
     robot = outcome.results["robots"]["red-1"]
     assert robot["oom_killed"] is True and robot["exit_code"] == 137
     assert outcome.results["robots"]["red-2"]["oom_killed"] is False
+
+
+def test_unexpected_error_still_tears_down_and_is_raised(tmp_path: Path) -> None:
+    import pytest
+
+    runtime = FakeRuntime()
+
+    def explode(container: Any) -> None:
+        if container.request.name == "hlvs-u1-blue-1":
+            raise ValueError("bug")
+
+    runtime.on_start = explode
+    with pytest.raises(ValueError):
+        _run(tmp_path, _plan(), runtime)
+    assert runtime.containers == {} and runtime.networks == {}
+    report = json.loads((tmp_path / "report.json").read_text())
+    assert report["failure_class"] == "infrastructure" and "bug" in report["cause"]
