@@ -103,3 +103,25 @@ def test_batch_world_gives_the_same_measurements_as_single_calls() -> None:
     assert msg.position_sensors[0].value == 0.5
     assert (len(msg.accelerometers), len(msg.gyros), len(msg.forces)) == (1, 0, 1)
     assert [m.text for m in msg.messages] == ['Motor "Tail" not found, position command ignored.']
+
+
+def test_sensors_of_several_periods_keep_their_enabling_order() -> None:
+    world = FakeDeviceWorld([RED1])
+    session = RobotSession(robot=RED1, world=world, rendering_quota_mb_s=87.5, clock_ms=lambda: 7)
+    enable = pb.ActuatorRequests()
+    for name, period in {"NeckS": 8, "HeadS": 16, "ShoulderLS": 8, "Camera": 32}.items():
+        enable.sensor_time_steps.add(name=name, timeStep=period)
+    session.apply(enable, step_time_ms=8)
+    seen = {}
+    for t in range(8, 48, 8):
+        measurement = session.measure(t)
+        msg = measurement.parsed()
+        seen[t] = ([s.name for s in msg.position_sensors], [j.time_ms for j in measurement.jobs])
+    assert seen[8] == ([], [])  # the enabling step
+    assert seen[16] == (["NeckS", "ShoulderLS"], [])
+    assert seen[24] == (["NeckS", "HeadS", "ShoulderLS"], [])
+    assert seen[40] == (["NeckS", "HeadS", "ShoulderLS"], [40])
+    session.apply(
+        pb.ActuatorRequests(sensor_time_steps=[{"name": "NeckS", "timeStep": 0}]), step_time_ms=48
+    )
+    assert [s.name for s in session.measure(48).parsed().position_sensors] == ["ShoulderLS"]
