@@ -249,7 +249,8 @@ class MatchRunner:
     def _on_simulator_exit(self, exit_code: int | None) -> None:
         log.info("match %s: simulator exited with code %s", self.plan.match_id, exit_code)
         if exit_code != 0:
-            tail = collection.simulator_stderr_tail(self)
+            reported = (collection.read_sim_result(self) or {}).get("error")
+            tail = str(reported) if reported else collection.simulator_stderr_tail(self)
             self._fail(FailureClass.SIMULATOR,
                        f"simulator exited with code {exit_code}" + (f": {tail}" if tail else ""))
             return
