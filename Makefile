@@ -41,9 +41,11 @@ $(BUILD)/system.ok: scripts/setup-system.sh
 engine:
 	@bash scripts/ensure-docker.sh
 
-# Content-tagged images: rebuilt only when their inputs change.
+# Content-tagged images: rebuilt only when their inputs change. BASE_IMAGE=python:3.11-slim uses
+# a registry's base instead of the one made locally with debootstrap.
+BASE_IMAGE ?=
 images: venv engine
-	$(HLVS) images build
+	$(HLVS) images build $(if $(BASE_IMAGE),--base $(BASE_IMAGE),)
 
 lint:
 	$(VENV)/bin/ruff check orchestrator simulator referee tests
