@@ -26,6 +26,7 @@ from orchestrator.match import (
     TeamPlan,
     cleanup,
 )
+from orchestrator.telemetry import ZenohTelemetry
 from tests.conftest import TEST_LABEL
 
 ASSETS = Path(__file__).parent / "assets"
@@ -130,6 +131,7 @@ def play(runtime: Any, test_image: str, tmp_path: Path) -> Iterator[MatchFactory
         sim: tuple[str, ...] = ("3",), limits: Limits | None = None, grace_s: float = 2.0,
         red_image: str | None = "", blue_image: str | None = "", out: Path | None = None,
         runner_hook: Callable[[MatchRunner], None] | None = None,
+        telemetry_silence_s: float | None = None,
     ) -> MatchOutcome:
         match_id = f"t{uuid.uuid4().hex[:8]}"
         match_ids.append(match_id)
@@ -141,14 +143,18 @@ def play(runtime: Any, test_image: str, tmp_path: Path) -> Iterator[MatchFactory
             blue=TeamPlan(color="blue", name="Blue", robots=tuple(blue_plan)),
             spec_builder=spec_builder(match_id, red_plan, blue_plan),
             limits=limits or Limits(cpus=1.0, memory_gb=0.5, log_folder_gb=0.05),
-            grace_period_s=grace_s, telemetry=False,
+            grace_period_s=grace_s, telemetry=telemetry_silence_s is not None,
+            telemetry_silence_s=telemetry_silence_s or 30.0,
         )
         options = RunOptions(
             out_dir=out or tmp_path / match_id, simulator_image=test_image,
             simulator_command=("python3", "/opt/t/fakesim.py", *sim),
             extra_labels={TEST_LABEL: "1"}, poll_s=0.2,
         )
-        runner = MatchRunner(plan, runtime=runtime, host=host, options=options)
+        runner = MatchRunner(
+            plan, runtime=runtime, host=host, options=options,
+            telemetry=lambda endpoint, mid: ZenohTelemetry(endpoint=endpoint, match_id=mid),
+        )
         if runner_hook is not None:
             runner_hook(runner)
         return runner.run()

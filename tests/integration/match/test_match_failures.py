@@ -86,3 +86,13 @@ def test_stop_request_stops_everything_cleanly(play: MatchFactory, runtime: Any)
     term = (outcome.out_dir / "teams/red/1/robocup-logs/term.txt").read_text()
     assert term == "got SIGTERM\nflushed\n"
     _nothing_left(runtime, outcome.match_id)
+
+
+def test_silent_simulator_telemetry_fails_the_match(play: MatchFactory, runtime: Any) -> None:
+    outcome = play(red=[["env"]], blue=[["env"]], sim=("60",), telemetry_silence_s=4.0)
+    report = _report(outcome.out_dir)
+    assert report["failure_class"] == "simulator"
+    assert "telemetry silent" in report["cause"]
+    assert (outcome.out_dir / "simulator/stdout.log").read_text().startswith("fake simulator up")
+    assert (outcome.out_dir / "teams/blue/1/stdout.log").is_file()
+    _nothing_left(runtime, outcome.match_id)
