@@ -117,6 +117,7 @@ class MatchRunner:
     def run(self) -> MatchOutcome:
         out = self.options.out_dir
         out.mkdir(parents=True, exist_ok=True)
+        (out / "report.json").unlink(missing_ok=True)  # a stale one would say "complete"
         try:
             self._advance(MatchState.PULLING)
             self._resolve_images()
