@@ -197,3 +197,24 @@ def test_unexpected_error_still_tears_down_and_is_raised(tmp_path: Path) -> None
     assert runtime.containers == {} and runtime.networks == {}
     report = json.loads((tmp_path / "report.json").read_text())
     assert report["failure_class"] == "infrastructure" and "bug" in report["cause"]
+
+
+def test_team_whose_robots_cannot_start_is_a_team_startup_failure(tmp_path: Path) -> None:
+    from orchestrator.errors import InfrastructureError
+
+    runtime = FakeRuntime()
+
+    def refuse_red(container: Any) -> None:
+        if container.request.name.startswith("hlvs-u1-red-") and "-net" not in \
+                container.request.name:
+            raise InfrastructureError("exec: start: executable file not found in $PATH")
+
+    runtime.on_start = refuse_red
+    runner, outcome = _run(tmp_path, _plan(), runtime)
+    assert outcome.failure is not None
+    assert outcome.failure.failure_class is FailureClass.TEAM_STARTUP
+    assert "red" in outcome.failure.cause and "executable file not found" in outcome.failure.cause
+    assert MatchState.PLAYING not in runner.lifecycle.history
+    assert outcome.results["robots"]["red-1"]["startup_error"]
+    assert outcome.results["robots"]["blue-1"]["startup_error"] is None
+    assert runtime.containers == {} and runtime.networks == {}
