@@ -2,7 +2,10 @@
 
 :class:`DeviceWorld` is the subset of ``simulator.world.World`` used by the server (names and
 semantics as HLVS: motors by name, position sensors ``<motor>S``, IMU, foot force sensors and a
-head camera). :class:`FakeDeviceWorld` implements it without MuJoCo for unit tests.
+head camera). :class:`FakeDeviceWorld` implements it without MuJoCo for unit tests. A world may
+also offer the batch forms ``set_motor_positions(robot, names, rads)`` and
+``read_sensors(robot, names) -> flat values`` (``simulator.world.World`` does); sessions use them
+when present, with the same results as the one-by-one calls.
 """
 
 from __future__ import annotations

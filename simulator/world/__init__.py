@@ -8,8 +8,9 @@ Public surface::
     world.step(); world.snapshot() -> WorldSnapshot; world.apply(WorldCommand)
     world.sim_time_ms, world.robot_ids, world.model, world.data, world.field
     world.devices(robot) -> dict[str, DeviceKind]; set_motor_position / velocity / torque / pid;
-    read_position, read_positions, read_position_array, read_accelerometer, read_gyro,
-    read_force, camera_info, is_limp, is_removed, motor_names
+    set_motor_positions(robot, names, rads) (batch); read_sensors(robot, names) -> ndarray
+    (batch, flat); read_position, read_positions, read_position_array, read_accelerometer,
+    read_gyro, read_force, camera_info, is_limp, is_removed, motor_names
     CameraRenderer(world, width, height).render(robot) -> bytes (B,G,R rows top to bottom)
     known_models() -> tuple[str, ...]; robot_model(name) -> RobotModel
 """
