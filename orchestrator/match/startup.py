@@ -98,11 +98,11 @@ def start(runner: MatchRunner, started_at: float) -> None:
         command=runner.options.simulator_command,
     )
     _start_simulator(runner, request)  # first: it boots while the robots start
-    if endpoint is not None and runner.telemetry_factory is not None:
-        runner.telemetry = runner.telemetry_factory(endpoint, plan.match_id)
     robots = [r for r in plan.robots if runner.records[r.key].image_error is None]
     with ThreadPoolExecutor(max_workers=max(1, min(8, len(robots)))) as pool:
         list(pool.map(lambda robot: _start_robot(runner, robot), robots))
+    if endpoint is not None and runner.telemetry_factory is not None:
+        runner.telemetry = runner.telemetry_factory(endpoint, plan.match_id)
     for team in plan.teams:
         tried = [r for r in team.robots if runner.records[r.key].image_error is None]
         failed = [r for r in tried if runner.records[r.key].startup_error is not None]
