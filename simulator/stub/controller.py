@@ -30,6 +30,7 @@ BALL_MEMORY_MS = 4000
 SCAN = [(-0.9, 0.45), (-0.45, 0.5), (0.0, 0.55), (0.45, 0.5), (0.9, 0.45), (0.45, 0.95),
         (0.0, 1.0), (-0.45, 0.95)]  # fmt: skip
 SCAN_DWELL_S = 0.35
+KICK_SETTLE_S = 0.5  # stand still this long before a kick
 SETTLE_S = 1.0  # stand still this long after start and after getting up
 FIELD_HALF_LENGTH_M = {"kid": 4.5, "adult": 7.0}
 BALL_RADIUS_M = {"kid": 0.07, "adult": 0.1125}
@@ -78,6 +79,7 @@ class StubController:
         )
         self._last_ms: int | None = None
         self._settle_until_ms: int | None = None
+        self._still_s = 0.0
         self._tilted_s = 0.0
         self._motion: KeyframeMotion | None = None
         self._motion_kind = ""
@@ -143,8 +145,10 @@ class StubController:
         if sensors.time_ms < self._settle_until_ms:
             action = Action(search=action.search)  # settle into the stance first
         self.last_action = action
+        self._still_s = 0.0 if self.walk.walking else self._still_s + dt
         if action.kick_foot is not None:
-            if self.walk.walking:
+            swaying = sensors.gyro is not None and math.hypot(*sensors.gyro[:2]) > 0.3
+            if self.walk.walking or self._still_s < KICK_SETTLE_S or swaying:
                 targets = self.walk.step(dt, 0.0, 0.0, 0.0, accel=sensors.accel, gyro=sensors.gyro)
             else:
                 self.stats.kicks += 1
