@@ -300,7 +300,7 @@ def _camera(text: str) -> tuple[int, int, int] | None:
 def main(argv: list[str]) -> int:
     args = _parser().parse_args(argv)
     os.environ.setdefault("MUJOCO_GL", "osmesa")
-    os.environ.setdefault("LP_NUM_THREADS", "1")  # rendering on one core, physics on another
+    os.environ.setdefault("LP_NUM_THREADS", "0")  # as the simulator process: see runtime.py
     camera = _camera(args.camera)
     robots = _robots(args.robots)
     world_rtf, world_cpu = _world_only(robots, args.physics_dt, min(args.sim_seconds, 10.0))
@@ -330,6 +330,8 @@ def main(argv: list[str]) -> int:
             "real_time_factor": stalled["real_time_factor"],
             "real_time_factor_without": api["real_time_factor"],
             "ratio": round(stalled["real_time_factor"] / api["real_time_factor"], 3),
+            # step-thread CPU per simulated second without / with the stalled client
+            "cpu_ratio": round(api["cpu_s_per_sim_s"] / stalled["cpu_s_per_sim_s"], 3),
             "dropped_out": stalled["dropped_out"],
         }
     print(json.dumps(result, sort_keys=True), flush=True)

@@ -1,0 +1,43 @@
+"""``python -m simulator bench api`` end to end, small: real clients, one JSON line."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+
+def _bench(*args: str) -> dict[str, object]:
+    proc = subprocess.run(
+        [sys.executable, "-m", "simulator", "bench", "api", "--robots", "2", *args, "--json"],
+        capture_output=True,
+        text=True,
+        timeout=180,
+    )
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    result: dict[str, object] = json.loads(proc.stdout.strip().splitlines()[-1])
+    return result
+
+
+def test_bench_api_lockstep_reports_every_figure() -> None:
+    result = _bench("--mode", "lockstep", "--sim-seconds", "0.5")
+    assert result["bench"] == "api" and result["mode"] == "lockstep"
+    assert result["slow_periods"] == 0  # both clients answered every measurement
+    for key in ("real_time_factor", "world_only_real_time_factor", "ratio", "cpu_ratio"):
+        value = result[key]
+        assert isinstance(value, float) and value > 0, key
+    assert result["round_trip_p50_ms"] is not None
+
+
+@pytest.mark.slow
+def test_bench_api_camera_and_stalled_client() -> None:
+    result = _bench(
+        "--mode", "async", "--camera", "320x240@32", "--sim-seconds", "0.25", "--stalled-client"
+    )
+    assert result["camera_robots"] == 2
+    assert isinstance(result["camera_frames"], int) and result["camera_frames"] >= 8
+    stalled = result["stalled_client"]
+    assert isinstance(stalled, dict) and stalled["real_time_factor"] > 0
+    assert stalled["cpu_ratio"] > 0
