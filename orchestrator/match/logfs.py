@@ -9,6 +9,7 @@ a plain folder without a cap is used and the result says so.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
 import re
@@ -91,6 +92,8 @@ def release(folder: LogFolder) -> None:
         _run("umount", str(folder.path))
     folder.image.unlink(missing_ok=True)
     shutil.rmtree(folder.path, ignore_errors=True)
+    with contextlib.suppress(OSError):  # the match's folder, once its last robot is released
+        folder.path.parent.rmdir()
 
 
 def _mounts() -> list[str]:
