@@ -111,23 +111,30 @@ def _client(port: int, camera_period: int, stalled: bool) -> None:
         for i, motor in enumerate(MOTORS):
             request.motor_positions.add(name=motor, position=0.05 * math.sin(k * 0.008 + i))
         cycle.append(_frame(request))
-    buffer = bytearray()
-    answered = 0
+    buffer = bytearray(1 << 20)  # received bytes land in place: no allocation per receive
+    view = memoryview(buffer)
+    filled = answered = 0
     try:
         while True:
-            data = sock.recv(1 << 20)
-            if not data:
+            if filled == len(buffer):  # a frame larger than the buffer
+                view.release()
+                buffer.extend(bytes(len(buffer)))
+                view = memoryview(buffer)
+            received = sock.recv_into(view[filled:])
+            if not received:
                 break
-            buffer += data
+            filled += received
             start = 0
-            while len(buffer) - start >= 4:
+            while filled - start >= 4:
                 end = start + 4 + int.from_bytes(buffer[start : start + 4], "big")
-                if end > len(buffer):
+                if end > filled:
                     break
                 start = end
                 sock.sendall(cycle[answered % CYCLE_STEPS])
                 answered += 1
-            del buffer[:start]
+            if start:
+                buffer[: filled - start] = buffer[start:filled]
+                filled -= start
     except OSError:
         pass
     os._exit(0)
