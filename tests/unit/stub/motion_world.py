@@ -37,12 +37,14 @@ class OneRobot:
             self.command(posture)
             self.world.step()
 
-    def run(self, seconds: float, targets: Callable[[], dict[str, float]]) -> bool:
-        """Steps ``seconds``; False as soon as the robot falls."""
+    def run(
+        self, seconds: float, targets: Callable[[], dict[str, float]], *, stop_on_fall: bool = True
+    ) -> bool:
+        """Steps ``seconds``; False as soon as the robot falls (unless ``stop_on_fall`` is off)."""
         for _ in range(int(seconds / 0.008)):
             self.command(targets())
             self.world.step()
-            if self.up < 0.5:
+            if stop_on_fall and self.up < 0.5:
                 return False
         return True
 
@@ -77,3 +79,24 @@ class OneRobot:
     def sole(self, side: str) -> np.ndarray:
         geom = self.world.model.geom(f"red_1/foot:sole_{side}").id
         return self.world.data.geom_xpos[geom].copy()
+
+    def lay_down(self, side: str, *, settle_s: float = 1.2) -> None:
+        """Put the robot on its front or back (torso 0.15 m up, falling flat), joints standing."""
+        import mujoco
+
+        adr = self.world.model.joint("red_1/root").qposadr[0]
+        angle = math.pi / 2 if side == "front" else -math.pi / 2
+        yaw = self.yaw
+        qz = np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)])
+        qy = np.array([math.cos(angle / 2), 0.0, math.sin(angle / 2), 0.0])
+        quat = np.zeros(4)
+        mujoco.mju_mulQuat(quat, qz, qy)
+        self.world.data.qpos[adr + 2] = 0.15
+        self.world.data.qpos[adr + 3 : adr + 7] = quat
+        self.world.data.qvel[:] = 0.0
+        mujoco.mj_forward(self.world.model, self.world.data)
+        self.stand(settle_s)
+
+    @property
+    def joints(self) -> dict[str, float]:
+        return {name[:-1]: value for name, value in self.world.read_positions(RED1).items()}

@@ -1,0 +1,26 @@
+"""Getting up on the real MuJoCo robot after lying on the front."""
+
+from __future__ import annotations
+
+import pytest
+
+from simulator.motion import GetUpMotion, standing_posture
+
+from .motion_world import OneRobot
+
+
+@pytest.mark.parametrize("yaw", [0.0, 2.0])
+def test_gets_up_from_the_front(yaw: float) -> None:
+    robot = OneRobot(yaw_rad=yaw)
+    robot.lay_down("front")
+    assert robot.up < 0.5  # really lying
+    motion = GetUpMotion("front", start=robot.joints)
+    robot.run(motion.duration_s, lambda: motion.step(0.008), stop_on_fall=False)
+    robot.run(2.0, standing_posture, stop_on_fall=False)
+    assert robot.up > 0.9
+    assert robot.position[2] > 0.3  # pelvis at standing height
+
+
+def test_get_up_rejects_an_unknown_side() -> None:
+    with pytest.raises(ValueError, match="side"):
+        GetUpMotion("left")
