@@ -25,7 +25,7 @@ logger = logging.getLogger(__name__)
 
 Vec3 = tuple[float, float, float]
 FALL_TILT_RAD = 0.9
-FALL_CONFIRM_S = 0.25
+FALL_CONFIRM_S = 0.6
 BALL_MEMORY_MS = 4000
 SCAN = [(-0.9, 0.45), (-0.45, 0.5), (0.0, 0.55), (0.45, 0.5), (0.9, 0.45), (0.45, 0.95),
         (0.0, 1.0), (-0.45, 0.95)]  # fmt: skip

@@ -24,3 +24,28 @@ def test_gets_up_from_the_front(yaw: float) -> None:
 def test_get_up_rejects_an_unknown_side() -> None:
     with pytest.raises(ValueError, match="side"):
         GetUpMotion("left")
+
+
+def test_stub_controller_detects_the_fall_and_gets_up() -> None:
+    from simulator.stub import GameInfo, Phase, Pose2D, Role, Sensors, StubController
+
+    from .motion_world import RED1
+
+    robot = OneRobot()
+    robot.lay_down("front")
+    controller = StubController(role=Role.IDLE, start_pose=Pose2D(0.0, 0.0, 0.0))
+    game = GameInfo(phase=Phase.PLAYING)
+
+    def tick() -> dict[str, float]:
+        sensors = Sensors(
+            time_ms=robot.world.sim_time_ms,
+            joints=robot.joints,
+            accel=robot.world.read_accelerometer(RED1),
+            gyro=robot.world.read_gyro(RED1),
+        )
+        return controller.tick(sensors, game)
+
+    robot.run(8.0, tick, stop_on_fall=False)
+    assert controller.stats.falls >= 1
+    assert controller.stats.get_ups >= 1
+    assert robot.up > 0.9
