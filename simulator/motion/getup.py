@@ -1,10 +1,9 @@
 """Getting up after a fall, from lying on the front or on the back (joint-space keyframes).
 
-Front: push up on the hands (elbows bent, then straightened), pull the knees under the hips
-(on all fours), sit back onto the feet with the hands pushing the torso back, raise the torso
-into a deep squat, stand. Back: lift the legs and swing the arms to roll onto the front, then
-the front sequence. Angles are written for kid-default's motor signs
-(simulator/world/robots/geometry.py) and apply to every model of that shape.
+Front: push up on the hands, throw the legs under the body and the arms up into a deep squat,
+stand. Back: swing the legs and arms across to roll onto the front and lie flat; the caller
+(the stub controller) then sees a robot lying on its front and runs the front get-up. Angles
+are written for kid-default's motor signs (simulator/world/robots/geometry.py).
 """
 
 from __future__ import annotations
@@ -32,19 +31,49 @@ FRONT: tuple[Frame, ...] = (
     (0.52, {"Shoulder": 0.1, "ArmLower": -0.07, "ArmUpper": 0.34, "LegUpper": 1.45,
             "LegLower": 2.5, "Ankle": 1.15}),
 )  # fmt: skip
-BACK_TO_FRONT: tuple[Frame, ...] = (
-    (0.5, {"Shoulder": 0.0, "ArmLower": 0.0, "ArmUpper": 0.2, "LegUpper": 0.0, "LegLower": 0.0,
-           "Ankle": 0.0, "Pelv": 0.0, "PelvY": 0.0, "Foot": 0.0}),
-    (0.6, {"Shoulder": -1.5, "LegUpper": 1.5}),
-    (0.6, {"Shoulder": -2.5, "LegUpper": 2.1, "LegLower": 1.0}),
+BACK_TO_FRONT: tuple[Frame, ...] = (  # roll over onto the front (sides differ)
+    (
+        1.35,
+        {"ShoulderL": 1.38, "ShoulderR": 1.82, "ArmUpperL": -0.15, "ArmUpperR": 1.15,
+        "ArmLowerL": -0.04, "ArmLowerR": 0.0, "LegUpperL": 1.5, "LegUpperR": 2.39, "LegLowerL":
+        0.31, "LegLowerR": 0.93, "PelvL": -1.03, "PelvR": 0.25, "PelvYL": 0.0, "PelvYR": 0.82},
+    ),
+    (
+        0.2,
+        {"ShoulderL": 1.5, "ShoulderR": 1.58, "ArmUpperL": -0.3, "ArmUpperR": -2.5, "ArmLowerL":
+        1.1, "ArmLowerR": 0.0, "LegUpperL": 2.22, "LegUpperR": 1.5, "LegLowerL": 1.24,
+        "LegLowerR": 0.12, "PelvL": -0.55, "PelvR": -0.34, "PelvYL": 1.02, "PelvYR": 0.09},
+    ),
+    (
+        1.21,
+        {"ShoulderL": 0.84, "ShoulderR": 0.94, "ArmUpperL": 0.85, "ArmUpperR": -2.98,
+        "ArmLowerL": -0.53, "ArmLowerR": 0.0, "LegUpperL": 0.5, "LegUpperR": 0.5, "LegLowerL":
+        0.3, "LegLowerR": 0.15, "PelvL": 0.54, "PelvR": -1.82, "PelvYL": 0.93, "PelvYR": -0.5},
+    ),
+    (
+        0.36,
+        {"ShoulderL": 1.53, "ShoulderR": -0.39, "ArmUpperL": 0.56, "ArmUpperR": 1.28,
+        "ArmLowerL": 0.45, "ArmLowerR": 0.0, "LegUpperL": -1.26, "LegUpperR": -1.13,
+        "LegLowerL": -1.23, "LegLowerR": -0.13, "PelvL": 0.0, "PelvR": 0.0, "PelvYL": -0.17,
+        "PelvYR": 0.36},
+    ),
+)  # fmt: skip
+LIE_FLAT: Frame = (
+    0.6,
+    {"Shoulder": 0.0, "ArmLower": 0.0, "ArmUpper": 0.2, "LegUpper": 0.0, "LegLower": 0.0,
+     "Ankle": 0.0, "Pelv": 0.0, "PelvY": 0.0, "Foot": 0.0},
 )  # fmt: skip
 STAND_S = 1.0
 MIRRORED = ("ArmUpper", "Pelv", "PelvY", "Foot")  # roll/yaw joints: opposite sign on the right
 
 
 def _both_sides(joints: dict[str, float]) -> dict[str, float]:
+    """Expand joint names without a side to both sides; full motor names stay as they are."""
     out: dict[str, float] = {}
     for name, value in joints.items():
+        if name.endswith(("L", "R")) and name not in ("ArmUpper",):
+            out[name] = value
+            continue
         out[name + "L"] = value
         out[name + "R"] = -value if name in MIRRORED else value
     return out
@@ -61,13 +90,14 @@ class GetUpMotion(KeyframeMotion):
         self.side = side
         kin = kinematics(model)
         stand = standing_posture(model)
-        script = FRONT if side == "front" else BACK_TO_FRONT + FRONT
         frames: list[Keyframe] = []
         current = dict(stand)
         current.update(kin.head_targets(0.0, 0.0))
+        script = FRONT if side == "front" else (*BACK_TO_FRONT, LIE_FLAT)
         for duration, joints in script:
             current = dict(current)
             current.update(_both_sides(joints))
             frames.append(Keyframe(duration_s=duration, targets=current))
-        frames.append(Keyframe(duration_s=STAND_S, targets=stand))
+        if side == "front":
+            frames.append(Keyframe(duration_s=STAND_S, targets=stand))
         super().__init__(frames, start=start or stand)

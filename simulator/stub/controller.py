@@ -80,6 +80,7 @@ class StubController:
         self._last_ms: int | None = None
         self._settle_until_ms: int | None = None
         self._still_s = 0.0
+        self._upright_since_fall = True
         self._tilted_s = 0.0
         self._motion: KeyframeMotion | None = None
         self._motion_kind = ""
@@ -105,6 +106,8 @@ class StubController:
             self.attitude.update(dt, sensors.accel, sensors.gyro)
         att = self.attitude.attitude
         upright = att.tilt_rad < 0.5
+        if upright and self._motion is None:
+            self._upright_since_fall = True
         self.world.integrate(
             dt,
             self.walk.velocity if upright else (0.0, 0.0, 0.0),
@@ -119,7 +122,9 @@ class StubController:
             return self._remember(targets)
         if self._fallen(dt, att.tilt_rad):
             side = "front" if att.pitch_rad > 0 else "back"
-            self.stats.falls += 1
+            if self._upright_since_fall:
+                self.stats.falls += 1  # later attempts while still down are not new falls
+            self._upright_since_fall = False
             logger.info("fallen on the %s; getting up", side)
             self._start(GetUpMotion(side, model=self.model, start=sensors.joints), "get-up")
             return self._remember(self._motion.step(dt) if self._motion else {})

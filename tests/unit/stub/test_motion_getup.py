@@ -26,13 +26,14 @@ def test_get_up_rejects_an_unknown_side() -> None:
         GetUpMotion("left")
 
 
-def test_stub_controller_detects_the_fall_and_gets_up() -> None:
+@pytest.mark.parametrize("side", ["front", "back"])
+def test_stub_controller_detects_the_fall_and_gets_up(side: str) -> None:
     from simulator.stub import GameInfo, Phase, Pose2D, Role, Sensors, StubController
 
     from .motion_world import RED1
 
     robot = OneRobot()
-    robot.lay_down("front")
+    robot.lay_down(side)
     controller = StubController(role=Role.IDLE, start_pose=Pose2D(0.0, 0.0, 0.0))
     game = GameInfo(phase=Phase.PLAYING)
 
@@ -45,7 +46,39 @@ def test_stub_controller_detects_the_fall_and_gets_up() -> None:
         )
         return controller.tick(sensors, game)
 
-    robot.run(8.0, tick, stop_on_fall=False)
-    assert controller.stats.falls >= 1
+    robot.run(12.0, tick, stop_on_fall=False)
+    assert controller.stats.falls == 1
     assert controller.stats.get_ups >= 1
     assert robot.up > 0.9
+
+
+@pytest.mark.parametrize("direction_rad", [0.3, 2.2, -2.5])
+def test_pushed_over_robot_gets_back_up(direction_rad: float) -> None:
+    import math
+
+    from simulator.stub import GameInfo, Phase, Pose2D, Role, Sensors, StubController
+
+    from .motion_world import RED1
+
+    robot = OneRobot(yaw_rad=1.0)
+    controller = StubController(role=Role.IDLE, start_pose=Pose2D(0.0, 0.0, 1.0))
+    game = GameInfo(phase=Phase.PLAYING)
+    push = robot.world.data.xfrc_applied[robot.torso]
+    lowest = 1.0
+    for step in range(int(20.0 / 0.008)):
+        t = step * 0.008
+        push[:3] = (
+            (60 * math.cos(direction_rad), 60 * math.sin(direction_rad), 0) if 2 <= t < 2.15 else 0
+        )
+        sensors = Sensors(
+            time_ms=robot.world.sim_time_ms,
+            joints=robot.joints,
+            accel=robot.world.read_accelerometer(RED1),
+            gyro=robot.world.read_gyro(RED1),
+        )
+        robot.command(controller.tick(sensors, game))
+        robot.world.step()
+        lowest = min(lowest, robot.up)
+    assert lowest < 0.3  # the push did knock it over
+    assert controller.stats.falls == 1
+    assert robot.up > 0.9 and not controller.busy
