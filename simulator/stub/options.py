@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
 
+from simulator.motion import known_models
 from simulator.stub.errors import StubConfigError
 
 
@@ -35,6 +36,8 @@ class StubOptions:
     start_pose: tuple[float, float, float] | None = None  # own-half frame x, y, yaw
     gc_data_port: int = 3838
     gc_return_port: int = 3939
+    mirror_port: int = 3737
+    model: str = "kid-default"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -60,6 +63,8 @@ def parse_args(argv: list[str]) -> StubOptions:
     parser.add_argument("--start-pose", nargs=3, type=float, metavar=("X", "Y", "YAW"))
     parser.add_argument("--gc-data-port", type=int, default=3838)
     parser.add_argument("--gc-return-port", type=int, default=3939)
+    parser.add_argument("--mirror-port", type=int, default=3737)
+    parser.add_argument("--model", default="kid-default")
     try:
         ns, unknown = parser.parse_known_args(argv)
     except (argparse.ArgumentError, SystemExit) as exc:
@@ -67,6 +72,8 @@ def parse_args(argv: list[str]) -> StubOptions:
     if unknown:
         raise StubConfigError(field="argv", value=" ".join(unknown), expected=_usage())
     behaviour = Behaviour(ns.behaviour)
+    if ns.model not in known_models():
+        raise StubConfigError(field="--model", value=ns.model, expected=" or ".join(known_models()))
     if behaviour is Behaviour.CRASH_AFTER:
         if ns.seconds is None or ns.seconds < 0:
             raise StubConfigError(
@@ -84,6 +91,8 @@ def parse_args(argv: list[str]) -> StubOptions:
         start_pose=pose,
         gc_data_port=ns.gc_data_port,
         gc_return_port=ns.gc_return_port,
+        mirror_port=ns.mirror_port,
+        model=ns.model,
     )
 
 

@@ -57,7 +57,12 @@ class StubRobot:
         self.start_pose = (
             Pose2D(*options.start_pose) if options.start_pose else default_start_pose(env.robot_id)
         )
-        self.controller = StubController(role=role, start_pose=self.start_pose)
+        self.controller = StubController(
+            role=role,
+            start_pose=self.start_pose,
+            model=options.model,
+            field_class="adult" if options.model.startswith("adult") else "kid",
+        )
         self.gc = GameControllerLink(
             team_color=env.team_color,
             player=env.robot_id,
@@ -65,7 +70,7 @@ class StubRobot:
             data_port=gc_data_port,
             return_port=gc_return_port,
         )
-        self._motors = kinematics("kid-default").motor_names
+        self._motors = kinematics(options.model).motor_names
         self._threads: list[threading.Thread] = []
         self._started = time.monotonic()
         self._crashed = False
@@ -113,7 +118,7 @@ class StubRobot:
                 "fill-logs", lambda: fill_logs(self.env.log_dir, cap_bytes=cap, stop=self.stop)
             )
         if behaviour is Behaviour.FLOOD and self.env.mirror_ip:
-            flooder = MirrorFlooder(self.env.mirror_ip)
+            flooder = MirrorFlooder(self.env.mirror_ip, port=self.options.mirror_port)
             self._spawn("flood-mirror", lambda: flooder.run(self.stop))
 
     def _spawn(self, name: str, target: Callable[[], object]) -> None:
