@@ -109,3 +109,31 @@ def test_bad_environment_exits_2_with_the_variable(tmp_path: Path) -> None:
     assert result.returncode == 2
     assert "ROBOCUP_TEAM_COLOR" in result.stderr
     assert "Traceback" not in result.stderr
+
+
+@pytest.mark.root
+def test_fill_logs_fills_a_small_disk_and_keeps_running(tmp_path: Path) -> None:
+    disk = tmp_path / "logs"
+    disk.mkdir()
+    mounted = subprocess.run(
+        ["mount", "-t", "tmpfs", "-o", "size=4m", "tmpfs", str(disk)], capture_output=True
+    )
+    if mounted.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs: {mounted.stderr.decode().strip()}")
+    try:
+        with stub(tmp_path, "fill-logs") as proc:
+            deadline = time.monotonic() + 30
+            while time.monotonic() < deadline:
+                stats = os.statvfs(disk)
+                if stats.f_bavail * stats.f_frsize < 64 * 1024:
+                    break
+                time.sleep(0.05)
+            else:
+                raise AssertionError("the log disk never filled up")
+            time.sleep(1.0)
+            assert proc.poll() is None  # still running with a full disk
+            proc.send_signal(signal.SIGTERM)
+            assert proc.wait(timeout=15) == 0
+            assert (disk / "fill.log").stat().st_size > 3 * 1024 * 1024
+    finally:
+        subprocess.run(["umount", str(disk)], check=False)
