@@ -35,7 +35,7 @@ def write_schedule(tmp: Path, body: str) -> Path:
 
 
 COMPRESSED = """
-timing: {pull_lead_round_robin_s: 1.0, pull_lead_knockout_s: 1.5, play_after_pull_s: 0.2,
+timing: {pull_lead_round_robin_s: 3.0, pull_lead_knockout_s: 3.5, play_after_pull_s: 0.2,
          deliver_after_stream_s: 0.2, retry_s: 0.2}
 simulator_slots: 1
 """
@@ -77,7 +77,7 @@ def test_tournament_plays_each_match_once_in_its_window(tmp_path: Path) -> None:
     path = write_schedule(
         tmp_path,
         COMPRESSED
-        + "fixtures:\n  round_robin: {teams: [alpha, bravo, charlie], first_stream: '+1.5s',"
+        + "fixtures:\n  round_robin: {teams: [alpha, bravo, charlie], first_stream: '+3.5s',"
         " interval_s: 1.0, stream_length_s: 0.5}\n",
     )
     state = tmp_path / "state.sqlite"
@@ -115,7 +115,7 @@ def test_knockout_winners_advance(tmp_path: Path) -> None:
     path = write_schedule(
         tmp_path,
         COMPRESSED
-        + "fixtures:\n  knockout: {seeds: [alpha, bravo, charlie, delta], first_stream: '+2s',"
+        + "fixtures:\n  knockout: {seeds: [alpha, bravo, charlie, delta], first_stream: '+4s',"
         " interval_s: 1.0, stream_length_s: 0.3}\n",
     )
     state = tmp_path / "state.sqlite"
@@ -163,9 +163,11 @@ def test_cancel_and_status_cli(tmp_path: Path, capsys: pytest.CaptureFixture[str
 def test_sigkill_mid_tournament_then_restart_plays_every_match_once(tmp_path: Path) -> None:
     path = write_schedule(
         tmp_path,
-        COMPRESSED.replace("retry_s: 0.2", "retry_s: 0.2")
-        + "fixtures:\n  round_robin: {teams: [alpha, bravo, charlie, delta], first_stream: '+2s',"
-        " interval_s: 2.0, stream_length_s: 0.2}\n",
+        # Long windows (pull 8 s before each stream) so that a slow restart on a loaded machine
+        # still finds every match playable: the test is about exactly-once, not about misses.
+        COMPRESSED.replace("pull_lead_round_robin_s: 3.0", "pull_lead_round_robin_s: 8.0")
+        + "fixtures:\n  round_robin: {teams: [alpha, bravo, charlie, delta], first_stream: '+9s',"
+        " interval_s: 1.5, stream_length_s: 0.2}\n",
     )
     state = tmp_path / "state.sqlite"
     cmd = [
@@ -207,11 +209,8 @@ def test_sigkill_mid_tournament_then_restart_plays_every_match_once(tmp_path: Pa
     log = services_log(path)
     for row in rows:
         ends = [m for w, m, _ in log if w == "play-end" and m == row.id]
-        if row.state is MatchState.MISSED:
-            assert ends == [] and "window" in row.note
-        else:
-            assert row.state is MatchState.DELIVERED, row
-            assert len(ends) == 1, (row.id, ends)
+        assert row.state is MatchState.DELIVERED, row
+        assert len(ends) == 1, (row.id, ends)
     assert Ledger(state).row(playing).state is MatchState.DELIVERED
     history = [h for h in Ledger(state).history(playing) if "interrupted" in h[4]]
     assert history, "the interrupted match was not recorded as such"
