@@ -30,6 +30,7 @@ BALL_MEMORY_MS = 4000
 SCAN = [(-0.9, 0.45), (-0.45, 0.5), (0.0, 0.55), (0.45, 0.5), (0.9, 0.45), (0.45, 0.95),
         (0.0, 1.0), (-0.45, 0.95)]  # fmt: skip
 SCAN_DWELL_S = 0.35
+KNEE_RESET_RAD = 0.5  # knee this far from its target: the robot was reset or is limp
 KICK_SETTLE_S = 0.5  # stand still this long before a kick
 SETTLE_S = 1.0  # stand still this long after start and after getting up
 FIELD_HALF_LENGTH_M = {"kid": 4.5, "adult": 7.0}
@@ -97,6 +98,20 @@ class StubController:
     def reset_pose(self, pose: Pose2D) -> None:
         self.world.reset_pose(pose)
 
+    def settle(self, time_ms: int) -> None:
+        """Stand still for a moment before moving again (after a reset of the robot)."""
+        self._settle_until_ms = time_ms + int(SETTLE_S * 1000)
+        self.walk.reset()
+
+    def _moved_by_someone_else(self, joints: dict[str, float]) -> bool:
+        knees = [name for name in self.kin.motor_names if name.startswith("LegLower")]
+        return any(
+            name in joints
+            and name in self._last_targets
+            and abs(joints[name] - self._last_targets[name]) > KNEE_RESET_RAD
+            for name in knees
+        )
+
     def tick(self, sensors: Sensors, game: GameInfo) -> dict[str, float]:
         dt = 0.008 if self._last_ms is None else max(sensors.time_ms - self._last_ms, 1) / 1000.0
         if self._settle_until_ms is None:
@@ -115,6 +130,9 @@ class StubController:
         )
         if sensors.image_bgr is not None and upright and self._motion is None:
             self._look(sensors)
+        if self._motion is None and self._moved_by_someone_else(sensors.joints):
+            # teleported (half time, penalty) or limp: joints are not where we put them
+            self.settle(sensors.time_ms)
         if self._motion is not None:
             targets = self._motion.step(dt)
             if self._motion.done:

@@ -62,7 +62,7 @@ def find_ball_blobs(image_bgr: npt.NDArray[np.uint8]) -> list[BlobSighting]:
     black_c = (
         black[: rows_c * CELL, : cols_c * CELL].reshape(rows_c, CELL, cols_c, CELL).sum((1, 3))
     )
-    yy, xx = np.mgrid[0:rows, 0:cols]
+    either = white | black
     blobs: list[tuple[float, BlobSighting]] = []
     for cells in _components(black_c >= 2):
         y0 = min(c[0] for c in cells) * CELL
@@ -77,16 +77,16 @@ def find_ball_blobs(image_bgr: npt.NDArray[np.uint8]) -> list[BlobSighting]:
         cy, cx = y0 + sy.mean(), x0 + sx.mean()
         radius = math.sqrt(2.0 * area / math.pi)
         # re-centre on the ball pixels near the seed (robust to a line through the window)
-        near = (yy - cy) ** 2 + (xx - cx) ** 2 <= (1.6 * radius) ** 2
-        ball_px = (white | black) & near
+        near, (wy, wx) = _disc(either.shape, cy, cx, 1.6 * radius)
+        ball_px = either[wy, wx] & near
         if ball_px.sum() < 8:
             continue
         py, px = np.nonzero(ball_px)
-        cy, cx = float(np.median(py)), float(np.median(px))
-        disc = (yy - cy) ** 2 + (xx - cx) ** 2 <= radius**2
+        cy, cx = wy.start + float(np.median(py)), wx.start + float(np.median(px))
+        disc, (wy, wx) = _disc(either.shape, cy, cx, radius)
         n_disc = int(disc.sum())
-        n_white = int((white & disc).sum())
-        n_black = int((black & disc).sum())
+        n_white = int((white[wy, wx] & disc).sum())
+        n_black = int((black[wy, wx] & disc).sum())
         if n_disc == 0 or (n_white + n_black) < 0.6 * n_disc:
             continue
         if min(n_white, n_black) < 0.2 * n_disc:
@@ -95,6 +95,17 @@ def find_ball_blobs(image_bgr: npt.NDArray[np.uint8]) -> list[BlobSighting]:
         blobs.append((score, BlobSighting(cx * 2.0 + 1.0, cy * 2.0 + 1.0, radius * 2.0)))
     blobs.sort(key=lambda item: -item[0])
     return [blob for _, blob in blobs]
+
+
+def _disc(
+    shape: tuple[int, ...], cy: float, cx: float, radius: float
+) -> tuple[npt.NDArray[np.bool_], tuple[slice, slice]]:
+    """A disc mask in the window around (cy, cx) that it covers, and that window."""
+    y0, y1 = max(int(cy - radius), 0), min(int(cy + radius) + 2, shape[0])
+    x0, x1 = max(int(cx - radius), 0), min(int(cx + radius) + 2, shape[1])
+    yy, xx = np.mgrid[y0:y1, x0:x1]
+    mask = (yy - cy) ** 2 + (xx - cx) ** 2 <= radius**2
+    return mask, (slice(y0, y1), slice(x0, x1))
 
 
 def _components(mask: npt.NDArray[np.bool_]) -> list[list[tuple[int, int]]]:

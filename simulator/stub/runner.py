@@ -178,7 +178,7 @@ class StubRobot:
             if self._crash_due():
                 return CRASH_EXIT_CODE
             try:
-                measurement = client.receive(timeout=0.5)
+                measurement, image = _receive_latest(client)
             except ReceiveTimeout:
                 continue
             except RobotClientError as exc:
@@ -193,7 +193,7 @@ class StubRobot:
                 side = -1.0 if pose.y_m < 0 else 1.0
                 self.controller.reset_pose(Pose2D(-3.0, 3.2 * side, -side * math.pi / 2))
             was_penalised = game.penalised
-            targets = self.controller.tick(_sensors(measurement), game)
+            targets = self.controller.tick(_sensors(measurement, image), game)
             if self.options.behaviour is Behaviour.IGNORE_SIGTERM or targets:
                 try:
                     client.set_positions(targets)
@@ -203,7 +203,26 @@ class StubRobot:
         return 0
 
 
-def _sensors(measurement: pb.SensorMeasurements) -> Sensors:
+def _receive_latest(
+    client: RobotClient,
+) -> tuple[pb.SensorMeasurements, pb.CameraMeasurement | None]:
+    """The newest measurement, skipping older ones already waiting (when the simulation runs
+    ahead of this controller), and the newest camera image among them."""
+    measurement = client.receive(timeout=0.5)
+    image = measurement.cameras[-1] if measurement.cameras else None
+    while True:
+        try:
+            newer = client.receive(timeout=0.0005)
+        except ReceiveTimeout:
+            return measurement, image
+        measurement = newer
+        if newer.cameras:
+            image = newer.cameras[-1]
+
+
+def _sensors(
+    measurement: pb.SensorMeasurements, camera: pb.CameraMeasurement | None = None
+) -> Sensors:
     joints = {
         s.name[:-1] if s.name.endswith("S") else s.name: s.value
         for s in measurement.position_sensors
@@ -214,9 +233,8 @@ def _sensors(measurement: pb.SensorMeasurements) -> Sensors:
     for g in measurement.gyros:
         gyro = (g.value.X, g.value.Y, g.value.Z)
     image = None
-    for camera in measurement.cameras:
-        if len(camera.image) == camera.width * camera.height * 3:
-            image = np.frombuffer(camera.image, np.uint8).reshape(camera.height, camera.width, 3)
+    if camera is not None and len(camera.image) == camera.width * camera.height * 3:
+        image = np.frombuffer(camera.image, np.uint8).reshape(camera.height, camera.width, 3)
     return Sensors(time_ms=measurement.time, joints=joints, accel=accel, gyro=gyro, image_bgr=image)
 
 
