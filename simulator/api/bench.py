@@ -43,6 +43,9 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument(
         "--camera-robots", type=int, default=0, help="robots that enable the camera (0 = all)"
     )
+    parser.add_argument(
+        "--render-processes", type=int, default=0, help="camera render processes (0: a thread)"
+    )
     parser.add_argument("--stalled-client", action="store_true")
     parser.add_argument("--json", action="store_true", help="print only the JSON line")
     return parser
@@ -213,7 +216,7 @@ def _api_run(
         for r, p in zip(robots, ports, strict=True)
     ]
     stalled_robot = robots[-1] if stalled else None
-    cameras = world_cameras.world_render_worker(world)
+    cameras = world_cameras.world_render_worker(world, processes=args.render_processes)
     server = ApiServer(
         world=world,
         endpoints=endpoints,
@@ -329,6 +332,7 @@ def main(argv: list[str]) -> int:
         "camera_frames": api["camera_frames"],
         "camera_robots": (args.camera_robots or args.robots) if camera else 0,
         "render_ms_per_frame": api["render_ms_per_frame"],
+        "render_processes": args.render_processes,
         "slow_periods": api["slow_periods"],
     }
     if args.stalled_client:

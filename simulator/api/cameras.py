@@ -17,7 +17,7 @@ import queue
 import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 from referee.snapshot import RobotId
 from simulator.api.session import CameraJob
@@ -26,6 +26,26 @@ log = logging.getLogger(__name__)
 
 RenderFn = Callable[[Any, RobotId, int, int], bytes]
 MAX_IN_FLIGHT = 2
+
+
+class ImageSource(Protocol):
+    """What the server needs from a renderer: :class:`RenderWorker` or a render pool."""
+
+    error: BaseException | None
+    frames: int
+    render_s: float
+
+    @property
+    def wake_fd(self) -> int: ...
+
+    @property
+    def in_flight(self) -> int: ...
+
+    def submit(self, jobs: Sequence[CameraJob]) -> None: ...
+
+    def completed(self) -> list[tuple[CameraJob, bytes]]: ...
+
+    def close(self) -> None: ...
 
 
 @dataclass(slots=True)

@@ -24,7 +24,7 @@ from typing import Any
 
 from referee.snapshot import RobotId
 from simulator.api import messages_pb2 as pb
-from simulator.api.cameras import MAX_IN_FLIGHT, RenderWorker
+from simulator.api.cameras import MAX_IN_FLIGHT, ImageSource
 from simulator.api.connection import ClientClosed, Connection
 from simulator.api.devices import DeviceWorld
 from simulator.api.endpoints import PlayerEndpoint, peer_allowed_by_name
@@ -83,7 +83,7 @@ class ApiServer:
         endpoints: Sequence[PlayerEndpoint],
         network: NetworkSpec,
         lockstep: LockstepSettings | None = None,
-        cameras: RenderWorker | None = None,
+        cameras: ImageSource | None = None,
         unix_ms: Callable[[], int] = lambda: int(time.time() * 1000),
     ) -> None:
         self._world = world

@@ -12,15 +12,21 @@ from types import SimpleNamespace
 from typing import TYPE_CHECKING, Any
 
 from referee.snapshot import RobotId
-from simulator.api.cameras import RenderFn, RenderWorker
+from simulator.api.cameras import ImageSource, RenderFn, RenderWorker
 
 if TYPE_CHECKING:
     from simulator.world import World
 
 
-def world_render_worker(world: World, *, threads: int = 1) -> RenderWorker:
-    """Render threads for ``world``'s head cameras. One is the default: measured with OSMesa,
-    a second thread lowered the total frame rate (46 -> 26 frames/s at 320x240)."""
+def world_render_worker(world: World, *, threads: int = 1, processes: int = 0) -> ImageSource:
+    """Renderers for ``world``'s head cameras: ``processes`` > 0 gives a
+    :class:`~simulator.api.render_pool.RenderPool` of that many processes, else ``threads``
+    render threads in this process. One thread is the default: measured with OSMesa, a second
+    thread lowered the total frame rate (46 -> 26 frames/s at 320x240)."""
+    if processes > 0:
+        from simulator.api.render_pool import RenderPool
+
+        return RenderPool(world, processes=processes)
 
     def capture() -> Any:
         return (world.data.qpos.copy(), world.data.mocap_pos.copy(), world.data.mocap_quat.copy())

@@ -1,0 +1,216 @@
+"""Camera images rendered by worker processes (several cores, no shared interpreter lock).
+
+A drop-in for :class:`simulator.api.cameras.RenderWorker` (same ``submit`` / ``completed`` /
+``wake_fd`` / ``in_flight`` / ``close`` surface): each worker process gets a pickled copy of the
+world model at start, then per batch the joint state of the step the images are due for
+(``qpos``, ``mocap_pos``, ``mocap_quat``) and its share of the batch's jobs (round robin). It
+recomputes the kinematics and renders with :class:`simulator.world.CameraRenderer`; the images
+come back through a pipe, read by one thread per worker on the parent side. Threads in one
+process do not render in parallel (measured: two render threads were slower than one); separate
+processes do, with a core each.
+"""
+
+from __future__ import annotations
+
+import logging
+import multiprocessing as mp
+import os
+import queue
+import threading
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from multiprocessing.connection import Connection
+from typing import TYPE_CHECKING, Any
+
+from referee.snapshot import RobotId
+from simulator.api.session import CameraJob
+
+if TYPE_CHECKING:
+    from simulator.world import World
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(slots=True)
+class _Batch:
+    remaining: int
+
+
+def _serve(conn: Connection, model: Any, cameras: dict[RobotId, int]) -> None:
+    """Worker process body: render jobs until ``None`` or the parent is gone."""
+    from types import SimpleNamespace
+
+    import mujoco
+
+    from simulator.world import CameraRenderer
+
+    data = mujoco.MjData(model)
+    index = SimpleNamespace(by_id={r: SimpleNamespace(camera=c) for r, c in cameras.items()})
+    view = SimpleNamespace(model=model, data=data, index=index)
+    renderers: dict[tuple[int, int], CameraRenderer] = {}
+    while True:
+        try:
+            message = conn.recv()
+        except (EOFError, OSError):
+            return
+        if message is None:
+            return
+        qpos, mocap_pos, mocap_quat, jobs = message
+        data.qpos[:] = qpos
+        data.mocap_pos[:] = mocap_pos
+        data.mocap_quat[:] = mocap_quat
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_camlight(model, data)
+        for job_id, robot, width, height in jobs:
+            started = time.perf_counter()
+            renderer = renderers.get((width, height))
+            if renderer is None:
+                renderer = renderers[(width, height)] = CameraRenderer(
+                    view,  # type: ignore[arg-type]
+                    width,
+                    height,
+                )
+            image = renderer.render(robot)
+            conn.send((job_id, image, time.perf_counter() - started))
+
+
+class RenderPool:
+    """``processes`` rendering processes for ``world``'s head cameras."""
+
+    def __init__(self, world: World, *, processes: int = 2) -> None:
+        self._world = world
+        self._count = max(1, processes)
+        self._cameras = {r.id: r.camera for r in world.index.robots}
+        self._done: queue.Queue[tuple[CameraJob, bytes]] = queue.Queue()
+        self._read_fd, self._write_fd = os.pipe()
+        os.set_blocking(self._read_fd, False)
+        os.set_blocking(self._write_fd, False)
+        self._lock = threading.Lock()
+        self._jobs: dict[int, tuple[_Batch, CameraJob]] = {}
+        self._next_id = 0
+        self._conns: list[Connection] = []
+        self._procs: list[Any] = []
+        self._readers: list[threading.Thread] = []
+        self.error: BaseException | None = None
+        self.frames = 0
+        self.render_s = 0.0
+        self._submitted = 0
+        self._finished = 0
+        self._closing = False
+
+    @property
+    def wake_fd(self) -> int:
+        return self._read_fd
+
+    def _start(self) -> None:
+        ctx = mp.get_context("spawn")  # a clean process: no inherited threads or GL state
+        for n in range(self._count):
+            parent, child = ctx.Pipe()
+            proc = ctx.Process(
+                target=_serve,
+                args=(child, self._world.model, self._cameras),
+                name=f"camera-render-{n}",
+                daemon=True,
+            )
+            proc.start()
+            child.close()
+            reader = threading.Thread(
+                target=self._collect, args=(parent,), name=f"camera-results-{n}", daemon=True
+            )
+            reader.start()
+            self._conns.append(parent)
+            self._procs.append(proc)
+            self._readers.append(reader)
+
+    def submit(self, jobs: Sequence[CameraJob]) -> None:
+        if not self._procs:
+            self._start()
+        data = self._world.data
+        state = (data.qpos.copy(), data.mocap_pos.copy(), data.mocap_quat.copy())
+        batch = _Batch(len(jobs))
+        shares: list[list[tuple[int, RobotId, int, int]]] = [[] for _ in self._conns]
+        with self._lock:
+            self._submitted += 1
+            for i, job in enumerate(jobs):
+                job_id = self._next_id
+                self._next_id += 1
+                self._jobs[job_id] = (batch, job)
+                shares[i % len(shares)].append((job_id, job.robot, job.width, job.height))
+        for conn, share in zip(self._conns, shares, strict=True):
+            if share:
+                try:
+                    conn.send((*state, share))
+                except OSError as exc:  # the worker is gone: its jobs come back black
+                    self._fail(exc, [job_id for job_id, *_ in share])
+
+    @property
+    def in_flight(self) -> int:
+        with self._lock:
+            return self._submitted - self._finished
+
+    def completed(self) -> list[tuple[CameraJob, bytes]]:
+        try:
+            os.read(self._read_fd, 4096)
+        except BlockingIOError:
+            pass
+        done: list[tuple[CameraJob, bytes]] = []
+        while True:
+            try:
+                done.append(self._done.get_nowait())
+            except queue.Empty:
+                return done
+
+    def _collect(self, conn: Connection) -> None:
+        while True:
+            try:
+                job_id, image, seconds = conn.recv()
+            except (EOFError, OSError) as exc:
+                if not self._closing:  # a worker died: nothing may wait for it forever
+                    with self._lock:
+                        pending = list(self._jobs)
+                    self._fail(exc, pending)
+                return
+            self._deliver(job_id, image, seconds)
+
+    def _deliver(self, job_id: int, image: bytes | None, seconds: float) -> None:
+        with self._lock:
+            entry = self._jobs.pop(job_id, None)
+            if entry is None:
+                return
+            batch, job = entry
+            self.frames += 1
+            self.render_s += seconds
+            batch.remaining -= 1
+            if batch.remaining == 0:
+                self._finished += 1
+        self._done.put((job, image if image is not None else bytes(job.width * job.height * 3)))
+        try:
+            os.write(self._write_fd, b"x")
+        except BlockingIOError:
+            pass  # the pipe is full of wake-ups already
+
+    def _fail(self, exc: BaseException, job_ids: list[int]) -> None:
+        log.error("camera render process failed: %s; black images", exc or "it exited")
+        self.error = exc
+        for job_id in job_ids:
+            self._deliver(job_id, None, 0.0)
+
+    def close(self) -> None:
+        self._closing = True
+        for conn in self._conns:
+            try:
+                conn.send(None)
+            except OSError:
+                pass  # already gone
+        for proc in self._procs:
+            proc.join(timeout=5.0)
+            if proc.is_alive():
+                proc.kill()
+                proc.join(timeout=5.0)
+        for conn in self._conns:
+            conn.close()
+        for reader in self._readers:
+            reader.join(timeout=5.0)
+        os.close(self._read_fd)
+        os.close(self._write_fd)

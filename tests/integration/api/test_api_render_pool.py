@@ -1,0 +1,89 @@
+"""Camera images from render processes match the in-process renderer; a dead worker gives
+black images instead of a step loop waiting forever."""
+
+from __future__ import annotations
+
+import os
+import select
+import time
+
+import numpy as np
+import pytest
+
+from referee.snapshot import RobotId, TeamColor
+from simulator.api import messages_pb2 as pb
+from simulator.api.render_pool import RenderPool
+from simulator.api.session import CameraJob
+from simulator.world import CameraRenderer, RobotPlacement, World
+
+RED_1, BLUE_1 = RobotId(TeamColor.RED, 1), RobotId(TeamColor.BLUE, 1)
+
+
+@pytest.fixture(autouse=True)
+def _offscreen(monkeypatch: pytest.MonkeyPatch) -> None:
+    if not os.environ.get("DISPLAY"):
+        monkeypatch.setenv("MUJOCO_GL", os.environ.get("MUJOCO_GL", "osmesa"))
+        monkeypatch.setenv("PYOPENGL_PLATFORM", os.environ.get("MUJOCO_GL", "osmesa"))
+
+
+def _world() -> World:
+    placements = [
+        RobotPlacement(id=RED_1, model="kid-default", x_m=-1.0, y_m=0.0, yaw_rad=0.0),
+        RobotPlacement(id=BLUE_1, model="kid-default", x_m=1.0, y_m=0.0, yaw_rad=3.14159),
+    ]
+    world = World.create(field_class="kid", robots=placements, seed=3)
+    for _ in range(10):
+        world.step()
+    return world
+
+
+def _jobs(time_ms: int) -> list[CameraJob]:
+    return [
+        CameraJob(robot, "Camera", 320, 240, time_ms, pb.CameraMeasurement())
+        for robot in (RED_1, BLUE_1)
+    ]
+
+
+def _collect(pool: RenderPool, count: int) -> dict[RobotId, bytes]:
+    images: dict[RobotId, bytes] = {}
+    deadline = time.monotonic() + 60
+    while len(images) < count and time.monotonic() < deadline:
+        select.select([pool.wake_fd], [], [], 0.5)
+        images.update((job.robot, image) for job, image in pool.completed())
+    return images
+
+
+def test_pool_images_equal_in_process_rendering() -> None:
+    world = _world()
+    with CameraRenderer(world, 320, 240) as local:
+        expected = {robot: local.render(robot) for robot in (RED_1, BLUE_1)}
+    pool = RenderPool(world, processes=2)
+    try:
+        pool.submit(_jobs(world.sim_time_ms))
+        images = _collect(pool, 2)
+        assert pool.in_flight == 0 and pool.frames == 2 and pool.error is None
+    finally:
+        pool.close()
+    assert set(images) == {RED_1, BLUE_1}
+    for robot in (RED_1, BLUE_1):  # the same picture (kinematics recomputed from qpos)
+        got = np.frombuffer(images[robot], dtype=np.uint8).astype(int)
+        want = np.frombuffer(expected[robot], dtype=np.uint8).astype(int)
+        assert got.shape == want.shape
+        assert np.mean(got != want) < 0.002  # a few edge pixels differ
+    assert images[RED_1] != images[BLUE_1]
+
+
+def test_dead_worker_gives_black_images() -> None:
+    world = _world()
+    pool = RenderPool(world, processes=1)
+    try:
+        pool.submit(_jobs(world.sim_time_ms))
+        assert len(_collect(pool, 2)) == 2
+        pool._procs[0].kill()  # noqa: SLF001 - the failure under test
+        pool._procs[0].join(timeout=10)
+        pool.submit(_jobs(world.sim_time_ms + 8))
+        images = _collect(pool, 2)
+        assert images and all(image == bytes(320 * 240 * 3) for image in images.values())
+        assert pool.error is not None and pool.in_flight == 0
+    finally:
+        pool.close()
