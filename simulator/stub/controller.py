@@ -18,7 +18,12 @@ from simulator.motion import AttitudeFilter, GetUpMotion, KickMotion, WalkEngine
 from simulator.motion.keyframes import KeyframeMotion
 from simulator.motion.walk import default_walk_params
 from simulator.stub.behaviour import Action, Field, GameInfo, Role, decide
-from simulator.stub.perception import CameraPose, find_ball_blobs, ground_point
+from simulator.stub.perception import (
+    CameraPose,
+    find_ball_blobs,
+    ground_point,
+    white_above_horizon,
+)
 from simulator.stub.world_model import Pose2D, WorldModel
 
 logger = logging.getLogger(__name__)
@@ -30,6 +35,10 @@ BALL_MEMORY_MS = 4000
 SCAN = [(-0.9, 0.45), (-0.45, 0.5), (0.0, 0.55), (0.45, 0.5), (0.9, 0.45), (0.45, 0.95),
         (0.0, 1.0), (-0.45, 0.95)]  # fmt: skip
 SCAN_DWELL_S = 0.35
+SIDE_LOOK_S = 0.45  # per head position, when checking which side the own goal is on
+SIDE_LOOK_YAWS_RAD = (0.55, 1.3, -0.55, -1.3)  # left first, then right; 60 deg field of view
+SIDE_LOOK_PITCH_RAD = -0.15  # slightly up: goal posts stand above the horizon
+SIDE_MIN_PIXELS = 30
 KNEE_RESET_RAD = 0.5  # knee this far from its target: the robot was reset or is limp
 KICK_SETTLE_S = 0.5  # stand still this long before a kick
 SETTLE_S = 1.0  # stand still this long after start and after getting up
@@ -62,7 +71,10 @@ class StubController:
         start_pose: Pose2D,
         model: str = "kid-default",
         field_class: str = "kid",
+        detect_side: bool = False,
     ) -> None:
+        """``detect_side``: before moving, look left and right for the own goal to find out
+        whether the pitch is mirrored for this team (see :meth:`_finish_side_check`)."""
         self.role = role
         self.model = model
         self.kin = kinematics(model)
@@ -89,6 +101,10 @@ class StubController:
         self._missing_since_ms: int | None = None
         self._scan_s = 0.0
         self.last_action: Action | None = None
+        self._detect_side = detect_side
+        self._side_check_s: float | None = 0.0 if detect_side else None
+        self._side_pixels = [0, 0]  # left, right
+        self.mirrored: bool | None = None
 
     @property
     def busy(self) -> str:
@@ -97,11 +113,71 @@ class StubController:
 
     def reset_pose(self, pose: Pose2D) -> None:
         self.world.reset_pose(pose)
+        if self._detect_side:
+            self._side_check_s = 0.0
+            self._side_pixels = [0, 0]
 
     def settle(self, time_ms: int) -> None:
         """Stand still for a moment before moving again (after a reset of the robot)."""
         self._settle_until_ms = time_ms + int(SETTLE_S * 1000)
         self.walk.reset()
+
+    def _side_check(self, dt: float, sensors: Sensors) -> dict[str, float]:
+        """Stand and look left, then right; count white pixels above the horizon."""
+        assert self._side_check_s is not None
+        self._side_check_s += dt
+        slot = min(int(self._side_check_s / SIDE_LOOK_S), len(SIDE_LOOK_YAWS_RAD) - 1)
+        yaw = SIDE_LOOK_YAWS_RAD[slot]
+        looking_left = yaw > 0
+        neck = sensors.joints.get(self.kin.neck_motor)
+        if sensors.image_bgr is not None and neck is not None and abs(neck - yaw) < 0.1:
+            att = self.attitude.attitude
+            pose = CameraPose(
+                neck_yaw_rad=neck,
+                head_pitch_rad=self.kin.head_down_sign
+                * sensors.joints.get(self.kin.head_motor, 0.0),
+                torso_roll_rad=att.roll_rad,
+                torso_pitch_rad=att.pitch_rad,
+                pelvis_height_m=self._pelvis_height_m,
+            )
+            pixels = white_above_horizon(sensors.image_bgr, pose, self.kin.camera, margin_rad=0.06)
+            self._side_pixels[0 if looking_left else 1] += pixels
+        if self._side_check_s >= len(SIDE_LOOK_YAWS_RAD) * SIDE_LOOK_S:
+            self._finish_side_check()
+        targets = self.walk.step(dt, 0.0, 0.0, 0.0, accel=sensors.accel, gyro=sensors.gyro)
+        targets.update(self.kin.head_targets(yaw, SIDE_LOOK_PITCH_RAD))
+        return targets
+
+    def _finish_side_check(self) -> None:
+        """Decide whether this team's pitch is mirrored.
+
+        HLVS gives starting poses as if the team played on the left half; the team on the right
+        is placed at the mirror image (x -> -x, yaw -> pi - yaw). A mirror image cannot be
+        reached by turning, so odometry only works in a frame turned by pi, where the mirrored
+        start pose is (x, -y, -yaw). The own goal is nearer than the other: if it shows up on
+        the other side than the team-file pose predicts, the pitch is mirrored.
+        """
+        self._side_check_s = None
+        left, right = self._side_pixels
+        if max(left, right) < SIDE_MIN_PIXELS:
+            logger.info(
+                "side check: no goal in sight (%d/%d px); keeping the start pose", left, right
+            )
+            return
+        pose = self.world.pose
+        gx, gy = pose.to_relative(-self.field.half_length_m, 0.0)
+        predicted_left = math.atan2(gy, gx) > 0
+        seen_left = left > right
+        self.mirrored = predicted_left != seen_left
+        logger.info(
+            "side check: own goal on the %s (%d/%d px): %s",
+            "left" if seen_left else "right",
+            left,
+            right,
+            "mirrored pitch" if self.mirrored else "as in the team file",
+        )
+        if self.mirrored:
+            self.world.reset_pose(Pose2D(pose.x_m, -pose.y_m, -pose.yaw_rad))
 
     def _moved_by_someone_else(self, joints: dict[str, float]) -> bool:
         knees = [name for name in self.kin.motor_names if name.startswith("LegLower")]
@@ -157,6 +233,8 @@ class StubController:
             if self._missing_since_ms is None
             else (sensors.time_ms - self._missing_since_ms) / 1000.0
         )
+        if self._side_check_s is not None:
+            return self._remember(self._side_check(dt, sensors))
         action = decide(
             role=self.role,
             game=game,

@@ -187,3 +187,22 @@ def _rot_y(a: float) -> npt.NDArray[np.float64]:
 def _rot_z(a: float) -> npt.NDArray[np.float64]:
     c, s = math.cos(a), math.sin(a)
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def white_above_horizon(
+    image_bgr: npt.NDArray[np.uint8], pose: CameraPose, mount: CameraMount, *, margin_rad: float
+) -> int:
+    """White pixels clearly above the horizon (goal posts and crossbars; field lines lie below
+    it and robot heads around it), on every second pixel."""
+    height, width = image_bgr.shape[0], image_bgr.shape[1]
+    focal = (width / 2.0) / math.tan(mount.fov_rad / 2.0)
+    # the camera looks down by head pitch + torso pitch; the horizon is that far above centre
+    down = pose.head_pitch_rad + pose.torso_pitch_rad
+    horizon_row = height / 2.0 - focal * math.tan(down)
+    last_row = int(horizon_row - focal * math.tan(margin_rad))
+    if last_row <= 0:
+        return 0
+    top = image_bgr[: min(last_row, height) : 2, ::2].astype(np.int16)
+    low = top.min(axis=2)
+    high = top.max(axis=2)
+    return int(((low > 200) & (high - low < 30)).sum())

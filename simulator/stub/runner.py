@@ -62,6 +62,7 @@ class StubRobot:
             start_pose=self.start_pose,
             model=options.model,
             field_class="adult" if options.model.startswith("adult") else "kid",
+            detect_side=role is not Role.IDLE,
         )
         self.gc = GameControllerLink(
             team_color=env.team_color,

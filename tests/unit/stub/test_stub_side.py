@@ -1,0 +1,41 @@
+"""The stub finds out from its camera whether the pitch is mirrored for its team."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from simulator.stub import GameInfo, Phase, Pose2D, Role, Sensors, StubController
+from simulator.world import CameraRenderer
+
+from .motion_world import RED1, OneRobot
+
+
+@pytest.mark.parametrize(("world_x", "mirrored"), [(-2.5, False), (2.5, True), (4.0, True)])
+def test_side_check_from_the_own_goal(world_x: float, mirrored: bool) -> None:
+    team_file_pose = Pose2D(-abs(world_x), -3.1, math.pi / 2)  # as if playing on the left
+    robot = OneRobot(x_m=world_x, y_m=-3.1, yaw_rad=math.pi / 2)
+    controller = StubController(role=Role.STRIKER, start_pose=team_file_pose, detect_side=True)
+    game = GameInfo(phase=Phase.INITIAL)
+    with CameraRenderer(robot.world, 320, 240) as camera:
+        for _ in range(int(2.5 / 0.008)):
+            t = robot.world.sim_time_ms
+            image = None
+            if t % 96 == 0:
+                image = np.frombuffer(camera.render(RED1), np.uint8).reshape(240, 320, 3)
+            sensors = Sensors(
+                time_ms=t,
+                joints=robot.joints,
+                accel=robot.world.read_accelerometer(RED1),
+                gyro=robot.world.read_gyro(RED1),
+                image_bgr=image,
+            )
+            robot.command(controller.tick(sensors, game))
+            robot.world.step()
+    assert controller.mirrored is mirrored
+    pose = controller.world.pose
+    expected_y = 3.1 if mirrored else -3.1
+    assert pose.y_m == pytest.approx(expected_y, abs=0.05)
+    assert math.copysign(1.0, pose.yaw_rad) == (-1.0 if mirrored else 1.0)
