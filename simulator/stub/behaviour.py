@@ -32,6 +32,7 @@ class GameInfo:
     penalised: bool = False
     our_kick_off: bool = True
     first_half: bool = True
+    ball_free_in_s: float = 0.0  # PLAYING: the opponents' kick-off is still protected this long
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -75,6 +76,8 @@ def decide(
     if game.phase is Phase.READY:
         return _go_to(pose, _kick_off_position(role, game, field))
     # PLAYING
+    if not game.our_kick_off and game.ball_free_in_s > 0:
+        return STAND  # the opponents' kick-off: keep out of the centre circle
     if role is Role.GOALIE:
         return _goalie(pose, ball, field, searching_s)
     return _striker(pose, ball, field, searching_s)

@@ -105,15 +105,21 @@ class StubController:
         self._side_check_s: float | None = 0.0 if detect_side else None
         self._side_pixels = [0, 0]  # left, right
         self.mirrored: bool | None = None
+        self._expect_mirrored: bool | None = None
 
     @property
     def busy(self) -> str:
         """ "kick", "get-up" or "" (walking or standing)."""
         return self._motion_kind if self._motion is not None else ""
 
-    def reset_pose(self, pose: Pose2D) -> None:
+    def reset_pose(
+        self, pose: Pose2D, *, check_side: bool = True, expect_mirrored: bool | None = None
+    ) -> None:
+        """Start again from ``pose`` (team-file frame when ``check_side``; the turned frame of
+        the odometry otherwise). ``expect_mirrored`` applies when the check is undecided."""
         self.world.reset_pose(pose)
-        if self._detect_side:
+        self._expect_mirrored = expect_mirrored
+        if self._detect_side and check_side:
             self._side_check_s = 0.0
             self._side_pixels = [0, 0]
 
@@ -214,7 +220,9 @@ class StubController:
             if self._motion.done:
                 self._finish_motion()
             return self._remember(targets)
-        if self._fallen(dt, att.tilt_rad):
+        if game.penalised:  # limp or being carried: nothing to get up from
+            self._tilted_s = 0.0
+        elif self._fallen(dt, att.tilt_rad):
             side = "front" if att.pitch_rad > 0 else "back"
             if self._upright_since_fall:
                 self.stats.falls += 1  # later attempts while still down are not new falls
@@ -233,8 +241,9 @@ class StubController:
             if self._missing_since_ms is None
             else (sensors.time_ms - self._missing_since_ms) / 1000.0
         )
-        if self._side_check_s is not None:
-            return self._remember(self._side_check(dt, sensors))
+        if self._side_check_s is not None and not game.penalised:
+            if sensors.time_ms >= self._settle_until_ms:
+                return self._remember(self._side_check(dt, sensors))
         action = decide(
             role=self.role,
             game=game,

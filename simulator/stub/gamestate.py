@@ -84,6 +84,9 @@ class GameControllerLink:
             penalised=bool(penalty),
             our_kick_off=team is not None and data.kick_off_team == team,
             first_half=data.first_half,
+            ball_free_in_s=float(max(data.secondary_time, 0))
+            if data.state is GameState.PLAYING
+            else 0.0,
         )
 
     def _run(self) -> None:

@@ -187,12 +187,15 @@ class StubRobot:
                 return None
             game = self.gc.info() or GameInfo(phase=Phase.INITIAL)
             if previous_half is not None and game.first_half != previous_half:
-                self.controller.reset_pose(self.start_pose)
+                before = self.controller.mirrored  # sides change at half time
+                expect = None if before is None else not before
+                self.controller.reset_pose(self.start_pose, expect_mirrored=expect)
             previous_half = game.first_half
             if was_penalised and not game.penalised:
                 pose = self.controller.world.pose
                 side = -1.0 if pose.y_m < 0 else 1.0
-                self.controller.reset_pose(Pose2D(-3.0, 3.2 * side, -side * math.pi / 2))
+                reentry = Pose2D(-3.0, 3.2 * side, -side * math.pi / 2)
+                self.controller.reset_pose(reentry, check_side=False)
             was_penalised = game.penalised
             targets = self.controller.tick(_sensors(measurement, image), game)
             if self.options.behaviour is Behaviour.IGNORE_SIGTERM or targets:

@@ -20,7 +20,7 @@ def test_side_check_from_the_own_goal(world_x: float, mirrored: bool) -> None:
     controller = StubController(role=Role.STRIKER, start_pose=team_file_pose, detect_side=True)
     game = GameInfo(phase=Phase.INITIAL)
     with CameraRenderer(robot.world, 320, 240) as camera:
-        for _ in range(int(2.5 / 0.008)):
+        for _ in range(int(3.5 / 0.008)):
             t = robot.world.sim_time_ms
             image = None
             if t % 96 == 0:
