@@ -150,7 +150,10 @@ def _goalie(
     if ball is None:
         return Action(search=True)
     bx, by = ball
-    if math.hypot(bx, by) < 0.6:
+    ball_field = pose.to_field(bx, by)
+    if math.hypot(bx, by) < 0.6 and ball_field[0] > pose.x_m + 0.1:
+        # clear only a ball on the field side of the goalie; circling a ball that is behind
+        # it, next to its own goal, could push it in
         return _striker(pose, ball, field, searching_s)
     bearing = math.atan2(by, bx)
     if abs(bearing) > 0.25:
