@@ -56,7 +56,8 @@ def team_file(name: str, image: str, players: int, *, goalie_first: bool,
         x, y, yaw = POSES_KID[n]
         role = "goalie" if (n == 1 and goalie_first) else "striker"
         entries[str(n)] = {
-            "dockerCmd": command or role,
+            # The stub cannot see where it was placed: its dockerCmd tells it (team-file frame).
+            "dockerCmd": command or f"{role} --start-pose {x} {y} {yaw}",
             "halfTimeStartingPose": _pose(x, y, yaw),
             "reentryStartingPose": _pose(x, y, yaw),
             "shootoutStartingPose": _pose(2.6, 0.0, 0.0),
