@@ -5,10 +5,12 @@ Tree::
     OrchestratorError
     ├── ConfigError              a configuration file is invalid (carries every problem found)
     ├── InfrastructureError      the Docker engine, a network or the host failed us
-    │   └── EngineUnavailable    no Docker engine answers
+    │   ├── EngineUnavailable    no Docker engine answers
+    │   └── RegistryError        the registry API refused or failed (registry.py)
     ├── ImageError               an image cannot be used for a robot
     │   ├── ImagePullError       pull failed (auth, unknown tag, unreachable registry)
-    │   └── ImageTooLarge        over the size limit
+    │   ├── ImageTooLarge        over the size limit
+    │   └── BuildFailed          a project image did not build (engine/images.py)
     ├── MatchFailed              a match ended in a typed failure (see results.FailureClass)
     ├── DeliveryError            a log set could not be delivered (auth, host key, bucket, ...)
     └── ScheduleError            the schedule file or its state is unusable
