@@ -10,6 +10,7 @@ from collections import deque
 from google.protobuf.message import DecodeError
 
 from simulator.api import messages_pb2 as pb
+from simulator.api.fastreq import PositionTargets, PositionTemplate, scan_positions
 from simulator.api.framing import FrameDecoder, FramingError
 from simulator.api.stats import RobotStats
 
@@ -31,7 +32,9 @@ class Connection:
 
     ``answered`` is the lockstep flag: a request arrived after the last measurement was queued
     (a new connection owes its first request). Requests are decoded on arrival and kept until the
-    step loop applies them.
+    step loop applies them: a request of position targets in the layout of the client's previous
+    one as :class:`PositionTargets` (no protobuf, see :mod:`simulator.api.fastreq`), any other
+    as ``ActuatorRequests``.
     """
 
     def __init__(
@@ -50,7 +53,8 @@ class Connection:
         self.stats = stats
         self.queue_limit = max(1, queue_limit)
         self.decoder = FrameDecoder()
-        self.requests: list[pb.ActuatorRequests] = []
+        self.requests: list[pb.ActuatorRequests | PositionTargets] = []
+        self._template: PositionTemplate | None = None
         self.outbox: deque[bytes] = deque()
         self._partial: memoryview | None = None
         self.answered = False
@@ -88,16 +92,14 @@ class Connection:
             except FramingError as exc:
                 self.stats.bad_frames += 1
                 raise ClientClosed(f"out of sync: {exc}") from exc
+            template = self._template
             for frame in frames:
-                request = pb.ActuatorRequests()
-                try:
-                    request.ParseFromString(frame)
-                except DecodeError as exc:
-                    self.stats.decode_errors += 1
-                    raise ClientClosed(
-                        f"undecodable ActuatorRequests ({len(frame)} bytes)"
-                    ) from exc
-                self.requests.append(request)
+                targets = template.match(frame) if template is not None else None
+                if targets is not None:
+                    self.requests.append(targets)
+                else:
+                    self.requests.append(self._parse(frame))
+                    template = self._template
                 count += 1
             if len(data) < RECV_CHUNK:
                 break
@@ -109,6 +111,19 @@ class Connection:
                 self.stats.round_trip_s.append(now - self.last_sent_at)
                 self.last_sent_at = None
         return count
+
+    def _parse(self, frame: bytes) -> pb.ActuatorRequests:
+        request = pb.ActuatorRequests()
+        try:
+            request.ParseFromString(frame)
+        except DecodeError as exc:
+            self.stats.decode_errors += 1
+            raise ClientClosed(f"undecodable ActuatorRequests ({len(frame)} bytes)") from exc
+        if request.motor_positions and len(request.ListFields()) == 1:
+            template = scan_positions(frame)
+            if template is not None:
+                self._template = template
+        return request
 
     # --- writing ----------------------------------------------------------------------------
 
@@ -122,6 +137,33 @@ class Connection:
         self.answered = False
         self.last_sent_at = now
         self.enqueued_at = now
+
+    def send(self, frame: bytes, now: float) -> None:
+        """:meth:`enqueue` and :meth:`flush`, but a frame with nothing queued before it goes
+        straight to the socket (the usual case: no queue, no view).
+
+        Raises:
+            ClientClosed: on a fatal send error.
+        """
+        if self._partial is not None or self.outbox:
+            self.enqueue(frame, now)
+            self.flush()
+            return
+        self.answered = False
+        self.last_sent_at = now
+        self.enqueued_at = now
+        stats = self.stats
+        stats.messages_out += 1
+        try:
+            sent = self.sock.send(frame)
+        except (BlockingIOError, InterruptedError):
+            sent = 0
+        except OSError as exc:
+            raise ClientClosed(f"send failed: {exc}") from exc
+        stats.bytes_out += sent
+        if sent < len(frame):
+            self._partial = memoryview(frame)[sent:]
+            self.want_write = True
 
     def flush(self) -> bool:
         """Write as much as the socket takes; True when everything queued was written.

@@ -24,7 +24,8 @@ GYROS = 10
 POSITION_SENSORS = 11
 
 
-def _varint(value: int) -> bytes:
+def varint(value: int) -> bytes:
+    """Protobuf base-128 varint of a non-negative integer."""
     out = bytearray()
     while True:
         byte = value & 0x7F
@@ -38,22 +39,20 @@ def _varint(value: int) -> bytes:
 
 def _name_field(name: str) -> bytes:
     raw = name.encode()
-    return b"\x0a" + _varint(len(raw)) + raw
+    return b"\x0a" + varint(len(raw)) + raw
 
 
 def scalar_prefix(field: int, name: str) -> bytes:
     """Wire bytes of ``{name, double value = 2}`` up to the 8 value bytes."""
     body_len = len(_name_field(name)) + 9
-    return _varint(field << 3 | 2) + _varint(body_len) + _name_field(name) + b"\x11"
+    return varint(field << 3 | 2) + varint(body_len) + _name_field(name) + b"\x11"
 
 
 def vector_prefix(field: int, name: str) -> bytes:
     """Wire bytes of ``{name, Vector3 value = 2}`` up to the Vector3's first tag."""
     vec_len = 27
     body_len = len(_name_field(name)) + 2 + vec_len
-    return (
-        _varint(field << 3 | 2) + _varint(body_len) + _name_field(name) + b"\x12" + _varint(vec_len)
-    )
+    return varint(field << 3 | 2) + varint(body_len) + _name_field(name) + b"\x12" + varint(vec_len)
 
 
 class SensorLayout:

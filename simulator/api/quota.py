@@ -13,13 +13,14 @@ from collections import deque
 class NetworkQuota:
     """Sliding-window byte budget of one robot."""
 
-    __slots__ = ("quota_mb_s", "window_ms", "_history", "_total")
+    __slots__ = ("quota_mb_s", "window_ms", "_history", "_total", "_limit")
 
     def __init__(self, *, quota_mb_s: float, window_s: float = 1.0) -> None:
         self.quota_mb_s = quota_mb_s
         self.window_ms = window_s * 1000.0
         self._history: deque[tuple[int, int]] = deque()
-        self._total = 0
+        self._total = 0  # bytes in the history (may hold entries older than the window)
+        self._limit = self.limit_bytes
 
     @property
     def limit_bytes(self) -> float:
@@ -36,9 +37,14 @@ class NetworkQuota:
 
     def allows(self, size: int, now_ms: int) -> bool:
         """Whether a message of ``size`` bytes sent at ``now_ms`` (unix ms) fits the budget."""
+        if size + self._total <= self._limit:  # fits even counting expired entries
+            return True
         self._expire(now_ms)
-        return size + self._total <= self.limit_bytes
+        return size + self._total <= self._limit
 
     def record(self, size: int, now_ms: int) -> None:
-        self._history.append((now_ms, size))
+        history = self._history
+        history.append((now_ms, size))
         self._total += size
+        if len(history) > 1024:  # keep the history short when nothing needed expiring
+            self._expire(now_ms)

@@ -308,8 +308,7 @@ class ApiServer:
             conn = slot.conn
             if conn is None or not conn.requests:
                 continue
-            for request in conn.requests:
-                slot.session.apply(request, step_time_ms=step_time_ms)
+            slot.session.apply_all(conn.requests, step_time_ms=step_time_ms)
             conn.requests.clear()
 
     def publish(self, time_ms: int) -> None:
@@ -340,18 +339,28 @@ class ApiServer:
     def _send(
         self, slot: RobotSlot, conn: Connection, measurement: Measurement, now: float
     ) -> None:
-        header = measurement.header
-        payload = header.SerializeToString() + measurement.sensors
-        real_time = header.real_time
-        if not slot.quota.allows(len(payload), real_time):
+        head, sensors = measurement.head(), measurement.sensors
+        size = len(head) + len(sensors)
+        real_time = measurement.real_time
+        quota = slot.quota
+        if quota.allows(size, real_time):
+            frame = b"".join((HEADER.pack(size), head, sensors))
+            warnings = measurement.message_count
+        else:
             slot.stats.quota_errors += 1
-            header = pb.SensorMeasurements(time=header.time, real_time=real_time)
-            header.messages.add(message_type=ERROR, text=slot.quota.error_text)
+            header = pb.SensorMeasurements(time=measurement.time, real_time=real_time)
+            header.messages.add(message_type=ERROR, text=quota.error_text)
             payload = header.SerializeToString()
-        slot.quota.record(len(payload), real_time)
-        if header.messages:
-            slot.stats.warnings_sent += len(header.messages)
-        conn.enqueue(HEADER.pack(len(payload)) + payload, now)
+            size = len(payload)
+            frame = HEADER.pack(size) + payload
+            warnings = 1
+        quota.record(size, real_time)
+        if warnings:
+            slot.stats.warnings_sent += warnings
+        try:
+            conn.send(frame, now)
+        except ClientClosed as exc:
+            self._drop(slot, exc.reason)
 
     def _flush_all(self) -> None:
         blocking = self._network.blocking_send
@@ -378,7 +387,7 @@ class ApiServer:
             slot = self.slots[job.robot]
             job.measurement.image = image
             for pending in slot.pending:
-                if pending.measurement.header.time == job.time_ms and pending.missing:
+                if pending.measurement.time == job.time_ms and pending.missing:
                     pending.missing -= 1
                     break
             touched.add(job.robot)

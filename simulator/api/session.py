@@ -10,7 +10,7 @@ Camera images are filled in later by the caller (see :mod:`simulator.api.cameras
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -34,7 +34,9 @@ from simulator.api.encode import (
     GYROS,
     POSITION_SENSORS,
     SensorLayout,
+    varint,
 )
+from simulator.api.fastreq import PositionTargets
 
 log = logging.getLogger(__name__)
 
@@ -65,25 +67,66 @@ class CameraJob:
     measurement: pb.CameraMeasurement
 
 
-@dataclass(slots=True)
 class Measurement:
-    """One step's measurement: ``header`` (time, messages, cameras) + encoded ``sensors``."""
+    """One step's measurement: ``time``, ``real_time``, the encoded regular ``sensors`` and the
+    camera ``jobs``. The protobuf ``header`` (time, real_time, messages, cameras) is only made
+    when a message or a camera needs it; otherwise :meth:`head` is hand-encoded."""
 
-    header: pb.SensorMeasurements
-    sensors: bytes
-    jobs: list[CameraJob]
+    __slots__ = ("time", "real_time", "sensors", "jobs", "_header")
+
+    def __init__(self, time: int, real_time: int, sensors: bytes = b"") -> None:
+        self.time = time
+        self.real_time = real_time
+        self.sensors = sensors
+        self.jobs: list[CameraJob] = []
+        self._header: pb.SensorMeasurements | None = None
+
+    @property
+    def header(self) -> pb.SensorMeasurements:
+        if self._header is None:
+            self._header = pb.SensorMeasurements(time=self.time, real_time=self.real_time)
+        return self._header
+
+    @property
+    def message_count(self) -> int:
+        return 0 if self._header is None else len(self._header.messages)
+
+    def head(self) -> bytes:
+        """The serialized header (everything but the regular sensors)."""
+        if self._header is None:
+            return header_bytes(self.time, self.real_time)
+        return bytes(self._header.SerializeToString())
 
     def size(self) -> int:
-        return int(self.header.ByteSize()) + len(self.sensors)
+        return len(self.head()) + len(self.sensors)
 
     def payload(self) -> bytes:
-        return bytes(self.header.SerializeToString()) + self.sensors
+        return self.head() + self.sensors
 
     def parsed(self) -> pb.SensorMeasurements:
         """The whole measurement as a message (for tests and tools; slow path)."""
         msg = pb.SensorMeasurements()
         msg.ParseFromString(self.payload())
         return msg
+
+
+_last_head: list[tuple[int, int, bytes]] = [(-1, -1, b"")]  # all robots of a step share it
+
+
+def header_bytes(time_ms: int, real_time_ms: int) -> bytes:
+    """``SensorMeasurements(time=time_ms, real_time=real_time_ms).SerializeToString()``."""
+    last = _last_head[0]
+    if last[0] == time_ms and last[1] == real_time_ms:
+        return last[2]
+    if not (0 <= time_ms < 2**32 and 0 <= real_time_ms < 2**64):  # protobuf says what is wrong
+        return bytes(
+            pb.SensorMeasurements(time=time_ms, real_time=real_time_ms).SerializeToString()
+        )
+    head = (b"\x08" + varint(time_ms) if time_ms else b"") + (
+        b"\x10" + varint(real_time_ms) if real_time_ms else b""
+    )
+    _last_head[0] = (time_ms, real_time_ms, head)
+    return head
 
 
 class RobotSession:
@@ -131,25 +174,52 @@ class RobotSession:
     def warn(self, text: str, *, kind: int = WARNING) -> None:
         self._pending.append((kind, text))
 
-    def apply(self, request: pb.ActuatorRequests, *, step_time_ms: int) -> None:
+    def apply(self, request: pb.ActuatorRequests | PositionTargets, *, step_time_ms: int) -> None:
         """Apply one request; ``step_time_ms`` is the time of the measurement this step sends."""
         world, robot = self._world, self.robot
         if world.is_removed(robot):
             return
+        self._apply_one(request, step_time_ms, not world.is_limp(robot))
+
+    def apply_all(
+        self, requests: list[pb.ActuatorRequests | PositionTargets], *, step_time_ms: int
+    ) -> None:
+        """:meth:`apply` each request in order, right after :meth:`update_limp` (whose limp flag
+        it uses: one world query per step instead of two per request)."""
+        if self._world.is_removed(self.robot):
+            return
+        active = not self._limp
+        for request in requests:
+            if type(request) is PositionTargets:
+                self._apply_positions(request.names, request.values, active)
+            else:
+                self._apply_one(request, step_time_ms, active)
+
+    def _apply_positions(
+        self, names: tuple[str, ...], values: Sequence[float], active: bool
+    ) -> None:
+        if names in self._valid_names:  # the usual case: the same distinct, known motors
+            self._positions.update(zip(names, values, strict=True))
+            if active:
+                self._set_many(names, values)
+        else:
+            self._apply_checked(names, values, active)
+
+    def _apply_one(
+        self, request: pb.ActuatorRequests | PositionTargets, step_time_ms: int, active: bool
+    ) -> None:
+        if type(request) is PositionTargets:
+            self._apply_positions(request.names, request.values, active)
+            return
+        assert isinstance(request, pb.ActuatorRequests)
+        world, robot = self._world, self.robot
         motors = self._motor_names
-        active = not world.is_limp(robot)
         present = len(request.ListFields())
         if request.motor_positions:
             present -= 1
             positions = list(request.motor_positions)  # one wrapper per item, read twice
             names = tuple([mp.name for mp in positions])
-            if names in self._valid_names:  # the usual case: the same distinct, known motors
-                values = [mp.position for mp in positions]
-                self._positions.update(zip(names, values, strict=True))
-                if active:
-                    self._set_many(names, values)
-            else:
-                self._apply_checked(positions, names, active)
+            self._apply_positions(names, [mp.position for mp in positions], active)
         if not present:  # nothing but position targets (the usual request)
             return
         for mv in request.motor_velocities:
@@ -185,23 +255,22 @@ class RobotSession:
         for step in request.sensor_time_steps:
             self._time_step(step.name, step.timeStep, step_time_ms)
 
-    def _apply_checked(self, positions: Any, names: tuple[str, ...], active: bool) -> None:
+    def _apply_checked(self, names: tuple[str, ...], values: Sequence[float], active: bool) -> None:
         """Position targets with unknown or repeated names (the later target wins)."""
         motors = self._motor_names
         targets: dict[str, float] = {}
-        for mp in positions:
-            name = mp.name
+        for name, value in zip(names, values, strict=True):
             if name not in motors:
                 self.warn(f'Motor "{name}" not found, position command ignored.')
                 continue
-            targets[name] = mp.position
+            targets[name] = value
         if len(targets) == len(names) and len(self._valid_names) < MAX_LAYOUTS:
             self._valid_names.add(names)
         self._positions.update(targets)
         if active and targets:
             self._set_many(tuple(targets), list(targets.values()))
 
-    def _set_many(self, names: tuple[str, ...], values: list[float]) -> None:
+    def _set_many(self, names: tuple[str, ...], values: Sequence[float]) -> None:
         if self._set_positions is not None:
             self._set_positions(self.robot, names, values)
         else:
@@ -276,32 +345,32 @@ class RobotSession:
 
     def measure(self, time_ms: int) -> Measurement:
         """The measurement of the step that ended at ``time_ms`` (camera images still empty)."""
-        msg = pb.SensorMeasurements(time=time_ms, real_time=self._clock_ms())
-        jobs: list[CameraJob] = []
-        for message_type, text in self._pending:
-            msg.messages.add(message_type=message_type, text=text)
-        self._pending.clear()
+        out = Measurement(time_ms, self._clock_ms())
+        if self._pending:
+            msg = out.header
+            for message_type, text in self._pending:
+                msg.messages.add(message_type=message_type, text=text)
+            self._pending.clear()
         world, robot = self._world, self.robot
         if world.is_removed(robot):
             self._sensors.clear()
             self._new_sensors.clear()
             self._groups = None
-            return Measurement(msg, b"", jobs)
+            return out
         if self._new_sensors:
-            due = self._due_slow(msg, time_ms, jobs)
+            due = self._due_slow(out, time_ms)
         else:
-            due = self._due(msg, time_ms, jobs)
+            due = self._due(out, time_ms)
         if not due:
-            return Measurement(msg, b"", jobs)
+            return out
         plan = self._layouts.get(due)
         if plan is None:
             plan = self._layout(due)
         names, layout = plan
-        return Measurement(msg, layout.encode(self._read(names)), jobs)
+        out.sensors = layout.encode(self._read(names))
+        return out
 
-    def _due(
-        self, msg: pb.SensorMeasurements, time_ms: int, jobs: list[CameraJob]
-    ) -> tuple[str, ...]:
+    def _due(self, out: Measurement, time_ms: int) -> tuple[str, ...]:
         """Due regular sensors (in enabling order); camera jobs added. Sensors sharing a period
         and a start are checked as one group."""
         if self._groups is None:
@@ -310,7 +379,7 @@ class RobotSession:
         due = [group for group in self._groups if not (time_ms - group[1]) % group[0]]
         for name, period, start in self._camera_sensors:
             if not (time_ms - start) % period:
-                self._camera_job(msg, name, time_ms, jobs)
+                self._camera_job(out, name, time_ms)
         if len(due) == 1:
             return due[0][2]
         if not due:
@@ -333,9 +402,7 @@ class RobotSession:
             for (period, start), members in groups.items()
         ]
 
-    def _due_slow(
-        self, msg: pb.SensorMeasurements, time_ms: int, jobs: list[CameraJob]
-    ) -> tuple[str, ...]:
+    def _due_slow(self, out: Measurement, time_ms: int) -> tuple[str, ...]:
         """:meth:`_due` in a step that enabled sensors (those are not reported in it)."""
         new, kinds, enabled_at = self._new_sensors, self._kinds, self._enabled_at
         due: list[str] = []
@@ -345,17 +412,15 @@ class RobotSession:
             if kinds[name] != CAMERA:
                 due.append(name)
             else:
-                self._camera_job(msg, name, time_ms, jobs)
+                self._camera_job(out, name, time_ms)
         new.clear()
         return tuple(due)
 
-    def _camera_job(
-        self, msg: pb.SensorMeasurements, name: str, time_ms: int, jobs: list[CameraJob]
-    ) -> None:
+    def _camera_job(self, out: Measurement, name: str, time_ms: int) -> None:
         if self._camera_size is not None:
             width, height = self._camera_size
-            camera = msg.cameras.add(name=name, width=width, height=height, quality=-1)
-            jobs.append(CameraJob(self.robot, name, width, height, time_ms, camera))
+            camera = out.header.cameras.add(name=name, width=width, height=height, quality=-1)
+            out.jobs.append(CameraJob(self.robot, name, width, height, time_ms, camera))
 
     def _layout(self, due: tuple[str, ...]) -> tuple[tuple[str, ...], SensorLayout]:
         """Due sensors in field-number order (the order of the message) and their layout."""

@@ -1,0 +1,89 @@
+"""Decoding of the usual ``ActuatorRequests`` without protobuf: position targets only.
+
+A robot controller sends the same motor names in the same order every step; only the 8-byte
+doubles change. The first such request is decoded by protobuf and scanned once
+(:func:`scan_positions`) into a :class:`PositionTemplate`: the fixed wire bytes between the
+values and one ``struct`` format for the whole frame. A later frame of the same length whose
+fixed bytes are identical has the same structure (each item ``{name = 1, position = 2}``), so
+its targets are the unpacked doubles (:meth:`PositionTemplate.match`). Anything else (other
+fields, a target of exactly 0.0 that a proto3 encoder leaves out, another name list) goes the
+protobuf way, so both ways give the same result.
+"""
+
+from __future__ import annotations
+
+import struct
+
+
+class PositionTargets:
+    """Position targets of one request: ``names[i]`` to ``values[i]`` (in request order)."""
+
+    __slots__ = ("names", "values")
+
+    def __init__(self, names: tuple[str, ...], values: tuple[float, ...]) -> None:
+        self.names = names
+        self.values = values
+
+
+class PositionTemplate:
+    """The wire layout of one request made of ``motor_positions`` only."""
+
+    __slots__ = ("names", "size", "_fixed", "_unpack")
+
+    def __init__(self, names: tuple[str, ...], fixed: tuple[bytes, ...]) -> None:
+        self.names = names
+        self._fixed = fixed
+        layout = struct.Struct("<" + "".join(f"{len(segment)}sd" for segment in fixed))
+        self._unpack = layout.unpack
+        self.size = layout.size
+
+    def match(self, frame: bytes) -> PositionTargets | None:
+        """The targets of ``frame`` when it has this layout, else None."""
+        if len(frame) != self.size:
+            return None
+        parts = self._unpack(frame)
+        if parts[0::2] != self._fixed:
+            return None
+        return PositionTargets(self.names, parts[1::2])
+
+
+def _varint(data: bytes, at: int) -> tuple[int, int]:
+    """(value, next offset); raises IndexError past the end, ValueError when too long."""
+    value = shift = 0
+    while True:
+        byte = data[at]
+        at += 1
+        value |= (byte & 0x7F) << shift
+        if byte < 0x80:
+            return value, at
+        shift += 7
+        if shift > 63:
+            raise ValueError("varint too long")
+
+
+def scan_positions(frame: bytes) -> PositionTemplate | None:
+    """The template of ``frame`` when it holds nothing but ``motor_positions`` items, each
+    exactly ``{name = 1, position = 2}`` in that order; None otherwise."""
+    names: list[str] = []
+    fixed: list[bytes] = []
+    segment_start = at = 0
+    try:
+        while at < len(frame):
+            if frame[at] != 0x0A:  # motor_positions, length-delimited
+                return None
+            length, body = _varint(frame, at + 1)
+            end = body + length
+            if frame[body] != 0x0A:  # name, length-delimited
+                return None
+            name_length, name_at = _varint(frame, body + 1)
+            value_tag = name_at + name_length
+            if value_tag + 9 != end or end > len(frame) or frame[value_tag] != 0x11:
+                return None
+            names.append(frame[name_at:value_tag].decode("utf-8"))
+            fixed.append(frame[segment_start : value_tag + 1])
+            segment_start = at = end
+    except (IndexError, ValueError):  # truncated, an over-long varint or a name not UTF-8
+        return None
+    if not names:
+        return None
+    return PositionTemplate(tuple(names), tuple(fixed))
