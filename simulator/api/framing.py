@@ -47,6 +47,10 @@ class FrameDecoder:
     def feed(self, data: bytes) -> list[bytes]:
         """Add received bytes; return the payloads of every frame now complete, in order."""
         buffer = self._buffer
+        if not buffer and len(data) >= 4:  # the usual case: exactly one frame, nothing buffered
+            (length,) = HEADER.unpack_from(data)
+            if len(data) == 4 + length and 0 < length <= self._limit:
+                return [data[4:]]
         buffer += data
         frames: list[bytes] = []
         offset = 0

@@ -184,7 +184,8 @@ class ApiServer:
                     self._read(slot, now)
                 if slot.conn is not None and events & selectors.EVENT_WRITE:
                     self._flush(slot)
-        self._finish_lookups()
+        if self._lookups is not None:
+            self._finish_lookups()
 
     def _accept(self, slot: RobotSlot) -> None:
         assert slot.listener is not None

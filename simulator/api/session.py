@@ -151,6 +151,8 @@ class RobotSession:
         self._enabled_at: dict[str, int] = {}
         self._motor_names = frozenset(n for n, k in self._kinds.items() if k == MOTOR)
         self._positions: dict[str, float] = {}  # last commands, re-applied after a penalty
+        # the latest targets of a known name list, not yet merged into _positions
+        self._held: tuple[tuple[str, ...], Sequence[float]] | None = None
         self._velocities: dict[str, float] = {}
         self._torques: dict[str, float] = {}
         # batch forms of the world (simulator.world.World has them; a fake world may not)
@@ -198,8 +200,14 @@ class RobotSession:
     def _apply_positions(
         self, names: tuple[str, ...], values: Sequence[float], active: bool
     ) -> None:
-        if names in self._valid_names:  # the usual case: the same distinct, known motors
-            self._positions.update(zip(names, values, strict=True))
+        held = self._held
+        if held is not None and held[0] is names:  # the usual case: the same name list again
+            self._held = (names, values)
+            if active:
+                self._set_many(names, values)
+        elif names in self._valid_names:  # distinct, known motors
+            self._merge_held()
+            self._held = (names, values)
             if active:
                 self._set_many(names, values)
         else:
@@ -255,6 +263,12 @@ class RobotSession:
         for step in request.sensor_time_steps:
             self._time_step(step.name, step.timeStep, step_time_ms)
 
+    def _merge_held(self) -> None:
+        if self._held is not None:
+            names, values = self._held
+            self._positions.update(zip(names, values, strict=True))
+            self._held = None
+
     def _apply_checked(self, names: tuple[str, ...], values: Sequence[float], active: bool) -> None:
         """Position targets with unknown or repeated names (the later target wins)."""
         motors = self._motor_names
@@ -266,6 +280,7 @@ class RobotSession:
             targets[name] = value
         if len(targets) == len(names) and len(self._valid_names) < MAX_LAYOUTS:
             self._valid_names.add(names)
+        self._merge_held()
         self._positions.update(targets)
         if active and targets:
             self._set_many(tuple(targets), list(targets.values()))
@@ -330,6 +345,7 @@ class RobotSession:
         if limp:
             return
         world, robot = self._world, self.robot
+        self._merge_held()
         if self._positions:
             self._set_many(tuple(self._positions), list(self._positions.values()))
         for name, velocity in self._velocities.items():
