@@ -49,6 +49,12 @@ class Action:
 
 
 STAND = Action()
+APPROACH_M = 0.55  # nearer than this the striker lines up and kicks
+BEHIND_M = 0.35  # where it heads for: this far behind the ball, on the goal line through it
+ROUND_M = 0.5  # how wide it goes round a ball it is in front of
+FAST_M_S = 0.2
+AIM_HALF_WIDTH_M = 0.8  # aim this close to the goal centre (posts at 1.3 m)
+SEARCH_TURN_AFTER_S = 2.0
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -110,13 +116,14 @@ def _striker(
     bx, by = ball
     distance = math.hypot(bx, by)
     bearing = math.atan2(by, bx)
-    # direction from the ball to the opponent goal, relative to the robot's heading
+    # direction from the ball to the opponent goal centre, relative to the robot's heading
     ball_field = pose.to_field(bx, by)
-    goal_dir = math.atan2(0.0 - ball_field[1], field.half_length_m - ball_field[0])
-    heading_error = _wrap(goal_dir - pose.yaw_rad)
-    if distance > 0.55:
-        forward = 0.15 if abs(bearing) < 0.3 else (0.06 if abs(bearing) < 0.7 else 0.0)
-        return Action(walk=(forward, 0.0, _clip(1.5 * bearing, 0.6)))
+    goal_dx, goal_dy = field.half_length_m - ball_field[0], 0.0 - ball_field[1]
+    heading_error = _wrap(math.atan2(goal_dy, goal_dx) - pose.yaw_rad)
+    ux, uy = math.cos(heading_error), math.sin(heading_error)
+    behind = -(bx * ux + by * uy) < -0.1  # the robot is on the far side of the ball from goal
+    if distance > APPROACH_M or not behind or abs(bearing) > 1.2:
+        return _approach(bx, by, heading_error)
     if abs(heading_error) > 0.35:
         # circle around the ball: side-step while turning, keep about 0.3 m away
         return Action(
@@ -126,10 +133,12 @@ def _striker(
                 _clip(0.8 * heading_error + 0.8 * bearing, 0.5),
             )
         )
+    # the farther the goal, the straighter the kick must be to land between the posts
+    aim_tolerance = min(max(math.atan2(AIM_HALF_WIDTH_M, math.hypot(goal_dx, goal_dy)), 0.12), 0.3)
     foot = "left" if by > 0 else "right"
     target_y = field.foot_y_m if foot == "left" else -field.foot_y_m
     ex, ey = bx - field.kick_x_m, by - target_y
-    if abs(ex) < 0.04 and abs(ey) < 0.025:
+    if abs(ex) < 0.05 and abs(ey) < 0.035 and abs(heading_error) < aim_tolerance:
         return Action(kick_foot=foot)
     return Action(
         walk=(
@@ -138,6 +147,25 @@ def _striker(
             _clip(0.8 * heading_error, 0.3),
         )
     )
+
+
+def _approach(bx: float, by: float, goal_bearing: float) -> Action:
+    """Walk to a point behind the ball on the line from the goal centre through the ball (the
+    robot frame; ``goal_bearing`` the direction from the ball to the goal). When the robot is
+    on the goal side of the ball, go round it first, on the side it is already on, so that it
+    neither pushes the ball towards its own goal nor has to circle it for long."""
+    ux, uy = math.cos(goal_bearing), math.sin(goal_bearing)
+    along = -(bx * ux + by * uy)  # the robot relative to the ball, along ball -> goal
+    if along > -0.1:
+        beside = -(-bx * uy + by * ux)  # the robot relative to the ball, across the line
+        side = 1.0 if beside >= 0 else -1.0
+        px = bx - 0.25 * ux - side * ROUND_M * uy
+        py = by - 0.25 * uy + side * ROUND_M * ux
+    else:
+        px, py = bx - BEHIND_M * ux, by - BEHIND_M * uy
+    target = math.atan2(py, px)
+    forward = FAST_M_S if abs(target) < 0.3 else (0.06 if abs(target) < 0.7 else 0.0)
+    return Action(walk=(forward, 0.0, _clip(1.5 * target, 0.7)))
 
 
 def _goalie(
@@ -163,9 +191,9 @@ def _goalie(
 
 def _search(searching_s: float) -> Action:
     """Scan with the head first; then turn on the spot while scanning."""
-    if searching_s < 4.0:
+    if searching_s < SEARCH_TURN_AFTER_S:
         return Action(search=True)
-    return Action(walk=(0.0, 0.0, 0.5), search=True)
+    return Action(walk=(0.0, 0.0, 0.7), search=True)
 
 
 def _clip(value: float, high: float, *, low: float | None = None) -> float:

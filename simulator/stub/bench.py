@@ -131,6 +131,8 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--distance-m", type=float, default=2.0)
     parser.add_argument("--time-limit-s", type=float, default=60.0)
+    parser.add_argument("--scenario", choices=("reach", "shots"), default="reach")
+    parser.add_argument("--goalie", action="store_true", help="shots: an opponent goalie defends")
     parser.add_argument("--json", action="store_true", help="only the JSON line")
     args = parser.parse_args(argv)
     if args.trials < 1:
@@ -139,6 +141,8 @@ def main(argv: list[str]) -> int:
     os.environ.setdefault("MUJOCO_GL", "osmesa")
     os.environ.setdefault("PYOPENGL_PLATFORM", os.environ["MUJOCO_GL"])
     start = time.perf_counter()
+    if args.scenario == "shots":
+        return _shots(args, start)
     results = []
     for trial in range(args.trials):
         result = run_trial(
@@ -150,4 +154,22 @@ def main(argv: list[str]) -> int:
         if not args.json:
             print(f"trial {trial}: {result}", file=sys.stderr)
     print(json.dumps(summarize(results, seed=args.seed, wall_s=time.perf_counter() - start)))
+    return 0
+
+
+def _shots(args: argparse.Namespace, start: float) -> int:
+    from simulator.stub.bench_shots import run_shot, summarize_shots
+
+    shots = []
+    for trial in range(args.trials):
+        shot = run_shot(
+            seed=args.seed * 1000 + trial, time_limit_s=args.time_limit_s, goalie=args.goalie
+        )
+        shots.append(shot)
+        if not args.json:
+            print(f"trial {trial}: {shot}", file=sys.stderr)
+    summary = summarize_shots(
+        shots, seed=args.seed, goalie=args.goalie, wall_s=time.perf_counter() - start
+    )
+    print(json.dumps(summary))
     return 0

@@ -41,6 +41,7 @@ SIDE_LOOK_PITCH_RAD = -0.15  # slightly up: goal posts stand above the horizon
 SIDE_MIN_PIXELS = 30
 KNEE_RESET_RAD = 0.5  # knee this far from its target: the robot was reset or is limp
 KICK_SETTLE_S = 0.5  # stand still this long before a kick
+KICK_COMMIT_MS = 1500  # keep to a kick decided this long ago while the ball stays in reach
 SETTLE_S = 1.0  # stand still this long after start and after getting up
 FIELD_HALF_LENGTH_M = {"kid": 4.5, "adult": 7.0}
 BALL_RADIUS_M = {"kid": 0.07, "adult": 0.1125}
@@ -100,6 +101,7 @@ class StubController:
         self._last_targets: dict[str, float] = {}
         self._missing_since_ms: int | None = None
         self._scan_s = 0.0
+        self._kick_committed: tuple[str, int] | None = None  # foot, when lined up
         self.last_action: Action | None = None
         self._detect_side = detect_side
         self._side_check_s: float | None = 0.0 if detect_side else None
@@ -254,6 +256,7 @@ class StubController:
         )
         if sensors.time_ms < self._settle_until_ms:
             action = Action(search=action.search)  # settle into the stance first
+        action = self._commit_kick(sensors.time_ms, action, ball)
         self.last_action = action
         self._still_s = 0.0 if self.walk.walking else self._still_s + dt
         if action.kick_foot is not None:
@@ -272,6 +275,26 @@ class StubController:
         return self._remember(targets)
 
     # --- parts ---------------------------------------------------------------------------------
+
+    def _commit_kick(
+        self, time_ms: int, action: Action, ball: tuple[float, float] | None
+    ) -> Action:
+        """Once lined up, keep to the kick while the robot settles: the ball estimate jitters
+        by a few centimetres between frames, and re-aligning for every frame would never end."""
+        if action.kick_foot is not None:
+            if self._kick_committed is None or self._kick_committed[1] + KICK_COMMIT_MS < time_ms:
+                self._kick_committed = (action.kick_foot, time_ms)
+            return Action(kick_foot=self._kick_committed[0])
+        committed = self._kick_committed
+        if committed is None or ball is None or time_ms > committed[1] + KICK_COMMIT_MS:
+            self._kick_committed = None
+            return action
+        bx, by = ball
+        side = self.field.foot_y_m if committed[0] == "left" else -self.field.foot_y_m
+        if abs(bx - self.field.kick_x_m) < 0.08 and abs(by - side) < 0.06:
+            return Action(kick_foot=committed[0])
+        self._kick_committed = None
+        return action
 
     def _look(self, sensors: Sensors) -> None:
         image = sensors.image_bgr
@@ -324,6 +347,7 @@ class StubController:
 
     def _finish_motion(self) -> None:
         if self._motion_kind == "kick":
+            self._kick_committed = None
             self.world.forget_ball()  # look again: it should be far away now
         if self._motion_kind == "get-up":
             self.stats.get_ups += 1
