@@ -129,8 +129,8 @@ def _striker(
         return Action(
             walk=(
                 _clip(0.8 * (distance - 0.3), 0.06),
-                _clip(-0.15 * math.copysign(1.0, heading_error), 0.05),
-                _clip(0.8 * heading_error + 0.8 * bearing, 0.5),
+                _clip(-0.2 * math.copysign(1.0, heading_error), 0.07),
+                _clip(0.8 * heading_error + 0.8 * bearing, 0.7),
             )
         )
     # the farther the goal, the straighter the kick must be to land between the posts
