@@ -182,7 +182,7 @@ def _world_only(
 
 
 def _bench_sim(robots: int, physics_dt: float, sim_seconds: float) -> dict[str, Any] | None:
-    """The world engineer's ``bench sim`` numbers for the same setup, when it is available."""
+    """The world's ``bench sim`` numbers for the same setup, when they are available."""
     try:
         from simulator.bench_sim import run
     except ImportError:

@@ -1,4 +1,4 @@
-"""`hlvs check`: kinds found from the content, --kind, other engineers' loaders, clean lines."""
+"""`hlvs check`: kinds found from the content, --kind, the credentials and schedule loaders."""
 
 from __future__ import annotations
 
