@@ -1,4 +1,4 @@
-"""``python -m simulator COMMAND``: run (a match from a spec), render (a replay), bench (sim|api|stub).
+"""``python -m simulator COMMAND``: run a match from a spec, render a replay, bench sim|api|stub.
 
 Each command lives in its own module exposing ``main(argv) -> int``.
 """

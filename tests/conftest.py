@@ -1,4 +1,4 @@
-"""Shared test settings. Integration tests mark what they need (docker, root) and clean up by label."""
+"""Shared test settings. Integration tests mark what they need (docker, root), clean up by label."""
 
 from __future__ import annotations
 
