@@ -15,7 +15,7 @@ PYTEST_ARGS ?=
 scrimmage: setup
 	$(HLVS) scrimmage --out matches/scrimmage
 
-test: setup
+test: setup lint typecheck
 	$(PY) -m pytest $(PYTEST_ARGS)
 
 setup: venv system engine images
