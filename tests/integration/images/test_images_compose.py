@@ -97,7 +97,7 @@ def test_compose_document_follows_the_match_layout() -> None:
     assert red["environment"]["ROBOCUP_TEAM_PLAYER1_IP"] == "10.99.0.11"
     assert red["cap_drop"] == ["ALL"] and red["security_opt"] == ["no-new-privileges"]
     assert (red["cpus"], red["mem_limit"], red["pids_limit"]) == (1.0, 1_000_000_000, 256)
-    assert red["command"] == ["striker"]
+    assert red["command"] == ["striker", "--start-pose", "-1.0", "-3.1", "1.57"]
     assert spec["red"]["robot_addresses"] == ["10.99.0.11"]
     assert spec["network"]["telemetry_listen"] == "tcp/10.99.2.2:7447"
 
