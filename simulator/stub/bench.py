@@ -35,10 +35,29 @@ class TrialResult:
     sightings: int
 
 
+def sense(world: Any, robot: Any, camera: Any) -> Any:
+    """What the robot's controller gets in a match: joints, IMU, and a camera image when due."""
+    from simulator.stub.controller import Sensors
+
+    t_ms = world.sim_time_ms
+    image = None
+    if t_ms % CAMERA_PERIOD_MS == 0:
+        raw = camera.render(robot)
+        image = np.frombuffer(raw, np.uint8).reshape(240, 320, 3)
+    joints = {name[:-1]: value for name, value in world.read_positions(robot).items()}
+    return Sensors(
+        time_ms=t_ms,
+        joints=joints,
+        accel=world.read_accelerometer(robot),
+        gyro=world.read_gyro(robot),
+        image_bgr=image,
+    )
+
+
 def run_trial(*, seed: int, distance_m: float, time_limit_s: float) -> TrialResult:
     from referee.snapshot import RobotId, TeamColor
     from simulator.stub.behaviour import GameInfo, Phase, Role
-    from simulator.stub.controller import Sensors, StubController
+    from simulator.stub.controller import StubController
     from simulator.stub.world_model import Pose2D
     from simulator.world import CameraRenderer, RobotPlacement, World
 
@@ -62,18 +81,7 @@ def run_trial(*, seed: int, distance_m: float, time_limit_s: float) -> TrialResu
         step = 0
         while True:
             t_ms = world.sim_time_ms
-            image = None
-            if t_ms % CAMERA_PERIOD_MS == 0:
-                raw = camera.render(robot)
-                image = np.frombuffer(raw, np.uint8).reshape(240, 320, 3)
-            joints = {name[:-1]: value for name, value in world.read_positions(robot).items()}
-            sensors = Sensors(
-                time_ms=t_ms,
-                joints=joints,
-                accel=world.read_accelerometer(robot),
-                gyro=world.read_gyro(robot),
-                image_bgr=image,
-            )
+            sensors = sense(world, robot, camera)
             kicks_before = controller.stats.kicks
             targets = controller.tick(sensors, game)
             if controller.stats.kicks > kicks_before and kicked_at_s is None:

@@ -16,7 +16,6 @@ from typing import Any
 
 import numpy as np
 
-CAMERA_PERIOD_MS = 96
 GOAL_HALF_WIDTH_M = 1.3
 HALF_LENGTH_M = 4.5
 HALF_WIDTH_M = 3.0
@@ -48,7 +47,8 @@ def shot_layout(seed: int) -> tuple[tuple[float, float], tuple[float, float, flo
 def run_shot(*, seed: int, time_limit_s: float, goalie: bool) -> ShotResult:
     from referee.snapshot import PlaceBall, RobotId, TeamColor
     from simulator.stub.behaviour import GameInfo, Phase, Role
-    from simulator.stub.controller import Sensors, StubController
+    from simulator.stub.bench import sense
+    from simulator.stub.controller import StubController
     from simulator.stub.world_model import Pose2D
     from simulator.world import CameraRenderer, RobotPlacement, World
 
@@ -72,20 +72,8 @@ def run_shot(*, seed: int, time_limit_s: float, goalie: bool) -> ShotResult:
     outcome, goal_at = "time", None
     with CameraRenderer(world, 320, 240) as camera:
         for _ in range(steps):
-            t_ms = world.sim_time_ms
             for robot, controller in players:
-                image = None
-                if t_ms % CAMERA_PERIOD_MS == 0:
-                    raw = camera.render(robot)
-                    image = np.frombuffer(raw, np.uint8).reshape(240, 320, 3)
-                joints = {n[:-1]: v for n, v in world.read_positions(robot).items()}
-                sensors = Sensors(
-                    time_ms=t_ms,
-                    joints=joints,
-                    accel=world.read_accelerometer(robot),
-                    gyro=world.read_gyro(robot),
-                    image_bgr=image,
-                )
+                sensors = sense(world, robot, camera)
                 for name, value in controller.tick(sensors, game).items():
                     world.set_motor_position(robot, name, value)
             world.step()
