@@ -54,6 +54,47 @@ class _Batch:
     remaining: int
 
 
+class CompletedImages:
+    """Finished camera jobs handed from rendering threads to the step thread.
+
+    ``put`` queues an image and writes a wake-up byte to a non-blocking pipe whose read end
+    (:attr:`wake_fd`) the step loop polls; ``take`` drains both.
+    """
+
+    def __init__(self) -> None:
+        self._done: queue.Queue[tuple[CameraJob, bytes]] = queue.Queue()
+        self._read_fd, self._write_fd = os.pipe()
+        os.set_blocking(self._read_fd, False)
+        os.set_blocking(self._write_fd, False)
+
+    @property
+    def wake_fd(self) -> int:
+        return self._read_fd
+
+    def put(self, job: CameraJob, image: bytes) -> None:
+        self._done.put((job, image))
+        try:
+            os.write(self._write_fd, b"x")
+        except BlockingIOError:
+            pass  # the pipe is full of wake-ups already
+
+    def take(self) -> list[tuple[CameraJob, bytes]]:
+        try:
+            os.read(self._read_fd, 4096)
+        except BlockingIOError:
+            pass
+        done: list[tuple[CameraJob, bytes]] = []
+        while True:
+            try:
+                done.append(self._done.get_nowait())
+            except queue.Empty:
+                return done
+
+    def close(self) -> None:
+        os.close(self._read_fd)
+        os.close(self._write_fd)
+
+
 class RenderWorker:
     """Rendering threads (``threads``, each with its own GL context); completed jobs are
     collected on the step thread with :meth:`completed` when :attr:`wake_fd` is readable."""
@@ -69,10 +110,7 @@ class RenderWorker:
         self._make_render = make_render
         self._count = max(1, threads)
         self._inbox: queue.Queue[tuple[_Batch, CameraJob] | None] = queue.Queue()
-        self._done: queue.Queue[tuple[CameraJob, bytes]] = queue.Queue()
-        self._read_fd, self._write_fd = os.pipe()
-        os.set_blocking(self._read_fd, False)
-        os.set_blocking(self._write_fd, False)
+        self._completed = CompletedImages()
         self._threads: list[threading.Thread] = []
         self._lock = threading.Lock()
         self.error: BaseException | None = None
@@ -84,7 +122,7 @@ class RenderWorker:
     @property
     def wake_fd(self) -> int:
         """Readable when completed jobs are waiting."""
-        return self._read_fd
+        return self._completed.wake_fd
 
     def submit(self, jobs: Sequence[CameraJob]) -> None:
         if not self._threads:
@@ -104,16 +142,7 @@ class RenderWorker:
             return self._submitted - self._finished
 
     def completed(self) -> list[tuple[CameraJob, bytes]]:
-        try:
-            os.read(self._read_fd, 4096)
-        except BlockingIOError:
-            pass
-        done: list[tuple[CameraJob, bytes]] = []
-        while True:
-            try:
-                done.append(self._done.get_nowait())
-            except queue.Empty:
-                return done
+        return self._completed.take()
 
     def _run(self) -> None:
         import time
@@ -144,16 +173,11 @@ class RenderWorker:
                 batch.remaining -= 1
                 if batch.remaining == 0:
                     self._finished += 1
-            self._done.put((job, image))
-            try:
-                os.write(self._write_fd, b"x")
-            except BlockingIOError:
-                pass  # the pipe is full of wake-ups already
+            self._completed.put(job, image)
 
     def close(self) -> None:
         for _ in self._threads:
             self._inbox.put(None)
         for thread in self._threads:
             thread.join(timeout=5.0)
-        os.close(self._read_fd)
-        os.close(self._write_fd)
+        self._completed.close()

@@ -14,8 +14,6 @@ from __future__ import annotations
 
 import logging
 import multiprocessing as mp
-import os
-import queue
 import threading
 import time
 from collections.abc import Sequence
@@ -24,6 +22,7 @@ from multiprocessing.connection import Connection
 from typing import TYPE_CHECKING, Any
 
 from referee.snapshot import RobotId
+from simulator.api.cameras import CompletedImages
 from simulator.api.session import CameraJob
 
 if TYPE_CHECKING:
@@ -82,10 +81,7 @@ class RenderPool:
         self._world = world
         self._count = max(1, processes)
         self._cameras = {r.id: r.camera for r in world.index.robots}
-        self._done: queue.Queue[tuple[CameraJob, bytes]] = queue.Queue()
-        self._read_fd, self._write_fd = os.pipe()
-        os.set_blocking(self._read_fd, False)
-        os.set_blocking(self._write_fd, False)
+        self._completed = CompletedImages()
         self._lock = threading.Lock()
         self._jobs: dict[int, tuple[_Batch, CameraJob]] = {}
         self._next_id = 0
@@ -101,7 +97,7 @@ class RenderPool:
 
     @property
     def wake_fd(self) -> int:
-        return self._read_fd
+        return self._completed.wake_fd
 
     def _start(self) -> None:
         ctx = mp.get_context("spawn")  # a clean process: no inherited threads or GL state
@@ -150,16 +146,7 @@ class RenderPool:
             return self._submitted - self._finished
 
     def completed(self) -> list[tuple[CameraJob, bytes]]:
-        try:
-            os.read(self._read_fd, 4096)
-        except BlockingIOError:
-            pass
-        done: list[tuple[CameraJob, bytes]] = []
-        while True:
-            try:
-                done.append(self._done.get_nowait())
-            except queue.Empty:
-                return done
+        return self._completed.take()
 
     def _collect(self, conn: Connection) -> None:
         while True:
@@ -184,11 +171,7 @@ class RenderPool:
             batch.remaining -= 1
             if batch.remaining == 0:
                 self._finished += 1
-        self._done.put((job, image if image is not None else bytes(job.width * job.height * 3)))
-        try:
-            os.write(self._write_fd, b"x")
-        except BlockingIOError:
-            pass  # the pipe is full of wake-ups already
+        self._completed.put(job, image if image is not None else bytes(job.width * job.height * 3))
 
     def _fail(self, exc: BaseException, job_ids: list[int]) -> None:
         log.error("camera render process failed: %s; black images", exc or "it exited")
@@ -212,5 +195,4 @@ class RenderPool:
             conn.close()
         for reader in self._readers:
             reader.join(timeout=5.0)
-        os.close(self._read_fd)
-        os.close(self._write_fd)
+        self._completed.close()
