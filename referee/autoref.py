@@ -21,6 +21,7 @@ from referee.gamecontroller import (
     SecondaryState,
     Tick,
 )
+from referee.gamecontroller.states import Card
 from referee.judgement import apply_decisions
 from referee.logs import RefereeLog
 from referee.mirror import TeamMirror
@@ -28,7 +29,7 @@ from referee.net import GameControllerNetwork
 from referee.publisher import Publisher
 from referee.rulebook import RuleBook
 from referee.rules import end_of_game, goal, kickoff, set_play
-from referee.rules.base import Decision, GameView
+from referee.rules.base import Decision, GameView, GiveCard
 from referee.shootout import Shootout
 from referee.snapshot import (
     PlaceBall,
@@ -354,6 +355,13 @@ class Referee:
             return commands
         decisions = self.rules.judge(snapshot, self.view())
         return commands + self._apply(decisions, snapshot)
+
+    def give_card(
+        self, robot: RobotId, card: Card, reason: str, snapshot: WorldSnapshot
+    ) -> list[WorldCommand]:
+        """A card given by hand, as the league's human referee does at the GameController (the
+        automatic rules give none). Escalates like every card; a red card removes the robot."""
+        return self._apply([GiveCard(robot, card, reason)], snapshot)
 
     def _apply(self, decisions: list[Decision], snapshot: WorldSnapshot) -> list[WorldCommand]:
         return apply_decisions(self, decisions, snapshot) if decisions else []

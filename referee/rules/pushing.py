@@ -8,27 +8,26 @@ Only contacts between opponents count, and only while PLAYING (not in the shoot-
 * Charging: when a contact begins, a robot moving at least 0.2 m/s faster than the other,
   towards it, and more than 30 degrees away from the direction of the ball, charges.
 
-Consequence, for the pusher: a warning (two make a yellow card) and, when the ball is in play
-and the pusher is within 1 m of it, a direct free kick for the other team at the victim's
-position (a penalty kick when the pusher stands in its own penalty area); otherwise removal for
+Speeds are those of the virtual league's referee: the centre of mass's average velocity over
+the last second (:class:`VelocityTracks`), so the sway of a walk or the first instants of a fall
+are not a charge. A jump of more than 0.5 m between two snapshots (a robot placed by the
+referee) starts the average again.
+
+Consequence, for the pusher, as in the virtual league (no card): when the ball is in play and
+the pusher is within 1 m of it, a direct free kick for the other team at the victim's position
+(a penalty kick when the pusher stands in its own penalty area); otherwise removal for
 PHYSICAL_CONTACT. A pair is immune for 2 s after a foul.
 """
 
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass, field
 
-from referee.gamecontroller.states import Card, GameState, Penalty, SecondaryState
-from referee.rules.base import (
-    AwardSetPlay,
-    Decision,
-    GameView,
-    GiveCard,
-    PenalizeRobot,
-    distance2d,
-)
-from referee.snapshot import RobotId, RobotState, WorldSnapshot
+from referee.gamecontroller.states import GameState, Penalty, SecondaryState
+from referee.rules.base import AwardSetPlay, Decision, GameView, PenalizeRobot, distance2d
+from referee.snapshot import RobotId, RobotState, Vec3, WorldSnapshot
 
 PERIOD_MS = 2000
 CONTACT_MS = 1000
@@ -38,8 +37,37 @@ CHARGE_SPEED_M_S = 0.2
 CHARGE_ANGLE_RAD = math.radians(30.0)
 FREE_KICK_RANGE_M = 1.0
 IMMUNITY_MS = 2000
+AVERAGE_MS = 1000  # speeds are averaged over this long
+JUMP_M = 0.5  # a larger move between two snapshots is a placement, not motion
 
 Pair = tuple[RobotId, RobotId]
+
+
+class VelocityTracks:
+    """Recent centre-of-mass positions of every robot, for 1 s average velocities."""
+
+    def __init__(self) -> None:
+        self._tracks: dict[RobotId, deque[tuple[int, float, float]]] = {}
+
+    def add(self, snapshot: WorldSnapshot) -> None:
+        now = snapshot.sim_time_ms
+        for robot in snapshot.robots:
+            x, y = robot.center_of_mass[0], robot.center_of_mass[1]
+            track = self._tracks.setdefault(robot.id, deque())
+            if track and math.hypot(x - track[-1][1], y - track[-1][2]) > JUMP_M:
+                track.clear()
+            track.append((now, x, y))
+            while len(track) > 2 and track[1][0] <= now - AVERAGE_MS:
+                track.popleft()
+
+    def velocity(self, robot: RobotId) -> Vec3:
+        """Average velocity over the last second (or since the robot was placed)."""
+        track = self._tracks.get(robot)
+        if not track or len(track) < 2:
+            return (0.0, 0.0, 0.0)
+        (t0, x0, y0), (t1, x1, y1) = track[0], track[-1]
+        dt = (t1 - t0) / 1000.0
+        return ((x1 - x0) / dt, (y1 - y0) / dt, 0.0) if dt > 0 else (0.0, 0.0, 0.0)
 
 
 @dataclass(frozen=True, slots=True)
@@ -47,6 +75,7 @@ class PushingMemory:
     contacts: dict[Pair, tuple[tuple[int, int], ...]] = field(default_factory=dict)
     immune_until: dict[Pair, int] = field(default_factory=dict)
     last_ms: int | None = None
+    tracks: VelocityTracks = field(default_factory=VelocityTracks)
 
 
 def _pair(a: RobotId, b: RobotId) -> Pair:
@@ -54,10 +83,13 @@ def _pair(a: RobotId, b: RobotId) -> Pair:
     return (a, b) if key_a <= key_b else (b, a)
 
 
-def _charging(pusher: RobotState, victim: RobotState, ball: tuple[float, float]) -> bool:
-    vx, vy = pusher.velocity[0], pusher.velocity[1]
+def _charging(
+    pusher: RobotState, victim: RobotState, ball: tuple[float, float], tracks: VelocityTracks
+) -> bool:
+    vx, vy, _ = tracks.velocity(pusher.id)
+    victim_velocity = tracks.velocity(victim.id)
     speed = math.hypot(vx, vy)
-    if speed - math.hypot(victim.velocity[0], victim.velocity[1]) <= CHARGE_SPEED_M_S:
+    if speed - math.hypot(victim_velocity[0], victim_velocity[1]) <= CHARGE_SPEED_M_S:
         return False
     to_victim = (victim.position[0] - pusher.position[0], victim.position[1] - pusher.position[1])
     if vx * to_victim[0] + vy * to_victim[1] <= 0:
@@ -88,7 +120,7 @@ def _in_own_penalty_area(robot: RobotState, game: GameView) -> bool:
 def _consequence(
     pusher: RobotState, victim: RobotState, game: GameView, ball: tuple[float, float], why: str
 ) -> list[Decision]:
-    decisions: list[Decision] = [GiveCard(pusher.id, Card.WARNING, why)]
+    decisions: list[Decision] = []
     near = distance2d(pusher.position, ball) <= FREE_KICK_RANGE_M
     if game.running and game.ball_in_play and near:
         if _in_own_penalty_area(pusher, game):
@@ -111,6 +143,8 @@ def judge(
 ) -> tuple[list[Decision], PushingMemory]:
     if game.state is not GameState.PLAYING or game.phase is SecondaryState.PENALTYSHOOT:
         return [], PushingMemory()
+    tracks = memory.tracks
+    tracks.add(snapshot)
     now = snapshot.sim_time_ms
     previous = memory.last_ms if memory.last_ms is not None else now
     robots = {r.id: r for r in snapshot.robots if game.active(r)}
@@ -139,9 +173,9 @@ def judge(
         a, b = robots[pair[0]], robots[pair[1]]
         pusher: RobotState | None = None
         why = ""
-        if onset and _charging(a, b, ball):
+        if onset and _charging(a, b, ball, tracks):
             pusher, why = a, "charging"
-        elif onset and _charging(b, a, ball):
+        elif onset and _charging(b, a, ball, tracks):
             pusher, why = b, "charging"
         elif sum(end - max(start, now - PERIOD_MS) for start, end in intervals) > CONTACT_MS:
             pusher, why = _sustained_pusher(a, b, ball), "pushing"
@@ -151,4 +185,4 @@ def judge(
         victim = b if pusher is a else a
         decisions.extend(_consequence(pusher, victim, game, ball, f"{why} {victim.id}"))
         immune[pair] = now + IMMUNITY_MS
-    return decisions, PushingMemory(contacts, immune, now)
+    return decisions, PushingMemory(contacts, immune, now, tracks)

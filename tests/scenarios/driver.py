@@ -10,6 +10,7 @@ from typing import Any
 from referee.autoref import Referee
 from referee.clock import FakeClock
 from referee.config import GameType, PlayerConfig, Pose, RefereeConfig, TeamConfig, TimingConfig
+from referee.gamecontroller.states import Card
 from referee.snapshot import (
     PlaceBall,
     RefereeEvent,
@@ -117,6 +118,11 @@ def _apply_action(run: Run, action: Action, first: bool) -> None:
         )
         return
     robot = parse_robot_id(args.get("robot"), path=str(run.scenario.path), pointer="/actions")
+    if action.kind == "card" and first:  # by hand, as the human referee at the GameController
+        card = Card(str(args.get("card", "warning")))
+        for command in run.referee.give_card(robot, card, "given by hand", world.snapshot()):
+            world.apply(command)
+        return
     info = world.index.robots[_robot_number(world, robot)]
     q0, d0 = info.qpos_range[0], info.dof_range[0]
     if action.kind == "teleport" and first:

@@ -58,7 +58,7 @@ STATE_KEYS = {
     "phase",
     "secs_remaining",
 }
-ACTIONS = {"place_ball", "teleport", "push", "fall", "kick"}
+ACTIONS = {"place_ball", "teleport", "push", "fall", "kick", "card"}
 
 
 @dataclass(frozen=True, slots=True)

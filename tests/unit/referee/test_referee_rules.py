@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import pytest
 
 from referee.config import GameType, Pose, TimingConfig
 from referee.field import KID_FIELD
-from referee.gamecontroller import Card, GameState, Penalty, SecondaryState
+from referee.gamecontroller import GameState, Penalty, SecondaryState
 from referee.gamecontroller.machine import SetPlay
 from referee.rules import (
     ball_holding,
@@ -245,19 +246,48 @@ def test_sustained_contact_pusher_is_farther_from_ball() -> None:
     for ms in range(0, 1100, 8):
         decisions, memory = pushing.judge(snapshot(ms, (a, b)), view(ball_in_play=False), memory)
         out += decisions
-    assert GiveCard(R1, Card.WARNING, "pushing blue player 1") in out
     assert PenalizeRobot(R1, Penalty.PHYSICAL_CONTACT, "pushing blue player 1") in out
+    assert not [d for d in out if isinstance(d, GiveCard)]  # no card, as in the virtual league
+
+
+def _approach(
+    y_at: Callable[[int], float], until_ms: int, ball: tuple[float, float, float]
+) -> list[object]:
+    """Blue 2 at y_at(ms) comes down onto a still red 2 at y 0.3; it touches at ``until_ms``."""
+    b = robot(RED, 2, 0.0, 0.3)
+    memory = pushing.PushingMemory()
+    decisions: list[object] = []
+    for ms in range(0, until_ms + 8, 8):
+        touching = ms >= until_ms
+        a = robot(BLUE, 2, 0.0, y_at(ms), contacts=(R2,) if touching else ())
+        red = robot(RED, 2, 0.0, 0.3, contacts=(B2,) if touching else ())
+        found, memory = pushing.judge(snapshot(ms, (a, red if touching else b), ball=ball), view(),
+                                      memory)  # fmt: skip
+        decisions += found
+    return decisions
 
 
 def test_charging_near_ball_gives_free_kick() -> None:
-    a = robot(BLUE, 2, 0.0, 0.6, velocity=(0.0, -0.8, 0.0))
-    b = robot(RED, 2, 0.0, 0.3)
-    memory = pushing.PushingMemory()
-    _, memory = pushing.judge(snapshot(0, (a, b), ball=(0.5, 0.5, 0.07)), view(), memory)
-    a2 = robot(BLUE, 2, 0.0, 0.6, velocity=(0.0, -0.8, 0.0), contacts=(R2,))
-    decisions, _ = pushing.judge(snapshot(8, (a2, b), ball=(0.5, 0.5, 0.07)), view(), memory)
+    # 0.8 m/s over the last second, away from the ball's direction
+    decisions = _approach(lambda ms: 1.4 - 0.8 * ms / 1000.0, 1000, ball=(0.5, 0.5, 0.07))
     kicks = [d for d in decisions if isinstance(d, AwardSetPlay)]
     assert kicks and kicks[0].kind is SecondaryState.DIRECT_FREEKICK and kicks[0].team is RED
+    assert "charging" in kicks[0].reason
+
+
+def test_charging_speed_is_the_average_over_one_second() -> None:
+    # a sway: fast for the last 40 ms, but 0.1 m/s on average over the second: not a charge
+    def sway(ms: int) -> float:
+        return 0.7 - 0.1 * ms / 1000.0 - (0.03 * (ms - 960) / 40.0 if ms > 960 else 0.0)
+
+    decisions = _approach(sway, 1000, ball=(0.5, 0.5, 0.07))
+    assert not [d for d in decisions if isinstance(d, AwardSetPlay | PenalizeRobot)]
+
+
+def test_a_placed_robot_starts_its_average_again() -> None:
+    # teleported 3 m at 500 ms, then still: the jump is not a speed
+    decisions = _approach(lambda ms: 3.7 if ms < 500 else 0.6, 1000, ball=(0.5, 0.5, 0.07))
+    assert not [d for d in decisions if isinstance(d, AwardSetPlay | PenalizeRobot)]
 
 
 # --- removal and end of game ----------------------------------------------------------------
