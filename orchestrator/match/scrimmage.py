@@ -20,6 +20,10 @@ POSES_KID = {  # as if playing on the left (x < 0)
     4: (-3.0, -3.1, 1.57),
 }
 
+# Players 3 and 4 defend from spots in the own half: three strikers chasing one ball mostly
+# knock each other over.
+DEFENDER_HOMES = {3: (-2.3, 1.0), 4: (-2.3, -1.0)}
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", type=Path, default=Path("matches/scrimmage"),
@@ -55,9 +59,13 @@ def team_file(name: str, image: str, players: int, *, goalie_first: bool,
     for n in range(1, players + 1):
         x, y, yaw = POSES_KID[n]
         role = "goalie" if (n == 1 and goalie_first) else "striker"
+        extra = ""
+        if n in DEFENDER_HOMES and players >= n:  # one striker; the others keep their spots
+            role = "defender"
+            extra = " --home {} {}".format(*DEFENDER_HOMES[n])
         entries[str(n)] = {
             # The stub cannot see where it was placed: its dockerCmd tells it (team-file frame).
-            "dockerCmd": command or f"{role} --start-pose {x} {y} {yaw}",
+            "dockerCmd": command or f"{role} --start-pose {x} {y} {yaw}{extra}",
             "halfTimeStartingPose": _pose(x, y, yaw),
             "reentryStartingPose": _pose(x, y, yaw),
             "shootoutStartingPose": _pose(2.6, 0.0, 0.0),

@@ -15,6 +15,7 @@ from simulator.stub.world_model import Pose2D
 class Role(StrEnum):
     STRIKER = "striker"
     GOALIE = "goalie"
+    DEFENDER = "defender"  # keeps its home spot in the own half; plays a ball that comes near
     IDLE = "idle"
 
 
@@ -55,6 +56,9 @@ ROUND_M = 0.5  # how wide it goes round a ball it is in front of
 FAST_M_S = 0.2
 AIM_HALF_WIDTH_M = 0.8  # aim this close to the goal centre (posts at 1.3 m)
 SEARCH_TURN_AFTER_S = 2.0
+DEFENDER_HOME = (-2.3, 0.0)  # when none is given
+DEFENDER_ENGAGE_M = 1.2  # a defender plays a ball this close to its home spot
+DEFENDER_NEAR_M = 0.8  # ... or this close to itself
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -72,27 +76,62 @@ def decide(
     ball: tuple[float, float] | None,
     field: Field,
     searching_s: float,
+    home: tuple[float, float] | None = None,
 ) -> Action:
     """``ball`` is relative to the robot (x forward, y left) or None when not seen lately;
-    ``searching_s`` how long the ball has been missing."""
+    ``searching_s`` how long the ball has been missing; ``home`` a defender's spot (own-half
+    frame)."""
     if role is Role.IDLE or game.penalised or game.phase in (Phase.INITIAL, Phase.SET):
         return STAND
     if game.phase is Phase.FINISHED:
         return STAND
     if game.phase is Phase.READY:
-        return _go_to(pose, _kick_off_position(role, game, field))
+        return _go_to(pose, _kick_off_position(role, game, field, home))
     # PLAYING
     if not game.our_kick_off and game.ball_free_in_s > 0:
         return STAND  # the opponents' kick-off: keep out of the centre circle
     if role is Role.GOALIE:
         return _goalie(pose, ball, field, searching_s)
+    if role is Role.DEFENDER:
+        return _defender(pose, ball, field, searching_s, home or DEFENDER_HOME)
     return _striker(pose, ball, field, searching_s)
 
 
-def _kick_off_position(role: Role, game: GameInfo, field: Field) -> Pose2D:
+def _kick_off_position(
+    role: Role, game: GameInfo, field: Field, home: tuple[float, float] | None
+) -> Pose2D:
     if role is Role.GOALIE:
         return Pose2D(-field.half_length_m + 0.5, 0.0, 0.0)
+    if role is Role.DEFENDER:
+        x, y = home or DEFENDER_HOME
+        return Pose2D(x, y, 0.0)
     return Pose2D(-0.35 if game.our_kick_off else -1.0, 0.0, 0.0)
+
+
+def _defender(
+    pose: Pose2D,
+    ball: tuple[float, float] | None,
+    field: Field,
+    searching_s: float,
+    home: tuple[float, float],
+) -> Action:
+    """Stay at home facing the ball, so that teammates do not crowd the striker; play the ball
+    (as a striker) when it comes within reach of home or of the robot."""
+    if ball is not None:
+        bx, by = ball
+        ball_field = pose.to_field(bx, by)
+        near_home = math.hypot(ball_field[0] - home[0], ball_field[1] - home[1])
+        if near_home < DEFENDER_ENGAGE_M or math.hypot(bx, by) < DEFENDER_NEAR_M:
+            return _striker(pose, ball, field, searching_s)
+    hx, hy = pose.to_relative(*home)
+    if math.hypot(hx, hy) > 0.4:
+        return _go_to(pose, Pose2D(home[0], home[1], 0.0), tolerance_m=0.3)
+    if ball is None:
+        return Action(search=True)
+    bearing = math.atan2(ball[1], ball[0])
+    if abs(bearing) > 0.3:
+        return Action(walk=(0.0, 0.0, _clip(1.0 * bearing, 0.4)))
+    return STAND
 
 
 def _go_to(pose: Pose2D, target: Pose2D, *, tolerance_m: float = 0.2) -> Action:

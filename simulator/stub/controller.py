@@ -73,10 +73,13 @@ class StubController:
         model: str = "kid-default",
         field_class: str = "kid",
         detect_side: bool = False,
+        home: tuple[float, float] | None = None,
     ) -> None:
         """``detect_side``: before moving, look left and right for the own goal to find out
-        whether the pitch is mirrored for this team (see :meth:`_finish_side_check`)."""
+        whether the pitch is mirrored for this team (see :meth:`_finish_side_check`);
+        ``home``: a defender's spot in the own half."""
         self.role = role
+        self.home = home
         self.model = model
         self.kin = kinematics(model)
         self.walk = WalkEngine(model=model)
@@ -253,6 +256,7 @@ class StubController:
             ball=ball,
             field=self.field,
             searching_s=searching_s,
+            home=self.home,
         )
         if sensors.time_ms < self._settle_until_ms:
             action = Action(search=action.search)  # settle into the stance first

@@ -1,7 +1,8 @@
 """Command line and environment of the stub robot controller.
 
-``python -m simulator.stub BEHAVIOUR [ARG]`` where BEHAVIOUR is ``striker``, ``goalie``, ``idle``
-or a fault mode: ``crash-after SECONDS``, ``ignore-sigterm``, ``flood``, ``fill-logs``. The robot
+``python -m simulator.stub BEHAVIOUR [ARG]`` where BEHAVIOUR is ``striker``, ``goalie``,
+``defender`` (``--home X Y``: its spot in the own half), ``idle`` or a fault mode:
+``crash-after SECONDS``, ``ignore-sigterm``, ``flood``, ``fill-logs``. The robot
 itself is described by the HLVS container environment (``ROBOCUP_*``).
 """
 
@@ -21,6 +22,7 @@ from simulator.stub.errors import StubConfigError
 class Behaviour(StrEnum):
     STRIKER = "striker"
     GOALIE = "goalie"
+    DEFENDER = "defender"
     IDLE = "idle"
     CRASH_AFTER = "crash-after"
     IGNORE_SIGTERM = "ignore-sigterm"
@@ -34,6 +36,7 @@ class StubOptions:
     crash_after_s: float | None = None
     fill_cap_bytes: int | None = None  # None: until the disk is full
     start_pose: tuple[float, float, float] | None = None  # own-half frame x, y, yaw
+    home: tuple[float, float] | None = None  # a defender's spot, own-half frame
     gc_data_port: int = 3838
     gc_return_port: int = 3939
     mirror_port: int = 3737
@@ -61,6 +64,7 @@ def parse_args(argv: list[str]) -> StubOptions:
     parser.add_argument("seconds", nargs="?", type=float, default=None)
     parser.add_argument("--fill-cap-bytes", type=int, default=None)
     parser.add_argument("--start-pose", nargs=3, type=float, metavar=("X", "Y", "YAW"))
+    parser.add_argument("--home", nargs=2, type=float, metavar=("X", "Y"))
     parser.add_argument("--gc-data-port", type=int, default=3838)
     parser.add_argument("--gc-return-port", type=int, default=3939)
     parser.add_argument("--mirror-port", type=int, default=3737)
@@ -84,8 +88,16 @@ def parse_args(argv: list[str]) -> StubOptions:
     pose: tuple[float, float, float] | None = None
     if ns.start_pose:
         pose = (float(ns.start_pose[0]), float(ns.start_pose[1]), float(ns.start_pose[2]))
+    home: tuple[float, float] | None = None
+    if ns.home:
+        home = (float(ns.home[0]), float(ns.home[1]))
+        if not (-6.0 <= home[0] <= 0.0 and abs(home[1]) <= 4.5):
+            raise StubConfigError(
+                field="--home", value=f"{home[0]} {home[1]}", expected="a spot in the own half"
+            )
     return StubOptions(
         behaviour=behaviour,
+        home=home,
         crash_after_s=ns.seconds,
         fill_cap_bytes=ns.fill_cap_bytes,
         start_pose=pose,
@@ -97,7 +109,10 @@ def parse_args(argv: list[str]) -> StubOptions:
 
 
 def _usage() -> str:
-    return "striker | goalie | idle | crash-after SECONDS | ignore-sigterm | flood | fill-logs"
+    return (
+        "striker | goalie | defender [--home X Y] | idle | crash-after SECONDS | ignore-sigterm"
+        " | flood | fill-logs"
+    )
 
 
 def read_env(env: Mapping[str, str] | None = None) -> RobotEnv:

@@ -51,9 +51,11 @@ class StubRobot:
         self.options = options
         self.env = env
         self.stop = threading.Event()
-        role = {Behaviour.STRIKER: Role.STRIKER, Behaviour.GOALIE: Role.GOALIE}.get(
-            options.behaviour, Role.IDLE
-        )
+        role = {
+            Behaviour.STRIKER: Role.STRIKER,
+            Behaviour.GOALIE: Role.GOALIE,
+            Behaviour.DEFENDER: Role.DEFENDER,
+        }.get(options.behaviour, Role.IDLE)
         self.start_pose = (
             Pose2D(*options.start_pose) if options.start_pose else default_start_pose(env.robot_id)
         )
@@ -63,6 +65,7 @@ class StubRobot:
             model=options.model,
             field_class="adult" if options.model.startswith("adult") else "kid",
             detect_side=role is not Role.IDLE,
+            home=options.home,
         )
         self.gc = GameControllerLink(
             team_color=env.team_color,

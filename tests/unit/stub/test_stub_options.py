@@ -51,6 +51,14 @@ def test_unknown_behaviour_names_the_choices() -> None:
     assert info.value.value == "dancer"
 
 
+def test_defender_home_option() -> None:
+    options = parse_args(["defender", "--home", "-2.3", "1.0"])
+    assert options.behaviour is Behaviour.DEFENDER and options.home == (-2.3, 1.0)
+    with pytest.raises(StubConfigError) as err:
+        parse_args(["defender", "--home", "2.0", "0"])  # the opponents' half
+    assert err.value.field == "--home"
+
+
 def test_start_pose_option() -> None:
     assert parse_args(["striker", "--start-pose", "-1", "2", "0.5"]).start_pose == (-1.0, 2.0, 0.5)
 

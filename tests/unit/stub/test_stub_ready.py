@@ -12,12 +12,14 @@ from .motion_world import RED1, OneRobot
 
 
 @pytest.mark.parametrize(
-    ("role", "target"), [(Role.STRIKER, (-1.0, 0.0)), (Role.GOALIE, (-4.0, 0.0))]
+    ("role", "target"),
+    [(Role.STRIKER, (-1.0, 0.0)), (Role.GOALIE, (-4.0, 0.0)), (Role.DEFENDER, (-2.3, -1.0))],
 )
 def test_walks_to_the_kick_off_position_in_ready(role: Role, target: tuple[float, float]) -> None:
     start = Pose2D(-1.5, -3.2, math.pi / 2)  # on the touch line, facing the field
     robot = OneRobot(x_m=start.x_m, y_m=start.y_m, yaw_rad=start.yaw_rad)
-    controller = StubController(role=role, start_pose=start)
+    home = target if role is Role.DEFENDER else None
+    controller = StubController(role=role, start_pose=start, home=home)
     game = GameInfo(phase=Phase.READY, our_kick_off=False)
 
     def tick() -> dict[str, float]:
