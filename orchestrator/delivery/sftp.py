@@ -129,8 +129,14 @@ class SftpUploader:
         return stat.S_ISREG(attributes.st_mode or 0) and attributes.st_size == size
 
     def close(self) -> None:
-        self._client.close()
-        self._transport.close()
+        """Best effort: after a server died mid-transfer, closing the channel cannot be sent
+        (paramiko raises EOFError); the transport is closed all the same."""
+        try:
+            self._client.close()
+        except (OSError, paramiko.SSHException, EOFError) as exc:
+            log.debug("closing the SFTP channel to a dead connection: %r", exc)
+        finally:
+            self._transport.close()
 
     def _mkdir_p(self, folder: str) -> None:
         if folder in ("", ".", "/") or folder in self._made:
