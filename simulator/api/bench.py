@@ -8,6 +8,11 @@ the API run's real-time factor, the world-only real-time factor of the same worl
 (``World.step`` + ``snapshot``, what ``bench sim`` measures) and their ratio.
 ``--stalled-client`` adds a run in which one more client connects and never reads, and reports
 both runs.
+
+Without cameras, on a machine with two or more CPUs, the step thread runs on CPU 0 in every
+measurement (the world-only and ``bench sim`` figures too) and the client processes on the
+others, as robot code runs on its own computers in the virtual league; ``--shared-cpus`` lets
+them share every CPU. (With cameras everything shares: the render thread needs a CPU too.)
 """
 
 from __future__ import annotations
@@ -47,6 +52,11 @@ def _parser() -> argparse.ArgumentParser:
         "--render-processes", type=int, default=0, help="camera render processes (0: a thread)"
     )
     parser.add_argument("--stalled-client", action="store_true")
+    parser.add_argument(
+        "--shared-cpus",
+        action="store_true",
+        help="clients share the step thread's CPU (default: CPU 0 is the step thread's)",
+    )
     parser.add_argument("--json", action="store_true", help="print only the JSON line")
     return parser
 
@@ -79,11 +89,14 @@ def _frame(request: Any) -> bytes:
     return len(payload).to_bytes(4, "big") + payload
 
 
-def _client(port: int, camera_period: int, stalled: bool) -> None:
+def _client(port: int, camera_period: int, stalled: bool, cpus: frozenset[int]) -> None:
     """Client process body: enables the sensors, then answers every measurement with 20 joint
     targets (a 1 s cycle of pre-encoded requests: the bench measures the server, so the clients
     sharing its cores skip decoding). The stalled client connects, enables, and never reads."""
     from simulator.api import messages_pb2 as pb
+
+    if cpus:
+        os.sched_setaffinity(0, cpus)
 
     if stalled:  # a small receive window, and it never reads: the server's queue overflows
         raw = socket.socket()
@@ -223,6 +236,7 @@ def _api_run(
         network=NetworkSpec(api_bind_host="127.0.0.1"),
         lockstep=lockstep if args.mode == "lockstep" else None,
         cameras=cameras,
+        send_cpus=args.client_cpus or None,
     )
     server.start()
     ctx = mp.get_context("fork")
@@ -234,6 +248,7 @@ def _api_run(
                 e.port,
                 camera[2] if camera and i < camera_robots else 0,
                 e.robot == stalled_robot,
+                args.client_cpus,
             ),
             daemon=True,
         )
@@ -313,6 +328,11 @@ def main(argv: list[str]) -> int:
     os.environ.setdefault("LP_NUM_THREADS", "0")  # as the simulator process: see runtime.py
     camera = _camera(args.camera)
     robots = _robots(args.robots)
+    args.client_cpus = frozenset()
+    available = sorted(os.sched_getaffinity(0))
+    if not args.shared_cpus and camera is None and len(available) >= 2:
+        os.sched_setaffinity(0, {available[0]})  # this (the step) thread only
+        args.client_cpus = frozenset(available[1:])
     world_rtf, world_cpu = _world_only(robots, args.physics_dt, min(args.sim_seconds, 10.0))
     api = _api_run(args, camera, stalled=False)
     result: dict[str, Any] = {
@@ -334,6 +354,8 @@ def main(argv: list[str]) -> int:
         "render_ms_per_frame": api["render_ms_per_frame"],
         "render_processes": args.render_processes,
         "slow_periods": api["slow_periods"],
+        "step_thread_cpus": sorted(os.sched_getaffinity(0)),
+        "client_cpus": sorted(args.client_cpus) or "shared",
     }
     if args.stalled_client:
         stalled = _api_run(args, camera, stalled=True)

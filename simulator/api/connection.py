@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import logging
 import socket
+import threading
 import time
 from collections import deque
 
@@ -46,8 +47,16 @@ class Connection:
         stats: RobotStats,
         queue_limit: int,
         time_bank_s: float,
+        threaded: bool = False,
     ) -> None:
+        """``threaded``: a :class:`simulator.api.sender.SendThread` writes the queue; the step
+        thread only appends to it (:meth:`send`) and drops the client when ``error`` is set."""
         self.sock = sock
+        self.fd = sock.fileno()
+        self.threaded = threaded
+        self.closed = False
+        self.error: str | None = None  # set by the send thread: the step thread drops the client
+        self._lock = threading.Lock()  # the send thread's writes against close()
         self.peer = peer
         self.key = key
         self.stats = stats
@@ -145,6 +154,9 @@ class Connection:
         Raises:
             ClientClosed: on a fatal send error.
         """
+        if self.threaded:
+            self._enqueue_threaded(frame, now)
+            return
         if self._partial is not None or self.outbox:
             self.enqueue(frame, now)
             self.flush()
@@ -164,6 +176,50 @@ class Connection:
         if sent < len(frame):
             self._partial = memoryview(frame)[sent:]
             self.want_write = True
+
+    def _enqueue_threaded(self, frame: bytes, now: float) -> None:
+        outbox = self.outbox
+        if len(outbox) >= self.queue_limit:
+            self.write_queued()  # the send thread is behind: the socket may still take them
+        while len(outbox) >= self.queue_limit:
+            try:
+                outbox.popleft()
+            except IndexError:  # the send thread took it meanwhile
+                break
+            self.stats.dropped_out += 1
+        outbox.append(frame)
+        self.answered = False
+        self.last_sent_at = now
+        self.enqueued_at = now
+
+    def write_queued(self) -> bool:
+        """Write what the socket takes (the send thread; the step thread when the send thread
+        is behind and the queue is full); True when nothing is left to wait for
+        (all written, or the connection failed or closed), False when the socket is full."""
+        with self._lock:
+            if self.closed or self.error is not None:
+                return True
+            sock, outbox, stats = self.sock, self.outbox, self.stats
+            while True:
+                if self._partial is None:
+                    try:
+                        frame = outbox.popleft()
+                    except IndexError:
+                        return True
+                    stats.messages_out += 1
+                    self._partial = memoryview(frame)
+                try:
+                    sent = sock.send(self._partial)
+                except (BlockingIOError, InterruptedError):
+                    return False
+                except OSError as exc:
+                    self.error = f"send failed: {exc}"
+                    return True
+                stats.bytes_out += sent
+                if sent == len(self._partial):
+                    self._partial = None
+                else:
+                    self._partial = self._partial[sent:]
 
     def flush(self) -> bool:
         """Write as much as the socket takes; True when everything queued was written.
@@ -198,10 +254,12 @@ class Connection:
         return self._partial is None and not self.outbox
 
     def close(self) -> None:
-        try:
-            self.sock.close()
-        except OSError:  # already gone; nothing left to release
-            pass
+        with self._lock:
+            self.closed = True
+            try:
+                self.sock.close()
+            except OSError:  # already gone; nothing left to release
+                pass
 
 
 def monotonic() -> float:

@@ -3,7 +3,9 @@
 All socket I/O is non-blocking and runs on the step thread at three points of each step
 (:meth:`ApiServer.poll` while waiting or pacing, :meth:`ApiServer.apply_requests` before the
 physics step, :meth:`ApiServer.publish` after it), so the world is only touched by one thread and
-a client can never block the step (except with ``blocking_send``, the HLVS behaviour).
+a client can never block the step (except with ``blocking_send``, the HLVS behaviour). In async
+stepping the writes of measurements go to a send thread (:mod:`simulator.api.sender`): the step
+thread queues them and goes back to the physics.
 
 Per step: every complete request received is applied (later ones override earlier targets),
 then one ``SensorMeasurements`` per connected robot is queued. Lockstep: :meth:`wait_lockstep`
@@ -30,6 +32,7 @@ from simulator.api.devices import DeviceWorld
 from simulator.api.endpoints import PlayerEndpoint, peer_allowed_by_name
 from simulator.api.framing import HEADER, REFUSED, WELCOME
 from simulator.api.quota import NetworkQuota
+from simulator.api.sender import SendThread
 from simulator.api.session import ERROR, Measurement, RobotSession
 from simulator.api.stats import RobotStats
 from simulator.errors import ApiError
@@ -85,7 +88,11 @@ class ApiServer:
         lockstep: LockstepSettings | None = None,
         cameras: ImageSource | None = None,
         unix_ms: Callable[[], int] = lambda: int(time.time() * 1000),
+        send_thread: bool | None = None,
+        send_cpus: frozenset[int] | None = None,
     ) -> None:
+        """``send_thread``: write measurements from a thread (default: in async stepping
+        without ``blocking_send``); ``send_cpus``: the CPUs that thread may use."""
         self._world = world
         self._network = network
         self._lockstep = lockstep
@@ -94,6 +101,12 @@ class ApiServer:
         self._selector = selectors.DefaultSelector()
         self._lookups: ThreadPoolExecutor | None = None
         self.stop_requested = False
+        if send_thread is None:
+            send_thread = lockstep is None and not network.blocking_send
+        self._send_cpus = send_cpus
+        self._sender: SendThread | None = None
+        self._use_sender = send_thread
+        self._woken: list[Connection] = []
         self.slots: dict[RobotId, RobotSlot] = {}
         for endpoint in endpoints:
             team_size = max(1, endpoint.team_size)
@@ -115,6 +128,8 @@ class ApiServer:
     # --- lifecycle --------------------------------------------------------------------------
 
     def start(self) -> None:
+        if self._use_sender and self._sender is None:
+            self._sender = SendThread(cpus=self._send_cpus)
         host = self._network.api_bind_host
         for slot in self.slots.values():
             sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
@@ -146,6 +161,9 @@ class ApiServer:
                 slot.listener = None
         if self._lookups is not None:
             self._lookups.shutdown(wait=False, cancel_futures=True)
+        if self._sender is not None:
+            self._sender.close()
+            self._sender = None
         self._selector.close()
 
     def __enter__(self) -> ApiServer:
@@ -254,6 +272,7 @@ class ApiServer:
             stats=slot.stats,
             queue_limit=self._network.send_queue_messages,
             time_bank_s=bank,
+            threaded=self._sender is not None,
         )
         slot.pending.clear()
         slot.stats.connects.append(time.time())
@@ -307,6 +326,9 @@ class ApiServer:
         for slot in self.slots.values():
             slot.session.update_limp()
             conn = slot.conn
+            if conn is not None and conn.error is not None:  # from the send thread
+                self._drop(slot, conn.error)
+                continue
             if conn is None or not conn.requests:
                 continue
             slot.session.apply_all(conn.requests, step_time_ms=step_time_ms)
@@ -362,8 +384,16 @@ class ApiServer:
             conn.send(frame, now)
         except ClientClosed as exc:
             self._drop(slot, exc.reason)
+            return
+        if conn.threaded:
+            self._woken.append(conn)
 
     def _flush_all(self) -> None:
+        if self._sender is not None:
+            if self._woken:
+                self._sender.wake(self._woken)
+                self._woken = []
+            return
         blocking = self._network.blocking_send
         for slot in self.slots.values():
             if slot.conn is None or slot.conn.idle:
