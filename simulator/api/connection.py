@@ -56,7 +56,8 @@ class Connection:
         self.threaded = threaded
         self.closed = False
         self.error: str | None = None  # set by the send thread: the step thread drops the client
-        self._lock = threading.Lock()  # the send thread's writes against close()
+        self._lock = threading.Lock()  # the I/O thread's reads and writes against close()
+        self._requests_lock = threading.Lock()
         self.peer = peer
         self.key = key
         self.stats = stats
@@ -102,14 +103,18 @@ class Connection:
                 self.stats.bad_frames += 1
                 raise ClientClosed(f"out of sync: {exc}") from exc
             template = self._template
+            decoded: list[pb.ActuatorRequests | PositionTargets] = []
             for frame in frames:
                 targets = template.match(frame) if template is not None else None
                 if targets is not None:
-                    self.requests.append(targets)
+                    decoded.append(targets)
                 else:
-                    self.requests.append(self._parse(frame))
+                    decoded.append(self._parse(frame))
                     template = self._template
                 count += 1
+            if decoded:
+                with self._requests_lock:
+                    self.requests.extend(decoded)
             if len(data) < RECV_CHUNK:
                 break
         if count:
@@ -120,6 +125,22 @@ class Connection:
                 self.stats.round_trip_s.append(now - self.last_sent_at)
                 self.last_sent_at = None
         return count
+
+    def read_threaded(self, now: float) -> None:
+        """I/O thread: :meth:`read`, leaving a failure in ``error`` for the step thread."""
+        with self._lock:
+            if self.closed or self.error is not None:
+                return
+            try:
+                self.read(now)
+            except ClientClosed as exc:
+                self.error = exc.reason
+
+    def take_requests(self) -> list[pb.ActuatorRequests | PositionTargets]:
+        """The requests received since the last call, in arrival order."""
+        with self._requests_lock:
+            requests, self.requests = self.requests, []
+        return requests
 
     def _parse(self, frame: bytes) -> pb.ActuatorRequests:
         request = pb.ActuatorRequests()

@@ -1,11 +1,13 @@
-"""A thread that writes queued measurements to the clients' sockets (async stepping).
+"""A thread that does the clients' socket I/O in async stepping.
 
-One kernel ``send`` per client per step is most of the robot API's cost on the step thread.
-In async mode the step thread only appends each framed measurement to its connection's bounded
-queue (:meth:`simulator.api.connection.Connection.send`) and wakes this thread, which writes
-while the step thread is back in the physics (MuJoCo releases the GIL while it steps). A client
-that does not read only fills its own queue; the oldest measurements are dropped and counted
-as before. A socket error is left on the connection for the step thread to drop it.
+A kernel ``send`` and ``recv`` per client per step are most of the robot API's cost on the
+step thread. In async mode the step thread only appends each framed measurement to its
+connection's bounded queue (:meth:`simulator.api.connection.Connection.send`), wakes this thread
+and takes the requests this thread has decoded (:meth:`Connection.take_requests`); the writes
+and reads happen while the step thread is back in the physics (MuJoCo releases the GIL while it
+steps). A client that does not read only fills its own queue (the oldest measurements are
+dropped and counted as before). A socket error, end of stream or bad frame is left on the
+connection (``error``) for the step thread to drop it, logged once there.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ import logging
 import os
 import selectors
 import threading
+import time
 from collections import deque
 from collections.abc import Iterable
 from typing import TYPE_CHECKING
@@ -23,65 +26,115 @@ if TYPE_CHECKING:
 
 log = logging.getLogger(__name__)
 
-IDLE_WAIT_S = 0.05  # how long a blocked socket is waited for before queues are looked at again
+IDLE_WAIT_S = 0.05  # the longest the thread sleeps without being woken
+READ = selectors.EVENT_READ
+WRITE = selectors.EVENT_WRITE
 
 
 class SendThread:
-    """Writes the queues of the connections it is woken for. ``cpus``: where it may run."""
+    """Reads and writes the sockets of the connections added to it. ``cpus``: where it runs."""
 
     def __init__(self, *, cpus: Iterable[int] | None = None) -> None:
         self._ready: deque[Connection] = deque()
-        self._wake = threading.Event()
+        self._changes: deque[tuple[bool, Connection]] = deque()  # (add?, connection)
+        self._wake_r, self._wake_w = os.pipe()
+        os.set_blocking(self._wake_r, False)
+        os.set_blocking(self._wake_w, False)
+        self._woken = threading.Event()  # a wake byte is in the pipe and not read yet
         self._stop = False
         self._cpus = frozenset(cpus) if cpus else None
-        self._thread = threading.Thread(target=self._run, name="api-send", daemon=True)
+        self._thread = threading.Thread(target=self._run, name="api-io", daemon=True)
         self._thread.start()
+
+    def add(self, conn: Connection) -> None:
+        self._changes.append((True, conn))
+        self._signal()
+
+    def remove(self, conn: Connection) -> None:
+        """Forget ``conn`` (before the step thread closes it)."""
+        self._changes.append((False, conn))
+        self._signal()
 
     def wake(self, connections: Iterable[Connection]) -> None:
         """The connections have new frames queued."""
         self._ready.extend(connections)
-        self._wake.set()
+        self._signal()
 
     def close(self) -> None:
         self._stop = True
-        self._wake.set()
+        self._signal()
         self._thread.join(timeout=5.0)
+        os.close(self._wake_r)
+        os.close(self._wake_w)
+
+    def _signal(self) -> None:
+        if self._woken.is_set():
+            return  # one byte in the pipe is enough
+        self._woken.set()
+        try:
+            os.write(self._wake_w, b"\0")
+        except BlockingIOError:
+            pass  # the pipe is full of wake-ups already
 
     def _run(self) -> None:
         if self._cpus:
             try:
                 os.sched_setaffinity(0, self._cpus)  # this thread only
             except OSError as exc:
-                log.warning("send thread: cannot run on CPUs %s: %s", sorted(self._cpus), exc)
-        blocked: dict[Connection, None] = {}  # sockets that took only part of a frame
+                log.warning("robot API I/O thread: cannot run on CPUs %s: %s",
+                            sorted(self._cpus), exc)  # fmt: skip
+        masks: dict[Connection, int] = {}
         with selectors.DefaultSelector() as selector:
+            selector.register(self._wake_r, READ, None)
             while not self._stop:
-                if blocked:
-                    for key, _ in selector.select(IDLE_WAIT_S if not self._ready else 0.0):
-                        self._ready.append(key.data)
-                else:
-                    self._wake.wait(IDLE_WAIT_S)
-                self._wake.clear()
-                while self._ready:
-                    conn = self._ready.popleft()
-                    was_blocked = conn in blocked
-                    if conn.write_queued():
-                        if was_blocked:
-                            del blocked[conn]
-                            _unregister(selector, conn)
-                    elif not was_blocked and not conn.closed:
-                        blocked[conn] = None
+                for key, events in selector.select(IDLE_WAIT_S):
+                    conn = key.data
+                    if conn is None:  # drain, then clear: a wake-up after this is not lost
                         try:
-                            selector.register(conn.sock, selectors.EVENT_WRITE, conn)
-                        except (ValueError, KeyError, OSError):
-                            del blocked[conn]  # closed meanwhile
-                for conn in [c for c in blocked if c.closed]:
-                    del blocked[conn]
-                    _unregister(selector, conn)
+                            os.read(self._wake_r, 4096)
+                        except BlockingIOError:
+                            pass
+                        self._woken.clear()
+                        continue
+                    if events & READ and conn.error is None:
+                        conn.read_threaded(time.monotonic())
+                    if events & WRITE:
+                        self._ready.append(conn)
+                self._apply_changes(selector, masks)
+                self._write_ready(selector, masks)
 
+    def _apply_changes(
+        self, selector: selectors.BaseSelector, masks: dict[Connection, int]
+    ) -> None:
+        while self._changes:
+            add, conn = self._changes.popleft()
+            if add:
+                if conn.closed:
+                    continue
+                try:
+                    selector.register(conn.fd, READ, conn)
+                    masks[conn] = READ
+                except (KeyError, ValueError, OSError) as exc:
+                    conn.error = f"cannot watch the socket: {exc}"
+            elif conn in masks:
+                del masks[conn]
+                try:
+                    selector.unregister(conn.fd)
+                except (KeyError, ValueError, OSError):
+                    pass  # closed already: the kernel forgot it
 
-def _unregister(selector: selectors.BaseSelector, conn: Connection) -> None:
-    try:
-        selector.unregister(conn.fd)  # by number: the socket may be closed already
-    except (KeyError, ValueError, OSError):
-        pass  # closed by the step thread already
+    def _write_ready(
+        self, selector: selectors.BaseSelector, masks: dict[Connection, int]
+    ) -> None:
+        while self._ready:
+            conn = self._ready.popleft()
+            mask = masks.get(conn)
+            if mask is None:
+                continue  # removed
+            wanted = READ if conn.write_queued() else READ | WRITE
+            if wanted != mask:
+                masks[conn] = wanted
+                try:
+                    selector.modify(conn.fd, wanted, conn)
+                except (KeyError, ValueError, OSError):
+                    pass  # closed meanwhile; its removal follows

@@ -4,8 +4,8 @@ All socket I/O is non-blocking and runs on the step thread at three points of ea
 (:meth:`ApiServer.poll` while waiting or pacing, :meth:`ApiServer.apply_requests` before the
 physics step, :meth:`ApiServer.publish` after it), so the world is only touched by one thread and
 a client can never block the step (except with ``blocking_send``, the HLVS behaviour). In async
-stepping the writes of measurements go to a send thread (:mod:`simulator.api.sender`): the step
-thread queues them and goes back to the physics.
+stepping the clients' reads and writes go to an I/O thread (:mod:`simulator.api.sender`): the
+step thread queues measurements, takes decoded requests and goes back to the physics.
 
 Per step: every complete request received is applied (later ones override earlier targets),
 then one ``SensorMeasurements`` per connected robot is queued. Lockstep: :meth:`wait_lockstep`
@@ -276,8 +276,12 @@ class ApiServer:
         )
         slot.pending.clear()
         slot.stats.connects.append(time.time())
-        slot.mask = selectors.EVENT_READ
-        self._selector.register(sock, slot.mask, ("conn", slot))
+        if self._sender is not None:
+            slot.mask = 0  # the I/O thread watches it
+            self._sender.add(slot.conn)
+        else:
+            slot.mask = selectors.EVENT_READ
+            self._selector.register(sock, slot.mask, ("conn", slot))
         log.info(
             "%s: client %s connected on port %d (sim time %d ms)",
             slot.session.key, peer, slot.endpoint.port, self._world.sim_time_ms,
@@ -309,10 +313,13 @@ class ApiServer:
             return
         slot.conn = None
         slot.pending.clear()
-        try:
-            self._selector.unregister(conn.sock)
-        except (KeyError, ValueError):
-            pass  # never registered or selector closed
+        if conn.threaded and self._sender is not None:
+            self._sender.remove(conn)
+        else:
+            try:
+                self._selector.unregister(conn.sock)
+            except (KeyError, ValueError):
+                pass  # never registered or selector closed
         conn.close()
         slot.stats.disconnects.append(time.time())
         slot.stats.disconnect_reasons.append(reason)
@@ -326,13 +333,18 @@ class ApiServer:
         for slot in self.slots.values():
             slot.session.update_limp()
             conn = slot.conn
-            if conn is not None and conn.error is not None:  # from the send thread
-                self._drop(slot, conn.error)
+            if conn is None:
                 continue
-            if conn is None or not conn.requests:
+            if conn.threaded:
+                if conn.error is not None:  # found by the I/O thread
+                    self._drop(slot, conn.error)
+                    continue
+                if conn.requests:
+                    slot.session.apply_all(conn.take_requests(), step_time_ms=step_time_ms)
                 continue
-            slot.session.apply_all(conn.requests, step_time_ms=step_time_ms)
-            conn.requests.clear()
+            if conn.requests:
+                slot.session.apply_all(conn.requests, step_time_ms=step_time_ms)
+                conn.requests.clear()
 
     def publish(self, time_ms: int) -> None:
         """Queue the measurement of the step that ended at ``time_ms`` for every client."""
