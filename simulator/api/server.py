@@ -311,6 +311,9 @@ class ApiServer:
         conn = slot.conn
         if conn is None:
             return
+        # the statistics first: whoever sees the client gone also sees why
+        slot.stats.disconnects.append(time.time())
+        slot.stats.disconnect_reasons.append(reason)
         slot.conn = None
         slot.pending.clear()
         if conn.threaded and self._sender is not None:
@@ -321,8 +324,6 @@ class ApiServer:
             except (KeyError, ValueError):
                 pass  # never registered or selector closed
         conn.close()
-        slot.stats.disconnects.append(time.time())
-        slot.stats.disconnect_reasons.append(reason)
         log.info("%s: client %s dropped: %s", slot.session.key, conn.peer, reason)
 
     # --- the step ---------------------------------------------------------------------------
