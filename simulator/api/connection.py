@@ -49,13 +49,14 @@ class Connection:
         time_bank_s: float,
         threaded: bool = False,
     ) -> None:
-        """``threaded``: a :class:`simulator.api.sender.SendThread` writes the queue; the step
-        thread only appends to it (:meth:`send`) and drops the client when ``error`` is set."""
+        """``threaded``: a :class:`simulator.api.sender.SendThread` reads the socket and writes
+        the queue; the step thread only appends to the queue (:meth:`send`), takes the decoded
+        requests (:meth:`take_requests`) and drops the client when ``error`` is set."""
         self.sock = sock
         self.fd = sock.fileno()
         self.threaded = threaded
         self.closed = False
-        self.error: str | None = None  # set by the send thread: the step thread drops the client
+        self.error: str | None = None  # set by the I/O thread: the step thread drops the client
         self._lock = threading.Lock()  # the I/O thread's reads and writes against close()
         self._requests_lock = threading.Lock()
         self.peer = peer
@@ -161,7 +162,10 @@ class Connection:
         """Queue one framed measurement; the oldest queued ones are dropped when full."""
         outbox = self.outbox
         while len(outbox) >= self.queue_limit:
-            outbox.popleft()
+            try:
+                outbox.popleft()
+            except IndexError:  # threaded: the I/O thread took it meanwhile
+                break
             self.stats.dropped_out += 1
         outbox.append(frame)
         self.answered = False
@@ -170,13 +174,16 @@ class Connection:
 
     def send(self, frame: bytes, now: float) -> None:
         """:meth:`enqueue` and :meth:`flush`, but a frame with nothing queued before it goes
-        straight to the socket (the usual case: no queue, no view).
+        straight to the socket (the usual case: no queue, no view). Threaded: only
+        :meth:`enqueue`; the I/O thread writes.
 
         Raises:
             ClientClosed: on a fatal send error.
         """
         if self.threaded:
-            self._enqueue_threaded(frame, now)
+            if len(self.outbox) >= self.queue_limit:
+                self.write_queued()  # the I/O thread is behind: the socket may still take them
+            self.enqueue(frame, now)
             return
         if self._partial is not None or self.outbox:
             self.enqueue(frame, now)
@@ -198,49 +205,19 @@ class Connection:
             self._partial = memoryview(frame)[sent:]
             self.want_write = True
 
-    def _enqueue_threaded(self, frame: bytes, now: float) -> None:
-        outbox = self.outbox
-        if len(outbox) >= self.queue_limit:
-            self.write_queued()  # the send thread is behind: the socket may still take them
-        while len(outbox) >= self.queue_limit:
-            try:
-                outbox.popleft()
-            except IndexError:  # the send thread took it meanwhile
-                break
-            self.stats.dropped_out += 1
-        outbox.append(frame)
-        self.answered = False
-        self.last_sent_at = now
-        self.enqueued_at = now
-
     def write_queued(self) -> bool:
-        """Write what the socket takes (the send thread; the step thread when the send thread
-        is behind and the queue is full); True when nothing is left to wait for
-        (all written, or the connection failed or closed), False when the socket is full."""
+        """:meth:`flush` for the I/O thread (and for the step thread when the I/O thread is
+        behind and the queue is full): True when nothing is left to wait for (all written, or
+        the connection failed or closed), False when the socket is full. A failure is left in
+        ``error``."""
         with self._lock:
             if self.closed or self.error is not None:
                 return True
-            sock, outbox, stats = self.sock, self.outbox, self.stats
-            while True:
-                if self._partial is None:
-                    try:
-                        frame = outbox.popleft()
-                    except IndexError:
-                        return True
-                    stats.messages_out += 1
-                    self._partial = memoryview(frame)
-                try:
-                    sent = sock.send(self._partial)
-                except (BlockingIOError, InterruptedError):
-                    return False
-                except OSError as exc:
-                    self.error = f"send failed: {exc}"
-                    return True
-                stats.bytes_out += sent
-                if sent == len(self._partial):
-                    self._partial = None
-                else:
-                    self._partial = self._partial[sent:]
+            try:
+                return self.flush()
+            except ClientClosed as exc:
+                self.error = exc.reason
+                return True
 
     def flush(self) -> bool:
         """Write as much as the socket takes; True when everything queued was written.
@@ -251,10 +228,11 @@ class Connection:
         sock = self.sock
         while True:
             if self._partial is None:
-                if not self.outbox:
+                try:
+                    frame = self.outbox.popleft()
+                except IndexError:  # all written
                     self.want_write = False
                     return True
-                frame = self.outbox.popleft()
                 self.stats.messages_out += 1
                 self._partial = memoryview(frame)
             try:

@@ -91,8 +91,8 @@ class ApiServer:
         send_thread: bool | None = None,
         send_cpus: frozenset[int] | None = None,
     ) -> None:
-        """``send_thread``: write measurements from a thread (default: in async stepping
-        without ``blocking_send``); ``send_cpus``: the CPUs that thread may use."""
+        """``send_thread``: the clients' reads and writes on an I/O thread (default: in async
+        stepping without ``blocking_send``); ``send_cpus``: the CPUs that thread may use."""
         self._world = world
         self._network = network
         self._lockstep = lockstep
