@@ -126,12 +126,7 @@ def _defender(
     hx, hy = pose.to_relative(*home)
     if math.hypot(hx, hy) > 0.4:
         return _go_to(pose, Pose2D(home[0], home[1], 0.0), tolerance_m=0.3)
-    if ball is None:
-        return Action(search=True)
-    bearing = math.atan2(ball[1], ball[0])
-    if abs(bearing) > 0.3:
-        return Action(walk=(0.0, 0.0, _clip(1.0 * bearing, 0.4)))
-    return STAND
+    return _face(ball, tolerance_rad=0.3)
 
 
 def _go_to(pose: Pose2D, target: Pose2D, *, tolerance_m: float = 0.2) -> Action:
@@ -215,16 +210,22 @@ def _goalie(
     hx, hy = pose.to_relative(home.x_m, home.y_m)
     if math.hypot(hx, hy) > 0.5:
         return _go_to(pose, home, tolerance_m=0.3)
+    if ball is not None:
+        bx, by = ball
+        ball_field = pose.to_field(bx, by)
+        if math.hypot(bx, by) < 0.6 and ball_field[0] > pose.x_m + 0.1:
+            # clear only a ball on the field side of the goalie; circling a ball that is behind
+            # it, next to its own goal, could push it in
+            return _striker(pose, ball, field, searching_s)
+    return _face(ball, tolerance_rad=0.25)
+
+
+def _face(ball: tuple[float, float] | None, *, tolerance_rad: float) -> Action:
+    """Stay on the spot turned towards the ball; scan for it when it is not seen."""
     if ball is None:
         return Action(search=True)
-    bx, by = ball
-    ball_field = pose.to_field(bx, by)
-    if math.hypot(bx, by) < 0.6 and ball_field[0] > pose.x_m + 0.1:
-        # clear only a ball on the field side of the goalie; circling a ball that is behind
-        # it, next to its own goal, could push it in
-        return _striker(pose, ball, field, searching_s)
-    bearing = math.atan2(by, bx)
-    if abs(bearing) > 0.25:
+    bearing = math.atan2(ball[1], ball[0])
+    if abs(bearing) > tolerance_rad:
         return Action(walk=(0.0, 0.0, _clip(1.0 * bearing, 0.4)))
     return STAND
 
