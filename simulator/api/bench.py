@@ -28,6 +28,7 @@ import time
 from typing import Any
 
 from referee.snapshot import RobotId, TeamColor
+from simulator.api.endpoints import free_ports
 from simulator.api.framing import WELCOME
 
 MOTORS = (
@@ -223,7 +224,7 @@ def _api_run(
         if world_camera[:2] != camera[:2]:
             raise SystemExit(f"--camera: the robot camera is {world_camera[0]}x{world_camera[1]}")
     lockstep = LockstepSettings(deadline_s=0.05, time_bank_s=1.0)
-    ports = _free_ports(len(robots))
+    ports = free_ports(len(robots))
     endpoints = [
         PlayerEndpoint(robot=r, port=p, hosts=("127.0.0.1",), team_size=4)
         for r, p in zip(robots, ports, strict=True)
@@ -298,17 +299,6 @@ def _api_run(
         if cameras.frames
         else None,
     }
-
-
-def _free_ports(count: int) -> list[int]:
-    socks = [socket.socket() for _ in range(count)]
-    try:
-        for s in socks:
-            s.bind(("127.0.0.1", 0))
-        return [s.getsockname()[1] for s in socks]
-    finally:
-        for s in socks:
-            s.close()
 
 
 def _camera(text: str) -> tuple[int, int, int] | None:

@@ -7,7 +7,6 @@ tests that inspect the calls the server makes or flip limp / removed flags from 
 from __future__ import annotations
 
 import math
-import socket
 import threading
 import time
 from collections.abc import Callable, Iterator, Sequence
@@ -23,6 +22,7 @@ from simulator.api import (
     RenderWorker,
     wait_lockstep,
 )
+from simulator.api.endpoints import free_ports
 from simulator.spec import NetworkSpec
 
 RED1 = RobotId(TeamColor.RED, 1)
@@ -44,17 +44,6 @@ def real_world(robots: Sequence[RobotId]) -> Any:
         for r in robots
     ]
     return World.create(field_class="kid", robots=placements, seed=11)
-
-
-def free_ports(count: int) -> list[int]:
-    socks = [socket.socket() for _ in range(count)]
-    try:
-        for s in socks:
-            s.bind(("127.0.0.1", 0))
-        return [s.getsockname()[1] for s in socks]
-    finally:
-        for s in socks:
-            s.close()
 
 
 def wait_until(predicate: Callable[[], Any], timeout_s: float = 10.0) -> Any:

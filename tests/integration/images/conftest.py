@@ -6,7 +6,6 @@ from __future__ import annotations
 import io
 import os
 import shutil
-import socket
 import subprocess
 import tarfile
 import time
@@ -20,6 +19,7 @@ import docker
 import docker.errors
 import pytest
 
+from orchestrator.delivery.local_sftp import free_port
 from tests.conftest import TEST_LABEL
 
 REGISTRY_BINARY = "/usr/bin/docker-registry"
@@ -32,23 +32,6 @@ class Registry:
     url: str  # http://127.0.0.1:PORT
     users: dict[str, str]
     config: Path
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return int(sock.getsockname()[1])
-
-
-@pytest.fixture(scope="session")
-def docker_client() -> Iterator[docker.DockerClient]:
-    try:
-        client = docker.from_env()
-        client.ping()
-    except docker.errors.DockerException as exc:
-        pytest.skip(f"no Docker engine: {exc}")
-    yield client
-    client.close()
 
 
 def _start_registry(root: Path) -> tuple[subprocess.Popen[bytes], Registry]:

@@ -50,17 +50,6 @@ def _base_image(client: docker.DockerClient) -> str:
 
 
 @pytest.fixture(scope="session")
-def docker_client() -> Iterator[docker.DockerClient]:
-    try:
-        client = docker.from_env()
-        client.ping()
-    except docker.errors.DockerException as exc:
-        pytest.skip(f"no Docker engine: {exc}")
-    yield client
-    client.close()
-
-
-@pytest.fixture(scope="session")
 def runtime(docker_client: docker.DockerClient) -> Any:
     from orchestrator.engine.containers import DockerRuntime
 

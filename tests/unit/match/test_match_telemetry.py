@@ -4,22 +4,16 @@ from __future__ import annotations
 
 import io
 import json
-import socket
 import time
 
 import zenoh
 
+from orchestrator.delivery.local_sftp import free_port
 from orchestrator.telemetry import LiveView, ZenohTelemetry, describe
 
 
-def _free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return int(sock.getsockname()[1])
-
-
 def test_subscriber_receives_state_and_events_from_a_listening_publisher() -> None:
-    endpoint = f"tcp/127.0.0.1:{_free_port()}"
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
     watcher = ZenohTelemetry(endpoint=endpoint, match_id="tm1")  # before the publisher exists
     config = zenoh.Config()
     config.insert_json5("mode", '"peer"')
