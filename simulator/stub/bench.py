@@ -20,7 +20,8 @@ from typing import Any
 
 import numpy as np
 
-CAMERA_PERIOD_MS = 96
+from simulator.stub.runner import CAMERA_PERIOD_MS  # the period the robot asks for in a match
+
 AFTER_KICK_S = 4.0
 MIN_KICK_M = 0.5
 
@@ -35,13 +36,14 @@ class TrialResult:
     sightings: int
 
 
-def sense(world: Any, robot: Any, camera: Any) -> Any:
-    """What the robot's controller gets in a match: joints, IMU, and a camera image when due."""
+def sense(world: Any, robot: Any, camera: Any | None) -> Any:
+    """What the robot's controller gets in a match: joints, IMU, and a camera image when due
+    (never without a ``camera``)."""
     from simulator.stub.controller import Sensors
 
     t_ms = world.sim_time_ms
     image = None
-    if t_ms % CAMERA_PERIOD_MS == 0:
+    if camera is not None and t_ms % CAMERA_PERIOD_MS == 0:
         raw = camera.render(robot)
         image = np.frombuffer(raw, np.uint8).reshape(240, 320, 3)
     joints = {name[:-1]: value for name, value in world.read_positions(robot).items()}

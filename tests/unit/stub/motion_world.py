@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
 from referee.snapshot import PlaceBall, RobotId, TeamColor
 from simulator.motion import standing_posture
+from simulator.stub.bench import sense
+from simulator.stub.controller import Sensors
 from simulator.world import RobotPlacement, World
 
 RED1 = RobotId(TeamColor.RED, 1)
@@ -96,6 +99,11 @@ class OneRobot:
         self.world.data.qvel[:] = 0.0
         mujoco.mj_forward(self.world.model, self.world.data)
         self.stand(settle_s)
+
+    def sensors(self, camera: Any | None = None) -> Sensors:
+        """What the controller reads now, as in a match (the image every 96 ms with a camera)."""
+        sensed: Sensors = sense(self.world, RED1, camera)
+        return sensed
 
     @property
     def joints(self) -> dict[str, float]:

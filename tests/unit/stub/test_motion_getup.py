@@ -28,9 +28,8 @@ def test_get_up_rejects_an_unknown_side() -> None:
 
 @pytest.mark.parametrize("side", ["front", "back"])
 def test_stub_controller_detects_the_fall_and_gets_up(side: str) -> None:
-    from simulator.stub import GameInfo, Phase, Pose2D, Role, Sensors, StubController
+    from simulator.stub import GameInfo, Phase, Pose2D, Role, StubController
 
-    from .motion_world import RED1
 
     robot = OneRobot()
     robot.lay_down(side)
@@ -38,12 +37,7 @@ def test_stub_controller_detects_the_fall_and_gets_up(side: str) -> None:
     game = GameInfo(phase=Phase.PLAYING)
 
     def tick() -> dict[str, float]:
-        sensors = Sensors(
-            time_ms=robot.world.sim_time_ms,
-            joints=robot.joints,
-            accel=robot.world.read_accelerometer(RED1),
-            gyro=robot.world.read_gyro(RED1),
-        )
+        sensors = robot.sensors()
         return controller.tick(sensors, game)
 
     robot.run(12.0, tick, stop_on_fall=False)
@@ -56,9 +50,8 @@ def test_stub_controller_detects_the_fall_and_gets_up(side: str) -> None:
 def test_pushed_over_robot_gets_back_up(direction_rad: float) -> None:
     import math
 
-    from simulator.stub import GameInfo, Phase, Pose2D, Role, Sensors, StubController
+    from simulator.stub import GameInfo, Phase, Pose2D, Role, StubController
 
-    from .motion_world import RED1
 
     robot = OneRobot(yaw_rad=1.0)
     controller = StubController(role=Role.IDLE, start_pose=Pose2D(0.0, 0.0, 1.0))
@@ -70,12 +63,7 @@ def test_pushed_over_robot_gets_back_up(direction_rad: float) -> None:
         push[:3] = (
             (60 * math.cos(direction_rad), 60 * math.sin(direction_rad), 0) if 2 <= t < 2.15 else 0
         )
-        sensors = Sensors(
-            time_ms=robot.world.sim_time_ms,
-            joints=robot.joints,
-            accel=robot.world.read_accelerometer(RED1),
-            gyro=robot.world.read_gyro(RED1),
-        )
+        sensors = robot.sensors()
         robot.command(controller.tick(sensors, game))
         robot.world.step()
         lowest = min(lowest, robot.up)

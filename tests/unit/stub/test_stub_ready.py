@@ -6,9 +6,9 @@ import math
 
 import pytest
 
-from simulator.stub import GameInfo, Phase, Pose2D, Role, Sensors, StubController
+from simulator.stub import GameInfo, Phase, Pose2D, Role, StubController
 
-from .motion_world import RED1, OneRobot
+from .motion_world import OneRobot
 
 
 @pytest.mark.parametrize(
@@ -23,12 +23,7 @@ def test_walks_to_the_kick_off_position_in_ready(role: Role, target: tuple[float
     game = GameInfo(phase=Phase.READY, our_kick_off=False)
 
     def tick() -> dict[str, float]:
-        sensors = Sensors(
-            time_ms=robot.world.sim_time_ms,
-            joints=robot.joints,
-            accel=robot.world.read_accelerometer(RED1),
-            gyro=robot.world.read_gyro(RED1),
-        )
+        sensors = robot.sensors()
         return controller.tick(sensors, game)
 
     assert robot.run(45.0, tick), "fell on the way"

@@ -4,13 +4,12 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 import pytest
 
-from simulator.stub import GameInfo, Phase, Pose2D, Role, Sensors, StubController
+from simulator.stub import GameInfo, Phase, Pose2D, Role, StubController
 from simulator.world import CameraRenderer
 
-from .motion_world import RED1, OneRobot
+from .motion_world import OneRobot
 
 
 @pytest.mark.parametrize(("world_x", "mirrored"), [(-2.5, False), (2.5, True), (4.0, True)])
@@ -21,18 +20,7 @@ def test_side_check_from_the_own_goal(world_x: float, mirrored: bool) -> None:
     game = GameInfo(phase=Phase.INITIAL)
     with CameraRenderer(robot.world, 320, 240) as camera:
         for _ in range(int(3.5 / 0.008)):
-            t = robot.world.sim_time_ms
-            image = None
-            if t % 96 == 0:
-                image = np.frombuffer(camera.render(RED1), np.uint8).reshape(240, 320, 3)
-            sensors = Sensors(
-                time_ms=t,
-                joints=robot.joints,
-                accel=robot.world.read_accelerometer(RED1),
-                gyro=robot.world.read_gyro(RED1),
-                image_bgr=image,
-            )
-            robot.command(controller.tick(sensors, game))
+            robot.command(controller.tick(robot.sensors(camera), game))
             robot.world.step()
     assert controller.mirrored is mirrored
     pose = controller.world.pose
