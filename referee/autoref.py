@@ -94,6 +94,7 @@ class Referee:
             gc=self.gc,
             team_numbers={c: config.team(c).team_id for c in (TeamColor.RED, TeamColor.BLUE)},
             players_per_team=self.field.players_per_team,
+            left_team=lambda: self.left_team,
             log=self.log,
             clock=self._clock,
         )
@@ -384,20 +385,31 @@ class Referee:
         if following is end_of_game.Next.FINISHED:
             self._finish(snapshot, end_of_game.winner(score))
         else:
-            self._wait(self.config.timing.half_time_break_real_s, self._next_period,
-                       f"before the {following.value}", snapshot.sim_time_ms)
+            self._publish()  # robots see FINISHED before the next period's INITIAL
+            commands += self._next_period(snapshot, following)
         return commands
 
-    def _next_period(self, snapshot: WorldSnapshot) -> list[WorldCommand]:
+    def _next_period(
+        self, snapshot: WorldSnapshot, following: end_of_game.Next
+    ) -> list[WorldCommand]:
+        """The break between periods, as the league's referee spends it: the GameController
+        goes to INITIAL of the next period at once (``firstHalf`` 0 before the second half),
+        sides change and robots are placed, then READY (or the shoot-out) after the break."""
         phase = self.gc.next_period()
         self.reset_memories()
+        self.state_event(snapshot, "INITIAL")
+        commands: list[WorldCommand] = []
         if phase is SecondaryState.PENALTYSHOOT:
-            return self._begin_shootout(snapshot)
-        self.left_team = self.left_team.opponent
-        self.log.info(snapshot.sim_time_ms, f"Sides changed: {self.left_team.value} on the left.")
-        commands = self._starting_positions(snapshot.sim_time_ms)
-        self.gc.transition(GameState.READY)
-        self.state_event(snapshot, "READY")
+            after: Action = self._begin_shootout
+        else:
+            self.left_team = self.left_team.opponent
+            self.log.info(
+                snapshot.sim_time_ms, f"Sides changed: {self.left_team.value} on the left."
+            )
+            commands = self._starting_positions(snapshot.sim_time_ms)
+            after = self._to_ready
+        self._wait(self.config.timing.half_time_break_real_s, after,
+                   f"before the {following.value}", snapshot.sim_time_ms)
         return commands
 
     def _finish(self, snapshot: WorldSnapshot, winner: TeamColor | None) -> None:

@@ -1,7 +1,9 @@
 """GameController network: ``RGme`` to every robot on UDP 3838, ``RGrt`` from robots on 3939.
 
 One background thread sends the latest packet to every robot address at 2 Hz (configurable)
-and immediately when the game state changed, and receives return packets: per robot it tracks
+and immediately when the game state changed (every changed packet, in order, so a state that
+lasts a single step, like FINISHED before the next period's INITIAL, still reaches the robots),
+and receives return packets: per robot it tracks
 the last alive time (wall clock), goalkeeper claims, manual penalise / unpenalise requests and
 game-interruption-ready messages. Datagrams that do not decode are ignored and counted.
 """
@@ -64,6 +66,7 @@ class GameControllerNetwork:
         self._clock = clock
         self._lock = threading.Lock()
         self._packet: bytes | None = None
+        self._changes: list[bytes] = []  # changed packets not sent yet, oldest first
         self._changed = threading.Event()
         self._stop = threading.Event()
         self._links: dict[RobotId, RobotLink] = {}
@@ -103,6 +106,8 @@ class GameControllerNetwork:
     def publish(self, packet: bytes, *, changed: bool) -> None:
         with self._lock:
             self._packet = packet
+            if changed:
+                self._changes.append(packet)
         if changed:
             self._changed.set()
 
@@ -133,7 +138,13 @@ class GameControllerNetwork:
                 now = self._clock.monotonic()
                 if now >= next_send or self._changed.is_set():
                     self._changed.clear()
-                    self._send_packet()
+                    with self._lock:
+                        changes, self._changes = self._changes, []
+                        latest = self._packet
+                    if latest is not None and (not changes or changes[-1] is not latest):
+                        changes.append(latest)
+                    for packet in changes:
+                        self._send_packet(packet)
                     next_send = now + self._period_s
                 timeout = max(0.0, min(0.02, next_send - self._clock.monotonic()))
                 if selector.select(timeout):
@@ -141,11 +152,7 @@ class GameControllerNetwork:
         finally:
             selector.close()
 
-    def _send_packet(self) -> None:
-        with self._lock:
-            packet = self._packet
-        if packet is None:
-            return
+    def _send_packet(self, packet: bytes) -> None:
         sent = 0
         for address in self._targets:
             try:

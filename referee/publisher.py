@@ -1,11 +1,13 @@
 """Hands the GameController's state to the network and logs its changes.
 
-Every change of state, secondary state, set play, half, kick-off team, score or penalties is
-one line in ``gamecontroller.log`` and an immediate ``RGme`` send; otherwise the packet handed
-to the sender thread is refreshed every 0.1 s of wall time (the thread sends it at 2 Hz).
+Every change of state, secondary state, set play, half, kick-off team, score, penalties or
+sides is one line in ``gamecontroller.log`` and an immediate ``RGme`` send; otherwise the packet
+handed to the sender thread is refreshed every 0.1 s of wall time (the thread sends it at 2 Hz).
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 from referee.clock import Clock
 from referee.gamecontroller import GameController, game_control_data
@@ -24,10 +26,13 @@ class Publisher:
         gc: GameController,
         team_numbers: dict[TeamColor, int],
         players_per_team: int,
+        left_team: Callable[[], TeamColor],
         log: RefereeLog,
         clock: Clock,
     ) -> None:
+        """``left_team`` tells which team plays on the left now: its TeamInfo goes first."""
         self._gc = gc
+        self._left_team = left_team
         self._team_numbers = dict(team_numbers)
         self._players_per_team = players_per_team
         self._log = log
@@ -45,6 +50,7 @@ class Publisher:
             team_numbers=self._team_numbers,
             players_per_team=self._players_per_team,
             packet_number=self._packet_number,
+            left_team=self._left_team(),
         )
         return encode_game_state(data)
 
@@ -52,9 +58,10 @@ class Publisher:
         gc = self._gc
         red, blue = gc.score(TeamColor.RED), gc.score(TeamColor.BLUE)
         penalised = gc.penalised()
+        left = self._left_team()
         signature = (
             gc.state, gc.secondary_state, gc.set_play, gc.half, gc.kickoff_team, red, blue,
-            penalised,
+            penalised, left,
         )
         changed = signature != self._signature
         if changed:
@@ -62,7 +69,8 @@ class Publisher:
             self._log.gamecontroller(
                 sim_time_ms,
                 f"state {gc.state.name} secondary {gc.secondary_state.name} half {gc.half} "
-                f"score red {red} blue {blue} penalised {[str(r) for r in penalised]}",
+                f"score red {red} blue {blue} penalised {[str(r) for r in penalised]} "
+                f"left {left.value}",
             )
         if self.network is None:
             return

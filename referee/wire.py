@@ -1,8 +1,8 @@
 """GameController datagrams: ``RGme`` version 12 (688 bytes) and ``RGrt`` version 2 (8 bytes).
 
 Little-endian, packed, layout of ``RoboCupGameControlData.h``: a 24-byte header, then two
-332-byte TeamInfo blocks (teams[0] BLUE, teams[1] RED by default), each with a coach and 11
-players of 6-byte RobotInfo.
+332-byte TeamInfo blocks (teams[0] the team playing on the left, teams[1] the other), each with
+a coach and 11 players of 6-byte RobotInfo.
 """
 
 from __future__ import annotations

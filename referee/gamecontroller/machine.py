@@ -142,6 +142,7 @@ class GameController:
         elif new_state is GameState.FINISHED:
             self.set_play = None
             self.secondary_time = 0.0
+            self.secs_remaining = 0.0  # as the league's GameController shows a finished period
             for team in self.teams.values():
                 for info in team.robots.values():
                     if info.red_cards == 0:

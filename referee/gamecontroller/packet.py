@@ -50,14 +50,19 @@ def game_control_data(
     team_numbers: dict[TeamColor, int],
     players_per_team: int,
     packet_number: int,
-    blue_first: bool = True,
+    left_team: TeamColor,
 ) -> GameControlData:
-    """``blue_first``: teams[0] is BLUE and teams[1] RED, as the league GameController sends."""
+    """The ``RGme`` content of ``gc``, ordered as the league's GameController orders it.
+
+    ``teams[0]`` is the team playing on the left (``left_team``) and ``teams[1]`` the other; the
+    two entries swap when the sides change at half time, and robots find their own entry by
+    ``teamNumber``.
+    """
     kickoff = DROPBALL_TEAM if gc.kickoff_team is None else team_numbers[gc.kickoff_team]
     info = (0, 0, 0, 0)
     if gc.set_play is not None:
         info = (team_numbers[gc.set_play.team], gc.set_play.sub_phase, 0, 0)
-    order = (TeamColor.BLUE, TeamColor.RED) if blue_first else (TeamColor.RED, TeamColor.BLUE)
+    order = (left_team, left_team.opponent)
     game_type = GameTypeCode.ROUNDROBIN if gc.game_type is GameType.NORMAL else GameTypeCode.PLAYOFF
     return GameControlData(
         packet_number=packet_number & 0xFF,

@@ -165,6 +165,7 @@ class RobotSession:
         self._order: list[str] = []
         self._camera_sensors: list[tuple[str, int, int]] = []
         self._pending: list[tuple[int, str]] = []
+        self._warned: set[str] = set()  # warnings already sent: each distinct one goes out once
         self._limp = False
         self._camera_size: tuple[int, int] | None = None
         if CAMERA in self._kinds.values():
@@ -174,6 +175,13 @@ class RobotSession:
     # --- commands ---------------------------------------------------------------------------
 
     def warn(self, text: str, *, kind: int = WARNING) -> None:
+        """Queue a message for the next measurement. A warning goes out once per distinct text
+        (a client repeating a bad request every step is told once, as the league's server
+        does); errors go out every time."""
+        if kind == WARNING:
+            if text in self._warned:
+                return
+            self._warned.add(text)
         self._pending.append((kind, text))
 
     def apply(self, request: pb.ActuatorRequests | PositionTargets, *, step_time_ms: int) -> None:

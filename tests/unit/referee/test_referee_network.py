@@ -72,7 +72,7 @@ def test_rgme_sent_to_every_robot_at_2_hz_and_on_change(robots: dict[str, socket
         got = receive_all(robots["127.0.0.3"], 1.6)
         assert 3 <= len(got) <= 5, len(got)  # first at once, then every 0.5 s
         data = decode_game_state(got[0][0], peer="test")
-        assert data.teams[0].team_number == 25 and data.teams[1].team_number == 8
+        assert data.teams[0].team_number == 8 and data.teams[1].team_number == 25  # red on the left
         assert got[0][1][0] == "127.0.0.1"
         ref.step(snapshot(0, (robot(RED, 1, -1, 0),)))  # INITIAL -> READY (no wait)
         started = time.monotonic()
@@ -129,7 +129,7 @@ def test_referee_network_end_to_end(tmp_path: Path, robots: dict[str, socket.soc
     try:
         assert ref.network is not None and ref.mirror is not None
         got = receive_all(robots["127.0.0.4"], 0.3)
-        assert got and decode_game_state(got[0][0]).teams[1].team_number == 8
+        assert got and decode_game_state(got[0][0]).teams[0].team_number == 8  # red on the left
         claim = encode_return(ReturnData(8, 2, ReturnMessage.GOALKEEPER))
         robots["127.0.0.3"].sendto(claim, ref.network.return_address)
         assert wait_for(lambda: RobotId(RED, 2) in ref.network.links())  # type: ignore[union-attr]

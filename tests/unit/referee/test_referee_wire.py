@@ -123,7 +123,7 @@ def test_rgrt_rejects_garbage(raw: bytes) -> None:
         decode_return(raw, peer="robot")
 
 
-def test_packet_from_gamecontroller_puts_blue_first_and_set_play_info() -> None:
+def test_packet_from_gamecontroller_puts_the_left_team_first_and_set_play_info() -> None:
     gc = GameController(
         game_type=GameType.KNOCKOUT, players={TeamColor.RED: (1, 2), TeamColor.BLUE: (1, 2)},
         kickoff=TeamColor.RED, timing=TimingConfig(),
@@ -135,7 +135,7 @@ def test_packet_from_gamecontroller_puts_blue_first_and_set_play_info() -> None:
     gc.begin_set_play(SecondaryState.CORNER_KICK, TeamColor.RED)
     data = game_control_data(
         gc, team_numbers={TeamColor.RED: 8, TeamColor.BLUE: 25}, players_per_team=4,
-        packet_number=300,
+        packet_number=300, left_team=TeamColor.BLUE,
     )
     raw = encode_game_state(data)
     assert raw[6] == 300 & 0xFF and raw[8] == 1  # PLAYOFF
@@ -157,6 +157,6 @@ def test_dropped_ball_kickoff_team_is_128() -> None:
     gc.dropped_ball()
     data = game_control_data(
         gc, team_numbers={TeamColor.RED: 8, TeamColor.BLUE: 25}, players_per_team=4,
-        packet_number=1,
+        packet_number=1, left_team=TeamColor.RED,
     )
     assert data.kick_off_team == 128 and data.state == 1 and data.secondary_time == 45
