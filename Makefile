@@ -10,7 +10,7 @@ HLVS   := $(VENV)/bin/hlvs
 BUILD  := .build
 PYTEST_ARGS ?=
 
-.PHONY: scrimmage test setup venv system engine images lint typecheck clean-build
+.PHONY: scrimmage test setup venv system engine postgres images lint typecheck clean-build
 
 scrimmage: setup
 	$(HLVS) scrimmage --out matches/scrimmage
@@ -18,7 +18,7 @@ scrimmage: setup
 test: setup lint typecheck
 	$(PY) -m pytest $(PYTEST_ARGS)
 
-setup: venv system engine images
+setup: venv system engine postgres images
 
 venv: $(VENV)/.installed
 
@@ -41,6 +41,10 @@ $(BUILD)/system.ok: scripts/setup-system.sh
 engine:
 	@bash scripts/ensure-docker.sh
 
+# Debian's PostgreSQL on 127.0.0.1 with a test role, for the service's tests (root only).
+postgres: system
+	@bash scripts/ensure-postgres.sh
+
 # Content-tagged images: rebuilt only when their inputs change. BASE_IMAGE=python:3.11-slim uses
 # a registry's base instead of the one made locally with debootstrap.
 BASE_IMAGE ?=
@@ -48,7 +52,7 @@ images: venv engine
 	$(HLVS) images build $(if $(BASE_IMAGE),--base $(BASE_IMAGE),)
 
 lint:
-	$(VENV)/bin/ruff check orchestrator simulator referee tests
+	$(VENV)/bin/ruff check orchestrator simulator referee service tests
 
 typecheck:
 	$(VENV)/bin/mypy

@@ -24,6 +24,7 @@ COMMAND_MODULES = (
     "orchestrator.commands.logs",
     "orchestrator.commands.schedule",
     "orchestrator.commands.simulator",
+    "service.commands",
 )
 
 

@@ -1,0 +1,128 @@
+"""The application factory: ``create_app(settings)`` builds the FastAPI app with its lifespan.
+
+Nothing happens at import time. The lifespan opens the database (migrating it to the newest
+schema), builds the match pool and starts the queue worker; it stops the worker on shutdown
+(running matches go on in the pool and are picked up again by the next start).
+
+Routers: every module named in :data:`ROUTER_MODULES` exposes ``mount(app)``, which includes its
+``APIRouter`` (and static files, if any). A package adds its own module to that tuple; to require
+a team token in it use ``service.require_team`` (see :mod:`service.deps`).
+"""
+
+from __future__ import annotations
+
+import importlib
+import logging
+from collections.abc import AsyncIterator, Callable, Sequence
+from contextlib import asynccontextmanager
+from dataclasses import dataclass, field
+from typing import Any
+
+from fastapi import FastAPI, Request
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import JSONResponse
+from sqlalchemy import Engine
+from sqlalchemy.orm import Session, sessionmaker
+from starlette.exceptions import HTTPException as StarletteHTTPException
+
+from service.db import make_engine, migrate, session_factory
+from service.errors import AuthError, ServiceError
+from service.settings import Settings
+
+log = logging.getLogger(__name__)
+
+ROUTER_MODULES: tuple[str, ...] = (
+    "service.routers.health",
+    "service.routers.teams",
+)
+
+
+@dataclass(slots=True)
+class Services:
+    """What request handlers and the worker share; built by the lifespan."""
+
+    settings: Settings
+    engine: Engine
+    sessions: sessionmaker[Session]
+    pool: Any = None  # service.pool.MatchPool
+    worker: Any = None  # service.worker.QueueWorker
+    extras: dict[str, Any] = field(default_factory=dict)
+
+
+PoolFactory = Callable[[Settings], Any]
+
+
+def create_app(
+    settings: Settings,
+    *,
+    pool_factory: PoolFactory | None = None,
+    start_worker: bool = True,
+    router_modules: Sequence[str] = ROUTER_MODULES,
+) -> FastAPI:
+    """The service's app. ``pool_factory`` defaults to the local Docker pool; tests pass a fake
+    one. ``start_worker=False`` serves the API without playing matches."""
+
+    @asynccontextmanager
+    async def lifespan(app: FastAPI) -> AsyncIterator[None]:
+        settings.data_dir.mkdir(parents=True, exist_ok=True)
+        engine = make_engine(settings.db_url)
+        migrate(engine)
+        services = Services(settings=settings, engine=engine, sessions=session_factory(engine))
+        app.state.services = services
+        if start_worker:
+            from service.pool import make_pool
+            from service.worker import QueueWorker
+
+            services.pool = (pool_factory or make_pool)(settings)
+            services.worker = QueueWorker(services)
+            services.worker.start()
+        try:
+            yield
+        finally:
+            if services.worker is not None:
+                services.worker.stop()
+            engine.dispose()
+
+    app = FastAPI(
+        title="hlvs-runner submission service",
+        version="1",
+        description="Test matches, team files, results and logs for the teams of a league.",
+        lifespan=lifespan,
+    )
+    _install_error_handlers(app)
+    for name in router_modules:
+        importlib.import_module(name).mount(app)
+    return app
+
+
+def _install_error_handlers(app: FastAPI) -> None:
+    @app.exception_handler(ServiceError)
+    async def service_error(request: Request, exc: ServiceError) -> JSONResponse:
+        body = {"error": exc.kind, "message": str(exc), **exc.fields()}
+        headers = {"WWW-Authenticate": "Bearer"} if isinstance(exc, AuthError) else None
+        if exc.status_code >= 500:
+            log.error("%s %s: %s", request.method, request.url.path, exc)
+        return JSONResponse(body, status_code=exc.status_code, headers=headers)
+
+    @app.exception_handler(RequestValidationError)
+    async def validation_error(request: Request, exc: RequestValidationError) -> JSONResponse:
+        problems = []
+        for error in exc.errors():
+            location = [str(part) for part in error.get("loc", ())]
+            pointer = "/" + "/".join(location[1:]) if len(location) > 1 else "/"
+            problems.append({"where": location[0] if location else "body",
+                             "pointer": pointer, "message": str(error.get("msg", "")),
+                             "type": str(error.get("type", ""))})
+        summary = "; ".join(f"{p['where']} {p['pointer']}: {p['message']}" for p in problems)
+        return JSONResponse({"error": "invalid_input", "message": summary, "problems": problems},
+                            status_code=422)
+
+    @app.exception_handler(StarletteHTTPException)
+    async def http_error(request: Request, exc: StarletteHTTPException) -> JSONResponse:
+        kind = {404: "not_found", 405: "method_not_allowed", 413: "too_large",
+                415: "unsupported_media_type"}.get(exc.status_code, "http_error")
+        return JSONResponse({"error": kind, "message": str(exc.detail)},
+                            status_code=exc.status_code)
+
+
+__all__ = ["ROUTER_MODULES", "Services", "create_app"]

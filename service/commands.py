@@ -1,0 +1,189 @@
+"""``hlvs serve`` and ``hlvs admin``: parse arguments, wire objects, map errors to exit codes.
+
+``hlvs admin`` works on the service's database directly (same settings as ``hlvs serve``:
+``HLVS_SERVICE_*`` variables, or ``--data-dir`` / ``--database-url``), so the first operator
+token can be issued before the service runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import json
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from service.errors import ServiceError
+from service.settings import Settings
+
+
+def guarded(func: Callable[[argparse.Namespace], int]) -> Callable[[argparse.Namespace], int]:
+    """Service errors become one line on stderr and their exit code (no traceback)."""
+
+    @functools.wraps(func)
+    def run(args: argparse.Namespace) -> int:
+        try:
+            return func(args)
+        except ServiceError as exc:
+            print(f"hlvs: {exc}", file=sys.stderr)
+            return exc.exit_code
+
+    return run
+
+
+def _settings(args: argparse.Namespace) -> Settings:
+    settings = Settings.from_env()
+    changes: dict[str, Any] = {}
+    if getattr(args, "data_dir", None) is not None:
+        changes["data_dir"] = args.data_dir
+    if getattr(args, "database_url", None):
+        changes["database_url"] = args.database_url
+    return settings.with_(**changes) if changes else settings
+
+
+def _add_db_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--data-dir", type=Path, default=None,
+                        help="folder of the service's files (default: $HLVS_SERVICE_DATA_DIR "
+                             "or ./service-data)")
+    parser.add_argument("--database-url", default=None,
+                        help="SQLAlchemy URL (default: $HLVS_SERVICE_DATABASE_URL or SQLite in "
+                             "the data folder)")
+
+
+def register(sub: Any) -> None:
+    serve = sub.add_parser("serve", help="run the submission service (HTTP API)")
+    serve.add_argument("--host", default="127.0.0.1")
+    serve.add_argument("--port", type=int, default=8000)
+    serve.add_argument("--no-worker", action="store_true",
+                       help="serve the API without playing matches")
+    _add_db_options(serve)
+    serve.set_defaults(func=guarded(run_serve))
+
+    admin = sub.add_parser("admin", help="teams and tokens of the submission service")
+    admin_sub = admin.add_subparsers(dest="admin_command", metavar="WHAT", required=True)
+    team = admin_sub.add_parser("team", help="teams").add_subparsers(
+        dest="team_command", metavar="ACTION", required=True)
+    add = team.add_parser("add", help="add a team")
+    add.add_argument("name")
+    add.add_argument("--email", default=None, help="where the team's mail goes")
+    add.add_argument("--accepts-friendlies", action="store_true",
+                     help="other teams may ask for test matches against this team")
+    _add_db_options(add)
+    add.set_defaults(func=guarded(run_team_add))
+    listing = team.add_parser("list", help="list teams")
+    _add_db_options(listing)
+    listing.set_defaults(func=guarded(run_team_list))
+
+    token = admin_sub.add_parser("token", help="API tokens").add_subparsers(
+        dest="token_command", metavar="ACTION", required=True)
+    issue = token.add_parser("issue", help="issue a token (printed once; only its hash is kept)")
+    who = issue.add_mutually_exclusive_group(required=True)
+    who.add_argument("--team", help="a team token for this team")
+    who.add_argument("--operator", action="store_true", help="an operator token")
+    issue.add_argument("--days", type=float, default=None,
+                       help="lifetime in days (default: $HLVS_SERVICE_TOKEN_DAYS, 90)")
+    issue.add_argument("--no-expiry", action="store_true", help="a token that never expires")
+    issue.add_argument("--label", default="", help="a note shown in 'token list'")
+    issue.add_argument("--json", action="store_true", help="print a JSON object")
+    _add_db_options(issue)
+    issue.set_defaults(func=guarded(run_token_issue))
+    revoke = token.add_parser("revoke", help="revoke a token by its id")
+    revoke.add_argument("token_id", help="the id part of hlvs_<id>_<secret>")
+    _add_db_options(revoke)
+    revoke.set_defaults(func=guarded(run_token_revoke))
+    tlist = token.add_parser("list", help="list tokens (ids, scopes, expiry; never secrets)")
+    _add_db_options(tlist)
+    tlist.set_defaults(func=guarded(run_token_list))
+
+    from service.client import register as register_client
+
+    register_client(sub, guarded)
+
+
+def _sessions(args: argparse.Namespace) -> Any:
+    from service.db import make_engine, migrate, session_factory
+
+    settings = _settings(args)
+    settings.data_dir.mkdir(parents=True, exist_ok=True)
+    engine = make_engine(settings.db_url)
+    migrate(engine)
+    return session_factory(engine)
+
+
+def run_serve(args: argparse.Namespace) -> int:
+    import uvicorn
+
+    from service.app import create_app
+
+    app = create_app(_settings(args), start_worker=not args.no_worker)
+    uvicorn.run(app, host=args.host, port=args.port, log_level="info", access_log=False)
+    return 0
+
+
+def run_team_add(args: argparse.Namespace) -> int:
+    from service.admin import add_team
+    from service.db import transaction
+
+    with transaction(_sessions(args)) as session:
+        team = add_team(session, name=args.name, email=args.email,
+                        accepts_friendlies=args.accepts_friendlies)
+        print(json.dumps({"team": team.name, "id": team.id}))
+    return 0
+
+
+def run_team_list(args: argparse.Namespace) -> int:
+    from sqlalchemy import select
+
+    from service.db import Team, transaction
+
+    with transaction(_sessions(args)) as session:
+        for team in session.scalars(select(Team).order_by(Team.name)):
+            print(json.dumps({"team": team.name, "email": team.email,
+                              "accepts_friendlies": team.accepts_friendlies}))
+    return 0
+
+
+def run_token_issue(args: argparse.Namespace) -> int:
+    from service import tokens
+    from service.db import Scope, transaction
+
+    days = None if args.no_expiry else (args.days if args.days is not None
+                                        else _settings(args).token_days)
+    with transaction(_sessions(args)) as session:
+        issued = tokens.issue(session, scope=Scope.OPERATOR if args.operator else Scope.TEAM,
+                              team=args.team, days=days, label=args.label)
+    if args.json:
+        print(json.dumps({
+            "token": issued.secret, "id": issued.token_id, "scope": issued.scope.value,
+            "team": issued.team,
+            "expires_at": issued.expires_at.isoformat(timespec="seconds")
+            if issued.expires_at else None,
+        }))
+    else:
+        print(issued.secret)
+    return 0
+
+
+def run_token_revoke(args: argparse.Namespace) -> int:
+    from service import tokens
+    from service.db import transaction
+
+    with transaction(_sessions(args)) as session:
+        tokens.revoke(session, args.token_id)
+    print(json.dumps({"revoked": args.token_id}))
+    return 0
+
+
+def run_token_list(args: argparse.Namespace) -> int:
+    from service.admin import list_tokens
+    from service.db import transaction
+
+    with transaction(_sessions(args)) as session:
+        for row in list_tokens(session):
+            print(json.dumps(row))
+    return 0
+
+
+__all__ = ["guarded", "register"]

@@ -1,0 +1,38 @@
+"""Database layer: typed models, engine/session helpers, Alembic migrations."""
+
+from __future__ import annotations
+
+from service.db.models import (
+    ACTIVE_STATES,
+    Base,
+    Notification,
+    Scope,
+    ServiceFlag,
+    Submission,
+    SubmissionState,
+    Team,
+    TeamFile,
+    Token,
+    now,
+    utc,
+)
+from service.db.session import make_engine, migrate, session_factory, transaction
+
+__all__ = [
+    "ACTIVE_STATES",
+    "Base",
+    "Notification",
+    "Scope",
+    "ServiceFlag",
+    "Submission",
+    "SubmissionState",
+    "Team",
+    "TeamFile",
+    "Token",
+    "make_engine",
+    "migrate",
+    "now",
+    "session_factory",
+    "transaction",
+    "utc",
+]

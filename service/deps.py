@@ -1,0 +1,87 @@
+"""FastAPI dependencies: the database session per request and the caller's token.
+
+Routers of other packages require a team token with::
+
+    from service import TeamPrincipal
+    @router.get("/v1/envs")
+    def list_envs(principal: TeamPrincipal) -> ...:   # principal.team_id, .team_name
+
+(``TeamPrincipal`` is ``Annotated[Principal, Depends(require_team)]``; for a whole router:
+``APIRouter(dependencies=[Depends(require_team)])``.) ``OperatorPrincipal`` /
+``require_operator`` admit operator tokens only; ``require_token`` admits both.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import TYPE_CHECKING, Annotated
+
+from fastapi import Depends, Request
+from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
+from sqlalchemy.orm import Session
+
+from service import tokens
+from service.db import Scope
+from service.errors import AuthError
+
+if TYPE_CHECKING:
+    from service.app import Services
+
+_bearer = HTTPBearer(auto_error=False, description="a team or operator token: hlvs_<id>_<secret>")
+
+
+def get_services(request: Request) -> Services:
+    services: Services = request.app.state.services
+    return services
+
+
+def get_db(request: Request) -> Iterator[Session]:
+    """One session per request, committed when the handler returns without error."""
+    factory = get_services(request).sessions
+    with factory() as session:
+        with session.begin():
+            yield session
+
+
+DbSession = Annotated[Session, Depends(get_db)]
+
+
+def require_token(
+    session: DbSession,
+    credentials: Annotated[HTTPAuthorizationCredentials | None, Depends(_bearer)],
+) -> tokens.Principal:
+    presented = credentials.credentials if credentials is not None else None
+    return tokens.verify(session, presented)
+
+
+def require_team(
+    principal: Annotated[tokens.Principal, Depends(require_token)],
+) -> tokens.Principal:
+    if principal.scope is not Scope.TEAM or principal.team_id is None:
+        raise AuthError("scope", "this endpoint needs a team token (this one is an "
+                        f"{principal.scope.value} token)")
+    return principal
+
+
+def require_operator(
+    principal: Annotated[tokens.Principal, Depends(require_token)],
+) -> tokens.Principal:
+    if principal.scope is not Scope.OPERATOR:
+        raise AuthError("scope", "this endpoint needs an operator token (this one is a "
+                        f"{principal.scope.value} token)")
+    return principal
+
+
+TeamPrincipal = Annotated[tokens.Principal, Depends(require_team)]
+OperatorPrincipal = Annotated[tokens.Principal, Depends(require_operator)]
+
+__all__ = [
+    "DbSession",
+    "OperatorPrincipal",
+    "TeamPrincipal",
+    "get_db",
+    "get_services",
+    "require_operator",
+    "require_team",
+    "require_token",
+]

@@ -1,0 +1,76 @@
+"""The match pool: the port through which the service plays matches.
+
+A pool takes a prepared match (a ``game.json`` with its team files, in a work folder), plays it
+somewhere and leaves the usual match output (``report.json``, ``results.json``, logs) in
+``results_dir(handle)``. The service keeps only the handle (a string) in its database, so a pool
+must answer ``status`` for handles made by an earlier process: that is how a restarted service
+finds the matches that went on while it was down.
+
+Implementations: :class:`service.pool.local.LocalDockerPool` (this host's Docker engine, one
+``hlvs match`` process per match). A cluster implements the same four methods (e.g. ``sbatch`` /
+``squeue`` / ``scancel`` in its own adapter module) and is chosen in :func:`make_pool`.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Protocol
+
+if TYPE_CHECKING:
+    from service.settings import Settings
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class MatchJob:
+    """One match to play: ``game_path`` references its team files; output goes under
+    ``work_dir`` (the pool decides where; see ``results_dir``)."""
+
+    match_id: str
+    game_path: Path
+    work_dir: Path
+
+
+class JobState(enum.StrEnum):
+    PENDING = "pending"  # accepted, waiting for resources inside the pool (clusters)
+    RUNNING = "running"
+    FINISHED = "finished"  # ended, with a report.json in results_dir (whatever the outcome)
+    LOST = "lost"  # not running and no report: the pool lost it; it never played to an end
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class JobStatus:
+    state: JobState
+    detail: str = ""
+
+
+class MatchPool(Protocol):
+    """Port of the match pool (see the module doc). Every method is safe to call again."""
+
+    slots: int
+    """Matches the pool plays at once; the service starts no more than that."""
+
+    def submit(self, job: MatchJob) -> str:
+        """Start ``job``; returns its handle. Submitting a match id that is already running
+        returns the running one's handle instead of starting it twice."""
+        ...
+
+    def status(self, handle: str) -> JobStatus: ...
+
+    def cancel(self, handle: str) -> None:
+        """Ask the match to stop gracefully (robots get their grace period, logs are
+        collected, report.json says ``interrupted``)."""
+        ...
+
+    def results_dir(self, handle: str) -> Path: ...
+
+
+def make_pool(settings: Settings) -> MatchPool:
+    """The pool named by ``settings.pool``."""
+    from service.pool.local import LocalDockerPool
+
+    return LocalDockerPool(slots=settings.match_slots)
+
+
+__all__ = ["JobState", "JobStatus", "MatchJob", "MatchPool", "make_pool"]

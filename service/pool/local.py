@@ -1,0 +1,136 @@
+"""The local pool: each match is one ``hlvs match`` process on this host's Docker engine.
+
+The process runs in its own session, so it outlives a restart of the service; its pid and
+start time are written to ``<work_dir>/pool.json`` before ``submit`` returns, and a later
+service process reads them back to tell a running match from a finished or lost one. Cancel
+sends SIGTERM, which ``hlvs match`` answers with a graceful stop and a complete report.
+The handle is the work folder.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import signal
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+from service.errors import PoolError
+from service.pool import JobState, JobStatus, MatchJob
+
+log = logging.getLogger(__name__)
+
+STATE_FILE = "pool.json"
+LOG_FILE = "orchestrator.log"
+
+
+def _start_time(pid: int) -> int | None:
+    """The kernel's start time of ``pid`` (clock ticks since boot), None when it is gone."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return None
+    fields = stat.rsplit(")", 1)[1].split()
+    if fields[0] == "Z":  # exited, not yet reaped
+        return None
+    return int(fields[19])
+
+
+class LocalDockerPool:
+    def __init__(self, *, slots: int = 1, python: str = sys.executable,
+                 extra_args: tuple[str, ...] = ()) -> None:
+        self.slots = slots
+        self.python = python
+        self.extra_args = extra_args
+        self._children: dict[str, subprocess.Popen[bytes]] = {}
+        self._lock = threading.Lock()
+
+    # MatchPool ---------------------------------------------------------------------------
+    def submit(self, job: MatchJob) -> str:
+        handle = str(job.work_dir.resolve())
+        with self._lock:
+            if self._alive(handle):
+                log.info("match %s already running in the local pool; adopted", job.match_id)
+                return handle
+            out = self.results_dir(handle)
+            out.mkdir(parents=True, exist_ok=True)
+            command = [self.python, "-m", "orchestrator", *self.extra_args, "match",
+                       str(job.game_path.resolve()), "--out", str(out)]
+            with (job.work_dir / LOG_FILE).open("ab") as log_file:
+                try:
+                    child = subprocess.Popen(command, stdout=log_file, stderr=subprocess.STDOUT,
+                                             stdin=subprocess.DEVNULL, start_new_session=True)
+                except OSError as exc:
+                    raise PoolError(handle=handle, reason=f"cannot start hlvs match: {exc}") \
+                        from exc
+            started = _start_time(child.pid)
+            state = {"pid": child.pid, "start_time": started, "match_id": job.match_id}
+            tmp = job.work_dir / (STATE_FILE + ".tmp")
+            tmp.write_text(json.dumps(state))
+            tmp.replace(job.work_dir / STATE_FILE)
+            self._children[handle] = child
+            log.info("match %s started in the local pool (pid %d)", job.match_id, child.pid)
+            return handle
+
+    def status(self, handle: str) -> JobStatus:
+        with self._lock:
+            if self._alive(handle):
+                return JobStatus(state=JobState.RUNNING)
+        if (self.results_dir(handle) / "report.json").is_file():
+            return JobStatus(state=JobState.FINISHED)
+        detail = "the match process ended without a report.json"
+        child = self._children.get(handle)
+        if child is not None and child.returncode is not None:
+            detail += f" (exit code {child.returncode})"
+        elif not (Path(handle) / STATE_FILE).is_file():
+            detail = "the match was never started"
+        return JobStatus(state=JobState.LOST, detail=detail + self._log_tail(handle))
+
+    def cancel(self, handle: str) -> None:
+        state = self._state(handle)
+        with self._lock:
+            pid = None if state is None else state.get("pid")
+            if not isinstance(pid, int) or not self._alive(handle):
+                return
+            try:
+                os.kill(pid, signal.SIGTERM)
+                log.info("match in %s asked to stop (SIGTERM to pid %s)", handle, pid)
+            except ProcessLookupError:
+                pass
+
+    def results_dir(self, handle: str) -> Path:
+        return Path(handle) / "out"
+
+    # helpers -----------------------------------------------------------------------------
+    def _state(self, handle: str) -> dict[str, object] | None:
+        try:
+            data = json.loads((Path(handle) / STATE_FILE).read_text())
+        except (OSError, ValueError):
+            return None
+        return data if isinstance(data, dict) else None
+
+    def _alive(self, handle: str) -> bool:
+        child = self._children.get(handle)
+        if child is not None:
+            return child.poll() is None  # reaps our own child
+        state = self._state(handle)
+        if state is None:
+            return False
+        pid, recorded = state.get("pid"), state.get("start_time")
+        if not isinstance(pid, int):
+            return False
+        current = _start_time(pid)
+        return current is not None and current == recorded  # same pid, same process
+
+    def _log_tail(self, handle: str) -> str:
+        try:
+            lines = (Path(handle) / LOG_FILE).read_text(errors="replace").strip().splitlines()
+        except OSError:
+            return ""
+        return (": " + lines[-1][-300:]) if lines else ""
+
+
+__all__ = ["LocalDockerPool"]

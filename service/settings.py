@@ -1,0 +1,116 @@
+"""The service's settings: one frozen object, read from ``HLVS_SERVICE_*`` environment variables.
+
+Every default lives here. ``Settings.from_env()`` is called by the entrypoint (``hlvs serve``,
+``hlvs admin``) only; tests build ``Settings(...)`` directly.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields, replace
+from pathlib import Path
+from typing import Any
+
+from service.errors import SettingsError
+
+PREFIX = "HLVS_SERVICE_"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Settings:
+    """Typed settings of ``hlvs serve``; environment variable = ``HLVS_SERVICE_`` + upper name."""
+
+    data_dir: Path = Path("service-data")
+    """Team files, match folders and the default SQLite database live here."""
+    database_url: str = ""
+    """SQLAlchemy URL; empty: ``sqlite:///<data_dir>/service.sqlite``. PostgreSQL:
+    ``postgresql+psycopg://user:password@host/db``."""
+    max_upload_bytes: int = 1_000_000
+    token_days: float = 90.0
+    """Lifetime of a newly issued token (``hlvs admin token issue --days`` overrides)."""
+    match_slots: int = 1
+    """Test matches played at the same time by the pool."""
+    pool: str = "local"
+    """``local``: the Docker engine of this host."""
+    worker_poll_s: float = 1.0
+    test_half_duration_s: float = 30.0
+    test_players: int = 1
+    test_grace_s: float = 5.0
+    expected_match_s: float = 120.0
+    """Assumed wall time of one test match until some have finished (for expected starts)."""
+    preflight: str = "full"
+    """``full``: pull, size, start and connect to a simulator; ``images``: pull and size only."""
+    preflight_timeout_s: float = 25.0
+    smtp_host: str = ""
+    """Empty: no mail is sent."""
+    smtp_port: int = 25
+    mail_from: str = "hlvs@localhost"
+    webhook_attempts: int = 5
+    webhook_backoff_s: float = 2.0
+    webhook_timeout_s: float = 5.0
+    public_url: str = "http://127.0.0.1:8000"
+    extra: Mapping[str, str] = field(default_factory=dict)
+
+    @property
+    def db_url(self) -> str:
+        if self.database_url:
+            return self.database_url
+        return f"sqlite:///{(self.data_dir / 'service.sqlite').resolve()}"
+
+    @property
+    def matches_dir(self) -> Path:
+        return self.data_dir / "matches"
+
+    def with_(self, **changes: Any) -> Settings:
+        return replace(self, **changes)
+
+    @classmethod
+    def from_env(cls, environ: Mapping[str, str] | None = None) -> Settings:
+        environ = os.environ if environ is None else environ
+        values: dict[str, Any] = {}
+        defaults = cls()
+        for f in fields(cls):
+            if f.name == "extra":
+                continue
+            name = PREFIX + f.name.upper()
+            if name not in environ:
+                continue
+            raw = environ[name]
+            current = getattr(defaults, f.name)
+            values[f.name] = _convert(name, raw, current)
+        settings = cls(**values)
+        _check(settings)
+        return settings
+
+
+def _convert(name: str, raw: str, current: object) -> object:
+    try:
+        if isinstance(current, bool):
+            if raw.lower() not in ("1", "0", "true", "false", "yes", "no"):
+                raise ValueError(raw)
+            return raw.lower() in ("1", "true", "yes")
+        if isinstance(current, int):
+            return int(raw)
+        if isinstance(current, float):
+            return float(raw)
+        if isinstance(current, Path):
+            return Path(raw)
+    except ValueError:
+        raise SettingsError(name=name, value=raw,
+                            expected=f"a {type(current).__name__}") from None
+    return raw
+
+
+def _check(settings: Settings) -> None:
+    if settings.pool not in ("local",):
+        raise SettingsError(name=PREFIX + "POOL", value=settings.pool, expected="local")
+    if settings.preflight not in ("full", "images"):
+        raise SettingsError(name=PREFIX + "PREFLIGHT", value=settings.preflight,
+                            expected="full or images")
+    if settings.match_slots < 1:
+        raise SettingsError(name=PREFIX + "MATCH_SLOTS", value=str(settings.match_slots),
+                            expected="at least 1")
+
+
+__all__ = ["Settings"]

@@ -1,0 +1,197 @@
+"""Test-match submissions: create, cancel, queue position and expected start. Domain code.
+
+States (see :class:`service.db.SubmissionState`): a submission is QUEUED when accepted; the
+worker moves it to STARTING, asks the pool, then RUNNING; it ends DONE, FAILED or CANCELLED.
+A team has at most one active (queued, starting or running) submission; the database's
+partial unique index keeps that true even for simultaneous requests.
+"""
+
+from __future__ import annotations
+
+import heapq
+import logging
+import secrets
+from dataclasses import dataclass
+from datetime import datetime, timedelta
+
+from sqlalchemy import func, select
+from sqlalchemy.exc import IntegrityError
+from sqlalchemy.orm import Session
+
+from service.db import (
+    ACTIVE_STATES,
+    ServiceFlag,
+    Submission,
+    SubmissionState,
+    Team,
+    now,
+    utc,
+)
+from service.errors import Conflict, InvalidInput, NotFound
+
+log = logging.getLogger(__name__)
+
+STUB = "stub"
+TEAM_SIDE = {"image_pull", "team_startup", "team_crash"}
+LEAGUE_SIDE = {"infrastructure", "simulator", "referee"}
+
+
+def failure_side(failure_class: str | None) -> str | None:
+    """Whose side a failure was on: ``team``, ``league`` or None (no failure / cancelled)."""
+    if failure_class in TEAM_SIDE:
+        return "team"
+    if failure_class in LEAGUE_SIDE:
+        return "league"
+    return None
+
+
+def active_of(session: Session, team_id: int) -> Submission | None:
+    states = [s.value for s in ACTIVE_STATES]
+    return session.scalar(select(Submission).where(
+        Submission.team_id == team_id, Submission.state.in_(states)))
+
+
+def check_opponent(session: Session, *, team_id: int, opponent: str) -> None:
+    if opponent == STUB:
+        return
+    other = session.scalar(select(Team).where(Team.name == opponent))
+    if other is None or other.id == team_id or not other.accepts_friendlies:
+        names = [STUB, *session.scalars(select(Team.name).where(
+            Team.accepts_friendlies.is_(True), Team.id != team_id))]
+        raise InvalidInput(
+            f"opponent {opponent!r} is not a team that accepts friendlies "
+            f"(expected one of: {', '.join(names)})",
+            problems=[{"pointer": "/opponent", "message": "unknown opponent",
+                       "expected": " | ".join(names)}])
+
+
+def refuse_if_active(session: Session, team_id: int) -> None:
+    existing = active_of(session, team_id)
+    if existing is not None:
+        raise Conflict(f"the team already has an active test match {existing.id} "
+                       f"({existing.state}); cancel it or wait until it ends",
+                       existing_id=existing.id)
+
+
+def create(session: Session, *, team_id: int, opponent: str, team_file_id: int,
+           credentials_file_id: int | None, preflight_s: float | None) -> Submission:
+    """Insert a QUEUED submission; 409 when the team already has an active one."""
+    row = Submission(id="sub_" + secrets.token_hex(6), team_id=team_id, opponent=opponent,
+                     team_file_id=team_file_id, credentials_file_id=credentials_file_id,
+                     state=SubmissionState.QUEUED.value, preflight_s=preflight_s, attempts=0,
+                     cancel_requested=False, charged=False)
+    try:
+        with session.begin_nested():
+            session.add(row)
+            session.flush()
+    except IntegrityError:
+        refuse_if_active(session, team_id)
+        raise
+    log.info("submission %s queued (team %d, opponent %s)", row.id, team_id, opponent)
+    return row
+
+
+def get_own(session: Session, *, team_id: int, submission_id: str) -> Submission:
+    """The team's submission; another team's id is 'not found', like an unknown one."""
+    row = session.scalar(select(Submission).where(Submission.id == submission_id))
+    if row is None or row.team_id != team_id:
+        raise NotFound(what="submission", ident=submission_id)
+    return row
+
+
+def cancel(session: Session, row: Submission) -> Submission:
+    """Queued: cancelled at once, not charged. Running: the worker stops it gracefully."""
+    state = SubmissionState(row.state)
+    if state is SubmissionState.QUEUED:
+        row.state = SubmissionState.CANCELLED.value
+        row.finished_at = now()
+        row.cause = "cancelled by the team while queued"
+        row.charged = False
+        log.info("submission %s cancelled while queued", row.id)
+    elif state in (SubmissionState.STARTING, SubmissionState.RUNNING):
+        row.cancel_requested = True
+        log.info("submission %s: cancel requested while %s", row.id, state.value)
+    else:
+        raise Conflict(f"submission {row.id} has already ended ({row.state})",
+                       existing_id=row.id)
+    return row
+
+
+def queue_paused(session: Session) -> bool:
+    flag = session.get(ServiceFlag, "queue_paused")
+    return flag is not None and flag.value == "1"
+
+
+def set_queue_paused(session: Session, paused: bool) -> None:
+    flag = session.get(ServiceFlag, "queue_paused")
+    if flag is None:
+        session.add(ServiceFlag(key="queue_paused", value="1" if paused else "0"))
+    else:
+        flag.value = "1" if paused else "0"
+        flag.updated_at = now()
+    log.info("queue %s", "paused" if paused else "resumed")
+
+
+@dataclass(frozen=True, slots=True)
+class QueueInfo:
+    position: int | None  # 1 = next to start
+    expected_start: datetime | None
+    reason: str | None
+
+
+def average_match_s(session: Session, default_s: float) -> float:
+    rows = session.execute(select(Submission.started_at, Submission.finished_at).where(
+        Submission.state == SubmissionState.DONE.value, Submission.started_at.is_not(None),
+        Submission.finished_at.is_not(None)).order_by(Submission.seq.desc()).limit(20)).all()
+    durations = [(utc(end) - utc(start)).total_seconds() for start, end in rows if start and end]
+    return sum(durations) / len(durations) if durations else default_s
+
+
+def queue_info(session: Session, row: Submission, *, slots: int, default_match_s: float
+               ) -> QueueInfo:
+    """Where a queued submission stands: position, expected start and why it waits."""
+    if row.state != SubmissionState.QUEUED.value:
+        return QueueInfo(None, None, None)
+    ahead = session.scalar(select(func.count()).select_from(Submission).where(
+        Submission.state == SubmissionState.QUEUED.value, Submission.seq < row.seq)) or 0
+    position = ahead + 1
+    if queue_paused(session):
+        return QueueInfo(position, None, "the queue is paused by the league's operators")
+    running = list(session.scalars(select(Submission.started_at).where(Submission.state.in_(
+        [SubmissionState.STARTING.value, SubmissionState.RUNNING.value]))))
+    match_s = average_match_s(session, default_match_s)
+    current = now()
+    duration = timedelta(seconds=match_s)
+    free = [max(current, utc(start) + duration) if start else current + duration
+            for start in running[:slots]]
+    free += [current] * max(0, slots - len(free))
+    heapq.heapify(free)
+    start = current
+    for _ in range(position):
+        start = heapq.heappop(free)
+        heapq.heappush(free, start + duration)
+    busy = min(len(running), slots)
+    if ahead:
+        reason = (f"{ahead} submission(s) ahead in the queue; {busy} of {slots} match slot(s) "
+                  "busy")
+    elif busy >= slots:
+        reason = f"next in line; all {slots} match slot(s) busy"
+    else:
+        reason = "next in line; starting shortly"
+    return QueueInfo(position, start, reason)
+
+
+__all__ = [
+    "QueueInfo",
+    "STUB",
+    "active_of",
+    "cancel",
+    "check_opponent",
+    "create",
+    "failure_side",
+    "get_own",
+    "queue_info",
+    "queue_paused",
+    "refuse_if_active",
+    "set_queue_paused",
+]
