@@ -14,13 +14,17 @@ its result does not depend on machine speed.
 from __future__ import annotations
 
 import logging
+import struct
 import time
 from dataclasses import asdict, dataclass
 from typing import Any, Protocol
 
+import numpy as np
+
 from referee.snapshot import RefereeEvent, WorldCommand, WorldSnapshot
 from simulator.api import ApiServer, LockstepSettings, wait_lockstep
-from simulator.telemetry import STATE_PERIOD_S, Telemetry
+from simulator.telemetry import POSES_PERIOD_S, STATE_PERIOD_S, Telemetry
+from simulator.traffic import TrafficLog
 
 log = logging.getLogger(__name__)
 
@@ -43,6 +47,7 @@ class RefereeLike(Protocol):
 class WorldLike(Protocol):
     sim_time_ms: int
     step_ms: int
+    data: Any  # mujoco.MjData: xpos and xquat are sent to live viewers
 
     def step(self) -> None: ...
 
@@ -84,6 +89,7 @@ class MatchLoop:
         recorder: RecorderLike | None,
         telemetry: Telemetry,
         settings: LoopSettings,
+        traffic: TrafficLog | None = None,
     ) -> None:
         self.world = world
         self.referee = referee
@@ -91,6 +97,7 @@ class MatchLoop:
         self.recorder = recorder
         self.telemetry = telemetry
         self.settings = settings
+        self.traffic = traffic
         self.stop_requested = False
         self.stop_reason = ""
         self.steps = 0
@@ -98,6 +105,7 @@ class MatchLoop:
         self.real_time_s = 0.0
         self._events_seen = 0
         self._next_state_s = 0.0
+        self._next_poses_s = 0.0
         self._rtf_window: tuple[float, int] = (0.0, 0)
         self._rtf = 0.0
 
@@ -189,16 +197,30 @@ class MatchLoop:
             self._rtf_window = (now, self.world.sim_time_ms)
         return self._rtf
 
+    def _publish_poses(self, now: float) -> None:
+        if now < self._next_poses_s:
+            return
+        self._next_poses_s = now + POSES_PERIOD_S
+        data = self.world.data
+        poses = np.concatenate([data.xpos, data.xquat], axis=1).astype("<f4")
+        self.telemetry.poses(struct.pack("<I", self.world.sim_time_ms) + poses.tobytes())
+
     def _publish_state(self, *, force: bool = False) -> None:
         now = time.monotonic()
+        self._publish_poses(now)
         if not force and now < self._next_state_s:
             return
         self._next_state_s = now + STATE_PERIOD_S
         game = self.referee.game_state
+        rtf = self.real_time_factor()
+        robots = None
+        if self.traffic is not None:
+            self.traffic.sample(now_s=now, sim_time_ms=self.world.sim_time_ms, real_time_factor=rtf)
+            robots = self.traffic.latest["robots"] if self.traffic.latest else None
         self.telemetry.state(
             {
                 "sim_time_ms": self.world.sim_time_ms,
-                "real_time_factor": round(self.real_time_factor(), 3),
+                "real_time_factor": round(rtf, 3),
                 "state": game.get("state"),
                 "secondary_state": game.get("secondary_state"),
                 "half": game.get("half"),
@@ -206,5 +228,6 @@ class MatchLoop:
                 "score": game.get("score"),
                 "connected": self.server.connected(),
                 "stepping": self.settings.stepping,
+                "robots": robots,
             }
         )

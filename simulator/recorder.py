@@ -1,117 +1,108 @@
-"""Replay files (``.hlvsrec``): a versioned header, then frames at a fixed rate.
+"""The replay writer: :class:`Recorder` writes a match as a version 2 ``.hlvsrec`` file.
 
-Layout (little-endian)::
-
-    b"HLVSREC\\0"
-    u32 header length, header JSON (format, version, match_id, seed, field_class,
-        physics_dt_s, step_ms, rate_hz, robots [{team, number, model, x_m, y_m, yaw_rad}],
-        body_names)
-    frames, each: u32 payload length, then
-        u32 sim_time_ms, u32 meta length, meta JSON {"game": {...}, "events": [...]},
-        zlib(float32[len(body_names) * 7]): x y z qw qx qy qz of every body (world frame)
-
-JSON is written with sorted keys and fixed separators and zlib at a fixed level, so a match
-replayed from the same seed and inputs gives a byte-identical file. Frames are independent (each
-pose block compressed on its own: about 3x smaller than raw float32).
+The format (self-describing header with the scene, chunks of frames, an index and a trailer for
+seeking) is described in :mod:`simulator.replay.format`; reading is :mod:`simulator.replay`.
 """
 
 from __future__ import annotations
 
-import json
-import struct
 import zlib
-from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
 
 import numpy as np
-import numpy.typing as npt
 
-from referee.snapshot import RobotId, TeamColor
-from simulator.errors import ReplayError
-from simulator.world import RobotPlacement, World
+from simulator.replay.format import (
+    CHUNK,
+    FORMAT_VERSION,
+    INDEX,
+    INDEX_MAGIC,
+    MAGIC,
+    RECORD_HEAD,
+    TRAILER,
+    U32,
+    dumps,
+    shuffle,
+)
+from simulator.replay.reader import load_replay
+from simulator.replay.scene import scene_of
+from simulator.world import World
 
-MAGIC = b"HLVSREC\0"
-FORMAT_VERSION = 1
-_U32 = struct.Struct("<I")
-_FRAME_HEAD = struct.Struct("<II")
-
-
-def _dumps(value: object) -> bytes:
-    return json.dumps(value, sort_keys=True, separators=(",", ":"), default=str).encode()
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class ReplayHeader:
-    version: int
-    match_id: str
-    seed: int
-    field_class: str
-    physics_dt_s: float
-    step_ms: int
-    rate_hz: float
-    robots: tuple[RobotPlacement, ...]
-    body_names: tuple[str, ...]
+ZLIB_LEVEL = 6
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
-class ReplayFrame:
-    sim_time_ms: int
-    game: dict[str, Any]
-    events: list[dict[str, Any]]
-    poses: npt.NDArray[np.float32]  # (nbody, 7): x y z qw qx qy qz
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Replay:
-    header: ReplayHeader
-    frames: tuple[ReplayFrame, ...]
+def replay_header(
+    world: World, *, match_id: str, rate_hz: float, chunk_frames: int
+) -> dict[str, Any]:
+    """The header of a version 2 replay of ``world`` (also the scene sent to live viewers)."""
+    return {
+        "format": "hlvsrec",
+        "version": FORMAT_VERSION,
+        "match_id": match_id,
+        "seed": world.seed,
+        "field_class": world.field.field_class.value,
+        "physics_dt_s": world.physics_dt_s,
+        "step_ms": world.step_ms,
+        "rate_hz": rate_hz,
+        "chunk_frames": chunk_frames,
+        "robots": [
+            {
+                "team": p.id.team.value,
+                "number": p.id.number,
+                "model": p.model,
+                "x_m": p.x_m,
+                "y_m": p.y_m,
+                "yaw_rad": p.yaw_rad,
+            }
+            for p in world.placements
+        ],
+        "body_names": [world.model.body(i).name for i in range(world.model.nbody)],
+        "scene": scene_of(world.model, world.placements, world.field),
+    }
 
 
 class Recorder:
     """Writes a replay while a match runs: call :meth:`record` after every step (it writes a
     frame when one is due at ``rate_hz`` of simulated time), :meth:`event` for referee events
     (stored with the next frame) and :meth:`close` at the end. The first frame, written on
-    creation, holds the initial state with an empty game state."""
+    creation, holds the initial state with an empty game state. Frames are written in chunks of
+    ``chunk_frames`` (flushed to disk as each chunk completes)."""
 
     def __init__(
-        self, path: str | Path, world: World, *, match_id: str, rate_hz: float = 25.0
+        self,
+        path: str | Path,
+        world: World,
+        *,
+        match_id: str,
+        rate_hz: float = 25.0,
+        chunk_frames: int = 25,
     ) -> None:
         if rate_hz <= 0:
             raise ValueError(f"rate_hz must be positive, not {rate_hz}")
+        if chunk_frames <= 0:
+            raise ValueError(f"chunk_frames must be positive, not {chunk_frames}")
         self.path = Path(path)
         self.rate_hz = rate_hz
+        self.chunk_frames = chunk_frames
         self._period_ms = 1000.0 / rate_hz
         self._frames = 0
         self._events: list[dict[str, Any]] = []
         self._game: dict[str, Any] = {}
         self._last_time_ms = -1
+        self._pending: dict[str, list[Any]] = self._empty_chunk()
+        self._poses: list[np.ndarray] = []
+        self._index_chunks: list[list[int]] = []
+        self._index_events: list[dict[str, Any]] = []
+        self._offset = 0
         self._out: IO[bytes] | None = self.path.open("wb")
-        header = {
-            "format": "hlvsrec",
-            "version": FORMAT_VERSION,
-            "match_id": match_id,
-            "seed": world.seed,
-            "field_class": world.field.field_class.value,
-            "physics_dt_s": world.physics_dt_s,
-            "step_ms": world.step_ms,
-            "rate_hz": rate_hz,
-            "robots": [
-                {
-                    "team": p.id.team.value,
-                    "number": p.id.number,
-                    "model": p.model,
-                    "x_m": p.x_m,
-                    "y_m": p.y_m,
-                    "yaw_rad": p.yaw_rad,
-                }
-                for p in world.placements
-            ],
-            "body_names": [world.model.body(i).name for i in range(world.model.nbody)],
-        }
-        blob = _dumps(header)
-        self._out.write(MAGIC + _U32.pack(len(blob)) + blob)
+        header = replay_header(world, match_id=match_id, rate_hz=rate_hz, chunk_frames=chunk_frames)
+        blob = dumps(header)
+        self._emit(MAGIC + U32.pack(len(blob)) + blob)
         self.record(world, {})  # the initial state
+
+    @staticmethod
+    def _empty_chunk() -> dict[str, list[Any]]:
+        return {"times": [], "games": [], "events": []}
 
     @property
     def frames_written(self) -> int:
@@ -120,29 +111,66 @@ class Recorder:
     def record(self, world: World, game_state: dict[str, Any]) -> None:
         self._game = game_state
         if world.sim_time_ms >= self._frames * self._period_ms:
-            self._write(world.sim_time_ms, world.data.xpos, world.data.xquat)
+            self._add(world.sim_time_ms, world.data.xpos, world.data.xquat)
             while self._frames * self._period_ms <= world.sim_time_ms:
                 self._frames += 1
 
     def event(self, event: dict[str, Any]) -> None:
         self._events.append(event)
 
-    def _write(self, sim_time_ms: int, xpos: np.ndarray, xquat: np.ndarray) -> None:
+    def _emit(self, blob: bytes) -> None:
         if self._out is None:
             raise ValueError(f"{self.path}: recorder is closed")
-        meta = _dumps({"game": self._game, "events": self._events})
+        self._out.write(blob)
+        self._offset += len(blob)
+
+    def _add(self, sim_time_ms: int, xpos: np.ndarray, xquat: np.ndarray) -> None:
+        if self._out is None:
+            raise ValueError(f"{self.path}: recorder is closed")
+        chunk = self._pending
+        chunk["times"].append(sim_time_ms)
+        chunk["games"].append(self._game)
+        chunk["events"].append(self._events)
+        self._index_events.extend({**e, "frame_ms": sim_time_ms} for e in self._events)
         self._events = []
-        poses = zlib.compress(np.concatenate([xpos, xquat], axis=1).astype("<f4").tobytes(), 6)
-        payload = _FRAME_HEAD.pack(sim_time_ms, len(meta)) + meta + poses
-        self._out.write(_U32.pack(len(payload)) + payload)
+        self._poses.append(np.concatenate([xpos, xquat], axis=1).astype("<f4"))
         self._last_time_ms = sim_time_ms
+        if len(chunk["times"]) >= self.chunk_frames:
+            self._flush_chunk()
+
+    def _flush_chunk(self) -> None:
+        chunk = self._pending
+        if not chunk["times"]:
+            return
+        meta = dumps(chunk)
+        poses = zlib.compress(shuffle(np.stack(self._poses)), ZLIB_LEVEL)
+        payload = U32.pack(len(meta)) + meta + poses
+        times = chunk["times"]
+        self._index_chunks.append([self._offset, times[0], times[-1], len(times)])
+        self._emit(RECORD_HEAD.pack(CHUNK, len(payload)) + payload)
+        assert self._out is not None
+        self._out.flush()
+        self._pending = self._empty_chunk()
+        self._poses = []
 
     def close(self, world: World | None = None) -> None:
-        """Flush events not yet written (in a last frame when ``world`` is given) and close."""
+        """Write the frame of events not yet written (when ``world`` is given), the last chunk,
+        the index and the trailer, and close."""
         if self._out is None:
             return
         if self._events and world is not None and world.sim_time_ms != self._last_time_ms:
-            self._write(world.sim_time_ms, world.data.xpos, world.data.xquat)
+            self._add(world.sim_time_ms, world.data.xpos, world.data.xquat)
+        self._flush_chunk()
+        index = dumps(
+            {
+                "chunks": self._index_chunks,
+                "events": self._index_events,
+                "frames": sum(c[3] for c in self._index_chunks),
+                "duration_ms": self._last_time_ms,
+            }
+        )
+        at = self._offset
+        self._emit(RECORD_HEAD.pack(INDEX, len(index)) + index + TRAILER.pack(at, INDEX_MAGIC))
         self._out.close()
         self._out = None
 
@@ -153,66 +181,4 @@ class Recorder:
         self.close()
 
 
-def _header(data: dict[str, Any]) -> ReplayHeader:
-    return ReplayHeader(
-        version=int(data["version"]),
-        match_id=str(data["match_id"]),
-        seed=int(data["seed"]),
-        field_class=str(data["field_class"]),
-        physics_dt_s=float(data["physics_dt_s"]),
-        step_ms=int(data["step_ms"]),
-        rate_hz=float(data["rate_hz"]),
-        robots=tuple(
-            RobotPlacement(
-                id=RobotId(TeamColor(r["team"]), int(r["number"])),
-                model=str(r["model"]),
-                x_m=float(r["x_m"]),
-                y_m=float(r["y_m"]),
-                yaw_rad=float(r["yaw_rad"]),
-            )
-            for r in data["robots"]
-        ),
-        body_names=tuple(data["body_names"]),
-    )
-
-
-def load_replay(path: str | Path) -> Replay:
-    """Read a whole replay; ReplayError names the file and the problem."""
-    path = Path(path)
-    try:
-        blob = path.read_bytes()
-    except OSError as exc:
-        raise ReplayError(path=str(path), reason=f"cannot read: {exc}") from exc
-    if not blob.startswith(MAGIC):
-        raise ReplayError(path=str(path), reason="not an hlvsrec file (bad magic)")
-    try:
-        (size,) = _U32.unpack_from(blob, len(MAGIC))
-        start = len(MAGIC) + 4
-        raw = json.loads(blob[start : start + size])
-        if raw.get("version") != FORMAT_VERSION:
-            raise ReplayError(
-                path=str(path), reason=f"version {raw.get('version')}, expected {FORMAT_VERSION}"
-            )
-        header = _header(raw)
-        nbody = len(header.body_names)
-        offset = start + size
-        frames = []
-        while offset < len(blob):
-            (length,) = _U32.unpack_from(blob, offset)
-            offset += 4
-            time_ms, meta_len = _FRAME_HEAD.unpack_from(blob, offset)
-            meta = json.loads(blob[offset + 8 : offset + 8 + meta_len])
-            packed = blob[offset + 8 + meta_len : offset + length]
-            poses = np.frombuffer(zlib.decompress(packed), dtype="<f4", count=nbody * 7)
-            frames.append(
-                ReplayFrame(
-                    sim_time_ms=time_ms,
-                    game=meta["game"],
-                    events=meta["events"],
-                    poses=poses.reshape(nbody, 7),
-                )
-            )
-            offset += length
-    except (struct.error, zlib.error, ValueError, KeyError, TypeError) as exc:
-        raise ReplayError(path=str(path), reason=f"truncated or corrupt: {exc}") from exc
-    return Replay(header=header, frames=tuple(frames))
+__all__ = ["Recorder", "load_replay", "replay_header"]

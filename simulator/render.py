@@ -1,7 +1,8 @@
 """Videos from replays: ``python -m simulator render REPLAY -o match.mp4 [--width --height --fps]``.
 
-The world model is rebuilt from the replay header; each frame's body poses are turned into geom
-poses (no physics) and drawn offscreen from the ``overview`` camera, and the raw RGB frames are
+A model of shapes only is built from the scene the replay carries (for a version 1 replay, from
+today's robot models); each frame's body poses are turned into geom poses (no physics) and
+drawn offscreen from the ``overview`` camera, and the raw RGB frames are
 piped to ffmpeg (libx264, yuv420p). The game state of the frames (state, half, time left, score)
 becomes a subtitle track. Needs ``MUJOCO_GL=osmesa`` (or ``egl``) without a display.
 """
@@ -22,7 +23,7 @@ import numpy as np
 import numpy.typing as npt
 
 from simulator.errors import RenderError, ReplayError
-from simulator.recorder import Replay, load_replay
+from simulator.replay import Replay, load_replay, scene_for
 
 logger = logging.getLogger(__name__)
 
@@ -95,6 +96,66 @@ def _subtitles(replay: Replay, indices: list[int], fps: float) -> str:
     return "\n".join(cues)
 
 
+def _f(values: list[float]) -> str:
+    return " ".join(f"{v:.6g}" for v in values)
+
+
+def _geom_xml(geom: dict[str, Any], material: str | None) -> str:
+    look = f'material="{material}"' if material else f'rgba="{_f(geom["rgba"])}"'
+    return (
+        f'<geom type="{geom["type"]}" size="{_f(geom["size"])}" pos="{_f(geom["pos"])}" '
+        f'quat="{_f(geom["quat"])}" {look} group="{geom["group"]}" contype="0" '
+        f'conaffinity="0"/>'
+    )
+
+
+def scene_xml(scene: dict[str, Any]) -> str:
+    """An MJCF of shapes only (no joints, no physics) with one body per recorded body, in the
+    recorded order, so that body ``i`` of the model is body ``i`` of every frame."""
+    bodies = scene["bodies"]
+    geoms: list[list[str]] = [[] for _ in bodies]
+    assets = [
+        '<texture name="sky" type="skybox" builtin="gradient" rgb1="0.55 0.7 0.9" '
+        'rgb2="0.1 0.15 0.25" width="64" height="64"/>'
+    ]
+    for i, geom in enumerate(scene["geoms"]):
+        material = None
+        pattern = geom.get("pattern")
+        if pattern is not None:
+            material = f"m{i}"
+            first, second = pattern["colors"]
+            kind = "cube" if pattern["cube"] else "2d"
+            assets.append(
+                f'<texture name="t{i}" type="{kind}" builtin="checker" rgb1="{_f(first)}" '
+                f'rgb2="{_f(second)}" width="64" height="64"/>'
+                f'<material name="{material}" texture="t{i}" texrepeat="{_f(pattern["repeat"])}" '
+                f'reflectance="0"/>'
+            )
+        geoms[geom["body"]].append(_geom_xml(geom, material))
+    cameras = "".join(
+        f'<camera name="{c["name"]}" pos="{_f(c["pos"])}" quat="{_f(c["quat"])}" '
+        f'fovy="{c["fovy_deg"]:.6g}"/>'
+        for c in scene["cameras"]
+    )
+    children = "".join(
+        f'<body name="b{i}">{"".join(geoms[i])}</body>' for i in range(1, len(bodies))
+    )
+    return f"""<mujoco model="replay">
+<visual>
+ <global offwidth="1920" offheight="1080"/>
+ <quality shadowsize="2048" offsamples="0"/>
+ <headlight ambient="0.35 0.35 0.35" diffuse="0.3 0.3 0.3" specular="0 0 0"/>
+ <map znear="0.01" zfar="100"/>
+</visual>
+<asset>{"".join(assets)}</asset>
+<worldbody>
+<light directional="true" pos="0 0 10" dir="0.2 0.3 -1" diffuse="0.7 0.7 0.7" castshadow="false"/>
+<light directional="true" pos="0 0 10" dir="-0.2 -0.3 -1" diffuse="0.3 0.3 0.3" castshadow="false"/>
+{cameras}{"".join(geoms[0])}{children}
+</worldbody>
+</mujoco>"""
+
+
 def render_video(
     replay_path: str | Path,
     output: str | Path,
@@ -106,22 +167,16 @@ def render_video(
     """Render a replay file to an MP4 video; returns the output path."""
     import mujoco
 
-    from referee.field import field_for
-    from simulator.world.scene import compile_scene
-
     output = Path(output)
     ffmpeg = shutil.which("ffmpeg")
     if ffmpeg is None:
         raise RenderError(output=str(output), reason="ffmpeg not found on PATH")
     replay = load_replay(replay_path)
-    header = replay.header
-    model = compile_scene(
-        field_for(header.field_class), header.robots, physics_dt_s=header.physics_dt_s
-    )
-    if model.nbody != len(header.body_names):
+    model = mujoco.MjModel.from_xml_string(scene_xml(scene_for(replay.header, str(replay_path))))
+    if model.nbody != len(replay.header.body_names):
         raise ReplayError(
             path=str(replay_path),
-            reason=f"{len(header.body_names)} bodies recorded, the rebuilt model has {model.nbody}",
+            reason=f"{len(replay.header.body_names)} bodies recorded, the scene has {model.nbody}",
         )
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)

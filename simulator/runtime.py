@@ -2,10 +2,11 @@
 
 Wires the world, the robot API server, the referee (GameController, mirror, AutoRef), the
 recorder and telemetry, runs :class:`simulator.match_loop.MatchLoop` and writes into ``--out``:
-``sim_result.json``, ``replay.hlvsrec``, ``referee.log``, ``referee_events.jsonl``,
-``gamecontroller.log`` and the video when the spec asks for one. Exit codes: 0 the game reached
-FINISHED, 1 it did not (time limit, physics divergence), 2 invalid spec, 3 infrastructure (a port
-or the telemetry endpoint unavailable), 130 stopped by SIGTERM / SIGINT (results still written).
+``sim_result.json``, ``replay.hlvsrec``, ``api_stats.jsonl``, ``referee.log``,
+``referee_events.jsonl``, ``gamecontroller.log`` and the video when the spec asks for one. Exit
+codes: 0 the game reached FINISHED, 1 it did not (time limit, physics divergence), 2 invalid
+spec, 3 infrastructure (a port or the telemetry endpoint unavailable), 130 stopped by SIGTERM /
+SIGINT (results still written).
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ from simulator.match_loop import LoopSettings, MatchLoop
 from simulator.match_setup import referee_config
 from simulator.spec import MatchSpec
 from simulator.telemetry import TelemetryError, open_telemetry
+from simulator.traffic import STATS_FILE, TrafficLog
 
 log = logging.getLogger(__name__)
 
@@ -106,7 +108,7 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
     """Play the match of ``spec``, writing every output file into ``out``; returns the exit code."""
     from referee.autoref import Referee
     from simulator.api.world_cameras import world_render_worker
-    from simulator.recorder import Recorder
+    from simulator.recorder import Recorder, replay_header
     from simulator.world import World
 
     log.info(
@@ -140,14 +142,23 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
         recorder = Recorder(
             out / REPLAY_FILE, world, match_id=spec.match_id, rate_hz=spec.recorder_rate_hz
         )
-        telemetry = open_telemetry(match_id=spec.match_id, listen=spec.network.telemetry_listen)
+        telemetry = open_telemetry(
+            match_id=spec.match_id,
+            listen=spec.network.telemetry_listen,
+            scene=replay_header(
+                world, match_id=spec.match_id, rate_hz=spec.recorder_rate_hz, chunk_frames=1
+            ),
+        )
         stack.callback(telemetry.close)
+        traffic = TrafficLog(server, path=out / STATS_FILE)
+        stack.callback(traffic.close)
         loop = MatchLoop(
             world=world,
             referee=referee,
             server=server,
             recorder=recorder,
             telemetry=telemetry,
+            traffic=traffic,
             settings=LoopSettings(
                 stepping=spec.stepping,
                 maximum_real_time_factor=spec.maximum_real_time_factor,

@@ -1,15 +1,20 @@
 """Live telemetry of a match over zenoh (the only module of the simulator that imports zenoh).
 
 Keys: ``hlvs/<match_id>/state`` (JSON, about 5 Hz: sim_time_ms, real_time_factor, state,
-secondary_state, half, secs_remaining, score, connected, stepping) and ``hlvs/<match_id>/events``
-(one JSON referee event per message). The simulator listens on ``NetworkSpec.telemetry_listen``
-(peer mode, multicast scouting and shared memory off); viewers connect to it.
+secondary_state, half, secs_remaining, score, connected, stepping, robots: each robot's latest
+API traffic sample, see simulator.traffic), ``hlvs/<match_id>/events`` (one JSON referee event
+per message), ``hlvs/<match_id>/poses`` (about 10 Hz, binary: u32 sim_time_ms, then float32
+x y z qw qx qy qz of every body, little-endian) and ``hlvs/<match_id>/scene`` (the replay header
+with its scene, JSON, every ``SCENE_PERIOD_S``, so that a viewer joining late can draw the
+poses). The simulator listens on ``NetworkSpec.telemetry_listen`` (peer mode, multicast scouting
+and shared memory off); viewers connect to it.
 """
 
 from __future__ import annotations
 
 import json
 import logging
+import time
 from typing import Any, Protocol
 
 from simulator.errors import SimulatorError
@@ -17,6 +22,8 @@ from simulator.errors import SimulatorError
 log = logging.getLogger(__name__)
 
 STATE_PERIOD_S = 0.2
+POSES_PERIOD_S = 0.1
+SCENE_PERIOD_S = 2.0
 
 
 class TelemetryError(SimulatorError):
@@ -31,6 +38,8 @@ class Telemetry(Protocol):
 
     def event(self, payload: dict[str, Any]) -> None: ...
 
+    def poses(self, payload: bytes) -> None: ...
+
     def close(self) -> None: ...
 
 
@@ -41,6 +50,9 @@ class NullTelemetry:
         return None
 
     def event(self, payload: dict[str, Any]) -> None:
+        return None
+
+    def poses(self, payload: bytes) -> None:
         return None
 
     def close(self) -> None:
@@ -66,7 +78,9 @@ def zenoh_config(
 class ZenohTelemetry:
     """Publishes the match state and referee events on a zenoh session."""
 
-    def __init__(self, *, match_id: str, listen: str) -> None:
+    def __init__(
+        self, *, match_id: str, listen: str, scene: dict[str, Any] | None = None
+    ) -> None:
         import zenoh
 
         try:
@@ -75,21 +89,34 @@ class ZenohTelemetry:
             raise TelemetryError(endpoint=listen, reason=str(exc)) from exc
         self._state: Any = self._session.declare_publisher(f"hlvs/{match_id}/state")
         self._events: Any = self._session.declare_publisher(f"hlvs/{match_id}/events")
+        self._poses: Any = self._session.declare_publisher(f"hlvs/{match_id}/poses")
+        self._scene: Any = self._session.declare_publisher(f"hlvs/{match_id}/scene")
+        self._scene_blob = json.dumps(scene, sort_keys=True) if scene is not None else None
+        self._next_scene_s = 0.0
         log.info("telemetry on %s (keys hlvs/%s/state, hlvs/%s/events)", listen, match_id, match_id)
 
     def state(self, payload: dict[str, Any]) -> None:
         self._state.put(json.dumps(payload, sort_keys=True))
+        now = time.monotonic()
+        if self._scene_blob is not None and now >= self._next_scene_s:
+            self._next_scene_s = now + SCENE_PERIOD_S
+            self._scene.put(self._scene_blob)
 
     def event(self, payload: dict[str, Any]) -> None:
         self._events.put(json.dumps(payload, sort_keys=True, default=str))
 
+    def poses(self, payload: bytes) -> None:
+        self._poses.put(payload)
+
     def close(self) -> None:
-        self._state.undeclare()
-        self._events.undeclare()
+        for publisher in (self._state, self._events, self._poses, self._scene):
+            publisher.undeclare()
         self._session.close()
 
 
-def open_telemetry(*, match_id: str, listen: str | None) -> Telemetry:
+def open_telemetry(
+    *, match_id: str, listen: str | None, scene: dict[str, Any] | None = None
+) -> Telemetry:
     if not listen:
         return NullTelemetry()
-    return ZenohTelemetry(match_id=match_id, listen=listen)
+    return ZenohTelemetry(match_id=match_id, listen=listen, scene=scene)

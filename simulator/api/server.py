@@ -178,6 +178,10 @@ class ApiServer:
     def connected(self) -> list[str]:
         return [slot.session.key for slot in self.slots.values() if slot.conn is not None]
 
+    def traffic(self) -> dict[str, tuple[bool, RobotStats]]:
+        """Each robot's live counters and whether it is connected (cheap: nothing copied)."""
+        return {s.session.key: (s.conn is not None, s.stats) for s in self.slots.values()}
+
     def statistics(self) -> dict[str, dict[str, Any]]:
         return {slot.session.key: slot.stats.to_dict() for slot in self.slots.values()}
 

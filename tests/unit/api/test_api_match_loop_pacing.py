@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import time
+from types import SimpleNamespace
+
+import numpy as np
 
 from referee.snapshot import RefereeEvent, WorldCommand, WorldSnapshot
 from simulator.api import LockstepSettings
@@ -15,6 +18,7 @@ class _World:
 
     def __init__(self) -> None:
         self.sim_time_ms = 0
+        self.data = SimpleNamespace(xpos=np.zeros((2, 3)), xquat=np.zeros((2, 4)))
 
     def step(self) -> None:
         self.sim_time_ms += self.step_ms

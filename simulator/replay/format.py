@@ -1,0 +1,128 @@
+"""Replay files (``.hlvsrec``): what the bytes are, for every version a reader accepts.
+
+Version 2 (written today; little-endian)::
+
+    b"HLVSREC\\0"
+    u32 header length, header JSON: format "hlvsrec", version 2, match_id, seed, field_class,
+        physics_dt_s, step_ms, rate_hz, chunk_frames, robots [{team, number, model, x_m, y_m,
+        yaw_rad}], body_names, scene (see simulator.replay.scene)
+    records, each: u8 kind, u32 payload length, payload
+      kind 1, chunk: u32 meta length, meta JSON {"times": [ms...], "games": [{...}...],
+          "events": [[{...}...]...]}, then zlib of the float32 poses
+          (frames, bodies, 7: x y z qw qx qy qz in the world frame) with their bytes shuffled
+          (all first bytes, then all second bytes...), which compresses about 1.5x better
+      kind 2, index (last): JSON {"chunks": [[offset, first_ms, last_ms, frames]...],
+          "events": [{..., "frame_ms"}...], "frames", "duration_ms"}
+    trailer: u64 offset of the index record, b"HLVSIDX\\0"
+
+A reader seeks to the trailer, reads the index and then only the chunks it needs. A file whose
+writer died has no trailer; it is read by scanning its records (an unfinished last record is
+dropped). Version 1 (no scene, no index, one zlib block per frame) is described in
+:mod:`simulator.replay.reader`.
+
+JSON is written with sorted keys and fixed separators and zlib at a fixed level, so a match
+replayed from the same seed and inputs gives a byte-identical file (nothing measured on the
+wall clock goes into it: API traffic and the real-time factor are in ``api_stats.jsonl``).
+"""
+
+from __future__ import annotations
+
+import json
+import struct
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+MAGIC = b"HLVSREC\0"
+INDEX_MAGIC = b"HLVSIDX\0"
+FORMAT_VERSION = 2
+SUPPORTED_VERSIONS = (1, 2)
+CHUNK = 1
+INDEX = 2
+U32 = struct.Struct("<I")
+RECORD_HEAD = struct.Struct("<BI")
+TRAILER = struct.Struct("<Q8s")
+POSE_WIDTH = 7
+
+
+def dumps(value: object) -> bytes:
+    return json.dumps(value, sort_keys=True, separators=(",", ":"), default=str).encode()
+
+
+def shuffle(poses: npt.NDArray[np.float32]) -> bytes:
+    """Byte-shuffle little-endian float32 values: all byte 0s, then byte 1s..."""
+    raw = np.ascontiguousarray(poses, dtype="<f4").view(np.uint8).reshape(-1, 4)
+    return raw.T.tobytes()
+
+
+def unshuffle(blob: bytes, count: int) -> npt.NDArray[np.float32]:
+    """Inverse of :func:`shuffle` for ``count`` float32 values."""
+    planes = np.frombuffer(blob, dtype=np.uint8, count=count * 4).reshape(4, count)
+    return np.ascontiguousarray(planes.T).view("<f4").reshape(count)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RobotEntry:
+    """A robot as the replay header lists it (team colour value, number, model, start pose)."""
+
+    team: str
+    number: int
+    model: str
+    x_m: float
+    y_m: float
+    yaw_rad: float
+
+    @property
+    def key(self) -> str:
+        return f"{self.team}_{self.number}"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ReplayHeader:
+    version: int
+    match_id: str
+    seed: int
+    field_class: str
+    physics_dt_s: float
+    step_ms: int
+    rate_hz: float
+    robots: tuple[RobotEntry, ...]
+    body_names: tuple[str, ...]
+    scene: dict[str, Any] | None  # None for version 1 (see simulator.replay.scene_for)
+    raw: dict[str, Any]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ChunkRef:
+    """Where a run of frames is: the file offset of its record (or of its first frame, v1)."""
+
+    offset: int
+    first_ms: int
+    last_ms: int
+    frames: int
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class FrameBlock:
+    """Decoded frames of one chunk."""
+
+    times_ms: npt.NDArray[np.int64]
+    games: list[dict[str, Any]]
+    events: list[list[dict[str, Any]]]
+    poses: npt.NDArray[np.float32]  # (frames, bodies, 7)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ReplayFrame:
+    sim_time_ms: int
+    game: dict[str, Any]
+    events: list[dict[str, Any]]
+    poses: npt.NDArray[np.float32]  # (nbody, 7): x y z qw qx qy qz
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Replay:
+    header: ReplayHeader
+    frames: tuple[ReplayFrame, ...]

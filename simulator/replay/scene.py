@@ -1,0 +1,149 @@
+"""The scene a replay carries: every geom's shape, size, colour and place on its body.
+
+A replay of format 2 holds this description in its header, so that it still renders and plays
+after the robot models change. ``scene_of`` reads it from a compiled MuJoCo model::
+
+    {"bodies": ["world", "ball", "red_1/torso", ...],
+     "geoms": [{"name", "body", "type", "size": [3], "pos": [3], "quat": [w x y z],
+                "rgba": [4], "group", "pattern"?: {"colors": [[r g b], [r g b]],
+                                                   "repeat": [u v], "cube": bool}}],
+     "cameras": [{"name", "body", "pos": [3], "quat": [4], "fovy_deg"}],
+     "robots": [{"team", "number", "model", "root_body"}],
+     "field": {FieldGeometry fields}}
+
+``type`` is one of ``plane sphere capsule ellipsoid cylinder box``; sizes are MuJoCo's (half
+sizes, radius and half length). ``pattern`` is a two-colour texture (MuJoCo's builtin checker).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    import mujoco
+
+    from referee.field import FieldGeometry
+    from simulator.replay.format import ReplayHeader
+    from simulator.world.types import RobotPlacement
+
+GEOM_TYPES = {0: "plane", 2: "sphere", 3: "capsule", 4: "ellipsoid", 5: "cylinder", 6: "box"}
+TEXTURE_ROLE_RGB = 1
+
+
+def _round(values: Any, digits: int = 6) -> list[float]:
+    return [round(float(v), digits) for v in values]
+
+
+def _pattern(model: mujoco.MjModel, matid: int) -> dict[str, Any] | None:
+    texid = int(model.mat_texid[matid][TEXTURE_ROLE_RGB])
+    if texid < 0:
+        return None
+    adr, channels = int(model.tex_adr[texid]), int(model.tex_nchannel[texid])
+    size = int(model.tex_width[texid]) * int(model.tex_height[texid]) * channels
+    texels = model.tex_data[adr : adr + size].reshape(-1, channels)[:, :3]
+    step = max(1, len(texels) // 512)
+    colors = sorted({tuple(int(c) for c in texel) for texel in texels[::step]})
+    if len(colors) != 2:
+        return None
+    return {
+        "colors": [_round([c / 255.0 for c in color], 4) for color in colors],
+        "repeat": _round(model.mat_texrepeat[matid], 4),
+        "cube": int(model.tex_type[texid]) == 1,
+    }
+
+
+def _geom(model: mujoco.MjModel, i: int) -> dict[str, Any]:
+    gtype = int(model.geom_type[i])
+    matid = int(model.geom_matid[i])
+    rgba = model.mat_rgba[matid] if matid >= 0 else model.geom_rgba[i]
+    geom: dict[str, Any] = {
+        "name": model.geom(i).name,
+        "body": int(model.geom_bodyid[i]),
+        "type": GEOM_TYPES.get(gtype, "sphere"),
+        "size": (
+            _round(model.geom_size[i])
+            if gtype in GEOM_TYPES
+            else [float(model.geom_rbound[i])] * 3
+        ),
+        "pos": _round(model.geom_pos[i]),
+        "quat": _round(model.geom_quat[i]),
+        "rgba": _round(rgba, 4),
+        "group": int(model.geom_group[i]),
+    }
+    pattern = _pattern(model, matid) if matid >= 0 else None
+    if pattern is not None:
+        mean = [(a + b) / 2 for a, b in zip(*pattern["colors"], strict=True)]
+        geom["rgba"] = _round([*mean, float(rgba[3])], 4)
+        geom["pattern"] = pattern
+    return geom
+
+
+def scene_of(
+    model: mujoco.MjModel, placements: tuple[RobotPlacement, ...], field: FieldGeometry
+) -> dict[str, Any]:
+    """The scene description of a compiled world model (see the module docstring)."""
+    from simulator.world.types import robot_prefix
+
+    bodies = [model.body(i).name for i in range(model.nbody)]
+    robots = []
+    for p in placements:
+        prefix = robot_prefix(p.id) + "/"
+        root = next((i for i, name in enumerate(bodies) if name.startswith(prefix)), -1)
+        robots.append(
+            {"team": p.id.team.value, "number": p.id.number, "model": p.model, "root_body": root}
+        )
+    cameras = [
+        {
+            "name": model.camera(i).name,
+            "body": int(model.cam_bodyid[i]),
+            "pos": _round(model.cam_pos[i]),
+            "quat": _round(model.cam_quat[i]),
+            "fovy_deg": round(float(model.cam_fovy[i]), 4),
+        }
+        for i in range(model.ncam)
+        if int(model.cam_bodyid[i]) == 0
+    ]
+    field_data = {k: v.value if k == "field_class" else v for k, v in asdict(field).items()}
+    return {
+        "bodies": bodies,
+        "geoms": [_geom(model, i) for i in range(model.ngeom)],
+        "cameras": cameras,
+        "robots": robots,
+        "field": field_data,
+    }
+
+
+def scene_for(header: ReplayHeader, path: str) -> dict[str, Any]:
+    """The scene of a replay: its own (version 2), or for version 1 the scene of today's models
+    for the robots it lists, when those still have the recorded bodies."""
+    if header.scene is not None:
+        return header.scene
+    from referee.field import field_for
+    from referee.snapshot import RobotId, TeamColor
+    from simulator.errors import ReplayError, UnknownModelError
+    from simulator.world.scene import compile_scene
+    from simulator.world.types import RobotPlacement
+
+    placements = tuple(
+        RobotPlacement(
+            id=RobotId(TeamColor(r.team), r.number), model=r.model, x_m=r.x_m, y_m=r.y_m,
+            yaw_rad=r.yaw_rad,
+        )
+        for r in header.robots
+    )  # fmt: skip
+    field = field_for(header.field_class)
+    try:
+        model = compile_scene(field, placements, physics_dt_s=header.physics_dt_s)
+    except UnknownModelError as exc:
+        raise ReplayError(
+            path=path, reason=f"version 1 replay without a scene, and {exc}"
+        ) from exc
+    names = tuple(model.body(i).name for i in range(model.nbody))
+    if names != header.body_names:
+        raise ReplayError(
+            path=path,
+            reason=f"version 1 replay without a scene: {len(header.body_names)} bodies recorded, "
+            f"today's robot models have {model.nbody} (or other names); it cannot be shown",
+        )
+    return scene_of(model, placements, field)
