@@ -41,6 +41,7 @@ from referee.snapshot import (
     WorldCommand,
     WorldSnapshot,
 )
+from referee.spoofing import Senders, SpoofingLog, robot_key
 
 logger = logging.getLogger(__name__)
 
@@ -90,6 +91,12 @@ class Referee:
         self.reset_memories()
         self._network: GameControllerNetwork | None = None
         self._mirror: TeamMirror | None = None
+        self.spoofing = SpoofingLog()
+        self.senders = Senders({
+            RobotId(color, n): address
+            for color in (TeamColor.RED, TeamColor.BLUE)
+            for n, address in enumerate(config.team(color).robot_addresses, start=1)
+        })
         self._publisher = Publisher(
             gc=self.gc,
             team_numbers={c: config.team(c).team_id for c in (TeamColor.RED, TeamColor.BLUE)},
@@ -121,11 +128,15 @@ class Referee:
         )
 
     def result(self) -> dict[str, object]:
-        """score, winner (red, blue, draw; None before the end), events_summary {type: count}."""
-        return reporting.result(
+        """score, winner (red, blue, draw; None before the end), events_summary {type: count},
+        spoofing {total, attempts}."""
+        self._report_spoofing()
+        out = reporting.result(
             self.gc, self.events, finished=self._finished, winner=self._winner,
             shootout=self._shootout is not None, coin_toss=self._coin_toss,
         )
+        out["spoofing"] = self.spoofing.to_json()
+        return out
 
     def start_network(self) -> None:
         """Start the GameController sender / receiver and the team mirror (UDP)."""
@@ -142,6 +153,8 @@ class Referee:
             team_numbers={self.config.team(c).team_id: c for c in addresses},
             send_rate_hz=net.send_rate_hz,
             clock=self._clock,
+            senders=self.senders,
+            spoofing=self.spoofing,
         )
         self._mirror = TeamMirror(
             bind_host=net.bind_host,
@@ -149,6 +162,7 @@ class Referee:
             teams=addresses,
             max_bytes=net.mirror_max_bytes,
             log_dir=self._log_dir,
+            spoofing=self.spoofing,
         )
         self._publisher.network = self._network
         self._network.start()
@@ -192,6 +206,7 @@ class Referee:
             if line.startswith("STATUS: state"):
                 self._publisher.log_counts(snapshot.sim_time_ms)
         self._ball_touch(snapshot)
+        self._report_spoofing()
         self._goalkeeper_claims()
         if self._finished:
             return commands
@@ -497,6 +512,20 @@ class Referee:
                 self.log.info(snapshot.sim_time_ms, f"Ball touched by {toucher}.")
             self._last_toucher = toucher
             self._last_touch_ms = snapshot.last_ball_touch_ms
+
+    def _report_spoofing(self) -> None:
+        """Each new kind of spoofing attempt: one warning and one ``spoofing`` event."""
+        for attempt in self.spoofing.take_new():
+            sim_ms = self._last_ms or 0
+            self.log.warning(sim_ms, attempt.describe() + ".")
+            sender = self.senders.robots_at(attempt.sender)
+            robot = min(sender, key=robot_key) if len(sender) == 1 else None
+            self.emit(RefereeEvent(
+                sim_time_ms=sim_ms, type="spoofing",
+                team=robot.team if robot is not None else None,
+                player=robot.number if robot is not None else None,
+                reason=attempt.describe(), details=attempt.to_json(),
+            ))
 
     def _goalkeeper_claims(self) -> None:
         if self._network is None:

@@ -3,7 +3,9 @@
 Robots may not broadcast; a robot sends its team message to the mirror, which relays it to each
 teammate (its IP, same port), never to the opponents. The sender is known by its source IP
 among the team's hosts; unknown senders are ignored and counted, datagrams over 1024 bytes are
-dropped whole (never truncated) and counted. An address listed for both teams is ignored.
+dropped whole (never truncated) and counted. An address listed for both teams is ignored. A
+datagram from an address that is no member of either team is recorded as a spoofing attempt
+(with its sender) in the shared :class:`~referee.spoofing.SpoofingLog`.
 Log lines in the style of the league's ``bouncing_log.txt``.
 """
 
@@ -20,6 +22,7 @@ from pathlib import Path
 from typing import TextIO
 
 from referee.snapshot import TeamColor
+from referee.spoofing import SpoofingLog
 
 logger = logging.getLogger(__name__)
 
@@ -43,7 +46,9 @@ class TeamMirror:
         teams: Mapping[TeamColor, Sequence[str]],
         max_bytes: int = 1024,
         log_dir: Path | None = None,
+        spoofing: SpoofingLog | None = None,
     ) -> None:
+        self._spoofing = spoofing or SpoofingLog()
         shared = set(teams.get(TeamColor.RED, ())) & set(teams.get(TeamColor.BLUE, ()))
         self._team_of: dict[str, TeamColor] = {}
         self._members: dict[TeamColor, tuple[str, ...]] = {}
@@ -128,7 +133,9 @@ class TeamMirror:
             elif len(payload) > self._max_bytes:
                 self._oversized += 1
         if team is None:
-            self._line(f"Ignored {len(payload)} bytes from unknown host {host}:{port}")
+            self._line(f"Ignored {len(payload)} bytes from unknown host {host}:{port} (spoofing)")
+            self._spoofing.record(channel="mirror", sender=host, sender_robot=None, claimed=None,
+                                  message="team message")
             return
         if len(payload) > self._max_bytes:
             self._line(

@@ -6,6 +6,11 @@ lasts a single step, like FINISHED before the next period's INITIAL, still reach
 and receives return packets: per robot it tracks
 the last alive time (wall clock), goalkeeper claims, manual penalise / unpenalise requests and
 game-interruption-ready messages. Datagrams that do not decode are ignored and counted.
+
+A return packet is attributed by its sender's address: when the robots' addresses are known, a
+packet whose team number and player number name a robot other than the one at its source
+address is a spoofing attempt; it changes nothing and is recorded in the shared
+:class:`~referee.spoofing.SpoofingLog` with the sender.
 """
 
 from __future__ import annotations
@@ -20,6 +25,7 @@ from dataclasses import dataclass, replace
 from referee.clock import Clock
 from referee.errors import ProtocolError
 from referee.snapshot import RobotId, TeamColor
+from referee.spoofing import Senders, SpoofingLog, robot_key
 from referee.wire import ReturnMessage, decode_return
 
 logger = logging.getLogger(__name__)
@@ -45,6 +51,7 @@ class NetworkStats:
     returns_received: int
     garbage: int
     unknown: int
+    spoofed: int = 0
 
 
 class GameControllerNetwork:
@@ -58,7 +65,12 @@ class GameControllerNetwork:
         team_numbers: dict[int, TeamColor],
         send_rate_hz: float,
         clock: Clock,
+        senders: Senders | None = None,
+        spoofing: SpoofingLog | None = None,
     ) -> None:
+        self._senders = senders or Senders({})
+        self._spoofing = spoofing or SpoofingLog()
+        self._spoofed = 0
         self._targets = tuple(targets)
         self._data_port = data_port
         self._team_numbers = dict(team_numbers)
@@ -124,7 +136,7 @@ class GameControllerNetwork:
         with self._lock:
             return NetworkStats(
                 self._packets_sent, self._datagrams_sent, self._returns, self._garbage,
-                self._unknown,
+                self._unknown, self._spoofed,
             )
 
     # --- thread ----------------------------------------------------------------------------
@@ -184,6 +196,19 @@ class GameControllerNetwork:
             logger.debug("ignored datagram: %s", exc)
             return
         color = self._team_numbers.get(data.team)
+        claimed = RobotId(color, data.player) if color is not None else None
+        if self._senders.known and (
+            (claimed is None and not self._senders.robots_at(host))
+            or (claimed is not None and not self._senders.may_speak_for(host, claimed))
+        ):
+            with self._lock:
+                self._spoofed += 1
+            self._spoofing.record(
+                channel="gamecontroller", sender=host, sender_robot=self._senders.label(host),
+                claimed=robot_key(claimed) if claimed is not None else f"team {data.team}",
+                message=data.message.name,
+            )
+            return
         with self._lock:
             if color is None:
                 self._unknown += 1

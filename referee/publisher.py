@@ -87,5 +87,5 @@ class Publisher:
             sim_time_ms,
             f"packets sent: {stats.packets_sent} ({stats.datagrams_sent} datagrams), "
             f"returns received: {stats.returns_received}, garbage: {stats.garbage}, "
-            f"unknown teams: {stats.unknown}",
+            f"unknown teams: {stats.unknown}, spoofed: {stats.spoofed}",
         )

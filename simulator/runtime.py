@@ -134,6 +134,7 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
             network=spec.network,
             lockstep=lockstep if spec.stepping == "lockstep" else None,
             cameras=cameras,
+            spoofing=referee.spoofing,
         )
         server.start()
         stack.callback(server.close)

@@ -80,6 +80,7 @@ class RobotRecord:
             "received_bytes": self.received_bytes,
             "limits": self.limits,
             "api": api,
+            "spoofing_attempts": 0,  # messages sent as another robot (set from the simulator)
         }
 
 
@@ -109,6 +110,12 @@ def build_results(
     if forfeit is not None:
         score = forfeit.get("score", score)
         winner = forfeit.get("winner")
+    spoofing = sim.get("spoofing") if isinstance(sim.get("spoofing"), dict) else None
+    robot_json = {r.key: r.to_json(api_stats.get(r.key)) for r in robots}
+    for attempt in (spoofing or {}).get("attempts") or []:
+        sender = robot_json.get(str(attempt.get("sender_robot")))
+        if sender is not None:
+            sender["spoofing_attempts"] += int(attempt.get("count") or 0)
     return {
         "match_id": match_id,
         "seed": seed,
@@ -123,7 +130,8 @@ def build_results(
         "events_summary": sim.get("events_summary", {}),
         "sim_time_ms": sim.get("sim_time_ms"),
         "real_time_factor": sim.get("real_time_factor"),
-        "robots": {r.key: r.to_json(api_stats.get(r.key)) for r in robots},
+        "robots": robot_json,
+        "spoofing": spoofing,
         "limits": limits,
         "versions": {**versions, "simulator": sim.get("versions")},
         "timings_s": timings_s,

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import ipaddress
 import socket
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 
 from referee.snapshot import RobotId, TeamColor
 from simulator.spec import MatchSpec
@@ -13,16 +13,26 @@ from simulator.spec import MatchSpec
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class PlayerEndpoint:
-    """One robot API port. ``hosts`` are the team's allowed peers (IPs or host names)."""
+    """One robot API port. ``hosts`` are the team's allowed peers (IPs or host names).
+
+    ``others`` maps the addresses of the match's other robots to their keys (``red-2``): when
+    the robots' addresses are known, a robot's port refuses every other robot's address, so a
+    robot can only speak as itself.
+    """
 
     robot: RobotId
     port: int
     hosts: tuple[str, ...]
     team_size: int
+    others: Mapping[str, str] = field(default_factory=dict)
+
+    @property
+    def key(self) -> str:
+        return f"{self.robot.team.value}-{self.robot.number}"
 
     @property
     def allowed_ips(self) -> frozenset[str]:
-        return frozenset(h for h in self.hosts if _is_ip(h))
+        return frozenset(h for h in self.hosts if _is_ip(h) and h not in self.others)
 
     @property
     def allowed_names(self) -> frozenset[str]:
@@ -38,16 +48,26 @@ def _is_ip(text: str) -> bool:
 
 
 def endpoints_from_spec(spec: MatchSpec) -> list[PlayerEndpoint]:
+    addresses = {
+        f"{team.color}-{n}": address
+        for team in (spec.red, spec.blue)
+        for n, address in enumerate(team.robot_addresses, start=1)
+        if address
+    }
     result: list[PlayerEndpoint] = []
     for team in (spec.red, spec.blue):
         color = TeamColor(team.color)
         for player in team.players:
+            key = f"{team.color}-{player.number}"
+            own = addresses.get(key)
+            others = {a: k for k, a in addresses.items() if k != key and a != own}
             result.append(
                 PlayerEndpoint(
                     robot=RobotId(color, player.number),
                     port=player.port,
                     hosts=team.hosts,
                     team_size=len(team.players),
+                    others=others,
                 )
             )
     return result

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from referee.snapshot import RobotId
+from referee.spoofing import SpoofingLog
 from simulator.api import messages_pb2 as pb
 from simulator.api.cameras import MAX_IN_FLIGHT, ImageSource
 from simulator.api.connection import ClientClosed, Connection
@@ -90,10 +91,12 @@ class ApiServer:
         unix_ms: Callable[[], int] = lambda: int(time.time() * 1000),
         send_thread: bool | None = None,
         send_cpus: frozenset[int] | None = None,
+        spoofing: SpoofingLog | None = None,
     ) -> None:
         """``send_thread``: the clients' reads and writes on an I/O thread (default: in async
         stepping without ``blocking_send``); ``send_cpus``: the CPUs that thread may use."""
         self._world = world
+        self._spoofing = spoofing or SpoofingLog()
         self._network = network
         self._lockstep = lockstep
         self._cameras = cameras
@@ -231,7 +234,7 @@ class ApiServer:
             ip = address[0]
             if ip in slot.endpoint.allowed_ips:
                 self._welcome(slot, sock, peer)
-            elif slot.endpoint.allowed_names:
+            elif slot.endpoint.allowed_names and ip not in slot.endpoint.others:
                 if self._lookups is None:
                     self._lookups = ThreadPoolExecutor(max_workers=1, thread_name_prefix="api-dns")
                 names = sorted(slot.endpoint.allowed_names)
@@ -253,10 +256,18 @@ class ApiServer:
 
     def _refuse_host(self, slot: RobotSlot, sock: socket.socket, peer: str) -> None:
         slot.stats.refused += 1
-        log.warning(
-            "%s: refused %s: not in the team's hosts %s",
-            slot.session.key, peer, list(slot.endpoint.hosts),
-        )  # fmt: skip
+        ip = peer.rpartition(":")[0]
+        other = slot.endpoint.others.get(ip)
+        if other is not None:
+            log.warning("%s: refused %s: the address of %s (spoofing)", slot.session.key, peer,
+                        other)
+        else:
+            log.warning(
+                "%s: refused %s: not in the team's hosts %s",
+                slot.session.key, peer, list(slot.endpoint.hosts),
+            )  # fmt: skip
+        self._spoofing.record(channel="api", sender=ip, sender_robot=other,
+                              claimed=slot.endpoint.key, message="connect")
         _refuse(sock)
 
     def _welcome(self, slot: RobotSlot, sock: socket.socket, peer: str) -> None:

@@ -186,3 +186,56 @@ def test_mirror_ignores_address_listed_for_both_teams() -> None:
                 shared.sendto(b"who am i", mirror.address)
                 assert wait_for(lambda: mirror.stats().unknown == 1)
             assert receive_all(blue, 0.1) == [] and receive_all(red, 0.1) == []
+
+
+def test_rgrt_attributed_by_sender_address(tmp_path: Path,
+                                           robots: dict[str, socket.socket]) -> None:
+    """A red robot claiming blue's team number (or a teammate's number) changes nothing and is
+    recorded as spoofing with its sender; its own claims are taken; the mirror records strangers."""
+    port = robots["127.0.0.2"].getsockname()[1]
+    config = make_config(addresses={RED: ("127.0.0.2", "127.0.0.3"), BLUE: ("127.0.0.4",)})
+    from dataclasses import replace
+
+    config = replace(
+        config,
+        network=NetworkConfig(bind_host="127.0.0.1", gc_data_port=port, gc_return_port=0,
+                              mirror_port=0),
+    )
+    ref = Referee(config=config, clock=SystemClock(), log_dir=tmp_path)
+    ref.start_network()
+    try:
+        assert ref.network is not None and ref.mirror is not None
+        red1 = robots["127.0.0.2"]
+        for _ in range(20):
+            red1.sendto(encode_return(ReturnData(25, 1, ReturnMessage.GOALKEEPER)),
+                        ref.network.return_address)
+        red1.sendto(encode_return(ReturnData(8, 2, ReturnMessage.MAN_PENALISE)),
+                    ref.network.return_address)
+        red1.sendto(encode_return(ReturnData(8, 1, ReturnMessage.ALIVE)),
+                    ref.network.return_address)
+        with udp("127.0.0.9", 0) as stranger:
+            stranger.sendto(b"let me in", ref.mirror.address)
+        assert wait_for(lambda: ref.spoofing.total == 22)
+        assert wait_for(lambda: RobotId(RED, 1) in ref.network.links())  # type: ignore[union-attr]
+        links = ref.network.links()
+        assert RobotId(BLUE, 1) not in links and RobotId(RED, 2) not in links
+        assert ref.network.stats().spoofed == 21
+        assert ref.network.take_goalkeeper_claims() == []
+        ref.step(snapshot(0, (robot(RED, 1, -1, 0),)))
+        result = ref.result()
+    finally:
+        ref.close()
+    spoofing = result["spoofing"]
+    assert isinstance(spoofing, dict) and spoofing["total"] == 22
+    attempts = {(a["channel"], a["claimed"], a["message"]): a for a in spoofing["attempts"]}
+    keeper = attempts[("gamecontroller", "blue-1", "GOALKEEPER")]
+    assert keeper["sender"] == "127.0.0.2" and keeper["sender_robot"] == "red-1"
+    assert keeper["count"] == 20
+    assert attempts[("gamecontroller", "red-2", "MAN_PENALISE")]["count"] == 1
+    assert attempts[("mirror", None, "team message")]["sender"] == "127.0.0.9"
+    log = (tmp_path / "referee.log").read_text()
+    assert "GOALKEEPER from 127.0.0.2 (red-1) claiming to be blue-1 ignored" in log
+    assert "declared itself goalkeeper" not in log
+    events = (tmp_path / "referee_events.jsonl").read_text().splitlines()
+    assert sum('"type": "spoofing"' in line for line in events) == 3
+    assert "spoofed: 21" in (tmp_path / "gamecontroller.log").read_text()

@@ -1,0 +1,61 @@
+"""One real match against a hostile red robot that tries several attacks at once; each test
+checks one of them: the result is right, nothing of the teams' logs is lost, nothing is left."""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+import docker
+import pytest
+
+from tests.integration.attack.conftest import Prepare, Prepared, left_behind
+
+pytestmark = [pytest.mark.docker, pytest.mark.root]
+
+
+@pytest.fixture(scope="module")
+def hostile(prepare: Prepare, docker_client: docker.DockerClient
+            ) -> tuple[Prepared, Any, list[str]]:
+    match = prepare("spoof")
+    done = match.run()
+    assert done.returncode == 0, done.stderr[-3000:]
+    return match, done, left_behind(docker_client, match.match_id)
+
+
+def test_played_to_the_end_and_nothing_left(hostile: tuple[Prepared, Any, list[str]]) -> None:
+    match, _, leftovers = hostile
+    assert match.report() == {"status": "success"}
+    results = match.results()
+    assert results["final_state"] == "FINISHED"
+    assert leftovers == []
+    for color in ("red", "blue"):
+        assert (match.out / "teams" / color / "1" / "stdout.log").is_file()
+    assert "attacks done" in (match.out / "teams/red/1/stdout.log").read_text()
+
+
+def test_spoofed_gamecontroller_and_api_messages_are_refused_and_reported(
+    hostile: tuple[Prepared, Any, list[str]],
+) -> None:
+    match, _, _ = hostile
+    results = match.results()
+    spoofing = results["spoofing"]
+    attempts = {(a["channel"], a["claimed"], a["message"]): a for a in spoofing["attempts"]}
+    keeper = attempts[("gamecontroller", "blue-1", "GOALKEEPER")]
+    assert keeper["count"] == 20 and keeper["sender_robot"] == "red-1"
+    assert attempts[("gamecontroller", "blue-1", "MAN_PENALISE")]["count"] == 5
+    seen = json.loads((match.out / "teams/red/1/robocup-logs/attacks.json").read_text())
+    assert seen["blue_api"] == ["Refused\0"] * 3, seen
+    api = attempts[("api", "blue-1", "connect")]
+    assert api["sender_robot"] == "red-1" and api["count"] == 3
+    assert results["robots"]["red-1"]["spoofing_attempts"] == 28
+    assert results["robots"]["blue-1"]["spoofing_attempts"] == 0
+    public = match.out / "public"
+    referee_log = (public / "referee.log").read_text()
+    assert "declared itself goalkeeper" not in referee_log
+    assert "GOALKEEPER from" in referee_log and "(red-1) claiming to be blue-1" in referee_log
+    events = [json.loads(line) for line in
+              (public / "referee_events.jsonl").read_text().splitlines()]
+    spoofs = [e for e in events if e["type"] == "spoofing"]
+    assert {(e["team"], e["player"]) for e in spoofs} == {("red", 1)}
+    assert results["events_summary"]["spoofing"] == len(spoofs) == 3
