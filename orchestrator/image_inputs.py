@@ -13,10 +13,12 @@ from __future__ import annotations
 import hashlib
 import logging
 import os
+import re
 import shutil
 import subprocess
 import sys
 import tempfile
+import tomllib
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from importlib import metadata
@@ -26,10 +28,33 @@ from orchestrator.errors import ImageError
 
 log = logging.getLogger(__name__)
 
+_REPO_ROOT = Path(__file__).resolve().parents[1]
+
 BASE_REPOSITORY = "hlvs-runner/base"
 IMAGE_PYTHON_VERSION = "3.11"  # Debian bookworm's python3, and python:3.11-slim
+ROBOT_PACKAGES = ("robot", "contracts")  # what a robot image carries of this project
 _SKIP_DIRS = {"__pycache__", ".mypy_cache", ".pytest_cache", ".ruff_cache"}
 _SKIP_SUFFIXES = {".pyc", ".pyo"}
+
+
+def package_requirements(packages: Sequence[str]) -> tuple[str, ...]:
+    """Distribution names the given stand-alone packages depend on, read from their own
+    ``<package>/pyproject.toml`` (the packages themselves are copied as sources, not installed)."""
+    names: set[str] = set()
+    for package in packages:
+        path = _REPO_ROOT / package / "pyproject.toml"
+        try:
+            document = tomllib.loads(path.read_text(encoding="utf-8"))
+            dependencies = document["project"]["dependencies"]
+        except (OSError, KeyError, tomllib.TOMLDecodeError) as exc:
+            raise ImageError(
+                image="(requirements)", reason=f"{path}: project.dependencies: {exc}"
+            ) from exc
+        for requirement in dependencies:
+            name = re.split(r"[<>=!~;\[ ]", requirement, maxsplit=1)[0].strip()
+            if not name.startswith("hlvs-"):
+                names.add(name)
+    return tuple(sorted(names))
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -209,10 +234,12 @@ def _link_or_copy(source: Path, target: Path) -> None:
 
 __all__ = [
     "BASE_REPOSITORY",
+    "ROBOT_PACKAGES",
     "BaseRecipe",
     "assemble_context",
     "debootstrap_rootfs",
     "ensure_wheels",
+    "package_requirements",
     "pinned_requirements",
     "project_version",
     "source_files",

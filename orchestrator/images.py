@@ -47,7 +47,7 @@ class ImageRecipe:
     name: str
     base: image_inputs.BaseRecipe  # used when no base image is given
     requirements: tuple[str, ...]  # distributions, pinned to the host's versions
-    packages: tuple[str, ...] = ("simulator", "referee")  # copied to /opt/hlvs/src
+    packages: tuple[str, ...]  # package folders copied to /opt/hlvs/src
 
     @property
     def dockerfile(self) -> Path:
@@ -63,15 +63,26 @@ class ImageRecipe:
         return f"hlvs-runner/{self.name}"
 
 
+ROBOT_REQUIREMENTS = image_inputs.package_requirements(image_inputs.ROBOT_PACKAGES)
 RECIPES: dict[str, ImageRecipe] = {
     "simulator": ImageRecipe(
         name="simulator",
         base=SIM_BASE,
         requirements=("mujoco", "numpy", "eclipse-zenoh", "protobuf"),
+        packages=("simulator", "referee", "robot", "contracts"),
     ),
-    "stub": ImageRecipe(name="stub", base=ROBOT_BASE, requirements=("numpy", "protobuf")),
+    # Robot images carry the robot package and its own dependency list only (no MuJoCo).
+    "stub": ImageRecipe(
+        name="stub",
+        base=ROBOT_BASE,
+        requirements=ROBOT_REQUIREMENTS,
+        packages=image_inputs.ROBOT_PACKAGES,
+    ),
     "team-base": ImageRecipe(
-        name="team-base", base=ROBOT_BASE, requirements=("numpy", "protobuf")
+        name="team-base",
+        base=ROBOT_BASE,
+        requirements=ROBOT_REQUIREMENTS,
+        packages=image_inputs.ROBOT_PACKAGES,
     ),
 }
 IMAGE_NAMES = tuple(RECIPES)

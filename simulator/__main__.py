@@ -16,7 +16,7 @@ COMMANDS = {
 BENCHES = {
     "sim": "simulator.bench_sim",
     "api": "simulator.api.bench",
-    "stub": "simulator.stub.bench",
+    "stub": "benchmarks.stub",
 }
 
 USAGE = "usage: python -m simulator {run|render|bench sim|bench api|bench stub} ..."

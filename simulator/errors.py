@@ -4,15 +4,30 @@ Tree::
 
     SimulatorError
     ├── SpecError            match_spec.json that does not describe a match
-    ├── UnknownModelError    a robot model name we do not ship (lists the known ones)
     ├── PhysicsDivergence    MuJoCo reported instability (carries its warning and the policy)
     ├── ApiError             robot API misuse on the simulator side
     ├── UnknownDeviceError   a device name a robot does not have (world device access)
     ├── ReplayError          a replay file that cannot be read
     └── RenderError          a video that could not be produced (ffmpeg missing or failing)
+
+Unknown robot model names raise :class:`robot.errors.UnknownModelError` (one class for the
+simulator and the robot-side motion code).
 """
 
 from __future__ import annotations
+
+from robot.errors import UnknownModelError
+
+__all__ = [
+    "ApiError",
+    "PhysicsDivergence",
+    "RenderError",
+    "ReplayError",
+    "SimulatorError",
+    "SpecError",
+    "UnknownDeviceError",
+    "UnknownModelError",
+]
 
 
 class SimulatorError(Exception):
@@ -27,11 +42,6 @@ class SpecError(SimulatorError):
         super().__init__(f"{source}: {pointer or '/'}: {reason}")
 
 
-class UnknownModelError(SimulatorError):
-    def __init__(self, *, name: str, known: list[str]) -> None:
-        self.name = name
-        self.known = sorted(known)
-        super().__init__(f"unknown robot model {name!r}; known models: {', '.join(self.known)}")
 
 
 class PhysicsDivergence(SimulatorError):

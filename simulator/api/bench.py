@@ -94,7 +94,7 @@ def _client(port: int, camera_period: int, stalled: bool, cpus: frozenset[int]) 
     """Client process body: enables the sensors, then answers every measurement with 20 joint
     targets (a 1 s cycle of pre-encoded requests: the bench measures the server, so the clients
     sharing its cores skip decoding). The stalled client connects, enables, and never reads."""
-    from simulator.api import messages_pb2 as pb
+    from contracts.robot_api import messages_pb2 as pb
 
     if cpus:
         os.sched_setaffinity(0, cpus)

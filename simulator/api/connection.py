@@ -10,7 +10,7 @@ from collections import deque
 
 from google.protobuf.message import DecodeError
 
-from simulator.api import messages_pb2 as pb
+from contracts.robot_api import messages_pb2 as pb
 from simulator.api.fastreq import PositionTargets, PositionTemplate, scan_positions
 from simulator.api.framing import FrameDecoder, FramingError
 from simulator.api.stats import RobotStats

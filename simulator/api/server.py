@@ -24,9 +24,9 @@ from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any
 
+from contracts.robot_api import messages_pb2 as pb
 from referee.snapshot import RobotId
 from referee.spoofing import SpoofingLog
-from simulator.api import messages_pb2 as pb
 from simulator.api.cameras import MAX_IN_FLIGHT, ImageSource
 from simulator.api.connection import ClientClosed, Connection
 from simulator.api.devices import DeviceWorld

@@ -2,38 +2,38 @@
 
 from __future__ import annotations
 
-from simulator.errors import UnknownModelError
-from simulator.world.robots.geometry import (
+from robot.errors import UnknownModelError
+from robot.geometry import (
     ADULT_GEOMETRY,
     ADULT_SCALE,
     KID_GEOMETRY,
+    MOTOR_NAMES,
     HumanoidGeometry,
+    motor_range,
 )
 from simulator.world.robots.model import (
     FORCE_SENSORS,
-    MOTOR_NAMES,
     CameraSpec,
     MotorSpec,
     RobotMjcf,
     RobotModel,
 )
 
-# (lower, upper) rad, kp N m/rad, max torque N m, max velocity rad/s for the kid model.
+# kp N m/rad, max torque N m, max velocity rad/s for the kid model (ranges: robot.geometry).
 # Stiff, damped servos (kv = KV_TIME_S * kp): with the softer kp / 2 and no damping the
-# open-loop gait of simulator.motion drifts and falls within seconds.
-_KID_MOTORS: dict[str, tuple[float, float, float, float, float]] = {
-    "Neck": (-2.0, 2.0, 16.0, 6.0, 6.0),
-    "Head": (-0.8, 1.2, 16.0, 6.0, 6.0),
-    "Shoulder": (-3.1, 3.1, 40.0, 6.0, 6.0),
-    "ArmUpperL": (-0.3, 2.8, 40.0, 6.0, 6.0),
-    "ArmUpperR": (-2.8, 0.3, 40.0, 6.0, 6.0),
-    "ArmLower": (-0.1, 2.6, 30.0, 6.0, 6.0),
-    "PelvY": (-0.9, 0.9, 80.0, 8.0, 6.0),
-    "Pelv": (-0.6, 0.6, 160.0, 10.0, 6.0),
-    "LegUpper": (-1.0, 2.2, 160.0, 10.0, 6.0),
-    "LegLower": (-0.05, 2.6, 160.0, 10.0, 6.0),
-    "Ankle": (-1.2, 1.2, 160.0, 10.0, 6.0),
-    "Foot": (-0.6, 0.6, 160.0, 10.0, 6.0),
+# open-loop gait of robot.motion drifts and falls within seconds.
+_KID_MOTORS: dict[str, tuple[float, float, float]] = {
+    "Neck": (16.0, 6.0, 6.0),
+    "Head": (16.0, 6.0, 6.0),
+    "Shoulder": (40.0, 6.0, 6.0),
+    "ArmUpper": (40.0, 6.0, 6.0),
+    "ArmLower": (30.0, 6.0, 6.0),
+    "PelvY": (80.0, 8.0, 6.0),
+    "Pelv": (160.0, 10.0, 6.0),
+    "LegUpper": (160.0, 10.0, 6.0),
+    "LegLower": (160.0, 10.0, 6.0),
+    "Ankle": (160.0, 10.0, 6.0),
+    "Foot": (160.0, 10.0, 6.0),
 }
 KV_TIME_S = 0.005
 
@@ -42,8 +42,8 @@ def _motors(scale: float) -> tuple[MotorSpec, ...]:
     torque_scale = scale**4  # torque ~ mass x length ~ scale^4
     motors = []
     for name in MOTOR_NAMES:
-        key = name if name in _KID_MOTORS else name[:-1]
-        lower, upper, kp, torque, velocity = _KID_MOTORS[key]
+        kp, torque, velocity = _KID_MOTORS[name if name in _KID_MOTORS else name[:-1]]
+        lower, upper = motor_range(name)
         motors.append(
             MotorSpec(
                 name=name,

@@ -192,7 +192,7 @@ def build_humanoid(
         rgba,
     )
     camera = (
-        f'<camera name="{p}/{cam.name}" pos="{_f(hr * 0.92, 0, 0)}" xyaxes="0 -1 0 0 0 1" '
+        f'<camera name="{p}/{cam.name}" pos="{_f(g.camera_forward_m, 0, 0)}" xyaxes="0 -1 0 0 0 1" '
         f'fovy="{fovy_deg:.6g}"/>'
     )
     body = f"""

@@ -4,16 +4,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from simulator.world.robots.geometry import HumanoidGeometry
+from robot.geometry import CAMERA_FOV_RAD, HumanoidGeometry
 
 FORCE_SENSORS = ("llb", "llf", "lrf", "lrb", "rlb", "rlf", "rrf", "rrb")
 """Sole corner force sensors: first letter foot (l/r), then side (l/r), then back/front."""
 
-MOTOR_NAMES = (
-    "Neck", "Head", "ShoulderL", "ArmUpperL", "ArmLowerL", "PelvYL", "PelvL", "LegUpperL",
-    "LegLowerL", "AnkleL", "FootL", "PelvYR", "PelvR", "LegUpperR", "LegLowerR", "AnkleR", "FootR",
-    "ShoulderR", "ArmUpperR", "ArmLowerR",
-)  # fmt: skip
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -34,7 +29,7 @@ class CameraSpec:
     name: str = "Camera"
     width: int = 320
     height: int = 240
-    fov_rad: float = 1.04  # horizontal
+    fov_rad: float = CAMERA_FOV_RAD  # horizontal
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -17,8 +17,8 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
-from simulator.client import GameControllerListener
-from simulator.client.gamecontroller import GameControlData, GameState
+from robot.client import GameControllerListener
+from robot.client.gamecontroller import GameControlData, GameState
 from simulator.spec import MatchSpec
 from tests.integration.api.match_specs import short_spec
 

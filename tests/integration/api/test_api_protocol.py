@@ -8,9 +8,9 @@ import time
 
 import pytest
 
+from contracts.robot_api import messages_pb2 as pb
+from robot.client import HandshakeRefused, RobotClient
 from simulator.api import FakeDeviceWorld
-from simulator.api import messages_pb2 as pb
-from simulator.client import HandshakeRefused, RobotClient
 from simulator.spec import NetworkSpec
 from tests.integration.api.harness import BLUE1, RED1, RED2, running_server, wait_until
 

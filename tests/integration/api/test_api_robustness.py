@@ -8,8 +8,8 @@ import time
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from robot.client import RobotClient
 from simulator.api import FakeDeviceWorld, LockstepSettings
-from simulator.client import RobotClient
 from simulator.spec import NetworkSpec
 from tests.integration.api.harness import BLUE1, RED1, RED2, running_server, wait_until
 

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from simulator.client import ConnectionClosed, RobotClient
+from robot.client import ConnectionClosed, RobotClient
 from simulator.runtime import run_match
 from simulator.spec import MatchSpec
 from tests.integration.api.harness import free_ports, wait_until

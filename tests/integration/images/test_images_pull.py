@@ -54,13 +54,13 @@ def test_team_image_on_team_base_is_pushed_pulled_pinned_and_runs(
     from orchestrator.images import project_image
 
     # The team's side, as images/README.md tells it: build FROM team-base, push.
-    (tmp_path / "robot.py").write_text(
-        "import os, simulator.client\n"
+    (tmp_path / "player.py").write_text(
+        "import os, robot.client\n"
         "print(os.environ['ROBOCUP_TEAM_COLOR'], os.environ['ROBOCUP_ROBOT_ID'], 'client ok')\n"
     )
     (tmp_path / "Dockerfile").write_text(
-        f"FROM {project_image('team-base')}\nCOPY robot.py /robot/robot.py\n"
-        'CMD ["python", "/robot/robot.py"]\n'
+        f"FROM {project_image('team-base')}\nCOPY player.py /robot/player.py\n"
+        'CMD ["python", "/robot/player.py"]\n'
     )
     repository = f"{registry.host}/alpha/robot"
     docker_client.images.build(

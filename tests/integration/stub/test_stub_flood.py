@@ -30,7 +30,7 @@ def test_flood_saturates_the_api_connection_and_the_mirror(tmp_path: Path) -> No
         argv = ["flood", "--mirror-port", str(mirror.getsockname()[1])]
         argv += ["--gc-data-port", str(gc_data), "--gc-return-port", str(gc_return)]
         proc = subprocess.Popen(
-            [sys.executable, "-m", "simulator.stub", *argv], env=env, stderr=subprocess.DEVNULL
+            [sys.executable, "-m", "robot.stub", *argv], env=env, stderr=subprocess.DEVNULL
         )
         received = 0
         try:

@@ -77,7 +77,7 @@ def test_stub_striker_connects_answers_the_gamecontroller_and_kicks(tmp_path: Pa
         argv = ["striker", "--start-pose", "-1", "0", "0"]
         argv += ["--gc-data-port", str(gc_data), "--gc-return-port", str(gc_return)]
         proc = subprocess.Popen(
-            [sys.executable, "-m", "simulator.stub", *argv], env=env, stderr=subprocess.DEVNULL
+            [sys.executable, "-m", "robot.stub", *argv], env=env, stderr=subprocess.DEVNULL
         )
         sender = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         ball = world.model.body("ball").id

@@ -7,7 +7,7 @@ import struct
 
 import pytest
 
-from simulator.client import (
+from robot.client import (
     BadPacket,
     GameControllerListener,
     GameControllerReplier,

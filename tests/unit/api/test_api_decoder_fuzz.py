@@ -6,8 +6,8 @@ from google.protobuf.message import DecodeError
 from hypothesis import given
 from hypothesis import strategies as st
 
+from contracts.robot_api import messages_pb2 as pb
 from simulator.api import FrameDecoder, FramingError
-from simulator.api import messages_pb2 as pb
 
 
 @given(st.lists(st.binary(max_size=200), max_size=10))

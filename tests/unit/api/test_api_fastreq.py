@@ -7,7 +7,7 @@ import math
 from hypothesis import given
 from hypothesis import strategies as st
 
-from simulator.api import messages_pb2 as pb
+from contracts.robot_api import messages_pb2 as pb
 from simulator.api.fastreq import PositionTemplate, scan_positions
 
 NAMES = ("Neck", "Head", "ShoulderL", "AnkleR", "Ü-motor")

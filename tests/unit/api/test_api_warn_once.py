@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
+from contracts.robot_api import messages_pb2 as pb
 from referee.snapshot import RobotId, TeamColor
 from simulator.api import FakeDeviceWorld, RobotSession
-from simulator.api import messages_pb2 as pb
 
 RED1 = RobotId(TeamColor.RED, 1)
 

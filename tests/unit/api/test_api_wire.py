@@ -6,8 +6,8 @@ import struct
 
 import pytest
 
+from contracts.robot_api import messages_pb2 as pb
 from simulator.api import FrameDecoder, FramingError, encode_frame
-from simulator.api import messages_pb2 as pb
 from simulator.api.framing import MAX_FRAME_BYTES
 
 

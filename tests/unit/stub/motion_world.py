@@ -8,10 +8,10 @@ from typing import Any
 
 import numpy as np
 
+from benchmarks.stub import sense
 from referee.snapshot import PlaceBall, RobotId, TeamColor
-from simulator.motion import standing_posture
-from simulator.stub.bench import sense
-from simulator.stub.controller import Sensors
+from robot.motion import standing_posture
+from robot.stub.controller import Sensors
 from simulator.world import RobotPlacement, World
 
 RED1 = RobotId(TeamColor.RED, 1)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from simulator.motion import GetUpMotion, standing_posture
+from robot.motion import GetUpMotion, standing_posture
 
 from .motion_world import OneRobot
 
@@ -28,7 +28,7 @@ def test_get_up_rejects_an_unknown_side() -> None:
 
 @pytest.mark.parametrize("side", ["front", "back"])
 def test_stub_controller_detects_the_fall_and_gets_up(side: str) -> None:
-    from simulator.stub import GameInfo, Phase, Pose2D, Role, StubController
+    from robot.stub import GameInfo, Phase, Pose2D, Role, StubController
 
 
     robot = OneRobot()
@@ -50,7 +50,7 @@ def test_stub_controller_detects_the_fall_and_gets_up(side: str) -> None:
 def test_pushed_over_robot_gets_back_up(direction_rad: float) -> None:
     import math
 
-    from simulator.stub import GameInfo, Phase, Pose2D, Role, StubController
+    from robot.stub import GameInfo, Phase, Pose2D, Role, StubController
 
 
     robot = OneRobot(yaw_rad=1.0)

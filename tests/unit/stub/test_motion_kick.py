@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from simulator.motion import KickMotion, standing_posture
+from robot.motion import KickMotion, standing_posture
 
 from .motion_world import OneRobot
 

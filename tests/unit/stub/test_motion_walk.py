@@ -6,9 +6,9 @@ import math
 
 import pytest
 
-from simulator.motion import WalkEngine
-from simulator.motion.ik import FootTarget, leg_fk, leg_ik
-from simulator.motion.models import kinematics
+from robot.motion import WalkEngine
+from robot.motion.ik import FootTarget, leg_fk, leg_ik
+from robot.motion.models import kinematics
 
 from .motion_world import OneRobot
 
@@ -74,7 +74,7 @@ def test_walks_60_s_on_flat_ground_without_falling() -> None:
 
 
 def test_attitude_filter_ignores_an_all_zero_first_reading() -> None:
-    from simulator.motion import AttitudeFilter
+    from robot.motion import AttitudeFilter
 
     f = AttitudeFilter()
     f.update(0.008, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import math
 
-from simulator.stub.behaviour import STAND, Field, GameInfo, Phase, Role, decide
-from simulator.stub.world_model import Pose2D
+from robot.stub.behaviour import STAND, Field, GameInfo, Phase, Role, decide
+from robot.stub.world_model import Pose2D
 
 FIELD = Field(half_length_m=4.5, foot_y_m=0.06, kick_x_m=0.165)
 PLAYING = GameInfo(phase=Phase.PLAYING)

@@ -6,10 +6,10 @@ from pathlib import Path
 
 import pytest
 
-from simulator.stub import Behaviour, StubConfigError, parse_args, read_env
-from simulator.stub.behaviour import GameInfo, Phase, Role, decide
-from simulator.stub.runner import StubRobot
-from simulator.stub.world_model import Pose2D
+from robot.stub import Behaviour, StubConfigError, parse_args, read_env
+from robot.stub.behaviour import GameInfo, Phase, Role, decide
+from robot.stub.runner import StubRobot
+from robot.stub.world_model import Pose2D
 
 ENV = {
     "ROBOCUP_ROBOT_ID": "2",
@@ -105,7 +105,7 @@ def test_role_of_each_behaviour(argv: list[str], role: Role) -> None:
 
 def test_behaviour_by_game_state() -> None:
     pose = Pose2D(-2.0, 0.0, 0.0)
-    from simulator.stub.behaviour import Field
+    from robot.stub.behaviour import Field
 
     field = Field(half_length_m=4.5, foot_y_m=0.075, kick_x_m=0.165)
     args = {"pose": pose, "ball": (1.0, 0.0), "field": field, "searching_s": 0.0}

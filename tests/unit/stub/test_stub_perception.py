@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from simulator.motion import kinematics, standing_posture
-from simulator.stub.perception import CameraPose, find_ball_blobs, ground_point
+from robot.motion import kinematics, standing_posture
+from robot.stub.perception import CameraPose, find_ball_blobs, ground_point
 from simulator.world import CameraRenderer
 
 from .motion_world import RED1, OneRobot

@@ -33,7 +33,7 @@ def stub(tmp_path: Path, *argv: str) -> Iterator[subprocess.Popen[str]]:
     }
     ports = ["--gc-data-port", str(_closed_port()), "--gc-return-port", str(_closed_port())]
     proc = subprocess.Popen(
-        [sys.executable, "-m", "simulator.stub", *argv, *ports],
+        [sys.executable, "-m", "robot.stub", *argv, *ports],
         env=env,
         stderr=subprocess.PIPE,
         text=True,
@@ -100,7 +100,7 @@ def test_bad_environment_exits_2_with_the_variable(tmp_path: Path) -> None:
     env = {k: v for k, v in os.environ.items() if not k.startswith("ROBOCUP_")}
     env["ROBOCUP_ROBOT_ID"] = "1"
     result = subprocess.run(
-        [sys.executable, "-m", "simulator.stub", "striker"],
+        [sys.executable, "-m", "robot.stub", "striker"],
         env=env,
         capture_output=True,
         text=True,

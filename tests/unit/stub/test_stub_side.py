@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from simulator.stub import GameInfo, Phase, Pose2D, Role, StubController
+from robot.stub import GameInfo, Phase, Pose2D, Role, StubController
 from simulator.world import CameraRenderer
 
 from .motion_world import OneRobot

@@ -1,0 +1,185 @@
+"""``python -m simulator bench stub``: can the stub striker find, reach and kick the ball?
+
+In-process world (no network), one kid-default striker 2 m from the ball at a random (seeded)
+bearing and heading. The striker runs the same controller as in a match: it sees only its joint
+angles, IMU and head camera (320x240 rendered every 96 ms; colour blob detector), and knows its
+starting pose (as a team knows its starting pose from its team file). A trial succeeds when the
+striker kicks within the time limit and the ball travels at least 0.5 m. Prints one JSON line.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from robot.stub.runner import CAMERA_PERIOD_MS  # the period the robot asks for in a match
+
+AFTER_KICK_S = 4.0
+MIN_KICK_M = 0.5
+
+
+@dataclass(frozen=True, slots=True)
+class TrialResult:
+    success: bool
+    kick_distance_m: float
+    time_to_kick_s: float | None
+    falls: int
+    sim_time_s: float
+    sightings: int
+
+
+def sense(world: Any, robot: Any, camera: Any | None) -> Any:
+    """What the robot's controller gets in a match: joints, IMU, and a camera image when due
+    (never without a ``camera``)."""
+    from robot.stub.controller import Sensors
+
+    t_ms = world.sim_time_ms
+    image = None
+    if camera is not None and t_ms % CAMERA_PERIOD_MS == 0:
+        raw = camera.render(robot)
+        image = np.frombuffer(raw, np.uint8).reshape(240, 320, 3)
+    joints = {name[:-1]: value for name, value in world.read_positions(robot).items()}
+    return Sensors(
+        time_ms=t_ms,
+        joints=joints,
+        accel=world.read_accelerometer(robot),
+        gyro=world.read_gyro(robot),
+        image_bgr=image,
+    )
+
+
+def run_trial(*, seed: int, distance_m: float, time_limit_s: float) -> TrialResult:
+    from referee.snapshot import RobotId, TeamColor
+    from robot.stub.behaviour import GameInfo, Phase, Role
+    from robot.stub.controller import StubController
+    from robot.stub.world_model import Pose2D
+    from simulator.world import CameraRenderer, RobotPlacement, World
+
+    rng = np.random.default_rng(seed)
+    bearing = float(rng.uniform(-math.pi, math.pi))
+    heading = float(rng.uniform(-math.pi, math.pi))
+    robot = RobotId(TeamColor.RED, 1)
+    x, y = distance_m * math.cos(bearing), distance_m * math.sin(bearing)
+    world = World.create(
+        field_class="kid",
+        robots=[RobotPlacement(id=robot, model="kid-default", x_m=x, y_m=y, yaw_rad=heading)],
+        seed=seed,
+    )
+    controller = StubController(role=Role.STRIKER, start_pose=Pose2D(x, y, heading))
+    game = GameInfo(phase=Phase.PLAYING)
+    ball_body = world.model.body("ball").id
+    kicked_at_s: float | None = None
+    ball_before: np.ndarray | None = None
+    steps = int(time_limit_s * 1000 / world.step_ms)
+    with CameraRenderer(world, 320, 240) as camera:
+        step = 0
+        while True:
+            t_ms = world.sim_time_ms
+            sensors = sense(world, robot, camera)
+            kicks_before = controller.stats.kicks
+            targets = controller.tick(sensors, game)
+            if controller.stats.kicks > kicks_before and kicked_at_s is None:
+                kicked_at_s = t_ms / 1000.0
+                ball_before = world.data.xpos[ball_body].copy()
+            for name, value in targets.items():
+                world.set_motor_position(robot, name, value)
+            world.step()
+            step += 1
+            if kicked_at_s is not None and world.sim_time_ms / 1000.0 > kicked_at_s + AFTER_KICK_S:
+                break
+            if kicked_at_s is None and step >= steps:
+                break
+    distance = 0.0
+    if ball_before is not None:
+        moved = world.data.xpos[ball_body] - ball_before
+        distance = float(math.hypot(moved[0], moved[1]))
+    return TrialResult(
+        success=kicked_at_s is not None and distance >= MIN_KICK_M,
+        kick_distance_m=distance,
+        time_to_kick_s=kicked_at_s,
+        falls=controller.stats.falls,
+        sim_time_s=world.sim_time_ms / 1000.0,
+        sightings=controller.stats.ball_sightings,
+    )
+
+
+def summarize(results: list[TrialResult], *, seed: int, wall_s: float) -> dict[str, Any]:
+    kicks = [r.kick_distance_m for r in results if r.success]
+    times = [r.time_to_kick_s for r in results if r.success and r.time_to_kick_s is not None]
+    sim_s = sum(r.sim_time_s for r in results)
+    return {
+        "bench": "stub",
+        "model": "kid-default",
+        "trials": len(results),
+        "successes": sum(r.success for r in results),
+        "success_rate": round(sum(r.success for r in results) / max(len(results), 1), 3),
+        "mean_kick_distance_m": round(sum(kicks) / len(kicks), 3) if kicks else None,
+        "mean_time_to_kick_s": round(sum(times) / len(times), 2) if times else None,
+        "falls_per_min": round(sum(r.falls for r in results) / (sim_s / 60.0), 3) if sim_s else 0,
+        "sim_time_s": round(sim_s, 1),
+        "wall_time_s": round(wall_s, 1),
+        "seed": seed,
+        "perception": (
+            "head camera 320x240 every 96 ms, white+black ball blob detector, "
+            "ground projection from joint angles and IMU; pose from the known start pose, "
+            "gait odometry and gyro; no ground truth"
+        ),
+    }
+
+
+def main(argv: list[str]) -> int:
+    parser = argparse.ArgumentParser(prog="python -m simulator bench stub")
+    parser.add_argument("--trials", type=int, default=10)
+    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--distance-m", type=float, default=2.0)
+    parser.add_argument("--time-limit-s", type=float, default=60.0)
+    parser.add_argument("--scenario", choices=("reach", "shots"), default="reach")
+    parser.add_argument("--goalie", action="store_true", help="shots: an opponent goalie defends")
+    parser.add_argument("--json", action="store_true", help="only the JSON line")
+    args = parser.parse_args(argv)
+    if args.trials < 1:
+        print("--trials: expected an integer >= 1", file=sys.stderr)
+        return 2
+    os.environ.setdefault("MUJOCO_GL", "osmesa")
+    os.environ.setdefault("PYOPENGL_PLATFORM", os.environ["MUJOCO_GL"])
+    start = time.perf_counter()
+    if args.scenario == "shots":
+        return _shots(args, start)
+    results = []
+    for trial in range(args.trials):
+        result = run_trial(
+            seed=args.seed * 1000 + trial,
+            distance_m=args.distance_m,
+            time_limit_s=args.time_limit_s,
+        )
+        results.append(result)
+        if not args.json:
+            print(f"trial {trial}: {result}", file=sys.stderr)
+    print(json.dumps(summarize(results, seed=args.seed, wall_s=time.perf_counter() - start)))
+    return 0
+
+
+def _shots(args: argparse.Namespace, start: float) -> int:
+    from benchmarks.stub_shots import run_shot, summarize_shots
+
+    shots = []
+    for trial in range(args.trials):
+        shot = run_shot(
+            seed=args.seed * 1000 + trial, time_limit_s=args.time_limit_s, goalie=args.goalie
+        )
+        shots.append(shot)
+        if not args.json:
+            print(f"trial {trial}: {shot}", file=sys.stderr)
+    summary = summarize_shots(
+        shots, seed=args.seed, goalie=args.goalie, wall_s=time.perf_counter() - start
+    )
+    print(json.dumps(summary))
+    return 0

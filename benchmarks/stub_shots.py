@@ -1,0 +1,119 @@
+"""``bench stub --scenario shots``: does the stub striker score from in front of the goal?
+
+Each trial puts the ball 1.5-4 m in front of the goal the striker attacks (x > 0, at most
+60 degrees off the goal axis) and the striker 1 m from the ball at a random (seeded) bearing and
+heading; optionally an opponent goalie (the stub goalie behaviour, same perception) defends.
+The striker plays with the same controller and perception as in a match. A trial succeeds when
+the ball crosses the goal line between the posts within the time limit; it ends early when the
+ball leaves the field anywhere else.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+GOAL_HALF_WIDTH_M = 1.3
+HALF_LENGTH_M = 4.5
+HALF_WIDTH_M = 3.0
+
+
+@dataclass(frozen=True, slots=True)
+class ShotResult:
+    goal: bool
+    time_to_goal_s: float | None
+    outcome: str  # "goal", "out", "time"
+    kicks: int
+    falls: int
+    sim_time_s: float
+
+
+def shot_layout(seed: int) -> tuple[tuple[float, float], tuple[float, float, float]]:
+    """Ball (x, y) and striker (x, y, yaw) in the world frame for trial ``seed``."""
+    rng = np.random.default_rng(seed)
+    while True:
+        distance = float(rng.uniform(1.5, 4.0))
+        angle = float(rng.uniform(-math.pi / 3, math.pi / 3))
+        ball = (HALF_LENGTH_M - distance * math.cos(angle), distance * math.sin(angle))
+        bearing = float(rng.uniform(-math.pi, math.pi))
+        robot = (ball[0] + math.cos(bearing), ball[1] + math.sin(bearing))
+        if abs(ball[1]) < 2.6 and abs(robot[1]) < 2.7 and robot[0] < HALF_LENGTH_M - 0.2:
+            return ball, (robot[0], robot[1], float(rng.uniform(-math.pi, math.pi)))
+
+
+def run_shot(*, seed: int, time_limit_s: float, goalie: bool) -> ShotResult:
+    from benchmarks.stub import sense
+    from referee.snapshot import PlaceBall, RobotId, TeamColor
+    from robot.stub.behaviour import GameInfo, Phase, Role
+    from robot.stub.controller import StubController
+    from robot.stub.world_model import Pose2D
+    from simulator.world import CameraRenderer, RobotPlacement, World
+
+    ball, (x, y, yaw) = shot_layout(seed)
+    striker = RobotId(TeamColor.RED, 1)
+    placements = [RobotPlacement(id=striker, model="kid-default", x_m=x, y_m=y, yaw_rad=yaw)]
+    players = [(striker, StubController(role=Role.STRIKER, start_pose=Pose2D(x, y, yaw)))]
+    if goalie:
+        keeper = RobotId(TeamColor.BLUE, 1)
+        gx, gyaw = HALF_LENGTH_M - 0.5, math.pi
+        placements.append(
+            RobotPlacement(id=keeper, model="kid-default", x_m=gx, y_m=0.0, yaw_rad=gyaw)
+        )
+        # the goalie's own frame: it defends x < 0
+        players.append((keeper, StubController(role=Role.GOALIE, start_pose=Pose2D(-gx, 0, 0))))
+    world = World.create(field_class="kid", robots=placements, seed=seed)
+    world.apply(PlaceBall(position=(ball[0], ball[1], world.field.ball_radius_m)))
+    game = GameInfo(phase=Phase.PLAYING)
+    ball_body = world.model.body("ball").id
+    steps = int(time_limit_s * 1000 / world.step_ms)
+    outcome, goal_at = "time", None
+    with CameraRenderer(world, 320, 240) as camera:
+        for _ in range(steps):
+            for robot, controller in players:
+                sensors = sense(world, robot, camera)
+                for name, value in controller.tick(sensors, game).items():
+                    world.set_motor_position(robot, name, value)
+            world.step()
+            bx, by = (float(v) for v in world.data.xpos[ball_body][:2])
+            if bx > HALF_LENGTH_M + world.field.ball_radius_m and abs(by) < GOAL_HALF_WIDTH_M:
+                outcome, goal_at = "goal", world.sim_time_ms / 1000.0
+                break
+            if abs(bx) > HALF_LENGTH_M + 0.1 or abs(by) > HALF_WIDTH_M + 0.1:
+                outcome = "out"
+                break
+    stats = players[0][1].stats
+    return ShotResult(
+        goal=outcome == "goal",
+        time_to_goal_s=goal_at,
+        outcome=outcome,
+        kicks=stats.kicks,
+        falls=stats.falls,
+        sim_time_s=world.sim_time_ms / 1000.0,
+    )
+
+
+def summarize_shots(
+    results: list[ShotResult], *, seed: int, goalie: bool, wall_s: float
+) -> dict[str, Any]:
+    goals = [r for r in results if r.goal]
+    times = [r.time_to_goal_s for r in goals if r.time_to_goal_s is not None]
+    sim_s = sum(r.sim_time_s for r in results)
+    return {
+        "bench": "stub",
+        "scenario": "shots",
+        "model": "kid-default",
+        "goalie": goalie,
+        "trials": len(results),
+        "goals": len(goals),
+        "goal_rate": round(len(goals) / max(len(results), 1), 3),
+        "outcomes": [r.outcome for r in results],
+        "mean_time_to_goal_s": round(sum(times) / len(times), 2) if times else None,
+        "kicks": sum(r.kicks for r in results),
+        "falls_per_min": round(sum(r.falls for r in results) / (sim_s / 60.0), 3) if sim_s else 0,
+        "sim_time_s": round(sim_s, 1),
+        "wall_time_s": round(wall_s, 1),
+        "seed": seed,
+    }

@@ -1,0 +1,245 @@
+"""Decisions of the stub robot: what to do this tick, from the game state and its beliefs.
+
+Pure functions of plain data (no I/O), so the same code runs in a match and in the bench.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from enum import StrEnum
+
+from robot.stub.world_model import Pose2D
+
+
+class Role(StrEnum):
+    STRIKER = "striker"
+    GOALIE = "goalie"
+    DEFENDER = "defender"  # keeps its home spot in the own half; plays a ball that comes near
+    IDLE = "idle"
+
+
+class Phase(StrEnum):
+    INITIAL = "INITIAL"
+    READY = "READY"
+    SET = "SET"
+    PLAYING = "PLAYING"
+    FINISHED = "FINISHED"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class GameInfo:
+    phase: Phase
+    penalised: bool = False
+    our_kick_off: bool = True
+    first_half: bool = True
+    ball_free_in_s: float = 0.0  # PLAYING: the opponents' kick-off is still protected this long
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Action:
+    """Walk with (vx m/s, vy m/s, vyaw rad/s), or kick with ``kick_foot``, or stand."""
+
+    walk: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    kick_foot: str | None = None
+    search: bool = False  # scan with the head
+
+    @property
+    def stands(self) -> bool:
+        return self.kick_foot is None and self.walk == (0.0, 0.0, 0.0)
+
+
+STAND = Action()
+APPROACH_M = 0.55  # nearer than this the striker lines up and kicks
+BEHIND_M = 0.35  # where it heads for: this far behind the ball, on the goal line through it
+ROUND_M = 0.5  # how wide it goes round a ball it is in front of
+FAST_M_S = 0.2
+AIM_HALF_WIDTH_M = 0.8  # aim this close to the goal centre (posts at 1.3 m)
+SEARCH_TURN_AFTER_S = 2.0
+DEFENDER_HOME = (-2.3, 0.0)  # when none is given
+DEFENDER_ENGAGE_M = 1.2  # a defender plays a ball this close to its home spot
+DEFENDER_NEAR_M = 0.8  # ... or this close to itself
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Field:
+    half_length_m: float
+    foot_y_m: float  # lateral distance of each foot from the centre line
+    kick_x_m: float  # best ball distance in front of the pelvis for a kick
+
+
+def decide(
+    *,
+    role: Role,
+    game: GameInfo,
+    pose: Pose2D,
+    ball: tuple[float, float] | None,
+    field: Field,
+    searching_s: float,
+    home: tuple[float, float] | None = None,
+) -> Action:
+    """``ball`` is relative to the robot (x forward, y left) or None when not seen lately;
+    ``searching_s`` how long the ball has been missing; ``home`` a defender's spot (own-half
+    frame)."""
+    if role is Role.IDLE or game.penalised or game.phase in (Phase.INITIAL, Phase.SET):
+        return STAND
+    if game.phase is Phase.FINISHED:
+        return STAND
+    if game.phase is Phase.READY:
+        return _go_to(pose, _kick_off_position(role, game, field, home))
+    # PLAYING
+    if not game.our_kick_off and game.ball_free_in_s > 0:
+        return STAND  # the opponents' kick-off: keep out of the centre circle
+    if role is Role.GOALIE:
+        return _goalie(pose, ball, field, searching_s)
+    if role is Role.DEFENDER:
+        return _defender(pose, ball, field, searching_s, home or DEFENDER_HOME)
+    return _striker(pose, ball, field, searching_s)
+
+
+def _kick_off_position(
+    role: Role, game: GameInfo, field: Field, home: tuple[float, float] | None
+) -> Pose2D:
+    if role is Role.GOALIE:
+        return Pose2D(-field.half_length_m + 0.5, 0.0, 0.0)
+    if role is Role.DEFENDER:
+        x, y = home or DEFENDER_HOME
+        return Pose2D(x, y, 0.0)
+    return Pose2D(-0.35 if game.our_kick_off else -1.0, 0.0, 0.0)
+
+
+def _defender(
+    pose: Pose2D,
+    ball: tuple[float, float] | None,
+    field: Field,
+    searching_s: float,
+    home: tuple[float, float],
+) -> Action:
+    """Stay at home facing the ball, so that teammates do not crowd the striker; play the ball
+    (as a striker) when it comes within reach of home or of the robot."""
+    if ball is not None:
+        bx, by = ball
+        ball_field = pose.to_field(bx, by)
+        near_home = math.hypot(ball_field[0] - home[0], ball_field[1] - home[1])
+        if near_home < DEFENDER_ENGAGE_M or math.hypot(bx, by) < DEFENDER_NEAR_M:
+            return _striker(pose, ball, field, searching_s)
+    hx, hy = pose.to_relative(*home)
+    if math.hypot(hx, hy) > 0.4:
+        return _go_to(pose, Pose2D(home[0], home[1], 0.0), tolerance_m=0.3)
+    return _face(ball, tolerance_rad=0.3)
+
+
+def _go_to(pose: Pose2D, target: Pose2D, *, tolerance_m: float = 0.2) -> Action:
+    x, y = pose.to_relative(target.x_m, target.y_m)
+    distance = math.hypot(x, y)
+    if distance < tolerance_m:
+        error = _wrap(target.yaw_rad - pose.yaw_rad)
+        if abs(error) < 0.2:
+            return STAND
+        return Action(walk=(0.0, 0.0, _clip(1.2 * error, 0.5)))
+    bearing = math.atan2(y, x)
+    # full speed while far: from the opponent goal back to the own half takes most of READY
+    forward = (FAST_M_S if distance > 1.0 else 0.15) if abs(bearing) < 0.35 else 0.0
+    return Action(walk=(forward, 0.0, _clip(1.5 * bearing, 0.6)))
+
+
+def _striker(
+    pose: Pose2D, ball: tuple[float, float] | None, field: Field, searching_s: float
+) -> Action:
+    if ball is None:
+        return _search(searching_s)
+    bx, by = ball
+    distance = math.hypot(bx, by)
+    bearing = math.atan2(by, bx)
+    # direction from the ball to the opponent goal centre, relative to the robot's heading
+    ball_field = pose.to_field(bx, by)
+    goal_dx, goal_dy = field.half_length_m - ball_field[0], 0.0 - ball_field[1]
+    heading_error = _wrap(math.atan2(goal_dy, goal_dx) - pose.yaw_rad)
+    ux, uy = math.cos(heading_error), math.sin(heading_error)
+    behind = -(bx * ux + by * uy) < -0.1  # the robot is on the far side of the ball from goal
+    if distance > APPROACH_M or not behind or abs(bearing) > 1.2:
+        return _approach(bx, by, heading_error)
+    if abs(heading_error) > 0.35:
+        # circle around the ball: side-step while turning, keep about 0.3 m away
+        return Action(
+            walk=(
+                _clip(0.8 * (distance - 0.3), 0.06),
+                _clip(-0.2 * math.copysign(1.0, heading_error), 0.07),
+                _clip(0.8 * heading_error + 0.8 * bearing, 0.7),
+            )
+        )
+    # the farther the goal, the straighter the kick must be to land between the posts
+    aim_tolerance = min(max(math.atan2(AIM_HALF_WIDTH_M, math.hypot(goal_dx, goal_dy)), 0.12), 0.3)
+    foot = "left" if by > 0 else "right"
+    target_y = field.foot_y_m if foot == "left" else -field.foot_y_m
+    ex, ey = bx - field.kick_x_m, by - target_y
+    if abs(ex) < 0.05 and abs(ey) < 0.035 and abs(heading_error) < aim_tolerance:
+        return Action(kick_foot=foot)
+    return Action(
+        walk=(
+            _clip(0.8 * ex, 0.08, low=-0.05),
+            _clip(1.2 * ey, 0.05),
+            _clip(0.8 * heading_error, 0.3),
+        )
+    )
+
+
+def _approach(bx: float, by: float, goal_bearing: float) -> Action:
+    """Walk to a point behind the ball on the line from the goal centre through the ball (the
+    robot frame; ``goal_bearing`` the direction from the ball to the goal). When the robot is
+    on the goal side of the ball, go round it first, on the side it is already on, so that it
+    neither pushes the ball towards its own goal nor has to circle it for long."""
+    ux, uy = math.cos(goal_bearing), math.sin(goal_bearing)
+    along = -(bx * ux + by * uy)  # the robot relative to the ball, along ball -> goal
+    if along > -0.1:
+        beside = -(-bx * uy + by * ux)  # the robot relative to the ball, across the line
+        side = 1.0 if beside >= 0 else -1.0
+        px = bx - 0.25 * ux - side * ROUND_M * uy
+        py = by - 0.25 * uy + side * ROUND_M * ux
+    else:
+        px, py = bx - BEHIND_M * ux, by - BEHIND_M * uy
+    target = math.atan2(py, px)
+    forward = FAST_M_S if abs(target) < 0.3 else (0.06 if abs(target) < 0.7 else 0.0)
+    return Action(walk=(forward, 0.0, _clip(1.5 * target, 0.7)))
+
+
+def _goalie(
+    pose: Pose2D, ball: tuple[float, float] | None, field: Field, searching_s: float
+) -> Action:
+    home = Pose2D(-field.half_length_m + 0.5, 0.0, 0.0)
+    hx, hy = pose.to_relative(home.x_m, home.y_m)
+    if math.hypot(hx, hy) > 0.5:
+        return _go_to(pose, home, tolerance_m=0.3)
+    if ball is not None:
+        bx, by = ball
+        ball_field = pose.to_field(bx, by)
+        if math.hypot(bx, by) < 0.6 and ball_field[0] > pose.x_m + 0.1:
+            # clear only a ball on the field side of the goalie; circling a ball that is behind
+            # it, next to its own goal, could push it in
+            return _striker(pose, ball, field, searching_s)
+    return _face(ball, tolerance_rad=0.25)
+
+
+def _face(ball: tuple[float, float] | None, *, tolerance_rad: float) -> Action:
+    """Stay on the spot turned towards the ball; scan for it when it is not seen."""
+    if ball is None:
+        return Action(search=True)
+    bearing = math.atan2(ball[1], ball[0])
+    if abs(bearing) > tolerance_rad:
+        return Action(walk=(0.0, 0.0, _clip(1.0 * bearing, 0.4)))
+    return STAND
+
+
+def _search(searching_s: float) -> Action:
+    """Scan with the head first; then turn on the spot while scanning."""
+    if searching_s < SEARCH_TURN_AFTER_S:
+        return Action(search=True)
+    return Action(walk=(0.0, 0.0, 0.7), search=True)
+
+
+def _clip(value: float, high: float, *, low: float | None = None) -> float:
+    return min(max(value, -high if low is None else low), high)
+
+
+def _wrap(angle: float) -> float:
+    return math.atan2(math.sin(angle), math.cos(angle))

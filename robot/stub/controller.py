@@ -1,0 +1,366 @@
+"""The stub robot's control loop body: one call per sensor measurement, motor targets out.
+
+Wires the motion engines (walk, kick, get-up), the IMU attitude filter, the ball detector and
+the behaviour. It never sees ground truth: only joint angles, accelerometer, gyro and the head
+camera image, exactly what the robot API delivers.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from robot.motion import AttitudeFilter, GetUpMotion, KickMotion, WalkEngine, kinematics
+from robot.motion.keyframes import KeyframeMotion
+from robot.motion.walk import default_walk_params
+from robot.stub.behaviour import Action, Field, GameInfo, Role, decide
+from robot.stub.perception import (
+    CameraPose,
+    find_ball_blobs,
+    ground_point,
+    white_above_horizon,
+)
+from robot.stub.world_model import Pose2D, WorldModel
+
+logger = logging.getLogger(__name__)
+
+Vec3 = tuple[float, float, float]
+FALL_TILT_RAD = 0.9
+FALL_CONFIRM_S = 0.6
+BALL_MEMORY_MS = 4000
+SCAN = [(-0.9, 0.45), (-0.45, 0.5), (0.0, 0.55), (0.45, 0.5), (0.9, 0.45), (0.45, 0.95),
+        (0.0, 1.0), (-0.45, 0.95)]  # fmt: skip
+SCAN_DWELL_S = 0.35
+SIDE_LOOK_S = 0.45  # per head position, when checking which side the own goal is on
+SIDE_LOOK_YAWS_RAD = (0.55, 1.3, -0.55, -1.3)  # left first, then right; 60 deg field of view
+SIDE_LOOK_PITCH_RAD = -0.15  # slightly up: goal posts stand above the horizon
+SIDE_MIN_PIXELS = 30
+KNEE_RESET_RAD = 0.5  # knee this far from its target: the robot was reset or is limp
+KICK_SETTLE_S = 0.5  # stand still this long before a kick
+KICK_COMMIT_MS = 1500  # keep to a kick decided this long ago while the ball stays in reach
+SETTLE_S = 1.0  # stand still this long after start and after getting up
+FIELD_HALF_LENGTH_M = {"kid": 4.5, "adult": 7.0}
+BALL_RADIUS_M = {"kid": 0.07, "adult": 0.1125}
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Sensors:
+    time_ms: int
+    joints: dict[str, float]  # motor name -> rad
+    accel: Vec3 | None = None
+    gyro: Vec3 | None = None
+    image_bgr: npt.NDArray[np.uint8] | None = None  # height x width x 3
+
+
+@dataclass(slots=True)
+class Stats:
+    falls: int = 0
+    kicks: int = 0
+    get_ups: int = 0
+    ball_sightings: int = 0
+
+
+class StubController:
+    def __init__(
+        self,
+        *,
+        role: Role,
+        start_pose: Pose2D,
+        model: str = "kid-default",
+        field_class: str = "kid",
+        detect_side: bool = False,
+        home: tuple[float, float] | None = None,
+    ) -> None:
+        """``detect_side``: before moving, look left and right for the own goal to find out
+        whether the pitch is mirrored for this team (see :meth:`_finish_side_check`);
+        ``home``: a defender's spot in the own half."""
+        self.role = role
+        self.home = home
+        self.model = model
+        self.kin = kinematics(model)
+        self.walk = WalkEngine(model=model)
+        self.world = WorldModel(start_pose)
+        self.attitude = AttitudeFilter()
+        self.stats = Stats()
+        walk = default_walk_params(model)
+        self._pelvis_height_m = walk.hip_height_m + self.kin.camera.hip_below_pelvis_m
+        self._ball_radius_m = BALL_RADIUS_M[field_class]
+        self.field = Field(
+            half_length_m=FIELD_HALF_LENGTH_M[field_class],
+            foot_y_m=self.kin.leg.hip_offset_y_m + walk.foot_y_offset_m,
+            kick_x_m=0.165 * self.kin.leg.thigh_m / 0.16,
+        )
+        self._last_ms: int | None = None
+        self._settle_until_ms: int | None = None
+        self._still_s = 0.0
+        self._upright_since_fall = True
+        self._tilted_s = 0.0
+        self._motion: KeyframeMotion | None = None
+        self._motion_kind = ""
+        self._last_targets: dict[str, float] = {}
+        self._missing_since_ms: int | None = None
+        self._scan_s = 0.0
+        self._kick_committed: tuple[str, int] | None = None  # foot, when lined up
+        self.last_action: Action | None = None
+        self._detect_side = detect_side
+        self._side_check_s: float | None = 0.0 if detect_side else None
+        self._side_pixels = [0, 0]  # left, right
+        self.mirrored: bool | None = None
+        self._expect_mirrored: bool | None = None
+
+    @property
+    def busy(self) -> str:
+        """ "kick", "get-up" or "" (walking or standing)."""
+        return self._motion_kind if self._motion is not None else ""
+
+    def reset_pose(
+        self, pose: Pose2D, *, check_side: bool = True, expect_mirrored: bool | None = None
+    ) -> None:
+        """Start again from ``pose`` (team-file frame when ``check_side``; the turned frame of
+        the odometry otherwise). ``expect_mirrored`` applies when the check is undecided."""
+        self.world.reset_pose(pose)
+        self._expect_mirrored = expect_mirrored
+        if self._detect_side and check_side:
+            self._side_check_s = 0.0
+            self._side_pixels = [0, 0]
+
+    def settle(self, time_ms: int) -> None:
+        """Stand still for a moment before moving again (after a reset of the robot)."""
+        self._settle_until_ms = time_ms + int(SETTLE_S * 1000)
+        self.walk.reset()
+
+    def _side_check(self, dt: float, sensors: Sensors) -> dict[str, float]:
+        """Stand and look left, then right; count white pixels above the horizon."""
+        assert self._side_check_s is not None
+        self._side_check_s += dt
+        slot = min(int(self._side_check_s / SIDE_LOOK_S), len(SIDE_LOOK_YAWS_RAD) - 1)
+        yaw = SIDE_LOOK_YAWS_RAD[slot]
+        looking_left = yaw > 0
+        neck = sensors.joints.get(self.kin.neck_motor)
+        if sensors.image_bgr is not None and neck is not None and abs(neck - yaw) < 0.1:
+            att = self.attitude.attitude
+            pose = CameraPose(
+                neck_yaw_rad=neck,
+                head_pitch_rad=self.kin.head_down_sign
+                * sensors.joints.get(self.kin.head_motor, 0.0),
+                torso_roll_rad=att.roll_rad,
+                torso_pitch_rad=att.pitch_rad,
+                pelvis_height_m=self._pelvis_height_m,
+            )
+            pixels = white_above_horizon(sensors.image_bgr, pose, self.kin.camera, margin_rad=0.06)
+            self._side_pixels[0 if looking_left else 1] += pixels
+        if self._side_check_s >= len(SIDE_LOOK_YAWS_RAD) * SIDE_LOOK_S:
+            self._finish_side_check()
+        targets = self.walk.step(dt, 0.0, 0.0, 0.0, accel=sensors.accel, gyro=sensors.gyro)
+        targets.update(self.kin.head_targets(yaw, SIDE_LOOK_PITCH_RAD))
+        return targets
+
+    def _finish_side_check(self) -> None:
+        """Decide whether this team's pitch is mirrored.
+
+        HLVS gives starting poses as if the team played on the left half; the team on the right
+        is placed at the mirror image (x -> -x, yaw -> pi - yaw). A mirror image cannot be
+        reached by turning, so odometry only works in a frame turned by pi, where the mirrored
+        start pose is (x, -y, -yaw). The own goal is nearer than the other: if it shows up on
+        the other side than the team-file pose predicts, the pitch is mirrored.
+        """
+        self._side_check_s = None
+        left, right = self._side_pixels
+        if max(left, right) < SIDE_MIN_PIXELS:
+            logger.info(
+                "side check: no goal in sight (%d/%d px); keeping the start pose", left, right
+            )
+            return
+        pose = self.world.pose
+        gx, gy = pose.to_relative(-self.field.half_length_m, 0.0)
+        predicted_left = math.atan2(gy, gx) > 0
+        seen_left = left > right
+        self.mirrored = predicted_left != seen_left
+        logger.info(
+            "side check: own goal on the %s (%d/%d px): %s",
+            "left" if seen_left else "right",
+            left,
+            right,
+            "mirrored pitch" if self.mirrored else "as in the team file",
+        )
+        if self.mirrored:
+            self.world.reset_pose(Pose2D(pose.x_m, -pose.y_m, -pose.yaw_rad))
+
+    def _moved_by_someone_else(self, joints: dict[str, float]) -> bool:
+        knees = [name for name in self.kin.motor_names if name.startswith("LegLower")]
+        return any(
+            name in joints
+            and name in self._last_targets
+            and abs(joints[name] - self._last_targets[name]) > KNEE_RESET_RAD
+            for name in knees
+        )
+
+    def tick(self, sensors: Sensors, game: GameInfo) -> dict[str, float]:
+        dt = 0.008 if self._last_ms is None else max(sensors.time_ms - self._last_ms, 1) / 1000.0
+        if self._settle_until_ms is None:
+            self._settle_until_ms = sensors.time_ms + int(SETTLE_S * 1000)
+        self._last_ms = sensors.time_ms
+        if sensors.accel is not None and sensors.gyro is not None:
+            self.attitude.update(dt, sensors.accel, sensors.gyro)
+        att = self.attitude.attitude
+        upright = att.tilt_rad < 0.5
+        if upright and self._motion is None:
+            self._upright_since_fall = True
+        self.world.integrate(
+            dt,
+            self.walk.velocity if upright else (0.0, 0.0, 0.0),
+            sensors.gyro[2] if sensors.gyro is not None and upright else None,
+        )
+        if sensors.image_bgr is not None and upright and self._motion is None:
+            self._look(sensors)
+        if self._motion is None and self._moved_by_someone_else(sensors.joints):
+            # teleported (half time, penalty) or limp: joints are not where we put them
+            self.settle(sensors.time_ms)
+        if self._motion is not None:
+            targets = self._motion.step(dt)
+            if self._motion.done:
+                self._finish_motion()
+            return self._remember(targets)
+        if game.penalised:  # limp or being carried: nothing to get up from
+            self._tilted_s = 0.0
+        elif self._fallen(dt, att.tilt_rad):
+            side = "front" if att.pitch_rad > 0 else "back"
+            if self._upright_since_fall:
+                self.stats.falls += 1  # later attempts while still down are not new falls
+            self._upright_since_fall = False
+            logger.info("fallen on the %s; getting up", side)
+            self._start(GetUpMotion(side, model=self.model, start=sensors.joints), "get-up")
+            return self._remember(self._motion.step(dt) if self._motion else {})
+        ball = self.world.ball_relative(sensors.time_ms, max_age_ms=BALL_MEMORY_MS)
+        if ball is None:
+            if self._missing_since_ms is None:
+                self._missing_since_ms = sensors.time_ms
+        else:
+            self._missing_since_ms = None
+        searching_s = (
+            0.0
+            if self._missing_since_ms is None
+            else (sensors.time_ms - self._missing_since_ms) / 1000.0
+        )
+        if self._side_check_s is not None and not game.penalised:
+            if sensors.time_ms >= self._settle_until_ms:
+                return self._remember(self._side_check(dt, sensors))
+        action = decide(
+            role=self.role,
+            game=game,
+            pose=self.world.pose,
+            ball=ball,
+            field=self.field,
+            searching_s=searching_s,
+            home=self.home,
+        )
+        if sensors.time_ms < self._settle_until_ms:
+            action = Action(search=action.search)  # settle into the stance first
+        action = self._commit_kick(sensors.time_ms, action, ball)
+        self.last_action = action
+        self._still_s = 0.0 if self.walk.walking else self._still_s + dt
+        if action.kick_foot is not None:
+            swaying = sensors.gyro is not None and math.hypot(*sensors.gyro[:2]) > 0.3
+            if self.walk.walking or self._still_s < KICK_SETTLE_S or swaying:
+                targets = self.walk.step(dt, 0.0, 0.0, 0.0, accel=sensors.accel, gyro=sensors.gyro)
+            else:
+                self.stats.kicks += 1
+                logger.info("kicking with the %s foot", action.kick_foot)
+                kick = KickMotion(foot=action.kick_foot, model=self.model, start=self._last_targets)
+                self._start(kick, "kick")
+                return self._remember(kick.step(dt))
+        else:
+            targets = self.walk.step(dt, *action.walk, accel=sensors.accel, gyro=sensors.gyro)
+        targets.update(self._head(dt, ball, action, att.pitch_rad))
+        return self._remember(targets)
+
+    # --- parts ---------------------------------------------------------------------------------
+
+    def _commit_kick(
+        self, time_ms: int, action: Action, ball: tuple[float, float] | None
+    ) -> Action:
+        """Once lined up, keep to the kick while the robot settles: the ball estimate jitters
+        by a few centimetres between frames, and re-aligning for every frame would never end."""
+        if action.kick_foot is not None:
+            if self._kick_committed is None or self._kick_committed[1] + KICK_COMMIT_MS < time_ms:
+                self._kick_committed = (action.kick_foot, time_ms)
+            return Action(kick_foot=self._kick_committed[0])
+        committed = self._kick_committed
+        if committed is None or ball is None or time_ms > committed[1] + KICK_COMMIT_MS:
+            self._kick_committed = None
+            return action
+        bx, by = ball
+        side = self.field.foot_y_m if committed[0] == "left" else -self.field.foot_y_m
+        if abs(bx - self.field.kick_x_m) < 0.08 and abs(by - side) < 0.06:
+            return Action(kick_foot=committed[0])
+        self._kick_committed = None
+        return action
+
+    def _look(self, sensors: Sensors) -> None:
+        image = sensors.image_bgr
+        assert image is not None
+        att = self.attitude.attitude
+        pose = CameraPose(
+            neck_yaw_rad=sensors.joints.get(self.kin.neck_motor, 0.0),
+            head_pitch_rad=self.kin.head_down_sign * sensors.joints.get(self.kin.head_motor, 0.0),
+            torso_roll_rad=att.roll_rad,
+            torso_pitch_rad=att.pitch_rad,
+            pelvis_height_m=self._pelvis_height_m,
+        )
+        height, width = image.shape[0], image.shape[1]
+        for blob in find_ball_blobs(image):
+            seen = ground_point(
+                blob,
+                pose,
+                self.kin.camera,
+                width_px=width,
+                height_px=height,
+                ball_radius_m=self._ball_radius_m,
+            )
+            if seen is not None and seen.distance_m < 8.0:
+                self.world.see_ball(sensors.time_ms, seen.x_m, seen.y_m)
+                self.stats.ball_sightings += 1
+                return
+
+    def _head(
+        self, dt: float, ball: tuple[float, float] | None, action: Action, torso_pitch: float
+    ) -> dict[str, float]:
+        if ball is not None and not action.search:
+            self._scan_s = 0.0
+            distance = math.hypot(*ball)
+            camera_height = self._pelvis_height_m + self.kin.camera.neck_height_m
+            down = math.atan2(camera_height - self._ball_radius_m, distance) - torso_pitch
+            yaw = max(-1.2, min(1.2, math.atan2(ball[1], ball[0])))
+            return self.kin.head_targets(yaw, max(0.2, min(1.15, down)))
+        self._scan_s += dt
+        yaw, pitch = SCAN[int(self._scan_s / SCAN_DWELL_S) % len(SCAN)]
+        return self.kin.head_targets(yaw, pitch)
+
+    def _fallen(self, dt: float, tilt_rad: float) -> bool:
+        self._tilted_s = self._tilted_s + dt if tilt_rad > FALL_TILT_RAD else 0.0
+        return self._tilted_s >= FALL_CONFIRM_S
+
+    def _start(self, motion: KeyframeMotion, kind: str) -> None:
+        self._motion = motion
+        self._motion_kind = kind
+        self.walk.reset()
+
+    def _finish_motion(self) -> None:
+        if self._motion_kind == "kick":
+            self._kick_committed = None
+            self.world.forget_ball()  # look again: it should be far away now
+        if self._motion_kind == "get-up":
+            self.stats.get_ups += 1
+            self._settle_until_ms = (self._last_ms or 0) + int(SETTLE_S * 1000)
+        self._motion = None
+        self._motion_kind = ""
+        self._tilted_s = 0.0
+        self.walk.reset()
+
+    def _remember(self, targets: dict[str, float]) -> dict[str, float]:
+        self._last_targets.update(targets)
+        return dict(self._last_targets)
