@@ -34,6 +34,8 @@ log = logging.getLogger(__name__)
 ROUTER_MODULES: tuple[str, ...] = (
     "service.routers.health",
     "service.routers.teams",
+    "service.routers.submissions",
+    "service.routers.operator",
 )
 
 
@@ -46,34 +48,47 @@ class Services:
     sessions: sessionmaker[Session]
     pool: Any = None  # service.pool.MatchPool
     worker: Any = None  # service.worker.QueueWorker
+    preflight: Preflight | None = None
     extras: dict[str, Any] = field(default_factory=dict)
 
 
 PoolFactory = Callable[[Settings], Any]
+Preflight = Callable[[dict[str, Any], Settings], float]
+"""(team file, settings) -> seconds taken; raises service.errors.PreflightFailed."""
 
 
 def create_app(
     settings: Settings,
     *,
     pool_factory: PoolFactory | None = None,
+    preflight: Preflight | None = None,
     start_worker: bool = True,
     router_modules: Sequence[str] = ROUTER_MODULES,
 ) -> FastAPI:
-    """The service's app. ``pool_factory`` defaults to the local Docker pool; tests pass a fake
-    one. ``start_worker=False`` serves the API without playing matches."""
+    """The service's app. ``pool_factory`` defaults to the local Docker pool and ``preflight``
+    to :func:`service.preflight.run`; unit tests pass fakes. ``start_worker=False`` serves the
+    API without starting matches."""
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
         settings.data_dir.mkdir(parents=True, exist_ok=True)
         engine = make_engine(settings.db_url)
         migrate(engine)
-        services = Services(settings=settings, engine=engine, sessions=session_factory(engine))
+        if preflight is None:
+            from service.preflight import run as real_preflight
+
+            def checked(team: dict[str, Any], current: Settings) -> float:
+                return real_preflight(team, settings=current)
+
+        services = Services(settings=settings, engine=engine, sessions=session_factory(engine),
+                            preflight=preflight or checked)
         app.state.services = services
+        from service.pool import make_pool
+
+        services.pool = (pool_factory or make_pool)(settings)
         if start_worker:
-            from service.pool import make_pool
             from service.worker import QueueWorker
 
-            services.pool = (pool_factory or make_pool)(settings)
             services.worker = QueueWorker(services)
             services.worker.start()
         try:

@@ -56,6 +56,8 @@ def register(sub: Any) -> None:
     serve = sub.add_parser("serve", help="run the submission service (HTTP API)")
     serve.add_argument("--host", default="127.0.0.1")
     serve.add_argument("--port", type=int, default=8000)
+    serve.add_argument("--no-worker", action="store_true",
+                       help="serve the API without starting matches")
     _add_db_options(serve)
     serve.set_defaults(func=guarded(run_serve))
 
@@ -115,7 +117,7 @@ def run_serve(args: argparse.Namespace) -> int:
 
     from service.app import create_app
 
-    app = create_app(_settings(args), start_worker=False)
+    app = create_app(_settings(args), start_worker=not args.no_worker)
     uvicorn.run(app, host=args.host, port=args.port, log_level="info", access_log=False)
     return 0
 

@@ -31,6 +31,8 @@ class Settings:
     """Lifetime of a newly issued token (``hlvs admin token issue --days`` overrides)."""
     match_slots: int = 1
     """Test matches played at the same time by the pool."""
+    stub_image: str = ""
+    """Image of the stub opponent; empty: the project's stub image (built when missing)."""
     pool: str = "local"
     """``local``: the Docker engine of this host."""
     worker_poll_s: float = 1.0
@@ -50,6 +52,9 @@ class Settings:
     webhook_backoff_s: float = 2.0
     webhook_timeout_s: float = 5.0
     public_url: str = "http://127.0.0.1:8000"
+    """Base of the links in mails and webhooks."""
+    schedule_state: str = ""
+    """The tournament's state file (``hlvs schedule run --state``), served to operators."""
     extra: Mapping[str, str] = field(default_factory=dict)
 
     @property

@@ -91,9 +91,11 @@ def create(session: Session, *, team_id: int, opponent: str, team_file_id: int,
     return row
 
 
-def get_own(session: Session, *, team_id: int, submission_id: str) -> Submission:
+def get_own(session: Session, *, team_id: int, submission_id: str,
+            for_update: bool = False) -> Submission:
     """The team's submission; another team's id is 'not found', like an unknown one."""
-    row = session.scalar(select(Submission).where(Submission.id == submission_id))
+    query = select(Submission).where(Submission.id == submission_id)
+    row = session.scalar(query.with_for_update() if for_update else query)
     if row is None or row.team_id != team_id:
         raise NotFound(what="submission", ident=submission_id)
     return row

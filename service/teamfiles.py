@@ -91,4 +91,20 @@ def versions(session: Session, *, team_id: int, kind: str) -> list[TeamFile]:
         TeamFile.team_id == team_id, TeamFile.kind == kind).order_by(TeamFile.version)))
 
 
-__all__ = ["KINDS", "check", "get", "store", "versions"]
+
+
+
+def get_by_id(session: Session, file_id: int) -> TeamFile:
+    row = session.get(TeamFile, file_id)
+    if row is None:
+        raise NotFound(what="uploaded file", ident=str(file_id))
+    return row
+
+
+def newest_id(session: Session, *, team_id: int, kind: str) -> int | None:
+    return session.scalar(select(TeamFile.id).where(
+        TeamFile.team_id == team_id, TeamFile.kind == kind)
+        .order_by(TeamFile.version.desc()).limit(1))
+
+
+__all__ = ["KINDS", "check", "get", "get_by_id", "newest_id", "store", "versions"]

@@ -4,66 +4,16 @@ PostgreSQL, called over HTTP with httpx."""
 from __future__ import annotations
 
 import os
-import socket
-import threading
-import time
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import httpx
 import pytest
-import uvicorn
 
-from service import Settings, create_app
-from service.app import PoolFactory
+from service import Settings
 from service.db import Scope, make_engine, migrate, session_factory, transaction
 from service.tokens import issue
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        port: int = sock.getsockname()[1]
-        return port
-
-
-@dataclass
-class Served:
-    url: str
-    settings: Settings
-    server: uvicorn.Server
-    thread: threading.Thread
-
-    def client(self, token: str | None = None) -> httpx.Client:
-        headers = {"Authorization": f"Bearer {token}"} if token else {}
-        return httpx.Client(base_url=self.url, headers=headers, timeout=30)
-
-    def stop(self) -> None:
-        self.server.should_exit = True
-        self.thread.join(timeout=30)
-
-
-def serve(settings: Settings, *, pool_factory: PoolFactory | None = None,
-          start_worker: bool = False) -> Served:
-    """Start the app on a free loopback port; returns once it answers."""
-    port = free_port()
-    app = create_app(settings, pool_factory=pool_factory, start_worker=start_worker)
-    config = uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning",
-                            lifespan="on")
-    server = uvicorn.Server(config)
-    thread = threading.Thread(target=server.run, name=f"service-{port}", daemon=True)
-    thread.start()
-    url = f"http://127.0.0.1:{port}"
-    deadline = time.monotonic() + 30
-    while time.monotonic() < deadline:
-        if server.started:
-            return Served(url=url, settings=settings, server=server, thread=thread)
-        if not thread.is_alive():
-            break
-        time.sleep(0.02)
-    raise RuntimeError(f"the service did not start on {url}")
+from tests.integration.service.harness import Served, serve
 
 
 def _postgres_url() -> str | None:

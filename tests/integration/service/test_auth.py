@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from tests.integration.service.conftest import Served, TokenMaker
+from tests.integration.service.conftest import TokenMaker
+from tests.integration.service.harness import Served
 
 
 def test_requests_without_or_with_bad_tokens_get_401_saying_why(

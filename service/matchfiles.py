@@ -1,0 +1,44 @@
+"""The files of one test match: ``game.json`` and the two team files, in the match's folder.
+
+The submitting team plays red with the team file version it submitted; the opponent plays blue
+(the project's stub team, or the newest team file of a team that accepts friendlies). Test
+matches are short, lockstep scrimmages (see :class:`service.settings.Settings`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any
+
+from orchestrator.match.scrimmage import game_file, team_file
+from service.settings import Settings
+
+
+def _ports(base: int, team: dict[str, Any]) -> list[int]:
+    players = team.get("players") or {}
+    return [base + n for n in range(1, max(1, len(players)) + 1)]
+
+
+def write_match(folder: Path, *, match_id: str, team: dict[str, Any],
+                opponent: dict[str, Any] | None, stub_image: str | None,
+                settings: Settings, seed: int) -> Path:
+    """Write the match files into ``folder``; returns the game.json path."""
+    if opponent is None:
+        assert stub_image is not None
+        opponent = team_file("Stub", stub_image, settings.test_players, goalie_first=True)
+    args = argparse.Namespace(players=settings.test_players, seed=seed,
+                              half_duration=settings.test_half_duration_s,
+                              wait_before_ready=3.0, grace=settings.test_grace_s)
+    game = game_file(args, match_id)
+    game["red"]["ports"] = _ports(10000, team)
+    game["blue"]["ports"] = _ports(10020, opponent)
+    folder.mkdir(parents=True, exist_ok=True)
+    files = {"game.json": game, "team_red.json": team, "team_blue.json": opponent}
+    for name, content in files.items():
+        (folder / name).write_text(json.dumps(content, indent=2) + "\n", encoding="utf-8")
+    return folder / "game.json"
+
+
+__all__ = ["write_match"]

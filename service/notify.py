@@ -1,0 +1,172 @@
+"""Notifications: an outbox of mails and webhooks, written with each state change and sent by
+the :class:`Notifier` thread with retries (so a restart loses none).
+
+Webhooks are signed (see :mod:`service.webhooks`); mail goes through the SMTP server of the
+settings (none configured: no mail rows are written).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import secrets
+import smtplib
+import threading
+from datetime import timedelta
+from email.message import EmailMessage
+from typing import TYPE_CHECKING, Any
+
+import httpx
+from sqlalchemy import select
+from sqlalchemy.orm import Session
+
+from service import webhooks
+from service.db import Notification, Submission, Team, now, transaction, utc
+from service.settings import Settings
+
+if TYPE_CHECKING:
+    from service.app import Services
+
+log = logging.getLogger(__name__)
+
+MAIL_EVENTS = {"submission.started", "submission.finished", "submission.failed"}
+
+
+def payload(row: Submission, event: str, settings: Settings) -> dict[str, Any]:
+    base = f"{settings.public_url.rstrip('/')}/v1/submissions/{row.id}"
+    return {
+        "event": event,
+        "submission": {
+            "id": row.id, "state": row.state, "opponent": row.opponent, "match_id": row.match_id,
+            "failure_class": row.failure_class, "failure_side": row.failure_side,
+            "cause": row.cause, "charged": row.charged,
+            "links": {"status": base, "report": base + "/report", "results": base + "/results",
+                      "logs": base + "/logs"},
+        },
+    }
+
+
+def enqueue(session: Session, row: Submission, event: str, settings: Settings) -> None:
+    """Outbox rows for ``event``: a mail when the team has an address and SMTP is set, a
+    webhook when the team has a webhook URL."""
+    team = session.get(Team, row.team_id)
+    if team is None:
+        return
+    body = json.dumps(payload(row, event, settings), sort_keys=True)
+    channels = []
+    if team.email and settings.smtp_host and event in MAIL_EVENTS:
+        channels.append("mail")
+    if team.webhook_url:
+        channels.append("webhook")
+    for channel in channels:
+        session.add(Notification(delivery_id=secrets.token_hex(16), team_id=team.id,
+                                 submission_id=row.id, channel=channel, event=event,
+                                 payload_json=body, attempts=0, next_attempt_at=now(),
+                                 given_up=False))
+
+
+def send_mail(settings: Settings, *, to: str, event: str, data: dict[str, Any]) -> None:
+    sub = data["submission"]
+    message = EmailMessage()
+    message["From"] = settings.mail_from
+    message["To"] = to
+    what = event.split(".", 1)[1]
+    message["Subject"] = f"[hlvs] test match {sub['id']} {what}"
+    lines = [f"Your test match {sub['id']} against {sub['opponent']} {what}.", "",
+             f"state: {sub['state']}"]
+    if sub.get("failure_class"):
+        lines.append(f"failure: {sub['failure_class']} (on the {sub['failure_side']} side)")
+    if sub.get("cause"):
+        lines.append(f"cause: {sub['cause']}")
+    lines += ["", f"status:  {sub['links']['status']}", f"report:  {sub['links']['report']}",
+              f"results: {sub['links']['results']}", f"logs:    {sub['links']['logs']}"]
+    message.set_content("\n".join(lines) + "\n")
+    with smtplib.SMTP(settings.smtp_host, settings.smtp_port, timeout=10) as smtp:
+        smtp.send_message(message)
+
+
+class Notifier:
+    """Sends due outbox rows; failures are retried with exponential back-off."""
+
+    def __init__(self, services: Services) -> None:
+        self.services = services
+        self.settings = services.settings
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._http = httpx.Client(timeout=self.settings.webhook_timeout_s)
+
+    def start(self) -> None:
+        self._thread = threading.Thread(target=self._run, name="notifier", daemon=True)
+        self._thread.start()
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(timeout=30)
+        self._http.close()
+
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            try:
+                self.round()
+            except Exception:  # process boundary of the notifier thread
+                log.exception("notifier round failed; retrying")
+            self._stop.wait(0.5)
+
+    def round(self) -> int:
+        """Send every due notification once; returns how many were sent."""
+        with transaction(self.services.sessions) as session:
+            due = list(session.scalars(select(Notification).where(
+                Notification.sent_at.is_(None), Notification.given_up.is_(False),
+                Notification.next_attempt_at <= now()).order_by(Notification.id).limit(50)))
+            work = [(n.id, n.channel, n.event, n.payload_json, n.delivery_id, n.team_id)
+                    for n in due]
+            teams = {t.id: (t.email, t.webhook_url, t.webhook_secret)
+                     for t in session.scalars(select(Team).where(
+                         Team.id.in_({w[5] for w in work})))}
+        sent = 0
+        for ident, channel, event, body, delivery_id, team_id in work:
+            email, url, secret = teams.get(team_id, (None, None, None))
+            error = None
+            try:
+                if channel == "mail":
+                    if not email:
+                        raise ValueError("the team has no e-mail address any more")
+                    send_mail(self.settings, to=email, event=event, data=json.loads(body))
+                else:
+                    if not url:
+                        raise ValueError("the team has no webhook URL any more")
+                    headers = webhooks.sign(secret or "", delivery_id=delivery_id, event=event,
+                                            body=body.encode())
+                    answer = self._http.post(url, content=body.encode(), headers=headers)
+                    if answer.status_code >= 300:
+                        raise ValueError(f"HTTP {answer.status_code} from {url}")
+            except (OSError, ValueError, smtplib.SMTPException, httpx.HTTPError) as exc:
+                error = f"{type(exc).__name__}: {exc}"
+            self._record(ident, error)
+            sent += error is None
+        return sent
+
+    def _record(self, ident: int, error: str | None) -> None:
+        with transaction(self.services.sessions) as session:
+            row = session.get(Notification, ident)
+            assert row is not None
+            row.attempts += 1
+            if error is None:
+                row.sent_at = now()
+                log.info("%s %s for %s sent (attempt %d)", row.channel, row.event,
+                         row.submission_id, row.attempts)
+                return
+            row.last_error = error
+            if row.attempts >= self.settings.webhook_attempts:
+                row.given_up = True
+                log.warning("%s %s for %s given up after %d attempts: %s", row.channel,
+                            row.event, row.submission_id, row.attempts, error)
+            else:
+                delay = self.settings.webhook_backoff_s * 2 ** (row.attempts - 1)
+                row.next_attempt_at = utc(now()) + timedelta(seconds=delay)
+                log.info("%s %s for %s failed (attempt %d, next in %.0f s): %s", row.channel,
+                         row.event, row.submission_id, row.attempts, delay, error)
+
+
+__all__ = ["MAIL_EVENTS", "Notifier", "enqueue", "payload", "send_mail"]

@@ -1,0 +1,157 @@
+"""The pre-flight check of a submission: a few seconds that spare a failed match hours later.
+
+Stages, in order (the first failure is the answer, with its cause):
+
+1. ``pull``  every image of the team is pulled with the team's registry login;
+2. ``size``  each within the league's size limit (10 GB per image);
+3. ``start`` one robot per distinct image starts under the official limits (CPUs capped at
+   this host's count);
+4. ``connect`` and connects to a simulator's robot API within ``preflight_timeout_s``.
+
+Stages 3-4 use the match machinery itself (``MatchRunner``) on a short-lived match of those
+robots against one stub robot, stopped as soon as every robot has connected. With
+``settings.preflight == "images"`` only stages 1-2 run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import os
+import secrets
+import tempfile
+import threading
+import time
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+from orchestrator.config import Limits, load_team
+from orchestrator.errors import ImageTooLarge, OrchestratorError
+from service.errors import PreflightFailed
+from service.settings import Settings
+
+log = logging.getLogger(__name__)
+
+
+def official_limits() -> Limits:
+    return replace(Limits(), cpus=min(Limits().cpus, float(os.cpu_count() or 1)))
+
+
+def run(team_doc: dict[str, Any], *, settings: Settings) -> float:
+    """Check the team's images; returns the seconds it took, raises :class:`PreflightFailed`."""
+    started = time.monotonic()
+    with tempfile.TemporaryDirectory(prefix="hlvs-preflight-") as folder:
+        path = Path(folder) / "team_config.json"
+        path.write_text(json.dumps(team_doc), encoding="utf-8")
+        team = load_team(path, images_required=True).team
+        from orchestrator.engine import connect
+        from orchestrator.pull import resolve_team_images
+
+        try:
+            engine = connect()
+            resolved = resolve_team_images(engine, team, limits=official_limits())
+        except OrchestratorError as exc:
+            raise PreflightFailed(stage="pull", image="(all)", cause=str(exc)) from exc
+        for number in sorted(resolved):
+            image = resolved[number]
+            if image.error is not None:
+                stage = "size" if isinstance(image.error, ImageTooLarge) else "pull"
+                raise PreflightFailed(stage=stage, image=image.reference or "(none)",
+                                      cause=image.error.reason)
+        if settings.preflight == "full":
+            _start_and_connect(team_doc, Path(folder), settings=settings)
+    elapsed = time.monotonic() - started
+    log.info("pre-flight of %s passed in %.1f s", team.name, elapsed)
+    return elapsed
+
+
+def _distinct_players(team_doc: dict[str, Any]) -> dict[str, Any]:
+    """The team file with one player per distinct (image, tag, command)."""
+    players = team_doc.get("players") or {}
+    kept: dict[str, Any] = {}
+    seen: set[tuple[Any, ...]] = set()
+    for key in sorted(players, key=int):
+        entry = players[key]
+        ident = (entry.get("image", team_doc.get("image")), entry.get("dockerTag"),
+                 entry.get("dockerCmd"))
+        if ident not in seen:
+            seen.add(ident)
+            kept[str(len(kept) + 1)] = entry
+    return {**team_doc, "players": kept}
+
+
+def _start_and_connect(team_doc: dict[str, Any], folder: Path, *, settings: Settings) -> None:
+    from orchestrator.config import load_game
+    from orchestrator.engine import connect
+    from orchestrator.engine.containers import DockerRuntime
+    from orchestrator.images import project_image
+    from orchestrator.match import HostControl, MatchRunner, RunOptions, cleanup, plan_from_game
+    from orchestrator.match.scrimmage import game_file, team_file
+    from orchestrator.telemetry import ZenohTelemetry
+
+    team = _distinct_players(team_doc)
+    match_id = "preflight-" + secrets.token_hex(4)
+    args = argparse.Namespace(players=1, seed=1, half_duration=60.0, wait_before_ready=120.0,
+                              grace=1.0)
+    game = game_file(args, match_id)
+    game["red"]["ports"] = [10000 + n for n in range(1, len(team["players"]) + 1)]
+    limits = official_limits()
+    game["limits"] = {"cpus": limits.cpus, "memory_gb": limits.memory_gb, "pids": limits.pids,
+                      "log_folder_gb": 1}
+    config = folder / "config"
+    config.mkdir()
+    files = {"game.json": game, "team_red.json": team,
+             "team_blue.json": team_file("Stub", project_image("stub"), 1, goalie_first=True)}
+    for name, content in files.items():
+        (config / name).write_text(json.dumps(content), encoding="utf-8")
+    plan = plan_from_game(load_game(config / "game.json", images_required=True),
+                          grace_period_s=1.0)
+    runtime = DockerRuntime(connect())
+    host = HostControl.for_current_user()
+    runner = MatchRunner(
+        plan, runtime=runtime, host=host,
+        options=RunOptions(out_dir=folder / "out", simulator_image=project_image("simulator"),
+                           poll_s=0.1),
+        telemetry=lambda endpoint, mid: ZenohTelemetry(endpoint=endpoint, match_id=mid),
+    )
+    thread = threading.Thread(target=runner.run, name=match_id, daemon=True)
+    thread.start()
+    deadline = time.monotonic() + settings.preflight_timeout_s
+    failure: PreflightFailed | None = None
+    try:
+        while True:
+            if runner.bringup_s is not None:
+                break
+            red = [r for r in runner.records.values() if r.color == "red"]
+            broken = next((r for r in red if r.startup_error or r.exited_during_game), None)
+            if broken is not None:
+                stage = "start"
+                cause = broken.startup_error or (
+                    f"the robot's container exited with code {broken.exit_code}"
+                    + (" (out of memory)" if broken.oom_killed else "")
+                    + " before connecting to the simulator")
+                failure = PreflightFailed(stage=stage, image=broken.image or "?", cause=cause)
+                break
+            if runner.failure is not None or not thread.is_alive():
+                cause = runner.failure.cause if runner.failure else "the check ended early"
+                failure = PreflightFailed(stage="start", image="(simulator)", cause=cause)
+                break
+            if time.monotonic() > deadline:
+                waiting = [r.image or "?" for r in red]
+                failure = PreflightFailed(
+                    stage="connect", image=", ".join(sorted(set(waiting))),
+                    cause=f"no connection to the simulator's robot API within "
+                          f"{settings.preflight_timeout_s:.0f} s")
+                break
+            time.sleep(0.1)
+    finally:
+        runner.stop_event.set()
+        thread.join(timeout=60)
+        cleanup(runtime, host, match_id=match_id)
+    if failure is not None:
+        raise failure
+
+
+__all__ = ["official_limits", "run"]

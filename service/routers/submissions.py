@@ -1,0 +1,210 @@
+"""``/v1/submissions``: test matches of the calling team; status, cancel and downloads.
+
+Another team's submission id answers 404 exactly like an unknown one, so ids do not leak.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from fastapi import APIRouter, FastAPI, Request
+from fastapi.responses import FileResponse, JSONResponse
+from pydantic import BaseModel
+from sqlalchemy import select
+
+from service import submissions, teamfiles
+from service.db import Submission, transaction
+from service.deps import DbSession, TeamPrincipal, get_services
+from service.errors import NotFound
+from service.views import SubmissionCreate, SubmissionView, submission_view
+
+router = APIRouter(prefix="/v1/submissions", tags=["submissions"])
+
+OWN_COLOR = "red"  # the submitting team plays red in its test matches
+
+
+class LogListing(BaseModel):
+    team: list[str]
+    public: list[str]
+
+
+def _slots(request: Request) -> int:
+    services = get_services(request)
+    return services.pool.slots if services.pool is not None else services.settings.match_slots
+
+
+@router.post("", status_code=201, responses={
+    409: {"description": "the team already has an active test match (its id is in the body)"},
+    422: {"description": "invalid body, unknown opponent or failed pre-flight check"}})
+def create_submission(body: SubmissionCreate, request: Request,
+                      principal: TeamPrincipal) -> SubmissionView:
+    """Check the team's images (pre-flight) and queue a test match."""
+    services = get_services(request)
+    team_id = principal.team_id
+    assert team_id is not None
+    with transaction(services.sessions) as session:
+        submissions.check_opponent(session, team_id=team_id, opponent=body.opponent)
+        submissions.refuse_if_active(session, team_id)
+        team_file = teamfiles.get(session, team_id=team_id, kind="team_config",
+                                  version=body.team_config_version)
+        file_id, document = team_file.id, json.loads(team_file.content)
+        credentials = teamfiles.newest_id(session, team_id=team_id, kind="credentials")
+    assert services.preflight is not None
+    elapsed = services.preflight(document, services.settings)
+    with transaction(services.sessions) as session:
+        row = submissions.create(session, team_id=team_id, opponent=body.opponent,
+                                 team_file_id=file_id, credentials_file_id=credentials,
+                                 preflight_s=elapsed)
+        view = submission_view(session, row, services.settings, slots=_slots(request))
+    if services.worker is not None:
+        services.worker.wake()
+    return view
+
+
+@router.get("")
+def list_submissions(request: Request, principal: TeamPrincipal,
+                     session: DbSession) -> list[SubmissionView]:
+    rows = session.scalars(select(Submission).where(Submission.team_id == principal.team_id)
+                           .order_by(Submission.seq.desc()).limit(100))
+    settings = get_services(request).settings
+    return [submission_view(session, r, settings, slots=_slots(request)) for r in rows]
+
+
+@router.get("/{submission_id}")
+def get_submission(submission_id: str, request: Request, principal: TeamPrincipal,
+                   session: DbSession) -> SubmissionView:
+    assert principal.team_id is not None
+    row = submissions.get_own(session, team_id=principal.team_id, submission_id=submission_id)
+    return submission_view(session, row, get_services(request).settings, slots=_slots(request))
+
+
+@router.post("/{submission_id}/cancel", responses={
+    409: {"description": "the submission has already ended"}})
+def cancel_submission(submission_id: str, request: Request, principal: TeamPrincipal,
+                      session: DbSession) -> SubmissionView:
+    """Queued: cancelled at once and not charged. Running: stopped gracefully (the state
+    becomes ``cancelled`` once the match has stopped and its logs are collected)."""
+    assert principal.team_id is not None
+    row = submissions.get_own(session, team_id=principal.team_id, submission_id=submission_id,
+                              for_update=True)
+    submissions.cancel(session, row)
+    session.flush()
+    services = get_services(request)
+    if services.worker is not None:
+        services.worker.wake()
+    return submission_view(session, row, services.settings, slots=_slots(request))
+
+
+# downloads -------------------------------------------------------------------------------
+def _match_dir(request: Request, row: Submission) -> Path:
+    services = get_services(request)
+    if row.pool_handle is None or services.pool is None:
+        raise NotFound(what="match output of submission", ident=row.id)
+    out: Path = services.pool.results_dir(row.pool_handle)
+    return out
+
+
+def _own(request: Request, principal: TeamPrincipal, session: Any, submission_id: str
+         ) -> tuple[Submission, Path]:
+    assert principal.team_id is not None
+    row = submissions.get_own(session, team_id=principal.team_id, submission_id=submission_id)
+    return row, _match_dir(request, row)
+
+
+def _file(path: Path, what: str, row: Submission, media_type: str) -> FileResponse:
+    if not path.is_file():
+        raise NotFound(what=what, ident=f"{row.id} ({row.state})")
+    return FileResponse(path, media_type=media_type, filename=path.name)
+
+
+@router.get("/{submission_id}/report")
+def get_report(submission_id: str, request: Request, principal: TeamPrincipal,
+               session: DbSession) -> JSONResponse:
+    """The match's ``report.json`` with whose side a failure was on (``backend_error`` is true
+    when it was the league's) and the exit codes of the team's own robots."""
+    assert principal.team_id is not None
+    row = submissions.get_own(session, team_id=principal.team_id, submission_id=submission_id)
+    match_report: Any = None
+    robots: dict[str, Any] = {}
+    if row.pool_handle is not None:
+        out = _match_dir(request, row)
+        for name, target in (("report.json", "report"), ("results.json", "results")):
+            try:
+                data = json.loads((out / name).read_text(encoding="utf-8"))
+            except (OSError, ValueError):
+                continue
+            if target == "report":
+                match_report = data
+            else:
+                for key, robot in (data.get("robots") or {}).items():
+                    if key.startswith(OWN_COLOR + "-"):
+                        robots[key] = {k: robot.get(k) for k in (
+                            "image", "exit_code", "oom_killed", "image_error", "startup_error",
+                            "exited_during_game")}
+    return JSONResponse({
+        "submission": row.id, "state": row.state, "match_id": row.match_id,
+        "status": "success" if row.state == "done" else row.state,
+        "failure_class": row.failure_class, "failure_side": row.failure_side,
+        "backend_error": row.failure_side == "league", "cause": row.cause,
+        "charged": row.charged, "team_robots": robots, "match_report": match_report,
+    })
+
+
+@router.get("/{submission_id}/results")
+def get_results(submission_id: str, request: Request, principal: TeamPrincipal,
+                session: DbSession) -> FileResponse:
+    row, out = _own(request, principal, session, submission_id)
+    return _file(out / "results.json", "results of submission", row, "application/json")
+
+
+@router.get("/{submission_id}/replay")
+def get_replay(submission_id: str, request: Request, principal: TeamPrincipal,
+               session: DbSession) -> FileResponse:
+    row, out = _own(request, principal, session, submission_id)
+    return _file(out / "public" / "replay.hlvsrec", "replay of submission", row,
+                 "application/octet-stream")
+
+
+@router.get("/{submission_id}/video")
+def get_video(submission_id: str, request: Request, principal: TeamPrincipal,
+              session: DbSession) -> FileResponse:
+    row, out = _own(request, principal, session, submission_id)
+    return _file(out / "public" / "match.mp4", "video of submission", row, "video/mp4")
+
+
+def _listing(root: Path) -> list[str]:
+    if not root.is_dir():
+        return []
+    return sorted(str(p.relative_to(root)) for p in root.rglob("*") if p.is_file())
+
+
+@router.get("/{submission_id}/logs")
+def list_logs(submission_id: str, request: Request, principal: TeamPrincipal,
+              session: DbSession) -> LogListing:
+    """The team's own logs (its robots' stdout/stderr and /robocup-logs) and the public logs;
+    download one with ``/logs/team/<path>`` or ``/logs/public/<path>``."""
+    _, out = _own(request, principal, session, submission_id)
+    return LogListing(team=_listing(out / "teams" / OWN_COLOR), public=_listing(out / "public"))
+
+
+@router.get("/{submission_id}/logs/{part}/{path:path}")
+def get_log(submission_id: str, part: str, path: str, request: Request,
+            principal: TeamPrincipal, session: DbSession) -> FileResponse:
+    row, out = _own(request, principal, session, submission_id)
+    roots = {"team": out / "teams" / OWN_COLOR, "public": out / "public"}
+    if part not in roots:
+        raise NotFound(what="log folder", ident=part)
+    root = roots[part].resolve()
+    target = (root / path).resolve()
+    if not target.is_relative_to(root) or not target.is_file():
+        raise NotFound(what="log file", ident=f"{part}/{path}")
+    return FileResponse(target, media_type="application/octet-stream", filename=target.name)
+
+
+def mount(app: FastAPI) -> None:
+    app.include_router(router)
+
+
+__all__ = ["mount", "router"]

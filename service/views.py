@@ -1,0 +1,76 @@
+"""Response bodies shared by the routers (Pydantic models; the OpenAPI document comes from
+them)."""
+
+from __future__ import annotations
+
+from datetime import datetime
+
+from pydantic import BaseModel, ConfigDict, Field
+from sqlalchemy.orm import Session
+
+from service.db import Submission, Team, utc
+from service.settings import Settings
+from service.submissions import queue_info
+
+
+class Links(BaseModel):
+    status: str
+    report: str
+    results: str
+    logs: str
+    replay: str
+    video: str
+
+
+class SubmissionView(BaseModel):
+    id: str
+    team: str
+    opponent: str
+    state: str
+    created_at: datetime
+    started_at: datetime | None
+    finished_at: datetime | None
+    queue_position: int | None = Field(description="1 = next to start; only while queued")
+    expected_start: datetime | None
+    waiting_reason: str | None
+    match_id: str | None
+    attempts: int
+    cancel_requested: bool
+    charged: bool
+    failure_class: str | None
+    failure_side: str | None = Field(description="team | league, when it failed")
+    cause: str | None
+    preflight_s: float | None
+    links: Links
+
+
+class SubmissionCreate(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+    opponent: str = Field(default="stub", max_length=64,
+                          description="'stub' or a team that accepts friendlies")
+    team_config_version: int | None = Field(default=None, ge=1,
+                                            description="default: the newest version")
+
+
+def submission_view(session: Session, row: Submission, settings: Settings, *,
+                    slots: int) -> SubmissionView:
+    team = session.get(Team, row.team_id)
+    info = queue_info(session, row, slots=slots, default_match_s=settings.expected_match_s)
+    base = f"/v1/submissions/{row.id}"
+    return SubmissionView(
+        id=row.id, team=team.name if team else "?", opponent=row.opponent, state=row.state,
+        created_at=utc(row.created_at),
+        started_at=utc(row.started_at) if row.started_at else None,
+        finished_at=utc(row.finished_at) if row.finished_at else None,
+        queue_position=info.position, expected_start=info.expected_start,
+        waiting_reason=info.reason, match_id=row.match_id, attempts=row.attempts,
+        cancel_requested=row.cancel_requested, charged=row.charged,
+        failure_class=row.failure_class, failure_side=row.failure_side, cause=row.cause,
+        preflight_s=round(row.preflight_s, 2) if row.preflight_s is not None else None,
+        links=Links(status=base, report=base + "/report", results=base + "/results",
+                    logs=base + "/logs", replay=base + "/replay", video=base + "/video"),
+    )
+
+
+__all__ = ["Links", "SubmissionCreate", "SubmissionView", "submission_view"]

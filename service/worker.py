@@ -1,0 +1,235 @@
+"""The queue worker: starts queued test matches in the pool and follows them to their end.
+
+One thread in the service process. Each round it (1) reconciles every STARTING / RUNNING
+submission with the pool (this is also what a restarted service does first), (2) starts the
+oldest queued submissions while the pool has free slots and the queue is not paused. Every
+state change and its notifications are written in one transaction (the notifications are an
+outbox sent by :mod:`service.notify`).
+
+Restart safety: STARTING is committed before the pool is asked, with the match id the pool
+will use. A STARTING submission found later is submitted again: the pool answers with the
+running match when it did start (no duplicate); a match the pool lost (no process, no report)
+is queued again at its old place, with a new attempt number (nothing is lost).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import threading
+import zlib
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from sqlalchemy import func, select
+from sqlalchemy.orm import Session
+
+from service import matchfiles, notify, teamfiles
+from service.db import Submission, SubmissionState, Team, now, transaction
+from service.errors import PoolError, ServiceError
+from service.pool import JobState, MatchJob
+from service.submissions import STUB, failure_side, queue_paused
+
+if TYPE_CHECKING:
+    from service.app import Services
+
+log = logging.getLogger(__name__)
+
+MAX_ATTEMPTS = 3
+
+
+class QueueWorker:
+    def __init__(self, services: Services) -> None:
+        self.services = services
+        self.settings = services.settings
+        self.pool = services.pool
+        self._stub_image = services.settings.stub_image or None
+        self._stop = threading.Event()
+        self._wake = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._cancel_sent: set[str] = set()
+        self.notifier = notify.Notifier(services)
+
+    # lifecycle ---------------------------------------------------------------------------
+    def start(self) -> None:
+        self._thread = threading.Thread(target=self._run, name="queue-worker", daemon=True)
+        self._thread.start()
+        self.notifier.start()
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._wake.set()
+        if self._thread is not None:
+            self._thread.join(timeout=30)
+        self.notifier.stop()
+
+    def wake(self) -> None:
+        """Run a round now (after a submission, a cancel or a resume)."""
+        self._wake.set()
+
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            try:
+                self.round()
+            except Exception:  # process boundary of the worker thread: log, keep serving
+                log.exception("queue worker round failed; retrying")
+            self._wake.wait(self.settings.worker_poll_s)
+            self._wake.clear()
+
+    # one round ---------------------------------------------------------------------------
+    def round(self) -> None:
+        sessions = self.services.sessions
+        with transaction(sessions) as session:
+            active = list(session.scalars(select(Submission).where(Submission.state.in_(
+                [SubmissionState.STARTING.value, SubmissionState.RUNNING.value])).order_by(
+                Submission.seq)))
+            for row in active:
+                self._follow(session, row)
+        while not self._stop.is_set():
+            with transaction(sessions) as session:
+                if queue_paused(session):
+                    return
+                busy = session.scalar(select(func.count()).select_from(Submission).where(
+                    Submission.state.in_([SubmissionState.STARTING.value,
+                                          SubmissionState.RUNNING.value]))) or 0
+                if busy >= self.pool.slots:
+                    return
+                queued = session.scalar(select(Submission).where(
+                    Submission.state == SubmissionState.QUEUED.value).order_by(
+                    Submission.seq).limit(1).with_for_update(skip_locked=True))
+                if queued is None:
+                    return
+                row = queued
+                row.state = SubmissionState.STARTING.value
+                row.attempts += 1
+                row.match_id = f"{row.id}-a{row.attempts}"
+                row.cause = None
+                job = self._prepare(session, row)
+                row.pool_handle = None
+                seq = row.seq
+            with transaction(sessions) as session:
+                starting = session.get(Submission, seq)
+                assert starting is not None
+                self._submit(session, starting, job)
+
+    # helpers -----------------------------------------------------------------------------
+    def _work_dir(self, match_id: str) -> Path:
+        return (self.settings.matches_dir / match_id).resolve()
+
+    def _stub(self) -> str:
+        if self._stub_image is None:
+            from orchestrator.images import project_image
+
+            self._stub_image = project_image("stub")
+        return self._stub_image
+
+    def _prepare(self, session: Session, row: Submission) -> MatchJob:
+        assert row.match_id is not None
+        team_doc = json.loads(teamfiles.get_by_id(session, row.team_file_id).content)
+        opponent_doc: dict[str, Any] | None = None
+        if row.opponent != STUB:
+            other = session.scalar(select(Team).where(Team.name == row.opponent))
+            assert other is not None
+            opponent_doc = json.loads(teamfiles.get(session, team_id=other.id,
+                                                    kind="team_config").content)
+        work = self._work_dir(row.match_id)
+        game = matchfiles.write_match(
+            work / "config", match_id=row.match_id, team=team_doc, opponent=opponent_doc,
+            stub_image=None if opponent_doc else self._stub(), settings=self.settings,
+            seed=zlib.crc32(row.match_id.encode()))
+        return MatchJob(match_id=row.match_id, game_path=game, work_dir=work)
+
+    def _submit(self, session: Session, row: Submission, job: MatchJob) -> None:
+        try:
+            handle = self.pool.submit(job)
+        except PoolError as exc:
+            log.error("submission %s: %s", row.id, exc)
+            self._end(session, row, SubmissionState.FAILED, failure_class="infrastructure",
+                      cause=str(exc))
+            return
+        row.pool_handle = handle
+        self._mark_running(session, row)
+
+    def _mark_running(self, session: Session, row: Submission) -> None:
+        row.state = SubmissionState.RUNNING.value
+        row.started_at = row.started_at or now()
+        row.charged = True
+        notify.enqueue(session, row, "submission.started", self.settings)
+        log.info("submission %s running as match %s", row.id, row.match_id)
+
+    def _follow(self, session: Session, row: Submission) -> None:
+        if row.pool_handle is None:  # STARTING when the service stopped: submit again
+            if row.match_id is None:
+                row.state = SubmissionState.QUEUED.value
+                return
+            job = MatchJob(match_id=row.match_id, game_path=self._work_dir(row.match_id)
+                           / "config" / "game.json", work_dir=self._work_dir(row.match_id))
+            if not job.game_path.is_file():
+                job = self._prepare(session, row)
+            self._submit(session, row, job)
+            return
+        try:
+            status = self.pool.status(row.pool_handle)
+        except ServiceError as exc:
+            log.warning("submission %s: pool status failed: %s", row.id, exc)
+            return
+        if status.state in (JobState.RUNNING, JobState.PENDING):
+            if row.state == SubmissionState.STARTING.value:
+                self._mark_running(session, row)
+            if row.cancel_requested and row.id not in self._cancel_sent:
+                self.pool.cancel(row.pool_handle)
+                self._cancel_sent.add(row.id)
+            return
+        if status.state is JobState.FINISHED:
+            self._finish(session, row)
+            return
+        # LOST: nothing runs and no report was written
+        if row.cancel_requested:
+            self._end(session, row, SubmissionState.CANCELLED, cause="cancelled by the team")
+        elif row.attempts >= MAX_ATTEMPTS:
+            self._end(session, row, SubmissionState.FAILED, failure_class="infrastructure",
+                      cause=f"the pool lost the match {MAX_ATTEMPTS} times: {status.detail}")
+        else:
+            log.warning("submission %s: match %s lost (%s); queued again", row.id,
+                        row.match_id, status.detail)
+            row.state = SubmissionState.QUEUED.value
+            row.pool_handle = None
+            row.cause = f"attempt {row.attempts} lost by the pool: {status.detail}"
+
+    def _finish(self, session: Session, row: Submission) -> None:
+        assert row.pool_handle is not None
+        out = self.pool.results_dir(row.pool_handle)
+        try:
+            report = json.loads((out / "report.json").read_text(encoding="utf-8"))
+        except (OSError, ValueError) as exc:
+            report = {"status": "failed", "failure_class": "infrastructure",
+                      "cause": f"unreadable report.json: {exc}"}
+        if report.get("status") == "success":
+            self._end(session, row, SubmissionState.DONE, cause=None)
+        elif report.get("failure_class") == "interrupted" and row.cancel_requested:
+            self._end(session, row, SubmissionState.CANCELLED,
+                      cause="cancelled by the team while running (stopped gracefully)")
+        else:
+            self._end(session, row, SubmissionState.FAILED,
+                      failure_class=str(report.get("failure_class") or "infrastructure"),
+                      cause=str(report.get("cause") or "the match failed"))
+
+    def _end(self, session: Session, row: Submission, state: SubmissionState, *,
+             cause: str | None, failure_class: str | None = None) -> None:
+        row.state = state.value
+        row.finished_at = now()
+        row.cause = cause
+        row.failure_class = failure_class
+        row.failure_side = failure_side(failure_class)
+        if row.failure_side == "league":
+            row.charged = False  # the league's fault costs the team nothing
+        self._cancel_sent.discard(row.id)
+        event = {SubmissionState.DONE: "submission.finished",
+                 SubmissionState.FAILED: "submission.failed",
+                 SubmissionState.CANCELLED: "submission.cancelled"}[state]
+        notify.enqueue(session, row, event, self.settings)
+        log.info("submission %s %s%s", row.id, state.value,
+                 f" ({failure_class}: {cause})" if failure_class else "")
+
+
+__all__ = ["MAX_ATTEMPTS", "QueueWorker"]

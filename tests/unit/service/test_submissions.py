@@ -1,0 +1,207 @@
+"""Test-match submissions with a fake pool: queue, one per team, cancel, status, downloads,
+team isolation, operators, restart."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from typing import Any
+
+import httpx
+
+from service.pool.fake import FakePool
+from tests.integration.service.harness import Served
+from tests.unit.service.conftest import team_doc
+
+
+def wait_for(http: httpx.Client, submission: str, predicate: Callable[[dict[str, Any]], bool],
+             timeout_s: float = 10.0) -> dict[str, Any]:
+    deadline = time.monotonic() + timeout_s
+    while True:
+        body: dict[str, Any] = http.get(f"/v1/submissions/{submission}").json()
+        if predicate(body):
+            return body
+        assert time.monotonic() < deadline, f"timed out; last status {body}"
+        time.sleep(0.05)
+
+
+def handle_of(served: Served, submission: str) -> str:
+    from sqlalchemy import select
+
+    from service.db import Submission, make_engine, session_factory, transaction
+
+    engine = make_engine(served.settings.db_url)
+    with transaction(session_factory(engine)) as session:
+        row = session.scalar(select(Submission).where(Submission.id == submission))
+        assert row is not None and row.pool_handle is not None
+        handle = row.pool_handle
+    engine.dispose()
+    return handle
+
+
+def setup_team(served: Served, token: str, name: str) -> httpx.Client:
+    with served.client(token) as http:
+        assert http.put("/v1/team/files/team_config", json=team_doc(name)).status_code == 201
+    return served.client(token)
+
+
+def test_submit_run_finish_and_download(start: Callable[..., Served], token: Callable[..., str],
+                                        pool: FakePool) -> None:
+    served = start()
+    with setup_team(served, token("Alpha"), "Alpha") as http:
+        created = http.post("/v1/submissions", json={})
+        assert created.status_code == 201, created.text
+        sid = created.json()["id"]
+        running = wait_for(http, sid, lambda b: b["state"] == "running")
+        assert running["queue_position"] is None and running["charged"] is True
+        second = http.post("/v1/submissions", json={"opponent": "stub"})
+        assert second.status_code == 409
+        assert second.json()["existing_id"] == sid
+        pool.finish(handle_of(served, sid), {"status": "success"})
+        done = wait_for(http, sid, lambda b: b["state"] == "done")
+        assert done["failure_class"] is None
+        report = http.get(f"/v1/submissions/{sid}/report").json()
+        assert report["status"] == "success" and report["backend_error"] is False
+        assert report["match_report"] == {"status": "success"}
+        assert http.get(f"/v1/submissions/{sid}/results").json()["score"] == {"red": 1, "blue": 0}
+        logs = http.get(f"/v1/submissions/{sid}/logs").json()
+        assert logs == {"team": ["1/stdout.log"], "public": ["referee.log"]}
+        own = http.get(f"/v1/submissions/{sid}/logs/team/1/stdout.log")
+        assert own.status_code == 200 and own.text == "red robot log\n"
+        escape = http.get(f"/v1/submissions/{sid}/logs/team/..%2Fblue%2F1%2Fstdout.log")
+        assert escape.status_code == 404
+        assert http.get(f"/v1/submissions/{sid}/video").status_code == 404
+        # a new submission is accepted once the first has ended
+        again = http.post("/v1/submissions", json={})
+        assert again.status_code == 201
+        sid2 = again.json()["id"]
+        wait_for(http, sid2, lambda b: b["state"] == "running")
+    assert pool.started == [f"{sid}-a1", f"{sid2}-a1"]
+
+
+def test_other_teams_ids_are_not_found(start: Callable[..., Served],
+                                       token: Callable[..., str]) -> None:
+    served = start()
+    with setup_team(served, token("Alpha"), "Alpha") as alpha, \
+            setup_team(served, token("Beta"), "Beta") as beta:
+        sid = alpha.post("/v1/submissions", json={}).json()["id"]
+        for path in ("", "/report", "/results", "/logs", "/logs/team/1/stdout.log", "/replay"):
+            answer = beta.get(f"/v1/submissions/{sid}{path}")
+            assert answer.status_code == 404, path
+            unknown = beta.get(f"/v1/submissions/sub_000000000000{path}")
+            assert unknown.status_code == 404
+            assert answer.json()["error"] == unknown.json()["error"] == "not_found"
+        assert beta.post(f"/v1/submissions/{sid}/cancel").status_code == 404
+        assert alpha.get(f"/v1/submissions/{sid}").status_code == 200
+
+
+def test_cancel_queued_is_free_and_cancel_running_stops_the_match(
+        start: Callable[..., Served], token: Callable[..., str], pool: FakePool) -> None:
+    served = start()
+    operator = served.client(token(operator=True))
+    assert operator.post("/v1/operator/queue/pause").json()["paused"] is True
+    with setup_team(served, token("Alpha"), "Alpha") as http:
+        sid = http.post("/v1/submissions", json={}).json()["id"]
+        queued = http.get(f"/v1/submissions/{sid}").json()
+        assert queued["state"] == "queued" and queued["queue_position"] == 1
+        assert "paused" in queued["waiting_reason"]
+        cancelled = http.post(f"/v1/submissions/{sid}/cancel").json()
+        assert cancelled["state"] == "cancelled" and cancelled["charged"] is False
+        again = http.post(f"/v1/submissions/{sid}/cancel")
+        assert again.status_code == 409
+        operator.post("/v1/operator/queue/resume")
+        sid2 = http.post("/v1/submissions", json={}).json()["id"]
+        wait_for(http, sid2, lambda b: b["state"] == "running")
+        asked = http.post(f"/v1/submissions/{sid2}/cancel").json()
+        assert asked["cancel_requested"] is True
+        ended = wait_for(http, sid2, lambda b: b["state"] == "cancelled")
+        assert "gracefully" in ended["cause"]
+        assert pool.cancelled == [handle_of(served, sid2)]
+    operator.close()
+
+
+def test_queue_position_expected_start_and_reason(start: Callable[..., Served],
+                                                  token: Callable[..., str]) -> None:
+    served = start(expected_match_s=600.0)
+    clients = [setup_team(served, token(name), name) for name in ("A1", "B2", "C3")]
+    ids = [c.post("/v1/submissions", json={}).json()["id"] for c in clients]
+    wait_for(clients[0], ids[0], lambda b: b["state"] == "running")
+    second = clients[1].get(f"/v1/submissions/{ids[1]}").json()
+    third = clients[2].get(f"/v1/submissions/{ids[2]}").json()
+    assert (second["queue_position"], third["queue_position"]) == (1, 2)
+    assert "all 1 match slot(s) busy" in second["waiting_reason"]
+    assert "1 submission(s) ahead" in third["waiting_reason"]
+    from datetime import datetime
+
+    gap = (datetime.fromisoformat(third["expected_start"])
+           - datetime.fromisoformat(second["expected_start"])).total_seconds()
+    assert abs(gap - 600.0) < 1.0
+    for c in clients:
+        c.close()
+
+
+def test_restart_mid_match_neither_loses_nor_duplicates(
+        start: Callable[..., Served], token: Callable[..., str], pool: FakePool) -> None:
+    served = start()
+    tok = token("Alpha")
+    with setup_team(served, tok, "Alpha") as http:
+        sid = http.post("/v1/submissions", json={}).json()["id"]
+        wait_for(http, sid, lambda b: b["state"] == "running")
+    served.stop()
+    again = start()
+    with again.client(tok) as http:
+        status = wait_for(http, sid, lambda b: b["state"] == "running")
+        assert status["attempts"] == 1
+        assert pool.started == [f"{sid}-a1"]  # adopted, not started twice
+        pool.lose(handle_of(again, sid))  # the match process died with the host
+        back = wait_for(http, sid, lambda b: b["attempts"] == 2 and b["state"] == "running")
+        assert back["match_id"] == f"{sid}-a2"
+        assert pool.started == [f"{sid}-a1", f"{sid}-a2"]
+
+
+def test_operator_requeues_only_league_failures(start: Callable[..., Served],
+                                                token: Callable[..., str],
+                                                pool: FakePool) -> None:
+    served = start()
+    operator = served.client(token(operator=True))
+    with setup_team(served, token("Alpha"), "Alpha") as http:
+        sid = http.post("/v1/submissions", json={}).json()["id"]
+        wait_for(http, sid, lambda b: b["state"] == "running")
+        pool.finish(handle_of(served, sid), {"status": "failed", "failure_class": "simulator",
+                                             "cause": "simulator exited with code 139"})
+        failed = wait_for(http, sid, lambda b: b["state"] == "failed")
+        assert failed["failure_side"] == "league" and failed["charged"] is False
+        report = http.get(f"/v1/submissions/{sid}/report").json()
+        assert report["backend_error"] is True and report["failure_class"] == "simulator"
+        assert http.post(f"/v1/operator/submissions/{sid}/requeue").status_code == 401
+        requeued = operator.post(f"/v1/operator/submissions/{sid}/requeue")
+        assert requeued.status_code == 200, requeued.text
+        rerun = wait_for(http, sid, lambda b: b["state"] == "running" and b["attempts"] == 2)
+        pool.finish(handle_of(served, sid), {"status": "failed", "failure_class": "team_crash",
+                                             "cause": "robots broke the match"})
+        team_fault = wait_for(http, sid, lambda b: b["state"] == "failed")
+        assert team_fault["failure_side"] == "team" and rerun["charged"] is True
+        refused = operator.post(f"/v1/operator/submissions/{sid}/requeue")
+        assert refused.status_code == 409
+        queue = operator.get("/v1/operator/queue").json()
+        assert queue["paused"] is False and queue["active"] == []
+    operator.close()
+
+
+def test_bad_submissions(start: Callable[..., Served], token: Callable[..., str]) -> None:
+    served = start()
+    with served.client(token("Alpha")) as http:
+        none_yet = http.post("/v1/submissions", json={})
+        assert none_yet.status_code == 404
+        assert "team_config.json" in none_yet.json()["message"]
+        bad = team_doc(image="127.0.0.1:1/bad/image")
+        assert http.put("/v1/team/files/team_config", json=bad).status_code == 201
+        refused = http.post("/v1/submissions", json={})
+        assert refused.status_code == 422
+        assert refused.json()["stage"] == "pull" and refused.json()["cause"]
+        unknown = http.post("/v1/submissions", json={"opponent": "Nobody"})
+        assert unknown.status_code == 422 and "stub" in unknown.json()["message"]
+        extra = http.post("/v1/submissions", json={"opponent": "stub", "priority": 1})
+        assert extra.status_code == 422
+        assert extra.json()["problems"][0]["pointer"] == "/priority"
+        assert http.get("/v1/submissions").json() == []
