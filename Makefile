@@ -52,7 +52,7 @@ images: venv engine
 	$(HLVS) images build $(if $(BASE_IMAGE),--base $(BASE_IMAGE),)
 
 lint:
-	$(VENV)/bin/ruff check orchestrator simulator referee service tests
+	$(VENV)/bin/ruff check orchestrator simulator referee service envs tests
 
 typecheck:
 	$(VENV)/bin/mypy

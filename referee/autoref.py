@@ -46,6 +46,13 @@ from referee.spoofing import Senders, SpoofingLog, robot_key
 logger = logging.getLogger(__name__)
 
 Action = Callable[[WorldSnapshot], list[WorldCommand]]
+_PREDECESSOR = {
+    GameState.INITIAL: GameState.FINISHED,
+    GameState.READY: GameState.PLAYING,
+    GameState.SET: GameState.INITIAL,
+    GameState.PLAYING: GameState.SET,
+    GameState.FINISHED: GameState.READY,
+}
 
 
 class Referee:
@@ -378,6 +385,23 @@ class Referee:
         """A card given by hand, as the league's human referee does at the GameController (the
         automatic rules give none). Escalates like every card; a red card removes the robot."""
         return self._apply([GiveCard(robot, card, reason)], snapshot)
+
+    def force_state(self, state: GameState, snapshot: WorldSnapshot) -> None:
+        """Put the game into ``state`` now, as a trainer may (learning environments): cancels a
+        pending wall-clock wait and skips the transitions a match would take. READY goes on to
+        SET when its time is up, SET to PLAYING after ``set_to_play_s``; PLAYING starts with the
+        ball in play as after a dropped ball's SET."""
+        gc = self.gc
+        self._started = True
+        self._wait_until_s = None
+        self._after_wait = None
+        self._set_since_ms = snapshot.sim_time_ms if state is GameState.SET else None
+        self.ball_in_play = False
+        gc.state = _PREDECESSOR[state]  # a state from which the transition is allowed
+        gc.transition(state)
+        if state is GameState.PLAYING:
+            self.rules.restart(snapshot, None)
+        self.log.info(snapshot.sim_time_ms, f"State {state.name} set by the trainer.")
 
     def _apply(self, decisions: list[Decision], snapshot: WorldSnapshot) -> list[WorldCommand]:
         return apply_decisions(self, decisions, snapshot) if decisions else []

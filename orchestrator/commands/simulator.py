@@ -1,4 +1,5 @@
-"""``hlvs render`` and ``hlvs bench sim|api|stub``: run the simulator package's own commands.
+"""``hlvs render`` and ``hlvs bench sim|api|stub|envs``: run the simulator's (or the learning
+environments') own commands.
 
 The orchestrator does not import the simulator; these commands run ``python -m simulator`` in a
 child process with the same interpreter, so ``hlvs`` stays the one entry point for users.
@@ -15,8 +16,8 @@ from typing import Any
 SIMULATOR_BENCHES = ("sim", "api", "stub")
 
 
-def _exec_simulator(argv: list[str]) -> int:
-    os.execv(sys.executable, [sys.executable, "-m", "simulator", *argv])
+def _exec_simulator(argv: list[str], module: str = "simulator") -> int:
+    os.execv(sys.executable, [sys.executable, "-m", module, *argv])
     return 0  # not reached
 
 
@@ -31,10 +32,10 @@ def register(sub: Any) -> None:
 
     bench = sub.add_parser(
         "bench",
-        help="benchmarks that print JSON: sim, api, stub, bringup, delivery",
+        help="benchmarks that print JSON: sim, api, stub, envs, bringup, delivery",
         add_help=False,
     )
-    bench.add_argument("kind", choices=(*SIMULATOR_BENCHES, "bringup", "delivery"))
+    bench.add_argument("kind", choices=(*SIMULATOR_BENCHES, "envs", "bringup", "delivery"))
     bench.add_argument("rest", nargs=argparse.REMAINDER)
     bench.set_defaults(func=_bench)
 
@@ -42,6 +43,8 @@ def register(sub: Any) -> None:
 def _bench(args: argparse.Namespace) -> int:
     if args.kind in SIMULATOR_BENCHES:
         return _exec_simulator(["bench", args.kind, *args.rest])
+    if args.kind == "envs":  # the learning environments' package
+        return _exec_simulator(["bench", *args.rest], module="envs")
     if args.kind == "delivery":
         from orchestrator.delivery.bench import main as delivery_main
 

@@ -7,7 +7,7 @@ import importlib
 import pytest
 
 
-@pytest.mark.parametrize("package", ["orchestrator", "simulator", "referee", "service"])
+@pytest.mark.parametrize("package", ["orchestrator", "simulator", "referee", "service", "envs"])
 def test_all_is_sorted_and_resolves(package: str) -> None:
     module = importlib.import_module(package)
     names = list(module.__all__)

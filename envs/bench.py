@@ -1,0 +1,106 @@
+"""``hlvs bench envs``: environment steps per second, in-process and over remotes. One JSON line.
+
+In-process: ``hlvs/Kick-v0`` made with ``gymnasium.make`` (its wrappers included) against bare
+world stepping of the same model in the same process (a world with the same robot, the same motor
+targets written with ``set_motor_positions`` then ``step()``, what a hand-written loop does).
+The two alternate in blocks of ``--block`` steps for ``--rounds`` rounds, so load from other
+processes hits both alike; rates are computed from the step thread's CPU time (``cpu``) and from
+wall time (``wall``). ``ratio`` = env steps/s over bare steps/s (CPU time); the target is >= 0.8.
+
+With ``--remotes N`` (needs Docker and the simulator image), it also measures one remote over
+TCP and a vector environment over 1, 2, ... N remotes (``--vector 1,2,4``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from typing import Any
+
+import numpy as np
+
+ACTION_AMPLITUDE_RAD = 0.05
+
+
+def _actions(count: int, seed: int) -> np.ndarray:
+    """Small motor targets around the standing posture (the robot stays up)."""
+    rng = np.random.default_rng(seed)
+    return rng.uniform(-ACTION_AMPLITUDE_RAD, ACTION_AMPLITUDE_RAD, (count, 20)).astype(np.float32)
+
+
+def bench_inprocess(*, rounds: int, block: int, seed: int) -> dict[str, Any]:
+    import gymnasium as gym
+
+    import envs  # noqa: F401  (registers the ids)
+    from referee import RobotId, TeamColor
+    from simulator.world import MOTOR_NAMES, RobotPlacement, World
+
+    env = gym.make("hlvs/Kick-v0", max_episode_s=1e6)
+    env.reset(seed=seed)
+    bare = World.create(
+        field_class="kid",
+        robots=[
+            RobotPlacement(
+                id=RobotId(TeamColor.RED, 1), model="kid-default", x_m=0.0, y_m=0.0, yaw_rad=0.0
+            )
+        ],  # fmt: skip
+        seed=seed,
+    )
+    robot = RobotId(TeamColor.RED, 1)
+    actions = _actions(block, seed)
+    bare_actions = actions.astype(np.float64)
+    totals = {"env_cpu": 0.0, "env_wall": 0.0, "bare_cpu": 0.0, "bare_wall": 0.0}
+    for _ in range(rounds):
+        c0, w0 = time.thread_time(), time.perf_counter()
+        for a in actions:
+            _, _, terminated, truncated, _ = env.step(a)
+            if terminated or truncated:
+                env.reset()
+        c1, w1 = time.thread_time(), time.perf_counter()
+        for a in bare_actions:
+            bare.set_motor_positions(robot, MOTOR_NAMES, a)
+            bare.step()
+        c2, w2 = time.thread_time(), time.perf_counter()
+        totals["env_cpu"] += c1 - c0
+        totals["env_wall"] += w1 - w0
+        totals["bare_cpu"] += c2 - c1
+        totals["bare_wall"] += w2 - w1
+    env.close()
+    steps = rounds * block
+    rates = {k: steps / v for k, v in totals.items() if v > 0}
+    return {
+        "env_steps_per_s_cpu": round(rates["env_cpu"], 1),
+        "bare_steps_per_s_cpu": round(rates["bare_cpu"], 1),
+        "env_steps_per_s_wall": round(rates["env_wall"], 1),
+        "bare_steps_per_s_wall": round(rates["bare_wall"], 1),
+        "ratio": round(rates["env_cpu"] / rates["bare_cpu"], 3),
+        "ratio_wall": round(rates["env_wall"] / rates["bare_wall"], 3),
+        "steps": steps,
+    }
+
+
+def main(argv: list[str]) -> int:
+    parser = argparse.ArgumentParser(prog="hlvs bench envs")
+    parser.add_argument("--rounds", type=int, default=10)
+    parser.add_argument("--block", type=int, default=500)
+    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--remotes", type=int, default=0, help="also measure N remotes (Docker)")
+    parser.add_argument("--vector", default="1,2,4", help="vector sizes over remotes")
+    parser.add_argument("--remote-steps", type=int, default=1000)
+    parser.add_argument("--json", action="store_true", help="only the JSON line")
+    args = parser.parse_args(argv)
+    if args.rounds < 1 or args.block < 1:
+        print("--rounds and --block: expected integers >= 1", file=sys.stderr)
+        return 2
+    out: dict[str, Any] = {"bench": "envs", "env": "hlvs/Kick-v0", "seed": args.seed}
+    out["inprocess"] = bench_inprocess(rounds=args.rounds, block=args.block, seed=args.seed)
+    if args.remotes > 0:
+        from envs.bench_remote import bench_remotes
+
+        sizes = [int(v) for v in args.vector.split(",") if v.strip()]
+        out.update(bench_remotes(remotes=args.remotes, sizes=sizes, steps=args.remote_steps,
+                                 seed=args.seed))  # fmt: skip
+    print(json.dumps(out))
+    return 0

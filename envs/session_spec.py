@@ -1,0 +1,101 @@
+"""What a session builds: plain, JSON-serialisable settings (they travel to remote simulators).
+
+A session is one world with one learning robot (its motors driven by the environment's actions)
+and optionally stub robots and the referee with its GameController. ``to_dict`` / ``from_dict``
+carry it over the trainer channel of a remote.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field, fields
+from typing import Any
+
+from envs.errors import EnvConfigError
+
+FIELD_CLASSES = ("kid", "adult")
+ROLES = ("striker", "goalie", "defender", "idle")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class StubSpec:
+    """A stub robot played by the session (in-process controller, idealised ball perception)."""
+
+    color: str  # "red" | "blue"
+    number: int
+    role: str = "striker"
+    x_m: float = 0.0  # starting pose in the team's own frame (own goal at x < 0)
+    y_m: float = 0.0
+    yaw_rad: float = 0.0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class SessionSpec:
+    field_class: str = "kid"
+    model: str = "kid-default"
+    learner_color: str = "red"
+    learner_number: int = 1
+    learner_pose: tuple[float, float, float] = (-1.0, 0.0, 0.0)  # team frame, for matches
+    stubs: tuple[StubSpec, ...] = ()
+    referee: bool = False  # run the GameController and the automatic referee
+    half_duration_s: float = 60.0
+    steps_per_action: int = 1  # basic steps (8 ms) per environment step
+    camera: bool = False
+    perception: bool = False
+    perception_noise: float = 0.0
+    perception_range_m: float = 10.0
+    physics_dt_s: float = 0.002
+
+    def __post_init__(self) -> None:
+        if self.field_class not in FIELD_CLASSES:
+            raise EnvConfigError(
+                field="field_class", value=self.field_class, expected="'kid' or 'adult'",
+                choices=FIELD_CLASSES,
+            )  # fmt: skip
+        if self.learner_color not in ("red", "blue"):
+            raise EnvConfigError(
+                field="learner_color", value=self.learner_color, expected="'red' or 'blue'",
+                choices=("red", "blue"),
+            )  # fmt: skip
+        if not 1 <= self.steps_per_action <= 125:
+            raise EnvConfigError(
+                field="steps_per_action", value=self.steps_per_action, expected="1..125"
+            )
+        if self.perception_noise < 0:
+            raise EnvConfigError(
+                field="perception_noise", value=self.perception_noise, expected="a number >= 0"
+            )
+        for stub in self.stubs:
+            if stub.role not in ROLES:
+                raise EnvConfigError(
+                    field="stubs[].role", value=stub.role, expected=f"one of {list(ROLES)}",
+                    choices=ROLES,
+                )  # fmt: skip
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> SessionSpec:
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise EnvConfigError(
+                field=unknown[0], value=data[unknown[0]], expected="a session setting",
+                choices=sorted(known),
+            )  # fmt: skip
+        values = dict(data)
+        if "stubs" in values:
+            values["stubs"] = tuple(StubSpec(**s) for s in values["stubs"])
+        if "learner_pose" in values:
+            values["learner_pose"] = tuple(values["learner_pose"])
+        return cls(**values)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ResetRequest:
+    """Where to put things at reset (world frame); ``None`` keeps the session's default."""
+
+    seed: int
+    learner_pose: tuple[float, float, float] | None = None
+    ball_xy: tuple[float, float] | None = None
+    extra: dict[str, Any] = field(default_factory=dict)
