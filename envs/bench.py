@@ -83,12 +83,12 @@ def bench_inprocess(*, rounds: int, block: int, seed: int) -> dict[str, Any]:
 
 def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(prog="hlvs bench envs")
-    parser.add_argument("--rounds", type=int, default=10)
-    parser.add_argument("--block", type=int, default=500)
-    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--rounds", type=int, default=10, help="alternating rounds")
+    parser.add_argument("--block", type=int, default=500, help="steps per block")
+    parser.add_argument("--seed", type=int, default=1, help="episode and action seed")
     parser.add_argument("--remotes", type=int, default=0, help="also measure N remotes (Docker)")
     parser.add_argument("--vector", default="1,2,4", help="vector sizes over remotes")
-    parser.add_argument("--remote-steps", type=int, default=1000)
+    parser.add_argument("--remote-steps", type=int, default=1000, help="steps per remote run")
     parser.add_argument("--json", action="store_true", help="only the JSON line")
     args = parser.parse_args(argv)
     if args.rounds < 1 or args.block < 1:
