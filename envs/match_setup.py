@@ -30,7 +30,7 @@ READY_DURATION_S = 15.0
 @dataclass(slots=True)
 class StubRobot:
     id: RobotId
-    controller: Any  # simulator.stub.controller.StubController
+    controller: Any  # robot.stub.controller.StubController
 
 
 def _player(number: int, pose: tuple[float, float, float], model: str, keeper: bool) -> PlayerSpec:
@@ -85,9 +85,9 @@ def match_spec(spec: SessionSpec, seed: int) -> MatchSpec:
 def build_match(
     spec: SessionSpec, *, seed: int, clock: Any
 ) -> tuple[World, Referee, list[StubRobot]]:
-    from simulator.stub.behaviour import Role
-    from simulator.stub.controller import StubController
-    from simulator.stub.world_model import Pose2D
+    from robot.stub.behaviour import Role
+    from robot.stub.controller import StubController
+    from robot.stub.world_model import Pose2D
 
     mspec = match_spec(spec, seed)
     world = World.from_spec(mspec)
@@ -119,9 +119,9 @@ def _team_pose(x: float, y: float, yaw: float, attack_sign: float) -> tuple[floa
 def tick_stub(stub: StubRobot, world: World, referee: Referee, range_m: float) -> None:
     """One control step of a stub robot: sensors in, motor targets out."""
     from envs.perception import CameraView
-    from simulator.stub.behaviour import GameInfo, Phase
-    from simulator.stub.controller import Sensors
-    from simulator.stub.world_model import Pose2D
+    from robot.stub.behaviour import GameInfo, Phase
+    from robot.stub.controller import Sensors
+    from robot.stub.world_model import Pose2D
 
     gc = referee.gc
     robot = world.index.by_id[stub.id]
