@@ -136,12 +136,16 @@ def summarize(results: list[TrialResult], *, seed: int, wall_s: float) -> dict[s
 
 
 def main(argv: list[str]) -> int:
-    parser = argparse.ArgumentParser(prog="python -m simulator bench stub")
-    parser.add_argument("--trials", type=int, default=10)
-    parser.add_argument("--seed", type=int, default=1)
-    parser.add_argument("--distance-m", type=float, default=2.0)
-    parser.add_argument("--time-limit-s", type=float, default=60.0)
-    parser.add_argument("--scenario", choices=("reach", "shots"), default="reach")
+    program = os.environ.get("HLVS_PROG", "python -m simulator")
+    parser = argparse.ArgumentParser(prog=f"{program} bench stub")
+    parser.add_argument("--trials", type=int, default=10, help="trials to run (default 10)")
+    parser.add_argument("--seed", type=int, default=1, help="seed of the first trial (default 1)")
+    parser.add_argument("--distance-m", type=float, default=2.0,
+                        help="reach: start distance to the ball in metres (default 2)")
+    parser.add_argument("--time-limit-s", type=float, default=60.0,
+                        help="simulated seconds per trial (default 60)")
+    parser.add_argument("--scenario", choices=("reach", "shots"), default="reach",
+                        help="reach the ball, or shots on goal (default reach)")
     parser.add_argument("--goalie", action="store_true", help="shots: an opponent goalie defends")
     parser.add_argument("--json", action="store_true", help="only the JSON line")
     args = parser.parse_args(argv)

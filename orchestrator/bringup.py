@@ -29,9 +29,11 @@ TARGET_S = 10.0
 
 def _parse(argv: Sequence[str]) -> argparse.Namespace:
     parser = argparse.ArgumentParser(prog="hlvs bench bringup", description=__doc__)
-    parser.add_argument("--robots", type=int, default=8, choices=(2, 4, 6, 8))
+    parser.add_argument("--robots", type=int, default=8, choices=(2, 4, 6, 8),
+                        help="robots in the match, both teams together (default 8)")
     parser.add_argument("--json", action="store_true", help="print only the JSON line")
-    parser.add_argument("--timeout", type=float, default=90.0)
+    parser.add_argument("--timeout", type=float, default=90.0,
+                        help="seconds to wait for every robot to connect (default 90)")
     parser.add_argument("--keep", type=Path, default=None, help="keep the match folder here")
     parser.add_argument("--robot-image", default=None,
                         help="image of every robot (default: the project's stub image)")

@@ -1,8 +1,19 @@
 """The ``hlvs`` command line: parses arguments, wires objects, maps errors to exit codes.
 
-Each sub-command lives in ``orchestrator/commands/<name>.py`` and exposes
-``register(subparsers)``, which adds its parser and sets ``func(args) -> int``.
-Exit codes: 0 success, 1 operation failed, 2 invalid input, 3 infrastructure, 130 interrupted.
+Rules every command follows (a unit test checks them for every command that exists):
+
+- It lives in ``orchestrator/commands/<name>.py`` with ``register(subparsers)``, listed in
+  :data:`COMMAND_MODULES`. At module level it imports only the standard library and
+  ``orchestrator.errors`` / ``orchestrator.exitcodes`` / ``orchestrator.console``; everything
+  else is imported inside the function that runs the command, so ``hlvs --help`` stays fast.
+- Every sub-command and every option or argument has a ``help=`` text.
+- It returns an :class:`~orchestrator.exitcodes.ExitCode` or raises an ``OrchestratorError``;
+  the mapping of errors to codes is here, once.
+- Logging: WARNING by default, since most commands print their result on stdout; commands that
+  run for long (a match, a schedule) ``set_defaults(log_level=logging.INFO)``. ``-v`` lowers the
+  level by one step, ``-q`` raises it, before or after the command name.
+- A command forwarded to another module's own parser (``hlvs bench sim``, ``hlvs render``) is
+  added with :func:`forward`, and that parser names itself ``hlvs ...``.
 """
 
 from __future__ import annotations
@@ -10,10 +21,15 @@ from __future__ import annotations
 import argparse
 import importlib
 import logging
+import os
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from typing import Any
 
 from orchestrator.errors import OrchestratorError
+from orchestrator.exitcodes import ExitCode
+
+PROG = "hlvs"
 
 COMMAND_MODULES = (
     "orchestrator.commands.check",
@@ -27,38 +43,124 @@ COMMAND_MODULES = (
     "service.commands",
 )
 
+EPILOG = (
+    "exit codes: 0 success, 1 the operation failed, 2 invalid input, 3 infrastructure "
+    "(Docker engine, registry, network), 4 the match was decided by forfeit, 130 interrupted"
+)
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("hlvs-runner")
+    except PackageNotFoundError:
+        return "unknown"
+
+
+class _VersionAction(argparse.Action):
+    """``--version`` that reads the installed version only when asked."""
+
+    def __init__(self, option_strings: list[str], dest: str, **kwargs: Any) -> None:
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)
+
+    def __call__(self, parser: argparse.ArgumentParser, *args: Any, **kwargs: Any) -> None:
+        print(f"{PROG} {_version()}")
+        parser.exit()
+
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
-        prog="hlvs", description="Run RoboCup Humanoid League virtual soccer matches."
+        prog=PROG,
+        description="Run RoboCup Humanoid League virtual soccer matches.",
+        epilog=EPILOG,
     )
-    parser.add_argument("-v", "--verbose", action="count", default=0, help="more log output")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    parser.add_argument("--version", action=_VersionAction, help="print the version and exit")
+    _add_verbosity(parser, default=0)
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", title="commands")
     sub.required = True
     for name in COMMAND_MODULES:
         importlib.import_module(name).register(sub)
+    for child in walk(parser):
+        if child is not parser and not child.get_default("forwarded"):
+            _add_verbosity(child, default=argparse.SUPPRESS)
     return parser
 
 
-def configure_logging(verbosity: int) -> None:
-    level = logging.WARNING if verbosity < 0 else logging.INFO if verbosity == 0 else logging.DEBUG
-    logging.basicConfig(
-        level=level, format="%(asctime)s %(levelname)s %(name)s: %(message)s", stream=sys.stderr
+def _add_verbosity(parser: argparse.ArgumentParser, *, default: Any) -> None:
+    prefix = "" if default == 0 else "sub_"
+    try:
+        parser.add_argument(
+            "-v", "--verbose", action="count", default=default, dest=prefix + "verbose",
+            help="more log output (-vv for debug)",
+        )
+        parser.add_argument(
+            "-q", "--quiet", action="count", default=default, dest=prefix + "quiet",
+            help="less log output (errors only)",
+        )
+    except argparse.ArgumentError:
+        pass  # the command has its own -v or -q
+
+
+def walk(parser: argparse.ArgumentParser) -> Iterator[argparse.ArgumentParser]:
+    """``parser`` and every sub-command parser below it, depth first."""
+    yield parser
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for child in dict.fromkeys(action.choices.values()):
+                yield from walk(child)
+
+
+def forward(
+    sub: Any, name: str, *, help: str, func: Any, **kwargs: Any
+) -> argparse.ArgumentParser:
+    """A sub-command whose arguments (``--help`` included) go to another parser unread.
+
+    ``func(args)`` gets ``args.rest``, the arguments after the command name.
+    """
+    parser: argparse.ArgumentParser = sub.add_parser(
+        name, help=help, add_help=False, usage=f"{sub._prog_prefix} {name} ...", **kwargs
     )
+    parser.set_defaults(func=func, forwarded=True)
+    return parser
+
+
+def log_level(args: argparse.Namespace) -> int:
+    """The command's default level moved by one step per ``-v`` (down) or ``-q`` (up)."""
+    base = int(getattr(args, "log_level", logging.WARNING))
+    verbose = int(getattr(args, "verbose", 0)) + int(getattr(args, "sub_verbose", 0))
+    quiet = int(getattr(args, "quiet", 0)) + int(getattr(args, "sub_quiet", 0))
+    return max(logging.DEBUG, min(logging.CRITICAL, base + 10 * (quiet - verbose)))
+
+
+def configure_logging(level: int) -> None:
+    fmt = (
+        "%(asctime)s %(levelname)s %(name)s: %(message)s"
+        if level <= logging.INFO
+        else f"{PROG}: %(levelname)s: %(message)s"
+    )
+    logging.basicConfig(level=level, format=fmt, stream=sys.stderr, force=True)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
-    configure_logging(args.verbose)
+    args, rest = parser.parse_known_args(argv)
+    if getattr(args, "forwarded", False):
+        args.rest = rest  # unread, in order: the forwarded command's parser reads them
+    elif rest:
+        parser.error(f"unrecognized arguments: {' '.join(rest)}")
+    configure_logging(log_level(args))
     try:
         return int(args.func(args))
     except KeyboardInterrupt:
-        print("hlvs: interrupted", file=sys.stderr)
-        return 130
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        return ExitCode.INTERRUPTED
     except OrchestratorError as exc:
-        print(f"hlvs: {exc}", file=sys.stderr)
-        return exc.exit_code
+        print(f"{PROG}: {exc}", file=sys.stderr)
+        return int(exc.exit_code)
+    except BrokenPipeError:  # `hlvs ... | head`
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return ExitCode.OK
 
 
 if __name__ == "__main__":

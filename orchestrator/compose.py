@@ -1,7 +1,8 @@
 """A docker-compose file that plays the same match as ``hlvs match``, for a team's laptop.
 
-``compose_files(loaded, ...)`` returns the compose document (file format 2.4, which Debian's
-docker-compose 1.29 reads) and the ``match_spec.json`` content written next to it. The layout
+``compose_files(loaded, ...)`` returns the compose document (the Compose specification, without
+the obsolete ``version`` key; read by ``docker compose`` v2 and by ``docker-compose`` 1.27 and
+later) and the ``match_spec.json`` content written next to it. The layout
 follows the official match: one internal network per team and an internal control network, the
 simulator at ``.2`` of each, robot n at ``.10+n`` of its team's network, the ROBOCUP_* environment,
 CPU / memory / PID limits, no capabilities, no privilege gain, ``/robocup-logs`` bind-mounted from
@@ -114,7 +115,7 @@ def compose_files(
         }
         for role in ("red", "blue", "control")
     }
-    return {"version": "2.4", "services": services, "networks": networks}, spec
+    return {"services": services, "networks": networks}, spec
 
 
 def _simulator(loaded: LoadedGame, image: str, subnets: Subnets) -> dict[str, Any]:

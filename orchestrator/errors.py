@@ -15,18 +15,21 @@ Tree::
     ├── DeliveryError            a log set could not be delivered (auth, host key, bucket, ...)
     └── ScheduleError            the schedule file or its state is unusable
 
-The CLI maps these to exit codes: 2 for ConfigError, 3 for InfrastructureError, 1 otherwise.
+The CLI maps these to exit codes (``orchestrator.exitcodes``): 2 for ConfigError, 3 for
+InfrastructureError, 1 otherwise.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+from orchestrator.exitcodes import ExitCode
+
 
 class OrchestratorError(Exception):
     """Root of every error the orchestrator package raises."""
 
-    exit_code = 1
+    exit_code: int = ExitCode.FAILED
 
 
 @dataclass(frozen=True, slots=True)
@@ -58,7 +61,7 @@ class Problem:
 
 
 class ConfigError(OrchestratorError):
-    exit_code = 2
+    exit_code = ExitCode.INVALID
 
     def __init__(self, problems: list[Problem]) -> None:
         self.problems = list(problems)
@@ -66,7 +69,7 @@ class ConfigError(OrchestratorError):
 
 
 class InfrastructureError(OrchestratorError):
-    exit_code = 3
+    exit_code = ExitCode.INFRASTRUCTURE
 
 
 class EngineUnavailable(InfrastructureError):

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import time
 
@@ -100,11 +101,15 @@ def run(
 
 
 def main(argv: list[str]) -> int:
-    parser = argparse.ArgumentParser(prog="python -m simulator bench sim")
-    parser.add_argument("--robots", type=int, default=8)
-    parser.add_argument("--sim-seconds", type=float, default=20.0)
-    parser.add_argument("--physics-dt", type=float, default=0.002)
-    parser.add_argument("--field", choices=("kid", "adult"), default="kid")
+    program = os.environ.get("HLVS_PROG", "python -m simulator")
+    parser = argparse.ArgumentParser(prog=f"{program} bench sim")
+    parser.add_argument("--robots", type=int, default=8, help="robots on the field (default 8)")
+    parser.add_argument("--sim-seconds", type=float, default=20.0,
+                        help="simulated seconds to run (default 20)")
+    parser.add_argument("--physics-dt", type=float, default=0.002,
+                        help="physics step in seconds (default 0.002)")
+    parser.add_argument("--field", choices=("kid", "adult"), default="kid",
+                        help="field size (default kid)")
     parser.add_argument("--json", action="store_true", help="print one JSON line")
     args = parser.parse_args(argv)
     if not 0 <= args.robots <= 29 or args.sim_seconds <= 0:

@@ -229,12 +229,16 @@ def render_video(
 
 
 def main(argv: list[str]) -> int:
-    parser = argparse.ArgumentParser(prog="python -m simulator render")
-    parser.add_argument("replay", type=Path)
-    parser.add_argument("-o", "--output", type=Path, default=Path("match.mp4"))
-    parser.add_argument("--width", type=int, default=1280)
-    parser.add_argument("--height", type=int, default=720)
-    parser.add_argument("--fps", type=float, default=25.0)
+    program = os.environ.get("HLVS_PROG", "python -m simulator")
+    parser = argparse.ArgumentParser(
+        prog=f"{program} render", description="Render a match replay to a video, offscreen."
+    )
+    parser.add_argument("replay", type=Path, help="replay file of a match (replay.hlvsrec)")
+    parser.add_argument("-o", "--output", type=Path, default=Path("match.mp4"),
+                        help="video file to write (default: match.mp4)")
+    parser.add_argument("--width", type=int, default=1280, help="pixels (default 1280)")
+    parser.add_argument("--height", type=int, default=720, help="pixels (default 720)")
+    parser.add_argument("--fps", type=float, default=25.0, help="frames per second (default 25)")
     args = parser.parse_args(argv)
     os.environ.setdefault("MUJOCO_GL", "osmesa")
     logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")

@@ -1,30 +1,33 @@
 """`hlvs check FILE...`: validate game.json, team_config.json, credentials.json and schedules.
 
 Each problem is printed as one line ``file: /json/pointer: what is wrong (expected ...; did you
-mean ...?)``; warnings start with ``warning:``. Exit code 0 when every file is valid (warnings
-allowed), 2 when any is not.
+mean ...?)``; warnings start with ``warning:``. ``--json`` prints one JSON object instead and
+``--format github`` prints workflow commands that GitHub shows as pull-request annotations.
+Exit code 0 when every file is valid (warnings allowed), 2 when any is not.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import json
 import logging
 import sys
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, TextIO
+from typing import TYPE_CHECKING, Any, TextIO
 
-from orchestrator.config import check_game, check_team
-from orchestrator.config.detect import KINDS, Kind, kind_by_content, kind_by_name
-from orchestrator.config.jsonfile import parse_json, read_text
-from orchestrator.config.model import FieldClass
 from orchestrator.errors import ConfigError, OrchestratorError, Problem
+from orchestrator.exitcodes import ExitCode
+
+if TYPE_CHECKING:
+    from orchestrator.config.detect import Kind
+    from orchestrator.config.model import FieldClass
 
 log = logging.getLogger(__name__)
 
-EXIT_OK = 0
-EXIT_FAILED = 1
-EXIT_INVALID = 2
+KINDS = ("game", "team", "credentials", "schedule")
+FORMATS = ("text", "json", "github")
 
 # Loaders written in other modules: kind -> (module, function). Skipped when not installed.
 _OPTIONAL_LOADERS = {
@@ -41,6 +44,7 @@ def register(sub: Any) -> None:
             "Validate game.json (with the team files it references), team_config.json, "
             "credentials.json and schedule files. The kind is found from the content."
         ),
+        epilog="exit codes: 0 every file is valid (warnings allowed), 2 a file is invalid",
     )
     parser.add_argument("files", nargs="+", metavar="FILE", help="files to check")
     parser.add_argument("--kind", choices=KINDS, help="check every FILE as this kind")
@@ -55,21 +59,73 @@ def register(sub: Any) -> None:
         action="store_true",
         help="a player without image and dockerTag is an error (as for a match)",
     )
+    parser.add_argument(
+        "--format",
+        choices=FORMATS,
+        default="text",
+        help="text: one line per problem; json: one JSON object; github: workflow commands "
+        "shown as annotations on a pull request (default: text)",
+    )
+    parser.add_argument("--json", action="store_true", help="same as --format json")
     parser.set_defaults(func=run)
 
 
+@dataclass(slots=True)
+class FileReport:
+    """The outcome of checking one file."""
+
+    file: str
+    kind: str | None
+    problems: list[Problem] = field(default_factory=list)
+
+    @property
+    def errors(self) -> list[Problem]:
+        return [p for p in self.problems if p.severity == "error"]
+
+    @property
+    def valid(self) -> bool:
+        return not self.errors
+
+    def as_json(self) -> dict[str, Any]:
+        return {
+            "file": self.file,
+            "kind": self.kind,
+            "valid": self.valid,
+            "problems": [
+                {
+                    "file": p.file,
+                    "pointer": p.pointer or "/",
+                    "message": p.message,
+                    "expected": p.expected,
+                    "suggestion": p.suggestion,
+                    "severity": p.severity,
+                }
+                for p in self.problems
+            ],
+        }
+
+
 def run(args: argparse.Namespace) -> int:
-    code = EXIT_OK
-    for name in args.files:
-        result = check_file(
+    reports = [
+        check_report(
             Path(name),
             kind=args.kind,
             field_class=args.field_class,
             images_required=args.require_images,
-            out=sys.stdout,
         )
-        code = max(code, result)
-    return code
+        for name in args.files
+    ]
+    fmt = "json" if args.json else args.format
+    if fmt == "json":
+        valid = all(r.valid for r in reports)
+        print(json.dumps({"valid": valid, "files": [r.as_json() for r in reports]}, indent=2))
+    elif fmt == "github":
+        for report in reports:
+            print_github(report, out=sys.stdout)
+    else:
+        for report in reports:
+            print_text(report, out=sys.stdout)
+    return ExitCode.OK if all(r.valid for r in reports) else ExitCode.INVALID
 
 
 def check_file(
@@ -81,6 +137,21 @@ def check_file(
     out: TextIO,
 ) -> int:
     """Check one file, print its problems to ``out``, and return its exit code."""
+    report = check_report(
+        path, kind=kind, field_class=field_class, images_required=images_required
+    )
+    print_text(report, out=out)
+    return ExitCode.OK if report.valid else ExitCode.INVALID
+
+
+def check_report(
+    path: Path,
+    *,
+    kind: Kind | None = None,
+    field_class: FieldClass | None = None,
+    images_required: bool = False,
+) -> FileReport:
+    """Check one file and return every problem found (nothing printed)."""
     try:
         found_kind, problems = _check(
             path, kind=kind, field_class=field_class, images_required=images_required
@@ -88,22 +159,49 @@ def check_file(
     except ConfigError as exc:
         found_kind, problems = kind, exc.problems
     except OrchestratorError as exc:
-        print(f"{path}: /: {exc}", file=out)
-        return EXIT_INVALID
-    errors = [p for p in problems if p.severity == "error"]
-    for problem in errors + [p for p in problems if p.severity != "error"]:
+        found_kind, problems = kind, [Problem(str(path), "", str(exc))]
+    return FileReport(file=str(path), kind=found_kind, problems=list(problems))
+
+
+def print_text(report: FileReport, *, out: TextIO) -> None:
+    for problem in report.errors + [p for p in report.problems if p.severity != "error"]:
         print(str(problem), file=out)
-    if errors:
-        return EXIT_INVALID
-    warnings = len(problems) - len(errors)
-    note = f", {warnings} warning{'s' if warnings != 1 else ''}" if warnings else ""
-    print(f"{path}: ok ({found_kind}{note})", file=out)
-    return EXIT_OK
+    if report.valid:
+        warnings = len(report.problems)
+        note = f", {warnings} warning{'s' if warnings != 1 else ''}" if warnings else ""
+        print(f"{report.file}: ok ({report.kind}{note})", file=out)
+
+
+def print_github(report: FileReport, *, out: TextIO) -> None:
+    """GitHub Actions workflow commands (``::error file=...,title=...::message``)."""
+    for problem in report.problems:
+        level = "error" if problem.severity == "error" else "warning"
+        title = f"{problem.pointer or '/'}"
+        text = str(problem).removeprefix("warning: ")
+        print(
+            f"::{level} file={_gh_property(problem.file)},title={_gh_property(title)}"
+            f"::{_gh_data(text)}",
+            file=out,
+        )
+    if report.valid:
+        print(f"{report.file}: ok ({report.kind})", file=out)
+
+
+def _gh_data(text: str) -> str:
+    return text.replace("%", "%25").replace("\r", "%0D").replace("\n", "%0A")
+
+
+def _gh_property(text: str) -> str:
+    return _gh_data(text).replace(":", "%3A").replace(",", "%2C")
 
 
 def _check(
     path: Path, *, kind: Kind | None, field_class: FieldClass | None, images_required: bool
 ) -> tuple[Kind | None, list[Problem]]:
+    from orchestrator.config import check_game, check_team
+    from orchestrator.config.detect import kind_by_content, kind_by_name
+    from orchestrator.config.jsonfile import parse_json, read_text
+
     text = read_text(path)  # missing, directory, empty, binary: one clean problem each
     kind = kind or kind_by_name(path)
     document: Any = None
@@ -144,6 +242,8 @@ def _referenced_credentials(path: Path, document: Any) -> list[Path]:
 
 
 def _check_optional(kind: Kind, path: Path) -> list[Problem]:
+    from orchestrator.config.jsonfile import parse_json, read_text
+
     module_name, function = _OPTIONAL_LOADERS[kind]
     try:
         module = importlib.import_module(module_name)

@@ -1,13 +1,15 @@
 """``hlvs compose GAME.json -o docker-compose.yml``: the match as a docker-compose project.
 
 Writes the compose file, ``match_spec.json`` next to it, and the ``out/`` and ``logs/`` folders;
-``docker-compose up --abort-on-container-exit --exit-code-from simulator`` then plays the match.
+``docker compose up --abort-on-container-exit --exit-code-from simulator`` (or the same with
+``docker-compose`` 1.27 or later) then plays the match.
 """
 
 from __future__ import annotations
 
 import argparse
 import ipaddress
+import json
 from pathlib import Path
 from typing import Any
 
@@ -20,7 +22,8 @@ def register(sub: Any) -> None:
     )
     parser.add_argument("game", type=Path, help="game.json (its team files are read too)")
     parser.add_argument(
-        "-o", "--output", type=Path, default=Path("docker-compose.yml"), help="compose file"
+        "-o", "--output", type=Path, default=Path("docker-compose.yml"),
+        help="compose file to write (default: docker-compose.yml)",
     )
     parser.add_argument(
         "--simulator-image",
@@ -32,6 +35,10 @@ def register(sub: Any) -> None:
         metavar="A.B.C.0",
         help="first of three consecutive /24 subnets for red, blue and control "
         "(default: in 10.214.0.0/16, derived from the match id)",
+    )
+    parser.add_argument(
+        "--json", action="store_true",
+        help="print one JSON object (files written, warnings, command to play it)",
     )
     parser.set_defaults(func=_compose)
 
@@ -49,8 +56,9 @@ def _compose(args: argparse.Namespace) -> int:
                 [Problem("(command line)", "--subnet-start", str(exc), "an address like 10.9.0.0")]
             ) from exc
     loaded = load_game(args.game, images_required=True)
-    for warning in loaded.warnings:
-        print(warning)
+    if not args.json:
+        for warning in loaded.warnings:
+            print(warning)
     if args.simulator_image:
         image = args.simulator_image
     else:
@@ -58,9 +66,24 @@ def _compose(args: argparse.Namespace) -> int:
 
         image = project_image("simulator")
     spec = write_compose(loaded, args.output, simulator_image=image, subnets=subnets)
+    up = f"-f {args.output.name} up --abort-on-container-exit --exit-code-from simulator"
+    command = f"docker compose {up}"
+    if args.json:
+        print(
+            json.dumps(
+                {
+                    "compose_file": str(args.output),
+                    "match_spec": str(spec),
+                    "warnings": [str(w) for w in loaded.warnings],
+                    "directory": str(args.output.parent),
+                    "command": command,
+                    "command_v1": f"docker-compose {up}",
+                },
+                indent=2,
+            )
+        )
+        return 0
     print(f"wrote {args.output} and {spec}")
-    print(
-        f"play it: cd {args.output.parent} && docker-compose -f {args.output.name} up "
-        "--abort-on-container-exit --exit-code-from simulator"
-    )
+    print(f"play it: cd {args.output.parent} && {command}")
+    print(f"  or, with docker-compose 1.27 or later: docker-compose {up}")
     return 0

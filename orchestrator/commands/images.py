@@ -17,7 +17,7 @@ from typing import Any
 
 def register(sub: Any) -> None:
     parser: argparse.ArgumentParser = sub.add_parser(
-        "images", help="build the simulator, stub and team-base images (content-tagged)"
+        "images", help="build the project images; pull and check a team's images"
     )
     actions = parser.add_subparsers(dest="images_action", metavar="ACTION")
     actions.required = True
@@ -34,7 +34,10 @@ def register(sub: Any) -> None:
         "pull", help="pull and pin a team's images as a match would (reports each player)"
     )
     pull.add_argument("team_config", type=Path, help="team_config.json")
-    pull.add_argument("--image-limit-gb", type=float, default=10.0, metavar="GB")
+    pull.add_argument(
+        "--image-limit-gb", type=float, default=10.0, metavar="GB",
+        help="largest image a player may use (default 10, the league's limit)",
+    )
     pull.add_argument("--json", action="store_true", help="print one JSON object")
     pull.set_defaults(func=_pull)
 

@@ -16,17 +16,13 @@ import logging
 import os
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from orchestrator.delivery import (
-    ERROR_KINDS,
-    DeliveryOutcome,
-    PendingSet,
-    deliver_pending,
-    enqueue_match_logs,
-    pending_status,
-)
 from orchestrator.errors import ConfigError, Problem
+from orchestrator.exitcodes import ExitCode
+
+if TYPE_CHECKING:
+    from orchestrator.delivery import DeliveryOutcome, PendingSet
 
 STORE_ENV = "HLVS_LOG_STORE"
 
@@ -54,7 +50,9 @@ def register(sub: Any) -> None:
     status.set_defaults(func=_status)
 
     enqueue = actions.add_parser("enqueue", help="queue the logs of a finished match")
-    enqueue.add_argument("match_dir", type=Path, metavar="MATCH_DIR")
+    enqueue.add_argument(
+        "match_dir", type=Path, metavar="MATCH_DIR", help="output folder of a finished match"
+    )
     enqueue.add_argument(
         "--game",
         type=Path,
@@ -62,7 +60,8 @@ def register(sub: Any) -> None:
         metavar="GAME.json",
         help="the match's game.json (team names and credentials)",
     )
-    enqueue.add_argument("--match-id", help="default: the match id of game.json")
+    enqueue.add_argument("--match-id", help="match id (default: the match id of game.json)")
+    enqueue.add_argument("--json", action="store_true", help="a JSON array of the queued sets")
     enqueue.add_argument(
         "--copy",
         action="store_true",
@@ -88,13 +87,15 @@ def _quiet_libraries() -> None:
 
 
 def _deliver(args: argparse.Namespace) -> int:
+    from orchestrator.delivery import deliver_pending
+
     _quiet_libraries()
     outcomes = deliver_pending(args.store or default_store(), team=args.team)
     for outcome in outcomes:
         print(json.dumps(outcome.to_json()) if args.json else _describe_outcome(outcome))
     if not outcomes and not args.json:
         print("nothing to deliver")
-    return 0 if all(o.delivered for o in outcomes) else 1
+    return ExitCode.OK if all(o.delivered for o in outcomes) else ExitCode.FAILED
 
 
 def _describe_outcome(outcome: DeliveryOutcome) -> str:
@@ -106,20 +107,24 @@ def _describe_outcome(outcome: DeliveryOutcome) -> str:
             f"in {outcome.seconds:.1f} s"
         )
     assert outcome.error is not None
+    from orchestrator.delivery import ERROR_KINDS
+
     hint = ERROR_KINDS.get(outcome.error.kind, "")
     return f"FAILED {head} ({outcome.error.kind}: {hint}): {outcome.error.reason}"
 
 
 def _status(args: argparse.Namespace) -> int:
+    from orchestrator.delivery import pending_status
+
     sets = pending_status(args.store or default_store())
     if args.json:
         print(json.dumps([s.to_json() for s in sets], indent=2))
-        return 0
+        return ExitCode.OK
     if not sets:
         print("no log sets are waiting")
     for pending in sets:
         print(_describe_set(pending))
-    return 0
+    return ExitCode.OK
 
 
 def _describe_set(pending: PendingSet) -> str:
@@ -153,6 +158,8 @@ def _enqueue(args: argparse.Namespace) -> int:
     teams = {
         color: (loaded.team(color).name, game.team(color).credentials) for color in ("red", "blue")
     }
+    from orchestrator.delivery import enqueue_match_logs
+
     sets = enqueue_match_logs(
         args.match_dir,
         match_id=args.match_id or game.match_id,
@@ -161,9 +168,12 @@ def _enqueue(args: argparse.Namespace) -> int:
         store=args.store or default_store(),
         move_team_logs=not args.copy,
     )
+    if args.json:
+        print(json.dumps([s.to_json() for s in sets], indent=2))
+        return ExitCode.OK
     for pending in sets:
         print(
             f"queued {pending.match_id} {pending.team}: {len(pending.files)} files, "
             f"{pending.total_bytes / 1e6:.1f} MB"
         )
-    return 0
+    return ExitCode.OK

@@ -31,8 +31,14 @@ def register(sub: Any) -> None:
     enforce.add_argument(
         "--password", help="registry password (default: $HLVS_REGISTRY_PASSWORD)"
     )
-    enforce.add_argument("--image-limit-gb", type=float, default=10.0, metavar="GB")
-    enforce.add_argument("--team-limit-gb", type=float, default=40.0, metavar="GB")
+    enforce.add_argument(
+        "--image-limit-gb", type=float, default=10.0, metavar="GB",
+        help="largest image (default 10, the league's limit)",
+    )
+    enforce.add_argument(
+        "--team-limit-gb", type=float, default=40.0, metavar="GB",
+        help="a team's images together (default 40, the league's limit)",
+    )
     enforce.add_argument(
         "--team-of",
         action="append",

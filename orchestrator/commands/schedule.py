@@ -4,10 +4,13 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
 from datetime import UTC, datetime
 from typing import Any
 
-from orchestrator.errors import ScheduleError
+from orchestrator.errors import ConfigError, Problem, ScheduleError
+
+_STATE_HELP = "SQLite state file written by 'hlvs schedule run'"
 
 
 def register(sub: Any) -> None:
@@ -22,27 +25,27 @@ def register(sub: Any) -> None:
     run.add_argument("--state", required=True, help="SQLite state file (jobs and ledger)")
     run.add_argument("--exit-when-done", action="store_true", help="stop when every match is final")
     run.add_argument("--services", help="module:factory of the pull/play/deliver services (tests)")
-    run.set_defaults(func=_run)
+    run.set_defaults(func=_run, log_level=logging.INFO)
 
     plan = verbs.add_parser("list", help="what is planned, with absolute times")
-    plan.add_argument("schedule")
+    plan.add_argument("schedule", help="schedule file (YAML)")
     plan.add_argument("--state", help="use the reference time recorded in this state file")
-    plan.add_argument("--json", action="store_true")
+    plan.add_argument("--json", action="store_true", help="print a JSON array")
     plan.set_defaults(func=_list)
 
     status = verbs.add_parser("status", help="state of every match")
-    status.add_argument("--state", required=True)
-    status.add_argument("--json", action="store_true")
+    status.add_argument("--state", required=True, help=_STATE_HELP)
+    status.add_argument("--json", action="store_true", help="print a JSON array")
     status.set_defaults(func=_status)
 
     cancel = verbs.add_parser("cancel", help="cancel a match that is not played yet")
-    cancel.add_argument("match_id")
-    cancel.add_argument("--state", required=True)
+    cancel.add_argument("match_id", help="id of the match in the schedule")
+    cancel.add_argument("--state", required=True, help=_STATE_HELP)
     cancel.set_defaults(func=_cancel)
 
     table = verbs.add_parser("standings", help="points, goal difference and goals")
-    table.add_argument("--state", required=True)
-    table.add_argument("--json", action="store_true")
+    table.add_argument("--state", required=True, help=_STATE_HELP)
+    table.add_argument("--json", action="store_true", help="print a JSON array")
     table.set_defaults(func=_standings)
 
 
@@ -52,7 +55,9 @@ def _ledger(path: str) -> Any:
     from orchestrator.schedule.state import Ledger
 
     if not Path(path).is_file():
-        raise ScheduleError(f"{path}: no such state file (start it with 'hlvs schedule run')")
+        raise ConfigError(
+            [Problem(path, "", "no such state file", "the --state file of 'hlvs schedule run'")]
+        )
     return Ledger(Path(path))
 
 

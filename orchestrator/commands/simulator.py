@@ -1,9 +1,10 @@
-"""``hlvs render`` and ``hlvs bench sim|api|stub|envs``: run the simulator's (or the learning
-environments') own commands.
+"""``hlvs render`` and ``hlvs bench sim|api|stub|envs|bringup|delivery|cli``: commands with
+parsers of their own, to which the arguments are forwarded unread (``--help`` included).
 
-The orchestrator does not import the simulator; these commands run ``python -m simulator`` in a
-child process with the same interpreter, so ``hlvs`` stays the one entry point for users.
-``hlvs bench bringup`` and ``hlvs bench delivery`` are the orchestrator's own benchmarks.
+The orchestrator does not import the simulator; ``render`` and the simulator's (or the learning
+environments') benchmarks run ``python -m simulator`` (``python -m envs``) with the same
+interpreter (``HLVS_PROG`` tells it to name itself ``hlvs``), so ``hlvs`` stays the one entry
+point for users. ``hlvs bench bringup``, ``delivery`` and ``cli`` are the orchestrator's own.
 """
 
 from __future__ import annotations
@@ -13,42 +14,61 @@ import os
 import sys
 from typing import Any
 
-SIMULATOR_BENCHES = ("sim", "api", "stub")
+from orchestrator.cli import forward
+
+SIMULATOR_BENCHES = {
+    "sim": "physics steps of the soccer world per second (JSON)",
+    "api": "the robot API server: step rate and latency with clients connected (JSON)",
+    "stub": "the stub robot: reach and shots on goal (JSON)",
+}
 
 
 def _exec_simulator(argv: list[str], module: str = "simulator") -> int:
+    os.environ["HLVS_PROG"] = "hlvs"
     os.execv(sys.executable, [sys.executable, "-m", module, *argv])
     return 0  # not reached
 
 
 def register(sub: Any) -> None:
-    render = sub.add_parser("render", help="render a replay file to a video (offscreen)")
-    render.add_argument("replay")
-    render.add_argument("-o", "--output", required=True)
-    render.add_argument("rest", nargs=argparse.REMAINDER)
-    render.set_defaults(
-        func=lambda a: _exec_simulator(["render", a.replay, "-o", a.output, *a.rest])
+    forward(
+        sub,
+        "render",
+        help="render a replay file to a video (offscreen)",
+        func=lambda a: _exec_simulator(["render", *a.rest]),
     )
-
-    bench = sub.add_parser(
-        "bench",
-        help="benchmarks that print JSON: sim, api, stub, envs, bringup, delivery",
-        add_help=False,
+    bench: argparse.ArgumentParser = sub.add_parser(
+        "bench", help="benchmarks that print JSON", description="Benchmarks that print JSON."
     )
-    bench.add_argument("kind", choices=(*SIMULATOR_BENCHES, "envs", "bringup", "delivery"))
-    bench.add_argument("rest", nargs=argparse.REMAINDER)
-    bench.set_defaults(func=_bench)
+    kinds = bench.add_subparsers(dest="bench_kind", metavar="KIND", title="benchmarks")
+    kinds.required = True
+    for kind, text in SIMULATOR_BENCHES.items():
+        forward(
+            kinds, kind, help=text,
+            func=lambda a, kind=kind: _exec_simulator(["bench", kind, *a.rest]),
+        )
+    forward(
+        kinds, "envs", help="the learning environments: steps per second (JSON)",
+        func=lambda a: _exec_simulator(["bench", *a.rest], module="envs"),
+    )
+    forward(kinds, "bringup", help="time from hlvs match to the kick-off (JSON)", func=_bringup)
+    forward(kinds, "delivery", help="log delivery throughput to SFTP and S3 (JSON)",
+            func=_delivery)
+    forward(kinds, "cli", help="start-up time of hlvs --help (JSON)", func=_cli)
 
 
-def _bench(args: argparse.Namespace) -> int:
-    if args.kind in SIMULATOR_BENCHES:
-        return _exec_simulator(["bench", args.kind, *args.rest])
-    if args.kind == "envs":  # the learning environments' package
-        return _exec_simulator(["bench", *args.rest], module="envs")
-    if args.kind == "delivery":
-        from orchestrator.delivery.bench import main as delivery_main
-
-        return int(delivery_main(list(args.rest)))
+def _bringup(args: argparse.Namespace) -> int:
     from orchestrator.bringup import main as bringup_main
 
     return int(bringup_main(list(args.rest)))
+
+
+def _cli(args: argparse.Namespace) -> int:
+    from orchestrator.clibench import main as cli_main
+
+    return int(cli_main(list(args.rest)))
+
+
+def _delivery(args: argparse.Namespace) -> int:
+    from orchestrator.delivery.bench import main as delivery_main
+
+    return int(delivery_main(list(args.rest)))

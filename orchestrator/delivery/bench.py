@@ -30,11 +30,15 @@ SERVERS = {"sftp": ("sshd", "asyncssh"), "s3": ("seaweedfs", "moto")}
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m orchestrator.delivery.bench")
-    parser.add_argument("--target", choices=sorted(SERVERS), required=True)
-    parser.add_argument("--server", choices=[s for pair in SERVERS.values() for s in pair])
-    parser.add_argument("--files", type=int, default=200)
-    parser.add_argument("--mb", type=float, default=50.0)
+    parser = argparse.ArgumentParser(prog="hlvs bench delivery")
+    parser.add_argument("--target", choices=sorted(SERVERS), required=True,
+                        help="delivery target kind")
+    parser.add_argument("--server", choices=[s for pair in SERVERS.values() for s in pair],
+                        help="server on loopback (default: sshd as root, else asyncssh; "
+                        "seaweedfs when installed, else moto)")
+    parser.add_argument("--files", type=int, default=200, help="files in the log set (default 200)")
+    parser.add_argument("--mb", type=float, default=50.0,
+                        help="total megabytes in the log set (default 50)")
     parser.add_argument("--json", action="store_true", help="print one JSON line only")
     args = parser.parse_args(argv)
     if not args.json:

@@ -13,6 +13,8 @@ import uuid
 from pathlib import Path
 from typing import Any
 
+from orchestrator.commands.scrimmage_args import add_arguments
+
 POSES_KID = {  # as if playing on the left (x < 0)
     1: (-4.0, -3.1, 1.57),
     2: (-1.0, -3.1, 1.57),
@@ -23,29 +25,6 @@ POSES_KID = {  # as if playing on the left (x < 0)
 # Players 3 and 4 defend from spots in the own half: three strikers chasing one ball mostly
 # knock each other over.
 DEFENDER_HOMES = {3: (-2.3, 1.0), 4: (-2.3, -1.0)}
-
-
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--out", type=Path, default=Path("matches/scrimmage"),
-                        help="output folder (default: matches/scrimmage)")
-    parser.add_argument("--red-image", default=None,
-                        help="image of the red robots (default: the project's stub image)")
-    parser.add_argument("--blue-image", default=None,
-                        help="image of the blue robots (default: the project's stub image)")
-    parser.add_argument("--players", type=int, default=1, choices=(1, 2, 3, 4),
-                        help="robots per team (default 1)")
-    parser.add_argument("--half-duration", type=float, default=30.0,
-                        help="simulated seconds per half (default 30)")
-    parser.add_argument("--wait-before-ready", type=float, default=3.0,
-                        help="wall seconds between robot start and the first READY (default 3)")
-    parser.add_argument("--grace", type=float, default=5.0,
-                        help="seconds robots get to stop after the game (default 5)")
-    parser.add_argument("--robot-command", default=None,
-                        help="dockerCmd of every robot (default: goalie / striker for the stub)")
-    parser.add_argument("--match-id", default=None, help="default: scrimmage-<random>")
-    parser.add_argument("--seed", type=int, default=42)
-    parser.add_argument("--stub", action="store_true",
-                        help="accepted for compatibility: stub robots are the default")
 
 
 def _pose(x: float, y: float, yaw: float) -> dict[str, Any]:

@@ -40,19 +40,24 @@ CYCLE_STEPS = 125  # pre-encoded requests of the bench clients: one second of ta
 
 
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="python -m simulator bench api")
-    parser.add_argument("--robots", type=int, default=8)
-    parser.add_argument("--mode", choices=("lockstep", "async"), default="lockstep")
+    program = os.environ.get("HLVS_PROG", "python -m simulator")
+    parser = argparse.ArgumentParser(prog=f"{program} bench api")
+    parser.add_argument("--robots", type=int, default=8, help="connected clients (default 8)")
+    parser.add_argument("--mode", choices=("lockstep", "async"), default="lockstep",
+                        help="stepping mode (default lockstep)")
     parser.add_argument("--camera", default="", help="WxH@PERIOD, e.g. 320x240@32")
-    parser.add_argument("--sim-seconds", type=float, default=10.0)
-    parser.add_argument("--physics-dt", type=float, default=0.002)
+    parser.add_argument("--sim-seconds", type=float, default=10.0,
+                        help="simulated seconds to run (default 10)")
+    parser.add_argument("--physics-dt", type=float, default=0.002,
+                        help="physics step in seconds (default 0.002)")
     parser.add_argument(
         "--camera-robots", type=int, default=0, help="robots that enable the camera (0 = all)"
     )
     parser.add_argument(
         "--render-processes", type=int, default=0, help="camera render processes (0: a thread)"
     )
-    parser.add_argument("--stalled-client", action="store_true")
+    parser.add_argument("--stalled-client", action="store_true",
+                        help="one more client that connects and never reads")
     parser.add_argument(
         "--shared-cpus",
         action="store_true",

@@ -82,7 +82,7 @@ def test_compose_document_follows_the_match_layout() -> None:
     subnets = Subnets.starting_at(ipaddress.IPv4Network("10.99.0.0/24"))
     document, spec = compose_files(loaded, simulator_image="sim:x", subnets=subnets, cpu_count=1)
 
-    assert document["version"] == "2.4"
+    assert "version" not in document  # obsolete in the Compose specification
     assert set(document["services"]) == {"simulator", "red-1", "blue-1"}
     assert all(net["internal"] for net in document["networks"].values())
     simulator = document["services"]["simulator"]

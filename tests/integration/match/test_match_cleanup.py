@@ -3,6 +3,7 @@ containers, networks, host firewall rules and log mounts (found by labels and na
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
@@ -58,7 +59,8 @@ def _leftovers(runtime: Any, match_id: str) -> tuple[int, bool, bool]:
     )
 
 
-def test_cleanup_after_kill_9(runtime: Any, test_image: str, tmp_path: Path) -> None:
+def test_cleanup_after_kill_9(runtime: Any, test_image: str, tmp_path: Path,
+                              capsys: pytest.CaptureFixture[str]) -> None:
     match_id = f"k{uuid.uuid4().hex[:8]}"
     process = subprocess.Popen(
         [sys.executable, "-c", SCRIPT, match_id, test_image, str(tmp_path / "out")],
@@ -82,6 +84,14 @@ def test_cleanup_after_kill_9(runtime: Any, test_image: str, tmp_path: Path) -> 
         process.wait(timeout=10)
         containers, rule, mount = _leftovers(runtime, match_id)
         assert containers == 8 and rule and mount  # simulator, 2 holders, 2 robots, 3 networks
+        capsys.readouterr()
+        assert hlvs(["cleanup", "--dry-run", "--match", match_id]) == 0
+        listed = json.loads(capsys.readouterr().out)
+        assert listed["dry_run"] is True
+        assert len(listed["containers"]) + len(listed["networks"]) == 8
+        assert len(listed["networks"]) == 3 and listed["log_mounts"]
+        assert all(match_id in name for name in listed["containers"] + listed["networks"])
+        assert _leftovers(runtime, match_id) == (containers, rule, mount)  # nothing removed
         assert hlvs(["cleanup", "--match", match_id]) == 0
         assert _leftovers(runtime, match_id) == (0, False, False)
     finally:

@@ -1,0 +1,218 @@
+"""``hlvs match``, ``hlvs scrimmage`` and ``hlvs cleanup`` at work: wire the real engine, host
+controls, image resolution and telemetry to :class:`orchestrator.match.MatchRunner`.
+
+Exit codes: 0 the match played to its end, 1 it failed (see report.json), 2 invalid input,
+3 infrastructure, 4 decided by forfeit, 130 interrupted (SIGINT / SIGTERM: everything is stopped
+and collected first).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import os
+import signal
+import sys
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from types import FrameType
+from typing import Any
+
+from orchestrator.config.loader import load_game
+from orchestrator.errors import InfrastructureError, OrchestratorError
+from orchestrator.exitcodes import ExitCode
+from orchestrator.match import (
+    FailureClass,
+    HostControl,
+    MatchOutcome,
+    MatchPlan,
+    MatchRunner,
+    RunOptions,
+    cleanup,
+    local_images,
+    plan_from_game,
+    scrimmage,
+)
+from orchestrator.match.runner import ImageResolver
+
+log = logging.getLogger(__name__)
+
+
+@contextmanager
+def stop_on_signals() -> Iterator[threading.Event]:
+    """SIGINT / SIGTERM set the event (the runner then stops and collects everything)."""
+    event = threading.Event()
+    owner = os.getpid()
+
+    def handler(signum: int, frame: FrameType | None) -> None:
+        if os.getpid() != owner:  # a forked helper (pyroute2's netns worker) inherits this
+            os._exit(0)
+        log.warning("received %s: stopping the match", signal.Signals(signum).name)
+        event.set()
+
+    previous = {s: signal.signal(s, handler) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield event
+    finally:
+        for sig, old in previous.items():
+            signal.signal(sig, old)
+
+
+def _pull_resolver(client: Any, loaded: Any) -> ImageResolver:
+    from orchestrator.pull import resolve_team_images
+
+    def resolve(plan: MatchPlan) -> dict[str, tuple[str | None, str | None]]:
+        found: dict[str, tuple[str | None, str | None]] = {}
+        for color in ("red", "blue"):
+            resolved = resolve_team_images(client, loaded.team(color), limits=loaded.game.limits)
+            for number, image in resolved.items():
+                key = f"{color}-{number}"
+                found[key] = (image.digest or None, str(image.error) if image.error else None)
+        for robot in plan.robots:
+            found.setdefault(robot.key, (None, "no image named for this player"))
+        return found
+
+    return resolve
+
+
+def play(
+    plan: MatchPlan, *, out_dir: Path, pull: bool, loaded: Any = None,
+    extra_labels: dict[str, str] | None = None,
+) -> MatchOutcome:
+    """Play ``plan`` on the local engine with the real host controls, showing progress."""
+    from orchestrator.engine import connect
+    from orchestrator.engine.containers import DockerRuntime
+    from orchestrator.images import project_image
+    from orchestrator.telemetry import LiveView, ZenohTelemetry
+
+    client = connect()
+    runtime = DockerRuntime(client)
+    host = HostControl.for_current_user()
+    leftovers = cleanup(runtime, host, match_id=plan.match_id)
+    if leftovers.containers or leftovers.networks:
+        log.info("removed %d containers and %d networks left by an earlier run of %s",
+                 len(leftovers.containers), len(leftovers.networks), plan.match_id)
+    simulator_image = project_image("simulator")
+    images = _pull_resolver(client, loaded) if pull and loaded is not None else None
+    view = LiveView(match_id=plan.match_id)
+    with stop_on_signals() as stop_event:
+        options = RunOptions(
+            out_dir=out_dir, simulator_image=simulator_image, extra_labels=extra_labels or {},
+            progress=lambda phase, state: view.update(phase=phase, state=state),
+        )
+        runner = MatchRunner(
+            plan, runtime=runtime, host=host, options=options,
+            images=images or local_images(runtime),
+            telemetry=lambda endpoint, match_id: ZenohTelemetry(
+                endpoint=endpoint, match_id=match_id),
+            stop_event=stop_event,
+        )
+        try:
+            outcome = runner.run()
+        finally:
+            view.close()
+    return outcome
+
+
+def summarize(outcome: MatchOutcome, *, as_json: bool = False) -> int:
+    """Print the outcome (one line, or results.json with ``as_json``) and return its exit code:
+    0 played, 4 decided by forfeit, 1 failed, 3 infrastructure, 130 interrupted."""
+    results = outcome.results
+    score = results.get("score") or {}
+    failure = outcome.failure
+    forfeit = results.get("forfeit")
+    if failure is None:
+        code = ExitCode.FORFEIT if forfeit else ExitCode.OK
+    elif failure.failure_class is FailureClass.INTERRUPTED:
+        code = ExitCode.INTERRUPTED
+    elif failure.failure_class is FailureClass.INFRASTRUCTURE:
+        code = ExitCode(InfrastructureError.exit_code)
+    else:
+        code = ExitCode.FAILED
+    if as_json:
+        document = dict(results)
+        document.setdefault("match_id", outcome.match_id)
+        document["out_dir"] = str(outcome.out_dir)
+        document["exit_code"] = int(code)
+        if failure is not None:
+            document.setdefault(
+                "failure", {"class": failure.failure_class.value, "cause": failure.cause}
+            )
+        print(json.dumps(document, indent=2, sort_keys=True, default=str))
+        return code
+    if failure is None:
+        if forfeit:
+            what = f"{forfeit['team']} forfeits, winner {forfeit['winner']}"
+        else:
+            what = (f"red {score.get('red')} - {score.get('blue')} blue, "
+                    f"winner {results.get('winner')}")
+        print(f"match {outcome.match_id}: {what}; results in {outcome.out_dir}")
+        return code
+    print(f"match {outcome.match_id} failed ({failure.failure_class.value}): {failure.cause}; "
+          f"results in {outcome.out_dir}", file=sys.stderr)
+    return code
+
+
+def run_match_command(args: argparse.Namespace) -> int:
+    loaded = load_game(args.game, images_required=True)
+    for warning in loaded.warnings:
+        print(f"hlvs: {warning}", file=sys.stderr)
+    plan = plan_from_game(loaded, grace_period_s=args.grace)
+    out = args.out or Path("matches") / plan.match_id
+    outcome = play(plan, out_dir=out, pull=True, loaded=loaded)
+    return summarize(outcome, as_json=getattr(args, "json", False))
+
+
+def run_scrimmage_command(args: argparse.Namespace) -> int:
+    out: Path = args.out
+    game_path = scrimmage.write_files(args, out / "config")
+    loaded = load_game(game_path, images_required=True)
+    plan = plan_from_game(loaded, grace_period_s=args.grace)
+    outcome = play(plan, out_dir=out, pull=False, loaded=loaded)
+    return summarize(outcome, as_json=getattr(args, "json", False))
+
+
+def run_cleanup_command(args: argparse.Namespace) -> int:
+    from orchestrator.engine import connect
+    from orchestrator.engine.containers import DockerRuntime
+
+    runtime = DockerRuntime(connect())
+    if getattr(args, "dry_run", False):
+        found = runtime.list_project(match_id=args.match)
+        print(json.dumps({
+            "dry_run": True,
+            "containers": sorted(o.name for o in found if o.kind == "container"),
+            "networks": sorted(o.name for o in found if o.kind == "network"),
+            "log_mounts": leftover_log_mounts(args.match),
+        }))
+        return ExitCode.OK
+    host = HostControl.for_current_user()
+    report = cleanup(runtime, host, match_id=args.match)
+    print(json.dumps({
+        "containers": list(report.containers), "networks": list(report.networks),
+        "host_objects": report.host_objects, "errors": list(report.errors),
+    }))
+    if report.errors:
+        raise OrchestratorError("cleanup incomplete: " + "; ".join(report.errors))
+    return ExitCode.OK
+
+
+def leftover_log_mounts(match_id: str | None) -> list[str]:
+    """The capped log folders still mounted (of one match, or all) that cleanup would unmount."""
+    from orchestrator.match import logfs
+
+    root = logfs.state_dir() / "logfs"
+    if match_id is not None:
+        root = root / logfs.safe_name(match_id)
+    mounts = Path("/proc/mounts").read_text().splitlines() if Path("/proc/mounts").is_file() else []
+    points = [line.split()[1].replace("\\040", " ") for line in mounts if len(line.split()) > 1]
+    return sorted(p for p in points if p.startswith(str(root) + "/"))
+
+
+__all__ = [
+    "leftover_log_mounts", "play", "run_cleanup_command", "run_match_command",
+    "run_scrimmage_command", "stop_on_signals", "summarize",
+]

@@ -1,0 +1,35 @@
+"""The options of ``hlvs scrimmage`` (also used by ``hlvs bench bringup``); standard library only,
+so that ``hlvs --help`` does not import the match machinery."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--out", type=Path, default=Path("matches/scrimmage"),
+                        help="output folder (default: matches/scrimmage)")
+    parser.add_argument("--red-image", default=None,
+                        help="image of the red robots (default: the project's stub image)")
+    parser.add_argument("--blue-image", default=None,
+                        help="image of the blue robots (default: the project's stub image)")
+    parser.add_argument("--players", type=int, default=1, choices=(1, 2, 3, 4),
+                        help="robots per team (default 1)")
+    parser.add_argument("--half-duration", type=float, default=30.0,
+                        help="simulated seconds per half (default 30)")
+    parser.add_argument("--wait-before-ready", type=float, default=3.0,
+                        help="wall seconds between robot start and the first READY (default 3)")
+    parser.add_argument("--grace", type=float, default=5.0,
+                        help="seconds robots get to stop after the game (default 5)")
+    parser.add_argument("--robot-command", default=None,
+                        help="dockerCmd of every robot (default: goalie / striker for the stub)")
+    parser.add_argument("--match-id", default=None,
+                        help="match id (default: scrimmage-<random>)")
+    parser.add_argument("--seed", type=int, default=42,
+                        help="seed of the simulation and the referee (default 42)")
+    parser.add_argument("--stub", action="store_true",
+                        help="accepted for compatibility: stub robots are the default")
+
+
+__all__ = ["add_arguments"]

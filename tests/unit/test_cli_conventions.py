@@ -1,0 +1,167 @@
+"""Every ``hlvs`` command follows the command-line conventions (see ``orchestrator/cli.py``):
+help text on every command and option, the right program name, ``--help`` exits 0, building the
+parser imports nothing heavy, ``--version``, ``-q``/``-v`` and the documented exit codes."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import re
+import subprocess
+import sys
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import pytest
+
+from orchestrator.cli import build_parser, log_level, main, walk
+from orchestrator.exitcodes import ExitCode
+
+# Modules that make `hlvs --help` slow; a command imports them when it runs, never at parse time.
+HEAVY = (
+    "docker", "pyroute2", "jsonschema", "yaml", "mujoco", "numpy", "zenoh", "boto3", "botocore",
+    "paramiko", "sqlalchemy", "fastapi", "uvicorn", "pydantic", "starlette", "rich", "requests",
+    "urllib3", "apscheduler", "httpx", "gymnasium", "google.protobuf", "asyncssh",
+    "orchestrator.config", "orchestrator.engine", "orchestrator.match", "orchestrator.delivery",
+    "orchestrator.schedule", "simulator", "referee",
+)
+
+
+def _command_paths() -> list[tuple[str, ...]]:
+    paths: list[tuple[str, ...]] = []
+    for parser in walk(build_parser()):
+        words = tuple(parser.prog.split()[1:])
+        paths.append(words)
+    return sorted(set(paths))
+
+
+def undocumented(help_text: str) -> list[str]:
+    """Items of an argparse help listing (options, arguments, sub-commands) without help text."""
+    lines = help_text.splitlines()
+    missing = []
+    in_listing = False
+    for i, line in enumerate(lines):
+        if line and not line.startswith(" "):
+            in_listing = line.endswith(":") and not line.startswith("usage:")
+            continue
+        item = re.match(r"^  (\S.*)$", line)
+        if not in_listing or not item:
+            continue
+        if re.search(r"\S {2,}\S", item.group(1)):
+            continue  # help on the same line
+        following = lines[i + 1] if i + 1 < len(lines) else ""
+        if following.startswith("   ") and following.strip():
+            continue  # help on the next line, indented deeper
+        missing.append(item.group(1).strip())
+    return missing
+
+
+def test_the_help_checker_finds_an_option_without_help() -> None:
+    parser = argparse.ArgumentParser(prog="x")
+    parser.add_argument("--with-help", help="documented")
+    parser.add_argument("--without-help")
+    parser.add_argument("positional")
+    parser.add_argument(
+        "--a-very-long-option-name-that-wraps", metavar="LONG_METAVAR", help="on the next line"
+    )
+    assert undocumented(parser.format_help()) == ["positional", "--without-help WITHOUT_HELP"]
+
+
+def test_every_command_has_help_text_in_the_parser_tree() -> None:
+    for parser in walk(build_parser()):
+        for action in parser._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                listed = {a.dest for a in action._choices_actions}
+                assert set(action.choices) <= listed, f"{parser.prog}: sub-command without help"
+            elif action.help is None:
+                pytest.fail(f"{parser.prog}: {action.option_strings or action.dest} has no help")
+
+
+def test_every_command_help_exits_0_with_its_name_and_documents_every_option() -> None:
+    paths = _command_paths()
+    assert ("check",) in paths and ("bench", "sim") in paths and ("images", "pull") in paths
+
+    def run(words: tuple[str, ...]) -> tuple[tuple[str, ...], subprocess.CompletedProcess[str]]:
+        command = [sys.executable, "-m", "orchestrator", *words, "--help"]
+        return words, subprocess.run(command, capture_output=True, text=True, timeout=120)
+
+    with ThreadPoolExecutor(max_workers=4) as pool:
+        results = list(pool.map(run, paths))
+    failures = []
+    for words, done in results:
+        name = " ".join(("hlvs", *words))
+        if done.returncode != 0:
+            failures.append(f"{name} --help exited {done.returncode}: {done.stderr[-300:]}")
+            continue
+        if not re.match(rf"usage: {re.escape(name)}( |$)", done.stdout):
+            failures.append(f"{name} --help: usage line {done.stdout.splitlines()[:1]}")
+        for item in undocumented(done.stdout):
+            failures.append(f"{name}: {item!r} has no help text")
+    assert not failures, "\n".join(failures)
+
+
+def test_building_the_parser_imports_nothing_heavy() -> None:
+    code = (
+        "import json, sys\n"
+        "from orchestrator.cli import build_parser\n"
+        "build_parser()\n"
+        "print(json.dumps(sorted(sys.modules)))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    loaded = json.loads(done.stdout)
+    heavy = sorted(
+        m for m in loaded if any(m == h or m.startswith(h + ".") for h in HEAVY)
+    )
+    assert not heavy, f"imported while building the parser: {heavy[:20]}"
+
+
+def test_version(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as exit_info:
+        main(["--version"])
+    assert exit_info.value.code == 0
+    assert re.fullmatch(r"hlvs \d+\.\d+\S*\n", capsys.readouterr().out)
+
+
+def test_verbosity_moves_the_command_default_by_one_step_per_flag() -> None:
+    parser = build_parser()
+    assert log_level(parser.parse_args(["check", "x.json"])) == logging.WARNING
+    assert log_level(parser.parse_args(["-v", "check", "x.json"])) == logging.INFO
+    assert log_level(parser.parse_args(["check", "-vv", "x.json"])) == logging.DEBUG
+    assert log_level(parser.parse_args(["check", "-q", "x.json"])) == logging.ERROR
+    assert log_level(parser.parse_args(["match", "game.json"])) == logging.INFO
+    assert log_level(parser.parse_args(["match", "-q", "game.json"])) == logging.WARNING
+
+
+def test_unknown_argument_is_an_input_error(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as exit_info:
+        main(["check", "--no-such-option", "x.json"])
+    assert exit_info.value.code == ExitCode.INVALID
+    assert "unrecognized arguments: --no-such-option" in capsys.readouterr().err
+
+
+def test_a_missing_state_file_is_invalid_input_like_every_missing_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    missing = tmp_path / "missing.sqlite"
+    assert main(["schedule", "status", "--state", str(missing)]) == ExitCode.INVALID
+    assert f"{missing}: /: no such state file" in capsys.readouterr().err
+    assert main(["check", str(tmp_path / "missing.json")]) == ExitCode.INVALID
+
+
+def test_check_json_and_github_formats(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    bad = tmp_path / "team_config.json"
+    bad.write_text(json.dumps({"name": "x", "players": {"1": {"dockerTag": 5}}}))
+    assert main(["check", "--json", str(bad)]) == ExitCode.INVALID
+    report = json.loads(capsys.readouterr().out)
+    assert report["valid"] is False
+    (entry,) = report["files"]
+    assert entry["file"] == str(bad) and entry["valid"] is False
+    pointers = {p["pointer"] for p in entry["problems"]}
+    assert any(p.startswith("/players/1") for p in pointers), pointers
+
+    assert main(["check", "--format", "github", str(bad)]) == ExitCode.INVALID
+    lines = capsys.readouterr().out.splitlines()
+    assert lines and all(line.startswith("::error file=") for line in lines), lines
+    assert any("title=/players/1" in line for line in lines), lines
+    assert all("\n" not in line.split("::", 2)[2] for line in lines)
