@@ -3,22 +3,53 @@
 Public surface: :func:`create_app` and :class:`Settings` to build the app; ``require_team`` /
 ``require_operator`` (FastAPI dependencies) and :class:`Principal` for routers of other
 packages; :class:`MatchPool` is the port a cluster implements to play matches.
+
+The names are imported on first use, so that ``hlvs --help`` (which reads
+``service.commands``) does not import FastAPI and SQLAlchemy.
 """
 
 from __future__ import annotations
 
-from service.app import ROUTER_MODULES, Services, create_app
-from service.deps import (
-    OperatorPrincipal,
-    TeamPrincipal,
-    get_db,
-    require_operator,
-    require_team,
-    require_token,
-)
-from service.errors import ServiceError
-from service.settings import Settings
-from service.tokens import Principal
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from service.app import ROUTER_MODULES, Services, create_app
+    from service.deps import (
+        OperatorPrincipal,
+        TeamPrincipal,
+        get_db,
+        require_operator,
+        require_team,
+        require_token,
+    )
+    from service.errors import ServiceError
+    from service.settings import Settings
+    from service.tokens import Principal
+
+_WHERE = {
+    "OperatorPrincipal": "service.deps",
+    "Principal": "service.tokens",
+    "ROUTER_MODULES": "service.app",
+    "ServiceError": "service.errors",
+    "Services": "service.app",
+    "Settings": "service.settings",
+    "TeamPrincipal": "service.deps",
+    "create_app": "service.app",
+    "get_db": "service.deps",
+    "require_operator": "service.deps",
+    "require_team": "service.deps",
+    "require_token": "service.deps",
+}
+
+
+def __getattr__(name: str) -> Any:
+    if name not in _WHERE:
+        raise AttributeError(f"module 'service' has no attribute {name!r}")
+    value = getattr(importlib.import_module(_WHERE[name]), name)
+    globals()[name] = value
+    return value
+
 
 __all__ = [
     "OperatorPrincipal",

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import functools
 import json
+import logging
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -54,19 +55,20 @@ def _add_db_options(parser: argparse.ArgumentParser) -> None:
 
 def register(sub: Any) -> None:
     serve = sub.add_parser("serve", help="run the submission service (HTTP API)")
-    serve.add_argument("--host", default="127.0.0.1")
-    serve.add_argument("--port", type=int, default=8000)
+    serve.add_argument("--host", default="127.0.0.1",
+                       help="address to listen on (default 127.0.0.1)")
+    serve.add_argument("--port", type=int, default=8000, help="TCP port (default 8000)")
     serve.add_argument("--no-worker", action="store_true",
                        help="serve the API without starting matches")
     _add_db_options(serve)
-    serve.set_defaults(func=guarded(run_serve))
+    serve.set_defaults(func=guarded(run_serve), log_level=logging.INFO)
 
     admin = sub.add_parser("admin", help="teams and tokens of the submission service")
     admin_sub = admin.add_subparsers(dest="admin_command", metavar="WHAT", required=True)
     team = admin_sub.add_parser("team", help="teams").add_subparsers(
         dest="team_command", metavar="ACTION", required=True)
     add = team.add_parser("add", help="add a team")
-    add.add_argument("name")
+    add.add_argument("name", help="team name, as in its team_config.json")
     add.add_argument("--email", default=None, help="where the team's mail goes")
     add.add_argument("--accepts-friendlies", action="store_true",
                      help="other teams may ask for test matches against this team")
