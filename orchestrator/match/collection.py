@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from orchestrator.errors import OrchestratorError
+from orchestrator.match.logfs import LogFolder
 from orchestrator.match.results import (
     FailureClass,
     build_results,
@@ -128,6 +129,17 @@ def _copy_public(runner: MatchRunner) -> None:
             shutil.copy2(source, public / name)
 
 
+def _collect_log_folder(runner: MatchRunner, key: str, folder: LogFolder,
+                        destination: Path) -> None:
+    """What a team wrote never fails the match: only releasing the mount can raise."""
+    report = runner.host.collect_logs(folder, destination)
+    runner.records[key].log_folder = report.to_json()
+    if report.skipped_count:
+        log.warning("match %s: %s: %d entries of /robocup-logs not collected (%s)",
+                    runner.plan.match_id, key, report.skipped_count,
+                    ", ".join(f"{s['path']}: {s['kind']}" for s in report.skipped[:5]))
+
+
 def _teardown(runner: MatchRunner) -> None:
     started = runner.started
     runtime = runner.runtime
@@ -139,8 +151,8 @@ def _teardown(runner: MatchRunner) -> None:
     for key, folder in started.log_folders.items():
         record = runner.records[key]
         target = runner.options.out_dir / "teams" / record.color / str(record.number)
-        _guarded(runner, f"collecting /robocup-logs of {key}",
-                 partial(runner.host.collect_logs, folder, target / "robocup-logs"))
+        _guarded(runner, f"releasing /robocup-logs of {key}",
+                 partial(_collect_log_folder, runner, key, folder, target / "robocup-logs"))
     for network in started.networks.values():
         _guarded(runner, f"removing network {network.name}",
                  partial(runtime.remove_network, network.name))

@@ -22,6 +22,7 @@ from orchestrator.match.runtime import (
     StatsSample,
     SubnetInUse,
 )
+from orchestrator.match.safecopy import CopyReport
 
 
 @dataclass(slots=True)
@@ -194,8 +195,9 @@ class FakeHost:
         self.folders.append(fallback)
         return LogFolder(path=fallback, cap_bytes=cap_bytes)
 
-    def collect_logs(self, folder: LogFolder, destination: Path) -> None:
+    def collect_logs(self, folder: LogFolder, destination: Path) -> CopyReport:
         destination.mkdir(parents=True, exist_ok=True)
+        return CopyReport()
 
     def cleanup(self, *, match_id: str | None) -> int:
         return self.remove_isolation(match_id=match_id)

@@ -18,6 +18,7 @@ from orchestrator.bandwidth import AppliedShaping, RobotShaping, TrafficCounters
 from orchestrator.engine import networks
 from orchestrator.match import logfs
 from orchestrator.match.logfs import LogFolder
+from orchestrator.match.safecopy import CopyReport
 
 log = logging.getLogger(__name__)
 
@@ -34,7 +35,7 @@ class Host(Protocol):
     def log_folder(self, *, match_id: str, name: str, cap_bytes: int, fallback: Path
                    ) -> LogFolder: ...
 
-    def collect_logs(self, folder: LogFolder, destination: Path) -> None: ...
+    def collect_logs(self, folder: LogFolder, destination: Path) -> CopyReport: ...
 
     def cleanup(self, *, match_id: str | None) -> int: ...
 
@@ -91,8 +92,8 @@ class HostControl:
         return logfs.create(match_id=match_id, name=name, cap_bytes=cap_bytes,
                             fallback_dir=fallback)
 
-    def collect_logs(self, folder: LogFolder, destination: Path) -> None:
-        logfs.collect(folder, destination)
+    def collect_logs(self, folder: LogFolder, destination: Path) -> CopyReport:
+        return logfs.collect(folder, destination)
 
     def cleanup(self, *, match_id: str | None) -> int:
         removed = self.remove_isolation(match_id=match_id)

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from orchestrator.errors import InfrastructureError
+from orchestrator.match.safecopy import CopyReport, copy_tree, sweep
 
 log = logging.getLogger(__name__)
 
@@ -76,20 +77,36 @@ def create(*, match_id: str, name: str, cap_bytes: int, fallback_dir: Path) -> L
     return LogFolder(path=mountpoint, cap_bytes=cap_bytes, image=image)
 
 
-def collect(folder: LogFolder, destination: Path) -> None:
-    """Copy the folder's content to ``destination`` and release the folder."""
-    destination.mkdir(parents=True, exist_ok=True)
-    if folder.path.resolve() != destination.resolve():
-        shutil.copytree(folder.path, destination, dirs_exist_ok=True, symlinks=True)
-    if folder.image is not None:
-        release(folder)
+def collect(folder: LogFolder, destination: Path) -> CopyReport:
+    """Copy the folder's regular files and directories to ``destination`` (see
+    :mod:`orchestrator.match.safecopy`) and release the folder, whatever the team left in it.
+    Only a failure to release the mount raises."""
+    try:
+        destination.mkdir(parents=True, exist_ok=True)
+        if folder.path.resolve() != destination.resolve():
+            report = copy_tree(folder.path, destination)
+        else:
+            report = sweep(destination)
+    except OSError as exc:
+        report = CopyReport()
+        report.skip(".", f"not collected ({exc})")
+        log.warning("log folder %s not collected: %s", folder.path, exc)
+    finally:
+        if folder.image is not None:
+            release(folder)
+    return report
 
 
 def release(folder: LogFolder) -> None:
+    """Unmount (lazily when a plain unmount fails) and delete the folder and its image."""
     if folder.image is None:
         return
     if _is_mounted(folder.path):
-        _run("umount", str(folder.path))
+        try:
+            _run("umount", str(folder.path))
+        except InfrastructureError as exc:
+            log.warning("%s; unmounting lazily", exc)
+            _run("umount", "-l", str(folder.path))
     folder.image.unlink(missing_ok=True)
     shutil.rmtree(folder.path, ignore_errors=True)
     with contextlib.suppress(OSError):  # the match's folder, once its last robot is released

@@ -62,6 +62,7 @@ class RobotRecord:
     sent_bytes: int | None = None
     received_bytes: int | None = None
     limits: dict[str, Any] = field(default_factory=dict)
+    log_folder: dict[str, Any] | None = None  # what collection copied and skipped
 
     def to_json(self, api: dict[str, Any] | None) -> dict[str, Any]:
         return {
@@ -80,6 +81,7 @@ class RobotRecord:
             "received_bytes": self.received_bytes,
             "limits": self.limits,
             "api": api,
+            "log_folder": self.log_folder,
             "spoofing_attempts": 0,  # messages sent as another robot (set from the simulator)
         }
 

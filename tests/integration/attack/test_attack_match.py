@@ -17,7 +17,7 @@ pytestmark = [pytest.mark.docker, pytest.mark.root]
 @pytest.fixture(scope="module")
 def hostile(prepare: Prepare, docker_client: docker.DockerClient
             ) -> tuple[Prepared, Any, list[str]]:
-    match = prepare("spoof")
+    match = prepare("special-files", "spoof")
     done = match.run()
     assert done.returncode == 0, done.stderr[-3000:]
     return match, done, left_behind(docker_client, match.match_id)
@@ -59,3 +59,20 @@ def test_spoofed_gamecontroller_and_api_messages_are_refused_and_reported(
     spoofs = [e for e in events if e["type"] == "spoofing"]
     assert {(e["team"], e["player"]) for e in spoofs} == {("red", 1)}
     assert results["events_summary"]["spoofing"] == len(spoofs) == 3
+
+
+def test_special_files_in_the_log_folder_are_skipped_not_followed(
+    hostile: tuple[Prepared, Any, list[str]],
+) -> None:
+    match, _, _ = hostile
+    logs = match.out / "teams/red/1/robocup-logs"
+    assert (logs / "sub" / "kept.txt").read_text() == "kept\n"
+    assert json.loads((logs / "attacks.json").read_text())["special_files"]
+    for path in logs.rglob("*"):
+        assert path.is_dir() or path.is_file(), path
+        assert not path.is_symlink(), path
+    folder = match.results()["robots"]["red-1"]["log_folder"]
+    skipped = {(s["path"], s["kind"]) for s in folder["skipped"]}
+    assert {("a_fifo", "pipe"), ("shadow", "symlink"), ("root", "symlink"),
+            ("environ", "symlink"), ("sub/loop", "symlink"), ("a_socket", "socket")} <= skipped
+    assert folder["files"] >= 2
