@@ -74,14 +74,13 @@ def create_app(
         settings.data_dir.mkdir(parents=True, exist_ok=True)
         engine = make_engine(settings.db_url)
         migrate(engine)
+        checker = None
         if preflight is None:
-            from service.preflight import run as real_preflight
+            from service.preflight import PreflightChecker
 
-            def checked(team: dict[str, Any], current: Settings) -> float:
-                return real_preflight(team, settings=current)
-
+            checker = PreflightChecker()
         services = Services(settings=settings, engine=engine, sessions=session_factory(engine),
-                            preflight=preflight or checked)
+                            preflight=preflight or checker)
         app.state.services = services
         from service.pool import make_pool
 
@@ -96,6 +95,8 @@ def create_app(
         finally:
             if services.worker is not None:
                 services.worker.stop()
+            if checker is not None:
+                checker.close()
             engine.dispose()
 
     app = FastAPI(

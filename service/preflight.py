@@ -39,8 +39,30 @@ def official_limits() -> Limits:
     return replace(Limits(), cpus=min(Limits().cpus, float(os.cpu_count() or 1)))
 
 
-def run(team_doc: dict[str, Any], *, settings: Settings) -> float:
-    """Check the team's images; returns the seconds it took, raises :class:`PreflightFailed`."""
+class PreflightChecker:
+    """The service's pre-flight check (a callable); the robots of a passed or failed check are
+    stopped and removed in the background, and :meth:`close` waits for that."""
+
+    def __init__(self) -> None:
+        self._teardowns: list[threading.Thread] = []
+        self._lock = threading.Lock()
+
+    def __call__(self, team_doc: dict[str, Any], settings: Settings) -> float:
+        with self._lock:
+            self._teardowns = [t for t in self._teardowns if t.is_alive()]
+        return run(team_doc, settings=settings, teardowns=self._teardowns)
+
+    def close(self) -> None:
+        for thread in list(self._teardowns):
+            thread.join(timeout=120)
+
+
+def run(team_doc: dict[str, Any], *, settings: Settings,
+        teardowns: list[threading.Thread] | None = None) -> float:
+    """Check the team's images; returns the seconds it took, raises :class:`PreflightFailed`.
+
+    With ``teardowns``, stopping the check's containers happens in a background thread added
+    to that list (the answer does not wait for it); without, before returning."""
     started = time.monotonic()
     with tempfile.TemporaryDirectory(prefix="hlvs-preflight-") as folder:
         path = Path(folder) / "team_config.json"
@@ -61,7 +83,7 @@ def run(team_doc: dict[str, Any], *, settings: Settings) -> float:
                 raise PreflightFailed(stage=stage, image=image.reference or "(none)",
                                       cause=image.error.reason)
         if settings.preflight == "full":
-            _start_and_connect(team_doc, Path(folder), settings=settings)
+            _start_and_connect(team_doc, Path(folder), settings=settings, teardowns=teardowns)
     elapsed = time.monotonic() - started
     log.info("pre-flight of %s passed in %.1f s", team.name, elapsed)
     return elapsed
@@ -82,7 +104,8 @@ def _distinct_players(team_doc: dict[str, Any]) -> dict[str, Any]:
     return {**team_doc, "players": kept}
 
 
-def _start_and_connect(team_doc: dict[str, Any], folder: Path, *, settings: Settings) -> None:
+def _start_and_connect(team_doc: dict[str, Any], folder: Path, *, settings: Settings,
+                       teardowns: list[threading.Thread] | None) -> None:
     from orchestrator.config import load_game
     from orchestrator.engine import connect
     from orchestrator.engine.containers import DockerRuntime
@@ -148,10 +171,19 @@ def _start_and_connect(team_doc: dict[str, Any], folder: Path, *, settings: Sett
             time.sleep(0.1)
     finally:
         runner.stop_event.set()
-        thread.join(timeout=60)
-        cleanup(runtime, host, match_id=match_id)
+
+        def teardown() -> None:
+            thread.join(timeout=120)
+            cleanup(runtime, host, match_id=match_id)
+
+        if teardowns is None:
+            teardown()
+        else:
+            background = threading.Thread(target=teardown, name=f"{match_id}-teardown")
+            background.start()
+            teardowns.append(background)
     if failure is not None:
         raise failure
 
 
-__all__ = ["official_limits", "run"]
+__all__ = ["PreflightChecker", "official_limits", "run"]

@@ -1,0 +1,206 @@
+"""The service with the local Docker pool and the real pre-flight check: real matches on the
+engine, a real SMTP server on loopback (aiosmtpd), PostgreSQL and SQLite."""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from collections.abc import Callable, Iterator
+from email import message_from_bytes
+from email.message import Message
+from pathlib import Path
+from typing import Any
+
+import httpx
+import pytest
+
+from service import Settings
+from tests.integration.service.conftest import TokenMaker
+from tests.integration.service.harness import free_port, serve
+
+pytestmark = [pytest.mark.docker, pytest.mark.slow,
+              pytest.mark.skipif(os.geteuid() != 0, reason="matches need root (host controls)")]
+
+EXAMPLE_TEAM = Path(__file__).parents[3] / "configs" / "examples" / "scrimmage_1v1" / \
+    "team_red.json"
+
+
+def team_doc(name: str, **player: Any) -> dict[str, Any]:
+    doc: dict[str, Any] = json.loads(EXAMPLE_TEAM.read_text())
+    doc["name"] = name
+    doc["players"]["1"].update(player)
+    return doc
+
+
+class Inbox:
+    def __init__(self) -> None:
+        self.messages: list[Message] = []
+
+    async def handle_DATA(self, server: Any, session: Any, envelope: Any) -> str:  # noqa: N802
+        self.messages.append(message_from_bytes(envelope.content))
+        return "250 OK"
+
+    def subjects(self) -> list[str]:
+        return [str(m["Subject"]) for m in self.messages]
+
+
+@pytest.fixture
+def inbox() -> Iterator[tuple[Inbox, int]]:
+    from aiosmtpd.controller import Controller
+
+    handler = Inbox()
+    port = free_port()
+    controller = Controller(handler, hostname="127.0.0.1", port=port)
+    controller.start()
+    yield handler, port
+    controller.stop()
+
+
+@pytest.fixture
+def real_settings(settings: Settings, docker_client: Any) -> Settings:
+    from orchestrator.images import project_image
+
+    project_image("stub")
+    project_image("simulator")
+    return settings.with_(worker_poll_s=0.3, test_half_duration_s=10.0, test_grace_s=2.0,
+                          preflight_timeout_s=25.0)
+
+
+def wait_for(http: httpx.Client, sid: str, predicate: Callable[[dict[str, Any]], bool],
+             timeout_s: float) -> dict[str, Any]:
+    deadline = time.monotonic() + timeout_s
+    while True:
+        body: dict[str, Any] = http.get(f"/v1/submissions/{sid}").json()
+        if predicate(body):
+            return body
+        assert time.monotonic() < deadline, f"timed out waiting; last status {body}"
+        time.sleep(0.3)
+
+
+@pytest.mark.parametrize("db_url", ["postgresql"], indirect=True)
+def test_submit_run_mail_download_and_isolation(
+        real_settings: Settings, make_token: TokenMaker, inbox: tuple[Inbox, int]) -> None:
+    mails, smtp_port = inbox
+    settings = real_settings.with_(smtp_host="127.0.0.1", smtp_port=smtp_port)
+    served = serve(settings, start_worker=True)
+    try:
+        alpha = served.client(make_token(team="Alpha", email="alpha@example.org"))
+        beta = served.client(make_token(team="Beta", email="beta@example.org"))
+        for http, name in ((alpha, "Alpha"), (beta, "Beta")):
+            uploaded = http.put("/v1/team/files/team_config", json=team_doc(name))
+            assert uploaded.status_code == 201, uploaded.text
+        created = alpha.post("/v1/submissions", json={"opponent": "stub"})
+        assert created.status_code == 201, created.text
+        sid = created.json()["id"]
+        assert created.json()["preflight_s"] < 30
+        second = alpha.post("/v1/submissions", json={})
+        assert second.status_code == 409 and second.json()["existing_id"] == sid
+        wait_for(alpha, sid, lambda b: b["state"] == "running", 30)
+
+        # Beta waits behind Alpha's match, then cancels while queued: no charge.
+        queued = beta.post("/v1/submissions", json={})
+        assert queued.status_code == 201, queued.text
+        waiting = queued.json()
+        assert waiting["state"] == "queued" and waiting["queue_position"] == 1
+        assert "busy" in waiting["waiting_reason"] and waiting["expected_start"]
+        cancelled = beta.post(f"/v1/submissions/{waiting['id']}/cancel").json()
+        assert cancelled["state"] == "cancelled" and cancelled["charged"] is False
+
+        done = wait_for(alpha, sid, lambda b: b["state"] in ("done", "failed"), 180)
+        assert done["state"] == "done", done
+        report = alpha.get(f"/v1/submissions/{sid}/report").json()
+        assert report["match_report"] == {"status": "success"}
+        assert report["backend_error"] is False and set(report["team_robots"]) == {"red-1"}
+        results = alpha.get(f"/v1/submissions/{sid}/results").json()
+        assert results["final_state"] == "FINISHED"
+        logs = alpha.get(f"/v1/submissions/{sid}/logs").json()
+        assert "1/stdout.log" in logs["team"] and "replay.hlvsrec" in logs["public"]
+        assert all(not name.startswith("blue") for name in logs["team"])
+        robot_log = alpha.get(f"/v1/submissions/{sid}/logs/team/1/robocup-logs/stub_red_1.log")
+        assert robot_log.status_code == 200 and robot_log.content
+        replay = alpha.get(f"/v1/submissions/{sid}/replay")
+        assert replay.status_code == 200 and len(replay.content) > 1000
+        for path in ("/logs", "/logs/team/1/stdout.log", "/results", "/report"):
+            assert beta.get(f"/v1/submissions/{sid}{path}").status_code == 404, path
+
+        deadline = time.monotonic() + 20
+        while len([s for s in mails.subjects() if sid in s]) < 2:
+            assert time.monotonic() < deadline, mails.subjects()
+            time.sleep(0.2)
+        subjects = [s for s in mails.subjects() if sid in s]
+        assert subjects == [f"[hlvs] test match {sid} started",
+                            f"[hlvs] test match {sid} finished"]
+        finished = next(m for m in mails.messages if "finished" in str(m["Subject"]))
+        assert finished["To"] == "alpha@example.org"
+        assert f"/v1/submissions/{sid}/results" in finished.get_payload()
+        alpha.close()
+        beta.close()
+    finally:
+        served.stop()
+
+
+@pytest.mark.parametrize("db_url", ["sqlite"], indirect=True)
+def test_bad_images_are_refused_by_the_preflight_check_with_the_cause(
+        real_settings: Settings, make_token: TokenMaker) -> None:
+    served = serve(real_settings, start_worker=False)
+    try:
+        http = served.client(make_token(team="Alpha"))
+        unreachable = team_doc("Alpha")
+        unreachable["image"] = f"127.0.0.1:{free_port()}/alpha/robot"
+        assert http.put("/v1/team/files/team_config", json=unreachable).status_code == 201
+        started = time.monotonic()
+        answer = http.post("/v1/submissions", json={})
+        assert time.monotonic() - started < 30
+        assert answer.status_code == 422
+        body = answer.json()
+        assert body["error"] == "preflight_failed" and body["stage"] == "pull"
+        assert "alpha/robot" in body["image"] and body["cause"]
+
+        crashing = team_doc("Alpha", dockerCmd="no-such-role")
+        assert http.put("/v1/team/files/team_config", json=crashing).status_code == 201
+        started = time.monotonic()
+        answer = http.post("/v1/submissions", json={})
+        assert time.monotonic() - started < 30
+        assert answer.status_code == 422, answer.text
+        assert answer.json()["stage"] == "start"
+        assert "exited with code" in answer.json()["cause"]
+        assert http.get("/v1/submissions").json() == []  # nothing was queued
+        http.close()
+    finally:
+        served.stop()
+
+
+@pytest.mark.parametrize("db_url", ["sqlite"], indirect=True)
+def test_restart_mid_match_then_cancel_running(real_settings: Settings,
+                                               make_token: TokenMaker) -> None:
+    settings = real_settings.with_(test_half_duration_s=60.0)
+    token = make_token(team="Alpha")
+    served = serve(settings, start_worker=True)
+    with served.client(token) as http:
+        assert http.put("/v1/team/files/team_config", json=team_doc("Alpha")).status_code == 201
+        sid = http.post("/v1/submissions", json={}).json()["id"]
+        running = wait_for(http, sid, lambda b: b["state"] == "running", 30)
+    served.stop()
+    work = settings.matches_dir / running["match_id"]
+    pid = json.loads((work / "pool.json").read_text())["pid"]
+    os.kill(pid, 0)  # the match goes on without the service
+
+    again = serve(settings, start_worker=True)
+    try:
+        with again.client(token) as http:
+            time.sleep(1.5)  # a few worker rounds
+            status = wait_for(http, sid, lambda b: b["state"] == "running", 10)
+            assert status["attempts"] == 1 and status["match_id"] == running["match_id"]
+            assert json.loads((work / "pool.json").read_text())["pid"] == pid
+            assert sorted(p.name for p in settings.matches_dir.iterdir()) == [
+                running["match_id"]]
+            asked = http.post(f"/v1/submissions/{sid}/cancel").json()
+            assert asked["cancel_requested"] is True
+            ended = wait_for(http, sid, lambda b: b["state"] != "running", 90)
+            assert ended["state"] == "cancelled", ended
+            report = http.get(f"/v1/submissions/{sid}/report").json()
+            assert report["match_report"]["failure_class"] == "interrupted"
+            assert http.get(f"/v1/submissions/{sid}/logs").json()["team"]  # logs collected
+    finally:
+        again.stop()
