@@ -4,6 +4,7 @@ Tree::
 
     SimulatorError
     ├── SpecError            match_spec.json that does not describe a match
+    ├── ModelError           a team robot model package that cannot be used (every problem)
     ├── PhysicsDivergence    MuJoCo reported instability (carries its warning and the policy)
     ├── ApiError             robot API misuse on the simulator side
     ├── UnknownDeviceError   a device name a robot does not have (world device access)
@@ -16,10 +17,14 @@ simulator and the robot-side motion code).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from robot.errors import UnknownModelError
 
 __all__ = [
     "ApiError",
+    "ModelError",
+    "ModelProblem",
     "PhysicsDivergence",
     "RenderError",
     "ReplayError",
@@ -42,6 +47,26 @@ class SpecError(SimulatorError):
         super().__init__(f"{source}: {pointer or '/'}: {reason}")
 
 
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ModelProblem:
+    """One problem of a team robot model: the file, where in it, and what is wrong."""
+
+    source: str
+    where: str  # JSON pointer in the manifest, or the element / link / rule
+    reason: str
+
+    def __str__(self) -> str:
+        return f"{self.source}: {self.where or '/'}: {self.reason}"
+
+
+class ModelError(SimulatorError):
+    """A team robot model package that cannot be loaded; carries every problem found."""
+
+    def __init__(self, problems: list[ModelProblem]) -> None:
+        self.problems = list(problems)
+        super().__init__("\n".join(str(p) for p in self.problems))
 
 
 class PhysicsDivergence(SimulatorError):

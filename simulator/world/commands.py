@@ -61,17 +61,18 @@ def _standing_qpos(world: World, number: int, x: float, y: float, yaw: float) ->
     qpos: np.ndarray = np.array(world.data.qpos[start:end], dtype=np.float64)
     qpos[0:3] = (x, y, robot.model.standing_height_m + STANDING_CLEARANCE_M)
     qpos[3:7] = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
-    qpos[7:] = 0.0
+    qpos[robot.motor_qpos - start] = robot.model.standing_pose_rad
     return qpos
 
 
 def teleport(world: World, number: int, x: float, y: float, yaw: float) -> None:
-    """Standing posture (all joints at zero) at (x, y, yaw), velocities zeroed."""
+    """Standing posture (the model's standing pose: all joints at zero for the built-in models)
+    at (x, y, yaw), velocities zeroed."""
     robot = world.index.robots[number]
     start, end = robot.qpos_range
     world.data.qpos[start:end] = _standing_qpos(world, number, x, y, yaw)
     world.data.qvel[robot.dof_range[0] : robot.dof_range[1]] = 0.0
-    world.motors.hold(robot.actuators, np.zeros(robot.actuators.size))
+    world.motors.hold(robot.actuators, np.asarray(robot.model.standing_pose_rad, dtype=float))
 
 
 def set_limp(world: World, number: int, limp: bool) -> None:

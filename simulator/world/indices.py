@@ -12,7 +12,7 @@ import numpy.typing as npt
 
 from referee.snapshot import BodyPart, RobotId
 from simulator.world.ball import BALL_GEOM, BALL_JOINT
-from simulator.world.robots import RobotModel, robot_model
+from simulator.world.robots import AnyRobotModel, robot_model
 from simulator.world.types import RobotPlacement, robot_prefix
 
 IntArray = npt.NDArray[np.int64]
@@ -33,7 +33,7 @@ class RobotIndex:
     id: RobotId
     number: int  # position in World.robot_ids
     prefix: str
-    model: RobotModel
+    model: AnyRobotModel
     root_qpos: int  # 7 values: x y z qw qx qy qz
     root_dof: int  # 6 values
     motor_qpos: IntArray  # in model.motor_names order

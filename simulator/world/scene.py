@@ -48,6 +48,7 @@ def scene_xml(
     ]
     actuators = []
     sensors = []
+    assets: dict[str, str] = {}
     for i, placement in enumerate(robots):
         model = robot_model(placement.model)
         bit = 1 << i
@@ -59,6 +60,8 @@ def scene_xml(
             pose=(placement.x_m, placement.y_m, placement.yaw_rad),
         )
         bodies.append(parts.body)
+        if parts.assets:
+            assets.setdefault(parts.asset_key, parts.assets)
         actuators.append(parts.actuators)
         sensors.append(parts.sensors)
         sensors.append(
@@ -74,7 +77,7 @@ def scene_xml(
  <headlight ambient="0.35 0.35 0.35" diffuse="0.3 0.3 0.3" specular="0 0 0"/>
  <map znear="0.01" zfar="100"/>
 </visual>
-<asset>{field_assets()}{ball_assets()}</asset>
+<asset>{field_assets()}{ball_assets()}{"".join(assets.values())}</asset>
 <worldbody>{"".join(bodies)}</worldbody>
 <actuator>{"".join(actuators)}</actuator>
 <sensor>{"".join(sensors)}</sensor>

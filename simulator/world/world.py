@@ -81,13 +81,15 @@ class World(DeviceAccess):
         self.sim_time_ms = 0
         self.last_ball_toucher: RobotId | None = None
         self.last_ball_touch_ms: int | None = None
-        if initial_joint_noise_rad > 0:
-            for robot in self.index.robots:
-                noise = self.rng.uniform(
+        for robot in self.index.robots:
+            pose = np.asarray(robot.model.standing_pose_rad, dtype=np.float64)
+            if initial_joint_noise_rad > 0:
+                pose = pose + self.rng.uniform(
                     -initial_joint_noise_rad, initial_joint_noise_rad, size=robot.motor_qpos.size
                 )
-                self.data.qpos[robot.motor_qpos] = noise
-                self.motors.hold(robot.actuators, noise)
+            if pose.any():
+                self.data.qpos[robot.motor_qpos] = pose
+                self.motors.hold(robot.actuators, pose)
         mujoco.mj_forward(self.model, self.data)
         self._watch = DivergenceWatch(self.data)
         self._saved = self._save()

@@ -1,6 +1,9 @@
-"""Registry of the built-in robot models (``kid-default``, ``adult-default``)."""
+"""Registry of the robot models: the built-in ones (``kid-default``, ``adult-default``) and team
+model packages, named by their folder's path (see :mod:`simulator.world.robots.team`)."""
 
 from __future__ import annotations
+
+from pathlib import Path
 
 from robot.errors import UnknownModelError
 from robot.geometry import (
@@ -18,6 +21,9 @@ from simulator.world.robots.model import (
     RobotMjcf,
     RobotModel,
 )
+from simulator.world.robots.team import TeamRobotModel, load_team_model
+
+AnyRobotModel = RobotModel | TeamRobotModel
 
 # kp N m/rad, max torque N m, max velocity rad/s for the kid model (ranges: robot.geometry).
 # Stiff, damped servos (kv = KV_TIME_S * kp): with the softer kp / 2 and no damping the
@@ -83,8 +89,18 @@ def known_models() -> tuple[str, ...]:
     return tuple(sorted(_MODELS))
 
 
-def robot_model(name: str) -> RobotModel:
-    """The built-in model called ``name``; :class:`UnknownModelError` lists the known ones."""
+def is_model_path(name: str) -> bool:
+    """True when ``name`` names a model package folder rather than a built-in model."""
+    return "/" in name or name.startswith(".")
+
+
+def robot_model(name: str) -> AnyRobotModel:
+    """The built-in model called ``name``, or the team model package at the path ``name``.
+
+    Unknown built-in names raise :class:`UnknownModelError` (listing the known ones); a package
+    that cannot be used raises :class:`simulator.errors.ModelError` with every problem."""
+    if is_model_path(name):
+        return load_team_model(Path(name))
     try:
         return _MODELS[name]
     except KeyError:
@@ -93,6 +109,7 @@ def robot_model(name: str) -> RobotModel:
 
 __all__ = [
     "ADULT_DEFAULT",
+    "AnyRobotModel",
     "FORCE_SENSORS",
     "KID_DEFAULT",
     "MOTOR_NAMES",
@@ -101,6 +118,8 @@ __all__ = [
     "MotorSpec",
     "RobotMjcf",
     "RobotModel",
+    "TeamRobotModel",
+    "is_model_path",
     "known_models",
     "robot_model",
 ]

@@ -39,6 +39,8 @@ class RobotMjcf:
     body: str
     actuators: str
     sensors: str
+    assets: str = ""  # <asset> children (meshes) shared by every robot of the same model
+    asset_key: str = ""  # robots with the same key share one copy of ``assets``
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -57,6 +59,11 @@ class RobotModel:
     @property
     def standing_height_m(self) -> float:
         return self.geometry.standing_height_m
+
+    @property
+    def standing_pose_rad(self) -> tuple[float, ...]:
+        """Joint positions (``motor_names`` order) the robot stands in when placed: all zero."""
+        return (0.0,) * len(self.motors)
 
     @property
     def motor_names(self) -> tuple[str, ...]:

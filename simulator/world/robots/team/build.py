@@ -1,0 +1,332 @@
+"""Turns a team's model file and manifest into the MJCF the world places once per robot.
+
+What is added to a URDF or MJCF file as teams write it: a free base at the root link, position
+servos from the manifest, the IMU site and its sensors, the cameras, touch sensors for the foot
+force sensors, bodies marking the hands and feet for the referee, and a team-coloured marker.
+Collision geometry is simplified to one box per link (``collision: "link-boxes"``, the default:
+hundreds of small shapes cost more than the rest of the world) or kept as it is; visual meshes
+are kept for cameras and video.
+
+Names follow the world's contract (see :mod:`simulator.world.robots.humanoid`): the root body
+``<prefix>/torso`` with the free joint ``<prefix>/root``, joints and actuators by HLVS motor name,
+geoms ``<prefix>/<part>:<label>`` so the referee knows feet from hands, ``<prefix>/visual:...``
+for what never collides. The template uses the placeholder :data:`PREFIX` for the prefix.
+"""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from simulator.errors import ModelError, ModelProblem
+from simulator.world.robots.team.manifest import Manifest
+
+PREFIX = "@ROBOT@"
+HULL = (("hands", 0, "hand_L"), ("hands", 1, "hand_R"), ("feet", 0, "foot_L"),
+        ("feet", 1, "foot_R"))
+MARKER_RADIUS_M = 0.04
+
+
+@dataclass(frozen=True, slots=True)
+class Template:
+    """The robot's MJCF with :data:`PREFIX` in every name, ready to be instantiated."""
+
+    key: str  # prefix of this model's mesh asset names (shared by its robots)
+    assets: str
+    body: ET.Element
+    actuators: str
+    sensors: str
+    standing_height_m: float  # root body origin above the ground at the zero pose
+    root_body: str  # the link that became <prefix>/torso
+    ranges: dict[str, tuple[float, float]]  # motor name -> joint range (rad)
+    trunk_body: str  # the heaviest body (template name): its visuals wear the team colour
+
+
+def _problem(manifest: Manifest, where: str, reason: str) -> ModelProblem:
+    return ModelProblem(source=str(manifest.path), where=where, reason=reason)
+
+
+def _bodies(spec: mujoco.MjSpec) -> list[mujoco.MjsBody]:
+    out: list[mujoco.MjsBody] = []
+
+    def walk(body: mujoco.MjsBody) -> None:
+        for child in body.bodies:
+            out.append(child)
+            walk(child)
+
+    walk(spec.worldbody)
+    return out
+
+
+def _is_collision(geom: mujoco.MjsGeom) -> bool:
+    return bool(geom.contype or geom.conaffinity)
+
+
+def _link_boxes(model: mujoco.MjModel) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+    """Body id -> (min, max) corners, in the body frame, of its collision geoms."""
+    boxes: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+    rot = np.zeros(9)
+    for g in range(model.ngeom):
+        if not (model.geom_contype[g] or model.geom_conaffinity[g]):
+            continue
+        centre, half = model.geom_aabb[g][:3], model.geom_aabb[g][3:]
+        corners = centre + signs * half
+        mujoco.mju_quat2Mat(rot, model.geom_quat[g])
+        in_body = corners @ rot.reshape(3, 3).T + model.geom_pos[g]
+        b = int(model.geom_bodyid[g])
+        lo, hi = in_body.min(axis=0), in_body.max(axis=0)
+        if b in boxes:
+            lo, hi = np.minimum(lo, boxes[b][0]), np.maximum(hi, boxes[b][1])
+        boxes[b] = (lo, hi)
+    return boxes
+
+
+def _parts(spec: mujoco.MjSpec, manifest: Manifest) -> dict[str, str]:
+    """Link -> body part; a link's part is the manifest's, else its parent's, else torso."""
+    out: dict[str, str] = {}
+
+    def walk(body: mujoco.MjsBody, inherited: str) -> None:
+        for child in body.bodies:
+            part = manifest.parts.get(child.name, inherited)
+            out[child.name] = part
+            walk(child, part)
+
+    walk(spec.worldbody, "torso")
+    return out
+
+
+def _validate(spec: mujoco.MjSpec, manifest: Manifest) -> list[ModelProblem]:
+    problems = []
+    links = {b.name for b in _bodies(spec)}
+    joints = {j.name: j for b in _bodies(spec) for j in b.joints}
+    motor_joints = {m.joint for m in manifest.motors}
+    if len(spec.worldbody.bodies) != 1:
+        problems.append(_problem(manifest, "model_file",
+                                 f"{len(spec.worldbody.bodies)} root links; expected one tree"))
+    if not joints:
+        problems.append(_problem(manifest, "model_file",
+                                 "the model has no movable joints (a robot needs motors)"))
+    for i, motor in enumerate(manifest.motors):
+        joint = joints.get(motor.joint)
+        if joint is None:
+            hint = _did_you_mean(motor.joint, joints)
+            problems.append(_problem(manifest, f"/motors/{i}/joint",
+                                     f"no joint {motor.joint!r} in the model{hint}"))
+        elif joint.type not in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE):
+            problems.append(_problem(manifest, f"/motors/{i}/joint",
+                                     f"joint {motor.joint!r} is not a revolute joint"))
+        elif not joint.limited and not (joint.range[0] < joint.range[1]):
+            problems.append(_problem(manifest, f"/motors/{i}/joint",
+                                     f"joint {motor.joint!r} has no limits (rule: every motor "
+                                     "joint has a range)"))
+    for name, joint in joints.items():
+        if name not in motor_joints and joint.type != mujoco.mjtJoint.mjJNT_FREE:
+            problems.append(_problem(manifest, "/motors",
+                                     f"joint {name!r} is movable but not a motor; list it under "
+                                     "motors (unactuated joints are not allowed)"))
+    named: list[tuple[str, str]] = [("/imu/link", manifest.imu_link)]
+    named += [(f"/cameras/{i}/link", c.link) for i, c in enumerate(manifest.cameras)]
+    named += [(f"/force_sensors/{k}", v) for k, v in manifest.force_sensors.items()]
+    named += [(f"/parts ({part})", link) for link, part in manifest.parts.items()]
+    named += [("/hands/left", manifest.hands[0]), ("/hands/right", manifest.hands[1]),
+              ("/feet/left", manifest.feet[0]), ("/feet/right", manifest.feet[1])]
+    for where, link in named:
+        if link not in links:
+            problems.append(_problem(manifest, where,
+                                     f"no link {link!r} in the model{_did_you_mean(link, links)}"))
+    return problems
+
+
+def _did_you_mean(name: str, known: object) -> str:
+    import difflib
+
+    close = difflib.get_close_matches(name, list(known), n=1)  # type: ignore[call-overload]
+    return f"; did you mean {close[0]!r}?" if close else ""
+
+
+def build_template(spec: mujoco.MjSpec, manifest: Manifest, *, key: str) -> Template:
+    """Edit ``spec`` (consumed) into the world's robot template. Raises :class:`ModelError`."""
+    problems = _validate(spec, manifest)
+    if problems:
+        raise ModelError(problems)
+    original = spec.compile()
+    boxes = _link_boxes(original)
+    parts = _parts(spec, manifest)
+    root = spec.worldbody.bodies[0]
+    root_name = root.name
+    motors = {m.joint: m for m in manifest.motors}
+    ranges: dict[str, tuple[float, float]] = {}
+    p = PREFIX
+    for mesh in spec.meshes:
+        mesh.name = f"{key}:{mesh.name}"
+    for body in [root, *_bodies(spec)[1:]]:
+        b = original.body(body.name).id
+        link = body.name
+        body.explicitinertial = True
+        body.mass = max(float(original.body_mass[b]), 1e-6)
+        body.ipos = original.body_ipos[b]
+        body.iquat = original.body_iquat[b]
+        body.inertia = np.maximum(original.body_inertia[b], 1e-9)
+        body.fullinertia = np.full(6, np.nan)
+        part = parts[link]
+        visuals = 0
+        for i, geom in enumerate(list(body.geoms)):
+            if _is_collision(geom):
+                if manifest.collision == "link-boxes":
+                    spec.delete(geom)
+                    continue
+                geom.name = f"{p}/{part}:{link}_{i}"
+            else:
+                geom.name = f"{p}/visual:{link}_{visuals}"
+                visuals += 1
+            geom.mass = 0
+            geom.density = 0
+            if geom.type == mujoco.mjtGeom.mjGEOM_MESH:
+                geom.meshname = f"{key}:{geom.meshname}"
+        if manifest.collision == "link-boxes" and b in boxes:
+            lo, hi = boxes[b]
+            box = body.add_geom()
+            box.name = f"{p}/{part}:{link}"
+            box.type = mujoco.mjtGeom.mjGEOM_BOX
+            box.pos = (lo + hi) / 2
+            box.size = np.maximum((hi - lo) / 2, 1e-3)
+            box.group = 3
+            box.mass = 0
+            box.rgba = (0.5, 0.5, 0.5, 0.0)
+        for joint in body.joints:
+            motor = motors[joint.name]
+            ranges[motor.name] = (float(joint.range[0]), float(joint.range[1]))
+            joint.name = f"{p}/{motor.name}"
+            if manifest.joint_damping is not None:
+                joint.damping = [manifest.joint_damping, 0.0, 0.0]
+            if manifest.joint_armature is not None:
+                joint.armature = manifest.joint_armature
+            if manifest.joint_frictionloss is not None:
+                joint.frictionloss = manifest.joint_frictionloss
+        if link == manifest.imu_link:
+            site = body.add_site()
+            site.name = f"{p}/site:imu"
+        for sensor, sensor_link in manifest.force_sensors.items():
+            if sensor_link == link:
+                lo, hi = boxes.get(b, (np.full(3, -0.01), np.full(3, 0.01)))
+                site = body.add_site()
+                site.name = f"{p}/site:{sensor}"
+                site.type = mujoco.mjtGeom.mjGEOM_BOX
+                site.pos = (lo + hi) / 2
+                site.size = (hi - lo) / 2 + 2e-3
+                site.group = 4
+        for group, side, hull in HULL:
+            if getattr(manifest, group)[side] == link:
+                marker = body.add_body()
+                marker.name = f"{p}/{hull}"
+                lo, hi = boxes.get(b, (np.zeros(3), np.zeros(3)))
+                marker.pos = (lo + hi) / 2
+        for camera in manifest.cameras:
+            if camera.link == link:
+                cam = body.add_camera()
+                cam.name = f"{p}/{camera.name}"
+                cam.pos = camera.pos_m
+                cam.alt.type = mujoco.mjtOrientation.mjORIENTATION_XYAXES
+                cam.alt.xyaxes = (0, -1, 0, 0, 0, 1)
+                cam.fovy = math.degrees(
+                    2 * math.atan(math.tan(camera.fov_rad / 2) * camera.height / camera.width)
+                )
+        body.name = f"{p}/torso" if body is root else f"{p}/link:{link}"
+    for joint in root.joints:
+        spec.delete(joint)
+    root.add_freejoint().name = f"{p}/root"
+    top = _top_of(original, manifest)
+    head = root if top[0] == root_name else spec.body(f"{p}/link:{top[0]}")
+    marker = head.add_geom()
+    marker.name = f"{p}/visual:marker"
+    marker.type = mujoco.mjtGeom.mjGEOM_CYLINDER
+    marker.size = (MARKER_RADIUS_M, 0.006, 0)
+    marker.pos = top[1]
+    marker.contype = marker.conaffinity = 0
+    marker.group = 1
+    marker.mass = 0
+    for actuator in list(spec.actuators):
+        spec.delete(actuator)
+    for sensor in list(spec.sensors):
+        spec.delete(sensor)
+    standing = _standing_height(spec, manifest.standing_pose_rad)
+    xml = spec.to_xml()
+    heaviest = int(np.argmax(original.body_mass))
+    trunk = original.body(heaviest).name
+    trunk_name = f"{p}/torso" if trunk == root_name else f"{p}/link:{trunk}"
+    return _template(xml, manifest, key=key, standing=standing, root_name=root_name,
+                     ranges=ranges, trunk=trunk_name)
+
+
+def _top_of(model: mujoco.MjModel, manifest: Manifest) -> tuple[str, np.ndarray]:
+    """The link holding the robot's highest point at the zero pose, and that point (link frame)."""
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    best = (-math.inf, 0, np.zeros(3))
+    for g in range(model.ngeom):
+        centre, half = model.geom_aabb[g][:3], model.geom_aabb[g][3:]
+        z = data.geom_xpos[g][2] + float(np.abs(data.geom_xmat[g].reshape(3, 3)[2]) @ half)
+        if z > best[0]:
+            b = int(model.geom_bodyid[g])
+            top_world = data.geom_xpos[g] + data.geom_xmat[g].reshape(3, 3) @ centre
+            top_world = top_world.copy()
+            top_world[2] = z + 0.006
+            local = data.xmat[b].reshape(3, 3).T @ (top_world - data.xpos[b])
+            best = (z, b, local)
+    return model.body(best[1]).name, best[2]
+
+
+def _standing_height(spec: mujoco.MjSpec, pose: dict[str, float]) -> float:
+    """Height of the root above the ground when the lowest collision geom touches it, the
+    joints in the standing pose."""
+    model = spec.compile()
+    data = mujoco.MjData(model)
+    for name, rad in pose.items():
+        data.qpos[model.jnt_qposadr[model.joint(f"{PREFIX}/{name}").id]] = rad
+    mujoco.mj_kinematics(model, data)
+    lowest = math.inf
+    for g in range(model.ngeom):
+        if not (model.geom_contype[g] or model.geom_conaffinity[g]):
+            continue
+        half = model.geom_aabb[g][3:]
+        centre = data.geom_xpos[g] + data.geom_xmat[g].reshape(3, 3) @ model.geom_aabb[g][:3]
+        extent = float(np.abs(data.geom_xmat[g].reshape(3, 3)[2]) @ half)
+        lowest = min(lowest, centre[2] - extent)
+    root_z = float(data.xpos[1][2])
+    return root_z - lowest
+
+
+def _template(xml: str, manifest: Manifest, *, key: str, standing: float,
+              root_name: str, ranges: dict[str, tuple[float, float]], trunk: str) -> Template:
+    doc = ET.fromstring(xml)
+    asset = doc.find("asset")
+    assets = "".join(ET.tostring(e, encoding="unicode") for e in (asset if asset is not None
+                                                                   else []))
+    worldbody = doc.find("worldbody")
+    assert worldbody is not None
+    body = worldbody.find("body")
+    assert body is not None
+    for element in body.iter():
+        element.attrib.pop("class", None)
+        element.attrib.pop("childclass", None)
+    motors = "".join(
+        f'<position name="{PREFIX}/{m.name}" joint="{PREFIX}/{m.name}" kp="{m.kp_nm_per_rad:.6g}" '
+        f'kv="{m.kv_nm_s_per_rad:.6g}" forcerange="{-m.max_torque_nm:.6g} {m.max_torque_nm:.6g}" '
+        f'ctrllimited="false"/>'
+        for m in manifest.motors
+    )
+    sensors = (
+        f'<accelerometer name="{PREFIX}/Accelerometer" site="{PREFIX}/site:imu"/>'
+        f'<gyro name="{PREFIX}/Gyro" site="{PREFIX}/site:imu"/>'
+        f'<subtreelinvel name="{PREFIX}/com_velocity" body="{PREFIX}/torso"/>'
+        + "".join(f'<touch name="{PREFIX}/{n}" site="{PREFIX}/site:{n}"/>'
+                  for n in manifest.force_sensors)
+    )
+    return Template(key=key, assets=assets, body=body, actuators=motors, sensors=sensors,
+                    standing_height_m=standing, root_body=root_name, ranges=ranges,
+                    trunk_body=trunk)

@@ -1,0 +1,283 @@
+"""The manifest of a team robot model (``robot_model.json``): how a URDF or MJCF file maps to the
+league's robot API.
+
+A model package is a folder with the manifest, the model file and its meshes::
+
+    robot_model.json
+    wolfgang_description/urdf/robot.urdf      (``model_file``, relative to the manifest)
+    wolfgang_description/urdf/*.stl           (``package://wolfgang_description/...``)
+
+Every problem is a :class:`ModelProblem` naming the file, the JSON pointer (or the XML element),
+the value and what was expected; :func:`load_manifest` raises :class:`ModelError` with all of them.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from simulator.errors import ModelError, ModelProblem
+
+MANIFEST_NAME = "robot_model.json"
+FORMAT_VERSION = 1
+PART_NAMES = ("foot", "hand", "arm", "head", "torso", "leg")
+COLLISION_MODES = ("link-boxes", "as-is")
+FIELD_CLASSES = ("kid", "adult")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class MotorEntry:
+    """One joint of the model file driven as an HLVS motor."""
+
+    joint: str  # joint name in the model file
+    name: str  # HLVS device name (position sensor: name + sensor suffix)
+    kp_nm_per_rad: float
+    kv_nm_s_per_rad: float
+    max_torque_nm: float
+    max_velocity_rad_s: float
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class CameraEntry:
+    name: str
+    link: str
+    width: int
+    height: int
+    fov_rad: float  # horizontal
+    pos_m: tuple[float, float, float] = (0.0, 0.0, 0.0)  # in the link frame; looks along link +x
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Manifest:
+    """A validated ``robot_model.json``; paths are absolute."""
+
+    path: Path
+    name: str
+    field_class: str
+    model_file: Path
+    packages: dict[str, Path]
+    motors: tuple[MotorEntry, ...]
+    sensor_suffix: str
+    imu_link: str
+    cameras: tuple[CameraEntry, ...]
+    force_sensors: dict[str, str]  # HLVS name -> link
+    parts: dict[str, str]  # link -> part (its subtree inherits it)
+    hands: tuple[str, str]  # left, right link
+    feet: tuple[str, str]
+    collision: str
+    standing_pose_rad: dict[str, float]  # HLVS motor name -> rad; others 0
+    joint_damping: float | None = None
+    joint_armature: float | None = None
+    joint_frictionloss: float | None = None
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def folder(self) -> Path:
+        return self.path.parent
+
+
+class _Reader:
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        self.problems: list[ModelProblem] = []
+
+    def problem(self, pointer: str, reason: str) -> None:
+        self.problems.append(ModelProblem(source=str(self.path), where=pointer, reason=reason))
+
+    def get(self, obj: dict[str, Any], key: str, kind: type | tuple[type, ...], pointer: str,
+            *, required: bool = True, default: Any = None) -> Any:
+        if key not in obj:
+            if required:
+                self.problem(f"{pointer}/{key}", f"missing; expected {_kind_name(kind)}")
+            return default
+        value = obj[key]
+        if isinstance(value, bool) and bool not in _as_tuple(kind):
+            self.problem(f"{pointer}/{key}", f"{value!r} is not {_kind_name(kind)}")
+            return default
+        if not isinstance(value, kind):
+            self.problem(f"{pointer}/{key}", f"{value!r} is not {_kind_name(kind)}")
+            return default
+        return value
+
+    def positive(self, obj: dict[str, Any], key: str, pointer: str, *, required: bool = True,
+                 default: float | None = None) -> float | None:
+        value = self.get(obj, key, (int, float), pointer, required=required, default=default)
+        if value is None:
+            return None
+        if not math.isfinite(float(value)) or float(value) <= 0:
+            self.problem(f"{pointer}/{key}", f"{value!r} must be a positive number")
+            return default
+        return float(value)
+
+
+def _as_tuple(kind: type | tuple[type, ...]) -> tuple[type, ...]:
+    return kind if isinstance(kind, tuple) else (kind,)
+
+
+def _kind_name(kind: type | tuple[type, ...]) -> str:
+    names = {int: "an integer", float: "a number", str: "a string", dict: "an object",
+             list: "an array", bool: "true or false"}
+    return " or ".join(dict.fromkeys(names.get(k, k.__name__) for k in _as_tuple(kind)))
+
+
+_KNOWN_KEYS = {
+    "format_version", "name", "class", "model_file", "packages", "motors", "sensor_suffix",
+    "imu", "cameras", "force_sensors", "parts", "hands", "feet", "collision", "joint_damping",
+    "joint_armature", "joint_frictionloss", "description", "standing_pose_rad",
+}
+
+
+def load_manifest(folder_or_file: Path) -> Manifest:
+    """Read and validate a model package's manifest. Raises :class:`ModelError`."""
+    path = folder_or_file / MANIFEST_NAME if folder_or_file.is_dir() else folder_or_file
+    path = path.resolve()
+    if not path.is_file():
+        raise ModelError([ModelProblem(source=str(path), where="",
+                                       reason=f"no {MANIFEST_NAME} here (a model package is a "
+                                       f"folder with {MANIFEST_NAME} and the model file)")])
+    try:
+        raw = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ModelError([ModelProblem(source=str(path), where="", reason=f"not JSON: {exc}")])
+    if not isinstance(raw, dict):
+        raise ModelError([ModelProblem(source=str(path), where="", reason="expected an object")])
+    r = _Reader(path)
+    for key in sorted(set(raw) - _KNOWN_KEYS):
+        r.problem(f"/{key}", f"unknown field; known fields: {', '.join(sorted(_KNOWN_KEYS))}")
+    version = r.get(raw, "format_version", int, "")
+    if version is not None and version != FORMAT_VERSION:
+        r.problem("/format_version", f"{version} is not a version this program reads "
+                  f"(expected {FORMAT_VERSION})")
+    name = r.get(raw, "name", str, "") or ""
+    field_class = r.get(raw, "class", str, "") or "kid"
+    if field_class not in FIELD_CLASSES:
+        r.problem("/class", f"{field_class!r} is not one of {', '.join(FIELD_CLASSES)}")
+    model_rel = r.get(raw, "model_file", str, "") or ""
+    model_file = (path.parent / model_rel).resolve()
+    if model_rel and not model_file.is_file():
+        r.problem("/model_file", f"{model_rel!r}: no such file ({model_file})")
+    elif model_rel and model_file.suffix.lower() not in (".urdf", ".xml", ".mjcf"):
+        r.problem("/model_file", f"{model_rel!r}: expected a .urdf, .xml or .mjcf file")
+    packages: dict[str, Path] = {}
+    for pkg, rel in (r.get(raw, "packages", dict, "", required=False, default={}) or {}).items():
+        if not isinstance(rel, str):
+            r.problem(f"/packages/{pkg}", f"{rel!r} is not a string (a folder)")
+            continue
+        folder = (path.parent / rel).resolve()
+        if not folder.is_dir():
+            r.problem(f"/packages/{pkg}", f"{rel!r}: no such folder ({folder})")
+        packages[pkg] = folder
+    motors = _motors(r, raw)
+    imu = r.get(raw, "imu", dict, "") or {}
+    imu_link = r.get(imu, "link", str, "/imu") or ""
+    cameras = _cameras(r, raw)
+    forces = r.get(raw, "force_sensors", dict, "", required=False, default={}) or {}
+    for key, link in forces.items():
+        if not isinstance(link, str):
+            r.problem(f"/force_sensors/{key}", f"{link!r} is not a string (a link name)")
+    parts_raw = r.get(raw, "parts", dict, "") or {}
+    parts: dict[str, str] = {}
+    for part, links in parts_raw.items():
+        if part not in PART_NAMES:
+            r.problem(f"/parts/{part}", f"unknown part; expected one of {', '.join(PART_NAMES)}")
+            continue
+        if not isinstance(links, list) or not all(isinstance(x, str) for x in links):
+            r.problem(f"/parts/{part}", "expected an array of link names")
+            continue
+        for link in links:
+            parts[link] = part
+    hands = _pair(r, raw, "hands")
+    feet = _pair(r, raw, "feet")
+    collision = r.get(raw, "collision", str, "", required=False, default="link-boxes")
+    if collision not in COLLISION_MODES:
+        r.problem("/collision", f"{collision!r} is not one of {', '.join(COLLISION_MODES)}")
+    standing = r.get(raw, "standing_pose_rad", dict, "", required=False, default={}) or {}
+    motor_names = {m.name for m in motors}
+    for key, value in standing.items():
+        if key not in motor_names:
+            r.problem(f"/standing_pose_rad/{key}", "not the name of a motor in /motors")
+        elif isinstance(value, bool) or not isinstance(value, (int, float)):
+            r.problem(f"/standing_pose_rad/{key}", f"{value!r} is not a number (rad)")
+    damping = r.get(raw, "joint_damping", (int, float), "", required=False)
+    armature = r.get(raw, "joint_armature", (int, float), "", required=False)
+    friction = r.get(raw, "joint_frictionloss", (int, float), "", required=False)
+    if r.problems:
+        raise ModelError(r.problems)
+    return Manifest(
+        path=path, name=name, field_class=field_class, model_file=model_file, packages=packages,
+        motors=motors, sensor_suffix=str(raw.get("sensor_suffix", "S")), imu_link=imu_link,
+        cameras=cameras, force_sensors={str(k): str(v) for k, v in forces.items()},
+        parts=parts, hands=hands, feet=feet, collision=str(collision),
+        standing_pose_rad={str(k): float(v) for k, v in standing.items()},
+        joint_damping=None if damping is None else float(damping),
+        joint_armature=None if armature is None else float(armature),
+        joint_frictionloss=None if friction is None else float(friction),
+    )
+
+
+def _motors(r: _Reader, raw: dict[str, Any]) -> tuple[MotorEntry, ...]:
+    entries = r.get(raw, "motors", list, "") or []
+    if not entries and "motors" in raw:
+        r.problem("/motors", "no motors: expected at least one joint driven as a motor")
+    motors = []
+    seen: dict[str, int] = {}
+    for i, entry in enumerate(entries):
+        p = f"/motors/{i}"
+        if not isinstance(entry, dict):
+            r.problem(p, "expected an object with joint, name, kp, max_torque_nm ...")
+            continue
+        joint = r.get(entry, "joint", str, p) or ""
+        name = r.get(entry, "name", str, p, required=False, default=joint) or joint
+        if name in seen:
+            r.problem(f"{p}/name", f"{name!r} is also the name of /motors/{seen[name]}")
+        seen[name] = i
+        kp = r.positive(entry, "kp", p)
+        kv = r.get(entry, "kv", (int, float), p, required=False, default=None)
+        torque = r.positive(entry, "max_torque_nm", p)
+        velocity = r.positive(entry, "max_velocity_rad_s", p)
+        if kp is None or torque is None or velocity is None:
+            continue
+        motors.append(MotorEntry(
+            joint=joint, name=name, kp_nm_per_rad=kp,
+            kv_nm_s_per_rad=float(kv) if kv is not None else 0.005 * kp,
+            max_torque_nm=torque, max_velocity_rad_s=velocity,
+        ))
+    return tuple(motors)
+
+
+def _cameras(r: _Reader, raw: dict[str, Any]) -> tuple[CameraEntry, ...]:
+    cameras = []
+    for i, entry in enumerate(r.get(raw, "cameras", list, "") or []):
+        p = f"/cameras/{i}"
+        if not isinstance(entry, dict):
+            r.problem(p, "expected an object with name, link, width, height, fov_rad")
+            continue
+        name = r.get(entry, "name", str, p, required=False, default="Camera") or "Camera"
+        link = r.get(entry, "link", str, p) or ""
+        width = r.get(entry, "width", int, p)
+        height = r.get(entry, "height", int, p)
+        fov = r.positive(entry, "fov_rad", p)
+        pos = r.get(entry, "pos_m", list, p, required=False, default=[0.0, 0.0, 0.0])
+        if not (isinstance(pos, list) and len(pos) == 3
+                and all(isinstance(v, (int, float)) for v in pos)):
+            r.problem(f"{p}/pos_m", f"{pos!r} is not [x, y, z] in metres")
+            pos = [0.0, 0.0, 0.0]
+        for key, value in (("width", width), ("height", height)):
+            if value is not None and not 1 <= value <= 4096:
+                r.problem(f"{p}/{key}", f"{value} pixels is outside 1..4096")
+        if width is None or height is None or fov is None:
+            continue
+        cameras.append(CameraEntry(name=name, link=link, width=width, height=height,
+                                   fov_rad=fov, pos_m=(float(pos[0]), float(pos[1]),
+                                                       float(pos[2]))))
+    return tuple(cameras)
+
+
+def _pair(r: _Reader, raw: dict[str, Any], key: str) -> tuple[str, str]:
+    obj = r.get(raw, key, dict, "") or {}
+    left = r.get(obj, "left", str, f"/{key}") or ""
+    right = r.get(obj, "right", str, f"/{key}") or ""
+    return (left, right)

@@ -1,0 +1,125 @@
+"""A team robot model as the world uses it: the same surface as the built-in models."""
+
+from __future__ import annotations
+
+import copy
+import math
+import threading
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+from simulator.world.robots.model import CameraSpec, MotorSpec, RobotMjcf
+from simulator.world.robots.team.build import PREFIX, Template, build_template
+from simulator.world.robots.team.manifest import Manifest, load_manifest
+from simulator.world.robots.team.source import load_spec
+
+VISUAL = "/visual:"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TeamRobotModel:
+    """A model package loaded for the world: motors, sensors and the MJCF of one robot."""
+
+    name: str  # the package's folder, as the match spec names it
+    field_class: str
+    manifest: Manifest
+    motors: tuple[MotorSpec, ...]
+    camera: CameraSpec
+    force_sensors: tuple[str, ...]
+    template: Template
+
+    @property
+    def standing_height_m(self) -> float:
+        return self.template.standing_height_m
+
+    @property
+    def standing_pose_rad(self) -> tuple[float, ...]:
+        """Joint positions (``motor_names`` order) the robot stands in when placed."""
+        pose = self.manifest.standing_pose_rad
+        return tuple(pose.get(m.name, 0.0) for m in self.motors)
+
+    @property
+    def motor_names(self) -> tuple[str, ...]:
+        return tuple(m.name for m in self.motors)
+
+    def motor(self, name: str) -> MotorSpec:
+        for motor in self.motors:
+            if motor.name == name:
+                return motor
+        raise KeyError(name)
+
+    def mjcf(
+        self,
+        *,
+        prefix: str,
+        rgba: str,
+        contype: int,
+        conaffinity: int,
+        pose: tuple[float, float, float],
+    ) -> RobotMjcf:
+        """The robot's body at ``pose`` (x, y, yaw), its servos and sensors, named by ``prefix``;
+        collision geoms get ``contype``/``conaffinity``, the marker and the trunk's visuals the
+        team colour ``rgba``."""
+        body = copy.deepcopy(self.template.body)
+        x, y, yaw = pose
+        body.set("pos", f"{x:.9g} {y:.9g} {self.standing_height_m:.9g}")
+        body.set("quat", f"{math.cos(yaw / 2):.9g} 0 0 {math.sin(yaw / 2):.9g}")
+        for element in body.iter("body"):
+            colour_visuals = element.get("name") == self.template.trunk_body
+            for geom in element.findall("geom"):
+                name = geom.get("name", "")
+                if VISUAL in name:
+                    if colour_visuals or name.endswith("/visual:marker"):
+                        geom.set("rgba", rgba)
+                    continue
+                geom.set("contype", str(contype))
+                geom.set("conaffinity", str(conaffinity))
+        text = ET.tostring(body, encoding="unicode").replace(PREFIX, prefix)
+        return RobotMjcf(
+            body=text,
+            actuators=self.template.actuators.replace(PREFIX, prefix),
+            sensors=self.template.sensors.replace(PREFIX, prefix),
+            assets=self.template.assets,
+            asset_key=self.template.key,
+        )
+
+
+_CACHE: dict[Path, TeamRobotModel] = {}
+_LOCK = threading.Lock()
+
+
+def load_team_model(folder: Path) -> TeamRobotModel:
+    """The model package in ``folder`` (cached per process). Raises ModelError."""
+    folder = folder.resolve()
+    with _LOCK:
+        cached = _CACHE.get(folder)
+        if cached is not None:
+            return cached
+        manifest = load_manifest(folder)
+        key = manifest.name or folder.name
+        template = build_template(load_spec(manifest), manifest, key=key)
+        camera = manifest.cameras[0]
+        model = TeamRobotModel(
+            name=str(folder),
+            field_class=manifest.field_class,
+            manifest=manifest,
+            motors=tuple(
+                MotorSpec(
+                    name=m.name,
+                    lower_rad=template.ranges[m.name][0],
+                    upper_rad=template.ranges[m.name][1],
+                    kp_nm_per_rad=m.kp_nm_per_rad,
+                    kv_nm_s_per_rad=m.kv_nm_s_per_rad,
+                    max_torque_nm=m.max_torque_nm,
+                    max_velocity_rad_s=m.max_velocity_rad_s,
+                )
+                for m in manifest.motors
+            ),
+            camera=CameraSpec(name=camera.name, width=camera.width, height=camera.height,
+                              fov_rad=camera.fov_rad),
+            force_sensors=tuple(manifest.force_sensors),
+            template=template,
+        )
+        _CACHE[folder] = model
+        return model
