@@ -46,7 +46,12 @@ def register(sub: Any) -> None:
         ),
         epilog="exit codes: 0 every file is valid (warnings allowed), 2 a file is invalid",
     )
-    parser.add_argument("files", nargs="+", metavar="FILE", help="files to check")
+    parser.add_argument(
+        "files",
+        nargs="+",
+        metavar="FILE",
+        help="files to check; a folder with robot_model.json is checked as a robot model package",
+    )
     parser.add_argument("--kind", choices=KINDS, help="check every FILE as this kind")
     parser.add_argument(
         "--class",
@@ -77,6 +82,7 @@ class FileReport:
     file: str
     kind: str | None
     problems: list[Problem] = field(default_factory=list)
+    measurements: dict[str, Any] | None = None  # robot model packages
 
     @property
     def errors(self) -> list[Problem]:
@@ -87,7 +93,9 @@ class FileReport:
         return not self.errors
 
     def as_json(self) -> dict[str, Any]:
+        extra = {} if self.measurements is None else {"measurements": self.measurements}
         return {
+            **extra,
             "file": self.file,
             "kind": self.kind,
             "valid": self.valid,
@@ -151,7 +159,13 @@ def check_report(
     field_class: FieldClass | None = None,
     images_required: bool = False,
 ) -> FileReport:
-    """Check one file and return every problem found (nothing printed)."""
+    """Check one file (or robot model package) and return every problem found (nothing
+    printed)."""
+    from orchestrator.commands.check_model import MODEL_KIND, check_model, is_model_package
+
+    if is_model_package(path):
+        problems, measurements = check_model(path)
+        return FileReport(str(path), MODEL_KIND, problems, measurements)
     try:
         found_kind, problems = _check(
             path, kind=kind, field_class=field_class, images_required=images_required
@@ -164,6 +178,10 @@ def check_report(
 
 
 def print_text(report: FileReport, *, out: TextIO) -> None:
+    if report.measurements is not None:
+        from orchestrator.commands.check_model import describe
+
+        print(f"{report.file}: {describe(report.measurements)}", file=out)
     for problem in report.errors + [p for p in report.problems if p.severity != "error"]:
         print(str(problem), file=out)
     if report.valid:

@@ -26,8 +26,12 @@ from simulator.errors import ModelError, ModelProblem
 from simulator.world.robots.team.manifest import Manifest
 
 PREFIX = "@ROBOT@"
-HULL = (("hands", 0, "hand_L"), ("hands", 1, "hand_R"), ("feet", 0, "foot_L"),
-        ("feet", 1, "foot_R"))
+HULL = (
+    ("hands", 0, "hand_L"),
+    ("hands", 1, "hand_R"),
+    ("feet", 0, "foot_L"),
+    ("feet", 1, "foot_R"),
+)
 MARKER_RADIUS_M = 0.04
 
 
@@ -106,39 +110,69 @@ def _validate(spec: mujoco.MjSpec, manifest: Manifest) -> list[ModelProblem]:
     joints = {j.name: j for b in _bodies(spec) for j in b.joints}
     motor_joints = {m.joint for m in manifest.motors}
     if len(spec.worldbody.bodies) != 1:
-        problems.append(_problem(manifest, "model_file",
-                                 f"{len(spec.worldbody.bodies)} root links; expected one tree"))
+        problems.append(
+            _problem(
+                manifest,
+                "model_file",
+                f"{len(spec.worldbody.bodies)} root links; expected one tree",
+            )
+        )
     if not joints:
-        problems.append(_problem(manifest, "model_file",
-                                 "the model has no movable joints (a robot needs motors)"))
+        problems.append(
+            _problem(
+                manifest, "model_file", "the model has no movable joints (a robot needs motors)"
+            )
+        )
     for i, motor in enumerate(manifest.motors):
         joint = joints.get(motor.joint)
         if joint is None:
             hint = _did_you_mean(motor.joint, joints)
-            problems.append(_problem(manifest, f"/motors/{i}/joint",
-                                     f"no joint {motor.joint!r} in the model{hint}"))
+            problems.append(
+                _problem(
+                    manifest, f"/motors/{i}/joint", f"no joint {motor.joint!r} in the model{hint}"
+                )
+            )
         elif joint.type not in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE):
-            problems.append(_problem(manifest, f"/motors/{i}/joint",
-                                     f"joint {motor.joint!r} is not a revolute joint"))
+            problems.append(
+                _problem(
+                    manifest, f"/motors/{i}/joint", f"joint {motor.joint!r} is not a revolute joint"
+                )
+            )
         elif not joint.limited and not (joint.range[0] < joint.range[1]):
-            problems.append(_problem(manifest, f"/motors/{i}/joint",
-                                     f"joint {motor.joint!r} has no limits (rule: every motor "
-                                     "joint has a range)"))
+            problems.append(
+                _problem(
+                    manifest,
+                    f"/motors/{i}/joint",
+                    f"joint {motor.joint!r} has no limits (rule: every motor joint has a range)",
+                )
+            )
     for name, joint in joints.items():
         if name not in motor_joints and joint.type != mujoco.mjtJoint.mjJNT_FREE:
-            problems.append(_problem(manifest, "/motors",
-                                     f"joint {name!r} is movable but not a motor; list it under "
-                                     "motors (unactuated joints are not allowed)"))
+            problems.append(
+                _problem(
+                    manifest,
+                    "/motors",
+                    f"joint {name!r} is movable but not a motor; list it under "
+                    "motors (unactuated joints are not allowed)",
+                )
+            )
     named: list[tuple[str, str]] = [("/imu/link", manifest.imu_link)]
     named += [(f"/cameras/{i}/link", c.link) for i, c in enumerate(manifest.cameras)]
     named += [(f"/force_sensors/{k}", v) for k, v in manifest.force_sensors.items()]
     named += [(f"/parts ({part})", link) for link, part in manifest.parts.items()]
-    named += [("/hands/left", manifest.hands[0]), ("/hands/right", manifest.hands[1]),
-              ("/feet/left", manifest.feet[0]), ("/feet/right", manifest.feet[1])]
+    named += [
+        ("/hands/left", manifest.hands[0]),
+        ("/hands/right", manifest.hands[1]),
+        ("/feet/left", manifest.feet[0]),
+        ("/feet/right", manifest.feet[1]),
+    ]
     for where, link in named:
         if link not in links:
-            problems.append(_problem(manifest, where,
-                                     f"no link {link!r} in the model{_did_you_mean(link, links)}"))
+            problems.append(
+                _problem(
+                    manifest, where, f"no link {link!r} in the model{_did_you_mean(link, links)}"
+                )
+            )
     return problems
 
 
@@ -259,8 +293,15 @@ def build_template(spec: mujoco.MjSpec, manifest: Manifest, *, key: str) -> Temp
     heaviest = int(np.argmax(original.body_mass))
     trunk = original.body(heaviest).name
     trunk_name = f"{p}/torso" if trunk == root_name else f"{p}/link:{trunk}"
-    return _template(xml, manifest, key=key, standing=standing, root_name=root_name,
-                     ranges=ranges, trunk=trunk_name)
+    return _template(
+        xml,
+        manifest,
+        key=key,
+        standing=standing,
+        root_name=root_name,
+        ranges=ranges,
+        trunk=trunk_name,
+    )
 
 
 def _top_of(model: mujoco.MjModel, manifest: Manifest) -> tuple[str, np.ndarray]:
@@ -301,12 +342,21 @@ def _standing_height(spec: mujoco.MjSpec, pose: dict[str, float]) -> float:
     return root_z - lowest
 
 
-def _template(xml: str, manifest: Manifest, *, key: str, standing: float,
-              root_name: str, ranges: dict[str, tuple[float, float]], trunk: str) -> Template:
+def _template(
+    xml: str,
+    manifest: Manifest,
+    *,
+    key: str,
+    standing: float,
+    root_name: str,
+    ranges: dict[str, tuple[float, float]],
+    trunk: str,
+) -> Template:
     doc = ET.fromstring(xml)
     asset = doc.find("asset")
-    assets = "".join(ET.tostring(e, encoding="unicode") for e in (asset if asset is not None
-                                                                   else []))
+    assets = "".join(
+        ET.tostring(e, encoding="unicode") for e in (asset if asset is not None else [])
+    )
     worldbody = doc.find("worldbody")
     assert worldbody is not None
     body = worldbody.find("body")
@@ -324,9 +374,18 @@ def _template(xml: str, manifest: Manifest, *, key: str, standing: float,
         f'<accelerometer name="{PREFIX}/Accelerometer" site="{PREFIX}/site:imu"/>'
         f'<gyro name="{PREFIX}/Gyro" site="{PREFIX}/site:imu"/>'
         f'<subtreelinvel name="{PREFIX}/com_velocity" body="{PREFIX}/torso"/>'
-        + "".join(f'<touch name="{PREFIX}/{n}" site="{PREFIX}/site:{n}"/>'
-                  for n in manifest.force_sensors)
+        + "".join(
+            f'<touch name="{PREFIX}/{n}" site="{PREFIX}/site:{n}"/>' for n in manifest.force_sensors
+        )
     )
-    return Template(key=key, assets=assets, body=body, actuators=motors, sensors=sensors,
-                    standing_height_m=standing, root_body=root_name, ranges=ranges,
-                    trunk_body=trunk)
+    return Template(
+        key=key,
+        assets=assets,
+        body=body,
+        actuators=motors,
+        sensors=sensors,
+        standing_height_m=standing,
+        root_body=root_name,
+        ranges=ranges,
+        trunk_body=trunk,
+    )

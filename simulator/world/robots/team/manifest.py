@@ -87,8 +87,16 @@ class _Reader:
     def problem(self, pointer: str, reason: str) -> None:
         self.problems.append(ModelProblem(source=str(self.path), where=pointer, reason=reason))
 
-    def get(self, obj: dict[str, Any], key: str, kind: type | tuple[type, ...], pointer: str,
-            *, required: bool = True, default: Any = None) -> Any:
+    def get(
+        self,
+        obj: dict[str, Any],
+        key: str,
+        kind: type | tuple[type, ...],
+        pointer: str,
+        *,
+        required: bool = True,
+        default: Any = None,
+    ) -> Any:
         if key not in obj:
             if required:
                 self.problem(f"{pointer}/{key}", f"missing; expected {_kind_name(kind)}")
@@ -102,8 +110,15 @@ class _Reader:
             return default
         return value
 
-    def positive(self, obj: dict[str, Any], key: str, pointer: str, *, required: bool = True,
-                 default: float | None = None) -> float | None:
+    def positive(
+        self,
+        obj: dict[str, Any],
+        key: str,
+        pointer: str,
+        *,
+        required: bool = True,
+        default: float | None = None,
+    ) -> float | None:
         value = self.get(obj, key, (int, float), pointer, required=required, default=default)
         if value is None:
             return None
@@ -118,15 +133,37 @@ def _as_tuple(kind: type | tuple[type, ...]) -> tuple[type, ...]:
 
 
 def _kind_name(kind: type | tuple[type, ...]) -> str:
-    names = {int: "an integer", float: "a number", str: "a string", dict: "an object",
-             list: "an array", bool: "true or false"}
+    names = {
+        int: "an integer",
+        float: "a number",
+        str: "a string",
+        dict: "an object",
+        list: "an array",
+        bool: "true or false",
+    }
     return " or ".join(dict.fromkeys(names.get(k, k.__name__) for k in _as_tuple(kind)))
 
 
 _KNOWN_KEYS = {
-    "format_version", "name", "class", "model_file", "packages", "motors", "sensor_suffix",
-    "imu", "cameras", "force_sensors", "parts", "hands", "feet", "collision", "joint_damping",
-    "joint_armature", "joint_frictionloss", "description", "standing_pose_rad",
+    "format_version",
+    "name",
+    "class",
+    "model_file",
+    "packages",
+    "motors",
+    "sensor_suffix",
+    "imu",
+    "cameras",
+    "force_sensors",
+    "parts",
+    "hands",
+    "feet",
+    "collision",
+    "joint_damping",
+    "joint_armature",
+    "joint_frictionloss",
+    "description",
+    "standing_pose_rad",
 }
 
 
@@ -135,13 +172,22 @@ def load_manifest(folder_or_file: Path) -> Manifest:
     path = folder_or_file / MANIFEST_NAME if folder_or_file.is_dir() else folder_or_file
     path = path.resolve()
     if not path.is_file():
-        raise ModelError([ModelProblem(source=str(path), where="",
-                                       reason=f"no {MANIFEST_NAME} here (a model package is a "
-                                       f"folder with {MANIFEST_NAME} and the model file)")])
+        raise ModelError(
+            [
+                ModelProblem(
+                    source=str(path),
+                    where="",
+                    reason=f"no {MANIFEST_NAME} here (a model package is a "
+                    f"folder with {MANIFEST_NAME} and the model file)",
+                )
+            ]
+        )
     try:
         raw = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise ModelError([ModelProblem(source=str(path), where="", reason=f"not JSON: {exc}")])
+        raise ModelError(
+            [ModelProblem(source=str(path), where="", reason=f"not JSON: {exc}")]
+        ) from None
     if not isinstance(raw, dict):
         raise ModelError([ModelProblem(source=str(path), where="", reason="expected an object")])
     r = _Reader(path)
@@ -149,8 +195,10 @@ def load_manifest(folder_or_file: Path) -> Manifest:
         r.problem(f"/{key}", f"unknown field; known fields: {', '.join(sorted(_KNOWN_KEYS))}")
     version = r.get(raw, "format_version", int, "")
     if version is not None and version != FORMAT_VERSION:
-        r.problem("/format_version", f"{version} is not a version this program reads "
-                  f"(expected {FORMAT_VERSION})")
+        r.problem(
+            "/format_version",
+            f"{version} is not a version this program reads (expected {FORMAT_VERSION})",
+        )
     name = r.get(raw, "name", str, "") or ""
     field_class = r.get(raw, "class", str, "") or "kid"
     if field_class not in FIELD_CLASSES:
@@ -207,10 +255,20 @@ def load_manifest(folder_or_file: Path) -> Manifest:
     if r.problems:
         raise ModelError(r.problems)
     return Manifest(
-        path=path, name=name, field_class=field_class, model_file=model_file, packages=packages,
-        motors=motors, sensor_suffix=str(raw.get("sensor_suffix", "S")), imu_link=imu_link,
-        cameras=cameras, force_sensors={str(k): str(v) for k, v in forces.items()},
-        parts=parts, hands=hands, feet=feet, collision=str(collision),
+        path=path,
+        name=name,
+        field_class=field_class,
+        model_file=model_file,
+        packages=packages,
+        motors=motors,
+        sensor_suffix=str(raw.get("sensor_suffix", "S")),
+        imu_link=imu_link,
+        cameras=cameras,
+        force_sensors={str(k): str(v) for k, v in forces.items()},
+        parts=parts,
+        hands=hands,
+        feet=feet,
+        collision=str(collision),
         standing_pose_rad={str(k): float(v) for k, v in standing.items()},
         joint_damping=None if damping is None else float(damping),
         joint_armature=None if armature is None else float(armature),
@@ -240,11 +298,16 @@ def _motors(r: _Reader, raw: dict[str, Any]) -> tuple[MotorEntry, ...]:
         velocity = r.positive(entry, "max_velocity_rad_s", p)
         if kp is None or torque is None or velocity is None:
             continue
-        motors.append(MotorEntry(
-            joint=joint, name=name, kp_nm_per_rad=kp,
-            kv_nm_s_per_rad=float(kv) if kv is not None else 0.005 * kp,
-            max_torque_nm=torque, max_velocity_rad_s=velocity,
-        ))
+        motors.append(
+            MotorEntry(
+                joint=joint,
+                name=name,
+                kp_nm_per_rad=kp,
+                kv_nm_s_per_rad=float(kv) if kv is not None else 0.005 * kp,
+                max_torque_nm=torque,
+                max_velocity_rad_s=velocity,
+            )
+        )
     return tuple(motors)
 
 
@@ -261,8 +324,11 @@ def _cameras(r: _Reader, raw: dict[str, Any]) -> tuple[CameraEntry, ...]:
         height = r.get(entry, "height", int, p)
         fov = r.positive(entry, "fov_rad", p)
         pos = r.get(entry, "pos_m", list, p, required=False, default=[0.0, 0.0, 0.0])
-        if not (isinstance(pos, list) and len(pos) == 3
-                and all(isinstance(v, (int, float)) for v in pos)):
+        if not (
+            isinstance(pos, list)
+            and len(pos) == 3
+            and all(isinstance(v, (int, float)) for v in pos)
+        ):
             r.problem(f"{p}/pos_m", f"{pos!r} is not [x, y, z] in metres")
             pos = [0.0, 0.0, 0.0]
         for key, value in (("width", width), ("height", height)):
@@ -270,9 +336,16 @@ def _cameras(r: _Reader, raw: dict[str, Any]) -> tuple[CameraEntry, ...]:
                 r.problem(f"{p}/{key}", f"{value} pixels is outside 1..4096")
         if width is None or height is None or fov is None:
             continue
-        cameras.append(CameraEntry(name=name, link=link, width=width, height=height,
-                                   fov_rad=fov, pos_m=(float(pos[0]), float(pos[1]),
-                                                       float(pos[2]))))
+        cameras.append(
+            CameraEntry(
+                name=name,
+                link=link,
+                width=width,
+                height=height,
+                fov_rad=fov,
+                pos_m=(float(pos[0]), float(pos[1]), float(pos[2])),
+            )
+        )
     return tuple(cameras)
 
 

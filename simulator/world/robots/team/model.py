@@ -116,8 +116,9 @@ def load_team_model(folder: Path) -> TeamRobotModel:
                 )
                 for m in manifest.motors
             ),
-            camera=CameraSpec(name=camera.name, width=camera.width, height=camera.height,
-                              fov_rad=camera.fov_rad),
+            camera=CameraSpec(
+                name=camera.name, width=camera.width, height=camera.height, fov_rad=camera.fov_rad
+            ),
             force_sensors=tuple(manifest.force_sensors),
             template=template,
         )

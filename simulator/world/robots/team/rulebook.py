@@ -101,8 +101,9 @@ def measure(robot: TeamRobotModel) -> Measurements:
         if not any(name.startswith(f"r/{part}:") for part in ("arm", "hand")):
             continue
         for j in arm_joints:
-            arm = max(arm, float(np.linalg.norm(_corners(model, data, g) - anchors[j],
-                                                axis=1).max()))
+            arm = max(
+                arm, float(np.linalg.norm(_corners(model, data, g) - anchors[j], axis=1).max())
+            )
     foot_length = foot_width = 0.0
     for side in robot.manifest.feet:
         foot = model.body(f"r/link:{side}")
@@ -120,10 +121,17 @@ def measure(robot: TeamRobotModel) -> Measurements:
             foot_width = max(foot_width, float(min(extent[0], extent[1])))
     cams = robot.manifest.cameras
     return Measurements(
-        height_m=height, leg_m=leg, head_m=head, top_m=height - leg, arm_m=arm,
-        foot_length_m=foot_length, foot_width_m=foot_width,
-        mass_kg=float(model.body_subtreemass[1]), cameras=len(cams),
-        max_fov_rad=max((c.fov_rad for c in cams), default=0.0), motors=len(robot.motors),
+        height_m=height,
+        leg_m=leg,
+        head_m=head,
+        top_m=height - leg,
+        arm_m=arm,
+        foot_length_m=foot_length,
+        foot_width_m=foot_width,
+        mass_kg=float(model.body_subtreemass[1]),
+        cameras=len(cams),
+        max_fov_rad=max((c.fov_rad for c in cams), default=0.0),
+        motors=len(robot.motors),
     )
 
 
@@ -157,35 +165,58 @@ def check(robot: TeamRobotModel) -> tuple[Measurements, list[ModelProblem]]:
 
     low, high = HEIGHT_M[robot.field_class]
     if not low <= m.height_m <= high:
-        bad("height", f"H = {m.height_m:.3f} m is outside {low}-{high} m for the "
-            f"{robot.field_class} size class")
+        bad(
+            "height",
+            f"H = {m.height_m:.3f} m is outside {low}-{high} m for the "
+            f"{robot.field_class} size class",
+        )
     h = m.height_m
     if not LEG_RATIO[0] * h <= m.leg_m <= LEG_RATIO[1] * h:
-        bad("leg length", f"Hleg = {m.leg_m:.3f} m is outside {LEG_RATIO[0]} H - {LEG_RATIO[1]} H "
-            f"= {LEG_RATIO[0] * h:.3f}-{LEG_RATIO[1] * h:.3f} m")
+        bad(
+            "leg length",
+            f"Hleg = {m.leg_m:.3f} m is outside {LEG_RATIO[0]} H - {LEG_RATIO[1]} H "
+            f"= {LEG_RATIO[0] * h:.3f}-{LEG_RATIO[1] * h:.3f} m",
+        )
     if not HEAD_RATIO[0] * h <= m.head_m <= HEAD_RATIO[1] * h:
-        bad("head size", f"Hhead = {m.head_m:.3f} m is outside {HEAD_RATIO[0]} H - "
-            f"{HEAD_RATIO[1]} H = {HEAD_RATIO[0] * h:.3f}-{HEAD_RATIO[1] * h:.3f} m")
+        bad(
+            "head size",
+            f"Hhead = {m.head_m:.3f} m is outside {HEAD_RATIO[0]} H - "
+            f"{HEAD_RATIO[1]} H = {HEAD_RATIO[0] * h:.3f}-{HEAD_RATIO[1] * h:.3f} m",
+        )
     if m.arm_m > ARM_TOP_RATIO * m.top_m:
-        bad("arm length", f"Harm = {m.arm_m:.3f} m is above {ARM_TOP_RATIO} Htop = "
-            f"{ARM_TOP_RATIO * m.top_m:.3f} m")
+        bad(
+            "arm length",
+            f"Harm = {m.arm_m:.3f} m is above {ARM_TOP_RATIO} Htop = "
+            f"{ARM_TOP_RATIO * m.top_m:.3f} m",
+        )
     area = m.foot_length_m * m.foot_width_m
     if area > FOOT_AREA_H2 * h * h:
-        bad("foot size", f"foot {m.foot_length_m:.3f} x {m.foot_width_m:.3f} m = {area:.4f} m^2 "
-            f"is above 2.2 H^2 / 32 = {FOOT_AREA_H2 * h * h:.4f} m^2")
+        bad(
+            "foot size",
+            f"foot {m.foot_length_m:.3f} x {m.foot_width_m:.3f} m = {area:.4f} m^2 "
+            f"is above 2.2 H^2 / 32 = {FOOT_AREA_H2 * h * h:.4f} m^2",
+        )
     if m.foot_width_m > 0 and m.foot_length_m / m.foot_width_m > FOOT_ASPECT:
-        bad("foot size", f"foot length / width = {m.foot_length_m / m.foot_width_m:.2f} is above "
-            f"{FOOT_ASPECT}")
+        bad(
+            "foot size",
+            f"foot length / width = {m.foot_length_m / m.foot_width_m:.2f} is above {FOOT_ASPECT}",
+        )
     if m.cameras > MAX_CAMERAS:
         bad("cameras", f"{m.cameras} cameras; at most {MAX_CAMERAS}")
     for i, cam in enumerate(robot.manifest.cameras):
         if cam.fov_rad > MAX_FOV_RAD:
-            bad(f"/cameras/{i}/fov_rad", f"horizontal field of view {cam.fov_rad:.3f} rad "
-                f"({math.degrees(cam.fov_rad):.0f} deg) is above {MAX_FOV_RAD:.3f} rad (180 deg)")
+            bad(
+                f"/cameras/{i}/fov_rad",
+                f"horizontal field of view {cam.fov_rad:.3f} rad "
+                f"({math.degrees(cam.fov_rad):.0f} deg) is above {MAX_FOV_RAD:.3f} rad (180 deg)",
+            )
     weight_limit = TORQUE_PER_WEIGHT_M * m.mass_kg * 9.81 * h
     for i, motor in enumerate(robot.manifest.motors):
         if motor.max_torque_nm > weight_limit:
-            bad(f"/motors/{i}/max_torque_nm", f"{motor.max_torque_nm} N m for {motor.name} is "
+            bad(
+                f"/motors/{i}/max_torque_nm",
+                f"{motor.max_torque_nm} N m for {motor.name} is "
                 f"above {weight_limit:.1f} N m (5 x the robot's weight x its height): check the "
-                "unit (N m)")
+                "unit (N m)",
+            )
     return m, problems

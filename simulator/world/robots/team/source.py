@@ -23,14 +23,14 @@ def _resolve(manifest: Manifest, ref: str) -> list[Path]:
     """Candidate files for a mesh reference, in the order they are tried."""
     base = manifest.model_file.parent
     if ref.startswith(PACKAGE_SCHEME):
-        package, _, rest = ref[len(PACKAGE_SCHEME):].partition("/")
+        package, _, rest = ref[len(PACKAGE_SCHEME) :].partition("/")
         roots = [manifest.packages[package]] if package in manifest.packages else []
         roots += [manifest.folder / package]
         roots += [parent / package for parent in base.parents if parent != manifest.folder]
         roots += [p for p in base.parents if p.name == package]
         return [root / rest for root in dict.fromkeys(roots)]
     if ref.startswith("file://"):
-        ref = ref[len("file://"):]
+        ref = ref[len("file://") :]
     path = Path(ref)
     return [path] if path.is_absolute() else [base / path]
 
@@ -41,8 +41,15 @@ def _parse(manifest: Manifest) -> ET.Element:
         return ET.parse(manifest.model_file).getroot()
     except ET.ParseError as exc:
         line, column = exc.position
-        raise ModelError([ModelProblem(source=source, where=f"line {line}, column {column}",
-                                       reason=f"malformed XML: {exc}")]) from None
+        raise ModelError(
+            [
+                ModelProblem(
+                    source=source,
+                    where=f"line {line}, column {column}",
+                    reason=f"malformed XML: {exc}",
+                )
+            ]
+        ) from None
     except OSError as exc:
         raise ModelError([ModelProblem(source=source, where="", reason=str(exc))]) from None
 
@@ -60,15 +67,25 @@ def _check_meshes(manifest: Manifest, root: ET.Element) -> list[ModelProblem]:
         found = next((p for p in candidates if p.is_file()), None)
         if found is None:
             tried = ", ".join(str(p) for p in candidates)
-            problems.append(ModelProblem(source=source, where=f"<mesh {attr}={ref!r}>",
-                                         reason=f"mesh file not found (tried {tried})"))
+            problems.append(
+                ModelProblem(
+                    source=source,
+                    where=f"<mesh {attr}={ref!r}>",
+                    reason=f"mesh file not found (tried {tried})",
+                )
+            )
             continue
         try:
             with found.open("rb") as handle:
                 handle.read(1)
         except OSError as exc:
-            problems.append(ModelProblem(source=source, where=f"<mesh {attr}={ref!r}>",
-                                         reason=f"mesh file not readable: {exc}"))
+            problems.append(
+                ModelProblem(
+                    source=source,
+                    where=f"<mesh {attr}={ref!r}>",
+                    reason=f"mesh file not readable: {exc}",
+                )
+            )
             continue
         element.set(attr, str(found.resolve()))
     return problems
@@ -82,16 +99,29 @@ def load_spec(manifest: Manifest) -> mujoco.MjSpec:
         raise ModelError(problems)
     is_urdf = root.tag == "robot"
     if not is_urdf and root.tag != "mujoco":
-        raise ModelError([ModelProblem(source=str(manifest.model_file), where=f"<{root.tag}>",
-                                       reason="expected a URDF <robot> or an MJCF <mujoco> file")])
+        raise ModelError(
+            [
+                ModelProblem(
+                    source=str(manifest.model_file),
+                    where=f"<{root.tag}>",
+                    reason="expected a URDF <robot> or an MJCF <mujoco> file",
+                )
+            ]
+        )
     if is_urdf:
         for old in root.findall("mujoco"):
             root.remove(old)
         extension = ET.SubElement(root, "mujoco")
-        ET.SubElement(extension, "compiler", {
-            "strippath": "false", "discardvisual": "false", "fusestatic": "false",
-            "balanceinertia": "true",
-        })
+        ET.SubElement(
+            extension,
+            "compiler",
+            {
+                "strippath": "false",
+                "discardvisual": "false",
+                "fusestatic": "false",
+                "balanceinertia": "true",
+            },
+        )
     else:
         compiler = root.find("compiler")
         if compiler is None:
@@ -102,6 +132,13 @@ def load_spec(manifest: Manifest) -> mujoco.MjSpec:
         spec = mujoco.MjSpec.from_string(text)
         spec.compile()
     except (ValueError, mujoco.FatalError) as exc:
-        raise ModelError([ModelProblem(source=str(manifest.model_file), where="",
-                                       reason=f"MuJoCo cannot load the model: {exc}")]) from None
+        raise ModelError(
+            [
+                ModelProblem(
+                    source=str(manifest.model_file),
+                    where="",
+                    reason=f"MuJoCo cannot load the model: {exc}",
+                )
+            ]
+        ) from None
     return spec
