@@ -10,7 +10,7 @@ HLVS   := $(VENV)/bin/hlvs
 BUILD  := .build
 PYTEST_ARGS ?=
 
-.PHONY: scrimmage test setup venv system engine postgres images lint typecheck clean-build
+.PHONY: scrimmage test setup venv system engine postgres images lint typecheck clean-build web
 
 scrimmage: setup
 	$(HLVS) scrimmage --out matches/scrimmage
@@ -52,10 +52,15 @@ images: venv engine
 	$(HLVS) images build $(if $(BASE_IMAGE),--base $(BASE_IMAGE),)
 
 lint:
-	$(VENV)/bin/ruff check orchestrator simulator referee service envs tests
+	$(VENV)/bin/ruff check orchestrator simulator referee service envs viewer tests
 
 typecheck:
 	$(VENV)/bin/mypy
 
 clean-build:
 	rm -rf $(BUILD)
+
+# The web front end (web/, TypeScript + three.js from the npm lock file) bundled into
+# viewer/static/app.js, which is committed: installing the package needs no Node.js.
+web:
+	cd web && npm ci --no-audit --no-fund && npm run build

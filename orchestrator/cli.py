@@ -40,6 +40,7 @@ COMMAND_MODULES = (
     "orchestrator.commands.logs",
     "orchestrator.commands.schedule",
     "orchestrator.commands.simulator",
+    "orchestrator.commands.viewer",
     "service.commands",
 )
 

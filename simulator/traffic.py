@@ -4,7 +4,7 @@ About once a wall-clock second :class:`TrafficLog` takes a sample from the robot
 counters and writes it as one JSON line::
 
     {"real_time_s", "sim_time_ms", "real_time_factor",
-     "robots": {"red_1": {"connected", "bytes_in", "bytes_out", "messages_in", "messages_out",
+     "robots": {"red-1": {"connected", "bytes_in", "bytes_out", "messages_in", "messages_out",
                           "round_trip_ms"}}}
 
 Byte and message counts are totals since the start; ``round_trip_ms`` is the mean round trip of

@@ -34,6 +34,7 @@ log = logging.getLogger(__name__)
 PUBLIC_FILES = (
     "sim_result.json",
     "replay.hlvsrec",
+    "api_stats.jsonl",
     "referee.log",
     "referee_events.jsonl",
     "gamecontroller.log",

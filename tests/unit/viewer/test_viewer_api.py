@@ -1,0 +1,137 @@
+"""The viewer API over HTTP (in-process app): meta, chunks, stats, sources, live stream."""
+
+from __future__ import annotations
+
+import json
+import struct
+import threading
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+from fastapi.testclient import TestClient
+
+from simulator.replay import ReplayFile
+from tests.unit.viewer.replays import GOAL_MS, record_match
+from viewer import Catalog, SourceError
+from viewer.api import create_app
+from viewer.live import Callback
+
+V1_FIXTURE = Path(__file__).parents[1] / "replay" / "fixtures" / "v1-two-robots.hlvsrec"
+
+
+@pytest.fixture(scope="module")
+def match_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("viewer") / "match-7"
+    record_match(folder)
+    return folder
+
+
+def _client(*paths: Path) -> tuple[TestClient, list[str]]:
+    catalog = Catalog()
+    pages = [page for path in paths for page in catalog.add_path(path)]
+    return TestClient(create_app(catalog)), pages
+
+
+def test_meta_and_chunks_carry_the_replay(match_dir: Path) -> None:
+    client, pages = _client(match_dir)
+    assert pages == ["/watch/replay/match-7"]
+    meta = client.get("/api/viewer/replays/match-7/meta").json()
+    assert meta["match_id"] == "viewer-test" and meta["version"] == 2 and meta["has_stats"]
+    assert meta["duration_ms"] == 3000 and meta["chunks"][1] == [1000, 1960, 25]
+    assert [(e["type"], e["frame_ms"]) for e in meta["events"]] == [("goal", GOAL_MS)]
+    assert len(meta["scene"]["geoms"]) > 200 and meta["body_count"] == len(meta["scene"]["bodies"])
+    blob = client.get("/api/viewer/replays/match-7/chunks/2").content
+    (length,) = struct.unpack_from("<I", blob)
+    head = json.loads(blob[4 : 4 + length])
+    start = 4 + length + (-length % 4)
+    poses = np.frombuffer(blob[start:], dtype="<f4").reshape(25, meta["body_count"], 7)
+    with ReplayFile(match_dir / "public" / "replay.hlvsrec") as replay:
+        block = replay.read_chunk(2)
+    assert head["times"] == block.times_ms.tolist() and head["games"] == block.games
+    np.testing.assert_array_equal(poses, block.poses)
+    assert head["games"][0]["score"] == {"red": 1, "blue": 0}
+    stats = client.get("/api/viewer/replays/match-7/stats").json()
+    assert [s["real_time_factor"] for s in stats] == [1.0, 1.1, 1.2, 1.3]
+
+
+def test_pages_and_static_files_are_served(match_dir: Path) -> None:
+    client, _ = _client(match_dir)
+    page = client.get("/watch/replay/match-7")
+    assert page.status_code == 200
+    assert '<script type="module" src="/watch/static/app.js">' in page.text
+    script = client.get("/watch/static/app.js")
+    assert script.status_code == 200 and "javascript" in script.headers["content-type"]
+    assert len(script.content) > 100_000  # three.js is bundled: no page needs the internet
+    assert "https://" not in page.text
+
+
+def test_unknown_ids_and_chunks_are_named(match_dir: Path) -> None:
+    client, _ = _client(match_dir)
+    missing = client.get("/api/viewer/replays/match-8/meta")
+    assert missing.status_code == 404 and "match-8" in missing.text and "match-7" in missing.text
+    far = client.get("/api/viewer/replays/match-7/chunks/99")
+    assert far.status_code == 404 and "out of range 0..3" in far.text
+
+
+def test_version_1_replays_are_served_with_a_rebuilt_scene() -> None:
+    client, pages = _client(V1_FIXTURE)
+    assert pages == ["/watch/replay/v1-two-robots"]
+    meta = client.get("/api/viewer/replays/v1-two-robots/meta").json()
+    assert meta["version"] == 1 and meta["scene"]["bodies"][2] == "red_1/torso"
+    assert len(client.get("/api/viewer/replays/v1-two-robots/chunks/0").content) > 13 * 48 * 28
+
+
+def test_paths_without_replays_are_refused(tmp_path: Path) -> None:
+    with pytest.raises(SourceError, match="no replay in this folder"):
+        Catalog().add_path(tmp_path)
+    other = tmp_path / "notes.txt"
+    other.write_text("x")
+    with pytest.raises(SourceError, match="not a replay"):
+        Catalog().add_path(other)
+    with pytest.raises(SourceError, match="no such file"):
+        Catalog().add_path(tmp_path / "absent")
+
+
+class _FakeFeed:
+    """Stands in for the zenoh subscription: pushes canned telemetry from a thread."""
+
+    def __init__(self, endpoint: str, match_id: str, callback: Callback) -> None:
+        self.endpoint = endpoint
+        poses = struct.pack("<I", 1234) + np.arange(14, dtype="<f4").tobytes()
+        messages = [("scene", b'{"scene": {}}'), ("state", b'{"sim_time_ms": 1234}'),
+                    ("poses", poses), ("events", b'{"type": "goal"}')]  # fmt: skip
+        self._thread = threading.Thread(target=lambda: [callback(*m) for m in messages])
+        self._thread.start()
+
+    def close(self) -> None:
+        self._thread.join()
+
+
+def test_the_live_stream_relays_telemetry_as_server_sent_events(tmp_path: Path) -> None:
+    folder = tmp_path / "running"
+    (folder / "simulator").mkdir(parents=True)
+    (folder / "simulator" / "match_spec.json").write_text(
+        json.dumps({"match_id": "m 1", "network": {"telemetry_listen": "tcp/10.0.0.2:7447"}})
+    )
+    catalog = Catalog()
+    assert catalog.add_path(folder) == ["/watch/live/m-1"]
+    client = TestClient(create_app(catalog, feed_factory=_FakeFeed))
+    events: list[tuple[str, str]] = []
+    with client.stream("GET", "/api/viewer/live/m-1/stream") as response:
+        kind = ""
+        lines: Iterator[str] = response.iter_lines()
+        for line in lines:
+            if line.startswith("event: "):
+                kind = line[7:]
+            elif line.startswith("data: "):
+                events.append((kind, line[6:]))
+                if len(events) == 4:
+                    break
+    assert [k for k, _ in events] == ["scene", "state", "poses", "event"]
+    assert events[1][1] == '{"sim_time_ms": 1234}'
+    import base64
+
+    raw = base64.b64decode(events[2][1])
+    assert struct.unpack_from("<I", raw)[0] == 1234 and len(raw) == 4 + 14 * 4

@@ -1,0 +1,199 @@
+"""The viewer's HTTP API and pages (FastAPI router), shared by ``hlvs view`` and ``hlvs serve``.
+
+Pages: ``/watch/`` (index), ``/watch/replay/<id>``, ``/watch/live/<id>`` and the service pages;
+every one is ``static/index.html`` with the bundled front end (``static/app.js``), which picks
+the page from the path. API under ``/api/viewer``:
+
+- ``GET index``: the replays and live matches known;
+- ``GET replays/<id>/meta``: match id, format version, frame rate, duration, body count, the
+  scene (``simulator.replay.scene``), the chunk index ``[[first_ms, last_ms, frames]...]``, the
+  referee events (each with the ``frame_ms`` it was recorded with) and whether statistics exist;
+- ``GET replays/<id>/chunks/<k>``: one chunk of frames, binary: u32 JSON length, JSON
+  ``{"times": [...], "games": [...]}``, zero padding to 4 bytes, then float32 poses
+  (frames x bodies x 7, little-endian);
+- ``GET replays/<id>/stats``: the ``api_stats.jsonl`` samples as a JSON list;
+- ``GET live/<id>/stream``: server-sent events ``scene``, ``state``, ``event``, ``poses``
+  (base64 of the telemetry's binary poses) from the match's telemetry.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import base64
+import json
+import struct
+from collections.abc import AsyncIterator
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+from fastapi import APIRouter, FastAPI, HTTPException
+from fastapi.responses import FileResponse, Response, StreamingResponse
+from fastapi.staticfiles import StaticFiles
+
+from simulator.errors import ReplayError
+from simulator.replay import ReplayFile, scene_for
+from simulator.traffic import read_stats
+from viewer.live import FeedFactory, LiveUnavailable, ZenohFeed
+from viewer.sources import Catalog, ReplaySource
+
+STATIC = Path(__file__).parent / "static"
+API_PREFIX = "/api/viewer"
+KEEPALIVE_S = 10.0
+
+
+def _missing(what: str, key: str, known: list[str]) -> HTTPException:
+    hint = f"; known: {', '.join(sorted(known)[:20])}" if known else ""
+    return HTTPException(status_code=404, detail=f"no {what} {key!r}{hint}")
+
+
+class _OpenReplays:
+    """Keeps replay files open (header and index read once) per source path and mtime."""
+
+    def __init__(self) -> None:
+        self._open = lru_cache(maxsize=16)(self._load)
+
+    @staticmethod
+    def _load(path: Path, mtime_ns: int) -> tuple[ReplayFile, dict[str, Any]]:
+        del mtime_ns  # part of the cache key: a replay still being written is reopened
+        replay = ReplayFile(path)
+        return replay, scene_for(replay.header, str(path))
+
+    def get(self, source: ReplaySource) -> tuple[ReplayFile, dict[str, Any]]:
+        try:
+            return self._open(source.path, source.path.stat().st_mtime_ns)
+        except OSError as exc:
+            raise HTTPException(status_code=404, detail=f"{source.path}: {exc}") from exc
+        except ReplayError as exc:
+            raise HTTPException(status_code=422, detail=str(exc)) from exc
+
+
+def build_router(catalog: Catalog, *, feed_factory: FeedFactory = ZenohFeed) -> APIRouter:
+    router = APIRouter()
+    replays = _OpenReplays()
+
+    def source_of(replay_id: str) -> ReplaySource:
+        source = catalog.replays.get(replay_id)
+        if source is None:
+            raise _missing("replay", replay_id, list(catalog.replays))
+        return source
+
+    @router.get(f"{API_PREFIX}/index")
+    def index() -> dict[str, Any]:
+        listing = []
+        for source in catalog.replays.values():
+            try:
+                replay, _ = replays.get(source)
+            except HTTPException:
+                continue
+            listing.append({"id": source.id, "match_id": replay.header.match_id,
+                            "duration_ms": replay.duration_ms, "version": replay.header.version})
+        return {"replays": listing, "live": [{"id": key} for key in catalog.live]}
+
+    @router.get(f"{API_PREFIX}/replays/{{replay_id}}/meta")
+    def meta(replay_id: str) -> dict[str, Any]:
+        source = source_of(replay_id)
+        replay, scene = replays.get(source)
+        return {
+            "id": source.id,
+            "match_id": replay.header.match_id,
+            "version": replay.header.version,
+            "rate_hz": replay.header.rate_hz,
+            "duration_ms": replay.duration_ms,
+            "body_count": replay.nbody,
+            "robots": [r.key for r in replay.header.robots],
+            "chunks": [[c.first_ms, c.last_ms, c.frames] for c in replay.chunks],
+            "events": list(replay.events),
+            "scene": scene,
+            "has_stats": source.stats_path is not None,
+        }
+
+    @router.get(f"{API_PREFIX}/replays/{{replay_id}}/chunks/{{index}}")
+    def chunk(replay_id: str, index: int) -> Response:
+        replay, _ = replays.get(source_of(replay_id))
+        if not 0 <= index < len(replay.chunks):
+            raise HTTPException(
+                status_code=404, detail=f"chunk {index} out of range 0..{len(replay.chunks) - 1}"
+            )
+        try:
+            block = replay.read_chunk(index)
+        except ReplayError as exc:
+            raise HTTPException(status_code=422, detail=str(exc)) from exc
+        head = json.dumps(
+            {"times": block.times_ms.tolist(), "games": block.games}, separators=(",", ":")
+        ).encode()
+        pad = b"\0" * ((4 - len(head) % 4) % 4)
+        body = struct.pack("<I", len(head)) + head + pad + block.poses.astype("<f4").tobytes()
+        return Response(body, media_type="application/octet-stream",
+                        headers={"Cache-Control": "max-age=60"})
+
+    @router.get(f"{API_PREFIX}/replays/{{replay_id}}/stats")
+    def stats(replay_id: str) -> list[dict[str, Any]]:
+        source = source_of(replay_id)
+        return read_stats(source.stats_path) if source.stats_path is not None else []
+
+    @router.get(f"{API_PREFIX}/live/{{match_id}}/stream")
+    async def stream(match_id: str) -> StreamingResponse:
+        live = catalog.live.get(match_id)
+        if live is None:
+            raise _missing("live match", match_id, list(catalog.live))
+        return StreamingResponse(
+            _sse(live.endpoint, match_id, feed_factory), media_type="text/event-stream",
+            headers={"Cache-Control": "no-cache"},
+        )
+
+    @router.get("/watch", include_in_schema=False)
+    @router.get("/watch/{page:path}", include_in_schema=False)
+    def page(page: str = "") -> FileResponse:
+        del page
+        return FileResponse(STATIC / "index.html")
+
+    return router
+
+
+_SSE_NAMES = {"state": "state", "events": "event", "poses": "poses", "scene": "scene"}
+
+
+async def _sse(endpoint: str, match_id: str, factory: FeedFactory) -> AsyncIterator[bytes]:
+    loop = asyncio.get_running_loop()
+    queue: asyncio.Queue[tuple[str, bytes]] = asyncio.Queue(maxsize=256)
+
+    def on_message(kind: str, payload: bytes) -> None:
+        def put() -> None:
+            if kind == "poses" and queue.qsize() > 128:
+                return  # a slow browser skips pose updates, never state or events
+            if not queue.full():
+                queue.put_nowait((kind, payload))
+
+        loop.call_soon_threadsafe(put)
+
+    try:
+        feed = await asyncio.to_thread(factory, endpoint, match_id, on_message)
+    except LiveUnavailable as exc:
+        yield f"event: failure\ndata: {json.dumps(str(exc))}\n\n".encode()
+        return
+    try:
+        yield b": connected\n\n"
+        while True:
+            try:
+                kind, payload = await asyncio.wait_for(queue.get(), KEEPALIVE_S)
+            except TimeoutError:
+                yield b": keep-alive\n\n"
+                continue
+            data = base64.b64encode(payload).decode() if kind == "poses" else payload.decode()
+            yield f"event: {_SSE_NAMES[kind]}\ndata: {data}\n\n".encode()
+    finally:
+        await asyncio.to_thread(feed.close)
+
+
+def mount(app: FastAPI, catalog: Catalog, *, feed_factory: FeedFactory = ZenohFeed) -> None:
+    """Add the viewer's pages, API and static files to ``app``."""
+    app.mount("/watch/static", StaticFiles(directory=STATIC), name="viewer-static")
+    app.include_router(build_router(catalog, feed_factory=feed_factory))
+
+
+def create_app(catalog: Catalog, *, feed_factory: FeedFactory = ZenohFeed) -> FastAPI:
+    """The app of ``hlvs view``: the viewer alone, no account, no database."""
+    app = FastAPI(title="hlvs view", docs_url=None, redoc_url=None)
+    mount(app, catalog, feed_factory=feed_factory)
+    return app

@@ -1,0 +1,118 @@
+"""What a viewer shows: replays (with their API statistics) and live matches, found from paths.
+
+A path is a replay file, or a match folder as ``hlvs match`` / ``hlvs scrimmage`` write it:
+``public/replay.hlvsrec`` once the match is over, ``simulator/out/replay.hlvsrec`` while it
+runs, ``api_stats.jsonl`` beside the replay, and ``simulator/match_spec.json`` whose
+``network.telemetry_listen`` is where a running match's telemetry is (the live view).
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from viewer.errors import SourceError
+
+STATS_FILE = "api_stats.jsonl"
+REPLAY_SUFFIX = ".hlvsrec"
+_REPLAY_PLACES = ("public/replay.hlvsrec", "simulator/out/replay.hlvsrec", "replay.hlvsrec")
+
+
+@dataclass(frozen=True, slots=True)
+class ReplaySource:
+    id: str
+    path: Path
+    stats_path: Path | None
+
+
+@dataclass(frozen=True, slots=True)
+class LiveSource:
+    id: str  # the match id (telemetry keys hlvs/<id>/...)
+    endpoint: str  # zenoh endpoint, e.g. tcp/10.213.4.2:7447
+    replay_path: Path | None  # where the replay is being written (shown once the match is over)
+
+
+@dataclass(slots=True)
+class Catalog:
+    """Replays and live matches by id; ids are safe in a URL path segment."""
+
+    replays: dict[str, ReplaySource] = field(default_factory=dict)
+    live: dict[str, LiveSource] = field(default_factory=dict)
+
+    def add_replay(self, path: Path, *, id: str | None = None) -> ReplaySource:
+        stats = path.with_name(STATS_FILE)
+        source = ReplaySource(
+            id=self._unique(id or _slug(path)),
+            path=path,
+            stats_path=stats if stats.is_file() else None,
+        )
+        self.replays[source.id] = source
+        return source
+
+    def _unique(self, base: str) -> str:
+        name, n = base, 2
+        while name in self.replays:
+            name, n = f"{base}-{n}", n + 1
+        return name
+
+    def add_path(self, path: Path) -> list[str]:
+        """Add a replay file or a match folder; returns the viewer paths to open (/watch/...)."""
+        path = path.resolve()
+        if path.is_file():
+            if path.suffix != REPLAY_SUFFIX:
+                raise SourceError(
+                    path=str(path),
+                    reason=f"not a replay (expected a *{REPLAY_SUFFIX} file or a match folder)",
+                )
+            return [f"/watch/replay/{self.add_replay(path).id}"]
+        if not path.is_dir():
+            raise SourceError(path=str(path), reason="no such file or folder")
+        opened: list[str] = []
+        live = _live_of(path)
+        if live is not None and not (path / "public" / "replay.hlvsrec").is_file():
+            self.live[live.id] = live
+            opened.append(f"/watch/live/{live.id}")
+        for place in _REPLAY_PLACES:
+            replay = path / place
+            if replay.is_file():
+                source = self.add_replay(replay, id=_slug_text(live.id if live else path.name))
+                opened.append(f"/watch/replay/{source.id}")
+                break
+        if not opened:
+            raise SourceError(
+                path=str(path),
+                reason="no replay in this folder (looked for "
+                + ", ".join(_REPLAY_PLACES) + ") and no running match (simulator/match_spec.json)",
+            )
+        return opened
+
+
+def _slug_text(text: str) -> str:
+    return re.sub(r"[^A-Za-z0-9._-]+", "-", text).strip("-") or "replay"
+
+
+def _slug(path: Path) -> str:
+    if path.stem == "replay":  # public/replay.hlvsrec -> the match folder's name
+        parent = path.parent.parent if path.parent.name in ("public", "out") else path.parent
+        if path.parent.name == "out":
+            parent = parent.parent
+        return _slug_text(parent.name)
+    return _slug_text(path.stem)
+
+
+def _live_of(folder: Path) -> LiveSource | None:
+    spec_path = folder / "simulator" / "match_spec.json"
+    if not spec_path.is_file():
+        return None
+    try:
+        spec = json.loads(spec_path.read_text(encoding="utf-8"))
+        endpoint = spec["network"]["telemetry_listen"]
+        match_id = str(spec["match_id"])
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise SourceError(path=str(spec_path), reason=f"unreadable match spec: {exc}") from exc
+    if not endpoint:
+        return None
+    replay = folder / "simulator" / "out" / "replay.hlvsrec"
+    return LiveSource(id=_slug_text(match_id), endpoint=str(endpoint), replay_path=replay)

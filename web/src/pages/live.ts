@@ -1,0 +1,85 @@
+// The live page: the same scene and scoreboard fed by the match's telemetry (server-sent events
+// from the viewer API), the real-time factor and each robot's connection health.
+import type { GameState, RefereeEvent } from "../replay";
+import { SceneView, type SceneSpec } from "../scene";
+import { Scoreboard, clock, describeEvent, el } from "../ui";
+
+interface LiveState extends GameState {
+  sim_time_ms: number;
+  real_time_factor: number;
+  connected?: string[];
+  robots?: Record<string, { connected: boolean; bytes_in: number; bytes_out: number; round_trip_ms: number | null }> | null;
+}
+
+function decodePoses(b64: string): { timeMs: number; poses: Float32Array } {
+  const bytes = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
+  const view = new DataView(bytes.buffer);
+  return { timeMs: view.getUint32(0, true), poses: new Float32Array(bytes.buffer.slice(4)) };
+}
+
+export function livePage(root: HTMLElement, api: string, matchId: string): void {
+  const board = new Scoreboard(`${matchId} (live)`);
+  const status = el("div", { class: "live-status", "data-testid": "live-status" }, "waiting for telemetry...");
+  const canvas = el("canvas", { class: "view", "data-testid": "scene" });
+  const health = el("table", { class: "health", "data-testid": "health" });
+  const list = el("ol", { class: "events", "data-testid": "events" });
+  root.append(
+    board.root,
+    status,
+    el("div", { class: "stage" }, canvas, el("aside", {}, el("h3", {}, "Robots"), health, el("h3", {}, "Referee events"), list)),
+  );
+  let view: SceneView | null = null;
+  let latest: Float32Array | null = null;
+  let updates = 0;
+  let simTimeMs = 0;
+  let rtf = 0;
+  const source = new EventSource(`${api}/live/${encodeURIComponent(matchId)}/stream`);
+  source.addEventListener("scene", (e) => {
+    if (view) return;
+    const header = JSON.parse((e as MessageEvent).data) as { scene: SceneSpec };
+    view = new SceneView(canvas, header.scene);
+    if (latest) view.setPoses(latest);
+  });
+  source.addEventListener("poses", (e) => {
+    const { timeMs, poses } = decodePoses((e as MessageEvent).data);
+    latest = poses;
+    simTimeMs = timeMs;
+    updates += 1;
+    view?.setPoses(poses);
+  });
+  source.addEventListener("state", (e) => {
+    const state = JSON.parse((e as MessageEvent).data) as LiveState;
+    board.update(state);
+    rtf = state.real_time_factor;
+    simTimeMs = Math.max(simTimeMs, state.sim_time_ms);
+    status.textContent = `sim ${clock(state.sim_time_ms)}  real-time factor ${state.real_time_factor.toFixed(2)}  ${state.stepping ?? ""}`;
+    const robots = state.robots ?? {};
+    health.replaceChildren(
+      el("tr", {}, el("th", {}, "robot"), el("th", {}, "link"), el("th", {}, "kB in/out"), el("th", {}, "RTT ms")),
+      ...Object.entries(robots).map(([key, r]) =>
+        el("tr", { "data-robot": key, class: r.connected ? "up" : "down" },
+          el("td", {}, key), el("td", {}, r.connected ? "connected" : "down"),
+          el("td", {}, `${(r.bytes_in / 1000).toFixed(0)} / ${(r.bytes_out / 1000).toFixed(0)}`),
+          el("td", {}, r.round_trip_ms === null ? "-" : r.round_trip_ms.toFixed(1)))),
+    );
+  });
+  source.addEventListener("event", (e) => {
+    const event = JSON.parse((e as MessageEvent).data) as RefereeEvent;
+    list.prepend(el("li", { "data-type": event.type }, `${clock(event.sim_time_ms)} ${describeEvent(event)}`));
+  });
+  source.addEventListener("end", () => {
+    status.textContent += "  (match over)";
+    source.close();
+  });
+  function frame(): void {
+    view?.render();
+    requestAnimationFrame(frame);
+  }
+  requestAnimationFrame(frame);
+  (window as unknown as Record<string, unknown>).hlvsLive = {
+    get updates() { return updates; },
+    get simTimeMs() { return simTimeMs; },
+    get realTimeFactor() { return rtf; },
+    get hasScene() { return view !== null; },
+  };
+}

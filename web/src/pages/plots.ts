@@ -1,0 +1,96 @@
+// Plots from api_stats.jsonl samples: the real-time factor over time, and per robot the
+// bandwidth used (both directions, from the byte counters) and the round-trip latency.
+import { TEAM_CSS } from "../scene";
+import { el, getJson } from "../ui";
+
+interface Sample {
+  real_time_s: number;
+  sim_time_ms: number;
+  real_time_factor: number;
+  robots: Record<string, { bytes_in: number; bytes_out: number; round_trip_ms: number | null; connected: boolean }>;
+}
+
+type Series = { name: string; colour: string; points: [number, number][] };
+
+const SVG = "http://www.w3.org/2000/svg";
+const PALETTE = ["#d91f1a", "#f07a2a", "#c2185b", "#8e2424", "#1a40e6", "#2aa7f0", "#5e35b1", "#00897b"];
+
+function colourOf(robot: string, index: number): string {
+  return PALETTE[index % PALETTE.length] ?? TEAM_CSS[robot.split("_")[0]] ?? "#333";
+}
+
+export function lineChart(title: string, unit: string, series: Series[], testid: string): HTMLElement {
+  const width = 420;
+  const height = 180;
+  const pad = 36;
+  const all = series.flatMap((s) => s.points);
+  const xmax = Math.max(1, ...all.map((p) => p[0]));
+  const ymax = Math.max(1e-9, ...all.map((p) => p[1])) * 1.1;
+  const svg = document.createElementNS(SVG, "svg");
+  svg.setAttribute("viewBox", `0 0 ${width} ${height}`);
+  svg.setAttribute("data-testid", testid);
+  const axis = document.createElementNS(SVG, "path");
+  axis.setAttribute("d", `M${pad},8 V${height - 20} H${width - 8}`);
+  axis.setAttribute("stroke", "#888");
+  axis.setAttribute("fill", "none");
+  svg.append(axis);
+  for (const [y, text] of [[8, ymax.toPrecision(3)], [height - 20, "0"]] as [number, string][]) {
+    const label = document.createElementNS(SVG, "text");
+    label.setAttribute("x", "2");
+    label.setAttribute("y", String(y + 4));
+    label.setAttribute("font-size", "10");
+    label.textContent = text;
+    svg.append(label);
+  }
+  const xLabel = document.createElementNS(SVG, "text");
+  xLabel.setAttribute("x", String(width - 80));
+  xLabel.setAttribute("y", String(height - 4));
+  xLabel.setAttribute("font-size", "10");
+  xLabel.textContent = `${xmax.toFixed(0)} s (wall)`;
+  svg.append(xLabel);
+  for (const s of series) {
+    const line = document.createElementNS(SVG, "polyline");
+    const points = s.points.map(([x, y]) => `${(pad + (x / xmax) * (width - pad - 8)).toFixed(1)},${(height - 20 - (y / ymax) * (height - 28)).toFixed(1)}`);
+    line.setAttribute("points", points.join(" "));
+    line.setAttribute("stroke", s.colour);
+    line.setAttribute("fill", "none");
+    line.setAttribute("stroke-width", "1.5");
+    line.setAttribute("data-series", s.name);
+    svg.append(line);
+  }
+  const legend = el("div", { class: "legend" }, ...series.map((s) => el("span", { style: `color:${s.colour}` }, `■ ${s.name} `)));
+  return el("figure", { class: "chart" }, el("figcaption", {}, `${title} (${unit})`), svg, legend);
+}
+
+export function statsSeries(samples: Sample[]): { rtf: Series[]; bandwidth: Series[]; latency: Series[] } {
+  const robots = [...new Set(samples.flatMap((s) => Object.keys(s.robots ?? {})))].sort();
+  const rtf = [{ name: "real-time factor", colour: "#2e7d32", points: samples.map((s) => [s.real_time_s, s.real_time_factor] as [number, number]) }];
+  const bandwidth: Series[] = [];
+  const latency: Series[] = [];
+  robots.forEach((robot, index) => {
+    const colour = colourOf(robot, index);
+    const kb: [number, number][] = [];
+    const rtt: [number, number][] = [];
+    for (let i = 1; i < samples.length; i++) {
+      const a = samples[i - 1].robots?.[robot];
+      const b = samples[i].robots?.[robot];
+      const dt = samples[i].real_time_s - samples[i - 1].real_time_s;
+      if (a && b && dt > 0) kb.push([samples[i].real_time_s, (b.bytes_in + b.bytes_out - a.bytes_in - a.bytes_out) / 1000 / dt]);
+      if (b && b.round_trip_ms !== null) rtt.push([samples[i].real_time_s, b.round_trip_ms]);
+    }
+    bandwidth.push({ name: robot, colour, points: kb });
+    latency.push({ name: robot, colour, points: rtt });
+  });
+  return { rtf, bandwidth, latency };
+}
+
+export async function drawStats(root: HTMLElement, url: string): Promise<void> {
+  const samples = await getJson<Sample[]>(url);
+  if (samples.length === 0) return;
+  const { rtf, bandwidth, latency } = statsSeries(samples);
+  root.append(
+    lineChart("Real-time factor", "sim s per wall s", rtf, "plot-rtf"),
+    lineChart("Robot API bandwidth", "kB/s, both directions", bandwidth, "plot-bandwidth"),
+    lineChart("Robot API round trip", "ms", latency, "plot-latency"),
+  );
+}

@@ -1,0 +1,104 @@
+// The replay page: the match in 3D with play/pause, speed, seeking, the scoreboard and the
+// referee's events on a clickable timeline.
+import { ReplayData, type RefereeEvent } from "../replay";
+import { SceneView } from "../scene";
+import { Scoreboard, clock, describeEvent, el } from "../ui";
+import { drawStats } from "./plots";
+
+const SPEEDS = [0.25, 0.5, 1, 2, 4, 8, 16];
+const EVENT_LEAD_MS = 2000; // clicking an event shows the 2 s before it
+const TIMELINE_TYPES = new Set(["goal", "penalty", "card", "ball_out", "kickoff", "dropped_ball", "state"]);
+
+export async function replayPage(root: HTMLElement, api: string, replayId: string): Promise<void> {
+  const data = await ReplayData.open(`${api}/replays/${encodeURIComponent(replayId)}`);
+  const meta = data.meta;
+  const board = new Scoreboard(meta.match_id);
+  const canvas = el("canvas", { class: "view", "data-testid": "scene" });
+  const play = el("button", { "data-testid": "play" }, "Play");
+  const speed = el("select", { "data-testid": "speed" });
+  for (const s of SPEEDS) speed.append(el("option", { value: String(s), ...(s === 1 ? { selected: "" } : {}) }, `${s}x`));
+  const seek = el("input", {
+    type: "range", min: "0", max: String(meta.duration_ms), step: "40", value: "0", "data-testid": "seek",
+  });
+  const now = el("span", { class: "time", "data-testid": "time" }, "00:00");
+  const timeline = el("div", { class: "timeline", "data-testid": "timeline" });
+  const list = el("ol", { class: "events", "data-testid": "events" });
+  const shown = meta.events.filter((e) => TIMELINE_TYPES.has(e.type) && !(e.type === "state" && e.reason === ""));
+  for (const event of shown) {
+    const left = meta.duration_ms > 0 ? (100 * event.frame_ms) / meta.duration_ms : 0;
+    const mark = el("button", {
+      class: `mark ${event.type} ${event.team ?? ""}`, style: `left:${left}%`, title: `${clock(event.frame_ms)} ${describeEvent(event)}`,
+      "data-testid": `mark-${event.type}`, "data-ms": String(event.frame_ms),
+    }, event.type === "goal" ? "⚽" : "");
+    mark.addEventListener("click", () => jumpTo(event));
+    timeline.append(mark);
+    const item = el("li", { "data-type": event.type },
+      el("button", { class: "link" }, `${clock(event.frame_ms)} ${describeEvent(event)}`));
+    item.addEventListener("click", () => jumpTo(event));
+    list.append(item);
+  }
+  const plots = el("div", { class: "plots" });
+  root.append(
+    board.root,
+    el("div", { class: "stage" }, canvas, el("aside", {}, el("h3", {}, "Referee events"), list)),
+    el("div", { class: "controls" }, play, speed, seek, now),
+    timeline,
+    plots,
+  );
+  const view = new SceneView(canvas, meta.scene);
+  const poses = new Float32Array(data.stride);
+  let timeMs = 0;
+  let playing = false;
+  let last = performance.now();
+  let ready = false;
+
+  function jumpTo(event: RefereeEvent): void {
+    setTime(Math.max(0, event.frame_ms - EVENT_LEAD_MS));
+  }
+  function setTime(t: number): void {
+    timeMs = Math.min(meta.duration_ms, Math.max(0, t));
+    seek.value = String(timeMs);
+  }
+  play.addEventListener("click", () => {
+    playing = !playing;
+    if (playing && timeMs >= meta.duration_ms) setTime(0);
+    play.textContent = playing ? "Pause" : "Play";
+  });
+  seek.addEventListener("input", () => setTime(Number(seek.value)));
+  document.addEventListener("keydown", (e) => {
+    if (e.key === " ") { play.click(); e.preventDefault(); }
+  });
+
+  await data.load(0);
+  function frame(at: number): void {
+    const dt = at - last;
+    last = at;
+    if (playing) {
+      setTime(timeMs + dt * Number(speed.value));
+      if (timeMs >= meta.duration_ms) { playing = false; play.textContent = "Play"; }
+    }
+    const game = data.sample(timeMs, poses);
+    if (game !== null) {
+      view.setPoses(poses);
+      board.update(game);
+      ready = true;
+    }
+    now.textContent = `${clock(timeMs)} / ${clock(meta.duration_ms)}`;
+    view.render();
+    requestAnimationFrame(frame);
+  }
+  requestAnimationFrame(frame);
+  if (meta.has_stats) void drawStats(plots, `${api}/replays/${encodeURIComponent(replayId)}/stats`);
+
+  // A small handle for tests and benchmarks (read-only views of the player's state).
+  (window as unknown as Record<string, unknown>).hlvsViewer = {
+    meta,
+    get time() { return timeMs; },
+    get ready() { return ready && data.loaded(data.chunkAt(timeMs)); },
+    get frames() { return view.frames; },
+    get playing() { return playing; },
+    seek: (t: number) => setTime(t),
+    project: (p: number[]) => view.project(p),
+    poses: () => Array.from(poses),
+  };
+}

@@ -1,0 +1,63 @@
+// Small DOM helpers shared by the pages: elements, the scoreboard, time formatting.
+import type { GameState } from "./replay";
+
+export function el<K extends keyof HTMLElementTagNameMap>(
+  tag: K,
+  attrs: Record<string, string> = {},
+  ...children: (Node | string)[]
+): HTMLElementTagNameMap[K] {
+  const node = document.createElement(tag);
+  for (const [k, v] of Object.entries(attrs)) node.setAttribute(k, v);
+  for (const child of children) node.append(child);
+  return node;
+}
+
+export function clock(ms: number): string {
+  const s = Math.max(0, Math.floor(ms / 1000));
+  return `${String(Math.floor(s / 60)).padStart(2, "0")}:${String(s % 60).padStart(2, "0")}`;
+}
+
+export class Scoreboard {
+  readonly root = el("div", { class: "scoreboard", "data-testid": "scoreboard" });
+  private readonly red = el("span", { class: "score red", "data-testid": "score-red" }, "0");
+  private readonly blue = el("span", { class: "score blue", "data-testid": "score-blue" }, "0");
+  private readonly state = el("span", { class: "state", "data-testid": "game-state" }, "-");
+  private readonly clockText = el("span", { class: "clock", "data-testid": "game-clock" }, "--:--");
+
+  constructor(title: string) {
+    this.root.append(
+      el("span", { class: "title" }, title),
+      el("span", { class: "team red" }, "RED"),
+      this.red,
+      el("span", { class: "colon" }, ":"),
+      this.blue,
+      el("span", { class: "team blue" }, "BLUE"),
+      this.state,
+      this.clockText,
+    );
+  }
+
+  update(game: GameState | null | undefined): void {
+    if (!game) return;
+    const score = game.score;
+    if (score) {
+      this.red.textContent = String(score.red);
+      this.blue.textContent = String(score.blue);
+    }
+    const half = game.half === 1 ? "1st half" : game.half === 2 ? "2nd half" : "";
+    const secondary = game.secondary_state && game.secondary_state !== "NORMAL" ? ` ${game.secondary_state}` : "";
+    this.state.textContent = `${game.state ?? "-"}${secondary} ${half}`.trim();
+    if (typeof game.secs_remaining === "number") this.clockText.textContent = clock(game.secs_remaining * 1000);
+  }
+}
+
+export function describeEvent(e: { type: string; team?: string | null; player?: number | null; reason?: string }): string {
+  const who = e.team ? ` ${e.team}${e.player ? ` ${e.player}` : ""}` : "";
+  return `${e.type}${who}${e.reason ? `: ${e.reason}` : ""}`;
+}
+
+export async function getJson<T>(url: string): Promise<T> {
+  const response = await fetch(url);
+  if (!response.ok) throw new Error(`${url}: ${response.status} ${await response.text()}`);
+  return (await response.json()) as T;
+}
