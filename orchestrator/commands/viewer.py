@@ -2,17 +2,43 @@
 
 from __future__ import annotations
 
+import argparse
+import logging
 from typing import Any
 
 
 def register(sub: Any) -> None:
-    from viewer.cli import add_export_arguments, add_view_arguments, export, view
-
-    parser = sub.add_parser(
-        "view", help="serve the replay / live viewer for match folders or replays on 127.0.0.1"
+    view: argparse.ArgumentParser = sub.add_parser(
+        "view",
+        help="serve the 3D replay viewer (and the live view of a running match) on 127.0.0.1",
     )
-    add_view_arguments(parser)
-    parser.set_defaults(func=view)
-    parser = sub.add_parser("export", help="export a replay to MCAP (Foxglove schemas)")
-    add_export_arguments(parser)
-    parser.set_defaults(func=export)
+    view.add_argument(
+        "paths", nargs="+", metavar="MATCH_DIR|REPLAY",
+        help="match folders (as hlvs match / scrimmage write them) or .hlvsrec replay files",
+    )  # fmt: skip
+    view.add_argument(
+        "--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1)"
+    )
+    view.add_argument("--port", type=int, default=0, help="port (default: a free one)")
+    view.set_defaults(func=_view, log_level=logging.INFO)
+    export: argparse.ArgumentParser = sub.add_parser(
+        "export", help="export a replay to MCAP (Foxglove schemas, simulated time)"
+    )
+    export.add_argument("replay", metavar="REPLAY", help="the .hlvsrec replay file")
+    export.add_argument("-o", "--output", required=True, help="MCAP file to write")
+    export.add_argument(
+        "--stats", help="api_stats.jsonl to include (default: the one beside the replay)"
+    )
+    export.set_defaults(func=_export)
+
+
+def _view(args: argparse.Namespace) -> int:
+    from viewer.cli import view
+
+    return view(paths=args.paths, host=args.host, port=args.port)
+
+
+def _export(args: argparse.Namespace) -> int:
+    from viewer.cli import export
+
+    return export(replay=args.replay, output=args.output, stats=args.stats)
