@@ -101,6 +101,8 @@ class HlvsEnv(gym.Env[dict[str, Any], np.ndarray]):
             raise EnvStateError(operation="reset", reason="the environment is closed")
         world_seed = int(self.np_random.integers(0, SEED_LIMIT))
         request = self.reset_request(world_seed, options or {})
+        if getattr(self.session, "crashed", False):
+            self._replace_crashed()
         self.frame = self.session.reset(request)
         self.on_reset(self.frame)
         return observe(self.frame, self.observation_space), self.info(self.frame)  # type: ignore[arg-type]
@@ -108,6 +110,11 @@ class HlvsEnv(gym.Env[dict[str, Any], np.ndarray]):
     def step(
         self, action: np.ndarray
     ) -> tuple[dict[str, Any], SupportsFloat, bool, bool, dict[str, Any]]:
+        frame = self.session.step(self.targets(action))
+        return self.finish_step(frame)
+
+    def targets(self, action: np.ndarray) -> FloatArray:
+        """The motor targets of ``action`` (checked: after reset, right shape)."""
         if self.frame is None:
             raise EnvStateError(operation="step", reason="call reset() before step()")
         targets = np.asarray(action, dtype=np.float64).reshape(-1)
@@ -116,8 +123,12 @@ class HlvsEnv(gym.Env[dict[str, Any], np.ndarray]):
                 field="action", value=f"shape {targets.shape}",
                 expected=f"shape {self.action_space.shape} (motor targets, rad)",
             )  # fmt: skip
+        return targets
+
+    def finish_step(self, frame: Frame) -> tuple[dict[str, Any], float, bool, bool, dict[str, Any]]:
+        """Reward, ends and observation of the frame a step produced."""
+        assert self.frame is not None
         previous = self.frame
-        frame = self.session.step(targets)
         self.frame = frame
         reward, terminated, truncated = self.judge(previous, frame)
         obs = observe(frame, self.observation_space)  # type: ignore[arg-type]
@@ -139,6 +150,16 @@ class HlvsEnv(gym.Env[dict[str, Any], np.ndarray]):
         self.session.close()
         if self._owner is not None:
             self._owner.close()
+
+    def _replace_crashed(self) -> None:
+        """A remote that crashed is replaced when the pool started it; else RemoteError."""
+        if self._owner is None:
+            from envs.errors import RemoteError
+
+            raise RemoteError(address=str(getattr(self.session, "address", "?")),
+                              reason="crashed; no pool to replace it")  # fmt: skip
+        self.session.close()
+        self.session = self._owner.replace(0, self.session_spec)
 
     # --- trainer -----------------------------------------------------------------------------
 

@@ -68,8 +68,9 @@ RECIPES: dict[str, ImageRecipe] = {
     "simulator": ImageRecipe(
         name="simulator",
         base=SIM_BASE,
-        requirements=("mujoco", "numpy", "eclipse-zenoh", "protobuf"),
-        packages=("simulator", "referee", "robot", "contracts"),
+        requirements=("mujoco", "numpy", "eclipse-zenoh", "protobuf", "gymnasium"),
+        # envs: `remote` serves learning sessions (the simulator image started with a flag)
+        packages=("simulator", "referee", "robot", "contracts", "envs"),
     ),
     # Robot images carry the robot package and its own dependency list only (no MuJoCo).
     "stub": ImageRecipe(

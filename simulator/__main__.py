@@ -11,6 +11,7 @@ import sys
 COMMANDS = {
     "run": "simulator.runtime",
     "render": "simulator.render",
+    "remote": "envs.remote_server",  # learning sessions for remote environments
     "bench": None,
 }
 BENCHES = {
@@ -19,7 +20,7 @@ BENCHES = {
     "stub": "benchmarks.stub",
 }
 
-USAGE = "usage: python -m simulator {run|render|bench sim|bench api|bench stub} ..."
+USAGE = "usage: python -m simulator {run|render|remote|bench sim|bench api|bench stub} ..."
 
 
 def main(argv: list[str]) -> int:

@@ -1,0 +1,198 @@
+"""Remote simulators as containers on the local Docker engine (the only envs module that imports
+``docker``).
+
+Each remote is the simulator image started with ``remote --port 7700``, its port published on
+127.0.0.1 at a port the engine picks. Containers carry the project label, the role ``env-remote``,
+the pool id and the owner (``host:pid``): :meth:`DockerLauncher.close` removes a pool's containers
+by label, and a new pool first removes the containers of owners that no longer run on this host
+(left by a killed process). A remote is healthy once it greets and answers ``health``.
+"""
+
+from __future__ import annotations
+
+import atexit
+import json
+import logging
+import os
+import socket
+import time
+import uuid
+
+import docker
+import docker.errors
+
+from envs.errors import RemoteStartFailed
+from envs.remote import RemoteAddress
+from envs.wire import WELCOME, FrameReader, WireError, send_frame
+
+log = logging.getLogger(__name__)
+
+LABEL_PROJECT = "org.hlvs-runner"
+LABEL_ROLE = "org.hlvs-runner.role"
+LABEL_POOL = "org.hlvs-runner.env-pool"
+LABEL_OWNER = "org.hlvs-runner.env-owner"
+ROLE = "env-remote"
+CONTAINER_PORT = 7700
+HEALTH_TIMEOUT_S = 60.0
+
+
+def _owner() -> str:
+    return f"{socket.gethostname()}:{os.getpid()}"
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def default_image() -> str:
+    """``HLVS_SIMULATOR_IMAGE``, else the simulator image of this code (built if missing)."""
+    name = os.environ.get("HLVS_SIMULATOR_IMAGE")
+    if name:
+        return name
+    from orchestrator.images import ensure_image
+
+    return ensure_image("simulator").reference
+
+
+class DockerLauncher:
+    def __init__(
+        self, *, image: str | None = None, health_timeout_s: float = HEALTH_TIMEOUT_S
+    ) -> None:
+        try:
+            self.client = docker.from_env(timeout=120)
+            self.client.ping()
+        except (docker.errors.DockerException, OSError) as exc:
+            raise RemoteStartFailed(address="docker", reason=f"no Docker engine: {exc}") from exc
+        self.image = image or default_image()
+        self.pool_id = uuid.uuid4().hex[:10]
+        self.health_timeout_s = health_timeout_s
+        self.containers: list[str] = []
+        self._closed = False
+        atexit.register(self.close)
+        self._remove_orphans()
+
+    def _labels(self) -> dict[str, str]:
+        return {LABEL_PROJECT: "1", LABEL_ROLE: ROLE, LABEL_POOL: self.pool_id,
+                LABEL_OWNER: _owner()}  # fmt: skip
+
+    def _remove_orphans(self) -> None:
+        host = socket.gethostname()
+        for c in self.client.containers.list(all=True, filters={"label": f"{LABEL_ROLE}={ROLE}"}):
+            owner = c.labels.get(LABEL_OWNER, "")
+            owner_host, _, pid = owner.rpartition(":")
+            if owner_host == host and pid.isdigit() and not _pid_alive(int(pid)):
+                log.info("removing remote %s left by process %s", c.name, pid)
+                self._remove(c.id)
+
+    def start(self, count: int) -> list[RemoteAddress]:
+        started = [self._run(i) for i in range(count)]
+        return [self._healthy(cid, i) for i, cid in enumerate(started)]
+
+    def _run(self, index: int) -> str:
+        name = f"hlvs-env-{self.pool_id}-{index}-{uuid.uuid4().hex[:4]}"
+        try:
+            container = self.client.containers.run(
+                self.image,
+                command=["remote", "--port", str(CONTAINER_PORT)],
+                name=name,
+                detach=True,
+                labels=self._labels(),
+                ports={f"{CONTAINER_PORT}/tcp": ("127.0.0.1", None)},
+                environment={"LP_NUM_THREADS": "0"},
+            )
+        except docker.errors.DockerException as exc:
+            raise RemoteStartFailed(address=name, reason=str(exc)) from exc
+        cid = str(container.id)
+        if index < len(self.containers):
+            self.containers[index] = cid
+        else:
+            self.containers.append(cid)
+        log.info("started remote %s (%s)", name, self.image)
+        return cid
+
+    def _port(self, cid: str) -> int | None:
+        container = self.client.containers.get(cid)
+        ports = (container.attrs.get("NetworkSettings") or {}).get("Ports") or {}
+        bound = ports.get(f"{CONTAINER_PORT}/tcp") or []
+        return int(bound[0]["HostPort"]) if bound else None
+
+    def _healthy(self, cid: str, index: int) -> RemoteAddress:
+        deadline = time.monotonic() + self.health_timeout_s
+        reason = "no answer"
+        while time.monotonic() < deadline:
+            cause = self.diagnose(index)
+            if cause is not None:
+                raise RemoteStartFailed(address=cid[:12], reason=cause)
+            port = self._port(cid)
+            if port is not None:
+                try:
+                    _probe("127.0.0.1", port)
+                    return RemoteAddress("127.0.0.1", port)
+                except (OSError, WireError) as exc:
+                    reason = str(exc)
+            time.sleep(0.2)
+        raise RemoteStartFailed(
+            address=cid[:12], reason=f"not healthy after {self.health_timeout_s:g} s: {reason}"
+        )
+
+    def replace(self, index: int) -> RemoteAddress:
+        old = self.containers[index]
+        self._remove(old)
+        return self._healthy(self._run(index), index)
+
+    def diagnose(self, index: int) -> str | None:
+        """Why remote ``index`` is not running (exit code, OOM, last log lines), or None."""
+        try:
+            container = self.client.containers.get(self.containers[index])
+        except docker.errors.NotFound:
+            return "its container is gone (removed by someone)"
+        except docker.errors.DockerException as exc:
+            return f"the engine cannot tell: {exc}"
+        state = container.attrs.get("State") or {}
+        if state.get("Running"):
+            return None
+        logs = container.logs(tail=5).decode(errors="replace").strip().replace("\n", " | ")
+        oom = " (out of memory)" if state.get("OOMKilled") else ""
+        return f"container exited with code {state.get('ExitCode')}{oom}; last log lines: {logs}"
+
+    def _remove(self, cid: str) -> None:
+        try:
+            self.client.containers.get(cid).remove(force=True)
+        except docker.errors.NotFound:
+            pass
+        except docker.errors.DockerException as exc:
+            log.warning("could not remove remote %s: %s", cid[:12], exc)
+
+    def close(self) -> None:
+        if self._closed:
+            return
+        self._closed = True
+        atexit.unregister(self.close)
+        found = self.client.containers.list(
+            all=True, filters={"label": f"{LABEL_POOL}={self.pool_id}"}
+        )
+        for container in found:
+            self._remove(str(container.id))
+        log.info("removed %d remote(s) of pool %s", len(found), self.pool_id)
+        self.client.close()
+
+
+def _probe(host: str, port: int) -> None:
+    """Greeting and a ``health`` answer, then close (raises OSError / WireError)."""
+    with socket.create_connection((host, port), timeout=2.0) as sock:
+        sock.settimeout(5.0)
+        greeting = sock.recv(8)
+        if greeting != WELCOME:
+            raise WireError(f"greeting {greeting!r}")
+        reader = FrameReader(sock)
+        send_frame(sock, b"T", json.dumps({"op": "health"}).encode())
+        if not reader.expect_json().get("ok"):
+            raise WireError("health check failed")
+        send_frame(sock, b"T", json.dumps({"op": "close"}).encode())
+        reader.expect_json()

@@ -1,0 +1,277 @@
+"""Remote simulators behind environments: addresses, the client session, the pool.
+
+``remotes="hlvs://host:port,host:port"`` names simulators someone started
+(``docker run -p 7700:7700 hlvs-runner/simulator remote --port 7700``); ``remotes=N`` starts N
+simulator containers on the local Docker engine (:mod:`envs.docker_pool`), health-checked,
+labelled and removed at close. A remote that dies during an episode raises
+:class:`envs.errors.RemoteCrashed` with its cause (the container's exit code and last log lines,
+or the socket error); the next ``reset()`` replaces a container the pool started.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import socket
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+import numpy.typing as npt
+
+from envs.errors import (
+    EnvConfigError,
+    EnvStateError,
+    RemoteCrashed,
+    RemoteError,
+    TrainerError,
+)
+from envs.frame import Frame
+from envs.session_spec import ResetRequest, SessionSpec
+from envs.wire import (
+    REFUSED,
+    TAG_ACTUATORS,
+    TAG_SENSORS,
+    TAG_TRAINER,
+    WELCOME,
+    FrameReader,
+    WireError,
+    decode_sensors,
+    encode_targets,
+    send_frame,
+)
+
+log = logging.getLogger(__name__)
+SCHEME = "hlvs://"
+CONNECT_TIMEOUT_S = 10.0
+REPLY_TIMEOUT_S = 120.0
+
+
+@dataclass(frozen=True, slots=True)
+class RemoteAddress:
+    host: str
+    port: int
+
+    def __str__(self) -> str:
+        return f"{SCHEME}{self.host}:{self.port}"
+
+
+def parse_remotes(text: str) -> list[RemoteAddress]:
+    """``"hlvs://host:port,host:port"`` (the scheme may be given once, for each, or not at all)."""
+    out = []
+    for item in (part.strip() for part in text.split(",")):
+        if not item:
+            continue
+        bare = item[len(SCHEME) :] if item.startswith(SCHEME) else item
+        host, sep, port = bare.rpartition(":")
+        if "://" in bare or not sep or not host or not port.isdigit() or not 0 < int(port) < 65536:
+            raise EnvConfigError(
+                field="remotes", value=item, expected="hlvs://host:port[,host:port...]"
+            )
+        out.append(RemoteAddress(host, int(port)))
+    if not out:
+        raise EnvConfigError(field="remotes", value=text, expected="at least one hlvs://host:port")
+    return out
+
+
+class RemoteSession:
+    """A session on a remote simulator (the :class:`envs.base.Session` protocol)."""
+
+    def __init__(
+        self,
+        address: RemoteAddress,
+        spec: SessionSpec,
+        *,
+        diagnose: Callable[[], str | None] | None = None,
+        connect_timeout_s: float = CONNECT_TIMEOUT_S,
+    ) -> None:
+        self.address = address
+        self.spec = spec
+        self.crashed = False
+        self._diagnose = diagnose
+        self._sock = self._connect(connect_timeout_s)
+        self._reader = FrameReader(self._sock)
+        self._call({"op": "open", "spec": spec.to_dict()})
+
+    def _connect(self, timeout_s: float) -> socket.socket:
+        where = str(self.address)
+        try:
+            sock = socket.create_connection((self.address.host, self.address.port), timeout_s)
+            greeting = b""
+            while len(greeting) < 8:
+                chunk = sock.recv(8 - len(greeting))
+                if not chunk:
+                    break
+                greeting += chunk
+        except OSError as exc:
+            raise RemoteError(address=where, reason=f"cannot connect: {exc}") from exc
+        if greeting == REFUSED:
+            sock.close()
+            raise RemoteError(address=where, reason="refused: it already serves another client")
+        if greeting != WELCOME:
+            sock.close()
+            raise RemoteError(
+                address=where, reason=f"not a remote simulator (greeting {greeting!r})"
+            )
+        sock.settimeout(REPLY_TIMEOUT_S)
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        return sock
+
+    # --- calls -------------------------------------------------------------------------------
+
+    def _crash(self, exc: BaseException) -> RemoteCrashed:
+        self.crashed = True
+        cause = self._diagnose() if self._diagnose is not None else None
+        return RemoteCrashed(address=str(self.address), cause=cause or f"connection lost ({exc})")
+
+    def _check(self) -> None:
+        if self.crashed:
+            raise EnvStateError(operation="remote", reason=f"{self.address} crashed; reset()")
+
+    def _call(self, request: dict[str, Any], *, operation: str = "") -> dict[str, Any]:
+        self._check()
+        try:
+            send_frame(self._sock, TAG_TRAINER, json.dumps(request).encode())
+            answer = self._reader.expect_json()
+        except (OSError, WireError) as exc:
+            raise self._crash(exc) from exc
+        return self._answer(answer, operation or str(request.get("op")))
+
+    def _answer(self, answer: dict[str, Any], operation: str) -> dict[str, Any]:
+        if answer.get("ok"):
+            return answer
+        kind, message = str(answer.get("error")), str(answer.get("message"))
+        if kind == "TrainerError":
+            raise TrainerError(operation=operation, reason=message)
+        raise RemoteError(address=str(self.address), reason=f"{operation}: {kind}: {message}")
+
+    def _read_frame(self, operation: str) -> Frame:
+        try:
+            tag, payload = self._reader.read()
+            if tag == TAG_TRAINER:  # an error instead of a frame
+                self._answer(json.loads(payload), operation)
+                raise WireError("a trainer answer without ok")
+            if tag != TAG_SENSORS:
+                raise WireError(f"unexpected frame tag {tag!r}")
+            time_ms, sensors, image = decode_sensors(payload)
+            answer = self._answer(self._reader.expect_json(), operation)
+        except (OSError, WireError) as exc:
+            raise self._crash(exc) from exc
+        return Frame.from_wire(answer["frame"], sensors, image)
+
+    # --- the Session protocol ----------------------------------------------------------------
+
+    def reset(self, request: ResetRequest) -> Frame:
+        self._check()
+        wire = {
+            "seed": request.seed,
+            "learner_pose": list(request.learner_pose) if request.learner_pose else None,
+            "ball_xy": list(request.ball_xy) if request.ball_xy else None,
+        }
+        try:
+            send_frame(
+                self._sock, TAG_TRAINER, json.dumps({"op": "reset", "request": wire}).encode()
+            )
+        except OSError as exc:
+            raise self._crash(exc) from exc
+        return self._read_frame("reset")
+
+    def send_step(self, targets: npt.NDArray[np.float64] | Sequence[float]) -> None:
+        """First half of :meth:`step` (a vector environment sends to every remote first)."""
+        self._check()
+        try:
+            send_frame(self._sock, TAG_ACTUATORS, encode_targets(np.asarray(targets, np.float64)))
+        except OSError as exc:
+            raise self._crash(exc) from exc
+
+    def receive_step(self) -> Frame:
+        return self._read_frame("step")
+
+    def step(self, targets: npt.NDArray[np.float64] | Sequence[float]) -> Frame:
+        self.send_step(targets)
+        return self.receive_step()
+
+    def place_ball(self, x_m: float, y_m: float, vx_m_s: float = 0.0, vy_m_s: float = 0.0) -> None:
+        self._call({"op": "place_ball", "args": [x_m, y_m, vx_m_s, vy_m_s]})
+
+    def place_robot(self, color: str, number: int, x_m: float, y_m: float, yaw_rad: float) -> None:
+        self._call({"op": "place_robot", "args": [color, number, x_m, y_m, yaw_rad]})
+
+    def set_game_state(self, state: str) -> None:
+        self._call({"op": "set_game_state", "args": [state]})
+
+    def drop_ball(self, x_m: float = 0.0, y_m: float = 0.0) -> None:
+        self._call({"op": "drop_ball", "args": [x_m, y_m]})
+
+    def health(self) -> dict[str, Any]:
+        return self._call({"op": "health"})
+
+    def close(self) -> None:
+        if not self.crashed:
+            try:
+                send_frame(self._sock, TAG_TRAINER, b'{"op": "close"}')
+                self._reader.expect_json()
+            except (OSError, WireError):
+                pass
+        self._sock.close()
+
+
+class Launcher(Protocol):
+    """Starts and removes remote simulators (the Docker pool; a Slurm pool could be another)."""
+
+    def start(self, count: int) -> list[RemoteAddress]: ...
+
+    def replace(self, index: int) -> RemoteAddress: ...
+
+    def diagnose(self, index: int) -> str | None: ...
+
+    def close(self) -> None: ...
+
+
+class RemotePool:
+    """The remotes of one environment (or vector environment)."""
+
+    def __init__(self, addresses: list[RemoteAddress], launcher: Launcher | None) -> None:
+        self.addresses = addresses
+        self.launcher = launcher
+
+    @classmethod
+    def open(cls, remotes: int | str, *, image: str | None = None) -> RemotePool:
+        if isinstance(remotes, str):
+            return cls(parse_remotes(remotes), None)
+        if isinstance(remotes, bool) or not isinstance(remotes, int) or remotes < 1:
+            raise EnvConfigError(
+                field="remotes", value=remotes, expected="None, an integer >= 1 or 'hlvs://host:port,...'"
+            )  # fmt: skip
+        from envs.docker_pool import DockerLauncher
+
+        launcher = DockerLauncher(image=image)
+        try:
+            return cls(launcher.start(remotes), launcher)
+        except BaseException:
+            launcher.close()
+            raise
+
+    def __len__(self) -> int:
+        return len(self.addresses)
+
+    def session(self, index: int, spec: SessionSpec) -> RemoteSession:
+        launcher = self.launcher
+        diagnose = (lambda: launcher.diagnose(index)) if launcher is not None else None
+        return RemoteSession(self.addresses[index], spec, diagnose=diagnose)
+
+    def replace(self, index: int, spec: SessionSpec) -> RemoteSession:
+        """A new remote in place of a crashed one (only for remotes the pool started)."""
+        if self.launcher is None:
+            raise RemoteError(
+                address=str(self.addresses[index]),
+                reason="crashed, and it was started by someone else: start it again",
+            )
+        self.addresses[index] = self.launcher.replace(index)
+        log.info("remote %d replaced by %s", index, self.addresses[index])
+        return self.session(index, spec)
+
+    def close(self) -> None:
+        if self.launcher is not None:
+            self.launcher.close()

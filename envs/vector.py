@@ -1,0 +1,111 @@
+"""A vector environment spread over remote simulators: one environment per remote.
+
+``make_vector("hlvs/Kick-v0", remotes=4)`` starts four simulator containers (or takes
+``remotes="hlvs://a:7700,b:7700"``). A step sends every remote its action first and then
+collects the answers, so the remotes step at the same time. Environments that end are reset in
+the same step (Gymnasium's ``SAME_STEP`` autoreset: ``infos["final_obs"]`` and
+``infos["final_info"]`` hold what ended). Environment ``i`` is seeded with ``seed + i``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space, concatenate, create_empty_array
+
+from envs.base import HlvsEnv
+from envs.remote import RemotePool, RemoteSession
+
+
+def make_vector(
+    env_id: str, *, remotes: int | str, image: str | None = None, **kwargs: Any
+) -> RemoteVectorEnv:
+    pool = RemotePool.open(remotes, image=image)
+    try:
+        spec_env = gym.make(env_id, session=_NullSession(), **kwargs).unwrapped
+        assert isinstance(spec_env, HlvsEnv)
+        sessions = [pool.session(i, spec_env.session_spec) for i in range(len(pool))]
+        envs = []
+        for session in sessions:
+            env = gym.make(env_id, session=session, **kwargs).unwrapped
+            assert isinstance(env, HlvsEnv)
+            envs.append(env)
+    except BaseException:
+        pool.close()
+        raise
+    return RemoteVectorEnv(envs, pool)
+
+
+class _NullSession:
+    """Stands in while an environment is built only to read its session settings."""
+
+    def close(self) -> None:
+        return None
+
+
+class RemoteVectorEnv(VectorEnv):
+    metadata: dict[str, Any] = {"autoreset_mode": AutoresetMode.SAME_STEP}
+
+    def __init__(self, envs: list[HlvsEnv], pool: RemotePool) -> None:
+        self.envs = envs
+        self.pool = pool
+        self.num_envs = len(envs)
+        self.single_observation_space = envs[0].observation_space
+        self.single_action_space = envs[0].action_space
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        self._obs = create_empty_array(self.single_observation_space, n=self.num_envs)
+
+    def reset(
+        self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[Any, dict[str, Any]]:
+        seeds = (
+            [None] * self.num_envs
+            if seed is None
+            else list(seed)
+            if isinstance(seed, list)
+            else [seed + i for i in range(self.num_envs)]
+        )
+        observations: list[Any] = []
+        infos: dict[str, Any] = {}
+        for i, env in enumerate(self.envs):
+            obs, info = env.reset(seed=seeds[i], options=options)
+            observations.append(obs)
+            infos = self._add_info(infos, info, i)
+        return self._batch(observations), infos
+
+    def _batch(self, observations: list[Any]) -> Any:
+        return concatenate(self.single_observation_space, observations, self._obs)  # type: ignore[arg-type]
+
+    def step(self, actions: Any) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        batch = np.asarray(actions)
+        for i, env in enumerate(self.envs):
+            session = env.session
+            assert isinstance(session, RemoteSession)
+            session.send_step(env.targets(batch[i]))
+        observations = []
+        rewards = np.zeros(self.num_envs)
+        terminated = np.zeros(self.num_envs, dtype=bool)
+        truncated = np.zeros(self.num_envs, dtype=bool)
+        infos: dict[str, Any] = {}
+        for i, env in enumerate(self.envs):
+            session = env.session
+            assert isinstance(session, RemoteSession)
+            obs, reward, term, trunc, info = env.finish_step(session.receive_step())
+            if term or trunc:
+                final = {"final_obs": obs, "final_info": info}
+                obs, info = env.reset()
+                info = {**info, **final}
+            observations.append(obs)
+            rewards[i], terminated[i], truncated[i] = reward, term, trunc
+            infos = self._add_info(infos, info, i)
+        obs_batch = self._batch(observations)
+        return obs_batch, rewards, terminated, truncated, infos
+
+    def close_extras(self, **kwargs: Any) -> None:
+        for env in self.envs:
+            env.session.close()
+        self.pool.close()
