@@ -21,6 +21,7 @@ from orchestrator.config.loader import load_game
 from orchestrator.errors import OrchestratorError
 from orchestrator.match import HostControl, MatchRunner, RunOptions, cleanup, plan_from_game
 from orchestrator.match.scrimmage import add_arguments, write_files
+from orchestrator.paths import user_path
 
 log = logging.getLogger(__name__)
 
@@ -34,7 +35,7 @@ def _parse(argv: Sequence[str]) -> argparse.Namespace:
     parser.add_argument("--json", action="store_true", help="print only the JSON line")
     parser.add_argument("--timeout", type=float, default=90.0,
                         help="seconds to wait for every robot to connect (default 90)")
-    parser.add_argument("--keep", type=Path, default=None, help="keep the match folder here")
+    parser.add_argument("--keep", type=user_path, default=None, help="keep the match folder here")
     parser.add_argument("--robot-image", default=None,
                         help="image of every robot (default: the project's stub image)")
     parser.add_argument("--robot-command", default=None,

@@ -9,7 +9,8 @@ Tree::
     ├── ApiError             robot API misuse on the simulator side
     ├── UnknownDeviceError   a device name a robot does not have (world device access)
     ├── ReplayError          a replay file that cannot be read
-    └── RenderError          a video that could not be produced (ffmpeg missing or failing)
+    ├── RenderError          a video that could not be produced (ffmpeg missing or failing)
+    └── OffscreenGLError     no offscreen OpenGL back end works (each one tried, with why)
 
 Unknown robot model names raise :class:`robot.errors.UnknownModelError` (one class for the
 simulator and the robot-side motion code).
@@ -108,3 +109,17 @@ class RenderError(SimulatorError):
         self.output = output
         self.reason = reason
         super().__init__(f"{output}: {reason}")
+
+
+class OffscreenGLError(SimulatorError):
+    """No offscreen OpenGL back end could make a context."""
+
+    def __init__(self, *, tried: tuple[tuple[str, str], ...], from_environment: bool) -> None:
+        self.tried = tried
+        self.from_environment = from_environment
+        attempts = "; ".join(f"MUJOCO_GL={name}: {reason}" for name, reason in tried)
+        if from_environment:
+            hint = "unset MUJOCO_GL to let the program try egl and osmesa"
+        else:
+            hint = "install Mesa's EGL (libegl1, libegl-mesa0) or OSMesa (libosmesa6)"
+        super().__init__(f"no offscreen OpenGL back end works (tried {attempts}); {hint}")

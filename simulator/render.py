@@ -4,7 +4,9 @@ A model of shapes only is built from the scene the replay carries (for a version
 today's robot models); each frame's body poses are turned into geom poses (no physics) and
 drawn offscreen from the ``overview`` camera, and the raw RGB frames are
 piped to ffmpeg (libx264, yuv420p). The game state of the frames (state, half, time left, score)
-becomes a subtitle track. Needs ``MUJOCO_GL=osmesa`` (or ``egl``) without a display.
+becomes a subtitle track. The offscreen OpenGL back end is chosen by :mod:`simulator.gl` before
+MuJoCo is imported (``egl``, then ``osmesa``; a ``MUJOCO_GL`` set by the user is kept), so this
+module imports nothing that imports MuJoCo at its top.
 """
 
 from __future__ import annotations
@@ -22,7 +24,8 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from simulator.errors import RenderError, ReplayError
+from simulator.errors import OffscreenGLError, RenderError, ReplayError
+from simulator.gl import choose_offscreen_gl
 from simulator.replay import Replay, load_replay, scene_for
 
 logger = logging.getLogger(__name__)
@@ -228,23 +231,36 @@ def render_video(
     return output
 
 
+def _absolute(text: str) -> Path:
+    """A path from the command line, made absolute against the current directory."""
+    return Path(os.path.abspath(os.path.expanduser(text)))
+
+
 def main(argv: list[str]) -> int:
     program = os.environ.get("HLVS_PROG", "python -m simulator")
     parser = argparse.ArgumentParser(
         prog=f"{program} render", description="Render a match replay to a video, offscreen."
     )
-    parser.add_argument("replay", type=Path, help="replay file of a match (replay.hlvsrec)")
-    parser.add_argument("-o", "--output", type=Path, default=Path("match.mp4"),
+    parser.add_argument("replay", type=_absolute, help="replay file of a match (replay.hlvsrec)")
+    parser.add_argument("-o", "--output", type=_absolute, default="match.mp4",
                         help="video file to write (default: match.mp4)")
     parser.add_argument("--width", type=int, default=1280, help="pixels (default 1280)")
     parser.add_argument("--height", type=int, default=720, help="pixels (default 720)")
     parser.add_argument("--fps", type=float, default=25.0, help="frames per second (default 25)")
     args = parser.parse_args(argv)
-    os.environ.setdefault("MUJOCO_GL", "osmesa")
     logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
     if args.width <= 0 or args.height <= 0 or args.fps <= 0:
         print("error: --width, --height and --fps must be positive", file=sys.stderr)
         return 2
+    if not args.replay.is_file():
+        print(f"error: {args.replay}: no such replay file", file=sys.stderr)
+        return 2
+    try:
+        backend = choose_offscreen_gl()
+    except OffscreenGLError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 3
+    logger.info("offscreen OpenGL back end: %s", backend)
     try:
         render_video(args.replay, args.output, width=args.width, height=args.height, fps=args.fps)
     except ReplayError as exc:

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any, TextIO
 
 from orchestrator.errors import ConfigError, OrchestratorError, Problem
 from orchestrator.exitcodes import ExitCode
+from orchestrator.paths import user_path
 
 if TYPE_CHECKING:
     from orchestrator.config.detect import Kind
@@ -49,6 +50,7 @@ def register(sub: Any) -> None:
     parser.add_argument(
         "files",
         nargs="+",
+        type=user_path,
         metavar="FILE",
         help="files to check; a folder with robot_model.json is checked as a robot model package",
     )
@@ -116,7 +118,7 @@ class FileReport:
 def run(args: argparse.Namespace) -> int:
     reports = [
         check_report(
-            Path(name),
+            name,
             kind=args.kind,
             field_class=args.field_class,
             images_required=args.require_images,

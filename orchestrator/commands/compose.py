@@ -10,19 +10,19 @@ from __future__ import annotations
 import argparse
 import ipaddress
 import json
-from pathlib import Path
 from typing import Any
 
 from orchestrator.errors import ConfigError, Problem
+from orchestrator.paths import user_path
 
 
 def register(sub: Any) -> None:
     parser: argparse.ArgumentParser = sub.add_parser(
         "compose", help="write a docker-compose file that plays the match of a game.json"
     )
-    parser.add_argument("game", type=Path, help="game.json (its team files are read too)")
+    parser.add_argument("game", type=user_path, help="game.json (its team files are read too)")
     parser.add_argument(
-        "-o", "--output", type=Path, default=Path("docker-compose.yml"),
+        "-o", "--output", type=user_path, default="docker-compose.yml",
         help="compose file to write (default: docker-compose.yml)",
     )
     parser.add_argument(

@@ -11,8 +11,9 @@ from __future__ import annotations
 import argparse
 import json
 import time
-from pathlib import Path
 from typing import Any
+
+from orchestrator.paths import user_path
 
 
 def register(sub: Any) -> None:
@@ -33,7 +34,7 @@ def register(sub: Any) -> None:
     pull = actions.add_parser(
         "pull", help="pull and pin a team's images as a match would (reports each player)"
     )
-    pull.add_argument("team_config", type=Path, help="team_config.json")
+    pull.add_argument("team_config", type=user_path, help="team_config.json")
     pull.add_argument(
         "--image-limit-gb", type=float, default=10.0, metavar="GB",
         help="largest image a player may use (default 10, the league's limit)",

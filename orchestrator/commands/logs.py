@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 from orchestrator.errors import ConfigError, Problem
 from orchestrator.exitcodes import ExitCode
+from orchestrator.paths import user_path
 
 if TYPE_CHECKING:
     from orchestrator.delivery import DeliveryOutcome, PendingSet
@@ -28,7 +29,7 @@ STORE_ENV = "HLVS_LOG_STORE"
 
 
 def default_store() -> Path:
-    return Path(os.environ.get(STORE_ENV, "log-store"))
+    return user_path(os.environ.get(STORE_ENV, "log-store"))
 
 
 def register(sub: Any) -> None:
@@ -51,11 +52,11 @@ def register(sub: Any) -> None:
 
     enqueue = actions.add_parser("enqueue", help="queue the logs of a finished match")
     enqueue.add_argument(
-        "match_dir", type=Path, metavar="MATCH_DIR", help="output folder of a finished match"
+        "match_dir", type=user_path, metavar="MATCH_DIR", help="output folder of a finished match"
     )
     enqueue.add_argument(
         "--game",
-        type=Path,
+        type=user_path,
         required=True,
         metavar="GAME.json",
         help="the match's game.json (team names and credentials)",
@@ -74,7 +75,7 @@ def register(sub: Any) -> None:
 def _store_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--store",
-        type=Path,
+        type=user_path,
         default=None,
         metavar="DIR",
         help=f"the pending log store (default ${STORE_ENV} or ./log-store)",

@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import argparse
 import logging
-from pathlib import Path
 from typing import Any
 
 from orchestrator.commands.scrimmage_args import add_arguments as add_scrimmage_arguments
+from orchestrator.paths import user_path
 
 MATCH_EPILOG = (
     "exit codes: 0 the match played to its end, 1 it failed (see report.json), 2 invalid input, "
@@ -25,8 +25,8 @@ def register(sub: Any) -> None:
     match = sub.add_parser(
         "match", help="play one match from a game.json in Docker containers", epilog=MATCH_EPILOG
     )
-    match.add_argument("game", type=Path, help="game.json (references the two team files)")
-    match.add_argument("--out", type=Path, default=None,
+    match.add_argument("game", type=user_path, help="game.json (references the two team files)")
+    match.add_argument("--out", type=user_path, default=None,
                        help="output folder (default: matches/<match_id>)")
     match.add_argument("--grace", type=float, default=None,
                        help="seconds robots get to stop after the game (default: from game.json)")

@@ -37,6 +37,7 @@ from orchestrator.match import (
     scrimmage,
 )
 from orchestrator.match.runner import ImageResolver
+from orchestrator.paths import user_path
 
 log = logging.getLogger(__name__)
 
@@ -161,7 +162,7 @@ def run_match_command(args: argparse.Namespace) -> int:
     for warning in loaded.warnings:
         print(f"hlvs: {warning}", file=sys.stderr)
     plan = plan_from_game(loaded, grace_period_s=args.grace)
-    out = args.out or Path("matches") / plan.match_id
+    out = args.out or user_path(Path("matches") / plan.match_id)
     outcome = play(plan, out_dir=out, pull=True, loaded=loaded)
     return summarize(outcome, as_json=getattr(args, "json", False))
 

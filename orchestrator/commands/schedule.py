@@ -6,9 +6,11 @@ import argparse
 import json
 import logging
 from datetime import UTC, datetime
+from pathlib import Path
 from typing import Any
 
 from orchestrator.errors import ConfigError, Problem, ScheduleError
+from orchestrator.paths import user_path
 
 _STATE_HELP = "SQLite state file written by 'hlvs schedule run'"
 
@@ -21,44 +23,46 @@ def register(sub: Any) -> None:
     verbs.required = True
 
     run = verbs.add_parser("run", help="run the schedule; survives restarts")
-    run.add_argument("schedule", help="schedule file (YAML)")
-    run.add_argument("--state", required=True, help="SQLite state file (jobs and ledger)")
+    run.add_argument("schedule", type=user_path, help="schedule file (YAML)")
+    run.add_argument(
+        "--state", type=user_path, required=True, help="SQLite state file (jobs and ledger)"
+    )
     run.add_argument("--exit-when-done", action="store_true", help="stop when every match is final")
     run.add_argument("--services", help="module:factory of the pull/play/deliver services (tests)")
     run.set_defaults(func=_run, log_level=logging.INFO)
 
     plan = verbs.add_parser("list", help="what is planned, with absolute times")
-    plan.add_argument("schedule", help="schedule file (YAML)")
-    plan.add_argument("--state", help="use the reference time recorded in this state file")
+    plan.add_argument("schedule", type=user_path, help="schedule file (YAML)")
+    plan.add_argument(
+        "--state", type=user_path, help="use the reference time recorded in this state file"
+    )
     plan.add_argument("--json", action="store_true", help="print a JSON array")
     plan.set_defaults(func=_list)
 
     status = verbs.add_parser("status", help="state of every match")
-    status.add_argument("--state", required=True, help=_STATE_HELP)
+    status.add_argument("--state", type=user_path, required=True, help=_STATE_HELP)
     status.add_argument("--json", action="store_true", help="print a JSON array")
     status.set_defaults(func=_status)
 
     cancel = verbs.add_parser("cancel", help="cancel a match that is not played yet")
     cancel.add_argument("match_id", help="id of the match in the schedule")
-    cancel.add_argument("--state", required=True, help=_STATE_HELP)
+    cancel.add_argument("--state", type=user_path, required=True, help=_STATE_HELP)
     cancel.set_defaults(func=_cancel)
 
     table = verbs.add_parser("standings", help="points, goal difference and goals")
-    table.add_argument("--state", required=True, help=_STATE_HELP)
+    table.add_argument("--state", type=user_path, required=True, help=_STATE_HELP)
     table.add_argument("--json", action="store_true", help="print a JSON array")
     table.set_defaults(func=_standings)
 
 
-def _ledger(path: str) -> Any:
-    from pathlib import Path
-
+def _ledger(path: Path) -> Any:
     from orchestrator.schedule.state import Ledger
 
-    if not Path(path).is_file():
+    if not path.is_file():
         raise ConfigError(
-            [Problem(path, "", "no such state file", "the --state file of 'hlvs schedule run'")]
+            [Problem(str(path), "", "no such state file", "the --state file of hlvs schedule run")]
         )
-    return Ledger(Path(path))
+    return Ledger(path)
 
 
 def _run(args: argparse.Namespace) -> int:

@@ -4,11 +4,12 @@ so that ``hlvs --help`` does not import the match machinery."""
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
+
+from orchestrator.paths import user_path
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--out", type=Path, default=Path("matches/scrimmage"),
+    parser.add_argument("--out", type=user_path, default="matches/scrimmage",
                         help="output folder (default: matches/scrimmage)")
     parser.add_argument("--red-image", default=None,
                         help="image of the red robots (default: the project's stub image)")

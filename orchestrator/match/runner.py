@@ -30,6 +30,7 @@ from orchestrator.match.plan import MatchPlan
 from orchestrator.match.results import Failure, FailureClass, RobotRecord
 from orchestrator.match.runtime import ContainerRuntime
 from orchestrator.match.state import Lifecycle, MatchState
+from orchestrator.paths import user_path
 from orchestrator.telemetry import TelemetrySource
 
 log = logging.getLogger(__name__)
@@ -49,6 +50,10 @@ class RunOptions:
     poll_s: float = 0.5
     simulator_stop_s: float = 10.0
     progress: Callable[[str, dict[str, Any] | None], None] | None = None
+
+    def __post_init__(self) -> None:
+        # The output folder becomes bind-mount sources: Docker takes a relative one for a volume.
+        object.__setattr__(self, "out_dir", user_path(self.out_dir))
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -63,9 +63,13 @@ class Attachment:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class BindMount:
-    source: Path  # on the host
+    source: Path  # on the host, absolute (Docker takes a relative source for a volume name)
     target: str  # in the container
     read_only: bool = False
+
+    def __post_init__(self) -> None:
+        if not self.source.is_absolute():
+            raise ValueError(f"bind-mount source must be absolute, got {self.source}")
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -19,7 +19,9 @@ pytestmark = [pytest.mark.docker, pytest.mark.root]
 
 
 def test_match_command_plays_a_game_file(tmp_path: Path, test_image: str, runtime: Any,
-                                         capsys: pytest.CaptureFixture[str]) -> None:
+                                         capsys: pytest.CaptureFixture[str],
+                                         monkeypatch: pytest.MonkeyPatch) -> None:
+    """Relative paths as a user types them: the game file and ``--out`` (a bind-mount source)."""
     try:
         from orchestrator.images import project_image
 
@@ -33,14 +35,16 @@ def test_match_command_plays_a_game_file(tmp_path: Path, test_image: str, runtim
         "--match-id", "cmd-test", "--red-image", test_image, "--blue-image", test_image,
         "--robot-command", "python3 /opt/t/robot.py env",
     ])
-    game = write_files(args, tmp_path / "config")
+    write_files(args, tmp_path / "config")
     out = tmp_path / "out"
+    monkeypatch.chdir(tmp_path)
     try:
-        code = hlvs(["match", str(game), "--out", str(out), "--grace", "1"])
+        code = hlvs(["match", "config/game.json", "--out", "out", "--grace", "1"])
     finally:
         hlvs(["cleanup", "--match", "cmd-test"])
     printed = capsys.readouterr()
     assert code == 0, printed.err[-3000:]
+    assert f"results in {out}" in printed.out
     results = json.loads((out / "results.json").read_text())
     assert results["final_state"] == "FINISHED"
     robot = results["robots"]["blue-2"]
@@ -52,10 +56,12 @@ def test_match_command_plays_a_game_file(tmp_path: Path, test_image: str, runtim
 
 
 def test_match_command_reports_a_bad_game_file(tmp_path: Path,
-                                               capsys: pytest.CaptureFixture[str]) -> None:
+                                               capsys: pytest.CaptureFixture[str],
+                                               monkeypatch: pytest.MonkeyPatch) -> None:
     game = tmp_path / "game.json"
     game.write_text('{"type": "NORMAL"}')
-    assert hlvs(["match", str(game), "--out", str(tmp_path / "out")]) == 2
+    monkeypatch.chdir(tmp_path)
+    assert hlvs(["match", "game.json", "--out", "out"]) == 2
     err = capsys.readouterr().err
     assert str(game) in err and "Traceback" not in err
     assert not (tmp_path / "out").exists()

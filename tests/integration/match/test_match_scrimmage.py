@@ -16,7 +16,10 @@ pytestmark = [pytest.mark.docker, pytest.mark.root]
 
 
 def test_short_scrimmage_plays_to_finished(tmp_path: Path, runtime: Any,
-                                           capsys: pytest.CaptureFixture[str]) -> None:
+                                           capsys: pytest.CaptureFixture[str],
+                                           monkeypatch: pytest.MonkeyPatch) -> None:
+    """From a working directory with a relative ``--out``, as ``make scrimmage`` runs it: the
+    folders reach Docker as absolute bind-mount sources."""
     try:
         from orchestrator.images import project_image
 
@@ -24,16 +27,17 @@ def test_short_scrimmage_plays_to_finished(tmp_path: Path, runtime: Any,
         project_image("stub")
     except (ImportError, OrchestratorError) as exc:
         pytest.skip(f"project images unavailable: {exc}")
-    out = tmp_path / "scrim"
+    out = tmp_path / "matches" / "scrim"
     match_id = "scrim-test"
+    monkeypatch.chdir(tmp_path)
     try:
-        code = hlvs(["scrimmage", "--out", str(out), "--half-duration", "4",
+        code = hlvs(["scrimmage", "--out", "matches/scrim", "--half-duration", "4",
                      "--wait-before-ready", "1", "--grace", "2", "--match-id", match_id])
     finally:
         hlvs(["cleanup", "--match", match_id])
     printed = capsys.readouterr()
     assert code == 0, printed.err[-3000:]
-    assert f"match {match_id}:" in printed.out
+    assert f"match {match_id}:" in printed.out and f"results in {out}" in printed.out
     assert json.loads((out / "report.json").read_text()) == {"status": "success"}
     results = json.loads((out / "results.json").read_text())
     assert results["final_state"] == "FINISHED"

@@ -1,0 +1,24 @@
+"""Paths given by users, made absolute once, where they enter.
+
+Every path on the command line (``--out``, game and team files, credentials, replays, schedules,
+state files, log stores) goes through :func:`user_path`, the ``type=`` of its argparse argument.
+From there on the program holds absolute paths only, so a relative ``--out`` reaches Docker as an
+absolute bind-mount source and every message names the file it really means.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+
+def user_path(text: str | os.PathLike[str]) -> Path:
+    """``text`` made absolute against the current directory (``~`` expanded).
+
+    Symbolic links are kept as written (``..`` is folded away), so messages show the path the
+    user would recognise.
+    """
+    return Path(os.path.abspath(os.path.expanduser(os.fspath(text))))
+
+
+__all__ = ["user_path"]
