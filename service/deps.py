@@ -36,11 +36,18 @@ def get_services(request: Request) -> Services:
 
 
 def get_db(request: Request) -> Iterator[Session]:
-    """One session per request, committed when the handler returns without error."""
+    """One session per request. Handlers that write call ``session.commit()`` before they
+    return (FastAPI may finish this dependency after the response is sent, so a client could
+    otherwise read before the write lands); anything left is committed here, and an error
+    rolls back."""
     factory = get_services(request).sessions
     with factory() as session:
-        with session.begin():
+        try:
             yield session
+            session.commit()
+        except BaseException:
+            session.rollback()
+            raise
 
 
 DbSession = Annotated[Session, Depends(get_db)]

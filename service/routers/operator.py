@@ -60,7 +60,7 @@ def pause_queue(request: Request, principal: OperatorPrincipal,
                 session: DbSession) -> QueueView:
     """No new match starts until resumed; running ones go on; status says why it waits."""
     submissions.set_queue_paused(session, True)
-    session.flush()
+    session.commit()
     return _queue(request, session)
 
 
@@ -68,7 +68,7 @@ def pause_queue(request: Request, principal: OperatorPrincipal,
 def resume_queue(request: Request, principal: OperatorPrincipal,
                  session: DbSession) -> QueueView:
     submissions.set_queue_paused(session, False)
-    session.flush()
+    session.commit()
     worker = get_services(request).worker
     if worker is not None:
         worker.wake()
@@ -98,7 +98,7 @@ def requeue(submission_id: str, request: Request, principal: OperatorPrincipal,
     row.pool_handle = None
     row.charged = False
     row.cancel_requested = False
-    session.flush()
+    session.commit()
     worker = get_services(request).worker
     if worker is not None:
         worker.wake()

@@ -90,7 +90,7 @@ def cancel_submission(submission_id: str, request: Request, principal: TeamPrinc
     row = submissions.get_own(session, team_id=principal.team_id, submission_id=submission_id,
                               for_update=True)
     submissions.cancel(session, row)
-    session.flush()
+    session.commit()
     services = get_services(request)
     if services.worker is not None:
         services.worker.wake()

@@ -94,6 +94,7 @@ def update_team(body: TeamUpdate, principal: TeamPrincipal, session: DbSession) 
         team.webhook_url = str(body.webhook_url) if body.webhook_url else None
     if "webhook_secret" in given:
         team.webhook_secret = body.webhook_secret
+    session.commit()
     return _view(team)
 
 
