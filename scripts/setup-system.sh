@@ -3,7 +3,7 @@
 set -euo pipefail
 need=()
 have() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "ok installed"; }
-for pkg in docker.io docker-compose docker-registry apache2-utils debootstrap libosmesa6 ffmpeg openssh-server iproute2 postgresql; do
+for pkg in docker.io docker-compose docker-registry apache2-utils debootstrap libosmesa6 ffmpeg openssh-server iproute2 postgresql chromium; do
   have "$pkg" || need+=("$pkg")
 done
 if [ ${#need[@]} -eq 0 ]; then

@@ -185,6 +185,17 @@ export class SceneView {
     this.frames += 1;
   }
 
+  /** The colour drawn where a world point lands on the canvas (RGBA bytes), for tests. */
+  pixel(point: number[]): number[] {
+    const v = new THREE.Vector3(point[0], point[1], point[2]).project(this.camera);
+    const x = Math.round(((v.x + 1) / 2) * this.canvas.width);
+    const y = Math.round(((1 - v.y) / 2) * this.canvas.height);
+    const gl = this.renderer.getContext();
+    const out = new Uint8Array(4);
+    gl.readPixels(x, this.canvas.height - 1 - y, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, out);
+    return Array.from(out);
+  }
+
   /** Canvas pixel coordinates of a world point (for tests and overlays). */
   project(point: number[]): number[] {
     const v = new THREE.Vector3(point[0], point[1], point[2]).project(this.camera);

@@ -10,7 +10,7 @@ from simulator.recorder import Recorder
 from simulator.world import World
 from tests.unit.world.conftest import eight_robots
 
-GOAL_MS = 2000
+GOAL_MS = 2600
 
 
 def record_match(folder: Path, *, seconds: float = 3.0) -> Path:

@@ -29,7 +29,7 @@ export async function replayPage(root: HTMLElement, api: string, replayId: strin
     const mark = el("button", {
       class: `mark ${event.type} ${event.team ?? ""}`, style: `left:${left}%`, title: `${clock(event.frame_ms)} ${describeEvent(event)}`,
       "data-testid": `mark-${event.type}`, "data-ms": String(event.frame_ms),
-    }, event.type === "goal" ? "⚽" : "");
+    }, event.type === "goal" ? "G" : "");
     mark.addEventListener("click", () => jumpTo(event));
     timeline.append(mark);
     const item = el("li", { "data-type": event.type },
@@ -50,7 +50,7 @@ export async function replayPage(root: HTMLElement, api: string, replayId: strin
   let timeMs = 0;
   let playing = false;
   let last = performance.now();
-  let ready = false;
+  let shownMs = -1; // the time whose poses are on screen
 
   function jumpTo(event: RefereeEvent): void {
     setTime(Math.max(0, event.frame_ms - EVENT_LEAD_MS));
@@ -81,7 +81,7 @@ export async function replayPage(root: HTMLElement, api: string, replayId: strin
     if (game !== null) {
       view.setPoses(poses);
       board.update(game);
-      ready = true;
+      shownMs = timeMs;
     }
     now.textContent = `${clock(timeMs)} / ${clock(meta.duration_ms)}`;
     view.render();
@@ -94,11 +94,12 @@ export async function replayPage(root: HTMLElement, api: string, replayId: strin
   (window as unknown as Record<string, unknown>).hlvsViewer = {
     meta,
     get time() { return timeMs; },
-    get ready() { return ready && data.loaded(data.chunkAt(timeMs)); },
+    get ready() { return shownMs === timeMs; },
     get frames() { return view.frames; },
     get playing() { return playing; },
     seek: (t: number) => setTime(t),
     project: (p: number[]) => view.project(p),
+    pixel: (p: number[]) => { view.render(); return view.pixel(p); },
     poses: () => Array.from(poses),
   };
 }

@@ -1,0 +1,96 @@
+"""The replay viewer in Chromium: it loads, draws robots and ball where the replay has them at a
+sought time, jumps to a goal from the timeline, plots the API statistics, reads version 1."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from simulator.replay import ReplayFile
+from tests.integration.viewer.conftest import hlvs_view, screenshot
+from tests.unit.viewer.replays import GOAL_MS, record_match
+
+pytestmark = pytest.mark.browser
+V1_FIXTURE = Path(__file__).parents[2] / "unit" / "replay" / "fixtures" / "v1-two-robots.hlvsrec"
+SEEK_MS = 1520  # a recorded frame: the poses on screen are the recorded ones, not interpolated
+
+
+@pytest.fixture(scope="module")
+def match(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("browser") / "match-b"
+    record_match(folder)
+    return folder
+
+
+def _open(page: Any, url: str) -> None:
+    page.goto(url)
+    page.wait_for_function("window.hlvsViewer && window.hlvsViewer.ready", timeout=30_000)
+
+
+def _is_team(rgb: list[int], team: str) -> bool:
+    r, g, b = rgb[:3]
+    return r > 1.6 * g and r > 1.6 * b if team == "red" else b > 1.6 * r and b > 1.2 * g
+
+
+def test_robots_and_ball_are_drawn_where_the_replay_has_them(page: Any, match: Path) -> None:
+    with ReplayFile(match / "public" / "replay.hlvsrec") as replay:
+        frame = next(f for f in replay.frames() if f.sim_time_ms == SEEK_MS)
+        names = replay.header.body_names
+        robots = [(r.team, names.index(f"{r.key}/torso")) for r in replay.header.robots]
+        ball = frame.poses[names.index("ball"), :3].tolist()
+    with hlvs_view(match) as urls:
+        _open(page, urls[0])
+        page.locator("[data-testid=seek]").fill(str(SEEK_MS))
+        page.wait_for_function(f"window.hlvsViewer.time === {SEEK_MS} && window.hlvsViewer.ready")
+        page.wait_for_timeout(300)
+        shown = np.asarray(page.evaluate("window.hlvsViewer.poses()"), dtype=np.float32)
+        np.testing.assert_allclose(shown.reshape(-1, 7), frame.poses, atol=1e-5)
+        for team, body in robots:
+            torso = frame.poses[body, :3].tolist()
+            rgb = page.evaluate("p => window.hlvsViewer.pixel(p)", torso)
+            assert _is_team(rgb, team), f"{names[body]} at {torso}: drawn colour {rgb}"
+        rgb = page.evaluate("p => window.hlvsViewer.pixel(p)", ball)
+        assert not (rgb[1] > rgb[0] + 30 and rgb[1] > rgb[2] + 30), f"grass at the ball: {rgb}"
+        grass = page.evaluate("p => window.hlvsViewer.pixel(p)", [1.2, -2.2, 0.0])
+        assert grass[1] > grass[0] + 30 and grass[1] > grass[2] + 30, f"no grass: {grass}"
+        assert page.locator("[data-testid=game-state]").inner_text() == "PLAYING 1st half"
+        screenshot(page, "replay-sought")
+
+
+def test_the_timeline_jumps_to_the_goal_and_playback_runs(page: Any, match: Path) -> None:
+    with hlvs_view(match) as urls:
+        _open(page, urls[0])
+        assert page.locator("[data-testid=score-red]").inner_text() == "0"
+        page.locator("[data-testid=mark-goal]").click()
+        page.wait_for_function("window.hlvsViewer.ready")
+        assert page.evaluate("window.hlvsViewer.time") == GOAL_MS - 2000
+        page.locator("[data-testid=speed]").select_option("0.5")
+        page.locator("[data-testid=play]").click()
+        page.wait_for_function(f"window.hlvsViewer.time > {GOAL_MS + 40}", timeout=15_000)
+        page.locator("[data-testid=play]").click()  # pause (0.5x: 0.7 s of wall time left)
+        paused_at = page.evaluate("window.hlvsViewer.time")
+        assert GOAL_MS < paused_at < 3000
+        page.wait_for_timeout(300)
+        assert page.evaluate("window.hlvsViewer.time") == paused_at
+        assert page.locator("[data-testid=score-red]").inner_text() == "1"
+        events = page.locator("[data-testid=events] li").all_inner_texts()
+        assert events == ["00:02 goal red 2"]
+        series = page.locator("[data-testid=plot-latency] polyline").evaluate_all(
+            "ls => ls.map(l => [l.dataset.series, l.getAttribute('points').split(' ').length])"
+        )
+        assert series == [["red-1", 3]]
+        assert page.locator("[data-testid=plot-rtf] polyline").count() == 1
+        screenshot(page, "replay-goal")
+
+
+def test_a_version_1_replay_plays_in_the_browser(page: Any) -> None:
+    with hlvs_view(V1_FIXTURE) as urls:
+        _open(page, urls[0])
+        assert page.evaluate("window.hlvsViewer.meta.version") == 1
+        page.locator("[data-testid=play]").click()
+        page.wait_for_function("window.hlvsViewer.time >= 480", timeout=15_000)
+        assert page.locator("[data-testid=score-red]").inner_text() == "1"
+        screenshot(page, "replay-version-1")
