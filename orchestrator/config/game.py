@@ -8,6 +8,7 @@ referenced files.
 from __future__ import annotations
 
 import hashlib
+import os
 import re
 from pathlib import Path
 from typing import Any
@@ -17,6 +18,9 @@ from orchestrator.config.problems import Collector, pointer
 from orchestrator.config.schema import validate
 
 LEGACY_RTF = ("minimum_real_time_factor", "real_time_factor")
+# Real time, as the league's official matches run; used when game.json names no factor at all
+# (several of the league's own game files have neither the current nor a legacy name).
+DEFAULT_MAXIMUM_REAL_TIME_FACTOR = 1.0
 BASIC_TIME_STEP_S = 0.008
 FAST_WAIT_BEFORE_FIRST_READY_S = 5.0
 FAST_HALF_TIME_BREAK_S = 2.0
@@ -137,12 +141,12 @@ def _real_time_factor(document: dict[str, Any], where: Collector) -> float | Non
             expected='"maximum_real_time_factor"',
         )
         return float(document[name])
-    where.error(
+    where.warn(
         "/maximum_real_time_factor",
-        "required field is missing",
+        f"missing: the league's default {DEFAULT_MAXIMUM_REAL_TIME_FACTOR:g} (real time) is used",
         expected="a number (<= 0: as fast as possible)",
     )
-    return None
+    return DEFAULT_MAXIMUM_REAL_TIME_FACTOR
 
 
 def _timing(document: dict[str, Any], where: Collector, *, fast: bool) -> Timing:
@@ -249,8 +253,26 @@ def _check_ports(document: dict[str, Any], where: Collector) -> None:
                 used[port] = at
 
 
+def locate_team_config(
+    config: str, base: Path, *, cwd: Path | None = None
+) -> tuple[Path, tuple[Path, ...]]:
+    """The team file a game.json ``config`` names, and every place looked at.
+
+    A relative path is looked up next to the game file first, then in the current working
+    directory (the league's referee resolves it from its own folder). Returns the first existing
+    file, or the first place when none exists, with all the places tried in order.
+    """
+    written = Path(config).expanduser()
+    if written.is_absolute():
+        return written, (written,)
+    here = Path(os.path.abspath(cwd if cwd is not None else Path.cwd()))
+    tried = tuple(dict.fromkeys(Path(os.path.abspath(b / written)) for b in (base, here)))
+    found = next((p for p in tried if p.is_file()), tried[0])
+    return found, tried
+
+
 def _team_ref(color: Color, raw: dict[str, Any], base: Path, where: Collector) -> TeamRef:
-    config = base / raw["config"]
+    config, _ = locate_team_config(raw["config"], base)
     return TeamRef(
         color=color,
         team_id=team_id(raw["id"]),

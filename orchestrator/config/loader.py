@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from orchestrator.config.game import build_game
+from orchestrator.config.game import build_game, locate_team_config
 from orchestrator.config.jsonfile import read_json
 from orchestrator.config.model import (
     COLORS,
@@ -75,22 +75,36 @@ def _game(path: Path, *, images_required: bool) -> tuple[LoadedGame | None, list
     teams: dict[str, TeamConfig | None] = {}
     field_class = _field_class(document)
     for color in COLORS:
-        config = _team_path(document, color, path.parent)
-        if config is None:
+        located = _team_path(document, color, path.parent)
+        if located is None:
             teams[color] = None
             continue
+        config, tried = located
         if not config.is_file():
             what = "is a directory" if config.is_dir() else "file not found"
+            places = " nor ".join(str(p) for p in tried)
             problems.append(
                 Problem(
                     str(path),
                     pointer(color, "config"),
-                    f"{what}: {config}",
-                    expected="a team_config.json path relative to this file",
+                    f"{what}: neither {places}" if len(tried) > 1 else f"{what}: {config}",
+                    expected="a team_config.json path relative to this file "
+                    "or to the current directory",
                 )
             )
             teams[color] = None
             continue
+        if config != tried[0]:
+            problems.append(
+                Problem(
+                    str(path),
+                    pointer(color, "config"),
+                    f"not next to this file ({tried[0]}); found in the current directory: "
+                    f"{config}",
+                    expected="a team_config.json path relative to this file",
+                    severity="warning",
+                )
+            )
         team, team_problems = _team(
             config, field_class=field_class, images_required=images_required
         )
@@ -136,14 +150,17 @@ def _cross_checks(game: GameConfig, color: str, team: TeamConfig) -> list[Proble
     return where.problems
 
 
-def _team_path(document: object, color: str, base: Path) -> Path | None:
+def _team_path(
+    document: object, color: str, base: Path
+) -> tuple[Path, tuple[Path, ...]] | None:
+    """The team file of ``color`` and every place looked at (see locate_team_config)."""
     if not isinstance(document, dict):
         return None
     side = document.get(color)
     if not isinstance(side, dict) or not isinstance(side.get("config"), str):
         return None
     config: str = side["config"]
-    return base / config if config else None
+    return locate_team_config(config, base) if config else None
 
 
 def _field_class(document: object) -> FieldClass | None:

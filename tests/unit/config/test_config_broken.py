@@ -87,13 +87,6 @@ CASES = [
     # game.json: fields
     Case("missing-type", drop("game", "type"), "game.json", "/type", "required"),
     Case(
-        "missing-rtf",
-        drop("game", "maximum_real_time_factor"),
-        "game.json",
-        "/maximum_real_time_factor",
-        "required",
-    ),
-    Case(
         "rtf-string",
         put("game", "maximum_real_time_factor", value="fast"),
         "game.json",
