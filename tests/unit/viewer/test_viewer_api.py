@@ -51,7 +51,8 @@ def test_meta_and_chunks_carry_the_replay(match_dir: Path) -> None:
         block = replay.read_chunk(2)
     assert head["times"] == block.times_ms.tolist() and head["games"] == block.games
     np.testing.assert_array_equal(poses, block.poses)
-    assert head["games"][0]["score"] == {"red": 1, "blue": 0}
+    assert head["games"][0]["score"] == {"red": 0, "blue": 0}
+    assert head["games"][-1]["score"] == {"red": 1, "blue": 0}
     stats = client.get("/api/viewer/replays/match-7/stats").json()
     assert [s["real_time_factor"] for s in stats] == [1.0, 1.1, 1.2, 1.3]
 
