@@ -12,13 +12,20 @@ Use::
     obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
     env.unwrapped.trainer.place_ball(1.0, 0.5)                  # trainer operations
 
-Importing the package registers the ids (Gymnasium's convention); nothing else happens at
-import time.
+Importing the package registers the ids (Gymnasium's convention) and, without a display,
+selects offscreen rendering (``MUJOCO_GL=osmesa`` unless set: camera observations and monitor
+videos; MuJoCo reads it when first imported).
 """
 
 from __future__ import annotations
 
-import gymnasium
+import os
+
+if not os.environ.get("DISPLAY"):
+    os.environ.setdefault("MUJOCO_GL", "osmesa")
+    os.environ.setdefault("PYOPENGL_PLATFORM", os.environ["MUJOCO_GL"])
+
+import gymnasium  # noqa: E402
 
 from envs.base import HlvsEnv, Session
 from envs.errors import (

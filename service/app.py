@@ -36,6 +36,7 @@ ROUTER_MODULES: tuple[str, ...] = (
     "service.routers.teams",
     "service.routers.submissions",
     "service.routers.operator",
+    "envs.http_api",  # the HTTP environment API (learning environments)
 )
 
 

@@ -1,0 +1,111 @@
+"""Python client of the HTTP environment API (:mod:`envs.http_api`), like gym-http-api's.
+
+    client = EnvClient("http://127.0.0.1:8000", token="hlvs_...")
+    instance = client.env_create("hlvs/Kick-v0", perception=True)
+    obs = client.env_reset(instance, seed=1)
+    obs, reward, done, info = client.env_step(instance, [0.0] * 20)
+    client.env_monitor_start(instance, video=True); ...; client.env_monitor_close(instance)
+    client.download(instance, "episodes.jsonl", "episodes.jsonl")
+    client.env_close(instance)
+
+Errors come back as :class:`EnvApiError` with the HTTP status, the service's error kind and its
+message.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import httpx
+
+from envs.errors import EnvError
+
+
+class EnvApiError(EnvError):
+    def __init__(self, *, status: int, kind: str, message: str, url: str) -> None:
+        self.status = status
+        self.kind = kind
+        self.message = message
+        self.url = url
+        super().__init__(f"{url}: HTTP {status} {kind}: {message}")
+
+
+class EnvClient:
+    def __init__(self, base_url: str, *, token: str | None, timeout_s: float = 60.0) -> None:
+        headers = {"Authorization": f"Bearer {token}"} if token else {}
+        self._http = httpx.Client(base_url=base_url.rstrip("/"), headers=headers,
+                                  timeout=timeout_s)  # fmt: skip
+
+    def _call(self, method: str, path: str, body: dict[str, Any] | None = None) -> Any:
+        try:
+            response = self._http.request(method, path, json=body)
+        except httpx.HTTPError as exc:
+            raise EnvApiError(status=0, kind="unreachable", message=str(exc), url=path) from exc
+        if response.status_code >= 400:
+            try:
+                data = response.json()
+            except ValueError:
+                data = {"error": "http_error", "message": response.text[:200]}
+            raise EnvApiError(
+                status=response.status_code, kind=str(data.get("error")),
+                message=str(data.get("message")), url=path,
+            )  # fmt: skip
+        return response.json()
+
+    def env_create(self, env_id: str, **kwargs: Any) -> str:
+        return str(
+            self._call("POST", "/v1/envs/", {"env_id": env_id, "kwargs": kwargs})["instance_id"]
+        )
+
+    def env_list_all(self) -> dict[str, str]:
+        return dict(self._call("GET", "/v1/envs/")["all_envs"])
+
+    def env_reset(self, instance_id: str, seed: int | None = None) -> dict[str, Any]:
+        return dict(
+            self._call("POST", f"/v1/envs/{instance_id}/reset/", {"seed": seed})["observation"]
+        )
+
+    def env_step(
+        self, instance_id: str, action: list[float]
+    ) -> tuple[dict[str, Any], float, bool, dict[str, Any]]:
+        data = self._call("POST", f"/v1/envs/{instance_id}/step/", {"action": list(action)})
+        return data["observation"], float(data["reward"]), bool(data["done"]), data["info"]
+
+    def env_action_space_info(self, instance_id: str) -> dict[str, Any]:
+        return dict(self._call("GET", f"/v1/envs/{instance_id}/action_space/")["info"])
+
+    def env_monitor_start(
+        self, instance_id: str, *, force: bool = False, resume: bool = False, video: bool = False
+    ) -> None:
+        body = {"force": force, "resume": resume, "video": video}
+        self._call("POST", f"/v1/envs/{instance_id}/monitor/start/", body)
+
+    def env_monitor_close(self, instance_id: str) -> dict[str, Any]:
+        return dict(self._call("POST", f"/v1/envs/{instance_id}/monitor/close/")["stats"])
+
+    def monitor_files(self, instance_id: str) -> list[dict[str, Any]]:
+        return list(self._call("GET", f"/v1/envs/{instance_id}/monitor/files/")["files"])
+
+    def download(self, instance_id: str, name: str, destination: str | Path) -> Path:
+        path = f"/v1/envs/{instance_id}/monitor/files/{name}"
+        response = self._http.get(path)
+        if response.status_code >= 400:
+            data = response.json()
+            raise EnvApiError(status=response.status_code, kind=str(data.get("error")),
+                              message=str(data.get("message")), url=path)  # fmt: skip
+        out = Path(destination)
+        out.write_bytes(response.content)
+        return out
+
+    def env_close(self, instance_id: str) -> None:
+        self._call("POST", f"/v1/envs/{instance_id}/close/")
+
+    def close(self) -> None:
+        self._http.close()
+
+    def __enter__(self) -> EnvClient:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
