@@ -14,6 +14,7 @@ from orchestrator.errors import (
     OrchestratorError,
     Problem,
     ScheduleError,
+    TeamImagesTooLarge,
 )
 
 __all__ = [
@@ -28,4 +29,5 @@ __all__ = [
     "OrchestratorError",
     "Problem",
     "ScheduleError",
+    "TeamImagesTooLarge",
 ]

@@ -134,13 +134,27 @@ def log_level(args: argparse.Namespace) -> int:
     return max(logging.DEBUG, min(logging.CRITICAL, base + 10 * (quiet - verbose)))
 
 
+class _StderrHandler(logging.StreamHandler):  # type: ignore[type-arg]
+    """Writes to whatever ``sys.stderr`` is when a record is logged (not when configured)."""
+
+    @property
+    def stream(self) -> Any:
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, value: Any) -> None:
+        pass
+
+
 def configure_logging(level: int) -> None:
     fmt = (
         "%(asctime)s %(levelname)s %(name)s: %(message)s"
         if level <= logging.INFO
         else f"{PROG}: %(levelname)s: %(message)s"
     )
-    logging.basicConfig(level=level, format=fmt, stream=sys.stderr, force=True)
+    handler = _StderrHandler()
+    handler.setFormatter(logging.Formatter(fmt))
+    logging.basicConfig(level=level, handlers=[handler], force=True)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -6,10 +6,11 @@ Tree::
     ├── ConfigError              a configuration file is invalid (carries every problem found)
     ├── InfrastructureError      the Docker engine, a network or the host failed us
     │   ├── EngineUnavailable    no Docker engine answers
-    │   └── RegistryError        the registry API refused or failed (registry.py)
+    │   └── RegistryError        the registry API refused or failed (registry/client.py)
     ├── ImageError               an image cannot be used for a robot
     │   ├── ImagePullError       pull failed (auth, unknown tag, unreachable registry)
     │   ├── ImageTooLarge        over the size limit
+    │   ├── TeamImagesTooLarge   a team's images together over the team limit
     │   └── BuildFailed          a project image did not build (engine/images.py)
     ├── MatchFailed              a match ended in a typed failure (see results.FailureClass)
     ├── DeliveryError            a log set could not be delivered (auth, host key, bucket, ...)
@@ -90,7 +91,12 @@ class ImageError(OrchestratorError):
 
 
 class ImagePullError(ImageError):
-    pass
+    """A pull failed; ``transient`` when trying again may help (registry unreachable, 5xx,
+    connection reset), not for a refused login or an unknown tag."""
+
+    def __init__(self, *, image: str, reason: str, transient: bool = False) -> None:
+        self.transient = transient
+        super().__init__(image=image, reason=reason)
 
 
 class ImageTooLarge(ImageError):
@@ -100,6 +106,19 @@ class ImageTooLarge(ImageError):
         super().__init__(
             image=image,
             reason=f"{size_bytes / 1e9:.2f} GB is over the limit of {limit_bytes / 1e9:.2f} GB",
+        )
+
+
+class TeamImagesTooLarge(ImageError):
+    """A team's images together (each layer once) are over the team limit."""
+
+    def __init__(self, *, image: str, team_bytes: int, limit_bytes: int) -> None:
+        self.team_bytes = team_bytes
+        self.limit_bytes = limit_bytes
+        super().__init__(
+            image=image,
+            reason=f"the team's images take {team_bytes / 1e9:.2f} GB together (each layer "
+            f"once), over the team limit of {limit_bytes / 1e9:.2f} GB",
         )
 
 

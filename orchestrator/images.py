@@ -12,6 +12,7 @@ from __future__ import annotations
 import fcntl
 import hashlib
 import logging
+import re
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -20,6 +21,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from orchestrator import image_inputs
+from orchestrator.console import NullProgress, Progress
 from orchestrator.engine import LABEL_PROJECT, connect
 from orchestrator.engine import images as engine_images
 from orchestrator.errors import ConfigError, ImageError, Problem
@@ -121,7 +123,8 @@ def project_image(name: str, *, base: str | None = None) -> str:
 
 
 def ensure_image(
-    name: str, *, base: str | None = None, client: DockerClient | None = None
+    name: str, *, base: str | None = None, client: DockerClient | None = None,
+    progress: Progress | None = None,
 ) -> BuiltImage:
     """Make sure ``hlvs-runner/<name>:<content hash>`` exists; build it (and its base) if not."""
     recipe = _recipe(name)
@@ -160,6 +163,13 @@ def ensure_image(
             )
         log_path = BUILD_DIR / "logs" / f"{name}-{content}.log"
         log.info("building %s (build log: %s)", reference, log_path)
+        task = (progress or NullProgress()).add(f"build {name}", unit="steps")
+
+        def steps(line: str) -> None:
+            log.info("%s: %s", name, line)
+            found = re.match(r"Step (\d+)/(\d+)", line)
+            if found:
+                task.update(completed=int(found.group(1)) - 1, total=int(found.group(2)))
         info = engine_images.build(
             client,
             context_dir=context_dir,
@@ -168,8 +178,9 @@ def ensure_image(
             labels={LABEL_PROJECT: "1", LABEL_IMAGE: name, LABEL_CONTENT: content},
             log_path=log_path,
             network_mode=network_mode,
-            on_step=lambda line: log.info("%s: %s", name, line),
+            on_step=steps,
         )
+        task.finish()
         seconds = time.monotonic() - started
         log.info("built %s in %.1f s (%.0f MB)", reference, seconds, info.size_bytes / 1e6)
         _tag_latest(client, recipe, reference, info)
@@ -185,10 +196,15 @@ def ensure_image(
         )
 
 
-def build_all(*, base: str | None = None, client: DockerClient | None = None) -> list[BuiltImage]:
-    """Ensure every project image, in a fixed order."""
+def build_all(
+    *, base: str | None = None, client: DockerClient | None = None,
+    progress: Progress | None = None,
+) -> list[BuiltImage]:
+    """Ensure every project image, in a fixed order (a progress bar per image built)."""
     client = client or connect()
-    return [ensure_image(name, base=base, client=client) for name in IMAGE_NAMES]
+    return [
+        ensure_image(name, base=base, client=client, progress=progress) for name in IMAGE_NAMES
+    ]
 
 
 def content_hash(name: str, context_dir: Path, base_id: str, build_args: dict[str, str]) -> str:

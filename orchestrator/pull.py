@@ -5,6 +5,13 @@
 unreachable registry, over the size limit), so the match can spawn that robot without a
 controller, or forfeit a team without any valid image. The pinned reference (``repo@sha256:..``)
 is what the match starts, so a tag pushed during the match changes nothing.
+
+Before anything is pulled, the registry's manifests are read with the team's login (Basic or
+Bearer token, or an ECR token; :mod:`orchestrator.registry`): an unknown tag, a refused login, an
+image over the image limit or a team over its total (each layer once) fails at once, without
+pulling gigabytes. Pulls that fail for a transient reason (registry unreachable, 5xx, a broken
+connection) are retried with backoff and jitter; their progress goes to a
+:class:`~orchestrator.console.Progress`.
 """
 
 from __future__ import annotations
@@ -12,14 +19,24 @@ from __future__ import annotations
 import logging
 import os
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from orchestrator.config import COLORS, Limits, RegistryAuth, TeamConfig
-from orchestrator.ecr import ecr_login
+from orchestrator.console import NullProgress, Progress, PullTracker
 from orchestrator.engine import images as engine_images
-from orchestrator.errors import ImageError, ImagePullError, ImageTooLarge
+from orchestrator.errors import ImageError, ImagePullError, ImageTooLarge, TeamImagesTooLarge
+from orchestrator.registry import (
+    Credentials,
+    RegistryClient,
+    RegistryError,
+    RemoteImage,
+    client_for,
+    inspect_remote,
+    team_stored_bytes,
+)
+from orchestrator.retry import Backoff, retry
 
 if TYPE_CHECKING:
     from docker import DockerClient
@@ -39,10 +56,15 @@ class ResolvedImage:
     image_id: str
     size_bytes: int
     error: ImageError | None = None
+    stored_bytes: int = 0  # compressed size in the registry (0 when not read)
+    pull_attempts: int = 0  # engine pulls made (1 + retries; 0 for a local image)
 
     @property
     def ok(self) -> bool:
         return self.error is None
+
+
+PULL_BACKOFF = Backoff(attempts=4, base_s=2.0, cap_s=30.0)
 
 
 def resolve_team_images(
@@ -51,31 +73,57 @@ def resolve_team_images(
     *,
     limits: Limits,
     environ: Mapping[str, str] | None = None,
+    progress: Progress | None = None,
+    backoff: Backoff = PULL_BACKOFF,
 ) -> dict[int, ResolvedImage]:
-    """Pull every player's image (once per distinct reference) and pin it; see module doc."""
+    """Check every player's image in its registry, then pull and pin it; see module doc."""
     environ = os.environ if environ is None else environ
-    limit_bytes = int(limits.image_gb * GB)
+    limit_bytes = round(limits.image_gb * GB)
+    references = list(dict.fromkeys(p.image for p in team_config.players if p.image))
+    logins = _Logins(team_config.registry_auth, environ)
+    failed: dict[str, ImageError] = {}
+    remote: dict[str, RemoteImage] = {}
+    for reference in references:
+        try:
+            found = _inspect(reference, logins)
+        except ImageError as exc:
+            log.info("image %s: %s", reference, exc.reason)
+            failed[reference] = exc
+            continue
+        if found is None:
+            continue
+        remote[reference] = found
+        if found.size_bytes > limit_bytes:
+            failed[reference] = ImageTooLarge(
+                image=reference, size_bytes=found.size_bytes, limit_bytes=limit_bytes
+            )
+            log.info("image %s: %s (not pulled)", reference, failed[reference].reason)
+    team_limit = round(limits.team_images_gb * GB)
+    team_bytes = team_stored_bytes([r for ref, r in remote.items() if ref not in failed])
+    if team_bytes > team_limit:
+        for reference in remote:
+            failed.setdefault(reference, TeamImagesTooLarge(
+                image=reference, team_bytes=team_bytes, limit_bytes=team_limit))
+        log.info("team %s: images over the team limit (%.2f GB)", team_config.name,
+                 team_bytes / 1e9)
     by_reference: dict[str, ResolvedImage] = {}
+    for reference in references:
+        stored = remote[reference].size_bytes if reference in remote else 0
+        if reference in failed:
+            by_reference[reference] = _failed(0, reference, failed[reference], stored)
+        else:
+            by_reference[reference] = _resolve_one(
+                engine, reference, logins, limit_bytes,
+                progress=progress or NullProgress(), backoff=backoff, stored_bytes=stored,
+            )
     result: dict[int, ResolvedImage] = {}
     for player in team_config.players:
-        reference = player.image
-        if reference is None:
+        if player.image is None:
             error = ImageError(image="(none)", reason=f"no image named for player {player.number}")
             result[player.number] = _failed(player.number, "", error)
             continue
-        if reference not in by_reference:
-            by_reference[reference] = _resolve_one(
-                engine, reference, team_config.registry_auth, environ, limit_bytes
-            )
-        resolved = by_reference[reference]
-        result[player.number] = ResolvedImage(
-            number=player.number,
-            reference=resolved.reference,
-            digest=resolved.digest,
-            image_id=resolved.image_id,
-            size_bytes=resolved.size_bytes,
-            error=resolved.error,
-        )
+        resolved = by_reference[player.image]
+        result[player.number] = replace(resolved, number=player.number)
     return result
 
 
@@ -133,51 +181,125 @@ def split_reference(reference: str) -> tuple[str, str]:
     return repository, tag_name
 
 
+class _Logins:
+    """A team's registry logins, made once per registry (an ECR token is asked for once)."""
+
+    def __init__(self, auth: RegistryAuth | None, environ: Mapping[str, str]) -> None:
+        self.auth = auth
+        self.environ = environ
+        self._engine: dict[str, engine_images.RegistryAuth | None] = {}
+        self._clients: dict[str, RegistryClient] = {}
+
+    def engine_login(self, registry: str, reference: str) -> engine_images.RegistryAuth | None:
+        if registry not in self._engine:
+            self._engine[registry] = _login(registry, reference, self.auth, self.environ)
+        return self._engine[registry]
+
+    def client(self, registry: str, reference: str) -> RegistryClient:
+        if registry not in self._clients:
+            login = self.engine_login(registry, reference)
+            credentials = (
+                Credentials(username=login.username, password=login.password) if login else None
+            )
+            self._clients[registry] = client_for(registry, credentials, environ=self.environ)
+        return self._clients[registry]
+
+
+def _inspect(reference: str, logins: _Logins) -> RemoteImage | None:
+    """The image in its registry (None for a local or Docker Hub name, or when the registry's
+    API cannot be read for another reason than the image: the pull then decides)."""
+    repository, tag_name = split_reference(reference)
+    registry = engine_images.registry_of(repository)
+    if not registry:
+        return None
+    try:
+        return inspect_remote(reference, logins.client(registry, reference))
+    except RegistryError as exc:
+        if exc.kind == "auth":
+            raise ImagePullError(image=reference, reason=exc.reason) from exc
+        if exc.kind == "denied":
+            raise ImagePullError(image=reference, reason=f"{registry}: {exc.reason}") from exc
+        if exc.kind == "not_found":
+            raise ImagePullError(
+                image=reference, reason=f"tag {tag_name} not found in {repository}"
+            ) from exc
+        if exc.transient:
+            raise ImagePullError(
+                image=reference, reason=f"registry {registry} unreachable: {exc.reason}",
+                transient=True,
+            ) from exc
+        log.warning("image %s: cannot read its manifest (%s); pulling it unchecked", reference,
+                    exc)
+        return None
+
+
 def _resolve_one(
     engine: DockerClient,
     reference: str,
-    auth: RegistryAuth | None,
-    environ: Mapping[str, str],
+    logins: _Logins,
     limit_bytes: int,
+    *,
+    progress: Progress,
+    backoff: Backoff,
+    stored_bytes: int = 0,
 ) -> ResolvedImage:
     repository, tag_name = split_reference(reference)
     registry = engine_images.registry_of(repository)
+    attempts = 0
+
+    def pull_once(login: engine_images.RegistryAuth | None) -> engine_images.ImageInfo:
+        nonlocal attempts
+        attempts += 1
+        task = progress.add(f"pull {reference}", unit="B")
+        try:
+            info = engine_images.pull(engine, repository, tag_name, auth=login,
+                                      on_progress=PullTracker(task))
+        except ImageError:
+            task.finish("failed")
+            raise
+        task.finish()
+        return info
+
+    def pull(login: engine_images.RegistryAuth | None) -> engine_images.ImageInfo:
+        return retry(
+            lambda: pull_once(login),
+            transient=lambda exc: isinstance(exc, ImagePullError) and exc.transient,
+            backoff=backoff,
+            what=f"pull of {reference}",
+        )
+
     try:
         if not registry:
             info = engine_images.inspect(engine, reference)
             if info is not None:
                 log.info("image %s: local image %s, used as is", reference, info.id)
             else:
-                info = engine_images.pull(engine, repository, tag_name, auth=None)
+                info = pull(None)
         else:
-            login = _login(registry, reference, auth, environ)
-            info = engine_images.pull(engine, repository, tag_name, auth=login)
+            info = pull(logins.engine_login(registry, reference))
     except ImageError as exc:
         log.info("image %s: %s", reference, exc.reason)
-        return _failed(0, reference, exc)
+        return _failed(0, reference, exc, stored_bytes, attempts)
     digest = next((d for d in info.repo_digests if d.startswith(repository + "@")), "")
     if not digest:
         digest = info.repo_digests[0] if info.repo_digests else info.id
+    error: ImageError | None = None
     if info.size_bytes > limit_bytes:
         error = ImageTooLarge(image=reference, size_bytes=info.size_bytes, limit_bytes=limit_bytes)
         log.info("image %s: %s; removing it", reference, error.reason)
         if registry:  # a pulled copy goes; a team's local-only image is not ours to delete
             engine_images.remove(engine, reference)
-        return ResolvedImage(
-            number=0,
-            reference=reference,
-            digest=digest,
-            image_id=info.id,
-            size_bytes=info.size_bytes,
-            error=error,
-        )
-    log.info("image %s: pinned %s (%.0f MB)", reference, digest, info.size_bytes / 1e6)
+    else:
+        log.info("image %s: pinned %s (%.0f MB)", reference, digest, info.size_bytes / 1e6)
     return ResolvedImage(
         number=0,
         reference=reference,
         digest=digest,
         image_id=info.id,
         size_bytes=info.size_bytes,
+        error=error,
+        stored_bytes=stored_bytes,
+        pull_attempts=attempts,
     )
 
 
@@ -187,6 +309,8 @@ def _login(
     if auth is None:
         return None
     if auth.ecr is not None:
+        from orchestrator.ecr import ecr_login  # boto3, only for teams on Amazon ECR
+
         return ecr_login(
             registry=registry,
             region=auth.ecr.region,
@@ -206,9 +330,12 @@ def _login(
     return engine_images.RegistryAuth(username=auth.username, password=password)
 
 
-def _failed(number: int, reference: str, error: ImageError) -> ResolvedImage:
+def _failed(
+    number: int, reference: str, error: ImageError, stored_bytes: int = 0, attempts: int = 0
+) -> ResolvedImage:
     return ResolvedImage(
-        number=number, reference=reference, digest="", image_id="", size_bytes=0, error=error
+        number=number, reference=reference, digest="", image_id="", size_bytes=0, error=error,
+        stored_bytes=stored_bytes, pull_attempts=attempts,
     )
 
 

@@ -2,8 +2,9 @@
 
 ``build [--base IMAGE] [--json]`` builds project images whose inputs changed and prints one line
 per image (tag, size, rebuilt or cached). ``pull TEAM_CONFIG [--image-limit-gb GB] [--json]``
-pulls every player's image with the team's registry login, pins it by digest and checks its size,
-as the runner does before a match; it exits 1 when a player has no usable image.
+checks every player's image in its registry (login, tag, size, the team's total with each layer
+once), pulls it with retries and a progress bar, pins it by digest and checks its size, as the
+runner does before a match; it exits 1 when a player has no usable image.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ import json
 import time
 from typing import Any
 
+from orchestrator.exitcodes import ExitCode
 from orchestrator.paths import user_path
 
 
@@ -39,15 +41,21 @@ def register(sub: Any) -> None:
         "--image-limit-gb", type=float, default=10.0, metavar="GB",
         help="largest image a player may use (default 10, the league's limit)",
     )
+    pull.add_argument(
+        "--team-limit-gb", type=float, default=40.0, metavar="GB",
+        help="the team's images together, each layer once (default 40, the league's limit)",
+    )
     pull.add_argument("--json", action="store_true", help="print one JSON object")
     pull.set_defaults(func=_pull)
 
 
 def _build(args: argparse.Namespace) -> int:
+    from orchestrator.console import progress
     from orchestrator.images import build_all
 
     started = time.monotonic()
-    built = build_all(base=args.base)
+    with progress() as bars:
+        built = build_all(base=args.base, progress=bars)
     total_s = time.monotonic() - started
     if args.json:
         print(
@@ -66,30 +74,36 @@ def _build(args: argparse.Namespace) -> int:
 
 def _pull(args: argparse.Namespace) -> int:
     from orchestrator.config import Limits, load_team
+    from orchestrator.console import progress
     from orchestrator.engine import connect
     from orchestrator.pull import resolve_team_images
 
     loaded = load_team(args.team_config, images_required=True)
-    for warning in loaded.warnings:
-        print(warning)
-    resolved = resolve_team_images(
-        connect(), loaded.team, limits=Limits(image_gb=args.image_limit_gb)
-    )
+    if not args.json:
+        for warning in loaded.warnings:
+            print(warning)
+    limits = Limits(image_gb=args.image_limit_gb, team_images_gb=args.team_limit_gb)
+    with progress() as bars:
+        resolved = resolve_team_images(connect(), loaded.team, limits=limits, progress=bars)
+    ok = all(image.error is None for image in resolved.values())
     if args.json:
         players = {
             str(number): {
                 "reference": image.reference,
                 "digest": image.digest,
                 "size_bytes": image.size_bytes,
+                "stored_bytes": image.stored_bytes,
+                "pull_attempts": image.pull_attempts,
                 "error": image.error.reason if image.error else None,
             }
             for number, image in sorted(resolved.items())
         }
-        print(json.dumps({"team": loaded.team.name, "players": players}, sort_keys=True))
+        print(json.dumps({"team": loaded.team.name, "ok": ok, "players": players},
+                         sort_keys=True))
     else:
         for number, image in sorted(resolved.items()):
             if image.error is None:
                 print(f"player {number}: {image.digest} ({image.size_bytes / 1e6:.1f} MB)")
             else:
                 print(f"player {number}: {image.error}")
-    return 0 if all(image.error is None for image in resolved.values()) else 1
+    return ExitCode.OK if ok else ExitCode.FAILED

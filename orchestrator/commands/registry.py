@@ -75,8 +75,8 @@ def _enforce(args: argparse.Namespace) -> int:
     seed = args.seed if args.seed is not None else random.SystemRandom().randrange(2**31)
     report = enforce(
         RegistryClient(args.url, username=args.user, password=password),
-        image_limit_bytes=int(args.image_limit_gb * GB),
-        team_limit_bytes=int(args.team_limit_gb * GB),
+        image_limit_bytes=round(args.image_limit_gb * GB),
+        team_limit_bytes=round(args.team_limit_gb * GB),
         seed=seed,
         team_of=team_of,
         dry_run=args.dry_run,

@@ -16,6 +16,7 @@ from typing import Any
 
 import docker
 import docker.errors
+import requests.exceptions
 
 from orchestrator.errors import ImageError, ImagePullError, InfrastructureError
 
@@ -227,10 +228,32 @@ def push(
     return digest
 
 
+@dataclass(frozen=True, slots=True, kw_only=True)
+class PullEvent:
+    """One progress message of a pull: a layer's status and bytes so far (0 when unknown)."""
+
+    layer: str
+    status: str
+    current: int = 0
+    total: int = 0
+
+
+PullSink = Callable[[PullEvent], None]
+
+
 def pull(
-    client: docker.DockerClient, repository: str, tag_name: str, *, auth: RegistryAuth | None
+    client: docker.DockerClient,
+    repository: str,
+    tag_name: str,
+    *,
+    auth: RegistryAuth | None,
+    on_progress: PullSink | None = None,
 ) -> ImageInfo:
-    """Pull ``repository:tag`` and return the local image (its ``repo_digests`` pin it)."""
+    """Pull ``repository:tag`` and return the local image (its ``repo_digests`` pin it).
+
+    ``on_progress`` gets every layer progress message of the engine. A failed pull raises
+    :class:`ImagePullError` whose ``transient`` says whether trying again may help.
+    """
     reference = f"{repository}:{tag_name}"
     try:
         stream = client.api.pull(
@@ -242,11 +265,23 @@ def pull(
         )
         for chunk in stream:
             if "error" in chunk:
-                reason = _classify(reference, str(chunk["error"]), auth)
-                raise ImagePullError(image=reference, reason=reason)
+                message = str(chunk["error"])
+                raise ImagePullError(image=reference, reason=_classify(reference, message, auth),
+                                     transient=_transient(message))
+            if on_progress is not None and chunk.get("id"):
+                detail = chunk.get("progressDetail") or {}
+                on_progress(PullEvent(
+                    layer=str(chunk["id"]), status=str(chunk.get("status", "")),
+                    current=int(detail.get("current") or 0), total=int(detail.get("total") or 0),
+                ))
     except docker.errors.APIError as exc:
-        reason = _classify(reference, str(exc.explanation or exc), auth)
-        raise ImagePullError(image=reference, reason=reason) from exc
+        message = str(exc.explanation or exc)
+        reason = _classify(reference, message, auth)
+        transient = _transient(message) or (exc.status_code or 0) >= 500
+        raise ImagePullError(image=reference, reason=reason, transient=transient) from exc
+    except requests.exceptions.ConnectionError as exc:  # the engine's stream broke off
+        raise ImagePullError(image=reference, reason=f"pull interrupted: {exc}",
+                             transient=True) from exc
     info = inspect(client, reference)
     if info is None:
         raise ImagePullError(image=reference, reason="pull finished but the image is absent")
@@ -265,6 +300,32 @@ _UNREACHABLE = (
     "timeout exceeded",
     "server gave http response to https client",
 )
+
+
+_TRANSIENT = (
+    "connection refused",
+    "connection reset",
+    "i/o timeout",
+    "tls handshake timeout",
+    "timeout exceeded",
+    "network is unreachable",
+    "unexpected eof",
+    "503 service unavailable",
+    "502 bad gateway",
+    "504 gateway timeout",
+    "500 internal server error",
+    "429 too many requests",
+    "toomanyrequests",
+    "unexpected http status: 5",
+)
+
+
+def _transient(message: str) -> bool:
+    """Whether an engine error message says that trying again may help."""
+    lowered = message.lower()
+    if any(word in lowered for word in _AUTH) or "server gave http response" in lowered:
+        return False
+    return any(word in lowered for word in _TRANSIENT)
 
 
 def registry_of(repository: str) -> str:
@@ -293,6 +354,8 @@ def _classify(reference: str, message: str, auth: RegistryAuth | None) -> str:
 __all__ = [
     "BuildFailed",
     "ImageInfo",
+    "PullEvent",
+    "PullSink",
     "RegistryAuth",
     "build",
     "import_rootfs",

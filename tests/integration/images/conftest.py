@@ -1,5 +1,6 @@
-"""Fixtures for image tests: a Docker engine, a real registry (Debian's docker-registry with
-htpasswd users) on a free loopback port, and tiny images made with ``docker import``."""
+"""Fixtures for image tests: a Docker engine, a real registry (Debian's docker-registry) on a free
+loopback port with htpasswd users (Basic auth) or with token auth and a token service on loopback,
+a proxy that fails the first requests, and tiny images made with ``docker import``."""
 
 from __future__ import annotations
 
@@ -8,12 +9,14 @@ import os
 import shutil
 import subprocess
 import tarfile
+import threading
 import time
 import urllib.error
 import urllib.request
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import docker
 import docker.errors
@@ -21,6 +24,7 @@ import pytest
 
 from orchestrator.delivery.local_sftp import free_port
 from tests.conftest import TEST_LABEL
+from tests.integration.images.token_issuer import ISSUER, SERVICE, TokenIssuer
 
 REGISTRY_BINARY = "/usr/bin/docker-registry"
 USERS = {"alpha": "alpha-secret", "beta": "beta-secret", "janitor": "janitor-secret"}
@@ -32,9 +36,13 @@ class Registry:
     url: str  # http://127.0.0.1:PORT
     users: dict[str, str]
     config: Path
+    auth: str = "basic"  # or "token"
+    issuer: TokenIssuer | None = field(default=None, repr=False)
 
 
-def _start_registry(root: Path) -> tuple[subprocess.Popen[bytes], Registry]:
+def _start_registry(
+    root: Path, issuer: TokenIssuer | None = None
+) -> tuple[subprocess.Popen[bytes], Registry]:
     if not os.path.exists(REGISTRY_BINARY) or shutil.which("htpasswd") is None:
         pytest.skip("docker-registry and htpasswd (apache2-utils) are needed")
     root.mkdir(parents=True, exist_ok=True)
@@ -59,11 +67,7 @@ storage:
     enabled: true
 http:
   addr: 127.0.0.1:{port}
-auth:
-  htpasswd:
-    realm: test-registry
-    path: {htpasswd}
-"""
+{_auth_section(htpasswd, issuer)}"""
     )
     log = (root / "registry.log").open("wb")
     process = subprocess.Popen([REGISTRY_BINARY, "serve", str(config)], stdout=log, stderr=log)
@@ -80,7 +84,26 @@ auth:
                 process.kill()
                 pytest.fail(f"registry did not start; see {root / 'registry.log'}")
             time.sleep(0.1)
-    return process, Registry(host=f"127.0.0.1:{port}", url=url, users=dict(USERS), config=config)
+    return process, Registry(
+        host=f"127.0.0.1:{port}", url=url, users=dict(USERS), config=config,
+        auth="token" if issuer else "basic", issuer=issuer,
+    )
+
+
+def _auth_section(htpasswd: Path, issuer: TokenIssuer | None) -> str:
+    if issuer is None:
+        return f"""auth:
+  htpasswd:
+    realm: test-registry
+    path: {htpasswd}
+"""
+    return f"""auth:
+  token:
+    realm: {issuer.realm}
+    service: {SERVICE}
+    issuer: {ISSUER}
+    rootcertbundle: {issuer.cert_path}
+"""
 
 
 @pytest.fixture
@@ -96,6 +119,134 @@ def registry(tmp_path: Path, docker_client: docker.DockerClient) -> Iterator[Reg
         except subprocess.TimeoutExpired:
             process.kill()
         _remove_images_of(docker_client, reg.host)
+
+
+@pytest.fixture(params=["basic", "token"])
+def any_registry(
+    request: pytest.FixtureRequest, tmp_path: Path, docker_client: docker.DockerClient
+) -> Iterator[Registry]:
+    """A registry with Basic auth, then one with token auth (the same test runs on both)."""
+    yield from _serve_registry(tmp_path, docker_client, token=request.param == "token")
+
+
+@pytest.fixture
+def token_registry(tmp_path: Path, docker_client: docker.DockerClient) -> Iterator[Registry]:
+    """A registry with token auth; its token service runs on loopback in this process."""
+    yield from _serve_registry(tmp_path, docker_client, token=True)
+
+
+def _serve_registry(
+    tmp_path: Path, docker_client: docker.DockerClient, *, token: bool
+) -> Iterator[Registry]:
+    issuer = TokenIssuer(folder=tmp_path / "issuer", users=dict(USERS)) if token else None
+    server = issuer.start() if issuer else None
+    process, reg = _start_registry(tmp_path / "registry", issuer)
+    try:
+        yield reg
+    finally:
+        process.terminate()
+        try:
+            process.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            process.kill()
+        if server is not None:
+            server.shutdown()
+            server.server_close()
+        _remove_images_of(docker_client, reg.host)
+
+
+@dataclass
+class FlakyProxy:
+    """An HTTP proxy on loopback in front of a registry that makes the first ``failures`` pulls
+    of the Docker engine fail: their manifest requests get 503 (a pull starts with the engine's
+    ``GET /v2/``; clients whose User-Agent does not start with ``agent`` pass). Everything else
+    passes through. ``seen`` records (method, path, status); ``pulls`` counts the engine's."""
+
+    upstream: str  # 127.0.0.1:PORT
+    failures: int = 2
+    agent: str = "docker/"
+    seen: list[tuple[str, str, int]] = field(default_factory=list)
+    pulls: int = 0
+    port: int = 0
+
+    @property
+    def host(self) -> str:
+        return f"127.0.0.1:{self.port}"
+
+    def start(self) -> Any:
+        import http.client
+        from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+
+        proxy = self
+        lock = threading.Lock()
+
+        class Handler(BaseHTTPRequestHandler):
+            protocol_version = "HTTP/1.1"
+
+            def _forward(self) -> None:
+                engine = self.headers.get("User-Agent", "").startswith(proxy.agent)
+                with lock:
+                    if engine and self.path == "/v2/":
+                        proxy.pulls += 1
+                    fail = engine and "/manifests/" in self.path and proxy.pulls <= proxy.failures
+                if fail:
+                    body = b'{"errors":[{"code":"UNAVAILABLE","message":"try again"}]}'
+                    self.send_response(503)
+                    self.send_header("Content-Type", "application/json")
+                    self.send_header("Content-Length", str(len(body)))
+                    self.end_headers()
+                    if self.command != "HEAD":
+                        self.wfile.write(body)
+                    proxy.seen.append((self.command, self.path, 503))
+                    return
+                length = int(self.headers.get("Content-Length") or 0)
+                data = self.rfile.read(length) if length else None
+                upstream = http.client.HTTPConnection(proxy.upstream, timeout=60)
+                upstream.putrequest(self.command, self.path, skip_host=True,
+                                    skip_accept_encoding=True)
+                upstream.putheader("Host", proxy.upstream)
+                for name, value in self.headers.items():  # repeated headers (Accept) kept
+                    if name.lower() not in ("host", "connection", "proxy-connection"):
+                        upstream.putheader(name, value)
+                upstream.endheaders(data)
+                answer = upstream.getresponse()
+                payload = answer.read()
+                self.send_response(answer.status)
+                for name, value in answer.getheaders():
+                    if name.lower() in ("transfer-encoding", "connection"):
+                        continue
+                    if name.lower() == "content-length" and self.command != "HEAD":
+                        continue
+                    self.send_header(name, value)
+                if self.command != "HEAD":
+                    self.send_header("Content-Length", str(len(payload)))
+                self.end_headers()
+                if self.command != "HEAD":
+                    self.wfile.write(payload)
+                upstream.close()
+                proxy.seen.append((self.command, self.path, answer.status))
+
+            do_GET = do_HEAD = do_POST = do_PUT = do_PATCH = do_DELETE = _forward  # noqa: N815
+
+            def log_message(self, format: str, *args: Any) -> None:
+                pass
+
+        server = ThreadingHTTPServer(("127.0.0.1", 0), Handler)
+        self.port = server.server_address[1]
+        threading.Thread(target=server.serve_forever, daemon=True).start()
+        return server
+
+
+@pytest.fixture
+def flaky_proxy(registry: Registry) -> Iterator[FlakyProxy]:
+    """A proxy in front of ``registry`` that fails the engine's first two manifest requests."""
+    proxy = FlakyProxy(upstream=registry.host)
+    server = proxy.start()
+    try:
+        yield proxy
+    finally:
+        server.shutdown()
+        server.server_close()
 
 
 def _remove_images_of(client: docker.DockerClient, host: str) -> None:

@@ -11,7 +11,8 @@ from orchestrator.engine.images import RegistryAuth, _classify, registry_of
 from orchestrator.errors import ImagePullError
 from orchestrator.images import content_hash
 from orchestrator.pull import split_reference
-from orchestrator.registry import RegistryImage, TeamRule, _next_link, plan_enforcement
+from orchestrator.registry import RegistryImage, TeamRule, plan_enforcement
+from orchestrator.registry.client import _next_link
 
 
 def image(repo: str, size: int) -> RegistryImage:

@@ -1,0 +1,317 @@
+"""A registry client for the distribution specification's HTTP API (``/v2/``).
+
+Authentication follows the registry's ``WWW-Authenticate`` challenge (Basic, or Bearer tokens
+from its token service; see :mod:`orchestrator.registry.auth`). Listings (catalog, tags) follow
+``Link: <...>; rel="next"`` pages. Unreachable registries and 429/5xx answers are retried with
+backoff and jitter. Every failure becomes one :class:`RegistryError`, translated here only.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import time
+import urllib.error
+import urllib.parse
+import urllib.request
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from orchestrator.errors import InfrastructureError
+from orchestrator.registry.auth import Credentials, TokenCache, parse_challenges, scope_for
+from orchestrator.retry import Backoff, retry
+
+log = logging.getLogger(__name__)
+
+MANIFEST_TYPES = (
+    "application/vnd.docker.distribution.manifest.v2+json",
+    "application/vnd.oci.image.manifest.v1+json",
+    "application/vnd.docker.distribution.manifest.list.v2+json",
+    "application/vnd.oci.image.index.v1+json",
+)
+INDEX_TYPES = MANIFEST_TYPES[2:]
+TRANSIENT_STATUS = (429, 500, 502, 503, 504)
+USER_AGENT = "hlvs-runner"
+
+
+class RegistryError(InfrastructureError):
+    """A registry request failed: ``url``, HTTP ``status`` (0 when unreachable), ``reason`` and
+    ``kind``: auth, denied, not_found, unreachable, transient or failed."""
+
+    def __init__(self, *, url: str, status: int, reason: str, kind: str = "failed") -> None:
+        self.url = url
+        self.status = status
+        self.reason = reason
+        self.kind = kind
+        where = f"HTTP {status}" if status else "unreachable"
+        super().__init__(f"registry request {url} failed ({where}): {reason}")
+
+    @property
+    def transient(self) -> bool:
+        return self.kind in ("unreachable", "transient")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Manifest:
+    """A manifest's digest, media type and the blobs (config and layers) it needs, by digest."""
+
+    digest: str
+    media_type: str
+    blobs: Mapping[str, int] = field(default_factory=dict)
+
+    @property
+    def size_bytes(self) -> int:
+        """Stored (compressed) size: each blob once."""
+        return sum(self.blobs.values())
+
+
+@dataclass(frozen=True, slots=True)
+class _Response:
+    status: int
+    body: bytes
+    headers: Mapping[str, str]  # names in lower case
+
+
+def _lower(items: Any) -> dict[str, str]:
+    return {str(name).lower(): str(value) for name, value in items}
+
+
+class RegistryClient:
+    """Reads (and deletes) through a registry's ``/v2/`` API; see the module documentation."""
+
+    def __init__(
+        self,
+        url: str,
+        *,
+        credentials: Credentials | None = None,
+        username: str | None = None,
+        password: str | None = None,
+        page_size: int = 100,
+        backoff: Backoff | None = None,
+        clock: Callable[[], float] = time.monotonic,
+        timeout_s: float = 30.0,
+    ) -> None:
+        self.url = url.rstrip("/")
+        if credentials is None and username:
+            credentials = Credentials(username=username, password=password or "")
+        self.credentials = credentials
+        self.page_size = page_size
+        self.backoff = backoff or Backoff(attempts=4, base_s=0.5, cap_s=8.0)
+        self.timeout_s = timeout_s
+        self.tokens = TokenCache(clock=clock)
+        self.token_requests = 0  # token service calls made (tokens are cached per scope)
+        self._basic = False  # the registry asked for Basic: send it on every request
+        self._bearer: dict[str, str] | None = None  # realm and service of the token service
+
+    # -- listings ---------------------------------------------------------------------------
+
+    def repositories(self) -> list[str]:
+        return sorted(self._pages("/v2/_catalog", "repositories"))
+
+    def tags(self, repository: str) -> list[str]:
+        return sorted(self._pages(f"/v2/{repository}/tags/list", "tags"))
+
+    def _pages(self, path: str, key: str) -> Iterator[str]:
+        page: str | None = f"{path}?n={self.page_size}"
+        while page:
+            response = self._request("GET", page)
+            yield from self._json(response, page).get(key) or []
+            page = _next_link(response.headers.get("link", ""))
+
+    # -- manifests --------------------------------------------------------------------------
+
+    def manifest(self, repository: str, reference: str) -> Manifest:
+        """The manifest of ``repository:reference`` (tag or digest); an index needs the blobs of
+        every image it lists (each blob once)."""
+        digest, media_type, document = self._fetch(repository, reference)
+        blobs: dict[str, int] = {}
+        if _is_index(media_type, document):
+            for child in document.get("manifests") or []:
+                blobs.update(self.manifest(repository, str(child["digest"])).blobs)
+        else:
+            blobs = _blobs(document)
+        return Manifest(digest=digest, media_type=media_type, blobs=blobs)
+
+    def image(self, repository: str, reference: str, *, platform: str = "linux/amd64") -> Manifest:
+        """The manifest of the image a machine of ``platform`` pulls for ``repository:reference``
+        (from an index, the entry of that platform)."""
+        digest, media_type, document = self._fetch(repository, reference)
+        if not _is_index(media_type, document):
+            return Manifest(digest=digest, media_type=media_type, blobs=_blobs(document))
+        os_name, _, arch = platform.partition("/")
+        for child in document.get("manifests") or []:
+            wanted = child.get("platform") or {}
+            if wanted.get("os") == os_name and wanted.get("architecture") == arch:
+                return self.manifest(repository, str(child["digest"]))
+        raise RegistryError(
+            url=f"{self.url}/v2/{repository}/manifests/{reference}", status=404,
+            kind="not_found", reason=f"{repository}:{reference} has no image for {platform}",
+        )
+
+    def _fetch(self, repository: str, reference: str) -> tuple[str, str, dict[str, Any]]:
+        path = f"/v2/{repository}/manifests/{reference}"
+        response = self._request("GET", path, accept=", ".join(MANIFEST_TYPES))
+        computed = f"sha256:{hashlib.sha256(response.body).hexdigest()}"
+        digest = response.headers.get("docker-content-digest") or computed
+        document = self._json(response, path)
+        media_type = str(document.get("mediaType") or response.headers.get("content-type", ""))
+        return digest, media_type, document
+
+    def delete(self, repository: str, digest: str) -> None:
+        self._request("DELETE", f"/v2/{repository}/manifests/{digest}")
+        log.info("registry %s: deleted %s@%s", self.url, repository, digest)
+
+    # -- requests ---------------------------------------------------------------------------
+
+    def _json(self, response: _Response, path: str) -> dict[str, Any]:
+        try:
+            document = json.loads(response.body)
+        except ValueError as exc:
+            raise RegistryError(
+                url=self.url + path, status=response.status, reason=f"not JSON: {exc}"
+            ) from exc
+        if not isinstance(document, dict):
+            raise RegistryError(url=self.url + path, status=response.status,
+                                reason="expected a JSON object")
+        return document
+
+    def _request(self, method: str, path: str, *, accept: str | None = None) -> _Response:
+        return retry(
+            lambda: self._authorized(method, path, accept),
+            transient=lambda exc: isinstance(exc, RegistryError) and exc.transient,
+            backoff=self.backoff,
+            what=f"registry request {method} {self.url}{path}",
+        )
+
+    def _authorized(self, method: str, path: str, accept: str | None) -> _Response:
+        url = self.url + path
+        headers = {"Accept": accept} if accept else {}
+        scope = scope_for(method, path)
+        authorization = self._known_authorization(scope)
+        response = self._send(method, url, headers, authorization)
+        if response.status != 401:
+            return self._checked(method, url, response)
+        challenges = parse_challenges(response.headers.get("www-authenticate", ""))
+        bearer = next((c for c in challenges if c.scheme == "bearer"), None)
+        basic = next((c for c in challenges if c.scheme == "basic"), None)
+        if bearer is not None and bearer.realm:
+            self._bearer = {"realm": bearer.realm, "service": bearer.params.get("service", "")}
+            wanted = bearer.params.get("scope") or scope
+            key = (bearer.realm, self._bearer["service"], wanted)
+            self.tokens.drop(key)  # refused or absent: fetch a fresh one
+            authorization = "Bearer " + self._fetch_token(key)
+        elif basic is not None or not challenges:
+            if self.credentials is None:
+                raise self._auth_error(url, 401, "the registry asks for a user and password")
+            if authorization and authorization.startswith("Basic "):
+                raise self._auth_error(url, 401, "user or password refused")
+            self._basic = True
+            authorization = self.credentials.basic()
+        else:
+            schemes = ", ".join(c.scheme for c in challenges)
+            raise self._auth_error(url, 401, f"unsupported authentication scheme {schemes}")
+        response = self._send(method, url, headers, authorization)
+        if response.status == 401:
+            raise self._auth_error(url, 401, "the registry refused the token or the credentials")
+        return self._checked(method, url, response)
+
+    def _known_authorization(self, scope: str) -> str | None:
+        if self._basic and self.credentials is not None:
+            return self.credentials.basic()
+        if self._bearer is not None:
+            token = self.tokens.get((self._bearer["realm"], self._bearer["service"], scope))
+            return f"Bearer {token}" if token else None
+        return None
+
+    def _fetch_token(self, key: tuple[str, str, str]) -> str:
+        realm, service, scope = key
+        query = [("service", service)] if service else []
+        query += [("scope", s) for s in scope.split(" ") if s]
+        url = realm + ("&" if "?" in realm else "?") + urllib.parse.urlencode(query)
+        authorization = self.credentials.basic() if self.credentials else None
+        self.token_requests += 1
+        response = self._send("GET", url, {}, authorization)
+        if response.status in (401, 403):
+            raise self._auth_error(url, response.status, "the token service refused the login")
+        response = self._checked("GET", url, response)
+        try:
+            document = json.loads(response.body)
+            token = str(document.get("token") or document.get("access_token") or "")
+            expires = document.get("expires_in")
+        except (ValueError, AttributeError) as exc:
+            raise RegistryError(url=url, status=response.status,
+                                reason=f"token service answer is not JSON: {exc}") from exc
+        if not token:
+            raise RegistryError(url=url, status=response.status,
+                                reason="token service answered without a token")
+        self.tokens.put(key, token, expires_in_s=float(expires) if expires else None)
+        log.debug("token for %s from %s", scope, realm)
+        return token
+
+    def _auth_error(self, url: str, status: int, detail: str) -> RegistryError:
+        user = self.credentials.username if self.credentials else "anonymous"
+        host = urllib.parse.urlsplit(self.url).netloc
+        return RegistryError(
+            url=url, status=status, kind="auth",
+            reason=f"authentication failed for {host} (user {user}): {detail}",
+        )
+
+    def _checked(self, method: str, url: str, response: _Response) -> _Response:
+        if 200 <= response.status < 300:
+            return response
+        detail = response.body.decode(errors="replace").strip()[:300]
+        kind = "failed"
+        if response.status == 403:
+            kind, detail = "denied", f"access denied: {detail}"
+        elif response.status == 404:
+            kind = "not_found"
+        elif response.status == 405 and method == "DELETE":
+            detail = "deletion is disabled on this registry (storage: delete: enabled: true)"
+        elif response.status in TRANSIENT_STATUS:
+            kind = "transient"
+        raise RegistryError(url=url, status=response.status, reason=detail, kind=kind)
+
+    def _send(
+        self, method: str, url: str, headers: Mapping[str, str], authorization: str | None
+    ) -> _Response:
+        request = urllib.request.Request(url, method=method)
+        request.add_header("User-Agent", USER_AGENT)
+        for name, value in headers.items():
+            request.add_header(name, value)
+        if authorization:
+            request.add_header("Authorization", authorization)
+        try:
+            with urllib.request.urlopen(request, timeout=self.timeout_s) as answer:
+                return _Response(answer.status, answer.read(), _lower(answer.headers.items()))
+        except urllib.error.HTTPError as exc:
+            return _Response(exc.code, exc.read(), _lower(exc.headers.items()))
+        except (urllib.error.URLError, OSError) as exc:
+            reason = getattr(exc, "reason", exc)
+            raise RegistryError(url=url, status=0, reason=str(reason), kind="unreachable") from exc
+
+
+def _blobs(document: Mapping[str, Any]) -> dict[str, int]:
+    """Config and layers of an image manifest, by digest."""
+    blobs: dict[str, int] = {}
+    for entry in [document.get("config") or {}, *(document.get("layers") or [])]:
+        if isinstance(entry, dict) and entry.get("digest"):
+            blobs[str(entry["digest"])] = int(entry.get("size", 0))
+    return blobs
+
+
+def _is_index(media_type: str, document: Mapping[str, Any]) -> bool:
+    return media_type in INDEX_TYPES or "manifests" in document
+
+
+def _next_link(header: str) -> str | None:
+    """The path of a ``Link: </v2/_catalog?last=x&n=100>; rel="next"`` header."""
+    if 'rel="next"' not in header:
+        return None
+    target = header.split(";", 1)[0].strip().strip("<>")
+    parsed = urllib.parse.urlsplit(target)
+    return parsed.path + ("?" + parsed.query if parsed.query else "")
+
+
+__all__ = ["Manifest", "RegistryClient", "RegistryError"]
