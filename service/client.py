@@ -1,13 +1,262 @@
-"""The command-line client: ``hlvs submit|status|cancel|results|logs --server URL``."""
+"""The command-line client of the service: ``hlvs submit|status|cancel|results`` and
+``hlvs logs fetch``, each with ``--server URL`` (or ``$HLVS_SERVER``).
+
+The token comes from ``--token-file FILE``, else ``$HLVS_TOKEN``, else the file
+``~/.config/hlvs/token``; it is sent as ``Authorization: Bearer`` and never printed. Every
+answer is printed as JSON on stdout. Exit codes: 0 success (``submit --wait``: the match
+played to its end), 1 the match failed or was cancelled, 2 refused (bad input, unknown id,
+409, pre-flight failure, no or bad token), 3 no answer from the server.
+"""
 
 from __future__ import annotations
 
+import argparse
+import json
+import os
+import sys
+import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
+
+DEFAULT_TOKEN_FILE = Path("~/.config/hlvs/token")
+FINAL_STATES = ("done", "failed", "cancelled")
 
 
 def register(sub: Any, guarded: Callable[[Any], Any]) -> None:
-    """Added in a later slice."""
+    submit = sub.add_parser("submit", help="ask the league's service for a test match")
+    _common(submit)
+    submit.add_argument("--team-config", type=Path, default=None,
+                        help="upload this team_config.json first (a new version)")
+    submit.add_argument("--credentials", type=Path, default=None,
+                        help="upload this credentials.json (log delivery) first")
+    submit.add_argument("--opponent", default="stub",
+                        help="'stub' (default) or a team that accepts friendlies")
+    submit.add_argument("--wait", action="store_true",
+                        help="poll until the match has ended; exit 0 only when it played")
+    submit.add_argument("--poll", type=float, default=5.0,
+                        help="seconds between polls with --wait (default 5)")
+    submit.set_defaults(func=guarded(run_submit))
+
+    status = sub.add_parser("status", help="a test match's state, queue position and "
+                                           "expected start (all of them without ID)")
+    _common(status)
+    status.add_argument("submission", nargs="?", default=None,
+                        help="submission id (sub_...); default: list the team's submissions")
+    status.set_defaults(func=guarded(run_status))
+
+    cancel = sub.add_parser("cancel", help="cancel a queued (free) or running test match")
+    _common(cancel)
+    cancel.add_argument("submission", help="submission id (sub_...)")
+    cancel.set_defaults(func=guarded(run_cancel))
+
+    results = sub.add_parser("results", help="download report.json, results.json, the replay "
+                                             "and the video of a test match")
+    _common(results)
+    results.add_argument("submission", help="submission id (sub_...)")
+    results.add_argument("-o", "--out", type=Path, default=None,
+                         help="folder to write into (default: ./<submission id>)")
+    results.set_defaults(func=guarded(run_results))
+
+    logs_parser = sub.choices.get("logs")
+    if logs_parser is not None:
+        actions = next(a for a in logs_parser._actions
+                       if isinstance(a, argparse._SubParsersAction))
+        fetch = actions.add_parser("fetch", help="download a test match's logs from the "
+                                                 "league's service (own team and public)")
+        _common(fetch)
+        fetch.add_argument("submission", help="submission id (sub_...)")
+        fetch.add_argument("-o", "--out", type=Path, default=None,
+                           help="folder to write into (default: ./<submission id>/logs)")
+        fetch.set_defaults(func=guarded(run_logs))
 
 
-__all__ = ["register"]
+def _common(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--server", default=None,
+                        help="the service's URL (default: $HLVS_SERVER)")
+    parser.add_argument("--token-file", type=Path, default=None,
+                        help="file holding the team token (default: $HLVS_TOKEN, then "
+                             "~/.config/hlvs/token)")
+
+
+class Api:
+    """A thin httpx client that turns error answers into :class:`ClientError`."""
+
+    def __init__(self, server: str, token: str) -> None:
+        import httpx
+
+        self.server = server.rstrip("/")
+        self._http = httpx.Client(base_url=self.server, timeout=120,
+                                  headers={"Authorization": f"Bearer {token}"})
+
+    def close(self) -> None:
+        self._http.close()
+
+    def call(self, method: str, path: str, **kwargs: Any) -> Any:
+        import httpx
+
+        from service.errors import ClientError
+
+        try:
+            answer = self._http.request(method, path, **kwargs)
+        except httpx.HTTPError as exc:
+            raise ClientError(url=self.server + path, status=None, message=str(exc)) from exc
+        if answer.status_code >= 400:
+            try:
+                body = answer.json()
+                message = str(body.get("message", answer.text))
+                if body.get("existing_id"):
+                    message += f" (existing: {body['existing_id']})"
+                for problem in body.get("problems", [])[:20]:
+                    message += "\n  " + str(problem.get("text") or problem)
+            except ValueError:
+                message = answer.text[:500]
+            raise ClientError(url=self.server + path, status=answer.status_code,
+                              message=message)
+        if answer.headers.get("content-type", "").startswith("application/json"):
+            return answer.json()
+        return answer.content
+
+
+def _api(args: argparse.Namespace) -> Api:
+    from service.errors import InvalidInput
+
+    server = args.server or os.environ.get("HLVS_SERVER")
+    if not server:
+        raise InvalidInput("no server: give --server URL or set HLVS_SERVER")
+    token: str | None
+    if args.token_file is not None:
+        token = _read_token(args.token_file)
+    else:
+        token = os.environ.get("HLVS_TOKEN") or None
+        default = DEFAULT_TOKEN_FILE.expanduser()
+        if token is None and default.is_file():
+            token = _read_token(default)
+    if not token:
+        raise InvalidInput("no token: give --token-file FILE, set HLVS_TOKEN or write it to "
+                           "~/.config/hlvs/token")
+    return Api(server, token)
+
+
+def _read_token(path: Path) -> str:
+    from service.errors import InvalidInput
+
+    try:
+        return path.expanduser().read_text(encoding="utf-8").strip()
+    except OSError as exc:
+        raise InvalidInput(f"{path}: cannot read the token file: {exc.strerror}") from None
+
+
+def _load_json(path: Path) -> Any:
+    from service.errors import InvalidInput
+
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise InvalidInput(f"{path}: cannot read the file: {exc.strerror}") from None
+    except json.JSONDecodeError as exc:
+        raise InvalidInput(f"{path}: invalid JSON at line {exc.lineno} column {exc.colno}: "
+                           f"{exc.msg}") from None
+
+
+def _print(data: Any) -> None:
+    print(json.dumps(data, indent=2, sort_keys=True))
+
+
+def run_submit(args: argparse.Namespace) -> int:
+    api = _api(args)
+    try:
+        for kind, path in (("team_config", args.team_config), ("credentials", args.credentials)):
+            if path is not None:
+                stored = api.call("PUT", f"/v1/team/files/{kind}", json=_load_json(path))
+                print(f"hlvs: {path} stored as {kind} version {stored['version']}",
+                      file=sys.stderr)
+        status = api.call("POST", "/v1/submissions", json={"opponent": args.opponent})
+        if not args.wait:
+            _print(status)
+            return 0
+        print(f"hlvs: {status['id']} queued; waiting for it to end", file=sys.stderr)
+        last = None
+        while status["state"] not in FINAL_STATES:
+            line = f"{status['state']}" + (f", position {status['queue_position']}, "
+                                           f"{status['waiting_reason']}"
+                                           if status.get("queue_position") else "")
+            if line != last:
+                print(f"hlvs: {status['id']}: {line}", file=sys.stderr)
+                last = line
+            time.sleep(args.poll)
+            status = api.call("GET", f"/v1/submissions/{status['id']}")
+        _print(status)
+        return 0 if status["state"] == "done" else 1
+    finally:
+        api.close()
+
+
+def run_status(args: argparse.Namespace) -> int:
+    api = _api(args)
+    try:
+        path = "/v1/submissions" + (f"/{args.submission}" if args.submission else "")
+        _print(api.call("GET", path))
+        return 0
+    finally:
+        api.close()
+
+
+def run_cancel(args: argparse.Namespace) -> int:
+    api = _api(args)
+    try:
+        _print(api.call("POST", f"/v1/submissions/{args.submission}/cancel"))
+        return 0
+    finally:
+        api.close()
+
+
+def run_results(args: argparse.Namespace) -> int:
+    from service.errors import ClientError
+
+    api = _api(args)
+    out: Path = args.out or Path(args.submission)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        report = api.call("GET", f"/v1/submissions/{args.submission}/report")
+        (out / "report.json").write_text(json.dumps(report, indent=2) + "\n")
+        written = ["report.json"]
+        for name, path in (("results.json", "results"), ("replay.hlvsrec", "replay"),
+                           ("match.mp4", "video")):
+            try:
+                data = api.call("GET", f"/v1/submissions/{args.submission}/{path}")
+            except ClientError as exc:
+                if exc.status == 404:
+                    continue  # not produced (yet): the match has not ended, or no video
+                raise
+            content = data if isinstance(data, bytes) else json.dumps(data, indent=2).encode()
+            (out / name).write_bytes(content)
+            written.append(name)
+        _print({"submission": args.submission, "state": report["state"], "folder": str(out),
+                "files": written})
+        return 0
+    finally:
+        api.close()
+
+
+def run_logs(args: argparse.Namespace) -> int:
+    api = _api(args)
+    out: Path = args.out or Path(args.submission) / "logs"
+    try:
+        listing = api.call("GET", f"/v1/submissions/{args.submission}/logs")
+        written = []
+        for part in ("team", "public"):
+            for name in listing[part]:
+                data = api.call("GET", f"/v1/submissions/{args.submission}/logs/{part}/{name}")
+                target = out / part / name
+                target.parent.mkdir(parents=True, exist_ok=True)
+                target.write_bytes(data if isinstance(data, bytes) else
+                                   json.dumps(data).encode())
+                written.append(f"{part}/{name}")
+        _print({"submission": args.submission, "folder": str(out), "files": written})
+        return 0
+    finally:
+        api.close()
+
+
+__all__ = ["Api", "register"]

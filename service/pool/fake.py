@@ -16,8 +16,9 @@ from service.pool import JobState, JobStatus, MatchJob
 
 
 class FakePool:
-    def __init__(self, *, slots: int = 1) -> None:
+    def __init__(self, *, slots: int = 1, auto_finish: bool = False) -> None:
         self.slots = slots
+        self.auto_finish = auto_finish  # a running match succeeds at its first status query
         self.submitted: list[str] = []  # match ids, in order, including adopted ones
         self.started: list[str] = []  # match ids actually started
         self.cancelled: list[str] = []
@@ -33,6 +34,8 @@ class FakePool:
         return handle
 
     def status(self, handle: str) -> JobStatus:
+        if self.auto_finish and (Path(handle) / "running").exists():
+            self.finish(handle, {"status": "success"})
         if (Path(handle) / "running").exists():
             return JobStatus(state=JobState.RUNNING)
         if (self.results_dir(handle) / "report.json").exists():
@@ -57,7 +60,10 @@ class FakePool:
         (out / "teams" / "red" / "1" / "stdout.log").write_text("red robot log\n")
         (out / "teams" / "blue" / "1" / "stdout.log").write_text("blue robot log\n")
         (out / "public" / "referee.log").write_text("referee\n")
-        (out / "results.json").write_text(json.dumps({"score": {"red": 1, "blue": 0}}))
+        (out / "results.json").write_text(json.dumps({
+            "score": {"red": 1, "blue": 0},
+            "robots": {"red-1": {"exit_code": 0}, "blue-1": {"exit_code": 0}}}))
+        (out / "public" / "replay.hlvsrec").write_bytes(b"HLVSREC fake replay")
         (out / "report.json").write_text(json.dumps(report))
         (Path(handle) / "running").unlink(missing_ok=True)
 

@@ -123,7 +123,9 @@ def _file(path: Path, what: str, row: Submission, media_type: str) -> FileRespon
 def get_report(submission_id: str, request: Request, principal: TeamPrincipal,
                session: DbSession) -> JSONResponse:
     """The match's ``report.json`` with whose side a failure was on (``backend_error`` is true
-    when it was the league's) and the exit codes of the team's own robots."""
+    when it was the league's), the exit codes of the team's own robots and
+    ``user_returncode`` (the first non-zero one, 0 when all exited 0, null when unknown or
+    on a backend error)."""
     assert principal.team_id is not None
     row = submissions.get_own(session, team_id=principal.team_id, submission_id=submission_id)
     match_report: Any = None
@@ -143,8 +145,13 @@ def get_report(submission_id: str, request: Request, principal: TeamPrincipal,
                         robots[key] = {k: robot.get(k) for k in (
                             "image", "exit_code", "oom_killed", "image_error", "startup_error",
                             "exited_during_game")}
+    codes = [r.get("exit_code") for r in robots.values()]
+    user_returncode = None
+    if codes and all(isinstance(c, int) for c in codes) and row.failure_side != "league":
+        user_returncode = next((c for c in codes if c != 0), 0)
     return JSONResponse({
         "submission": row.id, "state": row.state, "match_id": row.match_id,
+        "user_returncode": user_returncode,
         "status": "success" if row.state == "done" else row.state,
         "failure_class": row.failure_class, "failure_side": row.failure_side,
         "backend_error": row.failure_side == "league", "cause": row.cause,

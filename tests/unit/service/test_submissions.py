@@ -63,9 +63,10 @@ def test_submit_run_finish_and_download(start: Callable[..., Served], token: Cal
         report = http.get(f"/v1/submissions/{sid}/report").json()
         assert report["status"] == "success" and report["backend_error"] is False
         assert report["match_report"] == {"status": "success"}
+        assert report["user_returncode"] == 0 and set(report["team_robots"]) == {"red-1"}
         assert http.get(f"/v1/submissions/{sid}/results").json()["score"] == {"red": 1, "blue": 0}
         logs = http.get(f"/v1/submissions/{sid}/logs").json()
-        assert logs == {"team": ["1/stdout.log"], "public": ["referee.log"]}
+        assert logs == {"team": ["1/stdout.log"], "public": ["referee.log", "replay.hlvsrec"]}
         own = http.get(f"/v1/submissions/{sid}/logs/team/1/stdout.log")
         assert own.status_code == 200 and own.text == "red robot log\n"
         escape = http.get(f"/v1/submissions/{sid}/logs/team/..%2Fblue%2F1%2Fstdout.log")
