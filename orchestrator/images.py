@@ -175,7 +175,9 @@ def ensure_image(
             context_dir=context_dir,
             tag=reference,
             build_args=build_args,
-            labels={LABEL_PROJECT: "1", LABEL_IMAGE: name, LABEL_CONTENT: content},
+            # LABEL_PROJECT marks what a match creates; containers inherit image labels, so
+            # images clear it (older bases still carry it).
+            labels={LABEL_PROJECT: "", LABEL_IMAGE: name, LABEL_CONTENT: content},
             log_path=log_path,
             network_mode=network_mode,
             on_step=steps,
@@ -273,7 +275,7 @@ def _ensure_base(
                 repository=image_inputs.BASE_REPOSITORY,
                 tag=base_recipe.tag,
                 changes=[
-                    f'LABEL {LABEL_PROJECT}="1" {LABEL_IMAGE}="base"',
+                    f'LABEL {LABEL_IMAGE}="base"',
                     "ENV LANG=C.UTF-8",
                     'CMD ["/bin/bash"]',
                 ],
@@ -298,7 +300,7 @@ def _tag_latest(
 
 
 def _prune_old_versions(client: DockerClient, recipe: ImageRecipe, *, keep_id: str) -> None:
-    versions = engine_images.list_labelled(client, {LABEL_PROJECT: "1", LABEL_IMAGE: recipe.name})
+    versions = engine_images.list_labelled(client, {LABEL_IMAGE: recipe.name})
     for info in versions[KEEP_VERSIONS:]:
         if info.id == keep_id or time.time() - info.created_unix < KEEP_RECENT_S:
             continue

@@ -42,8 +42,12 @@ def register(sub: Any) -> None:
                        help="print results.json (with the outcome and output folder) on stdout")
     scrim.set_defaults(func=run_scrimmage_command, log_level=logging.INFO)
 
-    clean = sub.add_parser("cleanup", help="remove containers, networks and mounts left behind")
-    clean.add_argument("--match", default=None, help="only this match id (default: all)")
+    clean = sub.add_parser(
+        "cleanup", help="salvage the logs of matches whose orchestrator is gone, then remove "
+        "their containers, networks and mounts")
+    clean.add_argument("--match", default=None,
+                       help="only this match id, refused while its orchestrator runs (default: "
+                       "every match whose orchestrator is gone)")
     clean.add_argument("--dry-run", action="store_true",
                        help="list what would be removed, remove nothing")
     clean.set_defaults(func=run_cleanup_command)

@@ -33,9 +33,12 @@ from orchestrator.match import (
     RunOptions,
     cleanup,
     local_images,
+    ownership,
     plan_from_game,
     scrimmage,
 )
+from orchestrator.match.cleanup import clean_match
+from orchestrator.match.ownership import LABEL_RUN
 from orchestrator.match.runner import ImageResolver
 from orchestrator.paths import user_path
 
@@ -83,19 +86,33 @@ def play(
     plan: MatchPlan, *, out_dir: Path, pull: bool, loaded: Any = None,
     extra_labels: dict[str, str] | None = None,
 ) -> MatchOutcome:
-    """Play ``plan`` on the local engine with the real host controls, showing progress."""
+    """Play ``plan`` on the local engine with the real host controls, showing progress. The
+    match id is claimed first (:class:`~orchestrator.match.ownership.MatchRunning` while another
+    orchestrator plays it); what a dead earlier run of it left is salvaged and removed."""
     from orchestrator.engine import connect
     from orchestrator.engine.containers import DockerRuntime
-    from orchestrator.images import project_image
-    from orchestrator.telemetry import LiveView, ZenohTelemetry
 
     client = connect()
     runtime = DockerRuntime(client)
     host = HostControl.for_current_user()
-    leftovers = cleanup(runtime, host, match_id=plan.match_id)
-    if leftovers.containers or leftovers.networks:
-        log.info("removed %d containers and %d networks left by an earlier run of %s",
-                 len(leftovers.containers), len(leftovers.networks), plan.match_id)
+    with ownership.claim(plan.match_id, out_dir) as claim:  # refused while another runs it
+        leftovers = clean_match(runtime, host, match_id=plan.match_id, record=claim.previous,
+                                keep_run=claim.record.run_id)
+        if leftovers.containers or leftovers.networks:
+            log.info("removed %d containers and %d networks left by an earlier run of %s",
+                     len(leftovers.containers), len(leftovers.networks), plan.match_id)
+        return _play(plan, out_dir=out_dir, pull=pull, loaded=loaded, client=client,
+                     runtime=runtime, host=host,
+                     extra_labels={**(extra_labels or {}), LABEL_RUN: claim.record.run_id})
+
+
+def _play(
+    plan: MatchPlan, *, out_dir: Path, pull: bool, loaded: Any, client: Any, runtime: Any,
+    host: HostControl, extra_labels: dict[str, str],
+) -> MatchOutcome:
+    from orchestrator.images import project_image
+    from orchestrator.telemetry import LiveView, ZenohTelemetry
+
     simulator_image = project_image("simulator")
     images = _pull_resolver(client, loaded) if pull and loaded is not None else None
     view = LiveView(match_id=plan.match_id)
@@ -195,6 +212,7 @@ def run_cleanup_command(args: argparse.Namespace) -> int:
     print(json.dumps({
         "containers": list(report.containers), "networks": list(report.networks),
         "host_objects": report.host_objects, "errors": list(report.errors),
+        "salvaged": list(report.salvaged), "skipped": list(report.skipped),
     }))
     if report.errors:
         raise OrchestratorError("cleanup incomplete: " + "; ".join(report.errors))

@@ -1,17 +1,25 @@
 """Remove what matches left behind (after a crash or kill -9), found by our labels.
 
-Containers go first (so networks have no endpoints left), then networks, then the host firewall
-rules and the loop-mounted log folders.
+Only matches whose orchestrator is gone are touched (see :mod:`orchestrator.match.ownership`),
+or one match named by the operator (refused while its orchestrator runs). Before anything is
+removed, the teams' logs are salvaged into the match's output folder. Then containers go first
+(so networks have no endpoints left), then networks, then the host firewall rules and the
+loop-mounted log folders. Objects of a match with no run record are listed, never removed, unless
+that match is named.
 """
 
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
+from orchestrator.engine import LABEL_MATCH
 from orchestrator.errors import OrchestratorError
+from orchestrator.match import logfs, ownership
 from orchestrator.match.host import Host
-from orchestrator.match.runtime import ContainerRuntime, ObjectNotFound
+from orchestrator.match.ownership import LABEL_RUN, MatchRunning, RunRecord
+from orchestrator.match.runtime import ContainerRuntime, ObjectNotFound, ProjectObject
+from orchestrator.match.salvage import salvage
 
 log = logging.getLogger(__name__)
 
@@ -22,40 +30,97 @@ class CleanupReport:
     networks: tuple[str, ...]
     host_objects: int
     errors: tuple[str, ...] = ()
+    salvaged: tuple[str, ...] = ()  # output folders the teams' logs were saved into
+    skipped: tuple[str, ...] = ()  # matches left alone, with the reason
+
+
+@dataclass(slots=True)
+class _Totals:
+    containers: list[str] = field(default_factory=list)
+    networks: list[str] = field(default_factory=list)
+    host_objects: int = 0
+    errors: list[str] = field(default_factory=list)
+    salvaged: list[str] = field(default_factory=list)
+    skipped: list[str] = field(default_factory=list)
+
+    def report(self) -> CleanupReport:
+        return CleanupReport(
+            containers=tuple(self.containers), networks=tuple(self.networks),
+            host_objects=self.host_objects, errors=tuple(self.errors),
+            salvaged=tuple(self.salvaged), skipped=tuple(sorted(set(self.skipped))),
+        )
 
 
 def cleanup(runtime: ContainerRuntime, host: Host, *, match_id: str | None = None
             ) -> CleanupReport:
-    """Remove every container and network of ``match_id`` (or of every match)."""
-    found = runtime.list_project(match_id=match_id)
-    containers: list[str] = []
-    networks: list[str] = []
-    errors: list[str] = []
-    for obj in found:
-        if obj.kind != "container":
+    """Clean ``match_id`` (refused while its orchestrator runs), or every match whose
+    orchestrator is gone."""
+    totals = _Totals()
+    if match_id is not None:
+        record = ownership.read(match_id)
+        if record is not None and ownership.owner_alive(record):
+            raise MatchRunning(record)
+        clean_match(runtime, host, match_id=match_id, record=record, totals=totals)
+        return totals.report()
+    owned: dict[str, RunRecord] = {}
+    for record in ownership.records():
+        owned[record.match_id] = record
+        if ownership.owner_alive(record):
+            totals.skipped.append(f"{record.match_id}: its orchestrator (pid {record.pid} on "
+                                  f"{record.hostname}) is running")
             continue
-        try:
-            runtime.remove(obj.id)
-            containers.append(obj.name)
-        except ObjectNotFound:
-            continue
-        except OrchestratorError as exc:
-            errors.append(str(exc))
-    for obj in found:
-        if obj.kind != "network":
-            continue
-        try:
-            runtime.remove_network(obj.id)
-            networks.append(obj.name)
-        except ObjectNotFound:
-            continue
-        except OrchestratorError as exc:
-            errors.append(str(exc))
-    host_objects = host.cleanup(match_id=match_id)
-    for name in containers + networks:
-        log.info("cleanup: removed %s", name)
-    return CleanupReport(containers=tuple(containers), networks=tuple(networks),
-                         host_objects=host_objects, errors=tuple(errors))
+        clean_match(runtime, host, match_id=record.match_id, record=record, totals=totals)
+    for obj in runtime.list_project():
+        other = obj.labels.get(LABEL_MATCH)
+        if other and other not in owned:
+            totals.skipped.append(f"{other}: no run record (name it: hlvs cleanup --match "
+                                  f"{other})")
+    return totals.report()
 
 
-__all__ = ["CleanupReport", "cleanup"]
+def clean_match(runtime: ContainerRuntime, host: Host, *, match_id: str,
+                record: RunRecord | None, keep_run: str | None = None,
+                totals: _Totals | None = None) -> CleanupReport:
+    """Salvage (when the run record names an output folder) and remove one match's objects;
+    objects labelled with run ``keep_run`` (the caller's own) are kept."""
+    totals = totals if totals is not None else _Totals()
+    found = [o for o in runtime.list_project(match_id=match_id)
+             if keep_run is None or o.labels.get(LABEL_RUN) != keep_run]
+    leftover_logs = (logfs.state_dir() / "logfs" / logfs.safe_name(match_id)).is_dir()
+    if record is not None and (found or leftover_logs):
+        try:
+            salvaged = salvage(runtime, record, found)
+            totals.salvaged.append(salvaged.out_dir)
+            totals.errors.extend(salvaged.errors)
+        except (OrchestratorError, OSError) as exc:
+            totals.errors.append(f"{match_id}: salvage failed: {exc}")
+    _remove(runtime, found, totals)
+    try:
+        totals.host_objects += host.cleanup(match_id=match_id)
+    except OrchestratorError as exc:
+        totals.errors.append(f"{match_id}: {exc}")
+    if record is not None:
+        ownership.forget(record)
+    return totals.report()
+
+
+def _remove(runtime: ContainerRuntime, found: list[ProjectObject], totals: _Totals) -> None:
+    for kind in ("container", "network"):
+        for obj in found:
+            if obj.kind != kind:
+                continue
+            try:
+                if kind == "container":
+                    runtime.remove(obj.id)
+                    totals.containers.append(obj.name)
+                else:
+                    runtime.remove_network(obj.id)
+                    totals.networks.append(obj.name)
+                log.info("cleanup: removed %s", obj.name)
+            except ObjectNotFound:
+                continue
+            except OrchestratorError as exc:
+                totals.errors.append(str(exc))
+
+
+__all__ = ["CleanupReport", "clean_match", "cleanup"]

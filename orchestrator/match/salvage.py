@@ -1,0 +1,103 @@
+"""Salvage a match whose orchestrator is gone: stop its containers and save what the teams
+produced (each robot's stdout/stderr and ``/robocup-logs``) and the simulator's public files into
+the match's output folder, with a ``report.json`` that says the match was interrupted.
+"""
+
+from __future__ import annotations
+
+import logging
+import re
+import shutil
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from orchestrator.engine import LABEL_ROBOT, LABEL_ROLE, LABEL_TEAM
+from orchestrator.errors import OrchestratorError
+from orchestrator.match import logfs
+from orchestrator.match.ownership import RunRecord
+from orchestrator.match.results import Failure, FailureClass, write_report, write_results
+from orchestrator.match.runtime import ContainerRuntime, ProjectObject
+from orchestrator.match.safecopy import copy_tree
+
+log = logging.getLogger(__name__)
+
+STOP_TIMEOUT_S = 10.0
+PUBLIC_FILES = (
+    "sim_result.json", "replay.hlvsrec", "referee.log", "referee_events.jsonl",
+    "gamecontroller.log", "bouncing_log.txt",
+)
+
+
+@dataclass(slots=True)
+class SalvageReport:
+    out_dir: str
+    robots: dict[str, dict[str, Any]] = field(default_factory=dict)
+    public: list[str] = field(default_factory=list)
+    errors: list[str] = field(default_factory=list)
+
+
+def _robot_key(obj: ProjectObject) -> tuple[str, str] | None:
+    team, number = obj.labels.get(LABEL_TEAM, ""), obj.labels.get(LABEL_ROBOT, "")
+    if team in ("red", "blue") and re.fullmatch(r"[1-9][0-9]?", number):
+        return team, number
+    return None
+
+
+def salvage(runtime: ContainerRuntime, record: RunRecord, objects: list[ProjectObject]
+            ) -> SalvageReport:
+    out = Path(record.out_dir)
+    report = SalvageReport(out_dir=str(out))
+    containers = [o for o in objects if o.kind == "container"]
+    robots = [(o, key) for o in containers if o.labels.get(LABEL_ROLE) == "robot"
+              and (key := _robot_key(o)) is not None]
+    for obj, (team, number) in robots:
+        folder = out / "teams" / team / number
+        entry = report.robots.setdefault(f"{team}-{number}", {})
+        try:
+            runtime.stop(obj.id, timeout_s=STOP_TIMEOUT_S)
+            folder.mkdir(parents=True, exist_ok=True, mode=0o700)
+            runtime.save_logs(obj.id, stdout=folder / "stdout.log", stderr=folder / "stderr.log")
+            entry["stdout"] = True
+        except (OrchestratorError, OSError) as exc:
+            report.errors.append(f"{team}-{number}: logs not saved: {exc}")
+    for obj in containers:
+        if obj.labels.get(LABEL_ROLE) != "simulator":
+            continue
+        sim_dir = out / "simulator"
+        try:
+            runtime.stop(obj.id, timeout_s=STOP_TIMEOUT_S)
+            runtime.save_logs(obj.id, stdout=sim_dir / "stdout.log", stderr=sim_dir / "stderr.log")
+        except (OrchestratorError, OSError) as exc:
+            report.errors.append(f"simulator: logs not saved: {exc}")
+    public = out / "public"
+    for name in PUBLIC_FILES:
+        source = out / "simulator" / "out" / name
+        if source.is_file() and not source.is_symlink():
+            public.mkdir(parents=True, exist_ok=True, mode=0o700)
+            shutil.copyfile(source, public / name)
+            report.public.append(name)
+    base = logfs.state_dir() / "logfs" / logfs.safe_name(record.match_id)
+    for team in ("red", "blue"):
+        for mount in sorted(base.glob(f"{team}-*")) if base.is_dir() else []:
+            number = mount.name.partition("-")[2]
+            if not mount.is_dir() or mount.is_symlink() or not number.isdigit():
+                continue
+            copied = copy_tree(mount, out / "teams" / team / number / "robocup-logs")
+            report.robots.setdefault(mount.name, {})["log_folder"] = copied.to_json()
+    cause = (f"the orchestrator (pid {record.pid} on {record.hostname}) was gone; hlvs cleanup "
+             "stopped the match and salvaged the teams' logs")
+    failure = Failure(failure_class=FailureClass.INTERRUPTED, cause=cause)
+    if not (out / "results.json").is_file():
+        write_results(out, {
+            "match_id": record.match_id, "status": "failed",
+            "failure": {"class": failure.failure_class.value, "cause": cause},
+            "salvaged": {"robots": report.robots, "public": report.public,
+                         "errors": report.errors},
+        })
+    write_report(out, failure)
+    log.info("match %s: salvaged into %s (%d robots)", record.match_id, out, len(report.robots))
+    return report
+
+
+__all__ = ["SalvageReport", "salvage"]

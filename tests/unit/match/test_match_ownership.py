@@ -1,0 +1,92 @@
+"""Matches own what they create: a running match id is refused, cleanup touches only matches
+whose orchestrator is gone and salvages their logs first (fake engine, real files)."""
+
+from __future__ import annotations
+
+import json
+import os
+import socket
+from dataclasses import asdict, replace
+from pathlib import Path
+
+import pytest
+
+from orchestrator.match import ownership
+from orchestrator.match.cleanup import cleanup
+from orchestrator.match.fake import FakeHost, FakeRuntime
+from orchestrator.match.layout import labels
+from orchestrator.match.ownership import LABEL_RUN, MatchRunning, RunRecord
+from orchestrator.match.runtime import ContainerRequest
+
+
+@pytest.fixture(autouse=True)
+def state(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    monkeypatch.setenv("HLVS_STATE_DIR", str(tmp_path / "state"))
+    return tmp_path / "state"
+
+
+def _dead_record(match_id: str, out: Path) -> RunRecord:
+    record = RunRecord(match_id=match_id, run_id=f"run-{match_id}", pid=os.getpid(),
+                       pid_start="0", hostname=socket.gethostname(), out_dir=str(out),
+                       started_unix_s=0.0)  # pid_start 0: this pid is some other process now
+    ownership.runs_dir().mkdir(parents=True, exist_ok=True)
+    ownership.record_path(match_id).write_text(json.dumps(asdict(record)))
+    return record
+
+
+def _robot(runtime: FakeRuntime, match_id: str, run: str, team: str, number: int) -> str:
+    cid = runtime.create_container(ContainerRequest(
+        name=f"hlvs-{match_id}-{team}-{number}", image="img",
+        labels={**labels(match_id, "robot", team=team, robot=str(number)), LABEL_RUN: run}))
+    runtime.start(cid)
+    return cid
+
+
+def test_second_claim_of_a_running_match_is_refused_with_its_details(tmp_path: Path) -> None:
+    with ownership.claim("m1", tmp_path / "out") as first:
+        with pytest.raises(MatchRunning) as refused:
+            with ownership.claim("m1", tmp_path / "other"):
+                pass
+        assert refused.value.record == first.record
+        message = str(refused.value)
+        assert f"pid {os.getpid()}" in message and str(tmp_path / "out") in message
+    with ownership.claim("m1", tmp_path / "again") as second:  # released at the end
+        assert second.previous is None
+
+
+def test_claim_after_a_dead_orchestrator_hands_back_its_record(tmp_path: Path) -> None:
+    dead = _dead_record("m2", tmp_path / "out")
+    with ownership.claim("m2", tmp_path / "out") as claim:
+        assert claim.previous == dead
+        assert ownership.read("m2") == claim.record
+
+
+def test_cleanup_touches_only_dead_matches_and_salvages_their_logs(tmp_path: Path) -> None:
+    runtime, host = FakeRuntime(), FakeHost()
+    out = tmp_path / "dead-out"
+    _dead_record("dead", out)
+    dead_robot = _robot(runtime, "dead", "run-dead", "red", 1)
+    with ownership.claim("alive", tmp_path / "alive-out") as alive:
+        _robot(runtime, "alive", alive.record.run_id, "blue", 2)
+        _robot(runtime, "unowned", "x", "red", 1)
+        report = cleanup(runtime, host, match_id=None)
+        assert report.containers == ("hlvs-dead-red-1",)
+        assert report.salvaged == (str(out),)
+        assert any(s.startswith("alive: its orchestrator") for s in report.skipped)
+        assert any(s.startswith("unowned: no run record") for s in report.skipped)
+        assert ("stop", dead_robot) in runtime.calls
+        assert (out / "teams/red/1/stdout.log").is_file()
+        assert json.loads((out / "report.json").read_text())["failure_class"] == "interrupted"
+        assert json.loads((out / "results.json").read_text())["status"] == "failed"
+        assert ownership.read("dead") is None
+        with pytest.raises(MatchRunning):
+            cleanup(runtime, host, match_id="alive")
+    remaining = {o.name for o in runtime.list_project()}
+    assert remaining == {"hlvs-alive-blue-2", "hlvs-unowned-red-1"}
+    named = cleanup(runtime, host, match_id="unowned")  # named: removed without a record
+    assert named.containers == ("hlvs-unowned-red-1",) and named.salvaged == ()
+
+
+def test_a_record_from_another_host_counts_as_alive(tmp_path: Path) -> None:
+    record = replace(_dead_record("far", tmp_path), hostname="elsewhere")
+    assert ownership.owner_alive(record)
