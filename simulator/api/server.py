@@ -223,6 +223,12 @@ class ApiServer:
                 log.warning("%s: accept failed: %s", slot.session.key, exc)
                 return
             peer = f"{address[0]}:{address[1]}"
+            ip = address[0]
+            if ip in slot.endpoint.others or (
+                ip not in slot.endpoint.allowed_ips and not slot.endpoint.allowed_names
+            ):  # who may speak as this robot is checked first, connected or not
+                self._refuse_host(slot, sock, peer)
+                continue
             if slot.conn is not None or slot.checking is not None:
                 slot.stats.refused += 1
                 log.warning(
@@ -231,17 +237,14 @@ class ApiServer:
                 )  # fmt: skip
                 _refuse(sock)
                 continue
-            ip = address[0]
             if ip in slot.endpoint.allowed_ips:
                 self._welcome(slot, sock, peer)
-            elif slot.endpoint.allowed_names and ip not in slot.endpoint.others:
-                if self._lookups is None:
-                    self._lookups = ThreadPoolExecutor(max_workers=1, thread_name_prefix="api-dns")
-                names = sorted(slot.endpoint.allowed_names)
-                future = self._lookups.submit(peer_allowed_by_name, ip, names)
-                slot.checking = (sock, peer, future)
-            else:
-                self._refuse_host(slot, sock, peer)
+                continue
+            if self._lookups is None:  # the team's hosts are names: resolve off the step thread
+                self._lookups = ThreadPoolExecutor(max_workers=1, thread_name_prefix="api-dns")
+            names = sorted(slot.endpoint.allowed_names)
+            future = self._lookups.submit(peer_allowed_by_name, ip, names)
+            slot.checking = (sock, peer, future)
 
     def _finish_lookups(self) -> None:
         for slot in self.slots.values():

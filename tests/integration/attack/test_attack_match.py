@@ -45,7 +45,7 @@ def test_spoofed_gamecontroller_and_api_messages_are_refused_and_reported(
     assert keeper["count"] == 20 and keeper["sender_robot"] == "red-1"
     assert attempts[("gamecontroller", "blue-1", "MAN_PENALISE")]["count"] == 5
     seen = json.loads((match.out / "teams/red/1/robocup-logs/attacks.json").read_text())
-    assert seen["blue_api"] == ["Refused\0"] * 3, seen
+    assert seen["blue_api"] == ["Refused\0"] * 3 and seen["rgme"] is True, seen
     api = attempts[("api", "blue-1", "connect")]
     assert api["sender_robot"] == "red-1" and api["count"] == 3
     assert results["robots"]["red-1"]["spoofing_attempts"] == 28

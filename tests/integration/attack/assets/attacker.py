@@ -37,7 +37,15 @@ def spoof() -> None:
         except OSError:
             time.sleep(0.2)  # the simulator is still starting
     seen["blue_api"] = answers
-    time.sleep(1.0)  # the GameController opens its ports right after the API server
+    listener = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    listener.bind(("0.0.0.0", 3838))
+    listener.settimeout(60)
+    try:
+        listener.recvfrom(4096)  # the first RGme: the GameController's ports are open
+        seen["rgme"] = True
+    except OSError as exc:
+        seen["rgme"] = f"failed: {exc}"
+    listener.close()
     sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     for _ in range(20):
         sock.sendto(rgrt(2, 1, 3), (gc, 3939))  # blue (team 2) player 1 GOALKEEPER
