@@ -52,7 +52,7 @@ images: venv engine
 	$(HLVS) images build $(if $(BASE_IMAGE),--base $(BASE_IMAGE),)
 
 lint:
-	$(VENV)/bin/ruff check orchestrator simulator referee service envs viewer tests
+	$(VENV)/bin/ruff check orchestrator simulator referee service envs viewer examples tests
 
 typecheck:
 	$(VENV)/bin/mypy

@@ -82,6 +82,7 @@ class KickEnv(HlvsEnv):
         self._steps = 0
         self._ball_start = np.zeros(2)
         self._last: tuple[Frame | None, tuple[float, float]] = (None, (0.0, 0.0))
+        self._outcome: tuple[Frame | None, tuple[bool, bool, bool]] = (None, (False,) * 3)
 
     def reset_request(self, world_seed: int, options: dict[str, Any]) -> ResetRequest:
         rng = self.np_random
@@ -117,6 +118,13 @@ class KickEnv(HlvsEnv):
 
     def outcome(self, frame: Frame) -> tuple[bool, bool, bool]:
         """(goal, fallen, out) for a frame."""
+        if self._outcome[0] is frame:
+            return self._outcome[1]
+        result = self._judge_outcome(frame)
+        self._outcome = (frame, result)
+        return result
+
+    def _judge_outcome(self, frame: Frame) -> tuple[bool, bool, bool]:
         x, y, z = frame.truth[BALL_POS].tolist()
         f = self.field
         r = f.ball_radius_m

@@ -80,7 +80,7 @@ def observation_space(
 
 def observe(frame: Frame, space: spaces.Dict) -> dict[str, Any]:
     """The observation of ``frame`` for ``space`` (values clipped into the bounds)."""
-    s = np.clip(frame.sensors, _LOW, _HIGH).astype(F32)
+    s = np.minimum(np.maximum(frame.sensors, _LOW), _HIGH).astype(F32)
     obs: dict[str, Any] = {
         "joints": s[JOINTS],
         "accelerometer": s[ACCEL],

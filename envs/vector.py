@@ -1,10 +1,11 @@
 """A vector environment spread over remote simulators: one environment per remote.
 
 ``make_vector("hlvs/Kick-v0", remotes=4)`` starts four simulator containers (or takes
-``remotes="hlvs://a:7700,b:7700"``). A step sends every remote its action first and then
-collects the answers, so the remotes step at the same time. Environments that end are reset in
-the same step (Gymnasium's ``SAME_STEP`` autoreset: ``infos["final_obs"]`` and
-``infos["final_info"]`` hold what ended). Environment ``i`` is seeded with ``seed + i``.
+``remotes="hlvs://a:7700,b:7700"``; ``remotes=None, num_envs=n`` keeps them in this process).
+A step sends every remote its action first and then collects the answers, so the remotes step
+at the same time. Environments that end are reset in the same step (Gymnasium's ``SAME_STEP``
+autoreset: ``infos["final_obs"]`` and ``infos["final_info"]`` hold what ended). Environment
+``i`` is seeded with ``seed + i``.
 """
 
 from __future__ import annotations
@@ -21,8 +22,19 @@ from envs.remote import RemotePool, RemoteSession
 
 
 def make_vector(
-    env_id: str, *, remotes: int | str, image: str | None = None, **kwargs: Any
-) -> RemoteVectorEnv:
+    env_id: str,
+    *,
+    remotes: int | str | None,
+    num_envs: int = 1,
+    image: str | None = None,
+    **kwargs: Any,
+) -> VectorEnv:
+    """One environment per remote; with ``remotes=None``, ``num_envs`` in-process environments
+    stepped one after the other (Gymnasium's ``SyncVectorEnv``)."""
+    if remotes is None:
+        from gymnasium.vector import SyncVectorEnv
+
+        return SyncVectorEnv([lambda: gym.make(env_id, **kwargs) for _ in range(num_envs)])
     pool = RemotePool.open(remotes, image=image)
     try:
         spec_env = gym.make(env_id, session=_NullSession(), **kwargs).unwrapped

@@ -168,3 +168,14 @@ def test_camera_observation_and_render() -> None:
     green = image[:, :, 1].astype(int) - image[:, :, 0].astype(int)
     assert (green > 30).mean() > 0.2  # the robot looks at the turf
     env.close()
+
+
+def test_in_process_vector_env() -> None:
+    from envs.vector import make_vector
+
+    vec = make_vector("hlvs/Kick-v0", remotes=None, num_envs=2)
+    obs, _ = vec.reset(seed=3)
+    assert obs["joints"].shape == (2, 20)
+    obs, rewards, *_ = vec.step(np.zeros((2, 20), np.float32))
+    assert rewards.shape == (2,) and not np.array_equal(obs["joints"][0], obs["joints"][1])
+    vec.close()
