@@ -1,4 +1,4 @@
-"""``hlvs render`` and ``hlvs bench sim|api|stub|envs|bringup|delivery|cli``: commands with
+"""``hlvs render`` and ``hlvs bench sim|api|stub|envs|bringup|delivery|cli|viewer``: commands with
 parsers of their own, to which the arguments are forwarded unread (``--help`` included).
 
 The orchestrator does not import the simulator; ``render`` and the simulator's (or the learning
@@ -54,12 +54,23 @@ def register(sub: Any) -> None:
     forward(kinds, "delivery", help="log delivery throughput to SFTP and S3 (JSON)",
             func=_delivery)
     forward(kinds, "cli", help="start-up time of hlvs --help (JSON)", func=_cli)
+    forward(
+        kinds, "viewer", help="the web viewer: open and play a 2 x 10 min 4 v 4 replay (JSON)",
+        func=_viewer,
+    )
 
 
 def _bringup(args: argparse.Namespace) -> int:
     from orchestrator.bringup import main as bringup_main
 
     return int(bringup_main(list(args.rest)))
+
+
+def _viewer(args: argparse.Namespace) -> int:
+    os.environ["HLVS_PROG"] = "hlvs"
+    from benchmarks.viewer import main as viewer_main
+
+    return int(viewer_main(list(args.rest)))
 
 
 def _cli(args: argparse.Namespace) -> int:

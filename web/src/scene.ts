@@ -2,6 +2,7 @@
 // body by body from frames (x y z qw qx qy qz per body, MuJoCo's world frame, z up).
 import * as THREE from "three";
 import { OrbitControls } from "three/examples/jsm/controls/OrbitControls.js";
+import { mergeGeometries } from "three/examples/jsm/utils/BufferGeometryUtils.js";
 
 export interface GeomSpec {
   name: string;
@@ -64,13 +65,13 @@ function geometry(g: GeomSpec): THREE.BufferGeometry {
     case "box":
       return new THREE.BoxGeometry(2 * a, 2 * b, 2 * c);
     case "capsule":
-      return new THREE.CapsuleGeometry(a, 2 * b, 4, 12).rotateX(Math.PI / 2);
+      return new THREE.CapsuleGeometry(a, 2 * b, 2, 8).rotateX(Math.PI / 2);
     case "cylinder":
-      return new THREE.CylinderGeometry(a, a, 2 * b, 16).rotateX(Math.PI / 2);
+      return new THREE.CylinderGeometry(a, a, 2 * b, 12).rotateX(Math.PI / 2);
     case "ellipsoid":
-      return new THREE.SphereGeometry(1, 16, 12).scale(a, b, c);
+      return new THREE.SphereGeometry(1, 12, 8).scale(a, b, c);
     default:
-      return new THREE.SphereGeometry(a, 24, 16);
+      return new THREE.SphereGeometry(a, 16, 10);
   }
 }
 
@@ -95,11 +96,46 @@ function numberSprite(robot: RobotSpec): THREE.Sprite {
   return sprite;
 }
 
+/** One geom's triangles in its body's frame, with a colour per vertex (a checker pattern
+ * alternates colours per triangle, which reads as a football on a low-poly sphere). */
+function bodyGeometry(g: GeomSpec): THREE.BufferGeometry {
+  const shape = geometry(g).toNonIndexed();
+  shape.deleteAttribute("uv");
+  shape.applyMatrix4(new THREE.Matrix4().compose(
+    new THREE.Vector3(g.pos[0], g.pos[1], g.pos[2]),
+    new THREE.Quaternion(g.quat[1], g.quat[2], g.quat[3], g.quat[0]),
+    new THREE.Vector3(1, 1, 1),
+  ));
+  const count = shape.getAttribute("position").count;
+  const colours = new Float32Array(count * 3);
+  const pattern = g.pattern && g.type !== "plane" ? g.pattern.colors.map(colour) : null;
+  const plain = colour(g.rgba);
+  for (let v = 0; v < count; v++) {
+    const c = pattern ? pattern[Math.floor(v / 3) % 2] : plain;
+    colours.set([c.r, c.g, c.b], v * 3);
+  }
+  shape.setAttribute("color", new THREE.BufferAttribute(colours, 3));
+  const index = new Uint16Array(count * 4);
+  const weight = new Float32Array(count * 4);
+  for (let v = 0; v < count; v++) {
+    index[v * 4] = g.body;
+    weight[v * 4] = 1;
+  }
+  shape.setAttribute("skinIndex", new THREE.BufferAttribute(index, 4));
+  shape.setAttribute("skinWeight", new THREE.BufferAttribute(weight, 4));
+  return shape;
+}
+
+/**
+ * The scene in few draw calls (software WebGL pays per call): every opaque geom of every body
+ * is merged into one skinned mesh with one bone per body, posed by setting the bones; the
+ * turf (textured) and the see-through nets are meshes of their own.
+ */
 export class SceneView {
   readonly renderer: THREE.WebGLRenderer;
   readonly camera: THREE.PerspectiveCamera;
   readonly scene = new THREE.Scene();
-  readonly bodies: THREE.Object3D[] = [];
+  readonly bones: THREE.Bone[] = [];
   private readonly labels: { sprite: THREE.Sprite; body: number }[] = [];
   private readonly controls: OrbitControls;
   frames = 0;
@@ -112,32 +148,36 @@ export class SceneView {
     const sun = new THREE.DirectionalLight(0xffffff, 1.4);
     sun.position.set(2, 3, 10);
     this.scene.add(sun);
-    const materials = new Map<string, THREE.Material>();
     for (let i = 0; i < spec.bodies.length; i++) {
-      const body = new THREE.Group();
-      body.name = spec.bodies[i];
-      this.bodies.push(body);
-      this.scene.add(body);
+      const bone = new THREE.Bone();
+      bone.name = spec.bodies[i];
+      this.bones.push(bone);
+      this.scene.add(bone);
     }
+    const opaque: THREE.BufferGeometry[] = [];
+    const seeThrough: THREE.BufferGeometry[] = [];
     for (const g of spec.geoms) {
       if (g.group >= 3) continue; // MuJoCo's hidden groups (collision-only helpers)
-      const key = g.pattern ? `pattern:${g.name}` : g.rgba.join(",");
-      let material = materials.get(key);
-      if (!material) {
-        material = new THREE.MeshLambertMaterial({
-          color: g.pattern ? 0xffffff : colour(g.rgba),
-          map: g.pattern ? checker(g.pattern) : null,
-          transparent: g.rgba[3] < 1,
-          opacity: g.rgba[3],
-          depthWrite: g.rgba[3] >= 1,
-        });
-        materials.set(key, material);
+      if (g.type === "plane" && g.pattern) {
+        // unlit: a flat plane is evenly lit anyway, and the cheapest shader covers most pixels
+        const turf = new THREE.Mesh(geometry(g), new THREE.MeshBasicMaterial({ map: checker(g.pattern), color: 0xbbbbbb }));
+        turf.position.set(g.pos[0], g.pos[1], g.pos[2] - 0.0005);
+        turf.name = g.name;
+        this.scene.add(turf);
+        continue;
       }
-      const mesh = new THREE.Mesh(geometry(g), material);
-      mesh.position.set(g.pos[0], g.pos[1], g.pos[2]);
-      mesh.quaternion.set(g.quat[1], g.quat[2], g.quat[3], g.quat[0]);
-      mesh.name = g.name;
-      this.bodies[g.body].add(mesh);
+      (g.rgba[3] < 1 ? seeThrough : opaque).push(bodyGeometry(g));
+    }
+    const skeleton = new THREE.Skeleton(this.bones, this.bones.map(() => new THREE.Matrix4()));
+    for (const [parts, transparent] of [[opaque, false], [seeThrough, true]] as const) {
+      if (parts.length === 0) continue;
+      const material = new THREE.MeshLambertMaterial({
+        vertexColors: true, transparent, opacity: transparent ? 0.35 : 1, depthWrite: !transparent,
+      });
+      const mesh = new THREE.SkinnedMesh(mergeGeometries([...parts]), material);
+      mesh.bind(skeleton, new THREE.Matrix4());
+      mesh.frustumCulled = false;
+      this.scene.add(mesh);
     }
     for (const robot of spec.robots) {
       if (robot.root_body < 0) continue;
@@ -156,6 +196,17 @@ export class SceneView {
     window.addEventListener("resize", () => this.resize());
   }
 
+  /** Render at `scale` of the canvas size (lower while playing on a slow software renderer). */
+  setScale(scale: number): void {
+    if (this.renderer.getPixelRatio() === scale) return;
+    this.renderer.setPixelRatio(scale);
+    this.resize();
+  }
+
+  get scale(): number {
+    return this.renderer.getPixelRatio();
+  }
+
   resize(): void {
     const width = this.canvas.clientWidth || 960;
     const height = this.canvas.clientHeight || 540;
@@ -166,12 +217,12 @@ export class SceneView {
 
   /** Pose every body from `poses` (bodies x 7 floats: x y z qw qx qy qz). */
   setPoses(poses: Float32Array): void {
-    const n = Math.min(this.bodies.length, poses.length / 7);
+    const n = Math.min(this.bones.length, poses.length / 7);
     for (let i = 1; i < n; i++) {
       const o = i * 7;
-      const body = this.bodies[i];
-      body.position.set(poses[o], poses[o + 1], poses[o + 2]);
-      body.quaternion.set(poses[o + 4], poses[o + 5], poses[o + 6], poses[o + 3]);
+      const bone = this.bones[i];
+      bone.position.set(poses[o], poses[o + 1], poses[o + 2]);
+      bone.quaternion.set(poses[o + 4], poses[o + 5], poses[o + 6], poses[o + 3]);
     }
     for (const label of this.labels) {
       const o = label.body * 7;

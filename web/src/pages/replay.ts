@@ -70,9 +70,14 @@ export async function replayPage(root: HTMLElement, api: string, replayId: strin
   });
 
   await data.load(0);
+  // Dynamic resolution: while playing, frames slower than 30 per second halve the rendered
+  // resolution (software WebGL is bound by pixels); paused, the view is drawn in full.
+  let frameMs = 16;
   function frame(at: number): void {
     const dt = at - last;
     last = at;
+    frameMs = 0.9 * frameMs + 0.1 * Math.min(dt, 1000);
+    view.setScale(playing && frameMs > 36 ? 0.5 : playing ? view.scale : 1);
     if (playing) {
       setTime(timeMs + dt * Number(speed.value));
       if (timeMs >= meta.duration_ms) { playing = false; play.textContent = "Play"; }
@@ -96,10 +101,12 @@ export async function replayPage(root: HTMLElement, api: string, replayId: strin
     get time() { return timeMs; },
     get ready() { return shownMs === timeMs; },
     get frames() { return view.frames; },
+    get scale() { return view.scale; },
     get playing() { return playing; },
     seek: (t: number) => setTime(t),
     project: (p: number[]) => view.project(p),
     pixel: (p: number[]) => { view.render(); return view.pixel(p); },
+    view,
     poses: () => Array.from(poses),
   };
 }
