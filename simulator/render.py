@@ -17,7 +17,9 @@ import os
 import shutil
 import subprocess
 import sys
-from collections.abc import Iterator
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -166,8 +168,12 @@ def render_video(
     width: int = 1280,
     height: int = 720,
     fps: float = 25.0,
+    on_frame: Callable[[int, int], None] | None = None,
 ) -> Path:
-    """Render a replay file to an MP4 video; returns the output path."""
+    """Render a replay file to an MP4 video; returns the output path.
+
+    ``on_frame(done, total)`` is called after each frame (for a progress display).
+    """
     import mujoco
 
     output = Path(output)
@@ -217,6 +223,8 @@ def render_video(
             renderer.update_scene(data, camera="overview", scene_option=option)
             proc.stdin.write(renderer.render().tobytes())
             count += 1
+            if on_frame is not None:
+                on_frame(count, len(indices))
         proc.stdin.close()
     except BrokenPipeError:
         pass
@@ -229,6 +237,36 @@ def render_video(
         raise RenderError(output=str(output), reason=f"ffmpeg exited {code}: {stderr.strip()}")
     logger.info("rendered %d frames of %s to %s", count, replay_path, output)
     return output
+
+
+@contextmanager
+def _frame_progress(description: str) -> Iterator[Callable[[int, int], None]]:
+    """A rich progress bar on a terminal; otherwise a plain line every 10 s and at the end
+    (``HLVS_PROGRESS=plain|rich|off`` to choose, as for the other commands)."""
+    mode = os.environ.get("HLVS_PROGRESS", "auto").lower()
+    if mode == "auto":
+        mode = "rich" if sys.stderr.isatty() and os.environ.get("TERM") != "dumb" else "plain"
+    if mode == "off":
+        yield lambda done, total: None
+        return
+    if mode == "rich":
+        from rich.console import Console
+        from rich.progress import Progress
+
+        with Progress(console=Console(file=sys.stderr)) as bars:
+            task = bars.add_task(description, total=None)
+            yield lambda done, total: bars.update(task, completed=done, total=total)
+        return
+    last = [time.monotonic()]
+
+    def line(done: int, total: int) -> None:
+        now = time.monotonic()
+        if now - last[0] >= 10.0 or done == total:
+            last[0] = now
+            print(f"{description}: {done} of {total} frames ({100 * done / max(total, 1):.0f} %)",
+                  file=sys.stderr, flush=True)
+
+    yield line
 
 
 def _absolute(text: str) -> Path:
@@ -262,7 +300,9 @@ def main(argv: list[str]) -> int:
         return 3
     logger.info("offscreen OpenGL back end: %s", backend)
     try:
-        render_video(args.replay, args.output, width=args.width, height=args.height, fps=args.fps)
+        with _frame_progress(f"render {args.output.name}") as on_frame:
+            render_video(args.replay, args.output, width=args.width, height=args.height,
+                         fps=args.fps, on_frame=on_frame)
     except ReplayError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

@@ -88,10 +88,12 @@ def _quiet_libraries() -> None:
 
 
 def _deliver(args: argparse.Namespace) -> int:
+    from orchestrator.console import progress
     from orchestrator.delivery import deliver_pending
 
     _quiet_libraries()
-    outcomes = deliver_pending(args.store or default_store(), team=args.team)
+    with progress() as bars:
+        outcomes = deliver_pending(args.store or default_store(), team=args.team, progress=bars)
     for outcome in outcomes:
         print(json.dumps(outcome.to_json()) if args.json else _describe_outcome(outcome))
     if not outcomes and not args.json:

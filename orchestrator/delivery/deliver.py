@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from orchestrator.config.credentials import Credentials, load_credentials
+from orchestrator.console import NullProgress, Progress
 from orchestrator.delivery import store as st
 from orchestrator.delivery.targets import open_uploader
 from orchestrator.delivery.uploader import Uploader, is_transient
@@ -79,6 +80,7 @@ def deliver_pending(
     retry: RetryPolicy | None = None,
     opener: Opener | None = None,
     sleep: Callable[[float], None] = time.sleep,
+    progress: Progress | None = None,
 ) -> list[DeliveryOutcome]:
     """Try every pending set (of ``team`` only, if given), oldest first."""
     outcomes = []
@@ -94,7 +96,8 @@ def deliver_pending(
                 )
                 continue
             outcomes.append(
-                deliver_set(pending, retry=retry or RetryPolicy(), opener=opener, sleep=sleep)
+                deliver_set(pending, retry=retry or RetryPolicy(), opener=opener, sleep=sleep,
+                            progress=progress)
             )
     return outcomes
 
@@ -110,6 +113,7 @@ def deliver_set(
     retry: RetryPolicy,
     opener: Opener | None = None,
     sleep: Callable[[float], None] = time.sleep,
+    progress: Progress | None = None,
 ) -> DeliveryOutcome:
     """Upload one set; on success delete it locally, on failure record the cause in it.
 
@@ -119,6 +123,11 @@ def deliver_set(
     target = str(pending.credentials) if pending.credentials else "(no credentials)"
     session: _Session | None = None
     uploaded = skipped = uploaded_bytes = 0
+    total_bytes = sum(entry.size for entry in pending.files)
+    task = (progress or NullProgress()).add(
+        f"upload {pending.match_id} {pending.team}", total=total_bytes, unit="B"
+    )
+    done_bytes = 0
     try:
         credentials = _credentials_of(pending)
         target = credentials.describe()
@@ -127,16 +136,20 @@ def deliver_set(
         for entry in pending.files:
             remote = f"{base}/{entry.path}"
             local = pending.files_dir / entry.path
+            done_bytes += entry.size
             if session.run(functools.partial(_exists, remote=remote, size=entry.size)):
                 skipped += 1
+                task.update(completed=done_bytes)
                 continue
             _check_local(pending, local, entry.size)
             session.run(functools.partial(_upload, local=local, remote=remote))
             uploaded += 1
             uploaded_bytes += entry.size
+            task.update(completed=done_bytes)
         manifest = _write_manifest(pending)
         session.run(functools.partial(_upload, local=manifest, remote=f"{base}/{MANIFEST_NAME}"))
     except DeliveryError as exc:
+        task.finish("failed")
         error = DeliveryError(team=pending.team, target=target, kind=exc.kind, reason=exc.reason)
         st.save_set(
             pending,
@@ -159,6 +172,7 @@ def deliver_set(
     finally:
         if session is not None:
             session.close()
+    task.finish()
     st.remove_set(pending)
     seconds = time.monotonic() - started
     log.info(

@@ -165,3 +165,49 @@ def test_check_json_and_github_formats(tmp_path: Path, capsys: pytest.CaptureFix
     assert lines and all(line.startswith("::error file=") for line in lines), lines
     assert any("title=/players/1" in line for line in lines), lines
     assert all("\n" not in line.split("::", 2)[2] for line in lines)
+
+
+def test_compose_json_names_the_files_and_both_compose_commands(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    game = Path(__file__).parents[2] / "configs" / "examples" / "scrimmage_1v1" / "game.json"
+    output = tmp_path / "match" / "docker-compose.yml"
+    code = main(["compose", str(game), "-o", str(output), "--simulator-image", "sim:x", "--json"])
+    assert code == ExitCode.OK
+    printed = json.loads(capsys.readouterr().out)
+    assert printed["compose_file"] == str(output) and Path(printed["match_spec"]).is_file()
+    assert printed["command"].startswith("docker compose -f docker-compose.yml up")
+    assert printed["command_v1"].startswith("docker-compose -f docker-compose.yml up")
+    assert "version:" not in output.read_text()
+
+
+@pytest.mark.parametrize(
+    ("results", "failure", "code"),
+    [
+        ({"score": {"red": 1, "blue": 0}, "winner": "red"}, None, ExitCode.OK),
+        ({"forfeit": {"team": "Blue", "winner": "red"}}, None, ExitCode.FORFEIT),
+        ({}, ("team_crash", "red-1 crashed"), ExitCode.FAILED),
+        ({}, ("infrastructure", "engine gone"), ExitCode.INFRASTRUCTURE),
+        ({}, ("interrupted", "SIGTERM"), ExitCode.INTERRUPTED),
+    ],
+)
+def test_match_exit_codes_and_json(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], results: dict[str, object],
+    failure: tuple[str, str] | None, code: ExitCode,
+) -> None:
+    from orchestrator.commands.play import summarize
+    from orchestrator.match import Failure, FailureClass, MatchOutcome
+
+    outcome = MatchOutcome(
+        match_id="m1", out_dir=tmp_path, results=dict(results), bringup_s=None,
+        failure=Failure(failure_class=FailureClass(failure[0]), cause=failure[1])
+        if failure else None,
+    )
+    assert summarize(outcome) == code
+    capsys.readouterr()
+    assert summarize(outcome, as_json=True) == code
+    printed = json.loads(capsys.readouterr().out)
+    assert printed["exit_code"] == code and printed["match_id"] == "m1"
+    assert printed["out_dir"] == str(tmp_path)
+    if failure:
+        assert printed["failure"] == {"class": failure[0], "cause": failure[1]}

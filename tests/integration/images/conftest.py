@@ -27,7 +27,11 @@ from tests.conftest import TEST_LABEL
 from tests.integration.images.token_issuer import ISSUER, SERVICE, TokenIssuer
 
 REGISTRY_BINARY = "/usr/bin/docker-registry"
-USERS = {"alpha": "alpha-secret", "beta": "beta-secret", "janitor": "janitor-secret"}
+USERS = {
+    "alpha": "alpha-secret", "beta": "beta-secret", "janitor": "janitor-secret",
+    # What moto's Amazon ECR answers for a registry whose host starts with 127: the ECR test.
+    "AWS": "127-auth-token",
+}
 
 
 @dataclass(frozen=True)

@@ -15,6 +15,7 @@ import pytest
 
 from orchestrator.cli import main
 from orchestrator.config import Limits, PlayerConfig, RegistryAuth, StartingPose, TeamConfig
+from orchestrator.config.model import EcrAuth
 from orchestrator.errors import ImagePullError, TeamImagesTooLarge
 from orchestrator.pull import resolve_team_images
 from orchestrator.registry import Credentials, RegistryClient, RegistryError
@@ -224,6 +225,29 @@ def test_enforce_with_token_auth_counts_shared_layers_once(
     assert report["deleted"] and report["teams"]["alpha"]["after_bytes"] <= union - 1
     left = {r: janitor.tags(r) for r in janitor.repositories()}
     assert sum(1 for tags in left.values() if tags) == 3 - len(report["deleted"])
+
+
+def test_ecr_token_logs_in_to_the_registry(
+    registry: Registry, docker_client: docker.DockerClient, make_image: MakeImage,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The team file names ECR; the token comes from the ECR API (moto stands in for AWS, the
+    registry is real) and logs in to both the registry API and the engine's pull."""
+    moto = pytest.importorskip("moto")
+    for name in ("AWS_ENDPOINT_URL", "AWS_PROFILE", "AWS_CONFIG_FILE"):
+        monkeypatch.delenv(name, raising=False)
+    make_image(f"{registry.host}/aws/robot:v1", 5 * KB)
+    pushed = push(docker_client, f"{registry.host}/aws/robot:v1", "AWS", registry.users["AWS"])
+    docker_client.images.remove(f"{registry.host}/aws/robot:v1")
+    auth = RegistryAuth(ecr=EcrAuth(region="us-east-1", access_id="id", access_secret="secret"))
+    with moto.mock_aws():
+        resolved = resolve_team_images(
+            docker_client, team([f"{registry.host}/aws/robot:v1"], auth), limits=Limits(),
+            backoff=FAST,
+        )
+    assert resolved[1].error is None, resolved[1].error
+    assert resolved[1].digest == f"{registry.host}/aws/robot@{pushed}"
+    assert resolved[1].stored_bytes > 5 * KB
 
 
 def test_pull_that_fails_twice_then_succeeds(

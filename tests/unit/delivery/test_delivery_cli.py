@@ -43,6 +43,12 @@ def test_enqueue_from_game_json_then_status(
         ("Big Feet", False),
     }
 
+    (match / "teams" / "red" / "red-1").mkdir(parents=True)
+    (match / "teams" / "red" / "red-1" / "stdout.log").write_text("again\n")
+    assert main([*args[:-1], "final-2", "--store", str(store), "--json"]) == 0
+    queued = json.loads(capsys.readouterr().out)
+    assert {(s["match_id"], s["team"]) for s in queued} >= {("final-2", "Tall Team")}
+
 
 def test_enqueue_rejects_a_missing_match_folder(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]

@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+import io
 import json
+import re
 from collections import deque
 from pathlib import Path
 
 import pytest
 
 from orchestrator.config.credentials import Credentials
+from orchestrator.console import PlainProgress
 from orchestrator.delivery import (
     KEEP_UNDELIVERED,
     MANIFEST_NAME,
@@ -78,9 +81,15 @@ def test_enqueue_then_deliver_uploads_files_then_manifest(tmp_path: Path, creds:
     assert not (match / "teams" / "red").exists()  # team logs moved into the store
     assert (match / "sim_result.json").exists()  # public logs stay with the match
     fake = FakeUploader()
-    outcomes = deliver_pending(store, opener=Opener(fake), retry=FAST, sleep=lambda s: None)
+    lines = io.StringIO()
+    outcomes = deliver_pending(store, opener=Opener(fake), retry=FAST, sleep=lambda s: None,
+                               progress=PlainProgress(out=lines))
     assert all(o.delivered for o in outcomes)
     assert pending_status(store) == []
+    alpha_bytes = next(o.uploaded_bytes for o in outcomes if o.team == "Alpha")
+    assert "upload m1 Alpha: started" in lines.getvalue().splitlines()
+    assert re.search(rf"^upload m1 Alpha: done, {alpha_bytes / 1e6:.1f} MB, ", lines.getvalue(),
+                     re.M)
     alpha = [c for c in fake.calls if c.startswith("m1/Alpha/")]
     assert alpha[-1] == f"m1/Alpha/{MANIFEST_NAME}"
     manifest = json.loads(fake.files[f"m1/Alpha/{MANIFEST_NAME}"])

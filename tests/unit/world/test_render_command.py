@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -38,6 +39,8 @@ def test_render_as_documented_from_a_relative_path(tmp_path: Path) -> None:
     )  # fmt: skip
     assert done.returncode == 0, done.stderr
     assert "offscreen OpenGL back end: " in done.stderr
+    # Not a terminal: plain progress lines, the last one at the end.
+    assert re.search(r"^render match\.mp4: (\d+) of \1 frames \(100 %\)$", done.stderr, re.M)
     probe = subprocess.run(
         ["ffprobe", "-v", "error", "-show_entries",
          "stream=codec_type,codec_name,width,height:format=duration", "-of", "json",
