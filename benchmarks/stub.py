@@ -57,7 +57,7 @@ def sense(world: Any, robot: Any, camera: Any | None) -> Any:
 
 
 def run_trial(*, seed: int, distance_m: float, time_limit_s: float) -> TrialResult:
-    from referee.snapshot import RobotId, TeamColor
+    from contracts.ids import RobotId, TeamColor
     from robot.stub.behaviour import GameInfo, Phase, Role
     from robot.stub.controller import StubController
     from robot.stub.world_model import Pose2D

@@ -46,7 +46,8 @@ def shot_layout(seed: int) -> tuple[tuple[float, float], tuple[float, float, flo
 
 def run_shot(*, seed: int, time_limit_s: float, goalie: bool) -> ShotResult:
     from benchmarks.stub import sense
-    from referee.snapshot import PlaceBall, RobotId, TeamColor
+    from contracts.ids import RobotId, TeamColor
+    from referee.snapshot import PlaceBall
     from robot.stub.behaviour import GameInfo, Phase, Role
     from robot.stub.controller import StubController
     from robot.stub.world_model import Pose2D

@@ -22,7 +22,7 @@ from envs.frame import SENSOR_NAMES, Frame
 from envs.perception import CameraView, add_noise, field_segments, goal_post_feet
 from envs.session_spec import ResetRequest, SessionSpec
 from referee import GameState, Referee, RobotId, TeamColor
-from referee.field import field_for
+from contracts.field import field_for
 from referee.snapshot import PlaceBall, TeleportRobot
 from simulator.world import MOTOR_NAMES, RobotPlacement, World, robot_model
 

@@ -115,7 +115,7 @@ def compose_files(
         }
         for role in ("red", "blue", "control")
     }
-    return {"services": services, "networks": networks}, spec
+    return {"services": services, "networks": networks}, spec.to_dict()
 
 
 def _simulator(loaded: LoadedGame, image: str, subnets: Subnets) -> dict[str, Any]:

@@ -16,19 +16,14 @@ READY, between periods), so a lockstep runtime can hold instead of stepping. Rul
 
 from __future__ import annotations
 
+from contracts.field import ADULT_FIELD, KID_FIELD, FieldClass, FieldGeometry, field_for
+from contracts.geometry import Pose
+from contracts.ids import RobotId, TeamColor
+from contracts.match_spec import GameType
 from referee.autoref import Referee
 from referee.clock import Clock, FakeClock, SystemClock
-from referee.config import (
-    GameType,
-    NetworkConfig,
-    PlayerConfig,
-    Pose,
-    RefereeConfig,
-    TeamConfig,
-    TimingConfig,
-)
+from referee.config import NetworkConfig, RefereeConfig, RefereePlayer, RefereeTeam, TimingConfig
 from referee.errors import IllegalTransition, ProtocolError, RefereeError, ScenarioError
-from referee.field import ADULT_FIELD, KID_FIELD, FieldClass, FieldGeometry, field_for
 from referee.gamecontroller import (
     Card,
     GameController,
@@ -45,10 +40,8 @@ from referee.snapshot import (
     RefereeEvent,
     RemoveRobot,
     RestoreRobot,
-    RobotId,
     RobotState,
     SetLimp,
-    TeamColor,
     TeleportRobot,
     WorldCommand,
     WorldSnapshot,
@@ -69,12 +62,7 @@ __all__ = [
     "BodyPart",
     "Card",
     "Clock",
-    "decode_game_state",
-    "decode_return",
-    "encode_game_state",
-    "encode_return",
     "FakeClock",
-    "field_for",
     "FieldClass",
     "FieldGeometry",
     "GameControlData",
@@ -89,13 +77,14 @@ __all__ = [
     "NetworkStats",
     "Penalty",
     "PlaceBall",
-    "PlayerConfig",
     "Pose",
     "ProtocolError",
     "Referee",
     "RefereeConfig",
     "RefereeError",
     "RefereeEvent",
+    "RefereePlayer",
+    "RefereeTeam",
     "RemoveRobot",
     "RestoreRobot",
     "ReturnData",
@@ -108,10 +97,14 @@ __all__ = [
     "SetLimp",
     "SystemClock",
     "TeamColor",
-    "TeamConfig",
     "TeamMirror",
     "TeleportRobot",
     "TimingConfig",
     "WorldCommand",
     "WorldSnapshot",
+    "decode_game_state",
+    "decode_return",
+    "encode_game_state",
+    "encode_return",
+    "field_for",
 ]

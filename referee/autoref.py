@@ -12,9 +12,12 @@ import logging
 from collections.abc import Callable
 from pathlib import Path
 
+from contracts.geometry import Pose
+from contracts.ids import RobotId, TeamColor
+from contracts.match_spec import GameType
 from referee import reporting
 from referee.clock import Clock, SystemClock
-from referee.config import GameType, Pose, RefereeConfig
+from referee.config import RefereeConfig
 from referee.gamecontroller import (
     GameController,
     GameState,
@@ -34,9 +37,7 @@ from referee.shootout import Shootout
 from referee.snapshot import (
     PlaceBall,
     RefereeEvent,
-    RobotId,
     SetLimp,
-    TeamColor,
     TeleportRobot,
     WorldCommand,
     WorldSnapshot,

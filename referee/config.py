@@ -1,44 +1,23 @@
 """Referee configuration: everything the referee needs, resolved, as frozen dataclasses.
 
-The simulator runtime maps its ``MatchSpec`` onto :class:`RefereeConfig`. Poses are given as in
-HLVS team files: as if the team played on the left half (x < 0); the referee mirrors them for
-the team on the right.
+The simulator maps the ``contracts.match_spec.MatchSpec`` onto :class:`RefereeConfig` (the
+referee's view: no ports or robot models, its own timing details). Poses are
+:class:`contracts.geometry.Pose`, given as in HLVS team files: as if the team played on the left
+half (x < 0); the referee mirrors them for the team on the right.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
-from enum import StrEnum
 
-from referee.field import FieldClass, FieldGeometry, field_for
-from referee.snapshot import RobotId, TeamColor
-
-
-class GameType(StrEnum):
-    NORMAL = "NORMAL"  # round robin: two halves, draws allowed
-    KNOCKOUT = "KNOCKOUT"  # play-off: overtime 2 x 300 s, then a penalty shoot-out
-    PENALTY = "PENALTY"  # starts with the penalty shoot-out
+from contracts.field import FieldClass, FieldGeometry, field_for
+from contracts.geometry import Pose
+from contracts.ids import RobotId, TeamColor
+from contracts.match_spec import GameType
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
-class Pose:
-    x_m: float
-    y_m: float
-    yaw_rad: float
-
-    def mirrored(self) -> Pose:
-        """The pose for the team playing on the right (x > 0): HLVS ``flip_pose``, a reflection
-        across the centre line (x -> -x, heading -> pi - heading)."""
-        return Pose(x_m=-self.x_m, y_m=self.y_m, yaw_rad=_wrap(math.pi - self.yaw_rad))
-
-
-def _wrap(angle: float) -> float:
-    return (angle + math.pi) % (2.0 * math.pi) - math.pi
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class PlayerConfig:
+class RefereePlayer:
     number: int
     half_time_pose: Pose
     reentry_pose: Pose
@@ -48,13 +27,13 @@ class PlayerConfig:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
-class TeamConfig:
+class RefereeTeam:
     team_id: int  # GameController team number
     name: str
-    players: tuple[PlayerConfig, ...]
+    players: tuple[RefereePlayer, ...]
     robot_addresses: tuple[str, ...] = ()  # robot n at index n-1: RGme target, mirror member
 
-    def player(self, number: int) -> PlayerConfig:
+    def player(self, number: int) -> RefereePlayer:
         for player in self.players:
             if player.number == number:
                 return player
@@ -98,8 +77,8 @@ class NetworkConfig:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class RefereeConfig:
-    red: TeamConfig
-    blue: TeamConfig
+    red: RefereeTeam
+    blue: RefereeTeam
     game_type: GameType = GameType.NORMAL
     field_class: FieldClass = FieldClass.KID
     side_left: TeamColor = TeamColor.RED  # team on x < 0 in the first half
@@ -113,7 +92,7 @@ class RefereeConfig:
     def field(self) -> FieldGeometry:
         return field_for(self.field_class)
 
-    def team(self, color: TeamColor) -> TeamConfig:
+    def team(self, color: TeamColor) -> RefereeTeam:
         return self.red if color is TeamColor.RED else self.blue
 
     def robot_ids(self) -> tuple[RobotId, ...]:

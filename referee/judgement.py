@@ -8,8 +8,9 @@ from __future__ import annotations
 
 from typing import Protocol
 
+from contracts.field import FieldGeometry
+from contracts.ids import RobotId, TeamColor
 from referee.config import RefereeConfig
-from referee.field import FieldGeometry
 from referee.gamecontroller import Card, GameController, GameState, Penalty
 from referee.logs import RefereeLog
 from referee.rules import removal
@@ -22,15 +23,7 @@ from referee.rules.base import (
     Goal,
     PenalizeRobot,
 )
-from referee.snapshot import (
-    PlaceBall,
-    RefereeEvent,
-    RobotId,
-    TeamColor,
-    Vec2,
-    WorldCommand,
-    WorldSnapshot,
-)
+from referee.snapshot import PlaceBall, RefereeEvent, Vec2, WorldCommand, WorldSnapshot
 
 PENALTY_NAMES = {
     Penalty.PICKUP_OR_INCAPABLE: "INCAPABLE",

@@ -22,9 +22,9 @@ import threading
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
+from contracts.ids import RobotId, TeamColor
 from referee.clock import Clock
 from referee.errors import ProtocolError
-from referee.snapshot import RobotId, TeamColor
 from referee.spoofing import Senders, SpoofingLog, robot_key
 from referee.wire import ReturnMessage, decode_return
 

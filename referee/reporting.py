@@ -5,9 +5,10 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Sequence
 
+from contracts.ids import TeamColor
 from referee.clock import Clock
 from referee.gamecontroller import GameController
-from referee.snapshot import RefereeEvent, TeamColor
+from referee.snapshot import RefereeEvent
 
 COLORS = (TeamColor.RED, TeamColor.BLUE)
 

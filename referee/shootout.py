@@ -13,20 +13,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from referee.config import Pose, RefereeConfig
+from contracts.geometry import Pose
+from contracts.ids import RobotId, TeamColor
+from referee.config import RefereeConfig
 from referee.gamecontroller import GameController
 from referee.rules.ball_out import in_goal, over_goal_line, over_touch_line
 from referee.rules.base import ball_speed, distance2d
 from referee.rules.end_of_game import ShootoutStatus, shootout_status
-from referee.snapshot import (
-    PlaceBall,
-    RobotId,
-    TeamColor,
-    TeleportRobot,
-    Vec3,
-    WorldCommand,
-    WorldSnapshot,
-)
+from referee.snapshot import PlaceBall, TeleportRobot, Vec3, WorldCommand, WorldSnapshot
 
 STOPPED_M_S = 0.02
 MOVED_M = 0.05

@@ -2,7 +2,7 @@
 
 The simulator builds one :class:`WorldSnapshot` per basic step (8 ms of simulated time) and hands
 it to the referee; the referee answers with :data:`WorldCommand` values that the simulator
-applies before the next step. Frame: see :mod:`referee.field`. Angles in radians.
+applies before the next step. Frame: see :mod:`contracts.field`. Angles in radians.
 """
 
 from __future__ import annotations
@@ -10,17 +10,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from enum import Enum
 
+from contracts.ids import RobotId, TeamColor
+
 Vec3 = tuple[float, float, float]
 Vec2 = tuple[float, float]
-
-
-class TeamColor(str, Enum):  # noqa: UP042
-    RED = "red"
-    BLUE = "blue"
-
-    @property
-    def opponent(self) -> TeamColor:
-        return TeamColor.BLUE if self is TeamColor.RED else TeamColor.RED
 
 
 class BodyPart(str, Enum):  # noqa: UP042
@@ -32,15 +25,6 @@ class BodyPart(str, Enum):  # noqa: UP042
     HEAD = "head"
     TORSO = "torso"
     LEG = "leg"
-
-
-@dataclass(frozen=True, slots=True)
-class RobotId:
-    team: TeamColor
-    number: int  # 1-based player number
-
-    def __str__(self) -> str:
-        return f"{self.team.value} player {self.number}"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -14,7 +14,7 @@ import threading
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-from referee.snapshot import RobotId
+from contracts.ids import RobotId
 
 MAX_RECORDS = 256  # distinct (channel, sender, claimed, message) kept; the rest only counted
 

@@ -1,4 +1,8 @@
-"""MuJoCo soccer world, robot API server, recorder and telemetry of hlvs-runner."""
+"""MuJoCo soccer world, robot API server, recorder and telemetry of hlvs-runner.
+
+What the simulator reads and writes (``match_spec.json``, ``sim_result.json``, telemetry) is
+typed in the ``contracts`` package.
+"""
 
 from __future__ import annotations
 
@@ -6,21 +10,12 @@ from simulator.errors import (
     ApiError,
     PhysicsDivergence,
     SimulatorError,
-    SpecError,
     UnknownModelError,
 )
-from simulator.spec import MatchSpec, NetworkSpec, PlayerSpec, Pose, TeamSpec, TimingSpec
 
 __all__ = [
     "ApiError",
-    "MatchSpec",
-    "NetworkSpec",
     "PhysicsDivergence",
-    "PlayerSpec",
-    "Pose",
     "SimulatorError",
-    "SpecError",
-    "TeamSpec",
-    "TimingSpec",
     "UnknownModelError",
 ]

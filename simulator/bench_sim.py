@@ -23,7 +23,7 @@ import time
 
 import mujoco
 
-from referee.snapshot import RobotId, TeamColor
+from contracts.ids import RobotId, TeamColor
 from simulator.world import RobotPlacement, World
 from simulator.world.scene import compile_scene
 

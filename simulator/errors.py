@@ -3,7 +3,6 @@
 Tree::
 
     SimulatorError
-    ├── SpecError            match_spec.json that does not describe a match
     ├── ModelError           a team robot model package that cannot be used (every problem)
     ├── PhysicsDivergence    MuJoCo reported instability (carries its warning and the policy)
     ├── ApiError             robot API misuse on the simulator side
@@ -12,6 +11,7 @@ Tree::
     ├── RenderError          a video that could not be produced (ffmpeg missing or failing)
     └── OffscreenGLError     no offscreen OpenGL back end works (each one tried, with why)
 
+A match_spec.json that does not describe a match raises :class:`contracts.errors.ContractError`.
 Unknown robot model names raise :class:`robot.errors.UnknownModelError` (one class for the
 simulator and the robot-side motion code).
 """
@@ -30,7 +30,6 @@ __all__ = [
     "RenderError",
     "ReplayError",
     "SimulatorError",
-    "SpecError",
     "UnknownDeviceError",
     "UnknownModelError",
 ]
@@ -38,14 +37,6 @@ __all__ = [
 
 class SimulatorError(Exception):
     """Root of every error the simulator package raises."""
-
-
-class SpecError(SimulatorError):
-    def __init__(self, *, source: str, pointer: str, reason: str) -> None:
-        self.source = source
-        self.pointer = pointer
-        self.reason = reason
-        super().__init__(f"{source}: {pointer or '/'}: {reason}")
 
 
 

@@ -4,35 +4,27 @@ from __future__ import annotations
 
 from dataclasses import fields
 
+from contracts.match_spec import MatchSpec, TeamSpec
 from referee.config import (
-    GameType,
     NetworkConfig,
-    PlayerConfig,
     RefereeConfig,
-    TeamConfig,
+    RefereePlayer,
+    RefereeTeam,
     TimingConfig,
 )
-from referee.config import Pose as RefereePose
-from referee.field import FieldClass
-from referee.snapshot import TeamColor
-from simulator.spec import MatchSpec, Pose, TeamSpec
 
 
-def _pose(pose: Pose) -> RefereePose:
-    return RefereePose(x_m=pose.x_m, y_m=pose.y_m, yaw_rad=pose.yaw_rad)
-
-
-def _team(team: TeamSpec) -> TeamConfig:
-    return TeamConfig(
+def _team(team: TeamSpec) -> RefereeTeam:
+    return RefereeTeam(
         team_id=team.team_id,
         name=team.name,
         players=tuple(
-            PlayerConfig(
+            RefereePlayer(
                 number=p.number,
-                half_time_pose=_pose(p.half_time_pose),
-                reentry_pose=_pose(p.reentry_pose),
-                shootout_pose=_pose(p.shootout_pose),
-                goalkeeper_pose=_pose(p.goalkeeper_pose),
+                half_time_pose=p.half_time_pose,
+                reentry_pose=p.reentry_pose,
+                shootout_pose=p.shootout_pose,
+                goalkeeper_pose=p.goalkeeper_pose,
                 goalkeeper=p.goalkeeper,
             )
             for p in team.players
@@ -60,10 +52,10 @@ def referee_config(spec: MatchSpec) -> RefereeConfig:
     return RefereeConfig(
         red=_team(spec.red),
         blue=_team(spec.blue),
-        game_type=GameType(spec.game_type),
-        field_class=FieldClass(spec.field_class),
-        side_left=TeamColor(spec.side_left),
-        kickoff=TeamColor(spec.kickoff),
+        game_type=spec.game_type,
+        field_class=spec.field,
+        side_left=spec.side_left_color,
+        kickoff=spec.kickoff_color,
         timing=timing,
         network=network,
         match_id=spec.match_id,

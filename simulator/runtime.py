@@ -24,18 +24,21 @@ from pathlib import Path
 from types import FrameType
 from typing import Any
 
+from contracts import files
+from contracts.errors import ContractError
+from contracts.match_spec import MatchSpec
+from contracts.sim_result import SimResult
 from simulator.api import ApiServer, LockstepSettings, endpoints_from_spec
-from simulator.errors import PhysicsDivergence, SimulatorError, SpecError, UnknownModelError
+from simulator.errors import PhysicsDivergence, SimulatorError, UnknownModelError
 from simulator.match_loop import LoopSettings, MatchLoop
 from simulator.match_setup import referee_config
-from simulator.spec import MatchSpec
 from simulator.telemetry import TelemetryError, open_telemetry
 from simulator.traffic import STATS_FILE, TrafficLog
 
 log = logging.getLogger(__name__)
 
-RESULT_FILE = "sim_result.json"
-REPLAY_FILE = "replay.hlvsrec"
+RESULT_FILE = files.SIM_RESULT
+REPLAY_FILE = files.REPLAY
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -79,7 +82,7 @@ def main(argv: list[str]) -> int:
     )
     try:
         spec = MatchSpec.load(args.spec)
-    except SpecError as exc:
+    except ContractError as exc:
         log.error("invalid match spec: %s", exc)
         return 2
     out = Path(args.out)
@@ -185,7 +188,7 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
             exit_code = 0
         elif reason in ("SIGTERM", "SIGINT"):
             exit_code = 130
-        result = {
+        fields: dict[str, Any] = {
             "match_id": spec.match_id,
             "seed": spec.seed,
             **referee.result(),
@@ -201,10 +204,13 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
             "started_unix_s": round(started, 3),
             "versions": versions(),
         }
-    _write_json(out / RESULT_FILE, result)
+        result = SimResult.from_dict(
+            json.loads(json.dumps(fields, default=str)), source=str(out / RESULT_FILE)
+        )
+    result.write(out / RESULT_FILE)
     log.info(
         "match %s ended (%s): %s, score %s, %d ms simulated in %.1f s",
-        spec.match_id, reason, result["state"], result["score"], world.sim_time_ms,
+        spec.match_id, reason, result.state, result.score, world.sim_time_ms,
         loop.real_time_s,
     )  # fmt: skip
     if spec.record_video:
@@ -214,12 +220,6 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
 
 def _rtf(sim_ms: int, real_s: float) -> float:
     return round(sim_ms / 1000.0 / real_s, 3) if real_s > 0 else 0.0
-
-
-def _write_json(path: Path, data: dict[str, Any]) -> None:
-    tmp = path.with_suffix(".tmp")
-    tmp.write_text(json.dumps(data, indent=2, sort_keys=True, default=str), encoding="utf-8")
-    tmp.replace(path)
 
 
 def _render_video(replay: Path, output: Path) -> None:

@@ -1,16 +1,25 @@
-"""From a validated game to the ``match_spec.json`` content the simulator process reads.
+"""From a validated game to the :class:`contracts.match_spec.MatchSpec` the simulator reads.
 
-The simulator is not imported here: this module writes the plain JSON dict that
-``simulator.spec.MatchSpec.from_dict`` accepts (a unit test checks the round trip). Every random
-choice (first-half side, first kick-off) is resolved from the match seed.
+The simulator is not imported here: both sides share the typed contract (a unit test checks the
+JSON round trip). Every random choice (first-half side, first kick-off) is resolved from the
+match seed.
 """
 
 from __future__ import annotations
 
 import random
 from collections.abc import Mapping, Sequence
-from typing import Any
 
+from contracts.field import FieldClass
+from contracts.geometry import Pose
+from contracts.match_spec import (
+    GameType,
+    MatchSpec,
+    NetworkSpec,
+    PlayerSpec,
+    TeamSpec,
+    TimingSpec,
+)
 from orchestrator.config.model import COLORS, Color, LoadedGame, StartingPose
 
 GOALKEEPER_NUMBER = 1  # HLVS: player 1 is the goalkeeper unless the robot declares otherwise
@@ -33,8 +42,8 @@ def to_match_spec(
     robot_addresses: Mapping[str, Sequence[str]],
     telemetry_listen: str | None,
     api_bind_host: str = "0.0.0.0",
-) -> dict[str, Any]:
-    """The match spec as a JSON-ready dict.
+) -> MatchSpec:
+    """The match spec of ``loaded``.
 
     Args:
         loaded: the validated game and teams.
@@ -46,67 +55,67 @@ def to_match_spec(
     game = loaded.game
     side_left, kickoff = resolve_sides(loaded)
     timing = game.timing
-    return {
-        "match_id": game.match_id,
-        "seed": game.seed,
-        "game_type": game.game_type,
-        "field_class": game.field_class.lower(),
-        "side_left": side_left,
-        "kickoff": kickoff,
-        "red": _team(loaded, "red", robot_addresses.get("red", ())),
-        "blue": _team(loaded, "blue", robot_addresses.get("blue", ())),
-        "stepping": game.stepping,
-        "maximum_real_time_factor": game.maximum_real_time_factor,
-        "physics_dt_s": game.physics_dt_s,
-        "lockstep_deadline_ms": game.lockstep_deadline_ms,
-        "lockstep_time_bank_ms": game.lockstep_time_bank_ms,
-        "timing": {
-            "half_duration_s": timing.half_duration_s,
-            "overtime_half_duration_s": timing.overtime_half_duration_s,
-            "ready_duration_s": timing.ready_duration_s,
-            "wait_before_first_ready_real_s": timing.wait_before_first_ready_s,
-            "half_time_break_real_s": timing.half_time_break_s,
-            "removal_penalty_s": timing.removal_penalty_s,
-            "max_duration_real_s": timing.max_duration_s,
-        },
-        "network": {
-            "api_bind_host": api_bind_host,
-            "telemetry_listen": telemetry_listen,
-            "team_quota_mb_s": game.limits.team_api_mb_s,
-        },
-        "record_video": (
+    return MatchSpec(
+        match_id=game.match_id,
+        seed=game.seed,
+        game_type=GameType(game.game_type),
+        field_class=FieldClass(game.field_class.lower()).value,
+        side_left=side_left,
+        kickoff=kickoff,
+        red=_team(loaded, "red", robot_addresses.get("red", ())),
+        blue=_team(loaded, "blue", robot_addresses.get("blue", ())),
+        stepping=game.stepping,
+        maximum_real_time_factor=game.maximum_real_time_factor,
+        physics_dt_s=game.physics_dt_s,
+        lockstep_deadline_ms=game.lockstep_deadline_ms,
+        lockstep_time_bank_ms=game.lockstep_time_bank_ms,
+        timing=TimingSpec(
+            half_duration_s=timing.half_duration_s,
+            overtime_half_duration_s=timing.overtime_half_duration_s,
+            ready_duration_s=timing.ready_duration_s,
+            wait_before_first_ready_real_s=timing.wait_before_first_ready_s,
+            half_time_break_real_s=timing.half_time_break_s,
+            removal_penalty_s=timing.removal_penalty_s,
+            max_duration_real_s=timing.max_duration_s,
+        ),
+        network=NetworkSpec(
+            api_bind_host=api_bind_host,
+            telemetry_listen=telemetry_listen,
+            team_quota_mb_s=game.limits.team_api_mb_s,
+        ),
+        record_video=(
             VIDEO_FILE
             if game.record_simulation and game.record_simulation.endswith(".mp4")
             else None
         ),
-    }
+    )
 
 
-def _team(loaded: LoadedGame, color: Color, addresses: Sequence[str]) -> dict[str, Any]:
+def _team(loaded: LoadedGame, color: Color, addresses: Sequence[str]) -> TeamSpec:
     ref = loaded.game.team(color)
     team = loaded.team(color)
-    hosts = list(dict.fromkeys([*ref.hosts, *addresses]))
-    return {
-        "color": color,
-        "team_id": ref.team_id,
-        "name": team.display_name,
-        "hosts": hosts,
-        "robot_addresses": list(addresses),
-        "players": [
-            {
-                "number": player.number,
-                "model": player.model,
-                "port": ref.port(player.number),
-                "half_time_pose": _pose(player.half_time_pose),
-                "reentry_pose": _pose(player.reentry_pose),
-                "shootout_pose": _pose(player.shootout_pose),
-                "goalkeeper_pose": _pose(player.goalkeeper_pose),
-                "goalkeeper": player.number == GOALKEEPER_NUMBER,
-            }
+    hosts = tuple(dict.fromkeys([*ref.hosts, *addresses]))
+    return TeamSpec(
+        color=color,
+        team_id=ref.team_id,
+        name=team.display_name,
+        hosts=hosts,
+        robot_addresses=tuple(addresses),
+        players=tuple(
+            PlayerSpec(
+                number=player.number,
+                model=player.model,
+                port=ref.port(player.number),
+                half_time_pose=_pose(player.half_time_pose),
+                reentry_pose=_pose(player.reentry_pose),
+                shootout_pose=_pose(player.shootout_pose),
+                goalkeeper_pose=_pose(player.goalkeeper_pose),
+                goalkeeper=player.number == GOALKEEPER_NUMBER,
+            )
             for player in team.players
-        ],
-    }
+        ),
+    )
 
 
-def _pose(pose: StartingPose) -> dict[str, float]:
-    return {"x_m": pose.x_m, "y_m": pose.y_m, "yaw_rad": pose.yaw_rad}
+def _pose(pose: StartingPose) -> Pose:
+    return Pose(x_m=pose.x_m, y_m=pose.y_m, yaw_rad=pose.yaw_rad)

@@ -7,7 +7,6 @@ Every teardown step runs even when an earlier one failed; a teardown failure mak
 from __future__ import annotations
 
 import importlib.metadata
-import json
 import logging
 import shutil
 from collections.abc import Callable
@@ -16,6 +15,9 @@ from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from contracts import files
+from contracts.errors import ContractError
+from contracts.sim_result import SimResult
 from orchestrator.errors import OrchestratorError
 from orchestrator.match.logfs import LogFolder
 from orchestrator.match.results import (
@@ -31,27 +33,23 @@ if TYPE_CHECKING:
 
 log = logging.getLogger(__name__)
 
-PUBLIC_FILES = (
-    "sim_result.json",
-    "replay.hlvsrec",
-    "api_stats.jsonl",
-    "referee.log",
-    "referee_events.jsonl",
-    "gamecontroller.log",
-    "match.mp4",
-)
+PUBLIC_FILES = files.PUBLIC_FILES
 
 
-def read_sim_result(runner: MatchRunner) -> dict[str, Any] | None:
+def read_sim_result(runner: MatchRunner) -> SimResult | None:
+    """The simulator's ``sim_result.json``; None when it is missing or does not fit the contract
+    (logged with the file, field and reason)."""
     match_dir = runner.started.match_dir
     if match_dir is None:
         return None
-    path = match_dir / "out" / "sim_result.json"
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    path = match_dir / files.OUT_DIR / files.SIM_RESULT
+    if not path.exists():
         return None
-    return data if isinstance(data, dict) else None
+    try:
+        return SimResult.load(path)
+    except ContractError as exc:
+        log.error("match %s: %s", runner.plan.match_id, exc)
+        return None
 
 
 def simulator_stderr_tail(runner: MatchRunner) -> str:

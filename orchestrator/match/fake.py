@@ -4,12 +4,13 @@
 from __future__ import annotations
 
 import itertools
-import json
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from contracts import files
+from contracts.sim_result import SimResult
 from orchestrator.bandwidth import AppliedShaping, RobotShaping, TrafficCounters
 from orchestrator.match.logfs import LogFolder
 from orchestrator.match.runtime import (
@@ -38,15 +39,15 @@ class FakeRuntime:
 
     def __init__(self, *, busy_subnets: tuple[str, ...] = (), missing_images: tuple[str, ...] = (),
                  simulator_exit_code: int | None = 0, simulator_polls: int = 3,
-                 sim_result: dict[str, Any] | None = None) -> None:
+                 sim_result: SimResult | None = None) -> None:
         self.networks: dict[str, NetworkRequest] = {}
         self.containers: dict[str, FakeContainer] = {}
         self.busy_subnets = set(busy_subnets)
         self.missing_images = set(missing_images)
         self.simulator_exit_code = simulator_exit_code
         self.simulator_polls = simulator_polls
-        self.sim_result = sim_result or {"final_state": "FINISHED", "score": {"red": 2, "blue": 1},
-                                         "winner": "red", "robots": {}}
+        self.sim_result = sim_result or SimResult(
+            match_id="fake", seed=0, state="FINISHED", score={"red": 2, "blue": 1}, winner="red")
         self.calls: list[tuple[str, str]] = []
         self._ids = itertools.count(1)
         self.on_start: Callable[[FakeContainer], None] | None = None
@@ -126,8 +127,8 @@ class FakeRuntime:
         out = Path(mount) / "out"
         out.mkdir(parents=True, exist_ok=True)
         if self.simulator_exit_code == 0:
-            (out / "sim_result.json").write_text(json.dumps(self.sim_result))
-            (out / "replay.hlvsrec").write_text("replay")
+            self.sim_result.write(out / files.SIM_RESULT)
+            (out / files.REPLAY).write_text("replay")
         assert self.simulator_exit_code is not None
         self.exit(found.state.id, self.simulator_exit_code)
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 from orchestrator.config import Limits, LoadedGame, PlayerConfig
@@ -104,10 +104,15 @@ def spec_dict(
         loaded, robot_addresses={c: list(a) for c, a in addresses.items()},
         telemetry_listen=telemetry,
     )
-    for color in ("red", "blue"):
-        spec[color]["hosts"] = list(addresses.get(color, ()))
-        spec[color]["robot_addresses"] = list(addresses.get(color, ()))
-    return spec
+    teams = {
+        color: replace(
+            spec.team(color),
+            hosts=tuple(addresses.get(color, ())),
+            robot_addresses=tuple(addresses.get(color, ())),
+        )
+        for color in ("red", "blue")
+    }
+    return replace(spec, red=teams["red"], blue=teams["blue"]).to_dict()
 
 
 def per_robot_rate_mb_s(team_rate_mb_s: float, n_robots: int) -> float:

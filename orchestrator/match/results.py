@@ -24,6 +24,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from contracts import files
+from contracts.sim_result import SimResult
+
 
 class FailureClass(enum.Enum):
     INFRASTRUCTURE = "infrastructure"
@@ -97,7 +100,7 @@ def build_results(
     *,
     match_id: str,
     seed: int,
-    sim_result: dict[str, Any] | None,
+    sim_result: SimResult | None,
     robots: list[RobotRecord],
     forfeit: dict[str, Any] | None,
     limits: dict[str, Any],
@@ -105,14 +108,14 @@ def build_results(
     timings_s: dict[str, float],
     failure: Failure | None,
 ) -> dict[str, Any]:
-    sim = sim_result or {}
-    api_stats: dict[str, Any] = sim.get("robots") or {}
-    score = sim.get("score")
-    winner = sim.get("winner")
+    sim = sim_result
+    api_stats: dict[str, Any] = sim.robots if sim is not None else {}
+    score: Any = sim.score if sim is not None else None
+    winner: Any = sim.winner if sim is not None else None
     if forfeit is not None:
         score = forfeit.get("score", score)
         winner = forfeit.get("winner")
-    spoofing = sim.get("spoofing") if isinstance(sim.get("spoofing"), dict) else None
+    spoofing = sim.spoofing if sim is not None else None
     robot_json = {r.key: r.to_json(api_stats.get(r.key)) for r in robots}
     for attempt in (spoofing or {}).get("attempts") or []:
         sender = robot_json.get(str(attempt.get("sender_robot")))
@@ -126,22 +129,22 @@ def build_results(
         if failure is None
         else {"class": failure.failure_class.value, "cause": failure.cause},
         "forfeit": forfeit,
-        "final_state": sim.get("final_state", sim.get("state")),
+        "final_state": sim.state if sim is not None else None,
         "score": score,
         "winner": winner,
-        "events_summary": sim.get("events_summary", {}),
-        "sim_time_ms": sim.get("sim_time_ms"),
-        "real_time_factor": sim.get("real_time_factor"),
+        "events_summary": sim.events_summary if sim is not None else {},
+        "sim_time_ms": sim.sim_time_ms if sim is not None else None,
+        "real_time_factor": sim.real_time_factor if sim is not None else None,
         "robots": robot_json,
         "spoofing": spoofing,
         "limits": limits,
-        "versions": {**versions, "simulator": sim.get("versions")},
+        "versions": {**versions, "simulator": sim.versions if sim is not None else None},
         "timings_s": timings_s,
     }
 
 
 def write_results(out_dir: Path, results: dict[str, Any]) -> Path:
-    path = out_dir / "results.json"
+    path = out_dir / files.RESULTS
     _write_json(path, results)
     return path
 
@@ -155,7 +158,7 @@ def write_report(out_dir: Path, failure: Failure | None) -> Path:
             "failure_class": failure.failure_class.value,
             "cause": failure.cause,
         }
-    path = out_dir / "report.json"
+    path = out_dir / files.REPORT
     _write_json(path, report)
     return path
 

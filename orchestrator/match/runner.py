@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from contracts import files
 from orchestrator.errors import OrchestratorError
 from orchestrator.match import collection, startup
 from orchestrator.match.host import Host
@@ -122,7 +123,7 @@ class MatchRunner:
     def run(self) -> MatchOutcome:
         out = self.options.out_dir
         out.mkdir(parents=True, exist_ok=True)
-        (out / "report.json").unlink(missing_ok=True)  # a stale one would say "complete"
+        (out / files.REPORT).unlink(missing_ok=True)  # a stale one would say "complete"
         try:
             self._advance(MatchState.PULLING)
             self._resolve_images()
@@ -255,18 +256,18 @@ class MatchRunner:
     def _on_simulator_exit(self, exit_code: int | None) -> None:
         log.info("match %s: simulator exited with code %s", self.plan.match_id, exit_code)
         if exit_code != 0:
-            reported = (collection.read_sim_result(self) or {}).get("error")
+            written = collection.read_sim_result(self)
+            reported = written.error if written is not None else None
             tail = str(reported) if reported else collection.simulator_stderr_tail(self)
             self._fail(FailureClass.SIMULATOR,
                        f"simulator exited with code {exit_code}" + (f": {tail}" if tail else ""))
             return
         sim_result = collection.read_sim_result(self)
-        final = None if sim_result is None else sim_result.get(
-            "final_state", sim_result.get("state"))
         if sim_result is None:
             self._fail(FailureClass.SIMULATOR, "simulator exited 0 without sim_result.json")
-        elif final is not None and final != "FINISHED":
-            self._fail(FailureClass.REFEREE, f"the game ended in state {final}, not FINISHED")
+        elif not sim_result.finished:
+            self._fail(FailureClass.REFEREE,
+                       f"the game ended in state {sim_result.state}, not FINISHED")
 
 
 __all__ = ["ImageResolver", "MatchOutcome", "MatchRunner", "RunOptions", "TelemetryFactory",

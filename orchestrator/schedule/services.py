@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
+from contracts import files
 from orchestrator.config.schedule import PlannedMatch, Schedule, ScheduledTeam
 from orchestrator.errors import ScheduleError
 
@@ -125,7 +126,7 @@ def _die_with_parent() -> None:  # pragma: no cover - runs in the child before e
 
 def read_outcome(out_dir: Path) -> PlayOutcome:
     """The outcome of a finished ``hlvs match`` from its report.json and results.json."""
-    report_path, results_path = out_dir / "report.json", out_dir / "results.json"
+    report_path, results_path = out_dir / files.REPORT, out_dir / files.RESULTS
     if not report_path.is_file():
         return PlayOutcome(
             status="infrastructure",

@@ -10,7 +10,9 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass, field
 
-from referee.config import GameType, TimingConfig
+from contracts.ids import RobotId, TeamColor
+from contracts.match_spec import GameType
+from referee.config import TimingConfig
 from referee.errors import IllegalTransition
 from referee.gamecontroller.states import (
     ALLOWED_TRANSITIONS,
@@ -19,7 +21,6 @@ from referee.gamecontroller.states import (
     Penalty,
     SecondaryState,
 )
-from referee.snapshot import RobotId, TeamColor
 
 logger = logging.getLogger(__name__)
 

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import math
 
-from referee.config import GameType
+from contracts.ids import TeamColor
+from contracts.match_spec import GameType
 from referee.gamecontroller.machine import GameController
 from referee.gamecontroller.states import DROPBALL_TEAM, GameTypeCode, TeamColourCode
-from referee.snapshot import TeamColor
 from referee.wire import MAX_PLAYERS, GameControlData, RobotInfo, TeamInfo
 
 

@@ -9,9 +9,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from contracts.ids import TeamColor
 from referee.gamecontroller.states import SecondaryState
 from referee.rules.base import AwardSetPlay, Decision, GameView, distance2d
-from referee.snapshot import TeamColor, Vec2, WorldSnapshot
+from referee.snapshot import Vec2, WorldSnapshot
 
 WINDOW_S = 5.0
 RADIUS_RATIO = 1.0 / 3.0

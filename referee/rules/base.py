@@ -11,11 +11,12 @@ import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
+from contracts.field import FieldGeometry
+from contracts.ids import RobotId, TeamColor
 from referee.config import TimingConfig
-from referee.field import FieldGeometry
 from referee.gamecontroller.machine import SetPlay
 from referee.gamecontroller.states import Card, GameState, Penalty, SecondaryState
-from referee.snapshot import RobotId, RobotState, TeamColor, Vec2, Vec3, WorldSnapshot
+from referee.snapshot import RobotState, Vec2, Vec3, WorldSnapshot
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

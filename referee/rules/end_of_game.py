@@ -13,9 +13,9 @@ import random
 from dataclasses import dataclass
 from enum import StrEnum
 
-from referee.config import GameType
+from contracts.ids import TeamColor
+from contracts.match_spec import GameType
 from referee.gamecontroller.states import SecondaryState
-from referee.snapshot import TeamColor
 
 REGULATION_KICKS = 5
 MAX_KICKS = 10

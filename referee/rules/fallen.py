@@ -4,9 +4,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from contracts.ids import RobotId
 from referee.gamecontroller.states import GameState, Penalty, SecondaryState
 from referee.rules.base import Decision, GameView, PenalizeRobot, timers
-from referee.snapshot import RobotId, WorldSnapshot
+from referee.snapshot import WorldSnapshot
 
 JUDGED_STATES = frozenset({GameState.READY, GameState.SET, GameState.PLAYING})
 

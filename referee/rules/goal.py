@@ -11,9 +11,10 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from enum import StrEnum
 
+from contracts.ids import RobotId
 from referee.rules.ball_out import goal_line_restart, in_goal
 from referee.rules.base import Decision, GameView, Goal, distance2d
-from referee.snapshot import RobotId, WorldSnapshot
+from referee.snapshot import WorldSnapshot
 
 
 class Restriction(StrEnum):

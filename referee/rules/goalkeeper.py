@@ -5,9 +5,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from contracts.ids import RobotId
 from referee.gamecontroller.states import Penalty
 from referee.rules.base import Decision, GameView, PenalizeRobot, distance2d
-from referee.snapshot import RobotId, RobotState, WorldSnapshot
+from referee.snapshot import RobotState, WorldSnapshot
 
 BALL_NEAR_M = 0.5
 PROGRESS_M = 0.05

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from contracts.ids import RobotId
 from referee.gamecontroller.states import GameState, Penalty
 from referee.rules.base import Decision, GameView, PenalizeRobot, timers
-from referee.snapshot import RobotId, RobotState, WorldSnapshot
+from referee.snapshot import RobotState, WorldSnapshot
 
 JUDGED_STATES = frozenset({GameState.READY, GameState.SET, GameState.PLAYING})
 

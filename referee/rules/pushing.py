@@ -25,9 +25,10 @@ import math
 from collections import deque
 from dataclasses import dataclass, field
 
+from contracts.ids import RobotId
 from referee.gamecontroller.states import GameState, Penalty, SecondaryState
 from referee.rules.base import AwardSetPlay, Decision, GameView, PenalizeRobot, distance2d
-from referee.snapshot import RobotId, RobotState, Vec3, WorldSnapshot
+from referee.snapshot import RobotState, Vec3, WorldSnapshot
 
 PERIOD_MS = 2000
 CONTACT_MS = 1000

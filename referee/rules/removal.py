@@ -13,16 +13,10 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from referee.config import Pose
-from referee.field import FieldGeometry
-from referee.snapshot import (
-    RemoveRobot,
-    RobotId,
-    SetLimp,
-    TeleportRobot,
-    Vec2,
-    WorldCommand,
-)
+from contracts.field import FieldGeometry
+from contracts.geometry import Pose
+from contracts.ids import RobotId
+from referee.snapshot import RemoveRobot, SetLimp, TeleportRobot, Vec2, WorldCommand
 
 
 def reentry_pose(

@@ -27,7 +27,7 @@ import sys
 import time
 from typing import Any
 
-from referee.snapshot import RobotId, TeamColor
+from contracts.ids import RobotId, TeamColor
 from simulator.api.endpoints import free_ports
 from simulator.api.framing import WELCOME
 
@@ -213,6 +213,7 @@ def _bench_sim(robots: int, physics_dt: float, sim_seconds: float) -> dict[str, 
 def _api_run(
     args: argparse.Namespace, camera: tuple[int, int, int] | None, stalled: bool
 ) -> dict[str, Any]:
+    from contracts.match_spec import NetworkSpec
     from simulator.api import (
         ApiServer,
         LockstepSettings,
@@ -220,7 +221,6 @@ def _api_run(
         wait_lockstep,
         world_cameras,
     )
-    from simulator.spec import NetworkSpec
 
     robots = _robots(args.robots)
     world = _world(robots, args.physics_dt)

@@ -7,8 +7,8 @@ import socket
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
-from referee.snapshot import RobotId, TeamColor
-from simulator.spec import MatchSpec
+from contracts.ids import RobotId, TeamColor
+from contracts.match_spec import MatchSpec
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

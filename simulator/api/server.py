@@ -24,8 +24,9 @@ from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any
 
+from contracts.ids import RobotId
+from contracts.match_spec import NetworkSpec
 from contracts.robot_api import messages_pb2 as pb
-from referee.snapshot import RobotId
 from referee.spoofing import SpoofingLog
 from simulator.api.cameras import MAX_IN_FLIGHT, ImageSource
 from simulator.api.connection import ClientClosed, Connection
@@ -37,7 +38,6 @@ from simulator.api.sender import SendThread
 from simulator.api.session import ERROR, Measurement, RobotSession
 from simulator.api.stats import RobotStats
 from simulator.errors import ApiError
-from simulator.spec import NetworkSpec
 
 log = logging.getLogger(__name__)
 

@@ -14,8 +14,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from contracts.ids import RobotId
 from contracts.robot_api import messages_pb2 as pb
-from referee.snapshot import RobotId
 from simulator.api.devices import (
     ACCELEROMETER,
     CAMERA,

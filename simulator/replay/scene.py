@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     import mujoco
 
-    from referee.field import FieldGeometry
+    from contracts.field import FieldGeometry
     from simulator.replay.format import ReplayHeader
     from simulator.world.types import RobotPlacement
 
@@ -119,8 +119,8 @@ def scene_for(header: ReplayHeader, path: str) -> dict[str, Any]:
     for the robots it lists, when those still have the recorded bodies."""
     if header.scene is not None:
         return header.scene
-    from referee.field import field_for
-    from referee.snapshot import RobotId, TeamColor
+    from contracts.field import field_for
+    from contracts.ids import RobotId, TeamColor
     from simulator.errors import ReplayError, UnknownModelError
     from simulator.world.scene import compile_scene
     from simulator.world.types import RobotPlacement

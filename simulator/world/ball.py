@@ -10,7 +10,7 @@ within 6 s.
 
 from __future__ import annotations
 
-from referee.field import FieldGeometry
+from contracts.field import FieldGeometry
 
 BALL_BODY = "ball"
 BALL_JOINT = "ball/root"

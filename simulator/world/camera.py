@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
-from referee.snapshot import RobotId
+from contracts.ids import RobotId
 from simulator.errors import UnknownDeviceError
 
 if TYPE_CHECKING:

@@ -9,12 +9,12 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
+from contracts.ids import TeamColor
 from referee.snapshot import (
     PlaceBall,
     RemoveRobot,
     RestoreRobot,
     SetLimp,
-    TeamColor,
     TeleportRobot,
     Vec3,
     WorldCommand,

@@ -17,7 +17,8 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 
-from referee.snapshot import RobotId, Vec3
+from contracts.ids import RobotId
+from referee.snapshot import Vec3
 from simulator.errors import UnknownDeviceError
 from simulator.world.types import DeviceKind
 

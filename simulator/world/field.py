@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from referee.field import FieldGeometry
+from contracts.field import FieldGeometry
 
 TURF_FRICTION = 0.5
 LINE_HEIGHT_M = 0.001

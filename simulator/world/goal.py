@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from referee.field import FieldGeometry
+from contracts.field import FieldGeometry
 
 POST_RGBA = "1 1 1 1"
 NET_RGBA = "0.9 0.9 0.9 0.35"

@@ -10,7 +10,8 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 
-from referee.snapshot import BodyPart, RobotId
+from contracts.ids import RobotId
+from referee.snapshot import BodyPart
 from simulator.world.ball import BALL_GEOM, BALL_JOINT
 from simulator.world.robots import AnyRobotModel, robot_model
 from simulator.world.types import RobotPlacement, robot_prefix

@@ -12,8 +12,8 @@ from collections.abc import Sequence
 import mujoco
 import numpy as np
 
-from referee.field import FieldGeometry
-from referee.snapshot import TeamColor
+from contracts.field import FieldGeometry
+from contracts.ids import TeamColor
 from simulator.world.ball import BALL_GEOM, BALL_JOINT, ball_assets, ball_body, ball_damping
 from simulator.world.field import field_assets, field_bodies
 from simulator.world.goal import goal_bodies

@@ -14,7 +14,8 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 
-from referee.snapshot import BallState, BodyPart, RobotId, RobotState, WorldSnapshot
+from contracts.ids import RobotId
+from referee.snapshot import BallState, BodyPart, RobotState, WorldSnapshot
 from simulator.world.indices import (
     FOOT_BIT,
     KIND_BALL,

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from enum import StrEnum
 from typing import Literal
 
-from referee.snapshot import RobotId, TeamColor
+from contracts.ids import RobotId, TeamColor
 
 FieldClassName = Literal["kid", "adult"]
 DivergencePolicy = Literal["fail", "reset_robot"]

@@ -17,10 +17,11 @@ from collections.abc import Sequence
 import mujoco
 import numpy as np
 
-from referee.field import FieldGeometry, field_for
-from referee.snapshot import RobotId, TeamColor, WorldCommand, WorldSnapshot
+from contracts.field import FieldGeometry, field_for
+from contracts.ids import RobotId, TeamColor
+from contracts.match_spec import MatchSpec
+from referee.snapshot import WorldCommand, WorldSnapshot
 from simulator.errors import PhysicsDivergence
-from simulator.spec import MatchSpec
 from simulator.world import commands
 from simulator.world.devices import DeviceAccess
 from simulator.world.divergence import DivergenceWatch
@@ -123,22 +124,20 @@ class World(DeviceAccess):
     @classmethod
     def from_spec(cls, spec: MatchSpec, *, divergence_policy: DivergencePolicy = "fail") -> World:
         """Every player of both teams at its ``half_time_pose``; the team playing on the right
-        (not ``spec.side_left``) is mirrored: ``x -> -x``, ``yaw -> pi - yaw``."""
+        (not ``spec.side_left``) is mirrored (:meth:`contracts.geometry.Pose.mirrored`)."""
         placements = []
         for color in (TeamColor.RED, TeamColor.BLUE):
             team = spec.red if color is TeamColor.RED else spec.blue
-            mirror = spec.side_left != color.value
+            left = spec.side_left == color.value
             for player in team.players:
-                pose = player.half_time_pose
-                x, yaw = (-pose.x_m, math.pi - pose.yaw_rad) if mirror else (pose.x_m, pose.yaw_rad)
-                yaw = math.atan2(math.sin(yaw), math.cos(yaw))
+                pose = player.half_time_pose.on_side(left=left)
                 placements.append(
                     RobotPlacement(
                         id=RobotId(color, player.number),
                         model=player.model,
-                        x_m=x,
+                        x_m=pose.x_m,
                         y_m=pose.y_m,
-                        yaw_rad=yaw,
+                        yaw_rad=pose.yaw_rad,
                     )
                 )
         return cls.create(

@@ -7,18 +7,14 @@ import math
 from dataclasses import dataclass, field, replace
 from typing import Any
 
+from contracts.geometry import Pose
+from contracts.ids import RobotId, TeamColor
+from contracts.match_spec import GameType
 from referee.autoref import Referee
 from referee.clock import FakeClock
-from referee.config import GameType, PlayerConfig, Pose, RefereeConfig, TeamConfig, TimingConfig
+from referee.config import RefereeConfig, RefereePlayer, RefereeTeam, TimingConfig
 from referee.gamecontroller.states import Card
-from referee.snapshot import (
-    PlaceBall,
-    RefereeEvent,
-    RobotId,
-    TeamColor,
-    TeleportRobot,
-    WorldSnapshot,
-)
+from referee.snapshot import PlaceBall, RefereeEvent, TeleportRobot, WorldSnapshot
 from simulator.world import RobotPlacement, World
 from tests.scenarios.scenario import Action, Expectation, Scenario, parse_robot_id
 
@@ -59,13 +55,13 @@ def build_config(scenario: Scenario) -> RefereeConfig:
     half = int(game.get("half", 1))
     left_now = side_left if half == 1 else side_left.opponent
     timing = replace(SCENARIO_TIMING, **scenario.timing)
-    players: dict[TeamColor, list[PlayerConfig]] = {TeamColor.RED: [], TeamColor.BLUE: []}
+    players: dict[TeamColor, list[RefereePlayer]] = {TeamColor.RED: [], TeamColor.BLUE: []}
     for start in scenario.robots:
         pose = Pose(x_m=start.x, y_m=start.y, yaw_rad=start.yaw)
         if start.id.team is not left_now:
             pose = pose.mirrored()
         players[start.id.team].append(
-            PlayerConfig(
+            RefereePlayer(
                 number=start.id.number,
                 half_time_pose=pose,
                 reentry_pose=Pose(x_m=-3.0, y_m=-3.1, yaw_rad=math.pi / 2),
@@ -75,7 +71,7 @@ def build_config(scenario: Scenario) -> RefereeConfig:
             )
         )
     teams = {
-        color: TeamConfig(
+        color: RefereeTeam(
             team_id=8 if color is TeamColor.RED else 25,
             name=f"{color.value} team",
             players=tuple(sorted(players[color], key=lambda p: p.number)),

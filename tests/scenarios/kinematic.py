@@ -10,13 +10,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from referee.field import KID_FIELD, FieldGeometry
+from contracts.field import KID_FIELD, FieldGeometry
+from contracts.ids import RobotId
 from referee.snapshot import (
     BallState,
     PlaceBall,
     RemoveRobot,
     RestoreRobot,
-    RobotId,
     RobotState,
     SetLimp,
     TeleportRobot,

@@ -32,8 +32,8 @@ from typing import Any
 
 import yaml
 
+from contracts.ids import RobotId, TeamColor
 from referee.errors import ScenarioError
-from referee.snapshot import RobotId, TeamColor
 
 STATE_KEYS = {
     "state",

@@ -7,8 +7,8 @@ from collections.abc import Callable
 
 import pytest
 
+from contracts.ids import RobotId, TeamColor
 from referee import FakeClock, Referee, RefereeConfig, TimingConfig
-from referee.snapshot import RobotId, TeamColor
 from tests.scenarios.kinematic import KinematicWorld
 from tests.unit.referee.referee_helpers import make_config
 

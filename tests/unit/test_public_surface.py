@@ -21,7 +21,7 @@ def test_referee_imports_neither_mujoco_nor_docker() -> None:
     import sys
 
     code = (
-        "import sys, referee, referee.snapshot, referee.field;"
+        "import sys, referee, referee.snapshot, contracts.field;"
         "bad=[m for m in ('mujoco','docker') if m in sys.modules];"
         "print(','.join(bad))"
     )

@@ -13,7 +13,8 @@ from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from typing import Any
 
-from referee.snapshot import RobotId, TeamColor
+from contracts.ids import RobotId, TeamColor
+from contracts.match_spec import NetworkSpec
 from simulator.api import (
     ApiServer,
     FakeCameraRenderer,
@@ -23,7 +24,6 @@ from simulator.api import (
     wait_lockstep,
 )
 from simulator.api.endpoints import free_ports
-from simulator.spec import NetworkSpec
 
 RED1 = RobotId(TeamColor.RED, 1)
 RED2 = RobotId(TeamColor.RED, 2)

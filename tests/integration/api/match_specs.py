@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Any
 
-from simulator.spec import MatchSpec, NetworkSpec, PlayerSpec, Pose, TeamSpec, TimingSpec
+from contracts.match_spec import MatchSpec, NetworkSpec, PlayerSpec, Pose, TeamSpec, TimingSpec
 from tests.integration.api.harness import free_ports
 
 

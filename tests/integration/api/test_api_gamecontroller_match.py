@@ -17,9 +17,9 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
+from contracts.match_spec import MatchSpec
 from robot.client import GameControllerListener
 from robot.client.gamecontroller import GameControlData, GameState
-from simulator.spec import MatchSpec
 from tests.integration.api.match_specs import short_spec
 
 ROBOTS = {"red": "127.0.0.21", "blue": "127.0.0.22"}

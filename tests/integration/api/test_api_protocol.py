@@ -8,10 +8,10 @@ import time
 
 import pytest
 
+from contracts.match_spec import NetworkSpec
 from contracts.robot_api import messages_pb2 as pb
 from robot.client import HandshakeRefused, RobotClient
 from simulator.api import FakeDeviceWorld
-from simulator.spec import NetworkSpec
 from tests.integration.api.harness import BLUE1, RED1, RED2, running_server, wait_until
 
 

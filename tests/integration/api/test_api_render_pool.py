@@ -10,8 +10,8 @@ import time
 import numpy as np
 import pytest
 
+from contracts.ids import RobotId, TeamColor
 from contracts.robot_api import messages_pb2 as pb
-from referee.snapshot import RobotId, TeamColor
 from simulator.api.render_pool import RenderPool
 from simulator.api.session import CameraJob
 from simulator.world import CameraRenderer, RobotPlacement, World

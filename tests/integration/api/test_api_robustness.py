@@ -8,9 +8,9 @@ import time
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from contracts.match_spec import NetworkSpec
 from robot.client import RobotClient
 from simulator.api import FakeDeviceWorld, LockstepSettings
-from simulator.spec import NetworkSpec
 from tests.integration.api.harness import BLUE1, RED1, RED2, running_server, wait_until
 
 

@@ -14,9 +14,9 @@ from pathlib import Path
 
 import pytest
 
+from contracts.match_spec import MatchSpec
 from robot.client import ConnectionClosed, RobotClient
 from simulator.runtime import run_match
-from simulator.spec import MatchSpec
 from tests.integration.api.harness import free_ports, wait_until
 from tests.integration.api.match_specs import short_spec
 

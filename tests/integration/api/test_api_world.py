@@ -8,11 +8,11 @@ import time
 
 import pytest
 
-from referee.snapshot import RobotId, TeamColor
+from contracts.ids import RobotId, TeamColor
+from contracts.match_spec import NetworkSpec
 from robot.client import RobotClient
 from simulator.api import FakeDeviceWorld
 from simulator.api.world_cameras import world_render_worker
-from simulator.spec import NetworkSpec
 from simulator.world import RobotPlacement, World
 from tests.integration.api.harness import RED1, running_server, wait_until
 

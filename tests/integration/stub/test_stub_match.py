@@ -18,7 +18,8 @@ from pathlib import Path
 
 import pytest
 
-from referee.snapshot import PlaceBall, TeamColor
+from contracts.ids import TeamColor
+from referee.snapshot import PlaceBall
 from referee.wire import GameControlData, RobotInfo, TeamInfo, decode_return, encode_game_state
 from simulator.api import LockstepSettings
 from simulator.api.world_cameras import world_render_worker

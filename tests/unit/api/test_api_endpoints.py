@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from contracts.match_spec import MatchSpec
 from simulator.api.endpoints import endpoints_from_spec
-from simulator.spec import MatchSpec
 
 
 def _spec(red_addresses: list[str], blue_addresses: list[str]) -> MatchSpec:

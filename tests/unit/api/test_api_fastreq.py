@@ -101,7 +101,7 @@ def test_scan_of_encoded_requests(pairs: list[tuple[str, float]]) -> None:
 
 
 def test_session_applies_decoded_targets_like_requests() -> None:
-    from referee.snapshot import RobotId, TeamColor
+    from contracts.ids import RobotId, TeamColor
     from simulator.api import FakeDeviceWorld, RobotSession
     from simulator.api.fastreq import PositionTargets
 

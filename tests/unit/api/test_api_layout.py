@@ -7,8 +7,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from contracts.ids import RobotId, TeamColor
 from contracts.robot_api import messages_pb2 as pb
-from referee.snapshot import RobotId, TeamColor
 from simulator.api import FakeDeviceWorld, RobotSession
 from simulator.api.devices import KID_MOTORS
 from simulator.api.encode import (

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
+from contracts.ids import RobotId, TeamColor
 from contracts.robot_api import messages_pb2 as pb
-from referee.snapshot import RobotId, TeamColor
 from simulator.api import FakeDeviceWorld, NetworkQuota, RobotSession, rendering_bandwidth_mb_s
 
 RED1 = RobotId(TeamColor.RED, 1)

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from contracts.ids import RobotId, TeamColor
 from contracts.robot_api import messages_pb2 as pb
-from referee.snapshot import RobotId, TeamColor
 from simulator.api import FakeDeviceWorld, RobotSession
 
 RED1 = RobotId(TeamColor.RED, 1)

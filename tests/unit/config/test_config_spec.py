@@ -1,4 +1,4 @@
-"""to_match_spec writes what simulator.spec.MatchSpec reads, with random choices from the seed."""
+"""to_match_spec builds the MatchSpec the simulator reads, with random choices from the seed."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import sys
 
 import pytest
 
+from contracts.match_spec import MatchSpec
 from orchestrator.config import load_game, resolve_sides, to_match_spec
-from simulator.spec import MatchSpec
 from tests.unit.config.conftest import EXAMPLES, GameFiles
 
 
@@ -21,7 +21,7 @@ def test_round_trip_through_match_spec(example: str) -> None:
         "blue": [f"172.30.2.{n}" for n in range(1, len(loaded.blue.players) + 1)],
     }
     data = to_match_spec(loaded, robot_addresses=addresses, telemetry_listen="tcp/172.30.0.2:7447")
-    spec = MatchSpec.from_dict(json.loads(json.dumps(data)))
+    spec = MatchSpec.from_dict(json.loads(data.to_json()))
     game = loaded.game
     assert (spec.match_id, spec.seed, spec.game_type) == (game.match_id, game.seed, game.game_type)
     assert spec.field_class == game.field_class.lower()
@@ -48,10 +48,10 @@ def test_video_only_for_mp4(game_files: GameFiles) -> None:
     game_files.game["record_simulation"] = "/tmp/anything.mp4"
     loaded = load_game(game_files.write())
     data = to_match_spec(loaded, robot_addresses={}, telemetry_listen=None)
-    assert MatchSpec.from_dict(data).record_video == "match.mp4"
+    assert MatchSpec.from_dict(data.to_dict()).record_video == "match.mp4"
     game_files.game["record_simulation"] = "recording.html"
     loaded = load_game(game_files.write())
-    assert to_match_spec(loaded, robot_addresses={}, telemetry_listen=None)["record_video"] is None
+    assert to_match_spec(loaded, robot_addresses={}, telemetry_listen=None).record_video is None
 
 
 def test_random_sides_follow_the_seed(game_files: GameFiles) -> None:
@@ -62,7 +62,7 @@ def test_random_sides_follow_the_seed(game_files: GameFiles) -> None:
         first = resolve_sides(loaded)
         assert resolve_sides(loaded) == first  # same seed, same choice
         data = to_match_spec(loaded, robot_addresses={}, telemetry_listen=None)
-        assert (data["side_left"], data["kickoff"]) == first
+        assert (data.side_left, data.kickoff) == first
         outcomes.add(first)
     assert len(outcomes) == 4  # every combination happens for some seed
 

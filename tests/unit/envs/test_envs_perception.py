@@ -6,8 +6,8 @@ import math
 
 import numpy as np
 
+from contracts.field import KID_FIELD
 from envs.perception import LINE_COUNT, CameraView, add_noise, field_segments, goal_post_feet
-from referee.field import KID_FIELD
 
 
 def _view(yaw: float = 0.0, height: float = 0.7) -> CameraView:

@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+from contracts.sim_result import SimResult
 from orchestrator.config import Limits
 from orchestrator.match import (
     FailureClass,
@@ -123,7 +124,8 @@ def test_simulator_crash_is_a_simulator_failure(tmp_path: Path) -> None:
 
 
 def test_game_not_finished_is_a_referee_failure(tmp_path: Path) -> None:
-    runtime = FakeRuntime(sim_result={"final_state": "PLAYING", "robots": {}})
+    runtime = FakeRuntime(sim_result=SimResult(
+        match_id="u1", seed=3, state="PLAYING", score={"red": 0, "blue": 0}, winner=None))
     _, outcome = _run(tmp_path, _plan(), runtime)
     assert outcome.failure is not None
     assert outcome.failure.failure_class is FailureClass.REFEREE

@@ -11,8 +11,9 @@ import jsonschema
 import mujoco
 import numpy as np
 
+from contracts.ids import RobotId, TeamColor
 from orchestrator.commands.check import check_file, check_report
-from referee.snapshot import BodyPart, RobotId, TeamColor
+from referee.snapshot import BodyPart
 from simulator.world import RobotPlacement, World
 from simulator.world.camera import CameraRenderer
 from simulator.world.robots.team import load_team_model

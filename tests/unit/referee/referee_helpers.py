@@ -2,22 +2,11 @@
 
 from __future__ import annotations
 
-from referee.config import (
-    GameType,
-    PlayerConfig,
-    Pose,
-    RefereeConfig,
-    TeamConfig,
-    TimingConfig,
-)
-from referee.snapshot import (
-    BallState,
-    BodyPart,
-    RobotId,
-    RobotState,
-    TeamColor,
-    WorldSnapshot,
-)
+from contracts.geometry import Pose
+from contracts.ids import RobotId, TeamColor
+from contracts.match_spec import GameType
+from referee.config import RefereeConfig, RefereePlayer, RefereeTeam, TimingConfig
+from referee.snapshot import BallState, BodyPart, RobotState, WorldSnapshot
 
 RED = TeamColor.RED
 BLUE = TeamColor.BLUE
@@ -42,9 +31,9 @@ FAST_TIMING = TimingConfig(
 )
 
 
-def player(number: int, *, y: float = -3.1) -> PlayerConfig:
+def player(number: int, *, y: float = -3.1) -> RefereePlayer:
     """Poses as if playing on the left: half-time pose on the touch line of the own half."""
-    return PlayerConfig(
+    return RefereePlayer(
         number=number,
         half_time_pose=Pose(x_m=-0.6 - 0.9 * number, y_m=y, yaw_rad=1.57),
         reentry_pose=Pose(x_m=-3.0, y_m=-3.1, yaw_rad=1.57),
@@ -65,11 +54,11 @@ def make_config(
 ) -> RefereeConfig:
     addresses = addresses or {}
     return RefereeConfig(
-        red=TeamConfig(
+        red=RefereeTeam(
             team_id=8, name="Red Team", players=tuple(player(n) for n in range(1, players + 1)),
             robot_addresses=addresses.get(RED, ()),
         ),
-        blue=TeamConfig(
+        blue=RefereeTeam(
             team_id=25, name="Blue Team", players=tuple(player(n) for n in range(1, players + 1)),
             robot_addresses=addresses.get(BLUE, ()),
         ),

@@ -7,8 +7,8 @@ import re
 from dataclasses import replace
 from pathlib import Path
 
+from contracts.match_spec import GameType
 from referee import FakeClock, PlaceBall, Referee, SetLimp, TeleportRobot
-from referee.config import GameType
 from tests.unit.referee.referee_helpers import FAST_TIMING, RED, make_config, robot, snapshot
 
 LINE = re.compile(r"^\[\d{4}\.\d{3}\|\d{4}\.\d{3}\] (Info|Warning|Error): .+$")

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import pytest
 
+from contracts.ids import RobotId, TeamColor
+from contracts.match_spec import GameType
 from referee import IllegalTransition
-from referee.config import GameType, TimingConfig
+from referee.config import TimingConfig
 from referee.gamecontroller import (
     Card,
     GameController,
@@ -14,7 +16,6 @@ from referee.gamecontroller import (
     SecondaryState,
     Tick,
 )
-from referee.snapshot import RobotId, TeamColor
 
 RED, BLUE = TeamColor.RED, TeamColor.BLUE
 

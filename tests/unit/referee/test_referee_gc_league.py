@@ -8,8 +8,9 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
+from contracts.match_spec import GameType
 from referee import FakeClock, Referee
-from referee.config import GameType, NetworkConfig
+from referee.config import NetworkConfig
 from referee.wire import GameControlData, decode_game_state
 from tests.unit.referee.referee_helpers import (
     BLUE,

@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pytest
 
+from contracts.ids import RobotId, TeamColor
 from referee import FakeClock, Referee, SystemClock, TeamMirror
 from referee.config import NetworkConfig
 from referee.net import GameControllerNetwork
-from referee.snapshot import RobotId, TeamColor
 from referee.wire import ReturnData, ReturnMessage, decode_game_state, encode_return
 from tests.unit.referee.referee_helpers import BLUE, RED, make_config, robot, snapshot
 

@@ -7,8 +7,11 @@ from collections.abc import Callable
 
 import pytest
 
-from referee.config import GameType, Pose, TimingConfig
-from referee.field import KID_FIELD
+from contracts.field import KID_FIELD
+from contracts.geometry import Pose
+from contracts.ids import RobotId
+from contracts.match_spec import GameType
+from referee.config import TimingConfig
 from referee.gamecontroller import GameState, Penalty, SecondaryState
 from referee.gamecontroller.machine import SetPlay
 from referee.rules import (
@@ -25,7 +28,6 @@ from referee.rules import (
     removal,
 )
 from referee.rules.base import AwardSetPlay, DropBall, GameView, GiveCard, Goal, PenalizeRobot
-from referee.snapshot import RobotId
 from tests.unit.referee.referee_helpers import BLUE, RED, robot, snapshot
 
 R1, R2, B1, B2 = RobotId(RED, 1), RobotId(RED, 2), RobotId(BLUE, 1), RobotId(BLUE, 2)

@@ -6,11 +6,12 @@ import struct
 
 import pytest
 
+from contracts.ids import RobotId, TeamColor
+from contracts.match_spec import GameType
 from referee import ProtocolError
-from referee.config import GameType, TimingConfig
+from referee.config import TimingConfig
 from referee.gamecontroller import GameController, GameState, Penalty, SecondaryState
 from referee.gamecontroller.packet import game_control_data
-from referee.snapshot import RobotId, TeamColor
 from referee.wire import (
     GameControlData,
     ReturnData,

@@ -9,7 +9,8 @@ from typing import Any
 import numpy as np
 
 from benchmarks.stub import sense
-from referee.snapshot import PlaceBall, RobotId, TeamColor
+from contracts.ids import RobotId, TeamColor
+from referee.snapshot import PlaceBall
 from robot.motion import standing_posture
 from robot.stub.controller import Sensors
 from simulator.world import RobotPlacement, World

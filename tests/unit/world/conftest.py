@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from referee.snapshot import RobotId, TeamColor
+from contracts.ids import RobotId, TeamColor
 from simulator.world import RobotPlacement, World
 
 RED_1 = RobotId(TeamColor.RED, 1)

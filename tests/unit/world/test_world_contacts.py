@@ -7,7 +7,7 @@ import math
 import pytest
 
 import simulator.world
-from referee.snapshot import RobotId, TeamColor
+from contracts.ids import RobotId, TeamColor
 from simulator.world import RobotPlacement, World
 from tests.unit.world.conftest import RED_1, run_steps
 

@@ -6,16 +6,8 @@ import math
 
 import pytest
 
-from referee.snapshot import (
-    BodyPart,
-    PlaceBall,
-    RemoveRobot,
-    RestoreRobot,
-    RobotId,
-    SetLimp,
-    TeamColor,
-    TeleportRobot,
-)
+from contracts.ids import RobotId, TeamColor
+from referee.snapshot import BodyPart, PlaceBall, RemoveRobot, RestoreRobot, SetLimp, TeleportRobot
 from simulator.errors import UnknownDeviceError
 from simulator.world import FORCE_SENSORS, MOTOR_NAMES, CameraRenderer, DeviceKind, World
 from tests.unit.world.conftest import RED_1, run_steps

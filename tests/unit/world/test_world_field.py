@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from referee.field import ADULT_FIELD, KID_FIELD, FieldGeometry
+from contracts.field import ADULT_FIELD, KID_FIELD, FieldGeometry
 from simulator.errors import UnknownModelError
 from simulator.world import (
     MOTOR_NAMES,

@@ -9,7 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from referee.snapshot import BodyPart, PlaceBall, RobotId, TeamColor
+from contracts.ids import RobotId, TeamColor
+from referee.snapshot import BodyPart, PlaceBall
 from simulator.errors import PhysicsDivergence
 from simulator.recorder import Recorder
 from simulator.world import RobotPlacement, World

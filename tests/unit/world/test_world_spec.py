@@ -6,8 +6,8 @@ import math
 
 import pytest
 
-from referee.snapshot import RobotId, TeamColor
-from simulator.spec import MatchSpec, PlayerSpec, Pose, TeamSpec
+from contracts.ids import RobotId, TeamColor
+from contracts.match_spec import MatchSpec, PlayerSpec, Pose, TeamSpec
 from simulator.world import World
 
 

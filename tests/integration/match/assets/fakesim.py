@@ -73,7 +73,7 @@ time.sleep(duration)
 with lock:
     robots = dict(stats)
 result = {
-    "match_id": spec["match_id"], "seed": spec["seed"], "final_state": "FINISHED",
+    "match_id": spec["match_id"], "seed": spec["seed"], "state": "FINISHED",
     "score": {"red": 1, "blue": 0}, "winner": "red", "sim_time_ms": int(duration * 1000),
     "real_time_s": duration, "real_time_factor": 1.0, "events_summary": {"GOAL": 1},
     "robots": robots, "versions": {"fakesim": "1"},

@@ -1,0 +1,42 @@
+"""Names of the files the processes hand to each other, spelled once.
+
+The orchestrator mounts a match folder into the simulator container at ``/match``: it writes
+:data:`MATCH_SPEC` there, the simulator writes everything else into :data:`OUT_DIR`; the public
+files are copied next to the orchestrator's :data:`RESULTS` and :data:`REPORT`.
+"""
+
+from __future__ import annotations
+
+CONTAINER_MATCH_DIR = "/match"  # the match folder inside the simulator container
+MATCH_SPEC = "match_spec.json"  # contracts.match_spec.MatchSpec
+OUT_DIR = "out"  # the simulator's output folder, inside the match folder
+SIM_RESULT = "sim_result.json"  # contracts.sim_result.SimResult
+REPLAY = "replay.hlvsrec"
+API_STATS = "api_stats.jsonl"
+REFEREE_LOG = "referee.log"
+REFEREE_EVENTS = "referee_events.jsonl"
+GAMECONTROLLER_LOG = "gamecontroller.log"
+VIDEO = "match.mp4"
+RESULTS = "results.json"  # the orchestrator's match results
+REPORT = "report.json"  # written last: the match folder is complete
+
+PUBLIC_FILES = (
+    SIM_RESULT, REPLAY, API_STATS, REFEREE_LOG, REFEREE_EVENTS, GAMECONTROLLER_LOG, VIDEO,
+)  # fmt: skip
+"""Simulator outputs published with the match (the logs teams and spectators may read)."""
+
+__all__ = [
+    "API_STATS",
+    "CONTAINER_MATCH_DIR",
+    "GAMECONTROLLER_LOG",
+    "MATCH_SPEC",
+    "OUT_DIR",
+    "PUBLIC_FILES",
+    "REFEREE_EVENTS",
+    "REFEREE_LOG",
+    "REPLAY",
+    "REPORT",
+    "RESULTS",
+    "SIM_RESULT",
+    "VIDEO",
+]

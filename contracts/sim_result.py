@@ -1,0 +1,56 @@
+"""``sim_result.json``: what the simulator reports when its process ends.
+
+Written by the simulator (``simulator.runtime``) and by the orchestrator's fake runtime in unit
+tests, read by the orchestrator's runner and results; all three use this one type.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, ClassVar, Literal
+
+from contracts.codec import Versioned
+
+Winner = Literal["red", "blue", "draw"]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class SimResult(Versioned):
+    VERSION: ClassVar[int] = 1
+    KIND: ClassVar[str] = "simulator result"
+
+    match_id: str
+    seed: int
+    state: str  # GameController state at the end: FINISHED when the game was played out
+    score: dict[str, int]  # {"red": goals, "blue": goals}
+    winner: Winner | None  # None while the game is not over
+    events_summary: dict[str, int] = field(default_factory=dict)  # referee event type -> count
+    stop_reason: str = "finished"  # finished | SIGTERM | SIGINT | time_limit | internal_error ...
+    error: str = ""  # what went wrong when the process failed
+    stepping: str = "async"
+    sim_time_ms: int = 0
+    real_time_s: float = 0.0
+    held_real_s: float = 0.0  # wall time the world was held (waiting for robots)
+    real_time_factor: float = 0.0
+    robots: dict[str, dict[str, Any]] = field(default_factory=dict)  # robot key -> API statistics
+    cameras: dict[str, Any] = field(default_factory=dict)
+    started_unix_s: float = 0.0
+    versions: dict[str, str] = field(default_factory=dict)  # distribution -> version
+    spoofing: dict[str, Any] | None = None  # {"total": n, "attempts": [...]}
+    shootout: dict[str, dict[str, int]] | None = None  # color -> kicks, scored
+    coin_toss: bool | None = None  # decided by a coin toss after the shoot-out
+    version: int = VERSION
+
+    def to_dict(self) -> dict[str, Any]:
+        data = Versioned.to_dict(self)
+        for optional in ("shootout", "coin_toss"):  # only written when there was a shoot-out
+            if data[optional] is None:
+                del data[optional]
+        return data
+
+    @property
+    def finished(self) -> bool:
+        return self.state == "FINISHED"
+
+
+__all__ = ["SimResult", "Winner"]
