@@ -23,6 +23,7 @@ SPEC_VERSION = 1
 
 SteppingMode = Literal["async", "lockstep"]
 Color = Literal["red", "blue"]  # contracts.ids.TeamColor values
+GameTypeName = Literal["NORMAL", "KNOCKOUT", "PENALTY"]  # GameType values
 FieldClassName = Literal["kid", "adult"]  # contracts.field.FieldClass values
 
 
@@ -97,7 +98,7 @@ class MatchSpec(Versioned):
 
     match_id: str
     seed: int
-    game_type: GameType
+    game_type: GameTypeName
     field_class: FieldClassName
     side_left: Color  # team on x < 0 in the first half
     kickoff: Color  # team with the first kick-off
@@ -114,8 +115,9 @@ class MatchSpec(Versioned):
     recorder_rate_hz: float = 25.0
     version: int = SPEC_VERSION
 
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "game_type", GameType(self.game_type))  # "NORMAL" given as str
+    @property
+    def game(self) -> GameType:
+        return GameType(self.game_type)
 
     @property
     def side_left_color(self) -> TeamColor:
@@ -142,6 +144,7 @@ __all__ = [
     "Pose",
     "Color",
     "FieldClassName",
+    "GameTypeName",
     "SteppingMode",
     "TeamSpec",
     "TimingSpec",

@@ -52,7 +52,7 @@ def referee_config(spec: MatchSpec) -> RefereeConfig:
     return RefereeConfig(
         red=_team(spec.red),
         blue=_team(spec.blue),
-        game_type=spec.game_type,
+        game_type=spec.game,
         field_class=spec.field,
         side_left=spec.side_left_color,
         kickoff=spec.kickoff_color,

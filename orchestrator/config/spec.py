@@ -13,7 +13,6 @@ from collections.abc import Mapping, Sequence
 from contracts.field import FieldClass
 from contracts.geometry import Pose
 from contracts.match_spec import (
-    GameType,
     MatchSpec,
     NetworkSpec,
     PlayerSpec,
@@ -58,7 +57,7 @@ def to_match_spec(
     return MatchSpec(
         match_id=game.match_id,
         seed=game.seed,
-        game_type=GameType(game.game_type),
+        game_type=game.game_type,
         field_class=FieldClass(game.field_class.lower()).value,
         side_left=side_left,
         kickoff=kickoff,

@@ -14,7 +14,6 @@ from contracts.field import KID_FIELD, FieldGeometry
 from contracts.geometry import Pose
 from contracts.ids import RobotId, TeamColor
 from contracts.match_spec import (
-    GameType,
     MatchSpec,
     NetworkSpec,
     PlayerSpec,
@@ -46,7 +45,7 @@ def _spec() -> MatchSpec:
         )  # fmt: skip
 
     return MatchSpec(
-        match_id="m1", seed=7, game_type=GameType.KNOCKOUT, field_class="kid", side_left="blue",
+        match_id="m1", seed=7, game_type="KNOCKOUT", field_class="kid", side_left="blue",
         kickoff="red", red=team("red", 8), blue=team("blue", 25), stepping="lockstep",
         timing=TimingSpec(half_duration_s=30.0, max_duration_real_s=120.0),
         network=NetworkSpec(telemetry_listen="tcp/10.0.0.2:7447"), record_video="match.mp4",
