@@ -42,7 +42,7 @@ def write_replay(path: Path, *, half_s: int = HALF_S, seed: int = 7) -> dict[str
     """A 4 v 4 replay of two halves of ``half_s`` seconds (see the module docstring)."""
     import mujoco
 
-    from referee.snapshot import RobotId, TeamColor
+    from contracts.ids import RobotId, TeamColor
     from simulator.recorder import Recorder
     from simulator.world import RobotPlacement, World
 

@@ -21,11 +21,11 @@ from typing import Any
 
 import numpy as np
 
+from contracts.field import field_for
 from envs.base import HlvsEnv, Session
 from envs.frame import BALL_POS, UP_Z, Frame
 from envs.match_setup import default_stubs
 from envs.session_spec import SessionSpec, StubSpec
-from contracts.field import field_for
 
 GOAL_REWARD = 1.0
 PROGRESS_WEIGHT = 0.1

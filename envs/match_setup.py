@@ -16,10 +16,10 @@ from typing import Any
 
 import numpy as np
 
+from contracts.match_spec import MatchSpec, PlayerSpec, Pose, TeamSpec, TimingSpec
 from envs.session_spec import SessionSpec, StubSpec
 from referee import GameState, Referee, RobotId, TeamColor
 from simulator.match_setup import referee_config
-from contracts.match_spec import MatchSpec, PlayerSpec, Pose, TeamSpec, TimingSpec
 from simulator.world import MOTOR_NAMES, World
 
 STUB_LOOK_PERIOD_MS = 96

@@ -17,12 +17,12 @@ from typing import Any, cast
 import numpy as np
 import numpy.typing as npt
 
+from contracts.field import field_for
 from envs.errors import EnvStateError, TrainerError
 from envs.frame import SENSOR_NAMES, Frame
 from envs.perception import CameraView, add_noise, field_segments, goal_post_feet
 from envs.session_spec import ResetRequest, SessionSpec
 from referee import GameState, Referee, RobotId, TeamColor
-from contracts.field import field_for
 from referee.snapshot import PlaceBall, TeleportRobot
 from simulator.world import MOTOR_NAMES, RobotPlacement, World, robot_model
 

@@ -24,11 +24,11 @@ from typing import Any
 
 import numpy as np
 
+from contracts.field import field_for
 from envs.base import HlvsEnv, Session
 from envs.errors import EnvConfigError
 from envs.frame import BALL_POS, UP_Z, Frame
 from envs.session_spec import ResetRequest, SessionSpec
-from contracts.field import field_for
 
 APPROACH_WEIGHT = 0.5
 PROGRESS_WEIGHT = 2.0
