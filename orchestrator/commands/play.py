@@ -135,6 +135,25 @@ def _play(
     return outcome
 
 
+def _shown(path: Path) -> str:
+    """``path`` relative to the current directory when it is below it, else absolute."""
+    try:
+        return str(path.relative_to(Path.cwd()))
+    except ValueError:
+        return str(path)
+
+
+def watch_hint(out_dir: Path) -> list[str]:
+    """Where to watch a played match: the viewer and the video command (empty: no replay)."""
+    replay = out_dir / "public" / "replay.hlvsrec"
+    if not replay.is_file():
+        return []
+    return [
+        f"watch it in the browser:  hlvs view {_shown(out_dir)}",
+        f"or as a video:            hlvs render {_shown(replay)} -o match.mp4",
+    ]
+
+
 def summarize(outcome: MatchOutcome, *, as_json: bool = False) -> int:
     """Print the outcome (one line, or results.json with ``as_json``) and return its exit code:
     0 played, 4 decided by forfeit, 1 failed, 3 infrastructure, 130 interrupted."""
@@ -168,6 +187,8 @@ def summarize(outcome: MatchOutcome, *, as_json: bool = False) -> int:
             what = (f"red {score.get('red')} - {score.get('blue')} blue, "
                     f"winner {results.get('winner')}")
         print(f"match {outcome.match_id}: {what}; results in {outcome.out_dir}")
+        for line in watch_hint(outcome.out_dir):
+            print(line)
         return code
     print(f"match {outcome.match_id} failed ({failure.failure_class.value}): {failure.cause}; "
           f"results in {outcome.out_dir}", file=sys.stderr)

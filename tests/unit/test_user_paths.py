@@ -71,3 +71,20 @@ def test_schedule_status_names_the_resolved_state_file(
     assert hlvs(["schedule", "status", "--state", "state.sqlite"]) != 0
     err = capsys.readouterr().err
     assert str(tmp_path / "state.sqlite") in err and "no such state file" in err
+
+
+def test_watch_hint_names_the_replay_as_seen_from_the_cwd(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from orchestrator.commands.play import watch_hint
+
+    out = tmp_path / "matches" / "scrimmage"
+    assert watch_hint(out) == []  # nothing to watch without a replay
+    (out / "public").mkdir(parents=True)
+    (out / "public" / "replay.hlvsrec").write_bytes(b"x")
+    monkeypatch.chdir(tmp_path)
+    hint = "\n".join(watch_hint(out))
+    assert "hlvs view matches/scrimmage" in hint
+    assert "hlvs render matches/scrimmage/public/replay.hlvsrec -o match.mp4" in hint
+    monkeypatch.chdir(tmp_path / "matches" / "scrimmage" / "public")
+    assert f"hlvs view {out}" in "\n".join(watch_hint(out))

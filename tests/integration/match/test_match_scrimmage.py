@@ -38,6 +38,9 @@ def test_short_scrimmage_plays_to_finished(tmp_path: Path, runtime: Any,
     printed = capsys.readouterr()
     assert code == 0, printed.err[-3000:]
     assert f"match {match_id}:" in printed.out and f"results in {out}" in printed.out
+    # Where to watch it, with paths as typed from the working directory.
+    assert "hlvs view matches/scrim\n" in printed.out
+    assert "hlvs render matches/scrim/public/replay.hlvsrec -o match.mp4" in printed.out
     assert json.loads((out / "report.json").read_text()) == {"status": "success"}
     results = json.loads((out / "results.json").read_text())
     assert results["final_state"] == "FINISHED"
