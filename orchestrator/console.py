@@ -146,10 +146,18 @@ def _mode(stream: TextIO) -> str:
 
 
 @contextmanager
-def progress(*, stream: TextIO | None = None, interval_s: float = 10.0) -> Iterator[Progress]:
-    """Progress bars on a terminal, plain periodic lines elsewhere (see the module doc)."""
+def progress(
+    *, stream: TextIO | None = None, interval_s: float = 10.0, allow_rich: bool = True
+) -> Iterator[Progress]:
+    """Progress bars on a terminal, plain periodic lines elsewhere (see the module doc).
+
+    ``allow_rich=False`` keeps to plain lines, for use under another live display (the match
+    view), with which rich bars cannot share the terminal.
+    """
     out = stream if stream is not None else sys.stderr
     mode = _mode(out)
+    if mode == "rich" and not allow_rich:
+        mode = "plain"
     if mode == "off":
         yield NullProgress()
         return

@@ -69,9 +69,14 @@ def _pull_resolver(client: Any, loaded: Any) -> ImageResolver:
     from orchestrator.pull import resolve_team_images
 
     def resolve(plan: MatchPlan) -> dict[str, tuple[str | None, str | None]]:
+        from orchestrator.console import progress
+
         found: dict[str, tuple[str | None, str | None]] = {}
         for color in ("red", "blue"):
-            resolved = resolve_team_images(client, loaded.team(color), limits=loaded.game.limits)
+            with progress(allow_rich=False) as bars:  # under the match's live view
+                resolved = resolve_team_images(
+                    client, loaded.team(color), limits=loaded.game.limits, progress=bars
+                )
             for number, image in resolved.items():
                 key = f"{color}-{number}"
                 found[key] = (image.digest or None, str(image.error) if image.error else None)

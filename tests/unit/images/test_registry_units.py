@@ -186,3 +186,19 @@ def test_progress_is_plain_when_not_a_terminal(monkeypatch: pytest.MonkeyPatch) 
     with progress(stream=out) as bars:
         bars.add("quiet").finish()
     assert "quiet" not in out.getvalue()
+
+
+def test_rich_progress_draws_bars(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("HLVS_PROGRESS", "rich")
+    out = io.StringIO()
+    with progress(stream=out) as bars:
+        pull = bars.add("pull team/robot:v1")
+        PullTracker(pull)(PullEvent(layer="a", status="Downloading", current=5_000_000,
+                                    total=10_000_000))
+        pull.finish()
+        build = bars.add("build simulator", unit="steps")
+        build.update(completed=3, total=9)
+        build.finish()
+    drawn = out.getvalue()
+    assert "pull team/robot:v1 (done)" in drawn and "10.0/10.0 MB" in drawn
+    assert "build simulator (done)" in drawn and "9/9 steps" in drawn
