@@ -2,9 +2,11 @@
 ``docker``).
 
 Each remote is the simulator image started with ``remote --port 7700``, its port published on
-127.0.0.1 at a port the engine picks. Containers carry the project label, the role ``env-remote``,
-the pool id and the owner (``host:pid``): :meth:`DockerLauncher.close` removes a pool's containers
-by label, and a new pool first removes the containers of owners that no longer run on this host
+127.0.0.1 at a port the engine picks; the pool connects to the container's bridge address when
+it answers there (a local engine), else to the published port. Containers carry the project
+label, the role ``env-remote``, the pool id and the owner (``host:pid``):
+:meth:`DockerLauncher.close` removes a pool's containers by label, and a new pool first removes
+the containers of owners that no longer run on this host
 (left by a killed process). A remote is healthy once it greets and answers ``health``.
 """
 
@@ -116,11 +118,20 @@ class DockerLauncher:
         log.info("started remote %s (%s)", name, self.image)
         return cid
 
-    def _port(self, cid: str) -> int | None:
-        container = self.client.containers.get(cid)
-        ports = (container.attrs.get("NetworkSettings") or {}).get("Ports") or {}
-        bound = ports.get(f"{CONTAINER_PORT}/tcp") or []
-        return int(bound[0]["HostPort"]) if bound else None
+    def _candidates(self, cid: str) -> list[RemoteAddress]:
+        """Where the remote answers: its bridge address first (a local engine: no userland
+        proxy in the way, about three times the steps per second here), then the published
+        port on 127.0.0.1."""
+        settings = self.client.containers.get(cid).attrs.get("NetworkSettings") or {}
+        out = [
+            RemoteAddress(str(net["IPAddress"]), CONTAINER_PORT)
+            for net in (settings.get("Networks") or {}).values()
+            if net.get("IPAddress")
+        ]
+        bound = (settings.get("Ports") or {}).get(f"{CONTAINER_PORT}/tcp") or []
+        if bound:
+            out.append(RemoteAddress("127.0.0.1", int(bound[0]["HostPort"])))
+        return out
 
     def _healthy(self, cid: str, index: int) -> RemoteAddress:
         deadline = time.monotonic() + self.health_timeout_s
@@ -129,13 +140,12 @@ class DockerLauncher:
             cause = self.diagnose(index)
             if cause is not None:
                 raise RemoteStartFailed(address=cid[:12], reason=cause)
-            port = self._port(cid)
-            if port is not None:
+            for address in self._candidates(cid):
                 try:
-                    _probe("127.0.0.1", port)
-                    return RemoteAddress("127.0.0.1", port)
+                    _probe(address.host, address.port)
+                    return address
                 except (OSError, WireError) as exc:
-                    reason = str(exc)
+                    reason = f"{address}: {exc}"
             time.sleep(0.2)
         raise RemoteStartFailed(
             address=cid[:12], reason=f"not healthy after {self.health_timeout_s:g} s: {reason}"
