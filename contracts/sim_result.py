@@ -12,6 +12,35 @@ from typing import Any, ClassVar, Literal
 from contracts.codec import Versioned
 
 Winner = Literal["red", "blue", "draw"]
+COLORS = ("red", "blue")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class PlayRecord:
+    """How much football the referee saw (``play`` of ``sim_result.json`` and ``results.json``).
+
+    ``halves_playing``: halves of regular time that reached PLAYING; ``playing_s``: simulated
+    seconds in PLAYING; kicks, shots (kicks heading between the posts of the goal attacked),
+    goals (own goals included), own goals (scored by the team's own players) and falls are
+    counted per team colour.
+    """
+
+    halves_playing: tuple[int, ...]
+    both_halves_playing: bool
+    playing_s: float
+    kicks: dict[str, int]
+    shots: dict[str, int]
+    goals: dict[str, int]
+    own_goals: dict[str, int]
+    falls: dict[str, int]
+
+    def __post_init__(self) -> None:
+        for name in ("kicks", "shots", "goals", "own_goals", "falls"):
+            counts = getattr(self, name)
+            if set(counts) != set(COLORS) or any(n < 0 for n in counts.values()):
+                raise ValueError(f"{name}: expected counts >= 0 for red and blue, got {counts}")
+        if self.both_halves_playing != ({1, 2} <= set(self.halves_playing)):
+            raise ValueError("both_halves_playing disagrees with halves_playing")
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -39,6 +68,7 @@ class SimResult(Versioned):
     spoofing: dict[str, Any] | None = None  # {"total": n, "attempts": [...]}
     shootout: dict[str, dict[str, int]] | None = None  # color -> kicks, scored
     coin_toss: bool | None = None  # decided by a coin toss after the shoot-out
+    play: PlayRecord | None = None  # None from a simulator that did not count play
     version: int = VERSION
 
     def to_dict(self) -> dict[str, Any]:
@@ -53,4 +83,4 @@ class SimResult(Versioned):
         return self.state == "FINISHED"
 
 
-__all__ = ["SimResult", "Winner"]
+__all__ = ["PlayRecord", "SimResult", "Winner"]

@@ -29,6 +29,7 @@ from referee.judgement import apply_decisions
 from referee.logs import RefereeLog
 from referee.mirror import TeamMirror
 from referee.net import GameControllerNetwork
+from referee.play_stats import PlayTracker
 from referee.publisher import Publisher
 from referee.rulebook import RuleBook
 from referee.rules import end_of_game, goal, kickoff, set_play
@@ -96,6 +97,7 @@ class Referee:
         self._set_since_ms: int | None = None
         self._shootout: Shootout | None = None
         self.ball_in_play = False
+        self.play = PlayTracker()
         self.reset_memories()
         self._network: GameControllerNetwork | None = None
         self._mirror: TeamMirror | None = None
@@ -137,11 +139,12 @@ class Referee:
 
     def result(self) -> dict[str, object]:
         """score, winner (red, blue, draw; None before the end), events_summary {type: count},
-        spoofing {total, attempts}."""
+        spoofing {total, attempts}, play (see :class:`referee.play_stats.PlayStats`)."""
         self._report_spoofing()
         out = reporting.result(
             self.gc, self.events, finished=self._finished, winner=self._winner,
             shootout=self._shootout is not None, coin_toss=self._coin_toss,
+            play=self.play.stats(self.events),
         )
         out["spoofing"] = self.spoofing.to_json()
         return out
@@ -215,6 +218,7 @@ class Referee:
                 self._publisher.log_counts(snapshot.sim_time_ms)
         self._ball_touch(snapshot)
         self._report_spoofing()
+        self.play.observe(snapshot, self.view())
         self._goalkeeper_claims()
         if self._finished:
             return commands

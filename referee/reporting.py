@@ -8,6 +8,7 @@ from collections.abc import Sequence
 from contracts.ids import TeamColor
 from referee.clock import Clock
 from referee.gamecontroller import GameController
+from referee.play_stats import PlayStats
 from referee.snapshot import RefereeEvent
 
 COLORS = (TeamColor.RED, TeamColor.BLUE)
@@ -52,6 +53,7 @@ def result(
     winner: TeamColor | None,
     shootout: bool,
     coin_toss: bool,
+    play: PlayStats,
 ) -> dict[str, object]:
     """``winner`` is ``"red"``, ``"blue"``, ``"draw"`` or None while the game is not over."""
     summary = Counter(event.type for event in events)
@@ -60,6 +62,7 @@ def result(
         "score": score(gc),
         "winner": (winner.value if winner is not None else "draw") if finished else None,
         "events_summary": dict(sorted(summary.items())),
+        "play": play.to_json(),
     }
     if shootout:
         out["shootout"] = {

@@ -16,9 +16,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--blue-image", default=None,
                         help="image of the blue robots (default: the project's stub image)")
     parser.add_argument("--players", type=int, default=1, choices=(1, 2, 3, 4),
-                        help="robots per team (default 1)")
-    parser.add_argument("--half-duration", type=float, default=30.0,
-                        help="simulated seconds per half (default 30)")
+                        help="robots per team: a striker, then a goalie, then defenders "
+                             "(default 1)")
+    parser.add_argument("--half-duration", type=float, default=60.0,
+                        help="simulated seconds per half, READY and SET included (default 60)")
+    parser.add_argument("--ready-duration", type=float, default=15.0,
+                        help="simulated seconds of READY in this scrimmage (default 15; "
+                             "matches: 45)")
     parser.add_argument("--wait-before-ready", type=float, default=3.0,
                         help="wall seconds between robot start and the first READY (default 3)")
     parser.add_argument("--grace", type=float, default=5.0,
@@ -28,7 +32,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--match-id", default=None,
                         help="match id (default: scrimmage-<random>)")
     parser.add_argument("--seed", type=int, default=42,
-                        help="seed of the simulation and the referee (default 42)")
+                        help="seed of the simulation and the referee, and of the sides and "
+                             "kick-off (default 42)")
     parser.add_argument("--stub", action="store_true",
                         help="accepted for compatibility: stub robots are the default")
 

@@ -1,10 +1,12 @@
-"""``hlvs render`` and ``hlvs bench sim|api|stub|envs|bringup|delivery|cli|viewer``: commands with
-parsers of their own, to which the arguments are forwarded unread (``--help`` included).
+"""``hlvs render`` and ``hlvs bench sim|api|stub|envs|bringup|delivery|cli|viewer|scrimmage``:
+commands with parsers of their own, to which the arguments are forwarded unread (``--help``
+included).
 
 The orchestrator does not import the simulator; ``render`` and the simulator's (or the learning
 environments') benchmarks run ``python -m simulator`` (``python -m envs``) with the same
 interpreter (``HLVS_PROG`` tells it to name itself ``hlvs``), so ``hlvs`` stays the one entry
-point for users. ``hlvs bench bringup``, ``delivery`` and ``cli`` are the orchestrator's own.
+point for users. ``hlvs bench bringup``, ``delivery``, ``cli`` and ``scrimmage`` are the
+orchestrator's own.
 """
 
 from __future__ import annotations
@@ -58,6 +60,15 @@ def register(sub: Any) -> None:
         kinds, "viewer", help="the web viewer: open and play a 2 x 10 min 4 v 4 replay (JSON)",
         func=_viewer,
     )
+    forward(kinds, "scrimmage",
+            help="K default scrimmages: halves reaching PLAYING, kicks, goals, wall time (JSON)",
+            func=_scrimmage)
+
+
+def _scrimmage(args: argparse.Namespace) -> int:
+    from orchestrator.bench_scrimmage import main as scrimmage_main
+
+    return int(scrimmage_main(list(args.rest)))
 
 
 def _bringup(args: argparse.Namespace) -> int:

@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from contracts import files
+from contracts.codec import to_data
 from contracts.sim_result import SimResult
 
 
@@ -133,6 +134,8 @@ def build_results(
         "score": score,
         "winner": winner,
         "events_summary": sim.events_summary if sim is not None else {},
+        # how much football was played (contracts.sim_result.PlayRecord), None when not counted
+        "play": to_data(sim.play) if sim is not None and sim.play is not None else None,
         "sim_time_ms": sim.sim_time_ms if sim is not None else None,
         "real_time_factor": sim.real_time_factor if sim is not None else None,
         "robots": robot_json,

@@ -2,7 +2,11 @@
 
 The files (game.json, team_red.json, team_blue.json) are written into the output folder and then
 played exactly like ``hlvs match`` would play them, so a team can rerun or edit them.
-Defaults: 1 player per team, two halves of 30 s simulated, lockstep stepping, 3 s before READY.
+
+Defaults make a short game a newcomer can watch in about two minutes: one striker per team,
+two halves of 60 s simulated with READY shortened to 15 s (so each half has about 40 s of
+PLAYING), lockstep stepping, 3 s before the first READY and 1 s at half time. These timings
+are the scrimmage's own; official matches keep the rules' timings (45 s READY, 10 min halves).
 """
 
 from __future__ import annotations
@@ -15,33 +19,38 @@ from typing import Any
 
 from orchestrator.commands.scrimmage_args import add_arguments
 
-POSES_KID = {  # as if playing on the left (x < 0)
-    1: (-4.0, -3.1, 1.57),
-    2: (-1.0, -3.1, 1.57),
-    3: (-2.0, -3.1, 1.57),
-    4: (-3.0, -3.1, 1.57),
+# Starting poses as if playing on the left (x < 0), on the own touch line facing the field;
+# the striker starts near the halfway line so that it reaches its kick-off spot during READY.
+POSES_KID = {
+    "goalie": (-4.0, -3.1, 1.57),
+    "striker": (-0.6, -3.1, 1.57),
+    "defender-3": (-2.0, -3.1, 1.57),
+    "defender-4": (-3.0, -3.1, 1.57),
 }
 
-# Players 3 and 4 defend from spots in the own half: three strikers chasing one ball mostly
-# knock each other over.
-DEFENDER_HOMES = {3: (-2.3, 1.0), 4: (-2.3, -1.0)}
+# Who plays, by team size: one striker alone; then a goalie; players 3 and 4 defend from spots
+# in the own half (several strikers chasing one ball mostly knock each other over).
+ROLES = {
+    1: ("striker",),
+    2: ("goalie", "striker"),
+    3: ("goalie", "striker", "defender-3"),
+    4: ("goalie", "striker", "defender-3", "defender-4"),
+}
+DEFENDER_HOMES = {"defender-3": (-2.3, 1.0), "defender-4": (-2.3, -1.0)}
 
 
 def _pose(x: float, y: float, yaw: float) -> dict[str, Any]:
     return {"translation": [x, y, 0.43], "rotation": [0, 0, 1, yaw]}
 
 
-def team_file(name: str, image: str, players: int, *, goalie_first: bool,
-              command: str | None = None) -> dict[str, Any]:
+def team_file(name: str, image: str, players: int, *, command: str | None = None
+              ) -> dict[str, Any]:
     repository, _, tag = image.rpartition(":") if ":" in image.split("/")[-1] else (image, "", "")
     entries: dict[str, Any] = {}
-    for n in range(1, players + 1):
-        x, y, yaw = POSES_KID[n]
-        role = "goalie" if (n == 1 and goalie_first) else "striker"
-        extra = ""
-        if n in DEFENDER_HOMES and players >= n:  # one striker; the others keep their spots
-            role = "defender"
-            extra = " --home {} {}".format(*DEFENDER_HOMES[n])
+    for n, slot in enumerate(ROLES[players], start=1):
+        x, y, yaw = POSES_KID[slot]
+        role = slot.split("-")[0]
+        extra = " --home {} {}".format(*DEFENDER_HOMES[slot]) if slot in DEFENDER_HOMES else ""
         entries[str(n)] = {
             # The stub cannot see where it was placed: its dockerCmd tells it (team-file frame).
             "dockerCmd": command or f"{role} --start-pose {x} {y} {yaw}{extra}",
@@ -62,8 +71,8 @@ def game_file(args: argparse.Namespace, match_id: str) -> dict[str, Any]:
         "class": "KID",
         "host": "127.0.0.1",
         "maximum_real_time_factor": 0,
-        "side_left": "red",
-        "kickoff": "red",
+        "side_left": "random",  # drawn from the seed, as every random choice of a match
+        "kickoff": "random",
         "match_id": match_id,
         "seed": args.seed,
         "stepping": "lockstep",
@@ -75,6 +84,7 @@ def game_file(args: argparse.Namespace, match_id: str) -> dict[str, Any]:
                  "ports": [10020 + n for n in range(1, players + 1)]},
         "timing": {
             "half_duration_s": args.half_duration,
+            "ready_duration_s": args.ready_duration,
             "wait_before_first_ready_s": args.wait_before_ready,
             "half_time_break_s": 1,
             "grace_period_s": args.grace,
@@ -99,8 +109,8 @@ def write_files(args: argparse.Namespace, folder: Path, *, stub_image: str | Non
     files = {
         "game.json": game_file(args, match_id),
         "team_red.json": team_file("Stub Red", red_image, args.players,
-                                   goalie_first=args.players > 1, command=args.robot_command),
-        "team_blue.json": team_file("Stub Blue", blue_image, args.players, goalie_first=True,
+                                   command=args.robot_command),
+        "team_blue.json": team_file("Stub Blue", blue_image, args.players,
                                     command=args.robot_command),
     }
     for name, content in files.items():

@@ -15,6 +15,7 @@ import numpy as np
 import numpy.typing as npt
 
 from robot.motion import AttitudeFilter, GetUpMotion, KickMotion, WalkEngine, kinematics
+from robot.motion.imu import GRAVITY_M_S2
 from robot.motion.keyframes import KeyframeMotion
 from robot.motion.walk import default_walk_params
 from robot.stub.behaviour import Action, Field, GameInfo, Role, decide
@@ -85,6 +86,7 @@ class StubController:
         self.walk = WalkEngine(model=model)
         self.world = WorldModel(start_pose)
         self.attitude = AttitudeFilter()
+        self._heading = HeadingTracker()
         self.stats = Stats()
         walk = default_walk_params(model)
         self._pelvis_height_m = walk.hip_height_m + self.kin.camera.hip_below_pelvis_m
@@ -213,7 +215,8 @@ class StubController:
         self.world.integrate(
             dt,
             self.walk.velocity if upright else (0.0, 0.0, 0.0),
-            sensors.gyro[2] if sensors.gyro is not None and upright else None,
+            None,
+            turned_rad=self._heading.heading_change(dt, sensors.accel, sensors.gyro),
         )
         if sensors.image_bgr is not None and upright and self._motion is None:
             self._look(sensors)
@@ -364,3 +367,73 @@ class StubController:
     def _remember(self, targets: dict[str, float]) -> dict[str, float]:
         self._last_targets.update(targets)
         return dict(self._last_targets)
+
+
+class HeadingTracker:
+    """The torso's full orientation from the gyro, its tilt corrected by the accelerometer
+    (a Mahony filter without magnetometer), and from it the heading on the ground.
+
+    Upright, the heading change is the gyro's turn about the vertical. Through a fall and a
+    get-up the torso may tip past vertical or roll over, where the yaw of any angle triple jumps
+    by pi without the robot turning; following the whole orientation keeps the heading right
+    once the robot stands again.
+    """
+
+    def __init__(self, *, gain: float = 2.0) -> None:
+        self._gain = gain
+        self._q: tuple[float, float, float, float] | None = None  # w, x, y, z: body -> world
+        self._heading: float | None = None
+
+    def heading_change(self, dt_s: float, accel: Vec3 | None, gyro: Vec3 | None) -> float | None:
+        """Radians turned about the vertical since the last call (None without a gyro)."""
+        if gyro is None:
+            return None
+        norm = math.sqrt(sum(a * a for a in accel)) if accel is not None else 0.0
+        trusted = accel is not None and abs(norm - GRAVITY_M_S2) < 0.3 * GRAVITY_M_S2
+        if self._q is None:
+            if not trusted or accel is None:
+                return gyro[2] * dt_s
+            self._q = _tilt_quaternion(accel[0] / norm, accel[1] / norm, accel[2] / norm)
+            self._heading = _heading(self._q)
+            return 0.0
+        w, x, y, z = self._q
+        wx, wy, wz = gyro
+        if trusted and accel is not None:
+            # up as the torso sees it now, against the measured specific force
+            ux, uy, uz = 2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)
+            ax, ay, az = accel[0] / norm, accel[1] / norm, accel[2] / norm
+            wx += self._gain * (ay * uz - az * uy)
+            wy += self._gain * (az * ux - ax * uz)
+            wz += self._gain * (ax * uy - ay * ux)
+        half = 0.5 * dt_s
+        w, x, y, z = (
+            w - half * (x * wx + y * wy + z * wz),
+            x + half * (w * wx + y * wz - z * wy),
+            y + half * (w * wy - x * wz + z * wx),
+            z + half * (w * wz + x * wy - y * wx),
+        )
+        length = math.sqrt(w * w + x * x + y * y + z * z) or 1.0
+        self._q = (w / length, x / length, y / length, z / length)
+        heading = _heading(self._q)
+        before = self._heading if self._heading is not None else heading
+        self._heading = heading
+        return math.atan2(math.sin(heading - before), math.cos(heading - before))
+
+
+def _tilt_quaternion(ux: float, uy: float, uz: float) -> tuple[float, float, float, float]:
+    """A body -> world rotation with heading 0 whose world up is ``(ux, uy, uz)`` in the body."""
+    roll = math.atan2(uy, uz)
+    pitch = math.atan2(-ux, math.hypot(uy, uz))
+    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
+    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
+    return (cr * cp, sr * cp, cr * sp, -sr * sp)
+
+
+def _heading(q: tuple[float, float, float, float]) -> float:
+    """Direction of the torso's forward axis on the ground (its up axis when the forward axis
+    points straight up or down)."""
+    w, x, y, z = q
+    fx, fy = 1 - 2 * (y * y + z * z), 2 * (x * y + w * z)
+    if math.hypot(fx, fy) < 0.2:  # forward axis vertical: lying; use the torso's up axis
+        fx, fy = 2 * (x * z + w * y), 2 * (y * z - w * x)
+    return math.atan2(fy, fx)

@@ -43,14 +43,24 @@ class WorldModel:
         self.ball_field = None
         self.ball_seen_ms = None
 
-    def integrate(self, dt_s: float, velocity: Vec3, yaw_rate_rad_s: float | None) -> None:
-        """Dead reckoning: gait velocity (vx, vy, vyaw) in the robot frame, gyro yaw rate."""
+    def integrate(
+        self,
+        dt_s: float,
+        velocity: Vec3,
+        yaw_rate_rad_s: float | None,
+        *,
+        turned_rad: float | None = None,
+    ) -> None:
+        """Dead reckoning: gait velocity (vx, vy, vyaw) in the robot frame; the heading follows
+        ``turned_rad`` (radians turned this step) when given, else the gyro's yaw rate, else
+        the gait's."""
         vx, vy, vyaw = velocity
-        yaw_rate = vyaw if yaw_rate_rad_s is None else yaw_rate_rad_s
+        if turned_rad is None:
+            turned_rad = (vyaw if yaw_rate_rad_s is None else yaw_rate_rad_s) * dt_s
         c, s = math.cos(self.pose.yaw_rad), math.sin(self.pose.yaw_rad)
         yaw = math.atan2(
-            math.sin(self.pose.yaw_rad + yaw_rate * dt_s),
-            math.cos(self.pose.yaw_rad + yaw_rate * dt_s),
+            math.sin(self.pose.yaw_rad + turned_rad),
+            math.cos(self.pose.yaw_rad + turned_rad),
         )
         self.pose = Pose2D(
             self.pose.x_m + (c * vx - s * vy) * dt_s,

@@ -6,7 +6,7 @@ import pytest
 
 from robot.motion import GetUpMotion, standing_posture
 
-from .motion_world import OneRobot
+from .motion_world import RED1, OneRobot
 
 
 @pytest.mark.parametrize("yaw", [0.0, 2.0])
@@ -70,3 +70,8 @@ def test_pushed_over_robot_gets_back_up(direction_rad: float) -> None:
     assert lowest < 0.3  # the push did knock it over
     assert controller.stats.falls == 1
     assert robot.up > 0.9 and not controller.busy
+    # it still knows which way it faces: the heading followed the fall and the get-up
+    true_yaw = robot.world.snapshot().robot(RED1).yaw_rad
+    error = math.atan2(math.sin(controller.world.pose.yaw_rad - true_yaw),
+                       math.cos(controller.world.pose.yaw_rad - true_yaw))
+    assert abs(error) < 0.2, (controller.world.pose.yaw_rad, true_yaw)

@@ -1,0 +1,156 @@
+"""How much football was played: periods that reached PLAYING, kicks, shots, falls.
+
+The referee feeds every snapshot to :class:`PlayTracker`; goals and own goals come from its goal
+events. All of it is judged from ground truth (ball velocity, contacts, the simulator's fallen
+flag), never from what the robots say.
+
+- A **kick** is a touch of the ball by a robot after which, within ``KICK_WINDOW_MS``, the ball
+  moves at least ``KICK_MIN_SPEED_M_S`` and ``KICK_MIN_GAIN_M_S`` faster than just before the
+  touch (walking into the ball does not make it that fast). One kick per robot per
+  ``KICK_WINDOW_MS``.
+- A **shot** is a kick, made while the game runs, whose ball heads for the goal the kicker's team
+  attacks: its straight path crosses that goal line between the posts, from no farther than half
+  the field's length.
+- A **fall** is a robot's fallen flag going from false to true (not while penalised or removed).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from contracts.ids import RobotId, TeamColor
+from referee.gamecontroller import GameState, SecondaryState
+from referee.rules.base import GameView
+from referee.snapshot import RefereeEvent, WorldSnapshot
+
+KICK_MIN_SPEED_M_S = 1.0
+KICK_MIN_GAIN_M_S = 0.6
+KICK_WINDOW_MS = 400
+COLORS = (TeamColor.RED, TeamColor.BLUE)
+
+
+def _per_team() -> dict[TeamColor, int]:
+    return dict.fromkeys(COLORS, 0)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class PlayStats:
+    """What :class:`PlayTracker` counted (``to_json`` is the ``play`` object of the results)."""
+
+    halves_playing: tuple[int, ...]  # halves of regular time that reached PLAYING
+    playing_s: float  # simulated seconds spent in PLAYING
+    kicks: dict[TeamColor, int]
+    shots: dict[TeamColor, int]
+    goals: dict[TeamColor, int]  # goals credited to the team, own goals included
+    own_goals: dict[TeamColor, int]  # own goals the team's players scored (credited to the other)
+    falls: dict[TeamColor, int]
+
+    def to_json(self) -> dict[str, object]:
+        def teams(values: dict[TeamColor, int]) -> dict[str, int]:
+            return {color.value: values[color] for color in COLORS}
+
+        return {
+            "halves_playing": list(self.halves_playing),
+            "both_halves_playing": {1, 2} <= set(self.halves_playing),
+            "playing_s": round(self.playing_s, 3),
+            "kicks": teams(self.kicks),
+            "shots": teams(self.shots),
+            "goals": teams(self.goals),
+            "own_goals": teams(self.own_goals),
+            "falls": teams(self.falls),
+        }
+
+
+@dataclass(slots=True)
+class _Touch:
+    robot: RobotId
+    time_ms: int
+    speed_before_m_s: float
+
+
+@dataclass(slots=True)
+class PlayTracker:
+    halves: set[int] = field(default_factory=set)
+    playing_ms: int = 0
+    kicks: dict[TeamColor, int] = field(default_factory=_per_team)
+    shots: dict[TeamColor, int] = field(default_factory=_per_team)
+    falls: dict[TeamColor, int] = field(default_factory=_per_team)
+    _touches: dict[RobotId, _Touch] = field(default_factory=dict)
+    _last_kick_ms: dict[RobotId, int] = field(default_factory=dict)
+    _fallen: set[RobotId] = field(default_factory=set)
+    _last_ms: int | None = None
+    _last_speed_m_s: float = 0.0
+
+    def observe(self, snapshot: WorldSnapshot, view: GameView) -> None:
+        now = snapshot.sim_time_ms
+        dt_ms = 0 if self._last_ms is None else max(0, now - self._last_ms)
+        self._last_ms = now
+        playing = view.state is GameState.PLAYING
+        if playing:
+            self.playing_ms += dt_ms
+            if view.phase is SecondaryState.NORMAL:
+                self.halves.add(view.half)
+        self._observe_falls(snapshot, view)
+        ball = snapshot.ball
+        speed = math.hypot(ball.velocity[0], ball.velocity[1])
+        for robot in snapshot.robots:
+            if robot.ball_contacts and robot.id not in self._touches:
+                self._touches[robot.id] = _Touch(robot.id, now, self._last_speed_m_s)
+        for robot_id, touch in list(self._touches.items()):
+            if now - touch.time_ms > KICK_WINDOW_MS:
+                del self._touches[robot_id]
+                continue
+            fast = speed >= KICK_MIN_SPEED_M_S
+            if not fast or speed - touch.speed_before_m_s < KICK_MIN_GAIN_M_S:
+                continue
+            del self._touches[robot_id]
+            last = self._last_kick_ms.get(robot_id)
+            if not playing or (last is not None and now - last < KICK_WINDOW_MS):
+                continue
+            self._last_kick_ms[robot_id] = now
+            self.kicks[robot_id.team] += 1
+            if view.running and _towards_goal(snapshot, view, robot_id.team):
+                self.shots[robot_id.team] += 1
+        self._last_speed_m_s = speed
+
+    def _observe_falls(self, snapshot: WorldSnapshot, view: GameView) -> None:
+        for robot in snapshot.robots:
+            if not robot.fallen or robot.limp or robot.removed:
+                self._fallen.discard(robot.id)
+                continue
+            if robot.id not in self._fallen and robot.id not in view.penalised:
+                self.falls[robot.id.team] += 1
+            self._fallen.add(robot.id)
+
+    def stats(self, events: list[RefereeEvent]) -> PlayStats:
+        goals, own_goals = _per_team(), _per_team()
+        for event in events:
+            if event.type != "goal" or event.team is None:
+                continue
+            goals[event.team] += 1
+            if event.details.get("own_goal"):
+                own_goals[event.team.opponent] += 1
+        return PlayStats(
+            halves_playing=tuple(sorted(self.halves)),
+            playing_s=self.playing_ms / 1000.0,
+            kicks=dict(self.kicks),
+            shots=dict(self.shots),
+            goals=goals,
+            own_goals=own_goals,
+            falls=dict(self.falls),
+        )
+
+
+def _towards_goal(snapshot: WorldSnapshot, view: GameView, team: TeamColor) -> bool:
+    """The ball's straight path crosses the goal line ``team`` attacks between the posts."""
+    geometry = view.field
+    goal_x = -view.side_sign(team) * geometry.half_length_m  # the opponents' goal line
+    (x, y, _), (vx, vy, _) = snapshot.ball.position, snapshot.ball.velocity
+    if vx == 0.0 or (goal_x - x) / vx <= 0.0 or abs(goal_x - x) > geometry.half_length_m:
+        return False
+    y_at_line = y + vy * (goal_x - x) / vx
+    return abs(y_at_line) < geometry.goal_width_m / 2.0
+
+
+__all__ = ["PlayStats", "PlayTracker"]

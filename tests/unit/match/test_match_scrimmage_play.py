@@ -1,0 +1,91 @@
+"""The default scrimmage's files (football in about two minutes, official timings untouched)
+and the typed ``play`` record of results.json."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from contracts.errors import ContractError
+from contracts.sim_result import SimResult
+from orchestrator.config.loader import load_game
+from orchestrator.match.results import build_results
+from orchestrator.match.scrimmage import add_arguments, write_files
+
+PLAY = {
+    "halves_playing": [1, 2], "both_halves_playing": True, "playing_s": 73.4,
+    "kicks": {"red": 2, "blue": 1}, "shots": {"red": 1, "blue": 0},
+    "goals": {"red": 1, "blue": 0}, "own_goals": {"red": 0, "blue": 0},
+    "falls": {"red": 0, "blue": 2},
+}
+
+
+def _scrimmage(tmp_path: Path, *argv: str) -> tuple[dict[str, Any], dict[str, Any]]:
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    game = write_files(parser.parse_args(list(argv)), tmp_path, stub_image="stub:1")
+    red = json.loads((tmp_path / "team_red.json").read_text())
+    return json.loads(game.read_text()), red
+
+
+def test_default_scrimmage_is_a_short_game_with_a_short_ready(tmp_path: Path) -> None:
+    game, red = _scrimmage(tmp_path)
+    assert game["timing"]["half_duration_s"] == 60 and game["timing"]["ready_duration_s"] == 15
+    assert game["stepping"] == "lockstep"
+    assert [p["dockerCmd"].split()[0] for p in red["players"].values()] == ["striker"]
+    loaded = load_game(tmp_path / "game.json").game
+    assert loaded.timing.ready_duration_s == 15.0 and loaded.timing.half_duration_s == 60.0
+
+
+def test_larger_scrimmage_teams_add_a_goalie_then_defenders(tmp_path: Path) -> None:
+    _game, red = _scrimmage(tmp_path, "--players", "4")
+    roles = [p["dockerCmd"].split()[0] for p in red["players"].values()]
+    assert roles == ["goalie", "striker", "defender", "defender"]
+
+
+def test_official_timings_are_the_rules(tmp_path: Path) -> None:
+    game, _red = _scrimmage(tmp_path)
+    del game["timing"]
+    (tmp_path / "game.json").write_text(json.dumps(game))
+    timing = load_game(tmp_path / "game.json").game.timing
+    assert timing.ready_duration_s == 45.0 and timing.half_duration_s == 600.0
+
+
+def _sim_result(play: dict[str, Any]) -> dict[str, Any]:
+    return {"match_id": "m", "seed": 1, "state": "FINISHED", "score": {"red": 1, "blue": 0},
+            "winner": "red", "play": play}
+
+
+def test_play_record_round_trip_and_results() -> None:
+    sim = SimResult.from_dict(_sim_result(PLAY), source="sim_result.json")
+    assert sim.play is not None and sim.play.both_halves_playing
+    assert sim.play.kicks == {"red": 2, "blue": 1}
+    results = build_results(
+        match_id="m", seed=1, sim_result=sim, robots=[], forfeit=None, limits={},
+        versions={}, timings_s={}, failure=None,
+    )
+    assert results["play"] == PLAY
+    old = dict(_sim_result(PLAY))
+    del old["play"]  # a simulator that did not count play
+    assert build_results(
+        match_id="m", seed=1, sim_result=SimResult.from_dict(old), robots=[], forfeit=None,
+        limits={}, versions={}, timings_s={}, failure=None,
+    )["play"] is None
+
+
+@pytest.mark.parametrize(
+    ("broken", "pointer"),
+    [({"kicks": {"red": 1}}, "/play"), ({"halves_playing": "1,2"}, "/play/halves_playing"),
+     ({"falls": {"red": -1, "blue": 0}}, "/play"), ({"playing_s": None}, "/play/playing_s"),
+     ({"both_halves_playing": False}, "/play"), ({"dribbles": 3}, "/play/dribbles")],
+)
+def test_a_broken_play_record_is_refused_naming_the_field(
+    broken: dict[str, Any], pointer: str
+) -> None:
+    with pytest.raises(ContractError) as info:
+        SimResult.from_dict(_sim_result({**PLAY, **broken}), source="sim_result.json")
+    assert info.value.pointer == pointer and info.value.source == "sim_result.json"
