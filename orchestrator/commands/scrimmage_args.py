@@ -32,8 +32,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--match-id", default=None,
                         help="match id (default: scrimmage-<random>)")
     parser.add_argument("--seed", type=int, default=42,
-                        help="seed of the simulation and the referee, and of the sides and "
-                             "kick-off (default 42)")
+                        help="seed of the simulation and the referee (default 42)")
     parser.add_argument("--stub", action="store_true",
                         help="accepted for compatibility: stub robots are the default")
 

@@ -43,11 +43,16 @@ def _pose(x: float, y: float, yaw: float) -> dict[str, Any]:
     return {"translation": [x, y, 0.43], "rotation": [0, 0, 1, yaw]}
 
 
-def team_file(name: str, image: str, players: int, *, command: str | None = None
-              ) -> dict[str, Any]:
+def team_file(name: str, image: str, players: int, *, command: str | None = None,
+              goalie_first: bool = False) -> dict[str, Any]:
+    """A stub team of ``players`` with the roles of :data:`ROLES`; ``goalie_first`` makes a
+    lone player a goalie (an opponent that only defends)."""
     repository, _, tag = image.rpartition(":") if ":" in image.split("/")[-1] else (image, "", "")
     entries: dict[str, Any] = {}
-    for n, slot in enumerate(ROLES[players], start=1):
+    roles = ROLES[players]
+    if goalie_first and roles[0] != "goalie":
+        roles = ("goalie", *roles[1:])
+    for n, slot in enumerate(roles, start=1):
         x, y, yaw = POSES_KID[slot]
         role = slot.split("-")[0]
         extra = " --home {} {}".format(*DEFENDER_HOMES[slot]) if slot in DEFENDER_HOMES else ""
@@ -71,8 +76,8 @@ def game_file(args: argparse.Namespace, match_id: str) -> dict[str, Any]:
         "class": "KID",
         "host": "127.0.0.1",
         "maximum_real_time_factor": 0,
-        "side_left": "random",  # drawn from the seed, as every random choice of a match
-        "kickoff": "random",
+        "side_left": "red",
+        "kickoff": "red",
         "match_id": match_id,
         "seed": args.seed,
         "stepping": "lockstep",
@@ -84,7 +89,9 @@ def game_file(args: argparse.Namespace, match_id: str) -> dict[str, Any]:
                  "ports": [10020 + n for n in range(1, players + 1)]},
         "timing": {
             "half_duration_s": args.half_duration,
-            "ready_duration_s": args.ready_duration,
+            # a shorter READY only where the caller asks for one (hlvs scrimmage does)
+            **({"ready_duration_s": args.ready_duration}
+               if getattr(args, "ready_duration", None) is not None else {}),
             "wait_before_first_ready_s": args.wait_before_ready,
             "half_time_break_s": 1,
             "grace_period_s": args.grace,
