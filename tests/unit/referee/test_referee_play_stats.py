@@ -5,8 +5,8 @@ from __future__ import annotations
 from dataclasses import replace
 
 import pytest
-from referee.field import KID_FIELD
 
+from contracts.field import KID_FIELD
 from referee import FakeClock, Referee
 from referee.gamecontroller import GameState, SecondaryState
 from referee.play_stats import PlayTracker
