@@ -15,8 +15,8 @@ instances (others answer 404). Environments run in the service's process.
     GET  /v1/envs/<id>/monitor/files/<name>                          -> the file
     POST /v1/envs/<id>/close/
 
-At most ``HLVS_ENVS_PER_TEAM`` (default 2) environments per team at a time (409 beyond). A closed
-instance's monitor files stay downloadable until the service restarts.
+At most ``HLVS_ENVS_PER_TOKEN`` (default 2) environments open per token at a time (409 beyond).
+A closed instance's monitor files stay downloadable until the service restarts.
 """
 
 from __future__ import annotations
@@ -45,7 +45,7 @@ ALLOWED_KWARGS = frozenset({
     "perception", "perception_noise", "steps_per_action", "max_episode_s", "ball_distance_m",
     "half_duration_s", "field_class",
 })  # fmt: skip
-DEFAULT_PER_TEAM = 2
+DEFAULT_PER_TOKEN = 2
 
 
 # --- bodies -----------------------------------------------------------------------------------
@@ -122,6 +122,7 @@ class Closed(BaseModel):
 class Instance:
     instance_id: str
     team_id: int
+    token_id: str
     env_id: str
     env: Any
     folder: Path
@@ -131,8 +132,8 @@ class Instance:
 
 
 class Registry:
-    def __init__(self, *, per_team: int) -> None:
-        self.per_team = per_team
+    def __init__(self, *, per_token: int) -> None:
+        self.per_token = per_token
         self.instances: dict[str, Instance] = {}
         self.lock = threading.Lock()
 
@@ -143,8 +144,8 @@ class Registry:
             raise NotFound(what="environment instance", ident=instance_id)
         return instance
 
-    def open_count(self, team_id: int) -> int:
-        return sum(1 for i in self.instances.values() if i.team_id == team_id and i.open)
+    def open_count(self, token_id: str) -> int:
+        return sum(1 for i in self.instances.values() if i.token_id == token_id and i.open)
 
 
 def _registry(request: Request) -> Registry:
@@ -193,10 +194,11 @@ def create(body: CreateBody, principal: TeamPrincipal, request: Request) -> Crea
     registry = _registry(request)
     team_id = int(principal.team_id or 0)
     with registry.lock:
-        if registry.open_count(team_id) >= registry.per_team:
+        token_id = str(principal.token_id)
+        if registry.open_count(token_id) >= registry.per_token:
             raise Conflict(
-                f"team {principal.team_name} has {registry.per_team} environments open "
-                f"(the limit per team); close one first"
+                f"this token of team {principal.team_name} has {registry.per_token} environments"
+                " open (the limit per token); close one first"
             )
         instance_id = secrets.token_hex(4)
         while instance_id in registry.instances:
@@ -207,7 +209,12 @@ def create(body: CreateBody, principal: TeamPrincipal, request: Request) -> Crea
             raise InvalidInput(f"kwargs: {exc}") from exc
         folder = _data_dir(request) / str(team_id) / instance_id
         registry.instances[instance_id] = Instance(
-            instance_id=instance_id, team_id=team_id, env_id=body.env_id, env=env, folder=folder
+            instance_id=instance_id,
+            team_id=team_id,
+            token_id=token_id,
+            env_id=body.env_id,
+            env=env,
+            folder=folder,
         )
     return Created(instance_id=instance_id)
 
@@ -330,6 +337,6 @@ def close(instance_id: str, principal: TeamPrincipal, request: Request) -> Close
 
 
 def mount(app: FastAPI) -> None:
-    per_team = int(os.environ.get("HLVS_ENVS_PER_TEAM", str(DEFAULT_PER_TEAM)))
-    app.state.envs_registry = Registry(per_team=per_team)
+    per_token = int(os.environ.get("HLVS_ENVS_PER_TOKEN", str(DEFAULT_PER_TOKEN)))
+    app.state.envs_registry = Registry(per_token=per_token)
     app.include_router(router)

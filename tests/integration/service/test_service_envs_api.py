@@ -42,6 +42,9 @@ def test_an_episode_with_a_token_monitor_files_and_limits(
         with pytest.raises(EnvApiError) as limit:
             client.env_create("hlvs/Kick-v0")
         assert limit.value.status == 409 and "limit" in limit.value.message
+        with EnvClient(served.url, token=make_token(team="Kickers")) as other_token:
+            third = other_token.env_create("hlvs/Kick-v0")  # the limit is per token
+            other_token.env_close(third)
         client.env_close(second)
         client.env_close(instance)
         assert client.env_list_all() == {}
