@@ -16,15 +16,19 @@ instances (others answer 404). Environments run in the service's process.
     POST /v1/envs/<id>/close/
 
 At most ``HLVS_ENVS_PER_TOKEN`` (default 2) environments open per token at a time (409 beyond).
-A closed instance's monitor files stay downloadable until the service restarts.
+An instance left without a call for ``HLVS_ENVS_IDLE_S`` (default 600 s) is closed when the next
+environment is created. A closed instance's monitor files stay downloadable until the service
+restarts.
 """
 
 from __future__ import annotations
 
+import logging
 import os
 import secrets
 import shutil
 import threading
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -46,6 +50,8 @@ ALLOWED_KWARGS = frozenset({
     "half_duration_s", "field_class",
 })  # fmt: skip
 DEFAULT_PER_TOKEN = 2
+DEFAULT_IDLE_S = 600.0
+log = logging.getLogger(__name__)
 
 
 # --- bodies -----------------------------------------------------------------------------------
@@ -129,11 +135,13 @@ class Instance:
     lock: threading.Lock = field(default_factory=threading.Lock)
     monitor: Monitor | None = None
     open: bool = True
+    last_used_s: float = field(default_factory=time.monotonic)
 
 
 class Registry:
-    def __init__(self, *, per_token: int) -> None:
+    def __init__(self, *, per_token: int, idle_s: float) -> None:
         self.per_token = per_token
+        self.idle_s = idle_s
         self.instances: dict[str, Instance] = {}
         self.lock = threading.Lock()
 
@@ -142,7 +150,18 @@ class Registry:
             instance = self.instances.get(instance_id)
         if instance is None or instance.team_id != team_id or (live and not instance.open):
             raise NotFound(what="environment instance", ident=instance_id)
+        instance.last_used_s = time.monotonic()
         return instance
+
+    def close_idle(self) -> None:
+        """Close instances nobody called for ``idle_s`` (with the registry lock held)."""
+        now = time.monotonic()
+        for instance in self.instances.values():
+            if instance.open and now - instance.last_used_s > self.idle_s:
+                with instance.lock:
+                    _close(instance)
+                log.info("closed idle environment %s of team %d", instance.instance_id,
+                         instance.team_id)  # fmt: skip
 
     def open_count(self, token_id: str) -> int:
         return sum(1 for i in self.instances.values() if i.token_id == token_id and i.open)
@@ -194,6 +213,7 @@ def create(body: CreateBody, principal: TeamPrincipal, request: Request) -> Crea
     registry = _registry(request)
     team_id = int(principal.team_id or 0)
     with registry.lock:
+        registry.close_idle()
         token_id = str(principal.token_id)
         if registry.open_count(token_id) >= registry.per_token:
             raise Conflict(
@@ -328,15 +348,21 @@ def monitor_file(
 def close(instance_id: str, principal: TeamPrincipal, request: Request) -> Closed:
     instance = _registry(request).get(instance_id, int(principal.team_id or 0))
     with instance.lock:
-        if instance.monitor is not None:
-            instance.monitor.close()
-            instance.monitor = None
+        _close(instance)
+    return Closed()
+
+
+def _close(instance: Instance) -> None:
+    if instance.monitor is not None:
+        instance.monitor.close()
+        instance.monitor = None
+    if instance.open:
         instance.env.close()
         instance.open = False
-    return Closed()
 
 
 def mount(app: FastAPI) -> None:
     per_token = int(os.environ.get("HLVS_ENVS_PER_TOKEN", str(DEFAULT_PER_TOKEN)))
-    app.state.envs_registry = Registry(per_token=per_token)
+    idle_s = float(os.environ.get("HLVS_ENVS_IDLE_S", str(DEFAULT_IDLE_S)))
+    app.state.envs_registry = Registry(per_token=per_token, idle_s=idle_s)
     app.include_router(router)

@@ -80,3 +80,26 @@ def test_without_a_token_or_with_another_teams_token_nothing_runs(
             a.env_step(instance, [0.0] * 3)
         assert shape.value.status == 422 and "action" in shape.value.message
         a.env_close(instance)
+
+
+def test_idle_environments_are_closed_for_new_ones(
+    settings: object, make_token: TokenMaker, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import time
+
+    from tests.integration.service.harness import serve
+
+    monkeypatch.setenv("HLVS_ENVS_PER_TOKEN", "1")
+    monkeypatch.setenv("HLVS_ENVS_IDLE_S", "0.5")
+    served = serve(settings)  # type: ignore[arg-type]
+    try:
+        with EnvClient(served.url, token=make_token(team="Idle")) as client:
+            first = client.env_create("hlvs/Kick-v0")
+            time.sleep(1.0)
+            second = client.env_create("hlvs/Kick-v0")  # the idle one made room
+            with pytest.raises(EnvApiError) as gone:
+                client.env_reset(first)
+            assert gone.value.status == 404
+            client.env_close(second)
+    finally:
+        served.stop()
