@@ -163,11 +163,11 @@ def check_report(
 ) -> FileReport:
     """Check one file (or robot model package) and return every problem found (nothing
     printed)."""
-    from orchestrator.commands.check_model import MODEL_KIND, check_model, is_model_package
+    from orchestrator.config.robot_models import check_model, is_model_package
 
     if is_model_package(path):
         problems, measurements = check_model(path)
-        return FileReport(str(path), MODEL_KIND, problems, measurements)
+        return FileReport(str(path), "robot model", problems, measurements)
     try:
         found_kind, problems = _check(
             path, kind=kind, field_class=field_class, images_required=images_required
@@ -181,7 +181,7 @@ def check_report(
 
 def print_text(report: FileReport, *, out: TextIO) -> None:
     if report.measurements is not None:
-        from orchestrator.commands.check_model import describe
+        from orchestrator.config.robot_models import describe
 
         print(f"{report.file}: {describe(report.measurements)}", file=out)
     for problem in report.errors + [p for p in report.problems if p.severity != "error"]:

@@ -20,6 +20,7 @@ from contracts.match_spec import (
     TimingSpec,
 )
 from orchestrator.config.model import COLORS, Color, LoadedGame, StartingPose
+from orchestrator.config.robot_models import spec_model
 
 GOALKEEPER_NUMBER = 1  # HLVS: player 1 is the goalkeeper unless the robot declares otherwise
 VIDEO_FILE = "match.mp4"
@@ -103,7 +104,7 @@ def _team(loaded: LoadedGame, color: Color, addresses: Sequence[str]) -> TeamSpe
         players=tuple(
             PlayerSpec(
                 number=player.number,
-                model=player.model,
+                model=spec_model(player.model),
                 port=ref.port(player.number),
                 half_time_pose=_pose(player.half_time_pose),
                 reentry_pose=_pose(player.reentry_pose),

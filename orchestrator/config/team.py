@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -18,6 +18,12 @@ from orchestrator.config.model import (
     TeamConfig,
 )
 from orchestrator.config.problems import Collector, pointer
+from orchestrator.config.robot_models import (
+    MODEL_MANIFEST,
+    check_model,
+    is_model_package,
+    is_model_path,
+)
 from orchestrator.config.schema import validate
 
 POSE_KEYS = {
@@ -79,6 +85,7 @@ def build_team(
     if not valid:
         return None
     players = [_player(number, document, field_class) for number in numbers]
+    players = _resolve_models(players, source, where)
     if not document["players"]:
         where.warn(
             "/players", "the team has no players: it plays without robots (like HLVS Invisibles)"
@@ -101,6 +108,35 @@ def build_team(
         image=document.get("image"),
         registry_auth=_registry_auth(document.get("registry_auth")),
     )
+
+
+def _resolve_models(
+    players: list[PlayerConfig], source: Path, where: Collector
+) -> list[PlayerConfig]:
+    """Model package paths made absolute (relative to the team file) and checked against the
+    rule book, once per folder; a model that cannot be used is an error of its player."""
+    checked: dict[Path, list[str]] = {}
+    out = []
+    for player in players:
+        if not is_model_path(player.model):
+            out.append(player)
+            continue
+        at = pointer("players", str(player.number), "model")
+        folder = (source.parent / player.model).resolve()
+        if not is_model_package(folder):
+            where.error(
+                at,
+                f"no robot model package at {folder}",
+                expected=f"a built-in model ({', '.join(sorted(set(DEFAULT_MODEL.values())))}) "
+                f"or a folder with {MODEL_MANIFEST}",
+            )
+            continue
+        if folder not in checked:
+            checked[folder] = [str(problem) for problem in check_model(folder)[0]]
+        for problem in checked[folder]:
+            where.error(at, f"the robot model cannot be used: {problem}")
+        out.append(replace(player, model=str(folder)))
+    return out
 
 
 def _player(number: int, document: dict[str, Any], field_class: FieldClass | None) -> PlayerConfig:

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from orchestrator.config import Limits
+from orchestrator.config.robot_models import container_path
 from orchestrator.engine import (
     LABEL_MATCH,
     LABEL_PROJECT,
@@ -166,7 +167,14 @@ def simulator_request(
     plan: MatchPlan, *, prefix: str, image: str, match_dir: Path,
     attachments: tuple[Attachment, ...], extra_labels: Mapping[str, str],
     command: tuple[str, ...] = SIMULATOR_COMMAND,
+    model_dirs: tuple[Path, ...] = (),
 ) -> ContainerRequest:
+    """The simulator container; team robot model packages mounted read-only where the match
+    spec names them (:func:`orchestrator.config.robot_models.container_path`)."""
+    models = tuple(
+        BindMount(source=folder, target=container_path(str(folder)), read_only=True)
+        for folder in model_dirs
+    )
     return ContainerRequest(
         name=f"{prefix}-simulator",
         image=image,
@@ -174,7 +182,7 @@ def simulator_request(
         environment={"PYTHONUNBUFFERED": "1", "HLVS_MATCH_ID": plan.match_id},
         labels={**labels(plan.match_id, "simulator"), **extra_labels},
         networks=attachments,
-        mounts=(BindMount(source=match_dir, target=MATCH_TARGET),),
+        mounts=(BindMount(source=match_dir, target=MATCH_TARGET), *models),
         hostname="simulator",
         cap_drop=("ALL",),
         security_opt=("no-new-privileges",),

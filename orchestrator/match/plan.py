@@ -10,9 +10,11 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 from typing import Any
 
 from orchestrator.config import Limits, LoadedGame, PlayerConfig
+from orchestrator.config.robot_models import is_model_path
 from orchestrator.config.spec import to_match_spec
 
 SpecBuilder = Callable[[Mapping[str, tuple[str, ...]], str | None], dict[str, Any]]
@@ -53,6 +55,7 @@ class MatchPlan:
     telemetry_silence_s: float = 30.0  # fail the match when telemetry stays silent this long
     mirror_port: int = 3737
     versions: Mapping[str, str] = field(default_factory=dict)
+    model_dirs: tuple[Path, ...] = ()  # team robot model packages the simulator must read
 
     @property
     def teams(self) -> tuple[TeamPlan, TeamPlan]:
@@ -92,6 +95,14 @@ def plan_from_game(loaded: LoadedGame, *, grace_period_s: float | None = None) -
         limits=game.limits,
         allow_internet=game.allow_internet,
         grace_period_s=game.timing.grace_period_s if grace_period_s is None else grace_period_s,
+        model_dirs=tuple(
+            dict.fromkeys(
+                Path(p.model)
+                for color in ("red", "blue")
+                for p in loaded.team(color).players
+                if is_model_path(p.model)
+            )
+        ),
     )
 
 

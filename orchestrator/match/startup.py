@@ -95,7 +95,7 @@ def start(runner: MatchRunner, started_at: float) -> None:
     request = layout.simulator_request(
         plan, prefix=started.prefix, image=runner.options.simulator_image, match_dir=match_dir,
         attachments=attachments, extra_labels=runner.options.extra_labels,
-        command=runner.options.simulator_command,
+        command=runner.options.simulator_command, model_dirs=plan.model_dirs,
     )
     _start_simulator(runner, request)  # first: it boots while the robots start
     robots = [r for r in plan.robots if runner.records[r.key].image_error is None]

@@ -1,0 +1,66 @@
+"""Team robot models named in team_config.json: found, checked and mounted into the simulator.
+
+A player's ``model`` is a built-in name (``kid-default``, ``adult-default``) or the path of a
+model package folder (a folder with ``robot_model.json``, see configs/README.md), relative to the
+team file. The package is checked against the rule book when the team file is loaded (a model
+that breaks a rule is an error: it cannot be used in a match) and mounted read-only into the
+simulator container, where the match spec names it by its container path.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+from typing import Any
+
+from orchestrator.errors import Problem
+
+MODEL_MANIFEST = "robot_model.json"
+MODELS_TARGET = "/opt/hlvs/team-models"
+
+
+def is_model_path(name: str) -> bool:
+    """True when ``name`` names a model package folder rather than a built-in model (the same
+    rule as the simulator's)."""
+    return "/" in name or name.startswith(".")
+
+
+def is_model_package(path: Path) -> bool:
+    """A folder holding a model manifest, or the manifest itself."""
+    return (path.is_dir() and (path / MODEL_MANIFEST).is_file()) or path.name == MODEL_MANIFEST
+
+
+def container_path(host_folder: str) -> str:
+    """Where the simulator container sees the model package ``host_folder`` (absolute)."""
+    digest = hashlib.sha256(host_folder.encode()).hexdigest()[:12]
+    return f"{MODELS_TARGET}/{Path(host_folder).name}-{digest}"
+
+
+def spec_model(model: str) -> str:
+    """The model name the match spec carries: built-in names as they are, packages by their
+    container path."""
+    return container_path(model) if is_model_path(model) else model
+
+
+def check_model(path: Path) -> tuple[list[Problem], dict[str, Any] | None]:
+    """Problems and measurements of a model package (None when it cannot even be loaded).
+    Imports the simulator's model loader (and MuJoCo) on first use."""
+    from simulator.errors import ModelError
+    from simulator.world.robots.team import load_team_model
+    from simulator.world.robots.team.rulebook import check
+
+    folder = path if path.is_dir() else path.parent
+    try:
+        measurements, found = check(load_team_model(folder))
+    except ModelError as exc:
+        return [Problem(p.source, p.where, p.reason) for p in exc.problems], None
+    return [Problem(p.source, p.where, p.reason) for p in found], measurements.to_json()
+
+
+def describe(measurements: dict[str, Any]) -> str:
+    m = measurements
+    return (
+        f"H {m['height_m']} m, Hleg {m['leg_m']} m, Hhead {m['head_m']} m, Harm {m['arm_m']} m, "
+        f"foot {m['foot_length_m']} x {m['foot_width_m']} m, mass {m['mass_kg']} kg, "
+        f"{m['motors']} motors, {m['cameras']} camera(s)"
+    )
