@@ -8,6 +8,12 @@ import argparse
 from orchestrator.paths import user_path
 
 
+def _model(text: str) -> str:
+    """A model package path made absolute (the team files are written elsewhere); built-in
+    names as they are."""
+    return text if text in ("adult-default", "kid-default") else str(user_path(text))
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", type=user_path, default="matches/scrimmage",
                         help="output folder (default: matches/scrimmage)")
@@ -15,6 +21,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="image of the red robots (default: the project's stub image)")
     parser.add_argument("--blue-image", default=None,
                         help="image of the blue robots (default: the project's stub image)")
+    parser.add_argument("--red-model", default=None, type=_model,
+                        help="robot model of every red robot: a built-in name (kid-default) or "
+                        "a robot model package folder (default: kid-default)")
+    parser.add_argument("--blue-model", default=None, type=_model,
+                        help="robot model of every blue robot (as --red-model)")
     parser.add_argument("--players", type=int, default=1, choices=(1, 2, 3, 4),
                         help="robots per team: a striker, then a goalie, then defenders "
                              "(default 1)")

@@ -19,10 +19,12 @@ MODEL_MANIFEST = "robot_model.json"
 MODELS_TARGET = "/opt/hlvs/team-models"
 
 
+BUILT_IN_MODELS = ("adult-default", "kid-default")
+
+
 def is_model_path(name: str) -> bool:
-    """True when ``name`` names a model package folder rather than a built-in model (the same
-    rule as the simulator's)."""
-    return "/" in name or name.startswith(".")
+    """True when ``name`` names a model package folder rather than a built-in model."""
+    return name not in BUILT_IN_MODELS
 
 
 def is_model_package(path: Path) -> bool:

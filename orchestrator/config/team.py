@@ -19,6 +19,7 @@ from orchestrator.config.model import (
 )
 from orchestrator.config.problems import Collector, pointer
 from orchestrator.config.robot_models import (
+    BUILT_IN_MODELS,
     MODEL_MANIFEST,
     check_model,
     is_model_package,
@@ -127,7 +128,7 @@ def _resolve_models(
             where.error(
                 at,
                 f"no robot model package at {folder}",
-                expected=f"a built-in model ({', '.join(sorted(set(DEFAULT_MODEL.values())))}) "
+                expected=f"a built-in model ({', '.join(BUILT_IN_MODELS)}) "
                 f"or a folder with {MODEL_MANIFEST}",
             )
             continue

@@ -44,9 +44,10 @@ def _pose(x: float, y: float, yaw: float) -> dict[str, Any]:
 
 
 def team_file(name: str, image: str, players: int, *, command: str | None = None,
-              goalie_first: bool = False) -> dict[str, Any]:
+              goalie_first: bool = False, model: str | None = None) -> dict[str, Any]:
     """A stub team of ``players`` with the roles of :data:`ROLES`; ``goalie_first`` makes a
-    lone player a goalie (an opponent that only defends)."""
+    lone player a goalie (an opponent that only defends); ``model`` the robot model of every
+    player (a built-in name or a model package folder; default: the class's built-in)."""
     repository, _, tag = image.rpartition(":") if ":" in image.split("/")[-1] else (image, "", "")
     entries: dict[str, Any] = {}
     roles = ROLES[players]
@@ -66,6 +67,8 @@ def team_file(name: str, image: str, players: int, *, command: str | None = None
         }
         if tag:
             entries[str(n)]["dockerTag"] = tag
+        if model:
+            entries[str(n)]["model"] = model
     return {"name": name, "image": repository or image, "players": entries}
 
 
@@ -116,9 +119,11 @@ def write_files(args: argparse.Namespace, folder: Path, *, stub_image: str | Non
     files = {
         "game.json": game_file(args, match_id),
         "team_red.json": team_file("Stub Red", red_image, args.players,
-                                   command=args.robot_command),
+                                   command=args.robot_command,
+                                   model=getattr(args, "red_model", None)),
         "team_blue.json": team_file("Stub Blue", blue_image, args.players,
-                                    command=args.robot_command),
+                                    command=args.robot_command,
+                                    model=getattr(args, "blue_model", None)),
     }
     for name, content in files.items():
         (folder / name).write_text(json.dumps(content, indent=2) + "\n", encoding="utf-8")

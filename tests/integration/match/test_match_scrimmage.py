@@ -54,3 +54,39 @@ def test_short_scrimmage_plays_to_finished(tmp_path: Path, runtime: Any,
         assert (out / "teams" / color / "1" / "robocup-logs").is_dir()
     assert (out / "config" / "game.json").is_file()
     assert runtime.list_project(match_id=match_id) == []
+
+
+def test_scrimmage_with_a_team_of_wolfgang_models_plays_to_the_end(
+    tmp_path: Path, runtime: Any, capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Red plays with the Wolfgang model package (URDF and meshes mounted read-only into the
+    simulator), blue with the built-in robot; the stub drives both through the robot API."""
+    try:
+        from orchestrator.images import project_image
+
+        project_image("simulator")
+        project_image("stub")
+    except (ImportError, OrchestratorError) as exc:
+        pytest.skip(f"project images unavailable: {exc}")
+    wolfgang = Path(__file__).resolve().parents[3] / "configs/examples/robots/wolfgang"
+    match_id = "scrim-wolfgang"
+    monkeypatch.chdir(tmp_path)
+    try:
+        code = hlvs(["scrimmage", "--out", "wolf", "--red-model", str(wolfgang),
+                     "--half-duration", "4", "--wait-before-ready", "1", "--grace", "2",
+                     "--match-id", match_id])
+    finally:
+        hlvs(["cleanup", "--match", match_id])
+    printed = capsys.readouterr()
+    assert code == 0, printed.err[-3000:]
+    out = tmp_path / "wolf"
+    results = json.loads((out / "results.json").read_text())
+    assert results["final_state"] == "FINISHED" and results["status"] == "success"
+    spec = json.loads((out / "simulator" / "match_spec.json").read_text())
+    models = {t["color"]: t["players"][0]["model"] for t in (spec["red"], spec["blue"])}
+    assert models["blue"] == "kid-default"
+    assert models["red"].startswith("/opt/hlvs/team-models/wolfgang-")
+    team = json.loads((out / "config" / "team_red.json").read_text())
+    assert team["players"]["1"]["model"] == str(wolfgang)
+    assert runtime.list_project(match_id=match_id) == []
