@@ -57,6 +57,10 @@ def register(sub: Any) -> None:
             func=_delivery)
     forward(kinds, "cli", help="start-up time of hlvs --help (JSON)", func=_cli)
     forward(
+        kinds, "models", help="physics cost per robot: team model against built-in (JSON)",
+        func=_models,
+    )
+    forward(
         kinds, "viewer", help="the web viewer: open and play a 2 x 10 min 4 v 4 replay (JSON)",
         func=_viewer,
     )
@@ -82,6 +86,13 @@ def _viewer(args: argparse.Namespace) -> int:
     from benchmarks.viewer import main as viewer_main
 
     return int(viewer_main(list(args.rest)))
+
+
+def _models(args: argparse.Namespace) -> int:
+    os.environ["HLVS_PROG"] = "hlvs"
+    from benchmarks.models import main as models_main
+
+    return int(models_main(list(args.rest)))
 
 
 def _cli(args: argparse.Namespace) -> int:
