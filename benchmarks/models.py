@@ -23,7 +23,7 @@ EXAMPLE = Path(__file__).resolve().parents[1] / "configs" / "examples" / "robots
 
 
 def _world(model: str | None, robots: int) -> Any:
-    from referee.snapshot import RobotId, TeamColor
+    from contracts.ids import RobotId, TeamColor
     from simulator.world import RobotPlacement, World
 
     placements = []

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from referee.snapshot import RobotId, TeamColor
+from contracts.ids import RobotId, TeamColor
 from robot.client import RobotClient
 from simulator.api.world_cameras import world_render_worker
 from simulator.world import RobotPlacement, World
