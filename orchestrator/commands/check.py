@@ -12,6 +12,7 @@ import argparse
 import importlib
 import json
 import logging
+import re
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -193,18 +194,39 @@ def print_text(report: FileReport, *, out: TextIO) -> None:
 
 
 def print_github(report: FileReport, *, out: TextIO) -> None:
-    """GitHub Actions workflow commands (``::error file=...,title=...::message``)."""
+    """GitHub Actions workflow commands (``::error file=...,line=...,title=...::message``)."""
     for problem in report.problems:
         level = "error" if problem.severity == "error" else "warning"
         title = f"{problem.pointer or '/'}"
         text = str(problem).removeprefix("warning: ")
+        line = line_of(Path(problem.file), problem.pointer)
+        where = f",line={line}" if line else ""
         print(
-            f"::{level} file={_gh_property(problem.file)},title={_gh_property(title)}"
+            f"::{level} file={_gh_property(problem.file)}{where},title={_gh_property(title)}"
             f"::{_gh_data(text)}",
             file=out,
         )
     if report.valid:
         print(f"{report.file}: ok ({report.kind})", file=out)
+
+
+def line_of(path: Path, pointer: str) -> int | None:
+    """The line of a JSON file where the member a JSON pointer names starts (found by looking
+    for each key in turn after the previous one), or None when it cannot be told."""
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return None
+    position = 0
+    for token in [t for t in pointer.split("/") if t]:
+        key = token.replace("~1", "/").replace("~0", "~")
+        found = re.compile(r'"' + re.escape(json.dumps(key)[1:-1]) + r'"\s*:').search(
+            text, position
+        )
+        if found is None:
+            return None if position == 0 else text.count("\n", 0, position) + 1
+        position = found.start()
+    return text.count("\n", 0, position) + 1
 
 
 def _gh_data(text: str) -> str:
@@ -273,6 +295,9 @@ def _check_optional(kind: Kind, path: Path) -> list[Problem]:
                 str(path), "", f"{kind} files cannot be checked by this version", severity="warning"
             )
         ]
+    loader_log = logging.getLogger(module_name)
+    level = loader_log.level
+    loader_log.setLevel(logging.ERROR)  # its warnings are returned and printed as the result
     try:
         text = read_text(path)
         if kind == "credentials":
@@ -285,5 +310,7 @@ def _check_optional(kind: Kind, path: Path) -> list[Problem]:
     except Exception as exc:  # a loader of another module failed: report it, do not crash
         log.debug("checking %s failed", path, exc_info=True)
         return [Problem(str(path), "", f"cannot be checked: {type(exc).__name__}: {exc}")]
+    finally:
+        loader_log.setLevel(level)
     warnings = getattr(loaded, "warnings", ())
     return [w for w in warnings if isinstance(w, Problem)]

@@ -151,7 +151,8 @@ def test_a_missing_state_file_is_invalid_input_like_every_missing_file(
 
 def test_check_json_and_github_formats(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     bad = tmp_path / "team_config.json"
-    bad.write_text(json.dumps({"name": "x", "players": {"1": {"dockerTag": 5}}}))
+    bad.write_text(json.dumps({"name": "x", "players": {"1": {"dockerTag": 5}}}, indent=2))
+    tag_line = bad.read_text().splitlines().index('      "dockerTag": 5') + 1
     assert main(["check", "--json", str(bad)]) == ExitCode.INVALID
     report = json.loads(capsys.readouterr().out)
     assert report["valid"] is False
@@ -164,6 +165,7 @@ def test_check_json_and_github_formats(tmp_path: Path, capsys: pytest.CaptureFix
     lines = capsys.readouterr().out.splitlines()
     assert lines and all(line.startswith("::error file=") for line in lines), lines
     assert any("title=/players/1" in line for line in lines), lines
+    assert any(f"line={tag_line},title=/players/1/dockerTag" in line for line in lines), lines
     assert all("\n" not in line.split("::", 2)[2] for line in lines)
 
 
@@ -211,3 +213,16 @@ def test_match_exit_codes_and_json(
     assert printed["out_dir"] == str(tmp_path)
     if failure:
         assert printed["failure"] == {"class": failure[0], "cause": failure[1]}
+
+
+def test_check_prints_a_credentials_warning_once(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    credentials = tmp_path / "credentials.json"
+    credentials.write_text(json.dumps({"type": "sftp", "credentials": {
+        "hostname": "logs.example", "username": "u", "password": "p", "path": "/upload"}}))
+    credentials.chmod(0o644)
+    assert main(["check", str(credentials)]) == ExitCode.OK
+    printed = capsys.readouterr()
+    assert printed.out.count("readable by group or others") == 1, printed.out
+    assert "readable by group or others" not in printed.err
