@@ -37,6 +37,7 @@ class Limits:
     memory_gb: float = 16.0
     pids: int = 1024
     log_folder_gb: float = 10.0  # per robot /robocup-logs
+    scratch_gb: float = 10.0  # per robot writable scratch (/tmp, /var/tmp, /root); root fs is ro
     image_gb: float = 10.0  # one robot image
     team_images_gb: float = 40.0  # all images of one team
     team_api_mb_s: float = 350.0  # robot API traffic of one team, split evenly per robot

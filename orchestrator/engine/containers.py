@@ -81,6 +81,8 @@ class DockerRuntime:
             "mem_limit": request.mem_bytes,
             "memswap_limit": request.mem_bytes,
             "pids_limit": request.pids_limit,
+            "read_only": request.read_only or None,
+            "tmpfs": dict(request.tmpfs) or None,
             "network_mode": request.network_mode
             or (request.networks[0].network if request.networks else "none"),
         }

@@ -152,6 +152,9 @@ def _teardown(runner: MatchRunner) -> None:
         target = runner.options.out_dir / "teams" / record.color / str(record.number)
         _guarded(runner, f"releasing /robocup-logs of {key}",
                  partial(_collect_log_folder, runner, key, folder, target / "robocup-logs"))
+    for key, scratch in started.scratch.items():
+        _guarded(runner, f"releasing the scratch space of {key}",
+                 partial(runner.host.release, scratch))
     for network in started.networks.values():
         _guarded(runner, f"removing network {network.name}",
                  partial(runtime.remove_network, network.name))

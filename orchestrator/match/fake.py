@@ -169,6 +169,7 @@ class FakeHost:
     shaped: list[RobotShaping] = field(default_factory=list)
     folders: list[Path] = field(default_factory=list)
     released: list[str] = field(default_factory=list)
+    released_folders: list[Path] = field(default_factory=list)
 
     def isolate_bridge(self, bridge_name: str, *, match_id: str) -> bool:
         self.isolated.append(bridge_name)
@@ -195,6 +196,9 @@ class FakeHost:
         fallback.mkdir(parents=True, exist_ok=True)
         self.folders.append(fallback)
         return LogFolder(path=fallback, cap_bytes=cap_bytes)
+
+    def release(self, folder: LogFolder) -> None:
+        self.released_folders.append(folder.path)
 
     def collect_logs(self, folder: LogFolder, destination: Path) -> CopyReport:
         destination.mkdir(parents=True, exist_ok=True)

@@ -37,6 +37,8 @@ class Host(Protocol):
 
     def collect_logs(self, folder: LogFolder, destination: Path) -> CopyReport: ...
 
+    def release(self, folder: LogFolder) -> None: ...
+
     def cleanup(self, *, match_id: str | None) -> int: ...
 
 
@@ -94,6 +96,9 @@ class HostControl:
 
     def collect_logs(self, folder: LogFolder, destination: Path) -> CopyReport:
         return logfs.collect(folder, destination)
+
+    def release(self, folder: LogFolder) -> None:
+        logfs.release(folder)
 
     def cleanup(self, *, match_id: str | None) -> int:
         removed = self.remove_isolation(match_id=match_id)

@@ -39,6 +39,11 @@ SIMULATOR_HOST = 2
 ROBOT_HOST_BASE = 10
 TELEMETRY_PORT = 7447
 LOGS_TARGET = "/robocup-logs"
+# A robot's root file system is read-only; these folders of its capped scratch space are
+# writable (sub-folder name in the scratch space -> path in the container).
+SCRATCH_DIRS = {"tmp": "/tmp", "var-tmp": "/var/tmp", "root": "/root"}
+SCRATCH_FALLBACK_TMPFS_BYTES = 256 * 1024 * 1024  # per folder, when no capped space can be made
+RUN_TMPFS = "size=16m,mode=755"
 MATCH_TARGET = "/match"
 SIMULATOR_COMMAND = (
     "python3", "-m", "simulator", "run", "--spec", "/match/match_spec.json", "--out", "/match/out"
@@ -144,8 +149,19 @@ def holder_request(
 def robot_request(
     robot: RobotPlan, *, prefix: str, holder_id: str, environment: Mapping[str, str],
     logs_dir: Path, limits: Limits, match_id: str, extra_labels: Mapping[str, str],
+    scratch_dir: Path | None = None,
 ) -> ContainerRequest:
+    """``scratch_dir``: the robot's capped scratch space (its :data:`SCRATCH_DIRS` are bound
+    into the container); None: size-capped tmpfs folders instead (they count as memory)."""
     assert robot.image is not None
+    scratch: tuple[BindMount, ...] = ()
+    tmpfs = {"/run": RUN_TMPFS}
+    if scratch_dir is not None:
+        scratch = tuple(BindMount(source=scratch_dir / name, target=target)
+                        for name, target in SCRATCH_DIRS.items())
+    else:
+        size = min(SCRATCH_FALLBACK_TMPFS_BYTES, int(limits.scratch_gb * 1e9))
+        tmpfs.update({target: f"size={size}" for target in SCRATCH_DIRS.values()})
     return ContainerRequest(
         name=f"{prefix}-{robot.key}",
         image=robot.image,
@@ -154,7 +170,9 @@ def robot_request(
         labels={**labels(match_id, "robot", team=robot.color, robot=str(robot.number)),
                 **extra_labels},
         network_mode=f"container:{holder_id}",
-        mounts=(BindMount(source=logs_dir, target=LOGS_TARGET),),
+        mounts=(BindMount(source=logs_dir, target=LOGS_TARGET), *scratch),
+        read_only=True,
+        tmpfs=tmpfs,
         nano_cpus=int(limits.cpus * 1e9),
         mem_bytes=int(limits.memory_gb * 1e9),
         pids_limit=limits.pids,
@@ -191,6 +209,7 @@ def simulator_request(
 
 __all__ = [
     "LOGS_TARGET",
+    "SCRATCH_DIRS",
     "SIMULATOR_COMMAND",
     "Subnet",
     "TELEMETRY_PORT",

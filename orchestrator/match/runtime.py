@@ -94,6 +94,8 @@ class ContainerRequest:
     cap_add: tuple[str, ...] = ()
     security_opt: tuple[str, ...] = ()
     working_dir: str | None = None
+    read_only: bool = False  # read-only root file system
+    tmpfs: Mapping[str, str] = field(default_factory=dict)  # path -> mount options ("size=16m")
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

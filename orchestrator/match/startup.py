@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import logging
+import shutil
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -37,6 +38,7 @@ class Started:
     robot_ids: dict[str, str] = field(default_factory=dict)  # robot key -> container id
     shaping: dict[str, AppliedShaping] = field(default_factory=dict)
     log_folders: dict[str, LogFolder] = field(default_factory=dict)
+    scratch: dict[str, LogFolder] = field(default_factory=dict)  # robot key -> scratch space
     match_dir: Path | None = None
 
 
@@ -160,11 +162,14 @@ def _start_robot(runner: MatchRunner, robot: RobotPlan) -> None:
             / "robocup-logs",
         )
         started.log_folders[robot.key] = folder
+        scratch = _scratch(runner, robot)
         record.limits = {
             "nano_cpus": int(limits.cpus * 1e9),
             "memory_bytes": int(limits.memory_gb * 1e9),
             "pids": limits.pids,
             "log_folder_bytes": folder.cap_bytes,
+            "scratch_bytes": scratch.cap_bytes if scratch is not None else None,
+            "read_only_root": True,
             "api_rate_bit_s": applied.api_rate_bit if applied else None,
             "comm_rate_bit_s": applied.comm_rate_bit if applied else None,
             "shaping_applied_ms": round(applied.applied_ms, 1) if applied else None,
@@ -178,6 +183,7 @@ def _start_robot(runner: MatchRunner, robot: RobotPlan) -> None:
             prefix=started.prefix, holder_id=holder_id, environment=environment,
             logs_dir=folder.path, limits=limits, match_id=plan.match_id,
             extra_labels=runner.options.extra_labels,
+            scratch_dir=scratch.path if scratch is not None else None,
         )
         container_id = runner.runtime.create_container(request)
         started.robot_ids[robot.key] = container_id
@@ -189,6 +195,26 @@ def _start_robot(runner: MatchRunner, robot: RobotPlan) -> None:
     except OrchestratorError as exc:
         record.startup_error = str(exc)
         log.warning("match %s: robot %s could not be started: %s", plan.match_id, robot.key, exc)
+
+
+def _scratch(runner: MatchRunner, robot: RobotPlan) -> LogFolder | None:
+    """The robot's capped scratch space with its :data:`layout.SCRATCH_DIRS`, or None when no
+    cap can be applied (the robot then gets small tmpfs folders)."""
+    started = runner.started
+    cap = int(runner.plan.limits.scratch_gb * 1e9)
+    scratch = runner.host.log_folder(
+        match_id=runner.plan.match_id, name=f"{robot.key}-scratch", cap_bytes=cap,
+        fallback=runner.options.out_dir / ".scratch" / robot.key,
+    )
+    if scratch.cap_bytes is None:
+        shutil.rmtree(runner.options.out_dir / ".scratch", ignore_errors=True)
+        return None
+    started.scratch[robot.key] = scratch
+    for name in layout.SCRATCH_DIRS:
+        path = scratch.path / name
+        path.mkdir(exist_ok=True)
+        path.chmod(0o700 if name == "root" else 0o1777)
+    return scratch
 
 
 __all__ = ["Started", "start"]

@@ -13,11 +13,14 @@ from tests.integration.attack.conftest import Prepare, Prepared, left_behind
 
 pytestmark = [pytest.mark.docker, pytest.mark.root]
 
+SCRATCH_GB = 0.05
+
 
 @pytest.fixture(scope="module")
 def hostile(prepare: Prepare, docker_client: docker.DockerClient
             ) -> tuple[Prepared, Any, list[str]]:
-    match = prepare("special-files", "spoof")
+    match = prepare("special-files", "fill=/var/tmp/big", "fill=/opt/big", "spoof",
+                    game={"limits": {"scratch_gb": SCRATCH_GB}})
     done = match.run()
     assert done.returncode == 0, done.stderr[-3000:]
     return match, done, left_behind(docker_client, match.match_id)
@@ -76,3 +79,17 @@ def test_special_files_in_the_log_folder_are_skipped_not_followed(
     assert {("a_fifo", "pipe"), ("shadow", "symlink"), ("root", "symlink"),
             ("environ", "symlink"), ("sub/loop", "symlink"), ("a_socket", "socket")} <= skipped
     assert folder["files"] >= 2
+
+
+def test_writing_past_the_scratch_space_fails_inside_the_robot_only(
+    hostile: tuple[Prepared, Any, list[str]],
+) -> None:
+    match, _, _ = hostile
+    seen = json.loads((match.out / "teams/red/1/robocup-logs/attacks.json").read_text())
+    scratch = seen["fill /var/tmp/big"]
+    assert "No space left on device" in scratch["result"], scratch
+    assert scratch["bytes"] <= SCRATCH_GB * 1e9
+    root = seen["fill /opt/big"]
+    assert "Read-only file system" in root["result"] and root["bytes"] == 0, root
+    limits = match.results()["robots"]["red-1"]["limits"]
+    assert limits["scratch_bytes"] == int(SCRATCH_GB * 1e9) and limits["read_only_root"]

@@ -66,7 +66,9 @@ def test_limits_are_visible_in_docker_inspect(
         assert host_config["Privileged"] is False
         assert host_config["NetworkMode"].startswith("container:")
         binds = host_config["Binds"]
-        assert len(binds) == 1 and binds[0].endswith(":/robocup-logs:rw")
+        assert sorted(b.rpartition(":")[0].rpartition(":")[2] for b in binds) == [
+            "/robocup-logs", "/root", "/tmp", "/var/tmp"]
+        assert host_config["ReadonlyRootfs"] is True
 
 
 def test_oom_killed_robot_is_recorded_and_the_game_goes_on(play: MatchFactory) -> None:

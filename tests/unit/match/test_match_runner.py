@@ -96,7 +96,8 @@ def test_robot_requests_carry_environment_limits_and_no_privileges(tmp_path: Pat
     assert robot.nano_cpus == 2_000_000_000 and robot.mem_bytes == 1_000_000_000
     assert robot.cap_drop == ("ALL",) and robot.security_opt == ("no-new-privileges",)
     assert robot.network_mode is not None and robot.network_mode.startswith("container:")
-    assert [m.target for m in robot.mounts] == ["/robocup-logs"]
+    assert [m.target for m in robot.mounts] == ["/robocup-logs", "/tmp", "/var/tmp", "/root"]
+    assert robot.read_only and robot.tmpfs == {"/run": "size=16m,mode=755"}
 
 
 def test_forfeit_when_a_team_has_no_usable_image(tmp_path: Path) -> None:
