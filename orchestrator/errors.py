@@ -10,7 +10,7 @@ Tree::
     ├── ImageError               an image cannot be used for a robot
     │   ├── ImagePullError       pull failed (auth, unknown tag, unreachable registry)
     │   ├── ImageTooLarge        over the size limit
-    │   ├── TeamImagesTooLarge   a team's images together over the team limit
+    │   │   └── TeamImagesTooLarge  a team's images together over the team limit
     │   └── BuildFailed          a project image did not build (engine/images.py)
     ├── MatchFailed              a match ended in a typed failure (see results.FailureClass)
     ├── DeliveryError            a log set could not be delivered (auth, host key, bucket, ...)
@@ -109,13 +109,16 @@ class ImageTooLarge(ImageError):
         )
 
 
-class TeamImagesTooLarge(ImageError):
-    """A team's images together (each layer once) are over the team limit."""
+class TeamImagesTooLarge(ImageTooLarge):
+    """A team's images together (each layer once) are over the team limit; ``size_bytes`` is
+    the team's total."""
 
     def __init__(self, *, image: str, team_bytes: int, limit_bytes: int) -> None:
         self.team_bytes = team_bytes
+        self.size_bytes = team_bytes
         self.limit_bytes = limit_bytes
-        super().__init__(
+        ImageError.__init__(
+            self,
             image=image,
             reason=f"the team's images take {team_bytes / 1e9:.2f} GB together (each layer "
             f"once), over the team limit of {limit_bytes / 1e9:.2f} GB",

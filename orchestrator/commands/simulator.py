@@ -96,7 +96,7 @@ def _models(args: argparse.Namespace) -> int:
 
 
 def _cli(args: argparse.Namespace) -> int:
-    from orchestrator.clibench import main as cli_main
+    from benchmarks.cli import main as cli_main
 
     return int(cli_main(list(args.rest)))
 

@@ -1,5 +1,7 @@
 """``hlvs bench cli``: wall time of ``hlvs --help`` (and of each command's ``--help``) in a fresh
-interpreter, as a user types it. Prints one JSON line; the target is 0.5 s for ``hlvs --help``."""
+interpreter, as a user types it. Prints one JSON line; the target is 0.5 s for ``hlvs --help``.
+``python_median_s`` is a bare ``python -c pass`` on the same machine at the same time, so that a
+loaded machine shows as such (``help_over_python_s`` is what hlvs adds)."""
 
 from __future__ import annotations
 
@@ -38,6 +40,16 @@ def time_help(args: Sequence[str], *, runs: int) -> list[float]:
     return times
 
 
+def time_python(*, runs: int) -> list[float]:
+    """Seconds of a bare ``python -c pass`` (the interpreter's own start-up)."""
+    times = []
+    for _ in range(runs):
+        started = time.perf_counter()
+        subprocess.run([sys.executable, "-c", "pass"], check=True)
+        times.append(time.perf_counter() - started)
+    return times
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="hlvs bench cli", description=__doc__)
     parser.add_argument("--runs", type=int, default=10, help="runs of each command (default 10)")
@@ -50,11 +62,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.runs < 1:
         parser.error("--runs: expected an integer >= 1")
     top = time_help([], runs=args.runs)
+    bare = time_python(runs=args.runs)
     result: dict[str, object] = {
         "bench": "cli",
         "runs": args.runs,
         "help_median_s": round(statistics.median(top), 4),
         "help_max_s": round(max(top), 4),
+        "python_median_s": round(statistics.median(bare), 4),
+        "help_over_python_s": round(statistics.median(top) - statistics.median(bare), 4),
         "target_s": TARGET_S,
         "ok": statistics.median(top) < TARGET_S,
     }
@@ -71,4 +86,4 @@ def main(argv: Sequence[str] | None = None) -> int:
     return 0
 
 
-__all__ = ["main", "time_help"]
+__all__ = ["main", "time_help", "time_python"]
