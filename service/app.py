@@ -37,6 +37,7 @@ ROUTER_MODULES: tuple[str, ...] = (
     "service.routers.submissions",
     "service.routers.operator",
     "envs.http_api",  # the HTTP environment API (learning environments)
+    "viewer.service_pages",  # the web front end: replays, live view, queue and standings pages
 )
 
 

@@ -25,9 +25,9 @@ import struct
 from collections.abc import AsyncIterator
 from functools import lru_cache
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
-from fastapi import APIRouter, FastAPI, HTTPException
+from fastapi import APIRouter, Depends, FastAPI, HTTPException
 from fastapi.responses import FileResponse, Response, StreamingResponse
 from fastapi.staticfiles import StaticFiles
 
@@ -35,7 +35,7 @@ from simulator.errors import ReplayError
 from simulator.replay import ReplayFile, scene_for
 from simulator.traffic import read_stats
 from viewer.live import FeedFactory, LiveUnavailable, ZenohFeed
-from viewer.sources import Catalog, ReplaySource
+from viewer.sources import Catalog, LiveSource, ReplaySource
 
 STATIC = Path(__file__).parent / "static"
 API_PREFIX = "/api/viewer"
@@ -68,31 +68,63 @@ class _OpenReplays:
             raise HTTPException(status_code=422, detail=str(exc)) from exc
 
 
-def build_router(catalog: Catalog, *, feed_factory: FeedFactory = ZenohFeed) -> APIRouter:
-    router = APIRouter()
-    replays = _OpenReplays()
+class Resolver(Protocol):
+    """Finds replays and live matches; each method is used as a FastAPI dependency, so an
+    implementation may ask for more (a token, a database session) in its own signature."""
 
-    def source_of(replay_id: str) -> ReplaySource:
-        source = catalog.replays.get(replay_id)
+    def replay(self, replay_id: str) -> ReplaySource: ...
+
+    def live(self, match_id: str) -> LiveSource: ...
+
+    def listing(self) -> tuple[list[ReplaySource], list[LiveSource]]: ...
+
+
+class CatalogResolver:
+    """Replays and live matches of a fixed :class:`Catalog` (``hlvs view``: no accounts)."""
+
+    def __init__(self, catalog: Catalog) -> None:
+        self.catalog = catalog
+
+    def replay(self, replay_id: str) -> ReplaySource:
+        source = self.catalog.replays.get(replay_id)
         if source is None:
-            raise _missing("replay", replay_id, list(catalog.replays))
+            raise _missing("replay", replay_id, list(self.catalog.replays))
         return source
 
+    def live(self, match_id: str) -> LiveSource:
+        live = self.catalog.live.get(match_id)
+        if live is None:
+            raise _missing("live match", match_id, list(self.catalog.live))
+        return live
+
+    def listing(self) -> tuple[list[ReplaySource], list[LiveSource]]:
+        return list(self.catalog.replays.values()), list(self.catalog.live.values())
+
+
+def build_router(resolver: Any, *, feed_factory: FeedFactory = ZenohFeed) -> APIRouter:
+    """The API and page routes; ``resolver`` is a :class:`Resolver`."""
+    router = APIRouter()
+    replays = _OpenReplays()
+    # dependencies as defaults: annotations are strings here and cannot name local aliases
+    by_id = Depends(resolver.replay)
+    live_by_id = Depends(resolver.live)
+    found_all = Depends(resolver.listing)
+
     @router.get(f"{API_PREFIX}/index")
-    def index() -> dict[str, Any]:
+    def index(found: tuple[list[ReplaySource], list[LiveSource]] = found_all) -> dict[str, Any]:
         listing = []
-        for source in catalog.replays.values():
+        sources, live = found
+        for source in sources:
             try:
                 replay, _ = replays.get(source)
             except HTTPException:
                 continue
             listing.append({"id": source.id, "match_id": replay.header.match_id,
                             "duration_ms": replay.duration_ms, "version": replay.header.version})
-        return {"replays": listing, "live": [{"id": key} for key in catalog.live]}
+        return {"replays": listing, "live": [{"id": source.id} for source in live]}
 
     @router.get(f"{API_PREFIX}/replays/{{replay_id}}/meta")
-    def meta(replay_id: str) -> dict[str, Any]:
-        source = source_of(replay_id)
+    def meta(source: ReplaySource = by_id) -> dict[str, Any]:
         replay, scene = replays.get(source)
         return {
             "id": source.id,
@@ -109,8 +141,8 @@ def build_router(catalog: Catalog, *, feed_factory: FeedFactory = ZenohFeed) -> 
         }
 
     @router.get(f"{API_PREFIX}/replays/{{replay_id}}/chunks/{{index}}")
-    def chunk(replay_id: str, index: int) -> Response:
-        replay, _ = replays.get(source_of(replay_id))
+    def chunk(index: int, source: ReplaySource = by_id) -> Response:
+        replay, _ = replays.get(source)
         if not 0 <= index < len(replay.chunks):
             raise HTTPException(
                 status_code=404, detail=f"chunk {index} out of range 0..{len(replay.chunks) - 1}"
@@ -128,17 +160,13 @@ def build_router(catalog: Catalog, *, feed_factory: FeedFactory = ZenohFeed) -> 
                         headers={"Cache-Control": "max-age=60"})
 
     @router.get(f"{API_PREFIX}/replays/{{replay_id}}/stats")
-    def stats(replay_id: str) -> list[dict[str, Any]]:
-        source = source_of(replay_id)
+    def stats(source: ReplaySource = by_id) -> list[dict[str, Any]]:
         return read_stats(source.stats_path) if source.stats_path is not None else []
 
     @router.get(f"{API_PREFIX}/live/{{match_id}}/stream")
-    async def stream(match_id: str) -> StreamingResponse:
-        live = catalog.live.get(match_id)
-        if live is None:
-            raise _missing("live match", match_id, list(catalog.live))
+    async def stream(live: LiveSource = live_by_id) -> StreamingResponse:
         return StreamingResponse(
-            _sse(live.endpoint, match_id, feed_factory), media_type="text/event-stream",
+            _sse(live.endpoint, live.match_id, feed_factory), media_type="text/event-stream",
             headers={"Cache-Control": "no-cache"},
         )
 
@@ -186,14 +214,14 @@ async def _sse(endpoint: str, match_id: str, factory: FeedFactory) -> AsyncItera
         await asyncio.to_thread(feed.close)
 
 
-def mount(app: FastAPI, catalog: Catalog, *, feed_factory: FeedFactory = ZenohFeed) -> None:
-    """Add the viewer's pages, API and static files to ``app``."""
+def mount_viewer(app: FastAPI, resolver: Any, *, feed_factory: FeedFactory = ZenohFeed) -> None:
+    """Add the viewer's pages, API and static files to ``app`` (``resolver``: a Resolver)."""
     app.mount("/watch/static", StaticFiles(directory=STATIC), name="viewer-static")
-    app.include_router(build_router(catalog, feed_factory=feed_factory))
+    app.include_router(build_router(resolver, feed_factory=feed_factory))
 
 
 def create_app(catalog: Catalog, *, feed_factory: FeedFactory = ZenohFeed) -> FastAPI:
     """The app of ``hlvs view``: the viewer alone, no account, no database."""
     app = FastAPI(title="hlvs view", docs_url=None, redoc_url=None)
-    mount(app, catalog, feed_factory=feed_factory)
+    mount_viewer(app, CatalogResolver(catalog), feed_factory=feed_factory)
     return app

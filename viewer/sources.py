@@ -29,7 +29,8 @@ class ReplaySource:
 
 @dataclass(frozen=True, slots=True)
 class LiveSource:
-    id: str  # the match id (telemetry keys hlvs/<id>/...)
+    id: str  # what the page's URL names it by
+    match_id: str  # telemetry keys hlvs/<match_id>/...
     endpoint: str  # zenoh endpoint, e.g. tcp/10.213.4.2:7447
     replay_path: Path | None  # where the replay is being written (shown once the match is over)
 
@@ -102,6 +103,15 @@ def _slug(path: Path) -> str:
     return _slug_text(path.stem)
 
 
+def live_of(folder: Path, *, id: str | None = None) -> LiveSource | None:
+    """The live source of a running match's folder (None when it has no telemetry)."""
+    live = _live_of(folder)
+    if live is not None and id is not None:
+        return LiveSource(id=id, match_id=live.match_id, endpoint=live.endpoint,
+                          replay_path=live.replay_path)
+    return live
+
+
 def _live_of(folder: Path) -> LiveSource | None:
     spec_path = folder / "simulator" / "match_spec.json"
     if not spec_path.is_file():
@@ -115,4 +125,6 @@ def _live_of(folder: Path) -> LiveSource | None:
     if not endpoint:
         return None
     replay = folder / "simulator" / "out" / "replay.hlvsrec"
-    return LiveSource(id=_slug_text(match_id), endpoint=str(endpoint), replay_path=replay)
+    return LiveSource(
+        id=_slug_text(match_id), match_id=match_id, endpoint=str(endpoint), replay_path=replay
+    )

@@ -3,12 +3,14 @@ import { livePage } from "./pages/live";
 import { indexPage } from "./pages/index";
 import { replayPage } from "./pages/replay";
 import { tablePage } from "./pages/tables";
-import { el } from "./ui";
+import { el, tokenBox } from "./ui";
 
 const API = "/api/viewer";
 
 async function route(): Promise<void> {
   const root = document.getElementById("app")!;
+  const nav = document.querySelector("nav");
+  if (nav) tokenBox(nav);
   const parts = location.pathname.replace(/^\/watch\/?/, "").split("/").filter(Boolean).map(decodeURIComponent);
   try {
     if (parts[0] === "replay" && parts[1]) await replayPage(root, API, parts[1]);

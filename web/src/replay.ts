@@ -2,6 +2,7 @@
 // frames on demand, so that opening and seeking never read the whole replay.
 
 import type { SceneSpec } from "./scene";
+import { authFetch } from "./ui";
 
 export interface RefereeEvent {
   type: string;
@@ -51,7 +52,7 @@ export class ReplayData {
   }
 
   static async open(base: string): Promise<ReplayData> {
-    const response = await fetch(`${base}/meta`);
+    const response = await authFetch(`${base}/meta`);
     if (!response.ok) throw new Error(`${base}/meta: ${response.status} ${await response.text()}`);
     return new ReplayData(base, (await response.json()) as ReplayMeta);
   }
@@ -77,7 +78,7 @@ export class ReplayData {
     if (have) return Promise.resolve(have);
     let waiting = this.pending.get(index);
     if (!waiting) {
-      waiting = fetch(`${this.base}/chunks/${index}`)
+      waiting = authFetch(`${this.base}/chunks/${index}`)
         .then(async (response) => {
           if (!response.ok) throw new Error(`chunk ${index}: ${response.status}`);
           const buffer = await response.arrayBuffer();

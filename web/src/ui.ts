@@ -56,8 +56,33 @@ export function describeEvent(e: { type: string; team?: string | null; player?: 
   return `${e.type}${who}${e.reason ? `: ${e.reason}` : ""}`;
 }
 
+const TOKEN_KEY = "hlvs-token";
+
+/** The service token the user entered (hlvs serve); none for hlvs view. */
+export function authHeaders(): Record<string, string> {
+  const token = localStorage.getItem(TOKEN_KEY);
+  return token ? { Authorization: `Bearer ${token}` } : {};
+}
+
+export function authFetch(url: string): Promise<Response> {
+  return fetch(url, { headers: authHeaders() });
+}
+
+/** A token box in the navigation bar: kept in this browser's local storage. */
+export function tokenBox(nav: HTMLElement): void {
+  const input = el("input", { type: "password", placeholder: "service token", "data-testid": "token", size: "28" });
+  input.value = localStorage.getItem(TOKEN_KEY) ?? "";
+  const save = el("button", { "data-testid": "token-save" }, "use token");
+  save.addEventListener("click", () => {
+    if (input.value) localStorage.setItem(TOKEN_KEY, input.value.trim());
+    else localStorage.removeItem(TOKEN_KEY);
+    location.reload();
+  });
+  nav.append(el("span", { class: "token" }, input, save));
+}
+
 export async function getJson<T>(url: string): Promise<T> {
-  const response = await fetch(url);
+  const response = await authFetch(url);
   if (!response.ok) throw new Error(`${url}: ${response.status} ${await response.text()}`);
   return (await response.json()) as T;
 }

@@ -17,6 +17,9 @@ from typing import Any
 
 import pytest
 
+# the service's fake-pool fixtures, for the pages served by hlvs serve
+from tests.unit.service.conftest import pool, settings, start, token  # noqa: F401
+
 CHROMIUM = "/usr/bin/chromium"
 LAUNCH_ARGS = ["--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--no-sandbox"]
 REPO = Path(__file__).parents[3]

@@ -2,7 +2,39 @@
 // from the viewer API), the real-time factor and each robot's connection health.
 import type { GameState, RefereeEvent } from "../replay";
 import { SceneView, type SceneSpec } from "../scene";
-import { Scoreboard, clock, describeEvent, el } from "../ui";
+import { Scoreboard, authHeaders, clock, describeEvent, el } from "../ui";
+
+type Handler = (data: string) => void;
+
+/** Server-sent events read with fetch, so that the token goes in a header (EventSource
+ * cannot send one). Calls `handlers[event]` with each message's data. */
+async function readEvents(url: string, handlers: Record<string, Handler>, status: HTMLElement): Promise<void> {
+  const response = await fetch(url, { headers: { ...authHeaders(), Accept: "text/event-stream" } });
+  if (!response.ok || !response.body) {
+    status.textContent = `live view unavailable: ${response.status} ${await response.text()}`;
+    return;
+  }
+  const reader = response.body.pipeThrough(new TextDecoderStream()).getReader();
+  let buffer = "";
+  for (;;) {
+    const { value, done } = await reader.read();
+    if (done) break;
+    buffer += value;
+    let cut: number;
+    while ((cut = buffer.indexOf("\n\n")) >= 0) {
+      const block = buffer.slice(0, cut);
+      buffer = buffer.slice(cut + 2);
+      let name = "message";
+      const data: string[] = [];
+      for (const line of block.split("\n")) {
+        if (line.startsWith("event: ")) name = line.slice(7);
+        else if (line.startsWith("data: ")) data.push(line.slice(6));
+      }
+      if (data.length) handlers[name]?.(data.join("\n"));
+    }
+  }
+  handlers.end?.("");
+}
 
 interface LiveState extends GameState {
   sim_time_ms: number;
@@ -33,22 +65,22 @@ export function livePage(root: HTMLElement, api: string, matchId: string): void 
   let updates = 0;
   let simTimeMs = 0;
   let rtf = 0;
-  const source = new EventSource(`${api}/live/${encodeURIComponent(matchId)}/stream`);
-  source.addEventListener("scene", (e) => {
+  const handlers: Record<string, Handler> = {};
+  handlers.scene = (data) => {
     if (view) return;
-    const header = JSON.parse((e as MessageEvent).data) as { scene: SceneSpec };
+    const header = JSON.parse(data) as { scene: SceneSpec };
     view = new SceneView(canvas, header.scene);
     if (latest) view.setPoses(latest);
-  });
-  source.addEventListener("poses", (e) => {
-    const { timeMs, poses } = decodePoses((e as MessageEvent).data);
+  };
+  handlers.poses = (data) => {
+    const { timeMs, poses } = decodePoses(data);
     latest = poses;
     simTimeMs = timeMs;
     updates += 1;
     view?.setPoses(poses);
-  });
-  source.addEventListener("state", (e) => {
-    const state = JSON.parse((e as MessageEvent).data) as LiveState;
+  };
+  handlers.state = (data) => {
+    const state = JSON.parse(data) as LiveState;
     board.update(state);
     rtf = state.real_time_factor;
     simTimeMs = Math.max(simTimeMs, state.sim_time_ms);
@@ -62,15 +94,18 @@ export function livePage(root: HTMLElement, api: string, matchId: string): void 
           el("td", {}, `${(r.bytes_in / 1000).toFixed(0)} / ${(r.bytes_out / 1000).toFixed(0)}`),
           el("td", {}, r.round_trip_ms === null ? "-" : r.round_trip_ms.toFixed(1)))),
     );
-  });
-  source.addEventListener("event", (e) => {
-    const event = JSON.parse((e as MessageEvent).data) as RefereeEvent;
+  };
+  handlers.event = (data) => {
+    const event = JSON.parse(data) as RefereeEvent;
     list.prepend(el("li", { "data-type": event.type }, `${clock(event.sim_time_ms)} ${describeEvent(event)}`));
-  });
-  source.addEventListener("end", () => {
-    status.textContent += "  (match over)";
-    source.close();
-  });
+  };
+  handlers.failure = (data) => {
+    status.textContent = `live view unavailable: ${JSON.parse(data)}`;
+  };
+  handlers.end = () => {
+    status.textContent += "  (stream closed)";
+  };
+  void readEvents(`${api}/live/${encodeURIComponent(matchId)}/stream`, handlers, status);
   function frame(): void {
     view?.render();
     requestAnimationFrame(frame);

@@ -1,7 +1,109 @@
-// Service pages (queue, schedule and standings, submissions, pool nodes): tables filled from the
-// submission service's API. Placeholder until the service routes are wired in.
-import { el } from "../ui";
+// Service pages, filled from hlvs serve's /v1 API with the token of the navigation bar:
+// a team's submissions (queue position, expected start, why it waits, results, replay and live
+// links), the operator's queue, the tournament schedule and standings, and the pool.
+import { el, getJson } from "../ui";
+
+interface Submission {
+  id: string;
+  team: string;
+  opponent: string;
+  state: string;
+  created_at: string;
+  started_at: string | null;
+  finished_at: string | null;
+  queue_position: number | null;
+  expected_start: string | null;
+  waiting_reason: string | null;
+  match_id: string | null;
+  failure_class: string | null;
+  cause: string | null;
+}
+
+interface Queue {
+  paused: boolean;
+  slots: number;
+  active: Submission[];
+}
+
+interface Schedule {
+  matches: Record<string, unknown>[];
+  standings: Record<string, unknown>[];
+}
+
+function when(iso: string | null): string {
+  return iso ? new Date(iso).toISOString().replace("T", " ").slice(0, 19) + " UTC" : "-";
+}
+
+export function table(testid: string, columns: string[], rows: (string | Node)[][]): HTMLTableElement {
+  return el("table", { "data-testid": testid },
+    el("tr", {}, ...columns.map((c) => el("th", {}, c))),
+    ...rows.map((cells) => el("tr", {}, ...cells.map((c) => el("td", {}, c)))));
+}
+
+function watchLinks(s: Submission): Node {
+  const links = el("span", {});
+  if (s.state === "running") links.append(el("a", { href: `/watch/live/${encodeURIComponent(s.id)}` }, "live"), " ");
+  if (s.state === "done" || s.state === "failed") links.append(el("a", { href: `/watch/replay/${encodeURIComponent(s.id)}` }, "replay"));
+  return links;
+}
+
+function queueRows(active: Submission[]): (string | Node)[][] {
+  return active.map((s) => [
+    s.queue_position === null ? "-" : String(s.queue_position), s.id, s.team, s.opponent, s.state,
+    when(s.expected_start), s.waiting_reason ?? "-",
+  ]);
+}
+
+const QUEUE_COLUMNS = ["position", "submission", "team", "opponent", "state", "expected start", "reason"];
+
+async function submissionsPage(root: HTMLElement): Promise<void> {
+  const rows = await getJson<Submission[]>("/v1/submissions");
+  root.append(el("h1", {}, "Your test matches"), table("submissions", [
+    "submission", "opponent", "state", "queue position", "expected start", "reason", "finished", "outcome", "watch",
+  ], rows.map((s) => [
+    s.id, s.opponent, s.state, s.queue_position === null ? "-" : String(s.queue_position), when(s.expected_start),
+    s.waiting_reason ?? "-", when(s.finished_at), s.failure_class ? `${s.failure_class}: ${s.cause ?? ""}` : (s.cause ?? "-"),
+    watchLinks(s),
+  ])));
+}
+
+async function queuePage(root: HTMLElement): Promise<void> {
+  const queue = await getJson<Queue>("/v1/operator/queue");
+  root.append(
+    el("h1", {}, "Queue"),
+    el("p", { "data-testid": "queue-summary" }, `${queue.paused ? "paused" : "running"}, ${queue.slots} match slot(s), ${queue.active.length} active`),
+    table("queue", QUEUE_COLUMNS, queueRows(queue.active)),
+  );
+}
+
+async function standingsPage(root: HTMLElement): Promise<void> {
+  const schedule = await getJson<Schedule>("/v1/operator/schedule");
+  const standingColumns = ["team", "played", "won", "drawn", "lost", "goals_for", "goals_against", "goal_difference", "points"];
+  root.append(
+    el("h1", {}, "Standings"),
+    table("standings", ["#", ...standingColumns], schedule.standings.map((s, i) => [String(i + 1), ...standingColumns.map((c) => String(s[c] ?? ""))])),
+    el("h1", {}, "Schedule"),
+    table("schedule", ["match", "kind", "red", "blue", "plays at", "state", "score"], schedule.matches.map((m) => {
+      const result = m.result as { score?: { red: number; blue: number } } | null;
+      return [String(m.id), String(m.kind), String(m.red), String(m.blue), when(String(m.play_at)), String(m.state),
+        result?.score ? `${result.score.red} : ${result.score.blue}` : "-"];
+    })),
+  );
+}
+
+async function poolPage(root: HTMLElement): Promise<void> {
+  const queue = await getJson<Queue>("/v1/operator/queue");
+  const running = queue.active.filter((s) => s.state === "running" || s.state === "starting");
+  root.append(
+    el("h1", {}, "Pool"),
+    el("p", { "data-testid": "pool-summary" }, `${queue.slots} match slot(s), ${running.length} in use${queue.paused ? ", queue paused" : ""}`),
+    table("pool", ["slot", "submission", "team", "state", "started"], running.map((s, i) => [String(i + 1), s.id, s.team, s.state, when(s.started_at)])),
+  );
+}
 
 export async function tablePage(root: HTMLElement, page: string, _arg?: string): Promise<void> {
-  root.append(el("h1", {}, page), el("p", { "data-testid": "error" }, "this page needs hlvs serve"));
+  if (page === "submissions") await submissionsPage(root);
+  else if (page === "queue") await queuePage(root);
+  else if (page === "standings" || page === "schedule") await standingsPage(root);
+  else await poolPage(root);
 }
