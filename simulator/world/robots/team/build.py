@@ -3,9 +3,10 @@
 What is added to a URDF or MJCF file as teams write it: a free base at the root link, position
 servos from the manifest, the IMU site and its sensors, the cameras, touch sensors for the foot
 force sensors, bodies marking the hands and feet for the referee, and a team-coloured marker.
-Collision geometry is simplified to one box per link (``collision: "link-boxes"``, the default:
-hundreds of small shapes cost more than the rest of the world) or kept as it is; visual meshes
-are kept for cameras and video.
+Collision geometry is simplified to one box per moving part, around the collision shapes of a
+link and of every link welded to it (``collision: "link-boxes"``, the default: hundreds of small
+shapes cost more than the rest of the world) or kept as it is; visual meshes are kept for
+cameras and video.
 
 Names follow the world's contract (see :mod:`simulator.world.robots.humanoid`): the root body
 ``<prefix>/torso`` with the free joint ``<prefix>/root``, joints and actuators by HLVS motor name,
@@ -88,6 +89,62 @@ def _link_boxes(model: mujoco.MjModel) -> dict[int, tuple[np.ndarray, np.ndarray
             lo, hi = np.minimum(lo, boxes[b][0]), np.maximum(hi, boxes[b][1])
         boxes[b] = (lo, hi)
     return boxes
+
+
+def _owner_boxes(model: mujoco.MjModel) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+    """Body id -> (min, max) corners, in that body's frame, of the collision geoms of the body
+    and of every body welded to it (no joint between them): one box per moving part. The feet's
+    cleats, sole plates and frames become one box per foot: a few contacts with the turf where
+    dozens of small shapes made hundreds."""
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+    boxes: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+    for g in range(model.ngeom):
+        if not (model.geom_contype[g] or model.geom_conaffinity[g]):
+            continue
+        owner = int(model.geom_bodyid[g])
+        while model.body_jntnum[owner] == 0 and model.body_parentid[owner] != 0:
+            owner = int(model.body_parentid[owner])
+        centre, half = model.geom_aabb[g][:3], model.geom_aabb[g][3:]
+        rot = data.geom_xmat[g].reshape(3, 3)
+        world = data.geom_xpos[g] + (centre + signs * half) @ rot.T
+        local = (world - data.xpos[owner]) @ data.xmat[owner].reshape(3, 3)
+        lo, hi = local.min(axis=0), local.max(axis=0)
+        if owner in boxes:
+            lo, hi = np.minimum(lo, boxes[owner][0]), np.maximum(hi, boxes[owner][1])
+        boxes[owner] = (lo, hi)
+    return boxes
+
+
+def _sensor_sites(
+    model: mujoco.MjModel,
+    manifest: Manifest,
+    owner_boxes: dict[int, tuple[np.ndarray, np.ndarray]],
+) -> dict[str, dict[str, tuple[np.ndarray, np.ndarray]]]:
+    """Owner link -> sensor link -> (min, max) of its touch sensor site in the owner's frame.
+
+    With one box per foot the turf touches the box's bottom corners, so each force sensor
+    measures the quarter of the sole (split at the box's centre) its link lies in, from 5 mm
+    below to 5 mm above the sole."""
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    out: dict[str, dict[str, tuple[np.ndarray, np.ndarray]]] = {}
+    for link in manifest.force_sensors.values():
+        body = model.body(link).id
+        owner = body
+        while model.body_jntnum[owner] == 0 and model.body_parentid[owner] != 0:
+            owner = int(model.body_parentid[owner])
+        if owner not in owner_boxes:
+            continue
+        lo, hi = owner_boxes[owner]
+        centre = (data.xpos[body] - data.xpos[owner]) @ data.xmat[owner].reshape(3, 3)
+        mid = (lo + hi) / 2
+        site_lo = np.where(centre < mid, lo - 2e-3, mid)
+        site_hi = np.where(centre < mid, mid, hi + 2e-3)
+        site_lo[2], site_hi[2] = lo[2] - 5e-3, lo[2] + 5e-3
+        out.setdefault(model.body(owner).name, {})[link] = (site_lo, site_hi)
+    return out
 
 
 def _parts(spec: mujoco.MjSpec, manifest: Manifest) -> dict[str, str]:
@@ -190,6 +247,8 @@ def build_template(spec: mujoco.MjSpec, manifest: Manifest, *, key: str) -> Temp
         raise ModelError(problems)
     original = spec.compile()
     boxes = _link_boxes(original)
+    owner_boxes = _owner_boxes(original)
+    sensor_sites = _sensor_sites(original, manifest, owner_boxes)
     parts = _parts(spec, manifest)
     root = spec.worldbody.bodies[0]
     root_name = root.name
@@ -222,8 +281,8 @@ def build_template(spec: mujoco.MjSpec, manifest: Manifest, *, key: str) -> Temp
             geom.density = 0
             if geom.type == mujoco.mjtGeom.mjGEOM_MESH:
                 geom.meshname = f"{key}:{geom.meshname}"
-        if manifest.collision == "link-boxes" and b in boxes:
-            lo, hi = boxes[b]
+        if manifest.collision == "link-boxes" and b in owner_boxes:
+            lo, hi = owner_boxes[b]
             box = body.add_geom()
             box.name = f"{p}/{part}:{link}"
             box.type = mujoco.mjtGeom.mjGEOM_BOX
@@ -246,14 +305,19 @@ def build_template(spec: mujoco.MjSpec, manifest: Manifest, *, key: str) -> Temp
             site = body.add_site()
             site.name = f"{p}/site:imu"
         for sensor, sensor_link in manifest.force_sensors.items():
-            if sensor_link == link:
+            if manifest.collision == "link-boxes" and sensor_link in sensor_sites.get(link, {}):
+                lo, hi = sensor_sites[link][sensor_link]
+            elif sensor_link == link and manifest.collision != "link-boxes":
                 lo, hi = boxes.get(b, (np.full(3, -0.01), np.full(3, 0.01)))
-                site = body.add_site()
-                site.name = f"{p}/site:{sensor}"
-                site.type = mujoco.mjtGeom.mjGEOM_BOX
-                site.pos = (lo + hi) / 2
-                site.size = (hi - lo) / 2 + 2e-3
-                site.group = 4
+                lo, hi = lo - 2e-3, hi + 2e-3
+            else:
+                continue
+            site = body.add_site()
+            site.name = f"{p}/site:{sensor}"
+            site.type = mujoco.mjtGeom.mjGEOM_BOX
+            site.pos = (lo + hi) / 2
+            site.size = (hi - lo) / 2
+            site.group = 4
         for group, side, hull in HULL:
             if getattr(manifest, group)[side] == link:
                 marker = body.add_body()
