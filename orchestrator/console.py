@@ -9,6 +9,7 @@ Domain code sees only :class:`Progress` and :class:`Task`; rich is imported only
 from __future__ import annotations
 
 import os
+import re
 import sys
 import time
 from collections.abc import Callable, Iterator
@@ -61,6 +62,8 @@ class _PlainTask:
         if self.done:
             return
         self.done = True
+        if not note and self.total:
+            self.completed = self.total  # done: all of it
         seconds = self.clock() - self.started
         amount = _amount(self.completed, self.unit) if self.completed else ""
         what = ", ".join(x for x in (note or "done", amount, f"{seconds:.1f} s") if x)
@@ -222,4 +225,18 @@ class PullTracker:
         self.task.update(completed=done, total=size or None)
 
 
-__all__ = ["NullProgress", "PlainProgress", "Progress", "PullTracker", "Task", "progress"]
+@dataclass
+class StepTracker:
+    """Build output lines (``Step 3/9 : RUN ...``) into a task of steps."""
+
+    task: Task
+
+    def __call__(self, line: str) -> None:
+        found = re.match(r"\s*Step (\d+)/(\d+)", line)
+        if found:
+            self.task.update(completed=int(found.group(1)) - 1, total=int(found.group(2)))
+
+
+__all__ = [
+    "NullProgress", "PlainProgress", "Progress", "PullTracker", "StepTracker", "Task", "progress",
+]

@@ -12,7 +12,6 @@ from __future__ import annotations
 import fcntl
 import hashlib
 import logging
-import re
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -21,7 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from orchestrator import image_inputs
-from orchestrator.console import NullProgress, Progress
+from orchestrator.console import NullProgress, Progress, StepTracker
 from orchestrator.engine import LABEL_PROJECT, connect
 from orchestrator.engine import images as engine_images
 from orchestrator.errors import ConfigError, ImageError, Problem
@@ -164,24 +163,28 @@ def ensure_image(
         log_path = BUILD_DIR / "logs" / f"{name}-{content}.log"
         log.info("building %s (build log: %s)", reference, log_path)
         task = (progress or NullProgress()).add(f"build {name}", unit="steps")
+        tracker = StepTracker(task)
 
         def steps(line: str) -> None:
             log.info("%s: %s", name, line)
-            found = re.match(r"Step (\d+)/(\d+)", line)
-            if found:
-                task.update(completed=int(found.group(1)) - 1, total=int(found.group(2)))
-        info = engine_images.build(
-            client,
-            context_dir=context_dir,
-            tag=reference,
-            build_args=build_args,
-            # LABEL_PROJECT marks what a match creates; containers inherit image labels, so
-            # images clear it (older bases still carry it).
-            labels={LABEL_PROJECT: "", LABEL_IMAGE: name, LABEL_CONTENT: content},
-            log_path=log_path,
-            network_mode=network_mode,
-            on_step=steps,
-        )
+            tracker(line)
+
+        try:
+            info = engine_images.build(
+                client,
+                context_dir=context_dir,
+                tag=reference,
+                build_args=build_args,
+                # LABEL_PROJECT marks what a match creates; containers inherit image labels, so
+                # images clear it (older bases still carry it).
+                labels={LABEL_PROJECT: "", LABEL_IMAGE: name, LABEL_CONTENT: content},
+                log_path=log_path,
+                network_mode=network_mode,
+                on_step=steps,
+            )
+        except ImageError:
+            task.finish("failed")
+            raise
         task.finish()
         seconds = time.monotonic() - started
         log.info("built %s in %.1f s (%.0f MB)", reference, seconds, info.size_bytes / 1e6)

@@ -15,7 +15,7 @@ import time
 import urllib.error
 import urllib.parse
 import urllib.request
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -65,6 +65,17 @@ class Manifest:
     def size_bytes(self) -> int:
         """Stored (compressed) size: each blob once."""
         return sum(self.blobs.values())
+
+
+def union_bytes(blob_sets: Iterable[Mapping[str, int]]) -> int:
+    """Bytes that several manifests occupy together: each blob (layer, config) counted once.
+
+    The one size rule of the league's team limit, for the registry janitor and for the pull.
+    """
+    blobs: dict[str, int] = {}
+    for blob_set in blob_sets:
+        blobs.update(blob_set)
+    return sum(blobs.values())
 
 
 @dataclass(frozen=True, slots=True)
@@ -314,4 +325,4 @@ def _next_link(header: str) -> str | None:
     return parsed.path + ("?" + parsed.query if parsed.query else "")
 
 
-__all__ = ["Manifest", "RegistryClient", "RegistryError"]
+__all__ = ["Manifest", "RegistryClient", "RegistryError", "union_bytes"]

@@ -17,7 +17,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
-from orchestrator.registry.client import RegistryClient
+from orchestrator.registry.client import RegistryClient, union_bytes
 
 log = logging.getLogger(__name__)
 
@@ -68,10 +68,7 @@ def registry_images(client: RegistryClient, team_of: TeamRule) -> list[RegistryI
 
 def stored_bytes(images: Sequence[RegistryImage]) -> int:
     """What ``images`` occupy together: a layer shared by several of them counts once."""
-    blobs: dict[str, int] = {}
-    for image in images:
-        blobs.update(image.blob_sizes())
-    return sum(blobs.values())
+    return union_bytes(image.blob_sizes() for image in images)
 
 
 @dataclass(frozen=True, slots=True)

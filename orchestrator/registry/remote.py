@@ -16,7 +16,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 from orchestrator.registry.auth import Credentials
-from orchestrator.registry.client import Manifest, RegistryClient
+from orchestrator.registry.client import Manifest, RegistryClient, union_bytes
 
 DOCKER_HUB = "registry-1.docker.io"
 INSECURE_ENV = "HLVS_INSECURE_REGISTRIES"  # comma-separated hosts spoken to over plain HTTP
@@ -90,12 +90,11 @@ def inspect_remote(
 
 
 def team_stored_bytes(images: list[RemoteImage]) -> int:
-    """What a team's images occupy in registries: each layer once (by registry and digest)."""
-    blobs: dict[tuple[str, str], int] = {}
-    for image in images:
-        for digest, size in image.manifest.blobs.items():
-            blobs[(image.registry, digest)] = size
-    return sum(blobs.values())
+    """What a team's images occupy in registries: each layer once per registry."""
+    return union_bytes(
+        {f"{image.registry}/{digest}": size for digest, size in image.manifest.blobs.items()}
+        for image in images
+    )
 
 
 __all__ = [

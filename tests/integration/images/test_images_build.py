@@ -2,10 +2,17 @@
 
 from __future__ import annotations
 
+import io
+from pathlib import Path
+
 import docker
 import pytest
 
+from orchestrator.console import PlainProgress, StepTracker
+from orchestrator.engine import images as engine_images
 from orchestrator.images import LABEL_CONTENT, LABEL_IMAGE, ensure_image, project_image
+from tests.conftest import TEST_LABEL
+from tests.integration.images.conftest import MakeImage
 
 pytestmark = pytest.mark.docker
 
@@ -42,3 +49,34 @@ def test_image_carries_its_content_hash_and_runs(docker_client: docker.DockerCli
         labels={"org.hlvs-runner.test": "1"},
     )
     assert output.decode().strip() == "(3, 11)"
+
+
+def test_build_steps_show_as_progress(
+    docker_client: docker.DockerClient, make_image: MakeImage, tmp_path: Path
+) -> None:
+    """A real build's ``Step n/m`` lines drive a progress task (plain lines off a terminal)."""
+    base = make_image("hlvs-runner-test/progress-base:v1", 1000)
+    (tmp_path / "extra.txt").write_text("x\n")
+    (tmp_path / "Dockerfile").write_text(
+        f'FROM {base}\nCOPY extra.txt /extra.txt\nLABEL {TEST_LABEL}="1"\n'
+    )
+    out = io.StringIO()
+    task = PlainProgress(out=out, interval_s=0.0).add("build progress-test", unit="steps")
+    reference = "hlvs-runner-test/progress-built:v1"
+    try:
+        engine_images.build(
+            docker_client, context_dir=tmp_path, tag=reference, build_args={},
+            labels={TEST_LABEL: "1"}, log_path=tmp_path / "build.log", network_mode="none",
+            on_step=StepTracker(task),
+        )
+        task.finish()
+    finally:
+        try:
+            docker_client.images.remove(reference, force=True)
+        except docker.errors.APIError:
+            pass
+    lines = out.getvalue().splitlines()
+    assert lines[0] == "build progress-test: started"
+    # FROM, COPY, LABEL and the build's labels: four steps, each announced as it starts.
+    assert "build progress-test: 2 steps of 4 steps (50 %)" in lines
+    assert lines[-1].startswith("build progress-test: done, 4 steps, ")
