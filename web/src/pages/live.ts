@@ -105,7 +105,9 @@ export function livePage(root: HTMLElement, api: string, matchId: string): void 
   handlers.end = () => {
     status.textContent += "  (stream closed)";
   };
-  void readEvents(`${api}/live/${encodeURIComponent(matchId)}/stream`, handlers, status);
+  readEvents(`${api}/live/${encodeURIComponent(matchId)}/stream`, handlers, status).catch((error) => {
+    status.textContent += `  (stream lost: ${error})`;
+  });
   function frame(): void {
     view?.render();
     requestAnimationFrame(frame);

@@ -13,10 +13,16 @@ interface Sample {
 type Series = { name: string; colour: string; points: [number, number][] };
 
 const SVG = "http://www.w3.org/2000/svg";
-const PALETTE = ["#d91f1a", "#f07a2a", "#c2185b", "#8e2424", "#1a40e6", "#2aa7f0", "#5e35b1", "#00897b"];
+const SHADES: Record<string, string[]> = {
+  red: ["#d91f1a", "#f07a2a", "#c2185b", "#8e2424"],
+  blue: ["#1a40e6", "#2aa7f0", "#5e35b1", "#00897b"],
+};
 
-function colourOf(robot: string, index: number): string {
-  return PALETTE[index % PALETTE.length] ?? TEAM_CSS[robot.split("_")[0]] ?? "#333";
+/** Red robots in reds, blue robots in blues ("red-2": the second red shade). */
+function colourOf(robot: string): string {
+  const [team, number] = robot.split(/[-_]/);
+  const shades = SHADES[team];
+  return shades ? shades[(Number(number) - 1 + shades.length) % shades.length] : TEAM_CSS[team] ?? "#333";
 }
 
 export function lineChart(title: string, unit: string, series: Series[], testid: string): HTMLElement {
@@ -67,8 +73,8 @@ export function statsSeries(samples: Sample[]): { rtf: Series[]; bandwidth: Seri
   const rtf = [{ name: "real-time factor", colour: "#2e7d32", points: samples.map((s) => [s.real_time_s, s.real_time_factor] as [number, number]) }];
   const bandwidth: Series[] = [];
   const latency: Series[] = [];
-  robots.forEach((robot, index) => {
-    const colour = colourOf(robot, index);
+  robots.forEach((robot) => {
+    const colour = colourOf(robot);
     const kb: [number, number][] = [];
     const rtt: [number, number][] = [];
     for (let i = 1; i < samples.length; i++) {
