@@ -54,7 +54,7 @@ class LocalSession:
         self._segments = field_segments(self.field)
         self._camera = robot_model(spec.model).camera
         self._closed = False
-        self._truth_plan: tuple[World, Any, slice, int] | None = None
+        self._plan: tuple[World, Any, Any, slice, int, int] | None = None
 
     # --- lifecycle ---------------------------------------------------------------------------
 
@@ -148,8 +148,8 @@ class LocalSession:
 
     def _frame(self) -> Frame:
         world = self._live_world("observe")
-        sensors = world.read_sensors(self.learner, SENSOR_NAMES)
-        frame = Frame(sim_time_ms=world.sim_time_ms, sensors=sensors, truth=self.truth(world))
+        sensors, truth = self._read(world)
+        frame = Frame(sim_time_ms=world.sim_time_ms, sensors=sensors, truth=truth)
         if self._renderer is not None:
             raw = self._renderer.render(self.learner)
             frame.image = np.frombuffer(raw, np.uint8).reshape(
@@ -168,20 +168,35 @@ class LocalSession:
         return frame
 
     def truth(self, world: World) -> FloatArray:
-        plan = self._truth_plan
+        return self._read(world)[1]
+
+    def _read(self, world: World) -> tuple[FloatArray, FloatArray]:
+        """The robot API sensors (``SENSOR_NAMES`` order) and the ground truth, in two gathers
+        (index arrays computed once per world)."""
+        plan = self._plan
         if plan is None or plan[0] is not world:
-            index = world.index
-            robot = index.by_id[self.learner]
-            q, d, r = index.ball_qpos, index.ball_dof, robot.root_qpos
-            qpos_at = np.array([q, q + 1, q + 2, r, r + 1, r + 3, r + 4, r + 5, r + 6, r + 2])
-            plan = self._truth_plan = (world, qpos_at, slice(d, d + 3), robot.torso_body * 9 + 8)
-        _, qpos_at, ball_dof, up_z = plan
+            plan = self._plan = self._read_plan(world)
+        _, qpos_at, sensordata_at, ball_dof, up_z, n = plan
         data = world.data
-        bx, by, bz, x, y, w, qx, qy, qz, z = data.qpos[qpos_at].tolist()
+        q = data.qpos[qpos_at]
+        sensors = np.concatenate((q[:n], data.sensordata[sensordata_at]))
+        bx, by, bz, x, y, w, qx, qy, qz, z = q[n:].tolist()
         vx, vy, vz = data.qvel[ball_dof].tolist()
         yaw = math.atan2(2 * (w * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
         up = float(data.xmat.reshape(-1)[up_z])
-        return np.array([bx, by, bz, vx, vy, vz, x, y, yaw, up, z])
+        return sensors, np.array([bx, by, bz, vx, vy, vz, x, y, yaw, up, z])
+
+    def _read_plan(self, world: World) -> tuple[World, Any, Any, slice, int, int]:
+        index = world.index
+        robot = index.by_id[self.learner]
+        q, d, r = index.ball_qpos, index.ball_dof, robot.root_qpos
+        truth_at = [q, q + 1, q + 2, r, r + 1, r + 3, r + 4, r + 5, r + 6, r + 2]
+        qpos_at = np.array([*robot.motor_qpos.tolist(), *truth_at], dtype=np.int64)
+        a, g = robot.accelerometer, robot.gyro
+        forces = [robot.forces[name] for name in SENSOR_NAMES[len(robot.motor_qpos) + 2 :]]
+        sensordata_at = np.array([a, a + 1, a + 2, g, g + 1, g + 2, *forces], dtype=np.int64)
+        up_z = robot.torso_body * 9 + 8
+        return world, qpos_at, sensordata_at, slice(d, d + 3), up_z, len(robot.motor_qpos)
 
     def attack_sign(self, color: TeamColor) -> float:
         """+1 when ``color`` attacks the goal at x > 0 now."""
