@@ -19,7 +19,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from types import FrameType
-from typing import Any
+from typing import Any, TextIO
 
 from orchestrator.config.loader import load_game
 from orchestrator.errors import InfrastructureError, OrchestratorError
@@ -89,7 +89,7 @@ def _pull_resolver(client: Any, loaded: Any) -> ImageResolver:
 
 def play(
     plan: MatchPlan, *, out_dir: Path, pull: bool, loaded: Any = None,
-    extra_labels: dict[str, str] | None = None,
+    extra_labels: dict[str, str] | None = None, view_stream: TextIO | None = None,
 ) -> MatchOutcome:
     """Play ``plan`` on the local engine with the real host controls, showing progress. The
     match id is claimed first (:class:`~orchestrator.match.ownership.MatchRunning` while another
@@ -108,19 +108,20 @@ def play(
                      len(leftovers.containers), len(leftovers.networks), plan.match_id)
         return _play(plan, out_dir=out_dir, pull=pull, loaded=loaded, client=client,
                      runtime=runtime, host=host,
-                     extra_labels={**(extra_labels or {}), LABEL_RUN: claim.record.run_id})
+                     extra_labels={**(extra_labels or {}), LABEL_RUN: claim.record.run_id},
+                     view_stream=view_stream)
 
 
 def _play(
     plan: MatchPlan, *, out_dir: Path, pull: bool, loaded: Any, client: Any, runtime: Any,
-    host: HostControl, extra_labels: dict[str, str],
+    host: HostControl, extra_labels: dict[str, str], view_stream: TextIO | None = None,
 ) -> MatchOutcome:
     from orchestrator.images import project_image
     from orchestrator.telemetry import LiveView, ZenohTelemetry
 
     simulator_image = project_image("simulator")
     images = _pull_resolver(client, loaded) if pull and loaded is not None else None
-    view = LiveView(match_id=plan.match_id)
+    view = LiveView(match_id=plan.match_id, stream=view_stream)
     with stop_on_signals() as stop_event:
         options = RunOptions(
             out_dir=out_dir, simulator_image=simulator_image, extra_labels=extra_labels or {},
@@ -206,7 +207,8 @@ def run_match_command(args: argparse.Namespace) -> int:
         print(f"hlvs: {warning}", file=sys.stderr)
     plan = plan_from_game(loaded, grace_period_s=args.grace)
     out = args.out or user_path(Path("matches") / plan.match_id)
-    outcome = play(plan, out_dir=out, pull=True, loaded=loaded)
+    outcome = play(plan, out_dir=out, pull=True, loaded=loaded,
+                   view_stream=sys.stderr if getattr(args, "json", False) else None)
     return summarize(outcome, as_json=getattr(args, "json", False))
 
 
@@ -215,7 +217,8 @@ def run_scrimmage_command(args: argparse.Namespace) -> int:
     game_path = scrimmage.write_files(args, out / "config")
     loaded = load_game(game_path, images_required=True)
     plan = plan_from_game(loaded, grace_period_s=args.grace)
-    outcome = play(plan, out_dir=out, pull=False, loaded=loaded)
+    outcome = play(plan, out_dir=out, pull=False, loaded=loaded,
+                   view_stream=sys.stderr if getattr(args, "json", False) else None)
     return summarize(outcome, as_json=getattr(args, "json", False))
 
 

@@ -75,13 +75,16 @@ def test_scrimmage_with_a_team_of_wolfgang_models_plays_to_the_end(
     try:
         code = hlvs(["scrimmage", "--out", "wolf", "--red-model", str(wolfgang),
                      "--half-duration", "4", "--wait-before-ready", "1", "--grace", "2",
-                     "--match-id", match_id])
+                     "--match-id", match_id, "--json"])
+        printed = capsys.readouterr()
     finally:
         hlvs(["cleanup", "--match", match_id])
-    printed = capsys.readouterr()
     assert code == 0, printed.err[-3000:]
     out = tmp_path / "wolf"
+    printed_results = json.loads(printed.out)  # --json: stdout holds the one JSON document
+    assert printed_results["exit_code"] == 0 and printed_results["out_dir"] == str(out)
     results = json.loads((out / "results.json").read_text())
+    assert printed_results["final_state"] == results["final_state"]
     assert results["final_state"] == "FINISHED" and results["status"] == "success"
     spec = json.loads((out / "simulator" / "match_spec.json").read_text())
     models = {t["color"]: t["players"][0]["model"] for t in (spec["red"], spec["blue"])}
