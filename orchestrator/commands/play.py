@@ -17,6 +17,7 @@ import sys
 import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
+from dataclasses import replace
 from pathlib import Path
 from types import FrameType
 from typing import Any, TextIO
@@ -37,6 +38,7 @@ from orchestrator.match import (
     plan_from_game,
     scrimmage,
 )
+from orchestrator.match.admission import HostResources, admit
 from orchestrator.match.cleanup import clean_match
 from orchestrator.match.ownership import LABEL_RUN
 from orchestrator.match.runner import ImageResolver
@@ -93,10 +95,14 @@ def play(
 ) -> MatchOutcome:
     """Play ``plan`` on the local engine with the real host controls, showing progress. The
     match id is claimed first (:class:`~orchestrator.match.ownership.MatchRunning` while another
-    orchestrator plays it); what a dead earlier run of it left is salvaged and removed."""
+    orchestrator plays it); what a dead earlier run of it left is salvaged and removed. An
+    official match that does not fit the host is refused before all that
+    (:mod:`orchestrator.match.admission`)."""
     from orchestrator.engine import connect
     from orchestrator.engine.containers import DockerRuntime
 
+    verdict = admit(plan, host=HostResources.local(), official=plan.official)
+    plan = replace(plan, admission=verdict.to_json())
     client = connect()
     runtime = DockerRuntime(client)
     host = HostControl.for_current_user()

@@ -1,4 +1,4 @@
-"""``hlvs render`` and ``hlvs bench sim|api|stub|envs|bringup|delivery|cli|viewer|scrimmage``:
+"""``hlvs render`` and ``hlvs bench sim|api|stub|envs|bringup|delivery|cli|viewer|scrimmage|hog``:
 commands with parsers of their own, to which the arguments are forwarded unread (``--help``
 included).
 
@@ -64,9 +64,18 @@ def register(sub: Any) -> None:
         kinds, "viewer", help="the web viewer: open and play a 2 x 10 min 4 v 4 replay (JSON)",
         func=_viewer,
     )
+    forward(kinds, "hog",
+            help="a CPU-hogging robot: the others' real-time factor against a match without "
+            "it, under the admission rules (JSON)", func=_hog)
     forward(kinds, "scrimmage",
             help="K default scrimmages: halves reaching PLAYING, kicks, goals, wall time (JSON)",
             func=_scrimmage)
+
+
+def _hog(args: argparse.Namespace) -> int:
+    from benchmarks.hog import main as hog_main
+
+    return int(hog_main(list(args.rest)))
 
 
 def _scrimmage(args: argparse.Namespace) -> int:

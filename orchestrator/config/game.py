@@ -121,6 +121,7 @@ def build_game(document: Any, where: Collector, *, source: Path) -> GameConfig |
         limits=_limits(document.get("limits", {})),
         timing=timing,
         allow_internet=document.get("allow_internet", False),
+        official=document.get("official", False),
         public_logs=public_logs,
     )
 

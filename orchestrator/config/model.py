@@ -101,6 +101,7 @@ class GameConfig:
     limits: Limits = field(default_factory=Limits)
     timing: Timing = field(default_factory=Timing)
     allow_internet: bool = False
+    official: bool = False  # refused when it does not fit the host (see match.admission)
     public_logs: Path | None = None  # credentials.json-style target for the public logs
 
     def team(self, color: Color) -> TeamRef:

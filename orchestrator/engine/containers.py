@@ -82,6 +82,8 @@ class DockerRuntime:
             "memswap_limit": request.mem_bytes,
             "pids_limit": request.pids_limit,
             "read_only": request.read_only or None,
+            "cpu_shares": request.cpu_shares,
+            "cpuset_cpus": request.cpuset_cpus,
             "tmpfs": dict(request.tmpfs) or None,
             "network_mode": request.network_mode
             or (request.networks[0].network if request.networks else "none"),

@@ -229,6 +229,7 @@ def _write(runner: MatchRunner) -> dict[str, Any]:
         failure=runner.failure,
     )
     results["bringup_s"] = runner.bringup_s
+    results["admission"] = dict(plan.admission) if plan.admission is not None else None
     write_results(out, results)
     lifecycle = runner.lifecycle
     if lifecycle.state is MatchState.COLLECTING:

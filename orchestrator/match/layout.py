@@ -27,6 +27,7 @@ from orchestrator.engine import (
     LABEL_ROLE,
     LABEL_TEAM,
 )
+from orchestrator.match.admission import SIMULATOR_CPU_SHARES
 from orchestrator.match.plan import MatchPlan, RobotPlan
 from orchestrator.match.runtime import (
     Attachment,
@@ -202,6 +203,7 @@ def simulator_request(
         networks=attachments,
         mounts=(BindMount(source=match_dir, target=MATCH_TARGET), *models),
         hostname="simulator",
+        cpu_shares=SIMULATOR_CPU_SHARES,
         cap_drop=("ALL",),
         security_opt=("no-new-privileges",),
     )

@@ -50,6 +50,8 @@ class MatchPlan:
     spec_builder: SpecBuilder
     limits: Limits = field(default_factory=Limits)
     allow_internet: bool = False
+    official: bool = False
+    admission: Mapping[str, Any] | None = None  # the admission verdict, copied into results
     grace_period_s: float = 120.0
     telemetry: bool = True  # ask the simulator for zenoh telemetry on the control network
     telemetry_silence_s: float = 30.0  # fail the match when telemetry stays silent this long
@@ -94,6 +96,7 @@ def plan_from_game(loaded: LoadedGame, *, grace_period_s: float | None = None) -
         spec_builder=build,
         limits=game.limits,
         allow_internet=game.allow_internet,
+        official=game.official,
         grace_period_s=game.timing.grace_period_s if grace_period_s is None else grace_period_s,
         model_dirs=tuple(
             dict.fromkeys(

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 from orchestrator.bandwidth import AppliedShaping, RobotShaping, mb_s_to_bit
 from orchestrator.errors import InfrastructureError, OrchestratorError
 from orchestrator.match import layout
+from orchestrator.match.admission import cpu_sets
 from orchestrator.match.layout import Subnet
 from orchestrator.match.logfs import LogFolder, safe_name
 from orchestrator.match.plan import RobotPlan, per_robot_rate_mb_s
@@ -99,6 +100,7 @@ def start(runner: MatchRunner, started_at: float) -> None:
         attachments=attachments, extra_labels=runner.options.extra_labels,
         command=runner.options.simulator_command, model_dirs=plan.model_dirs,
     )
+    request = replace(request, cpuset_cpus=cpu_sets().simulator)
     _start_simulator(runner, request)  # first: it boots while the robots start
     robots = [r for r in plan.robots if runner.records[r.key].image_error is None]
     with ThreadPoolExecutor(max_workers=max(1, min(8, len(robots)))) as pool:
@@ -185,6 +187,8 @@ def _start_robot(runner: MatchRunner, robot: RobotPlan) -> None:
             extra_labels=runner.options.extra_labels,
             scratch_dir=scratch.path if scratch is not None else None,
         )
+        request = replace(request, cpuset_cpus=cpu_sets().robots)
+        record.limits["cpuset"] = request.cpuset_cpus
         container_id = runner.runtime.create_container(request)
         started.robot_ids[robot.key] = container_id
         record.container = request.name

@@ -19,7 +19,7 @@ SCRATCH_GB = 0.05
 @pytest.fixture(scope="module")
 def hostile(prepare: Prepare, docker_client: docker.DockerClient
             ) -> tuple[Prepared, Any, list[str]]:
-    match = prepare("special-files", "fill=/var/tmp/big", "fill=/opt/big", "spoof",
+    match = prepare("special-files", "fill=/var/tmp/big", "fill=/opt/big", "spoof", "hog=4",
                     game={"limits": {"scratch_gb": SCRATCH_GB}})
     done = match.run()
     assert done.returncode == 0, done.stderr[-3000:]
@@ -93,3 +93,32 @@ def test_writing_past_the_scratch_space_fails_inside_the_robot_only(
     assert "Read-only file system" in root["result"] and root["bytes"] == 0, root
     limits = match.results()["robots"]["red-1"]["limits"]
     assert limits["scratch_bytes"] == int(SCRATCH_GB * 1e9) and limits["read_only_root"]
+
+
+def test_a_cpu_hog_is_held_to_its_limit_and_the_overcommit_is_recorded(
+    hostile: tuple[Prepared, Any, list[str]],
+) -> None:
+    """Two robots of 1 CPU and the simulator do not fit 2 CPUs: a scrimmage plays with the
+    warning in the result; the hogging robot stays within its CPUs, the game still finishes."""
+    match, _, _ = hostile
+    results = match.results()
+    admission = results["admission"]
+    if admission["fits"]:
+        pytest.skip(f"this host fits the match: {admission}")
+    assert admission["official"] is False and "does not fit" in admission["warning"]
+    assert admission["cpus"]["needed"] == 3.0
+    red = results["robots"]["red-1"]
+    assert red["cpu_peak_percent"] <= 100 * red["limits"]["nano_cpus"] / 1e9 * 1.3
+    assert results["final_state"] == "FINISHED" and results["status"] == "success"
+
+
+def test_an_official_match_that_does_not_fit_is_refused_with_the_numbers(
+    prepare: Prepare, docker_client: docker.DockerClient,
+) -> None:
+    match = prepare("spoof", game={"official": True, "limits": {"cpus": 4, "memory_gb": 16}})
+    done = match.run(timeout_s=60)
+    assert done.returncode == 1, done.stderr[-2000:]
+    assert f"official match {match.match_id} refused" in done.stderr
+    assert "CPUs needed 9 (robots' limits + simulator 1) >" in done.stderr
+    assert not match.out.exists()
+    assert left_behind(docker_client, match.match_id) == []

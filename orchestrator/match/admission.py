@@ -1,0 +1,146 @@
+"""Admission: does a match fit the machine it is about to run on?
+
+The robots' CPU and memory limits plus what the simulator needs (:data:`SIMULATOR_CPUS`,
+:data:`SIMULATOR_MEMORY_GB`) are compared with what the host (or the pool node) has. An official
+match that does not fit is refused with the numbers; any other match (a scrimmage, a test match)
+is played with a warning recorded in ``results.json`` (``admission``). Whatever the verdict, the
+simulator container gets :data:`SIMULATOR_CPU_SHARES` (robots keep Docker's 1024), so under
+contention the kernel gives it its share first, and on a local engine with more CPUs than the
+simulator needs the CPUs are split (:func:`cpu_sets`): the simulator's own, which no robot may
+use, and the robots'. A team cannot starve the simulator.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import os
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+from orchestrator.errors import OrchestratorError
+from orchestrator.match.plan import MatchPlan
+
+log = logging.getLogger(__name__)
+
+SIMULATOR_CPUS = 1.0  # the step thread needs a core of its own
+SIMULATOR_MEMORY_GB = 2.0
+SIMULATOR_CPU_SHARES = 8192  # 8x a robot's weight when CPUs are contended
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class HostResources:
+    cpus: float
+    memory_gb: float
+    name: str = "this host"
+
+    @classmethod
+    def local(cls) -> HostResources:
+        """The CPUs this process may run on and the machine's memory."""
+        cpus = float(len(os.sched_getaffinity(0)))
+        memory_gb = 0.0
+        try:
+            for line in Path("/proc/meminfo").read_text().splitlines():
+                if line.startswith("MemTotal:"):
+                    memory_gb = int(line.split()[1]) * 1024 / 1e9
+                    break
+        except OSError:
+            pass
+        return cls(cpus=cpus, memory_gb=memory_gb)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Admission:
+    official: bool
+    fits: bool
+    robots: int
+    needed_cpus: float
+    available_cpus: float
+    needed_memory_gb: float
+    available_memory_gb: float
+    host: str
+
+    def shortfall(self) -> str:
+        """The numbers, e.g. ``CPUs: 8 robots x 4 + simulator 1 = 33 > 2 on this host``."""
+        parts = []
+        if self.needed_cpus > self.available_cpus:
+            parts.append(f"CPUs needed {self.needed_cpus:g} (robots' limits + simulator "
+                         f"{SIMULATOR_CPUS:g}) > {self.available_cpus:g} available")
+        if self.needed_memory_gb > self.available_memory_gb:
+            parts.append(f"memory needed {self.needed_memory_gb:g} GB (robots' limits + "
+                         f"simulator {SIMULATOR_MEMORY_GB:g} GB) > "
+                         f"{self.available_memory_gb:.1f} GB available")
+        return "; ".join(parts)
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "official": self.official, "fits": self.fits, "host": self.host,
+            "robots": self.robots,
+            "cpus": {"needed": self.needed_cpus, "available": self.available_cpus},
+            "memory_gb": {"needed": round(self.needed_memory_gb, 3),
+                          "available": round(self.available_memory_gb, 3)},
+            "simulator_cpu_shares": SIMULATOR_CPU_SHARES,
+            "warning": None if self.fits else
+            f"the match does not fit {self.host}: {self.shortfall()}; played anyway (not "
+            "official), so speeds and results may suffer",
+        }
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class CpuSets:
+    simulator: str | None  # cpuset of the simulator container (None: no pinning)
+    robots: str | None  # cpuset of every robot container
+
+
+def cpu_sets() -> CpuSets:
+    """The first ``ceil(SIMULATOR_CPUS)`` CPUs this process may use for the simulator, the rest
+    for the robots; no pinning with a remote engine (``DOCKER_HOST`` not a local socket) or when
+    there are no CPUs left for the robots."""
+    remote = os.environ.get("DOCKER_HOST", "unix://")
+    allowed = sorted(os.sched_getaffinity(0))
+    reserved = math.ceil(SIMULATOR_CPUS)
+    if not remote.startswith("unix://") or len(allowed) <= reserved:
+        return CpuSets(simulator=None, robots=None)
+    return CpuSets(simulator=",".join(map(str, allowed[:reserved])),
+                   robots=",".join(map(str, allowed[reserved:])))
+
+
+class AdmissionRefused(OrchestratorError):
+    def __init__(self, admission: Admission, match_id: str) -> None:
+        self.admission = admission
+        self.match_id = match_id
+        super().__init__(
+            f"official match {match_id} refused: it does not fit {admission.host}: "
+            f"{admission.shortfall()}; lower limits.cpus / limits.memory_gb in game.json or "
+            "run it on a larger machine"
+        )
+
+
+def admit(plan: MatchPlan, *, host: HostResources, official: bool) -> Admission:
+    """The verdict for ``plan``; raises :class:`AdmissionRefused` for an official match that
+    does not fit."""
+    robots = len(plan.robots)
+    limits = plan.limits
+    admission = Admission(
+        official=official, robots=robots, host=host.name,
+        needed_cpus=round(robots * limits.cpus + SIMULATOR_CPUS, 3),
+        available_cpus=host.cpus,
+        needed_memory_gb=robots * limits.memory_gb + SIMULATOR_MEMORY_GB,
+        available_memory_gb=host.memory_gb,
+        fits=False,
+    )
+    fits = (admission.needed_cpus <= host.cpus + 1e-9
+            and admission.needed_memory_gb <= host.memory_gb + 1e-9)
+    admission = replace(admission, fits=fits)
+    if not fits:
+        if official:
+            raise AdmissionRefused(admission, plan.match_id)
+        log.warning("match %s: %s", plan.match_id, admission.to_json()["warning"])
+    return admission
+
+
+__all__ = [
+    "Admission", "AdmissionRefused", "CpuSets", "HostResources", "SIMULATOR_CPUS",
+    "SIMULATOR_CPU_SHARES", "SIMULATOR_MEMORY_GB", "admit", "cpu_sets",
+]

@@ -1,0 +1,38 @@
+"""Admission of a match against the host's CPUs and memory."""
+
+from __future__ import annotations
+
+import pytest
+
+from orchestrator.config import Limits
+from orchestrator.match import MatchPlan, RobotPlan, TeamPlan
+from orchestrator.match.admission import AdmissionRefused, HostResources, admit
+
+
+def _plan(robots: int, limits: Limits) -> MatchPlan:
+    def team(color: str) -> TeamPlan:
+        return TeamPlan(color=color, name=color, robots=tuple(
+            RobotPlan(color=color, number=n, port=10000 + n, image="img")
+            for n in range(1, robots + 1)))
+
+    return MatchPlan(match_id="m", seed=1, red=team("red"), blue=team("blue"),
+                     spec_builder=lambda a, t: {}, limits=limits)
+
+
+def test_the_league_default_does_not_fit_a_small_host_and_is_refused_when_official() -> None:
+    host = HostResources(cpus=2.0, memory_gb=24.0)
+    plan = _plan(4, Limits())
+    with pytest.raises(AdmissionRefused) as refused:
+        admit(plan, host=host, official=True)
+    text = str(refused.value)
+    assert "CPUs needed 33 (robots' limits + simulator 1) > 2 available" in text
+    assert "memory needed 130 GB" in text and "24.0 GB available" in text
+    verdict = admit(plan, host=host, official=False)  # a scrimmage plays, with the warning
+    assert not verdict.fits and "does not fit" in str(verdict.to_json()["warning"])
+
+
+def test_a_match_that_fits_has_no_warning() -> None:
+    verdict = admit(_plan(1, Limits(cpus=0.5, memory_gb=1)),
+                    host=HostResources(cpus=2.0, memory_gb=8.0), official=True)
+    assert verdict.fits and verdict.to_json()["warning"] is None
+    assert verdict.to_json()["cpus"] == {"needed": 2.0, "available": 2.0}
