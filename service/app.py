@@ -51,6 +51,8 @@ class Services:
     pool: Any = None  # service.pool.MatchPool
     worker: Any = None  # service.worker.QueueWorker
     preflight: Preflight | None = None
+    queue: Any = None  # service.submissions.QueueBoard
+    tokens: Any = None  # service.tokens.TokenCache
     extras: dict[str, Any] = field(default_factory=dict)
 
 
@@ -73,6 +75,10 @@ def create_app(
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
+        import anyio.to_thread
+
+        # Request handlers run in this many threads: more only fight over the GIL.
+        anyio.to_thread.current_default_thread_limiter().total_tokens = settings.threads
         settings.data_dir.mkdir(parents=True, exist_ok=True)
         engine = make_engine(settings.db_url)
         migrate(engine)
@@ -81,8 +87,14 @@ def create_app(
             from service.preflight import PreflightChecker
 
             checker = PreflightChecker()
+        from service.submissions import MatchTimes, QueueBoard
+        from service.tokens import TokenCache
+
         services = Services(settings=settings, engine=engine, sessions=session_factory(engine),
-                            preflight=preflight or checker)
+                            preflight=preflight or checker,
+                            queue=QueueBoard(times=MatchTimes(
+                                default_s=settings.expected_match_s)),
+                            tokens=TokenCache(ttl_s=settings.token_cache_s))
         app.state.services = services
         from service.pool import make_pool
 

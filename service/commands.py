@@ -102,6 +102,19 @@ def register(sub: Any) -> None:
     from service.client import register as register_client
 
     register_client(sub, guarded)
+    bench = sub.choices.get("bench")
+    if bench is not None:
+        from orchestrator.cli import forward
+
+        kinds = next(a for a in bench._actions if isinstance(a, argparse._SubParsersAction))
+        forward(kinds, "service", help="the submission service under 200 polling and 20 "
+                                       "submitting clients (JSON)", func=_bench)
+
+
+def _bench(args: argparse.Namespace) -> int:
+    from service.bench import main as bench_main
+
+    return int(bench_main(list(args.rest)))
 
 
 def _sessions(args: argparse.Namespace) -> Any:

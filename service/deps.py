@@ -54,11 +54,15 @@ DbSession = Annotated[Session, Depends(get_db)]
 
 
 def require_token(
+    request: Request,
     session: DbSession,
     credentials: Annotated[HTTPAuthorizationCredentials | None, Depends(_bearer)],
 ) -> tokens.Principal:
     presented = credentials.credentials if credentials is not None else None
-    return tokens.verify(session, presented)
+    cache = get_services(request).tokens
+    principal = cache.verify(session, presented) if cache else tokens.verify(session, presented)
+    session.commit()  # gives the connection back: a handler may read a body or wait first
+    return principal
 
 
 def require_team(

@@ -27,6 +27,10 @@ class Settings:
     """SQLAlchemy URL; empty: ``sqlite:///<data_dir>/service.sqlite``. PostgreSQL:
     ``postgresql+psycopg://user:password@host/db``."""
     max_upload_bytes: int = 1_000_000
+    threads: int = 8
+    """Threads that run request handlers (database work); more mostly contend for the GIL."""
+    token_cache_s: float = 2.0
+    """A verified token is trusted this long without a query (a revocation takes this long)."""
     token_days: float = 90.0
     """Lifetime of a newly issued token (``hlvs admin token issue --days`` overrides)."""
     match_slots: int = 1

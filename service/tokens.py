@@ -12,6 +12,8 @@ import hmac
 import logging
 import re
 import secrets
+import threading
+import time
 from dataclasses import dataclass
 from datetime import datetime, timedelta
 
@@ -34,6 +36,7 @@ class Principal:
     scope: Scope
     team_id: int | None
     team_name: str | None
+    expires_at: datetime | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -88,21 +91,48 @@ def verify(session: Session, presented: str | None) -> Principal:
     if match is None:
         raise AuthError("malformed", "the token is malformed (expected hlvs_<id>_<secret>)")
     token_id, secret = match.groups()
-    token = session.get(Token, token_id)
-    if token is None or not hmac.compare_digest(token.secret_sha256, _digest(secret)):
+    row = session.execute(
+        select(Token.secret_sha256, Token.scope, Token.team_id, Token.revoked_at,
+               Token.expires_at, Team.name)
+        .outerjoin(Team, Team.id == Token.team_id).where(Token.id == token_id)).first()
+    if row is None or not hmac.compare_digest(row.secret_sha256, _digest(secret)):
         raise AuthError("unknown", "the token is not known to this service")
-    if token.revoked_at is not None:
+    if row.revoked_at is not None:
         raise AuthError("revoked", f"the token {token_id} was revoked at "
-                        f"{utc(token.revoked_at).isoformat(timespec='seconds')}")
-    if token.expires_at is not None and utc(token.expires_at) <= now():
+                        f"{utc(row.revoked_at).isoformat(timespec='seconds')}")
+    if row.expires_at is not None and utc(row.expires_at) <= now():
         raise AuthError("expired", f"the token {token_id} expired at "
-                        f"{utc(token.expires_at).isoformat(timespec='seconds')}")
-    team_name = None
-    if token.team_id is not None:
-        team = session.get(Team, token.team_id)
-        team_name = team.name if team else None
-    return Principal(token_id=token_id, scope=Scope(token.scope), team_id=token.team_id,
-                     team_name=team_name)
+                        f"{utc(row.expires_at).isoformat(timespec='seconds')}")
+    return Principal(token_id=token_id, scope=Scope(row.scope), team_id=row.team_id,
+                     team_name=row.name,
+                     expires_at=utc(row.expires_at) if row.expires_at else None)
 
 
-__all__ = ["IssuedToken", "Principal", "TOKEN_RE", "issue", "revoke", "verify"]
+class TokenCache:
+    """Tokens verified in the last ``ttl_s`` seconds (keyed by their SHA-256), so that a client
+    polling every second costs no token query. A revoked token is refused at the latest
+    ``ttl_s`` after the revocation; expiry is checked on every use."""
+
+    def __init__(self, *, ttl_s: float = 2.0, max_entries: int = 10_000) -> None:
+        self.ttl_s = ttl_s
+        self.max_entries = max_entries
+        self._entries: dict[str, tuple[Principal, float]] = {}
+        self._lock = threading.Lock()
+
+    def verify(self, session: Session, presented: str | None) -> Principal:
+        key = _digest(presented or "")
+        with self._lock:
+            hit = self._entries.get(key)
+        if hit is not None and time.monotonic() - hit[1] < self.ttl_s:
+            principal = hit[0]
+            if principal.expires_at is None or principal.expires_at > now():
+                return principal
+        principal = verify(session, presented)
+        with self._lock:
+            if len(self._entries) >= self.max_entries:
+                self._entries.clear()
+            self._entries[key] = (principal, time.monotonic())
+        return principal
+
+
+__all__ = ["IssuedToken", "Principal", "TOKEN_RE", "TokenCache", "issue", "revoke", "verify"]

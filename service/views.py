@@ -5,12 +5,13 @@ from __future__ import annotations
 
 from datetime import datetime
 
+from fastapi import Request
 from pydantic import BaseModel, ConfigDict, Field
 from sqlalchemy.orm import Session
 
 from service.db import Submission, Team, utc
 from service.settings import Settings
-from service.submissions import queue_info
+from service.submissions import QueueBoard
 
 
 class Links(BaseModel):
@@ -54,12 +55,15 @@ class SubmissionCreate(BaseModel):
 
 
 def submission_view(session: Session, row: Submission, settings: Settings, *,
-                    slots: int) -> SubmissionView:
-    team = session.get(Team, row.team_id)
-    info = queue_info(session, row, slots=slots, default_match_s=settings.expected_match_s)
+                    slots: int, queue: QueueBoard, team_name: str | None = None
+                    ) -> SubmissionView:
+    if team_name is None:
+        team = session.get(Team, row.team_id)
+        team_name = team.name if team else "?"
+    info = queue.info(session, row, slots=slots)
     base = f"/v1/submissions/{row.id}"
     return SubmissionView(
-        id=row.id, team=team.name if team else "?", opponent=row.opponent, state=row.state,
+        id=row.id, team=team_name, opponent=row.opponent, state=row.state,
         created_at=utc(row.created_at),
         started_at=utc(row.started_at) if row.started_at else None,
         finished_at=utc(row.finished_at) if row.finished_at else None,
@@ -73,4 +77,15 @@ def submission_view(session: Session, row: Submission, settings: Settings, *,
     )
 
 
-__all__ = ["Links", "SubmissionCreate", "SubmissionView", "submission_view"]
+def view_of(request: Request, session: Session, row: Submission,
+            team_name: str | None = None) -> SubmissionView:
+    """The view of ``row`` with the app's settings, pool slots and match-time cache."""
+    from service.deps import get_services
+
+    services = get_services(request)
+    slots = services.pool.slots if services.pool is not None else services.settings.match_slots
+    return submission_view(session, row, services.settings, slots=slots, queue=services.queue,
+                           team_name=team_name)
+
+
+__all__ = ["Links", "SubmissionCreate", "SubmissionView", "submission_view", "view_of"]

@@ -73,6 +73,8 @@ class QueueWorker:
                 self.round()
             except Exception:  # process boundary of the worker thread: log, keep serving
                 log.exception("queue worker round failed; retrying")
+            if self.services.queue is not None:
+                self.services.queue.invalidate()
             self._wake.wait(self.settings.worker_poll_s)
             self._wake.clear()
 

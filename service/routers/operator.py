@@ -14,7 +14,7 @@ from service import submissions
 from service.db import ACTIVE_STATES, Submission, SubmissionState, Team
 from service.deps import DbSession, OperatorPrincipal, get_services
 from service.errors import Conflict, NotFound
-from service.views import SubmissionView, submission_view
+from service.views import SubmissionView, view_of
 
 router = APIRouter(prefix="/v1/operator", tags=["operator"])
 
@@ -44,10 +44,8 @@ def _slots(request: Request) -> int:
 def _queue(request: Request, session: DbSession) -> QueueView:
     rows = session.scalars(select(Submission).where(Submission.state.in_(
         [s.value for s in ACTIVE_STATES])).order_by(Submission.seq))
-    settings = get_services(request).settings
     return QueueView(paused=submissions.queue_paused(session), slots=_slots(request),
-                     active=[submission_view(session, r, settings, slots=_slots(request))
-                             for r in rows])
+                     active=[view_of(request, session, r) for r in rows])
 
 
 @router.get("/queue")
@@ -61,6 +59,7 @@ def pause_queue(request: Request, principal: OperatorPrincipal,
     """No new match starts until resumed; running ones go on; status says why it waits."""
     submissions.set_queue_paused(session, True)
     session.commit()
+    get_services(request).queue.invalidate()
     return _queue(request, session)
 
 
@@ -69,6 +68,7 @@ def resume_queue(request: Request, principal: OperatorPrincipal,
                  session: DbSession) -> QueueView:
     submissions.set_queue_paused(session, False)
     session.commit()
+    get_services(request).queue.invalidate()
     worker = get_services(request).worker
     if worker is not None:
         worker.wake()
@@ -99,10 +99,11 @@ def requeue(submission_id: str, request: Request, principal: OperatorPrincipal,
     row.charged = False
     row.cancel_requested = False
     session.commit()
+    get_services(request).queue.invalidate()
     worker = get_services(request).worker
     if worker is not None:
         worker.wake()
-    return submission_view(session, row, get_services(request).settings, slots=_slots(request))
+    return view_of(request, session, row)
 
 
 @router.get("/teams")

@@ -15,10 +15,10 @@ from pydantic import BaseModel
 from sqlalchemy import select
 
 from service import submissions, teamfiles
-from service.db import Submission, transaction
+from service.db import Submission
 from service.deps import DbSession, TeamPrincipal, get_services
 from service.errors import NotFound
-from service.views import SubmissionCreate, SubmissionView, submission_view
+from service.views import SubmissionCreate, SubmissionView, view_of
 
 router = APIRouter(prefix="/v1/submissions", tags=["submissions"])
 
@@ -30,37 +30,32 @@ class LogListing(BaseModel):
     public: list[str]
 
 
-def _slots(request: Request) -> int:
-    services = get_services(request)
-    return services.pool.slots if services.pool is not None else services.settings.match_slots
-
-
 @router.post("", status_code=201, responses={
     409: {"description": "the team already has an active test match (its id is in the body)"},
     422: {"description": "invalid body, unknown opponent or failed pre-flight check"}})
-def create_submission(body: SubmissionCreate, request: Request,
-                      principal: TeamPrincipal) -> SubmissionView:
+def create_submission(body: SubmissionCreate, request: Request, principal: TeamPrincipal,
+                      session: DbSession) -> SubmissionView:
     """Check the team's images (pre-flight) and queue a test match."""
     services = get_services(request)
     team_id = principal.team_id
     assert team_id is not None
-    with transaction(services.sessions) as session:
-        submissions.check_opponent(session, team_id=team_id, opponent=body.opponent)
-        submissions.refuse_if_active(session, team_id)
-        team_file = teamfiles.get(session, team_id=team_id, kind="team_config",
-                                  version=body.team_config_version)
-        file_id, document = team_file.id, json.loads(team_file.content)
-        credentials = teamfiles.newest_id(session, team_id=team_id, kind="credentials")
+    submissions.check_opponent(session, team_id=team_id, opponent=body.opponent)
+    submissions.refuse_if_active(session, team_id)
+    team_file = teamfiles.get(session, team_id=team_id, kind="team_config",
+                              version=body.team_config_version)
+    file_id, document = team_file.id, json.loads(team_file.content)
+    credentials = teamfiles.newest_id(session, team_id=team_id, kind="credentials")
+    session.commit()  # no connection is held during the pre-flight check
     assert services.preflight is not None
     elapsed = services.preflight(document, services.settings)
-    with transaction(services.sessions) as session:
-        row = submissions.create(session, team_id=team_id, opponent=body.opponent,
-                                 team_file_id=file_id, credentials_file_id=credentials,
-                                 preflight_s=elapsed)
-        view = submission_view(session, row, services.settings, slots=_slots(request))
+    row = submissions.create(session, team_id=team_id, opponent=body.opponent,
+                             team_file_id=file_id, credentials_file_id=credentials,
+                             preflight_s=elapsed)
+    session.commit()
+    services.queue.invalidate()
     if services.worker is not None:
         services.worker.wake()
-    return view
+    return view_of(request, session, row, principal.team_name)
 
 
 @router.get("")
@@ -68,8 +63,7 @@ def list_submissions(request: Request, principal: TeamPrincipal,
                      session: DbSession) -> list[SubmissionView]:
     rows = session.scalars(select(Submission).where(Submission.team_id == principal.team_id)
                            .order_by(Submission.seq.desc()).limit(100))
-    settings = get_services(request).settings
-    return [submission_view(session, r, settings, slots=_slots(request)) for r in rows]
+    return [view_of(request, session, r, principal.team_name) for r in rows]
 
 
 @router.get("/{submission_id}")
@@ -77,7 +71,7 @@ def get_submission(submission_id: str, request: Request, principal: TeamPrincipa
                    session: DbSession) -> SubmissionView:
     assert principal.team_id is not None
     row = submissions.get_own(session, team_id=principal.team_id, submission_id=submission_id)
-    return submission_view(session, row, get_services(request).settings, slots=_slots(request))
+    return view_of(request, session, row, principal.team_name)
 
 
 @router.post("/{submission_id}/cancel", responses={
@@ -92,9 +86,10 @@ def cancel_submission(submission_id: str, request: Request, principal: TeamPrinc
     submissions.cancel(session, row)
     session.commit()
     services = get_services(request)
+    services.queue.invalidate()
     if services.worker is not None:
         services.worker.wake()
-    return submission_view(session, row, services.settings, slots=_slots(request))
+    return view_of(request, session, row, principal.team_name)
 
 
 # downloads -------------------------------------------------------------------------------

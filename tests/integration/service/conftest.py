@@ -38,7 +38,8 @@ def db_url(request: pytest.FixtureRequest, tmp_path: Path) -> str:
 
 @pytest.fixture
 def settings(tmp_path: Path, db_url: str) -> Settings:
-    return Settings(data_dir=tmp_path / "data", database_url=db_url, max_upload_bytes=20_000)
+    return Settings(data_dir=tmp_path / "data", database_url=db_url, max_upload_bytes=20_000,
+                    token_cache_s=0.0)
 
 
 @pytest.fixture
