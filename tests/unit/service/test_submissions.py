@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import httpx
@@ -206,3 +207,23 @@ def test_bad_submissions(start: Callable[..., Served], token: Callable[..., str]
         assert extra.status_code == 422
         assert extra.json()["problems"][0]["pointer"] == "/priority"
         assert http.get("/v1/submissions").json() == []
+
+
+def test_operators_read_the_tournament_schedule_and_standings(
+        start: Callable[..., Served], token: Callable[..., str], tmp_path: Path) -> None:
+    from orchestrator.schedule import run_schedule
+    from tests.unit.schedule.test_schedule import COMPRESSED, FAKE, write_schedule
+
+    schedule = write_schedule(
+        tmp_path, COMPRESSED + "fixtures:\n  round_robin: {teams: [alpha, bravo, charlie], "
+        "first_stream: '+2s', interval_s: 0.5, stream_length_s: 0.3}\n")
+    state = tmp_path / "state.sqlite"
+    assert run_schedule(schedule, state, services=FAKE, exit_when_done=True, poll_s=0.1) == 0
+    served = start(schedule_state=str(state))
+    with served.client(token(operator=True)) as http:
+        body = http.get("/v1/operator/schedule").json()
+        assert {m["id"] for m in body["matches"]} == {"rr-1", "rr-2", "rr-3"}
+        assert {"alpha", "bravo", "charlie"} <= {s["team"] for s in body["standings"]}
+        assert sum(s["played"] for s in body["standings"]) == 6
+    with served.client(token("Alpha")) as http:
+        assert http.get("/v1/operator/schedule").status_code == 401
