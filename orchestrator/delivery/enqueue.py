@@ -4,7 +4,9 @@ Each team's folder (``teams/<color>/`` of the match output) becomes one set; the
 match output (recording, referee and GameController logs, results) becomes the ``public`` set
 when the operator gives a public target. Of the undelivered sets of a team only the
 :data:`KEEP_UNDELIVERED` newest are kept: the oldest are deleted and logged, as the league rules
-ask. Public sets are never pruned.
+ask. Public sets are never pruned. A folder without files makes no set (it is logged), and sets
+without files never count towards the limit, so that queueing a match again cannot push a real
+set out.
 """
 
 from __future__ import annotations
@@ -53,6 +55,10 @@ def enqueue_match_logs(
                     "match %s: no logs of team %s (%s) in %s", match_id, team, color, folder
                 )
             sources = _files_under(folder, exclude=None)
+            if not sources:
+                log.warning("match %s: team %s (%s) has no log files: no set made", match_id,
+                            team, color)
+                continue
             created.append(
                 st.create_set(
                     store,
@@ -68,8 +74,11 @@ def enqueue_match_logs(
                 shutil.rmtree(folder)  # only empty folders are left
             log.info("match %s: queued %d log files of team %s", match_id, len(sources), team)
             _prune(store, team)
-        if public_target is not None:
-            sources = _files_under(match_dir, exclude=match_dir / TEAMS_FOLDER)
+        public = (_files_under(match_dir, exclude=match_dir / TEAMS_FOLDER)
+                  if public_target is not None else [])
+        if public_target is not None and not public:
+            log.warning("match %s: no public log files: no set made", match_id)
+        elif public_target is not None:
             created.append(
                 st.create_set(
                     store,
@@ -77,11 +86,11 @@ def enqueue_match_logs(
                     team=PUBLIC_TEAM,
                     kind="public",
                     credentials=public_target,
-                    sources=sources,
+                    sources=public,
                     move=False,
                 )
             )
-            log.info("match %s: queued %d public log files", match_id, len(sources))
+            log.info("match %s: queued %d public log files", match_id, len(public))
     return created
 
 
@@ -98,7 +107,7 @@ def _files_under(folder: Path, *, exclude: Path | None) -> list[tuple[Path, str]
 
 
 def _prune(store: Path, team: str) -> None:
-    sets = [s for s in st.list_sets(store) if s.team == team and s.kind == "team"]
+    sets = [s for s in st.list_sets(store) if s.team == team and s.kind == "team" and s.files]
     for old in sets[: max(0, len(sets) - KEEP_UNDELIVERED)]:
         with st.claimed(old) as mine:
             if not mine:

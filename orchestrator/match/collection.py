@@ -26,6 +26,7 @@ from orchestrator.match.results import (
     write_report,
     write_results,
 )
+from orchestrator.match.safecopy import restrict
 from orchestrator.match.state import MatchState
 
 if TYPE_CHECKING:
@@ -238,6 +239,7 @@ def _write(runner: MatchRunner) -> dict[str, Any]:
         runner._advance(MatchState.FAILED)
     results["timings_s"] = dict(lifecycle.timings_s)
     write_results(out, results)
+    restrict(out)  # the teams' logs are theirs: owner-only, as everything else here
     write_report(out, runner.failure)
     log.info("match %s: %s, results in %s", plan.match_id,
              "failed" if runner.failure else "done", out)

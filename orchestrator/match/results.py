@@ -94,6 +94,7 @@ def _write_json(path: Path, data: dict[str, Any]) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(path.suffix + ".tmp")
     tmp.write_text(json.dumps(data, indent=2, sort_keys=True) + "\n", encoding="utf-8")
+    tmp.chmod(0o600)
     os.replace(tmp, path)
 
 
@@ -125,6 +126,7 @@ def build_results(
     return {
         "match_id": match_id,
         "seed": seed,
+        "warnings": team_warnings(robots, api_stats) if sim_result is not None else [],
         "status": "failed" if failure else "success",
         "failure": None
         if failure is None
@@ -144,6 +146,23 @@ def build_results(
         "versions": {**versions, "simulator": sim.versions if sim is not None else None},
         "timings_s": timings_s,
     }
+
+
+def team_warnings(robots: list[RobotRecord], api_stats: dict[str, Any]) -> list[str]:
+    """What a score alone hides: a team whose started robots all exited during the game, or
+    none of which ever connected to the simulator."""
+    warnings = []
+    for color in ("red", "blue"):
+        started = [r for r in robots if r.color == color and r.container is not None]
+        if not started:
+            continue
+        if all(r.exited_during_game for r in started):
+            warnings.append(f"every robot of {color} exited during the game ("
+                            + ", ".join(f"{r.key}: exit code {r.exit_code}" for r in started)
+                            + ")")
+        if not any((api_stats.get(r.key) or {}).get("connects") for r in started):
+            warnings.append(f"no robot of {color} ever connected to the simulator")
+    return warnings
 
 
 def write_results(out_dir: Path, results: dict[str, Any]) -> Path:
@@ -171,6 +190,7 @@ __all__ = [
     "FailureClass",
     "RobotRecord",
     "build_results",
+    "team_warnings",
     "write_report",
     "write_results",
 ]

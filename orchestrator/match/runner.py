@@ -123,6 +123,7 @@ class MatchRunner:
     def run(self) -> MatchOutcome:
         out = self.options.out_dir
         out.mkdir(parents=True, exist_ok=True)
+        out.chmod(0o700)  # the teams' logs are theirs: owner-only (see collection)
         (out / files.REPORT).unlink(missing_ok=True)  # a stale one would say "complete"
         try:
             self._advance(MatchState.PULLING)

@@ -124,6 +124,25 @@ def _copy_file(source: Path, target: Path, rel: str, report: CopyReport, file_mo
         os.close(fd)
 
 
+def restrict(folder: Path) -> None:
+    """Make ``folder`` readable by its owner only: directories 0700, regular files 0600
+    (links are neither followed nor changed)."""
+    if not folder.is_dir() or folder.is_symlink():
+        return
+    os.chmod(folder, 0o700)
+    for root, dirs, files in os.walk(folder, followlinks=False):
+        for name in dirs + files:
+            path = os.path.join(root, name)
+            try:
+                mode = os.lstat(path).st_mode
+                if stat.S_ISDIR(mode):
+                    os.chmod(path, 0o700)
+                elif stat.S_ISREG(mode):
+                    os.chmod(path, 0o600)
+            except OSError as exc:
+                log.warning("could not restrict %s: %s", path, exc)
+
+
 def sweep(folder: Path) -> CopyReport:
     """In place: remove every entry under ``folder`` that is not a regular file or directory
     (the robot wrote straight into the output folder); returns what stays and what went."""
@@ -153,4 +172,4 @@ def sweep(folder: Path) -> CopyReport:
     return report
 
 
-__all__ = ["CopyReport", "MAX_LISTED", "copy_tree", "kind_of", "sweep"]
+__all__ = ["CopyReport", "MAX_LISTED", "copy_tree", "kind_of", "restrict", "sweep"]

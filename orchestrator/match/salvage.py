@@ -18,7 +18,7 @@ from orchestrator.match import logfs
 from orchestrator.match.ownership import RunRecord
 from orchestrator.match.results import Failure, FailureClass, write_report, write_results
 from orchestrator.match.runtime import ContainerRuntime, ProjectObject
-from orchestrator.match.safecopy import copy_tree
+from orchestrator.match.safecopy import copy_tree, restrict
 
 log = logging.getLogger(__name__)
 
@@ -95,6 +95,7 @@ def salvage(runtime: ContainerRuntime, record: RunRecord, objects: list[ProjectO
             "salvaged": {"robots": report.robots, "public": report.public,
                          "errors": report.errors},
         })
+    restrict(out)
     write_report(out, failure)
     log.info("match %s: salvaged into %s (%d robots)", record.match_id, out, len(report.robots))
     return report

@@ -4,6 +4,7 @@ checks one of them: the result is right, nothing of the teams' logs is lost, not
 from __future__ import annotations
 
 import json
+import stat
 from typing import Any
 
 import docker
@@ -121,4 +122,26 @@ def test_an_official_match_that_does_not_fit_is_refused_with_the_numbers(
     assert f"official match {match.match_id} refused" in done.stderr
     assert "CPUs needed 9 (robots' limits + simulator 1) >" in done.stderr
     assert not match.out.exists()
+    assert left_behind(docker_client, match.match_id) == []
+
+
+def test_outputs_are_readable_by_their_owner_only(hostile: tuple[Prepared, Any, list[str]]
+                                                  ) -> None:
+    match, _, _ = hostile
+    modes = {p: stat.S_IMODE(p.lstat().st_mode) for p in [match.out, *match.out.rglob("*")]}
+    assert {m for p, m in modes.items() if p.is_dir()} == {0o700}
+    assert {m for p, m in modes.items() if p.is_file()} == {0o600}
+
+
+def test_a_team_whose_robots_all_exit_is_named_in_the_result(
+    prepare: Prepare, docker_client: docker.DockerClient,
+) -> None:
+    match = prepare("exit=3", half_s=2.0)
+    done = match.run()
+    assert done.returncode == 0, done.stderr[-3000:]
+    results = match.results()
+    assert results["final_state"] == "FINISHED"
+    assert "every robot of red exited during the game (red-1: exit code 3)" in results["warnings"]
+    assert "no robot of red ever connected to the simulator" in results["warnings"]
+    assert not any("blue" in w for w in results["warnings"])
     assert left_behind(docker_client, match.match_id) == []

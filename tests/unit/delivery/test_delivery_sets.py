@@ -250,3 +250,24 @@ def test_a_file_lost_from_the_local_store_is_a_typed_failure(tmp_path: Path, cre
     [outcome] = deliver_pending(store, opener=Opener(fake), retry=FAST)
     assert outcome.error is not None and outcome.error.kind == "store"
     assert f"m1/Alpha/{MANIFEST_NAME}" not in fake.files
+
+
+def test_reenqueueing_a_match_makes_no_empty_set_and_keeps_the_real_ones(
+    tmp_path: Path, creds: Path
+) -> None:
+    store = tmp_path / "store"
+    for i in range(KEEP_UNDELIVERED):
+        enqueue_match_logs(make_match(tmp_path, f"m{i}"), match_id=f"m{i}",
+                           teams={"red": ("Alpha", creds)}, public_target=None, store=store)
+    for _ in range(4):  # the team folder has moved into the store: nothing left to queue
+        again = enqueue_match_logs(tmp_path / "m0", match_id="m0",
+                                   teams={"red": ("Alpha", creds)}, public_target=creds,
+                                   store=store)
+        assert [s.kind for s in again] == ["public"]
+    team_sets = [s for s in pending_status(store) if s.kind == "team"]
+    assert [s.match_id for s in team_sets] == [f"m{i}" for i in range(KEEP_UNDELIVERED)]
+    assert all(s.files for s in pending_status(store))
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    assert enqueue_match_logs(empty, match_id="e", teams={"red": ("Alpha", creds)},
+                              public_target=creds, store=store) == []

@@ -120,6 +120,8 @@ def main(argv: list[str]) -> None:
                 special_files()
             elif arg.startswith("fill="):
                 fill(arg.partition("=")[2])
+            elif arg.startswith("exit="):
+                sys.exit(int(arg.partition("=")[2]))
             elif arg.startswith("hog="):
                 hog(int(arg.partition("=")[2]))
         except Exception as exc:  # an attack that breaks is reported, the next one still runs
