@@ -1,4 +1,4 @@
-"""The replay writer: :class:`Recorder` writes a match as a version 2 ``.hlvsrec`` file.
+"""The replay writer: :class:`Recorder` writes a match as a version 3 ``.hlvsrec`` file.
 
 The format (self-describing header with the scene, chunks of frames, an index and a trailer for
 seeking) is described in :mod:`simulator.replay.format`; reading is :mod:`simulator.replay`.
@@ -22,7 +22,7 @@ from simulator.replay.format import (
     TRAILER,
     U32,
     dumps,
-    shuffle,
+    encode_poses,
 )
 from simulator.replay.reader import load_replay
 from simulator.replay.scene import scene_of
@@ -34,7 +34,7 @@ ZLIB_LEVEL = 6
 def replay_header(
     world: World, *, match_id: str, rate_hz: float, chunk_frames: int
 ) -> dict[str, Any]:
-    """The header of a version 2 replay of ``world`` (also the scene sent to live viewers)."""
+    """The header of a version 3 replay of ``world`` (also the scene sent to live viewers)."""
     return {
         "format": "hlvsrec",
         "version": FORMAT_VERSION,
@@ -133,7 +133,7 @@ class Recorder:
         chunk["events"].append(self._events)
         self._index_events.extend({**e, "frame_ms": sim_time_ms} for e in self._events)
         self._events = []
-        self._poses.append(np.concatenate([xpos, xquat], axis=1).astype("<f4"))
+        self._poses.append(np.concatenate([xpos, xquat], axis=1))
         self._last_time_ms = sim_time_ms
         if len(chunk["times"]) >= self.chunk_frames:
             self._flush_chunk()
@@ -143,7 +143,7 @@ class Recorder:
         if not chunk["times"]:
             return
         meta = dumps(chunk)
-        poses = zlib.compress(shuffle(np.stack(self._poses)), ZLIB_LEVEL)
+        poses = zlib.compress(encode_poses(np.stack(self._poses)), ZLIB_LEVEL)
         payload = U32.pack(len(meta)) + meta + poses
         times = chunk["times"]
         self._index_chunks.append([self._offset, times[0], times[-1], len(times)])

@@ -1,23 +1,27 @@
 """Replay files (``.hlvsrec``): what the bytes are, for every version a reader accepts.
 
-Version 2 (written today; little-endian)::
+Version 3 (written today; little-endian)::
 
     b"HLVSREC\\0"
-    u32 header length, header JSON: format "hlvsrec", version 2, match_id, seed, field_class,
+    u32 header length, header JSON: format "hlvsrec", version 3, match_id, seed, field_class,
         physics_dt_s, step_ms, rate_hz, chunk_frames, robots [{team, number, model, x_m, y_m,
         yaw_rad}], body_names, scene (see simulator.replay.scene)
     records, each: u8 kind, u32 payload length, payload
       kind 1, chunk: u32 meta length, meta JSON {"times": [ms...], "games": [{...}...],
-          "events": [[{...}...]...]}, then zlib of the float32 poses
-          (frames, bodies, 7: x y z qw qx qy qz in the world frame) with their bytes shuffled
-          (all first bytes, then all second bytes...), which compresses about 1.5x better
+          "events": [[{...}...]...]}, then the poses (frames, bodies, 7: x y z qw qx qy qz in
+          the world frame) as integers: positions in units of ``POSITION_UNIT_M`` (0.1 mm),
+          quaternion components times ``QUATERNION_SCALE`` with qw >= 0; each frame but the
+          chunk's first as the difference to the frame before; zig-zag coded as u32, bytes
+          shuffled (all first bytes, then all second bytes...), zlib. About 3x smaller than
+          version 2 on a real match.
       kind 2, index (last): JSON {"chunks": [[offset, first_ms, last_ms, frames]...],
           "events": [{..., "frame_ms"}...], "frames", "duration_ms"}
     trailer: u64 offset of the index record, b"HLVSIDX\\0"
 
 A reader seeks to the trailer, reads the index and then only the chunks it needs. A file whose
 writer died has no trailer; it is read by scanning its records (an unfinished last record is
-dropped). Version 1 (no scene, no index, one zlib block per frame) is described in
+dropped). Version 2 is the same but for the poses of a chunk: zlib of the byte-shuffled float32
+values. Version 1 (no scene, no index, one zlib block per frame) is described in
 :mod:`simulator.replay.reader`.
 
 JSON is written with sorted keys and fixed separators and zlib at a fixed level, so a match
@@ -37,8 +41,10 @@ import numpy.typing as npt
 
 MAGIC = b"HLVSREC\0"
 INDEX_MAGIC = b"HLVSIDX\0"
-FORMAT_VERSION = 2
-SUPPORTED_VERSIONS = (1, 2)
+FORMAT_VERSION = 3
+SUPPORTED_VERSIONS = (1, 2, 3)
+POSITION_UNIT_M = 1e-4
+QUATERNION_SCALE = 32767.0
 CHUNK = 1
 INDEX = 2
 U32 = struct.Struct("<I")
@@ -61,6 +67,31 @@ def unshuffle(blob: bytes, count: int) -> npt.NDArray[np.float32]:
     """Inverse of :func:`shuffle` for ``count`` float32 values."""
     planes = np.frombuffer(blob, dtype=np.uint8, count=count * 4).reshape(4, count)
     return np.ascontiguousarray(planes.T).view("<f4").reshape(count)
+
+
+def encode_poses(poses: npt.NDArray[np.floating[Any]]) -> bytes:
+    """Version 3 pose block of (frames, bodies, 7) poses, before zlib (see the docstring)."""
+    values = np.asarray(poses, dtype=np.float64)
+    quat = values[:, :, 3:7] * np.where(values[:, :, 3:4] < 0, -1.0, 1.0)
+    ints = np.concatenate(
+        [np.rint(values[:, :, :3] / POSITION_UNIT_M), np.rint(quat * QUATERNION_SCALE)], axis=2
+    ).astype(np.int64)
+    ints[1:] -= ints[:-1].copy()
+    zigzag = ((ints << 1) ^ (ints >> 63)).astype("<u4")
+    return zigzag.view(np.uint8).reshape(-1, 4).T.tobytes()
+
+
+def decode_poses(blob: bytes, frames: int, bodies: int) -> npt.NDArray[np.float32]:
+    """Inverse of :func:`encode_poses`: (frames, bodies, 7) float32 poses."""
+    count = frames * bodies * POSE_WIDTH
+    planes = np.frombuffer(blob, dtype=np.uint8, count=count * 4).reshape(4, count)
+    zigzag = np.ascontiguousarray(planes.T).view("<u4").reshape(frames, bodies, POSE_WIDTH)
+    z = zigzag.astype(np.int64)
+    ints = np.cumsum((z >> 1) ^ -(z & 1), axis=0)
+    out = np.empty((frames, bodies, POSE_WIDTH), dtype=np.float32)
+    out[:, :, :3] = ints[:, :, :3] * POSITION_UNIT_M
+    out[:, :, 3:] = ints[:, :, 3:] / QUATERNION_SCALE
+    return out
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -1,5 +1,7 @@
 """Reading replays of every version, with seeking: :class:`ReplayFile` and :func:`load_replay`.
 
+Versions 2 and 3 are described in :mod:`simulator.replay.format`.
+
 Version 1 (the first format, still read)::
 
     b"HLVSREC\\0", u32 header length, header JSON (version 1, no scene, no chunk_frames)
@@ -39,6 +41,7 @@ from simulator.replay.format import (
     ReplayFrame,
     ReplayHeader,
     RobotEntry,
+    decode_poses,
     unshuffle,
 )
 
@@ -186,13 +189,19 @@ class ReplayFile:
 
     def _read_chunk_v2(self, ref: ChunkRef) -> FrameBlock:
         meta, poses_at, end = self._chunk_meta(ref.offset)
-        count = len(meta["times"]) * self.nbody * POSE_WIDTH
-        values = unshuffle(zlib.decompress(self._read_at(poses_at, end - poses_at)), count)
+        frames = len(meta["times"])
+        blob = zlib.decompress(self._read_at(poses_at, end - poses_at))
+        if self.header.version == 2:
+            poses = unshuffle(blob, frames * self.nbody * POSE_WIDTH).reshape(
+                frames, self.nbody, POSE_WIDTH
+            )
+        else:
+            poses = decode_poses(blob, frames, self.nbody)
         return FrameBlock(
             times_ms=np.asarray(meta["times"], dtype=np.int64),
             games=list(meta["games"]),
             events=list(meta["events"]),
-            poses=values.reshape(-1, self.nbody, POSE_WIDTH),
+            poses=poses,
         )
 
     # -- version 1 -------------------------------------------------------------------------

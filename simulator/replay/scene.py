@@ -115,8 +115,8 @@ def scene_of(
 
 
 def scene_for(header: ReplayHeader, path: str) -> dict[str, Any]:
-    """The scene of a replay: its own (version 2), or for version 1 the scene of today's models
-    for the robots it lists, when those still have the recorded bodies."""
+    """The scene of a replay: its own (versions 2 and 3), or for version 1 the scene of today's
+    models for the robots it lists, when those still have the recorded bodies."""
     if header.scene is not None:
         return header.scene
     from contracts.field import field_for

@@ -18,6 +18,7 @@ from simulator.world import World
 from tests.unit.world.conftest import eight_robots
 
 V1_FIXTURE = Path(__file__).parent / "fixtures" / "v1-two-robots.hlvsrec"
+V2_FIXTURE = Path(__file__).parent / "fixtures" / "v2-two-robots.hlvsrec"
 
 
 def _record(path: Path, *, seconds: float, robots: int = 2, chunk_frames: int = 10) -> World:
@@ -37,7 +38,7 @@ def test_version_2_is_indexed_and_seeks_to_a_chunk(tmp_path: Path) -> None:
     world = _record(path, seconds=2.0)
     assert path.read_bytes().endswith(INDEX_MAGIC)
     with ReplayFile(path) as replay:
-        assert replay.indexed and replay.header.version == 2
+        assert replay.indexed and replay.header.version == 3
         assert [c.frames for c in replay.chunks] == [10] * 5 + [1]
         assert replay.duration_ms == 2000 and replay.frame_count == 51
         assert replay.chunk_at(0) == 0 and replay.chunk_at(399) == 0 and replay.chunk_at(400) == 1
@@ -46,8 +47,10 @@ def test_version_2_is_indexed_and_seeks_to_a_chunk(tmp_path: Path) -> None:
                                   "frame_ms": 520},)  # fmt: skip
         block = replay.read_chunk(5)
         assert block.times_ms.tolist() == [2000]
-        np.testing.assert_allclose(block.poses[0, :, :3], world.data.xpos, atol=1e-5)
-        np.testing.assert_allclose(block.poses[0, :, 3:], world.data.xquat, atol=1e-5)
+        np.testing.assert_allclose(block.poses[0, :, :3], world.data.xpos, atol=6e-5)
+        quat = block.poses[0, :, 3:]
+        assert np.all(quat[:, 0] >= 0)  # stored with qw >= 0: the same turn as -q
+        np.testing.assert_allclose(np.abs(np.sum(quat * world.data.xquat, axis=1)), 1, atol=1e-4)
         with pytest.raises(ReplayError, match="chunk 6 out of range"):
             replay.read_chunk(6)
 
@@ -96,7 +99,7 @@ def test_unknown_versions_and_corrupt_chunks_are_named(tmp_path: Path) -> None:
     bumped = json.dumps({**header, "version": 9}).encode()
     future.write_bytes(bytes(blob[:8]) + len(bumped).to_bytes(4, "little") + bumped
                        + bytes(blob[12 + length:]))  # fmt: skip
-    with pytest.raises(ReplayError, match="format version 9; this reader knows versions 1, 2"):
+    with pytest.raises(ReplayError, match="format version 9; this reader knows versions 1, 2, 3"):
         ReplayFile(future)
     with ReplayFile(path) as replay:
         offset = replay.chunks[1].offset
@@ -141,3 +144,31 @@ def test_a_version_1_replay_still_renders(tmp_path: Path) -> None:
 
     video = render_video(V1_FIXTURE, tmp_path / "v1.mp4", width=160, height=90, fps=5)
     assert video.stat().st_size > 1000
+
+
+def test_version_2_replays_are_still_read() -> None:
+    """Version 2 (float32 poses) as its writer made it: 13 frames in chunks of 5."""
+    with ReplayFile(V2_FIXTURE) as replay:
+        assert replay.header.version == 2 and replay.indexed
+        assert [c.frames for c in replay.chunks] == [5, 5, 3]
+        assert replay.header.scene is not None
+        assert scene_for(replay.header, "x") is replay.header.scene
+        frames = list(replay.frames())
+    assert [f.sim_time_ms for f in frames] == [40 * k for k in range(13)]
+    assert frames[3].events == [{"sim_time_ms": 88, "team": "red", "type": "goal"}]
+    assert frames[-1].poses.dtype == np.float32 and frames[-1].poses.shape == (48, 7)
+    assert float(frames[-1].poses[1, 2]) == pytest.approx(0.07, abs=0.01)  # the ball, on the turf
+
+
+def test_pose_coding_keeps_a_tenth_of_a_millimetre_and_the_turn() -> None:
+    from simulator.replay.format import decode_poses, encode_poses
+
+    rng = np.random.default_rng(4)
+    poses = np.zeros((25, 30, 7))
+    poses[:, :, :3] = rng.uniform(-7, 7, size=(25, 30, 3))
+    quat = rng.normal(size=(25, 30, 4))
+    poses[:, :, 3:] = quat / np.linalg.norm(quat, axis=2, keepdims=True)
+    decoded = decode_poses(encode_poses(poses), 25, 30)
+    np.testing.assert_allclose(decoded[:, :, :3], poses[:, :, :3], atol=5.01e-5)
+    np.testing.assert_allclose(np.abs(np.sum(decoded[:, :, 3:] * poses[:, :, 3:], axis=2)), 1,
+                               atol=1e-4)  # fmt: skip

@@ -38,7 +38,7 @@ def test_meta_and_chunks_carry_the_replay(match_dir: Path) -> None:
     client, pages = _client(match_dir)
     assert pages == ["/watch/replay/match-7"]
     meta = client.get("/api/viewer/replays/match-7/meta").json()
-    assert meta["match_id"] == "viewer-test" and meta["version"] == 2 and meta["has_stats"]
+    assert meta["match_id"] == "viewer-test" and meta["version"] == 3 and meta["has_stats"]
     assert meta["duration_ms"] == 3000 and meta["chunks"][1] == [1000, 1960, 25]
     assert [(e["type"], e["frame_ms"]) for e in meta["events"]] == [("goal", GOAL_MS)]
     assert len(meta["scene"]["geoms"]) > 200 and meta["body_count"] == len(meta["scene"]["bodies"])
