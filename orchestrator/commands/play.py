@@ -234,12 +234,13 @@ def run_cleanup_command(args: argparse.Namespace) -> int:
 
     runtime = DockerRuntime(connect())
     if getattr(args, "dry_run", False):
-        found = runtime.list_project(match_id=args.match)
+        from orchestrator.match.cleanup import plan_cleanup
+
+        planned = plan_cleanup(runtime, match_id=args.match)
         print(json.dumps({
-            "dry_run": True,
-            "containers": sorted(o.name for o in found if o.kind == "container"),
-            "networks": sorted(o.name for o in found if o.kind == "network"),
-            "log_mounts": leftover_log_mounts(args.match),
+            "dry_run": True, "containers": list(planned.containers),
+            "networks": list(planned.networks), "log_mounts": list(planned.mounts),
+            "salvaged": list(planned.salvaged), "skipped": list(planned.skipped),
         }))
         return ExitCode.OK
     host = HostControl.for_current_user()
@@ -254,19 +255,7 @@ def run_cleanup_command(args: argparse.Namespace) -> int:
     return ExitCode.OK
 
 
-def leftover_log_mounts(match_id: str | None) -> list[str]:
-    """The capped log folders still mounted (of one match, or all) that cleanup would unmount."""
-    from orchestrator.match import logfs
-
-    root = logfs.state_dir() / "logfs"
-    if match_id is not None:
-        root = root / logfs.safe_name(match_id)
-    mounts = Path("/proc/mounts").read_text().splitlines() if Path("/proc/mounts").is_file() else []
-    points = [line.split()[1].replace("\\040", " ") for line in mounts if len(line.split()) > 1]
-    return sorted(p for p in points if p.startswith(str(root) + "/"))
-
-
 __all__ = [
-    "leftover_log_mounts", "play", "run_cleanup_command", "run_match_command",
-    "run_scrimmage_command", "stop_on_signals", "summarize",
+    "play", "run_cleanup_command", "run_match_command", "run_scrimmage_command",
+    "stop_on_signals", "summarize",
 ]

@@ -32,6 +32,7 @@ class CleanupReport:
     errors: tuple[str, ...] = ()
     salvaged: tuple[str, ...] = ()  # output folders the teams' logs were saved into
     skipped: tuple[str, ...] = ()  # matches left alone, with the reason
+    mounts: tuple[str, ...] = ()  # mounted log / scratch folders (listed by a dry run)
 
 
 @dataclass(slots=True)
@@ -42,12 +43,14 @@ class _Totals:
     errors: list[str] = field(default_factory=list)
     salvaged: list[str] = field(default_factory=list)
     skipped: list[str] = field(default_factory=list)
+    mounts: list[str] = field(default_factory=list)
 
     def report(self) -> CleanupReport:
         return CleanupReport(
             containers=tuple(self.containers), networks=tuple(self.networks),
             host_objects=self.host_objects, errors=tuple(self.errors),
             salvaged=tuple(self.salvaged), skipped=tuple(sorted(set(self.skipped))),
+            mounts=tuple(self.mounts),
         )
 
 
@@ -70,6 +73,46 @@ def cleanup(runtime: ContainerRuntime, host: Host, *, match_id: str | None = Non
                                   f"{record.hostname}) is running")
             continue
         clean_match(runtime, host, match_id=record.match_id, record=record, totals=totals)
+    for obj in runtime.list_project():
+        other = obj.labels.get(LABEL_MATCH)
+        if other and other not in owned:
+            totals.skipped.append(f"{other}: no run record (name it: hlvs cleanup --match "
+                                  f"{other})")
+    return totals.report()
+
+
+def plan_cleanup(runtime: ContainerRuntime, *, match_id: str | None = None) -> CleanupReport:
+    """What :func:`cleanup` would do, doing nothing (``hlvs cleanup --dry-run``): the containers
+    and networks it would remove, the output folders it would salvage logs into, the matches it
+    would leave alone and why, and the mounted log and scratch folders it would unmount.
+    """
+    totals = _Totals()
+
+    def plan(one: str, record: RunRecord | None) -> None:
+        found = runtime.list_project(match_id=one)
+        mounts = logfs.mounted(match_id=one)
+        leftover_logs = (logfs.state_dir() / "logfs" / logfs.safe_name(one)).is_dir()
+        if record is not None and (found or leftover_logs):
+            totals.salvaged.append(record.out_dir)
+        totals.containers += sorted(o.name for o in found if o.kind == "container")
+        totals.networks += sorted(o.name for o in found if o.kind == "network")
+        totals.host_objects += len(mounts)
+        totals.mounts += mounts
+
+    if match_id is not None:
+        record = ownership.read(match_id)
+        if record is not None and ownership.owner_alive(record):
+            raise MatchRunning(record)
+        plan(match_id, record)
+        return totals.report()
+    owned: dict[str, RunRecord] = {}
+    for record in ownership.records():
+        owned[record.match_id] = record
+        if ownership.owner_alive(record):
+            totals.skipped.append(f"{record.match_id}: its orchestrator (pid {record.pid} on "
+                                  f"{record.hostname}) is running")
+            continue
+        plan(record.match_id, record)
     for obj in runtime.list_project():
         other = obj.labels.get(LABEL_MATCH)
         if other and other not in owned:
@@ -123,4 +166,4 @@ def _remove(runtime: ContainerRuntime, found: list[ProjectObject], totals: _Tota
                 totals.errors.append(str(exc))
 
 
-__all__ = ["CleanupReport", "clean_match", "cleanup"]
+__all__ = ["CleanupReport", "clean_match", "cleanup", "plan_cleanup"]

@@ -125,21 +125,29 @@ def _is_mounted(path: Path) -> bool:
     return str(path) in _mounts()
 
 
+def mounted(*, match_id: str | None = None) -> list[str]:
+    """The capped folders still mounted (of one match, or all), as :func:`cleanup` finds them."""
+    root = state_dir() / "logfs"
+    if match_id is not None:
+        root = root / safe_name(match_id)
+    return sorted(p for p in _mounts() if p.startswith(str(root) + "/"))
+
+
 def cleanup(*, match_id: str | None = None) -> int:
     """Unmount and delete what crashed runs left (of one match, or all); returns the count."""
     root = state_dir() / "logfs"
     if match_id is not None:
         root = root / safe_name(match_id)
     count = 0
-    for mountpoint in _mounts():
-        if mountpoint.startswith(str(root) + "/"):
-            _run("umount", "-l", mountpoint)
-            count += 1
+    for mountpoint in mounted(match_id=match_id):
+        _run("umount", "-l", mountpoint)
+        count += 1
     if root.is_dir():
         shutil.rmtree(root, ignore_errors=True)
     return count
 
 
 __all__ = [
-    "LogFolder", "can_cap", "cleanup", "collect", "create", "release", "safe_name", "state_dir",
+    "LogFolder", "can_cap", "cleanup", "collect", "create", "mounted", "release", "safe_name",
+    "state_dir",
 ]

@@ -91,6 +91,13 @@ def test_cleanup_after_kill_9(runtime: Any, test_image: str, tmp_path: Path,
         assert len(listed["containers"]) + len(listed["networks"]) == 8
         assert len(listed["networks"]) == 3 and listed["log_mounts"]
         assert all(match_id in name for name in listed["containers"] + listed["networks"])
+        assert listed["salvaged"] == []  # the runner alone wrote no run record to salvage by
+        assert hlvs(["cleanup", "--dry-run"]) == 0  # every match whose orchestrator is gone
+        everything = json.loads(capsys.readouterr().out)
+        assert not set(listed["containers"]) & set(everything["containers"])
+        assert f"{match_id}: no run record (name it: hlvs cleanup --match {match_id})" in (
+            everything["skipped"]
+        ), "without a run record, only a cleanup naming the match removes it"
         assert _leftovers(runtime, match_id) == (containers, rule, mount)  # nothing removed
         assert hlvs(["cleanup", "--match", match_id]) == 0
         assert _leftovers(runtime, match_id) == (0, False, False)

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from orchestrator.match import ownership
-from orchestrator.match.cleanup import cleanup
+from orchestrator.match.cleanup import cleanup, plan_cleanup
 from orchestrator.match.fake import FakeHost, FakeRuntime
 from orchestrator.match.layout import labels
 from orchestrator.match.ownership import LABEL_RUN, MatchRunning, RunRecord
@@ -69,6 +69,14 @@ def test_cleanup_touches_only_dead_matches_and_salvages_their_logs(tmp_path: Pat
     with ownership.claim("alive", tmp_path / "alive-out") as alive:
         _robot(runtime, "alive", alive.record.run_id, "blue", 2)
         _robot(runtime, "unowned", "x", "red", 1)
+        planned = plan_cleanup(runtime, match_id=None)  # a dry run: the same decisions
+        assert planned.containers == ("hlvs-dead-red-1",) and planned.salvaged == (str(out),)
+        assert any(s.startswith("alive: its orchestrator") for s in planned.skipped)
+        assert any(s.startswith("unowned: no run record") for s in planned.skipped)
+        assert len(runtime.list_project()) == 3 and not out.exists()  # nothing done
+        assert ownership.read("dead") is not None
+        with pytest.raises(MatchRunning):
+            plan_cleanup(runtime, match_id="alive")
         report = cleanup(runtime, host, match_id=None)
         assert report.containers == ("hlvs-dead-red-1",)
         assert report.salvaged == (str(out),)
