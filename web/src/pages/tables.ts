@@ -102,6 +102,12 @@ async function poolPage(root: HTMLElement): Promise<void> {
 }
 
 export async function tablePage(root: HTMLElement, page: string, _arg?: string): Promise<void> {
+  const health = await fetch("/v1/health");
+  if (health.status === 404) {
+    root.append(el("p", { class: "error", "data-testid": "error" },
+      "This page is part of hlvs serve (the submission service); hlvs view shows replays and live matches only."));
+    return;
+  }
   if (page === "submissions") await submissionsPage(root);
   else if (page === "queue") await queuePage(root);
   else if (page === "standings" || page === "schedule") await standingsPage(root);
