@@ -4,6 +4,7 @@ Tree::
 
     ContractError        a field missing, unknown or of the wrong type (file, field, reason)
     └── UnknownVersion   the document's ``version`` is not one this build reads
+    ProtocolError        a GameController datagram that is not RGme v12 / RGrt v2 (peer, reason)
 """
 
 from __future__ import annotations
@@ -32,4 +33,14 @@ class UnknownVersion(ContractError):
         )
 
 
-__all__ = ["ContractError", "UnknownVersion"]
+class ProtocolError(ValueError):
+    """A GameController datagram that does not follow the protocol (names the peer)."""
+
+    def __init__(self, *, peer: str, reason: str, size: int | None = None) -> None:
+        self.peer = peer
+        self.reason = reason
+        self.size = size
+        super().__init__(f"{peer}: {reason}" + (f" ({size} bytes)" if size is not None else ""))
+
+
+__all__ = ["ContractError", "ProtocolError", "UnknownVersion"]

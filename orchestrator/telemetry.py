@@ -22,6 +22,7 @@ from rich.console import Console
 from rich.live import Live
 from rich.table import Table
 
+from contracts import telemetry as topics
 from orchestrator.errors import InfrastructureError
 
 log = logging.getLogger(__name__)
@@ -56,8 +57,12 @@ class ZenohTelemetry:
         try:
             self._session = zenoh.open(config)
             self._subs = [
-                self._session.declare_subscriber(f"hlvs/{match_id}/state", self._on_state),
-                self._session.declare_subscriber(f"hlvs/{match_id}/events", self._on_event),
+                self._session.declare_subscriber(
+                    topics.topic(match_id, topics.STATE), self._on_state
+                ),
+                self._session.declare_subscriber(
+                    topics.topic(match_id, topics.EVENTS), self._on_event
+                ),
             ]
         except zenoh.ZError as exc:
             raise InfrastructureError(

@@ -17,6 +17,15 @@ READY, between periods), so a lockstep runtime can hold instead of stepping. Rul
 from __future__ import annotations
 
 from contracts.field import ADULT_FIELD, KID_FIELD, FieldClass, FieldGeometry, field_for
+from contracts.gamecontroller import (
+    GameControlData,
+    ReturnData,
+    ReturnMessage,
+    decode_game_state,
+    decode_return,
+    encode_game_state,
+    encode_return,
+)
 from contracts.geometry import Pose
 from contracts.ids import RobotId, TeamColor
 from contracts.match_spec import GameType
@@ -45,15 +54,6 @@ from referee.snapshot import (
     TeleportRobot,
     WorldCommand,
     WorldSnapshot,
-)
-from referee.wire import (
-    GameControlData,
-    ReturnData,
-    ReturnMessage,
-    decode_game_state,
-    decode_return,
-    encode_game_state,
-    encode_return,
 )
 
 __all__ = [

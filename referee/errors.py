@@ -3,24 +3,19 @@
 Tree::
 
     RefereeError
-    ├── ProtocolError        a GameController datagram (RGme / RGrt) that does not decode
     ├── IllegalTransition    a game state change the rules do not allow
     └── ScenarioError        a scenario file that does not describe a valid case
+
+A GameController datagram that does not decode raises :class:`contracts.errors.ProtocolError`.
 """
 
 from __future__ import annotations
 
+from contracts.errors import ProtocolError
+
 
 class RefereeError(Exception):
     """Root of every error the referee package raises."""
-
-
-class ProtocolError(RefereeError):
-    def __init__(self, *, peer: str, reason: str, size: int | None = None) -> None:
-        self.peer = peer
-        self.reason = reason
-        self.size = size
-        super().__init__(f"{peer}: {reason}" + (f" ({size} bytes)" if size is not None else ""))
 
 
 class IllegalTransition(RefereeError):
@@ -36,3 +31,6 @@ class ScenarioError(RefereeError):
         self.pointer = pointer
         self.reason = reason
         super().__init__(f"{path}: {pointer or '/'}: {reason}")
+
+
+__all__ = ["IllegalTransition", "ProtocolError", "RefereeError", "ScenarioError"]

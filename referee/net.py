@@ -22,11 +22,11 @@ import threading
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
+from contracts.gamecontroller import ReturnMessage, decode_return
 from contracts.ids import RobotId, TeamColor
 from referee.clock import Clock
 from referee.errors import ProtocolError
 from referee.spoofing import Senders, SpoofingLog, robot_key
-from referee.wire import ReturnMessage, decode_return
 
 logger = logging.getLogger(__name__)
 

@@ -9,12 +9,12 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from contracts.gamecontroller import encode_game_state
 from contracts.ids import TeamColor
 from referee.clock import Clock
 from referee.gamecontroller import GameController, game_control_data
 from referee.logs import RefereeLog
 from referee.net import GameControllerNetwork
-from referee.wire import encode_game_state
 
 REFRESH_PERIOD_REAL_S = 0.1
 

@@ -17,6 +17,7 @@ import logging
 import time
 from typing import Any, Protocol
 
+from contracts import telemetry as topics
 from simulator.errors import SimulatorError
 
 log = logging.getLogger(__name__)
@@ -87,10 +88,10 @@ class ZenohTelemetry:
             self._session: Any = zenoh.open(zenoh_config(listen=listen))
         except zenoh.ZError as exc:
             raise TelemetryError(endpoint=listen, reason=str(exc)) from exc
-        self._state: Any = self._session.declare_publisher(f"hlvs/{match_id}/state")
-        self._events: Any = self._session.declare_publisher(f"hlvs/{match_id}/events")
-        self._poses: Any = self._session.declare_publisher(f"hlvs/{match_id}/poses")
-        self._scene: Any = self._session.declare_publisher(f"hlvs/{match_id}/scene")
+        self._state: Any = self._session.declare_publisher(topics.topic(match_id, topics.STATE))
+        self._events: Any = self._session.declare_publisher(topics.topic(match_id, topics.EVENTS))
+        self._poses: Any = self._session.declare_publisher(topics.topic(match_id, topics.POSES))
+        self._scene: Any = self._session.declare_publisher(topics.topic(match_id, topics.SCENE))
         self._scene_blob = json.dumps(scene, sort_keys=True) if scene is not None else None
         self._next_scene_s = 0.0
         log.info("telemetry on %s (keys hlvs/%s/state, hlvs/%s/events)", listen, match_id, match_id)

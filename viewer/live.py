@@ -12,6 +12,8 @@ import logging
 from collections.abc import Callable
 from typing import Any, Protocol
 
+from contracts import telemetry as topics
+
 log = logging.getLogger(__name__)
 
 KINDS = ("state", "events", "poses", "scene")
@@ -46,7 +48,7 @@ class ZenohFeed:
             self._session: Any = zenoh.open(config)
             self._subs = [
                 self._session.declare_subscriber(
-                    f"hlvs/{match_id}/{kind}", _forward(kind, callback)
+                    topics.topic(match_id, kind), _forward(kind, callback)
                 )
                 for kind in KINDS
             ]

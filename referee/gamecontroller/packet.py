@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import math
 
+from contracts.gamecontroller import MAX_PLAYERS, GameControlData, RobotInfo, TeamInfo
 from contracts.ids import TeamColor
 from contracts.match_spec import GameType
 from referee.gamecontroller.machine import GameController
 from referee.gamecontroller.states import DROPBALL_TEAM, GameTypeCode, TeamColourCode
-from referee.wire import MAX_PLAYERS, GameControlData, RobotInfo, TeamInfo
 
 
 def _seconds(value: float, low: int, high: int) -> int:

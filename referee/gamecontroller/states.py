@@ -1,47 +1,20 @@
-"""Values of the GameController: states, secondary states, penalties, cards (wire codes)."""
+"""Values of the GameController: cards and the allowed state transitions.
+
+The wire codes (states, secondary states, penalties...) are :mod:`contracts.gamecontroller`'s,
+re-exported here for the referee's modules."""
 
 from __future__ import annotations
 
-from enum import IntEnum, StrEnum
+from enum import StrEnum
 
-
-class GameState(IntEnum):
-    INITIAL = 0
-    READY = 1
-    SET = 2
-    PLAYING = 3
-    FINISHED = 4
-
-
-class SecondaryState(IntEnum):
-    NORMAL = 0
-    PENALTYSHOOT = 1
-    OVERTIME = 2
-    TIMEOUT = 3
-    DIRECT_FREEKICK = 4
-    INDIRECT_FREEKICK = 5
-    PENALTYKICK = 6
-    CORNER_KICK = 7
-    GOAL_KICK = 8
-    THROW_IN = 9
-
-    @property
-    def is_set_play(self) -> bool:
-        return self.value >= SecondaryState.DIRECT_FREEKICK.value
-
-
-class Penalty(IntEnum):
-    """Penalty codes on the wire (GameController ``Penalties.java``)."""
-
-    NONE = 0
-    SUBSTITUTE = 14
-    MANUAL = 15
-    BALL_MANIPULATION = 30
-    PHYSICAL_CONTACT = 31
-    ILLEGAL_ATTACK = 32
-    ILLEGAL_DEFENSE = 33
-    PICKUP_OR_INCAPABLE = 34
-    SERVICE = 35
+from contracts.gamecontroller import (
+    DROPBALL_TEAM,
+    GameState,
+    GameTypeCode,
+    Penalty,
+    SecondaryState,
+    TeamColourCode,
+)
 
 
 class Card(StrEnum):
@@ -49,19 +22,6 @@ class Card(StrEnum):
     YELLOW = "yellow"
     RED = "red"
 
-
-class GameTypeCode(IntEnum):
-    ROUNDROBIN = 0
-    PLAYOFF = 1
-    DROPIN = 2
-
-
-class TeamColourCode(IntEnum):
-    BLUE = 0
-    RED = 1
-
-
-DROPBALL_TEAM = 128  # kickOffTeam after a dropped ball
 
 # Which state may follow which. READY -> SET and SET -> PLAYING are the normal flow; PLAYING ->
 # READY after a goal or a dropped ball; PLAYING -> FINISHED at the end of a period; FINISHED ->
@@ -74,3 +34,15 @@ ALLOWED_TRANSITIONS: dict[GameState, frozenset[GameState]] = {
     GameState.PLAYING: frozenset({GameState.READY, GameState.SET, GameState.FINISHED}),
     GameState.FINISHED: frozenset({GameState.INITIAL}),
 }
+
+
+__all__ = [
+    "ALLOWED_TRANSITIONS",
+    "DROPBALL_TEAM",
+    "Card",
+    "GameState",
+    "GameTypeCode",
+    "Penalty",
+    "SecondaryState",
+    "TeamColourCode",
+]

@@ -1,59 +1,27 @@
 """Robot side of the GameController protocol: read ``RGme`` v12, send ``RGrt`` v2.
 
-Written from the packet layout (little-endian, packed; 688 bytes), independently of the
-referee package, as a robot's own parser would be.
+The packet codec and the wire codes are :mod:`contracts.gamecontroller`'s (the same the referee
+sends with); this module gives robot code a view of one packet (its own team found by number,
+states as enums) and the UDP listener and replier.
 """
 
 from __future__ import annotations
 
 import socket
-import struct
 import time
 from dataclasses import dataclass
-from enum import IntEnum
 
+from contracts import gamecontroller as wire
+from contracts.errors import ProtocolError
+from contracts.gamecontroller import (
+    GC_DATA_PORT,
+    GC_RETURN_PORT,
+    GameState,
+    ReturnData,
+    ReturnMessage,
+    SecondaryState,
+)
 from robot.client.errors import RobotClientError
-
-GC_DATA_PORT = 3838
-GC_RETURN_PORT = 3939
-PACKET_SIZE = 688
-TEAM_SIZE = 332
-ROBOT_INFO_SIZE = 6
-MAX_PLAYERS = 11
-_HEAD = struct.Struct("<4sHBBBBBBB4sBHhh")  # 24 bytes
-_TEAM_HEAD = struct.Struct("<BBBBHB")  # teamNumber, colour, score, penaltyShot, singleShots, seq
-_ROBOT = struct.Struct("<BBBBBB")
-_PLAYERS_OFFSET = 266
-
-
-class GameState(IntEnum):
-    INITIAL = 0
-    READY = 1
-    SET = 2
-    PLAYING = 3
-    FINISHED = 4
-
-
-class SecondaryState(IntEnum):
-    NORMAL = 0
-    PENALTYSHOOT = 1
-    OVERTIME = 2
-    TIMEOUT = 3
-    DIRECT_FREEKICK = 4
-    INDIRECT_FREEKICK = 5
-    PENALTYKICK = 6
-    CORNER_KICK = 7
-    GOAL_KICK = 8
-    THROW_IN = 9
-    UNKNOWN = 255
-
-
-class RobotReply(IntEnum):
-    MAN_PENALISE = 0
-    MAN_UNPENALISE = 1
-    ALIVE = 2
-    GOALKEEPER = 3
-    GAME_INTERRUPTION_READY = 4
 
 
 class BadPacket(RobotClientError):
@@ -117,62 +85,57 @@ def decode_game_state(data: bytes) -> GameControlData:
     """Decode one ``RGme`` version 12 packet.
 
     Raises:
-        BadPacket: wrong size, header or version.
+        BadPacket: wrong size, header, version or game state.
     """
-    if len(data) != PACKET_SIZE:
-        raise BadPacket(reason=f"expected {PACKET_SIZE} bytes", size=len(data))
-    (header, version, number, per_team, game_type, state, first_half, kick_off, secondary,
-     info, _drop_team, _drop_time, secs, secondary_time) = _HEAD.unpack_from(data)  # fmt: skip
-    if header != b"RGme":
-        raise BadPacket(reason=f"header {header!r}", size=len(data))
-    if version != 12:
-        raise BadPacket(reason=f"version {version}", size=len(data))
     try:
-        state_value = GameState(state)
-    except ValueError as exc:
-        raise BadPacket(reason=f"state {state}", size=len(data)) from exc
+        packet = wire.decode_game_state(data)
+    except ProtocolError as exc:
+        raise BadPacket(reason=exc.reason, size=len(data)) from None
     try:
-        secondary_value = SecondaryState(secondary)
+        state_value = GameState(packet.state)
+    except ValueError:
+        raise BadPacket(reason=f"state {packet.state}", size=len(data)) from None
+    try:
+        secondary_value = SecondaryState(packet.secondary_state)
     except ValueError:
         secondary_value = SecondaryState.UNKNOWN
-    teams = (_team(data, 24), _team(data, 24 + TEAM_SIZE))
     return GameControlData(
-        packet_number=number,
-        players_per_team=per_team,
-        game_type=game_type,
+        packet_number=packet.packet_number,
+        players_per_team=packet.players_per_team,
+        game_type=packet.game_type,
         state=state_value,
-        first_half=bool(first_half),
-        kick_off_team=kick_off,
+        first_half=packet.first_half,
+        kick_off_team=packet.kick_off_team,
         secondary_state=secondary_value,
-        secondary_state_info=bytes(info),
-        secs_remaining=secs,
-        secondary_time=secondary_time,
-        teams=teams,
+        secondary_state_info=bytes(packet.secondary_state_info),
+        secs_remaining=packet.secs_remaining,
+        secondary_time=packet.secondary_time,
+        teams=(_team(packet.teams[0]), _team(packet.teams[1])),
     )
 
 
-def _team(data: bytes, offset: int) -> TeamInfo:
-    number, colour, score, _shot, _single, _seq = _TEAM_HEAD.unpack_from(data, offset)
+def _team(team: wire.TeamInfo) -> TeamInfo:
     players = tuple(
         PlayerInfo(
-            penalty=values[0],
-            secs_till_unpenalised=values[1],
-            warnings=values[2],
-            yellow_cards=values[3],
-            red_cards=values[4],
-            goalkeeper=bool(values[5]),
+            penalty=robot.penalty,
+            secs_till_unpenalised=robot.secs_till_unpenalised,
+            warnings=robot.number_of_warnings,
+            yellow_cards=robot.yellow_card_count,
+            red_cards=robot.red_card_count,
+            goalkeeper=robot.goal_keeper,
         )
-        for values in (
-            _ROBOT.unpack_from(data, offset + _PLAYERS_OFFSET + i * ROBOT_INFO_SIZE)
-            for i in range(MAX_PLAYERS)
-        )
+        for robot in team.players
     )
-    return TeamInfo(team_number=number, colour=colour, score=score, players=players)
+    return TeamInfo(
+        team_number=team.team_number, colour=team.team_colour, score=team.score, players=players
+    )
 
 
-def encode_reply(*, team: int, player: int, message: RobotReply = RobotReply.ALIVE) -> bytes:
+def encode_reply(
+    *, team: int, player: int, message: ReturnMessage = ReturnMessage.ALIVE
+) -> bytes:
     """An ``RGrt`` version 2 packet (8 bytes)."""
-    return struct.pack("<4sBBBB", b"RGrt", 2, team, player, int(message))
+    return wire.encode_return(ReturnData(team=team, player=player, message=message))
 
 
 class GameControllerListener:
@@ -223,10 +186,27 @@ class GameControllerReplier:
         self.team = team
         self.player = player
 
-    def send(self, message: RobotReply = RobotReply.ALIVE) -> None:
+    def send(self, message: ReturnMessage = ReturnMessage.ALIVE) -> None:
         self._sock.sendto(
             encode_reply(team=self.team, player=self.player, message=message), self._target
         )
 
     def close(self) -> None:
         self._sock.close()
+
+
+__all__ = [
+    "GC_DATA_PORT",
+    "GC_RETURN_PORT",
+    "BadPacket",
+    "GameControlData",
+    "GameControllerListener",
+    "GameControllerReplier",
+    "GameState",
+    "PlayerInfo",
+    "ReturnMessage",
+    "SecondaryState",
+    "TeamInfo",
+    "decode_game_state",
+    "encode_reply",
+]

@@ -18,9 +18,15 @@ from pathlib import Path
 
 import pytest
 
+from contracts.gamecontroller import (
+    GameControlData,
+    RobotInfo,
+    TeamInfo,
+    decode_return,
+    encode_game_state,
+)
 from contracts.ids import TeamColor
 from referee.snapshot import PlaceBall
-from referee.wire import GameControlData, RobotInfo, TeamInfo, decode_return, encode_game_state
 from simulator.api import LockstepSettings
 from simulator.api.world_cameras import world_render_worker
 from tests.integration.api.harness import RED1, free_ports, real_world, running_server

@@ -12,7 +12,7 @@ from robot.client import (
     GameControllerListener,
     GameControllerReplier,
     GameState,
-    RobotReply,
+    ReturnMessage,
     SecondaryState,
     decode_game_state,
     encode_reply,
@@ -67,7 +67,7 @@ def test_bad_packets_are_typed_errors(packet: bytes) -> None:
 
 def test_reply_layout() -> None:
     assert encode_reply(team=8, player=3) == b"RGrt\x02\x08\x03\x02"
-    assert encode_reply(team=8, player=1, message=RobotReply.GOALKEEPER)[-1] == 3
+    assert encode_reply(team=8, player=1, message=ReturnMessage.GOALKEEPER)[-1] == 3
 
 
 def test_listener_and_replier_over_loopback_udp() -> None:

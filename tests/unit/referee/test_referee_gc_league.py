@@ -8,10 +8,10 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
+from contracts.gamecontroller import GameControlData, decode_game_state
 from contracts.match_spec import GameType
 from referee import FakeClock, Referee
 from referee.config import NetworkConfig
-from referee.wire import GameControlData, decode_game_state
 from tests.unit.referee.referee_helpers import (
     BLUE,
     FAST_TIMING,

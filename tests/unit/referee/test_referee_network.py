@@ -9,11 +9,11 @@ from pathlib import Path
 
 import pytest
 
+from contracts.gamecontroller import ReturnData, ReturnMessage, decode_game_state, encode_return
 from contracts.ids import RobotId, TeamColor
 from referee import FakeClock, Referee, SystemClock, TeamMirror
 from referee.config import NetworkConfig
 from referee.net import GameControllerNetwork
-from referee.wire import ReturnData, ReturnMessage, decode_game_state, encode_return
 from tests.unit.referee.referee_helpers import BLUE, RED, make_config, robot, snapshot
 
 

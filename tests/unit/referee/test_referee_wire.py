@@ -6,13 +6,7 @@ import struct
 
 import pytest
 
-from contracts.ids import RobotId, TeamColor
-from contracts.match_spec import GameType
-from referee import ProtocolError
-from referee.config import TimingConfig
-from referee.gamecontroller import GameController, GameState, Penalty, SecondaryState
-from referee.gamecontroller.packet import game_control_data
-from referee.wire import (
+from contracts.gamecontroller import (
     GameControlData,
     ReturnData,
     ReturnMessage,
@@ -23,6 +17,12 @@ from referee.wire import (
     encode_game_state,
     encode_return,
 )
+from contracts.ids import RobotId, TeamColor
+from contracts.match_spec import GameType
+from referee import ProtocolError
+from referee.config import TimingConfig
+from referee.gamecontroller import GameController, GameState, Penalty, SecondaryState
+from referee.gamecontroller.packet import game_control_data
 
 
 def _expected_bytes() -> bytes:

@@ -1,4 +1,7 @@
-"""GameController datagrams: ``RGme`` version 12 (688 bytes) and ``RGrt`` version 2 (8 bytes).
+"""The GameController protocol: ``RGme`` version 12 (688 bytes) and ``RGrt`` version 2 (8 bytes).
+
+The one codec and the one set of wire codes for the referee (which sends ``RGme`` and reads
+``RGrt``) and robot code (:mod:`robot.client.gamecontroller`, which does the opposite).
 
 Little-endian, packed, layout of ``RoboCupGameControlData.h``: a 24-byte header, then two
 332-byte TeamInfo blocks (teams[0] the team playing on the left, teams[1] the other), each with
@@ -11,8 +14,10 @@ import struct
 from dataclasses import dataclass, field
 from enum import IntEnum
 
-from referee.errors import ProtocolError
+from contracts.errors import ProtocolError
 
+GC_DATA_PORT = 3838  # RGme, GameController -> robots (UDP)
+GC_RETURN_PORT = 3939  # RGrt, robots -> GameController (UDP)
 GAME_HEADER = b"RGme"
 GAME_VERSION = 12
 RETURN_HEADER = b"RGrt"
@@ -26,6 +31,60 @@ _ROBOT = struct.Struct("<6B")
 _RETURN = struct.Struct("<4sBBBB")
 TEAM_SIZE = _TEAM.size + (MAX_PLAYERS + 1) * _ROBOT.size  # 332
 GAME_SIZE = _HEADER.size + 2 * TEAM_SIZE  # 688
+
+
+class GameState(IntEnum):
+    INITIAL = 0
+    READY = 1
+    SET = 2
+    PLAYING = 3
+    FINISHED = 4
+
+
+class SecondaryState(IntEnum):
+    NORMAL = 0
+    PENALTYSHOOT = 1
+    OVERTIME = 2
+    TIMEOUT = 3
+    DIRECT_FREEKICK = 4
+    INDIRECT_FREEKICK = 5
+    PENALTYKICK = 6
+    CORNER_KICK = 7
+    GOAL_KICK = 8
+    THROW_IN = 9
+    UNKNOWN = 255  # robot side: a code this build does not know (never sent)
+
+    @property
+    def is_set_play(self) -> bool:
+        return SecondaryState.DIRECT_FREEKICK <= self <= SecondaryState.THROW_IN
+
+
+class Penalty(IntEnum):
+    """Penalty codes on the wire (GameController ``Penalties.java``)."""
+
+    NONE = 0
+    SUBSTITUTE = 14
+    MANUAL = 15
+    BALL_MANIPULATION = 30
+    PHYSICAL_CONTACT = 31
+    ILLEGAL_ATTACK = 32
+    ILLEGAL_DEFENSE = 33
+    PICKUP_OR_INCAPABLE = 34
+    SERVICE = 35
+
+
+class GameTypeCode(IntEnum):
+    ROUNDROBIN = 0
+    PLAYOFF = 1
+    DROPIN = 2
+
+
+class TeamColourCode(IntEnum):
+    BLUE = 0
+    RED = 1
+
+
+DROPBALL_TEAM = 128  # kickOffTeam after a dropped ball
 
 
 @dataclass(frozen=True, slots=True)
