@@ -18,6 +18,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
+from contracts import files
 from orchestrator.config import Limits
 from orchestrator.config.robot_models import container_path
 from orchestrator.engine import (
@@ -45,10 +46,11 @@ LOGS_TARGET = "/robocup-logs"
 SCRATCH_DIRS = {"tmp": "/tmp", "var-tmp": "/var/tmp", "root": "/root"}
 SCRATCH_FALLBACK_TMPFS_BYTES = 256 * 1024 * 1024  # per folder, when no capped space can be made
 RUN_TMPFS = "size=16m,mode=755"
-MATCH_TARGET = "/match"
+MATCH_TARGET = files.CONTAINER_MATCH_DIR
 SIMULATOR_COMMAND = (
-    "python3", "-m", "simulator", "run", "--spec", "/match/match_spec.json", "--out", "/match/out"
-)
+    "python3", "-m", "simulator", "run",
+    "--spec", f"{MATCH_TARGET}/{files.MATCH_SPEC}", "--out", f"{MATCH_TARGET}/{files.OUT_DIR}",
+)  # fmt: skip
 
 
 def short_token(match_id: str, salt: str) -> str:
