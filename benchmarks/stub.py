@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from robot.stub.runner import CAMERA_PERIOD_MS  # the period the robot asks for in a match
+from testkit.stub_world import ShotResult, sense
 
 AFTER_KICK_S = 4.0
 MIN_KICK_M = 0.5
@@ -34,26 +34,6 @@ class TrialResult:
     falls: int
     sim_time_s: float
     sightings: int
-
-
-def sense(world: Any, robot: Any, camera: Any | None) -> Any:
-    """What the robot's controller gets in a match: joints, IMU, and a camera image when due
-    (never without a ``camera``)."""
-    from robot.stub.controller import Sensors
-
-    t_ms = world.sim_time_ms
-    image = None
-    if camera is not None and t_ms % CAMERA_PERIOD_MS == 0:
-        raw = camera.render(robot)
-        image = np.frombuffer(raw, np.uint8).reshape(240, 320, 3)
-    joints = {name[:-1]: value for name, value in world.read_positions(robot).items()}
-    return Sensors(
-        time_ms=t_ms,
-        joints=joints,
-        accel=world.read_accelerometer(robot),
-        gyro=world.read_gyro(robot),
-        image_bgr=image,
-    )
 
 
 def run_trial(*, seed: int, distance_m: float, time_limit_s: float) -> TrialResult:
@@ -172,7 +152,7 @@ def main(argv: list[str]) -> int:
 
 
 def _shots(args: argparse.Namespace, start: float) -> int:
-    from benchmarks.stub_shots import run_shot, summarize_shots
+    from testkit.stub_world import run_shot
 
     shots = []
     for trial in range(args.trials):
@@ -187,3 +167,27 @@ def _shots(args: argparse.Namespace, start: float) -> int:
     )
     print(json.dumps(summary))
     return 0
+
+
+def summarize_shots(
+    results: list[ShotResult], *, seed: int, goalie: bool, wall_s: float
+) -> dict[str, Any]:
+    goals = [r for r in results if r.goal]
+    times = [r.time_to_goal_s for r in goals if r.time_to_goal_s is not None]
+    sim_s = sum(r.sim_time_s for r in results)
+    return {
+        "bench": "stub",
+        "scenario": "shots",
+        "model": "kid-default",
+        "goalie": goalie,
+        "trials": len(results),
+        "goals": len(goals),
+        "goal_rate": round(len(goals) / max(len(results), 1), 3),
+        "outcomes": [r.outcome for r in results],
+        "mean_time_to_goal_s": round(sum(times) / len(times), 2) if times else None,
+        "kicks": sum(r.kicks for r in results),
+        "falls_per_min": round(sum(r.falls for r in results) / (sim_s / 60.0), 3) if sim_s else 0,
+        "sim_time_s": round(sim_s, 1),
+        "wall_time_s": round(wall_s, 1),
+        "seed": seed,
+    }

@@ -56,9 +56,13 @@ class Subnets:
     blue: ipaddress.IPv4Network
     control: ipaddress.IPv4Network
 
-    def of(self, role: str) -> layout.Subnet:
+    def of(self, role: str) -> ipaddress.IPv4Network:
         network: ipaddress.IPv4Network = getattr(self, role)
-        return layout.Subnet(network=network)
+        return network
+
+    def subnet(self, role: str) -> layout.Subnet:
+        """The network of ``role`` as the match layout addresses it."""
+        return layout.Subnet(network=self.of(role))
 
     @classmethod
     def starting_at(cls, first: ipaddress.IPv4Network) -> Subnets:
@@ -95,22 +99,22 @@ def match_requests(loaded: LoadedGame, *, simulator_image: str, subnets: Subnets
     extra = {LABEL_COMPOSE: "1"}
     networks = {
         role: layout.network_request(
-            prefix=prefix, role=role, subnet=subnets.of(role),
+            prefix=prefix, role=role, subnet=subnets.subnet(role),
             internal=True if role == "control" else not plan.allow_internet,
             match_id=plan.match_id, extra_labels=extra,
         )
         for role in NETWORK_ROLES
     }  # fmt: skip
     addresses = {
-        team.color: tuple(subnets.of(team.color).robot(r.number) for r in team.robots)
+        team.color: tuple(subnets.subnet(team.color).robot(r.number) for r in team.robots)
         for team in plan.teams
     }
-    control = subnets.of("control")
+    control = subnets.subnet("control")
     endpoint = f"tcp/{control.simulator}:{layout.TELEMETRY_PORT}" if plan.telemetry else None
     attachments = tuple(
         Attachment(
             network=networks[role].name,
-            ipv4_address=subnets.of(role).simulator,
+            ipv4_address=subnets.subnet(role).simulator,
             aliases=("simulator",),
         )
         for role in ("control", "red", "blue")
@@ -121,7 +125,7 @@ def match_requests(loaded: LoadedGame, *, simulator_image: str, subnets: Subnets
     )  # fmt: skip
     robots: dict[str, tuple[ContainerRequest, ContainerRequest]] = {}
     for team in plan.teams:
-        subnet = subnets.of(team.color)
+        subnet = subnets.subnet(team.color)
         for robot in team.robots:
             if robot.image is None:
                 log.info("%s has no image: it plays without a controller", robot.key)

@@ -15,8 +15,8 @@ COMMANDS = {
     "bench": None,
 }
 BENCHES = {
-    "sim": "simulator.bench_sim",
-    "api": "simulator.api.bench",
+    "sim": "benchmarks.sim",
+    "api": "benchmarks.api",
     "stub": "benchmarks.stub",
 }
 

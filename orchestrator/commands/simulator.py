@@ -85,7 +85,7 @@ def _scrimmage(args: argparse.Namespace) -> int:
 
 
 def _bringup(args: argparse.Namespace) -> int:
-    from orchestrator.bringup import main as bringup_main
+    from benchmarks.bringup import main as bringup_main
 
     return int(bringup_main(list(args.rest)))
 
@@ -111,6 +111,6 @@ def _cli(args: argparse.Namespace) -> int:
 
 
 def _delivery(args: argparse.Namespace) -> int:
-    from orchestrator.delivery.bench import main as delivery_main
+    from benchmarks.delivery import main as delivery_main
 
     return int(delivery_main(list(args.rest)))

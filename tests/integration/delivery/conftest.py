@@ -12,8 +12,8 @@ from typing import Any
 import pytest
 
 from orchestrator.delivery import MANIFEST_NAME, RetryPolicy
-from orchestrator.delivery.local_s3 import MotoServer, SeaweedServer, weed_binary
-from orchestrator.delivery.local_sftp import AsyncsshServer, SshdServer
+from testkit.s3 import MotoServer, SeaweedServer, weed_binary
+from testkit.sftp import AsyncsshServer, SshdServer
 
 FAST_RETRY = RetryPolicy(attempts=2, initial_delay_s=0.1, factor=2.0, max_delay_s=1.0)
 

@@ -17,9 +17,9 @@ from orchestrator.delivery import (
     enqueue_match_logs,
     pending_status,
 )
-from orchestrator.delivery.local_s3 import MotoServer, S3Identity, SeaweedServer
-from orchestrator.delivery.local_sftp import free_port
 from orchestrator.delivery.s3 import create_bucket
+from testkit.s3 import MotoServer, S3Identity, SeaweedServer
+from testkit.sftp import free_port
 from tests.integration.delivery.conftest import (
     FAST_RETRY,
     check_manifest,

@@ -12,7 +12,7 @@ from typing import Any
 import pytest
 
 from orchestrator.delivery import deliver_pending, enqueue_match_logs, pending_status
-from orchestrator.delivery.local_sftp import (
+from testkit.sftp import (
     AsyncsshServer,
     SftpServer,
     SshdServer,

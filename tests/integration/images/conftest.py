@@ -22,7 +22,7 @@ import docker
 import docker.errors
 import pytest
 
-from orchestrator.delivery.local_sftp import free_port
+from testkit.sftp import free_port
 from tests.conftest import TEST_LABEL
 from tests.integration.images.token_issuer import ISSUER, SERVICE, TokenIssuer
 

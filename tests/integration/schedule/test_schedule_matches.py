@@ -16,9 +16,9 @@ import boto3
 import pytest
 
 from orchestrator.config.credentials import load_credentials
-from orchestrator.delivery.local_s3 import MotoServer
 from orchestrator.delivery.s3 import create_bucket
 from orchestrator.schedule import Ledger, MatchState, run_schedule, standings
+from testkit.s3 import MotoServer
 
 pytestmark = [pytest.mark.docker, pytest.mark.slow]
 

@@ -8,8 +8,8 @@ import time
 
 import zenoh
 
-from orchestrator.delivery.local_sftp import free_port
 from orchestrator.telemetry import LiveView, ZenohTelemetry, describe
+from testkit.sftp import free_port
 
 
 def test_subscriber_receives_state_and_events_from_a_listening_publisher() -> None:

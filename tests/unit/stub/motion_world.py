@@ -8,12 +8,12 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.stub import sense
 from contracts.ids import RobotId, TeamColor
 from referee.snapshot import PlaceBall
 from robot.motion import standing_posture
 from robot.stub.controller import Sensors
 from simulator.world import RobotPlacement, World
+from testkit.stub_world import sense
 
 RED1 = RobotId(TeamColor.RED, 1)
 

@@ -5,9 +5,9 @@ import os
 
 import pytest
 
-from benchmarks.stub_shots import run_shot, shot_layout
 from robot.stub.behaviour import Field, GameInfo, Phase, Role, decide
 from robot.stub.world_model import Pose2D
+from testkit.stub_world import run_shot, shot_layout
 
 FIELD = Field(half_length_m=4.5, foot_y_m=0.075, kick_x_m=0.165)
 PLAYING = GameInfo(phase=Phase.PLAYING)

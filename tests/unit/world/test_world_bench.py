@@ -3,15 +3,24 @@
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 
 import pytest
 
-from simulator.bench_sim import main
+
+def bench_sim(*args: str) -> subprocess.CompletedProcess[str]:
+    """``python -m simulator bench sim ARGS`` (what ``hlvs bench sim`` runs)."""
+    return subprocess.run(
+        [sys.executable, "-m", "simulator", "bench", "sim", *args],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
 
 
-def test_bench_sim_prints_one_json_line(capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["--robots", "2", "--sim-seconds", "1", "--json"]) == 0
-    lines = capsys.readouterr().out.strip().splitlines()
+def test_bench_sim_prints_one_json_line() -> None:
+    run = bench_sim("--robots", "2", "--sim-seconds", "1", "--json")
+    assert run.returncode == 0, run.stderr
+    lines = run.stdout.strip().splitlines()
     assert len(lines) == 1
     result = json.loads(lines[0])
     assert result["bench"] == "sim" and result["robots"] == 2
@@ -21,6 +30,7 @@ def test_bench_sim_prints_one_json_line(capsys: pytest.CaptureFixture[str]) -> N
     assert result["fallen"] == 0  # robots holding the standing posture stay up
 
 
-def test_bench_sim_rejects_bad_arguments(capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["--robots", "40", "--json"]) == 2
-    assert "--robots" in capsys.readouterr().err
+def test_bench_sim_rejects_bad_arguments() -> None:
+    run = bench_sim("--robots", "40", "--json")
+    assert run.returncode == 2
+    assert "--robots" in run.stderr

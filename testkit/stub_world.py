@@ -1,11 +1,13 @@
-"""``bench stub --scenario shots``: does the stub striker score from in front of the goal?
+"""The stub robot controller on an in-process world (no network), for tests and benchmarks.
 
-Each trial puts the ball 1.5-4 m in front of the goal the striker attacks (x > 0, at most
-60 degrees off the goal axis) and the striker 1 m from the ball at a random (seeded) bearing and
-heading; optionally an opponent goalie (the stub goalie behaviour, same perception) defends.
-The striker plays with the same controller and perception as in a match. A trial succeeds when
-the ball crosses the goal line between the posts within the time limit; it ends early when the
-ball leaves the field anywhere else.
+:func:`sense` gives a controller what it gets in a match (joints, IMU, a camera image when due).
+:func:`run_shot` is one trial of ``hlvs bench stub --scenario shots``: does the stub striker
+score from in front of the goal? Each trial puts the ball 1.5-4 m in front of the goal the
+striker attacks (x > 0, at most 60 degrees off the goal axis) and the striker 1 m from the ball
+at a random (seeded) bearing and heading; optionally an opponent goalie (the stub goalie
+behaviour, same perception) defends. The striker plays with the same controller and perception
+as in a match. A trial succeeds when the ball crosses the goal line between the posts within the
+time limit; it ends early when the ball leaves the field anywhere else.
 """
 
 from __future__ import annotations
@@ -16,9 +18,31 @@ from typing import Any
 
 import numpy as np
 
+from robot.stub.runner import CAMERA_PERIOD_MS  # the period the robot asks for in a match
+
 GOAL_HALF_WIDTH_M = 1.3
 HALF_LENGTH_M = 4.5
 HALF_WIDTH_M = 3.0
+
+
+def sense(world: Any, robot: Any, camera: Any | None) -> Any:
+    """What the robot's controller gets in a match: joints, IMU, and a camera image when due
+    (never without a ``camera``)."""
+    from robot.stub.controller import Sensors
+
+    t_ms = world.sim_time_ms
+    image = None
+    if camera is not None and t_ms % CAMERA_PERIOD_MS == 0:
+        raw = camera.render(robot)
+        image = np.frombuffer(raw, np.uint8).reshape(240, 320, 3)
+    joints = {name[:-1]: value for name, value in world.read_positions(robot).items()}
+    return Sensors(
+        time_ms=t_ms,
+        joints=joints,
+        accel=world.read_accelerometer(robot),
+        gyro=world.read_gyro(robot),
+        image_bgr=image,
+    )
 
 
 @dataclass(frozen=True, slots=True)
@@ -45,7 +69,6 @@ def shot_layout(seed: int) -> tuple[tuple[float, float], tuple[float, float, flo
 
 
 def run_shot(*, seed: int, time_limit_s: float, goalie: bool) -> ShotResult:
-    from benchmarks.stub import sense
     from contracts.ids import RobotId, TeamColor
     from referee.snapshot import PlaceBall
     from robot.stub.behaviour import GameInfo, Phase, Role
@@ -96,25 +119,4 @@ def run_shot(*, seed: int, time_limit_s: float, goalie: bool) -> ShotResult:
     )
 
 
-def summarize_shots(
-    results: list[ShotResult], *, seed: int, goalie: bool, wall_s: float
-) -> dict[str, Any]:
-    goals = [r for r in results if r.goal]
-    times = [r.time_to_goal_s for r in goals if r.time_to_goal_s is not None]
-    sim_s = sum(r.sim_time_s for r in results)
-    return {
-        "bench": "stub",
-        "scenario": "shots",
-        "model": "kid-default",
-        "goalie": goalie,
-        "trials": len(results),
-        "goals": len(goals),
-        "goal_rate": round(len(goals) / max(len(results), 1), 3),
-        "outcomes": [r.outcome for r in results],
-        "mean_time_to_goal_s": round(sum(times) / len(times), 2) if times else None,
-        "kicks": sum(r.kicks for r in results),
-        "falls_per_min": round(sum(r.falls for r in results) / (sim_s / 60.0), 3) if sim_s else 0,
-        "sim_time_s": round(sim_s, 1),
-        "wall_time_s": round(wall_s, 1),
-        "seed": seed,
-    }
+__all__ = ["ShotResult", "run_shot", "sense", "shot_layout"]

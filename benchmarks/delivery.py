@@ -1,6 +1,6 @@
 """Delivery benchmark: one log set of N files / M MB to a local SFTP or S3 server.
 
-``python -m orchestrator.delivery.bench --target sftp|s3 [--server NAME] --files 200 --mb 50
+``python -m benchmarks.delivery --target sftp|s3 [--server NAME] --files 200 --mb 50
 --json`` starts the server on 127.0.0.1 (sftp: sshd when root, else asyncssh; s3: SeaweedFS when
 installed, else moto), enqueues a match whose team folder holds the files, delivers it and
 prints one JSON line: seconds to enqueue (hashing included) and to deliver, MB/s, files/s.
@@ -21,8 +21,8 @@ from typing import Any
 
 from orchestrator.delivery.deliver import RetryPolicy, deliver_pending
 from orchestrator.delivery.enqueue import enqueue_match_logs
-from orchestrator.delivery.local_s3 import MotoServer, SeaweedServer, weed_binary
-from orchestrator.delivery.local_sftp import AsyncsshServer, SshdServer
+from testkit.s3 import MotoServer, SeaweedServer, weed_binary
+from testkit.sftp import AsyncsshServer, SshdServer
 
 __all__ = ["main"]
 

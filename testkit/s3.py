@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from orchestrator.delivery.local_sftp import free_port
+from testkit.sftp import free_port
 
 __all__ = ["MotoServer", "S3Identity", "SeaweedServer", "weed_binary"]
 

@@ -203,7 +203,7 @@ def _world_only(
 def _bench_sim(robots: int, physics_dt: float, sim_seconds: float) -> dict[str, Any] | None:
     """The world's ``bench sim`` numbers for the same setup, when they are available."""
     try:
-        from simulator.bench_sim import run
+        from benchmarks.sim import run
     except ImportError:
         return None
     result = run(robots=robots, sim_seconds=sim_seconds, physics_dt_s=physics_dt, field_class="kid")
