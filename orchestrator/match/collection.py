@@ -13,12 +13,13 @@ from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from functools import partial
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from contracts import files
 from contracts.errors import ContractError
 from contracts.sim_result import SimResult
 from orchestrator.errors import OrchestratorError
+from orchestrator.match.context import MatchContext
 from orchestrator.match.logfs import LogFolder
 from orchestrator.match.results import (
     FailureClass,
@@ -29,18 +30,15 @@ from orchestrator.match.results import (
 from orchestrator.match.safecopy import restrict
 from orchestrator.match.state import MatchState
 
-if TYPE_CHECKING:
-    from orchestrator.match.runner import MatchRunner
-
 log = logging.getLogger(__name__)
 
 PUBLIC_FILES = files.PUBLIC_FILES
 
 
-def read_sim_result(runner: MatchRunner) -> SimResult | None:
+def read_sim_result(match: MatchContext) -> SimResult | None:
     """The simulator's ``sim_result.json``; None when it is missing or does not fit the contract
     (logged with the file, field and reason)."""
-    match_dir = runner.started.match_dir
+    match_dir = match.started.match_dir
     if match_dir is None:
         return None
     path = match_dir / files.OUT_DIR / files.SIM_RESULT
@@ -49,17 +47,17 @@ def read_sim_result(runner: MatchRunner) -> SimResult | None:
     try:
         return SimResult.load(path)
     except ContractError as exc:
-        log.error("match %s: %s", runner.plan.match_id, exc)
+        log.error("match %s: %s", match.plan.match_id, exc)
         return None
 
 
-def simulator_stderr_tail(runner: MatchRunner) -> str:
-    sim_id = runner.started.simulator_id
-    match_dir = runner.started.match_dir
+def simulator_stderr_tail(match: MatchContext) -> str:
+    sim_id = match.started.simulator_id
+    match_dir = match.started.match_dir
     if sim_id is None or match_dir is None:
         return ""
     try:
-        runner.runtime.save_logs(sim_id, stdout=match_dir / "stdout.log",
+        match.runtime.save_logs(sim_id, stdout=match_dir / "stdout.log",
                                  stderr=match_dir / "stderr.log")
         lines = (match_dir / "stderr.log").read_text(errors="replace").strip().splitlines()
     except (OrchestratorError, OSError):
@@ -67,59 +65,59 @@ def simulator_stderr_tail(runner: MatchRunner) -> str:
     return lines[-1][:300] if lines else ""
 
 
-def _guarded(runner: MatchRunner, what: str, step: Callable[[], object]) -> None:
+def _guarded(match: MatchContext, what: str, step: Callable[[], object]) -> None:
     try:
         step()
     except (OrchestratorError, OSError) as exc:
-        log.error("match %s: %s failed: %s", runner.plan.match_id, what, exc)
-        runner._fail(FailureClass.INFRASTRUCTURE, f"{what}: {exc}")
+        log.error("match %s: %s failed: %s", match.plan.match_id, what, exc)
+        match.fail(FailureClass.INFRASTRUCTURE, f"{what}: {exc}")
 
 
-def _stop_robots(runner: MatchRunner) -> None:
-    grace = runner.plan.grace_period_s
-    ids = runner.started.robot_ids
+def _stop_robots(match: MatchContext) -> None:
+    grace = match.plan.grace_period_s
+    ids = match.started.robot_ids
 
     def stop(item: tuple[str, str]) -> None:
         key, container_id = item
-        _guarded(runner, f"stopping robot {key}",
-                 lambda: runner.runtime.stop(container_id, timeout_s=grace))
+        _guarded(match, f"stopping robot {key}",
+                 lambda: match.runtime.stop(container_id, timeout_s=grace))
 
     if ids:
-        log.info("match %s: stopping %d robots (grace %.0f s)", runner.plan.match_id, len(ids),
+        log.info("match %s: stopping %d robots (grace %.0f s)", match.plan.match_id, len(ids),
                  grace)
         with ThreadPoolExecutor(max_workers=min(8, len(ids))) as pool:
             list(pool.map(stop, ids.items()))
 
 
-def _read_counters(runner: MatchRunner) -> None:
-    for key, applied in runner.started.shaping.items():
-        record = runner.records[key]
+def _read_counters(match: MatchContext) -> None:
+    for key, applied in match.started.shaping.items():
+        record = match.records[key]
         try:
-            counters = runner.host.counters(applied)
+            counters = match.host.counters(applied)
         except OrchestratorError as exc:
-            log.warning("match %s: no traffic counters for %s: %s", runner.plan.match_id, key, exc)
+            log.warning("match %s: no traffic counters for %s: %s", match.plan.match_id, key, exc)
             continue
         record.sent_bytes = counters.sent_bytes
         record.received_bytes = counters.received_bytes
 
 
-def _collect_robot(runner: MatchRunner, key: str, container_id: str) -> None:
-    record = runner.records[key]
-    folder = runner.options.out_dir / "teams" / record.color / str(record.number)
-    state = runner.runtime.inspect(container_id)
+def _collect_robot(match: MatchContext, key: str, container_id: str) -> None:
+    record = match.records[key]
+    folder = match.options.out_dir / "teams" / record.color / str(record.number)
+    state = match.runtime.inspect(container_id)
     record.exit_code = state.exit_code
     record.oom_killed = record.oom_killed or state.oom_killed
     record.restarts = state.restart_count
-    peaks = runner.monitor.peaks(key)
+    peaks = match.monitor.peaks(key)
     record.cpu_peak_percent = peaks.cpu_percent
     record.memory_peak_bytes = peaks.memory_bytes
-    runner.runtime.save_logs(container_id, stdout=folder / "stdout.log",
+    match.runtime.save_logs(container_id, stdout=folder / "stdout.log",
                              stderr=folder / "stderr.log")
 
 
-def _copy_public(runner: MatchRunner) -> None:
-    match_dir = runner.started.match_dir
-    public = runner.options.out_dir / "public"
+def _copy_public(match: MatchContext) -> None:
+    match_dir = match.started.match_dir
+    public = match.options.out_dir / "public"
     public.mkdir(parents=True, exist_ok=True)
     if match_dir is None:
         return
@@ -129,75 +127,75 @@ def _copy_public(runner: MatchRunner) -> None:
             shutil.copy2(source, public / name)
 
 
-def _collect_log_folder(runner: MatchRunner, key: str, folder: LogFolder,
+def _collect_log_folder(match: MatchContext, key: str, folder: LogFolder,
                         destination: Path) -> None:
     """What a team wrote never fails the match: only releasing the mount can raise."""
-    report = runner.host.collect_logs(folder, destination)
-    runner.records[key].log_folder = report.to_json()
+    report = match.host.collect_logs(folder, destination)
+    match.records[key].log_folder = report.to_json()
     if report.skipped_count:
         log.warning("match %s: %s: %d entries of /robocup-logs not collected (%s)",
-                    runner.plan.match_id, key, report.skipped_count,
+                    match.plan.match_id, key, report.skipped_count,
                     ", ".join(f"{s['path']}: {s['kind']}" for s in report.skipped[:5]))
 
 
-def _teardown(runner: MatchRunner) -> None:
-    started = runner.started
-    runtime = runner.runtime
+def _teardown(match: MatchContext) -> None:
+    started = match.started
+    runtime = match.runtime
     for key, container_id in list(started.robot_ids.items()) + list(started.holder_ids.items()):
-        _guarded(runner, f"removing container of {key}", partial(runtime.remove, container_id))
+        _guarded(match, f"removing container of {key}", partial(runtime.remove, container_id))
     if started.simulator_id is not None:
         sim_id = started.simulator_id
-        _guarded(runner, "removing the simulator", lambda: runtime.remove(sim_id))
+        _guarded(match, "removing the simulator", lambda: runtime.remove(sim_id))
     for key, folder in started.log_folders.items():
-        record = runner.records[key]
-        target = runner.options.out_dir / "teams" / record.color / str(record.number)
-        _guarded(runner, f"releasing /robocup-logs of {key}",
-                 partial(_collect_log_folder, runner, key, folder, target / "robocup-logs"))
+        record = match.records[key]
+        target = match.options.out_dir / "teams" / record.color / str(record.number)
+        _guarded(match, f"releasing /robocup-logs of {key}",
+                 partial(_collect_log_folder, match, key, folder, target / "robocup-logs"))
     for key, scratch in started.scratch.items():
-        _guarded(runner, f"releasing the scratch space of {key}",
-                 partial(runner.host.release, scratch))
+        _guarded(match, f"releasing the scratch space of {key}",
+                 partial(match.host.release, scratch))
     for network in started.networks.values():
-        _guarded(runner, f"removing network {network.name}",
+        _guarded(match, f"removing network {network.name}",
                  partial(runtime.remove_network, network.name))
-    _guarded(runner, "removing host firewall rules",
-             lambda: runner.host.remove_isolation(match_id=runner.plan.match_id))
+    _guarded(match, "removing host firewall rules",
+             lambda: match.host.remove_isolation(match_id=match.plan.match_id))
 
 
-def finish(runner: MatchRunner) -> dict[str, Any]:
+def _finish(match: MatchContext) -> dict[str, Any]:
     """Run STOPPING and COLLECTING from wherever the match got to; returns the results."""
-    lifecycle = runner.lifecycle
+    lifecycle = match.lifecycle
     if lifecycle.state in (MatchState.PULLING, MatchState.STARTING, MatchState.WAITING,
                            MatchState.PLAYING):
-        runner._advance(MatchState.STOPPING)
-    started = runner.started
+        match.advance(MatchState.STOPPING)
+    started = match.started
     if lifecycle.state is MatchState.STOPPING:
-        _stop_robots(runner)
-        _read_counters(runner)
+        _stop_robots(match)
+        _read_counters(match)
         if started.simulator_id is not None:
-            _guarded(runner, "stopping the simulator", partial(
-                runner.runtime.stop, started.simulator_id,
-                timeout_s=runner.options.simulator_stop_s))
+            _guarded(match, "stopping the simulator", partial(
+                match.runtime.stop, started.simulator_id,
+                timeout_s=match.options.simulator_stop_s))
         for key, holder_id in started.holder_ids.items():
-            _guarded(runner, f"stopping the network holder of {key}",
-                     partial(runner.runtime.kill, holder_id))
-        runner._advance(MatchState.COLLECTING)
-    if runner.telemetry is not None:
-        runner.telemetry.close()
-    runner.monitor.join(timeout_s=1.0)
+            _guarded(match, f"stopping the network holder of {key}",
+                     partial(match.runtime.kill, holder_id))
+        match.advance(MatchState.COLLECTING)
+    if match.telemetry is not None:
+        match.telemetry.close()
+    match.monitor.join(timeout_s=1.0)
     for key, container_id in started.robot_ids.items():
-        _guarded(runner, f"collecting logs of {key}",
-                 partial(_collect_robot, runner, key, container_id))
+        _guarded(match, f"collecting logs of {key}",
+                 partial(_collect_robot, match, key, container_id))
     if started.simulator_id is not None and started.match_dir is not None:
         sim_id, match_dir = started.simulator_id, started.match_dir
-        _guarded(runner, "collecting simulator logs", lambda: runner.runtime.save_logs(
+        _guarded(match, "collecting simulator logs", lambda: match.runtime.save_logs(
             sim_id, stdout=match_dir / "stdout.log", stderr=match_dir / "stderr.log"))
-    _guarded(runner, "copying public files", lambda: _copy_public(runner))
-    _teardown(runner)
-    return _write(runner)
+    _guarded(match, "copying public files", lambda: _copy_public(match))
+    _teardown(match)
+    return _write(match)
 
 
-def _host_controls(runner: MatchRunner) -> dict[str, bool] | None:
-    describe = getattr(runner.host, "describe", None)
+def _host_controls(match: MatchContext) -> dict[str, bool] | None:
+    describe = getattr(match.host, "describe", None)
     return describe() if callable(describe) else None
 
 
@@ -208,42 +206,55 @@ def _version() -> str:
         return "unknown"
 
 
-def _write(runner: MatchRunner) -> dict[str, Any]:
-    out: Path = runner.options.out_dir
-    plan = runner.plan
+def _write(match: MatchContext) -> dict[str, Any]:
+    out: Path = match.options.out_dir
+    plan = match.plan
     limits = plan.limits
     results = build_results(
         match_id=plan.match_id,
         seed=plan.seed,
-        sim_result=read_sim_result(runner),
-        robots=list(runner.records.values()),
-        forfeit=runner.forfeit,
+        sim_result=read_sim_result(match),
+        robots=list(match.records.values()),
+        forfeit=match.forfeit,
         limits={
             "cpus": limits.cpus, "memory_gb": limits.memory_gb, "pids": limits.pids,
             "log_folder_gb": limits.log_folder_gb, "team_api_mb_s": limits.team_api_mb_s,
             "team_comm_mb_s": limits.team_comm_mb_s, "grace_period_s": plan.grace_period_s,
             "allow_internet": plan.allow_internet,
-            "host_controls": _host_controls(runner),
+            "host_controls": _host_controls(match),
         },
         versions={"hlvs-runner": _version(), **plan.versions},
-        timings_s=dict(runner.lifecycle.timings_s),
-        failure=runner.failure,
+        timings_s=dict(match.lifecycle.timings_s),
+        failure=match.failure,
     )
-    results["bringup_s"] = runner.bringup_s
+    results["bringup_s"] = match.bringup_s
     results["admission"] = dict(plan.admission) if plan.admission is not None else None
     write_results(out, results)
-    lifecycle = runner.lifecycle
+    lifecycle = match.lifecycle
     if lifecycle.state is MatchState.COLLECTING:
-        runner._advance(MatchState.FAILED if runner.failure else MatchState.DONE)
+        match.advance(MatchState.FAILED if match.failure else MatchState.DONE)
     elif lifecycle.state is MatchState.PENDING:
-        runner._advance(MatchState.FAILED)
+        match.advance(MatchState.FAILED)
     results["timings_s"] = dict(lifecycle.timings_s)
     write_results(out, results)
     restrict(out)  # the teams' logs are theirs: owner-only, as everything else here
-    write_report(out, runner.failure)
+    write_report(out, match.failure)
     log.info("match %s: %s, results in %s", plan.match_id,
-             "failed" if runner.failure else "done", out)
+             "failed" if match.failure else "done", out)
     return results
 
 
-__all__ = ["PUBLIC_FILES", "finish", "read_sim_result", "simulator_stderr_tail"]
+class CollectionPhase:
+    """STOPPING and COLLECTING from wherever the match got to; returns the results."""
+
+    def __init__(self, match: MatchContext) -> None:
+        self.match = match
+
+
+    def run(self) -> dict[str, Any]:
+        """Stop, collect, remove everything created, write ``results.json`` and, last,
+        ``report.json``; returns the results."""
+        return _finish(self.match)
+
+
+__all__ = ["PUBLIC_FILES", "CollectionPhase", "read_sim_result", "simulator_stderr_tail"]

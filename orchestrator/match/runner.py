@@ -17,44 +17,25 @@ import logging
 import threading
 import time
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from contracts import files
 from orchestrator.errors import OrchestratorError
-from orchestrator.match import collection, startup
+from orchestrator.match.collection import CollectionPhase, read_sim_result, simulator_stderr_tail
+from orchestrator.match.context import MatchContext, RunOptions, TelemetryFactory
 from orchestrator.match.host import Host
-from orchestrator.match.layout import SIMULATOR_COMMAND
-from orchestrator.match.monitor import StatsMonitor
 from orchestrator.match.plan import MatchPlan
-from orchestrator.match.results import Failure, FailureClass, RobotRecord
+from orchestrator.match.results import Failure, FailureClass
 from orchestrator.match.runtime import ContainerRuntime
-from orchestrator.match.state import Lifecycle, MatchState
-from orchestrator.paths import user_path
-from orchestrator.telemetry import TelemetrySource
+from orchestrator.match.startup import StartupPhase
+from orchestrator.match.state import MatchState
 
 log = logging.getLogger(__name__)
 
-TelemetryFactory = Callable[[str, str], TelemetrySource]  # (endpoint, match_id)
 ImageResolver = Callable[[MatchPlan], Mapping[str, tuple[str | None, str | None]]]
 """plan -> {robot key: (digest, error)}; a robot with an error has no usable image."""
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class RunOptions:
-    out_dir: Path
-    simulator_image: str
-    simulator_command: tuple[str, ...] = SIMULATOR_COMMAND
-    holder_image: str | None = None  # default: the simulator image (needs ``sleep``)
-    extra_labels: Mapping[str, str] = field(default_factory=dict)
-    poll_s: float = 0.5
-    simulator_stop_s: float = 10.0
-    progress: Callable[[str, dict[str, Any] | None], None] | None = None
-
-    def __post_init__(self) -> None:
-        # The output folder becomes bind-mount sources: Docker takes a relative one for a volume.
-        object.__setattr__(self, "out_dir", user_path(self.out_dir))
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -86,7 +67,9 @@ def local_images(runtime: ContainerRuntime) -> ImageResolver:
     return resolve
 
 
-class MatchRunner:
+class MatchRunner(MatchContext):
+    """Runs the phases of one match in order on its :class:`MatchContext`."""
+
     def __init__(
         self,
         plan: MatchPlan,
@@ -99,25 +82,11 @@ class MatchRunner:
         stop_event: threading.Event | None = None,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
-        self.plan = plan
-        self.runtime = runtime
-        self.host = host
-        self.options = options
+        super().__init__(
+            plan, runtime=runtime, host=host, options=options, telemetry=telemetry,
+            stop_event=stop_event, clock=clock,
+        )  # fmt: skip
         self.images = images or local_images(runtime)
-        self.telemetry_factory = telemetry
-        self.stop_event = stop_event or threading.Event()
-        self.clock = clock
-        self.lifecycle = Lifecycle(plan.match_id, clock=clock)
-        self.records = {
-            r.key: RobotRecord(key=r.key, color=r.color, number=r.number, image=r.image)
-            for r in plan.robots
-        }
-        self.monitor = StatsMonitor(runtime)
-        self.started = startup.Started()
-        self.failure: Failure | None = None
-        self.forfeit: dict[str, Any] | None = None
-        self.bringup_s: float | None = None
-        self.telemetry: TelemetrySource | None = None
 
     # public -------------------------------------------------------------------------------
     def run(self) -> MatchOutcome:
@@ -126,44 +95,31 @@ class MatchRunner:
         out.chmod(0o700)  # the teams' logs are theirs: owner-only (see collection)
         (out / files.REPORT).unlink(missing_ok=True)  # a stale one would say "complete"
         try:
-            self._advance(MatchState.PULLING)
+            self.advance(MatchState.PULLING)
             self._resolve_images()
             if self.failure is None and self.forfeit is None:
-                self._advance(MatchState.STARTING)
+                self.advance(MatchState.STARTING)
                 started_at = self.clock()
-                startup.start(self, started_at)
+                StartupPhase(self).run(started_at)
                 if self.failure is None:
-                    self._advance(MatchState.WAITING)
+                    self.advance(MatchState.WAITING)
                     self._watch(started_at)
         except OrchestratorError as exc:
             log.error("match %s: %s", self.plan.match_id, exc)
-            self._fail(FailureClass.INFRASTRUCTURE, str(exc))
+            self.fail(FailureClass.INFRASTRUCTURE, str(exc))
         except KeyboardInterrupt:
-            self._fail(FailureClass.INTERRUPTED, "interrupted")
+            self.fail(FailureClass.INTERRUPTED, "interrupted")
         except Exception as exc:  # a bug: still stop and remove everything, then re-raise
-            self._fail(FailureClass.INFRASTRUCTURE, f"internal error: {exc!r}")
-            collection.finish(self)
+            self.fail(FailureClass.INFRASTRUCTURE, f"internal error: {exc!r}")
+            CollectionPhase(self).run()
             raise
-        results = collection.finish(self)
+        results = CollectionPhase(self).run()
         return MatchOutcome(
             match_id=self.plan.match_id, failure=self.failure, out_dir=out, results=results,
             bringup_s=self.bringup_s,
         )
 
-    # helpers used by startup / collection ------------------------------------------------
-    def _advance(self, target: MatchState) -> None:
-        self.lifecycle.advance(target)
-        self._progress(None)
-
-    def _progress(self, state: dict[str, Any] | None) -> None:
-        if self.options.progress is not None:
-            self.options.progress(self.lifecycle.state.value, state)
-
-    def _fail(self, failure_class: FailureClass, cause: str) -> None:
-        if self.failure is None:
-            self.failure = Failure(failure_class=failure_class, cause=cause)
-            log.error("match %s failed (%s): %s", self.plan.match_id, failure_class.value, cause)
-
+    # phases run by run() -----------------------------------------------------------------
     def _resolve_images(self) -> None:
         resolved = self.images(self.plan)
         usable: dict[str, int] = {"red": 0, "blue": 0}
@@ -183,7 +139,7 @@ class MatchRunner:
             for color in forfeiting
         }
         if len(forfeiting) == 2:
-            self._fail(FailureClass.IMAGE_PULL, "neither team has a usable image ("
+            self.fail(FailureClass.IMAGE_PULL, "neither team has a usable image ("
                        + "; ".join(first_error.values()) + ")")
         elif forfeiting:
             loser = forfeiting[0]
@@ -203,7 +159,7 @@ class MatchRunner:
         last_robot_poll = 0.0
         while True:
             if self.stop_event.is_set():
-                self._fail(FailureClass.INTERRUPTED, "the orchestrator was asked to stop")
+                self.fail(FailureClass.INTERRUPTED, "the orchestrator was asked to stop")
                 return
             state = self.runtime.inspect(sim_id)
             if state.exited:
@@ -218,7 +174,7 @@ class MatchRunner:
                 self.telemetry is None
                 or (latest is not None and latest.get("state") not in (None, "INITIAL"))
             ):
-                self._advance(MatchState.PLAYING)
+                self.advance(MatchState.PLAYING)
             if self.bringup_s is None and latest is not None:
                 expected = {k for k in self.started.robot_ids}
                 if expected and expected <= set(latest.get("connected") or []):
@@ -228,10 +184,10 @@ class MatchRunner:
             if self.telemetry is not None:
                 heard = self.telemetry.last_message_at() or self.started.simulator_started_at
                 if now - heard > self.plan.telemetry_silence_s:
-                    self._fail(FailureClass.SIMULATOR,
+                    self.fail(FailureClass.SIMULATOR,
                                f"telemetry silent for {now - heard:.0f} s")
                     return
-            self._progress(latest)
+            self.progress(latest)
             self.stop_event.wait(self.options.poll_s)
 
     def _poll_robots(self) -> None:
@@ -257,17 +213,17 @@ class MatchRunner:
     def _on_simulator_exit(self, exit_code: int | None) -> None:
         log.info("match %s: simulator exited with code %s", self.plan.match_id, exit_code)
         if exit_code != 0:
-            written = collection.read_sim_result(self)
+            written = read_sim_result(self)
             reported = written.error if written is not None else None
-            tail = str(reported) if reported else collection.simulator_stderr_tail(self)
-            self._fail(FailureClass.SIMULATOR,
+            tail = str(reported) if reported else simulator_stderr_tail(self)
+            self.fail(FailureClass.SIMULATOR,
                        f"simulator exited with code {exit_code}" + (f": {tail}" if tail else ""))
             return
-        sim_result = collection.read_sim_result(self)
+        sim_result = read_sim_result(self)
         if sim_result is None:
-            self._fail(FailureClass.SIMULATOR, "simulator exited 0 without sim_result.json")
+            self.fail(FailureClass.SIMULATOR, "simulator exited 0 without sim_result.json")
         elif not sim_result.finished:
-            self._fail(FailureClass.REFEREE,
+            self.fail(FailureClass.REFEREE,
                        f"the game ended in state {sim_result.state}, not FINISHED")
 
 

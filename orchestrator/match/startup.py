@@ -1,4 +1,7 @@
-"""STARTING: networks, host firewall, match spec, simulator, then the robots in parallel."""
+"""STARTING: networks, host firewall, match spec, simulator, then the robots in parallel.
+
+:class:`StartupPhase` runs it on a :class:`~orchestrator.match.context.MatchContext`.
+"""
 
 from __future__ import annotations
 
@@ -6,56 +9,34 @@ import json
 import logging
 import shutil
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, field, replace
-from pathlib import Path
-from typing import TYPE_CHECKING
+from dataclasses import replace
 
-from orchestrator.bandwidth import AppliedShaping, RobotShaping, mb_s_to_bit
+from orchestrator.bandwidth import RobotShaping, mb_s_to_bit
 from orchestrator.errors import InfrastructureError, OrchestratorError
 from orchestrator.match import layout
 from orchestrator.match.admission import cpu_sets
-from orchestrator.match.layout import Subnet
+from orchestrator.match.context import MatchContext, Started
 from orchestrator.match.logfs import LogFolder, safe_name
 from orchestrator.match.plan import RobotPlan, per_robot_rate_mb_s
 from orchestrator.match.results import FailureClass
-from orchestrator.match.runtime import Attachment, ContainerRequest, NetworkInfo, SubnetInUse
-
-if TYPE_CHECKING:
-    from orchestrator.match.runner import MatchRunner
+from orchestrator.match.runtime import Attachment, ContainerRequest, SubnetInUse
 
 log = logging.getLogger(__name__)
 
 
-@dataclass(slots=True)
-class Started:
-    """Everything created so far, so that teardown removes exactly that."""
-
-    prefix: str = ""
-    networks: dict[str, NetworkInfo] = field(default_factory=dict)  # role -> network
-    subnets: dict[str, Subnet] = field(default_factory=dict)
-    simulator_id: str | None = None
-    simulator_started_at: float = 0.0
-    holder_ids: dict[str, str] = field(default_factory=dict)  # robot key -> holder id
-    robot_ids: dict[str, str] = field(default_factory=dict)  # robot key -> container id
-    shaping: dict[str, AppliedShaping] = field(default_factory=dict)
-    log_folders: dict[str, LogFolder] = field(default_factory=dict)
-    scratch: dict[str, LogFolder] = field(default_factory=dict)  # robot key -> scratch space
-    match_dir: Path | None = None
-
-
-def _create_network(runner: MatchRunner, role: str, internal: bool) -> None:
-    plan = runner.plan
-    started = runner.started
+def _create_network(match: MatchContext, role: str, internal: bool) -> None:
+    plan = match.plan
+    started = match.started
     taken = {str(s.network) for s in started.subnets.values()}
     for subnet in layout.candidate_subnets(f"{plan.match_id}/{role}"):
         if str(subnet.network) in taken:
             continue
         request = layout.network_request(
             prefix=started.prefix, role=role, subnet=subnet, internal=internal,
-            match_id=plan.match_id, extra_labels=runner.options.extra_labels,
+            match_id=plan.match_id, extra_labels=match.options.extra_labels,
         )
         try:
-            started.networks[role] = runner.runtime.create_network(request)
+            started.networks[role] = match.runtime.create_network(request)
         except SubnetInUse:
             continue
         started.subnets[role] = subnet
@@ -63,15 +44,15 @@ def _create_network(runner: MatchRunner, role: str, internal: bool) -> None:
     raise InfrastructureError(f"no free /24 in 10.213.0.0/16 for the {role} network")
 
 
-def start(runner: MatchRunner, started_at: float) -> None:
-    plan = runner.plan
-    started = runner.started
+def _start(match: MatchContext, started_at: float) -> None:
+    plan = match.plan
+    started = match.started
     started.prefix = f"hlvs-{safe_name(plan.match_id)}"
     for role, internal in (("control", True), ("red", not plan.allow_internet),
                            ("blue", not plan.allow_internet)):
-        _create_network(runner, role, internal)
+        _create_network(match, role, internal)
     for color in ("red", "blue"):
-        runner.host.isolate_bridge(started.networks[color].bridge_name, match_id=plan.match_id)
+        match.host.isolate_bridge(started.networks[color].bridge_name, match_id=plan.match_id)
 
     addresses = {
         team.color: tuple(started.subnets[team.color].robot(r.number) for r in team.robots)
@@ -79,7 +60,7 @@ def start(runner: MatchRunner, started_at: float) -> None:
     }
     control = started.subnets["control"]
     endpoint = f"tcp/{control.simulator}:{layout.TELEMETRY_PORT}" if plan.telemetry else None
-    match_dir = runner.options.out_dir / "simulator"
+    match_dir = match.options.out_dir / "simulator"
     (match_dir / "out").mkdir(parents=True, exist_ok=True)
     for folder in (match_dir, match_dir / "out"):
         folder.chmod(0o777)
@@ -96,58 +77,58 @@ def start(runner: MatchRunner, started_at: float) -> None:
         for role in ("control", "red", "blue")
     )
     request = layout.simulator_request(
-        plan, prefix=started.prefix, image=runner.options.simulator_image, match_dir=match_dir,
-        attachments=attachments, extra_labels=runner.options.extra_labels,
-        command=runner.options.simulator_command, model_dirs=plan.model_dirs,
+        plan, prefix=started.prefix, image=match.options.simulator_image, match_dir=match_dir,
+        attachments=attachments, extra_labels=match.options.extra_labels,
+        command=match.options.simulator_command, model_dirs=plan.model_dirs,
     )
     request = replace(request, cpuset_cpus=cpu_sets().simulator)
-    _start_simulator(runner, request)  # first: it boots while the robots start
-    robots = [r for r in plan.robots if runner.records[r.key].image_error is None]
+    _start_simulator(match, request)  # first: it boots while the robots start
+    robots = [r for r in plan.robots if match.records[r.key].image_error is None]
     with ThreadPoolExecutor(max_workers=max(1, min(8, len(robots)))) as pool:
-        list(pool.map(lambda robot: _start_robot(runner, robot), robots))
-    if endpoint is not None and runner.telemetry_factory is not None:
-        runner.telemetry = runner.telemetry_factory(endpoint, plan.match_id)
+        list(pool.map(lambda robot: _start_robot(match, robot), robots))
+    if endpoint is not None and match.telemetry_factory is not None:
+        match.telemetry = match.telemetry_factory(endpoint, plan.match_id)
     for team in plan.teams:
-        tried = [r for r in team.robots if runner.records[r.key].image_error is None]
-        failed = [r for r in tried if runner.records[r.key].startup_error is not None]
+        tried = [r for r in team.robots if match.records[r.key].image_error is None]
+        failed = [r for r in tried if match.records[r.key].startup_error is not None]
         if tried and len(failed) == len(tried):
-            runner._fail(FailureClass.TEAM_STARTUP, f"no robot of {team.color} could be started: "
-                         f"{runner.records[failed[0].key].startup_error}")
+            match.fail(FailureClass.TEAM_STARTUP, f"no robot of {team.color} could be started: "
+                         f"{match.records[failed[0].key].startup_error}")
     log.info("match %s: %d robot containers started in %.2f s", plan.match_id,
-             len(started.robot_ids), runner.clock() - started_at)
+             len(started.robot_ids), match.clock() - started_at)
 
 
-def _start_simulator(runner: MatchRunner, request: ContainerRequest) -> None:
+def _start_simulator(match: MatchContext, request: ContainerRequest) -> None:
     """Started before the robots, so that it boots while they start (robot clients retry)."""
-    started = runner.started
-    started.simulator_id = runner.runtime.create_container(request)
-    runner.runtime.start(started.simulator_id)
-    started.simulator_started_at = runner.clock()
-    log.info("match %s: simulator container %s started (%s)", runner.plan.match_id,
+    started = match.started
+    started.simulator_id = match.runtime.create_container(request)
+    match.runtime.start(started.simulator_id)
+    started.simulator_started_at = match.clock()
+    log.info("match %s: simulator container %s started (%s)", match.plan.match_id,
              request.name, request.image)
-    runner.monitor.watch("simulator", started.simulator_id)
+    match.monitor.watch("simulator", started.simulator_id)
 
 
-def _start_robot(runner: MatchRunner, robot: RobotPlan) -> None:
-    plan = runner.plan
-    started = runner.started
-    record = runner.records[robot.key]
+def _start_robot(match: MatchContext, robot: RobotPlan) -> None:
+    plan = match.plan
+    started = match.started
+    record = match.records[robot.key]
     team = plan.red if robot.color == "red" else plan.blue
     subnet = started.subnets[robot.color]
     network = started.networks[robot.color].name
-    n_robots = len([r for r in team.robots if runner.records[r.key].image_error is None])
+    n_robots = len([r for r in team.robots if match.records[r.key].image_error is None])
     limits = plan.limits
     try:
         holder = layout.holder_request(
             robot, prefix=started.prefix,
-            image=runner.options.holder_image or runner.options.simulator_image,
+            image=match.options.holder_image or match.options.simulator_image,
             network=network, team_net=subnet, match_id=plan.match_id,
-            extra_labels=runner.options.extra_labels,
+            extra_labels=match.options.extra_labels,
         )
-        holder_id = runner.runtime.create_container(holder)
+        holder_id = match.runtime.create_container(holder)
         started.holder_ids[robot.key] = holder_id
-        runner.runtime.start(holder_id)
-        pid = runner.runtime.inspect(holder_id).pid
+        match.runtime.start(holder_id)
+        pid = match.runtime.inspect(holder_id).pid
         shaping = RobotShaping(
             api_rate_bit=mb_s_to_bit(per_robot_rate_mb_s(limits.team_api_mb_s, n_robots)),
             comm_rate_bit=mb_s_to_bit(per_robot_rate_mb_s(limits.team_comm_mb_s, n_robots)),
@@ -155,16 +136,16 @@ def _start_robot(runner: MatchRunner, robot: RobotPlan) -> None:
             teammate_ips=tuple(subnet.robot(r.number) for r in team.robots if r != robot),
             mirror_port=plan.mirror_port,
         )
-        applied = runner.host.shape(pid, shaping)
+        applied = match.host.shape(pid, shaping)
         if applied is not None:
             started.shaping[robot.key] = applied
-        folder = runner.host.log_folder(
+        folder = match.host.log_folder(
             match_id=plan.match_id, name=robot.key, cap_bytes=int(limits.log_folder_gb * 1e9),
-            fallback=runner.options.out_dir / "teams" / robot.color / str(robot.number)
+            fallback=match.options.out_dir / "teams" / robot.color / str(robot.number)
             / "robocup-logs",
         )
         started.log_folders[robot.key] = folder
-        scratch = _scratch(runner, robot)
+        scratch = _scratch(match, robot)
         record.limits = {
             "nano_cpus": int(limits.cpus * 1e9),
             "memory_bytes": int(limits.memory_gb * 1e9),
@@ -184,16 +165,16 @@ def _start_robot(runner: MatchRunner, robot: RobotPlan) -> None:
             replace(robot, image=record.digest or robot.image),
             prefix=started.prefix, holder_id=holder_id, environment=environment,
             logs_dir=folder.path, limits=limits, match_id=plan.match_id,
-            extra_labels=runner.options.extra_labels,
+            extra_labels=match.options.extra_labels,
             scratch_dir=scratch.path if scratch is not None else None,
         )
         request = replace(request, cpuset_cpus=cpu_sets().robots)
         record.limits["cpuset"] = request.cpuset_cpus
-        container_id = runner.runtime.create_container(request)
+        container_id = match.runtime.create_container(request)
         started.robot_ids[robot.key] = container_id
         record.container = request.name
-        runner.runtime.start(container_id)
-        runner.monitor.watch(robot.key, container_id)
+        match.runtime.start(container_id)
+        match.monitor.watch(robot.key, container_id)
         log.info("match %s: robot %s started (%s, %s)", plan.match_id, robot.key, robot.image,
                  subnet.robot(robot.number))
     except OrchestratorError as exc:
@@ -201,17 +182,17 @@ def _start_robot(runner: MatchRunner, robot: RobotPlan) -> None:
         log.warning("match %s: robot %s could not be started: %s", plan.match_id, robot.key, exc)
 
 
-def _scratch(runner: MatchRunner, robot: RobotPlan) -> LogFolder | None:
+def _scratch(match: MatchContext, robot: RobotPlan) -> LogFolder | None:
     """The robot's capped scratch space with its :data:`layout.SCRATCH_DIRS`, or None when no
     cap can be applied (the robot then gets small tmpfs folders)."""
-    started = runner.started
-    cap = int(runner.plan.limits.scratch_gb * 1e9)
-    scratch = runner.host.log_folder(
-        match_id=runner.plan.match_id, name=f"{robot.key}-scratch", cap_bytes=cap,
-        fallback=runner.options.out_dir / ".scratch" / robot.key,
+    started = match.started
+    cap = int(match.plan.limits.scratch_gb * 1e9)
+    scratch = match.host.log_folder(
+        match_id=match.plan.match_id, name=f"{robot.key}-scratch", cap_bytes=cap,
+        fallback=match.options.out_dir / ".scratch" / robot.key,
     )
     if scratch.cap_bytes is None:
-        shutil.rmtree(runner.options.out_dir / ".scratch", ignore_errors=True)
+        shutil.rmtree(match.options.out_dir / ".scratch", ignore_errors=True)
         return None
     started.scratch[robot.key] = scratch
     for name in layout.SCRATCH_DIRS:
@@ -221,4 +202,18 @@ def _scratch(runner: MatchRunner, robot: RobotPlan) -> LogFolder | None:
     return scratch
 
 
-__all__ = ["Started", "start"]
+class StartupPhase:
+    """STARTING: networks, firewall, match spec, simulator, robots; returns what it created."""
+
+    def __init__(self, match: MatchContext) -> None:
+        self.match = match
+
+
+    def run(self, started_at: float) -> Started:
+        """Start everything; a robot that cannot start is recorded, a team without any fails the
+        match. Returns what was created (also kept in the context for teardown)."""
+        _start(self.match, started_at)
+        return self.match.started
+
+
+__all__ = ["StartupPhase"]

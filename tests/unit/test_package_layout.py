@@ -45,3 +45,55 @@ def test_tests_import_nothing_from_the_benchmarks() -> None:
 
 def test_production_packages_import_neither_benchmarks_nor_the_test_kit() -> None:
     assert offenders(PRODUCTION, {"benchmarks", "testkit"}) == []
+
+
+def module_level_imports(path: Path, package_root: Path) -> set[str]:
+    """Modules of our packages imported at module level (TYPE_CHECKING blocks included)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    found: set[str] = set()
+    nodes: list[ast.stmt] = list(tree.body)
+    while nodes:
+        node = nodes.pop()
+        if isinstance(node, ast.If | ast.Try):
+            nodes.extend(node.body)
+            nodes.extend(getattr(node, "orelse", []))
+        elif isinstance(node, ast.Import):
+            found.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            found.add(node.module)
+            found.update(f"{node.module}.{alias.name}" for alias in node.names)
+    return found
+
+
+def import_cycles(package: str) -> list[list[str]]:
+    modules: dict[str, Path] = {}
+    for path in (ROOT / package).rglob("*.py"):
+        parts = path.relative_to(ROOT).with_suffix("").parts
+        name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+        modules[name] = path
+    graph = {
+        name: {m for m in module_level_imports(path, ROOT) if m in modules and m != name}
+        for name, path in modules.items()
+    }
+    packages = {name for name, path in modules.items() if path.name == "__init__.py"}
+    cycles: list[list[str]] = []
+
+    def visit(node: str, trail: list[str]) -> None:
+        for nxt in sorted(graph[node]):
+            if nxt in packages:
+                continue  # a package's __init__ re-exporting its modules is not a circle
+            if nxt in trail:
+                cycles.append(trail[trail.index(nxt):] + [nxt])
+            elif len(trail) < 12:
+                visit(nxt, [*trail, nxt])
+
+    for start in sorted(graph):
+        if start not in packages:
+            visit(start, [start])
+    return cycles
+
+
+def test_the_match_phases_form_no_import_circle() -> None:
+    assert (ROOT / "orchestrator" / "match" / "context.py").is_file()
+    cycles = [c for c in import_cycles("orchestrator") if c[0].startswith("orchestrator.match")]
+    assert cycles == []
