@@ -33,7 +33,7 @@ from orchestrator.config import LoadedGame
 from orchestrator.match import layout
 from orchestrator.match.logfs import safe_name
 from orchestrator.match.plan import MatchPlan, plan_from_game
-from orchestrator.match.runtime import Attachment, ContainerRequest, NetworkRequest
+from orchestrator.match.runtime import Attachment, BindMount, ContainerRequest, NetworkRequest
 
 log = logging.getLogger(__name__)
 
@@ -121,7 +121,7 @@ def match_requests(loaded: LoadedGame, *, simulator_image: str, subnets: Subnets
     )
     simulator = layout.simulator_request(
         plan, prefix=prefix, image=simulator_image, match_dir=PROJECT,
-        attachments=attachments, extra_labels=extra,
+        attachments=attachments, extra_labels=extra, model_dirs=plan.model_dirs,
     )  # fmt: skip
     robots: dict[str, tuple[ContainerRequest, ContainerRequest]] = {}
     for team in plan.teams:
@@ -187,9 +187,13 @@ def _networks(attachments: tuple[Attachment, ...], roles: Mapping[str, str]) -> 
     return {roles[a.network]: {"ipv4_address": a.ipv4_address} for a in attachments}
 
 
-def _volume(source: Path, target: str) -> str:
-    relative = source.relative_to(PROJECT).as_posix()
-    return f"./{'' if relative == '.' else relative}:{target}"
+def _volume(mount: BindMount) -> str:
+    if mount.source.is_relative_to(PROJECT):
+        relative = mount.source.relative_to(PROJECT).as_posix()
+        source = f"./{'' if relative == '.' else relative}"
+    else:
+        source = str(mount.source)  # e.g. a team's robot model folder
+    return f"{source}:{mount.target}" + (":ro" if mount.read_only else "")
 
 
 def _service(request: ContainerRequest, roles: Mapping[str, str]) -> dict[str, Any]:
@@ -200,7 +204,11 @@ def _service(request: ContainerRequest, roles: Mapping[str, str]) -> dict[str, A
         service["hostname"] = request.hostname
     service["environment"] = dict(request.environment)
     service["labels"] = dict(request.labels)
-    service["volumes"] = [_volume(m.source, m.target) for m in request.mounts]
+    service["volumes"] = [_volume(m) for m in request.mounts]
+    if request.read_only:
+        service["read_only"] = True
+    if request.tmpfs:
+        service["tmpfs"] = [f"{path}:{options}" for path, options in request.tmpfs.items()]
     if request.networks:
         service["networks"] = _networks(request.networks, roles)
     service["cap_drop"] = list(request.cap_drop)
