@@ -241,12 +241,26 @@ def _check_team_ids(document: dict[str, Any], where: Collector) -> None:
             )
 
 
+# Ports the simulator container listens on besides the robot API ports.
+SIMULATOR_PORTS = {
+    3737: "the team mirror (UDP)",
+    3838: "the GameController's data port (UDP)",
+    3939: "the GameController's return port (UDP)",
+    7447: "telemetry (zenoh)",
+}
+
+
 def _check_ports(document: dict[str, Any], where: Collector) -> None:
     used: dict[int, str] = {}
     for color in COLORS:
         for index, port in enumerate(document[color]["ports"]):
             at = pointer(color, "ports", index)
-            if port in used:
+            if port in SIMULATOR_PORTS:
+                where.error(
+                    at, f"port {port} is the simulator's port for {SIMULATOR_PORTS[port]}",
+                    expected="a port other than " + ", ".join(map(str, sorted(SIMULATOR_PORTS))),
+                )
+            elif port in used:
                 where.error(
                     at, f"port {port} is already used at {used[port]}", expected="a free port"
                 )

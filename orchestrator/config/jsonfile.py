@@ -53,7 +53,7 @@ def read_text(path: Path) -> str:
 def parse_json(text: str, *, file: str) -> Any:
     """Parse JSON text; invalid JSON becomes a problem with line and column."""
     try:
-        return json.loads(text, parse_constant=_reject_constant, parse_float=_finite_float)
+        value = json.loads(text, parse_constant=_reject_constant, parse_float=_finite_float)
     except json.JSONDecodeError as exc:
         where = Collector(file)
         where.error("", f"invalid JSON at line {exc.lineno} column {exc.colno}: {exc.msg}")
@@ -66,6 +66,70 @@ def parse_json(text: str, *, file: str) -> Any:
         where = Collector(file)
         where.error("", "invalid JSON: nested too deeply")
         raise ConfigError(where.problems) from None
+    duplicates = duplicate_keys(text)
+    if duplicates:
+        where = Collector(file)
+        for at, key, first, second in duplicates:
+            where.error(at, f"key {json.dumps(key)} appears twice: at line {first} and at line "
+                        f"{second} (JSON readers keep only one of them)",
+                        expected="each key once per object")
+        raise ConfigError(where.problems)
+    return value
+
+
+def duplicate_keys(text: str) -> list[tuple[str, str, int, int]]:
+    """Keys repeated within one object of valid JSON ``text``: (pointer of the object, key,
+    line of the first, line of the repeat)."""
+    found: list[tuple[str, str, int, int]] = []
+    # stack entries: [pointer, keys seen (key -> line) or None for an array, expecting a key,
+    #                 the current key or array index]
+    stack: list[list[Any]] = []
+    line, i, n = 1, 0, len(text)
+
+    def child() -> str:
+        if not stack:
+            return ""
+        top = stack[-1]
+        part = str(top[3]).replace("~", "~0").replace("/", "~1")
+        return f"{top[0]}/{part}"
+
+    while i < n:
+        c = text[i]
+        if c == "\n":
+            line += 1
+        elif c == '"':
+            j, start_line = i + 1, line
+            chars: list[str] = []
+            while text[j] != '"':
+                if text[j] == "\\":
+                    chars.append(text[j:j + 2])
+                    j += 2
+                    continue
+                chars.append(text[j])
+                j += 1
+            raw = '"' + "".join(chars) + '"'
+            if stack and stack[-1][1] is not None and stack[-1][2]:
+                key = json.loads(raw)
+                top = stack[-1]
+                if key in top[1]:
+                    found.append((top[0], key, top[1][key], start_line))
+                else:
+                    top[1][key] = start_line
+                top[2], top[3] = False, key
+            i = j
+        elif c in "{[":
+            pointer = child()
+            stack.append([pointer, {} if c == "{" else None, c == "{", 0])
+        elif c in "}]":
+            stack.pop()
+        elif c == "," and stack:
+            top = stack[-1]
+            if top[1] is not None:
+                top[2] = True
+            else:
+                top[3] += 1
+        i += 1
+    return found
 
 
 def read_json(path: Path) -> Any:

@@ -122,6 +122,9 @@ def _translate(error: ValidationError, where: Collector) -> None:
         where.error(at, f"{len(instance)} items", expected=_items_expected(schema))
     elif keyword == "minLength":
         where.error(at, "must not be empty")
+    elif keyword == "maxLength":
+        where.error(at, f"{len(instance)} characters: {_show(instance)}",
+                    expected=f"at most {value} characters")
     elif keyword in ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum"):
         where.error(at, f"{_show(instance)} is out of range", expected=_range_expected(schema))
     elif keyword == "oneOf":

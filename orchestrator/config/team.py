@@ -74,6 +74,7 @@ def build_team(
         for k in players_raw
     ):
         return None
+    _check_name(document.get("name"), where)
     numbers = _check_numbers(players_raw, where, field_class)
     for number in numbers:
         for key in POSE_KEYS:
@@ -151,6 +152,19 @@ def _player(number: int, document: dict[str, Any], field_class: FieldClass | Non
         docker_cmd=raw.get("dockerCmd"),
         **{attr: _pose(raw[key]) for key, attr in POSE_KEYS.items()},
     )
+
+
+def _check_name(name: object, where: Collector) -> None:
+    """A team name goes into logs, folder names and web pages: printable text only, no path
+    separators (the length is the schema's)."""
+    if not isinstance(name, str) or not name:
+        return
+    bad = sorted({f"U+{ord(c):04X}" for c in name if not c.isprintable() or c in "/\\"})
+    if bad or name != name.strip() or name.startswith("."):
+        what = ("characters " + ", ".join(bad[:5])) if bad else "leading or trailing blanks or dot"
+        where.error("/name", f"the team name has {what}",
+                    expected="printable text without / or \\, control or format characters, "
+                    "not starting with a dot or blank, at most 64 characters")
 
 
 def _check_numbers(
