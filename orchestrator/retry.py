@@ -45,8 +45,13 @@ def retry(
     backoff: Backoff,
     what: str,
     on_retry: Callable[[int, Exception, float], None] | None = None,
+    wait_hint: Callable[[Exception], float | None] | None = None,
 ) -> T:
-    """``call()``, again after a backoff while it raises an error ``transient`` accepts."""
+    """``call()``, again after a backoff while it raises an error ``transient`` accepts.
+
+    ``wait_hint(error)`` may name a wait the server asked for (``Retry-After``); the backoff then
+    waits at least that long, at most ``cap_s``.
+    """
     for attempt in range(backoff.attempts):
         try:
             return call()
@@ -54,6 +59,9 @@ def retry(
             if not transient(exc) or attempt + 1 >= backoff.attempts:
                 raise
             delay = backoff.delay_s(attempt)
+            asked = wait_hint(exc) if wait_hint is not None else None
+            if asked is not None:
+                delay = min(max(delay, asked), backoff.cap_s)
             log.warning(
                 "%s failed (attempt %d of %d): %s; retrying in %.1f s",
                 what, attempt + 1, backoff.attempts, exc, delay,

@@ -40,11 +40,15 @@ class RegistryError(InfrastructureError):
     """A registry request failed: ``url``, HTTP ``status`` (0 when unreachable), ``reason`` and
     ``kind``: auth, denied, not_found, unreachable, transient or failed."""
 
-    def __init__(self, *, url: str, status: int, reason: str, kind: str = "failed") -> None:
+    def __init__(
+        self, *, url: str, status: int, reason: str, kind: str = "failed",
+        retry_after_s: float | None = None,
+    ) -> None:
         self.url = url
         self.status = status
         self.reason = reason
         self.kind = kind
+        self.retry_after_s = retry_after_s  # the server's Retry-After, in seconds
         where = f"HTTP {status}" if status else "unreachable"
         super().__init__(f"registry request {url} failed ({where}): {reason}")
 
@@ -194,6 +198,7 @@ class RegistryClient:
             transient=lambda exc: isinstance(exc, RegistryError) and exc.transient,
             backoff=self.backoff,
             what=f"registry request {method} {self.url}{path}",
+            wait_hint=lambda exc: getattr(exc, "retry_after_s", None),
         )
 
     def _authorized(self, method: str, path: str, accept: str | None) -> _Response:
@@ -282,7 +287,8 @@ class RegistryClient:
             detail = "deletion is disabled on this registry (storage: delete: enabled: true)"
         elif response.status in TRANSIENT_STATUS:
             kind = "transient"
-        raise RegistryError(url=url, status=response.status, reason=detail, kind=kind)
+        raise RegistryError(url=url, status=response.status, reason=detail, kind=kind,
+                            retry_after_s=_retry_after(response.headers.get("retry-after", "")))
 
     def _send(
         self, method: str, url: str, headers: Mapping[str, str], authorization: str | None
@@ -301,6 +307,14 @@ class RegistryClient:
         except (urllib.error.URLError, OSError) as exc:
             reason = getattr(exc, "reason", exc)
             raise RegistryError(url=url, status=0, reason=str(reason), kind="unreachable") from exc
+
+
+def _retry_after(value: str) -> float | None:
+    """Seconds of a ``Retry-After`` header given in seconds (an HTTP date is not used)."""
+    try:
+        return max(0.0, float(value)) if value.strip() else None
+    except ValueError:
+        return None
 
 
 def _blobs(document: Mapping[str, Any]) -> dict[str, int]:

@@ -202,3 +202,20 @@ def test_rich_progress_draws_bars(monkeypatch: pytest.MonkeyPatch) -> None:
     drawn = out.getvalue()
     assert "pull team/robot:v1 (done)" in drawn and "10.0/10.0 MB" in drawn
     assert "build simulator (done)" in drawn and "9/9 steps" in drawn
+
+
+def test_retry_waits_at_least_what_the_server_asks_up_to_the_cap() -> None:
+    slept: list[float] = []
+    backoff = Backoff(attempts=3, base_s=0.1, cap_s=5.0, sleep=slept.append)
+    errors = iter([RuntimeError("429"), RuntimeError("429")])
+
+    def call() -> str:
+        error = next(errors, None)
+        if error is not None:
+            raise error
+        return "ok"
+
+    hints = iter([2.0, 60.0])
+    assert retry(call, transient=lambda e: True, backoff=backoff, what="x",
+                 wait_hint=lambda e: next(hints)) == "ok"
+    assert slept == [2.0, 5.0]
