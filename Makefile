@@ -10,7 +10,7 @@ HLVS   := $(VENV)/bin/hlvs
 BUILD  := .build
 PYTEST_ARGS ?=
 
-.PHONY: scrimmage test setup venv system engine postgres images lint typecheck clean-build web
+.PHONY: cluster scrimmage test setup venv system engine postgres images lint typecheck clean-build web
 
 scrimmage: setup
 	$(HLVS) scrimmage --out matches/scrimmage
@@ -64,3 +64,8 @@ clean-build:
 # viewer/static/app.js, which is committed: installing the package needs no Node.js.
 web:
 	cd web && npm ci --no-audit --no-fund && npm run build
+
+# A Slurm cluster on this machine (controller, accounting with MariaDB, three nodes in network
+# namespaces) for the Slurm pool: `make cluster`, then HLVS_SERVICE_POOL=slurm hlvs serve.
+cluster:
+	bash scripts/ensure-slurm.sh up

@@ -41,6 +41,7 @@ COMMAND_MODULES = (
     "orchestrator.commands.schedule",
     "orchestrator.commands.simulator",
     "orchestrator.commands.viewer",
+    "orchestrator.commands.pool",
     "service.commands",
 )
 

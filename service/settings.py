@@ -112,8 +112,8 @@ def _convert(name: str, raw: str, current: object) -> object:
 
 
 def _check(settings: Settings) -> None:
-    if settings.pool not in ("local",):
-        raise SettingsError(name=PREFIX + "POOL", value=settings.pool, expected="local")
+    if settings.pool not in ("local", "slurm"):
+        raise SettingsError(name=PREFIX + "POOL", value=settings.pool, expected="local or slurm")
     if settings.preflight not in ("full", "images"):
         raise SettingsError(name=PREFIX + "PREFLIGHT", value=settings.preflight,
                             expected="full or images")

@@ -7,8 +7,9 @@ must answer ``status`` for handles made by an earlier process: that is how a res
 finds the matches that went on while it was down.
 
 Implementations: :class:`service.pool.local.LocalDockerPool` (this host's Docker engine, one
-``hlvs match`` process per match). A cluster implements the same four methods (e.g. ``sbatch`` /
-``squeue`` / ``scancel`` in its own adapter module) and is chosen in :func:`make_pool`.
+``hlvs match`` process per match) and :class:`service.pool.slurm.SlurmPool` (one Slurm batch job
+per match, ``sbatch`` / ``squeue`` / ``scancel`` in its own adapter module), chosen in
+:func:`make_pool`.
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ class MatchJob:
     match_id: str
     game_path: Path
     work_dir: Path
+    account: str | None = None  # a cluster account the match is charged to (a team's)
 
 
 class JobState(enum.StrEnum):
@@ -67,7 +69,12 @@ class MatchPool(Protocol):
 
 
 def make_pool(settings: Settings) -> MatchPool:
-    """The pool named by ``settings.pool``."""
+    """The pool named by ``settings.pool``: ``local`` (this host's Docker engine) or ``slurm``
+    (the cluster that ``SLURM_CONF`` names, see :mod:`service.pool.slurm`)."""
+    if settings.pool == "slurm":
+        from service.pool.slurm import SlurmPool
+
+        return SlurmPool(slots=settings.match_slots)
     from service.pool.local import LocalDockerPool
 
     return LocalDockerPool(slots=settings.match_slots)

@@ -1,0 +1,178 @@
+#!/usr/bin/env bash
+# A Slurm cluster on this machine for the Slurm pool's tests and for trying it out: a controller,
+# the accounting daemon with MariaDB, and NODES nodes (default 3), each slurmd in its own network
+# namespace with its own address on a private bridge. Idempotent: starts what is not running.
+#   scripts/ensure-slurm.sh [up|down|status]
+# Everything lives under $HLVS_SLURM_DIR (default /var/lib/hlvs/slurm); commands find the
+# cluster with SLURM_CONF=$HLVS_SLURM_DIR/slurm.conf (printed by `status`). Needs root (Debian).
+set -euo pipefail
+DIR=${HLVS_SLURM_DIR:-/var/lib/hlvs/slurm}
+NODES=${HLVS_SLURM_NODES:-3}
+BRIDGE=hlvsslurm0
+NET=10.77.0
+CTL_IP=$NET.1
+CLUSTER=hlvs
+export SLURM_CONF=$DIR/slurm.conf
+LOG=/var/log/hlvs
+mkdir -p "$LOG"
+
+need_packages() {
+  local need=()
+  for pkg in slurm-wlm slurmdbd munge mariadb-server; do
+    dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "ok installed" || need+=("$pkg")
+  done
+  if [ ${#need[@]} -gt 0 ]; then
+    echo "==> installing ${need[*]} (log: $LOG/apt.log)"
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${need[@]}" \
+      >>"$LOG/apt.log" 2>&1 || { apt-get update -qq >>"$LOG/apt.log" 2>&1;
+      DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${need[@]}" \
+      >>"$LOG/apt.log" 2>&1; }
+    systemctl disable --now slurmctld slurmd slurmdbd munge mariadb >/dev/null 2>&1 || true
+  fi
+}
+
+running() { pgrep -f "$1" >/dev/null 2>&1; }
+
+network() {
+  # the host's own network namespace by name: jobs of the one-machine cluster enter it to reach
+  # the Docker engine's networks (nodes of a real cluster have an engine of their own)
+  if ! mountpoint -q /run/netns/hlvs-host 2>/dev/null; then
+    mkdir -p /run/netns && touch /run/netns/hlvs-host
+    mount --bind /proc/self/ns/net /run/netns/hlvs-host
+  fi
+  ip link show "$BRIDGE" >/dev/null 2>&1 || {
+    ip link add "$BRIDGE" type bridge
+    ip addr add "$CTL_IP/24" dev "$BRIDGE"
+    ip link set "$BRIDGE" up
+  }
+  for n in $(seq 1 "$NODES"); do
+    ip netns list | grep -qw "hlvs-n$n" || ip netns add "hlvs-n$n"
+    if ! ip link show "hlvsn$n" >/dev/null 2>&1; then
+      ip link add "hlvsn$n" type veth peer name eth0 netns "hlvs-n$n"
+      ip link set "hlvsn$n" master "$BRIDGE" up
+      ip -n "hlvs-n$n" addr add "$NET.1$n/24" dev eth0
+      ip -n "hlvs-n$n" link set eth0 up
+      ip -n "hlvs-n$n" link set lo up
+      ip -n "hlvs-n$n" route add default via "$CTL_IP"
+    fi
+  done
+}
+
+munge_up() {
+  mkdir -p /etc/munge /var/lib/munge /run/munge /var/log/munge
+  [ -s /etc/munge/munge.key ] || { dd if=/dev/urandom of=/etc/munge/munge.key bs=1k count=1 2>/dev/null; }
+  chown -R munge:munge /etc/munge /var/lib/munge /run/munge /var/log/munge
+  chmod 0700 /etc/munge; chmod 0400 /etc/munge/munge.key
+  running "/usr/sbin/munged" || su -s /bin/sh munge -c /usr/sbin/munged
+}
+
+mariadb_up() {
+  mkdir -p /run/mysqld && chown mysql:mysql /run/mysqld
+  if ! running mariadbd; then
+    (mysqld_safe --bind-address=127.0.0.1 >>"$LOG/mariadb.log" 2>&1 &)
+    for _ in $(seq 60); do mariadb -e "select 1" >/dev/null 2>&1 && break; sleep 0.5; done
+  fi
+  mariadb -e "CREATE DATABASE IF NOT EXISTS slurm_acct_db;
+    CREATE USER IF NOT EXISTS 'slurm'@'localhost' IDENTIFIED BY 'slurm';
+    GRANT ALL ON slurm_acct_db.* TO 'slurm'@'localhost'; FLUSH PRIVILEGES;"
+}
+
+configs() {
+  mkdir -p "$DIR"/{state,spool,log}
+
+  cat >"$DIR/slurmdbd.conf" <<CONF
+AuthType=auth/munge
+DbdHost=localhost
+DbdAddr=127.0.0.1
+DbdPort=6819
+SlurmUser=root
+StorageType=accounting_storage/mysql
+StorageHost=127.0.0.1
+StorageUser=slurm
+StoragePass=slurm
+StorageLoc=slurm_acct_db
+LogFile=$DIR/log/slurmdbd.log
+PidFile=$DIR/slurmdbd.pid
+CONF
+  chown root:root "$DIR/slurmdbd.conf"; chmod 600 "$DIR/slurmdbd.conf"
+  local nodes=""
+  for n in $(seq 1 "$NODES"); do
+    nodes+="NodeName=n$n NodeAddr=$NET.1$n CPUs=2 RealMemory=4000 Features=dense,sim,robot State=UNKNOWN"$'\n'
+  done
+  cat >"$DIR/slurm.conf" <<CONF
+ClusterName=$CLUSTER
+SlurmctldHost=$(hostname)($CTL_IP)
+SlurmctldAddr=$CTL_IP
+SlurmUser=root
+SlurmdUser=root
+AuthType=auth/munge
+StateSaveLocation=$DIR/state
+SlurmdSpoolDir=$DIR/spool/%n
+SlurmctldPidFile=$DIR/slurmctld.pid
+SlurmdPidFile=$DIR/slurmd-%n.pid
+SlurmctldLogFile=$DIR/log/slurmctld.log
+SlurmdLogFile=$DIR/log/slurmd-%n.log
+SlurmctldPort=6817
+SlurmdPort=6818
+ProctrackType=proctrack/linuxproc
+TaskPlugin=task/none
+SelectType=select/cons_tres
+SelectTypeParameters=CR_CPU
+SchedulerType=sched/backfill
+SchedulerParameters=bf_interval=5
+ReturnToService=2
+SlurmdTimeout=10
+KillWait=150
+InactiveLimit=0
+MinJobAge=600
+JobAcctGatherType=jobacct_gather/none
+AccountingStorageType=accounting_storage/slurmdbd
+AccountingStorageHost=127.0.0.1
+AccountingStoragePort=6819
+AccountingStorageEnforce=associations,limits,qos
+PriorityType=priority/multifactor
+PriorityWeightQOS=10000
+MpiDefault=none
+$nodes
+PartitionName=matches Nodes=ALL Default=YES MaxTime=INFINITE State=UP OverSubscribe=EXCLUSIVE
+CONF
+}
+
+up() {
+  need_packages
+  network
+  munge_up
+  mariadb_up
+  configs
+  pgrep -x slurmdbd >/dev/null || slurmdbd  # reads slurmdbd.conf beside $SLURM_CONF
+  for _ in $(seq 60); do sacctmgr -n show cluster >/dev/null 2>&1 && break; sleep 0.5; done
+  sacctmgr -i add cluster "$CLUSTER" >/dev/null 2>&1 || true
+  running "slurmctld -f $DIR" || slurmctld -f "$SLURM_CONF"
+  for n in $(seq 1 "$NODES"); do
+    running "slurmd -f $SLURM_CONF -N n$n" || \
+      nsenter --net="/run/netns/hlvs-n$n" slurmd -f "$SLURM_CONF" -N "n$n"
+  done
+  for _ in $(seq 120); do
+    idle=$(sinfo -h -N -t idle -o %N 2>/dev/null | wc -l)
+    [ "$idle" -ge "$NODES" ] && break
+    scontrol update nodename="n[1-$NODES]" state=resume >/dev/null 2>&1 || true
+    sleep 0.5
+  done
+  echo "==> Slurm cluster '$CLUSTER' up: $(sinfo -h -o '%D nodes %t' | tr '\n' ' ')(SLURM_CONF=$SLURM_CONF)"
+}
+
+down() {
+  pkill -f "slurmd -f $SLURM_CONF" || true
+  pkill -f "slurmctld -f $SLURM_CONF" || true
+  pkill -f "/usr/sbin/slurmdbd" || pkill -x slurmdbd || true
+  for n in $(seq 1 "$NODES"); do ip netns del "hlvs-n$n" 2>/dev/null || true; done
+  ip link del "$BRIDGE" 2>/dev/null || true
+  umount /run/netns/hlvs-host 2>/dev/null && rm -f /run/netns/hlvs-host || true
+}
+
+case "${1:-up}" in
+  up) up ;;
+  down) down ;;
+  status) sinfo -N -l; echo "SLURM_CONF=$SLURM_CONF" ;;
+  *) echo "usage: $0 [up|down|status]" >&2; exit 2 ;;
+esac

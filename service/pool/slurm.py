@@ -1,0 +1,225 @@
+"""The Slurm pool: each match is one Slurm batch job that runs ``hlvs match`` on a node.
+
+Dense placement: a job takes one whole node (``--exclusive``, ``-N1``), so matches run side by
+side across the cluster's nodes and Slurm queues the rest. A team's test matches are submitted
+under the team's Slurm account (``sbatch --account``), so the account's limits (``GrpJobs=1``:
+one running match per team; ``MaxSubmitJobs``: a bounded queue) and its QOS apply; Slurm gives
+the reason a job waits and its expected start (``squeue``), which :meth:`SlurmPool.queue`
+returns for ``hlvs pool status``.
+
+Slurm does not control the Docker containers a match starts, so the job runs ``hlvs match``
+itself as the batch step (``exec``): ``scancel`` sends it SIGTERM, which stops the match
+gracefully (robots get their grace period, logs are collected, ``report.json`` says
+``interrupted``); the cluster's ``KillWait`` must be longer than that (150 s in the cluster that
+``scripts/ensure-slurm.sh`` sets up).
+
+The handle is ``slurm:<job id>:<work folder>``; ``<work folder>/slurm.json`` remembers the job
+so that a second submit of the same match adopts it. This is the only module that runs Slurm's
+commands.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import shlex
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from service.errors import PoolError
+from service.pool import JobState, JobStatus, MatchJob
+
+log = logging.getLogger(__name__)
+
+STATE_FILE = "slurm.json"
+HOST_NETNS = "/run/netns/hlvs-host"  # named by scripts/ensure-slurm.sh
+LOG_FILE = "slurm-%j.out"
+ACTIVE = {"PENDING", "CONFIGURING", "RUNNING", "COMPLETING", "SUSPENDED", "REQUEUED",
+          "RESIZING", "SIGNALING", "STAGE_OUT"}
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class QueueEntry:
+    """A match job as Slurm sees it."""
+
+    job_id: str
+    name: str
+    account: str
+    state: str  # PENDING, RUNNING, ...
+    reason: str  # why it waits (Priority, Resources, AssocGrpJobsLimit...) or "None"
+    expected_start: str  # ISO time Slurm expects it to start (pending), or when it started
+    nodes: str
+
+    def to_json(self) -> dict[str, str]:
+        return {
+            "job_id": self.job_id, "match_id": self.name.removeprefix("hlvs-"),
+            "account": self.account, "state": self.state, "reason": self.reason,
+            "expected_start": self.expected_start, "nodes": self.nodes,
+        }
+
+
+class SlurmPool:
+    def __init__(
+        self, *, slots: int = 3, partition: str | None = None, slurm_conf: str | None = None,
+        python: str = sys.executable, extra_args: tuple[str, ...] = (), qos: str | None = None,
+        host_network: bool = False,
+    ) -> None:
+        self.slots = slots
+        self.partition = partition
+        self.slurm_conf = slurm_conf
+        self.python = python
+        self.extra_args = extra_args
+        self.qos = qos
+        # Nodes of the one-machine cluster share this host's Docker engine, whose networks
+        # live in the host's network namespace: the match enters it (a real node has its own).
+        self.host_network = host_network
+
+    # MatchPool ---------------------------------------------------------------------------
+    def submit(self, job: MatchJob) -> str:
+        work = job.work_dir.resolve()
+        previous = self._recorded(work)
+        if previous is not None and self._squeue_state(previous) in ACTIVE:
+            log.info("match %s already in Slurm as job %s; adopted", job.match_id, previous)
+            return self._handle(previous, work)
+        out = work / "out"
+        out.mkdir(parents=True, exist_ok=True)
+        command = [self.python, "-m", "orchestrator", *self.extra_args, "match",
+                   str(job.game_path.resolve()), "--out", str(out)]
+        if self.host_network:
+            command = ["nsenter", f"--net={HOST_NETNS}", *command]
+        script = "#!/bin/sh\nexec " + " ".join(shlex.quote(c) for c in command) + "\n"
+        args = ["sbatch", "--parsable", "--exclusive", "-N1", f"--job-name=hlvs-{job.match_id}",
+                f"--chdir={work}", f"--output={work / LOG_FILE}"]
+        if self.partition:
+            args.append(f"--partition={self.partition}")
+        account = job.account
+        if account:
+            args.append(f"--account={account}")
+        if self.qos:
+            args.append(f"--qos={self.qos}")
+        result = self._run(args, stdin=script, handle=str(work))
+        job_id = result.strip().split(";")[0]
+        if not job_id.isdigit():
+            raise PoolError(handle=str(work), reason=f"sbatch answered {result.strip()!r}")
+        tmp = work / (STATE_FILE + ".tmp")
+        tmp.write_text(json.dumps({"job_id": job_id, "match_id": job.match_id,
+                                   "account": account}))
+        tmp.replace(work / STATE_FILE)
+        log.info("match %s submitted to Slurm as job %s (account %s)", job.match_id, job_id,
+                 account or "default")
+        return self._handle(job_id, work)
+
+    def status(self, handle: str) -> JobStatus:
+        job_id, work = self._parse(handle)
+        entry = self._entry(job_id)
+        if entry is not None and entry.state in ACTIVE:
+            if entry.state == "PENDING":
+                detail = f"waiting in Slurm: {entry.reason}"
+                if entry.expected_start not in ("N/A", ""):
+                    detail += f", expected start {entry.expected_start}"
+                return JobStatus(state=JobState.PENDING, detail=detail)
+            return JobStatus(state=JobState.RUNNING, detail=f"on {entry.nodes}")
+        if (work / "out" / "report.json").is_file():
+            return JobStatus(state=JobState.FINISHED)
+        final = self._sacct_state(job_id)
+        return JobStatus(state=JobState.LOST,
+                         detail=f"Slurm job {job_id} ended ({final or 'unknown state'}) "
+                         "without a report.json")
+
+    def cancel(self, handle: str) -> None:
+        job_id, work = self._parse(handle)
+        self._run(["scancel", job_id], handle=handle)
+        log.info("Slurm job %s of %s cancelled (SIGTERM: graceful stop)", job_id, work)
+
+    def results_dir(self, handle: str) -> Path:
+        return self._parse(handle)[1] / "out"
+
+    # queue for hlvs pool status ------------------------------------------------------------
+    def queue(self) -> list[QueueEntry]:
+        """Every match job Slurm knows of (pending first), with its reason and expected start."""
+        text = self._run(["squeue", "-h", "-o", "%i|%j|%a|%T|%r|%S|%N"], handle="squeue")
+        entries = [_parse_entry(line) for line in text.splitlines() if line.strip()]
+        return sorted((e for e in entries if e.name.startswith("hlvs-")),
+                      key=lambda e: (e.state != "PENDING", e.job_id))
+
+    def ensure_account(self, name: str, *, max_running: int = 1, max_queued: int = 5) -> None:
+        """A Slurm account for a team (idempotent): at most ``max_running`` of its jobs run
+        (``GrpJobs``) and at most ``max_queued`` are accepted (``MaxSubmitJobs``); root may
+        submit under it (the pool submits for the teams)."""
+        self._run(["sacctmgr", "-i", "add", "account", name], handle=name, ok_codes=(0, 1))
+        self._run(["sacctmgr", "-i", "modify", "account", name, "set",
+                   f"GrpJobs={max_running}", f"MaxSubmitJobs={max_queued}"], handle=name,
+                  ok_codes=(0, 1))
+        self._run(["sacctmgr", "-i", "add", "user", "root", f"account={name}"], handle=name,
+                  ok_codes=(0, 1))
+        deadline = time.monotonic() + 30  # the controller learns of it from the database
+        while time.monotonic() < deadline:
+            shown = self._run(["scontrol", "show", "assoc_mgr", "users=root", f"accounts={name}",
+                               "flags=assoc"], handle=name, ok_codes=(0, 1))
+            if f"Account={name} " in shown and "UserName=root" in shown:
+                return
+            time.sleep(0.5)
+        raise PoolError(handle=name, reason="the Slurm controller did not learn of the account")
+
+    # helpers -----------------------------------------------------------------------------
+    @staticmethod
+    def _handle(job_id: str, work: Path) -> str:
+        return f"slurm:{job_id}:{work}"
+
+    @staticmethod
+    def _parse(handle: str) -> tuple[str, Path]:
+        kind, job_id, work = (handle.split(":", 2) + ["", ""])[:3]
+        if kind != "slurm" or not job_id.isdigit() or not work:
+            raise PoolError(handle=handle, reason="not a Slurm pool handle (slurm:<job>:<dir>)")
+        return job_id, Path(work)
+
+    def _recorded(self, work: Path) -> str | None:
+        try:
+            data = json.loads((work / STATE_FILE).read_text())
+        except (OSError, ValueError):
+            return None
+        job_id = data.get("job_id") if isinstance(data, dict) else None
+        return job_id if isinstance(job_id, str) else None
+
+    def _entry(self, job_id: str) -> QueueEntry | None:
+        text = self._run(["squeue", "-h", "-j", job_id, "-o", "%i|%j|%a|%T|%r|%S|%N"],
+                         handle=job_id, ok_codes=(0, 1))
+        lines = [line for line in text.splitlines() if line.startswith(job_id + "|")]
+        return _parse_entry(lines[0]) if lines else None
+
+    def _squeue_state(self, job_id: str) -> str | None:
+        entry = self._entry(job_id)
+        return None if entry is None else entry.state
+
+    def _sacct_state(self, job_id: str) -> str:
+        text = self._run(["sacct", "-n", "-X", "-P", "-j", job_id, "-o", "State,ExitCode"],
+                         handle=job_id, ok_codes=(0, 1))
+        return text.strip().splitlines()[0] if text.strip() else ""
+
+    def _run(self, args: list[str], *, handle: str, stdin: str | None = None,
+             ok_codes: tuple[int, ...] = (0,)) -> str:
+        env = dict(os.environ)
+        if self.slurm_conf:
+            env["SLURM_CONF"] = self.slurm_conf
+        try:
+            result = subprocess.run(args, input=stdin, capture_output=True, text=True,
+                                    env=env, timeout=60, check=False)
+        except (OSError, subprocess.TimeoutExpired) as exc:
+            raise PoolError(handle=handle, reason=f"{args[0]} failed: {exc}") from exc
+        if result.returncode not in ok_codes:
+            raise PoolError(handle=handle, reason=f"{' '.join(args[:2])}: exit "
+                            f"{result.returncode}: {result.stderr.strip()[-300:]}")
+        return result.stdout
+
+
+def _parse_entry(line: str) -> QueueEntry:
+    job_id, name, account, state, reason, start, nodes = (line.split("|") + [""] * 7)[:7]
+    return QueueEntry(job_id=job_id, name=name, account=account, state=state, reason=reason,
+                      expected_start=start, nodes=nodes)
+
+
+__all__ = ["QueueEntry", "SlurmPool"]
