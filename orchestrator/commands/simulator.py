@@ -57,6 +57,10 @@ def register(sub: Any) -> None:
             func=_delivery)
     forward(kinds, "cli", help="start-up time of hlvs --help (JSON)", func=_cli)
     forward(
+        kinds, "pool", help="matches through the Slurm pool against the same match locally "
+        "(JSON)", func=_pool,
+    )
+    forward(
         kinds, "models", help="physics cost per robot: team model against built-in (JSON)",
         func=_models,
     )
@@ -95,6 +99,13 @@ def _viewer(args: argparse.Namespace) -> int:
     from benchmarks.viewer import main as viewer_main
 
     return int(viewer_main(list(args.rest)))
+
+
+def _pool(args: argparse.Namespace) -> int:
+    os.environ["HLVS_PROG"] = "hlvs"
+    from benchmarks.pool import main as pool_main
+
+    return int(pool_main(list(args.rest)))
 
 
 def _models(args: argparse.Namespace) -> int:
