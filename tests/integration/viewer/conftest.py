@@ -21,7 +21,12 @@ import pytest
 from tests.unit.service.conftest import pool, settings, start, token  # noqa: F401
 
 CHROMIUM = "/usr/bin/chromium"
-LAUNCH_ARGS = ["--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--no-sandbox"]
+# WebGL in software (SwiftShader); the GPU work in the browser process without compositing:
+# measured about 3x more frames per second on a loaded 2-core machine than a GPU process.
+LAUNCH_ARGS = [
+    "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--no-sandbox",
+    "--in-process-gpu", "--disable-gpu-compositing",
+]
 REPO = Path(__file__).parents[3]
 
 
