@@ -217,7 +217,7 @@ def _inspect(reference: str, logins: _Logins) -> RemoteImage | None:
     except RegistryError as exc:
         if exc.kind == "auth":
             raise ImagePullError(image=reference, reason=exc.reason) from exc
-        if exc.kind == "denied":
+        if exc.kind in ("denied", "platform"):
             raise ImagePullError(image=reference, reason=f"{registry}: {exc.reason}") from exc
         if exc.kind == "not_found":
             raise ImagePullError(

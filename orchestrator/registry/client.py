@@ -38,7 +38,8 @@ USER_AGENT = "hlvs-runner"
 
 class RegistryError(InfrastructureError):
     """A registry request failed: ``url``, HTTP ``status`` (0 when unreachable), ``reason`` and
-    ``kind``: auth, denied, not_found, unreachable, transient or failed."""
+    ``kind``: auth, denied, not_found, platform (no image for the machine's platform),
+    unreachable, transient or failed."""
 
     def __init__(
         self, *, url: str, status: int, reason: str, kind: str = "failed",
@@ -162,7 +163,7 @@ class RegistryClient:
                 return self.manifest(repository, str(child["digest"]))
         raise RegistryError(
             url=f"{self.url}/v2/{repository}/manifests/{reference}", status=404,
-            kind="not_found", reason=f"{repository}:{reference} has no image for {platform}",
+            kind="platform", reason=f"{repository}:{reference} has no image for {platform}",
         )
 
     def _fetch(self, repository: str, reference: str) -> tuple[str, str, dict[str, Any]]:

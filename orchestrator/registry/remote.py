@@ -23,13 +23,16 @@ INSECURE_ENV = "HLVS_INSECURE_REGISTRIES"  # comma-separated hosts spoken to ove
 
 
 def split_image(reference: str) -> tuple[str, str, str]:
-    """(registry host, repository path in that registry, tag) of ``[host/]repo[:tag]``.
+    """(registry host, repository path in that registry, tag or digest) of
+    ``[host/]repo[:tag]`` or ``[host/]repo@sha256:...``.
 
     A name without a host is on Docker Hub (``library/`` added for one-word names).
     """
     name, tag = reference, "latest"
     last = reference.rsplit("/", 1)[-1]
-    if ":" in last:
+    if "@" in last:  # pinned by digest: the digest is the reference to read
+        name, _, tag = reference.rpartition("@")
+    elif ":" in last:
         name, _, tag = reference.rpartition(":")
     first, _, rest = name.partition("/")
     if rest and ("." in first or ":" in first or first == "localhost"):

@@ -274,3 +274,46 @@ def test_pull_that_fails_twice_then_succeeds(
     assert flaky_proxy.pulls == 3
     assert len([s for s in flaky_proxy.seen if s[2] == 503]) >= 2
     assert any(status == 200 and "/manifests/" in path for _, path, status in flaky_proxy.seen)
+
+
+def test_an_index_gives_the_image_of_the_machine_platform(
+    registry: Registry, docker_client: docker.DockerClient, make_image: MakeImage
+) -> None:
+    """A multi-platform tag (an OCI index) resolves to its linux/amd64 image; its size is that
+    image's, and a platform it lacks is named in the error."""
+    import base64
+    import urllib.request
+
+    reference = make_image(f"{registry.host}/alpha/multi:single", 8 * KB)
+    push(docker_client, reference, "alpha", registry.users["alpha"])
+    janitor = client(registry)
+    single = janitor.manifest("alpha/multi", "single")
+    raw = urllib.request.Request(f"{registry.url}/v2/alpha/multi/manifests/single", headers={
+        "Accept": "application/vnd.docker.distribution.manifest.v2+json",
+        "Authorization": "Basic " + base64.b64encode(
+            f"alpha:{registry.users['alpha']}".encode()).decode()})
+    with urllib.request.urlopen(raw) as answer:
+        body = answer.read()
+        media_type = answer.headers["Content-Type"]
+    index = {
+        "schemaVersion": 2,
+        "mediaType": "application/vnd.oci.image.index.v1+json",
+        "manifests": [
+            {"mediaType": media_type, "digest": single.digest, "size": len(body),
+             "platform": {"os": "linux", "architecture": arch}}
+            for arch in ("arm64", "amd64")
+        ],
+    }
+    put = urllib.request.Request(
+        f"{registry.url}/v2/alpha/multi/manifests/v1", data=json.dumps(index).encode(),
+        method="PUT", headers={"Content-Type": "application/vnd.oci.image.index.v1+json",
+                               "Authorization": raw.get_header("Authorization")})
+    with urllib.request.urlopen(put) as answer:
+        assert answer.status == 201
+
+    chosen = janitor.image("alpha/multi", "v1")
+    assert chosen.digest == single.digest and chosen.size_bytes == single.size_bytes
+    assert janitor.manifest("alpha/multi", "v1").blobs == single.blobs  # each blob once
+    with pytest.raises(RegistryError) as missing:
+        janitor.image("alpha/multi", "v1", platform="linux/s390x")
+    assert missing.value.kind == "platform" and "linux/s390x" in missing.value.reason

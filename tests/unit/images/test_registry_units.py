@@ -141,6 +141,7 @@ def test_shared_layers_count_once_per_team() -> None:
         ("localhost/robot:2", ("localhost", "robot", "2")),
         ("team/robot:v2", ("registry-1.docker.io", "team/robot", "v2")),
         ("ubuntu", ("registry-1.docker.io", "library/ubuntu", "latest")),
+        ("reg.example:5000/a/b@sha256:00ff", ("reg.example:5000", "a/b", "sha256:00ff")),
     ],
 )
 def test_split_image(reference: str, parts: tuple[str, str, str]) -> None:
