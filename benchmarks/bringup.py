@@ -47,7 +47,7 @@ def measure(*, robots: int, out: Path, timeout_s: float, robot_image: str | None
             robot_command: str | None = None) -> dict[str, object]:
     from orchestrator.engine import connect
     from orchestrator.engine.containers import DockerRuntime
-    from orchestrator.images import project_image
+    from orchestrator.project_images import project_image
     from orchestrator.telemetry import ZenohTelemetry
 
     scrim = argparse.ArgumentParser()

@@ -39,8 +39,8 @@ def _hog_command(processes: int) -> str:
 def _files(folder: Path, *, match_id: str, red_command: str, cpus: float, half_s: float,
            stepping: str) -> Path:
     from orchestrator.commands import scrimmage_args
-    from orchestrator.images import project_image
     from orchestrator.match import scrimmage
+    from orchestrator.project_images import project_image
 
     parser = argparse.ArgumentParser()
     scrimmage_args.add_arguments(parser)

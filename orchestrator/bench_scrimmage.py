@@ -86,7 +86,7 @@ def play_one(*, seed: int, out: Path, players: int | None) -> MatchFigures:
     """One default scrimmage with ``seed`` played into ``out``; its figures."""
     from orchestrator.engine import connect
     from orchestrator.engine.containers import DockerRuntime
-    from orchestrator.images import project_image
+    from orchestrator.project_images import project_image
     from orchestrator.telemetry import ZenohTelemetry
 
     scrim = argparse.ArgumentParser()

@@ -186,7 +186,7 @@ async def _load(url: str, args: argparse.Namespace, tokens: list[str], operator:
 
 def main(argv: Sequence[str]) -> int:
     args = _parse(argv)
-    from orchestrator.images import project_image
+    from orchestrator.project_images import project_image
 
     stub = project_image("stub")
     repository, _, tag = stub.rpartition(":")

@@ -109,9 +109,9 @@ def _start_and_connect(team_doc: dict[str, Any], folder: Path, *, settings: Sett
     from orchestrator.config import load_game
     from orchestrator.engine import connect
     from orchestrator.engine.containers import DockerRuntime
-    from orchestrator.images import project_image
     from orchestrator.match import HostControl, MatchRunner, RunOptions, cleanup, plan_from_game
     from orchestrator.match.scrimmage import game_file, team_file
+    from orchestrator.project_images import project_image
     from orchestrator.telemetry import ZenohTelemetry
 
     team = _distinct_players(team_doc)

@@ -120,7 +120,7 @@ class QueueWorker:
 
     def _stub(self) -> str:
         if self._stub_image is None:
-            from orchestrator.images import project_image
+            from orchestrator.project_images import project_image
 
             self._stub_image = project_image("stub")
         return self._stub_image

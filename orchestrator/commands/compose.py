@@ -62,7 +62,7 @@ def _compose(args: argparse.Namespace) -> int:
     if args.simulator_image:
         image = args.simulator_image
     else:
-        from orchestrator.images import project_image
+        from orchestrator.project_images import project_image
 
         image = project_image("simulator")
     spec = write_compose(loaded, args.output, simulator_image=image, subnets=subnets)

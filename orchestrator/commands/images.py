@@ -51,7 +51,7 @@ def register(sub: Any) -> None:
 
 def _build(args: argparse.Namespace) -> int:
     from orchestrator.console import progress
-    from orchestrator.images import build_all
+    from orchestrator.project_images import build_all
 
     started = time.monotonic()
     with progress() as bars:

@@ -122,7 +122,7 @@ def _play(
     plan: MatchPlan, *, out_dir: Path, pull: bool, loaded: Any, client: Any, runtime: Any,
     host: HostControl, extra_labels: dict[str, str], view_stream: TextIO | None = None,
 ) -> MatchOutcome:
-    from orchestrator.images import project_image
+    from orchestrator.project_images import project_image
     from orchestrator.telemetry import LiveView, ZenohTelemetry
 
     simulator_image = project_image("simulator")

@@ -123,11 +123,17 @@ def _status(args: argparse.Namespace) -> int:
 
 
 def _cancel(args: argparse.Namespace) -> int:
-    from orchestrator.schedule.state import MatchState
+    from orchestrator.schedule.state import ScheduledMatchState
 
     ledger = _ledger(args.state)
-    not_started = (MatchState.PLANNED, MatchState.PULLING, MatchState.PULLED)
-    if not ledger.transition(args.match_id, not_started, MatchState.CANCELLED, note="cancelled"):
+    not_started = (
+        ScheduledMatchState.PLANNED,
+        ScheduledMatchState.PULLING,
+        ScheduledMatchState.PULLED,
+    )
+    if not ledger.transition(
+        args.match_id, not_started, ScheduledMatchState.CANCELLED, note="cancelled"
+    ):
         try:
             state = ledger.row(args.match_id).state.value
         except KeyError:

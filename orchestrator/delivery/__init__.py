@@ -18,7 +18,7 @@ from orchestrator.delivery.deliver import (
     pending_status,
 )
 from orchestrator.delivery.enqueue import KEEP_UNDELIVERED, PUBLIC_TEAM, enqueue_match_logs
-from orchestrator.delivery.store import FileEntry, PendingSet, SetError
+from orchestrator.delivery.store import DeliveryFailure, FileEntry, PendingSet
 from orchestrator.delivery.targets import open_uploader
 from orchestrator.delivery.uploader import (
     ERROR_KINDS,
@@ -45,7 +45,7 @@ __all__ = [
     "PendingSet",
     "PUBLIC_TEAM",
     "RetryPolicy",
-    "SetError",
+    "DeliveryFailure",
     "TRANSIENT_KINDS",
     "Uploader",
 ]

@@ -154,7 +154,7 @@ def deliver_set(
         st.save_set(
             pending,
             attempts=pending.attempts + 1,
-            last_error=st.SetError(error.kind, error.reason, time.time()),
+            last_error=st.DeliveryFailure(error.kind, error.reason, time.time()),
         )
         log.warning("match %s: %s", pending.match_id, error)
         return DeliveryOutcome(

@@ -31,7 +31,7 @@ from typing import Any, Literal
 __all__ = [
     "FileEntry",
     "PendingSet",
-    "SetError",
+    "DeliveryFailure",
     "claimed",
     "create_set",
     "list_sets",
@@ -55,7 +55,7 @@ class FileEntry:
 
 
 @dataclass(frozen=True, slots=True)
-class SetError:
+class DeliveryFailure:
     """Why the last delivery attempt failed (DeliveryError.kind and reason)."""
 
     kind: str
@@ -75,7 +75,7 @@ class PendingSet:
     created_ns: int
     files: tuple[FileEntry, ...]
     attempts: int = 0
-    last_error: SetError | None = None
+    last_error: DeliveryFailure | None = None
     root: Path  # the set's folder in the store
 
     @property
@@ -188,7 +188,9 @@ def list_sets(store: Path) -> list[PendingSet]:
     return sorted(found, key=lambda s: (s.created_ns, s.set_id))
 
 
-def save_set(pending: PendingSet, *, attempts: int, last_error: SetError | None) -> PendingSet:
+def save_set(
+    pending: PendingSet, *, attempts: int, last_error: DeliveryFailure | None
+) -> PendingSet:
     updated = replace(pending, attempts=attempts, last_error=last_error)
     _write_state(pending.root, updated)
     return updated
@@ -218,7 +220,7 @@ def _read_state(folder: Path) -> PendingSet:
         created_ns=int(data["created_ns"]),
         files=tuple(FileEntry(**entry) for entry in data["files"]),
         attempts=int(data.get("attempts", 0)),
-        last_error=SetError(**error) if error else None,
+        last_error=DeliveryFailure(**error) if error else None,
         root=folder,
     )
 

@@ -18,7 +18,7 @@ from orchestrator.match.runner import (
     local_images,
 )
 from orchestrator.match.runtime import ContainerRuntime
-from orchestrator.match.state import IllegalTransition, Lifecycle, MatchState
+from orchestrator.match.state import IllegalMatchTransition, Lifecycle, MatchState
 
 __all__ = [
     "CleanupReport",
@@ -27,7 +27,7 @@ __all__ = [
     "FailureClass",
     "Host",
     "HostControl",
-    "IllegalTransition",
+    "IllegalMatchTransition",
     "ImageResolver",
     "Lifecycle",
     "MatchOutcome",

@@ -108,7 +108,7 @@ def write_files(args: argparse.Namespace, folder: Path, *, stub_image: str | Non
     """Write game.json and the two team files into ``folder``; returns the game.json path."""
     if args.red_image is None or args.blue_image is None:
         if stub_image is None:
-            from orchestrator.images import project_image
+            from orchestrator.project_images import project_image
 
             stub_image = project_image("stub")
     red_image = args.red_image or stub_image

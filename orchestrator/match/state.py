@@ -45,7 +45,7 @@ ALLOWED: dict[MatchState, frozenset[MatchState]] = {
 }
 
 
-class IllegalTransition(OrchestratorError):
+class IllegalMatchTransition(OrchestratorError):
     def __init__(self, *, match_id: str, source: MatchState, target: MatchState) -> None:
         self.match_id = match_id
         self.source = source
@@ -75,7 +75,7 @@ class Lifecycle:
 
     def advance(self, target: MatchState) -> None:
         if target not in ALLOWED[self._state]:
-            raise IllegalTransition(match_id=self.match_id, source=self._state, target=target)
+            raise IllegalMatchTransition(match_id=self.match_id, source=self._state, target=target)
         now = self._clock()
         spent = now - self._entered
         key = self._state.value
@@ -91,4 +91,4 @@ class Lifecycle:
             observer(target)
 
 
-__all__ = ["ALLOWED", "IllegalTransition", "Lifecycle", "MatchState"]
+__all__ = ["ALLOWED", "IllegalMatchTransition", "Lifecycle", "MatchState"]

@@ -12,14 +12,14 @@ from orchestrator.schedule.services import (
     write_game_file,
 )
 from orchestrator.schedule.standings import Standing, standings
-from orchestrator.schedule.state import Ledger, MatchRow, MatchState
+from orchestrator.schedule.state import Ledger, MatchRow, ScheduledMatchState
 
 __all__ = [
     "Ledger",
     "MatchContext",
     "MatchRow",
     "MatchServices",
-    "MatchState",
+    "ScheduledMatchState",
     "PlayOutcome",
     "Standing",
     "TournamentServices",

@@ -20,11 +20,11 @@ from orchestrator.schedule.services import (
     TournamentServices,
     load_services,
 )
-from orchestrator.schedule.state import Ledger, MatchState
+from orchestrator.schedule.state import Ledger, ScheduledMatchState
 
 log = logging.getLogger(__name__)
 
-S = MatchState
+S = ScheduledMatchState
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

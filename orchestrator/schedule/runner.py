@@ -24,10 +24,10 @@ from apscheduler.schedulers.background import BackgroundScheduler
 
 from orchestrator.config.schedule import Schedule, load_schedule, resolve_time
 from orchestrator.errors import ScheduleError
-from orchestrator.schedule.state import Ledger, MatchState
+from orchestrator.schedule.state import Ledger, ScheduledMatchState
 
 log = logging.getLogger(__name__)
-S = MatchState
+S = ScheduledMatchState
 
 JOB_FUNCTIONS = {
     "pull": "orchestrator.schedule.jobs:pull_job",

@@ -4,9 +4,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from orchestrator.schedule.state import MatchRow, MatchState
+from orchestrator.schedule.state import MatchRow, ScheduledMatchState
 
-COUNTED = (MatchState.PLAYED, MatchState.DELIVERING, MatchState.DELIVERED, MatchState.LOGS_PENDING)
+COUNTED = (
+    ScheduledMatchState.PLAYED,
+    ScheduledMatchState.DELIVERING,
+    ScheduledMatchState.DELIVERED,
+    ScheduledMatchState.LOGS_PENDING,
+)
 
 
 @dataclass(slots=True)

@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Any
 
 
-class MatchState(StrEnum):
+class ScheduledMatchState(StrEnum):
     PLANNED = "PLANNED"
     PULLING = "PULLING"
     PULLED = "PULLED"
@@ -38,18 +38,18 @@ class MatchState(StrEnum):
     @property
     def final(self) -> bool:
         return self in (
-            MatchState.DELIVERED,
-            MatchState.LOGS_PENDING,
-            MatchState.MISSED,
-            MatchState.FAILED,
-            MatchState.CANCELLED,
+            ScheduledMatchState.DELIVERED,
+            ScheduledMatchState.LOGS_PENDING,
+            ScheduledMatchState.MISSED,
+            ScheduledMatchState.FAILED,
+            ScheduledMatchState.CANCELLED,
         )
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class MatchRow:
     id: str
-    state: MatchState
+    state: ScheduledMatchState
     kind: str
     red: str  # team name, or "winner of X" until resolved
     blue: str
@@ -160,8 +160,8 @@ class Ledger:
     def transition(
         self,
         match_id: str,
-        allowed_from: tuple[MatchState, ...],
-        to: MatchState,
+        allowed_from: tuple[ScheduledMatchState, ...],
+        to: ScheduledMatchState,
         *,
         note: str = "",
         result: dict[str, Any] | None = None,
@@ -171,7 +171,7 @@ class Ledger:
         """Compare-and-set: move the match to ``to`` only if it is in ``allowed_from``."""
         with self._connect() as db:
             row = db.execute("SELECT state FROM hlvs_matches WHERE id=?", (match_id,)).fetchone()
-            if row is None or MatchState(row[0]) not in allowed_from:
+            if row is None or ScheduledMatchState(row[0]) not in allowed_from:
                 return False
             sets = ["state=?", "note=?", "updated_at=?"]
             args: list[Any] = [to.value, note, _now()]
@@ -229,7 +229,7 @@ def _row(r: tuple[Any, ...]) -> MatchRow:
     ts = datetime.fromisoformat
     return MatchRow(
         id=r[0],
-        state=MatchState(r[1]),
+        state=ScheduledMatchState(r[1]),
         kind=r[2],
         red=r[3],
         blue=r[4],

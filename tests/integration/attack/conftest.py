@@ -31,7 +31,7 @@ REPO = Path(__file__).resolve().parents[3]
 @pytest.fixture(scope="session")
 def project_images() -> dict[str, str]:
     try:
-        from orchestrator.images import project_image
+        from orchestrator.project_images import project_image
 
         return {name: project_image(name) for name in ("simulator", "stub", "team-base")}
     except (ImportError, OrchestratorError) as exc:

@@ -10,7 +10,7 @@ import pytest
 
 from orchestrator.console import PlainProgress, StepTracker
 from orchestrator.engine import images as engine_images
-from orchestrator.images import LABEL_CONTENT, LABEL_IMAGE, ensure_image, project_image
+from orchestrator.project_images import LABEL_CONTENT, LABEL_IMAGE, ensure_image, project_image
 from tests.conftest import TEST_LABEL
 from tests.integration.images.conftest import MakeImage
 

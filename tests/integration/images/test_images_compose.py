@@ -18,7 +18,7 @@ import yaml
 
 from orchestrator.compose import Subnets, compose_files, write_compose
 from orchestrator.config import load_game
-from orchestrator.images import project_image
+from orchestrator.project_images import project_image
 from tests.conftest import TEST_LABEL
 
 pytestmark = pytest.mark.docker

@@ -51,7 +51,7 @@ def alpha_login(registry: Registry, password: str | None = None) -> RegistryAuth
 def test_team_image_on_team_base_is_pushed_pulled_pinned_and_runs(
     registry: Registry, docker_client: docker.DockerClient, tmp_path: Path
 ) -> None:
-    from orchestrator.images import project_image
+    from orchestrator.project_images import project_image
 
     # The team's side, as images/README.md tells it: build FROM team-base, push.
     (tmp_path / "player.py").write_text(
@@ -243,7 +243,7 @@ def test_hlvs_images_pull_reports_each_player(
 
 
 def test_pull_game_images_pins_both_teams(docker_client: docker.DockerClient) -> None:
-    from orchestrator.images import project_image
+    from orchestrator.project_images import project_image
     from orchestrator.pull import pull_game_images
 
     project_image("stub")  # also tags hlvs-runner/stub:latest, which the example names

@@ -35,7 +35,7 @@ LOCAL_BASES = ("hlvs-runner/base:bookworm", "hlvs-runner-test/e-base:bookworm")
 
 def _base_image(client: docker.DockerClient) -> str:
     try:
-        from orchestrator.images import project_image  # type: ignore[attr-defined]
+        from orchestrator.project_images import project_image  # type: ignore[attr-defined]
 
         return str(project_image("team-base"))
     except (ImportError, AttributeError, OrchestratorError):

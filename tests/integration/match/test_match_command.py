@@ -23,7 +23,7 @@ def test_match_command_plays_a_game_file(tmp_path: Path, test_image: str, runtim
                                          monkeypatch: pytest.MonkeyPatch) -> None:
     """Relative paths as a user types them: the game file and ``--out`` (a bind-mount source)."""
     try:
-        from orchestrator.images import project_image
+        from orchestrator.project_images import project_image
 
         project_image("simulator")
     except (ImportError, OrchestratorError) as exc:
@@ -77,7 +77,7 @@ def test_sigterm_to_hlvs_match_stops_everything_and_exits_130(
     import time
 
     try:
-        from orchestrator.images import project_image
+        from orchestrator.project_images import project_image
 
         project_image("simulator")
     except (ImportError, OrchestratorError) as exc:

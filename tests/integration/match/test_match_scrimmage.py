@@ -21,7 +21,7 @@ def test_short_scrimmage_plays_to_finished(tmp_path: Path, runtime: Any,
     """From a working directory with a relative ``--out``, as ``make scrimmage`` runs it: the
     folders reach Docker as absolute bind-mount sources."""
     try:
-        from orchestrator.images import project_image
+        from orchestrator.project_images import project_image
 
         project_image("simulator")
         project_image("stub")
@@ -63,7 +63,7 @@ def test_scrimmage_with_a_team_of_wolfgang_models_plays_to_the_end(
     """Red plays with the Wolfgang model package (URDF and meshes mounted read-only into the
     simulator), blue with the built-in robot; the stub drives both through the robot API."""
     try:
-        from orchestrator.images import project_image
+        from orchestrator.project_images import project_image
 
         project_image("simulator")
         project_image("stub")

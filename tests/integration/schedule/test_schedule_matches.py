@@ -17,7 +17,7 @@ import pytest
 
 from orchestrator.config.credentials import load_credentials
 from orchestrator.delivery.s3 import create_bucket
-from orchestrator.schedule import Ledger, MatchState, run_schedule, standings
+from orchestrator.schedule import Ledger, ScheduledMatchState, run_schedule, standings
 from testkit.s3 import MotoServer
 
 pytestmark = [pytest.mark.docker, pytest.mark.slow]
@@ -85,7 +85,7 @@ def test_compressed_tournament_of_real_matches(tmp_path: Path, s3: MotoServer) -
 
     ledger = Ledger(state)
     rows = {row.id: row for row in ledger.rows()}
-    assert {r.state for r in rows.values()} == {MatchState.DELIVERED}, {
+    assert {r.state for r in rows.values()} == {ScheduledMatchState.DELIVERED}, {
         r.id: (r.state, r.note) for r in rows.values()
     }
     for match_id, row in rows.items():

@@ -59,7 +59,7 @@ def inbox() -> Iterator[tuple[Inbox, int]]:
 
 @pytest.fixture
 def real_settings(settings: Settings, docker_client: Any) -> Settings:
-    from orchestrator.images import project_image
+    from orchestrator.project_images import project_image
 
     project_image("stub")
     project_image("simulator")

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from orchestrator import image_inputs
-from orchestrator.images import BUILD_DIR, ROBOT_REQUIREMENTS
+from orchestrator.project_images import BUILD_DIR, ROBOT_REQUIREMENTS
 from tests.unit.stub.test_robot_imports import FORBIDDEN
 
 REPO = Path(__file__).resolve().parents[3]

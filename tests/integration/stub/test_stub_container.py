@@ -18,7 +18,7 @@ pytestmark = pytest.mark.docker
 
 @pytest.fixture(scope="module")
 def stub_image() -> str:
-    from orchestrator.images import project_image
+    from orchestrator.project_images import project_image
 
     return str(project_image("stub"))
 

@@ -30,7 +30,7 @@ def test_live_view_follows_a_running_scrimmage_and_its_replay_plays(
 ) -> None:
     try:
         from orchestrator.errors import OrchestratorError
-        from orchestrator.images import project_image
+        from orchestrator.project_images import project_image
 
         project_image("simulator")
         project_image("stub")

@@ -9,7 +9,7 @@ import pytest
 
 from orchestrator.engine.images import RegistryAuth, _classify, registry_of
 from orchestrator.errors import ImagePullError
-from orchestrator.images import content_hash
+from orchestrator.project_images import content_hash
 from orchestrator.pull import split_reference
 from orchestrator.registry import RegistryImage, TeamRule, plan_enforcement
 from orchestrator.registry.client import _next_link

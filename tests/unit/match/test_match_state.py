@@ -4,7 +4,7 @@ import logging
 
 import pytest
 
-from orchestrator.match import IllegalTransition, Lifecycle, MatchState
+from orchestrator.match import IllegalMatchTransition, Lifecycle, MatchState
 
 
 class Clock:
@@ -46,7 +46,7 @@ def test_illegal_transitions_are_rejected(path: list[MatchState], target: MatchS
     for state in path:
         life.advance(state)
     before = life.state
-    with pytest.raises(IllegalTransition) as info:
+    with pytest.raises(IllegalMatchTransition) as info:
         life.advance(target)
     assert info.value.source is before and info.value.target is target
     assert "m2" in str(info.value) and "allowed from" in str(info.value)

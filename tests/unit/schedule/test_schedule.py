@@ -16,7 +16,7 @@ import pytest
 
 from orchestrator.config.schedule import load_schedule, round_robin_fixtures
 from orchestrator.errors import ConfigError
-from orchestrator.schedule import Ledger, MatchState, run_schedule, standings
+from orchestrator.schedule import Ledger, ScheduledMatchState, run_schedule, standings
 from tests.unit.schedule.fake_services import goals
 
 FAKE = "tests.unit.schedule.fake_services:FakeServices"
@@ -94,7 +94,7 @@ def test_tournament_plays_each_match_once_in_its_window(tmp_path: Path) -> None:
     ledger = Ledger(state)
     rows = {r.id: r for r in ledger.rows()}
     assert set(rows) == {"rr-1", "rr-2", "rr-3"}
-    assert all(r.state is MatchState.DELIVERED for r in rows.values()), rows
+    assert all(r.state is ScheduledMatchState.DELIVERED for r in rows.values()), rows
     log = services_log(path)
     for match_id, row in rows.items():
         steps = [(what, at) for what, mid, at in log if mid == match_id]
@@ -122,7 +122,7 @@ def test_knockout_winners_advance(tmp_path: Path) -> None:
     assert run_schedule(path, state, services=FAKE, exit_when_done=True, poll_s=0.1) == 0
     rows = {r.id: r for r in Ledger(state).rows()}
     final = rows["ko-r2-1"]
-    assert final.state is MatchState.DELIVERED, final
+    assert final.state is ScheduledMatchState.DELIVERED, final
     semi_winners = {rows[m].result["winner_team"] for m in ("ko-r1-1", "ko-r1-2")}  # type: ignore[index]
     assert {final.red, final.blue} == semi_winners
 
@@ -139,7 +139,7 @@ def test_missed_match_is_marked_with_a_reason(tmp_path: Path) -> None:
     time.sleep(0.7)  # the scheduler was down past the stream start
     run_schedule(path, state, services=FAKE, exit_when_done=True, poll_s=0.1)
     row = Ledger(state).row("late")
-    assert row.state is MatchState.MISSED and "window" in row.note
+    assert row.state is ScheduledMatchState.MISSED and "window" in row.note
     assert not [e for e in services_log(path) if e[0].startswith("play")]
 
 
@@ -201,7 +201,7 @@ def test_sigkill_mid_tournament_then_restart_plays_every_match_once(tmp_path: Pa
     first.send_signal(signal.SIGKILL)
     first.wait()
     assert playing is not None
-    assert Ledger(state).row(playing).state is MatchState.PLAYING
+    assert Ledger(state).row(playing).state is ScheduledMatchState.PLAYING
     second = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=120)
     assert second.returncode == 0, second.stderr
     rows = Ledger(state).rows()
@@ -209,13 +209,13 @@ def test_sigkill_mid_tournament_then_restart_plays_every_match_once(tmp_path: Pa
     log = services_log(path)
     for row in rows:
         ends = [m for w, m, _ in log if w == "play-end" and m == row.id]
-        assert row.state is MatchState.DELIVERED, row
+        assert row.state is ScheduledMatchState.DELIVERED, row
         assert len(ends) == 1, (row.id, ends)
-    assert Ledger(state).row(playing).state is MatchState.DELIVERED
+    assert Ledger(state).row(playing).state is ScheduledMatchState.DELIVERED
     history = [h for h in Ledger(state).history(playing) if "interrupted" in h[4]]
     assert history, "the interrupted match was not recorded as such"
     assert sum(1 for w, *_ in log if w == "deliver") == sum(
-        1 for r in rows if r.state is MatchState.DELIVERED
+        1 for r in rows if r.state is ScheduledMatchState.DELIVERED
     )
 
 
