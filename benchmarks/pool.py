@@ -29,8 +29,8 @@ CONF = "/var/lib/hlvs/slurm/slurm.conf"
 
 
 def _job(folder: Path, name: str, half_s: float) -> Any:
-    from orchestrator.images import project_image
     from orchestrator.match.scrimmage import write_files
+    from orchestrator.project_images import project_image
     from service.pool import MatchJob
 
     args = argparse.Namespace(

@@ -35,8 +35,8 @@ def cluster() -> Iterator[str]:
 
 
 def _job(tmp: Path, name: str, account: str) -> MatchJob:
-    from orchestrator.images import project_image
     from orchestrator.match.scrimmage import write_files
+    from orchestrator.project_images import project_image
 
     args = argparse.Namespace(
         red_image=None, blue_image=None, players=1, half_duration=4.0, wait_before_ready=1.0,
