@@ -103,7 +103,10 @@ def _pull(args: argparse.Namespace) -> int:
     else:
         for number, image in sorted(resolved.items()):
             if image.error is None:
-                print(f"player {number}: {image.digest} ({image.size_bytes / 1e6:.1f} MB)")
+                retried = (f", pulled at attempt {image.pull_attempts}"
+                           if image.pull_attempts > 1 else "")
+                print(f"player {number}: {image.digest} ({image.size_bytes / 1e6:.1f} MB"
+                      f"{retried})")
             else:
                 print(f"player {number}: {image.error}")
     return ExitCode.OK if ok else ExitCode.FAILED
