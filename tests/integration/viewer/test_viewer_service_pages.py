@@ -99,7 +99,8 @@ def test_queue_submissions_replay_standings_and_pool_pages(
 
     _use_token(page, served.url, secrets["A1"], "/watch/submissions")
     mine = _rows(page, "submissions")
-    assert [(r[0], r[2]) for r in mine] == [(ids[0], "done")]
+    assert [(r[0], r[2], r[7]) for r in mine] == [(ids[0], "done", "A1 1 : 0 stub")]
+    screenshot(page, "service-submissions")
     page.locator("[data-testid=submissions] a", has_text="replay").click()
     page.wait_for_function("window.hlvsViewer && window.hlvsViewer.ready", timeout=30_000)
     assert page.evaluate("window.hlvsViewer.meta.match_id") == "viewer-test"

@@ -56,14 +56,25 @@ function queueRows(active: Submission[]): (string | Node)[][] {
 
 const QUEUE_COLUMNS = ["position", "submission", "team", "opponent", "state", "expected start", "reason"];
 
+async function score(s: Submission): Promise<string> {
+  if (s.state !== "done") return "-";
+  try {
+    const results = await getJson<{ score?: { red: number; blue: number } }>(`/v1/submissions/${encodeURIComponent(s.id)}/results`);
+    return results.score ? `${s.team} ${results.score.red} : ${results.score.blue} ${s.opponent}` : "-";
+  } catch {
+    return "-";
+  }
+}
+
 async function submissionsPage(root: HTMLElement): Promise<void> {
   const rows = await getJson<Submission[]>("/v1/submissions");
+  const scores = await Promise.all(rows.map(score));
   root.append(el("h1", {}, "Your test matches"), table("submissions", [
-    "submission", "opponent", "state", "queue position", "expected start", "reason", "finished", "outcome", "watch",
-  ], rows.map((s) => [
+    "submission", "opponent", "state", "queue position", "expected start", "reason", "finished", "result", "outcome", "watch",
+  ], rows.map((s, i) => [
     s.id, s.opponent, s.state, s.queue_position === null ? "-" : String(s.queue_position), when(s.expected_start),
-    s.waiting_reason ?? "-", when(s.finished_at), s.failure_class ? `${s.failure_class}: ${s.cause ?? ""}` : (s.cause ?? "-"),
-    watchLinks(s),
+    s.waiting_reason ?? "-", when(s.finished_at), scores[i],
+    s.failure_class ? `${s.failure_class}: ${s.cause ?? ""}` : (s.cause ?? "-"), watchLinks(s),
   ])));
 }
 
