@@ -5,9 +5,9 @@ The robots' CPU and memory limits plus what the simulator needs (:data:`SIMULATO
 match that does not fit is refused with the numbers; any other match (a scrimmage, a test match)
 is played with a warning recorded in ``results.json`` (``admission``). Whatever the verdict, the
 simulator container gets :data:`SIMULATOR_CPU_SHARES` (robots keep Docker's 1024), so under
-contention the kernel gives it its share first, and on a local engine with more CPUs than the
-simulator needs the CPUs are split (:func:`cpu_sets`): the simulator's own, which no robot may
-use, and the robots'. A team cannot starve the simulator.
+contention the kernel gives it its share first, and in async stepping on a local engine with
+more CPUs than the simulator needs the CPUs are split (:func:`cpu_sets`): the simulator's own,
+which no robot may use, and the robots'. A team cannot starve the simulator.
 """
 
 from __future__ import annotations
@@ -93,14 +93,16 @@ class CpuSets:
     robots: str | None  # cpuset of every robot container
 
 
-def cpu_sets() -> CpuSets:
-    """The first ``ceil(SIMULATOR_CPUS)`` CPUs this process may use for the simulator, the rest
-    for the robots; no pinning with a remote engine (``DOCKER_HOST`` not a local socket) or when
-    there are no CPUs left for the robots."""
+def cpu_sets(*, stepping: str = "async") -> CpuSets:
+    """In ``async`` stepping (the league's: the simulation never waits), the first
+    ``ceil(SIMULATOR_CPUS)`` CPUs this process may use go to the simulator, the rest to the
+    robots. No pinning in ``lockstep`` (simulator and robots take turns, so they share every
+    CPU best, and results do not depend on speed), with a remote engine (``DOCKER_HOST`` not a
+    local socket) or when no CPU would be left for the robots."""
     remote = os.environ.get("DOCKER_HOST", "unix://")
     allowed = sorted(os.sched_getaffinity(0))
     reserved = math.ceil(SIMULATOR_CPUS)
-    if not remote.startswith("unix://") or len(allowed) <= reserved:
+    if stepping != "async" or not remote.startswith("unix://") or len(allowed) <= reserved:
         return CpuSets(simulator=None, robots=None)
     return CpuSets(simulator=",".join(map(str, allowed[:reserved])),
                    robots=",".join(map(str, allowed[reserved:])))

@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from orchestrator.bandwidth import AppliedShaping
+from orchestrator.match.admission import CpuSets
 from orchestrator.match.host import Host
 from orchestrator.match.layout import SIMULATOR_COMMAND, Subnet
 from orchestrator.match.logfs import LogFolder
@@ -65,6 +66,7 @@ class Started:
     shaping: dict[str, AppliedShaping] = field(default_factory=dict)
     log_folders: dict[str, LogFolder] = field(default_factory=dict)
     scratch: dict[str, LogFolder] = field(default_factory=dict)  # robot key -> scratch space
+    cpu_sets: CpuSets = field(default_factory=lambda: CpuSets(simulator=None, robots=None))
     match_dir: Path | None = None
 
 

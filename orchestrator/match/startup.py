@@ -81,7 +81,9 @@ def _start(match: MatchContext, started_at: float) -> None:
         attachments=attachments, extra_labels=match.options.extra_labels,
         command=match.options.simulator_command, model_dirs=plan.model_dirs,
     )
-    request = replace(request, cpuset_cpus=cpu_sets().simulator)
+    sets = cpu_sets(stepping=str(spec.get("stepping", "async")))
+    started.cpu_sets = sets
+    request = replace(request, cpuset_cpus=sets.simulator)
     _start_simulator(match, request)  # first: it boots while the robots start
     robots = [r for r in plan.robots if match.records[r.key].image_error is None]
     with ThreadPoolExecutor(max_workers=max(1, min(8, len(robots)))) as pool:
@@ -168,7 +170,7 @@ def _start_robot(match: MatchContext, robot: RobotPlan) -> None:
             extra_labels=match.options.extra_labels,
             scratch_dir=scratch.path if scratch is not None else None,
         )
-        request = replace(request, cpuset_cpus=cpu_sets().robots)
+        request = replace(request, cpuset_cpus=started.cpu_sets.robots)
         record.limits["cpuset"] = request.cpuset_cpus
         container_id = match.runtime.create_container(request)
         started.robot_ids[robot.key] = container_id

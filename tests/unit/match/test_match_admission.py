@@ -36,3 +36,19 @@ def test_a_match_that_fits_has_no_warning() -> None:
                     host=HostResources(cpus=2.0, memory_gb=8.0), official=True)
     assert verdict.fits and verdict.to_json()["warning"] is None
     assert verdict.to_json()["cpus"] == {"needed": 2.0, "available": 2.0}
+
+
+def test_async_matches_give_the_simulator_cpus_of_its_own() -> None:
+    import os
+
+    from orchestrator.match.admission import cpu_sets
+
+    allowed = sorted(os.sched_getaffinity(0))
+    assert cpu_sets(stepping="lockstep") == cpu_sets(stepping="lockstep").__class__(
+        simulator=None, robots=None)
+    sets = cpu_sets(stepping="async")
+    if len(allowed) < 2 or os.environ.get("DOCKER_HOST", "unix://")[:7] != "unix://":
+        assert sets.simulator is None
+        return
+    assert sets.simulator == str(allowed[0])
+    assert sets.robots == ",".join(map(str, allowed[1:]))
