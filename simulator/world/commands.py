@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import logging
 import math
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import mujoco
 import numpy as np
 
-from contracts.ids import TeamColor
+from contracts.ids import RobotId, TeamColor
 from referee.snapshot import (
     PlaceBall,
     RemoveRobot,
@@ -19,9 +19,22 @@ from referee.snapshot import (
     Vec3,
     WorldCommand,
 )
+from simulator.world.indices import WorldIndex
+from simulator.world.motors import MotorBank
 
-if TYPE_CHECKING:
-    from simulator.world.world import World
+
+class CommandTarget(Protocol):
+    """What the commands change in a world (:class:`simulator.world.world.World` is one); the
+    world calls these functions, they never call back into it."""
+
+    model: mujoco.MjModel
+    data: mujoco.MjData
+    index: WorldIndex
+    robot_ids: tuple[RobotId, ...]
+    motors: MotorBank
+    limp: list[bool]
+    removed: list[bool]
+    parked_qpos: dict[int, np.ndarray]
 
 logger = logging.getLogger(__name__)
 
@@ -30,7 +43,7 @@ PARK_Y_M = 10.0
 STANDING_CLEARANCE_M = 0.002
 
 
-def apply(world: World, command: WorldCommand) -> None:
+def apply(world: CommandTarget, command: WorldCommand) -> None:
     if isinstance(command, PlaceBall):
         place_ball(world, command.position, command.velocity)
         return
@@ -46,7 +59,7 @@ def apply(world: World, command: WorldCommand) -> None:
     mujoco.mj_forward(world.model, world.data)
 
 
-def place_ball(world: World, position: Vec3, velocity: Vec3) -> None:
+def place_ball(world: CommandTarget, position: Vec3, velocity: Vec3) -> None:
     q, d = world.index.ball_qpos, world.index.ball_dof
     world.data.qpos[q : q + 3] = position
     world.data.qpos[q + 3 : q + 7] = (1.0, 0.0, 0.0, 0.0)
@@ -55,7 +68,7 @@ def place_ball(world: World, position: Vec3, velocity: Vec3) -> None:
     mujoco.mj_forward(world.model, world.data)
 
 
-def _standing_qpos(world: World, number: int, x: float, y: float, yaw: float) -> np.ndarray:
+def _standing_qpos(world: CommandTarget, number: int, x: float, y: float, yaw: float) -> np.ndarray:
     robot = world.index.robots[number]
     start, end = robot.qpos_range
     qpos: np.ndarray = np.array(world.data.qpos[start:end], dtype=np.float64)
@@ -65,7 +78,7 @@ def _standing_qpos(world: World, number: int, x: float, y: float, yaw: float) ->
     return qpos
 
 
-def teleport(world: World, number: int, x: float, y: float, yaw: float) -> None:
+def teleport(world: CommandTarget, number: int, x: float, y: float, yaw: float) -> None:
     """Standing posture (the model's standing pose: all joints at zero for the built-in models)
     at (x, y, yaw), velocities zeroed."""
     robot = world.index.robots[number]
@@ -75,14 +88,14 @@ def teleport(world: World, number: int, x: float, y: float, yaw: float) -> None:
     world.motors.hold(robot.actuators, np.asarray(robot.model.standing_pose_rad, dtype=float))
 
 
-def set_limp(world: World, number: int, limp: bool) -> None:
+def set_limp(world: CommandTarget, number: int, limp: bool) -> None:
     robot = world.index.robots[number]
     world.limp[number] = limp
     world.motors.set_limp(robot.actuators, limp)
     logger.info("%s %s", robot.id, "limp" if limp else "under control again")
 
 
-def remove(world: World, number: int) -> None:
+def remove(world: CommandTarget, number: int) -> None:
     """Park the robot far outside the field, frozen and without collisions."""
     robot = world.index.robots[number]
     if world.removed[number]:
@@ -97,7 +110,7 @@ def remove(world: World, number: int) -> None:
     logger.info("%s removed from the world", robot.id)
 
 
-def restore(world: World, number: int, x: float, y: float, yaw: float) -> None:
+def restore(world: CommandTarget, number: int, x: float, y: float, yaw: float) -> None:
     robot = world.index.robots[number]
     if world.removed[number]:
         bit = 1 << number
@@ -112,7 +125,7 @@ def restore(world: World, number: int, x: float, y: float, yaw: float) -> None:
     teleport(world, number, x, y, yaw)
 
 
-def hold_parked(world: World) -> None:
+def hold_parked(world: CommandTarget) -> None:
     """Keep removed robots frozen at their parking spots (after every step)."""
     for number, qpos in world.parked_qpos.items():
         robot = world.index.robots[number]

@@ -97,3 +97,8 @@ def test_the_match_phases_form_no_import_circle() -> None:
     assert (ROOT / "orchestrator" / "match" / "context.py").is_file()
     cycles = [c for c in import_cycles("orchestrator") if c[0].startswith("orchestrator.match")]
     assert cycles == []
+
+
+def test_no_package_has_an_import_circle() -> None:
+    found = {package: import_cycles(package)[:1] for package in (*PRODUCTION, "testkit")}
+    assert {package: cycle for package, cycle in found.items() if cycle} == {}
