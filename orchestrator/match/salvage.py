@@ -24,8 +24,8 @@ log = logging.getLogger(__name__)
 
 STOP_TIMEOUT_S = 10.0
 PUBLIC_FILES = (
-    "sim_result.json", "replay.hlvsrec", "referee.log", "referee_events.jsonl",
-    "gamecontroller.log", "bouncing_log.txt",
+    "sim_result.json", "replay.hlvsrec", "api_stats.jsonl", "referee.log",
+    "referee_events.jsonl", "gamecontroller.log", "bouncing_log.txt",
 )
 
 
