@@ -43,8 +43,9 @@ def _parser() -> argparse.ArgumentParser:
     program = os.environ.get("HLVS_PROG", "python -m simulator")
     parser = argparse.ArgumentParser(prog=f"{program} bench api")
     parser.add_argument("--robots", type=int, default=8, help="connected clients (default 8)")
-    parser.add_argument("--mode", choices=("lockstep", "async"), default="lockstep",
-                        help="stepping mode (default lockstep)")
+    parser.add_argument("--mode", choices=("lockstep", "pipelined", "async"), default="lockstep",
+                        help="stepping mode (default lockstep; pipelined: the clients answer "
+                        "while the next step is computed)")
     parser.add_argument("--camera", default="", help="WxH@PERIOD, e.g. 320x240@32")
     parser.add_argument("--sim-seconds", type=float, default=10.0,
                         help="simulated seconds to run (default 10)")
@@ -217,6 +218,7 @@ def _api_run(
     from simulator.api import (
         ApiServer,
         LockstepSettings,
+        Pipeline,
         PlayerEndpoint,
         wait_lockstep,
         world_cameras,
@@ -240,7 +242,7 @@ def _api_run(
         world=world,
         endpoints=endpoints,
         network=NetworkSpec(api_bind_host="127.0.0.1"),
-        lockstep=lockstep if args.mode == "lockstep" else None,
+        lockstep=lockstep if args.mode in ("lockstep", "pipelined") else None,
         cameras=cameras,
         send_cpus=args.client_cpus or None,
     )
@@ -266,24 +268,36 @@ def _api_run(
         deadline = time.monotonic() + 120
         while len(server.connected()) < len(endpoints) and time.monotonic() < deadline:
             server.poll(0.05)
-        for _ in range(50):  # warm-up: sensors enabled, caches hot
+        pipeline = Pipeline(server, lockstep) if args.mode == "pipelined" else None
+        waited = [0.0]
+
+        def one_step() -> None:
+            if pipeline is not None:
+                pipeline.before_step(world.sim_time_ms, world.sim_time_ms + world.step_ms)
+                world.step()
+                world.snapshot()
+                pipeline.after_step()
+                return
             if args.mode == "lockstep":
-                wait_lockstep(server, lockstep)
+                waited[0] += wait_lockstep(server, lockstep)
             server.apply_requests(world.sim_time_ms + world.step_ms)
             world.step()
             world.snapshot()
             server.publish(world.sim_time_ms)
+
+        for _ in range(50):  # warm-up: sensors enabled, caches hot
+            one_step()
+        waited[0] = 0.0
+        if pipeline is not None:
+            pipeline.waited_s = 0.0
         steps = int(args.sim_seconds * 1000 / world.step_ms)
         start_ms = world.sim_time_ms
         started, started_cpu = time.perf_counter(), time.thread_time()
         for _ in range(steps):
-            if args.mode == "lockstep":
-                wait_lockstep(server, lockstep)
-            server.apply_requests(world.sim_time_ms + world.step_ms)
-            world.step()
-            world.snapshot()
-            server.publish(world.sim_time_ms)
+            one_step()
         wall, cpu = time.perf_counter() - started, time.thread_time() - started_cpu
+        if pipeline is not None:
+            waited[0] = pipeline.waited_s
         stats = server.statistics()
     finally:
         server.close()
@@ -295,6 +309,7 @@ def _api_run(
     return {
         "real_time_factor": round((world.sim_time_ms - start_ms) / 1000.0 / wall, 3),
         "cpu_s_per_sim_s": cpu / ((world.sim_time_ms - start_ms) / 1000.0),
+        "wait_share": round(waited[0] / wall, 3),
         "connected": len(stats),
         "dropped_out": sum(s["dropped_out"] for s in stats.values()),
         "slow_periods": sum(s["slow_periods"] for s in stats.values()),
@@ -349,6 +364,8 @@ def main(argv: list[str]) -> int:
         "render_ms_per_frame": api["render_ms_per_frame"],
         "render_processes": args.render_processes,
         "slow_periods": api["slow_periods"],
+        # share of the API run's wall time the step thread waited for the clients (lockstep)
+        "client_wait_share": api["wait_share"],
         "step_thread_cpus": sorted(os.sched_getaffinity(0)),
         "client_cpus": sorted(args.client_cpus) or "shared",
     }

@@ -21,7 +21,7 @@ from contracts.ids import TeamColor
 
 SPEC_VERSION = 1
 
-SteppingMode = Literal["async", "lockstep"]
+SteppingMode = Literal["async", "lockstep", "pipelined"]
 Color = Literal["red", "blue"]  # contracts.ids.TeamColor values
 GameTypeName = Literal["NORMAL", "KNOCKOUT", "PENALTY"]  # GameType values
 FieldClassName = Literal["kid", "adult"]  # contracts.field.FieldClass values

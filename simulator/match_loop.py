@@ -6,9 +6,20 @@ One basic step (8 ms of simulated time)::
     -> snapshot -> referee.step -> apply its commands -> publish measurements
     -> recorder / telemetry -> pacing (async: maximum_real_time_factor)
 
+Pipelined lockstep overlaps the physics with the robots' thinking, at the price of one step of
+action latency (fixed, so the match stays deterministic)::
+
+    wait for one request per client (the answers to the measurement sent before this step)
+    -> take them -> send the measurement of step N -> apply the taken requests
+    -> world.step() (step N+1, while the clients compute their answers to step N) -> referee
+
+so the actions a robot sends while step N+1 is computed apply at step N+2 (in lockstep they
+apply at step N+1). Nothing of step N reaches a client before the answers to step N-1 are
+taken, so which requests a step applies never depends on timing.
+
 While the referee waits for wall-clock time (before the first READY, between halves) an async
-match keeps stepping, as in HLVS; a lockstep match holds (no steps, connections still served) so
-its result does not depend on machine speed.
+match keeps stepping, as in HLVS; a lockstep (or pipelined) match holds (no steps, connections
+still served) so its result does not depend on machine speed.
 """
 
 from __future__ import annotations
@@ -23,6 +34,7 @@ import numpy as np
 
 from referee.snapshot import RefereeEvent, WorldCommand, WorldSnapshot
 from simulator.api import ApiServer, LockstepSettings, wait_lockstep
+from simulator.api.lockstep import Pipeline
 from simulator.telemetry import POSES_PERIOD_S, STATE_PERIOD_S, Telemetry
 from simulator.traffic import TrafficLog
 
@@ -64,7 +76,7 @@ class RecorderLike(Protocol):
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class LoopSettings:
-    stepping: str  # "async" | "lockstep"
+    stepping: str  # "async" | "lockstep" | "pipelined"
     maximum_real_time_factor: float
     lockstep: LockstepSettings
     end_of_game_real_s: float
@@ -108,6 +120,9 @@ class MatchLoop:
         self._next_poses_s = 0.0
         self._rtf_window: tuple[float, int] = (0.0, 0)
         self._rtf = 0.0
+        self._pipeline = (
+            Pipeline(server, settings.lockstep) if settings.stepping == "pipelined" else None
+        )
 
     def request_stop(self, reason: str) -> None:
         self.stop_requested = True
@@ -116,7 +131,8 @@ class MatchLoop:
 
     @property
     def lockstep(self) -> bool:
-        return self.settings.stepping == "lockstep"
+        """Lockstep or pipelined: steps wait for the clients and the wall-clock waits hold."""
+        return self.settings.stepping in ("lockstep", "pipelined")
 
     def run(self) -> str:
         """Play; returns why the loop ended: finished, max_duration or the stop reason."""
@@ -141,6 +157,8 @@ class MatchLoop:
                     self.stop_reason = "finished"
                     break
             if self.lockstep and (self.referee.waiting_for_wall_clock or finished_at is not None):
+                if self._pipeline is not None and self._pipeline.unsent:
+                    self._pipeline.send(self.world.sim_time_ms)  # the state they wait in
                 self._hold(0.02)
                 pace_origin = (time.monotonic(), self.world.sim_time_ms)
                 continue
@@ -154,6 +172,8 @@ class MatchLoop:
                 while wait > 0:  # a socket event ends a poll early: wait until due
                     self.server.poll(wait)
                     wait = due - time.monotonic()
+        if self._pipeline is not None and self._pipeline.unsent and not self.stop_requested:
+            self.server.publish(self.world.sim_time_ms)  # the last step's, as in lockstep
         self.real_time_s = time.monotonic() - start
         self._publish_state(force=True)
         return self.stop_reason
@@ -165,8 +185,22 @@ class MatchLoop:
         self._publish_state()
         self.held_s += time.monotonic() - began
 
+    def _one_step_pipelined(self, pipeline: Pipeline) -> None:
+        world = self.world
+        pipeline.before_step(world.sim_time_ms, world.sim_time_ms + world.step_ms)
+        world.step()
+        self._referee_step(world.snapshot())
+        pipeline.after_step()
+        self.steps += 1
+        if self.recorder is not None:
+            self.recorder.record(world, dict(self.referee.game_state))
+        self._publish_state()
+
     def _one_step(self) -> None:
         world, server = self.world, self.server
+        if self._pipeline is not None:
+            self._one_step_pipelined(self._pipeline)
+            return
         if self.lockstep:
             wait_lockstep(server, self.settings.lockstep)
         server.apply_requests(world.sim_time_ms + world.step_ms)

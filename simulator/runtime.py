@@ -135,7 +135,7 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
             world=world,
             endpoints=endpoints_from_spec(spec),
             network=spec.network,
-            lockstep=lockstep if spec.stepping == "lockstep" else None,
+            lockstep=lockstep if spec.stepping in ("lockstep", "pipelined") else None,
             cameras=cameras,
             spoofing=referee.spoofing,
         )

@@ -21,7 +21,7 @@ GameType = Literal["NORMAL", "KNOCKOUT", "PENALTY"]
 FieldClass = Literal["KID", "ADULT"]
 Color = Literal["red", "blue"]
 SideChoice = Literal["red", "blue", "random"]
-SteppingMode = Literal["async", "lockstep"]
+SteppingMode = Literal["async", "lockstep", "pipelined"]
 
 COLORS: tuple[Color, Color] = ("red", "blue")
 MAX_PLAYERS: dict[str, int] = {"KID": 4, "ADULT": 3}

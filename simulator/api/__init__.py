@@ -6,7 +6,7 @@ from simulator.api.cameras import RenderWorker
 from simulator.api.devices import DeviceWorld, FakeCameraRenderer, FakeDeviceWorld, robot_key
 from simulator.api.endpoints import PlayerEndpoint, endpoints_from_spec
 from simulator.api.framing import MAX_FRAME_BYTES, FrameDecoder, FramingError, encode_frame
-from simulator.api.lockstep import wait_lockstep
+from simulator.api.lockstep import Pipeline, wait_lockstep
 from simulator.api.quota import NetworkQuota
 from simulator.api.server import ApiServer, LockstepSettings, PortUnavailable
 from simulator.api.session import RobotSession, rendering_bandwidth_mb_s
@@ -21,6 +21,7 @@ __all__ = [
     "FramingError",
     "LockstepSettings",
     "NetworkQuota",
+    "Pipeline",
     "PlayerEndpoint",
     "PortUnavailable",
     "RenderWorker",

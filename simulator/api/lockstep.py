@@ -5,6 +5,10 @@ measurement was queued, when a camera image delayed it) is free; time beyond it 
 taken from the client's time bank (a chess clock with a per-move allowance). A client whose bank
 runs out is marked slow (logged, counted) and the step goes on without it; it is waited for
 again, with a full bank, once it has answered the latest measurement and its send queue is empty.
+
+:class:`Pipeline` is pipelined lockstep: the same wait, but for the answers to the measurement
+sent before the step just computed, so the clients think while the next step is computed and
+their actions apply one step later than in lockstep (a fixed latency: still deterministic).
 """
 
 from __future__ import annotations
@@ -12,7 +16,8 @@ from __future__ import annotations
 import logging
 import time
 
-from simulator.api.server import ApiServer, LockstepSettings
+from contracts.ids import RobotId
+from simulator.api.server import ApiServer, LockstepSettings, Request
 
 log = logging.getLogger(__name__)
 
@@ -71,3 +76,41 @@ def wait_lockstep(server: ApiServer, settings: LockstepSettings) -> float:
             if late > 0:
                 conn.bank_s = max(0.0, conn.bank_s - late)
     return end - start
+
+
+class Pipeline:
+    """Pipelined lockstep around a step loop::
+
+        pipeline.before_step(world.sim_time_ms, world.sim_time_ms + world.step_ms)
+        world.step()  # step N+1: the clients compute their answers to step N meanwhile
+        ...           # referee
+        pipeline.after_step()
+
+    :meth:`before_step` sends the measurement of step N only after waiting for and taking the
+    answers to the measurement of step N-1, then applies those: no answer to step N can be among
+    them whatever the timing, and the answers to step N apply at step N+2 (lockstep: N+1).
+    """
+
+    def __init__(self, server: ApiServer, settings: LockstepSettings) -> None:
+        self._server = server
+        self._settings = settings
+        self._taken: dict[RobotId, list[Request]] = {}
+        self.unsent = False  # the latest step's measurement is not sent yet
+        self.waited_s = 0.0  # total time spent waiting for the clients
+
+    def send(self, time_ms: int) -> None:
+        """Wait for the answers to the measurement sent last, take them, send the latest one."""
+        self.waited_s += wait_lockstep(self._server, self._settings)
+        for robot, requests in self._server.take_requests().items():
+            self._taken.setdefault(robot, []).extend(requests)
+        self._server.publish(time_ms)
+        self.unsent = False
+
+    def before_step(self, time_ms: int, step_time_ms: int) -> None:
+        if self.unsent:
+            self.send(time_ms)
+        taken, self._taken = self._taken, {}
+        self._server.apply_taken(taken, step_time_ms)
+
+    def after_step(self) -> None:
+        self.unsent = True

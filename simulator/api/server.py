@@ -10,6 +10,9 @@ step thread queues measurements, takes decoded requests and goes back to the phy
 Per step: every complete request received is applied (later ones override earlier targets),
 then one ``SensorMeasurements`` per connected robot is queued. Lockstep: :meth:`wait_lockstep`
 waits for one request per connected, non-slow client (see :mod:`simulator.api.lockstep`).
+Pipelined lockstep takes the answers with :meth:`take_requests` before the measurement of the
+step just computed is sent and applies them with :meth:`apply_taken` (see
+:mod:`simulator.match_loop`).
 """
 
 from __future__ import annotations
@@ -32,6 +35,7 @@ from simulator.api.cameras import MAX_IN_FLIGHT, ImageSource
 from simulator.api.connection import ClientClosed, Connection
 from simulator.api.devices import DeviceWorld
 from simulator.api.endpoints import PlayerEndpoint, peer_allowed_by_name
+from simulator.api.fastreq import PositionTargets
 from simulator.api.framing import HEADER, REFUSED, WELCOME
 from simulator.api.quota import NetworkQuota
 from simulator.api.sender import SendThread
@@ -40,6 +44,8 @@ from simulator.api.stats import RobotStats
 from simulator.errors import ApiError
 
 log = logging.getLogger(__name__)
+
+Request = pb.ActuatorRequests | PositionTargets
 
 
 class PortUnavailable(ApiError):
@@ -364,6 +370,31 @@ class ApiServer:
             if conn.requests:
                 slot.session.apply_all(conn.requests, step_time_ms=step_time_ms)
                 conn.requests.clear()
+
+    def take_requests(self) -> dict[RobotId, list[Request]]:
+        """Pipelined stepping: read what is available and detach every client's received
+        requests, to be applied later by :meth:`apply_taken` (the step after next)."""
+        self.poll(0.0)
+        taken: dict[RobotId, list[Request]] = {}
+        for robot, slot in self.slots.items():
+            conn = slot.conn
+            if conn is None:
+                continue
+            if conn.threaded and conn.error is not None:  # found by the I/O thread
+                self._drop(slot, conn.error)
+                continue
+            if conn.requests:
+                taken[robot] = conn.take_requests()
+        return taken
+
+    def apply_taken(self, taken: dict[RobotId, list[Request]], step_time_ms: int) -> None:
+        """Pipelined stepping: apply requests detached by :meth:`take_requests` in arrival
+        order (a robot's requests apply even when its client left since)."""
+        for robot, slot in self.slots.items():
+            slot.session.update_limp()
+            requests = taken.get(robot)
+            if requests:
+                slot.session.apply_all(requests, step_time_ms=step_time_ms)
 
     def publish(self, time_ms: int) -> None:
         """Queue the measurement of the step that ended at ``time_ms`` for every client."""

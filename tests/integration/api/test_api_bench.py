@@ -21,9 +21,12 @@ def _bench(*args: str) -> dict[str, object]:
     return result
 
 
-def test_bench_api_lockstep_reports_every_figure() -> None:
-    result = _bench("--mode", "lockstep", "--sim-seconds", "0.5")
-    assert result["bench"] == "api" and result["mode"] == "lockstep"
+@pytest.mark.parametrize("mode", ["lockstep", "pipelined"])
+def test_bench_api_lockstep_reports_every_figure(mode: str) -> None:
+    result = _bench("--mode", mode, "--sim-seconds", "0.5")
+    assert result["bench"] == "api" and result["mode"] == mode
+    wait_share = result["client_wait_share"]
+    assert isinstance(wait_share, float) and 0 <= wait_share < 1
     assert result["slow_periods"] == 0  # both clients answered every measurement
     for key in ("real_time_factor", "world_only_real_time_factor", "ratio", "cpu_ratio"):
         value = result[key]

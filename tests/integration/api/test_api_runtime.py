@@ -72,6 +72,25 @@ def test_lockstep_match_replays_identically(tmp_path: Path) -> None:
     assert result["robots"]["red-1"]["slow_periods"] == 0
 
 
+def test_pipelined_match_replays_identically_and_differs_from_lockstep(tmp_path: Path) -> None:
+    timing = replace(short_spec().timing, wait_before_first_ready_real_s=1.0)
+    spec = short_spec(stepping="pipelined", timing=timing)
+    code_a, trace_a = _play(spec, tmp_path / "a")
+    code_b, trace_b = _play(spec, tmp_path / "b")
+    assert code_a == code_b == 0
+    assert len(trace_a) > 100 and trace_a == trace_b
+    replay_a = (tmp_path / "a" / "replay.hlvsrec").read_bytes()
+    assert replay_a == (tmp_path / "b" / "replay.hlvsrec").read_bytes()
+    result = json.loads((tmp_path / "a" / "sim_result.json").read_text())
+    assert result["stepping"] == "pipelined" and result["state"] == "FINISHED"
+    assert result["robots"]["red-1"]["messages_in"] > 100
+    assert result["robots"]["red-1"]["slow_periods"] == 0
+    # the same clients in lockstep: the actions apply one step earlier, so the joints differ
+    code_l, trace_l = _play(replace(spec, stepping="lockstep"), tmp_path / "l")
+    assert code_l == 0 and len(trace_l) > 100
+    assert trace_l != trace_a
+
+
 def _spawn(spec: MatchSpec, out: Path) -> subprocess.Popen[str]:
     spec_path = out.parent / f"{out.name}_spec.json"
     spec_path.write_text(spec.to_json())
