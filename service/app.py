@@ -53,6 +53,20 @@ class Services:
     preflight: Preflight | None = None
     queue: Any = None  # service.submissions.QueueBoard
     tokens: Any = None  # service.tokens.TokenCache
+    status: Any = None  # service.statusboard.StatusBoard
+
+    def slots(self) -> int:
+        return int(self.pool.slots) if self.pool is not None else self.settings.match_slots
+
+    def changed(self, submission_id: str | None = None) -> None:
+        """This process changed one submission (or, without an id, the queue as a whole)."""
+        if self.queue is not None:
+            self.queue.invalidate()
+        if self.status is not None:
+            if submission_id is None:
+                self.status.invalidate()
+            else:
+                self.status.forget(submission_id)
     extras: dict[str, Any] = field(default_factory=dict)
 
 
@@ -87,14 +101,19 @@ def create_app(
             from service.preflight import PreflightChecker
 
             checker = PreflightChecker()
+        from service.statusboard import StatusBoard
         from service.submissions import MatchTimes, QueueBoard
         from service.tokens import TokenCache
+        from service.views import submission_view
 
         services = Services(settings=settings, engine=engine, sessions=session_factory(engine),
                             preflight=preflight or checker,
                             queue=QueueBoard(times=MatchTimes(
                                 default_s=settings.expected_match_s)),
                             tokens=TokenCache(ttl_s=settings.token_cache_s))
+        services.status = StatusBoard(render=lambda session, row, team: submission_view(
+            session, row, settings, slots=services.slots(), queue=services.queue,
+            team_name=team).model_dump_json().encode(), ttl_s=settings.status_board_s)
         app.state.services = services
         from service.pool import make_pool
 

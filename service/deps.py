@@ -27,7 +27,7 @@ from service.errors import AuthError
 if TYPE_CHECKING:
     from service.app import Services
 
-_bearer = HTTPBearer(auto_error=False, description="a team or operator token: hlvs_<id>_<secret>")
+bearer = HTTPBearer(auto_error=False, description="a team or operator token: hlvs_<id>_<secret>")
 
 
 def get_services(request: Request) -> Services:
@@ -56,7 +56,7 @@ DbSession = Annotated[Session, Depends(get_db)]
 def require_token(
     request: Request,
     session: DbSession,
-    credentials: Annotated[HTTPAuthorizationCredentials | None, Depends(_bearer)],
+    credentials: Annotated[HTTPAuthorizationCredentials | None, Depends(bearer)],
 ) -> tokens.Principal:
     presented = credentials.credentials if credentials is not None else None
     cache = get_services(request).tokens
@@ -68,6 +68,7 @@ def require_token(
 def require_team(
     principal: Annotated[tokens.Principal, Depends(require_token)],
 ) -> tokens.Principal:
+    """The principal when it is a team's (usable as a plain function too)."""
     if principal.scope is not Scope.TEAM or principal.team_id is None:
         raise AuthError("scope", "this endpoint needs a team token (this one is an "
                         f"{principal.scope.value} token)")
@@ -91,6 +92,7 @@ __all__ = [
     "OperatorPrincipal",
     "TeamPrincipal",
     "get_db",
+    "bearer",
     "get_services",
     "require_operator",
     "require_team",

@@ -46,11 +46,19 @@ class PreflightChecker:
     def __init__(self) -> None:
         self._teardowns: list[threading.Thread] = []
         self._lock = threading.Lock()
+        self._engine: Any = None
 
     def __call__(self, team_doc: dict[str, Any], settings: Settings) -> float:
         with self._lock:
             self._teardowns = [t for t in self._teardowns if t.is_alive()]
-        return run(team_doc, settings=settings, teardowns=self._teardowns)
+            if self._engine is None:  # one engine client for every check
+                from orchestrator.engine import connect
+
+                try:
+                    self._engine = connect()
+                except OrchestratorError as exc:
+                    raise PreflightFailed(stage="pull", image="(all)", cause=str(exc)) from exc
+        return run(team_doc, settings=settings, teardowns=self._teardowns, engine=self._engine)
 
     def close(self) -> None:
         for thread in list(self._teardowns):
@@ -58,7 +66,7 @@ class PreflightChecker:
 
 
 def run(team_doc: dict[str, Any], *, settings: Settings,
-        teardowns: list[threading.Thread] | None = None) -> float:
+        teardowns: list[threading.Thread] | None = None, engine: Any = None) -> float:
     """Check the team's images; returns the seconds it took, raises :class:`PreflightFailed`.
 
     With ``teardowns``, stopping the check's containers happens in a background thread added
@@ -72,7 +80,7 @@ def run(team_doc: dict[str, Any], *, settings: Settings,
         from orchestrator.pull import resolve_team_images
 
         try:
-            engine = connect()
+            engine = engine or connect()
             resolved = resolve_team_images(engine, team, limits=official_limits())
         except OrchestratorError as exc:
             raise PreflightFailed(stage="pull", image="(all)", cause=str(exc)) from exc

@@ -29,8 +29,11 @@ class Settings:
     max_upload_bytes: int = 1_000_000
     threads: int = 8
     """Threads that run request handlers (database work); more mostly contend for the GIL."""
-    token_cache_s: float = 2.0
+    token_cache_s: float = 5.0
     """A verified token is trusted this long without a query (a revocation takes this long)."""
+    status_board_s: float = 2.0
+    """Queue positions of other teams' submissions may lag a change by this long (the status
+    of the submission that changed is current at once)."""
     token_days: float = 90.0
     """Lifetime of a newly issued token (``hlvs admin token issue --days`` overrides)."""
     match_slots: int = 1

@@ -119,15 +119,25 @@ class TokenCache:
         self._entries: dict[str, tuple[Principal, float]] = {}
         self._lock = threading.Lock()
 
-    def verify(self, session: Session, presented: str | None) -> Principal:
-        key = _digest(presented or "")
+    def cached(self, presented: str | None) -> Principal | None:
+        """The principal of a token verified less than ``ttl_s`` ago and not expired since."""
+        if not presented:
+            return None
+        key = _digest(presented)
         with self._lock:
             hit = self._entries.get(key)
         if hit is not None and time.monotonic() - hit[1] < self.ttl_s:
             principal = hit[0]
             if principal.expires_at is None or principal.expires_at > now():
                 return principal
+        return None
+
+    def verify(self, session: Session, presented: str | None) -> Principal:
+        principal = self.cached(presented)
+        if principal is not None:
+            return principal
         principal = verify(session, presented)
+        key = _digest(presented or "")
         with self._lock:
             if len(self._entries) >= self.max_entries:
                 self._entries.clear()

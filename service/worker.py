@@ -70,37 +70,42 @@ class QueueWorker:
     def _run(self) -> None:
         while not self._stop.is_set():
             try:
-                self.round()
+                if self.round():
+                    self.services.changed()
             except Exception:  # process boundary of the worker thread: log, keep serving
                 log.exception("queue worker round failed; retrying")
-            if self.services.queue is not None:
-                self.services.queue.invalidate()
+                self.services.changed()
             self._wake.wait(self.settings.worker_poll_s)
             self._wake.clear()
 
     # one round ---------------------------------------------------------------------------
-    def round(self) -> None:
+    def round(self) -> bool:
+        """One round; True when it changed a submission."""
         sessions = self.services.sessions
+        changed = False
         with transaction(sessions) as session:
             active = list(session.scalars(select(Submission).where(Submission.state.in_(
                 [SubmissionState.STARTING.value, SubmissionState.RUNNING.value])).order_by(
                 Submission.seq)))
             for row in active:
+                before = (row.state, row.attempts, row.cancel_requested)
                 self._follow(session, row)
+                changed |= before != (row.state, row.attempts, row.cancel_requested)
         while not self._stop.is_set():
             with transaction(sessions) as session:
                 if queue_paused(session):
-                    return
+                    return changed
                 busy = session.scalar(select(func.count()).select_from(Submission).where(
                     Submission.state.in_([SubmissionState.STARTING.value,
                                           SubmissionState.RUNNING.value]))) or 0
                 if busy >= self.pool.slots:
-                    return
+                    return changed
                 queued = session.scalar(select(Submission).where(
                     Submission.state == SubmissionState.QUEUED.value).order_by(
                     Submission.seq).limit(1).with_for_update(skip_locked=True))
                 if queued is None:
-                    return
+                    return changed
+                changed = True
                 row = queued
                 row.state = SubmissionState.STARTING.value
                 row.attempts += 1
@@ -113,6 +118,7 @@ class QueueWorker:
                 starting = session.get(Submission, seq)
                 assert starting is not None
                 self._submit(session, starting, job)
+        return changed
 
     # helpers -----------------------------------------------------------------------------
     def _work_dir(self, match_id: str) -> Path:

@@ -59,7 +59,7 @@ def pause_queue(request: Request, principal: OperatorPrincipal,
     """No new match starts until resumed; running ones go on; status says why it waits."""
     submissions.set_queue_paused(session, True)
     session.commit()
-    get_services(request).queue.invalidate()
+    get_services(request).changed()
     return _queue(request, session)
 
 
@@ -68,7 +68,7 @@ def resume_queue(request: Request, principal: OperatorPrincipal,
                  session: DbSession) -> QueueView:
     submissions.set_queue_paused(session, False)
     session.commit()
-    get_services(request).queue.invalidate()
+    get_services(request).changed()
     worker = get_services(request).worker
     if worker is not None:
         worker.wake()
@@ -99,7 +99,7 @@ def requeue(submission_id: str, request: Request, principal: OperatorPrincipal,
     row.charged = False
     row.cancel_requested = False
     session.commit()
-    get_services(request).queue.invalidate()
+    get_services(request).changed()
     worker = get_services(request).worker
     if worker is not None:
         worker.wake()

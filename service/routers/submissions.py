@@ -7,18 +7,22 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
 
-from fastapi import APIRouter, FastAPI, Request
+from fastapi import APIRouter, Depends, FastAPI, Request
 from fastapi.responses import FileResponse, JSONResponse
+from fastapi.security import HTTPAuthorizationCredentials
 from pydantic import BaseModel
 from sqlalchemy import select
+from starlette.concurrency import run_in_threadpool
+from starlette.responses import Response
 
 from service import submissions, teamfiles
-from service.db import Submission
-from service.deps import DbSession, TeamPrincipal, get_services
+from service.app import Services
+from service.db import Scope, Submission
+from service.deps import DbSession, TeamPrincipal, bearer, get_services, require_team
 from service.errors import NotFound
-from service.views import SubmissionCreate, SubmissionView, view_of
+from service.views import SubmissionCreate, SubmissionView, submission_view, view_of
 
 router = APIRouter(prefix="/v1/submissions", tags=["submissions"])
 
@@ -52,7 +56,7 @@ def create_submission(body: SubmissionCreate, request: Request, principal: TeamP
                              team_file_id=file_id, credentials_file_id=credentials,
                              preflight_s=elapsed)
     session.commit()
-    services.queue.invalidate()
+    services.changed(row.id)
     if services.worker is not None:
         services.worker.wake()
     return view_of(request, session, row, principal.team_name)
@@ -66,12 +70,38 @@ def list_submissions(request: Request, principal: TeamPrincipal,
     return [view_of(request, session, r, principal.team_name) for r in rows]
 
 
-@router.get("/{submission_id}")
-def get_submission(submission_id: str, request: Request, principal: TeamPrincipal,
-                   session: DbSession) -> SubmissionView:
-    assert principal.team_id is not None
-    row = submissions.get_own(session, team_id=principal.team_id, submission_id=submission_id)
-    return view_of(request, session, row, principal.team_name)
+@router.get("/{submission_id}", response_model=SubmissionView)
+async def get_submission(
+    submission_id: str, request: Request,
+    credentials: Annotated[HTTPAuthorizationCredentials | None, Depends(bearer)],
+) -> Response:
+    """The submission's state; while queued its position, expected start and the reason it
+    waits. Answered from the status board when it is fresh (see :mod:`service.statusboard`)."""
+    services = get_services(request)
+    presented = credentials.credentials if credentials is not None else None
+    principal = services.tokens.cached(presented)
+    if principal is not None and principal.scope is Scope.TEAM:
+        body = services.status.lookup(submission_id, principal.team_id)
+        if body is not None:
+            return Response(body, media_type="application/json")
+    body = await run_in_threadpool(_status_body, services, presented, submission_id)
+    return Response(body, media_type="application/json")
+
+
+def _status_body(services: Services, presented: str | None, submission_id: str) -> bytes:
+    with services.sessions() as session:
+        principal = require_team(services.tokens.verify(session, presented))
+        assert principal.team_id is not None
+        services.status.refresh(session)
+        body: bytes | None = services.status.lookup(submission_id, principal.team_id)
+        if body is None:  # an ended submission, or not this team's (404)
+            row = submissions.get_own(session, team_id=principal.team_id,
+                                      submission_id=submission_id)
+            body = submission_view(session, row, services.settings, slots=services.slots(),
+                                   queue=services.queue,
+                                   team_name=principal.team_name).model_dump_json().encode()
+        session.commit()
+        return body
 
 
 @router.post("/{submission_id}/cancel", responses={
@@ -86,7 +116,7 @@ def cancel_submission(submission_id: str, request: Request, principal: TeamPrinc
     submissions.cancel(session, row)
     session.commit()
     services = get_services(request)
-    services.queue.invalidate()
+    services.changed(row.id)
     if services.worker is not None:
         services.worker.wake()
     return view_of(request, session, row, principal.team_name)
