@@ -77,3 +77,22 @@ def test_team_settings_refuse_unknown_fields(start: Callable[..., Served],
         assert answer.json()["problems"][0]["pointer"] == "/emial"
         ok = http.patch("/v1/team", json={"email": "a@example.org"})
         assert ok.status_code == 200 and ok.json()["email"] == "a@example.org"
+
+
+def test_credentials_are_checked_stored_and_shown_masked(start: Callable[..., Served],
+                                                         token: Callable[..., str]) -> None:
+    from pathlib import Path
+
+    example = Path(__file__).parents[3] / "configs" / "examples" / "credentials" / "s3.json"
+    document = json.loads(example.read_text())
+    served = start()
+    with served.client(token("Alpha")) as http:
+        stored = http.put("/v1/team/files/credentials", json=document)
+        assert stored.status_code == 201, stored.text
+        shown = http.get("/v1/team/files/credentials/1").json()["content"]
+        assert shown["credentials"]["access_secret"] == "***"
+        assert shown["credentials"]["bucket"] == document["credentials"]["bucket"]
+        broken = {"type": "s3", "credentials": {"access_id": "x"}}
+        refused = http.put("/v1/team/files/credentials", json=broken)
+        assert refused.status_code == 422
+        assert any(p["file"] == "credentials.json" for p in refused.json()["problems"])
