@@ -9,7 +9,10 @@ every body, little-endian); ``hlvs/<match_id>/scene``: the replay header.
 
 from __future__ import annotations
 
-from typing import Literal
+from dataclasses import dataclass
+from typing import Any, Literal
+
+from contracts.codec import to_data
 
 PREFIX = "hlvs"
 Kind = Literal["state", "events", "poses", "scene"]
@@ -30,4 +33,35 @@ def match_topics(match_id: str) -> str:
     return f"{PREFIX}/{match_id}/*"
 
 
-__all__ = ["EVENTS", "KINDS", "POSES", "PREFIX", "SCENE", "STATE", "Kind", "match_topics", "topic"]
+@dataclass(frozen=True, slots=True, kw_only=True)
+class StateMessage:
+    """One ``hlvs/<match_id>/state`` message (JSON)."""
+
+    sim_time_ms: int
+    real_time_factor: float
+    state: str | None  # GameController state name
+    secondary_state: str | None
+    half: int | None
+    secs_remaining: float | None
+    score: dict[str, int] | None  # {"red": goals, "blue": goals}
+    connected: tuple[str, ...]  # robot keys connected to the robot API
+    stepping: str
+    robots: dict[str, Any] | None  # robot API traffic per robot key (simulator.traffic)
+
+    def to_dict(self) -> dict[str, Any]:
+        data: dict[str, Any] = to_data(self)
+        return data
+
+
+__all__ = [
+    "EVENTS",
+    "KINDS",
+    "POSES",
+    "PREFIX",
+    "SCENE",
+    "STATE",
+    "Kind",
+    "StateMessage",
+    "match_topics",
+    "topic",
+]

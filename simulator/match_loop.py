@@ -28,10 +28,11 @@ import logging
 import struct
 import time
 from dataclasses import asdict, dataclass
-from typing import Any, Protocol
+from typing import Any, Protocol, cast
 
 import numpy as np
 
+from contracts.telemetry import StateMessage
 from referee.snapshot import RefereeEvent, WorldCommand, WorldSnapshot
 from simulator.api import ApiServer, LockstepSettings, wait_lockstep
 from simulator.api.lockstep import Pipeline
@@ -252,16 +253,16 @@ class MatchLoop:
             self.traffic.sample(now_s=now, sim_time_ms=self.world.sim_time_ms, real_time_factor=rtf)
             robots = self.traffic.latest["robots"] if self.traffic.latest else None
         self.telemetry.state(
-            {
-                "sim_time_ms": self.world.sim_time_ms,
-                "real_time_factor": round(rtf, 3),
-                "state": game.get("state"),
-                "secondary_state": game.get("secondary_state"),
-                "half": game.get("half"),
-                "secs_remaining": game.get("secs_remaining"),
-                "score": game.get("score"),
-                "connected": self.server.connected(),
-                "stepping": self.settings.stepping,
-                "robots": robots,
-            }
+            StateMessage(
+                sim_time_ms=self.world.sim_time_ms,
+                real_time_factor=round(rtf, 3),
+                state=cast("str | None", game.get("state")),
+                secondary_state=cast("str | None", game.get("secondary_state")),
+                half=cast("int | None", game.get("half")),
+                secs_remaining=cast("float | None", game.get("secs_remaining")),
+                score=cast("dict[str, int] | None", game.get("score")),
+                connected=tuple(self.server.connected()),
+                stepping=self.settings.stepping,
+                robots=robots,
+            ).to_dict()
         )

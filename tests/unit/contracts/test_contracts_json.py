@@ -21,6 +21,7 @@ from contracts.match_spec import (
     TimingSpec,
 )
 from contracts.sim_result import SimResult
+from contracts.telemetry import StateMessage
 
 
 def _pose(x: float) -> Pose:
@@ -81,6 +82,14 @@ def test_versioned_documents_round_trip(document: MatchSpec | SimResult, tmp_pat
         (FieldGeometry, KID_FIELD),
         (TimingSpec, TimingSpec()),
         (NetworkSpec, NetworkSpec(blocking_send=True)),
+        (
+            StateMessage,
+            StateMessage(
+                sim_time_ms=8000, real_time_factor=0.98, state="PLAYING", secondary_state="NORMAL",
+                half=1, secs_remaining=592.0, score={"red": 0, "blue": 1},
+                connected=("red-1", "blue-1"), stepping="lockstep", robots=None,
+            ),
+        ),
     ],
 )
 def test_plain_contract_types_round_trip(cls: type, value: object) -> None:
