@@ -53,6 +53,11 @@ def register(sub: Any) -> None:
         func=lambda a: _exec_simulator(["bench", *a.rest], module="envs"),
     )
     forward(kinds, "bringup", help="time from hlvs match to the kick-off (JSON)", func=_bringup)
+    forward(
+        kinds, "report", help="the performance matrix (sim, async, lockstep, pipelined, "
+        "cameras, bring-up) with every ratio and its target in one JSON document",
+        func=_report,
+    )
     forward(kinds, "delivery", help="log delivery throughput to SFTP and S3 (JSON)",
             func=_delivery)
     forward(kinds, "cli", help="start-up time of hlvs --help (JSON)", func=_cli)
@@ -86,6 +91,12 @@ def _scrimmage(args: argparse.Namespace) -> int:
     from orchestrator.bench_scrimmage import main as scrimmage_main
 
     return int(scrimmage_main(list(args.rest)))
+
+
+def _report(args: argparse.Namespace) -> int:
+    from benchmarks.report import main as report_main
+
+    return report_main(args.rest)
 
 
 def _bringup(args: argparse.Namespace) -> int:

@@ -1,0 +1,240 @@
+"""``hlvs bench report``: the performance matrix in one run, every ratio in one JSON document.
+
+Runs, ``--repeats`` times and interleaved (so that the load of other processes falls on every
+kind alike), each benchmark as a child process with small sizes:
+
+- ``sim``: ``bench sim`` (the world against a bare ``mj_step`` loop), ratio and CPU ratio;
+- ``async``, ``lockstep``, ``pipelined``: ``bench api --mode M`` with ``--robots`` clients;
+  the ratio to ``bench sim`` measured in the same child (the issue's figure), to the world-only
+  loop, the CPU ratio and the share of time the step waited for its clients;
+- ``cameras``: ``bench api --mode async`` with every robot's camera at 320x240 every 32 ms
+  (the real-time factor is the figure: rendering is most of the cost);
+- ``bringup``: ``bench bringup`` (a real match of stub robots in Docker, images cached), once
+  per run at most (``--bringup-repeats``); needs Docker and the project's images.
+
+Prints one JSON document: per kind its runs, the median of each figure, the target and whether
+the median meets it; the load average before and after, so that a figure is read with the load
+it was measured under. A benchmark that fails is reported with its error (exit code 1).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+KINDS = ("sim", "async", "lockstep", "pipelined", "cameras", "bringup")
+
+
+@dataclass(frozen=True, slots=True)
+class Target:
+    figure: str
+    minimum: float | None = None
+    maximum: float | None = None
+
+    def met(self, value: float) -> bool:
+        if self.minimum is not None and value < self.minimum:
+            return False
+        return self.maximum is None or value <= self.maximum
+
+    def to_dict(self) -> dict[str, Any]:
+        bound = {"min": self.minimum} if self.minimum is not None else {"max": self.maximum}
+        return {"figure": self.figure, **bound}
+
+
+TARGETS = {
+    "sim": Target("ratio", minimum=0.95),
+    "async": Target("ratio_to_bench_sim", minimum=0.9),
+    "pipelined": Target("ratio_to_bench_sim", minimum=0.9),
+    "cameras": Target("real_time_factor", minimum=0.5),
+    "bringup": Target("bringup_s", maximum=5.0),
+}
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="hlvs bench report", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--robots", type=int, default=8, help="robots / clients (default 8)")
+    parser.add_argument("--repeats", type=int, default=3,
+                        help="runs of each kind, interleaved; medians over them (default 3)")
+    parser.add_argument("--sim-seconds", type=float, default=2.0,
+                        help="simulated seconds per sim / API run (default 2)")
+    parser.add_argument("--camera-seconds", type=float, default=1.0,
+                        help="simulated seconds per camera run (default 1)")
+    parser.add_argument("--bringup-repeats", type=int, default=1,
+                        help="bring-up runs (real matches in Docker; default 1)")
+    parser.add_argument("--only", default=",".join(KINDS),
+                        help=f"comma-separated kinds to run (default all: {','.join(KINDS)})")
+    parser.add_argument("--json", action="store_true", help="print only the JSON document")
+    return parser
+
+
+def _child(argv: list[str], timeout_s: float) -> dict[str, Any]:
+    """Run one benchmark child; its last stdout line is its JSON (or an error entry)."""
+    env = dict(os.environ, HLVS_PROG="hlvs")
+    try:
+        proc = subprocess.run([sys.executable, *argv], capture_output=True, text=True,
+                              timeout=timeout_s, env=env)  # fmt: skip
+    except subprocess.TimeoutExpired:
+        return {"error": f"no result within {timeout_s:.0f} s"}
+    lines = proc.stdout.strip().splitlines()
+    try:
+        result: dict[str, Any] = json.loads(lines[-1]) if lines else {}
+    except json.JSONDecodeError:
+        result = {}
+    if proc.returncode != 0 or not result or "error" in result:
+        last = (proc.stderr.strip().splitlines() or ["(no output)"])[-1]
+        return {"error": result.get("error") or f"exit code {proc.returncode}: {last}"}
+    return result
+
+
+def _api_figures(result: dict[str, Any]) -> dict[str, Any]:
+    bench_sim = (result.get("bench_sim") or {}).get("real_time_factor")
+    rtf = result["real_time_factor"]
+    return {
+        "real_time_factor": rtf,
+        "bench_sim_real_time_factor": bench_sim,
+        "ratio_to_bench_sim": round(rtf / bench_sim, 3) if bench_sim else None,
+        "ratio_to_world_only": result["ratio"],
+        "cpu_ratio": result["cpu_ratio"],
+        "client_wait_share": result.get("client_wait_share"),
+        "round_trip_p50_ms": result.get("round_trip_p50_ms"),
+        "slow_periods": result.get("slow_periods"),
+    }
+
+
+def _runners(args: argparse.Namespace) -> dict[str, Callable[[], dict[str, Any]]]:
+    robots = str(args.robots)
+    sim_s = str(args.sim_seconds)
+    api = ["-m", "simulator", "bench", "api", "--robots", robots, "--json"]
+
+    def api_mode(mode: str) -> Callable[[], dict[str, Any]]:
+        def run() -> dict[str, Any]:
+            result = _child([*api, "--mode", mode, "--sim-seconds", sim_s], 600)
+            return result if "error" in result else _api_figures(result)
+
+        return run
+
+    def sim() -> dict[str, Any]:
+        result = _child(["-m", "simulator", "bench", "sim", "--robots", robots,
+                         "--sim-seconds", sim_s, "--json"], 600)  # fmt: skip
+        if "error" in result:
+            return result
+        keys = ("ratio", "cpu_ratio", "real_time_factor", "bare_real_time_factor")
+        return {k: result[k] for k in keys if k in result}
+
+    def cameras() -> dict[str, Any]:
+        result = _child([*api, "--mode", "async", "--camera", "320x240@32",
+                         "--sim-seconds", str(args.camera_seconds)], 900)  # fmt: skip
+        if "error" in result:
+            return result
+        return {
+            "real_time_factor": result["real_time_factor"],
+            "ratio_to_world_only": result["ratio"],
+            "camera_frames": result["camera_frames"],
+            "render_ms_per_frame": result["render_ms_per_frame"],
+            **{k: result[k] for k in ("bare_render_ms_per_frame", "render_cost_ratio")
+               if k in result},
+        }  # fmt: skip
+
+    def bringup() -> dict[str, Any]:
+        result = _child(["-m", "orchestrator", "bench", "bringup", "--robots", robots,
+                         "--json"], 600)  # fmt: skip
+        if "error" in result:
+            return result
+        return {k: v for k, v in result.items() if k != "bench"}
+
+    return {
+        "sim": sim,
+        "async": api_mode("async"),
+        "lockstep": api_mode("lockstep"),
+        "pipelined": api_mode("pipelined"),
+        "cameras": cameras,
+        "bringup": bringup,
+    }
+
+
+def _median(runs: list[dict[str, Any]]) -> dict[str, Any]:
+    good = [r for r in runs if "error" not in r]
+    keys = sorted({k for r in good for k, v in r.items() if isinstance(v, int | float)
+                   and not isinstance(v, bool)})  # fmt: skip
+    medians: dict[str, Any] = {}
+    for key in keys:
+        values = [r[key] for r in good if isinstance(r.get(key), int | float)]
+        if values:
+            medians[key] = round(statistics.median(values), 3)
+    return medians
+
+
+def _load() -> list[float]:
+    return [round(x, 2) for x in os.getloadavg()]
+
+
+def _kinds(text: str) -> list[str]:
+    return [k.strip() for k in text.split(",") if k.strip()]
+
+
+def run(args: argparse.Namespace, progress: Callable[[str], None]) -> dict[str, Any]:
+    kinds = _kinds(args.only)
+    runners = _runners(args)
+    runs: dict[str, list[dict[str, Any]]] = {k: [] for k in kinds}
+    started = time.monotonic()
+    load_before = _load()
+    for repeat in range(max(1, args.repeats)):
+        for kind in kinds:
+            if kind == "bringup" and repeat >= args.bringup_repeats:
+                continue
+            progress(f"{kind} run {repeat + 1} (load {_load()[0]})")
+            result = runners[kind]()
+            result["load_1min"] = _load()[0]
+            runs[kind].append(result)
+    report: dict[str, Any] = {
+        "bench": "report",
+        "robots": args.robots,
+        "repeats": args.repeats,
+        "sim_seconds": args.sim_seconds,
+        "cpus": len(os.sched_getaffinity(0)),
+        "load_average_before": load_before,
+        "load_average_after": _load(),
+        "wall_s": round(time.monotonic() - started, 1),
+        "errors": 0,
+    }
+    for kind in kinds:
+        median = _median(runs[kind])
+        entry: dict[str, Any] = {"median": median, "runs": runs[kind]}
+        errors = sum(1 for r in runs[kind] if "error" in r)
+        report["errors"] += errors
+        target = TARGETS.get(kind)
+        if target is not None:
+            entry["target"] = target.to_dict()
+            value = median.get(target.figure)
+            entry["meets_target"] = None if value is None else target.met(value)
+        report[kind] = entry
+    return report
+
+
+def main(argv: Sequence[str]) -> int:
+    parser = _parser()
+    args = parser.parse_args(list(argv))
+    unknown = [k for k in _kinds(args.only) if k not in KINDS]
+    if unknown or not _kinds(args.only):
+        parser.error(f"--only: unknown kind(s) {', '.join(unknown) or '(none given)'}; "
+                     f"expected some of {', '.join(KINDS)}")
+
+    def progress(text: str) -> None:
+        print(text, file=sys.stderr, flush=True)  # minutes of work: say where it is
+
+    report = run(args, progress)
+    print(json.dumps(report, sort_keys=True, indent=None if args.json else 2), flush=True)
+    return 1 if report["errors"] else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
