@@ -15,18 +15,21 @@ PYTEST_ARGS ?=
 scrimmage: setup
 	$(HLVS) scrimmage --out matches/scrimmage
 
-test: setup lint typecheck
+test: setup postgres lint typecheck
 	$(PY) -m pytest $(PYTEST_ARGS)
 
-setup: venv system engine postgres images
+setup: venv system engine images
 
 venv: $(VENV)/.installed
 
 $(VENV)/.installed: pyproject.toml
-	@echo "==> virtual environment in $(VENV)"
+	@echo "==> virtual environment in $(VENV) (log: $(BUILD)/logs/pip.log)"
+	@mkdir -p $(BUILD)/logs
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e '.[dev]'
+	@$(PY) -m pip install --upgrade pip > $(BUILD)/logs/pip.log 2>&1 || \
+	  { tail -n 40 $(BUILD)/logs/pip.log; exit 1; }
+	@$(PY) -m pip install -e '.[dev]' >> $(BUILD)/logs/pip.log 2>&1 || \
+	  { tail -n 40 $(BUILD)/logs/pip.log; exit 1; }
 	touch $@
 
 # Host packages (Docker engine, registry, sshd, ffmpeg, OSMesa, debootstrap) on Debian/Ubuntu as root.
@@ -52,7 +55,8 @@ images: venv engine
 	$(HLVS) images build $(if $(BASE_IMAGE),--base $(BASE_IMAGE),)
 
 lint:
-	$(VENV)/bin/ruff check orchestrator simulator referee service envs viewer examples tests
+	$(VENV)/bin/ruff check orchestrator simulator referee contracts robot service envs viewer \
+	  benchmarks examples tests
 
 typecheck:
 	$(VENV)/bin/mypy
