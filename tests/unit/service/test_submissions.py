@@ -227,3 +227,54 @@ def test_operators_read_the_tournament_schedule_and_standings(
         assert sum(s["played"] for s in body["standings"]) == 6
     with served.client(token("Alpha")) as http:
         assert http.get("/v1/operator/schedule").status_code == 401
+
+
+def test_simultaneous_submissions_of_one_team_queue_exactly_one(
+        start: Callable[..., Served], token: Callable[..., str]) -> None:
+    from concurrent.futures import ThreadPoolExecutor
+
+    served = start()
+    operator = served.client(token(operator=True))
+    operator.post("/v1/operator/queue/pause")
+    tok = token("Alpha")
+    setup_team(served, tok, "Alpha").close()
+
+    def submit(_: int) -> httpx.Response:
+        with served.client(tok) as http:
+            return http.post("/v1/submissions", json={})
+
+    with ThreadPoolExecutor(8) as pool:
+        answers = list(pool.map(submit, range(8)))
+    codes = sorted(a.status_code for a in answers)
+    assert codes == [201] + [409] * 7, [a.text for a in answers]
+    created = next(a.json()["id"] for a in answers if a.status_code == 201)
+    assert {a.json()["existing_id"] for a in answers if a.status_code == 409} == {created}
+    operator.close()
+
+
+def test_a_start_interrupted_by_a_restart_is_submitted_once(
+        start: Callable[..., Served], token: Callable[..., str], pool: FakePool) -> None:
+    """STARTING was committed but the pool was never asked (the service died in between)."""
+    from sqlalchemy import select
+
+    from service.db import Submission, make_engine, session_factory, transaction
+
+    served = start()
+    operator = served.client(token(operator=True))
+    operator.post("/v1/operator/queue/pause")
+    tok = token("Alpha")
+    with setup_team(served, tok, "Alpha") as http:
+        sid = http.post("/v1/submissions", json={}).json()["id"]
+    served.stop()
+    engine = make_engine(served.settings.db_url)
+    with transaction(session_factory(engine)) as session:
+        row = session.scalar(select(Submission).where(Submission.id == sid))
+        assert row is not None
+        row.state, row.attempts, row.match_id = "starting", 1, f"{sid}-a1"
+    engine.dispose()
+    again = start()
+    with again.client(tok) as http:
+        status = wait_for(http, sid, lambda b: b["state"] == "running")
+        assert status["attempts"] == 1 and status["match_id"] == f"{sid}-a1"
+    assert pool.started == [f"{sid}-a1"]
+    operator.close()
