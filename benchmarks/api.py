@@ -201,6 +201,49 @@ def _world_only(
     return simulated / wall, cpu / simulated
 
 
+def _render_costs(
+    robots: list[RobotId], physics_dt: float, width: int, height: int, frames: int = 60
+) -> dict[str, float]:
+    """CPU ms per frame of a bare offscreen render (``mujoco.Renderer`` with the model's own
+    settings, update_scene + render) against the robot camera path (:class:`CameraRenderer`:
+    coarser tessellation, no shadows or reflections, B,G,R bytes) on the same scene, from the
+    robots' head cameras in turn. Same process, same run: the ratio is what the camera path adds
+    to (or saves on) what the renderer costs."""
+    import mujoco
+
+    from simulator.world import CameraRenderer
+
+    world = _world(robots, physics_dt)
+    for _ in range(25):  # the robots settle a little: a scene as in a match
+        world.step()
+    cameras = [world.index.by_id[r].camera for r in robots]
+
+    def timed(render: Any) -> float:
+        render(0)  # context and caches made outside the timing
+        started = time.thread_time()
+        for k in range(frames):
+            render(k % len(robots))
+        return (time.thread_time() - started) * 1000.0 / frames
+
+    bare = mujoco.Renderer(world.model, height=height, width=width)
+    ours = CameraRenderer(world, width, height)
+    try:
+        def bare_frame(k: int) -> None:
+            bare.update_scene(world.data, camera=cameras[k])
+            bare.render()
+
+        bare_ms = timed(bare_frame)
+        ours_ms = timed(lambda k: ours.render(robots[k]))
+    finally:
+        bare.close()
+        ours.close()
+    return {
+        "bare_render_ms_per_frame": round(bare_ms, 2),
+        "camera_path_ms_per_frame": round(ours_ms, 2),
+        "render_cost_ratio": round(ours_ms / bare_ms, 3) if bare_ms > 0 else float("nan"),
+    }
+
+
 def _bench_sim(robots: int, physics_dt: float, sim_seconds: float) -> dict[str, Any] | None:
     """The world's ``bench sim`` numbers for the same setup, when they are available."""
     try:
@@ -369,6 +412,8 @@ def main(argv: list[str]) -> int:
         "step_thread_cpus": sorted(os.sched_getaffinity(0)),
         "client_cpus": sorted(args.client_cpus) or "shared",
     }
+    if camera is not None:  # the camera path against a bare render of the same scene
+        result.update(_render_costs(robots, args.physics_dt, camera[0], camera[1]))
     if args.stalled_client:
         stalled = _api_run(args, camera, stalled=True)
         result["stalled_client"] = {

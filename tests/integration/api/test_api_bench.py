@@ -41,6 +41,9 @@ def test_bench_api_camera_and_stalled_client() -> None:
     )
     assert result["camera_robots"] == 2
     assert isinstance(result["camera_frames"], int) and result["camera_frames"] >= 8
+    bare, ours = result["bare_render_ms_per_frame"], result["camera_path_ms_per_frame"]
+    assert isinstance(bare, float) and isinstance(ours, float) and bare > 0 and ours > 0
+    assert result["render_cost_ratio"] == pytest.approx(ours / bare, abs=0.01)
     stalled = result["stalled_client"]
     assert isinstance(stalled, dict) and stalled["real_time_factor"] > 0
     assert stalled["cpu_ratio"] > 0
