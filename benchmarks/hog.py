@@ -3,10 +3,12 @@
 Plays pairs of short 1 v 1 matches with ``hlvs match``, both under the admission rules (each
 robot's ``limits.cpus`` chosen so that the robots plus the simulator fit this host, and the
 match marked official so that it would be refused otherwise): blue is the stub robot, red 1
-either idles (baseline) or forks ``--hogs`` busy processes (hog). By default the stepping is the
-league's ``async`` (the simulation never waits for clients), uncapped, so the simulator's
-real-time factor is the speed everyone gets; ``--stepping lockstep`` makes every step wait for
-the blue stub, which then shares the robots' CPUs with the hog. The runs alternate (baseline,
+either idles (baseline) or forks ``--hogs`` busy processes (hog). By default the matches run as
+the league's official ones: ``async`` stepping (the simulation never waits for clients) capped
+at real time (``--max-rtf 1``), so the simulator's real-time factor is the speed everyone gets;
+``--max-rtf 0`` lifts the cap (the raw speed, more sensitive to other load on the machine);
+``--stepping lockstep`` makes every step wait for the blue stub, which then shares the robots'
+CPUs with the hog. The runs alternate (baseline,
 hog, baseline, hog, ...) so that other load on the machine touches both.
 
 Prints one JSON line: the real-time factors of every run, their medians and the ratio
@@ -37,7 +39,7 @@ def _hog_command(processes: int) -> str:
 
 
 def _files(folder: Path, *, match_id: str, red_command: str, cpus: float, half_s: float,
-           stepping: str) -> Path:
+           stepping: str, max_rtf: float) -> Path:
     from orchestrator.commands import scrimmage_args
     from orchestrator.match import scrimmage
     from orchestrator.project_images import project_image
@@ -52,7 +54,7 @@ def _files(folder: Path, *, match_id: str, red_command: str, cpus: float, half_s
     data = json.loads(game.read_text())
     data["official"] = True
     data["stepping"] = stepping
-    data["maximum_real_time_factor"] = 0  # as fast as it can: the speed is the measurement
+    data["maximum_real_time_factor"] = max_rtf
     data["limits"].update({"cpus": cpus, "memory_gb": 1})
     game.write_text(json.dumps(data, indent=2))
     team = json.loads((folder / "team_red.json").read_text())
@@ -63,10 +65,10 @@ def _files(folder: Path, *, match_id: str, red_command: str, cpus: float, half_s
 
 
 def _play(work: Path, name: str, *, red_command: str, cpus: float, half_s: float,
-          stepping: str) -> dict[str, Any]:
+          stepping: str, max_rtf: float) -> dict[str, Any]:
     match_id = f"bench-hog-{name}-{os.getpid()}"
     game = _files(work / f"{name}-config", match_id=match_id, red_command=red_command,
-                  cpus=cpus, half_s=half_s, stepping=stepping)
+                  cpus=cpus, half_s=half_s, stepping=stepping, max_rtf=max_rtf)
     out = work / name
     done = subprocess.run([sys.executable, "-m", "orchestrator", "match", str(game), "--out",
                            str(out)], capture_output=True, text=True, timeout=900, check=False)
@@ -86,6 +88,9 @@ def main(argv: list[str] | None = None) -> int:
                         help="simulated seconds per half (default 10)")
     parser.add_argument("--stepping", choices=("async", "lockstep"), default="async",
                         help="stepping of the matches (default async, as the league)")
+    parser.add_argument("--max-rtf", type=float, default=1.0,
+                        help="maximum_real_time_factor of the matches (default 1, as official "
+                        "matches; 0: uncapped)")
     parser.add_argument("--json", action="store_true", help="accepted; the output is JSON")
     args = parser.parse_args(argv)
     from orchestrator.match.admission import SIMULATOR_CPUS, HostResources
@@ -100,7 +105,8 @@ def main(argv: list[str] | None = None) -> int:
         for i in range(args.pairs):
             for kind, command in (("baseline", IDLE), ("hog", _hog_command(args.hogs))):
                 results = _play(Path(tmp), f"{kind}{i}", red_command=command, cpus=cpus,
-                                half_s=args.half_duration, stepping=args.stepping)
+                                half_s=args.half_duration, stepping=args.stepping,
+                                max_rtf=args.max_rtf)
                 runs[kind].append(float(results["real_time_factor"]))
                 blue = results["robots"]["blue-1"].get("api") or {}
                 p90 = (blue.get("round_trip_ms") or {}).get("p90")
@@ -112,6 +118,7 @@ def main(argv: list[str] | None = None) -> int:
     print(json.dumps({
         "bench": "hog",
         "stepping": args.stepping,
+        "maximum_real_time_factor": args.max_rtf,
         "blue_stub_api": stub,
         "host_cpus": host.cpus,
         "cpus_per_robot": cpus,
