@@ -139,6 +139,17 @@ def create_app(
         lifespan=lifespan,
     )
     _install_error_handlers(app)
+
+    @app.middleware("http")
+    async def limit_body(request: Request, call_next: Any) -> Any:
+        """Any body declared larger than ``max_upload_bytes`` is refused before it is read."""
+        declared = request.headers.get("content-length", "")
+        if declared.isdigit() and int(declared) > settings.max_upload_bytes:
+            return JSONResponse({"error": "too_large", "message": (
+                f"the body of {declared} bytes is over the limit of "
+                f"{settings.max_upload_bytes} bytes")}, status_code=413)
+        return await call_next(request)
+
     for name in router_modules:
         importlib.import_module(name).mount(app)
     return app

@@ -206,6 +206,11 @@ def test_bad_submissions(start: Callable[..., Served], token: Callable[..., str]
         extra = http.post("/v1/submissions", json={"opponent": "stub", "priority": 1})
         assert extra.status_code == 422
         assert extra.json()["problems"][0]["pointer"] == "/priority"
+        huge = http.post("/v1/submissions", json={"opponent": "stub" * 10_000})
+        assert huge.status_code == 413 and "20000 bytes" in huge.json()["message"]
+        not_json = http.post("/v1/submissions", content=b"opponent=stub",
+                             headers={"Content-Type": "application/x-www-form-urlencoded"})
+        assert not_json.status_code == 422
         assert http.get("/v1/submissions").json() == []
 
 
