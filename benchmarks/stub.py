@@ -37,8 +37,9 @@ class TrialResult:
 
 
 def run_trial(*, seed: int, distance_m: float, time_limit_s: float) -> TrialResult:
+    from contracts.gamecontroller import GameState
     from contracts.ids import RobotId, TeamColor
-    from robot.stub.behaviour import GameInfo, Phase, Role
+    from robot.stub.behaviour import GameInfo, Role
     from robot.stub.controller import StubController
     from robot.stub.world_model import Pose2D
     from simulator.world import CameraRenderer, RobotPlacement, World
@@ -54,7 +55,7 @@ def run_trial(*, seed: int, distance_m: float, time_limit_s: float) -> TrialResu
         seed=seed,
     )
     controller = StubController(role=Role.STRIKER, start_pose=Pose2D(x, y, heading))
-    game = GameInfo(phase=Phase.PLAYING)
+    game = GameInfo(phase=GameState.PLAYING)
     ball_body = world.model.body("ball").id
     kicked_at_s: float | None = None
     ball_before: np.ndarray | None = None

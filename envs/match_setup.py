@@ -119,7 +119,7 @@ def _team_pose(x: float, y: float, yaw: float, attack_sign: float) -> tuple[floa
 def tick_stub(stub: StubRobot, world: World, referee: Referee, range_m: float) -> None:
     """One control step of a stub robot: sensors in, motor targets out."""
     from envs.perception import CameraView
-    from robot.stub.behaviour import GameInfo, Phase
+    from robot.stub.behaviour import GameInfo
     from robot.stub.controller import Sensors
     from robot.stub.world_model import Pose2D
 
@@ -157,7 +157,7 @@ def tick_stub(stub: StubRobot, world: World, referee: Referee, range_m: float) -
     )
     state = gc.state
     game = GameInfo(
-        phase=Phase(state.name),
+        phase=state,
         penalised=stub.id in gc.penalised(),
         our_kick_off=gc.kickoff_team is stub.id.team,
         first_half=gc.half == 1,

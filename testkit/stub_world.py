@@ -69,9 +69,10 @@ def shot_layout(seed: int) -> tuple[tuple[float, float], tuple[float, float, flo
 
 
 def run_shot(*, seed: int, time_limit_s: float, goalie: bool) -> ShotResult:
+    from contracts.gamecontroller import GameState
     from contracts.ids import RobotId, TeamColor
     from referee.snapshot import PlaceBall
-    from robot.stub.behaviour import GameInfo, Phase, Role
+    from robot.stub.behaviour import GameInfo, Role
     from robot.stub.controller import StubController
     from robot.stub.world_model import Pose2D
     from simulator.world import CameraRenderer, RobotPlacement, World
@@ -90,7 +91,7 @@ def run_shot(*, seed: int, time_limit_s: float, goalie: bool) -> ShotResult:
         players.append((keeper, StubController(role=Role.GOALIE, start_pose=Pose2D(-gx, 0, 0))))
     world = World.create(field_class="kid", robots=placements, seed=seed)
     world.apply(PlaceBall(position=(ball[0], ball[1], world.field.ball_radius_m)))
-    game = GameInfo(phase=Phase.PLAYING)
+    game = GameInfo(phase=GameState.PLAYING)
     ball_body = world.model.body("ball").id
     steps = int(time_limit_s * 1000 / world.step_ms)
     outcome, goal_at = "time", None

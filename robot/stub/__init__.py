@@ -7,7 +7,7 @@
 
 from __future__ import annotations
 
-from robot.stub.behaviour import Action, GameInfo, Phase, Role, decide
+from robot.stub.behaviour import Action, GameInfo, Role, decide
 from robot.stub.controller import Sensors, StubController
 from robot.stub.errors import StubConfigError, StubConnectionError, StubError
 from robot.stub.options import Behaviour, RobotEnv, StubOptions, parse_args, read_env
@@ -17,7 +17,6 @@ __all__ = [
     "Action",
     "Behaviour",
     "GameInfo",
-    "Phase",
     "Pose2D",
     "RobotEnv",
     "Role",

@@ -9,6 +9,7 @@ import math
 from dataclasses import dataclass
 from enum import StrEnum
 
+from contracts.gamecontroller import GameState
 from robot.stub.world_model import Pose2D
 
 
@@ -19,17 +20,9 @@ class Role(StrEnum):
     IDLE = "idle"
 
 
-class Phase(StrEnum):
-    INITIAL = "INITIAL"
-    READY = "READY"
-    SET = "SET"
-    PLAYING = "PLAYING"
-    FINISHED = "FINISHED"
-
-
 @dataclass(frozen=True, slots=True, kw_only=True)
 class GameInfo:
-    phase: Phase
+    phase: GameState
     penalised: bool = False
     our_kick_off: bool = True
     first_half: bool = True
@@ -81,11 +74,11 @@ def decide(
     """``ball`` is relative to the robot (x forward, y left) or None when not seen lately;
     ``searching_s`` how long the ball has been missing; ``home`` a defender's spot (own-half
     frame)."""
-    if role is Role.IDLE or game.penalised or game.phase in (Phase.INITIAL, Phase.SET):
+    if role is Role.IDLE or game.penalised or game.phase in (GameState.INITIAL, GameState.SET):
         return STAND
-    if game.phase is Phase.FINISHED:
+    if game.phase is GameState.FINISHED:
         return STAND
-    if game.phase is Phase.READY:
+    if game.phase is GameState.READY:
         return _go_to(pose, _kick_off_position(role, game, field, home))
     # PLAYING
     if not game.our_kick_off and game.ball_free_in_s > 0:

@@ -13,20 +13,12 @@ from robot.client import (
     GameControllerReplier,
     GameState,
 )
-from robot.stub.behaviour import GameInfo, Phase
+from robot.stub.behaviour import GameInfo
 
 logger = logging.getLogger(__name__)
 
 ALIVE_PERIOD_S = 1.0
 COLOUR_BY_TEAM = {"blue": 0, "red": 1}
-_PHASES = {
-    GameState.INITIAL: Phase.INITIAL,
-    GameState.READY: Phase.READY,
-    GameState.SET: Phase.SET,
-    GameState.PLAYING: Phase.PLAYING,
-    GameState.FINISHED: Phase.FINISHED,
-}
-
 
 class GameControllerLink:
     """Runs in its own thread until :meth:`close`; :meth:`info` is safe from any thread."""
@@ -80,7 +72,7 @@ class GameControllerLink:
         team = self.team_number(data)
         penalty = data.own_penalty(team, self._player) if team is not None else None
         return GameInfo(
-            phase=_PHASES.get(data.state, Phase.INITIAL),
+            phase=data.state,
             penalised=bool(penalty),
             our_kick_off=team is not None and data.kick_off_team == team,
             first_half=data.first_half,

@@ -19,11 +19,12 @@ from types import FrameType
 
 import numpy as np
 
+from contracts.gamecontroller import GameState
 from contracts.robot_api import messages_pb2 as pb
 from robot.client import ConnectionClosed, RobotClient, RobotClientError
 from robot.client.errors import ReceiveTimeout
 from robot.motion import kinematics
-from robot.stub.behaviour import GameInfo, Phase, Role
+from robot.stub.behaviour import GameInfo, Role
 from robot.stub.controller import Sensors, StubController
 from robot.stub.errors import StubConfigError
 from robot.stub.faults import MirrorFlooder, fill_logs
@@ -188,7 +189,7 @@ class StubRobot:
             except RobotClientError as exc:
                 logger.warning("lost the simulator connection: %s", exc)
                 return None
-            game = self.gc.info() or GameInfo(phase=Phase.INITIAL)
+            game = self.gc.info() or GameInfo(phase=GameState.INITIAL)
             if previous_half is not None and game.first_half != previous_half:
                 before = self.controller.mirrored  # sides change at half time
                 expect = None if before is None else not before

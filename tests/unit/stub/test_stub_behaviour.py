@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import math
 
-from robot.stub.behaviour import STAND, Field, GameInfo, Phase, Role, decide
+from contracts.gamecontroller import GameState
+from robot.stub.behaviour import STAND, Field, GameInfo, Role, decide
 from robot.stub.world_model import Pose2D
 
 FIELD = Field(half_length_m=4.5, foot_y_m=0.06, kick_x_m=0.165)
-PLAYING = GameInfo(phase=Phase.PLAYING)
+PLAYING = GameInfo(phase=GameState.PLAYING)
 HOME = (-2.3, 1.0)
 
 
@@ -40,7 +41,7 @@ def test_defender_plays_a_ball_near_home_as_a_striker() -> None:
 
 
 def test_defender_kick_off_position_is_its_home() -> None:
-    ready = GameInfo(phase=Phase.READY)
+    ready = GameInfo(phase=GameState.READY)
     there = Pose2D(HOME[0], HOME[1], 0.0)
     assert decide(role=Role.DEFENDER, game=ready, pose=there, ball=None, field=FIELD,
                   searching_s=0.0, home=HOME) == STAND  # fmt: skip

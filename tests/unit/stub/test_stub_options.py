@@ -6,8 +6,9 @@ from pathlib import Path
 
 import pytest
 
+from contracts.gamecontroller import GameState
 from robot.stub import Behaviour, StubConfigError, parse_args, read_env
-from robot.stub.behaviour import GameInfo, Phase, Role, decide
+from robot.stub.behaviour import GameInfo, Role, decide
 from robot.stub.runner import StubRobot
 from robot.stub.world_model import Pose2D
 
@@ -109,18 +110,18 @@ def test_behaviour_by_game_state() -> None:
 
     field = Field(half_length_m=4.5, foot_y_m=0.075, kick_x_m=0.165)
     args = {"pose": pose, "ball": (1.0, 0.0), "field": field, "searching_s": 0.0}
-    for phase in (Phase.INITIAL, Phase.SET, Phase.FINISHED):
+    for phase in (GameState.INITIAL, GameState.SET, GameState.FINISHED):
         assert decide(role=Role.STRIKER, game=GameInfo(phase=phase), **args).stands
-    playing = decide(role=Role.STRIKER, game=GameInfo(phase=Phase.PLAYING), **args)
+    playing = decide(role=Role.STRIKER, game=GameInfo(phase=GameState.PLAYING), **args)
     assert playing.walk[0] > 0  # walks to the ball ahead
-    penalised = GameInfo(phase=Phase.PLAYING, penalised=True)
+    penalised = GameInfo(phase=GameState.PLAYING, penalised=True)
     assert decide(role=Role.STRIKER, game=penalised, **args).stands
-    assert decide(role=Role.IDLE, game=GameInfo(phase=Phase.PLAYING), **args).stands
-    ready = decide(role=Role.STRIKER, game=GameInfo(phase=Phase.READY), **args)
+    assert decide(role=Role.IDLE, game=GameInfo(phase=GameState.PLAYING), **args).stands
+    ready = decide(role=Role.STRIKER, game=GameInfo(phase=GameState.READY), **args)
     assert ready.walk[0] > 0  # towards the kick-off position ahead (x = -0.35)
     close = decide(
         role=Role.STRIKER,
-        game=GameInfo(phase=Phase.PLAYING),
+        game=GameInfo(phase=GameState.PLAYING),
         pose=pose,
         ball=(0.165, -0.075),
         field=field,

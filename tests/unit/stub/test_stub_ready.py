@@ -6,7 +6,8 @@ import math
 
 import pytest
 
-from robot.stub import GameInfo, Phase, Pose2D, Role, StubController
+from contracts.gamecontroller import GameState
+from robot.stub import GameInfo, Pose2D, Role, StubController
 
 from .motion_world import OneRobot
 
@@ -20,7 +21,7 @@ def test_walks_to_the_kick_off_position_in_ready(role: Role, target: tuple[float
     robot = OneRobot(x_m=start.x_m, y_m=start.y_m, yaw_rad=start.yaw_rad)
     home = target if role is Role.DEFENDER else None
     controller = StubController(role=role, start_pose=start, home=home)
-    game = GameInfo(phase=Phase.READY, our_kick_off=False)
+    game = GameInfo(phase=GameState.READY, our_kick_off=False)
 
     def tick() -> dict[str, float]:
         sensors = robot.sensors()

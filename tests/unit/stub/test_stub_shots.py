@@ -5,12 +5,13 @@ import os
 
 import pytest
 
-from robot.stub.behaviour import Field, GameInfo, Phase, Role, decide
+from contracts.gamecontroller import GameState
+from robot.stub.behaviour import Field, GameInfo, Role, decide
 from robot.stub.world_model import Pose2D
 from testkit.stub_world import run_shot, shot_layout
 
 FIELD = Field(half_length_m=4.5, foot_y_m=0.075, kick_x_m=0.165)
-PLAYING = GameInfo(phase=Phase.PLAYING)
+PLAYING = GameInfo(phase=GameState.PLAYING)
 
 
 def _striker(pose: Pose2D, ball: tuple[float, float]) -> tuple[float, float, float]:

@@ -6,7 +6,8 @@ import math
 
 import pytest
 
-from robot.stub import GameInfo, Phase, Pose2D, Role, StubController
+from contracts.gamecontroller import GameState
+from robot.stub import GameInfo, Pose2D, Role, StubController
 from simulator.world import CameraRenderer
 
 from .motion_world import OneRobot
@@ -17,7 +18,7 @@ def test_side_check_from_the_own_goal(world_x: float, mirrored: bool) -> None:
     team_file_pose = Pose2D(-abs(world_x), -3.1, math.pi / 2)  # as if playing on the left
     robot = OneRobot(x_m=world_x, y_m=-3.1, yaw_rad=math.pi / 2)
     controller = StubController(role=Role.STRIKER, start_pose=team_file_pose, detect_side=True)
-    game = GameInfo(phase=Phase.INITIAL)
+    game = GameInfo(phase=GameState.INITIAL)
     with CameraRenderer(robot.world, 320, 240) as camera:
         for _ in range(int(3.5 / 0.008)):
             robot.command(controller.tick(robot.sensors(camera), game))
