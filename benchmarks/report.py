@@ -22,31 +22,15 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import statistics
 import subprocess
 import sys
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from typing import Any
 
+from testkit.figures import Target, median_figures
+
 KINDS = ("sim", "async", "lockstep", "pipelined", "cameras", "bringup")
-
-
-@dataclass(frozen=True, slots=True)
-class Target:
-    figure: str
-    minimum: float | None = None
-    maximum: float | None = None
-
-    def met(self, value: float) -> bool:
-        if self.minimum is not None and value < self.minimum:
-            return False
-        return self.maximum is None or value <= self.maximum
-
-    def to_dict(self) -> dict[str, Any]:
-        bound = {"min": self.minimum} if self.minimum is not None else {"max": self.maximum}
-        return {"figure": self.figure, **bound}
 
 
 TARGETS = {
@@ -162,18 +146,6 @@ def _runners(args: argparse.Namespace) -> dict[str, Callable[[], dict[str, Any]]
     }
 
 
-def _median(runs: list[dict[str, Any]]) -> dict[str, Any]:
-    good = [r for r in runs if "error" not in r]
-    keys = sorted({k for r in good for k, v in r.items() if isinstance(v, int | float)
-                   and not isinstance(v, bool)})  # fmt: skip
-    medians: dict[str, Any] = {}
-    for key in keys:
-        values = [r[key] for r in good if isinstance(r.get(key), int | float)]
-        if values:
-            medians[key] = round(statistics.median(values), 3)
-    return medians
-
-
 def _load() -> list[float]:
     return [round(x, 2) for x in os.getloadavg()]
 
@@ -208,7 +180,7 @@ def run(args: argparse.Namespace, progress: Callable[[str], None]) -> dict[str, 
         "errors": 0,
     }
     for kind in kinds:
-        median = _median(runs[kind])
+        median = median_figures(runs[kind])
         entry: dict[str, Any] = {"median": median, "runs": runs[kind]}
         errors = sum(1 for r in runs[kind] if "error" in r)
         report["errors"] += errors

@@ -6,7 +6,8 @@ import json
 import subprocess
 import sys
 
-from benchmarks.report import Target, _median
+from testkit.figures import Target
+from testkit.figures import median_figures as _median
 
 
 def test_report_runs_the_kinds_and_judges_medians_against_targets() -> None:
