@@ -68,6 +68,9 @@ class Started:
     scratch: dict[str, LogFolder] = field(default_factory=dict)  # robot key -> scratch space
     cpu_sets: CpuSets = field(default_factory=lambda: CpuSets(simulator=None, robots=None))
     match_dir: Path | None = None
+    # bring-up breakdown: seconds per phase of STARTING, and per robot and step of its start
+    phases_s: dict[str, float] = field(default_factory=dict)
+    robot_steps_s: dict[str, dict[str, float]] = field(default_factory=dict)
 
 
 class MatchContext:

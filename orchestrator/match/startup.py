@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 import logging
 import shutil
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 
@@ -48,11 +49,14 @@ def _start(match: MatchContext, started_at: float) -> None:
     plan = match.plan
     started = match.started
     started.prefix = f"hlvs-{safe_name(plan.match_id)}"
+    mark = _Marks(match.clock, started.phases_s)
     for role, internal in (("control", True), ("red", not plan.allow_internet),
                            ("blue", not plan.allow_internet)):
         _create_network(match, role, internal)
+    mark("networks")
     for color in ("red", "blue"):
         match.host.isolate_bridge(started.networks[color].bridge_name, match_id=plan.match_id)
+    mark("firewall")
 
     addresses = {
         team.color: tuple(started.subnets[team.color].robot(r.number) for r in team.robots)
@@ -84,10 +88,15 @@ def _start(match: MatchContext, started_at: float) -> None:
     sets = cpu_sets(stepping=str(spec.get("stepping", "async")))
     started.cpu_sets = sets
     request = replace(request, cpuset_cpus=sets.simulator)
-    _start_simulator(match, request)  # first: it boots while the robots start
+    mark("spec")
     robots = [r for r in plan.robots if match.records[r.key].image_error is None]
-    with ThreadPoolExecutor(max_workers=max(1, min(8, len(robots)))) as pool:
+    # the simulator and the robots start at the same time (robot clients retry until the
+    # simulator listens); the simulator is submitted first so that it boots while they start
+    with ThreadPoolExecutor(max_workers=max(1, min(8, len(robots) + 1))) as pool:
+        simulator = pool.submit(_start_simulator, match, request)
         list(pool.map(lambda robot: _start_robot(match, robot), robots))
+        simulator.result()
+    mark("containers")
     if endpoint is not None and match.telemetry_factory is not None:
         match.telemetry = match.telemetry_factory(endpoint, plan.match_id)
     for team in plan.teams:
@@ -101,11 +110,13 @@ def _start(match: MatchContext, started_at: float) -> None:
 
 
 def _start_simulator(match: MatchContext, request: ContainerRequest) -> None:
-    """Started before the robots, so that it boots while they start (robot clients retry)."""
+    """Started with the robots, so that it boots while they start (robot clients retry)."""
     started = match.started
+    began = match.clock()
     started.simulator_id = match.runtime.create_container(request)
     match.runtime.start(started.simulator_id)
     started.simulator_started_at = match.clock()
+    started.phases_s["simulator"] = round(started.simulator_started_at - began, 3)
     log.info("match %s: simulator container %s started (%s)", match.plan.match_id,
              request.name, request.image)
     match.monitor.watch("simulator", started.simulator_id)
@@ -120,6 +131,7 @@ def _start_robot(match: MatchContext, robot: RobotPlan) -> None:
     network = started.networks[robot.color].name
     n_robots = len([r for r in team.robots if match.records[r.key].image_error is None])
     limits = plan.limits
+    mark = _Marks(match.clock, started.robot_steps_s.setdefault(robot.key, {}))
     try:
         holder = layout.holder_request(
             robot, prefix=started.prefix,
@@ -131,6 +143,7 @@ def _start_robot(match: MatchContext, robot: RobotPlan) -> None:
         started.holder_ids[robot.key] = holder_id
         match.runtime.start(holder_id)
         pid = match.runtime.inspect(holder_id).pid
+        mark("holder")
         shaping = RobotShaping(
             api_rate_bit=mb_s_to_bit(per_robot_rate_mb_s(limits.team_api_mb_s, n_robots)),
             comm_rate_bit=mb_s_to_bit(per_robot_rate_mb_s(limits.team_comm_mb_s, n_robots)),
@@ -141,6 +154,7 @@ def _start_robot(match: MatchContext, robot: RobotPlan) -> None:
         applied = match.host.shape(pid, shaping)
         if applied is not None:
             started.shaping[robot.key] = applied
+        mark("shaping")
         folder = match.host.log_folder(
             match_id=plan.match_id, name=robot.key, cap_bytes=int(limits.log_folder_gb * 1e9),
             fallback=match.options.out_dir / "teams" / robot.color / str(robot.number)
@@ -148,6 +162,7 @@ def _start_robot(match: MatchContext, robot: RobotPlan) -> None:
         )
         started.log_folders[robot.key] = folder
         scratch = _scratch(match, robot)
+        mark("folders")
         record.limits = {
             "nano_cpus": int(limits.cpus * 1e9),
             "memory_bytes": int(limits.memory_gb * 1e9),
@@ -175,13 +190,29 @@ def _start_robot(match: MatchContext, robot: RobotPlan) -> None:
         container_id = match.runtime.create_container(request)
         started.robot_ids[robot.key] = container_id
         record.container = request.name
+        mark("create")
         match.runtime.start(container_id)
+        mark("start")
         match.monitor.watch(robot.key, container_id)
         log.info("match %s: robot %s started (%s, %s)", plan.match_id, robot.key, robot.image,
                  subnet.robot(robot.number))
     except OrchestratorError as exc:
         record.startup_error = str(exc)
         log.warning("match %s: robot %s could not be started: %s", plan.match_id, robot.key, exc)
+
+
+class _Marks:
+    """Records the seconds since the previous mark under each name (bring-up breakdown)."""
+
+    def __init__(self, clock: Callable[[], float], into: dict[str, float]) -> None:
+        self._clock = clock
+        self._into = into
+        self._last = clock()
+
+    def __call__(self, name: str) -> None:
+        now = self._clock()
+        self._into[name] = round(now - self._last, 3)
+        self._last = now
 
 
 def _scratch(match: MatchContext, robot: RobotPlan) -> LogFolder | None:
