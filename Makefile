@@ -56,7 +56,7 @@ images: venv engine
 
 lint:
 	$(VENV)/bin/ruff check orchestrator simulator referee contracts robot service envs viewer \
-	  benchmarks examples tests
+	  benchmarks testkit examples tests
 
 typecheck:
 	$(VENV)/bin/mypy
