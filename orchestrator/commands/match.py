@@ -32,6 +32,7 @@ def register(sub: Any) -> None:
                        help="seconds robots get to stop after the game (default: from game.json)")
     match.add_argument("--json", action="store_true",
                        help="print results.json (with the outcome and output folder) on stdout")
+    add_pool_arguments(match)
     match.set_defaults(func=run_match_command, log_level=logging.INFO)
 
     scrim = sub.add_parser(
@@ -40,6 +41,7 @@ def register(sub: Any) -> None:
     add_scrimmage_arguments(scrim)
     scrim.add_argument("--json", action="store_true",
                        help="print results.json (with the outcome and output folder) on stdout")
+    add_pool_arguments(scrim)
     scrim.set_defaults(func=run_scrimmage_command, log_level=logging.INFO)
 
     clean = sub.add_parser(
@@ -51,6 +53,18 @@ def register(sub: Any) -> None:
     clean.add_argument("--dry-run", action="store_true",
                        help="list what would be removed, remove nothing")
     clean.set_defaults(func=run_cleanup_command)
+
+
+def add_pool_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--pool", choices=("local", "slurm"), default="local",
+                        help="where the match runs: this host's Docker engine (local, default) "
+                        "or a Slurm job on a whole node of the cluster (slurm)")
+    parser.add_argument("--slurm-conf", default=None,
+                        help="the cluster's slurm.conf with --pool slurm (default: $SLURM_CONF "
+                        "or the one 'hlvs pool up' writes)")
+    parser.add_argument("--account", default=None,
+                        help="Slurm account the match is charged to with --pool slurm (a "
+                        "team's: its quota applies; default: the user's default account)")
 
 
 def run_match_command(args: argparse.Namespace) -> int:
@@ -79,4 +93,7 @@ def __getattr__(name: str) -> Any:  # play, summarize, stop_on_signals: kept imp
     raise AttributeError(name)
 
 
-__all__ = ["register", "run_cleanup_command", "run_match_command", "run_scrimmage_command"]
+__all__ = [
+    "add_pool_arguments", "register", "run_cleanup_command", "run_match_command",
+    "run_scrimmage_command",
+]

@@ -213,6 +213,8 @@ def run_match_command(args: argparse.Namespace) -> int:
         print(f"hlvs: {warning}", file=sys.stderr)
     plan = plan_from_game(loaded, grace_period_s=args.grace)
     out = args.out or user_path(Path("matches") / plan.match_id)
+    if getattr(args, "pool", "local") == "slurm":
+        return _in_pool(args, game_path=args.game, plan=plan, out=out)
     outcome = play(plan, out_dir=out, pull=True, loaded=loaded,
                    view_stream=sys.stderr if getattr(args, "json", False) else None)
     return summarize(outcome, as_json=getattr(args, "json", False))
@@ -223,9 +225,19 @@ def run_scrimmage_command(args: argparse.Namespace) -> int:
     game_path = scrimmage.write_files(args, out / "config")
     loaded = load_game(game_path, images_required=True)
     plan = plan_from_game(loaded, grace_period_s=args.grace)
+    if getattr(args, "pool", "local") == "slurm":
+        return _in_pool(args, game_path=game_path, plan=plan, out=out)
     outcome = play(plan, out_dir=out, pull=False, loaded=loaded,
                    view_stream=sys.stderr if getattr(args, "json", False) else None)
     return summarize(outcome, as_json=getattr(args, "json", False))
+
+
+def _in_pool(args: argparse.Namespace, *, game_path: Path, plan: MatchPlan, out: Path) -> int:
+    from orchestrator.commands.pooled import play_in_pool
+
+    grace = () if args.grace is None else ("--grace", str(args.grace))
+    return play_in_pool(args, game_path=game_path, match_id=plan.match_id, out_dir=out,
+                        official=plan.official, match_args=grace)
 
 
 def run_cleanup_command(args: argparse.Namespace) -> int:

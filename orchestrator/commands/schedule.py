@@ -29,6 +29,10 @@ def register(sub: Any) -> None:
     )
     run.add_argument("--exit-when-done", action="store_true", help="stop when every match is final")
     run.add_argument("--services", help="module:factory of the pull/play/deliver services (tests)")
+    run.add_argument("--pool", choices=("local", "slurm"), default=None,
+                     help="where matches run: this host's Docker engine or one Slurm job per "
+                     "match (default: the schedule's pool section, else local); remembered in "
+                     "the state file")
     run.set_defaults(func=_run, log_level=logging.INFO)
 
     plan = verbs.add_parser("list", help="what is planned, with absolute times")
@@ -69,7 +73,8 @@ def _run(args: argparse.Namespace) -> int:
     from orchestrator.schedule.runner import run_schedule
 
     return run_schedule(
-        args.schedule, args.state, services=args.services, exit_when_done=args.exit_when_done
+        args.schedule, args.state, services=args.services, pool=args.pool,
+        exit_when_done=args.exit_when_done,
     )
 
 

@@ -41,6 +41,17 @@ class ScheduleTiming:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class SchedulePool:
+    """Where the tournament's matches run: this host's Docker engine (``local``) or one Slurm
+    job per match on a whole node of a cluster (``slurm``; ``slurm_conf`` names the cluster,
+    ``account`` the Slurm account the matches are charged to)."""
+
+    kind: Literal["local", "slurm"] = "local"
+    slurm_conf: str | None = None
+    account: str | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class ScheduledTeam:
     name: str
     team_id: int
@@ -98,6 +109,7 @@ class Schedule:
     game_defaults: dict[str, Any]
     teams: tuple[ScheduledTeam, ...]
     matches: tuple[ScheduledMatch, ...]
+    pool: SchedulePool = SchedulePool()
 
     def team(self, name: str) -> ScheduledTeam:
         for team in self.teams:
@@ -242,6 +254,7 @@ def load_schedule(path: str | Path) -> Schedule:
         game_defaults=dict(data.get("game_defaults", {})),
         teams=teams,
         matches=tuple(matches),
+        pool=SchedulePool(**data.get("pool", {})),
     )
     problems = _cross_problems(path, schedule, data)
     if problems:

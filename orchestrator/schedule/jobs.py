@@ -8,7 +8,7 @@ was done. Knockout slots ("winner of X") are resolved when the match is pulled o
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
@@ -44,6 +44,11 @@ class Tournament:
         if schedule_path is None or reference is None:
             raise ScheduleError(f"{state_path}: not a tournament state file (no schedule recorded)")
         schedule = load_schedule(schedule_path)
+        pool = ledger.get_meta("pool")  # hlvs schedule run --pool overrides the file's
+        if pool == "slurm":
+            schedule = replace(schedule, pool=replace(schedule.pool, kind="slurm"))
+        elif pool == "local":
+            schedule = replace(schedule, pool=replace(schedule.pool, kind="local"))
         services = load_services(ledger.get_meta("services") or DEFAULT_SERVICES, schedule)
         return cls(
             schedule=schedule,

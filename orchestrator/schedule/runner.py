@@ -48,6 +48,7 @@ def init_state(
     *,
     services: str | None = None,
     now: datetime | None = None,
+    pool: str | None = None,
 ) -> tuple[Schedule, Ledger]:
     """Open (or create) the state file of a schedule and add its matches to the ledger."""
     schedule = load_schedule(schedule_path)
@@ -71,6 +72,8 @@ def init_state(
         reference = datetime.fromisoformat(reference_text)
     if services is not None:
         ledger.set_meta("services", services)
+    if pool is not None:
+        ledger.set_meta("pool", pool)
     for planned in schedule.plan(reference):
         added = ledger.ensure(
             {
@@ -145,13 +148,14 @@ def run_schedule(
     state_path: str | Path,
     *,
     services: str | None = None,
+    pool: str | None = None,
     exit_when_done: bool = False,
     poll_s: float = 1.0,
     stop: threading.Event | None = None,
 ) -> int:
     """Run the tournament until every match is final (with ``exit_when_done``) or a signal."""
     state = str(Path(state_path).resolve())
-    schedule, ledger = init_state(schedule_path, state, services=services)
+    schedule, ledger = init_state(schedule_path, state, services=services, pool=pool)
     recover_interrupted(ledger)
     stop = stop or threading.Event()
     wake = threading.Event()

@@ -2,8 +2,10 @@
 
 :class:`TournamentServices` is the boundary the scheduler's jobs call; :class:`MatchServices`
 is the real implementation (images through :mod:`orchestrator.pull`, the match through
-``hlvs match`` in a child process that dies with the scheduler, logs through
-:mod:`orchestrator.delivery`). Tests may plug in their own through a ``module:function`` factory.
+``hlvs match`` in a child process that dies with the scheduler, or, with the schedule's pool
+``slurm``, as a Slurm job that outlives the scheduler and is adopted by the next one, logs
+through :mod:`orchestrator.delivery`). Tests may plug in their own through a
+``module:function`` factory.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ import os
 import signal
 import subprocess
 import sys
+import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
@@ -27,6 +30,8 @@ from orchestrator.errors import ScheduleError
 log = logging.getLogger(__name__)
 
 DEFAULT_SERVICES = "orchestrator.schedule.services:MatchServices"
+SLURM_CONF = "/var/lib/hlvs/slurm/slurm.conf"  # written by 'hlvs pool up'
+SLURM_POLL_S = 2.0
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -164,6 +169,8 @@ class MatchServices:
     def play(self, ctx: MatchContext) -> PlayOutcome:
         game = write_game_file(ctx)
         out = ctx.out_dir / "match"
+        if self.schedule.pool.kind == "slurm":
+            return self._play_in_slurm(ctx, game, out)
         cmd = [sys.executable, "-m", "orchestrator.cli", "match", str(game), "--out", str(out)]
         log.info("match %s: %s", ctx.match_id, " ".join(cmd))
         with open(ctx.out_dir / "match.log", "ab") as sink:
@@ -184,6 +191,48 @@ class MatchServices:
             outcome.score_red,
             outcome.score_blue,
         )
+        return outcome
+
+    def _play_in_slurm(self, ctx: MatchContext, game: Path, out: Path) -> PlayOutcome:
+        """The match as a Slurm job (no requeue: tournament matches wait for the operator).
+        A job an earlier scheduler submitted for this match, still in Slurm or finished with
+        its report, is adopted instead of playing the match again."""
+        from service.errors import PoolError
+        from service.pool import JobState, MatchJob
+        from service.pool.slurm import HOST_NETNS, SlurmPool
+
+        settings = self.schedule.pool
+        pool = SlurmPool(
+            slurm_conf=settings.slurm_conf or os.environ.get("SLURM_CONF") or SLURM_CONF,
+            host_network=Path(HOST_NETNS).exists(), out_subdir="",
+        )
+        try:
+            handle = pool.recorded(out)
+            if handle is not None and (pool.active(handle)
+                                       or (out / files.REPORT).is_file()):
+                log.info("match %s: adopting Slurm job %s", ctx.match_id, pool.job_id(handle))
+            else:
+                (out / files.REPORT).unlink(missing_ok=True)
+                handle = pool.submit(MatchJob(match_id=ctx.match_id, game_path=game,
+                                              work_dir=out, account=settings.account))
+                log.info("match %s: Slurm job %s", ctx.match_id, pool.job_id(handle))
+            shown = ""
+            while True:
+                status = pool.status(handle)
+                if status.state in (JobState.FINISHED, JobState.LOST):
+                    break
+                if status.detail != shown:
+                    log.info("match %s: %s %s", ctx.match_id, status.state.value, status.detail)
+                    shown = status.detail
+                time.sleep(SLURM_POLL_S)
+        except PoolError as exc:
+            raise ScheduleError(f"match {ctx.match_id}: Slurm pool: {exc}") from exc
+        if status.state is JobState.LOST:
+            return PlayOutcome(status="infrastructure", score_red=None, score_blue=None,
+                               winner=None, cause=status.detail)
+        outcome = read_outcome(out)
+        log.info("match %s: %s %s-%s", ctx.match_id, outcome.status, outcome.score_red,
+                 outcome.score_blue)
         return outcome
 
     def deliver(self, ctx: MatchContext) -> str:

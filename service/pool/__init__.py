@@ -32,6 +32,8 @@ class MatchJob:
     game_path: Path
     work_dir: Path
     account: str | None = None  # a cluster account the match is charged to (a team's)
+    requeue: bool = False  # a cluster may play it again after a node failure (test matches)
+    match_args: tuple[str, ...] = ()  # more options of ``hlvs match`` (e.g. ``--grace 3``)
 
 
 class JobState(enum.StrEnum):

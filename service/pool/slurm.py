@@ -13,9 +13,14 @@ gracefully (robots get their grace period, logs are collected, ``report.json`` s
 ``interrupted``); the cluster's ``KillWait`` must be longer than that (150 s in the cluster that
 ``scripts/ensure-slurm.sh`` sets up).
 
+A test match (``MatchJob.requeue``) is submitted with ``--requeue``: when its node fails, Slurm
+puts it back in the queue and plays it again on another node (the new ``hlvs match`` salvages
+what the dead run left and plays the match from the start); official matches get
+``--no-requeue`` and wait for the operator.
+
 The handle is ``slurm:<job id>:<work folder>``; ``<work folder>/slurm.json`` remembers the job
-so that a second submit of the same match adopts it. This is the only module that runs Slurm's
-commands.
+so that a second submit of the same match adopts it (:meth:`SlurmPool.recorded`).
+This is the only module that runs Slurm's commands.
 """
 
 from __future__ import annotations
@@ -66,7 +71,7 @@ class SlurmPool:
     def __init__(
         self, *, slots: int = 3, partition: str | None = None, slurm_conf: str | None = None,
         python: str = sys.executable, extra_args: tuple[str, ...] = (), qos: str | None = None,
-        host_network: bool = False,
+        host_network: bool = False, out_subdir: str = "out",
     ) -> None:
         self.slots = slots
         self.partition = partition
@@ -77,6 +82,8 @@ class SlurmPool:
         # Nodes of the one-machine cluster share this host's Docker engine, whose networks
         # live in the host's network namespace: the match enters it (a real node has its own).
         self.host_network = host_network
+        # The match output goes to <work>/<out_subdir> (the work folder itself when empty).
+        self.out_subdir = out_subdir
 
     # MatchPool ---------------------------------------------------------------------------
     def submit(self, job: MatchJob) -> str:
@@ -85,15 +92,16 @@ class SlurmPool:
         if previous is not None and self._squeue_state(previous) in ACTIVE:
             log.info("match %s already in Slurm as job %s; adopted", job.match_id, previous)
             return self._handle(previous, work)
-        out = work / "out"
+        out = work / self.out_subdir if self.out_subdir else work
         out.mkdir(parents=True, exist_ok=True)
         command = [self.python, "-m", "orchestrator", *self.extra_args, "match",
-                   str(job.game_path.resolve()), "--out", str(out)]
+                   str(job.game_path.resolve()), "--out", str(out), *job.match_args]
         if self.host_network:
             command = ["nsenter", f"--net={HOST_NETNS}", *command]
         script = "#!/bin/sh\nexec " + " ".join(shlex.quote(c) for c in command) + "\n"
         args = ["sbatch", "--parsable", "--exclusive", "-N1", f"--job-name=hlvs-{job.match_id}",
-                f"--chdir={work}", f"--output={work / LOG_FILE}"]
+                f"--chdir={work}", f"--output={work / LOG_FILE}", "--open-mode=append",
+                "--requeue" if job.requeue else "--no-requeue"]
         if self.partition:
             args.append(f"--partition={self.partition}")
         account = job.account
@@ -123,7 +131,7 @@ class SlurmPool:
                     detail += f", expected start {entry.expected_start}"
                 return JobStatus(state=JobState.PENDING, detail=detail)
             return JobStatus(state=JobState.RUNNING, detail=f"on {entry.nodes}")
-        if (work / "out" / "report.json").is_file():
+        if (self.results_dir(handle) / "report.json").is_file():
             return JobStatus(state=JobState.FINISHED)
         final = self._sacct_state(job_id)
         return JobStatus(state=JobState.LOST,
@@ -136,7 +144,21 @@ class SlurmPool:
         log.info("Slurm job %s of %s cancelled (SIGTERM: graceful stop)", job_id, work)
 
     def results_dir(self, handle: str) -> Path:
-        return self._parse(handle)[1] / "out"
+        work = self._parse(handle)[1]
+        return work / self.out_subdir if self.out_subdir else work
+
+    def recorded(self, work_dir: Path) -> str | None:
+        """The handle of the job last submitted for ``work_dir`` (running or not), or None."""
+        work = work_dir.resolve()
+        job_id = self._recorded(work)
+        return None if job_id is None else self._handle(job_id, work)
+
+    def active(self, handle: str) -> bool:
+        """Whether Slurm still has the job (pending, running, requeued...)."""
+        return self._squeue_state(self._parse(handle)[0]) in ACTIVE
+
+    def job_id(self, handle: str) -> str:
+        return self._parse(handle)[0]
 
     # queue for hlvs pool status ------------------------------------------------------------
     def queue(self) -> list[QueueEntry]:

@@ -7,10 +7,8 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import shutil
 import subprocess
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -20,18 +18,6 @@ from service.pool.slurm import SlurmPool
 
 pytestmark = [pytest.mark.docker, pytest.mark.root, pytest.mark.slow]
 
-ROOT = Path(__file__).resolve().parents[3]
-CONF = "/var/lib/hlvs/slurm/slurm.conf"
-
-
-@pytest.fixture(scope="module")
-def cluster() -> Iterator[str]:
-    if os.geteuid() != 0 or shutil.which("apt-get") is None:
-        pytest.skip("the Slurm cluster needs root on Debian")
-    result = subprocess.run(["bash", str(ROOT / "scripts" / "ensure-slurm.sh"), "up"],
-                            capture_output=True, text=True, timeout=600, check=False)
-    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
-    yield CONF
 
 
 def _job(tmp: Path, name: str, account: str) -> MatchJob:

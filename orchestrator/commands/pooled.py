@@ -1,0 +1,108 @@
+"""``hlvs match --pool slurm`` and ``hlvs scrimmage --pool slurm``: the match as a Slurm job.
+
+The match is submitted through :class:`service.pool.slurm.SlurmPool` (one batch job on a whole
+node running ``hlvs match``), this command waits for it and shows Slurm's state and reason on
+one line each time they change, then reads ``report.json`` / ``results.json`` from the usual
+``--out`` folder and exits with the same codes as a local match. SIGINT / SIGTERM while waiting
+cancel the job (``scancel``: the match stops gracefully) and wait for its report. Running this
+command again with the same ``--out`` while the job is in Slurm adopts the job.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from orchestrator.commands.play import stop_on_signals, summarize
+from orchestrator.errors import InfrastructureError
+from orchestrator.match import MatchOutcome
+from orchestrator.match.results import Failure, FailureClass
+
+DEFAULT_CONF = "/var/lib/hlvs/slurm/slurm.conf"
+POLL_S = 1.0
+
+
+def make_pool(args: argparse.Namespace) -> Any:
+    """The Slurm pool the options name; the output goes straight into ``--out``."""
+    from service.pool.slurm import HOST_NETNS, SlurmPool
+
+    conf = args.slurm_conf or os.environ.get("SLURM_CONF") or DEFAULT_CONF
+    # The one-machine cluster of 'hlvs pool up' shares this host's Docker engine: its jobs
+    # enter the host's network namespace, which that script names (a real node has its own).
+    return SlurmPool(slurm_conf=conf, host_network=Path(HOST_NETNS).exists(), out_subdir="")
+
+
+def play_in_pool(
+    args: argparse.Namespace, *, game_path: Path, match_id: str, out_dir: Path, official: bool,
+    match_args: tuple[str, ...] = (),
+) -> int:
+    from service.errors import PoolError
+    from service.pool import JobState, MatchJob
+
+    pool = make_pool(args)
+    as_json = bool(getattr(args, "json", False))
+    try:
+        handle = pool.recorded(out_dir)
+        if handle is None or not pool.active(handle):
+            for name in ("report.json", "results.json"):  # of an earlier run in this folder
+                (out_dir / name).unlink(missing_ok=True)
+            handle = pool.submit(MatchJob(
+                match_id=match_id, game_path=game_path, work_dir=out_dir,
+                account=getattr(args, "account", None), requeue=not official,
+                match_args=match_args,
+            ))
+        job = pool.job_id(handle)
+        _say(f"match {match_id}: Slurm job {job} submitted", as_json)
+        shown = ""
+        cancelled = False
+        with stop_on_signals() as stop:
+            while True:
+                status = pool.status(handle)
+                if status.state in (JobState.FINISHED, JobState.LOST):
+                    break
+                line = f"match {match_id}: Slurm job {job} {status.state.value}: {status.detail}"
+                if line != shown:
+                    _say(line, as_json)
+                    shown = line
+                if stop.is_set() and not cancelled:
+                    pool.cancel(handle)
+                    cancelled = True
+                    _say(f"match {match_id}: Slurm job {job} cancelled, waiting for its "
+                         "report", as_json)
+                stop.wait(POLL_S)
+    except PoolError as exc:
+        raise InfrastructureError(f"Slurm pool: {exc}") from exc
+    if status.state is JobState.LOST:
+        raise InfrastructureError(f"match {match_id}: {status.detail}; see "
+                                  f"{out_dir}/slurm-{job}.out")
+    return summarize(read_outcome(match_id, out_dir), as_json=as_json)
+
+
+def read_outcome(match_id: str, out_dir: Path) -> MatchOutcome:
+    """The outcome of a match played elsewhere, from the files it left in ``out_dir``."""
+    report = json.loads((out_dir / "report.json").read_text(encoding="utf-8"))
+    results_path = out_dir / "results.json"
+    results = json.loads(results_path.read_text(encoding="utf-8")) if results_path.is_file() \
+        else {}
+    failure = None
+    if report.get("status") != "success":
+        try:
+            failure_class = FailureClass(report.get("failure_class"))
+        except ValueError:
+            failure_class = FailureClass.INFRASTRUCTURE
+        failure = Failure(failure_class=failure_class, cause=str(report.get("cause", "")))
+    return MatchOutcome(match_id=match_id, failure=failure, out_dir=out_dir, results=results,
+                        bringup_s=None)
+
+
+def _say(line: str, as_json: bool) -> None:
+    print(f"{time.strftime('%H:%M:%S')} {line}", file=sys.stderr if as_json else sys.stdout,
+          flush=True)
+
+
+__all__ = ["make_pool", "play_in_pool", "read_outcome"]

@@ -1,0 +1,55 @@
+"""--pool plumbing without a cluster: the schedule's pool section, and the exit code of a match
+played elsewhere read back from the files it left."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from orchestrator.commands.play import summarize
+from orchestrator.commands.pooled import read_outcome
+from orchestrator.config.schedule import load_schedule
+from orchestrator.errors import ConfigError
+
+
+def _schedule(tmp: Path, pool: str) -> Path:
+    (tmp / "a.json").write_text(json.dumps({"name": "a", "players": {}}))
+    (tmp / "b.json").write_text(json.dumps({"name": "b", "players": {}}))
+    path = tmp / "s.yaml"
+    path.write_text("name: cup\nteams:\n  - {name: a, id: 1, config: a.json}\n"
+                    f"  - {{name: b, id: 2, config: b.json}}\n{pool}")
+    return path
+
+
+def test_schedule_pool_section(tmp_path: Path) -> None:
+    assert load_schedule(_schedule(tmp_path, "")).pool.kind == "local"
+    pool = load_schedule(_schedule(
+        tmp_path, "pool: {kind: slurm, slurm_conf: /etc/slurm/slurm.conf, account: league}\n"
+    )).pool
+    assert (pool.kind, pool.slurm_conf, pool.account) == ("slurm", "/etc/slurm/slurm.conf",
+                                                         "league")
+    with pytest.raises(ConfigError) as err:
+        load_schedule(_schedule(tmp_path, "pool: {kind: k8s}\n"))
+    assert "/pool/kind" in str(err.value)
+    with pytest.raises(ConfigError) as err:
+        load_schedule(_schedule(tmp_path, "pool: {kind: slurm, partiton: x}\n"))
+    assert "/pool/partiton" in str(err.value) and "unknown key" in str(err.value)
+
+
+@pytest.mark.parametrize(("report", "results", "code"), [
+    ({"status": "success"}, {"score": {"red": 1, "blue": 0}, "winner": "red"}, 0),
+    ({"status": "success"}, {"forfeit": {"team": "red", "winner": "blue"}}, 4),
+    ({"status": "failed", "failure_class": "interrupted", "cause": "SIGTERM"}, {}, 130),
+    ({"status": "failed", "failure_class": "infrastructure", "cause": "engine"}, {}, 3),
+    ({"status": "failed", "failure_class": "simulator", "cause": "exited"}, {}, 1),
+])
+def test_exit_code_of_a_match_played_in_the_pool(
+    tmp_path: Path, report: dict[str, str], results: dict[str, object], code: int,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    (tmp_path / "report.json").write_text(json.dumps(report))
+    (tmp_path / "results.json").write_text(json.dumps(results))
+    assert summarize(read_outcome("m1", tmp_path), as_json=True) == code
+    assert json.loads(capsys.readouterr().out)["exit_code"] == code
