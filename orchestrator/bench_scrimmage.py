@@ -17,6 +17,7 @@ import json
 import logging
 import sys
 import tempfile
+import threading
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -82,8 +83,10 @@ def _parse(argv: Sequence[str]) -> argparse.Namespace:
     return args
 
 
-def play_one(*, seed: int, out: Path, players: int | None) -> MatchFigures:
-    """One default scrimmage with ``seed`` played into ``out``; its figures."""
+def play_one(*, seed: int, out: Path, players: int | None,
+             stop: threading.Event | None = None) -> MatchFigures:
+    """One default scrimmage with ``seed`` played into ``out``; its figures. ``stop`` set:
+    the match stops (and is collected) as on SIGINT."""
     from orchestrator.engine import connect
     from orchestrator.engine.containers import DockerRuntime
     from orchestrator.project_images import project_image
@@ -105,6 +108,7 @@ def play_one(*, seed: int, out: Path, players: int | None) -> MatchFigures:
         plan, runtime=runtime, host=host,
         options=RunOptions(out_dir=out, simulator_image=project_image("simulator")),
         telemetry=lambda endpoint, mid: ZenohTelemetry(endpoint=endpoint, match_id=mid),
+        stop_event=stop,
     )
     try:
         outcome = runner.run()
@@ -163,13 +167,23 @@ def summarize(matches: list[MatchFigures]) -> dict[str, Any]:
 
 def run(*, matches: int, seed: int, players: int | None, folder: Path,
         quiet: bool) -> dict[str, Any]:
+    """Play the scrimmages; SIGINT / SIGTERM stop the one playing and skip the rest (the
+    summary covers the matches played so far, the interrupted one included)."""
+    from orchestrator.commands.play import stop_on_signals
+
     figures = []
-    for i in range(matches):
-        figure = play_one(seed=seed + i, out=folder / f"match-{i + 1}", players=players)
-        figures.append(figure)
-        if not quiet:
-            print(json.dumps(figure.to_json()), file=sys.stderr)
-    return summarize(figures)
+    with stop_on_signals() as stop:
+        for i in range(matches):
+            figure = play_one(seed=seed + i, out=folder / f"match-{i + 1}", players=players,
+                              stop=stop)
+            figures.append(figure)
+            if not quiet:
+                print(json.dumps(figure.to_json()), file=sys.stderr)
+            if stop.is_set():
+                break
+    result = summarize(figures)
+    result["interrupted"] = len(figures) < matches or stop.is_set()
+    return result
 
 
 def main(argv: Sequence[str]) -> int:

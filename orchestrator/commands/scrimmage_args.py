@@ -29,10 +29,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--players", type=int, default=1, choices=(1, 2, 3, 4),
                         help="robots per team: a striker, then a goalie, then defenders "
                              "(default 1)")
-    parser.add_argument("--half-duration", type=float, default=60.0,
-                        help="simulated seconds per half, READY and SET included (default 60)")
-    parser.add_argument("--ready-duration", type=float, default=15.0,
-                        help="simulated seconds of READY in this scrimmage (default 15; "
+    parser.add_argument("--half-duration", type=float, default=65.0,
+                        help="simulated seconds per half, READY and SET included (default 65)")
+    parser.add_argument("--ready-duration", type=float, default=20.0,
+                        help="simulated seconds of READY in this scrimmage (default 20; "
                              "matches: 45)")
     parser.add_argument("--wait-before-ready", type=float, default=3.0,
                         help="wall seconds between robot start and the first READY (default 3)")

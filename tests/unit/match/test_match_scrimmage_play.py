@@ -34,11 +34,11 @@ def _scrimmage(tmp_path: Path, *argv: str) -> tuple[dict[str, Any], dict[str, An
 
 def test_default_scrimmage_is_a_short_game_with_a_short_ready(tmp_path: Path) -> None:
     game, red = _scrimmage(tmp_path)
-    assert game["timing"]["half_duration_s"] == 60 and game["timing"]["ready_duration_s"] == 15
+    assert game["timing"]["half_duration_s"] == 65 and game["timing"]["ready_duration_s"] == 20
     assert game["stepping"] == "lockstep"
     assert [p["dockerCmd"].split()[0] for p in red["players"].values()] == ["striker"]
     loaded = load_game(tmp_path / "game.json").game
-    assert loaded.timing.ready_duration_s == 15.0 and loaded.timing.half_duration_s == 60.0
+    assert loaded.timing.ready_duration_s == 20.0 and loaded.timing.half_duration_s == 65.0
 
 
 def test_larger_scrimmage_teams_add_a_goalie_then_defenders(tmp_path: Path) -> None:
