@@ -11,7 +11,9 @@ flag), never from what the robots say.
 - A **shot** is a kick, made while the game runs, whose ball heads for the goal the kicker's team
   attacks: its straight path crosses that goal line between the posts, from no farther than half
   the field's length.
-- A **fall** is a robot's fallen flag going from false to true (not while penalised or removed).
+- A **fall** is a robot's fallen flag going from false to true (not while penalised or removed)
+  after the robot stood for at least ``FALL_RECOVERED_MS``: the flag flickers while a robot
+  struggles to get up, and that is still the same fall.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from referee.snapshot import RefereeEvent, WorldSnapshot
 KICK_MIN_SPEED_M_S = 1.0
 KICK_MIN_GAIN_M_S = 0.6
 KICK_WINDOW_MS = 400
+FALL_RECOVERED_MS = 1000
 COLORS = (TeamColor.RED, TeamColor.BLUE)
 
 
@@ -79,6 +82,7 @@ class PlayTracker:
     _touches: dict[RobotId, _Touch] = field(default_factory=dict)
     _last_kick_ms: dict[RobotId, int] = field(default_factory=dict)
     _fallen: set[RobotId] = field(default_factory=set)
+    _up_since_ms: dict[RobotId, int] = field(default_factory=dict)
     _last_ms: int | None = None
     _last_speed_m_s: float = 0.0
 
@@ -115,13 +119,21 @@ class PlayTracker:
         self._last_speed_m_s = speed
 
     def _observe_falls(self, snapshot: WorldSnapshot, view: GameView) -> None:
+        now = snapshot.sim_time_ms
         for robot in snapshot.robots:
-            if not robot.fallen or robot.limp or robot.removed:
-                self._fallen.discard(robot.id)
+            down = robot.fallen and not robot.limp and not robot.removed
+            if not down:
+                if robot.id in self._fallen:
+                    self._fallen.discard(robot.id)
+                    self._up_since_ms[robot.id] = now
                 continue
-            if robot.id not in self._fallen and robot.id not in view.penalised:
-                self.falls[robot.id.team] += 1
+            if robot.id in self._fallen:
+                continue
             self._fallen.add(robot.id)
+            up_since = self._up_since_ms.get(robot.id)
+            recovered = up_since is None or now - up_since >= FALL_RECOVERED_MS
+            if recovered and robot.id not in view.penalised:
+                self.falls[robot.id.team] += 1
 
     def stats(self, events: list[RefereeEvent]) -> PlayStats:
         goals, own_goals = _per_team(), _per_team()

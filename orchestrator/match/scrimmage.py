@@ -19,16 +19,14 @@ from typing import Any
 
 from orchestrator.commands.scrimmage_args import add_arguments
 
-# Starting poses as if playing on the left (x < 0), on the own touch line facing the field.
-# The stub finds out whether its pitch is mirrored by seeing its own goal nearer than the other:
-# a robot starting near the halfway line sees both about as large (and the opponent next to
-# it), so the striker starts 1.9 m into the own half, 4.1 m from its goal and 7.1 m from the
-# other, and still reaches its kick-off spot within the scrimmage's READY.
+# Starting poses as if playing on the left (x < 0), on the own touch line facing the field;
+# the striker starts near the halfway line, so that it reaches its kick-off spot within the
+# scrimmage's READY.
 POSES_KID = {
     "goalie": (-4.0, -3.1, 1.57),
-    "striker": (-1.9, -3.1, 1.57),
-    "defender-3": (-2.6, -3.1, 1.57),
-    "defender-4": (-3.3, -3.1, 1.57),
+    "striker": (-0.8, -3.1, 1.57),
+    "defender-3": (-2.0, -3.1, 1.57),
+    "defender-4": (-3.0, -3.1, 1.57),
 }
 
 # Who plays, by team size: one striker alone; then a goalie; players 3 and 4 defend from spots

@@ -26,6 +26,7 @@ class GameInfo:
     penalised: bool = False
     our_kick_off: bool = True
     first_half: bool = True
+    on_left: bool | None = None  # the team's TeamInfo comes first in RGme: it plays on the left
     ball_free_in_s: float = 0.0  # PLAYING: the opponents' kick-off is still protected this long
 
 

@@ -123,8 +123,17 @@ class StubController:
         self, pose: Pose2D, *, check_side: bool = True, expect_mirrored: bool | None = None
     ) -> None:
         """Start again from ``pose`` (team-file frame when ``check_side``; the turned frame of
-        the odometry otherwise). ``expect_mirrored`` applies when the check is undecided."""
+        the odometry otherwise). ``expect_mirrored`` applies when the check is undecided.
+
+        The robot was placed by the referee: a motion under way (a get-up when the half ended
+        with the robot down) is dropped and the orientation is taken afresh from gravity."""
         self.world.reset_pose(pose)
+        self._heading = HeadingTracker()
+        if self._motion is not None:
+            self._motion = None
+            self._motion_kind = ""
+            self._tilted_s = 0.0
+            self.walk.reset()
         self._expect_mirrored = expect_mirrored
         if self._detect_side and check_side:
             self._side_check_s = 0.0
@@ -192,6 +201,17 @@ class StubController:
         if self.mirrored:
             self.world.reset_pose(Pose2D(pose.x_m, -pose.y_m, -pose.yaw_rad))
 
+    def _side_from_gamecontroller(self, on_left: bool) -> None:
+        """The league's GameController puts the TeamInfo of the team playing on the left first:
+        a team on the right is placed at the mirror image of its team-file poses."""
+        self._side_check_s = None
+        self.mirrored = not on_left
+        logger.info("side from the GameController: %s", "right (mirrored pitch)" if self.mirrored
+                    else "left (as in the team file)")
+        if self.mirrored:
+            pose = self.world.pose
+            self.world.reset_pose(Pose2D(pose.x_m, -pose.y_m, -pose.yaw_rad))
+
     def _moved_by_someone_else(self, joints: dict[str, float]) -> bool:
         knees = [name for name in self.kin.motor_names if name.startswith("LegLower")]
         return any(
@@ -249,6 +269,8 @@ class StubController:
             if self._missing_since_ms is None
             else (sensors.time_ms - self._missing_since_ms) / 1000.0
         )
+        if self._side_check_s is not None and game.on_left is not None:
+            self._side_from_gamecontroller(game.on_left)
         if self._side_check_s is not None and not game.penalised:
             if sensors.time_ms >= self._settle_until_ms:
                 return self._remember(self._side_check(dt, sensors))

@@ -76,6 +76,7 @@ class GameControllerLink:
             penalised=bool(penalty),
             our_kick_off=team is not None and data.kick_off_team == team,
             first_half=data.first_half,
+            on_left=None if team is None else data.teams[0].team_number == team,
             ball_free_in_s=float(max(data.secondary_time, 0))
             if data.state is GameState.PLAYING
             else 0.0,

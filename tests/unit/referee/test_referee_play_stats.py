@@ -72,14 +72,16 @@ def test_walking_the_ball_along_is_not_a_kick_and_nothing_counts_outside_playing
 
 def test_falls_count_once_per_fall_and_halves_reaching_playing() -> None:
     tracker = PlayTracker()
-    states = [False, True, True, False, True]
-    for i, fallen in enumerate(states):
-        tracker.observe(snapshot(i * 8, (robot(BLUE, 2, 1.0, 0.0, fallen=fallen),)),
-                        _view(half=1 if i < 3 else 2))
+    # down, a flicker while getting up (the same fall), up for 1.5 s, down again
+    states = [(0, False), (8, True), (16, True), (24, False), (32, True), (40, False),
+              (1540, False), (1548, True)]
+    for ms, fallen in states:
+        tracker.observe(snapshot(ms, (robot(BLUE, 2, 1.0, 0.0, fallen=fallen),)),
+                        _view(half=1 if ms < 100 else 2))
     stats = tracker.stats([])
     assert stats.falls == {RED: 0, BLUE: 2}
     assert stats.halves_playing == (1, 2) and stats.to_json()["both_halves_playing"] is True
-    assert stats.playing_s == pytest.approx(0.032)
+    assert stats.playing_s == pytest.approx(1.548)
 
 
 def test_goals_and_own_goals_from_the_goal_events() -> None:
