@@ -36,7 +36,7 @@ def test_side_from_the_gamecontroller_team_order(on_left: bool) -> None:
     team_file_pose = Pose2D(-0.8, -3.1, math.pi / 2)
     controller = StubController(role=Role.STRIKER, start_pose=team_file_pose, detect_side=True)
     robot = OneRobot(x_m=-0.8 if on_left else 0.8, y_m=-3.1, yaw_rad=math.pi / 2)
-    game = GameInfo(phase=Phase.INITIAL, on_left=on_left)
+    game = GameInfo(phase=GameState.INITIAL, on_left=on_left)
     robot.command(controller.tick(robot.sensors(), game))
     assert controller.mirrored is (not on_left)
     pose = controller.world.pose
