@@ -87,6 +87,14 @@ class CatalogResolver:
 
     def replay(self, replay_id: str) -> ReplaySource:
         source = self.catalog.replays.get(replay_id)
+        live = self.catalog.live.get(replay_id)
+        if source is None and live is not None and live.replay_path is not None:
+            # a match watched live: its replay once written (the public copy when collected)
+            folder = live.replay_path.parents[2]
+            for path in (folder / "public" / "replay.hlvsrec", live.replay_path):
+                if path.is_file():
+                    source = self.catalog.add_replay(path, id=replay_id)
+                    break
         if source is None:
             raise _missing("replay", replay_id, list(self.catalog.replays))
         return source

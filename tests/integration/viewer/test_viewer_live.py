@@ -59,15 +59,19 @@ def test_live_view_follows_a_running_scrimmage_and_its_replay_plays(
                 f"hlvsLive.updates > {first[0] + 10} && hlvsLive.simTimeMs > {first[1] + 1000}",
                 timeout=120_000,
             )
-            page.wait_for_selector("[data-testid=health] tr[data-robot='red-1'].up")
+            page.wait_for_function(  # both robots connected (they start within seconds)
+                "document.querySelectorAll('[data-testid=health] tr.up').length === 2",
+                timeout=60_000,
+            )
             health = page.locator("[data-testid=health] tr[data-robot]").evaluate_all(
                 "rows => rows.map(r => [r.dataset.robot, r.cells[1].innerText])"
             )
             assert sorted(health) == [["blue-1", "connected"], ["red-1", "connected"]]
             assert "real-time factor" in page.locator("[data-testid=live-status]").inner_text()
             screenshot(page, "live-scrimmage")
-        output, _ = scrimmage.communicate(timeout=300)
-        assert scrimmage.returncode == 0, output[-3000:]
+            output, _ = scrimmage.communicate(timeout=300)
+            assert scrimmage.returncode == 0, output[-3000:]
+            page.locator("[data-testid=replay-link]").wait_for(timeout=30_000)
     finally:
         if scrimmage.poll() is None:
             scrimmage.kill()

@@ -136,3 +136,16 @@ def test_the_live_stream_relays_telemetry_as_server_sent_events(tmp_path: Path) 
 
     raw = base64.b64decode(events[2][1])
     assert struct.unpack_from("<I", raw)[0] == 1234 and len(raw) == 4 + 14 * 4
+
+
+def test_hlvs_view_names_a_path_without_a_replay(tmp_path: Path) -> None:
+    import subprocess
+    import sys
+
+    done = subprocess.run(
+        [sys.executable, "-m", "orchestrator", "view", str(tmp_path / "nowhere")],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert done.returncode == 2
+    assert f"{tmp_path / 'nowhere'}: no such file or folder" in done.stderr
+    assert "Traceback" not in done.stderr and done.stdout == ""

@@ -2,7 +2,7 @@
 // from the viewer API), the real-time factor and each robot's connection health.
 import type { GameState, RefereeEvent } from "../replay";
 import { SceneView, type SceneSpec } from "../scene";
-import { Scoreboard, authHeaders, clock, describeEvent, el } from "../ui";
+import { Scoreboard, authFetch, authHeaders, clock, describeEvent, el } from "../ui";
 
 type Handler = (data: string) => void;
 
@@ -108,6 +108,21 @@ export function livePage(root: HTMLElement, api: string, matchId: string): void 
   readEvents(`${api}/live/${encodeURIComponent(matchId)}/stream`, handlers, status).catch((error) => {
     status.textContent += `  (stream lost: ${error})`;
   });
+  // When the telemetry falls silent, the match is over (or stopped): offer its replay.
+  let heardAt = performance.now();
+  let offered = false;
+  const heard = (handler: Handler): Handler => (data) => { heardAt = performance.now(); handler(data); };
+  for (const name of ["state", "poses"]) handlers[name] = heard(handlers[name]);
+  const watchdog = window.setInterval(async () => {
+    if (offered || updates === 0 || performance.now() - heardAt < 6000) return;
+    const replay = `${api}/replays/${encodeURIComponent(matchId)}/meta`;
+    const answer = await authFetch(replay).catch(() => null); // the server may be gone too
+    if (answer?.ok) {
+      offered = true;
+      window.clearInterval(watchdog);
+      status.append("  the match is over: ", el("a", { href: `/watch/replay/${encodeURIComponent(matchId)}`, "data-testid": "replay-link" }, "watch the replay"));
+    }
+  }, 2000);
   function frame(): void {
     view?.render();
     requestAnimationFrame(frame);
