@@ -42,6 +42,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="dockerCmd of every robot (default: goalie / striker for the stub)")
     parser.add_argument("--match-id", default=None,
                         help="match id (default: scrimmage-<random>)")
+    parser.add_argument("--stepping", choices=("lockstep", "pipelined", "async"),
+                        default="lockstep",
+                        help="lockstep (default): each step waits for the robots; pipelined: "
+                        "they think while the next step runs (one step more latency); async: "
+                        "the simulation never waits (HLVS)")
     parser.add_argument("--seed", type=int, default=42,
                         help="seed of the simulation and the referee (default 42)")
     parser.add_argument("--stub", action="store_true",

@@ -84,7 +84,7 @@ def game_file(args: argparse.Namespace, match_id: str) -> dict[str, Any]:
         "kickoff": "red",
         "match_id": match_id,
         "seed": args.seed,
-        "stepping": "lockstep",
+        "stepping": getattr(args, "stepping", "lockstep"),
         "lockstep_deadline_ms": 200,
         "lockstep_time_bank_ms": 10000,
         "red": {"id": 1, "config": "team_red.json", "hosts": ["127.0.0.1"],

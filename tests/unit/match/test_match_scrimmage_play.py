@@ -41,6 +41,12 @@ def test_default_scrimmage_is_a_short_game_with_a_short_ready(tmp_path: Path) ->
     assert loaded.timing.ready_duration_s == 20.0 and loaded.timing.half_duration_s == 65.0
 
 
+def test_scrimmage_stepping_can_be_pipelined(tmp_path: Path) -> None:
+    game, _red = _scrimmage(tmp_path, "--stepping", "pipelined")
+    assert game["stepping"] == "pipelined"
+    assert load_game(tmp_path / "game.json").game.stepping == "pipelined"
+
+
 def test_larger_scrimmage_teams_add_a_goalie_then_defenders(tmp_path: Path) -> None:
     _game, red = _scrimmage(tmp_path, "--players", "4")
     roles = [p["dockerCmd"].split()[0] for p in red["players"].values()]
