@@ -18,10 +18,11 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
+from orchestrator.commands.scrimmage_args import add_arguments
 from orchestrator.config.loader import load_game
 from orchestrator.errors import OrchestratorError
 from orchestrator.match import HostControl, MatchRunner, RunOptions, cleanup, plan_from_game
-from orchestrator.match.scrimmage import add_arguments, write_files
+from orchestrator.match.scrimmage import write_files
 from orchestrator.paths import user_path
 
 log = logging.getLogger(__name__)

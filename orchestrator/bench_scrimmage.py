@@ -27,10 +27,11 @@ from typing import Any
 from contracts.codec import from_data
 from contracts.errors import ContractError
 from contracts.sim_result import PlayRecord
+from orchestrator.commands.scrimmage_args import add_arguments
 from orchestrator.config.loader import load_game
 from orchestrator.errors import OrchestratorError
 from orchestrator.match import HostControl, MatchRunner, RunOptions, cleanup, plan_from_game
-from orchestrator.match.scrimmage import add_arguments, write_files
+from orchestrator.match.scrimmage import write_files
 
 log = logging.getLogger(__name__)
 

@@ -11,13 +11,27 @@ are the scrimmage's own; official matches keep the rules' timings (45 s READY, 1
 
 from __future__ import annotations
 
-import argparse
 import json
 import uuid
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
-from orchestrator.commands.scrimmage_args import add_arguments
+
+class ScrimmageOptions(Protocol):
+    """What the generated files depend on: ``hlvs scrimmage``'s parsed options
+    (:mod:`orchestrator.commands.scrimmage_args`) or any object with these attributes;
+    ``ready_duration``, ``red_model`` and ``blue_model`` are read when present."""
+
+    players: int
+    seed: int
+    half_duration: float
+    wait_before_ready: float
+    grace: float
+    red_image: str | None
+    blue_image: str | None
+    match_id: str | None
+    robot_command: str | None
+
 
 # Starting poses as if playing on the left (x < 0), on the own touch line facing the field;
 # the striker starts near the halfway line, so that it reaches its kick-off spot within the
@@ -73,8 +87,9 @@ def team_file(name: str, image: str, players: int, *, command: str | None = None
     return {"name": name, "image": repository or image, "players": entries}
 
 
-def game_file(args: argparse.Namespace, match_id: str) -> dict[str, Any]:
+def game_file(args: ScrimmageOptions, match_id: str) -> dict[str, Any]:
     players = args.players
+    ready = getattr(args, "ready_duration", None)
     return {
         "type": "NORMAL",
         "class": "KID",
@@ -94,8 +109,7 @@ def game_file(args: argparse.Namespace, match_id: str) -> dict[str, Any]:
         "timing": {
             "half_duration_s": args.half_duration,
             # a shorter READY only where the caller asks for one (hlvs scrimmage does)
-            **({"ready_duration_s": args.ready_duration}
-               if getattr(args, "ready_duration", None) is not None else {}),
+            **({"ready_duration_s": ready} if ready is not None else {}),
             "wait_before_first_ready_s": args.wait_before_ready,
             "half_time_break_s": 1,
             "grace_period_s": args.grace,
@@ -104,7 +118,7 @@ def game_file(args: argparse.Namespace, match_id: str) -> dict[str, Any]:
     }
 
 
-def write_files(args: argparse.Namespace, folder: Path, *, stub_image: str | None = None
+def write_files(args: ScrimmageOptions, folder: Path, *, stub_image: str | None = None
                 ) -> Path:
     """Write game.json and the two team files into ``folder``; returns the game.json path."""
     if args.red_image is None or args.blue_image is None:
@@ -131,4 +145,4 @@ def write_files(args: argparse.Namespace, folder: Path, *, stub_image: str | Non
     return folder / "game.json"
 
 
-__all__ = ["add_arguments", "game_file", "team_file", "write_files"]
+__all__ = ["ScrimmageOptions", "game_file", "team_file", "write_files"]

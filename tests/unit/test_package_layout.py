@@ -102,3 +102,13 @@ def test_the_match_phases_form_no_import_circle() -> None:
 def test_no_package_has_an_import_circle() -> None:
     found = {package: import_cycles(package)[:1] for package in (*PRODUCTION, "testkit")}
     assert {package: cycle for package, cycle in found.items() if cycle} == {}
+
+
+def test_the_match_domain_does_not_import_the_command_line() -> None:
+    found = []
+    for path in sorted((ROOT / "orchestrator" / "match").rglob("*.py")):
+        modules = module_level_imports(path, ROOT)
+        if any(m.startswith("orchestrator.commands") or m == "argparse" for m in modules):
+            found.append(str(path.relative_to(ROOT)))
+    assert (ROOT / "orchestrator" / "match" / "scrimmage.py").is_file()
+    assert found == []

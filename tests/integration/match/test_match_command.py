@@ -11,9 +11,10 @@ from typing import Any
 import pytest
 
 from orchestrator.cli import main as hlvs
+from orchestrator.commands.scrimmage_args import add_arguments
 from orchestrator.errors import OrchestratorError
 from orchestrator.match.logfs import state_dir
-from orchestrator.match.scrimmage import add_arguments, write_files
+from orchestrator.match.scrimmage import write_files
 
 pytestmark = [pytest.mark.docker, pytest.mark.root]
 

@@ -12,9 +12,10 @@ import pytest
 
 from contracts.errors import ContractError
 from contracts.sim_result import SimResult
+from orchestrator.commands.scrimmage_args import add_arguments
 from orchestrator.config.loader import load_game
 from orchestrator.match.results import build_results
-from orchestrator.match.scrimmage import add_arguments, write_files
+from orchestrator.match.scrimmage import write_files
 
 PLAY = {
     "halves_playing": [1, 2], "both_halves_playing": True, "playing_s": 73.4,
