@@ -85,9 +85,14 @@ class MotorBank:
             if not finite.all():
                 logger.debug("ignored non-finite positions for actuators %s", chosen[~finite])
             actuators, rads = chosen[finite], values[finite]
-        self.target[actuators] = np.minimum(
-            np.maximum(rads, self.lower[actuators]), self.upper[actuators]
-        )
+        if type(actuators) is slice:  # the usual request: clamped straight into the view
+            values = np.array(rads, dtype=np.float64)
+            np.maximum(values, self.lower[actuators], out=values)
+            np.minimum(values, self.upper[actuators], out=self.target[actuators])
+        else:
+            self.target[actuators] = np.minimum(
+                np.maximum(rads, self.lower[actuators]), self.upper[actuators]
+            )
         self._ramping = True
         if self._any_torque and self.torque_mode[actuators].any():
             self.torque_mode[actuators] = False
