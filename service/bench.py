@@ -116,7 +116,8 @@ async def _load(url: str, args: argparse.Namespace, tokens: list[str], operator:
                 team_doc: dict[str, Any]) -> dict[str, Any]:
     import httpx
 
-    limits = httpx.Limits(max_connections=args.pollers + args.submitters + 10)
+    limits = httpx.Limits(max_connections=args.pollers + args.submitters + 10,
+                          keepalive_expiry=10.0)  # below the server's keep-alive (30 s)
     async with httpx.AsyncClient(base_url=url, timeout=10.0, limits=limits) as http:
         def auth(token: str) -> dict[str, str]:
             return {"Authorization": f"Bearer {token}"}

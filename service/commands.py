@@ -132,8 +132,10 @@ def run_serve(args: argparse.Namespace) -> int:
 
     from service.app import create_app
 
-    app = create_app(_settings(args), start_worker=not args.no_worker)
-    uvicorn.run(app, host=args.host, port=args.port, log_level="info", access_log=False)
+    settings = _settings(args)
+    app = create_app(settings, start_worker=not args.no_worker)
+    uvicorn.run(app, host=args.host, port=args.port, log_level="info", access_log=False,
+                timeout_keep_alive=int(settings.keep_alive_s))
     return 0
 
 

@@ -27,6 +27,9 @@ class Settings:
     """SQLAlchemy URL; empty: ``sqlite:///<data_dir>/service.sqlite``. PostgreSQL:
     ``postgresql+psycopg://user:password@host/db``."""
     max_upload_bytes: int = 1_000_000
+    keep_alive_s: float = 30.0
+    """Idle HTTP connections stay open this long (pollers reuse theirs; a short value races
+    with clients that send just as the server closes)."""
     threads: int = 8
     """Threads that run request handlers (database work); more mostly contend for the GIL."""
     token_cache_s: float = 5.0
