@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from contracts.field import FieldClass, FieldGeometry, field_for
 from contracts.geometry import Pose
 from contracts.ids import RobotId, TeamColor
-from contracts.match_spec import GameType
+from contracts.match_spec import GameType, TimingSpec
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -41,18 +41,11 @@ class RefereeTeam:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
-class TimingConfig:
-    """``*_real_s`` are wall-clock waits; everything else is simulated time."""
+class TimingConfig(TimingSpec):
+    """The match spec's timing plus the rule book's own durations. ``*_real_s`` are wall-clock
+    waits; everything else is simulated time."""
 
-    half_duration_s: float = 600.0
-    overtime_half_duration_s: float = 300.0
-    ready_duration_s: float = 45.0
-    set_to_play_s: float = 5.0
     shootout_set_to_play_s: float = 15.0
-    wait_before_first_ready_real_s: float = 120.0
-    half_time_break_real_s: float = 15.0
-    removal_penalty_s: float = 10.0
-    end_of_game_real_s: float = 5.0
     kickoff_blocked_s: float = 10.0  # ball in play after this or a 5 cm move
     set_play_phase0_s: float = 5.0  # robots still, ball placed
     set_play_ready_s: float = 15.0  # phase 1: robots position (penalty kick: twice this)
