@@ -77,7 +77,10 @@ class DockerRuntime:
                 for m in request.mounts
             }
             or None,
-            "nano_cpus": request.nano_cpus,
+            "nano_cpus": request.nano_cpus if request.cpu_period_us is None else None,
+            "cpu_period": request.cpu_period_us if request.nano_cpus is not None else None,
+            "cpu_quota": int(request.nano_cpus * request.cpu_period_us / 1e9)
+            if request.nano_cpus is not None and request.cpu_period_us is not None else None,
             "mem_limit": request.mem_bytes,
             "memswap_limit": request.mem_bytes,
             "pids_limit": request.pids_limit,

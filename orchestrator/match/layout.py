@@ -46,6 +46,10 @@ LOGS_TARGET = "/robocup-logs"
 SCRATCH_DIRS = {"tmp": "/tmp", "var-tmp": "/var/tmp", "root": "/root"}
 SCRATCH_FALLBACK_TMPFS_BYTES = 256 * 1024 * 1024  # per folder, when no capped space can be made
 RUN_TMPFS = "size=16m,mode=755"
+# A robot's CPU limit is enforced over 10 ms periods (Docker's default is 100 ms): a robot that
+# burns its share is held back in short slices, so the robots it shares CPUs with wait
+# milliseconds, not tens of milliseconds, when they need a CPU.
+ROBOT_CPU_PERIOD_US = 10_000
 MATCH_TARGET = files.CONTAINER_MATCH_DIR
 SIMULATOR_COMMAND = (
     "python3", "-m", "simulator", "run",
@@ -177,6 +181,7 @@ def robot_request(
         read_only=True,
         tmpfs=tmpfs,
         nano_cpus=int(limits.cpus * 1e9),
+        cpu_period_us=ROBOT_CPU_PERIOD_US,
         mem_bytes=int(limits.memory_gb * 1e9),
         pids_limit=limits.pids,
         cap_drop=("ALL",),

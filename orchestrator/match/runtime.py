@@ -96,6 +96,7 @@ class ContainerRequest:
     working_dir: str | None = None
     read_only: bool = False  # read-only root file system
     cpu_shares: int | None = None  # CFS weight (Docker's default 1024)
+    cpu_period_us: int | None = None  # CFS period for nano_cpus (Docker's default 100 ms)
     cpuset_cpus: str | None = None  # e.g. "1-3": the CPUs it may run on
     tmpfs: Mapping[str, str] = field(default_factory=dict)  # path -> mount options ("size=16m")
 

@@ -57,7 +57,8 @@ def test_limits_are_visible_in_docker_inspect(
     assert outcome.ok
     assert len(seen) == 2
     for host_config in seen.values():
-        assert host_config["NanoCpus"] == 1_500_000_000
+        # 1.5 CPUs, enforced over 10 ms periods
+        assert (host_config["CpuQuota"], host_config["CpuPeriod"]) == (15_000, 10_000)
         assert host_config["Memory"] == 250_000_000
         assert host_config["MemorySwap"] == 250_000_000
         assert host_config["PidsLimit"] == 64

@@ -94,6 +94,7 @@ def test_robot_requests_carry_environment_limits_and_no_privileges(tmp_path: Pat
         "ROBOCUP_TEAM_PLAYER1_IP", "ROBOCUP_TEAM_PLAYER2_IP"}
     assert robot.command == ("start", "2")
     assert robot.nano_cpus == 2_000_000_000 and robot.mem_bytes == 1_000_000_000
+    assert robot.cpu_period_us == 10_000
     assert robot.cap_drop == ("ALL",) and robot.security_opt == ("no-new-privileges",)
     assert robot.network_mode is not None and robot.network_mode.startswith("container:")
     assert [m.target for m in robot.mounts] == ["/robocup-logs", "/tmp", "/var/tmp", "/root"]
