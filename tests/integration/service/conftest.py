@@ -23,17 +23,20 @@ def _postgres_url() -> str | None:
 
 
 @pytest.fixture(params=["sqlite", "postgresql"])
-def db_url(request: pytest.FixtureRequest, tmp_path: Path) -> str:
+def db_url(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[str]:
     if request.param == "sqlite":
-        return f"sqlite:///{tmp_path / 'service.sqlite'}"
+        yield f"sqlite:///{tmp_path / 'service.sqlite'}"
+        return
     url = _postgres_url()
     if url is None:
         if os.geteuid() == 0 and Path("/etc/debian_version").is_file():
             pytest.fail("no test PostgreSQL: run scripts/ensure-postgres.sh (make test does)")
         pytest.skip("PostgreSQL is set up only on Debian as root (scripts/ensure-postgres.sh)")
-    from tests.integration.service.postgres import fresh_database
+    from tests.integration.service.postgres import drop_database, fresh_database
 
-    return fresh_database(url)
+    database = fresh_database(url)
+    yield database
+    drop_database(database)
 
 
 @pytest.fixture

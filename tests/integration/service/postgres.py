@@ -33,3 +33,13 @@ def fresh_database(url: str) -> str:
     with psycopg.connect(plain, autocommit=True) as connection:
         connection.execute(f'CREATE DATABASE "{name}"')
     return f"{base}/{name}"
+
+
+def drop_database(url: str) -> None:
+    """Remove a database made by :func:`fresh_database` (connections to it are ended)."""
+    import psycopg
+
+    base, _, name = url.rpartition("/")
+    admin = (base + "/postgres").replace("postgresql+psycopg://", "postgresql://")
+    with psycopg.connect(admin, autocommit=True) as connection:
+        connection.execute(f'DROP DATABASE IF EXISTS "{name}" WITH (FORCE)')
