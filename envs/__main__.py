@@ -5,7 +5,7 @@ from __future__ import annotations
 import importlib
 import sys
 
-COMMANDS = {"bench": "envs.bench", "remote": "envs.remote_server"}
+COMMANDS = {"bench": "benchmarks.envs", "remote": "envs.remote_server"}
 USAGE = "usage: python -m envs {bench|remote} ..."
 
 

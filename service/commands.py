@@ -112,7 +112,7 @@ def register(sub: Any) -> None:
 
 
 def _bench(args: argparse.Namespace) -> int:
-    from service.bench import main as bench_main
+    from benchmarks.service import main as bench_main
 
     return int(bench_main(list(args.rest)))
 

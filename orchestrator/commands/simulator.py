@@ -88,7 +88,7 @@ def _hog(args: argparse.Namespace) -> int:
 
 
 def _scrimmage(args: argparse.Namespace) -> int:
-    from orchestrator.bench_scrimmage import main as scrimmage_main
+    from benchmarks.scrimmage import main as scrimmage_main
 
     return int(scrimmage_main(list(args.rest)))
 

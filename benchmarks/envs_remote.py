@@ -9,7 +9,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from envs.bench import _actions
+from benchmarks.envs import _actions
 from envs.remote import RemotePool
 from envs.vector import make_vector
 

@@ -97,7 +97,7 @@ def main(argv: list[str]) -> int:
     out: dict[str, Any] = {"bench": "envs", "env": "hlvs/Kick-v0", "seed": args.seed}
     out["inprocess"] = bench_inprocess(rounds=args.rounds, block=args.block, seed=args.seed)
     if args.remotes > 0:
-        from envs.bench_remote import bench_remotes
+        from benchmarks.envs_remote import bench_remotes
 
         sizes = [int(v) for v in args.vector.split(",") if v.strip()]
         out.update(bench_remotes(remotes=args.remotes, sizes=sizes, steps=args.remote_steps,
