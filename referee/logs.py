@@ -16,14 +16,15 @@ import logging
 from pathlib import Path
 from typing import TextIO
 
+from contracts import files
 from referee.clock import Clock
 from referee.snapshot import RefereeEvent
 
 logger = logging.getLogger(__name__)
 
-HUMAN_LOG = "referee.log"
-EVENTS_LOG = "referee_events.jsonl"
-GC_LOG = "gamecontroller.log"
+HUMAN_LOG = files.REFEREE_LOG
+EVENTS_LOG = files.REFEREE_EVENTS
+GC_LOG = files.GAMECONTROLLER_LOG
 
 
 def event_json(event: RefereeEvent) -> dict[str, object]:

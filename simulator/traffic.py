@@ -19,9 +19,10 @@ import json
 from pathlib import Path
 from typing import IO, Any, Protocol
 
+from contracts import files
 from simulator.api.stats import RobotStats
 
-STATS_FILE = "api_stats.jsonl"
+STATS_FILE = files.API_STATS
 SAMPLE_PERIOD_S = 1.0
 
 

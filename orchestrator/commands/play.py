@@ -22,6 +22,7 @@ from pathlib import Path
 from types import FrameType
 from typing import Any, TextIO
 
+from contracts import files
 from orchestrator.config.loader import load_game
 from orchestrator.errors import InfrastructureError, OrchestratorError
 from orchestrator.exitcodes import ExitCode
@@ -157,7 +158,7 @@ def _shown(path: Path) -> str:
 
 def watch_hint(out_dir: Path) -> list[str]:
     """Where to watch a played match: the viewer and the video command (empty: no replay)."""
-    replay = out_dir / "public" / "replay.hlvsrec"
+    replay = out_dir / "public" / files.REPLAY
     if not replay.is_file():
         return []
     return [

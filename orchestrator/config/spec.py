@@ -10,6 +10,7 @@ from __future__ import annotations
 import random
 from collections.abc import Mapping, Sequence
 
+from contracts import files
 from contracts.field import FieldClass
 from contracts.geometry import Pose
 from contracts.match_spec import (
@@ -23,7 +24,7 @@ from orchestrator.config.model import COLORS, Color, LoadedGame, StartingPose
 from orchestrator.config.robot_models import spec_model
 
 GOALKEEPER_NUMBER = 1  # HLVS: player 1 is the goalkeeper unless the robot declares otherwise
-VIDEO_FILE = "match.mp4"
+VIDEO_FILE = files.VIDEO
 
 
 def resolve_sides(loaded: LoadedGame) -> tuple[Color, Color]:

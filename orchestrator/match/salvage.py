@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from contracts import files
 from orchestrator.engine import LABEL_ROBOT, LABEL_ROLE, LABEL_TEAM
 from orchestrator.errors import OrchestratorError
 from orchestrator.match import logfs
@@ -24,9 +25,9 @@ log = logging.getLogger(__name__)
 
 STOP_TIMEOUT_S = 10.0
 PUBLIC_FILES = (
-    "sim_result.json", "replay.hlvsrec", "api_stats.jsonl", "referee.log",
-    "referee_events.jsonl", "gamecontroller.log", "bouncing_log.txt",
-)
+    files.SIM_RESULT, files.REPLAY, files.API_STATS, files.REFEREE_LOG, files.REFEREE_EVENTS,
+    files.GAMECONTROLLER_LOG, "bouncing_log.txt",
+)  # a salvaged match has no video
 
 
 @dataclass(slots=True)
@@ -72,7 +73,7 @@ def salvage(runtime: ContainerRuntime, record: RunRecord, objects: list[ProjectO
             report.errors.append(f"simulator: logs not saved: {exc}")
     public = out / "public"
     for name in PUBLIC_FILES:
-        source = out / "simulator" / "out" / name
+        source = out / "simulator" / files.OUT_DIR / name
         if source.is_file() and not source.is_symlink():
             public.mkdir(parents=True, exist_ok=True, mode=0o700)
             shutil.copyfile(source, public / name)
@@ -88,7 +89,7 @@ def salvage(runtime: ContainerRuntime, record: RunRecord, objects: list[ProjectO
     cause = (f"the orchestrator (pid {record.pid} on {record.hostname}) was gone; hlvs cleanup "
              "stopped the match and salvaged the teams' logs")
     failure = Failure(failure_class=FailureClass.INTERRUPTED, cause=cause)
-    if not (out / "results.json").is_file():
+    if not (out / files.RESULTS).is_file():
         write_results(out, {
             "match_id": record.match_id, "status": "failed",
             "failure": {"class": failure.failure_class.value, "cause": cause},

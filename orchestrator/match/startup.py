@@ -12,6 +12,7 @@ from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 
+from contracts import files
 from orchestrator.bandwidth import RobotShaping, mb_s_to_bit
 from orchestrator.errors import InfrastructureError, OrchestratorError
 from orchestrator.match import layout
@@ -70,7 +71,7 @@ def _start(match: MatchContext, started_at: float) -> None:
         folder.chmod(0o777)
     started.match_dir = match_dir
     spec = plan.spec_builder(addresses, endpoint)
-    (match_dir / "match_spec.json").write_text(json.dumps(spec, indent=2, sort_keys=True) + "\n")
+    (match_dir / files.MATCH_SPEC).write_text(json.dumps(spec, indent=2, sort_keys=True) + "\n")
 
     attachments = tuple(
         Attachment(
