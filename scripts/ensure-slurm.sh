@@ -99,6 +99,7 @@ CONF
   for n in $(seq 1 "$NODES"); do
     nodes+="NodeName=n$n NodeAddr=$NET.1$n CPUs=2 RealMemory=4000 Features=dense,sim,robot State=UNKNOWN"$'\n'
   done
+  before=$(cat "$DIR/slurm.conf" 2>/dev/null || true)
   cat >"$DIR/slurm.conf" <<CONF
 ClusterName=$CLUSTER
 SlurmctldHost=$(hostname)($CTL_IP)
@@ -106,6 +107,7 @@ SlurmctldAddr=$CTL_IP
 SlurmUser=root
 SlurmdUser=root
 AuthType=auth/munge
+AuthInfo=cred_expire=30
 StateSaveLocation=$DIR/state
 SlurmdSpoolDir=$DIR/spool/%n
 SlurmctldPidFile=$DIR/slurmctld.pid
@@ -136,6 +138,9 @@ MpiDefault=none
 $nodes
 PartitionName=matches Nodes=ALL Default=YES MaxTime=INFINITE State=UP OverSubscribe=EXCLUSIVE
 CONF
+  # cred_expire: a job requeued after a node failure may start again that many seconds later
+  # (Slurm's default, 120 s, is long for a match)
+  [ "$before" = "$(cat "$DIR/slurm.conf")" ] || CONF_CHANGED=1
 }
 
 up() {
@@ -147,6 +152,12 @@ up() {
   pgrep -x slurmdbd >/dev/null || slurmdbd  # reads slurmdbd.conf beside $SLURM_CONF
   for _ in $(seq 60); do sacctmgr -n show cluster >/dev/null 2>&1 && break; sleep 0.5; done
   sacctmgr -i add cluster "$CLUSTER" >/dev/null 2>&1 || true
+  if [ "${CONF_CHANGED:-0}" = 1 ] && running "slurmctld -f $DIR"; then
+    # a changed slurm.conf (AuthInfo among others) needs a controller restart; jobs survive it
+    scontrol shutdown slurmctld >/dev/null 2>&1 || true
+    for _ in $(seq 60); do running "slurmctld -f $DIR" || break; sleep 0.5; done
+    RECONFIGURE=1
+  fi
   running "slurmctld -f $DIR" || slurmctld -f "$SLURM_CONF"
   for n in $(seq 1 "$NODES"); do
     running "slurmd -f $SLURM_CONF -N n$n" || \
@@ -158,6 +169,7 @@ up() {
     scontrol update nodename="n[1-$NODES]" state=resume >/dev/null 2>&1 || true
     sleep 0.5
   done
+  if [ "${RECONFIGURE:-0}" = 1 ]; then scontrol reconfigure >/dev/null 2>&1 || true; fi
   echo "==> Slurm cluster '$CLUSTER' up: $(sinfo -h -o '%D nodes %t' | tr '\n' ' ')(SLURM_CONF=$SLURM_CONF)"
 }
 

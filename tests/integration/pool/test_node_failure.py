@@ -1,0 +1,163 @@
+"""A node dies mid-match: the test match is requeued by Slurm and played to its end on another
+node.
+
+What "the node died" means on this one-machine cluster: every node shares the host's kernel and
+Docker engine, so ``kill -9`` of a node's ``slurmd`` alone leaves the job's processes and the
+match's containers running (a dead VM would take them with it). The test therefore kills, as a
+dead node would, the node's ``slurmd`` (Slurm's own failure detection then marks the node DOWN
+after ``SlurmdTimeout`` and requeues the job), the job's processes on that node (its
+``slurmstepd`` and the ``hlvs match`` under it) and the match's containers. The requeued
+``hlvs match`` on another node finds the dead run's record, salvages and removes what it left,
+and plays the match from the start. The node is restarted and resumed afterwards."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import signal
+import subprocess
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from service.pool import JobState, MatchJob
+from service.pool.slurm import SlurmPool
+
+pytestmark = [pytest.mark.docker, pytest.mark.root, pytest.mark.slow]
+
+SLURM_DIR = Path("/var/lib/hlvs/slurm")
+
+
+def _job(tmp: Path, match_id: str) -> MatchJob:
+    from orchestrator.match.scrimmage import write_files
+    from orchestrator.project_images import project_image
+
+    args = argparse.Namespace(
+        red_image=None, blue_image=None, players=1, half_duration=6.0, ready_duration=1.0,
+        wait_before_ready=1.0, grace=2.0, robot_command=None, match_id=match_id, seed=7,
+    )
+    game = write_files(args, tmp / "config", stub_image=project_image("stub"))
+    return MatchJob(match_id=match_id, game_path=game, work_dir=tmp / "work", requeue=True)
+
+
+def _env(conf: str) -> dict[str, str]:
+    return {**os.environ, "SLURM_CONF": conf}
+
+
+def _show_job(conf: str, job_id: str) -> dict[str, str]:
+    text = subprocess.run(["scontrol", "show", "job", "-o", job_id], capture_output=True,
+                          text=True, env=_env(conf), check=False).stdout
+    return dict(f.split("=", 1) for f in text.split() if "=" in f)
+
+
+def _job_pids(job_id: str) -> list[int]:
+    """The job's processes on this machine: its slurmstepd and everything that carries the
+    job's id in its environment."""
+    pids = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            cmdline = (entry / "cmdline").read_bytes()
+            environ = (entry / "environ").read_bytes()
+        except OSError:
+            continue
+        if cmdline.startswith(f"slurmstepd: [{job_id}.".encode()) or \
+                f"SLURM_JOB_ID={job_id}\0".encode() in environ:
+            pids.append(int(entry.name))
+    return pids
+
+
+@pytest.fixture()
+def node_restarter(cluster: str) -> Iterator[list[str]]:
+    killed: list[str] = []
+    yield killed
+    for node in killed:  # bring the node back: slurmd in its namespace, then resume it
+        subprocess.run(["nsenter", f"--net=/run/netns/hlvs-{node}", "slurmd", "-f", cluster,
+                        "-N", node], env=_env(cluster), check=True, timeout=60)
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline:
+            subprocess.run(["scontrol", "update", f"nodename={node}", "state=resume"],
+                           env=_env(cluster), capture_output=True, check=False)
+            state = subprocess.run(["sinfo", "-h", "-n", node, "-o", "%T"], env=_env(cluster),
+                                   capture_output=True, text=True, check=False).stdout.strip()
+            if state in ("idle", "allocated", "mixed"):
+                break
+            time.sleep(2)
+        else:
+            pytest.fail(f"node {node} did not come back ({state})")
+
+
+def test_node_killed_mid_match_requeues_and_completes(
+    cluster: str, tmp_path: Path, node_restarter: list[str],
+) -> None:
+    import docker
+
+    pool = SlurmPool(slurm_conf=cluster, host_network=True)
+    match_id = f"slurm-fail-{os.getpid()}"
+    handle = pool.submit(_job(tmp_path, match_id))
+    job_id = pool.job_id(handle)
+    deadline = time.monotonic() + 120
+    client = docker.from_env()
+    while time.monotonic() < deadline:  # wait until the match is under way on its node
+        if pool.status(handle).state is JobState.RUNNING and client.containers.list(
+                filters={"label": f"org.hlvs-runner.match={match_id}"}):
+            break
+        time.sleep(1)
+    else:
+        pytest.fail(f"job {job_id} never ran its match: {pool.status(handle)}")
+    time.sleep(3)
+    node = _show_job(cluster, job_id)["NodeList"]
+
+    # the node dies: its slurmd, the job's processes on it and the match's containers
+    slurmd = int((SLURM_DIR / f"slurmd-{node}.pid").read_text())
+    os.kill(slurmd, signal.SIGKILL)
+    node_restarter.append(node)
+    for pid in _job_pids(job_id):
+        try:
+            os.kill(pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+    for container in client.containers.list(
+            filters={"label": f"org.hlvs-runner.match={match_id}"}):
+        container.kill()
+
+    deadline = time.monotonic() + 240  # SlurmdTimeout=10: DOWN in about 25 s, then requeued
+    while time.monotonic() < deadline:
+        if int(_show_job(cluster, job_id).get("Restarts", "0")) >= 1:
+            break
+        time.sleep(2)
+    else:
+        pytest.fail(f"job {job_id} was not requeued: {_show_job(cluster, job_id)}")
+    state = subprocess.run(["sinfo", "-h", "-n", node, "-o", "%T"], env=_env(cluster),
+                           capture_output=True, text=True, check=False).stdout.strip()
+    assert state.startswith("down"), state  # Slurm saw the node die
+
+    assert _wait_end(pool, handle, 600) is JobState.FINISHED
+    report = json.loads((pool.results_dir(handle) / "report.json").read_text())
+    assert report["status"] == "success", report
+    results = json.loads((pool.results_dir(handle) / "results.json").read_text())
+    assert results["final_state"] == "FINISHED"
+    second_node = _show_job(cluster, job_id).get("NodeList") or _sacct_node(cluster, job_id)
+    assert second_node != node  # played again on a live node
+    assert client.containers.list(all=True, filters={
+        "label": f"org.hlvs-runner.match={match_id}"}) == []  # nothing of either run is left
+
+
+def _sacct_node(conf: str, job_id: str) -> str:
+    return subprocess.run(["sacct", "-n", "-X", "-P", "-j", job_id, "-o", "NodeList"],
+                          capture_output=True, text=True, env=_env(conf),
+                          check=False).stdout.strip()
+
+
+def _wait_end(pool: SlurmPool, handle: str, timeout_s: float) -> JobState:
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        state = pool.status(handle).state
+        if state in (JobState.FINISHED, JobState.LOST):
+            return state
+        time.sleep(2)
+    raise AssertionError(f"{handle} did not end: {pool.status(handle)}")
