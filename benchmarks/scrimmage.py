@@ -77,6 +77,8 @@ def _parse(argv: Sequence[str]) -> argparse.Namespace:
                         help="robots per team (default: the scrimmage's default)")
     parser.add_argument("--keep", type=Path, default=None,
                         help="keep the match folders here (default: a temporary folder)")
+    parser.add_argument("--stepping", choices=("lockstep", "pipelined", "async"),
+                        default="lockstep", help="stepping of the scrimmages (default lockstep)")
     parser.add_argument("--json", action="store_true", help="print only the JSON document")
     args = parser.parse_args(list(argv))
     if args.matches < 1:
@@ -85,7 +87,7 @@ def _parse(argv: Sequence[str]) -> argparse.Namespace:
 
 
 def play_one(*, seed: int, out: Path, players: int | None,
-             stop: threading.Event | None = None) -> MatchFigures:
+             stop: threading.Event | None = None, stepping: str = "lockstep") -> MatchFigures:
     """One default scrimmage with ``seed`` played into ``out``; its figures. ``stop`` set:
     the match stops (and is collected) as on SIGINT."""
     from orchestrator.engine import connect
@@ -96,7 +98,7 @@ def play_one(*, seed: int, out: Path, players: int | None,
     scrim = argparse.ArgumentParser()
     add_arguments(scrim)
     match_id = f"bench-scrim-{int(time.time())}-{seed}"
-    argv = ["--seed", str(seed), "--match-id", match_id]
+    argv = ["--seed", str(seed), "--match-id", match_id, "--stepping", stepping]
     if players is not None:
         argv += ["--players", str(players)]
     args = scrim.parse_args(argv)
@@ -167,7 +169,7 @@ def summarize(matches: list[MatchFigures]) -> dict[str, Any]:
 
 
 def run(*, matches: int, seed: int, players: int | None, folder: Path,
-        quiet: bool) -> dict[str, Any]:
+        quiet: bool, stepping: str = "lockstep") -> dict[str, Any]:
     """Play the scrimmages; SIGINT / SIGTERM stop the one playing and skip the rest (the
     summary covers the matches played so far, the interrupted one included)."""
     from orchestrator.commands.play import stop_on_signals
@@ -176,7 +178,7 @@ def run(*, matches: int, seed: int, players: int | None, folder: Path,
     with stop_on_signals() as stop:
         for i in range(matches):
             figure = play_one(seed=seed + i, out=folder / f"match-{i + 1}", players=players,
-                              stop=stop)
+                              stop=stop, stepping=stepping)
             figures.append(figure)
             if not quiet:
                 print(json.dumps(figure.to_json()), file=sys.stderr)
@@ -184,6 +186,7 @@ def run(*, matches: int, seed: int, players: int | None, folder: Path,
                 break
     result = summarize(figures)
     result["interrupted"] = len(figures) < matches or stop.is_set()
+    result["stepping"] = stepping
     return result
 
 
@@ -192,11 +195,11 @@ def main(argv: Sequence[str]) -> int:
     try:
         if args.keep is not None:
             result = run(matches=args.matches, seed=args.seed, players=args.players,
-                         folder=args.keep, quiet=args.json)
+                         folder=args.keep, quiet=args.json, stepping=args.stepping)
         else:
             with tempfile.TemporaryDirectory(prefix="hlvs-bench-scrimmage-") as folder:
                 result = run(matches=args.matches, seed=args.seed, players=args.players,
-                             folder=Path(folder), quiet=args.json)
+                             folder=Path(folder), quiet=args.json, stepping=args.stepping)
     except OrchestratorError as exc:
         print(json.dumps({"bench": "scrimmage", "error": str(exc)}))
         return exc.exit_code
