@@ -37,6 +37,7 @@ MOTORS = (
     "FootR", "ShoulderR", "ArmUpperR", "ArmLowerR",
 )  # fmt: skip
 CYCLE_STEPS = 125  # pre-encoded requests of the bench clients: one second of targets
+INTERLEAVE_MS = 250  # simulated time per chunk of the API run and of the reference world
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -335,10 +336,28 @@ def _api_run(
             pipeline.waited_s = 0.0
         steps = int(args.sim_seconds * 1000 / world.step_ms)
         start_ms = world.sim_time_ms
-        started, started_cpu = time.perf_counter(), time.thread_time()
-        for _ in range(steps):
-            one_step()
-        wall, cpu = time.perf_counter() - started, time.thread_time() - started_cpu
+        # without cameras (whose render thread would run on), chunks of a reference world
+        # (World.step + snapshot, as bench sim) alternate with chunks of the API run, so that
+        # the machine's load falls on both alike: ``ratio_interleaved``
+        reference = _world(robots, args.physics_dt) if camera is None else None
+        chunk = max(1, INTERLEAVE_MS // world.step_ms)
+        wall = cpu = ref_wall = ref_cpu = 0.0
+        done = 0
+        while done < steps:
+            count = min(chunk, steps - done) if reference is not None else steps
+            started, started_cpu = time.perf_counter(), time.thread_time()
+            for _ in range(count):
+                one_step()
+            wall += time.perf_counter() - started
+            cpu += time.thread_time() - started_cpu
+            done += count
+            if reference is not None:
+                started, started_cpu = time.perf_counter(), time.thread_time()
+                for _ in range(count):
+                    reference.step()
+                    reference.snapshot()
+                ref_wall += time.perf_counter() - started
+                ref_cpu += time.thread_time() - started_cpu
         if pipeline is not None:
             waited[0] = pipeline.waited_s
         stats = server.statistics()
@@ -353,6 +372,8 @@ def _api_run(
         "real_time_factor": round((world.sim_time_ms - start_ms) / 1000.0 / wall, 3),
         "cpu_s_per_sim_s": cpu / ((world.sim_time_ms - start_ms) / 1000.0),
         "wait_share": round(waited[0] / wall, 3),
+        "ratio_interleaved": round(ref_wall / wall, 3) if ref_wall else None,
+        "cpu_ratio_interleaved": round(ref_cpu / cpu, 3) if ref_cpu else None,
         "connected": len(stats),
         "dropped_out": sum(s["dropped_out"] for s in stats.values()),
         "slow_periods": sum(s["slow_periods"] for s in stats.values()),
@@ -400,6 +421,9 @@ def main(argv: list[str]) -> int:
         "ratio": round(api["real_time_factor"] / world_rtf, 3),
         # load-independent: simulator-thread CPU per simulated second, world only vs with the API
         "cpu_ratio": round(world_cpu / api["cpu_s_per_sim_s"], 3),
+        # the same, with the world-only chunks interleaved with the API run's (no cameras)
+        "ratio_interleaved": api["ratio_interleaved"],
+        "cpu_ratio_interleaved": api["cpu_ratio_interleaved"],
         "bench_sim": _bench_sim(args.robots, args.physics_dt, min(args.sim_seconds, 5.0)),
         "round_trip_p50_ms": api["round_trip_p50_ms"],
         "camera_frames": api["camera_frames"],

@@ -27,6 +27,8 @@ def test_bench_api_lockstep_reports_every_figure(mode: str) -> None:
     assert result["bench"] == "api" and result["mode"] == mode
     wait_share = result["client_wait_share"]
     assert isinstance(wait_share, float) and 0 <= wait_share < 1
+    interleaved = result["ratio_interleaved"]
+    assert isinstance(interleaved, float) and interleaved > 0
     assert result["slow_periods"] == 0  # both clients answered every measurement
     for key in ("real_time_factor", "world_only_real_time_factor", "ratio", "cpu_ratio"):
         value = result[key]

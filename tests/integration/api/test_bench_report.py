@@ -27,7 +27,7 @@ def test_report_runs_the_kinds_and_judges_medians_against_targets() -> None:
     assert len(sim["runs"]) == 2 and len(pipelined["runs"]) == 2
     assert sim["target"] == {"figure": "ratio", "min": 0.95}
     assert sim["meets_target"] == (sim["median"]["ratio"] >= 0.95)
-    ratio = pipelined["median"]["ratio_to_bench_sim"]
+    ratio = pipelined["median"]["ratio_interleaved"]
     assert ratio > 0 and pipelined["meets_target"] == (ratio >= 0.9)
     assert 0 <= pipelined["median"]["client_wait_share"] < 1
 
