@@ -36,6 +36,7 @@ def view(*, paths: list[str], host: str, port: int) -> int:
     except OSError as exc:
         print(f"hlvs view: cannot listen on {host}:{port}: {exc}", file=sys.stderr)
         return 3
+    sock.listen(128)  # before the URLs are printed, so that opening one at once connects
     bound = sock.getsockname()[1]
     for page in pages:
         print(f"http://{host}:{bound}{page}", flush=True)
