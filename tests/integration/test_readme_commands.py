@@ -164,7 +164,10 @@ def scrimmage_played(ran: Ran, root: Path) -> None:
     out = root / "matches" / "scrimmage"
     assert json.loads((out / "report.json").read_text())["status"] == "success"
     results = json.loads((out / "results.json").read_text())
-    assert results["final_state"] == "FINISHED", results
+    assert results["status"] == "success" and results["final_state"] == "FINISHED", results
+    play = results["play"]  # the default scrimmage is football: both halves played, a kick
+    assert play["both_halves_playing"], play
+    assert sum(play["kicks"].values()) >= 1, play
     assert (out / "public" / "replay.hlvsrec").is_file()
     assert "hlvs render matches/scrimmage/public/replay.hlvsrec -o match.mp4" in ran.stdout
     assert "hlvs view matches/scrimmage" in ran.stdout
@@ -235,6 +238,7 @@ OUTCOMES: dict[str, Outcome] = {
     "hlvs check configs/examples/kid_4v4_official/game.json": Outcome(check_ok),
     "hlvs check --require-images configs/examples/kid_4v4_official/game.json": Outcome(check_ok),
     "hlvs check configs/examples/credentials/sftp_key.json": Outcome(check_ok),
+    "hlvs check configs/examples/robots/wolfgang": Outcome(check_ok),
     # images/README.md
     "hlvs compose configs/examples/scrimmage_1v1/game.json -o match/docker-compose.yml": Outcome(
         compose_written
