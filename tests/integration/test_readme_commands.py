@@ -203,6 +203,11 @@ def bench_json(ran: Ran, root: Path) -> None:
     assert document["bench"] == "envs", document
 
 
+def mcap_written(ran: Ran, root: Path) -> None:
+    exit_zero(ran, root)
+    assert (root / "match.mcap").read_bytes()[:8] == b"\x89MCAP0\r\n"
+
+
 def learnt_kick(ran: Ran, root: Path) -> None:
     exit_zero(ran, root)
     document = json.loads(ran.stdout.strip().splitlines()[0])
@@ -230,6 +235,9 @@ OUTCOMES: dict[str, Outcome] = {
                                            server=True),
     ".venv/bin/python examples/learn_kick.py --seed 1 --iterations 1 --population 3": Outcome(
         learnt_kick
+    ),
+    "hlvs export matches/scrimmage/public/replay.hlvsrec -o match.mcap": Outcome(
+        mcap_written, after=(SCRIMMAGE,)
     ),
     "hlvs bench envs --rounds 2 --block 200 --json": Outcome(bench_json),
     # configs/README.md
