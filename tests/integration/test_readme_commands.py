@@ -49,10 +49,11 @@ class Command:
 
     @property
     def key(self) -> str:
-        """The command without comments and with single spaces: what OUTCOMES is keyed by."""
+        """The command without comments, single spaces, shell quoting normalised (``'...'``):
+        what OUTCOMES is keyed by."""
         if self.language == "python":
             return self.text.strip()
-        return " ".join(shlex.split(self.text.replace("\\\n", " "), comments=True))
+        return shlex.join(shlex.split(self.text.replace("\\\n", " "), comments=True))
 
     @property
     def id(self) -> str:
@@ -214,6 +215,17 @@ def learnt_kick(ran: Ran, root: Path) -> None:
     assert document["example"] == "learn_kick" and document["episodes"] > 0, document
 
 
+def team_added(ran: Ran, root: Path) -> None:
+    exit_zero(ran, root)
+    assert json.loads(ran.stdout)["team"] == "Red Robots"
+    assert (root / "service-data").is_dir()
+
+
+def token_printed(ran: Ran, root: Path) -> None:
+    exit_zero(ran, root)
+    assert re.fullmatch(r"hlvs_[0-9a-f]+_\S+", ran.stdout.strip()), ran.describe()
+
+
 def compose_written(ran: Ran, root: Path) -> None:
     exit_zero(ran, root)
     written = root / "match" / "docker-compose.yml"
@@ -240,6 +252,11 @@ OUTCOMES: dict[str, Outcome] = {
         mcap_written, after=(SCRIMMAGE,)
     ),
     "hlvs bench envs --rounds 2 --block 200 --json": Outcome(bench_json),
+    "hlvs admin team add 'Red Robots' --email red@example.org": Outcome(team_added),
+    "hlvs admin token issue --team 'Red Robots' --days 90": Outcome(
+        token_printed, after=("hlvs admin team add 'Red Robots' --email red@example.org",)
+    ),
+    "hlvs admin token issue --operator": Outcome(token_printed),
     # configs/README.md
     "hlvs check configs/examples/kid_4v4_official/team_red.json": Outcome(check_ok),
     "hlvs check --class KID configs/examples/kid_4v4_official/team_red.json": Outcome(check_ok),
