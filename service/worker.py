@@ -145,7 +145,8 @@ class QueueWorker:
             work / "config", match_id=row.match_id, team=team_doc, opponent=opponent_doc,
             stub_image=None if opponent_doc else self._stub(), settings=self.settings,
             seed=zlib.crc32(row.match_id.encode()))
-        return MatchJob(match_id=row.match_id, game_path=game, work_dir=work)
+        # test matches: a cluster pool plays one again after a node failure
+        return MatchJob(match_id=row.match_id, game_path=game, work_dir=work, requeue=True)
 
     def _submit(self, session: Session, row: Submission, job: MatchJob) -> None:
         try:
@@ -171,7 +172,8 @@ class QueueWorker:
                 row.state = SubmissionState.QUEUED.value
                 return
             job = MatchJob(match_id=row.match_id, game_path=self._work_dir(row.match_id)
-                           / "config" / "game.json", work_dir=self._work_dir(row.match_id))
+                           / "config" / "game.json", work_dir=self._work_dir(row.match_id),
+                           requeue=True)
             if not job.game_path.is_file():
                 job = self._prepare(session, row)
             self._submit(session, row, job)

@@ -53,3 +53,28 @@ def test_exit_code_of_a_match_played_in_the_pool(
     (tmp_path / "results.json").write_text(json.dumps(results))
     assert summarize(read_outcome("m1", tmp_path), as_json=True) == code
     assert json.loads(capsys.readouterr().out)["exit_code"] == code
+
+
+def test_slurm_submission_requeues_test_matches_only(tmp_path: Path) -> None:
+    from service.pool import MatchJob
+    from service.pool.slurm import SlurmPool
+
+    calls: list[tuple[list[str], str | None]] = []
+
+    class Recording(SlurmPool):  # Slurm's commands recorded at the adapter's one boundary
+        def _run(self, args: list[str], *, handle: str, stdin: str | None = None,
+                 ok_codes: tuple[int, ...] = (0,)) -> str:
+            calls.append((args, stdin))
+            return "42\n" if args[0] == "sbatch" else ""
+
+    pool = Recording(out_subdir="")
+    game = tmp_path / "game.json"
+    for requeue, flag in ((True, "--requeue"), (False, "--no-requeue")):
+        work = tmp_path / flag
+        handle = pool.submit(MatchJob(match_id="m", game_path=game, work_dir=work,
+                                      requeue=requeue, match_args=("--grace", "3")))
+        args, script = calls[-1]
+        assert flag in args and "--exclusive" in args
+        assert script is not None and f"--out {work}" in script and "--grace 3" in script
+        assert pool.results_dir(handle) == work and pool.job_id(handle) == "42"
+        assert pool.recorded(work) == handle
