@@ -19,6 +19,8 @@ import time
 from pathlib import Path
 from typing import Any
 
+from orchestrator.paths import user_path
+
 EXAMPLE = Path(__file__).resolve().parents[1] / "configs" / "examples" / "robots" / "wolfgang"
 
 
@@ -57,7 +59,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--robots", type=int, default=8, help="robots per world (default 8)")
     parser.add_argument(
         "--model",
-        type=Path,
+        type=user_path,
         default=EXAMPLE,
         help="team robot model package (default: the Wolfgang example)",
     )

@@ -32,6 +32,7 @@ from orchestrator.config.loader import load_game
 from orchestrator.errors import OrchestratorError
 from orchestrator.match import HostControl, MatchRunner, RunOptions, cleanup, plan_from_game
 from orchestrator.match.scrimmage import write_files
+from orchestrator.paths import user_path
 
 log = logging.getLogger(__name__)
 
@@ -75,7 +76,7 @@ def _parse(argv: Sequence[str]) -> argparse.Namespace:
     parser.add_argument("--seed", type=int, default=1, help="seed of the first scrimmage")
     parser.add_argument("--players", type=int, default=None, choices=(1, 2, 3, 4),
                         help="robots per team (default: the scrimmage's default)")
-    parser.add_argument("--keep", type=Path, default=None,
+    parser.add_argument("--keep", type=user_path, default=None,
                         help="keep the match folders here (default: a temporary folder)")
     parser.add_argument("--stepping", choices=("lockstep", "pipelined", "async"),
                         default="lockstep", help="stepping of the scrimmages (default lockstep)")

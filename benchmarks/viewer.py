@@ -32,6 +32,8 @@ from typing import Any
 
 import numpy as np
 
+from orchestrator.paths import user_path
+
 HALF_S = 600
 RATE_HZ = 25.0
 CHROMIUM = "/usr/bin/chromium"
@@ -139,7 +141,7 @@ def measure(url: str, *, play_s: float, width: int, height: int, extra_args: lis
 def main(argv: list[str]) -> int:
     prog = f"{os.environ.get('HLVS_PROG', 'python -m benchmarks.viewer')} bench viewer"
     parser = argparse.ArgumentParser(prog=prog, description=__doc__.splitlines()[0])
-    parser.add_argument("--replay", type=Path, help="an existing replay (default: write one)")
+    parser.add_argument("--replay", type=user_path, help="an existing replay (default: write one)")
     parser.add_argument("--half-s", type=int, default=HALF_S, help="seconds per half (600)")
     parser.add_argument("--play-s", type=float, default=8.0, help="seconds of playback measured")
     parser.add_argument("--width", type=int, default=1300, help="browser window width")

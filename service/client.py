@@ -19,6 +19,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from orchestrator.paths import user_path
+
 DEFAULT_TOKEN_FILE = Path("~/.config/hlvs/token")
 FINAL_STATES = ("done", "failed", "cancelled")
 
@@ -26,9 +28,9 @@ FINAL_STATES = ("done", "failed", "cancelled")
 def register(sub: Any, guarded: Callable[[Any], Any]) -> None:
     submit = sub.add_parser("submit", help="ask the league's service for a test match")
     _common(submit)
-    submit.add_argument("--team-config", type=Path, default=None,
+    submit.add_argument("--team-config", type=user_path, default=None,
                         help="upload this team_config.json first (a new version)")
-    submit.add_argument("--credentials", type=Path, default=None,
+    submit.add_argument("--credentials", type=user_path, default=None,
                         help="upload this credentials.json (log delivery) first")
     submit.add_argument("--opponent", default="stub",
                         help="'stub' (default) or a team that accepts friendlies")
@@ -54,7 +56,7 @@ def register(sub: Any, guarded: Callable[[Any], Any]) -> None:
                                              "and the video of a test match")
     _common(results)
     results.add_argument("submission", help="submission id (sub_...)")
-    results.add_argument("-o", "--out", type=Path, default=None,
+    results.add_argument("-o", "--out", type=user_path, default=None,
                          help="folder to write into (default: ./<submission id>)")
     results.set_defaults(func=guarded(run_results))
 
@@ -66,7 +68,7 @@ def register(sub: Any, guarded: Callable[[Any], Any]) -> None:
                                                  "league's service (own team and public)")
         _common(fetch)
         fetch.add_argument("submission", help="submission id (sub_...)")
-        fetch.add_argument("-o", "--out", type=Path, default=None,
+        fetch.add_argument("-o", "--out", type=user_path, default=None,
                            help="folder to write into (default: ./<submission id>/logs)")
         fetch.set_defaults(func=guarded(run_logs))
 
@@ -74,7 +76,7 @@ def register(sub: Any, guarded: Callable[[Any], Any]) -> None:
 def _common(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--server", default=None,
                         help="the service's URL (default: $HLVS_SERVER)")
-    parser.add_argument("--token-file", type=Path, default=None,
+    parser.add_argument("--token-file", type=user_path, default=None,
                         help="file holding the team token (default: $HLVS_TOKEN, then "
                              "~/.config/hlvs/token)")
 

@@ -13,9 +13,9 @@ import json
 import logging
 import sys
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any
 
+from orchestrator.paths import user_path
 from service.errors import ServiceError
 from service.settings import Settings
 
@@ -45,7 +45,7 @@ def _settings(args: argparse.Namespace) -> Settings:
 
 
 def _add_db_options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--data-dir", type=Path, default=None,
+    parser.add_argument("--data-dir", type=user_path, default=None,
                         help="folder of the service's files (default: $HLVS_SERVICE_DATA_DIR "
                              "or ./service-data)")
     parser.add_argument("--database-url", default=None,

@@ -6,6 +6,8 @@ import argparse
 import logging
 from typing import Any
 
+from orchestrator.paths import user_path
+
 
 def register(sub: Any) -> None:
     view: argparse.ArgumentParser = sub.add_parser(
@@ -13,7 +15,7 @@ def register(sub: Any) -> None:
         help="serve the 3D replay viewer (and the live view of a running match) on 127.0.0.1",
     )
     view.add_argument(
-        "paths", nargs="+", metavar="MATCH_DIR|REPLAY",
+        "paths", nargs="+", type=user_path, metavar="MATCH_DIR|REPLAY",
         help="match folders (as hlvs match / scrimmage write them) or .hlvsrec replay files",
     )  # fmt: skip
     view.add_argument(
@@ -24,10 +26,11 @@ def register(sub: Any) -> None:
     export: argparse.ArgumentParser = sub.add_parser(
         "export", help="export a replay to MCAP (Foxglove schemas, simulated time)"
     )
-    export.add_argument("replay", metavar="REPLAY", help="the .hlvsrec replay file")
-    export.add_argument("-o", "--output", required=True, help="MCAP file to write")
+    export.add_argument("replay", type=user_path, metavar="REPLAY", help="the .hlvsrec replay file")
+    export.add_argument("-o", "--output", type=user_path, required=True, help="MCAP file to write")
     export.add_argument(
-        "--stats", help="api_stats.jsonl to include (default: the one beside the replay)"
+        "--stats", type=user_path,
+        help="api_stats.jsonl to include (default: the one beside the replay)",
     )
     export.set_defaults(func=_export)
 
@@ -35,10 +38,13 @@ def register(sub: Any) -> None:
 def _view(args: argparse.Namespace) -> int:
     from viewer.cli import view
 
-    return view(paths=args.paths, host=args.host, port=args.port)
+    return view(paths=[str(p) for p in args.paths], host=args.host, port=args.port)
 
 
 def _export(args: argparse.Namespace) -> int:
     from viewer.cli import export
 
-    return export(replay=args.replay, output=args.output, stats=args.stats)
+    return export(
+        replay=str(args.replay), output=str(args.output),
+        stats=str(args.stats) if args.stats else None,
+    )

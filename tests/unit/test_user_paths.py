@@ -30,6 +30,14 @@ COMMAND_LINES = {
     "schedule status": (["schedule", "status", "--state", "s.sqlite"], ["state"]),
     "schedule cancel": (["schedule", "cancel", "m1", "--state", "s.sqlite"], ["state"]),
     "schedule standings": (["schedule", "standings", "--state", "s.sqlite"], ["state"]),
+    "submit": (["submit", "--team-config", "t.json", "--credentials", "c.json",
+                "--token-file", "tok"], ["team_config", "credentials", "token_file"]),
+    "results": (["results", "sub_1", "-o", "runs"], ["out"]),
+    "logs fetch": (["logs", "fetch", "sub_1", "-o", "runs/logs"], ["out"]),
+    "serve": (["serve", "--data-dir", "data"], ["data_dir"]),
+    "view": (["view", "matches/scrimmage", "r.hlvsrec"], ["paths"]),
+    "export": (["export", "r.hlvsrec", "-o", "m.mcap", "--stats", "s.jsonl"],
+               ["replay", "output", "stats"]),
 }
 
 
