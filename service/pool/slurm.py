@@ -94,11 +94,7 @@ class SlurmPool:
             return self._handle(previous, work)
         out = work / self.out_subdir if self.out_subdir else work
         out.mkdir(parents=True, exist_ok=True)
-        command = [self.python, "-m", "orchestrator", *self.extra_args, "match",
-                   str(job.game_path.resolve()), "--out", str(out), *job.match_args]
-        if self.host_network:
-            command = ["nsenter", f"--net={HOST_NETNS}", *command]
-        script = "#!/bin/sh\nexec " + " ".join(shlex.quote(c) for c in command) + "\n"
+        script = self._script(job, out)
         args = ["sbatch", "--parsable", "--exclusive", "-N1", f"--job-name=hlvs-{job.match_id}",
                 f"--chdir={work}", f"--output={work / LOG_FILE}", "--open-mode=append",
                 "--requeue" if job.requeue else "--no-requeue"]
@@ -120,6 +116,36 @@ class SlurmPool:
         log.info("match %s submitted to Slurm as job %s (account %s)", job.match_id, job_id,
                  account or "default")
         return self._handle(job_id, work)
+
+    def _script(self, job: MatchJob, out: Path) -> str:
+        """The batch script. A requeued run (``SLURM_RESTART_COUNT`` > 0) first salvages what
+        the dead run left (``hlvs cleanup --match``: logs into the output folder, containers
+        and networks removed) and moves that attempt's files to ``attempt-<n>/``, then plays
+        the match from the start."""
+        prefix = ["nsenter", f"--net={HOST_NETNS}"] if self.host_network else []
+        hlvs = [*prefix, self.python, "-m", "orchestrator", *self.extra_args]
+        play = [*hlvs, "match", str(job.game_path.resolve()), "--out", str(out),
+                *job.match_args]
+        keep = ["slurm.json", "slurm-*.out", "config", "attempt-*"]
+        game = job.game_path.resolve()
+        if game.is_relative_to(out) and game != out:
+            keep.append(game.relative_to(out).parts[0])
+        q = shlex.quote
+        return "\n".join([
+            "#!/bin/sh",
+            'if [ "${SLURM_RESTART_COUNT:-0}" -gt 0 ]; then',
+            f"  {' '.join(q(c) for c in hlvs)} cleanup --match {q(job.match_id)}",
+            f'  attempt={q(str(out))}/attempt-"$SLURM_RESTART_COUNT"',
+            '  mkdir -p "$attempt"',
+            f"  for f in {q(str(out))}/*; do",
+            f'    case "${{f##*/}}" in {"|".join(q(k) if "*" not in k else k for k in keep)}) ;;',
+            '      *) mv "$f" "$attempt"/ ;;',
+            "    esac",
+            "  done",
+            "fi",
+            "exec " + " ".join(q(c) for c in play),
+            "",
+        ])
 
     def status(self, handle: str) -> JobStatus:
         job_id, work = self._parse(handle)

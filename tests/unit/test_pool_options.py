@@ -78,3 +78,4 @@ def test_slurm_submission_requeues_test_matches_only(tmp_path: Path) -> None:
         assert script is not None and f"--out {work}" in script and "--grace 3" in script
         assert pool.results_dir(handle) == work and pool.job_id(handle) == "42"
         assert pool.recorded(work) == handle
+        assert "cleanup --match m" in script  # a requeued run salvages the dead one first

@@ -6,9 +6,10 @@ Docker engine, so ``kill -9`` of a node's ``slurmd`` alone leaves the job's proc
 match's containers running (a dead VM would take them with it). The test therefore kills, as a
 dead node would, the node's ``slurmd`` (Slurm's own failure detection then marks the node DOWN
 after ``SlurmdTimeout`` and requeues the job), the job's processes on that node (its
-``slurmstepd`` and the ``hlvs match`` under it) and the match's containers. The requeued
-``hlvs match`` on another node finds the dead run's record, salvages and removes what it left,
-and plays the match from the start. The node is restarted and resumed afterwards."""
+``slurmstepd`` and the ``hlvs match`` under it) and the match's containers. The requeued job
+on another node salvages what the dead run left (``hlvs cleanup --match``), keeps that
+attempt's files in ``attempt-1/`` and plays the match from the start. The node is restarted
+and resumed afterwards."""
 
 from __future__ import annotations
 
@@ -143,6 +144,10 @@ def test_node_killed_mid_match_requeues_and_completes(
     assert results["final_state"] == "FINISHED"
     second_node = _show_job(cluster, job_id).get("NodeList") or _sacct_node(cluster, job_id)
     assert second_node != node  # played again on a live node
+    first = pool.results_dir(handle) / "attempt-1"  # the dead run's salvaged files, kept
+    salvaged = json.loads((first / "report.json").read_text())
+    assert salvaged.get("failure_class") == "interrupted", salvaged
+    assert sorted(p.name for p in first.iterdir()) != ["report.json"], list(first.iterdir())
     assert client.containers.list(all=True, filters={
         "label": f"org.hlvs-runner.match={match_id}"}) == []  # nothing of either run is left
 
