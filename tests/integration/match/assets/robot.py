@@ -87,7 +87,13 @@ def main(argv):
             time.sleep(0.1)
         time.sleep(0.2)
         targets = json.load(open(path))
-        reach = {name: try_connect(host, port) for name, (host, port) in targets.items()}
+        reach = {}
+        for name, (host, port) in targets.items():
+            until = time.monotonic() + 5  # a teammate may still be starting: refused, retry
+            reach[name] = try_connect(host, port)
+            while "refused" in reach[name] and time.monotonic() < until:
+                time.sleep(0.2)
+                reach[name] = try_connect(host, port)
         log("reach.json", reach)
         print("probe done", flush=True)
         wait_forever()
