@@ -16,7 +16,11 @@ from tests.integration.images.conftest import MakeImage
 
 pytestmark = pytest.mark.docker
 
-CHECK = "import simulator, numpy, google.protobuf, sys; print(sys.version_info[:2])"
+# The team base carries the robot client library and what it needs, not the simulator server.
+CHECK = (
+    "import importlib.util as u, numpy, google.protobuf, robot.client, sys; "
+    "print(sys.version_info[:2], u.find_spec('simulator') is None, u.find_spec('mujoco') is None)"
+)
 
 
 def test_second_call_builds_nothing(docker_client: docker.DockerClient) -> None:
@@ -48,7 +52,7 @@ def test_image_carries_its_content_hash_and_runs(docker_client: docker.DockerCli
         remove=True,
         labels={"org.hlvs-runner.test": "1"},
     )
-    assert output.decode().strip() == "(3, 11)"
+    assert output.decode().strip() == "(3, 11) True True"
 
 
 def test_build_steps_show_as_progress(
