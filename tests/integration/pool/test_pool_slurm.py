@@ -70,6 +70,9 @@ def test_matches_in_parallel_quota_and_cancel(cluster: str, tmp_path: Path) -> N
     assert len(nodes) == 2  # dense placement: one match per node, side by side
 
     pool.cancel(a2)  # while queued: it never starts
+    deadline = time.monotonic() + 60  # the accounting database learns of it a little later
+    while "CANCELLED" not in _sacct(cluster, a2, "State") and time.monotonic() < deadline:
+        time.sleep(1)
     assert "CANCELLED" in _sacct(cluster, a2, "State")
     assert not (pool.results_dir(a2) / "report.json").exists()
 
