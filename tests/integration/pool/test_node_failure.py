@@ -1,5 +1,5 @@
-"""A node dies mid-match: the test match is requeued by Slurm and played to its end on another
-node.
+"""Nodes die mid-match: the test match is requeued by Slurm and played to its end on another
+node; the official match is not requeued and waits for the operator.
 
 What "the node died" means on this one-machine cluster: every node shares the host's kernel and
 Docker engine, so ``kill -9`` of a node's ``slurmd`` alone leaves the job's processes and the
@@ -18,6 +18,7 @@ import json
 import os
 import signal
 import subprocess
+import sys
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -32,7 +33,7 @@ pytestmark = [pytest.mark.docker, pytest.mark.root, pytest.mark.slow]
 SLURM_DIR = Path("/var/lib/hlvs/slurm")
 
 
-def _job(tmp: Path, match_id: str) -> MatchJob:
+def _job(tmp: Path, match_id: str, *, requeue: bool) -> MatchJob:
     from orchestrator.match.scrimmage import write_files
     from orchestrator.project_images import project_image
 
@@ -41,7 +42,7 @@ def _job(tmp: Path, match_id: str) -> MatchJob:
         wait_before_ready=1.0, grace=2.0, robot_command=None, match_id=match_id, seed=7,
     )
     game = write_files(args, tmp / "config", stub_image=project_image("stub"))
-    return MatchJob(match_id=match_id, game_path=game, work_dir=tmp / "work", requeue=True)
+    return MatchJob(match_id=match_id, game_path=game, work_dir=tmp / "work", requeue=requeue)
 
 
 def _env(conf: str) -> dict[str, str]:
@@ -95,36 +96,44 @@ def node_restarter(cluster: str) -> Iterator[list[str]]:
 def test_node_killed_mid_match_requeues_and_completes(
     cluster: str, tmp_path: Path, node_restarter: list[str],
 ) -> None:
+    """Two matches on two nodes that both die: the test match (``--requeue``) is played again
+    on the third node; the official one (``--no-requeue``) ends as a node failure and waits
+    for the operator, whose ``hlvs cleanup --match`` salvages what it left."""
     import docker
 
     pool = SlurmPool(slurm_conf=cluster, host_network=True)
-    match_id = f"slurm-fail-{os.getpid()}"
-    handle = pool.submit(_job(tmp_path, match_id))
-    job_id = pool.job_id(handle)
-    deadline = time.monotonic() + 120
+    test_id, official_id = f"slurm-fail-{os.getpid()}", f"slurm-official-{os.getpid()}"
+    handle = pool.submit(_job(tmp_path / "test", test_id, requeue=True))
+    official = pool.submit(_job(tmp_path / "official", official_id, requeue=False))
+    job_id, official_job = pool.job_id(handle), pool.job_id(official)
     client = docker.from_env()
-    while time.monotonic() < deadline:  # wait until the match is under way on its node
-        if pool.status(handle).state is JobState.RUNNING and client.containers.list(
-                filters={"label": f"org.hlvs-runner.match={match_id}"}):
-            break
-        time.sleep(1)
-    else:
-        pytest.fail(f"job {job_id} never ran its match: {pool.status(handle)}")
+    for h, match_id in ((handle, test_id), (official, official_id)):
+        deadline = time.monotonic() + 180
+        while time.monotonic() < deadline:  # wait until each match is under way on its node
+            if pool.status(h).state is JobState.RUNNING and client.containers.list(
+                    filters={"label": f"org.hlvs-runner.match={match_id}"}):
+                break
+            time.sleep(1)
+        else:
+            pytest.fail(f"{h} never ran its match: {pool.status(h)}")
     time.sleep(3)
     node = _show_job(cluster, job_id)["NodeList"]
+    official_node = _show_job(cluster, official_job)["NodeList"]
+    assert node != official_node
 
-    # the node dies: its slurmd, the job's processes on it and the match's containers
-    slurmd = int((SLURM_DIR / f"slurmd-{node}.pid").read_text())
-    os.kill(slurmd, signal.SIGKILL)
-    node_restarter.append(node)
-    for pid in _job_pids(job_id):
-        try:
-            os.kill(pid, signal.SIGKILL)
-        except ProcessLookupError:
-            pass
-    for container in client.containers.list(
-            filters={"label": f"org.hlvs-runner.match={match_id}"}):
-        container.kill()
+    # both nodes die: their slurmd, the jobs' processes on them and the matches' containers
+    for dead, job, match_id in ((node, job_id, test_id),
+                                (official_node, official_job, official_id)):
+        os.kill(int((SLURM_DIR / f"slurmd-{dead}.pid").read_text()), signal.SIGKILL)
+        node_restarter.append(dead)
+        for pid in _job_pids(job):
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+        for container in client.containers.list(
+                filters={"label": f"org.hlvs-runner.match={match_id}"}):
+            container.kill()
 
     deadline = time.monotonic() + 240  # SlurmdTimeout=10: DOWN in about 25 s, then requeued
     while time.monotonic() < deadline:
@@ -137,23 +146,43 @@ def test_node_killed_mid_match_requeues_and_completes(
                            capture_output=True, text=True, check=False).stdout.strip()
     assert state.startswith("down"), state  # Slurm saw the node die
 
+    # the official match: not requeued, lost with Slurm's NODE_FAIL, for the operator
+    # (LOST without a report, or already salvaged by any 'hlvs cleanup' run on this machine,
+    # which takes every match whose orchestrator is gone)
+    if _wait_end(pool, official, 120) is JobState.LOST:
+        assert "NODE_FAIL" in pool.status(official).detail
+    assert _sacct_field(cluster, official_job, "State") == "NODE_FAIL"
+    assert _show_job(cluster, official_job).get("Restarts", "0") == "0"
+    cleanup = subprocess.run(
+        [sys.executable, "-m", "orchestrator", "cleanup", "--match", official_id],
+        capture_output=True, text=True, timeout=300, check=False)
+    assert cleanup.returncode == 0, cleanup.stderr[-2000:]
+    kept = json.loads((pool.results_dir(official) / "report.json").read_text())
+    assert kept.get("failure_class") == "interrupted", kept  # its logs so far, salvaged
+
+    # the test match: played again on the live node
     assert _wait_end(pool, handle, 600) is JobState.FINISHED
     report = json.loads((pool.results_dir(handle) / "report.json").read_text())
     assert report["status"] == "success", report
     results = json.loads((pool.results_dir(handle) / "results.json").read_text())
     assert results["final_state"] == "FINISHED"
     second_node = _show_job(cluster, job_id).get("NodeList") or _sacct_node(cluster, job_id)
-    assert second_node != node  # played again on a live node
+    assert second_node not in (node, official_node)  # played again on a live node
     first = pool.results_dir(handle) / "attempt-1"  # the dead run's salvaged files, kept
     salvaged = json.loads((first / "report.json").read_text())
     assert salvaged.get("failure_class") == "interrupted", salvaged
     assert sorted(p.name for p in first.iterdir()) != ["report.json"], list(first.iterdir())
-    assert client.containers.list(all=True, filters={
-        "label": f"org.hlvs-runner.match={match_id}"}) == []  # nothing of either run is left
+    for match_id in (test_id, official_id):  # nothing of any run is left
+        assert client.containers.list(all=True, filters={
+            "label": f"org.hlvs-runner.match={match_id}"}) == []
 
 
 def _sacct_node(conf: str, job_id: str) -> str:
-    return subprocess.run(["sacct", "-n", "-X", "-P", "-j", job_id, "-o", "NodeList"],
+    return _sacct_field(conf, job_id, "NodeList")
+
+
+def _sacct_field(conf: str, job_id: str, field: str) -> str:
+    return subprocess.run(["sacct", "-n", "-X", "-P", "-j", job_id, "-o", field],
                           capture_output=True, text=True, env=_env(conf),
                           check=False).stdout.strip()
 
