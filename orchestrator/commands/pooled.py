@@ -77,10 +77,36 @@ def play_in_pool(
                 stop.wait(POLL_S)
     except PoolError as exc:
         raise InfrastructureError(f"Slurm pool: {exc}") from exc
+    if not cancelled and _ended_early(status.state is JobState.LOST, out_dir) \
+            and _final(pool, handle) == "NODE_FAIL":  # not requeued: an official match
+        raise InfrastructureError(
+            f"match {match_id}: its node failed (Slurm job {job}: NODE_FAIL); an official "
+            f"match is not requeued, the operator decides; what it left is salvaged by "
+            f"'hlvs cleanup --match {match_id}' into {out_dir}")
     if status.state is JobState.LOST:
         raise InfrastructureError(f"match {match_id}: {status.detail}; see "
                                   f"{out_dir}/slurm-{job}.out")
     return summarize(read_outcome(match_id, out_dir), as_json=as_json)
+
+
+def _ended_early(lost: bool, out_dir: Path) -> bool:
+    """No report, or one that says the match was interrupted (salvaged after its run died)."""
+    if lost:
+        return True
+    try:
+        report = json.loads((out_dir / "report.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return True
+    return bool(report.get("failure_class") == "interrupted")
+
+
+def _final(pool: Any, handle: str) -> str:
+    deadline = time.monotonic() + 10  # the accounting database learns of the end a bit later
+    while True:
+        state = str(pool.final_state(handle))
+        if state not in ("", "RUNNING", "PENDING", "REQUEUED") or time.monotonic() > deadline:
+            return state
+        time.sleep(1)
 
 
 def read_outcome(match_id: str, out_dir: Path) -> MatchOutcome:

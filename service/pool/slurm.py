@@ -186,6 +186,10 @@ class SlurmPool:
     def job_id(self, handle: str) -> str:
         return self._parse(handle)[0]
 
+    def final_state(self, handle: str) -> str:
+        """Slurm's accounting state of an ended job (COMPLETED, CANCELLED, NODE_FAIL...)."""
+        return self._sacct_state(self._parse(handle)[0]).split("|")[0].split(" ")[0]
+
     # queue for hlvs pool status ------------------------------------------------------------
     def queue(self) -> list[QueueEntry]:
         """Every match job Slurm knows of (pending first), with its reason and expected start."""

@@ -79,3 +79,36 @@ def test_slurm_submission_requeues_test_matches_only(tmp_path: Path) -> None:
         assert pool.results_dir(handle) == work and pool.job_id(handle) == "42"
         assert pool.recorded(work) == handle
         assert "cleanup --match m" in script  # a requeued run salvages the dead one first
+
+
+def test_node_failure_of_an_official_match_is_an_infrastructure_failure(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    import argparse
+
+    from orchestrator.commands import pooled
+    from orchestrator.errors import InfrastructureError
+    from service.pool import JobState, JobStatus
+
+    class Ended:  # the pool's port as the command sees it, after a node failure
+        def recorded(self, work: Path) -> str | None:
+            return None
+
+        def submit(self, job: object) -> str:
+            return f"slurm:7:{tmp_path}"
+
+        def job_id(self, handle: str) -> str:
+            return "7"
+
+        def status(self, handle: str) -> JobStatus:
+            return JobStatus(state=JobState.LOST, detail="Slurm job 7 ended (NODE_FAIL|0:0)")
+
+        def final_state(self, handle: str) -> str:
+            return "NODE_FAIL"
+
+    monkeypatch.setattr(pooled, "make_pool", lambda args: Ended())
+    with pytest.raises(InfrastructureError) as err:
+        pooled.play_in_pool(argparse.Namespace(json=True), game_path=tmp_path / "g.json",
+                            match_id="m1", out_dir=tmp_path, official=True)
+    assert "NODE_FAIL" in str(err.value) and "hlvs cleanup --match m1" in str(err.value)
+    assert err.value.exit_code == 3
