@@ -12,7 +12,9 @@ after the robot models change. ``scene_of`` reads it from a compiled MuJoCo mode
      "field": {FieldGeometry fields}}
 
 ``type`` is one of ``plane sphere capsule ellipsoid cylinder box``; sizes are MuJoCo's (half
-sizes, radius and half length). ``pattern`` is a two-colour texture (MuJoCo's builtin checker).
+sizes, radius and half length). A mesh (the visual parts of a team's robot model) is recorded
+as its bounding box in the geom's frame. ``pattern`` is a two-colour texture (MuJoCo's builtin
+checker).
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ if TYPE_CHECKING:
     from simulator.world.types import RobotPlacement
 
 GEOM_TYPES = {0: "plane", 2: "sphere", 3: "capsule", 4: "ellipsoid", 5: "cylinder", 6: "box"}
+MESH = 7  # a mesh (team robot models' visual parts) travels as its bounding box
 TEXTURE_ROLE_RGB = 1
 
 
@@ -57,16 +60,26 @@ def _geom(model: mujoco.MjModel, i: int) -> dict[str, Any]:
     gtype = int(model.geom_type[i])
     matid = int(model.geom_matid[i])
     rgba = model.mat_rgba[matid] if matid >= 0 else model.geom_rgba[i]
+    pos = model.geom_pos[i]
+    if gtype == MESH:
+        import mujoco
+        import numpy as np
+
+        rot = np.zeros(9)
+        mujoco.mju_quat2Mat(rot, model.geom_quat[i])
+        pos = pos + rot.reshape(3, 3) @ model.geom_aabb[i][:3]
     geom: dict[str, Any] = {
         "name": model.geom(i).name,
         "body": int(model.geom_bodyid[i]),
-        "type": GEOM_TYPES.get(gtype, "sphere"),
+        "type": "box" if gtype == MESH else GEOM_TYPES.get(gtype, "sphere"),
         "size": (
             _round(model.geom_size[i])
             if gtype in GEOM_TYPES
+            else _round(model.geom_aabb[i][3:])
+            if gtype == MESH
             else [float(model.geom_rbound[i])] * 3
         ),
-        "pos": _round(model.geom_pos[i]),
+        "pos": _round(pos),
         "quat": _round(model.geom_quat[i]),
         "rgba": _round(rgba, 4),
         "group": int(model.geom_group[i]),

@@ -116,3 +116,13 @@ def test_referee_parts_and_hull_bodies_are_tagged() -> None:
     for hull in ("hand_L", "hand_R", "foot_L", "foot_R"):
         assert model.body(f"red_1/{hull}").id > 0
     assert mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, "red_1/Camera") >= 0
+
+
+def test_replay_scene_records_meshes_as_their_bounding_boxes() -> None:
+    from simulator.replay.scene import scene_of
+
+    world = _world()
+    scene = scene_of(world.model, world.placements, world.field)
+    visuals = [g for g in scene["geoms"] if g["name"].startswith("red_1/visual:torso_")]
+    assert visuals and all(g["type"] == "box" for g in visuals)
+    assert all(0.0 < max(g["size"]) < 0.2 for g in visuals)  # parts of a 0.8 m robot
