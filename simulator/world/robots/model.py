@@ -43,8 +43,25 @@ class RobotMjcf:
     asset_key: str = ""  # robots with the same key share one copy of ``assets``
 
 
+class MotorLookup:
+    """Motor names and lookup by name, shared by the built-in and the team models."""
+
+    __slots__ = ()
+    motors: tuple[MotorSpec, ...]
+
+    @property
+    def motor_names(self) -> tuple[str, ...]:
+        return tuple(m.name for m in self.motors)
+
+    def motor(self, name: str) -> MotorSpec:
+        for motor in self.motors:
+            if motor.name == name:
+                return motor
+        raise KeyError(name)
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
-class RobotModel:
+class RobotModel(MotorLookup):
     """A built-in robot model: its shape, motors and sensors."""
 
     name: str
@@ -64,16 +81,6 @@ class RobotModel:
     def standing_pose_rad(self) -> tuple[float, ...]:
         """Joint positions (``motor_names`` order) the robot stands in when placed: all zero."""
         return (0.0,) * len(self.motors)
-
-    @property
-    def motor_names(self) -> tuple[str, ...]:
-        return tuple(m.name for m in self.motors)
-
-    def motor(self, name: str) -> MotorSpec:
-        for motor in self.motors:
-            if motor.name == name:
-                return motor
-        raise KeyError(name)
 
     def mjcf(
         self,

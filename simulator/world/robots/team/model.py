@@ -9,7 +9,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
-from simulator.world.robots.model import CameraSpec, MotorSpec, RobotMjcf
+from simulator.world.robots.model import CameraSpec, MotorLookup, MotorSpec, RobotMjcf
 from simulator.world.robots.team.build import PREFIX, Template, build_template
 from simulator.world.robots.team.manifest import Manifest, load_manifest
 from simulator.world.robots.team.source import load_spec
@@ -18,7 +18,7 @@ VISUAL = "/visual:"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
-class TeamRobotModel:
+class TeamRobotModel(MotorLookup):
     """A model package loaded for the world: motors, sensors and the MJCF of one robot."""
 
     name: str  # the package's folder, as the match spec names it
@@ -38,16 +38,6 @@ class TeamRobotModel:
         """Joint positions (``motor_names`` order) the robot stands in when placed."""
         pose = self.manifest.standing_pose_rad
         return tuple(pose.get(m.name, 0.0) for m in self.motors)
-
-    @property
-    def motor_names(self) -> tuple[str, ...]:
-        return tuple(m.name for m in self.motors)
-
-    def motor(self, name: str) -> MotorSpec:
-        for motor in self.motors:
-            if motor.name == name:
-                return motor
-        raise KeyError(name)
 
     def mjcf(
         self,
