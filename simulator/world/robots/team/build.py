@@ -71,31 +71,21 @@ def _is_collision(geom: mujoco.MjsGeom) -> bool:
     return bool(geom.contype or geom.conaffinity)
 
 
-def _link_boxes(model: mujoco.MjModel) -> dict[int, tuple[np.ndarray, np.ndarray]]:
-    """Body id -> (min, max) corners, in the body frame, of its collision geoms."""
-    boxes: dict[int, tuple[np.ndarray, np.ndarray]] = {}
-    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
-    rot = np.zeros(9)
-    for g in range(model.ngeom):
-        if not (model.geom_contype[g] or model.geom_conaffinity[g]):
-            continue
-        centre, half = model.geom_aabb[g][:3], model.geom_aabb[g][3:]
-        corners = centre + signs * half
-        mujoco.mju_quat2Mat(rot, model.geom_quat[g])
-        in_body = corners @ rot.reshape(3, 3).T + model.geom_pos[g]
-        b = int(model.geom_bodyid[g])
-        lo, hi = in_body.min(axis=0), in_body.max(axis=0)
-        if b in boxes:
-            lo, hi = np.minimum(lo, boxes[b][0]), np.maximum(hi, boxes[b][1])
-        boxes[b] = (lo, hi)
-    return boxes
+def _owner(model: mujoco.MjModel, body: int) -> int:
+    """The body itself if it moves (has a joint or hangs from the world), else the nearest
+    ancestor it is welded to."""
+    while model.body_jntnum[body] == 0 and model.body_parentid[body] != 0:
+        body = int(model.body_parentid[body])
+    return body
 
 
-def _owner_boxes(model: mujoco.MjModel) -> dict[int, tuple[np.ndarray, np.ndarray]]:
-    """Body id -> (min, max) corners, in that body's frame, of the collision geoms of the body
-    and of every body welded to it (no joint between them): one box per moving part. The feet's
-    cleats, sole plates and frames become one box per foot: a few contacts with the turf where
-    dozens of small shapes made hundreds."""
+def _collision_boxes(
+    model: mujoco.MjModel, *, merge_welded: bool
+) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+    """Body id -> (min, max) corners, in that body's frame, of its collision geoms, at the zero
+    pose. With ``merge_welded`` a body also takes the geoms of every body welded to it (no joint
+    between them): one box per moving part. The feet's cleats, sole plates and frames become one
+    box per foot: a few contacts with the turf where dozens of small shapes made hundreds."""
     data = mujoco.MjData(model)
     mujoco.mj_kinematics(model, data)
     signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
@@ -103,9 +93,8 @@ def _owner_boxes(model: mujoco.MjModel) -> dict[int, tuple[np.ndarray, np.ndarra
     for g in range(model.ngeom):
         if not (model.geom_contype[g] or model.geom_conaffinity[g]):
             continue
-        owner = int(model.geom_bodyid[g])
-        while model.body_jntnum[owner] == 0 and model.body_parentid[owner] != 0:
-            owner = int(model.body_parentid[owner])
+        body = int(model.geom_bodyid[g])
+        owner = _owner(model, body) if merge_welded else body
         centre, half = model.geom_aabb[g][:3], model.geom_aabb[g][3:]
         rot = data.geom_xmat[g].reshape(3, 3)
         world = data.geom_xpos[g] + (centre + signs * half) @ rot.T
@@ -132,9 +121,7 @@ def _sensor_sites(
     out: dict[str, dict[str, tuple[np.ndarray, np.ndarray]]] = {}
     for link in manifest.force_sensors.values():
         body = model.body(link).id
-        owner = body
-        while model.body_jntnum[owner] == 0 and model.body_parentid[owner] != 0:
-            owner = int(model.body_parentid[owner])
+        owner = _owner(model, body)
         if owner not in owner_boxes:
             continue
         lo, hi = owner_boxes[owner]
@@ -246,8 +233,8 @@ def build_template(spec: mujoco.MjSpec, manifest: Manifest, *, key: str) -> Temp
     if problems:
         raise ModelError(problems)
     original = spec.compile()
-    boxes = _link_boxes(original)
-    owner_boxes = _owner_boxes(original)
+    boxes = _collision_boxes(original, merge_welded=False)
+    owner_boxes = _collision_boxes(original, merge_welded=True)
     sensor_sites = _sensor_sites(original, manifest, owner_boxes)
     parts = _parts(spec, manifest)
     root = spec.worldbody.bodies[0]
