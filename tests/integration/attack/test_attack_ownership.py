@@ -43,6 +43,16 @@ def _running(client: docker.DockerClient, match_id: str) -> list[str]:
         filters={"label": [f"{LABEL_MATCH}={match_id}", f"{LABEL_ROLE}=robot"]}))
 
 
+def _wait_running(client: docker.DockerClient, match_id: str, count: int) -> list[str]:
+    """The robots start side by side: red 1 may have written its attacks before blue 1 runs."""
+    deadline = time.monotonic() + 60
+    while len(robots := _running(client, match_id)) < count:
+        if time.monotonic() > deadline:
+            break
+        time.sleep(0.2)
+    return robots
+
+
 def test_second_start_and_cleanup_leave_a_running_match_alone(
     prepare: Prepare, docker_client: docker.DockerClient,
 ) -> None:
@@ -50,7 +60,7 @@ def test_second_start_and_cleanup_leave_a_running_match_alone(
     first = match.start()
     try:
         _wait_for_attacks(match, first)
-        robots = _running(docker_client, match.match_id)
+        robots = _wait_running(docker_client, match.match_id, 2)
         assert len(robots) == 2
         second = subprocess.run(match.command(), capture_output=True, text=True, timeout=120,
                                 cwd=REPO, check=False,
