@@ -54,12 +54,21 @@ def count(key, conn, peer):
         total += len(data)
         marks.append((now, total))
     rate = None
+    windows = []
     if first is not None and last - first > 1.0:
         # steady state: skip the first 0.5 s (token bucket burst)
         start = next((m for m in marks if m[0] >= first + 0.5), marks[0])
         rate = (total - start[1]) * 8 / (last - start[0])
+        # the rate in each whole second after that: a starved sender (a loaded machine) lowers
+        # some of them, a shaper that lets too much through raises every one
+        begin = start
+        for mark in marks:
+            if mark[0] - begin[0] >= 1.0:
+                windows.append((mark[1] - begin[1]) * 8 / (mark[0] - begin[0]))
+                begin = mark
     with lock:
-        stats[key] = {"peer": peer[0], "bytes": total, "rate_bit_s": rate}
+        stats[key] = {"peer": peer[0], "bytes": total, "rate_bit_s": rate,
+                      "window_rates_bit_s": windows}
 
 
 for color in ("red", "blue"):
