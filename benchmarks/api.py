@@ -25,11 +25,12 @@ import os
 import socket
 import sys
 import time
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from contracts.ids import RobotId, TeamColor
-from simulator.api.endpoints import free_ports
-from simulator.api.framing import WELCOME
+from contracts.ids import TeamColor
+
+if TYPE_CHECKING:
+    from contracts.ids import RobotId
 
 MOTORS = (
     "Neck", "Head", "ShoulderL", "ArmUpperL", "ArmLowerL", "PelvYL", "PelvL", "LegUpperL",
@@ -71,6 +72,8 @@ def _parser() -> argparse.ArgumentParser:
 
 def _connect(port: int) -> socket.socket:
     """Connect with retries (the server may still be starting) and take the greeting."""
+    from simulator.api.framing import WELCOME
+
     for _ in range(240):
         try:
             sock = socket.create_connection(("127.0.0.1", port), timeout=30.0)
@@ -165,6 +168,8 @@ def _client(port: int, camera_period: int, stalled: bool, cpus: frozenset[int]) 
 
 
 def _robots(count: int) -> list[RobotId]:
+    from contracts.ids import RobotId
+
     red = (count + 1) // 2
     return [RobotId(TeamColor.RED, n) for n in range(1, red + 1)] + [
         RobotId(TeamColor.BLUE, n) for n in range(1, count - red + 1)
@@ -267,6 +272,7 @@ def _api_run(
         wait_lockstep,
         world_cameras,
     )
+    from simulator.api.endpoints import free_ports
 
     robots = _robots(args.robots)
     world = _world(robots, args.physics_dt)

@@ -18,11 +18,7 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from orchestrator.commands.scrimmage_args import add_arguments
-from orchestrator.config.loader import load_game
 from orchestrator.errors import OrchestratorError
-from orchestrator.match import HostControl, MatchRunner, RunOptions, cleanup, plan_from_game
-from orchestrator.match.scrimmage import write_files
 from orchestrator.paths import user_path
 
 log = logging.getLogger(__name__)
@@ -47,8 +43,12 @@ def _parse(argv: Sequence[str]) -> argparse.Namespace:
 
 def measure(*, robots: int, out: Path, timeout_s: float, robot_image: str | None = None,
             robot_command: str | None = None) -> dict[str, object]:
+    from orchestrator.commands.scrimmage_args import add_arguments
+    from orchestrator.config.loader import load_game
     from orchestrator.engine import connect
     from orchestrator.engine.containers import DockerRuntime
+    from orchestrator.match import HostControl, MatchRunner, RunOptions, cleanup, plan_from_game
+    from orchestrator.match.scrimmage import write_files
     from orchestrator.project_images import project_image
     from orchestrator.telemetry import ZenohTelemetry
 

@@ -17,12 +17,10 @@ import tempfile
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from orchestrator.delivery.deliver import RetryPolicy, deliver_pending
-from orchestrator.delivery.enqueue import enqueue_match_logs
-from testkit.s3 import MotoServer, SeaweedServer, weed_binary
-from testkit.sftp import AsyncsshServer, SshdServer
+if TYPE_CHECKING:  # the delivery code and the test servers are imported after the arguments
+    from testkit.s3 import MotoServer, SeaweedServer
 
 __all__ = ["main"]
 
@@ -55,6 +53,9 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def run(workdir: Path, *, server: str, files: int, total_mb: float) -> dict[str, Any]:
     """Start ``server``, deliver one set of ``files`` files / ``total_mb`` MB, stop it."""
+    from orchestrator.delivery.deliver import RetryPolicy, deliver_pending
+    from orchestrator.delivery.enqueue import enqueue_match_logs
+
     started = time.monotonic()
     body, stop = _start(server, workdir)
     startup_s = time.monotonic() - started
@@ -96,12 +97,17 @@ def run(workdir: Path, *, server: str, files: int, total_mb: float) -> dict[str,
 
 
 def _default_server(target: str) -> str:
+    from testkit.s3 import weed_binary
+
     if target == "sftp":
         return "sshd" if os.geteuid() == 0 else "asyncssh"
     return "seaweedfs" if weed_binary() is not None else "moto"
 
 
 def _start(server: str, workdir: Path) -> tuple[dict[str, Any], Callable[[], None]]:
+    from testkit.s3 import MotoServer, SeaweedServer
+    from testkit.sftp import AsyncsshServer, SshdServer
+
     if server in ("sshd", "asyncssh"):
         sftp = SshdServer.start() if server == "sshd" else AsyncsshServer.start(workdir)
         body = {

@@ -17,21 +17,25 @@ import argparse
 import json
 import sys
 import time
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
+if TYPE_CHECKING:  # numpy and gymnasium are imported after the arguments (fast --help)
+    import numpy as np
 
 ACTION_AMPLITUDE_RAD = 0.05
 
 
 def _actions(count: int, seed: int) -> np.ndarray:
     """Small motor targets around the standing posture (the robot stays up)."""
+    import numpy as np
+
     rng = np.random.default_rng(seed)
     return rng.uniform(-ACTION_AMPLITUDE_RAD, ACTION_AMPLITUDE_RAD, (count, 20)).astype(np.float32)
 
 
 def bench_inprocess(*, rounds: int, block: int, seed: int) -> dict[str, Any]:
     import gymnasium as gym
+    import numpy as np
 
     import envs  # noqa: F401  (registers the ids)
     from referee import RobotId, TeamColor

@@ -27,11 +27,7 @@ from typing import Any
 from contracts.codec import from_data
 from contracts.errors import ContractError
 from contracts.sim_result import PlayRecord
-from orchestrator.commands.scrimmage_args import add_arguments
-from orchestrator.config.loader import load_game
 from orchestrator.errors import OrchestratorError
-from orchestrator.match import HostControl, MatchRunner, RunOptions, cleanup, plan_from_game
-from orchestrator.match.scrimmage import write_files
 from orchestrator.paths import user_path
 
 log = logging.getLogger(__name__)
@@ -91,8 +87,12 @@ def play_one(*, seed: int, out: Path, players: int | None,
              stop: threading.Event | None = None, stepping: str = "lockstep") -> MatchFigures:
     """One default scrimmage with ``seed`` played into ``out``; its figures. ``stop`` set:
     the match stops (and is collected) as on SIGINT."""
+    from orchestrator.commands.scrimmage_args import add_arguments
+    from orchestrator.config.loader import load_game
     from orchestrator.engine import connect
     from orchestrator.engine.containers import DockerRuntime
+    from orchestrator.match import HostControl, MatchRunner, RunOptions, cleanup, plan_from_game
+    from orchestrator.match.scrimmage import write_files
     from orchestrator.project_images import project_image
     from orchestrator.telemetry import ZenohTelemetry
 

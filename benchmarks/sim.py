@@ -20,16 +20,17 @@ import json
 import os
 import sys
 import time
+from typing import TYPE_CHECKING
 
-import mujoco
-
-from contracts.ids import RobotId, TeamColor
-from simulator.world import RobotPlacement, World
-from simulator.world.scene import compile_scene
+if TYPE_CHECKING:  # MuJoCo and the world are imported after the arguments (fast --help)
+    from simulator.world import RobotPlacement
 
 
 def placements(count: int, model: str) -> list[RobotPlacement]:
     """``count`` robots alternating red and blue, spread over both halves."""
+    from contracts.ids import RobotId, TeamColor
+    from simulator.world import RobotPlacement
+
     out = []
     for i in range(count):
         team = TeamColor.RED if i % 2 == 0 else TeamColor.BLUE
@@ -50,6 +51,11 @@ def placements(count: int, model: str) -> list[RobotPlacement]:
 def run(
     *, robots: int, sim_seconds: float, physics_dt_s: float, field_class: str
 ) -> dict[str, object]:
+    import mujoco
+
+    from simulator.world import World
+    from simulator.world.scene import compile_scene
+
     model_name = "kid-default" if field_class == "kid" else "adult-default"
     robot_list = placements(robots, model_name)
     world = World.create(

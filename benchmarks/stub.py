@@ -16,11 +16,12 @@ import os
 import sys
 import time
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
+if TYPE_CHECKING:  # numpy and the world are imported after the arguments (fast --help)
+    import numpy as np
 
-from testkit.stub_world import ShotResult, sense
+    from testkit.stub_world import ShotResult
 
 AFTER_KICK_S = 4.0
 MIN_KICK_M = 0.5
@@ -37,12 +38,15 @@ class TrialResult:
 
 
 def run_trial(*, seed: int, distance_m: float, time_limit_s: float) -> TrialResult:
+    import numpy as np
+
     from contracts.gamecontroller import GameState
     from contracts.ids import RobotId, TeamColor
     from robot.stub.behaviour import GameInfo, Role
     from robot.stub.controller import StubController
     from robot.stub.world_model import Pose2D
     from simulator.world import CameraRenderer, RobotPlacement, World
+    from testkit.stub_world import sense
 
     rng = np.random.default_rng(seed)
     bearing = float(rng.uniform(-math.pi, math.pi))

@@ -30,8 +30,6 @@ import time
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from orchestrator.paths import user_path
 
 HALF_S = 600
@@ -48,6 +46,7 @@ LAUNCH_ARGS = [
 def write_replay(path: Path, *, half_s: int = HALF_S, seed: int = 7) -> dict[str, Any]:
     """A 4 v 4 replay of two halves of ``half_s`` seconds (see the module docstring)."""
     import mujoco
+    import numpy as np
 
     from contracts.ids import RobotId, TeamColor
     from simulator.recorder import Recorder

@@ -21,22 +21,26 @@ import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
-
-import numpy as np
-import numpy.typing as npt
+from typing import TYPE_CHECKING, Any
 
 from simulator.errors import OffscreenGLError, RenderError, ReplayError
 from simulator.gl import choose_offscreen_gl
-from simulator.replay import Replay, load_replay, scene_for
+
+if TYPE_CHECKING:  # numpy, MuJoCo and the replay reader are imported after the arguments
+    import numpy as np
+    import numpy.typing as npt
+
+    from simulator.replay import Replay
+
+    Array = npt.NDArray[np.float64]
 
 logger = logging.getLogger(__name__)
-
-Array = npt.NDArray[np.float64]
 
 
 def _quat_to_mat(q: Array) -> Array:
     """(n, 4) w x y z -> (n, 3, 3) rotation matrices."""
+    import numpy as np
+
     q = q / np.linalg.norm(q, axis=1, keepdims=True)
     w, x, y, z = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
     return np.stack(
@@ -175,6 +179,9 @@ def render_video(
     ``on_frame(done, total)`` is called after each frame (for a progress display).
     """
     import mujoco
+    import numpy as np
+
+    from simulator.replay import load_replay, scene_for
 
     output = Path(output)
     ffmpeg = shutil.which("ffmpeg")

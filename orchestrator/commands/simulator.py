@@ -48,10 +48,8 @@ def register(sub: Any) -> None:
             kinds, kind, help=text,
             func=lambda a, kind=kind: _exec_simulator(["bench", kind, *a.rest]),
         )
-    forward(
-        kinds, "envs", help="the learning environments: steps per second (JSON)",
-        func=lambda a: _exec_simulator(["bench", *a.rest], module="envs"),
-    )
+    forward(kinds, "envs", help="the learning environments: steps per second (JSON)",
+            func=_envs)
     forward(kinds, "bringup", help="time from hlvs match to the kick-off (JSON)", func=_bringup)
     forward(
         kinds, "report", help="the performance matrix (sim, async, lockstep, pipelined, "
@@ -79,6 +77,12 @@ def register(sub: Any) -> None:
     forward(kinds, "scrimmage",
             help="K default scrimmages: halves reaching PLAYING, kicks, goals, wall time (JSON)",
             func=_scrimmage)
+
+
+def _envs(args: argparse.Namespace) -> int:
+    from benchmarks.envs import main as envs_main  # gymnasium is imported after the arguments
+
+    return int(envs_main(list(args.rest)))
 
 
 def _hog(args: argparse.Namespace) -> int:
