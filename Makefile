@@ -69,7 +69,7 @@ clean-build:
 web:
 	cd web && npm ci --no-audit --no-fund && npm run build
 
-# A Slurm cluster on this machine (controller, accounting with MariaDB, three nodes in network
+# A Slurm cluster on this machine (controller, accounting with MariaDB, five nodes in network
 # namespaces) for the Slurm pool: `make cluster`, then HLVS_SERVICE_POOL=slurm hlvs serve.
 cluster:
 	bash scripts/ensure-slurm.sh up

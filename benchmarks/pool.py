@@ -78,7 +78,7 @@ def main(argv: list[str] | None = None) -> int:
         prog=f"{os.environ.get('HLVS_PROG', 'python -m benchmarks.pool')} bench pool",
         description=__doc__.split("\n\n")[0] if __doc__ else None,
     )
-    parser.add_argument("--nodes", type=int, default=3, help="cluster nodes (default 3)")
+    parser.add_argument("--nodes", type=int, default=5, help="cluster nodes (default 5)")
     parser.add_argument(
         "--matches", type=int, default=3, help="matches through the pool (default 3)"
     )

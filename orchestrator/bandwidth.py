@@ -119,7 +119,12 @@ def _setup(ipr: IPRoute, index: int, shaping: RobotShaping, *, egress: bool) -> 
 
 def apply(pid: int, shaping: RobotShaping, *, device: str = "eth0") -> AppliedShaping:
     """Shape the network namespace of process ``pid`` (needs CAP_NET_ADMIN on the host)."""
-    netns = f"/proc/{pid}/ns/net"
+    return apply_netns(f"/proc/{pid}/ns/net", shaping, device=device)
+
+
+def apply_netns(netns: str, shaping: RobotShaping, *, device: str = "eth0") -> AppliedShaping:
+    """Shape ``device`` of the network namespace ``netns`` (a path) and its peer on the host:
+    a robot's own namespace (dense placement) or its node's (league placement)."""
     started = time.perf_counter()
     try:
         with IPRoute(netns=netns) as inner:
@@ -148,6 +153,30 @@ def apply(pid: int, shaping: RobotShaping, *, device: str = "eth0") -> AppliedSh
         comm_rate_bit=shaping.comm_rate_bit,
         applied_ms=applied_ms,
     )
+
+
+def remove(applied: AppliedShaping) -> None:
+    """Remove the shaping of a namespace that outlives the match (a league robot's node): the
+    root qdiscs on its device and on the host's peer. Idempotent."""
+    try:
+        with IPRoute(netns=applied.netns) as inner:
+            found = inner.link_lookup(ifname=applied.device)
+            if found:
+                _delete_root(inner, found[0])
+        with IPRoute() as host:
+            _delete_root(host, applied.host_ifindex)
+    except (NetlinkError, OSError) as exc:
+        raise BandwidthError(target=applied.netns, reason=f"cannot remove shaping: {exc}"
+                             ) from exc
+    log.info("bandwidth limits removed from %s", applied.netns)
+
+
+def _delete_root(ipr: IPRoute, index: int) -> None:
+    try:
+        ipr.tc("del", "htb", index, ROOT)
+    except NetlinkError as exc:
+        if exc.code not in (2, 22):  # no such qdisc (already gone)
+            raise
 
 
 def _class_bytes(ipr: IPRoute, index: int) -> dict[int, int]:

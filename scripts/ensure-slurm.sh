@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # A Slurm cluster on this machine for the Slurm pool's tests and for trying it out: a controller,
-# the accounting daemon with MariaDB, and NODES nodes (default 3), each slurmd in its own network
-# namespace with its own address on a private bridge. Idempotent: starts what is not running.
+# the accounting daemon with MariaDB, and NODES nodes (default 5: a league-placement 2 v 2 match
+# takes a simulator node and four robot nodes), each slurmd in its own network namespace with its
+# own address on a private bridge. Idempotent: starts what is not running.
 #   scripts/ensure-slurm.sh [up|down|status]
 # Everything lives under $HLVS_SLURM_DIR (default /var/lib/hlvs/slurm); commands find the
 # cluster with SLURM_CONF=$HLVS_SLURM_DIR/slurm.conf (printed by `status`). Needs root (Debian).
 set -euo pipefail
 DIR=${HLVS_SLURM_DIR:-/var/lib/hlvs/slurm}
-NODES=${HLVS_SLURM_NODES:-3}
+NODES=${HLVS_SLURM_NODES:-5}
 BRIDGE=hlvsslurm0
 NET=10.77.0
 CTL_IP=$NET.1
@@ -56,6 +57,37 @@ network() {
       ip -n "hlvs-n$n" route add default via "$CTL_IP"
     fi
   done
+  # node to node (a league match's robots talk to the simulator node): the bridge's frames pass
+  # the host's FORWARD chain (br_netfilter), whose policy Docker sets to DROP
+  iptables -C FORWARD -i "$BRIDGE" -o "$BRIDGE" -j ACCEPT 2>/dev/null || \
+    iptables -I FORWARD -i "$BRIDGE" -o "$BRIDGE" -j ACCEPT
+}
+
+epilog() {
+  # after every job, on each of its nodes (in the node's network namespace): remove what a match
+  # of the job left there -- containers labelled with the job id, the league firewall chains and
+  # the traffic shaping of the node's interface (normally removed by the match itself)
+  cat >"$DIR/epilog.sh" <<'SH'
+#!/bin/sh
+PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin
+job=${SLURM_JOB_ID:-}
+[ -n "$job" ] || exit 0
+ids=$(docker ps -aq --filter "label=org.hlvs-runner.slurm-job=$job" 2>/dev/null)
+[ -z "$ids" ] || docker rm -f $ids >/dev/null 2>&1
+for hook in OUTPUT:HLVS-ROBOTS INPUT:HLVS-ROBOTS-IN; do
+  chain=${hook#*:}
+  while iptables -w -D "${hook%%:*}" -j "$chain" 2>/dev/null; do :; done
+  while iptables -w -D "${hook%%:*}" -m cgroup --path hlvs-robots -j "$chain" 2>/dev/null; do :; done
+  iptables -w -F "$chain" 2>/dev/null && iptables -w -X "$chain" 2>/dev/null
+done
+tc qdisc show dev eth0 2>/dev/null | grep -q "qdisc htb 1:" && tc qdisc del dev eth0 root 2>/dev/null
+if [ -n "${SLURMD_NODENAME:-}" ] && [ -e /run/netns/hlvs-host ]; then
+  nsenter --net=/run/netns/hlvs-host tc qdisc show dev "hlvs$SLURMD_NODENAME" 2>/dev/null | \
+    grep -q "qdisc htb 1:" && nsenter --net=/run/netns/hlvs-host tc qdisc del dev "hlvs$SLURMD_NODENAME" root 2>/dev/null
+fi
+exit 0
+SH
+  chmod 0755 "$DIR/epilog.sh"
 }
 
 munge_up() {
@@ -125,6 +157,7 @@ SchedulerParameters=bf_interval=5
 ReturnToService=2
 SlurmdTimeout=10
 KillWait=150
+Epilog=$DIR/epilog.sh
 InactiveLimit=0
 MinJobAge=600
 JobAcctGatherType=jobacct_gather/none
@@ -149,6 +182,7 @@ up() {
   munge_up
   mariadb_up
   configs
+  epilog
   pgrep -x slurmdbd >/dev/null || slurmdbd  # reads slurmdbd.conf beside $SLURM_CONF
   for _ in $(seq 60); do sacctmgr -n show cluster >/dev/null 2>&1 && break; sleep 0.5; done
   sacctmgr -i add cluster "$CLUSTER" >/dev/null 2>&1 || true
@@ -177,7 +211,10 @@ down() {
   pkill -f "slurmd -f $SLURM_CONF" || true
   pkill -f "slurmctld -f $SLURM_CONF" || true
   pkill -f "/usr/sbin/slurmdbd" || pkill -x slurmdbd || true
-  for n in $(seq 1 "$NODES"); do ip netns del "hlvs-n$n" 2>/dev/null || true; done
+  for ns in $(ip netns list | awk '{print $1}' | grep -E '^hlvs-n[0-9]+$'); do
+    ip netns del "$ns" 2>/dev/null || true
+  done
+  iptables -D FORWARD -i "$BRIDGE" -o "$BRIDGE" -j ACCEPT 2>/dev/null || true
   ip link del "$BRIDGE" 2>/dev/null || true
   umount /run/netns/hlvs-host 2>/dev/null && rm -f /run/netns/hlvs-host || true
 }

@@ -62,6 +62,16 @@ def add_pool_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--slurm-conf", default=None,
                         help="the cluster's slurm.conf with --pool slurm (default: $SLURM_CONF "
                         "or the one 'hlvs pool up' writes)")
+    parser.add_argument("--placement", choices=("dense", "league"), default="dense",
+                        help="with --pool slurm: the whole match on one node (dense, default) "
+                        "or the simulator on a node and each robot on a node of its own "
+                        "(league: one heterogeneous job, robots with their node's network)")
+    parser.add_argument("--league-nodes", default=None, metavar="NAME=ADDR,...",
+                        help="league placement inside its job: the simulator's node, then one "
+                        "node per robot (red 1..n, blue 1..n), as the Slurm job passes them")
+    parser.add_argument("--node-netns", default=None, metavar="PATH",
+                        help="league placement on nodes that share this Docker engine: each "
+                        "node's network namespace, e.g. /run/netns/hlvs-{node}")
     parser.add_argument("--account", default=None,
                         help="Slurm account the match is charged to with --pool slurm (a "
                         "team's: its quota applies; default: the user's default account)")

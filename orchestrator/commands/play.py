@@ -24,7 +24,8 @@ from typing import Any, TextIO
 
 from contracts import files
 from orchestrator.config.loader import load_game
-from orchestrator.errors import InfrastructureError, OrchestratorError
+from orchestrator.engine import LABEL_SLURM_JOB
+from orchestrator.errors import ConfigError, InfrastructureError, OrchestratorError, Problem
 from orchestrator.exitcodes import ExitCode
 from orchestrator.match import (
     FailureClass,
@@ -42,6 +43,7 @@ from orchestrator.match import (
 from orchestrator.match.admission import HostResources, admit
 from orchestrator.match.cleanup import clean_match
 from orchestrator.match.ownership import LABEL_RUN
+from orchestrator.match.placement import LeaguePlacement, parse_nodes
 from orchestrator.match.runner import ImageResolver
 from orchestrator.paths import user_path
 
@@ -93,6 +95,7 @@ def _pull_resolver(client: Any, loaded: Any) -> ImageResolver:
 def play(
     plan: MatchPlan, *, out_dir: Path, pull: bool, loaded: Any = None,
     extra_labels: dict[str, str] | None = None, view_stream: TextIO | None = None,
+    placement: LeaguePlacement | None = None,
 ) -> MatchOutcome:
     """Play ``plan`` on the local engine with the real host controls, showing progress. The
     match id is claimed first (:class:`~orchestrator.match.ownership.MatchRunning` while another
@@ -113,15 +116,18 @@ def play(
         if leftovers.containers or leftovers.networks:
             log.info("removed %d containers and %d networks left by an earlier run of %s",
                      len(leftovers.containers), len(leftovers.networks), plan.match_id)
+        labels = {**(extra_labels or {}), LABEL_RUN: claim.record.run_id}
+        if os.environ.get("SLURM_JOB_ID", "").isdigit():  # the cluster's epilog removes them
+            labels[LABEL_SLURM_JOB] = os.environ["SLURM_JOB_ID"]
         return _play(plan, out_dir=out_dir, pull=pull, loaded=loaded, client=client,
-                     runtime=runtime, host=host,
-                     extra_labels={**(extra_labels or {}), LABEL_RUN: claim.record.run_id},
-                     view_stream=view_stream)
+                     runtime=runtime, host=host, extra_labels=labels, view_stream=view_stream,
+                     placement=placement)
 
 
 def _play(
     plan: MatchPlan, *, out_dir: Path, pull: bool, loaded: Any, client: Any, runtime: Any,
     host: HostControl, extra_labels: dict[str, str], view_stream: TextIO | None = None,
+    placement: LeaguePlacement | None = None,
 ) -> MatchOutcome:
     from orchestrator.project_images import project_image
     from orchestrator.telemetry import LiveView, ZenohTelemetry
@@ -133,6 +139,7 @@ def _play(
         options = RunOptions(
             out_dir=out_dir, simulator_image=simulator_image, extra_labels=extra_labels or {},
             progress=lambda phase, state: view.update(phase=phase, state=state),
+            placement=placement,
         )
         runner = MatchRunner(
             plan, runtime=runtime, host=host, options=options,
@@ -217,7 +224,8 @@ def run_match_command(args: argparse.Namespace) -> int:
     if getattr(args, "pool", "local") == "slurm":
         return _in_pool(args, game_path=args.game, plan=plan, out=out)
     outcome = play(plan, out_dir=out, pull=True, loaded=loaded,
-                   view_stream=sys.stderr if getattr(args, "json", False) else None)
+                   view_stream=sys.stderr if getattr(args, "json", False) else None,
+                   placement=_placement(args, plan))
     return summarize(outcome, as_json=getattr(args, "json", False))
 
 
@@ -229,16 +237,33 @@ def run_scrimmage_command(args: argparse.Namespace) -> int:
     if getattr(args, "pool", "local") == "slurm":
         return _in_pool(args, game_path=game_path, plan=plan, out=out)
     outcome = play(plan, out_dir=out, pull=False, loaded=loaded,
-                   view_stream=sys.stderr if getattr(args, "json", False) else None)
+                   view_stream=sys.stderr if getattr(args, "json", False) else None,
+                   placement=_placement(args, plan))
     return summarize(outcome, as_json=getattr(args, "json", False))
+
+
+def _placement(args: argparse.Namespace, plan: MatchPlan) -> LeaguePlacement | None:
+    """League placement inside its Slurm job (``--league-nodes``); None: dense."""
+    if getattr(args, "placement", "dense") != "league":
+        return None
+    if not getattr(args, "league_nodes", None):
+        raise ConfigError([Problem(
+            file="command line", pointer="--placement",
+            message="league placement needs its nodes",
+            expected="--pool slurm (the cluster allocates a node per robot), or "
+            "--league-nodes NAME=ADDR,... inside the job")])
+    return parse_nodes(args.league_nodes, [r.key for r in plan.robots],
+                       netns=getattr(args, "node_netns", None))
 
 
 def _in_pool(args: argparse.Namespace, *, game_path: Path, plan: MatchPlan, out: Path) -> int:
     from orchestrator.commands.pooled import play_in_pool
 
     grace = () if args.grace is None else ("--grace", str(args.grace))
+    league = getattr(args, "placement", "dense") == "league"
     return play_in_pool(args, game_path=game_path, match_id=plan.match_id, out_dir=out,
-                        official=plan.official, match_args=grace)
+                        official=plan.official, match_args=grace,
+                        robot_nodes=len(plan.robots) if league else 0)
 
 
 def run_cleanup_command(args: argparse.Namespace) -> int:

@@ -1,7 +1,7 @@
 """`hlvs pool up|down|status`: the Slurm cluster matches can run on.
 
 ``up`` installs (Debian, as root) and starts a cluster on this machine: a controller, the
-accounting daemon with MariaDB and three nodes, each in its own network namespace with its own
+accounting daemon with MariaDB and five nodes, each in its own network namespace with its own
 address (``scripts/ensure-slurm.sh``); ``down`` stops it. ``status`` lists the match jobs with
 the reason each waits and its expected start, as Slurm gives them.
 """
@@ -29,7 +29,7 @@ def register(sub: Any) -> None:
     actions = parser.add_subparsers(dest="pool_action", metavar="ACTION", title="actions")
     actions.required = True
     up = actions.add_parser("up", help="install and start a cluster of nodes on this machine")
-    up.add_argument("--nodes", type=int, default=3, help="nodes to start (default 3)")
+    up.add_argument("--nodes", type=int, default=5, help="nodes to start (default 5)")
     up.set_defaults(func=_up)
     down = actions.add_parser("down", help="stop the cluster started by 'hlvs pool up'")
     down.set_defaults(func=_down)

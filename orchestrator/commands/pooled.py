@@ -39,7 +39,7 @@ def make_pool(args: argparse.Namespace) -> Any:
 
 def play_in_pool(
     args: argparse.Namespace, *, game_path: Path, match_id: str, out_dir: Path, official: bool,
-    match_args: tuple[str, ...] = (),
+    match_args: tuple[str, ...] = (), robot_nodes: int = 0,
 ) -> int:
     from service.errors import PoolError
     from service.pool import JobState, MatchJob
@@ -54,7 +54,7 @@ def play_in_pool(
             handle = pool.submit(MatchJob(
                 match_id=match_id, game_path=game_path, work_dir=out_dir,
                 account=getattr(args, "account", None), requeue=not official,
-                match_args=match_args,
+                match_args=match_args, robot_nodes=robot_nodes,
             ))
         job = pool.job_id(handle)
         _say(f"match {match_id}: Slurm job {job} submitted", as_json)

@@ -44,11 +44,13 @@ class ScheduleTiming:
 class SchedulePool:
     """Where the tournament's matches run: this host's Docker engine (``local``) or one Slurm
     job per match on a whole node of a cluster (``slurm``; ``slurm_conf`` names the cluster,
-    ``account`` the Slurm account the matches are charged to)."""
+    ``account`` the Slurm account the matches are charged to; ``placement`` ``league`` puts
+    the simulator and each robot on nodes of their own)."""
 
     kind: Literal["local", "slurm"] = "local"
     slurm_conf: str | None = None
     account: str | None = None
+    placement: Literal["dense", "league"] = "dense"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -20,6 +20,7 @@ LABEL_MATCH = "org.hlvs-runner.match"  # value: match id
 LABEL_ROLE = "org.hlvs-runner.role"  # simulator | robot | network | helper
 LABEL_TEAM = "org.hlvs-runner.team"  # red | blue
 LABEL_ROBOT = "org.hlvs-runner.robot"  # player number
+LABEL_SLURM_JOB = "org.hlvs-runner.slurm-job"  # the Slurm job a match runs in (its epilog)
 
 
 def connect(*, timeout_s: float = 60.0) -> docker.DockerClient:
@@ -33,4 +34,5 @@ def connect(*, timeout_s: float = 60.0) -> docker.DockerClient:
     return client
 
 
-__all__ = ["LABEL_MATCH", "LABEL_PROJECT", "LABEL_ROBOT", "LABEL_ROLE", "LABEL_TEAM", "connect"]
+__all__ = ["LABEL_MATCH", "LABEL_PROJECT", "LABEL_ROBOT", "LABEL_ROLE", "LABEL_SLURM_JOB",
+           "LABEL_TEAM", "connect"]

@@ -88,6 +88,7 @@ class DockerRuntime:
             "cpu_shares": request.cpu_shares,
             "cpuset_cpus": request.cpuset_cpus,
             "tmpfs": dict(request.tmpfs) or None,
+            "cgroup_parent": request.cgroup_parent,
             "network_mode": request.network_mode
             or (request.networks[0].network if request.networks else "none"),
         }

@@ -154,6 +154,12 @@ def _teardown(match: MatchContext) -> None:
     for key, scratch in started.scratch.items():
         _guarded(match, f"releasing the scratch space of {key}",
                  partial(match.host.release, scratch))
+    for applied in started.node_shaping:  # league placement: the nodes outlive the match
+        _guarded(match, f"removing the bandwidth limits of {applied.netns}",
+                 partial(match.host.unshape, applied))
+    for netns in started.node_firewalls:
+        _guarded(match, f"removing the robot node firewall of {netns}",
+                 partial(match.host.remove_node_firewall, netns))
     for network in started.networks.values():
         _guarded(match, f"removing network {network.name}",
                  partial(runtime.remove_network, network.name))

@@ -24,6 +24,7 @@ from orchestrator.match.host import Host
 from orchestrator.match.layout import SIMULATOR_COMMAND, Subnet
 from orchestrator.match.logfs import LogFolder
 from orchestrator.match.monitor import StatsMonitor
+from orchestrator.match.placement import LeaguePlacement
 from orchestrator.match.plan import MatchPlan
 from orchestrator.match.results import Failure, FailureClass, RobotRecord
 from orchestrator.match.runtime import ContainerRuntime, NetworkInfo
@@ -46,6 +47,9 @@ class RunOptions:
     poll_s: float = 0.5
     simulator_stop_s: float = 10.0
     progress: Callable[[str, dict[str, Any] | None], None] | None = None
+    # league placement: the simulator and each robot on a node of its own (None: dense, the
+    # whole match on this host's engine with a network per team)
+    placement: LeaguePlacement | None = None
 
     def __post_init__(self) -> None:
         # The output folder becomes bind-mount sources: Docker takes a relative one for a volume.
@@ -71,6 +75,10 @@ class Started:
     # bring-up breakdown: seconds per phase of STARTING, and per robot and step of its start
     phases_s: dict[str, float] = field(default_factory=dict)
     robot_steps_s: dict[str, dict[str, float]] = field(default_factory=dict)
+    # league placement: robot node firewalls made (node netns, None: this network) and the
+    # shaping of robot nodes' interfaces (the nodes outlive the match: both are undone)
+    node_firewalls: list[str | None] = field(default_factory=list)
+    node_shaping: list[AppliedShaping] = field(default_factory=list)
 
 
 class MatchContext:

@@ -13,6 +13,7 @@ from contracts import files
 from contracts.sim_result import SimResult
 from orchestrator.bandwidth import AppliedShaping, RobotShaping, TrafficCounters
 from orchestrator.match.logfs import LogFolder
+from orchestrator.match.placement import NodeFirewall
 from orchestrator.match.runtime import (
     ContainerRequest,
     ContainerState,
@@ -170,6 +171,8 @@ class FakeHost:
     folders: list[Path] = field(default_factory=list)
     released: list[str] = field(default_factory=list)
     released_folders: list[Path] = field(default_factory=list)
+    node_firewalls: dict[str, NodeFirewall] = field(default_factory=dict)  # netns -> rules
+    unshaped: list[str] = field(default_factory=list)
 
     def isolate_bridge(self, bridge_name: str, *, match_id: str) -> bool:
         self.isolated.append(bridge_name)
@@ -186,6 +189,22 @@ class FakeHost:
         return AppliedShaping(netns=f"/proc/{pid}/ns/net", device="eth0", host_ifindex=7,
                               api_rate_bit=shaping.api_rate_bit,
                               comm_rate_bit=shaping.comm_rate_bit, applied_ms=1.0)
+
+    def shape_node(self, netns: str, shaping: RobotShaping) -> AppliedShaping | None:
+        self.shaped.append(shaping)
+        return AppliedShaping(netns=netns, device="eth0", host_ifindex=7,
+                              api_rate_bit=shaping.api_rate_bit,
+                              comm_rate_bit=shaping.comm_rate_bit, applied_ms=1.0)
+
+    def unshape(self, applied: AppliedShaping) -> None:
+        self.unshaped.append(applied.netns)
+
+    def node_firewall(self, netns: str | None, firewall: NodeFirewall) -> bool:
+        self.node_firewalls[str(netns)] = firewall
+        return True
+
+    def remove_node_firewall(self, netns: str | None) -> None:
+        self.node_firewalls.pop(str(netns), None)
 
     def counters(self, applied: AppliedShaping) -> TrafficCounters:
         return TrafficCounters(sent_api_bytes=100, sent_comm_bytes=10, received_api_bytes=200,

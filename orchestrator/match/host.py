@@ -15,9 +15,10 @@ from typing import Protocol
 
 from orchestrator import bandwidth
 from orchestrator.bandwidth import AppliedShaping, RobotShaping, TrafficCounters
-from orchestrator.engine import networks
+from orchestrator.engine import networks, nodes
 from orchestrator.match import logfs
 from orchestrator.match.logfs import LogFolder
+from orchestrator.match.placement import NodeFirewall
 from orchestrator.match.safecopy import CopyReport
 
 log = logging.getLogger(__name__)
@@ -29,6 +30,14 @@ class Host(Protocol):
     def remove_isolation(self, *, match_id: str | None) -> int: ...
 
     def shape(self, pid: int, shaping: RobotShaping) -> AppliedShaping | None: ...
+
+    def shape_node(self, netns: str, shaping: RobotShaping) -> AppliedShaping | None: ...
+
+    def unshape(self, applied: AppliedShaping) -> None: ...
+
+    def node_firewall(self, netns: str | None, firewall: NodeFirewall) -> bool: ...
+
+    def remove_node_firewall(self, netns: str | None) -> None: ...
 
     def counters(self, applied: AppliedShaping) -> TrafficCounters: ...
 
@@ -81,6 +90,26 @@ class HostControl:
         if not self.shaping:
             return None
         return bandwidth.apply(pid, shaping)
+
+    def shape_node(self, netns: str, shaping: RobotShaping) -> AppliedShaping | None:
+        """League placement: the limits on the robot node's interface."""
+        if not self.shaping:
+            return None
+        return bandwidth.apply_netns(netns, shaping)
+
+    def unshape(self, applied: AppliedShaping) -> None:
+        bandwidth.remove(applied)
+
+    def node_firewall(self, netns: str | None, firewall: NodeFirewall) -> bool:
+        """League placement: the robot node's firewall (:mod:`orchestrator.engine.nodes`)."""
+        if not self.firewall:
+            return False
+        nodes.apply(netns, firewall)
+        return True
+
+    def remove_node_firewall(self, netns: str | None) -> None:
+        if self.firewall:
+            nodes.remove(netns)
 
     def counters(self, applied: AppliedShaping) -> TrafficCounters:
         return bandwidth.read_counters(applied)

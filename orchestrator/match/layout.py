@@ -17,6 +17,7 @@ import ipaddress
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Protocol
 
 from contracts import files
 from orchestrator.config import Limits
@@ -40,6 +41,8 @@ from orchestrator.match.runtime import (
 SIMULATOR_HOST = 2
 ROBOT_HOST_BASE = 10
 TELEMETRY_PORT = 7447
+NODE_NETNS_TARGET = "/node-net"  # where a node holder sees its node's network namespace
+LABEL_NODE = "org.hlvs-runner.node"  # league placement: the node a holder stands for
 LOGS_TARGET = "/robocup-logs"
 # A robot's root file system is read-only; these folders of its capped scratch space are
 # writable (sub-folder name in the scratch space -> path in the container).
@@ -116,8 +119,19 @@ def network_request(
     )
 
 
+class TeamAddresses(Protocol):
+    """Where a team's robots find the simulator and each other: a :class:`Subnet` (dense
+    placement) or the nodes' addresses (:class:`orchestrator.match.placement.NodeAddresses`)."""
+
+    @property
+    def simulator(self) -> str: ...
+
+    def robot(self, number: int) -> str: ...
+
+
 def robot_environment(
-    robot: RobotPlan, *, team_net: Subnet, player_count: int, gamecontroller_ip: str | None
+    robot: RobotPlan, *, team_net: TeamAddresses, player_count: int,
+    gamecontroller_ip: str | None,
 ) -> dict[str, str]:
     env = {
         "ROBOCUP_ROBOT_ID": str(robot.number),
@@ -153,10 +167,34 @@ def holder_request(
     )
 
 
+def node_holder_request(
+    node: str, *, prefix: str, image: str, netns: str, match_id: str,
+    extra_labels: Mapping[str, str],
+) -> ContainerRequest:
+    """League placement where nodes share one Docker engine: a container that joins the node's
+    network namespace ``netns`` (``nsenter``, the one capability it needs) and sleeps; the
+    simulator or robot container started in its network (``container:<holder>``) then has the
+    node's network, as ``--network host`` gives it on the node's own machine."""
+    return ContainerRequest(
+        name=f"{prefix}-node-{node}",
+        image=image,
+        entrypoint=("nsenter",),
+        command=(f"--net={NODE_NETNS_TARGET}", "sleep", "infinity"),
+        labels={**labels(match_id, "netns", **{LABEL_NODE: node}), **extra_labels},
+        mounts=(BindMount(source=Path(netns), target=NODE_NETNS_TARGET, read_only=True),),
+        network_mode="none",
+        mem_bytes=32 * 1024 * 1024,
+        pids_limit=8,
+        cap_drop=("ALL",),
+        cap_add=("SYS_ADMIN",),
+        security_opt=("no-new-privileges",),
+    )
+
+
 def robot_request(
     robot: RobotPlan, *, prefix: str, holder_id: str, environment: Mapping[str, str],
     logs_dir: Path, limits: Limits, match_id: str, extra_labels: Mapping[str, str],
-    scratch_dir: Path | None = None,
+    scratch_dir: Path | None = None, cgroup_parent: str | None = None,
 ) -> ContainerRequest:
     """``scratch_dir``: the robot's capped scratch space (its :data:`SCRATCH_DIRS` are bound
     into the container); None: size-capped tmpfs folders instead (they count as memory)."""
@@ -186,6 +224,7 @@ def robot_request(
         pids_limit=limits.pids,
         cap_drop=("ALL",),
         security_opt=("no-new-privileges",),
+        cgroup_parent=cgroup_parent,
     )
 
 
@@ -222,10 +261,12 @@ __all__ = [
     "SIMULATOR_COMMAND",
     "Subnet",
     "TELEMETRY_PORT",
+    "TeamAddresses",
     "candidate_subnets",
     "holder_request",
     "labels",
     "network_request",
+    "node_holder_request",
     "robot_environment",
     "robot_request",
     "short_token",

@@ -99,6 +99,7 @@ class ContainerRequest:
     cpu_period_us: int | None = None  # CFS period for nano_cpus (Docker's default 100 ms)
     cpuset_cpus: str | None = None  # e.g. "1-3": the CPUs it may run on
     tmpfs: Mapping[str, str] = field(default_factory=dict)  # path -> mount options ("size=16m")
+    cgroup_parent: str | None = None  # e.g. "/hlvs-robots" (a node firewall matches it)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -11,14 +11,22 @@ import shutil
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
+from pathlib import Path
 
 from contracts import files
-from orchestrator.bandwidth import RobotShaping, mb_s_to_bit
+from contracts.gamecontroller import GC_RETURN_PORT
+from orchestrator.bandwidth import AppliedShaping, RobotShaping, mb_s_to_bit
 from orchestrator.errors import InfrastructureError, OrchestratorError
 from orchestrator.match import layout
 from orchestrator.match.admission import cpu_sets
 from orchestrator.match.context import MatchContext, Started
 from orchestrator.match.logfs import LogFolder, safe_name
+from orchestrator.match.placement import (
+    ROBOT_CGROUP_PARENT,
+    LeaguePlacement,
+    Node,
+    firewall_for,
+)
 from orchestrator.match.plan import RobotPlan, per_robot_rate_mb_s
 from orchestrator.match.results import FailureClass
 from orchestrator.match.runtime import Attachment, ContainerRequest, SubnetInUse
@@ -51,6 +59,10 @@ def _start(match: MatchContext, started_at: float) -> None:
     started = match.started
     started.prefix = f"hlvs-{safe_name(plan.match_id)}"
     mark = _Marks(match.clock, started.phases_s)
+    placement = match.options.placement
+    if placement is not None:
+        _start_league(match, started_at, placement, mark)
+        return
     for role, internal in (("control", True), ("red", not plan.allow_internet),
                            ("blue", not plan.allow_internet)):
         _create_network(match, role, internal)
@@ -65,13 +77,7 @@ def _start(match: MatchContext, started_at: float) -> None:
     }
     control = started.subnets["control"]
     endpoint = f"tcp/{control.simulator}:{layout.TELEMETRY_PORT}" if plan.telemetry else None
-    match_dir = match.options.out_dir / "simulator"
-    (match_dir / "out").mkdir(parents=True, exist_ok=True)
-    for folder in (match_dir, match_dir / "out"):
-        folder.chmod(0o777)
-    started.match_dir = match_dir
-    spec = plan.spec_builder(addresses, endpoint)
-    (match_dir / files.MATCH_SPEC).write_text(json.dumps(spec, indent=2, sort_keys=True) + "\n")
+    spec, match_dir = _write_spec(match, addresses, endpoint)
 
     attachments = tuple(
         Attachment(
@@ -90,6 +96,70 @@ def _start(match: MatchContext, started_at: float) -> None:
     started.cpu_sets = sets
     request = replace(request, cpuset_cpus=sets.simulator)
     mark("spec")
+    _start_containers(match, request, started_at, endpoint, mark)
+
+
+def _write_spec(match: MatchContext, addresses: dict[str, tuple[str, ...]],
+                endpoint: str | None) -> tuple[dict[str, object], Path]:
+    match_dir = match.options.out_dir / "simulator"
+    (match_dir / "out").mkdir(parents=True, exist_ok=True)
+    for folder in (match_dir, match_dir / "out"):
+        folder.chmod(0o777)
+    match.started.match_dir = match_dir
+    spec = match.plan.spec_builder(addresses, endpoint)
+    (match_dir / files.MATCH_SPEC).write_text(json.dumps(spec, indent=2, sort_keys=True) + "\n")
+    return spec, match_dir
+
+
+def _start_league(match: MatchContext, started_at: float, placement: LeaguePlacement,
+                  mark: _Marks) -> None:
+    """League placement: no Docker networks; the simulator has its node's network and address,
+    each robot its own node's (see :mod:`orchestrator.match.placement`)."""
+    plan = match.plan
+    addresses = {
+        team.color: tuple(placement.robots[r.key].address for r in team.robots)
+        for team in plan.teams
+    }
+    simulator_ip = placement.simulator.address
+    endpoint = f"tcp/{simulator_ip}:{layout.TELEMETRY_PORT}" if plan.telemetry else None
+    spec, match_dir = _write_spec(match, addresses, endpoint)
+    holder = _node_holder(match, placement, placement.simulator, key="simulator")
+    request = layout.simulator_request(
+        plan, prefix=match.started.prefix, image=match.options.simulator_image,
+        match_dir=match_dir, attachments=(), extra_labels=match.options.extra_labels,
+        command=match.options.simulator_command, model_dirs=plan.model_dirs,
+    )
+    request = replace(request, network_mode=f"container:{holder}", hostname=None)
+    sets = cpu_sets(stepping=str(spec.get("stepping", "async")))
+    match.started.cpu_sets = sets
+    request = replace(request, cpuset_cpus=sets.simulator)
+    mark("spec")
+    _start_containers(match, request, started_at, endpoint, mark)
+
+
+def _node_holder(match: MatchContext, placement: LeaguePlacement, node: Node, *, key: str
+                 ) -> str:
+    """The holder container that gives ``key``'s containers the network of ``node``."""
+    netns = placement.netns_of(node)
+    if netns is None:
+        raise InfrastructureError(
+            f"league placement of {key} on node {node.name}: no network namespace of the node "
+            "(this orchestrator starts containers on nodes that share its Docker engine)")
+    request = layout.node_holder_request(
+        node.name, prefix=match.started.prefix,
+        image=match.options.holder_image or match.options.simulator_image, netns=netns,
+        match_id=match.plan.match_id, extra_labels=match.options.extra_labels,
+    )
+    holder_id = match.runtime.create_container(request)
+    match.started.holder_ids[key] = holder_id
+    match.runtime.start(holder_id)
+    return holder_id
+
+
+def _start_containers(match: MatchContext, request: ContainerRequest, started_at: float,
+                      endpoint: str | None, mark: _Marks) -> None:
+    plan = match.plan
+    started = match.started
     robots = [r for r in plan.robots if match.records[r.key].image_error is None]
     # the simulator and the robots start at the same time (robot clients retry until the
     # simulator listens); the simulator is submitted first so that it boots while they start
@@ -128,31 +198,16 @@ def _start_robot(match: MatchContext, robot: RobotPlan) -> None:
     started = match.started
     record = match.records[robot.key]
     team = plan.red if robot.color == "red" else plan.blue
-    subnet = started.subnets[robot.color]
-    network = started.networks[robot.color].name
     n_robots = len([r for r in team.robots if match.records[r.key].image_error is None])
     limits = plan.limits
     mark = _Marks(match.clock, started.robot_steps_s.setdefault(robot.key, {}))
     try:
-        holder = layout.holder_request(
-            robot, prefix=started.prefix,
-            image=match.options.holder_image or match.options.simulator_image,
-            network=network, team_net=subnet, match_id=plan.match_id,
-            extra_labels=match.options.extra_labels,
-        )
-        holder_id = match.runtime.create_container(holder)
-        started.holder_ids[robot.key] = holder_id
-        match.runtime.start(holder_id)
-        pid = match.runtime.inspect(holder_id).pid
-        mark("holder")
-        shaping = RobotShaping(
-            api_rate_bit=mb_s_to_bit(per_robot_rate_mb_s(limits.team_api_mb_s, n_robots)),
-            comm_rate_bit=mb_s_to_bit(per_robot_rate_mb_s(limits.team_comm_mb_s, n_robots)),
-            simulator_ip=subnet.simulator,
-            teammate_ips=tuple(subnet.robot(r.number) for r in team.robots if r != robot),
-            mirror_port=plan.mirror_port,
-        )
-        applied = match.host.shape(pid, shaping)
+        if match.options.placement is not None:
+            holder_id, team_net, applied, cgroup_parent = _league_robot_network(
+                match, robot, match.options.placement, n_robots, mark)
+        else:
+            holder_id, team_net, applied = _dense_robot_network(match, robot, n_robots, mark)
+            cgroup_parent = None
         if applied is not None:
             started.shaping[robot.key] = applied
         mark("shaping")
@@ -176,8 +231,8 @@ def _start_robot(match: MatchContext, robot: RobotPlan) -> None:
             "shaping_applied_ms": round(applied.applied_ms, 1) if applied else None,
         }
         environment = layout.robot_environment(
-            robot, team_net=subnet, player_count=len(team.robots),
-            gamecontroller_ip=subnet.simulator,
+            robot, team_net=team_net, player_count=len(team.robots),
+            gamecontroller_ip=team_net.simulator,
         )
         request = layout.robot_request(
             replace(robot, image=record.digest or robot.image),
@@ -185,6 +240,7 @@ def _start_robot(match: MatchContext, robot: RobotPlan) -> None:
             logs_dir=folder.path, limits=limits, match_id=plan.match_id,
             extra_labels=match.options.extra_labels,
             scratch_dir=scratch.path if scratch is not None else None,
+            cgroup_parent=cgroup_parent,
         )
         request = replace(request, cpuset_cpus=started.cpu_sets.robots)
         record.limits["cpuset"] = request.cpuset_cpus
@@ -196,10 +252,74 @@ def _start_robot(match: MatchContext, robot: RobotPlan) -> None:
         mark("start")
         match.monitor.watch(robot.key, container_id)
         log.info("match %s: robot %s started (%s, %s)", plan.match_id, robot.key, robot.image,
-                 subnet.robot(robot.number))
+                 team_net.robot(robot.number))
     except OrchestratorError as exc:
         record.startup_error = str(exc)
         log.warning("match %s: robot %s could not be started: %s", plan.match_id, robot.key, exc)
+
+
+def _shaping(match: MatchContext, n_robots: int, *, simulator_ip: str,
+             teammate_ips: tuple[str, ...]) -> RobotShaping:
+    limits = match.plan.limits
+    return RobotShaping(
+        api_rate_bit=mb_s_to_bit(per_robot_rate_mb_s(limits.team_api_mb_s, n_robots)),
+        comm_rate_bit=mb_s_to_bit(per_robot_rate_mb_s(limits.team_comm_mb_s, n_robots)),
+        simulator_ip=simulator_ip, teammate_ips=teammate_ips, mirror_port=match.plan.mirror_port,
+    )
+
+
+def _dense_robot_network(match: MatchContext, robot: RobotPlan, n_robots: int, mark: _Marks
+                         ) -> tuple[str, layout.TeamAddresses, AppliedShaping | None]:
+    """A holder on the team's network with the robot's fixed address, shaped."""
+    plan = match.plan
+    started = match.started
+    team = plan.red if robot.color == "red" else plan.blue
+    subnet = started.subnets[robot.color]
+    holder = layout.holder_request(
+        robot, prefix=started.prefix,
+        image=match.options.holder_image or match.options.simulator_image,
+        network=started.networks[robot.color].name, team_net=subnet, match_id=plan.match_id,
+        extra_labels=match.options.extra_labels,
+    )
+    holder_id = match.runtime.create_container(holder)
+    started.holder_ids[robot.key] = holder_id
+    match.runtime.start(holder_id)
+    pid = match.runtime.inspect(holder_id).pid
+    mark("holder")
+    shaping = _shaping(match, n_robots, simulator_ip=subnet.simulator, teammate_ips=tuple(
+        subnet.robot(r.number) for r in team.robots if r != robot))
+    return holder_id, subnet, match.host.shape(pid, shaping)
+
+
+def _league_robot_network(
+    match: MatchContext, robot: RobotPlan, placement: LeaguePlacement, n_robots: int,
+    mark: _Marks,
+) -> tuple[str, layout.TeamAddresses, AppliedShaping | None, str | None]:
+    """The robot's node: its firewall (before anything of the robot runs), a holder in the
+    node's network, the limits on the node's interface."""
+    plan = match.plan
+    started = match.started
+    team = plan.red if robot.color == "red" else plan.blue
+    node = placement.robots[robot.key]
+    netns = placement.netns_of(node)
+    firewall = firewall_for(placement, color=robot.color, number=robot.number,
+                            api_port=robot.port, udp_ports=(plan.mirror_port, GC_RETURN_PORT))
+    cgroup_parent = None
+    if match.host.node_firewall(netns, firewall):
+        started.node_firewalls.append(netns)
+        cgroup_parent = ROBOT_CGROUP_PARENT
+    mark("firewall")
+    holder_id = _node_holder(match, placement, node, key=robot.key)
+    mark("holder")
+    applied = None
+    if netns is not None:
+        applied = match.host.shape_node(netns, _shaping(
+            match, n_robots, simulator_ip=placement.simulator.address,
+            teammate_ips=firewall.teammates))
+        if applied is not None:
+            started.node_shaping.append(applied)
+    team_net = placement.addresses(robot.color, [r.number for r in team.robots])
+    return holder_id, team_net, applied, cgroup_parent
 
 
 class _Marks:

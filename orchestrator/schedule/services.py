@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any, Protocol
 
 from contracts import files
-from orchestrator.config.schedule import PlannedMatch, Schedule, ScheduledTeam
+from orchestrator.config.schedule import PlannedMatch, Schedule, ScheduledTeam, SchedulePool
 from orchestrator.errors import ScheduleError
 
 log = logging.getLogger(__name__)
@@ -214,7 +214,8 @@ class MatchServices:
             else:
                 (out / files.REPORT).unlink(missing_ok=True)
                 handle = pool.submit(MatchJob(match_id=ctx.match_id, game_path=game,
-                                              work_dir=out, account=settings.account))
+                                              work_dir=out, account=settings.account,
+                                              robot_nodes=_robot_nodes(settings, game)))
                 log.info("match %s: Slurm job %s", ctx.match_id, pool.job_id(handle))
             shown = ""
             while True:
@@ -256,3 +257,13 @@ class MatchServices:
             for outcome in deliver_pending(store, team=team)
         ]
         return f"{len(outcomes)} log set(s) handled"
+
+
+def _robot_nodes(pool: SchedulePool, game: Path) -> int:
+    """League placement: a node for each robot of the match (0: dense placement)."""
+    if pool.placement != "league":
+        return 0
+    from orchestrator.config.loader import load_game
+    from orchestrator.match.plan import plan_from_game
+
+    return len(plan_from_game(load_game(game, images_required=False)).robots)

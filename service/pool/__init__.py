@@ -34,6 +34,9 @@ class MatchJob:
     account: str | None = None  # a cluster account the match is charged to (a team's)
     requeue: bool = False  # a cluster may play it again after a node failure (test matches)
     match_args: tuple[str, ...] = ()  # more options of ``hlvs match`` (e.g. ``--grace 3``)
+    # league placement: a node of its own for each of this many robots, besides the
+    # simulator's node (0: dense placement, the whole match on one node)
+    robot_nodes: int = 0
 
 
 class JobState(enum.StrEnum):

@@ -32,7 +32,8 @@ import shlex
 import subprocess
 import sys
 import time
-from dataclasses import dataclass
+from collections.abc import Iterable
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from service.errors import PoolError
@@ -42,6 +43,7 @@ log = logging.getLogger(__name__)
 
 STATE_FILE = "slurm.json"
 HOST_NETNS = "/run/netns/hlvs-host"  # named by scripts/ensure-slurm.sh
+NODE_NETNS = "/run/netns/hlvs-{node}"  # each node's network namespace, same script
 LOG_FILE = "slurm-%j.out"
 ACTIVE = {"PENDING", "CONFIGURING", "RUNNING", "COMPLETING", "SUSPENDED", "REQUEUED",
           "RESIZING", "SIGNALING", "STAGE_OUT"}
@@ -95,16 +97,24 @@ class SlurmPool:
         out = work / self.out_subdir if self.out_subdir else work
         out.mkdir(parents=True, exist_ok=True)
         script = self._script(job, out)
-        args = ["sbatch", "--parsable", "--exclusive", "-N1", f"--job-name=hlvs-{job.match_id}",
+        args = ["sbatch", "--parsable", f"--job-name=hlvs-{job.match_id}",
                 f"--chdir={work}", f"--output={work / LOG_FILE}", "--open-mode=append",
                 "--requeue" if job.requeue else "--no-requeue"]
-        if self.partition:
-            args.append(f"--partition={self.partition}")
         account = job.account
-        if account:
-            args.append(f"--account={account}")
-        if self.qos:
-            args.append(f"--qos={self.qos}")
+        # dense: one whole node; league: a heterogeneous job, the simulator's node (component
+        # 0, where the batch script runs) and a node for each robot, allocated together
+        components = [["--constraint=sim"] if job.robot_nodes else []]
+        components += [["--constraint=robot"] for _ in range(job.robot_nodes)]
+        for index, component in enumerate(components):
+            if index:
+                args.append(":")
+            args += ["--exclusive", "-N1", *component]
+            if self.partition:
+                args.append(f"--partition={self.partition}")
+            if account:
+                args.append(f"--account={account}")
+            if self.qos:
+                args.append(f"--qos={self.qos}")
         result = self._run(args, stdin=script, handle=str(work))
         job_id = result.strip().split(";")[0]
         if not job_id.isdigit():
@@ -126,6 +136,21 @@ class SlurmPool:
         hlvs = [*prefix, self.python, "-m", "orchestrator", *self.extra_args]
         play = [*hlvs, "match", str(job.game_path.resolve()), "--out", str(out),
                 *job.match_args]
+        nodes: list[str] = []
+        if job.robot_nodes:
+            play += ["--placement", "league", "--league-nodes", "$nodes"]
+            if self.host_network:
+                play += ["--node-netns", NODE_NETNS]
+            nodes = [  # NAME=ADDRESS of each component's node, the simulator's first
+                'nodes=""',
+                f"for group in $(seq 0 {job.robot_nodes}); do",
+                '  eval "list=\\${SLURM_JOB_NODELIST_HET_GROUP_$group:-}"',
+                '  name=$(scontrol show hostnames "$list" | head -n 1)',
+                '  addr=$(scontrol show node "$name" -o | tr " " "\\n" | '
+                "sed -n 's/^NodeAddr=//p')",
+                '  nodes="$nodes${nodes:+,}$name=$addr"',
+                "done",
+            ]
         keep = ["slurm.json", "slurm-*.out", "config", "attempt-*"]
         game = job.game_path.resolve()
         if game.is_relative_to(out) and game != out:
@@ -143,7 +168,8 @@ class SlurmPool:
             "    esac",
             "  done",
             "fi",
-            "exec " + " ".join(q(c) for c in play),
+            *nodes,
+            "exec " + " ".join('"$nodes"' if c == "$nodes" else q(c) for c in play),
             "",
         ])
 
@@ -194,7 +220,7 @@ class SlurmPool:
     def queue(self) -> list[QueueEntry]:
         """Every match job Slurm knows of (pending first), with its reason and expected start."""
         text = self._run(["squeue", "-h", "-o", "%i|%j|%a|%T|%r|%S|%N"], handle="squeue")
-        entries = [_parse_entry(line) for line in text.splitlines() if line.strip()]
+        entries = _merged(_parse_entry(line) for line in text.splitlines() if line.strip())
         return sorted((e for e in entries if e.name.startswith("hlvs-")),
                       key=lambda e: (e.state != "PENDING", e.job_id))
 
@@ -240,8 +266,8 @@ class SlurmPool:
     def _entry(self, job_id: str) -> QueueEntry | None:
         text = self._run(["squeue", "-h", "-j", job_id, "-o", "%i|%j|%a|%T|%r|%S|%N"],
                          handle=job_id, ok_codes=(0, 1))
-        lines = [line for line in text.splitlines() if line.startswith(job_id + "|")]
-        return _parse_entry(lines[0]) if lines else None
+        entries = _merged(_parse_entry(line) for line in text.splitlines() if line.strip())
+        return next((e for e in entries if e.job_id == job_id), None)
 
     def _squeue_state(self, job_id: str) -> str | None:
         entry = self._entry(job_id)
@@ -266,6 +292,21 @@ class SlurmPool:
             raise PoolError(handle=handle, reason=f"{' '.join(args[:2])}: exit "
                             f"{result.returncode}: {result.stderr.strip()[-300:]}")
         return result.stdout
+
+
+def _merged(entries: Iterable[QueueEntry]) -> list[QueueEntry]:
+    """One entry per job: the components of a heterogeneous job (``<id>+<k>``, league
+    placement) as one, with the nodes of all of them (the simulator's first)."""
+    merged: dict[str, QueueEntry] = {}
+    for entry in entries:
+        base = entry.job_id.split("+")[0]
+        first = merged.get(base)
+        if first is None:
+            merged[base] = replace(entry, job_id=base)
+        elif entry.nodes:
+            merged[base] = replace(first, nodes=",".join(n for n in (first.nodes, entry.nodes)
+                                                         if n))
+    return list(merged.values())
 
 
 def _parse_entry(line: str) -> QueueEntry:

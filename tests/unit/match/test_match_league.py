@@ -1,0 +1,131 @@
+"""League placement against in-memory fakes: node addresses in the robots' environment and the
+spec, a holder per node in the node's network, the robot node firewall and shaping made before
+the robot runs and undone at the end; parsing of the nodes a Slurm job passes; the
+heterogeneous job the Slurm pool submits."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from orchestrator.errors import ConfigError
+from orchestrator.match import MatchRunner, RunOptions
+from orchestrator.match.fake import FakeContainer, FakeHost, FakeRuntime
+from orchestrator.match.placement import ROBOT_CGROUP_PARENT, parse_nodes
+from tests.unit.match.test_match_runner import _plan
+
+KEYS = ["red-1", "red-2", "blue-1", "blue-2"]
+NODES = "n1=10.77.0.11,n2=10.77.0.12,n3=10.77.0.13,n4=10.77.0.14,n5=10.77.0.15"
+
+
+def test_league_match_runs_each_robot_in_its_nodes_network(tmp_path: Path) -> None:
+    runtime = FakeRuntime()
+    host = FakeHost()
+    started: dict[str, FakeContainer] = {}
+    firewalls_at_start: dict[str, int] = {}
+
+    def on_start(container: FakeContainer) -> None:
+        started[container.request.name] = container
+        firewalls_at_start[container.request.name] = len(host.node_firewalls)
+
+    runtime.on_start = on_start
+    placement = parse_nodes(NODES, KEYS, netns="/run/netns/hlvs-{node}")
+    runner = MatchRunner(_plan(), runtime=runtime, host=host, options=RunOptions(
+        out_dir=tmp_path, simulator_image="sim:1", poll_s=0.0, placement=placement))
+    outcome = runner.run()
+    assert outcome.ok, outcome.failure
+    assert runtime.networks == {} and not any(c == "create_network" for c, _ in runtime.calls)
+    spec = json.loads((tmp_path / "simulator/match_spec.json").read_text())
+    assert spec["hosts"] == {"red": ["10.77.0.12", "10.77.0.13"],
+                             "blue": ["10.77.0.14", "10.77.0.15"]}
+    assert spec["telemetry"] is None
+    holders = {name: c for name, c in started.items() if "-node-" in name}
+    assert sorted(holders) == [f"hlvs-u1-node-n{i}" for i in range(1, 6)]
+    for i in range(1, 6):
+        request = holders[f"hlvs-u1-node-n{i}"].request
+        assert request.network_mode == "none" and request.cap_add == ("SYS_ADMIN",)
+        assert request.cap_drop == ("ALL",)
+        assert [str(m.source) for m in request.mounts] == [f"/run/netns/hlvs-n{i}"]
+        assert request.entrypoint == ("nsenter",)
+    ids = {name: c.state.id for name, c in started.items()}
+    simulator = started["hlvs-u1-simulator"].request
+    assert simulator.network_mode == f"container:{ids['hlvs-u1-node-n1']}"
+    assert simulator.networks == ()
+    red2 = started["hlvs-u1-red-2"].request
+    assert red2.network_mode == f"container:{ids['hlvs-u1-node-n3']}"
+    assert red2.cgroup_parent == ROBOT_CGROUP_PARENT
+    assert red2.environment["ROBOCUP_SIMULATOR_ADDR"] == "10.77.0.11:10002"
+    assert red2.environment["ROBOCUP_MIRROR_SERVER_IP"] == "10.77.0.11"
+    assert red2.environment["ROBOCUP_GAMECONTROLLER_IP"] == "10.77.0.11"
+    assert red2.environment["ROBOCUP_TEAM_PLAYER1_IP"] == "10.77.0.12"
+    assert red2.environment["ROBOCUP_TEAM_PLAYER2_IP"] == "10.77.0.13"
+    blue1 = started["hlvs-u1-blue-1"].request
+    assert blue1.environment["ROBOCUP_TEAM_PLAYER2_IP"] == "10.77.0.15"
+    assert firewalls_at_start["hlvs-u1-blue-1"] >= 1  # its node was closed before it ran
+    # every firewall and shaping undone; what they were:
+    assert host.node_firewalls == {}
+    assert sorted(host.unshaped) == [f"/run/netns/hlvs-n{i}" for i in range(2, 6)]
+    red_mates = {s.teammate_ips for s in host.shaped if s.teammate_ips == ("10.77.0.13",)}
+    assert red_mates and all(s.simulator_ip == "10.77.0.11" for s in host.shaped)
+    results = json.loads((tmp_path / "results.json").read_text())
+    assert results["robots"]["red-1"]["limits"]["api_rate_bit_s"] == 40_000_000
+
+
+def test_league_firewall_rules_name_the_nodes(tmp_path: Path) -> None:
+    host = FakeHost()
+    seen: dict[str, object] = {}
+    runtime = FakeRuntime()
+    runtime.on_start = lambda c: seen.update(host.node_firewalls)
+    placement = parse_nodes(NODES, KEYS, netns="/run/netns/hlvs-{node}")
+    MatchRunner(_plan(), runtime=runtime, host=host, options=RunOptions(
+        out_dir=tmp_path, simulator_image="sim:1", poll_s=0.0, placement=placement)).run()
+    red1 = seen["/run/netns/hlvs-n2"]
+    assert red1 == type(red1)(simulator="10.77.0.11", api_port=10001, udp_ports=(3737, 3939),
+                              teammates=("10.77.0.13",),
+                              opponents=("10.77.0.14", "10.77.0.15"))
+    assert "/run/netns/hlvs-n1" not in seen  # the simulator's node has no robot firewall
+
+
+@pytest.mark.parametrize(("text", "netns", "expected"), [
+    ("n1=10.77.0.11,n2=10.77.0.12", None, "nodes for 4 robots"),
+    (NODES.replace("n5=10.77.0.15", "n4=10.77.0.15"), None, "named twice"),
+    (NODES.replace("10.77.0.13", "ten"), None, "is not NAME=ADDRESS"),
+    (NODES, "/run/netns/fixed", "does not name the node"),
+])
+def test_bad_league_nodes_are_named(text: str, netns: str | None, expected: str) -> None:
+    with pytest.raises(ConfigError) as err:
+        parse_nodes(text, KEYS, netns=netns)
+    assert expected in str(err.value)
+
+
+def test_slurm_pool_submits_a_heterogeneous_job_for_league_placement(tmp_path: Path) -> None:
+    from service.pool import MatchJob
+    from service.pool.slurm import SlurmPool
+
+    calls: list[tuple[list[str], str | None]] = []
+
+    class Recording(SlurmPool):  # Slurm's commands recorded at the adapter's one boundary
+        def _run(self, args: list[str], *, handle: str, stdin: str | None = None,
+                 ok_codes: tuple[int, ...] = (0,)) -> str:
+            calls.append((args, stdin))
+            if args[0] == "squeue":
+                return ("7+0|hlvs-m|a|RUNNING|None|2026-01-01T00:00:00|n1\n"
+                        "7+1|hlvs-m|a|RUNNING|None|2026-01-01T00:00:00|n2\n"
+                        "7+2|hlvs-m|a|RUNNING|None|2026-01-01T00:00:00|n3\n")
+            return "7\n" if args[0] == "sbatch" else ""
+
+    pool = Recording(out_subdir="", host_network=True)
+    handle = pool.submit(MatchJob(match_id="m", game_path=tmp_path / "g.json",
+                                  work_dir=tmp_path / "w", account="team_a", robot_nodes=2))
+    args, script = calls[0]
+    assert args.count(":") == 2 and args.count("--exclusive") == 3
+    assert args.count("--account=team_a") == 3
+    assert args.count("--constraint=sim") == 1 and args.count("--constraint=robot") == 2
+    assert script is not None and "SLURM_JOB_NODELIST_HET_GROUP_$group" in script
+    assert "--placement league --league-nodes \"$nodes\"" in script
+    assert "--node-netns '/run/netns/hlvs-{node}'" in script
+    status = pool.status(handle)
+    assert status.detail == "on n1,n2,n3"
+    assert [e.job_id for e in pool.queue()] == ["7"]
