@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import json
 import types
-from dataclasses import MISSING, fields, is_dataclass
+from dataclasses import MISSING, Field, fields, is_dataclass
 from enum import Enum
 from pathlib import Path
 from typing import Any, ClassVar, Literal, TypeVar, Union, get_args, get_origin, get_type_hints
@@ -21,10 +21,36 @@ T = TypeVar("T")
 V = TypeVar("V", bound="Versioned")
 
 
+JSON_KEY = "json_key"
+"""Field metadata: the field's key in JSON when it cannot be its Python name (``class``)."""
+
+
+OMIT_NONE = "omit_none"
+"""Field metadata: the key is left out of the JSON while the field is None."""
+
+
+def json_key(key: str) -> dict[str, str]:
+    """``field(metadata=json_key("class"))``: the field is written and read as ``key``."""
+    return {JSON_KEY: key}
+
+
+def omitted_when_none() -> dict[str, bool]:
+    """``field(default=None, metadata=omitted_when_none())``: no key while the value is None."""
+    return {OMIT_NONE: True}
+
+
+def _key(f: Field[Any]) -> str:
+    return str(f.metadata.get(JSON_KEY, f.name))
+
+
 def to_data(value: Any) -> Any:
     """JSON values for a dataclass (recursively); enums become their values, tuples lists."""
     if is_dataclass(value) and not isinstance(value, type):
-        return {f.name: to_data(getattr(value, f.name)) for f in fields(value)}
+        return {
+            _key(f): to_data(getattr(value, f.name))
+            for f in fields(value)
+            if not (f.metadata.get(OMIT_NONE) and getattr(value, f.name) is None)
+        }
     if isinstance(value, Enum):
         return value.value
     if isinstance(value, tuple | list):
@@ -39,21 +65,22 @@ def from_data(cls: type[T], data: Any, *, source: str, pointer: str = "") -> T:
     if not isinstance(data, dict):
         raise ContractError(source=source, pointer=pointer, reason="expected an object")
     hints = get_type_hints(cls)
-    names = {f.name for f in fields(cls) if f.init}  # type: ignore[arg-type]
-    unknown = sorted(set(data) - names)
+    keys = {_key(f): f.name for f in fields(cls) if f.init}  # type: ignore[arg-type]
+    unknown = sorted(set(data) - set(keys))
     if unknown:
         raise ContractError(
             source=source, pointer=f"{pointer}/{unknown[0]}", reason="unknown field"
         )
     for f in fields(cls):  # type: ignore[arg-type]
         required = f.default is MISSING and f.default_factory is MISSING
-        if f.init and required and f.name not in data:
+        if f.init and required and _key(f) not in data:
             raise ContractError(
-                source=source, pointer=f"{pointer}/{f.name}", reason="missing field"
+                source=source, pointer=f"{pointer}/{_key(f)}", reason="missing field"
             )
     kwargs = {
-        name: convert(hints[name], data[name], source=source, pointer=f"{pointer}/{name}")
-        for name in names & set(data)
+        name: convert(hints[name], data[key], source=source, pointer=f"{pointer}/{key}")
+        for key, name in keys.items()
+        if key in data
     }
     try:
         return cls(**kwargs)
@@ -141,6 +168,7 @@ class Versioned:
 
     VERSION: ClassVar[int] = 1
     KIND: ClassVar[str] = "document"
+    FILE_MODE: ClassVar[int | None] = None  # permissions of a written file (None: the umask's)
 
     def to_dict(self) -> dict[str, Any]:
         data: dict[str, Any] = to_data(self)
@@ -176,12 +204,24 @@ class Versioned:
         return cls.from_json(text, source=str(path))
 
     def write(self, path: str | Path) -> Path:
-        """Write atomically (a temporary file renamed into place)."""
+        """Write atomically (a temporary file renamed into place), with :attr:`FILE_MODE`."""
         path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
         tmp = path.with_name(path.name + ".tmp")
         tmp.write_text(self.to_json() + "\n", encoding="utf-8")
+        if self.FILE_MODE is not None:
+            tmp.chmod(self.FILE_MODE)
         tmp.replace(path)
         return path
 
 
-__all__ = ["Versioned", "convert", "from_data", "to_data"]
+__all__ = [
+    "JSON_KEY",
+    "OMIT_NONE",
+    "Versioned",
+    "convert",
+    "from_data",
+    "json_key",
+    "omitted_when_none",
+    "to_data",
+]

@@ -178,9 +178,9 @@ def summarize(outcome: MatchOutcome, *, as_json: bool = False) -> int:
     """Print the outcome (one line, or results.json with ``as_json``) and return its exit code:
     0 played, 4 decided by forfeit, 1 failed, 3 infrastructure, 130 interrupted."""
     results = outcome.results
-    score = results.get("score") or {}
+    score = (results.score if results is not None else None) or {}
     failure = outcome.failure
-    forfeit = results.get("forfeit")
+    forfeit = results.forfeit if results is not None else None
     if failure is None:
         code = ExitCode.FORFEIT if forfeit else ExitCode.OK
     elif failure.failure_class is FailureClass.INTERRUPTED:
@@ -190,7 +190,7 @@ def summarize(outcome: MatchOutcome, *, as_json: bool = False) -> int:
     else:
         code = ExitCode.FAILED
     if as_json:
-        document = dict(results)
+        document = results.to_dict() if results is not None else {}
         document.setdefault("match_id", outcome.match_id)
         document["out_dir"] = str(outcome.out_dir)
         document["exit_code"] = int(code)
@@ -202,10 +202,10 @@ def summarize(outcome: MatchOutcome, *, as_json: bool = False) -> int:
         return code
     if failure is None:
         if forfeit:
-            what = f"{forfeit['team']} forfeits, winner {forfeit['winner']}"
+            what = f"{forfeit.team} forfeits, winner {forfeit.winner}"
         else:
-            what = (f"red {score.get('red')} - {score.get('blue')} blue, "
-                    f"winner {results.get('winner')}")
+            winner = results.winner if results is not None else None
+            what = f"red {score.get('red')} - {score.get('blue')} blue, winner {winner}"
         print(f"match {outcome.match_id}: {what}; results in {outcome.out_dir}")
         for line in watch_hint(outcome.out_dir):
             print(line)

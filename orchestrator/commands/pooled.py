@@ -11,17 +11,18 @@ command again with the same ``--out`` while the job is in Slurm adopts the job.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 import time
 from pathlib import Path
 from typing import Any
 
+from contracts import files
+from contracts.errors import ContractError
+from contracts.match_results import FailureClass, MatchReport, MatchResults
 from orchestrator.commands.play import stop_on_signals, summarize
 from orchestrator.errors import InfrastructureError
 from orchestrator.match import MatchOutcome
-from orchestrator.match.results import Failure, FailureClass
 
 DEFAULT_CONF = "/var/lib/hlvs/slurm/slurm.conf"
 POLL_S = 1.0
@@ -49,7 +50,7 @@ def play_in_pool(
     try:
         handle = pool.recorded(out_dir)
         if handle is None or not pool.active(handle):
-            for name in ("report.json", "results.json"):  # of an earlier run in this folder
+            for name in (files.REPORT, files.RESULTS):  # of an earlier run in this folder
                 (out_dir / name).unlink(missing_ok=True)
             handle = pool.submit(MatchJob(
                 match_id=match_id, game_path=game_path, work_dir=out_dir,
@@ -94,10 +95,10 @@ def _ended_early(lost: bool, out_dir: Path) -> bool:
     if lost:
         return True
     try:
-        report = json.loads((out_dir / "report.json").read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+        report = MatchReport.load(out_dir / files.REPORT)
+    except ContractError:
         return True
-    return bool(report.get("failure_class") == "interrupted")
+    return report.failure_class is FailureClass.INTERRUPTED
 
 
 def _final(pool: Any, handle: str) -> str:
@@ -111,19 +112,14 @@ def _final(pool: Any, handle: str) -> str:
 
 def read_outcome(match_id: str, out_dir: Path) -> MatchOutcome:
     """The outcome of a match played elsewhere, from the files it left in ``out_dir``."""
-    report = json.loads((out_dir / "report.json").read_text(encoding="utf-8"))
-    results_path = out_dir / "results.json"
-    results = json.loads(results_path.read_text(encoding="utf-8")) if results_path.is_file() \
-        else {}
-    failure = None
-    if report.get("status") != "success":
-        try:
-            failure_class = FailureClass(report.get("failure_class"))
-        except ValueError:
-            failure_class = FailureClass.INFRASTRUCTURE
-        failure = Failure(failure_class=failure_class, cause=str(report.get("cause", "")))
-    return MatchOutcome(match_id=match_id, failure=failure, out_dir=out_dir, results=results,
-                        bringup_s=None)
+    results_path = out_dir / files.RESULTS
+    try:
+        report = MatchReport.load(out_dir / files.REPORT)
+        results = MatchResults.load(results_path) if results_path.is_file() else None
+    except ContractError as exc:
+        raise InfrastructureError(f"match {match_id}: {exc}") from exc
+    return MatchOutcome(match_id=match_id, failure=report.failure, out_dir=out_dir,
+                        results=results, bringup_s=None)
 
 
 def _say(line: str, as_json: bool) -> None:

@@ -11,12 +11,13 @@ import logging
 import shutil
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import replace
 from functools import partial
 from pathlib import Path
-from typing import Any
 
 from contracts import files
 from contracts.errors import ContractError
+from contracts.match_results import MatchLimits, MatchResults
 from contracts.sim_result import SimResult
 from orchestrator.errors import OrchestratorError
 from orchestrator.match.context import MatchContext
@@ -131,7 +132,7 @@ def _collect_log_folder(match: MatchContext, key: str, folder: LogFolder,
                         destination: Path) -> None:
     """What a team wrote never fails the match: only releasing the mount can raise."""
     report = match.host.collect_logs(folder, destination)
-    match.records[key].log_folder = report.to_json()
+    match.records[key].log_folder = report.record()
     if report.skipped_count:
         log.warning("match %s: %s: %d entries of /robocup-logs not collected (%s)",
                     match.plan.match_id, key, report.skipped_count,
@@ -167,7 +168,7 @@ def _teardown(match: MatchContext) -> None:
              lambda: match.host.remove_isolation(match_id=match.plan.match_id))
 
 
-def _finish(match: MatchContext) -> dict[str, Any]:
+def _finish(match: MatchContext) -> MatchResults:
     """Run STOPPING and COLLECTING from wherever the match got to; returns the results."""
     lifecycle = match.lifecycle
     if lifecycle.state in (MatchState.PULLING, MatchState.STARTING, MatchState.WAITING,
@@ -212,7 +213,7 @@ def _version() -> str:
         return "unknown"
 
 
-def _write(match: MatchContext) -> dict[str, Any]:
+def _write(match: MatchContext) -> MatchResults:
     out: Path = match.options.out_dir
     plan = match.plan
     limits = plan.limits
@@ -222,26 +223,25 @@ def _write(match: MatchContext) -> dict[str, Any]:
         sim_result=read_sim_result(match),
         robots=list(match.records.values()),
         forfeit=match.forfeit,
-        limits={
-            "cpus": limits.cpus, "memory_gb": limits.memory_gb, "pids": limits.pids,
-            "log_folder_gb": limits.log_folder_gb, "team_api_mb_s": limits.team_api_mb_s,
-            "team_comm_mb_s": limits.team_comm_mb_s, "grace_period_s": plan.grace_period_s,
-            "allow_internet": plan.allow_internet,
-            "host_controls": _host_controls(match),
-        },
+        limits=MatchLimits(
+            cpus=limits.cpus, memory_gb=limits.memory_gb, pids=limits.pids,
+            log_folder_gb=limits.log_folder_gb, team_api_mb_s=limits.team_api_mb_s,
+            team_comm_mb_s=limits.team_comm_mb_s, grace_period_s=plan.grace_period_s,
+            allow_internet=plan.allow_internet, host_controls=_host_controls(match),
+        ),
         versions={"hlvs-runner": _version(), **plan.versions},
         timings_s=dict(match.lifecycle.timings_s),
         failure=match.failure,
+        bringup_s=match.bringup_s,
+        admission=dict(plan.admission) if plan.admission is not None else None,
     )
-    results["bringup_s"] = match.bringup_s
-    results["admission"] = dict(plan.admission) if plan.admission is not None else None
     write_results(out, results)
     lifecycle = match.lifecycle
     if lifecycle.state is MatchState.COLLECTING:
         match.advance(MatchState.FAILED if match.failure else MatchState.DONE)
     elif lifecycle.state is MatchState.PENDING:
         match.advance(MatchState.FAILED)
-    results["timings_s"] = dict(lifecycle.timings_s)
+    results = replace(results, timings_s=dict(lifecycle.timings_s))
     write_results(out, results)
     restrict(out)  # the teams' logs are theirs: owner-only, as everything else here
     write_report(out, match.failure)
@@ -257,7 +257,7 @@ class CollectionPhase:
         self.match = match
 
 
-    def run(self) -> dict[str, Any]:
+    def run(self) -> MatchResults:
         """Stop, collect, remove everything created, write ``results.json`` and, last,
         ``report.json``; returns the results."""
         return _finish(self.match)

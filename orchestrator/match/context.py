@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from contracts.match_results import Forfeit
 from orchestrator.bandwidth import AppliedShaping
 from orchestrator.match.admission import CpuSets
 from orchestrator.match.host import Host
@@ -110,7 +111,7 @@ class MatchContext:
         self.monitor = StatsMonitor(runtime)
         self.started = Started()
         self.failure: Failure | None = None
-        self.forfeit: dict[str, Any] | None = None
+        self.forfeit: Forfeit | None = None
         self.bringup_s: float | None = None
         self.telemetry: TelemetrySource | None = None
 

@@ -1,48 +1,27 @@
-"""What a match leaves behind: ``results.json`` and, written last, ``report.json``.
-
-``report.json`` is ``{"status": "success"}`` or ``{"status": "failed", "failure_class": ...,
-"cause": ...}``; a reader that finds it knows every other file of the match folder is complete.
-
-Failure classes:
-
-- ``infrastructure``: the engine, a network, the host firewall or a mount failed us;
-- ``image_pull``: no robot of either team has a usable image;
-- ``team_startup``: the containers of a team's robots could not be created or started;
-- ``team_crash``: reserved for a team whose robots break the match (a robot that exits or is
-  OOM-killed mid-game does *not* fail the match; it is recorded per robot);
-- ``simulator``: the simulator container exited without FINISHED, or its telemetry was silent;
-- ``referee``: the simulator ran to its end but the game did not reach FINISHED;
-- ``interrupted``: the orchestrator was asked to stop (SIGINT / SIGTERM).
+"""Building ``results.json`` and ``report.json`` (:mod:`contracts.match_results`) from what the
+match recorded: :class:`RobotRecord` per robot (filled in as the match runs), the simulator's
+:class:`~contracts.sim_result.SimResult`, the forfeit and the failure.
 """
 
 from __future__ import annotations
 
-import enum
-import json
-import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from contracts import files
-from contracts.codec import to_data
+from contracts.match_results import (
+    Failure,
+    FailureClass,
+    Forfeit,
+    LogFolderCopy,
+    MatchLimits,
+    MatchReport,
+    MatchResults,
+    RobotResult,
+    Scalar,
+)
 from contracts.sim_result import SimResult
-
-
-class FailureClass(enum.Enum):
-    INFRASTRUCTURE = "infrastructure"
-    IMAGE_PULL = "image_pull"
-    TEAM_STARTUP = "team_startup"
-    TEAM_CRASH = "team_crash"
-    SIMULATOR = "simulator"
-    REFEREE = "referee"
-    INTERRUPTED = "interrupted"
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Failure:
-    failure_class: FailureClass
-    cause: str
 
 
 @dataclass(slots=True, kw_only=True)
@@ -65,37 +44,38 @@ class RobotRecord:
     memory_peak_bytes: int = 0
     sent_bytes: int | None = None
     received_bytes: int | None = None
-    limits: dict[str, Any] = field(default_factory=dict)
-    log_folder: dict[str, Any] | None = None  # what collection copied and skipped
+    limits: dict[str, Scalar] = field(default_factory=dict)
+    log_folder: LogFolderCopy | None = None  # what collection copied and skipped
 
-    def to_json(self, api: dict[str, Any] | None) -> dict[str, Any]:
-        return {
-            "image": self.image,
-            "digest": self.digest,
-            "image_error": self.image_error,
-            "container": self.container,
-            "startup_error": self.startup_error,
-            "exit_code": self.exit_code,
-            "oom_killed": self.oom_killed,
-            "restarts": self.restarts,
-            "exited_during_game": self.exited_during_game,
-            "cpu_peak_percent": round(self.cpu_peak_percent, 1),
-            "memory_peak_bytes": self.memory_peak_bytes,
-            "sent_bytes": self.sent_bytes,
-            "received_bytes": self.received_bytes,
-            "limits": self.limits,
-            "api": api,
-            "log_folder": self.log_folder,
-            "spoofing_attempts": 0,  # messages sent as another robot (set from the simulator)
-        }
+    def result(self, api: dict[str, Any] | None, *, spoofing_attempts: int = 0) -> RobotResult:
+        return RobotResult(
+            image=self.image,
+            digest=self.digest,
+            image_error=self.image_error,
+            container=self.container,
+            startup_error=self.startup_error,
+            exit_code=self.exit_code,
+            oom_killed=self.oom_killed,
+            restarts=self.restarts,
+            exited_during_game=self.exited_during_game,
+            cpu_peak_percent=round(self.cpu_peak_percent, 1),
+            memory_peak_bytes=self.memory_peak_bytes,
+            sent_bytes=self.sent_bytes,
+            received_bytes=self.received_bytes,
+            limits=dict(self.limits),
+            api=api,
+            log_folder=self.log_folder,
+            spoofing_attempts=spoofing_attempts,
+        )
 
 
-def _write_json(path: Path, data: dict[str, Any]) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(json.dumps(data, indent=2, sort_keys=True) + "\n", encoding="utf-8")
-    tmp.chmod(0o600)
-    os.replace(tmp, path)
+def spoofing_attempts(spoofing: dict[str, Any] | None) -> dict[str, int]:
+    """Messages each robot sent as another robot, from the simulator's spoofing record."""
+    counts: dict[str, int] = {}
+    for attempt in (spoofing or {}).get("attempts") or []:
+        sender = str(attempt.get("sender_robot"))
+        counts[sender] = counts.get(sender, 0) + int(attempt.get("count") or 0)
+    return counts
 
 
 def build_results(
@@ -104,51 +84,48 @@ def build_results(
     seed: int,
     sim_result: SimResult | None,
     robots: list[RobotRecord],
-    forfeit: dict[str, Any] | None,
-    limits: dict[str, Any],
-    versions: dict[str, Any],
+    forfeit: Forfeit | None,
+    limits: MatchLimits,
+    versions: dict[str, str],
     timings_s: dict[str, float],
     failure: Failure | None,
-) -> dict[str, Any]:
+    bringup_s: float | None = None,
+    admission: dict[str, Any] | None = None,
+) -> MatchResults:
     sim = sim_result
-    api_stats: dict[str, Any] = sim.robots if sim is not None else {}
-    score: Any = sim.score if sim is not None else None
-    winner: Any = sim.winner if sim is not None else None
+    api_stats: dict[str, dict[str, Any]] = sim.robots if sim is not None else {}
+    score = sim.score if sim is not None else None
+    winner: str | None = sim.winner if sim is not None else None
     if forfeit is not None:
-        score = forfeit.get("score", score)
-        winner = forfeit.get("winner")
+        score, winner = forfeit.score, forfeit.winner
     spoofing = sim.spoofing if sim is not None else None
-    robot_json = {r.key: r.to_json(api_stats.get(r.key)) for r in robots}
-    for attempt in (spoofing or {}).get("attempts") or []:
-        sender = robot_json.get(str(attempt.get("sender_robot")))
-        if sender is not None:
-            sender["spoofing_attempts"] += int(attempt.get("count") or 0)
-    return {
-        "match_id": match_id,
-        "seed": seed,
-        "warnings": team_warnings(robots, api_stats) if sim_result is not None else [],
-        "status": "failed" if failure else "success",
-        "failure": None
-        if failure is None
-        else {"class": failure.failure_class.value, "cause": failure.cause},
-        "forfeit": forfeit,
-        "final_state": sim.state if sim is not None else None,
-        "score": score,
-        "winner": winner,
-        "events_summary": sim.events_summary if sim is not None else {},
-        # how much football was played (contracts.sim_result.PlayRecord), None when not counted
-        "play": to_data(sim.play) if sim is not None and sim.play is not None else None,
-        "sim_time_ms": sim.sim_time_ms if sim is not None else None,
-        "real_time_factor": sim.real_time_factor if sim is not None else None,
-        "robots": robot_json,
-        "spoofing": spoofing,
-        "limits": limits,
-        "versions": {**versions, "simulator": sim.versions if sim is not None else None},
-        "timings_s": timings_s,
-    }
+    spoofed = spoofing_attempts(spoofing)
+    return MatchResults(
+        match_id=match_id,
+        seed=seed,
+        warnings=tuple(team_warnings(robots, api_stats)) if sim is not None else (),
+        status="failed" if failure else "success",
+        failure=failure,
+        forfeit=forfeit,
+        final_state=sim.state if sim is not None else None,
+        score=score,
+        winner=winner,
+        events_summary=sim.events_summary if sim is not None else {},
+        play=sim.play if sim is not None else None,
+        sim_time_ms=sim.sim_time_ms if sim is not None else None,
+        real_time_factor=sim.real_time_factor if sim is not None else None,
+        robots={r.key: r.result(api_stats.get(r.key), spoofing_attempts=spoofed.get(r.key, 0))
+                for r in robots},
+        spoofing=spoofing,
+        limits=limits,
+        versions={**versions, "simulator": sim.versions if sim is not None else None},
+        timings_s=timings_s,
+        bringup_s=bringup_s,
+        admission=admission,
+    )
 
 
-def team_warnings(robots: list[RobotRecord], api_stats: dict[str, Any]) -> list[str]:
+def team_warnings(robots: list[RobotRecord], api_stats: dict[str, dict[str, Any]]) -> list[str]:
     """What a score alone hides: a team whose started robots all exited during the game, or
     none of which ever connected to the simulator."""
     warnings = []
@@ -165,24 +142,13 @@ def team_warnings(robots: list[RobotRecord], api_stats: dict[str, Any]) -> list[
     return warnings
 
 
-def write_results(out_dir: Path, results: dict[str, Any]) -> Path:
-    path = out_dir / files.RESULTS
-    _write_json(path, results)
-    return path
+def write_results(out_dir: Path, results: MatchResults) -> Path:
+    return results.write(out_dir / files.RESULTS)
 
 
 def write_report(out_dir: Path, failure: Failure | None) -> Path:
     """Written last: its presence means the match folder is complete."""
-    report: dict[str, Any] = {"status": "success"}
-    if failure is not None:
-        report = {
-            "status": "failed",
-            "failure_class": failure.failure_class.value,
-            "cause": failure.cause,
-        }
-    path = out_dir / files.REPORT
-    _write_json(path, report)
-    return path
+    return MatchReport.of(failure).write(out_dir / files.REPORT)
 
 
 __all__ = [
@@ -190,6 +156,7 @@ __all__ = [
     "FailureClass",
     "RobotRecord",
     "build_results",
+    "spoofing_attempts",
     "team_warnings",
     "write_report",
     "write_results",

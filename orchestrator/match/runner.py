@@ -19,9 +19,9 @@ import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 from contracts import files
+from contracts.match_results import Color, Forfeit, MatchResults
 from orchestrator.errors import OrchestratorError
 from orchestrator.match.collection import CollectionPhase, read_sim_result, simulator_stderr_tail
 from orchestrator.match.context import MatchContext, RunOptions, TelemetryFactory
@@ -43,7 +43,7 @@ class MatchOutcome:
     match_id: str
     failure: Failure | None
     out_dir: Path
-    results: dict[str, Any]
+    results: MatchResults | None  # None: a match played elsewhere left no results.json
     bringup_s: float | None  # start of STARTING -> every robot connected (from telemetry)
 
     @property
@@ -132,7 +132,7 @@ class MatchRunner(MatchContext):
             else:
                 log.warning("match %s: robot %s has no usable image: %s",
                             self.plan.match_id, key, error)
-        forfeiting = [c for c in ("red", "blue") if usable[c] == 0]
+        forfeiting: list[Color] = [c for c in ("red", "blue") if usable[c] == 0]
         first_error = {
             color: next((f"{r.key}: {r.image_error}" for r in self.records.values()
                          if r.color == color and r.image_error), "no players")
@@ -143,13 +143,13 @@ class MatchRunner(MatchContext):
                        + "; ".join(first_error.values()) + ")")
         elif forfeiting:
             loser = forfeiting[0]
-            winner = "blue" if loser == "red" else "red"
-            self.forfeit = {
-                "team": loser,
-                "winner": winner,
-                "reason": f"no robot of {loser} has a usable image ({first_error[loser]})",
-                "score": {winner: 0, loser: 0},
-            }
+            winner: Color = "blue" if loser == "red" else "red"
+            self.forfeit = Forfeit(
+                team=loser,
+                winner=winner,
+                reason=f"no robot of {loser} has a usable image ({first_error[loser]})",
+                score={winner: 0, loser: 0},
+            )
             log.info("match %s: %s forfeits (no usable image)", self.plan.match_id, loser)
 
     def _watch(self, started_at: float) -> None:

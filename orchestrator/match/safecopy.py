@@ -16,6 +16,8 @@ import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from contracts.match_results import LogFolderCopy
+
 log = logging.getLogger(__name__)
 
 MAX_LISTED = 100  # skipped entries named in the result; the rest are only counted
@@ -34,9 +36,10 @@ class CopyReport:
         if len(self.skipped) < MAX_LISTED:
             self.skipped.append({"path": path, "kind": kind})
 
-    def to_json(self) -> dict[str, object]:
-        return {"files": self.files, "bytes": self.bytes, "skipped": list(self.skipped),
-                "skipped_count": self.skipped_count}
+    def record(self) -> LogFolderCopy:
+        """What ``results.json`` keeps of the copy."""
+        return LogFolderCopy(files=self.files, bytes=self.bytes, skipped=tuple(self.skipped),
+                             skipped_count=self.skipped_count)
 
 
 def kind_of(mode: int) -> str:

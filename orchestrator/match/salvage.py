@@ -8,11 +8,11 @@ from __future__ import annotations
 import logging
 import re
 import shutil
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
 
 from contracts import files
+from contracts.match_results import MatchResults, Salvage, SalvagedRobot
 from orchestrator.engine import LABEL_ROBOT, LABEL_ROLE, LABEL_TEAM
 from orchestrator.errors import OrchestratorError
 from orchestrator.match import logfs
@@ -33,7 +33,7 @@ PUBLIC_FILES = (
 @dataclass(slots=True)
 class SalvageReport:
     out_dir: str
-    robots: dict[str, dict[str, Any]] = field(default_factory=dict)
+    robots: dict[str, SalvagedRobot] = field(default_factory=dict)
     public: list[str] = field(default_factory=list)
     errors: list[str] = field(default_factory=list)
 
@@ -54,12 +54,13 @@ def salvage(runtime: ContainerRuntime, record: RunRecord, objects: list[ProjectO
               and (key := _robot_key(o)) is not None]
     for obj, (team, number) in robots:
         folder = out / "teams" / team / number
-        entry = report.robots.setdefault(f"{team}-{number}", {})
+        robot = f"{team}-{number}"
+        report.robots.setdefault(robot, SalvagedRobot())
         try:
             runtime.stop(obj.id, timeout_s=STOP_TIMEOUT_S)
             folder.mkdir(parents=True, exist_ok=True, mode=0o700)
             runtime.save_logs(obj.id, stdout=folder / "stdout.log", stderr=folder / "stderr.log")
-            entry["stdout"] = True
+            report.robots[robot] = replace(report.robots[robot], stdout=True)
         except (OrchestratorError, OSError) as exc:
             report.errors.append(f"{team}-{number}: logs not saved: {exc}")
     for obj in containers:
@@ -85,17 +86,17 @@ def salvage(runtime: ContainerRuntime, record: RunRecord, objects: list[ProjectO
             if not mount.is_dir() or mount.is_symlink() or not number.isdigit():
                 continue
             copied = copy_tree(mount, out / "teams" / team / number / "robocup-logs")
-            report.robots.setdefault(mount.name, {})["log_folder"] = copied.to_json()
+            saved = report.robots.get(mount.name, SalvagedRobot())
+            report.robots[mount.name] = replace(saved, log_folder=copied.record())
     cause = (f"the orchestrator (pid {record.pid} on {record.hostname}) was gone; hlvs cleanup "
              "stopped the match and salvaged the teams' logs")
     failure = Failure(failure_class=FailureClass.INTERRUPTED, cause=cause)
     if not (out / files.RESULTS).is_file():
-        write_results(out, {
-            "match_id": record.match_id, "status": "failed",
-            "failure": {"class": failure.failure_class.value, "cause": cause},
-            "salvaged": {"robots": report.robots, "public": report.public,
-                         "errors": report.errors},
-        })
+        write_results(out, MatchResults(
+            match_id=record.match_id, status="failed", failure=failure,
+            salvaged=Salvage(robots=report.robots, public=tuple(report.public),
+                             errors=tuple(report.errors)),
+        ))
     restrict(out)
     write_report(out, failure)
     log.info("match %s: salvaged into %s (%d robots)", record.match_id, out, len(report.robots))

@@ -24,6 +24,8 @@ from pathlib import Path
 from typing import Any, Protocol
 
 from contracts import files
+from contracts.errors import ContractError
+from contracts.match_results import MatchReport, MatchResults
 from orchestrator.config.schedule import PlannedMatch, Schedule, ScheduledTeam, SchedulePool
 from orchestrator.errors import ScheduleError
 
@@ -140,17 +142,18 @@ def read_outcome(out_dir: Path) -> PlayOutcome:
             winner=None,
             cause=f"{report_path} was not written",
         )
-    report = json.loads(report_path.read_text(encoding="utf-8"))
-    results: dict[str, Any] = {}
-    if results_path.is_file():
-        results = json.loads(results_path.read_text(encoding="utf-8"))
-    score = results.get("score") or {}
+    try:
+        report = MatchReport.load(report_path)
+        results = MatchResults.load(results_path) if results_path.is_file() else None
+    except ContractError as exc:
+        return PlayOutcome(status="infrastructure", score_red=None, score_blue=None,
+                           winner=None, cause=str(exc))
     return PlayOutcome(
-        status=str(report.get("status", "infrastructure")),
-        score_red=score.get("red"),
-        score_blue=score.get("blue"),
-        winner=results.get("winner"),
-        cause=str(report.get("cause", "")),
+        status=report.status,
+        score_red=results.team_score("red") if results is not None else None,
+        score_blue=results.team_score("blue") if results is not None else None,
+        winner=results.winner if results is not None else None,
+        cause=report.cause or "",
     )
 
 

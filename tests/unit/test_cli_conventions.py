@@ -12,9 +12,11 @@ import subprocess
 import sys
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
+from typing import Any
 
 import pytest
 
+from contracts.match_results import Forfeit
 from orchestrator.cli import build_parser, log_level, main, walk
 from orchestrator.exitcodes import ExitCode
 
@@ -187,23 +189,30 @@ def test_compose_json_names_the_files_and_both_compose_commands(
     ("results", "failure", "code"),
     [
         ({"score": {"red": 1, "blue": 0}, "winner": "red"}, None, ExitCode.OK),
-        ({"forfeit": {"team": "Blue", "winner": "red"}}, None, ExitCode.FORFEIT),
+        ({"forfeit": Forfeit(team="blue", winner="red", reason="no usable image",
+                             score={"red": 0, "blue": 0})}, None, ExitCode.FORFEIT),
         ({}, ("team_crash", "red-1 crashed"), ExitCode.FAILED),
         ({}, ("infrastructure", "engine gone"), ExitCode.INFRASTRUCTURE),
         ({}, ("interrupted", "SIGTERM"), ExitCode.INTERRUPTED),
     ],
 )
 def test_match_exit_codes_and_json(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str], results: dict[str, object],
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], results: dict[str, Any],
     failure: tuple[str, str] | None, code: ExitCode,
 ) -> None:
+    from contracts.match_results import MatchLimits, MatchResults
     from orchestrator.commands.play import summarize
     from orchestrator.match import Failure, FailureClass, MatchOutcome
 
+    failed = Failure(failure_class=FailureClass(failure[0]), cause=failure[1]) if failure \
+        else None
+    limits = MatchLimits(cpus=4.0, memory_gb=16.0, pids=1024, log_folder_gb=10.0,
+                         team_api_mb_s=350.0, team_comm_mb_s=1.0, grace_period_s=5.0,
+                         allow_internet=False, host_controls=None)
     outcome = MatchOutcome(
-        match_id="m1", out_dir=tmp_path, results=dict(results), bringup_s=None,
-        failure=Failure(failure_class=FailureClass(failure[0]), cause=failure[1])
-        if failure else None,
+        match_id="m1", out_dir=tmp_path, bringup_s=None, failure=failed,
+        results=MatchResults(match_id="m1", seed=1, status="failed" if failed else "success",
+                             failure=failed, limits=limits, **results),
     )
     assert summarize(outcome) == code
     capsys.readouterr()

@@ -5,9 +5,11 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import pytest
 
+from contracts.match_results import Forfeit, MatchLimits, MatchReport, MatchResults
 from orchestrator.commands.play import summarize
 from orchestrator.commands.pooled import read_outcome
 from orchestrator.config.schedule import load_schedule
@@ -38,19 +40,28 @@ def test_schedule_pool_section(tmp_path: Path) -> None:
     assert "/pool/partiton" in str(err.value) and "unknown key" in str(err.value)
 
 
+LIMITS = MatchLimits(cpus=4.0, memory_gb=16.0, pids=1024, log_folder_gb=10.0,
+                     team_api_mb_s=350.0, team_comm_mb_s=1.0, grace_period_s=5.0,
+                     allow_internet=False, host_controls=None)
+FORFEIT = Forfeit(team="red", winner="blue", reason="no usable image",
+                  score={"red": 0, "blue": 0})
+
+
 @pytest.mark.parametrize(("report", "results", "code"), [
     ({"status": "success"}, {"score": {"red": 1, "blue": 0}, "winner": "red"}, 0),
-    ({"status": "success"}, {"forfeit": {"team": "red", "winner": "blue"}}, 4),
+    ({"status": "success"}, {"forfeit": FORFEIT, "winner": "blue"}, 4),
     ({"status": "failed", "failure_class": "interrupted", "cause": "SIGTERM"}, {}, 130),
     ({"status": "failed", "failure_class": "infrastructure", "cause": "engine"}, {}, 3),
     ({"status": "failed", "failure_class": "simulator", "cause": "exited"}, {}, 1),
 ])
 def test_exit_code_of_a_match_played_in_the_pool(
-    tmp_path: Path, report: dict[str, str], results: dict[str, object], code: int,
+    tmp_path: Path, report: dict[str, str], results: dict[str, Any], code: int,
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     (tmp_path / "report.json").write_text(json.dumps(report))
-    (tmp_path / "results.json").write_text(json.dumps(results))
+    failure = MatchReport.from_dict(report).failure
+    MatchResults(match_id="m1", seed=1, status="success" if failure is None else "failed",
+                 failure=failure, limits=LIMITS, **results).write(tmp_path / "results.json")
     assert summarize(read_outcome("m1", tmp_path), as_json=True) == code
     assert json.loads(capsys.readouterr().out)["exit_code"] == code
 

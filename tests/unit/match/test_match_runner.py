@@ -10,6 +10,7 @@ from contracts.sim_result import SimResult
 from orchestrator.config import Limits
 from orchestrator.match import (
     FailureClass,
+    MatchOutcome,
     MatchPlan,
     MatchRunner,
     MatchState,
@@ -40,7 +41,7 @@ def _plan(*, red_image: str = "team/red:1", blue_image: str = "team/blue:1", n: 
 
 
 def _run(tmp_path: Path, plan: MatchPlan, runtime: FakeRuntime, **kwargs: Any
-         ) -> tuple[MatchRunner, Any]:
+         ) -> tuple[MatchRunner, MatchOutcome]:
     runner = MatchRunner(plan, runtime=runtime, host=FakeHost(),
                          options=RunOptions(out_dir=tmp_path, simulator_image="sim:1",
                                             poll_s=0.0), **kwargs)
@@ -105,8 +106,8 @@ def test_forfeit_when_a_team_has_no_usable_image(tmp_path: Path) -> None:
     runtime = FakeRuntime(missing_images=("team/blue:1",))
     runner, outcome = _run(tmp_path, _plan(), runtime)
     assert outcome.ok
-    assert outcome.results["forfeit"]["team"] == "blue"
-    assert outcome.results["winner"] == "red"
+    assert outcome.results.forfeit.team == "blue"
+    assert outcome.results.winner == "red"
     assert not [c for c in runtime.calls if c[0] == "create_container"]
     assert runner.lifecycle.history == [MatchState.PENDING, MatchState.PULLING,
                                         MatchState.STOPPING, MatchState.COLLECTING,
@@ -181,9 +182,9 @@ def test_robot_exit_mid_game_is_recorded_and_the_game_goes_on(tmp_path: Path) ->
     runtime.on_start = crash_red_1
     _, outcome = _run(tmp_path, _plan(), runtime)
     assert outcome.ok
-    robot = outcome.results["robots"]["red-1"]
-    assert robot["oom_killed"] is True and robot["exit_code"] == 137
-    assert outcome.results["robots"]["red-2"]["oom_killed"] is False
+    robot = outcome.results.robots["red-1"]
+    assert robot.oom_killed is True and robot.exit_code == 137
+    assert outcome.results.robots["red-2"].oom_killed is False
 
 
 def test_unexpected_error_still_tears_down_and_is_raised(tmp_path: Path) -> None:
@@ -219,6 +220,6 @@ def test_team_whose_robots_cannot_start_is_a_team_startup_failure(tmp_path: Path
     assert outcome.failure.failure_class is FailureClass.TEAM_STARTUP
     assert "red" in outcome.failure.cause and "executable file not found" in outcome.failure.cause
     assert MatchState.PLAYING not in runner.lifecycle.history
-    assert outcome.results["robots"]["red-1"]["startup_error"]
-    assert outcome.results["robots"]["blue-1"]["startup_error"] is None
+    assert outcome.results.robots["red-1"].startup_error
+    assert outcome.results.robots["blue-1"].startup_error is None
     assert runtime.containers == {} and runtime.networks == {}

@@ -11,6 +11,7 @@ from typing import Any
 import pytest
 
 from contracts.errors import ContractError
+from contracts.match_results import MatchLimits
 from contracts.sim_result import SimResult
 from orchestrator.commands.scrimmage_args import add_arguments
 from orchestrator.config.loader import load_game
@@ -67,21 +68,26 @@ def _sim_result(play: dict[str, Any]) -> dict[str, Any]:
             "winner": "red", "play": play}
 
 
+LIMITS = MatchLimits(cpus=4.0, memory_gb=16.0, pids=1024, log_folder_gb=10.0,
+                     team_api_mb_s=350.0, team_comm_mb_s=1.0, grace_period_s=5.0,
+                     allow_internet=False, host_controls=None)
+
+
 def test_play_record_round_trip_and_results() -> None:
     sim = SimResult.from_dict(_sim_result(PLAY), source="sim_result.json")
     assert sim.play is not None and sim.play.both_halves_playing
     assert sim.play.kicks == {"red": 2, "blue": 1}
     results = build_results(
-        match_id="m", seed=1, sim_result=sim, robots=[], forfeit=None, limits={},
+        match_id="m", seed=1, sim_result=sim, robots=[], forfeit=None, limits=LIMITS,
         versions={}, timings_s={}, failure=None,
-    )
+    ).to_dict()
     assert results["play"] == PLAY
     old = dict(_sim_result(PLAY))
     del old["play"]  # a simulator that did not count play
     assert build_results(
         match_id="m", seed=1, sim_result=SimResult.from_dict(old), robots=[], forfeit=None,
-        limits={}, versions={}, timings_s={}, failure=None,
-    )["play"] is None
+        limits=LIMITS, versions={}, timings_s={}, failure=None,
+    ).to_dict()["play"] is None
 
 
 @pytest.mark.parametrize(
