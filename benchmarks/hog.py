@@ -28,6 +28,9 @@ import time
 from pathlib import Path
 from typing import Any
 
+from contracts import files
+from contracts.match_results import MatchResults
+
 TARGET = 0.9
 IDLE = "python3 -c \"import time; time.sleep(10**6)\""
 
@@ -65,7 +68,7 @@ def _files(folder: Path, *, match_id: str, red_command: str, cpus: float, half_s
 
 
 def _play(work: Path, name: str, *, red_command: str, cpus: float, half_s: float,
-          stepping: str, max_rtf: float) -> dict[str, Any]:
+          stepping: str, max_rtf: float) -> MatchResults:
     match_id = f"bench-hog-{name}-{os.getpid()}"
     game = _files(work / f"{name}-config", match_id=match_id, red_command=red_command,
                   cpus=cpus, half_s=half_s, stepping=stepping, max_rtf=max_rtf)
@@ -75,8 +78,7 @@ def _play(work: Path, name: str, *, red_command: str, cpus: float, half_s: float
     if done.returncode != 0:
         raise SystemExit(f"hlvs bench hog: match {match_id} failed ({done.returncode}): "
                          f"{done.stderr.strip().splitlines()[-1:]}")
-    results: dict[str, Any] = json.loads((out / "results.json").read_text())
-    return results
+    return MatchResults.load(out / files.RESULTS)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -107,12 +109,12 @@ def main(argv: list[str] | None = None) -> int:
                 results = _play(Path(tmp), f"{kind}{i}", red_command=command, cpus=cpus,
                                 half_s=args.half_duration, stepping=args.stepping,
                                 max_rtf=args.max_rtf)
-                runs[kind].append(float(results["real_time_factor"]))
-                blue = results["robots"]["blue-1"].get("api") or {}
+                runs[kind].append(float(results.real_time_factor or 0.0))
+                blue = results.robots["blue-1"].api or {}
                 p90 = (blue.get("round_trip_ms") or {}).get("p90")
                 stub[kind].append({"messages_in": blue.get("messages_in"),
                                    "round_trip_ms_p90": p90})
-                admission = results.get("admission")
+                admission = results.admission
     baseline, hog = statistics.median(runs["baseline"]), statistics.median(runs["hog"])
     ratio = round(hog / baseline, 3) if baseline > 0 else 0.0
     print(json.dumps({

@@ -24,6 +24,10 @@ from datetime import datetime
 from pathlib import Path
 from typing import Any
 
+from contracts import files
+from contracts.errors import ContractError
+from contracts.match_results import MatchReport
+
 ROOT = Path(__file__).resolve().parents[1]
 CONF = "/var/lib/hlvs/slurm/slurm.conf"
 
@@ -50,8 +54,8 @@ def _job(folder: Path, name: str, half_s: float) -> Any:
 
 def _status(out: Path) -> str:
     try:
-        return str(json.loads((out / "report.json").read_text()).get("status"))
-    except (OSError, ValueError):
+        return MatchReport.load(out / files.REPORT).status
+    except ContractError:
         return "no report"
 
 

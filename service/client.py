@@ -214,17 +214,27 @@ def run_cancel(args: argparse.Namespace) -> int:
 
 
 def run_results(args: argparse.Namespace) -> int:
+    from pydantic import ValidationError
+
+    from contracts import files
     from service.errors import ClientError
+    from service.views import SubmissionReport
 
     api = _api(args)
     out: Path = args.out or Path(args.submission)
     try:
         out.mkdir(parents=True, exist_ok=True)
-        report = api.call("GET", f"/v1/submissions/{args.submission}/report")
-        (out / "report.json").write_text(json.dumps(report, indent=2) + "\n")
-        written = ["report.json"]
-        for name, path in (("results.json", "results"), ("replay.hlvsrec", "replay"),
-                           ("match.mp4", "video")):
+        where = f"/v1/submissions/{args.submission}/report"
+        report = api.call("GET", where)
+        try:
+            state = SubmissionReport.model_validate(report).state
+        except ValidationError as exc:
+            raise ClientError(url=where, status=200,
+                              message=f"not a submission report: {exc}") from exc
+        (out / files.REPORT).write_text(json.dumps(report, indent=2) + "\n")
+        written = [files.REPORT]
+        for name, path in ((files.RESULTS, "results"), (files.REPLAY, "replay"),
+                           (files.VIDEO, "video")):
             try:
                 data = api.call("GET", f"/v1/submissions/{args.submission}/{path}")
             except ClientError as exc:
@@ -234,7 +244,7 @@ def run_results(args: argparse.Namespace) -> int:
             content = data if isinstance(data, bytes) else json.dumps(data, indent=2).encode()
             (out / name).write_bytes(content)
             written.append(name)
-        _print({"submission": args.submission, "state": report["state"], "folder": str(out),
+        _print({"submission": args.submission, "state": state, "folder": str(out),
                 "files": written})
         return 0
     finally:

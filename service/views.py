@@ -45,6 +45,38 @@ class SubmissionView(BaseModel):
     links: Links
 
 
+class TeamRobot(BaseModel):
+    """What a team may see of its own robot in the match results."""
+
+    image: str | None
+    exit_code: int | None
+    oom_killed: bool
+    image_error: str | None
+    startup_error: str | None
+    exited_during_game: bool
+
+
+class SubmissionReport(BaseModel):
+    """``GET /v1/submissions/{id}/report``, saved as ``report.json`` by ``hlvs results``: the
+    match's own report with whose side a failure was on (``backend_error`` is true when it was
+    the league's) and ``user_returncode`` (the first non-zero exit code of the team's robots, 0
+    when all exited 0, null when unknown or on a backend error)."""
+
+    submission: str
+    state: str
+    match_id: str | None
+    user_returncode: int | None
+    status: str
+    failure_class: str | None
+    failure_side: str | None
+    backend_error: bool
+    cause: str | None
+    charged: bool
+    team_robots: dict[str, TeamRobot]
+    match_report: dict[str, str] | None = Field(
+        description="the match's report.json as written (contracts.match_results.MatchReport)")
+
+
 class SubmissionCreate(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
@@ -88,4 +120,12 @@ def view_of(request: Request, session: Session, row: Submission,
                            team_name=team_name)
 
 
-__all__ = ["Links", "SubmissionCreate", "SubmissionView", "submission_view", "view_of"]
+__all__ = [
+    "Links",
+    "SubmissionCreate",
+    "SubmissionReport",
+    "SubmissionView",
+    "TeamRobot",
+    "submission_view",
+    "view_of",
+]

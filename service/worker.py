@@ -24,6 +24,9 @@ from typing import TYPE_CHECKING, Any
 from sqlalchemy import func, select
 from sqlalchemy.orm import Session
 
+from contracts import files
+from contracts.errors import ContractError
+from contracts.match_results import FailureClass, MatchReport
 from service import matchfiles, notify, teamfiles
 from service.db import Submission, SubmissionState, Team, now, transaction
 from service.errors import PoolError, ServiceError
@@ -210,19 +213,19 @@ class QueueWorker:
         assert row.pool_handle is not None
         out = self.pool.results_dir(row.pool_handle)
         try:
-            report = json.loads((out / "report.json").read_text(encoding="utf-8"))
-        except (OSError, ValueError) as exc:
-            report = {"status": "failed", "failure_class": "infrastructure",
-                      "cause": f"unreadable report.json: {exc}"}
-        if report.get("status") == "success":
+            report = MatchReport.load(out / files.REPORT)
+        except ContractError as exc:
+            report = MatchReport(status="failed", failure_class=FailureClass.INFRASTRUCTURE,
+                                 cause=f"unreadable {files.REPORT}: {exc}")
+        if report.failure_class is None:
             self._end(session, row, SubmissionState.DONE, cause=None)
-        elif report.get("failure_class") == "interrupted" and row.cancel_requested:
+        elif report.failure_class is FailureClass.INTERRUPTED and row.cancel_requested:
             self._end(session, row, SubmissionState.CANCELLED,
                       cause="cancelled by the team while running (stopped gracefully)")
         else:
             self._end(session, row, SubmissionState.FAILED,
-                      failure_class=str(report.get("failure_class") or "infrastructure"),
-                      cause=str(report.get("cause") or "the match failed"))
+                      failure_class=report.failure_class.value,
+                      cause=report.cause or "the match failed")
 
     def _end(self, session: Session, row: Submission, state: SubmissionState, *,
              cause: str | None, failure_class: str | None = None) -> None:

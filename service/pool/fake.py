@@ -1,6 +1,6 @@
 """An in-memory pool for unit tests of the service: matches 'run' until the test ends them.
 
-``finish(handle, report)`` writes ``report.json`` (and a minimal ``results.json``) into the
+``finish(handle, report)`` writes ``report.json`` (and a ``results.json`` to match) into the
 results folder, as a real match would; ``lose(handle)`` makes the pool forget a match.
 Handles survive a new :class:`FakePool` built on the same ``root`` only as files, like the
 local pool's: a match is running while its ``running`` marker exists.
@@ -8,10 +8,17 @@ local pool's: a match is running while its ``running`` marker exists.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
+from contracts import files
+from contracts.match_results import (
+    Failure,
+    MatchLimits,
+    MatchReport,
+    MatchResults,
+    RobotResult,
+)
 from service.pool import JobState, JobStatus, MatchJob
 
 
@@ -27,7 +34,7 @@ class FakePool:
         handle = str(job.work_dir)
         self.submitted.append(job.match_id)
         marker = job.work_dir / "running"
-        if not marker.exists() and not (self.results_dir(handle) / "report.json").exists():
+        if not marker.exists() and not (self.results_dir(handle) / files.REPORT).exists():
             job.work_dir.mkdir(parents=True, exist_ok=True)
             marker.write_text(job.match_id)
             self.started.append(job.match_id)
@@ -38,7 +45,7 @@ class FakePool:
             self.finish(handle, {"status": "success"})
         if (Path(handle) / "running").exists():
             return JobStatus(state=JobState.RUNNING)
-        if (self.results_dir(handle) / "report.json").exists():
+        if (self.results_dir(handle) / files.REPORT).exists():
             return JobStatus(state=JobState.FINISHED)
         return JobStatus(state=JobState.LOST, detail="forgotten by the fake pool")
 
@@ -60,15 +67,28 @@ class FakePool:
         (out / "teams" / "red" / "1" / "stdout.log").write_text("red robot log\n")
         (out / "teams" / "blue" / "1" / "stdout.log").write_text("blue robot log\n")
         (out / "public" / "referee.log").write_text("referee\n")
-        (out / "results.json").write_text(json.dumps({
-            "score": {"red": 1, "blue": 0},
-            "robots": {"red-1": {"exit_code": 0}, "blue-1": {"exit_code": 0}}}))
-        (out / "public" / "replay.hlvsrec").write_bytes(b"HLVSREC fake replay")
-        (out / "report.json").write_text(json.dumps(report))
+        match_report = MatchReport.from_dict(report, source="FakePool.finish(report=...)")
+        failure = match_report.failure
+        fake_results(Path(handle).name, failure).write(out / files.RESULTS)
+        (out / "public" / files.REPLAY).write_bytes(b"HLVSREC fake replay")
+        match_report.write(out / files.REPORT)
         (Path(handle) / "running").unlink(missing_ok=True)
 
     def lose(self, handle: str) -> None:
         (Path(handle) / "running").unlink(missing_ok=True)
+
+
+def fake_results(match_id: str, failure: Failure | None) -> MatchResults:
+    """A played 1-0 with one robot a side that both exited 0 (failed: ``failure``)."""
+    robots = {key: RobotResult(image="team/image:1", container=f"{match_id}-{key}", exit_code=0)
+              for key in ("red-1", "blue-1")}
+    return MatchResults(
+        match_id=match_id, seed=1, status="failed" if failure else "success", failure=failure,
+        final_state="FINISHED", score={"red": 1, "blue": 0}, winner="red", robots=robots,
+        limits=MatchLimits(cpus=4.0, memory_gb=16.0, pids=1024, log_folder_gb=10.0,
+                           team_api_mb_s=350.0, team_comm_mb_s=1.0, grace_period_s=5.0,
+                           allow_internet=False, host_controls=None),
+    )  # fmt: skip
 
 
 __all__ = ["FakePool"]

@@ -18,6 +18,7 @@ import sys
 import threading
 from pathlib import Path
 
+from contracts import files
 from service.errors import PoolError
 from service.pool import JobState, JobStatus, MatchJob
 
@@ -79,7 +80,7 @@ class LocalDockerPool:
         with self._lock:
             if self._alive(handle):
                 return JobStatus(state=JobState.RUNNING)
-        if (self.results_dir(handle) / "report.json").is_file():
+        if (self.results_dir(handle) / files.REPORT).is_file():
             return JobStatus(state=JobState.FINISHED)
         detail = "the match process ended without a report.json"
         child = self._children.get(handle)

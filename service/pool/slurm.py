@@ -36,6 +36,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from contracts import files
 from service.errors import PoolError
 from service.pool import JobState, JobStatus, MatchJob
 
@@ -183,7 +184,7 @@ class SlurmPool:
                     detail += f", expected start {entry.expected_start}"
                 return JobStatus(state=JobState.PENDING, detail=detail)
             return JobStatus(state=JobState.RUNNING, detail=f"on {entry.nodes}")
-        if (self.results_dir(handle) / "report.json").is_file():
+        if (self.results_dir(handle) / files.REPORT).is_file():
             return JobStatus(state=JobState.FINISHED)
         final = self._sacct_state(job_id)
         return JobStatus(state=JobState.LOST,

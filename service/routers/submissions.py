@@ -10,19 +10,29 @@ from pathlib import Path
 from typing import Annotated, Any
 
 from fastapi import APIRouter, Depends, FastAPI, Request
-from fastapi.responses import FileResponse, JSONResponse
+from fastapi.responses import FileResponse
 from fastapi.security import HTTPAuthorizationCredentials
 from pydantic import BaseModel
 from sqlalchemy import select
 from starlette.concurrency import run_in_threadpool
 from starlette.responses import Response
 
+from contracts import files
+from contracts.errors import ContractError
+from contracts.match_results import MatchReport, MatchResults
 from service import submissions, teamfiles
 from service.app import Services
 from service.db import Scope, Submission
 from service.deps import DbSession, TeamPrincipal, bearer, get_services, require_team
 from service.errors import NotFound
-from service.views import SubmissionCreate, SubmissionView, submission_view, view_of
+from service.views import (
+    SubmissionCreate,
+    SubmissionReport,
+    SubmissionView,
+    TeamRobot,
+    submission_view,
+    view_of,
+)
 
 router = APIRouter(prefix="/v1/submissions", tags=["submissions"])
 
@@ -146,56 +156,58 @@ def _file(path: Path, what: str, row: Submission, media_type: str) -> FileRespon
 
 @router.get("/{submission_id}/report")
 def get_report(submission_id: str, request: Request, principal: TeamPrincipal,
-               session: DbSession) -> JSONResponse:
+               session: DbSession) -> SubmissionReport:
     """The match's ``report.json`` with whose side a failure was on (``backend_error`` is true
     when it was the league's), the exit codes of the team's own robots and
     ``user_returncode`` (the first non-zero one, 0 when all exited 0, null when unknown or
     on a backend error)."""
     assert principal.team_id is not None
     row = submissions.get_own(session, team_id=principal.team_id, submission_id=submission_id)
-    match_report: Any = None
-    robots: dict[str, Any] = {}
+    match_report: MatchReport | None = None
+    robots: dict[str, TeamRobot] = {}
     if row.pool_handle is not None:
         out = _match_dir(request, row)
-        for name, target in (("report.json", "report"), ("results.json", "results")):
-            try:
-                data = json.loads((out / name).read_text(encoding="utf-8"))
-            except (OSError, ValueError):
-                continue
-            if target == "report":
-                match_report = data
-            else:
-                for key, robot in (data.get("robots") or {}).items():
-                    if key.startswith(OWN_COLOR + "-"):
-                        robots[key] = {k: robot.get(k) for k in (
-                            "image", "exit_code", "oom_killed", "image_error", "startup_error",
-                            "exited_during_game")}
-    codes = [r.get("exit_code") for r in robots.values()]
+        try:
+            match_report = MatchReport.load(out / files.REPORT)
+        except ContractError:
+            pass  # not written yet, or unreadable: the submission's own state says enough
+        try:
+            results = MatchResults.load(out / files.RESULTS)
+        except ContractError:
+            results = None
+        for key, robot in (results.robots if results is not None else {}).items():
+            if key.startswith(OWN_COLOR + "-"):
+                robots[key] = TeamRobot(
+                    image=robot.image, exit_code=robot.exit_code, oom_killed=robot.oom_killed,
+                    image_error=robot.image_error, startup_error=robot.startup_error,
+                    exited_during_game=robot.exited_during_game)
+    codes = [r.exit_code for r in robots.values()]
     user_returncode = None
     if codes and all(isinstance(c, int) for c in codes) and row.failure_side != "league":
         user_returncode = next((c for c in codes if c != 0), 0)
-    return JSONResponse({
-        "submission": row.id, "state": row.state, "match_id": row.match_id,
-        "user_returncode": user_returncode,
-        "status": "success" if row.state == "done" else row.state,
-        "failure_class": row.failure_class, "failure_side": row.failure_side,
-        "backend_error": row.failure_side == "league", "cause": row.cause,
-        "charged": row.charged, "team_robots": robots, "match_report": match_report,
-    })
+    return SubmissionReport(
+        submission=row.id, state=row.state, match_id=row.match_id,
+        user_returncode=user_returncode,
+        status="success" if row.state == "done" else row.state,
+        failure_class=row.failure_class, failure_side=row.failure_side,
+        backend_error=row.failure_side == "league", cause=row.cause,
+        charged=row.charged, team_robots=robots,
+        match_report=match_report.to_dict() if match_report is not None else None,
+    )
 
 
 @router.get("/{submission_id}/results")
 def get_results(submission_id: str, request: Request, principal: TeamPrincipal,
                 session: DbSession) -> FileResponse:
     row, out = _own(request, principal, session, submission_id)
-    return _file(out / "results.json", "results of submission", row, "application/json")
+    return _file(out / files.RESULTS, "results of submission", row, "application/json")
 
 
 @router.get("/{submission_id}/replay")
 def get_replay(submission_id: str, request: Request, principal: TeamPrincipal,
                session: DbSession) -> FileResponse:
     row, out = _own(request, principal, session, submission_id)
-    return _file(out / "public" / "replay.hlvsrec", "replay of submission", row,
+    return _file(out / "public" / files.REPLAY, "replay of submission", row,
                  "application/octet-stream")
 
 
@@ -203,7 +215,7 @@ def get_replay(submission_id: str, request: Request, principal: TeamPrincipal,
 def get_video(submission_id: str, request: Request, principal: TeamPrincipal,
               session: DbSession) -> FileResponse:
     row, out = _own(request, principal, session, submission_id)
-    return _file(out / "public" / "match.mp4", "video of submission", row, "video/mp4")
+    return _file(out / "public" / files.VIDEO, "video of submission", row, "video/mp4")
 
 
 def _listing(root: Path) -> list[str]:
