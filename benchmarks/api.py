@@ -280,7 +280,9 @@ def _api_run(
         world_camera = world.camera_info(robots[0])
         if world_camera[:2] != camera[:2]:
             raise SystemExit(f"--camera: the robot camera is {world_camera[0]}x{world_camera[1]}")
-    lockstep = LockstepSettings(deadline_s=0.05, time_bank_s=1.0)
+    lockstep = LockstepSettings(
+        deadline_s=0.05, time_bank_s=1.0, pipelined=args.mode == "pipelined"
+    )
     ports = free_ports(len(robots))
     endpoints = [
         PlayerEndpoint(robot=r, port=p, hosts=("127.0.0.1",), team_size=4)

@@ -123,6 +123,7 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
     lockstep = LockstepSettings(
         deadline_s=spec.lockstep_deadline_ms / 1000.0,
         time_bank_s=spec.lockstep_time_bank_ms / 1000.0,
+        pipelined=spec.stepping == "pipelined",
     )
     started = time.time()
     exit_code = 1

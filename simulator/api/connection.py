@@ -127,15 +127,17 @@ class Connection:
                 self.last_sent_at = None
         return count
 
-    def read_threaded(self, now: float) -> None:
-        """I/O thread: :meth:`read`, leaving a failure in ``error`` for the step thread."""
+    def read_threaded(self, now: float) -> bool:
+        """I/O thread: :meth:`read`, leaving a failure in ``error`` for the step thread.
+        True when the step thread has something new: requests or a failure."""
         with self._lock:
             if self.closed or self.error is not None:
-                return
+                return False
             try:
-                self.read(now)
+                return self.read(now) > 0
             except ClientClosed as exc:
                 self.error = exc.reason
+                return True
 
     def take_requests(self) -> list[pb.ActuatorRequests | PositionTargets]:
         """The requests received since the last call, in arrival order."""

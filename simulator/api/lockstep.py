@@ -27,6 +27,24 @@ def wait_lockstep(server: ApiServer, settings: LockstepSettings) -> float:
     start = time.monotonic()
     deadline = settings.deadline_s
     missed: set[str] = set()
+    server.awaiting_answers = True  # before the flags are read: an answer after wakes the poll
+    try:
+        _wait(server, settings, start, deadline, missed)
+    finally:
+        server.awaiting_answers = False
+    end = time.monotonic()
+    for slot in server.slots.values():
+        conn = slot.conn
+        if conn is not None and not conn.slow and conn.answered:
+            late = conn.answered_at - max(start, conn.enqueued_at) - deadline
+            if late > 0:
+                conn.bank_s = max(0.0, conn.bank_s - late)
+    return end - start
+
+
+def _wait(
+    server: ApiServer, settings: LockstepSettings, start: float, deadline: float, missed: set[str]
+) -> None:
     while not server.stop_requested:
         now = time.monotonic()
         waiting = []
@@ -68,14 +86,6 @@ def wait_lockstep(server: ApiServer, settings: LockstepSettings) -> float:
         if not waiting:
             break
         server.poll(max(0.0, min(next_event, 0.05)))
-    end = time.monotonic()
-    for slot in server.slots.values():
-        conn = slot.conn
-        if conn is not None and not conn.slow and conn.answered:
-            late = conn.answered_at - max(start, conn.enqueued_at) - deadline
-            if late > 0:
-                conn.bank_s = max(0.0, conn.bank_s - late)
-    return end - start
 
 
 class Pipeline:

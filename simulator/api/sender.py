@@ -18,7 +18,7 @@ import selectors
 import threading
 import time
 from collections import deque
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -34,7 +34,12 @@ WRITE = selectors.EVENT_WRITE
 class SendThread:
     """Reads and writes the sockets of the connections added to it. ``cpus``: where it runs."""
 
-    def __init__(self, *, cpus: Iterable[int] | None = None) -> None:
+    def __init__(
+        self, *, cpus: Iterable[int] | None = None, on_news: Callable[[], None] | None = None
+    ) -> None:
+        """``on_news``: called (on this thread) after a read that brought requests or found a
+        failure, so that a step thread waiting for answers (lockstep) wakes up."""
+        self._on_news = on_news
         self._ready: deque[Connection] = deque()
         self._changes: deque[tuple[bool, Connection]] = deque()  # (add?, connection)
         self._wake_r, self._wake_w = os.pipe()
@@ -86,7 +91,9 @@ class SendThread:
         masks: dict[Connection, int] = {}
         with selectors.DefaultSelector() as selector:
             selector.register(self._wake_r, READ, None)
+            on_news = self._on_news
             while not self._stop:
+                news = False
                 for key, events in selector.select(IDLE_WAIT_S):
                     conn = key.data
                     if conn is None:  # drain, then clear: a wake-up after this is not lost
@@ -97,9 +104,11 @@ class SendThread:
                         self._woken.clear()
                         continue
                     if events & READ and conn.error is None:
-                        conn.read_threaded(time.monotonic())
+                        news = conn.read_threaded(time.monotonic()) or news
                     if events & WRITE:
                         self._ready.append(conn)
+                if news and on_news is not None:
+                    on_news()
                 self._apply_changes(selector, masks)
                 self._write_ready(selector, masks)
 

@@ -18,6 +18,7 @@ step just computed is sent and applies them with :meth:`apply_taken` (see
 from __future__ import annotations
 
 import logging
+import os
 import selectors
 import socket
 import time
@@ -81,6 +82,9 @@ class RobotSlot:
 class LockstepSettings:
     deadline_s: float
     time_bank_s: float
+    # pipelined lockstep: the clients' socket I/O runs on the I/O thread, while the physics
+    # runs; plain lockstep keeps it on the step thread (fewer wake-ups in the critical path)
+    pipelined: bool = False
 
 
 class ApiServer:
@@ -100,7 +104,8 @@ class ApiServer:
         spoofing: SpoofingLog | None = None,
     ) -> None:
         """``send_thread``: the clients' reads and writes on an I/O thread (default: in async
-        stepping without ``blocking_send``); ``send_cpus``: the CPUs that thread may use."""
+        and pipelined stepping without ``blocking_send``); ``send_cpus``: the CPUs that thread
+        may use."""
         self._world = world
         self._spoofing = spoofing or SpoofingLog()
         self._network = network
@@ -111,10 +116,15 @@ class ApiServer:
         self._lookups: ThreadPoolExecutor | None = None
         self.stop_requested = False
         if send_thread is None:
-            send_thread = lockstep is None and not network.blocking_send
+            send_thread = not network.blocking_send and (lockstep is None or lockstep.pipelined)
         self._send_cpus = send_cpus
         self._sender: SendThread | None = None
         self._use_sender = send_thread
+        # lockstep with the I/O thread: the step thread waiting for answers is woken through
+        # this pipe, written by the I/O thread only while ``awaiting_answers`` is set
+        self.awaiting_answers = False
+        self._wake: tuple[int, int] | None = None
+        self._wake_sent = False
         self._woken: list[Connection] = []
         self.slots: dict[RobotId, RobotSlot] = {}
         for endpoint in endpoints:
@@ -138,7 +148,12 @@ class ApiServer:
 
     def start(self) -> None:
         if self._use_sender and self._sender is None:
-            self._sender = SendThread(cpus=self._send_cpus)
+            if self._lockstep is not None:
+                self._wake = os.pipe()
+                for fd in self._wake:
+                    os.set_blocking(fd, False)
+                self._selector.register(self._wake[0], selectors.EVENT_READ, "wake")
+            self._sender = SendThread(cpus=self._send_cpus, on_news=self._news)
         host = self._network.api_bind_host
         for slot in self.slots.values():
             sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
@@ -174,6 +189,10 @@ class ApiServer:
             self._sender.close()
             self._sender = None
         self._selector.close()
+        if self._wake is not None:
+            for fd in self._wake:
+                os.close(fd)
+            self._wake = None
 
     def __enter__(self) -> ApiServer:
         self.start()
@@ -200,12 +219,16 @@ class ApiServer:
     # --- I/O --------------------------------------------------------------------------------
 
     def poll(self, timeout_s: float = 0.0) -> None:
-        """Serve sockets: accept, handshake, read requests, write queued measurements."""
+        """Serve sockets: accept, handshake, read requests, write queued measurements (with
+        the I/O thread: drop the clients it found failed)."""
         now = time.monotonic()
         for key, events in self._selector.select(max(0.0, timeout_s)):
             data = key.data
             if data == "cameras":
                 self._camera_results()
+                continue
+            if data == "wake":
+                self._drain_wake()
                 continue
             kind, slot = data
             if kind == "accept":
@@ -217,6 +240,28 @@ class ApiServer:
                     self._flush(slot)
         if self._lookups is not None:
             self._finish_lookups()
+        if self._sender is not None:
+            for slot in self.slots.values():
+                conn = slot.conn
+                if conn is not None and conn.error is not None:
+                    self._drop(slot, conn.error)
+
+    def _news(self) -> None:
+        """I/O thread: requests arrived or a client failed; wake a waiting step thread."""
+        if self.awaiting_answers and not self._wake_sent and self._wake is not None:
+            self._wake_sent = True
+            try:
+                os.write(self._wake[1], b"\0")
+            except (BlockingIOError, OSError):
+                pass  # full (a wake-up is pending anyway) or closed (shutting down)
+
+    def _drain_wake(self) -> None:
+        assert self._wake is not None
+        try:
+            os.read(self._wake[0], 4096)
+        except BlockingIOError:
+            pass
+        self._wake_sent = False  # cleared after reading: a later wake-up is not lost
 
     def _accept(self, slot: RobotSlot) -> None:
         assert slot.listener is not None

@@ -5,6 +5,7 @@ from __future__ import annotations
 import socket
 import time
 
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -37,8 +38,10 @@ def test_never_reading_client_does_not_stall_the_others() -> None:
         stalled.close()
 
 
-def test_lockstep_waits_for_each_client_then_marks_a_silent_one_slow() -> None:
-    lockstep = LockstepSettings(deadline_s=0.02, time_bank_s=0.5)
+# pipelined=True: the same waits with the clients' socket I/O on the I/O thread
+@pytest.mark.parametrize("pipelined", [False, True], ids=["step-thread-io", "io-thread"])
+def test_lockstep_waits_for_each_client_then_marks_a_silent_one_slow(pipelined: bool) -> None:
+    lockstep = LockstepSettings(deadline_s=0.02, time_bank_s=0.5, pipelined=pipelined)
     with running_server(lockstep=lockstep, pause_s=0.0, hold=True) as (driver, ports):
         with _client(ports[RED1]) as client:
             client.enable("NeckS", 8)
@@ -58,9 +61,10 @@ def test_lockstep_waits_for_each_client_then_marks_a_silent_one_slow() -> None:
             wait_until(lambda: driver.steps > steps + 20)  # goes on without the slow client
 
 
-def test_lockstep_is_deterministic_with_a_deterministic_client() -> None:
+@pytest.mark.parametrize("pipelined", [False, True], ids=["step-thread-io", "io-thread"])
+def test_lockstep_is_deterministic_with_a_deterministic_client(pipelined: bool) -> None:
     def run() -> list[tuple[int, float]]:
-        lockstep = LockstepSettings(deadline_s=1.0, time_bank_s=5.0)
+        lockstep = LockstepSettings(deadline_s=1.0, time_bank_s=5.0, pipelined=pipelined)
         with running_server(lockstep=lockstep, pause_s=0.0, hold=True) as (driver, ports):
             with _client(ports[RED1]) as client:
                 client.enable("NeckS", 8)
@@ -75,6 +79,30 @@ def test_lockstep_is_deterministic_with_a_deterministic_client() -> None:
                 return trace
 
     assert run() == run()
+
+
+@pytest.mark.parametrize("pipelined", [False, True], ids=["step-thread-io", "io-thread"])
+def test_a_client_leaving_during_the_lockstep_wait_is_dropped_at_once(pipelined: bool) -> None:
+    """The wait does not spend the deadline and time bank on a client that is gone (with the
+    I/O thread: it finds the end of stream and wakes the waiting step thread)."""
+    lockstep = LockstepSettings(deadline_s=5.0, time_bank_s=20.0, pipelined=pipelined)
+    with running_server(lockstep=lockstep, pause_s=0.0, hold=True) as (driver, ports):
+        assert (driver.server._sender is not None) is pipelined
+        client = _client(ports[RED1])
+        client.enable("NeckS", 8)
+        wait_until(lambda: driver.server.connected())
+        driver.max_steps = None
+        for _ in range(5):
+            msg = client.receive(timeout=5)
+            client.set_positions({"Neck": msg.time / 1000.0})
+        client.receive(timeout=5)  # the step waits for the answer to this one
+        steps = driver.steps
+        client.close()
+        started = time.monotonic()
+        wait_until(lambda: driver.steps > steps + 10, 3)
+        assert time.monotonic() - started < 2.0  # far below the 5 s deadline
+        reasons = driver.server.statistics()["red-1"]["disconnect_reasons"]
+        assert reasons == ["client disconnected"]
 
 
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
