@@ -42,7 +42,8 @@ class Session(Protocol):
 def open_session(spec: SessionSpec, remotes: int | str | None) -> tuple[Session, Any]:
     """The session for ``remotes``: None runs the world in this process; an int starts that
     many simulator containers (the environment uses the first); ``"hlvs://host:port,..."``
-    connects to simulators already running. Returns the session and what owns the remotes."""
+    connects to simulators already running; ``"slurm:N"`` has a Slurm cluster run them.
+    Returns the session and what owns the remotes."""
     if remotes is None or remotes == 0:
         from envs.session import LocalSession
 
@@ -84,9 +85,12 @@ class HlvsEnv(gym.Env[dict[str, Any], np.ndarray]):
             spec.model, camera=spec.camera, perception=spec.perception,
             other_robots=other_robots, game=game,
         )  # fmt: skip
-        self._owner: Any = None
+        self._owner: Any = None  # what owns the remotes; closed with the environment
+        self._remote: tuple[Any, int] | None = None  # (pool, index) replacing a crashed remote
         if session is None:
             session, self._owner = open_session(spec, remotes)
+            if self._owner is not None:
+                self._remote = (self._owner, 0)
         self.session: Session = session
         self.frame: Frame | None = None
         self._closed = False
@@ -151,15 +155,20 @@ class HlvsEnv(gym.Env[dict[str, Any], np.ndarray]):
         if self._owner is not None:
             self._owner.close()
 
+    def attach_remote(self, pool: Any, index: int) -> None:
+        """Remote ``index`` of ``pool`` (a vector environment's) replaces a crashed session."""
+        self._remote = (pool, index)
+
     def _replace_crashed(self) -> None:
         """A remote that crashed is replaced when the pool started it; else RemoteError."""
-        if self._owner is None:
+        if self._remote is None:
             from envs.errors import RemoteError
 
             raise RemoteError(address=str(getattr(self.session, "address", "?")),
                               reason="crashed; no pool to replace it")  # fmt: skip
+        pool, index = self._remote
         self.session.close()
-        self.session = self._owner.replace(0, self.session_spec)
+        self.session = pool.replace(index, self.session_spec)
 
     # --- trainer -----------------------------------------------------------------------------
 

@@ -13,7 +13,6 @@ the containers of owners that no longer run on this host
 from __future__ import annotations
 
 import atexit
-import json
 import logging
 import os
 import socket
@@ -24,8 +23,8 @@ import docker
 import docker.errors
 
 from envs.errors import RemoteStartFailed
-from envs.remote import RemoteAddress
-from envs.wire import WELCOME, FrameReader, WireError, send_frame
+from envs.remote import RemoteAddress, probe
+from envs.wire import WireError
 
 log = logging.getLogger(__name__)
 
@@ -64,7 +63,12 @@ def default_image() -> str:
 
 class DockerLauncher:
     def __init__(
-        self, *, image: str | None = None, health_timeout_s: float = HEALTH_TIMEOUT_S
+        self,
+        *,
+        image: str | None = None,
+        health_timeout_s: float = HEALTH_TIMEOUT_S,
+        labels: dict[str, str] | None = None,
+        publish_host: str = "127.0.0.1",
     ) -> None:
         try:
             self.client = docker.from_env(timeout=120)
@@ -74,6 +78,8 @@ class DockerLauncher:
         self.image = image or default_image()
         self.pool_id = uuid.uuid4().hex[:10]
         self.health_timeout_s = health_timeout_s
+        self.extra_labels = dict(labels or {})
+        self.publish_host = publish_host
         self.containers: list[str] = []
         self._closed = False
         atexit.register(self.close)
@@ -81,7 +87,7 @@ class DockerLauncher:
 
     def _labels(self) -> dict[str, str]:
         return {LABEL_PROJECT: "1", LABEL_ROLE: ROLE, LABEL_POOL: self.pool_id,
-                LABEL_OWNER: _owner()}  # fmt: skip
+                LABEL_OWNER: _owner(), **self.extra_labels}  # fmt: skip
 
     def _remove_orphans(self) -> None:
         host = socket.gethostname()
@@ -105,7 +111,7 @@ class DockerLauncher:
                 name=name,
                 detach=True,
                 labels=self._labels(),
-                ports={f"{CONTAINER_PORT}/tcp": ("127.0.0.1", None)},
+                ports={f"{CONTAINER_PORT}/tcp": (self.publish_host, None)},
                 environment={"LP_NUM_THREADS": "0"},
             )
         except docker.errors.DockerException as exc:
@@ -117,6 +123,14 @@ class DockerLauncher:
             self.containers.append(cid)
         log.info("started remote %s (%s)", name, self.image)
         return cid
+
+    def published_port(self, index: int) -> int | None:
+        """The host port the engine published remote ``index``'s port on, if any."""
+        settings = (
+            self.client.containers.get(self.containers[index]).attrs.get("NetworkSettings") or {}
+        )
+        bound = (settings.get("Ports") or {}).get(f"{CONTAINER_PORT}/tcp") or []
+        return int(bound[0]["HostPort"]) if bound else None
 
     def _candidates(self, cid: str) -> list[RemoteAddress]:
         """Where the remote answers: its bridge address first (a local engine: no userland
@@ -142,7 +156,7 @@ class DockerLauncher:
                 raise RemoteStartFailed(address=cid[:12], reason=cause)
             for address in self._candidates(cid):
                 try:
-                    _probe(address.host, address.port)
+                    probe(address.host, address.port)
                     return address
                 except (OSError, WireError) as exc:
                     reason = f"{address}: {exc}"
@@ -179,6 +193,16 @@ class DockerLauncher:
         except docker.errors.DockerException as exc:
             log.warning("could not remove remote %s: %s", cid[:12], exc)
 
+    def stop(self, grace_s: float) -> None:
+        """SIGTERM to every remote, SIGKILL after ``grace_s`` (then :meth:`close` removes)."""
+        for cid in self.containers:
+            try:
+                self.client.containers.get(cid).stop(timeout=max(0, round(grace_s)))
+            except docker.errors.NotFound:
+                pass
+            except docker.errors.DockerException as exc:
+                log.warning("could not stop remote %s: %s", cid[:12], exc)
+
     def close(self) -> None:
         if self._closed:
             return
@@ -191,18 +215,3 @@ class DockerLauncher:
             self._remove(str(container.id))
         log.info("removed %d remote(s) of pool %s", len(found), self.pool_id)
         self.client.close()
-
-
-def _probe(host: str, port: int) -> None:
-    """Greeting and a ``health`` answer, then close (raises OSError / WireError)."""
-    with socket.create_connection((host, port), timeout=2.0) as sock:
-        sock.settimeout(5.0)
-        greeting = sock.recv(8)
-        if greeting != WELCOME:
-            raise WireError(f"greeting {greeting!r}")
-        reader = FrameReader(sock)
-        send_frame(sock, b"T", json.dumps({"op": "health"}).encode())
-        if not reader.expect_json().get("ok"):
-            raise WireError("health check failed")
-        send_frame(sock, b"T", json.dumps({"op": "close"}).encode())
-        reader.expect_json()

@@ -3,7 +3,8 @@
 ``remotes="hlvs://host:port,host:port"`` names simulators someone started
 (``docker run -p 7700:7700 hlvs-runner/simulator remote --port 7700``); ``remotes=N`` starts N
 simulator containers on the local Docker engine (:mod:`envs.docker_pool`), health-checked,
-labelled and removed at close. A remote that dies during an episode raises
+labelled and removed at close; ``remotes="slurm:N"`` has a Slurm cluster run them, one job per
+remote (:mod:`envs.slurm_pool`). A remote that dies during an episode raises
 :class:`envs.errors.RemoteCrashed` with its cause (the container's exit code and last log lines,
 or the socket error); the next ``reset()`` replaces a container the pool started.
 """
@@ -48,6 +49,11 @@ CONNECT_TIMEOUT_S = 10.0
 REPLY_TIMEOUT_S = 120.0
 
 
+SLURM_SCHEME = "slurm:"
+SLURM_KEYS = {"conf": str, "partition": str, "account": str, "dir": str, "lease": float,
+              "timeout": float, "cpus": int}  # fmt: skip
+
+
 @dataclass(frozen=True, slots=True)
 class RemoteAddress:
     host: str
@@ -73,6 +79,48 @@ def parse_remotes(text: str) -> list[RemoteAddress]:
     if not out:
         raise EnvConfigError(field="remotes", value=text, expected="at least one hlvs://host:port")
     return out
+
+
+def parse_slurm(text: str) -> tuple[int, dict[str, str | float | int]]:
+    """``"slurm:N[?key=value&...]"``: how many remotes and the options (keys of
+    :data:`SLURM_KEYS`: ``conf``, ``partition``, ``account``, ``dir``, ``lease`` and
+    ``timeout`` in seconds, ``cpus``)."""
+    expected = "slurm:N or slurm:N?key=value&... (keys: " + ", ".join(SLURM_KEYS) + ")"
+    body = text[len(SLURM_SCHEME) :]
+    count_text, _, query = body.partition("?")
+    if not count_text.strip().isdigit() or int(count_text) < 1:
+        raise EnvConfigError(field="remotes", value=text, expected=expected)
+    options: dict[str, str | float | int] = {}
+    for item in (part for part in query.split("&") if part):
+        key, sep, value = item.partition("=")
+        if key not in SLURM_KEYS or not sep or not value:
+            raise EnvConfigError(field=f"remotes {text!r}: option", value=item,
+                                 expected=expected, choices=list(SLURM_KEYS))  # fmt: skip
+        kind = SLURM_KEYS[key]
+        try:
+            converted = kind(value)
+        except ValueError:
+            raise EnvConfigError(field=f"remotes {text!r}: {key}", value=value,
+                                 expected=f"a {kind.__name__}") from None  # fmt: skip
+        if not isinstance(converted, str) and converted <= 0:
+            raise EnvConfigError(field=f"remotes {text!r}: {key}", value=value, expected="> 0")
+        options[key] = converted
+    return int(count_text), options
+
+
+def probe(host: str, port: int) -> None:
+    """Greeting and a ``health`` answer, then close (raises OSError / WireError)."""
+    with socket.create_connection((host, port), timeout=2.0) as sock:
+        sock.settimeout(5.0)
+        greeting = sock.recv(8)
+        if greeting != WELCOME:
+            raise WireError(f"greeting {greeting!r}")
+        reader = FrameReader(sock)
+        send_frame(sock, TAG_TRAINER, json.dumps({"op": "health"}).encode())
+        if not reader.expect_json().get("ok"):
+            raise WireError("health check failed")
+        send_frame(sock, TAG_TRAINER, json.dumps({"op": "close"}).encode())
+        reader.expect_json()
 
 
 class RemoteSession:
@@ -218,7 +266,8 @@ class RemoteSession:
 
 
 class Launcher(Protocol):
-    """Starts and removes remote simulators (the Docker pool; a Slurm pool could be another)."""
+    """Starts and removes remote simulators (:class:`envs.docker_pool.DockerLauncher`,
+    :class:`envs.slurm_pool.SlurmLauncher`)."""
 
     def start(self, count: int) -> list[RemoteAddress]: ...
 
@@ -238,17 +287,25 @@ class RemotePool:
 
     @classmethod
     def open(cls, remotes: int | str, *, image: str | None = None) -> RemotePool:
-        if isinstance(remotes, str):
-            return cls(parse_remotes(remotes), None)
-        if isinstance(remotes, bool) or not isinstance(remotes, int) or remotes < 1:
-            raise EnvConfigError(
-                field="remotes", value=remotes, expected="None, an integer >= 1 or 'hlvs://host:port,...'"
-            )  # fmt: skip
-        from envs.docker_pool import DockerLauncher
+        launcher: Launcher
+        if isinstance(remotes, str) and remotes.startswith(SLURM_SCHEME):
+            count, options = parse_slurm(remotes)
+            from envs.slurm_pool import SlurmLauncher, SlurmOptions
 
-        launcher = DockerLauncher(image=image)
+            launcher = SlurmLauncher(SlurmOptions.from_query(options), image=image)
+        elif isinstance(remotes, str):
+            return cls(parse_remotes(remotes), None)
+        elif isinstance(remotes, bool) or not isinstance(remotes, int) or remotes < 1:
+            raise EnvConfigError(
+                field="remotes", value=remotes,
+                expected="None, an integer >= 1, 'hlvs://host:port,...' or 'slurm:N'",
+            )  # fmt: skip
+        else:
+            from envs.docker_pool import DockerLauncher
+
+            launcher, count = DockerLauncher(image=image), remotes
         try:
-            return cls(launcher.start(remotes), launcher)
+            return cls(launcher.start(count), launcher)
         except BaseException:
             launcher.close()
             raise

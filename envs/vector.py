@@ -5,7 +5,9 @@
 A step sends every remote its action first and then collects the answers, so the remotes step
 at the same time. Environments that end are reset in the same step (Gymnasium's ``SAME_STEP``
 autoreset: ``infos["final_obs"]`` and ``infos["final_info"]`` hold what ended). Environment
-``i`` is seeded with ``seed + i``.
+``i`` is seeded with ``seed + i``. A remote that dies raises :class:`envs.RemoteCrashed` from
+``step()``; the next ``reset()`` replaces it when the pool started it (``remotes=N`` or
+``remotes="slurm:N"``).
 """
 
 from __future__ import annotations
@@ -41,9 +43,10 @@ def make_vector(
         assert isinstance(spec_env, HlvsEnv)
         sessions = [pool.session(i, spec_env.session_spec) for i in range(len(pool))]
         envs = []
-        for session in sessions:
+        for index, session in enumerate(sessions):
             env = gym.make(env_id, session=session, **kwargs).unwrapped
             assert isinstance(env, HlvsEnv)
+            env.attach_remote(pool, index)
             envs.append(env)
     except BaseException:
         pool.close()

@@ -128,6 +128,45 @@ class SlurmPool:
                  account or "default")
         return self._handle(job_id, work)
 
+    def submit_script(self, script: str, *, name: str, work: Path, requeue: bool = False,
+                      account: str | None = None, cpus: int | None = None) -> str:
+        """Submit ``script`` as one batch job named ``name``, run in ``work`` (its output in
+        ``work/slurm-<job>.out``), on a whole node (``--exclusive -N1``) or, with ``cpus``, as
+        one task of that many CPUs (a partition may still give it a whole node); the job id."""
+        share = ["--exclusive"] if cpus is None else ["-n1", f"--cpus-per-task={cpus}"]
+        args = ["sbatch", "--parsable", *share, "-N1", f"--job-name={name}",
+                f"--chdir={work}", f"--output={work / LOG_FILE}", "--open-mode=append",
+                "--requeue" if requeue else "--no-requeue"]
+        if self.partition:
+            args.append(f"--partition={self.partition}")
+        if account:
+            args.append(f"--account={account}")
+        if self.qos:
+            args.append(f"--qos={self.qos}")
+        result = self._run(args, stdin=script, handle=str(work))
+        job_id = result.strip().split(";")[0]
+        if not job_id.isdigit():
+            raise PoolError(handle=str(work), reason=f"sbatch answered {result.strip()!r}")
+        return job_id
+
+    def entries(self, job_ids: list[str]) -> dict[str, QueueEntry]:
+        """What Slurm's queue says of these jobs (one ``squeue``); ended jobs are absent."""
+        if not job_ids:
+            return {}
+        text = self._run(["squeue", "-h", "-j", ",".join(job_ids), "-o",
+                          "%i|%j|%a|%T|%r|%S|%N"], handle=",".join(job_ids), ok_codes=(0, 1))
+        found = (_parse_entry(line) for line in text.splitlines() if "|" in line)
+        return {e.job_id: e for e in found if e.job_id in job_ids}
+
+    def cancel_jobs(self, job_ids: list[str]) -> None:
+        """``scancel``: SIGTERM to each job's processes (``KillWait`` later, SIGKILL)."""
+        if job_ids:
+            self._run(["scancel", *job_ids], handle=",".join(job_ids))
+
+    def accounting_state(self, job_id: str) -> str:
+        """``State|ExitCode`` of a job from Slurm's accounting (empty when unknown)."""
+        return self._sacct_state(job_id)
+
     def _script(self, job: MatchJob, out: Path) -> str:
         """The batch script. A requeued run (``SLURM_RESTART_COUNT`` > 0) first salvages what
         the dead run left (``hlvs cleanup --match``: logs into the output folder, containers
