@@ -37,7 +37,6 @@ from types import FrameType
 ADDRESS_FILE = "remote.json"
 FAILED_FILE = "failed.json"
 LEASE_FILE = "lease"
-LABEL_SLURM_JOB = "org.hlvs-runner.slurm-job"
 
 log = logging.getLogger("envs.slurm_node")
 
@@ -87,6 +86,7 @@ class Lease:
 def serve(args: argparse.Namespace, stop: threading.Event) -> int:
     from envs.docker_pool import DockerLauncher
     from envs.errors import RemoteStartFailed
+    from orchestrator.engine import LABEL_SLURM_JOB  # the cluster's epilog removes by it
 
     job_dir: Path = args.job_dir
     job_id = os.environ.get("SLURM_JOB_ID", "")

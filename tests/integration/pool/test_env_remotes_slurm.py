@@ -17,8 +17,8 @@ import pytest
 
 import envs  # noqa: F401
 from envs import RemoteCrashed
-from envs.slurm_node import LABEL_SLURM_JOB
 from envs.vector import make_vector
+from orchestrator.engine import LABEL_SLURM_JOB
 
 pytestmark = [pytest.mark.docker, pytest.mark.root, pytest.mark.slow]
 
