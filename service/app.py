@@ -113,7 +113,9 @@ def create_app(
                             tokens=TokenCache(ttl_s=settings.token_cache_s))
         services.status = StatusBoard(render=lambda session, row, team: submission_view(
             session, row, settings, slots=services.slots(), queue=services.queue,
-            team_name=team).model_dump_json().encode(), ttl_s=settings.status_board_s)
+            team_name=team).model_dump_json().encode(), ttl_s=settings.status_board_s,
+            also=[services.tokens.revalidate])
+        services.status.start(services.sessions)
         app.state.services = services
         from service.pool import make_pool
 
@@ -128,6 +130,7 @@ def create_app(
         finally:
             if services.worker is not None:
                 services.worker.stop()
+            services.status.stop()
             if checker is not None:
                 checker.close()
             engine.dispose()
@@ -140,16 +143,10 @@ def create_app(
     )
     _install_error_handlers(app)
 
-    @app.middleware("http")
-    async def limit_body(request: Request, call_next: Any) -> Any:
-        """Any body declared larger than ``max_upload_bytes`` is refused before it is read."""
-        declared = request.headers.get("content-length", "")
-        if declared.isdigit() and int(declared) > settings.max_upload_bytes:
-            return JSONResponse({"error": "too_large", "message": (
-                f"the body of {declared} bytes is over the limit of "
-                f"{settings.max_upload_bytes} bytes")}, status_code=413)
-        return await call_next(request)
+    from service.middleware import BodyLimit, StatusFastPath
 
+    app.add_middleware(StatusFastPath)
+    app.add_middleware(BodyLimit, max_bytes=settings.max_upload_bytes)
     for name in router_modules:
         importlib.import_module(name).mount(app)
     return app

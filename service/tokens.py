@@ -111,7 +111,9 @@ def verify(session: Session, presented: str | None) -> Principal:
 class TokenCache:
     """Tokens verified in the last ``ttl_s`` seconds (keyed by their SHA-256), so that a client
     polling every second costs no token query. A revoked token is refused at the latest
-    ``ttl_s`` after the revocation; expiry is checked on every use."""
+    ``ttl_s`` after the revocation; expiry is checked on every use. :meth:`revalidate` checks
+    every cached token again in one query (the status board's thread calls it on each
+    rebuild), so that a client that keeps polling keeps its entry."""
 
     def __init__(self, *, ttl_s: float = 2.0, max_entries: int = 10_000) -> None:
         self.ttl_s = ttl_s
@@ -131,6 +133,30 @@ class TokenCache:
             if principal.expires_at is None or principal.expires_at > now():
                 return principal
         return None
+
+    def revalidate(self, session: Session) -> None:
+        """Renew the entries of tokens that are still neither revoked nor expired (one query);
+        drop the others."""
+        if self.ttl_s <= 0:
+            return
+        with self._lock:
+            entries = dict(self._entries)
+        if not entries:
+            return
+        ids = {principal.token_id for principal, _ in entries.values()}
+        rows = session.execute(select(Token.id, Token.revoked_at, Token.expires_at).where(
+            Token.id.in_(ids))).all()
+        current = now()
+        valid = {row.id for row in rows if row.revoked_at is None and (
+            row.expires_at is None or utc(row.expires_at) > current)}
+        renewed = time.monotonic()
+        with self._lock:
+            for key, (principal, _) in entries.items():
+                if principal.token_id in valid:
+                    if key in self._entries:
+                        self._entries[key] = (principal, renewed)
+                else:
+                    self._entries.pop(key, None)
 
     def verify(self, session: Session, presented: str | None) -> Principal:
         principal = self.cached(presented)

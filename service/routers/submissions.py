@@ -22,7 +22,7 @@ from contracts.errors import ContractError
 from contracts.match_results import MatchReport, MatchResults
 from service import submissions, teamfiles
 from service.app import Services
-from service.db import Scope, Submission
+from service.db import Submission
 from service.deps import DbSession, TeamPrincipal, bearer, get_services, require_team
 from service.errors import NotFound
 from service.views import (
@@ -86,14 +86,11 @@ async def get_submission(
     credentials: Annotated[HTTPAuthorizationCredentials | None, Depends(bearer)],
 ) -> Response:
     """The submission's state; while queued its position, expected start and the reason it
-    waits. Answered from the status board when it is fresh (see :mod:`service.statusboard`)."""
+    waits. A poll is answered from the status board when it can be (see
+    :mod:`service.statusboard` and :class:`service.middleware.StatusFastPath`); here from the
+    database."""
     services = get_services(request)
     presented = credentials.credentials if credentials is not None else None
-    principal = services.tokens.cached(presented)
-    if principal is not None and principal.scope is Scope.TEAM:
-        body = services.status.lookup(submission_id, principal.team_id)
-        if body is not None:
-            return Response(body, media_type="application/json")
     body = await run_in_threadpool(_status_body, services, presented, submission_id)
     return Response(body, media_type="application/json")
 
@@ -102,14 +99,11 @@ def _status_body(services: Services, presented: str | None, submission_id: str) 
     with services.sessions() as session:
         principal = require_team(services.tokens.verify(session, presented))
         assert principal.team_id is not None
-        services.status.refresh(session)
-        body: bytes | None = services.status.lookup(submission_id, principal.team_id)
-        if body is None:  # an ended submission, or not this team's (404)
-            row = submissions.get_own(session, team_id=principal.team_id,
-                                      submission_id=submission_id)
-            body = submission_view(session, row, services.settings, slots=services.slots(),
-                                   queue=services.queue,
-                                   team_name=principal.team_name).model_dump_json().encode()
+        row = submissions.get_own(session, team_id=principal.team_id,
+                                  submission_id=submission_id)
+        body = submission_view(session, row, services.settings, slots=services.slots(),
+                               queue=services.queue,
+                               team_name=principal.team_name).model_dump_json().encode()
         session.commit()
         return body
 

@@ -283,3 +283,43 @@ def test_a_start_interrupted_by_a_restart_is_submitted_once(
         assert status["attempts"] == 1 and status["match_id"] == f"{sid}-a1"
     assert pool.started == [f"{sid}-a1"]
     operator.close()
+
+
+def test_status_polls_from_memory_follow_changes_and_revocations(
+        start: Callable[..., Served], token: Callable[..., str]) -> None:
+    """Polls answered from the status board and the token cache (no database) still see a
+    cancel at once, never another team's submission, and a revoked token within a rebuild."""
+    from service.db import Token, make_engine, now, session_factory, transaction
+
+    served = start(token_cache_s=60.0, status_board_s=0.2)
+    operator = served.client(token(operator=True))
+    operator.post("/v1/operator/queue/pause")
+    secret = token("Alpha")
+    alpha = setup_team(served, secret, "Alpha")
+    beta = setup_team(served, token("Beta"), "Beta")
+    sid = alpha.post("/v1/submissions", json={}).json()["id"]
+    other = beta.post("/v1/submissions", json={}).json()["id"]
+    time.sleep(0.6)  # a few rebuilds: both submissions are on the board
+    first = alpha.get(f"/v1/submissions/{sid}")
+    assert first.status_code == 200 and first.headers["content-type"] == "application/json"
+    assert first.json()["state"] == "queued" and first.json()["queue_position"] == 1
+    assert alpha.get(f"/v1/submissions/{other}").status_code == 404  # on the board, not theirs
+    assert beta.get(f"/v1/submissions/{other}").json()["queue_position"] == 2
+    assert alpha.post(f"/v1/submissions/{sid}/cancel").json()["state"] == "cancelled"
+    assert alpha.get(f"/v1/submissions/{sid}").json()["state"] == "cancelled"  # at once
+    again = alpha.post("/v1/submissions", json={}).json()["id"]
+    assert alpha.get(f"/v1/submissions/{again}").json()["state"] == "queued"
+    time.sleep(0.6)
+    assert alpha.get(f"/v1/submissions/{again}").json()["queue_position"] == 2
+
+    engine = make_engine(served.settings.db_url)
+    with transaction(session_factory(engine)) as session:
+        session.get(Token, secret.split("_")[1]).revoked_at = now()  # type: ignore[union-attr]
+    engine.dispose()
+    deadline = time.monotonic() + 5  # well within the 60 s of the token cache
+    while (answer := alpha.get(f"/v1/submissions/{again}")).status_code == 200:
+        assert time.monotonic() < deadline, "the revoked token is still accepted"
+        time.sleep(0.05)
+    assert answer.status_code == 401 and "revoked" in answer.json()["message"]
+    for http in (operator, alpha, beta):
+        http.close()
