@@ -28,10 +28,10 @@ from contracts.gamecontroller import (
 )
 from contracts.geometry import Pose
 from contracts.ids import RobotId, TeamColor
-from contracts.match_spec import GameType
+from contracts.match_spec import GameType, PlayerSpec, TeamSpec
 from referee.autoref import Referee
 from referee.clock import Clock, FakeClock, SystemClock
-from referee.config import NetworkConfig, RefereeConfig, RefereePlayer, RefereeTeam, TimingConfig
+from referee.config import NetworkConfig, RefereeConfig, TimingConfig
 from referee.errors import IllegalTransition, ProtocolError, RefereeError, ScenarioError
 from referee.gamecontroller import (
     Card,
@@ -77,14 +77,13 @@ __all__ = [
     "NetworkStats",
     "Penalty",
     "PlaceBall",
+    "PlayerSpec",
     "Pose",
     "ProtocolError",
     "Referee",
     "RefereeConfig",
     "RefereeError",
     "RefereeEvent",
-    "RefereePlayer",
-    "RefereeTeam",
     "RemoveRobot",
     "RestoreRobot",
     "ReturnData",
@@ -98,6 +97,7 @@ __all__ = [
     "SystemClock",
     "TeamColor",
     "TeamMirror",
+    "TeamSpec",
     "TeleportRobot",
     "TimingConfig",
     "WorldCommand",

@@ -266,7 +266,7 @@ class Referee:
         )
 
     def pose_on_side(self, team: TeamColor, pose: Pose) -> Pose:
-        return pose if team is self.left_team else pose.mirrored()
+        return pose.on_side(left=team is self.left_team)
 
     def ball_at(self, x_m: float, y_m: float) -> PlaceBall:
         return PlaceBall(position=(x_m, y_m, self.field.ball_radius_m))

@@ -1,9 +1,11 @@
 """Referee configuration: everything the referee needs, resolved, as frozen dataclasses.
 
-The simulator maps the ``contracts.match_spec.MatchSpec`` onto :class:`RefereeConfig` (the
-referee's view: no ports or robot models, its own timing details). Poses are
-:class:`contracts.geometry.Pose`, given as in HLVS team files: as if the team played on the left
-half (x < 0); the referee mirrors them for the team on the right.
+The simulator maps the ``contracts.match_spec.MatchSpec`` onto :class:`RefereeConfig`: the teams
+are the spec's own :class:`~contracts.match_spec.TeamSpec` (players, poses, robot addresses); the
+referee adds its rule book's durations (:class:`TimingConfig`) and its UDP details
+(:class:`NetworkConfig`). Poses are :class:`contracts.geometry.Pose`, given as in HLVS team files:
+as if the team played on the left half (x < 0); the referee places them with
+:meth:`~contracts.geometry.Pose.on_side`.
 """
 
 from __future__ import annotations
@@ -11,33 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from contracts.field import FieldClass, FieldGeometry, field_for
-from contracts.geometry import Pose
 from contracts.ids import RobotId, TeamColor
-from contracts.match_spec import GameType, TimingSpec
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class RefereePlayer:
-    number: int
-    half_time_pose: Pose
-    reentry_pose: Pose
-    shootout_pose: Pose
-    goalkeeper_pose: Pose
-    goalkeeper: bool = False
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class RefereeTeam:
-    team_id: int  # GameController team number
-    name: str
-    players: tuple[RefereePlayer, ...]
-    robot_addresses: tuple[str, ...] = ()  # robot n at index n-1: RGme target, mirror member
-
-    def player(self, number: int) -> RefereePlayer:
-        for player in self.players:
-            if player.number == number:
-                return player
-        raise KeyError(number)
+from contracts.match_spec import GameType, TeamSpec, TimingSpec
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -70,8 +47,8 @@ class NetworkConfig:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class RefereeConfig:
-    red: RefereeTeam
-    blue: RefereeTeam
+    red: TeamSpec  # robot_addresses: robot n at index n-1 (RGme target, mirror member)
+    blue: TeamSpec
     game_type: GameType = GameType.NORMAL
     field_class: FieldClass = FieldClass.KID
     side_left: TeamColor = TeamColor.RED  # team on x < 0 in the first half
@@ -85,7 +62,12 @@ class RefereeConfig:
     def field(self) -> FieldGeometry:
         return field_for(self.field_class)
 
-    def team(self, color: TeamColor) -> RefereeTeam:
+    def __post_init__(self) -> None:
+        for color, team in (("red", self.red), ("blue", self.blue)):
+            if team.color != color:
+                raise ValueError(f"{color}: expected the {color} team, got {team.color}")
+
+    def team(self, color: TeamColor) -> TeamSpec:
         return self.red if color is TeamColor.RED else self.blue
 
     def robot_ids(self) -> tuple[RobotId, ...]:

@@ -4,33 +4,8 @@ from __future__ import annotations
 
 from dataclasses import fields
 
-from contracts.match_spec import MatchSpec, TeamSpec
-from referee.config import (
-    NetworkConfig,
-    RefereeConfig,
-    RefereePlayer,
-    RefereeTeam,
-    TimingConfig,
-)
-
-
-def _team(team: TeamSpec) -> RefereeTeam:
-    return RefereeTeam(
-        team_id=team.team_id,
-        name=team.name,
-        players=tuple(
-            RefereePlayer(
-                number=p.number,
-                half_time_pose=p.half_time_pose,
-                reentry_pose=p.reentry_pose,
-                shootout_pose=p.shootout_pose,
-                goalkeeper_pose=p.goalkeeper_pose,
-                goalkeeper=p.goalkeeper,
-            )
-            for p in team.players
-        ),
-        robot_addresses=team.robot_addresses,
-    )
+from contracts.match_spec import MatchSpec
+from referee.config import NetworkConfig, RefereeConfig, TimingConfig
 
 
 def referee_config(spec: MatchSpec) -> RefereeConfig:
@@ -50,8 +25,8 @@ def referee_config(spec: MatchSpec) -> RefereeConfig:
         mirror_port=spec.network.mirror_port,
     )
     return RefereeConfig(
-        red=_team(spec.red),
-        blue=_team(spec.blue),
+        red=spec.red,
+        blue=spec.blue,
         game_type=spec.game,
         field_class=spec.field,
         side_left=spec.side_left_color,

@@ -9,10 +9,10 @@ from typing import Any
 
 from contracts.geometry import Pose
 from contracts.ids import RobotId, TeamColor
-from contracts.match_spec import GameType
+from contracts.match_spec import GameType, PlayerSpec, TeamSpec
 from referee.autoref import Referee
 from referee.clock import FakeClock
-from referee.config import RefereeConfig, RefereePlayer, RefereeTeam, TimingConfig
+from referee.config import RefereeConfig, TimingConfig
 from referee.gamecontroller.states import Card
 from referee.snapshot import PlaceBall, RefereeEvent, TeleportRobot, WorldSnapshot
 from simulator.world import RobotPlacement, World
@@ -55,14 +55,16 @@ def build_config(scenario: Scenario) -> RefereeConfig:
     half = int(game.get("half", 1))
     left_now = side_left if half == 1 else side_left.opponent
     timing = replace(SCENARIO_TIMING, **scenario.timing)
-    players: dict[TeamColor, list[RefereePlayer]] = {TeamColor.RED: [], TeamColor.BLUE: []}
+    players: dict[TeamColor, list[PlayerSpec]] = {TeamColor.RED: [], TeamColor.BLUE: []}
     for start in scenario.robots:
-        pose = Pose(x_m=start.x, y_m=start.y, yaw_rad=start.yaw)
-        if start.id.team is not left_now:
-            pose = pose.mirrored()
+        # the scenario gives where the robot stands now: written back as if on the left half
+        pose = Pose(x_m=start.x, y_m=start.y, yaw_rad=start.yaw).on_side(
+            left=start.id.team is left_now)
         players[start.id.team].append(
-            RefereePlayer(
+            PlayerSpec(
                 number=start.id.number,
+                model="kid-default",
+                port=10000 + start.id.number,
                 half_time_pose=pose,
                 reentry_pose=Pose(x_m=-3.0, y_m=-3.1, yaw_rad=math.pi / 2),
                 shootout_pose=Pose(x_m=2.6, y_m=0.0, yaw_rad=0.0),
@@ -71,7 +73,9 @@ def build_config(scenario: Scenario) -> RefereeConfig:
             )
         )
     teams = {
-        color: RefereeTeam(
+        color: TeamSpec(
+            color=color.value,
+            hosts=(),
             team_id=8 if color is TeamColor.RED else 25,
             name=f"{color.value} team",
             players=tuple(sorted(players[color], key=lambda p: p.number)),

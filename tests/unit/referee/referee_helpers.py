@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from contracts.geometry import Pose
 from contracts.ids import RobotId, TeamColor
-from contracts.match_spec import GameType
-from referee.config import RefereeConfig, RefereePlayer, RefereeTeam, TimingConfig
+from contracts.match_spec import GameType, PlayerSpec, TeamSpec
+from referee.config import RefereeConfig, TimingConfig
 from referee.snapshot import BallState, BodyPart, RobotState, WorldSnapshot
 
 RED = TeamColor.RED
@@ -31,10 +31,12 @@ FAST_TIMING = TimingConfig(
 )
 
 
-def player(number: int, *, y: float = -3.1) -> RefereePlayer:
+def player(number: int, *, y: float = -3.1) -> PlayerSpec:
     """Poses as if playing on the left: half-time pose on the touch line of the own half."""
-    return RefereePlayer(
+    return PlayerSpec(
         number=number,
+        model="kid-default",
+        port=10000 + number,
         half_time_pose=Pose(x_m=-0.6 - 0.9 * number, y_m=y, yaw_rad=1.57),
         reentry_pose=Pose(x_m=-3.0, y_m=-3.1, yaw_rad=1.57),
         shootout_pose=Pose(x_m=2.75, y_m=0.0, yaw_rad=0.0),
@@ -54,12 +56,14 @@ def make_config(
 ) -> RefereeConfig:
     addresses = addresses or {}
     return RefereeConfig(
-        red=RefereeTeam(
-            team_id=8, name="Red Team", players=tuple(player(n) for n in range(1, players + 1)),
+        red=TeamSpec(
+            color="red", team_id=8, name="Red Team", hosts=addresses.get(RED, ()),
+            players=tuple(player(n) for n in range(1, players + 1)),
             robot_addresses=addresses.get(RED, ()),
         ),
-        blue=RefereeTeam(
-            team_id=25, name="Blue Team", players=tuple(player(n) for n in range(1, players + 1)),
+        blue=TeamSpec(
+            color="blue", team_id=25, name="Blue Team", hosts=addresses.get(BLUE, ()),
+            players=tuple(player(n) for n in range(1, players + 1)),
             robot_addresses=addresses.get(BLUE, ()),
         ),
         game_type=game_type,
