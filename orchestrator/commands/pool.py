@@ -3,7 +3,8 @@
 ``up`` installs (Debian, as root) and starts a cluster on this machine: a controller, the
 accounting daemon with MariaDB and five nodes, each in its own network namespace with its own
 address (``scripts/ensure-slurm.sh``); ``down`` stops it. ``status`` lists the match jobs with
-the reason each waits and its expected start, as Slurm gives them.
+the reason each waits and its expected start, as Slurm gives them, and the nodes with their
+state (and why one is drained or down) and the match on each.
 """
 
 from __future__ import annotations
@@ -33,7 +34,9 @@ def register(sub: Any) -> None:
     up.set_defaults(func=_up)
     down = actions.add_parser("down", help="stop the cluster started by 'hlvs pool up'")
     down.set_defaults(func=_down)
-    status = actions.add_parser("status", help="match jobs: state, reason, expected start")
+    status = actions.add_parser(
+        "status", help="match jobs (state, reason, expected start) and the nodes (state, "
+        "reason, the match on each)")
     status.add_argument("--json", action="store_true", help="one JSON document")
     status.add_argument("--slurm-conf", default=os.environ.get("SLURM_CONF", DEFAULT_CONF),
                         help="the cluster's slurm.conf (default: $SLURM_CONF or the one "
@@ -60,13 +63,20 @@ def _down(args: argparse.Namespace) -> int:
 def _status(args: argparse.Namespace) -> int:
     from service.pool.slurm import SlurmPool
 
-    entries = SlurmPool(slurm_conf=args.slurm_conf).queue()
+    pool = SlurmPool(slurm_conf=args.slurm_conf)
+    entries = pool.queue()
+    nodes = pool.nodes()
     if args.json:
-        print(json.dumps({"jobs": [e.to_json() for e in entries]}, indent=2))
-    elif not entries:
+        print(json.dumps({"jobs": [e.to_json() for e in entries],
+                          "nodes": [n.to_json() for n in nodes]}, indent=2))
+        return ExitCode.OK
+    if not entries:
         print("no match jobs in the cluster")
-    else:
-        for e in entries:
-            print(f"{e.job_id:>6} {e.name.removeprefix('hlvs-'):<24} {e.account:<12} "
-                  f"{e.state:<10} {e.reason:<20} {e.expected_start} {e.nodes}")
+    for e in entries:
+        print(f"{e.job_id:>6} {e.name.removeprefix('hlvs-'):<24} {e.account:<12} "
+              f"{e.state:<10} {e.reason:<20} {e.expected_start} {e.nodes}")
+    for n in nodes:
+        jobs = ", ".join(f"{j.match_id or 'job'} ({j.job_id})" for j in n.jobs) or "-"
+        print(f"node {n.name:<8} {n.state:<12} {n.cpus_allocated}/{n.cpus} CPUs  {jobs}"
+              + (f"  reason: {n.reason}" if n.reason else ""))
     return ExitCode.OK

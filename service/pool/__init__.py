@@ -19,6 +19,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
 
+from service.pool.nodes import NodeJob, PoolNode
+
 if TYPE_CHECKING:
     from service.settings import Settings
 
@@ -72,6 +74,10 @@ class MatchPool(Protocol):
 
     def results_dir(self, handle: str) -> Path: ...
 
+    def nodes(self) -> list[PoolNode]:
+        """The pool's machines for operators: state, CPUs, memory, the matches on each."""
+        ...
+
 
 def make_pool(settings: Settings) -> MatchPool:
     """The pool named by ``settings.pool``: ``local`` (this host's Docker engine) or ``slurm``
@@ -85,4 +91,4 @@ def make_pool(settings: Settings) -> MatchPool:
     return LocalDockerPool(slots=settings.match_slots)
 
 
-__all__ = ["JobState", "JobStatus", "MatchJob", "MatchPool", "make_pool"]
+__all__ = ["JobState", "JobStatus", "MatchJob", "MatchPool", "NodeJob", "PoolNode", "make_pool"]

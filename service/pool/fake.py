@@ -19,7 +19,7 @@ from contracts.match_results import (
     MatchResults,
     RobotResult,
 )
-from service.pool import JobState, JobStatus, MatchJob
+from service.pool import JobState, JobStatus, MatchJob, NodeJob, PoolNode
 
 
 class FakePool:
@@ -29,10 +29,12 @@ class FakePool:
         self.submitted: list[str] = []  # match ids, in order, including adopted ones
         self.started: list[str] = []  # match ids actually started
         self.cancelled: list[str] = []
+        self.handles: dict[str, str] = {}  # handle -> match id
 
     def submit(self, job: MatchJob) -> str:
         handle = str(job.work_dir)
         self.submitted.append(job.match_id)
+        self.handles[handle] = job.match_id
         marker = job.work_dir / "running"
         if not marker.exists() and not (self.results_dir(handle) / files.REPORT).exists():
             job.work_dir.mkdir(parents=True, exist_ok=True)
@@ -57,6 +59,15 @@ class FakePool:
 
     def results_dir(self, handle: str) -> Path:
         return Path(handle) / "out"
+
+    def nodes(self) -> list[PoolNode]:
+        """One node, ``fake-node``, with the matches running on it."""
+        jobs = tuple(NodeJob(job_id=f"fake-{i}", match_id=match_id, state="running")
+                     for i, (handle, match_id) in enumerate(self.handles.items())
+                     if (Path(handle) / "running").exists())
+        return [PoolNode(name="fake-node", state="up", reason="", features=("fake",), cpus=2,
+                         cpus_allocated=None, cpu_load=None, memory_mb=1024, memory_free_mb=512,
+                         slots=self.slots, jobs=jobs)]
 
     # test controls -----------------------------------------------------------------------
     def finish(self, handle: str, report: dict[str, Any]) -> None:

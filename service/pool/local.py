@@ -13,6 +13,7 @@ import json
 import logging
 import os
 import signal
+import socket
 import subprocess
 import sys
 import threading
@@ -21,6 +22,7 @@ from pathlib import Path
 from contracts import files
 from service.errors import PoolError
 from service.pool import JobState, JobStatus, MatchJob
+from service.pool.nodes import NodeJob, PoolNode
 
 log = logging.getLogger(__name__)
 
@@ -40,6 +42,20 @@ def _start_time(pid: int) -> int | None:
     return int(fields[19])
 
 
+def _memory_mb() -> tuple[int, int | None]:
+    """This host's memory and the part still available (``/proc/meminfo``), in MiB."""
+    values: dict[str, int] = {}
+    try:
+        for line in Path("/proc/meminfo").read_text().splitlines():
+            key, _, rest = line.partition(":")
+            number = rest.split()[0] if rest.split() else ""
+            if number.isdigit():
+                values[key] = int(number) // 1024  # kB
+    except OSError:
+        pass
+    return values.get("MemTotal", 0), values.get("MemAvailable")
+
+
 class LocalDockerPool:
     def __init__(self, *, slots: int = 1, python: str = sys.executable,
                  extra_args: tuple[str, ...] = ()) -> None:
@@ -47,6 +63,7 @@ class LocalDockerPool:
         self.python = python
         self.extra_args = extra_args
         self._children: dict[str, subprocess.Popen[bytes]] = {}
+        self._seen: set[str] = set()  # handles seen running (started here or asked about)
         self._lock = threading.Lock()
 
     # MatchPool ---------------------------------------------------------------------------
@@ -73,13 +90,16 @@ class LocalDockerPool:
             tmp.write_text(json.dumps(state))
             tmp.replace(job.work_dir / STATE_FILE)
             self._children[handle] = child
+            self._seen.add(handle)
             log.info("match %s started in the local pool (pid %d)", job.match_id, child.pid)
             return handle
 
     def status(self, handle: str) -> JobStatus:
         with self._lock:
             if self._alive(handle):
+                self._seen.add(handle)
                 return JobStatus(state=JobState.RUNNING)
+            self._seen.discard(handle)
         if (self.results_dir(handle) / files.REPORT).is_file():
             return JobStatus(state=JobState.FINISHED)
         detail = "the match process ended without a report.json"
@@ -104,6 +124,26 @@ class LocalDockerPool:
 
     def results_dir(self, handle: str) -> Path:
         return Path(handle) / "out"
+
+    def nodes(self) -> list[PoolNode]:
+        """This host: its CPUs, load and memory, and the matches running here (the ones
+        this process started or was asked about: a restarted service learns of the others
+        from its first status queries)."""
+        jobs = []
+        with self._lock:
+            for handle in sorted(self._seen):
+                state = self._state(handle)
+                if state is None or not self._alive(handle):
+                    continue
+                match_id = state.get("match_id")
+                jobs.append(NodeJob(job_id=str(state.get("pid")), state="running",
+                                    match_id=match_id if isinstance(match_id, str) else None))
+        total_mb, free_mb = _memory_mb()
+        return [PoolNode(
+            name=socket.gethostname(), state="up", reason="", features=("docker",),
+            cpus=os.cpu_count() or 1, cpus_allocated=None, cpu_load=round(os.getloadavg()[0], 2),
+            memory_mb=total_mb, memory_free_mb=free_mb, slots=self.slots, jobs=tuple(jobs),
+        )]  # fmt: skip
 
     # helpers -----------------------------------------------------------------------------
     def _state(self, handle: str) -> dict[str, object] | None:

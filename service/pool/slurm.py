@@ -39,6 +39,13 @@ from pathlib import Path
 from contracts import files
 from service.errors import PoolError
 from service.pool import JobState, JobStatus, MatchJob
+from service.pool.nodes import (
+    SINFO_FORMAT,
+    SQUEUE_NODES_FORMAT,
+    PoolNode,
+    parse_sinfo,
+    parse_squeue_nodes,
+)
 
 log = logging.getLogger(__name__)
 
@@ -263,6 +270,18 @@ class SlurmPool:
         entries = _merged(_parse_entry(line) for line in text.splitlines() if line.strip())
         return sorted((e for e in entries if e.name.startswith("hlvs-")),
                       key=lambda e: (e.state != "PENDING", e.job_id))
+
+    def nodes(self) -> list[PoolNode]:
+        """The cluster's nodes (``sinfo``): state, the reason a node is drained or down, its
+        features, CPUs and memory, and the jobs running on it (``squeue``)."""
+        listed = self._run(["sinfo", "-N", "-h", "-o", SINFO_FORMAT], handle="sinfo")
+        running = self._run(["squeue", "-h", "-o", SQUEUE_NODES_FORMAT], handle="squeue")
+        try:
+            nodes = parse_sinfo(listed)
+            jobs = parse_squeue_nodes(running)
+        except ValueError as exc:
+            raise PoolError(handle="sinfo", reason=str(exc)) from exc
+        return [replace(n, jobs=tuple(jobs.get(n.name, ()))) for n in nodes]
 
     def ensure_account(self, name: str, *, max_running: int = 1, max_queued: int = 5) -> None:
         """A Slurm account for a team (idempotent): at most ``max_running`` of its jobs run

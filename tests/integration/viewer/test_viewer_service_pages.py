@@ -87,11 +87,17 @@ def test_queue_submissions_replay_standings_and_pool_pages(
     page.goto(f"{served.url}/watch/nodes")
     assert page.locator("[data-testid=pool-summary]").inner_text() == "1 match slot(s), 1 in use"
     assert _rows(page, "pool")[0][1] == ids[0]
+    (node,) = _rows(page, "nodes")
+    assert (node[0], node[1], node[6]) == ("fake-node", "up", "1/1")
+    assert node[7].startswith(f"{ids[0]} (A1 v stub)")
     screenshot(page, "service-pool")
 
     handle = handle_of(served, ids[0])
     pool.finish(handle, {"status": "success"})
     wait_for(clients[0], ids[0], lambda b: b["state"] == "done")
+    page.wait_for_function(  # the pool page refreshes by itself: the match left the node
+        "document.querySelector('[data-testid=nodes] tr:nth-child(2) td:nth-child(8)')"
+        ".innerText.startsWith(" + repr(ids[1]) + ")", timeout=20_000)
     public = pool.results_dir(handle) / "public"
     recorded = record_match(tmp_path / "recorded")
     shutil.copy(recorded, public / "replay.hlvsrec")

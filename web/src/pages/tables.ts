@@ -102,14 +102,82 @@ async function standingsPage(root: HTMLElement): Promise<void> {
   );
 }
 
-async function poolPage(root: HTMLElement): Promise<void> {
-  const queue = await getJson<Queue>("/v1/operator/queue");
+interface NodeJob {
+  job_id: string;
+  state: string;
+  match_id: string | null;
+  submission_id: string | null;
+  team: string | null;
+  opponent: string | null;
+}
+
+interface PoolNode {
+  name: string;
+  state: string;
+  reason: string;
+  features: string[];
+  cpus: number;
+  cpus_allocated: number | null;
+  cpu_load: number | null;
+  memory_mb: number;
+  memory_free_mb: number | null;
+  slots: number;
+  jobs: NodeJob[];
+}
+
+interface PoolNodes {
+  pool: string;
+  slots: number;
+  nodes: PoolNode[];
+}
+
+const POOL_REFRESH_MS = 3000;
+
+function describeJob(j: NodeJob): string {
+  if (j.submission_id) return `${j.submission_id} (${j.team} v ${j.opponent}) ${j.state}`;
+  if (j.match_id) return `match ${j.match_id} (job ${j.job_id}) ${j.state}`;
+  return `job ${j.job_id} ${j.state}`;
+}
+
+function nodeRows(nodes: PoolNode[]): (string | Node)[][] {
+  return nodes.map((n) => [
+    n.name, n.state, n.reason || "-", n.features.join(", ") || "-",
+    `${n.cpus_allocated === null ? "" : `${n.cpus_allocated}/`}${n.cpus}${n.cpu_load === null ? "" : `, load ${n.cpu_load.toFixed(2)}`}`,
+    `${n.memory_mb} MB${n.memory_free_mb === null ? "" : `, ${n.memory_free_mb} free`}`,
+    `${n.jobs.length}/${n.slots}`,
+    n.jobs.length ? n.jobs.map(describeJob).join("; ") : "-",
+  ]);
+}
+
+async function poolSection(): Promise<HTMLElement> {
+  const [queue, pool] = await Promise.all([getJson<Queue>("/v1/operator/queue"), getJson<PoolNodes>("/v1/operator/nodes")]);
   const running = queue.active.filter((s) => s.state === "running" || s.state === "starting");
-  root.append(
-    el("h1", {}, "Pool"),
+  const down = pool.nodes.filter((n) => n.reason !== "").length;
+  return el("div", { "data-testid": "pool-section" },
     el("p", { "data-testid": "pool-summary" }, `${queue.slots} match slot(s), ${running.length} in use${queue.paused ? ", queue paused" : ""}`),
     table("pool", ["slot", "submission", "team", "state", "started"], running.map((s, i) => [String(i + 1), s.id, s.team, s.state, when(s.started_at)])),
+    el("h2", {}, `Nodes (${pool.pool} pool)`),
+    el("p", { "data-testid": "nodes-summary" }, `${pool.nodes.length} node(s), ${down} out of service`),
+    table("nodes", ["node", "state", "reason", "features", "CPUs", "memory", "matches", "running"], nodeRows(pool.nodes)),
+    el("p", { class: "muted", "data-testid": "pool-updated" }, `updated ${new Date().toISOString().slice(11, 19)} UTC`),
   );
+}
+
+/** The pool for operators: slots in use and the pool's nodes, refreshed every few seconds. */
+async function poolPage(root: HTMLElement): Promise<void> {
+  let section = await poolSection();
+  root.append(el("h1", {}, "Pool"), section);
+  const refresh = async (): Promise<void> => {
+    try {
+      const next = await poolSection();
+      section.replaceWith(next);
+      section = next;
+    } catch (error) {
+      section.querySelector("[data-testid=pool-updated]")!.textContent = `not updated: ${String(error)}`;
+    }
+    setTimeout(() => void refresh(), POOL_REFRESH_MS);
+  };
+  setTimeout(() => void refresh(), POOL_REFRESH_MS);
 }
 
 export async function tablePage(root: HTMLElement, page: string, _arg?: string): Promise<void> {

@@ -1,0 +1,33 @@
+"""``GET /v1/operator/nodes``: operators only; each node's job names its submission and teams."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from tests.integration.service.harness import Served
+from tests.unit.service.test_submissions import setup_team, wait_for
+
+
+def test_operators_see_the_nodes_and_the_submission_on_each(
+    start: Callable[..., Served], token: Callable[..., str],
+) -> None:
+    served = start()
+    team = setup_team(served, token("Alpha"), "Alpha")
+    sid = team.post("/v1/submissions", json={}).json()["id"]
+    body = wait_for(team, sid, lambda b: b["state"] == "running")
+    refused = team.get("/v1/operator/nodes")  # a team's token is not an operator's
+    assert refused.status_code == 401 and "operator" in refused.text, refused.text
+    with served.client() as anonymous:
+        assert anonymous.get("/v1/operator/nodes").status_code == 401
+    with served.client(token(operator=True)) as operator:
+        answer = operator.get("/v1/operator/nodes")
+        assert answer.status_code == 200, answer.text
+        view = answer.json()
+    assert (view["pool"], view["slots"]) == ("local", 1)
+    (node,) = view["nodes"]
+    assert (node["name"], node["state"], node["memory_mb"], node["slots"]) == \
+        ("fake-node", "up", 1024, 1)
+    assert node["jobs"] == [{"job_id": "fake-0", "state": "running",
+                             "match_id": body["match_id"], "submission_id": sid,
+                             "team": "Alpha", "opponent": "stub"}]
+    team.close()
