@@ -17,8 +17,9 @@ from typing import Any
 import pytest
 
 from service.pool.slurm import SlurmPool
+from tests.integration.pool.conftest import cluster  # noqa: F401
 from tests.integration.service.harness import Served, serve
-from tests.integration.viewer.conftest import browser, page, screenshot  # noqa: F401
+from tests.integration.viewer.conftest import screenshot
 from tests.unit.service.conftest import settings, token  # noqa: F401
 
 pytestmark = [pytest.mark.root, pytest.mark.browser]
