@@ -48,6 +48,11 @@ log = logging.getLogger(__name__)
 
 Request = pb.ActuatorRequests | PositionTargets
 
+# With the I/O thread the step thread's own selector only accepts connections (and takes camera
+# images): before a step it is polled every POLL_EVERY_STEPS steps, and every step while a
+# measurement waits for an image or a name lookup runs (a syscall less on most steps).
+POLL_EVERY_STEPS = 4
+
 
 class PortUnavailable(ApiError):
     def __init__(self, *, host: str, port: int, reason: str) -> None:
@@ -125,6 +130,7 @@ class ApiServer:
         self.awaiting_answers = False
         self._wake: tuple[int, int] | None = None
         self._wake_sent = False
+        self._step_polls = 0
         self._woken: list[Connection] = []
         self.slots: dict[RobotId, RobotSlot] = {}
         for endpoint in endpoints:
@@ -397,9 +403,18 @@ class ApiServer:
 
     # --- the step ---------------------------------------------------------------------------
 
+    def _poll_before_step(self) -> None:
+        if self._sender is not None:
+            self._step_polls += 1
+            if self._step_polls % POLL_EVERY_STEPS and not any(
+                slot.pending or slot.checking for slot in self.slots.values()
+            ):
+                return
+        self.poll(0.0)
+
     def apply_requests(self, step_time_ms: int) -> None:
         """Read what is available, then apply every received request in arrival order."""
-        self.poll(0.0)
+        self._poll_before_step()
         for slot in self.slots.values():
             slot.session.update_limp()
             conn = slot.conn
@@ -419,7 +434,7 @@ class ApiServer:
     def take_requests(self) -> dict[RobotId, list[Request]]:
         """Pipelined stepping: read what is available and detach every client's received
         requests, to be applied later by :meth:`apply_taken` (the step after next)."""
-        self.poll(0.0)
+        self._poll_before_step()
         taken: dict[RobotId, list[Request]] = {}
         for robot, slot in self.slots.items():
             conn = slot.conn
