@@ -8,7 +8,8 @@ processes hits both alike; rates are computed from the step thread's CPU time (`
 wall time (``wall``). ``ratio`` = env steps/s over bare steps/s (CPU time); the target is >= 0.8.
 
 With ``--remotes N`` (needs Docker and the simulator image), it also measures one remote over
-TCP and a vector environment over 1, 2, ... N remotes (``--vector 1,2,4``).
+TCP and a vector environment over 1, 2, ... N remotes (``--vector 1,2,4``, each size
+``--repeats`` times, interleaved), with the client's and the remotes' CPU time per step.
 """
 
 from __future__ import annotations
@@ -93,10 +94,12 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--remotes", type=int, default=0, help="also measure N remotes (Docker)")
     parser.add_argument("--vector", default="1,2,4", help="vector sizes over remotes")
     parser.add_argument("--remote-steps", type=int, default=1000, help="steps per remote run")
+    parser.add_argument("--repeats", type=int, default=1,
+                        help="runs of each vector size, interleaved (medians reported)")
     parser.add_argument("--json", action="store_true", help="only the JSON line")
     args = parser.parse_args(argv)
-    if args.rounds < 1 or args.block < 1:
-        print("--rounds and --block: expected integers >= 1", file=sys.stderr)
+    if args.rounds < 1 or args.block < 1 or args.repeats < 1:
+        print("--rounds, --block and --repeats: expected integers >= 1", file=sys.stderr)
         return 2
     out: dict[str, Any] = {"bench": "envs", "env": "hlvs/Kick-v0", "seed": args.seed}
     out["inprocess"] = bench_inprocess(rounds=args.rounds, block=args.block, seed=args.seed)
@@ -105,6 +108,6 @@ def main(argv: list[str]) -> int:
 
         sizes = [int(v) for v in args.vector.split(",") if v.strip()]
         out.update(bench_remotes(remotes=args.remotes, sizes=sizes, steps=args.remote_steps,
-                                 seed=args.seed))  # fmt: skip
+                                 seed=args.seed, repeats=args.repeats))  # fmt: skip
     print(json.dumps(out))
     return 0

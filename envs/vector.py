@@ -22,6 +22,8 @@ from gymnasium.vector.utils import batch_space, concatenate, create_empty_array
 from envs.base import HlvsEnv
 from envs.remote import RemotePool, RemoteSession
 
+_NUMBERS = (int, float, bool, np.float64, np.int64, np.bool_)
+
 
 def make_vector(
     env_id: str,
@@ -73,6 +75,12 @@ class RemoteVectorEnv(VectorEnv):
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self._obs = create_empty_array(self.single_observation_space, n=self.num_envs)
+        space = self.single_observation_space
+        # a Dict of Boxes (every hlvs observation): batched by writing rows in place
+        self._rows: dict[str, np.ndarray] | None = None
+        if isinstance(space, gym.spaces.Dict) and isinstance(self._obs, dict):
+            if all(isinstance(s, gym.spaces.Box) for s in space.spaces.values()):
+                self._rows = self._obs
 
     def reset(
         self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None
@@ -85,15 +93,40 @@ class RemoteVectorEnv(VectorEnv):
             else [seed + i for i in range(self.num_envs)]
         )
         observations: list[Any] = []
-        infos: dict[str, Any] = {}
+        infos: list[dict[str, Any]] = []
         for i, env in enumerate(self.envs):
             obs, info = env.reset(seed=seeds[i], options=options)
             observations.append(obs)
-            infos = self._add_info(infos, info, i)
-        return self._batch(observations), infos
+            infos.append(info)
+        return self._batch(observations), self._infos(infos)
 
     def _batch(self, observations: list[Any]) -> Any:
-        return concatenate(self.single_observation_space, observations, self._obs)  # type: ignore[arg-type]
+        if self._rows is None:
+            return concatenate(self.single_observation_space, observations, self._obs)  # type: ignore[arg-type]
+        for key, rows in self._rows.items():
+            for i, obs in enumerate(observations):
+                rows[i] = obs[key]
+        return self._obs
+
+    def _infos(self, infos: list[dict[str, Any]]) -> dict[str, Any]:
+        """Gymnasium's batched infos (``infos[key]`` array, ``infos["_" + key]`` mask). When
+        every environment reports the same keys with plain numbers (a step without an episode
+        end), built in one go; otherwise key by key as Gymnasium does."""
+        keys = infos[0].keys()
+        if all(info.keys() == keys for info in infos) and all(
+            type(value) in _NUMBERS for value in infos[0].values()
+        ):
+            out: dict[str, Any] = {}
+            present = np.ones(self.num_envs, dtype=np.bool_)
+            for key in keys:
+                values = [info[key] for info in infos]
+                out[key] = np.array(values, dtype=type(values[0]))
+                out["_" + key] = present.copy()
+            return out
+        batched: dict[str, Any] = {}
+        for i, info in enumerate(infos):
+            batched = self._add_info(batched, info, i)
+        return batched
 
     def step(self, actions: Any) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         batch = np.asarray(actions)
@@ -105,7 +138,7 @@ class RemoteVectorEnv(VectorEnv):
         rewards = np.zeros(self.num_envs)
         terminated = np.zeros(self.num_envs, dtype=bool)
         truncated = np.zeros(self.num_envs, dtype=bool)
-        infos: dict[str, Any] = {}
+        infos: list[dict[str, Any]] = []
         for i, env in enumerate(self.envs):
             session = env.session
             assert isinstance(session, RemoteSession)
@@ -116,9 +149,8 @@ class RemoteVectorEnv(VectorEnv):
                 info = {**info, **final}
             observations.append(obs)
             rewards[i], terminated[i], truncated[i] = reward, term, trunc
-            infos = self._add_info(infos, info, i)
-        obs_batch = self._batch(observations)
-        return obs_batch, rewards, terminated, truncated, infos
+            infos.append(info)
+        return self._batch(observations), rewards, terminated, truncated, self._infos(infos)
 
     def close_extras(self, **kwargs: Any) -> None:
         for env in self.envs:
