@@ -12,7 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Literal
 
-from contracts.codec import to_data
+from contracts.codec import from_data, to_data
 
 PREFIX = "hlvs"
 Kind = Literal["state", "events", "poses", "scene"]
@@ -51,6 +51,11 @@ class StateMessage:
     def to_dict(self) -> dict[str, Any]:
         data: dict[str, Any] = to_data(self)
         return data
+
+    @classmethod
+    def from_dict(cls, data: Any, *, source: str) -> StateMessage:
+        """Decode one message; :class:`~contracts.errors.ContractError` names the field."""
+        return from_data(cls, data, source=source)
 
 
 __all__ = [

@@ -23,13 +23,15 @@ from rich.live import Live
 from rich.table import Table
 
 from contracts import telemetry as topics
+from contracts.errors import ContractError
+from contracts.telemetry import StateMessage
 from orchestrator.errors import InfrastructureError
 
 log = logging.getLogger(__name__)
 
 
 class TelemetrySource(Protocol):
-    def latest(self) -> dict[str, Any] | None: ...
+    def latest(self) -> StateMessage | None: ...
 
     def last_message_at(self) -> float | None: ...  # time.monotonic() of the last message
 
@@ -45,7 +47,8 @@ class ZenohTelemetry:
                  ) -> None:
         self._clock = clock
         self._lock = threading.Lock()
-        self._latest: dict[str, Any] | None = None
+        self._latest: StateMessage | None = None
+        self._refused: set[str] = set()  # why state messages were refused (logged once each)
         self._last_at: float | None = None
         self._events: list[dict[str, Any]] = []
         config = zenoh.Config()
@@ -80,10 +83,18 @@ class ZenohTelemetry:
 
     def _on_state(self, sample: Any) -> None:
         value = self._decode(sample)
+        message = None
+        if value is not None:
+            try:
+                message = StateMessage.from_dict(value, source=f"telemetry {sample.key_expr}")
+            except ContractError as exc:
+                if str(exc) not in self._refused:
+                    self._refused.add(str(exc))
+                    log.warning("%s (message ignored)", exc)
         with self._lock:
             self._last_at = self._clock()
-            if value is not None:
-                self._latest = value
+            if message is not None:
+                self._latest = message
 
     def _on_event(self, sample: Any) -> None:
         value = self._decode(sample)
@@ -92,7 +103,7 @@ class ZenohTelemetry:
             if value is not None:
                 self._events.append(value)
 
-    def latest(self) -> dict[str, Any] | None:
+    def latest(self) -> StateMessage | None:
         with self._lock:
             return self._latest
 
@@ -110,19 +121,20 @@ class ZenohTelemetry:
         self._session.close()  # type: ignore[no-untyped-call]
 
 
-def describe(state: dict[str, Any]) -> str:
+def describe(state: StateMessage) -> str:
     """One progress line for a telemetry state."""
-    score = state.get("score") or {}
-    secondary = state.get("secondary_state")
+    score = state.score or {}
+    secondary = state.secondary_state
     return (
-        f"{state.get('state', '?')}"
+        f"{state.state}"
         + (f"/{secondary}" if secondary and secondary != "NORMAL" else "")
-        + f" half {state.get('half', '?')} {state.get('secs_remaining', '?')} s left"
+        + f" half {state.half} {state.secs_remaining} s left"
         + f" score red {score.get('red', '?')} - {score.get('blue', '?')} blue"
-        + f" sim {float(state.get('sim_time_ms', 0)) / 1000:.1f} s"
-        + f" rtf {float(state.get('real_time_factor', 0)):.2f}"
-        + f" connected {','.join(state.get('connected') or []) or '-'}"
+        + f" sim {state.sim_time_ms / 1000:.1f} s"
+        + f" rtf {state.real_time_factor:.2f}"
+        + f" connected {','.join(state.connected) or '-'}"
     )
+
 
 
 class LiveView:
@@ -147,27 +159,26 @@ class LiveView:
                               refresh_per_second=4, transient=False)
             self._live.start()
 
-    def _table(self, state: dict[str, Any] | None) -> Table:
+    def _table(self, state: StateMessage | None) -> Table:
         table = Table(title=f"match {self._match_id}", show_header=False)
         table.add_row("phase", self._phase)
         if state is not None:
-            score = state.get("score") or {}
-            table.add_row("game", f"{state.get('state')} ({state.get('secondary_state')}), "
-                          f"half {state.get('half')}, {state.get('secs_remaining')} s left")
+            score = state.score or {}
+            table.add_row("game", f"{state.state} ({state.secondary_state}), "
+                          f"half {state.half}, {state.secs_remaining} s left")
             table.add_row("score", f"red {score.get('red')} - {score.get('blue')} blue")
-            table.add_row("sim time", f"{float(state.get('sim_time_ms', 0)) / 1000:.1f} s")
-            table.add_row("real-time factor", f"{float(state.get('real_time_factor', 0)):.2f}")
-            table.add_row("connected", ", ".join(state.get("connected") or []) or "-")
+            table.add_row("sim time", f"{state.sim_time_ms / 1000:.1f} s")
+            table.add_row("real-time factor", f"{state.real_time_factor:.2f}")
+            table.add_row("connected", ", ".join(state.connected) or "-")
         return table
 
-    def update(self, *, phase: str, state: dict[str, Any] | None) -> None:
+    def update(self, *, phase: str, state: StateMessage | None) -> None:
         self._phase = phase
         if self._live is not None:
             self._live.update(self._table(state))
             return
         key = (phase, None if state is None else (
-            state.get("state"), state.get("half"), json.dumps(state.get("score"), sort_keys=True),
-            tuple(state.get("connected") or ())))
+            state.state, state.half, json.dumps(state.score, sort_keys=True), state.connected))
         now = time.monotonic()
         if key != self._last_key or now - self._last_print >= self.PLAIN_PERIOD_S:
             line = f"[{phase}]" + (f" {describe(state)}" if state else "")

@@ -16,9 +16,9 @@ import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 from contracts.match_results import Forfeit
+from contracts.telemetry import StateMessage
 from orchestrator.bandwidth import AppliedShaping
 from orchestrator.match.admission import CpuSets
 from orchestrator.match.host import Host
@@ -47,7 +47,7 @@ class RunOptions:
     extra_labels: Mapping[str, str] = field(default_factory=dict)
     poll_s: float = 0.5
     simulator_stop_s: float = 10.0
-    progress: Callable[[str, dict[str, Any] | None], None] | None = None
+    progress: Callable[[str, StateMessage | None], None] | None = None
     # league placement: the simulator and each robot on a node of its own (None: dense, the
     # whole match on this host's engine with a network per team)
     placement: LeaguePlacement | None = None
@@ -121,7 +121,7 @@ class MatchContext:
         self.lifecycle.advance(target)
         self.progress(None)
 
-    def progress(self, state: dict[str, Any] | None) -> None:
+    def progress(self, state: StateMessage | None) -> None:
         if self.options.progress is not None:
             self.options.progress(self.lifecycle.state.value, state)
 

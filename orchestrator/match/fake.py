@@ -11,6 +11,7 @@ from typing import Any
 
 from contracts import files
 from contracts.sim_result import SimResult
+from contracts.telemetry import StateMessage
 from orchestrator.bandwidth import AppliedShaping, RobotShaping, TrafficCounters
 from orchestrator.match.logfs import LogFolder
 from orchestrator.match.placement import NodeFirewall
@@ -230,15 +231,15 @@ class FakeHost:
 class FakeTelemetry:
     """A telemetry source a test feeds by hand (``states`` are served one per ``latest``)."""
 
-    def __init__(self, states: list[dict[str, Any]], *, clock: Callable[[], float],
+    def __init__(self, states: list[StateMessage], *, clock: Callable[[], float],
                  silent: bool = False) -> None:
         self._states = list(states)
         self._clock = clock
         self._silent = silent
-        self._last: dict[str, Any] | None = None
+        self._last: StateMessage | None = None
         self.closed = False
 
-    def latest(self) -> dict[str, Any] | None:
+    def latest(self) -> StateMessage | None:
         if self._states and not self._silent:
             self._last = self._states.pop(0)
         return self._last

@@ -172,12 +172,12 @@ class MatchRunner(MatchContext):
             latest = self.telemetry.latest() if self.telemetry else None
             if self.lifecycle.state is MatchState.WAITING and (
                 self.telemetry is None
-                or (latest is not None and latest.get("state") not in (None, "INITIAL"))
+                or (latest is not None and latest.state not in (None, "INITIAL"))
             ):
                 self.advance(MatchState.PLAYING)
             if self.bringup_s is None and latest is not None:
                 expected = {k for k in self.started.robot_ids}
-                if expected and expected <= set(latest.get("connected") or []):
+                if expected and expected <= set(latest.connected):
                     self.bringup_s = now - started_at
                     log.info("match %s: all %d robots connected after %.2f s",
                              self.plan.match_id, len(expected), self.bringup_s)

@@ -151,3 +151,16 @@ def test_contracts_import_only_the_standard_library_and_protobuf() -> None:
     assert "contracts" in tops and "google" in tops
     ours = {"robot", "simulator", "referee", "orchestrator", "service", "benchmarks"}
     assert tops & (ours | {"mujoco", "numpy", "zenoh", "docker", "yaml"}) == set()
+
+
+def test_a_telemetry_state_message_names_its_wrong_field() -> None:
+    message = StateMessage(
+        sim_time_ms=8000, real_time_factor=0.98, state="PLAYING", secondary_state="NORMAL",
+        half=1, secs_remaining=592.0, score={"red": 0, "blue": 1}, connected=("red-1",),
+        stepping="lockstep", robots=None,
+    )  # fmt: skip
+    data = json.loads(json.dumps(message.to_dict()))
+    assert StateMessage.from_dict(data, source="hlvs/m1/state") == message
+    data["connected"] = "red-1"
+    with pytest.raises(ContractError, match=r"^hlvs/m1/state: /connected: expected a list"):
+        StateMessage.from_dict(data, source="hlvs/m1/state")

@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from contracts.sim_result import SimResult
+from contracts.telemetry import StateMessage
 from orchestrator.config import Limits
 from orchestrator.match import (
     FailureClass,
@@ -151,6 +152,12 @@ def test_silent_telemetry_fails_the_match(tmp_path: Path) -> None:
     assert telemetry.closed
 
 
+def _state(state: str, *connected: str) -> StateMessage:
+    return StateMessage(sim_time_ms=0, real_time_factor=1.0, state=state, secondary_state=None,
+                        half=1, secs_remaining=None, score=None, connected=connected,
+                        stepping="lockstep", robots=None)
+
+
 def test_telemetry_moves_waiting_to_playing_and_measures_bringup(tmp_path: Path) -> None:
     runtime = FakeRuntime(simulator_polls=6)
     clock_now = [0.0]
@@ -159,9 +166,9 @@ def test_telemetry_moves_waiting_to_playing_and_measures_bringup(tmp_path: Path)
         clock_now[0] += 0.5
         return clock_now[0]
 
-    states = [{"state": "INITIAL", "connected": ["red-1"]},
-              {"state": "INITIAL", "connected": ["red-1", "red-2", "blue-1", "blue-2"]},
-              {"state": "READY", "connected": ["red-1", "red-2", "blue-1", "blue-2"]}]
+    states = [_state("INITIAL", "red-1"),
+              _state("INITIAL", "red-1", "red-2", "blue-1", "blue-2"),
+              _state("READY", "red-1", "red-2", "blue-1", "blue-2")]
     telemetry = FakeTelemetry(states, clock=clock)
     runner, outcome = _run(tmp_path, _plan(telemetry=True), runtime,
                            telemetry=lambda endpoint, match_id: telemetry, clock=clock)

@@ -5,9 +5,11 @@ from __future__ import annotations
 import io
 import json
 import time
+from dataclasses import replace
 
 import zenoh
 
+from contracts.telemetry import StateMessage
 from orchestrator.telemetry import LiveView, ZenohTelemetry, describe
 from testkit.sftp import free_port
 
@@ -22,14 +24,16 @@ def test_subscriber_receives_state_and_events_from_a_listening_publisher() -> No
     publisher = zenoh.open(config)
     try:
         state = {"state": "READY", "half": 1, "score": {"red": 0, "blue": 0},
-                 "connected": ["red-1"], "sim_time_ms": 1200, "real_time_factor": 1.0}
+                 "connected": ["red-1"], "sim_time_ms": 1200, "real_time_factor": 1.0,
+                 "secondary_state": "NORMAL", "secs_remaining": 40, "stepping": "async",
+                 "robots": None}
         deadline = time.monotonic() + 20
         while watcher.latest() is None and time.monotonic() < deadline:
             publisher.put("hlvs/tm1/state", json.dumps(state))
             publisher.put("hlvs/other/state", json.dumps({"state": "PLAYING"}))
             publisher.put("hlvs/tm1/events", json.dumps({"type": "GOAL"}))
             time.sleep(0.1)
-        assert watcher.latest() == state
+        assert watcher.latest() == StateMessage.from_dict(state, source="test")
         assert watcher.last_message_at() is not None
         deadline = time.monotonic() + 5
         while not watcher.events() and time.monotonic() < deadline:
@@ -40,13 +44,21 @@ def test_subscriber_receives_state_and_events_from_a_listening_publisher() -> No
         publisher.close()
 
 
+def _message(**fields: object) -> StateMessage:
+    data: dict[str, object] = {
+        "sim_time_ms": 0, "real_time_factor": 0.0, "state": None, "secondary_state": None,
+        "half": None, "secs_remaining": None, "score": None, "connected": [],
+        "stepping": "async", "robots": None}
+    return StateMessage.from_dict({**data, **fields}, source="test")
+
+
 def test_plain_view_prints_changes_only() -> None:
     out = io.StringIO()
     view = LiveView(match_id="m", stream=out)
-    state = {"state": "PLAYING", "half": 1, "score": {"red": 1, "blue": 0}, "connected": []}
+    state = _message(state="PLAYING", half=1, score={"red": 1, "blue": 0}, connected=[])
     view.update(phase="playing", state=state)
-    view.update(phase="playing", state={**state, "sim_time_ms": 500})
-    view.update(phase="playing", state={**state, "score": {"red": 2, "blue": 0}})
+    view.update(phase="playing", state=replace(state, sim_time_ms=500))
+    view.update(phase="playing", state=replace(state, score={"red": 2, "blue": 0}))
     lines = out.getvalue().splitlines()
     assert len(lines) == 2
     assert "score red 2 - 0 blue" in lines[1]
@@ -61,10 +73,10 @@ class _Terminal(io.StringIO):
 def test_terminal_view_renders_a_table() -> None:
     out = _Terminal()
     view = LiveView(match_id="m9", stream=out)
-    view.update(phase="playing", state={"state": "SET", "secondary_state": "NORMAL", "half": 2,
-                                        "secs_remaining": 12, "score": {"red": 3, "blue": 1},
-                                        "sim_time_ms": 4500, "real_time_factor": 1.5,
-                                        "connected": ["red-1", "blue-1"]})
+    view.update(phase="playing", state=_message(
+        state="SET", secondary_state="NORMAL", half=2, secs_remaining=12,
+        score={"red": 3, "blue": 1}, sim_time_ms=4500, real_time_factor=1.5,
+        connected=["red-1", "blue-1"]))
     view.close()
     text = out.getvalue()
     assert "match m9" in text and "red 3 - 1 blue" in text and "red-1, blue-1" in text
