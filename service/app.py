@@ -51,6 +51,7 @@ class Services:
     sessions: sessionmaker[Session]
     pool: Any = None  # service.pool.MatchPool
     worker: Any = None  # service.worker.QueueWorker
+    aftermatch: Any = None  # service.aftermatch.AfterMatch
     preflight: Preflight | None = None
     queue: Any = None  # service.submissions.QueueBoard
     tokens: Any = None  # service.tokens.TokenCache
@@ -122,8 +123,11 @@ def create_app(
 
         services.pool = (pool_factory or make_pool)(settings)
         if start_worker:
+            from service.aftermatch import AfterMatch
             from service.worker import QueueWorker
 
+            services.aftermatch = AfterMatch(services)
+            services.aftermatch.start()
             services.worker = QueueWorker(services)
             services.worker.start()
         try:
@@ -131,6 +135,8 @@ def create_app(
         finally:
             if services.worker is not None:
                 services.worker.stop()
+            if services.aftermatch is not None:
+                services.aftermatch.stop()
             services.status.stop()
             if checker is not None:
                 checker.close()

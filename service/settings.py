@@ -51,6 +51,14 @@ class Settings:
     test_grace_s: float = 5.0
     expected_match_s: float = 120.0
     """Assumed wall time of one test match until some have finished (for expected starts)."""
+    video: bool = True
+    """Render a video of every test match that played (after it ended, by ``hlvs render``);
+    a failed render leaves the match's outcome as it was."""
+    video_width: int = 1280
+    video_height: int = 720
+    video_fps: float = 25.0
+    video_timeout_s: float = 1800.0
+    """A render still running after this long is stopped and its video marked failed."""
     preflight: str = "full"
     """``full``: pull, size, start and connect to a simulator; ``images``: pull and size only."""
     preflight_timeout_s: float = 25.0
@@ -123,6 +131,10 @@ def _check(settings: Settings) -> None:
     if settings.preflight not in ("full", "images"):
         raise SettingsError(name=PREFIX + "PREFLIGHT", value=settings.preflight,
                             expected="full or images")
+    for name in ("video_width", "video_height", "video_fps", "video_timeout_s"):
+        if getattr(settings, name) <= 0:
+            raise SettingsError(name=PREFIX + name.upper(), value=str(getattr(settings, name)),
+                                expected="a positive number")
     if settings.match_slots < 1:
         raise SettingsError(name=PREFIX + "MATCH_SLOTS", value=str(settings.match_slots),
                             expected="at least 1")

@@ -23,6 +23,13 @@ class Links(BaseModel):
     video: str
 
 
+class Product(BaseModel):
+    """Something made after the match ended (its video)."""
+
+    state: str = Field(description="pending | ready | failed")
+    detail: str | None
+
+
 class SubmissionView(BaseModel):
     id: str
     team: str
@@ -42,6 +49,9 @@ class SubmissionView(BaseModel):
     failure_side: str | None = Field(description="team | league, when it failed")
     cause: str | None
     preflight_s: float | None
+    video: Product | None = Field(description="the match's video, rendered after it ended "
+                                  "(download it from links.video when ready); null when the "
+                                  "match did not play")
     links: Links
 
 
@@ -104,6 +114,8 @@ def submission_view(session: Session, row: Submission, settings: Settings, *,
         cancel_requested=row.cancel_requested, charged=row.charged,
         failure_class=row.failure_class, failure_side=row.failure_side, cause=row.cause,
         preflight_s=round(row.preflight_s, 2) if row.preflight_s is not None else None,
+        video=Product(state=row.video_state, detail=row.video_detail)
+        if row.video_state else None,
         links=Links(status=base, report=base + "/report", results=base + "/results",
                     logs=base + "/logs", replay=base + "/replay", video=base + "/video"),
     )
@@ -122,6 +134,7 @@ def view_of(request: Request, session: Session, row: Submission,
 
 __all__ = [
     "Links",
+    "Product",
     "SubmissionCreate",
     "SubmissionReport",
     "SubmissionView",

@@ -5,6 +5,7 @@ from __future__ import annotations
 from service.db.models import (
     ACTIVE_STATES,
     Base,
+    MediaState,
     Notification,
     Scope,
     ServiceFlag,
@@ -21,6 +22,7 @@ from service.db.session import make_engine, migrate, session_factory, transactio
 __all__ = [
     "ACTIVE_STATES",
     "Base",
+    "MediaState",
     "Notification",
     "Scope",
     "ServiceFlag",

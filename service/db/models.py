@@ -57,6 +57,15 @@ class SubmissionState(enum.StrEnum):
     CANCELLED = "cancelled"
 
 
+class MediaState(enum.StrEnum):
+    """A product made after a match ended (its video): NULL in the database when there is
+    none to make (the match never played)."""
+
+    PENDING = "pending"
+    READY = "ready"
+    FAILED = "failed"
+
+
 ACTIVE_STATES = (SubmissionState.QUEUED, SubmissionState.STARTING, SubmissionState.RUNNING)
 _ACTIVE_SQL = "state IN ('queued', 'starting', 'running')"
 
@@ -133,6 +142,8 @@ class Submission(Base):
     failure_side: Mapped[str | None] = mapped_column(String(16))
     cause: Mapped[str | None] = mapped_column(Text)
     preflight_s: Mapped[float | None] = mapped_column(Float)
+    video_state: Mapped[str | None] = mapped_column(String(16))  # see MediaState
+    video_detail: Mapped[str | None] = mapped_column(Text)
 
 
 class Notification(Base):
@@ -167,6 +178,7 @@ class ServiceFlag(Base):
 __all__ = [
     "ACTIVE_STATES",
     "Base",
+    "MediaState",
     "Notification",
     "Scope",
     "ServiceFlag",

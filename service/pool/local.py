@@ -30,7 +30,7 @@ STATE_FILE = "pool.json"
 LOG_FILE = "orchestrator.log"
 
 
-def _start_time(pid: int) -> int | None:
+def process_start_time(pid: int) -> int | None:
     """The kernel's start time of ``pid`` (clock ticks since boot), None when it is gone."""
     try:
         stat = Path(f"/proc/{pid}/stat").read_text()
@@ -84,7 +84,7 @@ class LocalDockerPool:
                 except OSError as exc:
                     raise PoolError(handle=handle, reason=f"cannot start hlvs match: {exc}") \
                         from exc
-            started = _start_time(child.pid)
+            started = process_start_time(child.pid)
             state = {"pid": child.pid, "start_time": started, "match_id": job.match_id}
             tmp = job.work_dir / (STATE_FILE + ".tmp")
             tmp.write_text(json.dumps(state))
@@ -163,7 +163,7 @@ class LocalDockerPool:
         pid, recorded = state.get("pid"), state.get("start_time")
         if not isinstance(pid, int):
             return False
-        current = _start_time(pid)
+        current = process_start_time(pid)
         return current is not None and current == recorded  # same pid, same process
 
     def _log_tail(self, handle: str) -> str:
@@ -174,4 +174,4 @@ class LocalDockerPool:
         return (": " + lines[-1][-300:]) if lines else ""
 
 
-__all__ = ["LocalDockerPool"]
+__all__ = ["LocalDockerPool", "process_start_time"]

@@ -208,7 +208,12 @@ def get_replay(submission_id: str, request: Request, principal: TeamPrincipal,
 @router.get("/{submission_id}/video")
 def get_video(submission_id: str, request: Request, principal: TeamPrincipal,
               session: DbSession) -> FileResponse:
+    """The match's video (``video.state`` in the status says whether it is ready yet)."""
     row, out = _own(request, principal, session, submission_id)
+    if row.video_state != "ready":
+        raise NotFound(what="video of submission", ident=f"{row.id} (video "
+                       f"{row.video_state or 'none: the match did not play'}"
+                       + (f": {row.video_detail})" if row.video_detail else ")"))
     return _file(out / "public" / files.VIDEO, "video of submission", row, "video/mp4")
 
 

@@ -64,7 +64,8 @@ def real_settings(settings: Settings, docker_client: Any) -> Settings:
     project_image("stub")
     project_image("simulator")
     return settings.with_(worker_poll_s=0.3, test_half_duration_s=5.0, test_grace_s=2.0,
-                          preflight_timeout_s=25.0)
+                          preflight_timeout_s=25.0, video_width=320, video_height=180,
+                          video_fps=5.0)
 
 
 def wait_for(http: httpx.Client, sid: str, predicate: Callable[[dict[str, Any]], bool],
@@ -121,8 +122,17 @@ def test_submit_run_mail_download_and_isolation(
         assert robot_log.status_code == 200 and robot_log.content
         replay = alpha.get(f"/v1/submissions/{sid}/replay")
         assert replay.status_code == 200 and len(replay.content) > 1000
-        for path in ("/logs", "/logs/team/1/stdout.log", "/results", "/report"):
+        for path in ("/logs", "/logs/team/1/stdout.log", "/results", "/report", "/video"):
             assert beta.get(f"/v1/submissions/{sid}{path}").status_code == 404, path
+
+        # the video is rendered after the match ended, outside it
+        assert done["video"]["state"] in ("pending", "ready"), done
+        rendered = wait_for(alpha, sid, lambda b: b["video"]["state"] != "pending", 180)
+        assert rendered["video"]["state"] == "ready", rendered["video"]
+        assert "320x180 at 5 fps" in rendered["video"]["detail"]
+        video = alpha.get(f"/v1/submissions/{sid}/video")
+        assert video.status_code == 200 and video.headers["content-type"] == "video/mp4"
+        assert video.content[4:8] == b"ftyp" and len(video.content) > 10_000
 
         deadline = time.monotonic() + 20
         while len([s for s in mails.subjects() if sid in s]) < 2:

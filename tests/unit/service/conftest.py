@@ -45,7 +45,7 @@ class FakePreflight:
 @pytest.fixture
 def settings(tmp_path: Path) -> Settings:
     return Settings(data_dir=tmp_path / "data", max_upload_bytes=20_000, worker_poll_s=0.05,
-                    stub_image="hlvs-runner/stub:test", webhook_backoff_s=0.1)
+                    stub_image="hlvs-runner/stub:test", webhook_backoff_s=0.1, video=False)
 
 
 @pytest.fixture

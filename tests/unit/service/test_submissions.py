@@ -323,3 +323,23 @@ def test_status_polls_from_memory_follow_changes_and_revocations(
     assert answer.status_code == 401 and "revoked" in answer.json()["message"]
     for http in (operator, alpha, beta):
         http.close()
+
+
+def test_a_failed_video_render_leaves_the_match_done(
+        start: Callable[..., Served], token: Callable[..., str], pool: FakePool) -> None:
+    """The video is rendered by hlvs render after the match; the fake pool's replay is not a
+    real one, so the render fails: the status says why and the submission stays done."""
+    served = start(video=True)
+    with setup_team(served, token("Alpha"), "Alpha") as http:
+        sid = http.post("/v1/submissions", json={}).json()["id"]
+        wait_for(http, sid, lambda b: b["state"] == "running")
+        assert http.get(f"/v1/submissions/{sid}").json()["video"] is None
+        pool.finish(handle_of(served, sid), {"status": "success"})
+        done = wait_for(http, sid, lambda b: b["state"] == "done")
+        assert done["video"]["state"] in ("pending", "failed")
+        ended = wait_for(http, sid, lambda b: b["video"]["state"] != "pending", 60)
+        assert ended["state"] == "done" and ended["video"]["state"] == "failed", ended
+        assert "hlvs render exited with code 2" in ended["video"]["detail"]
+        assert "replay" in ended["video"]["detail"]
+        video = http.get(f"/v1/submissions/{sid}/video")
+        assert video.status_code == 404 and "video failed" in video.json()["message"]

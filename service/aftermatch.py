@@ -1,0 +1,222 @@
+"""After a test match ended: its video, made by a thread of the service outside the match.
+
+When the worker ends a submission whose match left a replay, it marks the video ``pending``
+(:class:`service.db.MediaState`). This thread renders it with ``hlvs render`` (the simulator's
+offscreen renderer, which picks ``MUJOCO_GL`` itself) in a process of its own at a lower CPU
+priority, one render at a time, into ``public/match.mp4`` of the match output (written under
+another name and renamed, so a download never gets half a file). The state becomes ``ready``,
+or ``failed`` with the cause; either way the submission's outcome stays what the match gave, and
+the match was over before the render began, so a video never makes a match slower.
+
+Restart safety: the render's pid and start time are kept in ``render.json`` of the match's work
+folder. A later service process waits for a render that still runs, takes a video that is
+there, and renders again (once) when an earlier render stopped without one.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from sqlalchemy import select
+
+from contracts import files
+from service.db import MediaState, Submission, transaction
+from service.pool.local import process_start_time
+
+if TYPE_CHECKING:
+    from service.app import Services
+
+log = logging.getLogger(__name__)
+
+VIDEO_FILE = files.VIDEO
+PARTIAL_VIDEO_FILE = "match.partial.mp4"  # ffmpeg picks the format from the extension
+RENDER_STATE = "render.json"
+RENDER_LOG = "render.log"
+MAX_RENDERS = 2  # renders of one video (a second one after a restart killed the first)
+POLL_S = 1.0
+
+
+def replay_of(out: Path) -> Path:
+    return out / "public" / files.REPLAY
+
+
+def video_of(out: Path) -> Path:
+    return out / "public" / VIDEO_FILE
+
+
+@dataclass
+class _Render:
+    submission_id: str
+    process: subprocess.Popen[bytes]
+    started: float
+    partial: Path
+    video: Path
+
+
+class AfterMatch:
+    def __init__(self, services: Services, *, python: str = sys.executable) -> None:
+        self.services = services
+        self.settings = services.settings
+        self.python = python
+        self._render: _Render | None = None
+        self._stop = threading.Event()
+        self._wake = threading.Event()
+        self._thread: threading.Thread | None = None
+
+    # lifecycle ---------------------------------------------------------------------------
+    def start(self) -> None:
+        self._thread = threading.Thread(target=self._run, name="after-match", daemon=True)
+        self._thread.start()
+
+    def stop(self) -> None:
+        """Stop the thread; a render under way goes on and is taken up by the next start."""
+        self._stop.set()
+        self._wake.set()
+        if self._thread is not None:
+            self._thread.join(timeout=30)
+
+    def wake(self) -> None:
+        self._wake.set()
+
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            try:
+                self.round()
+            except Exception:  # the thread's boundary: log, keep serving
+                log.exception("after-match round failed; retrying")
+            self._wake.wait(POLL_S)
+            self._wake.clear()
+
+    # one round ---------------------------------------------------------------------------
+    def round(self) -> None:
+        with transaction(self.services.sessions) as session:
+            pending = list(session.scalars(select(Submission).where(
+                Submission.video_state == MediaState.PENDING.value).order_by(Submission.seq)))
+            for row in pending:
+                self._video(row)
+
+    def _work_dir(self, row: Submission) -> Path:
+        assert row.match_id is not None
+        return (self.settings.matches_dir / row.match_id).resolve()
+
+    def _video(self, row: Submission) -> None:
+        if row.pool_handle is None or row.match_id is None:
+            self._set(row, MediaState.FAILED, "the match left no output")
+            return
+        out = self.services.pool.results_dir(row.pool_handle)
+        work = self._work_dir(row)
+        render = self._render
+        if render is not None and render.submission_id == row.id:
+            self._follow(row, render, work)
+            return
+        video = video_of(out)
+        if video.is_file():  # rendered while an earlier service process ran
+            self._set(row, MediaState.READY, f"{video.stat().st_size} bytes")
+            return
+        if not replay_of(out).is_file():
+            self._set(row, MediaState.FAILED, "the match left no replay")
+            return
+        if render is not None:
+            return  # one render at a time: this one waits
+        state = _read_json(work / RENDER_STATE)
+        pid, recorded = state.get("pid"), state.get("start_time")
+        if isinstance(pid, int) and recorded is not None and \
+                process_start_time(pid) == recorded:
+            return  # an earlier service process's render still runs
+        count = state.get("renders", 0)
+        renders = count if isinstance(count, int) else 0
+        if renders >= MAX_RENDERS:
+            self._set(row, MediaState.FAILED, f"{renders} renders stopped without a video"
+                      + _tail(work / RENDER_LOG))
+            return
+        self._start(row, out, work, renders + 1)
+
+    def _start(self, row: Submission, out: Path, work: Path, renders: int) -> None:
+        s = self.settings
+        partial = out / "public" / PARTIAL_VIDEO_FILE
+        partial.unlink(missing_ok=True)
+        command = ["nice", "-n", "10", self.python, "-m", "simulator", "render",
+                   str(replay_of(out)), "-o", str(partial), "--width", str(s.video_width),
+                   "--height", str(s.video_height), "--fps", f"{s.video_fps:g}"]
+        work.mkdir(parents=True, exist_ok=True)
+        env = {**os.environ, "HLVS_PROGRESS": "plain", "HLVS_PROG": "hlvs"}
+        with (work / RENDER_LOG).open("ab") as log_file:
+            try:
+                process = subprocess.Popen(command, stdout=log_file, stderr=subprocess.STDOUT,
+                                           stdin=subprocess.DEVNULL, env=env,
+                                           start_new_session=True)
+            except OSError as exc:
+                self._set(row, MediaState.FAILED, f"hlvs render could not start: {exc}")
+                return
+        tmp = work / (RENDER_STATE + ".tmp")
+        tmp.write_text(json.dumps({"pid": process.pid,
+                                   "start_time": process_start_time(process.pid),
+                                   "renders": renders}))
+        tmp.replace(work / RENDER_STATE)
+        self._render = _Render(submission_id=row.id, process=process, started=time.monotonic(),
+                               partial=partial, video=video_of(out))
+        log.info("submission %s: rendering the video of match %s (pid %d)", row.id,
+                 row.match_id, process.pid)
+
+    def _follow(self, row: Submission, render: _Render, work: Path) -> None:
+        code = render.process.poll()
+        elapsed = time.monotonic() - render.started
+        if code is None:
+            if elapsed > self.settings.video_timeout_s:
+                try:
+                    os.killpg(render.process.pid, signal.SIGKILL)  # the renderer and ffmpeg
+                except ProcessLookupError:
+                    pass
+                render.process.wait()
+                self._render = None
+                self._set(row, MediaState.FAILED, f"the render took more than "
+                          f"{self.settings.video_timeout_s:g} s and was stopped")
+            return
+        self._render = None
+        if code == 0 and render.partial.is_file():
+            render.partial.replace(render.video)
+            s = self.settings
+            self._set(row, MediaState.READY, f"{render.video.stat().st_size} bytes, "
+                      f"{s.video_width}x{s.video_height} at {s.video_fps:g} fps, rendered "
+                      f"in {elapsed:.0f} s")
+            return
+        render.partial.unlink(missing_ok=True)
+        out = render.video.parent.parent
+        self._set(row, MediaState.FAILED, f"hlvs render exited with code {code}"
+                  + _tail(work / RENDER_LOG).replace(f"{out}/", ""))
+
+    def _set(self, row: Submission, state: MediaState, detail: str) -> None:
+        row.video_state = state.value
+        row.video_detail = detail
+        log.log(logging.WARNING if state is MediaState.FAILED else logging.INFO,
+                "submission %s: video %s (%s)", row.id, state.value, detail)
+
+
+def _read_json(path: Path) -> dict[str, object]:
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return {}
+    return data if isinstance(data, dict) else {}
+
+
+def _tail(path: Path) -> str:
+    """': <the last line of the log>' ('' when there is none)."""
+    try:
+        lines = [line for line in path.read_text(errors="replace").splitlines() if line.strip()]
+    except OSError:
+        return ""
+    return f": {lines[-1][-300:]}" if lines else ""
+
+
+__all__ = ["AfterMatch", "PARTIAL_VIDEO_FILE", "VIDEO_FILE", "replay_of", "video_of"]
