@@ -30,10 +30,12 @@ import tempfile
 import threading
 import time
 import uuid
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-from envs.errors import RemoteStartFailed
+from envs.errors import EnvConfigError, RemoteStartFailed
 from envs.remote import RemoteAddress, probe
 from envs.slurm_node import ADDRESS_FILE, FAILED_FILE, LEASE_FILE
 from envs.wire import WireError
@@ -99,6 +101,11 @@ class SlurmLauncher:
 
         self.options = options or SlurmOptions()
         conf = self.options.conf or os.environ.get("SLURM_CONF") or None
+        if conf is not None and not Path(conf).is_file():  # Slurm would retry for a minute
+            raise EnvConfigError(
+                field="remotes conf" if self.options.conf else "SLURM_CONF", value=conf,
+                expected="the slurm.conf of a cluster (a file)",
+            )  # fmt: skip
         # Nodes of the one-machine cluster share this host's Docker engine: the job enters the
         # host's network namespace and reports the container's bridge address.
         self.host_network = Path(HOST_NETNS).exists() if host_network is None else host_network
@@ -123,15 +130,17 @@ class SlurmLauncher:
     # --- the Launcher protocol ---------------------------------------------------------------
 
     def start(self, count: int) -> list[RemoteAddress]:
-        jobs = [self._submit(i) for i in range(count)]
-        self._wait(jobs)
+        with _slurm_errors():
+            jobs = [self._submit(i) for i in range(count)]
+            self._wait(jobs)
         return [job.address for job in jobs if job.address is not None]
 
     def replace(self, index: int) -> RemoteAddress:
-        old = self.jobs[index]
-        self.slurm.cancel_jobs([old.job_id])
-        job = self._submit(index)
-        self._wait([job])
+        with _slurm_errors():
+            old = self.jobs[index]
+            self.slurm.cancel_jobs([old.job_id])
+            job = self._submit(index)
+            self._wait([job])
         assert job.address is not None
         return job.address
 
@@ -279,6 +288,17 @@ class SlurmLauncher:
                     (job.folder / LEASE_FILE).write_text(str(time.time()))
                 except OSError as exc:
                     log.warning("cannot renew the lease of %s: %s", job.describe(), exc)
+
+
+@contextmanager
+def _slurm_errors() -> Iterator[None]:
+    """Slurm's commands failing (no cluster, a refused submission) as RemoteStartFailed."""
+    from service.errors import PoolError
+
+    try:
+        yield
+    except PoolError as exc:
+        raise RemoteStartFailed(address=f"Slurm ({exc.handle})", reason=exc.reason) from exc
 
 
 def _read_json(path: Path) -> dict[str, object] | None:

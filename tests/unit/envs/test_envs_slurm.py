@@ -93,3 +93,30 @@ def test_the_lease_expires_only_when_the_file_stops_changing(tmp_path: Path) -> 
         assert not lease.expired()
     time.sleep(0.4)
     assert lease.expired()
+
+
+
+def test_a_missing_slurm_conf_is_named_at_once(tmp_path: Path) -> None:
+    conf = tmp_path / "missing" / "slurm.conf"
+    with pytest.raises(EnvConfigError) as error:
+        SlurmLauncher(SlurmOptions(conf=str(conf)), image="x:1", host_network=False)
+    assert error.value.field == "remotes conf" and error.value.value == str(conf)
+
+
+def test_slurm_refusing_a_job_is_a_remote_start_failure(tmp_path: Path) -> None:
+    from envs.errors import RemoteStartFailed
+    from service.errors import PoolError
+
+    launcher = SlurmLauncher(SlurmOptions(dir=str(tmp_path)), image="x:1", host_network=False)
+
+    def refuse(*_args: object, **_kwargs: object) -> str:  # sbatch at the boundary
+        raise PoolError(handle=str(tmp_path), reason="sbatch --parsable: exit 1: Invalid account")
+
+    launcher.slurm.submit_script = refuse  # type: ignore[method-assign]
+    try:
+        with pytest.raises(RemoteStartFailed) as failed:
+            launcher.start(1)
+        assert failed.value.reason.endswith("Invalid account")
+        assert failed.value.address == f"Slurm ({tmp_path})"
+    finally:
+        launcher.close()
