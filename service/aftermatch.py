@@ -1,4 +1,15 @@
-"""After a test match ended: its video, made by a thread of the service outside the match.
+"""After a test match ended: the delivery of the team's logs and the match's video, done by a
+thread of the service outside the match.
+
+Logs: when the team uploaded credentials (``PUT /v1/team/files/credentials``) before it
+submitted, the worker marks the delivery ``pending`` as the match ends. This thread puts the
+team's logs (``teams/red/`` of the match output, which stay downloadable from the service) in
+the service's log store (``<data_dir>/log-store``) and uploads them to the team's SFTP or S3
+target the way ``hlvs match`` delivers logs (:mod:`orchestrator.delivery`: files, then
+``MANIFEST.json``, under ``<match_id>/<team>/``; transient failures retried with back-off). The
+state becomes ``delivered`` or ``failed`` with the cause (wrong password, unknown host key,
+bucket missing...); a failed set stays in the store, where ``hlvs logs deliver --store`` can
+try it again.
 
 When the worker ends a submission whose match left a replay, it marks the video ``pending``
 (:class:`service.db.MediaState`). This thread renders it with ``hlvs render`` (the simulator's
@@ -30,7 +41,8 @@ from typing import TYPE_CHECKING
 from sqlalchemy import select
 
 from contracts import files
-from service.db import MediaState, Submission, transaction
+from service.db import MediaState, Submission, Team, TeamFile, transaction
+from service.matchfiles import OWN_COLOR
 from service.pool.local import process_start_time
 
 if TYPE_CHECKING:
@@ -44,6 +56,14 @@ RENDER_STATE = "render.json"
 RENDER_LOG = "render.log"
 MAX_RENDERS = 2  # renders of one video (a second one after a restart killed the first)
 POLL_S = 1.0
+
+
+LOG_STORE = "log-store"  # in the service's data folder
+CREDENTIALS_FILE = "credentials.json"  # the submission's credentials, in its work folder
+
+
+def team_logs_of(out: Path, color: str) -> Path:
+    return out / "teams" / color
 
 
 def replay_of(out: Path) -> Path:
@@ -99,12 +119,70 @@ class AfterMatch:
 
     # one round ---------------------------------------------------------------------------
     def round(self) -> None:
+        self._deliveries()
         with transaction(self.services.sessions) as session:
             pending = list(session.scalars(select(Submission).where(
                 Submission.video_state == MediaState.PENDING.value).order_by(Submission.seq)))
             for row in pending:
                 self._video(row)
 
+    # logs ----------------------------------------------------------------------------------
+    def _deliveries(self) -> None:
+        """Every pending delivery, oldest first; the uploads run outside any transaction."""
+        with transaction(self.services.sessions) as session:
+            rows = session.execute(select(Submission, Team.name, TeamFile.content).join(
+                Team, Team.id == Submission.team_id).outerjoin(
+                TeamFile, TeamFile.id == Submission.credentials_file_id).where(
+                Submission.delivery_state == MediaState.PENDING.value).order_by(
+                Submission.seq)).all()
+            jobs = [(row.seq, row.id, row.match_id, row.pool_handle, team, content)
+                    for row, team, content in rows]
+        for seq, sid, match_id, handle, team, content in jobs:
+            if self._stop.is_set():
+                return
+            state, detail = self._deliver(match_id, handle, team, content)
+            with transaction(self.services.sessions) as session:
+                row = session.get(Submission, seq)
+                if row is not None and row.delivery_state == MediaState.PENDING.value:
+                    row.delivery_state, row.delivery_detail = state.value, detail
+            log.log(logging.WARNING if state is MediaState.FAILED else logging.INFO,
+                    "submission %s: logs %s (%s)", sid, state.value, detail)
+
+    def _deliver(self, match_id: str | None, handle: str | None, team: str,
+                 content: str | None) -> tuple[MediaState, str]:
+        from orchestrator.delivery import deliver_pending, enqueue_match_logs
+        from orchestrator.delivery.store import list_sets
+
+        if match_id is None or handle is None or content is None:
+            return MediaState.FAILED, "the match left no logs, or no credentials were given"
+        out = self.services.pool.results_dir(handle)
+        work = (self.settings.matches_dir / match_id).resolve()
+        work.mkdir(parents=True, exist_ok=True)
+        credentials = work / CREDENTIALS_FILE
+        credentials.write_text(content, encoding="utf-8")
+        credentials.chmod(0o600)
+        store = self.settings.data_dir.resolve() / LOG_STORE
+        if not any(s.match_id == match_id and s.team == team for s in list_sets(store)):
+            made = enqueue_match_logs(out, match_id=match_id,
+                                      teams={OWN_COLOR: (team, credentials)},
+                                      public_target=None, store=store, move_team_logs=False)
+            if not made:
+                return MediaState.FAILED, "the team's robots left no log files"
+        outcomes = [o for o in deliver_pending(store, team=team) if o.match_id == match_id]
+        if not outcomes:
+            return MediaState.FAILED, "the log set is being delivered by another process"
+        outcome = outcomes[-1]
+        if outcome.delivered:
+            return MediaState.DELIVERED, (
+                f"{outcome.uploaded_files} file(s) uploaded ({outcome.skipped_files} already "
+                f"there), {outcome.uploaded_bytes / 1e6:.2f} MB to {outcome.target}/{match_id}/"
+                f"{team} in {outcome.seconds:.1f} s")
+        error = outcome.error
+        cause = f"{error.kind}: {error.reason}" if error is not None else "unknown error"
+        return MediaState.FAILED, (f"upload to {outcome.target} failed ({cause}); the logs "
+                                   "wait in the service's log store")
+
+    # video ---------------------------------------------------------------------------------
     def _work_dir(self, row: Submission) -> Path:
         assert row.match_id is not None
         return (self.settings.matches_dir / row.match_id).resolve()
@@ -219,4 +297,13 @@ def _tail(path: Path) -> str:
     return f": {lines[-1][-300:]}" if lines else ""
 
 
-__all__ = ["AfterMatch", "PARTIAL_VIDEO_FILE", "VIDEO_FILE", "replay_of", "video_of"]
+__all__ = [
+    "AfterMatch",
+    "CREDENTIALS_FILE",
+    "LOG_STORE",
+    "PARTIAL_VIDEO_FILE",
+    "VIDEO_FILE",
+    "replay_of",
+    "team_logs_of",
+    "video_of",
+]

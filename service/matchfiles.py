@@ -15,6 +15,9 @@ from typing import Any
 from orchestrator.match.scrimmage import game_file, team_file
 from service.settings import Settings
 
+OWN_COLOR = "red"
+"""The submitting team plays red in its test matches (and sees only red's logs)."""
+
 
 def _ports(base: int, team: dict[str, Any]) -> list[int]:
     players = team.get("players") or {}
@@ -41,4 +44,4 @@ def write_match(folder: Path, *, match_id: str, team: dict[str, Any],
     return folder / "game.json"
 
 
-__all__ = ["write_match"]
+__all__ = ["OWN_COLOR", "write_match"]

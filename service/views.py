@@ -24,9 +24,9 @@ class Links(BaseModel):
 
 
 class Product(BaseModel):
-    """Something made after the match ended (its video)."""
+    """Work done after the match ended: its video, the delivery of the team's logs."""
 
-    state: str = Field(description="pending | ready | failed")
+    state: str = Field(description="pending | ready (video) | delivered (logs) | failed")
     detail: str | None
 
 
@@ -52,6 +52,9 @@ class SubmissionView(BaseModel):
     video: Product | None = Field(description="the match's video, rendered after it ended "
                                   "(download it from links.video when ready); null when the "
                                   "match did not play")
+    log_delivery: Product | None = Field(description="the upload of the team's logs to the "
+                                         "target of its credentials.json; null when the team "
+                                         "had uploaded none when it submitted")
     links: Links
 
 
@@ -116,6 +119,8 @@ def submission_view(session: Session, row: Submission, settings: Settings, *,
         preflight_s=round(row.preflight_s, 2) if row.preflight_s is not None else None,
         video=Product(state=row.video_state, detail=row.video_detail)
         if row.video_state else None,
+        log_delivery=Product(state=row.delivery_state, detail=row.delivery_detail)
+        if row.delivery_state else None,
         links=Links(status=base, report=base + "/report", results=base + "/results",
                     logs=base + "/logs", replay=base + "/replay", video=base + "/video"),
     )

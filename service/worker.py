@@ -28,9 +28,10 @@ from contracts import files
 from contracts.errors import ContractError
 from contracts.match_results import FailureClass, MatchReport
 from service import matchfiles, notify, teamfiles
-from service.aftermatch import replay_of
+from service.aftermatch import replay_of, team_logs_of
 from service.db import MediaState, Submission, SubmissionState, Team, now, transaction
 from service.errors import PoolError, ServiceError
+from service.matchfiles import OWN_COLOR
 from service.pool import JobState, MatchJob
 from service.submissions import STUB, failure_side, queue_paused
 
@@ -235,12 +236,16 @@ class QueueWorker:
         row.cause = cause
         row.failure_class = failure_class
         row.failure_side = failure_side(failure_class)
-        if self.settings.video and row.pool_handle is not None and \
-                replay_of(self.pool.results_dir(row.pool_handle)).is_file():
+        out = self.pool.results_dir(row.pool_handle) if row.pool_handle is not None else None
+        if out is not None and self.settings.video and replay_of(out).is_file():
             row.video_state = MediaState.PENDING.value
             row.video_detail = "waiting for the render"
-            if self.services.aftermatch is not None:
-                self.services.aftermatch.wake()
+        if out is not None and row.credentials_file_id is not None and \
+                team_logs_of(out, OWN_COLOR).is_dir():
+            row.delivery_state = MediaState.PENDING.value
+            row.delivery_detail = "waiting to be uploaded"
+        if self.services.aftermatch is not None and out is not None:
+            self.services.aftermatch.wake()
         if row.failure_side == "league":
             row.charged = False  # the league's fault costs the team nothing
         self._cancel_sent.discard(row.id)

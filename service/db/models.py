@@ -58,11 +58,12 @@ class SubmissionState(enum.StrEnum):
 
 
 class MediaState(enum.StrEnum):
-    """A product made after a match ended (its video): NULL in the database when there is
-    none to make (the match never played)."""
+    """Work done after a match ended (its video, the delivery of the team's logs): NULL in the
+    database when there is none to do (the match never played; no credentials uploaded)."""
 
     PENDING = "pending"
-    READY = "ready"
+    READY = "ready"  # the video
+    DELIVERED = "delivered"  # the logs
     FAILED = "failed"
 
 
@@ -144,6 +145,8 @@ class Submission(Base):
     preflight_s: Mapped[float | None] = mapped_column(Float)
     video_state: Mapped[str | None] = mapped_column(String(16))  # see MediaState
     video_detail: Mapped[str | None] = mapped_column(Text)
+    delivery_state: Mapped[str | None] = mapped_column(String(16))  # see MediaState
+    delivery_detail: Mapped[str | None] = mapped_column(Text)
 
 
 class Notification(Base):

@@ -25,6 +25,7 @@ from service.app import Services
 from service.db import Submission
 from service.deps import DbSession, TeamPrincipal, bearer, get_services, require_team
 from service.errors import NotFound
+from service.matchfiles import OWN_COLOR
 from service.views import (
     SubmissionCreate,
     SubmissionReport,
@@ -36,7 +37,6 @@ from service.views import (
 
 router = APIRouter(prefix="/v1/submissions", tags=["submissions"])
 
-OWN_COLOR = "red"  # the submitting team plays red in its test matches
 
 
 class LogListing(BaseModel):

@@ -16,6 +16,9 @@ import httpx
 import pytest
 
 from service import Settings
+from testkit.s3 import MotoServer
+from tests.integration.delivery.conftest import check_manifest, moto  # noqa: F401 (fixture)
+from tests.integration.delivery.test_delivery_s3 import ensure_bucket, read_bucket, s3_body
 from tests.integration.service.conftest import TokenMaker
 from tests.integration.service.harness import free_port, serve
 
@@ -81,7 +84,8 @@ def wait_for(http: httpx.Client, sid: str, predicate: Callable[[dict[str, Any]],
 
 @pytest.mark.parametrize("db_url", ["postgresql"], indirect=True)
 def test_submit_run_mail_download_and_isolation(
-        real_settings: Settings, make_token: TokenMaker, inbox: tuple[Inbox, int]) -> None:
+        real_settings: Settings, make_token: TokenMaker, inbox: tuple[Inbox, int],
+        moto: MotoServer) -> None:  # noqa: F811
     mails, smtp_port = inbox
     settings = real_settings.with_(smtp_host="127.0.0.1", smtp_port=smtp_port)
     served = serve(settings, start_worker=True)
@@ -91,6 +95,10 @@ def test_submit_run_mail_download_and_isolation(
         for http, name in ((alpha, "Alpha"), (beta, "Beta")):
             uploaded = http.put("/v1/team/files/team_config", json=team_doc(name))
             assert uploaded.status_code == 201, uploaded.text
+        ensure_bucket(moto.endpoint_url, moto.admin, "alpha-logs")
+        target = {"type": "s3", "credentials": s3_body(moto.endpoint_url, moto.admin,
+                                                        "alpha-logs")}
+        assert alpha.put("/v1/team/files/credentials", json=target).status_code == 201
         created = alpha.post("/v1/submissions", json={"opponent": "stub"})
         assert created.status_code == 201, created.text
         sid = created.json()["id"]
@@ -124,6 +132,13 @@ def test_submit_run_mail_download_and_isolation(
         assert replay.status_code == 200 and len(replay.content) > 1000
         for path in ("/logs", "/logs/team/1/stdout.log", "/results", "/report", "/video"):
             assert beta.get(f"/v1/submissions/{sid}{path}").status_code == 404, path
+
+        # Alpha's logs went to its S3 bucket after the match
+        delivered = wait_for(alpha, sid, lambda b: b["log_delivery"]["state"] != "pending", 60)
+        assert delivered["log_delivery"]["state"] == "delivered", delivered["log_delivery"]
+        bucket = read_bucket(moto.endpoint_url, moto.admin, "alpha-logs", "hlvs/2026")
+        check_manifest(bucket, f"{done['match_id']}/Alpha")
+        assert f"{done['match_id']}/Alpha/1/robocup-logs/stub_red_1.log" in bucket
 
         # the video is rendered after the match ended, outside it
         assert done["video"]["state"] in ("pending", "ready"), done
