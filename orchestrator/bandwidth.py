@@ -122,9 +122,11 @@ def apply(pid: int, shaping: RobotShaping, *, device: str = "eth0") -> AppliedSh
     return apply_netns(f"/proc/{pid}/ns/net", shaping, device=device)
 
 
-def apply_netns(netns: str, shaping: RobotShaping, *, device: str = "eth0") -> AppliedShaping:
+def apply_netns(netns: str, shaping: RobotShaping, *, device: str = "eth0",
+                replace: bool = False) -> AppliedShaping:
     """Shape ``device`` of the network namespace ``netns`` (a path) and its peer on the host:
-    a robot's own namespace (dense placement) or its node's (league placement)."""
+    a robot's own namespace (dense placement) or its node's (league placement; ``replace``
+    removes shaping an earlier match on the node left first)."""
     started = time.perf_counter()
     try:
         with IPRoute(netns=netns) as inner:
@@ -133,8 +135,12 @@ def apply_netns(netns: str, shaping: RobotShaping, *, device: str = "eth0") -> A
                 raise BandwidthError(target=netns, reason=f"no device {device}")
             index = found[0]
             host_ifindex = int(inner.get_links(index)[0].get_attr("IFLA_LINK"))
+            if replace:
+                _delete_root(inner, index)
             _setup(inner, index, shaping, egress=True)
         with IPRoute() as host:
+            if replace:
+                _delete_root(host, host_ifindex)
             _setup(host, host_ifindex, shaping, egress=False)
     except NetlinkError as exc:
         raise BandwidthError(target=netns, reason=f"netlink error {exc.code}: {exc}") from exc

@@ -67,13 +67,18 @@ epilog() {
   # after every job, on each of its nodes (in the node's network namespace): remove what a match
   # of the job left there -- containers labelled with the job id, the league firewall chains and
   # the traffic shaping of the node's interface (normally removed by the match itself)
-  cat >"$DIR/epilog.sh" <<'SH'
-#!/bin/sh
-PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin
+  { echo '#!/bin/sh'; echo "export SLURM_CONF=$SLURM_CONF"; cat <<'SH'; } >"$DIR/epilog.sh"
+export PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin
 job=${SLURM_JOB_ID:-}
 [ -n "$job" ] || exit 0
-ids=$(docker ps -aq --filter "label=org.hlvs-runner.slurm-job=$job" 2>/dev/null)
-[ -z "$ids" ] || docker rm -f $ids >/dev/null 2>&1
+# the containers a league match placed on this node (the nodes share one Docker engine here);
+# a component of a heterogeneous job has an id of its own, the containers carry the job's
+het=$(scontrol show job "$job" -o 2>/dev/null | tr ' ' '\n' | sed -n 's/^HetJobId=//p')
+for id in $job $het; do
+  ids=$(docker ps -aq --filter "label=org.hlvs-runner.slurm-job=$id" \
+    --filter "label=org.hlvs-runner.node=${SLURMD_NODENAME:-none}" 2>/dev/null)
+  [ -z "$ids" ] || docker rm -f $ids >/dev/null 2>&1
+done
 for hook in OUTPUT:HLVS-ROBOTS INPUT:HLVS-ROBOTS-IN; do
   chain=${hook#*:}
   while iptables -w -D "${hook%%:*}" -j "$chain" 2>/dev/null; do :; done

@@ -95,7 +95,7 @@ class HostControl:
         """League placement: the limits on the robot node's interface."""
         if not self.shaping:
             return None
-        return bandwidth.apply_netns(netns, shaping)
+        return bandwidth.apply_netns(netns, shaping, replace=True)
 
     def unshape(self, applied: AppliedShaping) -> None:
         bandwidth.remove(applied)

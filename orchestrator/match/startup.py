@@ -129,7 +129,8 @@ def _start_league(match: MatchContext, started_at: float, placement: LeaguePlace
         match_dir=match_dir, attachments=(), extra_labels=match.options.extra_labels,
         command=match.options.simulator_command, model_dirs=plan.model_dirs,
     )
-    request = replace(request, network_mode=f"container:{holder}", hostname=None)
+    request = replace(request, network_mode=f"container:{holder}", hostname=None,
+                      labels={**request.labels, layout.LABEL_NODE: placement.simulator.name})
     sets = cpu_sets(stepping=str(spec.get("stepping", "async")))
     match.started.cpu_sets = sets
     request = replace(request, cpuset_cpus=sets.simulator)
@@ -243,6 +244,9 @@ def _start_robot(match: MatchContext, robot: RobotPlan) -> None:
             cgroup_parent=cgroup_parent,
         )
         request = replace(request, cpuset_cpus=started.cpu_sets.robots)
+        if match.options.placement is not None:  # the node's epilog finds it by this label
+            node = match.options.placement.robots[robot.key].name
+            request = replace(request, labels={**request.labels, layout.LABEL_NODE: node})
         record.limits["cpuset"] = request.cpuset_cpus
         container_id = match.runtime.create_container(request)
         started.robot_ids[robot.key] = container_id

@@ -5,7 +5,8 @@ The robots connect, play and are isolated: from inside a robot container (its pr
 node's network), the simulator's port and the teammate's node answer; the opponents' nodes, the
 controller and the simulator's telemetry port do not. A cancelled league match stops its robots
 with their grace period. Either way nothing of the match is left on any node: no container, no
-firewall chain, no traffic shaping.
+firewall chain, no traffic shaping; nor when the match's orchestrator is killed (the cluster's
+epilog on each node cleans up).
 """
 
 from __future__ import annotations
@@ -212,3 +213,59 @@ def test_cancelled_league_match_gives_robots_their_grace_period(
     states = {state.split()[0] for _, state, _ in _sacct(cluster, job_id)}
     assert states == {"CANCELLED"}, states
     _nothing_left(client, match_id)
+
+
+def _orchestrator_pid(out: Path) -> int:
+    """The job's ``hlvs match`` (the batch step on the simulator's node)."""
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:
+        for proc_dir in Path("/proc").iterdir():
+            try:
+                args = (proc_dir / "cmdline").read_bytes().split(b"\0")
+            except OSError:
+                continue
+            if b"--league-nodes" in args and str(out).encode() in args and b"match" in args:
+                return int(proc_dir.name)
+        time.sleep(0.5)
+    raise AssertionError("no hlvs match with --league-nodes for " + str(out))
+
+
+def test_killed_league_match_leaves_nothing_on_its_nodes(cluster: str, tmp_path: Path) -> None:
+    """The orchestrator dies (kill -9) mid-match: the job ends, and the cluster's epilog on each
+    of its nodes removes the containers placed there, the firewall chains and the shaping;
+    ``hlvs cleanup --match`` then salvages the logs the match left."""
+    client = docker.from_env()
+    out = tmp_path / "killed"
+    match_id = f"league-killed-{os.getpid()}"
+    proc = _scrimmage(cluster, out, match_id, half_s=120)
+    try:
+        _robots(client, match_id, proc)
+        job_id = json.loads((out / "slurm.json").read_text())["job_id"]
+        rules = subprocess.run(["nsenter", "--net=/run/netns/hlvs-n2", "iptables", "-w", "-S"],
+                               capture_output=True, text=True, check=True).stdout
+        assert "-m cgroup --path hlvs-robots -j HLVS-ROBOTS" in rules, rules  # red 1's node
+        os.kill(_orchestrator_pid(out), signal.SIGKILL)
+        stdout, stderr = proc.communicate(timeout=300)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 3, stdout[-2000:] + stderr[-3000:]  # infrastructure
+    assert f"Slurm job {job_id} ended" in stderr, stderr[-2000:]
+    states = {state.split()[0] for _, state, _ in _sacct(cluster, job_id)}
+    assert "RUNNING" not in states and "COMPLETED" not in states, states
+    deadline = time.monotonic() + 60
+    while True:  # the epilogs run as the job's nodes are released
+        try:
+            _nothing_left(client, match_id)
+            break
+        except AssertionError:
+            if time.monotonic() > deadline:
+                raise
+            time.sleep(1)
+    salvage = subprocess.run([sys.executable, "-m", "orchestrator", "cleanup", "--match",
+                              match_id], capture_output=True, text=True, timeout=300,
+                             check=False)
+    assert salvage.returncode == 0, salvage.stdout + salvage.stderr
+    assert json.loads((out / "report.json").read_text())["failure_class"] == "interrupted"
+    assert (out / "teams" / "red" / "1").is_dir()

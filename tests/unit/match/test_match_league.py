@@ -56,6 +56,8 @@ def test_league_match_runs_each_robot_in_its_nodes_network(tmp_path: Path) -> No
     red2 = started["hlvs-u1-red-2"].request
     assert red2.network_mode == f"container:{ids['hlvs-u1-node-n3']}"
     assert red2.cgroup_parent == ROBOT_CGROUP_PARENT
+    assert red2.labels["org.hlvs-runner.node"] == "n3"  # the node's epilog finds it
+    assert simulator.labels["org.hlvs-runner.node"] == "n1"
     assert red2.environment["ROBOCUP_SIMULATOR_ADDR"] == "10.77.0.11:10002"
     assert red2.environment["ROBOCUP_MIRROR_SERVER_IP"] == "10.77.0.11"
     assert red2.environment["ROBOCUP_GAMECONTROLLER_IP"] == "10.77.0.11"
