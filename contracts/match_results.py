@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 from typing import Any, ClassVar, Literal
 
 from contracts.codec import Versioned, json_key, omitted_when_none
-from contracts.sim_result import PlayRecord
+from contracts.sim_result import PlayRecord, SpoofingRecord
 
 Color = Literal["red", "blue"]
 Status = Literal["success", "failed"]
@@ -153,7 +153,7 @@ class MatchResults(Versioned):
     sim_time_ms: int | None = None
     real_time_factor: float | None = None
     robots: dict[str, RobotResult] = field(default_factory=dict)
-    spoofing: dict[str, Any] | None = None  # {"total": n, "attempts": [...]} (sim_result)
+    spoofing: SpoofingRecord | None = None  # from the simulator (sim_result)
     limits: MatchLimits | None = None
     versions: dict[str, str | dict[str, str] | None] = field(default_factory=dict)
     timings_s: dict[str, float] = field(default_factory=dict)  # per match state

@@ -44,6 +44,52 @@ class PlayRecord:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class SpoofingAttempt:
+    """One kind of attempt: ``count`` messages on ``channel`` from ``sender`` claiming
+    ``claimed`` (``None`` when it claimed no robot of this match)."""
+
+    channel: str  # "gamecontroller" | "mirror" | "api"
+    sender: str  # source IP address
+    sender_robot: str | None  # the robot at that address ("red-1"), None if none
+    claimed: str | None  # the robot the message claimed to be ("blue-2")
+    message: str  # what it asked for (RGrt message name, "team message", "connect")
+    count: int = 1
+
+    def to_json(self) -> dict[str, object]:
+        return {
+            "channel": self.channel,
+            "sender": self.sender,
+            "sender_robot": self.sender_robot,
+            "claimed": self.claimed,
+            "message": self.message,
+            "count": self.count,
+        }
+
+    def describe(self) -> str:
+        who = f"{self.sender} ({self.sender_robot})" if self.sender_robot else self.sender
+        claimed = self.claimed or "no robot of this match"
+        return (f"spoofing on {self.channel}: {self.message} from {who} claiming to be "
+                f"{claimed} ignored")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class SpoofingRecord:
+    """Messages robots sent as another robot (``spoofing`` of ``sim_result.json`` and
+    ``results.json``): ``total`` messages, ``attempts`` grouped by kind (the first ones)."""
+
+    total: int
+    attempts: tuple[SpoofingAttempt, ...] = ()
+
+    def per_sender(self) -> dict[str, int]:
+        """Messages each robot (``red-1``) sent as another robot."""
+        counts: dict[str, int] = {}
+        for attempt in self.attempts:
+            sender = str(attempt.sender_robot)
+            counts[sender] = counts.get(sender, 0) + attempt.count
+        return counts
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class SimResult(Versioned):
     VERSION: ClassVar[int] = 1
     KIND: ClassVar[str] = "simulator result"
@@ -65,7 +111,7 @@ class SimResult(Versioned):
     cameras: dict[str, Any] = field(default_factory=dict)
     started_unix_s: float = 0.0
     versions: dict[str, str] = field(default_factory=dict)  # distribution -> version
-    spoofing: dict[str, Any] | None = None  # {"total": n, "attempts": [...]}
+    spoofing: SpoofingRecord | None = None
     shootout: dict[str, dict[str, int]] | None = None  # color -> kicks, scored
     coin_toss: bool | None = None  # decided by a coin toss after the shoot-out
     play: PlayRecord | None = None  # None from a simulator that did not count play
@@ -83,4 +129,4 @@ class SimResult(Versioned):
         return self.state == "FINISHED"
 
 
-__all__ = ["PlayRecord", "SimResult", "Winner"]
+__all__ = ["PlayRecord", "SimResult", "SpoofingAttempt", "SpoofingRecord", "Winner"]

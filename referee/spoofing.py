@@ -12,40 +12,11 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Mapping
-from dataclasses import dataclass
 
 from contracts.ids import RobotId
+from contracts.sim_result import SpoofingAttempt
 
 MAX_RECORDS = 256  # distinct (channel, sender, claimed, message) kept; the rest only counted
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class SpoofingAttempt:
-    """One kind of attempt: ``count`` messages on ``channel`` from ``sender`` claiming
-    ``claimed`` (``None`` when it claimed no robot of this match)."""
-
-    channel: str  # "gamecontroller" | "mirror" | "api"
-    sender: str  # source IP address
-    sender_robot: str | None  # the robot at that address ("red-1"), None if none
-    claimed: str | None  # the robot the message claimed to be ("blue-2")
-    message: str  # what it asked for (RGrt message name, "team message", "connect")
-    count: int = 1
-
-    def to_json(self) -> dict[str, object]:
-        return {
-            "channel": self.channel,
-            "sender": self.sender,
-            "sender_robot": self.sender_robot,
-            "claimed": self.claimed,
-            "message": self.message,
-            "count": self.count,
-        }
-
-    def describe(self) -> str:
-        who = f"{self.sender} ({self.sender_robot})" if self.sender_robot else self.sender
-        claimed = self.claimed or "no robot of this match"
-        return (f"spoofing on {self.channel}: {self.message} from {who} claiming to be "
-                f"{claimed} ignored")
 
 
 def robot_key(robot: RobotId) -> str:

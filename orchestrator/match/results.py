@@ -69,15 +69,6 @@ class RobotRecord:
         )
 
 
-def spoofing_attempts(spoofing: dict[str, Any] | None) -> dict[str, int]:
-    """Messages each robot sent as another robot, from the simulator's spoofing record."""
-    counts: dict[str, int] = {}
-    for attempt in (spoofing or {}).get("attempts") or []:
-        sender = str(attempt.get("sender_robot"))
-        counts[sender] = counts.get(sender, 0) + int(attempt.get("count") or 0)
-    return counts
-
-
 def build_results(
     *,
     match_id: str,
@@ -99,7 +90,7 @@ def build_results(
     if forfeit is not None:
         score, winner = forfeit.score, forfeit.winner
     spoofing = sim.spoofing if sim is not None else None
-    spoofed = spoofing_attempts(spoofing)
+    spoofed = spoofing.per_sender() if spoofing is not None else {}
     return MatchResults(
         match_id=match_id,
         seed=seed,
@@ -156,7 +147,6 @@ __all__ = [
     "FailureClass",
     "RobotRecord",
     "build_results",
-    "spoofing_attempts",
     "team_warnings",
     "write_report",
     "write_results",

@@ -20,7 +20,7 @@ from contracts.match_spec import (
     TeamSpec,
     TimingSpec,
 )
-from contracts.sim_result import SimResult
+from contracts.sim_result import SimResult, SpoofingRecord
 from contracts.telemetry import StateMessage
 
 
@@ -59,7 +59,7 @@ def _result() -> SimResult:
         events_summary={"goal": 3}, stop_reason="finished", stepping="lockstep",
         sim_time_ms=60000, real_time_s=61.5, held_real_s=1.0, real_time_factor=0.99,
         robots={"red-1": {"connected": True, "bytes_sent": 10}}, cameras={"frames": 3},
-        versions={"mujoco": "4.0.0"}, spoofing={"total": 0, "attempts": []},
+        versions={"mujoco": "4.0.0"}, spoofing=SpoofingRecord(total=0),
         shootout={"red": {"kicks": 5, "scored": 3}}, coin_toss=False,
     )  # fmt: skip
 

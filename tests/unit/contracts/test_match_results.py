@@ -20,7 +20,7 @@ from contracts.match_results import (
     Salvage,
     SalvagedRobot,
 )
-from contracts.sim_result import PlayRecord
+from contracts.sim_result import PlayRecord, SpoofingAttempt, SpoofingRecord
 
 RESULT_KEYS = {
     "match_id", "seed", "warnings", "status", "failure", "forfeit", "final_state", "score",
@@ -59,7 +59,9 @@ def _played() -> MatchResults:
                 spoofing_attempts=2),
             "blue-1": RobotResult(image=None, image_error="no image named for this player"),
         },
-        spoofing={"total": 2, "attempts": [{"sender_robot": "red-1", "count": 2}]},
+        spoofing=SpoofingRecord(total=2, attempts=(SpoofingAttempt(
+            channel="api", sender="10.0.1.11", sender_robot="red-1", claimed="blue-1",
+            message="connect", count=2),)),
         limits=LIMITS, versions={"hlvs-runner": "0.1", "simulator": {"mujoco": "3"}},
         timings_s={"playing": 60.0}, bringup_s=4.5, admission={"fits": True},
     )  # fmt: skip
