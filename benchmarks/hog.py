@@ -29,7 +29,8 @@ from pathlib import Path
 from typing import Any
 
 from contracts import files
-from contracts.match_results import MatchResults
+from contracts.codec import to_data
+from contracts.match_results import AdmissionRecord, MatchResults
 
 TARGET = 0.9
 IDLE = "python3 -c \"import time; time.sleep(10**6)\""
@@ -101,7 +102,7 @@ def main(argv: list[str] | None = None) -> int:
     cpus = round(max(0.1, (host.cpus - SIMULATOR_CPUS) / 2), 2)  # two robots + the simulator
     runs: dict[str, list[float]] = {"baseline": [], "hog": []}
     stub: dict[str, list[dict[str, Any]]] = {"baseline": [], "hog": []}
-    admission: Any = None
+    admission: AdmissionRecord | None = None
     started = time.monotonic()
     with tempfile.TemporaryDirectory(prefix="hlvs-bench-hog-") as tmp:
         for i in range(args.pairs):
@@ -125,7 +126,7 @@ def main(argv: list[str] | None = None) -> int:
         "host_cpus": host.cpus,
         "cpus_per_robot": cpus,
         "hog_processes": 2 ** max(0, args.hogs.bit_length() - 1),
-        "admission": admission,
+        "admission": to_data(admission),
         "real_time_factor": {k: [round(v, 3) for v in vals] for k, vals in runs.items()},
         "median_baseline": round(baseline, 3),
         "median_hog": round(hog, 3),

@@ -112,6 +112,27 @@ class MatchLimits:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class NeededAvailable:
+    needed: float
+    available: float
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class AdmissionRecord:
+    """Whether the match fits the host (``admission`` of ``results.json``): an official match
+    that does not fit is refused, any other plays with ``warning``."""
+
+    official: bool
+    fits: bool
+    host: str
+    robots: int
+    cpus: NeededAvailable
+    memory_gb: NeededAvailable
+    simulator_cpu_shares: int
+    warning: str | None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class SalvagedRobot:
     stdout: bool | None = field(default=None, metadata=omitted_when_none())  # True: saved
     log_folder: LogFolderCopy | None = field(default=None, metadata=omitted_when_none())
@@ -158,7 +179,7 @@ class MatchResults(Versioned):
     versions: dict[str, str | dict[str, str] | None] = field(default_factory=dict)
     timings_s: dict[str, float] = field(default_factory=dict)  # per match state
     bringup_s: float | None = None  # start of STARTING -> every robot connected
-    admission: dict[str, Any] | None = None  # orchestrator.match.admission verdict
+    admission: AdmissionRecord | None = None  # orchestrator.match.admission verdict
     salvaged: Salvage | None = None
     version: int = VERSION
 
@@ -228,6 +249,7 @@ class MatchReport(Versioned):
 
 __all__ = [
     "SALVAGED_KEYS",
+    "AdmissionRecord",
     "Failure",
     "FailureClass",
     "Forfeit",
@@ -235,6 +257,7 @@ __all__ = [
     "MatchLimits",
     "MatchReport",
     "MatchResults",
+    "NeededAvailable",
     "RobotResult",
     "Salvage",
     "SalvagedRobot",

@@ -106,7 +106,7 @@ def play(
     from orchestrator.engine.containers import DockerRuntime
 
     verdict = admit(plan, host=HostResources.local(), official=plan.official)
-    plan = replace(plan, admission=verdict.to_json())
+    plan = replace(plan, admission=verdict.record())
     client = connect()
     runtime = DockerRuntime(client)
     host = HostControl.for_current_user()

@@ -19,6 +19,8 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from contracts.codec import to_data
+from contracts.match_results import AdmissionRecord, NeededAvailable
 from orchestrator.errors import OrchestratorError
 from orchestrator.match.plan import MatchPlan
 
@@ -73,18 +75,22 @@ class Admission:
                          f"{self.available_memory_gb:.1f} GB available")
         return "; ".join(parts)
 
-    def to_json(self) -> dict[str, Any]:
-        return {
-            "official": self.official, "fits": self.fits, "host": self.host,
-            "robots": self.robots,
-            "cpus": {"needed": self.needed_cpus, "available": self.available_cpus},
-            "memory_gb": {"needed": round(self.needed_memory_gb, 3),
-                          "available": round(self.available_memory_gb, 3)},
-            "simulator_cpu_shares": SIMULATOR_CPU_SHARES,
-            "warning": None if self.fits else
+    def record(self) -> AdmissionRecord:
+        """What ``results.json`` keeps of the verdict."""
+        return AdmissionRecord(
+            official=self.official, fits=self.fits, host=self.host, robots=self.robots,
+            cpus=NeededAvailable(needed=self.needed_cpus, available=self.available_cpus),
+            memory_gb=NeededAvailable(needed=round(self.needed_memory_gb, 3),
+                                      available=round(self.available_memory_gb, 3)),
+            simulator_cpu_shares=SIMULATOR_CPU_SHARES,
+            warning=None if self.fits else
             f"the match does not fit {self.host}: {self.shortfall()}; played anyway (not "
             "official), so speeds and results may suffer",
-        }
+        )
+
+    def to_json(self) -> dict[str, Any]:
+        data: dict[str, Any] = to_data(self.record())
+        return data
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -138,7 +144,7 @@ def admit(plan: MatchPlan, *, host: HostResources, official: bool) -> Admission:
     if not fits:
         if official:
             raise AdmissionRefused(admission, plan.match_id)
-        log.warning("match %s: %s", plan.match_id, admission.to_json()["warning"])
+        log.warning("match %s: %s", plan.match_id, admission.record().warning)
     return admission
 
 

@@ -233,7 +233,7 @@ def _write(match: MatchContext) -> MatchResults:
         timings_s=dict(match.lifecycle.timings_s),
         failure=match.failure,
         bringup_s=match.bringup_s,
-        admission=dict(plan.admission) if plan.admission is not None else None,
+        admission=plan.admission,
     )
     write_results(out, results)
     lifecycle = match.lifecycle

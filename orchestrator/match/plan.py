@@ -13,6 +13,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from contracts.match_results import AdmissionRecord
 from orchestrator.config import Limits, LoadedGame, PlayerConfig
 from orchestrator.config.robot_models import is_model_path
 from orchestrator.config.spec import to_match_spec
@@ -51,7 +52,7 @@ class MatchPlan:
     limits: Limits = field(default_factory=Limits)
     allow_internet: bool = False
     official: bool = False
-    admission: Mapping[str, Any] | None = None  # the admission verdict, copied into results
+    admission: AdmissionRecord | None = None  # the admission verdict, copied into results
     grace_period_s: float = 120.0
     telemetry: bool = True  # ask the simulator for zenoh telemetry on the control network
     telemetry_silence_s: float = 30.0  # fail the match when telemetry stays silent this long

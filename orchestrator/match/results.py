@@ -11,6 +11,7 @@ from typing import Any
 
 from contracts import files
 from contracts.match_results import (
+    AdmissionRecord,
     Failure,
     FailureClass,
     Forfeit,
@@ -81,7 +82,7 @@ def build_results(
     timings_s: dict[str, float],
     failure: Failure | None,
     bringup_s: float | None = None,
-    admission: dict[str, Any] | None = None,
+    admission: AdmissionRecord | None = None,
 ) -> MatchResults:
     sim = sim_result
     api_stats: dict[str, dict[str, Any]] = sim.robots if sim is not None else {}

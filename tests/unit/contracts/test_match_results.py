@@ -9,6 +9,7 @@ import pytest
 
 from contracts.errors import ContractError, UnknownVersion
 from contracts.match_results import (
+    AdmissionRecord,
     Failure,
     FailureClass,
     Forfeit,
@@ -16,6 +17,7 @@ from contracts.match_results import (
     MatchLimits,
     MatchReport,
     MatchResults,
+    NeededAvailable,
     RobotResult,
     Salvage,
     SalvagedRobot,
@@ -63,7 +65,11 @@ def _played() -> MatchResults:
             channel="api", sender="10.0.1.11", sender_robot="red-1", claimed="blue-1",
             message="connect", count=2),)),
         limits=LIMITS, versions={"hlvs-runner": "0.1", "simulator": {"mujoco": "3"}},
-        timings_s={"playing": 60.0}, bringup_s=4.5, admission={"fits": True},
+        timings_s={"playing": 60.0}, bringup_s=4.5, admission=AdmissionRecord(
+            official=False, fits=True, host="this host", robots=2,
+            cpus=NeededAvailable(needed=3.0, available=4.0),
+            memory_gb=NeededAvailable(needed=4.0, available=15.5),
+            simulator_cpu_shares=8192, warning=None),
     )  # fmt: skip
 
 
