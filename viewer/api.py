@@ -31,6 +31,7 @@ from fastapi import APIRouter, Depends, FastAPI, HTTPException
 from fastapi.responses import FileResponse, Response, StreamingResponse
 from fastapi.staticfiles import StaticFiles
 
+from contracts import files
 from simulator.errors import ReplayError
 from simulator.replay import ReplayFile, scene_for
 from simulator.traffic import read_stats
@@ -91,7 +92,7 @@ class CatalogResolver:
         if source is None and live is not None and live.replay_path is not None:
             # a match watched live: its replay once written (the public copy when collected)
             folder = live.replay_path.parents[2]
-            for path in (folder / "public" / "replay.hlvsrec", live.replay_path):
+            for path in (folder / "public" / files.REPLAY, live.replay_path):
                 if path.is_file():
                     source = self.catalog.add_replay(path, id=replay_id)
                     break

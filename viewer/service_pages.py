@@ -14,6 +14,7 @@ from pathlib import Path
 from fastapi import FastAPI, Request
 from sqlalchemy import select
 
+from contracts import files
 from service import submissions
 from service.db import Submission
 from service.deps import DbSession, TeamPrincipal, get_services
@@ -21,8 +22,8 @@ from service.errors import NotFound
 from viewer.api import mount_viewer
 from viewer.sources import LiveSource, ReplaySource, live_of
 
-REPLAY = Path("public") / "replay.hlvsrec"
-STATS = Path("public") / "api_stats.jsonl"
+REPLAY = Path("public") / files.REPLAY
+STATS = Path("public") / files.API_STATS
 
 
 def _match_dir(request: Request, row: Submission) -> Path | None:

@@ -8,16 +8,19 @@ runs, ``api_stats.jsonl`` beside the replay, and ``simulator/match_spec.json`` w
 
 from __future__ import annotations
 
-import json
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from contracts import files
+from contracts.errors import ContractError
+from contracts.match_spec import MatchSpec
 from viewer.errors import SourceError
 
-STATS_FILE = "api_stats.jsonl"
+STATS_FILE = files.API_STATS
 REPLAY_SUFFIX = ".hlvsrec"
-_REPLAY_PLACES = ("public/replay.hlvsrec", "simulator/out/replay.hlvsrec", "replay.hlvsrec")
+_REPLAY_PLACES = (f"public/{files.REPLAY}", f"simulator/{files.OUT_DIR}/{files.REPLAY}",
+                  files.REPLAY)
 
 
 @dataclass(frozen=True, slots=True)
@@ -72,7 +75,7 @@ class Catalog:
             raise SourceError(path=str(path), reason="no such file or folder")
         opened: list[str] = []
         live = _live_of(path)
-        if live is not None and not (path / "public" / "replay.hlvsrec").is_file():
+        if live is not None and not (path / "public" / files.REPLAY).is_file():
             self.live[live.id] = live
             opened.append(f"/watch/live/{live.id}")
         for place in _REPLAY_PLACES:
@@ -113,18 +116,17 @@ def live_of(folder: Path, *, id: str | None = None) -> LiveSource | None:
 
 
 def _live_of(folder: Path) -> LiveSource | None:
-    spec_path = folder / "simulator" / "match_spec.json"
+    spec_path = folder / "simulator" / files.MATCH_SPEC
     if not spec_path.is_file():
         return None
     try:
-        spec = json.loads(spec_path.read_text(encoding="utf-8"))
-        endpoint = spec["network"]["telemetry_listen"]
-        match_id = str(spec["match_id"])
-    except (OSError, ValueError, KeyError, TypeError) as exc:
+        spec = MatchSpec.load(spec_path)
+    except ContractError as exc:
         raise SourceError(path=str(spec_path), reason=f"unreadable match spec: {exc}") from exc
+    endpoint, match_id = spec.network.telemetry_listen, spec.match_id
     if not endpoint:
         return None
-    replay = folder / "simulator" / "out" / "replay.hlvsrec"
+    replay = folder / "simulator" / files.OUT_DIR / files.REPLAY
     return LiveSource(
         id=_slug_text(match_id), match_id=match_id, endpoint=str(endpoint), replay_path=replay
     )

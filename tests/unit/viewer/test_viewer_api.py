@@ -6,13 +6,16 @@ import json
 import struct
 import threading
 from collections.abc import Iterator
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 
+from orchestrator.config import load_game, to_match_spec
 from simulator.replay import ReplayFile
+from tests.unit.config.conftest import EXAMPLES
 from tests.unit.viewer.replays import GOAL_MS, record_match
 from viewer import Catalog, SourceError
 from viewer.api import create_app
@@ -95,6 +98,15 @@ def test_paths_without_replays_are_refused(tmp_path: Path) -> None:
         Catalog().add_path(tmp_path / "absent")
 
 
+def test_a_running_match_with_a_broken_spec_is_refused_naming_the_field(tmp_path: Path) -> None:
+    spec_path = tmp_path / "running" / "simulator" / "match_spec.json"
+    spec_path.parent.mkdir(parents=True)
+    spec_path.write_text(json.dumps({"match_id": "m 1",
+                                     "network": {"telemetry_listen": "tcp/10.0.0.2:7447"}}))
+    with pytest.raises(SourceError, match=r"unreadable match spec: .*: /(seed|red|blue|game_type)"):
+        Catalog().add_path(tmp_path / "running")
+
+
 class _FakeFeed:
     """Stands in for the zenoh subscription: pushes canned telemetry from a thread."""
 
@@ -113,9 +125,9 @@ class _FakeFeed:
 def test_the_live_stream_relays_telemetry_as_server_sent_events(tmp_path: Path) -> None:
     folder = tmp_path / "running"
     (folder / "simulator").mkdir(parents=True)
-    (folder / "simulator" / "match_spec.json").write_text(
-        json.dumps({"match_id": "m 1", "network": {"telemetry_listen": "tcp/10.0.0.2:7447"}})
-    )
+    spec = to_match_spec(load_game(EXAMPLES / "scrimmage_1v1" / "game.json"),
+                         robot_addresses={}, telemetry_listen="tcp/10.0.0.2:7447")
+    replace(spec, match_id="m 1").write(folder / "simulator" / "match_spec.json")
     catalog = Catalog()
     assert catalog.add_path(folder) == ["/watch/live/m-1"]
     client = TestClient(create_app(catalog, feed_factory=_FakeFeed))
