@@ -118,6 +118,7 @@ class MatchLoop:
         self.real_time_s = 0.0
         self._events_seen = 0
         self._next_state_s = 0.0
+        self._connection_changes = 0
         self._next_poses_s = 0.0
         self._rtf_window: tuple[float, int] = (0.0, 0)
         self._rtf = 0.0
@@ -243,8 +244,10 @@ class MatchLoop:
     def _publish_state(self, *, force: bool = False) -> None:
         now = time.monotonic()
         self._publish_poses(now)
-        if not force and now < self._next_state_s:
-            return
+        changes = self.server.connection_changes
+        if not force and now < self._next_state_s and changes == self._connection_changes:
+            return  # a client came or went: the state tells it at once (bring-up is seen)
+        self._connection_changes = changes
         self._next_state_s = now + STATE_PERIOD_S
         game = self.referee.game_state
         rtf = self.real_time_factor()

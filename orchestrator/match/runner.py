@@ -34,6 +34,10 @@ from orchestrator.match.state import MatchState
 
 log = logging.getLogger(__name__)
 
+# until every robot is connected (at most this long after STARTING) the simulator and its
+# telemetry are polled every 0.1 s: the match goes on, and bring-up is seen, without a 0.5 s lag
+BRINGUP_FAST_POLL_S = 30.0
+
 ImageResolver = Callable[[MatchPlan], Mapping[str, tuple[str | None, str | None]]]
 """plan -> {robot key: (digest, error)}; a robot with an error has no usable image."""
 
@@ -188,7 +192,9 @@ class MatchRunner(MatchContext):
                                f"telemetry silent for {now - heard:.0f} s")
                     return
             self.progress(latest)
-            self.stop_event.wait(self.options.poll_s)
+            bringing_up = self.bringup_s is None and now - started_at < BRINGUP_FAST_POLL_S
+            self.stop_event.wait(min(self.options.poll_s, 0.1) if bringing_up
+                                 else self.options.poll_s)
 
     def _poll_robots(self) -> None:
         for key, container_id in self.started.robot_ids.items():

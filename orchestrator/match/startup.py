@@ -63,9 +63,11 @@ def _start(match: MatchContext, started_at: float) -> None:
     if placement is not None:
         _start_league(match, started_at, placement, mark)
         return
-    for role, internal in (("control", True), ("red", not plan.allow_internet),
-                           ("blue", not plan.allow_internet)):
-        _create_network(match, role, internal)
+    roles = (("control", True), ("red", not plan.allow_internet),
+             ("blue", not plan.allow_internet))
+    with ThreadPoolExecutor(max_workers=len(roles)) as pool:  # side by side (a subnet taken
+        # meanwhile by another is SubnetInUse: the next candidate is tried)
+        list(pool.map(lambda role: _create_network(match, *role), roles))
     mark("networks")
     for color in ("red", "blue"):
         match.host.isolate_bridge(started.networks[color].bridge_name, match_id=plan.match_id)
@@ -164,9 +166,11 @@ def _start_containers(match: MatchContext, request: ContainerRequest, started_at
     robots = [r for r in plan.robots if match.records[r.key].image_error is None]
     # the simulator and the robots start at the same time (robot clients retry until the
     # simulator listens); the simulator is submitted first so that it boots while they start
-    with ThreadPoolExecutor(max_workers=max(1, min(8, len(robots) + 1))) as pool:
+    with (ThreadPoolExecutor(max_workers=len(robots) + 1) as pool,
+          ThreadPoolExecutor(max_workers=max(1, len(robots)), thread_name_prefix="folders")
+          as folders):
         simulator = pool.submit(_start_simulator, match, request)
-        list(pool.map(lambda robot: _start_robot(match, robot), robots))
+        list(pool.map(lambda robot: _start_robot(match, robot, folders), robots))
         simulator.result()
     mark("containers")
     if endpoint is not None and match.telemetry_factory is not None:
@@ -194,7 +198,7 @@ def _start_simulator(match: MatchContext, request: ContainerRequest) -> None:
     match.monitor.watch("simulator", started.simulator_id)
 
 
-def _start_robot(match: MatchContext, robot: RobotPlan) -> None:
+def _start_robot(match: MatchContext, robot: RobotPlan, folders: ThreadPoolExecutor) -> None:
     plan = match.plan
     started = match.started
     record = match.records[robot.key]
@@ -202,6 +206,8 @@ def _start_robot(match: MatchContext, robot: RobotPlan) -> None:
     n_robots = len([r for r in team.robots if match.records[r.key].image_error is None])
     limits = plan.limits
     mark = _Marks(match.clock, started.robot_steps_s.setdefault(robot.key, {}))
+    # the capped log and scratch folders are made while the holder starts
+    made = folders.submit(_robot_folders, match, robot)
     try:
         if match.options.placement is not None:
             holder_id, team_net, applied, cgroup_parent = _league_robot_network(
@@ -212,13 +218,7 @@ def _start_robot(match: MatchContext, robot: RobotPlan) -> None:
         if applied is not None:
             started.shaping[robot.key] = applied
         mark("shaping")
-        folder = match.host.log_folder(
-            match_id=plan.match_id, name=robot.key, cap_bytes=int(limits.log_folder_gb * 1e9),
-            fallback=match.options.out_dir / "teams" / robot.color / str(robot.number)
-            / "robocup-logs",
-        )
-        started.log_folders[robot.key] = folder
-        scratch = _scratch(match, robot)
+        folder, scratch = made.result()
         mark("folders")
         record.limits = {
             "nano_cpus": int(limits.cpus * 1e9),
@@ -260,6 +260,20 @@ def _start_robot(match: MatchContext, robot: RobotPlan) -> None:
     except OrchestratorError as exc:
         record.startup_error = str(exc)
         log.warning("match %s: robot %s could not be started: %s", plan.match_id, robot.key, exc)
+    finally:
+        made.exception()  # made and recorded (for the teardown) even when the robot failed
+
+
+def _robot_folders(match: MatchContext, robot: RobotPlan) -> tuple[LogFolder, LogFolder | None]:
+    """The robot's capped /robocup-logs folder and its scratch space."""
+    folder = match.host.log_folder(
+        match_id=match.plan.match_id, name=robot.key,
+        cap_bytes=int(match.plan.limits.log_folder_gb * 1e9),
+        fallback=match.options.out_dir / "teams" / robot.color / str(robot.number)
+        / "robocup-logs",
+    )
+    match.started.log_folders[robot.key] = folder
+    return folder, _scratch(match, robot)
 
 
 def _shaping(match: MatchContext, n_robots: int, *, simulator_ip: str,

@@ -36,7 +36,7 @@ logger = logging.getLogger(__name__)
 
 SENSOR_PERIOD_MS = 8
 CAMERA_PERIOD_MS = 96
-CONNECT_RETRY_S = 1.0
+CONNECT_RETRY_S = 0.25  # a refused connect costs nothing; the simulator may boot after us
 CRASH_EXIT_CODE = 1
 
 

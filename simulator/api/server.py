@@ -131,6 +131,7 @@ class ApiServer:
         self._wake: tuple[int, int] | None = None
         self._wake_sent = False
         self._step_polls = 0
+        self.connection_changes = 0  # clients welcomed or dropped so far
         self._woken: list[Connection] = []
         self.slots: dict[RobotId, RobotSlot] = {}
         for endpoint in endpoints:
@@ -351,6 +352,7 @@ class ApiServer:
         )
         slot.pending.clear()
         slot.stats.connects.append(time.time())
+        self.connection_changes += 1
         if self._sender is not None:
             slot.mask = 0  # the I/O thread watches it
             self._sender.add(slot.conn)
@@ -391,6 +393,7 @@ class ApiServer:
         slot.stats.disconnect_reasons.append(reason)
         slot.conn = None
         slot.pending.clear()
+        self.connection_changes += 1
         if conn.threaded and self._sender is not None:
             self._sender.remove(conn)
         else:

@@ -51,6 +51,7 @@ class _BusyServer:
     """Every poll returns at once, as when a client's request arrives."""
 
     stop_requested = False
+    connection_changes = 0
 
     def __init__(self) -> None:
         self.polls = 0

@@ -15,6 +15,8 @@ class _PipelineServer:
     """Records the order of the loop's calls; a client answers every sent measurement."""
 
     stop_requested = False
+    connection_changes = 0
+    awaiting_answers = False
 
     def __init__(self, world: _World) -> None:
         self.world = world
