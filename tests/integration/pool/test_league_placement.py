@@ -16,6 +16,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 from typing import Any
@@ -42,6 +43,66 @@ udp.connect(("10.77.0.1", 9))
 found["own address"] = udp.getsockname()[0]
 print(json.dumps(found))
 """
+
+LISTEN = """
+import json, select, socket, sys, time
+socks = {}
+for port in (3737, 5999):
+    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    s.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4 << 20)
+    s.bind(("0.0.0.0", port))
+    socks[s] = port
+got = {"mirror": [], "blast_bytes": 0, "blast_first": None, "blast_last": None}
+end = time.monotonic() + float(sys.argv[1])
+while time.monotonic() < end:
+    ready, _, _ = select.select(list(socks), [], [], 0.2)
+    for s in ready:
+        data, peer = s.recvfrom(65535)
+        if socks[s] == 3737:
+            got["mirror"].append([data.decode(errors="replace"), peer[0]])
+        else:
+            now = time.monotonic()
+            got["blast_first"] = got["blast_first"] or now
+            got["blast_last"] = now
+            got["blast_bytes"] += len(data)
+print(json.dumps(got))
+"""
+
+SEND = """
+import socket, sys, time
+simulator, mate = sys.argv[1], sys.argv[2]
+s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+for i in range(5):
+    s.sendto(f"team message {i}".encode(), (simulator, 3737))
+    time.sleep(0.2)
+payload = bytes(1200)
+end = time.monotonic() + 3.0
+while time.monotonic() < end:
+    try:
+        s.sendto(payload, (mate, 5999))
+    except OSError:
+        time.sleep(0.001)  # the shaper's queue is full
+print("sent")
+"""
+
+
+def _team_traffic(sender: Any, receiver: Any, simulator: str, mate: str) -> dict[str, Any]:
+    """Team messages through the mirror, then 3 s of UDP as fast as the sender can, from
+    ``sender`` to ``receiver``'s node: what ``receiver`` got (its node's limits apply)."""
+    result: dict[str, Any] = {}
+
+    def listen() -> None:
+        code, output = receiver.exec_run(["python3", "-c", LISTEN, "8"])
+        result.update(json.loads(output.decode().strip().splitlines()[-1]) if code == 0
+                      else {"error": output.decode()})
+
+    thread = threading.Thread(target=listen)
+    thread.start()
+    time.sleep(1.5)  # the listener binds
+    code, output = sender.exec_run(["python3", "-c", SEND, simulator, mate])
+    thread.join(timeout=30)
+    assert code == 0, output
+    return result
 
 
 def _scrimmage(cluster: str, out: Path, match_id: str, half_s: int) -> subprocess.Popen[str]:
@@ -131,6 +192,7 @@ def test_league_2v2_on_four_robot_nodes_connects_plays_and_is_isolated(
                        ("controller", *CONTROLLER)],
         }
         reach = {key: _probe(robots[key], t) for key, t in targets.items()}
+        team = _team_traffic(robots["red-1"], robots["red-2"], simulator, node["red-2"])
         stdout, stderr = proc.communicate(timeout=300)
     finally:
         if proc.poll() is None:
@@ -165,8 +227,19 @@ def test_league_2v2_on_four_robot_nodes_connects_plays_and_is_isolated(
         for name in names:
             assert reach[key][name].startswith("failed"), (key, name, reach[key][name])
 
-    # connected and played across the nodes: robot API, GameController, bandwidth limits
+    # the mirror relays a robot's team message to its teammate's node (from the simulator's)
+    assert [text for text, _ in team["mirror"]][:1] == ["team message 0"], team
+    assert {peer for _, peer in team["mirror"]} == {simulator}, team
+    # the bandwidth limits hold per node: the teammate traffic leaving red 1's node is held
+    # to its team communication rate (bytes per second, 10 % and one burst of slack)
     results = json.loads((out / "results.json").read_text())
+    comm_bytes_s = results["robots"]["red-1"]["limits"]["comm_rate_bit_s"] / 8
+    span = team["blast_last"] - team["blast_first"]
+    assert span > 2.0, team
+    assert team["blast_bytes"] <= comm_bytes_s * span * 1.1 + 64_000, (team, comm_bytes_s)
+    assert team["blast_bytes"] >= comm_bytes_s * span * 0.5, (team, comm_bytes_s)
+
+    # connected and played across the nodes: robot API, GameController, bandwidth limits
     for key in ("red-1", "red-2", "blue-1", "blue-2"):
         robot = results["robots"][key]
         assert robot["api"]["messages_in"] > 50, (key, robot["api"])

@@ -131,3 +131,41 @@ def test_slurm_pool_submits_a_heterogeneous_job_for_league_placement(tmp_path: P
     status = pool.status(handle)
     assert status.detail == "on n1,n2,n3"
     assert [e.job_id for e in pool.queue()] == ["7"]
+
+
+def test_schedule_pool_section_takes_a_placement(tmp_path: Path) -> None:
+    from orchestrator.config.schedule import load_schedule
+    from orchestrator.schedule.services import _robot_nodes
+
+    for name in ("a", "b"):
+        (tmp_path / f"{name}.json").write_text(json.dumps({"name": name, "players": {}}))
+
+    def schedule(pool: str) -> Path:
+        path = tmp_path / "s.yaml"
+        path.write_text("name: cup\nteams:\n  - {name: a, id: 1, config: a.json}\n"
+                        f"  - {{name: b, id: 2, config: b.json}}\npool: {pool}\n")
+        return path
+
+    pool = load_schedule(schedule("{kind: slurm, placement: league}")).pool
+    assert (pool.kind, pool.placement) == ("slurm", "league")
+    assert load_schedule(schedule("{kind: slurm}")).pool.placement == "dense"
+    assert _robot_nodes(load_schedule(schedule("{kind: slurm}")).pool, tmp_path / "g.json") == 0
+    with pytest.raises(ConfigError) as err:
+        load_schedule(schedule("{kind: slurm, placement: spread}"))
+    assert "/pool/placement" in str(err.value)
+
+
+def test_league_schedule_asks_a_node_per_robot(tmp_path: Path) -> None:
+    import argparse
+
+    from orchestrator.commands.scrimmage_args import add_arguments
+    from orchestrator.config.schedule import SchedulePool
+    from orchestrator.match import scrimmage
+    from orchestrator.schedule.services import _robot_nodes
+
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    args = parser.parse_args(["--players", "2", "--out", str(tmp_path / "m")])
+    game = scrimmage.write_files(args, tmp_path / "config")
+    assert _robot_nodes(SchedulePool(kind="slurm", placement="league"), game) == 4
+    assert _robot_nodes(SchedulePool(kind="slurm"), game) == 0
