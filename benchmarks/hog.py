@@ -31,7 +31,6 @@ from typing import Any
 from contracts import files
 from contracts.codec import to_data
 from contracts.match_results import AdmissionRecord, MatchResults
-from contracts.sim_result import RobotApiStats
 
 TARGET = 0.9
 IDLE = "python3 -c \"import time; time.sleep(10**6)\""
@@ -112,9 +111,10 @@ def main(argv: list[str] | None = None) -> int:
                                 half_s=args.half_duration, stepping=args.stepping,
                                 max_rtf=args.max_rtf)
                 runs[kind].append(float(results.real_time_factor or 0.0))
-                blue = results.robots["blue-1"].api or RobotApiStats()
-                stub[kind].append({"messages_in": blue.messages_in,
-                                   "round_trip_ms_p90": blue.round_trip_ms.get("p90")})
+                blue = results.robots["blue-1"].api or {}
+                p90 = (blue.get("round_trip_ms") or {}).get("p90")
+                stub[kind].append({"messages_in": blue.get("messages_in"),
+                                   "round_trip_ms_p90": p90})
                 admission = results.admission
     baseline, hog = statistics.median(runs["baseline"]), statistics.median(runs["hog"])
     ratio = round(hog / baseline, 3) if baseline > 0 else 0.0

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 from typing import Any, ClassVar, Literal
 
 from contracts.codec import Versioned, json_key, omitted_when_none
-from contracts.sim_result import PlayRecord, RobotApiStats, SpoofingRecord
+from contracts.sim_result import PlayRecord, SpoofingRecord
 
 Color = Literal["red", "blue"]
 Status = Literal["success", "failed"]
@@ -91,7 +91,7 @@ class RobotResult:
     sent_bytes: int | None = None
     received_bytes: int | None = None
     limits: dict[str, Scalar] = field(default_factory=dict)  # empty when never started
-    api: RobotApiStats | None = None  # the simulator's robot API counters (sim_result)
+    api: dict[str, Any] | None = None  # the simulator's robot API statistics (sim_result)
     log_folder: LogFolderCopy | None = None
     spoofing_attempts: int = 0  # messages sent as another robot (from the simulator)
 

@@ -73,30 +73,6 @@ class SpoofingAttempt:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
-class RobotApiStats:
-    """One robot's robot API counters over the whole match (all its connections); ``robots``
-    of ``sim_result.json``, ``robots[*].api`` of ``results.json``."""
-
-    connects: tuple[float, ...] = ()  # unix s
-    disconnects: tuple[float, ...] = ()
-    disconnect_reasons: tuple[str, ...] = ()
-    refused_connections: int = 0
-    messages_in: int = 0
-    bytes_in: int = 0
-    messages_out: int = 0
-    bytes_out: int = 0
-    dropped_out: int = 0
-    quota_errors: int = 0
-    bad_frames: int = 0
-    decode_errors: int = 0
-    missed_deadlines: int = 0
-    slow_periods: int = 0
-    warnings_sent: int = 0
-    round_trip_ms: dict[str, float | None] = field(default_factory=dict)  # p50 p90 p99 max
-    round_trip_samples: int = 0
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
 class SpoofingRecord:
     """Messages robots sent as another robot (``spoofing`` of ``sim_result.json`` and
     ``results.json``): ``total`` messages, ``attempts`` grouped by kind (the first ones)."""
@@ -131,7 +107,7 @@ class SimResult(Versioned):
     real_time_s: float = 0.0
     held_real_s: float = 0.0  # wall time the world was held (waiting for robots)
     real_time_factor: float = 0.0
-    robots: dict[str, RobotApiStats] = field(default_factory=dict)  # robot key -> API counters
+    robots: dict[str, dict[str, Any]] = field(default_factory=dict)  # robot key -> API statistics
     cameras: dict[str, Any] = field(default_factory=dict)
     started_unix_s: float = 0.0
     versions: dict[str, str] = field(default_factory=dict)  # distribution -> version
@@ -153,11 +129,4 @@ class SimResult(Versioned):
         return self.state == "FINISHED"
 
 
-__all__ = [
-    "PlayRecord",
-    "RobotApiStats",
-    "SimResult",
-    "SpoofingAttempt",
-    "SpoofingRecord",
-    "Winner",
-]
+__all__ = ["PlayRecord", "SimResult", "SpoofingAttempt", "SpoofingRecord", "Winner"]

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from contracts import files
 from contracts.match_results import (
@@ -21,7 +22,7 @@ from contracts.match_results import (
     RobotResult,
     Scalar,
 )
-from contracts.sim_result import RobotApiStats, SimResult
+from contracts.sim_result import SimResult
 
 
 @dataclass(slots=True, kw_only=True)
@@ -47,7 +48,7 @@ class RobotRecord:
     limits: dict[str, Scalar] = field(default_factory=dict)
     log_folder: LogFolderCopy | None = None  # what collection copied and skipped
 
-    def result(self, api: RobotApiStats | None, *, spoofing_attempts: int = 0) -> RobotResult:
+    def result(self, api: dict[str, Any] | None, *, spoofing_attempts: int = 0) -> RobotResult:
         return RobotResult(
             image=self.image,
             digest=self.digest,
@@ -84,7 +85,7 @@ def build_results(
     admission: AdmissionRecord | None = None,
 ) -> MatchResults:
     sim = sim_result
-    api_stats: dict[str, RobotApiStats] = sim.robots if sim is not None else {}
+    api_stats: dict[str, dict[str, Any]] = sim.robots if sim is not None else {}
     score = sim.score if sim is not None else None
     winner: str | None = sim.winner if sim is not None else None
     if forfeit is not None:
@@ -116,7 +117,7 @@ def build_results(
     )
 
 
-def team_warnings(robots: list[RobotRecord], api_stats: dict[str, RobotApiStats]) -> list[str]:
+def team_warnings(robots: list[RobotRecord], api_stats: dict[str, dict[str, Any]]) -> list[str]:
     """What a score alone hides: a team whose started robots all exited during the game, or
     none of which ever connected to the simulator."""
     warnings = []
@@ -128,7 +129,7 @@ def team_warnings(robots: list[RobotRecord], api_stats: dict[str, RobotApiStats]
             warnings.append(f"every robot of {color} exited during the game ("
                             + ", ".join(f"{r.key}: exit code {r.exit_code}" for r in started)
                             + ")")
-        if not any(r.key in api_stats and api_stats[r.key].connects for r in started):
+        if not any((api_stats.get(r.key) or {}).get("connects") for r in started):
             warnings.append(f"no robot of {color} ever connected to the simulator")
     return warnings
 

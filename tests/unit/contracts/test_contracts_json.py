@@ -20,7 +20,7 @@ from contracts.match_spec import (
     TeamSpec,
     TimingSpec,
 )
-from contracts.sim_result import RobotApiStats, SimResult, SpoofingRecord
+from contracts.sim_result import SimResult, SpoofingRecord
 from contracts.telemetry import StateMessage
 
 
@@ -58,8 +58,7 @@ def _result() -> SimResult:
         match_id="m1", seed=7, state="FINISHED", score={"red": 2, "blue": 1}, winner="red",
         events_summary={"goal": 3}, stop_reason="finished", stepping="lockstep",
         sim_time_ms=60000, real_time_s=61.5, held_real_s=1.0, real_time_factor=0.99,
-        robots={"red-1": RobotApiStats(connects=(1795446562.225,), bytes_out=10)},
-        cameras={"frames": 3},
+        robots={"red-1": {"connected": True, "bytes_sent": 10}}, cameras={"frames": 3},
         versions={"mujoco": "4.0.0"}, spoofing=SpoofingRecord(total=0),
         shootout={"red": {"kicks": 5, "scored": 3}}, coin_toss=False,
     )  # fmt: skip

@@ -22,7 +22,7 @@ from contracts.match_results import (
     Salvage,
     SalvagedRobot,
 )
-from contracts.sim_result import PlayRecord, RobotApiStats, SpoofingAttempt, SpoofingRecord
+from contracts.sim_result import PlayRecord, SpoofingAttempt, SpoofingRecord
 
 RESULT_KEYS = {
     "match_id", "seed", "warnings", "status", "failure", "forfeit", "final_state", "score",
@@ -55,8 +55,7 @@ def _played() -> MatchResults:
                 cpu_peak_percent=12.5, memory_peak_bytes=1000, sent_bytes=10, received_bytes=20,
                 limits={"nano_cpus": 4_000_000_000, "read_only_root": True, "cpuset": None,
                         "shaping_applied_ms": 1.5},
-                api=RobotApiStats(connects=(1.5,), round_trip_ms={"p50": 1.2, "max": None}),
-                log_folder=LogFolderCopy(
+                api={"connects": 1}, log_folder=LogFolderCopy(
                     files=2, bytes=30, skipped=({"path": "x", "kind": "symlink"},),
                     skipped_count=1),
                 spoofing_attempts=2),

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 
 from contracts.match_results import Forfeit, MatchLimits, MatchResults
-from contracts.sim_result import RobotApiStats, SimResult, SpoofingAttempt, SpoofingRecord
+from contracts.sim_result import SimResult, SpoofingAttempt, SpoofingRecord
 from orchestrator.match.results import RobotRecord, build_results
 
 LIMITS = MatchLimits(cpus=4.0, memory_gb=16.0, pids=1024, log_folder_gb=10.0,
@@ -21,7 +21,7 @@ def _attempt(sender: str | None, count: int) -> SpoofingAttempt:
 def test_spoofing_is_counted_per_sending_robot() -> None:
     sim = SimResult(
         match_id="m", seed=1, state="FINISHED", score={"red": 1, "blue": 0}, winner="red",
-        robots={"red-1": RobotApiStats(connects=(1.0,)), "blue-1": RobotApiStats(connects=(2.0,))},
+        robots={"red-1": {"connects": 1}, "blue-1": {"connects": 1}},
         spoofing=SpoofingRecord(total=7, attempts=(_attempt("red-1", 5), _attempt("red-1", 1),
                                                    _attempt(None, 1))),
     )  # fmt: skip
@@ -31,7 +31,7 @@ def test_spoofing_is_counted_per_sending_robot() -> None:
                             limits=LIMITS, versions={}, timings_s={}, failure=None)
     assert results.robots["red-1"].spoofing_attempts == 6
     assert results.robots["blue-1"].spoofing_attempts == 0
-    assert results.robots["red-1"].api == RobotApiStats(connects=(1.0,))
+    assert results.robots["red-1"].api == {"connects": 1}
     assert results.warnings == ()
     again = MatchResults.from_json(results.to_json())
     assert again == results and json.loads(results.to_json())["spoofing"]["total"] == 7
