@@ -141,12 +141,29 @@ def run_serve(args: argparse.Namespace) -> int:
 
 def run_team_add(args: argparse.Namespace) -> int:
     from service.admin import add_team
-    from service.db import transaction
+    from service.db import Team, transaction
+    from service.errors import PoolError
 
+    settings = _settings(args)
     with transaction(_sessions(args)) as session:
         team = add_team(session, name=args.name, email=args.email,
                         accepts_friendlies=args.accepts_friendlies)
-        print(json.dumps({"team": team.name, "id": team.id}))
+        session.flush()
+        result: dict[str, object] = {"team": team.name, "id": team.id}
+    if settings.pool == "slurm":  # the team's Slurm account now (else at its first match)
+        from service.accounts import ensure_team_account
+        from service.pool import make_pool
+
+        with transaction(_sessions(args)) as session:
+            row = session.get(Team, team.id)
+            assert row is not None
+            try:
+                result["slurm_account"] = ensure_team_account(session, make_pool(settings),
+                                                              row, settings)
+            except PoolError as exc:
+                print(f"hlvs: warning: no Slurm account yet ({exc}); it is made before the "
+                      "team's first test match", file=sys.stderr)
+    print(json.dumps(result))
     return 0
 
 

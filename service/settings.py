@@ -44,7 +44,12 @@ class Settings:
     stub_image: str = ""
     """Image of the stub opponent; empty: the project's stub image (built when missing)."""
     pool: str = "local"
-    """``local``: the Docker engine of this host."""
+    """``local``: the Docker engine of this host; ``slurm``: the Slurm cluster (each team's
+    test matches run under its own account, see :mod:`service.accounts`)."""
+    slurm_conf: str = ""
+    """The cluster's slurm.conf (empty: ``SLURM_CONF`` or Slurm's default)."""
+    slurm_max_queued: int = 5
+    """``MaxSubmitJobs`` of each team's Slurm account (its ``GrpJobs`` is 1)."""
     worker_poll_s: float = 1.0
     test_half_duration_s: float = 30.0
     test_players: int = 1

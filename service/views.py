@@ -40,7 +40,9 @@ class SubmissionView(BaseModel):
     finished_at: datetime | None
     queue_position: int | None = Field(description="1 = next to start; only while queued")
     expected_start: datetime | None
-    waiting_reason: str | None
+    waiting_reason: str | None = Field(description="why it waits: in the service's queue, or "
+                                       "in the cluster (e.g. Slurm's AssocGrpJobsLimit: the "
+                                       "team's account runs a match already)")
     match_id: str | None
     attempts: int
     cancel_requested: bool
@@ -113,7 +115,7 @@ def submission_view(session: Session, row: Submission, settings: Settings, *,
         started_at=utc(row.started_at) if row.started_at else None,
         finished_at=utc(row.finished_at) if row.finished_at else None,
         queue_position=info.position, expected_start=info.expected_start,
-        waiting_reason=info.reason, match_id=row.match_id, attempts=row.attempts,
+        waiting_reason=info.reason or row.pool_detail, match_id=row.match_id, attempts=row.attempts,
         cancel_requested=row.cancel_requested, charged=row.charged,
         failure_class=row.failure_class, failure_side=row.failure_side, cause=row.cause,
         preflight_s=round(row.preflight_s, 2) if row.preflight_s is not None else None,

@@ -18,6 +18,7 @@ import json
 import logging
 import threading
 import zlib
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -28,11 +29,12 @@ from contracts import files
 from contracts.errors import ContractError
 from contracts.match_results import FailureClass, MatchReport
 from service import matchfiles, notify, teamfiles
+from service.accounts import ensure_team_account, supports_accounts
 from service.aftermatch import replay_of, team_logs_of
 from service.db import MediaState, Submission, SubmissionState, Team, now, transaction
 from service.errors import PoolError, ServiceError
 from service.matchfiles import OWN_COLOR
-from service.pool import JobState, MatchJob
+from service.pool import JobState, JobStatus, MatchJob
 from service.submissions import STUB, failure_side, queue_paused
 
 if TYPE_CHECKING:
@@ -93,9 +95,10 @@ class QueueWorker:
                 [SubmissionState.STARTING.value, SubmissionState.RUNNING.value])).order_by(
                 Submission.seq)))
             for row in active:
-                before = (row.state, row.attempts, row.cancel_requested)
+                before = (row.state, row.attempts, row.cancel_requested, row.pool_detail)
                 self._follow(session, row)
-                changed |= before != (row.state, row.attempts, row.cancel_requested)
+                changed |= before != (row.state, row.attempts, row.cancel_requested,
+                                      row.pool_detail)
         while not self._stop.is_set():
             with transaction(sessions) as session:
                 if queue_paused(session):
@@ -154,7 +157,14 @@ class QueueWorker:
         return MatchJob(match_id=row.match_id, game_path=game, work_dir=work, requeue=True)
 
     def _submit(self, session: Session, row: Submission, job: MatchJob) -> None:
+        """Hand the match to the pool (under the team's account on a cluster); RUNNING once
+        the pool runs it, STARTING with the pool's reason while the pool keeps it waiting."""
         try:
+            if supports_accounts(self.pool):
+                team = session.get(Team, row.team_id)
+                assert team is not None
+                job = replace(job, account=ensure_team_account(session, self.pool, team,
+                                                               self.settings))
             handle = self.pool.submit(job)
         except PoolError as exc:
             log.error("submission %s: %s", row.id, exc)
@@ -162,7 +172,18 @@ class QueueWorker:
                       cause=str(exc))
             return
         row.pool_handle = handle
-        self._mark_running(session, row)
+        try:
+            status = self.pool.status(handle)
+        except ServiceError as exc:
+            log.warning("submission %s: pool status failed: %s", row.id, exc)
+            return  # the next round asks again
+        self._observe(session, row, status)
+
+    def _observe(self, session: Session, row: Submission, status: JobStatus) -> None:
+        """A match the pool has (pending or running): state and waiting reason from it."""
+        if status.state is JobState.RUNNING and row.state == SubmissionState.STARTING.value:
+            self._mark_running(session, row)
+        row.pool_detail = (status.detail or None) if status.state is JobState.PENDING else None
 
     def _mark_running(self, session: Session, row: Submission) -> None:
         row.state = SubmissionState.RUNNING.value
@@ -189,8 +210,7 @@ class QueueWorker:
             log.warning("submission %s: pool status failed: %s", row.id, exc)
             return
         if status.state in (JobState.RUNNING, JobState.PENDING):
-            if row.state == SubmissionState.STARTING.value:
-                self._mark_running(session, row)
+            self._observe(session, row, status)
             if row.cancel_requested and row.id not in self._cancel_sent:
                 self.pool.cancel(row.pool_handle)
                 self._cancel_sent.add(row.id)
@@ -233,6 +253,7 @@ class QueueWorker:
              cause: str | None, failure_class: str | None = None) -> None:
         row.state = state.value
         row.finished_at = now()
+        row.pool_detail = None
         row.cause = cause
         row.failure_class = failure_class
         row.failure_side = failure_side(failure_class)

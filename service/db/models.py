@@ -80,6 +80,7 @@ class Team(Base):
     accepts_friendlies: Mapped[bool] = mapped_column(Boolean, default=False)
     webhook_url: Mapped[str | None] = mapped_column(String(2000))
     webhook_secret: Mapped[str | None] = mapped_column(String(128))
+    slurm_account: Mapped[str | None] = mapped_column(String(64))  # made by service.accounts
     created_at: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=now)
 
 
@@ -147,6 +148,7 @@ class Submission(Base):
     video_detail: Mapped[str | None] = mapped_column(Text)
     delivery_state: Mapped[str | None] = mapped_column(String(16))  # see MediaState
     delivery_detail: Mapped[str | None] = mapped_column(Text)
+    pool_detail: Mapped[str | None] = mapped_column(Text)  # why a cluster keeps it waiting
 
 
 class Notification(Base):

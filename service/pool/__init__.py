@@ -83,9 +83,12 @@ def make_pool(settings: Settings) -> MatchPool:
     """The pool named by ``settings.pool``: ``local`` (this host's Docker engine) or ``slurm``
     (the cluster that ``SLURM_CONF`` names, see :mod:`service.pool.slurm`)."""
     if settings.pool == "slurm":
-        from service.pool.slurm import SlurmPool
+        from service.pool.slurm import HOST_NETNS, SlurmPool
 
-        return SlurmPool(slots=settings.match_slots)
+        # on a one-machine cluster (scripts/ensure-slurm.sh) the nodes reach Docker's networks
+        # through the host's network namespace
+        return SlurmPool(slots=settings.match_slots, slurm_conf=settings.slurm_conf or None,
+                         host_network=Path(HOST_NETNS).exists())
     from service.pool.local import LocalDockerPool
 
     return LocalDockerPool(slots=settings.match_slots)

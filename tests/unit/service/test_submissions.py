@@ -343,3 +343,12 @@ def test_a_failed_video_render_leaves_the_match_done(
         assert "replay" in ended["video"]["detail"]
         video = http.get(f"/v1/submissions/{sid}/video")
         assert video.status_code == 404 and "video failed" in video.json()["message"]
+
+
+def test_slurm_account_names_are_per_team_and_slurm_safe() -> None:
+    from service.accounts import account_name
+
+    assert account_name(7, "Red Robots") == "hlvs_t7_red_robots"
+    assert account_name(8, "Red.Robots") == "hlvs_t8_red_robots"  # the id keeps them apart
+    assert account_name(9, "..") == "hlvs_t9"
+    assert len(account_name(10, "x" * 64)) <= 40
