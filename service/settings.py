@@ -50,6 +50,9 @@ class Settings:
     """The cluster's slurm.conf (empty: ``SLURM_CONF`` or Slurm's default)."""
     slurm_max_queued: int = 5
     """``MaxSubmitJobs`` of each team's Slurm account (its ``GrpJobs`` is 1)."""
+    placement: str = "dense"
+    """With the Slurm pool: ``dense``, a whole match on one node; ``league``, the simulator on a
+    node and each robot on a node of its own (docs/slurm.md)."""
     worker_poll_s: float = 1.0
     test_half_duration_s: float = 30.0
     test_players: int = 1
@@ -133,6 +136,12 @@ def _convert(name: str, raw: str, current: object) -> object:
 def _check(settings: Settings) -> None:
     if settings.pool not in ("local", "slurm"):
         raise SettingsError(name=PREFIX + "POOL", value=settings.pool, expected="local or slurm")
+    if settings.placement not in ("dense", "league"):
+        raise SettingsError(name=PREFIX + "PLACEMENT", value=settings.placement,
+                            expected="dense or league")
+    if settings.placement == "league" and settings.pool != "slurm":
+        raise SettingsError(name=PREFIX + "PLACEMENT", value=settings.placement,
+                            expected=f"dense, or {PREFIX}POOL=slurm (a node per robot)")
     if settings.preflight not in ("full", "images"):
         raise SettingsError(name=PREFIX + "PREFLIGHT", value=settings.preflight,
                             expected="full or images")

@@ -154,7 +154,16 @@ class QueueWorker:
             stub_image=None if opponent_doc else self._stub(), settings=self.settings,
             seed=zlib.crc32(row.match_id.encode()))
         # test matches: a cluster pool plays one again after a node failure
-        return MatchJob(match_id=row.match_id, game_path=game, work_dir=work, requeue=True)
+        return MatchJob(match_id=row.match_id, game_path=game, work_dir=work, requeue=True,
+                        robot_nodes=self._robot_nodes(game))
+
+    def _robot_nodes(self, game: Path) -> int:
+        """League placement: a node for each robot (0: dense placement)."""
+        if self.settings.placement != "league":
+            return 0
+        from orchestrator.match.plan import robots_in_game
+
+        return robots_in_game(game)
 
     def _submit(self, session: Session, row: Submission, job: MatchJob) -> None:
         """Hand the match to the pool (under the team's account on a cluster); RUNNING once
@@ -197,10 +206,12 @@ class QueueWorker:
             if row.match_id is None:
                 row.state = SubmissionState.QUEUED.value
                 return
-            job = MatchJob(match_id=row.match_id, game_path=self._work_dir(row.match_id)
-                           / "config" / "game.json", work_dir=self._work_dir(row.match_id),
-                           requeue=True)
-            if not job.game_path.is_file():
+            game = self._work_dir(row.match_id) / "config" / "game.json"
+            if game.is_file():
+                job = MatchJob(match_id=row.match_id, game_path=game,
+                               work_dir=self._work_dir(row.match_id), requeue=True,
+                               robot_nodes=self._robot_nodes(game))
+            else:
                 job = self._prepare(session, row)
             self._submit(session, row, job)
             return

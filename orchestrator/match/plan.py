@@ -130,6 +130,14 @@ def spec_dict(
     return replace(spec, red=teams["red"], blue=teams["blue"]).to_dict()
 
 
+def robots_in_game(game_path: Path) -> int:
+    """How many robots the match of ``game_path`` plays (both teams): the nodes a
+    league-placement job asks for besides the simulator's."""
+    from orchestrator.config.loader import load_game
+
+    return len(plan_from_game(load_game(game_path)).robots)
+
+
 def per_robot_rate_mb_s(team_rate_mb_s: float, n_robots: int) -> float:
     return team_rate_mb_s / max(1, n_robots) if math.isfinite(team_rate_mb_s) else team_rate_mb_s
 
@@ -141,5 +149,6 @@ __all__ = [
     "TeamPlan",
     "per_robot_rate_mb_s",
     "plan_from_game",
+    "robots_in_game",
     "spec_dict",
 ]

@@ -266,7 +266,6 @@ def _robot_nodes(pool: SchedulePool, game: Path) -> int:
     """League placement: a node for each robot of the match (0: dense placement)."""
     if pool.placement != "league":
         return 0
-    from orchestrator.config.loader import load_game
-    from orchestrator.match.plan import plan_from_game
+    from orchestrator.match.plan import robots_in_game
 
-    return len(plan_from_game(load_game(game, images_required=False)).robots)
+    return robots_in_game(game)

@@ -169,3 +169,40 @@ def test_league_schedule_asks_a_node_per_robot(tmp_path: Path) -> None:
     game = scrimmage.write_files(args, tmp_path / "config")
     assert _robot_nodes(SchedulePool(kind="slurm", placement="league"), game) == 4
     assert _robot_nodes(SchedulePool(kind="slurm"), game) == 0
+
+
+def test_service_placement_setting(tmp_path: Path) -> None:
+    from service.errors import SettingsError
+    from service.settings import Settings
+
+    base = {"HLVS_SERVICE_DATA_DIR": str(tmp_path)}
+    found = Settings.from_env({**base, "HLVS_SERVICE_POOL": "slurm",
+                               "HLVS_SERVICE_PLACEMENT": "league"})
+    assert (found.pool, found.placement) == ("slurm", "league")
+    assert Settings.from_env(base).placement == "dense"
+    for env, expected in (({"HLVS_SERVICE_PLACEMENT": "league"}, "POOL=slurm"),
+                          ({"HLVS_SERVICE_POOL": "slurm", "HLVS_SERVICE_PLACEMENT": "spread"},
+                           "dense or league")):
+        with pytest.raises(SettingsError) as err:
+            Settings.from_env({**base, **env})
+        assert "HLVS_SERVICE_PLACEMENT" in str(err.value) and expected in str(err.value)
+
+
+def test_service_worker_asks_a_node_per_robot_in_league_placement(tmp_path: Path) -> None:
+    import argparse
+    from types import SimpleNamespace
+
+    from orchestrator.commands.scrimmage_args import add_arguments
+    from orchestrator.match import scrimmage
+    from service.settings import Settings
+    from service.worker import QueueWorker
+
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    game = scrimmage.write_files(parser.parse_args(["--players", "3", "--out", str(tmp_path)]),
+                                 tmp_path / "config")
+    for env, nodes in (({"HLVS_SERVICE_POOL": "slurm", "HLVS_SERVICE_PLACEMENT": "league"}, 6),
+                       ({"HLVS_SERVICE_POOL": "slurm"}, 0)):
+        settings = Settings.from_env({"HLVS_SERVICE_DATA_DIR": str(tmp_path), **env})
+        worker = QueueWorker(SimpleNamespace(settings=settings, pool=None))  # type: ignore[arg-type]
+        assert worker._robot_nodes(game) == nodes
