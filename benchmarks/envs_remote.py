@@ -135,6 +135,7 @@ def bench_remotes(
         "vector_env_steps_per_s": rates,
         "vector": vector,
         "vector_repeats": repeats,
+        "transport": "unix" if getattr(pool.addresses[0], "path", None) else "tcp",
         "remotes_started": count,
         "remotes_start_s": round(start_s, 2),
         "load_average": {"before": [round(v, 2) for v in load_before],

@@ -1,5 +1,6 @@
-"""``python -m simulator remote --port 7700`` (the simulator image started with ``remote``):
-serve learning sessions over the remote protocol (:mod:`envs.wire`), one client at a time.
+"""``python -m simulator remote --port 7700 [--unix PATH]`` (the simulator image started with
+``remote``): serve learning sessions over the remote protocol (:mod:`envs.wire`) on a TCP port
+and optionally a Unix socket, one client at a time.
 
 The session runs in this process exactly as in-process (:class:`envs.session.LocalSession`), so
 an episode over a remote equals the same seeded episode in-process. A second client while one is
@@ -42,38 +43,58 @@ TRAINER_OPS = ("place_ball", "place_robot", "set_game_state", "drop_ball")
 
 
 class RemoteServer:
-    def __init__(self, *, host: str, port: int) -> None:
+    """Serves on a TCP port and, with ``unix_path``, also on a Unix socket (bound first: when
+    the port answers, the socket does too); one client at a time over both."""
+
+    def __init__(self, *, host: str, port: int, unix_path: str | None = None) -> None:
+        self.listeners: list[socket.socket] = []
+        if unix_path is not None:
+            if os.path.exists(unix_path):
+                os.unlink(unix_path)
+            unix = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+            unix.bind(unix_path)
+            os.chmod(unix_path, 0o666)  # like a port on 127.0.0.1: any local user may connect
+            unix.listen()
+            self.listeners.append(unix)
         self.listener = socket.create_server((host, port), reuse_port=False)
+        self.listeners.append(self.listener)
         self.port = int(self.listener.getsockname()[1])
         self.busy = threading.Lock()
         self.stopping = threading.Event()
 
     def serve_forever(self) -> None:
-        self.listener.settimeout(0.5)
+        for extra in self.listeners[:-1]:
+            threading.Thread(target=self._accept, args=(extra,), daemon=True).start()
+        self._accept(self.listener)
+
+    def _accept(self, listener: socket.socket) -> None:
+        listener.settimeout(0.5)
         while not self.stopping.is_set():
             try:
-                conn, peer = self.listener.accept()
+                conn, peer = listener.accept()
             except TimeoutError:
                 continue
             except OSError:
                 break
+            where = f"{peer[0]}:{peer[1]}" if isinstance(peer, tuple) else "unix socket"
             if not self.busy.acquire(blocking=False):
-                log.info("refused %s:%d: a client is being served", *peer[:2])
+                log.info("refused %s: a client is being served", where)
                 _refuse(conn)
                 continue
-            threading.Thread(target=self._serve, args=(conn, peer), daemon=True).start()
+            threading.Thread(target=self._serve, args=(conn, where), daemon=True).start()
 
     def close(self) -> None:
         self.stopping.set()
-        self.listener.close()
+        for listener in self.listeners:
+            listener.close()
 
-    def _serve(self, conn: socket.socket, peer: Any) -> None:
-        where = f"{peer[0]}:{peer[1]}"
+    def _serve(self, conn: socket.socket, where: str) -> None:
         log.info("client %s connected", where)
         session: LocalSession | None = None
         released = False
         try:
-            conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            if conn.family != socket.AF_UNIX:
+                conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
             conn.sendall(WELCOME)
             reader = FrameReader(conn)
             while True:
@@ -171,6 +192,7 @@ def main(argv: list[str]) -> int:
     )
     parser.add_argument("--host", default="0.0.0.0", help="address to listen on")
     parser.add_argument("--port", type=int, default=7700, help="TCP port")
+    parser.add_argument("--unix", default=None, help="also serve on this Unix socket path")
     parser.add_argument("--log-level", default="INFO", help="logging level")
     args = parser.parse_args(argv)
     if not os.environ.get("DISPLAY"):
@@ -181,9 +203,10 @@ def main(argv: list[str]) -> int:
         format="%(asctime)s %(levelname)s %(name)s: %(message)s",
     )  # fmt: skip
     try:
-        server = RemoteServer(host=args.host, port=args.port)
+        server = RemoteServer(host=args.host, port=args.port, unix_path=args.unix)
     except OSError as exc:
-        log.error("cannot listen on %s:%d: %s", args.host, args.port, exc)
+        log.error("cannot listen on %s:%d%s: %s", args.host, args.port,
+                  f" and {args.unix}" if args.unix else "", exc)  # fmt: skip
         return 3
 
     def stop(signum: int, _frame: FrameType | None) -> None:
@@ -192,6 +215,7 @@ def main(argv: list[str]) -> int:
 
     signal.signal(signal.SIGTERM, stop)
     signal.signal(signal.SIGINT, stop)
-    log.info("learning sessions on %s:%d", args.host, server.port)
+    log.info("learning sessions on %s:%d%s", args.host, server.port,
+             f" and {args.unix}" if args.unix else "")  # fmt: skip
     server.serve_forever()
     return 0

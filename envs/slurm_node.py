@@ -94,7 +94,7 @@ def serve(args: argparse.Namespace, stop: threading.Event) -> int:
     labels = {LABEL_SLURM_JOB: job_id} if job_id else {}
     launcher = DockerLauncher(
         image=args.image, labels=labels, health_timeout_s=args.health_timeout_s,
-        publish_host="0.0.0.0" if args.advertise == "node" else "127.0.0.1",
+        publish_host="0.0.0.0" if args.advertise == "node" else "127.0.0.1", unix=False,
     )  # fmt: skip
     try:
         try:

@@ -235,7 +235,7 @@ class SlurmLauncher:
                     address = RemoteAddress(str(found["host"]), int(str(found["port"])))
                     job.node = str(found.get("node") or job.node)
                     try:
-                        probe(address.host, address.port)
+                        probe(address)
                     except (OSError, WireError) as exc:
                         reasons[job.job_id] = f"reported {address}, which does not answer: {exc}"
                     else:

@@ -9,6 +9,7 @@ import subprocess
 import sys
 import time
 from collections.abc import Iterator
+from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
@@ -26,10 +27,11 @@ def _free_port() -> int:
         return int(s.getsockname()[1])
 
 
-def _start_server() -> tuple[subprocess.Popen[bytes], int]:
+def _start_server(unix: Path) -> tuple[subprocess.Popen[bytes], int]:
     port = _free_port()
     proc = subprocess.Popen(
-        [sys.executable, "-m", "simulator", "remote", "--host", "127.0.0.1", "--port", str(port)],
+        [sys.executable, "-m", "simulator", "remote", "--host", "127.0.0.1", "--port", str(port),
+         "--unix", str(unix)],  # fmt: skip
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
     )
@@ -48,8 +50,8 @@ def _start_server() -> tuple[subprocess.Popen[bytes], int]:
 
 
 @pytest.fixture
-def remote() -> Iterator[tuple[subprocess.Popen[bytes], int]]:
-    proc, port = _start_server()
+def remote(tmp_path: Path) -> Iterator[tuple[subprocess.Popen[bytes], int]]:
+    proc, port = _start_server(tmp_path / "remote.sock")
     yield proc, port
     if proc.poll() is None:
         proc.send_signal(signal.SIGTERM)
@@ -69,7 +71,7 @@ def _episode(env: gym.Env, seed: int, steps: int) -> list[tuple[bytes, float]]: 
 
 
 def test_remote_episode_equals_the_in_process_episode(
-    remote: tuple[subprocess.Popen[bytes], int],
+    remote: tuple[subprocess.Popen[bytes], int], tmp_path: Path
 ) -> None:
     _, port = remote
     env = gym.make("hlvs/Kick-v0", remotes=f"hlvs://127.0.0.1:{port}", perception=True)
@@ -78,13 +80,17 @@ def test_remote_episode_equals_the_in_process_episode(
     with pytest.raises(TrainerError):
         env.unwrapped.trainer.set_game_state("PLAYING")  # a skill session has no referee
     env.close()
+    socket_url = f"hlvs+unix://{tmp_path / 'remote.sock'}"
+    env = gym.make("hlvs/Kick-v0", remotes=socket_url, perception=True)
+    over_unix = _episode(env, 11, 120)
+    env.close()
     local = gym.make("hlvs/Kick-v0", perception=True)
-    assert _episode(local, 11, 120) == over_tcp
+    assert _episode(local, 11, 120) == over_tcp == over_unix
     local.close()
 
 
 def test_match_over_a_remote_and_second_client_refused(
-    remote: tuple[subprocess.Popen[bytes], int],
+    remote: tuple[subprocess.Popen[bytes], int], tmp_path: Path
 ) -> None:
     _, port = remote
     env = gym.make("hlvs/Match-v0", remotes=f"hlvs://127.0.0.1:{port}", half_duration_s=5.0)
@@ -94,6 +100,9 @@ def test_match_over_a_remote_and_second_client_refused(
     assert info["game"]["state"] == "PLAYING"
     with pytest.raises(RemoteError) as refused:
         RemoteSession(RemoteAddress("127.0.0.1", port), SessionSpec())
+    assert "already serves" in str(refused.value)
+    with pytest.raises(RemoteError) as refused:  # one client over both the port and the socket
+        RemoteSession(parse_remotes(f"hlvs+unix://{tmp_path / 'remote.sock'}")[0], SessionSpec())
     assert "already serves" in str(refused.value)
     env.close()
 
@@ -122,6 +131,10 @@ def test_bad_addresses_are_refused_with_the_field() -> None:
         parse_remotes("hlvs://nohost")
     assert bad.value.field == "remotes"
     assert parse_remotes("hlvs://a:1,b:2") == [RemoteAddress("a", 1), RemoteAddress("b", 2)]
+    assert parse_remotes("hlvs+unix:///run/r.sock")[0].path == "/run/r.sock"
+    with pytest.raises(envs.EnvConfigError) as bad:
+        parse_remotes("hlvs+unix://relative.sock")
+    assert "absolute" in bad.value.expected
     with pytest.raises(RemoteError) as refused:
         gym.make("hlvs/Kick-v0", remotes=f"hlvs://127.0.0.1:{_free_port()}")
     assert "cannot connect" in str(refused.value)

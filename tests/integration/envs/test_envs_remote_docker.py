@@ -26,7 +26,10 @@ def test_one_remote_container_runs_an_episode_and_is_replaced_after_a_crash(
     env = gym.make("hlvs/Kick-v0", remotes=1)
     pool = env.unwrapped._owner
     pool_id = pool.launcher.pool_id
+    socket_root = pool.launcher.socket_root
     try:
+        # a local engine: the remote answers on its Unix socket (mounted from a folder of ours)
+        assert str(pool.addresses[0]).startswith(f"hlvs+unix://{socket_root}/")
         obs, info = env.reset(seed=3)
         steps = 0
         for _ in range(100):
@@ -47,6 +50,7 @@ def test_one_remote_container_runs_an_episode_and_is_replaced_after_a_crash(
     finally:
         env.close()
     assert _pool_containers(docker_client, pool_id) == []
+    assert not socket_root.exists()
 
 
 def test_vector_env_over_two_remotes(docker_client: docker.DockerClient) -> None:
