@@ -13,9 +13,10 @@ try it again.
 
 When the worker ends a submission whose match left a replay, it marks the video ``pending``
 (:class:`service.db.MediaState`). This thread renders it with ``hlvs render`` (the simulator's
-offscreen renderer, which picks ``MUJOCO_GL`` itself) in a process of its own at a lower CPU
-priority, one render at a time, into ``public/match.mp4`` of the match output (written under
-another name and renamed, so a download never gets half a file). The state becomes ``ready``,
+offscreen renderer, which picks ``MUJOCO_GL`` itself) in a process of its own at the idle CPU
+priority (``SCHED_IDLE``: a match playing meanwhile keeps its CPU), one render at a time,
+into ``public/match.mp4`` of the match output (written under another name and renamed, so a
+download never gets half a file). The state becomes ``ready``,
 or ``failed`` with the cause; either way the submission's outcome stays what the match gave, and
 the match was over before the render began, so a video never makes a match slower.
 
@@ -29,6 +30,7 @@ from __future__ import annotations
 import json
 import logging
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -223,7 +225,7 @@ class AfterMatch:
         s = self.settings
         partial = out / "public" / PARTIAL_VIDEO_FILE
         partial.unlink(missing_ok=True)
-        command = ["nice", "-n", "10", self.python, "-m", "simulator", "render",
+        command = [*_idle_priority(), self.python, "-m", "simulator", "render",
                    str(replay_of(out)), "-o", str(partial), "--width", str(s.video_width),
                    "--height", str(s.video_height), "--fps", f"{s.video_fps:g}"]
         work.mkdir(parents=True, exist_ok=True)
@@ -278,6 +280,12 @@ class AfterMatch:
         row.video_detail = detail
         log.log(logging.WARNING if state is MediaState.FAILED else logging.INFO,
                 "submission %s: video %s (%s)", row.id, state.value, detail)
+
+
+def _idle_priority() -> list[str]:
+    """Run at the idle CPU priority (SCHED_IDLE: CPU time nothing else wants, so a match
+    playing meanwhile is not slowed), or at the lowest nice level without ``chrt``."""
+    return ["chrt", "--idle", "0"] if shutil.which("chrt") else ["nice", "-n", "19"]
 
 
 def _read_json(path: Path) -> dict[str, object]:

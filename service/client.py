@@ -180,9 +180,10 @@ def run_submit(args: argparse.Namespace) -> int:
         print(f"hlvs: {status['id']} queued; waiting for it to end", file=sys.stderr)
         last = None
         while status["state"] not in FINAL_STATES:
-            line = f"{status['state']}" + (f", position {status['queue_position']}, "
-                                           f"{status['waiting_reason']}"
-                                           if status.get("queue_position") else "")
+            line = (f"{status['state']}"
+                    + (f", position {status['queue_position']}" if status.get("queue_position")
+                       else "")
+                    + (f", {status['waiting_reason']}" if status.get("waiting_reason") else ""))
             if line != last:
                 print(f"hlvs: {status['id']}: {line}", file=sys.stderr)
                 last = line
