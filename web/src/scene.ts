@@ -37,44 +37,6 @@ function colour(rgb: number[]): THREE.Color {
   return new THREE.Color().setRGB(rgb[0], rgb[1], rgb[2], THREE.SRGBColorSpace);
 }
 
-function checker(spec: NonNullable<GeomSpec["pattern"]>): THREE.Texture {
-  const canvas = document.createElement("canvas");
-  canvas.width = canvas.height = 64;
-  const ctx = canvas.getContext("2d")!;
-  const css = spec.colors.map((c) => `#${colour(c).getHexString(THREE.SRGBColorSpace)}`);
-  for (let y = 0; y < 2; y++) {
-    for (let x = 0; x < 2; x++) {
-      ctx.fillStyle = css[(x + y) % 2];
-      ctx.fillRect(x * 32, y * 32, 32, 32);
-    }
-  }
-  const texture = new THREE.CanvasTexture(canvas);
-  texture.colorSpace = THREE.SRGBColorSpace;
-  texture.wrapS = texture.wrapT = THREE.RepeatWrapping;
-  texture.magFilter = THREE.NearestFilter;
-  const [u, v] = spec.cube ? [2, 2] : spec.repeat;
-  texture.repeat.set(u, v);
-  return texture;
-}
-
-function geometry(g: GeomSpec): THREE.BufferGeometry {
-  const [a, b, c] = g.size;
-  switch (g.type) {
-    case "plane":
-      return new THREE.PlaneGeometry(2 * a, 2 * b);
-    case "box":
-      return new THREE.BoxGeometry(2 * a, 2 * b, 2 * c);
-    case "capsule":
-      return new THREE.CapsuleGeometry(a, 2 * b, 2, 8).rotateX(Math.PI / 2);
-    case "cylinder":
-      return new THREE.CylinderGeometry(a, a, 2 * b, 12).rotateX(Math.PI / 2);
-    case "ellipsoid":
-      return new THREE.SphereGeometry(1, 12, 8).scale(a, b, c);
-    default:
-      return new THREE.SphereGeometry(a, 16, 10);
-  }
-}
-
 function numberSprite(robot: RobotSpec): THREE.Sprite {
   const canvas = document.createElement("canvas");
   canvas.width = canvas.height = 64;
@@ -96,87 +58,202 @@ function numberSprite(robot: RobotSpec): THREE.Sprite {
   return sprite;
 }
 
-/** One geom's triangles in its body's frame, with a colour per vertex (a checker pattern
- * alternates colours per triangle, which reads as a football on a low-poly sphere). */
-function bodyGeometry(g: GeomSpec): THREE.BufferGeometry {
-  const shape = geometry(g).toNonIndexed();
+/** A unit primitive that geoms are drawn as (scaled by their sizes): boxes, spheres (also
+ * ellipsoids and unknown shapes), cylinders; a capsule is an open tube with a low-poly sphere
+ * at each end. Few triangles: software WebGL pays for each one, however small on screen. */
+type Primitive = "box" | "sphere" | "cylinder" | "tube" | "cap";
+
+function unitGeometry(kind: Primitive): THREE.BufferGeometry {
+  const shape =
+    kind === "box" ? new THREE.BoxGeometry(2, 2, 2)
+    : kind === "sphere" ? new THREE.SphereGeometry(1, 10, 6)
+    : kind === "cap" ? new THREE.SphereGeometry(1, 6, 4)
+    : kind === "tube" ? new THREE.CylinderGeometry(1, 1, 2, 8, 1, true).rotateX(Math.PI / 2)
+    : new THREE.CylinderGeometry(1, 1, 2, 12).rotateX(Math.PI / 2); // along z like MuJoCo's
   shape.deleteAttribute("uv");
-  shape.applyMatrix4(new THREE.Matrix4().compose(
-    new THREE.Vector3(g.pos[0], g.pos[1], g.pos[2]),
-    new THREE.Quaternion(g.quat[1], g.quat[2], g.quat[3], g.quat[0]),
-    new THREE.Vector3(1, 1, 1),
-  ));
-  const count = shape.getAttribute("position").count;
-  const colours = new Float32Array(count * 3);
-  const pattern = g.pattern && g.type !== "plane" ? g.pattern.colors.map(colour) : null;
-  const plain = colour(g.rgba);
-  for (let v = 0; v < count; v++) {
-    const c = pattern ? pattern[Math.floor(v / 3) % 2] : plain;
-    colours.set([c.r, c.g, c.b], v * 3);
-  }
-  shape.setAttribute("color", new THREE.BufferAttribute(colours, 3));
-  const index = new Uint16Array(count * 4);
-  const weight = new Float32Array(count * 4);
-  for (let v = 0; v < count; v++) {
-    index[v * 4] = g.body;
-    weight[v * 4] = 1;
-  }
-  shape.setAttribute("skinIndex", new THREE.BufferAttribute(index, 4));
-  shape.setAttribute("skinWeight", new THREE.BufferAttribute(weight, 4));
   return shape;
 }
 
+/** One piece of a geom: a unit primitive placed in its body's frame. */
+interface Piece {
+  kind: Primitive;
+  local: THREE.Matrix4;
+}
+
+/** A geom as unit primitives in its body's frame (a capsule is a cylinder and two spheres). */
+function pieces(g: GeomSpec): Piece[] {
+  const [a, b, c] = g.size;
+  const frame = new THREE.Matrix4().compose(
+    new THREE.Vector3(g.pos[0], g.pos[1], g.pos[2]),
+    new THREE.Quaternion(g.quat[1], g.quat[2], g.quat[3], g.quat[0]),
+    new THREE.Vector3(1, 1, 1),
+  );
+  const scaled = (x: number, y: number, z: number, dz = 0): THREE.Matrix4 =>
+    frame.clone().multiply(new THREE.Matrix4().makeTranslation(0, 0, dz)).scale(new THREE.Vector3(x, y, z));
+  switch (g.type) {
+    case "box":
+      return [{ kind: "box", local: scaled(a, b, c) }];
+    case "cylinder":
+      return [{ kind: "cylinder", local: scaled(a, a, b) }];
+    case "capsule":
+      return [
+        { kind: "tube", local: scaled(a, a, b) },
+        { kind: "cap", local: scaled(a, a, a, b) },
+        { kind: "cap", local: scaled(a, a, a, -b) },
+      ];
+    case "ellipsoid":
+      return [{ kind: "sphere", local: scaled(a, b, c) }];
+    default:
+      return [{ kind: "sphere", local: scaled(a, a, a) }];
+  }
+}
+
+/** A sphere whose triangles alternate the pattern's two colours (a football on a low-poly
+ * sphere), in its geom's frame. */
+function patternedSphere(g: GeomSpec, colours: THREE.Color[]): THREE.BufferGeometry {
+  const shape = new THREE.SphereGeometry(g.size[0], 16, 10).toNonIndexed();
+  shape.deleteAttribute("uv");
+  const count = shape.getAttribute("position").count;
+  const rgb = new Float32Array(count * 3);
+  for (let v = 0; v < count; v++) {
+    const c = colours[Math.floor(v / 3) % 2];
+    rgb.set([c.r, c.g, c.b], v * 3);
+  }
+  shape.setAttribute("color", new THREE.BufferAttribute(rgb, 3));
+  return shape;
+}
+
+/** The turf's checker pattern as coloured quads (no texture to sample: the turf covers most
+ * pixels, and software WebGL pays for every texture read). Same cells as the texture MuJoCo
+ * describes: two colours, 2 x repeat cells across the plane, multiplied by `tint`. */
+function turfGeometry(g: GeomSpec, tint: THREE.Color): THREE.BufferGeometry {
+  const pattern = g.pattern!;
+  const [halfX, halfY] = g.size;
+  const colours = pattern.colors.map((c) => colour(c).multiply(tint));
+  const nx = Math.ceil(2 * pattern.repeat[0] - 1e-6);
+  const ny = Math.ceil(2 * pattern.repeat[1] - 1e-6);
+  const cellX = (2 * halfX) / (2 * pattern.repeat[0]);
+  const cellY = (2 * halfY) / (2 * pattern.repeat[1]);
+  const position = new Float32Array(nx * ny * 18);
+  const rgb = new Float32Array(nx * ny * 18);
+  let o = 0;
+  for (let j = 0; j < ny; j++) {
+    for (let i = 0; i < nx; i++) {
+      const x0 = -halfX + i * cellX;
+      const x1 = Math.min(halfX, x0 + cellX);
+      const y0 = -halfY + j * cellY;
+      const y1 = Math.min(halfY, y0 + cellY);
+      const c = colours[(i + j + 1) % 2]; // the texture's first row is its top (flipY)
+      for (const [x, y] of [[x0, y0], [x1, y0], [x1, y1], [x0, y0], [x1, y1], [x0, y1]]) {
+        position.set([x, y, 0], o);
+        rgb.set([c.r, c.g, c.b], o);
+        o += 3;
+      }
+    }
+  }
+  const shape = new THREE.BufferGeometry();
+  shape.setAttribute("position", new THREE.BufferAttribute(position, 3));
+  shape.setAttribute("color", new THREE.BufferAttribute(rgb, 3));
+  return shape;
+}
+
+interface Instanced {
+  mesh: THREE.InstancedMesh;
+  bodies: number[]; // per instance
+  locals: THREE.Matrix4[]; // per instance, in its body's frame
+}
+
 /**
- * The scene in few draw calls (software WebGL pays per call): every opaque geom of every body
- * is merged into one skinned mesh with one bone per body, posed by setting the bones; the
- * turf (textured) and the see-through nets are meshes of their own.
+ * The scene in few draw calls and little work per frame (software WebGL pays per call, per
+ * vertex and per pixel): the static world (lines, goals) merged into one mesh; every moving
+ * geom an instance of a few unit primitives (boxes, spheres, cylinders, capsule tubes and ends),
+ * one instanced mesh each, whose instance matrices are the only thing that changes per frame;
+ * the turf as flat-coloured quads.
  */
 export class SceneView {
   readonly renderer: THREE.WebGLRenderer;
   readonly camera: THREE.PerspectiveCamera;
   readonly scene = new THREE.Scene();
-  readonly bones: THREE.Bone[] = [];
+  private readonly instanced: Instanced[] = [];
+  private readonly posed: { object: THREE.Object3D; body: number; local: THREE.Matrix4 }[] = [];
+  private readonly bodies: THREE.Matrix4[];
   private readonly labels: { sprite: THREE.Sprite; body: number }[] = [];
   private readonly controls: OrbitControls;
+  private readonly position = new THREE.Vector3();
+  private readonly rotation = new THREE.Quaternion();
+  private readonly unit = new THREE.Vector3(1, 1, 1);
+  private readonly product = new THREE.Matrix4();
   frames = 0;
 
   constructor(readonly canvas: HTMLCanvasElement, readonly spec: SceneSpec) {
-    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: false, preserveDrawingBuffer: true });
+    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: false });
     this.renderer.setPixelRatio(1);
     this.scene.background = new THREE.Color(0x9ab8d8);
     this.scene.add(new THREE.HemisphereLight(0xffffff, 0x445544, 1.6));
     const sun = new THREE.DirectionalLight(0xffffff, 1.4);
     sun.position.set(2, 3, 10);
     this.scene.add(sun);
-    for (let i = 0; i < spec.bodies.length; i++) {
-      const bone = new THREE.Bone();
-      bone.name = spec.bodies[i];
-      this.bones.push(bone);
-      this.scene.add(bone);
-    }
-    const opaque: THREE.BufferGeometry[] = [];
-    const seeThrough: THREE.BufferGeometry[] = [];
+    this.bodies = spec.bodies.map(() => new THREE.Matrix4());
+    const staticParts: [THREE.BufferGeometry[], THREE.BufferGeometry[]] = [[], []];
+    const moving = new Map<string, { kind: Primitive; transparent: boolean; bodies: number[]; locals: THREE.Matrix4[]; colours: THREE.Color[] }>();
     for (const g of spec.geoms) {
       if (g.group >= 3) continue; // MuJoCo's hidden groups (collision-only helpers)
+      const transparent = g.rgba[3] < 1;
       if (g.type === "plane" && g.pattern) {
         // unlit: a flat plane is evenly lit anyway, and the cheapest shader covers most pixels
-        const turf = new THREE.Mesh(geometry(g), new THREE.MeshBasicMaterial({ map: checker(g.pattern), color: 0xbbbbbb }));
+        const turf = new THREE.Mesh(turfGeometry(g, new THREE.Color(0xbbbbbb)), new THREE.MeshBasicMaterial({ vertexColors: true }));
         turf.position.set(g.pos[0], g.pos[1], g.pos[2] - 0.0005);
         turf.name = g.name;
         this.scene.add(turf);
         continue;
       }
-      (g.rgba[3] < 1 ? seeThrough : opaque).push(bodyGeometry(g));
+      if (g.pattern && g.type === "sphere") {
+        const mesh = new THREE.Mesh(patternedSphere(g, g.pattern.colors.map(colour)), new THREE.MeshLambertMaterial({ vertexColors: true }));
+        mesh.name = g.name;
+        mesh.matrixAutoUpdate = false;
+        const local = new THREE.Matrix4().compose(
+          new THREE.Vector3(g.pos[0], g.pos[1], g.pos[2]),
+          new THREE.Quaternion(g.quat[1], g.quat[2], g.quat[3], g.quat[0]), this.unit);
+        this.posed.push({ object: mesh, body: g.body, local });
+        this.scene.add(mesh);
+        continue;
+      }
+      for (const piece of pieces(g)) { // other patterned shapes: in their mean colour (rgba)
+        if (g.body === 0) {
+          const part = unitGeometry(piece.kind).applyMatrix4(piece.local);
+          const count = part.getAttribute("position").count;
+          const c = colour(g.rgba);
+          const rgb = new Float32Array(count * 3);
+          for (let v = 0; v < count; v++) rgb.set([c.r, c.g, c.b], v * 3);
+          part.setAttribute("color", new THREE.BufferAttribute(rgb, 3));
+          staticParts[transparent ? 1 : 0].push(part);
+          continue;
+        }
+        const key = `${piece.kind}:${transparent}`;
+        let group = moving.get(key);
+        if (!group) moving.set(key, (group = { kind: piece.kind, transparent, bodies: [], locals: [], colours: [] }));
+        group.bodies.push(g.body);
+        group.locals.push(piece.local);
+        group.colours.push(colour(g.rgba));
+      }
     }
-    const skeleton = new THREE.Skeleton(this.bones, this.bones.map(() => new THREE.Matrix4()));
-    for (const [parts, transparent] of [[opaque, false], [seeThrough, true]] as const) {
-      if (parts.length === 0) continue;
-      const material = new THREE.MeshLambertMaterial({
-        vertexColors: true, transparent, opacity: transparent ? 0.35 : 1, depthWrite: !transparent,
-      });
-      const mesh = new THREE.SkinnedMesh(mergeGeometries([...parts]), material);
-      mesh.bind(skeleton, new THREE.Matrix4());
+    const material = (transparent: boolean, vertexColors: boolean): THREE.Material =>
+      new THREE.MeshLambertMaterial({ vertexColors, transparent, opacity: transparent ? 0.35 : 1, depthWrite: !transparent });
+    staticParts.forEach((parts, transparent) => {
+      if (parts.length === 0) return;
+      const mesh = new THREE.Mesh(mergeGeometries(parts), material(transparent === 1, true));
+      mesh.matrixAutoUpdate = false;
+      if (transparent) mesh.renderOrder = 1;
+      this.scene.add(mesh);
+    });
+    for (const group of moving.values()) {
+      const mesh = new THREE.InstancedMesh(unitGeometry(group.kind), material(group.transparent, false), group.bodies.length);
+      mesh.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
+      group.colours.forEach((c, k) => mesh.setColorAt(k, c));
       mesh.frustumCulled = false;
+      mesh.matrixAutoUpdate = false;
+      if (group.transparent) mesh.renderOrder = 1;
+      this.instanced.push({ mesh, bodies: group.bodies, locals: group.locals });
       this.scene.add(mesh);
     }
     for (const robot of spec.robots) {
@@ -215,14 +292,25 @@ export class SceneView {
     this.camera.updateProjectionMatrix();
   }
 
-  /** Pose every body from `poses` (bodies x 7 floats: x y z qw qx qy qz). */
+  /** Pose every body from `poses` (bodies x 7 floats: x y z qw qx qy qz); allocates nothing. */
   setPoses(poses: Float32Array): void {
-    const n = Math.min(this.bones.length, poses.length / 7);
+    const n = Math.min(this.bodies.length, poses.length / 7);
     for (let i = 1; i < n; i++) {
       const o = i * 7;
-      const bone = this.bones[i];
-      bone.position.set(poses[o], poses[o + 1], poses[o + 2]);
-      bone.quaternion.set(poses[o + 4], poses[o + 5], poses[o + 6], poses[o + 3]);
+      this.position.set(poses[o], poses[o + 1], poses[o + 2]);
+      this.rotation.set(poses[o + 4], poses[o + 5], poses[o + 6], poses[o + 3]);
+      this.bodies[i].compose(this.position, this.rotation, this.unit);
+    }
+    for (const { mesh, bodies, locals } of this.instanced) {
+      const out = mesh.instanceMatrix.array as Float32Array;
+      for (let k = 0; k < bodies.length; k++) {
+        this.product.multiplyMatrices(this.bodies[bodies[k]], locals[k]).toArray(out, k * 16);
+      }
+      mesh.instanceMatrix.needsUpdate = true;
+    }
+    for (const { object, body, local } of this.posed) {
+      object.matrix.multiplyMatrices(this.bodies[body], local);
+      object.matrixWorldNeedsUpdate = true;
     }
     for (const label of this.labels) {
       const o = label.body * 7;
@@ -236,7 +324,8 @@ export class SceneView {
     this.frames += 1;
   }
 
-  /** The colour drawn where a world point lands on the canvas (RGBA bytes), for tests. */
+  /** The colour drawn where a world point lands on the canvas (RGBA bytes), for tests: call
+   * it right after `render()`, in the same task (the drawing buffer is not preserved). */
   pixel(point: number[]): number[] {
     const v = new THREE.Vector3(point[0], point[1], point[2]).project(this.camera);
     const x = Math.round(((v.x + 1) / 2) * this.canvas.width);

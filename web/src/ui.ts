@@ -17,6 +17,11 @@ export function clock(ms: number): string {
   return `${String(Math.floor(s / 60)).padStart(2, "0")}:${String(s % 60).padStart(2, "0")}`;
 }
 
+/** Set a node's text only when it differs (a write, even of the same text, costs a layout). */
+export function setText(node: Node, text: string): void {
+  if (node.textContent !== text) node.textContent = text;
+}
+
 export class Scoreboard {
   readonly root = el("div", { class: "scoreboard", "data-testid": "scoreboard" });
   private readonly red = el("span", { class: "score red", "data-testid": "score-red" }, "0");
@@ -37,17 +42,18 @@ export class Scoreboard {
     );
   }
 
+  /** Called every frame: touches the page only where a text changed (no layout otherwise). */
   update(game: GameState | null | undefined): void {
     if (!game) return;
     const score = game.score;
     if (score) {
-      this.red.textContent = String(score.red);
-      this.blue.textContent = String(score.blue);
+      setText(this.red, String(score.red));
+      setText(this.blue, String(score.blue));
     }
     const half = game.half === 1 ? "1st half" : game.half === 2 ? "2nd half" : "";
     const secondary = game.secondary_state && game.secondary_state !== "NORMAL" ? ` ${game.secondary_state}` : "";
-    this.state.textContent = `${game.state ?? "-"}${secondary} ${half}`.trim();
-    if (typeof game.secs_remaining === "number") this.clockText.textContent = clock(game.secs_remaining * 1000);
+    setText(this.state, `${game.state ?? "-"}${secondary} ${half}`.trim());
+    if (typeof game.secs_remaining === "number") setText(this.clockText, clock(game.secs_remaining * 1000));
   }
 }
 

@@ -2,7 +2,7 @@
 // referee's events on a clickable timeline.
 import { ReplayData, type RefereeEvent } from "../replay";
 import { SceneView } from "../scene";
-import { Scoreboard, clock, describeEvent, el } from "../ui";
+import { Scoreboard, clock, describeEvent, el, setText } from "../ui";
 import { drawStats } from "./plots";
 
 const SPEEDS = [0.25, 0.5, 1, 2, 4, 8, 16];
@@ -88,7 +88,7 @@ export async function replayPage(root: HTMLElement, api: string, replayId: strin
       board.update(game);
       shownMs = timeMs;
     }
-    now.textContent = `${clock(timeMs)} / ${clock(meta.duration_ms)}`;
+    setText(now, `${clock(timeMs)} / ${clock(meta.duration_ms)}`);
     view.render();
     requestAnimationFrame(frame);
   }
