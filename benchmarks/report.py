@@ -117,7 +117,8 @@ def _runners(args: argparse.Namespace) -> dict[str, Callable[[], dict[str, Any]]
                          "--sim-seconds", sim_s, "--json"], 600)  # fmt: skip
         if "error" in result:
             return result
-        keys = ("ratio", "cpu_ratio", "real_time_factor", "bare_real_time_factor")
+        keys = ("ratio", "cpu_ratio", "ratio_pair_median", "real_time_factor",
+                "bare_real_time_factor")
         return {k: result[k] for k in keys if k in result}
 
     def cameras() -> dict[str, Any]:

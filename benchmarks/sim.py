@@ -2,10 +2,11 @@
 
 Measures ``World.step`` + ``World.snapshot`` with N robots holding the standing posture, and a bare
 ``mujoco.mj_step`` loop on the same model with the same physics time step. The two are run in
-alternating one-second (simulated) chunks so that load from other processes affects both alike;
+alternating chunks of 250 ms (simulated) so that load from other processes affects both alike;
 The world evaluates sensors only in the last physics substep of a basic step (they are read
 once per step), the bare loop in every substep, as a plain ``mj_step`` loop does.
-``cpu_ratio`` compares thread CPU time instead of wall time (steadier on a busy machine) and
+``cpu_ratio`` compares thread CPU time instead of wall time (steadier on a busy machine),
+``ratio_pair_median`` is the median of the ratios of adjacent chunk pairs, and
 ``snapshot_us`` is the CPU time of one snapshot. Prints one JSON line with ``--json``::
 
     {"bench": "sim", "robots": 8, "sim_seconds": 20.0, "physics_dt_s": 0.002, "steps_per_s": ...,
@@ -18,12 +19,15 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import statistics
 import sys
 import time
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:  # MuJoCo and the world are imported after the arguments (fast --help)
     from simulator.world import RobotPlacement
+
+CHUNK_MS = 250  # simulated time of each alternating chunk (as bench api's interleaving)
 
 
 def placements(count: int, model: str) -> list[RobotPlacement]:
@@ -66,28 +70,31 @@ def run(
     )
     bare_model = compile_scene(world.field, robot_list, physics_dt_s=physics_dt_s)
     bare_data = mujoco.MjData(bare_model)
-    steps_per_chunk = max(1, round(1000 / world.step_ms))
-    substeps_per_chunk = steps_per_chunk * world.substeps
-    chunks = max(1, round(sim_seconds))
+    steps_per_chunk = max(1, round(CHUNK_MS / world.step_ms))
+    steps = max(1, round(sim_seconds * 1000 / world.step_ms))
     world_s = bare_s = snapshot_s = world_cpu = bare_cpu = 0.0
+    pair_ratios: list[float] = []
     clock = time.perf_counter
     cpu = time.thread_time
-    for _ in range(chunks):
+    for first in range(0, steps, steps_per_chunk):
+        count = min(steps_per_chunk, steps - first)
         start, start_cpu = clock(), cpu()
-        for _ in range(steps_per_chunk):
+        for _ in range(count):
             world.step()
             t = cpu()
             world.snapshot()
             snapshot_s += cpu() - t
-        world_s += clock() - start
+        world_chunk = clock() - start
+        world_s += world_chunk
         world_cpu += cpu() - start_cpu
         start, start_cpu = clock(), cpu()
-        for _ in range(substeps_per_chunk):
+        for _ in range(count * world.substeps):
             mujoco.mj_step(bare_model, bare_data)
-        bare_s += clock() - start
+        bare_chunk = clock() - start
+        bare_s += bare_chunk
         bare_cpu += cpu() - start_cpu
-    simulated = chunks * steps_per_chunk * world.step_ms / 1000.0
-    steps = chunks * steps_per_chunk
+        pair_ratios.append(bare_chunk / world_chunk)
+    simulated = steps * world.step_ms / 1000.0
     rtf = simulated / world_s
     bare = simulated / bare_s
     return {
@@ -101,6 +108,9 @@ def run(
         "bare_real_time_factor": round(bare, 3),
         "ratio": round(rtf / bare, 3),
         "cpu_ratio": round(bare_cpu / world_cpu, 3),
+        # median over the (world, bare) pairs of adjacent chunks: a burst of load that falls
+        # on one chunk moves one pair, not the figure
+        "ratio_pair_median": round(statistics.median(pair_ratios), 3),
         "snapshot_us": round(snapshot_s / steps * 1e6, 1),
         "fallen": sum(r.fallen for r in world.snapshot().robots),
     }
