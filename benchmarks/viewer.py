@@ -9,7 +9,11 @@ the page in Debian's Chromium (WebGL through SwiftShader, as in the browser test
 - ``open_s``: navigation start to the first frame drawn with the replay's poses;
 - ``seek_s``: a seek to 15:00 until that frame is drawn;
 - ``fps``: frames drawn per second while playing at 1x (``play_s`` seconds), with the render
-  scale the viewer chose (it halves the resolution while playing when frames are slow).
+  scale the viewer chose (it halves the resolution while playing when frames are slow);
+- ``browser_cpu_ms_per_frame``: CPU time of the browser's processes (all of them: WebGL runs in
+  software) per frame drawn while playing; it depends much less on the machine's load than
+  ``fps``, so it compares versions of the viewer measured at different times;
+- ``draw_calls`` and ``triangles`` of one frame.
 
 The machine's load average is printed too: software WebGL shares the CPU with everything else.
 
@@ -100,14 +104,53 @@ def write_replay(path: Path, *, half_s: int = HALF_S, seed: int = 7) -> dict[str
     return {"write_s": round(time.monotonic() - started, 2), "bodies": model.nbody}
 
 
+def _cpu_s(root_pid: int) -> float:
+    """CPU seconds (user + system) of ``root_pid`` and its descendants (``/proc``)."""
+    parents: dict[int, int] = {}
+    ticks: dict[int, int] = {}
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            fields = Path(f"/proc/{entry}/stat").read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        parents[int(entry)] = int(fields[1])
+        ticks[int(entry)] = int(fields[11]) + int(fields[12])
+    tree, grew = {root_pid}, True
+    while grew:
+        grew = False
+        for pid, parent in parents.items():
+            if parent in tree and pid not in tree:
+                tree.add(pid)
+                grew = True
+    return sum(ticks.get(pid, 0) for pid in tree) / os.sysconf("SC_CLK_TCK")
+
+
+def _browser_pid(marker: str) -> int | None:
+    """The browser's main process: the one whose command line has ``marker`` (an unknown
+    switch Chromium ignores) and no ``--type=`` (its children have one)."""
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                command = Path(f"/proc/{entry}/cmdline").read_bytes().split(b"\0")
+            except OSError:
+                continue
+            if marker.encode() in command and not any(c.startswith(b"--type=") for c in command):
+                return int(entry)
+    return None
+
+
 def measure(url: str, *, play_s: float, width: int, height: int, extra_args: list[str]
             ) -> dict[str, Any]:
     from playwright.sync_api import sync_playwright
 
+    marker = f"--hlvs-bench-viewer={os.getpid()}"
     with sync_playwright() as playwright:
         browser = playwright.chromium.launch(
-            executable_path=CHROMIUM, headless=True, args=LAUNCH_ARGS + extra_args
+            executable_path=CHROMIUM, headless=True, args=LAUNCH_ARGS + extra_args + [marker]
         )
+        browser_pid = _browser_pid(marker)
         page = browser.new_page(viewport={"width": width, "height": height})
         started = time.monotonic()
         page.goto(url)
@@ -120,14 +163,23 @@ def measure(url: str, *, play_s: float, width: int, height: int, extra_args: lis
         page.wait_for_function("window.hlvsViewer.ready", timeout=60_000, polling=10)
         seek_s = time.monotonic() - started
         probe = "[window.hlvsViewer.frames, performance.now(), window.hlvsViewer.time]"
-        before = page.evaluate(probe)
         page.locator("[data-testid=play]").click()
+        page.wait_for_timeout(500)  # the render scale settles
+        cpu_before = _cpu_s(browser_pid) if browser_pid else None
+        before = page.evaluate(probe)
         page.wait_for_timeout(play_s * 1000)
         after = page.evaluate(probe)
+        cpu_after = _cpu_s(browser_pid) if browser_pid else None
         scale = page.evaluate("window.hlvsViewer.scale")
+        drawn = page.evaluate("window.hlvsViewer.view.renderer.info.render")
         browser.close()
     wall_s = (after[1] - before[1]) / 1000.0
+    frames = max(1, after[0] - before[0])
     return {
+        "browser_cpu_ms_per_frame": None if cpu_before is None or cpu_after is None
+        else round(1000 * (cpu_after - cpu_before) / frames, 1),
+        "draw_calls": drawn["calls"],
+        "triangles": drawn["triangles"],
         "open_s": round(open_s, 3),
         "seek_s": round(seek_s, 3),
         "fps": round((after[0] - before[0]) / wall_s, 1),
