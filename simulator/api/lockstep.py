@@ -109,11 +109,13 @@ class Pipeline:
         self.waited_s = 0.0  # total time spent waiting for the clients
 
     def send(self, time_ms: int) -> None:
-        """Wait for the answers to the measurement sent last, take them, send the latest one."""
+        """Wait for the answers to the measurement sent last, take them, send the latest one
+        (read and encoded before the wait: the world does not change until it is sent)."""
+        prepared = self._server.prepare(time_ms)
         self.waited_s += wait_lockstep(self._server, self._settings)
         for robot, requests in self._server.take_requests().items():
             self._taken.setdefault(robot, []).extend(requests)
-        self._server.publish(time_ms)
+        self._server.publish_prepared(prepared)
         self.unsent = False
 
     def before_step(self, time_ms: int, step_time_ms: int) -> None:

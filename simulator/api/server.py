@@ -461,13 +461,26 @@ class ApiServer:
 
     def publish(self, time_ms: int) -> None:
         """Queue the measurement of the step that ended at ``time_ms`` for every client."""
+        self.publish_prepared(self.prepare(time_ms))
+
+    def prepare(self, time_ms: int) -> list[tuple[RobotSlot, Measurement]]:
+        """The measurements of the step that ended at ``time_ms`` for the connected clients,
+        read and encoded but not queued: :meth:`publish_prepared` queues them. Pipelined
+        stepping builds them before it waits for the answers to the previous ones."""
+        return [
+            (slot, slot.session.measure(time_ms))
+            for slot in self.slots.values()
+            if slot.conn is not None
+        ]
+
+    def publish_prepared(self, prepared: list[tuple[RobotSlot, Measurement]]) -> None:
+        """Queue measurements made by :meth:`prepare` (a client dropped meanwhile gets none)."""
         jobs_all = []
         now = time.monotonic()
-        for slot in self.slots.values():
+        for slot, measurement in prepared:
             conn = slot.conn
             if conn is None:
                 continue
-            measurement = slot.session.measure(time_ms)
             jobs = measurement.jobs
             conn.answered = False
             if jobs:

@@ -33,8 +33,14 @@ class _PipelineServer:
         return {ROBOT: [f"answer {self.sent[-1]}"]} if self.sent else {}
 
     def publish(self, time_ms: int) -> None:
-        self.calls.append("publish")
+        self.publish_prepared(self.prepare(time_ms))
+
+    def prepare(self, time_ms: int) -> int:
         assert time_ms == self.world.sim_time_ms
+        return time_ms
+
+    def publish_prepared(self, time_ms: int) -> None:
+        self.calls.append("publish")
         self.sent.append(time_ms)
 
     def apply_taken(self, taken: dict[RobotId, list[str]], step_time_ms: int) -> None:
