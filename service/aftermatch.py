@@ -125,6 +125,10 @@ class AfterMatch:
         with transaction(self.services.sessions) as session:
             pending = list(session.scalars(select(Submission).where(
                 Submission.video_state == MediaState.PENDING.value).order_by(Submission.seq)))
+            render = self._render
+            if render is not None and render.submission_id not in {r.id for r in pending} \
+                    and render.process.poll() is not None:
+                self._render = None  # its submission was requeued meanwhile
             for row in pending:
                 self._video(row)
 

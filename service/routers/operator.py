@@ -96,6 +96,9 @@ def requeue(submission_id: str, request: Request, principal: OperatorPrincipal,
     row.failure_class = row.failure_side = None
     row.finished_at = None
     row.pool_handle = None
+    row.pool_detail = None
+    row.video_state = row.video_detail = None  # the next attempt makes its own
+    row.delivery_state = row.delivery_detail = None
     row.charged = False
     row.cancel_requested = False
     session.commit()
