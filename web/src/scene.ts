@@ -183,7 +183,8 @@ export class SceneView {
   private readonly rotation = new THREE.Quaternion();
   private readonly unit = new THREE.Vector3(1, 1, 1);
   private readonly product = new THREE.Matrix4();
-  frames = 0;
+  private dirty = true; // something changed since the last drawing
+  frames = 0; // drawings
 
   constructor(readonly canvas: HTMLCanvasElement, readonly spec: SceneSpec) {
     this.renderer = new THREE.WebGLRenderer({ canvas, antialias: false });
@@ -268,6 +269,7 @@ export class SceneView {
     this.camera.position.set(0, -halfLength * 1.55, halfLength * 1.2);
     this.controls = new OrbitControls(this.camera, canvas);
     this.controls.target.set(0, 0, 0);
+    this.controls.addEventListener("change", () => { this.dirty = true; });
     this.controls.update();
     this.resize();
     window.addEventListener("resize", () => this.resize());
@@ -290,6 +292,7 @@ export class SceneView {
     this.renderer.setSize(width, height, false);
     this.camera.aspect = width / height;
     this.camera.updateProjectionMatrix();
+    this.dirty = true;
   }
 
   /** Pose every body from `poses` (bodies x 7 floats: x y z qw qx qy qz); allocates nothing. */
@@ -316,16 +319,25 @@ export class SceneView {
       const o = label.body * 7;
       label.sprite.position.set(poses[o], poses[o + 1], poses[o + 2] + 0.45);
     }
+    this.dirty = true;
   }
 
+  /** Draw if anything changed since the last drawing (poses, camera, size); called every
+   * animation frame, it costs nothing while the view stands still. */
   render(): void {
     this.controls.update();
+    if (this.dirty) this.draw();
+  }
+
+  /** Draw now. */
+  draw(): void {
     this.renderer.render(this.scene, this.camera);
     this.frames += 1;
+    this.dirty = false;
   }
 
   /** The colour drawn where a world point lands on the canvas (RGBA bytes), for tests: call
-   * it right after `render()`, in the same task (the drawing buffer is not preserved). */
+   * it right after `draw()`, in the same task (the drawing buffer is not preserved). */
   pixel(point: number[]): number[] {
     const v = new THREE.Vector3(point[0], point[1], point[2]).project(this.camera);
     const x = Math.round(((v.x + 1) / 2) * this.canvas.width);

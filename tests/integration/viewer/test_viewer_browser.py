@@ -73,8 +73,11 @@ def test_the_timeline_jumps_to_the_goal_and_playback_runs(page: Any, match: Path
         page.locator("[data-testid=play]").click()  # pause (0.5x: 0.7 s of wall time left)
         paused_at = page.evaluate("window.hlvsViewer.time")
         assert GOAL_MS < paused_at < 3000
+        page.wait_for_timeout(100)  # the last frame of the playback is drawn
+        drawn = page.evaluate("window.hlvsViewer.frames")
         page.wait_for_timeout(300)
         assert page.evaluate("window.hlvsViewer.time") == paused_at
+        assert page.evaluate("window.hlvsViewer.frames") == drawn  # paused: nothing redrawn
         assert page.locator("[data-testid=score-red]").inner_text() == "1"
         events = page.locator("[data-testid=events] li").all_inner_texts()
         assert events == ["00:02 goal red 2"]

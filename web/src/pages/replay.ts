@@ -82,11 +82,13 @@ export async function replayPage(root: HTMLElement, api: string, replayId: strin
       setTime(timeMs + dt * Number(speed.value));
       if (timeMs >= meta.duration_ms) { playing = false; play.textContent = "Play"; }
     }
-    const game = data.sample(timeMs, poses);
-    if (game !== null) {
-      view.setPoses(poses);
-      board.update(game);
-      shownMs = timeMs;
+    if (shownMs !== timeMs) { // paused and shown: nothing to pose, nothing to draw
+      const game = data.sample(timeMs, poses);
+      if (game !== null) {
+        view.setPoses(poses);
+        board.update(game);
+        shownMs = timeMs;
+      }
     }
     setText(now, `${clock(timeMs)} / ${clock(meta.duration_ms)}`);
     view.render();
@@ -105,7 +107,7 @@ export async function replayPage(root: HTMLElement, api: string, replayId: strin
     get playing() { return playing; },
     seek: (t: number) => setTime(t),
     project: (p: number[]) => view.project(p),
-    pixel: (p: number[]) => { view.render(); return view.pixel(p); },
+    pixel: (p: number[]) => { view.draw(); return view.pixel(p); },
     view,
     poses: () => Array.from(poses),
   };
