@@ -29,6 +29,7 @@ from typing import Any
 import yaml
 
 from contracts import files
+from contracts.match_spec import MatchSpec
 from orchestrator.config import LoadedGame
 from orchestrator.match import layout
 from orchestrator.match.logfs import safe_name
@@ -88,7 +89,7 @@ class MatchRequests:
     networks: dict[str, NetworkRequest]  # role -> request
     simulator: ContainerRequest
     robots: dict[str, tuple[ContainerRequest, ContainerRequest]]  # key -> (holder, robot)
-    spec: dict[str, Any]  # match_spec.json content
+    spec: MatchSpec  # the match's match_spec.json
 
 
 def match_requests(loaded: LoadedGame, *, simulator_image: str, subnets: Subnets) -> MatchRequests:
@@ -171,7 +172,7 @@ def compose_files(
             holder, robot, roles, cpus_here, grace_s=requests.plan.grace_period_s
         )
     networks = {role: _network(request) for role, request in requests.networks.items()}
-    return {"services": services, "networks": networks}, requests.spec
+    return {"services": services, "networks": networks}, requests.spec.to_dict()
 
 
 def _network(request: NetworkRequest) -> dict[str, Any]:

@@ -11,15 +11,15 @@ import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
 
 from contracts.match_results import AdmissionRecord
+from contracts.match_spec import MatchSpec
 from orchestrator.config import Limits, LoadedGame, PlayerConfig
 from orchestrator.config.robot_models import is_model_path
 from orchestrator.config.spec import to_match_spec
 
-SpecBuilder = Callable[[Mapping[str, tuple[str, ...]], str | None], dict[str, Any]]
-"""(robot addresses per color, telemetry endpoint or None) -> match_spec.json content."""
+SpecBuilder = Callable[[Mapping[str, tuple[str, ...]], str | None], MatchSpec]
+"""(robot addresses per color, telemetry endpoint or None) -> the match's ``match_spec.json``."""
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -86,8 +86,8 @@ def plan_from_game(loaded: LoadedGame, *, grace_period_s: float | None = None) -
         robots = tuple(_robot(color, p, ref.port(p.number)) for p in cfg.players)
         teams.append(TeamPlan(color=color, name=cfg.display_name, robots=robots))
 
-    def build(addresses: Mapping[str, tuple[str, ...]], telemetry: str | None) -> dict[str, Any]:
-        return spec_dict(loaded, addresses, telemetry)
+    def build(addresses: Mapping[str, tuple[str, ...]], telemetry: str | None) -> MatchSpec:
+        return match_spec(loaded, addresses, telemetry)
 
     return MatchPlan(
         match_id=game.match_id,
@@ -110,11 +110,11 @@ def plan_from_game(loaded: LoadedGame, *, grace_period_s: float | None = None) -
     )
 
 
-def spec_dict(
+def match_spec(
     loaded: LoadedGame, addresses: Mapping[str, tuple[str, ...]], telemetry: str | None
-) -> dict[str, Any]:
-    """match_spec.json content from the config layer, with this run's addresses: the robots'
-    fixed IPs are the team's allowed hosts and GameController targets."""
+) -> MatchSpec:
+    """The match spec from the config layer, with this run's addresses: the robots' fixed IPs
+    are the team's allowed hosts and GameController targets."""
     spec = to_match_spec(
         loaded, robot_addresses={c: list(a) for c, a in addresses.items()},
         telemetry_listen=telemetry,
@@ -127,7 +127,7 @@ def spec_dict(
         )
         for color in ("red", "blue")
     }
-    return replace(spec, red=teams["red"], blue=teams["blue"]).to_dict()
+    return replace(spec, red=teams["red"], blue=teams["blue"])
 
 
 def robots_in_game(game_path: Path) -> int:
@@ -147,8 +147,8 @@ __all__ = [
     "RobotPlan",
     "SpecBuilder",
     "TeamPlan",
+    "match_spec",
     "per_robot_rate_mb_s",
     "plan_from_game",
     "robots_in_game",
-    "spec_dict",
 ]

@@ -5,7 +5,6 @@
 
 from __future__ import annotations
 
-import json
 import logging
 import shutil
 from collections.abc import Callable
@@ -15,6 +14,7 @@ from pathlib import Path
 
 from contracts import files
 from contracts.gamecontroller import GC_RETURN_PORT
+from contracts.match_spec import MatchSpec
 from orchestrator.bandwidth import AppliedShaping, RobotShaping, mb_s_to_bit
 from orchestrator.errors import InfrastructureError, OrchestratorError
 from orchestrator.match import layout
@@ -94,7 +94,7 @@ def _start(match: MatchContext, started_at: float) -> None:
         attachments=attachments, extra_labels=match.options.extra_labels,
         command=match.options.simulator_command, model_dirs=plan.model_dirs,
     )
-    sets = cpu_sets(stepping=str(spec.get("stepping", "async")))
+    sets = cpu_sets(stepping=spec.stepping)
     started.cpu_sets = sets
     request = replace(request, cpuset_cpus=sets.simulator)
     mark("spec")
@@ -102,14 +102,14 @@ def _start(match: MatchContext, started_at: float) -> None:
 
 
 def _write_spec(match: MatchContext, addresses: dict[str, tuple[str, ...]],
-                endpoint: str | None) -> tuple[dict[str, object], Path]:
+                endpoint: str | None) -> tuple[MatchSpec, Path]:
     match_dir = match.options.out_dir / "simulator"
     (match_dir / "out").mkdir(parents=True, exist_ok=True)
     for folder in (match_dir, match_dir / "out"):
         folder.chmod(0o777)
     match.started.match_dir = match_dir
     spec = match.plan.spec_builder(addresses, endpoint)
-    (match_dir / files.MATCH_SPEC).write_text(json.dumps(spec, indent=2, sort_keys=True) + "\n")
+    spec.write(match_dir / files.MATCH_SPEC)
     return spec, match_dir
 
 
@@ -133,7 +133,7 @@ def _start_league(match: MatchContext, started_at: float, placement: LeaguePlace
     )
     request = replace(request, network_mode=f"container:{holder}", hostname=None,
                       labels={**request.labels, layout.LABEL_NODE: placement.simulator.name})
-    sets = cpu_sets(stepping=str(spec.get("stepping", "async")))
+    sets = cpu_sets(stepping=spec.stepping)
     match.started.cpu_sets = sets
     request = replace(request, cpuset_cpus=sets.simulator)
     mark("spec")

@@ -14,6 +14,7 @@ from typing import Any
 import docker
 import pytest
 
+from contracts.match_spec import MatchSpec
 from orchestrator.config import Limits
 from orchestrator.errors import OrchestratorError
 from orchestrator.match import (
@@ -27,6 +28,7 @@ from orchestrator.match import (
     cleanup,
 )
 from orchestrator.telemetry import ZenohTelemetry
+from testkit.specs import match_spec
 from tests.conftest import TEST_LABEL
 
 ASSETS = Path(__file__).parent / "assets"
@@ -83,16 +85,11 @@ def test_image(docker_client: docker.DockerClient) -> str:
 
 
 def spec_builder(match_id: str, red: list[RobotPlan], blue: list[RobotPlan]) -> Any:
-    def build(addresses: Mapping[str, tuple[str, ...]], telemetry: str | None) -> dict[str, Any]:
-        return {
-            "match_id": match_id,
-            "seed": 7,
-            "red": {"players": [{"number": r.number, "port": r.port} for r in red],
-                    "hosts": list(addresses["red"])},
-            "blue": {"players": [{"number": r.number, "port": r.port} for r in blue],
-                     "hosts": list(addresses["blue"])},
-            "network": {"telemetry_listen": telemetry},
-        }
+    ports = {"red": {r.number: r.port for r in red}, "blue": {r.number: r.port for r in blue}}
+
+    def build(addresses: Mapping[str, tuple[str, ...]], telemetry: str | None) -> MatchSpec:
+        return match_spec(match_id=match_id, seed=7, ports=ports, addresses=addresses,
+                          telemetry=telemetry)
 
     return build
 

@@ -38,9 +38,9 @@ def test_league_match_runs_each_robot_in_its_nodes_network(tmp_path: Path) -> No
     assert outcome.ok, outcome.failure
     assert runtime.networks == {} and not any(c == "create_network" for c, _ in runtime.calls)
     spec = json.loads((tmp_path / "simulator/match_spec.json").read_text())
-    assert spec["hosts"] == {"red": ["10.77.0.12", "10.77.0.13"],
-                             "blue": ["10.77.0.14", "10.77.0.15"]}
-    assert spec["telemetry"] is None
+    assert {c: spec[c]["hosts"] for c in ("red", "blue")} == {
+        "red": ["10.77.0.12", "10.77.0.13"], "blue": ["10.77.0.14", "10.77.0.15"]}
+    assert spec["network"]["telemetry_listen"] is None
     holders = {name: c for name, c in started.items() if "-node-" in name}
     assert sorted(holders) == [f"hlvs-u1-node-n{i}" for i in range(1, 6)]
     for i in range(1, 6):

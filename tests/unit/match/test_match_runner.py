@@ -20,6 +20,7 @@ from orchestrator.match import (
     TeamPlan,
 )
 from orchestrator.match.fake import FakeHost, FakeRuntime, FakeTelemetry
+from testkit.specs import match_spec
 
 
 def _plan(*, red_image: str = "team/red:1", blue_image: str = "team/blue:1", n: int = 2,
@@ -29,13 +30,13 @@ def _plan(*, red_image: str = "team/red:1", blue_image: str = "team/blue:1", n: 
         return tuple(RobotPlan(color=color, number=i, port=base + i, image=image,
                                command=("start", str(i))) for i in range(1, n + 1))
 
+    red = TeamPlan(color="red", name="R", robots=robots("red", red_image))
+    blue = TeamPlan(color="blue", name="B", robots=robots("blue", blue_image))
+    ports = {t.color: {r.number: r.port for r in t.robots} for t in (red, blue)}
     return MatchPlan(
-        match_id="u1", seed=3,
-        red=TeamPlan(color="red", name="R", robots=robots("red", red_image)),
-        blue=TeamPlan(color="blue", name="B", robots=robots("blue", blue_image)),
-        spec_builder=lambda addresses, telemetry: {"hosts": {k: list(v) for k, v in
-                                                             addresses.items()},
-                                                   "telemetry": telemetry},
+        match_id="u1", seed=3, red=red, blue=blue,
+        spec_builder=lambda addresses, telemetry: match_spec(
+            match_id="u1", seed=3, ports=ports, addresses=addresses, telemetry=telemetry),
         limits=Limits(cpus=2.0, memory_gb=1.0, team_api_mb_s=10.0, team_comm_mb_s=1.0),
         grace_period_s=3.0, telemetry=telemetry, telemetry_silence_s=silence_s,
     )
@@ -66,7 +67,7 @@ def test_success_writes_results_and_report_last(tmp_path: Path) -> None:
     assert (tmp_path / "teams/red/2/stdout.log").read_text().startswith("hlvs-u1-red-2")
     assert runtime.containers == {} and runtime.networks == {}
     spec = json.loads((tmp_path / "simulator/match_spec.json").read_text())
-    assert spec["hosts"]["red"][1].endswith(".12")
+    assert spec["red"]["hosts"][1].endswith(".12")
     created = [name for call, name in runtime.calls if call == "create_container"]
     assert len(created) == 9 and "hlvs-u1-simulator" in created
     for key in ("red-1", "red-2", "blue-1", "blue-2"):  # shaped namespace before the robot
@@ -176,7 +177,8 @@ def test_telemetry_moves_waiting_to_playing_and_measures_bringup(tmp_path: Path)
     assert outcome.bringup_s is not None and outcome.bringup_s > 0
     assert MatchState.PLAYING in runner.lifecycle.history
     spec = json.loads((tmp_path / "simulator/match_spec.json").read_text())
-    assert spec["telemetry"].startswith("tcp/10.213.") and spec["telemetry"].endswith(":7447")
+    telemetry = spec["network"]["telemetry_listen"]
+    assert telemetry.startswith("tcp/10.213.") and telemetry.endswith(":7447")
 
 
 def test_robot_exit_mid_game_is_recorded_and_the_game_goes_on(tmp_path: Path) -> None:
