@@ -46,7 +46,7 @@ class PoolView(BaseModel):
 
 
 @router.get("/nodes", responses={404: {"description": "the service has no match pool"},
-                                 500: {"description": "the pool did not answer (e.g. the "
+                                 503: {"description": "the pool did not answer (e.g. the "
                                        "Slurm controller is down)"}})
 def get_nodes(request: Request, principal: OperatorPrincipal, session: DbSession) -> PoolView:
     services = get_services(request)

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from service.errors import PoolError
+from service.pool import PoolNode
+from service.pool.fake import FakePool
 from tests.integration.service.harness import Served
 from tests.unit.service.test_submissions import setup_team, wait_for
 
@@ -31,3 +34,18 @@ def test_operators_see_the_nodes_and_the_submission_on_each(
                              "match_id": body["match_id"], "submission_id": sid,
                              "team": "Alpha", "opponent": "stub"}]
     team.close()
+
+
+def test_a_pool_that_does_not_answer_is_a_503_naming_why(
+    start: Callable[..., Served], token: Callable[..., str], pool: FakePool,
+) -> None:
+    def down() -> list[PoolNode]:
+        raise PoolError(handle="sinfo", reason="sinfo -N: exit 1: Unable to contact slurm "
+                        "controller")
+
+    pool.nodes = down  # type: ignore[method-assign]
+    served = start()
+    with served.client(token(operator=True)) as operator:
+        answer = operator.get("/v1/operator/nodes")
+    assert answer.status_code == 503 and answer.json()["error"] == "pool_unavailable"
+    assert answer.json()["reason"] == "sinfo -N: exit 1: Unable to contact slurm controller"
