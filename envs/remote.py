@@ -35,11 +35,14 @@ from envs.wire import (
     TAG_ACTUATORS,
     TAG_SENSORS,
     TAG_TRAINER,
+    TAG_TRUTH,
     WELCOME,
     FrameReader,
     WireError,
     decode_sensors,
+    decode_truth,
     encode_targets,
+    json_object,
     send_frame,
 )
 
@@ -171,7 +174,8 @@ class RemoteSession:
         self._diagnose = diagnose
         self._sock = self._connect(connect_timeout_s)
         self._reader = FrameReader(self._sock)
-        self._call({"op": "open", "spec": spec.to_dict()})
+        opened = self._call({"op": "open", "spec": spec.to_dict(), "compact": True})
+        self.compact = bool(opened.get("compact"))  # older remotes answer every step in JSON
 
     def _connect(self, timeout_s: float) -> socket.socket:
         where = str(self.address)
@@ -233,7 +237,13 @@ class RemoteSession:
             if tag != TAG_SENSORS:
                 raise WireError(f"unexpected frame tag {tag!r}")
             time_ms, sensors, image = decode_sensors(payload)
-            answer = self._answer(self._reader.expect_json(), operation)
+            tag, payload = self._reader.read()
+            if tag == TAG_TRUTH and self.compact:
+                truth = decode_truth(payload)
+                return Frame(sim_time_ms=time_ms, sensors=sensors, truth=truth, image=image)
+            if tag != TAG_TRAINER:
+                raise WireError(f"unexpected frame tag {tag!r} after the sensors")
+            answer = self._answer(json_object(payload), operation)
         except (OSError, WireError) as exc:
             raise self._crash(exc) from exc
         return Frame.from_wire(answer["frame"], sensors, image)

@@ -22,6 +22,7 @@ from types import FrameType
 from typing import Any
 
 from envs.errors import EnvError
+from envs.frame import Frame
 from envs.session import LocalSession
 from envs.session_spec import ResetRequest, SessionSpec
 from envs.wire import (
@@ -29,11 +30,13 @@ from envs.wire import (
     TAG_ACTUATORS,
     TAG_SENSORS,
     TAG_TRAINER,
+    TAG_TRUTH,
     WELCOME,
     FrameReader,
     WireError,
     decode_targets,
     encode_sensors,
+    encode_truth,
     send_frames,
     send_json,
 )
@@ -91,6 +94,7 @@ class RemoteServer:
     def _serve(self, conn: socket.socket, where: str) -> None:
         log.info("client %s connected", where)
         session: LocalSession | None = None
+        compact = False  # the client asked for F frames (see envs.wire)
         released = False
         try:
             if conn.family != socket.AF_UNIX:
@@ -103,7 +107,7 @@ class RemoteServer:
                     if session is None:
                         send_json(conn, _error("EnvStateError", "open and reset first"))
                         continue
-                    _reply_frame(conn, session.step(decode_targets(payload)))
+                    _reply_frame(conn, session.step(decode_targets(payload)), compact)
                     continue
                 if tag != TAG_TRAINER:
                     raise WireError(f"unexpected frame tag {tag!r}")
@@ -117,7 +121,9 @@ class RemoteServer:
                     released = True
                     send_json(conn, {"ok": True})
                     break
-                session = self._trainer(conn, session, op, request)
+                if op == "open":
+                    compact = bool(request.get("compact"))
+                session = self._trainer(conn, session, op, request, compact)
         except (WireError, OSError, ValueError) as exc:
             log.info("client %s gone: %s", where, exc)
         finally:
@@ -129,8 +135,9 @@ class RemoteServer:
             log.info("client %s done", where)
 
     def _trainer(
-        self, conn: socket.socket, session: LocalSession | None, op: Any, request: dict[str, Any]
-    ) -> LocalSession | None:
+        self, conn: socket.socket, session: LocalSession | None, op: Any, request: dict[str, Any],
+        compact: bool,
+    ) -> LocalSession | None:  # fmt: skip
         try:
             if op == "health":
                 send_json(conn, {"ok": True, "pid": os.getpid()})
@@ -138,7 +145,7 @@ class RemoteServer:
                 if session is not None:
                     session.close()
                 session = LocalSession(SessionSpec.from_dict(dict(request.get("spec") or {})))
-                send_json(conn, {"ok": True})
+                send_json(conn, {"ok": True, "compact": compact})
             elif op == "reset":
                 if session is None:
                     raise _NotOpen()
@@ -148,7 +155,7 @@ class RemoteServer:
                     learner_pose=tuple(r["learner_pose"]) if r.get("learner_pose") else None,
                     ball_xy=tuple(r["ball_xy"]) if r.get("ball_xy") else None,
                 )
-                _reply_frame(conn, session.reset(reset))
+                _reply_frame(conn, session.reset(reset), compact)
             elif op in TRAINER_OPS:
                 if session is None:
                     raise _NotOpen()
@@ -171,8 +178,11 @@ def _error(kind: str, message: str) -> dict[str, Any]:
     return {"ok": False, "error": kind, "message": message}
 
 
-def _reply_frame(conn: socket.socket, frame: Any) -> None:
+def _reply_frame(conn: socket.socket, frame: Frame, compact: bool) -> None:
     sensors = encode_sensors(frame.sim_time_ms, frame.sensors, frame.image)
+    if compact and frame.perception is None and frame.game is None and not frame.events:
+        send_frames(conn, [(TAG_SENSORS, sensors), (TAG_TRUTH, encode_truth(frame.truth))])
+        return
     answer = json.dumps({"ok": True, "frame": frame.to_wire()}).encode()
     send_frames(conn, [(TAG_SENSORS, sensors), (TAG_TRAINER, answer)])
 

@@ -5,7 +5,7 @@ serves a client) and then both sides send frames: a 4-byte big-endian length, th
 and the payload (the length counts both):
 
 - ``A`` client -> remote: a robot API ``ActuatorRequests`` (the 20 motor position targets);
-  the remote steps and answers ``S`` then ``T``;
+  the remote steps and answers ``S`` then ``T`` (or ``F``);
 - ``S`` remote -> client: a robot API ``SensorMeasurements`` of the learning robot (joint
   positions, accelerometer, gyro, the eight sole forces, the camera image when enabled);
 - ``T`` both ways: one JSON object, the trainer channel. Requests ``{"op": ...}``: ``open``
@@ -13,7 +13,11 @@ and the payload (the length counts both):
   ``place_ball``, ``place_robot``, ``set_game_state``, ``drop_ball`` (``args``), ``health``,
   ``close``. Answers ``{"ok": true, ...}`` (after a step or reset: ``frame``, the ground truth,
   perception and game view of :meth:`envs.frame.Frame.to_wire`) or ``{"ok": false, "error":
-  class name, "message": text}``.
+  class name, "message": text}``;
+- ``F`` remote -> client, in place of ``T`` after a step or reset when the client opened with
+  ``"compact": true`` (the remote's ``open`` answer says ``"compact": true`` back) and the frame
+  has nothing but ground truth (no perception, game or events): the truth as 11 little-endian
+  doubles (:data:`envs.frame.TRUTH_SIZE`), no JSON to write or read at every step.
 """
 
 from __future__ import annotations
@@ -27,7 +31,7 @@ import numpy as np
 import numpy.typing as npt
 
 from contracts.robot_api import messages_pb2 as pb
-from envs.frame import N_JOINTS, SENSOR_SIZE
+from envs.frame import N_JOINTS, SENSOR_SIZE, TRUTH_SIZE
 from simulator.world import FORCE_SENSORS, MOTOR_NAMES
 
 WELCOME = b"Welcome\0"
@@ -37,6 +41,8 @@ MAX_FRAME_BYTES = 1920 * 1080 * 3 + 100_000
 TAG_ACTUATORS = b"A"
 TAG_SENSORS = b"S"
 TAG_TRAINER = b"T"
+TAG_TRUTH = b"F"
+_TRUTH = struct.Struct(f"<{TRUTH_SIZE}d")
 
 
 class WireError(Exception):
@@ -87,14 +93,18 @@ class FrameReader:
         return payload
 
     def expect_json(self) -> dict[str, Any]:
-        payload = self.expect(TAG_TRAINER)
-        try:
-            data = json.loads(payload)
-        except ValueError as exc:
-            raise WireError(f"undecodable trainer message: {exc}") from exc
-        if not isinstance(data, dict):
-            raise WireError("a trainer message must be a JSON object")
-        return data
+        return json_object(self.expect(TAG_TRAINER))
+
+
+def json_object(payload: bytes) -> dict[str, Any]:
+    """The JSON object of a ``T`` frame (WireError when it is not one)."""
+    try:
+        data = json.loads(payload)
+    except ValueError as exc:
+        raise WireError(f"undecodable trainer message: {exc}") from exc
+    if not isinstance(data, dict):
+        raise WireError("a trainer message must be a JSON object")
+    return data
 
 
 # --- robot API messages ---------------------------------------------------------------------
@@ -170,6 +180,16 @@ _SENSORS = _Layout(
     + [c for name in FORCE_SENSORS for c in _named_double(7, name)]
 )
 _TIME_TAG = _tag(1, 0)[0]
+
+
+def encode_truth(truth: npt.NDArray[np.float64]) -> bytes:
+    return _TRUTH.pack(*truth.tolist())
+
+
+def decode_truth(payload: bytes) -> npt.NDArray[np.float64]:
+    if len(payload) != _TRUTH.size:
+        raise WireError(f"a truth frame of {len(payload)} bytes (expected {_TRUTH.size})")
+    return np.array(_TRUTH.unpack(payload))
 
 
 def encode_targets(targets: npt.NDArray[np.float64]) -> bytes:

@@ -138,3 +138,45 @@ def test_bad_addresses_are_refused_with_the_field() -> None:
     with pytest.raises(RemoteError) as refused:
         gym.make("hlvs/Kick-v0", remotes=f"hlvs://127.0.0.1:{_free_port()}")
     assert "cannot connect" in str(refused.value)
+
+
+def _plain_episode(env: gym.Env, seed: int, steps: int) -> list[tuple[bytes, float, float]]:  # type: ignore[type-arg]
+    rng = np.random.default_rng(seed)
+    obs, info = env.reset(seed=seed)
+    out = [(obs["joints"].tobytes(), 0.0, info["robot_to_ball_m"])]
+    for _ in range(steps):
+        obs, reward, _, _, info = env.step(rng.uniform(-0.1, 0.1, 20).astype(np.float32))
+        out.append((obs["joints"].tobytes() + obs["forces"].tobytes(), float(reward),
+                    info["kick_distance_m"]))  # fmt: skip
+    return out
+
+
+def test_compact_truth_frames_and_json_frames(
+    remote: tuple[subprocess.Popen[bytes], int], tmp_path: Path
+) -> None:
+    """A client that asks for compact frames gets the truth as doubles (F) when there is
+    nothing else to say, and the same episode as in-process; a client that does not (an
+    older one) still gets JSON (T)."""
+    from envs.wire import TAG_TRAINER, TAG_TRUTH, FrameReader, send_json
+
+    url = f"hlvs+unix://{tmp_path / 'remote.sock'}"
+    env = gym.make("hlvs/Kick-v0", remotes=url)
+    assert env.unwrapped.session.compact
+    remote_run = _plain_episode(env, 7, 80)
+    env.close()
+    local = gym.make("hlvs/Kick-v0")
+    assert _plain_episode(local, 7, 80) == remote_run
+    local.close()
+    for compact, tag in ((False, TAG_TRAINER), (True, TAG_TRUTH)):
+        time.sleep(0.2)  # the previous client is released
+        with socket.socket(socket.AF_UNIX) as sock:
+            sock.connect(str(tmp_path / "remote.sock"))
+            assert sock.recv(8) == b"Welcome\0"
+            reader = FrameReader(sock)
+            opened = {"op": "open", "spec": SessionSpec().to_dict()}
+            send_json(sock, {**opened, "compact": True} if compact else opened)
+            assert reader.expect_json() == {"ok": True, "compact": compact}
+            send_json(sock, {"op": "reset", "request": {"seed": 3}})
+            assert reader.read()[0] == b"S" and reader.read()[0] == tag
+            send_json(sock, {"op": "close"})
+            assert reader.expect_json() == {"ok": True}

@@ -102,3 +102,13 @@ def test_the_fixed_layout_is_the_robot_api_message() -> None:
             if image is not None:
                 assert np.array_equal(fast[2], image) and np.array_equal(generic[2], image)
         assert np.array_equal(decode_sensors(m.SerializeToString())[1], sensors)
+
+
+def test_truth_frames() -> None:
+    from envs.frame import TRUTH_SIZE
+    from envs.wire import decode_truth, encode_truth
+
+    truth = np.linspace(-3.0, 3.0, TRUTH_SIZE)
+    assert np.array_equal(decode_truth(encode_truth(truth)), truth)
+    with pytest.raises(WireError, match="a truth frame of 8 bytes"):
+        decode_truth(b"\0" * 8)
