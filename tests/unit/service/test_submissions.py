@@ -352,3 +352,36 @@ def test_slurm_account_names_are_per_team_and_slurm_safe() -> None:
     assert account_name(8, "Red.Robots") == "hlvs_t8_red_robots"  # the id keeps them apart
     assert account_name(9, "..") == "hlvs_t9"
     assert len(account_name(10, "x" * 64)) <= 40
+
+
+def test_a_render_left_by_an_earlier_service_process_is_waited_for(
+        start: Callable[..., Served], token: Callable[..., str], pool: FakePool) -> None:
+    """render.json names a render that still runs (started before a restart): the video stays
+    pending until it ends; then, no video being there, it is rendered again (and here fails:
+    the fake pool's replay is not a real one)."""
+    import json
+    import subprocess
+
+    from service.pool.local import process_start_time
+
+    served = start(video=True)
+    with setup_team(served, token("Alpha"), "Alpha") as http:
+        sid = http.post("/v1/submissions", json={}).json()["id"]
+        running = wait_for(http, sid, lambda b: b["state"] == "running")
+        work = (served.settings.matches_dir / running["match_id"]).resolve()
+        earlier = subprocess.Popen(["sleep", "60"])
+        try:
+            (work / "render.json").write_text(json.dumps({
+                "pid": earlier.pid, "start_time": process_start_time(earlier.pid),
+                "renders": 1}))
+            pool.finish(handle_of(served, sid), {"status": "success"})
+            wait_for(http, sid, lambda b: b["state"] == "done")
+            time.sleep(1.5)  # rounds of the after-match thread
+            assert http.get(f"/v1/submissions/{sid}").json()["video"]["state"] == "pending"
+        finally:
+            earlier.kill()
+            earlier.wait()
+        ended = wait_for(http, sid, lambda b: b["video"]["state"] != "pending", 60)
+        assert ended["video"]["state"] == "failed", ended["video"]
+        assert "hlvs render exited with code 2" in ended["video"]["detail"]
+        assert json.loads((work / "render.json").read_text())["renders"] == 2
