@@ -59,15 +59,16 @@ function numberSprite(robot: RobotSpec): THREE.Sprite {
 }
 
 /** A unit primitive that geoms are drawn as (scaled by their sizes): boxes, spheres (also
- * ellipsoids and unknown shapes), cylinders; a capsule is an open tube with a low-poly sphere
- * at each end. Few triangles: software WebGL pays for each one, however small on screen. */
+ * ellipsoids and unknown shapes), cylinders; a capsule is an open tube with a low-poly half
+ * sphere at each end, facing outwards. Few triangles: software WebGL pays for each one,
+ * however small on screen. */
 type Primitive = "box" | "sphere" | "cylinder" | "tube" | "cap";
 
 function unitGeometry(kind: Primitive): THREE.BufferGeometry {
   const shape =
     kind === "box" ? new THREE.BoxGeometry(2, 2, 2)
     : kind === "sphere" ? new THREE.SphereGeometry(1, 10, 6)
-    : kind === "cap" ? new THREE.SphereGeometry(1, 6, 4)
+    : kind === "cap" ? new THREE.SphereGeometry(1, 8, 2, 0, 2 * Math.PI, 0, Math.PI / 2).rotateX(Math.PI / 2) // +z half, rim on the tube's
     : kind === "tube" ? new THREE.CylinderGeometry(1, 1, 2, 8, 1, true).rotateX(Math.PI / 2)
     : new THREE.CylinderGeometry(1, 1, 2, 12).rotateX(Math.PI / 2); // along z like MuJoCo's
   shape.deleteAttribute("uv");
@@ -88,8 +89,9 @@ function pieces(g: GeomSpec): Piece[] {
     new THREE.Quaternion(g.quat[1], g.quat[2], g.quat[3], g.quat[0]),
     new THREE.Vector3(1, 1, 1),
   );
-  const scaled = (x: number, y: number, z: number, dz = 0): THREE.Matrix4 =>
-    frame.clone().multiply(new THREE.Matrix4().makeTranslation(0, 0, dz)).scale(new THREE.Vector3(x, y, z));
+  const scaled = (x: number, y: number, z: number, dz = 0, flip = false): THREE.Matrix4 =>
+    frame.clone().multiply(new THREE.Matrix4().makeTranslation(0, 0, dz))
+      .multiply(new THREE.Matrix4().makeRotationX(flip ? Math.PI : 0)).scale(new THREE.Vector3(x, y, z));
   switch (g.type) {
     case "box":
       return [{ kind: "box", local: scaled(a, b, c) }];
@@ -99,7 +101,7 @@ function pieces(g: GeomSpec): Piece[] {
       return [
         { kind: "tube", local: scaled(a, a, b) },
         { kind: "cap", local: scaled(a, a, a, b) },
-        { kind: "cap", local: scaled(a, a, a, -b) },
+        { kind: "cap", local: scaled(a, a, a, -b, true) },
       ];
     case "ellipsoid":
       return [{ kind: "sphere", local: scaled(a, b, c) }];
