@@ -123,7 +123,7 @@ def _copy_public(match: MatchContext) -> None:
     if match_dir is None:
         return
     for name in PUBLIC_FILES:
-        source = match_dir / "out" / name
+        source = match_dir / files.OUT_DIR / name
         if source.is_file():
             shutil.copy2(source, public / name)
 

@@ -126,7 +126,7 @@ class FakeRuntime:
 
     def _finish_simulator(self, found: FakeContainer) -> None:
         mount = found.request.mounts[0].source
-        out = Path(mount) / "out"
+        out = Path(mount) / files.OUT_DIR
         out.mkdir(parents=True, exist_ok=True)
         if self.simulator_exit_code == 0:
             self.sim_result.write(out / files.SIM_RESULT)

@@ -104,8 +104,8 @@ def _start(match: MatchContext, started_at: float) -> None:
 def _write_spec(match: MatchContext, addresses: dict[str, tuple[str, ...]],
                 endpoint: str | None) -> tuple[MatchSpec, Path]:
     match_dir = match.options.out_dir / "simulator"
-    (match_dir / "out").mkdir(parents=True, exist_ok=True)
-    for folder in (match_dir, match_dir / "out"):
+    (match_dir / files.OUT_DIR).mkdir(parents=True, exist_ok=True)
+    for folder in (match_dir, match_dir / files.OUT_DIR):
         folder.chmod(0o777)
     match.started.match_dir = match_dir
     spec = match.plan.spec_builder(addresses, endpoint)
