@@ -10,6 +10,7 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import docker
 import numpy as np
@@ -81,11 +82,11 @@ def test_two_remotes_on_the_cluster_step_are_replaced_and_released(
 
 
 def test_a_dead_client_lets_its_remote_go_when_the_lease_expires(
-    cluster: str, docker_client: docker.DockerClient
+    cluster: str, docker_client: docker.DockerClient, tmp_path: Path
 ) -> None:
-    code = (
+    code = (  # its job folder (kept: nobody closed the pool) goes to tmp_path
         "import gymnasium as gym, envs, sys\n"
-        f"env = gym.make('hlvs/Kick-v0', remotes='slurm:1?conf={cluster}&lease=4')\n"
+        f"env = gym.make('hlvs/Kick-v0', remotes='slurm:1?conf={cluster}&lease=4&dir={tmp_path}')\n"
         "env.reset(seed=1)\n"
         "print(env.unwrapped._owner.launcher.jobs[0].job_id, flush=True)\n"
         "sys.stdin.read()\n"
