@@ -5,8 +5,9 @@ token is in the token cache and whose submission is on the board is answered fro
 :class:`service.middleware.StatusFastPath`, before routing: no database query, no worker
 thread, no serialization. The board is rebuilt by one query every ``ttl_s`` seconds, by its own
 thread and only while polls read it, so a poll never waits for a rebuild (it reads the previous
-board meanwhile). A submission this process changes (submit, cancel) is dropped from the board
-at once (its next poll reads the database), also from a rebuild that was under way; queue
+board meanwhile). A submission this process creates is put on the board at once; one it
+changes otherwise (cancel) is dropped from it at once (its next poll reads the database), also
+from a rebuild that was under way; queue
 controls and worker rounds that changed something set the whole board aside until the early
 rebuild they ask for is done. Other submissions' positions may lag a change by about
 ``ttl_s``. Each rebuild also runs the ``also`` callbacks with its session (the token cache
@@ -32,6 +33,9 @@ log = logging.getLogger(__name__)
 Render = Callable[[Session, Submission, str], bytes]
 """(session, row, team name) -> the JSON body of the row's status."""
 
+MIN_GAP_S = 0.2
+"""Rebuilds asked for early are at least this far apart."""
+
 IDLE_S = 30.0
 """No rebuild when no poll has read the board for this long."""
 
@@ -47,7 +51,8 @@ class StatusBoard:
         self._at = float("-inf")  # monotonic time of the query the board was built from
         self._read_at = float("-inf")
         self._invalidated_at = float("-inf")
-        self._forgotten: dict[str, float] = {}
+        # submissions this process changed: when, and their new entry (None: dropped)
+        self._changed: dict[str, tuple[float, tuple[int, bytes] | None]] = {}
         self._lock = threading.Lock()
         self._wake = threading.Event()
         self._stop = threading.Event()
@@ -75,8 +80,11 @@ class StatusBoard:
                         session.commit()
                 except Exception:  # the thread's boundary: polls fall back to the database
                     log.exception("status board rebuild failed; retrying")
+            began = time.monotonic()
             self._wake.wait(self.ttl_s)
             self._wake.clear()
+            # woken early (a change, a poll the board missed): not more often than this
+            self._stop.wait(max(0.0, min(MIN_GAP_S, self.ttl_s) - (time.monotonic() - began)))
 
     # changes -------------------------------------------------------------------------------
     def invalidate(self) -> None:
@@ -85,11 +93,22 @@ class StatusBoard:
         self._invalidated_at = time.monotonic()
         self._wake.set()
 
+    def missed(self) -> None:
+        """A poll for an active submission found it not on the board (new, or the board was
+        set aside): rebuild soon, so that the next polls find it."""
+        self._wake.set()
+
     def forget(self, submission_id: str) -> None:
         """Drop one submission (it changed); the others stay until the next rebuild."""
         with self._lock:
             self._bodies.pop(submission_id, None)
-            self._forgotten[submission_id] = time.monotonic()
+            self._changed[submission_id] = (time.monotonic(), None)
+
+    def put(self, submission_id: str, team_id: int, body: bytes) -> None:
+        """The status of a submission this process just made: on the board at once."""
+        with self._lock:
+            self._bodies[submission_id] = (team_id, body)
+            self._changed[submission_id] = (time.monotonic(), (team_id, body))
 
     # reads ---------------------------------------------------------------------------------
     def lookup(self, submission_id: str, team_id: int | None) -> bytes | None:
@@ -114,11 +133,13 @@ class StatusBoard:
             Submission.state.in_([s.value for s in ACTIVE_STATES]))).all()
         bodies = {row.id: (row.team_id, self.render(session, row, name)) for row, name in rows}
         with self._lock:
-            for sid, when in list(self._forgotten.items()):
-                if when >= started:
-                    bodies.pop(sid, None)  # changed while this board was being built
+            for sid, (when, entry) in list(self._changed.items()):
+                if when < started:
+                    del self._changed[sid]  # the query saw the change
+                elif entry is None:  # changed while this board was being built
+                    bodies.pop(sid, None)
                 else:
-                    del self._forgotten[sid]
+                    bodies[sid] = entry
             self._bodies = bodies
             self._at = started
 

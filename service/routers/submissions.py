@@ -22,7 +22,7 @@ from contracts.errors import ContractError
 from contracts.match_results import MatchReport, MatchResults
 from service import submissions, teamfiles
 from service.app import Services
-from service.db import Submission
+from service.db import ACTIVE_STATES, Submission
 from service.deps import DbSession, TeamPrincipal, bearer, get_services, require_team
 from service.errors import NotFound
 from service.matchfiles import OWN_COLOR
@@ -36,6 +36,7 @@ from service.views import (
 )
 
 router = APIRouter(prefix="/v1/submissions", tags=["submissions"])
+ACTIVE_VALUES = frozenset(state.value for state in ACTIVE_STATES)
 
 
 
@@ -69,7 +70,9 @@ def create_submission(body: SubmissionCreate, request: Request, principal: TeamP
     services.changed(row.id)
     if services.worker is not None:
         services.worker.wake()
-    return view_of(request, session, row, principal.team_name)
+    view = view_of(request, session, row, principal.team_name)
+    services.status.put(row.id, team_id, view.model_dump_json().encode())
+    return view
 
 
 @router.get("")
@@ -105,6 +108,8 @@ def _status_body(services: Services, presented: str | None, submission_id: str) 
                                queue=services.queue,
                                team_name=principal.team_name).model_dump_json().encode()
         session.commit()
+        if row.state in ACTIVE_VALUES:
+            services.status.missed()
         return body
 
 
