@@ -94,8 +94,9 @@ class StatusBoard:
         self._wake.set()
 
     def missed(self) -> None:
-        """A poll for an active submission found it not on the board (new, or the board was
-        set aside): rebuild soon, so that the next polls find it."""
+        """A poll missed the board (its submission is not on it, or its token not in the
+        cache, e.g. after a quiet spell): rebuild soon, so that the next polls find them."""
+        self._read_at = time.monotonic()
         self._wake.set()
 
     def forget(self, submission_id: str) -> None:

@@ -100,6 +100,7 @@ async def get_submission(
 
 def _status_body(services: Services, presented: str | None, submission_id: str) -> bytes:
     with services.sessions() as session:
+        token_cached = services.tokens.cached(presented) is not None
         principal = require_team(services.tokens.verify(session, presented))
         assert principal.team_id is not None
         row = submissions.get_own(session, team_id=principal.team_id,
@@ -108,8 +109,8 @@ def _status_body(services: Services, presented: str | None, submission_id: str) 
                                queue=services.queue,
                                team_name=principal.team_name).model_dump_json().encode()
         session.commit()
-        if row.state in ACTIVE_VALUES:
-            services.status.missed()
+        if row.state in ACTIVE_VALUES or not token_cached:
+            services.status.missed()  # the next polls find it (and the cached tokens renewed)
         return body
 
 
