@@ -65,7 +65,7 @@ def test_the_pool_page_lists_slurm_nodes_their_state_and_the_match_on_each(
     reason = f"pool page test {match_id}"
     try:
         _until(lambda: _slurm(cluster, "squeue", "-h", "-j", job, "-o", "%T").strip()
-               == "RUNNING", f"job {job} running")
+               == "RUNNING", f"job {job} running", timeout_s=180)
         on = _slurm(cluster, "squeue", "-h", "-j", job, "-o", "%N").strip()
         listed = _slurm(cluster, "sinfo", "-N", "-h", "-o", "%N %T").split()
         names, states = listed[0::2], dict(zip(listed[0::2], listed[1::2], strict=True))
@@ -89,6 +89,8 @@ def test_the_pool_page_lists_slurm_nodes_their_state_and_the_match_on_each(
         assert node[4].startswith("2/2") and node[6] == "1/1"
         if drained is not None:
             assert rows[drained][1].startswith("drain") and rows[drained][2].startswith(reason)
+            marked = page.locator("[data-testid=nodes] tr.down td:first-child").all_inner_texts()
+            assert drained in marked and all(rows[m][2] != "-" for m in marked)  # out of service
         assert page.locator("[data-testid=nodes-summary]").inner_text().startswith(
             f"{len(set(names))} node(s)")
         screenshot(page, "service-pool-slurm")

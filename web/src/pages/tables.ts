@@ -153,12 +153,14 @@ async function poolSection(): Promise<HTMLElement> {
   const [queue, pool] = await Promise.all([getJson<Queue>("/v1/operator/queue"), getJson<PoolNodes>("/v1/operator/nodes")]);
   const running = queue.active.filter((s) => s.state === "running" || s.state === "starting");
   const down = pool.nodes.filter((n) => n.reason !== "").length;
+  const nodes = table("nodes", ["node", "state", "reason", "features", "CPUs", "memory", "matches", "running"], nodeRows(pool.nodes));
+  pool.nodes.forEach((n, i) => { if (n.reason !== "") nodes.rows[i + 1].classList.add("down"); });
   return el("div", { "data-testid": "pool-section" },
     el("p", { "data-testid": "pool-summary" }, `${queue.slots} match slot(s), ${running.length} in use${queue.paused ? ", queue paused" : ""}`),
     table("pool", ["slot", "submission", "team", "state", "started"], running.map((s, i) => [String(i + 1), s.id, s.team, s.state, when(s.started_at)])),
     el("h2", {}, `Nodes (${pool.pool} pool)`),
     el("p", { "data-testid": "nodes-summary" }, `${pool.nodes.length} node(s), ${down} out of service`),
-    table("nodes", ["node", "state", "reason", "features", "CPUs", "memory", "matches", "running"], nodeRows(pool.nodes)),
+    nodes,
     el("p", { class: "muted", "data-testid": "pool-updated" }, `updated ${new Date().toISOString().slice(11, 19)} UTC`),
   );
 }
