@@ -188,12 +188,14 @@ class SlurmLauncher:
 
     def _submit(self, index: int) -> _Job:
         folder = self.root / f"remote-{index}-{self._submitted}"
+        from service.pool.nodes import ENV_REMOTE_COMMENT
+
         self._submitted += 1
         folder.mkdir()
         (folder / LEASE_FILE).write_text("0")
         job_id = self.slurm.submit_script(
             self._script(folder), name=f"hlvs-env-{self.pool_id}-{index}", work=folder,
-            account=self.options.account, cpus=self.options.cpus,
+            account=self.options.account, cpus=self.options.cpus, comment=ENV_REMOTE_COMMENT,
         )  # fmt: skip
         job = _Job(job_id, folder)
         if index < len(self.jobs):

@@ -73,7 +73,8 @@ def _status(args: argparse.Namespace) -> int:
     if not entries:
         print("no match jobs in the cluster")
     for e in entries:
-        print(f"{e.job_id:>6} {e.name.removeprefix('hlvs-'):<24} {e.account:<12} "
+        what = e.name.removeprefix("hlvs-") if e.kind == "match" else f"({e.kind}) {e.name}"
+        print(f"{e.job_id:>6} {what:<24} {e.account:<12} "
               f"{e.state:<10} {e.reason:<20} {e.expected_start} {e.nodes}")
     for n in nodes:
         jobs = ", ".join(f"{j.match_id or 'job'} ({j.job_id})" for j in n.jobs) or "-"

@@ -16,8 +16,11 @@ from typing import Any
 # sinfo -N: one line per node and partition; the reason last (free text that may hold '|')
 SINFO_FORMAT = "%N|%T|%C|%m|%e|%O|%f|%E"
 # squeue: every job with its nodes (empty while pending)
-SQUEUE_NODES_FORMAT = "%i|%j|%T|%N"
+SQUEUE_NODES_FORMAT = "%i|%j|%T|%N|%k"
 MATCH_JOB_PREFIX = "hlvs-"  # the Slurm pool names a match's job hlvs-<match id>
+# the Slurm comment of a job that serves a learning environment (not a match); its name is
+# hlvs-env-..., which a match id could also give, so the comment tells them apart
+ENV_REMOTE_COMMENT = "hlvs:environment-remote"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -58,8 +61,10 @@ class PoolNode:
         }
 
 
-def match_of_job_name(name: str) -> str | None:
-    return name.removeprefix(MATCH_JOB_PREFIX) if name.startswith(MATCH_JOB_PREFIX) else None
+def match_of_job_name(name: str, comment: str = "") -> str | None:
+    if comment == ENV_REMOTE_COMMENT or not name.startswith(MATCH_JOB_PREFIX):
+        return None
+    return name.removeprefix(MATCH_JOB_PREFIX)
 
 
 _BRACKET = re.compile(r"\[([^\]]*)\]")
@@ -146,16 +151,16 @@ def parse_squeue_nodes(text: str) -> dict[str, list[NodeJob]]:
     for line in text.splitlines():
         if not line.strip():
             continue
-        job_id, name, state, nodelist = (line.split("|", 3) + ["", "", ""])[:4]
+        job_id, name, state, nodelist, comment = (line.split("|", 4) + [""] * 4)[:5]
         if not nodelist.strip() or state == "PENDING":
             continue
-        job = NodeJob(job_id=job_id, match_id=match_of_job_name(name), state=state)
+        job = NodeJob(job_id=job_id, match_id=match_of_job_name(name, comment), state=state)
         for node in expand_hostlist(nodelist):
             per_node.setdefault(node, []).append(job)
     return per_node
 
 
 __all__ = [
-    "NodeJob", "PoolNode", "expand_hostlist", "match_of_job_name", "parse_sinfo",
-    "parse_squeue_nodes",
+    "ENV_REMOTE_COMMENT", "NodeJob", "PoolNode", "expand_hostlist", "match_of_job_name",
+    "parse_sinfo", "parse_squeue_nodes",
 ]

@@ -40,14 +40,18 @@ from contracts import files
 from service.errors import PoolError
 from service.pool import JobState, JobStatus, MatchJob
 from service.pool.nodes import (
+    ENV_REMOTE_COMMENT,
     SINFO_FORMAT,
     SQUEUE_NODES_FORMAT,
     PoolNode,
+    match_of_job_name,
     parse_sinfo,
     parse_squeue_nodes,
 )
 
 log = logging.getLogger(__name__)
+
+QUEUE_FORMAT = "%i|%j|%a|%T|%r|%S|%N|%k"  # id, name, account, state, reason, start, nodes, comment
 
 STATE_FILE = "slurm.json"
 HOST_NETNS = "/run/netns/hlvs-host"  # named by scripts/ensure-slurm.sh
@@ -68,12 +72,19 @@ class QueueEntry:
     reason: str  # why it waits (Priority, Resources, AssocGrpJobsLimit...) or "None"
     expected_start: str  # ISO time Slurm expects it to start (pending), or when it started
     nodes: str
+    comment: str = ""
 
-    def to_json(self) -> dict[str, str]:
+    @property
+    def kind(self) -> str:
+        """``match``, or ``environment`` for a learning environment's remote."""
+        return "environment" if self.comment == ENV_REMOTE_COMMENT else "match"
+
+    def to_json(self) -> dict[str, str | None]:
         return {
-            "job_id": self.job_id, "match_id": self.name.removeprefix("hlvs-"),
-            "account": self.account, "state": self.state, "reason": self.reason,
-            "expected_start": self.expected_start, "nodes": self.nodes,
+            "job_id": self.job_id, "kind": self.kind,
+            "match_id": match_of_job_name(self.name, self.comment), "account": self.account,
+            "state": self.state, "reason": self.reason, "expected_start": self.expected_start,
+            "nodes": self.nodes,
         }
 
 
@@ -136,7 +147,8 @@ class SlurmPool:
         return self._handle(job_id, work)
 
     def submit_script(self, script: str, *, name: str, work: Path, requeue: bool = False,
-                      account: str | None = None, cpus: int | None = None) -> str:
+                      account: str | None = None, cpus: int | None = None,
+                      comment: str | None = None) -> str:
         """Submit ``script`` as one batch job named ``name``, run in ``work`` (its output in
         ``work/slurm-<job>.out``), on a whole node (``--exclusive -N1``) or, with ``cpus``, as
         one task of that many CPUs (a partition may still give it a whole node); the job id."""
@@ -150,6 +162,8 @@ class SlurmPool:
             args.append(f"--account={account}")
         if self.qos:
             args.append(f"--qos={self.qos}")
+        if comment:
+            args.append(f"--comment={comment}")
         result = self._run(args, stdin=script, handle=str(work))
         job_id = result.strip().split(";")[0]
         if not job_id.isdigit():
@@ -161,7 +175,7 @@ class SlurmPool:
         if not job_ids:
             return {}
         text = self._run(["squeue", "-h", "-j", ",".join(job_ids), "-o",
-                          "%i|%j|%a|%T|%r|%S|%N"], handle=",".join(job_ids), ok_codes=(0, 1))
+                          QUEUE_FORMAT], handle=",".join(job_ids), ok_codes=(0, 1))
         found = (_parse_entry(line) for line in text.splitlines() if "|" in line)
         return {e.job_id: e for e in found if e.job_id in job_ids}
 
@@ -266,7 +280,7 @@ class SlurmPool:
     # queue for hlvs pool status ------------------------------------------------------------
     def queue(self) -> list[QueueEntry]:
         """Every match job Slurm knows of (pending first), with its reason and expected start."""
-        text = self._run(["squeue", "-h", "-o", "%i|%j|%a|%T|%r|%S|%N"], handle="squeue")
+        text = self._run(["squeue", "-h", "-o", QUEUE_FORMAT], handle="squeue")
         entries = _merged(_parse_entry(line) for line in text.splitlines() if line.strip())
         return sorted((e for e in entries if e.name.startswith("hlvs-")),
                       key=lambda e: (e.state != "PENDING", e.job_id))
@@ -323,7 +337,7 @@ class SlurmPool:
         return job_id if isinstance(job_id, str) else None
 
     def _entry(self, job_id: str) -> QueueEntry | None:
-        text = self._run(["squeue", "-h", "-j", job_id, "-o", "%i|%j|%a|%T|%r|%S|%N"],
+        text = self._run(["squeue", "-h", "-j", job_id, "-o", QUEUE_FORMAT],
                          handle=job_id, ok_codes=(0, 1))
         entries = _merged(_parse_entry(line) for line in text.splitlines() if line.strip())
         return next((e for e in entries if e.job_id == job_id), None)
@@ -369,9 +383,10 @@ def _merged(entries: Iterable[QueueEntry]) -> list[QueueEntry]:
 
 
 def _parse_entry(line: str) -> QueueEntry:
-    job_id, name, account, state, reason, start, nodes = (line.split("|") + [""] * 7)[:7]
+    job_id, name, account, state, reason, start, nodes, comment = (
+        line.split("|", 7) + [""] * 8)[:8]
     return QueueEntry(job_id=job_id, name=name, account=account, state=state, reason=reason,
-                      expected_start=start, nodes=nodes)
+                      expected_start=start, nodes=nodes, comment=comment)
 
 
 __all__ = ["QueueEntry", "SlurmPool"]

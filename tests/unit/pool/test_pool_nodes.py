@@ -14,7 +14,13 @@ import pytest
 
 from service.pool import MatchJob
 from service.pool.local import LocalDockerPool
-from service.pool.nodes import expand_hostlist, parse_sinfo, parse_squeue_nodes
+from service.pool.nodes import (
+    ENV_REMOTE_COMMENT,
+    expand_hostlist,
+    parse_sinfo,
+    parse_squeue_nodes,
+)
+from service.pool.slurm import _merged, _parse_entry
 
 
 @pytest.mark.parametrize(("text", "names"), [
@@ -67,6 +73,27 @@ def test_squeue_jobs_per_node() -> None:
     assert {node: [(j.job_id, j.match_id, j.state) for j in js] for node, js in jobs.items()} \
         == {"n1": [("41", "m-7", "RUNNING")], "n2": [("42", None, "RUNNING")],
             "n3": [("42", None, "RUNNING"), ("44", "m-9", "COMPLETING")]}
+
+
+def test_an_environment_remote_job_is_not_a_match() -> None:
+    jobs = parse_squeue_nodes(
+        f"51|hlvs-env-ab12-0|RUNNING|n4|{ENV_REMOTE_COMMENT}\n52|hlvs-env-x|RUNNING|n5|\n"
+    )
+    assert [(j.job_id, j.match_id) for j in jobs["n4"]] == [("51", None)]
+    assert [(j.job_id, j.match_id) for j in jobs["n5"]] == [("52", "env-x")]  # a match's id
+
+
+def test_queue_entries_say_their_kind_and_merge_league_components() -> None:
+    lines = [f"60|hlvs-env-ab12-0|root|RUNNING|None|2026-11-23T15:00:00|n1|{ENV_REMOTE_COMMENT}",
+             "61+0|hlvs-league-1|team_a|RUNNING|None|2026-11-23T15:01:00|n2|",
+             "61+1|hlvs-league-1|team_a|RUNNING|None|2026-11-23T15:01:00|n3|"]
+    env, league = _merged(_parse_entry(line) for line in lines)
+    assert env.to_json() == {
+        "job_id": "60", "kind": "environment", "match_id": None, "account": "root",
+        "state": "RUNNING", "reason": "None", "expected_start": "2026-11-23T15:00:00",
+        "nodes": "n1"}
+    assert (league.job_id, league.kind, league.nodes) == ("61", "match", "n2,n3")
+    assert league.to_json()["match_id"] == "league-1"
 
 
 def test_the_local_pool_is_this_host_with_its_match_processes(tmp_path: Path) -> None:
