@@ -7,7 +7,9 @@ wall time of the whole batch, submit-to-start latency percentiles (Slurm's Submi
 StartTime), and the pool's overhead: a match's wall time through the pool (submit to report)
 over the local match's wall time, median over the pool's matches. With more matches than nodes
 the later ones wait for a node, so the overhead is computed over the first ``--nodes``
-matches only. Prints one JSON line.
+matches only. ``--placement league`` plays 2 v 2 scrimmages, each with the simulator and every
+robot on a node of its own (five nodes per match; the local match is the same 2 v 2 on this
+host). Prints one JSON line.
 """
 
 from __future__ import annotations
@@ -32,7 +34,7 @@ ROOT = Path(__file__).resolve().parents[1]
 CONF = "/var/lib/hlvs/slurm/slurm.conf"
 
 
-def _job(folder: Path, name: str, half_s: float) -> Any:
+def _job(folder: Path, name: str, half_s: float, *, league: bool = False) -> Any:
     from orchestrator.match.scrimmage import write_files
     from orchestrator.project_images import project_image
     from service.pool import MatchJob
@@ -40,7 +42,7 @@ def _job(folder: Path, name: str, half_s: float) -> Any:
     args = argparse.Namespace(
         red_image=None,
         blue_image=None,
-        players=1,
+        players=2 if league else 1,
         half_duration=half_s,
         wait_before_ready=1.0,
         grace=2.0,
@@ -49,7 +51,8 @@ def _job(folder: Path, name: str, half_s: float) -> Any:
         seed=5,
     )
     game = write_files(args, folder / name / "config", stub_image=project_image("stub"))
-    return MatchJob(match_id=args.match_id, game_path=game, work_dir=folder / name)
+    return MatchJob(match_id=args.match_id, game_path=game, work_dir=folder / name,
+                    robot_nodes=4 if league else 0)
 
 
 def _status(out: Path) -> str:
@@ -92,6 +95,13 @@ def main(argv: list[str] | None = None) -> int:
         default=4.0,
         help="simulated seconds per half of each scrimmage (default 4)",
     )
+    parser.add_argument(
+        "--placement",
+        choices=("dense", "league"),
+        default="dense",
+        help="dense (default): a 1 v 1 on one node per match; league: a 2 v 2 with the "
+        "simulator and each robot on a node of its own",
+    )
     parser.add_argument("--json", action="store_true", help="accepted: the output is JSON")
     args = parser.parse_args(argv)
     from service.pool import JobState
@@ -109,7 +119,8 @@ def main(argv: list[str] | None = None) -> int:
         return 3
     with tempfile.TemporaryDirectory(prefix="hlvs-bench-pool-") as tmp:
         folder = Path(tmp)
-        local = _job(folder, "local", args.half_duration)
+        league = args.placement == "league"
+        local = _job(folder, "local", args.half_duration, league=league)
         started = time.monotonic()
         subprocess.run(
             [
@@ -127,7 +138,9 @@ def main(argv: list[str] | None = None) -> int:
         )
         local_s = time.monotonic() - started
         pool = SlurmPool(slurm_conf=CONF, host_network=True, slots=args.nodes)
-        jobs = [_job(folder, f"p{i}", args.half_duration) for i in range(args.matches)]
+        jobs = [_job(folder, f"p{i}", args.half_duration, league=league)
+                for i in range(args.matches)]
+        at_once = max(1, args.nodes // 5) if league else args.nodes  # matches side by side
         batch_start = time.monotonic()
         handles = [pool.submit(job) for job in jobs]
         ended: dict[str, float] = {}
@@ -145,11 +158,12 @@ def main(argv: list[str] | None = None) -> int:
             times = _sacct_times(handle.split(":")[1])
             if times is not None:
                 latencies.append(times[1] - times[0])
-        first = sorted(ended[h] for h in handles)[: args.nodes]
+        first = sorted(ended[h] for h in handles)[:at_once]
         outcomes = [_status(pool.results_dir(h)) for h in handles]
         result = {
             "bench": "pool",
             "nodes": args.nodes,
+            "placement": args.placement,
             "matches": args.matches,
             "completed": sum(1 for o in outcomes if o == "success"),
             "outcomes": outcomes,

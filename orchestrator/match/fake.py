@@ -207,6 +207,9 @@ class FakeHost:
     def remove_node_firewall(self, netns: str | None) -> None:
         self.node_firewalls.pop(str(netns), None)
 
+    def in_netns(self, pid: int, netns: str) -> bool:
+        return True
+
     def counters(self, applied: AppliedShaping) -> TrafficCounters:
         return TrafficCounters(sent_api_bytes=100, sent_comm_bytes=10, received_api_bytes=200,
                                received_comm_bytes=20)

@@ -39,6 +39,8 @@ class Host(Protocol):
 
     def remove_node_firewall(self, netns: str | None) -> None: ...
 
+    def in_netns(self, pid: int, netns: str) -> bool: ...
+
     def counters(self, applied: AppliedShaping) -> TrafficCounters: ...
 
     def log_folder(self, *, match_id: str, name: str, cap_bytes: int, fallback: Path
@@ -110,6 +112,14 @@ class HostControl:
     def remove_node_firewall(self, netns: str | None) -> None:
         if self.firewall:
             nodes.remove(netns)
+
+    def in_netns(self, pid: int, netns: str) -> bool:
+        """Whether process ``pid`` has entered the network namespace ``netns`` (a path)."""
+        try:
+            mine, theirs = os.stat(f"/proc/{pid}/ns/net"), os.stat(netns)
+        except OSError:
+            return False
+        return (mine.st_dev, mine.st_ino) == (theirs.st_dev, theirs.st_ino)
 
     def counters(self, applied: AppliedShaping) -> TrafficCounters:
         return bandwidth.read_counters(applied)

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import logging
 import shutil
+import time
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
@@ -32,6 +33,8 @@ from orchestrator.match.results import FailureClass
 from orchestrator.match.runtime import Attachment, ContainerRequest, SubnetInUse
 
 log = logging.getLogger(__name__)
+
+NODE_HOLDER_TIMEOUT_S = 20.0
 
 
 def _create_network(match: MatchContext, role: str, internal: bool) -> None:
@@ -156,6 +159,15 @@ def _node_holder(match: MatchContext, placement: LeaguePlacement, node: Node, *,
     holder_id = match.runtime.create_container(request)
     match.started.holder_ids[key] = holder_id
     match.runtime.start(holder_id)
+    # a container started in the holder's network joins the namespace the holder's process
+    # is in at that moment: wait until nsenter has entered the node's
+    deadline = match.clock() + NODE_HOLDER_TIMEOUT_S
+    while not match.host.in_netns(match.runtime.inspect(holder_id).pid, netns):
+        if match.clock() > deadline or match.runtime.inspect(holder_id).exited:
+            raise InfrastructureError(
+                f"league placement of {key}: the holder of node {node.name} did not enter "
+                f"{netns} within {NODE_HOLDER_TIMEOUT_S:.0f} s")
+        time.sleep(0.02)
     return holder_id
 
 

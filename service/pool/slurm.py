@@ -211,6 +211,18 @@ class SlurmPool:
                 "sed -n 's/^NodeAddr=//p')",
                 '  nodes="$nodes${nodes:+,}$name=$addr"',
                 "done",
+                # a step on each robot node holds it while its robot runs: cancelled (or the
+                # job ending), it stops the node's robot with a grace period (also when the
+                # match's orchestrator died) and leaves the match a moment to collect its logs,
+                # instead of the node ending at once and its epilog removing the robot
+                'export HLVS_SLURM_JOB="$SLURM_JOB_ID"',
+                "keeper=$(cat <<'KEEP'",
+                *_KEEPER.splitlines(),
+                "KEEP",
+                ")",
+                f"for group in $(seq 1 {job.robot_nodes}); do",
+                '  srun --het-group="$group" -N1 -n1 --quiet sh -c "$keeper" &',
+                "done",
             ]
         keep = ["slurm.json", "slurm-*.out", "config", "attempt-*"]
         game = job.game_path.resolve()
@@ -365,6 +377,20 @@ class SlurmPool:
             raise PoolError(handle=handle, reason=f"{' '.join(args[:2])}: exit "
                             f"{result.returncode}: {result.stderr.strip()[-300:]}")
         return result.stdout
+
+
+_KEEPER = """\
+mine="--filter label=org.hlvs-runner.slurm-job=$HLVS_SLURM_JOB"
+mine="$mine --filter label=org.hlvs-runner.node=$SLURMD_NODENAME"
+stop() {
+  robots=$(docker ps -q $mine --filter label=org.hlvs-runner.role=robot)
+  [ -z "$robots" ] || docker stop -t 120 $robots >/dev/null 2>&1
+  n=0
+  while [ $n -lt 30 ] && [ -n "$(docker ps -aq $mine)" ]; do sleep 0.5; n=$((n + 1)); done
+  exit 0
+}
+trap stop TERM INT
+while :; do sleep 1 & wait $!; done"""
 
 
 def _merged(entries: Iterable[QueueEntry]) -> list[QueueEntry]:

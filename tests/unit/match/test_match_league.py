@@ -206,3 +206,35 @@ def test_service_worker_asks_a_node_per_robot_in_league_placement(tmp_path: Path
         settings = Settings.from_env({"HLVS_SERVICE_DATA_DIR": str(tmp_path), **env})
         worker = QueueWorker(SimpleNamespace(settings=settings, pool=None))  # type: ignore[arg-type]
         assert worker._robot_nodes(game) == nodes
+
+
+def test_containers_join_a_node_holder_only_once_it_is_in_the_nodes_network(
+    tmp_path: Path,
+) -> None:
+    checks: list[str] = []
+
+    class SlowHolders(FakeHost):  # nsenter has not entered the node's namespace at once
+        def in_netns(self, pid: int, netns: str) -> bool:
+            checks.append(netns)
+            return checks.count(netns) > 2
+
+    runtime = FakeRuntime()
+    created_after: dict[str, int] = {}
+    runtime.on_start = lambda c: created_after.setdefault(c.request.name, len(checks))
+    placement = parse_nodes(NODES, KEYS, netns="/run/netns/hlvs-{node}")
+    outcome = MatchRunner(_plan(), runtime=runtime, host=SlowHolders(), options=RunOptions(
+        out_dir=tmp_path, simulator_image="sim:1", poll_s=0.0, placement=placement)).run()
+    assert outcome.ok, outcome.failure
+    assert sorted(set(checks)) == [f"/run/netns/hlvs-n{i}" for i in range(1, 6)]
+    assert created_after["hlvs-u1-simulator"] >= 3  # after its holder's third check
+
+    class NeverThere(FakeHost):
+        def in_netns(self, pid: int, netns: str) -> bool:
+            return False
+
+    ticks = iter(range(0, 10_000, 5))
+    outcome = MatchRunner(_plan(), runtime=FakeRuntime(), host=NeverThere(), options=RunOptions(
+        out_dir=tmp_path / "never", simulator_image="sim:1", poll_s=0.0, placement=placement),
+        clock=lambda: float(next(ticks))).run()
+    assert not outcome.ok
+    assert "did not enter /run/netns/hlvs-n" in str(outcome.failure)
