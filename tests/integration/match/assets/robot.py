@@ -32,6 +32,28 @@ def try_connect(host, port, timeout=1.0):
         sock.close()
 
 
+def try_simulator(retry_s=20.0):
+    """The simulator starts side by side with the robots: retry while it does not listen yet,
+    as the robot clients do."""
+    deadline = time.monotonic() + retry_s
+    while True:
+        result = try_connect(*sim_addr())
+        if result == "connected" or time.monotonic() > deadline:
+            return result
+        time.sleep(0.2)
+
+
+def connect_simulator(retry_s=20.0):
+    deadline = time.monotonic() + retry_s
+    while True:
+        try:
+            return socket.create_connection(sim_addr(), timeout=10)
+        except ConnectionRefusedError:
+            if time.monotonic() > deadline:
+                raise
+            time.sleep(0.2)
+
+
 def measure(sock):
     """Receive until EOF; the rate in bit/s after the first 0.5 s (token bucket burst)."""
     marks = []
@@ -68,7 +90,7 @@ def main(argv):
         for target in argv[2:]:
             host, port = target.rsplit(":", 1)
             reach[target] = try_connect(host, int(port))
-        reach["simulator"] = try_connect(*sim_addr())
+        reach["simulator"] = try_simulator()
         log("reach.json", reach)
         print("env written", flush=True)
         wait_forever()
@@ -129,7 +151,7 @@ def main(argv):
         wait_forever()
     if mode == "send":
         seconds = float(argv[2]) if len(argv) > 2 else 3.0
-        sock = socket.create_connection(sim_addr(), timeout=10)
+        sock = connect_simulator()
         chunk = b"\0" * 65536
         end = time.monotonic() + seconds
         while time.monotonic() < end:
@@ -139,7 +161,7 @@ def main(argv):
         wait_forever()
     if mode == "recv":  # ask the simulator for data, measure the rate that arrives
         seconds = float(argv[2]) if len(argv) > 2 else 3.0
-        sock = socket.create_connection(sim_addr(), timeout=10)
+        sock = connect_simulator()
         sock.sendall(f"DOWNLOAD {seconds}\n".encode())
         log("recv.json", {"rate_bit_s": measure(sock)})
         wait_forever()
