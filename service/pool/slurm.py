@@ -116,9 +116,7 @@ class SlurmPool:
         out = work / self.out_subdir if self.out_subdir else work
         out.mkdir(parents=True, exist_ok=True)
         script = self._script(job, out)
-        args = ["sbatch", "--parsable", f"--job-name=hlvs-{job.match_id}",
-                f"--chdir={work}", f"--output={work / LOG_FILE}", "--open-mode=append",
-                "--requeue" if job.requeue else "--no-requeue"]
+        args = self._batch_args(name=f"hlvs-{job.match_id}", work=work, requeue=job.requeue)
         account = job.account
         # dense: one whole node; league: a heterogeneous job, the simulator's node (component
         # 0, where the batch script runs) and a node for each robot, allocated together
@@ -127,17 +125,8 @@ class SlurmPool:
         for index, component in enumerate(components):
             if index:
                 args.append(":")
-            args += ["--exclusive", "-N1", *component]
-            if self.partition:
-                args.append(f"--partition={self.partition}")
-            if account:
-                args.append(f"--account={account}")
-            if self.qos:
-                args.append(f"--qos={self.qos}")
-        result = self._run(args, stdin=script, handle=str(work))
-        job_id = result.strip().split(";")[0]
-        if not job_id.isdigit():
-            raise PoolError(handle=str(work), reason=f"sbatch answered {result.strip()!r}")
+            args += ["--exclusive", "-N1", *component, *self._placement_args(account)]
+        job_id = self._sbatch(args, script, work)
         tmp = work / (STATE_FILE + ".tmp")
         tmp.write_text(json.dumps({"job_id": job_id, "match_id": job.match_id,
                                    "account": account}))
@@ -153,22 +142,11 @@ class SlurmPool:
         ``work/slurm-<job>.out``), on a whole node (``--exclusive -N1``) or, with ``cpus``, as
         one task of that many CPUs (a partition may still give it a whole node); the job id."""
         share = ["--exclusive"] if cpus is None else ["-n1", f"--cpus-per-task={cpus}"]
-        args = ["sbatch", "--parsable", *share, "-N1", f"--job-name={name}",
-                f"--chdir={work}", f"--output={work / LOG_FILE}", "--open-mode=append",
-                "--requeue" if requeue else "--no-requeue"]
-        if self.partition:
-            args.append(f"--partition={self.partition}")
-        if account:
-            args.append(f"--account={account}")
-        if self.qos:
-            args.append(f"--qos={self.qos}")
+        args = [*self._batch_args(name=name, work=work, requeue=requeue), *share, "-N1",
+                *self._placement_args(account)]
         if comment:
             args.append(f"--comment={comment}")
-        result = self._run(args, stdin=script, handle=str(work))
-        job_id = result.strip().split(";")[0]
-        if not job_id.isdigit():
-            raise PoolError(handle=str(work), reason=f"sbatch answered {result.strip()!r}")
-        return job_id
+        return self._sbatch(args, script, work)
 
     def entries(self, job_ids: list[str]) -> dict[str, QueueEntry]:
         """What Slurm's queue says of these jobs (one ``squeue``); ended jobs are absent."""
@@ -362,6 +340,28 @@ class SlurmPool:
         text = self._run(["sacct", "-n", "-X", "-P", "-j", job_id, "-o", "State,ExitCode"],
                          handle=job_id, ok_codes=(0, 1))
         return text.strip().splitlines()[0] if text.strip() else ""
+
+    @staticmethod
+    def _batch_args(*, name: str, work: Path, requeue: bool) -> list[str]:
+        """``sbatch`` for one job named ``name``, run in ``work`` (its output appended to
+        ``work/slurm-<job>.out``)."""
+        return ["sbatch", "--parsable", f"--job-name={name}", f"--chdir={work}",
+                f"--output={work / LOG_FILE}", "--open-mode=append",
+                "--requeue" if requeue else "--no-requeue"]
+
+    def _placement_args(self, account: str | None) -> list[str]:
+        """The partition, account and QOS a job (or each component of a het job) runs under."""
+        return [*([f"--partition={self.partition}"] if self.partition else []),
+                *([f"--account={account}"] if account else []),
+                *([f"--qos={self.qos}"] if self.qos else [])]
+
+    def _sbatch(self, args: list[str], script: str, work: Path) -> str:
+        """Submit; the job id ``sbatch --parsable`` answers."""
+        result = self._run(args, stdin=script, handle=str(work))
+        job_id = result.strip().split(";")[0]
+        if not job_id.isdigit():
+            raise PoolError(handle=str(work), reason=f"sbatch answered {result.strip()!r}")
+        return job_id
 
     def _run(self, args: list[str], *, handle: str, stdin: str | None = None,
              ok_codes: tuple[int, ...] = (0,)) -> str:
