@@ -11,11 +11,9 @@ import os
 import subprocess
 import sys
 import time
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-import httpx
 import pytest
 
 from service import Settings
@@ -23,6 +21,7 @@ from service.db import Scope, make_engine, migrate, session_factory, transaction
 from service.pool.slurm import SlurmPool
 from service.tokens import issue
 from tests.integration.service.harness import serve
+from tests.unit.service.conftest import wait_for_status
 
 pytestmark = [pytest.mark.docker, pytest.mark.root, pytest.mark.slow]
 
@@ -33,17 +32,6 @@ EXAMPLE_TEAM = Path(__file__).parents[3] / "configs" / "examples" / "scrimmage_1
 def slurm(cluster: str, *args: str) -> str:
     return subprocess.run(list(args), capture_output=True, text=True, check=True, timeout=60,
                           env={**os.environ, "SLURM_CONF": cluster}).stdout
-
-
-def wait_for(http: httpx.Client, sid: str, predicate: Callable[[dict[str, Any]], bool],
-             timeout_s: float) -> dict[str, Any]:
-    deadline = time.monotonic() + timeout_s
-    while True:
-        body: dict[str, Any] = http.get(f"/v1/submissions/{sid}").json()
-        if predicate(body):
-            return body
-        assert time.monotonic() < deadline, f"timed out; last status {body}"
-        time.sleep(0.5)
 
 
 def test_team_matches_run_under_its_account_and_wait_with_slurms_reason(
@@ -91,7 +79,7 @@ def test_team_matches_run_under_its_account_and_wait_with_slurms_reason(
             created = http.post("/v1/submissions", json={})
             assert created.status_code == 201, created.text
             sid = created.json()["id"]
-            waiting = wait_for(http, sid, lambda b: "AssocGrpJobsLimit" in str(
+            waiting = wait_for_status(http, sid, lambda b: "AssocGrpJobsLimit" in str(
                 b["waiting_reason"]), 60)
             assert waiting["state"] == "starting" and waiting["charged"] is False
             assert waiting["queue_position"] is None
@@ -102,7 +90,7 @@ def test_team_matches_run_under_its_account_and_wait_with_slurms_reason(
 
             asked = http.post(f"/v1/submissions/{sid}/cancel").json()
             assert asked["cancel_requested"] is True
-            ended = wait_for(http, sid, lambda b: b["state"] != "starting", 60)
+            ended = wait_for_status(http, sid, lambda b: b["state"] != "starting", 60)
             assert ended["state"] == "cancelled" and ended["charged"] is False, ended
             assert ended["waiting_reason"] is None
     finally:

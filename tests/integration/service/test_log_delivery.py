@@ -4,8 +4,6 @@ comes from the fake pool (real matches deliver in test_real_matches.py)."""
 
 from __future__ import annotations
 
-import time
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -26,28 +24,18 @@ from tests.integration.delivery.test_delivery_s3 import ensure_bucket, read_buck
 from tests.integration.delivery.test_delivery_sftp import sftp_body
 from tests.integration.service.conftest import TokenMaker
 from tests.integration.service.harness import Served, serve
-from tests.unit.service.conftest import team_doc
-
-
-def wait_for(http: httpx.Client, sid: str, predicate: Callable[[dict[str, Any]], bool],
-             timeout_s: float = 30.0) -> dict[str, Any]:
-    deadline = time.monotonic() + timeout_s
-    while True:
-        body: dict[str, Any] = http.get(f"/v1/submissions/{sid}").json()
-        if predicate(body):
-            return body
-        assert time.monotonic() < deadline, f"timed out; last status {body}"
-        time.sleep(0.1)
+from tests.unit.service.conftest import team_doc, wait_for_status
 
 
 def play(served: Served, pool: FakePool, http: httpx.Client) -> dict[str, Any]:
     """Submit, let the fake pool finish the match, wait until the delivery has ended."""
     sid = http.post("/v1/submissions", json={}).json()["id"]
-    wait_for(http, sid, lambda b: b["state"] == "running")
+    wait_for_status(http, sid, lambda b: b["state"] == "running", 30)
     [handle] = [h for h, m in pool.handles.items() if m.startswith(sid)]
     pool.finish(handle, {"status": "success"})
-    return wait_for(http, sid, lambda b: b["state"] == "done" and b["log_delivery"] is not None
-                    and b["log_delivery"]["state"] != "pending")
+    return wait_for_status(http, sid, lambda b: b["state"] == "done"
+                           and b["log_delivery"] is not None
+                           and b["log_delivery"]["state"] != "pending", 30)
 
 
 @pytest.mark.parametrize("db_url", ["sqlite"], indirect=True)
@@ -107,10 +95,11 @@ def test_logs_go_to_the_uploaded_sftp_or_s3_target_and_failures_say_why(
         clients["Delta"] = delta
         assert delta.put("/v1/team/files/team_config", json=team_doc("Delta")).status_code == 201
         sid = delta.post("/v1/submissions", json={}).json()["id"]
-        wait_for(delta, sid, lambda b: b["state"] == "running")
+        wait_for_status(delta, sid, lambda b: b["state"] == "running", 30)
         [handle] = [h for h, m in pool.handles.items() if m.startswith(sid)]
         pool.finish(handle, {"status": "success"})
-        assert wait_for(delta, sid, lambda b: b["state"] == "done")["log_delivery"] is None
+        done = wait_for_status(delta, sid, lambda b: b["state"] == "done", 30)
+        assert done["log_delivery"] is None
     finally:
         for http in clients.values():
             http.close()

@@ -6,13 +6,12 @@ from __future__ import annotations
 import json
 import os
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from email import message_from_bytes
 from email.message import Message
 from pathlib import Path
 from typing import Any
 
-import httpx
 import pytest
 
 from service import Settings
@@ -21,6 +20,7 @@ from tests.integration.delivery.conftest import check_manifest, moto  # noqa: F4
 from tests.integration.delivery.test_delivery_s3 import ensure_bucket, read_bucket, s3_body
 from tests.integration.service.conftest import TokenMaker
 from tests.integration.service.harness import free_port, serve
+from tests.unit.service.conftest import wait_for_status
 
 pytestmark = [pytest.mark.docker, pytest.mark.slow,
               pytest.mark.skipif(os.geteuid() != 0, reason="matches need root (host controls)")]
@@ -71,17 +71,6 @@ def real_settings(settings: Settings, docker_client: Any) -> Settings:
                           video_fps=5.0)
 
 
-def wait_for(http: httpx.Client, sid: str, predicate: Callable[[dict[str, Any]], bool],
-             timeout_s: float) -> dict[str, Any]:
-    deadline = time.monotonic() + timeout_s
-    while True:
-        body: dict[str, Any] = http.get(f"/v1/submissions/{sid}").json()
-        if predicate(body):
-            return body
-        assert time.monotonic() < deadline, f"timed out waiting; last status {body}"
-        time.sleep(0.3)
-
-
 @pytest.mark.parametrize("db_url", ["postgresql"], indirect=True)
 def test_submit_run_mail_download_and_isolation(
         real_settings: Settings, make_token: TokenMaker, inbox: tuple[Inbox, int],
@@ -105,7 +94,7 @@ def test_submit_run_mail_download_and_isolation(
         assert created.json()["preflight_s"] < 30
         second = alpha.post("/v1/submissions", json={})
         assert second.status_code == 409 and second.json()["existing_id"] == sid
-        wait_for(alpha, sid, lambda b: b["state"] == "running", 30)
+        wait_for_status(alpha, sid, lambda b: b["state"] == "running", 30)
 
         # Beta waits behind Alpha's match, then cancels while queued: no charge.
         queued = beta.post("/v1/submissions", json={})
@@ -116,7 +105,7 @@ def test_submit_run_mail_download_and_isolation(
         cancelled = beta.post(f"/v1/submissions/{waiting['id']}/cancel").json()
         assert cancelled["state"] == "cancelled" and cancelled["charged"] is False
 
-        done = wait_for(alpha, sid, lambda b: b["state"] in ("done", "failed"), 180)
+        done = wait_for_status(alpha, sid, lambda b: b["state"] in ("done", "failed"), 180)
         assert done["state"] == "done", done
         report = alpha.get(f"/v1/submissions/{sid}/report").json()
         assert report["match_report"] == {"status": "success"}
@@ -134,7 +123,8 @@ def test_submit_run_mail_download_and_isolation(
             assert beta.get(f"/v1/submissions/{sid}{path}").status_code == 404, path
 
         # Alpha's logs went to its S3 bucket after the match
-        delivered = wait_for(alpha, sid, lambda b: b["log_delivery"]["state"] != "pending", 60)
+        delivered = wait_for_status(alpha, sid,
+                                    lambda b: b["log_delivery"]["state"] != "pending", 60)
         assert delivered["log_delivery"]["state"] == "delivered", delivered["log_delivery"]
         bucket = read_bucket(moto.endpoint_url, moto.admin, "alpha-logs", "hlvs/2026")
         check_manifest(bucket, f"{done['match_id']}/Alpha")
@@ -142,7 +132,7 @@ def test_submit_run_mail_download_and_isolation(
 
         # the video is rendered after the match ended, outside it
         assert done["video"]["state"] in ("pending", "ready"), done
-        rendered = wait_for(alpha, sid, lambda b: b["video"]["state"] != "pending", 180)
+        rendered = wait_for_status(alpha, sid, lambda b: b["video"]["state"] != "pending", 180)
         assert rendered["video"]["state"] == "ready", rendered["video"]
         assert "320x180 at 5 fps" in rendered["video"]["detail"]
         video = alpha.get(f"/v1/submissions/{sid}/video")
@@ -205,7 +195,7 @@ def test_restart_mid_match_then_cancel_running(real_settings: Settings,
     with served.client(token) as http:
         assert http.put("/v1/team/files/team_config", json=team_doc("Alpha")).status_code == 201
         sid = http.post("/v1/submissions", json={}).json()["id"]
-        running = wait_for(http, sid, lambda b: b["state"] == "running", 30)
+        running = wait_for_status(http, sid, lambda b: b["state"] == "running", 30)
     served.stop()
     work = settings.matches_dir / running["match_id"]
     pid = json.loads((work / "pool.json").read_text())["pid"]
@@ -215,14 +205,14 @@ def test_restart_mid_match_then_cancel_running(real_settings: Settings,
     try:
         with again.client(token) as http:
             time.sleep(1.5)  # a few worker rounds
-            status = wait_for(http, sid, lambda b: b["state"] == "running", 10)
+            status = wait_for_status(http, sid, lambda b: b["state"] == "running", 10)
             assert status["attempts"] == 1 and status["match_id"] == running["match_id"]
             assert json.loads((work / "pool.json").read_text())["pid"] == pid
             assert sorted(p.name for p in settings.matches_dir.iterdir()) == [
                 running["match_id"]]
             asked = http.post(f"/v1/submissions/{sid}/cancel").json()
             assert asked["cancel_requested"] is True
-            ended = wait_for(http, sid, lambda b: b["state"] != "running", 90)
+            ended = wait_for_status(http, sid, lambda b: b["state"] != "running", 90)
             assert ended["state"] == "cancelled", ended
             report = http.get(f"/v1/submissions/{sid}/report").json()
             assert report["match_report"]["failure_class"] == "interrupted"

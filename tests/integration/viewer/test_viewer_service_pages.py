@@ -18,7 +18,8 @@ from service.pool.fake import FakePool
 from tests.integration.service.harness import Served
 from tests.integration.viewer.conftest import screenshot
 from tests.unit.schedule.test_schedule import COMPRESSED, FAKE, write_schedule
-from tests.unit.service.test_submissions import handle_of, setup_team, wait_for
+from tests.unit.service.conftest import wait_for_status
+from tests.unit.service.test_submissions import handle_of, setup_team
 from tests.unit.viewer.replays import record_match
 
 pytestmark = pytest.mark.browser
@@ -59,7 +60,7 @@ def test_queue_submissions_replay_standings_and_pool_pages(
     secrets = {name: token(name) for name in ("A1", "B2", "C3")}
     clients = [setup_team(served, secrets[name], name) for name in secrets]
     ids = [c.post("/v1/submissions", json={}).json()["id"] for c in clients]
-    wait_for(clients[0], ids[0], lambda b: b["state"] == "running")
+    wait_for_status(clients[0], ids[0], lambda b: b["state"] == "running")
 
     _use_token(page, served.url, token(operator=True), "/watch/queue")
     rows = _rows(page, "queue")
@@ -94,7 +95,7 @@ def test_queue_submissions_replay_standings_and_pool_pages(
 
     handle = handle_of(served, ids[0])
     pool.finish(handle, {"status": "success"})
-    wait_for(clients[0], ids[0], lambda b: b["state"] == "done")
+    wait_for_status(clients[0], ids[0], lambda b: b["state"] == "done")
     page.wait_for_function(  # the pool page refreshes by itself: the match left the node
         "document.querySelector('[data-testid=nodes] tr:nth-child(2) td:nth-child(8)')"
         ".innerText.startsWith(" + repr(ids[1]) + ")", timeout=20_000)

@@ -4,10 +4,12 @@ real app served on 127.0.0.1 with SQLite."""
 from __future__ import annotations
 
 import json
+import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
+import httpx
 import pytest
 
 from service import Settings
@@ -16,6 +18,20 @@ from service.errors import PreflightFailed
 from service.pool.fake import FakePool
 from service.tokens import issue
 from tests.integration.service.harness import Served, serve
+
+
+def wait_for_status(http: httpx.Client, submission: str,
+                    predicate: Callable[[dict[str, Any]], bool],
+                    timeout_s: float = 10.0) -> dict[str, Any]:
+    """Poll a submission's status until ``predicate`` holds; the status then."""
+    deadline = time.monotonic() + timeout_s
+    while True:
+        body: dict[str, Any] = http.get(f"/v1/submissions/{submission}").json()
+        if predicate(body):
+            return body
+        assert time.monotonic() < deadline, f"timed out; last status {body}"
+        time.sleep(0.1)
+
 
 EXAMPLE_TEAM = Path(__file__).parents[3] / "configs" / "examples" / "scrimmage_1v1" / \
     "team_red.json"

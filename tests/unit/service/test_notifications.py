@@ -15,7 +15,8 @@ import pytest
 from service import webhooks
 from service.pool.fake import FakePool
 from tests.integration.service.harness import Served
-from tests.unit.service.test_submissions import handle_of, setup_team, wait_for
+from tests.unit.service.conftest import wait_for_status
+from tests.unit.service.test_submissions import handle_of, setup_team
 
 SECRET = "a-webhook-secret-of-the-team"
 
@@ -83,9 +84,9 @@ def test_webhooks_are_signed_retried_and_not_replayable(
         assert SECRET not in answer.text
     with setup_team(served, tok, "Alpha") as http:
         sid = http.post("/v1/submissions", json={}).json()["id"]
-        wait_for(http, sid, lambda b: b["state"] == "running")
+        wait_for_status(http, sid, lambda b: b["state"] == "running")
         pool.finish(handle_of(served, sid), {"status": "success"})
-        wait_for(http, sid, lambda b: b["state"] == "done")
+        wait_for_status(http, sid, lambda b: b["state"] == "done")
     deadline = time.monotonic() + 15
     while len(state.accepted) < 2:
         assert time.monotonic() < deadline, (state.accepted, state.rejected)

@@ -8,7 +8,8 @@ from service.errors import PoolError
 from service.pool import PoolNode
 from service.pool.fake import FakePool
 from tests.integration.service.harness import Served
-from tests.unit.service.test_submissions import setup_team, wait_for
+from tests.unit.service.conftest import wait_for_status
+from tests.unit.service.test_submissions import setup_team
 
 
 def test_operators_see_the_nodes_and_the_submission_on_each(
@@ -17,7 +18,7 @@ def test_operators_see_the_nodes_and_the_submission_on_each(
     served = start()
     team = setup_team(served, token("Alpha"), "Alpha")
     sid = team.post("/v1/submissions", json={}).json()["id"]
-    body = wait_for(team, sid, lambda b: b["state"] == "running")
+    body = wait_for_status(team, sid, lambda b: b["state"] == "running")
     refused = team.get("/v1/operator/nodes")  # a team's token is not an operator's
     assert refused.status_code == 401 and "operator" in refused.text, refused.text
     with served.client() as anonymous:

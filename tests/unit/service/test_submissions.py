@@ -6,24 +6,12 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
 
 import httpx
 
 from service.pool.fake import FakePool
 from tests.integration.service.harness import Served
-from tests.unit.service.conftest import team_doc
-
-
-def wait_for(http: httpx.Client, submission: str, predicate: Callable[[dict[str, Any]], bool],
-             timeout_s: float = 10.0) -> dict[str, Any]:
-    deadline = time.monotonic() + timeout_s
-    while True:
-        body: dict[str, Any] = http.get(f"/v1/submissions/{submission}").json()
-        if predicate(body):
-            return body
-        assert time.monotonic() < deadline, f"timed out; last status {body}"
-        time.sleep(0.05)
+from tests.unit.service.conftest import team_doc, wait_for_status
 
 
 def handle_of(served: Served, submission: str) -> str:
@@ -53,13 +41,13 @@ def test_submit_run_finish_and_download(start: Callable[..., Served], token: Cal
         created = http.post("/v1/submissions", json={})
         assert created.status_code == 201, created.text
         sid = created.json()["id"]
-        running = wait_for(http, sid, lambda b: b["state"] == "running")
+        running = wait_for_status(http, sid, lambda b: b["state"] == "running")
         assert running["queue_position"] is None and running["charged"] is True
         second = http.post("/v1/submissions", json={"opponent": "stub"})
         assert second.status_code == 409
         assert second.json()["existing_id"] == sid
         pool.finish(handle_of(served, sid), {"status": "success"})
-        done = wait_for(http, sid, lambda b: b["state"] == "done")
+        done = wait_for_status(http, sid, lambda b: b["state"] == "done")
         assert done["failure_class"] is None
         report = http.get(f"/v1/submissions/{sid}/report").json()
         assert report["status"] == "success" and report["backend_error"] is False
@@ -77,7 +65,7 @@ def test_submit_run_finish_and_download(start: Callable[..., Served], token: Cal
         again = http.post("/v1/submissions", json={})
         assert again.status_code == 201
         sid2 = again.json()["id"]
-        wait_for(http, sid2, lambda b: b["state"] == "running")
+        wait_for_status(http, sid2, lambda b: b["state"] == "running")
     assert pool.started == [f"{sid}-a1", f"{sid2}-a1"]
 
 
@@ -113,10 +101,10 @@ def test_cancel_queued_is_free_and_cancel_running_stops_the_match(
         assert again.status_code == 409
         operator.post("/v1/operator/queue/resume")
         sid2 = http.post("/v1/submissions", json={}).json()["id"]
-        wait_for(http, sid2, lambda b: b["state"] == "running")
+        wait_for_status(http, sid2, lambda b: b["state"] == "running")
         asked = http.post(f"/v1/submissions/{sid2}/cancel").json()
         assert asked["cancel_requested"] is True
-        ended = wait_for(http, sid2, lambda b: b["state"] == "cancelled")
+        ended = wait_for_status(http, sid2, lambda b: b["state"] == "cancelled")
         assert "gracefully" in ended["cause"]
         assert pool.cancelled == [handle_of(served, sid2)]
     operator.close()
@@ -127,7 +115,7 @@ def test_queue_position_expected_start_and_reason(start: Callable[..., Served],
     served = start(expected_match_s=600.0)
     clients = [setup_team(served, token(name), name) for name in ("A1", "B2", "C3")]
     ids = [c.post("/v1/submissions", json={}).json()["id"] for c in clients]
-    wait_for(clients[0], ids[0], lambda b: b["state"] == "running")
+    wait_for_status(clients[0], ids[0], lambda b: b["state"] == "running")
     second = clients[1].get(f"/v1/submissions/{ids[1]}").json()
     third = clients[2].get(f"/v1/submissions/{ids[2]}").json()
     assert (second["queue_position"], third["queue_position"]) == (1, 2)
@@ -148,15 +136,15 @@ def test_restart_mid_match_neither_loses_nor_duplicates(
     tok = token("Alpha")
     with setup_team(served, tok, "Alpha") as http:
         sid = http.post("/v1/submissions", json={}).json()["id"]
-        wait_for(http, sid, lambda b: b["state"] == "running")
+        wait_for_status(http, sid, lambda b: b["state"] == "running")
     served.stop()
     again = start()
     with again.client(tok) as http:
-        status = wait_for(http, sid, lambda b: b["state"] == "running")
+        status = wait_for_status(http, sid, lambda b: b["state"] == "running")
         assert status["attempts"] == 1
         assert pool.started == [f"{sid}-a1"]  # adopted, not started twice
         pool.lose(handle_of(again, sid))  # the match process died with the host
-        back = wait_for(http, sid, lambda b: b["attempts"] == 2 and b["state"] == "running")
+        back = wait_for_status(http, sid, lambda b: b["attempts"] == 2 and b["state"] == "running")
         assert back["match_id"] == f"{sid}-a2"
         assert pool.started == [f"{sid}-a1", f"{sid}-a2"]
 
@@ -168,20 +156,20 @@ def test_operator_requeues_only_league_failures(start: Callable[..., Served],
     operator = served.client(token(operator=True))
     with setup_team(served, token("Alpha"), "Alpha") as http:
         sid = http.post("/v1/submissions", json={}).json()["id"]
-        wait_for(http, sid, lambda b: b["state"] == "running")
+        wait_for_status(http, sid, lambda b: b["state"] == "running")
         pool.finish(handle_of(served, sid), {"status": "failed", "failure_class": "simulator",
                                              "cause": "simulator exited with code 139"})
-        failed = wait_for(http, sid, lambda b: b["state"] == "failed")
+        failed = wait_for_status(http, sid, lambda b: b["state"] == "failed")
         assert failed["failure_side"] == "league" and failed["charged"] is False
         report = http.get(f"/v1/submissions/{sid}/report").json()
         assert report["backend_error"] is True and report["failure_class"] == "simulator"
         assert http.post(f"/v1/operator/submissions/{sid}/requeue").status_code == 401
         requeued = operator.post(f"/v1/operator/submissions/{sid}/requeue")
         assert requeued.status_code == 200, requeued.text
-        rerun = wait_for(http, sid, lambda b: b["state"] == "running" and b["attempts"] == 2)
+        rerun = wait_for_status(http, sid, lambda b: b["state"] == "running" and b["attempts"] == 2)
         pool.finish(handle_of(served, sid), {"status": "failed", "failure_class": "team_crash",
                                              "cause": "robots broke the match"})
-        team_fault = wait_for(http, sid, lambda b: b["state"] == "failed")
+        team_fault = wait_for_status(http, sid, lambda b: b["state"] == "failed")
         assert team_fault["failure_side"] == "team" and rerun["charged"] is True
         refused = operator.post(f"/v1/operator/submissions/{sid}/requeue")
         assert refused.status_code == 409
@@ -279,7 +267,7 @@ def test_a_start_interrupted_by_a_restart_is_submitted_once(
     engine.dispose()
     again = start()
     with again.client(tok) as http:
-        status = wait_for(http, sid, lambda b: b["state"] == "running")
+        status = wait_for_status(http, sid, lambda b: b["state"] == "running")
         assert status["attempts"] == 1 and status["match_id"] == f"{sid}-a1"
     assert pool.started == [f"{sid}-a1"]
     operator.close()
@@ -332,12 +320,12 @@ def test_a_failed_video_render_leaves_the_match_done(
     served = start(video=True)
     with setup_team(served, token("Alpha"), "Alpha") as http:
         sid = http.post("/v1/submissions", json={}).json()["id"]
-        wait_for(http, sid, lambda b: b["state"] == "running")
+        wait_for_status(http, sid, lambda b: b["state"] == "running")
         assert http.get(f"/v1/submissions/{sid}").json()["video"] is None
         pool.finish(handle_of(served, sid), {"status": "success"})
-        done = wait_for(http, sid, lambda b: b["state"] == "done")
+        done = wait_for_status(http, sid, lambda b: b["state"] == "done")
         assert done["video"]["state"] in ("pending", "failed")
-        ended = wait_for(http, sid, lambda b: b["video"]["state"] != "pending", 60)
+        ended = wait_for_status(http, sid, lambda b: b["video"]["state"] != "pending", 60)
         assert ended["state"] == "done" and ended["video"]["state"] == "failed", ended
         assert "hlvs render exited with code 2" in ended["video"]["detail"]
         assert "replay" in ended["video"]["detail"]
@@ -367,7 +355,7 @@ def test_a_render_left_by_an_earlier_service_process_is_waited_for(
     served = start(video=True)
     with setup_team(served, token("Alpha"), "Alpha") as http:
         sid = http.post("/v1/submissions", json={}).json()["id"]
-        running = wait_for(http, sid, lambda b: b["state"] == "running")
+        running = wait_for_status(http, sid, lambda b: b["state"] == "running")
         work = (served.settings.matches_dir / running["match_id"]).resolve()
         earlier = subprocess.Popen(["sleep", "60"])
         try:
@@ -375,13 +363,13 @@ def test_a_render_left_by_an_earlier_service_process_is_waited_for(
                 "pid": earlier.pid, "start_time": process_start_time(earlier.pid),
                 "renders": 1}))
             pool.finish(handle_of(served, sid), {"status": "success"})
-            wait_for(http, sid, lambda b: b["state"] == "done")
+            wait_for_status(http, sid, lambda b: b["state"] == "done")
             time.sleep(1.5)  # rounds of the after-match thread
             assert http.get(f"/v1/submissions/{sid}").json()["video"]["state"] == "pending"
         finally:
             earlier.kill()
             earlier.wait()
-        ended = wait_for(http, sid, lambda b: b["video"]["state"] != "pending", 60)
+        ended = wait_for_status(http, sid, lambda b: b["video"]["state"] != "pending", 60)
         assert ended["video"]["state"] == "failed", ended["video"]
         assert "hlvs render exited with code 2" in ended["video"]["detail"]
         assert json.loads((work / "render.json").read_text())["renders"] == 2
