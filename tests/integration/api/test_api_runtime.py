@@ -11,6 +11,7 @@ import threading
 import time
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -57,34 +58,33 @@ def _play(spec: MatchSpec, out: Path) -> tuple[int, list[tuple[int, float]]]:
     return code, trace
 
 
-def test_lockstep_match_replays_identically(tmp_path: Path) -> None:
-    spec = short_spec(stepping="lockstep", timing=replace(
-        short_spec().timing, wait_before_first_ready_real_s=1.0))  # fmt: skip
+def _play_twice(spec: MatchSpec, tmp_path: Path) -> tuple[list[tuple[int, float]], dict[str, Any]]:
+    """Play ``spec`` twice with the same clients: the same joint trace and the same recording
+    byte for byte; the first run's trace and sim_result."""
     code_a, trace_a = _play(spec, tmp_path / "a")
     code_b, trace_b = _play(spec, tmp_path / "b")
     assert code_a == code_b == 0
     assert len(trace_a) > 100 and trace_a == trace_b
     replay_a = (tmp_path / "a" / "replay.hlvsrec").read_bytes()
     assert replay_a == (tmp_path / "b" / "replay.hlvsrec").read_bytes()
-    result = json.loads((tmp_path / "a" / "sim_result.json").read_text())
-    assert result["state"] == "FINISHED" and result["winner"] == "draw"
+    result: dict[str, Any] = json.loads((tmp_path / "a" / "sim_result.json").read_text())
     assert result["robots"]["red-1"]["messages_in"] > 100
     assert result["robots"]["red-1"]["slow_periods"] == 0
+    return trace_a, result
+
+
+def test_lockstep_match_replays_identically(tmp_path: Path) -> None:
+    spec = short_spec(stepping="lockstep", timing=replace(
+        short_spec().timing, wait_before_first_ready_real_s=1.0))  # fmt: skip
+    _, result = _play_twice(spec, tmp_path)
+    assert result["state"] == "FINISHED" and result["winner"] == "draw"
 
 
 def test_pipelined_match_replays_identically_and_differs_from_lockstep(tmp_path: Path) -> None:
     timing = replace(short_spec().timing, wait_before_first_ready_real_s=1.0)
     spec = short_spec(stepping="pipelined", timing=timing)
-    code_a, trace_a = _play(spec, tmp_path / "a")
-    code_b, trace_b = _play(spec, tmp_path / "b")
-    assert code_a == code_b == 0
-    assert len(trace_a) > 100 and trace_a == trace_b
-    replay_a = (tmp_path / "a" / "replay.hlvsrec").read_bytes()
-    assert replay_a == (tmp_path / "b" / "replay.hlvsrec").read_bytes()
-    result = json.loads((tmp_path / "a" / "sim_result.json").read_text())
+    trace_a, result = _play_twice(spec, tmp_path)
     assert result["stepping"] == "pipelined" and result["state"] == "FINISHED"
-    assert result["robots"]["red-1"]["messages_in"] > 100
-    assert result["robots"]["red-1"]["slow_periods"] == 0
     # the same clients in lockstep: the actions apply one step earlier, so the joints differ
     code_l, trace_l = _play(replace(spec, stepping="lockstep"), tmp_path / "l")
     assert code_l == 0 and len(trace_l) > 100
