@@ -9,7 +9,6 @@ nothing changed. Without a base image given, the base is made locally with deboo
 
 from __future__ import annotations
 
-import fcntl
 import hashlib
 import logging
 import time
@@ -24,6 +23,7 @@ from orchestrator.console import NullProgress, Progress, StepTracker
 from orchestrator.engine import LABEL_PROJECT, connect
 from orchestrator.engine import images as engine_images
 from orchestrator.errors import ConfigError, ImageError, Problem
+from orchestrator.filelock import held
 
 if TYPE_CHECKING:
     from docker import DockerClient
@@ -316,12 +316,8 @@ def _prune_old_versions(client: DockerClient, recipe: ImageRecipe, *, keep_id: s
 def _build_lock() -> Iterator[None]:
     """One build at a time across processes (tests and make may ask concurrently)."""
     BUILD_DIR.mkdir(parents=True, exist_ok=True)
-    with (BUILD_DIR / "images.lock").open("w") as handle:
-        fcntl.flock(handle, fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(handle, fcntl.LOCK_UN)
+    with held(BUILD_DIR / "images.lock"):
+        yield
 
 
 __all__ = [

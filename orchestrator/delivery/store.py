@@ -28,6 +28,8 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any, Literal
 
+from orchestrator.filelock import held
+
 __all__ = [
     "FileEntry",
     "PendingSet",
@@ -102,12 +104,8 @@ def sets_dir(store: Path) -> Path:
 def locked(store: Path) -> Iterator[None]:
     """Hold the store's lock (an flock on ``<store>/.lock``), waiting for other holders."""
     store.mkdir(parents=True, exist_ok=True)
-    with (store / ".lock").open("a") as handle:
-        fcntl.flock(handle, fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(handle, fcntl.LOCK_UN)
+    with held(store / ".lock"):
+        yield
 
 
 @contextmanager

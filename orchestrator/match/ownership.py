@@ -11,7 +11,6 @@ whose orchestrator is gone, and finds their output folder here to salvage the te
 from __future__ import annotations
 
 import contextlib
-import fcntl
 import json
 import os
 import socket
@@ -22,6 +21,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from orchestrator.errors import OrchestratorError
+from orchestrator.filelock import held
 from orchestrator.match.logfs import safe_name, state_dir
 
 LABEL_RUN = "org.hlvs-runner.run"  # value: the run id of the orchestrator that created it
@@ -120,12 +120,8 @@ def forget(record: RunRecord) -> None:
 @contextlib.contextmanager
 def _locked() -> Iterator[None]:
     runs_dir().mkdir(parents=True, exist_ok=True, mode=0o700)
-    with open(runs_dir() / ".lock", "a") as handle:
-        fcntl.flock(handle, fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(handle, fcntl.LOCK_UN)
+    with held(runs_dir() / ".lock"):
+        yield
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
