@@ -1,4 +1,4 @@
-"""The three-node Slurm cluster on this machine (scripts/ensure-slurm.sh, idempotent)."""
+"""The five-node Slurm cluster on this machine (scripts/ensure-slurm.sh, idempotent)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""``hlvs scrimmage --pool slurm``: the match runs as a Slurm job on a node of the three-node
+"""``hlvs scrimmage --pool slurm``: the match runs as a Slurm job on a node of the five-node
 cluster, the command shows Slurm's state while it waits, the results land in the usual --out
 folder and the exit code is the match's."""
 

@@ -1,4 +1,4 @@
-"""The Slurm pool on a real Slurm cluster of three nodes on this machine (scripts/ensure-slurm.sh):
+"""The Slurm pool on a real Slurm cluster of five nodes on this machine (scripts/ensure-slurm.sh):
 real matches side by side on different nodes, a team account's quota making its second match
 wait with Slurm's reason, cancel while queued and while running."""
 

@@ -1,7 +1,7 @@
 """The scheduler's restart test with the Slurm pool: the scheduler is killed (SIGKILL) while its
 match runs as a Slurm job; the job goes on without it, the restarted scheduler adopts it, and
 every match is played exactly once (one Slurm job each) and delivered. Short real stub matches
-(1 v 1, 4 s halves) on the three-node cluster of scripts/ensure-slurm.sh."""
+(1 v 1, 4 s halves) on the five-node cluster of scripts/ensure-slurm.sh."""
 
 from __future__ import annotations
 
