@@ -66,8 +66,30 @@ def _parser() -> argparse.ArgumentParser:
         action="store_true",
         help="clients share the step thread's CPU (default: CPU 0 is the step thread's)",
     )
+    parser.add_argument("--gpu", choices=("auto", "on", "off"), default="auto",
+                        help="cameras on an NVIDIA GPU through EGL: auto (default) when this "
+                        "host has one, on: required, off: OSMesa on the CPU; a MUJOCO_GL set in "
+                        "the environment is kept")
     parser.add_argument("--json", action="store_true", help="print only the JSON line")
     return parser
+
+
+def _choose_gl(mode: str) -> None:
+    """``MUJOCO_GL`` of this process before MuJoCo is imported, as the simulator of a match
+    chooses it (:func:`simulator.gl.select_match_gl`): EGL when this host has an NVIDIA GPU
+    that renders (``--gpu``), else OSMesa."""
+    from orchestrator.engine.gpu import device_files
+    from simulator.errors import GpuRenderError
+    from simulator.gl import GPU_ENVIRONMENT, select_match_gl
+
+    if "MUJOCO_GL" in os.environ:
+        return
+    if mode == "on" or (mode == "auto" and device_files()):
+        os.environ.update({GPU_ENVIRONMENT: mode, "MUJOCO_GL": "egl", "PYOPENGL_PLATFORM": "egl"})
+    try:
+        select_match_gl()
+    except GpuRenderError as exc:
+        raise SystemExit(str(exc)) from None
 
 
 def _connect(port: int) -> socket.socket:
@@ -406,7 +428,7 @@ def _camera(text: str) -> tuple[int, int, int] | None:
 
 def main(argv: list[str]) -> int:
     args = _parser().parse_args(argv)
-    os.environ.setdefault("MUJOCO_GL", "osmesa")
+    _choose_gl(args.gpu)
     os.environ.setdefault("LP_NUM_THREADS", "0")  # as the simulator process: see runtime.py
     camera = _camera(args.camera)
     robots = _robots(args.robots)
@@ -445,7 +467,10 @@ def main(argv: list[str]) -> int:
         "client_cpus": sorted(args.client_cpus) or "shared",
     }
     if camera is not None:  # the camera path against a bare render of the same scene
+        from simulator.gl import read_gl_info
+
         result.update(_render_costs(robots, args.physics_dt, camera[0], camera[1]))
+        result.update(read_gl_info().record())  # gl_backend, gl_renderer: llvmpipe is the CPU
     if args.stalled_client:
         stalled = _api_run(args, camera, stalled=True)
         result["stalled_client"] = {

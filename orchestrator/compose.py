@@ -32,9 +32,16 @@ from contracts import files
 from contracts.match_spec import MatchSpec
 from orchestrator.config import LoadedGame
 from orchestrator.match import layout
+from orchestrator.match.gpu import SimulatorGpu
 from orchestrator.match.logfs import safe_name
 from orchestrator.match.plan import MatchPlan, plan_from_game
-from orchestrator.match.runtime import Attachment, BindMount, ContainerRequest, NetworkRequest
+from orchestrator.match.runtime import (
+    Attachment,
+    BindMount,
+    ContainerRequest,
+    DeviceRequest,
+    NetworkRequest,
+)
 
 log = logging.getLogger(__name__)
 
@@ -120,9 +127,11 @@ def match_requests(loaded: LoadedGame, *, simulator_image: str, subnets: Subnets
         )
         for role in ("control", "red", "blue")
     )
+    # the host that runs the compose file is not looked at: gpu "on" asks for its GPUs
+    gpu = SimulatorGpu(mode="on", access="device-request") if plan.gpu == "on" else None
     simulator = layout.simulator_request(
         plan, prefix=prefix, image=simulator_image, match_dir=PROJECT,
-        attachments=attachments, extra_labels=extra, model_dirs=plan.model_dirs,
+        attachments=attachments, extra_labels=extra, model_dirs=plan.model_dirs, gpu=gpu,
     )  # fmt: skip
     robots: dict[str, tuple[ContainerRequest, ContainerRequest]] = {}
     for team in plan.teams:
@@ -214,7 +223,23 @@ def _service(request: ContainerRequest, roles: Mapping[str, str]) -> dict[str, A
         service["networks"] = _networks(request.networks, roles)
     service["cap_drop"] = list(request.cap_drop)
     service["security_opt"] = list(request.security_opt)
+    if request.device_requests:
+        service["deploy"] = {"resources": {"reservations": {"devices": [
+            _device(d) for d in request.device_requests]}}}
     return service
+
+
+def _device(request: DeviceRequest) -> dict[str, Any]:
+    """A device request as a compose ``deploy.resources.reservations.devices`` entry."""
+    device: dict[str, Any] = {}
+    if request.driver:
+        device["driver"] = request.driver
+    if request.device_ids:
+        device["device_ids"] = list(request.device_ids)
+    elif request.count:
+        device["count"] = "all" if request.count < 0 else request.count
+    device["capabilities"] = list(request.capabilities[0]) if request.capabilities else []
+    return device
 
 
 def _robot_service(

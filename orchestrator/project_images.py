@@ -37,9 +37,13 @@ LABEL_IMAGE = "org.hlvs-runner.image"  # simulator | stub | team-base | base
 LABEL_CONTENT = "org.hlvs-runner.content"  # the content hash
 
 ROBOT_BASE = image_inputs.BaseRecipe(flavour="robot")
+# OSMesa renders the cameras on the CPU; the glvnd EGL and OpenGL dispatchers (libegl1 brings
+# Mesa's EGL too) let the NVIDIA EGL driver that the NVIDIA container toolkit mounts render them
+# on a GPU (``gpu`` of game.json).
 SIM_BASE = image_inputs.BaseRecipe(
     flavour="sim",
-    packages=("python3", "python3-venv", "ca-certificates", "libosmesa6", "ffmpeg"),
+    packages=("python3", "python3-venv", "ca-certificates", "libosmesa6", "libegl1",
+              "libopengl0", "ffmpeg"),
 )
 
 

@@ -9,7 +9,8 @@ Tree::
     ├── UnknownDeviceError   a device name a robot does not have (world device access)
     ├── ReplayError          a replay file that cannot be read
     ├── RenderError          a video that could not be produced (ffmpeg missing or failing)
-    └── OffscreenGLError     no offscreen OpenGL back end works (each one tried, with why)
+    ├── OffscreenGLError     no offscreen OpenGL back end works (each one tried, with why)
+    └── GpuRenderError       gpu "on" but the simulator cannot render on the GPU
 
 A match_spec.json that does not describe a match raises :class:`contracts.errors.ContractError`.
 Unknown robot model names raise :class:`robot.errors.UnknownModelError` (one class for the
@@ -114,3 +115,14 @@ class OffscreenGLError(SimulatorError):
         else:
             hint = "install Mesa's EGL (libegl1, libegl-mesa0) or OSMesa (libosmesa6)"
         super().__init__(f"no offscreen OpenGL back end works (tried {attempts}); {hint}")
+
+
+class GpuRenderError(SimulatorError):
+    """``gpu`` "on" (``HLVS_GPU=on``) but EGL gives no hardware renderer in this process."""
+
+    def __init__(self, *, reason: str) -> None:
+        self.reason = reason
+        super().__init__(
+            f'gpu "on": the simulator cannot render on the GPU ({reason}); check the NVIDIA '
+            'container toolkit on the host (graphics capability) or set gpu to "auto" or "off"'
+        )

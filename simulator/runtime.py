@@ -29,7 +29,14 @@ from contracts.errors import ContractError
 from contracts.match_spec import MatchSpec
 from contracts.sim_result import SimResult
 from simulator.api import ApiServer, LockstepSettings, endpoints_from_spec
-from simulator.errors import PhysicsDivergence, SimulatorError, UnknownModelError
+from simulator.errors import (
+    GpuRenderError,
+    OffscreenGLError,
+    PhysicsDivergence,
+    SimulatorError,
+    UnknownModelError,
+)
+from simulator.gl import read_gl_info, select_match_gl
 from simulator.match_loop import LoopSettings, MatchLoop
 from simulator.match_setup import referee_config
 from simulator.telemetry import TelemetryError, open_telemetry
@@ -68,18 +75,21 @@ def versions() -> dict[str, str]:
 
 def main(argv: list[str]) -> int:
     args = _parser().parse_args(argv)
-    if not os.environ.get("DISPLAY"):  # offscreen rendering (cameras, video) without a display
-        os.environ.setdefault("MUJOCO_GL", "osmesa")
-        os.environ.setdefault("PYOPENGL_PLATFORM", os.environ["MUJOCO_GL"])
-    # Mesa's CPU rasteriser inline in the rendering thread (no rasteriser threads): camera
-    # rendering takes one core, physics keeps another. Measured at 320x240 with 8 cameras in
-    # lockstep: 5.2 ms a frame and RTF 0.69, against 6.1 ms and 0.58 with one rasteriser thread.
-    os.environ.setdefault("LP_NUM_THREADS", "0")
     logging.basicConfig(
         level=args.log_level.upper(),
         stream=sys.stderr,
         format="%(asctime)s %(levelname)s %(name)s: %(message)s",
     )
+    if not os.environ.get("DISPLAY"):  # offscreen rendering (cameras, video) without a display
+        try:  # OSMesa, or EGL on the GPU the orchestrator gave this container (before MuJoCo)
+            select_match_gl()
+        except GpuRenderError as exc:
+            log.error("%s", exc)
+            return 3
+    # Mesa's CPU rasteriser inline in the rendering thread (no rasteriser threads): camera
+    # rendering takes one core, physics keeps another. Measured at 320x240 with 8 cameras in
+    # lockstep: 5.2 ms a frame and RTF 0.69, against 6.1 ms and 0.58 with one rasteriser thread.
+    os.environ.setdefault("LP_NUM_THREADS", "0")
     try:
         spec = MatchSpec.load(args.spec)
     except ContractError as exc:
@@ -120,6 +130,7 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
         spec.maximum_real_time_factor,
     )  # fmt: skip
     world = World.from_spec(spec)
+    camera_gl = _camera_gl()
     lockstep = LockstepSettings(
         deadline_s=spec.lockstep_deadline_ms / 1000.0,
         time_bank_s=spec.lockstep_time_bank_ms / 1000.0,
@@ -201,7 +212,8 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
             "held_real_s": round(loop.held_s, 3),
             "real_time_factor": _rtf(world.sim_time_ms, loop.real_time_s - loop.held_s),
             "robots": server.statistics(),
-            "cameras": {"frames": cameras.frames, "render_s": round(cameras.render_s, 3)},
+            "cameras": {"frames": cameras.frames, "render_s": round(cameras.render_s, 3),
+                        **camera_gl},
             "started_unix_s": round(started, 3),
             "versions": versions(),
         }
@@ -217,6 +229,18 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
     if spec.record_video:
         _render_video(out / REPLAY_FILE, out / spec.record_video)
     return exit_code
+
+
+def _camera_gl() -> dict[str, str]:
+    """The OpenGL the robot cameras render with (logged; the ``gl_*`` keys of the result's
+    ``cameras``): ``gl_backend`` and ``gl_renderer`` (llvmpipe: the CPU), or ``gl_error``."""
+    try:
+        info = read_gl_info()
+    except OffscreenGLError as exc:
+        log.warning("robot cameras: no offscreen OpenGL (%s); camera requests will fail", exc)
+        return {"gl_backend": os.environ.get("MUJOCO_GL", ""), "gl_error": str(exc)}
+    log.info("robot cameras render with %s", info.describe())
+    return info.record()
 
 
 def _rtf(sim_ms: int, real_s: float) -> float:

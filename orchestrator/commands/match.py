@@ -13,6 +13,7 @@ import logging
 from typing import Any
 
 from orchestrator.commands.scrimmage_args import add_arguments as add_scrimmage_arguments
+from orchestrator.commands.scrimmage_args import add_gpu_argument
 from orchestrator.paths import user_path
 
 MATCH_EPILOG = (
@@ -32,6 +33,7 @@ def register(sub: Any) -> None:
                        help="seconds robots get to stop after the game (default: from game.json)")
     match.add_argument("--json", action="store_true",
                        help="print results.json (with the outcome and output folder) on stdout")
+    add_gpu_argument(match, default=None)
     add_pool_arguments(match)
     match.set_defaults(func=run_match_command, log_level=logging.INFO)
 

@@ -42,6 +42,7 @@ from orchestrator.match import (
 )
 from orchestrator.match.admission import HostResources, admit
 from orchestrator.match.cleanup import clean_match
+from orchestrator.match.gpu import GpuOrigin, SimulatorGpu, simulator_gpu
 from orchestrator.match.ownership import LABEL_RUN
 from orchestrator.match.placement import LeaguePlacement, parse_nodes
 from orchestrator.match.runner import ImageResolver
@@ -104,10 +105,12 @@ def play(
     (:mod:`orchestrator.match.admission`)."""
     from orchestrator.engine import connect
     from orchestrator.engine.containers import DockerRuntime
+    from orchestrator.engine.gpu import detect_nvidia
 
     verdict = admit(plan, host=HostResources.local(), official=plan.official)
     plan = replace(plan, admission=verdict.record())
     client = connect()
+    gpu = simulator_gpu(plan.gpu, lambda: detect_nvidia(client), origin=plan.gpu_origin)
     runtime = DockerRuntime(client)
     host = HostControl.for_current_user()
     with ownership.claim(plan.match_id, out_dir) as claim:  # refused while another runs it
@@ -121,13 +124,13 @@ def play(
             labels[LABEL_SLURM_JOB] = os.environ["SLURM_JOB_ID"]
         return _play(plan, out_dir=out_dir, pull=pull, loaded=loaded, client=client,
                      runtime=runtime, host=host, extra_labels=labels, view_stream=view_stream,
-                     placement=placement)
+                     placement=placement, gpu=gpu)
 
 
 def _play(
     plan: MatchPlan, *, out_dir: Path, pull: bool, loaded: Any, client: Any, runtime: Any,
     host: HostControl, extra_labels: dict[str, str], view_stream: TextIO | None = None,
-    placement: LeaguePlacement | None = None,
+    placement: LeaguePlacement | None = None, gpu: SimulatorGpu | None = None,
 ) -> MatchOutcome:
     from orchestrator.project_images import project_image
     from orchestrator.telemetry import LiveView, ZenohTelemetry
@@ -139,7 +142,7 @@ def _play(
         options = RunOptions(
             out_dir=out_dir, simulator_image=simulator_image, extra_labels=extra_labels or {},
             progress=lambda phase, state: view.update(phase=phase, state=state),
-            placement=placement,
+            placement=placement, gpu=gpu,
         )
         runner = MatchRunner(
             plan, runtime=runtime, host=host, options=options,
@@ -219,7 +222,7 @@ def run_match_command(args: argparse.Namespace) -> int:
     loaded = load_game(args.game, images_required=True)
     for warning in loaded.warnings:
         print(f"hlvs: {warning}", file=sys.stderr)
-    plan = plan_from_game(loaded, grace_period_s=args.grace)
+    plan = _gpu_option(args, plan_from_game(loaded, grace_period_s=args.grace))
     out = args.out or user_path(Path("matches") / plan.match_id)
     if getattr(args, "pool", "local") == "slurm":
         return _in_pool(args, game_path=args.game, plan=plan, out=out)
@@ -233,13 +236,21 @@ def run_scrimmage_command(args: argparse.Namespace) -> int:
     out: Path = args.out
     game_path = scrimmage.write_files(args, out / "config")
     loaded = load_game(game_path, images_required=True)
-    plan = plan_from_game(loaded, grace_period_s=args.grace)
+    plan = _gpu_option(args, plan_from_game(loaded, grace_period_s=args.grace))
     if getattr(args, "pool", "local") == "slurm":
         return _in_pool(args, game_path=game_path, plan=plan, out=out)
     outcome = play(plan, out_dir=out, pull=False, loaded=loaded,
                    view_stream=sys.stderr if getattr(args, "json", False) else None,
                    placement=_placement(args, plan))
     return summarize(outcome, as_json=getattr(args, "json", False))
+
+
+def _gpu_option(args: argparse.Namespace, plan: MatchPlan) -> MatchPlan:
+    """``--gpu`` given on the command line overrides ``gpu`` of game.json."""
+    mode = getattr(args, "gpu", None)
+    if mode is None:
+        return plan
+    return replace(plan, gpu=mode, gpu_origin=GpuOrigin(file="command line", pointer="--gpu"))
 
 
 def _placement(args: argparse.Namespace, plan: MatchPlan) -> LeaguePlacement | None:
@@ -259,10 +270,12 @@ def _placement(args: argparse.Namespace, plan: MatchPlan) -> LeaguePlacement | N
 def _in_pool(args: argparse.Namespace, *, game_path: Path, plan: MatchPlan, out: Path) -> int:
     from orchestrator.commands.pooled import play_in_pool
 
-    grace = () if args.grace is None else ("--grace", str(args.grace))
+    extra = () if args.grace is None else ("--grace", str(args.grace))
+    if getattr(args, "gpu", None) is not None:
+        extra += ("--gpu", args.gpu)
     league = getattr(args, "placement", "dense") == "league"
     return play_in_pool(args, game_path=game_path, match_id=plan.match_id, out_dir=out,
-                        official=plan.official, match_args=grace,
+                        official=plan.official, match_args=extra,
                         robot_nodes=len(plan.robots) if league else 0)
 
 

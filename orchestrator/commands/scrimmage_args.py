@@ -51,6 +51,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="seed of the simulation and the referee (default 42)")
     parser.add_argument("--stub", action="store_true",
                         help="accepted for compatibility: stub robots are the default")
+    add_gpu_argument(parser, default="auto")
 
 
-__all__ = ["add_arguments"]
+def add_gpu_argument(parser: argparse.ArgumentParser, *, default: str | None) -> None:
+    """``--gpu auto|on|off``: the host's NVIDIA GPU for the robot cameras (``gpu`` of
+    game.json)."""
+    parser.add_argument("--gpu", choices=("auto", "on", "off"), default=default,
+                        help="robot cameras on the host's NVIDIA GPU: auto uses it when Docker "
+                        "can, else the CPU; on requires it; off: the CPU (default: "
+                        + (default or "gpu of game.json, else auto") + ")")
+
+
+__all__ = ["add_arguments", "add_gpu_argument"]

@@ -102,6 +102,7 @@ class GameConfig:
     timing: Timing = field(default_factory=Timing)
     allow_internet: bool = False
     official: bool = False  # refused when it does not fit the host (see match.admission)
+    gpu: str = "auto"  # auto | on | off: the host's GPU for the cameras (see match.gpu)
     public_logs: Path | None = None  # credentials.json-style target for the public logs
 
     def team(self, color: Color) -> TeamRef:

@@ -16,6 +16,7 @@ from typing import Any
 
 import docker
 import docker.errors
+import docker.types
 import requests.exceptions
 
 from orchestrator.engine import LABEL_MATCH, LABEL_PROJECT
@@ -89,6 +90,13 @@ class DockerRuntime:
             "cpuset_cpus": request.cpuset_cpus,
             "tmpfs": dict(request.tmpfs) or None,
             "cgroup_parent": request.cgroup_parent,
+            "device_requests": [
+                docker.types.DeviceRequest(
+                    driver=d.driver, count=d.count, device_ids=list(d.device_ids),
+                    capabilities=[list(c) for c in d.capabilities],
+                )
+                for d in request.device_requests
+            ] or None,
             "network_mode": request.network_mode
             or (request.networks[0].network if request.networks else "none"),
         }

@@ -21,6 +21,7 @@ from contracts.match_results import Forfeit
 from contracts.telemetry import StateMessage
 from orchestrator.bandwidth import AppliedShaping
 from orchestrator.match.admission import CpuSets
+from orchestrator.match.gpu import SimulatorGpu
 from orchestrator.match.host import Host
 from orchestrator.match.layout import SIMULATOR_COMMAND, Subnet
 from orchestrator.match.logfs import LogFolder
@@ -51,6 +52,7 @@ class RunOptions:
     # league placement: the simulator and each robot on a node of its own (None: dense, the
     # whole match on this host's engine with a network per team)
     placement: LeaguePlacement | None = None
+    gpu: SimulatorGpu | None = None  # the host's GPU for the simulator (None: cameras on CPU)
 
     def __post_init__(self) -> None:
         # The output folder becomes bind-mount sources: Docker takes a relative one for a volume.

@@ -30,6 +30,7 @@ from orchestrator.engine import (
     LABEL_TEAM,
 )
 from orchestrator.match.admission import SIMULATOR_CPU_SHARES
+from orchestrator.match.gpu import SimulatorGpu
 from orchestrator.match.plan import MatchPlan, RobotPlan
 from orchestrator.match.runtime import (
     Attachment,
@@ -233,9 +234,11 @@ def simulator_request(
     attachments: tuple[Attachment, ...], extra_labels: Mapping[str, str],
     command: tuple[str, ...] = SIMULATOR_COMMAND,
     model_dirs: tuple[Path, ...] = (),
+    gpu: SimulatorGpu | None = None,
 ) -> ContainerRequest:
     """The simulator container; team robot model packages mounted read-only where the match
-    spec names them (:func:`orchestrator.config.robot_models.container_path`)."""
+    spec names them (:func:`orchestrator.config.robot_models.container_path`); with ``gpu`` the
+    host's NVIDIA GPUs and the environment that makes MuJoCo render through them."""
     models = tuple(
         BindMount(source=folder, target=container_path(str(folder)), read_only=True)
         for folder in model_dirs
@@ -244,7 +247,8 @@ def simulator_request(
         name=f"{prefix}-simulator",
         image=image,
         command=command,
-        environment={"PYTHONUNBUFFERED": "1", "HLVS_MATCH_ID": plan.match_id},
+        environment={"PYTHONUNBUFFERED": "1", "HLVS_MATCH_ID": plan.match_id,
+                     **(gpu.environment() if gpu is not None else {})},
         labels={**labels(plan.match_id, "simulator"), **extra_labels},
         networks=attachments,
         mounts=(BindMount(source=match_dir, target=MATCH_TARGET), *models),
@@ -252,6 +256,7 @@ def simulator_request(
         cpu_shares=SIMULATOR_CPU_SHARES,
         cap_drop=("ALL",),
         security_opt=("no-new-privileges",),
+        device_requests=gpu.device_requests() if gpu is not None else (),
     )
 
 

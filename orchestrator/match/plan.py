@@ -17,6 +17,7 @@ from contracts.match_spec import MatchSpec
 from orchestrator.config import Limits, LoadedGame, PlayerConfig
 from orchestrator.config.robot_models import is_model_path
 from orchestrator.config.spec import to_match_spec
+from orchestrator.match.gpu import GpuOrigin
 
 SpecBuilder = Callable[[Mapping[str, tuple[str, ...]], str | None], MatchSpec]
 """(robot addresses per color, telemetry endpoint or None) -> the match's ``match_spec.json``."""
@@ -52,6 +53,8 @@ class MatchPlan:
     limits: Limits = field(default_factory=Limits)
     allow_internet: bool = False
     official: bool = False
+    gpu: str = "auto"  # auto | on | off (orchestrator.match.gpu)
+    gpu_origin: GpuOrigin = field(default_factory=GpuOrigin)  # where ``gpu`` was set
     admission: AdmissionRecord | None = None  # the admission verdict, copied into results
     grace_period_s: float = 120.0
     telemetry: bool = True  # ask the simulator for zenoh telemetry on the control network
@@ -98,6 +101,8 @@ def plan_from_game(loaded: LoadedGame, *, grace_period_s: float | None = None) -
         limits=game.limits,
         allow_internet=game.allow_internet,
         official=game.official,
+        gpu=game.gpu,
+        gpu_origin=GpuOrigin(file=str(game.source), pointer="/gpu"),
         grace_period_s=game.timing.grace_period_s if grace_period_s is None else grace_period_s,
         model_dirs=tuple(
             dict.fromkeys(

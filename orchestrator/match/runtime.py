@@ -73,6 +73,18 @@ class BindMount:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class DeviceRequest:
+    """Devices of a driver for a container, as ``docker run --gpus``: ``count`` -1 is all of
+    them; ``capabilities`` alternatives (each a set the driver must offer, e.g. ``gpu``);
+    ``device_ids`` names them instead (a CDI device such as ``nvidia.com/gpu=all``)."""
+
+    driver: str = ""  # "": the engine picks the driver offering the capabilities
+    count: int = 0
+    device_ids: tuple[str, ...] = ()
+    capabilities: tuple[tuple[str, ...], ...] = ()
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class ContainerRequest:
     """Everything needed to create one container. ``network_mode`` ("container:<id>") excludes
     ``networks``; the first attachment is made at creation, the others before start."""
@@ -100,6 +112,7 @@ class ContainerRequest:
     cpuset_cpus: str | None = None  # e.g. "1-3": the CPUs it may run on
     tmpfs: Mapping[str, str] = field(default_factory=dict)  # path -> mount options ("size=16m")
     cgroup_parent: str | None = None  # e.g. "/hlvs-robots" (a node firewall matches it)
+    device_requests: tuple[DeviceRequest, ...] = ()  # e.g. the host's GPUs
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -173,6 +186,7 @@ __all__ = [
     "ContainerRequest",
     "ContainerRuntime",
     "ContainerState",
+    "DeviceRequest",
     "NetworkInfo",
     "NetworkRequest",
     "ObjectNotFound",

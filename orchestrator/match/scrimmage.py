@@ -100,6 +100,7 @@ def game_file(args: ScrimmageOptions, match_id: str) -> dict[str, Any]:
         "match_id": match_id,
         "seed": args.seed,
         "stepping": getattr(args, "stepping", "lockstep"),
+        "gpu": getattr(args, "gpu", None) or "auto",
         "lockstep_deadline_ms": 200,
         "lockstep_time_bank_ms": 10000,
         "red": {"id": 1, "config": "team_red.json", "hosts": ["127.0.0.1"],

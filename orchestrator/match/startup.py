@@ -96,6 +96,7 @@ def _start(match: MatchContext, started_at: float) -> None:
         plan, prefix=started.prefix, image=match.options.simulator_image, match_dir=match_dir,
         attachments=attachments, extra_labels=match.options.extra_labels,
         command=match.options.simulator_command, model_dirs=plan.model_dirs,
+        gpu=match.options.gpu,
     )
     sets = cpu_sets(stepping=spec.stepping)
     started.cpu_sets = sets
@@ -133,6 +134,7 @@ def _start_league(match: MatchContext, started_at: float, placement: LeaguePlace
         plan, prefix=match.started.prefix, image=match.options.simulator_image,
         match_dir=match_dir, attachments=(), extra_labels=match.options.extra_labels,
         command=match.options.simulator_command, model_dirs=plan.model_dirs,
+        gpu=match.options.gpu,
     )
     request = replace(request, network_mode=f"container:{holder}", hostname=None,
                       labels={**request.labels, layout.LABEL_NODE: placement.simulator.name})

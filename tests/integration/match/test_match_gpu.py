@@ -1,0 +1,113 @@
+"""The ``gpu`` setting on a machine without a GPU, for real: the default ``auto`` plays a
+scrimmage with its cameras on the CPU and says so; ``on`` is refused before anything starts; the
+simulator image's EGL (the glvnd dispatcher that an NVIDIA driver plugs into) loads, and the
+simulator under ``HLVS_GPU`` falls back from a software EGL renderer (auto) or refuses it (on)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import docker
+import pytest
+
+from orchestrator.cli import main as hlvs
+from orchestrator.engine.gpu import device_files
+from orchestrator.errors import OrchestratorError
+from orchestrator.match import gpu
+from tests.conftest import TEST_LABEL
+
+pytestmark = [pytest.mark.docker, pytest.mark.root]
+
+
+@pytest.fixture(scope="module")
+def images() -> str:
+    if device_files():
+        pytest.skip("this host has an NVIDIA GPU: these tests are about the CPU fallback")
+    try:
+        from orchestrator.project_images import project_image
+
+        project_image("stub")
+        return str(project_image("simulator"))
+    except (ImportError, OrchestratorError) as exc:
+        pytest.skip(f"project images unavailable: {exc}")
+
+
+def test_auto_without_a_gpu_plays_with_cameras_on_the_cpu(
+    images: str, tmp_path: Path, runtime: Any, capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.setattr(gpu, "_said", set())  # once per process: this test's process
+    match_id = "gpu-auto-test"
+    out = tmp_path / "scrim"
+    try:
+        code = hlvs(["scrimmage", "--out", str(out), "--half-duration", "4",
+                     "--wait-before-ready", "1", "--grace", "2", "--match-id", match_id])
+    finally:
+        hlvs(["cleanup", "--match", match_id])
+    printed = capsys.readouterr()
+    assert code == 0, printed.err[-3000:]
+    said = [line for line in printed.err.splitlines() if "gpu auto" in line]
+    assert len(said) == 1, printed.err[-3000:]
+    assert said[0].endswith("gpu auto: no NVIDIA device file (/dev/nvidia0, ...) on this host; "
+                            "the simulator renders cameras on the CPU (OSMesa)")
+    result = json.loads((out / "public" / "sim_result.json").read_text())
+    cameras = result["cameras"]
+    assert cameras["frames"] > 0  # the stubs asked for images and got them
+    assert cameras["gl_backend"] == "osmesa"
+    assert "llvmpipe" in cameras["gl_renderer"] and cameras["gl_vendor"]
+    simulator_log = (out / "simulator" / "stderr.log").read_text()
+    assert "robot cameras render with osmesa: llvmpipe" in simulator_log
+
+
+def test_on_without_a_gpu_is_refused_naming_the_option(
+    images: str, tmp_path: Path, runtime: Any, capsys: pytest.CaptureFixture[str],
+) -> None:
+    match_id = "gpu-on-test"
+    code = hlvs(["scrimmage", "--out", str(tmp_path / "on"), "--gpu", "on",
+                 "--match-id", match_id])
+    printed = capsys.readouterr()
+    assert code == 2
+    assert 'command line: --gpu: "on" but no NVIDIA GPU that Docker can use here' in printed.err
+    assert "Traceback" not in printed.err
+    assert runtime.list_project(match_id=match_id) == []
+
+
+def _in_simulator_image(client: docker.DockerClient, image: str, environment: dict[str, str],
+                        command: list[str]) -> tuple[int, str]:
+    container = client.containers.run(
+        image, command=command, environment=environment, labels={TEST_LABEL: "gpu"},
+        network_mode="none", detach=True,
+    )
+    try:
+        code = int(container.wait(timeout=120)["StatusCode"])
+        return code, container.logs().decode("utf-8", "replace")
+    finally:
+        container.remove(force=True)
+
+
+def test_the_simulator_image_loads_egl_and_keeps_only_a_gpu(
+    images: str, docker_client: docker.DockerClient,
+) -> None:
+    egl = {"MUJOCO_GL": "egl", "PYOPENGL_PLATFORM": "egl", "MUJOCO_EGL_DEVICE_ID": "0"}
+    code, output = _in_simulator_image(docker_client, images, egl, [
+        "python", "-c", "import json\nfrom simulator.gl import probe_gl_info, select_match_gl\n"
+        "import os\nprint(json.dumps(probe_gl_info('egl').record()))\n"
+        "print(select_match_gl())\n"])
+    # glvnd's libEGL.so.1 found Mesa's vendor file: the NVIDIA one plugs in the same way
+    assert code == 0, output
+    first, chosen = output.strip().splitlines()[-2:]
+    assert json.loads(first)["gl_backend"] == "egl" and "llvmpipe" in first
+    assert chosen == "egl"  # no HLVS_GPU: a MUJOCO_GL of the environment is kept
+    code, output = _in_simulator_image(docker_client, images, {**egl, "HLVS_GPU": "auto"}, [
+        "python", "-c", "import os\nfrom simulator.gl import select_match_gl\n"
+        "print(select_match_gl(), os.environ['MUJOCO_GL'])\n"])
+    assert code == 0, output
+    assert output.strip().splitlines()[-1] == "osmesa osmesa"
+    assert "EGL gave the software renderer llvmpipe" in output
+    code, output = _in_simulator_image(docker_client, images, {**egl, "HLVS_GPU": "on"},
+                                       ["run", "--spec", "/nonexistent.json", "--out", "/tmp/o"])
+    assert code == 3, output
+    assert 'gpu "on": the simulator cannot render on the GPU (EGL gave the software renderer ' \
+           "llvmpipe" in output
