@@ -134,6 +134,9 @@ def _runners(args: argparse.Namespace) -> dict[str, Callable[[], dict[str, Any]]
             "bare_render_ms_per_frame": result["bare_render_ms_per_frame"],
             "camera_path_ms_per_frame": result["camera_path_ms_per_frame"],
             "render_cost_ratio": result["render_cost_ratio"],
+            # what rendered: osmesa / llvmpipe is the CPU; egl with a GPU's name is the GPU
+            "gl_backend": result.get("gl_backend"),
+            "gl_renderer": result.get("gl_renderer"),
         }
 
     def bringup() -> dict[str, Any]:

@@ -19,18 +19,20 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal, get_args
 
 from orchestrator.errors import ConfigError, Problem
-from orchestrator.match.runtime import DeviceRequest
+from orchestrator.match.runtime import ContainerRequest, DeviceRequest
 
 log = logging.getLogger(__name__)
 
 GpuMode = Literal["auto", "on", "off"]
 GPU_MODES: tuple[str, ...] = get_args(GpuMode)
 DEFAULT_GPU_MODE: GpuMode = "auto"
-EGL_DEVICE_ID = 0  # the first EGL device: the NVIDIA driver's vendor file sorts before Mesa's
+# The first GPU the container sees: MuJoCo orders EGL devices by CUDA id when the driver tells
+# it (NVIDIA's does), ahead of other EGL devices such as Mesa's software one.
+EGL_DEVICE_ID = 0
 DRIVER_CAPABILITIES = "graphics,compute,utility"  # graphics: the EGL/OpenGL driver libraries
 GPU_ENVIRONMENT = "HLVS_GPU"  # what was asked (on | auto), read by the simulator
 CDI_ALL_GPUS = "nvidia.com/gpu=all"
@@ -87,6 +89,13 @@ class SimulatorGpu:
         if self.access == "cdi":
             return (DeviceRequest(driver="cdi", device_ids=(CDI_ALL_GPUS,)),)
         return (DeviceRequest(count=-1, capabilities=(("gpu",),)),)
+
+    def taken_from(self, request: ContainerRequest) -> ContainerRequest:
+        """``request`` without this GPU: no device request, none of its environment."""
+        mine = self.environment()
+        return replace(
+            request, device_requests=(),
+            environment={k: v for k, v in request.environment.items() if k not in mine})
 
 
 _said: set[str] = set()

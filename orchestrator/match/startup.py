@@ -200,11 +200,26 @@ def _start_containers(match: MatchContext, request: ContainerRequest, started_at
 
 
 def _start_simulator(match: MatchContext, request: ContainerRequest) -> None:
-    """Started with the robots, so that it boots while they start (robot clients retry)."""
+    """Started with the robots, so that it boots while they start (robot clients retry). Under
+    ``gpu`` "auto", an engine that refuses the GPU (a driver or toolkit problem that detection
+    could not see) gets the simulator without it: cameras on the CPU, said in the log."""
     started = match.started
     began = match.clock()
-    started.simulator_id = match.runtime.create_container(request)
-    match.runtime.start(started.simulator_id)
+    gpu = match.options.gpu
+    try:
+        started.simulator_id = match.runtime.create_container(request)
+        match.runtime.start(started.simulator_id)
+    except InfrastructureError as exc:
+        if gpu is None or gpu.mode != "auto":
+            raise
+        log.warning("match %s: the engine refused the simulator the GPU (%s); gpu auto: it "
+                    "renders its cameras on the CPU", match.plan.match_id, exc)
+        if started.simulator_id is not None:
+            match.runtime.remove(started.simulator_id)
+            started.simulator_id = None
+        request = gpu.taken_from(request)
+        started.simulator_id = match.runtime.create_container(request)
+        match.runtime.start(started.simulator_id)
     started.simulator_started_at = match.clock()
     started.phases_s["simulator"] = round(started.simulator_started_at - began, 3)
     log.info("match %s: simulator container %s started (%s)", match.plan.match_id,

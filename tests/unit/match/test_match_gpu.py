@@ -279,3 +279,46 @@ def test_compose_asks_for_the_gpu_only_when_on(tmp_path: Path) -> None:
         {"count": "all", "capabilities": ["gpu"]}]}}}
     assert "deploy" not in _service(_request(None, tmp_path), {})
     json.dumps(service)  # plain data for the YAML file
+
+
+def _refusing_gpu(tmp_path: Path, mode: str) -> tuple[Any, list[ContainerRequest], FakeRuntime]:
+    from orchestrator.errors import InfrastructureError
+
+    runtime = FakeRuntime()
+    seen: list[ContainerRequest] = []
+
+    def start(container: Any) -> None:
+        seen.append(container.request)
+        if container.request.device_requests:
+            raise InfrastructureError('Docker engine refused on container c1: could not select '
+                                      'device driver "" with capabilities: [[gpu]]')
+
+    runtime.on_start = start
+    grant = SimulatorGpu(mode=mode, access="device-request")  # type: ignore[arg-type]
+    runner = MatchRunner(_plan(), runtime=runtime, host=FakeHost(),
+                         options=RunOptions(out_dir=tmp_path, simulator_image="sim:1",
+                                            poll_s=0.0, gpu=grant))
+    return runner.run(), seen, runtime
+
+
+def test_auto_falls_back_to_the_cpu_when_the_engine_refuses_the_gpu(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture,
+) -> None:
+    with caplog.at_level(logging.WARNING, logger="orchestrator.match.startup"):
+        outcome, seen, runtime = _refusing_gpu(tmp_path, "auto")
+    assert outcome.ok
+    simulators = [r for r in seen if r.name == "hlvs-u1-simulator"]
+    assert [bool(r.device_requests) for r in simulators] == [True, False]
+    assert "MUJOCO_GL" not in simulators[1].environment
+    assert simulators[1].environment["HLVS_MATCH_ID"] == "u1"
+    assert any("refused the simulator the GPU" in r.getMessage()
+               and "could not select device driver" in r.getMessage() for r in caplog.records)
+    assert runtime.containers == {}  # the refused container was removed too
+
+
+def test_on_fails_the_match_when_the_engine_refuses_the_gpu(tmp_path: Path) -> None:
+    outcome, seen, runtime = _refusing_gpu(tmp_path, "on")
+    assert outcome.failure is not None
+    assert "could not select device driver" in outcome.failure.cause
+    assert [r.name for r in seen].count("hlvs-u1-simulator") == 1
+    assert runtime.containers == {}
