@@ -74,6 +74,32 @@ def test_on_without_a_gpu_is_refused_naming_the_option(
     assert runtime.list_project(match_id=match_id) == []
 
 
+def test_auto_plays_on_the_cpu_when_the_engine_refuses_the_gpu(
+    images: str, tmp_path: Path, runtime: Any, capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Detection fooled into seeing a GPU: the real engine gets the device request, refuses it
+    (it has no NVIDIA device driver), and the simulator starts again without it."""
+    from orchestrator.engine import gpu as engine_gpu
+
+    monkeypatch.setattr(engine_gpu, "detect_nvidia", lambda client: gpu.GpuDetection(
+        access="device-request", devices=("/dev/nvidia0", "/dev/nvidiactl"), via="a test"))
+    match_id = "gpu-refused-test"
+    out = tmp_path / "refused"
+    try:
+        code = hlvs(["scrimmage", "--out", str(out), "--half-duration", "2",
+                     "--wait-before-ready", "1", "--grace", "2", "--match-id", match_id])
+    finally:
+        hlvs(["cleanup", "--match", match_id])
+    printed = capsys.readouterr()
+    assert code == 0, printed.err[-3000:]
+    assert "the engine refused the simulator the GPU" in printed.err
+    assert 'could not select device driver "" with capabilities: [[gpu]]' in printed.err
+    cameras = json.loads((out / "public" / "sim_result.json").read_text())["cameras"]
+    assert cameras["gl_backend"] == "osmesa" and "llvmpipe" in cameras["gl_renderer"]
+    assert runtime.list_project(match_id=match_id) == []
+
+
 def _in_simulator_image(client: docker.DockerClient, image: str, environment: dict[str, str],
                         command: list[str]) -> tuple[int, str]:
     container = client.containers.run(
