@@ -40,17 +40,17 @@ class DivergenceWatch:
     def __init__(self, data: mujoco.MjData) -> None:
         self._data = data
         self._numbers = data.warning.number  # a live view into mjData
-        self._lo = min(int(w) for w in WATCHED)
-        self._hi = max(int(w) for w in WATCHED) + 1
-        self._total = int(self._numbers[self._lo : self._hi].sum())
+        lo = min(int(w) for w in WATCHED)
+        self._watched = self._numbers[lo : max(int(w) for w in WATCHED) + 1]  # live too
+        self._seen = self._watched.tolist()
         self._counts = [int(self._numbers[int(w)]) for w in WATCHED]
 
     def check(self, data: mujoco.MjData) -> Divergence | None:
         """The first new instability warning since the last call, or None."""
-        total = int(self._numbers[self._lo : self._hi].sum())
-        if total == self._total:
+        seen = self._watched.tolist()  # one numpy call in the common case: nothing new
+        if seen == self._seen:
             return None
-        self._total = total
+        self._seen = seen
         found: Divergence | None = None
         for i, w in enumerate(WATCHED):
             number = int(self._numbers[int(w)])

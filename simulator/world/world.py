@@ -6,6 +6,10 @@ evaluated in the last substep only, since they are read once per basic step), re
 are held at their parking spots, divergence is checked (policy ``fail`` raises
 :class:`PhysicsDivergence`, ``reset_robot`` restores the previous state and resets the offending
 robot), and the last ball toucher is updated.
+
+:meth:`World.snapshot` is built by :class:`simulator.world.snapshot.SnapshotBuilder`, which
+precomputes what it can so that a snapshot of eight robots costs about 40 us of the 8 ms step's
+roughly 900 us of CPU (its module says how and what was measured).
 """
 
 from __future__ import annotations
@@ -29,7 +33,7 @@ from simulator.world.indices import build_index
 from simulator.world.motors import MotorBank
 from simulator.world.robots import robot_model
 from simulator.world.scene import compile_scene
-from simulator.world.snapshot import ball_toucher, build_snapshot
+from simulator.world.snapshot import SnapshotBuilder, ball_toucher
 from simulator.world.types import DivergencePolicy, FieldClassName, RobotPlacement
 
 logger = logging.getLogger(__name__)
@@ -73,6 +77,7 @@ class World(DeviceAccess):
         self.rng = np.random.default_rng(seed)
         self.model = compile_scene(field, placements, physics_dt_s=physics_dt_s)
         self.data = mujoco.MjData(self.model)
+        self._opt = self.model.opt  # a view of the model's options (one wrapper, not one a step)
         self.index = build_index(self.model, placements)
         self.robot_ids: tuple[RobotId, ...] = tuple(ids)
         self.motors = MotorBank(self.model, self.index, step_ms / 1000.0)
@@ -93,6 +98,7 @@ class World(DeviceAccess):
                 self.motors.hold(robot.actuators, pose)
         mujoco.mj_forward(self.model, self.data)
         self._watch = DivergenceWatch(self.data)
+        self._snapshots = SnapshotBuilder(self.data, self.index, self.robot_ids)
         self._saved = self._save()
 
     @classmethod
@@ -157,7 +163,7 @@ class World(DeviceAccess):
         self.motors.apply(self.data)
         if self.substeps > 1:
             # Sensors are read once per basic step: skip them in all but the last substep.
-            opt = self.model.opt
+            opt = self._opt
             opt.disableflags |= _SENSOR_OFF
             mujoco.mj_step(self.model, self.data, nstep=self.substeps - 1)
             opt.disableflags &= ~_SENSOR_OFF
@@ -174,10 +180,7 @@ class World(DeviceAccess):
             self.last_ball_touch_ms = self.sim_time_ms
 
     def snapshot(self) -> WorldSnapshot:
-        return build_snapshot(
-            data=self.data,
-            index=self.index,
-            robot_ids=self.robot_ids,
+        return self._snapshots.build(
             sim_time_ms=self.sim_time_ms,
             limp=self.limp,
             removed=self.removed,
