@@ -183,9 +183,7 @@ class Connection:
             ClientClosed: on a fatal send error.
         """
         if self.threaded:
-            if len(self.outbox) >= self.queue_limit:
-                self.write_queued()  # the I/O thread is behind: the socket may still take them
-            self.enqueue(frame, now)
+            self.send_threaded(frame, now)
             return
         if self._partial is not None or self.outbox:
             self.enqueue(frame, now)
@@ -206,6 +204,19 @@ class Connection:
         if sent < len(frame):
             self._partial = memoryview(frame)[sent:]
             self.want_write = True
+
+    def send_threaded(self, frame: bytes, now: float) -> None:
+        """:meth:`send` of a threaded connection: queue the frame for the I/O thread (never
+        raises: a failure is left in ``error``)."""
+        outbox = self.outbox
+        if len(outbox) >= self.queue_limit:
+            self.write_queued()  # the I/O thread is behind: the socket may still take them
+            self.enqueue(frame, now)
+            return
+        outbox.append(frame)
+        self.answered = False
+        self.last_sent_at = now
+        self.enqueued_at = now
 
     def write_queued(self) -> bool:
         """:meth:`flush` for the I/O thread (and for the step thread when the I/O thread is

@@ -63,7 +63,7 @@ class SensorLayout:
     measurement of 22 sensors costs about as much as one of them.
     """
 
-    __slots__ = ("_template", "_byte_index", "values")
+    __slots__ = ("template", "byte_index", "values")
 
     def __init__(self, entries: Sequence[tuple[int, str, int]]) -> None:
         template = bytearray()
@@ -82,12 +82,12 @@ class SensorLayout:
             else:
                 raise ValueError(f"sensor {name!r}: width {width}, expected 1 or 3")
         self.values = len(starts)
-        self._template = np.frombuffer(bytes(template), dtype=np.uint8)
-        self._byte_index = (np.asarray(starts, dtype=np.int64)[:, None] + np.arange(8)).ravel()
+        self.template = np.frombuffer(bytes(template), dtype=np.uint8)
+        self.byte_index = (np.asarray(starts, dtype=np.int64)[:, None] + np.arange(8)).ravel()
 
     def encode(self, values: Sequence[float] | np.ndarray) -> bytes:
-        out = self._template.copy()
-        out[self._byte_index] = np.ascontiguousarray(values, dtype="<f8").view(np.uint8)
+        out = self.template.copy()
+        out[self.byte_index] = np.ascontiguousarray(values, dtype="<f8").view(np.uint8)
         return out.tobytes()
 
 

@@ -13,14 +13,24 @@ protobuf way, so both ways give the same result.
 from __future__ import annotations
 
 import struct
+from collections.abc import Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+TargetValues = Sequence[float] | npt.NDArray[np.float64]
 
 
 class PositionTargets:
-    """Position targets of one request: ``names[i]`` to ``values[i]`` (in request order)."""
+    """Position targets of one request: ``names[i]`` to ``values[i]`` (in request order).
+    Read from a frame, ``values`` is a float64 array (made on the I/O thread, so that the step
+    thread writes every robot's targets with one concatenation)."""
 
     __slots__ = ("names", "values")
 
-    def __init__(self, names: tuple[str, ...], values: tuple[float, ...]) -> None:
+    def __init__(
+        self, names: tuple[str, ...], values: TargetValues
+    ) -> None:
         self.names = names
         self.values = values
 
@@ -44,7 +54,7 @@ class PositionTemplate:
         parts = self._unpack(frame)
         if parts[0::2] != self._fixed:
             return None
-        return PositionTargets(self.names, parts[1::2])
+        return PositionTargets(self.names, np.array(parts[1::2], dtype=np.float64))
 
 
 def _varint(data: bytes, at: int) -> tuple[int, int]:

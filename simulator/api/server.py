@@ -32,15 +32,16 @@ from contracts.ids import RobotId
 from contracts.match_spec import NetworkSpec
 from contracts.robot_api import messages_pb2 as pb
 from referee.spoofing import SpoofingLog
+from simulator.api.batch import StepBatch
 from simulator.api.cameras import MAX_IN_FLIGHT, ImageSource
 from simulator.api.connection import ClientClosed, Connection
 from simulator.api.devices import DeviceWorld
 from simulator.api.endpoints import PlayerEndpoint, peer_allowed_by_name
-from simulator.api.fastreq import PositionTargets
+from simulator.api.fastreq import PositionTargets, TargetValues
 from simulator.api.framing import HEADER, REFUSED, WELCOME
 from simulator.api.quota import NetworkQuota
 from simulator.api.sender import SendThread
-from simulator.api.session import ERROR, Measurement, RobotSession
+from simulator.api.session import ERROR, DuePlan, Measurement, RobotSession, TargetPlan
 from simulator.api.stats import RobotStats
 from simulator.errors import ApiError
 
@@ -112,6 +113,8 @@ class ApiServer:
         and pipelined stepping without ``blocking_send``); ``send_cpus``: the CPUs that thread
         may use."""
         self._world = world
+        # the per-step work over all robots at once, when the world has the batch forms
+        self._batch = StepBatch(world) if StepBatch.supports(world) else None
         self._spoofing = spoofing or SpoofingLog()
         self._network = network
         self._lockstep = lockstep
@@ -418,8 +421,11 @@ class ApiServer:
     def apply_requests(self, step_time_ms: int) -> None:
         """Read what is available, then apply every received request in arrival order."""
         self._poll_before_step()
+        batch = self._batch
+        targets: list[tuple[TargetPlan, TargetValues]] = []
         for slot in self.slots.values():
-            slot.session.update_limp()
+            session = slot.session
+            session.update_limp()
             conn = slot.conn
             if conn is None:
                 continue
@@ -427,12 +433,22 @@ class ApiServer:
                 if conn.error is not None:  # found by the I/O thread
                     self._drop(slot, conn.error)
                     continue
-                if conn.requests:
-                    slot.session.apply_all(conn.take_requests(), step_time_ms=step_time_ms)
+                if not conn.requests:
+                    continue
+                requests = conn.take_requests()
+            elif conn.requests:
+                requests = conn.requests
+                conn.requests = []
+            else:
                 continue
-            if conn.requests:
-                slot.session.apply_all(conn.requests, step_time_ms=step_time_ms)
-                conn.requests.clear()
+            usual = session.take_targets(requests) if batch is not None else None
+            if usual is not None:
+                targets.append(usual)
+            else:
+                session.apply_all(requests, step_time_ms=step_time_ms)
+        if targets:
+            assert batch is not None
+            batch.set_targets(targets)
 
     def take_requests(self) -> dict[RobotId, list[Request]]:
         """Pipelined stepping: read what is available and detach every client's received
@@ -453,11 +469,22 @@ class ApiServer:
     def apply_taken(self, taken: dict[RobotId, list[Request]], step_time_ms: int) -> None:
         """Pipelined stepping: apply requests detached by :meth:`take_requests` in arrival
         order (a robot's requests apply even when its client left since)."""
+        batch = self._batch
+        targets: list[tuple[TargetPlan, TargetValues]] = []
         for robot, slot in self.slots.items():
-            slot.session.update_limp()
+            session = slot.session
+            session.update_limp()
             requests = taken.get(robot)
-            if requests:
-                slot.session.apply_all(requests, step_time_ms=step_time_ms)
+            if not requests:
+                continue
+            usual = session.take_targets(requests) if batch is not None else None
+            if usual is not None:
+                targets.append(usual)
+            else:
+                session.apply_all(requests, step_time_ms=step_time_ms)
+        if targets:
+            assert batch is not None
+            batch.set_targets(targets)
 
     def publish(self, time_ms: int) -> None:
         """Queue the measurement of the step that ended at ``time_ms`` for every client."""
@@ -467,11 +494,25 @@ class ApiServer:
         """The measurements of the step that ended at ``time_ms`` for the connected clients,
         read and encoded but not queued: :meth:`publish_prepared` queues them. Pipelined
         stepping builds them before it waits for the answers to the previous ones."""
-        return [
-            (slot, slot.session.measure(time_ms))
-            for slot in self.slots.values()
-            if slot.conn is not None
-        ]
+        real_time = self._unix_ms()  # one instant for the whole step
+        prepared: list[tuple[RobotSlot, Measurement]] = []
+        batched: list[tuple[Measurement, DuePlan]] = []
+        for slot in self.slots.values():
+            if slot.conn is None:
+                continue
+            session = slot.session
+            measurement, plan = session.begin_measure(time_ms, real_time)
+            prepared.append((slot, measurement))
+            if plan is None:
+                continue
+            if plan.sources is not None and self._batch is not None:
+                batched.append((measurement, plan))
+            else:
+                measurement.sensors = session.encode(plan)
+        if batched:
+            assert self._batch is not None
+            self._batch.encode(batched)
+        return prepared
 
     def publish_prepared(self, prepared: list[tuple[RobotSlot, Measurement]]) -> None:
         """Queue measurements made by :meth:`prepare` (a client dropped meanwhile gets none)."""
@@ -504,7 +545,7 @@ class ApiServer:
         size = len(head) + len(sensors)
         real_time = measurement.real_time
         quota = slot.quota
-        if quota.allows(size, real_time):
+        if quota.admit(size, real_time):
             frame = b"".join((HEADER.pack(size), head, sensors))
             warnings = measurement.message_count
         else:
@@ -515,16 +556,17 @@ class ApiServer:
             size = len(payload)
             frame = HEADER.pack(size) + payload
             warnings = 1
-        quota.record(size, real_time)
+            quota.record(size, real_time)
         if warnings:
             slot.stats.warnings_sent += warnings
+        if conn.threaded:  # queued for the I/O thread (woken once per step by _flush_all)
+            conn.send_threaded(frame, now)
+            self._woken.append(conn)
+            return
         try:
             conn.send(frame, now)
         except ClientClosed as exc:
             self._drop(slot, exc.reason)
-            return
-        if conn.threaded:
-            self._woken.append(conn)
 
     def _flush_all(self) -> None:
         if self._sender is not None:

@@ -10,7 +10,7 @@ Camera images are filled in later by the caller (see :mod:`simulator.api.cameras
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -36,7 +36,7 @@ from simulator.api.encode import (
     SensorLayout,
     varint,
 )
-from simulator.api.fastreq import PositionTargets
+from simulator.api.fastreq import PositionTargets, TargetValues
 
 log = logging.getLogger(__name__)
 
@@ -129,6 +129,31 @@ def header_bytes(time_ms: int, real_time_ms: int) -> bytes:
     return head
 
 
+class DuePlan:
+    """The due regular sensors of a measurement: ``names`` in message order, their wire
+    ``layout`` and, when the world has the batch form, where their values come from
+    (``sources``, :meth:`simulator.world.World.sensor_sources`). Compared and hashed by
+    identity: one object per robot and name list, reused every step."""
+
+    __slots__ = ("names", "layout", "sources")
+
+    def __init__(self, names: tuple[str, ...], layout: SensorLayout, sources: Any) -> None:
+        self.names = names
+        self.layout = layout
+        self.sources = sources
+
+
+class TargetPlan:
+    """The actuators of a robot's held motor name list (distinct names), for
+    :meth:`simulator.world.World.set_motor_targets`. Compared and hashed by identity."""
+
+    __slots__ = ("names", "actuators")
+
+    def __init__(self, names: tuple[str, ...], actuators: Any) -> None:
+        self.names = names
+        self.actuators = actuators
+
+
 class RobotSession:
     """Sensor enabling, command application and measurement building for one robot."""
 
@@ -152,13 +177,25 @@ class RobotSession:
         self._motor_names = frozenset(n for n, k in self._kinds.items() if k == MOTOR)
         self._positions: dict[str, float] = {}  # last commands, re-applied after a penalty
         # the latest targets of a known name list, not yet merged into _positions
-        self._held: tuple[tuple[str, ...], Sequence[float]] | None = None
+        self._held: tuple[tuple[str, ...], TargetValues] | None = None
         self._velocities: dict[str, float] = {}
         self._torques: dict[str, float] = {}
         # batch forms of the world (simulator.world.World has them; a fake world may not)
         self._read_sensors = getattr(world, "read_sensors", None)
         self._set_positions = getattr(world, "set_motor_positions", None)
-        self._layouts: dict[tuple[str, ...], tuple[tuple[str, ...], SensorLayout]] = {}
+        # the world's limp / removed flags, read in place (one list item per step and robot)
+        flags = getattr(world, "robot_flags", None)
+        self._flags: tuple[list[bool], list[bool], int] | None = (
+            flags(robot) if flags is not None else None
+        )
+        # the due plan while every regular sensor has one period and one start and nothing
+        # else is going on (no message, no camera, no sensor just enabled): (period, start, plan)
+        self._steady: tuple[int, int, DuePlan] | None = None
+        self._sensor_sources = getattr(world, "sensor_sources", None)
+        self._targets_plan = getattr(world, "motor_targets_plan", None)
+        self._layouts: dict[tuple[str, ...], DuePlan] = {}
+        # the actuators of the held name list, for batched writes (None: not batchable)
+        self._batch_targets: TargetPlan | None = None
         self._valid_names: set[tuple[str, ...]] = set()  # motor name lists known to be fine
         # sensors by (period, start): (period, start, names, positions in enabling order)
         self._groups: list[tuple[int, int, tuple[str, ...], list[int]]] | None = None
@@ -183,6 +220,7 @@ class RobotSession:
                 return
             self._warned.add(text)
         self._pending.append((kind, text))
+        self._steady = None
 
     def apply(self, request: pb.ActuatorRequests | PositionTargets, *, step_time_ms: int) -> None:
         """Apply one request; ``step_time_ms`` is the time of the measurement this step sends."""
@@ -196,7 +234,7 @@ class RobotSession:
     ) -> None:
         """:meth:`apply` each request in order, right after :meth:`update_limp` (whose limp flag
         it uses: one world query per step instead of two per request)."""
-        if self._world.is_removed(self.robot):
+        if self._removed():
             return
         active = not self._limp
         for request in requests:
@@ -205,8 +243,43 @@ class RobotSession:
             else:
                 self._apply_one(request, step_time_ms, active)
 
+    def take_targets(
+        self, requests: list[pb.ActuatorRequests | PositionTargets]
+    ) -> tuple[TargetPlan, TargetValues] | None:
+        """The usual step, for a batched write: when every request is position targets in the
+        held name list and the robot is active, they are taken (the last one wins, as in
+        :meth:`apply_all`) and returned with the plan of their actuators; the caller writes
+        them (:class:`simulator.api.batch.StepBatch`). Otherwise None and nothing is taken:
+        the caller uses :meth:`apply_all`. Called right after :meth:`update_limp`."""
+        held = self._held
+        plan = self._batch_targets
+        if held is None or plan is None or plan.names is not held[0] or self._limp:
+            if held is None or self._limp or self._targets_plan is None:
+                return None
+            plan = self._plan_targets(held[0])
+            if plan is None:
+                return None
+        names = plan.names
+        values: TargetValues | None = None
+        for request in requests:
+            if type(request) is not PositionTargets or request.names is not names:
+                return None
+            values = request.values
+        if values is None or self._removed():
+            return None
+        self._held = (names, values)
+        return plan, values
+
+    def _plan_targets(self, names: tuple[str, ...]) -> TargetPlan | None:
+        assert self._targets_plan is not None
+        if names not in self._valid_names:
+            return None
+        actuators = self._targets_plan(self.robot, names)
+        self._batch_targets = None if actuators is None else TargetPlan(names, actuators)
+        return self._batch_targets
+
     def _apply_positions(
-        self, names: tuple[str, ...], values: Sequence[float], active: bool
+        self, names: tuple[str, ...], values: TargetValues, active: bool
     ) -> None:
         held = self._held
         if held is not None and held[0] is names:  # the usual case: the same name list again
@@ -277,7 +350,7 @@ class RobotSession:
             self._positions.update(zip(names, values, strict=True))
             self._held = None
 
-    def _apply_checked(self, names: tuple[str, ...], values: Sequence[float], active: bool) -> None:
+    def _apply_checked(self, names: tuple[str, ...], values: TargetValues, active: bool) -> None:
         """Position targets with unknown or repeated names (the later target wins)."""
         motors = self._motor_names
         targets: dict[str, float] = {}
@@ -293,7 +366,7 @@ class RobotSession:
         if active and targets:
             self._set_many(tuple(targets), list(targets.values()))
 
-    def _set_many(self, names: tuple[str, ...], values: Sequence[float]) -> None:
+    def _set_many(self, names: tuple[str, ...], values: TargetValues) -> None:
         if self._set_positions is not None:
             self._set_positions(self.robot, names, values)
         else:
@@ -313,6 +386,7 @@ class RobotSession:
             self._sensors.pop(name, None)
             self._new_sensors.discard(name)
             self._groups = None
+            self._steady = None
             return
         if period < minimum:
             self.warn(
@@ -342,11 +416,13 @@ class RobotSession:
         self._sensors[name] = period
         self._enabled_at[name] = now_ms
         self._groups = None
+        self._steady = None
         log.debug("%s: %s enabled every %d ms", self.key, name, period)
 
     def update_limp(self) -> None:
         """Follow the world's limp flag; re-apply cached commands when the robot is released."""
-        limp = self._world.is_limp(self.robot)
+        flags = self._flags
+        limp = flags[0][flags[2]] if flags is not None else self._world.is_limp(self.robot)
         if limp == self._limp:
             return
         self._limp = limp
@@ -369,30 +445,49 @@ class RobotSession:
 
     def measure(self, time_ms: int) -> Measurement:
         """The measurement of the step that ended at ``time_ms`` (camera images still empty)."""
-        out = Measurement(time_ms, self._clock_ms())
+        out, plan = self.begin_measure(time_ms, self._clock_ms())
+        if plan is not None:
+            out.sensors = plan.layout.encode(self._read(plan.names))
+        return out
+
+    def begin_measure(self, time_ms: int, real_time_ms: int) -> tuple[Measurement, DuePlan | None]:
+        """:meth:`measure` without reading and encoding the regular sensors: the measurement
+        (messages and camera jobs in it) and the plan of its due sensors (None when none is
+        due), whose encoding goes to ``out.sensors`` (:class:`simulator.api.batch.StepBatch`
+        encodes the plans of every robot of a step at once)."""
+        steady = self._steady
+        if steady is not None and not (time_ms - steady[1]) % steady[0] and not self._removed():
+            return Measurement(time_ms, real_time_ms), steady[2]
+        out = Measurement(time_ms, real_time_ms)
         if self._pending:
             msg = out.header
             for message_type, text in self._pending:
                 msg.messages.add(message_type=message_type, text=text)
             self._pending.clear()
-        world, robot = self._world, self.robot
-        if world.is_removed(robot):
+        if self._removed():
             self._sensors.clear()
             self._new_sensors.clear()
             self._groups = None
-            return out
+            self._steady = None
+            return out, None
         if self._new_sensors:
             due = self._due_slow(out, time_ms)
         else:
             due = self._due(out, time_ms)
         if not due:
-            return out
+            return out, None
         plan = self._layouts.get(due)
         if plan is None:
             plan = self._layout(due)
-        names, layout = plan
-        out.sensors = layout.encode(self._read(names))
-        return out
+        groups = self._groups
+        if groups is not None and len(groups) == 1 and not self._camera_sensors:
+            if not self._new_sensors and not self._pending:
+                self._steady = (groups[0][0], groups[0][1], plan)
+        return out, plan
+
+    def _removed(self) -> bool:
+        flags = self._flags
+        return flags[1][flags[2]] if flags is not None else self._world.is_removed(self.robot)
 
     def _due(self, out: Measurement, time_ms: int) -> tuple[str, ...]:
         """Due regular sensors (in enabling order); camera jobs added. Sensors sharing a period
@@ -446,7 +541,7 @@ class RobotSession:
             camera = out.header.cameras.add(name=name, width=width, height=height, quality=-1)
             out.jobs.append(CameraJob(self.robot, name, width, height, time_ms, camera))
 
-    def _layout(self, due: tuple[str, ...]) -> tuple[tuple[str, ...], SensorLayout]:
+    def _layout(self, due: tuple[str, ...]) -> DuePlan:
         """Due sensors in field-number order (the order of the message) and their layout."""
         if len(self._layouts) >= MAX_LAYOUTS:
             self._layouts.clear()
@@ -456,9 +551,16 @@ class RobotSession:
         for name in names:
             field, width = _FIELDS[kinds[name]]
             entries.append((field, name, width))
-        layout = SensorLayout(entries)
-        plan = self._layouts[due] = (names, layout)
+        sources = None
+        if self._sensor_sources is not None:
+            sources = self._sensor_sources(self.robot, names)
+        plan = self._layouts[due] = DuePlan(names, SensorLayout(entries), sources)
         return plan
+
+    def encode(self, plan: DuePlan) -> bytes:
+        """The regular sensors of ``plan`` read and encoded (one robot; see
+        :meth:`begin_measure`)."""
+        return plan.layout.encode(self._read(plan.names))
 
     def _read(self, names: tuple[str, ...]) -> Any:
         if self._read_sensors is not None:

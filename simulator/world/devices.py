@@ -6,11 +6,16 @@ Names are HLVS device names (``Neck``, ``NeckS``, ``Accelerometer``, ``Gyro``, `
 (numpy array in ``motor_names(robot)`` order), :meth:`DeviceAccess.set_motor_positions` (many
 targets in one vectorised write) and :meth:`DeviceAccess.read_sensors` (the values of named
 sensors as one array, index arrays cached per name list: what the robot API reads each step).
+Forms over several robots at once, for the robot API's per-step batches
+(:mod:`simulator.api.batch`): :meth:`DeviceAccess.motor_targets_plan` +
+:meth:`DeviceAccess.motor_targets_writer` (the targets of many robots in one clamped write) and
+:meth:`DeviceAccess.sensor_sources` + :meth:`DeviceAccess.gather_sensors` (the sensors of many
+robots in one gather).
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
 import mujoco
@@ -95,6 +100,25 @@ class DeviceAccess:
             rads = [rads[i] for i in picks]
         self.motors.set_positions(actuators, rads)
 
+    def motor_targets_plan(
+        self, robot: RobotId, names: Sequence[str]
+    ) -> npt.NDArray[np.int64] | None:
+        """The actuator indices of ``names`` (in order) when they are distinct motors of the
+        robot, for :meth:`set_motor_targets`; None when a name repeats (that list goes through
+        :meth:`set_motor_positions`, which keeps the last value). Unknown names raise
+        :class:`UnknownDeviceError`."""
+        if len(set(names)) != len(names):
+            return None
+        return np.array([self._actuator(robot, name) for name in names], dtype=np.int64)
+
+    def motor_targets_writer(
+        self, actuators: npt.NDArray[np.int64]
+    ) -> Callable[[Sequence[float] | npt.NDArray[np.float64]], None]:
+        """A writer of position targets for distinct ``actuators`` (of one or many robots,
+        from :meth:`motor_targets_plan`, concatenated): one clamped write with the same result
+        as :meth:`set_motor_positions` robot by robot."""
+        return self.motors.position_writer(actuators)
+
     def set_motor_velocity(self, robot: RobotId, name: str, rad_s: float) -> None:
         """Maximum velocity of the position controller (clamped to the motor's maximum)."""
         self.motors.set_velocity(self._actuator(robot, name), float(rad_s))
@@ -128,13 +152,28 @@ class DeviceAccess:
     def read_sensors(self, robot: RobotId, names: Sequence[str]) -> npt.NDArray[np.float64]:
         """The values of ``names`` in order, flat: one per position (``<motor>S``) and force
         sensor, three per ``Accelerometer`` and ``Gyro`` (x, y, z)."""
+        return self.gather_sensors(self.sensor_sources(robot, names))
+
+    def sensor_sources(
+        self, robot: RobotId, names: Sequence[str]
+    ) -> tuple[npt.NDArray[np.int64], ...]:
+        """Where the values of :meth:`read_sensors` come from: ``(out_q, src_q, out_s, src_s)``,
+        value ``out_q[k]`` is ``qpos[src_q[k]]`` and ``out_s[k]`` is ``sensordata[src_s[k]]``.
+        The plans of several robots concatenate (``out`` indices shifted) into one
+        :meth:`gather_sensors`. Cached per name list."""
         key = ("read", robot, tuple(names))
         plans = self._plans()
         plan = plans.get(key)
         if plan is None:
             plan = self._sensor_plan(robot, names)
             plans[key] = plan
-        out_q, src_q, out_s, src_s = plan
+        return plan
+
+    def gather_sensors(
+        self, sources: tuple[npt.NDArray[np.int64], ...]
+    ) -> npt.NDArray[np.float64]:
+        """The values of a :meth:`sensor_sources` plan (or of several concatenated), flat."""
+        out_q, src_q, out_s, src_s = sources
         out = np.empty(len(out_q) + len(out_s))
         out[out_q] = self.data.qpos[src_q]
         out[out_s] = self.data.sensordata[src_s]
@@ -201,6 +240,12 @@ class DeviceAccess:
         """(width, height, horizontal field of view in rad) of the head camera."""
         cam = self._robot(robot).model.camera
         return cam.width, cam.height, cam.fov_rad
+
+    def robot_flags(self, robot: RobotId) -> tuple[list[bool], list[bool], int]:
+        """``(limp, removed, i)``: the world's flag lists (changed in place by referee
+        commands, never replaced) and the robot's index in them: ``limp[i]`` is
+        :meth:`is_limp`, ``removed[i]`` :meth:`is_removed`."""
+        return self.limp, self.removed, self._robot(robot).number
 
     def is_limp(self, robot: RobotId) -> bool:
         return self.limp[self._robot(robot).number]

@@ -78,7 +78,8 @@ class MotorBank:
     ) -> None:
         """:meth:`set_position` for distinct ``actuators`` (a slice or an index array) at once;
         non-finite values are ignored."""
-        if not math.isfinite(sum(rads)):  # a NaN or infinity somewhere (or a huge sum)
+        total = rads.sum() if type(rads) is np.ndarray else sum(rads)
+        if not math.isfinite(total):  # a NaN or infinity somewhere (or a huge sum)
             values = np.asarray(rads, dtype=np.float64)
             finite = np.isfinite(values)
             chosen = np.arange(len(self.target))[actuators]
@@ -98,6 +99,11 @@ class MotorBank:
             self.torque_mode[actuators] = False
             self._any_torque = bool(self.torque_mode.any())
             self._dirty = True
+
+    def position_writer(self, actuators: npt.NDArray[np.int64]) -> PositionWriter:
+        """:meth:`set_positions` for a fixed set of distinct ``actuators`` (their limits
+        gathered once): what the robot API writes every step for all robots at once."""
+        return PositionWriter(self, actuators)
 
     def set_velocity(self, actuator: int, rad_s: float) -> None:
         if not math.isfinite(rad_s):
@@ -170,3 +176,31 @@ class MotorBank:
         self._model.actuator_biasprm[:, 1] = -self.kp * position
         self._model.actuator_biasprm[:, 2] = -self.kv * position
         self._dirty = False
+
+
+class PositionWriter:
+    """Position targets of a fixed set of distinct actuators, clamped to limits gathered once;
+    the same result as :meth:`MotorBank.set_positions`."""
+
+    __slots__ = ("_bank", "actuators", "_lower", "_upper")
+
+    def __init__(self, bank: MotorBank, actuators: npt.NDArray[np.int64]) -> None:
+        self._bank = bank
+        self.actuators = actuators
+        self._lower = bank.lower[actuators]
+        self._upper = bank.upper[actuators]
+
+    def __call__(self, rads: Sequence[float] | FloatArray) -> None:
+        bank = self._bank
+        values = np.asarray(rads, dtype=np.float64)
+        if not math.isfinite(values.sum()):  # a NaN or infinity (or a huge sum): filtered there
+            bank.set_positions(self.actuators, values)
+            return
+        clamped = np.maximum(values, self._lower)
+        np.minimum(clamped, self._upper, out=clamped)
+        bank.target[self.actuators] = clamped
+        bank._ramping = True
+        if bank._any_torque and bank.torque_mode[self.actuators].any():
+            bank.torque_mode[self.actuators] = False
+            bank._any_torque = bool(bank.torque_mode.any())
+            bank._dirty = True
