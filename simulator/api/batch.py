@@ -5,9 +5,10 @@ once per robot. A :class:`StepBatch` makes them once per step:
 
 - the regular sensors of every measurement of the step: one gather from the world
   (:meth:`simulator.world.World.gather_sensors` over the robots' concatenated
-  :meth:`~simulator.world.World.sensor_sources`), one scatter of the values into the
-  concatenated wire templates (:class:`simulator.api.encode.SensorLayout`) and one ``tobytes``,
-  cut into each robot's bytes;
+  :meth:`~simulator.world.World.sensor_sources`), one scatter of the values and of the step's
+  head (time, real time) into the concatenated framed templates (length prefix, head,
+  :class:`simulator.api.encode.SensorLayout`) and one ``tobytes``, cut into each robot's framed
+  message;
 - the position targets of every robot that sent the usual request (the same motor names as
   before, robot active): one clamped write (:meth:`simulator.world.World.motor_targets_writer`;
   the I/O thread made each robot's targets an array as it read them).
@@ -27,22 +28,30 @@ import numpy as np
 import numpy.typing as npt
 
 from simulator.api.fastreq import TargetValues
+from simulator.api.framing import HEADER
 from simulator.api.session import DuePlan, Measurement, TargetPlan
 
 MAX_COMBINATIONS = 64  # distinct combinations kept (robots enabling sensors at other periods)
 
 
 class _Encoding:
-    __slots__ = ("sources", "template", "byte_index", "bounds")
+    """The concatenated plans of one combination of robots. Each robot's span is
+    ``[4-byte length][head][sensors]`` with room for a head of ``head_size`` bytes (the same
+    for every robot of a step): the framed messages of robots without messages or cameras are
+    cut out whole; the others take their sensors only."""
 
-    def __init__(self, plans: Sequence[DuePlan]) -> None:
+    __slots__ = ("sources", "buffer", "array", "byte_index", "heads", "frames", "sensors")
+
+    def __init__(self, plans: Sequence[DuePlan], head_size: int) -> None:
         out_q: list[npt.NDArray[np.int64]] = []
         src_q: list[npt.NDArray[np.int64]] = []
         out_s: list[npt.NDArray[np.int64]] = []
         src_s: list[npt.NDArray[np.int64]] = []
         templates: list[npt.NDArray[np.uint8]] = []
         byte_index: list[npt.NDArray[np.int64]] = []
-        bounds: list[tuple[int, int]] = []
+        head_index: list[npt.NDArray[np.int64]] = []
+        frames: list[tuple[int, int]] = []
+        sensors: list[tuple[int, int]] = []
         values = size = 0
         for plan in plans:
             oq, sq, os_, ss = plan.sources
@@ -51,19 +60,44 @@ class _Encoding:
             out_s.append(os_ + values)
             src_s.append(ss)
             layout = plan.layout
+            length = head_size + len(layout.template)
+            templates.append(np.frombuffer(HEADER.pack(length), dtype=np.uint8))
+            head_index.append(np.arange(size + HEADER.size, size + HEADER.size + head_size))
+            templates.append(np.zeros(head_size, dtype=np.uint8))
+            start = size + HEADER.size + head_size
             templates.append(layout.template)
-            byte_index.append(layout.byte_index + size)
-            bounds.append((size, size + len(layout.template)))
+            byte_index.append(layout.byte_index + start)
+            frames.append((size, start + len(layout.template)))
+            sensors.append((start, start + len(layout.template)))
             values += layout.values
-            size += len(layout.template)
+            size = start + len(layout.template)
 
         def joined(parts: list[npt.NDArray[np.int64]]) -> npt.NDArray[np.int64]:
             return np.concatenate(parts).astype(np.int64) if parts else np.zeros(0, np.int64)
 
         self.sources = (joined(out_q), joined(src_q), joined(out_s), joined(src_s))
-        self.template = np.concatenate(templates)
+        # the wire bytes, written in place every step (the fixed bytes never change)
+        self.buffer = bytearray(np.concatenate(templates).tobytes())
+        self.array = np.frombuffer(self.buffer, dtype=np.uint8)
         self.byte_index = joined(byte_index)
-        self.bounds = tuple(bounds)
+        spans = {end - start for start, end in frames}
+        if len(spans) == 1:  # robots with the same sensors: the heads are one strided view
+            span = spans.pop()
+            rows = self.array.reshape(len(plans), span)
+            self.heads: npt.NDArray[np.uint8] | npt.NDArray[np.int64] = rows[
+                :, HEADER.size : HEADER.size + head_size
+            ]
+        else:
+            self.heads = joined(head_index).reshape(len(plans), head_size)
+        self.frames = tuple(frames)
+        self.sensors = tuple(sensors)
+
+    def write_head(self, head: bytes) -> None:
+        values = np.frombuffer(head, dtype=np.uint8)
+        if self.heads.dtype == np.uint8:
+            self.heads[:] = values
+        else:
+            self.array[self.heads] = values
 
 
 class StepBatch:
@@ -72,7 +106,7 @@ class StepBatch:
     def __init__(self, world: Any) -> None:
         self._gather = world.gather_sensors
         self._writer = world.motor_targets_writer
-        self._encodings: dict[tuple[DuePlan, ...], _Encoding] = {}
+        self._encodings: dict[tuple[tuple[DuePlan, ...], int], _Encoding] = {}
         self._targets: dict[tuple[TargetPlan, ...], Callable[[Any], None]] = {}
 
     @staticmethod
@@ -83,21 +117,30 @@ class StepBatch:
                          "motor_targets_plan")
         )  # fmt: skip
 
-    def encode(self, items: Sequence[tuple[Measurement, DuePlan]]) -> None:
+    def encode(self, items: Sequence[tuple[Measurement, DuePlan]], head: bytes) -> None:
         """Fill ``sensors`` of each measurement with the encoding of its plan (every plan has
-        ``sources``)."""
-        key = tuple([plan for _, plan in items])
+        ``sources``), and ``frame`` of those without header (``head``: the step's
+        :func:`~simulator.api.session.header_bytes`)."""
+        plans = tuple([plan for _, plan in items])
+        key = (plans, len(head))
         encoding = self._encodings.get(key)
         if encoding is None:
             if len(self._encodings) >= MAX_COMBINATIONS:
                 self._encodings.clear()
-            encoding = self._encodings[key] = _Encoding(key)
+            encoding = self._encodings[key] = _Encoding(plans, len(head))
         values = self._gather(encoding.sources)
-        out = encoding.template.copy()
-        out[encoding.byte_index] = values.astype("<f8", copy=False).view(np.uint8)
-        raw = out.tobytes()
-        for (measurement, _), (start, end) in zip(items, encoding.bounds, strict=True):
-            measurement.sensors = raw[start:end]
+        encoding.array[encoding.byte_index] = values.astype("<f8", copy=False).view(np.uint8)
+        if head:
+            encoding.write_head(head)
+        raw = memoryview(encoding.buffer)
+        for (measurement, _), frame, sensors in zip(
+            items, encoding.frames, encoding.sensors, strict=True
+        ):
+            if measurement.plain:
+                measurement.set_frame(bytes(raw[frame[0] : frame[1]]))
+            else:
+                measurement.sensors = bytes(raw[sensors[0] : sensors[1]])
+        raw.release()
 
     def set_targets(self, items: Sequence[tuple[TargetPlan, TargetValues]]) -> None:
         """Write the position targets of several robots (distinct actuators) at once."""

@@ -41,7 +41,14 @@ from simulator.api.fastreq import PositionTargets, TargetValues
 from simulator.api.framing import HEADER, REFUSED, WELCOME
 from simulator.api.quota import NetworkQuota
 from simulator.api.sender import SendThread
-from simulator.api.session import ERROR, DuePlan, Measurement, RobotSession, TargetPlan
+from simulator.api.session import (
+    ERROR,
+    DuePlan,
+    Measurement,
+    RobotSession,
+    TargetPlan,
+    header_bytes,
+)
 from simulator.api.stats import RobotStats
 from simulator.errors import ApiError
 
@@ -511,7 +518,7 @@ class ApiServer:
                 measurement.sensors = session.encode(plan)
         if batched:
             assert self._batch is not None
-            self._batch.encode(batched)
+            self._batch.encode(batched, header_bytes(time_ms, real_time))
         return prepared
 
     def publish_prepared(self, prepared: list[tuple[RobotSlot, Measurement]]) -> None:
@@ -541,12 +548,17 @@ class ApiServer:
     def _send(
         self, slot: RobotSlot, conn: Connection, measurement: Measurement, now: float
     ) -> None:
-        head, sensors = measurement.head(), measurement.sensors
-        size = len(head) + len(sensors)
         real_time = measurement.real_time
         quota = slot.quota
+        frame = measurement.frame
+        if frame is not None:  # built whole by the step's batch
+            size = len(frame) - HEADER.size
+        else:
+            head, sensors = measurement.head(), measurement.sensors
+            size = len(head) + len(sensors)
         if quota.admit(size, real_time):
-            frame = b"".join((HEADER.pack(size), head, sensors))
+            if frame is None:
+                frame = b"".join((HEADER.pack(size), head, sensors))
             warnings = measurement.message_count
         else:
             slot.stats.quota_errors += 1

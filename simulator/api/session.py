@@ -37,6 +37,7 @@ from simulator.api.encode import (
     varint,
 )
 from simulator.api.fastreq import PositionTargets, TargetValues
+from simulator.api.framing import HEADER
 
 log = logging.getLogger(__name__)
 
@@ -70,16 +71,42 @@ class CameraJob:
 class Measurement:
     """One step's measurement: ``time``, ``real_time``, the encoded regular ``sensors`` and the
     camera ``jobs``. The protobuf ``header`` (time, real_time, messages, cameras) is only made
-    when a message or a camera needs it; otherwise :meth:`head` is hand-encoded."""
+    when a message or a camera needs it; otherwise :meth:`head` is hand-encoded. ``frame``: the
+    whole framed message (length prefix, head, sensors) when the step's batch built it (a
+    measurement without header), else None."""
 
-    __slots__ = ("time", "real_time", "sensors", "jobs", "_header")
+    __slots__ = ("time", "real_time", "_sensors", "jobs", "frame", "_header")
 
     def __init__(self, time: int, real_time: int, sensors: bytes = b"") -> None:
         self.time = time
         self.real_time = real_time
-        self.sensors = sensors
+        self._sensors: bytes | None = sensors
         self.jobs: list[CameraJob] = []
+        self.frame: bytes | None = None
         self._header: pb.SensorMeasurements | None = None
+
+    @property
+    def sensors(self) -> bytes:
+        """The encoded regular sensors (cut from ``frame`` when only the frame was built)."""
+        if self._sensors is None:
+            assert self.frame is not None
+            self._sensors = self.frame[HEADER.size + len(self.head()) :]
+        return self._sensors
+
+    @sensors.setter
+    def sensors(self, value: bytes) -> None:
+        self._sensors = value
+
+    def set_frame(self, frame: bytes) -> None:
+        """The whole framed message of a measurement without header (its sensors are cut
+        from it when asked for)."""
+        self.frame = frame
+        self._sensors = None
+
+    @property
+    def plain(self) -> bool:
+        """No header: no message and no camera (the head is :func:`header_bytes`)."""
+        return self._header is None
 
     @property
     def header(self) -> pb.SensorMeasurements:
