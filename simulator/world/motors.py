@@ -157,15 +157,21 @@ class MotorBank:
     def apply(self, data: mujoco.MjData) -> None:
         """Advance the velocity-limited targets by one basic step and write ``ctrl`` (only when
         something changed: the common case of robots holding a posture costs nothing)."""
-        if self._ramping:
+        if self._ramping:  # effective = clip(target, effective - reach, effective + reach)
             reach = self.velocity_limit * self._step_s
-            np.clip(self.target, self.effective - reach, self.effective + reach, out=self.effective)
-            self._ramping = not np.array_equal(self.effective, self.target)
+            effective = self.effective
+            low = effective - reach
+            np.maximum(self.target, low, out=low)
+            np.minimum(low, effective + reach, out=effective)
+            self._ramping = not np.array_equal(effective, self.target)
             self._ctrl_dirty = True
         if self._dirty:
             self._write_gains()
         if self._ctrl_dirty:
-            data.ctrl[:] = np.where(self.torque_mode, self.torque, self.effective)
+            if self._any_torque:  # (no actuator is in torque mode while it is False)
+                data.ctrl[:] = np.where(self.torque_mode, self.torque, self.effective)
+            else:
+                data.ctrl[:] = self.effective
             self._ctrl_dirty = False
 
     def _write_gains(self) -> None:
