@@ -113,8 +113,12 @@ class Pipeline:
         (read and encoded before the wait: the world does not change until it is sent)."""
         prepared = self._server.prepare(time_ms)
         self.waited_s += wait_lockstep(self._server, self._settings)
-        for robot, requests in self._server.take_requests().items():
-            self._taken.setdefault(robot, []).extend(requests)
+        taken = self._server.take_requests()
+        if not self._taken:  # the usual case: the answers applied before this send
+            self._taken = taken
+        else:
+            for robot, requests in taken.items():
+                self._taken.setdefault(robot, []).extend(requests)
         self._server.publish_prepared(prepared)
         self.unsent = False
 

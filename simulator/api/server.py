@@ -478,10 +478,10 @@ class ApiServer:
         order (a robot's requests apply even when its client left since)."""
         batch = self._batch
         targets: list[tuple[TargetPlan, TargetValues]] = []
-        for robot, slot in self.slots.items():
-            session = slot.session
-            session.update_limp()
-            requests = taken.get(robot)
+        for slot in self.slots.values():
+            slot.session.update_limp()
+        for robot, requests in taken.items():
+            session = self.slots[robot].session
             if not requests:
                 continue
             usual = session.take_targets(requests) if batch is not None else None
