@@ -419,8 +419,10 @@ class ApiServer:
     def _poll_before_step(self) -> None:
         if self._sender is not None:
             self._step_polls += 1
-            if self._step_polls % POLL_EVERY_STEPS and not any(
-                slot.pending or slot.checking for slot in self.slots.values()
+            if self._step_polls % POLL_EVERY_STEPS and (
+                # measurements wait for images only with cameras, names only with lookups
+                (self._cameras is None and self._lookups is None)
+                or not any(slot.pending or slot.checking for slot in self.slots.values())
             ):
                 return
         self.poll(0.0)
