@@ -4,7 +4,7 @@ With eight robots, the API's cost on the step thread was mostly the same few num
 once per robot. A :class:`StepBatch` makes them once per step:
 
 - the regular sensors of every measurement of the step: one gather from the world
-  (:meth:`simulator.world.World.gather_sensors_into` over the robots' concatenated
+  (:meth:`simulator.world.World.gather_sensors` over the robots' concatenated
   :meth:`~simulator.world.World.sensor_sources`), one scatter of the values and of the step's
   head (time, real time) into the concatenated framed templates (length prefix, head,
   :class:`simulator.api.encode.SensorLayout`) and one ``tobytes``, cut into each robot's framed
@@ -40,10 +40,7 @@ class _Encoding:
     for every robot of a step): the framed messages of robots without messages or cameras are
     cut out whole; the others take their sensors only."""
 
-    __slots__ = (
-        "src_q", "src_s", "stage_q", "stage_s", "stage_bytes", "buffer", "array", "byte_index",
-        "heads", "frames", "sensors",
-    )  # fmt: skip
+    __slots__ = ("sources", "buffer", "array", "byte_index", "heads", "frames", "sensors")
 
     def __init__(self, plans: Sequence[DuePlan], head_size: int) -> None:
         out_q: list[npt.NDArray[np.int64]] = []
@@ -78,17 +75,11 @@ class _Encoding:
         def joined(parts: list[npt.NDArray[np.int64]]) -> npt.NDArray[np.int64]:
             return np.concatenate(parts).astype(np.int64) if parts else np.zeros(0, np.int64)
 
-        # the values are gathered into a stage (those from qpos, then those from sensordata)
-        # whose bytes go to their places in the wire buffer in one scatter
-        self.src_q, self.src_s = joined(src_q), joined(src_s)
-        stage = np.empty(len(self.src_q) + len(self.src_s), dtype="<f8")  # wire order
-        self.stage_q, self.stage_s = stage[: len(self.src_q)], stage[len(self.src_q) :]
-        self.stage_bytes = stage.view(np.uint8)
-        order = np.concatenate([joined(out_q), joined(out_s)])  # value number of each stage slot
-        self.byte_index = joined(byte_index).reshape(-1, 8)[order].ravel()
+        self.sources = (joined(out_q), joined(src_q), joined(out_s), joined(src_s))
         # the wire bytes, written in place every step (the fixed bytes never change)
         self.buffer = bytearray(np.concatenate(templates).tobytes())
         self.array = np.frombuffer(self.buffer, dtype=np.uint8)
+        self.byte_index = joined(byte_index)
         spans = {end - start for start, end in frames}
         if len(spans) == 1:  # robots with the same sensors: the heads are one strided view
             span = spans.pop()
@@ -113,7 +104,7 @@ class StepBatch:
     """Batched sensor encoding and target writes for a world with the batch forms."""
 
     def __init__(self, world: Any) -> None:
-        self._gather = world.gather_sensors_into
+        self._gather = world.gather_sensors
         self._writer = world.motor_targets_writer
         self._encodings: dict[tuple[tuple[DuePlan, ...], int], _Encoding] = {}
         self._targets: dict[tuple[TargetPlan, ...], Callable[[Any], None]] = {}
@@ -122,7 +113,7 @@ class StepBatch:
     def supports(world: object) -> bool:
         return all(
             hasattr(world, name)
-            for name in ("gather_sensors_into", "sensor_sources", "motor_targets_writer",
+            for name in ("gather_sensors", "sensor_sources", "motor_targets_writer",
                          "motor_targets_plan")
         )  # fmt: skip
 
@@ -137,8 +128,8 @@ class StepBatch:
             if len(self._encodings) >= MAX_COMBINATIONS:
                 self._encodings.clear()
             encoding = self._encodings[key] = _Encoding(plans, len(head))
-        self._gather(encoding.src_q, encoding.src_s, encoding.stage_q, encoding.stage_s)
-        encoding.array[encoding.byte_index] = encoding.stage_bytes
+        values = self._gather(encoding.sources)
+        encoding.array[encoding.byte_index] = values.astype("<f8", copy=False).view(np.uint8)
         if head:
             encoding.write_head(head)
         raw = memoryview(encoding.buffer)

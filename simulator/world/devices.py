@@ -9,8 +9,8 @@ sensors as one array, index arrays cached per name list: what the robot API read
 Forms over several robots at once, for the robot API's per-step batches
 (:mod:`simulator.api.batch`): :meth:`DeviceAccess.motor_targets_plan` +
 :meth:`DeviceAccess.motor_targets_writer` (the targets of many robots in one clamped write) and
-:meth:`DeviceAccess.sensor_sources` + :meth:`DeviceAccess.gather_sensors_into` (the sensors of
-many robots in one gather).
+:meth:`DeviceAccess.sensor_sources` + :meth:`DeviceAccess.gather_sensors` (the sensors of many
+robots in one gather).
 """
 
 from __future__ import annotations
@@ -168,18 +168,6 @@ class DeviceAccess:
             plan = self._sensor_plan(robot, names)
             plans[key] = plan
         return plan
-
-    def gather_sensors_into(
-        self,
-        src_q: npt.NDArray[np.int64],
-        src_s: npt.NDArray[np.int64],
-        out_q: npt.NDArray[np.float64],
-        out_s: npt.NDArray[np.float64],
-    ) -> None:
-        """``out_q[:] = qpos[src_q]`` and ``out_s[:] = sensordata[src_s]`` without temporaries
-        (the indices come from :meth:`sensor_sources`, so they are in range)."""
-        np.take(self.data.qpos, src_q, out=out_q, mode="clip")
-        np.take(self.data.sensordata, src_s, out=out_s, mode="clip")
 
     def gather_sensors(
         self, sources: tuple[npt.NDArray[np.int64], ...]
