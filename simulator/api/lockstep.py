@@ -104,7 +104,10 @@ class Pipeline:
 
     :meth:`before_step` sends the measurement of step N only after waiting for and taking the
     answers to the measurement of step N-1, then applies those: no answer to step N can be among
-    them whatever the timing, and the answers to step N apply at step N+2 (lockstep: N+1).
+    them whatever the timing, and the answers to step N apply at step N+2 (lockstep: N+1). Right
+    before a step the answers are taken and applied in one pass
+    (:meth:`ApiServer.apply_requests`, before the measurement goes out: nothing can have
+    answered it yet); a send during a hold keeps them for the next step.
     """
 
     def __init__(self, server: ApiServer, settings: LockstepSettings) -> None:
@@ -114,21 +117,25 @@ class Pipeline:
         self.unsent = False  # the latest step's measurement is not sent yet
         self.waited_s = 0.0  # total time spent waiting for the clients
 
-    def send(self, time_ms: int) -> None:
+    def send(self, time_ms: int, step_time_ms: int | None = None) -> None:
         """Wait for the answers to the measurement sent last, take them, send the latest one
-        (read and encoded before the wait: the world does not change until it is sent)."""
-        prepared = self._server.prepare(time_ms)
-        self.waited_s += wait_lockstep(self._server, self._settings)
-        taken = self._server.take_requests()
-        if not self._taken:  # the usual case: the answers applied before this send
-            self._taken = taken
+        (read and encoded before the wait: the world does not change until it is sent). With
+        ``step_time_ms`` (right before that step) the answers are applied at once."""
+        server = self._server
+        prepared = server.prepare(time_ms)
+        self.waited_s += wait_lockstep(server, self._settings)
+        if step_time_ms is not None and not self._taken:
+            server.apply_requests(step_time_ms)  # takes what arrived and applies it
         else:
-            for robot, requests in taken.items():
+            for robot, requests in server.take_requests().items():
                 self._taken.setdefault(robot, []).extend(requests)
-        self._server.publish_prepared(prepared)
+        server.publish_prepared(prepared)
         self.unsent = False
 
     def before_step(self, time_ms: int, step_time_ms: int) -> None:
+        if self.unsent and not self._taken:
+            self.send(time_ms, step_time_ms)
+            return
         if self.unsent:
             self.send(time_ms)
         taken, self._taken = self._taken, {}
