@@ -46,20 +46,27 @@ Probe = Callable[[str], str | None]
 """back end -> None when it works, else why not (one line)."""
 
 
-def probe_backend(backend: str) -> str | None:
-    """Try ``backend`` in a child process; None when it works, else the reason."""
+def _run_probe(backend: str, code: str) -> subprocess.CompletedProcess[str] | str:
+    """Run ``code`` in a child process with ``backend``: its result when it exited 0, else
+    the reason it failed (one line)."""
     env = dict(os.environ, MUJOCO_GL=backend, PYOPENGL_PLATFORM=backend)
     try:
         done = subprocess.run(
-            [sys.executable, "-c", _PROBE],
+            [sys.executable, "-c", code],
             env=env, capture_output=True, text=True, timeout=PROBE_TIMEOUT_S, check=False,
         )  # fmt: skip
     except subprocess.TimeoutExpired:
         return f"no context within {PROBE_TIMEOUT_S:g} s"
     if done.returncode == 0:
-        return None
+        return done
     lines = [line.strip() for line in done.stderr.splitlines() if line.strip()]
     return lines[-1] if lines else f"exit code {done.returncode}"
+
+
+def probe_backend(backend: str) -> str | None:
+    """Try ``backend`` in a child process; None when it works, else the reason."""
+    done = _run_probe(backend, _PROBE)
+    return done if isinstance(done, str) else None
 
 
 def choose_offscreen_gl(
@@ -163,17 +170,9 @@ InfoProbe = Callable[[str], "GLInfo | str"]
 
 def probe_gl_info(backend: str) -> GLInfo | str:
     """:func:`read_gl_info` for ``backend`` in a child process; the reason when it fails."""
-    env = dict(os.environ, MUJOCO_GL=backend, PYOPENGL_PLATFORM=backend)
-    try:
-        done = subprocess.run(
-            [sys.executable, "-c", _INFO_PROBE],
-            env=env, capture_output=True, text=True, timeout=PROBE_TIMEOUT_S, check=False,
-        )  # fmt: skip
-    except subprocess.TimeoutExpired:
-        return f"no context within {PROBE_TIMEOUT_S:g} s"
-    if done.returncode != 0:
-        lines = [line.strip() for line in done.stderr.splitlines() if line.strip()]
-        return lines[-1] if lines else f"exit code {done.returncode}"
+    done = _run_probe(backend, _INFO_PROBE)
+    if isinstance(done, str):
+        return done
     try:
         record = json.loads(done.stdout.strip().splitlines()[-1])
         return GLInfo(backend=backend, vendor=record["gl_vendor"],

@@ -430,8 +430,7 @@ class ApiServer:
     def apply_requests(self, step_time_ms: int) -> None:
         """Read what is available, then apply every received request in arrival order."""
         self._poll_before_step()
-        batch = self._batch
-        targets: list[tuple[TargetPlan, TargetValues]] = []
+        received: list[tuple[RobotSession, list[Request]]] = []
         for slot in self.slots.values():
             session = slot.session
             session.update_limp()
@@ -442,22 +441,12 @@ class ApiServer:
                 if conn.error is not None:  # found by the I/O thread
                     self._drop(slot, conn.error)
                     continue
-                if not conn.requests:
-                    continue
-                requests = conn.take_requests()
+                if conn.requests:
+                    received.append((session, conn.take_requests()))
             elif conn.requests:
-                requests = conn.requests
+                received.append((session, conn.requests))
                 conn.requests = []
-            else:
-                continue
-            usual = session.take_targets(requests) if batch is not None else None
-            if usual is not None:
-                targets.append(usual)
-            else:
-                session.apply_all(requests, step_time_ms=step_time_ms)
-        if targets:
-            assert batch is not None
-            batch.set_targets(targets)
+        self._apply(received, step_time_ms)
 
     def take_requests(self) -> dict[RobotId, list[Request]]:
         """Pipelined stepping: read what is available and detach every client's received
@@ -478,14 +467,22 @@ class ApiServer:
     def apply_taken(self, taken: dict[RobotId, list[Request]], step_time_ms: int) -> None:
         """Pipelined stepping: apply requests detached by :meth:`take_requests` in arrival
         order (a robot's requests apply even when its client left since)."""
-        batch = self._batch
-        targets: list[tuple[TargetPlan, TargetValues]] = []
         for slot in self.slots.values():
             slot.session.update_limp()
-        for robot, requests in taken.items():
-            session = self.slots[robot].session
-            if not requests:
-                continue
+        slots = self.slots
+        self._apply(
+            [(slots[robot].session, requests) for robot, requests in taken.items() if requests],
+            step_time_ms,
+        )
+
+    def _apply(
+        self, received: list[tuple[RobotSession, list[Request]]], step_time_ms: int
+    ) -> None:
+        """Apply each robot's requests (after its :meth:`RobotSession.update_limp`): the usual
+        ones of every robot in one batched write, the others robot by robot."""
+        batch = self._batch
+        targets: list[tuple[TargetPlan, TargetValues]] = []
+        for session, requests in received:
             usual = session.take_targets(requests) if batch is not None else None
             if usual is not None:
                 targets.append(usual)

@@ -34,18 +34,23 @@ def images() -> str:
         pytest.skip(f"project images unavailable: {exc}")
 
 
+
+def _scrimmage(match_id: str, out: Path, *, half_duration_s: int) -> int:
+    """A short default scrimmage; its containers are removed whatever happens."""
+    try:
+        return hlvs(["scrimmage", "--out", str(out), "--half-duration", str(half_duration_s),
+                     "--wait-before-ready", "1", "--grace", "2", "--match-id", match_id])
+    finally:
+        hlvs(["cleanup", "--match", match_id])
+
+
 def test_auto_without_a_gpu_plays_with_cameras_on_the_cpu(
     images: str, tmp_path: Path, runtime: Any, capsys: pytest.CaptureFixture[str],
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     monkeypatch.setattr(gpu, "_said", set())  # once per process: this test's process
-    match_id = "gpu-auto-test"
     out = tmp_path / "scrim"
-    try:
-        code = hlvs(["scrimmage", "--out", str(out), "--half-duration", "4",
-                     "--wait-before-ready", "1", "--grace", "2", "--match-id", match_id])
-    finally:
-        hlvs(["cleanup", "--match", match_id])
+    code = _scrimmage("gpu-auto-test", out, half_duration_s=4)
     printed = capsys.readouterr()
     assert code == 0, printed.err[-3000:]
     said = [line for line in printed.err.splitlines() if "gpu auto" in line]
@@ -86,11 +91,7 @@ def test_auto_plays_on_the_cpu_when_the_engine_refuses_the_gpu(
         access="device-request", devices=("/dev/nvidia0", "/dev/nvidiactl"), via="a test"))
     match_id = "gpu-refused-test"
     out = tmp_path / "refused"
-    try:
-        code = hlvs(["scrimmage", "--out", str(out), "--half-duration", "2",
-                     "--wait-before-ready", "1", "--grace", "2", "--match-id", match_id])
-    finally:
-        hlvs(["cleanup", "--match", match_id])
+    code = _scrimmage(match_id, out, half_duration_s=2)
     printed = capsys.readouterr()
     assert code == 0, printed.err[-3000:]
     assert "the engine refused the simulator the GPU" in printed.err
