@@ -28,9 +28,7 @@ class PositionTargets:
 
     __slots__ = ("names", "values")
 
-    def __init__(
-        self, names: tuple[str, ...], values: TargetValues
-    ) -> None:
+    def __init__(self, names: tuple[str, ...], values: TargetValues) -> None:
         self.names = names
         self.values = values
 

@@ -104,7 +104,7 @@ class DeviceAccess:
         self, robot: RobotId, names: Sequence[str]
     ) -> npt.NDArray[np.int64] | None:
         """The actuator indices of ``names`` (in order) when they are distinct motors of the
-        robot, for :meth:`set_motor_targets`; None when a name repeats (that list goes through
+        robot, for :meth:`motor_targets_writer`; None when a name repeats (that list goes through
         :meth:`set_motor_positions`, which keeps the last value). Unknown names raise
         :class:`UnknownDeviceError`."""
         if len(set(names)) != len(names):
