@@ -5,10 +5,10 @@ once per robot. A :class:`StepBatch` makes them once per step:
 
 - the regular sensors of every measurement of the step: one gather from the world
   (:meth:`simulator.world.World.gather_sensors` over the robots' concatenated
-  :meth:`~simulator.world.World.sensor_sources`), one scatter of the values and of the step's
-  head (time, real time) into the concatenated framed templates (length prefix, head,
-  :class:`simulator.api.encode.SensorLayout`) and one ``tobytes``, cut into each robot's framed
-  message;
+  :meth:`~simulator.world.World.sensor_sources`), one scatter of the values and one write of
+  the step's head (time, real time) into a buffer of the concatenated framed templates (length
+  prefix, head, :class:`simulator.api.encode.SensorLayout`; the fixed bytes stay in place from
+  step to step), cut into each robot's framed message;
 - the position targets of every robot that sent the usual request (the same motor names as
   before, robot active): one clamped write (:meth:`simulator.world.World.motor_targets_writer`;
   the I/O thread made each robot's targets an array as it read them).
@@ -22,7 +22,7 @@ those of the robot-by-robot calls (:meth:`simulator.api.session.RobotSession.mea
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -30,6 +30,9 @@ import numpy.typing as npt
 from simulator.api.fastreq import TargetValues
 from simulator.api.framing import HEADER
 from simulator.api.session import DuePlan, Measurement, TargetPlan
+
+K = TypeVar("K")
+V = TypeVar("V")
 
 MAX_COMBINATIONS = 64  # distinct combinations kept (robots enabling sensors at other periods)
 
@@ -100,6 +103,17 @@ class _Encoding:
             self.array[self.heads] = values
 
 
+def _cached(cache: dict[K, V], key: K, build: Callable[[], V]) -> V:
+    """``cache[key]``, built on first use; the cache is emptied when it holds
+    ``MAX_COMBINATIONS`` (clients choose their sensors: it stays bounded)."""
+    value = cache.get(key)
+    if value is None:
+        if len(cache) >= MAX_COMBINATIONS:
+            cache.clear()
+        value = cache[key] = build()
+    return value
+
+
 class StepBatch:
     """Batched sensor encoding and target writes for a world with the batch forms."""
 
@@ -122,12 +136,7 @@ class StepBatch:
         ``sources``), and ``frame`` of those without header (``head``: the step's
         :func:`~simulator.api.session.header_bytes`)."""
         plans = tuple([plan for _, plan in items])
-        key = (plans, len(head))
-        encoding = self._encodings.get(key)
-        if encoding is None:
-            if len(self._encodings) >= MAX_COMBINATIONS:
-                self._encodings.clear()
-            encoding = self._encodings[key] = _Encoding(plans, len(head))
+        encoding = _cached(self._encodings, (plans, len(head)), lambda: _Encoding(plans, len(head)))
         values = self._gather(encoding.sources)
         encoding.array[encoding.byte_index] = values.astype("<f8", copy=False).view(np.uint8)
         if head:
@@ -144,10 +153,8 @@ class StepBatch:
 
     def set_targets(self, items: Sequence[tuple[TargetPlan, TargetValues]]) -> None:
         """Write the position targets of several robots (distinct actuators) at once."""
-        key = tuple([plan for plan, _ in items])
-        write = self._targets.get(key)
-        if write is None:
-            if len(self._targets) >= MAX_COMBINATIONS:
-                self._targets.clear()
-            write = self._targets[key] = self._writer(np.concatenate([p.actuators for p in key]))
+        plans = tuple([plan for plan, _ in items])
+        write = _cached(
+            self._targets, plans, lambda: self._writer(np.concatenate([p.actuators for p in plans]))
+        )
         write(np.concatenate([values for _, values in items]))

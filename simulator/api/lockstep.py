@@ -133,11 +133,10 @@ class Pipeline:
         self.unsent = False
 
     def before_step(self, time_ms: int, step_time_ms: int) -> None:
-        if self.unsent and not self._taken:
-            self.send(time_ms, step_time_ms)
-            return
         if self.unsent:
-            self.send(time_ms)
+            self.send(time_ms, step_time_ms)  # applies the answers unless some were kept
+            if not self._taken:
+                return
         taken, self._taken = self._taken, {}
         self._server.apply_taken(taken, step_time_ms)
 

@@ -45,15 +45,9 @@ class NetworkQuota:
     def admit(self, size: int, now_ms: int) -> bool:
         """:meth:`allows`, and :meth:`record` the message when it does (one call per message
         on the usual path)."""
-        if size + self._total > self._limit:
-            self._expire(now_ms)
-            if size + self._total > self._limit:
-                return False
-        history = self._history
-        history.append((now_ms, size))
-        self._total += size
-        if len(history) > 1024:
-            self._expire(now_ms)
+        if not self.allows(size, now_ms):
+            return False
+        self.record(size, now_ms)
         return True
 
     def record(self, size: int, now_ms: int) -> None:

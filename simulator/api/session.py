@@ -172,7 +172,7 @@ class DuePlan:
 
 class TargetPlan:
     """The actuators of a robot's held motor name list (distinct names), for
-    :meth:`simulator.world.World.set_motor_targets`. Compared and hashed by identity."""
+    :meth:`simulator.world.World.motor_targets_writer`. Compared and hashed by identity."""
 
     __slots__ = ("names", "actuators")
 
@@ -279,10 +279,10 @@ class RobotSession:
         them (:class:`simulator.api.batch.StepBatch`). Otherwise None and nothing is taken:
         the caller uses :meth:`apply_all`. Called right after :meth:`update_limp`."""
         held = self._held
+        if held is None or self._limp:
+            return None
         plan = self._batch_targets
-        if held is None or plan is None or plan.names is not held[0] or self._limp:
-            if held is None or self._limp or self._targets_plan is None:
-                return None
+        if plan is None or plan.names is not held[0]:
             plan = self._plan_targets(held[0])
             if plan is None:
                 return None
@@ -298,8 +298,7 @@ class RobotSession:
         return plan, values
 
     def _plan_targets(self, names: tuple[str, ...]) -> TargetPlan | None:
-        assert self._targets_plan is not None
-        if names not in self._valid_names:
+        if self._targets_plan is None or names not in self._valid_names:
             return None
         actuators = self._targets_plan(self.robot, names)
         self._batch_targets = None if actuators is None else TargetPlan(names, actuators)
@@ -474,7 +473,7 @@ class RobotSession:
         """The measurement of the step that ended at ``time_ms`` (camera images still empty)."""
         out, plan = self.begin_measure(time_ms, self._clock_ms())
         if plan is not None:
-            out.sensors = plan.layout.encode(self._read(plan.names))
+            out.sensors = self.encode(plan)
         return out
 
     def begin_measure(self, time_ms: int, real_time_ms: int) -> tuple[Measurement, DuePlan | None]:

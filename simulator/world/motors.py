@@ -94,6 +94,10 @@ class MotorBank:
             self.target[actuators] = np.minimum(
                 np.maximum(rads, self.lower[actuators]), self.upper[actuators]
             )
+        self._targets_changed(actuators)
+
+    def _targets_changed(self, actuators: slice | npt.NDArray[np.int64]) -> None:
+        """New position targets for ``actuators``: ramp towards them, out of torque mode."""
         self._ramping = True
         if self._any_torque and self.torque_mode[actuators].any():
             self.torque_mode[actuators] = False
@@ -205,8 +209,4 @@ class PositionWriter:
         clamped = np.maximum(values, self._lower)
         np.minimum(clamped, self._upper, out=clamped)
         bank.target[self.actuators] = clamped
-        bank._ramping = True
-        if bank._any_torque and bank.torque_mode[self.actuators].any():
-            bank.torque_mode[self.actuators] = False
-            bank._any_torque = bool(bank.torque_mode.any())
-            bank._dirty = True
+        bank._targets_changed(self.actuators)
