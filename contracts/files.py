@@ -1,4 +1,5 @@
-"""Names of the files the processes hand to each other, spelled once.
+"""Names of the files (and environment variables) the processes hand to each other, spelled
+once.
 
 The orchestrator mounts a match folder into the simulator container at ``/match``: it writes
 :data:`MATCH_SPEC` there, the simulator writes everything else into :data:`OUT_DIR`; the public
@@ -19,6 +20,9 @@ GAMECONTROLLER_LOG = "gamecontroller.log"
 VIDEO = "match.mp4"
 RESULTS = "results.json"  # the orchestrator's match results
 REPORT = "report.json"  # written last: the match folder is complete
+# environment of the simulator container: the gpu setting (on | auto) when the orchestrator gave
+# it the host's NVIDIA GPU
+GPU_ENVIRONMENT = "HLVS_GPU"
 
 PUBLIC_FILES = (
     SIM_RESULT, REPLAY, API_STATS, REFEREE_LOG, REFEREE_EVENTS, GAMECONTROLLER_LOG, VIDEO,
@@ -29,6 +33,7 @@ __all__ = [
     "API_STATS",
     "CONTAINER_MATCH_DIR",
     "GAMECONTROLLER_LOG",
+    "GPU_ENVIRONMENT",
     "MATCH_SPEC",
     "OUT_DIR",
     "PUBLIC_FILES",

@@ -25,13 +25,13 @@ import sys
 from collections.abc import Callable, MutableMapping, Sequence
 from dataclasses import dataclass
 
+from contracts.files import GPU_ENVIRONMENT  # on | auto: the orchestrator gave us the GPU
 from simulator.errors import GpuRenderError, OffscreenGLError
 
 log = logging.getLogger(__name__)
 
 OFFSCREEN_BACKENDS = ("egl", "osmesa")
 PROBE_TIMEOUT_S = 60.0
-GPU_ENVIRONMENT = "HLVS_GPU"  # on | auto: the orchestrator gave this container the GPU
 # GL_RENDERER of Mesa's CPU rasterisers (and of other software renderers)
 SOFTWARE_RENDERERS = ("llvmpipe", "softpipe", "swrast", "software")
 

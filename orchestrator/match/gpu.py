@@ -22,6 +22,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Literal, get_args
 
+from contracts.files import GPU_ENVIRONMENT  # what was asked (on | auto), read by the simulator
 from orchestrator.errors import ConfigError, Problem
 from orchestrator.match.runtime import ContainerRequest, DeviceRequest
 
@@ -34,7 +35,6 @@ DEFAULT_GPU_MODE: GpuMode = "auto"
 # it (NVIDIA's does), ahead of other EGL devices such as Mesa's software one.
 EGL_DEVICE_ID = 0
 DRIVER_CAPABILITIES = "graphics,compute,utility"  # graphics: the EGL/OpenGL driver libraries
-GPU_ENVIRONMENT = "HLVS_GPU"  # what was asked (on | auto), read by the simulator
 CDI_ALL_GPUS = "nvidia.com/gpu=all"
 
 Access = Literal["device-request", "cdi"]
