@@ -102,14 +102,18 @@ def test_auto_plays_on_the_cpu_when_the_engine_refuses_the_gpu(
 
 
 def _in_simulator_image(client: docker.DockerClient, image: str, environment: dict[str, str],
-                        command: list[str]) -> tuple[int, str]:
+                        command: list[str]) -> tuple[int, str, str]:
+    """Exit code, standard output, standard output and error (the two streams read apart:
+    interleaved, the order of their last lines is a race)."""
     container = client.containers.run(
         image, command=command, environment=environment, labels={TEST_LABEL: "gpu"},
         network_mode="none", detach=True,
     )
     try:
         code = int(container.wait(timeout=120)["StatusCode"])
-        return code, container.logs().decode("utf-8", "replace")
+        stdout = container.logs(stdout=True, stderr=False).decode("utf-8", "replace")
+        stderr = container.logs(stdout=False, stderr=True).decode("utf-8", "replace")
+        return code, stdout, stdout + stderr
     finally:
         container.remove(force=True)
 
@@ -118,22 +122,23 @@ def test_the_simulator_image_loads_egl_and_keeps_only_a_gpu(
     images: str, docker_client: docker.DockerClient,
 ) -> None:
     egl = {"MUJOCO_GL": "egl", "PYOPENGL_PLATFORM": "egl", "MUJOCO_EGL_DEVICE_ID": "0"}
-    code, output = _in_simulator_image(docker_client, images, egl, [
+    code, printed, output = _in_simulator_image(docker_client, images, egl, [
         "python", "-c", "import json\nfrom simulator.gl import probe_gl_info, select_match_gl\n"
         "import os\nprint(json.dumps(probe_gl_info('egl').record()))\n"
         "print(select_match_gl())\n"])
     # glvnd's libEGL.so.1 found Mesa's vendor file: the NVIDIA one plugs in the same way
     assert code == 0, output
-    first, chosen = output.strip().splitlines()[-2:]
+    first, chosen = printed.strip().splitlines()[-2:]
     assert json.loads(first)["gl_backend"] == "egl" and "llvmpipe" in first
     assert chosen == "egl"  # no HLVS_GPU: a MUJOCO_GL of the environment is kept
-    code, output = _in_simulator_image(docker_client, images, {**egl, "HLVS_GPU": "auto"}, [
+    auto = {**egl, "HLVS_GPU": "auto"}
+    code, printed, output = _in_simulator_image(docker_client, images, auto, [
         "python", "-c", "import os\nfrom simulator.gl import select_match_gl\n"
         "print(select_match_gl(), os.environ['MUJOCO_GL'])\n"])
     assert code == 0, output
-    assert output.strip().splitlines()[-1] == "osmesa osmesa"
+    assert printed.strip().splitlines()[-1] == "osmesa osmesa"
     assert "EGL gave the software renderer llvmpipe" in output
-    code, output = _in_simulator_image(docker_client, images, {**egl, "HLVS_GPU": "on"},
+    code, _, output = _in_simulator_image(docker_client, images, {**egl, "HLVS_GPU": "on"},
                                        ["run", "--spec", "/nonexistent.json", "--out", "/tmp/o"])
     assert code == 3, output
     assert 'gpu "on": the simulator cannot render on the GPU (EGL gave the software renderer ' \
