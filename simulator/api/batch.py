@@ -4,11 +4,11 @@ With eight robots, the API's cost on the step thread was mostly the same few num
 once per robot. A :class:`StepBatch` makes them once per step:
 
 - the regular sensors of every measurement of the step: one gather from the world
-  (:meth:`simulator.world.World.gather_sensors` over the robots' concatenated
-  :meth:`~simulator.world.World.sensor_sources`), one scatter of the values and one write of
-  the step's head (time, real time) into a buffer of the concatenated framed templates (length
-  prefix, head, :class:`simulator.api.encode.SensorLayout`; the fixed bytes stay in place from
-  step to step), cut into each robot's framed message;
+  (:meth:`simulator.world.World.sensor_gatherer`, or ``gather_sensors``, over the robots'
+  concatenated :meth:`~simulator.world.World.sensor_sources`), one scatter of the values and
+  one write of the step's head (time, real time) into a buffer of the concatenated framed
+  templates (length prefix, head, :class:`simulator.api.encode.SensorLayout`; the fixed bytes
+  stay in place from step to step), cut into each robot's framed message;
 - the position targets of every robot that sent the usual request (the same motor names as
   before, robot active): one clamped write (:meth:`simulator.world.World.motor_targets_writer`;
   the I/O thread made each robot's targets an array as it read them).
@@ -22,6 +22,7 @@ those of the robot-by-robot calls (:meth:`simulator.api.session.RobotSession.mea
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from functools import partial
 from typing import Any, TypeVar
 
 import numpy as np
@@ -43,9 +44,14 @@ class _Encoding:
     for every robot of a step): the framed messages of robots without messages or cameras are
     cut out whole; the others take their sensors only."""
 
-    __slots__ = ("sources", "buffer", "array", "byte_index", "heads", "frames", "sensors")
+    __slots__ = ("gather", "buffer", "array", "byte_index", "heads", "frames", "sensors")
 
-    def __init__(self, plans: Sequence[DuePlan], head_size: int) -> None:
+    def __init__(
+        self,
+        plans: Sequence[DuePlan],
+        head_size: int,
+        gatherer: Callable[[Any], Callable[[], npt.NDArray[np.float64]]],
+    ) -> None:
         out_q: list[npt.NDArray[np.int64]] = []
         src_q: list[npt.NDArray[np.int64]] = []
         out_s: list[npt.NDArray[np.int64]] = []
@@ -78,7 +84,8 @@ class _Encoding:
         def joined(parts: list[npt.NDArray[np.int64]]) -> npt.NDArray[np.int64]:
             return np.concatenate(parts).astype(np.int64) if parts else np.zeros(0, np.int64)
 
-        self.sources = (joined(out_q), joined(src_q), joined(out_s), joined(src_s))
+        # the values of every robot's due sensors in order: one call per step
+        self.gather = gatherer((joined(out_q), joined(src_q), joined(out_s), joined(src_s)))
         # the wire bytes, written in place every step (the fixed bytes never change)
         self.buffer = bytearray(np.concatenate(templates).tobytes())
         self.array = np.frombuffer(self.buffer, dtype=np.uint8)
@@ -118,10 +125,14 @@ class StepBatch:
     """Batched sensor encoding and target writes for a world with the batch forms."""
 
     def __init__(self, world: Any) -> None:
-        self._gather = world.gather_sensors
+        gatherer = getattr(world, "sensor_gatherer", None)
+        if gatherer is None:  # a world with the plain form only
+            gather = world.gather_sensors
+            gatherer = lambda sources: partial(gather, sources)  # noqa: E731
+        self._gatherer: Callable[[Any], Callable[[], npt.NDArray[np.float64]]] = gatherer
         self._writer = world.motor_targets_writer
         self._encodings: dict[tuple[tuple[DuePlan, ...], int], _Encoding] = {}
-        self._targets: dict[tuple[TargetPlan, ...], Callable[[Any], None]] = {}
+        self._targets: dict[tuple[TargetPlan, ...], Any] = {}  # PositionWriter
 
     @staticmethod
     def supports(world: object) -> bool:
@@ -136,8 +147,12 @@ class StepBatch:
         ``sources``), and ``frame`` of those without header (``head``: the step's
         :func:`~simulator.api.session.header_bytes`)."""
         plans = tuple([plan for _, plan in items])
-        encoding = _cached(self._encodings, (plans, len(head)), lambda: _Encoding(plans, len(head)))
-        values = self._gather(encoding.sources)
+        encoding = _cached(
+            self._encodings,
+            (plans, len(head)),
+            lambda: _Encoding(plans, len(head), self._gatherer),
+        )
+        values = encoding.gather()
         encoding.array[encoding.byte_index] = values.astype("<f8", copy=False).view(np.uint8)
         if head:
             encoding.write_head(head)
@@ -157,4 +172,5 @@ class StepBatch:
         write = _cached(
             self._targets, plans, lambda: self._writer(np.concatenate([p.actuators for p in plans]))
         )
-        write(np.concatenate([values for _, values in items]))
+        # every robot's values were read finite (:meth:`RobotSession.take_targets`)
+        write(np.concatenate([values for _, values in items]), finite=True)

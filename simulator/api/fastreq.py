@@ -12,6 +12,7 @@ protobuf way, so both ways give the same result.
 
 from __future__ import annotations
 
+import math
 import struct
 from collections.abc import Sequence
 
@@ -23,14 +24,18 @@ TargetValues = Sequence[float] | npt.NDArray[np.float64]
 
 class PositionTargets:
     """Position targets of one request: ``names[i]`` to ``values[i]`` (in request order).
-    Read from a frame, ``values`` is a float64 array (made on the I/O thread, so that the step
-    thread writes every robot's targets with one concatenation)."""
+    Read from a frame, ``values`` is a float64 array and ``finite`` tells that none is a NaN
+    or an infinity (both made on the I/O thread, so that the step thread writes every robot's
+    targets with one concatenation and no check); else ``finite`` is False (checked there)."""
 
-    __slots__ = ("names", "values")
+    __slots__ = ("names", "values", "finite")
 
-    def __init__(self, names: tuple[str, ...], values: TargetValues) -> None:
+    def __init__(
+        self, names: tuple[str, ...], values: TargetValues, finite: bool = False
+    ) -> None:
         self.names = names
         self.values = values
+        self.finite = finite
 
 
 class PositionTemplate:
@@ -52,7 +57,10 @@ class PositionTemplate:
         parts = self._unpack(frame)
         if parts[0::2] != self._fixed:
             return None
-        return PositionTargets(self.names, np.array(parts[1::2], dtype=np.float64))
+        values = parts[1::2]
+        # a sum that is finite has no NaN nor infinity (a huge one that overflows: checked later)
+        finite = math.isfinite(sum(values))
+        return PositionTargets(self.names, np.array(values, dtype=np.float64), finite)
 
 
 def _varint(data: bytes, at: int) -> tuple[int, int]:

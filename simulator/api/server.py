@@ -170,7 +170,9 @@ class ApiServer:
                 for fd in self._wake:
                     os.set_blocking(fd, False)
                 self._selector.register(self._wake[0], selectors.EVENT_READ, "wake")
-            self._sender = SendThread(cpus=self._send_cpus, on_news=self._news)
+            self._sender = SendThread(
+                cpus=self._send_cpus, on_news=self._news, poll=self._lockstep is None
+            )
         host = self._network.api_bind_host
         for slot in self.slots.values():
             sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)

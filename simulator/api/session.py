@@ -274,10 +274,11 @@ class RobotSession:
         self, requests: list[pb.ActuatorRequests | PositionTargets]
     ) -> tuple[TargetPlan, TargetValues] | None:
         """The usual step, for a batched write: when every request is position targets in the
-        held name list and the robot is active, they are taken (the last one wins, as in
-        :meth:`apply_all`) and returned with the plan of their actuators; the caller writes
-        them (:class:`simulator.api.batch.StepBatch`). Otherwise None and nothing is taken:
-        the caller uses :meth:`apply_all`. Called right after :meth:`update_limp`."""
+        held name list, read finite from the wire, and the robot is active, they are taken (the
+        last one wins, as in :meth:`apply_all`) and returned with the plan of their actuators;
+        the caller writes them (:class:`simulator.api.batch.StepBatch`). Otherwise None and
+        nothing is taken: the caller uses :meth:`apply_all`. Called right after
+        :meth:`update_limp`."""
         held = self._held
         if held is None or self._limp:
             return None
@@ -290,6 +291,8 @@ class RobotSession:
         values: TargetValues | None = None
         for request in requests:
             if type(request) is not PositionTargets or request.names is not names:
+                return None
+            if not request.finite:  # a NaN or an infinity is filtered robot by robot
                 return None
             values = request.values
         if values is None or self._removed():

@@ -200,12 +200,17 @@ class PositionWriter:
         self._lower = bank.lower[actuators]
         self._upper = bank.upper[actuators]
 
-    def __call__(self, rads: Sequence[float] | FloatArray) -> None:
+    def __call__(self, rads: Sequence[float] | FloatArray, *, finite: bool = False) -> None:
+        """``finite``: the caller knows that ``rads`` is a float64 array without NaN or
+        infinity (checked as they were read), so it is not checked again."""
         bank = self._bank
-        values = np.asarray(rads, dtype=np.float64)
-        if not math.isfinite(values.sum()):  # a NaN or infinity (or a huge sum): filtered there
-            bank.set_positions(self.actuators, values)
-            return
+        if finite:
+            values = rads
+        else:
+            values = np.asarray(rads, dtype=np.float64)
+            if not math.isfinite(values.sum()):  # a NaN or infinity (or a huge sum): filtered
+                bank.set_positions(self.actuators, values)
+                return
         clamped = np.maximum(values, self._lower)
         np.minimum(clamped, self._upper, out=clamped)
         bank.target[self.actuators] = clamped

@@ -33,6 +33,19 @@ def test_same_names_other_values_match_and_decode() -> None:
     targets = template.match(_request(list(zip(NAMES, values, strict=True))))
     assert targets is not None
     assert targets.names == NAMES and list(targets.values) == values
+    assert not targets.finite  # the infinity: the step thread checks these robot by robot
+
+
+def test_finite_tells_whether_every_value_is_a_number() -> None:
+    template = _template()
+    for values, finite in (
+        ([-1.5, 1e-300, 2.0, 3.0, -0.125], True),
+        ([-1.5, math.nan, 2.0, 3.0, -0.125], False),
+        ([-1.5, 1.0, 2.0, -math.inf, -0.125], False),
+        ([1e308, 1e308, 2.0, 3.0, -0.125], False),  # the sum overflows: checked as if not
+    ):
+        targets = template.match(_request(list(zip(NAMES, values, strict=True))))
+        assert targets is not None and targets.finite is finite, values
 
 
 def test_other_layouts_do_not_match() -> None:
