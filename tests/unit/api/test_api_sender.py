@@ -68,7 +68,9 @@ def test_fast_steps_are_polled_without_waking(
 ) -> None:
     conn, client = pair
     wakes = _run(conn, client, poll=True, steps=300, gap_s=0.0003, monkeypatch=monkeypatch)
-    assert wakes < 60, wakes  # a few while the interval is learned (or after a hiccup)
+    # a few while the interval is learned, or after a hiccup of a loaded machine (each step
+    # wakes the thread without polling: 300)
+    assert wakes < 150, wakes
 
 
 def test_slow_steps_wake_the_thread_every_time(
@@ -76,7 +78,9 @@ def test_slow_steps_wake_the_thread_every_time(
 ) -> None:
     conn, client = pair
     wakes = _run(conn, client, poll=True, steps=20, gap_s=0.005, monkeypatch=monkeypatch)
-    assert wakes >= 18, wakes  # steps 5 ms apart: no polling, each one wakes the thread
+    # steps 5 ms apart: no polling, each one wakes the thread (but when a loaded machine kept
+    # the thread busy past the next step; with polling: 2 or 3)
+    assert wakes >= 12, wakes
 
 
 def test_without_poll_fast_steps_wake_the_thread(
