@@ -4,8 +4,8 @@ With eight robots, the API's cost on the step thread was mostly the same few num
 once per robot. A :class:`StepBatch` makes them once per step:
 
 - the regular sensors of every measurement of the step: one gather from the world
-  (:meth:`simulator.world.World.sensor_gatherer`, or ``gather_sensors``, over the robots'
-  concatenated :meth:`~simulator.world.World.sensor_sources`), one scatter of the values and
+  (:meth:`simulator.world.World.sensor_gatherer` over the robots' concatenated
+  :meth:`~simulator.world.World.sensor_sources`), one scatter of the values and
   one write of the step's head (time, real time) into a buffer of the concatenated framed
   templates (length prefix, head, :class:`simulator.api.encode.SensorLayout`; the fixed bytes
   stay in place from step to step), cut into each robot's framed message;
@@ -22,8 +22,7 @@ those of the robot-by-robot calls (:meth:`simulator.api.session.RobotSession.mea
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from functools import partial
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -31,6 +30,9 @@ import numpy.typing as npt
 from simulator.api.fastreq import TargetValues
 from simulator.api.framing import HEADER
 from simulator.api.session import DuePlan, Measurement, TargetPlan
+
+if TYPE_CHECKING:
+    from simulator.world.motors import PositionWriter
 
 K = TypeVar("K")
 V = TypeVar("V")
@@ -125,20 +127,16 @@ class StepBatch:
     """Batched sensor encoding and target writes for a world with the batch forms."""
 
     def __init__(self, world: Any) -> None:
-        gatherer = getattr(world, "sensor_gatherer", None)
-        if gatherer is None:  # a world with the plain form only
-            gather = world.gather_sensors
-            gatherer = lambda sources: partial(gather, sources)  # noqa: E731
-        self._gatherer: Callable[[Any], Callable[[], npt.NDArray[np.float64]]] = gatherer
+        self._gatherer = world.sensor_gatherer
         self._writer = world.motor_targets_writer
         self._encodings: dict[tuple[tuple[DuePlan, ...], int], _Encoding] = {}
-        self._targets: dict[tuple[TargetPlan, ...], Any] = {}  # PositionWriter
+        self._targets: dict[tuple[TargetPlan, ...], PositionWriter] = {}
 
     @staticmethod
     def supports(world: object) -> bool:
         return all(
             hasattr(world, name)
-            for name in ("gather_sensors", "sensor_sources", "motor_targets_writer",
+            for name in ("sensor_gatherer", "sensor_sources", "motor_targets_writer",
                          "motor_targets_plan")
         )  # fmt: skip
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from functools import partial
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import mujoco
 import numpy as np
@@ -197,8 +197,7 @@ class DeviceAccess:
         index = np.empty(len(out_q) + len(out_s), dtype=np.intp)
         index[out_q] = flat.indices("qpos", src_q)
         index[out_s] = flat.indices("sensordata", src_s)
-        gather: Callable[[], npt.NDArray[np.float64]] = partial(flat.values.take, index)  # type: ignore[assignment]
-        return gather
+        return cast(Callable[[], npt.NDArray[np.float64]], partial(flat.values.take, index))
 
     def _sensor_plan(
         self, robot: RobotId, names: Sequence[str]
