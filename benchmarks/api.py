@@ -78,12 +78,12 @@ def _choose_gl(mode: str) -> None:
     """``MUJOCO_GL`` of this process before MuJoCo is imported, as the simulator of a match
     chooses it (:func:`simulator.gl.select_match_gl`): EGL when this host has an NVIDIA GPU
     that renders (``--gpu``), else OSMesa."""
+    if "MUJOCO_GL" in os.environ:
+        return
     from orchestrator.engine.gpu import device_files
     from simulator.errors import GpuRenderError
     from simulator.gl import GPU_ENVIRONMENT, select_match_gl
 
-    if "MUJOCO_GL" in os.environ:
-        return
     if mode == "on" or (mode == "auto" and device_files()):
         os.environ.update({GPU_ENVIRONMENT: mode, "MUJOCO_GL": "egl", "PYOPENGL_PLATFORM": "egl"})
     try:
