@@ -55,8 +55,9 @@ images: venv engine
 	$(HLVS) images build $(if $(BASE_IMAGE),--base $(BASE_IMAGE),)
 
 lint:
-	$(VENV)/bin/ruff check orchestrator simulator referee contracts robot service envs viewer \
-	  benchmarks testkit examples tests
+	$(VENV)/bin/ruff check hlvs viewer service envs tournament cluster orchestrator simulator \
+	  referee robot contracts benchmarks testkit examples tests
+	$(VENV)/bin/lint-imports
 
 typecheck:
 	$(VENV)/bin/mypy

@@ -1,2 +1,2 @@
-"""Benchmarks that print JSON, run as ``hlvs bench KIND`` (``python -m simulator bench KIND`` for
+"""Benchmarks that print JSON, run as ``hlvs bench KIND`` (``python -m benchmarks KIND`` for
 the simulator's own). Kept out of the production packages; the tests import nothing from here."""

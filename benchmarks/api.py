@@ -1,4 +1,4 @@
-"""``python -m simulator bench api``: real-time factor of the world with the robot API in use.
+"""``python -m benchmarks api``: real-time factor of the world with the robot API in use.
 
 Starts the world and the API server in this process and N client processes (one per robot)
 that enable every joint sensor and the IMU at 8 ms (and the camera when asked) and send 20

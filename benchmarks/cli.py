@@ -23,7 +23,7 @@ def _command() -> list[str]:
     if os.path.exists(script):
         return [script]
     found = shutil.which("hlvs")
-    return [found] if found else [sys.executable, "-m", "orchestrator"]
+    return [found] if found else [sys.executable, "-m", "hlvs"]
 
 
 def time_help(args: Sequence[str], *, runs: int) -> list[float]:

@@ -44,7 +44,7 @@ def _hog_command(processes: int) -> str:
 
 def _files(folder: Path, *, match_id: str, red_command: str, cpus: float, half_s: float,
            stepping: str, max_rtf: float) -> Path:
-    from orchestrator.commands import scrimmage_args
+    from hlvs.commands import scrimmage_args
     from orchestrator.match import scrimmage
     from orchestrator.project_images import project_image
 
@@ -74,7 +74,7 @@ def _play(work: Path, name: str, *, red_command: str, cpus: float, half_s: float
     game = _files(work / f"{name}-config", match_id=match_id, red_command=red_command,
                   cpus=cpus, half_s=half_s, stepping=stepping, max_rtf=max_rtf)
     out = work / name
-    done = subprocess.run([sys.executable, "-m", "orchestrator", "match", str(game), "--out",
+    done = subprocess.run([sys.executable, "-m", "hlvs", "match", str(game), "--out",
                            str(out)], capture_output=True, text=True, timeout=900, check=False)
     if done.returncode != 0:
         raise SystemExit(f"hlvs bench hog: match {match_id} failed ({done.returncode}): "

@@ -35,9 +35,9 @@ CONF = "/var/lib/hlvs/slurm/slurm.conf"
 
 
 def _job(folder: Path, name: str, half_s: float, *, league: bool = False) -> Any:
+    from cluster import MatchJob
     from orchestrator.match.scrimmage import write_files
     from orchestrator.project_images import project_image
-    from service.pool import MatchJob
 
     args = argparse.Namespace(
         red_image=None,
@@ -104,8 +104,8 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("--json", action="store_true", help="accepted: the output is JSON")
     args = parser.parse_args(argv)
-    from service.pool import JobState
-    from service.pool.slurm import SlurmPool
+    from cluster import JobState
+    from cluster.slurm import SlurmPool
 
     up = subprocess.run(
         ["bash", str(ROOT / "scripts" / "ensure-slurm.sh"), "up"],
@@ -126,7 +126,7 @@ def main(argv: list[str] | None = None) -> int:
             [
                 sys.executable,
                 "-m",
-                "orchestrator",
+                "hlvs",
                 "-q",
                 "match",
                 str(local.game_path),

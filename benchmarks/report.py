@@ -103,7 +103,7 @@ def _api_figures(result: dict[str, Any]) -> dict[str, Any]:
 def _runners(args: argparse.Namespace) -> dict[str, Callable[[], dict[str, Any]]]:
     robots = str(args.robots)
     sim_s = str(args.sim_seconds)
-    api = ["-m", "simulator", "bench", "api", "--robots", robots, "--json"]
+    api = ["-m", "benchmarks", "api", "--robots", robots, "--json"]
 
     def api_mode(mode: str) -> Callable[[], dict[str, Any]]:
         def run() -> dict[str, Any]:
@@ -113,7 +113,7 @@ def _runners(args: argparse.Namespace) -> dict[str, Callable[[], dict[str, Any]]
         return run
 
     def sim() -> dict[str, Any]:
-        result = _child(["-m", "simulator", "bench", "sim", "--robots", robots,
+        result = _child(["-m", "benchmarks", "sim", "--robots", robots,
                          "--sim-seconds", sim_s, "--json"], 600)  # fmt: skip
         if "error" in result:
             return result
@@ -140,7 +140,7 @@ def _runners(args: argparse.Namespace) -> dict[str, Callable[[], dict[str, Any]]
         }
 
     def bringup() -> dict[str, Any]:
-        result = _child(["-m", "orchestrator", "bench", "bringup", "--robots", robots,
+        result = _child(["-m", "hlvs", "bench", "bringup", "--robots", robots,
                          "--json"], 600)  # fmt: skip
         if "error" in result:
             return result

@@ -85,7 +85,7 @@ def play_one(*, seed: int, out: Path, players: int | None,
              stop: threading.Event | None = None, stepping: str = "lockstep") -> MatchFigures:
     """One default scrimmage with ``seed`` played into ``out``; its figures. ``stop`` set:
     the match stops (and is collected) as on SIGINT."""
-    from orchestrator.commands.scrimmage_args import add_arguments
+    from hlvs.commands.scrimmage_args import add_arguments
     from orchestrator.config.loader import load_game
     from orchestrator.engine import connect
     from orchestrator.engine.containers import DockerRuntime
@@ -168,7 +168,7 @@ def run(*, matches: int, seed: int, players: int | None, folder: Path,
         quiet: bool, stepping: str = "lockstep") -> dict[str, Any]:
     """Play the scrimmages; SIGINT / SIGTERM stop the one playing and skip the rest (the
     summary covers the matches played so far, the interrupted one included)."""
-    from orchestrator.commands.play import stop_on_signals
+    from hlvs.commands.play import stop_on_signals
 
     figures = []
     with stop_on_signals() as stop:

@@ -261,7 +261,7 @@ def main(argv: Sequence[str]) -> int:
         log_path = data / "serve.log"
         with log_path.open("wb") as log_file:
             server = subprocess.Popen(
-                [sys.executable, "-m", "orchestrator", "-q", "serve", "--port", str(port)],
+                [sys.executable, "-m", "hlvs", "-q", "serve", "--port", str(port)],
                 env=env, stdout=log_file, stderr=subprocess.STDOUT)
         try:
             url = f"http://127.0.0.1:{port}"

@@ -1,4 +1,4 @@
-"""``python -m simulator bench sim``: speed of the world against a bare MuJoCo loop.
+"""``python -m benchmarks sim``: speed of the world against a bare MuJoCo loop.
 
 Measures ``World.step`` + ``World.snapshot`` with N robots holding the standing posture, and a bare
 ``mujoco.mj_step`` loop on the same model with the same physics time step. The two are run in

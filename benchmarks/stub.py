@@ -1,4 +1,4 @@
-"""``python -m simulator bench stub``: can the stub striker find, reach and kick the ball?
+"""``python -m benchmarks stub``: can the stub striker find, reach and kick the ball?
 
 In-process world (no network), one kid-default striker 2 m from the ball at a random (seeded)
 bearing and heading. The striker runs the same controller as in a match: it sees only its joint

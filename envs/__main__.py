@@ -1,19 +1,20 @@
-"""``python -m envs bench ...`` (also ``hlvs bench envs``), ``python -m envs remote ...``."""
+"""``python -m envs remote ...``: the server of remote environments (the simulator image runs it
+for ``envs.DockerPool``). Their benchmark is ``python -m benchmarks envs`` (``hlvs bench envs``)."""
 
 from __future__ import annotations
 
-import importlib
 import sys
 
-COMMANDS = {"bench": "benchmarks.envs", "remote": "envs.remote_server"}
-USAGE = "usage: python -m envs {bench|remote} ..."
+USAGE = "usage: python -m envs remote ..."
 
 
 def main(argv: list[str]) -> int:
-    if not argv or argv[0] not in COMMANDS:
+    if not argv or argv[0] != "remote":
         print(USAGE, file=sys.stderr)
         return 2
-    return int(importlib.import_module(COMMANDS[argv[0]]).main(argv[1:]))
+    from envs import remote_server
+
+    return int(remote_server.main(argv[1:]))
 
 
 if __name__ == "__main__":

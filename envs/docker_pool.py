@@ -120,7 +120,7 @@ class DockerLauncher:
 
     def _run(self, index: int) -> str:
         name = f"hlvs-env-{self.pool_id}-{index}-{uuid.uuid4().hex[:4]}"
-        command = ["remote", "--port", str(CONTAINER_PORT)]
+        command = ["python3", "-m", "envs", "remote", "--port", str(CONTAINER_PORT)]
         volumes: dict[str, dict[str, str]] = {}
         folder = None
         if self.socket_root is not None:

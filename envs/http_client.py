@@ -1,4 +1,4 @@
-"""Python client of the HTTP environment API (:mod:`envs.http_api`), like gym-http-api's.
+"""Python client of the HTTP environment API (:mod:`service.routers.envs`), like gym-http-api's.
 
     client = EnvClient("http://127.0.0.1:8000", token="hlvs_...")
     instance = client.env_create("hlvs/Kick-v0", perception=True)

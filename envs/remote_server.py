@@ -1,4 +1,4 @@
-"""``python -m simulator remote --port 7700 [--unix PATH]`` (the simulator image started with
+"""``python -m envs remote --port 7700 [--unix PATH]`` (the simulator image started with
 ``remote``): serve learning sessions over the remote protocol (:mod:`envs.wire`) on a TCP port
 and optionally a Unix socket, one client at a time.
 

@@ -1,6 +1,6 @@
 """Remote simulators allocated from a Slurm cluster: ``remotes="slurm:N"``.
 
-Each remote is one Slurm batch job (submitted through :class:`service.pool.slurm.SlurmPool`)
+Each remote is one Slurm batch job (submitted through :class:`cluster.slurm.SlurmPool`)
 whose step is ``python -m envs.slurm_node``: it starts the simulator image with ``remote`` on
 the node it got, writes where it answers to ``remote.json`` in the job's folder, and keeps it
 while this process renews its lease. :class:`SlurmLauncher` submits the jobs, waits until every
@@ -96,8 +96,8 @@ class SlurmLauncher:
         self, options: SlurmOptions | None = None, *, image: str | None = None,
         python: str = sys.executable, host_network: bool | None = None,
     ) -> None:  # fmt: skip
+        from cluster.slurm import HOST_NETNS, SlurmPool
         from envs.docker_pool import default_image
-        from service.pool.slurm import HOST_NETNS, SlurmPool
 
         self.options = options or SlurmOptions()
         conf = self.options.conf or os.environ.get("SLURM_CONF") or None
@@ -188,7 +188,7 @@ class SlurmLauncher:
 
     def _submit(self, index: int) -> _Job:
         folder = self.root / f"remote-{index}-{self._submitted}"
-        from service.pool.nodes import ENV_REMOTE_COMMENT
+        from cluster.nodes import ENV_REMOTE_COMMENT
 
         self._submitted += 1
         folder.mkdir()
@@ -206,7 +206,7 @@ class SlurmLauncher:
         return job
 
     def _script(self, folder: Path) -> str:
-        from service.pool.slurm import HOST_NETNS
+        from cluster.slurm import HOST_NETNS
 
         prefix = ["nsenter", f"--net={HOST_NETNS}"] if self.host_network else []
         command = [*prefix, self.slurm.python, "-m", "envs.slurm_node", "--image", self.image,
@@ -295,7 +295,7 @@ class SlurmLauncher:
 @contextmanager
 def _slurm_errors() -> Iterator[None]:
     """Slurm's commands failing (no cluster, a refused submission) as RemoteStartFailed."""
-    from service.errors import PoolError
+    from cluster.errors import PoolError
 
     try:
         yield

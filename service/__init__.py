@@ -5,7 +5,7 @@ Public surface: :func:`create_app` and :class:`Settings` to build the app; ``req
 packages; :class:`MatchPool` is the port a cluster implements to play matches.
 
 The names are imported on first use, so that ``hlvs --help`` (which reads
-``service.commands``) does not import FastAPI and SQLAlchemy.
+``hlvs.commands.service``) does not import FastAPI and SQLAlchemy.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from service.app import ROUTER_MODULES, Services, create_app
+    from service.app import Services, create_app
     from service.deps import (
         OperatorPrincipal,
         TeamPrincipal,
@@ -30,7 +30,6 @@ if TYPE_CHECKING:
 _WHERE = {
     "OperatorPrincipal": "service.deps",
     "Principal": "service.tokens",
-    "ROUTER_MODULES": "service.app",
     "ServiceError": "service.errors",
     "Services": "service.app",
     "Settings": "service.settings",
@@ -54,7 +53,6 @@ def __getattr__(name: str) -> Any:
 __all__ = [
     "OperatorPrincipal",
     "Principal",
-    "ROUTER_MODULES",
     "ServiceError",
     "Services",
     "Settings",

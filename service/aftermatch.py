@@ -42,10 +42,10 @@ from typing import TYPE_CHECKING
 
 from sqlalchemy import select
 
+from cluster.local import process_start_time
 from contracts import files
 from service.db import MediaState, Submission, Team, TeamFile, transaction
 from service.matchfiles import OWN_COLOR
-from service.pool.local import process_start_time
 
 if TYPE_CHECKING:
     from service.app import Services

@@ -4,15 +4,15 @@ Nothing happens at import time. The lifespan opens the database (migrating it to
 schema), builds the match pool and starts the queue worker; it stops the worker on shutdown
 (running matches go on in the pool and are picked up again by the next start).
 
-Routers: every module named in :data:`ROUTER_MODULES` exposes ``mount(app)``, which includes its
-``APIRouter`` (and static files, if any). A package adds its own module to that tuple; to require
-a team token in it use ``service.require_team`` (see :mod:`service.deps`).
+Routers: each router module exposes ``mount(app)``, which includes its ``APIRouter`` (and static
+files, if any). The service's own are :data:`SERVICE_ROUTERS`; a package above the service (the
+pages, the environment API) hands its ``mount`` in ``mounts``, wired by :mod:`hlvs.app`; to
+require a team token in it use ``service.require_team`` (see :mod:`service.deps`).
 """
 
 from __future__ import annotations
 
 import gc
-import importlib
 import logging
 from collections.abc import AsyncIterator, Callable, Sequence
 from contextlib import asynccontextmanager
@@ -26,20 +26,24 @@ from sqlalchemy import Engine
 from sqlalchemy.orm import Session, sessionmaker
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
+from cluster import MatchPool, PoolError, make_pool
 from service.db import make_engine, migrate, session_factory
 from service.errors import AuthError, ServiceError
+from service.routers import envs, health, nodes, operator, submissions, teams
 from service.settings import Settings
 
 log = logging.getLogger(__name__)
 
-ROUTER_MODULES: tuple[str, ...] = (
-    "service.routers.health",
-    "service.routers.teams",
-    "service.routers.submissions",
-    "service.routers.operator",
-    "service.routers.nodes",  # the match pool's machines (operators)
-    "envs.http_api",  # the HTTP environment API (learning environments)
-    "viewer.service_pages",  # the web front end: replays, live view, queue and standings pages
+Mount = Callable[[FastAPI], None]
+"""``mount(app)`` of a router module: includes its ``APIRouter`` in the app."""
+
+SERVICE_ROUTERS: tuple[Mount, ...] = (
+    health.mount,
+    teams.mount,
+    submissions.mount,
+    operator.mount,
+    nodes.mount,  # the match pool's machines (operators)
+    envs.mount,  # the HTTP environment API (learning environments)
 )
 
 
@@ -50,7 +54,7 @@ class Services:
     settings: Settings
     engine: Engine
     sessions: sessionmaker[Session]
-    pool: Any = None  # service.pool.MatchPool
+    pool: Any = None  # cluster.MatchPool
     worker: Any = None  # service.worker.QueueWorker
     aftermatch: Any = None  # service.aftermatch.AfterMatch
     preflight: Preflight | None = None
@@ -84,11 +88,12 @@ def create_app(
     pool_factory: PoolFactory | None = None,
     preflight: Preflight | None = None,
     start_worker: bool = True,
-    router_modules: Sequence[str] = ROUTER_MODULES,
+    mounts: Sequence[Mount] = (),
 ) -> FastAPI:
     """The service's app. ``pool_factory`` defaults to the local Docker pool and ``preflight``
     to :func:`service.preflight.run`; unit tests pass fakes. ``start_worker=False`` serves the
-    API without starting matches."""
+    API without starting matches. ``mounts`` adds routers of packages above the service (see
+:func:`hlvs.app.create_app`, which adds the pages and the environment API)."""
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
@@ -120,9 +125,7 @@ def create_app(
             also=[services.tokens.revalidate])
         services.status.start(services.sessions)
         app.state.services = services
-        from service.pool import make_pool
-
-        services.pool = (pool_factory or make_pool)(settings)
+        services.pool = (pool_factory or pool_from_settings)(settings)
         if start_worker:
             from service.aftermatch import AfterMatch
             from service.worker import QueueWorker
@@ -159,12 +162,24 @@ def create_app(
 
     app.add_middleware(StatusFastPath)
     app.add_middleware(BodyLimit, max_bytes=settings.max_upload_bytes)
-    for name in router_modules:
-        importlib.import_module(name).mount(app)
+    for mount in (*SERVICE_ROUTERS, *mounts):
+        mount(app)
     return app
 
 
+def pool_from_settings(settings: Settings) -> MatchPool:
+    """The match pool that the settings name (``HLVS_SERVICE_POOL``: local or slurm)."""
+    return make_pool(kind=settings.pool, slots=settings.match_slots,
+                     slurm_conf=settings.slurm_conf or None)
+
+
 def _install_error_handlers(app: FastAPI) -> None:
+    @app.exception_handler(PoolError)
+    async def pool_error(request: Request, exc: PoolError) -> JSONResponse:
+        log.error("%s %s: %s", request.method, request.url.path, exc)
+        body = {"error": exc.kind, "message": str(exc), **exc.fields()}
+        return JSONResponse(body, status_code=503)
+
     @app.exception_handler(ServiceError)
     async def service_error(request: Request, exc: ServiceError) -> JSONResponse:
         body = {"error": exc.kind, "message": str(exc), **exc.fields()}
@@ -194,4 +209,4 @@ def _install_error_handlers(app: FastAPI) -> None:
                             status_code=exc.status_code)
 
 
-__all__ = ["ROUTER_MODULES", "Services", "create_app"]
+__all__ = ["SERVICE_ROUTERS", "Services", "create_app", "pool_from_settings"]

@@ -10,12 +10,11 @@ Tree::
     │                        submission per team; ``existing_id`` names the one in the way
     ├── InvalidInput         a body or file is unusable (HTTP 422); carries its problems
     ├── PreflightFailed      a team's images failed the pre-flight check (HTTP 422)
-    ├── PoolError            the match pool could not start, query or stop a match (HTTP 503
-    │                        when a request needed it, e.g. the Slurm controller is down)
     └── ClientError          the command-line client got an error answer or no answer
 
 The HTTP layer turns each into one JSON body ``{"error": kind, "message": ..., ...fields}``
-in exactly one place (:mod:`service.app`).
+in exactly one place (:mod:`service.app`), which also answers the cluster's
+``cluster.PoolError`` (the match pool could not start, query or stop a match) with HTTP 503.
 """
 
 from __future__ import annotations
@@ -109,19 +108,6 @@ class PreflightFailed(ServiceError):
 
     def fields(self) -> dict[str, Any]:
         return {"stage": self.stage, "image": self.image, "cause": self.cause}
-
-
-class PoolError(ServiceError):
-    status_code = 503
-    kind = "pool_unavailable"
-
-    def __init__(self, *, handle: str, reason: str) -> None:
-        self.handle = handle
-        self.reason = reason
-        super().__init__(f"match pool, job {handle}: {reason}")
-
-    def fields(self) -> dict[str, Any]:
-        return {"handle": self.handle, "reason": self.reason}
 
 
 class ClientError(ServiceError):

@@ -25,6 +25,8 @@ from typing import TYPE_CHECKING, Any
 from sqlalchemy import func, select
 from sqlalchemy.orm import Session
 
+from cluster import JobState, JobStatus, MatchJob
+from cluster.errors import PoolError
 from contracts import files
 from contracts.errors import ContractError
 from contracts.match_results import FailureClass, MatchReport
@@ -32,9 +34,8 @@ from service import matchfiles, notify, teamfiles
 from service.accounts import ensure_team_account, supports_accounts
 from service.aftermatch import replay_of, team_logs_of
 from service.db import MediaState, Submission, SubmissionState, Team, now, transaction
-from service.errors import PoolError, ServiceError
+from service.errors import ServiceError
 from service.matchfiles import OWN_COLOR
-from service.pool import JobState, JobStatus, MatchJob
 from service.submissions import STUB, failure_side, queue_paused
 
 if TYPE_CHECKING:

@@ -1,4 +1,4 @@
-"""``hlvs view`` and ``hlvs export`` (parsed in ``orchestrator/commands/viewer.py``).
+"""``hlvs view`` and ``hlvs export`` (parsed in ``hlvs/commands/viewer.py``).
 
 ``view`` serves the viewer for replay files and match folders on 127.0.0.1 (no account, no
 database) and prints one URL per page; ``export`` writes a replay as MCAP.

@@ -1,6 +1,6 @@
 """The viewer inside ``hlvs serve``: replays and live views of a team's own test matches.
 
-Listed in ``service.app.ROUTER_MODULES``. Replay and live ids are submission ids; every route
+Mounted by ``hlvs.app``. Replay and live ids are submission ids; every route
 needs the team's token (``Authorization: Bearer``; the pages keep it in the browser's local
 storage), and another team's submission answers 404 like an unknown one. The pages for the
 queue, submissions, schedule and standings and the pool are the same front end, reading the

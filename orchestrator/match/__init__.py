@@ -1,7 +1,7 @@
 """One match in real containers: plan, lifecycle, runner, results, cleanup.
 
 Domain code: it talks to the engine only through :class:`ContainerRuntime` and to the host only
-through :class:`Host`; ``orchestrator.commands.match`` wires the real implementations.
+through :class:`Host`; ``hlvs.commands.match`` wires the real implementations.
 """
 
 from __future__ import annotations

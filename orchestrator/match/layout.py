@@ -140,6 +140,8 @@ def robot_environment(
         "ROBOCUP_SIMULATOR_ADDR": f"{team_net.simulator}:{robot.port}",
         "ROBOCUP_MIRROR_SERVER_IP": team_net.simulator,
     }
+    if robot.team_id is not None:  # optional in the league; teams read it to find their team
+        env["ROBOCUP_TEAM_ID"] = str(robot.team_id)  # in the GameController's packets
     for n in range(1, player_count + 1):
         env[f"ROBOCUP_TEAM_PLAYER{n}_IP"] = team_net.robot(n)
     if gamecontroller_ip is not None:

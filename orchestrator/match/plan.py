@@ -30,6 +30,7 @@ class RobotPlan:
     port: int  # robot API port on the simulator
     image: str | None  # None: no image named (the robot is spawned without a controller)
     command: tuple[str, ...] | None = None  # None: the image's default command
+    team_id: int | None = None  # the team's GameController number (ROBOCUP_TEAM_ID)
 
     @property
     def key(self) -> str:
@@ -72,11 +73,11 @@ class MatchPlan:
         return self.red.robots + self.blue.robots
 
 
-def _robot(color: str, player: PlayerConfig, port: int) -> RobotPlan:
+def _robot(color: str, player: PlayerConfig, port: int, team_id: int) -> RobotPlan:
     args = player.docker_cmd_args
     return RobotPlan(
         color=color, number=player.number, port=port, image=player.image,
-        command=args if args else None,
+        command=args if args else None, team_id=team_id,
     )
 
 
@@ -86,7 +87,7 @@ def plan_from_game(loaded: LoadedGame, *, grace_period_s: float | None = None) -
     for color in ("red", "blue"):
         ref = game.team(color)
         cfg = loaded.team(color)
-        robots = tuple(_robot(color, p, ref.port(p.number)) for p in cfg.players)
+        robots = tuple(_robot(color, p, ref.port(p.number), ref.team_id) for p in cfg.players)
         teams.append(TeamPlan(color=color, name=cfg.display_name, robots=robots))
 
     def build(addresses: Mapping[str, tuple[str, ...]], telemetry: str | None) -> MatchSpec:

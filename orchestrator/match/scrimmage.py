@@ -19,7 +19,7 @@ from typing import Any, Protocol
 
 class ScrimmageOptions(Protocol):
     """What the generated files depend on: ``hlvs scrimmage``'s parsed options
-    (:mod:`orchestrator.commands.scrimmage_args`) or any object with these attributes;
+    (:mod:`hlvs.commands.scrimmage_args`) or any object with these attributes;
     ``ready_duration``, ``red_model`` and ``blue_model`` are read when present."""
 
     players: int

@@ -2,7 +2,7 @@
 
 ``python -m robot.stub BEHAVIOUR`` (the stub image's entrypoint) with BEHAVIOUR ``striker``,
 ``goalie``, ``idle`` or a fault mode (``crash-after SECONDS``, ``ignore-sigterm``, ``flood``,
-``fill-logs``). ``python -m simulator bench stub`` measures the striker in-process.
+``fill-logs``). ``python -m benchmarks stub`` measures the striker in-process.
 """
 
 from __future__ import annotations

@@ -120,7 +120,7 @@ def get_schedule(request: Request, principal: OperatorPrincipal) -> ScheduleView
     """The tournament's matches (state, times, results) and the standings, read from the
     schedule's state file (``HLVS_SERVICE_SCHEDULE_STATE``)."""
     from orchestrator.config.schedule import load_schedule
-    from orchestrator.schedule import Ledger, standings
+    from tournament import Ledger, standings
 
     state = get_services(request).settings.schedule_state
     if not state or not Path(state).is_file():

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 from fastapi import APIRouter, Depends, FastAPI, Request
 from fastapi.responses import FileResponse
@@ -21,7 +21,6 @@ from contracts import files
 from contracts.errors import ContractError
 from contracts.match_results import MatchReport, MatchResults
 from service import submissions, teamfiles
-from service.app import Services
 from service.db import ACTIVE_STATES, Submission
 from service.deps import DbSession, TeamPrincipal, bearer, get_services, require_team
 from service.errors import NotFound
@@ -34,6 +33,9 @@ from service.views import (
     submission_view,
     view_of,
 )
+
+if TYPE_CHECKING:
+    from service.app import Services
 
 router = APIRouter(prefix="/v1/submissions", tags=["submissions"])
 ACTIVE_VALUES = frozenset(state.value for state in ACTIVE_STATES)

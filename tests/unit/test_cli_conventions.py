@@ -1,4 +1,4 @@
-"""Every ``hlvs`` command follows the command-line conventions (see ``orchestrator/cli.py``):
+"""Every ``hlvs`` command follows the command-line conventions (see ``hlvs/cli.py``):
 help text on every command and option, the right program name, ``--help`` exits 0, building the
 parser imports nothing heavy, ``--version``, ``-q``/``-v`` and the documented exit codes."""
 
@@ -17,7 +17,7 @@ from typing import Any
 import pytest
 
 from contracts.match_results import Forfeit
-from orchestrator.cli import build_parser, log_level, main, walk
+from hlvs.cli import build_parser, log_level, main, walk
 from orchestrator.exitcodes import ExitCode
 
 # Modules that make `hlvs --help` slow; a command imports them when it runs, never at parse time.
@@ -26,7 +26,7 @@ HEAVY = (
     "paramiko", "sqlalchemy", "fastapi", "uvicorn", "pydantic", "starlette", "rich", "requests",
     "urllib3", "apscheduler", "httpx", "gymnasium", "google.protobuf", "asyncssh",
     "orchestrator.config", "orchestrator.engine", "orchestrator.match", "orchestrator.delivery",
-    "orchestrator.schedule", "simulator", "referee",
+    "tournament", "simulator", "referee",
 )
 
 
@@ -85,7 +85,7 @@ def test_every_command_help_exits_0_with_its_name_and_documents_every_option() -
     assert ("check",) in paths and ("bench", "sim") in paths and ("images", "pull") in paths
 
     def run(words: tuple[str, ...]) -> tuple[tuple[str, ...], subprocess.CompletedProcess[str]]:
-        command = [sys.executable, "-m", "orchestrator", *words, "--help"]
+        command = [sys.executable, "-m", "hlvs", *words, "--help"]
         return words, subprocess.run(command, capture_output=True, text=True, timeout=120)
 
     with ThreadPoolExecutor(max_workers=4) as pool:
@@ -106,7 +106,7 @@ def test_every_command_help_exits_0_with_its_name_and_documents_every_option() -
 def test_building_the_parser_imports_nothing_heavy() -> None:
     code = (
         "import json, sys\n"
-        "from orchestrator.cli import build_parser\n"
+        "from hlvs.cli import build_parser\n"
         "build_parser()\n"
         "print(json.dumps(sorted(sys.modules)))\n"
     )
@@ -201,7 +201,7 @@ def test_match_exit_codes_and_json(
     failure: tuple[str, str] | None, code: ExitCode,
 ) -> None:
     from contracts.match_results import MatchLimits, MatchResults
-    from orchestrator.commands.play import summarize
+    from hlvs.commands.play import summarize
     from orchestrator.match import Failure, FailureClass, MatchOutcome
 
     failed = Failure(failure_class=FailureClass(failure[0]), cause=failure[1]) if failure \

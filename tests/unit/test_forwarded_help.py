@@ -8,7 +8,7 @@ import subprocess
 import sys
 from concurrent.futures import ThreadPoolExecutor
 
-from orchestrator.cli import build_parser, walk
+from hlvs.cli import build_parser, walk
 
 # What a forwarded command may import only once its arguments are parsed.
 HEAVY_AFTER_PARSE = (
@@ -28,7 +28,7 @@ def execv(path, argv):
     runpy.run_module(argv[2], run_name="__main__", alter_sys=True)
 
 os.execv = execv
-from orchestrator.cli import main
+from hlvs.cli import main
 try:
     main(json.loads(sys.argv[1]))
 except SystemExit as exc:

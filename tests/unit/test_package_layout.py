@@ -24,7 +24,7 @@ def imported_tops(path: Path) -> set[str]:
 
 
 # `hlvs bench KIND` runs the benchmarks: these command modules import them inside the command.
-BENCH_DISPATCH = {"orchestrator/commands/simulator.py", "service/commands.py"}
+BENCH_DISPATCH = {"hlvs/commands/simulator.py", "hlvs/commands/service.py"}
 
 
 def offenders(folders: tuple[str, ...], forbidden: set[str]) -> list[str]:
@@ -120,7 +120,7 @@ def test_the_match_domain_does_not_import_the_command_line() -> None:
     found = []
     for path in sorted((ROOT / "orchestrator" / "match").rglob("*.py")):
         modules = module_level_imports(path, ROOT)
-        if any(m.startswith("orchestrator.commands") or m == "argparse" for m in modules):
+        if any(m.startswith("hlvs.commands") or m == "argparse" for m in modules):
             found.append(str(path.relative_to(ROOT)))
     assert (ROOT / "orchestrator" / "match" / "scrimmage.py").is_file()
     assert found == []

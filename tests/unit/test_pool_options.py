@@ -10,8 +10,8 @@ from typing import Any
 import pytest
 
 from contracts.match_results import Forfeit, MatchLimits, MatchReport, MatchResults
-from orchestrator.commands.play import summarize
-from orchestrator.commands.pooled import read_outcome
+from hlvs.commands.play import summarize
+from hlvs.commands.pooled import read_outcome
 from orchestrator.config.schedule import load_schedule
 from orchestrator.errors import ConfigError
 
@@ -67,8 +67,8 @@ def test_exit_code_of_a_match_played_in_the_pool(
 
 
 def test_slurm_submission_requeues_test_matches_only(tmp_path: Path) -> None:
-    from service.pool import MatchJob
-    from service.pool.slurm import SlurmPool
+    from cluster import MatchJob
+    from cluster.slurm import SlurmPool
 
     calls: list[tuple[list[str], str | None]] = []
 
@@ -97,9 +97,9 @@ def test_node_failure_of_an_official_match_is_an_infrastructure_failure(
 ) -> None:
     import argparse
 
-    from orchestrator.commands import pooled
+    from cluster import JobState, JobStatus
+    from hlvs.commands import pooled
     from orchestrator.errors import InfrastructureError
-    from service.pool import JobState, JobStatus
 
     class Ended:  # the pool's port as the command sees it, after a node failure
         def recorded(self, work: Path) -> str | None:

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from orchestrator.cli import build_parser
-from orchestrator.cli import main as hlvs
+from hlvs.cli import build_parser
+from hlvs.cli import main as hlvs
 from orchestrator.paths import user_path
 
 COMMAND_LINES = {
@@ -84,7 +84,7 @@ def test_schedule_status_names_the_resolved_state_file(
 def test_watch_hint_names_the_replay_as_seen_from_the_cwd(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from orchestrator.commands.play import watch_hint
+    from hlvs.commands.play import watch_hint
 
     out = tmp_path / "matches" / "scrimmage"
     assert watch_hint(out) == []  # nothing to watch without a replay

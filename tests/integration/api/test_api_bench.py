@@ -1,4 +1,4 @@
-"""``python -m simulator bench api`` end to end, small: real clients, one JSON line."""
+"""``python -m benchmarks api`` end to end, small: real clients, one JSON line."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import pytest
 
 def _bench(*args: str) -> dict[str, object]:
     proc = subprocess.run(
-        [sys.executable, "-m", "simulator", "bench", "api", "--robots", "2", *args, "--json"],
+        [sys.executable, "-m", "benchmarks", "api", "--robots", "2", *args, "--json"],
         capture_output=True,
         text=True,
         timeout=180,

@@ -12,7 +12,7 @@ from testkit.figures import median_figures as _median
 
 def test_report_runs_the_kinds_and_judges_medians_against_targets() -> None:
     proc = subprocess.run(
-        [sys.executable, "-m", "orchestrator", "bench", "report", "--only", "sim,pipelined",
+        [sys.executable, "-m", "hlvs", "bench", "report", "--only", "sim,pipelined",
          "--repeats", "2", "--robots", "2", "--sim-seconds", "0.25", "--json"],
         capture_output=True, text=True, timeout=300,
     )  # fmt: skip
@@ -34,7 +34,7 @@ def test_report_runs_the_kinds_and_judges_medians_against_targets() -> None:
 
 def test_bad_kind_is_named() -> None:
     proc = subprocess.run(
-        [sys.executable, "-m", "orchestrator", "bench", "report", "--only", "sim,gpu"],
+        [sys.executable, "-m", "hlvs", "bench", "report", "--only", "sim,gpu"],
         capture_output=True, text=True, timeout=60,
     )  # fmt: skip
     assert proc.returncode == 2 and "--only: unknown kind(s) gpu" in proc.stderr

@@ -69,7 +69,7 @@ class Prepared:
     out: Path
 
     def command(self, *extra: str) -> list[str]:
-        return [sys.executable, "-m", "orchestrator", "match", str(self.game), "--out",
+        return [sys.executable, "-m", "hlvs", "match", str(self.game), "--out",
                 str(self.out), *extra]
 
     def run(self, timeout_s: float = 240.0) -> subprocess.CompletedProcess[str]:
@@ -135,7 +135,7 @@ def prepare(tmp_path_factory: pytest.TempPathFactory, attack_image: str,
 
     yield factory
     for match_id in made:
-        subprocess.run([sys.executable, "-m", "orchestrator", "cleanup", "--match", match_id],
+        subprocess.run([sys.executable, "-m", "hlvs", "cleanup", "--match", match_id],
                        capture_output=True, text=True, timeout=120, cwd=REPO, env=_env(),
                        check=False)
 

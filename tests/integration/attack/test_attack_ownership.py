@@ -21,7 +21,7 @@ pytestmark = [pytest.mark.docker, pytest.mark.root]
 
 
 def _hlvs(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "orchestrator", *args], capture_output=True,
+    return subprocess.run([sys.executable, "-m", "hlvs", *args], capture_output=True,
                           text=True, timeout=180, cwd=REPO, check=False,
                           env={**os.environ, "PYTHONPATH": str(REPO)})
 

@@ -193,7 +193,7 @@ def test_asyncssh_server_password_and_host_key_mismatch(
 def test_cli_status_and_deliver(
     asyncssh_server: AsyncsshServer, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from orchestrator.cli import main
+    from hlvs.cli import main
 
     creds = write_credentials(tmp_path, "sftp", sftp_body(asyncssh_server))
     bad = write_credentials(

@@ -30,7 +30,7 @@ def _free_port() -> int:
 def _start_server(unix: Path) -> tuple[subprocess.Popen[bytes], int]:
     port = _free_port()
     proc = subprocess.Popen(
-        [sys.executable, "-m", "simulator", "remote", "--host", "127.0.0.1", "--port", str(port),
+        [sys.executable, "-m", "envs", "remote", "--host", "127.0.0.1", "--port", str(port),
          "--unix", str(unix)],  # fmt: skip
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,

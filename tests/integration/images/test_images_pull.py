@@ -217,7 +217,7 @@ def test_hlvs_images_pull_reports_each_player(
 ) -> None:
     import json
 
-    from orchestrator.cli import main
+    from hlvs.cli import main
 
     repository = f"{registry.host}/alpha/robot"
     make_image(f"{repository}:v1", 1000)

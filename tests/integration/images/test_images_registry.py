@@ -8,7 +8,7 @@ from typing import Any
 import docker
 import pytest
 
-from orchestrator.cli import main
+from hlvs.cli import main
 from orchestrator.registry import RegistryClient
 from tests.integration.images.conftest import MakeImage, Registry, push
 

@@ -13,7 +13,7 @@ from pathlib import Path
 import docker
 import pytest
 
-from orchestrator.cli import main
+from hlvs.cli import main
 from orchestrator.config import Limits, PlayerConfig, RegistryAuth, StartingPose, TeamConfig
 from orchestrator.config.model import EcrAuth
 from orchestrator.errors import ImagePullError, TeamImagesTooLarge

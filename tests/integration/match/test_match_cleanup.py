@@ -16,7 +16,7 @@ from typing import Any
 
 import pytest
 
-from orchestrator.cli import main as hlvs
+from hlvs.cli import main as hlvs
 from orchestrator.match.logfs import state_dir
 
 pytestmark = [pytest.mark.docker, pytest.mark.root]

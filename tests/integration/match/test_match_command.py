@@ -10,8 +10,8 @@ from typing import Any
 
 import pytest
 
-from orchestrator.cli import main as hlvs
-from orchestrator.commands.scrimmage_args import add_arguments
+from hlvs.cli import main as hlvs
+from hlvs.commands.scrimmage_args import add_arguments
 from orchestrator.errors import OrchestratorError
 from orchestrator.match.logfs import state_dir
 from orchestrator.match.scrimmage import write_files
@@ -94,7 +94,7 @@ def test_sigterm_to_hlvs_match_stops_everything_and_exits_130(
     out = tmp_path / "out"
     repo = Path(__file__).resolve().parents[3]
     process = subprocess.Popen(
-        [sys.executable, "-m", "orchestrator", "match", str(game), "--out", str(out),
+        [sys.executable, "-m", "hlvs", "match", str(game), "--out", str(out),
          "--grace", "5"],
         cwd=repo, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )

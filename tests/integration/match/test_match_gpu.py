@@ -12,7 +12,7 @@ from typing import Any
 import docker
 import pytest
 
-from orchestrator.cli import main as hlvs
+from hlvs.cli import main as hlvs
 from orchestrator.engine.gpu import device_files
 from orchestrator.errors import OrchestratorError
 from orchestrator.match import gpu

@@ -9,7 +9,7 @@ from typing import Any
 
 import pytest
 
-from orchestrator.cli import main as hlvs
+from hlvs.cli import main as hlvs
 from orchestrator.errors import OrchestratorError
 
 pytestmark = [pytest.mark.docker, pytest.mark.root]

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import os
 
-from orchestrator.schedule.services import MatchContext, MatchServices, PlayOutcome
+from tournament.services import MatchContext, MatchServices, PlayOutcome
 
 
 class SlurmTestServices(MatchServices):

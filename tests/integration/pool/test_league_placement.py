@@ -106,7 +106,7 @@ def _team_traffic(sender: Any, receiver: Any, simulator: str, mate: str) -> dict
 
 
 def _scrimmage(cluster: str, out: Path, match_id: str, half_s: int) -> subprocess.Popen[str]:
-    cmd = [sys.executable, "-m", "orchestrator", "scrimmage", "--pool", "slurm",
+    cmd = [sys.executable, "-m", "hlvs", "scrimmage", "--pool", "slurm",
            "--placement", "league", "--players", "2", "--slurm-conf", cluster,
            "--half-duration", str(half_s), "--ready-duration", "1", "--wait-before-ready", "1",
            "--grace", "5", "--match-id", match_id, "--out", str(out), "--json"]
@@ -345,7 +345,7 @@ def test_killed_league_match_leaves_nothing_on_its_nodes(cluster: str, tmp_path:
             if time.monotonic() > deadline:
                 raise
             time.sleep(1)
-    salvage = subprocess.run([sys.executable, "-m", "orchestrator", "cleanup", "--match",
+    salvage = subprocess.run([sys.executable, "-m", "hlvs", "cleanup", "--match",
                               match_id], capture_output=True, text=True, timeout=300,
                              check=False)
     assert salvage.returncode == 0, salvage.stdout + salvage.stderr

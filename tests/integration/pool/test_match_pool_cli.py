@@ -18,7 +18,7 @@ pytestmark = [pytest.mark.docker, pytest.mark.root, pytest.mark.slow]
 def test_scrimmage_through_the_slurm_pool(cluster: str, tmp_path: Path) -> None:
     out = tmp_path / "scrim"
     match_id = f"slurm-cli-{os.getpid()}"
-    cmd = [sys.executable, "-m", "orchestrator", "scrimmage", "--pool", "slurm",
+    cmd = [sys.executable, "-m", "hlvs", "scrimmage", "--pool", "slurm",
            "--slurm-conf", cluster, "--half-duration", "4", "--ready-duration", "1",
            "--wait-before-ready", "1", "--grace", "2", "--match-id", match_id,
            "--out", str(out), "--json"]

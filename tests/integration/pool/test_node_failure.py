@@ -25,8 +25,8 @@ from pathlib import Path
 
 import pytest
 
-from service.pool import JobState, MatchJob
-from service.pool.slurm import SlurmPool
+from cluster import JobState, MatchJob
+from cluster.slurm import SlurmPool
 
 pytestmark = [pytest.mark.docker, pytest.mark.root, pytest.mark.slow]
 
@@ -154,7 +154,7 @@ def test_node_killed_mid_match_requeues_and_completes(
     assert _sacct_field(cluster, official_job, "State") == "NODE_FAIL"
     assert _show_job(cluster, official_job).get("Restarts", "0") == "0"
     cleanup = subprocess.run(
-        [sys.executable, "-m", "orchestrator", "cleanup", "--match", official_id],
+        [sys.executable, "-m", "hlvs", "cleanup", "--match", official_id],
         capture_output=True, text=True, timeout=300, check=False)
     assert cleanup.returncode == 0, cleanup.stderr[-2000:]
     kept = json.loads((pool.results_dir(official) / "report.json").read_text())

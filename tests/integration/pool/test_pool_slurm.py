@@ -13,8 +13,8 @@ from pathlib import Path
 
 import pytest
 
-from service.pool import JobState, MatchJob
-from service.pool.slurm import SlurmPool
+from cluster import JobState, MatchJob
+from cluster.slurm import SlurmPool
 
 pytestmark = [pytest.mark.docker, pytest.mark.root, pytest.mark.slow]
 

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from orchestrator.schedule import Ledger, ScheduledMatchState
+from tournament import Ledger, ScheduledMatchState
 
 pytestmark = [pytest.mark.docker, pytest.mark.root, pytest.mark.slow]
 
@@ -65,7 +65,7 @@ def test_scheduler_killed_mid_match_then_restarted_plays_each_match_once(
     ids = (f"sl{os.getpid()}a", f"sl{os.getpid()}b")
     path = _schedule(tmp_path, cluster, ids)
     state = tmp_path / "state.sqlite"
-    cmd = [sys.executable, "-m", "orchestrator.cli", "schedule", "run", str(path), "--state",
+    cmd = [sys.executable, "-m", "hlvs.cli", "schedule", "run", str(path), "--state",
            str(state), "--exit-when-done", "--services", SERVICES]
     first = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     record = tmp_path / "out" / ids[0] / "match" / "slurm.json"

@@ -16,9 +16,9 @@ from typing import Any
 
 import pytest
 
+from cluster.slurm import SlurmPool
 from service import Settings
 from service.db import Scope, make_engine, migrate, session_factory, transaction
-from service.pool.slurm import SlurmPool
 from service.tokens import issue
 from tests.integration.service.harness import serve
 from tests.unit.service.conftest import wait_for_status
@@ -45,7 +45,7 @@ def test_team_matches_run_under_its_account_and_wait_with_slurms_reason(
     env = {**os.environ, "HLVS_SERVICE_POOL": "slurm", "HLVS_SERVICE_SLURM_CONF": cluster,
            "HLVS_SERVICE_DATA_DIR": str(settings.data_dir),
            "HLVS_SERVICE_SLURM_MAX_QUEUED": "3"}
-    added = subprocess.run([sys.executable, "-m", "orchestrator", "admin", "team", "add", name],
+    added = subprocess.run([sys.executable, "-m", "hlvs", "admin", "team", "add", name],
                            env=env, capture_output=True, text=True, timeout=120, check=False)
     assert added.returncode == 0, added.stderr
     account = json.loads(added.stdout)["slurm_account"]

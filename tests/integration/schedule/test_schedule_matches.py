@@ -17,8 +17,8 @@ import pytest
 
 from orchestrator.config.credentials import load_credentials
 from orchestrator.delivery.s3 import create_bucket
-from orchestrator.schedule import Ledger, ScheduledMatchState, run_schedule, standings
 from testkit.s3 import MotoServer
+from tournament import Ledger, ScheduledMatchState, run_schedule, standings
 
 pytestmark = [pytest.mark.docker, pytest.mark.slow]
 

@@ -12,7 +12,8 @@ from typing import Any
 import httpx
 import uvicorn
 
-from service import Settings, create_app
+from hlvs.app import create_app
+from service import Settings
 
 
 def free_port() -> int:

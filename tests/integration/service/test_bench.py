@@ -13,7 +13,7 @@ pytestmark = pytest.mark.docker
 
 def test_bench_service_small(docker_client: object) -> None:
     done = subprocess.run(
-        [sys.executable, "-m", "orchestrator", "bench", "service", "--pollers", "4",
+        [sys.executable, "-m", "hlvs", "bench", "service", "--pollers", "4",
          "--submitters", "2", "--duration", "3", "--json"],
         capture_output=True, text=True, timeout=300, check=False)
     result = json.loads(done.stdout.strip().splitlines()[-1])

@@ -10,8 +10,8 @@ from typing import Any
 import httpx
 import pytest
 
+from cluster.fake import FakePool
 from service import Settings
-from service.pool.fake import FakePool
 from testkit.s3 import MotoServer
 from testkit.sftp import AsyncsshServer
 from tests.integration.delivery.conftest import (  # noqa: F401 (fixtures)

@@ -16,7 +16,7 @@ from typing import Any
 
 import pytest
 
-from service.pool.slurm import SlurmPool
+from cluster.slurm import SlurmPool
 from tests.integration.pool.conftest import cluster  # noqa: F401
 from tests.integration.service.harness import Served, serve
 from tests.integration.viewer.conftest import screenshot

@@ -12,15 +12,15 @@ from typing import Any
 import httpx
 import pytest
 
+from cluster.fake import FakePool
 from orchestrator.config.schedule import load_schedule
-from orchestrator.schedule import Ledger, run_schedule, standings
-from service.pool.fake import FakePool
 from tests.integration.service.harness import Served
 from tests.integration.viewer.conftest import screenshot
 from tests.unit.schedule.test_schedule import COMPRESSED, FAKE, write_schedule
 from tests.unit.service.conftest import wait_for_status
 from tests.unit.service.test_submissions import handle_of, setup_team
 from tests.unit.viewer.replays import record_match
+from tournament import Ledger, run_schedule, standings
 
 pytestmark = pytest.mark.browser
 

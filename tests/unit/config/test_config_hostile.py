@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from orchestrator.cli import main as hlvs
-from orchestrator.commands import scrimmage_args
+from hlvs.cli import main as hlvs
+from hlvs.commands import scrimmage_args
 from orchestrator.match import scrimmage
 
 

@@ -12,7 +12,7 @@ from typing import Any
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from orchestrator.cli import main
+from hlvs.cli import main
 from tests.unit.config.conftest import valid_game, valid_team
 
 KEYS = st.sampled_from(

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from orchestrator.cli import main
+from hlvs.cli import main
 
 EXAMPLES = Path(__file__).resolve().parents[3] / "configs" / "examples"
 

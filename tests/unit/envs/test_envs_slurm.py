@@ -104,8 +104,8 @@ def test_a_missing_slurm_conf_is_named_at_once(tmp_path: Path) -> None:
 
 
 def test_slurm_refusing_a_job_is_a_remote_start_failure(tmp_path: Path) -> None:
+    from cluster.errors import PoolError
     from envs.errors import RemoteStartFailed
-    from service.errors import PoolError
 
     launcher = SlurmLauncher(SlurmOptions(dir=str(tmp_path)), image="x:1", host_network=False)
 

@@ -245,7 +245,7 @@ def test_game_json_with_a_bad_gpu_value_names_the_field(tmp_path: Path) -> None:
 def test_the_command_line_overrides_game_json(tmp_path: Path) -> None:
     import argparse
 
-    from orchestrator.commands.play import _gpu_option
+    from hlvs.commands.play import _gpu_option
     from orchestrator.config import load_game
     from orchestrator.match import plan_from_game
 
@@ -257,7 +257,7 @@ def test_the_command_line_overrides_game_json(tmp_path: Path) -> None:
 
 def test_hlvs_match_and_scrimmage_take_gpu(tmp_path: Path,
                                            capsys: pytest.CaptureFixture[str]) -> None:
-    from orchestrator.cli import build_parser
+    from hlvs.cli import build_parser
     from orchestrator.match.scrimmage import game_file
 
     parser = build_parser()

@@ -103,8 +103,8 @@ def test_bad_league_nodes_are_named(text: str, netns: str | None, expected: str)
 
 
 def test_slurm_pool_submits_a_heterogeneous_job_for_league_placement(tmp_path: Path) -> None:
-    from service.pool import MatchJob
-    from service.pool.slurm import SlurmPool
+    from cluster import MatchJob
+    from cluster.slurm import SlurmPool
 
     calls: list[tuple[list[str], str | None]] = []
 
@@ -135,7 +135,7 @@ def test_slurm_pool_submits_a_heterogeneous_job_for_league_placement(tmp_path: P
 
 def test_schedule_pool_section_takes_a_placement(tmp_path: Path) -> None:
     from orchestrator.config.schedule import load_schedule
-    from orchestrator.schedule.services import _robot_nodes
+    from tournament.services import _robot_nodes
 
     for name in ("a", "b"):
         (tmp_path / f"{name}.json").write_text(json.dumps({"name": name, "players": {}}))
@@ -158,10 +158,10 @@ def test_schedule_pool_section_takes_a_placement(tmp_path: Path) -> None:
 def test_league_schedule_asks_a_node_per_robot(tmp_path: Path) -> None:
     import argparse
 
-    from orchestrator.commands.scrimmage_args import add_arguments
+    from hlvs.commands.scrimmage_args import add_arguments
     from orchestrator.config.schedule import SchedulePool
     from orchestrator.match import scrimmage
-    from orchestrator.schedule.services import _robot_nodes
+    from tournament.services import _robot_nodes
 
     parser = argparse.ArgumentParser()
     add_arguments(parser)
@@ -192,7 +192,7 @@ def test_service_worker_asks_a_node_per_robot_in_league_placement(tmp_path: Path
     import argparse
     from types import SimpleNamespace
 
-    from orchestrator.commands.scrimmage_args import add_arguments
+    from hlvs.commands.scrimmage_args import add_arguments
     from orchestrator.match import scrimmage
     from service.settings import Settings
     from service.worker import QueueWorker

@@ -232,3 +232,19 @@ def test_team_whose_robots_cannot_start_is_a_team_startup_failure(tmp_path: Path
     assert outcome.results.robots["red-1"].startup_error
     assert outcome.results.robots["blue-1"].startup_error is None
     assert runtime.containers == {} and runtime.networks == {}
+
+
+def test_robot_environment_names_the_team_number_the_stub_reads() -> None:
+    """``ROBOCUP_TEAM_ID`` (optional in the league, read by teams and by our stub to find their
+    team in the GameController's packets) is the team's number from game.json."""
+    import ipaddress
+
+    from orchestrator.match.layout import Subnet, robot_environment
+    from orchestrator.match.plan import RobotPlan
+    from robot.stub.options import read_env
+
+    robot = RobotPlan(color="blue", number=2, port=10022, image="img", team_id=13)
+    env = robot_environment(robot, team_net=Subnet(network=ipaddress.IPv4Network("10.213.7.0/24")), player_count=2,
+                            gamecontroller_ip=None)
+    assert env["ROBOCUP_TEAM_ID"] == "13"
+    assert read_env(env).team_id == 13

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from orchestrator.commands.check import check_file
+from hlvs.commands.check import check_file
 from simulator.errors import ModelError
 from simulator.world.robots.team import load_team_model
 from tests.unit.models.conftest import box_robot, edit_manifest

@@ -12,7 +12,7 @@ import mujoco
 import numpy as np
 
 from contracts.ids import RobotId, TeamColor
-from orchestrator.commands.check import check_file, check_report
+from hlvs.commands.check import check_file, check_report
 from referee.snapshot import BodyPart
 from simulator.world import RobotPlacement, World
 from simulator.world.camera import CameraRenderer

@@ -12,15 +12,15 @@ from pathlib import Path
 
 import pytest
 
-from service.pool import MatchJob
-from service.pool.local import LocalDockerPool
-from service.pool.nodes import (
+from cluster import MatchJob
+from cluster.local import LocalDockerPool
+from cluster.nodes import (
     ENV_REMOTE_COMMENT,
     expand_hostlist,
     parse_sinfo,
     parse_squeue_nodes,
 )
-from service.pool.slurm import _merged, _parse_entry
+from cluster.slurm import _merged, _parse_entry
 
 
 @pytest.mark.parametrize(("text", "names"), [

@@ -12,7 +12,7 @@ import zlib
 from datetime import UTC, datetime
 
 from orchestrator.config.schedule import Schedule
-from orchestrator.schedule.services import MatchContext, PlayOutcome
+from tournament.services import MatchContext, PlayOutcome
 
 PLAY_SECONDS = float(os.environ.get("HLVS_FAKE_PLAY_S", "0.3"))
 

@@ -16,8 +16,8 @@ import pytest
 
 from orchestrator.config.schedule import load_schedule, round_robin_fixtures
 from orchestrator.errors import ConfigError
-from orchestrator.schedule import Ledger, ScheduledMatchState, run_schedule, standings
 from tests.unit.schedule.fake_services import goals
+from tournament import Ledger, ScheduledMatchState, run_schedule, standings
 
 FAKE = "tests.unit.schedule.fake_services:FakeServices"
 TEAMS = ["alpha", "bravo", "charlie", "delta"]
@@ -133,7 +133,7 @@ def test_missed_match_is_marked_with_a_reason(tmp_path: Path) -> None:
         COMPRESSED + "matches:\n  - {id: late, red: alpha, blue: bravo, stream_start: '+0.5s'}\n",
     )
     state = tmp_path / "state.sqlite"
-    from orchestrator.schedule import init_state
+    from tournament import init_state
 
     init_state(path, state, services=FAKE)
     time.sleep(0.7)  # the scheduler was down past the stream start
@@ -144,8 +144,8 @@ def test_missed_match_is_marked_with_a_reason(tmp_path: Path) -> None:
 
 
 def test_cancel_and_status_cli(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    from orchestrator.cli import main
-    from orchestrator.schedule import init_state
+    from hlvs.cli import main
+    from tournament import init_state
 
     path = write_schedule(
         tmp_path, "matches:\n  - {id: m1, red: alpha, blue: bravo, stream_start: '+2h'}\n"
@@ -173,7 +173,7 @@ def test_sigkill_mid_tournament_then_restart_plays_every_match_once(tmp_path: Pa
     cmd = [
         sys.executable,
         "-m",
-        "orchestrator.cli",
+        "hlvs.cli",
         "schedule",
         "run",
         str(path),
@@ -221,7 +221,7 @@ def test_sigkill_mid_tournament_then_restart_plays_every_match_once(tmp_path: Pa
 
 def test_state_file_of_another_schedule_is_refused(tmp_path: Path) -> None:
     from orchestrator.errors import ScheduleError
-    from orchestrator.schedule import init_state
+    from tournament import init_state
 
     a = write_schedule(tmp_path, "matches: []\n")
     other = tmp_path / "b"
@@ -234,7 +234,7 @@ def test_state_file_of_another_schedule_is_refused(tmp_path: Path) -> None:
 
 
 def test_reference_time_is_fixed_at_first_run(tmp_path: Path) -> None:
-    from orchestrator.schedule import init_state
+    from tournament import init_state
 
     path = write_schedule(
         tmp_path, "matches:\n  - {id: m1, red: alpha, blue: bravo, stream_start: '+1h'}\n"

@@ -12,10 +12,10 @@ from typing import Any
 import httpx
 import pytest
 
+from cluster.fake import FakePool
 from service import Settings
 from service.db import Scope, make_engine, migrate, session_factory, transaction
 from service.errors import PreflightFailed
-from service.pool.fake import FakePool
 from service.tokens import issue
 from tests.integration.service.harness import Served, serve
 

@@ -12,9 +12,9 @@ from pathlib import Path
 
 import pytest
 
-from orchestrator.cli import main
+from cluster.fake import FakePool
+from hlvs.cli import main
 from service import Settings
-from service.pool.fake import FakePool
 from tests.integration.service.harness import Served, free_port, serve
 from tests.unit.service.conftest import FakePreflight, team_doc
 

@@ -12,8 +12,8 @@ from typing import Any
 
 import pytest
 
+from cluster.fake import FakePool
 from service import webhooks
-from service.pool.fake import FakePool
 from tests.integration.service.harness import Served
 from tests.unit.service.conftest import wait_for_status
 from tests.unit.service.test_submissions import handle_of, setup_team

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from service.errors import PoolError
-from service.pool import PoolNode
-from service.pool.fake import FakePool
+from cluster import PoolNode
+from cluster.errors import PoolError
+from cluster.fake import FakePool
 from tests.integration.service.harness import Served
 from tests.unit.service.conftest import wait_for_status
 from tests.unit.service.test_submissions import setup_team

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import httpx
 
-from service.pool.fake import FakePool
+from cluster.fake import FakePool
 from tests.integration.service.harness import Served
 from tests.unit.service.conftest import team_doc, wait_for_status
 
@@ -204,8 +204,8 @@ def test_bad_submissions(start: Callable[..., Served], token: Callable[..., str]
 
 def test_operators_read_the_tournament_schedule_and_standings(
         start: Callable[..., Served], token: Callable[..., str], tmp_path: Path) -> None:
-    from orchestrator.schedule import run_schedule
     from tests.unit.schedule.test_schedule import COMPRESSED, FAKE, write_schedule
+    from tournament import run_schedule
 
     schedule = write_schedule(
         tmp_path, COMPRESSED + "fixtures:\n  round_robin: {teams: [alpha, bravo, charlie], "
@@ -350,7 +350,7 @@ def test_a_render_left_by_an_earlier_service_process_is_waited_for(
     import json
     import subprocess
 
-    from service.pool.local import process_start_time
+    from cluster.local import process_start_time
 
     served = start(video=True)
     with setup_team(served, token("Alpha"), "Alpha") as http:

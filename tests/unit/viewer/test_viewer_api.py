@@ -155,7 +155,7 @@ def test_hlvs_view_names_a_path_without_a_replay(tmp_path: Path) -> None:
     import sys
 
     done = subprocess.run(
-        [sys.executable, "-m", "orchestrator", "view", str(tmp_path / "nowhere")],
+        [sys.executable, "-m", "hlvs", "view", str(tmp_path / "nowhere")],
         capture_output=True, text=True, timeout=120,
     )  # fmt: skip
     assert done.returncode == 2

@@ -24,7 +24,7 @@ def replay(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def test_export_writes_foxglove_channels_in_simulated_time(replay: Path, tmp_path: Path) -> None:
     output = tmp_path / "match.mcap"
     done = subprocess.run(
-        [sys.executable, "-m", "orchestrator", "export", str(replay), "-o", str(output)],
+        [sys.executable, "-m", "hlvs", "export", str(replay), "-o", str(output)],
         capture_output=True, text=True, timeout=120,
     )  # fmt: skip
     assert done.returncode == 0, done.stderr
@@ -72,7 +72,7 @@ def test_export_of_a_bad_replay_names_the_file(tmp_path: Path) -> None:
     bad = tmp_path / "bad.hlvsrec"
     bad.write_bytes(b"nothing")
     done = subprocess.run(
-        [sys.executable, "-m", "orchestrator", "export", str(bad), "-o", str(tmp_path / "x.mcap")],
+        [sys.executable, "-m", "hlvs", "export", str(bad), "-o", str(tmp_path / "x.mcap")],
         capture_output=True, text=True, timeout=120,
     )  # fmt: skip
     assert done.returncode == 2

@@ -17,7 +17,7 @@ from simulator.errors import OffscreenGLError
 from simulator.gl import choose_offscreen_gl
 from tests.unit.world.test_world_recorder import _record
 
-HLVS = [sys.executable, "-m", "orchestrator"]
+HLVS = [sys.executable, "-m", "hlvs"]
 
 
 def _environment_without_gl() -> dict[str, str]:

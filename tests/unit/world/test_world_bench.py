@@ -1,4 +1,4 @@
-"""``python -m simulator bench sim`` prints one JSON line with the agreed keys."""
+"""``python -m benchmarks sim`` prints one JSON line with the agreed keys."""
 
 from __future__ import annotations
 
@@ -10,9 +10,9 @@ import pytest
 
 
 def bench_sim(*args: str) -> subprocess.CompletedProcess[str]:
-    """``python -m simulator bench sim ARGS`` (what ``hlvs bench sim`` runs)."""
+    """``python -m benchmarks sim ARGS`` (what ``hlvs bench sim`` runs)."""
     return subprocess.run(
-        [sys.executable, "-m", "simulator", "bench", "sim", *args],
+        [sys.executable, "-m", "benchmarks", "sim", *args],
         capture_output=True, text=True, timeout=300,
     )  # fmt: skip
 

@@ -14,13 +14,13 @@ from pathlib import Path
 
 from orchestrator.config.schedule import PlannedMatch, Schedule, Slot, load_schedule
 from orchestrator.errors import DeliveryError, OrchestratorError, ScheduleError
-from orchestrator.schedule.services import (
+from tournament.services import (
     DEFAULT_SERVICES,
     MatchContext,
     TournamentServices,
     load_services,
 )
-from orchestrator.schedule.state import Ledger, ScheduledMatchState
+from tournament.state import Ledger, ScheduledMatchState
 
 log = logging.getLogger(__name__)
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from orchestrator.schedule.state import MatchRow, ScheduledMatchState
+from tournament.state import MatchRow, ScheduledMatchState
 
 COUNTED = (
     ScheduledMatchState.PLAYED,

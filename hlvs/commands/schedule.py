@@ -60,7 +60,7 @@ def register(sub: Any) -> None:
 
 
 def _ledger(path: Path) -> Any:
-    from orchestrator.schedule.state import Ledger
+    from tournament.state import Ledger
 
     if not path.is_file():
         raise ConfigError(
@@ -70,7 +70,7 @@ def _ledger(path: Path) -> Any:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from orchestrator.schedule.runner import run_schedule
+    from tournament.runner import run_schedule
 
     return run_schedule(
         args.schedule, args.state, services=args.services, pool=args.pool,
@@ -128,7 +128,7 @@ def _status(args: argparse.Namespace) -> int:
 
 
 def _cancel(args: argparse.Namespace) -> int:
-    from orchestrator.schedule.state import ScheduledMatchState
+    from tournament.state import ScheduledMatchState
 
     ledger = _ledger(args.state)
     not_started = (
@@ -152,7 +152,7 @@ def _cancel(args: argparse.Namespace) -> int:
 
 def _standings(args: argparse.Namespace) -> int:
     from orchestrator.config.schedule import load_schedule
-    from orchestrator.schedule.standings import standings
+    from tournament.standings import standings
 
     ledger = _ledger(args.state)
     schedule_path = ledger.get_meta("schedule")

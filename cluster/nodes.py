@@ -3,7 +3,7 @@ state, why it is out of service, its features, CPUs and memory, and the jobs (ma
 
 The local pool has one node, this host; the Slurm pool has the cluster's nodes as ``sinfo``
 lists them. The text formats of Slurm's commands are parsed here (pure functions); running
-the commands stays in :mod:`service.pool.slurm`.
+the commands stays in :mod:`cluster.slurm`.
 """
 
 from __future__ import annotations

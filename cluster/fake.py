@@ -11,6 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from cluster import JobState, JobStatus, MatchJob, NodeJob, PoolNode
 from contracts import files
 from contracts.match_results import (
     Failure,
@@ -19,7 +20,6 @@ from contracts.match_results import (
     MatchResults,
     RobotResult,
 )
-from service.pool import JobState, JobStatus, MatchJob, NodeJob, PoolNode
 
 
 class FakePool:

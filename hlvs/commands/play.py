@@ -268,7 +268,7 @@ def _placement(args: argparse.Namespace, plan: MatchPlan) -> LeaguePlacement | N
 
 
 def _in_pool(args: argparse.Namespace, *, game_path: Path, plan: MatchPlan, out: Path) -> int:
-    from orchestrator.commands.pooled import play_in_pool
+    from hlvs.commands.pooled import play_in_pool
 
     extra = () if args.grace is None else ("--grace", str(args.grace))
     if getattr(args, "gpu", None) is not None:

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from orchestrator.schedule.runner import init_state, recover_interrupted, run_schedule
-from orchestrator.schedule.services import (
+from tournament.runner import init_state, recover_interrupted, run_schedule
+from tournament.services import (
     MatchContext,
     MatchServices,
     PlayOutcome,
@@ -11,8 +11,8 @@ from orchestrator.schedule.services import (
     read_outcome,
     write_game_file,
 )
-from orchestrator.schedule.standings import Standing, standings
-from orchestrator.schedule.state import Ledger, MatchRow, ScheduledMatchState
+from tournament.standings import Standing, standings
+from tournament.state import Ledger, MatchRow, ScheduledMatchState
 
 __all__ = [
     "Ledger",

@@ -16,7 +16,7 @@ import os
 import sys
 from typing import Any
 
-from orchestrator.cli import forward
+from hlvs.commands.forwarding import forward
 
 SIMULATOR_BENCHES = {
     "sim": "physics steps of the soccer world per second (JSON)",
@@ -46,7 +46,7 @@ def register(sub: Any) -> None:
     for kind, text in SIMULATOR_BENCHES.items():
         forward(
             kinds, kind, help=text,
-            func=lambda a, kind=kind: _exec_simulator(["bench", kind, *a.rest]),
+            func=lambda a, kind=kind: _exec_simulator([kind, *a.rest], module="benchmarks"),
         )
     forward(kinds, "envs", help="the learning environments: steps per second (JSON)",
             func=_envs)

@@ -36,10 +36,9 @@ from collections.abc import Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from contracts import files
-from service.errors import PoolError
-from service.pool import JobState, JobStatus, MatchJob
-from service.pool.nodes import (
+from cluster import JobState, JobStatus, MatchJob
+from cluster.errors import PoolError
+from cluster.nodes import (
     ENV_REMOTE_COMMENT,
     SINFO_FORMAT,
     SQUEUE_NODES_FORMAT,
@@ -48,6 +47,7 @@ from service.pool.nodes import (
     parse_sinfo,
     parse_squeue_nodes,
 )
+from contracts import files
 
 log = logging.getLogger(__name__)
 
@@ -172,7 +172,7 @@ class SlurmPool:
         and networks removed) and moves that attempt's files to ``attempt-<n>/``, then plays
         the match from the start."""
         prefix = ["nsenter", f"--net={HOST_NETNS}"] if self.host_network else []
-        hlvs = [*prefix, self.python, "-m", "orchestrator", *self.extra_args]
+        hlvs = [*prefix, self.python, "-m", "hlvs", *self.extra_args]
         play = [*hlvs, "match", str(job.game_path.resolve()), "--out", str(out),
                 *job.match_args]
         nodes: list[str] = []

@@ -31,7 +31,7 @@ from orchestrator.errors import ScheduleError
 
 log = logging.getLogger(__name__)
 
-DEFAULT_SERVICES = "orchestrator.schedule.services:MatchServices"
+DEFAULT_SERVICES = "tournament.services:MatchServices"
 SLURM_CONF = "/var/lib/hlvs/slurm/slurm.conf"  # written by 'hlvs pool up'
 SLURM_POLL_S = 2.0
 
@@ -174,7 +174,7 @@ class MatchServices:
         out = ctx.out_dir / "match"
         if self.schedule.pool.kind == "slurm":
             return self._play_in_slurm(ctx, game, out)
-        cmd = [sys.executable, "-m", "orchestrator.cli", "match", str(game), "--out", str(out)]
+        cmd = [sys.executable, "-m", "hlvs.cli", "match", str(game), "--out", str(out)]
         log.info("match %s: %s", ctx.match_id, " ".join(cmd))
         with open(ctx.out_dir / "match.log", "ab") as sink:
             proc = subprocess.run(
@@ -200,9 +200,9 @@ class MatchServices:
         """The match as a Slurm job (no requeue: tournament matches wait for the operator).
         A job an earlier scheduler submitted for this match, still in Slurm or finished with
         its report, is adopted instead of playing the match again."""
-        from service.errors import PoolError
-        from service.pool import JobState, MatchJob
-        from service.pool.slurm import HOST_NETNS, SlurmPool
+        from cluster import JobState, MatchJob
+        from cluster.errors import PoolError
+        from cluster.slurm import HOST_NETNS, SlurmPool
 
         settings = self.schedule.pool
         pool = SlurmPool(

@@ -24,15 +24,15 @@ from apscheduler.schedulers.background import BackgroundScheduler
 
 from orchestrator.config.schedule import Schedule, load_schedule, resolve_time
 from orchestrator.errors import ScheduleError
-from orchestrator.schedule.state import Ledger, ScheduledMatchState
+from tournament.state import Ledger, ScheduledMatchState
 
 log = logging.getLogger(__name__)
 S = ScheduledMatchState
 
 JOB_FUNCTIONS = {
-    "pull": "orchestrator.schedule.jobs:pull_job",
-    "play": "orchestrator.schedule.jobs:play_job",
-    "deliver": "orchestrator.schedule.jobs:deliver_job",
+    "pull": "tournament.jobs:pull_job",
+    "play": "tournament.jobs:play_job",
+    "deliver": "tournament.jobs:deliver_job",
 }
 NEXT_STEP = {
     S.PLANNED: ("pull", "pull_at"),

@@ -2,7 +2,7 @@
 
 Rules every command follows (a unit test checks them for every command that exists):
 
-- It lives in ``orchestrator/commands/<name>.py`` with ``register(subparsers)``, listed in
+- It lives in ``hlvs/commands/<name>.py`` with ``register(subparsers)``, listed in
   :data:`COMMAND_MODULES`. At module level it imports only the standard library and
   ``orchestrator.errors`` / ``orchestrator.exitcodes`` / ``orchestrator.console``; everything
   else is imported inside the function that runs the command, so ``hlvs --help`` stays fast.
@@ -19,30 +19,42 @@ Rules every command follows (a unit test checks them for every command that exis
 from __future__ import annotations
 
 import argparse
-import importlib
 import logging
 import os
 import sys
 from collections.abc import Iterator, Sequence
 from typing import Any
 
+from hlvs.commands import (
+    check,
+    compose,
+    images,
+    logs,
+    match,
+    pool,
+    registry,
+    schedule,
+    service,
+    simulator,
+    viewer,
+)
 from orchestrator.errors import OrchestratorError
 from orchestrator.exitcodes import ExitCode
 
 PROG = "hlvs"
 
 COMMAND_MODULES = (
-    "orchestrator.commands.check",
-    "orchestrator.commands.match",
-    "orchestrator.commands.images",
-    "orchestrator.commands.registry",
-    "orchestrator.commands.compose",
-    "orchestrator.commands.logs",
-    "orchestrator.commands.schedule",
-    "orchestrator.commands.simulator",
-    "orchestrator.commands.viewer",
-    "orchestrator.commands.pool",
-    "service.commands",
+    check,
+    match,
+    images,
+    registry,
+    compose,
+    logs,
+    schedule,
+    simulator,
+    viewer,
+    pool,
+    service,
 )
 
 EPILOG = (
@@ -81,8 +93,8 @@ def build_parser() -> argparse.ArgumentParser:
     _add_verbosity(parser, default=0)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", title="commands")
     sub.required = True
-    for name in COMMAND_MODULES:
-        importlib.import_module(name).register(sub)
+    for module in COMMAND_MODULES:
+        module.register(sub)
     for child in walk(parser):
         if child is not parser and not child.get_default("forwarded"):
             _add_verbosity(child, default=argparse.SUPPRESS)
@@ -111,20 +123,6 @@ def walk(parser: argparse.ArgumentParser) -> Iterator[argparse.ArgumentParser]:
         if isinstance(action, argparse._SubParsersAction):
             for child in dict.fromkeys(action.choices.values()):
                 yield from walk(child)
-
-
-def forward(
-    sub: Any, name: str, *, help: str, func: Any, **kwargs: Any
-) -> argparse.ArgumentParser:
-    """A sub-command whose arguments (``--help`` included) go to another parser unread.
-
-    ``func(args)`` gets ``args.rest``, the arguments after the command name.
-    """
-    parser: argparse.ArgumentParser = sub.add_parser(
-        name, help=help, add_help=False, usage=f"{sub._prog_prefix} {name} ...", **kwargs
-    )
-    parser.set_defaults(func=func, forwarded=True)
-    return parser
 
 
 def log_level(args: argparse.Namespace) -> int:

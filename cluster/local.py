@@ -19,10 +19,10 @@ import sys
 import threading
 from pathlib import Path
 
+from cluster import JobState, JobStatus, MatchJob
+from cluster.errors import PoolError
+from cluster.nodes import NodeJob, PoolNode
 from contracts import files
-from service.errors import PoolError
-from service.pool import JobState, JobStatus, MatchJob
-from service.pool.nodes import NodeJob, PoolNode
 
 log = logging.getLogger(__name__)
 
@@ -75,7 +75,7 @@ class LocalDockerPool:
                 return handle
             out = self.results_dir(handle)
             out.mkdir(parents=True, exist_ok=True)
-            command = [self.python, "-m", "orchestrator", *self.extra_args, "match",
+            command = [self.python, "-m", "hlvs", *self.extra_args, "match",
                        str(job.game_path.resolve()), "--out", str(out)]
             with (job.work_dir / LOG_FILE).open("ab") as log_file:
                 try:

@@ -1,6 +1,6 @@
 """``hlvs match --pool slurm`` and ``hlvs scrimmage --pool slurm``: the match as a Slurm job.
 
-The match is submitted through :class:`service.pool.slurm.SlurmPool` (one batch job on a whole
+The match is submitted through :class:`cluster.slurm.SlurmPool` (one batch job on a whole
 node running ``hlvs match``), this command waits for it and shows Slurm's state and reason on
 one line each time they change, then reads ``report.json`` / ``results.json`` from the usual
 ``--out`` folder and exits with the same codes as a local match. SIGINT / SIGTERM while waiting
@@ -20,7 +20,7 @@ from typing import Any
 from contracts import files
 from contracts.errors import ContractError
 from contracts.match_results import FailureClass, MatchReport, MatchResults
-from orchestrator.commands.play import stop_on_signals, summarize
+from hlvs.commands.play import stop_on_signals, summarize
 from orchestrator.errors import InfrastructureError
 from orchestrator.match import MatchOutcome
 
@@ -30,7 +30,7 @@ POLL_S = 1.0
 
 def make_pool(args: argparse.Namespace) -> Any:
     """The Slurm pool the options name; the output goes straight into ``--out``."""
-    from service.pool.slurm import HOST_NETNS, SlurmPool
+    from cluster.slurm import HOST_NETNS, SlurmPool
 
     conf = args.slurm_conf or os.environ.get("SLURM_CONF") or DEFAULT_CONF
     # The one-machine cluster of 'hlvs pool up' shares this host's Docker engine: its jobs
@@ -42,8 +42,8 @@ def play_in_pool(
     args: argparse.Namespace, *, game_path: Path, match_id: str, out_dir: Path, official: bool,
     match_args: tuple[str, ...] = (), robot_nodes: int = 0,
 ) -> int:
-    from service.errors import PoolError
-    from service.pool import JobState, MatchJob
+    from cluster import JobState, MatchJob
+    from cluster.errors import PoolError
 
     pool = make_pool(args)
     as_json = bool(getattr(args, "json", False))

@@ -1,4 +1,5 @@
-"""The match pool: the port through which the service plays matches.
+"""The cluster: the match pool, the port through which the service, the schedule, the pooled
+commands and the learning environments play matches or run remotes.
 
 A pool takes a prepared match (a ``game.json`` with its team files, in a work folder), plays it
 somewhere and leaves the usual match output (``report.json``, ``results.json``, logs) in
@@ -6,10 +7,10 @@ somewhere and leaves the usual match output (``report.json``, ``results.json``, 
 must answer ``status`` for handles made by an earlier process: that is how a restarted service
 finds the matches that went on while it was down.
 
-Implementations: :class:`service.pool.local.LocalDockerPool` (this host's Docker engine, one
-``hlvs match`` process per match) and :class:`service.pool.slurm.SlurmPool` (one Slurm batch job
+Implementations: :class:`cluster.local.LocalDockerPool` (this host's Docker engine, one
+``hlvs match`` process per match) and :class:`cluster.slurm.SlurmPool` (one Slurm batch job
 per match, ``sbatch`` / ``squeue`` / ``scancel`` in its own adapter module), chosen in
-:func:`make_pool`.
+:func:`make_pool`. Errors: :mod:`cluster.errors`.
 """
 
 from __future__ import annotations
@@ -17,12 +18,10 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Protocol
+from typing import Protocol
 
-from service.pool.nodes import NodeJob, PoolNode
-
-if TYPE_CHECKING:
-    from service.settings import Settings
+from cluster.errors import ClusterError, PoolError
+from cluster.nodes import NodeJob, PoolNode
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -79,19 +78,30 @@ class MatchPool(Protocol):
         ...
 
 
-def make_pool(settings: Settings) -> MatchPool:
-    """The pool named by ``settings.pool``: ``local`` (this host's Docker engine) or ``slurm``
-    (the cluster that ``SLURM_CONF`` names, see :mod:`service.pool.slurm`)."""
-    if settings.pool == "slurm":
-        from service.pool.slurm import HOST_NETNS, SlurmPool
+def make_pool(*, kind: str = "local", slots: int, slurm_conf: str | None = None) -> MatchPool:
+    """The pool named by ``kind``: ``local`` (this host's Docker engine, ``slots`` matches at
+    once) or ``slurm`` (the cluster that ``slurm_conf`` or ``SLURM_CONF`` names, see
+    :mod:`cluster.slurm`)."""
+    if kind == "slurm":
+        from cluster.slurm import HOST_NETNS, SlurmPool
 
         # on a one-machine cluster (scripts/ensure-slurm.sh) the nodes reach Docker's networks
         # through the host's network namespace
-        return SlurmPool(slots=settings.match_slots, slurm_conf=settings.slurm_conf or None,
+        return SlurmPool(slots=slots, slurm_conf=slurm_conf or None,
                          host_network=Path(HOST_NETNS).exists())
-    from service.pool.local import LocalDockerPool
+    from cluster.local import LocalDockerPool
 
-    return LocalDockerPool(slots=settings.match_slots)
+    return LocalDockerPool(slots=slots)
 
 
-__all__ = ["JobState", "JobStatus", "MatchJob", "MatchPool", "NodeJob", "PoolNode", "make_pool"]
+__all__ = [
+    "ClusterError",
+    "JobState",
+    "JobStatus",
+    "MatchJob",
+    "MatchPool",
+    "NodeJob",
+    "PoolError",
+    "PoolNode",
+    "make_pool",
+]

@@ -1,5 +1,5 @@
 """``hlvs match``, ``hlvs scrimmage`` and ``hlvs cleanup``: the parsers; the work is in
-:mod:`orchestrator.commands.play`, imported only when a command runs.
+:mod:`hlvs.commands.play`, imported only when a command runs.
 
 Exit codes: 0 the match played to its end, 1 it failed (see report.json), 2 invalid input,
 3 infrastructure, 4 decided by forfeit, 130 interrupted (SIGINT / SIGTERM: everything is stopped
@@ -12,8 +12,8 @@ import argparse
 import logging
 from typing import Any
 
-from orchestrator.commands.scrimmage_args import add_arguments as add_scrimmage_arguments
-from orchestrator.commands.scrimmage_args import add_gpu_argument
+from hlvs.commands.scrimmage_args import add_arguments as add_scrimmage_arguments
+from hlvs.commands.scrimmage_args import add_gpu_argument
 from orchestrator.paths import user_path
 
 MATCH_EPILOG = (
@@ -80,26 +80,26 @@ def add_pool_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_match_command(args: argparse.Namespace) -> int:
-    from orchestrator.commands import play
+    from hlvs.commands import play
 
     return play.run_match_command(args)
 
 
 def run_scrimmage_command(args: argparse.Namespace) -> int:
-    from orchestrator.commands import play
+    from hlvs.commands import play
 
     return play.run_scrimmage_command(args)
 
 
 def run_cleanup_command(args: argparse.Namespace) -> int:
-    from orchestrator.commands import play
+    from hlvs.commands import play
 
     return play.run_cleanup_command(args)
 
 
 def __getattr__(name: str) -> Any:  # play, summarize, stop_on_signals: kept importable from here
     if name in ("play", "summarize", "stop_on_signals"):
-        from orchestrator.commands import play
+        from hlvs.commands import play
 
         return getattr(play, name)
     raise AttributeError(name)

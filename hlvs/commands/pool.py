@@ -61,7 +61,7 @@ def _down(args: argparse.Namespace) -> int:
 
 
 def _status(args: argparse.Namespace) -> int:
-    from service.pool.slurm import SlurmPool
+    from cluster.slurm import SlurmPool
 
     pool = SlurmPool(slurm_conf=args.slurm_conf)
     entries = pool.queue()

@@ -104,7 +104,7 @@ def register(sub: Any) -> None:
     register_client(sub, guarded)
     bench = sub.choices.get("bench")
     if bench is not None:
-        from orchestrator.cli import forward
+        from hlvs.commands.forwarding import forward
 
         kinds = next(a for a in bench._actions if isinstance(a, argparse._SubParsersAction))
         forward(kinds, "service", help="the submission service under 200 polling and 20 "
@@ -130,7 +130,7 @@ def _sessions(args: argparse.Namespace) -> Any:
 def run_serve(args: argparse.Namespace) -> int:
     import uvicorn
 
-    from service.app import create_app
+    from hlvs.app import create_app
 
     settings = _settings(args)
     app = create_app(settings, start_worker=not args.no_worker)
@@ -140,9 +140,9 @@ def run_serve(args: argparse.Namespace) -> int:
 
 
 def run_team_add(args: argparse.Namespace) -> int:
+    from cluster.errors import PoolError
     from service.admin import add_team
     from service.db import Team, transaction
-    from service.errors import PoolError
 
     settings = _settings(args)
     with transaction(_sessions(args)) as session:
@@ -152,13 +152,13 @@ def run_team_add(args: argparse.Namespace) -> int:
         result: dict[str, object] = {"team": team.name, "id": team.id}
     if settings.pool == "slurm":  # the team's Slurm account now (else at its first match)
         from service.accounts import ensure_team_account
-        from service.pool import make_pool
+        from service.app import pool_from_settings
 
         with transaction(_sessions(args)) as session:
             row = session.get(Team, team.id)
             assert row is not None
             try:
-                result["slurm_account"] = ensure_team_account(session, make_pool(settings),
+                result["slurm_account"] = ensure_team_account(session, pool_from_settings(settings),
                                                               row, settings)
             except PoolError as exc:
                 print(f"hlvs: warning: no Slurm account yet ({exc}); it is made before the "

@@ -1,0 +1,5 @@
+"""The product's entry points: the ``hlvs`` command (:mod:`hlvs.cli`) and the submission service
+as it is served, with the pages and the environment API mounted (:mod:`hlvs.app`).
+
+This is the only package that wires the others together; nothing imports it.
+"""

@@ -1,0 +1,5 @@
+import sys
+
+from hlvs.cli import main
+
+sys.exit(main())

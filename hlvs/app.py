@@ -1,0 +1,26 @@
+"""The submission service as ``hlvs serve`` serves it: the service's API with the web pages
+(:mod:`viewer.service_pages`) and the HTTP environment API (:mod:`envs.http_api`) mounted.
+
+The service knows neither: they sit above it and hand their ``mount`` here.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from fastapi import FastAPI
+
+from service.app import create_app as create_service_app
+from service.settings import Settings
+from viewer import service_pages
+
+MOUNTS = (service_pages.mount,)
+
+
+def create_app(settings: Settings, **options: Any) -> FastAPI:
+    """The whole app; ``options`` are those of :func:`service.app.create_app`
+    (``pool_factory``, ``preflight``, ``start_worker``)."""
+    return create_service_app(settings, mounts=MOUNTS, **options)
+
+
+__all__ = ["MOUNTS", "create_app"]
