@@ -5,7 +5,7 @@ schema), builds the match pool and starts the queue worker; it stops the worker 
 (running matches go on in the pool and are picked up again by the next start).
 
 Routers: each router module exposes ``mount(app)``, which includes its ``APIRouter`` (and static
-files, if any). The service's own are :data:`SERVICE_ROUTERS`; a package above the service (the
+files, if any). The service's own are :func:`service_routers`; a package above the service (the
 pages, the environment API) hands its ``mount`` in ``mounts``, wired by :mod:`hlvs.app`; to
 require a team token in it use ``service.require_team`` (see :mod:`service.deps`).
 """
@@ -29,7 +29,6 @@ from starlette.exceptions import HTTPException as StarletteHTTPException
 from cluster import MatchPool, PoolError, make_pool
 from service.db import make_engine, migrate, session_factory
 from service.errors import AuthError, ServiceError
-from service.routers import envs, health, nodes, operator, submissions, teams
 from service.settings import Settings
 
 log = logging.getLogger(__name__)
@@ -37,14 +36,19 @@ log = logging.getLogger(__name__)
 Mount = Callable[[FastAPI], None]
 """``mount(app)`` of a router module: includes its ``APIRouter`` in the app."""
 
-SERVICE_ROUTERS: tuple[Mount, ...] = (
-    health.mount,
-    teams.mount,
-    submissions.mount,
-    operator.mount,
-    nodes.mount,  # the match pool's machines (operators)
-    envs.mount,  # the HTTP environment API (learning environments)
-)
+def service_routers() -> tuple[Mount, ...]:
+    """The service's own routers, in the order they are mounted (imported when an app is built:
+    they import the service's modules, which import this one for :class:`Services`)."""
+    from service.routers import envs, health, nodes, operator, submissions, teams
+
+    return (
+        health.mount,
+        teams.mount,
+        submissions.mount,
+        operator.mount,
+        nodes.mount,  # the match pool's machines (operators)
+        envs.mount,  # the HTTP environment API (learning environments)
+    )
 
 
 @dataclass(slots=True)
@@ -162,7 +166,7 @@ def create_app(
 
     app.add_middleware(StatusFastPath)
     app.add_middleware(BodyLimit, max_bytes=settings.max_upload_bytes)
-    for mount in (*SERVICE_ROUTERS, *mounts):
+    for mount in (*service_routers(), *mounts):
         mount(app)
     return app
 
@@ -209,4 +213,4 @@ def _install_error_handlers(app: FastAPI) -> None:
                             status_code=exc.status_code)
 
 
-__all__ = ["SERVICE_ROUTERS", "Services", "create_app", "pool_from_settings"]
+__all__ = ["Services", "create_app", "pool_from_settings", "service_routers"]

@@ -9,6 +9,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 PRODUCTION = ("orchestrator", "simulator", "referee", "robot", "contracts", "service", "envs",
+              "cluster", "tournament",
               "viewer")  # fmt: skip
 
 
