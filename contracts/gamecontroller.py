@@ -192,6 +192,15 @@ def encode_game_state(data: GameControlData) -> bytes:
     return head + _team_bytes(data.teams[0]) + _team_bytes(data.teams[1])
 
 
+PACKET_NUMBER_OFFSET = 6  # after the header "RGme" and the u16 version
+
+
+def with_packet_number(raw: bytes, number: int) -> bytes:
+    """``raw`` (an encoded ``RGme`` datagram) with its ``packetNumber`` set to ``number`` (mod
+    256): the sender numbers the packets as it sends them, as the league's ``Sender`` does."""
+    return raw[:PACKET_NUMBER_OFFSET] + bytes((number & 0xFF,)) + raw[PACKET_NUMBER_OFFSET + 1 :]
+
+
 def _decode_team(raw: bytes) -> TeamInfo:
     number, colour, score, shot, singles, seq, message = _TEAM.unpack_from(raw, 0)
     robots = [

@@ -121,6 +121,10 @@ class ZenohTelemetry:
         self._session.close()  # type: ignore[no-untyped-call]
 
 
+def _seconds(value: float | None) -> str:
+    return "?" if value is None else f"{value:.1f}"
+
+
 def describe(state: StateMessage) -> str:
     """One progress line for a telemetry state."""
     score = state.score or {}
@@ -128,7 +132,7 @@ def describe(state: StateMessage) -> str:
     return (
         f"{state.state}"
         + (f"/{secondary}" if secondary and secondary != "NORMAL" else "")
-        + f" half {state.half} {state.secs_remaining} s left"
+        + f" half {state.half} {_seconds(state.secs_remaining)} s left"
         + f" score red {score.get('red', '?')} - {score.get('blue', '?')} blue"
         + f" sim {state.sim_time_ms / 1000:.1f} s"
         + f" rtf {state.real_time_factor:.2f}"
@@ -165,7 +169,7 @@ class LiveView:
         if state is not None:
             score = state.score or {}
             table.add_row("game", f"{state.state} ({state.secondary_state}), "
-                          f"half {state.half}, {state.secs_remaining} s left")
+                          f"half {state.half}, {_seconds(state.secs_remaining)} s left")
             table.add_row("score", f"red {score.get('red')} - {score.get('blue')} blue")
             table.add_row("sim time", f"{state.sim_time_ms / 1000:.1f} s")
             table.add_row("real-time factor", f"{state.real_time_factor:.2f}")

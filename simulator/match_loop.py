@@ -219,6 +219,8 @@ class MatchLoop:
             self.world.apply(command)
         events = self.referee.events
         while self._events_seen < len(events):
+            if events[self._events_seen].type == "state":
+                self._next_state_s = 0.0  # a new game state is published with this step
             payload = event_dict(events[self._events_seen])
             self._events_seen += 1
             if self.recorder is not None:

@@ -30,7 +30,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="robots per team: a striker, then a goalie, then defenders "
                              "(default 1)")
     parser.add_argument("--half-duration", type=float, default=65.0,
-                        help="simulated seconds per half, READY and SET included (default 65)")
+                        help="simulated seconds of game clock per half; READY and SET before the "
+                        "half's kick-off stop the clock (default 65)")
     parser.add_argument("--ready-duration", type=float, default=20.0,
                         help="simulated seconds of READY in this scrimmage (default 20; "
                              "matches: 45)")

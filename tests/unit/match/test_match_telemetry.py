@@ -80,3 +80,9 @@ def test_terminal_view_renders_a_table() -> None:
     view.close()
     text = out.getvalue()
     assert "match m9" in text and "red 3 - 1 blue" in text and "red-1, blue-1" in text
+
+
+def test_the_progress_line_shows_the_seconds_left_with_one_decimal() -> None:
+    state = _message(state="PLAYING", half=2, secs_remaining=60, score={"red": 0, "blue": 0})
+    assert describe(state).startswith("PLAYING half 2 60.0 s left")
+    assert " ? s left" in describe(replace(state, secs_remaining=None))
