@@ -147,13 +147,13 @@ def _real_time_factor(document: dict[str, Any], where: Collector) -> float | Non
         name = legacy[0]
         value = float(document[name])
         maximum = legacy_maximum_real_time_factor(value)
-        where.warn(
-            pointer(name),
-            f"legacy field: each 8 ms step lasts at least {value:g} x 8 ms of wall time, read "
-            f"as maximum_real_time_factor {maximum:g}"
-            + (" (as fast as possible)" if maximum <= 0 else ""),
-            expected='"maximum_real_time_factor"',
+        meaning = (
+            f"each 8 ms step lasts at least {value:g} x 8 ms of wall time, read as "
+            f"maximum_real_time_factor {maximum:g}"
+            if maximum > 0
+            else f"{value:g} runs as fast as possible (maximum_real_time_factor 0)"
         )
+        where.warn(pointer(name), f"legacy field: {meaning}", expected='"maximum_real_time_factor"')
         return maximum
     where.warn(
         "/maximum_real_time_factor",
