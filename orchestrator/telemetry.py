@@ -48,6 +48,7 @@ class ZenohTelemetry:
         self._clock = clock
         self._lock = threading.Lock()
         self._latest: StateMessage | None = None
+        self._change: StateMessage | None = None  # first message of a new game state, unread
         self._refused: set[str] = set()  # why state messages were refused (logged once each)
         self._last_at: float | None = None
         self._events: list[dict[str, Any]] = []
@@ -94,6 +95,9 @@ class ZenohTelemetry:
         with self._lock:
             self._last_at = self._clock()
             if message is not None:
+                before = self._latest
+                if before is None or (before.state, before.half) != (message.state, message.half):
+                    self._change = message
                 self._latest = message
 
     def _on_event(self, sample: Any) -> None:
@@ -104,8 +108,12 @@ class ZenohTelemetry:
                 self._events.append(value)
 
     def latest(self) -> StateMessage | None:
+        """The newest state message; but the first message of a new game state (or half) once,
+        before newer ones, so a progress line shows how that state began (the full half at the
+        first PLAYING), however fast the match runs between two reads."""
         with self._lock:
-            return self._latest
+            change, self._change = self._change, None
+            return change if change is not None else self._latest
 
     def last_message_at(self) -> float | None:
         with self._lock:

@@ -39,6 +39,28 @@ def test_subscriber_receives_state_and_events_from_a_listening_publisher() -> No
         while not watcher.events() and time.monotonic() < deadline:
             time.sleep(0.05)
         assert watcher.events()[0] == {"type": "GOAL"}
+        # the first message of a new state is read once before newer ones (the console line
+        # at the first PLAYING shows the full half however fast the match runs)
+        for secs in (60, 59, 58):
+            publisher.put("hlvs/tm1/state", json.dumps({**state, "state": "PLAYING",
+                                                        "secs_remaining": secs}))
+        deadline = time.monotonic() + 5
+        while (latest := watcher.latest()) is None or latest.secs_remaining != 58:
+            assert time.monotonic() < deadline
+            time.sleep(0.05)
+        publisher.put("hlvs/tm1/state", json.dumps({**state, "state": "SET", "half": 2,
+                                                    "secs_remaining": 60}))
+        publisher.put("hlvs/tm1/state", json.dumps({**state, "state": "SET", "half": 2,
+                                                    "secs_remaining": 50}))
+        deadline = time.monotonic() + 5
+        seen: list[tuple[str | None, float | None]] = []
+        while (not seen or seen[-1][1] != 50) and time.monotonic() < deadline:
+            message = watcher.latest()
+            assert message is not None
+            if message.half == 2:
+                seen.append((message.state, message.secs_remaining))
+            time.sleep(0.05)
+        assert seen[0] == ("SET", 60) and seen[-1] == ("SET", 50), seen
     finally:
         watcher.close()
         publisher.close()
