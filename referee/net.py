@@ -108,9 +108,15 @@ class GameControllerNetwork:
         self._thread.start()
 
     def close(self) -> None:
+        """Stop; a game state not sent yet (FINISHED at the end of the game) goes out first,
+        as the league's GameController, still running, would broadcast it at its next tick."""
         self._stop.set()
         if self._thread.is_alive():
             self._thread.join(timeout=5.0)
+        with self._lock:
+            unsent, self._pending = self._pending, []
+        for packet in unsent:
+            self._send_packet(packet)
         self._send.close()
         self._recv.close()
 

@@ -304,3 +304,28 @@ def test_rgrt_attributed_by_sender_address(tmp_path: Path,
     events = (tmp_path / "referee_events.jsonl").read_text().splitlines()
     assert sum('"type": "spoofing"' in line for line in events) == 3
     assert "spoofed: 21" in (tmp_path / "gamecontroller.log").read_text()
+
+
+def test_a_game_state_not_sent_yet_goes_out_when_the_network_closes(
+    robots: dict[str, socket.socket],
+) -> None:
+    """League referee (``referee.py``): after FINISHED the game runs on (``END_OF_GAME_TIMEOUT``)
+    while the GameController keeps broadcasting, so robots see FINISHED; a FINISHED entered
+    just before the network closes is sent as it closes."""
+    port = robots["127.0.0.2"].getsockname()[1]
+    net = GameControllerNetwork(
+        bind_host="127.0.0.1", data_port=port, return_port=0, targets=["127.0.0.2"],
+        team_numbers={8: RED, 25: BLUE}, send_rate_hz=2.0, clock=SystemClock(),
+    )
+    ref = Referee(config=make_config(), clock=FakeClock())
+    playing, finished = bytearray(ref.packet()), bytearray(ref.packet())
+    playing[9], finished[9] = 3, 4
+    with net:
+        net.publish(bytes(playing), state_changed=True)
+        assert wait_for(lambda: net.stats().packets_sent >= 1)
+        net.publish(bytes(finished), state_changed=True)
+    got = receive_all(robots["127.0.0.2"], 0.3)
+    states = [decode_game_state(raw).state for raw, _ in got]
+    assert states[-1] == 4, states
+    numbers = [decode_game_state(raw).packet_number for raw, _ in got]
+    assert numbers == list(range(numbers[0], numbers[0] + len(numbers)))
