@@ -6,6 +6,10 @@ The one codec and the one set of wire codes for the referee (which sends ``RGme`
 Little-endian, packed, layout of ``RoboCupGameControlData.h``: a 24-byte header, then two
 332-byte TeamInfo blocks (teams[0] the team playing on the left, teams[1] the other), each with
 a coach and 11 players of 6-byte RobotInfo.
+
+As the league's GameController (``controller/net/Sender.java``) sends it: one ``RGme`` at a
+fixed rate (every 500 ms), never an extra one on a state change, ``packetNumber`` + 1 per packet
+sent (mod 256, :func:`with_packet_number` stamps it at sending).
 """
 
 from __future__ import annotations
@@ -190,6 +194,15 @@ def encode_game_state(data: GameControlData) -> bytes:
         data.secondary_time,
     )
     return head + _team_bytes(data.teams[0]) + _team_bytes(data.teams[1])
+
+
+PACKET_NUMBER_OFFSET = 6  # after the header "RGme" and the u16 version
+
+
+def with_packet_number(raw: bytes, number: int) -> bytes:
+    """``raw`` (an encoded ``RGme`` datagram) with its ``packetNumber`` set to ``number`` (mod
+    256): the sender numbers the packets as it sends them, as the league's ``Sender`` does."""
+    return raw[:PACKET_NUMBER_OFFSET] + bytes((number & 0xFF,)) + raw[PACKET_NUMBER_OFFSET + 1 :]
 
 
 def _decode_team(raw: bytes) -> TeamInfo:

@@ -41,8 +41,8 @@ class PlayerSpec:
     half_time_pose: Pose
     reentry_pose: Pose
     shootout_pose: Pose
-    goalkeeper_pose: Pose
-    goalkeeper: bool = False
+    goalkeeper_pose: Pose  # used only while this robot is the GameController's goalkeeper
+    goalkeeper: bool = False  # marked goalkeeper at the start (league default: player 1)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -63,7 +63,13 @@ class TeamSpec:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class TimingSpec:
-    """Game timing. ``*_real_s`` are wall-clock waits; everything else is simulated time."""
+    """Game timing. ``*_real_s`` are wall-clock waits; everything else is simulated time.
+
+    ``half_duration_s`` is game-clock time, as the league's GameController counts it
+    (``AdvancedData.getRemainingGameTime``): the clock stands still in READY and SET before the
+    first kick-off of a half (and of an overtime half), so that PLAYING starts with the full
+    half; once the half has been played in, READY and SET after a goal count as played (no
+    added time)."""
 
     half_duration_s: float = 600.0
     overtime_half_duration_s: float = 300.0

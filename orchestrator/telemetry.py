@@ -48,6 +48,7 @@ class ZenohTelemetry:
         self._clock = clock
         self._lock = threading.Lock()
         self._latest: StateMessage | None = None
+        self._change: StateMessage | None = None  # first message of a new game state, unread
         self._refused: set[str] = set()  # why state messages were refused (logged once each)
         self._last_at: float | None = None
         self._events: list[dict[str, Any]] = []
@@ -94,6 +95,9 @@ class ZenohTelemetry:
         with self._lock:
             self._last_at = self._clock()
             if message is not None:
+                before = self._latest
+                if before is None or (before.state, before.half) != (message.state, message.half):
+                    self._change = message
                 self._latest = message
 
     def _on_event(self, sample: Any) -> None:
@@ -104,8 +108,12 @@ class ZenohTelemetry:
                 self._events.append(value)
 
     def latest(self) -> StateMessage | None:
+        """The newest state message; but the first message of a new game state (or half) once,
+        before newer ones, so a progress line shows how that state began (the full half at the
+        first PLAYING), however fast the match runs between two reads."""
         with self._lock:
-            return self._latest
+            change, self._change = self._change, None
+            return change if change is not None else self._latest
 
     def last_message_at(self) -> float | None:
         with self._lock:
@@ -121,6 +129,10 @@ class ZenohTelemetry:
         self._session.close()  # type: ignore[no-untyped-call]
 
 
+def _seconds(value: float | None) -> str:
+    return "?" if value is None else f"{value:.1f}"
+
+
 def describe(state: StateMessage) -> str:
     """One progress line for a telemetry state."""
     score = state.score or {}
@@ -128,7 +140,7 @@ def describe(state: StateMessage) -> str:
     return (
         f"{state.state}"
         + (f"/{secondary}" if secondary and secondary != "NORMAL" else "")
-        + f" half {state.half} {state.secs_remaining} s left"
+        + f" half {state.half} {_seconds(state.secs_remaining)} s left"
         + f" score red {score.get('red', '?')} - {score.get('blue', '?')} blue"
         + f" sim {state.sim_time_ms / 1000:.1f} s"
         + f" rtf {state.real_time_factor:.2f}"
@@ -165,7 +177,7 @@ class LiveView:
         if state is not None:
             score = state.score or {}
             table.add_row("game", f"{state.state} ({state.secondary_state}), "
-                          f"half {state.half}, {state.secs_remaining} s left")
+                          f"half {state.half}, {_seconds(state.secs_remaining)} s left")
             table.add_row("score", f"red {score.get('red')} - {score.get('blue')} blue")
             table.add_row("sim time", f"{state.sim_time_ms / 1000:.1f} s")
             table.add_row("real-time factor", f"{state.real_time_factor:.2f}")

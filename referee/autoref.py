@@ -568,5 +568,5 @@ class Referee:
         self._publisher.publish(self._last_ms or 0, force=force)
 
     def packet(self) -> bytes:
-        """The current ``RGme`` datagram (each call takes the next packet number)."""
+        """The current ``RGme`` datagram (``packetNumber`` 0: the sender numbers its packets)."""
         return self._publisher.packet()

@@ -1,9 +1,13 @@
 """GameController network: ``RGme`` to every robot on UDP 3838, ``RGrt`` from robots on 3939.
 
-One background thread sends the latest packet to every robot address at 2 Hz (configurable)
-and immediately when the game state changed (every changed packet, in order, so a state that
-lasts a single step, like FINISHED before the next period's INITIAL, still reaches the robots),
-and receives return packets: per robot it tracks
+One background thread sends one packet to every robot address at a fixed rate (2 Hz,
+configurable) and never between, as the league GameController's ``Sender`` does (a packet every
+500 ms, ``packetNumber`` + 1 per packet, mod 256, stamped as it is sent). Each packet is the
+latest state, except that a game state the robots have not been sent yet goes out first, at its
+own tick: the league's referee waits until the GameController has broadcast a state (FINISHED
+at the end of a half) before it commands the next one, so robots always see it; here FINISHED
+lasts a single step before the next period's INITIAL. The thread also
+receives return packets: per robot it tracks
 the last alive time (wall clock), goalkeeper claims, manual penalise / unpenalise requests and
 game-interruption-ready messages. Datagrams that do not decode are ignored and counted.
 
@@ -19,16 +23,19 @@ import logging
 import selectors
 import socket
 import threading
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
-from contracts.gamecontroller import ReturnMessage, decode_return
+from contracts.gamecontroller import ReturnMessage, decode_return, with_packet_number
 from contracts.ids import RobotId, TeamColor
 from referee.clock import Clock
 from referee.errors import ProtocolError
 from referee.spoofing import Senders, SpoofingLog, robot_key
 
 logger = logging.getLogger(__name__)
+
+MAX_PENDING_STATES = 8  # game states waiting for their tick; older ones are dropped
 
 
 @dataclass(slots=True)
@@ -78,8 +85,8 @@ class GameControllerNetwork:
         self._clock = clock
         self._lock = threading.Lock()
         self._packet: bytes | None = None
-        self._changes: list[bytes] = []  # changed packets not sent yet, oldest first
-        self._changed = threading.Event()
+        self._pending: list[bytes] = []  # packets of game states not sent yet, oldest first
+        self._packet_number = 0  # of the next packet (the league's Sender starts at 0)
         self._stop = threading.Event()
         self._links: dict[RobotId, RobotLink] = {}
         self._claims: list[RobotId] = []
@@ -101,10 +108,15 @@ class GameControllerNetwork:
         self._thread.start()
 
     def close(self) -> None:
+        """Stop; a game state not sent yet (FINISHED at the end of the game) goes out first,
+        as the league's GameController, still running, would broadcast it at its next tick."""
         self._stop.set()
-        self._changed.set()
         if self._thread.is_alive():
             self._thread.join(timeout=5.0)
+        with self._lock:
+            unsent, self._pending = self._pending, []
+        for packet in unsent:
+            self._send_packet(packet)
         self._send.close()
         self._recv.close()
 
@@ -115,13 +127,15 @@ class GameControllerNetwork:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-    def publish(self, packet: bytes, *, changed: bool) -> None:
+    def publish(self, packet: bytes, *, state_changed: bool = False) -> None:
+        """Make ``packet`` the latest state; nothing is sent before the next tick.
+        ``state_changed``: it starts a new game state, which then is the packet of a tick even
+        if the state is left again before."""
         with self._lock:
             self._packet = packet
-            if changed:
-                self._changes.append(packet)
-        if changed:
-            self._changed.set()
+            if state_changed:
+                self._pending.append(packet)
+                del self._pending[:-MAX_PENDING_STATES]
 
     def links(self) -> dict[RobotId, RobotLink]:
         with self._lock:
@@ -142,29 +156,38 @@ class GameControllerNetwork:
     # --- thread ----------------------------------------------------------------------------
 
     def _run(self) -> None:
+        """Send at the fixed rate on the machine's wall clock (the league's ``Sender`` sleeps
+        500 ms between packets); the first packet goes out as soon as there is one."""
         selector = selectors.DefaultSelector()
         selector.register(self._recv, selectors.EVENT_READ)
-        next_send = self._clock.monotonic()
+        next_send = time.monotonic()
         try:
             while not self._stop.is_set():
-                now = self._clock.monotonic()
-                if now >= next_send or self._changed.is_set():
-                    self._changed.clear()
-                    with self._lock:
-                        changes, self._changes = self._changes, []
-                        latest = self._packet
-                    if latest is not None and (not changes or changes[-1] is not latest):
-                        changes.append(latest)
-                    for packet in changes:
+                now = time.monotonic()
+                if now >= next_send:
+                    packet = self._next_packet()
+                    if packet is not None:
                         self._send_packet(packet)
-                    next_send = now + self._period_s
-                timeout = max(0.0, min(0.02, next_send - self._clock.monotonic()))
+                        next_send += self._period_s
+                        if next_send <= now:  # fell behind (a stalled machine): no burst
+                            next_send = now + self._period_s
+                timeout = max(0.0, min(0.02, next_send - time.monotonic()))
                 if selector.select(timeout):
                     self._receive_all()
         finally:
             selector.close()
 
+    def _next_packet(self) -> bytes | None:
+        """The packet of this tick: a game state left before it was sent, else the latest."""
+        with self._lock:
+            if len(self._pending) > 1:  # the last pending one began the current state
+                return self._pending.pop(0)
+            self._pending.clear()
+            return self._packet
+
     def _send_packet(self, packet: bytes) -> None:
+        packet = with_packet_number(packet, self._packet_number)
+        self._packet_number = (self._packet_number + 1) & 0xFF
         sent = 0
         for address in self._targets:
             try:

@@ -1,8 +1,9 @@
 """Hands the GameController's state to the network and logs its changes.
 
 Every change of state, secondary state, set play, half, kick-off team, score, penalties or
-sides is one line in ``gamecontroller.log`` and an immediate ``RGme`` send; otherwise the packet
-handed to the sender thread is refreshed every 0.1 s of wall time (the thread sends it at 2 Hz).
+sides is one line in ``gamecontroller.log`` and hands the packet to the sender thread at once;
+otherwise the packet is refreshed every 0.1 s of wall time. The thread sends at its fixed rate
+(2 Hz) and numbers the packets (:mod:`referee.net`); nothing is sent on a change by itself.
 """
 
 from __future__ import annotations
@@ -37,19 +38,18 @@ class Publisher:
         self._players_per_team = players_per_team
         self._log = log
         self._clock = clock
-        self._packet_number = 0
         self._signature: tuple[object, ...] = ()
         self._published_real_s = float("-inf")
+        self._state: tuple[object, ...] = ()  # game state and half last handed to the network
         self.network: GameControllerNetwork | None = None
 
     def packet(self) -> bytes:
-        """The current ``RGme`` datagram (each call takes the next packet number)."""
-        self._packet_number = (self._packet_number + 1) & 0xFF
+        """The current ``RGme`` datagram, ``packetNumber`` 0 (the sender numbers what it sends)."""
         data = game_control_data(
             self._gc,
             team_numbers=self._team_numbers,
             players_per_team=self._players_per_team,
-            packet_number=self._packet_number,
+            packet_number=0,
             left_team=self._left_team(),
         )
         return encode_game_state(data)
@@ -77,7 +77,9 @@ class Publisher:
         real = self._clock.monotonic()
         if changed or force or real - self._published_real_s >= REFRESH_PERIOD_REAL_S:
             self._published_real_s = real
-            self.network.publish(self.packet(), changed=changed or force)
+            state = (gc.state, gc.half, gc.phase)
+            self.network.publish(self.packet(), state_changed=state != self._state)
+            self._state = state
 
     def log_counts(self, sim_time_ms: int) -> None:
         if self.network is None:

@@ -55,6 +55,9 @@ class Settings:
     node and each robot on a node of its own (docs/slurm.md)."""
     worker_poll_s: float = 1.0
     test_half_duration_s: float = 30.0
+    test_ready_duration_s: float = 45.0
+    """READY of a test match (the GameController's clock stands still in it before each
+    half's kick-off, so it adds to the match's length)."""
     test_players: int = 1
     test_grace_s: float = 5.0
     expected_match_s: float = 120.0

@@ -19,7 +19,11 @@ taken, so which requests a step applies never depends on timing.
 
 While the referee waits for wall-clock time (before the first READY, between halves) an async
 match keeps stepping, as in HLVS; a lockstep (or pipelined) match holds (no steps, connections
-still served) so its result does not depend on machine speed.
+still served) so its result does not depend on machine speed: the number of steps in a wall-clock
+wait, and the step at which each robot connects within it, would depend on how fast the machine
+and the robots are, and so would every simulated time and pose after it. A client connected
+while a plain lockstep match holds gets one measurement of the held time with a warning that
+says so (:func:`hold_text`); a pipelined match sends it the held step's measurement.
 """
 
 from __future__ import annotations
@@ -40,6 +44,17 @@ from simulator.telemetry import POSES_PERIOD_S, STATE_PERIOD_S, Telemetry
 from simulator.traffic import TrafficLog
 
 log = logging.getLogger(__name__)
+
+
+def hold_text(sim_time_ms: int) -> str:
+    """The warning a lockstep client gets while the match holds for a wall-clock wait."""
+    return (
+        f"lockstep: simulated time holds at {sim_time_ms} ms while the referee waits for "
+        "wall-clock time (before the first READY, between periods); the next measurement "
+        "comes with the next step. The wait is not simulated so that the match replays "
+        "identically (its steps would depend on machine speed and connection times); "
+        "async stepping keeps stepping during the wait, as in the league."
+    )
 
 
 class RefereeLike(Protocol):
@@ -161,6 +176,9 @@ class MatchLoop:
             if self.lockstep and (self.referee.waiting_for_wall_clock or finished_at is not None):
                 if self._pipeline is not None and self._pipeline.unsent:
                     self._pipeline.send(self.world.sim_time_ms)  # the state they wait in
+                elif self._pipeline is None and finished_at is None:
+                    held_ms = self.world.sim_time_ms
+                    self.server.hold_notice(held_ms, hold_text(held_ms))
                 self._hold(0.02)
                 pace_origin = (time.monotonic(), self.world.sim_time_ms)
                 continue
@@ -219,6 +237,8 @@ class MatchLoop:
             self.world.apply(command)
         events = self.referee.events
         while self._events_seen < len(events):
+            if events[self._events_seen].type == "state":
+                self._next_state_s = 0.0  # a new game state is published with this step
             payload = event_dict(events[self._events_seen])
             self._events_seen += 1
             if self.recorder is not None:

@@ -29,8 +29,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--players", type=int, default=1, choices=(1, 2, 3, 4),
                         help="robots per team: a striker, then a goalie, then defenders "
                              "(default 1)")
-    parser.add_argument("--half-duration", type=float, default=65.0,
-                        help="simulated seconds per half, READY and SET included (default 65)")
+    parser.add_argument("--half-duration", type=float, default=40.0,
+                        help="simulated seconds of game clock per half; READY and SET before the "
+                        "half's kick-off stop the clock (default 40)")
     parser.add_argument("--ready-duration", type=float, default=20.0,
                         help="simulated seconds of READY in this scrimmage (default 20; "
                              "matches: 45)")

@@ -127,6 +127,14 @@ def build_game(document: Any, where: Collector, *, source: Path) -> GameConfig |
     )
 
 
+def legacy_maximum_real_time_factor(value: float) -> float:
+    """The maximum real-time factor a legacy ``minimum_real_time_factor`` (or the 2021
+    ``real_time_factor``) ``value`` means. The league's referee before March 2023 (``referee.py``)
+    made each basic time step last at least ``value`` times its simulated time, so the
+    simulation ran at most ``1 / value`` times real time; 0 ran as fast as possible."""
+    return 1.0 / value if value > 0 else 0.0
+
+
 def _real_time_factor(document: dict[str, Any], where: Collector) -> float | None:
     legacy = [name for name in LEGACY_RTF if name in document]
     if "maximum_real_time_factor" in document:
@@ -137,12 +145,16 @@ def _real_time_factor(document: dict[str, Any], where: Collector) -> float | Non
         return float(document["maximum_real_time_factor"])
     if legacy:
         name = legacy[0]
-        where.warn(
-            pointer(name),
-            "legacy field: read as maximum_real_time_factor",
-            expected='"maximum_real_time_factor"',
+        value = float(document[name])
+        maximum = legacy_maximum_real_time_factor(value)
+        meaning = (
+            f"each 8 ms step lasts at least {value:g} x 8 ms of wall time, read as "
+            f"maximum_real_time_factor {maximum:g}"
+            if maximum > 0
+            else f"{value:g} runs as fast as possible (maximum_real_time_factor 0)"
         )
-        return float(document[name])
+        where.warn(pointer(name), f"legacy field: {meaning}", expected='"maximum_real_time_factor"')
+        return maximum
     where.warn(
         "/maximum_real_time_factor",
         f"missing: the league's default {DEFAULT_MAXIMUM_REAL_TIME_FACTOR:g} (real time) is used",

@@ -22,8 +22,8 @@ from contracts.match_spec import (
 )
 from orchestrator.config.model import COLORS, Color, LoadedGame, StartingPose
 from orchestrator.config.robot_models import spec_model
+from orchestrator.config.team import GOALKEEPER_NUMBER
 
-GOALKEEPER_NUMBER = 1  # HLVS: player 1 is the goalkeeper unless the robot declares otherwise
 VIDEO_FILE = files.VIDEO
 
 

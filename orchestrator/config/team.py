@@ -27,6 +27,10 @@ from orchestrator.config.robot_models import (
 )
 from orchestrator.config.schema import validate
 
+# The robot the GameController marks as goalkeeper unless a robot declares itself goalkeeper
+# (RGrt GOALKEEPER): the league GameController's default, player 1.
+GOALKEEPER_NUMBER = 1
+
 POSE_KEYS = {
     "halfTimeStartingPose": "half_time_pose",
     "reentryStartingPose": "reentry_pose",
@@ -84,6 +88,8 @@ def build_team(
             ):
                 raw_pose = players_raw[str(number)][key]
                 _check_pose(raw_pose, at, key, where, field_class)
+                if key == "goalKeeperStartingPose" and number == GOALKEEPER_NUMBER:
+                    check_goalkeeper_pose(raw_pose, at, where, field_class)
     if not valid:
         return None
     players = [_player(number, document, field_class) for number in numbers]
@@ -224,12 +230,6 @@ def _check_pose(
             expected="x < 0 (poses are written as if the team played on the left half)",
         )
     if field_class is None:
-        if key == "goalKeeperStartingPose" and x >= 0.0:
-            where.error(
-                at + "/translation/0",
-                f"x = {x:g}: the goalkeeper is not near the own goal",
-                expected="x < 0, near the own goal line",
-            )
         return
     box = FIELDS[field_class]
     x_max, y_max = box.half_length_m + box.border_m, box.half_width_m + box.border_m
@@ -239,15 +239,39 @@ def _check_pose(
             f"({x:g}, {y:g}) is off the turf of the {field_class} field",
             expected=f"|x| <= {x_max:g} and |y| <= {y_max:g}",
         )
-    elif key == "goalKeeperStartingPose":
+
+
+def check_goalkeeper_pose(
+    raw: dict[str, Any], at: str, where: Collector, field_class: FieldClass | None
+) -> None:
+    """The one goalkeeper pose rule, the same for an upload (no field class yet), ``hlvs check``
+    and a match or pre-flight (with its class); for the goalkeeper's pose only.
+
+    The league's referee (``referee.py``) uses ``goalKeeperStartingPose`` only for the robot the
+    GameController marks as goalkeeper, to place it in a penalty shoot-out, and refuses no team
+    file for it: a pose away from the own goal is a warning (the shoot-out's goalkeeper rule
+    then applies: on or behind its goal line between the posts); the other players' goalkeeper
+    poses are not looked at (a robot that declares itself goalkeeper gets its own)."""
+    x, y = (float(v) for v in raw["translation"][:2])
+    if not (math.isfinite(x) and math.isfinite(y)):
+        return  # _check_pose reports it
+    if field_class is None:
+        x_limit, y_limit, wanted = 0.0, math.inf, "x < 0, near the own goal line"
+        near = x < x_limit
+    else:
+        box = FIELDS[field_class]
         x_limit = -(box.half_length_m - box.penalty_area_length_m)
         y_limit = box.penalty_area_width_m / 2
-        if x > x_limit or abs(y) > y_limit:
-            where.error(
-                at + "/translation",
-                f"({x:g}, {y:g}): the goalkeeper is not near the own goal",
-                expected=f"inside the own penalty area: x <= {x_limit:g} and |y| <= {y_limit:g}",
-            )
+        wanted = f"inside the own penalty area: x <= {x_limit:g} and |y| <= {y_limit:g}"
+        near = x <= x_limit and abs(y) <= y_limit
+    if not near:
+        where.warn(
+            at + "/translation",
+            f"({x:g}, {y:g}): the goalkeeper would start a penalty shoot-out away from its "
+            "own goal (league referee: the shoot-out goalkeeper must stay on or behind its "
+            "goal line between the posts)",
+            expected=wanted,
+        )
 
 
 def _check_image(player: PlayerConfig, where: Collector) -> None:

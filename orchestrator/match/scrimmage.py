@@ -4,8 +4,9 @@ The files (game.json, team_red.json, team_blue.json) are written into the output
 played exactly like ``hlvs match`` would play them, so a team can rerun or edit them.
 
 Defaults make a short game a newcomer can watch in two to three minutes: one striker per team,
-two halves of 65 s simulated with READY shortened to 20 s (so each half has about 40 s of
-PLAYING), lockstep stepping, 3 s before the first READY and 1 s at half time. These timings
+two halves of 40 s of game clock with READY shortened to 20 s (READY and SET before a half's
+kick-off stop the clock, as the league's GameController does, so a half lasts about 65 s of
+simulated time), lockstep stepping, 3 s before the first READY and 1 s at half time. These timings
 are the scrimmage's own; official matches keep the rules' timings (45 s READY, 10 min halves).
 """
 

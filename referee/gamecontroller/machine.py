@@ -82,6 +82,7 @@ class GameController:
         self.kickoff_team: TeamColor | None = kickoff  # None: dropped ball
         self.secs_remaining = timing.half_duration_s
         self.secondary_time = 0.0
+        self.period_started = False  # a PLAYING of this period began: READY and SET run the clock
         self.set_play: SetPlay | None = None
         self.teams: dict[TeamColor, TeamInfo] = {
             color: TeamInfo(robots={n: RobotInfo() for n in numbers})
@@ -101,6 +102,19 @@ class GameController:
     @property
     def secondary_state(self) -> SecondaryState:
         return self.set_play.kind if self.set_play is not None else self.phase
+
+    @property
+    def clock_running(self) -> bool:
+        """Whether the game clock runs now, as in the league GameController's
+        ``AdvancedData.getRemainingGameTime``: it runs in PLAYING; in READY and SET only once a
+        PLAYING of this period has begun (``timeBeforeCurrentGameState != 0``), so every period
+        starts its first PLAYING with its full time and, after a goal or a dropped ball, READY
+        and SET count as played (no added time); in the penalty shoot-out only in PLAYING."""
+        if self.state is GameState.PLAYING:
+            return True
+        if self.state not in (GameState.READY, GameState.SET):
+            return False
+        return self.period_started and self.phase is not SecondaryState.PENALTYSHOOT
 
     def score(self, color: TeamColor) -> int:
         return self.teams[color].score
@@ -135,6 +149,7 @@ class GameController:
         elif new_state is GameState.SET:
             self.secondary_time = 0.0
         elif new_state is GameState.PLAYING:
+            self.period_started = True
             self.secondary_time = (
                 self.timing.shootout_kick_s
                 if self.phase is SecondaryState.PENALTYSHOOT
@@ -171,6 +186,7 @@ class GameController:
     def next_period(self) -> SecondaryState:
         """From FINISHED, start the next period; returns its phase. Caller checks it exists."""
         self.transition(GameState.INITIAL)
+        self.period_started = False
         if self.phase is SecondaryState.NORMAL and self.half == 1:
             self.half = 2
             self.secs_remaining = self.timing.half_duration_s
@@ -244,10 +260,9 @@ class GameController:
         if self.state in (GameState.INITIAL, GameState.FINISHED) or dt_s <= 0:
             return Tick()
         period_over = False
-        shootout = self.phase is SecondaryState.PENALTYSHOOT
-        if not shootout or self.state is GameState.PLAYING:
+        if self.clock_running:
             before = self.secs_remaining
-            self.secs_remaining -= dt_s  # no added time: READY and SET count as played
+            self.secs_remaining -= dt_s
             period_over = before > EPSILON_S >= self.secs_remaining
         unpenalised = []
         for color, team in self.teams.items():

@@ -106,13 +106,15 @@ class Connection:
             template = self._template
             decoded: list[pb.ActuatorRequests | PositionTargets] = []
             for frame in frames:
+                count += 1
+                if not frame:  # an empty ActuatorRequests: an answer with nothing to apply
+                    continue
                 targets = template.match(frame) if template is not None else None
                 if targets is not None:
                     decoded.append(targets)
                 else:
                     decoded.append(self._parse(frame))
                     template = self._template
-                count += 1
             if decoded:
                 with self._requests_lock:
                     self.requests.extend(decoded)

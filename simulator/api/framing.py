@@ -1,9 +1,11 @@
 """Robot API framing: 4-byte big-endian length, then a serialized protobuf message.
 
 The decoder is fed arbitrary byte chunks as they arrive on a socket and yields complete
-payloads; a partial frame stays buffered until the rest arrives. An announced length of 0 or
-above :data:`MAX_FRAME_BYTES` (the reference client's ``max_answer_size``) means the stream is
-out of sync: :class:`FramingError` is raised and the connection must be closed.
+payloads; a partial frame stays buffered until the rest arrives. A length of 0 is an empty
+message (an empty ``ActuatorRequests``, which clients do send): it is yielded as ``b""`` and
+the caller skips it, as the league's player (``player.cpp``) does. An announced length above
+:data:`MAX_FRAME_BYTES` (the reference client's ``max_answer_size``) means the stream is out of
+sync: :class:`FramingError` is raised and the connection must be closed.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ class FramingError(ApiError):
     def __init__(self, *, length: int, limit: int) -> None:
         self.length = length
         self.limit = limit
-        super().__init__(f"announced frame length {length} is out of range 1..{limit}")
+        super().__init__(f"announced frame length {length} is out of range 0..{limit}")
 
 
 def encode_frame(payload: bytes) -> bytes:
@@ -45,7 +47,8 @@ class FrameDecoder:
         return len(self._buffer)
 
     def feed(self, data: bytes) -> list[bytes]:
-        """Add received bytes; return the payloads of every frame now complete, in order."""
+        """Add received bytes; return the payloads of every frame now complete, in order
+        (``b""`` for an empty frame)."""
         buffer = self._buffer
         if not buffer and len(data) >= 4:  # the usual case: exactly one frame, nothing buffered
             (length,) = HEADER.unpack_from(data)
@@ -57,7 +60,7 @@ class FrameDecoder:
         size = len(buffer)
         while size - offset >= 4:
             (length,) = HEADER.unpack_from(buffer, offset)
-            if length == 0 or length > self._limit:
+            if length > self._limit:
                 del buffer[:offset]
                 raise FramingError(length=length, limit=self._limit)
             end = offset + 4 + length

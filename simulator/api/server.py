@@ -43,6 +43,7 @@ from simulator.api.quota import NetworkQuota
 from simulator.api.sender import SendThread
 from simulator.api.session import (
     ERROR,
+    WARNING,
     DuePlan,
     Measurement,
     RobotSession,
@@ -143,6 +144,7 @@ class ApiServer:
         self._step_polls = 0
         self.connection_changes = 0  # clients welcomed or dropped so far
         self._woken: list[Connection] = []
+        self._hold_told: set[tuple[int, int]] = set()  # (connection id, held sim time) told
         self.slots: dict[RobotId, RobotSlot] = {}
         for endpoint in endpoints:
             team_size = max(1, endpoint.team_size)
@@ -493,6 +495,28 @@ class ApiServer:
         if targets:
             assert batch is not None
             batch.set_targets(targets)
+
+    def hold_notice(self, time_ms: int, text: str) -> int:
+        """While the lockstep loop holds at ``time_ms`` (the referee waits for wall-clock time):
+        each connected client not told yet during this hold gets one measurement of that time
+        with ``text`` as a warning and no sensors; nothing else reaches it until the next step.
+        The world is not touched: a notice changes nothing that is simulated. Returns the
+        number of clients told now."""
+        real_time = self._unix_ms()
+        now = time.monotonic()
+        told = 0
+        for slot in self.slots.values():
+            conn = slot.conn
+            if conn is None or (id(conn), time_ms) in self._hold_told:
+                continue
+            self._hold_told.add((id(conn), time_ms))
+            notice = Measurement(time_ms, real_time)
+            notice.header.messages.add(message_type=WARNING, text=text)
+            self._send(slot, conn, notice, now)
+            told += 1
+        if told:
+            self._flush_all()
+        return told
 
     def publish(self, time_ms: int) -> None:
         """Queue the measurement of the step that ended at ``time_ms`` for every client."""

@@ -48,8 +48,9 @@ def test_still_robots_play_two_halves_to_a_goalless_draw() -> None:
     assert isinstance(summary, dict) and summary["dropped_ball"] >= 6
     halves = [e for e in referee.events if e.type == "state" and e.reason == "FINISHED"]
     assert [e.details["half"] for e in halves] == [1, 2]
-    # 120 s wait + 600 s first half + 15 s break + 600 s second half (no added time)
-    assert halves[-1].sim_time_ms == pytest.approx(1_335_000, abs=100)
+    # 120 s wait + READY 45 s and SET 5 s before each half's kick-off (the clock stands still,
+    # league GameController getRemainingGameTime) + 600 s + 15 s break + 50 s + 600 s
+    assert halves[-1].sim_time_ms == pytest.approx(1_435_000, abs=100)
 
 
 def _roll(x: float, y: float, vx: float) -> Script:

@@ -66,7 +66,8 @@ def real_settings(settings: Settings, docker_client: Any) -> Settings:
 
     project_image("stub")
     project_image("simulator")
-    return settings.with_(worker_poll_s=0.3, test_half_duration_s=5.0, test_grace_s=2.0,
+    return settings.with_(worker_poll_s=0.3, test_half_duration_s=5.0, test_ready_duration_s=1.0,
+                          test_grace_s=2.0,
                           preflight_timeout_s=25.0, video_width=320, video_height=180,
                           video_fps=5.0)
 

@@ -68,7 +68,17 @@ def test_frames_split_anywhere_are_reassembled() -> None:
         assert decoder.buffered == 0
 
 
-@pytest.mark.parametrize("length", [0, MAX_FRAME_BYTES + 1, 0xFFFFFFFF])
+def test_an_empty_frame_is_yielded_empty_between_others() -> None:
+    """League ``controllers/player/player.cpp``: a 0-length message (an empty
+    ``ActuatorRequests``) is skipped, the stream stays in sync."""
+    stream = encode_frame(b"a") + struct.pack(">I", 0) + encode_frame(b"bc")
+    for cut in range(len(stream)):
+        decoder = FrameDecoder()
+        assert decoder.feed(stream[:cut]) + decoder.feed(stream[cut:]) == [b"a", b"", b"bc"]
+    assert FrameDecoder().feed(struct.pack(">I", 0)) == [b""]
+
+
+@pytest.mark.parametrize("length", [MAX_FRAME_BYTES + 1, 0xFFFFFFFF])
 def test_out_of_range_length_is_a_framing_error(length: int) -> None:
     with pytest.raises(FramingError) as info:
         FrameDecoder().feed(struct.pack(">I", length) + b"xx")

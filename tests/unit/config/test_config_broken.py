@@ -81,7 +81,6 @@ class Case:
 
 
 HALF = "halfTimeStartingPose"
-KEEPER = "goalKeeperStartingPose"
 
 CASES = [
     # game.json: fields
@@ -285,13 +284,6 @@ CASES = [
         "team_red.json",
         f"/players/2/{HALF}/translation/0",
         "own half",
-    ),
-    Case(
-        "goalkeeper-far-from-goal",
-        put("blue", "players", "1", KEEPER, "translation", 0, value=-1.0),
-        "team_blue.json",
-        f"/players/1/{KEEPER}/translation",
-        "own goal",
     ),
     Case(
         "pose-off-turf",

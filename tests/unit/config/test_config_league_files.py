@@ -38,6 +38,29 @@ def test_a_legacy_name_still_wins_over_the_default(game_files: GameFiles) -> Non
     assert "/maximum_real_time_factor" not in pointers
 
 
+@pytest.mark.parametrize(
+    ("name", "value", "maximum"),
+    [
+        ("minimum_real_time_factor", 0.1, 10.0),
+        ("minimum_real_time_factor", 3, 1 / 3),
+        ("minimum_real_time_factor", 1, 1.0),
+        ("real_time_factor", 2, 0.5),
+    ],
+)
+def test_a_legacy_factor_is_the_least_wall_time_of_a_step(
+    game_files: GameFiles, name: str, value: float, maximum: float
+) -> None:
+    """League referee ``controllers/referee/referee.py`` before March 2023 (and the 2021
+    ``real_time_factor``): each 8 ms step lasts at least ``v`` x 8 ms of wall time ("maximum
+    1 / v x speed"), so ``v`` 0.1 runs up to 10 x real time, not at 0.1 x."""
+    del game_files.game["maximum_real_time_factor"]
+    game_files.game[name] = value
+    loaded = load_game(game_files.write())
+    assert loaded.game.maximum_real_time_factor == pytest.approx(maximum)
+    [warning] = [w for w in loaded.warnings if w.pointer == f"/{name}"]
+    assert f"at least {value:g} x 8 ms of wall time" in warning.message
+
+
 def _split_layout(game_files: GameFiles, tmp_path: Path) -> Path:
     """game.json in games/, the team files in teams/ named as seen from tmp_path (the cwd)."""
     games, teams = tmp_path / "games", tmp_path / "teams"

@@ -36,11 +36,11 @@ def _scrimmage(tmp_path: Path, *argv: str) -> tuple[dict[str, Any], dict[str, An
 
 def test_default_scrimmage_is_a_short_game_with_a_short_ready(tmp_path: Path) -> None:
     game, red = _scrimmage(tmp_path)
-    assert game["timing"]["half_duration_s"] == 65 and game["timing"]["ready_duration_s"] == 20
+    assert game["timing"]["half_duration_s"] == 40 and game["timing"]["ready_duration_s"] == 20
     assert game["stepping"] == "lockstep"
     assert [p["dockerCmd"].split()[0] for p in red["players"].values()] == ["striker"]
     loaded = load_game(tmp_path / "game.json").game
-    assert loaded.timing.ready_duration_s == 20.0 and loaded.timing.half_duration_s == 65.0
+    assert loaded.timing.ready_duration_s == 20.0 and loaded.timing.half_duration_s == 40.0
 
 
 def test_scrimmage_stepping_can_be_pipelined(tmp_path: Path) -> None:

@@ -39,6 +39,28 @@ def test_subscriber_receives_state_and_events_from_a_listening_publisher() -> No
         while not watcher.events() and time.monotonic() < deadline:
             time.sleep(0.05)
         assert watcher.events()[0] == {"type": "GOAL"}
+        # the first message of a new state is read once before newer ones (the console line
+        # at the first PLAYING shows the full half however fast the match runs)
+        for secs in (60, 59, 58):
+            publisher.put("hlvs/tm1/state", json.dumps({**state, "state": "PLAYING",
+                                                        "secs_remaining": secs}))
+        deadline = time.monotonic() + 5
+        while (latest := watcher.latest()) is None or latest.secs_remaining != 58:
+            assert time.monotonic() < deadline
+            time.sleep(0.05)
+        publisher.put("hlvs/tm1/state", json.dumps({**state, "state": "SET", "half": 2,
+                                                    "secs_remaining": 60}))
+        publisher.put("hlvs/tm1/state", json.dumps({**state, "state": "SET", "half": 2,
+                                                    "secs_remaining": 50}))
+        deadline = time.monotonic() + 5
+        seen: list[tuple[str | None, float | None]] = []
+        while (not seen or seen[-1][1] != 50) and time.monotonic() < deadline:
+            message = watcher.latest()
+            assert message is not None
+            if message.half == 2:
+                seen.append((message.state, message.secs_remaining))
+            time.sleep(0.05)
+        assert seen[0] == ("SET", 60) and seen[-1] == ("SET", 50), seen
     finally:
         watcher.close()
         publisher.close()
@@ -80,3 +102,9 @@ def test_terminal_view_renders_a_table() -> None:
     view.close()
     text = out.getvalue()
     assert "match m9" in text and "red 3 - 1 blue" in text and "red-1, blue-1" in text
+
+
+def test_the_progress_line_shows_the_seconds_left_with_one_decimal() -> None:
+    state = _message(state="PLAYING", half=2, secs_remaining=60, score={"red": 0, "blue": 0})
+    assert describe(state).startswith("PLAYING half 2 60.0 s left")
+    assert " ? s left" in describe(replace(state, secs_remaining=None))

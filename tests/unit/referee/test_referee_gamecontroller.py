@@ -55,7 +55,10 @@ def test_illegal_transitions_are_rejected(path: tuple[GameState, ...], bad: Game
     assert info.value.requested == bad.name and info.value.current == gc.state.name
 
 
-def test_ready_lasts_45_s_then_set_and_clock_counts_ready() -> None:
+def test_ready_lasts_45_s_then_set_with_the_clock_stopped_before_the_first_kickoff() -> None:
+    """League GameController (2024-master) ``AdvancedData.getRemainingGameTime``: in READY and
+    SET with ``timeBeforeCurrentGameState == 0`` no time of the half has been played, so the
+    clock stands still and the first PLAYING of the half starts with the full half."""
     gc = make(half_duration_s=600.0)
     gc.transition(GameState.READY)
     assert gc.secondary_time == 45.0
@@ -63,7 +66,47 @@ def test_ready_lasts_45_s_then_set_and_clock_counts_ready() -> None:
     assert gc.state is GameState.READY and not any(t.auto_set for t in ticks)
     run(gc, 0.2)
     assert gc.state.name == "SET"
-    assert 554.8 < gc.secs_remaining < 555.0  # no added time
+    assert gc.secs_remaining == 600.0
+    run(gc, 5.0)
+    gc.transition(GameState.PLAYING)
+    assert gc.secs_remaining == 600.0
+    run(gc, 1.0)
+    assert 598.99 < gc.secs_remaining < 599.01
+
+
+def test_ready_and_set_after_a_goal_run_the_clock() -> None:
+    """League GameController (2024-master) ``AdvancedData.getRemainingGameTime``: once time of
+    the half was played (``timeBeforeCurrentGameState > 0``) READY and SET count as played, as
+    they do after a goal (no added time, ``lostTime`` false in the HL rules)."""
+    gc = make(half_duration_s=600.0, ready_duration_s=45.0)
+    for state in (GameState.READY, GameState.SET, GameState.PLAYING):
+        gc.transition(state)
+    run(gc, 10.0)
+    gc.goal(RED)
+    run(gc, 45.0)  # READY, then SET by itself
+    assert gc.state is GameState.SET
+    run(gc, 5.0)
+    assert 539.99 < gc.secs_remaining < 540.01
+
+
+def test_every_period_starts_its_first_playing_with_its_full_time() -> None:
+    """League GameController (2024-master) ``AdvancedData.getRemainingGameTime``:
+    ``timeBeforeCurrentGameState`` is 0 again at the start of each period, so the second half
+    and each overtime half stop the clock in READY and SET before their first kick-off too."""
+    gc = make(GameType.KNOCKOUT, half_duration_s=60.0, overtime_half_duration_s=30.0,
+              ready_duration_s=10.0)
+    expected = (60.0, 60.0, 30.0, 30.0)
+    for full in expected:
+        gc.transition(GameState.READY)
+        run(gc, 10.0)
+        assert gc.state is GameState.SET
+        run(gc, 5.0)
+        gc.transition(GameState.PLAYING)
+        assert gc.secs_remaining == full
+        ticks = run(gc, full)
+        assert any(t.period_over for t in ticks)
+        gc.transition(GameState.FINISHED)
+        gc.next_period()
 
 
 def test_clock_stands_still_in_initial_and_finished() -> None:

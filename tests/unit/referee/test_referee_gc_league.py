@@ -77,18 +77,19 @@ def test_half_time_break_is_spent_in_initial_of_the_second_half() -> None:
     clock = FakeClock()
     timing = replace(FAST_TIMING, half_duration_s=10.0, half_time_break_real_s=15.0)
     ref = Referee(config=make_config(timing=timing), clock=clock)
-    seen = _play(ref, clock, 10_500)  # the first half ends at 10 s of simulated time
+    # READY (5 s) and SET (1 s) before the kick-off stop the clock: the half ends at 16 s
+    seen = _play(ref, clock, 16_500)
     states = [(d.state, d.first_half) for _, d in seen]
     assert states[-1] == (INITIAL, False), states  # firstHalf 0 during the break
     assert ref.waiting_for_wall_clock
     assert _packet(ref).secs_remaining == 10  # the second half's clock, not yet running
     break_events = [(e.reason, e.details["half"]) for e in ref.events if e.type == "state"]
     assert break_events[-2:] == [("FINISHED", 1), ("INITIAL", 2)]
-    seen = _play(ref, clock, 27_000, start_ms=10_500)  # past the 15 s of wall clock
+    seen = _play(ref, clock, 33_000, start_ms=16_500)  # past the 15 s of wall clock
     after = [(d.state, d.first_half) for _, d in seen]
     assert after[0] == (INITIAL, False) and (READY, False) in after, after
     ready_ms = next(ms for ms, d in seen if d.state == READY)
-    assert ready_ms - 10_000 >= 15_000 - 500  # READY only after the 15 s break
+    assert ready_ms - 16_000 >= 15_000 - 500  # READY only after the 15 s break
 
 
 def test_break_before_a_penalty_shootout_is_spent_in_initial_too() -> None:
@@ -103,7 +104,9 @@ def test_break_before_a_penalty_shootout_is_spent_in_initial_too() -> None:
 
 
 def test_robots_receive_finished_then_initial_of_the_second_half(tmp_path: Path) -> None:
-    """Over real UDP: FINISHED lasts one step before the break's INITIAL, and still goes out."""
+    """Over real UDP: FINISHED lasts one step before the break's INITIAL, and still goes out
+    (the league's referee commands the next period only once the GameController broadcast
+    FINISHED, ``referee.py``)."""
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as listener:
         listener.bind(("127.0.0.2", 0))
         listener.settimeout(0.05)
@@ -120,7 +123,7 @@ def test_robots_receive_finished_then_initial_of_the_second_half(tmp_path: Path)
         ref = Referee(config=config, clock=clock, log_dir=tmp_path)
         ref.start_network()
         try:
-            _play(ref, clock, 3_500)
+            _play(ref, clock, 9_500)  # READY 5 s and SET 1 s, then 3 s of PLAYING
             assert ref.waiting_for_wall_clock
             seen: list[tuple[int, bool]] = []
             deadline = time.monotonic() + 5.0

@@ -9,7 +9,13 @@ from pathlib import Path
 
 import pytest
 
-from contracts.gamecontroller import ReturnData, ReturnMessage, decode_game_state, encode_return
+from contracts.gamecontroller import (
+    ReturnData,
+    ReturnMessage,
+    decode_game_state,
+    encode_return,
+    with_packet_number,
+)
 from contracts.ids import RobotId, TeamColor
 from referee import FakeClock, Referee, SystemClock, TeamMirror
 from referee.config import NetworkConfig
@@ -50,6 +56,21 @@ def receive_all(sock: socket.socket, duration_s: float) -> list[tuple[bytes, tup
     return got
 
 
+def receive_timed(
+    sock: socket.socket, duration_s: float
+) -> list[tuple[float, tuple[bytes, tuple[str, int]]]]:
+    """Every datagram within ``duration_s``, with its arrival time (monotonic)."""
+    got = []
+    deadline = time.monotonic() + duration_s
+    while time.monotonic() < deadline:
+        try:
+            datagram = sock.recvfrom(4096)
+        except TimeoutError:
+            continue
+        got.append((time.monotonic(), datagram))
+    return got
+
+
 @pytest.fixture
 def robots() -> Iterator[dict[str, socket.socket]]:
     port = free_port()
@@ -59,29 +80,73 @@ def robots() -> Iterator[dict[str, socket.socket]]:
         sock.close()
 
 
-def test_rgme_sent_to_every_robot_at_2_hz_and_on_change(robots: dict[str, socket.socket]) -> None:
+def test_rgme_sent_to_every_robot_at_a_fixed_2_hz_numbered_one_by_one(
+    robots: dict[str, socket.socket],
+) -> None:
+    """League GameController (2024-master) ``controller/net/Sender.java``: the latest state is
+    sent to every robot every 500 ms and ``packetNumber`` goes up by 1 per packet (mod 256); a
+    state change sends nothing by itself."""
     port = robots["127.0.0.2"].getsockname()[1]
     net = GameControllerNetwork(
         bind_host="127.0.0.1", data_port=port, return_port=0, targets=list(robots),
         team_numbers={8: RED, 25: BLUE}, send_rate_hz=2.0, clock=SystemClock(),
     )
-    config = make_config()
-    ref = Referee(config=config, clock=FakeClock())
+    ref = Referee(config=make_config(), clock=FakeClock())
     with net:
-        net.publish(ref.packet(), changed=True)
-        got = receive_all(robots["127.0.0.3"], 1.6)
-        assert 3 <= len(got) <= 5, len(got)  # first at once, then every 0.5 s
-        data = decode_game_state(got[0][0], peer="test")
-        assert data.teams[0].team_number == 8 and data.teams[1].team_number == 25  # red on the left
-        assert got[0][1][0] == "127.0.0.1"
+        net.publish(ref.packet(), state_changed=True)
         ref.step(snapshot(0, (robot(RED, 1, -1, 0),)))  # INITIAL -> READY (no wait)
-        started = time.monotonic()
-        net.publish(ref.packet(), changed=True)
-        first = robots["127.0.0.4"].recvfrom(4096)
-        assert time.monotonic() - started < 0.3  # a change is sent at once
-        assert decode_game_state(first[0]).state in (0, 1)
-        assert wait_for(lambda: net.stats().packets_sent >= 5)
-        assert net.stats().datagrams_sent >= 3 * 5
+        for _ in range(20):  # state changes and refreshes: not one packet more
+            net.publish(ref.packet(), state_changed=True)
+            time.sleep(0.01)
+        got = receive_timed(robots["127.0.0.3"], 2.6)
+    times = [at for at, _ in got]
+    datas = [decode_game_state(raw, peer="test") for _, (raw, _) in got]
+    assert 5 <= len(got) <= 7, len(got)  # 2.6 s at 2 Hz, room for a loaded machine
+    assert [d.packet_number for d in datas] == list(
+        range(datas[0].packet_number, datas[0].packet_number + len(datas))
+    )
+    gaps = [b - a for a, b in zip(times[1:], times[2:], strict=False)]  # the first was queued
+    assert min(gaps) > 0.3, gaps  # never an extra packet between two ticks
+    assert datas[-1].state == 1 and datas[-1].teams[0].team_number == 8  # READY, red on the left
+    assert got[0][1][1][0] == "127.0.0.1"
+    assert net.stats().datagrams_sent >= 3 * len(got)
+
+
+def test_packet_numbers_wrap_at_256() -> None:
+    """League GameController ``Sender.java``: ``packetNumber`` is a byte that wraps."""
+    ref = Referee(config=make_config(), clock=FakeClock())
+    raw = ref.packet()
+    assert decode_game_state(with_packet_number(raw, 255)).packet_number == 255
+    assert decode_game_state(with_packet_number(raw, 256)).packet_number == 0
+    assert with_packet_number(raw, 3)[7:] == raw[7:]
+
+
+def test_a_game_state_left_before_its_tick_still_gets_one_packet(
+    robots: dict[str, socket.socket],
+) -> None:
+    """League referee (``referee.py``): it commands the next state only after it has seen the
+    GameController broadcast FINISHED, so robots always get a FINISHED packet; ours lasts one
+    step before the next period's INITIAL and goes out at its own tick, then INITIAL."""
+    port = robots["127.0.0.2"].getsockname()[1]
+    net = GameControllerNetwork(
+        bind_host="127.0.0.1", data_port=port, return_port=0, targets=["127.0.0.2"],
+        team_numbers={8: RED, 25: BLUE}, send_rate_hz=5.0, clock=SystemClock(),
+    )
+    ref = Referee(config=make_config(), clock=FakeClock())
+    first, second = bytearray(ref.packet()), bytearray(ref.packet())
+    first[9] = 1  # READY
+    second[9] = 4  # FINISHED
+    third = bytearray(ref.packet())
+    third[9] = 0  # INITIAL
+    with net:
+        net.publish(bytes(first), state_changed=True)
+        time.sleep(0.3)
+        net.publish(bytes(second), state_changed=True)
+        net.publish(bytes(third), state_changed=True)
+        got = receive_all(robots["127.0.0.2"], 0.8)
+    states = [decode_game_state(raw).state for raw, _ in got]
+    assert 4 in states and states.index(4) < states.index(0), states
+    assert states[states.index(4) + 1 :] == [0] * (len(states) - states.index(4) - 1), states
 
 
 def test_rgrt_tracking_and_garbage() -> None:
@@ -239,3 +304,28 @@ def test_rgrt_attributed_by_sender_address(tmp_path: Path,
     events = (tmp_path / "referee_events.jsonl").read_text().splitlines()
     assert sum('"type": "spoofing"' in line for line in events) == 3
     assert "spoofed: 21" in (tmp_path / "gamecontroller.log").read_text()
+
+
+def test_a_game_state_not_sent_yet_goes_out_when_the_network_closes(
+    robots: dict[str, socket.socket],
+) -> None:
+    """League referee (``referee.py``): after FINISHED the game runs on (``END_OF_GAME_TIMEOUT``)
+    while the GameController keeps broadcasting, so robots see FINISHED; a FINISHED entered
+    just before the network closes is sent as it closes."""
+    port = robots["127.0.0.2"].getsockname()[1]
+    net = GameControllerNetwork(
+        bind_host="127.0.0.1", data_port=port, return_port=0, targets=["127.0.0.2"],
+        team_numbers={8: RED, 25: BLUE}, send_rate_hz=2.0, clock=SystemClock(),
+    )
+    ref = Referee(config=make_config(), clock=FakeClock())
+    playing, finished = bytearray(ref.packet()), bytearray(ref.packet())
+    playing[9], finished[9] = 3, 4
+    with net:
+        net.publish(bytes(playing), state_changed=True)
+        assert wait_for(lambda: net.stats().packets_sent >= 1)
+        net.publish(bytes(finished), state_changed=True)
+    got = receive_all(robots["127.0.0.2"], 0.3)
+    states = [decode_game_state(raw).state for raw, _ in got]
+    assert states[-1] == 4, states
+    numbers = [decode_game_state(raw).packet_number for raw, _ in got]
+    assert numbers == list(range(numbers[0], numbers[0] + len(numbers)))

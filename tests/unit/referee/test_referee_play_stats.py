@@ -109,4 +109,4 @@ def test_the_referee_result_carries_the_play_record() -> None:
     assert isinstance(play, dict)
     assert play["halves_playing"] == [1, 2] and play["both_halves_playing"] is True
     assert play["kicks"] == {"red": 0, "blue": 0}
-    assert 2 * (10.0 - 5.0 - 1.0) - 0.1 < play["playing_s"] <= 8.0  # READY 5 s, SET 1 s a half
+    assert 2 * 10.0 - 0.1 < play["playing_s"] <= 20.0  # READY and SET before kick-off: no clock
