@@ -244,7 +244,7 @@ def test_robot_environment_names_the_team_number_the_stub_reads() -> None:
     from robot.stub.options import read_env
 
     robot = RobotPlan(color="blue", number=2, port=10022, image="img", team_id=13)
-    env = robot_environment(robot, team_net=Subnet(network=ipaddress.IPv4Network("10.213.7.0/24")), player_count=2,
-                            gamecontroller_ip=None)
+    subnet = Subnet(network=ipaddress.IPv4Network("10.213.7.0/24"))
+    env = robot_environment(robot, team_net=subnet, player_count=2, gamecontroller_ip=None)
     assert env["ROBOCUP_TEAM_ID"] == "13"
     assert read_env(env).team_id == 13
