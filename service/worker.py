@@ -14,7 +14,6 @@ is queued again at its old place, with a new attempt number (nothing is lost).
 
 from __future__ import annotations
 
-import json
 import logging
 import threading
 import zlib
@@ -141,13 +140,14 @@ class QueueWorker:
 
     def _prepare(self, session: Session, row: Submission) -> MatchJob:
         assert row.match_id is not None
-        team_doc = json.loads(teamfiles.get_by_id(session, row.team_file_id).content)
+        sealer = self.services.sealer
+        team_doc = teamfiles.opened(teamfiles.get_by_id(session, row.team_file_id), sealer)
         opponent_doc: dict[str, Any] | None = None
         if row.opponent != STUB:
             other = session.scalar(select(Team).where(Team.name == row.opponent))
             assert other is not None
-            opponent_doc = json.loads(teamfiles.get(session, team_id=other.id,
-                                                    kind="team_config").content)
+            opponent_doc = teamfiles.opened(teamfiles.get(session, team_id=other.id,
+                                                          kind="team_config"), sealer)
         work = self._work_dir(row.match_id)
         game = matchfiles.write_match(
             work / "config", match_id=row.match_id, team=team_doc, opponent=opponent_doc,
