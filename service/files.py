@@ -17,7 +17,10 @@ def private_dir(path: Path, *, only_if_new: bool = False) -> Path:
     existed (unless ``only_if_new``: a folder the service does not own, e.g. the one that
     holds the data folder)."""
     existed = path.is_dir()
-    path.mkdir(mode=DIR_MODE, parents=True, exist_ok=True)
+    if not existed:
+        if not path.parent.is_dir():
+            private_dir(path.parent, only_if_new=True)
+        path.mkdir(mode=DIR_MODE, exist_ok=True)
     if not existed or not only_if_new:
         path.chmod(DIR_MODE)
     return path

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import shlex
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -88,6 +89,8 @@ def build_team(
         return None
     players = [_player(number, document, field_class) for number in numbers]
     players = _resolve_models(players, source, where)
+    for player in players:
+        _check_command(player, where)
     if not document["players"]:
         where.warn(
             "/players", "the team has no players: it plays without robots (like HLVS Invisibles)"
@@ -248,6 +251,20 @@ def _check_pose(
                 f"({x:g}, {y:g}): the goalkeeper is not near the own goal",
                 expected=f"inside the own penalty area: x <= {x_limit:g} and |y| <= {y_limit:g}",
             )
+
+
+def _check_command(player: PlayerConfig, where: Collector) -> None:
+    """``dockerCmd`` splits like a shell line (it is split so when the robot starts)."""
+    if player.docker_cmd is None:
+        return
+    try:
+        shlex.split(player.docker_cmd)
+    except ValueError as exc:
+        where.error(
+            pointer("players", str(player.number), "dockerCmd"),
+            f"cannot be split into arguments: {exc}",
+            expected="a command line with every quote closed, e.g. \"python3 /robot/main.py\"",
+        )
 
 
 def _check_image(player: PlayerConfig, where: Collector) -> None:
