@@ -225,3 +225,17 @@ def test_an_episode_length_out_of_bounds_names_its_field() -> None:
         with pytest.raises(EnvConfigError) as refused:
             KickEnv(max_episode_s=value)
         assert refused.value.field == "max_episode_s"
+
+
+@pytest.mark.parametrize("seconds", [0.001, 1e9])
+def test_max_duration_out_of_bounds_is_refused_at_check(tmp_path: Path, seconds: float) -> None:
+    import shutil
+
+    from orchestrator.config import check_game
+
+    example = Path(__file__).parents[3] / "configs" / "examples" / "scrimmage_1v1"
+    shutil.copytree(example, tmp_path / "game")
+    game = tmp_path / "game" / "game.json"
+    game.write_text(json.dumps({**json.loads(game.read_text()), "max_duration": seconds}))
+    errors = [p for p in check_game(game) if p.severity == "error"]
+    assert [p.pointer for p in errors] == ["/max_duration"]
