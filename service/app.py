@@ -106,6 +106,11 @@ def create_app(
                              key_path=key_file(settings.data_dir, settings.secret_key_file))
         engine = make_engine(settings.db_url)
         migrate(engine)
+        from service.db import transaction
+        from service.teamfiles import seal_stored
+
+        with transaction(session_factory(engine)) as session:
+            seal_stored(session, sealer)  # secrets stored in the clear by an older version
         checker = None
         if preflight is None:
             from service.preflight import PreflightChecker

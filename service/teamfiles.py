@@ -31,7 +31,7 @@ from orchestrator.errors import ConfigError, Problem
 from service.db import TeamFile
 from service.errors import InvalidInput, NotFound
 from service.files import write_private
-from service.sealing import Sealer
+from service.sealing import PREFIX, Sealer
 
 log = logging.getLogger(__name__)
 
@@ -179,6 +179,27 @@ def opened(row: TeamFile, sealer: Sealer) -> Any:
     return sealer.open_document(row.kind, json.loads(row.content))
 
 
+def seal_stored(session: Session, sealer: Sealer) -> int:
+    """Seal every secret still stored in the clear (stored before sealing existed); returns
+    how many rows changed."""
+    from service.db import Team
+
+    changed = 0
+    for row in session.scalars(select(TeamFile)):
+        document = json.loads(row.content)
+        sealed = sealer.seal_document(row.kind, document)
+        if sealed != document:
+            row.content = json.dumps(sealed, indent=2, sort_keys=False)
+            changed += 1
+    for team in session.scalars(select(Team).where(Team.webhook_secret.is_not(None))):
+        if team.webhook_secret and not team.webhook_secret.startswith(PREFIX):
+            team.webhook_secret = sealer.seal(team.webhook_secret)
+            changed += 1
+    if changed:
+        log.info("%d stored secret(s) sealed", changed)
+    return changed
+
+
 def get_by_id(session: Session, file_id: int) -> TeamFile:
     row = session.get(TeamFile, file_id)
     if row is None:
@@ -193,4 +214,4 @@ def newest_id(session: Session, *, team_id: int, kind: str) -> int | None:
 
 
 __all__ = ["KINDS", "check", "get", "get_by_id", "newest_id", "opened", "raise_if_invalid",
-           "service_problems", "store", "versions"]
+           "seal_stored", "service_problems", "store", "versions"]

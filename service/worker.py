@@ -44,6 +44,13 @@ log = logging.getLogger(__name__)
 MAX_ATTEMPTS = 3
 
 
+class _Refused(Exception):
+    def __init__(self, cause: str, failure_class: str) -> None:
+        super().__init__(cause)
+        self.cause = cause
+        self.failure_class = failure_class
+
+
 class QueueWorker:
     def __init__(self, services: Services) -> None:
         self.services = services
@@ -118,7 +125,13 @@ class QueueWorker:
                 row.attempts += 1
                 row.match_id = f"{row.id}-a{row.attempts}"
                 row.cause = None
-                job = self._prepare(session, row)
+                try:
+                    job = self._prepare(session, row)
+                except _Refused as exc:  # a file stored before the service's rules
+                    self._end(session, row, SubmissionState.FAILED, cause=exc.cause,
+                              failure_class=exc.failure_class)
+                    self.services.changed(row.id)
+                    continue
                 row.pool_handle = None
                 seq = row.seq
             with transaction(sessions) as session:
@@ -148,6 +161,12 @@ class QueueWorker:
             assert other is not None
             opponent_doc = teamfiles.opened(teamfiles.get(session, team_id=other.id,
                                                           kind="team_config"), sealer)
+        for doc, failure_class, whose in ((team_doc, "team_startup", "the team file"),
+                                          (opponent_doc, "infrastructure", "the opponent's")):
+            _, refused = teamfiles.service_problems("team_config", doc)
+            if refused:  # never hand a match a host variable or a key-less ECR login
+                raise _Refused(f"{whose} team_config.json: {refused[0].pointer}: "
+                               f"{refused[0].message}", failure_class)
         work = self._work_dir(row.match_id)
         game = matchfiles.write_match(
             work / "config", match_id=row.match_id, team=team_doc, opponent=opponent_doc,

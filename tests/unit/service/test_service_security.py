@@ -239,3 +239,48 @@ def test_max_duration_out_of_bounds_is_refused_at_check(tmp_path: Path, seconds:
     game.write_text(json.dumps({**json.loads(game.read_text()), "max_duration": seconds}))
     errors = [p for p in check_game(game) if p.severity == "error"]
     assert [p.pointer for p in errors] == ["/max_duration"]
+
+
+def test_files_stored_by_an_older_version_are_sealed_and_checked_again(
+        start: Any, token: Any, settings: Settings) -> None:
+    from sqlalchemy import select
+
+    from service.db import Team, TeamFile, make_engine, session_factory, transaction
+
+    tok = token("Old")
+    doc = team_doc("Old")
+    doc["registry_auth"] = {"username": "old", "password_env": "HOME", "password": "plain-pw"}
+    engine = make_engine(settings.db_url)
+    with transaction(session_factory(engine)) as session:
+        team = session.scalar(select(Team).where(Team.name == "Old"))
+        assert team is not None
+        team.webhook_secret = "plain-webhook-secret"
+        session.add(TeamFile(team_id=team.id, kind="team_config", version=1,
+                             content=json.dumps(doc), sha256="0" * 64, valid=True,
+                             problems_json="[]"))
+    served = start()
+    with transaction(session_factory(engine)) as session:
+        row = session.scalar(select(TeamFile))
+        team = session.scalar(select(Team).where(Team.name == "Old"))
+        assert row is not None and team is not None
+        assert "plain-pw" not in row.content and sealing.PREFIX in row.content
+        assert team.webhook_secret is not None and sealing.is_sealed(team.webhook_secret)
+    engine.dispose()
+    with served.client(tok) as http:
+        refused = http.post("/v1/submissions", json={})
+        assert refused.status_code == 422, refused.text
+        assert "/registry_auth/password_env" in [p["pointer"] for p in
+                                                 refused.json()["problems"]]
+
+
+def test_hlvs_submit_sends_a_key_file_as_its_text(tmp_path: Path) -> None:
+    from service.client import inline_key
+
+    key = "-----BEGIN OPENSSH PRIVATE KEY-----\nk\n-----END OPENSSH PRIVATE KEY-----\n"
+    (tmp_path / "id_team").write_text(key)
+    source = tmp_path / "credentials.json"
+    document = {"type": "sftp", "credentials": {"hostname": "h", "username": "u",
+                                                "private_key": "id_team"}}
+    assert inline_key(document, source)["credentials"]["private_key"] == key
+    missing = {"type": "sftp", "credentials": {"private_key": "nope"}}
+    assert inline_key(missing, source) == missing
