@@ -44,13 +44,14 @@ def test_a_sealed_secret_opens_only_with_its_key_and_old_plain_values_pass() -> 
 
 def test_documents_have_every_secret_sealed_and_nothing_else() -> None:
     sealer = sealing.Sealer(Fernet.generate_key())
-    team = {"name": "A", "registry_auth": {"username": "u", "password": "p1",
+    team = {"name": "A", "registry_auth": {"username": "u", "password": "pw-of-the-registry",
                                            "ecr": {"region": "r", "access_id": "id",
-                                                   "access_secret": "s1"}}}
+                                                   "access_secret": "secret-of-ecr"}}}
     sealed = sealer.seal_document("team_config", team)
     assert sealed["registry_auth"]["username"] == "u"
     assert sealed["registry_auth"]["ecr"]["access_id"] == "id"
-    assert "p1" not in json.dumps(sealed) and "s1" not in json.dumps(sealed)
+    assert "pw-of-the-registry" not in json.dumps(sealed)
+    assert "secret-of-ecr" not in json.dumps(sealed)
     assert sealer.open_document("team_config", sealed) == team
     creds = {"type": "sftp", "credentials": {"hostname": "h", "username": "u", "password": "p2",
                                              "private_key": "-----BEGIN k", "host_key": "x y"}}
@@ -58,7 +59,7 @@ def test_documents_have_every_secret_sealed_and_nothing_else() -> None:
     assert {k for k, v in sealed["credentials"].items() if sealing.is_sealed(v)} == {
         "password", "private_key"}
     assert sealer.open_document("credentials", sealed) == creds
-    assert team["registry_auth"]["password"] == "p1"  # the input is left as it was
+    assert team["registry_auth"]["password"] == "pw-of-the-registry"  # the input is left as it was
 
 
 def test_the_key_file_is_made_once_0600_beside_the_data_folder(tmp_path: Path) -> None:
