@@ -311,6 +311,10 @@ def test_hostile_json_gets_a_4xx_naming_the_field(
         version = http.post("/v1/submissions", json={"team_config_version": 1e30})
         assert version.status_code == 422
         assert version.json()["problems"][0]["pointer"] == "/team_config_version"
+        env = http.post("/v1/envs/", json={"env_id": "hlvs/Kick-v0",
+                                           "kwargs": {"max_episode_s": 1e308}})
+        assert env.status_code == 422, env.text
+        assert env.json()["problems"][0]["pointer"] == "/kwargs/max_episode_s"
         cmd = team_doc("Mallory")
         cmd["players"]["1"]["dockerCmd"] = "python3 -c 'unclosed"
         unclosed = http.put("/v1/team/files/team_config", json=cmd)
