@@ -42,6 +42,7 @@ class BodyLimit:
         if scope["type"] != "http":
             await self.app(scope, receive, send)
             return
+        has_body = False
         for name, value in scope["headers"]:
             if name == b"content-length":
                 declared = value.decode("latin-1")
@@ -50,7 +51,12 @@ class BodyLimit:
                         f"the body of {declared} bytes is over the limit of "
                         f"{self.max_bytes} bytes")})
                     return
-                break
+                has_body = True
+            elif name == b"transfer-encoding":
+                has_body = True
+        if not has_body:  # HTTP/1.1: neither header, no body (a status poll)
+            await self.app(scope, receive, send)
+            return
         received = 0
         started = False
 
