@@ -170,7 +170,7 @@ class AfterMatch:
         out = self.services.pool.results_dir(handle)
         work = private_dir((self.settings.matches_dir / match_id).resolve())
         credentials = write_private(work / CREDENTIALS_FILE, json.dumps(document))
-        store = self.settings.data_dir.resolve() / LOG_STORE
+        store = private_dir(self.settings.data_dir.resolve() / LOG_STORE)
         if not any(s.match_id == match_id and s.team == team for s in list_sets(store)):
             made = enqueue_match_logs(out, match_id=match_id,
                                       teams={OWN_COLOR: (team, credentials)},

@@ -119,9 +119,10 @@ def _bench(args: argparse.Namespace) -> int:
 
 def _sessions(args: argparse.Namespace) -> Any:
     from service.db import make_engine, migrate, session_factory
+    from service.files import private_dir
 
     settings = _settings(args)
-    settings.data_dir.mkdir(parents=True, exist_ok=True)
+    private_dir(settings.data_dir)
     engine = make_engine(settings.db_url)
     migrate(engine)
     return session_factory(engine)
