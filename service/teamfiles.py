@@ -27,6 +27,7 @@ from sqlalchemy import func, select
 from sqlalchemy.orm import Session
 
 from orchestrator.config import FieldClass, check_team
+from orchestrator.config.robot_models import BUILT_IN_MODELS
 from orchestrator.errors import ConfigError, Problem
 from service.db import TeamFile
 from service.errors import InvalidInput, NotFound
@@ -69,7 +70,7 @@ def service_problems(kind: str, document: Any) -> tuple[Any, list[Problem]]:
                 "ECR without access_id and access_secret is not accepted by the service "
                 "(it would sign with the league's AWS key)",
                 "the team's own access_id and access_secret (stored encrypted)"))
-        return document, problems
+        return _builtin_models_only(document, problems)
     body = document.get("credentials")
     if document.get("type") != "sftp" or not isinstance(body, dict):
         return document, problems
@@ -93,6 +94,25 @@ def service_problems(kind: str, document: Any) -> tuple[Any, list[Problem]]:
             name, "/credentials/host_key", "an SFTP target needs its pinned host key in the "
             "service", '"host_key": the server\'s key as in known_hosts, "ssh-ed25519 AAAA..."'))
     return {**document, "credentials": cleaned}, problems
+
+
+def _builtin_models_only(document: dict[str, Any],
+                         problems: list[Problem]) -> tuple[Any, list[Problem]]:
+    """A robot model package is a folder of the host that reads the file: refused (and taken
+    out, unread) in the service, which plays the built-in models."""
+    players = document.get("players")
+    if not isinstance(players, dict):
+        return document, problems
+    kept = dict(players)
+    for number, entry in players.items():
+        model = entry.get("model") if isinstance(entry, dict) else None
+        if isinstance(model, str) and model not in BUILT_IN_MODELS:
+            problems.append(Problem(
+                KINDS["team_config"], f"/players/{number}/model",
+                "a robot model package is not accepted by the service (its folder would be "
+                "one of the league's host)", "one of " + ", ".join(BUILT_IN_MODELS)))
+            kept[number] = {k: v for k, v in entry.items() if k != "model"}
+    return {**document, "players": kept}, problems
 
 
 def check(kind: str, document: Any) -> list[dict[str, str]]:

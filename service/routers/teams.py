@@ -152,7 +152,6 @@ def get_version(kind: str, version: int, principal: TeamPrincipal,
     assert principal.team_id is not None
     row = teamfiles.get(session, team_id=principal.team_id, kind=kind, version=version)
     content = _masked(json.loads(row.content))
-
     return FileContent(**_version(row).model_dump(), content=content)
 
 

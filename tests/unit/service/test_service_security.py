@@ -98,6 +98,14 @@ def test_registry_logins_must_be_the_teams_own() -> None:
     assert _errors("team_config", doc) == {}
 
 
+def test_a_robot_model_folder_of_the_host_is_refused(tmp_path: Path) -> None:
+    doc = team_doc()
+    doc["players"]["1"]["model"] = "kid-default"
+    assert _errors("team_config", doc) == {}
+    doc["players"]["1"]["model"] = str(tmp_path)  # a folder of the host: never read
+    assert list(_errors("team_config", doc)) == ["/players/1/model"]
+
+
 def test_sftp_credentials_are_inline_and_pinned(tmp_path: Path) -> None:
     key = "-----BEGIN OPENSSH PRIVATE KEY-----\nabc\n-----END OPENSSH PRIVATE KEY-----\n"
     pinned = "ssh-ed25519 AAAAC3NzaC1lZDI1NTE5AAAAILxD7/6Y8WqDP6ruY81+KhRD3hE1yx9rKAmI0vF5eFKN"
