@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import json
 from datetime import datetime
-from typing import Any
+from typing import Annotated, Any
 
 from fastapi import APIRouter, FastAPI, Request
+from fastapi import Path as PathParam
 from pydantic import BaseModel, ConfigDict, Field, HttpUrl
 from starlette.concurrency import run_in_threadpool
 
@@ -146,7 +147,8 @@ def list_versions(kind: str, principal: TeamPrincipal, session: DbSession) -> li
 
 
 @router.get("/files/{kind}/{version}")
-def get_version(kind: str, version: int, principal: TeamPrincipal,
+def get_version(kind: str, version: Annotated[int, PathParam(ge=1, le=2**31 - 1)],
+                principal: TeamPrincipal,
                 session: DbSession) -> FileContent:
     """One stored version (``credentials`` are returned with their secrets masked)."""
     assert principal.team_id is not None

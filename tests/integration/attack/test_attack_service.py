@@ -308,6 +308,8 @@ def test_hostile_json_gets_a_4xx_naming_the_field(
                                       path, content=body, headers=headers)
                 assert 400 <= answer.status_code < 500, (path, body[:20], answer.text[:300])
                 assert "Traceback" not in answer.text
+        huge = http.get("/v1/team/files/team_config/" + "9" * 30)
+        assert huge.status_code == 422 and huge.json()["problems"][0]["pointer"] == "/version"
         version = http.post("/v1/submissions", json={"team_config_version": 1e30})
         assert version.status_code == 422
         assert version.json()["problems"][0]["pointer"] == "/team_config_version"
