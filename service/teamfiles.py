@@ -201,12 +201,17 @@ def opened(row: TeamFile, sealer: Sealer) -> Any:
 
 def seal_stored(session: Session, sealer: Sealer) -> int:
     """Seal every secret still stored in the clear (stored before sealing existed); returns
-    how many rows changed."""
+    how many rows changed. :class:`~service.errors.SettingsError` when a sealed secret does
+    not open with ``sealer`` (the service was started with another key)."""
     from service.db import Team
 
     changed = 0
+    opened_one = False
     for row in session.scalars(select(TeamFile)):
         document = json.loads(row.content)
+        if not opened_one and PREFIX in row.content:
+            sealer.open_document(row.kind, document)  # raises with the wrong key
+            opened_one = True
         sealed = sealer.seal_document(row.kind, document)
         if sealed != document:
             row.content = json.dumps(sealed, indent=2, sort_keys=False)

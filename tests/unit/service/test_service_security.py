@@ -295,3 +295,15 @@ def test_hlvs_submit_sends_a_key_file_as_its_text(tmp_path: Path) -> None:
     assert inline_key(document, source)["credentials"]["private_key"] == key
     missing = {"type": "sftp", "credentials": {"private_key": "nope"}}
     assert inline_key(missing, source) == missing
+
+
+def test_the_service_does_not_start_with_a_key_that_opens_nothing(
+        start: Any, token: Any, settings: Settings) -> None:
+    served = start()
+    with served.client(token("Alpha")) as http:
+        doc = team_doc("Alpha")
+        doc["registry_auth"] = {"username": "a", "password": "pw-alpha-registry"}
+        assert http.put("/v1/team/files/team_config", json=doc).status_code == 201
+    served.stop()
+    with pytest.raises(RuntimeError):  # the lifespan fails: the service does not start
+        start(secret_key=Fernet.generate_key().decode())
