@@ -252,7 +252,8 @@ def main(argv: Sequence[str]) -> int:
     team_doc["image"] = repository
     team_doc["players"]["1"]["dockerTag"] = tag
     with tempfile.TemporaryDirectory(prefix="hlvs-bench-service-") as folder:
-        data = Path(folder)
+        data = Path(folder) / "data"  # the service's key file goes beside it, in folder
+        data.mkdir(mode=0o700)
         database = args.database_url or f"sqlite:///{data / 'service.sqlite'}"
         tokens, operator = _setup(database, data, args.pollers + args.submitters)
         port = args.port or _free_port()

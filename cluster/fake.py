@@ -20,6 +20,7 @@ from contracts.match_results import (
     MatchResults,
     RobotResult,
 )
+from orchestrator.private_files import private_dir, write_private
 
 
 class FakePool:
@@ -37,8 +38,8 @@ class FakePool:
         self.handles[handle] = job.match_id
         marker = job.work_dir / "running"
         if not marker.exists() and not (self.results_dir(handle) / files.REPORT).exists():
-            job.work_dir.mkdir(parents=True, exist_ok=True)
-            marker.write_text(job.match_id)
+            private_dir(job.work_dir)
+            write_private(marker, job.match_id)
             self.started.append(job.match_id)
         return handle
 

@@ -23,6 +23,7 @@ from cluster import JobState, JobStatus, MatchJob
 from cluster.errors import PoolError
 from cluster.nodes import NodeJob, PoolNode
 from contracts import files
+from orchestrator.private_files import open_private_append, write_private
 
 log = logging.getLogger(__name__)
 
@@ -77,7 +78,7 @@ class LocalDockerPool:
             out.mkdir(parents=True, exist_ok=True)
             command = [self.python, "-m", "hlvs", *self.extra_args, "match",
                        str(job.game_path.resolve()), "--out", str(out)]
-            with (job.work_dir / LOG_FILE).open("ab") as log_file:
+            with os.fdopen(open_private_append(job.work_dir / LOG_FILE), "ab") as log_file:
                 try:
                     child = subprocess.Popen(command, stdout=log_file, stderr=subprocess.STDOUT,
                                              stdin=subprocess.DEVNULL, start_new_session=True)
@@ -86,9 +87,7 @@ class LocalDockerPool:
                         from exc
             started = process_start_time(child.pid)
             state = {"pid": child.pid, "start_time": started, "match_id": job.match_id}
-            tmp = job.work_dir / (STATE_FILE + ".tmp")
-            tmp.write_text(json.dumps(state))
-            tmp.replace(job.work_dir / STATE_FILE)
+            write_private(job.work_dir / STATE_FILE, json.dumps(state))
             self._children[handle] = child
             self._seen.add(handle)
             log.info("match %s started in the local pool (pid %d)", job.match_id, child.pid)

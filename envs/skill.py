@@ -35,6 +35,7 @@ PROGRESS_WEIGHT = 2.0
 GOAL_REWARD = 10.0
 FALL_PENALTY = 1.0
 FALLEN_UP_Z = 0.5  # cos(60 deg)
+MAX_EPISODE_S = 3600.0  # an hour of simulated time: far past any skill episode
 
 
 class KickEnv(HlvsEnv):
@@ -62,8 +63,9 @@ class KickEnv(HlvsEnv):
                 value=ball_distance_m,
                 expected="(low, high) with 0.15 <= low <= high",
             )  # fmt: skip
-        if max_episode_s <= 0:
-            raise EnvConfigError(field="max_episode_s", value=max_episode_s, expected="> 0")
+        if not 0 < max_episode_s <= MAX_EPISODE_S:
+            raise EnvConfigError(field="max_episode_s", value=max_episode_s,
+                                 expected=f"seconds, > 0 and <= {MAX_EPISODE_S:g}")
         spec = SessionSpec(
             field_class=field_class, model=model, camera=camera or render_mode == "rgb_array",
             perception=perception, perception_noise=perception_noise,

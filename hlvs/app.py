@@ -1,7 +1,7 @@
-"""The submission service as ``hlvs serve`` serves it: the service's API with the web pages
-(:mod:`viewer.service_pages`) and the HTTP environment API (:mod:`envs.http_api`) mounted.
+"""The submission service as ``hlvs serve`` serves it: the service's API (with the HTTP
+environment API) and the web pages of :mod:`viewer.service_pages` mounted.
 
-The service knows neither: they sit above it and hand their ``mount`` here.
+The service does not know the pages: they sit above it and hand their ``mount`` here.
 """
 
 from __future__ import annotations

@@ -44,6 +44,8 @@ from sqlalchemy import select
 
 from cluster.local import process_start_time
 from contracts import files
+from orchestrator.private_files import open_private_append, private_dir, write_private
+from service import teamfiles
 from service.db import MediaState, Submission, Team, TeamFile, transaction
 from service.matchfiles import OWN_COLOR
 
@@ -161,13 +163,14 @@ class AfterMatch:
 
         if match_id is None or handle is None or content is None:
             return MediaState.FAILED, "the match left no logs, or no credentials were given"
+        document = self.services.sealer.open_document("credentials", json.loads(content))
+        _, refused = teamfiles.service_problems("credentials", document)
+        if refused:  # stored before the service's rules: never read the host's files for it
+            return MediaState.FAILED, str(refused[0]).replace(refused[0].file, CREDENTIALS_FILE)
         out = self.services.pool.results_dir(handle)
-        work = (self.settings.matches_dir / match_id).resolve()
-        work.mkdir(parents=True, exist_ok=True)
-        credentials = work / CREDENTIALS_FILE
-        credentials.write_text(content, encoding="utf-8")
-        credentials.chmod(0o600)
-        store = self.settings.data_dir.resolve() / LOG_STORE
+        work = private_dir((self.settings.matches_dir / match_id).resolve())
+        credentials = write_private(work / CREDENTIALS_FILE, json.dumps(document))
+        store = private_dir(self.settings.data_dir.resolve() / LOG_STORE)
         if not any(s.match_id == match_id and s.team == team for s in list_sets(store)):
             made = enqueue_match_logs(out, match_id=match_id,
                                       teams={OWN_COLOR: (team, credentials)},
@@ -232,9 +235,9 @@ class AfterMatch:
         command = [*_idle_priority(), self.python, "-m", "simulator", "render",
                    str(replay_of(out)), "-o", str(partial), "--width", str(s.video_width),
                    "--height", str(s.video_height), "--fps", f"{s.video_fps:g}"]
-        work.mkdir(parents=True, exist_ok=True)
+        private_dir(work)
         env = {**os.environ, "HLVS_PROGRESS": "plain", "HLVS_PROG": "hlvs"}
-        with (work / RENDER_LOG).open("ab") as log_file:
+        with os.fdopen(open_private_append(work / RENDER_LOG), "ab") as log_file:
             try:
                 process = subprocess.Popen(command, stdout=log_file, stderr=subprocess.STDOUT,
                                            stdin=subprocess.DEVNULL, env=env,
@@ -242,11 +245,9 @@ class AfterMatch:
             except OSError as exc:
                 self._set(row, MediaState.FAILED, f"hlvs render could not start: {exc}")
                 return
-        tmp = work / (RENDER_STATE + ".tmp")
-        tmp.write_text(json.dumps({"pid": process.pid,
-                                   "start_time": process_start_time(process.pid),
-                                   "renders": renders}))
-        tmp.replace(work / RENDER_STATE)
+        write_private(work / RENDER_STATE, json.dumps({
+            "pid": process.pid, "start_time": process_start_time(process.pid),
+            "renders": renders}))
         self._render = _Render(submission_id=row.id, process=process, started=time.monotonic(),
                                partial=partial, video=video_of(out))
         log.info("submission %s: rendering the video of match %s (pid %d)", row.id,

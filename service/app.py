@@ -65,6 +65,7 @@ class Services:
     queue: Any = None  # service.submissions.QueueBoard
     tokens: Any = None  # service.tokens.TokenCache
     status: Any = None  # service.statusboard.StatusBoard
+    sealer: Any = None  # service.sealing.Sealer: the secrets stored in the database
 
     def slots(self) -> int:
         return int(self.pool.slots) if self.pool is not None else self.settings.match_slots
@@ -105,9 +106,20 @@ def create_app(
 
         # Request handlers run in this many threads: more only fight over the GIL.
         anyio.to_thread.current_default_thread_limiter().total_tokens = settings.threads
-        settings.data_dir.mkdir(parents=True, exist_ok=True)
+        from orchestrator.private_files import private_dir
+        from service.sealing import key_file, load_sealer
+
+        private_dir(settings.data_dir)  # 0700; the files below it are 0600
+        private_dir(settings.matches_dir)
+        sealer = load_sealer(key=settings.secret_key,
+                             key_path=key_file(settings.data_dir, settings.secret_key_file))
         engine = make_engine(settings.db_url)
         migrate(engine)
+        from service.db import transaction
+        from service.teamfiles import seal_stored
+
+        with transaction(session_factory(engine)) as session:
+            seal_stored(session, sealer)  # secrets stored in the clear by an older version
         checker = None
         if preflight is None:
             from service.preflight import PreflightChecker
@@ -122,7 +134,7 @@ def create_app(
                             preflight=preflight or checker,
                             queue=QueueBoard(times=MatchTimes(
                                 default_s=settings.expected_match_s)),
-                            tokens=TokenCache(ttl_s=settings.token_cache_s))
+                            tokens=TokenCache(ttl_s=settings.token_cache_s), sealer=sealer)
         services.status = StatusBoard(render=lambda session, row, team: submission_view(
             session, row, settings, slots=services.slots(), queue=services.queue,
             team_name=team).model_dump_json().encode(), ttl_s=settings.status_board_s,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from typing import Any
 
 from fastapi import Request
@@ -31,7 +32,8 @@ async def read_json_body(request: Request, *, limit_bytes: int, name: str) -> An
         chunks.append(chunk)
     raw = b"".join(chunks)
     try:
-        return json.loads(raw.decode("utf-8"))
+        document = json.loads(raw.decode("utf-8"), parse_float=_finite, parse_int=_integer,
+                              parse_constant=_no_constant)
     except UnicodeDecodeError as exc:
         raise InvalidInput(f"{name}: not UTF-8 text (byte {exc.start})", problems=[
             {"file": name, "pointer": "", "message": "not UTF-8 text", "expected": "UTF-8"}
@@ -43,6 +45,68 @@ async def read_json_body(request: Request, *, limit_bytes: int, name: str) -> An
                        "message": f"invalid JSON at line {exc.lineno} column {exc.colno}: "
                                   f"{exc.msg}"}],
         ) from None
+    except RecursionError:
+        raise _unreadable(name, "", f"nested deeper than {MAX_DEPTH} levels",
+                          f"at most {MAX_DEPTH} levels of nesting") from None
+    except _BadNumber as exc:
+        raise _unreadable(name, "", str(exc), "a finite number of at most "
+                          f"{MAX_DIGITS} digits") from None
+    deep = _too_deep(document)
+    if deep is not None:
+        raise _unreadable(name, deep, f"nested deeper than {MAX_DEPTH} levels",
+                          f"at most {MAX_DEPTH} levels of nesting")
+    return document
+
+
+MAX_DEPTH = 64
+"""Nesting a JSON body may have (a team file needs 5)."""
+MAX_DIGITS = 400
+
+
+class _BadNumber(ValueError):
+    pass
+
+
+def _finite(text: str) -> float:
+    value = float(text)
+    if len(text) > MAX_DIGITS or not math.isfinite(value):
+        raise _BadNumber(f"the number {text[:20]}{'...' if len(text) > 20 else ''} is out of "
+                         "range")
+    return value
+
+
+def _integer(text: str) -> int:
+    if len(text) > MAX_DIGITS:
+        raise _BadNumber(f"the number {text[:20]}... has {len(text)} digits")
+    return int(text)
+
+
+def _no_constant(text: str) -> float:
+    raise _BadNumber(f"{text} is not a JSON number")
+
+
+def _too_deep(document: Any) -> str | None:
+    """The JSON pointer of a value nested deeper than :data:`MAX_DEPTH`, None when none is
+    (walked without recursion)."""
+    stack: list[tuple[Any, str, int]] = [(document, "", 0)]
+    while stack:
+        value, at, depth = stack.pop()
+        if depth > MAX_DEPTH:
+            return at
+        if isinstance(value, dict):
+            stack.extend((v, f"{at}/{_escape(str(k))}", depth + 1) for k, v in value.items())
+        elif isinstance(value, list):
+            stack.extend((v, f"{at}/{i}", depth + 1) for i, v in enumerate(value))
+    return None
+
+
+def _escape(key: str) -> str:
+    return key.replace("~", "~0").replace("/", "~1")
+
+
+def _unreadable(name: str, pointer: str, message: str, expected: str) -> InvalidInput:
+    return InvalidInput(f"{name}: {pointer or '/'}: {message}", problems=[
+        {"file": name, "pointer": pointer, "message": message, "expected": expected}])
 
 
 __all__ = ["read_json_body"]

@@ -161,6 +161,24 @@ def _load_json(path: Path) -> Any:
                            f"{exc.msg}") from None
 
 
+def inline_key(document: Any, source: Path) -> Any:
+    """credentials.json with an SFTP ``private_key`` path replaced by the key's text (read
+    here, on the team's machine: the service reads no path). Left as it is when unreadable,
+    for the service to say so."""
+    body = document.get("credentials") if isinstance(document, dict) else None
+    key = body.get("private_key") if isinstance(body, dict) else None
+    if not isinstance(body, dict) or not isinstance(key, str) or \
+            key.lstrip().startswith("-----BEGIN"):
+        return document
+    path = Path(key).expanduser()
+    path = path if path.is_absolute() else source.parent / path
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return document
+    return {**document, "credentials": {**body, "private_key": text}}
+
+
 def _print(data: Any) -> None:
     print(json.dumps(data, indent=2, sort_keys=True))
 
@@ -170,7 +188,10 @@ def run_submit(args: argparse.Namespace) -> int:
     try:
         for kind, path in (("team_config", args.team_config), ("credentials", args.credentials)):
             if path is not None:
-                stored = api.call("PUT", f"/v1/team/files/{kind}", json=_load_json(path))
+                document = _load_json(path)
+                if kind == "credentials":
+                    document = inline_key(document, path)
+                stored = api.call("PUT", f"/v1/team/files/{kind}", json=document)
                 print(f"hlvs: {path} stored as {kind} version {stored['version']}",
                       file=sys.stderr)
         status = api.call("POST", "/v1/submissions", json={"opponent": args.opponent})

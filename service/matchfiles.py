@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from orchestrator.match.scrimmage import game_file, team_file
+from orchestrator.private_files import private_dir, write_private
 from service.settings import Settings
 
 OWN_COLOR = "red"
@@ -38,10 +39,10 @@ def write_match(folder: Path, *, match_id: str, team: dict[str, Any],
     game = game_file(args, match_id)
     game["red"]["ports"] = _ports(10000, team)
     game["blue"]["ports"] = _ports(10020, opponent)
-    folder.mkdir(parents=True, exist_ok=True)
+    private_dir(folder)  # the team files hold registry logins
     files = {"game.json": game, "team_red.json": team, "team_blue.json": opponent}
     for name, content in files.items():
-        (folder / name).write_text(json.dumps(content, indent=2) + "\n", encoding="utf-8")
+        write_private(folder / name, json.dumps(content, indent=2) + "\n")
     return folder / "game.json"
 
 

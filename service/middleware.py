@@ -1,7 +1,8 @@
 """ASGI middlewares of the service (plain ASGI: no task or stream per request).
 
-- :class:`BodyLimit`: a body declared larger than ``max_upload_bytes`` is refused (413) before
-  it is read.
+- :class:`BodyLimit`: a body larger than ``max_upload_bytes`` is refused (413): at once when
+  its Content-Length says so, else as soon as the bytes read so far pass the limit (a chunked
+  body has no Content-Length), before any route, token check or body parser holds more.
 - :class:`StatusFastPath`: ``GET /v1/submissions/<id>`` answered from the status board
   (:mod:`service.statusboard`) when the caller's token is in the token cache and the board
   holds that team's submission; anything else goes on to the routes, which answer the same
@@ -14,7 +15,8 @@ import json
 import re
 from typing import TYPE_CHECKING, Any
 
-from starlette.types import ASGIApp, Receive, Scope, Send
+from starlette.exceptions import HTTPException
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from service.db import Scope as TokenScope
 
@@ -24,23 +26,61 @@ if TYPE_CHECKING:
 STATUS_PATH = re.compile(r"^/v1/submissions/([A-Za-z0-9_]{1,32})$")
 
 
+class BodyTooLarge(HTTPException):
+    """Raised by the counting ``receive`` of :class:`BodyLimit` (answered 413)."""
+
+    def __init__(self, limit: int) -> None:
+        super().__init__(413, f"the body is over the limit of {limit} bytes")
+
+
 class BodyLimit:
     def __init__(self, app: ASGIApp, *, max_bytes: int) -> None:
         self.app = app
         self.max_bytes = max_bytes
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
-        if scope["type"] == "http":
-            for name, value in scope["headers"]:
-                if name == b"content-length":
-                    declared = value.decode("latin-1")
-                    if declared.isdigit() and int(declared) > self.max_bytes:
-                        await _send_json(send, 413, {"error": "too_large", "message": (
-                            f"the body of {declared} bytes is over the limit of "
-                            f"{self.max_bytes} bytes")})
-                        return
-                    break
-        await self.app(scope, receive, send)
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        has_body = False
+        for name, value in scope["headers"]:
+            if name == b"content-length":
+                declared = value.decode("latin-1")
+                if declared.isdigit() and int(declared) > self.max_bytes:
+                    await _send_json(send, 413, {"error": "too_large", "message": (
+                        f"the body of {declared} bytes is over the limit of "
+                        f"{self.max_bytes} bytes")})
+                    return
+                has_body = True
+            elif name == b"transfer-encoding":
+                has_body = True
+        if not has_body:  # HTTP/1.1: neither header, no body (a status poll)
+            await self.app(scope, receive, send)
+            return
+        received = 0
+        started = False
+
+        async def counted() -> Message:
+            nonlocal received
+            message = await receive()
+            if message["type"] == "http.request":
+                received += len(message.get("body", b""))
+                if received > self.max_bytes:
+                    raise BodyTooLarge(self.max_bytes)
+            return message
+
+        async def tracked(message: Message) -> None:
+            nonlocal started
+            if message["type"] == "http.response.start":
+                started = True
+            await send(message)
+
+        try:
+            await self.app(scope, counted, tracked)
+        except BodyTooLarge as exc:  # read outside a route (the routes answer it themselves)
+            if started:
+                raise
+            await _send_json(send, 413, {"error": "too_large", "message": str(exc.detail)})
 
 
 class StatusFastPath:
@@ -87,4 +127,4 @@ async def _send_json(send: Send, status: int, content: dict[str, Any]) -> None:
     await send({"type": "http.response.body", "body": body})
 
 
-__all__ = ["BodyLimit", "STATUS_PATH", "StatusFastPath"]
+__all__ = ["BodyLimit", "BodyTooLarge", "STATUS_PATH", "StatusFastPath"]

@@ -20,7 +20,7 @@ import httpx
 from sqlalchemy import select
 from sqlalchemy.orm import Session
 
-from service import webhooks
+from service import outbound, webhooks
 from service.db import Notification, Submission, Team, now, transaction, utc
 from service.settings import Settings
 
@@ -93,7 +93,11 @@ class Notifier:
         self.settings = services.settings
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
-        self._http = httpx.Client(timeout=self.settings.webhook_timeout_s)
+        # no proxy from the environment and no redirect: a delivery goes to the address that
+        # service.outbound checked, and nowhere else
+        self._http = httpx.Client(timeout=self.settings.webhook_timeout_s, trust_env=False,
+                                  follow_redirects=False)
+        self._allowed = outbound.allowed_networks(self.settings)
 
     def start(self) -> None:
         self._thread = threading.Thread(target=self._run, name="notifier", daemon=True)
@@ -136,9 +140,11 @@ class Notifier:
                 else:
                     if not url:
                         raise ValueError("the team has no webhook URL any more")
-                    headers = webhooks.sign(secret or "", delivery_id=delivery_id, event=event,
+                    key = self.services.sealer.open(secret) if secret else ""
+                    headers = webhooks.sign(key, delivery_id=delivery_id, event=event,
                                             body=body.encode())
-                    answer = self._http.post(url, content=body.encode(), headers=headers)
+                    answer = outbound.post(self._http, url, content=body.encode(),
+                                           headers=headers, allowed=self._allowed)
                     if answer.status_code >= 300:
                         raise ValueError(f"HTTP {answer.status_code} from {url}")
             except (OSError, ValueError, smtplib.SMTPException, httpx.HTTPError) as exc:

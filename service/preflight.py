@@ -23,13 +23,14 @@ import secrets
 import tempfile
 import threading
 import time
-from dataclasses import replace
+from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
 from orchestrator.config import Limits, load_team
-from orchestrator.errors import ImageTooLarge, OrchestratorError
-from service.errors import PreflightFailed
+from orchestrator.errors import ConfigError, ImageTooLarge, OrchestratorError
+from orchestrator.private_files import write_private
+from service.errors import InvalidInput, PreflightFailed
 from service.settings import Settings
 
 log = logging.getLogger(__name__)
@@ -71,11 +72,19 @@ def run(team_doc: dict[str, Any], *, settings: Settings,
 
     With ``teardowns``, stopping the check's containers happens in a background thread added
     to that list (the answer does not wait for it); without, before returning."""
+    from service import teamfiles
+
     started = time.monotonic()
+    # the upload's check (service rules included): a file stored under older rules is refused
+    # here with the same problems, before anything of it is used
+    teamfiles.raise_if_invalid("team_config", team_doc)
     with tempfile.TemporaryDirectory(prefix="hlvs-preflight-") as folder:
-        path = Path(folder) / "team_config.json"
-        path.write_text(json.dumps(team_doc), encoding="utf-8")
-        team = load_team(path, images_required=True).team
+        path = write_private(Path(folder) / "team_config.json", json.dumps(team_doc))
+        try:
+            team = load_team(path, field_class=teamfiles.FIELD_CLASS,
+                             images_required=True).team
+        except ConfigError as exc:  # the check above passed: a rule of load_team alone
+            raise _invalid(exc, path) from None
         from orchestrator.engine import connect
         from orchestrator.pull import resolve_team_images
 
@@ -95,6 +104,15 @@ def run(team_doc: dict[str, Any], *, settings: Settings,
     elapsed = time.monotonic() - started
     log.info("pre-flight of %s passed in %.1f s", team.name, elapsed)
     return elapsed
+
+
+def _invalid(exc: ConfigError, path: Path) -> InvalidInput:
+    """A check that the upload's check did not make, as the upload would answer it."""
+    problems = [{**{k: str(v) for k, v in asdict(p).items()}, "file": "team_config.json",
+                 "text": str(p).replace(str(path), "team_config.json")} for p in exc.problems]
+    errors = [p for p in problems if p["severity"] == "error"] or problems
+    return InvalidInput(f"team_config.json has {len(errors)} problem(s): " + errors[0]["text"],
+                        problems=problems)
 
 
 def _distinct_players(team_doc: dict[str, Any]) -> dict[str, Any]:
@@ -136,9 +154,12 @@ def _start_and_connect(team_doc: dict[str, Any], folder: Path, *, settings: Sett
     files = {"game.json": game, "team_red.json": team,
              "team_blue.json": team_file("Stub", project_image("stub"), 1, goalie_first=True)}
     for name, content in files.items():
-        (config / name).write_text(json.dumps(content), encoding="utf-8")
-    plan = plan_from_game(load_game(config / "game.json", images_required=True),
-                          grace_period_s=1.0)
+        write_private(config / name, json.dumps(content))
+    try:
+        plan = plan_from_game(load_game(config / "game.json", images_required=True),
+                              grace_period_s=1.0)
+    except ConfigError as exc:
+        raise _invalid(exc, config / "team_red.json") from None
     runtime = DockerRuntime(connect())
     host = HostControl.for_current_user()
     runner = MatchRunner(

@@ -6,6 +6,7 @@ Every default lives here. ``Settings.from_env()`` is called by the entrypoint (`
 
 from __future__ import annotations
 
+import ipaddress
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
@@ -15,6 +16,7 @@ from typing import Any
 from service.errors import SettingsError
 
 PREFIX = "HLVS_SERVICE_"
+IPNetwork = ipaddress.IPv4Network | ipaddress.IPv6Network
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -80,6 +82,15 @@ class Settings:
     webhook_attempts: int = 5
     webhook_backoff_s: float = 2.0
     webhook_timeout_s: float = 5.0
+    webhook_allow: str = ""
+    """Networks a webhook may reach besides public addresses, comma-separated CIDRs (e.g.
+    ``10.20.0.0/16``); empty: public addresses only (no loopback, private, link-local)."""
+    secret_key: str = field(default="", repr=False)
+    """The key that seals the secrets stored in the database (a Fernet key); empty: the key
+    file."""
+    secret_key_file: str = ""
+    """Where the key is kept when ``secret_key`` is empty; empty: ``<data_dir>.key``, beside
+    the data folder (created 0600 on the first start)."""
     public_url: str = "http://127.0.0.1:8000"
     """Base of the links in mails and webhooks."""
     schedule_state: str = ""
@@ -118,6 +129,12 @@ class Settings:
         return settings
 
 
+def webhook_networks(settings: Settings) -> tuple[IPNetwork, ...]:
+    """The networks of ``webhook_allow``; ValueError for one that is not a network."""
+    return tuple(ipaddress.ip_network(part.strip(), strict=False)
+                 for part in settings.webhook_allow.split(",") if part.strip())
+
+
 def _convert(name: str, raw: str, current: object) -> object:
     try:
         if isinstance(current, bool):
@@ -152,9 +169,15 @@ def _check(settings: Settings) -> None:
         if getattr(settings, name) <= 0:
             raise SettingsError(name=PREFIX + name.upper(), value=str(getattr(settings, name)),
                                 expected="a positive number")
+    try:
+        webhook_networks(settings)
+    except ValueError as exc:
+        raise SettingsError(name=PREFIX + "WEBHOOK_ALLOW", value=settings.webhook_allow,
+                            expected=f"comma-separated networks, e.g. 10.0.0.0/8 ({exc})"
+                            ) from None
     if settings.match_slots < 1:
         raise SettingsError(name=PREFIX + "MATCH_SLOTS", value=str(settings.match_slots),
                             expected="at least 1")
 
 
-__all__ = ["Settings"]
+__all__ = ["Settings", "webhook_networks"]

@@ -1,5 +1,17 @@
-"""A team's files (``team_config.json``, ``credentials.json``): checked like ``hlvs check`` and
-kept in versions. Only valid files are stored; an invalid upload changes nothing stored."""
+"""A team's files (``team_config.json``, ``credentials.json``): checked like ``hlvs check`` plus
+the service's own rules, and kept in versions. Only valid files are stored; an invalid upload
+changes nothing stored.
+
+The service's rules (:func:`service_problems`): a team file names only secrets the team gave
+the league. Refused: ``registry_auth.password_env`` (an environment variable of the service's
+host), ``registry_auth.ecr`` without ``access_id`` and ``access_secret`` (it would sign with
+the host's AWS key), a ``private_key`` given as a path and ``known_hosts`` (files of the host);
+an SFTP target needs its ``host_key``. No host path or variable is ever looked at, so the
+answer tells nothing about the host. Secrets are stored sealed (:mod:`service.sealing`).
+
+:func:`check` is the one check of a team file: the upload, ``.../check`` and the pre-flight
+all call it.
+"""
 
 from __future__ import annotations
 
@@ -14,34 +26,114 @@ from typing import Any
 from sqlalchemy import func, select
 from sqlalchemy.orm import Session
 
-from orchestrator.config import check_team
+from orchestrator.config import FieldClass, check_team
+from orchestrator.config.robot_models import BUILT_IN_MODELS
 from orchestrator.errors import ConfigError, Problem
+from orchestrator.private_files import write_private
 from service.db import TeamFile
 from service.errors import InvalidInput, NotFound
+from service.sealing import PREFIX, Sealer
 
 log = logging.getLogger(__name__)
 
 KINDS = {"team_config": "team_config.json", "credentials": "credentials.json"}
 
 
-def check(kind: str, document: Any) -> list[dict[str, str]]:
-    """Every problem of ``document`` as ``hlvs check`` finds it (errors and warnings), with the
-    file named as the team knows it (``team_config.json`` / ``credentials.json``)."""
+FIELD_CLASS: FieldClass = "KID"
+"""The field class of the service's test matches (``orchestrator.match.scrimmage.game_file``):
+the pose rules of the upload are those the pre-flight and the match apply."""
+PLACEHOLDER_KEY = ("-----BEGIN OPENSSH PRIVATE KEY-----\n(refused)\n"
+                   "-----END OPENSSH PRIVATE KEY-----")
+
+
+def service_problems(kind: str, document: Any) -> tuple[Any, list[Problem]]:
+    """The service's own rules: ``(document to check further, problems)``. The document
+    returned has every refused host reference taken out, so that checking it further reads
+    nothing of the host."""
     name = KINDS[kind]
+    problems: list[Problem] = []
+    if not isinstance(document, dict):
+        return document, problems
+    if kind == "team_config":
+        auth = document.get("registry_auth")
+        if isinstance(auth, dict) and "password_env" in auth:
+            problems.append(Problem(
+                name, "/registry_auth/password_env",
+                "password_env is not accepted by the service (it names a variable of the "
+                "league's host, not a secret of the team)",
+                '"password": the registry password itself (stored encrypted, never shown '
+                "back)"))
+        ecr = auth.get("ecr") if isinstance(auth, dict) else None
+        if isinstance(ecr, dict) and not (ecr.get("access_id") and ecr.get("access_secret")):
+            problems.append(Problem(
+                name, "/registry_auth/ecr",
+                "ECR without access_id and access_secret is not accepted by the service "
+                "(it would sign with the league's AWS key)",
+                "the team's own access_id and access_secret (stored encrypted)"))
+        return _builtin_models_only(document, problems)
+    body = document.get("credentials")
+    if document.get("type") != "sftp" or not isinstance(body, dict):
+        return document, problems
+    cleaned = dict(body)
+    key = body.get("private_key")
+    if isinstance(key, str) and not key.lstrip().startswith("-----BEGIN"):
+        problems.append(Problem(
+            name, "/credentials/private_key",
+            "a path is not accepted by the service (files of the league's host are not "
+            "read for a team)", "the key's text (-----BEGIN ... PRIVATE KEY-----), stored "
+            "encrypted"))
+        cleaned["private_key"] = PLACEHOLDER_KEY
+    if "known_hosts" in body:
+        problems.append(Problem(
+            name, "/credentials/known_hosts",
+            "known_hosts is not accepted by the service (files of the league's host are not "
+            "read for a team)", '"host_key": the server\'s key, "ssh-ed25519 AAAA..."'))
+        cleaned.pop("known_hosts")
+    if body.get("host_key") is None:
+        problems.append(Problem(
+            name, "/credentials/host_key", "an SFTP target needs its pinned host key in the "
+            "service", '"host_key": the server\'s key as in known_hosts, "ssh-ed25519 AAAA..."'))
+    return {**document, "credentials": cleaned}, problems
+
+
+def _builtin_models_only(document: dict[str, Any],
+                         problems: list[Problem]) -> tuple[Any, list[Problem]]:
+    """A robot model package is a folder of the host that reads the file: refused (and taken
+    out, unread) in the service, which plays the built-in models."""
+    players = document.get("players")
+    if not isinstance(players, dict):
+        return document, problems
+    kept = dict(players)
+    for number, entry in players.items():
+        model = entry.get("model") if isinstance(entry, dict) else None
+        if isinstance(model, str) and model not in BUILT_IN_MODELS:
+            problems.append(Problem(
+                KINDS["team_config"], f"/players/{number}/model",
+                "a robot model package is not accepted by the service (its folder would be "
+                "one of the league's host)", "one of " + ", ".join(BUILT_IN_MODELS)))
+            kept[number] = {k: v for k, v in entry.items() if k != "model"}
+    return {**document, "players": kept}, problems
+
+
+def check(kind: str, document: Any) -> list[dict[str, str]]:
+    """Every problem of ``document`` as ``hlvs check`` finds it plus the service's rules
+    (errors and warnings), with the file named as the team knows it (``team_config.json`` /
+    ``credentials.json``). Never raises for a bad document."""
+    name = KINDS[kind]
+    document, problems = service_problems(kind, document)
     with tempfile.TemporaryDirectory(prefix="hlvs-check-") as folder:
         path = Path(folder) / name
-        path.write_text(json.dumps(document), encoding="utf-8")
-        path.chmod(0o600)
-        problems: list[Problem]
+        write_private(path, json.dumps(document))
         if kind == "team_config":
-            problems = check_team(path, images_required=True)
+            problems += check_team(path, field_class=FIELD_CLASS, images_required=True)
         else:
             from orchestrator.config.credentials import load_credentials
 
             try:
-                problems = list(load_credentials(path).warnings)
+                problems += [w for w in load_credentials(path).warnings
+                             if "known_hosts only" not in w.message]
             except ConfigError as exc:
-                problems = exc.problems
+                problems += exc.problems
     out = []
     for problem in problems:
         entry = {k: str(v) for k, v in asdict(problem).items()}
@@ -51,16 +143,24 @@ def check(kind: str, document: Any) -> list[dict[str, str]]:
     return out
 
 
-def store(session: Session, *, team_id: int, kind: str, document: Any) -> TeamFile:
-    """Check and store a new version; :class:`InvalidInput` with the problems when invalid."""
-    if kind not in KINDS:
-        raise NotFound(what="file kind", ident=kind)
+def raise_if_invalid(kind: str, document: Any) -> list[dict[str, str]]:
+    """The problems of ``document`` (warnings); :class:`InvalidInput` when one is an error."""
     problems = check(kind, document)
     errors = [p for p in problems if p["severity"] == "error"]
     if errors:
         raise InvalidInput(f"{KINDS[kind]} has {len(errors)} problem(s): " + errors[0]["text"],
                            problems=problems)
-    content = json.dumps(document, indent=2, sort_keys=False)
+    return problems
+
+
+def store(session: Session, *, team_id: int, kind: str, document: Any,
+          sealer: Sealer) -> TeamFile:
+    """Check and store a new version, its secrets sealed; :class:`InvalidInput` with the
+    problems when invalid."""
+    if kind not in KINDS:
+        raise NotFound(what="file kind", ident=kind)
+    problems = raise_if_invalid(kind, document)
+    content = json.dumps(sealer.seal_document(kind, document), indent=2, sort_keys=False)
     latest = session.scalar(select(func.max(TeamFile.version)).where(
         TeamFile.team_id == team_id, TeamFile.kind == kind)) or 0
     row = TeamFile(team_id=team_id, kind=kind, version=latest + 1, content=content,
@@ -94,6 +194,37 @@ def versions(session: Session, *, team_id: int, kind: str) -> list[TeamFile]:
 
 
 
+def opened(row: TeamFile, sealer: Sealer) -> Any:
+    """The stored document with its secrets opened (for a match, a pre-flight, a delivery)."""
+    return sealer.open_document(row.kind, json.loads(row.content))
+
+
+def seal_stored(session: Session, sealer: Sealer) -> int:
+    """Seal every secret still stored in the clear (stored before sealing existed); returns
+    how many rows changed. :class:`~service.errors.SettingsError` when a sealed secret does
+    not open with ``sealer`` (the service was started with another key)."""
+    from service.db import Team
+
+    changed = 0
+    opened_one = False
+    for row in session.scalars(select(TeamFile)):
+        document = json.loads(row.content)
+        if not opened_one and PREFIX in row.content:
+            sealer.open_document(row.kind, document)  # raises with the wrong key
+            opened_one = True
+        sealed = sealer.seal_document(row.kind, document)
+        if sealed != document:
+            row.content = json.dumps(sealed, indent=2, sort_keys=False)
+            changed += 1
+    for team in session.scalars(select(Team).where(Team.webhook_secret.is_not(None))):
+        if team.webhook_secret and not team.webhook_secret.startswith(PREFIX):
+            team.webhook_secret = sealer.seal(team.webhook_secret)
+            changed += 1
+    if changed:
+        log.info("%d stored secret(s) sealed", changed)
+    return changed
+
+
 def get_by_id(session: Session, file_id: int) -> TeamFile:
     row = session.get(TeamFile, file_id)
     if row is None:
@@ -107,4 +238,5 @@ def newest_id(session: Session, *, team_id: int, kind: str) -> int | None:
         .order_by(TeamFile.version.desc()).limit(1))
 
 
-__all__ = ["KINDS", "check", "get", "get_by_id", "newest_id", "store", "versions"]
+__all__ = ["KINDS", "check", "get", "get_by_id", "newest_id", "opened", "raise_if_invalid",
+           "seal_stored", "service_problems", "store", "versions"]

@@ -97,7 +97,7 @@ class SubmissionCreate(BaseModel):
 
     opponent: str = Field(default="stub", max_length=64,
                           description="'stub' or a team that accepts friendlies")
-    team_config_version: int | None = Field(default=None, ge=1,
+    team_config_version: int | None = Field(default=None, ge=1, le=2**31 - 1,
                                             description="default: the newest version")
 
 

@@ -14,7 +14,6 @@ is queued again at its old place, with a new attempt number (nothing is lost).
 
 from __future__ import annotations
 
-import json
 import logging
 import threading
 import zlib
@@ -44,6 +43,13 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 MAX_ATTEMPTS = 3
+
+
+class _Refused(Exception):
+    def __init__(self, cause: str, failure_class: str) -> None:
+        super().__init__(cause)
+        self.cause = cause
+        self.failure_class = failure_class
 
 
 class QueueWorker:
@@ -120,7 +126,13 @@ class QueueWorker:
                 row.attempts += 1
                 row.match_id = f"{row.id}-a{row.attempts}"
                 row.cause = None
-                job = self._prepare(session, row)
+                try:
+                    job = self._prepare(session, row)
+                except _Refused as exc:  # a file stored before the service's rules
+                    self._end(session, row, SubmissionState.FAILED, cause=exc.cause,
+                              failure_class=exc.failure_class)
+                    self.services.changed(row.id)
+                    continue
                 row.pool_handle = None
                 seq = row.seq
             with transaction(sessions) as session:
@@ -142,13 +154,20 @@ class QueueWorker:
 
     def _prepare(self, session: Session, row: Submission) -> MatchJob:
         assert row.match_id is not None
-        team_doc = json.loads(teamfiles.get_by_id(session, row.team_file_id).content)
+        sealer = self.services.sealer
+        team_doc = teamfiles.opened(teamfiles.get_by_id(session, row.team_file_id), sealer)
         opponent_doc: dict[str, Any] | None = None
         if row.opponent != STUB:
             other = session.scalar(select(Team).where(Team.name == row.opponent))
             assert other is not None
-            opponent_doc = json.loads(teamfiles.get(session, team_id=other.id,
-                                                    kind="team_config").content)
+            opponent_doc = teamfiles.opened(teamfiles.get(session, team_id=other.id,
+                                                          kind="team_config"), sealer)
+        for doc, failure_class, whose in ((team_doc, "team_startup", "the team file"),
+                                          (opponent_doc, "infrastructure", "the opponent's")):
+            _, refused = teamfiles.service_problems("team_config", doc)
+            if refused:  # never hand a match a host variable or a key-less ECR login
+                raise _Refused(f"{whose} team_config.json: {refused[0].pointer}: "
+                               f"{refused[0].message}", failure_class)
         work = self._work_dir(row.match_id)
         game = matchfiles.write_match(
             work / "config", match_id=row.match_id, team=team_doc, opponent=opponent_doc,

@@ -118,10 +118,11 @@ def _bench(args: argparse.Namespace) -> int:
 
 
 def _sessions(args: argparse.Namespace) -> Any:
+    from orchestrator.private_files import private_dir
     from service.db import make_engine, migrate, session_factory
 
     settings = _settings(args)
-    settings.data_dir.mkdir(parents=True, exist_ok=True)
+    private_dir(settings.data_dir)
     engine = make_engine(settings.db_url)
     migrate(engine)
     return session_factory(engine)

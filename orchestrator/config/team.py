@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import shlex
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -94,6 +95,8 @@ def build_team(
         return None
     players = [_player(number, document, field_class) for number in numbers]
     players = _resolve_models(players, source, where)
+    for player in players:
+        _check_command(player, where)
     if not document["players"]:
         where.warn(
             "/players", "the team has no players: it plays without robots (like HLVS Invisibles)"
@@ -271,6 +274,20 @@ def check_goalkeeper_pose(
             "own goal (league referee: the shoot-out goalkeeper must stay on or behind its "
             "goal line between the posts)",
             expected=wanted,
+        )
+
+
+def _check_command(player: PlayerConfig, where: Collector) -> None:
+    """``dockerCmd`` splits like a shell line (it is split so when the robot starts)."""
+    if player.docker_cmd is None:
+        return
+    try:
+        shlex.split(player.docker_cmd)
+    except ValueError as exc:
+        where.error(
+            pointer("players", str(player.number), "dockerCmd"),
+            f"cannot be split into arguments: {exc}",
+            expected="a command line with every quote closed, e.g. \"python3 /robot/main.py\"",
         )
 
 

@@ -79,7 +79,7 @@ class Team(Base):
     email: Mapped[str | None] = mapped_column(String(254))
     accepts_friendlies: Mapped[bool] = mapped_column(Boolean, default=False)
     webhook_url: Mapped[str | None] = mapped_column(String(2000))
-    webhook_secret: Mapped[str | None] = mapped_column(String(128))
+    webhook_secret: Mapped[str | None] = mapped_column(String(512))  # sealed
     slurm_account: Mapped[str | None] = mapped_column(String(64))  # made by service.accounts
     created_at: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=now)
 

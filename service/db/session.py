@@ -22,7 +22,7 @@ def make_engine(url: str) -> Engine:
     """An engine for ``url``; SQLite gets WAL, a busy timeout and foreign keys."""
     if url.startswith("sqlite"):
         if url.startswith("sqlite:///"):
-            Path(url.removeprefix("sqlite:///")).parent.mkdir(parents=True, exist_ok=True)
+            _private_sqlite(Path(url.removeprefix("sqlite:///")))
         engine = create_engine(url, connect_args={"check_same_thread": False, "timeout": 30},
                                pool_size=20, max_overflow=40)
 
@@ -36,6 +36,21 @@ def make_engine(url: str) -> Engine:
 
         return engine
     return create_engine(url, pool_size=20, max_overflow=30, pool_pre_ping=True)
+
+
+def _private_sqlite(path: Path) -> None:
+    """The database file (and its WAL files, which SQLite creates with the file's mode) 0600;
+    a missing folder is created 0700."""
+    from orchestrator.private_files import make_private_file, private_dir
+
+    if path.name in ("", ":memory:"):
+        return
+    private_dir(path.parent, only_if_new=True)
+    make_private_file(path)
+    for extra in ("-wal", "-shm", "-journal"):
+        companion = path.with_name(path.name + extra)
+        if companion.exists():
+            companion.chmod(0o600)
 
 
 def migrate(engine: Engine) -> None:

@@ -38,7 +38,7 @@ from fastapi import APIRouter, FastAPI, Request
 from fastapi.responses import FileResponse
 from pydantic import BaseModel, Field
 
-from envs.errors import EnvError
+from envs.errors import EnvConfigError, EnvError
 from envs.monitor import Monitor
 from service import TeamPrincipal
 from service.errors import Conflict, InvalidInput, NotFound
@@ -225,7 +225,11 @@ def create(body: CreateBody, principal: TeamPrincipal, request: Request) -> Crea
             instance_id = secrets.token_hex(4)
         try:
             env = gym.make(body.env_id, **body.kwargs)
-        except (EnvError, TypeError, ValueError) as exc:
+        except EnvConfigError as exc:
+            raise InvalidInput(f"kwargs/{exc.field}: {exc}", problems=[
+                {"where": "body", "pointer": f"/kwargs/{exc.field}", "message": str(exc),
+                 "expected": exc.expected}]) from exc
+        except (EnvError, TypeError, ValueError, OverflowError, RecursionError) as exc:
             raise InvalidInput(f"kwargs: {exc}") from exc
         folder = _data_dir(request) / str(team_id) / instance_id
         registry.instances[instance_id] = Instance(

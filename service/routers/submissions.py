@@ -5,7 +5,6 @@ Another team's submission id answers 404 exactly like an unknown one, so ids do 
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -60,10 +59,11 @@ def create_submission(body: SubmissionCreate, request: Request, principal: TeamP
     submissions.refuse_if_active(session, team_id)
     team_file = teamfiles.get(session, team_id=team_id, kind="team_config",
                               version=body.team_config_version)
-    file_id, document = team_file.id, json.loads(team_file.content)
+    file_id, document = team_file.id, teamfiles.opened(team_file, services.sealer)
     credentials = teamfiles.newest_id(session, team_id=team_id, kind="credentials")
     session.commit()  # no connection is held during the pre-flight check
     assert services.preflight is not None
+    teamfiles.raise_if_invalid("team_config", document)  # the upload's check, today's rules
     elapsed = services.preflight(document, services.settings)
     row = submissions.create(session, team_id=team_id, opponent=body.opponent,
                              team_file_id=file_id, credentials_file_id=credentials,

@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import json
 from datetime import datetime
-from typing import Any
+from typing import Annotated, Any
 
 from fastapi import APIRouter, FastAPI, Request
+from fastapi import Path as PathParam
 from pydantic import BaseModel, ConfigDict, Field, HttpUrl
 from starlette.concurrency import run_in_threadpool
 
-from service import teamfiles
+from service import outbound, sealing, teamfiles
 from service.bodies import read_json_body
 from service.db import Team, utc
 from service.deps import DbSession, TeamPrincipal, get_services
@@ -82,7 +83,12 @@ def get_team(principal: TeamPrincipal, session: DbSession) -> TeamView:
 
 
 @router.patch("")
-def update_team(body: TeamUpdate, principal: TeamPrincipal, session: DbSession) -> TeamView:
+def update_team(body: TeamUpdate, request: Request, principal: TeamPrincipal,
+                session: DbSession) -> TeamView:
+    services = get_services(request)
+    if body.webhook_url is not None:
+        outbound.check_url(str(body.webhook_url), outbound.allowed_networks(services.settings),
+                           field="/webhook_url")
     team = session.get(Team, principal.team_id)
     assert team is not None
     given = body.model_fields_set
@@ -93,7 +99,8 @@ def update_team(body: TeamUpdate, principal: TeamPrincipal, session: DbSession) 
     if "webhook_url" in given:
         team.webhook_url = str(body.webhook_url) if body.webhook_url else None
     if "webhook_secret" in given:
-        team.webhook_secret = body.webhook_secret
+        team.webhook_secret = (services.sealer.seal(body.webhook_secret)
+                               if body.webhook_secret else None)
     session.commit()
     return _view(team)
 
@@ -112,7 +119,7 @@ async def upload_file(kind: str, request: Request, principal: TeamPrincipal) -> 
         with services.sessions() as session, session.begin():
             assert principal.team_id is not None
             return _version(teamfiles.store(session, team_id=principal.team_id, kind=kind,
-                                            document=document))
+                                            document=document, sealer=services.sealer))
 
     return await run_in_threadpool(store)
 
@@ -140,16 +147,23 @@ def list_versions(kind: str, principal: TeamPrincipal, session: DbSession) -> li
 
 
 @router.get("/files/{kind}/{version}")
-def get_version(kind: str, version: int, principal: TeamPrincipal,
+def get_version(kind: str, version: Annotated[int, PathParam(ge=1, le=2**31 - 1)],
+                principal: TeamPrincipal,
                 session: DbSession) -> FileContent:
     """One stored version (``credentials`` are returned with their secrets masked)."""
     assert principal.team_id is not None
     row = teamfiles.get(session, team_id=principal.team_id, kind=kind, version=version)
-    content = json.loads(row.content)
-    if kind == "credentials" and isinstance(content.get("credentials"), dict):
-        content["credentials"] = {k: ("***" if k in ("password", "access_secret", "private_key")
-                                      else v) for k, v in content["credentials"].items()}
+    content = _masked(json.loads(row.content))
     return FileContent(**_version(row).model_dump(), content=content)
+
+
+def _masked(value: Any) -> Any:
+    """A stored file as shown back: every secret (sealed at rest) as ``***``."""
+    if isinstance(value, dict):
+        return {k: _masked(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_masked(v) for v in value]
+    return "***" if sealing.is_sealed(value) else value
 
 
 def mount(app: FastAPI) -> None:
