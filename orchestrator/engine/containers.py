@@ -90,6 +90,9 @@ class DockerRuntime:
             "cpuset_cpus": request.cpuset_cpus,
             "tmpfs": dict(request.tmpfs) or None,
             "cgroup_parent": request.cgroup_parent,
+            "log_config": docker.types.LogConfig(type="json-file", config={
+                "max-size": str(max(1, request.console_max_bytes // 2)), "max-file": "2"})
+            if request.console_max_bytes is not None else None,
             "device_requests": [
                 docker.types.DeviceRequest(
                     driver=d.driver, count=d.count, device_ids=list(d.device_ids),
@@ -197,15 +200,31 @@ class DockerRuntime:
                 if sample is not None:
                     yield sample
 
-    def save_logs(self, container_id: str, *, stdout: Path, stderr: Path) -> None:
+    def save_logs(self, container_id: str, *, stdout: Path, stderr: Path,
+                  max_bytes: int | None = None) -> tuple[str, ...]:
+        """Write the container's stdout and stderr, each cut at ``max_bytes``; returns the
+        streams that were cut ("stdout", "stderr")."""
+        cut: list[str] = []
         with translate("container", container_id):
             for path, out, err in ((stdout, True, False), (stderr, False, True)):
                 path.parent.mkdir(parents=True, exist_ok=True)
-                with path.open("wb") as handle:
-                    for chunk in self._client.api.logs(
-                        container_id, stdout=out, stderr=err, stream=True, follow=False
-                    ):
-                        handle.write(chunk)
+                written = 0
+                stream = self._client.api.logs(
+                    container_id, stdout=out, stderr=err, stream=True, follow=False)
+                try:
+                    with path.open("wb") as handle:
+                        for chunk in stream:
+                            if max_bytes is not None and written + len(chunk) > max_bytes:
+                                handle.write(chunk[:max_bytes - written])
+                                cut.append("stdout" if out else "stderr")
+                                break
+                            handle.write(chunk)
+                            written += len(chunk)
+                finally:
+                    close = getattr(stream, "close", None)
+                    if callable(close):
+                        close()
+        return tuple(cut)
 
     def copy_out(self, container_id: str, path: str, destination: Path) -> None:
         """Copy ``path`` (a file or a folder) out of the container into ``destination``."""

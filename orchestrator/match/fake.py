@@ -33,6 +33,7 @@ class FakeContainer:
     request: ContainerRequest
     state: ContainerState
     stops: list[float] = field(default_factory=list)
+    console: dict[str, str] = field(default_factory=dict)  # "stdout" / "stderr" -> more text
 
 
 class FakeRuntime:
@@ -141,11 +142,18 @@ class FakeRuntime:
         yield StatsSample(cpu_percent=50.0, memory_bytes=1000)
         yield StatsSample(cpu_percent=150.0, memory_bytes=4000)
 
-    def save_logs(self, container_id: str, *, stdout: Path, stderr: Path) -> None:
+    def save_logs(self, container_id: str, *, stdout: Path, stderr: Path,
+                  max_bytes: int | None = None) -> tuple[str, ...]:
         found = self._get(container_id)
+        cut = []
         for path in (stdout, stderr):
             path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_text(f"{found.request.name} {path.stem}\n")
+            text = f"{found.request.name} {path.stem}\n" + found.console.get(path.stem, "")
+            if max_bytes is not None and len(text) > max_bytes:
+                text = text[:max_bytes]
+                cut.append(path.stem)
+            path.write_text(text)
+        return tuple(cut)
 
     def copy_out(self, container_id: str, path: str, destination: Path) -> None:
         self._get(container_id)
@@ -223,7 +231,8 @@ class FakeHost:
     def release(self, folder: LogFolder) -> None:
         self.released_folders.append(folder.path)
 
-    def collect_logs(self, folder: LogFolder, destination: Path) -> CopyReport:
+    def collect_logs(self, folder: LogFolder, destination: Path, *,
+                     limit_bytes: int | None = None) -> CopyReport:
         destination.mkdir(parents=True, exist_ok=True)
         return CopyReport()
 
