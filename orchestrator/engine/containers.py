@@ -22,6 +22,7 @@ import requests.exceptions
 from orchestrator.engine import LABEL_MATCH, LABEL_PROJECT
 from orchestrator.engine import networks as _networks
 from orchestrator.errors import InfrastructureError
+from orchestrator.match import ledger
 from orchestrator.match.runtime import (
     ContainerRequest,
     ContainerState,
@@ -60,11 +61,15 @@ class DockerRuntime:
     # networks -------------------------------------------------------------------------------
     def create_network(self, request: NetworkRequest) -> NetworkInfo:
         with translate("network", request.name):
-            return _networks.create_network(self._client, request)
+            info = _networks.create_network(self._client, request)
+        ledger.note(info.id)
+        return info
 
     def remove_network(self, name: str) -> None:
         with translate("network", name):
+            network_id = str(self._client.api.inspect_network(name).get("Id", ""))
             _networks.remove_network(self._client, name)
+        ledger.forget(network_id)
 
     # containers -----------------------------------------------------------------------------
     def create_container(self, request: ContainerRequest) -> str:
@@ -130,6 +135,7 @@ class DockerRuntime:
                 networking_config=networking,
             )
             container_id = str(created["Id"])
+            ledger.note(container_id)
             for extra in request.networks[1:]:
                 api.connect_container_to_network(
                     container_id,
@@ -158,7 +164,9 @@ class DockerRuntime:
 
     def remove(self, container_id: str) -> None:
         with translate("container", container_id):
+            full_id = str(self._client.api.inspect_container(container_id).get("Id", ""))
             self._client.api.remove_container(container_id, force=True, v=True)
+        ledger.forget(full_id)
 
     def inspect(self, container_id: str) -> ContainerState:
         with translate("container", container_id):
@@ -258,14 +266,15 @@ class DockerRuntime:
                 name = (c.get("Names") or ["/?"])[0].lstrip("/")
                 found.append(
                     ProjectObject(
-                        kind="container", id=str(c["Id"]), name=name, labels=c["Labels"] or {}
+                        kind="container", id=str(c["Id"]), name=name, labels=c["Labels"] or {},
+                        created=ledger.created(str(c["Id"])),
                     )
                 )
             for n in self._client.api.networks(filters={"label": labels}):
                 found.append(
                     ProjectObject(
                         kind="network", id=str(n["Id"]), name=str(n["Name"]),
-                        labels=n.get("Labels") or {},
+                        labels=n.get("Labels") or {}, created=ledger.created(str(n["Id"])),
                     )
                 )
         return found

@@ -54,6 +54,7 @@ class FakeRuntime:
         self.calls: list[tuple[str, str]] = []
         self._ids = itertools.count(1)
         self.on_start: Callable[[FakeContainer], None] | None = None
+        self.foreign: set[str] = set()  # started outside the runner (not in its records)
 
     def create_network(self, request: NetworkRequest) -> NetworkInfo:
         self.calls.append(("create_network", request.name))
@@ -165,7 +166,8 @@ class FakeRuntime:
 
     def list_project(self, *, match_id: str | None = None) -> list[ProjectObject]:
         found = [ProjectObject(kind="container", id=cid, name=c.request.name,
-                               labels=c.request.labels) for cid, c in self.containers.items()]
+                               labels=c.request.labels, created=cid not in self.foreign)
+                 for cid, c in self.containers.items()]
         found += [ProjectObject(kind="network", id=name, name=name, labels=r.labels)
                   for name, r in self.networks.items()]
         if match_id is None:

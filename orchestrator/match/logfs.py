@@ -10,6 +10,7 @@ a plain folder without a cap is used and the result says so.
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import logging
 import os
 import re
@@ -24,10 +25,19 @@ from orchestrator.match.safecopy import CopyReport, copy_tree, remove_tree, swee
 log = logging.getLogger(__name__)
 
 
+_PLAIN = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,99}")
+
+
 def safe_name(text: str) -> str:
-    """``text`` usable as a Docker object name part and as one path component."""
-    cleaned = re.sub(r"[^A-Za-z0-9_.-]", "-", text).lstrip(".-") or "match"
-    return cleaned[:100]
+    """``text`` usable as a Docker object name part and as one path component, unique by
+    construction: a valid match id (letters, digits, '_', '.', '-', starting with a letter or
+    digit) is itself; any other text becomes ``_<cleaned>-<SHA-256>``, which no valid id can
+    be (it starts with '_'), so "Bit Bots" and "Bit-Bots" never share a folder or a name."""
+    if _PLAIN.fullmatch(text):
+        return text
+    cleaned = re.sub(r"[^A-Za-z0-9_.-]", "-", text)[:40]
+    digest = hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()[:32]
+    return f"_{cleaned}-{digest}"
 
 
 def state_dir() -> Path:

@@ -151,6 +151,7 @@ class ProjectObject:
     id: str
     name: str
     labels: Mapping[str, str]
+    created: bool = True  # in this runner's records (:mod:`orchestrator.match.ledger`)
 
 
 class ContainerRuntime(Protocol):
