@@ -75,8 +75,13 @@ def resolve_team_images(
     environ: Mapping[str, str] | None = None,
     progress: Progress | None = None,
     backoff: Backoff = PULL_BACKOFF,
+    registry_only: bool = False,
 ) -> dict[int, ResolvedImage]:
-    """Check every player's image in its registry, then pull and pin it; see module doc."""
+    """Check every player's image in its registry, then pull and pin it; see module doc.
+
+    ``registry_only`` (official and service matches): an image name without a registry part is
+    refused (:func:`local_name_refused`), so a team never runs an image that merely happens to
+    be on this host (another team's, pulled for an earlier match)."""
     environ = os.environ if environ is None else environ
     limit_bytes = round(limits.image_gb * GB)
     references = list(dict.fromkeys(p.image for p in team_config.players if p.image))
@@ -84,6 +89,11 @@ def resolve_team_images(
     failed: dict[str, ImageError] = {}
     remote: dict[str, RemoteImage] = {}
     for reference in references:
+        refused = local_name_refused(reference) if registry_only else None
+        if refused is not None:
+            log.info("image %s: %s", reference, refused.reason)
+            failed[reference] = refused
+            continue
         try:
             found = _inspect(reference, logins)
         except ImageError as exc:
@@ -164,13 +174,34 @@ def pull_game_images(
     engine = engine or connect()
     teams: dict[str, Mapping[int, ResolvedImage]] = {
         color: resolve_team_images(
-            engine, loaded.team(color), limits=loaded.game.limits, environ=environ
+            engine, loaded.team(color), limits=loaded.game.limits, environ=environ,
+            registry_only=loaded.game.registry_images,
         )
         for color in COLORS
     }
     result = GamePull(game=Path(game), teams=teams)
     log.info("pulled the images of %s: %s", game, result)
     return result
+
+
+PROJECT_REPOSITORY = "hlvs-runner/"  # the project's own images, built on this host
+
+
+def local_name_refused(reference: str) -> ImagePullError | None:
+    """The refusal of a team image named without a registry part (None when it names one, or
+    is one of the project's own ``hlvs-runner/`` images, such as the stub team)."""
+    repository, _ = split_reference(reference.partition("@")[0])
+    if engine_images.registry_of(repository) or repository.startswith(PROJECT_REPOSITORY):
+        return None
+    name = repository.rsplit("/", 1)[-1]
+    return ImagePullError(
+        image=reference,
+        reason=(f"{reference} names no registry: a team's image is pulled from its registry "
+                "with the team's login, never taken from this host; push it (docker tag "
+                f"{reference} REGISTRY/TEAM/{name} && docker push REGISTRY/TEAM/{name}) and name "
+                f"REGISTRY/TEAM/{name} in team_config.json, with registry_auth for a private "
+                "registry"),
+    )
 
 
 def split_reference(reference: str) -> tuple[str, str]:
@@ -272,7 +303,8 @@ def _resolve_one(
         if not registry:
             info = engine_images.inspect(engine, reference)
             if info is not None:
-                log.info("image %s: local image %s, used as is", reference, info.id)
+                log.warning("image %s: local image %s, used as is (allowed only where the game "
+                            "does not set registry_images)", reference, info.id)
             else:
                 info = pull(None)
         else:
@@ -284,7 +316,14 @@ def _resolve_one(
     if not digest:
         digest = info.repo_digests[0] if info.repo_digests else info.id
     error: ImageError | None = None
-    if info.size_bytes > limit_bytes:
+    if info.volumes:
+        error = ImageError(image=reference, reason=(
+            f"declares VOLUME {', '.join(info.volumes)}: a volume would give the robot disk "
+            "space outside its caps; a robot writes to /robocup-logs and its scratch folders "
+            "(/tmp, /var/tmp, /root) only: remove the VOLUME instruction (also from the base "
+            "image) and push it again"))
+        log.info("image %s: %s", reference, error.reason)
+    elif info.size_bytes > limit_bytes:
         error = ImageTooLarge(image=reference, size_bytes=info.size_bytes, limit_bytes=limit_bytes)
         log.info("image %s: %s; removing it", reference, error.reason)
         if registry:  # a pulled copy goes; a team's local-only image is not ours to delete
@@ -344,5 +383,6 @@ __all__ = [
     "ResolvedImage",
     "pull_game_images",
     "resolve_team_images",
+    "local_name_refused",
     "split_reference",
 ]

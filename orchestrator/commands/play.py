@@ -81,7 +81,8 @@ def _pull_resolver(client: Any, loaded: Any) -> ImageResolver:
         for color in ("red", "blue"):
             with progress(allow_rich=False) as bars:  # under the match's live view
                 resolved = resolve_team_images(
-                    client, loaded.team(color), limits=loaded.game.limits, progress=bars
+                    client, loaded.team(color), limits=loaded.game.limits, progress=bars,
+                    registry_only=loaded.game.registry_images,
                 )
             for number, image in resolved.items():
                 key = f"{color}-{number}"

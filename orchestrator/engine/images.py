@@ -35,6 +35,7 @@ class ImageInfo:
     size_bytes: int
     labels: Mapping[str, str]
     created_unix: int = 0  # filled by list_labelled
+    volumes: tuple[str, ...] = ()  # the image's VOLUME paths
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -73,6 +74,7 @@ def inspect(client: docker.DockerClient, reference: str) -> ImageInfo | None:
         repo_digests=tuple(attrs.get("RepoDigests") or ()),
         size_bytes=int(attrs.get("Size") or 0),
         labels=dict(config.get("Labels") or {}),
+        volumes=tuple(sorted(config.get("Volumes") or {})),
     )
 
 
