@@ -132,7 +132,7 @@ def _collect_robot(match: MatchContext, key: str, container_id: str) -> None:
     peaks = match.monitor.peaks(key)
     record.cpu_peak_percent = peaks.cpu_percent
     record.memory_peak_bytes = peaks.memory_bytes
-    cap = layout.ROBOT_CONSOLE_BYTES
+    cap = layout.ROBOT_CONSOLE_BYTES // 2  # per stream (the engine keeps less of a flood)
     cut = match.runtime.save_logs(container_id, stdout=folder / "stdout.log",
                                    stderr=folder / "stderr.log", max_bytes=cap)
     for stream in cut:
