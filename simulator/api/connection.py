@@ -11,6 +11,7 @@ from collections import deque
 from google.protobuf.message import DecodeError
 
 from contracts.robot_api import messages_pb2 as pb
+from simulator.api.bounds import READ_PER_CALL_BYTES, RequestBounds
 from simulator.api.fastreq import PositionTargets, PositionTemplate, scan_positions
 from simulator.api.framing import FrameDecoder, FramingError
 from simulator.api.stats import RobotStats
@@ -64,6 +65,7 @@ class Connection:
         self.stats = stats
         self.queue_limit = max(1, queue_limit)
         self.decoder = FrameDecoder()
+        self.bounds = RequestBounds(time.monotonic())
         self.requests: list[pb.ActuatorRequests | PositionTargets] = []
         self._template: PositionTemplate | None = None
         self.outbox: deque[bytes] = deque()
@@ -82,12 +84,16 @@ class Connection:
     # --- reading ----------------------------------------------------------------------------
 
     def read(self, now: float) -> int:
-        """Read everything available; returns the number of requests decoded.
+        """Read what is available, at most :data:`READ_PER_CALL_BYTES` (the rest waits for the
+        next call); returns the number of requests decoded. Requests over the client's bounds
+        (:mod:`simulator.api.bounds`) are dropped undecoded and counted.
 
         Raises:
             ClientClosed: on EOF, a socket error, a framing error or an undecodable message.
         """
         count = 0
+        taken = 0
+        bounds = self.bounds
         while True:
             try:
                 data = self.sock.recv(RECV_CHUNK)
@@ -98,6 +104,7 @@ class Connection:
             if not data:
                 raise ClientClosed("client disconnected")
             self.stats.bytes_in += len(data)
+            taken += len(data)
             try:
                 frames = self.decoder.feed(data)
             except FramingError as exc:
@@ -106,6 +113,10 @@ class Connection:
             template = self._template
             decoded: list[pb.ActuatorRequests | PositionTargets] = []
             for frame in frames:
+                dropped = bounds.admit(len(frame), now)
+                if dropped is not None:
+                    self.stats.drop_in(dropped, len(frame))
+                    continue
                 targets = template.match(frame) if template is not None else None
                 if targets is not None:
                     decoded.append(targets)
@@ -116,7 +127,7 @@ class Connection:
             if decoded:
                 with self._requests_lock:
                     self.requests.extend(decoded)
-            if len(data) < RECV_CHUNK:
+            if len(data) < RECV_CHUNK or taken >= READ_PER_CALL_BYTES:
                 break
         if count:
             self.stats.messages_in += count
