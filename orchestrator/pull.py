@@ -27,6 +27,7 @@ from orchestrator.config import COLORS, Limits, RegistryAuth, TeamConfig
 from orchestrator.console import NullProgress, Progress, PullTracker
 from orchestrator.engine import images as engine_images
 from orchestrator.errors import ImageError, ImagePullError, ImageTooLarge, TeamImagesTooLarge
+from orchestrator.image_origin import local_name_reason
 from orchestrator.registry import (
     Credentials,
     RegistryClient,
@@ -184,24 +185,11 @@ def pull_game_images(
     return result
 
 
-PROJECT_REPOSITORY = "hlvs-runner/"  # the project's own images, built on this host
-
-
 def local_name_refused(reference: str) -> ImagePullError | None:
-    """The refusal of a team image named without a registry part (None when it names one, or
-    is one of the project's own ``hlvs-runner/`` images, such as the stub team)."""
-    repository, _ = split_reference(reference.partition("@")[0])
-    if engine_images.registry_of(repository) or repository.startswith(PROJECT_REPOSITORY):
-        return None
-    name = repository.rsplit("/", 1)[-1]
-    return ImagePullError(
-        image=reference,
-        reason=(f"{reference} names no registry: a team's image is pulled from its registry "
-                "with the team's login, never taken from this host; push it (docker tag "
-                f"{reference} REGISTRY/TEAM/{name} && docker push REGISTRY/TEAM/{name}) and name "
-                f"REGISTRY/TEAM/{name} in team_config.json, with registry_auth for a private "
-                "registry"),
-    )
+    """The refusal of a team image named without a registry part (see
+    :func:`orchestrator.image_origin.local_name_reason`), or None."""
+    reason = local_name_reason(reference)
+    return None if reason is None else ImagePullError(image=reference, reason=reason)
 
 
 def split_reference(reference: str) -> tuple[str, str]:
