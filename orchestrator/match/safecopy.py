@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import itertools
 import logging
 import os
 import stat
@@ -266,21 +267,49 @@ def restrict(folder: Path) -> None:
 
 
 def remove_tree(folder: Path) -> None:
-    """Delete ``folder`` and everything under it, however deep (iteratively, never following
-    links)."""
+    """Delete ``folder`` and everything under it, however deep, in time linear in the number of
+    entries: each directory is first moved up into ``folder`` (by its file descriptors), so no
+    path grows with the depth and nothing recurses; links are never followed."""
     if folder.is_symlink() or not folder.is_dir():
         folder.unlink(missing_ok=True)
         return
-    directories = [folder]
-    for path, info, _ in _walk(folder):
-        if stat.S_ISDIR(info.st_mode):
-            directories.append(path)
-        else:
-            with contextlib.suppress(OSError):
-                path.unlink()
-    for directory in reversed(directories):  # children were listed after their parents
-        with contextlib.suppress(OSError):
-            directory.rmdir()
+    flags = os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW
+    try:
+        top = os.open(folder, flags)
+    except OSError as exc:
+        log.warning("cannot remove %s: %s", folder, exc)
+        return
+    moved = itertools.count()
+    try:
+        pending = [None]  # None: the top folder itself, else a name in it
+        while pending:
+            name = pending.pop()
+            try:
+                fd = top if name is None else os.open(name, flags, dir_fd=top)
+            except OSError:
+                continue
+            try:
+                for entry in list(os.scandir(fd)):
+                    with contextlib.suppress(OSError):
+                        if entry.is_dir(follow_symlinks=False):
+                            if name is None:
+                                pending.append(entry.name)
+                                continue
+                            staged = f".hlvs-removing-{next(moved)}"
+                            os.rename(entry.name, staged, src_dir_fd=fd, dst_dir_fd=top)
+                            pending.append(staged)
+                        else:
+                            os.unlink(entry.name, dir_fd=fd)
+            finally:
+                if fd != top:
+                    os.close(fd)
+            if name is not None:
+                with contextlib.suppress(OSError):
+                    os.rmdir(name, dir_fd=top)
+    finally:
+        os.close(top)
+    with contextlib.suppress(OSError):
+        folder.rmdir()
 
 
 def sweep(folder: Path, *, max_depth: int = MAX_DEPTH) -> CopyReport:
