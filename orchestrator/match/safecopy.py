@@ -281,7 +281,7 @@ def remove_tree(folder: Path) -> None:
         return
     moved = itertools.count()
     try:
-        pending = [None]  # None: the top folder itself, else a name in it
+        pending: list[str | None] = [None]  # None: the top folder itself, else a name in it
         while pending:
             name = pending.pop()
             try:
