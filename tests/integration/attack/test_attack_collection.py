@@ -1,18 +1,26 @@
 """A real match against a red robot that attacks log collection: 1,500 nested folders, a 3 GB
 sparse file with hard links, and a stdout flood. Collection survives, copies the data once, caps
-the console output, names the cuts in report.json, and leaves nothing behind."""
+the console output, names the cuts in report.json, and leaves nothing behind. While it plays,
+``hlvs cleanup --match`` of look-alike ids ("attack 1a2b", "attack_1a2b") touches nothing of it."""
 
 from __future__ import annotations
 
 import json
+import os
 import stat
+import subprocess
+import sys
+import time
+from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 import docker
 import pytest
 
+from orchestrator.match import logfs
 from orchestrator.match.layout import ROBOT_CONSOLE_BYTES
-from tests.integration.attack.conftest import Prepare, Prepared, left_behind
+from tests.integration.attack.conftest import REPO, Prepare, Prepared, left_behind
 
 pytestmark = [pytest.mark.docker, pytest.mark.root]
 
@@ -23,11 +31,41 @@ FLOOD_MB = 48
 @pytest.fixture(scope="module")
 def hoarder(prepare: Prepare, docker_client: docker.DockerClient
             ) -> tuple[Prepared, Any, list[str]]:
-    match = prepare("nest=1500", "sparse=5", f"flood={FLOOD_MB}", half_s=2.0,
+    """The match, and while it plays ``hlvs cleanup --match`` of ids that differ from its id
+    only in punctuation or spaces (the cleanup reports are kept in ``done.cleanups``)."""
+    match = prepare("nest=1500", "sparse=5", f"flood={FLOOD_MB}", half_s=5.0,
                     game={"limits": {"log_folder_gb": LOG_FOLDER_GB}})
-    done = match.run()
-    assert done.returncode == 0, done.stderr[-3000:]
+    process = match.start()
+    mount = logfs.state_dir() / "logfs" / logfs.safe_name(match.match_id) / "red-1"
+    deadline = time.monotonic() + 120
+    while not (mount / "attacks.json").is_file():
+        assert process.poll() is None and time.monotonic() < deadline, process.communicate()
+        time.sleep(0.2)
+    cleanups = []
+    for variant in (match.match_id.replace("-", " "), match.match_id.replace("-", "_")):
+        cleaned = subprocess.run(
+            [sys.executable, "-m", "orchestrator", "cleanup", "--match", variant],
+            capture_output=True, text=True, timeout=120, cwd=REPO, check=False,
+            env={**os.environ, "PYTHONPATH": str(REPO)})
+        assert cleaned.returncode == 0, cleaned.stderr[-2000:]
+        cleanups.append(json.loads(cleaned.stdout))
+    still_playing = process.poll() is None and str(mount) in Path("/proc/mounts").read_text()
+    stdout, stderr = process.communicate(timeout=300)
+    assert process.returncode == 0, stderr[-3000:]
+    done = SimpleNamespace(stdout=stdout, stderr=stderr, cleanups=cleanups,
+                           still_playing=still_playing)
     return match, done, left_behind(docker_client, match.match_id)
+
+
+def test_cleanup_of_a_look_alike_match_id_leaves_the_running_match_alone(
+    hoarder: tuple[Prepared, Any, list[str]],
+) -> None:
+    match, done, _ = hoarder
+    assert done.still_playing  # the cleanups ran during the match
+    for report in done.cleanups:
+        assert (report["containers"], report["networks"], report["host_objects"]) == ([], [], 0)
+    assert match.report()["status"] == "success"
+    assert (match.out / "teams/red/1/robocup-logs/attacks.json").is_file()
 
 
 def test_the_match_record_is_complete_and_nothing_is_left(
