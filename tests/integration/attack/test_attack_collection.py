@@ -118,3 +118,4 @@ def test_a_stdout_flood_is_capped_and_named_in_the_report(
     assert {"robot": "red-1", "what": "stdout.log",
             "reason": f"cut at the limit of {ROBOT_CONSOLE_BYTES // 2} bytes"} in report["logs_cut"]
     assert not any(cut["robot"].startswith("blue") for cut in report["logs_cut"])
+    assert match.results()["robots"]["red-1"]["limits"]["console_bytes"] == ROBOT_CONSOLE_BYTES
