@@ -93,7 +93,6 @@ class Connection:
         """
         count = 0
         taken = 0
-        bounds = self.bounds
         while True:
             try:
                 data = self.sock.recv(RECV_CHUNK)
@@ -110,13 +109,10 @@ class Connection:
             except FramingError as exc:
                 self.stats.bad_frames += 1
                 raise ClientClosed(f"out of sync: {exc}") from exc
+            frames = self._within_bounds(frames, now)
             template = self._template
             decoded: list[pb.ActuatorRequests | PositionTargets] = []
             for frame in frames:
-                dropped = bounds.admit(len(frame), now)
-                if dropped is not None:
-                    self.stats.drop_in(dropped, len(frame))
-                    continue
                 targets = template.match(frame) if template is not None else None
                 if targets is not None:
                     decoded.append(targets)
@@ -137,6 +133,21 @@ class Connection:
                 self.stats.round_trip_s.append(now - self.last_sent_at)
                 self.last_sent_at = None
         return count
+
+    def _within_bounds(self, frames: list[bytes], now: float) -> list[bytes]:
+        """The frames within the client's bounds (``frames`` itself when all are); the others
+        are dropped and counted."""
+        admit = self.bounds.admit
+        kept = frames
+        for index, frame in enumerate(frames):
+            dropped = admit(len(frame), now)
+            if dropped is not None:
+                if kept is frames:
+                    kept = frames[:index]
+                self.stats.drop_in(dropped, len(frame))
+            elif kept is not frames:
+                kept.append(frame)
+        return kept
 
     def read_threaded(self, now: float) -> bool:
         """I/O thread: :meth:`read`, leaving a failure in ``error`` for the step thread.
