@@ -406,6 +406,7 @@ def _api_run(
         "cpu_ratio_interleaved": round(ref_cpu / cpu, 3) if ref_cpu else None,
         "connected": len(stats),
         "dropped_out": sum(s["dropped_out"] for s in stats.values()),
+        "dropped_in": sum(sum(s["dropped_in"].values()) for s in stats.values()),
         "slow_periods": sum(s["slow_periods"] for s in stats.values()),
         "round_trip_p50_ms": round(sorted(rtts)[len(rtts) // 2], 3) if rtts else None,
         "camera_frames": cameras.frames,
@@ -461,6 +462,8 @@ def main(argv: list[str]) -> int:
         "render_ms_per_frame": api["render_ms_per_frame"],
         "render_processes": args.render_processes,
         "slow_periods": api["slow_periods"],
+        # requests over the clients' bounds (simulator.api.bounds): 0 for well-behaved clients
+        "dropped_in": api["dropped_in"],
         # share of the API run's wall time the step thread waited for the clients (lockstep)
         "client_wait_share": api["wait_share"],
         "step_thread_cpus": sorted(os.sched_getaffinity(0)),

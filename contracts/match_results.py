@@ -71,6 +71,7 @@ class LogFolderCopy:
     bytes: int = 0
     skipped: tuple[dict[str, str], ...] = ()  # {"path", "kind"}, the first ones only
     skipped_count: int = 0
+    stopped: str | None = field(default=None, metadata=omitted_when_none())  # at the size limit
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -216,6 +217,9 @@ class MatchReport(Versioned):
     status: Status
     failure_class: FailureClass | None = None
     cause: str | None = None
+    # what of the teams' logs was not kept (``{"robot", "what", "reason"}``: a log folder or
+    # console output cut at its size limit); the key is present only when something was cut
+    logs_cut: tuple[dict[str, str], ...] = ()
     version: int = VERSION
 
     def __post_init__(self) -> None:
@@ -224,10 +228,12 @@ class MatchReport(Versioned):
                              f"{self.failure_class}")
 
     @classmethod
-    def of(cls, failure: Failure | None) -> MatchReport:
+    def of(cls, failure: Failure | None, logs_cut: tuple[dict[str, str], ...] = ()
+           ) -> MatchReport:
         if failure is None:
-            return cls(status="success")
-        return cls(status="failed", failure_class=failure.failure_class, cause=failure.cause)
+            return cls(status="success", logs_cut=logs_cut)
+        return cls(status="failed", failure_class=failure.failure_class, cause=failure.cause,
+                   logs_cut=logs_cut)
 
     @property
     def failure(self) -> Failure | None:
@@ -238,11 +244,13 @@ class MatchReport(Versioned):
     def to_dict(self) -> dict[str, Any]:
         """Exactly ``{"status": "success"}`` or ``{"status": "failed", "failure_class": ...,
         "cause": ...}``, as teams' scripts compare it: the version (1) stays implicit until a
-        second one exists."""
+        second one exists. ``logs_cut`` is added only when a team's logs were cut."""
         data = Versioned.to_dict(self)
         del data["version"]
         if self.failure_class is None:
             del data["failure_class"], data["cause"]
+        if not self.logs_cut:
+            del data["logs_cut"]
         return data
 
 

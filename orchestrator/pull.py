@@ -27,6 +27,7 @@ from orchestrator.config import COLORS, Limits, RegistryAuth, TeamConfig
 from orchestrator.console import NullProgress, Progress, PullTracker
 from orchestrator.engine import images as engine_images
 from orchestrator.errors import ImageError, ImagePullError, ImageTooLarge, TeamImagesTooLarge
+from orchestrator.image_origin import local_name_reason
 from orchestrator.registry import (
     Credentials,
     RegistryClient,
@@ -75,8 +76,13 @@ def resolve_team_images(
     environ: Mapping[str, str] | None = None,
     progress: Progress | None = None,
     backoff: Backoff = PULL_BACKOFF,
+    registry_only: bool = False,
 ) -> dict[int, ResolvedImage]:
-    """Check every player's image in its registry, then pull and pin it; see module doc."""
+    """Check every player's image in its registry, then pull and pin it; see module doc.
+
+    ``registry_only`` (official and service matches): an image name without a registry part is
+    refused (:func:`local_name_refused`), so a team never runs an image that merely happens to
+    be on this host (another team's, pulled for an earlier match)."""
     environ = os.environ if environ is None else environ
     limit_bytes = round(limits.image_gb * GB)
     references = list(dict.fromkeys(p.image for p in team_config.players if p.image))
@@ -84,6 +90,11 @@ def resolve_team_images(
     failed: dict[str, ImageError] = {}
     remote: dict[str, RemoteImage] = {}
     for reference in references:
+        refused = local_name_refused(reference) if registry_only else None
+        if refused is not None:
+            log.info("image %s: %s", reference, refused.reason)
+            failed[reference] = refused
+            continue
         try:
             found = _inspect(reference, logins)
         except ImageError as exc:
@@ -164,13 +175,21 @@ def pull_game_images(
     engine = engine or connect()
     teams: dict[str, Mapping[int, ResolvedImage]] = {
         color: resolve_team_images(
-            engine, loaded.team(color), limits=loaded.game.limits, environ=environ
+            engine, loaded.team(color), limits=loaded.game.limits, environ=environ,
+            registry_only=loaded.game.registry_images,
         )
         for color in COLORS
     }
     result = GamePull(game=Path(game), teams=teams)
     log.info("pulled the images of %s: %s", game, result)
     return result
+
+
+def local_name_refused(reference: str) -> ImagePullError | None:
+    """The refusal of a team image named without a registry part (see
+    :func:`orchestrator.image_origin.local_name_reason`), or None."""
+    reason = local_name_reason(reference)
+    return None if reason is None else ImagePullError(image=reference, reason=reason)
 
 
 def split_reference(reference: str) -> tuple[str, str]:
@@ -272,7 +291,8 @@ def _resolve_one(
         if not registry:
             info = engine_images.inspect(engine, reference)
             if info is not None:
-                log.info("image %s: local image %s, used as is", reference, info.id)
+                log.warning("image %s: local image %s, used as is (allowed only where the game "
+                            "does not set registry_images)", reference, info.id)
             else:
                 info = pull(None)
         else:
@@ -284,7 +304,14 @@ def _resolve_one(
     if not digest:
         digest = info.repo_digests[0] if info.repo_digests else info.id
     error: ImageError | None = None
-    if info.size_bytes > limit_bytes:
+    if info.volumes:
+        error = ImageError(image=reference, reason=(
+            f"declares VOLUME {', '.join(info.volumes)}: a volume would give the robot disk "
+            "space outside its caps; a robot writes to /robocup-logs and its scratch folders "
+            "(/tmp, /var/tmp, /root) only: remove the VOLUME instruction (also from the base "
+            "image) and push it again"))
+        log.info("image %s: %s", reference, error.reason)
+    elif info.size_bytes > limit_bytes:
         error = ImageTooLarge(image=reference, size_bytes=info.size_bytes, limit_bytes=limit_bytes)
         log.info("image %s: %s; removing it", reference, error.reason)
         if registry:  # a pulled copy goes; a team's local-only image is not ours to delete
@@ -344,5 +371,6 @@ __all__ = [
     "ResolvedImage",
     "pull_game_images",
     "resolve_team_images",
+    "local_name_refused",
     "split_reference",
 ]

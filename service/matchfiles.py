@@ -37,6 +37,7 @@ def write_match(folder: Path, *, match_id: str, team: dict[str, Any],
                               ready_duration=settings.test_ready_duration_s,
                               wait_before_ready=3.0, grace=settings.test_grace_s)
     game = game_file(args, match_id)
+    game["registry_images"] = True  # a team's images only from its registry, with its login
     game["red"]["ports"] = _ports(10000, team)
     game["blue"]["ports"] = _ports(10020, opponent)
     private_dir(folder)  # the team files hold registry logins

@@ -90,7 +90,8 @@ def run(team_doc: dict[str, Any], *, settings: Settings,
 
         try:
             engine = engine or connect()
-            resolved = resolve_team_images(engine, team, limits=official_limits())
+            resolved = resolve_team_images(engine, team, limits=official_limits(),
+                                           registry_only=True)
         except OrchestratorError as exc:
             raise PreflightFailed(stage="pull", image="(all)", cause=str(exc)) from exc
         for number in sorted(resolved):

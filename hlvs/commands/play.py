@@ -27,6 +27,7 @@ from orchestrator.config.loader import load_game
 from orchestrator.engine import LABEL_SLURM_JOB
 from orchestrator.errors import ConfigError, InfrastructureError, OrchestratorError, Problem
 from orchestrator.exitcodes import ExitCode
+from orchestrator.image_origin import local_name_reason
 from orchestrator.match import (
     FailureClass,
     HostControl,
@@ -81,7 +82,8 @@ def _pull_resolver(client: Any, loaded: Any) -> ImageResolver:
         for color in ("red", "blue"):
             with progress(allow_rich=False) as bars:  # under the match's live view
                 resolved = resolve_team_images(
-                    client, loaded.team(color), limits=loaded.game.limits, progress=bars
+                    client, loaded.team(color), limits=loaded.game.limits, progress=bars,
+                    registry_only=loaded.game.registry_images,
                 )
             for number, image in resolved.items():
                 key = f"{color}-{number}"
@@ -234,6 +236,11 @@ def run_match_command(args: argparse.Namespace) -> int:
 
 def run_scrimmage_command(args: argparse.Namespace) -> int:
     out: Path = args.out
+    for image in (args.red_image, args.blue_image):
+        if image and local_name_reason(image) is not None:
+            log.warning("scrimmage: %s is played as this host has it (for the operator's own "
+                        "use; league and service matches take team images only from a "
+                        "registry)", image)
     game_path = scrimmage.write_files(args, out / "config")
     loaded = load_game(game_path, images_required=True)
     plan = _gpu_option(args, plan_from_game(loaded, grace_period_s=args.grace))

@@ -122,6 +122,7 @@ def build_game(document: Any, where: Collector, *, source: Path) -> GameConfig |
         timing=timing,
         allow_internet=document.get("allow_internet", False),
         official=document.get("official", False),
+        registry_images=bool(document.get("registry_images", document.get("official", False))),
         gpu=document.get("gpu", "auto"),
         public_logs=public_logs,
     )

@@ -21,6 +21,7 @@ from orchestrator.config.model import (
 from orchestrator.config.problems import Collector, pointer, raise_if_errors
 from orchestrator.config.team import build_team
 from orchestrator.errors import ConfigError, Problem
+from orchestrator.image_origin import local_name_reason
 
 
 def load_game(path: str | Path, *, images_required: bool = False) -> LoadedGame:
@@ -147,6 +148,28 @@ def _cross_checks(game: GameConfig, color: str, team: TeamConfig) -> list[Proble
             f"{len(ref.ports)} ports for the {len(team.players)} players of {team.source}",
             expected="one port per player",
         )
+    problems = list(where.problems)
+    if game.registry_images:
+        problems.extend(_registry_images(team))
+    return problems
+
+
+def _registry_images(team: TeamConfig) -> list[Problem]:
+    """Where the game takes team images from a registry only, each must name one (one problem
+    per field: the team's ``image`` or a player's own)."""
+    where = Collector(str(team.source))
+    found: dict[str, str] = {}
+    for player in team.players:
+        image = player.image
+        reason = local_name_reason(image) if image else None
+        if reason is None:
+            continue
+        own = player.image_repository != team.image
+        found.setdefault(pointer("players", str(player.number), "image") if own else "/image",
+                         reason)
+    for at, reason in found.items():
+        where.error(at, reason, expected="registry/path/name (game.json sets registry_images, "
+                    "or official)")
     return where.problems
 
 

@@ -102,6 +102,8 @@ class GameConfig:
     timing: Timing = field(default_factory=Timing)
     allow_internet: bool = False
     official: bool = False  # refused when it does not fit the host (see match.admission)
+    # team images only from a registry, with the team's login (default: as ``official``)
+    registry_images: bool = False
     gpu: str = "auto"  # auto | on | off: the host's GPU for the cameras (see match.gpu)
     public_logs: Path | None = None  # credentials.json-style target for the public logs
 

@@ -19,7 +19,6 @@ import hashlib
 import json
 import logging
 import os
-import re
 import shutil
 import time
 from collections.abc import Iterator
@@ -27,6 +26,7 @@ from contextlib import contextmanager
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any, Literal
+from urllib.parse import quote
 
 from orchestrator.filelock import held
 
@@ -45,7 +45,25 @@ __all__ = [
 log = logging.getLogger(__name__)
 
 SetKind = Literal["team", "public"]
-_UNSAFE = re.compile(r"[^A-Za-z0-9._-]+")
+_ID_SEPARATOR = "+"  # never in an escaped part (quote() escapes it)
+_MAX_PART = 120
+
+
+def set_id_of(match_id: str, team: str) -> str:
+    """The set's folder name: unique by construction for each (match id, team name), however
+    the names differ ("Bit Bots" and "Bit_Bots" are two sets). Each part is percent-escaped
+    (injective); a part too long for a folder name is cut and ends with its SHA-256."""
+    return _ID_SEPARATOR.join(_id_part(text) for text in (match_id, team))
+
+
+def _id_part(text: str) -> str:
+    escaped = quote(text, safe="")
+    if escaped.startswith("."):  # no hidden folder, no "." or ".."
+        escaped = "%2E" + escaped[1:]
+    if len(escaped) > _MAX_PART:
+        digest = hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()
+        escaped = f"{escaped[:_MAX_PART - 66]}%%{digest}"  # quote() never writes "%%"
+    return escaped or "%"  # nor a lone "%"
 _HASH_CHUNK = 1 << 20
 
 
@@ -144,7 +162,7 @@ def create_set(
 ) -> PendingSet:
     """Build a set from ``sources`` (local file, path inside the set). With ``move`` the files
     are moved into the store, otherwise hard-linked (copied across file systems)."""
-    set_id = f"{_UNSAFE.sub('_', match_id)}__{_UNSAFE.sub('_', team)}"
+    set_id = set_id_of(match_id, team)
     final = sets_dir(store) / set_id
     incoming = sets_dir(store) / f".incoming-{set_id}-{os.getpid()}"
     shutil.rmtree(incoming, ignore_errors=True)

@@ -22,6 +22,7 @@ import requests.exceptions
 from orchestrator.engine import LABEL_MATCH, LABEL_PROJECT
 from orchestrator.engine import networks as _networks
 from orchestrator.errors import InfrastructureError
+from orchestrator.match import ledger
 from orchestrator.match.runtime import (
     ContainerRequest,
     ContainerState,
@@ -60,11 +61,15 @@ class DockerRuntime:
     # networks -------------------------------------------------------------------------------
     def create_network(self, request: NetworkRequest) -> NetworkInfo:
         with translate("network", request.name):
-            return _networks.create_network(self._client, request)
+            info = _networks.create_network(self._client, request)
+        ledger.note(info.id)
+        return info
 
     def remove_network(self, name: str) -> None:
         with translate("network", name):
+            network_id = str(self._client.api.inspect_network(name).get("Id", ""))
             _networks.remove_network(self._client, name)
+        ledger.forget(network_id)
 
     # containers -----------------------------------------------------------------------------
     def create_container(self, request: ContainerRequest) -> str:
@@ -90,6 +95,9 @@ class DockerRuntime:
             "cpuset_cpus": request.cpuset_cpus,
             "tmpfs": dict(request.tmpfs) or None,
             "cgroup_parent": request.cgroup_parent,
+            "log_config": docker.types.LogConfig(type="json-file", config={
+                "max-size": str(max(1, request.console_max_bytes // 2)), "max-file": "2"})
+            if request.console_max_bytes is not None else None,
             "device_requests": [
                 docker.types.DeviceRequest(
                     driver=d.driver, count=d.count, device_ids=list(d.device_ids),
@@ -127,6 +135,7 @@ class DockerRuntime:
                 networking_config=networking,
             )
             container_id = str(created["Id"])
+            ledger.note(container_id)
             for extra in request.networks[1:]:
                 api.connect_container_to_network(
                     container_id,
@@ -155,7 +164,9 @@ class DockerRuntime:
 
     def remove(self, container_id: str) -> None:
         with translate("container", container_id):
+            full_id = str(self._client.api.inspect_container(container_id).get("Id", ""))
             self._client.api.remove_container(container_id, force=True, v=True)
+        ledger.forget(full_id)
 
     def inspect(self, container_id: str) -> ContainerState:
         with translate("container", container_id):
@@ -197,15 +208,31 @@ class DockerRuntime:
                 if sample is not None:
                     yield sample
 
-    def save_logs(self, container_id: str, *, stdout: Path, stderr: Path) -> None:
+    def save_logs(self, container_id: str, *, stdout: Path, stderr: Path,
+                  max_bytes: int | None = None) -> tuple[str, ...]:
+        """Write the container's stdout and stderr, each cut at ``max_bytes``; returns the
+        streams that were cut ("stdout", "stderr")."""
+        cut: list[str] = []
         with translate("container", container_id):
             for path, out, err in ((stdout, True, False), (stderr, False, True)):
                 path.parent.mkdir(parents=True, exist_ok=True)
-                with path.open("wb") as handle:
-                    for chunk in self._client.api.logs(
-                        container_id, stdout=out, stderr=err, stream=True, follow=False
-                    ):
-                        handle.write(chunk)
+                written = 0
+                stream = self._client.api.logs(
+                    container_id, stdout=out, stderr=err, stream=True, follow=False)
+                try:
+                    with path.open("wb") as handle:
+                        for chunk in stream:
+                            if max_bytes is not None and written + len(chunk) > max_bytes:
+                                handle.write(chunk[:max_bytes - written])
+                                cut.append("stdout" if out else "stderr")
+                                break
+                            handle.write(chunk)
+                            written += len(chunk)
+                finally:
+                    close = getattr(stream, "close", None)
+                    if callable(close):
+                        close()
+        return tuple(cut)
 
     def copy_out(self, container_id: str, path: str, destination: Path) -> None:
         """Copy ``path`` (a file or a folder) out of the container into ``destination``."""
@@ -239,14 +266,15 @@ class DockerRuntime:
                 name = (c.get("Names") or ["/?"])[0].lstrip("/")
                 found.append(
                     ProjectObject(
-                        kind="container", id=str(c["Id"]), name=name, labels=c["Labels"] or {}
+                        kind="container", id=str(c["Id"]), name=name, labels=c["Labels"] or {},
+                        created=ledger.created(str(c["Id"])),
                     )
                 )
             for n in self._client.api.networks(filters={"label": labels}):
                 found.append(
                     ProjectObject(
                         kind="network", id=str(n["Id"]), name=str(n["Name"]),
-                        labels=n.get("Labels") or {},
+                        labels=n.get("Labels") or {}, created=ledger.created(str(n["Id"])),
                     )
                 )
         return found

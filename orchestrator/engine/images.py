@@ -19,6 +19,7 @@ import docker.errors
 import requests.exceptions
 
 from orchestrator.errors import ImageError, ImagePullError, InfrastructureError
+from orchestrator.image_origin import registry_of
 
 log = logging.getLogger(__name__)
 
@@ -35,6 +36,7 @@ class ImageInfo:
     size_bytes: int
     labels: Mapping[str, str]
     created_unix: int = 0  # filled by list_labelled
+    volumes: tuple[str, ...] = ()  # the image's VOLUME paths
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -73,6 +75,7 @@ def inspect(client: docker.DockerClient, reference: str) -> ImageInfo | None:
         repo_digests=tuple(attrs.get("RepoDigests") or ()),
         size_bytes=int(attrs.get("Size") or 0),
         labels=dict(config.get("Labels") or {}),
+        volumes=tuple(sorted(config.get("Volumes") or {})),
     )
 
 
@@ -326,14 +329,6 @@ def _transient(message: str) -> bool:
     if any(word in lowered for word in _AUTH) or "server gave http response" in lowered:
         return False
     return any(word in lowered for word in _TRANSIENT)
-
-
-def registry_of(repository: str) -> str:
-    """The registry host of a repository name, or "" for a Docker Hub or local name."""
-    first = repository.split("/", 1)[0]
-    if "/" in repository and ("." in first or ":" in first or first == "localhost"):
-        return first
-    return ""
 
 
 def _classify(reference: str, message: str, auth: RegistryAuth | None) -> str:

@@ -1,7 +1,9 @@
 """Remove what matches left behind (after a crash or kill -9), found by our labels.
 
-Only matches whose orchestrator is gone are touched (see :mod:`orchestrator.match.ownership`),
-or one match named by the operator (refused while its orchestrator runs). Before anything is
+Only objects in this runner's records are touched (:mod:`orchestrator.match.ledger`: labels
+alone prove nothing, a team's image can carry them), and only of matches whose orchestrator is
+gone (see :mod:`orchestrator.match.ownership`), or of one match named by the operator (refused
+while its orchestrator runs). Before anything is
 removed, the teams' logs are salvaged into the match's output folder. Then containers go first
 (so networks have no endpoints left), then networks, then the host firewall rules and the
 loop-mounted log folders. Objects of a match with no run record are listed, never removed, unless
@@ -89,7 +91,7 @@ def plan_cleanup(runtime: ContainerRuntime, *, match_id: str | None = None) -> C
     totals = _Totals()
 
     def plan(one: str, record: RunRecord | None) -> None:
-        found = runtime.list_project(match_id=one)
+        found = _ours(runtime.list_project(match_id=one), totals)
         mounts = logfs.mounted(match_id=one)
         leftover_logs = (logfs.state_dir() / "logfs" / logfs.safe_name(one)).is_dir()
         if record is not None and (found or leftover_logs):
@@ -127,8 +129,8 @@ def clean_match(runtime: ContainerRuntime, host: Host, *, match_id: str,
     """Salvage (when the run record names an output folder) and remove one match's objects;
     objects labelled with run ``keep_run`` (the caller's own) are kept."""
     totals = totals if totals is not None else _Totals()
-    found = [o for o in runtime.list_project(match_id=match_id)
-             if keep_run is None or o.labels.get(LABEL_RUN) != keep_run]
+    found = _ours(runtime.list_project(match_id=match_id), totals)
+    found = [o for o in found if keep_run is None or o.labels.get(LABEL_RUN) != keep_run]
     leftover_logs = (logfs.state_dir() / "logfs" / logfs.safe_name(match_id)).is_dir()
     if record is not None and (found or leftover_logs):
         try:
@@ -145,6 +147,17 @@ def clean_match(runtime: ContainerRuntime, host: Host, *, match_id: str,
     if record is not None:
         ownership.forget(record)
     return totals.report()
+
+
+def _ours(found: list[ProjectObject], totals: _Totals) -> list[ProjectObject]:
+    """The objects this runner created (in its ledger); the others carry our labels without
+    being ours (an image with the labels baked in) and are listed, never touched."""
+    for obj in found:
+        if not obj.created:
+            totals.skipped.append(f"{obj.kind} {obj.name}: carries the labels of match "
+                                  f"{obj.labels.get(LABEL_MATCH, '?')} but this runner did not "
+                                  "create it (not in its records); left alone")
+    return [o for o in found if o.created]
 
 
 def _remove(runtime: ContainerRuntime, found: list[ProjectObject], totals: _Totals) -> None:

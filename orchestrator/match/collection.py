@@ -20,6 +20,7 @@ from contracts.errors import ContractError
 from contracts.match_results import MatchLimits, MatchResults
 from contracts.sim_result import SimResult
 from orchestrator.errors import OrchestratorError
+from orchestrator.match import layout
 from orchestrator.match.context import MatchContext
 from orchestrator.match.logfs import LogFolder
 from orchestrator.match.results import (
@@ -67,11 +68,16 @@ def simulator_stderr_tail(match: MatchContext) -> str:
 
 
 def _guarded(match: MatchContext, what: str, step: Callable[[], object]) -> None:
+    """Run one step of stopping, collecting or teardown; a failure fails the match (the first
+    one counts) and the next steps still run."""
     try:
         step()
     except (OrchestratorError, OSError) as exc:
         log.error("match %s: %s failed: %s", match.plan.match_id, what, exc)
         match.fail(FailureClass.INFRASTRUCTURE, f"{what}: {exc}")
+    except Exception as exc:  # noqa: BLE001 - the steps after this one must still run
+        log.exception("match %s: %s failed", match.plan.match_id, what)
+        match.fail(FailureClass.INFRASTRUCTURE, f"{what}: {type(exc).__name__}: {exc}")
 
 
 def _stop_robots(match: MatchContext) -> None:
@@ -102,6 +108,20 @@ def _read_counters(match: MatchContext) -> None:
         record.received_bytes = counters.received_bytes
 
 
+def _team_guarded(match: MatchContext, key: str, what: str, step: Callable[[], object]) -> None:
+    """A step that touches what a robot made: an engine failure fails the match (as
+    :func:`_guarded`), anything else costs only this robot's logs, named in report.json."""
+    try:
+        step()
+    except (OrchestratorError, OSError) as exc:
+        log.error("match %s: %s failed: %s", match.plan.match_id, what, exc)
+        match.fail(FailureClass.INFRASTRUCTURE, f"{what}: {exc}")
+    except Exception as exc:  # noqa: BLE001 - a robot's output never breaks the match record
+        log.exception("match %s: %s failed", match.plan.match_id, what)
+        match.logs_cut.append({"robot": key, "what": what,
+                               "reason": f"{type(exc).__name__}: {exc}"})
+
+
 def _collect_robot(match: MatchContext, key: str, container_id: str) -> None:
     record = match.records[key]
     folder = match.options.out_dir / "teams" / record.color / str(record.number)
@@ -112,8 +132,12 @@ def _collect_robot(match: MatchContext, key: str, container_id: str) -> None:
     peaks = match.monitor.peaks(key)
     record.cpu_peak_percent = peaks.cpu_percent
     record.memory_peak_bytes = peaks.memory_bytes
-    match.runtime.save_logs(container_id, stdout=folder / "stdout.log",
-                             stderr=folder / "stderr.log")
+    cap = layout.ROBOT_CONSOLE_BYTES // 2  # per stream (the engine keeps less of a flood)
+    cut = match.runtime.save_logs(container_id, stdout=folder / "stdout.log",
+                                   stderr=folder / "stderr.log", max_bytes=cap)
+    for stream in cut:
+        match.logs_cut.append({"robot": key, "what": f"{stream}.log",
+                               "reason": f"cut at the limit of {cap} bytes"})
 
 
 def _copy_public(match: MatchContext) -> None:
@@ -131,8 +155,11 @@ def _copy_public(match: MatchContext) -> None:
 def _collect_log_folder(match: MatchContext, key: str, folder: LogFolder,
                         destination: Path) -> None:
     """What a team wrote never fails the match: only releasing the mount can raise."""
-    report = match.host.collect_logs(folder, destination)
+    limit = int(match.plan.limits.log_folder_gb * 1e9)
+    report = match.host.collect_logs(folder, destination, limit_bytes=limit)
     match.records[key].log_folder = report.record()
+    if report.stopped:
+        match.logs_cut.append({"robot": key, "what": "robocup-logs", "reason": report.stopped})
     if report.skipped_count:
         log.warning("match %s: %s: %d entries of /robocup-logs not collected (%s)",
                     match.plan.match_id, key, report.skipped_count,
@@ -150,8 +177,8 @@ def _teardown(match: MatchContext) -> None:
     for key, folder in started.log_folders.items():
         record = match.records[key]
         target = match.options.out_dir / "teams" / record.color / str(record.number)
-        _guarded(match, f"releasing /robocup-logs of {key}",
-                 partial(_collect_log_folder, match, key, folder, target / "robocup-logs"))
+        _team_guarded(match, key, f"releasing /robocup-logs of {key}",
+                      partial(_collect_log_folder, match, key, folder, target / "robocup-logs"))
     for key, scratch in started.scratch.items():
         _guarded(match, f"releasing the scratch space of {key}",
                  partial(match.host.release, scratch))
@@ -169,7 +196,22 @@ def _teardown(match: MatchContext) -> None:
 
 
 def _finish(match: MatchContext) -> MatchResults:
-    """Run STOPPING and COLLECTING from wherever the match got to; returns the results."""
+    """Run STOPPING and COLLECTING from wherever the match got to; returns the results. The
+    teardown and the match record (results.json, report.json) happen whatever breaks before."""
+    try:
+        _stop_and_collect(match)
+    except Exception as exc:  # noqa: BLE001 - the record is written and everything removed
+        log.exception("match %s: collection failed", match.plan.match_id)
+        match.fail(FailureClass.INFRASTRUCTURE, f"collection failed: {type(exc).__name__}: {exc}")
+    try:
+        _teardown(match)
+    except Exception as exc:  # noqa: BLE001
+        log.exception("match %s: teardown failed", match.plan.match_id)
+        match.fail(FailureClass.INFRASTRUCTURE, f"teardown failed: {type(exc).__name__}: {exc}")
+    return _write(match)
+
+
+def _stop_and_collect(match: MatchContext) -> None:
     lifecycle = match.lifecycle
     if lifecycle.state in (MatchState.PULLING, MatchState.STARTING, MatchState.WAITING,
                            MatchState.PLAYING):
@@ -190,15 +232,13 @@ def _finish(match: MatchContext) -> MatchResults:
         match.telemetry.close()
     match.monitor.join(timeout_s=1.0)
     for key, container_id in started.robot_ids.items():
-        _guarded(match, f"collecting logs of {key}",
-                 partial(_collect_robot, match, key, container_id))
+        _team_guarded(match, key, f"collecting logs of {key}",
+                      partial(_collect_robot, match, key, container_id))
     if started.simulator_id is not None and started.match_dir is not None:
         sim_id, match_dir = started.simulator_id, started.match_dir
         _guarded(match, "collecting simulator logs", lambda: match.runtime.save_logs(
             sim_id, stdout=match_dir / "stdout.log", stderr=match_dir / "stderr.log"))
     _guarded(match, "copying public files", lambda: _copy_public(match))
-    _teardown(match)
-    return _write(match)
 
 
 def _host_controls(match: MatchContext) -> dict[str, bool] | None:
@@ -244,7 +284,7 @@ def _write(match: MatchContext) -> MatchResults:
     results = replace(results, timings_s=dict(lifecycle.timings_s))
     write_results(out, results)
     restrict(out)  # the teams' logs are theirs: owner-only, as everything else here
-    write_report(out, match.failure)
+    write_report(out, match.failure, tuple(match.logs_cut))
     log.info("match %s: %s, results in %s", plan.match_id,
              "failed" if match.failure else "done", out)
     return results

@@ -116,6 +116,8 @@ class MatchContext:
         self.forfeit: Forfeit | None = None
         self.bringup_s: float | None = None
         self.telemetry: TelemetrySource | None = None
+        # the teams' logs cut or lost in collection: {"robot", "what", "reason"} (report.json)
+        self.logs_cut: list[dict[str, str]] = []
 
 
     def advance(self, target: MatchState) -> None:

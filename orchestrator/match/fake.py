@@ -33,6 +33,7 @@ class FakeContainer:
     request: ContainerRequest
     state: ContainerState
     stops: list[float] = field(default_factory=list)
+    console: dict[str, str] = field(default_factory=dict)  # "stdout" / "stderr" -> more text
 
 
 class FakeRuntime:
@@ -53,6 +54,7 @@ class FakeRuntime:
         self.calls: list[tuple[str, str]] = []
         self._ids = itertools.count(1)
         self.on_start: Callable[[FakeContainer], None] | None = None
+        self.foreign: set[str] = set()  # started outside the runner (not in its records)
 
     def create_network(self, request: NetworkRequest) -> NetworkInfo:
         self.calls.append(("create_network", request.name))
@@ -141,11 +143,18 @@ class FakeRuntime:
         yield StatsSample(cpu_percent=50.0, memory_bytes=1000)
         yield StatsSample(cpu_percent=150.0, memory_bytes=4000)
 
-    def save_logs(self, container_id: str, *, stdout: Path, stderr: Path) -> None:
+    def save_logs(self, container_id: str, *, stdout: Path, stderr: Path,
+                  max_bytes: int | None = None) -> tuple[str, ...]:
         found = self._get(container_id)
+        cut = []
         for path in (stdout, stderr):
             path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_text(f"{found.request.name} {path.stem}\n")
+            text = f"{found.request.name} {path.stem}\n" + found.console.get(path.stem, "")
+            if max_bytes is not None and len(text) > max_bytes:
+                text = text[:max_bytes]
+                cut.append(path.stem)
+            path.write_text(text)
+        return tuple(cut)
 
     def copy_out(self, container_id: str, path: str, destination: Path) -> None:
         self._get(container_id)
@@ -157,7 +166,8 @@ class FakeRuntime:
 
     def list_project(self, *, match_id: str | None = None) -> list[ProjectObject]:
         found = [ProjectObject(kind="container", id=cid, name=c.request.name,
-                               labels=c.request.labels) for cid, c in self.containers.items()]
+                               labels=c.request.labels, created=cid not in self.foreign)
+                 for cid, c in self.containers.items()]
         found += [ProjectObject(kind="network", id=name, name=name, labels=r.labels)
                   for name, r in self.networks.items()]
         if match_id is None:
@@ -223,7 +233,8 @@ class FakeHost:
     def release(self, folder: LogFolder) -> None:
         self.released_folders.append(folder.path)
 
-    def collect_logs(self, folder: LogFolder, destination: Path) -> CopyReport:
+    def collect_logs(self, folder: LogFolder, destination: Path, *,
+                     limit_bytes: int | None = None) -> CopyReport:
         destination.mkdir(parents=True, exist_ok=True)
         return CopyReport()
 

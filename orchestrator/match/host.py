@@ -46,7 +46,8 @@ class Host(Protocol):
     def log_folder(self, *, match_id: str, name: str, cap_bytes: int, fallback: Path
                    ) -> LogFolder: ...
 
-    def collect_logs(self, folder: LogFolder, destination: Path) -> CopyReport: ...
+    def collect_logs(self, folder: LogFolder, destination: Path, *,
+                     limit_bytes: int | None = None) -> CopyReport: ...
 
     def release(self, folder: LogFolder) -> None: ...
 
@@ -133,8 +134,9 @@ class HostControl:
         return logfs.create(match_id=match_id, name=name, cap_bytes=cap_bytes,
                             fallback_dir=fallback)
 
-    def collect_logs(self, folder: LogFolder, destination: Path) -> CopyReport:
-        return logfs.collect(folder, destination)
+    def collect_logs(self, folder: LogFolder, destination: Path, *,
+                     limit_bytes: int | None = None) -> CopyReport:
+        return logfs.collect(folder, destination, limit_bytes=limit_bytes)
 
     def release(self, folder: LogFolder) -> None:
         logfs.release(folder)

@@ -194,6 +194,12 @@ def node_holder_request(
     )
 
 
+# what the engine keeps of one robot's stdout and stderr together (two rotated files of half),
+# and what the match keeps of each stream (stdout.log, stderr.log); the rest is dropped and the
+# cut is named in report.json
+ROBOT_CONSOLE_BYTES = 32_000_000
+
+
 def robot_request(
     robot: RobotPlan, *, prefix: str, holder_id: str, environment: Mapping[str, str],
     logs_dir: Path, limits: Limits, match_id: str, extra_labels: Mapping[str, str],
@@ -228,6 +234,7 @@ def robot_request(
         cap_drop=("ALL",),
         security_opt=("no-new-privileges",),
         cgroup_parent=cgroup_parent,
+        console_max_bytes=ROBOT_CONSOLE_BYTES,
     )
 
 
@@ -264,6 +271,7 @@ def simulator_request(
 
 __all__ = [
     "LOGS_TARGET",
+    "ROBOT_CONSOLE_BYTES",
     "SCRATCH_DIRS",
     "SIMULATOR_COMMAND",
     "Subnet",

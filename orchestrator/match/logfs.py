@@ -10,6 +10,7 @@ a plain folder without a cap is used and the result says so.
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import logging
 import os
 import re
@@ -19,15 +20,24 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from orchestrator.errors import InfrastructureError
-from orchestrator.match.safecopy import CopyReport, copy_tree, sweep
+from orchestrator.match.safecopy import CopyReport, copy_tree, remove_tree, sweep
 
 log = logging.getLogger(__name__)
 
 
+_PLAIN = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,99}")
+
+
 def safe_name(text: str) -> str:
-    """``text`` usable as a Docker object name part and as one path component."""
-    cleaned = re.sub(r"[^A-Za-z0-9_.-]", "-", text).lstrip(".-") or "match"
-    return cleaned[:100]
+    """``text`` usable as a Docker object name part and as one path component, unique by
+    construction: a valid match id (letters, digits, '_', '.', '-', starting with a letter or
+    digit) is itself; any other text becomes ``_<cleaned>-<SHA-256>``, which no valid id can
+    be (it starts with '_'), so "Bit Bots" and "Bit-Bots" never share a folder or a name."""
+    if _PLAIN.fullmatch(text):
+        return text
+    cleaned = re.sub(r"[^A-Za-z0-9_.-]", "-", text)[:40]
+    digest = hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()[:32]
+    return f"_{cleaned}-{digest}"
 
 
 def state_dir() -> Path:
@@ -77,19 +87,23 @@ def create(*, match_id: str, name: str, cap_bytes: int, fallback_dir: Path) -> L
     return LogFolder(path=mountpoint, cap_bytes=cap_bytes, image=image)
 
 
-def collect(folder: LogFolder, destination: Path) -> CopyReport:
+def collect(folder: LogFolder, destination: Path, *, limit_bytes: int | None = None
+            ) -> CopyReport:
     """Copy the folder's regular files and directories to ``destination`` (see
-    :mod:`orchestrator.match.safecopy`) and release the folder, whatever the team left in it.
-    Only a failure to release the mount raises."""
+    :mod:`orchestrator.match.safecopy`), at most ``limit_bytes`` (default: the folder's cap),
+    and release the folder, whatever the team left in it. Only a failure to release the mount
+    raises: whatever breaks the copy costs this folder's logs, nothing else."""
+    limit = limit_bytes if limit_bytes is not None else folder.cap_bytes
     try:
         destination.mkdir(parents=True, exist_ok=True)
         if folder.path.resolve() != destination.resolve():
-            report = copy_tree(folder.path, destination)
+            report = copy_tree(folder.path, destination, limit_bytes=limit)
         else:
             report = sweep(destination)
-    except OSError as exc:
+    except Exception as exc:  # noqa: BLE001 - a team's folder never breaks the match record
         report = CopyReport()
-        report.skip(".", f"not collected ({exc})")
+        report.skip(".", f"not collected ({type(exc).__name__}: {exc})")
+        report.stopped = f"collection failed: {type(exc).__name__}: {exc}"
         log.warning("log folder %s not collected: %s", folder.path, exc)
     finally:
         if folder.image is not None:
@@ -108,7 +122,7 @@ def release(folder: LogFolder) -> None:
             log.warning("%s; unmounting lazily", exc)
             _run("umount", "-l", str(folder.path))
     folder.image.unlink(missing_ok=True)
-    shutil.rmtree(folder.path, ignore_errors=True)
+    remove_tree(folder.path)
     with contextlib.suppress(OSError):  # the match's folder, once its last robot is released
         folder.path.parent.rmdir()
 

@@ -138,9 +138,11 @@ def write_results(out_dir: Path, results: MatchResults) -> Path:
     return results.write(out_dir / files.RESULTS)
 
 
-def write_report(out_dir: Path, failure: Failure | None) -> Path:
-    """Written last: its presence means the match folder is complete."""
-    return MatchReport.of(failure).write(out_dir / files.REPORT)
+def write_report(out_dir: Path, failure: Failure | None,
+                 logs_cut: tuple[dict[str, str], ...] = ()) -> Path:
+    """Written last: its presence means the match folder is complete. ``logs_cut``: the teams'
+    logs that were cut at their limit or lost, with the reason."""
+    return MatchReport.of(failure, logs_cut).write(out_dir / files.REPORT)
 
 
 __all__ = [

@@ -113,6 +113,9 @@ class ContainerRequest:
     tmpfs: Mapping[str, str] = field(default_factory=dict)  # path -> mount options ("size=16m")
     cgroup_parent: str | None = None  # e.g. "/hlvs-robots" (a node firewall matches it)
     device_requests: tuple[DeviceRequest, ...] = ()  # e.g. the host's GPUs
+    # the engine keeps at most this much of stdout and stderr together (two rotated files of
+    # half of it); None: the engine's default (no cap)
+    console_max_bytes: int | None = None
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -148,6 +151,7 @@ class ProjectObject:
     id: str
     name: str
     labels: Mapping[str, str]
+    created: bool = True  # in this runner's records (:mod:`orchestrator.match.ledger`)
 
 
 class ContainerRuntime(Protocol):
@@ -171,7 +175,8 @@ class ContainerRuntime(Protocol):
 
     def stats_stream(self, container_id: str) -> Iterator[StatsSample]: ...
 
-    def save_logs(self, container_id: str, *, stdout: Path, stderr: Path) -> None: ...
+    def save_logs(self, container_id: str, *, stdout: Path, stderr: Path,
+                  max_bytes: int | None = None) -> tuple[str, ...]: ...
 
     def copy_out(self, container_id: str, path: str, destination: Path) -> None: ...
 

@@ -6,6 +6,7 @@ the match's output folder, with a ``report.json`` that says the match was interr
 from __future__ import annotations
 
 import logging
+import os
 import re
 import shutil
 from dataclasses import dataclass, field, replace
@@ -16,6 +17,7 @@ from contracts.match_results import MatchResults, Salvage, SalvagedRobot
 from orchestrator.engine import LABEL_ROBOT, LABEL_ROLE, LABEL_TEAM
 from orchestrator.errors import OrchestratorError
 from orchestrator.match import logfs
+from orchestrator.match.layout import ROBOT_CONSOLE_BYTES
 from orchestrator.match.ownership import RunRecord
 from orchestrator.match.results import Failure, FailureClass, write_report, write_results
 from orchestrator.match.runtime import ContainerRuntime, ProjectObject
@@ -59,7 +61,8 @@ def salvage(runtime: ContainerRuntime, record: RunRecord, objects: list[ProjectO
         try:
             runtime.stop(obj.id, timeout_s=STOP_TIMEOUT_S)
             folder.mkdir(parents=True, exist_ok=True, mode=0o700)
-            runtime.save_logs(obj.id, stdout=folder / "stdout.log", stderr=folder / "stderr.log")
+            runtime.save_logs(obj.id, stdout=folder / "stdout.log", stderr=folder / "stderr.log",
+                              max_bytes=ROBOT_CONSOLE_BYTES // 2)
             report.robots[robot] = replace(report.robots[robot], stdout=True)
         except (OrchestratorError, OSError) as exc:
             report.errors.append(f"{team}-{number}: logs not saved: {exc}")
@@ -85,7 +88,13 @@ def salvage(runtime: ContainerRuntime, record: RunRecord, objects: list[ProjectO
             number = mount.name.partition("-")[2]
             if not mount.is_dir() or mount.is_symlink() or not number.isdigit():
                 continue
-            copied = copy_tree(mount, out / "teams" / team / number / "robocup-logs")
+            try:  # at most what the capped folder holds; one robot's folder breaks nothing
+                size = os.statvfs(mount)
+                copied = copy_tree(mount, out / "teams" / team / number / "robocup-logs",
+                                   limit_bytes=size.f_blocks * size.f_frsize)
+            except Exception as exc:  # noqa: BLE001
+                report.errors.append(f"{mount.name}: /robocup-logs not salvaged: {exc}")
+                continue
             saved = report.robots.get(mount.name, SalvagedRobot())
             report.robots[mount.name] = replace(saved, log_folder=copied.record())
     cause = (f"the orchestrator (pid {record.pid} on {record.hostname}) was gone; hlvs cleanup "

@@ -256,6 +256,7 @@ def _start_robot(match: MatchContext, robot: RobotPlan, folders: ThreadPoolExecu
             "log_folder_bytes": folder.cap_bytes,
             "scratch_bytes": scratch.cap_bytes if scratch is not None else None,
             "read_only_root": True,
+            "console_bytes": layout.ROBOT_CONSOLE_BYTES,  # what the engine keeps of its output
             "api_rate_bit_s": applied.api_rate_bit if applied else None,
             "comm_rate_bit_s": applied.comm_rate_bit if applied else None,
             "shaping_applied_ms": round(applied.applied_ms, 1) if applied else None,

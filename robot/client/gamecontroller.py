@@ -7,6 +7,7 @@ states as enums) and the UDP listener and replier.
 
 from __future__ import annotations
 
+import os
 import socket
 import time
 from dataclasses import dataclass
@@ -138,23 +139,40 @@ def encode_reply(
     return wire.encode_return(ReturnData(team=team, player=player, message=message))
 
 
-class GameControllerListener:
-    """Receives ``RGme`` packets on UDP 3838 and keeps the latest; garbage is counted."""
+GAMECONTROLLER_ENV = "ROBOCUP_GAMECONTROLLER_IP"
 
-    def __init__(self, *, host: str = "0.0.0.0", port: int = GC_DATA_PORT) -> None:
+
+class GameControllerListener:
+    """Receives ``RGme`` packets on UDP 3838 and keeps the latest; garbage is counted.
+
+    Only packets from the GameController are taken: ``gamecontroller`` (an address or a host
+    name; default: ``$ROBOCUP_GAMECONTROLLER_IP``, which the runner gives every robot). A packet
+    from any other address (a teammate, the other team) is ignored and counted in
+    ``foreign_packets``, its sender kept in ``foreign_sender``. With neither the argument nor the
+    variable (a robot outside a match), packets from any address are taken.
+    """
+
+    def __init__(self, *, host: str = "0.0.0.0", port: int = GC_DATA_PORT,
+                 gamecontroller: str | None = None) -> None:
         self._sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self._sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         self._sock.bind((host, port))
+        name = gamecontroller if gamecontroller is not None else os.environ.get(
+            GAMECONTROLLER_ENV, "")
+        self.allowed: frozenset[str] | None = _addresses(name.strip()) if name.strip() else None
         self.latest: GameControlData | None = None
         self.sender: str | None = None  # address of the last GameController packet
         self.bad_packets = 0
+        self.foreign_packets = 0  # packets from another address than the GameController's
+        self.foreign_sender: str | None = None
 
     @property
     def port(self) -> int:
         return int(self._sock.getsockname()[1])
 
     def receive(self, timeout: float | None = None) -> GameControlData | None:
-        """Wait up to ``timeout`` s for the next valid packet; None if none came."""
+        """Wait up to ``timeout`` s for the next valid packet from the GameController; None if
+        none came."""
         deadline = None if timeout is None else time.monotonic() + timeout
         while True:
             remaining = None if deadline is None else deadline - time.monotonic()
@@ -165,6 +183,10 @@ class GameControllerListener:
                 data, address = self._sock.recvfrom(4096)
             except TimeoutError:
                 return None
+            if self.allowed is not None and address[0] not in self.allowed:
+                self.foreign_packets += 1
+                self.foreign_sender = address[0]
+                continue
             try:
                 self.latest = decode_game_state(data)
             except BadPacket:
@@ -175,6 +197,15 @@ class GameControllerListener:
 
     def close(self) -> None:
         self._sock.close()
+
+
+def _addresses(name: str) -> frozenset[str]:
+    """The IPv4 addresses of ``name`` (itself when it is one, or cannot be resolved)."""
+    try:
+        found = socket.getaddrinfo(name, None, socket.AF_INET, socket.SOCK_DGRAM)
+    except OSError:
+        return frozenset({name})
+    return frozenset({str(info[4][0]) for info in found} | {name})
 
 
 class GameControllerReplier:
@@ -198,6 +229,7 @@ class GameControllerReplier:
 __all__ = [
     "GC_DATA_PORT",
     "GC_RETURN_PORT",
+    "GAMECONTROLLER_ENV",
     "BadPacket",
     "GameControlData",
     "GameControllerListener",

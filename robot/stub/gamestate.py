@@ -36,7 +36,7 @@ class GameControllerLink:
         self._player = player
         self._gc_ip = gamecontroller_ip
         self._return_port = return_port
-        self._listener = GameControllerListener(port=data_port)
+        self._listener = GameControllerListener(port=data_port, gamecontroller=gamecontroller_ip)
         self._replier: GameControllerReplier | None = None
         self._latest: GameControlData | None = None
         self._lock = threading.Lock()

@@ -11,6 +11,7 @@ from collections import deque
 from google.protobuf.message import DecodeError
 
 from contracts.robot_api import messages_pb2 as pb
+from simulator.api.bounds import READ_PER_CALL_BYTES, RequestBounds
 from simulator.api.fastreq import PositionTargets, PositionTemplate, scan_positions
 from simulator.api.framing import FrameDecoder, FramingError
 from simulator.api.stats import RobotStats
@@ -64,6 +65,7 @@ class Connection:
         self.stats = stats
         self.queue_limit = max(1, queue_limit)
         self.decoder = FrameDecoder()
+        self.bounds = RequestBounds(time.monotonic())
         self.requests: list[pb.ActuatorRequests | PositionTargets] = []
         self._template: PositionTemplate | None = None
         self.outbox: deque[bytes] = deque()
@@ -82,12 +84,15 @@ class Connection:
     # --- reading ----------------------------------------------------------------------------
 
     def read(self, now: float) -> int:
-        """Read everything available; returns the number of requests decoded.
+        """Read what is available, at most :data:`READ_PER_CALL_BYTES` (the rest waits for the
+        next call); returns the number of requests decoded. Requests over the client's bounds
+        (:mod:`simulator.api.bounds`) are dropped undecoded and counted.
 
         Raises:
             ClientClosed: on EOF, a socket error, a framing error or an undecodable message.
         """
         count = 0
+        taken = 0
         while True:
             try:
                 data = self.sock.recv(RECV_CHUNK)
@@ -98,11 +103,13 @@ class Connection:
             if not data:
                 raise ClientClosed("client disconnected")
             self.stats.bytes_in += len(data)
+            taken += len(data)
             try:
                 frames = self.decoder.feed(data)
             except FramingError as exc:
                 self.stats.bad_frames += 1
                 raise ClientClosed(f"out of sync: {exc}") from exc
+            frames = self._within_bounds(frames, now)
             template = self._template
             decoded: list[pb.ActuatorRequests | PositionTargets] = []
             for frame in frames:
@@ -118,7 +125,7 @@ class Connection:
             if decoded:
                 with self._requests_lock:
                     self.requests.extend(decoded)
-            if len(data) < RECV_CHUNK:
+            if len(data) < RECV_CHUNK or taken >= READ_PER_CALL_BYTES:
                 break
         if count:
             self.stats.messages_in += count
@@ -128,6 +135,21 @@ class Connection:
                 self.stats.round_trip_s.append(now - self.last_sent_at)
                 self.last_sent_at = None
         return count
+
+    def _within_bounds(self, frames: list[bytes], now: float) -> list[bytes]:
+        """The frames within the client's bounds (``frames`` itself when all are); the others
+        are dropped and counted."""
+        admit = self.bounds.admit
+        kept = frames
+        for index, frame in enumerate(frames):
+            dropped = admit(len(frame), now)
+            if dropped is not None:
+                if kept is frames:
+                    kept = frames[:index]
+                self.stats.drop_in(dropped, len(frame))
+            elif kept is not frames:
+                kept.append(frame)
+        return kept
 
     def read_threaded(self, now: float) -> bool:
         """I/O thread: :meth:`read`, leaving a failure in ``error`` for the step thread.

@@ -35,6 +35,14 @@ class RobotStats:
     slow_periods: int = 0
     warnings_sent: int = 0
     round_trip_s: array[float] = field(default_factory=lambda: array("d"))
+    # requests dropped undecoded, by reason ("size": over the request limit, "rate": over the
+    # client's byte or message budget; see simulator.api.bounds)
+    dropped_in: dict[str, int] = field(default_factory=dict)
+    dropped_in_bytes: int = 0
+
+    def drop_in(self, reason: str, size: int) -> None:
+        self.dropped_in[reason] = self.dropped_in.get(reason, 0) + 1
+        self.dropped_in_bytes += size
 
     def to_dict(self) -> dict[str, Any]:
         latencies = sorted(self.round_trip_s)
@@ -53,6 +61,8 @@ class RobotStats:
             "messages_out": self.messages_out,
             "bytes_out": self.bytes_out,
             "dropped_out": self.dropped_out,
+            "dropped_in": dict(self.dropped_in),
+            "dropped_in_bytes": self.dropped_in_bytes,
             "quota_errors": self.quota_errors,
             "bad_frames": self.bad_frames,
             "decode_errors": self.decode_errors,

@@ -116,7 +116,9 @@ def test_a_cpu_hog_is_held_to_its_limit_and_the_overcommit_is_recorded(
 def test_an_official_match_that_does_not_fit_is_refused_with_the_numbers(
     prepare: Prepare, docker_client: docker.DockerClient,
 ) -> None:
-    match = prepare("spoof", game={"official": True, "limits": {"cpus": 4, "memory_gb": 16}})
+    # registry_images off: the attacker is a local image, and admission is what is tested here
+    match = prepare("spoof", game={"official": True, "registry_images": False,
+                                   "limits": {"cpus": 4, "memory_gb": 16}})
     done = match.run(timeout_s=60)
     assert done.returncode == 1, done.stderr[-2000:]
     assert f"official match {match.match_id} refused" in done.stderr

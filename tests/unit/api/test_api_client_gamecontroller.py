@@ -104,3 +104,41 @@ def test_reads_the_referee_packets() -> None:
     assert {team.team_number for team in data.teams} == {8, 25}
     assert data.score(8) == 0 and data.own_penalty(25, 2) == 0
     assert data.team(8).players[0].goalkeeper  # type: ignore[union-attr]
+
+
+def test_listener_takes_packets_from_the_gamecontroller_only() -> None:
+    """A teammate (another address) forging a packet is ignored and counted; the
+    GameController's packets are taken."""
+    listener = GameControllerListener(host="0.0.0.0", port=0, gamecontroller="127.0.0.2")
+    teammate = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    teammate.bind(("127.0.0.1", 0))
+    gc = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    gc.bind(("127.0.0.2", 0))
+    try:
+        teammate.sendto(_packet(state=3), ("127.0.0.1", listener.port))  # a forged PLAYING
+        assert listener.receive(timeout=0.3) is None
+        assert listener.foreign_packets == 1 and listener.foreign_sender == "127.0.0.1"
+        assert listener.latest is None
+        gc.sendto(_packet(state=1), ("127.0.0.1", listener.port))
+        data = listener.receive(timeout=5)
+        assert data is not None and data.state is GameState.READY
+        assert listener.sender == "127.0.0.2" and listener.foreign_packets == 1
+    finally:
+        teammate.close()
+        gc.close()
+        listener.close()
+
+
+def test_listener_address_comes_from_the_environment(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("ROBOCUP_GAMECONTROLLER_IP", "localhost")
+    listener = GameControllerListener(host="127.0.0.1", port=0)
+    try:
+        assert listener.allowed is not None and "127.0.0.1" in listener.allowed
+    finally:
+        listener.close()
+    monkeypatch.delenv("ROBOCUP_GAMECONTROLLER_IP")
+    anyone = GameControllerListener(host="127.0.0.1", port=0)
+    try:
+        assert anyone.allowed is None  # outside a match: no address to hold packets to
+    finally:
+        anyone.close()

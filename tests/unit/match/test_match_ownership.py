@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import os
 import socket
+import stat
 from dataclasses import asdict, replace
 from pathlib import Path
 
@@ -98,3 +99,34 @@ def test_cleanup_touches_only_dead_matches_and_salvages_their_logs(tmp_path: Pat
 def test_a_record_from_another_host_counts_as_alive(tmp_path: Path) -> None:
     record = replace(_dead_record("far", tmp_path), hostname="elsewhere")
     assert ownership.owner_alive(record)
+
+
+def test_cleanup_leaves_a_container_that_only_carries_our_labels(tmp_path: Path) -> None:
+    """An image with our labels baked in, started outside the runner: named or not, cleanup
+    does not remove it (it is not in the runner's records), and says why."""
+    runtime, host = FakeRuntime(), FakeHost()
+    _dead_record("victim", tmp_path / "out")
+    ours = _robot(runtime, "victim", "run-victim", "red", 1)
+    foreign = _robot(runtime, "victim", "run-victim", "blue", 1)
+    runtime.foreign.add(foreign)
+    planned = plan_cleanup(runtime, match_id="victim")
+    assert planned.containers == ("hlvs-victim-red-1",)
+    report = cleanup(runtime, host, match_id="victim")
+    assert report.containers == ("hlvs-victim-red-1",)
+    assert any("hlvs-victim-blue-1" in s and "did not create it" in s for s in report.skipped)
+    assert ours not in runtime.containers and foreign in runtime.containers
+
+
+def test_ledger_records_ids_and_forgets_them(state: Path) -> None:
+    from orchestrator.match import ledger
+
+    cid = "ab" * 32
+    assert not ledger.created(cid)
+    ledger.note(cid)
+    assert ledger.created(cid)
+    assert stat.S_IMODE(ledger.ledger_dir().stat().st_mode) == 0o700
+    ledger.note("../../etc/passwd")  # not an engine id: never a path
+    assert not ledger.created("../../etc/passwd")
+    assert sorted(p.name for p in ledger.ledger_dir().iterdir()) == [cid]
+    ledger.forget(cid)
+    assert not ledger.created(cid)

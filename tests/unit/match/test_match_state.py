@@ -57,8 +57,14 @@ def test_safe_names_and_bandwidth_keys() -> None:
     from orchestrator.bandwidth import _ip_key, _udp_port_key, mb_s_to_bit
     from orchestrator.match.logfs import safe_name
 
-    assert safe_name("round 1/a:b") == "round-1-a-b"
-    assert safe_name("../x") == "x"
+    assert safe_name("round-1.a_b") == "round-1.a_b"  # a valid match id is itself
+    assert safe_name("round 1/a:b").startswith("_round-1-a-b-")
+    assert safe_name("../x").startswith("_..-x-")
+    # ids that differ only in punctuation or spaces never share a name
+    names = {safe_name(text) for text in ("Bit Bots", "Bit-Bots", "Bit_Bots", "Bit/Bots",
+                                          "Bit:Bots", "_Bit-Bots", "bit bots")}
+    assert len(names) == 7
+    assert all(len(n) <= 100 and "/" not in n for n in names)
     assert mb_s_to_bit(350 / 4) == 700_000_000
     assert mb_s_to_bit(1.0) == 8_000_000
     assert _ip_key("10.213.4.12", 16) == "0x0ad5040c/0xffffffff+16"

@@ -103,6 +103,41 @@ def fill(path: str) -> None:
         pass
 
 
+def nest(depth: int) -> None:
+    """``depth`` folders inside each other in /robocup-logs, a file at the bottom."""
+    here = os.open(LOGS, os.O_RDONLY)
+    for _ in range(depth):
+        os.mkdir("d", dir_fd=here)
+        deeper = os.open("d", os.O_RDONLY, dir_fd=here)
+        os.close(here)
+        here = deeper
+    fd = os.open("bottom.txt", os.O_WRONLY | os.O_CREAT, 0o644, dir_fd=here)
+    os.write(fd, b"deep\n")
+    os.close(fd)
+    os.close(here)
+    seen["nest"] = depth
+
+
+def sparse(links: int) -> None:
+    """A 3 GB sparse file with a little data, and ``links`` hard links to it."""
+    path = os.path.join(LOGS, "sparse.bin")
+    with open(path, "wb") as handle:
+        handle.write(b"head")
+        handle.seek(3 * 10**9)
+        handle.write(b"tail")
+    for i in range(links):
+        os.link(path, os.path.join(LOGS, f"link{i}"))
+    seen["sparse"] = {"size": os.stat(path).st_size, "links": links}
+
+
+def flood(megabytes: int) -> None:
+    """``megabytes`` MB on stdout as fast as it goes."""
+    line = ("x" * 1023 + "\n").encode()
+    for _ in range(megabytes * 1024):
+        os.write(1, line)
+    seen["flood"] = megabytes
+
+
 def hog(count: int) -> None:
     for _ in range(count):
         if os.fork() == 0:
@@ -124,6 +159,12 @@ def main(argv: list[str]) -> None:
                 sys.exit(int(arg.partition("=")[2]))
             elif arg.startswith("hog="):
                 hog(int(arg.partition("=")[2]))
+            elif arg.startswith("nest="):
+                nest(int(arg.partition("=")[2]))
+            elif arg.startswith("sparse="):
+                sparse(int(arg.partition("=")[2]))
+            elif arg.startswith("flood="):
+                flood(int(arg.partition("=")[2]))
         except Exception as exc:  # an attack that breaks is reported, the next one still runs
             seen[f"{arg} crashed"] = repr(exc)
         save()

@@ -1,0 +1,55 @@
+"""What this runner created: one empty file per container and network id.
+
+Cleanup removes only objects found here. Labels alone do not prove that the runner made an
+object: a team's image can carry our labels, and a container started from it outside the runner
+(to look at it, say) carries them too. The ledger lives in ``$HLVS_STATE_DIR/created/`` (0700),
+next to the run records; an id is entered when the engine has created the object and removed
+when the runner removes it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import re
+from pathlib import Path
+
+from orchestrator.match.logfs import state_dir
+
+log = logging.getLogger(__name__)
+
+_ID = re.compile(r"[0-9a-f]{12,64}")
+
+
+def ledger_dir() -> Path:
+    return state_dir() / "created"
+
+
+def note(object_id: str) -> None:
+    """Enter ``object_id`` (best effort: a state folder that cannot be written only means that
+    cleanup will not remove the object, and says so)."""
+    if not _ID.fullmatch(object_id):
+        return
+    try:
+        folder = ledger_dir()
+        folder.mkdir(parents=True, exist_ok=True, mode=0o700)
+        fd = os.open(folder / object_id, os.O_WRONLY | os.O_CREAT | os.O_NOFOLLOW, 0o600)
+        os.close(fd)
+    except OSError as exc:
+        log.warning("cannot record %s in %s (cleanup will leave it): %s", object_id[:12],
+                    ledger_dir(), exc)
+
+
+def created(object_id: str) -> bool:
+    """True when this runner created ``object_id`` and has not removed it yet."""
+    return bool(_ID.fullmatch(object_id)) and (ledger_dir() / object_id).is_file()
+
+
+def forget(object_id: str) -> None:
+    if _ID.fullmatch(object_id):
+        with contextlib.suppress(OSError):
+            (ledger_dir() / object_id).unlink()
+
+
+__all__ = ["created", "forget", "ledger_dir", "note"]
