@@ -44,7 +44,7 @@ def hoarder(prepare: Prepare, docker_client: docker.DockerClient
     cleanups = []
     for variant in (match.match_id.replace("-", " "), match.match_id.replace("-", "_")):
         cleaned = subprocess.run(
-            [sys.executable, "-m", "orchestrator", "cleanup", "--match", variant],
+            [sys.executable, "-m", "hlvs", "cleanup", "--match", variant],
             capture_output=True, text=True, timeout=120, cwd=REPO, check=False,
             env={**os.environ, "PYTHONPATH": str(REPO)})
         assert cleaned.returncode == 0, cleaned.stderr[-2000:]

@@ -49,7 +49,7 @@ def test_cleanup_leaves_a_foreign_container_that_carries_our_labels(
         labels={LABEL_PROJECT: "1", LABEL_MATCH: match_id, LABEL_ROLE: "robot",
                 TEST_LABEL: "1"}))
     try:
-        done = subprocess.run([sys.executable, "-m", "orchestrator", "cleanup", "--match",
+        done = subprocess.run([sys.executable, "-m", "hlvs", "cleanup", "--match",
                                match_id], capture_output=True, text=True, timeout=120, cwd=REPO,
                               env={**os.environ, "PYTHONPATH": str(REPO)}, check=False)
         assert done.returncode == 0, done.stderr[-2000:]
