@@ -46,6 +46,17 @@ def is_fixture(session: Session, submission_id: str) -> bool:
     return session.get(LadderFixture, submission_id) is not None
 
 
+def watchable(session: Session, *, team_id: int, team_name: str | None,
+              submission_id: str) -> Submission:
+    """The team's own submission, or a friendly it was the opponent in (its replay is the
+    team's too); anything else is 'not found', like an unknown id."""
+    row = session.scalar(select(Submission).where(Submission.id == submission_id))
+    if row is not None and (row.team_id == team_id or (
+            team_name is not None and row.opponent == team_name)):
+        return row
+    return submissions.get_own(session, team_id=team_id, submission_id=submission_id)
+
+
 class LadderThread:
     def __init__(self, services: Services) -> None:
         self.services = services
@@ -162,4 +173,4 @@ def _newest(session: Session, team_id: int, kind: str) -> int | None:
         .order_by(TeamFile.version.desc()).limit(1))
 
 
-__all__ = ["LadderThread", "is_fixture"]
+__all__ = ["LadderThread", "is_fixture", "watchable"]

@@ -202,7 +202,7 @@ def rate(matches: Iterable[RatedMatch], teams: Iterable[str] = ()) -> Ladder:
         red = ladder.teams.setdefault(match.red_team, TeamRating(team=match.red_team))
         blue = ladder.teams.setdefault(match.blue_team, TeamRating(team=match.blue_team))
         winner = match.winner or _winner(None, match.red_goals, match.blue_goals)
-        ranks = {"red": [0, 1], "blue": [1, 0]}.get(winner, [0, 0])
+        ranks: list[float] = {"red": [0.0, 1.0], "blue": [1.0, 0.0]}.get(winner, [0.0, 0.0])
         before = {"red": (red.mu, red.sigma), "blue": (blue.mu, blue.sigma)}
         [[new_red], [new_blue]] = MODEL.rate(
             [[MODEL.create_rating([red.mu, red.sigma], name=red.team)],
