@@ -185,3 +185,33 @@ def test_a_match_without_play_or_results_is_not_counted(tmp_path: Path) -> None:
     played = outcome_of(path)
     assert played.counted and (played.red_goals, played.blue_goals, played.winner) == (0, 2,
                                                                                         "blue")
+
+
+def test_official_matches_of_the_tournament_are_rated_once(
+    start: Callable[..., Served], token: Callable[..., str], tmp_path: Path,
+) -> None:
+    from tests.unit.schedule.test_schedule import COMPRESSED, FAKE, write_schedule
+    from tournament import Ledger, run_schedule, standings
+
+    path = write_schedule(tmp_path, COMPRESSED + "fixtures:\n  round_robin: {teams: [alpha, "
+                          "bravo, charlie], first_stream: '+1.5s', interval_s: 0.5, "
+                          "stream_length_s: 0.3}\n")
+    state = tmp_path / "state.sqlite"
+    assert run_schedule(path, state, services=FAKE, exit_when_done=True, poll_s=0.1) == 0
+    served = start(schedule_state=str(state))
+    http = served.client(token("Observer"))  # a team that plays no friendly reads it too
+    wait_rated(served, 3)
+    table = http.get("/v1/ladder").json()
+    expected = {s.team: s for s in standings(Ledger(state).rows(), ["alpha", "bravo", "charlie"])}
+    assert table["matches_rated"] == 3
+    assert {t["team"]: (t["won"], t["drawn"], t["lost"], t["goals_for"], t["goals_against"])
+            for t in table["teams"]} == {
+        name: (s.won, s.drawn, s.lost, s.goals_for, s.goals_against)
+        for name, s in expected.items()}
+    ratings = [t["rating"] for t in table["teams"]]
+    assert ratings == sorted(ratings, reverse=True) and ratings[0] != ratings[-1]
+    matches = http.get(f"/v1/ladder/{table['teams'][0]['team']}").json()["matches"]
+    assert {m["source"] for m in matches} == {"official"} and len(matches) == 2
+    assert all(m["replay_url"] is None for m in matches)
+    time.sleep(0.3)  # further rounds of the ladder thread
+    assert rated_count(served) == 3
