@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import logging
 import threading
+import time
 from collections import Counter
 from datetime import timedelta
 from pathlib import Path
@@ -39,6 +40,9 @@ if TYPE_CHECKING:
     from service.app import Services
 
 log = logging.getLogger(__name__)
+
+OFFICIAL_EVERY_S = 5.0
+"""The tournament's ledger is read for newly played official matches at most this often."""
 
 
 def is_fixture(session: Session, submission_id: str) -> bool:
@@ -65,6 +69,7 @@ class LadderThread:
         self._stop = threading.Event()
         self._wake = threading.Event()
         self._thread: threading.Thread | None = None
+        self._ledger_read = -OFFICIAL_EVERY_S
 
     def start(self) -> None:
         self._thread = threading.Thread(target=self._run, name="ladder", daemon=True)
@@ -91,7 +96,9 @@ class LadderThread:
         with transaction(self.services.sessions) as session:
             recorded = ratings.record_friendlies(session, self.services.pool.results_dir)
             state = self.settings.schedule_state
-            if state and Path(state).is_file():
+            if state and Path(state).is_file() and \
+                    time.monotonic() - self._ledger_read >= OFFICIAL_EVERY_S:
+                self._ledger_read = time.monotonic()
                 recorded += ratings.record_official(session, Path(state))
         if recorded:
             log.info("ladder: %d finished match(es) recorded", recorded)
