@@ -173,6 +173,10 @@ def test_ladder_off_waits_for_a_free_slot_and_survives_a_restart(
         assert len(list(session.scalars(select(Submission)))) == 2
     engine.dispose()
     assert http.get("/v1/ladder").json()["matches_rated"] == 2
+    schema = http.get("/openapi.json").json()
+    assert {"/v1/ladder", "/v1/ladder/{team}"} <= set(schema["paths"])
+    assert {"LadderView", "TeamLadderView", "LadderMatch"} <= set(schema["components"]["schemas"])
+    assert httpx.get(f"{served.url}/v1/ladder").status_code == 401  # signed-in readers only
 
 
 def test_a_match_without_play_or_results_is_not_counted(tmp_path: Path) -> None:
