@@ -12,9 +12,9 @@ from fastapi import FastAPI
 
 from service.app import create_app as create_service_app
 from service.settings import Settings
-from viewer import service_pages
+from viewer import ladder_page, service_pages
 
-MOUNTS = (service_pages.mount,)
+MOUNTS = (ladder_page.mount, service_pages.mount)  # the ladder before the viewer's /watch/*
 
 
 def create_app(settings: Settings, **options: Any) -> FastAPI:

@@ -39,7 +39,7 @@ Mount = Callable[[FastAPI], None]
 def service_routers() -> tuple[Mount, ...]:
     """The service's own routers, in the order they are mounted (imported when an app is built:
     they import the service's modules, which import this one for :class:`Services`)."""
-    from service.routers import envs, health, nodes, operator, submissions, teams
+    from service.routers import envs, health, ladder, nodes, operator, submissions, teams
 
     return (
         health.mount,
@@ -48,6 +48,7 @@ def service_routers() -> tuple[Mount, ...]:
         operator.mount,
         nodes.mount,  # the match pool's machines (operators)
         envs.mount,  # the HTTP environment API (learning environments)
+        ladder.mount,  # the league table of ratings
     )
 
 
@@ -150,6 +151,10 @@ def create_app(
             services.aftermatch.start()
             services.worker = QueueWorker(services)
             services.worker.start()
+            from service.ladder import LadderThread
+
+            services.extras["ladder_thread"] = LadderThread(services)
+            services.extras["ladder_thread"].start()
         # Everything loaded so far lives as long as the process: kept out of the collector's
         # full passes, which would otherwise stop every request for tens of milliseconds.
         gc.collect()
@@ -157,6 +162,8 @@ def create_app(
         try:
             yield
         finally:
+            if "ladder_thread" in services.extras:
+                services.extras["ladder_thread"].stop()
             if services.worker is not None:
                 services.worker.stop()
             if services.aftermatch is not None:

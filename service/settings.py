@@ -94,7 +94,11 @@ class Settings:
     public_url: str = "http://127.0.0.1:8000"
     """Base of the links in mails and webhooks."""
     schedule_state: str = ""
-    """The tournament's state file (``hlvs schedule run --state``), served to operators."""
+    """The tournament's state file (``hlvs schedule run --state``), served to operators; its
+    played matches also count for the ladder's ratings."""
+    ladder_every_s: float = 0.0
+    """The ladder schedules a friendly between two teams that accept them at most this often,
+    in a free slot (nothing queued); 0: off (friendlies are still rated)."""
     extra: Mapping[str, str] = field(default_factory=dict)
 
     @property
@@ -175,6 +179,9 @@ def _check(settings: Settings) -> None:
         raise SettingsError(name=PREFIX + "WEBHOOK_ALLOW", value=settings.webhook_allow,
                             expected=f"comma-separated networks, e.g. 10.0.0.0/8 ({exc})"
                             ) from None
+    if settings.ladder_every_s < 0:
+        raise SettingsError(name=PREFIX + "LADDER_EVERY_S", value=str(settings.ladder_every_s),
+                            expected="0 (off) or a positive number of seconds")
     if settings.match_slots < 1:
         raise SettingsError(name=PREFIX + "MATCH_SLOTS", value=str(settings.match_slots),
                             expected="at least 1")

@@ -34,6 +34,7 @@ from service.accounts import ensure_team_account, supports_accounts
 from service.aftermatch import replay_of, team_logs_of
 from service.db import MediaState, Submission, SubmissionState, Team, now, transaction
 from service.errors import ServiceError
+from service.ladder import is_fixture
 from service.matchfiles import OWN_COLOR
 from service.submissions import STUB, failure_side, queue_paused
 
@@ -217,7 +218,7 @@ class QueueWorker:
     def _mark_running(self, session: Session, row: Submission) -> None:
         row.state = SubmissionState.RUNNING.value
         row.started_at = row.started_at or now()
-        row.charged = True
+        row.charged = not is_fixture(session, row.id)  # the ladder's matches are free
         notify.enqueue(session, row, "submission.started", self.settings)
         log.info("submission %s running as match %s", row.id, row.match_id)
 

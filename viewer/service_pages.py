@@ -19,6 +19,7 @@ from service import submissions
 from service.db import Submission
 from service.deps import DbSession, TeamPrincipal, get_services
 from service.errors import NotFound
+from service.ladder import watchable
 from viewer.api import mount_viewer
 from viewer.sources import LiveSource, ReplaySource, live_of
 
@@ -45,7 +46,8 @@ class SubmissionResolver:
     def replay(self, replay_id: str, request: Request, principal: TeamPrincipal,
                session: DbSession) -> ReplaySource:
         assert principal.team_id is not None
-        row = submissions.get_own(session, team_id=principal.team_id, submission_id=replay_id)
+        row = watchable(session, team_id=principal.team_id, team_name=principal.team_name,
+                        submission_id=replay_id)  # a friendly's opponent watches it too
         source = _replay_of(row, _match_dir(request, row))
         if source is None:
             raise NotFound(what="replay of submission", ident=f"{row.id} ({row.state})")

@@ -1,0 +1,270 @@
+"""The ladder's ratings: every played match between two teams, rated with OpenSkill.
+
+Which matches count: friendlies (a finished test match whose opponent is a team) and, when the
+service is given the tournament's state (``HLVS_SERVICE_SCHEDULE_STATE``), the official matches
+of the schedule. A match counts only when football was played: its ``results.json`` has a half
+that reached PLAYING and some time in PLAYING (``play.halves_playing``, ``play.playing_s``). A
+win, a draw and a loss are the ranks of the two teams (a draw ties them); the goals only fill the
+table.
+
+Each match is recorded once (:class:`service.db.ladder.RatedMatch`, unique by source and id,
+written in the transaction that finds it), so a restart or a second look never counts it twice.
+The ratings themselves are not stored: they are the OpenSkill (Plackett-Luce) updates of the
+counted matches in the order they were recorded, recomputed when that list changes. A team's
+*rating* is OpenSkill's ordinal, ``mu - 3 sigma``: it rises as the team wins and as its rating
+becomes certain.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+from datetime import datetime
+from pathlib import Path
+from typing import Any
+
+from openskill.models import PlackettLuce
+from sqlalchemy import exists, func, select
+from sqlalchemy.orm import Session
+
+from contracts import files
+from contracts.errors import ContractError
+from contracts.match_results import MatchResults
+from service.db import Submission, SubmissionState, Team, now, utc
+from service.db.ladder import RatedMatch
+from service.matchfiles import OWN_COLOR
+from service.submissions import STUB
+
+FRIENDLY = "friendly"
+OFFICIAL = "official"
+OTHER_COLOR = "blue" if OWN_COLOR == "red" else "red"
+
+MODEL = PlackettLuce()
+"""OpenSkill's Plackett-Luce model with its defaults (mu 25, sigma 25/3)."""
+
+
+@dataclass(frozen=True, slots=True)
+class Outcome:
+    """What a finished match gives the ladder: the goals and the winner, or why it is not rated."""
+
+    red_goals: int | None
+    blue_goals: int | None
+    winner: str | None  # red | blue | draw
+    note: str | None  # None: counted
+
+    @property
+    def counted(self) -> bool:
+        return self.note is None
+
+
+def outcome_of(results_path: Path) -> Outcome:
+    """The outcome of a match from its ``results.json``; a match that did not play, or left no
+    readable results, is not counted (``note`` says why)."""
+    try:
+        results = MatchResults.load(results_path)
+    except ContractError as exc:
+        return Outcome(None, None, None, f"no readable {files.RESULTS}: {exc}")
+    score = results.score or {}
+    red, blue = score.get("red"), score.get("blue")
+    play = results.play
+    if play is None or not play.halves_playing or play.playing_s <= 0:
+        return Outcome(red, blue, None, "the match did not play (no half reached PLAYING)")
+    if red is None or blue is None:
+        return Outcome(red, blue, None, "the match has no score")
+    return Outcome(red, blue, _winner(results.winner, red, blue), None)
+
+
+def _winner(winner: str | None, red: int, blue: int) -> str:
+    if winner in ("red", "blue", "draw"):
+        return winner
+    return "red" if red > blue else "blue" if blue > red else "draw"
+
+
+# recording --------------------------------------------------------------------------------
+def record_friendlies(session: Session, results_dir: Callable[[str], Path]) -> int:
+    """Record every finished friendly not considered yet; the number recorded.
+
+    ``results_dir(pool_handle)`` is the pool's output folder of a match.
+    """
+    seen = exists().where(RatedMatch.source == FRIENDLY, RatedMatch.ref == Submission.id)
+    rows = session.execute(select(Submission, Team.name).join(
+        Team, Team.id == Submission.team_id).where(
+        Submission.state == SubmissionState.DONE.value, Submission.opponent != STUB,
+        Submission.pool_handle.is_not(None), ~seen).order_by(Submission.finished_at,
+                                                             Submission.seq)).all()
+    for row, team in rows:
+        assert row.pool_handle is not None
+        outcome = outcome_of(results_dir(row.pool_handle) / files.RESULTS)
+        teams = {OWN_COLOR: team, OTHER_COLOR: row.opponent}
+        _add(session, source=FRIENDLY, ref=row.id, red=teams["red"], blue=teams["blue"],
+             outcome=outcome, played_at=utc(row.finished_at) if row.finished_at else now())
+    return len(rows)
+
+
+def record_official(session: Session, state_file: Path) -> int:
+    """Record the tournament's played matches not considered yet (from its ledger)."""
+    from tournament import Ledger
+    from tournament.standings import COUNTED
+
+    known = set(session.scalars(select(RatedMatch.ref).where(RatedMatch.source == OFFICIAL)))
+    added = 0
+    for row in Ledger(state_file).rows():
+        result = row.result
+        if row.id in known or row.state not in COUNTED or not result:
+            continue
+        _add(session, source=OFFICIAL, ref=row.id, red=str(result.get("red_team", row.red)),
+             blue=str(result.get("blue_team", row.blue)), outcome=_official_outcome(result),
+             played_at=utc(row.updated_at))
+        added += 1
+    return added
+
+
+def _official_outcome(result: dict[str, Any]) -> Outcome:
+    out_dir = result.get("out_dir")
+    if out_dir and (Path(out_dir) / files.RESULTS).is_file():
+        return outcome_of(Path(out_dir) / files.RESULTS)
+    score = result.get("score") or {}
+    red, blue = score.get("red"), score.get("blue")
+    if not isinstance(red, int) or not isinstance(blue, int):
+        return Outcome(None, None, None, "the match has no score")
+    return Outcome(red, blue, _winner(result.get("winner"), red, blue), None)
+
+
+def _add(session: Session, *, source: str, ref: str, red: str, blue: str, outcome: Outcome,
+         played_at: datetime) -> None:
+    session.add(RatedMatch(source=source, ref=ref, red_team=red, blue_team=blue,
+                           red_goals=outcome.red_goals, blue_goals=outcome.blue_goals,
+                           winner=outcome.winner, counted=outcome.counted, note=outcome.note,
+                           played_at=played_at))
+    session.flush()
+
+
+# the table ----------------------------------------------------------------------------------
+@dataclass(slots=True)
+class TeamRating:
+    team: str
+    mu: float = MODEL.mu
+    sigma: float = MODEL.sigma
+    played: int = 0
+    won: int = 0
+    drawn: int = 0
+    lost: int = 0
+    goals_for: int = 0
+    goals_against: int = 0
+
+    @property
+    def rating(self) -> float:
+        """OpenSkill's ordinal: ``mu - 3 sigma``."""
+        return self.mu - 3 * self.sigma
+
+
+@dataclass(frozen=True, slots=True)
+class Side:
+    team: str
+    goals: int
+    before: tuple[float, float]  # mu, sigma
+    after: tuple[float, float]
+
+
+@dataclass(frozen=True, slots=True)
+class RatedGame:
+    id: int
+    source: str
+    ref: str
+    played_at: datetime
+    winner: str
+    red: Side
+    blue: Side
+
+
+@dataclass(slots=True)
+class Ladder:
+    """Every team's rating and the rated matches, oldest first."""
+
+    teams: dict[str, TeamRating] = field(default_factory=dict)
+    games: list[RatedGame] = field(default_factory=list)
+
+    def table(self) -> list[TeamRating]:
+        """Best first: rating, then mu, then name."""
+        return sorted(self.teams.values(), key=lambda t: (-t.rating, -t.mu, t.team))
+
+    def games_of(self, team: str) -> list[RatedGame]:
+        return [g for g in self.games if team in (g.red.team, g.blue.team)]
+
+
+def rate(matches: Iterable[RatedMatch], teams: Iterable[str] = ()) -> Ladder:
+    """The ladder after ``matches`` (counted ones, in order); ``teams`` appear unrated too."""
+    ladder = Ladder(teams={name: TeamRating(team=name) for name in teams})
+    for match in matches:
+        if not match.counted or match.red_goals is None or match.blue_goals is None:
+            continue
+        red = ladder.teams.setdefault(match.red_team, TeamRating(team=match.red_team))
+        blue = ladder.teams.setdefault(match.blue_team, TeamRating(team=match.blue_team))
+        winner = match.winner or _winner(None, match.red_goals, match.blue_goals)
+        ranks: list[float] = {"red": [0.0, 1.0], "blue": [1.0, 0.0]}.get(winner, [0.0, 0.0])
+        before = {"red": (red.mu, red.sigma), "blue": (blue.mu, blue.sigma)}
+        [[new_red], [new_blue]] = MODEL.rate(
+            [[MODEL.create_rating([red.mu, red.sigma], name=red.team)],
+             [MODEL.create_rating([blue.mu, blue.sigma], name=blue.team)]], ranks=ranks)
+        for me, new, goals_for, goals_against, color in (
+                (red, new_red, match.red_goals, match.blue_goals, "red"),
+                (blue, new_blue, match.blue_goals, match.red_goals, "blue")):
+            me.mu, me.sigma = float(new.mu), float(new.sigma)
+            me.played += 1
+            me.goals_for += goals_for
+            me.goals_against += goals_against
+            if winner == "draw":
+                me.drawn += 1
+            elif winner == color:
+                me.won += 1
+            else:
+                me.lost += 1
+        ladder.games.append(RatedGame(
+            id=match.id, source=match.source, ref=match.ref, played_at=utc(match.played_at),
+            winner=winner,
+            red=Side(match.red_team, match.red_goals, before["red"], (red.mu, red.sigma)),
+            blue=Side(match.blue_team, match.blue_goals, before["blue"],
+                      (blue.mu, blue.sigma))))
+    return ladder
+
+
+class LadderCache:
+    """The ladder, recomputed only when a match was recorded or a team added since."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._key: tuple[Any, ...] | None = None
+        self._ladder = Ladder()
+
+    def get(self, session: Session) -> Ladder:
+        key = (session.scalar(select(func.count(RatedMatch.id))),
+               session.scalar(select(func.max(RatedMatch.id))),
+               session.scalar(select(func.count(Team.id)).where(
+                   Team.accepts_friendlies.is_(True))))
+        with self._lock:
+            if key == self._key:
+                return self._ladder
+        matches = session.scalars(select(RatedMatch).where(RatedMatch.counted.is_(True))
+                                  .order_by(RatedMatch.id))
+        teams = session.scalars(select(Team.name).where(Team.accepts_friendlies.is_(True)))
+        ladder = rate(matches, teams)
+        with self._lock:
+            self._key, self._ladder = key, ladder
+        return ladder
+
+
+__all__ = [
+    "FRIENDLY",
+    "MODEL",
+    "OFFICIAL",
+    "Ladder",
+    "LadderCache",
+    "Outcome",
+    "RatedGame",
+    "TeamRating",
+    "outcome_of",
+    "rate",
+    "record_friendlies",
+    "record_official",
+]
