@@ -208,8 +208,15 @@ def apply_look(model: mujoco.MjModel, look: Look) -> None:
     _write_texture(model, BALL_TEXTURE, ball_image(look.texture_seed, look.ball))
     _write_texture(model, SKY_TEXTURE, sky_image(look.texture_seed, look.background))
     _write_texture(model, NET_TEXTURE, net_image())
-    model.light_diffuse[:] *= look.luminosity
-    model.light_ambient[:] *= look.luminosity
+    set_exposure(model, look.luminosity)
+
+
+def set_exposure(model: mujoco.MjModel, gain: float) -> None:
+    """Scale every light of ``model`` (and its headlight) by ``gain``."""
+    if gain == 1.0:
+        return
+    model.light_diffuse[:] *= gain
+    model.light_ambient[:] *= gain
     headlight = model.vis.headlight
-    headlight.ambient = np.asarray(headlight.ambient) * look.luminosity
-    headlight.diffuse = np.asarray(headlight.diffuse) * look.luminosity
+    headlight.ambient = np.asarray(headlight.ambient) * gain
+    headlight.diffuse = np.asarray(headlight.diffuse) * gain
