@@ -120,6 +120,17 @@ def _rounded(values: Any) -> list[float]:
     return [round(float(v), 4) for v in values]
 
 
+def look_from_summary(summary: dict[str, Any]) -> Look:
+    """The look a :meth:`Look.summary` describes (a replay's scene)."""
+    return Look(
+        texture_seed=int(summary["texture_seed"]),
+        turf=int(summary["turf"]) % len(TURFS),
+        ball=int(summary["ball"]) % len(BALLS),
+        background=int(summary["background"]) % len(BACKGROUNDS),
+        luminosity=float(summary["luminosity"]),
+    )
+
+
 def look_for(texture_seed: int) -> Look:
     """The look ``texture_seed`` picks (deterministic)."""
     rng = np.random.default_rng([texture_seed, 0x100C])
