@@ -53,6 +53,7 @@ def turf_tile(
     shade = 1.0 + 0.10 * blades + 0.07 * tufts + 0.05 * patches
     # blades lean one way: a slight streak along the rows of the tile
     shade = 0.6 * shade + 0.2 * np.roll(shade, 1, axis=0) + 0.2 * np.roll(shade, -1, axis=0)
+    shade = np.clip(shade, 0.75, 1.3)  # no blade as dark as the ball's patches
     stripe = np.where(np.arange(size_px) < size_px // 2, 1.0 + stripe_contrast, 1.0)
     stripe = stripe - stripe_contrast / 2
     shade = shade * stripe[np.newaxis, :]
