@@ -113,7 +113,11 @@ def motion_blur(rgb: npt.NDArray[np.uint8], blur_px: tuple[float, float]) -> npt
 
 
 def blur_px_of(
-    angular_velocity_cam: npt.NDArray[np.float64], *, height: int, fovy_deg: float, exposure_s: float
+    angular_velocity_cam: npt.NDArray[np.float64],
+    *,
+    height: int,
+    fovy_deg: float,
+    exposure_s: float,
 ) -> tuple[float, float]:
     """Image motion (columns, rows) during the exposure for a camera turning at
     ``angular_velocity_cam`` (rad/s, MuJoCo camera frame: x right, y up, looking along -z)."""

@@ -121,7 +121,8 @@ def ball_cube(
 ) -> Image:
     """The ball's cube texture: dark pentagons (``patch_rgb``) on white panels (``panel_rgb``)
     with seams. ``patch_size`` > 0 grows the pentagons against the hexagons (0 gives 31 % of
-    the surface dark, 0.02 37 %, 0.05 49 %); ``turn_rad`` turns the pattern about the vertical axis."""
+    the surface dark, 0.02 37 %, 0.05 49 %); ``turn_rad`` turns the pattern about the vertical
+    axis."""
     dirs = _cube_directions(face_px, skybox=False).reshape(-1, 3)
     pent, hexa = _icosahedron()
     c, s = math.cos(turn_rad), math.sin(turn_rad)

@@ -29,8 +29,8 @@ from contracts.match_spec import MatchSpec
 from referee.snapshot import WorldCommand, WorldSnapshot
 from simulator.errors import PhysicsDivergence
 from simulator.world import commands
-from simulator.world.devices import DeviceAccess
 from simulator.world.camera_model import CameraModel
+from simulator.world.devices import DeviceAccess
 from simulator.world.divergence import DivergenceWatch
 from simulator.world.flat import FlatData
 from simulator.world.indices import build_index
@@ -165,8 +165,8 @@ class World(DeviceAccess):
             camera_model=camera_model,
         )
 
-    @classmethod
-    def from_spec(cls, spec: MatchSpec, *, divergence_policy: DivergencePolicy = "fail") -> World:
+    @staticmethod
+    def placements_of(spec: MatchSpec) -> list[RobotPlacement]:
         """Every player of both teams at its ``half_time_pose``; the team playing on the right
         (not ``spec.side_left``) is mirrored (:meth:`contracts.geometry.Pose.mirrored`)."""
         placements = []
@@ -184,9 +184,15 @@ class World(DeviceAccess):
                         yaw_rad=pose.yaw_rad,
                     )
                 )
+        return placements
+
+    @classmethod
+    def from_spec(cls, spec: MatchSpec, *, divergence_policy: DivergencePolicy = "fail") -> World:
+        """The world of a match: :meth:`placements_of` the spec, its look (``texture_seed``)
+        and its sensors (``sensors``: the league's models unless ``"ideal"``)."""
         return cls.create(
             field_class=spec.field_class,
-            robots=placements,
+            robots=World.placements_of(spec),
             seed=spec.seed,
             physics_dt_s=spec.physics_dt_s,
             divergence_policy=divergence_policy,

@@ -12,7 +12,7 @@ import pytest
 from referee.snapshot import PlaceBall
 from simulator.world import CameraRenderer, World
 from simulator.world.camera_model import CameraModel
-from simulator.world.look import BALLS, BACKGROUNDS, TURFS, look_for
+from simulator.world.look import BACKGROUNDS, BALLS, TURFS, look_for
 
 from .conftest import RED_1, eight_robots
 
