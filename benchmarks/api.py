@@ -226,6 +226,20 @@ def _world(robots: list[RobotId], physics_dt: float, sensors: str = "league") ->
     )  # fmt: skip
 
 
+def _sensor_noise_cost(robots: list[RobotId], physics_dt: float, sensors: str) -> float | None:
+    """CPU microseconds of drawing every sensor's noisy reading once (what the league's sensor
+    model adds to each basic step), averaged over 2000 draws; None for ideal sensors."""
+    world = _world(robots, physics_dt, sensors)
+    noise = world.sensor_noise
+    if noise is None:
+        return None
+    world.step()
+    started = time.thread_time()
+    for _ in range(2000):
+        noise.update()
+    return round((time.thread_time() - started) / 2000 * 1e6, 2)
+
+
 def _world_only(
     robots: list[RobotId], physics_dt: float, sim_seconds: float, sensors: str = "league"
 ) -> tuple[float, float]:
@@ -466,6 +480,9 @@ def main(argv: list[str]) -> int:
         "ratio": round(api["real_time_factor"] / world_rtf, 3),
         # load-independent: simulator-thread CPU per simulated second, world only vs with the API
         "cpu_ratio": round(world_cpu / api["cpu_s_per_sim_s"], 3),
+        # the step thread's CPU per simulated second in the API run (compare --sensors runs)
+        "cpu_s_per_sim_s": round(api["cpu_s_per_sim_s"], 4),
+        "sensor_noise_us_per_step": _sensor_noise_cost(robots, args.physics_dt, args.sensors),
         # the same, with the world-only chunks interleaved with the API run's (no cameras)
         "ratio_interleaved": api["ratio_interleaved"],
         "cpu_ratio_interleaved": api["cpu_ratio_interleaved"],
