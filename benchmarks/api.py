@@ -204,9 +204,7 @@ def _robots(count: int) -> list[RobotId]:
 def _world(robots: list[RobotId], physics_dt: float, sensors: str = "league") -> Any:
     """The benchmark's world; ``sensors`` "league" (as a match plays: sensor noise and the
     camera model) or "ideal"."""
-    from simulator.world import RobotPlacement, World
-    from simulator.world.camera_model import CameraModel
-    from simulator.world.sensor_noise import SensorModel
+    from simulator.world import CameraModel, RobotPlacement, SensorModel, World
 
     placements = [
         RobotPlacement(

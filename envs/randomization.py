@@ -16,8 +16,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from simulator.world.camera_model import CameraModel
-from simulator.world.sensor_noise import ImuAxisModel, SensorModel
+from simulator.world import CameraModel, ImuAxisModel, SensorModel
 
 NOISE_SCALE = (0.5, 2.0)
 
