@@ -3,7 +3,8 @@
 The replay's scene (:mod:`simulator.replay.scene`) carries the match's look, the robots' head
 cameras (resolution and field of view) and the camera model; each frame's body poses place
 the camera and the world, and every video frame becomes ``DIR/red-1_00000.png`` (RGB, the
-camera's resolution), with the match's exposure and per-pixel noise (motion blur needs the
+camera's resolution), with the match's exposure (and the luminosity its auto-exposure leaves)
+and per-pixel noise (motion blur needs the
 robots' velocities, which replays do not keep). Imports nothing that imports MuJoCo at its top
 (the offscreen back end is chosen first).
 """
@@ -18,7 +19,7 @@ from simulator.errors import ReplayError
 
 
 def _robot_camera(scene: dict[str, Any], robot: str, path: str) -> dict[str, Any]:
-    cameras = {c["robot"]: c for c in scene.get("robot_cameras", ())}
+    cameras: dict[str, dict[str, Any]] = {c["robot"]: c for c in scene.get("robot_cameras", ())}
     camera = cameras.get(robot)
     if camera is None:
         known = ", ".join(sorted(cameras)) or "none (a replay recorded before head cameras were"
@@ -45,7 +46,7 @@ def render_camera_frames(
     from simulator.render import Placer, _frames_for, scene_model
     from simulator.replay import load_replay, scene_for
     from simulator.world.camera_model import CameraEffects, CameraModel
-    from simulator.world.look import set_exposure
+    from simulator.world.look import look_from_summary
 
     replay = load_replay(replay_path)
     scene = scene_for(replay.header, str(replay_path))
@@ -56,13 +57,13 @@ def render_camera_frames(
     camera_model = (
         CameraModel(**recorded) if recorded and not ideal else CameraModel.ideal()
     )
-    set_exposure(model, camera_model.exposure_gain)
     model.vis.global_.offwidth = max(model.vis.global_.offwidth, width)
     model.vis.global_.offheight = max(model.vis.global_.offheight, height)
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
     place = Placer(model, data)
-    effects = CameraEffects(camera_model, width, height)
+    luminosity = look_from_summary(scene["look"]).luminosity if scene.get("look") else 1.0
+    effects = CameraEffects(camera_model, width, height, luminosity=luminosity)
     number = int(robot.rsplit("-", 1)[1]) + (32 if robot.startswith("blue") else 0)
     out = Path(output_dir)
     out.mkdir(parents=True, exist_ok=True)

@@ -246,7 +246,11 @@ def render_video(
     if ffmpeg is None:
         raise RenderError(output=str(output), reason="ffmpeg not found on PATH")
     replay = load_replay(replay_path)
-    model = scene_model(scene_for(replay.header, str(replay_path)))
+    from simulator.world.look import apply_luminosity, look_from_summary
+
+    scene = scene_for(replay.header, str(replay_path))
+    model = scene_model(scene)
+    luminosity = look_from_summary(scene["look"]).luminosity if scene.get("look") else 1.0
     if model.nbody != len(replay.header.body_names):
         raise ReplayError(
             path=str(replay_path),
@@ -278,7 +282,7 @@ def render_video(
         for i in indices:
             place(replay.frames[i].poses.astype(np.float64))
             renderer.update_scene(data, camera="overview", scene_option=option)
-            proc.stdin.write(renderer.render().tobytes())
+            proc.stdin.write(apply_luminosity(renderer.render(), luminosity).tobytes())
             count += 1
             if on_frame is not None:
                 on_frame(count, len(indices))

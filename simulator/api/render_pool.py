@@ -37,7 +37,7 @@ class _Batch:
 
 
 def _serve(
-    conn: Connection, model: Any, cameras: dict[RobotId, int], camera_model: Any
+    conn: Connection, model: Any, cameras: dict[RobotId, int], camera_model: Any, look: Any
 ) -> None:
     """Worker process body: render jobs until ``None`` or the parent is gone."""
     from types import SimpleNamespace
@@ -48,7 +48,9 @@ def _serve(
 
     data = mujoco.MjData(model)
     index = SimpleNamespace(by_id={r: SimpleNamespace(camera=c) for r, c in cameras.items()})
-    view = SimpleNamespace(model=model, data=data, index=index, camera_model=camera_model)
+    view = SimpleNamespace(
+        model=model, data=data, index=index, camera_model=camera_model, look=look
+    )
     renderers: dict[tuple[int, int], CameraRenderer] = {}
     while True:
         try:
@@ -108,7 +110,8 @@ class RenderPool:
             parent, child = ctx.Pipe()
             proc = ctx.Process(
                 target=_serve,
-                args=(child, self._world.model, self._cameras, self._world.camera_model),
+                args=(child, self._world.model, self._cameras, self._world.camera_model,
+                      self._world.look),
                 name=f"camera-render-{n}",
                 daemon=True,
             )

@@ -42,7 +42,8 @@ def world_render_worker(world: World, *, threads: int = 1, processes: int = 0) -
         model = world.model
         data = mujoco.MjData(model)
         view = SimpleNamespace(
-            model=model, data=data, index=world.index, camera_model=world.camera_model
+            model=model, data=data, index=world.index, camera_model=world.camera_model,
+            look=world.look,
         )
         renderers: dict[tuple[int, int], CameraRenderer] = {}
         current: list[Any] = [None]

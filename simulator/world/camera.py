@@ -6,8 +6,9 @@ capsules and cylinders are tessellated more coarsely than MuJoCo's defaults (12 
 stacks instead of 28 and 16; planes and boxes in one quad): on a software renderer that cuts a
 320x240 frame from about 10 ms to 4.5 ms with no visible difference at robot camera resolution.
 The match video keeps the model's own quality. The camera model (exposure, noise, motion blur:
-:mod:`simulator.world.camera_model`) is the world's ``camera_model``; a view of the world
-without one (``model``, ``data``, ``index`` only) renders the ideal image.
+:mod:`simulator.world.camera_model`) is the world's ``camera_model`` in its ``look``'s
+luminosity; a view of the world without them (``model``, ``data``, ``index`` only) renders
+the ideal image.
 """
 
 from __future__ import annotations
@@ -58,7 +59,10 @@ class CameraRenderer:
         scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = False
         scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = False
         camera_model = getattr(world, "camera_model", None) or CameraModel.ideal()
-        self._effects = CameraEffects(camera_model, width, height)
+        look = getattr(world, "look", None)
+        self._effects = CameraEffects(
+            camera_model, width, height, luminosity=look.luminosity if look else 1.0
+        )
         self._velocity = np.zeros(6)
 
     def render(self, robot: RobotId, *, sim_time_ms: int = 0) -> bytes:

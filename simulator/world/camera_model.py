@@ -1,8 +1,9 @@
 """The robot camera as a real one delivers images: exposure, per-pixel noise, motion blur.
 
-- **Exposure**: a gain on the scene's light (one per match, from the match seed, and the
-  look's luminosity on top), applied to the lights of the model the robot cameras render, so
-  it costs nothing per frame.
+- **Exposure**: a gain on the rendered image: the camera's own (one per match, from the match
+  seed) times what its auto-exposure leaves of the scene's luminosity (the look's, 0.75 to
+  1.25: ``luminosity ** (1 - auto_exposure)``; 0.8 of a change is compensated), clipped at
+  full scale.
 - **Per-pixel noise**: zero-mean Gaussian read noise of ``noise_std`` grey levels on every byte,
   cut from a bank of noise drawn once per renderer; the cut's offset is a hash of the match seed,
   the robot and the simulated time, so the same match gives the same images whatever thread or
@@ -24,6 +25,7 @@ import numpy as np
 import numpy.typing as npt
 
 NOISE_BANK_EXTRA = 65_537  # values beyond one image in the bank: room for the offsets
+GAIN_BITS = 6  # the gain in fixed point: 255 * gain * 64 stays in int16 up to a gain of 2
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -32,13 +34,15 @@ class CameraModel:
 
     seed: int = 0
     exposure_gain: float = 1.0
+    auto_exposure: float = 0.8  # share of the scene's luminosity change compensated
     noise_std: float = 2.0  # grey levels (0..255) per byte
     motion_blur: bool = False
     exposure_s: float = 0.01
 
     @classmethod
     def ideal(cls) -> CameraModel:
-        return cls(noise_std=0.0, exposure_gain=1.0, motion_blur=False)
+        """Exact images: the scene at its own colours, no noise, no blur."""
+        return cls(noise_std=0.0, exposure_gain=1.0, auto_exposure=1.0, motion_blur=False)
 
     @classmethod
     def league(cls, seed: int, *, motion_blur: bool = False) -> CameraModel:
@@ -48,7 +52,14 @@ class CameraModel:
 
     @property
     def is_ideal(self) -> bool:
-        return self.noise_std <= 0 and not self.motion_blur
+        return (
+            self.noise_std <= 0 and not self.motion_blur and self.exposure_gain == 1.0
+            and self.auto_exposure == 1.0
+        )  # fmt: skip
+
+    def gain(self, luminosity: float) -> float:
+        """The image's gain in a scene of ``luminosity``."""
+        return float(self.exposure_gain * luminosity ** (1.0 - self.auto_exposure))
 
 
 def _mix(*values: int) -> int:
@@ -65,8 +76,12 @@ def _mix(*values: int) -> int:
 class CameraEffects:
     """Applies a :class:`CameraModel` to rendered RGB images of one size."""
 
-    def __init__(self, model: CameraModel, width: int, height: int) -> None:
+    def __init__(
+        self, model: CameraModel, width: int, height: int, *, luminosity: float = 1.0
+    ) -> None:
         self.model = model
+        gain = min(model.gain(luminosity), 2.0)
+        self._gain = int(round(gain * (1 << GAIN_BITS)))
         self._size = width * height * 3
         self._noise: npt.NDArray[np.int16] | None = None
         if model.noise_std > 0:
@@ -87,12 +102,18 @@ class CameraEffects:
         if self.model.motion_blur:
             rgb = motion_blur(rgb, blur_px)
         bgr = rgb[:, :, ::-1]
-        if self._noise is None:
+        unity = self._gain == 1 << GAIN_BITS
+        if self._noise is None and unity:
             return np.ascontiguousarray(bgr).tobytes()
-        offset = _mix(self.model.seed, robot, sim_time_ms) % NOISE_BANK_EXTRA
         work = self._work
-        noise = self._noise[offset : offset + self._size].reshape(work.shape)
-        np.add(bgr, noise, out=work, dtype=np.int16)
+        if unity:
+            work[:] = bgr
+        else:
+            np.multiply(bgr, np.int16(self._gain), out=work, dtype=np.int16)
+            np.right_shift(work, GAIN_BITS, out=work)
+        if self._noise is not None:
+            offset = _mix(self.model.seed, robot, sim_time_ms) % NOISE_BANK_EXTRA
+            work += self._noise[offset : offset + self._size].reshape(work.shape)
         np.clip(work, 0, 255, out=work)
         return work.astype(np.uint8).tobytes()
 

@@ -1,7 +1,8 @@
 """The league's look: turf, ball, goal nets, stadium background and lighting, from ``texture_seed``.
 
 As in the league's Webots world, ``texture_seed`` picks the variants (turf, ball, background)
-and the luminosity (uniform in 0.75..1.25); the same seed gives the same images. The textures
+and the luminosity (uniform in 0.75..1.25); the same seed gives the same images. Each texture
+depends on its variant alone, so it is generated once per process (about 0.3 s each). The textures
 are procedural (:mod:`simulator.world.textures`, numpy only, nothing downloaded or shipped):
 the model declares them as placeholders of the right size (:func:`look_assets`) and
 :func:`apply_look` writes the generated texels and the lights into the compiled model, before
@@ -97,7 +98,7 @@ class Look:
         """What a viewer needs to draw the same look simply (recorded in the replay's scene):
         the two stripe colours (mean texel colours), the stripe width, the ball's colours and
         the background's sky and stands colours."""
-        turf = turf_image(self.texture_seed, self.turf)
+        turf = turf_image(self.turf)
         half = turf.shape[1] // 2
         light = turf[:, :half].reshape(-1, 3).mean(axis=0) / 255.0
         dark = turf[:, half:].reshape(-1, 3).mean(axis=0) / 255.0
@@ -143,30 +144,35 @@ def look_for(texture_seed: int) -> Look:
     )
 
 
-@lru_cache(maxsize=8)
-def turf_image(texture_seed: int, variant: int) -> textures.Image:
+# Each texture is a function of its variant alone (its noise seeded by the variant's number),
+# as the league's world picked among fixed textures: a process generates each at most once.
+
+
+@lru_cache(maxsize=len(TURFS))
+def turf_image(variant: int) -> textures.Image:
     v = TURFS[variant]
     return textures.turf_tile(
-        seed=texture_seed, size_px=TURF_PX, base_rgb=v.base_rgb, stripe_contrast=v.stripe_contrast
-    )
-
-
-@lru_cache(maxsize=8)
-def ball_image(texture_seed: int, variant: int) -> textures.Image:
-    v = BALLS[variant]
-    turn = float(np.random.default_rng([texture_seed, 0xBA11]).uniform(0.0, 1.2566))
-    return textures.ball_cube(
-        face_px=BALL_FACE_PX, patch_rgb=v.patch_rgb, panel_rgb=v.panel_rgb,
-        patch_size=v.patch_size, turn_rad=turn,
+        seed=0x7F4F + variant, size_px=TURF_PX, base_rgb=v.base_rgb,
+        stripe_contrast=v.stripe_contrast,
     )  # fmt: skip
 
 
-@lru_cache(maxsize=8)
-def sky_image(texture_seed: int, variant: int) -> textures.Image:
+@lru_cache(maxsize=len(BALLS))
+def ball_image(variant: int) -> textures.Image:
+    v = BALLS[variant]
+    return textures.ball_cube(
+        face_px=BALL_FACE_PX, patch_rgb=v.patch_rgb, panel_rgb=v.panel_rgb,
+        patch_size=v.patch_size, turn_rad=0.3 * variant,
+    )  # fmt: skip
+
+
+@lru_cache(maxsize=len(BACKGROUNDS))
+def sky_image(variant: int) -> textures.Image:
     v = BACKGROUNDS[variant]
     return textures.stadium_cube(
-        seed=texture_seed, face_px=SKY_FACE_PX, sky_top=v.sky_top, sky_horizon=v.sky_horizon,
-        stands_rgb=v.stands_rgb, boards=v.boards, surround_rgb=v.surround_rgb,
+        seed=0x5747 + variant, face_px=SKY_FACE_PX, sky_top=v.sky_top,
+        sky_horizon=v.sky_horizon, stands_rgb=v.stands_rgb, boards=v.boards,
+        surround_rgb=v.surround_rgb,
     )  # fmt: skip
 
 
@@ -213,21 +219,19 @@ def _write_texture(model: mujoco.MjModel, name: str, image: textures.Image) -> N
 
 
 def apply_look(model: mujoco.MjModel, look: Look) -> None:
-    """Fill the look's textures of a model built with :func:`look_assets` and scale its lights
-    by the look's luminosity."""
-    _write_texture(model, TURF_TEXTURE, turf_image(look.texture_seed, look.turf))
-    _write_texture(model, BALL_TEXTURE, ball_image(look.texture_seed, look.ball))
-    _write_texture(model, SKY_TEXTURE, sky_image(look.texture_seed, look.background))
+    """Fill the look's textures of a model built with :func:`look_assets`. The luminosity is
+    a gain on rendered images (:func:`apply_luminosity`; the robot cameras' auto-exposure
+    compensates most of it, :mod:`simulator.world.camera_model`): MuJoCo's lights saturate the
+    textures' colours, so scaling them would change little."""
+    _write_texture(model, TURF_TEXTURE, turf_image(look.turf))
+    _write_texture(model, BALL_TEXTURE, ball_image(look.ball))
+    _write_texture(model, SKY_TEXTURE, sky_image(look.background))
     _write_texture(model, NET_TEXTURE, net_image())
-    set_exposure(model, look.luminosity)
 
 
-def set_exposure(model: mujoco.MjModel, gain: float) -> None:
-    """Scale every light of ``model`` (and its headlight) by ``gain``."""
-    if gain == 1.0:
-        return
-    model.light_diffuse[:] *= gain
-    model.light_ambient[:] *= gain
-    headlight = model.vis.headlight
-    headlight.ambient = np.asarray(headlight.ambient) * gain
-    headlight.diffuse = np.asarray(headlight.diffuse) * gain
+def apply_luminosity(rgb: textures.Image, luminosity: float) -> textures.Image:
+    """A rendered image as the scene's luminosity lights it (the video's frames)."""
+    if luminosity == 1.0:
+        return rgb
+    lit: textures.Image = np.clip(rgb * np.float32(luminosity), 0, 255).astype(np.uint8)
+    return lit

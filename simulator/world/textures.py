@@ -85,8 +85,9 @@ def _cube_directions(face_px: int, *, skybox: bool) -> Floats:
         faces = [
             (one, -t, -s), (-one, -t, s), (s, one, t), (s, -one, -t), (s, -t, one), (-s, -t, -one),
         ]
-    dirs = np.stack([np.stack(f, axis=-1) for f in faces])
-    return dirs / np.linalg.norm(dirs, axis=-1, keepdims=True)
+    dirs: Floats = np.stack([np.stack(f, axis=-1) for f in faces])
+    unit: Floats = dirs / np.linalg.norm(dirs, axis=-1, keepdims=True)
+    return unit
 
 
 def _icosahedron() -> tuple[Floats, Floats]:
@@ -130,7 +131,7 @@ def ball_cube(
     centres = np.concatenate([pent, hexa]) @ turn.T
     bias = np.concatenate([np.full(12, patch_size), np.zeros(20)])
     score = dirs @ centres.T + bias
-    top2 = np.sort(score, axis=1)[:, -2:]
+    top2 = np.partition(score, -2, axis=1)[:, -2:]
     best = np.argmax(score, axis=1)
     seam = (top2[:, 1] - top2[:, 0]) < 0.012
     rgb = np.where((best < 12)[:, None], np.array(patch_rgb), np.array(panel_rgb))

@@ -34,7 +34,7 @@ from simulator.world.devices import DeviceAccess
 from simulator.world.divergence import DivergenceWatch
 from simulator.world.flat import FlatData
 from simulator.world.indices import build_index
-from simulator.world.look import look_for, set_exposure
+from simulator.world.look import look_for
 from simulator.world.motors import MotorBank
 from simulator.world.robots import robot_model
 from simulator.world.scene import compile_scene
@@ -87,7 +87,6 @@ class World(DeviceAccess):
         self.look = look_for(seed if texture_seed is None else texture_seed)
         self.model = compile_scene(field, placements, physics_dt_s=physics_dt_s, look=self.look)
         self.camera_model = camera_model if camera_model is not None else CameraModel.ideal()
-        set_exposure(self.model, self.camera_model.exposure_gain)
         self.data = mujoco.MjData(self.model)
         self._opt = self.model.opt  # a view of the model's options (one wrapper, not one a step)
         self.index = build_index(self.model, placements)
