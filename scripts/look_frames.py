@@ -34,6 +34,7 @@ def main(argv: list[str]) -> int:
     from simulator.png import write_png
     from simulator.world import CameraRenderer, RobotPlacement, World
     from simulator.world.camera_model import CameraModel
+    from simulator.world.look import apply_luminosity
 
     red1 = RobotId(TeamColor.RED, 1)
     placements = [
@@ -67,7 +68,10 @@ def main(argv: list[str]) -> int:
         if name == "ideal":
             with mujoco.Renderer(world.model, 270, 480) as overview:
                 overview.update_scene(world.data, camera="overview")
-                write_png(args.out / "overview.png", overview.render())
+                write_png(
+                    args.out / "overview.png",
+                    apply_luminosity(overview.render(), world.look.luminosity),
+                )
     print(f"wrote {', '.join(f'camera_{name}.png' for name, *_ in shots)} and overview.png "
           f"to {args.out}")
     return 0
