@@ -145,24 +145,26 @@ def test_foot_pressure_noise_and_dead_band() -> None:
 
 
 def test_same_seed_same_readings_and_the_truth_untouched() -> None:
-    def run(seed: int) -> tuple[np.ndarray, np.ndarray]:
-        world = _world(SensorModel(), seed=seed, robots=2)
-        names = ["Gyro", "Accelerometer", "HeadS", "llb"]
+    names = ["Gyro", "Accelerometer", "HeadS", "llb"]
+
+    def run(model: SensorModel, seed: int) -> tuple[np.ndarray, World]:
+        world = _world(model, seed=seed, robots=2)
         out = []
         for _ in range(20):
             world.step()
             out.append(world.read_sensors(RED_1, names))
-        return np.array(out), world.data.qpos.copy()
+        return np.array(out), world
 
-    a, qpos_a = run(3)
-    b, qpos_b = run(3)
-    c, _ = run(4)
+    a, noisy = run(SensorModel(), 3)
+    b, _ = run(SensorModel(), 3)
+    c, _ = run(SensorModel(), 4)
     assert np.array_equal(a, b) and not np.array_equal(a, c)
-    ideal = _world(SensorModel.ideal(), seed=3, robots=2)
-    for _ in range(20):
-        ideal.step()
-    # noise never feeds back into the physics (the noisy world moved exactly as the ideal one)
-    assert np.array_equal(ideal.data.qpos, qpos_a)
+    exact, ideal = run(SensorModel.ideal(), 3)
+    assert not np.array_equal(a, exact)
+    # noise never feeds back into the physics, and what the referee, the replay and telemetry
+    # read (the snapshot) is the true state: the noisy world's equals the ideal world's
+    assert np.array_equal(ideal.data.qpos, noisy.data.qpos)
+    assert noisy.snapshot() == ideal.snapshot()
     gyro = ideal.index.by_id[RED_1].gyro
     assert ideal.read_gyro(RED_1) == tuple(ideal.data.sensordata[gyro : gyro + 3])
 
@@ -184,4 +186,3 @@ def test_every_read_path_gives_the_same_noisy_reading() -> None:
     assert world.read_position_array(RED_1)[slot] == single[0]
     true_head = float(world.data.qpos[world.index.by_id[RED_1].motor_qpos[slot]])
     assert single[0] != true_head
-    assert world.snapshot().robots[0] is not None  # the snapshot reads MuJoCo's state
