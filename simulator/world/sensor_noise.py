@@ -140,15 +140,16 @@ class SensorNoise:
         self._low[nq + nimu :] = 0.0
         self._dead_band = model.force_dead_band_n
         self._bias_now = self.rng.normal(0.0, 1.0, nimu) * bias_std
-        self._offsets = np.zeros((0, n))
-        self._bias_rows = np.zeros((0, nimu))
+        self._offsets: npt.NDArray[np.float64] = np.zeros((0, n))
+        self._bias_rows: npt.NDArray[np.float64] = np.zeros((0, nimu))
         self._row = 0
         self.update()
 
     @property
     def imu_bias(self) -> npt.NDArray[np.float64]:
         """The biases of the last readings: gyro x y z of every robot, then accelerometer."""
-        return self._bias_rows[self._row - 1]
+        row: npt.NDArray[np.float64] = self._bias_rows[self._row - 1]
+        return row
 
     def _draw_block(self) -> None:
         """The noise of the next :data:`BLOCK_STEPS` steps in one draw: white noise plus the
