@@ -70,6 +70,9 @@ def _parser() -> argparse.ArgumentParser:
                         help="cameras on an NVIDIA GPU through EGL: auto (default) when this "
                         "host has one, on: required, off: OSMesa on the CPU; a MUJOCO_GL set in "
                         "the environment is kept")
+    parser.add_argument("--sensors", choices=("league", "ideal"), default="league",
+                        help="league: sensor noise and camera model as in a match (default); "
+                        "ideal: exact sensors and images")
     parser.add_argument("--json", action="store_true", help="print only the JSON line")
     return parser
 
@@ -198,8 +201,10 @@ def _robots(count: int) -> list[RobotId]:
     ]
 
 
-def _world(robots: list[RobotId], physics_dt: float) -> Any:
-    from simulator.world import RobotPlacement, World
+def _world(robots: list[RobotId], physics_dt: float, sensors: str = "league") -> Any:
+    """The benchmark's world; ``sensors`` "league" (as a match plays: sensor noise and the
+    camera model) or "ideal"."""
+    from simulator.world import CameraModel, RobotPlacement, SensorModel, World
 
     placements = [
         RobotPlacement(
@@ -211,14 +216,45 @@ def _world(robots: list[RobotId], physics_dt: float) -> Any:
         )
         for r in robots
     ]
-    return World.create(field_class="kid", robots=placements, seed=1, physics_dt_s=physics_dt)
+    league = sensors == "league"
+    return World.create(
+        field_class="kid", robots=placements, seed=1, physics_dt_s=physics_dt,
+        sensor_model=SensorModel() if league else SensorModel.ideal(),
+        camera_model=CameraModel.league(1) if league else CameraModel.ideal(),
+    )  # fmt: skip
+
+
+def _sensor_noise_cost(
+    robots: list[RobotId], physics_dt: float, sensors: str
+) -> dict[str, float] | None:
+    """What the league's sensor model adds to a basic step (``World.step`` + snapshot), timed
+    where it runs, right after the physics: an ideal and a league world step in alternating
+    chunks of 25 steps (so the machine's load falls on both alike), 2 simulated seconds each.
+    CPU microseconds per step of each and their ratio; None for ideal sensors."""
+    if sensors == "ideal":
+        return None
+    worlds = {"ideal": _world(robots, physics_dt, "ideal"), "league": _world(robots, physics_dt)}
+    cpu = dict.fromkeys(worlds, 0.0)
+    for _ in range(10):
+        for name, world in worlds.items():
+            started = time.thread_time()
+            for _ in range(25):
+                world.step()
+                world.snapshot()
+            cpu[name] += time.thread_time() - started
+    ideal_us, league_us = (cpu[name] / 250 * 1e6 for name in ("ideal", "league"))
+    return {
+        "ideal_us_per_step": round(ideal_us, 1),
+        "league_us_per_step": round(league_us, 1),
+        "ratio": round(league_us / ideal_us, 3),
+    }
 
 
 def _world_only(
-    robots: list[RobotId], physics_dt: float, sim_seconds: float
+    robots: list[RobotId], physics_dt: float, sim_seconds: float, sensors: str = "league"
 ) -> tuple[float, float]:
     """(real-time factor, CPU seconds per simulated second) of World.step + snapshot."""
-    world = _world(robots, physics_dt)
+    world = _world(robots, physics_dt, sensors)
     steps = int(sim_seconds * 1000 / world.step_ms)
     started, started_cpu = time.perf_counter(), time.thread_time()
     for _ in range(steps):
@@ -297,7 +333,7 @@ def _api_run(
     from simulator.api.endpoints import free_ports
 
     robots = _robots(args.robots)
-    world = _world(robots, args.physics_dt)
+    world = _world(robots, args.physics_dt, args.sensors)
     if camera is not None:
         world_camera = world.camera_info(robots[0])
         if world_camera[:2] != camera[:2]:
@@ -369,7 +405,7 @@ def _api_run(
         # without cameras (whose render thread would run on), chunks of a reference world
         # (World.step + snapshot, as bench sim) alternate with chunks of the API run, so that
         # the machine's load falls on both alike: ``ratio_interleaved``
-        reference = _world(robots, args.physics_dt) if camera is None else None
+        reference = _world(robots, args.physics_dt, args.sensors) if camera is None else None
         chunk = max(1, INTERLEAVE_MS // world.step_ms)
         wall = cpu = ref_wall = ref_cpu = 0.0
         done = 0
@@ -438,7 +474,9 @@ def main(argv: list[str]) -> int:
     if not args.shared_cpus and camera is None and len(available) >= 2:
         os.sched_setaffinity(0, {available[0]})  # this (the step) thread only
         args.client_cpus = frozenset(available[1:])
-    world_rtf, world_cpu = _world_only(robots, args.physics_dt, min(args.sim_seconds, 10.0))
+    world_rtf, world_cpu = _world_only(
+        robots, args.physics_dt, min(args.sim_seconds, 10.0), args.sensors
+    )
     api = _api_run(args, camera, stalled=False)
     result: dict[str, Any] = {
         "bench": "api",
@@ -447,11 +485,15 @@ def main(argv: list[str]) -> int:
         "camera": args.camera or None,
         "sim_seconds": args.sim_seconds,
         "physics_dt_s": args.physics_dt,
+        "sensors": args.sensors,
         "real_time_factor": api["real_time_factor"],
         "world_only_real_time_factor": round(world_rtf, 3),
         "ratio": round(api["real_time_factor"] / world_rtf, 3),
         # load-independent: simulator-thread CPU per simulated second, world only vs with the API
         "cpu_ratio": round(world_cpu / api["cpu_s_per_sim_s"], 3),
+        # the step thread's CPU per simulated second in the API run (compare --sensors runs)
+        "cpu_s_per_sim_s": round(api["cpu_s_per_sim_s"], 4),
+        "sensor_noise_cost": _sensor_noise_cost(robots, args.physics_dt, args.sensors),
         # the same, with the world-only chunks interleaved with the API run's (no cameras)
         "ratio_interleaved": api["ratio_interleaved"],
         "cpu_ratio_interleaved": api["cpu_ratio_interleaved"],

@@ -22,6 +22,7 @@ from contracts.ids import TeamColor
 SPEC_VERSION = 1
 
 SteppingMode = Literal["async", "lockstep", "pipelined"]
+SensorMode = Literal["league", "ideal"]
 Color = Literal["red", "blue"]  # contracts.ids.TeamColor values
 GameTypeName = Literal["NORMAL", "KNOCKOUT", "PENALTY"]  # GameType values
 FieldClassName = Literal["kid", "adult"]  # contracts.field.FieldClass values
@@ -119,6 +120,9 @@ class MatchSpec(Versioned):
     network: NetworkSpec = field(default_factory=NetworkSpec)
     record_video: str | None = None  # file name inside the output folder, e.g. "match.mp4"
     recorder_rate_hz: float = 25.0
+    texture_seed: int | None = None  # the look (turf, ball, background, light); None: ``seed``
+    sensors: SensorMode = "league"  # "ideal": exact sensors and camera images
+    camera_motion_blur: bool = False
     version: int = SPEC_VERSION
 
     @property
@@ -151,6 +155,7 @@ __all__ = [
     "Color",
     "FieldClassName",
     "GameTypeName",
+    "SensorMode",
     "SteppingMode",
     "TeamSpec",
     "TimingSpec",

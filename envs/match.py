@@ -46,6 +46,9 @@ class MatchEnv(HlvsEnv):
         perception: bool = False,
         perception_noise: float = 0.0,
         steps_per_action: int = 1,
+        look: str = "fixed",
+        texture_seed: int = 0,
+        sensors: str = "ideal",
         remotes: int | str | None = None,
         render_mode: str | None = None,
         session: Session | None = None,
@@ -56,6 +59,7 @@ class MatchEnv(HlvsEnv):
             stubs=stubs, referee=True, half_duration_s=half_duration_s,
             camera=camera or render_mode == "rgb_array", perception=perception,
             perception_noise=perception_noise, steps_per_action=steps_per_action,
+            look=look, texture_seed=texture_seed, sensors=sensors,
         )  # fmt: skip
         super().__init__(
             spec=spec, other_robots=len(stubs), game=True, remotes=remotes,

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from contracts.match_spec import MatchSpec, PlayerSpec, Pose, TeamSpec, TimingSpec
+from envs.randomization import episode_world
 from envs.session_spec import SessionSpec, StubSpec
 from referee import GameState, Referee, RobotId, TeamColor
 from simulator.match_setup import referee_config
@@ -90,7 +91,18 @@ def build_match(
     from robot.stub.world_model import Pose2D
 
     mspec = match_spec(spec, seed)
-    world = World.from_spec(mspec)
+    episode = episode_world(
+        look=spec.look, texture_seed=spec.texture_seed, sensors=spec.sensors, seed=seed
+    )
+    world = World.create(
+        field_class=mspec.field_class,
+        robots=World.placements_of(mspec),
+        seed=seed,
+        physics_dt_s=mspec.physics_dt_s,
+        texture_seed=episode.texture_seed,
+        sensor_model=episode.sensor_model,
+        camera_model=episode.camera_model,
+    )
     config = referee_config(mspec)
     config = replace(config, timing=replace(config.timing, status_period_real_s=1e9))
     referee = Referee(config=config, clock=clock)

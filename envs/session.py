@@ -21,6 +21,7 @@ from contracts.field import field_for
 from envs.errors import EnvStateError, TrainerError
 from envs.frame import SENSOR_NAMES, Frame
 from envs.perception import CameraView, add_noise, field_segments, goal_post_feet
+from envs.randomization import episode_world
 from envs.session_spec import ResetRequest, SessionSpec
 from referee import GameState, Referee, RobotId, TeamColor
 from referee.snapshot import PlaceBall, TeleportRobot
@@ -85,6 +86,10 @@ class LocalSession:
 
     def _build_skill(self, request: ResetRequest) -> None:
         x, y, yaw = request.learner_pose or (0.0, 0.0, 0.0)
+        episode = episode_world(
+            look=self.spec.look, texture_seed=self.spec.texture_seed, sensors=self.spec.sensors,
+            seed=request.seed,
+        )  # fmt: skip
         world = World.create(
             field_class=self.spec.field_class,  # type: ignore[arg-type]
             robots=[
@@ -92,6 +97,9 @@ class LocalSession:
             ],  # fmt: skip
             seed=request.seed,
             physics_dt_s=self.spec.physics_dt_s,
+            texture_seed=episode.texture_seed,
+            sensor_model=episode.sensor_model,
+            camera_model=episode.camera_model,
         )
         bx, by = request.ball_xy or (0.0, 0.0)
         world.apply(PlaceBall(position=(bx, by, self.field.ball_radius_m)))

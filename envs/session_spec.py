@@ -12,6 +12,9 @@ from typing import Any
 
 from envs.errors import EnvConfigError
 
+LOOKS = ("fixed", "random")
+SENSOR_MODES = ("ideal", "league", "random")
+
 FIELD_CLASSES = ("kid", "adult")
 ROLES = ("striker", "goalie", "defender", "idle")
 
@@ -44,6 +47,9 @@ class SessionSpec:
     perception_noise: float = 0.0
     perception_range_m: float = 10.0
     physics_dt_s: float = 0.002
+    look: str = "fixed"  # "random": each episode its own turf, ball, background and light
+    texture_seed: int = 0  # the look of a "fixed" session
+    sensors: str = "ideal"  # "league" or "random": noisy sensors and camera (envs.randomization)
 
     def __post_init__(self) -> None:
         if self.field_class not in FIELD_CLASSES:
@@ -60,6 +66,15 @@ class SessionSpec:
             raise EnvConfigError(
                 field="steps_per_action", value=self.steps_per_action, expected="1..125"
             )
+        if self.look not in LOOKS:
+            raise EnvConfigError(
+                field="look", value=self.look, expected=f"one of {list(LOOKS)}", choices=LOOKS
+            )
+        if self.sensors not in SENSOR_MODES:
+            raise EnvConfigError(
+                field="sensors", value=self.sensors, expected=f"one of {list(SENSOR_MODES)}",
+                choices=SENSOR_MODES,
+            )  # fmt: skip
         if self.perception_noise < 0:
             raise EnvConfigError(
                 field="perception_noise", value=self.perception_noise, expected="a number >= 0"

@@ -48,6 +48,9 @@ class KickEnv(HlvsEnv):
         perception: bool = False,
         perception_noise: float = 0.0,
         steps_per_action: int = 1,
+        look: str = "fixed",
+        texture_seed: int = 0,
+        sensors: str = "ideal",
         max_episode_s: float = 15.0,
         ball_distance_m: tuple[float, float] = (0.3, 1.0),
         bearing_noise_rad: float = 0.6,
@@ -70,6 +73,7 @@ class KickEnv(HlvsEnv):
             field_class=field_class, model=model, camera=camera or render_mode == "rgb_array",
             perception=perception, perception_noise=perception_noise,
             steps_per_action=steps_per_action,
+            look=look, texture_seed=texture_seed, sensors=sensors,
         )  # fmt: skip
         super().__init__(
             spec=spec, other_robots=0, game=False, remotes=remotes, render_mode=render_mode,

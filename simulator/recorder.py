@@ -57,7 +57,9 @@ def replay_header(
             for p in world.placements
         ],
         "body_names": [world.model.body(i).name for i in range(world.model.nbody)],
-        "scene": scene_of(world.model, world.placements, world.field),
+        "scene": scene_of(
+            world.model, world.placements, world.field, world.look, world.camera_model
+        ),
     }
 
 

@@ -1,4 +1,5 @@
-"""Videos from replays: ``python -m simulator render REPLAY -o match.mp4 [--width --height --fps]``.
+"""Videos from replays: ``python -m simulator render REPLAY -o match.mp4 [--width --height --fps]``
+(``--camera red-1 -o DIR``: that robot's camera frames as PNG, :mod:`simulator.camera_frames`).
 
 A model of shapes only is built from the scene the replay carries (for a version 1 replay, from
 today's robot models); each frame's body poses are turned into geom poses (no physics) and
@@ -51,6 +52,39 @@ def _quat_to_mat(q: Array) -> Array:
         ],
         axis=1,
     ).reshape(-1, 3, 3)  # fmt: skip
+
+
+class Placer:
+    """Puts the bodies, geoms and cameras of a :func:`scene_model` at a frame's body poses
+    (``(n, 7)``: x y z, w x y z), as MuJoCo's kinematics would (the model has no joints)."""
+
+    def __init__(self, model: Any, data: Any) -> None:
+        self._data = data
+        self._geom_body = model.geom_bodyid.copy()
+        self._geom_pos = model.geom_pos.copy()
+        self._geom_rot = _quat_to_mat(model.geom_quat.copy())
+        self._cam_body = model.cam_bodyid.copy()
+        self._cam_pos = model.cam_pos.copy()
+        self._cam_rot = _quat_to_mat(model.cam_quat.copy())
+
+    def __call__(self, poses: Array) -> None:
+        import numpy as np
+
+        data = self._data
+        body_rot = _quat_to_mat(poses[:, 3:7])
+        rot = body_rot[self._geom_body]
+        data.xpos[:] = poses[:, 0:3]
+        data.xmat[:] = body_rot.reshape(-1, 9)
+        data.geom_xpos[:] = poses[self._geom_body, 0:3] + np.einsum(
+            "nij,nj->ni", rot, self._geom_pos
+        )
+        data.geom_xmat[:] = np.matmul(rot, self._geom_rot).reshape(-1, 9)
+        if len(self._cam_body):
+            cam_rot = body_rot[self._cam_body]
+            data.cam_xpos[:] = poses[self._cam_body, 0:3] + np.einsum(
+                "nij,nj->ni", cam_rot, self._cam_pos
+            )
+            data.cam_xmat[:] = np.matmul(cam_rot, self._cam_rot).reshape(-1, 9)
 
 
 def _frames_for(replay: Replay, fps: float) -> Iterator[int]:
@@ -121,14 +155,19 @@ def _geom_xml(geom: dict[str, Any], material: str | None) -> str:
 def scene_xml(scene: dict[str, Any]) -> str:
     """An MJCF of shapes only (no joints, no physics) with one body per recorded body, in the
     recorded order, so that body ``i`` of the model is body ``i`` of every frame."""
+    from simulator.world.look import look_assets, look_from_summary
+
     bodies = scene["bodies"]
     geoms: list[list[str]] = [[] for _ in bodies]
-    assets = [
-        '<texture name="sky" type="skybox" builtin="gradient" rgb1="0.55 0.7 0.9" '
-        'rgb2="0.1 0.15 0.25" width="64" height="64"/>'
-    ]
+    if scene.get("look") is not None:  # the match's look (textures filled by ``scene_model``)
+        assets = [look_assets(look_from_summary(scene["look"]))]
+    else:
+        assets = [
+            '<texture name="sky" type="skybox" builtin="gradient" rgb1="0.55 0.7 0.9" '
+            'rgb2="0.1 0.15 0.25" width="64" height="64"/>'
+        ]
     for i, geom in enumerate(scene["geoms"]):
-        material = None
+        material = geom.get("texture") if scene.get("look") is not None else None
         pattern = geom.get("pattern")
         if pattern is not None:
             material = f"m{i}"
@@ -146,8 +185,15 @@ def scene_xml(scene: dict[str, Any]) -> str:
         f'fovy="{c["fovy_deg"]:.6g}"/>'
         for c in scene["cameras"]
     )
+    body_cameras: list[list[str]] = [[] for _ in bodies]
+    for c in scene.get("robot_cameras", ()):
+        body_cameras[c["body"]].append(
+            f'<camera name="{c["name"]}" pos="{_f(c["pos"])}" quat="{_f(c["quat"])}" '
+            f'fovy="{c["fovy_deg"]:.6g}"/>'
+        )
     children = "".join(
-        f'<body name="b{i}">{"".join(geoms[i])}</body>' for i in range(1, len(bodies))
+        f'<body name="b{i}">{"".join(geoms[i])}{"".join(body_cameras[i])}</body>'
+        for i in range(1, len(bodies))
     )
     return f"""<mujoco model="replay">
 <visual>
@@ -163,6 +209,18 @@ def scene_xml(scene: dict[str, Any]) -> str:
 {cameras}{"".join(geoms[0])}{children}
 </worldbody>
 </mujoco>"""
+
+
+def scene_model(scene: dict[str, Any]) -> Any:
+    """The compiled :func:`scene_xml` of ``scene``, with its look's textures and lights."""
+    import mujoco
+
+    from simulator.world.look import apply_look, look_from_summary
+
+    model = mujoco.MjModel.from_xml_string(scene_xml(scene))
+    if scene.get("look") is not None:
+        apply_look(model, look_from_summary(scene["look"]))
+    return model
 
 
 def render_video(
@@ -188,7 +246,11 @@ def render_video(
     if ffmpeg is None:
         raise RenderError(output=str(output), reason="ffmpeg not found on PATH")
     replay = load_replay(replay_path)
-    model = mujoco.MjModel.from_xml_string(scene_xml(scene_for(replay.header, str(replay_path))))
+    from simulator.world.look import apply_luminosity, look_from_summary
+
+    scene = scene_for(replay.header, str(replay_path))
+    model = scene_model(scene)
+    luminosity = look_from_summary(scene["look"]).luminosity if scene.get("look") else 1.0
     if model.nbody != len(replay.header.body_names):
         raise ReplayError(
             path=str(replay_path),
@@ -196,9 +258,7 @@ def render_video(
         )
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
-    geom_body = model.geom_bodyid.copy()
-    geom_pos = model.geom_pos.copy()
-    geom_rot = _quat_to_mat(model.geom_quat.copy())
+    place = Placer(model, data)
     renderer = mujoco.Renderer(model, height=height, width=width)
     renderer.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = False
     renderer.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = False
@@ -220,15 +280,9 @@ def render_video(
     count = 0
     try:
         for i in indices:
-            poses = replay.frames[i].poses.astype(np.float64)
-            body_rot = _quat_to_mat(poses[:, 3:7])
-            rot = body_rot[geom_body]
-            data.xpos[:] = poses[:, 0:3]
-            data.xmat[:] = body_rot.reshape(-1, 9)
-            data.geom_xpos[:] = poses[geom_body, 0:3] + np.einsum("nij,nj->ni", rot, geom_pos)
-            data.geom_xmat[:] = np.matmul(rot, geom_rot).reshape(-1, 9)
+            place(replay.frames[i].poses.astype(np.float64))
             renderer.update_scene(data, camera="overview", scene_option=option)
-            proc.stdin.write(renderer.render().tobytes())
+            proc.stdin.write(apply_luminosity(renderer.render(), luminosity).tobytes())
             count += 1
             if on_frame is not None:
                 on_frame(count, len(indices))
@@ -287,8 +341,14 @@ def main(argv: list[str]) -> int:
         prog=f"{program} render", description="Render a match replay to a video, offscreen."
     )
     parser.add_argument("replay", type=_absolute, help="replay file of a match (replay.hlvsrec)")
-    parser.add_argument("-o", "--output", type=_absolute, default="match.mp4",
-                        help="video file to write (default: match.mp4)")
+    parser.add_argument("-o", "--output", type=_absolute, default=None,
+                        help="video file to write (default: match.mp4); with --camera, the "
+                        "folder of the PNG frames (default: frames)")
+    parser.add_argument("--camera", metavar="ROBOT", default=None,
+                        help="write what this robot's head camera saw (red-1, blue-2...) as PNG "
+                        "frames at its own resolution instead of the video")
+    parser.add_argument("--ideal", action="store_true",
+                        help="with --camera: without the camera model's exposure and noise")
     parser.add_argument("--width", type=int, default=1280, help="pixels (default 1280)")
     parser.add_argument("--height", type=int, default=720, help="pixels (default 720)")
     parser.add_argument("--fps", type=float, default=25.0, help="frames per second (default 25)")
@@ -306,10 +366,20 @@ def main(argv: list[str]) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return 3
     logger.info("offscreen OpenGL back end: %s", backend)
+    if args.output is None:
+        args.output = _absolute("frames" if args.camera else "match.mp4")
     try:
         with _frame_progress(f"render {args.output.name}") as on_frame:
-            render_video(args.replay, args.output, width=args.width, height=args.height,
-                         fps=args.fps, on_frame=on_frame)
+            if args.camera:
+                from simulator.camera_frames import render_camera_frames
+
+                files = render_camera_frames(args.replay, args.output, robot=args.camera,
+                                             fps=args.fps, ideal=args.ideal, on_frame=on_frame)
+                logger.info("wrote %d frames of %s's camera to %s", len(files), args.camera,
+                            args.output)
+            else:
+                render_video(args.replay, args.output, width=args.width, height=args.height,
+                             fps=args.fps, on_frame=on_frame)
     except ReplayError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

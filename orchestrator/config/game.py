@@ -113,6 +113,8 @@ def build_game(document: Any, where: Collector, *, source: Path) -> GameConfig |
         record_simulation=document.get("record_simulation"),
         game_controller_extra_args=tuple(document.get("game_controller_extra_args", ())),
         texture_seed=document.get("texture_seed"),
+        sensors=document.get("sensors", "league"),
+        camera_motion_blur=document.get("camera_motion_blur", False),
         supervisor=document.get("supervisor"),
         stepping=document.get("stepping", "async"),
         physics_dt_s=float(document.get("physics_dt_s", 0.002)),

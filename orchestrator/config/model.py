@@ -22,6 +22,7 @@ FieldClass = Literal["KID", "ADULT"]
 Color = Literal["red", "blue"]
 SideChoice = Literal["red", "blue", "random"]
 SteppingMode = Literal["async", "lockstep", "pipelined"]
+SensorMode = Literal["league", "ideal"]
 
 COLORS: tuple[Color, Color] = ("red", "blue")
 MAX_PLAYERS: dict[str, int] = {"KID": 4, "ADULT": 3}
@@ -93,6 +94,8 @@ class GameConfig:
     record_simulation: str | None = None  # path ending in .html or .mp4, as written
     game_controller_extra_args: tuple[str, ...] = ()
     texture_seed: int | None = None
+    sensors: SensorMode = "league"
+    camera_motion_blur: bool = False
     supervisor: str | None = None
     stepping: SteppingMode = "async"
     physics_dt_s: float = 0.002

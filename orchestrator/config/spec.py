@@ -84,6 +84,9 @@ def to_match_spec(
             telemetry_listen=telemetry_listen,
             team_quota_mb_s=game.limits.team_api_mb_s,
         ),
+        texture_seed=game.texture_seed,
+        sensors=game.sensors,
+        camera_motion_blur=game.camera_motion_blur,
         record_video=(
             VIDEO_FILE
             if game.record_simulation and game.record_simulation.endswith(".mp4")

@@ -1,11 +1,12 @@
 """What the stub robot sees: the ball in its head camera, projected onto the ground.
 
-The ball is white and black (a checkered texture) on a green turf; field lines and goal posts
-are white only, robots grey, black, team coloured. The detector keeps connected regions of
-non-green pixels that hold both clearly white and clearly black pixels, are about as wide as
-tall and fill their bounding box like a disc, and whose size matches the ball's expected size
-at the distance the region's position implies. It works on every second pixel (160x120 from
-the 320x240 camera) in numpy.
+The ball is white with dark patches (the league's pentagon pattern, patches black or nearly)
+on a textured green turf; field lines and goal posts are white only, robots grey, black, team
+coloured. Images come through the camera model (exposure, pixel noise). The detector keeps
+connected regions of non-green pixels that hold both clearly white and clearly black pixels,
+are about as wide as tall and fill their bounding box like a disc, and whose size matches the
+ball's expected size at the distance the region's position implies. It works on every second
+pixel (160x120 from the 320x240 camera) in numpy.
 """
 
 from __future__ import annotations

@@ -36,7 +36,9 @@ class _Batch:
     remaining: int
 
 
-def _serve(conn: Connection, model: Any, cameras: dict[RobotId, int]) -> None:
+def _serve(
+    conn: Connection, model: Any, cameras: dict[RobotId, int], camera_model: Any, look: Any
+) -> None:
     """Worker process body: render jobs until ``None`` or the parent is gone."""
     from types import SimpleNamespace
 
@@ -46,7 +48,9 @@ def _serve(conn: Connection, model: Any, cameras: dict[RobotId, int]) -> None:
 
     data = mujoco.MjData(model)
     index = SimpleNamespace(by_id={r: SimpleNamespace(camera=c) for r, c in cameras.items()})
-    view = SimpleNamespace(model=model, data=data, index=index)
+    view = SimpleNamespace(
+        model=model, data=data, index=index, camera_model=camera_model, look=look
+    )
     renderers: dict[tuple[int, int], CameraRenderer] = {}
     while True:
         try:
@@ -55,8 +59,9 @@ def _serve(conn: Connection, model: Any, cameras: dict[RobotId, int]) -> None:
             return
         if message is None:
             return
-        qpos, mocap_pos, mocap_quat, jobs = message
+        qpos, mocap_pos, mocap_quat, qvel, sim_time_ms, jobs = message
         data.qpos[:] = qpos
+        data.qvel[:] = qvel
         data.mocap_pos[:] = mocap_pos
         data.mocap_quat[:] = mocap_quat
         mujoco.mj_kinematics(model, data)
@@ -70,7 +75,7 @@ def _serve(conn: Connection, model: Any, cameras: dict[RobotId, int]) -> None:
                     width,
                     height,
                 )
-            image = renderer.render(robot)
+            image = renderer.render(robot, sim_time_ms=sim_time_ms)
             conn.send((job_id, image, time.perf_counter() - started))
 
 
@@ -105,7 +110,8 @@ class RenderPool:
             parent, child = ctx.Pipe()
             proc = ctx.Process(
                 target=_serve,
-                args=(child, self._world.model, self._cameras),
+                args=(child, self._world.model, self._cameras, self._world.camera_model,
+                      self._world.look),
                 name=f"camera-render-{n}",
                 daemon=True,
             )
@@ -123,7 +129,8 @@ class RenderPool:
         if not self._procs:
             self._start()
         data = self._world.data
-        state = (data.qpos.copy(), data.mocap_pos.copy(), data.mocap_quat.copy())
+        state = (data.qpos.copy(), data.mocap_pos.copy(), data.mocap_quat.copy(),
+                 data.qvel.copy(), self._world.sim_time_ms)  # fmt: skip
         batch = _Batch(len(jobs))
         shares: list[list[tuple[int, RobotId, int, int]]] = [[] for _ in self._conns]
         with self._lock:

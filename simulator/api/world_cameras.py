@@ -1,6 +1,7 @@
 """Camera rendering for the real MuJoCo world, off the step thread.
 
-``capture`` (step thread) copies the joint positions of the step an image is due for; the
+``capture`` (step thread) copies the joint positions (and velocities, for motion blur) and the
+simulated time of the step an image is due for; the
 worker thread owns its own ``MjData`` and renderers, sets those positions, recomputes the
 kinematics and renders with the world's :class:`~simulator.world.CameraRenderer`. The physics
 state is never shared between threads.
@@ -29,7 +30,9 @@ def world_render_worker(world: World, *, threads: int = 1, processes: int = 0) -
         return RenderPool(world, processes=processes)
 
     def capture() -> Any:
-        return (world.data.qpos.copy(), world.data.mocap_pos.copy(), world.data.mocap_quat.copy())
+        d = world.data
+        return (d.qpos.copy(), d.mocap_pos.copy(), d.mocap_quat.copy(), d.qvel.copy(),
+                world.sim_time_ms)  # fmt: skip
 
     def make_render() -> RenderFn:
         import mujoco
@@ -38,14 +41,18 @@ def world_render_worker(world: World, *, threads: int = 1, processes: int = 0) -
 
         model = world.model
         data = mujoco.MjData(model)
-        view = SimpleNamespace(model=model, data=data, index=world.index)
+        view = SimpleNamespace(
+            model=model, data=data, index=world.index, camera_model=world.camera_model,
+            look=world.look,
+        )
         renderers: dict[tuple[int, int], CameraRenderer] = {}
         current: list[Any] = [None]
 
         def render(state: Any, robot: RobotId, width: int, height: int) -> bytes:
             if state is not current[0]:
-                qpos, mocap_pos, mocap_quat = state
+                qpos, mocap_pos, mocap_quat, qvel, _ = state
                 data.qpos[:] = qpos
+                data.qvel[:] = qvel
                 data.mocap_pos[:] = mocap_pos
                 data.mocap_quat[:] = mocap_quat
                 mujoco.mj_kinematics(model, data)
@@ -55,7 +62,7 @@ def world_render_worker(world: World, *, threads: int = 1, processes: int = 0) -
             if renderer is None:
                 renderer = CameraRenderer(view, width, height)  # type: ignore[arg-type]
                 renderers[(width, height)] = renderer
-            return renderer.render(robot)
+            return renderer.render(robot, sim_time_ms=state[4])
 
         return render
 

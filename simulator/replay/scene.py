@@ -8,13 +8,21 @@ after the robot models change. ``scene_of`` reads it from a compiled MuJoCo mode
                 "rgba": [4], "group", "pattern"?: {"colors": [[r g b], [r g b]],
                                                    "repeat": [u v], "cube": bool}}],
      "cameras": [{"name", "body", "pos": [3], "quat": [4], "fovy_deg"}],
+     "robot_cameras": [{"robot": "red-1", "name", "body", "pos", "quat", "fovy_deg", "width",
+                        "height"}],
      "robots": [{"team", "number", "model", "root_body"}],
-     "field": {FieldGeometry fields}}
+     "field": {FieldGeometry fields},
+     "camera_model": {CameraModel fields} | null,
+     "look": {"texture_seed", "turf", "ball", "background", "luminosity", "turf_colors",
+              "stripe_m", "ball_colors", "sky_colors"}}
 
 ``type`` is one of ``plane sphere capsule ellipsoid cylinder box``; sizes are MuJoCo's (half
 sizes, radius and half length). A mesh (the visual parts of a team's robot model) is recorded
 as its bounding box in the geom's frame. ``pattern`` is a two-colour texture (MuJoCo's builtin
-checker).
+checker). ``texture`` names one of the look's materials (``look:turf``, ``look:ball``,
+``look:net``; ``rgba`` is then its mean colour) and ``look`` is the look's
+:meth:`simulator.world.look.Look.summary`: a renderer regenerates the textures from it
+(:func:`simulator.world.look.look_from_summary`), a viewer may draw its stripe and ball colours.
 """
 
 from __future__ import annotations
@@ -27,11 +35,14 @@ if TYPE_CHECKING:
 
     from contracts.field import FieldGeometry
     from simulator.replay.format import ReplayHeader
+    from simulator.world.camera_model import CameraModel
+    from simulator.world.look import Look
     from simulator.world.types import RobotPlacement
 
 GEOM_TYPES = {0: "plane", 2: "sphere", 3: "capsule", 4: "ellipsoid", 5: "cylinder", 6: "box"}
 MESH = 7  # a mesh (team robot models' visual parts) travels as its bounding box
 TEXTURE_ROLE_RGB = 1
+LOOK_PREFIX = "look:"
 
 
 def _round(values: Any, digits: int = 6) -> list[float]:
@@ -54,6 +65,14 @@ def _pattern(model: mujoco.MjModel, matid: int) -> dict[str, Any] | None:
         "repeat": _round(model.mat_texrepeat[matid], 4),
         "cube": int(model.tex_type[texid]) == 1,
     }
+
+
+def _mean_texel(model: mujoco.MjModel, matid: int) -> list[float]:
+    texid = int(model.mat_texid[matid][TEXTURE_ROLE_RGB])
+    adr, channels = int(model.tex_adr[texid]), int(model.tex_nchannel[texid])
+    size = int(model.tex_width[texid]) * int(model.tex_height[texid]) * channels
+    texels = model.tex_data[adr : adr + size].reshape(-1, channels)[:, :3]
+    return [float(v) / 255.0 for v in texels.mean(axis=0)]
 
 
 def _geom(model: mujoco.MjModel, i: int) -> dict[str, Any]:
@@ -84,7 +103,12 @@ def _geom(model: mujoco.MjModel, i: int) -> dict[str, Any]:
         "rgba": _round(rgba, 4),
         "group": int(model.geom_group[i]),
     }
-    pattern = _pattern(model, matid) if matid >= 0 else None
+    material = model.material(matid).name if matid >= 0 else ""
+    look = material.startswith(LOOK_PREFIX)
+    pattern = _pattern(model, matid) if matid >= 0 and not look else None
+    if look:
+        geom["texture"] = material
+        geom["rgba"] = _round([*_mean_texel(model, matid), float(rgba[3])], 4)
     if pattern is not None:
         mean = [(a + b) / 2 for a, b in zip(*pattern["colors"], strict=True)]
         geom["rgba"] = _round([*mean, float(rgba[3])], 4)
@@ -92,10 +116,28 @@ def _geom(model: mujoco.MjModel, i: int) -> dict[str, Any]:
     return geom
 
 
+def _camera_spec(model_name: str) -> tuple[int, int]:
+    """(width, height) of a robot model's head camera; 320 x 240 when it cannot be loaded."""
+    from simulator.errors import SimulatorError, UnknownModelError
+    from simulator.world.robots import robot_model
+
+    try:
+        camera = robot_model(model_name).camera
+    except (SimulatorError, UnknownModelError):
+        return 320, 240
+    return camera.width, camera.height
+
+
 def scene_of(
-    model: mujoco.MjModel, placements: tuple[RobotPlacement, ...], field: FieldGeometry
+    model: mujoco.MjModel,
+    placements: tuple[RobotPlacement, ...],
+    field: FieldGeometry,
+    look: Look | None = None,
+    camera_model: CameraModel | None = None,
 ) -> dict[str, Any]:
-    """The scene description of a compiled world model (see the module docstring)."""
+    """The scene description of a compiled world model (see the module docstring) built with
+    ``look`` (default: the look of texture seed 0, as :func:`compile_scene`'s)."""
+    from simulator.world.look import look_for
     from simulator.world.types import robot_prefix
 
     bodies = [model.body(i).name for i in range(model.nbody)]
@@ -117,13 +159,36 @@ def scene_of(
         for i in range(model.ncam)
         if int(model.cam_bodyid[i]) == 0
     ]
+    robot_cameras = []
+    for p, robot in zip(placements, robots, strict=True):
+        prefix = robot_prefix(p.id) + "/"
+        for i in range(model.ncam):
+            body = int(model.cam_bodyid[i])
+            if body > 0 and bodies[body].startswith(prefix):
+                spec = _camera_spec(p.model)
+                robot_cameras.append(
+                    {
+                        "robot": f"{robot['team']}-{robot['number']}",
+                        "name": model.camera(i).name,
+                        "body": body,
+                        "pos": _round(model.cam_pos[i]),
+                        "quat": _round(model.cam_quat[i]),
+                        "fovy_deg": round(float(model.cam_fovy[i]), 4),
+                        "width": spec[0],
+                        "height": spec[1],
+                    }
+                )
+                break
     field_data = {k: v.value if k == "field_class" else v for k, v in asdict(field).items()}
     return {
         "bodies": bodies,
         "geoms": [_geom(model, i) for i in range(model.ngeom)],
         "cameras": cameras,
+        "robot_cameras": robot_cameras,
         "robots": robots,
         "field": field_data,
+        "look": (look if look is not None else look_for(0)).summary(),
+        "camera_model": asdict(camera_model) if camera_model is not None else None,
     }
 
 

@@ -11,6 +11,7 @@ within 6 s.
 from __future__ import annotations
 
 from contracts.field import FieldGeometry
+from simulator.world.look import BALL_TEXTURE
 
 BALL_BODY = "ball"
 BALL_JOINT = "ball/root"
@@ -21,14 +22,6 @@ BALL_LINEAR_DAMPING_PER_KG = 0.6  # N s/m per kg of ball: v decays ~ exp(-0.6 t 
 BALL_ANGULAR_DAMPING = 0.0
 
 
-def ball_assets() -> str:
-    return (
-        '<texture name="ball" type="cube" builtin="checker" rgb1="1 1 1" rgb2="0.1 0.1 0.1" '
-        'width="64" height="64"/>'
-        '<material name="ball" texture="ball"/>'
-    )
-
-
 def ball_body(f: FieldGeometry, *, bits: tuple[int, int]) -> str:
     contype, conaffinity = bits
     r = f.ball_radius_m
@@ -36,7 +29,7 @@ def ball_body(f: FieldGeometry, *, bits: tuple[int, int]) -> str:
         f'<body name="{BALL_BODY}" pos="0 0 {r:.6g}">'
         f'<freejoint name="{BALL_JOINT}"/>'
         f'<geom name="{BALL_GEOM}" type="sphere" size="{r:.6g}" mass="{f.ball_mass_kg:.6g}" '
-        f'material="ball" condim="6" priority="2" '
+        f'material="{BALL_TEXTURE}" condim="6" priority="2" '
         f'friction="{" ".join(str(v) for v in BALL_FRICTION)}" '
         f'solref="{BALL_SOLREF[0]} {BALL_SOLREF[1]}" contype="{contype}" '
         f'conaffinity="{conaffinity}"/>'

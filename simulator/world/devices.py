@@ -12,6 +12,9 @@ Forms over several robots at once, for the robot API's per-step batches
 :meth:`DeviceAccess.sensor_sources` + :meth:`DeviceAccess.gather_sensors` (the sensors of many
 robots in one gather; :meth:`DeviceAccess.sensor_gatherer` makes it one numpy call, for a plan
 used every step).
+
+Every read returns the sensor's reading: MuJoCo's value, or with the world's sensor model
+(:mod:`simulator.world.sensor_noise`) its noisy copy drawn at the last step.
 """
 
 from __future__ import annotations
@@ -30,6 +33,7 @@ from simulator.errors import UnknownDeviceError
 from simulator.world.types import DeviceKind
 
 if TYPE_CHECKING:
+    from simulator.world.flat import FlatData
     from simulator.world.indices import RobotIndex, WorldIndex
     from simulator.world.motors import MotorBank, PositionWriter
 
@@ -51,6 +55,8 @@ class DeviceAccess:
     data: mujoco.MjData
     limp: list[bool]
     removed: list[bool]
+    _sensor_span: FlatData  # the true values of qpos and sensordata, one span
+    _readings: npt.NDArray[np.float64]  # what sensors read: the span or its noisy copy
     _device_plans: dict[tuple[str, RobotId, tuple[str, ...]], tuple[Any, ...]]
 
     def _robot(self, robot: RobotId) -> RobotIndex:
@@ -139,16 +145,19 @@ class DeviceAccess:
         slot = r.motor_slot.get(motor)
         if slot is None:
             raise UnknownDeviceError(robot=str(robot), name=sensor_name, kind="position sensor")
-        return float(self.data.qpos[r.motor_qpos[slot]])
+        return float(self._readings[self._sensor_span.offset("qpos") + int(r.motor_qpos[slot])])
+
+    def _joint_readings(self, r: RobotIndex) -> npt.NDArray[np.float64]:
+        return self._readings[self._sensor_span.offset("qpos") + r.motor_qpos]
 
     def read_position_array(self, robot: RobotId) -> npt.NDArray[np.float64]:
         """Every joint angle (rad) in ``motor_names(robot)`` order."""
-        return np.asarray(self.data.qpos[self._robot(robot).motor_qpos], dtype=np.float64)
+        return np.asarray(self._joint_readings(self._robot(robot)), dtype=np.float64)
 
     def read_positions(self, robot: RobotId) -> dict[str, float]:
         """``{"NeckS": rad, ...}`` for every position sensor."""
         r = self._robot(robot)
-        values = self.data.qpos[r.motor_qpos].tolist()
+        values = self._joint_readings(r).tolist()
         return {f"{n}S": v for n, v in zip(r.model.motor_names, values, strict=True)}
 
     def read_sensors(self, robot: RobotId, names: Sequence[str]) -> npt.NDArray[np.float64]:
@@ -177,8 +186,9 @@ class DeviceAccess:
         """The values of a :meth:`sensor_sources` plan (or of several concatenated), flat."""
         out_q, src_q, out_s, src_s = sources
         out = np.empty(len(out_q) + len(out_s))
-        out[out_q] = self.data.qpos[src_q]
-        out[out_s] = self.data.sensordata[src_s]
+        span, values = self._sensor_span, self._readings
+        out[out_q] = values[span.offset("qpos") + src_q]
+        out[out_s] = values[span.offset("sensordata") + src_s]
         return out
 
     def sensor_gatherer(
@@ -186,18 +196,14 @@ class DeviceAccess:
     ) -> Callable[[], npt.NDArray[np.float64]]:
         """:meth:`gather_sensors` of one plan as one ``take`` from a span over ``qpos`` and
         ``sensordata`` (:class:`simulator.world.flat.FlatData`): one numpy call per step, where
-        :meth:`gather_sensors` makes five, each a few microseconds right after ``mj_step``."""
-        from simulator.world.flat import FlatData
-
+        :meth:`gather_sensors` makes five, each a few microseconds right after ``mj_step``.
+        The span is the noisy readings' when the sensor model is not ideal."""
         out_q, src_q, out_s, src_s = sources
-        flat: FlatData | None = getattr(self, "_sensor_span", None)
-        if flat is None:
-            flat = FlatData(self.data, ("qpos", "sensordata"))
-            self._sensor_span = flat
+        flat = self._sensor_span
         index = np.empty(len(out_q) + len(out_s), dtype=np.intp)
         index[out_q] = flat.indices("qpos", src_q)
         index[out_s] = flat.indices("sensordata", src_s)
-        return cast(Callable[[], npt.NDArray[np.float64]], partial(flat.values.take, index))
+        return cast(Callable[[], npt.NDArray[np.float64]], partial(self._readings.take, index))
 
     def _sensor_plan(
         self, robot: RobotId, names: Sequence[str]
@@ -237,7 +243,8 @@ class DeviceAccess:
         return plans
 
     def _vec3(self, adr: int) -> Vec3:
-        x, y, z = self.data.sensordata[adr : adr + 3].tolist()
+        start = self._sensor_span.offset("sensordata") + adr
+        x, y, z = self._readings[start : start + 3].tolist()
         return (x, y, z)
 
     def read_accelerometer(self, robot: RobotId) -> Vec3:
@@ -254,7 +261,7 @@ class DeviceAccess:
         adr = r.forces.get(name)
         if adr is None:
             raise UnknownDeviceError(robot=str(robot), name=name, kind="force sensor")
-        return float(self.data.sensordata[adr])
+        return float(self._readings[self._sensor_span.offset("sensordata") + adr])
 
     def camera_info(self, robot: RobotId) -> tuple[int, int, float]:
         """(width, height, horizontal field of view in rad) of the head camera."""

@@ -1,10 +1,14 @@
-"""The pitch entity: turf (field plus border strip), visual lines, lights and the video camera."""
+"""The pitch entity: turf (field plus border strip), visual lines, lights and the video camera.
+
+The turf's texture and the lights' strength come from the look (:mod:`simulator.world.look`).
+"""
 
 from __future__ import annotations
 
 import math
 
 from contracts.field import FieldGeometry
+from simulator.world.look import TURF_TEXTURE
 
 TURF_FRICTION = 0.5
 LINE_HEIGHT_M = 0.001
@@ -51,16 +55,6 @@ def _lines(f: FieldGeometry) -> list[str]:
     return out
 
 
-def field_assets() -> str:
-    return (
-        '<texture name="sky" type="skybox" builtin="gradient" rgb1="0.55 0.7 0.9" '
-        'rgb2="0.1 0.15 0.25" width="64" height="64"/>'
-        '<texture name="grass" type="2d" builtin="checker" rgb1="0.2 0.55 0.2" '
-        'rgb2="0.18 0.5 0.18" width="64" height="64"/>'
-        '<material name="grass" texture="grass" texrepeat="12 12" reflectance="0"/>'
-    )
-
-
 def field_bodies(f: FieldGeometry, *, static_bits: tuple[int, int]) -> str:
     """Turf, lines, lights and the overview camera (children of the world body)."""
     contype, conaffinity = static_bits
@@ -69,7 +63,7 @@ def field_bodies(f: FieldGeometry, *, static_bits: tuple[int, int]) -> str:
     height = 0.75 * distance
     norm = math.hypot(distance, height)
     parts = [
-        f'<geom name="turf" type="plane" size="{tx:.6g} {ty:.6g} 0.1" material="grass" '
+        f'<geom name="turf" type="plane" size="{tx:.6g} {ty:.6g} 0.1" material="{TURF_TEXTURE}" '
         f'friction="{TURF_FRICTION} 0.005 0.0001" priority="1" contype="{contype}" '
         f'conaffinity="{conaffinity}"/>',
         '<light name="sun" directional="true" pos="0 0 10" dir="0.2 0.3 -1" '

@@ -1,11 +1,16 @@
-"""The goal entity: two posts, a crossbar, a back bar and nets (thin boxes) behind a goal line."""
+"""The goal entity: two posts, a crossbar, a back bar and nets (thin boxes with
+the look's net texture, see-through) behind a goal line.
+
+Each net box is turned so that its thin side is its local z: MuJoCo lays a 2D texture on a
+box's faces by the local x and y, so only the faces normal to z show the net's full mesh.
+"""
 
 from __future__ import annotations
 
 from contracts.field import FieldGeometry
+from simulator.world.look import NET_TEXTURE
 
 POST_RGBA = "1 1 1 1"
-NET_RGBA = "0.9 0.9 0.9 0.35"
 NET_HALF_THICKNESS_M = 0.01
 
 
@@ -31,7 +36,8 @@ def goal_bodies(f: FieldGeometry, *, sign: float, name: str, static_bits: tuple[
         geoms.append(
             f'<geom name="{name}:net_side_{label}" type="box" '
             f'pos="{mid_x:.6g} {ys * (half_w + r + t):.6g} {h / 2:.6g}" '
-            f'size="{d / 2:.6g} {t} {h / 2:.6g}" rgba="{NET_RGBA}" {col}/>'
+            f'size="{d / 2:.6g} {h / 2:.6g} {t}" euler="1.5707963 0 0" '
+            f'material="{NET_TEXTURE}" {col}/>'
         )
     geoms.append(
         f'<geom name="{name}:crossbar" type="cylinder" '
@@ -40,7 +46,8 @@ def goal_bodies(f: FieldGeometry, *, sign: float, name: str, static_bits: tuple[
     )
     geoms.append(
         f'<geom name="{name}:net_back" type="box" pos="{back_x + sign * t:.6g} 0 {h / 2:.6g}" '
-        f'size="{t} {half_w + r:.6g} {h / 2:.6g}" rgba="{NET_RGBA}" {col}/>'
+        f'size="{h / 2:.6g} {half_w + r:.6g} {t}" euler="0 1.5707963 0" '
+        f'material="{NET_TEXTURE}" {col}/>'
     )
     geoms.append(
         f'<geom name="{name}:back_bar" type="cylinder" '
@@ -49,6 +56,6 @@ def goal_bodies(f: FieldGeometry, *, sign: float, name: str, static_bits: tuple[
     )
     geoms.append(
         f'<geom name="{name}:net_top" type="box" pos="{mid_x:.6g} 0 {h + t:.6g}" '
-        f'size="{d / 2:.6g} {half_w + r:.6g} {t}" rgba="{NET_RGBA}" {col}/>'
+        f'size="{d / 2:.6g} {half_w + r:.6g} {t}" material="{NET_TEXTURE}" {col}/>'
     )
     return "".join(geoms)

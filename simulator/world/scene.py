@@ -14,9 +14,10 @@ import numpy as np
 
 from contracts.field import FieldGeometry
 from contracts.ids import TeamColor
-from simulator.world.ball import BALL_GEOM, BALL_JOINT, ball_assets, ball_body, ball_damping
-from simulator.world.field import field_assets, field_bodies
+from simulator.world.ball import BALL_GEOM, BALL_JOINT, ball_body, ball_damping
+from simulator.world.field import field_bodies
 from simulator.world.goal import goal_bodies
+from simulator.world.look import Look, apply_look, look_assets, look_for
 from simulator.world.robots import robot_model
 from simulator.world.types import RobotPlacement, robot_prefix
 
@@ -32,9 +33,15 @@ def ball_touch_sensor(placement: RobotPlacement) -> str:
 
 
 def scene_xml(
-    field: FieldGeometry, robots: Sequence[RobotPlacement], *, physics_dt_s: float
+    field: FieldGeometry,
+    robots: Sequence[RobotPlacement],
+    *,
+    physics_dt_s: float,
+    look: Look | None = None,
 ) -> str:
-    """The world MJCF. Raises UnknownModelError for a model name we do not ship."""
+    """The world MJCF (its look's textures still blank: :func:`compile_scene` fills them).
+    Raises UnknownModelError for a model name we do not ship."""
+    look = look if look is not None else look_for(0)
     if len(robots) > MAX_ROBOTS:
         raise ValueError(f"at most {MAX_ROBOTS} robots, got {len(robots)}")
     robot_bits = (1 << len(robots)) - 1
@@ -77,7 +84,7 @@ def scene_xml(
  <headlight ambient="0.35 0.35 0.35" diffuse="0.3 0.3 0.3" specular="0 0 0"/>
  <map znear="0.01" zfar="100"/>
 </visual>
-<asset>{field_assets()}{ball_assets()}{"".join(assets.values())}</asset>
+<asset>{look_assets(look)}{"".join(assets.values())}</asset>
 <worldbody>{"".join(bodies)}</worldbody>
 <actuator>{"".join(actuators)}</actuator>
 <sensor>{"".join(sensors)}</sensor>
@@ -85,10 +92,19 @@ def scene_xml(
 
 
 def compile_scene(
-    field: FieldGeometry, robots: Sequence[RobotPlacement], *, physics_dt_s: float
+    field: FieldGeometry,
+    robots: Sequence[RobotPlacement],
+    *,
+    physics_dt_s: float,
+    look: Look | None = None,
 ) -> mujoco.MjModel:
-    """Compile the world model, with the ball's per-axis damping applied."""
-    model = mujoco.MjModel.from_xml_string(scene_xml(field, robots, physics_dt_s=physics_dt_s))
+    """Compile the world model, with the ball's per-axis damping applied and ``look`` (default:
+    the look of texture seed 0) in its textures and lights."""
+    look = look if look is not None else look_for(0)
+    model = mujoco.MjModel.from_xml_string(
+        scene_xml(field, robots, physics_dt_s=physics_dt_s, look=look)
+    )
+    apply_look(model, look)
     linear, angular = ball_damping(field)
     adr = int(model.joint(BALL_JOINT).dofadr[0])
     model.dof_damping[adr : adr + 3] = linear

@@ -5,7 +5,9 @@ motors write ``ctrl`` (velocity-limited targets, torque mode, limp), MuJoCo step
 evaluated in the last substep only, since they are read once per basic step), removed robots
 are held at their parking spots, divergence is checked (policy ``fail`` raises
 :class:`PhysicsDivergence`, ``reset_robot`` restores the previous state and resets the offending
-robot), and the last ball toucher is updated.
+robot), the sensors' noisy readings are drawn (unless the sensor model is ideal:
+:mod:`simulator.world.sensor_noise`) and the last ball toucher is updated. The robot API's
+reads see those readings; the snapshot (referee, replay, telemetry) the true state.
 
 :meth:`World.snapshot` is built by :class:`simulator.world.snapshot.SnapshotBuilder`, which
 precomputes what it can so that a snapshot of eight robots costs about 40 us of the 8 ms step's
@@ -27,12 +29,16 @@ from contracts.match_spec import MatchSpec
 from referee.snapshot import WorldCommand, WorldSnapshot
 from simulator.errors import PhysicsDivergence
 from simulator.world import commands
+from simulator.world.camera_model import CameraModel
 from simulator.world.devices import DeviceAccess
 from simulator.world.divergence import DivergenceWatch
+from simulator.world.flat import FlatData
 from simulator.world.indices import build_index
+from simulator.world.look import look_for
 from simulator.world.motors import MotorBank
 from simulator.world.robots import robot_model
 from simulator.world.scene import compile_scene
+from simulator.world.sensor_noise import SensorModel, SensorNoise
 from simulator.world.snapshot import SnapshotBuilder, ball_toucher
 from simulator.world.types import DivergencePolicy, FieldClassName, RobotPlacement
 
@@ -54,6 +60,9 @@ class World(DeviceAccess):
         step_ms: int,
         divergence_policy: DivergencePolicy,
         initial_joint_noise_rad: float,
+        texture_seed: int | None = None,
+        sensor_model: SensorModel | None = None,
+        camera_model: CameraModel | None = None,
     ) -> None:
         substeps = step_ms / 1000.0 / physics_dt_s
         if physics_dt_s <= 0 or step_ms <= 0 or abs(substeps - round(substeps)) > 1e-6:
@@ -75,7 +84,9 @@ class World(DeviceAccess):
         self.substeps = int(round(substeps))
         self.divergence_policy: DivergencePolicy = divergence_policy
         self.rng = np.random.default_rng(seed)
-        self.model = compile_scene(field, placements, physics_dt_s=physics_dt_s)
+        self.look = look_for(seed if texture_seed is None else texture_seed)
+        self.model = compile_scene(field, placements, physics_dt_s=physics_dt_s, look=self.look)
+        self.camera_model = camera_model if camera_model is not None else CameraModel.ideal()
         self.data = mujoco.MjData(self.model)
         self._opt = self.model.opt  # a view of the model's options (one wrapper, not one a step)
         self.index = build_index(self.model, placements)
@@ -97,6 +108,22 @@ class World(DeviceAccess):
                 self.data.qpos[robot.motor_qpos] = pose
                 self.motors.hold(robot.actuators, pose)
         mujoco.mj_forward(self.model, self.data)
+        self._sensor_span = FlatData(self.data, ("qpos", "sensordata"))
+        self.sensor_model = sensor_model if sensor_model is not None else SensorModel.ideal()
+        self.sensor_noise: SensorNoise | None = None
+        self._readings = self._sensor_span.values
+        if self.sensor_model.enabled:
+            self.sensor_noise = SensorNoise(
+                model=self.sensor_model,
+                flat=self._sensor_span,
+                index=self.index,
+                encoder_resolution_rad=np.array(
+                    [m.encoder_resolution_rad for r in self.index.robots for m in r.model.motors]
+                ),
+                seed=seed,
+                step_s=step_ms / 1000.0,
+            )
+            self._readings = self.sensor_noise.values
         self._watch = DivergenceWatch(self.data)
         self._snapshots = SnapshotBuilder(self.data, self.index, self.robot_ids)
         self._saved = self._save()
@@ -112,9 +139,16 @@ class World(DeviceAccess):
         step_ms: int = 8,
         divergence_policy: DivergencePolicy = "fail",
         initial_joint_noise_rad: float = 0.0,
+        texture_seed: int | None = None,
+        sensor_model: SensorModel | None = None,
+        camera_model: CameraModel | None = None,
     ) -> World:
         """A world on the ``field_class`` pitch with ``robots`` standing at their poses (world
-        frame), the ball on the centre spot. Unknown model names raise UnknownModelError."""
+        frame), the ball on the centre spot. Unknown model names raise UnknownModelError.
+
+        The look comes from ``texture_seed`` (default: ``seed``); sensors and cameras are ideal
+        unless ``sensor_model`` / ``camera_model`` say otherwise (:meth:`from_spec` gives a
+        match the league's)."""
         for placement in robots:
             robot_model(placement.model)
         return cls(
@@ -125,10 +159,13 @@ class World(DeviceAccess):
             step_ms=step_ms,
             divergence_policy=divergence_policy,
             initial_joint_noise_rad=initial_joint_noise_rad,
+            texture_seed=texture_seed,
+            sensor_model=sensor_model,
+            camera_model=camera_model,
         )
 
-    @classmethod
-    def from_spec(cls, spec: MatchSpec, *, divergence_policy: DivergencePolicy = "fail") -> World:
+    @staticmethod
+    def placements_of(spec: MatchSpec) -> list[RobotPlacement]:
         """Every player of both teams at its ``half_time_pose``; the team playing on the right
         (not ``spec.side_left``) is mirrored (:meth:`contracts.geometry.Pose.mirrored`)."""
         placements = []
@@ -146,12 +183,25 @@ class World(DeviceAccess):
                         yaw_rad=pose.yaw_rad,
                     )
                 )
+        return placements
+
+    @classmethod
+    def from_spec(cls, spec: MatchSpec, *, divergence_policy: DivergencePolicy = "fail") -> World:
+        """The world of a match: :meth:`placements_of` the spec, its look (``texture_seed``)
+        and its sensors (``sensors``: the league's models unless ``"ideal"``)."""
         return cls.create(
             field_class=spec.field_class,
-            robots=placements,
+            robots=World.placements_of(spec),
             seed=spec.seed,
             physics_dt_s=spec.physics_dt_s,
             divergence_policy=divergence_policy,
+            texture_seed=spec.texture_seed,
+            sensor_model=SensorModel.ideal() if spec.sensors == "ideal" else SensorModel(),
+            camera_model=(
+                CameraModel.ideal()
+                if spec.sensors == "ideal"
+                else CameraModel.league(spec.seed, motion_blur=spec.camera_motion_blur)
+            ),
         )
 
     # --- stepping ------------------------------------------------------------------------------
@@ -171,6 +221,8 @@ class World(DeviceAccess):
         if self.parked_qpos:
             commands.hold_parked(self)
         self.sim_time_ms += self.step_ms
+        if self.sensor_noise is not None:
+            self.sensor_noise.update()
         divergence = self._watch.check(self.data)
         if divergence is not None:
             self._diverged(divergence.text(self._dof_name(divergence.info)), divergence.info)

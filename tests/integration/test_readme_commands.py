@@ -204,6 +204,13 @@ def bench_json(ran: Ran, root: Path) -> None:
     assert document["bench"] == "envs", document
 
 
+def camera_frames_written(ran: Ran, root: Path) -> None:
+    exit_zero(ran, root)
+    frames = sorted((root / "frames").glob("red-1_*.png"))
+    assert frames, ran.describe()
+    assert frames[0].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
 def mcap_written(ran: Ran, root: Path) -> None:
     exit_zero(ran, root)
     assert (root / "match.mcap").read_bytes()[:8] == b"\x89MCAP0\r\n"
@@ -242,6 +249,9 @@ OUTCOMES: dict[str, Outcome] = {
     ". .venv/bin/activate": Outcome(exit_zero),
     "hlvs render matches/scrimmage/public/replay.hlvsrec -o match.mp4": Outcome(
         video_made, timeout_s=1500, after=(SCRIMMAGE,)
+    ),
+    "hlvs render matches/scrimmage/public/replay.hlvsrec --camera red-1 -o frames --fps 0.2": (
+        Outcome(camera_frames_written, timeout_s=600, after=(SCRIMMAGE,))
     ),
     "hlvs view matches/scrimmage": Outcome(viewer_serves, timeout_s=60, after=(SCRIMMAGE,),
                                            server=True),

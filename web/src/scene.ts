@@ -14,6 +14,16 @@ export interface GeomSpec {
   rgba: number[];
   group: number;
   pattern?: { colors: number[][]; repeat: number[]; cube: boolean };
+  texture?: string; // one of the look's materials: "look:turf", "look:ball", "look:net"
+}
+
+/** The match's look (simulator/world/look.py `Look.summary`): what the viewer draws of it. */
+export interface LookSpec {
+  texture_seed: number;
+  turf_colors: number[][]; // light and dark mowing stripe, mean colours
+  stripe_m: number;
+  ball_colors: number[][]; // panels, patches
+  sky_colors: number[][]; // sky top, sky at the horizon, stands
 }
 
 export interface RobotSpec {
@@ -29,6 +39,7 @@ export interface SceneSpec {
   cameras: { name: string; pos: number[]; quat: number[]; fovy_deg: number }[];
   robots: RobotSpec[];
   field: Record<string, number | string>;
+  look?: LookSpec;
 }
 
 export const TEAM_CSS: Record<string, string> = { red: "#d91f1a", blue: "#1a40e6" };
@@ -125,6 +136,61 @@ function patternedSphere(g: GeomSpec, colours: THREE.Color[]): THREE.BufferGeome
   return shape;
 }
 
+/** The classic football on a sphere: a triangle takes the patch colour when its centre is
+ * nearer one of the 12 icosahedron vertices (the pentagons) than one of the 20 face centres
+ * (the hexagons), as the simulator's ball texture is drawn. */
+function footballSphere(g: GeomSpec, panel: THREE.Color, patch: THREE.Color): THREE.BufferGeometry {
+  const shape = new THREE.SphereGeometry(g.size[0], 32, 20).toNonIndexed();
+  shape.deleteAttribute("uv");
+  const ico = new THREE.IcosahedronGeometry(1, 0).toNonIndexed().getAttribute("position");
+  const vertices: THREE.Vector3[] = [];
+  const centres: THREE.Vector3[] = [];
+  for (let f = 0; f < ico.count; f += 3) {
+    const corners = [0, 1, 2].map((k) => new THREE.Vector3().fromBufferAttribute(ico, f + k).normalize());
+    centres.push(corners[0].clone().add(corners[1]).add(corners[2]).normalize());
+    for (const c of corners) if (!vertices.some((v) => v.distanceTo(c) < 1e-3)) vertices.push(c);
+  }
+  const position = shape.getAttribute("position");
+  const rgb = new Float32Array(position.count * 3);
+  const centre = new THREE.Vector3();
+  const p = new THREE.Vector3();
+  for (let v = 0; v < position.count; v += 3) {
+    centre.set(0, 0, 0);
+    for (let k = 0; k < 3; k++) centre.add(p.fromBufferAttribute(position, v + k));
+    centre.normalize();
+    const pent = Math.max(...vertices.map((d) => d.dot(centre))) + 0.02;
+    const hex = Math.max(...centres.map((d) => d.dot(centre)));
+    const c = pent > hex ? patch : panel;
+    for (let k = 0; k < 3; k++) rgb.set([c.r, c.g, c.b], (v + k) * 3);
+  }
+  shape.setAttribute("color", new THREE.BufferAttribute(rgb, 3));
+  return shape;
+}
+
+/** The look's turf: mowing stripes across the pitch (`stripe_m` wide along x, light first from
+ * x = 0, as MuJoCo lays the texture), as coloured quads. */
+function stripedTurf(g: GeomSpec, look: LookSpec): THREE.BufferGeometry {
+  const [halfX, halfY] = g.size;
+  const colours = look.turf_colors.map(colour);
+  const first = Math.floor(-halfX / look.stripe_m);
+  const last = Math.ceil(halfX / look.stripe_m);
+  const position: number[] = [];
+  const rgb: number[] = [];
+  for (let i = first; i < last; i++) {
+    const x0 = Math.max(-halfX, i * look.stripe_m);
+    const x1 = Math.min(halfX, (i + 1) * look.stripe_m);
+    const c = colours[((i % 2) + 2) % 2];
+    for (const [x, y] of [[x0, -halfY], [x1, -halfY], [x1, halfY], [x0, -halfY], [x1, halfY], [x0, halfY]]) {
+      position.push(x, y, 0);
+      rgb.push(c.r, c.g, c.b);
+    }
+  }
+  const shape = new THREE.BufferGeometry();
+  shape.setAttribute("position", new THREE.BufferAttribute(new Float32Array(position), 3));
+  shape.setAttribute("color", new THREE.BufferAttribute(new Float32Array(rgb), 3));
+  return shape;
+}
+
 /** The turf's checker pattern as coloured quads (no texture to sample: the turf covers most
  * pixels, and software WebGL pays for every texture read). Same cells as the texture MuJoCo
  * describes: two colours, 2 x repeat cells across the plane, multiplied by `tint`. */
@@ -191,7 +257,7 @@ export class SceneView {
   constructor(readonly canvas: HTMLCanvasElement, readonly spec: SceneSpec) {
     this.renderer = new THREE.WebGLRenderer({ canvas, antialias: false });
     this.renderer.setPixelRatio(1);
-    this.scene.background = new THREE.Color(0x9ab8d8);
+    this.scene.background = spec.look ? colour(spec.look.sky_colors[1]) : new THREE.Color(0x9ab8d8);
     this.scene.add(new THREE.HemisphereLight(0xffffff, 0x445544, 1.6));
     const sun = new THREE.DirectionalLight(0xffffff, 1.4);
     sun.position.set(2, 3, 10);
@@ -202,6 +268,26 @@ export class SceneView {
     for (const g of spec.geoms) {
       if (g.group >= 3) continue; // MuJoCo's hidden groups (collision-only helpers)
       const transparent = g.rgba[3] < 1;
+      const look = spec.look;
+      if (g.type === "plane" && g.texture === "look:turf" && look) {
+        const turf = new THREE.Mesh(stripedTurf(g, look), new THREE.MeshBasicMaterial({ vertexColors: true }));
+        turf.position.set(g.pos[0], g.pos[1], g.pos[2] - 0.0005);
+        turf.name = g.name;
+        this.scene.add(turf);
+        continue;
+      }
+      if (g.type === "sphere" && g.texture === "look:ball" && look) {
+        const [panel, patch] = look.ball_colors.map(colour);
+        const mesh = new THREE.Mesh(footballSphere(g, panel, patch), new THREE.MeshLambertMaterial({ vertexColors: true }));
+        mesh.name = g.name;
+        mesh.matrixAutoUpdate = false;
+        const local = new THREE.Matrix4().compose(
+          new THREE.Vector3(g.pos[0], g.pos[1], g.pos[2]),
+          new THREE.Quaternion(g.quat[1], g.quat[2], g.quat[3], g.quat[0]), this.unit);
+        this.posed.push({ object: mesh, body: g.body, local });
+        this.scene.add(mesh);
+        continue;
+      }
       if (g.type === "plane" && g.pattern) {
         // unlit: a flat plane is evenly lit anyway, and the cheapest shader covers most pixels
         const turf = new THREE.Mesh(turfGeometry(g, new THREE.Color(0xbbbbbb)), new THREE.MeshBasicMaterial({ vertexColors: true }));

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from robot.geometry import CAMERA_FOV_RAD, HumanoidGeometry
@@ -22,6 +23,9 @@ class MotorSpec:
     kv_nm_s_per_rad: float  # velocity feedback of the position controller
     max_torque_nm: float
     max_velocity_rad_s: float
+    # the position sensor's resolution: 2 pi / 4096 rad, the 4096-count encoder of the league's
+    # Dynamixel servos (:mod:`simulator.world.sensor_noise`)
+    encoder_resolution_rad: float = 2.0 * math.pi / 4096.0
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -64,10 +64,14 @@ def test_the_scene_travels_with_the_replay(tmp_path: Path) -> None:
     assert scene["bodies"] == list(header.body_names)
     assert len(scene["geoms"]) == world.model.ngeom
     by_name = {g["name"]: g for g in scene["geoms"]}
-    assert by_name["turf"]["type"] == "plane" and by_name["turf"]["pattern"]["colors"][0][1] > 0.4
+    turf = by_name["turf"]
+    assert turf["type"] == "plane" and turf["texture"] == "look:turf"
+    assert turf["rgba"][1] > 0.4 > turf["rgba"][0]  # the turf's mean colour: green
     torso = by_name["red_1/torso:torso"]
     assert torso["type"] == "box" and torso["rgba"] == [0.85, 0.12, 0.1, 1.0]
-    assert by_name["ball:geom"]["pattern"]["cube"] is True
+    assert by_name["ball:geom"]["texture"] == "look:ball"
+    assert scene["look"]["texture_seed"] == world.look.texture_seed
+    assert scene["look"]["turf_colors"][0] != scene["look"]["turf_colors"][1]  # mowing stripes
     assert scene["robots"][0]["team"] == "red"
     assert scene["bodies"][scene["robots"][0]["root_body"]] == "red_1/torso"
     assert scene["field"]["half_length_m"] == 4.5

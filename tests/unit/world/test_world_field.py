@@ -40,8 +40,8 @@ def test_pitch_goals_and_ball_follow_the_rules(field_class: str, geometry: Field
         assert inner_width == pytest.approx(geometry.goal_width_m)
         bar, bar_size = _geom(world, f"{name}:crossbar")
         assert bar[2] - bar_size[0] == pytest.approx(geometry.goal_height_m)
-        back, back_size = _geom(world, f"{name}:net_back")
-        assert abs(back[0]) - back_size[0] == pytest.approx(
+        back, back_size = _geom(world, f"{name}:net_back")  # turned: its thin side is local z
+        assert abs(back[0]) - back_size[2] == pytest.approx(
             geometry.half_length_m + geometry.goal_depth_m
         )
     ball = world.model.geom("ball:geom")

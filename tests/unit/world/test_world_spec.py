@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import pytest
 
@@ -50,3 +51,16 @@ def test_from_spec_mirrors_the_team_on_the_right(side_left: str) -> None:
     two_right = snap.robot(RobotId(right, 2))
     assert two_right.position[:2] == pytest.approx((1.0, -3.1), abs=1e-3)
     assert len(world.robot_ids) == 4
+
+
+def test_a_match_plays_with_league_sensors_and_look_unless_told_otherwise() -> None:
+    spec = MatchSpec(
+        match_id="spec-test", seed=9, game_type="NORMAL", field_class="kid", side_left="red",
+        kickoff="red", red=_team("red", 1), blue=_team("blue", 2),
+    )  # fmt: skip
+    world = World.from_spec(spec)
+    assert world.sensor_noise is not None and not world.camera_model.is_ideal
+    assert world.look.texture_seed == 9  # the match seed when no texture seed is given
+    other = World.from_spec(replace(spec, sensors="ideal", texture_seed=4))
+    assert other.sensor_noise is None and other.camera_model.is_ideal
+    assert other.look.texture_seed == 4
