@@ -46,6 +46,10 @@ def register(sub: Any) -> None:
     status = verbs.add_parser("status", help="state of every match")
     status.add_argument("--state", type=user_path, required=True, help=_STATE_HELP)
     status.add_argument("--json", action="store_true", help="print a JSON array")
+    status.add_argument("--watch", action="store_true",
+                        help="print the status again every --every seconds until Ctrl-C")
+    status.add_argument("--every", type=float, default=2.0, metavar="S",
+                        help="seconds between two prints with --watch (default 2)")
     status.set_defaults(func=_status)
 
     cancel = verbs.add_parser("cancel", help="cancel a match that is not played yet")
@@ -115,16 +119,29 @@ def _list(args: argparse.Namespace) -> int:
 
 
 def _status(args: argparse.Namespace) -> int:
-    rows = _ledger(args.state).rows()
-    if args.json:
-        print(json.dumps([r.as_dict() for r in rows], indent=2))
+    from orchestrator.schedule.overview import status_lines
+
+    ledger = _ledger(args.state)
+    if not args.watch:
+        if args.json:
+            print(json.dumps([r.as_dict() for r in ledger.rows()], indent=2))
+        else:
+            print("\n".join(status_lines(ledger)))
         return 0
-    for r in rows:
-        score = ""
-        if r.result and r.result.get("score", {}).get("red") is not None:
-            score = f" {r.result['score']['red']}-{r.result['score']['blue']}"
-        print(f"{r.id:<12} {r.state.value:<12} {r.red} v {r.blue}{score}  {r.note}".rstrip())
-    return 0
+    import time
+
+    try:
+        while True:
+            text = (json.dumps([r.as_dict() for r in ledger.rows()]) if args.json
+                    else "\n".join(status_lines(ledger)))
+            if not args.json:
+                print("\x1b[H\x1b[2J", end="")  # clear the terminal, as watch(1) does
+                print(f"{datetime.now(UTC).isoformat(timespec='seconds')}"
+                      f"  (every {args.every:g} s, Ctrl-C to stop)")
+            print(text, flush=True)
+            time.sleep(args.every)
+    except KeyboardInterrupt:
+        return 0
 
 
 def _cancel(args: argparse.Namespace) -> int:
@@ -156,8 +173,9 @@ def _standings(args: argparse.Namespace) -> int:
 
     ledger = _ledger(args.state)
     schedule_path = ledger.get_meta("schedule")
-    teams = [t.name for t in load_schedule(schedule_path).teams] if schedule_path else []
-    table = standings(ledger.rows(), teams)
+    schedule = load_schedule(schedule_path) if schedule_path else None
+    teams = [t.name for t in schedule.teams] if schedule is not None else []
+    table = standings(ledger.rows(), teams, seed=schedule.name if schedule else "")
     if args.json:
         print(json.dumps([s.as_dict() for s in table], indent=2))
         return 0
@@ -165,8 +183,9 @@ def _standings(args: argparse.Namespace) -> int:
         f"{'team':<16} {'P':>3} {'W':>3} {'D':>3} {'L':>3} {'GF':>4} {'GA':>4} {'GD':>4} {'Pts':>4}"
     )
     for s in table:
+        tie = f"  (above the next on points by {s.decided_by})" if s.decided_by else ""
         print(
             f"{s.team:<16} {s.played:>3} {s.won:>3} {s.drawn:>3} {s.lost:>3} {s.goals_for:>4}"
-            f" {s.goals_against:>4} {s.goal_difference:>4} {s.points:>4}"
+            f" {s.goals_against:>4} {s.goal_difference:>4} {s.points:>4}{tie}"
         )
     return 0

@@ -35,6 +35,7 @@ class ScheduleTiming:
     play_after_pull_s: float = 600.0
     deliver_after_stream_s: float = 0.0
     retry_s: float = 300.0
+    delivery_attempts: int = 3
 
     def pull_lead_s(self, kind: MatchKind) -> float:
         return self.pull_lead_knockout_s if kind == "knockout" else self.pull_lead_round_robin_s
@@ -252,7 +253,7 @@ def load_schedule(path: str | Path) -> Schedule:
         else output_dir / "log-store",
         public_logs=(base / data["public_logs"]).resolve() if "public_logs" in data else None,
         simulator_slots=int(data.get("simulator_slots", 1)),
-        timing=ScheduleTiming(**{k: float(v) for k, v in data.get("timing", {}).items()}),
+        timing=_timing(data.get("timing", {})),
         game_defaults=dict(data.get("game_defaults", {})),
         teams=teams,
         matches=tuple(matches),
@@ -262,6 +263,13 @@ def load_schedule(path: str | Path) -> Schedule:
     if problems:
         raise ConfigError(problems)
     return schedule
+
+
+def _timing(data: dict[str, Any]) -> ScheduleTiming:
+    values: dict[str, Any] = {k: float(v) for k, v in data.items()}
+    if "delivery_attempts" in values:
+        values["delivery_attempts"] = int(values["delivery_attempts"])
+    return ScheduleTiming(**values)
 
 
 def _slot(value: Any) -> Slot:

@@ -13,10 +13,12 @@ from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
 from orchestrator.config.schedule import PlannedMatch, Schedule, Slot, load_schedule
-from orchestrator.errors import DeliveryError, OrchestratorError, ScheduleError
+from orchestrator.errors import OrchestratorError, ScheduleError
+from orchestrator.schedule.logs import DONE, TeamLogs, all_done, summary, with_retry
 from orchestrator.schedule.services import (
     DEFAULT_SERVICES,
     MatchContext,
+    PlayOutcome,
     TournamentServices,
     load_services,
 )
@@ -163,8 +165,10 @@ def play_job(state_path: str, match_id: str) -> None:
     except OrchestratorError as exc:
         t.ledger.transition(match_id, (S.PLAYING,), S.FAILED, note=f"match failed: {exc}")
         return
+    if _needs_shootout(ctx, outcome):
+        outcome = _shootout(t, ctx, outcome)
     result = outcome.as_dict(ctx)
-    if outcome.status in ("success", "team_startup", "team_crash", "image_pull"):
+    if outcome.status in PLAYED_STATUSES:
         t.ledger.transition(match_id, (S.PLAYING,), S.PLAYED, result=result, note=outcome.status)
     else:
         t.ledger.transition(
@@ -176,15 +180,82 @@ def play_job(state_path: str, match_id: str) -> None:
         )
 
 
+PLAYED_STATUSES = ("success", "team_startup", "team_crash", "image_pull")
+
+
+def _needs_shootout(ctx: MatchContext, outcome: PlayOutcome) -> bool:
+    """A knockout match that ended without a winner (e.g. both teams forfeited the same way):
+    the league decides it by a penalty shoot-out, as the GameController's KNOCKOUT games do."""
+    return (ctx.planned.match.kind == "knockout" and outcome.status in PLAYED_STATUSES
+            and outcome.winner not in ("red", "blue"))
+
+
+def _shootout(t: Tournament, ctx: MatchContext, match: PlayOutcome) -> PlayOutcome:
+    """Play a penalty shoot-out (game type PENALTY); its winner wins the match."""
+    log.info("match %s: a draw in a knockout match; penalty shoot-out", ctx.match_id)
+    try:
+        kicks = t.services.shootout(ctx)
+    except OrchestratorError as exc:
+        return replace(match, status="infrastructure", cause=f"penalty shoot-out failed: {exc}")
+    if kicks.status != "success" or kicks.winner not in ("red", "blue"):
+        return replace(match, status=kicks.status if kicks.status != "success"
+                       else "infrastructure",
+                       cause=f"the penalty shoot-out was not decided: {kicks.cause}")
+    goals = kicks.shootout or {"red": kicks.score_red or 0, "blue": kicks.score_blue or 0}
+    return replace(match, winner=kicks.winner, shootout=goals)
+
+
 def deliver_job(state_path: str, match_id: str) -> None:
     t = Tournament.open(state_path)
-    if not t.ledger.transition(match_id, (S.PLAYED,), S.DELIVERING):
+    row = t.ledger.row(match_id)
+    retry = row.state is S.LOGS_PENDING
+    if not t.ledger.transition(match_id, (S.PLAYED, S.LOGS_PENDING), S.DELIVERING,
+                               note="retrying the log delivery" if retry else "delivering logs"):
         return
     ctx = t.context(match_id)
     assert ctx is not None
+    previous = {entry.team: entry for entry in row.logs}
+    if not retry:
+        t.ledger.set_logs(match_id, [TeamLogs(team=name, state="pending")
+                                     for name in (ctx.red.name, ctx.blue.name)])
     try:
-        summary = t.services.deliver(ctx)
-    except DeliveryError as exc:
-        t.ledger.transition(match_id, (S.DELIVERING,), S.LOGS_PENDING, note=str(exc))
+        found = t.services.redeliver(ctx) if retry else t.services.deliver(ctx)
+    except OrchestratorError as exc:  # the store itself failed: nothing was delivered
+        found = [TeamLogs(team=name, state="failed", cause=f"store: {exc}")
+                 for name in (ctx.red.name, ctx.blue.name)]
+    logs = _merge(previous, found, retry=retry)
+    attempts = max((e.attempts for e in logs if e.state == "failed"), default=0)
+    if all_done(logs):
+        t.ledger.set_logs(match_id, logs)
+        t.ledger.transition(match_id, (S.DELIVERING,), S.DELIVERED, note=summary(logs))
         return
-    t.ledger.transition(match_id, (S.DELIVERING,), S.DELIVERED, note=summary)
+    again = 0 < attempts < t.schedule.timing.delivery_attempts
+    logs = with_retry(logs, retry=again)
+    t.ledger.set_logs(match_id, logs)
+    if again:
+        t.ledger.transition(match_id, (S.DELIVERING,), S.LOGS_PENDING, note=summary(logs))
+        t.ledger.defer(match_id, _now() + timedelta(seconds=t.schedule.timing.retry_s),
+                       summary(logs))
+    else:
+        t.ledger.transition(match_id, (S.DELIVERING,), S.LOGS_FAILED, note=summary(logs))
+    log.warning("match %s: %s", match_id, summary(logs))
+
+
+def _merge(previous: dict[str, TeamLogs], found: list[TeamLogs], *, retry: bool) -> list[TeamLogs]:
+    """This attempt's states over the earlier ones; a retried set that left the store is gone."""
+    merged = dict(previous) if retry else {}
+    tried = {entry.team for entry in found}
+    for entry in found:
+        before = previous.get(entry.team)
+        attempts = (before.attempts if before is not None and retry else 0)
+        if entry.state in ("delivered", "failed"):
+            attempts += 1
+        merged[entry.team] = replace(entry, attempts=attempts)
+    if retry:
+        for team, entry in previous.items():
+            if team not in tried and entry.state not in (*DONE, "gone"):
+                merged[team] = replace(
+                    entry, state="gone",
+                    cause="no longer in the log store (delivered by 'hlvs logs deliver' or "
+                    "pruned)")
+    return list(merged.values())

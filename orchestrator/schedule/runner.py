@@ -38,6 +38,7 @@ NEXT_STEP = {
     S.PLANNED: ("pull", "pull_at"),
     S.PULLED: ("play", "play_at"),
     S.PLAYED: ("deliver", "deliver_at"),
+    S.LOGS_PENDING: ("deliver", "deliver_at"),  # a retry, at not_before
 }
 INTERRUPTED = {S.PULLING: S.PLANNED, S.PLAYING: S.PULLED, S.DELIVERING: S.PLAYED}
 
@@ -103,6 +104,8 @@ def recover_interrupted(ledger: Ledger) -> list[str]:
     recovered = []
     for row in ledger.rows():
         back = INTERRUPTED.get(row.state)
+        if row.state is S.DELIVERING and any(e.state in ("retrying", "failed") for e in row.logs):
+            back = S.LOGS_PENDING  # a retry was interrupted
         if back is not None and ledger.transition(
             row.id, (row.state,), back, note=f"{row.state.value} interrupted by a restart"
         ):
