@@ -74,7 +74,12 @@ def _ledger(path: Path) -> Any:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from orchestrator.config.schedule_check import check_schedule
     from orchestrator.schedule.runner import run_schedule
+
+    problems = check_schedule(args.schedule)  # what hlvs check finds: refused before any pull
+    if any(p.severity == "error" for p in problems):
+        raise ConfigError(problems)
 
     return run_schedule(
         args.schedule, args.state, services=args.services, pool=args.pool,

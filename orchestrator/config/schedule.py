@@ -148,6 +148,40 @@ class Schedule:
         return planned
 
 
+def game_document(
+    schedule: Schedule,
+    match: ScheduledMatch,
+    red: ScheduledTeam,
+    blue: ScheduledTeam,
+    *,
+    game_type: str | None = None,
+) -> dict[str, Any]:
+    """The game.json of a match: HLVS fields, the schedule's ``game_defaults``, both teams.
+
+    The game type follows the match's kind (NORMAL, or KNOCKOUT: overtime, then a penalty
+    shoot-out) and is never taken from the defaults; ``game_type`` PENALTY is a shoot-out only.
+    """
+    game: dict[str, Any] = {
+        "class": match.field_class,
+        "host": "127.0.0.1",
+        "maximum_real_time_factor": 0,
+        "match_id": match.id,
+    }
+    game.update(schedule.game_defaults)
+    game["type"] = game_type or ("KNOCKOUT" if match.kind == "knockout" else "NORMAL")
+    for color, team, base in (("red", red, 10000), ("blue", blue, 10020)):
+        side: dict[str, Any] = {
+            "id": team.team_id,
+            "config": str(team.config),
+            "hosts": ["127.0.0.1"],
+            "ports": [base + n for n in range(1, 5 if match.field_class == "KID" else 4)],
+        }
+        if team.credentials is not None:
+            side["credentials"] = str(team.credentials)
+        game[color] = side
+    return game
+
+
 def resolve_time(text: str, reference: datetime) -> datetime:
     match = _OFFSET.match(text)
     if match:

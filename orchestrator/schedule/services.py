@@ -26,7 +26,13 @@ from typing import Any, Protocol
 from contracts import files
 from contracts.errors import ContractError
 from contracts.match_results import MatchReport, MatchResults
-from orchestrator.config.schedule import PlannedMatch, Schedule, ScheduledTeam, SchedulePool
+from orchestrator.config.schedule import (
+    PlannedMatch,
+    Schedule,
+    ScheduledTeam,
+    SchedulePool,
+    game_document,
+)
 from orchestrator.errors import ScheduleError
 from orchestrator.schedule.logs import TeamLogs
 
@@ -109,28 +115,9 @@ def load_services(ref: str, schedule: Schedule) -> TournamentServices:
 
 
 def write_game_file(ctx: MatchContext, *, game_type: str | None = None) -> Path:
-    """The match's game.json: HLVS fields, the schedule's game defaults, both teams. The game
-    type follows the match's kind (NORMAL, or KNOCKOUT: overtime, then a shoot-out) and is
-    never taken from the defaults; ``game_type`` PENALTY plays a shoot-out only."""
-    match = ctx.planned.match
-    game: dict[str, Any] = {
-        "class": match.field_class,
-        "host": "127.0.0.1",
-        "maximum_real_time_factor": 0,
-        "match_id": ctx.match_id,
-    }
-    game.update(ctx.schedule.game_defaults)
-    game["type"] = game_type or ("KNOCKOUT" if match.kind == "knockout" else "NORMAL")
-    for color, team, base in (("red", ctx.red, 10000), ("blue", ctx.blue, 10020)):
-        side: dict[str, Any] = {
-            "id": team.team_id,
-            "config": str(team.config),
-            "hosts": ["127.0.0.1"],
-            "ports": [base + n for n in range(1, 5 if match.field_class == "KID" else 4)],
-        }
-        if team.credentials is not None:
-            side["credentials"] = str(team.credentials)
-        game[color] = side
+    """The match's game.json (see :func:`orchestrator.config.schedule.game_document`);
+    ``game_type`` PENALTY writes ``game-penalty.json``, a shoot-out only."""
+    game = game_document(ctx.schedule, ctx.planned.match, ctx.red, ctx.blue, game_type=game_type)
     ctx.out_dir.mkdir(parents=True, exist_ok=True)
     path = ctx.game_path if game_type is None else ctx.out_dir / f"game-{game_type.lower()}.json"
     path.write_text(json.dumps(game, indent=2) + "\n", encoding="utf-8")
