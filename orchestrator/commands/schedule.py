@@ -1,10 +1,12 @@
-"""``hlvs schedule run|list|status|cancel|standings``: a tournament from one schedule file."""
+"""``hlvs schedule run|list|status|cancel|abort|reschedule|apply|standings``: a tournament from
+one schedule file, and the operator's controls over it."""
 
 from __future__ import annotations
 
 import argparse
 import json
 import logging
+import sys
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -57,6 +59,32 @@ def register(sub: Any) -> None:
     cancel.add_argument("--state", type=user_path, required=True, help=_STATE_HELP)
     cancel.set_defaults(func=_cancel)
 
+    stop = verbs.add_parser(
+        "abort", help="stop a running match (SIGTERM, a grace period, then SIGKILL); the "
+        "match becomes ABORTED with the reason")
+    stop.add_argument("match_id", help="id of the match in the schedule")
+    stop.add_argument("--state", type=user_path, required=True, help=_STATE_HELP)
+    stop.add_argument("--reason", required=True, help="why (recorded with the match)")
+    stop.add_argument("--grace", type=float, default=None, metavar="S",
+                      help="seconds the match has to stop and collect its logs before it is "
+                      "killed (default 150)")
+    stop.set_defaults(func=_abort)
+
+    again = verbs.add_parser(
+        "reschedule", help="plan a match again: un-cancel it, or give it a new time")
+    again.add_argument("match_id", help="id of the match in the schedule")
+    again.add_argument("--state", type=user_path, required=True, help=_STATE_HELP)
+    again.add_argument("--at", metavar="TIME",
+                       help="new stream start: ISO 8601 with a time zone, or +30m from now "
+                       "(default: the schedule's time)")
+    again.set_defaults(func=_reschedule)
+
+    apply = verbs.add_parser(
+        "apply", help="make the edited schedule file the tournament's (until then the copy "
+        "recorded at the start runs on)")
+    apply.add_argument("--state", type=user_path, required=True, help=_STATE_HELP)
+    apply.set_defaults(func=_apply)
+
     table = verbs.add_parser("standings", help="points, goal difference and goals")
     table.add_argument("--state", type=user_path, required=True, help=_STATE_HELP)
     table.add_argument("--json", action="store_true", help="print a JSON array")
@@ -98,6 +126,8 @@ def _list(args: argparse.Namespace) -> int:
         reference = datetime.fromisoformat(recorded) if recorded else now
     elif schedule.start not in (None, "now"):
         reference = resolve_time(str(schedule.start), now)
+    if args.state:
+        _warn_differences(_ledger(args.state))
     rows = [
         {
             "id": p.match.id,
@@ -132,6 +162,7 @@ def _status(args: argparse.Namespace) -> int:
             print(json.dumps([r.as_dict() for r in ledger.rows()], indent=2))
         else:
             print("\n".join(status_lines(ledger)))
+        _warn_differences(ledger)
         return 0
     import time
 
@@ -170,6 +201,41 @@ def _cancel(args: argparse.Namespace) -> int:
         )
     print(f"{args.match_id}: CANCELLED")
     return 0
+
+
+def _abort(args: argparse.Namespace) -> int:
+    from orchestrator.schedule.controls import DEFAULT_ABORT_GRACE_S, abort
+
+    grace = DEFAULT_ABORT_GRACE_S if args.grace is None else args.grace
+    abort(_ledger(args.state), args.match_id, reason=args.reason, grace_s=grace)
+    print(f"{args.match_id}: abort requested ({args.reason}); the scheduler stops it within "
+          f"{grace:g} s and marks it ABORTED")
+    return 0
+
+
+def _reschedule(args: argparse.Namespace) -> int:
+    from orchestrator.schedule.controls import reschedule
+
+    planned = reschedule(_ledger(args.state), args.match_id, at=args.at)
+    print(f"{args.match_id}: PLANNED, pull {planned.pull_at.isoformat(timespec='seconds')}, "
+          f"stream {planned.stream_start.isoformat(timespec='seconds')}")
+    return 0
+
+
+def _apply(args: argparse.Namespace) -> int:
+    from orchestrator.schedule.controls import apply_file
+
+    changes = apply_file(_ledger(args.state))
+    for change in changes or ["no change"]:
+        print(change)
+    return 0
+
+
+def _warn_differences(ledger: Any) -> None:
+    from orchestrator.schedule.controls import file_differences
+
+    for note in file_differences(ledger):
+        print(f"warning: {note}", file=sys.stderr)
 
 
 def _standings(args: argparse.Namespace) -> int:

@@ -202,9 +202,9 @@ def _pointer(parts: Any) -> str:
     return "".join(f"/{p}" for p in parts)
 
 
-def _read(path: Path) -> Any:
+def _read(path: Path, text: str | None = None) -> Any:
     try:
-        raw = path.read_bytes()
+        raw = path.read_bytes() if text is None else text.encode("utf-8")
     except FileNotFoundError:
         raise ConfigError([Problem(str(path), "", "file not found")]) from None
     except OSError as exc:
@@ -253,10 +253,15 @@ def _schema_problems(path: Path, data: Any) -> list[Problem]:
     return problems
 
 
-def load_schedule(path: str | Path) -> Schedule:
-    """Validate and load a schedule file; raises ConfigError listing every problem."""
+def load_schedule(path: str | Path, *, text: str | None = None) -> Schedule:
+    """Validate and load a schedule file; raises ConfigError listing every problem.
+
+    ``text``: the file's content as it was recorded (the tournament's state file keeps the
+    schedule it runs, so that an edit applies only when the operator says so); relative paths
+    are still resolved against ``path``'s folder.
+    """
     path = Path(path)
-    data = _read(path)
+    data = _read(path, text)
     problems = _schema_problems(path, data)
     if problems:
         raise ConfigError(problems)

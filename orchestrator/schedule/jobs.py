@@ -14,9 +14,11 @@ from pathlib import Path
 
 from orchestrator.config.schedule import PlannedMatch, Schedule, Slot, load_schedule
 from orchestrator.errors import OrchestratorError, ScheduleError
+from orchestrator.schedule.controls import abort_request
 from orchestrator.schedule.logs import DONE, TeamLogs, all_done, summary, with_retry
 from orchestrator.schedule.services import (
     DEFAULT_SERVICES,
+    Abort,
     MatchContext,
     PlayOutcome,
     TournamentServices,
@@ -45,7 +47,7 @@ class Tournament:
         reference = ledger.get_meta("reference")
         if schedule_path is None or reference is None:
             raise ScheduleError(f"{state_path}: not a tournament state file (no schedule recorded)")
-        schedule = load_schedule(schedule_path)
+        schedule = load_schedule(schedule_path, text=ledger.get_meta("schedule_text"))
         pool = ledger.get_meta("pool")  # hlvs schedule run --pool overrides the file's
         if pool == "slurm":
             schedule = replace(schedule, pool=replace(schedule.pool, kind="slurm"))
@@ -80,7 +82,7 @@ class Tournament:
         return str(result["blue_team"] if winner == result["red_team"] else result["red_team"])
 
     def context(self, match_id: str) -> MatchContext | None:
-        planned = self.planned(match_id)
+        planned = self.planned_now(match_id)
         red, blue = self.resolve(planned.match.red), self.resolve(planned.match.blue)
         if red is None or blue is None:
             return None
@@ -90,11 +92,30 @@ class Tournament:
             red=self.schedule.team(red),
             blue=self.schedule.team(blue),
             out_dir=self.schedule.output_dir / match_id,
+            abort=lambda: self.abort_requested(match_id),
         )
+
+    def abort_requested(self, match_id: str) -> Abort | None:
+        request = abort_request(self.ledger.row(match_id).request)
+        return None if request is None else Abort(reason=request[0], grace_s=request[1])
+
+    def planned_now(self, match_id: str) -> PlannedMatch:
+        """The match as the ledger has it now (its times may have been rescheduled)."""
+        planned = self.planned(match_id)
+        row = self.ledger.row(match_id)
+        return replace(planned, pull_at=row.pull_at, play_at=row.play_at,
+                       stream_start=row.stream_start, stream_end=row.stream_end,
+                       deliver_at=row.deliver_at)
 
 
 def _now() -> datetime:
     return datetime.now(UTC)
+
+
+def _early(at: datetime) -> bool:
+    """A job of a match rescheduled later fired at the old time: its step is not due yet
+    (the runner adds the job at the new time)."""
+    return _now() < at - timedelta(seconds=1)
 
 
 def _pull(t: Tournament, match_id: str) -> bool:
@@ -132,7 +153,7 @@ def _pull(t: Tournament, match_id: str) -> bool:
 def pull_job(state_path: str, match_id: str) -> None:
     t = Tournament.open(state_path)
     row = t.ledger.row(match_id)
-    if row.state is not S.PLANNED:
+    if row.state is not S.PLANNED or _early(row.pull_at):
         return
     if _now() >= row.stream_start:
         t.ledger.transition(
@@ -145,6 +166,8 @@ def pull_job(state_path: str, match_id: str) -> None:
 def play_job(state_path: str, match_id: str) -> None:
     t = Tournament.open(state_path)
     row = t.ledger.row(match_id)
+    if _early(row.play_at):
+        return
     if row.state is S.PLANNED and not _pull(t, match_id):
         return
     row = t.ledger.row(match_id)
@@ -164,6 +187,13 @@ def play_job(state_path: str, match_id: str) -> None:
         outcome = t.services.play(ctx)
     except OrchestratorError as exc:
         t.ledger.transition(match_id, (S.PLAYING,), S.FAILED, note=f"match failed: {exc}")
+        return
+    aborted = t.abort_requested(match_id)
+    if aborted is not None:
+        t.ledger.transition(match_id, (S.PLAYING,), S.ABORTED, result=outcome.as_dict(ctx),
+                            note=f"aborted by the operator: {aborted.reason}")
+        t.ledger.set_request(match_id, None)
+        log.warning("match %s: aborted by the operator: %s", match_id, aborted.reason)
         return
     if _needs_shootout(ctx, outcome):
         outcome = _shootout(t, ctx, outcome)

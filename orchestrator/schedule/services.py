@@ -19,7 +19,8 @@ import signal
 import subprocess
 import sys
 import time
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -41,6 +42,15 @@ log = logging.getLogger(__name__)
 DEFAULT_SERVICES = "orchestrator.schedule.services:MatchServices"
 SLURM_CONF = "/var/lib/hlvs/slurm/slurm.conf"  # written by 'hlvs pool up'
 SLURM_POLL_S = 2.0
+ABORT_POLL_S = 1.0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Abort:
+    """An operator's request to stop a running match (``hlvs schedule abort``)."""
+
+    reason: str
+    grace_s: float  # after SIGTERM (the match stops and collects its logs), then SIGKILL
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -50,6 +60,8 @@ class MatchContext:
     red: ScheduledTeam
     blue: ScheduledTeam
     out_dir: Path
+    abort: Callable[[], Abort | None] = field(default=lambda: None, compare=False)
+    """Polled while the match plays: the operator's abort request, if any."""
 
     @property
     def match_id(self) -> str:
@@ -143,6 +155,28 @@ def keep_earlier_attempt(out: Path) -> Path | None:
     return folder
 
 
+def _wait_or_abort(ctx: MatchContext, proc: subprocess.Popen[bytes]) -> None:
+    """Wait for ``hlvs match``; on an abort request SIGTERM it (it stops the match and
+    collects what was played), and SIGKILL it when the grace period has passed."""
+    while proc.poll() is None:
+        abort = ctx.abort()
+        if abort is None:
+            try:
+                proc.wait(timeout=ABORT_POLL_S)
+            except subprocess.TimeoutExpired:
+                pass
+            continue
+        log.warning("match %s: aborting (%s); %g s of grace", ctx.match_id, abort.reason,
+                    abort.grace_s)
+        proc.terminate()
+        try:
+            proc.wait(timeout=abort.grace_s)
+        except subprocess.TimeoutExpired:
+            log.warning("match %s: still running after the grace period: killed", ctx.match_id)
+            proc.kill()
+            proc.wait()
+
+
 def _die_with_parent() -> None:  # pragma: no cover - runs in the child before exec
     """Linux: the match process gets SIGTERM (and cleans up) if the scheduler dies."""
     libc = ctypes.CDLL("libc.so.6", use_errno=True)
@@ -214,14 +248,14 @@ class MatchServices:
         cmd = [sys.executable, "-m", "orchestrator.cli", "match", str(game), "--out", str(out)]
         log.info("match %s: %s", ctx.match_id, " ".join(cmd))
         with open(ctx.out_dir / "match.log", "ab") as sink:
-            proc = subprocess.run(
+            proc = subprocess.Popen(
                 cmd,
                 stdout=sink,
                 stderr=subprocess.STDOUT,
                 preexec_fn=_die_with_parent if sys.platform == "linux" else None,
                 env=os.environ.copy(),
-                check=False,
             )
+            _wait_or_abort(ctx, proc)
         outcome = read_outcome(out)
         log.info(
             "match %s: exit %d, %s %s-%s",
@@ -258,10 +292,17 @@ class MatchServices:
                                               robot_nodes=_robot_nodes(settings, game)))
                 log.info("match %s: Slurm job %s", ctx.match_id, pool.job_id(handle))
             shown = ""
+            cancelled = False
             while True:
                 status = pool.status(handle)
                 if status.state in (JobState.FINISHED, JobState.LOST):
                     break
+                abort = ctx.abort()
+                if abort is not None and not cancelled:
+                    log.warning("match %s: aborting Slurm job %s (%s)", ctx.match_id,
+                                pool.job_id(handle), abort.reason)
+                    pool.cancel(handle)  # SIGTERM, then Slurm's KillWait, then SIGKILL
+                    cancelled = True
                 if status.detail != shown:
                     log.info("match %s: %s %s", ctx.match_id, status.state.value, status.detail)
                     shown = status.detail

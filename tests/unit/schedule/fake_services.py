@@ -10,6 +10,7 @@ Every step appends a line to ``<output_dir>/services.log`` (``pull|play-start|pl
 
 from __future__ import annotations
 
+import json
 import os
 import time
 import zlib
@@ -46,7 +47,15 @@ class FakeServices:
 
     def play(self, ctx: MatchContext) -> PlayOutcome:
         _log(self.schedule, "play-start", ctx.match_id)
-        time.sleep(PLAY_SECONDS)
+        ctx.out_dir.mkdir(parents=True, exist_ok=True)
+        (ctx.out_dir / "game_defaults.json").write_text(json.dumps(ctx.schedule.game_defaults))
+        until = time.monotonic() + PLAY_SECONDS
+        while time.monotonic() < until:
+            if ctx.abort() is not None:
+                _log(self.schedule, "play-stopped", ctx.match_id)
+                return PlayOutcome(status="infrastructure", score_red=None, score_blue=None,
+                                   winner=None, cause="stopped (SIGTERM)")
+            time.sleep(0.02)
         red, blue = goals(ctx.red.name), goals(ctx.blue.name)
         if ctx.planned.match.id in DRAWN:
             red = blue = 1
