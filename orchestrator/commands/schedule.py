@@ -154,14 +154,19 @@ def _list(args: argparse.Namespace) -> int:
 
 
 def _status(args: argparse.Namespace) -> int:
-    from orchestrator.schedule.overview import status_lines
+    from orchestrator.schedule.overview import Snapshot, status_lines
 
     ledger = _ledger(args.state)
+    snapshot: Snapshot | None = None
+    if not args.json:  # a running match's score and clock, from its telemetry
+        from viewer.snapshot import game_snapshot
+
+        snapshot = game_snapshot
     if not args.watch:
         if args.json:
             print(json.dumps([r.as_dict() for r in ledger.rows()], indent=2))
         else:
-            print("\n".join(status_lines(ledger)))
+            print("\n".join(status_lines(ledger, snapshot=snapshot)))
         _warn_differences(ledger)
         return 0
     import time
@@ -169,7 +174,7 @@ def _status(args: argparse.Namespace) -> int:
     try:
         while True:
             text = (json.dumps([r.as_dict() for r in ledger.rows()]) if args.json
-                    else "\n".join(status_lines(ledger)))
+                    else "\n".join(status_lines(ledger, snapshot=snapshot)))
             if not args.json:
                 print("\x1b[H\x1b[2J", end="")  # clear the terminal, as watch(1) does
                 print(f"{datetime.now(UTC).isoformat(timespec='seconds')}"

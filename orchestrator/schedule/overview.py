@@ -6,8 +6,18 @@ A match line tells "played" (PLAYED and after: the score is final) apart from "l
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+from urllib.parse import quote, urlencode
+
+from contracts import files
+from orchestrator.config.schedule import Schedule
 from orchestrator.schedule.logs import summary
 from orchestrator.schedule.state import Ledger, MatchRow, ScheduledMatchState
+
+Snapshot = Callable[[Path], dict[str, Any] | None]  # a running match's folder -> game state
 
 S = ScheduledMatchState
 
@@ -33,8 +43,26 @@ def logs_text(row: MatchRow) -> str:
     return ""
 
 
-def status_line(row: MatchRow) -> str:
-    score = score_text(row)
+def clock_text(live: dict[str, Any] | None) -> str:
+    """``2-1 PLAYING 1st half 07:31`` of a running match's game state."""
+    if not live:
+        return ""
+    score = live.get("score") or {}
+    half = {1: "1st half", 2: "2nd half"}.get(live.get("half") or 0, "")
+    secondary = live.get("secondary_state")
+    parts = [f"{score.get('red', '-')}-{score.get('blue', '-')}", str(live.get("state", "-"))]
+    if secondary and secondary != "NORMAL":
+        parts.append(str(secondary))
+    if half:
+        parts.append(half)
+    remaining = live.get("secs_remaining")
+    if isinstance(remaining, int | float):
+        parts.append(f"{int(remaining) // 60:02d}:{int(remaining) % 60:02d}")
+    return " ".join(parts)
+
+
+def status_line(row: MatchRow, live: dict[str, Any] | None = None) -> str:
+    score = clock_text(live) if live else score_text(row)
     played = "played" if row.state.played else ""
     parts = [f"{row.id:<12} {row.state.value:<12} {row.red} v {row.blue}"]
     if score:
@@ -48,5 +76,87 @@ def status_line(row: MatchRow) -> str:
     return "  ".join(parts).rstrip()
 
 
-def status_lines(ledger: Ledger) -> list[str]:
-    return [status_line(row) for row in ledger.rows()]
+def status_lines(ledger: Ledger, *, snapshot: Snapshot | None = None) -> list[str]:
+    """One line per match; a running match shows its score and clock when ``snapshot`` (see
+    :func:`viewer.snapshot.game_snapshot`) can read its telemetry."""
+    lines = []
+    for row in ledger.rows():
+        live = None
+        if snapshot is not None and row.state is S.PLAYING:
+            live = snapshot(match_folder(ledger, row.id))
+        lines.append(status_line(row, live))
+    return lines
+
+
+def match_folder(ledger: Ledger, match_id: str, schedule: Schedule | None = None) -> Path:
+    """``<output_dir>/<match id>/match``: where the match plays (and its public files end)."""
+    if schedule is None:
+        from orchestrator.schedule.controls import recorded_schedule
+
+        schedule = recorded_schedule(ledger)
+    return schedule.output_dir / match_id / "match"
+
+
+def replay_path(folder: Path) -> Path | None:
+    for candidate in (folder / files.REPLAY,
+                      folder / "simulator" / files.OUT_DIR / files.REPLAY):
+        if candidate.is_file():
+            return candidate
+    return None
+
+
+def bracket(schedule: Schedule) -> list[list[str]]:
+    """The knockout matches by round: a match is one round after the matches it takes its
+    teams from."""
+    depth: dict[str, int] = {}
+    for match in schedule.matches:
+        if match.kind != "knockout":
+            continue
+        refs = [r for s in (match.red, match.blue) for r in (s.winner_of, s.loser_of) if r]
+        depth[match.id] = 1 + max((depth.get(r, 0) for r in refs), default=0)
+    rounds: list[list[str]] = [[] for _ in range(max(depth.values(), default=0))]
+    for match_id, n in depth.items():
+        rounds[n - 1].append(match_id)
+    return rounds
+
+
+def overview(ledger: Ledger, *, snapshot: Snapshot | None = None,
+             links: str = "/watch/tournament") -> dict[str, Any]:
+    """Everything the operator's page shows: the tournament's name, every match (state, times,
+    score, live clock, log states, links to the live view and the replay), the standings with
+    their tie-breaks, the knockout bracket, and the warnings about the schedule file."""
+    from orchestrator.schedule.controls import file_differences, recorded_schedule
+    from orchestrator.schedule.standings import standings
+
+    schedule = recorded_schedule(ledger)
+    rows = ledger.rows()
+    matches = []
+    for row in rows:
+        folder = match_folder(ledger, row.id, schedule)
+        live = None
+        if snapshot is not None and row.state is S.PLAYING:
+            live = snapshot(folder)
+        names = {"red": row.red, "blue": row.blue}
+        query = "?" + urlencode(names)
+        watch: dict[str, str] = {}
+        if row.state is S.PLAYING and (folder / "simulator" / files.MATCH_SPEC).is_file():
+            watch["live"] = f"{links}/live/{quote(row.id)}{query}"
+        if row.state is not S.PLAYING and replay_path(folder) is not None:
+            watch["replay"] = f"{links}/replay/{quote(row.id)}{query}"
+        matches.append({
+            **row.as_dict(),
+            "score_text": score_text(row),
+            "logs_text": logs_text(row),
+            "live": live,
+            "clock_text": clock_text(live),
+            "watch": watch,
+        })
+    return {
+        "name": schedule.name,
+        "updated_at": datetime.now(UTC).isoformat(timespec="seconds"),
+        "matches": matches,
+        "standings": [s.as_dict() for s in standings(
+            rows, [t.name for t in schedule.teams], seed=schedule.name)],
+        "bracket": bracket(schedule),
+        "warnings": file_differences(ledger),
+    }
