@@ -15,13 +15,13 @@ import httpx
 import pytest
 
 from orchestrator.schedule import Ledger, ScheduledMatchState, run_schedule
+from testkit.sftp import free_port
+from testkit.specs import match_spec
 from tests.integration.service.harness import Served
 from tests.integration.viewer.conftest import screenshot
 from tests.unit.schedule import fake_services
 from tests.unit.schedule.test_schedule import COMPRESSED, FAKE, write_schedule
 from tests.unit.viewer.replays import record_match
-from testkit.sftp import free_port
-from testkit.specs import match_spec
 
 pytestmark = pytest.mark.browser
 S = ScheduledMatchState
