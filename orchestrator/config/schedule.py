@@ -439,6 +439,8 @@ def _cross_problems(path: Path, schedule: Schedule, data: dict[str, Any]) -> lis
                     )
                 )
     ids_seen: list[str] = []
+    listed = len(data.get("matches") or [])
+    generated = {m.id for m in schedule.matches[listed:]}  # fixtures: any match may follow them
     reference = datetime(2000, 1, 1, tzinfo=UTC)
     for i, match in enumerate(schedule.matches):
         pointer = f"/matches/{i}" if i < len(data.get("matches", [])) else f"(fixture {match.id})"
@@ -457,7 +459,7 @@ def _cross_problems(path: Path, schedule: Schedule, data: dict[str, Any]) -> lis
                     )
                 )
             ref = slot.winner_of or slot.loser_of
-            if ref is not None and ref not in ids_seen:
+            if ref is not None and ref not in ids_seen and ref not in generated:
                 problems.append(
                     Problem(
                         file,

@@ -108,12 +108,21 @@ def replay_path(folder: Path) -> Path | None:
 def bracket(schedule: Schedule) -> list[list[str]]:
     """The knockout matches by round: a match is one round after the matches it takes its
     teams from."""
+    knockout = {m.id: m for m in schedule.matches if m.kind == "knockout"}
     depth: dict[str, int] = {}
-    for match in schedule.matches:
-        if match.kind != "knockout":
-            continue
-        refs = [r for s in (match.red, match.blue) for r in (s.winner_of, s.loser_of) if r]
-        depth[match.id] = 1 + max((depth.get(r, 0) for r in refs), default=0)
+
+    def depth_of(match_id: str, seen: frozenset[str] = frozenset()) -> int:
+        if match_id not in depth:
+            match = knockout.get(match_id)
+            refs = [] if match is None else [
+                r for s in (match.red, match.blue) for r in (s.winner_of, s.loser_of)
+                if r and r not in seen]
+            depth[match_id] = 1 + max((depth_of(r, seen | {match_id}) for r in refs), default=0)
+        return depth[match_id]
+
+    for match_id in knockout:
+        depth_of(match_id)
+    depth = {k: v for k, v in depth.items() if k in knockout}
     rounds: list[list[str]] = [[] for _ in range(max(depth.values(), default=0))]
     for match_id, n in depth.items():
         rounds[n - 1].append(match_id)

@@ -141,3 +141,43 @@ def test_every_attempt_keeps_its_folder(tmp_path: Path) -> None:
     assert (out / "attempt-1" / "teams" / "red").is_dir()
     assert (out / "attempt-2" / "report.json").read_text() == "second"
     assert sorted(p.name for p in out.iterdir()) == ["attempt-1", "attempt-2"]
+
+
+def test_overview_and_status_watch(
+    tmp_path: Path, fake: None, monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    from orchestrator.cli import main
+    from orchestrator.schedule import init_state
+    from orchestrator.schedule.overview import overview
+
+    path = write_schedule(
+        tmp_path,
+        "fixtures:\n  knockout: {seeds: [alpha, bravo, charlie, delta], first_stream: '+2h'}\n"
+        "matches:\n  - {id: third, kind: knockout, red: {loser_of: ko-r1-1},"
+        " blue: {loser_of: ko-r1-2}, stream_start: '+5h'}\n")
+    state = tmp_path / "state.sqlite"
+    init_state(path, state)
+    ledger = Ledger(state)
+    assert ledger.transition("ko-r1-1", (S.PLANNED,), S.PLAYING)
+    live = {"state": "PLAYING", "half": 1, "secs_remaining": 75, "score": {"red": 1, "blue": 0}}
+    view = overview(ledger, snapshot=lambda folder: live)
+    assert view["name"] == "test cup" and view["warnings"] == []
+    assert view["bracket"] == [["ko-r1-1", "ko-r1-2"], ["third", "ko-r2-1"]]
+    playing = view["matches"][0]
+    assert playing["id"] == "ko-r1-1" and playing["clock_text"] == "1-0 PLAYING 1st half 01:15"
+    assert playing["watch"] == {}  # no telemetry spec in its folder: no live link
+    assert [m["played"] for m in view["matches"]] == [False] * 4
+
+    sleeps: list[float] = []
+
+    def sleep(seconds: float) -> None:
+        sleeps.append(seconds)
+        if len(sleeps) == 2:
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr("time.sleep", sleep)
+    assert main(["schedule", "status", "--state", str(state), "--watch", "--every", "0.5"]) == 0
+    out = capsys.readouterr().out
+    assert sleeps == [0.5, 0.5] and out.count("(every 0.5 s, Ctrl-C to stop)") == 2
+    assert out.count("ko-r1-1      PLAYING") == 2
