@@ -51,7 +51,8 @@ def test_abort_a_running_match_then_play_it_again(
         "services": FAKE, "poll_s": 0.1, "stop": stop})
     thread.start()
     try:
-        _wait_for(lambda: state.exists() and Ledger(state).row("m1").state is S.PLAYING)
+        _wait_for(lambda: state.exists() and any(r.id == "m1" and r.state is S.PLAYING
+                                                 for r in Ledger(state).rows()))
         ledger = Ledger(state)
         assert main(["schedule", "abort", "m1", "--state", str(state), "--reason",
                      "red's robot fell through the floor", "--grace", "5"]) == 0
