@@ -7,6 +7,7 @@ A match line tells "played" (PLAYED and after: the score is final) apart from "l
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -33,6 +34,25 @@ def score_text(row: MatchRow) -> str:
     if isinstance(shootout, dict) and shootout.get("red") is not None:
         text += f" (shoot-out {shootout['red']}-{shootout['blue']})"
     return text
+
+
+def with_store(row: MatchRow, waiting: set[tuple[str, str]]) -> MatchRow:
+    """The row with each failed set that is no longer in the log store marked ``gone`` (it was
+    delivered by ``hlvs logs deliver`` since, or pruned): the ledger cannot know which."""
+    if not any(e.state in ("failed", "retrying") for e in row.logs):
+        return row
+    logs = tuple(
+        replace(e, state="gone", cause="no longer in the log store (delivered by 'hlvs logs "
+                "deliver' or pruned)")
+        if e.state in ("failed", "retrying") and (row.id, e.team) not in waiting else e
+        for e in row.logs)
+    return replace(row, logs=logs)
+
+
+def waiting_sets(schedule: Schedule) -> set[tuple[str, str]]:
+    from orchestrator.delivery import pending_status
+
+    return {(s.match_id, s.team) for s in pending_status(schedule.log_store)}
 
 
 def logs_text(row: MatchRow) -> str:
@@ -79,8 +99,12 @@ def status_line(row: MatchRow, live: dict[str, Any] | None = None) -> str:
 def status_lines(ledger: Ledger, *, snapshot: Snapshot | None = None) -> list[str]:
     """One line per match; a running match shows its score and clock when ``snapshot`` (see
     :func:`viewer.snapshot.game_snapshot`) can read its telemetry."""
+    from orchestrator.schedule.controls import recorded_schedule
+
+    waiting = waiting_sets(recorded_schedule(ledger))
     lines = []
     for row in ledger.rows():
+        row = with_store(row, waiting)
         live = None
         if snapshot is not None and row.state is S.PLAYING:
             live = snapshot(match_folder(ledger, row.id))
@@ -139,8 +163,9 @@ def overview(ledger: Ledger, *, snapshot: Snapshot | None = None,
 
     schedule = recorded_schedule(ledger)
     rows = ledger.rows()
+    waiting = waiting_sets(schedule)
     matches = []
-    for row in rows:
+    for row in (with_store(r, waiting) for r in rows):
         folder = match_folder(ledger, row.id, schedule)
         live = None
         if snapshot is not None and row.state is S.PLAYING:

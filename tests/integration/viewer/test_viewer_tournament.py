@@ -21,6 +21,7 @@ from tests.integration.service.harness import Served
 from tests.integration.viewer.conftest import screenshot
 from tests.unit.schedule import fake_services
 from tests.unit.schedule.test_schedule import COMPRESSED, FAKE, write_schedule
+from tests.unit.schedule.test_tournament_day import queue_set
 from tests.unit.viewer.replays import record_match
 
 pytestmark = pytest.mark.browser
@@ -58,6 +59,7 @@ def cup(tmp_path: Path) -> Iterator[Path]:
         thread.join(timeout=30)
         fake_services.DRAWN.clear()
         fake_services.DEAD_TEAMS.clear()
+    queue_set(tmp_path / "out" / "log-store", "ko-r1-2", "delta")  # delta's set waits
     ledger = Ledger(state)
     assert ledger.transition("show", (S.PLANNED,), S.PLAYING, count_attempt=True)
     folder = tmp_path / "out" / "show" / "match" / "simulator"

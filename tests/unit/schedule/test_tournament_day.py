@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 
+from orchestrator.delivery.store import PendingSet, create_set, remove_set
 from orchestrator.schedule import Ledger, ScheduledMatchState, run_schedule, standings
 from orchestrator.schedule.overview import status_lines
 from orchestrator.schedule.services import keep_earlier_attempt
@@ -17,6 +18,15 @@ from tests.unit.schedule import fake_services
 from tests.unit.schedule.test_schedule import COMPRESSED, FAKE, services_log, write_schedule
 
 S = ScheduledMatchState
+
+
+def queue_set(store: Path, match_id: str, team: str) -> PendingSet:
+    """A team's log set waiting in the store (the fake services deliver nothing)."""
+    source = store.parent / f"{match_id}-{team}.log"
+    source.parent.mkdir(parents=True, exist_ok=True)
+    source.write_text("log\n")
+    return create_set(store, match_id=match_id, team=team, kind="team", credentials=None,
+                      sources=[(source, "robot.log")], move=False)
 
 
 @pytest.fixture
@@ -51,10 +61,14 @@ def test_failed_delivery_is_never_shown_delivered(tmp_path: Path, fake: None) ->
     assert not any(to == "DELIVERED" for to, _ in history)
     assert [w for w, mid, _ in services_log(path) if mid == "m1"][-2:] == ["deliver",
                                                                            "redeliver"]
+    pending = queue_set(tmp_path / "out" / "log-store", "m1", "bravo")  # as a real one stays
     lines = "\n".join(status_lines(ledger))
     assert "m1" in lines and "LOGS_FAILED" in lines and "played" in lines
     assert "bravo failed after 2 attempts (unreachable: connection refused)" in lines
     assert "alpha delivered" in lines
+    remove_set(pending)  # delivered by 'hlvs logs deliver' (or pruned): the status says so
+    lines = "\n".join(status_lines(ledger))
+    assert "bravo gone after 2 attempts (no longer in the log store" in lines
     as_dict = m1.as_dict()
     assert as_dict["played"] is True and as_dict["logs_delivered"] is False
 
