@@ -244,14 +244,12 @@ def _warn_differences(ledger: Any) -> None:
 
 
 def _standings(args: argparse.Namespace) -> int:
-    from orchestrator.config.schedule import load_schedule
+    from orchestrator.schedule.controls import recorded_schedule
     from orchestrator.schedule.standings import standings
 
     ledger = _ledger(args.state)
-    schedule_path = ledger.get_meta("schedule")
-    schedule = load_schedule(schedule_path) if schedule_path else None
-    teams = [t.name for t in schedule.teams] if schedule is not None else []
-    table = standings(ledger.rows(), teams, seed=schedule.name if schedule else "")
+    schedule = recorded_schedule(ledger)
+    table = standings(ledger.rows(), [t.name for t in schedule.teams], seed=schedule.name)
     if args.json:
         print(json.dumps([s.as_dict() for s in table], indent=2))
         return 0

@@ -129,9 +129,11 @@ def get_schedule(request: Request, principal: OperatorPrincipal) -> ScheduleView
     ledger = Ledger(Path(state))
     rows = ledger.rows()
     schedule_path = ledger.get_meta("schedule")
-    teams = [t.name for t in load_schedule(schedule_path).teams] if schedule_path else []
-    return ScheduleView(matches=[r.as_dict() for r in rows],
-                        standings=[s.as_dict() for s in standings(rows, teams)])
+    schedule = (load_schedule(schedule_path, text=ledger.get_meta("schedule_text"))
+                if schedule_path else None)
+    teams = [t.name for t in schedule.teams] if schedule is not None else []
+    return ScheduleView(matches=[r.as_dict() for r in rows], standings=[
+        s.as_dict() for s in standings(rows, teams, seed=schedule.name if schedule else "")])
 
 
 def mount(app: FastAPI) -> None:
