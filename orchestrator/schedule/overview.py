@@ -122,7 +122,7 @@ def match_folder(ledger: Ledger, match_id: str, schedule: Schedule | None = None
 
 
 def replay_path(folder: Path) -> Path | None:
-    for candidate in (folder / files.REPLAY,
+    for candidate in (folder / "public" / files.REPLAY,  # as hlvs match leaves it
                       folder / "simulator" / files.OUT_DIR / files.REPLAY):
         if candidate.is_file():
             return candidate

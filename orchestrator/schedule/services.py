@@ -206,11 +206,11 @@ def read_outcome(out_dir: Path) -> PlayOutcome:
         score_blue=results.team_score("blue") if results is not None else None,
         winner=results.winner if results is not None else None,
         cause=report.cause or "",
-        shootout=_shootout_goals(out_dir / files.SIM_RESULT),
+        shootout=shootout_goals(out_dir / "public" / files.SIM_RESULT),
     )
 
 
-def _shootout_goals(sim_result: Path) -> dict[str, int] | None:
+def shootout_goals(sim_result: Path) -> dict[str, int] | None:
     """Goals of the penalty shoot-out the referee played (None when there was none)."""
     try:
         data = json.loads(sim_result.read_text(encoding="utf-8"))

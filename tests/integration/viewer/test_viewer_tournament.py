@@ -66,7 +66,7 @@ def cup(tmp_path: Path) -> Iterator[Path]:
     folder.mkdir(parents=True)
     match_spec(match_id="show", seed=1, ports={}, addresses={},
                telemetry=f"tcp/127.0.0.1:{free_port()}").write(folder / "match_spec.json")
-    final = tmp_path / "out" / "ko-r2-1" / "match"
+    final = tmp_path / "out" / "ko-r2-1" / "match" / "public"  # where hlvs match leaves it
     final.mkdir(parents=True)
     shutil.copy(record_match(tmp_path / "recorded"), final / "replay.hlvsrec")
     yield state

@@ -3,6 +3,7 @@ tie-breaks, one folder per attempt, status lines."""
 
 from __future__ import annotations
 
+import json
 from collections.abc import Iterator
 from datetime import UTC, datetime
 from pathlib import Path
@@ -195,3 +196,15 @@ def test_overview_and_status_watch(
     out = capsys.readouterr().out
     assert sleeps == [0.5, 0.5] and out.count("(every 0.5 s, Ctrl-C to stop)") == 2
     assert out.count("ko-r1-1      PLAYING") == 2
+
+
+def test_the_referees_shootout_is_read_from_the_public_sim_result(tmp_path: Path) -> None:
+    from orchestrator.schedule.services import shootout_goals
+
+    path = tmp_path / "sim_result.json"
+    assert shootout_goals(path) is None  # no file
+    path.write_text(json.dumps({"score": {"red": 1, "blue": 1}}))
+    assert shootout_goals(path) is None  # no shoot-out
+    path.write_text(json.dumps({"shootout": {"red": {"kicks": 5, "scored": 4},
+                                             "blue": {"kicks": 5, "scored": 3}}}))
+    assert shootout_goals(path) == {"red": 4, "blue": 3}
