@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 
 from orchestrator.cli import main
+from orchestrator.config.schedule import load_schedule
 from orchestrator.schedule import Ledger, ScheduledMatchState, init_state, run_schedule
 from tests.unit.schedule import fake_services
 from tests.unit.schedule.test_schedule import COMPRESSED, FAKE, services_log, write_schedule
@@ -133,3 +134,35 @@ def test_an_edited_schedule_applies_only_when_the_operator_says_so(
     assert "was edited" not in capsys.readouterr().err
     row = ledger.row("m2")
     assert row.state is S.PLANNED
+
+
+@pytest.mark.parametrize("ignores_sigterm", [False, True])
+def test_an_aborted_match_process_gets_sigterm_then_sigkill_after_the_grace(
+    tmp_path: Path, ignores_sigterm: bool
+) -> None:
+    """The local pool's wait: SIGTERM on the abort request (``hlvs match`` stops and collects),
+    SIGKILL when the process is still there after the grace period."""
+    import signal
+    import subprocess
+    import sys
+
+    from orchestrator.schedule.services import Abort, MatchContext, _wait_or_abort
+
+    code = ("import signal, time\n"
+            + ("signal.signal(signal.SIGTERM, signal.SIG_IGN)\n" if ignores_sigterm else "")
+            + "print('up', flush=True)\ntime.sleep(60)\n")
+    proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE)
+    assert proc.stdout is not None and proc.stdout.readline() == b"up\n"
+    asked = time.monotonic() + 0.3
+    schedule = load_schedule(write_schedule(
+        tmp_path, "matches:\n  - {id: m1, red: alpha, blue: bravo, stream_start: '+1h'}\n"))
+    ctx = MatchContext(
+        schedule=schedule, planned=schedule.plan(datetime.now(UTC))[0],
+        red=schedule.team("alpha"), blue=schedule.team("bravo"), out_dir=tmp_path / "m1",
+        abort=lambda: Abort(reason="test", grace_s=0.5) if time.monotonic() > asked else None)
+    started = time.monotonic()
+    _wait_or_abort(ctx, proc)
+    took = time.monotonic() - started
+    expected = -signal.SIGKILL if ignores_sigterm else -signal.SIGTERM
+    assert proc.returncode == expected
+    assert took < 5.0 and (took >= 0.8 if ignores_sigterm else True)
