@@ -22,7 +22,7 @@ from orchestrator.config.schedule_check import check_schedule
 from orchestrator.delivery import pending_status
 from orchestrator.delivery.s3 import create_bucket
 from orchestrator.schedule import Ledger, ScheduledMatchState, run_schedule, standings
-from orchestrator.schedule.overview import status_lines
+from orchestrator.schedule.overview import overview, status_lines
 from testkit.s3 import MotoServer
 from testkit.sftp import free_port
 
@@ -169,6 +169,14 @@ def test_compressed_tournament_of_real_matches(tmp_path: Path, s3: MotoServer) -
     for team, match_id in (("ants", "m1"), ("bees", "m2"), ("dogs", "m2")):
         keys = [o["Key"] for o in client.list_objects_v2(Bucket=f"logs-{team}").get("Contents", [])]
         assert f"{match_id}/{team}/MANIFEST.json" in keys, keys
+
+    # the operator's overview: each played match links its replay (hlvs match's public/)
+    view = overview(ledger)
+    for match in view["matches"]:
+        assert match["watch"] == {
+            "replay": f"/watch/tournament/replay/{match['id']}?red={match['red']}"
+                      f"&blue={match['blue']}"}, match
+        assert match["played"] and match["logs_delivered"] is (match["id"] == "m2")
 
     table = {s.team: s for s in standings(ledger.rows(), ["ants", "bees", "cats", "dogs"])}
     for row in rows.values():
