@@ -161,7 +161,8 @@ def test_an_aborted_match_process_gets_sigterm_then_sigkill_after_the_grace(
         red=schedule.team("alpha"), blue=schedule.team("bravo"), out_dir=tmp_path / "m1",
         abort=lambda: Abort(reason="test", grace_s=0.5) if time.monotonic() > asked else None)
     started = time.monotonic()
-    _wait_or_abort(ctx, proc)
+    with proc.stdout:
+        _wait_or_abort(ctx, proc)
     took = time.monotonic() - started
     expected = -signal.SIGKILL if ignores_sigterm else -signal.SIGTERM
     assert proc.returncode == expected
