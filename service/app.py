@@ -37,10 +37,10 @@ ROUTER_MODULES: tuple[str, ...] = (
     "service.routers.teams",
     "service.routers.submissions",
     "service.routers.operator",
-    "service.routers.tournament",  # the tournament's overview, replays and live views (operators)
     "service.routers.nodes",  # the match pool's machines (operators)
     "envs.http_api",  # the HTTP environment API (learning environments)
     "viewer.service_pages",  # the web front end: replays, live view, queue and standings pages
+    "viewer.tournament_pages",  # the tournament's overview, replays and live views (operators)
 )
 
 

@@ -89,7 +89,7 @@ def test_operator_overview_of_a_tournament(
         seen.append(folder)
         return LIVE
 
-    monkeypatch.setattr("service.routers.tournament.snapshot", snapshot)
+    monkeypatch.setattr("viewer.tournament_pages.snapshot", snapshot)
     served = start(schedule_state=str(cup))
     operator = token(operator=True)
     team = token("A1")

@@ -1,9 +1,9 @@
-"""The tournament for operators: ``GET /v1/operator/tournament`` (every match with its state,
-score, live clock, log states and links; the standings with their tie-breaks; the knockout
-bracket) and the replays and live views of the tournament's matches under ``/api/tournament``
-(the viewer's API; the pages are ``/watch/tournament``, ``/watch/tournament/live/<match>`` and
-``/watch/tournament/replay/<match>``). Read from the schedule's state file
-(``HLVS_SERVICE_SCHEDULE_STATE``). Operator tokens only."""
+"""The tournament inside ``hlvs serve``, for operators: ``GET /v1/operator/tournament``
+(every match with its state, score, live clock, log states and links; the standings with their
+tie-breaks; the knockout bracket) and the replays and live views of the tournament's matches
+under ``/api/tournament`` (the viewer's API; the pages are ``/watch/tournament``,
+``/watch/tournament/live/<match>`` and ``/watch/tournament/replay/<match>``). Read from the
+schedule's state file (``HLVS_SERVICE_SCHEDULE_STATE``). Operator tokens only."""
 
 from __future__ import annotations
 
