@@ -32,6 +32,7 @@ class TeamSummary(BaseModel):
 
 
 class ScheduleView(BaseModel):
+    name: str = ""  # the tournament's
     matches: list[dict[str, Any]]
     standings: list[dict[str, Any]]
 
@@ -132,7 +133,8 @@ def get_schedule(request: Request, principal: OperatorPrincipal) -> ScheduleView
     schedule = (load_schedule(schedule_path, text=ledger.get_meta("schedule_text"))
                 if schedule_path else None)
     teams = [t.name for t in schedule.teams] if schedule is not None else []
-    return ScheduleView(matches=[r.as_dict() for r in rows], standings=[
+    return ScheduleView(name=schedule.name if schedule else "",
+                        matches=[r.as_dict() for r in rows], standings=[
         s.as_dict() for s in standings(rows, teams, seed=schedule.name if schedule else "")])
 
 

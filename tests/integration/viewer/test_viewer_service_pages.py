@@ -75,6 +75,7 @@ def test_queue_submissions_replay_standings_and_pool_pages(
 
     page.goto(f"{served.url}/watch/standings")
     table = _rows(page, "standings")
+    assert page.locator("[data-testid=standings-title]").inner_text() == "test cup: standings"
     ledger = Ledger(tournament)
     schedule = load_schedule(str(ledger.get_meta("schedule")))
     expected = standings(ledger.rows(), [t.name for t in schedule.teams], seed=schedule.name)

@@ -26,6 +26,7 @@ interface Queue {
 }
 
 interface Schedule {
+  name?: string;
   matches: Record<string, unknown>[];
   standings: Record<string, unknown>[];
 }
@@ -92,7 +93,7 @@ async function standingsPage(root: HTMLElement): Promise<void> {
   const standingColumns = ["team", "played", "won", "drawn", "lost", "goals_for", "goals_against", "goal_difference", "points"];
   const labels = ["team", "played", "won", "drawn", "lost", "goals for", "goals against", "goal difference", "points"];
   root.append(
-    el("h1", {}, "Standings"),
+    el("h1", { "data-testid": "standings-title" }, schedule.name ? `${schedule.name}: standings` : "Standings"),
     el("p", {}, el("a", { href: "/watch/tournament", "data-testid": "overview-link" }, "the tournament's live overview")),
     table("standings", ["#", ...labels], schedule.standings.map((s, i) => [String(i + 1), ...standingColumns.map((c) => String(s[c] ?? ""))])),
     el("h1", {}, "Schedule"),
