@@ -105,9 +105,12 @@ def _run(args: argparse.Namespace) -> int:
     from orchestrator.config.schedule_check import check_schedule
     from orchestrator.schedule.runner import run_schedule
 
-    problems = check_schedule(args.schedule)  # what hlvs check finds: refused before any pull
-    if any(p.severity == "error" for p in problems):
-        raise ConfigError(problems)
+    recorded = args.state.is_file() and _ledger(args.state).get_meta("schedule_text")
+    if not recorded:  # the first run: what hlvs check finds is refused before any pull (a
+        # restart runs the copy checked then; an edit waits for 'hlvs schedule apply')
+        problems = check_schedule(args.schedule)
+        if any(p.severity == "error" for p in problems):
+            raise ConfigError(problems)
 
     return run_schedule(
         args.schedule, args.state, services=args.services, pool=args.pool,
