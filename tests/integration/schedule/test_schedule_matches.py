@@ -11,7 +11,9 @@ from __future__ import annotations
 
 import json
 import shutil
-from collections.abc import Iterator
+import threading
+import time
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import boto3
@@ -22,6 +24,7 @@ from orchestrator.config.schedule_check import check_schedule
 from orchestrator.delivery import pending_status
 from orchestrator.delivery.s3 import create_bucket
 from orchestrator.schedule import Ledger, ScheduledMatchState, run_schedule, standings
+from orchestrator.schedule.controls import abort, reschedule
 from orchestrator.schedule.overview import overview, status_lines
 from testkit.s3 import MotoServer
 from testkit.sftp import free_port
@@ -184,4 +187,68 @@ def test_compressed_tournament_of_real_matches(tmp_path: Path, s3: MotoServer) -
         red, blue = table[row.result["red_team"]], table[row.result["blue_team"]]
         assert red.played == blue.played == 1
         assert red.goals_for == row.result["score"]["red"] == blue.goals_against
+    shutil.rmtree(tmp_path / "out", ignore_errors=True)
+
+
+ABORT_CUP = """
+name: abort cup
+output_dir: out
+timing: {pull_lead_round_robin_s: 600, play_after_pull_s: 0.2}
+game_defaults:
+  stepping: lockstep
+  seed: 7
+  timing: {half_duration_s: 16, ready_duration_s: 1, wait_before_first_ready_s: 1,
+           half_time_break_s: 1, grace_period_s: 2}
+  limits: {cpus: 1, memory_gb: 1, pids: 256}
+teams:
+  - {name: ants, id: 1, config: ants.json}
+  - {name: bees, id: 2, config: bees.json}
+matches:
+  - {id: a1, red: ants, blue: bees, stream_start: "+590s"}
+"""
+
+
+def _until(predicate: Callable[[], bool], what: str, timeout_s: float = 120.0) -> None:
+    deadline = time.monotonic() + timeout_s
+    while not predicate():
+        assert time.monotonic() < deadline, f"timed out waiting for {what}"
+        time.sleep(0.2)
+
+
+def test_abort_a_real_match_then_play_it_again_in_a_new_attempt_folder(tmp_path: Path) -> None:
+    """hlvs match stops on the abort (SIGTERM, its grace), the match is ABORTED with the reason;
+    rescheduled, it plays again and the first attempt's files stay in attempt-1/."""
+    for name, source in (("ants", "team_red.json"), ("bees", "team_blue.json")):
+        team = json.loads((EXAMPLES / source).read_text())
+        team["name"] = name
+        (tmp_path / f"{name}.json").write_text(json.dumps(team))
+    schedule = tmp_path / "cup.yaml"
+    schedule.write_text(ABORT_CUP)
+    state = tmp_path / "state.sqlite"
+    out = tmp_path / "out" / "a1" / "match"
+    stop = threading.Event()
+    runner = threading.Thread(target=run_schedule, args=(schedule, state),
+                              kwargs={"poll_s": 0.2, "stop": stop})
+    runner.start()
+    try:
+        _until(lambda: (out / "simulator" / "match_spec.json").is_file(), "the match to start")
+        ledger = Ledger(state)
+        abort(ledger, "a1", reason="the field lights went out", grace_s=60)
+        _until(lambda: ledger.row("a1").state is ScheduledMatchState.ABORTED, "the abort")
+        row = ledger.row("a1")
+        assert row.note == "aborted by the operator: the field lights went out"
+        assert row.result is not None and row.result["status"] != "success"
+        report = json.loads((out / "report.json").read_text())  # stopped and collected
+        assert report["status"] == "failed", report
+        reschedule(ledger, "a1", at="+300s")
+        _until(lambda: (out / "attempt-1" / "report.json").is_file()
+               and (out / "simulator" / "match_spec.json").is_file(), "the second attempt")
+        abort(ledger, "a1", reason="again", grace_s=60)
+        _until(lambda: ledger.row("a1").state is ScheduledMatchState.ABORTED, "the 2nd abort")
+    finally:
+        stop.set()
+        runner.join(timeout=120)
+    assert ledger.row("a1").attempts == 2
+    assert json.loads((out / "attempt-1" / "report.json").read_text()) == report
+    assert (out / "report.json").is_file() and not (out / "attempt-2").exists()
     shutil.rmtree(tmp_path / "out", ignore_errors=True)
