@@ -135,8 +135,8 @@ def file_differences(ledger: Ledger) -> list[str]:
             notes.append(f"match {row.id}: not in {path} any more")
         elif planned.stream_start != row.stream_start:
             notes.append(
-                f"match {row.id}: the file says stream {planned.stream_start.isoformat()}, the "
-                f"state keeps {row.stream_start.isoformat()} ({row.state.value}); "
+                f"match {row.id}: the file says stream {_at(planned.stream_start)}, the "
+                f"state keeps {_at(row.stream_start)} ({row.state.value}); "
                 f"'hlvs schedule reschedule {row.id}' or 'hlvs schedule apply' to change it")
     return notes
 
@@ -168,7 +168,7 @@ def apply_file(ledger: Ledger, *, now: datetime | None = None) -> list[str]:
             changes.append(f"match {planned.match.id}: added")
         elif row.state in (S.PLANNED, S.PULLED) and planned.stream_start != row.stream_start:
             ledger.reschedule(row.id, _times(planned), note="times from the applied schedule")
-            changes.append(f"match {row.id}: stream {planned.stream_start.isoformat()}")
+            changes.append(f"match {row.id}: stream {_at(planned.stream_start)}")
     listed = {p.match.id for p in planned_all}
     for row in rows.values():
         if row.id not in listed and ledger.transition(
@@ -181,6 +181,10 @@ def apply_file(ledger: Ledger, *, now: datetime | None = None) -> list[str]:
     ledger.set_meta("schedule_text", text)
     ledger.set_meta("applied_at", now.isoformat())
     return changes
+
+
+def _at(when: datetime) -> str:
+    return when.isoformat(timespec="seconds")
 
 
 def _state(ledger: Ledger, match_id: str) -> ScheduledMatchState:
