@@ -8,6 +8,7 @@ was done. Knockout slots ("winner of X") are resolved when the match is pulled o
 from __future__ import annotations
 
 import logging
+import threading
 from dataclasses import dataclass, replace
 from datetime import UTC, datetime, timedelta
 from pathlib import Path
@@ -29,6 +30,8 @@ from orchestrator.schedule.state import Ledger, ScheduledMatchState
 log = logging.getLogger(__name__)
 
 S = ScheduledMatchState
+STOPPING = threading.Event()
+"""Set when the scheduler process stops: a match that ends then was interrupted, not failed."""
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -194,6 +197,11 @@ def play_job(state_path: str, match_id: str) -> None:
                             note=f"aborted by the operator: {aborted.reason}")
         t.ledger.set_request(match_id, None)
         log.warning("match %s: aborted by the operator: %s", match_id, aborted.reason)
+        return
+    if STOPPING.is_set() and outcome.status not in PLAYED_STATUSES:
+        # the scheduler is stopping (Ctrl-C, SIGTERM): the match died with it; it stays
+        # PLAYING, and the next start replays it into a new attempt folder
+        log.warning("match %s: interrupted by the scheduler's stop (%s)", match_id, outcome.cause)
         return
     if _needs_shootout(ctx, outcome):
         outcome = _shootout(t, ctx, outcome)

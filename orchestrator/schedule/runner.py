@@ -173,6 +173,9 @@ def _moved(planned: datetime | None, wanted: datetime) -> bool:
 
 
 def _stop_now(stop: threading.Event, wake: threading.Event) -> None:
+    from orchestrator.schedule.jobs import STOPPING
+
+    STOPPING.set()
     stop.set()
     wake.set()
 

@@ -23,6 +23,7 @@ from orchestrator.schedule.services import MatchContext, PlayOutcome
 PLAY_SECONDS = float(os.environ.get("HLVS_FAKE_PLAY_S", "0.3"))
 DEAD_TEAMS = set(filter(None, os.environ.get("HLVS_FAKE_DEAD_TEAMS", "").split(",")))
 DRAWN = set(filter(None, os.environ.get("HLVS_FAKE_DRAWN", "").split(",")))
+BROKEN: set[str] = set()  # match ids whose play fails as a killed match process does
 
 
 def _log(schedule: Schedule, what: str, match_id: str) -> None:
@@ -57,6 +58,9 @@ class FakeServices:
                                    winner=None, cause="stopped (SIGTERM)")
             time.sleep(0.02)
         red, blue = goals(ctx.red.name), goals(ctx.blue.name)
+        if ctx.planned.match.id in BROKEN:
+            return PlayOutcome(status="infrastructure", score_red=None, score_blue=None,
+                               winner=None, cause="report.json was not written")
         if ctx.planned.match.id in DRAWN:
             red = blue = 1
         _log(self.schedule, "play-end", ctx.match_id)

@@ -167,3 +167,35 @@ def test_an_aborted_match_process_gets_sigterm_then_sigkill_after_the_grace(
     expected = -signal.SIGKILL if ignores_sigterm else -signal.SIGTERM
     assert proc.returncode == expected
     assert took < 5.0 and (took >= 0.8 if ignores_sigterm else True)
+
+
+def test_a_match_that_dies_with_a_stopping_scheduler_is_replayed_not_failed(
+    tmp_path: Path,
+) -> None:
+    from orchestrator.schedule import jobs
+    from orchestrator.schedule.runner import recover_interrupted
+
+    path = write_schedule(
+        tmp_path, COMPRESSED + "matches:\n  - {id: m1, red: alpha, blue: bravo,"
+        " stream_start: '+1h'}\n")
+    state = tmp_path / "state.sqlite"
+    init_state(path, state, services=FAKE)
+    ledger = Ledger(state)
+    fake_services.BROKEN.add("m1")
+    try:
+        for stopping in (True, False):
+            ledger.reschedule("m1", {"pull_at": datetime.now(UTC).isoformat(),
+                                     "play_at": datetime.now(UTC).isoformat()}, note="now")
+            if stopping:
+                jobs.STOPPING.set()
+            jobs.play_job(str(state), "m1")
+            jobs.STOPPING.clear()
+            if stopping:  # the scheduler's stop killed it: left PLAYING, put back at restart
+                assert ledger.row("m1").state is S.PLAYING
+                assert recover_interrupted(ledger) == ["m1"]
+                assert ledger.row("m1").state is S.PULLED
+            else:
+                assert ledger.row("m1").state is S.FAILED
+                assert ledger.row("m1").note == "infrastructure: report.json was not written"
+    finally:
+        fake_services.BROKEN.clear()
