@@ -12,9 +12,13 @@ from fastapi import FastAPI
 
 from service.app import create_app as create_service_app
 from service.settings import Settings
-from viewer import ladder_page, service_pages
+from viewer import ladder_page, service_pages, tournament_pages
 
-MOUNTS = (ladder_page.mount, service_pages.mount)  # the ladder before the viewer's /watch/*
+MOUNTS = (  # the ladder before the viewer's /watch/*
+    ladder_page.mount,
+    service_pages.mount,
+    tournament_pages.mount,  # the tournament's overview, replays and live views (operators)
+)
 
 
 def create_app(settings: Settings, **options: Any) -> FastAPI:

@@ -105,13 +105,12 @@ def record_friendlies(session: Session, results_dir: Callable[[str], Path]) -> i
 def record_official(session: Session, state_file: Path) -> int:
     """Record the tournament's played matches not considered yet (from its ledger)."""
     from tournament import Ledger
-    from tournament.standings import COUNTED
 
     known = set(session.scalars(select(RatedMatch.ref).where(RatedMatch.source == OFFICIAL)))
     added = 0
     for row in Ledger(state_file).rows():
         result = row.result
-        if row.id in known or row.state not in COUNTED or not result:
+        if row.id in known or not row.state.played or not result:
             continue
         _add(session, source=OFFICIAL, ref=row.id, red=str(result.get("red_team", row.red)),
              blue=str(result.get("blue_team", row.blue)), outcome=_official_outcome(result),

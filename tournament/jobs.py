@@ -8,15 +8,20 @@ was done. Knockout slots ("winner of X") are resolved when the match is pulled o
 from __future__ import annotations
 
 import logging
+import threading
 from dataclasses import dataclass, replace
 from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
 from orchestrator.config.schedule import PlannedMatch, Schedule, Slot, load_schedule
-from orchestrator.errors import DeliveryError, OrchestratorError, ScheduleError
+from orchestrator.errors import OrchestratorError, ScheduleError
+from tournament.controls import abort_request
+from tournament.logs import DONE, TeamLogs, all_done, summary, with_retry
 from tournament.services import (
     DEFAULT_SERVICES,
+    Abort,
     MatchContext,
+    PlayOutcome,
     TournamentServices,
     load_services,
 )
@@ -25,6 +30,8 @@ from tournament.state import Ledger, ScheduledMatchState
 log = logging.getLogger(__name__)
 
 S = ScheduledMatchState
+STOPPING = threading.Event()
+"""Set when the scheduler process stops: a match that ends then was interrupted, not failed."""
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -43,7 +50,7 @@ class Tournament:
         reference = ledger.get_meta("reference")
         if schedule_path is None or reference is None:
             raise ScheduleError(f"{state_path}: not a tournament state file (no schedule recorded)")
-        schedule = load_schedule(schedule_path)
+        schedule = load_schedule(schedule_path, text=ledger.get_meta("schedule_text"))
         pool = ledger.get_meta("pool")  # hlvs schedule run --pool overrides the file's
         if pool == "slurm":
             schedule = replace(schedule, pool=replace(schedule.pool, kind="slurm"))
@@ -78,7 +85,7 @@ class Tournament:
         return str(result["blue_team"] if winner == result["red_team"] else result["red_team"])
 
     def context(self, match_id: str) -> MatchContext | None:
-        planned = self.planned(match_id)
+        planned = self.planned_now(match_id)
         red, blue = self.resolve(planned.match.red), self.resolve(planned.match.blue)
         if red is None or blue is None:
             return None
@@ -88,11 +95,30 @@ class Tournament:
             red=self.schedule.team(red),
             blue=self.schedule.team(blue),
             out_dir=self.schedule.output_dir / match_id,
+            abort=lambda: self.abort_requested(match_id),
         )
+
+    def abort_requested(self, match_id: str) -> Abort | None:
+        request = abort_request(self.ledger.row(match_id).request)
+        return None if request is None else Abort(reason=request[0], grace_s=request[1])
+
+    def planned_now(self, match_id: str) -> PlannedMatch:
+        """The match as the ledger has it now (its times may have been rescheduled)."""
+        planned = self.planned(match_id)
+        row = self.ledger.row(match_id)
+        return replace(planned, pull_at=row.pull_at, play_at=row.play_at,
+                       stream_start=row.stream_start, stream_end=row.stream_end,
+                       deliver_at=row.deliver_at)
 
 
 def _now() -> datetime:
     return datetime.now(UTC)
+
+
+def _early(at: datetime) -> bool:
+    """A job of a match rescheduled later fired at the old time: its step is not due yet
+    (the runner adds the job at the new time)."""
+    return _now() < at - timedelta(seconds=1)
 
 
 def _pull(t: Tournament, match_id: str) -> bool:
@@ -130,7 +156,7 @@ def _pull(t: Tournament, match_id: str) -> bool:
 def pull_job(state_path: str, match_id: str) -> None:
     t = Tournament.open(state_path)
     row = t.ledger.row(match_id)
-    if row.state is not S.PLANNED:
+    if row.state is not S.PLANNED or _early(row.pull_at):
         return
     if _now() >= row.stream_start:
         t.ledger.transition(
@@ -143,6 +169,8 @@ def pull_job(state_path: str, match_id: str) -> None:
 def play_job(state_path: str, match_id: str) -> None:
     t = Tournament.open(state_path)
     row = t.ledger.row(match_id)
+    if _early(row.play_at):
+        return
     if row.state is S.PLANNED and not _pull(t, match_id):
         return
     row = t.ledger.row(match_id)
@@ -163,8 +191,22 @@ def play_job(state_path: str, match_id: str) -> None:
     except OrchestratorError as exc:
         t.ledger.transition(match_id, (S.PLAYING,), S.FAILED, note=f"match failed: {exc}")
         return
+    aborted = t.abort_requested(match_id)
+    if aborted is not None:
+        t.ledger.transition(match_id, (S.PLAYING,), S.ABORTED, result=outcome.as_dict(ctx),
+                            note=f"aborted by the operator: {aborted.reason}")
+        t.ledger.set_request(match_id, None)
+        log.warning("match %s: aborted by the operator: %s", match_id, aborted.reason)
+        return
+    if STOPPING.is_set() and outcome.status not in PLAYED_STATUSES:
+        # the scheduler is stopping (Ctrl-C, SIGTERM): the match died with it; it stays
+        # PLAYING, and the next start replays it into a new attempt folder
+        log.warning("match %s: interrupted by the scheduler's stop (%s)", match_id, outcome.cause)
+        return
+    if _needs_shootout(ctx, outcome):
+        outcome = _shootout(t, ctx, outcome)
     result = outcome.as_dict(ctx)
-    if outcome.status in ("success", "team_startup", "team_crash", "image_pull"):
+    if outcome.status in PLAYED_STATUSES:
         t.ledger.transition(match_id, (S.PLAYING,), S.PLAYED, result=result, note=outcome.status)
     else:
         t.ledger.transition(
@@ -176,15 +218,82 @@ def play_job(state_path: str, match_id: str) -> None:
         )
 
 
+PLAYED_STATUSES = ("success", "team_startup", "team_crash", "image_pull")
+
+
+def _needs_shootout(ctx: MatchContext, outcome: PlayOutcome) -> bool:
+    """A knockout match that ended without a winner (e.g. both teams forfeited the same way):
+    the league decides it by a penalty shoot-out, as the GameController's KNOCKOUT games do."""
+    return (ctx.planned.match.kind == "knockout" and outcome.status in PLAYED_STATUSES
+            and outcome.winner not in ("red", "blue"))
+
+
+def _shootout(t: Tournament, ctx: MatchContext, match: PlayOutcome) -> PlayOutcome:
+    """Play a penalty shoot-out (game type PENALTY); its winner wins the match."""
+    log.info("match %s: a draw in a knockout match; penalty shoot-out", ctx.match_id)
+    try:
+        kicks = t.services.shootout(ctx)
+    except OrchestratorError as exc:
+        return replace(match, status="infrastructure", cause=f"penalty shoot-out failed: {exc}")
+    if kicks.status != "success" or kicks.winner not in ("red", "blue"):
+        return replace(match, status=kicks.status if kicks.status != "success"
+                       else "infrastructure",
+                       cause=f"the penalty shoot-out was not decided: {kicks.cause}")
+    goals = kicks.shootout or {"red": kicks.score_red or 0, "blue": kicks.score_blue or 0}
+    return replace(match, winner=kicks.winner, shootout=goals)
+
+
 def deliver_job(state_path: str, match_id: str) -> None:
     t = Tournament.open(state_path)
-    if not t.ledger.transition(match_id, (S.PLAYED,), S.DELIVERING):
+    row = t.ledger.row(match_id)
+    retry = row.state is S.LOGS_PENDING
+    if not t.ledger.transition(match_id, (S.PLAYED, S.LOGS_PENDING), S.DELIVERING,
+                               note="retrying the log delivery" if retry else "delivering logs"):
         return
     ctx = t.context(match_id)
     assert ctx is not None
+    previous = {entry.team: entry for entry in row.logs}
+    if not retry:
+        t.ledger.set_logs(match_id, [TeamLogs(team=name, state="pending")
+                                     for name in (ctx.red.name, ctx.blue.name)])
     try:
-        summary = t.services.deliver(ctx)
-    except DeliveryError as exc:
-        t.ledger.transition(match_id, (S.DELIVERING,), S.LOGS_PENDING, note=str(exc))
+        found = t.services.redeliver(ctx) if retry else t.services.deliver(ctx)
+    except OrchestratorError as exc:  # the store itself failed: nothing was delivered
+        found = [TeamLogs(team=name, state="failed", cause=f"store: {exc}")
+                 for name in (ctx.red.name, ctx.blue.name)]
+    logs = _merge(previous, found, retry=retry)
+    attempts = max((e.attempts for e in logs if e.state == "failed"), default=0)
+    if all_done(logs):
+        t.ledger.set_logs(match_id, logs)
+        t.ledger.transition(match_id, (S.DELIVERING,), S.DELIVERED, note=summary(logs))
         return
-    t.ledger.transition(match_id, (S.DELIVERING,), S.DELIVERED, note=summary)
+    again = 0 < attempts < t.schedule.timing.delivery_attempts
+    logs = with_retry(logs, retry=again)
+    t.ledger.set_logs(match_id, logs)
+    if again:
+        t.ledger.transition(match_id, (S.DELIVERING,), S.LOGS_PENDING, note=summary(logs))
+        t.ledger.defer(match_id, _now() + timedelta(seconds=t.schedule.timing.retry_s),
+                       summary(logs))
+    else:
+        t.ledger.transition(match_id, (S.DELIVERING,), S.LOGS_FAILED, note=summary(logs))
+    log.warning("match %s: %s", match_id, summary(logs))
+
+
+def _merge(previous: dict[str, TeamLogs], found: list[TeamLogs], *, retry: bool) -> list[TeamLogs]:
+    """This attempt's states over the earlier ones; a retried set that left the store is gone."""
+    merged = dict(previous) if retry else {}
+    tried = {entry.team for entry in found}
+    for entry in found:
+        before = previous.get(entry.team)
+        attempts = (before.attempts if before is not None and retry else 0)
+        if entry.state in ("delivered", "failed"):
+            attempts += 1
+        merged[entry.team] = replace(entry, attempts=attempts)
+    if retry:
+        for team, entry in previous.items():
+            if team not in tried and entry.state not in (*DONE, "gone"):
+                merged[team] = replace(
+                    entry, state="gone",
+                    cause="no longer in the log store (delivered by 'hlvs logs deliver' or "
+                    "pruned)")
+    return list(merged.values())

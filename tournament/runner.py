@@ -13,7 +13,7 @@ from __future__ import annotations
 import logging
 import signal
 import threading
-from datetime import UTC, datetime
+from datetime import UTC, datetime, timedelta
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +24,7 @@ from apscheduler.schedulers.background import BackgroundScheduler
 
 from orchestrator.config.schedule import Schedule, load_schedule, resolve_time
 from orchestrator.errors import ScheduleError
+from tournament.controls import abort_request
 from tournament.state import Ledger, ScheduledMatchState
 
 log = logging.getLogger(__name__)
@@ -38,6 +39,7 @@ NEXT_STEP = {
     S.PLANNED: ("pull", "pull_at"),
     S.PULLED: ("play", "play_at"),
     S.PLAYED: ("deliver", "deliver_at"),
+    S.LOGS_PENDING: ("deliver", "deliver_at"),  # a retry, at not_before
 }
 INTERRUPTED = {S.PULLING: S.PLANNED, S.PLAYING: S.PULLED, S.DELIVERING: S.PLAYED}
 
@@ -50,15 +52,23 @@ def init_state(
     now: datetime | None = None,
     pool: str | None = None,
 ) -> tuple[Schedule, Ledger]:
-    """Open (or create) the state file of a schedule and add its matches to the ledger."""
-    schedule = load_schedule(schedule_path)
+    """Open (or create) the state file of a schedule and add its matches to the ledger.
+
+    The first run records the file's content in the state file: later runs (restarts) run that
+    recorded copy and only warn when the file was edited; 'hlvs schedule apply' applies it."""
     ledger = Ledger(Path(state_path))
     recorded = ledger.get_meta("schedule")
-    if recorded is not None and Path(recorded) != schedule.source:
+    if recorded is not None and Path(recorded) != Path(schedule_path).resolve():
         raise ScheduleError(
-            f"{state_path} belongs to the schedule {recorded}, not {schedule.source}; "
+            f"{state_path} belongs to the schedule {recorded}, not {schedule_path}; "
             "use another --state file"
         )
+    recorded_text = ledger.get_meta("schedule_text")
+    if recorded_text is None:
+        schedule = load_schedule(schedule_path)
+        ledger.set_meta("schedule_text", Path(schedule_path).read_text(encoding="utf-8"))
+    else:
+        schedule = load_schedule(schedule_path, text=recorded_text)
     ledger.set_meta("schedule", str(schedule.source))
     reference_text = ledger.get_meta("reference")
     if reference_text is None:
@@ -95,6 +105,10 @@ def init_state(
                 planned.pull_at.isoformat(timespec="seconds"),
                 planned.stream_start.isoformat(timespec="seconds"),
             )
+    from tournament.controls import file_differences
+
+    for note in file_differences(ledger):
+        log.warning("%s", note)
     return schedule, ledger
 
 
@@ -103,6 +117,16 @@ def recover_interrupted(ledger: Ledger) -> list[str]:
     recovered = []
     for row in ledger.rows():
         back = INTERRUPTED.get(row.state)
+        if row.state is S.PLAYING and abort_request(row.request) is not None:
+            reason = abort_request(row.request)
+            assert reason is not None
+            if ledger.transition(row.id, (S.PLAYING,), S.ABORTED,
+                                 note=f"aborted by the operator: {reason[0]}"):
+                ledger.set_request(row.id, None)
+                recovered.append(row.id)
+            continue
+        if row.state is S.DELIVERING and any(e.state in ("retrying", "failed") for e in row.logs):
+            back = S.LOGS_PENDING  # a retry was interrupted
         if back is not None and ledger.transition(
             row.id, (row.state,), back, note=f"{row.state.value} interrupted by a restart"
         ):
@@ -119,11 +143,12 @@ def reconcile(scheduler: Any, ledger: Ledger, state_path: str) -> None:
             continue
         kind, attr = step
         job_id = f"{kind}:{row.id}"
-        if scheduler.get_job(job_id) is not None:
-            continue
         run_at: datetime = getattr(row, attr)
         if row.not_before is not None and row.not_before > run_at:
             run_at = row.not_before
+        job = scheduler.get_job(job_id)
+        if job is not None and not _moved(job.next_run_time, run_at):
+            continue
         scheduler.add_job(
             JOB_FUNCTIONS[kind],
             "date",
@@ -138,7 +163,19 @@ def reconcile(scheduler: Any, ledger: Ledger, state_path: str) -> None:
         )
 
 
+def _moved(planned: datetime | None, wanted: datetime) -> bool:
+    """A rescheduled match's job is moved, unless it is due (the scheduler may be running it
+    right now; a job that fires early finds its step not due and the next pass adds it again)."""
+    if planned is None:
+        return True
+    now = datetime.now(UTC)
+    return abs((planned - wanted).total_seconds()) > 1.0 and planned > now + timedelta(seconds=2)
+
+
 def _stop_now(stop: threading.Event, wake: threading.Event) -> None:
+    from tournament.jobs import STOPPING
+
+    STOPPING.set()
     stop.set()
     wake.set()
 

@@ -19,21 +19,38 @@ import signal
 import subprocess
 import sys
 import time
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
 
 from contracts import files
 from contracts.errors import ContractError
 from contracts.match_results import MatchReport, MatchResults
-from orchestrator.config.schedule import PlannedMatch, Schedule, ScheduledTeam, SchedulePool
+from orchestrator.config.schedule import (
+    PlannedMatch,
+    Schedule,
+    ScheduledTeam,
+    SchedulePool,
+    game_document,
+)
 from orchestrator.errors import ScheduleError
+from tournament.logs import TeamLogs
 
 log = logging.getLogger(__name__)
 
 DEFAULT_SERVICES = "tournament.services:MatchServices"
 SLURM_CONF = "/var/lib/hlvs/slurm/slurm.conf"  # written by 'hlvs pool up'
 SLURM_POLL_S = 2.0
+ABORT_POLL_S = 1.0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Abort:
+    """An operator's request to stop a running match (``hlvs schedule abort``)."""
+
+    reason: str
+    grace_s: float  # after SIGTERM (the match stops and collects its logs), then SIGKILL
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -43,6 +60,8 @@ class MatchContext:
     red: ScheduledTeam
     blue: ScheduledTeam
     out_dir: Path
+    abort: Callable[[], Abort | None] = field(default=lambda: None, compare=False)
+    """Polled while the match plays: the operator's abort request, if any."""
 
     @property
     def match_id(self) -> str:
@@ -62,6 +81,7 @@ class PlayOutcome:
     score_blue: int | None
     winner: str | None  # "red" | "blue" | "draw" | None
     cause: str = ""
+    shootout: dict[str, int] | None = None  # color -> goals in the penalty shoot-out
 
     def as_dict(self, ctx: MatchContext) -> dict[str, Any]:
         team = {"red": ctx.red.name, "blue": ctx.blue.name}
@@ -74,6 +94,7 @@ class PlayOutcome:
             "winner_team": team.get(self.winner or ""),
             "cause": self.cause,
             "out_dir": str(ctx.out_dir),
+            "shootout": self.shootout,
         }
 
 
@@ -84,8 +105,14 @@ class TournamentServices(Protocol):
     def play(self, ctx: MatchContext) -> PlayOutcome:
         """Play the match into ``ctx.out_dir``."""
 
-    def deliver(self, ctx: MatchContext) -> str:
-        """Deliver the match's logs; a summary. Raises DeliveryError when sets stay pending."""
+    def shootout(self, ctx: MatchContext) -> PlayOutcome:
+        """A penalty shoot-out only (game type PENALTY): decides a drawn knockout match."""
+
+    def deliver(self, ctx: MatchContext) -> list[TeamLogs]:
+        """Queue the match's logs and deliver them: the state of each team's set."""
+
+    def redeliver(self, ctx: MatchContext) -> list[TeamLogs]:
+        """Try again the match's sets that are still in the log store."""
 
 
 def load_services(ref: str, schedule: Schedule) -> TournamentServices:
@@ -99,30 +126,55 @@ def load_services(ref: str, schedule: Schedule) -> TournamentServices:
     return services
 
 
-def write_game_file(ctx: MatchContext) -> Path:
-    """The match's game.json: HLVS fields, the schedule's game defaults, both teams."""
-    match = ctx.planned.match
-    game: dict[str, Any] = {
-        "type": "KNOCKOUT" if match.kind == "knockout" else "NORMAL",
-        "class": match.field_class,
-        "host": "127.0.0.1",
-        "maximum_real_time_factor": 0,
-        "match_id": ctx.match_id,
-    }
-    game.update(ctx.schedule.game_defaults)
-    for color, team, base in (("red", ctx.red, 10000), ("blue", ctx.blue, 10020)):
-        side: dict[str, Any] = {
-            "id": team.team_id,
-            "config": str(team.config),
-            "hosts": ["127.0.0.1"],
-            "ports": [base + n for n in range(1, 5 if match.field_class == "KID" else 4)],
-        }
-        if team.credentials is not None:
-            side["credentials"] = str(team.credentials)
-        game[color] = side
+def write_game_file(ctx: MatchContext, *, game_type: str | None = None) -> Path:
+    """The match's game.json (see :func:`orchestrator.config.schedule.game_document`);
+    ``game_type`` PENALTY writes ``game-penalty.json``, a shoot-out only."""
+    game = game_document(ctx.schedule, ctx.planned.match, ctx.red, ctx.blue, game_type=game_type)
     ctx.out_dir.mkdir(parents=True, exist_ok=True)
-    ctx.game_path.write_text(json.dumps(game, indent=2) + "\n", encoding="utf-8")
-    return ctx.game_path
+    path = ctx.game_path if game_type is None else ctx.out_dir / f"game-{game_type.lower()}.json"
+    path.write_text(json.dumps(game, indent=2) + "\n", encoding="utf-8")
+    return path
+
+
+def keep_earlier_attempt(out: Path) -> Path | None:
+    """Move what an earlier attempt left in ``out`` to ``out/attempt-<n>/`` (n = 1, 2, ...,
+    as the Slurm pool names a requeued job's attempts), so that playing the match again
+    overwrites nothing; returns that folder (None when ``out`` held nothing)."""
+    if not out.is_dir():
+        return None
+    earlier = [p for p in out.iterdir() if not p.name.startswith("attempt-")]
+    if not earlier:
+        return None
+    numbers = [int(p.name.removeprefix("attempt-")) for p in out.glob("attempt-*")
+               if p.name.removeprefix("attempt-").isdigit()]
+    folder = out / f"attempt-{max(numbers, default=0) + 1}"
+    folder.mkdir()
+    for path in earlier:
+        path.rename(folder / path.name)
+    log.info("kept the earlier attempt's files in %s", folder)
+    return folder
+
+
+def _wait_or_abort(ctx: MatchContext, proc: subprocess.Popen[bytes]) -> None:
+    """Wait for ``hlvs match``; on an abort request SIGTERM it (it stops the match and
+    collects what was played), and SIGKILL it when the grace period has passed."""
+    while proc.poll() is None:
+        abort = ctx.abort()
+        if abort is None:
+            try:
+                proc.wait(timeout=ABORT_POLL_S)
+            except subprocess.TimeoutExpired:
+                pass
+            continue
+        log.warning("match %s: aborting (%s); %g s of grace", ctx.match_id, abort.reason,
+                    abort.grace_s)
+        proc.terminate()
+        try:
+            proc.wait(timeout=abort.grace_s)
+        except subprocess.TimeoutExpired:
+            log.warning("match %s: still running after the grace period: killed", ctx.match_id)
+            proc.kill()
+            proc.wait()
 
 
 def _die_with_parent() -> None:  # pragma: no cover - runs in the child before exec
@@ -154,7 +206,20 @@ def read_outcome(out_dir: Path) -> PlayOutcome:
         score_blue=results.team_score("blue") if results is not None else None,
         winner=results.winner if results is not None else None,
         cause=report.cause or "",
+        shootout=shootout_goals(out_dir / "public" / files.SIM_RESULT),
     )
+
+
+def shootout_goals(sim_result: Path) -> dict[str, int] | None:
+    """Goals of the penalty shoot-out the referee played (None when there was none)."""
+    try:
+        data = json.loads(sim_result.read_text(encoding="utf-8"))
+        shootout = data.get("shootout")
+        if not isinstance(shootout, dict):
+            return None
+        return {color: int(shootout[color]["scored"]) for color in ("red", "blue")}
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return None
 
 
 class MatchServices:
@@ -170,21 +235,27 @@ class MatchServices:
         return str(pull_game_images(game))
 
     def play(self, ctx: MatchContext) -> PlayOutcome:
-        game = write_game_file(ctx)
-        out = ctx.out_dir / "match"
+        return self._play(ctx, write_game_file(ctx), ctx.out_dir / "match")
+
+    def shootout(self, ctx: MatchContext) -> PlayOutcome:
+        return self._play(ctx, write_game_file(ctx, game_type="PENALTY"),
+                          ctx.out_dir / "shootout")
+
+    def _play(self, ctx: MatchContext, game: Path, out: Path) -> PlayOutcome:
         if self.schedule.pool.kind == "slurm":
             return self._play_in_slurm(ctx, game, out)
+        keep_earlier_attempt(out)
         cmd = [sys.executable, "-m", "hlvs.cli", "match", str(game), "--out", str(out)]
         log.info("match %s: %s", ctx.match_id, " ".join(cmd))
         with open(ctx.out_dir / "match.log", "ab") as sink:
-            proc = subprocess.run(
+            proc = subprocess.Popen(
                 cmd,
                 stdout=sink,
                 stderr=subprocess.STDOUT,
                 preexec_fn=_die_with_parent if sys.platform == "linux" else None,
                 env=os.environ.copy(),
-                check=False,
             )
+            _wait_or_abort(ctx, proc)
         outcome = read_outcome(out)
         log.info(
             "match %s: exit %d, %s %s-%s",
@@ -215,16 +286,23 @@ class MatchServices:
                                        or (out / files.REPORT).is_file()):
                 log.info("match %s: adopting Slurm job %s", ctx.match_id, pool.job_id(handle))
             else:
-                (out / files.REPORT).unlink(missing_ok=True)
+                keep_earlier_attempt(out)
                 handle = pool.submit(MatchJob(match_id=ctx.match_id, game_path=game,
                                               work_dir=out, account=settings.account,
                                               robot_nodes=_robot_nodes(settings, game)))
                 log.info("match %s: Slurm job %s", ctx.match_id, pool.job_id(handle))
             shown = ""
+            cancelled = False
             while True:
                 status = pool.status(handle)
                 if status.state in (JobState.FINISHED, JobState.LOST):
                     break
+                abort = ctx.abort()
+                if abort is not None and not cancelled:
+                    log.warning("match %s: aborting Slurm job %s (%s)", ctx.match_id,
+                                pool.job_id(handle), abort.reason)
+                    pool.cancel(handle)  # SIGTERM, then Slurm's KillWait, then SIGKILL
+                    cancelled = True
                 if status.detail != shown:
                     log.info("match %s: %s %s", ctx.match_id, status.state.value, status.detail)
                     shown = status.detail
@@ -239,27 +317,54 @@ class MatchServices:
                  outcome.score_blue)
         return outcome
 
-    def deliver(self, ctx: MatchContext) -> str:
-        from orchestrator.delivery import deliver_pending, enqueue_match_logs
+    def deliver(self, ctx: MatchContext) -> list[TeamLogs]:
+        from orchestrator.delivery import PUBLIC_TEAM, enqueue_match_logs, pending_status
 
+        store = self.schedule.log_store
+        # sets queued by a delivery that a restart interrupted (their files left the match)
+        earlier = {s.team for s in pending_status(store) if s.match_id == ctx.match_id}
         teams = {
             "red": (ctx.red.name, ctx.red.credentials),
             "blue": (ctx.blue.name, ctx.blue.credentials),
         }
-        store = self.schedule.log_store
-        enqueue_match_logs(
+        created = enqueue_match_logs(
             ctx.out_dir / "match",
             match_id=ctx.match_id,
             teams=teams,
             public_target=self.schedule.public_logs,
             store=store,
         )
-        outcomes = [
-            outcome
-            for team in (ctx.red.name, ctx.blue.name)
-            for outcome in deliver_pending(store, team=team)
+        queued = {s.team for s in created} | earlier
+        names = [ctx.red.name, ctx.blue.name]
+        if self.schedule.public_logs is not None:
+            names.append(PUBLIC_TEAM)
+        delivered = {e.team: e for e in self.redeliver(ctx) if e.team in queued}
+        return [
+            delivered.get(name, TeamLogs(team=name, state="pending"))
+            if name in queued else TeamLogs(team=name, state="none", cause="no log files")
+            for name in names
         ]
-        return f"{len(outcomes)} log set(s) handled"
+
+    def redeliver(self, ctx: MatchContext) -> list[TeamLogs]:
+        """Try the match's sets still in the store (this match's only, never older ones)."""
+        from orchestrator.delivery import deliver_pending, pending_status
+
+        store = self.schedule.log_store
+        waiting = {s.team for s in pending_status(store) if s.match_id == ctx.match_id}
+        outcomes = {o.team: o for o in deliver_pending(store, match_id=ctx.match_id)}
+        found = []
+        for team in sorted(waiting):
+            outcome = outcomes.get(team)
+            if outcome is None:  # another process holds the set right now
+                found.append(TeamLogs(team=team, state="pending", cause="being delivered"))
+            elif outcome.delivered:
+                found.append(TeamLogs(team=team, state="delivered", target=outcome.target))
+            else:
+                error = outcome.error
+                cause = f"{error.kind}: {error.reason}" if error is not None else "failed"
+                found.append(TeamLogs(team=team, state="failed", cause=cause,
+                                      target=outcome.target))
+        return found
 
 
 def _robot_nodes(pool: SchedulePool, game: Path) -> int:

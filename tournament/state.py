@@ -5,8 +5,14 @@ its match through the states below with a compare-and-set update, so a job that 
 again after a restart) finds the match already past its step and does nothing:
 
     PLANNED -> PULLING -> PULLED -> PLAYING -> PLAYED -> DELIVERING -> DELIVERED
-    DELIVERING -> LOGS_PENDING (a target refused; the sets stay in the log store)
+    DELIVERING -> LOGS_PENDING (a set failed; it stays in the log store and is retried)
+    LOGS_PENDING -> DELIVERING (a retry) ... -> LOGS_FAILED (no attempt left; hlvs logs deliver)
     any non-final state -> MISSED (its window closed) | FAILED (a typed failure) | CANCELLED
+    PLAYING -> ABORTED (the operator stopped it; hlvs schedule reschedule plays it again)
+    CANCELLED | MISSED | FAILED | ABORTED -> PLANNED (hlvs schedule reschedule)
+
+Every set of logs has its own state in the row's ``logs`` (see :mod:`tournament.logs`),
+so "played" (PLAYED and after) and "logs delivered" (DELIVERED) are told apart.
 """
 
 from __future__ import annotations
@@ -21,6 +27,8 @@ from enum import StrEnum
 from pathlib import Path
 from typing import Any
 
+from tournament.logs import TeamLogs
+
 
 class ScheduledMatchState(StrEnum):
     PLANNED = "PLANNED"
@@ -30,20 +38,37 @@ class ScheduledMatchState(StrEnum):
     PLAYED = "PLAYED"
     DELIVERING = "DELIVERING"
     DELIVERED = "DELIVERED"
-    LOGS_PENDING = "LOGS_PENDING"  # played; some log sets wait in the store (hlvs logs deliver)
+    LOGS_PENDING = "LOGS_PENDING"  # played; a log set failed, a retry is due
+    LOGS_FAILED = "LOGS_FAILED"  # played; a log set failed every attempt (hlvs logs deliver)
     MISSED = "MISSED"
     FAILED = "FAILED"
     CANCELLED = "CANCELLED"
+    ABORTED = "ABORTED"  # stopped by the operator while playing
 
     @property
     def final(self) -> bool:
         return self in (
             ScheduledMatchState.DELIVERED,
-            ScheduledMatchState.LOGS_PENDING,
+            ScheduledMatchState.LOGS_FAILED,
             ScheduledMatchState.MISSED,
             ScheduledMatchState.FAILED,
             ScheduledMatchState.CANCELLED,
+            ScheduledMatchState.ABORTED,
         )
+
+    @property
+    def played(self) -> bool:
+        """The match was played to its end (its logs may still be on their way)."""
+        return self in PLAYED_STATES
+
+
+PLAYED_STATES = frozenset({
+    ScheduledMatchState.PLAYED,
+    ScheduledMatchState.DELIVERING,
+    ScheduledMatchState.DELIVERED,
+    ScheduledMatchState.LOGS_PENDING,
+    ScheduledMatchState.LOGS_FAILED,
+})
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -63,6 +88,8 @@ class MatchRow:
     result: dict[str, Any] | None
     updated_at: datetime
     not_before: datetime | None = None  # a deferred step waits until then
+    logs: tuple[TeamLogs, ...] = ()
+    request: dict[str, Any] | None = None  # an operator's pending request (abort)
 
     def as_dict(self) -> dict[str, Any]:
         return {
@@ -79,6 +106,10 @@ class MatchRow:
             "attempts": self.attempts,
             "note": self.note,
             "result": self.result,
+            "played": self.state.played,
+            "logs_delivered": self.state is ScheduledMatchState.DELIVERED,
+            "logs": [entry.as_dict() for entry in self.logs],
+            "request": self.request,
         }
 
 
@@ -89,7 +120,7 @@ CREATE TABLE IF NOT EXISTS hlvs_matches (
     blue TEXT NOT NULL, pull_at TEXT NOT NULL, play_at TEXT NOT NULL, stream_start TEXT NOT NULL,
     stream_end TEXT NOT NULL, deliver_at TEXT NOT NULL, attempts INTEGER NOT NULL DEFAULT 0,
     note TEXT NOT NULL DEFAULT '', result TEXT, updated_at TEXT NOT NULL,
-    not_before TEXT);
+    not_before TEXT, logs TEXT, request TEXT);
 CREATE TABLE IF NOT EXISTS hlvs_history (
     at TEXT NOT NULL, match_id TEXT NOT NULL, from_state TEXT, to_state TEXT NOT NULL,
     note TEXT NOT NULL DEFAULT '');
@@ -109,6 +140,10 @@ class Ledger:
         try:
             db.execute("PRAGMA journal_mode=WAL")
             db.executescript(_SCHEMA)
+            columns = {r[1] for r in db.execute("PRAGMA table_info(hlvs_matches)")}
+            for column in ("logs", "request"):  # state files of earlier versions
+                if column not in columns:
+                    db.execute(f"ALTER TABLE hlvs_matches ADD COLUMN {column} TEXT")
         finally:
             db.close()
 
@@ -199,11 +234,43 @@ class Ledger:
                 (until.isoformat(), note, _now(), match_id),
             )
 
+    def set_logs(self, match_id: str, logs: list[TeamLogs]) -> None:
+        with self._connect() as db:
+            db.execute(
+                "UPDATE hlvs_matches SET logs=?, updated_at=? WHERE id=?",
+                (json.dumps([e.as_dict() for e in logs]), _now(), match_id),
+            )
+
+    def set_request(self, match_id: str, request: dict[str, Any] | None) -> None:
+        """Record (or clear) an operator's request that the running job acts on."""
+        with self._connect() as db:
+            db.execute(
+                "UPDATE hlvs_matches SET request=? WHERE id=?",
+                (json.dumps(request) if request is not None else None, match_id),
+            )
+
+    def reschedule(self, match_id: str, times: dict[str, str], note: str) -> None:
+        """New times for a match (PLANNED again, not deferred)."""
+        with self._connect() as db:
+            row = db.execute("SELECT state FROM hlvs_matches WHERE id=?", (match_id,)).fetchone()
+            sets = ", ".join(f"{k}=?" for k in times)
+            db.execute(
+                f"UPDATE hlvs_matches SET {sets}, state='PLANNED', not_before=NULL, note=?,"
+                " request=NULL, updated_at=? WHERE id=?",
+                (*times.values(), note, _now(), match_id),
+            )
+            db.execute(
+                "INSERT INTO hlvs_history(at, match_id, from_state, to_state, note)"
+                " VALUES (?, ?, ?, 'PLANNED', ?)",
+                (_now(), match_id, row[0] if row else None, note),
+            )
+
     def rows(self) -> list[MatchRow]:
         with self._connect() as db:
             rows = db.execute(
                 "SELECT id, state, kind, red, blue, pull_at, play_at, stream_start, stream_end,"
-                " deliver_at, attempts, note, result, updated_at, not_before FROM hlvs_matches"
+                " deliver_at, attempts, note, result, updated_at, not_before, logs, request"
+                " FROM hlvs_matches"
                 " ORDER BY stream_start, id"
             ).fetchall()
         return [_row(r) for r in rows]
@@ -243,4 +310,6 @@ def _row(r: tuple[Any, ...]) -> MatchRow:
         result=json.loads(r[12]) if r[12] else None,
         updated_at=ts(r[13]),
         not_before=ts(r[14]) if r[14] else None,
+        logs=tuple(TeamLogs.from_dict(d) for d in json.loads(r[15])) if r[15] else (),
+        request=json.loads(r[16]) if r[16] else None,
     )

@@ -110,8 +110,11 @@ class CatalogResolver:
         return list(self.catalog.replays.values()), list(self.catalog.live.values())
 
 
-def build_router(resolver: Any, *, feed_factory: FeedFactory = ZenohFeed) -> APIRouter:
-    """The API and page routes; ``resolver`` is a :class:`Resolver`."""
+def build_router(resolver: Any, *, feed_factory: FeedFactory = ZenohFeed,
+                 prefix: str = API_PREFIX, pages: bool = True) -> APIRouter:
+    """The API (under ``prefix``) and, with ``pages``, the page routes; ``resolver`` is a
+    :class:`Resolver`."""
+    API_PREFIX = prefix  # noqa: N806 - the routes below read the prefix under this name
     router = APIRouter()
     replays = _OpenReplays()
     # dependencies as defaults: annotations are strings here and cannot name local aliases
@@ -179,11 +182,12 @@ def build_router(resolver: Any, *, feed_factory: FeedFactory = ZenohFeed) -> API
             headers={"Cache-Control": "no-cache"},
         )
 
-    @router.get("/watch", include_in_schema=False)
-    @router.get("/watch/{page:path}", include_in_schema=False)
-    def page(page: str = "") -> FileResponse:
-        del page
-        return FileResponse(STATIC / "index.html")
+    if pages:
+        @router.get("/watch", include_in_schema=False)
+        @router.get("/watch/{page:path}", include_in_schema=False)
+        def page(page: str = "") -> FileResponse:
+            del page
+            return FileResponse(STATIC / "index.html")
 
     return router
 

@@ -34,7 +34,7 @@ FORMATS = ("text", "json", "github")
 # Loaders written in other modules: kind -> (module, function). Skipped when not installed.
 _OPTIONAL_LOADERS = {
     "credentials": ("orchestrator.config.credentials", "load_credentials"),
-    "schedule": ("orchestrator.config.schedule", "load_schedule"),
+    "schedule": ("orchestrator.config.schedule_check", "check_schedule"),
 }
 
 
@@ -303,6 +303,8 @@ def _check_optional(kind: Kind, path: Path) -> list[Problem]:
         if kind == "credentials":
             parse_json(text, file=str(path))
         loaded = getattr(module, function)(path)
+        if isinstance(loaded, list):  # a checker: every problem, errors included
+            return [p for p in loaded if isinstance(p, Problem)]
     except ConfigError as exc:
         return exc.problems
     except OrchestratorError:

@@ -1,10 +1,12 @@
-"""``hlvs schedule run|list|status|cancel|standings``: a tournament from one schedule file."""
+"""``hlvs schedule run|list|status|cancel|abort|reschedule|apply|standings``: a tournament from
+one schedule file, and the operator's controls over it."""
 
 from __future__ import annotations
 
 import argparse
 import json
 import logging
+import sys
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -46,12 +48,42 @@ def register(sub: Any) -> None:
     status = verbs.add_parser("status", help="state of every match")
     status.add_argument("--state", type=user_path, required=True, help=_STATE_HELP)
     status.add_argument("--json", action="store_true", help="print a JSON array")
+    status.add_argument("--watch", action="store_true",
+                        help="print the status again every --every seconds until Ctrl-C")
+    status.add_argument("--every", type=float, default=2.0, metavar="S",
+                        help="seconds between two prints with --watch (default 2)")
     status.set_defaults(func=_status)
 
     cancel = verbs.add_parser("cancel", help="cancel a match that is not played yet")
     cancel.add_argument("match_id", help="id of the match in the schedule")
     cancel.add_argument("--state", type=user_path, required=True, help=_STATE_HELP)
     cancel.set_defaults(func=_cancel)
+
+    stop = verbs.add_parser(
+        "abort", help="stop a running match (SIGTERM, a grace period, then SIGKILL); the "
+        "match becomes ABORTED with the reason")
+    stop.add_argument("match_id", help="id of the match in the schedule")
+    stop.add_argument("--state", type=user_path, required=True, help=_STATE_HELP)
+    stop.add_argument("--reason", required=True, help="why (recorded with the match)")
+    stop.add_argument("--grace", type=float, default=None, metavar="S",
+                      help="seconds the match has to stop and collect its logs before it is "
+                      "killed (default 150)")
+    stop.set_defaults(func=_abort)
+
+    again = verbs.add_parser(
+        "reschedule", help="plan a match again: un-cancel it, or give it a new time")
+    again.add_argument("match_id", help="id of the match in the schedule")
+    again.add_argument("--state", type=user_path, required=True, help=_STATE_HELP)
+    again.add_argument("--at", metavar="TIME",
+                       help="new stream start: ISO 8601 with a time zone, or +30m from now "
+                       "(default: the schedule's time)")
+    again.set_defaults(func=_reschedule)
+
+    apply = verbs.add_parser(
+        "apply", help="make the edited schedule file the tournament's (until then the copy "
+        "recorded at the start runs on)")
+    apply.add_argument("--state", type=user_path, required=True, help=_STATE_HELP)
+    apply.set_defaults(func=_apply)
 
     table = verbs.add_parser("standings", help="points, goal difference and goals")
     table.add_argument("--state", type=user_path, required=True, help=_STATE_HELP)
@@ -70,7 +102,15 @@ def _ledger(path: Path) -> Any:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from orchestrator.config.schedule_check import check_schedule
     from tournament.runner import run_schedule
+
+    recorded = args.state.is_file() and _ledger(args.state).get_meta("schedule_text")
+    if not recorded:  # the first run: what hlvs check finds is refused before any pull (a
+        # restart runs the copy checked then; an edit waits for 'hlvs schedule apply')
+        problems = check_schedule(args.schedule)
+        if any(p.severity == "error" for p in problems):
+            raise ConfigError(problems)
 
     return run_schedule(
         args.schedule, args.state, services=args.services, pool=args.pool,
@@ -89,6 +129,8 @@ def _list(args: argparse.Namespace) -> int:
         reference = datetime.fromisoformat(recorded) if recorded else now
     elif schedule.start not in (None, "now"):
         reference = resolve_time(str(schedule.start), now)
+    if args.state:
+        _warn_differences(_ledger(args.state))
     rows = [
         {
             "id": p.match.id,
@@ -115,16 +157,35 @@ def _list(args: argparse.Namespace) -> int:
 
 
 def _status(args: argparse.Namespace) -> int:
-    rows = _ledger(args.state).rows()
-    if args.json:
-        print(json.dumps([r.as_dict() for r in rows], indent=2))
+    from tournament.overview import Snapshot, status_lines
+
+    ledger = _ledger(args.state)
+    snapshot: Snapshot | None = None
+    if not args.json:  # a running match's score and clock, from its telemetry
+        from viewer.snapshot import game_snapshot
+
+        snapshot = game_snapshot
+    if not args.watch:
+        if args.json:
+            print(json.dumps([r.as_dict() for r in ledger.rows()], indent=2))
+        else:
+            print("\n".join(status_lines(ledger, snapshot=snapshot)))
+        _warn_differences(ledger)
         return 0
-    for r in rows:
-        score = ""
-        if r.result and r.result.get("score", {}).get("red") is not None:
-            score = f" {r.result['score']['red']}-{r.result['score']['blue']}"
-        print(f"{r.id:<12} {r.state.value:<12} {r.red} v {r.blue}{score}  {r.note}".rstrip())
-    return 0
+    import time
+
+    try:
+        while True:
+            text = (json.dumps([r.as_dict() for r in ledger.rows()]) if args.json
+                    else "\n".join(status_lines(ledger, snapshot=snapshot)))
+            if not args.json:
+                print("\x1b[H\x1b[2J", end="")  # clear the terminal, as watch(1) does
+                print(f"{datetime.now(UTC).isoformat(timespec='seconds')}"
+                      f"  (every {args.every:g} s, Ctrl-C to stop)")
+            print(text, flush=True)
+            time.sleep(args.every)
+    except KeyboardInterrupt:
+        return 0
 
 
 def _cancel(args: argparse.Namespace) -> int:
@@ -150,14 +211,48 @@ def _cancel(args: argparse.Namespace) -> int:
     return 0
 
 
+def _abort(args: argparse.Namespace) -> int:
+    from tournament.controls import DEFAULT_ABORT_GRACE_S, abort
+
+    grace = DEFAULT_ABORT_GRACE_S if args.grace is None else args.grace
+    abort(_ledger(args.state), args.match_id, reason=args.reason, grace_s=grace)
+    print(f"{args.match_id}: abort requested ({args.reason}); the scheduler stops it within "
+          f"{grace:g} s and marks it ABORTED")
+    return 0
+
+
+def _reschedule(args: argparse.Namespace) -> int:
+    from tournament.controls import reschedule
+
+    planned = reschedule(_ledger(args.state), args.match_id, at=args.at)
+    print(f"{args.match_id}: PLANNED, pull {planned.pull_at.isoformat(timespec='seconds')}, "
+          f"stream {planned.stream_start.isoformat(timespec='seconds')}")
+    return 0
+
+
+def _apply(args: argparse.Namespace) -> int:
+    from tournament.controls import apply_file
+
+    changes = apply_file(_ledger(args.state))
+    for change in changes or ["no change"]:
+        print(change)
+    return 0
+
+
+def _warn_differences(ledger: Any) -> None:
+    from tournament.controls import file_differences
+
+    for note in file_differences(ledger):
+        print(f"warning: {note}", file=sys.stderr)
+
+
 def _standings(args: argparse.Namespace) -> int:
-    from orchestrator.config.schedule import load_schedule
+    from tournament.controls import recorded_schedule
     from tournament.standings import standings
 
     ledger = _ledger(args.state)
-    schedule_path = ledger.get_meta("schedule")
-    teams = [t.name for t in load_schedule(schedule_path).teams] if schedule_path else []
-    table = standings(ledger.rows(), teams)
+    schedule = recorded_schedule(ledger)
+    table = standings(ledger.rows(), [t.name for t in schedule.teams], seed=schedule.name)
     if args.json:
         print(json.dumps([s.as_dict() for s in table], indent=2))
         return 0
@@ -165,8 +260,9 @@ def _standings(args: argparse.Namespace) -> int:
         f"{'team':<16} {'P':>3} {'W':>3} {'D':>3} {'L':>3} {'GF':>4} {'GA':>4} {'GD':>4} {'Pts':>4}"
     )
     for s in table:
+        tie = f"  (above the next on points by {s.decided_by})" if s.decided_by else ""
         print(
             f"{s.team:<16} {s.played:>3} {s.won:>3} {s.drawn:>3} {s.lost:>3} {s.goals_for:>4}"
-            f" {s.goals_against:>4} {s.goal_difference:>4} {s.points:>4}"
+            f" {s.goals_against:>4} {s.goal_difference:>4} {s.points:>4}{tie}"
         )
     return 0

@@ -35,6 +35,7 @@ class ScheduleTiming:
     play_after_pull_s: float = 600.0
     deliver_after_stream_s: float = 0.0
     retry_s: float = 300.0
+    delivery_attempts: int = 3
 
     def pull_lead_s(self, kind: MatchKind) -> float:
         return self.pull_lead_knockout_s if kind == "knockout" else self.pull_lead_round_robin_s
@@ -147,6 +148,40 @@ class Schedule:
         return planned
 
 
+def game_document(
+    schedule: Schedule,
+    match: ScheduledMatch,
+    red: ScheduledTeam,
+    blue: ScheduledTeam,
+    *,
+    game_type: str | None = None,
+) -> dict[str, Any]:
+    """The game.json of a match: HLVS fields, the schedule's ``game_defaults``, both teams.
+
+    The game type follows the match's kind (NORMAL, or KNOCKOUT: overtime, then a penalty
+    shoot-out) and is never taken from the defaults; ``game_type`` PENALTY is a shoot-out only.
+    """
+    game: dict[str, Any] = {
+        "class": match.field_class,
+        "host": "127.0.0.1",
+        "maximum_real_time_factor": 0,
+        "match_id": match.id,
+    }
+    game.update(schedule.game_defaults)
+    game["type"] = game_type or ("KNOCKOUT" if match.kind == "knockout" else "NORMAL")
+    for color, team, base in (("red", red, 10000), ("blue", blue, 10020)):
+        side: dict[str, Any] = {
+            "id": team.team_id,
+            "config": str(team.config),
+            "hosts": ["127.0.0.1"],
+            "ports": [base + n for n in range(1, 5 if match.field_class == "KID" else 4)],
+        }
+        if team.credentials is not None:
+            side["credentials"] = str(team.credentials)
+        game[color] = side
+    return game
+
+
 def resolve_time(text: str, reference: datetime) -> datetime:
     match = _OFFSET.match(text)
     if match:
@@ -167,9 +202,9 @@ def _pointer(parts: Any) -> str:
     return "".join(f"/{p}" for p in parts)
 
 
-def _read(path: Path) -> Any:
+def _read(path: Path, text: str | None = None) -> Any:
     try:
-        raw = path.read_bytes()
+        raw = path.read_bytes() if text is None else text.encode("utf-8")
     except FileNotFoundError:
         raise ConfigError([Problem(str(path), "", "file not found")]) from None
     except OSError as exc:
@@ -218,10 +253,15 @@ def _schema_problems(path: Path, data: Any) -> list[Problem]:
     return problems
 
 
-def load_schedule(path: str | Path) -> Schedule:
-    """Validate and load a schedule file; raises ConfigError listing every problem."""
+def load_schedule(path: str | Path, *, text: str | None = None) -> Schedule:
+    """Validate and load a schedule file; raises ConfigError listing every problem.
+
+    ``text``: the file's content as it was recorded (the tournament's state file keeps the
+    schedule it runs, so that an edit applies only when the operator says so); relative paths
+    are still resolved against ``path``'s folder.
+    """
     path = Path(path)
-    data = _read(path)
+    data = _read(path, text)
     problems = _schema_problems(path, data)
     if problems:
         raise ConfigError(problems)
@@ -252,7 +292,7 @@ def load_schedule(path: str | Path) -> Schedule:
         else output_dir / "log-store",
         public_logs=(base / data["public_logs"]).resolve() if "public_logs" in data else None,
         simulator_slots=int(data.get("simulator_slots", 1)),
-        timing=ScheduleTiming(**{k: float(v) for k, v in data.get("timing", {}).items()}),
+        timing=_timing(data.get("timing", {})),
         game_defaults=dict(data.get("game_defaults", {})),
         teams=teams,
         matches=tuple(matches),
@@ -262,6 +302,13 @@ def load_schedule(path: str | Path) -> Schedule:
     if problems:
         raise ConfigError(problems)
     return schedule
+
+
+def _timing(data: dict[str, Any]) -> ScheduleTiming:
+    values: dict[str, Any] = {k: float(v) for k, v in data.items()}
+    if "delivery_attempts" in values:
+        values["delivery_attempts"] = int(values["delivery_attempts"])
+    return ScheduleTiming(**values)
 
 
 def _slot(value: Any) -> Slot:
@@ -392,6 +439,8 @@ def _cross_problems(path: Path, schedule: Schedule, data: dict[str, Any]) -> lis
                     )
                 )
     ids_seen: list[str] = []
+    listed = len(data.get("matches") or [])
+    generated = {m.id for m in schedule.matches[listed:]}  # fixtures: any match may follow them
     reference = datetime(2000, 1, 1, tzinfo=UTC)
     for i, match in enumerate(schedule.matches):
         pointer = f"/matches/{i}" if i < len(data.get("matches", [])) else f"(fixture {match.id})"
@@ -410,7 +459,7 @@ def _cross_problems(path: Path, schedule: Schedule, data: dict[str, Any]) -> lis
                     )
                 )
             ref = slot.winner_of or slot.loser_of
-            if ref is not None and ref not in ids_seen:
+            if ref is not None and ref not in ids_seen and ref not in generated:
                 problems.append(
                     Problem(
                         file,

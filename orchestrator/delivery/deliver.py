@@ -77,15 +77,19 @@ def deliver_pending(
     store: Path,
     *,
     team: str | None = None,
+    match_id: str | None = None,
     retry: RetryPolicy | None = None,
     opener: Opener | None = None,
     sleep: Callable[[float], None] = time.sleep,
     progress: Progress | None = None,
 ) -> list[DeliveryOutcome]:
-    """Try every pending set (of ``team`` only, if given), oldest first."""
+    """Try every pending set (of ``team`` and of ``match_id`` only, if given), oldest first."""
     outcomes = []
     with st.locked(store):
-        candidates = [s for s in st.list_sets(store) if team is None or s.team == team]
+        candidates = [
+            s for s in st.list_sets(store)
+            if (team is None or s.team == team) and (match_id is None or s.match_id == match_id)
+        ]
     for pending in candidates:
         with st.claimed(pending) as mine:
             if not mine:

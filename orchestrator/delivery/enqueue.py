@@ -74,8 +74,8 @@ def enqueue_match_logs(
                 shutil.rmtree(folder)  # only empty folders are left
             log.info("match %s: queued %d log files of team %s", match_id, len(sources), team)
             _prune(store, team)
-        public = (_files_under(match_dir, exclude=match_dir / TEAMS_FOLDER)
-                  if public_target is not None else [])
+        public = ([f for f in _files_under(match_dir, exclude=match_dir / TEAMS_FOLDER)
+                   if not _earlier_team_file(f[1])] if public_target is not None else [])
         if public_target is not None and not public:
             log.warning("match %s: no public log files: no set made", match_id)
         elif public_target is not None:
@@ -92,6 +92,12 @@ def enqueue_match_logs(
             )
             log.info("match %s: queued %d public log files", match_id, len(public))
     return created
+
+
+def _earlier_team_file(rel: str) -> bool:
+    """A team's file of an earlier attempt (``attempt-<n>/teams/...``): never public."""
+    parts = rel.split("/")
+    return len(parts) > 2 and parts[0].startswith("attempt-") and parts[1] == TEAMS_FOLDER
 
 
 def _files_under(folder: Path, *, exclude: Path | None) -> list[tuple[Path, str]]:

@@ -32,6 +32,7 @@ class TeamSummary(BaseModel):
 
 
 class ScheduleView(BaseModel):
+    name: str = ""  # the tournament's
     matches: list[dict[str, Any]]
     standings: list[dict[str, Any]]
 
@@ -129,9 +130,12 @@ def get_schedule(request: Request, principal: OperatorPrincipal) -> ScheduleView
     ledger = Ledger(Path(state))
     rows = ledger.rows()
     schedule_path = ledger.get_meta("schedule")
-    teams = [t.name for t in load_schedule(schedule_path).teams] if schedule_path else []
-    return ScheduleView(matches=[r.as_dict() for r in rows],
-                        standings=[s.as_dict() for s in standings(rows, teams)])
+    schedule = (load_schedule(schedule_path, text=ledger.get_meta("schedule_text"))
+                if schedule_path else None)
+    teams = [t.name for t in schedule.teams] if schedule is not None else []
+    return ScheduleView(name=schedule.name if schedule else "",
+                        matches=[r.as_dict() for r in rows], standings=[
+        s.as_dict() for s in standings(rows, teams, seed=schedule.name if schedule else "")])
 
 
 def mount(app: FastAPI) -> None:

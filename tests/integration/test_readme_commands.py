@@ -274,6 +274,8 @@ OUTCOMES: dict[str, Outcome] = {
     "hlvs check --require-images configs/examples/kid_4v4_official/game.json": Outcome(check_ok),
     "hlvs check configs/examples/credentials/sftp_key.json": Outcome(check_ok),
     "hlvs check configs/examples/robots/wolfgang": Outcome(check_ok),
+    "hlvs check configs/examples/schedule/knockout.yaml": Outcome(check_ok),
+    "hlvs schedule list configs/examples/schedule/knockout.yaml": Outcome(exit_zero),
     # images/README.md
     "hlvs compose configs/examples/scrimmage_1v1/game.json -o match/docker-compose.yml": Outcome(
         compose_written

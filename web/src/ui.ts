@@ -22,6 +22,12 @@ export function setText(node: Node, text: string): void {
   if (node.textContent !== text) node.textContent = text;
 }
 
+/** The teams' names a page was linked with (`?red=ants&blue=bees`). */
+export function teamNames(): { red: string | null; blue: string | null } {
+  const query = new URLSearchParams(location.search);
+  return { red: query.get("red"), blue: query.get("blue") };
+}
+
 export class Scoreboard {
   readonly root = el("div", { class: "scoreboard", "data-testid": "scoreboard" });
   private readonly red = el("span", { class: "score red", "data-testid": "score-red" }, "0");
@@ -29,14 +35,15 @@ export class Scoreboard {
   private readonly state = el("span", { class: "state", "data-testid": "game-state" }, "-");
   private readonly clockText = el("span", { class: "clock", "data-testid": "game-clock" }, "--:--");
 
-  constructor(title: string) {
+  /** `names`: the teams' names (default: the page's `?red=...&blue=...`, else RED and BLUE). */
+  constructor(title: string, names: { red?: string | null; blue?: string | null } = teamNames()) {
     this.root.append(
       el("span", { class: "title" }, title),
-      el("span", { class: "team red" }, "RED"),
+      el("span", { class: "team red", "data-testid": "team-red" }, names.red || "RED"),
       this.red,
       el("span", { class: "colon" }, ":"),
       this.blue,
-      el("span", { class: "team blue" }, "BLUE"),
+      el("span", { class: "team blue", "data-testid": "team-blue" }, names.blue || "BLUE"),
       this.state,
       this.clockText,
     );

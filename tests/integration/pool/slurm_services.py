@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 
+from tournament.logs import TeamLogs
 from tournament.services import MatchContext, MatchServices, PlayOutcome
 
 
@@ -30,6 +31,7 @@ class SlurmTestServices(MatchServices):
         self._log("play-end", ctx.match_id)
         return outcome
 
-    def deliver(self, ctx: MatchContext) -> str:
+    def deliver(self, ctx: MatchContext) -> list[TeamLogs]:
         self._log("deliver", ctx.match_id)
-        return "recorded"
+        return [TeamLogs(team=team.name, state="delivered", target="(recorded only)")
+                for team in (ctx.red, ctx.blue)]

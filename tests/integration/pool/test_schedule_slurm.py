@@ -35,21 +35,20 @@ name: slurm cup
 output_dir: out
 simulator_slots: 2
 pool: {{kind: slurm, slurm_conf: {conf}}}
-timing: {{pull_lead_round_robin_s: 40, play_after_pull_s: 0.5, deliver_after_stream_s: 0.5,
+timing: {{pull_lead_round_robin_s: 60, play_after_pull_s: 0.5, deliver_after_stream_s: 0.5,
          retry_s: 1}}
 game_defaults:
   stepping: lockstep
   seed: 7
-  timing: {{half_duration_s: 4, ready_duration_s: 1, wait_before_first_ready_s: 1,
-           half_time_break_s: 1,
-           grace_period_s: 2}}
+  timing: {{half_duration_s: 16, ready_duration_s: 1, wait_before_first_ready_s: 1,
+           half_time_break_s: 1, grace_period_s: 2}}
   limits: {{cpus: 1, memory_gb: 1, pids: 256}}
 teams:
   - {{name: ants, id: 1, config: ants.json}}
   - {{name: bees, id: 2, config: bees.json}}
 matches:
-  - {{id: {ids[0]}, red: ants, blue: bees, stream_start: "+42s", stream_length_s: 1}}
-  - {{id: {ids[1]}, red: bees, blue: ants, stream_start: "+44s", stream_length_s: 1}}
+  - {{id: {ids[0]}, red: ants, blue: bees, stream_start: "+62s", stream_length_s: 1}}
+  - {{id: {ids[1]}, red: bees, blue: ants, stream_start: "+64s", stream_length_s: 1}}
 """)
     return path
 

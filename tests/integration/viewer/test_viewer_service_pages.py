@@ -75,9 +75,10 @@ def test_queue_submissions_replay_standings_and_pool_pages(
 
     page.goto(f"{served.url}/watch/standings")
     table = _rows(page, "standings")
+    assert page.locator("[data-testid=standings-title]").inner_text() == "test cup: standings"
     ledger = Ledger(tournament)
-    teams = [t.name for t in load_schedule(str(ledger.get_meta("schedule"))).teams]
-    expected = standings(ledger.rows(), teams)
+    schedule = load_schedule(str(ledger.get_meta("schedule")))
+    expected = standings(ledger.rows(), [t.name for t in schedule.teams], seed=schedule.name)
     assert sum(s.played for s in expected) == 6
     assert [(r[1], r[2], r[9]) for r in table] == [
         (s.team, str(s.played), str(s.points)) for s in expected

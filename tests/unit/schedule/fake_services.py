@@ -1,20 +1,29 @@
 """Services for scheduler tests: a 'match' is a short sleep with a score derived from the names.
 
+``HLVS_FAKE_DRAWN`` (match ids) ends those matches 1-1; ``HLVS_FAKE_DEAD_TEAMS`` (team names)
+makes those teams' log deliveries fail as an unreachable target would. Both are read when the
+module is imported (set them before the scheduler's first job, or in a child's environment).
+
 Every step appends a line to ``<output_dir>/services.log`` (``pull|play-start|play-end|deliver
 <match id> <time>``) so tests can count what ran and when, across scheduler processes.
 """
 
 from __future__ import annotations
 
+import json
 import os
 import time
 import zlib
 from datetime import UTC, datetime
 
 from orchestrator.config.schedule import Schedule
+from tournament.logs import TeamLogs
 from tournament.services import MatchContext, PlayOutcome
 
 PLAY_SECONDS = float(os.environ.get("HLVS_FAKE_PLAY_S", "0.3"))
+DEAD_TEAMS = set(filter(None, os.environ.get("HLVS_FAKE_DEAD_TEAMS", "").split(",")))
+DRAWN = set(filter(None, os.environ.get("HLVS_FAKE_DRAWN", "").split(",")))
+BROKEN: set[str] = set()  # match ids whose play fails as a killed match process does
 
 
 def _log(schedule: Schedule, what: str, match_id: str) -> None:
@@ -39,14 +48,43 @@ class FakeServices:
 
     def play(self, ctx: MatchContext) -> PlayOutcome:
         _log(self.schedule, "play-start", ctx.match_id)
-        time.sleep(PLAY_SECONDS)
+        ctx.out_dir.mkdir(parents=True, exist_ok=True)
+        (ctx.out_dir / "game_defaults.json").write_text(json.dumps(ctx.schedule.game_defaults))
+        until = time.monotonic() + PLAY_SECONDS
+        while time.monotonic() < until:
+            if ctx.abort() is not None:
+                _log(self.schedule, "play-stopped", ctx.match_id)
+                return PlayOutcome(status="infrastructure", score_red=None, score_blue=None,
+                                   winner=None, cause="stopped (SIGTERM)")
+            time.sleep(0.02)
         red, blue = goals(ctx.red.name), goals(ctx.blue.name)
-        if ctx.planned.match.kind == "knockout" and red == blue:
-            red += 1  # decided by the shoot-out in a real knockout match
+        if ctx.planned.match.id in BROKEN:
+            return PlayOutcome(status="infrastructure", score_red=None, score_blue=None,
+                               winner=None, cause="report.json was not written")
+        if ctx.planned.match.id in DRAWN:
+            red = blue = 1
         _log(self.schedule, "play-end", ctx.match_id)
         winner = "red" if red > blue else "blue" if blue > red else "draw"
         return PlayOutcome(status="success", score_red=red, score_blue=blue, winner=winner)
 
-    def deliver(self, ctx: MatchContext) -> str:
+    def shootout(self, ctx: MatchContext) -> PlayOutcome:
+        _log(self.schedule, "shootout", ctx.match_id)
+        red, blue = (3, 2) if goals(ctx.red.name) >= goals(ctx.blue.name) else (2, 3)
+        winner = "red" if red > blue else "blue"
+        return PlayOutcome(status="success", score_red=red, score_blue=blue, winner=winner,
+                           shootout={"red": red, "blue": blue})
+
+    def deliver(self, ctx: MatchContext) -> list[TeamLogs]:
         _log(self.schedule, "deliver", ctx.match_id)
-        return "2 log sets delivered"
+        return [self._one(ctx.red.name), self._one(ctx.blue.name)]
+
+    def redeliver(self, ctx: MatchContext) -> list[TeamLogs]:
+        _log(self.schedule, "redeliver", ctx.match_id)
+        return [self._one(name) for name in (ctx.red.name, ctx.blue.name)
+                if name in DEAD_TEAMS]
+
+    def _one(self, team: str) -> TeamLogs:
+        if team in DEAD_TEAMS:
+            return TeamLogs(team=team, state="failed", target="sftp://127.0.0.1:9",
+                            cause="unreachable: connection refused")
+        return TeamLogs(team=team, state="delivered", target="s3://logs")

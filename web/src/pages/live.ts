@@ -49,7 +49,7 @@ function decodePoses(b64: string): { timeMs: number; poses: Float32Array } {
   return { timeMs: view.getUint32(0, true), poses: new Float32Array(bytes.buffer.slice(4)) };
 }
 
-export function livePage(root: HTMLElement, api: string, matchId: string): void {
+export function livePage(root: HTMLElement, api: string, matchId: string, replayBase = "/watch/replay"): void {
   const board = new Scoreboard(`${matchId} (live)`);
   const status = el("div", { class: "live-status", "data-testid": "live-status" }, "waiting for telemetry...");
   const canvas = el("canvas", { class: "view", "data-testid": "scene" });
@@ -120,7 +120,7 @@ export function livePage(root: HTMLElement, api: string, matchId: string): void 
     if (answer?.ok) {
       offered = true;
       window.clearInterval(watchdog);
-      status.append("  the match is over: ", el("a", { href: `/watch/replay/${encodeURIComponent(matchId)}`, "data-testid": "replay-link" }, "watch the replay"));
+      status.append("  the match is over: ", el("a", { href: `${replayBase}/${encodeURIComponent(matchId)}${location.search}`, "data-testid": "replay-link" }, "watch the replay"));
     }
   }, 2000);
   function frame(): void {

@@ -26,6 +26,7 @@ interface Queue {
 }
 
 interface Schedule {
+  name?: string;
   matches: Record<string, unknown>[];
   standings: Record<string, unknown>[];
 }
@@ -90,9 +91,11 @@ async function queuePage(root: HTMLElement): Promise<void> {
 async function standingsPage(root: HTMLElement): Promise<void> {
   const schedule = await getJson<Schedule>("/v1/operator/schedule");
   const standingColumns = ["team", "played", "won", "drawn", "lost", "goals_for", "goals_against", "goal_difference", "points"];
+  const labels = ["team", "played", "won", "drawn", "lost", "goals for", "goals against", "goal difference", "points"];
   root.append(
-    el("h1", {}, "Standings"),
-    table("standings", ["#", ...standingColumns], schedule.standings.map((s, i) => [String(i + 1), ...standingColumns.map((c) => String(s[c] ?? ""))])),
+    el("h1", { "data-testid": "standings-title" }, schedule.name ? `${schedule.name}: standings` : "Standings"),
+    el("p", {}, el("a", { href: "/watch/tournament", "data-testid": "overview-link" }, "the tournament's live overview")),
+    table("standings", ["#", ...labels], schedule.standings.map((s, i) => [String(i + 1), ...standingColumns.map((c) => String(s[c] ?? ""))])),
     el("h1", {}, "Schedule"),
     table("schedule", ["match", "kind", "red", "blue", "plays at", "state", "score"], schedule.matches.map((m) => {
       const result = m.result as { score?: { red: number; blue: number } } | null;

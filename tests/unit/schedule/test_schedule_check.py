@@ -1,0 +1,79 @@
+"""``hlvs check SCHEDULE`` opens everything a match will need and reports every problem at once."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from hlvs.cli import main
+from orchestrator.config.schedule_check import check_schedule
+
+EXAMPLES = Path(__file__).resolve().parents[3] / "configs" / "examples" / "scrimmage_1v1"
+
+
+def _cup(tmp: Path, body: str) -> Path:
+    team = json.loads((EXAMPLES / "team_red.json").read_text())
+    (tmp / "ants.json").write_text(json.dumps(team))
+    for player in team["players"].values():
+        player["dockerTag"] = 5
+    (tmp / "bees.json").write_text(json.dumps(team))
+    path = tmp / "cup.yaml"
+    path.write_text(body)
+    return path
+
+
+BROKEN = """
+name: cup
+simulator_slots: 0
+game_defaults:
+  stepping: lockstp
+  timing: {half_duraton_s: 8}
+teams:
+  - {name: ants, id: 1, config: ants.json}
+  - {name: bees, id: 2, config: bees.json, credentials: nope.json}
+matches:
+  - {id: m1, red: ants, blue: bess, stream_start: "+1h"}
+  - {id: m2, red: ants, blue: bees, stream_start: "+2h", kind: knockout}
+"""
+
+
+def test_every_problem_is_reported_at_once(tmp_path: Path) -> None:
+    path = _cup(tmp_path, BROKEN)
+    found = {(Path(p.file).name, p.pointer): p for p in check_schedule(path)}
+    assert "schema" not in str(found)
+    assert ("cup.yaml", "/simulator_slots") in found  # a schema error ...
+    unknown = found[("cup.yaml", "/matches/0/blue")]  # ... does not hide the cross-checks
+    assert "unknown team 'bess'" in unknown.message and unknown.suggestion == '"bees"'
+    assert "file not found" in found[("cup.yaml", "/teams/1/credentials")].message
+    assert "a string" in found[("bees.json", "/players/1/dockerTag")].expected
+    assert found[("cup.yaml", "/game_defaults/stepping")].suggestion == '"lockstep"'
+    typo = found[("cup.yaml", "/game_defaults/timing/half_duraton_s")]
+    assert typo.suggestion == '"half_duration_s"'
+    assert all(p.severity == "error" for p in found.values())
+
+
+def test_ready_must_fit_in_the_half(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    fixed = (BROKEN.replace("simulator_slots: 0", "simulator_slots: 1")
+             .replace("lockstp", "lockstep").replace("half_duraton_s", "half_duration_s")
+             .replace(", credentials: nope.json", "").replace("bess", "bees"))
+    path = _cup(tmp_path, fixed)
+    (tmp_path / "bees.json").write_text((tmp_path / "ants.json").read_text())
+    problems = check_schedule(path)
+    assert [(p.pointer, p.severity) for p in problems] == [
+        ("/game_defaults/timing/half_duration_s", "error")]
+    assert "READY (45 s) plus SET (5 s) leaves 0 s of play in a half of 8 s" in (
+        problems[0].message)
+    assert main(["check", str(path)]) == 2
+    assert "/game_defaults/timing/half_duration_s" in capsys.readouterr().out
+    path.write_text(fixed.replace("half_duration_s: 8", "half_duration_s: 60"))
+    assert check_schedule(path) == []
+    assert main(["check", str(path)]) == 0
+    assert "ok (schedule)" in capsys.readouterr().out
+
+
+def test_schedule_run_refuses_what_check_refuses(tmp_path: Path) -> None:
+    path = _cup(tmp_path, BROKEN)
+    assert main(["schedule", "run", str(path), "--state", str(tmp_path / "s.sqlite")]) == 2
+    assert not (tmp_path / "s.sqlite").exists()

@@ -1,0 +1,210 @@
+"""What a tournament operator relies on: truthful log states, shoot-outs in knockouts,
+tie-breaks, one folder per attempt, status lines."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from datetime import UTC, datetime
+from pathlib import Path
+
+import pytest
+
+from orchestrator.delivery.store import PendingSet, create_set, remove_set
+from tests.unit.schedule import fake_services
+from tests.unit.schedule.test_schedule import COMPRESSED, FAKE, services_log, write_schedule
+from tournament import Ledger, ScheduledMatchState, run_schedule, standings
+from tournament.overview import status_lines
+from tournament.services import keep_earlier_attempt
+from tournament.state import MatchRow
+
+S = ScheduledMatchState
+
+
+def queue_set(store: Path, match_id: str, team: str) -> PendingSet:
+    """A team's log set waiting in the store (the fake services deliver nothing)."""
+    source = store.parent / f"{match_id}-{team}.log"
+    source.parent.mkdir(parents=True, exist_ok=True)
+    source.write_text("log\n")
+    return create_set(store, match_id=match_id, team=team, kind="team", credentials=None,
+                      sources=[(source, "robot.log")], move=False)
+
+
+@pytest.fixture
+def fake() -> Iterator[None]:
+    yield
+    fake_services.DEAD_TEAMS.clear()
+    fake_services.DRAWN.clear()
+
+
+def test_failed_delivery_is_never_shown_delivered(tmp_path: Path, fake: None) -> None:
+    fake_services.DEAD_TEAMS.add("bravo")
+    path = write_schedule(
+        tmp_path,
+        COMPRESSED.replace("retry_s: 0.2", "retry_s: 0.2, delivery_attempts: 2")
+        + "matches:\n  - {id: m1, red: alpha, blue: bravo, stream_start: '+3.5s',"
+        " stream_length_s: 0.2}\n"
+        "  - {id: m2, red: charlie, blue: delta, stream_start: '+3.8s', stream_length_s: 0.2}\n",
+    )
+    state = tmp_path / "state.sqlite"
+    assert run_schedule(path, state, services=FAKE, exit_when_done=True, poll_s=0.1) == 0
+    ledger = Ledger(state)
+    m1, m2 = ledger.row("m1"), ledger.row("m2")
+    assert m2.state is S.DELIVERED and {e.state for e in m2.logs} == {"delivered"}
+    assert m1.state is S.LOGS_FAILED and m1.state.played
+    logs = {e.team: e for e in m1.logs}
+    assert logs["alpha"].state == "delivered" and logs["alpha"].attempts == 1
+    assert logs["bravo"].state == "failed" and logs["bravo"].attempts == 2
+    assert "unreachable: connection refused" in logs["bravo"].cause
+    history = [(to, note) for _, _, _, to, note in ledger.history("m1")]
+    assert ("LOGS_PENDING", "logs: alpha delivered; bravo retrying "
+            "(unreachable: connection refused)") in history
+    assert not any(to == "DELIVERED" for to, _ in history)
+    assert [w for w, mid, _ in services_log(path) if mid == "m1"][-2:] == ["deliver",
+                                                                           "redeliver"]
+    pending = queue_set(tmp_path / "out" / "log-store", "m1", "bravo")  # as a real one stays
+    lines = "\n".join(status_lines(ledger))
+    assert "m1" in lines and "LOGS_FAILED" in lines and "played" in lines
+    assert "bravo failed after 2 attempts (unreachable: connection refused)" in lines
+    assert "alpha delivered" in lines
+    remove_set(pending)  # delivered by 'hlvs logs deliver' (or pruned): the status says so
+    lines = "\n".join(status_lines(ledger))
+    assert "bravo gone after 2 attempts (no longer in the log store" in lines
+    as_dict = m1.as_dict()
+    assert as_dict["played"] is True and as_dict["logs_delivered"] is False
+
+
+def test_knockout_draw_goes_to_a_shootout_and_the_bracket_advances(
+    tmp_path: Path, fake: None
+) -> None:
+    fake_services.DRAWN.add("ko-r1-1")
+    path = write_schedule(
+        tmp_path,
+        COMPRESSED
+        + "fixtures:\n  knockout: {seeds: [alpha, bravo, charlie, delta], first_stream: '+4s',"
+        " interval_s: 1.0, stream_length_s: 0.3}\n",
+    )
+    state = tmp_path / "state.sqlite"
+    assert run_schedule(path, state, services=FAKE, exit_when_done=True, poll_s=0.1) == 0
+    rows = {r.id: r for r in Ledger(state).rows()}
+    semi = rows["ko-r1-1"].result
+    assert semi is not None and semi["score"] == {"red": 1, "blue": 1}
+    assert semi["winner"] in ("red", "blue") and sorted(semi["shootout"].values()) == [2, 3]
+    assert [w for w, m, _ in services_log(path) if m == "ko-r1-1"][:4] == [
+        "pull", "play-start", "play-end", "shootout"]
+    final = rows["ko-r2-1"]
+    assert final.state is S.DELIVERED
+    assert semi["winner_team"] in (final.red, final.blue)
+    assert "(shoot-out " in "\n".join(status_lines(Ledger(state)))
+
+
+def _row(match_id: str, red: str, blue: str, score: tuple[int, int]) -> MatchRow:
+    now = datetime.now(UTC)
+    return MatchRow(
+        id=match_id, state=S.DELIVERED, kind="round_robin", red=red, blue=blue, pull_at=now,
+        play_at=now, stream_start=now, stream_end=now, deliver_at=now, attempts=1, note="",
+        result={"red_team": red, "blue_team": blue,
+                "score": {"red": score[0], "blue": score[1]}},
+        updated_at=now,
+    )
+
+
+def test_ties_are_broken_head_to_head_then_by_a_documented_rule() -> None:
+    rows = [
+        _row("1", "alpha", "bravo", (0, 1)),  # bravo beat alpha
+        _row("2", "alpha", "charlie", (5, 0)),  # alpha: better goal difference overall
+        _row("3", "bravo", "charlie", (0, 1)),
+        _row("4", "delta", "echo", (1, 1)),
+    ]
+    table = standings(rows, ["alpha", "bravo", "charlie", "delta", "echo"], seed="cup")
+    order = [s.team for s in table]
+    # alpha, bravo and charlie have 3 points each; in their mini-table each won once:
+    # head-to-head goal difference decides (alpha +4, bravo 0, charlie -4)
+    assert order[:3] == ["alpha", "bravo", "charlie"]
+    assert table[0].decided_by == "head-to-head"
+    # delta and echo: level on everything, a drawing of lots fixed by the tournament's name
+    tail = [s for s in table if s.team in ("delta", "echo")]
+    assert tail[0].decided_by == "drawing of lots" and tail[1].decided_by == ""
+    again = standings(rows, ["echo", "delta", "charlie", "bravo", "alpha"], seed="cup")
+    assert [s.team for s in again] == order
+
+
+def test_head_to_head_before_goal_difference() -> None:
+    rows = [
+        _row("1", "alpha", "bravo", (0, 1)),  # bravo beat alpha head-to-head
+        _row("2", "alpha", "charlie", (9, 0)),
+        _row("3", "bravo", "charlie", (0, 0)),
+        _row("4", "charlie", "bravo", (1, 0)),
+        _row("5", "alpha", "charlie", (0, 0)),
+    ]
+    table = standings(rows, ["alpha", "bravo", "charlie"])
+    # charlie 5 points; bravo and alpha 4 each, alpha with the better goal difference (+8, 0)
+    assert [(s.team, s.points) for s in table] == [("charlie", 5), ("bravo", 4), ("alpha", 4)]
+    assert table[1].decided_by == "head-to-head" and table[0].decided_by == ""
+
+
+def test_every_attempt_keeps_its_folder(tmp_path: Path) -> None:
+    out = tmp_path / "match"
+    assert keep_earlier_attempt(out) is None
+    out.mkdir()
+    (out / "report.json").write_text("first")
+    (out / "teams" / "red").mkdir(parents=True)
+    assert keep_earlier_attempt(out) == out / "attempt-1"
+    (out / "report.json").write_text("second")
+    assert keep_earlier_attempt(out) == out / "attempt-2"
+    assert (out / "attempt-1" / "report.json").read_text() == "first"
+    assert (out / "attempt-1" / "teams" / "red").is_dir()
+    assert (out / "attempt-2" / "report.json").read_text() == "second"
+    assert sorted(p.name for p in out.iterdir()) == ["attempt-1", "attempt-2"]
+
+
+def test_overview_and_status_watch(
+    tmp_path: Path, fake: None, monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    from hlvs.cli import main
+    from tournament import init_state
+    from tournament.overview import overview
+
+    path = write_schedule(
+        tmp_path,
+        "fixtures:\n  knockout: {seeds: [alpha, bravo, charlie, delta], first_stream: '+2h'}\n"
+        "matches:\n  - {id: third, kind: knockout, red: {loser_of: ko-r1-1},"
+        " blue: {loser_of: ko-r1-2}, stream_start: '+5h'}\n")
+    state = tmp_path / "state.sqlite"
+    init_state(path, state)
+    ledger = Ledger(state)
+    assert ledger.transition("ko-r1-1", (S.PLANNED,), S.PLAYING)
+    live = {"state": "PLAYING", "half": 1, "secs_remaining": 75, "score": {"red": 1, "blue": 0}}
+    view = overview(ledger, snapshot=lambda folder: live)
+    assert view["name"] == "test cup" and view["warnings"] == []
+    assert view["bracket"] == [["ko-r1-1", "ko-r1-2"], ["third", "ko-r2-1"]]
+    playing = view["matches"][0]
+    assert playing["id"] == "ko-r1-1" and playing["clock_text"] == "1-0 PLAYING 1st half 01:15"
+    assert playing["watch"] == {}  # no telemetry spec in its folder: no live link
+    assert [m["played"] for m in view["matches"]] == [False] * 4
+
+    sleeps: list[float] = []
+
+    def sleep(seconds: float) -> None:
+        sleeps.append(seconds)
+        if len(sleeps) == 2:
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr("time.sleep", sleep)
+    assert main(["schedule", "status", "--state", str(state), "--watch", "--every", "0.5"]) == 0
+    out = capsys.readouterr().out
+    assert sleeps == [0.5, 0.5] and out.count("(every 0.5 s, Ctrl-C to stop)") == 2
+    assert out.count("ko-r1-1      PLAYING") == 2
+
+
+def test_the_referees_shootout_is_read_from_the_public_sim_result(tmp_path: Path) -> None:
+    from tournament.services import shootout_goals
+
+    path = tmp_path / "sim_result.json"
+    assert shootout_goals(path) is None  # no file
+    path.write_text(json.dumps({"score": {"red": 1, "blue": 1}}))
+    assert shootout_goals(path) is None  # no shoot-out
+    path.write_text(json.dumps({"shootout": {"red": {"kicks": 5, "scored": 4},
+                                             "blue": {"kicks": 5, "scored": 3}}}))
+    assert shootout_goals(path) == {"red": 4, "blue": 3}
