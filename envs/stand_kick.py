@@ -14,7 +14,7 @@ Action: the 20 motor position targets (rad).
 Reward per step (metres)::
 
     2.0 x (ball-to-goal-centre distance before - after)   progress of the ball
-  - 3 when the robot falls (torso up axis below 60 deg)    (terminates)
+  - fall_penalty (3) when the robot falls (torso up axis below 60 deg)   (terminates)
 
 The episode terminates when the ball leaves the field (a goal included) and is truncated after
 ``max_episode_s`` of simulated time. ``info`` carries ``kick_distance_m``, ``ball_speed_m_s``
@@ -36,11 +36,12 @@ from envs.frame import BALL_VEL, ROBOT_XY, ROBOT_YAW, Frame
 from envs.session_spec import ResetRequest
 from envs.skill import PROGRESS_WEIGHT, KickEnv
 from envs.spaces import observe
+from robot.learned.policy import KICK_BALL_AHEAD_M, KICK_BALL_RIGHT_M
 from robot.motion import standing_posture
 from simulator.world import MOTOR_NAMES
 
-BALL_AHEAD_M = 0.195  # in front of the torso: 2 to 6 cm in front of the right toe
-BALL_RIGHT_M = 0.075  # the stub striker lines it up there (robot.stub.behaviour)
+BALL_AHEAD_M = KICK_BALL_AHEAD_M  # the stub striker lines the ball up there for the policy
+BALL_RIGHT_M = KICK_BALL_RIGHT_M
 STAND_FALL_PENALTY = 3.0
 TIME_LIMIT_S = 1e4
 
@@ -55,6 +56,7 @@ class StandKickEnv(KickEnv):
         settle_s: float = 0.5,
         ball_noise_m: float = 0.02,
         heading_noise_rad: float = 0.15,
+        fall_penalty: float = STAND_FALL_PENALTY,
         remotes: int | str | None = None,
         render_mode: str | None = None,
         session: Session | None = None,
@@ -75,6 +77,7 @@ class StandKickEnv(KickEnv):
              "time": spaces.Box(0.0, TIME_LIMIT_S, (1,), np.float32)}
         )  # fmt: skip
         self.ball_noise_m = ball_noise_m
+        self.fall_penalty = float(fall_penalty)
         self.settle_steps = math.ceil(settle_s * 1000 / (8 * steps_per_action))
         stance = standing_posture(model)
         self.stance = np.array([stance.get(name, 0.0) for name in MOTOR_NAMES])
@@ -133,7 +136,7 @@ class StandKickEnv(KickEnv):
         reward = PROGRESS_WEIGHT * (bg0 - bg1)
         goal, fallen, out = self.outcome(frame)
         if fallen:
-            reward -= STAND_FALL_PENALTY
+            reward -= self.fall_penalty
         self._max_speed = max(self._max_speed, _speed(frame))
         terminated = goal or fallen or out
         truncated = not terminated and self._steps >= self.max_steps

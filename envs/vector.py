@@ -34,11 +34,15 @@ def make_vector(
     **kwargs: Any,
 ) -> VectorEnv:
     """One environment per remote; with ``remotes=None``, ``num_envs`` in-process environments
-    stepped one after the other (Gymnasium's ``SyncVectorEnv``)."""
+    stepped one after the other (Gymnasium's ``SyncVectorEnv``, resetting in the same step as
+    the remote one does)."""
     if remotes is None:
         from gymnasium.vector import SyncVectorEnv
 
-        return SyncVectorEnv([lambda: gym.make(env_id, **kwargs) for _ in range(num_envs)])
+        return SyncVectorEnv(
+            [lambda: gym.make(env_id, **kwargs) for _ in range(num_envs)],
+            autoreset_mode=AutoresetMode.SAME_STEP,
+        )
     pool = RemotePool.open(remotes, image=image)
     try:
         spec_env = gym.make(env_id, session=_NullSession(), **kwargs).unwrapped
