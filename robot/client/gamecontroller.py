@@ -131,7 +131,9 @@ def _team(team: wire.TeamInfo) -> TeamInfo:
     )
 
 
-def encode_reply(*, team: int, player: int, message: ReturnMessage = ReturnMessage.ALIVE) -> bytes:
+def encode_reply(
+    *, team: int, player: int, message: ReturnMessage = ReturnMessage.ALIVE
+) -> bytes:
     """An ``RGrt`` version 2 packet (8 bytes)."""
     return wire.encode_return(ReturnData(team=team, player=player, message=message))
 

@@ -20,7 +20,6 @@ logger = logging.getLogger(__name__)
 ALIVE_PERIOD_S = 1.0
 COLOUR_BY_TEAM = {"blue": 0, "red": 1}
 
-
 class GameControllerLink:
     """Runs in its own thread until :meth:`close`; :meth:`info` is safe from any thread."""
 
