@@ -215,10 +215,8 @@ class StubController:
         a team on the right is placed at the mirror image of its team-file poses."""
         self._side_check_s = None
         self.mirrored = not on_left
-        logger.info(
-            "side from the GameController: %s",
-            "right (mirrored pitch)" if self.mirrored else "left (as in the team file)",
-        )
+        logger.info("side from the GameController: %s", "right (mirrored pitch)" if self.mirrored
+                    else "left (as in the team file)")
         if self.mirrored:
             pose = self.world.pose
             self.world.reset_pose(Pose2D(pose.x_m, -pose.y_m, -pose.yaw_rad))
