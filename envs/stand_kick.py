@@ -51,7 +51,7 @@ class StandKickEnv(KickEnv):
         self,
         *,
         model: str = "kid-default",
-        steps_per_action: int = 2,
+        steps_per_action: int = 4,
         max_episode_s: float = 1.5,
         settle_s: float = 0.5,
         ball_noise_m: float = 0.02,

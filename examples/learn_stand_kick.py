@@ -258,7 +258,8 @@ def evaluate(
     """Seeded episodes of the policy run by the robot's own code (``PolicyMotion``, fed the
     readings as a robot gets them), or of random actions in [-1, 1] when ``policy`` is None."""
     template = policy or policy_template()
-    env = gym.make(ENV_ID, fall_penalty=fall_penalty, ball_noise_m=ball_noise)
+    env = gym.make(ENV_ID, steps_per_action=STEPS_PER_ACTION, max_episode_s=EPISODE_S,
+                   fall_penalty=fall_penalty, ball_noise_m=ball_noise)  # fmt: skip
     rng = np.random.default_rng(seed)
     rows = []
     for episode in range(episodes):
