@@ -324,10 +324,10 @@ def main(argv: list[str]) -> int:
     parser.add_argument(
         "--env-steps",
         type=int,
-        default=1_200_000,
+        default=250_000,
         help="environment steps to train for (all environments together)",
     )
-    parser.add_argument("--envs", type=int, default=32, help="environments in the vector")
+    parser.add_argument("--envs", type=int, default=16, help="environments in the vector")
     parser.add_argument(
         "--remotes",
         type=int,
@@ -336,7 +336,7 @@ def main(argv: list[str]) -> int:
     )
     parser.add_argument("--rollouts", type=int, default=32, help="steps per environment per update")
     parser.add_argument("--learning-rate", type=float, default=3e-4)
-    parser.add_argument("--init-log-std", type=float, default=-1.0, help="initial exploration")
+    parser.add_argument("--init-log-std", type=float, default=-2.3, help="initial exploration")
     parser.add_argument("--fall-penalty", type=float, default=1.0, help="reward lost by a fall")
     parser.add_argument("--ball-noise", type=float, default=0.01, help="ball placement noise (m)")
     parser.add_argument(
