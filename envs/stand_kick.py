@@ -125,7 +125,7 @@ class StandKickEnv(KickEnv):
         return self._observe(frame), reward, terminated, truncated, info
 
     def _observe(self, frame: Frame) -> dict[str, Any]:
-        obs = observe(frame, self.observation_space)
+        obs = observe(frame, self.observation_space)  # type: ignore[arg-type]
         obs["time"] = np.array([(frame.sim_time_ms - self._start_ms) / 1000.0], np.float32)
         return obs
 
