@@ -152,8 +152,9 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--seed", type=int, default=1, help="episode and action seed")
     parser.add_argument("--num-envs", type=int, default=4,
                         help="environments of the in-process vector environment")
-    parser.add_argument("--steps-per-action", type=int, default=1,
-                        help="8 ms world steps per environment step of the vector environment")
+    parser.add_argument("--steps-per-action", type=int, default=4,
+                        help="8 ms world steps per environment step of the vector environment "
+                        "(default 4: the 32 ms of examples/learn_stand_kick.py)")
     parser.add_argument("--remotes", type=int, default=0, help="also measure N remotes (Docker)")
     parser.add_argument("--vector", default="1,2,4", help="vector sizes over remotes")
     parser.add_argument("--remote-steps", type=int, default=1000, help="steps per remote run")

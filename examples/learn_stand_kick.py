@@ -77,14 +77,30 @@ def policy_template() -> Policy:
     )  # fmt: skip
 
 
+class FallPenalty:
+    """The fall penalty over training: ``start`` until 40 % of the steps, then rising linearly
+    to ``end`` at 80 % (first learn to touch the ball at all, then to stay up while kicking)."""
+
+    def __init__(self, start: float, end: float, total_steps: int) -> None:
+        self.start, self.end, self.total = start, end, max(1, total_steps)
+
+    def at(self, steps: int) -> float:
+        done = min(max((steps / self.total - 0.4) / 0.4, 0.0), 1.0)
+        return self.start + (self.end - self.start) * done
+
+
 class PolicyInputs(gym.vector.VectorWrapper):
     """The vector environment as the learner sees it: flat scaled observations, actions in
-    [-1, 1] mapped to targets around the stance; logs every finished episode."""
+    [-1, 1] mapped to targets around the stance; logs every finished episode and sets the fall
+    penalty of the moment."""
 
-    def __init__(self, env: gym.vector.VectorEnv, template: Policy, log: EpisodeLog) -> None:
+    def __init__(
+        self, env: gym.vector.VectorEnv, template: Policy, log: EpisodeLog, penalty: FallPenalty
+    ) -> None:
         super().__init__(env)
         self.template = template
         self.log = log
+        self.penalty = penalty
         n = len(OBS_SCALE)
         self.single_observation_space = gym.spaces.Box(-np.inf, np.inf, (n,), np.float32)
         self.observation_space = gym.vector.utils.batch_space(
@@ -104,6 +120,10 @@ class PolicyInputs(gym.vector.VectorWrapper):
 
     def step(self, actions: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
         targets = self.template.targets(np.asarray(actions, np.float64)).astype(np.float32)
+        penalty = self.penalty.at(self.log.steps)
+        for env in self.env.unwrapped.envs:  # type: ignore[attr-defined]
+            env.fall_penalty = penalty
+        self.log.fall_penalty = penalty
         obs, rewards, terminated, truncated, infos = self.env.step(targets)
         self._returns += rewards
         ended = np.logical_or(terminated, truncated)
@@ -130,8 +150,9 @@ class EpisodeLog:
         self.file = (out / "episodes.csv").open("w", newline="")
         self.csv = csv.writer(self.file)
         self.csv.writerow(["env_steps", "episode", "return", "kick_distance_m",
-                           "max_ball_speed_m_s", "fallen", "wall_s"])  # fmt: skip
+                           "max_ball_speed_m_s", "fallen", "fall_penalty", "wall_s"])  # fmt: skip
         self.steps = 0
+        self.fall_penalty = 0.0
         self.episodes = 0
         self.recent: deque[tuple[float, float, float, bool]] = deque(maxlen=200)
         self.started = time.perf_counter()
@@ -143,7 +164,8 @@ class EpisodeLog:
         self.episodes += 1
         wall = time.perf_counter() - self.started
         self.csv.writerow([self.steps, self.episodes, round(ret, 4), round(kick, 4),
-                           round(speed, 3), int(fallen), round(wall, 1)])  # fmt: skip
+                           round(speed, 3), int(fallen), round(self.fall_penalty, 3),
+                           round(wall, 1)])  # fmt: skip
         self.recent.append((ret, kick, speed, fallen))
         if time.perf_counter() - self._last_print >= self.every_s:
             self.progress()
@@ -299,17 +321,31 @@ def plot(out: Path, random_return: float, learned_return: float) -> Path:
     steps = np.array([float(r["env_steps"]) for r in rows])
     returns = np.array([float(r["return"]) for r in rows])
     window = max(1, min(200, len(returns) // 10))
-    smooth = np.convolve(returns, np.ones(window) / window, mode="valid")
-    fig, ax = plt.subplots(figsize=(7, 4), dpi=110)
+
+    def mean(values: np.ndarray) -> np.ndarray:
+        return np.convolve(values, np.ones(window) / window, mode="valid")
+
+    smooth = mean(returns)
+    fig, (ax, bx) = plt.subplots(2, 1, figsize=(7, 6.5), dpi=110, sharex=True)
     ax.plot(steps, returns, ".", ms=1.5, alpha=0.25, color="tab:blue", label="episode return")
     ax.plot(steps[window - 1 :], smooth, color="tab:blue", label=f"mean of {window} episodes")
     ax.axhline(random_return, color="tab:red", ls="--", label="random policy")
     ax.axhline(learned_return, color="tab:green", ls=":", label="learned policy (robot runner)")
-    ax.set_xlabel(f"environment steps ({8 * STEPS_PER_ACTION} ms each)")
-    ax.set_ylabel("return (2 x ball progress to goal in m, - fall)")
+    ax.set_ylabel("return (2 x ball progress in m\n- fall penalty then in force)")
     ax.set_title("hlvs/StandKick-v0, PPO (skrl, JAX CPU)")
     ax.legend(loc="lower right", fontsize=8)
     ax.grid(alpha=0.3)
+    column = {name: np.array([float(r[name]) for r in rows]) for name in rows[0]}
+    x = steps[window - 1 :]
+    bx.plot(x, mean(column["kick_distance_m"]), color="tab:blue", label="kick distance (m)")
+    bx.plot(x, mean(column["max_ball_speed_m_s"] >= 1.0), color="tab:orange",
+            label="share with ball >= 1 m/s")  # fmt: skip
+    bx.plot(x, mean(column["fallen"]), color="tab:red", label="share fallen")
+    bx.plot(steps, column["fall_penalty"], color="gray", ls=":", label="fall penalty")
+    bx.set_xlabel(f"environment steps ({8 * STEPS_PER_ACTION} ms each)")
+    bx.set_ylabel(f"mean of {window} episodes")
+    bx.legend(loc="upper left", fontsize=8)
+    bx.grid(alpha=0.3)
     fig.tight_layout()
     path = out / "learning_curve.png"
     fig.savefig(path)
@@ -337,7 +373,10 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--rollouts", type=int, default=32, help="steps per environment per update")
     parser.add_argument("--learning-rate", type=float, default=3e-4)
     parser.add_argument("--init-log-std", type=float, default=-2.3, help="initial exploration")
-    parser.add_argument("--fall-penalty", type=float, default=1.0, help="reward lost by a fall")
+    parser.add_argument("--fall-penalty", type=float, default=1.0,
+                        help="reward lost by a fall, until 40 %% of the steps")  # fmt: skip
+    parser.add_argument("--fall-penalty-end", type=float, default=None,
+                        help="... rising to this at 80 %% (default: --fall-penalty)")  # fmt: skip
     parser.add_argument("--ball-noise", type=float, default=0.01, help="ball placement noise (m)")
     parser.add_argument(
         "--progress-s", type=float, default=30.0, help="seconds between progress lines"
@@ -365,7 +404,9 @@ def main(argv: list[str]) -> int:
         every_s=args.progress_s,
         export=lambda: export_policy(holder["agent"], template, out / "policy.npz"),
     )
-    env = wrap_env(PolicyInputs(vec, template, log), wrapper="gymnasium")
+    end = args.fall_penalty if args.fall_penalty_end is None else args.fall_penalty_end
+    penalty = FallPenalty(args.fall_penalty, end, args.timesteps * num_envs)
+    env = wrap_env(PolicyInputs(vec, template, log, penalty), wrapper="gymnasium")
     agent = build_agent(env, args, out)
     holder["agent"] = agent
     print(f"training {ENV_ID}: {args.timesteps * num_envs} environment steps over {num_envs} "
@@ -384,13 +425,14 @@ def main(argv: list[str]) -> int:
     policy = load_policy(out / "policy.npz")  # what the robot would load
     eval_seed = 10_000 + args.seed
     same = {"episodes": args.eval_episodes, "seed": eval_seed,
-            "fall_penalty": args.fall_penalty, "ball_noise": args.ball_noise}  # fmt: skip
+            "fall_penalty": end, "ball_noise": args.ball_noise}  # fmt: skip
     learned = evaluate(policy, **same)  # type: ignore[arg-type]
     baseline = evaluate(None, **same)  # type: ignore[arg-type]
     png = plot(out, baseline["mean_return"], learned["mean_return"])
     summary = {
         "example": "learn_stand_kick", "env": ENV_ID, "seed": args.seed,
-        "env_steps": log.steps, "episodes": log.episodes, "train_wall_s": round(train_s, 1),
+        "env_steps": log.steps, "episodes": log.episodes, "fall_penalty": [args.fall_penalty, end],
+        "train_wall_s": round(train_s, 1),
         "steps_per_s": round(log.steps / train_s, 1), "learned": learned, "random": baseline,
         "policy": str(out / "policy.npz"), "plot": str(png),
         "wall_s": round(time.perf_counter() - started, 1),
