@@ -341,7 +341,8 @@ def plot(out: Path, random_return: float, learned_return: float) -> Path:
     bx.plot(x, mean(column["max_ball_speed_m_s"] >= 1.0), color="tab:orange",
             label="share with ball >= 1 m/s")  # fmt: skip
     bx.plot(x, mean(column["fallen"]), color="tab:red", label="share fallen")
-    bx.plot(steps, column["fall_penalty"], color="gray", ls=":", label="fall penalty")
+    if "fall_penalty" in column:
+        bx.plot(steps, column["fall_penalty"], color="gray", ls=":", label="fall penalty")
     bx.set_xlabel(f"environment steps ({8 * STEPS_PER_ACTION} ms each)")
     bx.set_ylabel(f"mean of {window} episodes")
     bx.legend(loc="upper left", fontsize=8)
