@@ -74,10 +74,10 @@ __all__ = [
     "RemoteCrashed",
     "RemoteError",
     "RemoteStartFailed",
-    "StandKickEnv",
     "ResetRequest",
     "Session",
     "SessionSpec",
+    "StandKickEnv",
     "StubSpec",
     "TrainerError",
 ]
