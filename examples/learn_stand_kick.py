@@ -7,13 +7,18 @@ robot API reports: joint angles, accelerometer, gyro and the time since the skil
 ball or robot position). It writes to ``--out``:
 
 - ``episodes.csv``: one row per finished episode (environment steps so far, return, kick
-  distance, fastest ball speed, fallen), and progress lines on the terminal;
+  distance, fastest ball speed, fallen, the fall penalty then), and progress lines on the
+  terminal;
 - ``skrl/``: skrl's TensorBoard event files and checkpoints;
 - ``policy.npz``: the policy's weights for the robot (:mod:`robot.learned`; numpy only), written
   at every progress line and at the end;
 - ``learning_curve.png``: the mean return per episode over training, against a random policy;
 - ``summary.json``: the evaluation of the learned policy (the ``policy.npz`` run by the robot's
   own code, deterministic) and of a random policy on the same seeded episodes.
+
+The reward is 2 x the ball's progress towards the goal (m); a fall costs 1 until 40 % of the
+steps, then more, up to 3 from 80 % on (``--fall-penalty``, ``--fall-penalty-end``): first
+reach the ball at all, then kick without falling.
 
     python examples/learn_stand_kick.py --seed 1 --out runs/stand_kick
 """
@@ -376,8 +381,8 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--init-log-std", type=float, default=-2.3, help="initial exploration")
     parser.add_argument("--fall-penalty", type=float, default=1.0,
                         help="reward lost by a fall, until 40 %% of the steps")  # fmt: skip
-    parser.add_argument("--fall-penalty-end", type=float, default=None,
-                        help="... rising to this at 80 %% (default: --fall-penalty)")  # fmt: skip
+    parser.add_argument("--fall-penalty-end", type=float, default=3.0,
+                        help="... rising to this at 80 %% (default 3)")  # fmt: skip
     parser.add_argument("--ball-noise", type=float, default=0.01, help="ball placement noise (m)")
     parser.add_argument(
         "--progress-s", type=float, default=30.0, help="seconds between progress lines"
@@ -405,7 +410,7 @@ def main(argv: list[str]) -> int:
         every_s=args.progress_s,
         export=lambda: export_policy(holder["agent"], template, out / "policy.npz"),
     )
-    end = args.fall_penalty if args.fall_penalty_end is None else args.fall_penalty_end
+    end = args.fall_penalty_end
     penalty = FallPenalty(args.fall_penalty, end, args.timesteps * num_envs)
     env = wrap_env(PolicyInputs(vec, template, log, penalty), wrapper="gymnasium")
     agent = build_agent(env, args, out)

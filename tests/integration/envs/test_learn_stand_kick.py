@@ -44,7 +44,9 @@ def test_training_writes_logs_checkpoints_policy_and_plot(
         rows = list(csv.DictReader(f))
     assert rows and int(rows[-1]["env_steps"]) <= 3000
     assert [int(r["episode"]) for r in rows] == list(range(1, len(rows) + 1))
-    assert all(float(r["return"]) >= -1.0 - 1e-6 for r in rows)  # a fall costs 1, no more
+    penalties = [float(r["fall_penalty"]) for r in rows]  # 1, rising to 3 at 80 % of the steps
+    assert penalties[0] == 1.0 and max(penalties) == 3.0 and penalties == sorted(penalties)
+    assert all(float(r["return"]) >= -3.0 - 1e-6 for r in rows)  # a fall costs 3 at most
     runs = out / "skrl" / "ppo"
     assert list(runs.glob("events.out.tfevents.*")), "no TensorBoard events"
     assert list((runs / "checkpoints").glob("*.pickle")), "no skrl checkpoints"
