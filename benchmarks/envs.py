@@ -15,7 +15,8 @@ target of the vector environment (>= 0.8).
 
 With ``--remotes N`` (needs Docker and the simulator image), it also measures one remote over
 TCP and a vector environment over 1, 2, ... N remotes (``--vector 1,2,4``, each size
-``--repeats`` times, interleaved), with the client's and the remotes' CPU time per step.
+``--repeats`` times, interleaved), with the client's and the remotes' CPU time per step, at the
+same ``--steps-per-action``.
 """
 
 from __future__ import annotations
@@ -177,6 +178,7 @@ def main(argv: list[str]) -> int:
 
         sizes = [int(v) for v in args.vector.split(",") if v.strip()]
         out.update(bench_remotes(remotes=args.remotes, sizes=sizes, steps=args.remote_steps,
-                                 seed=args.seed, repeats=args.repeats))  # fmt: skip
+                                 seed=args.seed, repeats=args.repeats,
+                                 steps_per_action=args.steps_per_action))  # fmt: skip
     print(json.dumps(out))
     return 0

@@ -72,6 +72,7 @@ def policy_template() -> Policy:
     """The mapping of actions to motor targets, without weights (filled in by export)."""
     env = gym.make(ENV_ID).unwrapped
     space = env.action_space
+    assert isinstance(space, gym.spaces.Box)
     stance = np.asarray(env.stance, np.float64)  # type: ignore[attr-defined]
     env.close()
     return Policy(
@@ -116,7 +117,8 @@ class PolicyInputs(gym.vector.VectorWrapper):
         self._returns = np.zeros(self.num_envs)
 
     def _scaled(self, obs: dict[str, Any]) -> np.ndarray:
-        return (flat_observation(obs) * OBS_SCALE).astype(np.float32)
+        scaled: np.ndarray = (flat_observation(obs) * OBS_SCALE).astype(np.float32)
+        return scaled
 
     def reset(self, **kwargs: Any) -> tuple[Any, dict[str, Any]]:
         obs, info = self.env.reset(**kwargs)
@@ -134,7 +136,7 @@ class PolicyInputs(gym.vector.VectorWrapper):
         ended = np.logical_or(terminated, truncated)
         if ended.any():
             final = infos.get("final_info", {})
-            for i in np.flatnonzero(ended):
+            for i in np.flatnonzero(ended).tolist():
                 self.log.episode(float(self._returns[i]), _item(final, "kick_distance_m", i),
                                  _item(final, "max_ball_speed_m_s", i),
                                  bool(_item(final, "fallen", i)))  # fmt: skip
@@ -207,7 +209,7 @@ def build_agent(env: Any, args: argparse.Namespace, out: Path) -> Any:
             GaussianMixin.__init__(self, clip_actions=False, clip_log_std=True,
                                    min_log_std=-5.0, max_log_std=1.0)  # fmt: skip
 
-        @nn.compact  # type: ignore[misc]
+        @nn.compact
         def __call__(self, inputs: dict[str, Any], role: str) -> Any:
             x = inputs["observations"]
             for width in HIDDEN:
@@ -225,7 +227,7 @@ def build_agent(env: Any, args: argparse.Namespace, out: Path) -> Any:
                            action_space=action_space, device=device, **kwargs)  # fmt: skip
             DeterministicMixin.__init__(self)
 
-        @nn.compact  # type: ignore[misc]
+        @nn.compact
         def __call__(self, inputs: dict[str, Any], role: str) -> Any:
             x = inputs["observations"]
             for width in (128, 128):
@@ -233,7 +235,7 @@ def build_agent(env: Any, args: argparse.Namespace, out: Path) -> Any:
             return nn.Dense(1)(x), {}
 
     device = env.device
-    models = {
+    models: dict[str, Any] = {
         "policy": PolicyNet(env.observation_space, None, env.action_space, device),
         "value": ValueNet(env.observation_space, None, env.action_space, device),
     }
@@ -430,10 +432,10 @@ def main(argv: list[str]) -> int:
     train_s = time.perf_counter() - started
     policy = load_policy(out / "policy.npz")  # what the robot would load
     eval_seed = 10_000 + args.seed
-    same = {"episodes": args.eval_episodes, "seed": eval_seed,
-            "fall_penalty": end, "ball_noise": args.ball_noise}  # fmt: skip
-    learned = evaluate(policy, **same)  # type: ignore[arg-type]
-    baseline = evaluate(None, **same)  # type: ignore[arg-type]
+    same: dict[str, Any] = {"episodes": args.eval_episodes, "seed": eval_seed,
+                            "fall_penalty": end, "ball_noise": args.ball_noise}  # fmt: skip
+    learned = evaluate(policy, **same)
+    baseline = evaluate(None, **same)
     png = plot(out, baseline["mean_return"], learned["mean_return"])
     summary = {
         "example": "learn_stand_kick", "env": ENV_ID, "seed": args.seed,
