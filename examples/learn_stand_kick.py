@@ -2,9 +2,10 @@
 
 PPO is skrl's (JAX on the CPU; ``pip install '.[learn]'``), over the project's vectorised
 environment (``envs.vector.make_vector``: in this process, or ``--remotes N`` simulator
-containers). The policy drives the robot's 20 motors around the walking stance from what the
-robot API reports: joint angles, accelerometer, gyro and the time since the skill started (no
-ball or robot position). It writes to ``--out``:
+containers). The policy moves the robot's 12 leg motors around the walking stance (arms and
+head stay), one decision per 32 ms, from what the robot API reports: joint angles,
+accelerometer, gyro and the time since the skill started (no ball or robot position). It writes
+to ``--out``:
 
 - ``episodes.csv``: one row per finished episode (environment steps so far, return, kick
   distance, fastest ball speed, fallen, the fall penalty then), and progress lines on the
@@ -12,7 +13,8 @@ ball or robot position). It writes to ``--out``:
 - ``skrl/``: skrl's TensorBoard event files and checkpoints;
 - ``policy.npz``: the policy's weights for the robot (:mod:`robot.learned`; numpy only), written
   at every progress line and at the end;
-- ``learning_curve.png``: the mean return per episode over training, against a random policy;
+- ``learning_curve.png``: the return per episode over training against a random policy, and
+  the kick distance, the share of fast balls (>= 1 m/s) and of falls;
 - ``summary.json``: the evaluation of the learned policy (the ``policy.npz`` run by the robot's
   own code, deterministic) and of a random policy on the same seeded episodes.
 
