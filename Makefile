@@ -28,7 +28,7 @@ $(VENV)/.installed: pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	@$(PY) -m pip install --upgrade pip > $(BUILD)/logs/pip.log 2>&1 || \
 	  { tail -n 40 $(BUILD)/logs/pip.log; exit 1; }
-	@$(PY) -m pip install -e '.[dev]' >> $(BUILD)/logs/pip.log 2>&1 || \
+	@$(PY) -m pip install -e '.[dev,learn]' >> $(BUILD)/logs/pip.log 2>&1 || \
 	  { tail -n 40 $(BUILD)/logs/pip.log; exit 1; }
 	touch $@
 

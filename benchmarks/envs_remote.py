@@ -60,13 +60,16 @@ def _run(env: Any, batch: Any, containers: list[str], env_steps: int) -> dict[st
     return out
 
 
-def _env_run(address: str, container: list[str], steps: int, seed: int) -> dict[str, Any]:
+def _env_run(
+    address: str, container: list[str], steps: int, seed: int, steps_per_action: int
+) -> dict[str, Any]:
     import gymnasium as gym
 
     import envs  # noqa: F401  (registers the ids)
     from benchmarks.envs import _actions
 
-    env = gym.make("hlvs/Kick-v0", remotes=address, max_episode_s=1e6)
+    env = gym.make("hlvs/Kick-v0", remotes=address, max_episode_s=1e6,
+                   steps_per_action=steps_per_action)  # fmt: skip
     try:
         env.reset(seed=seed)
         return _run(env, _actions(steps, seed), container, steps)
@@ -75,7 +78,7 @@ def _env_run(address: str, container: list[str], steps: int, seed: int) -> dict[
 
 
 def _vector_run(
-    addresses: list[str], containers: list[str], steps: int, seed: int
+    addresses: list[str], containers: list[str], steps: int, seed: int, steps_per_action: int
 ) -> dict[str, Any]:
     import numpy as np
 
@@ -83,7 +86,8 @@ def _vector_run(
     from envs.vector import make_vector
 
     size = len(addresses)
-    vec = make_vector("hlvs/Kick-v0", remotes=",".join(addresses), max_episode_s=1e6)
+    vec = make_vector("hlvs/Kick-v0", remotes=",".join(addresses), max_episode_s=1e6,
+                      steps_per_action=steps_per_action)  # fmt: skip
     try:
         vec.reset(seed=seed)
         batch = np.repeat(_actions(steps, seed)[:, None, :], size, axis=1)
@@ -107,7 +111,8 @@ def _summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
 
 
 def bench_remotes(
-    *, remotes: int, sizes: list[int], steps: int, seed: int, repeats: int = 1
+    *, remotes: int, sizes: list[int], steps: int, seed: int, repeats: int = 1,
+    steps_per_action: int = 1,
 ) -> dict[str, Any]:
     from envs.docker_pool import DockerLauncher
     from envs.remote import RemotePool
@@ -121,17 +126,20 @@ def bench_remotes(
     containers = list(pool.launcher.containers)
     try:
         urls = [str(a) for a in pool.addresses]
-        one = _env_run(urls[0], containers[:1], steps, seed)
+        one = _env_run(urls[0], containers[:1], steps, seed, steps_per_action)
         runs: dict[int, list[dict[str, Any]]] = {k: [] for k in sizes}
         for _ in range(repeats):
             for k in sizes:
-                runs[k].append(_vector_run(urls[:k], containers[:k], steps, seed))
+                runs[k].append(
+                    _vector_run(urls[:k], containers[:k], steps, seed, steps_per_action)
+                )
     finally:
         pool.close()
     vector = {str(k): _summary(v) for k, v in runs.items()}
     rates = {k: v["env_steps_per_s"] for k, v in vector.items()}
     out: dict[str, Any] = {
         "remote_tcp": {**one, "steps": steps},
+        "steps_per_action": steps_per_action,
         "vector_env_steps_per_s": rates,
         "vector": vector,
         "vector_repeats": repeats,

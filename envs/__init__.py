@@ -3,7 +3,7 @@
 Use::
 
     import gymnasium as gym
-    import envs  # registers hlvs/Kick-v0 and hlvs/Match-v0
+    import envs  # registers hlvs/Kick-v0, hlvs/StandKick-v0 and hlvs/Match-v0
 
     env = gym.make("hlvs/Kick-v0", perception=True)            # world in this process
     env = gym.make("hlvs/Kick-v0", remotes=1)                   # one simulator container
@@ -42,8 +42,9 @@ from envs.match import MatchEnv
 from envs.session import LocalSession
 from envs.session_spec import ResetRequest, SessionSpec, StubSpec
 from envs.skill import KickEnv
+from envs.stand_kick import StandKickEnv
 
-ENV_IDS = ("hlvs/Kick-v0", "hlvs/Match-v0")
+ENV_IDS = ("hlvs/Kick-v0", "hlvs/StandKick-v0", "hlvs/Match-v0")
 
 
 def register_envs() -> None:
@@ -51,6 +52,8 @@ def register_envs() -> None:
     registry = gymnasium.envs.registration.registry
     if "hlvs/Kick-v0" not in registry:
         gymnasium.register(id="hlvs/Kick-v0", entry_point="envs.skill:KickEnv")
+    if "hlvs/StandKick-v0" not in registry:
+        gymnasium.register(id="hlvs/StandKick-v0", entry_point="envs.stand_kick:StandKickEnv")
     if "hlvs/Match-v0" not in registry:
         gymnasium.register(id="hlvs/Match-v0", entry_point="envs.match:MatchEnv")
 
@@ -74,6 +77,7 @@ __all__ = [
     "ResetRequest",
     "Session",
     "SessionSpec",
+    "StandKickEnv",
     "StubSpec",
     "TrainerError",
 ]

@@ -1,13 +1,13 @@
 """A vector environment spread over remote simulators: one environment per remote.
 
 ``make_vector("hlvs/Kick-v0", remotes=4)`` starts four simulator containers (or takes
-``remotes="hlvs://a:7700,b:7700"``; ``remotes=None, num_envs=n`` keeps them in this process).
-A step sends every remote its action first and then collects the answers, so the remotes step
-at the same time. Environments that end are reset in the same step (Gymnasium's ``SAME_STEP``
-autoreset: ``infos["final_obs"]`` and ``infos["final_info"]`` hold what ended). Environment
-``i`` is seeded with ``seed + i``. A remote that dies raises :class:`envs.RemoteCrashed` from
-``step()``; the next ``reset()`` replaces it when the pool started it (``remotes=N`` or
-``remotes="slurm:N"``).
+``remotes="hlvs://a:7700,b:7700"``; ``remotes=None, num_envs=n`` keeps them in this process,
+stepped one after the other). A step sends every remote its action first and then collects the
+answers, so the remotes step at the same time. Environments that end are reset in the same
+step (Gymnasium's ``SAME_STEP`` autoreset: ``infos["final_obs"]`` and ``infos["final_info"]``
+hold what ended). Environment ``i`` is seeded with ``seed + i``. A remote that dies raises
+:class:`envs.RemoteCrashed` from ``step()``; the next ``reset()`` replaces it when the pool
+started it (``remotes=N`` or ``remotes="slurm:N"``).
 """
 
 from __future__ import annotations
@@ -34,11 +34,15 @@ def make_vector(
     **kwargs: Any,
 ) -> VectorEnv:
     """One environment per remote; with ``remotes=None``, ``num_envs`` in-process environments
-    stepped one after the other (Gymnasium's ``SyncVectorEnv``)."""
+    stepped one after the other (batched as over remotes, without Gymnasium's per-step
+    wrappers: the environments check their actions and time limits themselves)."""
     if remotes is None:
-        from gymnasium.vector import SyncVectorEnv
-
-        return SyncVectorEnv([lambda: gym.make(env_id, **kwargs) for _ in range(num_envs)])
+        local = []
+        for _ in range(num_envs):
+            env = gym.make(env_id, **kwargs).unwrapped
+            assert isinstance(env, HlvsEnv)
+            local.append(env)
+        return RemoteVectorEnv(local, None)
     pool = RemotePool.open(remotes, image=image)
     try:
         spec_env = gym.make(env_id, session=_NullSession(), **kwargs).unwrapped
@@ -64,9 +68,11 @@ class _NullSession:
 
 
 class RemoteVectorEnv(VectorEnv):
+    """Environments on remotes of ``pool``, or in this process when ``pool`` is None."""
+
     metadata: dict[str, Any] = {"autoreset_mode": AutoresetMode.SAME_STEP}
 
-    def __init__(self, envs: list[HlvsEnv], pool: RemotePool) -> None:
+    def __init__(self, envs: list[HlvsEnv], pool: RemotePool | None) -> None:
         self.envs = envs
         self.pool = pool
         self.num_envs = len(envs)
@@ -130,6 +136,8 @@ class RemoteVectorEnv(VectorEnv):
 
     def step(self, actions: Any) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         batch = np.asarray(actions)
+        if self.pool is None:
+            return self._step_local(batch)
         for i, env in enumerate(self.envs):
             session = env.session
             assert isinstance(session, RemoteSession)
@@ -143,16 +151,45 @@ class RemoteVectorEnv(VectorEnv):
             session = env.session
             assert isinstance(session, RemoteSession)
             obs, reward, term, trunc, info = env.finish_step(session.receive_step())
-            if term or trunc:
-                final = {"final_obs": obs, "final_info": info}
-                obs, info = env.reset()
-                info = {**info, **final}
             observations.append(obs)
             rewards[i], terminated[i], truncated[i] = reward, term, trunc
             infos.append(info)
+        return self._finish(observations, rewards, terminated, truncated, infos)
+
+    def _step_local(
+        self, batch: np.ndarray
+    ) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        observations = []
+        rewards = np.zeros(self.num_envs)
+        terminated = np.zeros(self.num_envs, dtype=bool)
+        truncated = np.zeros(self.num_envs, dtype=bool)
+        infos: list[dict[str, Any]] = []
+        for i, env in enumerate(self.envs):
+            obs, reward, term, trunc, info = env.step(batch[i])
+            observations.append(obs)
+            rewards[i], terminated[i], truncated[i] = float(reward), term, trunc
+            infos.append(info)
+        return self._finish(observations, rewards, terminated, truncated, infos)
+
+    def _finish(
+        self,
+        observations: list[Any],
+        rewards: np.ndarray,
+        terminated: np.ndarray,
+        truncated: np.ndarray,
+        infos: list[dict[str, Any]],
+    ) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        """Environments that ended are reset in the same step (their last observation and
+        info in ``final_obs`` and ``final_info``)."""
+        for i, env in enumerate(self.envs):
+            if terminated[i] or truncated[i]:
+                final = {"final_obs": observations[i], "final_info": infos[i]}
+                observations[i], info = env.reset()
+                infos[i] = {**info, **final}
         return self._batch(observations), rewards, terminated, truncated, self._infos(infos)
 
     def close_extras(self, **kwargs: Any) -> None:
         for env in self.envs:
             env.session.close()
-        self.pool.close()
+        if self.pool is not None:
+            self.pool.close()

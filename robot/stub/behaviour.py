@@ -60,6 +60,7 @@ class Field:
     half_length_m: float
     foot_y_m: float  # lateral distance of each foot from the centre line
     kick_x_m: float  # best ball distance in front of the pelvis for a kick
+    kick_feet: tuple[str, ...] = ("left", "right")  # the feet it kicks with
 
 
 def decide(
@@ -165,6 +166,8 @@ def _striker(
     # the farther the goal, the straighter the kick must be to land between the posts
     aim_tolerance = min(max(math.atan2(AIM_HALF_WIDTH_M, math.hypot(goal_dx, goal_dy)), 0.12), 0.3)
     foot = "left" if by > 0 else "right"
+    if foot not in field.kick_feet:
+        foot = field.kick_feet[0]
     target_y = field.foot_y_m if foot == "left" else -field.foot_y_m
     ex, ey = bx - field.kick_x_m, by - target_y
     if abs(ex) < 0.05 and abs(ey) < 0.035 and abs(heading_error) < aim_tolerance:

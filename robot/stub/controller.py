@@ -9,11 +9,13 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import numpy.typing as npt
 
+from robot.learned import Policy, PolicyMotion
+from robot.learned.policy import KICK_BALL_AHEAD_M
 from robot.motion import AttitudeFilter, GetUpMotion, KickMotion, WalkEngine, kinematics
 from robot.motion.imu import GRAVITY_M_S2
 from robot.motion.keyframes import KeyframeMotion
@@ -61,6 +63,7 @@ class Sensors:
 class Stats:
     falls: int = 0
     kicks: int = 0
+    learned_kicks: int = 0  # of the kicks, those the learned policy played
     get_ups: int = 0
     ball_sightings: int = 0
 
@@ -75,10 +78,13 @@ class StubController:
         field_class: str = "kid",
         detect_side: bool = False,
         home: tuple[float, float] | None = None,
+        kick_policy: Policy | None = None,
     ) -> None:
         """``detect_side``: before moving, look left and right for the own goal to find out
         whether the pitch is mirrored for this team (see :meth:`_finish_side_check`);
-        ``home``: a defender's spot in the own half."""
+        ``home``: a defender's spot in the own half; ``kick_policy``: a learned right-foot kick
+        from a stand (:mod:`robot.learned`) played instead of the keyframe kick (the striker
+        then lines up for the right foot only, the ball where the policy learnt it)."""
         self.role = role
         self.home = home
         self.model = model
@@ -96,12 +102,15 @@ class StubController:
             foot_y_m=self.kin.leg.hip_offset_y_m + walk.foot_y_offset_m,
             kick_x_m=0.165 * self.kin.leg.thigh_m / 0.16,
         )
+        self.kick_policy = kick_policy
+        if kick_policy is not None:
+            self.field = replace(self.field, kick_x_m=KICK_BALL_AHEAD_M, kick_feet=("right",))
         self._last_ms: int | None = None
         self._settle_until_ms: int | None = None
         self._still_s = 0.0
         self._upright_since_fall = True
         self._tilted_s = 0.0
-        self._motion: KeyframeMotion | None = None
+        self._motion: KeyframeMotion | PolicyMotion | None = None
         self._motion_kind = ""
         self._last_targets: dict[str, float] = {}
         self._missing_since_ms: int | None = None
@@ -244,6 +253,8 @@ class StubController:
             # teleported (half time, penalty) or limp: joints are not where we put them
             self.settle(sensors.time_ms)
         if self._motion is not None:
+            if isinstance(self._motion, PolicyMotion):
+                self._motion.sense(sensors.joints, sensors.accel, sensors.gyro)
             targets = self._motion.step(dt)
             if self._motion.done:
                 self._finish_motion()
@@ -294,8 +305,17 @@ class StubController:
                 targets = self.walk.step(dt, 0.0, 0.0, 0.0, accel=sensors.accel, gyro=sensors.gyro)
             else:
                 self.stats.kicks += 1
-                logger.info("kicking with the %s foot", action.kick_foot)
-                kick = KickMotion(foot=action.kick_foot, model=self.model, start=self._last_targets)
+                kick: KeyframeMotion | PolicyMotion
+                if self.kick_policy is not None and action.kick_foot == "right":
+                    self.stats.learned_kicks += 1
+                    logger.info("kicking with the learned policy (%s)", self.kick_policy.skill)
+                    kick = PolicyMotion(self.kick_policy)
+                    kick.sense(sensors.joints, sensors.accel, sensors.gyro)
+                else:
+                    logger.info("kicking with the %s foot", action.kick_foot)
+                    kick = KickMotion(
+                        foot=action.kick_foot, model=self.model, start=self._last_targets
+                    )
                 self._start(kick, "kick")
                 return self._remember(kick.step(dt))
         else:
@@ -369,7 +389,7 @@ class StubController:
         self._tilted_s = self._tilted_s + dt if tilt_rad > FALL_TILT_RAD else 0.0
         return self._tilted_s >= FALL_CONFIRM_S
 
-    def _start(self, motion: KeyframeMotion, kind: str) -> None:
+    def _start(self, motion: KeyframeMotion | PolicyMotion, kind: str) -> None:
         self._motion = motion
         self._motion_kind = kind
         self.walk.reset()

@@ -3,7 +3,9 @@
 ``python -m robot.stub BEHAVIOUR [ARG]`` where BEHAVIOUR is ``striker``, ``goalie``,
 ``defender`` (``--home X Y``: its spot in the own half), ``idle`` or a fault mode:
 ``crash-after SECONDS``, ``ignore-sigterm``, ``flood``, ``fill-logs``. The robot
-itself is described by the HLVS container environment (``ROBOCUP_*``).
+itself is described by the HLVS container environment (``ROBOCUP_*``). ``--kick-policy FILE``
+(default: ``$HLVS_KICK_POLICY``) plays a learned kick from a stand (:mod:`robot.learned`)
+instead of the keyframe kick.
 """
 
 from __future__ import annotations
@@ -17,6 +19,8 @@ from pathlib import Path
 
 from robot.motion import known_models
 from robot.stub.errors import StubConfigError
+
+KICK_POLICY_ENV = "HLVS_KICK_POLICY"
 
 
 class Behaviour(StrEnum):
@@ -41,6 +45,7 @@ class StubOptions:
     gc_return_port: int = 3939
     mirror_port: int = 3737
     model: str = "kid-default"
+    kick_policy: Path | None = None  # a learned kick (robot.learned policy file)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -69,6 +74,7 @@ def parse_args(argv: list[str]) -> StubOptions:
     parser.add_argument("--gc-return-port", type=int, default=3939)
     parser.add_argument("--mirror-port", type=int, default=3737)
     parser.add_argument("--model", default="kid-default")
+    parser.add_argument("--kick-policy", default=os.environ.get(KICK_POLICY_ENV) or None)
     try:
         ns, unknown = parser.parse_known_args(argv)
     except (argparse.ArgumentError, SystemExit) as exc:
@@ -105,6 +111,7 @@ def parse_args(argv: list[str]) -> StubOptions:
         gc_return_port=ns.gc_return_port,
         mirror_port=ns.mirror_port,
         model=ns.model,
+        kick_policy=Path(ns.kick_policy) if ns.kick_policy else None,
     )
 
 

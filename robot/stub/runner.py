@@ -23,6 +23,7 @@ from contracts.gamecontroller import GameState
 from contracts.robot_api import messages_pb2 as pb
 from robot.client import ConnectionClosed, RobotClient, RobotClientError
 from robot.client.errors import ReceiveTimeout
+from robot.learned import Policy, PolicyFileError, load_policy
 from robot.motion import kinematics
 from robot.stub.behaviour import GameInfo, Role
 from robot.stub.controller import Sensors, StubController
@@ -67,6 +68,7 @@ class StubRobot:
             field_class="adult" if options.model.startswith("adult") else "kid",
             detect_side=role is not Role.IDLE,
             home=options.home,
+            kick_policy=_kick_policy(options),
         )
         self.gc = GameControllerLink(
             team_color=env.team_color,
@@ -209,6 +211,22 @@ class StubRobot:
                     logger.warning("lost the simulator connection: %s", exc)
                     return None
         return 0
+
+
+def _kick_policy(options: StubOptions) -> Policy | None:
+    """The learned kick of ``--kick-policy``; a bad file is a configuration error."""
+    if options.kick_policy is None:
+        return None
+    try:
+        policy = load_policy(options.kick_policy)
+    except PolicyFileError as exc:
+        raise StubConfigError(
+            field="--kick-policy",
+            value=str(options.kick_policy),
+            expected=f"a policy file ({exc.field}: {exc.expected})",
+        ) from exc
+    logger.info("learned kick %s from %s", policy.skill, options.kick_policy)
+    return policy
 
 
 def _receive_latest(

@@ -202,6 +202,7 @@ def bench_json(ran: Ran, root: Path) -> None:
     exit_zero(ran, root)
     document = json.loads(ran.stdout.strip().splitlines()[-1])
     assert document["bench"] == "envs", document
+    assert document["vector_inprocess"]["ratio"] > 0, document
 
 
 def camera_frames_written(ran: Ran, root: Path) -> None:

@@ -1,0 +1,113 @@
+"""The learned-policy file, its numpy runner and the stub's use of it (robot.learned)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from contracts.gamecontroller import GameState
+from robot.learned import Policy, PolicyFileError, PolicyMotion, load_policy, save_policy
+from robot.learned.policy import KICK_BALL_AHEAD_M
+from robot.stub import StubConfigError, parse_args
+from robot.stub.behaviour import Field, GameInfo, Role, decide
+from robot.stub.controller import StubController
+from robot.stub.runner import _kick_policy
+from robot.stub.world_model import Pose2D
+
+MOTORS = tuple(f"M{i}" for i in range(20))
+
+
+def make_policy(seed: int = 0, *, period_ms: int = 32, duration_s: float = 0.2) -> Policy:
+    rng = np.random.default_rng(seed)
+    layers = ((rng.normal(0, 0.3, (27, 8)), rng.normal(0, 0.1, 8)),
+              (rng.normal(0, 0.3, (8, 20)), rng.normal(0, 0.1, 20)))  # fmt: skip
+    return Policy(
+        skill="test-kick", motors=MOTORS, layers=layers, obs_scale=np.full(27, 0.5),
+        stance=np.linspace(-0.2, 0.2, 20), action_scale=np.full(20, 0.4),
+        low=np.full(20, -0.3), high=np.full(20, 0.3), control_period_ms=period_ms,
+        duration_s=duration_s,
+    )  # fmt: skip
+
+
+def test_policy_file_round_trip_and_the_network(tmp_path: Path) -> None:
+    policy = make_policy()
+    save_policy(policy, tmp_path / "p.npz")
+    loaded = load_policy(tmp_path / "p.npz")
+    assert loaded.motors == MOTORS and loaded.skill == "test-kick"
+    assert loaded.control_period_ms == 32 and loaded.duration_s == pytest.approx(0.2)
+    obs = loaded.observation(dict(zip(MOTORS, np.linspace(0, 1, 20), strict=True)),
+                             (0.0, 0.0, 9.8), (0.1, 0.0, 0.0), 0.5)  # fmt: skip
+    assert obs.shape == (27,) and obs[-1] == 0.5 and obs[22] == pytest.approx(9.8)
+    (w0, b0), (w1, b1) = policy.layers
+    expected = np.tanh(np.tanh(obs * 0.5 @ w0 + b0) @ w1 + b1)
+    np.testing.assert_allclose(loaded.mean_action(obs), expected)
+    targets = loaded.act(obs)
+    np.testing.assert_allclose(targets, np.clip(policy.stance + 0.4 * expected, -0.3, 0.3))
+    assert np.all(targets <= 0.3) and np.all(targets >= -0.3)
+
+
+def test_bad_policy_files_name_the_file_and_field(tmp_path: Path) -> None:
+    with pytest.raises(PolicyFileError) as missing:
+        load_policy(tmp_path / "none.npz")
+    assert missing.value.field == "/" and "none.npz" in str(missing.value)
+    np.savez(tmp_path / "other.npz", format=np.array("something-else"))
+    with pytest.raises(PolicyFileError) as other:
+        load_policy(tmp_path / "other.npz")
+    assert other.value.field == "/format"
+    good = make_policy()
+    bad = Policy(**{**{f: getattr(good, f) for f in Policy.__dataclass_fields__},
+                    "layers": ((np.zeros((26, 20)), np.zeros(20)),)})  # fmt: skip
+    save_policy(bad, tmp_path / "shape.npz")
+    with pytest.raises(PolicyFileError) as shape:
+        load_policy(tmp_path / "shape.npz")
+    assert shape.value.field == "/w0" and "27" in shape.value.expected
+
+
+def test_policy_motion_decides_once_per_control_period_until_done() -> None:
+    policy = make_policy(period_ms=32, duration_s=0.2)
+    motion = PolicyMotion(policy)
+    joints = dict.fromkeys(MOTORS, 0.0)
+    seen_times: list[float] = []
+    ticks = 0
+    while not motion.done:
+        motion.sense(joints, (0.0, 0.0, 9.8), (0.0, 0.0, 0.0))
+        before = motion.decisions
+        targets = motion.step(0.008)
+        if motion.decisions > before:
+            seen_times.append(round(motion.elapsed_s - 0.008, 3))
+        ticks += 1
+        assert set(targets) == set(MOTORS)
+    assert ticks == 25  # 0.2 s of 8 ms ticks
+    assert seen_times == [0.0, 0.032, 0.064, 0.096, 0.128, 0.16, 0.192]
+    expected = policy.act(policy.observation(joints, (0.0, 0.0, 9.8), (0.0, 0.0, 0.0), 0.192))
+    np.testing.assert_allclose([targets[m] for m in MOTORS], expected)
+
+
+def test_stub_with_a_kick_policy_lines_up_for_the_right_foot(tmp_path: Path) -> None:
+    save_policy(make_policy(), tmp_path / "kick.npz")
+    options = parse_args(["striker", "--kick-policy", str(tmp_path / "kick.npz")])
+    policy = _kick_policy(options)
+    assert policy is not None and policy.skill == "test-kick"
+    controller = StubController(role=Role.STRIKER, start_pose=Pose2D(0, 0, 0), kick_policy=policy)
+    assert controller.field.kick_x_m == KICK_BALL_AHEAD_M
+    assert controller.field.kick_feet == ("right",)
+    game = GameInfo(phase=GameState.PLAYING)
+    # ball lined up in front of the LEFT foot: a plain stub kicks with the left foot, one with
+    # a right-foot policy steps across instead
+    field = Field(half_length_m=4.5, foot_y_m=0.075, kick_x_m=KICK_BALL_AHEAD_M)
+    ball = (KICK_BALL_AHEAD_M, 0.075)
+    plain = decide(role=Role.STRIKER, game=game, pose=Pose2D(1.0, 0.0, 0.0), ball=ball,
+                   field=field, searching_s=0.0)  # fmt: skip
+    assert plain.kick_foot == "left"
+    right_only = decide(role=Role.STRIKER, game=game, pose=Pose2D(1.0, 0.0, 0.0), ball=ball,
+                        field=controller.field, searching_s=0.0)  # fmt: skip
+    assert right_only.kick_foot is None and right_only.walk[1] > 0  # side-steps to its left
+
+
+def test_a_bad_kick_policy_is_a_configuration_error(tmp_path: Path) -> None:
+    (tmp_path / "junk.npz").write_bytes(b"not a zip")
+    with pytest.raises(StubConfigError) as err:
+        _kick_policy(parse_args(["striker", "--kick-policy", str(tmp_path / "junk.npz")]))
+    assert err.value.field == "--kick-policy" and "junk.npz" in err.value.value
