@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from contracts.field import field_for
+from contracts.timing import ENVIRONMENT
 from envs.base import HlvsEnv, Session
 from envs.frame import BALL_POS, UP_Z, Frame
 from envs.match_setup import default_stubs
@@ -39,7 +40,7 @@ class MatchEnv(HlvsEnv):
         *,
         field_class: str = "kid",
         model: str = "kid-default",
-        half_duration_s: float = 60.0,
+        half_duration_s: float = ENVIRONMENT.half_duration_s,
         learner_pose: tuple[float, float, float] = (-1.0, 0.0, 0.0),
         stubs: tuple[StubSpec, ...] | None = None,
         camera: bool = False,

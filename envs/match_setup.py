@@ -17,14 +17,15 @@ from typing import Any
 import numpy as np
 
 from contracts.match_spec import MatchSpec, PlayerSpec, Pose, TeamSpec, TimingSpec
+from contracts.timing import ENVIRONMENT
 from envs.session_spec import SessionSpec, StubSpec
 from referee import GameState, Referee, RobotId, TeamColor
 from simulator.match_setup import referee_config
 from simulator.world import MOTOR_NAMES, World
 
 STUB_LOOK_PERIOD_MS = 96
-WAIT_BEFORE_FIRST_READY_S = 1.0
-READY_DURATION_S = 15.0
+WAIT_BEFORE_FIRST_READY_S = ENVIRONMENT.wait_before_first_ready_s
+READY_DURATION_S = ENVIRONMENT.ready_duration_s
 
 
 @dataclass(slots=True)

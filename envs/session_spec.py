@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field, fields
 from typing import Any
 
+from contracts.timing import ENVIRONMENT, timing_problem
 from envs.errors import EnvConfigError
 
 FIELD_CLASSES = ("kid", "adult")
@@ -37,7 +38,7 @@ class SessionSpec:
     learner_pose: tuple[float, float, float] = (-1.0, 0.0, 0.0)  # team frame, for matches
     stubs: tuple[StubSpec, ...] = ()
     referee: bool = False  # run the GameController and the automatic referee
-    half_duration_s: float = 60.0
+    half_duration_s: float = ENVIRONMENT.half_duration_s
     steps_per_action: int = 1  # basic steps (8 ms) per environment step
     camera: bool = False
     perception: bool = False
@@ -64,6 +65,10 @@ class SessionSpec:
             raise EnvConfigError(
                 field="perception_noise", value=self.perception_noise, expected="a number >= 0"
             )
+        problem = timing_problem(self.half_duration_s, ENVIRONMENT.ready_duration_s)
+        if self.referee and problem is not None:
+            raise EnvConfigError(field="half_duration_s", value=self.half_duration_s,
+                                 expected=f"a longer half: {problem}")
         for stub in self.stubs:
             if stub.role not in ROLES:
                 raise EnvConfigError(

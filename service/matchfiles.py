@@ -12,6 +12,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+from contracts.timing import TEST_MATCH
 from orchestrator.match.scrimmage import game_file, team_file
 from service.settings import Settings
 
@@ -33,7 +34,9 @@ def write_match(folder: Path, *, match_id: str, team: dict[str, Any],
         opponent = team_file("Stub", stub_image, settings.test_players, goalie_first=True)
     args = argparse.Namespace(players=settings.test_players, seed=seed,
                               half_duration=settings.test_half_duration_s,
-                              wait_before_ready=3.0, grace=settings.test_grace_s)
+                              ready_duration=settings.test_ready_duration_s,
+                              wait_before_ready=TEST_MATCH.wait_before_first_ready_s,
+                              grace=settings.test_grace_s)
     game = game_file(args, match_id)
     game["red"]["ports"] = _ports(10000, team)
     game["blue"]["ports"] = _ports(10020, opponent)

@@ -13,6 +13,7 @@ import re
 from pathlib import Path
 from typing import Any
 
+from contracts.timing import MIN_PLAYING_S, SET_TO_PLAY_S, timing_problem
 from orchestrator.config.model import COLORS, Color, GameConfig, Limits, TeamRef, Timing
 from orchestrator.config.problems import Collector, pointer
 from orchestrator.config.schema import validate
@@ -200,9 +201,29 @@ def _timing(document: dict[str, Any], where: Collector, *, fast: bool) -> Timing
         written[name] = seconds
     durations: dict[str, float] = {k: float(v) for k, v in written.items()}
     max_duration = document.get("max_duration")
-    return Timing(
+    timing = Timing(
         **durations, max_duration_s=float(max_duration) if max_duration is not None else None
     )
+    _check_play_time(timing, written, document.get("type"), where)
+    return timing
+
+
+def _check_play_time(timing: Timing, written: dict[str, Any], game_type: Any,
+                     where: Collector) -> None:
+    """A half whose READY plus SET leaves less than the minimum of play is refused
+    (:mod:`contracts.timing`): the match would end 0:0 without a kick."""
+    halves = [("half_duration_s", timing.half_duration_s, "half")]
+    if game_type == "KNOCKOUT":
+        halves.append(("overtime_half_duration_s", timing.overtime_half_duration_s,
+                       "half of extra time"))
+    for name, seconds, what in halves:
+        problem = timing_problem(seconds, timing.ready_duration_s, what=what)
+        if problem is None:
+            continue
+        at = "ready_duration_s" if "ready_duration_s" in written else name
+        where.error(pointer("timing", at), problem,
+                    expected=f"ready_duration_s + {SET_TO_PLAY_S:g} s (SET) + "
+                    f"{MIN_PLAYING_S:g} s <= {name}")
 
 
 def _limits(raw: dict[str, Any]) -> Limits:

@@ -4,17 +4,32 @@ The files (game.json, team_red.json, team_blue.json) are written into the output
 played exactly like ``hlvs match`` would play them, so a team can rerun or edit them.
 
 Defaults make a short game a newcomer can watch in two to three minutes: one striker per team,
-two halves of 65 s simulated with READY shortened to 20 s (so each half has about 40 s of
-PLAYING), lockstep stepping, 3 s before the first READY and 1 s at half time. These timings
-are the scrimmage's own; official matches keep the rules' timings (45 s READY, 10 min halves).
+lockstep stepping and the timing of :data:`contracts.timing.SCRIMMAGE` (two halves of 65 s
+simulated with READY shortened to 20 s, so each half has about 40 s of PLAYING; 3 s before the
+first READY and 1 s at half time). A half too short for its READY gets a shorter READY with a
+warning (:func:`quick_ready`); official matches keep the rules' timings (45 s READY, 10 min
+halves).
 """
 
 from __future__ import annotations
 
 import json
+import logging
 import uuid
 from pathlib import Path
 from typing import Any, Protocol
+
+from contracts.timing import (
+    MIN_PLAYING_S,
+    MIN_READY_S,
+    SCRIMMAGE,
+    SET_TO_PLAY_S,
+    TimingError,
+    fit_ready,
+)
+from orchestrator.errors import ConfigError, Problem
+
+log = logging.getLogger(__name__)
 
 
 class ScrimmageOptions(Protocol):
@@ -87,9 +102,29 @@ def team_file(name: str, image: str, players: int, *, command: str | None = None
     return {"name": name, "image": repository or image, "players": entries}
 
 
+def quick_ready(half_duration_s: float, ready_duration_s: float | None) -> float:
+    """The READY of a quick test (:mod:`contracts.timing`): the scrimmage's unless given,
+    shortened with a warning when the half would keep less than the minimum of play.
+
+    Raises :class:`~orchestrator.errors.ConfigError` (at ``/timing/half_duration_s``) when the
+    half is too short even for the shortest READY."""
+    ready = SCRIMMAGE.ready_duration_s if ready_duration_s is None else ready_duration_s
+    try:
+        fitted, warning = fit_ready(half_duration_s, ready)
+    except TimingError as exc:
+        shortest = MIN_READY_S + SET_TO_PLAY_S + MIN_PLAYING_S
+        raise ConfigError([Problem(file="game.json", pointer="/timing/half_duration_s",
+                                   message=str(exc),
+                                   expected=f"a half of at least {shortest:g} s")]) from exc
+    if warning is not None:
+        log.warning("%s", warning)
+    return fitted
+
+
 def game_file(args: ScrimmageOptions, match_id: str) -> dict[str, Any]:
+    """A quick test's game.json; READY fitted to the half by :func:`quick_ready`."""
     players = args.players
-    ready = getattr(args, "ready_duration", None)
+    ready = quick_ready(args.half_duration, getattr(args, "ready_duration", None))
     return {
         "type": "NORMAL",
         "class": "KID",
@@ -109,10 +144,9 @@ def game_file(args: ScrimmageOptions, match_id: str) -> dict[str, Any]:
                  "ports": [10020 + n for n in range(1, players + 1)]},
         "timing": {
             "half_duration_s": args.half_duration,
-            # a shorter READY only where the caller asks for one (hlvs scrimmage does)
-            **({"ready_duration_s": ready} if ready is not None else {}),
+            "ready_duration_s": ready,
             "wait_before_first_ready_s": args.wait_before_ready,
-            "half_time_break_s": 1,
+            "half_time_break_s": SCRIMMAGE.half_time_break_s,
             "grace_period_s": args.grace,
         },
         "limits": {"cpus": 1, "memory_gb": 1, "pids": 256, "log_folder_gb": 1},
@@ -146,4 +180,4 @@ def write_files(args: ScrimmageOptions, folder: Path, *, stub_image: str | None 
     return folder / "game.json"
 
 
-__all__ = ["ScrimmageOptions", "game_file", "team_file", "write_files"]
+__all__ = ["ScrimmageOptions", "game_file", "quick_ready", "team_file", "write_files"]
