@@ -258,18 +258,20 @@ class QueueWorker:
         else:
             self._end(session, row, SubmissionState.FAILED,
                       failure_class=report.failure_class.value,
-                      cause=report.cause or "the match failed")
+                      cause=report.cause or "the match failed", team=report.team)
 
     def _end(self, session: Session, row: Submission, state: SubmissionState, *,
-             cause: str | None, failure_class: str | None = None) -> None:
+             cause: str | None, failure_class: str | None = None,
+             team: str | None = None) -> None:
         row.state = state.value
         row.finished_at = now()
         row.pool_detail = None
         row.cause = cause
         row.failure_class = failure_class
-        row.failure_side = failure_side(failure_class)
+        row.failure_side = failure_side(failure_class, team, OWN_COLOR)
         out = self.pool.results_dir(row.pool_handle) if row.pool_handle is not None else None
-        if out is not None and self.settings.video and replay_of(out).is_file():
+        if out is not None and self.settings.video and state is not SubmissionState.CANCELLED \
+                and replay_of(out).is_file():
             row.video_state = MediaState.PENDING.value
             row.video_detail = "waiting for the render"
         if out is not None and row.credentials_file_id is not None and \
