@@ -286,9 +286,22 @@ class QueueWorker:
         event = {SubmissionState.DONE: "submission.finished",
                  SubmissionState.FAILED: "submission.failed",
                  SubmissionState.CANCELLED: "submission.cancelled"}[state]
-        notify.enqueue(session, row, event, self.settings)
+        notify.enqueue(session, row, event, self.settings, results=_results_of(out))
         log.info("submission %s %s%s", row.id, state.value,
                  f" ({failure_class}: {cause})" if failure_class else "")
+
+
+def _results_of(out: Path | None) -> dict[str, Any] | None:
+    """The match's results.json as data (score, winner, play), None when there is none."""
+    path = out / files.RESULTS if out is not None else None
+    if path is None or not path.is_file():
+        return None
+    try:
+        data: dict[str, Any] = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        log.warning("unreadable %s: %s", path, exc)
+        return None
+    return data
 
 
 __all__ = ["MAX_ATTEMPTS", "QueueWorker"]
