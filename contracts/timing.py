@@ -50,10 +50,12 @@ OFFICIAL = TimingPreset(half_duration_s=600.0, ready_duration_s=45.0,
 SCRIMMAGE = TimingPreset(half_duration_s=65.0, ready_duration_s=20.0,
                          wait_before_first_ready_s=3.0, half_time_break_s=1.0, grace_period_s=5.0)
 """``hlvs scrimmage`` (local or ``--pool slurm``): about 40 s of PLAYING per half."""
-TEST_MATCH = TimingPreset(half_duration_s=30.0, ready_duration_s=10.0,
+TEST_MATCH = TimingPreset(half_duration_s=40.0, ready_duration_s=10.0,
                           wait_before_first_ready_s=3.0, half_time_break_s=1.0,
                           grace_period_s=5.0)
-"""The submission service's test matches: 15 s of PLAYING per half."""
+"""The submission service's test matches: 25 s of PLAYING per half (30 s halves with a 10 s
+READY reach PLAYING in both halves but leave a robot walking at 0.2 m/s from its touch line too
+little time to reach the ball)."""
 ENVIRONMENT = TimingPreset(half_duration_s=60.0, ready_duration_s=15.0,
                            wait_before_first_ready_s=1.0, half_time_break_s=0.0,
                            grace_period_s=0.0)

@@ -40,7 +40,7 @@ def test_every_preset_leaves_the_minimum_of_play() -> None:
     for half, ready in ((600, 45), (SCRIMMAGE.half_duration_s, SCRIMMAGE.ready_duration_s),
                         (TEST_MATCH.half_duration_s, TEST_MATCH.ready_duration_s)):
         check_half(half, ready)
-    assert TEST_MATCH.playing_per_half_s == 15.0
+    assert TEST_MATCH.playing_per_half_s == 25.0
     with pytest.raises(TimingError, match=r"READY \(45 s\) plus SET \(5 s\) leaves 0 s"):
         check_half(30, 45)
 
@@ -98,7 +98,7 @@ def test_service_test_matches_play_and_too_short_halves_are_refused(tmp_path: Pa
     game = write_match(tmp_path, match_id="m1", team=team, opponent=None, stub_image="stub:1",
                        settings=settings, seed=1)
     timing = json.loads(game.read_text())["timing"]
-    assert timing["half_duration_s"] == 30 and timing["ready_duration_s"] == 10
+    assert timing["half_duration_s"] == 40 and timing["ready_duration_s"] == 10
     with pytest.raises(SettingsError, match="HLVS_SERVICE_TEST_HALF_DURATION_S"):
         Settings.from_env({"HLVS_SERVICE_TEST_HALF_DURATION_S": "12"})
 
