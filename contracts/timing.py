@@ -22,7 +22,9 @@ SET_TO_PLAY_S = 5.0
 """Simulated seconds from SET to PLAYING (the automatic referee's, as the GameController's)."""
 MIN_PLAYING_S = 10.0
 """The documented minimum of play: simulated seconds of PLAYING each half must leave after READY
-and SET, and that a match must have played in all to count as played."""
+and SET, and that a match must have played in all to count as played. A game sets its own with
+``timing.minimum_play_s``; 0 marks a match not meant to play football (a test of the match's
+lifecycle: containers, logs, signals), which is neither refused nor failed for want of play."""
 MIN_READY_S = 5.0
 """The shortest READY a quick test is shortened to (robots need a moment to stand up)."""
 
@@ -72,47 +74,50 @@ def playing_per_half_s(half_s: float, ready_s: float, set_s: float = SET_TO_PLAY
 
 
 def timing_problem(half_s: float, ready_s: float, *, set_s: float = SET_TO_PLAY_S,
-                   what: str = "half") -> str | None:
-    """Why a half of ``half_s`` with this READY and SET cannot be played, or None."""
+                   minimum_s: float = MIN_PLAYING_S, what: str = "half") -> str | None:
+    """Why a half of ``half_s`` with this READY and SET cannot be played, or None.
+    ``minimum_s`` 0: a match not meant to play (a lifecycle test), never a problem."""
     left = playing_per_half_s(half_s, ready_s, set_s)
-    if left >= MIN_PLAYING_S:
+    if minimum_s <= 0 or left >= minimum_s:
         return None
     return (f"READY ({ready_s:g} s) plus SET ({set_s:g} s) leaves {max(left, 0.0):g} s of play "
-            f"in a {what} of {half_s:g} s; at least {MIN_PLAYING_S:g} s are needed "
-            f"(a {what} of at least {ready_s + set_s + MIN_PLAYING_S:g} s, or a shorter READY)")
+            f"in a {what} of {half_s:g} s; at least {minimum_s:g} s are needed "
+            f"(a {what} of at least {ready_s + set_s + minimum_s:g} s, or a shorter READY)")
 
 
-def check_half(half_s: float, ready_s: float, *, set_s: float = SET_TO_PLAY_S) -> None:
+def check_half(half_s: float, ready_s: float, *, set_s: float = SET_TO_PLAY_S,
+               minimum_s: float = MIN_PLAYING_S) -> None:
     """Raise :class:`TimingError` when the half leaves less than the minimum of play."""
-    problem = timing_problem(half_s, ready_s, set_s=set_s)
+    problem = timing_problem(half_s, ready_s, set_s=set_s, minimum_s=minimum_s)
     if problem is not None:
         raise TimingError(problem)
 
 
-def fit_ready(half_s: float, ready_s: float, *, set_s: float = SET_TO_PLAY_S
-              ) -> tuple[float, str | None]:
+def fit_ready(half_s: float, ready_s: float, *, set_s: float = SET_TO_PLAY_S,
+              minimum_s: float = MIN_PLAYING_S) -> tuple[float, str | None]:
     """For quick tests: READY shortened so that the half keeps the minimum of play.
 
     Returns the READY to use and a warning when it was shortened; raises :class:`TimingError`
     when even a READY of :data:`MIN_READY_S` does not fit.
     """
-    if timing_problem(half_s, ready_s, set_s=set_s) is None:
+    if timing_problem(half_s, ready_s, set_s=set_s, minimum_s=minimum_s) is None:
         return ready_s, None
-    fitted = half_s - set_s - MIN_PLAYING_S
+    fitted = half_s - set_s - minimum_s
     if fitted < MIN_READY_S:
-        shortest = MIN_READY_S + set_s + MIN_PLAYING_S
+        shortest = MIN_READY_S + set_s + minimum_s
         raise TimingError(
             f"a half of {half_s:g} s is too short to play: READY (at least {MIN_READY_S:g} s) "
-            f"plus SET ({set_s:g} s) plus the minimum of play ({MIN_PLAYING_S:g} s) need "
+            f"plus SET ({set_s:g} s) plus the minimum of play ({minimum_s:g} s) need "
             f"{shortest:g} s")
     return fitted, (f"READY shortened from {ready_s:g} s to {fitted:g} s so that each half of "
-                    f"{half_s:g} s keeps {MIN_PLAYING_S:g} s of play")
+                    f"{half_s:g} s keeps {minimum_s:g} s of play")
 
 
-def played_enough(halves_playing: tuple[int, ...] | list[int], playing_s: float) -> bool:
-    """True when a match played football: a half reached PLAYING and at least
-    :data:`MIN_PLAYING_S` seconds were played."""
-    return bool(halves_playing) and playing_s >= MIN_PLAYING_S
+def played_enough(halves_playing: tuple[int, ...] | list[int], playing_s: float,
+                  minimum_s: float = MIN_PLAYING_S) -> bool:
+    """True when a match played football: a half reached PLAYING and at least ``minimum_s``
+    seconds were played (``minimum_s`` 0: always, for a match not meant to play)."""
+    return minimum_s <= 0 or (bool(halves_playing) and playing_s >= minimum_s)
 
 
 __all__ = [

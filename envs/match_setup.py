@@ -25,7 +25,6 @@ from simulator.world import MOTOR_NAMES, World
 
 STUB_LOOK_PERIOD_MS = 96
 WAIT_BEFORE_FIRST_READY_S = ENVIRONMENT.wait_before_first_ready_s
-READY_DURATION_S = ENVIRONMENT.ready_duration_s
 
 
 @dataclass(slots=True)
@@ -63,7 +62,8 @@ def match_spec(spec: SessionSpec, seed: int) -> MatchSpec:
     }
     timing = TimingSpec(
         half_duration_s=spec.half_duration_s,
-        ready_duration_s=READY_DURATION_S,
+        ready_duration_s=spec.ready_duration_s,
+        minimum_play_s=spec.minimum_play_s,
         wait_before_first_ready_real_s=WAIT_BEFORE_FIRST_READY_S,
         half_time_break_real_s=0.0,
     )

@@ -39,6 +39,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="simulated seconds of READY in this scrimmage (default "
                         f"{SCRIMMAGE.ready_duration_s:g}, shortened with a warning when the "
                         "half would keep less than the minimum of play; matches: 45)")
+    parser.add_argument("--minimum-play", type=float, default=MIN_PLAYING_S,
+                        help="simulated seconds of PLAYING each half keeps and the match must "
+                        f"play to count (default {MIN_PLAYING_S:g}); 0: a match not meant to "
+                        "play football (a quick test of containers, logs or signals)")
     parser.add_argument("--wait-before-ready", type=float,
                         default=SCRIMMAGE.wait_before_first_ready_s,
                         help="wall seconds between robot start and the first READY (default "

@@ -13,7 +13,7 @@ import re
 from pathlib import Path
 from typing import Any
 
-from contracts.timing import MIN_PLAYING_S, SET_TO_PLAY_S, timing_problem
+from contracts.timing import SET_TO_PLAY_S, timing_problem
 from orchestrator.config.model import COLORS, Color, GameConfig, Limits, TeamRef, Timing
 from orchestrator.config.problems import Collector, pointer
 from orchestrator.config.schema import validate
@@ -217,13 +217,14 @@ def _check_play_time(timing: Timing, written: dict[str, Any], game_type: Any,
         halves.append(("overtime_half_duration_s", timing.overtime_half_duration_s,
                        "half of extra time"))
     for name, seconds, what in halves:
-        problem = timing_problem(seconds, timing.ready_duration_s, what=what)
+        problem = timing_problem(seconds, timing.ready_duration_s, what=what,
+                                 minimum_s=timing.minimum_play_s)
         if problem is None:
             continue
         at = "ready_duration_s" if "ready_duration_s" in written else name
         where.error(pointer("timing", at), problem,
-                    expected=f"ready_duration_s + {SET_TO_PLAY_S:g} s (SET) + "
-                    f"{MIN_PLAYING_S:g} s <= {name}")
+                    expected=f"ready_duration_s + {SET_TO_PLAY_S:g} s (SET) + minimum_play_s "
+                    f"({timing.minimum_play_s:g} s) <= {name}")
 
 
 def _limits(raw: dict[str, Any]) -> Limits:

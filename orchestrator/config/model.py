@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
 
-from contracts.timing import OFFICIAL
+from contracts.timing import MIN_PLAYING_S, OFFICIAL
 from orchestrator.errors import Problem
 
 GameType = Literal["NORMAL", "KNOCKOUT", "PENALTY"]
@@ -58,6 +58,7 @@ class Timing:
     grace_period_s: float = OFFICIAL.grace_period_s  # wall time given to robots to stop
     removal_penalty_s: float = 10.0
     max_duration_s: float | None = None  # HLVS max_duration: stop the game after this wall time
+    minimum_play_s: float = MIN_PLAYING_S  # simulated s of PLAYING per half (0: not meant to play)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -130,14 +130,14 @@ def play_failure(sim: SimResult | None, robots: list[RobotRecord],
     if sim is None or not sim.finished or sim.play is None:
         return None
     play = sim.play
-    if played_enough(play.halves_playing, play.playing_s):
+    minimum = timing.minimum_play_s if timing is not None else MIN_PLAYING_S
+    if played_enough(play.halves_playing, play.playing_s, minimum):
         return None
     played = (f"{play.playing_s:g} s of PLAYING, halves in PLAYING: "
-              f"{list(play.halves_playing) or 'none'}; the minimum of play is "
-              f"{MIN_PLAYING_S:g} s")
+              f"{list(play.halves_playing) or 'none'}; the minimum of play is {minimum:g} s")
     if timing is not None:
         problem = timing_problem(timing.half_duration_s, timing.ready_duration_s,
-                                 set_s=timing.set_to_play_s)
+                                 set_s=timing.set_to_play_s, minimum_s=minimum)
         if problem is not None:
             return Failure(failure_class=FailureClass.NOT_PLAYED,
                            cause=f"the match did not play ({played}): the league's timing: "

@@ -102,7 +102,8 @@ def team_file(name: str, image: str, players: int, *, command: str | None = None
     return {"name": name, "image": repository or image, "players": entries}
 
 
-def quick_ready(half_duration_s: float, ready_duration_s: float | None) -> float:
+def quick_ready(half_duration_s: float, ready_duration_s: float | None,
+                minimum_play_s: float = MIN_PLAYING_S) -> float:
     """The READY of a quick test (:mod:`contracts.timing`): the scrimmage's unless given,
     shortened with a warning when the half would keep less than the minimum of play.
 
@@ -110,12 +111,13 @@ def quick_ready(half_duration_s: float, ready_duration_s: float | None) -> float
     half is too short even for the shortest READY."""
     ready = SCRIMMAGE.ready_duration_s if ready_duration_s is None else ready_duration_s
     try:
-        fitted, warning = fit_ready(half_duration_s, ready)
+        fitted, warning = fit_ready(half_duration_s, ready, minimum_s=minimum_play_s)
     except TimingError as exc:
-        shortest = MIN_READY_S + SET_TO_PLAY_S + MIN_PLAYING_S
+        shortest = MIN_READY_S + SET_TO_PLAY_S + minimum_play_s
         raise ConfigError([Problem(file="game.json", pointer="/timing/half_duration_s",
                                    message=str(exc),
-                                   expected=f"a half of at least {shortest:g} s")]) from exc
+                                   expected=f"a half of at least {shortest:g} s (or "
+                                   "--minimum-play 0 for a match not meant to play)")]) from exc
     if warning is not None:
         log.warning("%s", warning)
     return fitted
@@ -124,7 +126,9 @@ def quick_ready(half_duration_s: float, ready_duration_s: float | None) -> float
 def game_file(args: ScrimmageOptions, match_id: str) -> dict[str, Any]:
     """A quick test's game.json; READY fitted to the half by :func:`quick_ready`."""
     players = args.players
-    ready = quick_ready(args.half_duration, getattr(args, "ready_duration", None))
+    minimum = getattr(args, "minimum_play", None)
+    minimum = MIN_PLAYING_S if minimum is None else minimum
+    ready = quick_ready(args.half_duration, getattr(args, "ready_duration", None), minimum)
     return {
         "type": "NORMAL",
         "class": "KID",
@@ -145,6 +149,7 @@ def game_file(args: ScrimmageOptions, match_id: str) -> dict[str, Any]:
         "timing": {
             "half_duration_s": args.half_duration,
             "ready_duration_s": ready,
+            "minimum_play_s": minimum,
             "wait_before_first_ready_s": args.wait_before_ready,
             "half_time_break_s": SCRIMMAGE.half_time_break_s,
             "grace_period_s": args.grace,

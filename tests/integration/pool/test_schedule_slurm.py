@@ -40,8 +40,8 @@ timing: {{pull_lead_round_robin_s: 40, play_after_pull_s: 0.5, deliver_after_str
 game_defaults:
   stepping: lockstep
   seed: 7
-  timing: {{half_duration_s: 4, wait_before_first_ready_s: 1, half_time_break_s: 1,
-           grace_period_s: 2}}
+  timing: {{half_duration_s: 4, minimum_play_s: 0, wait_before_first_ready_s: 1,
+           half_time_break_s: 1, grace_period_s: 2}}
   limits: {{cpus: 1, memory_gb: 1, pids: 256}}
 teams:
   - {{name: ants, id: 1, config: ants.json}}

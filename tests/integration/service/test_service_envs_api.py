@@ -38,7 +38,8 @@ def test_an_episode_with_a_token_monitor_files_and_limits(
         assert line["steps"] == 50 and line["truncated"] is True
         video = client.download(instance, "video.mp4", tmp_path / "video.mp4")
         assert video.stat().st_size == names["video.mp4"] > 1000
-        second = client.env_create("hlvs/Match-v0", half_duration_s=5.0)
+        second = client.env_create("hlvs/Match-v0", half_duration_s=5.0,
+                                   minimum_play_s=0.0)
         with pytest.raises(EnvApiError) as limit:
             client.env_create("hlvs/Kick-v0")
         assert limit.value.status == 409 and "limit" in limit.value.message

@@ -104,9 +104,18 @@ def test_service_test_matches_play_and_too_short_halves_are_refused(tmp_path: Pa
 
 
 def test_environment_matches_are_checked() -> None:
-    assert SessionSpec(referee=True).half_duration_s == 60
+    assert SessionSpec(referee=True).ready_duration_s == 15
+    assert SessionSpec(referee=True, half_duration_s=20).ready_duration_s == 5  # shortened
     with pytest.raises(EnvConfigError, match="half_duration_s"):
-        SessionSpec(referee=True, half_duration_s=20)
+        SessionSpec(referee=True, half_duration_s=12)
+    assert SessionSpec(referee=True, half_duration_s=5, minimum_play_s=0).ready_duration_s == 15
+
+
+def test_a_match_not_meant_to_play_is_neither_refused_nor_failed(tmp_path: Path) -> None:
+    game = load_game(_game(tmp_path, {"half_duration_s": 4, "minimum_play_s": 0})).game
+    assert game.timing.minimum_play_s == 0
+    timing = TimingSpec(half_duration_s=4.0, minimum_play_s=0.0)
+    assert play_failure(_sim(0.0, [], ()), ROBOTS, timing) is None
 
 
 def _sim(playing_s: float, halves: list[int], connected: tuple[str, ...]) -> SimResult:
