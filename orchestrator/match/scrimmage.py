@@ -27,6 +27,7 @@ from contracts.timing import (
     TimingError,
     fit_ready,
 )
+from orchestrator.config.robot_models import MODEL_MANIFEST, is_model_path
 from orchestrator.errors import ConfigError, Problem
 
 log = logging.getLogger(__name__)
@@ -158,9 +159,38 @@ def game_file(args: ScrimmageOptions, match_id: str) -> dict[str, Any]:
     }
 
 
+def stub_model_problem(model: str | None) -> str | None:
+    """Why the stub robot cannot drive ``model`` (a model package whose motor names are not the
+    built-in robot's, which the stub commands), or None."""
+    if model is None or not is_model_path(model):
+        return None
+    from robot.geometry import MOTOR_NAMES
+
+    manifest = Path(model) / MODEL_MANIFEST
+    try:
+        motors = {m["name"] for m in json.loads(manifest.read_text(encoding="utf-8"))["motors"]}
+    except (OSError, ValueError, KeyError, TypeError):
+        return None  # the team file's check reports a broken package with its field
+    missing = [name for name in MOTOR_NAMES if name not in motors]
+    if not missing:
+        return None
+    return (f"the stub robot commands the built-in robot's motors ({', '.join(missing[:4])}, "
+            f"...), which {manifest} does not name (it has {', '.join(sorted(motors)[:4])}, "
+            "...): every command is refused and the robot stands still all match. Give a "
+            "robot image that drives this model (--red-image / --blue-image)")
+
+
 def write_files(args: ScrimmageOptions, folder: Path, *, stub_image: str | None = None
                 ) -> Path:
-    """Write game.json and the two team files into ``folder``; returns the game.json path."""
+    """Write game.json and the two team files into ``folder``; returns the game.json path.
+
+    A stub robot given a team model with other motor names would stand still: said loudly (a
+    WARNING, shown whatever the log level)."""
+    for color, image in (("red", args.red_image), ("blue", args.blue_image)):
+        problem = stub_model_problem(getattr(args, f"{color}_model", None)) \
+            if image is None else None
+        if problem is not None:
+            log.warning("%s robots: %s", color, problem)
     if args.red_image is None or args.blue_image is None:
         if stub_image is None:
             from orchestrator.project_images import project_image
@@ -185,4 +215,5 @@ def write_files(args: ScrimmageOptions, folder: Path, *, stub_image: str | None 
     return folder / "game.json"
 
 
-__all__ = ["ScrimmageOptions", "game_file", "quick_ready", "team_file", "write_files"]
+__all__ = ["ScrimmageOptions", "game_file", "quick_ready", "stub_model_problem", "team_file",
+           "write_files"]

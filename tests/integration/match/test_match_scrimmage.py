@@ -82,6 +82,7 @@ def test_scrimmage_with_a_team_of_wolfgang_models_plays_to_the_end(
     finally:
         hlvs(["cleanup", "--match", match_id])
     assert code == 0, printed.err[-3000:]
+    assert "red robots: the stub robot commands the built-in robot's motors" in printed.err
     out = tmp_path / "wolf"
     printed_results = json.loads(printed.out)  # --json: stdout holds the one JSON document
     assert printed_results["exit_code"] == 0 and printed_results["out_dir"] == str(out)

@@ -162,3 +162,21 @@ def test_no_play_because_a_team_never_connected_names_the_team() -> None:
     neither = play_failure(_sim(2.0, [1], ()), ROBOTS, TimingSpec())
     assert neither is not None and neither.failure_class is FailureClass.NOT_PLAYED
     assert "either team" in neither.cause
+
+
+def test_a_stub_given_a_model_with_other_motor_names_is_said_loudly(
+        tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    wolfgang = Path(__file__).resolve().parents[3] / "configs/examples/robots/wolfgang"
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    with caplog.at_level(logging.WARNING):
+        write_files(parser.parse_args(["--red-model", str(wolfgang)]), tmp_path,
+                    stub_image="stub:1")
+    warned = [r for r in caplog.records if r.levelno == logging.WARNING]
+    assert len(warned) == 1 and warned[0].getMessage().startswith("red robots: the stub robot")
+    assert "stands still" in warned[0].getMessage()
+    caplog.clear()
+    with caplog.at_level(logging.WARNING):  # a robot image of the team's own: its business
+        write_files(parser.parse_args(["--red-model", str(wolfgang), "--red-image", "team:1"]),
+                    tmp_path, stub_image="stub:1")
+    assert not caplog.records
