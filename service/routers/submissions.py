@@ -24,7 +24,7 @@ from service import submissions, teamfiles
 from service.app import Services
 from service.db import ACTIVE_STATES, Submission
 from service.deps import DbSession, TeamPrincipal, bearer, get_services, require_team
-from service.errors import NotFound
+from service.errors import NotFound, PreflightFailed
 from service.matchfiles import OWN_COLOR
 from service.views import (
     SubmissionCreate,
@@ -62,7 +62,13 @@ def create_submission(body: SubmissionCreate, request: Request, principal: TeamP
     credentials = teamfiles.newest_id(session, team_id=team_id, kind="credentials")
     session.commit()  # no connection is held during the pre-flight check
     assert services.preflight is not None
-    elapsed = services.preflight(document, services.settings)
+    try:
+        elapsed = services.preflight(document, services.settings)
+    except PreflightFailed as failed:
+        teamfiles.refuse(session, teamfiles.get_by_id(session, file_id), stage=failed.stage,
+                         cause=failed.cause)
+        session.commit()
+        raise
     row = submissions.create(session, team_id=team_id, opponent=body.opponent,
                              team_file_id=file_id, credentials_file_id=credentials,
                              preflight_s=elapsed)
