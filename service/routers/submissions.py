@@ -21,6 +21,7 @@ from contracts import files
 from contracts.errors import ContractError
 from contracts.match_results import MatchReport, MatchResults
 from service import submissions, teamfiles
+from service.aftermatch import PARTIAL_VIDEO_FILE
 from service.app import Services
 from service.db import ACTIVE_STATES, Submission
 from service.deps import DbSession, TeamPrincipal, bearer, get_services, require_team
@@ -230,9 +231,11 @@ def get_video(submission_id: str, request: Request, principal: TeamPrincipal,
 
 
 def _listing(root: Path) -> list[str]:
+    """Every finished file under ``root`` (a video still being rendered is not one)."""
     if not root.is_dir():
         return []
-    return sorted(str(p.relative_to(root)) for p in root.rglob("*") if p.is_file())
+    return sorted(str(p.relative_to(root)) for p in root.rglob("*")
+                  if p.is_file() and p.name != PARTIAL_VIDEO_FILE)
 
 
 @router.get("/{submission_id}/logs")
@@ -253,7 +256,8 @@ def get_log(submission_id: str, part: str, path: str, request: Request,
         raise NotFound(what="log folder", ident=part)
     root = roots[part].resolve()
     target = (root / path).resolve()
-    if not target.is_relative_to(root) or not target.is_file():
+    if not target.is_relative_to(root) or not target.is_file() or \
+            target.name == PARTIAL_VIDEO_FILE:
         raise NotFound(what="log file", ident=f"{part}/{path}")
     return FileResponse(target, media_type="application/octet-stream", filename=target.name)
 

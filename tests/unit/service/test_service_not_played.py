@@ -5,13 +5,16 @@ becomes the current version."""
 from __future__ import annotations
 
 import json
+import time
 from collections.abc import Callable
 from email import message_from_bytes
+from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 import pytest
 
-from service import notify
+from service import Settings, notify
 from service.pool.fake import FakePool
 from tests.integration.service.harness import Served
 from tests.unit.service.conftest import team_doc, wait_for_status
@@ -48,7 +51,6 @@ def test_a_match_without_play_is_failed_and_charged_only_for_the_teams_cause(
 
 def test_the_mail_says_score_outcome_and_links_to_pages(
         monkeypatch: pytest.MonkeyPatch) -> None:
-    from service import Settings
     from service.db import Submission
 
     settings = Settings(public_url="https://league.example.org/")
@@ -98,3 +100,29 @@ def test_a_team_file_that_fails_its_preflight_never_becomes_current(
         assert "pre-flight check failed at pull" in versions[2]["problems"][-1]["text"]
         again = http.post("/v1/submissions", json={})  # the current version: 1
         assert again.status_code == 201, again.text
+
+
+def test_a_render_under_way_ends_with_the_service_and_its_partial_video_is_not_served(
+        tmp_path: Path, settings: Settings) -> None:
+    from service.aftermatch import PARTIAL_VIDEO_FILE, AfterMatch
+    from service.routers.submissions import _listing
+
+    renderer = tmp_path / "renderer.sh"  # stands for `python -m simulator render ... -o FILE`
+    renderer.write_text('#!/bin/sh\necho partial > "$6"\nexec sleep 60\n')
+    renderer.chmod(0o755)
+    out, work = tmp_path / "out", tmp_path / "work"
+    (out / "public").mkdir(parents=True)
+    (out / "public" / "replay.hlvsrec").write_bytes(b"replay")
+    after = AfterMatch(SimpleNamespace(settings=settings), python=str(renderer))  # type: ignore[arg-type]
+    after._start(SimpleNamespace(id="sub_1", match_id="m1"), out, work, 1)  # type: ignore[arg-type]
+    render = after._render
+    assert render is not None
+    deadline = time.monotonic() + 10
+    while not (out / "public" / PARTIAL_VIDEO_FILE).is_file():
+        assert time.monotonic() < deadline
+        time.sleep(0.05)
+    assert _listing(out / "public") == ["replay.hlvsrec"]
+    after.stop()
+    assert render.process.poll() is not None  # no render outlives the service
+    assert not (out / "public" / PARTIAL_VIDEO_FILE).exists()
+    assert json.loads((work / "render.json").read_text())["renders"] == 0
