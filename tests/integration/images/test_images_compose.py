@@ -16,7 +16,7 @@ import docker
 import pytest
 import yaml
 
-from orchestrator.compose import Subnets, compose_files, write_compose
+from orchestrator.compose import Subnets, collect_results, compose_files, write_compose
 from orchestrator.config import load_game
 from orchestrator.project_images import project_image
 from tests.conftest import TEST_LABEL
@@ -230,3 +230,9 @@ def test_compose_up_plays_a_stub_match(tmp_path: Path) -> None:
         assert robot_logs and all(p.stat().st_size > 0 for p in robot_logs)
     for name in ("replay.hlvsrec", "referee.log", "gamecontroller.log"):
         assert (compose_path.parent / "out" / name).stat().st_size > 0
+    results = collect_results(loaded, compose_path.parent)  # hlvs compose --collect
+    assert results.ok and results.final_state == "FINISHED", results.failure
+    report = json.loads((compose_path.parent / "report.json").read_text())
+    assert report == {"status": "success"}
+    written = json.loads((compose_path.parent / "results.json").read_text())
+    assert written["match_id"] == loaded.game.match_id and written["play"] is not None

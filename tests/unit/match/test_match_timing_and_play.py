@@ -180,3 +180,27 @@ def test_a_stub_given_a_model_with_other_motor_names_is_said_loudly(
         write_files(parser.parse_args(["--red-model", str(wolfgang), "--red-image", "team:1"]),
                     tmp_path, stub_image="stub:1")
     assert not caplog.records
+
+
+def test_compose_says_how_to_collect_results_and_take_it_down_and_collects(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from orchestrator.cli import main
+
+    game = Path(__file__).resolve().parents[3] / "configs/examples/scrimmage_1v1/game.json"
+    output = tmp_path / "docker-compose.yml"
+    assert main(["compose", str(game), "-o", str(output), "--simulator-image", "sim:x"]) == 0
+    printed = capsys.readouterr().out
+    assert f"hlvs compose {game} -o {output} --collect" in printed
+    assert "docker compose -f docker-compose.yml down" in printed
+    assert "docker-compose -f docker-compose.yml down" in printed
+    assert "--collect" in output.read_text() and "docker-compose down" in output.read_text()
+
+    sim = _sim(0.0, [], ("red-1", "blue-1")).to_dict()  # FINISHED 0:0 without kick-off
+    (tmp_path / "out" / "sim_result.json").write_text(json.dumps({**sim, "match_id": "m"}))
+    code = main(["compose", str(game), "-o", str(output), "--collect", "--json"])
+    summary = json.loads(capsys.readouterr().out)
+    assert code == 1 and summary["status"] == "failed"
+    assert summary["failure"].startswith("not_played: the match did not play")
+    report = json.loads((tmp_path / "report.json").read_text())
+    assert report["failure_class"] == "not_played"
+    assert json.loads((tmp_path / "results.json").read_text())["score"] == {"red": 0, "blue": 0}
