@@ -26,8 +26,9 @@ export class Scoreboard {
   readonly root = el("div", { class: "scoreboard", "data-testid": "scoreboard" });
   private readonly red = el("span", { class: "score red", "data-testid": "score-red" }, "0");
   private readonly blue = el("span", { class: "score blue", "data-testid": "score-blue" }, "0");
-  private readonly state = el("span", { class: "state", "data-testid": "game-state" }, "-");
-  private readonly clockText = el("span", { class: "clock", "data-testid": "game-clock" }, "--:--");
+  // before the first state arrives: the game has not started (no "-" and "--:--" placeholders)
+  private readonly state = el("span", { class: "state", "data-testid": "game-state" }, "not started");
+  private readonly clockText = el("span", { class: "clock", "data-testid": "game-clock" }, "");
 
   constructor(title: string) {
     this.root.append(
@@ -52,7 +53,7 @@ export class Scoreboard {
     }
     const half = game.half === 1 ? "1st half" : game.half === 2 ? "2nd half" : "";
     const secondary = game.secondary_state && game.secondary_state !== "NORMAL" ? ` ${game.secondary_state}` : "";
-    setText(this.state, `${game.state ?? "-"}${secondary} ${half}`.trim());
+    setText(this.state, `${game.state ?? "not started"}${secondary} ${half}`.trim());
     if (typeof game.secs_remaining === "number") setText(this.clockText, clock(game.secs_remaining * 1000));
   }
 }

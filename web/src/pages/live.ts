@@ -95,9 +95,12 @@ export function livePage(root: HTMLElement, api: string, matchId: string): void 
           el("td", {}, r.round_trip_ms === null ? "-" : r.round_trip_ms.toFixed(1)))),
     );
   };
+  let events = 0;
   handlers.event = (data) => {
     const event = JSON.parse(data) as RefereeEvent;
-    list.prepend(el("li", { "data-type": event.type }, `${clock(event.sim_time_ms)} ${describeEvent(event)}`));
+    events += 1; // the newest first, each with its number in a cell of its own
+    list.prepend(el("li", { "data-type": event.type }, el("span", { class: "n" }, `${events}.`),
+      el("span", {}, `${clock(event.sim_time_ms)} ${describeEvent(event)}`)));
   };
   handlers.failure = (data) => {
     status.textContent = `live view unavailable: ${JSON.parse(data)}`;
