@@ -3,11 +3,13 @@ sought time, jumps to a goal from the timeline, plots the API statistics, reads 
 
 from __future__ import annotations
 
+from io import BytesIO
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
+from PIL import Image
 
 from simulator.replay import ReplayFile
 from tests.integration.viewer.conftest import hlvs_view, screenshot
@@ -139,12 +141,9 @@ def test_event_list_timeline_and_plots_line_up(page: Any, busy_match: Path) -> N
         page.locator("[data-testid=seek]").fill(str(GOAL_MS))
         page.wait_for_function(f"window.hlvsViewer.time === {GOAL_MS}")
         seek = page.locator("[data-testid=seek]").bounding_box()
-        assert abs(seek["width"] - page.locator("[data-testid=timeline]").bounding_box()["width"]) < 1
+        strip = page.locator("[data-testid=timeline]").bounding_box()
+        assert abs(seek["width"] - strip["width"]) < 1 and abs(seek["x"] - strip["x"]) < 1
         row = page.locator("[data-testid=seek]").screenshot()
-        from io import BytesIO
-
-        from PIL import Image
-
         pixels = np.asarray(Image.open(BytesIO(row)).convert("RGB"), dtype=np.int32)
         # the thumb's columns: dark from top to bottom, away from the focus ring at the ends
         dark = np.where((pixels.sum(axis=2) < 200).sum(axis=0) > 0.6 * pixels.shape[0])[0]
