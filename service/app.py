@@ -38,6 +38,7 @@ ROUTER_MODULES: tuple[str, ...] = (
     "service.routers.submissions",
     "service.routers.operator",
     "service.routers.nodes",  # the match pool's machines (operators)
+    "service.routers.league",  # whoami, the queue for everyone, matches, the league table
     "envs.http_api",  # the HTTP environment API (learning environments)
     "viewer.service_pages",  # the web front end: replays, live view, queue and standings pages
 )
@@ -53,6 +54,7 @@ class Services:
     pool: Any = None  # service.pool.MatchPool
     worker: Any = None  # service.worker.QueueWorker
     aftermatch: Any = None  # service.aftermatch.AfterMatch
+    ladder: Any = None  # service.ladder.Ladder (when settings.ladder_interval_s > 0)
     preflight: Preflight | None = None
     queue: Any = None  # service.submissions.QueueBoard
     tokens: Any = None  # service.tokens.TokenCache
@@ -131,6 +133,11 @@ def create_app(
             services.aftermatch.start()
             services.worker = QueueWorker(services)
             services.worker.start()
+            if settings.ladder_interval_s > 0:
+                from service.ladder import Ladder
+
+                services.ladder = Ladder(services)
+                services.ladder.start()
         # Everything loaded so far lives as long as the process: kept out of the collector's
         # full passes, which would otherwise stop every request for tens of milliseconds.
         gc.collect()
@@ -138,6 +145,8 @@ def create_app(
         try:
             yield
         finally:
+            if services.ladder is not None:
+                services.ladder.stop()
             if services.worker is not None:
                 services.worker.stop()
             if services.aftermatch is not None:
