@@ -132,14 +132,16 @@ def test_submit_wait_from_a_registry_plays_both_halves_mail_download_and_isolati
     served = serve(settings, start_worker=True, port=port)
     try:
         alpha = served.client(alpha_token)
-        beta = served.client(make_token(team="Beta", email="beta@example.org"))
+        beta = served.client(make_token(team="Beta", email="beta@example.org",
+                                        accepts_friendlies=True))
         assert beta.put("/v1/team/files/team_config", json=team_doc("Beta")).status_code == 201
         ensure_bucket(moto.endpoint_url, moto.admin, "alpha-logs")
         target = {"type": "s3", "credentials": s3_body(moto.endpoint_url, moto.admin,
                                                         "alpha-logs")}
         assert alpha.put("/v1/team/files/credentials", json=target).status_code == 201
-        submit = _hlvs("submit", *common, "--team-config", str(team_file), "--wait",
-                       "--poll", "1")
+        # a friendly against Beta (a league match: it moves both teams' ratings)
+        submit = _hlvs("submit", *common, "--team-config", str(team_file), "--opponent", "Beta",
+                       "--wait", "--poll", "1")
         sid = _running_submission(alpha, submit, 90)
         second = alpha.post("/v1/submissions", json={})
         assert second.status_code == 409 and second.json()["existing_id"] == sid
@@ -208,7 +210,7 @@ def test_submit_wait_from_a_registry_plays_both_halves_mail_download_and_isolati
         assert finished["To"] == "alpha@example.org"
         text = str(finished.get_payload())
         score = results["score"]
-        assert f"score:   you (red) {score['red']} : {score['blue']} stub" in text
+        assert f"score:   you (red) {score['red']} : {score['blue']} Beta" in text
         outcome = {"red": "won", "blue": "lost", "draw": "draw"}[results["winner"]]
         assert f"outcome: {outcome}" in text
         pages = re.findall(r"http://127\.0\.0\.1:\d+/watch/\S+", text)
@@ -218,6 +220,13 @@ def test_submit_wait_from_a_registry_plays_both_halves_mail_download_and_isolati
                 opened = browser.get(page)
                 assert opened.status_code == 200 and "text/html" in \
                     opened.headers["content-type"], page
+        # the played friendly is in the league table: both teams rated from its result
+        table = {row["team"]: row for row in alpha.get("/v1/league").json()["table"]}
+        assert table["Alpha"]["played"] == table["Beta"]["played"] == 1
+        assert table["Alpha"]["sigma"] < 8.3 and table["Beta"]["sigma"] < 8.3  # from 25 / 3
+        history = alpha.get("/v1/league/Alpha").json()["history"]
+        assert history[0]["submission"] == sid and history[0]["outcome"] == {
+            "won": "won", "lost": "lost", "draw": "drawn"}[outcome]
         alpha.close()
         beta.close()
     finally:
