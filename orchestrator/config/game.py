@@ -152,6 +152,12 @@ def _real_time_factor(document: dict[str, Any], where: Collector) -> float | Non
     return DEFAULT_MAXIMUM_REAL_TIME_FACTOR
 
 
+def timing_of(document: dict[str, Any], where: Collector, *, fast: bool) -> Timing:
+    """The timing of a game document (``timing``, ``game_controller_extra_args``, ``type``),
+    its problems in ``where``; also used for a schedule's ``game_defaults``."""
+    return _timing(document, where, fast=fast)
+
+
 def _timing(document: dict[str, Any], where: Collector, *, fast: bool) -> Timing:
     """Timing from ``timing`` and the GameController arguments.
 

@@ -204,3 +204,21 @@ def test_compose_says_how_to_collect_results_and_take_it_down_and_collects(
     report = json.loads((tmp_path / "report.json").read_text())
     assert report["failure_class"] == "not_played"
     assert json.loads((tmp_path / "results.json").read_text())["score"] == {"red": 0, "blue": 0}
+
+
+def test_a_schedule_whose_game_timing_leaves_no_play_is_refused(tmp_path: Path) -> None:
+    from orchestrator.config.schedule import load_schedule
+    from tests.unit.schedule.test_schedule import COMPRESSED, write_schedule
+
+    fixtures = ("fixtures:\n  round_robin: {teams: [alpha, bravo], first_stream: '+1h', "
+                "interval_s: 60}\n")
+    short = write_schedule(tmp_path, COMPRESSED + fixtures +
+                           "game_defaults:\n  timing: {half_duration_s: 30}\n")
+    with pytest.raises(ConfigError) as info:
+        load_schedule(short)
+    (problem,) = info.value.problems
+    assert problem.pointer == "/game_defaults/timing/half_duration_s"
+    assert "leaves 0 s of play in a half of 30 s" in problem.message
+    fitted = write_schedule(tmp_path, COMPRESSED + fixtures + "game_defaults:\n  timing: "
+                            "{half_duration_s: 30, ready_duration_s: 15}\n")
+    assert load_schedule(fitted).game_defaults["timing"]["ready_duration_s"] == 15
