@@ -76,7 +76,7 @@ def real_settings(settings: Settings, docker_client: Any) -> Settings:
     # the service's own test-match timing (contracts.timing.TEST_MATCH: 40 s halves, 10 s READY)
     return settings.with_(worker_poll_s=0.3, test_grace_s=2.0,
                           preflight_timeout_s=25.0, video_width=320, video_height=180,
-                          video_fps=5.0)
+                          video_fps=2.0)  # 90 s of match: few frames to render
 
 
 def _hlvs(*argv: str) -> subprocess.Popen[str]:
@@ -186,7 +186,7 @@ def test_submit_wait_from_a_registry_plays_both_halves_mail_download_and_isolati
         # the video is rendered after the match ended, outside it; the team downloads it all
         rendered = wait_for_status(alpha, sid, lambda b: b["video"]["state"] != "pending", 180)
         assert rendered["video"]["state"] == "ready", rendered["video"]
-        assert "320x180 at 5 fps" in rendered["video"]["detail"]
+        assert "320x180 at 2 fps" in rendered["video"]["detail"]
         code, out, err = _finished(_hlvs("results", *common, sid, "--out",
                                          str(tmp_path / "r")), 60)
         assert code == 0, err
