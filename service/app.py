@@ -38,7 +38,8 @@ ROUTER_MODULES: tuple[str, ...] = (
     "service.routers.submissions",
     "service.routers.operator",
     "service.routers.nodes",  # the match pool's machines (operators)
-    "service.routers.league",  # whoami, the queue for everyone, matches, the league table
+    "service.routers.everyone",  # whoami, the queue and the matches, each role what it may see
+    "service.routers.league",  # the league table and rating histories
     "envs.http_api",  # the HTTP environment API (learning environments)
     "viewer.service_pages",  # the web front end: replays, live view, queue and standings pages
 )
@@ -54,7 +55,7 @@ class Services:
     pool: Any = None  # service.pool.MatchPool
     worker: Any = None  # service.worker.QueueWorker
     aftermatch: Any = None  # service.aftermatch.AfterMatch
-    ladder: Any = None  # service.ladder.Ladder (when settings.ladder_interval_s > 0)
+    ladder: Any = None  # service.league_ladder.Ladder (when settings.ladder_interval_s > 0)
     preflight: Preflight | None = None
     queue: Any = None  # service.submissions.QueueBoard
     tokens: Any = None  # service.tokens.TokenCache
@@ -134,7 +135,7 @@ def create_app(
             services.worker = QueueWorker(services)
             services.worker.start()
             if settings.ladder_interval_s > 0:
-                from service.ladder import Ladder
+                from service.league_ladder import Ladder
 
                 services.ladder = Ladder(services)
                 services.ladder.start()

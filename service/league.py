@@ -1,5 +1,5 @@
 """The league table teams climb: OpenSkill ratings from the friendlies teams played against each
-other (submitted by a team or scheduled by the ladder, :mod:`service.ladder`).
+other (submitted by a team or scheduled by the ladder, :mod:`service.league_ladder`).
 
 Ratings are not stored: they are replayed from the played matches in the order they finished
 (Plackett-Luce model of the ``openskill`` package, one rating per team), so the table, each

@@ -62,7 +62,7 @@ class Settings:
     test_players: int = 1
     ladder_interval_s: float = 0.0
     """Seconds between two friendlies the ladder schedules between teams that accept them
-    (:mod:`service.ladder`), in free slots only; 0: no ladder."""
+    (:mod:`service.league_ladder`), in free slots only; 0: no ladder."""
     test_grace_s: float = TEST_MATCH.grace_period_s
     expected_match_s: float = 120.0
     """Assumed wall time of one test match until some have finished (for expected starts)."""
