@@ -208,6 +208,13 @@ def test_each_page_with_a_team_token_and_with_an_operator_token(
     screenshot(page, "role-operator-tournament")
     page.goto(f"{served.url}/watch/nodes")
     assert _rows(page, "nodes")[0][0] == "fake-node"
+    page.goto(f"{served.url}/watch/live/{waiting}")  # the fake pool: no telemetry to watch
+    page.wait_for_function("document.querySelector('[data-testid=live-status]').innerText"
+                           ".startsWith('Live view unavailable.')")
+    assert page.locator("[data-testid=game-state]").inner_text() == "not started"
+    assert page.locator("[data-testid=game-clock]").inner_text() == ""
+    assert "no running match of submission" in _text(page)
+    screenshot(page, "role-operator-live-not-started")
     page.goto(f"{served.url}/watch/replay/{friendly}")
     page.wait_for_function("window.hlvsViewer && window.hlvsViewer.ready", timeout=30_000)
     alpha.close()

@@ -2,7 +2,7 @@
 // from the viewer API), the real-time factor and each robot's connection health.
 import type { GameState, RefereeEvent } from "../replay";
 import { SceneView, type SceneSpec } from "../scene";
-import { Scoreboard, authFetch, authHeaders, clock, describeEvent, el } from "../ui";
+import { Scoreboard, authFetch, authHeaders, clock, describeEvent, el, sentence } from "../ui";
 
 type Handler = (data: string) => void;
 
@@ -11,7 +11,7 @@ type Handler = (data: string) => void;
 async function readEvents(url: string, handlers: Record<string, Handler>, status: HTMLElement): Promise<void> {
   const response = await fetch(url, { headers: { ...authHeaders(), Accept: "text/event-stream" } });
   if (!response.ok || !response.body) {
-    status.textContent = `live view unavailable: ${response.status} ${await response.text()}`;
+    status.textContent = `Live view unavailable. ${await sentence(response, url)}`;
     return;
   }
   const reader = response.body.pipeThrough(new TextDecoderStream()).getReader();
