@@ -52,6 +52,7 @@ def _files(folder: Path, *, match_id: str, red_command: str, cpus: float, half_s
     scrimmage_args.add_arguments(parser)
     args = parser.parse_args([
         "--match-id", match_id, "--half-duration", str(half_s), "--ready-duration", "5",
+        "--minimum-play", "0",
         "--wait-before-ready", "1", "--grace", "1", "--red-image", project_image("team-base"),
     ])
     game = scrimmage.write_files(args, folder)

@@ -44,6 +44,7 @@ def _job(folder: Path, name: str, half_s: float, *, league: bool = False) -> Any
         blue_image=None,
         players=2 if league else 1,
         half_duration=half_s,
+        minimum_play=0.0,  # the pool's overhead is measured, not football
         wait_before_ready=1.0,
         grace=2.0,
         robot_command=None,

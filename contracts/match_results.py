@@ -16,7 +16,14 @@ Failure classes (:class:`FailureClass`):
   OOM-killed mid-game does *not* fail the match; it is recorded per robot);
 - ``simulator``: the simulator container exited without FINISHED, or its telemetry was silent;
 - ``referee``: the simulator ran to its end but the game did not reach FINISHED;
-- ``interrupted``: the orchestrator was asked to stop (SIGINT / SIGTERM).
+- ``interrupted``: the orchestrator was asked to stop (SIGINT / SIGTERM);
+- ``not_played``: the game reached FINISHED but no football was played (no half reached PLAYING,
+  or less than the minimum of play of :mod:`contracts.timing`) for a cause of the league: its
+  timing, the referee or the simulator;
+- ``team_absent``: the same, because no robot of a team ever connected; ``team`` names it.
+
+A failure that one team caused names it in ``team`` (``report.json`` too); a failure without a
+team is the league's or the engine's, and is never charged to a team.
 
 Both documents carry a ``version``; a file written before it had one reads as version 1.
 """
@@ -43,6 +50,8 @@ class FailureClass(enum.Enum):
     SIMULATOR = "simulator"
     REFEREE = "referee"
     INTERRUPTED = "interrupted"
+    NOT_PLAYED = "not_played"
+    TEAM_ABSENT = "team_absent"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -51,6 +60,7 @@ class Failure:
 
     failure_class: FailureClass = field(metadata=json_key("class"))
     cause: str
+    team: Color | None = field(default=None, metadata=omitted_when_none())  # who caused it
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -220,6 +230,7 @@ class MatchReport(Versioned):
     # what of the teams' logs was not kept (``{"robot", "what", "reason"}``: a log folder or
     # console output cut at its size limit); the key is present only when something was cut
     logs_cut: tuple[dict[str, str], ...] = ()
+    team: Color | None = field(default=None, metadata=omitted_when_none())
     version: int = VERSION
 
     def __post_init__(self) -> None:
@@ -233,18 +244,19 @@ class MatchReport(Versioned):
         if failure is None:
             return cls(status="success", logs_cut=logs_cut)
         return cls(status="failed", failure_class=failure.failure_class, cause=failure.cause,
-                   logs_cut=logs_cut)
+                   team=failure.team, logs_cut=logs_cut)
 
     @property
     def failure(self) -> Failure | None:
         if self.failure_class is None:
             return None
-        return Failure(failure_class=self.failure_class, cause=self.cause or "")
+        return Failure(failure_class=self.failure_class, cause=self.cause or "", team=self.team)
 
     def to_dict(self) -> dict[str, Any]:
         """Exactly ``{"status": "success"}`` or ``{"status": "failed", "failure_class": ...,
-        "cause": ...}``, as teams' scripts compare it: the version (1) stays implicit until a
-        second one exists. ``logs_cut`` is added only when a team's logs were cut."""
+        "cause": ...}`` (and ``"team"`` when a team caused it), as teams' scripts compare it:
+        the version (1) stays implicit until a second one exists. ``logs_cut`` is added only when
+        a team's logs were cut."""
         data = Versioned.to_dict(self)
         del data["version"]
         if self.failure_class is None:

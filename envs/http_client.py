@@ -4,7 +4,9 @@
     instance = client.env_create("hlvs/Kick-v0", perception=True)
     obs = client.env_reset(instance, seed=1)
     obs, reward, done, info = client.env_step(instance, [0.0] * 20)
-    client.env_monitor_start(instance, video=True); ...; client.env_monitor_close(instance)
+    client.env_monitor_start(instance, "monitor", video_callable=True)  # gym-http-api's form
+    ...
+    client.env_monitor_close(instance)  # the files are now in ./monitor as well
     client.download(instance, "episodes.jsonl", "episodes.jsonl")
     client.env_close(instance)
 
@@ -36,6 +38,7 @@ class EnvClient:
         headers = {"Authorization": f"Bearer {token}"} if token else {}
         self._http = httpx.Client(base_url=base_url.rstrip("/"), headers=headers,
                                   timeout=timeout_s)  # fmt: skip
+        self._directories: dict[str, Path] = {}  # instance -> env_monitor_start's directory
 
     def _call(self, method: str, path: str, body: dict[str, Any] | None = None) -> Any:
         try:
@@ -76,13 +79,31 @@ class EnvClient:
         return dict(self._call("GET", f"/v1/envs/{instance_id}/action_space/")["info"])
 
     def env_monitor_start(
-        self, instance_id: str, *, force: bool = False, resume: bool = False, video: bool = False
+        self, instance_id: str, directory: str | Path | None = None, force: bool = False,
+        resume: bool = False, video_callable: bool = False, *, video: bool | None = None,
     ) -> None:
-        body = {"force": force, "resume": resume, "video": video}
+        """Start recording episodes; gym-http-api's signature (``directory``, ``force``,
+        ``resume``, ``video_callable``), so ported code runs unchanged.
+
+        The monitor's files stay with the service (:meth:`monitor_files`, :meth:`download`);
+        with ``directory``, :meth:`env_monitor_close` also downloads them into that folder on
+        this machine. ``video`` (or a true ``video_callable``) records a video too."""
+        record_video = bool(video_callable) if video is None else video
+        body = {"force": force, "resume": resume, "video": record_video}
         self._call("POST", f"/v1/envs/{instance_id}/monitor/start/", body)
+        if directory is None:
+            self._directories.pop(instance_id, None)
+        else:
+            self._directories[instance_id] = Path(directory)
 
     def env_monitor_close(self, instance_id: str) -> dict[str, Any]:
-        return dict(self._call("POST", f"/v1/envs/{instance_id}/monitor/close/")["stats"])
+        stats = dict(self._call("POST", f"/v1/envs/{instance_id}/monitor/close/")["stats"])
+        directory = self._directories.pop(instance_id, None)
+        if directory is not None:
+            directory.mkdir(parents=True, exist_ok=True)
+            for entry in self.monitor_files(instance_id):
+                self.download(instance_id, str(entry["name"]), directory / str(entry["name"]))
+        return stats
 
     def monitor_files(self, instance_id: str) -> list[dict[str, Any]]:
         return list(self._call("GET", f"/v1/envs/{instance_id}/monitor/files/")["files"])

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from contracts.field import field_for
+from contracts.timing import ENVIRONMENT, MIN_PLAYING_S
 from envs.base import HlvsEnv, Session
 from envs.frame import BALL_POS, UP_Z, Frame
 from envs.match_setup import default_stubs
@@ -39,7 +40,8 @@ class MatchEnv(HlvsEnv):
         *,
         field_class: str = "kid",
         model: str = "kid-default",
-        half_duration_s: float = 60.0,
+        half_duration_s: float = ENVIRONMENT.half_duration_s,
+        minimum_play_s: float = MIN_PLAYING_S,
         learner_pose: tuple[float, float, float] = (-1.0, 0.0, 0.0),
         stubs: tuple[StubSpec, ...] | None = None,
         camera: bool = False,
@@ -57,6 +59,7 @@ class MatchEnv(HlvsEnv):
         spec = SessionSpec(
             field_class=field_class, model=model, learner_pose=tuple(learner_pose),  # type: ignore[arg-type]
             stubs=stubs, referee=True, half_duration_s=half_duration_s,
+            minimum_play_s=minimum_play_s,
             camera=camera or render_mode == "rgb_array", perception=perception,
             perception_noise=perception_noise, steps_per_action=steps_per_action,
             look=look, texture_seed=texture_seed, sensors=sensors,

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from contracts.match_spec import MatchSpec, PlayerSpec, Pose, TeamSpec, TimingSpec
+from contracts.timing import ENVIRONMENT
 from envs.randomization import episode_world
 from envs.session_spec import SessionSpec, StubSpec
 from referee import GameState, Referee, RobotId, TeamColor
@@ -24,8 +25,7 @@ from simulator.match_setup import referee_config
 from simulator.world import MOTOR_NAMES, World
 
 STUB_LOOK_PERIOD_MS = 96
-WAIT_BEFORE_FIRST_READY_S = 1.0
-READY_DURATION_S = 15.0
+WAIT_BEFORE_FIRST_READY_S = ENVIRONMENT.wait_before_first_ready_s
 
 
 @dataclass(slots=True)
@@ -63,7 +63,8 @@ def match_spec(spec: SessionSpec, seed: int) -> MatchSpec:
     }
     timing = TimingSpec(
         half_duration_s=spec.half_duration_s,
-        ready_duration_s=READY_DURATION_S,
+        ready_duration_s=spec.ready_duration_s,
+        minimum_play_s=spec.minimum_play_s,
         wait_before_first_ready_real_s=WAIT_BEFORE_FIRST_READY_S,
         half_time_break_real_s=0.0,
     )

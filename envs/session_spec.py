@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field, fields
 from typing import Any
 
+from contracts.timing import ENVIRONMENT, MIN_PLAYING_S, TimingError, fit_ready
 from envs.errors import EnvConfigError
 
 LOOKS = ("fixed", "random")
@@ -40,7 +41,8 @@ class SessionSpec:
     learner_pose: tuple[float, float, float] = (-1.0, 0.0, 0.0)  # team frame, for matches
     stubs: tuple[StubSpec, ...] = ()
     referee: bool = False  # run the GameController and the automatic referee
-    half_duration_s: float = 60.0
+    half_duration_s: float = ENVIRONMENT.half_duration_s
+    minimum_play_s: float = MIN_PLAYING_S  # PLAYING each half keeps (0: not meant to play)
     steps_per_action: int = 1  # basic steps (8 ms) per environment step
     camera: bool = False
     perception: bool = False
@@ -79,6 +81,22 @@ class SessionSpec:
             raise EnvConfigError(
                 field="perception_noise", value=self.perception_noise, expected="a number >= 0"
             )
+        if self.referee:
+            try:
+                fit_ready(self.half_duration_s, ENVIRONMENT.ready_duration_s,
+                          minimum_s=self.minimum_play_s)
+            except TimingError as exc:
+                raise EnvConfigError(field="half_duration_s", value=self.half_duration_s,
+                                     expected=f"a longer half (or minimum_play_s 0): {exc}"
+                                     ) from None
+
+    @property
+    def ready_duration_s(self) -> float:
+        """READY of this session's halves (:data:`contracts.timing.ENVIRONMENT`), shortened
+        when the half would keep less than ``minimum_play_s`` of play."""
+        ready, _warning = fit_ready(self.half_duration_s, ENVIRONMENT.ready_duration_s,
+                                    minimum_s=self.minimum_play_s)
+        return ready
         for stub in self.stubs:
             if stub.role not in ROLES:
                 raise EnvConfigError(

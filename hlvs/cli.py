@@ -145,7 +145,16 @@ class _StderrHandler(logging.StreamHandler):  # type: ignore[type-arg]
         pass
 
 
+LIBRARY_LOGGERS = ("alembic", "OpenGL", "urllib3", "docker", "httpx", "httpcore", "asyncio",
+                   "botocore", "boto3", "s3transfer", "paramiko", "apscheduler", "PIL",
+                   "matplotlib", "sqlalchemy", "multipart", "filelock")
+"""Libraries whose own lines are shown only from WARNING, whatever ``-v`` says: ``-v`` is for
+this project's lines (an INFO line of Alembic or OpenGL, a DEBUG line of urllib3, is noise)."""
+
+
 def configure_logging(level: int) -> None:
+    for name in LIBRARY_LOGGERS:
+        logging.getLogger(name).setLevel(max(level, logging.WARNING))
     fmt = (
         "%(asctime)s %(levelname)s %(name)s: %(message)s"
         if level <= logging.INFO

@@ -85,6 +85,7 @@ class _Render:
     started: float
     partial: Path
     video: Path
+    work: Path  # the match's work folder (render log and state)
 
 
 class AfterMatch:
@@ -103,11 +104,23 @@ class AfterMatch:
         self._thread.start()
 
     def stop(self) -> None:
-        """Stop the thread; a render under way goes on and is taken up by the next start."""
+        """Stop the thread and a render under way (the renderer and its ffmpeg: nothing of the
+        service outlives it); the next start renders that video again, not counting the
+        stopped render against :data:`MAX_RENDERS`."""
         self._stop.set()
         self._wake.set()
         if self._thread is not None:
             self._thread.join(timeout=30)
+        render, self._render = self._render, None
+        if render is not None and render.process.poll() is None:
+            _stop_group(render.process)
+            render.partial.unlink(missing_ok=True)
+            state = _read_json(render.work / RENDER_STATE)
+            renders = state.get("renders")
+            if isinstance(renders, int):
+                (render.work / RENDER_STATE).write_text(json.dumps(
+                    {"renders": max(0, renders - 1)}))
+            log.info("submission %s: render stopped with the service", render.submission_id)
 
     def wake(self) -> None:
         self._wake.set()
@@ -249,7 +262,7 @@ class AfterMatch:
             "pid": process.pid, "start_time": process_start_time(process.pid),
             "renders": renders}))
         self._render = _Render(submission_id=row.id, process=process, started=time.monotonic(),
-                               partial=partial, video=video_of(out))
+                               partial=partial, video=video_of(out), work=work)
         log.info("submission %s: rendering the video of match %s (pid %d)", row.id,
                  row.match_id, process.pid)
 
@@ -285,6 +298,20 @@ class AfterMatch:
         row.video_detail = detail
         log.log(logging.WARNING if state is MediaState.FAILED else logging.INFO,
                 "submission %s: video %s (%s)", row.id, state.value, detail)
+
+
+def _stop_group(process: subprocess.Popen[bytes], timeout_s: float = 5.0) -> None:
+    """SIGTERM to the process group (the renderer and ffmpeg), SIGKILL when it lingers."""
+    for sig in (signal.SIGTERM, signal.SIGKILL):
+        try:
+            os.killpg(process.pid, sig)
+        except ProcessLookupError:
+            return
+        try:
+            process.wait(timeout=timeout_s)
+            return
+        except subprocess.TimeoutExpired:
+            continue
 
 
 def _idle_priority() -> list[str]:

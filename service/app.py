@@ -39,7 +39,16 @@ Mount = Callable[[FastAPI], None]
 def service_routers() -> tuple[Mount, ...]:
     """The service's own routers, in the order they are mounted (imported when an app is built:
     they import the service's modules, which import this one for :class:`Services`)."""
-    from service.routers import envs, health, ladder, nodes, operator, submissions, teams
+    from service.routers import (
+        envs,
+        everyone,
+        health,
+        ladder,
+        nodes,
+        operator,
+        submissions,
+        teams,
+    )
 
     return (
         health.mount,
@@ -47,6 +56,7 @@ def service_routers() -> tuple[Mount, ...]:
         submissions.mount,
         operator.mount,
         nodes.mount,  # the match pool's machines (operators)
+        everyone.mount,  # whoami, the queue and the matches, each role what it may see
         envs.mount,  # the HTTP environment API (learning environments)
         ladder.mount,  # the league table of ratings
     )

@@ -12,6 +12,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+from contracts.timing import TEST_MATCH
 from orchestrator.match.scrimmage import game_file, team_file
 from orchestrator.private_files import private_dir, write_private
 from service.settings import Settings
@@ -35,7 +36,8 @@ def write_match(folder: Path, *, match_id: str, team: dict[str, Any],
     args = argparse.Namespace(players=settings.test_players, seed=seed,
                               half_duration=settings.test_half_duration_s,
                               ready_duration=settings.test_ready_duration_s,
-                              wait_before_ready=3.0, grace=settings.test_grace_s)
+                              wait_before_ready=TEST_MATCH.wait_before_first_ready_s,
+                              grace=settings.test_grace_s)
     game = game_file(args, match_id)
     game["registry_images"] = True  # a team's images only from its registry, with its login
     game["red"]["ports"] = _ports(10000, team)

@@ -22,6 +22,7 @@ from sqlalchemy.orm import Session
 
 from service import outbound, webhooks
 from service.db import Notification, Submission, Team, now, transaction, utc
+from service.matchfiles import OWN_COLOR
 from service.settings import Settings
 
 if TYPE_CHECKING:
@@ -32,27 +33,53 @@ log = logging.getLogger(__name__)
 MAIL_EVENTS = {"submission.started", "submission.finished", "submission.failed"}
 
 
-def payload(row: Submission, event: str, settings: Settings) -> dict[str, Any]:
-    base = f"{settings.public_url.rstrip('/')}/v1/submissions/{row.id}"
+def outcome_of(row: Submission, results: dict[str, Any] | None) -> str:
+    """The outcome in words for the submitting team (red): won, drew, lost, or why not played."""
+    if row.state == "cancelled":
+        return "cancelled"
+    if row.state == "failed":
+        side = "the league's side (not charged)" if row.failure_side == "league" else \
+            "your team's side"
+        return f"not counted: {row.failure_class} on {side}"
+    winner = (results or {}).get("winner")
+    if row.state != "done" or winner is None:
+        return row.state
+    return {OWN_COLOR: "won", "draw": "draw"}.get(winner, "lost")
+
+
+def payload(row: Submission, event: str, settings: Settings,
+            results: dict[str, Any] | None = None) -> dict[str, Any]:
+    """The notification's data: the submission, its score and outcome (from ``results``, the
+    match's results.json, when it ended), links to the API and to the pages a browser opens."""
+    public = settings.public_url.rstrip("/")
+    base = f"{public}/v1/submissions/{row.id}"
+    play = (results or {}).get("play") or {}
     return {
         "event": event,
         "submission": {
             "id": row.id, "state": row.state, "opponent": row.opponent, "match_id": row.match_id,
             "failure_class": row.failure_class, "failure_side": row.failure_side,
             "cause": row.cause, "charged": row.charged,
+            "score": (results or {}).get("score"), "outcome": outcome_of(row, results),
+            "playing_s": play.get("playing_s"), "halves_playing": play.get("halves_playing"),
             "links": {"status": base, "report": base + "/report", "results": base + "/results",
                       "logs": base + "/logs"},
+            "pages": {"submissions": f"{public}/watch/submissions",
+                      "live": f"{public}/watch/live/{row.id}",
+                      "replay": f"{public}/watch/replay/{row.id}",
+                      "ladder": f"{public}/watch/ladder"},
         },
     }
 
 
-def enqueue(session: Session, row: Submission, event: str, settings: Settings) -> None:
+def enqueue(session: Session, row: Submission, event: str, settings: Settings,
+            results: dict[str, Any] | None = None) -> None:
     """Outbox rows for ``event``: a mail when the team has an address and SMTP is set, a
     webhook when the team has a webhook URL."""
     team = session.get(Team, row.team_id)
     if team is None:
         return
-    body = json.dumps(payload(row, event, settings), sort_keys=True)
+    body = json.dumps(payload(row, event, settings, results), sort_keys=True)
     channels = []
     if team.email and settings.smtp_host and event in MAIL_EVENTS:
         channels.append("mail")
@@ -72,14 +99,28 @@ def send_mail(settings: Settings, *, to: str, event: str, data: dict[str, Any]) 
     message["To"] = to
     what = event.split(".", 1)[1]
     message["Subject"] = f"[hlvs] test match {sub['id']} {what}"
+    pages = sub.get("pages") or {}
     lines = [f"Your test match {sub['id']} against {sub['opponent']} {what}.", "",
-             f"state: {sub['state']}"]
-    if sub.get("failure_class"):
-        lines.append(f"failure: {sub['failure_class']} (on the {sub['failure_side']} side)")
+             f"state:   {sub['state']}"]
+    score = sub.get("score")
+    if score:
+        lines.append(f"score:   you (red) {score['red']} : {score['blue']} {sub['opponent']}")
+    if event != "submission.started":
+        lines.append(f"outcome: {sub.get('outcome') or sub['state']}")
+    if sub.get("playing_s") is not None:
+        lines.append(f"played:  {sub['playing_s']:g} s in PLAYING, halves "
+                     f"{sub.get('halves_playing') or 'none'}")
     if sub.get("cause"):
-        lines.append(f"cause: {sub['cause']}")
-    lines += ["", f"status:  {sub['links']['status']}", f"report:  {sub['links']['report']}",
-              f"results: {sub['links']['results']}", f"logs:    {sub['links']['logs']}"]
+        lines.append(f"cause:   {sub['cause']}")
+    lines += ["", "Open in a browser (sign in with your team token once):"]
+    if event == "submission.started":
+        lines.append(f"  watch live:   {pages.get('live', '')}")
+    else:
+        lines.append(f"  replay:       {pages.get('replay', '')}")
+    lines += [f"  your matches: {pages.get('submissions', '')}",
+              f"  ladder:       {pages.get('ladder', '')}",
+              "", "For scripts (API, Authorization: Bearer <token>):",
+              f"  results: {sub['links']['results']}", f"  logs:    {sub['links']['logs']}"]
     message.set_content("\n".join(lines) + "\n")
     with smtplib.SMTP(settings.smtp_host, settings.smtp_port, timeout=10) as smtp:
         smtp.send_message(message)

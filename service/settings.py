@@ -13,6 +13,7 @@ from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
+from contracts.timing import TEST_MATCH, TimingError, fit_ready
 from service.errors import SettingsError
 
 PREFIX = "HLVS_SERVICE_"
@@ -56,12 +57,13 @@ class Settings:
     """With the Slurm pool: ``dense``, a whole match on one node; ``league``, the simulator on a
     node and each robot on a node of its own (docs/slurm.md)."""
     worker_poll_s: float = 1.0
-    test_half_duration_s: float = 30.0
-    test_ready_duration_s: float = 45.0
-    """READY of a test match (the GameController's clock stands still in it before each
-    half's kick-off, so it adds to the match's length)."""
+    test_half_duration_s: float = TEST_MATCH.half_duration_s
+    test_ready_duration_s: float = TEST_MATCH.ready_duration_s
+    """READY of a test match; shortened with a warning when the half would keep less than the
+    minimum of play (:mod:`contracts.timing`). Before each half's kick-off the GameController's
+    clock stands still in it, so it adds to the match's length."""
     test_players: int = 1
-    test_grace_s: float = 5.0
+    test_grace_s: float = TEST_MATCH.grace_period_s
     expected_match_s: float = 120.0
     """Assumed wall time of one test match until some have finished (for expected starts)."""
     video: bool = True
@@ -185,6 +187,12 @@ def _check(settings: Settings) -> None:
     if settings.match_slots < 1:
         raise SettingsError(name=PREFIX + "MATCH_SLOTS", value=str(settings.match_slots),
                             expected="at least 1")
+    try:
+        fit_ready(settings.test_half_duration_s, settings.test_ready_duration_s)
+    except TimingError as exc:
+        raise SettingsError(name=PREFIX + "TEST_HALF_DURATION_S",
+                            value=f"{settings.test_half_duration_s:g}",
+                            expected=f"a longer half: {exc}") from None
 
 
 __all__ = ["Settings", "webhook_networks"]

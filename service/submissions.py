@@ -35,11 +35,19 @@ log = logging.getLogger(__name__)
 
 STUB = "stub"
 TEAM_SIDE = {"image_pull", "team_startup", "team_crash"}
-LEAGUE_SIDE = {"infrastructure", "simulator", "referee"}
+LEAGUE_SIDE = {"infrastructure", "simulator", "referee", "not_played"}
+ABSENT = "team_absent"
+"""No robot of one team connected, so nothing was played: that team's side (``team`` of the
+report), never the other's."""
 
 
-def failure_side(failure_class: str | None) -> str | None:
-    """Whose side a failure was on: ``team``, ``league`` or None (no failure / cancelled)."""
+def failure_side(failure_class: str | None, team: str | None = None,
+                 own_color: str = "red") -> str | None:
+    """Whose side a failure was on: ``team``, ``league`` or None (no failure / cancelled).
+    ``team`` is the colour the match report blames (the submitting team plays ``own_color``);
+    an absent opponent (the stub, or a friendly's) is not the submitting team's doing."""
+    if failure_class == ABSENT:
+        return "team" if team == own_color else "league"
     if failure_class in TEAM_SIDE:
         return "team"
     if failure_class in LEAGUE_SIDE:

@@ -173,17 +173,34 @@ def store(session: Session, *, team_id: int, kind: str, document: Any,
 
 
 def get(session: Session, *, team_id: int, kind: str, version: int | None = None) -> TeamFile:
-    """The given version, or the newest one."""
+    """The given version, or the current one: the newest that did not fail a pre-flight
+    check (:func:`refuse`)."""
     if kind not in KINDS:
         raise NotFound(what="file kind", ident=kind)
     query = select(TeamFile).where(TeamFile.team_id == team_id, TeamFile.kind == kind)
     if version is not None:
         query = query.where(TeamFile.version == version)
+    else:
+        query = query.where(TeamFile.valid.is_(True))
     row = session.scalar(query.order_by(TeamFile.version.desc()).limit(1))
     if row is None:
         ident = KINDS[kind] + (f" version {version}" if version is not None else "")
-        raise NotFound(what="uploaded file", ident=ident)
+        what = "uploaded file" if version is not None else "uploaded file that passed its checks"
+        raise NotFound(what=what, ident=ident)
     return row
+
+
+def refuse(session: Session, row: TeamFile, *, stage: str, cause: str) -> None:
+    """A version that failed the pre-flight check never becomes current: marked invalid, with
+    the failure among its problems (the previous valid version stays current)."""
+    problems = json.loads(row.problems_json)
+    text = f"pre-flight check failed at {stage}: {cause}"
+    problems.append({"file": KINDS[row.kind], "pointer": "", "message": text, "expected": "",
+                     "suggestion": "", "severity": "error", "text": text})
+    row.valid = False
+    row.problems_json = json.dumps(problems)
+    log.info("team %d: %s version %d failed its pre-flight check: not current", row.team_id,
+             KINDS[row.kind], row.version)
 
 
 def versions(session: Session, *, team_id: int, kind: str) -> list[TeamFile]:
@@ -239,4 +256,4 @@ def newest_id(session: Session, *, team_id: int, kind: str) -> int | None:
 
 
 __all__ = ["KINDS", "check", "get", "get_by_id", "newest_id", "opened", "raise_if_invalid",
-           "seal_stored", "service_problems", "store", "versions"]
+           "refuse", "seal_stored", "service_problems", "store", "versions"]

@@ -14,6 +14,7 @@ is queued again at its old place, with a new attempt number (nothing is lost).
 
 from __future__ import annotations
 
+import json
 import logging
 import threading
 import zlib
@@ -279,18 +280,20 @@ class QueueWorker:
         else:
             self._end(session, row, SubmissionState.FAILED,
                       failure_class=report.failure_class.value,
-                      cause=report.cause or "the match failed")
+                      cause=report.cause or "the match failed", team=report.team)
 
     def _end(self, session: Session, row: Submission, state: SubmissionState, *,
-             cause: str | None, failure_class: str | None = None) -> None:
+             cause: str | None, failure_class: str | None = None,
+             team: str | None = None) -> None:
         row.state = state.value
         row.finished_at = now()
         row.pool_detail = None
         row.cause = cause
         row.failure_class = failure_class
-        row.failure_side = failure_side(failure_class)
+        row.failure_side = failure_side(failure_class, team, OWN_COLOR)
         out = self.pool.results_dir(row.pool_handle) if row.pool_handle is not None else None
-        if out is not None and self.settings.video and replay_of(out).is_file():
+        if out is not None and self.settings.video and state is not SubmissionState.CANCELLED \
+                and replay_of(out).is_file():
             row.video_state = MediaState.PENDING.value
             row.video_detail = "waiting for the render"
         if out is not None and row.credentials_file_id is not None and \
@@ -305,9 +308,22 @@ class QueueWorker:
         event = {SubmissionState.DONE: "submission.finished",
                  SubmissionState.FAILED: "submission.failed",
                  SubmissionState.CANCELLED: "submission.cancelled"}[state]
-        notify.enqueue(session, row, event, self.settings)
+        notify.enqueue(session, row, event, self.settings, results=_results_of(out))
         log.info("submission %s %s%s", row.id, state.value,
                  f" ({failure_class}: {cause})" if failure_class else "")
+
+
+def _results_of(out: Path | None) -> dict[str, Any] | None:
+    """The match's results.json as data (score, winner, play), None when there is none."""
+    path = out / files.RESULTS if out is not None else None
+    if path is None or not path.is_file():
+        return None
+    try:
+        data: dict[str, Any] = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        log.warning("unreadable %s: %s", path, exc)
+        return None
+    return data
 
 
 __all__ = ["MAX_ATTEMPTS", "QueueWorker"]

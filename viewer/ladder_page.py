@@ -41,8 +41,8 @@ const app = document.getElementById("app");
 const box = document.querySelector("[data-testid=token]");
 box.value = sessionStorage.getItem(KEY) || localStorage.getItem(KEY) || "";
 document.querySelector("[data-testid=token-save]").addEventListener("click", () => {
-  if (box.value.trim()) localStorage.setItem(KEY, box.value.trim());
-  else localStorage.removeItem(KEY);
+  if (box.value.trim()) sessionStorage.setItem(KEY, box.value.trim());
+  else sessionStorage.removeItem(KEY);
   location.reload();
 });
 

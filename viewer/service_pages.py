@@ -1,30 +1,34 @@
 """The viewer inside ``hlvs serve``: replays and live views of a team's own test matches.
 
 Mounted by ``hlvs.app``. Replay and live ids are submission ids; every route
-needs the team's token (``Authorization: Bearer``; the pages keep it in the browser's local
-storage), and another team's submission answers 404 like an unknown one. The pages for the
-queue, submissions, schedule and standings and the pool are the same front end, reading the
-service's own ``/v1`` API with that token.
+needs a token (``Authorization: Bearer``; the pages ask for it once and keep it for the browser
+session). A team sees its own matches and the friendlies it played as the opponent; another
+team's submission answers 404 like an unknown one. An operator sees every match. The pages for
+the queue, the matches, the tournament and the pool (the ladder has a page of its own,
+:mod:`viewer.ladder_page`) are the same front end,
+reading the service's own ``/v1`` API with that token.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Annotated, Any
 
-from fastapi import FastAPI, Request
-from sqlalchemy import select
+from fastapi import Depends, FastAPI, Request
+from sqlalchemy import select, true
 
 from contracts import files
-from service import submissions
 from service.db import Submission
-from service.deps import DbSession, TeamPrincipal, get_services
+from service.db.models import Scope
+from service.deps import DbSession, get_services, require_token
 from service.errors import NotFound
-from service.ladder import watchable
+from service.tokens import Principal
 from viewer.api import mount_viewer
 from viewer.sources import LiveSource, ReplaySource, live_of
 
 REPLAY = Path("public") / files.REPLAY
 STATS = Path("public") / files.API_STATS
+LISTING_LIMIT = 200
 
 
 def _match_dir(request: Request, row: Submission) -> Path | None:
@@ -42,31 +46,47 @@ def _replay_of(row: Submission, out: Path | None) -> ReplaySource | None:
     return ReplaySource(id=row.id, path=out / REPLAY, stats_path=stats if stats.is_file() else None)
 
 
+AnyPrincipal = Annotated[Principal, Depends(require_token)]
+
+
+def _visible(principal: Principal) -> Any:
+    """The submissions ``principal`` may watch: all for an operator; a team's own and the
+    friendlies it played as the opponent."""
+    if principal.scope is Scope.OPERATOR:
+        return true()
+    return (Submission.team_id == principal.team_id) | (Submission.opponent == principal.team_name)
+
+
+def _get(session: DbSession, principal: Principal, submission_id: str) -> Submission:
+    row = session.scalar(select(Submission).where(Submission.id == submission_id,
+                                                  _visible(principal)))
+    if row is None:
+        raise NotFound(what="submission", ident=submission_id)
+    return row
+
+
 class SubmissionResolver:
-    def replay(self, replay_id: str, request: Request, principal: TeamPrincipal,
+    def replay(self, replay_id: str, request: Request, principal: AnyPrincipal,
                session: DbSession) -> ReplaySource:
-        assert principal.team_id is not None
-        row = watchable(session, team_id=principal.team_id, team_name=principal.team_name,
-                        submission_id=replay_id)  # a friendly's opponent watches it too
+        row = _get(session, principal, replay_id)
         source = _replay_of(row, _match_dir(request, row))
         if source is None:
             raise NotFound(what="replay of submission", ident=f"{row.id} ({row.state})")
         return source
 
-    def live(self, match_id: str, request: Request, principal: TeamPrincipal,
+    def live(self, match_id: str, request: Request, principal: AnyPrincipal,
              session: DbSession) -> LiveSource:
-        assert principal.team_id is not None
-        row = submissions.get_own(session, team_id=principal.team_id, submission_id=match_id)
+        row = _get(session, principal, match_id)
         out = _match_dir(request, row)
         live = live_of(out, id=row.id) if out is not None and row.state == "running" else None
         if live is None:
             raise NotFound(what="running match of submission", ident=f"{row.id} ({row.state})")
         return live
 
-    def listing(self, request: Request, principal: TeamPrincipal, session: DbSession
+    def listing(self, request: Request, principal: AnyPrincipal, session: DbSession
                 ) -> tuple[list[ReplaySource], list[LiveSource]]:
-        rows = session.scalars(select(Submission).where(Submission.team_id == principal.team_id)
-                               .order_by(Submission.seq.desc()))
+        rows = session.scalars(select(Submission).where(_visible(principal))
+                               .order_by(Submission.seq.desc()).limit(LISTING_LIMIT))
         replays, live = [], []
         for row in rows:
             out = _match_dir(request, row)

@@ -2,7 +2,9 @@
 
 Writes the compose file, ``match_spec.json`` next to it, and the ``out/`` and ``logs/`` folders;
 ``docker compose up --abort-on-container-exit --exit-code-from simulator`` (or the same with
-``docker-compose`` 1.27 or later) then plays the match.
+``docker-compose`` 1.27 or later) then plays the match. The same command with ``--collect``
+then writes ``results.json`` and ``report.json`` next to the compose file, and
+``docker compose down`` removes the containers and networks.
 """
 
 from __future__ import annotations
@@ -37,6 +39,11 @@ def register(sub: Any) -> None:
         "(default: in 10.214.0.0/16, derived from the match id)",
     )
     parser.add_argument(
+        "--collect", action="store_true",
+        help="after the match was played: write results.json and report.json next to the "
+        "compose file from out/sim_result.json (exit 0 only when the match played)",
+    )
+    parser.add_argument(
         "--json", action="store_true",
         help="print one JSON object (files written, warnings, command to play it)",
     )
@@ -56,6 +63,8 @@ def _compose(args: argparse.Namespace) -> int:
                 [Problem("(command line)", "--subnet-start", str(exc), "an address like 10.9.0.0")]
             ) from exc
     loaded = load_game(args.game, images_required=True)
+    if args.collect:
+        return _collect(args, loaded)
     if not args.json:
         for warning in loaded.warnings:
             print(warning)
@@ -68,6 +77,8 @@ def _compose(args: argparse.Namespace) -> int:
     spec = write_compose(loaded, args.output, simulator_image=image, subnets=subnets)
     up = f"-f {args.output.name} up --abort-on-container-exit --exit-code-from simulator"
     command = f"docker compose {up}"
+    collect = f"hlvs compose {args.game} -o {args.output} --collect"
+    down = f"-f {args.output.name} down"
     if args.json:
         print(
             json.dumps(
@@ -78,6 +89,9 @@ def _compose(args: argparse.Namespace) -> int:
                     "directory": str(args.output.parent),
                     "command": command,
                     "command_v1": f"docker-compose {up}",
+                    "collect": collect,
+                    "down": f"docker compose {down}",
+                    "down_v1": f"docker-compose {down}",
                 },
                 indent=2,
             )
@@ -86,4 +100,25 @@ def _compose(args: argparse.Namespace) -> int:
     print(f"wrote {args.output} and {spec}")
     print(f"play it: cd {args.output.parent} && {command}")
     print(f"  or, with docker-compose 1.27 or later: docker-compose {up}")
+    print(f"then results.json and report.json: {collect}")
+    print(f"and remove its containers and networks: docker compose {down}")
+    print(f"  or: docker-compose {down}")
     return 0
+
+
+def _collect(args: argparse.Namespace, loaded: Any) -> int:
+    from orchestrator.compose import collect_results
+    from orchestrator.exitcodes import ExitCode
+
+    results = collect_results(loaded, args.output.parent)
+    folder = args.output.parent
+    summary = {"results": str(folder / "results.json"), "report": str(folder / "report.json"),
+               "status": results.status, "score": results.score,
+               "failure": None if results.failure is None else
+               f"{results.failure.failure_class.value}: {results.failure.cause}"}
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        print(f"wrote {summary['results']} and {summary['report']}: {results.status}"
+              + (f" ({summary['failure']})" if results.failure else f", score {results.score}"))
+    return int(ExitCode.OK if results.ok else ExitCode.FAILED)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 
+from contracts.timing import MIN_PLAYING_S, MIN_READY_S, SCRIMMAGE, SET_TO_PLAY_S
 from orchestrator.paths import user_path
 
 
@@ -29,15 +30,25 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--players", type=int, default=1, choices=(1, 2, 3, 4),
                         help="robots per team: a striker, then a goalie, then defenders "
                              "(default 1)")
-    parser.add_argument("--half-duration", type=float, default=40.0,
+    parser.add_argument("--half-duration", type=float, default=SCRIMMAGE.half_duration_s,
                         help="simulated seconds of game clock per half; READY and SET before the "
-                        "half's kick-off stop the clock (default 40)")
-    parser.add_argument("--ready-duration", type=float, default=20.0,
-                        help="simulated seconds of READY in this scrimmage (default 20; "
-                             "matches: 45)")
-    parser.add_argument("--wait-before-ready", type=float, default=3.0,
-                        help="wall seconds between robot start and the first READY (default 3)")
-    parser.add_argument("--grace", type=float, default=5.0,
+                        "half's kick-off stop the clock (default "
+                        f"{SCRIMMAGE.half_duration_s:g}; at least "
+                        f"{MIN_READY_S + SET_TO_PLAY_S + MIN_PLAYING_S:g}: each half keeps "
+                        f"{MIN_PLAYING_S:g} s of play)")
+    parser.add_argument("--ready-duration", type=float, default=SCRIMMAGE.ready_duration_s,
+                        help="simulated seconds of READY in this scrimmage (default "
+                        f"{SCRIMMAGE.ready_duration_s:g}, shortened with a warning when the "
+                        "half would keep less than the minimum of play; matches: 45)")
+    parser.add_argument("--minimum-play", type=float, default=MIN_PLAYING_S,
+                        help="simulated seconds of PLAYING each half keeps and the match must "
+                        f"play to count (default {MIN_PLAYING_S:g}); 0: a match not meant to "
+                        "play football (a quick test of containers, logs or signals)")
+    parser.add_argument("--wait-before-ready", type=float,
+                        default=SCRIMMAGE.wait_before_first_ready_s,
+                        help="wall seconds between robot start and the first READY (default "
+                        f"{SCRIMMAGE.wait_before_first_ready_s:g})")
+    parser.add_argument("--grace", type=float, default=SCRIMMAGE.grace_period_s,
                         help="seconds robots get to stop after the game (default 5)")
     parser.add_argument("--robot-command", default=None,
                         help="dockerCmd of every robot (default: goalie / striker for the stub)")

@@ -13,6 +13,7 @@ import re
 from pathlib import Path
 from typing import Any
 
+from contracts.timing import SET_TO_PLAY_S, timing_problem
 from orchestrator.config.model import COLORS, Color, GameConfig, Limits, TeamRef, Timing
 from orchestrator.config.problems import Collector, pointer
 from orchestrator.config.schema import validate
@@ -166,6 +167,12 @@ def _real_time_factor(document: dict[str, Any], where: Collector) -> float | Non
     return DEFAULT_MAXIMUM_REAL_TIME_FACTOR
 
 
+def timing_of(document: dict[str, Any], where: Collector, *, fast: bool) -> Timing:
+    """The timing of a game document (``timing``, ``game_controller_extra_args``, ``type``),
+    its problems in ``where``; also used for a schedule's ``game_defaults``."""
+    return _timing(document, where, fast=fast)
+
+
 def _timing(document: dict[str, Any], where: Collector, *, fast: bool) -> Timing:
     """Timing from ``timing`` and the GameController arguments.
 
@@ -215,9 +222,30 @@ def _timing(document: dict[str, Any], where: Collector, *, fast: bool) -> Timing
         written[name] = seconds
     durations: dict[str, float] = {k: float(v) for k, v in written.items()}
     max_duration = document.get("max_duration")
-    return Timing(
+    timing = Timing(
         **durations, max_duration_s=float(max_duration) if max_duration is not None else None
     )
+    _check_play_time(timing, written, document.get("type"), where)
+    return timing
+
+
+def _check_play_time(timing: Timing, written: dict[str, Any], game_type: Any,
+                     where: Collector) -> None:
+    """A half whose READY plus SET leaves less than the minimum of play is refused
+    (:mod:`contracts.timing`): the match would end 0:0 without a kick."""
+    halves = [("half_duration_s", timing.half_duration_s, "half")]
+    if game_type == "KNOCKOUT":
+        halves.append(("overtime_half_duration_s", timing.overtime_half_duration_s,
+                       "half of extra time"))
+    for name, seconds, what in halves:
+        problem = timing_problem(seconds, timing.ready_duration_s, what=what,
+                                 minimum_s=timing.minimum_play_s)
+        if problem is None:
+            continue
+        at = "ready_duration_s" if "ready_duration_s" in written else name
+        where.error(pointer("timing", at), problem,
+                    expected=f"ready_duration_s + {SET_TO_PLAY_S:g} s (SET) + minimum_play_s "
+                    f"({timing.minimum_play_s:g} s) <= {name}")
 
 
 def _limits(raw: dict[str, Any]) -> Limits:

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
 
+from contracts.timing import MIN_PLAYING_S, OFFICIAL
 from orchestrator.errors import Problem
 
 GameType = Literal["NORMAL", "KNOCKOUT", "PENALTY"]
@@ -49,14 +50,16 @@ class Limits:
 class Timing:
     """Game timing. Durations of play are simulated seconds; waits and grace are wall seconds."""
 
-    half_duration_s: float = 600.0
+    half_duration_s: float = OFFICIAL.half_duration_s
     overtime_half_duration_s: float = 300.0
-    ready_duration_s: float = 45.0
-    wait_before_first_ready_s: float = 120.0  # wall time between robot start and first READY
-    half_time_break_s: float = 15.0  # wall time
-    grace_period_s: float = 120.0  # wall time given to robots to stop after the game
+    ready_duration_s: float = OFFICIAL.ready_duration_s
+    # wall time between robot start and first READY
+    wait_before_first_ready_s: float = OFFICIAL.wait_before_first_ready_s
+    half_time_break_s: float = OFFICIAL.half_time_break_s  # wall time
+    grace_period_s: float = OFFICIAL.grace_period_s  # wall time given to robots to stop
     removal_penalty_s: float = 10.0
     max_duration_s: float | None = None  # HLVS max_duration: stop the game after this wall time
+    minimum_play_s: float = MIN_PLAYING_S  # simulated s of PLAYING per half (0: not meant to play)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

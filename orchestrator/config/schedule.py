@@ -298,7 +298,7 @@ def load_schedule(path: str | Path, *, text: str | None = None) -> Schedule:
         matches=tuple(matches),
         pool=SchedulePool(**data.get("pool", {})),
     )
-    problems = _cross_problems(path, schedule, data)
+    problems = _cross_problems(path, schedule, data) + _timing_problems(path, schedule)
     if problems:
         raise ConfigError(problems)
     return schedule
@@ -309,6 +309,31 @@ def _timing(data: dict[str, Any]) -> ScheduleTiming:
     if "delivery_attempts" in values:
         values["delivery_attempts"] = int(values["delivery_attempts"])
     return ScheduleTiming(**values)
+
+
+def _timing_problems(path: Path, schedule: Schedule) -> list[Problem]:
+    """The game timing every match of the schedule gets (``game_defaults``), checked as a
+    game.json's is (:mod:`contracts.timing`): refused here, not when the first match starts."""
+    from orchestrator.config.game import timing_of
+    from orchestrator.config.problems import Collector
+
+    defaults = schedule.game_defaults
+    if not isinstance(defaults.get("timing", {}), dict):
+        return []  # the schema reports it
+    where = Collector(str(path))
+    rtf = defaults.get("maximum_real_time_factor", 0)
+    for kind in sorted({m.kind for m in schedule.matches}):
+        document = {**defaults, "type": "KNOCKOUT" if kind == "knockout" else "NORMAL"}
+        timing_of(document, where, fast=isinstance(rtf, int | float) and rtf <= 0)
+    seen: set[tuple[str, str]] = set()
+    problems = []
+    for problem in where.errors:
+        if (problem.pointer, problem.message) in seen:
+            continue
+        seen.add((problem.pointer, problem.message))
+        problems.append(Problem(problem.file, "/game_defaults" + problem.pointer,
+                                problem.message, expected=problem.expected))
+    return problems
 
 
 def _slot(value: Any) -> Slot:

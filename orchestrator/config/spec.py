@@ -78,6 +78,7 @@ def to_match_spec(
             half_time_break_real_s=timing.half_time_break_s,
             removal_penalty_s=timing.removal_penalty_s,
             max_duration_real_s=timing.max_duration_s,
+            minimum_play_s=timing.minimum_play_s,
         ),
         network=NetworkSpec(
             api_bind_host=api_bind_host,

@@ -18,6 +18,7 @@ from pathlib import Path
 from contracts import files
 from contracts.errors import ContractError
 from contracts.match_results import MatchLimits, MatchResults
+from contracts.match_spec import MatchSpec, TimingSpec
 from contracts.sim_result import SimResult
 from orchestrator.errors import OrchestratorError
 from orchestrator.match import layout
@@ -26,6 +27,7 @@ from orchestrator.match.logfs import LogFolder
 from orchestrator.match.results import (
     FailureClass,
     build_results,
+    play_failure,
     write_report,
     write_results,
 )
@@ -253,14 +255,30 @@ def _version() -> str:
         return "unknown"
 
 
+def _spec_timing(match: MatchContext) -> TimingSpec | None:
+    match_dir = match.started.match_dir
+    if match_dir is None or not (match_dir / files.MATCH_SPEC).is_file():
+        return None
+    try:
+        return MatchSpec.load(match_dir / files.MATCH_SPEC).timing
+    except ContractError as exc:
+        log.warning("match %s: %s", match.plan.match_id, exc)
+        return None
+
+
 def _write(match: MatchContext) -> MatchResults:
     out: Path = match.options.out_dir
     plan = match.plan
     limits = plan.limits
+    sim_result = read_sim_result(match)
+    if match.failure is None and match.forfeit is None:
+        not_played = play_failure(sim_result, list(match.records.values()), _spec_timing(match))
+        if not_played is not None:
+            match.fail(not_played.failure_class, not_played.cause, team=not_played.team)
     results = build_results(
         match_id=plan.match_id,
         seed=plan.seed,
-        sim_result=read_sim_result(match),
+        sim_result=sim_result,
         robots=list(match.records.values()),
         forfeit=match.forfeit,
         limits=MatchLimits(

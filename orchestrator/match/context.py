@@ -17,7 +17,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from contracts.match_results import Forfeit
+from contracts.match_results import Color, Forfeit
 from contracts.telemetry import StateMessage
 from orchestrator.bandwidth import AppliedShaping
 from orchestrator.match.admission import CpuSets
@@ -129,11 +129,16 @@ class MatchContext:
         if self.options.progress is not None:
             self.options.progress(self.lifecycle.state.value, state)
 
-    def fail(self, failure_class: FailureClass, cause: str) -> None:
-        """Record the match's failure; the first one counts."""
+    def fail(self, failure_class: FailureClass, cause: str, *, team: Color | None = None
+             ) -> None:
+        """Record the match's failure (``team``: the team that caused it); the first counts."""
         if self.failure is None:
-            self.failure = Failure(failure_class=failure_class, cause=cause)
-            log.error("match %s failed (%s): %s", self.plan.match_id, failure_class.value, cause)
+            self.failure = Failure(failure_class=failure_class, cause=cause, team=team)
+            if failure_class is FailureClass.INTERRUPTED:  # asked for (a stop, a pre-flight)
+                log.info("match %s stopped: %s", self.plan.match_id, cause)
+            else:
+                log.error("match %s failed (%s): %s", self.plan.match_id, failure_class.value,
+                          cause)
 
 
 __all__ = ["MatchContext", "RunOptions", "Started", "TelemetryFactory"]

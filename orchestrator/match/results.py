@@ -12,6 +12,7 @@ from typing import Any
 from contracts import files
 from contracts.match_results import (
     AdmissionRecord,
+    Color,
     Failure,
     FailureClass,
     Forfeit,
@@ -22,7 +23,11 @@ from contracts.match_results import (
     RobotResult,
     Scalar,
 )
+from contracts.match_spec import TimingSpec
 from contracts.sim_result import SimResult
+from contracts.timing import MIN_PLAYING_S, played_enough, timing_problem
+
+COLORS: tuple[Color, Color] = ("red", "blue")
 
 
 @dataclass(slots=True, kw_only=True)
@@ -117,6 +122,45 @@ def build_results(
     )
 
 
+def play_failure(sim: SimResult | None, robots: list[RobotRecord],
+                 timing: TimingSpec | None) -> Failure | None:
+    """A game that reached FINISHED without football (:func:`contracts.timing.played_enough`),
+    classified by its cause: the league's timing, a team none of whose robots connected, or the
+    referee; None when the match played (or its play was not counted)."""
+    if sim is None or not sim.finished or sim.play is None:
+        return None
+    play = sim.play
+    minimum = timing.minimum_play_s if timing is not None else MIN_PLAYING_S
+    if played_enough(play.halves_playing, play.playing_s, minimum):
+        return None
+    played = (f"{play.playing_s:g} s of PLAYING, halves in PLAYING: "
+              f"{list(play.halves_playing) or 'none'}; the minimum of play is {minimum:g} s")
+    if timing is not None:
+        problem = timing_problem(timing.half_duration_s, timing.ready_duration_s,
+                                 set_s=timing.set_to_play_s, minimum_s=minimum)
+        if problem is not None:
+            return Failure(failure_class=FailureClass.NOT_PLAYED,
+                           cause=f"the match did not play ({played}): the league's timing: "
+                           f"{problem}")
+    absent: list[Color] = [c for c in COLORS if _never_connected(c, robots, sim.robots)]
+    if len(absent) == 1:
+        return Failure(failure_class=FailureClass.TEAM_ABSENT, team=absent[0],
+                       cause=f"the match did not play ({played}): no robot of {absent[0]} "
+                       "ever connected to the simulator")
+    if absent:
+        return Failure(failure_class=FailureClass.NOT_PLAYED,
+                       cause=f"the match did not play ({played}): no robot of either team "
+                       "ever connected to the simulator")
+    return Failure(failure_class=FailureClass.NOT_PLAYED,
+                   cause=f"the match did not play ({played})")
+
+
+def _never_connected(color: str, robots: list[RobotRecord],
+                     api_stats: dict[str, dict[str, Any]]) -> bool:
+    team = [r for r in robots if r.color == color]
+    return bool(team) and not any((api_stats.get(r.key) or {}).get("connects") for r in team)
+
+
 def team_warnings(robots: list[RobotRecord], api_stats: dict[str, dict[str, Any]]) -> list[str]:
     """What a score alone hides: a team whose started robots all exited during the game, or
     none of which ever connected to the simulator."""
@@ -150,6 +194,7 @@ __all__ = [
     "FailureClass",
     "RobotRecord",
     "build_results",
+    "play_failure",
     "team_warnings",
     "write_report",
     "write_results",

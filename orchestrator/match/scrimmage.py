@@ -4,18 +4,33 @@ The files (game.json, team_red.json, team_blue.json) are written into the output
 played exactly like ``hlvs match`` would play them, so a team can rerun or edit them.
 
 Defaults make a short game a newcomer can watch in two to three minutes: one striker per team,
-two halves of 40 s of game clock with READY shortened to 20 s (READY and SET before a half's
-kick-off stop the clock, as the league's GameController does, so a half lasts about 65 s of
-simulated time), lockstep stepping, 3 s before the first READY and 1 s at half time. These timings
-are the scrimmage's own; official matches keep the rules' timings (45 s READY, 10 min halves).
+lockstep stepping and the timing of :data:`contracts.timing.SCRIMMAGE` (two halves of 40 s of game
+clock with READY shortened to 20 s: READY and SET before a half's kick-off stop the clock, as the
+league's GameController does, so a half lasts about 65 s of simulated time; 3 s before the first
+READY and 1 s at half time). A half too short for its READY gets a shorter READY with a warning
+(:func:`quick_ready`); official matches keep the rules' timings (45 s READY, 10 min halves).
 """
 
 from __future__ import annotations
 
 import json
+import logging
 import uuid
 from pathlib import Path
 from typing import Any, Protocol
+
+from contracts.timing import (
+    MIN_PLAYING_S,
+    MIN_READY_S,
+    SCRIMMAGE,
+    SET_TO_PLAY_S,
+    TimingError,
+    fit_ready,
+)
+from orchestrator.config.robot_models import MODEL_MANIFEST, is_model_path
+from orchestrator.errors import ConfigError, Problem
+
+log = logging.getLogger(__name__)
 
 
 class ScrimmageOptions(Protocol):
@@ -88,9 +103,33 @@ def team_file(name: str, image: str, players: int, *, command: str | None = None
     return {"name": name, "image": repository or image, "players": entries}
 
 
+def quick_ready(half_duration_s: float, ready_duration_s: float | None,
+                minimum_play_s: float = MIN_PLAYING_S) -> float:
+    """The READY of a quick test (:mod:`contracts.timing`): the scrimmage's unless given,
+    shortened with a warning when the half would keep less than the minimum of play.
+
+    Raises :class:`~orchestrator.errors.ConfigError` (at ``/timing/half_duration_s``) when the
+    half is too short even for the shortest READY."""
+    ready = SCRIMMAGE.ready_duration_s if ready_duration_s is None else ready_duration_s
+    try:
+        fitted, warning = fit_ready(half_duration_s, ready, minimum_s=minimum_play_s)
+    except TimingError as exc:
+        shortest = MIN_READY_S + SET_TO_PLAY_S + minimum_play_s
+        raise ConfigError([Problem(file="game.json", pointer="/timing/half_duration_s",
+                                   message=str(exc),
+                                   expected=f"a half of at least {shortest:g} s (or "
+                                   "--minimum-play 0 for a match not meant to play)")]) from exc
+    if warning is not None:
+        log.warning("%s", warning)
+    return fitted
+
+
 def game_file(args: ScrimmageOptions, match_id: str) -> dict[str, Any]:
+    """A quick test's game.json; READY fitted to the half by :func:`quick_ready`."""
     players = args.players
-    ready = getattr(args, "ready_duration", None)
+    minimum = getattr(args, "minimum_play", None)
+    minimum = MIN_PLAYING_S if minimum is None else minimum
+    ready = quick_ready(args.half_duration, getattr(args, "ready_duration", None), minimum)
     return {
         "type": "NORMAL",
         "class": "KID",
@@ -110,19 +149,48 @@ def game_file(args: ScrimmageOptions, match_id: str) -> dict[str, Any]:
                  "ports": [10020 + n for n in range(1, players + 1)]},
         "timing": {
             "half_duration_s": args.half_duration,
-            # a shorter READY only where the caller asks for one (hlvs scrimmage does)
-            **({"ready_duration_s": ready} if ready is not None else {}),
+            "ready_duration_s": ready,
+            "minimum_play_s": minimum,
             "wait_before_first_ready_s": args.wait_before_ready,
-            "half_time_break_s": 1,
+            "half_time_break_s": SCRIMMAGE.half_time_break_s,
             "grace_period_s": args.grace,
         },
         "limits": {"cpus": 1, "memory_gb": 1, "pids": 256, "log_folder_gb": 1},
     }
 
 
+def stub_model_problem(model: str | None) -> str | None:
+    """Why the stub robot cannot drive ``model`` (a model package whose motor names are not the
+    built-in robot's, which the stub commands), or None."""
+    if model is None or not is_model_path(model):
+        return None
+    from robot.geometry import MOTOR_NAMES
+
+    manifest = Path(model) / MODEL_MANIFEST
+    try:
+        motors = {m["name"] for m in json.loads(manifest.read_text(encoding="utf-8"))["motors"]}
+    except (OSError, ValueError, KeyError, TypeError):
+        return None  # the team file's check reports a broken package with its field
+    missing = [name for name in MOTOR_NAMES if name not in motors]
+    if not missing:
+        return None
+    return (f"the stub robot commands the built-in robot's motors ({', '.join(missing[:4])}, "
+            f"...), which {manifest} does not name (it has {', '.join(sorted(motors)[:4])}, "
+            "...): every command is refused and the robot stands still all match. Give a "
+            "robot image that drives this model (--red-image / --blue-image)")
+
+
 def write_files(args: ScrimmageOptions, folder: Path, *, stub_image: str | None = None
                 ) -> Path:
-    """Write game.json and the two team files into ``folder``; returns the game.json path."""
+    """Write game.json and the two team files into ``folder``; returns the game.json path.
+
+    A stub robot given a team model with other motor names would stand still: said loudly (a
+    WARNING, shown whatever the log level)."""
+    for color, image in (("red", args.red_image), ("blue", args.blue_image)):
+        problem = stub_model_problem(getattr(args, f"{color}_model", None)) \
+            if image is None else None
+        if problem is not None:
+            log.warning("%s robots: %s", color, problem)
     if args.red_image is None or args.blue_image is None:
         if stub_image is None:
             from orchestrator.project_images import project_image
@@ -147,4 +215,5 @@ def write_files(args: ScrimmageOptions, folder: Path, *, stub_image: str | None 
     return folder / "game.json"
 
 
-__all__ = ["ScrimmageOptions", "game_file", "team_file", "write_files"]
+__all__ = ["ScrimmageOptions", "game_file", "quick_ready", "stub_model_problem", "team_file",
+           "write_files"]

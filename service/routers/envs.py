@@ -47,7 +47,7 @@ router = APIRouter(prefix="/v1/envs", tags=["envs"])
 
 ALLOWED_KWARGS = frozenset({
     "perception", "perception_noise", "steps_per_action", "max_episode_s", "ball_distance_m",
-    "half_duration_s", "field_class",
+    "half_duration_s", "minimum_play_s", "field_class",
 })  # fmt: skip
 DEFAULT_PER_TOKEN = 2
 DEFAULT_IDLE_S = 600.0

@@ -20,9 +20,10 @@ from contracts import files
 from contracts.errors import ContractError
 from contracts.match_results import MatchReport, MatchResults
 from service import submissions, teamfiles
+from service.aftermatch import PARTIAL_VIDEO_FILE
 from service.db import ACTIVE_STATES, Submission
 from service.deps import DbSession, TeamPrincipal, bearer, get_services, require_team
-from service.errors import NotFound
+from service.errors import NotFound, PreflightFailed
 from service.matchfiles import OWN_COLOR
 from service.views import (
     SubmissionCreate,
@@ -64,7 +65,13 @@ def create_submission(body: SubmissionCreate, request: Request, principal: TeamP
     session.commit()  # no connection is held during the pre-flight check
     assert services.preflight is not None
     teamfiles.raise_if_invalid("team_config", document)  # the upload's check, today's rules
-    elapsed = services.preflight(document, services.settings)
+    try:
+        elapsed = services.preflight(document, services.settings)
+    except PreflightFailed as failed:
+        teamfiles.refuse(session, teamfiles.get_by_id(session, file_id), stage=failed.stage,
+                         cause=failed.cause)
+        session.commit()
+        raise
     row = submissions.create(session, team_id=team_id, opponent=body.opponent,
                              team_file_id=file_id, credentials_file_id=credentials,
                              preflight_s=elapsed)
@@ -226,9 +233,11 @@ def get_video(submission_id: str, request: Request, principal: TeamPrincipal,
 
 
 def _listing(root: Path) -> list[str]:
+    """Every finished file under ``root`` (a video still being rendered is not one)."""
     if not root.is_dir():
         return []
-    return sorted(str(p.relative_to(root)) for p in root.rglob("*") if p.is_file())
+    return sorted(str(p.relative_to(root)) for p in root.rglob("*")
+                  if p.is_file() and p.name != PARTIAL_VIDEO_FILE)
 
 
 @router.get("/{submission_id}/logs")
@@ -249,7 +258,8 @@ def get_log(submission_id: str, part: str, path: str, request: Request,
         raise NotFound(what="log folder", ident=part)
     root = roots[part].resolve()
     target = (root / path).resolve()
-    if not target.is_relative_to(root) or not target.is_file():
+    if not target.is_relative_to(root) or not target.is_file() or \
+            target.name == PARTIAL_VIDEO_FILE:
         raise NotFound(what="log file", ident=f"{part}/{path}")
     return FileResponse(target, media_type="application/octet-stream", filename=target.name)
 

@@ -53,6 +53,7 @@ class FileVersion(BaseModel):
     sha256: str
     created_at: datetime
     problems: list[Problem]
+    valid: bool = True  # False: it failed a pre-flight check and is never the current version
 
 
 class FileContent(FileVersion):
@@ -72,7 +73,8 @@ def _view(team: Team) -> TeamView:
 def _version(row: Any) -> FileVersion:
     return FileVersion(kind=row.kind, version=row.version, sha256=row.sha256,
                        created_at=utc(row.created_at),
-                       problems=[Problem(**p) for p in json.loads(row.problems_json)])
+                       problems=[Problem(**p) for p in json.loads(row.problems_json)],
+                       valid=bool(row.valid))
 
 
 @router.get("")

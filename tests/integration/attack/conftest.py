@@ -112,7 +112,8 @@ def prepare(tmp_path_factory: pytest.TempPathFactory, attack_image: str,
         out = tmp_path / match_id
         args = argparse.Namespace(
             red_image=attack_image, blue_image=project_images["stub"], players=players,
-            half_duration=half_s, ready_duration=1.0, wait_before_ready=1.0, grace=2.0,
+            half_duration=half_s, ready_duration=1.0, minimum_play=0.0, wait_before_ready=1.0,
+            grace=2.0,
             robot_command=None,
             match_id=match_id, seed=42,
         )

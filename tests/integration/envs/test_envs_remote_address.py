@@ -93,7 +93,8 @@ def test_match_over_a_remote_and_second_client_refused(
     remote: tuple[subprocess.Popen[bytes], int], tmp_path: Path
 ) -> None:
     _, port = remote
-    env = gym.make("hlvs/Match-v0", remotes=f"hlvs://127.0.0.1:{port}", half_duration_s=5.0)
+    env = gym.make("hlvs/Match-v0", remotes=f"hlvs://127.0.0.1:{port}", half_duration_s=5.0,
+                   minimum_play_s=0.0)
     env.reset(seed=2)
     env.unwrapped.trainer.set_game_state("PLAYING")
     *_, info = env.step(np.zeros(20, np.float32))

@@ -16,7 +16,7 @@ import docker
 import pytest
 import yaml
 
-from orchestrator.compose import Subnets, compose_files, write_compose
+from orchestrator.compose import Subnets, collect_results, compose_files, write_compose
 from orchestrator.config import load_game
 from orchestrator.project_images import project_image
 from tests.conftest import TEST_LABEL
@@ -175,7 +175,8 @@ def _game_copy(tmp_path: Path, *, robot_image: str, robot_cmd: str | None) -> Pa
     source = EXAMPLE.parent
     game = json.loads((source / "game.json").read_text())
     game["match_id"] = f"compose-{uuid.uuid4().hex[:6]}"
-    game["timing"].update({"half_duration_s": 10, "ready_duration_s": 1, "grace_period_s": 1})
+    game["timing"].update({"half_duration_s": 10, "ready_duration_s": 1, "grace_period_s": 1,
+                           "minimum_play_s": 0})
     (tmp_path / "game.json").write_text(json.dumps(game))
     for name in ("team_red.json", "team_blue.json"):
         team = json.loads((source / name).read_text())
@@ -230,3 +231,9 @@ def test_compose_up_plays_a_stub_match(tmp_path: Path) -> None:
         assert robot_logs and all(p.stat().st_size > 0 for p in robot_logs)
     for name in ("replay.hlvsrec", "referee.log", "gamecontroller.log"):
         assert (compose_path.parent / "out" / name).stat().st_size > 0
+    results = collect_results(loaded, compose_path.parent)  # hlvs compose --collect
+    assert results.ok and results.final_state == "FINISHED", results.failure
+    report = json.loads((compose_path.parent / "report.json").read_text())
+    assert report == {"status": "success"}
+    written = json.loads((compose_path.parent / "results.json").read_text())
+    assert written["match_id"] == loaded.game.match_id and written["play"] is not None

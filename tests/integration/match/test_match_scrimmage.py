@@ -32,6 +32,7 @@ def test_short_scrimmage_plays_to_finished(tmp_path: Path, runtime: Any,
     monkeypatch.chdir(tmp_path)
     try:
         code = hlvs(["scrimmage", "--out", "matches/scrim", "--half-duration", "4",
+                     "--minimum-play", "0",
                      "--wait-before-ready", "1", "--grace", "2", "--match-id", match_id])
     finally:
         hlvs(["cleanup", "--match", match_id])
@@ -74,12 +75,14 @@ def test_scrimmage_with_a_team_of_wolfgang_models_plays_to_the_end(
     monkeypatch.chdir(tmp_path)
     try:
         code = hlvs(["scrimmage", "--out", "wolf", "--red-model", str(wolfgang),
-                     "--half-duration", "4", "--wait-before-ready", "1", "--grace", "2",
+                     "--half-duration", "4",
+                     "--minimum-play", "0", "--wait-before-ready", "1", "--grace", "2",
                      "--match-id", match_id, "--json"])
         printed = capsys.readouterr()
     finally:
         hlvs(["cleanup", "--match", match_id])
     assert code == 0, printed.err[-3000:]
+    assert "red robots: the stub robot commands the built-in robot's motors" in printed.err
     out = tmp_path / "wolf"
     printed_results = json.loads(printed.out)  # --json: stdout holds the one JSON document
     assert printed_results["exit_code"] == 0 and printed_results["out_dir"] == str(out)

@@ -108,7 +108,8 @@ def _team_traffic(sender: Any, receiver: Any, simulator: str, mate: str) -> dict
 def _scrimmage(cluster: str, out: Path, match_id: str, half_s: int) -> subprocess.Popen[str]:
     cmd = [sys.executable, "-m", "hlvs", "scrimmage", "--pool", "slurm",
            "--placement", "league", "--players", "2", "--slurm-conf", cluster,
-           "--half-duration", str(half_s), "--ready-duration", "1", "--wait-before-ready", "1",
+           "--half-duration", str(half_s), "--ready-duration", "1",
+           "--minimum-play", "0", "--wait-before-ready", "1",
            "--grace", "5", "--match-id", match_id, "--out", str(out), "--json"]
     return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 

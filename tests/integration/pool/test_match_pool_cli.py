@@ -20,6 +20,7 @@ def test_scrimmage_through_the_slurm_pool(cluster: str, tmp_path: Path) -> None:
     match_id = f"slurm-cli-{os.getpid()}"
     cmd = [sys.executable, "-m", "hlvs", "scrimmage", "--pool", "slurm",
            "--slurm-conf", cluster, "--half-duration", "4", "--ready-duration", "1",
+           "--minimum-play", "0",
            "--wait-before-ready", "1", "--grace", "2", "--match-id", match_id,
            "--out", str(out), "--json"]
     result = subprocess.run(cmd, capture_output=True, text=True, timeout=600, check=False)

@@ -26,7 +26,7 @@ def _job(tmp: Path, name: str, account: str) -> MatchJob:
 
     args = argparse.Namespace(
         red_image=None, blue_image=None, players=1, half_duration=4.0, ready_duration=1.0,
-        wait_before_ready=1.0,
+        wait_before_ready=1.0, minimum_play=0.0,
         grace=2.0, robot_command=None, match_id=f"slurm-{name}-{os.getpid()}", seed=7,
     )
     work = tmp / name

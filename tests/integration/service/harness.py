@@ -39,10 +39,12 @@ class Served:
         self.thread.join(timeout=30)
 
 
-def serve(settings: Settings, *, start_worker: bool = False, **factory: Any) -> Served:
-    """Start the app on a free loopback port; returns once it answers. ``factory``:
-    keyword arguments of :func:`service.create_app` (``pool_factory``, ``preflight``)."""
-    port = free_port()
+def serve(settings: Settings, *, start_worker: bool = False, port: int | None = None,
+          **factory: Any) -> Served:
+    """Start the app on ``port`` (default: a free loopback port); returns once it answers.
+    ``factory``: keyword arguments of :func:`service.create_app` (``pool_factory``,
+    ``preflight``)."""
+    port = port or free_port()
     app = create_app(settings, start_worker=start_worker, **factory)
     config = uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning",
                             lifespan="on")

@@ -20,7 +20,8 @@ def test_an_episode_with_a_token_monitor_files_and_limits(
         instance = client.env_create("hlvs/Kick-v0", max_episode_s=0.4, perception=True)
         assert client.env_list_all() == {instance: "hlvs/Kick-v0"}
         assert client.env_action_space_info(instance)["shape"] == [20]
-        client.env_monitor_start(instance, video=True)
+        # gym-http-api's client signature: (instance_id, directory, force, resume, video_callable)
+        client.env_monitor_start(instance, str(tmp_path / "monitor"), False, False, True)
         obs = client.env_reset(instance, seed=3)
         assert len(obs["joints"]) == 20 and len(obs["perception"]["lines"]) == 33
         done, steps, info = False, 0, {}
@@ -33,12 +34,14 @@ def test_an_episode_with_a_token_monitor_files_and_limits(
         assert stats["video"], stats["video_error"]
         names = {f["name"]: f["bytes"] for f in client.monitor_files(instance)}
         assert {"episodes.jsonl", "stats.json", "video.mp4"} <= set(names)
+        assert {p.name for p in (tmp_path / "monitor").iterdir()} == set(names)
         episodes = client.download(instance, "episodes.jsonl", tmp_path / "episodes.jsonl")
         line = json.loads(episodes.read_text().splitlines()[0])
         assert line["steps"] == 50 and line["truncated"] is True
         video = client.download(instance, "video.mp4", tmp_path / "video.mp4")
         assert video.stat().st_size == names["video.mp4"] > 1000
-        second = client.env_create("hlvs/Match-v0", half_duration_s=5.0)
+        second = client.env_create("hlvs/Match-v0", half_duration_s=5.0,
+                                   minimum_play_s=0.0)
         with pytest.raises(EnvApiError) as limit:
             client.env_create("hlvs/Kick-v0")
         assert limit.value.status == 409 and "limit" in limit.value.message

@@ -3,11 +3,13 @@ sought time, jumps to a goal from the timeline, plots the API statistics, reads 
 
 from __future__ import annotations
 
+from io import BytesIO
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
+from PIL import Image
 
 from simulator.replay import ReplayFile
 from tests.integration.viewer.conftest import hlvs_view, screenshot
@@ -79,8 +81,9 @@ def test_the_timeline_jumps_to_the_goal_and_playback_runs(page: Any, match: Path
         assert page.evaluate("window.hlvsViewer.time") == paused_at
         assert page.evaluate("window.hlvsViewer.frames") == drawn  # paused: nothing redrawn
         assert page.locator("[data-testid=score-red]").inner_text() == "1"
-        events = page.locator("[data-testid=events] li").all_inner_texts()
+        events = page.locator("[data-testid=events] li button").all_inner_texts()
         assert events == ["00:02 goal red 2"]
+        assert page.locator("[data-testid=event-number]").all_inner_texts() == ["1."]
         series = page.locator("[data-testid=plot-latency] polyline").evaluate_all(
             "ls => ls.map(l => [l.dataset.series, l.getAttribute('points').split(' ').length])"
         )
@@ -97,3 +100,63 @@ def test_a_version_1_replay_plays_in_the_browser(page: Any) -> None:
         page.wait_for_function("window.hlvsViewer.time >= 480", timeout=15_000)
         assert page.locator("[data-testid=score-red]").inner_text() == "1"
         screenshot(page, "replay-version-1")
+
+
+LONG = "a pushing foul far from the ball that the referee describes at length, so it wraps"
+MANY_EVENTS = tuple(
+    {"type": "penalty", "team": "blue", "player": 1 + k % 4, "sim_time_ms": 200 + 160 * k,
+     "reason": LONG if k == 11 else "pushing"} for k in range(12)
+) + ({"type": "state", "team": None, "player": None, "sim_time_ms": GOAL_MS,
+      "reason": "goal: READY"},)
+
+
+@pytest.fixture(scope="module")
+def busy_match(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("browser") / "match-busy"
+    record_match(folder, events=MANY_EVENTS)
+    return folder
+
+
+def test_event_list_timeline_and_plots_line_up(page: Any, busy_match: Path) -> None:
+    """Numbers 10 and up are whole and stay beside the first line of a wrapped event; the goal
+    mark is above the state mark at the same time; a mark is where the slider's thumb is at its
+    time; the plots' x axis is match time with a playhead at the replay's time."""
+    with hlvs_view(busy_match) as urls:
+        _open(page, urls[0])
+        numbers = page.locator("[data-testid=event-number]")
+        assert numbers.count() == 14 and numbers.nth(12).inner_text() == "13."
+        for n in range(numbers.count()):  # never clipped: ".0", ".1" for 10 and 11 before
+            assert numbers.nth(n).evaluate("e => e.scrollWidth <= e.clientWidth"), n
+        wrapped = page.locator("[data-testid=events] li", has_text="at length")
+        text_box = wrapped.locator("button").bounding_box()
+        number_box = wrapped.locator("[data-testid=event-number]").bounding_box()
+        assert text_box["height"] > 1.8 * number_box["height"]  # it does wrap
+        assert abs(number_box["y"] - text_box["y"]) < 4  # the number is on the first line
+
+        goal = page.locator("[data-testid=mark-goal]").bounding_box()
+        on_top = page.evaluate("([x, y]) => document.elementFromPoint(x, y).dataset.testid",
+                               [goal["x"] + goal["width"] / 2, goal["y"] + goal["height"] / 2])
+        assert on_top == "mark-goal"
+
+        page.locator("[data-testid=seek]").fill(str(GOAL_MS))
+        page.wait_for_function(f"window.hlvsViewer.time === {GOAL_MS}")
+        seek = page.locator("[data-testid=seek]").bounding_box()
+        strip = page.locator("[data-testid=timeline]").bounding_box()
+        assert abs(seek["width"] - strip["width"]) < 1 and abs(seek["x"] - strip["x"]) < 1
+        row = page.locator("[data-testid=seek]").screenshot()
+        pixels = np.asarray(Image.open(BytesIO(row)).convert("RGB"), dtype=np.int32)
+        # the thumb's columns: dark from top to bottom, away from the focus ring at the ends
+        dark = np.where((pixels.sum(axis=2) < 200).sum(axis=0) > 0.6 * pixels.shape[0])[0]
+        dark = dark[(dark > 3) & (dark < pixels.shape[1] - 4)]
+        thumb_x = seek["x"] + dark.mean()
+        goal = page.locator("[data-testid=mark-goal]").bounding_box()
+        assert abs(thumb_x - (goal["x"] + goal["width"] / 2)) <= 2.0, (thumb_x, goal)
+
+        label = page.locator("[data-testid=plot-rtf] text").all_text_contents()
+        assert "3 s (match time)" in label
+        head = page.locator("[data-testid=plot-rtf-playhead]")
+        page.wait_for_function("document.querySelector('[data-testid=plot-rtf-playhead]')"
+                               ".getAttribute('x1') !== '36'")
+        expected = 36 + GOAL_MS / 3000 * (420 - 36 - 8)
+        assert abs(float(head.get_attribute("x1")) - expected) < 0.5
+        screenshot(page, "replay-events-timeline-plots")

@@ -77,7 +77,8 @@ def test_the_pool_page_lists_slurm_nodes_their_state_and_the_match_on_each(
 
         page.goto(f"{served_slurm.url}/watch/")
         page.locator("[data-testid=token]").fill(token(operator=True))
-        page.locator("[data-testid=token-save]").click()
+        page.locator("[data-testid=sign-in]").click()
+        page.wait_for_selector("[data-testid=who]")  # signed in for this browser session
         page.goto(f"{served_slurm.url}/watch/nodes")
         page.wait_for_selector("[data-testid=nodes] tr >> nth=1")
         rows = _rows(page)

@@ -26,10 +26,15 @@ pytestmark = pytest.mark.browser
 
 
 def _use_token(page: Any, base: str, secret: str, path: str) -> None:
+    """Sign in once (the token is kept for the browser session), then open ``path``."""
     page.goto(f"{base}/watch/")
+    page.evaluate("sessionStorage.clear()")
+    page.reload()
     page.locator("[data-testid=token]").fill(secret)
-    page.locator("[data-testid=token-save]").click()
+    page.locator("[data-testid=sign-in]").click()
+    page.wait_for_selector("[data-testid=who]")
     page.goto(f"{base}{path}")
+    page.wait_for_selector("[data-testid=who]")
 
 
 def _rows(page: Any, testid: str) -> list[list[str]]:
@@ -120,3 +125,98 @@ def test_queue_submissions_replay_standings_and_pool_pages(
         assert answer.status_code == status, answer.text
     for c in clients:
         c.close()
+
+
+def _text(page: Any) -> str:
+    page.wait_for_selector("#app > *")
+    page.wait_for_timeout(200)  # the page's last requests
+    text: str = page.locator("body").inner_text()
+    assert '{"' not in text and '"error"' not in text, text  # never raw JSON
+    return text
+
+
+def test_each_page_with_a_team_token_and_with_an_operator_token(
+    start: Callable[..., Served], token: Callable[..., str], pool: FakePool, page: Any,
+    tmp_path: Path,
+) -> None:
+    """One sign-in per browser session; a team sees its matches, the queue with the other
+    team's entry anonymised, the ladder and a team's history, and a sentence on the operators'
+    pages; an operator sees every page. No page shows raw JSON."""
+    served = start()
+    alpha_secret = token("Alpha", accepts_friendlies=True)
+    beta_secret = token("Beta", accepts_friendlies=True)
+    alpha, beta = setup_team(served, alpha_secret, "Alpha"), setup_team(served, beta_secret, "Beta")
+    friendly = alpha.post("/v1/submissions", json={"opponent": "Beta"}).json()["id"]
+    wait_for_status(alpha, friendly, lambda b: b["state"] == "running")
+    handle = handle_of(served, friendly)
+    pool.finish(handle, {"status": "success"})  # Alpha 1 : 0 Beta
+    wait_for_status(alpha, friendly, lambda b: b["state"] == "done")
+    recorded = record_match(tmp_path / "recorded")
+    shutil.copy(recorded, pool.results_dir(handle) / "public" / "replay.hlvsrec")
+    waiting = beta.post("/v1/submissions", json={}).json()["id"]
+
+    page.goto(f"{served.url}/watch/queue")  # not signed in: the sign-in form, not an error
+    page.wait_for_selector("[data-testid=sign-in-form]")
+    page.locator("[data-testid=token]").fill("hlvs_000000000000_" + "x" * 43)
+    page.locator("[data-testid=sign-in]").click()
+    page.wait_for_function("document.querySelector('[data-testid=error]').innerText !== ''")
+    assert "not signed in, or your token is no longer valid" in _text(page)
+
+    _use_token(page, served.url, alpha_secret, "/watch/")
+    assert page.locator("[data-testid=who]").inner_text().startswith("team Alpha")
+    nav = page.locator("nav a").all_inner_texts()
+    assert nav == ["live and replays", "our matches", "queue", "ladder"]
+    page.wait_for_selector("[data-testid=replay-list] li")
+    assert page.locator("[data-testid=replay-list] li").count() == 1
+    screenshot(page, "role-team-index")
+    page.goto(f"{served.url}/watch/submissions")
+    assert [r[0] for r in _rows(page, "submissions")] == [friendly]
+    screenshot(page, "role-team-matches")
+    page.goto(f"{served.url}/watch/queue")
+    (entry,) = _rows(page, "queue")
+    assert (entry[1], entry[2], entry[3]) == ("-", "another team", "-")
+    screenshot(page, "role-team-queue")
+    page.goto(f"{served.url}/watch/ladder")  # the ladder's own page, signed in already
+    assert [(r[0], r[1], r[5], r[6]) for r in _rows(page, "ladder")] == [
+        ("1", "Alpha", "1", "1"), ("2", "Beta", "1", "0")]
+    screenshot(page, "role-team-ladder")
+    page.locator("[data-testid=ladder] a", has_text="Alpha").click()
+    (played,) = _rows(page, "ladder-matches")
+    assert (played[2], played[3], played[4]) == ("Beta", "1:0", "won")
+    screenshot(page, "role-team-history")
+    page.locator("[data-testid=ladder-matches] a", has_text="replay").click()
+    page.wait_for_function("window.hlvsViewer && window.hlvsViewer.ready", timeout=30_000)
+    for path, words in (("/watch/standings", "for the league's operators"),
+                        ("/watch/nodes", "for the league's operators")):
+        page.goto(f"{served.url}{path}")
+        assert words in _text(page), path
+    screenshot(page, "role-team-operator-page")
+
+    _use_token(page, served.url, token(operator=True), "/watch/")
+    assert page.locator("nav a").all_inner_texts()[-3:] == ["tournament", "standings", "pool"]
+    page.wait_for_selector("[data-testid=replay-list] li")
+    assert page.locator("[data-testid=replay-list] li").count() == 1
+    screenshot(page, "role-operator-index")
+    page.goto(f"{served.url}/watch/submissions")
+    assert {r[1] for r in _rows(page, "submissions")} == {friendly, waiting}
+    screenshot(page, "role-operator-matches")
+    page.goto(f"{served.url}/watch/queue")
+    assert [r[1] for r in _rows(page, "queue")] == [waiting]
+    page.goto(f"{served.url}/watch/ladder")
+    assert len(_rows(page, "ladder")) == 2
+    page.goto(f"{served.url}/watch/standings")
+    assert "No tournament runs on this service" in _text(page)
+    screenshot(page, "role-operator-tournament")
+    page.goto(f"{served.url}/watch/nodes")
+    assert _rows(page, "nodes")[0][0] == "fake-node"
+    page.goto(f"{served.url}/watch/live/{waiting}")  # the fake pool: no telemetry to watch
+    page.wait_for_function("document.querySelector('[data-testid=live-status]').innerText"
+                           ".startsWith('Live view unavailable.')")
+    assert page.locator("[data-testid=game-state]").inner_text() == "not started"
+    assert page.locator("[data-testid=game-clock]").inner_text() == ""
+    assert "no running match of submission" in _text(page)
+    screenshot(page, "role-operator-live-not-started")
+    page.goto(f"{served.url}/watch/replay/{friendly}")
+    page.wait_for_function("window.hlvsViewer && window.hlvsViewer.ready", timeout=30_000)
+    alpha.close()
+    beta.close()

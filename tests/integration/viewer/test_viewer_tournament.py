@@ -99,7 +99,8 @@ def test_operator_overview_of_a_tournament(
 
     page.goto(f"{served.url}/watch/")
     page.locator("[data-testid=token]").fill(operator)
-    page.locator("[data-testid=token-save]").click()
+    page.locator("[data-testid=sign-in]").click()
+    page.wait_for_selector("[data-testid=who]")  # signed in for this browser session
     page.goto(f"{served.url}/watch/tournament")
     assert page.locator("[data-testid=tournament-name]").inner_text() == "test cup"
     rows = _rows(page, "tournament-matches")

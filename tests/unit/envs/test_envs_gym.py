@@ -16,7 +16,7 @@ from envs import EnvConfigError, EnvStateError, TrainerError
     [
         ("hlvs/Kick-v0", {}),
         ("hlvs/Kick-v0", {"perception": True, "perception_noise": 0.02}),
-        ("hlvs/Match-v0", {"perception": True, "half_duration_s": 5.0}),
+        ("hlvs/Match-v0", {"perception": True, "half_duration_s": 5.0, "minimum_play_s": 0.0}),
     ],
 )
 def test_gymnasium_checker_passes(env_id: str, kwargs: dict[str, object]) -> None:
@@ -56,8 +56,8 @@ def test_seeded_episodes_repeat_and_differ_by_seed() -> None:
 
 
 def test_match_seeded_runs_repeat() -> None:
-    assert _rollout("hlvs/Match-v0", 3, 200, half_duration_s=5.0) == _rollout(
-        "hlvs/Match-v0", 3, 200, half_duration_s=5.0
+    assert _rollout("hlvs/Match-v0", 3, 200, half_duration_s=5.0, minimum_play_s=0.0) == _rollout(
+        "hlvs/Match-v0", 3, 200, half_duration_s=5.0, minimum_play_s=0.0
     )
 
 

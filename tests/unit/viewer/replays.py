@@ -13,9 +13,11 @@ from tests.unit.world.conftest import eight_robots
 GOAL_MS = 2600
 
 
-def record_match(folder: Path, *, seconds: float = 3.0) -> Path:
+def record_match(folder: Path, *, seconds: float = 3.0,
+                 events: tuple[dict[str, object], ...] = ()) -> Path:
     """``folder/public/replay.hlvsrec`` (and ``api_stats.jsonl`` beside it): PLAYING, first half,
-    red scores at ``GOAL_MS``; the ball rolls towards the blue goal."""
+    red scores at ``GOAL_MS``; the ball rolls towards the blue goal. ``events``: more referee
+    events, each recorded at its ``sim_time_ms``."""
     public = folder / "public"
     public.mkdir(parents=True, exist_ok=True)
     path = public / "replay.hlvsrec"
@@ -29,6 +31,9 @@ def record_match(folder: Path, *, seconds: float = 3.0) -> Path:
                 score = {"red": 1, "blue": 0}
                 recorder.event({"type": "goal", "team": "red", "player": 2,
                                 "sim_time_ms": world.sim_time_ms, "reason": ""})  # fmt: skip
+            for event in events:
+                if event["sim_time_ms"] == world.sim_time_ms:
+                    recorder.event(dict(event))
             recorder.record(world, {"state": "PLAYING", "half": 1, "score": dict(score),
                                     "secs_remaining": 600 - world.sim_time_ms // 1000})  # fmt: skip
         recorder.close(world)

@@ -2,7 +2,7 @@
 // from the viewer API), the real-time factor and each robot's connection health.
 import type { GameState, RefereeEvent } from "../replay";
 import { SceneView, type SceneSpec } from "../scene";
-import { Scoreboard, authFetch, authHeaders, clock, describeEvent, el } from "../ui";
+import { Scoreboard, authFetch, authHeaders, clock, describeEvent, el, sentence } from "../ui";
 
 type Handler = (data: string) => void;
 
@@ -11,7 +11,7 @@ type Handler = (data: string) => void;
 async function readEvents(url: string, handlers: Record<string, Handler>, status: HTMLElement): Promise<void> {
   const response = await fetch(url, { headers: { ...authHeaders(), Accept: "text/event-stream" } });
   if (!response.ok || !response.body) {
-    status.textContent = `live view unavailable: ${response.status} ${await response.text()}`;
+    status.textContent = `Live view unavailable. ${await sentence(response, url)}`;
     return;
   }
   const reader = response.body.pipeThrough(new TextDecoderStream()).getReader();
@@ -95,9 +95,12 @@ export function livePage(root: HTMLElement, api: string, matchId: string, replay
           el("td", {}, r.round_trip_ms === null ? "-" : r.round_trip_ms.toFixed(1)))),
     );
   };
+  let events = 0;
   handlers.event = (data) => {
     const event = JSON.parse(data) as RefereeEvent;
-    list.prepend(el("li", { "data-type": event.type }, `${clock(event.sim_time_ms)} ${describeEvent(event)}`));
+    events += 1; // the newest first, each with its number in a cell of its own
+    list.prepend(el("li", { "data-type": event.type }, el("span", { class: "n" }, `${events}.`),
+      el("span", {}, `${clock(event.sim_time_ms)} ${describeEvent(event)}`)));
   };
   handlers.failure = (data) => {
     status.textContent = `live view unavailable: ${JSON.parse(data)}`;

@@ -1,5 +1,7 @@
 // Plots from api_stats.jsonl samples: the real-time factor over time, and per robot the
-// bandwidth used (both directions, from the byte counters) and the round-trip latency.
+// bandwidth used (both directions, from the byte counters) and the round-trip latency. The x
+// axis is match time (simulated seconds, as the replay's clock), with a playhead at the
+// replay's time.
 import { TEAM_CSS } from "../scene";
 import { el, getJson } from "../ui";
 
@@ -25,12 +27,16 @@ function colourOf(robot: string): string {
   return shades ? shades[(Number(number) - 1 + shades.length) % shades.length] : TEAM_CSS[team] ?? "#333";
 }
 
-export function lineChart(title: string, unit: string, series: Series[], testid: string): HTMLElement {
-  const width = 420;
-  const height = 180;
-  const pad = 36;
+const WIDTH = 420;
+const HEIGHT = 180;
+const PAD = 36;
+
+export function lineChart(title: string, unit: string, series: Series[], testid: string, xmax = 0): HTMLElement {
+  const width = WIDTH;
+  const height = HEIGHT;
+  const pad = PAD;
   const all = series.flatMap((s) => s.points);
-  const xmax = Math.max(1, ...all.map((p) => p[0]));
+  xmax = xmax || Math.max(1, ...all.map((p) => p[0]));
   const ymax = Math.max(1e-9, ...all.map((p) => p[1])) * 1.1;
   const svg = document.createElementNS(SVG, "svg");
   svg.setAttribute("viewBox", `0 0 ${width} ${height}`);
@@ -49,11 +55,22 @@ export function lineChart(title: string, unit: string, series: Series[], testid:
     svg.append(label);
   }
   const xLabel = document.createElementNS(SVG, "text");
-  xLabel.setAttribute("x", String(width - 80));
+  xLabel.setAttribute("x", String(width - 8));
+  xLabel.setAttribute("text-anchor", "end");
   xLabel.setAttribute("y", String(height - 4));
   xLabel.setAttribute("font-size", "10");
-  xLabel.textContent = `${xmax.toFixed(0)} s (wall)`;
+  xLabel.textContent = `${xmax.toFixed(0)} s (match time)`;
   svg.append(xLabel);
+  const head = document.createElementNS(SVG, "line");
+  head.setAttribute("class", "playhead");
+  head.setAttribute("data-testid", `${testid}-playhead`);
+  head.setAttribute("y1", "8");
+  head.setAttribute("y2", String(height - 20));
+  head.setAttribute("x1", String(pad));
+  head.setAttribute("x2", String(pad));
+  head.setAttribute("stroke", "#222");
+  head.setAttribute("stroke-dasharray", "3 2");
+  head.dataset.xmax = String(xmax);
   for (const s of series) {
     const line = document.createElementNS(SVG, "polyline");
     const points = s.points.map(([x, y]) => `${(pad + (x / xmax) * (width - pad - 8)).toFixed(1)},${(height - 20 - (y / ymax) * (height - 28)).toFixed(1)}`);
@@ -64,13 +81,15 @@ export function lineChart(title: string, unit: string, series: Series[], testid:
     line.setAttribute("data-series", s.name);
     svg.append(line);
   }
+  svg.append(head);
   const legend = el("div", { class: "legend" }, ...series.map((s) => el("span", { style: `color:${s.colour}` }, `■ ${s.name} `)));
   return el("figure", { class: "chart" }, el("figcaption", {}, `${title} (${unit})`), svg, legend);
 }
 
 export function statsSeries(samples: Sample[]): { rtf: Series[]; bandwidth: Series[]; latency: Series[] } {
   const robots = [...new Set(samples.flatMap((s) => Object.keys(s.robots ?? {})))].sort();
-  const rtf = [{ name: "real-time factor", colour: "#2e7d32", points: samples.map((s) => [s.real_time_s, s.real_time_factor] as [number, number]) }];
+  const at = (s: Sample): number => s.sim_time_ms / 1000; // match time, as the replay's clock
+  const rtf = [{ name: "real-time factor", colour: "#2e7d32", points: samples.map((s) => [at(s), s.real_time_factor] as [number, number]) }];
   const bandwidth: Series[] = [];
   const latency: Series[] = [];
   robots.forEach((robot) => {
@@ -81,8 +100,8 @@ export function statsSeries(samples: Sample[]): { rtf: Series[]; bandwidth: Seri
       const a = samples[i - 1].robots?.[robot];
       const b = samples[i].robots?.[robot];
       const dt = samples[i].real_time_s - samples[i - 1].real_time_s;
-      if (a && b && dt > 0) kb.push([samples[i].real_time_s, (b.bytes_in + b.bytes_out - a.bytes_in - a.bytes_out) / 1000 / dt]);
-      if (b && b.round_trip_ms !== null) rtt.push([samples[i].real_time_s, b.round_trip_ms]);
+      if (a && b && dt > 0) kb.push([at(samples[i]), (b.bytes_in + b.bytes_out - a.bytes_in - a.bytes_out) / 1000 / dt]);
+      if (b && b.round_trip_ms !== null) rtt.push([at(samples[i]), b.round_trip_ms]);
     }
     bandwidth.push({ name: robot, colour, points: kb });
     latency.push({ name: robot, colour, points: rtt });
@@ -90,13 +109,23 @@ export function statsSeries(samples: Sample[]): { rtf: Series[]; bandwidth: Seri
   return { rtf, bandwidth, latency };
 }
 
-export async function drawStats(root: HTMLElement, url: string): Promise<void> {
+/** Draws the charts; returns the function that moves their playheads to a match time (ms). */
+export async function drawStats(root: HTMLElement, url: string): Promise<(ms: number) => void> {
   const samples = await getJson<Sample[]>(url);
-  if (samples.length === 0) return;
+  if (samples.length === 0) return () => undefined;
   const { rtf, bandwidth, latency } = statsSeries(samples);
+  const xmax = Math.max(1, ...samples.map((s) => s.sim_time_ms / 1000));
   root.append(
-    lineChart("Real-time factor", "sim s per wall s", rtf, "plot-rtf"),
-    lineChart("Robot API bandwidth", "kB/s, both directions", bandwidth, "plot-bandwidth"),
-    lineChart("Robot API round trip", "ms", latency, "plot-latency"),
+    lineChart("Real-time factor", "sim s per wall s", rtf, "plot-rtf", xmax),
+    lineChart("Robot API bandwidth", "kB/s, both directions", bandwidth, "plot-bandwidth", xmax),
+    lineChart("Robot API round trip", "ms", latency, "plot-latency", xmax),
   );
+  const heads = Array.from(root.querySelectorAll<SVGLineElement>("line.playhead"));
+  let shown = "";
+  return (ms: number) => {
+    const x = (PAD + Math.min(1, ms / 1000 / xmax) * (WIDTH - PAD - 8)).toFixed(1);
+    if (x === shown) return; // unchanged: no write, no layout
+    shown = x;
+    for (const head of heads) { head.setAttribute("x1", x); head.setAttribute("x2", x); }
+  };
 }

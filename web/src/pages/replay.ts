@@ -18,31 +18,39 @@ export async function replayPage(root: HTMLElement, api: string, replayId: strin
   const speed = el("select", { "data-testid": "speed" });
   for (const s of SPEEDS) speed.append(el("option", { value: String(s), ...(s === 1 ? { selected: "" } : {}) }, `${s}x`));
   const seek = el("input", {
-    type: "range", min: "0", max: String(meta.duration_ms), step: "40", value: "0", "data-testid": "seek",
+    type: "range", class: "seek", min: "0", max: String(meta.duration_ms), step: "40", value: "0", "data-testid": "seek",
   });
   const now = el("span", { class: "time", "data-testid": "time" }, "00:00");
-  const timeline = el("div", { class: "timeline", "data-testid": "timeline" });
+  // The marks sit on a track as wide as the slider's thumb travels (both in one column), so a
+  // mark is where the thumb is at its time.
+  const track = el("div", { class: "track" });
+  const timeline = el("div", { class: "timeline", "data-testid": "timeline" }, track);
   const list = el("ol", { class: "events", "data-testid": "events" });
   const shown = meta.events.filter((e) => TIMELINE_TYPES.has(e.type) && !(e.type === "state" && e.reason === ""));
-  for (const event of shown) {
+  // goals last: drawn above a state change at the same moment
+  const marked = [...shown.filter((e) => e.type !== "goal"), ...shown.filter((e) => e.type === "goal")];
+  for (const event of marked) {
     const left = meta.duration_ms > 0 ? (100 * event.frame_ms) / meta.duration_ms : 0;
     const mark = el("button", {
       class: `mark ${event.type} ${event.team ?? ""}`, style: `left:${left}%`, title: `${clock(event.frame_ms)} ${describeEvent(event)}`,
       "data-testid": `mark-${event.type}`, "data-ms": String(event.frame_ms),
     }, event.type === "goal" ? "G" : "");
     mark.addEventListener("click", () => jumpTo(event));
-    timeline.append(mark);
+    track.append(mark);
+  }
+  shown.forEach((event, index) => {
+    // the number is a cell of its own: it stays beside the first line when the text wraps
     const item = el("li", { "data-type": event.type },
+      el("span", { class: "n", "data-testid": "event-number" }, `${index + 1}.`),
       el("button", { class: "link" }, `${clock(event.frame_ms)} ${describeEvent(event)}`));
     item.addEventListener("click", () => jumpTo(event));
     list.append(item);
-  }
+  });
   const plots = el("div", { class: "plots" });
   root.append(
     board.root,
     el("div", { class: "stage" }, canvas, el("aside", {}, el("h3", {}, "Referee events"), list)),
-    el("div", { class: "controls" }, play, speed, seek, now),
-    timeline,
+    el("div", { class: "controls" }, play, speed, el("div", { class: "scrub" }, seek, timeline), now),
     plots,
   );
   const view = new SceneView(canvas, meta.scene);
@@ -91,11 +99,15 @@ export async function replayPage(root: HTMLElement, api: string, replayId: strin
       }
     }
     setText(now, `${clock(timeMs)} / ${clock(meta.duration_ms)}`);
+    playhead(timeMs);
     view.render();
     requestAnimationFrame(frame);
   }
+  let playhead: (ms: number) => void = () => undefined;
   requestAnimationFrame(frame);
-  if (meta.has_stats) void drawStats(plots, `${api}/replays/${encodeURIComponent(replayId)}/stats`);
+  if (meta.has_stats) {
+    void drawStats(plots, `${api}/replays/${encodeURIComponent(replayId)}/stats`).then((move) => { playhead = move; });
+  }
 
   // A small handle for tests and benchmarks (read-only views of the player's state).
   (window as unknown as Record<string, unknown>).hlvsViewer = {

@@ -1,7 +1,9 @@
-// Service pages, filled from hlvs serve's /v1 API with the token of the navigation bar:
-// a team's submissions (queue position, expected start, why it waits, results, replay and live
-// links), the operator's queue, the tournament schedule and standings, and the pool.
-import { el, getJson } from "../ui";
+// Service pages, filled from hlvs serve's /v1 API with the session's token, each showing what
+// the token's role may see: the matches (a team's own, all for an operator: queue position,
+// expected start, why it waits, results, replay and live links), the queue (other teams'
+// entries anonymised for a team), and for
+// operators the tournament schedule and standings and the pool.
+import { PageError, type Who, el, getJson } from "../ui";
 
 interface Submission {
   id: string;
@@ -48,13 +50,6 @@ function watchLinks(s: Submission): Node {
   return links;
 }
 
-function queueRows(active: Submission[]): (string | Node)[][] {
-  return active.map((s) => [
-    s.queue_position === null ? "-" : String(s.queue_position), s.id, s.team, s.opponent, s.state,
-    when(s.expected_start), s.waiting_reason ?? "-",
-  ]);
-}
-
 const QUEUE_COLUMNS = ["position", "submission", "team", "opponent", "state", "expected start", "reason"];
 
 async function score(s: Submission): Promise<string> {
@@ -67,29 +62,57 @@ async function score(s: Submission): Promise<string> {
   }
 }
 
-async function submissionsPage(root: HTMLElement): Promise<void> {
-  const rows = await getJson<Submission[]>("/v1/submissions");
-  const scores = await Promise.all(rows.map(score));
-  root.append(el("h1", {}, "Your test matches"), table("submissions", [
-    "submission", "opponent", "state", "queue position", "expected start", "reason", "finished", "result", "outcome", "watch",
-  ], rows.map((s, i) => [
-    s.id, s.opponent, s.state, s.queue_position === null ? "-" : String(s.queue_position), when(s.expected_start),
-    s.waiting_reason ?? "-", when(s.finished_at), scores[i],
-    s.failure_class ? `${s.failure_class}: ${s.cause ?? ""}` : (s.cause ?? "-"), watchLinks(s),
-  ])));
+async function submissionsPage(root: HTMLElement, who: Who | null): Promise<void> {
+  const rows = await getJson<Submission[]>("/v1/matches");
+  const operator = who?.scope === "operator";
+  const scores = await Promise.all(rows.map((s) => (operator ? Promise.resolve("-") : score(s))));
+  root.append(el("h1", {}, operator ? "All matches" : "Your matches"), rows.length === 0
+    ? el("p", { "data-testid": "empty" }, "No matches yet: submit one with hlvs submit.")
+    : table("submissions", [
+      ...(operator ? ["team"] : []), "submission", "opponent", "state", "queue position", "expected start", "reason", "finished", "result", "outcome", "watch",
+    ], rows.map((s, i) => [
+      ...(operator ? [s.team] : []),
+      s.id, s.opponent, s.state, s.queue_position === null ? "-" : String(s.queue_position), when(s.expected_start),
+      s.waiting_reason ?? "-", when(s.finished_at), scores[i],
+      s.failure_class ? `${s.failure_class}: ${s.cause ?? ""}` : (s.cause ?? "-"), watchLinks(s),
+    ])));
+}
+
+interface QueueEntry {
+  own: boolean;
+  position: number | null;
+  state: string;
+  team: string;
+  opponent: string;
+  id: string | null;
+  expected_start: string | null;
+  waiting_reason: string | null;
 }
 
 async function queuePage(root: HTMLElement): Promise<void> {
-  const queue = await getJson<Queue>("/v1/operator/queue");
+  const queue = await getJson<{ paused: boolean; slots: number; active: QueueEntry[] }>("/v1/queue");
   root.append(
     el("h1", {}, "Queue"),
     el("p", { "data-testid": "queue-summary" }, `${queue.paused ? "paused" : "running"}, ${queue.slots} match slot(s), ${queue.active.length} active`),
-    table("queue", QUEUE_COLUMNS, queueRows(queue.active)),
+    table("queue", QUEUE_COLUMNS, queue.active.map((e) => [
+      e.position === null ? "-" : String(e.position), e.id ?? "-", e.team, e.opponent, e.state,
+      when(e.expected_start), e.waiting_reason ?? "-",
+    ])),
   );
 }
 
 async function standingsPage(root: HTMLElement): Promise<void> {
-  const schedule = await getJson<Schedule>("/v1/operator/schedule");
+  let schedule: Schedule;
+  try {
+    schedule = await getJson<Schedule>("/v1/operator/schedule");
+  } catch (error) {
+    if (error instanceof PageError && error.message.startsWith("Not found")) {
+      root.append(el("h1", {}, "Tournament"), el("p", { "data-testid": "error", class: "error" },
+        "No tournament runs on this service: its operator starts one with hlvs schedule run and names its state file in HLVS_SERVICE_SCHEDULE_STATE. The ladder (/watch/ladder) shows the ratings from friendlies."));
+      return;
+    }
+    throw error;
+  }
   const standingColumns = ["team", "played", "won", "drawn", "lost", "goals_for", "goals_against", "goal_difference", "points"];
   const labels = ["team", "played", "won", "drawn", "lost", "goals for", "goals against", "goal difference", "points"];
   root.append(
@@ -185,14 +208,21 @@ async function poolPage(root: HTMLElement): Promise<void> {
   setTimeout(() => void refresh(), POOL_REFRESH_MS);
 }
 
-export async function tablePage(root: HTMLElement, page: string, _arg?: string): Promise<void> {
+const OPERATOR_PAGES: Record<string, string> = { standings: "the tournament", schedule: "the tournament", nodes: "the pool" };
+
+export async function tablePage(root: HTMLElement, page: string, arg?: string, who: Who | null = null): Promise<void> {
   const health = await fetch("/v1/health");
   if (health.status === 404) {
     root.append(el("p", { class: "error", "data-testid": "error" },
       "This page is part of hlvs serve (the submission service); hlvs view shows replays and live matches only."));
     return;
   }
-  if (page === "submissions") await submissionsPage(root);
+  if (page in OPERATOR_PAGES && who?.scope !== "operator") {
+    root.append(el("p", { class: "error", "data-testid": "error" },
+      `The page of ${OPERATOR_PAGES[page]} is for the league's operators. Your team sees its matches, the queue and the ladder.`));
+    return;
+  }
+  if (page === "submissions") await submissionsPage(root, who);
   else if (page === "queue") await queuePage(root);
   else if (page === "standings" || page === "schedule") await standingsPage(root);
   else await poolPage(root);

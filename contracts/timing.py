@@ -1,0 +1,140 @@
+"""Match timing: the one source every way of making a match takes its timing from.
+
+Official matches, ``hlvs scrimmage`` (local and on the Slurm pool), the service's test matches,
+``hlvs compose``, tournament schedules and the Gymnasium environments all start from a preset of
+this module and pass :func:`check_half` (or :func:`fit_ready` for quick tests), so that a game
+whose READY plus SET does not leave time to play is refused before it starts.
+
+The rule is written for the worst case, a half clock that runs through READY and SET (as after a
+goal, and in HLVS before every kick-off): each half must keep at least :data:`MIN_PLAYING_S`
+simulated seconds of PLAYING after its READY and SET. A GameController that stops the clock
+before the first kick-off of a half only plays longer.
+
+After the match, :func:`played_enough` tells a match that played football from one that did not:
+no half reached PLAYING, or fewer than :data:`MIN_PLAYING_S` seconds were played in all.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+SET_TO_PLAY_S = 5.0
+"""Simulated seconds from SET to PLAYING (the automatic referee's, as the GameController's)."""
+MIN_PLAYING_S = 10.0
+"""The documented minimum of play: simulated seconds of PLAYING each half must leave after READY
+and SET, and that a match must have played in all to count as played. A game sets its own with
+``timing.minimum_play_s``; 0 marks a match not meant to play football (a test of the match's
+lifecycle: containers, logs, signals), which is neither refused nor failed for want of play."""
+MIN_READY_S = 5.0
+"""The shortest READY a quick test is shortened to (robots need a moment to stand up)."""
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TimingPreset:
+    """The timing of one way of making a match. Play durations are simulated seconds; the waits
+    before the first READY, at half time and after the game (grace) are wall seconds."""
+
+    half_duration_s: float
+    ready_duration_s: float
+    wait_before_first_ready_s: float
+    half_time_break_s: float
+    grace_period_s: float
+
+    @property
+    def playing_per_half_s(self) -> float:
+        return playing_per_half_s(self.half_duration_s, self.ready_duration_s)
+
+
+OFFICIAL = TimingPreset(half_duration_s=600.0, ready_duration_s=45.0,
+                        wait_before_first_ready_s=120.0, half_time_break_s=15.0,
+                        grace_period_s=120.0)
+"""The league's rules: 10 min halves, 45 s READY (game.json defaults)."""
+SCRIMMAGE = TimingPreset(half_duration_s=40.0, ready_duration_s=20.0,
+                         wait_before_first_ready_s=3.0, half_time_break_s=1.0, grace_period_s=5.0)
+"""``hlvs scrimmage`` (local or ``--pool slurm``): 40 s of PLAYING per half when no goal is
+scored (READY and SET before a half's kick-off stop the clock), about 65 s simulated."""
+TEST_MATCH = TimingPreset(half_duration_s=40.0, ready_duration_s=10.0,
+                          wait_before_first_ready_s=3.0, half_time_break_s=1.0,
+                          grace_period_s=5.0)
+"""The submission service's test matches: 40 s of PLAYING per half before any goal (READY and SET
+before the kick-off stop the clock), at least 25 s when the clock runs through them (30 s halves
+with a 10 s READY, the clock running, left a robot walking at 0.2 m/s from its touch line too
+little time to reach the ball)."""
+ENVIRONMENT = TimingPreset(half_duration_s=60.0, ready_duration_s=15.0,
+                           wait_before_first_ready_s=1.0, half_time_break_s=0.0,
+                           grace_period_s=0.0)
+"""The Gymnasium match environments (simulated waits)."""
+
+
+class TimingError(ValueError):
+    """A timing that leaves a half no time to play; the message is a sentence saying why."""
+
+
+def playing_per_half_s(half_s: float, ready_s: float, set_s: float = SET_TO_PLAY_S) -> float:
+    """Simulated seconds of PLAYING a half keeps when its clock runs through READY and SET."""
+    return half_s - ready_s - set_s
+
+
+def timing_problem(half_s: float, ready_s: float, *, set_s: float = SET_TO_PLAY_S,
+                   minimum_s: float = MIN_PLAYING_S, what: str = "half") -> str | None:
+    """Why a half of ``half_s`` with this READY and SET cannot be played, or None.
+    ``minimum_s`` 0: a match not meant to play (a lifecycle test), never a problem."""
+    left = playing_per_half_s(half_s, ready_s, set_s)
+    if minimum_s <= 0 or left >= minimum_s:
+        return None
+    return (f"READY ({ready_s:g} s) plus SET ({set_s:g} s) leaves {max(left, 0.0):g} s of play "
+            f"in a {what} of {half_s:g} s; at least {minimum_s:g} s are needed "
+            f"(a {what} of at least {ready_s + set_s + minimum_s:g} s, or a shorter READY)")
+
+
+def check_half(half_s: float, ready_s: float, *, set_s: float = SET_TO_PLAY_S,
+               minimum_s: float = MIN_PLAYING_S) -> None:
+    """Raise :class:`TimingError` when the half leaves less than the minimum of play."""
+    problem = timing_problem(half_s, ready_s, set_s=set_s, minimum_s=minimum_s)
+    if problem is not None:
+        raise TimingError(problem)
+
+
+def fit_ready(half_s: float, ready_s: float, *, set_s: float = SET_TO_PLAY_S,
+              minimum_s: float = MIN_PLAYING_S) -> tuple[float, str | None]:
+    """For quick tests: READY shortened so that the half keeps the minimum of play.
+
+    Returns the READY to use and a warning when it was shortened; raises :class:`TimingError`
+    when even a READY of :data:`MIN_READY_S` does not fit.
+    """
+    if timing_problem(half_s, ready_s, set_s=set_s, minimum_s=minimum_s) is None:
+        return ready_s, None
+    fitted = half_s - set_s - minimum_s
+    if fitted < MIN_READY_S:
+        shortest = MIN_READY_S + set_s + minimum_s
+        raise TimingError(
+            f"a half of {half_s:g} s is too short to play: READY (at least {MIN_READY_S:g} s) "
+            f"plus SET ({set_s:g} s) plus the minimum of play ({minimum_s:g} s) need "
+            f"{shortest:g} s")
+    return fitted, (f"READY shortened from {ready_s:g} s to {fitted:g} s so that each half of "
+                    f"{half_s:g} s keeps {minimum_s:g} s of play")
+
+
+def played_enough(halves_playing: tuple[int, ...] | list[int], playing_s: float,
+                  minimum_s: float = MIN_PLAYING_S) -> bool:
+    """True when a match played football: a half reached PLAYING and at least ``minimum_s``
+    seconds were played (``minimum_s`` 0: always, for a match not meant to play)."""
+    return minimum_s <= 0 or (bool(halves_playing) and playing_s >= minimum_s)
+
+
+__all__ = [
+    "ENVIRONMENT",
+    "MIN_PLAYING_S",
+    "MIN_READY_S",
+    "OFFICIAL",
+    "SCRIMMAGE",
+    "SET_TO_PLAY_S",
+    "TEST_MATCH",
+    "TimingError",
+    "TimingPreset",
+    "check_half",
+    "fit_ready",
+    "played_enough",
+    "playing_per_half_s",
+    "timing_problem",
+]

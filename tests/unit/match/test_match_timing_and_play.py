@@ -1,0 +1,224 @@
+"""One source of match timing (contracts.timing) on every path, and a match that did not play
+classified by its cause instead of a success."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+from pathlib import Path
+from typing import Any
+
+import pytest
+from orchestrator.commands.scrimmage_args import add_arguments
+
+from contracts.match_results import FailureClass, MatchReport
+from contracts.match_spec import TimingSpec
+from contracts.sim_result import SimResult
+from contracts.timing import (
+    MIN_PLAYING_S,
+    SCRIMMAGE,
+    TEST_MATCH,
+    TimingError,
+    check_half,
+    fit_ready,
+    played_enough,
+)
+from envs.errors import EnvConfigError
+from envs.session_spec import SessionSpec
+from orchestrator.config.loader import load_game
+from orchestrator.errors import ConfigError
+from orchestrator.match.results import RobotRecord, play_failure
+from orchestrator.match.scrimmage import write_files
+from service import Settings
+from service.errors import SettingsError
+from service.matchfiles import write_match
+from service.submissions import failure_side
+
+
+def test_every_preset_leaves_the_minimum_of_play() -> None:
+    for half, ready in ((600, 45), (SCRIMMAGE.half_duration_s, SCRIMMAGE.ready_duration_s),
+                        (TEST_MATCH.half_duration_s, TEST_MATCH.ready_duration_s)):
+        check_half(half, ready)
+    assert TEST_MATCH.playing_per_half_s == 25.0
+    with pytest.raises(TimingError, match=r"READY \(45 s\) plus SET \(5 s\) leaves 0 s"):
+        check_half(30, 45)
+
+
+def test_quick_tests_shorten_ready_or_refuse() -> None:
+    assert fit_ready(65, 20) == (20, None)
+    ready, warning = fit_ready(30, 45)
+    assert ready == 15 and warning is not None and "shortened from 45 s to 15 s" in warning
+    with pytest.raises(TimingError, match="too short to play"):
+        fit_ready(10, 20)
+
+
+def _game(tmp_path: Path, timing: dict[str, Any], game_type: str = "NORMAL") -> Path:
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    game_path = write_files(parser.parse_args([]), tmp_path, stub_image="stub:1")
+    game = json.loads(game_path.read_text())
+    game["timing"] = timing
+    game["type"] = game_type
+    game_path.write_text(json.dumps(game))
+    return game_path
+
+
+def test_a_game_whose_ready_is_longer_than_its_half_is_refused(tmp_path: Path) -> None:
+    with pytest.raises(ConfigError) as info:
+        load_game(_game(tmp_path, {"half_duration_s": 30}))  # READY: the rules' 45 s
+    problem = info.value.problems[0]
+    assert problem.pointer == "/timing/half_duration_s"
+    assert "leaves 0 s of play in a half of 30 s" in problem.message
+    with pytest.raises(ConfigError) as info:
+        load_game(_game(tmp_path, {"half_duration_s": 30, "ready_duration_s": 20}))
+    assert info.value.problems[0].pointer == "/timing/ready_duration_s"
+    knockout = {"half_duration_s": 65, "ready_duration_s": 20, "overtime_half_duration_s": 30}
+    with pytest.raises(ConfigError, match="half of extra time"):
+        load_game(_game(tmp_path, knockout, "KNOCKOUT"))
+    assert load_game(_game(tmp_path, {"half_duration_s": 35, "ready_duration_s": 20}))
+
+
+def test_a_scrimmage_with_a_short_half_gets_a_short_ready_with_a_warning(
+        tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    with caplog.at_level(logging.WARNING):
+        game = write_files(parser.parse_args(["--half-duration", "25"]), tmp_path,
+                           stub_image="stub:1")
+    assert "READY shortened from 20 s to 10 s" in caplog.text
+    assert load_game(game).game.timing.ready_duration_s == 10
+    with pytest.raises(ConfigError, match="too short to play"):
+        write_files(parser.parse_args(["--half-duration", "10"]), tmp_path, stub_image="s:1")
+
+
+def test_service_test_matches_play_and_too_short_halves_are_refused(tmp_path: Path) -> None:
+    settings = Settings()
+    team = {"name": "A", "image": "a/robot", "players": {"1": {"dockerTag": "1"}}}
+    game = write_match(tmp_path, match_id="m1", team=team, opponent=None, stub_image="stub:1",
+                       settings=settings, seed=1)
+    timing = json.loads(game.read_text())["timing"]
+    assert timing["half_duration_s"] == 40 and timing["ready_duration_s"] == 10
+    with pytest.raises(SettingsError, match="HLVS_SERVICE_TEST_HALF_DURATION_S"):
+        Settings.from_env({"HLVS_SERVICE_TEST_HALF_DURATION_S": "12"})
+
+
+def test_environment_matches_are_checked() -> None:
+    assert SessionSpec(referee=True).ready_duration_s == 15
+    assert SessionSpec(referee=True, half_duration_s=20).ready_duration_s == 5  # shortened
+    with pytest.raises(EnvConfigError, match="half_duration_s"):
+        SessionSpec(referee=True, half_duration_s=12)
+    assert SessionSpec(referee=True, half_duration_s=5, minimum_play_s=0).ready_duration_s == 15
+
+
+def test_a_match_not_meant_to_play_is_neither_refused_nor_failed(tmp_path: Path) -> None:
+    game = load_game(_game(tmp_path, {"half_duration_s": 4, "minimum_play_s": 0})).game
+    assert game.timing.minimum_play_s == 0
+    timing = TimingSpec(half_duration_s=4.0, minimum_play_s=0.0)
+    assert play_failure(_sim(0.0, [], ()), ROBOTS, timing) is None
+
+
+def _sim(playing_s: float, halves: list[int], connected: tuple[str, ...]) -> SimResult:
+    zero = {"red": 0, "blue": 0}
+    return SimResult.from_dict({
+        "match_id": "m", "seed": 1, "state": "FINISHED", "score": zero, "winner": "draw",
+        "robots": {key: {"connects": [1.0]} for key in connected},
+        "play": {"halves_playing": halves, "both_halves_playing": {1, 2} <= set(halves),
+                 "playing_s": playing_s, "kicks": zero, "shots": zero, "goals": zero,
+                 "own_goals": zero, "falls": zero}})
+
+
+ROBOTS = [RobotRecord(key="red-1", color="red", number=1, image="r"),
+          RobotRecord(key="blue-1", color="blue", number=1, image="b")]
+BOTH = ("red-1", "blue-1")
+
+
+def test_a_match_that_played_is_not_a_failure() -> None:
+    assert played_enough([1, 2], 30.0) and not played_enough([], 0.0)
+    assert not played_enough([1], MIN_PLAYING_S - 1)
+    assert play_failure(_sim(30.0, [1, 2], BOTH), ROBOTS, TimingSpec()) is None
+
+
+def test_no_play_by_the_leagues_timing_is_the_leagues() -> None:
+    timing = TimingSpec(half_duration_s=30.0, ready_duration_s=45.0)
+    failure = play_failure(_sim(0.0, [], BOTH), ROBOTS, timing)
+    assert failure is not None and failure.failure_class is FailureClass.NOT_PLAYED
+    assert failure.team is None and "the league's timing" in failure.cause
+    report = MatchReport.of(failure)
+    assert report.to_dict() == {"status": "failed", "failure_class": "not_played",
+                                "cause": failure.cause}
+    assert failure_side("not_played") == "league"
+
+
+def test_no_play_because_a_team_never_connected_names_the_team() -> None:
+    failure = play_failure(_sim(0.0, [], ("blue-1",)), ROBOTS, TimingSpec(half_duration_s=65.0))
+    assert failure is not None and failure.failure_class is FailureClass.TEAM_ABSENT
+    assert failure.team == "red" and "no robot of red ever connected" in failure.cause
+    report = MatchReport.of(failure)
+    assert report.to_dict()["team"] == "red"
+    assert MatchReport.from_dict(report.to_dict()).team == "red"
+    assert failure_side("team_absent", "red") == "team"
+    assert failure_side("team_absent", "blue") == "league"  # the stub's absence is not charged
+    neither = play_failure(_sim(2.0, [1], ()), ROBOTS, TimingSpec())
+    assert neither is not None and neither.failure_class is FailureClass.NOT_PLAYED
+    assert "either team" in neither.cause
+
+
+def test_a_stub_given_a_model_with_other_motor_names_is_said_loudly(
+        tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    wolfgang = Path(__file__).resolve().parents[3] / "configs/examples/robots/wolfgang"
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    with caplog.at_level(logging.WARNING):
+        write_files(parser.parse_args(["--red-model", str(wolfgang)]), tmp_path,
+                    stub_image="stub:1")
+    warned = [r for r in caplog.records if r.levelno == logging.WARNING]
+    assert len(warned) == 1 and warned[0].getMessage().startswith("red robots: the stub robot")
+    assert "stands still" in warned[0].getMessage()
+    caplog.clear()
+    with caplog.at_level(logging.WARNING):  # a robot image of the team's own: its business
+        write_files(parser.parse_args(["--red-model", str(wolfgang), "--red-image", "team:1"]),
+                    tmp_path, stub_image="stub:1")
+    assert not caplog.records
+
+
+def test_compose_says_how_to_collect_results_and_take_it_down_and_collects(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from orchestrator.cli import main
+
+    game = Path(__file__).resolve().parents[3] / "configs/examples/scrimmage_1v1/game.json"
+    output = tmp_path / "docker-compose.yml"
+    assert main(["compose", str(game), "-o", str(output), "--simulator-image", "sim:x"]) == 0
+    printed = capsys.readouterr().out
+    assert f"hlvs compose {game} -o {output} --collect" in printed
+    assert "docker compose -f docker-compose.yml down" in printed
+    assert "docker-compose -f docker-compose.yml down" in printed
+    assert "--collect" in output.read_text() and "docker-compose down" in output.read_text()
+
+    sim = _sim(0.0, [], ("red-1", "blue-1")).to_dict()  # FINISHED 0:0 without kick-off
+    (tmp_path / "out" / "sim_result.json").write_text(json.dumps({**sim, "match_id": "m"}))
+    code = main(["compose", str(game), "-o", str(output), "--collect", "--json"])
+    summary = json.loads(capsys.readouterr().out)
+    assert code == 1 and summary["status"] == "failed"
+    assert summary["failure"].startswith("not_played: the match did not play")
+    report = json.loads((tmp_path / "report.json").read_text())
+    assert report["failure_class"] == "not_played"
+    assert json.loads((tmp_path / "results.json").read_text())["score"] == {"red": 0, "blue": 0}
+
+
+def test_a_schedule_whose_game_timing_leaves_no_play_is_refused(tmp_path: Path) -> None:
+    from orchestrator.config.schedule import load_schedule
+    from tests.unit.schedule.test_schedule import COMPRESSED, write_schedule
+
+    fixtures = ("fixtures:\n  round_robin: {teams: [alpha, bravo], first_stream: '+1h', "
+                "interval_s: 60}\n")
+    short = write_schedule(tmp_path, COMPRESSED + fixtures +
+                           "game_defaults:\n  timing: {half_duration_s: 30}\n")
+    with pytest.raises(ConfigError) as info:
+        load_schedule(short)
+    (problem,) = info.value.problems
+    assert problem.pointer == "/game_defaults/timing/half_duration_s"
+    assert "leaves 0 s of play in a half of 30 s" in problem.message
+    fitted = write_schedule(tmp_path, COMPRESSED + fixtures + "game_defaults:\n  timing: "
+                            "{half_duration_s: 30, ready_duration_s: 15}\n")
+    assert load_schedule(fitted).game_defaults["timing"]["ready_duration_s"] == 15
