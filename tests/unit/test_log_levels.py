@@ -6,7 +6,7 @@ from __future__ import annotations
 import logging
 
 import pytest
-from orchestrator.cli import configure_logging
+from hlvs.cli import configure_logging
 
 
 @pytest.mark.parametrize("level", [logging.DEBUG, logging.INFO, logging.WARNING])

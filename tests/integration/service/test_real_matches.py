@@ -81,7 +81,7 @@ def real_settings(settings: Settings, docker_client: Any) -> Settings:
 
 def _hlvs(*argv: str) -> subprocess.Popen[str]:
     """The ``hlvs`` command a team runs, as a process of its own."""
-    return subprocess.Popen([sys.executable, "-m", "orchestrator", *argv], cwd=REPO,
+    return subprocess.Popen([sys.executable, "-m", "hlvs", *argv], cwd=REPO,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 

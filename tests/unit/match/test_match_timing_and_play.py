@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from orchestrator.commands.scrimmage_args import add_arguments
+from hlvs.commands.scrimmage_args import add_arguments
 
 from contracts.match_results import FailureClass, MatchReport
 from contracts.match_spec import TimingSpec
@@ -184,7 +184,7 @@ def test_a_stub_given_a_model_with_other_motor_names_is_said_loudly(
 
 def test_compose_says_how_to_collect_results_and_take_it_down_and_collects(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    from orchestrator.cli import main
+    from hlvs.cli import main
 
     game = Path(__file__).resolve().parents[3] / "configs/examples/scrimmage_1v1/game.json"
     output = tmp_path / "docker-compose.yml"

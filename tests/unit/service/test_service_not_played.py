@@ -13,7 +13,7 @@ from types import SimpleNamespace
 from typing import Any
 
 import pytest
-from service.pool.fake import FakePool
+from cluster.fake import FakePool
 
 from service import Settings, notify
 from tests.integration.service.harness import Served
