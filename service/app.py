@@ -27,6 +27,7 @@ from sqlalchemy.orm import Session, sessionmaker
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from cluster import MatchPool, PoolError, make_pool
+from orchestrator.config import TeamConfig
 from service.db import make_engine, migrate, session_factory
 from service.errors import AuthError, ServiceError
 from service.settings import Settings
@@ -84,8 +85,9 @@ class Services:
 
 
 PoolFactory = Callable[[Settings], Any]
-Preflight = Callable[[dict[str, Any], Settings], float]
-"""(team file, settings) -> seconds taken; raises service.errors.PreflightFailed."""
+Preflight = Callable[[TeamConfig, Settings], float]
+"""(the submitted team, checked; settings) -> seconds taken; raises
+service.errors.PreflightFailed."""
 
 
 def create_app(

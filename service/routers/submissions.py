@@ -63,8 +63,8 @@ def create_submission(body: SubmissionCreate, request: Request, principal: TeamP
     credentials = teamfiles.newest_id(session, team_id=team_id, kind="credentials")
     session.commit()  # no connection is held during the pre-flight check
     assert services.preflight is not None
-    teamfiles.raise_if_invalid("team_config", document)  # the upload's check, today's rules
-    elapsed = services.preflight(document, services.settings)
+    team = teamfiles.validated_team(document)  # the upload's check, today's rules
+    elapsed = services.preflight(team, services.settings)
     row = submissions.create(session, team_id=team_id, opponent=body.opponent,
                              team_file_id=file_id, credentials_file_id=credentials,
                              preflight_s=elapsed)

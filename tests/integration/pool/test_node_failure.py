@@ -34,14 +34,14 @@ SLURM_DIR = Path("/var/lib/hlvs/slurm")
 
 
 def _job(tmp: Path, match_id: str, *, requeue: bool) -> MatchJob:
-    from orchestrator.match.scrimmage import write_files
+    from orchestrator.match.scrimmage import ScrimmageRequest, write_files
     from orchestrator.project_images import project_image
 
     args = argparse.Namespace(
         red_image=None, blue_image=None, players=1, half_duration=6.0, ready_duration=1.0,
         wait_before_ready=1.0, grace=2.0, robot_command=None, match_id=match_id, seed=7,
     )
-    game = write_files(args, tmp / "config", stub_image=project_image("stub"))
+    game = write_files(ScrimmageRequest.from_options(args), tmp / "config", stub_image=project_image("stub"))
     return MatchJob(match_id=match_id, game_path=game, work_dir=tmp / "work", requeue=requeue)
 
 
