@@ -123,14 +123,15 @@ def _start_and_connect(team: TeamConfig, folder: Path, *, settings: Settings,
     from orchestrator.match import HostControl, MatchRunner, RunOptions, cleanup, plan_from_game
     from orchestrator.match.scrimmage import ScrimmageRequest, game_file, team_file
     from orchestrator.project_images import project_image
+    from orchestrator.telemetry import ZenohTelemetry
     from service.teamfiles import FIELD_CLASS
 
-    red = _distinct_players(team)
+    checked = _distinct_players(team)
     match_id = "preflight-" + secrets.token_hex(4)
     request = ScrimmageRequest(players=1, seed=1, half_duration_s=60.0, wait_before_ready_s=120.0,
                                grace_s=1.0)
     game = game_file(request, match_id)
-    game["red"]["ports"] = [10000 + n for n in range(1, len(red.players) + 1)]
+    game["red"]["ports"] = [10000 + n for n in range(1, len(checked.players) + 1)]
     limits = official_limits()
     game["limits"] = {"cpus": limits.cpus, "memory_gb": limits.memory_gb, "pids": limits.pids,
                       "log_folder_gb": 1}
@@ -139,7 +140,7 @@ def _start_and_connect(team: TeamConfig, folder: Path, *, settings: Settings,
         stub = parse_team(team_file("Stub", project_image("stub"), 1, goalie_first=True),
                           source=config / "team_blue.json", field_class=FIELD_CLASS,
                           images_required=True).team
-        loaded = parse_game(game, source=config / "game.json", teams={"red": red, "blue": stub},
+        loaded = parse_game(game, source=config / "game.json", teams={"red": checked, "blue": stub},
                             images_required=True)
         plan = plan_from_game(loaded, grace_period_s=1.0)
     except ConfigError as exc:
