@@ -60,7 +60,8 @@ def measure(*, robots: int, out: Path, timeout_s: float, robot_image: str | None
                             + (["--robot-command", robot_command] if robot_command else []))
     stub = robot_image or project_image("stub")
     simulator = project_image("simulator")
-    plan = plan_from_game(load_game(write_files(ScrimmageRequest.from_options(args), out / "config", stub_image=stub)),
+    request = ScrimmageRequest.from_options(args)
+    plan = plan_from_game(load_game(write_files(request, out / "config", stub_image=stub)),
                           grace_period_s=1.0)
     runtime = DockerRuntime(connect())
     runner = MatchRunner(

@@ -50,7 +50,8 @@ def _job(folder: Path, name: str, half_s: float, *, league: bool = False) -> Any
         match_id=f"bench-{name}-{os.getpid()}",
         seed=5,
     )
-    game = write_files(ScrimmageRequest.from_options(args), folder / name / "config", stub_image=project_image("stub"))
+    game = write_files(ScrimmageRequest.from_options(args), folder / name / "config",
+                       stub_image=project_image("stub"))
     return MatchJob(match_id=args.match_id, game_path=game, work_dir=folder / name,
                     robot_nodes=4 if league else 0)
 

@@ -102,7 +102,8 @@ def play_one(*, seed: int, out: Path, players: int | None,
         argv += ["--players", str(players)]
     args = scrim.parse_args(argv)
     started = time.monotonic()
-    plan = plan_from_game(load_game(write_files(ScrimmageRequest.from_options(args), out / "config")),
+    request = ScrimmageRequest.from_options(args)
+    plan = plan_from_game(load_game(write_files(request, out / "config")),
                           grace_period_s=args.grace)
     runtime = DockerRuntime(connect())
     host = HostControl.for_current_user()

@@ -37,7 +37,7 @@ log = logging.getLogger(__name__)
 KINDS = {"team_config": "team_config.json", "credentials": "credentials.json"}
 
 
-FIELD_CLASS: FieldClass = "KID"
+FIELD_CLASS = FieldClass.KID
 """The field class of the service's test matches (``orchestrator.match.scrimmage.game_file``):
 the pose rules of the upload are those the pre-flight and the match apply."""
 PLACEHOLDER_KEY = ("-----BEGIN OPENSSH PRIVATE KEY-----\n(refused)\n"

@@ -274,9 +274,9 @@ def _field_class(document: object) -> FieldClass | None:
     if isinstance(document, dict):
         value = document.get("class")
         if value == "KID":
-            return "KID"
+            return FieldClass.KID
         if value == "ADULT":
-            return "ADULT"
+            return FieldClass.ADULT
     return None
 
 

@@ -41,7 +41,8 @@ def _job(tmp: Path, match_id: str, *, requeue: bool) -> MatchJob:
         red_image=None, blue_image=None, players=1, half_duration=6.0, ready_duration=1.0,
         wait_before_ready=1.0, grace=2.0, robot_command=None, match_id=match_id, seed=7,
     )
-    game = write_files(ScrimmageRequest.from_options(args), tmp / "config", stub_image=project_image("stub"))
+    game = write_files(ScrimmageRequest.from_options(args), tmp / "config",
+                       stub_image=project_image("stub"))
     return MatchJob(match_id=match_id, game_path=game, work_dir=tmp / "work", requeue=requeue)
 
 

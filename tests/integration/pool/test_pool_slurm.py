@@ -30,7 +30,8 @@ def _job(tmp: Path, name: str, account: str) -> MatchJob:
         grace=2.0, robot_command=None, match_id=f"slurm-{name}-{os.getpid()}", seed=7,
     )
     work = tmp / name
-    game = write_files(ScrimmageRequest.from_options(args), work / "config", stub_image=project_image("stub"))
+    game = write_files(ScrimmageRequest.from_options(args), work / "config",
+                       stub_image=project_image("stub"))
     return MatchJob(match_id=args.match_id, game_path=game, work_dir=work, account=account)
 
 

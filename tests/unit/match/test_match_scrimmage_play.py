@@ -29,7 +29,8 @@ PLAY = {
 def _scrimmage(tmp_path: Path, *argv: str) -> tuple[dict[str, Any], dict[str, Any]]:
     parser = argparse.ArgumentParser()
     add_arguments(parser)
-    game = write_files(ScrimmageRequest.from_options(parser.parse_args(list(argv))), tmp_path, stub_image="stub:1")
+    request = ScrimmageRequest.from_options(parser.parse_args(list(argv)))
+    game = write_files(request, tmp_path, stub_image="stub:1")
     red = json.loads((tmp_path / "team_red.json").read_text())
     return json.loads(game.read_text()), red
 

@@ -137,7 +137,7 @@ def test_the_upload_checks_the_field_class_the_service_plays() -> None:
 
     request = ScrimmageRequest(players=1, seed=1, half_duration_s=30.0, wait_before_ready_s=3.0,
                                grace_s=5.0)
-    assert game_file(request, "m")["class"] == teamfiles.FIELD_CLASS
+    assert game_file(request, "m")["class"] == teamfiles.FIELD_CLASS.name
 
 
 # --- webhook addresses --------------------------------------------------------------------------
