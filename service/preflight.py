@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import logging
 import os
+import queue
 import secrets
 import tempfile
 import threading
@@ -153,36 +154,13 @@ def _start_and_connect(team: TeamConfig, folder: Path, *, settings: Settings,
                            poll_s=0.1),
         telemetry=lambda endpoint, mid: ZenohTelemetry(endpoint=endpoint, match_id=mid),
     )
+    events = runner.events.subscribe()
     thread = threading.Thread(target=runner.run, name=match_id, daemon=True)
     thread.start()
-    deadline = time.monotonic() + settings.preflight_timeout_s
     failure: PreflightFailed | None = None
     try:
-        while True:
-            if runner.bringup_s is not None:
-                break
-            red = [r for r in runner.records.values() if r.color == "red"]
-            broken = next((r for r in red if r.startup_error or r.exited_during_game), None)
-            if broken is not None:
-                stage = "start"
-                cause = broken.startup_error or (
-                    f"the robot's container exited with code {broken.exit_code}"
-                    + (" (out of memory)" if broken.oom_killed else "")
-                    + " before connecting to the simulator")
-                failure = PreflightFailed(stage=stage, image=broken.image or "?", cause=cause)
-                break
-            if runner.failure is not None or not thread.is_alive():
-                cause = runner.failure.cause if runner.failure else "the check ended early"
-                failure = PreflightFailed(stage="start", image="(simulator)", cause=cause)
-                break
-            if time.monotonic() > deadline:
-                waiting = [r.image or "?" for r in red]
-                failure = PreflightFailed(
-                    stage="connect", image=", ".join(sorted(set(waiting))),
-                    cause=f"no connection to the simulator's robot API within "
-                          f"{settings.preflight_timeout_s:.0f} s")
-                break
-            time.sleep(0.1)
+        failure = _connected_or_failure(events, timeout_s=settings.preflight_timeout_s,
+                                        images=[r.image or "?" for r in plan.red.robots])
     finally:
         runner.stop_event.set()
 
@@ -198,6 +176,42 @@ def _start_and_connect(team: TeamConfig, folder: Path, *, settings: Settings,
             teardowns.append(background)
     if failure is not None:
         raise failure
+
+
+def _connected_or_failure(events: queue.SimpleQueue[Any], *, timeout_s: float,
+                          images: list[str]) -> PreflightFailed | None:
+    """Follow the check's match until every robot has connected (None) or the check has
+    failed: a robot of the team that did not start or exited, the match itself, or the
+    deadline."""
+    from orchestrator.match import (
+        AllConnected,
+        MatchEnded,
+        MatchFailed,
+        RobotExited,
+        RobotNotStarted,
+    )
+
+    deadline = time.monotonic() + timeout_s
+    while True:
+        try:
+            event = events.get(timeout=max(0.0, deadline - time.monotonic()))
+        except queue.Empty:
+            return PreflightFailed(
+                stage="connect", image=", ".join(sorted(set(images))),
+                cause=f"no connection to the simulator's robot API within {timeout_s:.0f} s")
+        if isinstance(event, AllConnected):
+            return None
+        if isinstance(event, RobotNotStarted) and event.color == "red":
+            return PreflightFailed(stage="start", image=event.image or "?", cause=event.cause)
+        if isinstance(event, RobotExited) and event.color == "red":
+            return PreflightFailed(
+                stage="start", image=event.image or "?",
+                cause=f"the robot's container exited with code {event.exit_code}"
+                      + (" (out of memory)" if event.oom_killed else "")
+                      + " before connecting to the simulator")
+        if isinstance(event, MatchFailed | MatchEnded):
+            cause = event.failure.cause if event.failure else "the check ended early"
+            return PreflightFailed(stage="start", image="(simulator)", cause=cause)
 
 
 __all__ = ["PreflightChecker", "official_limits", "run"]

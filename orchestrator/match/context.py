@@ -21,6 +21,7 @@ from contracts.match_results import Forfeit
 from contracts.telemetry import StateMessage
 from orchestrator.bandwidth import AppliedShaping
 from orchestrator.match.admission import CpuSets
+from orchestrator.match.events import EventStream, MatchFailed, StateChanged
 from orchestrator.match.gpu import SimulatorGpu
 from orchestrator.match.host import Host
 from orchestrator.match.layout import SIMULATOR_COMMAND, Subnet
@@ -118,11 +119,13 @@ class MatchContext:
         self.telemetry: TelemetrySource | None = None
         # the teams' logs cut or lost in collection: {"robot", "what", "reason"} (report.json)
         self.logs_cut: list[dict[str, str]] = []
+        self.events = EventStream()  # the match's progress, for observers in other threads
 
 
     def advance(self, target: MatchState) -> None:
         """Move the match to ``target`` (the lifecycle checks the transition)."""
         self.lifecycle.advance(target)
+        self.events.publish(StateChanged(state=self.lifecycle.state))
         self.progress(None)
 
     def progress(self, state: StateMessage | None) -> None:
@@ -133,6 +136,7 @@ class MatchContext:
         """Record the match's failure; the first one counts."""
         if self.failure is None:
             self.failure = Failure(failure_class=failure_class, cause=cause)
+            self.events.publish(MatchFailed(failure=self.failure))
             log.error("match %s failed (%s): %s", self.plan.match_id, failure_class.value, cause)
 
 

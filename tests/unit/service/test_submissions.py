@@ -385,13 +385,16 @@ class _Runner:
     plans: list[Any] = []
 
     def __init__(self, plan: Any, **_: Any) -> None:
+        from orchestrator.match import EventStream
+
         self.plans.append(plan)
-        self.bringup_s: float | None = 0.1
-        self.records: dict[str, Any] = {}
-        self.failure = None
+        self.events = EventStream()
         self.stop_event = threading.Event()
 
     def run(self) -> None:
+        from orchestrator.match import AllConnected
+
+        self.events.publish(AllConnected(bringup_s=0.1))
         self.stop_event.wait(5)
 
 
