@@ -26,7 +26,7 @@ from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
-from orchestrator.config import Limits, TeamConfig
+from orchestrator.config import Limits, PlayerConfig, TeamConfig
 from orchestrator.errors import ConfigError, ImageTooLarge, OrchestratorError
 from service.errors import InvalidInput, PreflightFailed
 from service.settings import Settings
@@ -106,7 +106,7 @@ def _invalid(exc: ConfigError) -> InvalidInput:
 
 def _distinct_players(team: TeamConfig) -> TeamConfig:
     """The team with one player per distinct (image, tag, command), numbered from 1."""
-    kept: list[Any] = []
+    kept: list[PlayerConfig] = []
     seen: set[tuple[str | None, str | None, str | None]] = set()
     for player in team.players:
         ident = (player.image_repository, player.docker_tag, player.docker_cmd)

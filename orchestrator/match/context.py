@@ -5,7 +5,8 @@
 :class:`~orchestrator.match.collection.CollectionPhase`) work on: a phase gets the context, records
 what it created in :attr:`MatchContext.started` (so that teardown removes exactly that) and
 reports failures with :meth:`MatchContext.fail`. This module imports none of them, so there is no
-import circle between the runner and its phases.
+import circle between the runner and its phases. Observers in other threads subscribe to
+:attr:`MatchContext.events` (:mod:`orchestrator.match.events`) rather than read its fields.
 """
 
 from __future__ import annotations
