@@ -48,7 +48,7 @@ def measure(*, robots: int, out: Path, timeout_s: float, robot_image: str | None
     from orchestrator.engine import connect
     from orchestrator.engine.containers import DockerRuntime
     from orchestrator.match import HostControl, MatchRunner, RunOptions, cleanup, plan_from_game
-    from orchestrator.match.scrimmage import write_files
+    from orchestrator.match.scrimmage import ScrimmageRequest, write_files
     from orchestrator.project_images import project_image
     from orchestrator.telemetry import ZenohTelemetry
 
@@ -60,7 +60,8 @@ def measure(*, robots: int, out: Path, timeout_s: float, robot_image: str | None
                             + (["--robot-command", robot_command] if robot_command else []))
     stub = robot_image or project_image("stub")
     simulator = project_image("simulator")
-    plan = plan_from_game(load_game(write_files(args, out / "config", stub_image=stub)),
+    request = ScrimmageRequest.from_options(args)
+    plan = plan_from_game(load_game(write_files(request, out / "config", stub_image=stub)),
                           grace_period_s=1.0)
     runtime = DockerRuntime(connect())
     runner = MatchRunner(

@@ -55,7 +55,7 @@ def _files(folder: Path, *, match_id: str, red_command: str, cpus: float, half_s
         "--minimum-play", "0",
         "--wait-before-ready", "1", "--grace", "1", "--red-image", project_image("team-base"),
     ])
-    game = scrimmage.write_files(args, folder)
+    game = scrimmage.write_files(scrimmage.ScrimmageRequest.from_options(args), folder)
     data = json.loads(game.read_text())
     data["official"] = True
     data["stepping"] = stepping

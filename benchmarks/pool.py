@@ -36,7 +36,7 @@ CONF = "/var/lib/hlvs/slurm/slurm.conf"
 
 def _job(folder: Path, name: str, half_s: float, *, league: bool = False) -> Any:
     from cluster import MatchJob
-    from orchestrator.match.scrimmage import write_files
+    from orchestrator.match.scrimmage import ScrimmageRequest, write_files
     from orchestrator.project_images import project_image
 
     args = argparse.Namespace(
@@ -51,7 +51,8 @@ def _job(folder: Path, name: str, half_s: float, *, league: bool = False) -> Any
         match_id=f"bench-{name}-{os.getpid()}",
         seed=5,
     )
-    game = write_files(args, folder / name / "config", stub_image=project_image("stub"))
+    game = write_files(ScrimmageRequest.from_options(args), folder / name / "config",
+                       stub_image=project_image("stub"))
     return MatchJob(match_id=args.match_id, game_path=game, work_dir=folder / name,
                     robot_nodes=4 if league else 0)
 

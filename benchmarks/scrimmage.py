@@ -90,7 +90,7 @@ def play_one(*, seed: int, out: Path, players: int | None,
     from orchestrator.engine import connect
     from orchestrator.engine.containers import DockerRuntime
     from orchestrator.match import HostControl, MatchRunner, RunOptions, cleanup, plan_from_game
-    from orchestrator.match.scrimmage import write_files
+    from orchestrator.match.scrimmage import ScrimmageRequest, write_files
     from orchestrator.project_images import project_image
     from orchestrator.telemetry import ZenohTelemetry
 
@@ -102,7 +102,8 @@ def play_one(*, seed: int, out: Path, players: int | None,
         argv += ["--players", str(players)]
     args = scrim.parse_args(argv)
     started = time.monotonic()
-    plan = plan_from_game(load_game(write_files(args, out / "config")),
+    request = ScrimmageRequest.from_options(args)
+    plan = plan_from_game(load_game(write_files(request, out / "config")),
                           grace_period_s=args.grace)
     runtime = DockerRuntime(connect())
     host = HostControl.for_current_user()

@@ -12,6 +12,45 @@ from dataclasses import dataclass
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class StartingPose:
+    """A pose as HLVS team files write it: translation [x, y, z] in m and axis-angle rotation
+    [ax, ay, az, angle]."""
+
+    translation: tuple[float, float, float]
+    rotation: tuple[float, float, float, float]
+
+    @property
+    def x_m(self) -> float:
+        return self.translation[0]
+
+    @property
+    def y_m(self) -> float:
+        return self.translation[1]
+
+    @property
+    def z_m(self) -> float:
+        return self.translation[2]
+
+    @property
+    def yaw_rad(self) -> float:
+        """Heading of the robot's x axis in the ground plane (angle * sign(az) for a z axis)."""
+        ax, ay, az, angle = self.rotation
+        norm = math.sqrt(ax * ax + ay * ay + az * az)
+        if norm == 0.0:
+            return 0.0
+        ux, uy, uz = ax / norm, ay / norm, az / norm
+        c, s = math.cos(angle), math.sin(angle)
+        r00 = c + ux * ux * (1 - c)
+        r10 = uy * ux * (1 - c) + uz * s
+        return math.atan2(r10, r00)
+
+    @property
+    def pose(self) -> Pose:
+        """The pose on the ground (height and tilt left to the world)."""
+        return Pose(x_m=self.x_m, y_m=self.y_m, yaw_rad=self.yaw_rad)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Pose:
     """A pose on the ground: torso x, y (z chosen by the world), heading."""
 
@@ -34,4 +73,4 @@ def wrap_angle(angle: float) -> float:
     return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
-__all__ = ["Pose", "wrap_angle"]
+__all__ = ["Pose", "StartingPose", "wrap_angle"]

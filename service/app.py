@@ -17,7 +17,7 @@ import logging
 from collections.abc import AsyncIterator, Callable, Sequence
 from contextlib import asynccontextmanager
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
@@ -27,9 +27,16 @@ from sqlalchemy.orm import Session, sessionmaker
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from cluster import MatchPool, PoolError, make_pool
+from orchestrator.config import TeamConfig
 from service.db import make_engine, migrate, session_factory
 from service.errors import AuthError, ServiceError
 from service.settings import Settings
+
+if TYPE_CHECKING:
+    from service.sealing import Sealer
+    from service.statusboard import StatusBoard
+    from service.submissions import QueueBoard
+    from service.tokens import TokenCache
 
 log = logging.getLogger(__name__)
 
@@ -62,21 +69,33 @@ def service_routers() -> tuple[Mount, ...]:
     )
 
 
-@dataclass(slots=True)
+class Background(Protocol):
+    """A thread of the service that waits for work (the queue worker, the after-match
+    delivery); :meth:`wake` tells it there is some now."""
+
+    def start(self) -> None: ...
+
+    def wake(self) -> None: ...
+
+    def stop(self) -> None: ...
+
+
+@dataclass(slots=True, kw_only=True)
 class Services:
-    """What request handlers and the worker share; built by the lifespan."""
+    """What request handlers and the worker share; built by the lifespan (routers get it, or
+    one of its parts, through the accessors of :mod:`service.deps`)."""
 
     settings: Settings
     engine: Engine
     sessions: sessionmaker[Session]
-    pool: Any = None  # cluster.MatchPool
-    worker: Any = None  # service.worker.QueueWorker
-    aftermatch: Any = None  # service.aftermatch.AfterMatch
+    pool: MatchPool  # the port: a local-Docker or Slurm pool, a fake in unit tests
+    queue: QueueBoard
+    tokens: TokenCache
+    status: StatusBoard
+    sealer: Sealer  # the secrets stored in the database
     preflight: Preflight | None = None
-    queue: Any = None  # service.submissions.QueueBoard
-    tokens: Any = None  # service.tokens.TokenCache
-    status: Any = None  # service.statusboard.StatusBoard
-    sealer: Any = None  # service.sealing.Sealer: the secrets stored in the database
+    worker: Background | None = None  # service.worker.QueueWorker; None when the app serves
+    aftermatch: Background | None = None  # service.aftermatch.AfterMatch  without matches
 
     def slots(self) -> int:
         return int(self.pool.slots) if self.pool is not None else self.settings.match_slots
@@ -93,9 +112,10 @@ class Services:
     extras: dict[str, Any] = field(default_factory=dict)
 
 
-PoolFactory = Callable[[Settings], Any]
-Preflight = Callable[[dict[str, Any], Settings], float]
-"""(team file, settings) -> seconds taken; raises service.errors.PreflightFailed."""
+PoolFactory = Callable[[Settings], MatchPool]
+Preflight = Callable[[TeamConfig, Settings], float]
+"""(the submitted team, checked; settings) -> seconds taken; raises
+service.errors.PreflightFailed."""
 
 
 def create_app(
@@ -141,18 +161,18 @@ def create_app(
         from service.tokens import TokenCache
         from service.views import submission_view
 
-        services = Services(settings=settings, engine=engine, sessions=session_factory(engine),
-                            preflight=preflight or checker,
-                            queue=QueueBoard(times=MatchTimes(
-                                default_s=settings.expected_match_s)),
-                            tokens=TokenCache(ttl_s=settings.token_cache_s), sealer=sealer)
-        services.status = StatusBoard(render=lambda session, row, team: submission_view(
-            session, row, settings, slots=services.slots(), queue=services.queue,
+        queue = QueueBoard(times=MatchTimes(default_s=settings.expected_match_s))
+        tokens = TokenCache(ttl_s=settings.token_cache_s)
+        status = StatusBoard(render=lambda session, row, team: submission_view(
+            session, row, settings, slots=services.slots(), queue=queue,
             team_name=team).model_dump_json().encode(), ttl_s=settings.status_board_s,
-            also=[services.tokens.revalidate])
-        services.status.start(services.sessions)
+            also=[tokens.revalidate])
+        services = Services(settings=settings, engine=engine, sessions=session_factory(engine),
+                            pool=(pool_factory or pool_from_settings)(settings),
+                            preflight=preflight or checker, queue=queue, tokens=tokens,
+                            status=status, sealer=sealer)
+        status.start(services.sessions)
         app.state.services = services
-        services.pool = (pool_factory or pool_from_settings)(settings)
         if start_worker:
             from service.aftermatch import AfterMatch
             from service.worker import QueueWorker

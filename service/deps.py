@@ -14,25 +14,28 @@ Routers of other packages require a team token with::
 from __future__ import annotations
 
 from collections.abc import Iterator
-from typing import TYPE_CHECKING, Annotated
+from typing import Annotated
 
 from fastapi import Depends, Request
 from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
 from sqlalchemy.orm import Session
 
 from service import tokens
+from service.app import Services
 from service.db import Scope
 from service.errors import AuthError
-
-if TYPE_CHECKING:
-    from service.app import Services
 
 bearer = HTTPBearer(auto_error=False, description="a team or operator token: hlvs_<id>_<secret>")
 
 
 def get_services(request: Request) -> Services:
+    """The app's :class:`service.app.Services` (built by its lifespan); a handler takes it as
+    ``services: AppServices``."""
     services: Services = request.app.state.services
     return services
+
+
+AppServices = Annotated[Services, Depends(get_services)]
 
 
 def get_db(request: Request) -> Iterator[Session]:
@@ -88,6 +91,7 @@ TeamPrincipal = Annotated[tokens.Principal, Depends(require_team)]
 OperatorPrincipal = Annotated[tokens.Principal, Depends(require_operator)]
 
 __all__ = [
+    "AppServices",
     "DbSession",
     "OperatorPrincipal",
     "TeamPrincipal",

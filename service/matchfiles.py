@@ -7,13 +7,12 @@ matches are short, lockstep scrimmages (see :class:`service.settings.Settings`).
 
 from __future__ import annotations
 
-import argparse
 import json
 from pathlib import Path
 from typing import Any
 
 from contracts.timing import TEST_MATCH
-from orchestrator.match.scrimmage import game_file, team_file
+from orchestrator.match.scrimmage import ScrimmageRequest, game_file, team_file
 from orchestrator.private_files import private_dir, write_private
 from service.settings import Settings
 
@@ -33,12 +32,12 @@ def write_match(folder: Path, *, match_id: str, team: dict[str, Any],
     if opponent is None:
         assert stub_image is not None
         opponent = team_file("Stub", stub_image, settings.test_players, goalie_first=True)
-    args = argparse.Namespace(players=settings.test_players, seed=seed,
-                              half_duration=settings.test_half_duration_s,
-                              ready_duration=settings.test_ready_duration_s,
-                              wait_before_ready=TEST_MATCH.wait_before_first_ready_s,
-                              grace=settings.test_grace_s)
-    game = game_file(args, match_id)
+    request = ScrimmageRequest(players=settings.test_players, seed=seed,
+                               half_duration_s=settings.test_half_duration_s,
+                               ready_duration_s=settings.test_ready_duration_s,
+                               wait_before_ready_s=TEST_MATCH.wait_before_first_ready_s,
+                               grace_s=settings.test_grace_s)
+    game = game_file(request, match_id)
     game["registry_images"] = True  # a team's images only from its registry, with its login
     game["red"]["ports"] = _ports(10000, team)
     game["blue"]["ports"] = _ports(10020, opponent)

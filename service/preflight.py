@@ -15,10 +15,9 @@ robots against one stub robot, stopped as soon as every robot has connected. Wit
 
 from __future__ import annotations
 
-import argparse
-import json
 import logging
 import os
+import queue
 import secrets
 import tempfile
 import threading
@@ -27,9 +26,8 @@ from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
-from orchestrator.config import Limits, load_team
+from orchestrator.config import Limits, PlayerConfig, TeamConfig
 from orchestrator.errors import ConfigError, ImageTooLarge, OrchestratorError
-from orchestrator.private_files import write_private
 from service.errors import InvalidInput, PreflightFailed
 from service.settings import Settings
 
@@ -49,7 +47,7 @@ class PreflightChecker:
         self._lock = threading.Lock()
         self._engine: Any = None
 
-    def __call__(self, team_doc: dict[str, Any], settings: Settings) -> float:
+    def __call__(self, team: TeamConfig, settings: Settings) -> float:
         with self._lock:
             self._teardowns = [t for t in self._teardowns if t.is_alive()]
             if self._engine is None:  # one engine client for every check
@@ -59,108 +57,95 @@ class PreflightChecker:
                     self._engine = connect()
                 except OrchestratorError as exc:
                     raise PreflightFailed(stage="pull", image="(all)", cause=str(exc)) from exc
-        return run(team_doc, settings=settings, teardowns=self._teardowns, engine=self._engine)
+        return run(team, settings=settings, teardowns=self._teardowns, engine=self._engine)
 
     def close(self) -> None:
         for thread in list(self._teardowns):
             thread.join(timeout=120)
 
 
-def run(team_doc: dict[str, Any], *, settings: Settings,
+def run(team: TeamConfig, *, settings: Settings,
         teardowns: list[threading.Thread] | None = None, engine: Any = None) -> float:
-    """Check the team's images; returns the seconds it took, raises :class:`PreflightFailed`.
+    """Check the images of ``team`` (as :func:`service.teamfiles.validated_team` gave it);
+    returns the seconds it took, raises :class:`PreflightFailed`.
 
     With ``teardowns``, stopping the check's containers happens in a background thread added
     to that list (the answer does not wait for it); without, before returning."""
-    from service import teamfiles
+    from orchestrator.engine import connect
+    from orchestrator.pull import resolve_team_images
 
     started = time.monotonic()
-    # the upload's check (service rules included): a file stored under older rules is refused
-    # here with the same problems, before anything of it is used
-    teamfiles.raise_if_invalid("team_config", team_doc)
-    with tempfile.TemporaryDirectory(prefix="hlvs-preflight-") as folder:
-        path = write_private(Path(folder) / "team_config.json", json.dumps(team_doc))
-        try:
-            team = load_team(path, field_class=teamfiles.FIELD_CLASS,
-                             images_required=True).team
-        except ConfigError as exc:  # the check above passed: a rule of load_team alone
-            raise _invalid(exc, path) from None
-        from orchestrator.engine import connect
-        from orchestrator.pull import resolve_team_images
-
-        try:
-            engine = engine or connect()
-            resolved = resolve_team_images(engine, team, limits=official_limits(),
-                                           registry_only=True)
-        except OrchestratorError as exc:
-            raise PreflightFailed(stage="pull", image="(all)", cause=str(exc)) from exc
-        for number in sorted(resolved):
-            image = resolved[number]
-            if image.error is not None:
-                stage = "size" if isinstance(image.error, ImageTooLarge) else "pull"
-                raise PreflightFailed(stage=stage, image=image.reference or "(none)",
-                                      cause=image.error.reason)
-        if settings.preflight == "full":
-            _start_and_connect(team_doc, Path(folder), settings=settings, teardowns=teardowns)
+    try:
+        engine = engine or connect()
+        resolved = resolve_team_images(engine, team, limits=official_limits(),
+                                       registry_only=True)
+    except OrchestratorError as exc:
+        raise PreflightFailed(stage="pull", image="(all)", cause=str(exc)) from exc
+    for number in sorted(resolved):
+        image = resolved[number]
+        if image.error is not None:
+            stage = "size" if isinstance(image.error, ImageTooLarge) else "pull"
+            raise PreflightFailed(stage=stage, image=image.reference or "(none)",
+                                  cause=image.error.reason)
+    if settings.preflight == "full":
+        with tempfile.TemporaryDirectory(prefix="hlvs-preflight-") as folder:
+            _start_and_connect(team, Path(folder), settings=settings, teardowns=teardowns)
     elapsed = time.monotonic() - started
     log.info("pre-flight of %s passed in %.1f s", team.name, elapsed)
     return elapsed
 
 
-def _invalid(exc: ConfigError, path: Path) -> InvalidInput:
+def _invalid(exc: ConfigError) -> InvalidInput:
     """A check that the upload's check did not make, as the upload would answer it."""
     problems = [{**{k: str(v) for k, v in asdict(p).items()}, "file": "team_config.json",
-                 "text": str(p).replace(str(path), "team_config.json")} for p in exc.problems]
+                 "text": str(p)} for p in exc.problems]
     errors = [p for p in problems if p["severity"] == "error"] or problems
     return InvalidInput(f"team_config.json has {len(errors)} problem(s): " + errors[0]["text"],
                         problems=problems)
 
 
-def _distinct_players(team_doc: dict[str, Any]) -> dict[str, Any]:
-    """The team file with one player per distinct (image, tag, command)."""
-    players = team_doc.get("players") or {}
-    kept: dict[str, Any] = {}
-    seen: set[tuple[Any, ...]] = set()
-    for key in sorted(players, key=int):
-        entry = players[key]
-        ident = (entry.get("image", team_doc.get("image")), entry.get("dockerTag"),
-                 entry.get("dockerCmd"))
+def _distinct_players(team: TeamConfig) -> TeamConfig:
+    """The team with one player per distinct (image, tag, command), numbered from 1."""
+    kept: list[PlayerConfig] = []
+    seen: set[tuple[str | None, str | None, str | None]] = set()
+    for player in team.players:
+        ident = (player.image_repository, player.docker_tag, player.docker_cmd)
         if ident not in seen:
             seen.add(ident)
-            kept[str(len(kept) + 1)] = entry
-    return {**team_doc, "players": kept}
+            kept.append(replace(player, number=len(kept) + 1))
+    return replace(team, players=tuple(kept))
 
 
-def _start_and_connect(team_doc: dict[str, Any], folder: Path, *, settings: Settings,
+def _start_and_connect(team: TeamConfig, folder: Path, *, settings: Settings,
                        teardowns: list[threading.Thread] | None) -> None:
-    from orchestrator.config import load_game
+    from orchestrator.config import parse_game, parse_team
     from orchestrator.engine import connect
     from orchestrator.engine.containers import DockerRuntime
     from orchestrator.match import HostControl, MatchRunner, RunOptions, cleanup, plan_from_game
-    from orchestrator.match.scrimmage import game_file, team_file
+    from orchestrator.match.scrimmage import ScrimmageRequest, game_file, team_file
     from orchestrator.project_images import project_image
     from orchestrator.telemetry import ZenohTelemetry
+    from service.teamfiles import FIELD_CLASS
 
-    team = _distinct_players(team_doc)
+    checked = _distinct_players(team)
     match_id = "preflight-" + secrets.token_hex(4)
-    args = argparse.Namespace(players=1, seed=1, half_duration=60.0, wait_before_ready=120.0,
-                              grace=1.0)
-    game = game_file(args, match_id)
-    game["red"]["ports"] = [10000 + n for n in range(1, len(team["players"]) + 1)]
+    request = ScrimmageRequest(players=1, seed=1, half_duration_s=60.0, wait_before_ready_s=120.0,
+                               grace_s=1.0)
+    game = game_file(request, match_id)
+    game["red"]["ports"] = [10000 + n for n in range(1, len(checked.players) + 1)]
     limits = official_limits()
     game["limits"] = {"cpus": limits.cpus, "memory_gb": limits.memory_gb, "pids": limits.pids,
                       "log_folder_gb": 1}
     config = folder / "config"
-    config.mkdir()
-    files = {"game.json": game, "team_red.json": team,
-             "team_blue.json": team_file("Stub", project_image("stub"), 1, goalie_first=True)}
-    for name, content in files.items():
-        write_private(config / name, json.dumps(content))
     try:
-        plan = plan_from_game(load_game(config / "game.json", images_required=True),
-                              grace_period_s=1.0)
+        stub = parse_team(team_file("Stub", project_image("stub"), 1, goalie_first=True),
+                          source=config / "team_blue.json", field_class=FIELD_CLASS,
+                          images_required=True).team
+        loaded = parse_game(game, source=config / "game.json", teams={"red": checked, "blue": stub},
+                            images_required=True)
+        plan = plan_from_game(loaded, grace_period_s=1.0)
     except ConfigError as exc:
-        raise _invalid(exc, config / "team_red.json") from None
+        raise _invalid(exc) from None
     runtime = DockerRuntime(connect())
     host = HostControl.for_current_user()
     runner = MatchRunner(
@@ -169,36 +154,13 @@ def _start_and_connect(team_doc: dict[str, Any], folder: Path, *, settings: Sett
                            poll_s=0.1),
         telemetry=lambda endpoint, mid: ZenohTelemetry(endpoint=endpoint, match_id=mid),
     )
+    events = runner.events.subscribe()
     thread = threading.Thread(target=runner.run, name=match_id, daemon=True)
     thread.start()
-    deadline = time.monotonic() + settings.preflight_timeout_s
     failure: PreflightFailed | None = None
     try:
-        while True:
-            if runner.bringup_s is not None:
-                break
-            red = [r for r in runner.records.values() if r.color == "red"]
-            broken = next((r for r in red if r.startup_error or r.exited_during_game), None)
-            if broken is not None:
-                stage = "start"
-                cause = broken.startup_error or (
-                    f"the robot's container exited with code {broken.exit_code}"
-                    + (" (out of memory)" if broken.oom_killed else "")
-                    + " before connecting to the simulator")
-                failure = PreflightFailed(stage=stage, image=broken.image or "?", cause=cause)
-                break
-            if runner.failure is not None or not thread.is_alive():
-                cause = runner.failure.cause if runner.failure else "the check ended early"
-                failure = PreflightFailed(stage="start", image="(simulator)", cause=cause)
-                break
-            if time.monotonic() > deadline:
-                waiting = [r.image or "?" for r in red]
-                failure = PreflightFailed(
-                    stage="connect", image=", ".join(sorted(set(waiting))),
-                    cause=f"no connection to the simulator's robot API within "
-                          f"{settings.preflight_timeout_s:.0f} s")
-                break
-            time.sleep(0.1)
+        failure = _connected_or_failure(events, timeout_s=settings.preflight_timeout_s,
+                                        images=[r.image or "?" for r in plan.red.robots])
     finally:
         runner.stop_event.set()
 
@@ -214,6 +176,42 @@ def _start_and_connect(team_doc: dict[str, Any], folder: Path, *, settings: Sett
             teardowns.append(background)
     if failure is not None:
         raise failure
+
+
+def _connected_or_failure(events: queue.SimpleQueue[Any], *, timeout_s: float,
+                          images: list[str]) -> PreflightFailed | None:
+    """Follow the check's match until every robot has connected (None) or the check has
+    failed: a robot of the team that did not start or exited, the match itself, or the
+    deadline."""
+    from orchestrator.match import (
+        AllConnected,
+        MatchEnded,
+        MatchFailed,
+        RobotExited,
+        RobotNotStarted,
+    )
+
+    deadline = time.monotonic() + timeout_s
+    while True:
+        try:
+            event = events.get(timeout=max(0.0, deadline - time.monotonic()))
+        except queue.Empty:
+            return PreflightFailed(
+                stage="connect", image=", ".join(sorted(set(images))),
+                cause=f"no connection to the simulator's robot API within {timeout_s:.0f} s")
+        if isinstance(event, AllConnected):
+            return None
+        if isinstance(event, RobotNotStarted) and event.color == "red":
+            return PreflightFailed(stage="start", image=event.image or "?", cause=event.cause)
+        if isinstance(event, RobotExited) and event.color == "red":
+            return PreflightFailed(
+                stage="start", image=event.image or "?",
+                cause=f"the robot's container exited with code {event.exit_code}"
+                      + (" (out of memory)" if event.oom_killed else "")
+                      + " before connecting to the simulator")
+        if isinstance(event, MatchFailed | MatchEnded):
+            cause = event.failure.cause if event.failure else "the check ended early"
+            return PreflightFailed(stage="start", image="(simulator)", cause=cause)
 
 
 __all__ = ["PreflightChecker", "official_limits", "run"]

@@ -18,7 +18,6 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
-import tempfile
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -26,10 +25,9 @@ from typing import Any
 from sqlalchemy import func, select
 from sqlalchemy.orm import Session
 
-from orchestrator.config import FieldClass, check_team
+from orchestrator.config import FieldClass, TeamConfig, check_team_document
 from orchestrator.config.robot_models import BUILT_IN_MODELS
 from orchestrator.errors import ConfigError, Problem
-from orchestrator.private_files import write_private
 from service.db import TeamFile
 from service.errors import InvalidInput, NotFound
 from service.sealing import PREFIX, Sealer
@@ -39,7 +37,7 @@ log = logging.getLogger(__name__)
 KINDS = {"team_config": "team_config.json", "credentials": "credentials.json"}
 
 
-FIELD_CLASS: FieldClass = "KID"
+FIELD_CLASS = FieldClass.KID
 """The field class of the service's test matches (``orchestrator.match.scrimmage.game_file``):
 the pose rules of the upload are those the pre-flight and the match apply."""
 PLACEHOLDER_KEY = ("-----BEGIN OPENSSH PRIVATE KEY-----\n(refused)\n"
@@ -119,33 +117,54 @@ def check(kind: str, document: Any) -> list[dict[str, str]]:
     """Every problem of ``document`` as ``hlvs check`` finds it plus the service's rules
     (errors and warnings), with the file named as the team knows it (``team_config.json`` /
     ``credentials.json``). Never raises for a bad document."""
+    return _checked(kind, document)[1]
+
+
+def _checked(kind: str, document: Any) -> tuple[TeamConfig | None, list[dict[str, str]]]:
+    """The team (for ``team_config`` without an error) and the problems of :func:`check`: the
+    document itself is validated, no file is written or read."""
     name = KINDS[kind]
     document, problems = service_problems(kind, document)
-    with tempfile.TemporaryDirectory(prefix="hlvs-check-") as folder:
-        path = Path(folder) / name
-        write_private(path, json.dumps(document))
-        if kind == "team_config":
-            problems += check_team(path, field_class=FIELD_CLASS, images_required=True)
-        else:
-            from orchestrator.config.credentials import load_credentials
+    team: TeamConfig | None = None
+    if kind == "team_config":
+        team, found = check_team_document(document, source=name, field_class=FIELD_CLASS,
+                                          images_required=True)
+        problems += found
+        if any(p.severity == "error" for p in problems):
+            team = None
+    else:
+        from orchestrator.config.credentials import parse_credentials
 
-            try:
-                problems += [w for w in load_credentials(path).warnings
-                             if "known_hosts only" not in w.message]
-            except ConfigError as exc:
-                problems += exc.problems
+        try:
+            problems += [w for w in parse_credentials(document, source=Path(name)).warnings
+                         if "known_hosts only" not in w.message]
+        except ConfigError as exc:
+            problems += exc.problems
     out = []
     for problem in problems:
         entry = {k: str(v) for k, v in asdict(problem).items()}
         entry["file"] = name
-        entry["text"] = str(problem).replace(str(path), name)
+        entry["text"] = str(problem)
         out.append(entry)
-    return out
+    return team, out
 
 
 def raise_if_invalid(kind: str, document: Any) -> list[dict[str, str]]:
     """The problems of ``document`` (warnings); :class:`InvalidInput` when one is an error."""
-    problems = check(kind, document)
+    return _raise_if_errors(kind, _checked(kind, document)[1])
+
+
+def validated_team(document: Any) -> TeamConfig:
+    """The team of a ``team_config`` document, checked once by today's rules (the upload's
+    check, the service's rules included); :class:`InvalidInput` with the problems when
+    invalid. What a submission's pre-flight and match are built from."""
+    team, problems = _checked("team_config", document)
+    _raise_if_errors("team_config", problems)
+    assert team is not None
+    return team
+
+
+def _raise_if_errors(kind: str, problems: list[dict[str, str]]) -> list[dict[str, str]]:
     errors = [p for p in problems if p["severity"] == "error"]
     if errors:
         raise InvalidInput(f"{KINDS[kind]} has {len(errors)} problem(s): " + errors[0]["text"],
@@ -256,4 +275,4 @@ def newest_id(session: Session, *, team_id: int, kind: str) -> int | None:
 
 
 __all__ = ["KINDS", "check", "get", "get_by_id", "newest_id", "opened", "raise_if_invalid",
-           "refuse", "seal_stored", "service_problems", "store", "versions"]
+           "refuse", "seal_stored", "service_problems", "store", "validated_team", "versions"]

@@ -23,8 +23,8 @@ from orchestrator.exitcodes import ExitCode
 from orchestrator.paths import user_path
 
 if TYPE_CHECKING:
+    from contracts.field import FieldClass
     from orchestrator.config.detect import Kind
-    from orchestrator.config.model import FieldClass
 
 log = logging.getLogger(__name__)
 
@@ -117,11 +117,13 @@ class FileReport:
 
 
 def run(args: argparse.Namespace) -> int:
+    from contracts.field import FieldClass
+
     reports = [
         check_report(
             name,
             kind=args.kind,
-            field_class=args.field_class,
+            field_class=FieldClass(args.field_class.lower()) if args.field_class else None,
             images_required=args.require_images,
         )
         for name in args.files

@@ -241,7 +241,8 @@ def run_scrimmage_command(args: argparse.Namespace) -> int:
             log.warning("scrimmage: %s is played as this host has it (for the operator's own "
                         "use; league and service matches take team images only from a "
                         "registry)", image)
-    game_path = scrimmage.write_files(args, out / "config")
+    game_path = scrimmage.write_files(scrimmage.ScrimmageRequest.from_options(args),
+                                       out / "config")
     loaded = load_game(game_path, images_required=True)
     plan = _gpu_option(args, plan_from_game(loaded, grace_period_s=args.grace))
     if getattr(args, "pool", "local") == "slurm":

@@ -1,14 +1,23 @@
 """Configuration layer: the only code that reads game.json and team_config.json.
 
-``load_game(path)`` validates game.json and the team files it references (JSON Schema, then the
-cross-file rules) and returns frozen dataclasses; every problem found is raised at once in one
-:class:`orchestrator.errors.ConfigError`.
+``parse_game(document, source=...)`` validates a game.json document and its teams (JSON Schema,
+then the cross-file rules) and returns frozen dataclasses; ``parse_team`` one team document.
+Every problem found is raised at once in one :class:`orchestrator.errors.ConfigError`. Files are
+one way to get a document: ``load_game(path)`` and ``load_team(path)`` read one and parse it.
 """
 
 from __future__ import annotations
 
 from orchestrator.config.game import default_match_id, default_seed
-from orchestrator.config.loader import check_game, check_team, load_game, load_team
+from orchestrator.config.loader import (
+    check_game,
+    check_team,
+    check_team_document,
+    load_game,
+    load_team,
+    parse_game,
+    parse_team,
+)
 from orchestrator.config.model import (
     COLORS,
     DEFAULT_MODEL,
@@ -54,10 +63,13 @@ __all__ = [
     "Timing",
     "check_game",
     "check_team",
+    "check_team_document",
     "default_match_id",
     "default_seed",
     "load_game",
     "load_team",
+    "parse_game",
+    "parse_team",
     "resolve_sides",
     "to_match_spec",
 ]

@@ -14,7 +14,15 @@ from pathlib import Path
 from typing import Any
 
 from contracts.timing import SET_TO_PLAY_S, timing_problem
-from orchestrator.config.model import COLORS, Color, GameConfig, Limits, TeamRef, Timing
+from orchestrator.config.model import (
+    COLORS,
+    Color,
+    FieldClass,
+    GameConfig,
+    Limits,
+    TeamRef,
+    Timing,
+)
 from orchestrator.config.problems import Collector, pointer
 from orchestrator.config.schema import validate
 
@@ -102,7 +110,7 @@ def build_game(document: Any, where: Collector, *, source: Path) -> GameConfig |
         match_id=match_id,
         seed=seed if seed is not None else default_seed(match_id),
         game_type=document["type"],
-        field_class=document["class"],
+        field_class=FieldClass(str(document["class"]).lower()),
         host=document["host"],
         maximum_real_time_factor=rtf,
         red=red,

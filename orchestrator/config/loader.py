@@ -1,17 +1,21 @@
-"""Loading game.json with its team files, or one team file, into validated dataclasses.
+"""Validating game.json with its team files, or one team file, into frozen dataclasses.
 
-``load_*`` raise one :class:`ConfigError` listing every problem found (warnings included);
-``check_*`` return the problems instead, for ``hlvs check``.
+``parse_game`` and ``parse_team`` take a document (the parsed JSON) and the name of its source;
+files are one way to get a document: ``load_*`` read the file and parse it. Both raise one
+:class:`ConfigError` listing every problem found (warnings included); ``check_*`` return the
+problems instead, for ``hlvs check``.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 
 from orchestrator.config.game import build_game, locate_team_config
 from orchestrator.config.jsonfile import read_json
 from orchestrator.config.model import (
     COLORS,
+    Color,
     FieldClass,
     GameConfig,
     LoadedGame,
@@ -44,14 +48,69 @@ def load_game(path: str | Path, *, images_required: bool = False) -> LoadedGame:
     return loaded
 
 
+def parse_game(
+    document: object,
+    *,
+    source: str | Path,
+    teams: Mapping[Color, TeamConfig] | None = None,
+    images_required: bool = False,
+) -> LoadedGame:
+    """A game.json document with its two teams, validated.
+
+    Args:
+        document: the parsed JSON of game.json.
+        source: where the document comes from: names it in problems; relative paths in it
+            (team ``config``, ``credentials``) resolve against its folder.
+        teams: both teams, already parsed (:func:`parse_team` with the game's field class);
+            without, each is read from the file its ``config`` names.
+        images_required: as in :func:`load_game`.
+
+    Raises:
+        ConfigError: with every problem found.
+    """
+    loaded, problems = _game_document(document, Path(source), teams=teams,
+                                      images_required=images_required)
+    raise_if_errors(problems)
+    assert loaded is not None
+    return loaded
+
+
+def parse_team(
+    document: object,
+    *,
+    source: str | Path,
+    field_class: FieldClass | None = None,
+    images_required: bool = False,
+) -> LoadedTeam:
+    """A team_config.json document, validated (pose rules for ``field_class`` when given);
+    ``source`` names it in problems and relative model folders resolve next to it."""
+    team, problems = _team_document(document, Path(source), field_class=field_class,
+                                    images_required=images_required)
+    raise_if_errors(problems)
+    assert team is not None
+    return LoadedTeam(team=team, warnings=tuple(problems))
+
+
 def load_team(
     path: str | Path, *, field_class: FieldClass | None = None, images_required: bool = False
 ) -> LoadedTeam:
-    """One team_config.json, validated (pose rules for ``field_class`` when given)."""
+    """One team_config.json file, validated (pose rules for ``field_class`` when given)."""
     team, problems = _team(Path(path), field_class=field_class, images_required=images_required)
     raise_if_errors(problems)
     assert team is not None
     return LoadedTeam(team=team, warnings=tuple(problems))
+
+
+def check_team_document(
+    document: object,
+    *,
+    source: str | Path,
+    field_class: FieldClass | None = None,
+    images_required: bool = False,
+) -> tuple[TeamConfig | None, list[Problem]]:
+    """A team document's TeamConfig (None when it has an error) and every problem of it."""
+    return _team_document(document, Path(source), field_class=field_class,
+                          images_required=images_required)
 
 
 def check_game(path: str | Path, *, images_required: bool = False) -> list[Problem]:
@@ -66,19 +125,31 @@ def check_team(
 
 
 def _game(path: Path, *, images_required: bool) -> tuple[LoadedGame | None, list[Problem]]:
-    where = Collector(str(path))
     try:
         document = read_json(path)
     except ConfigError as exc:
         return None, exc.problems
+    return _game_document(document, path, teams=None, images_required=images_required)
+
+
+def _game_document(
+    document: object, path: Path, *, teams: Mapping[Color, TeamConfig] | None,
+    images_required: bool,
+) -> tuple[LoadedGame | None, list[Problem]]:
+    where = Collector(str(path))
     game = build_game(document, where, source=path)
     problems = list(where.problems)
-    teams: dict[str, TeamConfig | None] = {}
+    if teams is not None:
+        for color in COLORS:
+            if game is not None:
+                problems.extend(_cross_checks(game, color, teams[color]))
+        return _assembled(game, teams.get("red"), teams.get("blue"), problems)
+    found: dict[str, TeamConfig | None] = {}
     field_class = _field_class(document)
     for color in COLORS:
         located = _team_path(document, color, path.parent)
         if located is None:
-            teams[color] = None
+            found[color] = None
             continue
         config, tried = located
         if not config.is_file():
@@ -93,7 +164,7 @@ def _game(path: Path, *, images_required: bool) -> tuple[LoadedGame | None, list
                     "or to the current directory",
                 )
             )
-            teams[color] = None
+            found[color] = None
             continue
         if config != tried[0]:
             problems.append(
@@ -110,10 +181,16 @@ def _game(path: Path, *, images_required: bool) -> tuple[LoadedGame | None, list
             config, field_class=field_class, images_required=images_required
         )
         problems.extend(team_problems)
-        teams[color] = team
+        found[color] = team
         if team is not None and game is not None:
             problems.extend(_cross_checks(game, color, team))
-    red, blue = teams.get("red"), teams.get("blue")
+    return _assembled(game, found.get("red"), found.get("blue"), problems)
+
+
+def _assembled(
+    game: GameConfig | None, red: TeamConfig | None, blue: TeamConfig | None,
+    problems: list[Problem],
+) -> tuple[LoadedGame | None, list[Problem]]:
     if game is None or red is None or blue is None or _has_errors(problems):
         return None, problems
     warnings = tuple(p for p in problems if p.severity == "warning")
@@ -123,11 +200,18 @@ def _game(path: Path, *, images_required: bool) -> tuple[LoadedGame | None, list
 def _team(
     path: Path, *, field_class: FieldClass | None, images_required: bool
 ) -> tuple[TeamConfig | None, list[Problem]]:
-    where = Collector(str(path))
     try:
         document = read_json(path)
     except ConfigError as exc:
         return None, exc.problems
+    return _team_document(document, path, field_class=field_class,
+                          images_required=images_required)
+
+
+def _team_document(
+    document: object, path: Path, *, field_class: FieldClass | None, images_required: bool
+) -> tuple[TeamConfig | None, list[Problem]]:
+    where = Collector(str(path))
     team = build_team(
         document,
         where,
@@ -190,9 +274,9 @@ def _field_class(document: object) -> FieldClass | None:
     if isinstance(document, dict):
         value = document.get("class")
         if value == "KID":
-            return "KID"
+            return FieldClass.KID
         if value == "ADULT":
-            return "ADULT"
+            return FieldClass.ADULT
     return None
 
 

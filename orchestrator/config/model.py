@@ -3,31 +3,33 @@
 Everything here is produced by :mod:`orchestrator.config.loader` after JSON Schema validation and
 the cross-file rules; other packages trust these values. Units are in the names (``_s``, ``_gb``,
 ``_mb_s``, ``_m``, ``_rad``). Poses are kept as the team wrote them: as if the team played on the
-left half (x < 0); whoever places robots mirrors them for the team on the right.
+left half (x < 0); whoever places robots mirrors them for the team on the right. The shared
+vocabulary (colours, field class, game type, stepping, starting poses) is ``contracts``'; the
+files keep their spelling (``"class": "KID"`` is :attr:`FieldClass.KID`).
 """
 
 from __future__ import annotations
 
-import math
 import shlex
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
 
+from contracts.field import FieldClass
+from contracts.geometry import StartingPose
+from contracts.match_spec import Color, SteppingMode
+from contracts.match_spec import GameTypeName as GameType
 from contracts.timing import MIN_PLAYING_S, OFFICIAL
 from orchestrator.errors import Problem
 
-GameType = Literal["NORMAL", "KNOCKOUT", "PENALTY"]
-FieldClass = Literal["KID", "ADULT"]
-Color = Literal["red", "blue"]
 SideChoice = Literal["red", "blue", "random"]
-SteppingMode = Literal["async", "lockstep", "pipelined"]
 SensorMode = Literal["league", "ideal"]
 
 COLORS: tuple[Color, Color] = ("red", "blue")
-MAX_PLAYERS: dict[str, int] = {"KID": 4, "ADULT": 3}
-DEFAULT_MODEL: dict[str, str] = {"KID": "kid-default", "ADULT": "adult-default"}
+MAX_PLAYERS: dict[FieldClass, int] = {FieldClass.KID: 4, FieldClass.ADULT: 3}
+DEFAULT_MODEL: dict[FieldClass, str] = {FieldClass.KID: "kid-default",
+                                        FieldClass.ADULT: "adult-default"}
 DISPLAY_NAME_CHARS = 12
 
 
@@ -85,7 +87,7 @@ class GameConfig:
     match_id: str
     seed: int
     game_type: GameType
-    field_class: FieldClass
+    field_class: FieldClass  # "class" of game.json ("KID" or "ADULT")
     host: str
     maximum_real_time_factor: float  # <= 0: as fast as possible
     red: TeamRef
@@ -119,39 +121,6 @@ class GameConfig:
     @property
     def max_players(self) -> int:
         return MAX_PLAYERS[self.field_class]
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class StartingPose:
-    """An HLVS pose: translation [x, y, z] in m and axis-angle rotation [ax, ay, az, angle]."""
-
-    translation: tuple[float, float, float]
-    rotation: tuple[float, float, float, float]
-
-    @property
-    def x_m(self) -> float:
-        return self.translation[0]
-
-    @property
-    def y_m(self) -> float:
-        return self.translation[1]
-
-    @property
-    def z_m(self) -> float:
-        return self.translation[2]
-
-    @property
-    def yaw_rad(self) -> float:
-        """Heading of the robot's x axis in the ground plane (angle * sign(az) for a z axis)."""
-        ax, ay, az, angle = self.rotation
-        norm = math.sqrt(ax * ax + ay * ay + az * az)
-        if norm == 0.0:
-            return 0.0
-        ux, uy, uz = ax / norm, ay / norm, az / norm
-        c, s = math.cos(angle), math.sin(angle)
-        r00 = c + ux * ux * (1 - c)
-        r10 = uy * ux * (1 - c) + uz * s
-        return math.atan2(r10, r00)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -242,3 +211,27 @@ class LoadedGame:
 
     def team(self, color: Color) -> TeamConfig:
         return self.red if color == "red" else self.blue
+
+
+__all__ = [
+    "COLORS",
+    "Color",
+    "DEFAULT_MODEL",
+    "DISPLAY_NAME_CHARS",
+    "EcrAuth",
+    "FieldClass",
+    "GameConfig",
+    "GameType",
+    "Limits",
+    "LoadedGame",
+    "LoadedTeam",
+    "MAX_PLAYERS",
+    "PlayerConfig",
+    "RegistryAuth",
+    "SideChoice",
+    "StartingPose",
+    "SteppingMode",
+    "TeamConfig",
+    "TeamRef",
+    "Timing",
+]

@@ -11,7 +11,6 @@ import random
 from collections.abc import Mapping, Sequence
 
 from contracts import files
-from contracts.field import FieldClass
 from contracts.geometry import Pose
 from contracts.match_spec import (
     MatchSpec,
@@ -60,7 +59,7 @@ def to_match_spec(
         match_id=game.match_id,
         seed=game.seed,
         game_type=game.game_type,
-        field_class=FieldClass(game.field_class.lower()).value,
+        field_class=game.field_class.value,
         side_left=side_left,
         kickoff=kickoff,
         red=_team(loaded, "red", robot_addresses.get("red", ())),
@@ -123,4 +122,4 @@ def _team(loaded: LoadedGame, color: Color, addresses: Sequence[str]) -> TeamSpe
 
 
 def _pose(pose: StartingPose) -> Pose:
-    return Pose(x_m=pose.x_m, y_m=pose.y_m, yaw_rad=pose.yaw_rad)
+    return pose.pose

@@ -51,9 +51,9 @@ class FieldBox:
     penalty_area_width_m: float
 
 
-FIELDS: dict[str, FieldBox] = {
-    "KID": FieldBox(4.5, 3.0, 1.0, 2.0, 5.0),
-    "ADULT": FieldBox(7.0, 4.5, 1.0, 3.0, 6.0),
+FIELDS: dict[FieldClass, FieldBox] = {
+    FieldClass.KID: FieldBox(4.5, 3.0, 1.0, 2.0, 5.0),
+    FieldClass.ADULT: FieldBox(7.0, 4.5, 1.0, 3.0, 6.0),
 }
 
 
@@ -154,7 +154,7 @@ def _player(number: int, document: dict[str, Any], field_class: FieldClass | Non
     raw = document["players"][str(number)]
     return PlayerConfig(
         number=number,
-        model=raw.get("model", DEFAULT_MODEL[field_class or "KID"]),
+        model=raw.get("model", DEFAULT_MODEL[field_class or FieldClass.KID]),
         proto=raw.get("proto"),
         image_repository=raw.get("image", document.get("image")),
         docker_tag=raw.get("dockerTag"),
@@ -190,7 +190,7 @@ def _check_numbers(
             )
             return []
     if len(numbers) > limit:
-        klass = f"{field_class} class" if field_class else "any class"
+        klass = f"{field_class.name} class" if field_class else "any class"
         where.error(
             pointer("players", str(numbers[limit])),
             f"{len(numbers)} players: too many for {klass}",
@@ -239,7 +239,7 @@ def _check_pose(
     if abs(x) > x_max or abs(y) > y_max:
         where.error(
             at + "/translation",
-            f"({x:g}, {y:g}) is off the turf of the {field_class} field",
+            f"({x:g}, {y:g}) is off the turf of the {field_class.name} field",
             expected=f"|x| <= {x_max:g} and |y| <= {y_max:g}",
         )
 

@@ -7,6 +7,16 @@ through :class:`Host`; ``hlvs.commands.match`` wires the real implementations.
 from __future__ import annotations
 
 from orchestrator.match.cleanup import CleanupReport, cleanup
+from orchestrator.match.events import (
+    AllConnected,
+    EventStream,
+    MatchEnded,
+    MatchEvent,
+    MatchFailed,
+    RobotExited,
+    RobotNotStarted,
+    StateChanged,
+)
 from orchestrator.match.host import Host, HostControl
 from orchestrator.match.plan import MatchPlan, RobotPlan, TeamPlan, plan_from_game
 from orchestrator.match.results import Failure, FailureClass, RobotRecord
@@ -21,8 +31,10 @@ from orchestrator.match.runtime import ContainerRuntime
 from orchestrator.match.state import IllegalMatchTransition, Lifecycle, MatchState
 
 __all__ = [
+    "AllConnected",
     "CleanupReport",
     "ContainerRuntime",
+    "EventStream",
     "Failure",
     "FailureClass",
     "Host",
@@ -30,13 +42,19 @@ __all__ = [
     "IllegalMatchTransition",
     "ImageResolver",
     "Lifecycle",
+    "MatchEnded",
+    "MatchEvent",
+    "MatchFailed",
     "MatchOutcome",
     "MatchPlan",
     "MatchRunner",
     "MatchState",
+    "RobotExited",
+    "RobotNotStarted",
     "RobotPlan",
     "RobotRecord",
     "RunOptions",
+    "StateChanged",
     "TeamPlan",
     "cleanup",
     "local_images",

@@ -5,7 +5,8 @@
 :class:`~orchestrator.match.collection.CollectionPhase`) work on: a phase gets the context, records
 what it created in :attr:`MatchContext.started` (so that teardown removes exactly that) and
 reports failures with :meth:`MatchContext.fail`. This module imports none of them, so there is no
-import circle between the runner and its phases.
+import circle between the runner and its phases. Observers in other threads subscribe to
+:attr:`MatchContext.events` (:mod:`orchestrator.match.events`) rather than read its fields.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from contracts.match_results import Color, Forfeit
 from contracts.telemetry import StateMessage
 from orchestrator.bandwidth import AppliedShaping
 from orchestrator.match.admission import CpuSets
+from orchestrator.match.events import EventStream, MatchFailed, StateChanged
 from orchestrator.match.gpu import SimulatorGpu
 from orchestrator.match.host import Host
 from orchestrator.match.layout import SIMULATOR_COMMAND, Subnet
@@ -118,11 +120,13 @@ class MatchContext:
         self.telemetry: TelemetrySource | None = None
         # the teams' logs cut or lost in collection: {"robot", "what", "reason"} (report.json)
         self.logs_cut: list[dict[str, str]] = []
+        self.events = EventStream()  # the match's progress, for observers in other threads
 
 
     def advance(self, target: MatchState) -> None:
         """Move the match to ``target`` (the lifecycle checks the transition)."""
         self.lifecycle.advance(target)
+        self.events.publish(StateChanged(state=self.lifecycle.state))
         self.progress(None)
 
     def progress(self, state: StateMessage | None) -> None:
@@ -134,6 +138,7 @@ class MatchContext:
         """Record the match's failure (``team``: the team that caused it); the first counts."""
         if self.failure is None:
             self.failure = Failure(failure_class=failure_class, cause=cause, team=team)
+            self.events.publish(MatchFailed(failure=self.failure))
             if failure_class is FailureClass.INTERRUPTED:  # asked for (a stop, a pre-flight)
                 log.info("match %s stopped: %s", self.plan.match_id, cause)
             else:

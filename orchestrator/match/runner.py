@@ -25,6 +25,7 @@ from contracts.match_results import Color, Forfeit, MatchResults
 from orchestrator.errors import OrchestratorError
 from orchestrator.match.collection import CollectionPhase, read_sim_result, simulator_stderr_tail
 from orchestrator.match.context import MatchContext, RunOptions, TelemetryFactory
+from orchestrator.match.events import AllConnected, MatchEnded, RobotExited
 from orchestrator.match.host import Host
 from orchestrator.match.plan import MatchPlan
 from orchestrator.match.results import Failure, FailureClass
@@ -94,6 +95,14 @@ class MatchRunner(MatchContext):
 
     # public -------------------------------------------------------------------------------
     def run(self) -> MatchOutcome:
+        """Play the match; :attr:`events` tells observers how it goes, ending with
+        :class:`~orchestrator.match.events.MatchEnded`."""
+        try:
+            return self._run()
+        finally:
+            self.events.publish(MatchEnded(failure=self.failure))
+
+    def _run(self) -> MatchOutcome:
         out = self.options.out_dir
         out.mkdir(parents=True, exist_ok=True)
         out.chmod(0o700)  # the teams' logs are theirs: owner-only (see collection)
@@ -183,6 +192,7 @@ class MatchRunner(MatchContext):
                 expected = {k for k in self.started.robot_ids}
                 if expected and expected <= set(latest.connected):
                     self.bringup_s = now - started_at
+                    self.events.publish(AllConnected(bringup_s=self.bringup_s))
                     log.info("match %s: all %d robots connected after %.2f s",
                              self.plan.match_id, len(expected), self.bringup_s)
             if self.telemetry is not None:
@@ -210,6 +220,9 @@ class MatchRunner(MatchContext):
                 record.exited_during_game = True
                 record.exit_code = state.exit_code
                 record.oom_killed = state.oom_killed
+                self.events.publish(RobotExited(
+                    key=key, color=record.color, image=record.image,
+                    exit_code=state.exit_code, oom_killed=state.oom_killed))
                 log.info(
                     "match %s: robot %s exited during the game (code %s%s); the game goes on",
                     self.plan.match_id, key, state.exit_code,

@@ -16,6 +16,7 @@ from __future__ import annotations
 import json
 import logging
 import uuid
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -33,10 +34,52 @@ from orchestrator.errors import ConfigError, Problem
 log = logging.getLogger(__name__)
 
 
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ScrimmageRequest:
+    """What the generated files depend on. ``ready_duration_s`` None: the scrimmage's READY
+    (:data:`contracts.timing.SCRIMMAGE`), fitted to the half; ``minimum_play_s`` 0: a match not
+    meant to play; images None play the project's stub image; models None the class's built-in
+    model."""
+
+    players: int
+    seed: int
+    half_duration_s: float
+    wait_before_ready_s: float
+    grace_s: float
+    ready_duration_s: float | None = None
+    stepping: str = "lockstep"
+    gpu: str = "auto"
+    red_image: str | None = None
+    blue_image: str | None = None
+    match_id: str | None = None
+    robot_command: str | None = None
+    red_model: str | None = None
+    blue_model: str | None = None
+    minimum_play_s: float = MIN_PLAYING_S
+
+    @classmethod
+    def from_options(cls, options: ScrimmageOptions) -> ScrimmageRequest:
+        """The request of ``hlvs scrimmage``'s parsed options (or any object with their
+        attributes; ``ready_duration``, ``stepping``, ``gpu`` and the models when present)."""
+        return cls(
+            players=options.players, seed=options.seed,
+            half_duration_s=options.half_duration,
+            wait_before_ready_s=options.wait_before_ready, grace_s=options.grace,
+            ready_duration_s=getattr(options, "ready_duration", None),
+            stepping=getattr(options, "stepping", None) or "lockstep",
+            gpu=getattr(options, "gpu", None) or "auto",
+            red_image=options.red_image, blue_image=options.blue_image,
+            match_id=options.match_id, robot_command=options.robot_command,
+            red_model=getattr(options, "red_model", None),
+            blue_model=getattr(options, "blue_model", None),
+            minimum_play_s=MIN_PLAYING_S if getattr(options, "minimum_play", None) is None
+            else options.minimum_play,  # type: ignore[attr-defined]
+        )
+
+
 class ScrimmageOptions(Protocol):
-    """What the generated files depend on: ``hlvs scrimmage``'s parsed options
-    (:mod:`hlvs.commands.scrimmage_args`) or any object with these attributes;
-    ``ready_duration``, ``red_model`` and ``blue_model`` are read when present."""
+    """``hlvs scrimmage``'s parsed options (:mod:`hlvs.commands.scrimmage_args`), as
+    :meth:`ScrimmageRequest.from_options` reads them."""
 
     players: int
     seed: int
@@ -124,12 +167,11 @@ def quick_ready(half_duration_s: float, ready_duration_s: float | None,
     return fitted
 
 
-def game_file(args: ScrimmageOptions, match_id: str) -> dict[str, Any]:
+def game_file(request: ScrimmageRequest, match_id: str) -> dict[str, Any]:
     """A quick test's game.json; READY fitted to the half by :func:`quick_ready`."""
-    players = args.players
-    minimum = getattr(args, "minimum_play", None)
-    minimum = MIN_PLAYING_S if minimum is None else minimum
-    ready = quick_ready(args.half_duration, getattr(args, "ready_duration", None), minimum)
+    players = request.players
+    minimum = request.minimum_play_s
+    ready = quick_ready(request.half_duration_s, request.ready_duration_s, minimum)
     return {
         "type": "NORMAL",
         "class": "KID",
@@ -138,9 +180,9 @@ def game_file(args: ScrimmageOptions, match_id: str) -> dict[str, Any]:
         "side_left": "red",
         "kickoff": "red",
         "match_id": match_id,
-        "seed": args.seed,
-        "stepping": getattr(args, "stepping", "lockstep"),
-        "gpu": getattr(args, "gpu", None) or "auto",
+        "seed": request.seed,
+        "stepping": request.stepping,
+        "gpu": request.gpu,
         "lockstep_deadline_ms": 200,
         "lockstep_time_bank_ms": 10000,
         "red": {"id": 1, "config": "team_red.json", "hosts": ["127.0.0.1"],
@@ -148,12 +190,12 @@ def game_file(args: ScrimmageOptions, match_id: str) -> dict[str, Any]:
         "blue": {"id": 2, "config": "team_blue.json", "hosts": ["127.0.0.1"],
                  "ports": [10020 + n for n in range(1, players + 1)]},
         "timing": {
-            "half_duration_s": args.half_duration,
+            "half_duration_s": request.half_duration_s,
             "ready_duration_s": ready,
             "minimum_play_s": minimum,
-            "wait_before_first_ready_s": args.wait_before_ready,
+            "wait_before_first_ready_s": request.wait_before_ready_s,
             "half_time_break_s": SCRIMMAGE.half_time_break_s,
-            "grace_period_s": args.grace,
+            "grace_period_s": request.grace_s,
         },
         "limits": {"cpus": 1, "memory_gb": 1, "pids": 256, "log_folder_gb": 1},
     }
@@ -180,40 +222,38 @@ def stub_model_problem(model: str | None) -> str | None:
             "robot image that drives this model (--red-image / --blue-image)")
 
 
-def write_files(args: ScrimmageOptions, folder: Path, *, stub_image: str | None = None
+def write_files(request: ScrimmageRequest, folder: Path, *, stub_image: str | None = None
                 ) -> Path:
     """Write game.json and the two team files into ``folder``; returns the game.json path.
 
     A stub robot given a team model with other motor names would stand still: said loudly (a
     WARNING, shown whatever the log level)."""
-    for color, image in (("red", args.red_image), ("blue", args.blue_image)):
-        problem = stub_model_problem(getattr(args, f"{color}_model", None)) \
-            if image is None else None
+    for color, image, model in (("red", request.red_image, request.red_model),
+                                ("blue", request.blue_image, request.blue_model)):
+        problem = stub_model_problem(model) if image is None else None
         if problem is not None:
             log.warning("%s robots: %s", color, problem)
-    if args.red_image is None or args.blue_image is None:
+    if request.red_image is None or request.blue_image is None:
         if stub_image is None:
             from orchestrator.project_images import project_image
 
             stub_image = project_image("stub")
-    red_image = args.red_image or stub_image
-    blue_image = args.blue_image or stub_image
+    red_image = request.red_image or stub_image
+    blue_image = request.blue_image or stub_image
     assert red_image is not None and blue_image is not None
-    match_id = args.match_id or f"scrimmage-{uuid.uuid4().hex[:6]}"
+    match_id = request.match_id or f"scrimmage-{uuid.uuid4().hex[:6]}"
     folder.mkdir(parents=True, exist_ok=True)
     files = {
-        "game.json": game_file(args, match_id),
-        "team_red.json": team_file("Stub Red", red_image, args.players,
-                                   command=args.robot_command,
-                                   model=getattr(args, "red_model", None)),
-        "team_blue.json": team_file("Stub Blue", blue_image, args.players,
-                                    command=args.robot_command,
-                                    model=getattr(args, "blue_model", None)),
+        "game.json": game_file(request, match_id),
+        "team_red.json": team_file("Stub Red", red_image, request.players,
+                                   command=request.robot_command, model=request.red_model),
+        "team_blue.json": team_file("Stub Blue", blue_image, request.players,
+                                    command=request.robot_command, model=request.blue_model),
     }
     for name, content in files.items():
         (folder / name).write_text(json.dumps(content, indent=2) + "\n", encoding="utf-8")
     return folder / "game.json"
 
 
-__all__ = ["ScrimmageOptions", "game_file", "quick_ready", "stub_model_problem", "team_file",
-           "write_files"]
+__all__ = ["ScrimmageOptions", "ScrimmageRequest", "game_file", "quick_ready",
+           "stub_model_problem", "team_file", "write_files"]

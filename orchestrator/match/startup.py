@@ -21,6 +21,7 @@ from orchestrator.errors import InfrastructureError, OrchestratorError
 from orchestrator.match import layout
 from orchestrator.match.admission import cpu_sets
 from orchestrator.match.context import MatchContext, Started
+from orchestrator.match.events import RobotNotStarted
 from orchestrator.match.logfs import LogFolder, safe_name
 from orchestrator.match.placement import (
     ROBOT_CGROUP_PARENT,
@@ -289,6 +290,8 @@ def _start_robot(match: MatchContext, robot: RobotPlan, folders: ThreadPoolExecu
                  team_net.robot(robot.number))
     except OrchestratorError as exc:
         record.startup_error = str(exc)
+        match.events.publish(RobotNotStarted(key=robot.key, color=record.color,
+                                             image=record.image, cause=str(exc)))
         log.warning("match %s: robot %s could not be started: %s", plan.match_id, robot.key, exc)
     finally:
         made.exception()  # made and recorded (for the teardown) even when the robot failed

@@ -4,12 +4,12 @@ that plays a submission's match names the submission and its teams. Operator tok
 
 from __future__ import annotations
 
-from fastapi import APIRouter, FastAPI, Request
+from fastapi import APIRouter, FastAPI
 from pydantic import BaseModel, Field
 from sqlalchemy import select
 
 from service.db import Submission, Team
-from service.deps import DbSession, OperatorPrincipal, get_services
+from service.deps import AppServices, DbSession, OperatorPrincipal
 from service.errors import NotFound
 
 router = APIRouter(prefix="/v1/operator", tags=["operator"])
@@ -48,8 +48,8 @@ class PoolView(BaseModel):
 @router.get("/nodes", responses={404: {"description": "the service has no match pool"},
                                  503: {"description": "the pool did not answer (e.g. the "
                                        "Slurm controller is down)"}})
-def get_nodes(request: Request, principal: OperatorPrincipal, session: DbSession) -> PoolView:
-    services = get_services(request)
+def get_nodes(services: AppServices, principal: OperatorPrincipal,
+              session: DbSession) -> PoolView:
     if services.pool is None:
         raise NotFound(what="match pool", ident="(the service runs without a worker)")
     nodes = services.pool.nodes()

@@ -12,7 +12,7 @@ from sqlalchemy import select
 
 from service import submissions
 from service.db import ACTIVE_STATES, Submission, SubmissionState, Team
-from service.deps import DbSession, OperatorPrincipal, get_services
+from service.deps import AppServices, DbSession, OperatorPrincipal, get_services
 from service.errors import Conflict, NotFound
 from service.views import SubmissionView, view_of
 
@@ -117,13 +117,13 @@ def list_teams(principal: OperatorPrincipal, session: DbSession) -> list[TeamSum
 
 
 @router.get("/schedule")
-def get_schedule(request: Request, principal: OperatorPrincipal) -> ScheduleView:
+def get_schedule(services: AppServices, principal: OperatorPrincipal) -> ScheduleView:
     """The tournament's matches (state, times, results) and the standings, read from the
     schedule's state file (``HLVS_SERVICE_SCHEDULE_STATE``)."""
     from orchestrator.config.schedule import load_schedule
     from tournament import Ledger, standings
 
-    state = get_services(request).settings.schedule_state
+    state = services.settings.schedule_state
     if not state or not Path(state).is_file():
         raise NotFound(what="tournament schedule state",
                        ident=state or "(HLVS_SERVICE_SCHEDULE_STATE is not set)")

@@ -22,7 +22,14 @@ from contracts.match_results import MatchReport, MatchResults
 from service import submissions, teamfiles
 from service.aftermatch import PARTIAL_VIDEO_FILE
 from service.db import ACTIVE_STATES, Submission
-from service.deps import DbSession, TeamPrincipal, bearer, get_services, require_team
+from service.deps import (
+    AppServices,
+    DbSession,
+    TeamPrincipal,
+    bearer,
+    get_services,
+    require_team,
+)
 from service.errors import NotFound, PreflightFailed
 from service.matchfiles import OWN_COLOR
 from service.views import (
@@ -50,10 +57,9 @@ class LogListing(BaseModel):
 @router.post("", status_code=201, responses={
     409: {"description": "the team already has an active test match (its id is in the body)"},
     422: {"description": "invalid body, unknown opponent or failed pre-flight check"}})
-def create_submission(body: SubmissionCreate, request: Request, principal: TeamPrincipal,
-                      session: DbSession) -> SubmissionView:
+def create_submission(body: SubmissionCreate, request: Request, services: AppServices,
+                      principal: TeamPrincipal, session: DbSession) -> SubmissionView:
     """Check the team's images (pre-flight) and queue a test match."""
-    services = get_services(request)
     team_id = principal.team_id
     assert team_id is not None
     submissions.check_opponent(session, team_id=team_id, opponent=body.opponent)
@@ -64,9 +70,9 @@ def create_submission(body: SubmissionCreate, request: Request, principal: TeamP
     credentials = teamfiles.newest_id(session, team_id=team_id, kind="credentials")
     session.commit()  # no connection is held during the pre-flight check
     assert services.preflight is not None
-    teamfiles.raise_if_invalid("team_config", document)  # the upload's check, today's rules
+    team = teamfiles.validated_team(document)  # the upload's check, today's rules
     try:
-        elapsed = services.preflight(document, services.settings)
+        elapsed = services.preflight(team, services.settings)
     except PreflightFailed as failed:
         teamfiles.refuse(session, teamfiles.get_by_id(session, file_id), stage=failed.stage,
                          cause=failed.cause)
@@ -94,14 +100,13 @@ def list_submissions(request: Request, principal: TeamPrincipal,
 
 @router.get("/{submission_id}", response_model=SubmissionView)
 async def get_submission(
-    submission_id: str, request: Request,
+    submission_id: str, services: AppServices,
     credentials: Annotated[HTTPAuthorizationCredentials | None, Depends(bearer)],
 ) -> Response:
     """The submission's state; while queued its position, expected start and the reason it
     waits. A poll is answered from the status board when it can be (see
     :mod:`service.statusboard` and :class:`service.middleware.StatusFastPath`); here from the
     database."""
-    services = get_services(request)
     presented = credentials.credentials if credentials is not None else None
     body = await run_in_threadpool(_status_body, services, presented, submission_id)
     return Response(body, media_type="application/json")
@@ -125,8 +130,8 @@ def _status_body(services: Services, presented: str | None, submission_id: str) 
 
 @router.post("/{submission_id}/cancel", responses={
     409: {"description": "the submission has already ended"}})
-def cancel_submission(submission_id: str, request: Request, principal: TeamPrincipal,
-                      session: DbSession) -> SubmissionView:
+def cancel_submission(submission_id: str, request: Request, services: AppServices,
+                      principal: TeamPrincipal, session: DbSession) -> SubmissionView:
     """Queued: cancelled at once and not charged. Running: stopped gracefully (the state
     becomes ``cancelled`` once the match has stopped and its logs are collected)."""
     assert principal.team_id is not None
@@ -134,7 +139,6 @@ def cancel_submission(submission_id: str, request: Request, principal: TeamPrinc
                               for_update=True)
     submissions.cancel(session, row)
     session.commit()
-    services = get_services(request)
     services.changed(row.id)
     if services.worker is not None:
         services.worker.wake()

@@ -14,7 +14,7 @@ from starlette.concurrency import run_in_threadpool
 from service import outbound, sealing, teamfiles
 from service.bodies import read_json_body
 from service.db import Team, utc
-from service.deps import DbSession, TeamPrincipal, get_services
+from service.deps import AppServices, DbSession, TeamPrincipal
 from service.errors import NotFound
 
 router = APIRouter(prefix="/v1/team", tags=["team"])
@@ -85,9 +85,8 @@ def get_team(principal: TeamPrincipal, session: DbSession) -> TeamView:
 
 
 @router.patch("")
-def update_team(body: TeamUpdate, request: Request, principal: TeamPrincipal,
+def update_team(body: TeamUpdate, services: AppServices, principal: TeamPrincipal,
                 session: DbSession) -> TeamView:
-    services = get_services(request)
     if body.webhook_url is not None:
         outbound.check_url(str(body.webhook_url), outbound.allowed_networks(services.settings),
                            field="/webhook_url")
@@ -110,11 +109,11 @@ def update_team(body: TeamUpdate, request: Request, principal: TeamPrincipal,
 @router.put("/files/{kind}", status_code=201, responses={
     413: {"description": "over the upload limit"}, 415: {"description": "not JSON"},
     422: {"description": "invalid: every problem as hlvs check finds it"}})
-async def upload_file(kind: str, request: Request, principal: TeamPrincipal) -> FileVersion:
+async def upload_file(kind: str, request: Request, services: AppServices,
+                      principal: TeamPrincipal) -> FileVersion:
     """Check and store a new version of ``team_config`` or ``credentials`` (a JSON body)."""
     if kind not in teamfiles.KINDS:
         raise NotFound(what="file kind", ident=kind)
-    services = get_services(request)
     document = await read_json_body(request, limit_bytes=services.settings.max_upload_bytes,
                                     name=teamfiles.KINDS[kind])
     def store() -> FileVersion:
@@ -127,11 +126,11 @@ async def upload_file(kind: str, request: Request, principal: TeamPrincipal) -> 
 
 
 @router.post("/files/{kind}/check")
-async def check_file(kind: str, request: Request, principal: TeamPrincipal) -> CheckResult:
+async def check_file(kind: str, request: Request, services: AppServices,
+                     principal: TeamPrincipal) -> CheckResult:
     """Check a file without storing it."""
     if kind not in teamfiles.KINDS:
         raise NotFound(what="file kind", ident=kind)
-    services = get_services(request)
     document = await read_json_body(request, limit_bytes=services.settings.max_upload_bytes,
                                     name=teamfiles.KINDS[kind])
     problems = teamfiles.check(kind, document)

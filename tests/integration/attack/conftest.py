@@ -118,7 +118,7 @@ def prepare(tmp_path_factory: pytest.TempPathFactory, attack_image: str,
             match_id=match_id, seed=42,
         )
         config = tmp_path / f"{match_id}-config"
-        game_path = scrimmage.write_files(args, config)
+        game_path = scrimmage.write_files(scrimmage.ScrimmageRequest.from_options(args), config)
         team_path = config / "team_red.json"
         team = json.loads(team_path.read_text())
         for entry in team["players"].values():

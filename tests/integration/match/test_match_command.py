@@ -14,7 +14,7 @@ from hlvs.cli import main as hlvs
 from hlvs.commands.scrimmage_args import add_arguments
 from orchestrator.errors import OrchestratorError
 from orchestrator.match.logfs import state_dir
-from orchestrator.match.scrimmage import write_files
+from orchestrator.match.scrimmage import ScrimmageRequest, write_files
 
 pytestmark = [pytest.mark.docker, pytest.mark.root]
 
@@ -36,7 +36,7 @@ def test_match_command_plays_a_game_file(tmp_path: Path, test_image: str, runtim
         "--match-id", "cmd-test", "--red-image", test_image, "--blue-image", test_image,
         "--robot-command", "python3 /opt/t/robot.py env",
     ])
-    write_files(args, tmp_path / "config")
+    write_files(ScrimmageRequest.from_options(args), tmp_path / "config")
     out = tmp_path / "out"
     monkeypatch.chdir(tmp_path)
     try:
@@ -90,7 +90,7 @@ def test_sigterm_to_hlvs_match_stops_everything_and_exits_130(
         "--red-image", test_image, "--blue-image", test_image,
         "--robot-command", "python3 /opt/t/robot.py sigterm",
     ])
-    game = write_files(args, tmp_path / "config")
+    game = write_files(ScrimmageRequest.from_options(args), tmp_path / "config")
     out = tmp_path / "out"
     repo = Path(__file__).resolve().parents[3]
     process = subprocess.Popen(

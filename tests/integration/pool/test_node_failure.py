@@ -34,7 +34,7 @@ SLURM_DIR = Path("/var/lib/hlvs/slurm")
 
 
 def _job(tmp: Path, match_id: str, *, requeue: bool) -> MatchJob:
-    from orchestrator.match.scrimmage import write_files
+    from orchestrator.match.scrimmage import ScrimmageRequest, write_files
     from orchestrator.project_images import project_image
 
     args = argparse.Namespace(
@@ -42,7 +42,8 @@ def _job(tmp: Path, match_id: str, *, requeue: bool) -> MatchJob:
         minimum_play=0.0,
         wait_before_ready=1.0, grace=2.0, robot_command=None, match_id=match_id, seed=7,
     )
-    game = write_files(args, tmp / "config", stub_image=project_image("stub"))
+    game = write_files(ScrimmageRequest.from_options(args), tmp / "config",
+                       stub_image=project_image("stub"))
     return MatchJob(match_id=match_id, game_path=game, work_dir=tmp / "work", requeue=requeue)
 
 

@@ -21,7 +21,7 @@ pytestmark = [pytest.mark.docker, pytest.mark.root, pytest.mark.slow]
 
 
 def _job(tmp: Path, name: str, account: str) -> MatchJob:
-    from orchestrator.match.scrimmage import write_files
+    from orchestrator.match.scrimmage import ScrimmageRequest, write_files
     from orchestrator.project_images import project_image
 
     args = argparse.Namespace(
@@ -30,7 +30,8 @@ def _job(tmp: Path, name: str, account: str) -> MatchJob:
         grace=2.0, robot_command=None, match_id=f"slurm-{name}-{os.getpid()}", seed=7,
     )
     work = tmp / name
-    game = write_files(args, work / "config", stub_image=project_image("stub"))
+    game = write_files(ScrimmageRequest.from_options(args), work / "config",
+                       stub_image=project_image("stub"))
     return MatchJob(match_id=args.match_id, game_path=game, work_dir=work, account=account)
 
 

@@ -10,7 +10,7 @@ from typing import Any
 
 import pytest
 
-from orchestrator.config import check_game, check_team, load_game
+from orchestrator.config import FieldClass, check_game, check_team, load_game
 from tests.unit.config.conftest import GameFiles
 
 KEEPER = "goalKeeperStartingPose"
@@ -38,7 +38,7 @@ def test_a_field_players_goalkeeper_pose_is_no_error_in_any_check(
     assert not _problems_at(problems, KEEPER)
     upload = check_team(path.parent / "team_red.json")  # the upload's check: no class yet
     assert not [p for p in upload if p.severity == "error"], upload
-    for klass in ("KID", "ADULT"):
+    for klass in (FieldClass.KID, FieldClass.ADULT):
         assert not _problems_at(check_team(path.parent / "team_red.json", field_class=klass),
                                 KEEPER)
     run = hlvs_check(path)

@@ -19,7 +19,7 @@ def _files(folder: Path) -> Path:
     scrimmage_args.add_arguments(parser)
     args = parser.parse_args(["--red-image", "team/red:1", "--blue-image", "team/blue:1",
                               "--match-id", "hostile-config"])
-    return scrimmage.write_files(args, folder)
+    return scrimmage.write_files(scrimmage.ScrimmageRequest.from_options(args), folder)
 
 
 def _edit(path: Path, **changes: object) -> None:

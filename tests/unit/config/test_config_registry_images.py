@@ -16,7 +16,7 @@ def _game(tmp_path: Path, *, red: str, game: dict[str, object]) -> Path:
         red_image=red, blue_image="hlvs-runner/stub:0123456789ab", players=2,
         half_duration=10.0, minimum_play=0.0, wait_before_ready=1.0, grace=1.0, robot_command=None,
         match_id="m-registry", seed=1)
-    path = scrimmage.write_files(args, tmp_path / "config")
+    path = scrimmage.write_files(scrimmage.ScrimmageRequest.from_options(args), tmp_path / "config")
     data = json.loads(path.read_text())
     data.update(game)
     path.write_text(json.dumps(data))

@@ -24,7 +24,7 @@ def test_round_trip_through_match_spec(example: str) -> None:
     spec = MatchSpec.from_dict(json.loads(data.to_json()))
     game = loaded.game
     assert (spec.match_id, spec.seed, spec.game_type) == (game.match_id, game.seed, game.game_type)
-    assert spec.field_class == game.field_class.lower()
+    assert spec.field_class == game.field_class.value
     assert spec.stepping == game.stepping
     assert spec.network.telemetry_listen == "tcp/172.30.0.2:7447"
     assert spec.timing.half_duration_s == game.timing.half_duration_s

@@ -26,10 +26,13 @@ EXPECTED = {
     "Timing",
     "check_game",
     "check_team",
+    "check_team_document",
     "default_match_id",
     "default_seed",
     "load_game",
     "load_team",
+    "parse_game",
+    "parse_team",
     "resolve_sides",
     "to_match_spec",
 }

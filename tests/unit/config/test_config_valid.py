@@ -11,6 +11,7 @@ import pytest
 
 from orchestrator.config import (
     DEFAULT_MODEL,
+    FieldClass,
     StartingPose,
     default_match_id,
     default_seed,
@@ -63,7 +64,7 @@ def test_scrimmage_example_is_short_and_lockstep() -> None:
 
 def test_adult_example_uses_adult_models_and_gc_durations() -> None:
     loaded = load_game(EXAMPLES / "adult_3v3" / "game.json")
-    assert loaded.game.field_class == "ADULT"
+    assert loaded.game.field_class == FieldClass.ADULT
     assert {p.model for p in loaded.red.players} == {"adult-default"}
     assert loaded.game.timing.overtime_half_duration_s == 300
 
@@ -73,7 +74,7 @@ def test_hlvs_game_json_validates_unchanged(hlvs_check: Any) -> None:
     game = loaded.game
     assert (game.game_type, game.field_class, game.side_left, game.kickoff) == (
         "NORMAL",
-        "KID",
+        FieldClass.KID,
         "blue",
         "red",
     )
@@ -84,12 +85,12 @@ def test_hlvs_game_json_validates_unchanged(hlvs_check: Any) -> None:
 
 
 def test_hlvs_bitbots_team_values() -> None:
-    team = load_team(HLVS / "team_1.json", field_class="KID").team
+    team = load_team(HLVS / "team_1.json", field_class=FieldClass.KID).team
     goalie = team.player(1)
     assert goalie.proto == "WolfgangRobocup"
     assert goalie.docker_cmd == "start goalie 0"
     assert goalie.docker_cmd_args == ("start", "goalie", "0")
-    assert goalie.model == DEFAULT_MODEL["KID"]
+    assert goalie.model == DEFAULT_MODEL[FieldClass.KID]
     assert goalie.half_time_pose.yaw_rad == pytest.approx(1.57)  # [0, -0, -1, -1.57]
     assert goalie.goalkeeper_pose.x_m == pytest.approx(-4.475)
     assert goalie.image is None  # HLVS files do not name the repository

@@ -258,14 +258,15 @@ def test_the_command_line_overrides_game_json(tmp_path: Path) -> None:
 def test_hlvs_match_and_scrimmage_take_gpu(tmp_path: Path,
                                            capsys: pytest.CaptureFixture[str]) -> None:
     from hlvs.cli import build_parser
-    from orchestrator.match.scrimmage import game_file
+    from orchestrator.match.scrimmage import ScrimmageRequest, game_file
 
     parser = build_parser()
     assert parser.parse_args(["match", "g.json", "--gpu", "on"]).gpu == "on"
     assert parser.parse_args(["match", "g.json"]).gpu is None  # game.json decides
     scrim = parser.parse_args(["scrimmage", "--gpu", "off"])
-    assert game_file(scrim, "m")["gpu"] == "off"
-    assert game_file(parser.parse_args(["scrimmage"]), "m")["gpu"] == "auto"
+    assert game_file(ScrimmageRequest.from_options(scrim), "m")["gpu"] == "off"
+    default = ScrimmageRequest.from_options(parser.parse_args(["scrimmage"]))
+    assert game_file(default, "m")["gpu"] == "auto"
     with pytest.raises(SystemExit):
         parser.parse_args(["scrimmage", "--gpu", "maybe"])
     assert "invalid choice: 'maybe'" in capsys.readouterr().err

@@ -166,7 +166,7 @@ def test_league_schedule_asks_a_node_per_robot(tmp_path: Path) -> None:
     parser = argparse.ArgumentParser()
     add_arguments(parser)
     args = parser.parse_args(["--players", "2", "--out", str(tmp_path / "m")])
-    game = scrimmage.write_files(args, tmp_path / "config")
+    game = scrimmage.write_files(scrimmage.ScrimmageRequest.from_options(args), tmp_path / "config")
     assert _robot_nodes(SchedulePool(kind="slurm", placement="league"), game) == 4
     assert _robot_nodes(SchedulePool(kind="slurm"), game) == 0
 
@@ -199,7 +199,8 @@ def test_service_worker_asks_a_node_per_robot_in_league_placement(tmp_path: Path
 
     parser = argparse.ArgumentParser()
     add_arguments(parser)
-    game = scrimmage.write_files(parser.parse_args(["--players", "3", "--out", str(tmp_path)]),
+    game = scrimmage.write_files(scrimmage.ScrimmageRequest.from_options(
+        parser.parse_args(["--players", "3", "--out", str(tmp_path)])),
                                  tmp_path / "config")
     for env, nodes in (({"HLVS_SERVICE_POOL": "slurm", "HLVS_SERVICE_PLACEMENT": "league"}, 6),
                        ({"HLVS_SERVICE_POOL": "slurm"}, 0)):

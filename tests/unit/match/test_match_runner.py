@@ -248,3 +248,60 @@ def test_robot_environment_names_the_team_number_the_stub_reads() -> None:
     env = robot_environment(robot, team_net=subnet, player_count=2, gamecontroller_ip=None)
     assert env["ROBOCUP_TEAM_ID"] == "13"
     assert read_env(env).team_id == 13
+
+
+def _events(tmp_path: Path, plan: MatchPlan, runtime: FakeRuntime, **kwargs: Any
+            ) -> tuple[list[Any], MatchOutcome]:
+    runner = MatchRunner(plan, runtime=runtime, host=FakeHost(),
+                         options=RunOptions(out_dir=tmp_path, simulator_image="sim:1",
+                                            poll_s=0.0), **kwargs)
+    stream = runner.events.subscribe()
+    outcome = runner.run()
+    seen = []
+    while not stream.empty():
+        seen.append(stream.get())
+    return seen, outcome
+
+
+def test_events_tell_an_observer_the_states_bringup_and_the_end(tmp_path: Path) -> None:
+    from orchestrator.match import AllConnected, MatchEnded, StateChanged
+
+    clock_now = [0.0]
+
+    def clock() -> float:
+        clock_now[0] += 0.5
+        return clock_now[0]
+
+    states = [_state("INITIAL", "red-1", "red-2", "blue-1", "blue-2"),
+              _state("READY", "red-1", "red-2", "blue-1", "blue-2")]
+    telemetry = FakeTelemetry(states, clock=clock)
+    seen, outcome = _events(tmp_path, _plan(telemetry=True), FakeRuntime(simulator_polls=6),
+                            telemetry=lambda endpoint, match_id: telemetry, clock=clock)
+    assert outcome.ok
+    assert [e.state for e in seen if isinstance(e, StateChanged)] == [
+        MatchState.PULLING, MatchState.STARTING, MatchState.WAITING, MatchState.PLAYING,
+        MatchState.STOPPING, MatchState.COLLECTING, MatchState.DONE]
+    connected = [e for e in seen if isinstance(e, AllConnected)]
+    assert len(connected) == 1 and connected[0].bringup_s == outcome.bringup_s
+    assert seen[-1] == MatchEnded(failure=None)
+
+
+def test_events_name_the_robots_that_did_not_start_then_the_failure(tmp_path: Path) -> None:
+    from orchestrator.errors import InfrastructureError
+    from orchestrator.match import MatchEnded, MatchFailed, RobotNotStarted
+
+    runtime = FakeRuntime()
+
+    def refuse_red(container: Any) -> None:
+        if container.request.name.startswith("hlvs-u1-red-") and "-net" not in \
+                container.request.name:
+            raise InfrastructureError("exec: start: executable file not found in $PATH")
+
+    runtime.on_start = refuse_red
+    seen, outcome = _events(tmp_path, _plan(), runtime)
+    not_started = [e for e in seen if isinstance(e, RobotNotStarted)]
+    assert sorted(e.key for e in not_started) == ["red-1", "red-2"]  # started in parallel
+    assert all("executable file not found" in e.cause for e in not_started)
+    failed = [i for i, e in enumerate(seen) if isinstance(e, MatchFailed)]
+    assert len(failed) == 1 and failed[0] > seen.index(not_started[-1])
+    assert seen[-1] == MatchEnded(failure=outcome.failure)

@@ -16,7 +16,7 @@ from contracts.sim_result import SimResult
 from hlvs.commands.scrimmage_args import add_arguments
 from orchestrator.config.loader import load_game
 from orchestrator.match.results import build_results
-from orchestrator.match.scrimmage import write_files
+from orchestrator.match.scrimmage import ScrimmageRequest, write_files
 
 PLAY = {
     "halves_playing": [1, 2], "both_halves_playing": True, "playing_s": 73.4,
@@ -29,7 +29,8 @@ PLAY = {
 def _scrimmage(tmp_path: Path, *argv: str) -> tuple[dict[str, Any], dict[str, Any]]:
     parser = argparse.ArgumentParser()
     add_arguments(parser)
-    game = write_files(parser.parse_args(list(argv)), tmp_path, stub_image="stub:1")
+    request = ScrimmageRequest.from_options(parser.parse_args(list(argv)))
+    game = write_files(request, tmp_path, stub_image="stub:1")
     red = json.loads((tmp_path / "team_red.json").read_text())
     return json.loads(game.read_text()), red
 

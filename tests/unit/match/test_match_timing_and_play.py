@@ -10,7 +10,6 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from hlvs.commands.scrimmage_args import add_arguments
 
 from contracts.match_results import FailureClass, MatchReport
 from contracts.match_spec import TimingSpec
@@ -26,14 +25,19 @@ from contracts.timing import (
 )
 from envs.errors import EnvConfigError
 from envs.session_spec import SessionSpec
+from hlvs.commands.scrimmage_args import add_arguments
 from orchestrator.config.loader import load_game
 from orchestrator.errors import ConfigError
 from orchestrator.match.results import RobotRecord, play_failure
-from orchestrator.match.scrimmage import write_files
+from orchestrator.match.scrimmage import ScrimmageRequest, write_files
 from service import Settings
 from service.errors import SettingsError
 from service.matchfiles import write_match
 from service.submissions import failure_side
+
+
+def _request(parser: argparse.ArgumentParser, argv: list[str]) -> ScrimmageRequest:
+    return ScrimmageRequest.from_options(parser.parse_args(argv))
 
 
 def test_every_preset_leaves_the_minimum_of_play() -> None:
@@ -56,7 +60,7 @@ def test_quick_tests_shorten_ready_or_refuse() -> None:
 def _game(tmp_path: Path, timing: dict[str, Any], game_type: str = "NORMAL") -> Path:
     parser = argparse.ArgumentParser()
     add_arguments(parser)
-    game_path = write_files(parser.parse_args([]), tmp_path, stub_image="stub:1")
+    game_path = write_files(_request(parser, []), tmp_path, stub_image="stub:1")
     game = json.loads(game_path.read_text())
     game["timing"] = timing
     game["type"] = game_type
@@ -84,12 +88,12 @@ def test_a_scrimmage_with_a_short_half_gets_a_short_ready_with_a_warning(
     parser = argparse.ArgumentParser()
     add_arguments(parser)
     with caplog.at_level(logging.WARNING):
-        game = write_files(parser.parse_args(["--half-duration", "25"]), tmp_path,
+        game = write_files(_request(parser, ["--half-duration", "25"]), tmp_path,
                            stub_image="stub:1")
     assert "READY shortened from 20 s to 10 s" in caplog.text
     assert load_game(game).game.timing.ready_duration_s == 10
     with pytest.raises(ConfigError, match="too short to play"):
-        write_files(parser.parse_args(["--half-duration", "10"]), tmp_path, stub_image="s:1")
+        write_files(_request(parser, ["--half-duration", "10"]), tmp_path, stub_image="s:1")
 
 
 def test_service_test_matches_play_and_too_short_halves_are_refused(tmp_path: Path) -> None:
@@ -170,14 +174,14 @@ def test_a_stub_given_a_model_with_other_motor_names_is_said_loudly(
     parser = argparse.ArgumentParser()
     add_arguments(parser)
     with caplog.at_level(logging.WARNING):
-        write_files(parser.parse_args(["--red-model", str(wolfgang)]), tmp_path,
+        write_files(_request(parser, ["--red-model", str(wolfgang)]), tmp_path,
                     stub_image="stub:1")
     warned = [r for r in caplog.records if r.levelno == logging.WARNING]
     assert len(warned) == 1 and warned[0].getMessage().startswith("red robots: the stub robot")
     assert "stands still" in warned[0].getMessage()
     caplog.clear()
     with caplog.at_level(logging.WARNING):  # a robot image of the team's own: its business
-        write_files(parser.parse_args(["--red-model", str(wolfgang), "--red-image", "team:1"]),
+        write_files(_request(parser, ["--red-model", str(wolfgang), "--red-image", "team:1"]),
                     tmp_path, stub_image="stub:1")
     assert not caplog.records
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from orchestrator.config import check_team, load_team
+from orchestrator.config import FieldClass, check_team, load_team
 from orchestrator.config.robot_models import container_path, spec_model
 from orchestrator.match.layout import simulator_request
 from orchestrator.match.scrimmage import team_file
@@ -21,14 +21,14 @@ def _team(folder: Path, model: str) -> Path:
 
 def test_relative_model_path_resolved_against_the_team_file(tmp_path: Path) -> None:
     box_robot(tmp_path / "models" / "box", height_m=0.7)
-    team = load_team(_team(tmp_path, "models/box"), field_class="KID").team
+    team = load_team(_team(tmp_path, "models/box"), field_class=FieldClass.KID).team
     assert {p.model for p in team.players} == {str(tmp_path / "models" / "box")}
     assert spec_model(team.players[0].model) == container_path(str(tmp_path / "models/box"))
     assert spec_model("kid-default") == "kid-default"
 
 
 def test_missing_package_names_the_folder_and_what_was_expected(tmp_path: Path) -> None:
-    problems = check_team(_team(tmp_path, "./nowhere"), field_class="KID")
+    problems = check_team(_team(tmp_path, "./nowhere"), field_class=FieldClass.KID)
     text = [str(p) for p in problems]
     assert any(
         "/players/1/model: no robot model package at " + str(tmp_path / "nowhere") in t
@@ -39,7 +39,7 @@ def test_missing_package_names_the_folder_and_what_was_expected(tmp_path: Path) 
 
 def test_a_model_that_breaks_the_rules_cannot_be_used(tmp_path: Path) -> None:
     box_robot(tmp_path / "tall", height_m=1.4)
-    problems = [str(p) for p in check_team(_team(tmp_path, "tall"), field_class="KID")]
+    problems = [str(p) for p in check_team(_team(tmp_path, "tall"), field_class=FieldClass.KID)]
     assert len([p for p in problems if "/players/" in p and "height: H = 1.4" in p]) == 2
 
 

@@ -13,6 +13,7 @@ import httpx
 import pytest
 
 from cluster.fake import FakePool
+from orchestrator.config import TeamConfig
 from service import Settings
 from service.db import Scope, make_engine, migrate, session_factory, transaction
 from service.errors import PreflightFailed
@@ -50,11 +51,10 @@ class FakePreflight:
     def __init__(self) -> None:
         self.calls = 0
 
-    def __call__(self, team: dict[str, Any], settings: Settings) -> float:
+    def __call__(self, team: TeamConfig, settings: Settings) -> float:
         self.calls += 1
-        if "bad" in str(team.get("image")):
-            raise PreflightFailed(stage="pull", image=str(team["image"]),
-                                  cause="manifest unknown")
+        if "bad" in str(team.image):
+            raise PreflightFailed(stage="pull", image=str(team.image), cause="manifest unknown")
         return 0.01
 
 

@@ -3,7 +3,6 @@ for team files, webhook addresses, body limits, file modes, bounds of numbers.""
 
 from __future__ import annotations
 
-import argparse
 import asyncio
 import json
 import socket
@@ -134,11 +133,11 @@ def test_a_command_that_does_not_split_is_refused_at_check(tmp_path: Path) -> No
 
 
 def test_the_upload_checks_the_field_class_the_service_plays() -> None:
-    from orchestrator.match.scrimmage import game_file
+    from orchestrator.match.scrimmage import ScrimmageRequest, game_file
 
-    args = argparse.Namespace(players=1, seed=1, half_duration=30.0, wait_before_ready=3.0,
-                              grace=5.0)
-    assert game_file(args, "m")["class"] == teamfiles.FIELD_CLASS
+    request = ScrimmageRequest(players=1, seed=1, half_duration_s=30.0, wait_before_ready_s=3.0,
+                               grace_s=5.0)
+    assert game_file(request, "m")["class"] == teamfiles.FIELD_CLASS.name
 
 
 # --- webhook addresses --------------------------------------------------------------------------

@@ -3,14 +3,18 @@ team isolation, operators, restart."""
 
 from __future__ import annotations
 
+import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import httpx
+import pytest
 
 from cluster.fake import FakePool
-from tests.integration.service.harness import Served
+from service import Settings
+from tests.integration.service.harness import Served, serve
 from tests.unit.service.conftest import team_doc, wait_for_status
 
 
@@ -373,3 +377,74 @@ def test_a_render_left_by_an_earlier_service_process_is_waited_for(
         assert ended["video"]["state"] == "failed", ended["video"]
         assert "hlvs render exited with code 2" in ended["video"]["detail"]
         assert json.loads((work / "render.json").read_text())["renders"] == 2
+
+
+class _Runner:
+    """A match runner whose robots have all connected at once (the pre-flight's view)."""
+
+    plans: list[Any] = []
+
+    def __init__(self, plan: Any, **_: Any) -> None:
+        from orchestrator.match import EventStream
+
+        self.plans.append(plan)
+        self.events = EventStream()
+        self.stop_event = threading.Event()
+
+    def run(self) -> None:
+        from orchestrator.match import AllConnected
+
+        self.events.publish(AllConnected(bringup_s=0.1))
+        self.stop_event.wait(5)
+
+
+def test_a_submissions_team_file_is_parsed_once(settings: Settings, token: Callable[..., str],
+                                                pool: FakePool,
+                                                monkeypatch: pytest.MonkeyPatch) -> None:
+    """From the request to the pool: the submitted team file is validated once (the upload's
+    rules); the full pre-flight (its match machinery faked) and the match files use that
+    validated team."""
+    import orchestrator.engine
+    import orchestrator.engine.containers
+    import orchestrator.match
+    import orchestrator.project_images
+    import orchestrator.pull
+    from service import preflight
+
+    monkeypatch.setattr(orchestrator.pull, "resolve_team_images", lambda *a, **k: {})
+    monkeypatch.setattr(orchestrator.engine, "connect", lambda: object())
+    monkeypatch.setattr(orchestrator.engine.containers, "DockerRuntime", lambda engine: engine)
+    monkeypatch.setattr(orchestrator.match.HostControl, "for_current_user",
+                        staticmethod(lambda: None))
+    monkeypatch.setattr(orchestrator.match, "MatchRunner", _Runner)
+    monkeypatch.setattr(orchestrator.match, "cleanup", lambda *a, **k: None)
+    monkeypatch.setattr(orchestrator.project_images, "project_image",
+                        lambda name: f"hlvs-runner/{name}:test")
+    served = serve(settings.with_(preflight="full"), start_worker=True,
+                   pool_factory=lambda _s: pool,
+                   preflight=lambda team, current: preflight.run(team, settings=current))
+    try:
+        _count_parses(served, token, monkeypatch)
+    finally:
+        served.stop()
+    assert len(pool.started) == 1
+
+
+def _count_parses(served: Served, token: Callable[..., str],
+                  monkeypatch: pytest.MonkeyPatch) -> None:
+    from orchestrator.config import loader
+
+    with setup_team(served, token("Alpha"), "Alpha") as http:
+        parsed: list[object] = []
+        build_team = loader.build_team
+
+        def counted(document: Any, *args: Any, **kwargs: Any) -> Any:
+            parsed.append(document.get("name") if isinstance(document, dict) else None)
+            return build_team(document, *args, **kwargs)
+
+        monkeypatch.setattr(loader, "build_team", counted)
+        created = http.post("/v1/submissions", json={})
+        assert created.status_code == 201, created.text
+        wait_for_status(http, created.json()["id"], lambda b: b["state"] == "running")
+    assert parsed.count("Alpha") == 1
+    assert [plan.red.name for plan in _Runner.plans] == ["Alpha"]
