@@ -190,6 +190,7 @@ def _classes_of(schedule: Schedule, team: str) -> set[str]:
 
 
 def _team_problems(schedule: Schedule) -> list[Problem]:
+    from contracts.field import FieldClass
     from orchestrator.config.loader import check_team
 
     problems: list[Problem] = []
@@ -198,8 +199,9 @@ def _team_problems(schedule: Schedule) -> list[Problem]:
             continue  # reported by the cross-checks
         classes: list[str | None] = [*sorted(_classes_of(schedule, team.name))] or [None]
         for field_class in classes:
-            problems += check_team(team.config, field_class=field_class,  # type: ignore[arg-type]
-                                   images_required=True)
+            problems += check_team(  # the schedule says KID / ADULT, as game.json does
+                team.config, field_class=FieldClass(field_class.lower()) if field_class else None,
+                images_required=True)
     return problems
 
 
