@@ -113,12 +113,10 @@ def remove(world: CommandTarget, number: int) -> None:
 def restore(world: CommandTarget, number: int, x: float, y: float, yaw: float) -> None:
     robot = world.index.robots[number]
     if world.removed[number]:
-        bit = 1 << number
-        from simulator.world.scene import BALL_BIT, STATIC_BIT
+        from simulator.world.scene import robot_conaffinity
 
-        all_robots = (1 << len(world.robot_ids)) - 1
-        world.model.geom_contype[robot.geoms] = bit
-        world.model.geom_conaffinity[robot.geoms] = (all_robots & ~bit) | STATIC_BIT | BALL_BIT
+        world.model.geom_contype[robot.geoms] = 1 << number
+        world.model.geom_conaffinity[robot.geoms] = robot_conaffinity(len(world.robot_ids))
         world.removed[number] = False
         world.parked_qpos.pop(number, None)
         logger.info("%s restored", robot.id)
