@@ -80,10 +80,7 @@ def actuator_xml(name: str, joint: str, spec: MotorSpec) -> str:
 
 def joint_attributes(spec: MotorSpec) -> str:
     """The joint's friction and damping from its servo (MJCF attributes)."""
-    return (
-        f'damping="{spec.damping_nm_s_per_rad:.6g}" '
-        f'frictionloss="{spec.static_friction_nm:.6g}"'
-    )
+    return f'damping="{spec.damping_nm_s_per_rad:.6g}" frictionloss="{spec.static_friction_nm:.6g}"'
 
 
 @dataclass(frozen=True, slots=True)

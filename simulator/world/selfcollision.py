@@ -77,6 +77,4 @@ def _compute(model: AnyRobotModel) -> tuple[tuple[str, str], ...]:
             if a != b:
                 pairs.add((min(a, b), max(a, b)))
     start = len(_PREFIX) + 1
-    return tuple(
-        sorted((mj.body(a).name[start:], mj.body(b).name[start:]) for a, b in pairs)
-    )
+    return tuple(sorted((mj.body(a).name[start:], mj.body(b).name[start:]) for a, b in pairs))

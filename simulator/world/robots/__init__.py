@@ -35,11 +35,11 @@ _KID_SERVOS: dict[str, str] = {
     "ArmUpper": "MX-64@14.8V",
     "ArmLower": "MX-64@14.8V",
     "PelvY": "MX-64@14.8V",
-    "Pelv": "MX-106@14.8V",
-    "LegUpper": "MX-106@14.8V",
-    "LegLower": "MX-106@14.8V",
-    "Ankle": "MX-106@14.8V",
-    "Foot": "MX-106@14.8V",
+    "Pelv": "XW540-T140@14.8V",
+    "LegUpper": "XW540-T140@14.8V",
+    "LegLower": "XW540-T140@14.8V",
+    "Ankle": "XW540-T140@14.8V",
+    "Foot": "XW540-T140@14.8V",
 }
 _ADULT_SERVOS: dict[str, str] = {
     "Neck": "PH42-020-S300-R@24V",

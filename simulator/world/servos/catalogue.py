@@ -53,7 +53,9 @@ class Servo:
         if speed <= self.full_torque_speed_rad_s:
             return self.stall_torque_nm
         span = self.no_load_speed_rad_s - self.full_torque_speed_rad_s
-        return max(0.0, self.stall_torque_nm * (1.0 - (speed - self.full_torque_speed_rad_s) / span))
+        return max(
+            0.0, self.stall_torque_nm * (1.0 - (speed - self.full_torque_speed_rad_s) / span)
+        )
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -77,8 +79,11 @@ def _number(raw: dict[str, Any], key: str, source: str, where: str) -> float:
     value = raw.get(key)
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not value >= 0:
         raise ModelError(
-            [ModelProblem(source=source, where=f"{where}/{key}", reason=f"{value!r} is not a "
-                          "number >= 0")]
+            [
+                ModelProblem(
+                    source=source, where=f"{where}/{key}", reason=f"{value!r} is not a number >= 0"
+                )
+            ]
         )
     return float(value)
 
@@ -92,7 +97,9 @@ def _load(path: Path) -> list[Servo]:
     try:
         raw = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, json.JSONDecodeError) as exc:
-        raise ModelError([ModelProblem(source=source, where="", reason=f"not JSON: {exc}")]) from None
+        raise ModelError(
+            [ModelProblem(source=source, where="", reason=f"not JSON: {exc}")]
+        ) from None
     model = raw.get("model")
     if not isinstance(model, str) or not model:
         raise ModelError([ModelProblem(source=source, where="/model", reason="expected a name")])
@@ -116,14 +123,21 @@ def _load(path: Path) -> list[Servo]:
     for i, variant in enumerate(variants):
         where = f"/variants/{i}"
         if not isinstance(variant, dict):
-            raise ModelError([ModelProblem(source=source, where=where, reason="expected an object")])
+            raise ModelError(
+                [ModelProblem(source=source, where=where, reason="expected an object")]
+            )
         voltage = _number(variant, "voltage_v", source, where)
         no_load = _number(variant, "no_load_speed_rpm", source, where) * RPM
         corner = float(variant.get("full_torque_speed_rpm", 0.0)) * RPM
         if not 0 <= corner < no_load:
             raise ModelError(
-                [ModelProblem(source=source, where=f"{where}/full_torque_speed_rpm",
-                              reason="must be below the no-load speed")]
+                [
+                    ModelProblem(
+                        source=source,
+                        where=f"{where}/full_torque_speed_rpm",
+                        reason="must be below the no-load speed",
+                    )
+                ]
             )
         out.append(
             Servo(

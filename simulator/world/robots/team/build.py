@@ -25,8 +25,8 @@ import numpy as np
 
 from simulator.errors import ModelError, ModelProblem
 from simulator.world.actuator import actuator_xml
-from simulator.world.robots.team.servos import motor_spec
 from simulator.world.robots.team.manifest import Manifest
+from simulator.world.robots.team.servos import motor_spec
 
 PREFIX = "@ROBOT@"
 HULL = (

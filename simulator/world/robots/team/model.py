@@ -10,9 +10,9 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from simulator.world.robots.model import CameraSpec, MotorLookup, MotorSpec, RobotMjcf
-from simulator.world.robots.team.servos import motor_spec
 from simulator.world.robots.team.build import PREFIX, Template, build_template
 from simulator.world.robots.team.manifest import Manifest, load_manifest
+from simulator.world.robots.team.servos import motor_spec
 from simulator.world.robots.team.source import load_spec
 
 VISUAL = "/visual:"

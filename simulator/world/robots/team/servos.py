@@ -21,8 +21,9 @@ def motor_spec(entry: MotorEntry, manifest: Manifest) -> MotorSpec:
         torque = min(entry.max_torque_nm or spec.max_torque_nm, spec.max_torque_nm)
         velocity = min(entry.max_velocity_rad_s or spec.max_velocity_rad_s, spec.max_velocity_rad_s)
     else:
-        spec = MotorSpec(name=entry.name, lower_rad=0.0, upper_rad=0.0, max_torque_nm=1.0,
-                         max_velocity_rad_s=1.0)
+        spec = MotorSpec(
+            name=entry.name, lower_rad=0.0, upper_rad=0.0, max_torque_nm=1.0, max_velocity_rad_s=1.0
+        )
         torque = entry.max_torque_nm or 1.0
         velocity = entry.max_velocity_rad_s or 1.0
     friction = manifest.joint_frictionloss
@@ -53,35 +54,52 @@ def servo_problems(manifest: Manifest, *, official: bool) -> list[ModelProblem]:
         at = f"/motors/{i}"
         found = find_servo(entry.servo) if entry.servo else None
         if found is None:
-            out.append(ModelProblem(
-                source=source, where=f"{at}/servo", severity=free,
-                reason=f"{entry.name} (joint {entry.joint}) names no catalogue servo: free-form "
-                f"max_torque_nm {entry.max_torque_nm} and max_velocity_rad_s "
-                f"{entry.max_velocity_rad_s} are for {match} (rule: {RULE})",
-            ))
+            out.append(
+                ModelProblem(
+                    source=source,
+                    where=f"{at}/servo",
+                    severity=free,
+                    reason=f"{entry.name} (joint {entry.joint}) names no catalogue servo: "
+                    f"free-form max_torque_nm {entry.max_torque_nm} and max_velocity_rad_s "
+                    f"{entry.max_velocity_rad_s} are for {match} (rule: {RULE})",
+                )
+            )
         else:
             for key, value, limit in (
                 ("max_torque_nm", entry.max_torque_nm, found.stall_torque_nm),
                 ("max_velocity_rad_s", entry.max_velocity_rad_s, found.no_load_speed_rad_s),
             ):
                 if value is not None and value > limit * (1 + 1e-6):
-                    out.append(ModelProblem(
-                        source=source, where=f"{at}/{key}",
-                        reason=f"{entry.name} (joint {entry.joint}): {key} {value:g} is above "
-                        f"the catalogue's {limit:.4g} for {found.id} (rule: {RULE})",
-                    ))
+                    out.append(
+                        ModelProblem(
+                            source=source,
+                            where=f"{at}/{key}",
+                            reason=f"{entry.name} (joint {entry.joint}): {key} {value:g} is above "
+                            f"the catalogue's {limit:.4g} for {found.id} (rule: {RULE})",
+                        )
+                    )
         for key in entry.free_gains:
-            out.append(ModelProblem(
-                source=source, where=f"{at}/{key}", severity=free,
-                reason=f"{entry.name}: free-form gain {key} is for {match} and has no effect: "
-                f"position control is Webots' (P, I, D from MotorPID; rule: {RULE})",
-            ))
-    for key, value in (("joint_damping", manifest.joint_damping),
-                       ("joint_frictionloss", manifest.joint_frictionloss)):
+            out.append(
+                ModelProblem(
+                    source=source,
+                    where=f"{at}/{key}",
+                    severity=free,
+                    reason=f"{entry.name}: free-form gain {key} is for {match} and has no effect: "
+                    f"position control is Webots' (P, I, D from MotorPID; rule: {RULE})",
+                )
+            )
+    for key, value in (
+        ("joint_damping", manifest.joint_damping),
+        ("joint_frictionloss", manifest.joint_frictionloss),
+    ):
         if value is not None:
-            out.append(ModelProblem(
-                source=source, where=f"/{key}", severity=free,
-                reason=f"{key} {value:g} replaces the catalogue servos' friction: for {match} "
-                f"(rule: {RULE})",
-            ))
+            out.append(
+                ModelProblem(
+                    source=source,
+                    where=f"/{key}",
+                    severity=free,
+                    reason=f"{key} {value:g} replaces the catalogue servos' friction: for {match} "
+                    f"(rule: {RULE})",
+                )
+            )
     return out
