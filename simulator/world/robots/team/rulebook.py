@@ -41,6 +41,7 @@ MAX_FOV_RAD = math.pi
 MARKER = "/visual:marker"  # the team-colour marker we add is not part of the robot
 DENSITY_KG_M3 = (50.0, 10000.0)  # foam-light shells to steel, over the bounding box volume
 MIN_INERTIA_KG_M2 = 1e-8
+FRAME_KG = 1e-5  # lighter links are frames (camera, IMU), not parts
 
 
 @dataclass(frozen=True, slots=True)
@@ -176,7 +177,8 @@ def _arm_chains(
                 continue
             if not _subtree_of(model, int(model.geom_bodyid[g]), root):
                 continue
-            reach = max(reach, float(np.linalg.norm(_corners(model, data, g) - anchor, axis=1).max()))
+            distances = np.linalg.norm(_corners(model, data, g) - anchor, axis=1)
+            reach = max(reach, float(distances.max()))
         chains[link] = reach
     return chains
 
@@ -294,35 +296,38 @@ def _inertia_problems(robot: TeamRobotModel, source: str) -> list[ModelProblem]:
         if not model.body(body).name.startswith("r/link:"):
             continue  # the frame we add around the model's root
         mass = float(model.body_mass[body])
+        if mass <= FRAME_KG:
+            continue  # a frame (camera, IMU) without mass of its own
+        name = model.body(body).name.removeprefix("r/").removeprefix("link:")
+        inertia = model.body_inertia[body]
         geoms = [
             g
             for g in range(model.ngeom)
             if model.geom_bodyid[g] == body and not model.geom(g).name.endswith(MARKER)
         ]
-        if mass <= 0 or not geoms:
-            continue
-        rot = data.xmat[body].reshape(3, 3)
-        local = np.concatenate([(_corners(model, data, g) - data.xpos[body]) @ rot for g in geoms])
-        extent = local.max(axis=0) - local.min(axis=0)
-        volume = float(np.prod(np.maximum(extent, 1e-3)))
-        diagonal = float(np.linalg.norm(extent))
-        density = mass / volume
-        name = model.body(body).name.removeprefix("r/").removeprefix("link:")
-        low, high = DENSITY_KG_M3
-        if not low <= density <= high:
-            out.append(ModelProblem(
-                source=source, where=f"mass of {name}",
-                reason=f"{mass:.4g} kg in a {extent[0]:.3f} x {extent[1]:.3f} x {extent[2]:.3f} m "
-                f"box is {density:.0f} kg/m^3, outside {low:g}-{high:g} kg/m^3 (rule: link masses "
-                "plausible for their size)",
-            ))  # fmt: skip
-        inertia = model.body_inertia[body]
-        top = mass * diagonal * diagonal
+        top = math.inf
+        if geoms:
+            rot = data.xmat[body].reshape(3, 3)
+            corners = [(_corners(model, data, g) - data.xpos[body]) @ rot for g in geoms]
+            local = np.concatenate(corners)
+            extent = local.max(axis=0) - local.min(axis=0)
+            density = mass / float(np.prod(np.maximum(extent, 1e-3)))
+            diagonal = float(np.linalg.norm(extent))
+            top = mass * diagonal * diagonal
+            low, high = DENSITY_KG_M3
+            if not low <= density <= high:
+                size = " x ".join(f"{v:.3f}" for v in extent)
+                out.append(ModelProblem(
+                    source=source, where=f"mass of {name}",
+                    reason=f"{mass:.4g} kg in a {size} m box is {density:.0f} kg/m^3, outside "
+                    f"{low:g}-{high:g} kg/m^3 (rule: link masses plausible for their size)",
+                ))  # fmt: skip
         if inertia.min() < MIN_INERTIA_KG_M2 or inertia.max() > top:
+            bound = f"{top:.3g} kg m^2 (mass x squared size)" if geoms else "-"
             out.append(ModelProblem(
                 source=source, where=f"inertia of {name}",
-                reason=f"principal inertia {', '.join(f'{v:.3g}' for v in inertia)} kg m^2 is "
-                f"outside {MIN_INERTIA_KG_M2:g}-{top:.3g} kg m^2 (mass x squared size; rule: "
-                "link inertias plausible for their size)",
+                reason=f"principal inertia {', '.join(f'{v:.3g}' for v in inertia)} kg m^2 of "
+                f"{mass:.4g} kg is outside {MIN_INERTIA_KG_M2:g} - {bound} (rule: link "
+                "inertias plausible for their size)",
             ))  # fmt: skip
     return out
