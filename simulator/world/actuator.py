@@ -3,17 +3,25 @@
 
 Construction (chosen by measurement, ``hlvs bench actuators`` and ``hlvs bench sim``): one
 ``<general>`` actuator per joint with an affine bias, ``force = gain ctrl + b1 q + b2 qdot``,
-rewritten once per basic step by the motor bank (a velocity servo ``K (v - qdot)`` or, while
-the P controller is not saturated, the exact linear law ``K (P (target - q) - qdot)``), and a
-force range rewritten at the same time from the servo's torque-speed line at the joint's speed.
+rewritten once per basic step by the motor bank: a velocity servo ``K (v - qdot)``, or while the
+P controller is not saturated the exact linear law ``K (P (target - q) - qdot)``, and a force
+range rewritten at the same time from the servo's torque-speed line at the joint's speed.
+
+Measured alternative: the line itself as the actuator's affine law (``reach - slope qdot``, a DC
+motor at full voltage) whenever the servo asks for more than the line gives. It is integrated
+implicitly (stable for any link), but while it acts the servo's velocity feedback does not, so a
+position step overshoots the Webots trajectory by 16-77 % of the step (against 1-6 % with the
+force range); the force range is what runs. Its limit: a link so light that the line's slope
+times the 8 ms step exceeds the link's inertia (``slope dt / I > 1``, far below any robot link
+with its servo's armature) chatters near the no-load speed.
+Backlash (position control): within half the gear play of the target the gears do not touch
+and the servo gives no torque; beyond it the controller acts on the error less that half, so a
+load moves the joint across the whole play and holds it at the far side, as a real gear train
+does (decided once per basic step; the 8 ms step resolves the play's statics, not its rattle).
 Friction and damping are the joint's ``frictionloss`` and ``damping``; the motor's line is
 raised by both so that the output follows the datasheet: stall torque at rest, zero torque at
 the no-load speed. ``K`` (N m s/rad) makes the servo saturate at 5 % of its no-load speed of
 velocity error, stiff enough to track the Webots model and soft enough for 2 ms substeps.
-
-A controller per substep (four ``mj_step`` calls per basic step instead of one) was measured
-too: it changes the torque-speed line's lag from 8 ms to 2 ms, below what the stall and
-no-load tests resolve, at several times the Python cost; the per-step form is what runs.
 """
 
 from __future__ import annotations
@@ -95,9 +103,10 @@ class ActuatorParams:
     lower: FloatArray
     upper: FloatArray
     motor_torque: FloatArray
-    line_speed: FloatArray
-    line_span: FloatArray
+    line_reach: FloatArray  # the line's torque extrapolated to zero speed (>= motor torque)
+    line_slope: FloatArray  # N m per rad/s
     gain: FloatArray
+    half_play: FloatArray  # half the backlash, rad
 
 
 def _compact(values: list[int]) -> slice | IntArray:
@@ -125,7 +134,10 @@ def actuator_params(model: mujoco.MjModel, specs: Sequence[tuple[int, Any]]) -> 
         lower=array([s.lower_rad for _, s in ordered]),
         upper=array([s.upper_rad for _, s in ordered]),
         motor_torque=array([c.motor_torque_nm for c in constants]),
-        line_speed=array([c.line_speed_rad_s for c in constants]),
-        line_span=array([c.line_span_rad_s for c in constants]),
+        line_reach=array(
+            [c.motor_torque_nm * c.line_speed_rad_s / c.line_span_rad_s for c in constants]
+        ),
+        line_slope=array([c.motor_torque_nm / c.line_span_rad_s for c in constants]),
         gain=array([c.gain_nm_s_per_rad for c in constants]),
+        half_play=array([s.backlash_rad / 2 for _, s in ordered]),
     )

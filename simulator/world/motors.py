@@ -9,10 +9,12 @@ joint's speed. ``setPosition(+-inf)`` is velocity control (the signed ``setVeloc
 ``setTorque`` is torque control (clamped to the stall torque, the line still applies); a limp
 robot's actuators give no torque (the joint's friction and damping remain).
 
-Per basic step (``step_ms``) :meth:`MotorBank.apply` chooses each actuator's mode and writes its
-gain, bias, ``ctrl`` and force range: unsaturated position control is the affine law
+Backlash: see :mod:`simulator.world.actuator`. Per basic step (``step_ms``)
+:meth:`MotorBank.apply` chooses each actuator's mode and writes its
+gain, bias and ``ctrl``: unsaturated position control is the affine law
 ``K (P (target - q) + I integral - (1 + D) qdot)`` evaluated by MuJoCo every substep (exact for
-the linear part), saturated position control and velocity control are ``K (v - qdot)``.
+the linear part), saturated position control and velocity control are ``K (v - qdot)``; the
+force range is the motor's torque-speed line at the joint's speed.
 """
 
 from __future__ import annotations
@@ -158,20 +160,16 @@ class MotorBank:
         """Kept for callers that reset MuJoCo's state: every step writes everything anyway."""
 
     def apply(self, data: mujoco.MjData) -> None:
-        """Choose each actuator's mode and write gain, bias, ``ctrl`` and force range for the
-        next basic step, from the joints' positions and velocities now."""
+        """Choose each actuator's mode and write gain, bias and ``ctrl`` for the next basic
+        step, from the joints' positions and velocities now."""
         ids, par = self._ids, self.params
         q = data.qpos[self._qpos]
         qdot = data.qvel[self._dof]
-        # torque-speed line: full torque against the motion, the line's torque with it
-        drive = par.motor_torque * np.clip(
-            (par.line_speed - np.abs(qdot)) / par.line_span, 0.0, 1.0
-        )
-        np.minimum(drive, par.motor_torque, out=drive)
-        self._range[ids, 1] = np.where(qdot > 0, drive, par.motor_torque)
-        self._range[ids, 0] = -np.where(qdot < 0, drive, par.motor_torque)
         p, d = self.p[ids], self.d[ids]
         target = self.target[ids]
+        error = target - q
+        loose = np.abs(error) <= par.half_play  # within the gear play: the gears do not touch
+        target = target - np.clip(error, -par.half_play, par.half_play)
         if self._any_integral:
             self.integral[ids] += (target - q) * self._step_s
             pull = self.i[ids] * self.integral[ids]
@@ -181,13 +179,12 @@ class MotorBank:
         limit = self.velocity_limit[ids]
         velocity = self.velocity_mode[ids]
         saturated = velocity | (np.abs(wanted) > limit)
-        k = par.gain
-        ctrl = np.where(
-            velocity,
-            self.velocity[ids],
-            np.where(saturated, np.copysign(limit, wanted), p * target + pull),
+        command = np.where(
+            velocity, self.velocity[ids], np.where(saturated, np.copysign(limit, wanted), wanted)
         )
+        k = par.gain
         gain = k.copy()
+        ctrl = np.where(saturated, command, p * target + pull)
         bias_q = np.where(saturated, 0.0, -k * p)
         bias_v = np.where(saturated, -k, -k * (1.0 + d))
         torque = self.torque_mode[ids]
@@ -196,11 +193,17 @@ class MotorBank:
             gain[torque] = 1.0
             bias_q[torque] = 0.0
             bias_v[torque] = 0.0
-        limp = self.limp[ids]
-        if limp.any():
-            gain[limp] = 0.0
-            bias_q[limp] = 0.0
-            bias_v[limp] = 0.0
+        # the torque-speed line at this speed bounds the force for the step: full torque
+        # against the motion, the line's torque with it
+        drive = np.minimum(par.line_reach - par.line_slope * np.abs(qdot), par.motor_torque)
+        np.maximum(drive, 0.0, out=drive)
+        self._range[ids, 1] = np.where(qdot > 0, drive, par.motor_torque)
+        self._range[ids, 0] = -np.where(qdot < 0, drive, par.motor_torque)
+        off = (loose & ~velocity & ~torque) | self.limp[ids]
+        if off.any():
+            gain[off] = 0.0
+            bias_q[off] = 0.0
+            bias_v[off] = 0.0
         self._gain[ids] = gain
         self._bias_q[ids] = bias_q
         self._bias_v[ids] = bias_v

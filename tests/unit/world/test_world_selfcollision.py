@@ -8,10 +8,11 @@ from simulator.world.selfcollision import excluded_pairs
 
 from .conftest import RED_1, run_steps
 
-# both legs in a crouch, hip rolls crossing them (each within its range)
+# a deep crouch with the hip rolls crossing the legs (each within its range): the knees meet,
+# the legs wedge and the robot topples; with the legs passing through each other it stays up
 CROSSED = {
-    "LegUpperL": 0.4, "LegLowerL": 0.8, "AnkleL": 0.4,
-    "LegUpperR": 0.4, "LegLowerR": 0.8, "AnkleR": 0.4,
+    "LegUpperL": 0.6, "LegLowerL": 1.2, "AnkleL": 0.6,
+    "LegUpperR": 0.6, "LegLowerR": 1.2, "AnkleR": 0.6,
     "PelvL": -0.6, "PelvR": 0.6,
 }  # fmt: skip
 
