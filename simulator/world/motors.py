@@ -70,6 +70,9 @@ class MotorBank:
         self.torque = np.zeros(nu)
         self.torque_mode = np.zeros(nu, dtype=bool)
         self.limp = np.zeros(nu, dtype=bool)
+        self.held = np.zeros(nu, dtype=bool)  # held by the world: commands wait
+        self.hold_target = np.zeros(nu)
+        self._any_held = False
         self._gain = model.actuator_gainprm[:, 0]
         self._bias_q = model.actuator_biasprm[:, 1]
         self._bias_v = model.actuator_biasprm[:, 2]
@@ -147,6 +150,14 @@ class MotorBank:
     def set_limp(self, actuators: npt.NDArray[np.int64], limp: bool) -> None:
         self.limp[actuators] = limp
 
+    def set_held(self, actuators: npt.NDArray[np.int64], positions: FloatArray | None) -> None:
+        """Hold ``actuators`` at ``positions`` under position control whatever is commanded
+        (commands still update the targets, which apply again on release: ``None``)."""
+        self.held[actuators] = positions is not None
+        if positions is not None:
+            self.hold_target[actuators] = positions
+        self._any_held = bool(self.held.any())
+
     def hold(self, actuators: npt.NDArray[np.int64], positions: FloatArray) -> None:
         """Position control at ``positions`` (after a teleport or restore)."""
         self.target[actuators] = positions
@@ -167,6 +178,14 @@ class MotorBank:
         qdot = data.qvel[self._dof]
         p, d = self.p[ids], self.d[ids]
         target = self.target[ids]
+        velocity = self.velocity_mode[ids]
+        torque = self.torque_mode[ids]
+        if self._any_held:
+            held = self.held[ids]
+            target = np.where(held, self.hold_target[ids], target)
+            p = np.where(held, np.maximum(p, DEFAULT_P), p)
+            velocity = velocity & ~held
+            torque = torque & ~held
         error = target - q
         loose = np.abs(error) <= par.half_play  # within the gear play: the gears do not touch
         target = target - np.clip(error, -par.half_play, par.half_play)
@@ -177,7 +196,6 @@ class MotorBank:
             pull = 0.0
         wanted = p * (target - q) + pull - d * qdot
         limit = self.velocity_limit[ids]
-        velocity = self.velocity_mode[ids]
         saturated = velocity | (np.abs(wanted) > limit)
         command = np.where(
             velocity, self.velocity[ids], np.where(saturated, np.copysign(limit, wanted), wanted)
@@ -187,7 +205,6 @@ class MotorBank:
         ctrl = np.where(saturated, command, p * target + pull)
         bias_q = np.where(saturated, 0.0, -k * p)
         bias_v = np.where(saturated, -k, -k * (1.0 + d))
-        torque = self.torque_mode[ids]
         if torque.any():
             ctrl = np.where(torque, self.torque[ids], ctrl)
             gain[torque] = 1.0
