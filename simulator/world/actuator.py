@@ -107,6 +107,9 @@ class ActuatorParams:
     line_slope: FloatArray  # N m per rad/s
     gain: FloatArray
     half_play: FloatArray  # half the backlash, rad
+    minus_half_play: FloatArray
+    has_play: npt.NDArray[np.bool_]
+    minus_motor_torque: FloatArray
 
 
 def _compact(values: list[int]) -> slice | IntArray:
@@ -140,4 +143,7 @@ def actuator_params(model: mujoco.MjModel, specs: Sequence[tuple[int, Any]]) -> 
         line_slope=array([c.motor_torque_nm / c.line_span_rad_s for c in constants]),
         gain=array([c.gain_nm_s_per_rad for c in constants]),
         half_play=array([s.backlash_rad / 2 for _, s in ordered]),
+        minus_half_play=array([-s.backlash_rad / 2 for _, s in ordered]),
+        has_play=np.array([s.backlash_rad > 0 for _, s in ordered], dtype=bool),
+        minus_motor_torque=array([-c.motor_torque_nm for c in constants]),
     )

@@ -76,7 +76,11 @@ class MotorBank:
         self._gain = model.actuator_gainprm[:, 0]
         self._bias_q = model.actuator_biasprm[:, 1]
         self._bias_v = model.actuator_biasprm[:, 2]
-        self._range = model.actuator_forcerange
+        self._range_lo = model.actuator_forcerange[:, 0]
+        self._range_hi = model.actuator_forcerange[:, 1]
+        self._any_velocity = False
+        self._any_torque = False
+        self._any_limp = False
 
     # --- commands ----------------------------------------------------------------------------
 
@@ -89,6 +93,7 @@ class MotorBank:
         self.torque_mode[actuator] = False
         if math.isinf(rad):
             self.velocity_mode[actuator] = True
+            self._any_velocity = True
             return
         self.velocity_mode[actuator] = False
         self.target[actuator] = min(max(rad, self.lower[actuator]), self.upper[actuator])
@@ -110,8 +115,12 @@ class MotorBank:
 
     def _targets_changed(self, actuators: slice | npt.NDArray[np.int64]) -> None:
         """New finite position targets for ``actuators``: position control."""
-        self.torque_mode[actuators] = False
-        self.velocity_mode[actuators] = False
+        if self._any_torque:
+            self.torque_mode[actuators] = False
+            self._any_torque = bool(self.torque_mode.any())
+        if self._any_velocity:
+            self.velocity_mode[actuators] = False
+            self._any_velocity = bool(self.velocity_mode.any())
 
     def position_writer(self, actuators: npt.NDArray[np.int64]) -> PositionWriter:
         """:meth:`set_positions` for a fixed set of distinct ``actuators`` (their limits
@@ -135,6 +144,7 @@ class MotorBank:
         limit = self.max_torque[actuator]
         self.torque[actuator] = min(max(nm, -limit), limit)
         self.torque_mode[actuator] = True
+        self._any_torque = True
 
     def set_pid(self, actuator: int, p: float, i: float, d: float) -> None:
         """Webots' ``setControlPID``: the gains of the position-to-velocity controller."""
@@ -149,6 +159,7 @@ class MotorBank:
 
     def set_limp(self, actuators: npt.NDArray[np.int64], limp: bool) -> None:
         self.limp[actuators] = limp
+        self._any_limp = bool(self.limp.any())
 
     def set_held(self, actuators: npt.NDArray[np.int64], positions: FloatArray | None) -> None:
         """Hold ``actuators`` at ``positions`` under position control whatever is commanded
@@ -162,8 +173,7 @@ class MotorBank:
         """Position control at ``positions`` (after a teleport or restore)."""
         self.target[actuators] = positions
         self.integral[actuators] = 0.0
-        self.torque_mode[actuators] = False
-        self.velocity_mode[actuators] = False
+        self._targets_changed(actuators)
 
     # --- per step ----------------------------------------------------------------------------
 
@@ -172,55 +182,73 @@ class MotorBank:
 
     def apply(self, data: mujoco.MjData) -> None:
         """Choose each actuator's mode and write gain, bias and ``ctrl`` for the next basic
-        step, from the joints' positions and velocities now."""
+        step, from the joints' positions and velocities now (about twenty numpy operations
+        on the arrays of all actuators; the rare modes only when some actuator is in them)."""
         ids, par = self._ids, self.params
         q = data.qpos[self._qpos]
         qdot = data.qvel[self._dof]
-        p, d = self.p[ids], self.d[ids]
+        p = self.p[ids]
         target = self.target[ids]
-        velocity = self.velocity_mode[ids]
-        torque = self.torque_mode[ids]
-        if self._any_held:
-            held = self.held[ids]
+        held = self.held[ids] if self._any_held else None
+        if held is not None:
             target = np.where(held, self.hold_target[ids], target)
             p = np.where(held, np.maximum(p, DEFAULT_P), p)
-            velocity = velocity & ~held
-            torque = torque & ~held
+        # backlash: within half the play of the target the gears do not touch; beyond it the
+        # controller acts on the error less that half
         error = target - q
-        loose = np.abs(error) <= par.half_play  # within the gear play: the gears do not touch
-        target = target - np.clip(error, -par.half_play, par.half_play)
+        shift = np.minimum(np.maximum(error, par.minus_half_play), par.half_play)
+        target = target - shift  # (a new array: ``self.target`` keeps the command)
+        error -= shift
+        wanted = p * error
+        pull: FloatArray | float = 0.0
         if self._any_integral:
-            self.integral[ids] += (target - q) * self._step_s
+            self.integral[ids] += error * self._step_s
             pull = self.i[ids] * self.integral[ids]
-        else:
-            pull = 0.0
-        wanted = p * (target - q) + pull - d * qdot
-        limit = self.velocity_limit[ids]
-        saturated = velocity | (np.abs(wanted) > limit)
-        command = np.where(
-            velocity, self.velocity[ids], np.where(saturated, np.copysign(limit, wanted), wanted)
-        )
+            wanted += pull
+        d = self.d[ids]
+        wanted -= d * qdot
         k = par.gain
+        limit = self.velocity_limit[ids]
+        saturated = np.abs(wanted) > limit
+        velocity = self.velocity_mode[ids] if self._any_velocity else None
+        if velocity is not None:
+            if held is not None:
+                velocity = velocity & ~held
+            saturated |= velocity
+        free = ~saturated
+        ctrl = p * target + pull
+        ctrl = np.where(saturated, np.copysign(limit, wanted), ctrl)
+        if velocity is not None:
+            ctrl = np.where(velocity, self.velocity[ids], ctrl)
         gain = k.copy()
-        ctrl = np.where(saturated, command, p * target + pull)
-        bias_q = np.where(saturated, 0.0, -k * p)
-        bias_v = np.where(saturated, -k, -k * (1.0 + d))
-        if torque.any():
+        bias_q = -k * p * free
+        bias_v = -k - k * d * free
+        torque = self.torque_mode[ids] if self._any_torque else None
+        if torque is not None:
+            if held is not None:
+                torque = torque & ~held
             ctrl = np.where(torque, self.torque[ids], ctrl)
             gain[torque] = 1.0
             bias_q[torque] = 0.0
             bias_v[torque] = 0.0
+        off = (error == 0.0) & par.has_play  # within the play (the shift took the whole error)
+        if velocity is not None:
+            off &= ~velocity
+        if torque is not None:
+            off &= ~torque
+        if self._any_limp:
+            off |= self.limp[ids]
+        gain[off] = 0.0
+        bias_q[off] = 0.0
+        bias_v[off] = 0.0
         # the torque-speed line at this speed bounds the force for the step: full torque
         # against the motion, the line's torque with it
-        drive = np.minimum(par.line_reach - par.line_slope * np.abs(qdot), par.motor_torque)
+        drive = par.line_reach - par.line_slope * np.abs(qdot)
+        np.minimum(drive, par.motor_torque, out=drive)
         np.maximum(drive, 0.0, out=drive)
-        self._range[ids, 1] = np.where(qdot > 0, drive, par.motor_torque)
-        self._range[ids, 0] = -np.where(qdot < 0, drive, par.motor_torque)
-        off = (loose & ~velocity & ~torque) | self.limp[ids]
-        if off.any():
-            gain[off] = 0.0
-            bias_q[off] = 0.0
-            bias_v[off] = 0.0
+        forward = qdot > 0
+        self._range_hi[ids] = np.where(forward, drive, par.motor_torque)
+        self._range_lo[ids] = np.where(forward, par.minus_motor_torque, -drive)
         self._gain[ids] = gain
         self._bias_q[ids] = bias_q
         self._bias_v[ids] = bias_v
