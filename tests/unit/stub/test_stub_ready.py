@@ -11,7 +11,6 @@ from robot.stub import GameInfo, Pose2D, Role, StubController
 
 from .motion_world import OneRobot
 
-
 GOALIE_DRIFT = pytest.mark.xfail(
     strict=True,
     reason="with the catalogue servos the goalie's 4 m READY walk drifts sideways and lands "
