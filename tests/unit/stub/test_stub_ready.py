@@ -14,7 +14,7 @@ from .motion_world import OneRobot
 GOALIE_DRIFT = pytest.mark.xfail(
     strict=True,
     reason="with the catalogue servos the goalie's 4 m READY walk drifts sideways and lands "
-    "0.8 m from its spot (odometry from the gait's command misses the drift); the gait is "
+    "about a metre from its spot (odometry from the gait's command misses the drift); the gait is "
     "not yet retuned for them",
 )
 
