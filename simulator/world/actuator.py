@@ -12,9 +12,11 @@ motor at full voltage) whenever the servo asks for more than the line gives. It 
 implicitly (stable for any link), but while it acts the servo's velocity feedback does not, so a
 position step missed the Webots trajectory by 16-77 % of the step on a light test lever
 (against 1-6 % with the force range for the MX and X servos on the same lever, 4 % for every
-catalogue servo on the lever of ``hlvs bench actuators``); the force range is what runs. Its limit: a link so light that the line's slope
-times the 8 ms step exceeds the link's inertia (``slope dt / I > 1``, far below any robot link
-with its servo's armature) chatters near the no-load speed.
+catalogue servo on the lever of ``hlvs bench actuators``); the force range is what runs. Its
+limit: a link so light that the line's slope times the 8 ms step exceeds the link's inertia
+(``slope dt / I > 1``, far below any robot link with its servo's armature) chatters near the
+no-load speed.
+
 Backlash (position control): within half the gear play of the target the gears do not touch
 and the servo gives no torque; beyond it the controller acts on the error less that half, so a
 load moves the joint across the whole play and holds it at the far side, as a real gear train
