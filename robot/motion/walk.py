@@ -45,6 +45,9 @@ class WalkParams:
     tilt_pitch_hip_gain: float = 0.0  # hip pitch per rad of torso pitch error
     tilt_roll_ankle_gain: float = 0.0  # ankle roll per rad of torso roll error
     tilt_roll_hip_gain: float = 0.0  # hip roll per rad of torso roll error
+    # distance walked per commanded distance (x, y), measured: the servos' lag and slip
+    stride_efficiency_x: float = 1.0
+    stride_efficiency_y: float = 1.0
 
 
 class WalkEngine:
@@ -66,8 +69,11 @@ class WalkEngine:
 
     @property
     def velocity(self) -> Vec3:
-        """Smoothed velocity the gait is currently producing (vx m/s, vy m/s, vyaw rad/s)."""
-        return self._v
+        """Velocity the gait is currently producing (vx m/s, vy m/s, vyaw rad/s): the smoothed
+        command times the measured stride efficiency, for odometry."""
+        vx, vy, vyaw = self._v
+        p = self.params
+        return (vx * p.stride_efficiency_x, vy * p.stride_efficiency_y, vyaw)
 
     @property
     def walking(self) -> bool:

@@ -10,7 +10,6 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from hlvs.commands.scrimmage_args import add_arguments
 
 from contracts.match_results import FailureClass, MatchReport
 from contracts.match_spec import TimingSpec
@@ -26,6 +25,7 @@ from contracts.timing import (
 )
 from envs.errors import EnvConfigError
 from envs.session_spec import SessionSpec
+from hlvs.commands.scrimmage_args import add_arguments
 from orchestrator.config.loader import load_game
 from orchestrator.errors import ConfigError
 from orchestrator.match.results import RobotRecord, play_failure

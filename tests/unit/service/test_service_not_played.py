@@ -13,8 +13,8 @@ from types import SimpleNamespace
 from typing import Any
 
 import pytest
-from cluster.fake import FakePool
 
+from cluster.fake import FakePool
 from service import Settings, notify
 from tests.integration.service.harness import Served
 from tests.unit.service.conftest import team_doc, wait_for_status
