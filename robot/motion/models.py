@@ -219,7 +219,7 @@ def _scaled_walk(scale: float) -> dict[str, float]:
         "hip_height_m": 0.30,
         "foot_x_offset_m": 0.01,
         "foot_y_offset_m": 0.02,
-        "max_vx_m_s": 0.2,
+        "max_vx_m_s": 0.3,
         "max_vy_m_s": 0.05,
     }
     out = {key: value * scale for key, value in lengths.items()}
