@@ -17,7 +17,7 @@ from robot.motion.walk import default_walk_params
 @dataclass(frozen=True, slots=True, kw_only=True)
 class KickParams:
     shift_m: float = 0.07  # torso over the support foot
-    lift_m: float = 0.05
+    lift_m: float = 0.07
     windup_x_m: float = -0.07
     strike_x_m: float = 0.18
     strike_lift_m: float = 0.035

@@ -230,10 +230,10 @@ def _scaled_walk(scale: float) -> dict[str, float]:
         torso_pitch_rad=0.05,
         tilt_pitch_ankle_gain=-0.2,
         tilt_pitch_hip_gain=-0.1,
-        # walked / commanded on kid-default with its catalogue servos and P = 30: 0.90-0.92
-        # straight ahead (how a striker walks to the ball and aims), 0.65 on the goalie's
-        # READY walk (turning as it goes), 0.94 sideways
-        stride_efficiency_x=0.9,
+        # walked / commanded on kid-default with its catalogue servos and P = 30: 0.84 straight
+        # ahead at 0.3 m/s (0.88 at 0.2 m/s), 0.76-0.80 at 0.3 m/s turning at up to 0.2 rad/s
+        # (how a striker walks to the ball), 0.6 at 0.2 m/s turning, 0.94 sideways
+        stride_efficiency_x=0.82,
         stride_efficiency_y=0.94,
     )
     return out
