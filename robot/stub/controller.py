@@ -56,9 +56,12 @@ KICK_HOLD_X_M = 0.12
 KICK_HOLD_Y_M = 0.08
 # READY and SET: the ball lies on the centre spot, a landmark that corrects the odometry (each
 # sighting nearer than this moves the believed position by the gain towards what it implies)
-CENTRE_BALL_MAX_M = 2.5
+CENTRE_BALL_MAX_M = 1.5  # farther, the ball's distance is underestimated by up to a third
 CENTRE_BALL_GAIN = 0.2
 SETTLE_S = 1.0  # stand still this long after start and after getting up
+# after a reset of the pose (half time, end of a penalty) the referee may still be placing the
+# robot: its orientation is taken from gravity afresh for this long, without counting turns
+RESET_HOLD_S = 0.6
 FIELD_HALF_LENGTH_M = {"kid": 4.5, "adult": 7.0}
 BALL_RADIUS_M = {"kid": 0.07, "adult": 0.1125}
 
@@ -155,7 +158,7 @@ class StubController:
         The robot was placed by the referee: a motion under way (a get-up when the half ended
         with the robot down) is dropped and the orientation is taken afresh from gravity."""
         self.world.reset_pose(pose)
-        self._heading = HeadingTracker()
+        self._heading = HeadingTracker(hold_s=RESET_HOLD_S)
         if self._motion is not None:
             self._motion = None
             self._motion_kind = ""
@@ -444,8 +447,12 @@ class HeadingTracker:
     once the robot stands again.
     """
 
-    def __init__(self, *, gain: float = 2.0) -> None:
+    def __init__(self, *, gain: float = 2.0, hold_s: float = 0.0) -> None:
+        """``hold_s``: for this long the orientation is taken afresh from gravity at every call
+        and no turn is reported (the referee is still placing the robot: the turns of a
+        teleport are no turns of the robot's own)."""
         self._gain = gain
+        self._hold_s = hold_s
         self._q: tuple[float, float, float, float] | None = None  # w, x, y, z: body -> world
         self._heading: float | None = None
 
@@ -455,6 +462,10 @@ class HeadingTracker:
             return None
         norm = math.sqrt(sum(a * a for a in accel)) if accel is not None else 0.0
         trusted = accel is not None and abs(norm - GRAVITY_M_S2) < 0.3 * GRAVITY_M_S2
+        if self._hold_s > 0.0:
+            self._hold_s -= dt_s
+            self._q = None
+            return 0.0
         if self._q is None:
             if not trusted or accel is None:
                 return gyro[2] * dt_s
