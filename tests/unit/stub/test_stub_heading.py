@@ -20,7 +20,8 @@ def _rotate(r: npt.NDArray[np.float64], omega: tuple[float, float, float], dt: f
     skew = np.array([[0.0, -wz, wy], [wz, 0.0, -wx], [-wy, wx, 0.0]])
     turned: npt.NDArray[np.float64] = r @ (np.eye(3) + skew * dt)
     u, _, vt = np.linalg.svd(turned)
-    return u @ vt
+    rotation: npt.NDArray[np.float64] = u @ vt
+    return rotation
 
 
 def _track(motions: list[tuple[tuple[float, float, float], float]]) -> tuple[float, float]:
