@@ -48,6 +48,7 @@ class WalkParams:
     # distance walked per commanded distance (x, y), measured: the servos' lag and slip
     stride_efficiency_x: float = 1.0
     stride_efficiency_y: float = 1.0
+    turn_stride_loss: float = 0.0  # fraction of the stride lost per rad/s of turning, measured
 
 
 class WalkEngine:
@@ -70,10 +71,11 @@ class WalkEngine:
     @property
     def velocity(self) -> Vec3:
         """Velocity the gait is currently producing (vx m/s, vy m/s, vyaw rad/s): the smoothed
-        command times the measured stride efficiency, for odometry."""
+        command times the measured stride efficiency (less while turning), for odometry."""
         vx, vy, vyaw = self._v
         p = self.params
-        return (vx * p.stride_efficiency_x, vy * p.stride_efficiency_y, vyaw)
+        turning = max(1.0 - p.turn_stride_loss * abs(vyaw), 0.5)
+        return (vx * p.stride_efficiency_x * turning, vy * p.stride_efficiency_y * turning, vyaw)
 
     @property
     def walking(self) -> bool:
