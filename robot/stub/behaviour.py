@@ -54,6 +54,7 @@ AIM_HALF_WIDTH_M = 0.8  # aim this close to the goal centre (posts at 1.3 m)
 # stands there), towards this point (fractions of the half length: 3 m, 1 m on the kid field)
 KICK_OFF_AIM = (0.67, 0.22)
 KICK_OFF_AIM_TOLERANCE_RAD = 0.12
+KICK_OFF_SHORT_M = 0.08  # READY: the ball this much farther than the kick spot (no touching)
 CENTRE_SPOT_M = 0.3  # a ball this close to the centre spot is a kick-off ball
 SEARCH_TURN_AFTER_S = 2.0
 DEFENDER_HOME = (-2.3, 0.0)  # when none is given
@@ -116,10 +117,12 @@ def _kick_off_position(
         return Pose2D(x, y, 0.0)
     if not game.our_kick_off:
         return Pose2D(-1.0, 0.0, 0.0)
-    # behind the centre spot on the line of the kick-off pass, facing along it
+    # facing along the kick-off pass, the ball a little short of the left foot's kick spot
     ax, ay = _kick_off_aim(field)
     direction = math.atan2(ay, ax)
-    return Pose2D(-BEHIND_M * math.cos(direction), -BEHIND_M * math.sin(direction), direction)
+    c, s = math.cos(direction), math.sin(direction)
+    ahead, left = field.kick_x_m + KICK_OFF_SHORT_M, field.foot_y_m
+    return Pose2D(-(c * ahead - s * left), -(s * ahead + c * left), direction)
 
 
 def _defender(

@@ -48,11 +48,16 @@ def test_opponents_kick_off_ball_is_shot_at_the_goal() -> None:
     assert _striker(theirs, _lined_up(0.0, (0.0, 0.0)), (0.0, 0.0)).kick_foot == "right"
 
 
-def test_ready_spot_for_the_own_kick_off_is_behind_the_ball_on_the_pass_line() -> None:
+def test_ready_spot_for_the_own_kick_off_faces_the_pass_with_the_ball_short_of_a_kick() -> None:
     ready = GameInfo(phase=GameState.READY, our_kick_off=True)
     diagonal = math.atan2(0.22, 0.67)
-    spot = Pose2D(-0.35 * math.cos(diagonal), -0.35 * math.sin(diagonal), diagonal)
-    assert _striker(ready, spot, (0.0, 0.0)).stands
+    # the ball 8 cm farther than the kick spot, in front of the left foot
+    ahead, left = FIELD.kick_x_m + 0.08, FIELD.foot_y_m
+    c, s = math.cos(diagonal), math.sin(diagonal)
+    left_foot = Pose2D(-(c * ahead - s * left), -(s * ahead + c * left), diagonal)
+    assert _striker(ready, left_foot, (0.0, 0.0)).stands
+    bx, by = left_foot.to_relative(0.0, 0.0)
+    assert bx == pytest.approx(ahead) and by == pytest.approx(left)
     assert not _striker(ready, Pose2D(-0.35, 0.0, 0.0), (0.0, 0.0)).stands
 
 
