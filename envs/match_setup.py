@@ -87,6 +87,7 @@ def match_spec(spec: SessionSpec, seed: int) -> MatchSpec:
 def build_match(
     spec: SessionSpec, *, seed: int, clock: Any
 ) -> tuple[World, Referee, list[StubRobot]]:
+    from robot.motion import SERVO_PID
     from robot.stub.behaviour import Role
     from robot.stub.controller import StubController
     from robot.stub.world_model import Pose2D
@@ -120,6 +121,9 @@ def build_match(
                                controller=controller))  # fmt: skip
         if stub.role == "idle":
             stubs.pop()
+            continue
+        for name in world.motor_names(stubs[-1].id):  # the gains the stub's motions expect
+            world.set_motor_pid(stubs[-1].id, name, *SERVO_PID)
     return world, referee, stubs
 
 

@@ -49,9 +49,11 @@ class ModelProblem:
     source: str
     where: str  # JSON pointer in the manifest, or the element / link / rule
     reason: str
+    severity: str = "error"  # or "warning": allowed in friendlies, refused in official matches
 
     def __str__(self) -> str:
-        return f"{self.source}: {self.where or '/'}: {self.reason}"
+        text = f"{self.source}: {self.where or '/'}: {self.reason}"
+        return f"warning: {text}" if self.severity == "warning" else text
 
 
 class ModelError(SimulatorError):

@@ -72,6 +72,7 @@ def run_shot(*, seed: int, time_limit_s: float, goalie: bool) -> ShotResult:
     from contracts.gamecontroller import GameState
     from contracts.ids import RobotId, TeamColor
     from referee.snapshot import PlaceBall
+    from robot.motion import SERVO_PID
     from robot.stub.behaviour import GameInfo, Role
     from robot.stub.controller import StubController
     from robot.stub.world_model import Pose2D
@@ -91,6 +92,9 @@ def run_shot(*, seed: int, time_limit_s: float, goalie: bool) -> ShotResult:
         players.append((keeper, StubController(role=Role.GOALIE, start_pose=Pose2D(-gx, 0, 0))))
     world = World.create(field_class="kid", robots=placements, seed=seed)
     world.apply(PlaceBall(position=(ball[0], ball[1], world.field.ball_radius_m)))
+    for robot, _ in players:
+        for name in world.motor_names(robot):
+            world.set_motor_pid(robot, name, *SERVO_PID)
     game = GameInfo(phase=GameState.PLAYING)
     ball_body = world.model.body("ball").id
     steps = int(time_limit_s * 1000 / world.step_ms)

@@ -75,6 +75,12 @@ def register(sub: Any) -> None:
         "shown as annotations on a pull request (default: text)",
     )
     parser.add_argument("--json", action="store_true", help="same as --format json")
+    parser.add_argument(
+        "--official",
+        action="store_true",
+        help="robot model packages as for an official match: free-form servos and gains "
+        "(no catalogue servo) are errors, not warnings",
+    )
     parser.set_defaults(func=run)
 
 
@@ -125,6 +131,7 @@ def run(args: argparse.Namespace) -> int:
             kind=args.kind,
             field_class=FieldClass(args.field_class.lower()) if args.field_class else None,
             images_required=args.require_images,
+            official=args.official,
         )
         for name in args.files
     ]
@@ -163,13 +170,14 @@ def check_report(
     kind: Kind | None = None,
     field_class: FieldClass | None = None,
     images_required: bool = False,
+    official: bool = False,
 ) -> FileReport:
     """Check one file (or robot model package) and return every problem found (nothing
-    printed)."""
+    printed); ``official``: model packages as for an official match."""
     from orchestrator.config.robot_models import check_model, is_model_package
 
     if is_model_package(path):
-        problems, measurements = check_model(path)
+        problems, measurements = check_model(path, official=official)
         return FileReport(str(path), "robot model", problems, measurements)
     try:
         found_kind, problems = _check(

@@ -68,6 +68,10 @@ def register(sub: Any) -> None:
         func=_models,
     )
     forward(
+        kinds, "actuators", help="catalogue servos in the simulator against their datasheets "
+        "and Webots' motor model (JSON)", func=_actuators,
+    )
+    forward(
         kinds, "viewer", help="the web viewer: open and play a 2 x 10 min 4 v 4 replay (JSON)",
         func=_viewer,
     )
@@ -128,6 +132,13 @@ def _models(args: argparse.Namespace) -> int:
     from benchmarks.models import main as models_main
 
     return int(models_main(list(args.rest)))
+
+
+def _actuators(args: argparse.Namespace) -> int:
+    os.environ["HLVS_PROG"] = "hlvs"
+    from benchmarks.actuators import main as actuators_main
+
+    return int(actuators_main(list(args.rest)))
 
 
 def _cli(args: argparse.Namespace) -> int:

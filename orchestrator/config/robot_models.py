@@ -44,19 +44,24 @@ def spec_model(model: str) -> str:
     return container_path(model) if is_model_path(model) else model
 
 
-def check_model(path: Path) -> tuple[list[Problem], dict[str, Any] | None]:
-    """Problems and measurements of a model package (None when it cannot even be loaded).
-    Imports the simulator's model loader (and MuJoCo) on first use."""
+def check_model(
+    path: Path, *, official: bool = False
+) -> tuple[list[Problem], dict[str, Any] | None]:
+    """Problems and measurements of a model package (None when it cannot even be loaded);
+    free-form servos are warnings, or errors when ``official``. Imports the simulator's model
+    loader (and MuJoCo) on first use."""
     from simulator.errors import ModelError
     from simulator.world.robots.team import load_team_model
     from simulator.world.robots.team.rulebook import check
 
     folder = path if path.is_dir() else path.parent
     try:
-        measurements, found = check(load_team_model(folder))
+        measurements, found = check(load_team_model(folder), official=official)
     except ModelError as exc:
         return [Problem(p.source, p.where, p.reason) for p in exc.problems], None
-    return [Problem(p.source, p.where, p.reason) for p in found], measurements.to_json()
+    return [
+        Problem(p.source, p.where, p.reason, severity=p.severity) for p in found
+    ], measurements.to_json()
 
 
 def describe(measurements: dict[str, Any]) -> str:

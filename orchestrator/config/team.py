@@ -143,7 +143,9 @@ def _resolve_models(
             )
             continue
         if folder not in checked:
-            checked[folder] = [str(problem) for problem in check_model(folder)[0]]
+            checked[folder] = [
+                str(problem) for problem in check_model(folder)[0] if problem.severity == "error"
+            ]
         for problem in checked[folder]:
             where.error(at, f"the robot model cannot be used: {problem}")
         out.append(replace(player, model=str(folder)))

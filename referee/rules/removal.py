@@ -3,8 +3,10 @@
 A removed robot is placed at its re-entry pose: x on the penalty-mark line of its own half, y at
 the touch line on the side opposite to the ball (the y of its ``reentryStartingPose``, sign
 chosen away from the ball), shifted along the line by the penalty offset when another robot
-stands there. It is made limp (actuators off) until the GameController's penalty time is over,
-then its actuators are re-enabled and it walks back in by itself. A red card removes the robot
+stands there. It is taken out of its team's control (``SetLimp``: the world holds it in its
+standing pose, as a referee carries a removed robot, so it neither folds up nor counts a fall)
+until the GameController's penalty time is over, then its team's commands apply again and it
+walks back in by itself. A red card removes the robot
 from the world.
 """
 

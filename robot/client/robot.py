@@ -138,6 +138,13 @@ class RobotClient:
             request.sensor_time_steps.add(name=name, timeStep=period)
         self.send(request)
 
+    def set_pids(self, gains: Mapping[str, tuple[float, float, float]]) -> None:
+        """Webots' ``setControlPID`` per motor: ``{name: (P, I, D)}``."""
+        request = pb.ActuatorRequests()
+        for name, (p, i, d) in gains.items():
+            request.motor_pids.add(name=name, PID=pb.Vector3(X=p, Y=i, Z=d))
+        self.send(request)
+
     def set_positions(self, positions_rad: Mapping[str, float]) -> None:
         request = pb.ActuatorRequests()
         for name, position in positions_rad.items():

@@ -12,9 +12,11 @@ from robot.motion.keyframes import Keyframe, KeyframeMotion
 from robot.motion.kick import KickMotion
 from robot.motion.models import RobotKinematics, kinematics, known_models
 from robot.motion.posture import standing_posture
+from robot.motion.servo import SERVO_PID
 from robot.motion.walk import WalkEngine, WalkParams, default_walk_params
 
 __all__ = [
+    "SERVO_PID",
     "Attitude",
     "AttitudeFilter",
     "GetUpMotion",

@@ -17,9 +17,9 @@ from robot.motion.walk import default_walk_params
 @dataclass(frozen=True, slots=True, kw_only=True)
 class KickParams:
     shift_m: float = 0.07  # torso over the support foot
-    lift_m: float = 0.05
+    lift_m: float = 0.07
     windup_x_m: float = -0.07
-    strike_x_m: float = 0.14
+    strike_x_m: float = 0.18
     strike_lift_m: float = 0.035
     shift_s: float = 0.6
     lift_s: float = 0.3

@@ -45,6 +45,10 @@ class WalkParams:
     tilt_pitch_hip_gain: float = 0.0  # hip pitch per rad of torso pitch error
     tilt_roll_ankle_gain: float = 0.0  # ankle roll per rad of torso roll error
     tilt_roll_hip_gain: float = 0.0  # hip roll per rad of torso roll error
+    # distance walked per commanded distance (x, y), measured: the servos' lag and slip
+    stride_efficiency_x: float = 1.0
+    stride_efficiency_y: float = 1.0
+    turn_stride_loss: float = 0.0  # fraction of the stride lost per rad/s of turning, measured
 
 
 class WalkEngine:
@@ -66,8 +70,12 @@ class WalkEngine:
 
     @property
     def velocity(self) -> Vec3:
-        """Smoothed velocity the gait is currently producing (vx m/s, vy m/s, vyaw rad/s)."""
-        return self._v
+        """Velocity the gait is currently producing (vx m/s, vy m/s, vyaw rad/s): the smoothed
+        command times the measured stride efficiency (less while turning), for odometry."""
+        vx, vy, vyaw = self._v
+        p = self.params
+        turning = max(1.0 - p.turn_stride_loss * abs(vyaw), 0.5)
+        return (vx * p.stride_efficiency_x * turning, vy * p.stride_efficiency_y * turning, vyaw)
 
     @property
     def walking(self) -> bool:

@@ -47,8 +47,15 @@ STAND = Action()
 APPROACH_M = 0.55  # nearer than this the striker lines up and kicks
 BEHIND_M = 0.35  # where it heads for: this far behind the ball, on the goal line through it
 ROUND_M = 0.5  # how wide it goes round a ball it is in front of
-FAST_M_S = 0.2
+FAST_M_S = 0.3
 AIM_HALF_WIDTH_M = 0.8  # aim this close to the goal centre (posts at 1.3 m)
+# At its own kick-off the striker plays the ball diagonally forward, past the opponents' kick-off
+# spot in front of the centre circle (a ball kicked straight at the goal hits the opponent who
+# stands there), towards this point (fractions of the half length: 3 m, 1 m on the kid field)
+KICK_OFF_AIM = (0.67, 0.22)
+KICK_OFF_AIM_TOLERANCE_RAD = 0.12
+KICK_OFF_SHORT_M = 0.08  # READY: the ball this much farther than the kick spot (no touching)
+CENTRE_SPOT_M = 0.3  # a ball this close to the centre spot is a kick-off ball
 SEARCH_TURN_AFTER_S = 2.0
 DEFENDER_HOME = (-2.3, 0.0)  # when none is given
 DEFENDER_ENGAGE_M = 1.2  # a defender plays a ball this close to its home spot
@@ -89,7 +96,15 @@ def decide(
         return _goalie(pose, ball, field, searching_s)
     if role is Role.DEFENDER:
         return _defender(pose, ball, field, searching_s, home or DEFENDER_HOME)
+    if game.our_kick_off and ball is not None:
+        ball_field = pose.to_field(*ball)
+        if math.hypot(*ball_field) < CENTRE_SPOT_M:
+            return _striker(pose, ball, field, searching_s, aim=_kick_off_aim(field))
     return _striker(pose, ball, field, searching_s)
+
+
+def _kick_off_aim(field: Field) -> tuple[float, float]:
+    return KICK_OFF_AIM[0] * field.half_length_m, KICK_OFF_AIM[1] * field.half_length_m
 
 
 def _kick_off_position(
@@ -100,7 +115,14 @@ def _kick_off_position(
     if role is Role.DEFENDER:
         x, y = home or DEFENDER_HOME
         return Pose2D(x, y, 0.0)
-    return Pose2D(-0.35 if game.our_kick_off else -1.0, 0.0, 0.0)
+    if not game.our_kick_off:
+        return Pose2D(-1.0, 0.0, 0.0)
+    # facing along the kick-off pass, the ball a little short of the left foot's kick spot
+    ax, ay = _kick_off_aim(field)
+    direction = math.atan2(ay, ax)
+    c, s = math.cos(direction), math.sin(direction)
+    ahead, left = field.kick_x_m + KICK_OFF_SHORT_M, field.foot_y_m
+    return Pose2D(-(c * ahead - s * left), -(s * ahead + c * left), direction)
 
 
 def _defender(
@@ -139,8 +161,14 @@ def _go_to(pose: Pose2D, target: Pose2D, *, tolerance_m: float = 0.2) -> Action:
 
 
 def _striker(
-    pose: Pose2D, ball: tuple[float, float] | None, field: Field, searching_s: float
+    pose: Pose2D,
+    ball: tuple[float, float] | None,
+    field: Field,
+    searching_s: float,
+    *,
+    aim: tuple[float, float] | None = None,
 ) -> Action:
+    """Play the ball towards ``aim`` (field frame; default the opponent goal's centre)."""
     if ball is None:
         return _search(searching_s)
     bx, by = ball
@@ -148,7 +176,8 @@ def _striker(
     bearing = math.atan2(by, bx)
     # direction from the ball to the opponent goal centre, relative to the robot's heading
     ball_field = pose.to_field(bx, by)
-    goal_dx, goal_dy = field.half_length_m - ball_field[0], 0.0 - ball_field[1]
+    aim_x, aim_y = aim if aim is not None else (field.half_length_m, 0.0)
+    goal_dx, goal_dy = aim_x - ball_field[0], aim_y - ball_field[1]
     heading_error = _wrap(math.atan2(goal_dy, goal_dx) - pose.yaw_rad)
     ux, uy = math.cos(heading_error), math.sin(heading_error)
     behind = -(bx * ux + by * uy) < -0.1  # the robot is on the far side of the ball from goal
@@ -165,6 +194,8 @@ def _striker(
         )
     # the farther the goal, the straighter the kick must be to land between the posts
     aim_tolerance = min(max(math.atan2(AIM_HALF_WIDTH_M, math.hypot(goal_dx, goal_dy)), 0.12), 0.3)
+    if aim is not None:
+        aim_tolerance = KICK_OFF_AIM_TOLERANCE_RAD
     foot = "left" if by > 0 else "right"
     if foot not in field.kick_feet:
         foot = field.kick_feet[0]

@@ -14,6 +14,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import numpy.typing as npt
 
+from contracts.gamecontroller import GameState
 from robot.learned import Policy, PolicyMotion
 from robot.learned.policy import KICK_BALL_AHEAD_M
 from robot.motion import AttitudeFilter, GetUpMotion, KickMotion, WalkEngine, kinematics
@@ -44,8 +45,23 @@ SIDE_LOOK_PITCH_RAD = -0.15  # slightly up: goal posts stand above the horizon
 SIDE_MIN_PIXELS = 30
 KNEE_RESET_RAD = 0.5  # knee this far from its target: the robot was reset or is limp
 KICK_SETTLE_S = 0.5  # stand still this long before a kick
-KICK_COMMIT_MS = 1500  # keep to a kick decided this long ago while the ball stays in reach
+# where the keyframe kick wants the ball across: this far outside the kicking sole's centre (a
+# ball 1.5 cm inside it is struck by the sole's inner edge and flies off up to 0.4 rad inwards;
+# up to 6 cm outside it still goes straight)
+KICK_BALL_OUTSIDE_M = 0.02
+KICK_COMMIT_MS = 2500  # keep to a kick decided this long ago while the ball stays in reach
+# ... within this much of the kick spot: while the gait comes to a stop the body sways and the
+# ball estimate jumps by several centimetres; re-aligning on it restarts the gait for ever
+KICK_HOLD_X_M = 0.12
+KICK_HOLD_Y_M = 0.08
+# READY and SET: the ball lies on the centre spot, a landmark that corrects the odometry (each
+# sighting nearer than this moves the believed position by the gain towards what it implies)
+CENTRE_BALL_MAX_M = 1.5  # farther, the ball's distance is underestimated by up to a third
+CENTRE_BALL_GAIN = 0.2
 SETTLE_S = 1.0  # stand still this long after start and after getting up
+# after a reset of the pose (half time, end of a penalty) the referee may still be placing the
+# robot: its orientation is taken from gravity afresh for this long, without counting turns
+RESET_HOLD_S = 0.6
 FIELD_HALF_LENGTH_M = {"kid": 4.5, "adult": 7.0}
 BALL_RADIUS_M = {"kid": 0.07, "adult": 0.1125}
 
@@ -99,12 +115,17 @@ class StubController:
         self._ball_radius_m = BALL_RADIUS_M[field_class]
         self.field = Field(
             half_length_m=FIELD_HALF_LENGTH_M[field_class],
-            foot_y_m=self.kin.leg.hip_offset_y_m + walk.foot_y_offset_m,
+            foot_y_m=self.kin.leg.hip_offset_y_m + walk.foot_y_offset_m + KICK_BALL_OUTSIDE_M,
             kick_x_m=0.165 * self.kin.leg.thigh_m / 0.16,
         )
         self.kick_policy = kick_policy
         if kick_policy is not None:
-            self.field = replace(self.field, kick_x_m=KICK_BALL_AHEAD_M, kick_feet=("right",))
+            self.field = replace(
+                self.field,
+                foot_y_m=self.kin.leg.hip_offset_y_m + walk.foot_y_offset_m,
+                kick_x_m=KICK_BALL_AHEAD_M,
+                kick_feet=("right",),
+            )
         self._last_ms: int | None = None
         self._settle_until_ms: int | None = None
         self._still_s = 0.0
@@ -137,7 +158,7 @@ class StubController:
         The robot was placed by the referee: a motion under way (a get-up when the half ended
         with the robot down) is dropped and the orientation is taken afresh from gravity."""
         self.world.reset_pose(pose)
-        self._heading = HeadingTracker()
+        self._heading = HeadingTracker(hold_s=RESET_HOLD_S)
         if self._motion is not None:
             self._motion = None
             self._motion_kind = ""
@@ -248,7 +269,10 @@ class StubController:
             turned_rad=self._heading.heading_change(dt, sensors.accel, sensors.gyro),
         )
         if sensors.image_bgr is not None and upright and self._motion is None:
-            self._look(sensors)
+            seen = self._look(sensors)
+            on_centre_spot = game.phase in (GameState.READY, GameState.SET) and not game.penalised
+            if seen is not None and on_centre_spot and math.hypot(*seen) < CENTRE_BALL_MAX_M:
+                self.world.relocate_from_centre_ball(*seen, gain=CENTRE_BALL_GAIN)
         if self._motion is None and self._moved_by_someone_else(sensors.joints):
             # teleported (half time, penalty) or limp: joints are not where we put them
             self.settle(sensors.time_ms)
@@ -340,12 +364,13 @@ class StubController:
             return action
         bx, by = ball
         side = self.field.foot_y_m if committed[0] == "left" else -self.field.foot_y_m
-        if abs(bx - self.field.kick_x_m) < 0.08 and abs(by - side) < 0.06:
+        if abs(bx - self.field.kick_x_m) < KICK_HOLD_X_M and abs(by - side) < KICK_HOLD_Y_M:
             return Action(kick_foot=committed[0])
         self._kick_committed = None
         return action
 
-    def _look(self, sensors: Sensors) -> None:
+    def _look(self, sensors: Sensors) -> tuple[float, float] | None:
+        """Look for the ball in the image; the sighting (robot frame) or None."""
         image = sensors.image_bgr
         assert image is not None
         att = self.attitude.attitude
@@ -369,7 +394,8 @@ class StubController:
             if seen is not None and seen.distance_m < 8.0:
                 self.world.see_ball(sensors.time_ms, seen.x_m, seen.y_m)
                 self.stats.ball_sightings += 1
-                return
+                return seen.x_m, seen.y_m
+        return None
 
     def _head(
         self, dt: float, ball: tuple[float, float] | None, action: Action, torso_pitch: float
@@ -421,8 +447,12 @@ class HeadingTracker:
     once the robot stands again.
     """
 
-    def __init__(self, *, gain: float = 2.0) -> None:
+    def __init__(self, *, gain: float = 2.0, hold_s: float = 0.0) -> None:
+        """``hold_s``: for this long the orientation is taken afresh from gravity at every call
+        and no turn is reported (the referee is still placing the robot: the turns of a
+        teleport are no turns of the robot's own)."""
         self._gain = gain
+        self._hold_s = hold_s
         self._q: tuple[float, float, float, float] | None = None  # w, x, y, z: body -> world
         self._heading: float | None = None
 
@@ -432,6 +462,10 @@ class HeadingTracker:
             return None
         norm = math.sqrt(sum(a * a for a in accel)) if accel is not None else 0.0
         trusted = accel is not None and abs(norm - GRAVITY_M_S2) < 0.3 * GRAVITY_M_S2
+        if self._hold_s > 0.0:
+            self._hold_s -= dt_s
+            self._q = None
+            return 0.0
         if self._q is None:
             if not trusted or accel is None:
                 return gyro[2] * dt_s

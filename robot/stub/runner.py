@@ -24,7 +24,7 @@ from contracts.robot_api import messages_pb2 as pb
 from robot.client import ConnectionClosed, RobotClient, RobotClientError
 from robot.client.errors import ReceiveTimeout
 from robot.learned import Policy, PolicyFileError, load_policy
-from robot.motion import kinematics
+from robot.motion import SERVO_PID, kinematics
 from robot.stub.behaviour import GameInfo, Role
 from robot.stub.controller import Sensors, StubController
 from robot.stub.errors import StubConfigError
@@ -158,6 +158,7 @@ class StubRobot:
             if self.controller.role is not Role.IDLE:
                 periods["Camera"] = CAMERA_PERIOD_MS
             client.enable_many(periods)
+            client.set_pids({name: SERVO_PID for name in self._motors})
             if self.options.behaviour is Behaviour.FLOOD:
                 self._spawn("flood-simulator", functools.partial(self._flood_simulator, client))
             return client

@@ -76,6 +76,14 @@ class WorldModel:
         self.ball_field = self.pose.to_field(x_rel_m, y_rel_m)
         self.ball_seen_ms = time_ms
 
+    def relocate_from_centre_ball(self, x_rel_m: float, y_rel_m: float, *, gain: float) -> None:
+        """The ball, seen at ``(x_rel_m, y_rel_m)``, lies on the centre spot (as it does in
+        READY and SET): move the believed position by ``gain`` of the way to where that sighting
+        puts the robot (the heading stays the gyro's)."""
+        fx, fy = self.pose.to_field(x_rel_m, y_rel_m)
+        self.pose = Pose2D(self.pose.x_m - gain * fx, self.pose.y_m - gain * fy, self.pose.yaw_rad)
+        self.ball_field = self.pose.to_field(x_rel_m, y_rel_m)
+
     def ball_relative(self, time_ms: int, *, max_age_ms: int) -> tuple[float, float] | None:
         if self.ball_field is None or self.ball_seen_ms is None:
             return None

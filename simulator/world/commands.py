@@ -89,10 +89,15 @@ def teleport(world: CommandTarget, number: int, x: float, y: float, yaw: float) 
 
 
 def set_limp(world: CommandTarget, number: int, limp: bool) -> None:
+    """Take the robot out of its team's control (``limp``) or give it back. While out of
+    control (a penalised robot at its re-entry spot) the world holds it in its standing pose,
+    as a referee carries a removed robot, instead of letting it fold up and fall: its team's
+    motor commands wait until it is released (:mod:`simulator.api.session`)."""
     robot = world.index.robots[number]
     world.limp[number] = limp
-    world.motors.set_limp(robot.actuators, limp)
-    logger.info("%s %s", robot.id, "limp" if limp else "under control again")
+    pose = np.asarray(robot.model.standing_pose_rad, dtype=float) if limp else None
+    world.motors.set_held(robot.actuators, pose)
+    logger.info("%s %s", robot.id, "held out of play" if limp else "under control again")
 
 
 def remove(world: CommandTarget, number: int) -> None:
@@ -113,12 +118,10 @@ def remove(world: CommandTarget, number: int) -> None:
 def restore(world: CommandTarget, number: int, x: float, y: float, yaw: float) -> None:
     robot = world.index.robots[number]
     if world.removed[number]:
-        bit = 1 << number
-        from simulator.world.scene import BALL_BIT, STATIC_BIT
+        from simulator.world.scene import robot_conaffinity
 
-        all_robots = (1 << len(world.robot_ids)) - 1
-        world.model.geom_contype[robot.geoms] = bit
-        world.model.geom_conaffinity[robot.geoms] = (all_robots & ~bit) | STATIC_BIT | BALL_BIT
+        world.model.geom_contype[robot.geoms] = 1 << number
+        world.model.geom_conaffinity[robot.geoms] = robot_conaffinity(len(world.robot_ids))
         world.removed[number] = False
         world.parked_qpos.pop(number, None)
         logger.info("%s restored", robot.id)

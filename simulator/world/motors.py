@@ -1,12 +1,20 @@
-"""Motor control state of every actuator: position targets with a velocity limit, torque mode,
-PID gains, limp robots. Applied to MuJoCo's ``ctrl`` and actuator gains once per basic step.
+"""Motor control of every actuator as the league's Webots motors behave, with the servo's own
+limits (:mod:`simulator.world.actuator` builds the MuJoCo actuator and says why).
 
-A position actuator produces ``kp * (ctrl - q) - kv * qdot`` (clipped to the motor's torque
-range). Torque mode sets gain 1 and no bias so ``ctrl`` is the torque. Limp robots get zero gain
-and bias (only passive joint damping remains). Webots-style PID: ``P`` scales the stiffness
-relative to the default ``P = 10`` (``kp = model_kp * P / 10``), ``D`` sets the damping
-``kv = model_kp * D / 10`` (N m s/rad; the model's default kv corresponds to ``D = 0.05``);
-``I`` is stored but has no effect.
+Position control (Webots' ``RotationalMotor``): the controller turns the position error into a
+target velocity ``v = P e + I integral(e) + D de/dt`` (``P`` default 10, ``I`` and ``D`` 0),
+bounded by the velocity limit (``setVelocity``, at most the servo's no-load speed), and the
+servo drives the joint towards ``v`` with at most the torque its torque-speed line gives at the
+joint's speed. ``setPosition(+-inf)`` is velocity control (the signed ``setVelocity`` value);
+``setTorque`` is torque control (clamped to the stall torque, the line still applies); a limp
+robot's actuators give no torque (the joint's friction and damping remain).
+
+Backlash: see :mod:`simulator.world.actuator`. Per basic step (``step_ms``)
+:meth:`MotorBank.apply` chooses each actuator's mode and writes its
+gain, bias and ``ctrl``: unsaturated position control is the affine law
+``K (P (target - q) + I integral - (1 + D) qdot)`` evaluated by MuJoCo every substep (exact for
+the linear part), saturated position control and velocity control are ``K (v - qdot)``; the
+force range is the motor's torque-speed line at the joint's speed.
 """
 
 from __future__ import annotations
@@ -19,90 +27,100 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 
-from simulator.world.indices import WorldIndex
+from simulator.world.actuator import ActuatorParams, actuator_params
 
 logger = logging.getLogger(__name__)
 
 FloatArray = npt.NDArray[np.float64]
-DEFAULT_P = 10.0
+DEFAULT_P = 10.0  # Webots' default controlPID P (1/s)
 
 
 class MotorBank:
-    def __init__(self, model: mujoco.MjModel, index: WorldIndex, step_s: float) -> None:
+    """Commands and per-step control of the actuators listed in ``specs`` (actuator id and the
+    motor's :class:`simulator.world.robots.model.MotorSpec`); other actuators are left alone."""
+
+    def __init__(
+        self, model: mujoco.MjModel, specs: Sequence[tuple[int, object]], step_s: float
+    ) -> None:
         self._model = model
         self._step_s = step_s
         nu = model.nu
-        self.default_kp = np.zeros(nu)
-        self.default_kv = np.zeros(nu)
+        params: ActuatorParams = actuator_params(model, specs)
+        self.params = params
+        self._ids = params.actuators
+        self._qpos = params.qpos
+        self._dof = params.dof
         self.max_torque = np.zeros(nu)
         self.max_velocity = np.zeros(nu)
-        self.lower = np.zeros(nu)
-        self.upper = np.zeros(nu)
-        for robot in index.robots:
-            for slot, spec in enumerate(robot.model.motors):
-                a = robot.actuators[slot]
-                self.default_kp[a] = spec.kp_nm_per_rad
-                self.default_kv[a] = spec.kv_nm_s_per_rad
-                self.max_torque[a] = spec.max_torque_nm
-                self.max_velocity[a] = spec.max_velocity_rad_s
-                self.lower[a] = spec.lower_rad
-                self.upper[a] = spec.upper_rad
-        self.kp = self.default_kp.copy()
-        self.kv = self.default_kv.copy()
-        self.ki = np.zeros(nu)
+        self.lower = np.full(nu, -np.inf)
+        self.upper = np.full(nu, np.inf)
+        self.max_torque[self._ids] = params.max_torque
+        self.max_velocity[self._ids] = params.max_velocity
+        self.lower[self._ids] = params.lower
+        self.upper[self._ids] = params.upper
+        self.p = np.full(nu, DEFAULT_P)
+        self.i = np.zeros(nu)
+        self.d = np.zeros(nu)
+        self.integral = np.zeros(nu)
+        self._any_integral = False
         self.velocity_limit = self.max_velocity.copy()
         self.target = np.zeros(nu)
-        self.effective = np.zeros(nu)
+        self.velocity_mode = np.zeros(nu, dtype=bool)
+        self.velocity = np.zeros(nu)  # signed, for velocity mode
         self.torque = np.zeros(nu)
         self.torque_mode = np.zeros(nu, dtype=bool)
-        self._any_torque = False  # some actuator is in torque mode
         self.limp = np.zeros(nu, dtype=bool)
-        self._dirty = True  # gains must be written
-        self._ctrl_dirty = True  # ctrl must be written
-        self._ramping = True  # some effective target still moves towards its command
+        self.held = np.zeros(nu, dtype=bool)  # held by the world: commands wait
+        self.hold_target = np.zeros(nu)
+        self._any_held = False
+        self._gain = model.actuator_gainprm[:, 0]
+        self._bias_q = model.actuator_biasprm[:, 1]
+        self._bias_v = model.actuator_biasprm[:, 2]
+        self._range_lo = model.actuator_forcerange[:, 0]
+        self._range_hi = model.actuator_forcerange[:, 1]
+        self._any_velocity = False
+        self._any_torque = False
+        self._any_limp = False
 
     # --- commands ----------------------------------------------------------------------------
 
     def set_position(self, actuator: int, rad: float) -> None:
-        if not math.isfinite(rad):
-            logger.debug("ignored non-finite position %r for actuator %d", rad, actuator)
+        """A position target (clamped to the joint range); ``+-inf`` selects velocity control
+        as in Webots; NaN is ignored."""
+        if math.isnan(rad):
+            logger.debug("ignored NaN position for actuator %d", actuator)
             return
+        self.torque_mode[actuator] = False
+        if math.isinf(rad):
+            self.velocity_mode[actuator] = True
+            self._any_velocity = True
+            return
+        self.velocity_mode[actuator] = False
         self.target[actuator] = min(max(rad, self.lower[actuator]), self.upper[actuator])
-        self._ramping = True
-        if self.torque_mode[actuator]:
-            self.torque_mode[actuator] = False
-            self._dirty = True
 
     def set_positions(
         self, actuators: slice | npt.NDArray[np.int64], rads: Sequence[float] | FloatArray
     ) -> None:
-        """:meth:`set_position` for distinct ``actuators`` (a slice or an index array) at once;
-        non-finite values are ignored."""
-        total = rads.sum() if type(rads) is np.ndarray else sum(rads)
-        if not math.isfinite(total):  # a NaN or infinity somewhere (or a huge sum)
-            values = np.asarray(rads, dtype=np.float64)
-            finite = np.isfinite(values)
+        """:meth:`set_position` for distinct ``actuators`` (a slice or an index array) at once."""
+        values = np.asarray(rads, dtype=np.float64)
+        if not math.isfinite(float(values.sum())):  # NaN or infinity somewhere: one by one
             chosen = np.arange(len(self.target))[actuators]
-            if not finite.all():
-                logger.debug("ignored non-finite positions for actuators %s", chosen[~finite])
-            actuators, rads = chosen[finite], values[finite]
-        if type(actuators) is slice:  # the usual request: clamped straight into the view
-            values = np.array(rads, dtype=np.float64)
-            np.maximum(values, self.lower[actuators], out=values)
-            np.minimum(values, self.upper[actuators], out=self.target[actuators])
-        else:
-            self.target[actuators] = np.minimum(
-                np.maximum(rads, self.lower[actuators]), self.upper[actuators]
-            )
+            for actuator, value in zip(chosen.tolist(), values.tolist(), strict=True):
+                self.set_position(actuator, value)
+            return
+        self.target[actuators] = np.minimum(
+            np.maximum(values, self.lower[actuators]), self.upper[actuators]
+        )
         self._targets_changed(actuators)
 
     def _targets_changed(self, actuators: slice | npt.NDArray[np.int64]) -> None:
-        """New position targets for ``actuators``: ramp towards them, out of torque mode."""
-        self._ramping = True
-        if self._any_torque and self.torque_mode[actuators].any():
+        """New finite position targets for ``actuators``: position control."""
+        if self._any_torque:
             self.torque_mode[actuators] = False
             self._any_torque = bool(self.torque_mode.any())
-            self._dirty = True
+        if self._any_velocity:
+            self.velocity_mode[actuators] = False
+            self._any_velocity = bool(self.velocity_mode.any())
 
     def position_writer(self, actuators: npt.NDArray[np.int64]) -> PositionWriter:
         """:meth:`set_positions` for a fixed set of distinct ``actuators`` (their limits
@@ -110,11 +128,14 @@ class MotorBank:
         return PositionWriter(self, actuators)
 
     def set_velocity(self, actuator: int, rad_s: float) -> None:
+        """Webots' ``setVelocity``: the velocity limit of position control (its magnitude, at
+        most the servo's no-load speed) and the target of velocity control (signed)."""
         if not math.isfinite(rad_s):
             logger.debug("ignored non-finite velocity %r for actuator %d", rad_s, actuator)
             return
-        self.velocity_limit[actuator] = min(abs(rad_s), self.max_velocity[actuator])
-        self._ramping = True
+        limit = self.max_velocity[actuator]
+        self.velocity_limit[actuator] = min(abs(rad_s), limit)
+        self.velocity[actuator] = min(max(rad_s, -limit), limit)
 
     def set_torque(self, actuator: int, nm: float) -> None:
         if not math.isfinite(nm):
@@ -122,70 +143,116 @@ class MotorBank:
             return
         limit = self.max_torque[actuator]
         self.torque[actuator] = min(max(nm, -limit), limit)
-        self._ctrl_dirty = True
-        if not self.torque_mode[actuator]:
-            self.torque_mode[actuator] = True
-            self._any_torque = True
-            self._dirty = True
+        self.torque_mode[actuator] = True
+        self._any_torque = True
 
     def set_pid(self, actuator: int, p: float, i: float, d: float) -> None:
+        """Webots' ``setControlPID``: the gains of the position-to-velocity controller."""
         if not all(math.isfinite(v) for v in (p, i, d)):
             logger.debug("ignored non-finite PID for actuator %d", actuator)
             return
-        base = self.default_kp[actuator] / DEFAULT_P
-        self.kp[actuator] = max(p, 0.0) * base
-        self.ki[actuator] = i
-        self.kv[actuator] = max(d, 0.0) * base
-        self._dirty = True
+        self.p[actuator] = max(p, 0.0)
+        self.i[actuator] = max(i, 0.0)
+        self.d[actuator] = max(d, 0.0)
+        self.integral[actuator] = 0.0
+        self._any_integral = bool(self.i.any())
 
     def set_limp(self, actuators: npt.NDArray[np.int64], limp: bool) -> None:
         self.limp[actuators] = limp
-        self._dirty = True
+        self._any_limp = bool(self.limp.any())
+
+    def set_held(self, actuators: npt.NDArray[np.int64], positions: FloatArray | None) -> None:
+        """Hold ``actuators`` at ``positions`` under position control whatever is commanded
+        (commands still update the targets, which apply again on release: ``None``)."""
+        self.held[actuators] = positions is not None
+        if positions is not None:
+            self.hold_target[actuators] = positions
+        self._any_held = bool(self.held.any())
 
     def hold(self, actuators: npt.NDArray[np.int64], positions: FloatArray) -> None:
-        """Position mode at ``positions`` immediately (no ramp): after a teleport or restore."""
+        """Position control at ``positions`` (after a teleport or restore)."""
         self.target[actuators] = positions
-        self.effective[actuators] = positions
-        self._ctrl_dirty = True
-        if self.torque_mode[actuators].any():
-            self.torque_mode[actuators] = False
-            self._dirty = True
+        self.integral[actuators] = 0.0
+        self._targets_changed(actuators)
 
     # --- per step ----------------------------------------------------------------------------
 
     def invalidate(self) -> None:
-        """Write gains and ``ctrl`` again at the next step (after MuJoCo reset its state)."""
-        self._dirty = True
-        self._ctrl_dirty = True
+        """Kept for callers that reset MuJoCo's state: every step writes everything anyway."""
 
     def apply(self, data: mujoco.MjData) -> None:
-        """Advance the velocity-limited targets by one basic step and write ``ctrl`` (only when
-        something changed: the common case of robots holding a posture costs nothing)."""
-        if self._ramping:  # effective = clip(target, effective - reach, effective + reach)
-            reach = self.velocity_limit * self._step_s
-            effective = self.effective
-            low = effective - reach
-            np.maximum(self.target, low, out=low)
-            np.minimum(low, effective + reach, out=effective)
-            self._ramping = not np.array_equal(effective, self.target)
-            self._ctrl_dirty = True
-        if self._dirty:
-            self._write_gains()
-        if self._ctrl_dirty:
-            if self._any_torque:  # (no actuator is in torque mode while it is False)
-                data.ctrl[:] = np.where(self.torque_mode, self.torque, self.effective)
-            else:
-                data.ctrl[:] = self.effective
-            self._ctrl_dirty = False
-
-    def _write_gains(self) -> None:
-        active = ~self.limp
-        position = active & ~self.torque_mode
-        gain = np.where(self.torque_mode, 1.0, self.kp) * active
-        self._model.actuator_gainprm[:, 0] = gain
-        self._model.actuator_biasprm[:, 1] = -self.kp * position
-        self._model.actuator_biasprm[:, 2] = -self.kv * position
-        self._dirty = False
+        """Choose each actuator's mode and write gain, bias and ``ctrl`` for the next basic
+        step, from the joints' positions and velocities now (about twenty numpy operations
+        on the arrays of all actuators; the rare modes only when some actuator is in them)."""
+        ids, par = self._ids, self.params
+        q = data.qpos[self._qpos]
+        qdot = data.qvel[self._dof]
+        p = self.p[ids]
+        target = self.target[ids]
+        held = self.held[ids] if self._any_held else None
+        if held is not None:
+            target = np.where(held, self.hold_target[ids], target)
+            p = np.where(held, np.maximum(p, DEFAULT_P), p)
+        # backlash: within half the play of the target the gears do not touch; beyond it the
+        # controller acts on the error less that half
+        error = target - q
+        shift = np.minimum(np.maximum(error, par.minus_half_play), par.half_play)
+        target = target - shift  # (a new array: ``self.target`` keeps the command)
+        error -= shift
+        wanted = p * error
+        pull: FloatArray | float = 0.0
+        if self._any_integral:
+            self.integral[ids] += error * self._step_s
+            pull = self.i[ids] * self.integral[ids]
+            wanted += pull
+        d = self.d[ids]
+        wanted -= d * qdot
+        k = par.gain
+        limit = self.velocity_limit[ids]
+        saturated = np.abs(wanted) > limit
+        velocity = self.velocity_mode[ids] if self._any_velocity else None
+        if velocity is not None:
+            if held is not None:
+                velocity = velocity & ~held
+            saturated |= velocity
+        free = ~saturated
+        ctrl = p * target + pull
+        ctrl = np.where(saturated, np.copysign(limit, wanted), ctrl)
+        if velocity is not None:
+            ctrl = np.where(velocity, self.velocity[ids], ctrl)
+        gain = k.copy()
+        bias_q = -k * p * free
+        bias_v = -k - k * d * free
+        torque = self.torque_mode[ids] if self._any_torque else None
+        if torque is not None:
+            if held is not None:
+                torque = torque & ~held
+            ctrl = np.where(torque, self.torque[ids], ctrl)
+            gain[torque] = 1.0
+            bias_q[torque] = 0.0
+            bias_v[torque] = 0.0
+        off = (error == 0.0) & par.has_play  # within the play (the shift took the whole error)
+        if velocity is not None:
+            off &= ~velocity
+        if torque is not None:
+            off &= ~torque
+        if self._any_limp:
+            off |= self.limp[ids]
+        gain[off] = 0.0
+        bias_q[off] = 0.0
+        bias_v[off] = 0.0
+        # the torque-speed line at this speed bounds the force for the step: full torque
+        # against the motion, the line's torque with it
+        drive = par.line_reach - par.line_slope * np.abs(qdot)
+        np.minimum(drive, par.motor_torque, out=drive)
+        np.maximum(drive, 0.0, out=drive)
+        forward = qdot > 0
+        self._range_hi[ids] = np.where(forward, drive, par.motor_torque)
+        self._range_lo[ids] = np.where(forward, par.minus_motor_torque, -drive)
+        self._gain[ids] = gain
+        self._bias_q[ids] = bias_q
+        self._bias_v[ids] = bias_v
+        data.ctrl[ids] = ctrl
 
 
 class PositionWriter:
@@ -208,7 +275,7 @@ class PositionWriter:
             values = rads
         else:
             values = np.asarray(rads, dtype=np.float64)
-            if not math.isfinite(values.sum()):  # a NaN or infinity (or a huge sum): filtered
+            if not math.isfinite(values.sum()):  # NaN or infinity: one by one
                 bank.set_positions(self.actuators, values)
                 return
         clamped = np.maximum(values, self._lower)

@@ -1,8 +1,9 @@
 """Assembles the world MJCF from its entities (field, goals, ball, robots) and compiles it.
 
-Collision filtering: each robot ``i`` gets its own bit ``1 << i`` as ``contype`` and every other
-bit as ``conaffinity``, so a robot's parts never collide with each other but do collide with
-other robots, the ball, the turf and the goals. Static geoms and the ball have bits of their own.
+Collision filtering: each robot ``i`` gets its own bit ``1 << i`` as ``contype`` and every robot
+bit as ``conaffinity`` (:func:`robot_conaffinity`), so a robot's parts collide with other robots,
+the ball, the turf, the goals and its own non-adjacent links (the exclusion rule is
+:mod:`simulator.world.selfcollision`'s). Static geoms and the ball have bits of their own.
 """
 
 from __future__ import annotations
@@ -19,12 +20,18 @@ from simulator.world.field import field_bodies
 from simulator.world.goal import goal_bodies
 from simulator.world.look import Look, apply_look, look_assets, look_for
 from simulator.world.robots import robot_model
+from simulator.world.selfcollision import exclude_xml
 from simulator.world.types import RobotPlacement, robot_prefix
 
 STATIC_BIT = 1 << 30
 BALL_BIT = 1 << 29
 MAX_ROBOTS = 29
 TEAM_RGBA = {TeamColor.RED: "0.85 0.12 0.1 1", TeamColor.BLUE: "0.1 0.25 0.9 1"}
+
+
+def robot_conaffinity(robots: int) -> int:
+    """The ``conaffinity`` of every robot geom in a world of ``robots`` robots."""
+    return ((1 << robots) - 1) | STATIC_BIT | BALL_BIT
 
 
 def ball_touch_sensor(placement: RobotPlacement) -> str:
@@ -55,6 +62,7 @@ def scene_xml(
     ]
     actuators = []
     sensors = []
+    excludes = []
     assets: dict[str, str] = {}
     for i, placement in enumerate(robots):
         model = robot_model(placement.model)
@@ -63,10 +71,11 @@ def scene_xml(
             prefix=robot_prefix(placement.id),
             rgba=TEAM_RGBA[placement.id.team],
             contype=bit,
-            conaffinity=(robot_bits & ~bit) | STATIC_BIT | BALL_BIT,
+            conaffinity=robot_conaffinity(len(robots)),
             pose=(placement.x_m, placement.y_m, placement.yaw_rad),
         )
         bodies.append(parts.body)
+        excludes.append(exclude_xml(model, robot_prefix(placement.id)))
         if parts.assets:
             assets.setdefault(parts.asset_key, parts.assets)
         actuators.append(parts.actuators)
@@ -86,6 +95,7 @@ def scene_xml(
 </visual>
 <asset>{look_assets(look)}{"".join(assets.values())}</asset>
 <worldbody>{"".join(bodies)}</worldbody>
+<contact>{"".join(excludes)}</contact>
 <actuator>{"".join(actuators)}</actuator>
 <sensor>{"".join(sensors)}</sensor>
 </mujoco>"""

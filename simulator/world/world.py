@@ -91,7 +91,15 @@ class World(DeviceAccess):
         self._opt = self.model.opt  # a view of the model's options (one wrapper, not one a step)
         self.index = build_index(self.model, placements)
         self.robot_ids: tuple[RobotId, ...] = tuple(ids)
-        self.motors = MotorBank(self.model, self.index, step_ms / 1000.0)
+        self.motors = MotorBank(
+            self.model,
+            [
+                (int(robot.actuators[slot]), spec)
+                for robot in self.index.robots
+                for slot, spec in enumerate(robot.model.motors)
+            ],
+            step_ms / 1000.0,
+        )
         self.limp = [False] * len(ids)
         self.removed = [False] * len(ids)
         self.parked_qpos: dict[int, np.ndarray] = {}

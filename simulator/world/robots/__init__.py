@@ -22,45 +22,46 @@ from simulator.world.robots.model import (
     RobotModel,
 )
 from simulator.world.robots.team import TeamRobotModel, load_team_model
+from simulator.world.servos import servo
 
 AnyRobotModel = RobotModel | TeamRobotModel
 
-# kp N m/rad, max torque N m, max velocity rad/s for the kid model (ranges: robot.geometry).
-# Stiff, damped servos (kv = KV_TIME_S * kp): with the softer kp / 2 and no damping the
-# open-loop gait of robot.motion drifts and falls within seconds.
-_KID_MOTORS: dict[str, tuple[float, float, float]] = {
-    "Neck": (16.0, 6.0, 6.0),
-    "Head": (16.0, 6.0, 6.0),
-    "Shoulder": (40.0, 6.0, 6.0),
-    "ArmUpper": (40.0, 6.0, 6.0),
-    "ArmLower": (30.0, 6.0, 6.0),
-    "PelvY": (80.0, 8.0, 6.0),
-    "Pelv": (160.0, 10.0, 6.0),
-    "LegUpper": (160.0, 10.0, 6.0),
-    "LegLower": (160.0, 10.0, 6.0),
-    "Ankle": (160.0, 10.0, 6.0),
-    "Foot": (160.0, 10.0, 6.0),
+# Catalogue servos of the built-in models per joint group (ranges: robot.geometry): kid-size
+# as the league's Dynamixel robots at 14.8 V, adult-size with Dynamixel-P servos.
+_KID_SERVOS: dict[str, str] = {
+    "Neck": "MX-28@14.8V",
+    "Head": "MX-28@14.8V",
+    "Shoulder": "MX-64@14.8V",
+    "ArmUpper": "MX-64@14.8V",
+    "ArmLower": "MX-64@14.8V",
+    "PelvY": "MX-64@14.8V",
+    "Pelv": "XW540-T140@14.8V",
+    "LegUpper": "XW540-T140@14.8V",
+    "LegLower": "XW540-T140@14.8V",
+    "Ankle": "XW540-T140@14.8V",
+    "Foot": "XW540-T140@14.8V",
 }
-KV_TIME_S = 0.005
+_ADULT_SERVOS: dict[str, str] = {
+    "Neck": "PH42-020-S300-R@24V",
+    "Head": "PH42-020-S300-R@24V",
+    "Shoulder": "PH54-100-S500-R@24V",
+    "ArmUpper": "PH54-100-S500-R@24V",
+    "ArmLower": "PH54-100-S500-R@24V",
+    "PelvY": "PH54-100-S500-R@24V",
+    "Pelv": "PH54-200-S500-R@24V",
+    "LegUpper": "PH54-200-S500-R@24V",
+    "LegLower": "PH54-200-S500-R@24V",
+    "Ankle": "PH54-200-S500-R@24V",
+    "Foot": "PH54-200-S500-R@24V",
+}
 
 
-def _motors(scale: float) -> tuple[MotorSpec, ...]:
-    torque_scale = scale**4  # torque ~ mass x length ~ scale^4
+def _motors(servos: dict[str, str]) -> tuple[MotorSpec, ...]:
     motors = []
     for name in MOTOR_NAMES:
-        kp, torque, velocity = _KID_MOTORS[name if name in _KID_MOTORS else name[:-1]]
         lower, upper = motor_range(name)
-        motors.append(
-            MotorSpec(
-                name=name,
-                lower_rad=lower,
-                upper_rad=upper,
-                kp_nm_per_rad=kp * torque_scale,
-                kv_nm_s_per_rad=kp * torque_scale * KV_TIME_S * scale**0.5,
-                max_torque_nm=torque * torque_scale,
-                max_velocity_rad_s=velocity / scale**0.5,
-            )
-        )
+        entry = servo(servos[name if name in servos else name[:-1]])
+        motors.append(MotorSpec.from_servo(name, lower, upper, entry))
     return tuple(motors)
 
 
@@ -68,16 +69,14 @@ KID_DEFAULT = RobotModel(
     name="kid-default",
     field_class="kid",
     geometry=KID_GEOMETRY,
-    motors=_motors(1.0),
-    joint_damping=0.3,
+    motors=_motors(_KID_SERVOS),
     joint_armature=0.01,
 )
 ADULT_DEFAULT = RobotModel(
     name="adult-default",
     field_class="adult",
     geometry=ADULT_GEOMETRY,
-    motors=_motors(ADULT_SCALE),
-    joint_damping=0.3 * ADULT_SCALE**4,
+    motors=_motors(_ADULT_SERVOS),
     joint_armature=0.01 * ADULT_SCALE**5,
 )
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
+from simulator.world.actuator import actuator_xml, joint_attributes
 from simulator.world.robots.model import RobotMjcf
 
 if TYPE_CHECKING:
@@ -39,7 +40,7 @@ class _Writer:
         spec = self.model.motor(motor)
         return (
             f'<joint name="{self.p}/{motor}" type="hinge" axis="{_f(*axis)}" '
-            f'range="{_f(spec.lower_rad, spec.upper_rad)}" damping="{self.model.joint_damping}" '
+            f'range="{_f(spec.lower_rad, spec.upper_rad)}" {joint_attributes(spec)} '
             f'armature="{self.model.joint_armature}"/>'
         )
 
@@ -210,12 +211,7 @@ def build_humanoid(
   </body>
  </body>
 </body>"""
-    actuators = "".join(
-        f'<position name="{p}/{m.name}" joint="{p}/{m.name}" kp="{m.kp_nm_per_rad:.6g}" '
-        f'kv="{m.kv_nm_s_per_rad:.6g}" '
-        f'forcerange="{_f(-m.max_torque_nm, m.max_torque_nm)}" ctrllimited="false"/>'
-        for m in model.motors
-    )
+    actuators = "".join(actuator_xml(f"{p}/{m.name}", f"{p}/{m.name}", m) for m in model.motors)
     sensors = (
         f'<accelerometer name="{p}/Accelerometer" site="{p}/site:imu"/>'
         f'<gyro name="{p}/Gyro" site="{p}/site:imu"/>'

@@ -6,6 +6,7 @@ import math
 from dataclasses import dataclass
 
 from robot.geometry import CAMERA_FOV_RAD, HumanoidGeometry
+from simulator.world.servos import Servo
 
 FORCE_SENSORS = ("llb", "llf", "lrf", "lrb", "rlb", "rlf", "rrf", "rrb")
 """Sole corner force sensors: first letter foot (l/r), then side (l/r), then back/front."""
@@ -14,18 +15,39 @@ FORCE_SENSORS = ("llb", "llf", "lrf", "lrb", "rlb", "rlf", "rrf", "rrb")
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class MotorSpec:
-    """One position-controlled motor (a hinge joint and its actuator)."""
+    """One motor (a hinge joint and its servo): the servo's figures at the joint, from the
+    league catalogue (``servo`` names the entry) or, in friendlies, from a team's manifest
+    (``servo`` empty). :mod:`simulator.world.actuator` turns it into MuJoCo."""
 
     name: str
     lower_rad: float
     upper_rad: float
-    kp_nm_per_rad: float
-    kv_nm_s_per_rad: float  # velocity feedback of the position controller
-    max_torque_nm: float
-    max_velocity_rad_s: float
-    # the position sensor's resolution: 2 pi / 4096 rad, the 4096-count encoder of the league's
-    # Dynamixel servos (:mod:`simulator.world.sensor_noise`)
+    max_torque_nm: float  # stall torque (Webots maxTorque), N m at the output
+    max_velocity_rad_s: float  # no-load speed (Webots maxVelocity)
+    full_torque_speed_rad_s: float = 0.0  # the torque-speed line starts falling here
+    static_friction_nm: float = 0.0
+    damping_nm_s_per_rad: float = 0.0
+    backlash_rad: float = 0.0
+    # the position sensor's resolution (:mod:`simulator.world.sensor_noise`); free-form motors
+    # get 2 pi / 4096 rad, the 4096-count encoder of the league's Dynamixel servos
     encoder_resolution_rad: float = 2.0 * math.pi / 4096.0
+    servo: str = ""  # catalogue id (MX-106@14.8V); empty for free-form figures
+
+    @classmethod
+    def from_servo(cls, name: str, lower_rad: float, upper_rad: float, servo: Servo) -> MotorSpec:
+        return cls(
+            name=name,
+            lower_rad=lower_rad,
+            upper_rad=upper_rad,
+            max_torque_nm=servo.stall_torque_nm,
+            max_velocity_rad_s=servo.no_load_speed_rad_s,
+            full_torque_speed_rad_s=servo.full_torque_speed_rad_s,
+            static_friction_nm=servo.static_friction_nm,
+            damping_nm_s_per_rad=servo.viscous_damping_nm_s_per_rad,
+            backlash_rad=servo.backlash_rad,
+            encoder_resolution_rad=servo.encoder_resolution_rad,
+            servo=servo.id,
+        )
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -72,7 +94,6 @@ class RobotModel(MotorLookup):
     field_class: str  # "kid" | "adult"
     geometry: HumanoidGeometry
     motors: tuple[MotorSpec, ...]
-    joint_damping: float
     joint_armature: float
     camera: CameraSpec = CameraSpec()
     force_sensors: tuple[str, ...] = FORCE_SENSORS

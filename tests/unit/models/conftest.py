@@ -27,9 +27,18 @@ def edit_manifest(folder: Path, **changes: Any) -> None:
     path.write_text(json.dumps(manifest))
 
 
-def box_robot(folder: Path, *, height_m: float, joints: bool = True) -> Path:
+def box_robot(
+    folder: Path,
+    *,
+    height_m: float,
+    joints: bool = True,
+    arms_sideways_m: float = 0.0,
+    motor: dict[str, Any] | None = None,
+) -> Path:
     """An MJCF stick robot ``height_m`` tall (legs 0.45 H, head 0.2 H) with its manifest (which
-    names five motors, whether or not the model has ``joints``)."""
+    names five motors, whether or not the model has ``joints``, each a catalogue MX-64 unless
+    ``motor`` gives other fields). ``arms_sideways_m``: arms that long held straight out
+    sideways instead of hanging down."""
     folder.mkdir(parents=True, exist_ok=True)
     h = height_m
     leg, head = 0.45 * h, 0.2 * h
@@ -45,12 +54,17 @@ def box_robot(folder: Path, *, height_m: float, joints: bool = True) -> Path:
         f'<geom type="box" size="0.08 0.04 0.01" pos="0.02 0 0"/></body></body>'
         for s, y in (("l", 0.06), ("r", -0.06))
     )
+    arm = (0.0, 0.0, -trunk * 0.8)
+
+    def reach(side: float) -> tuple[float, float, float]:
+        return (0.0, side * arms_sideways_m, 0.0) if arms_sideways_m else arm
+
     arms = "".join(
         f'<body name="arm_{s}" pos="0 {y} {leg + trunk * 0.9}">{hinge("arm_" + s)}'
-        f'<geom type="capsule" fromto="0 0 0 0 0 {-trunk * 0.8}" size="0.02"/>'
-        f'<body name="hand_{s}" pos="0 0 {-trunk * 0.8}"><geom type="sphere" size="0.025"/>'
-        f"</body></body>"
-        for s, y in (("l", 0.15), ("r", -0.15))
+        f'<geom type="capsule" fromto="0 0 0 {" ".join(map(str, reach(sign)))}" size="0.02"/>'
+        f'<body name="hand_{s}" pos="{" ".join(map(str, reach(sign)))}">'
+        f'<geom type="sphere" size="0.025"/></body></body>'
+        for s, y, sign in (("l", 0.15, 1.0), ("r", -0.15, -1.0))
     )
     xml = f"""<mujoco model="box">
 <worldbody><body name="base">
@@ -64,7 +78,7 @@ def box_robot(folder: Path, *, height_m: float, joints: bool = True) -> Path:
 </body></worldbody></mujoco>"""
     (folder / "robot.xml").write_text(xml)
     motors = [
-        {"joint": j, "kp": 40, "max_torque_nm": 8, "max_velocity_rad_s": 6}
+        {"joint": j, **(motor if motor is not None else {"servo": "MX-64@14.8V"})}
         for j in ("hip_l", "hip_r", "arm_l", "arm_r", "neck")
     ]
     manifest = {

@@ -10,7 +10,7 @@ import numpy as np
 
 from contracts.ids import RobotId, TeamColor
 from referee.snapshot import PlaceBall
-from robot.motion import standing_posture
+from robot.motion import SERVO_PID, standing_posture
 from robot.stub.controller import Sensors
 from simulator.world import RobotPlacement, World
 from testkit.stub_world import sense
@@ -27,6 +27,8 @@ class OneRobot:
             ],
             seed=3,
         )
+        for name in self.world.motor_names(RED1):
+            self.world.set_motor_pid(RED1, name, *SERVO_PID)
         self.torso = self.world.model.body("red_1/torso").id
         self.ball = self.world.model.body("ball").id
         self.place_ball(x_m + 3.0, y_m + 3.0)  # out of the way

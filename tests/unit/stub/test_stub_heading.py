@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import numpy.typing as npt
+import pytest
 
 from robot.stub.controller import HeadingTracker
 
@@ -19,7 +20,8 @@ def _rotate(r: npt.NDArray[np.float64], omega: tuple[float, float, float], dt: f
     skew = np.array([[0.0, -wz, wy], [wz, 0.0, -wx], [-wy, wx, 0.0]])
     turned: npt.NDArray[np.float64] = r @ (np.eye(3) + skew * dt)
     u, _, vt = np.linalg.svd(turned)
-    return u @ vt
+    rotation: npt.NDArray[np.float64] = u @ vt
+    return rotation
 
 
 def _track(motions: list[tuple[tuple[float, float, float], float]]) -> tuple[float, float]:
@@ -61,3 +63,17 @@ def test_rolling_over_and_pitching_back_up_turns_the_heading_by_pi() -> None:
     reported, true = _track([((0.0, math.pi / 2, 0.0), 2.0), ((math.pi / 2, 0.0, 0.0), 2.0)])
     assert abs(_wrap(true - math.pi)) < 0.05
     assert abs(_wrap(reported - true)) < 0.05
+
+
+def test_a_held_tracker_counts_no_turn_until_the_hold_is_over() -> None:
+    """After a reset of the pose the referee may still be placing the robot: turns then are not
+    the robot's."""
+    tracker, dt = HeadingTracker(hold_s=0.5), 0.008
+    placing = sum(
+        tracker.heading_change(dt, (0.0, 0.0, G), (0.0, 0.0, 2.0)) or 0.0 for _ in range(50)
+    )
+    assert placing == 0.0  # 0.4 s of a 2 rad/s spin, all within the hold
+    turned = sum(
+        tracker.heading_change(dt, (0.0, 0.0, G), (0.0, 0.0, 1.0)) or 0.0 for _ in range(125)
+    )
+    assert turned == pytest.approx(1.0 * (125 - 13) * dt, abs=0.05)  # after the rest of the hold

@@ -14,7 +14,11 @@ from .motion_world import OneRobot
 
 @pytest.mark.parametrize(
     ("role", "target"),
-    [(Role.STRIKER, (-1.0, 0.0)), (Role.GOALIE, (-4.0, 0.0)), (Role.DEFENDER, (-2.3, -1.0))],
+    [
+        (Role.STRIKER, (-1.0, 0.0)),
+        (Role.GOALIE, (-4.0, 0.0)),
+        (Role.DEFENDER, (-2.3, -1.0)),
+    ],
 )
 def test_walks_to_the_kick_off_position_in_ready(role: Role, target: tuple[float, float]) -> None:
     start = Pose2D(-1.5, -3.2, math.pi / 2)  # on the touch line, facing the field

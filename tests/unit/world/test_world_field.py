@@ -14,6 +14,7 @@ from simulator.world import (
     known_models,
     robot_model,
 )
+from simulator.world.servos import servo
 from tests.unit.world.conftest import RED_1
 
 
@@ -64,7 +65,13 @@ def test_robot_models_fit_their_class(name: str) -> None:
     assert model.motor_names == MOTOR_NAMES
     if name == "kid-default":
         assert 4.0 <= model.geometry.total_mass_kg <= 5.5
-        assert all(6.0 <= m.max_torque_nm <= 10.0 for m in model.motors)
+        assert all(2.0 <= m.max_torque_nm <= 10.0 for m in model.motors)
+    for m in model.motors:  # every motor a catalogue servo with its datasheet figures
+        entry = servo(m.servo)
+        assert (m.max_torque_nm, m.max_velocity_rad_s) == (
+            entry.stall_torque_nm,
+            entry.no_load_speed_rad_s,
+        )
 
 
 def test_unknown_model_lists_the_known_ones() -> None:

@@ -24,7 +24,9 @@ import mujoco
 import numpy as np
 
 from simulator.errors import ModelError, ModelProblem
+from simulator.world.actuator import actuator_xml
 from simulator.world.robots.team.manifest import Manifest
+from simulator.world.robots.team.servos import motor_spec
 
 PREFIX = "@ROBOT@"
 HULL = (
@@ -282,12 +284,11 @@ def build_template(spec: mujoco.MjSpec, manifest: Manifest, *, key: str) -> Temp
             motor = motors[joint.name]
             ranges[motor.name] = (float(joint.range[0]), float(joint.range[1]))
             joint.name = f"{p}/{motor.name}"
-            if manifest.joint_damping is not None:
-                joint.damping = [manifest.joint_damping, 0.0, 0.0]
+            physics = motor_spec(motor, manifest)
+            joint.damping = [physics.damping_nm_s_per_rad, 0.0, 0.0]
+            joint.frictionloss = physics.static_friction_nm
             if manifest.joint_armature is not None:
                 joint.armature = manifest.joint_armature
-            if manifest.joint_frictionloss is not None:
-                joint.frictionloss = manifest.joint_frictionloss
         if link == manifest.imu_link:
             site = body.add_site()
             site.name = f"{p}/site:imu"
@@ -416,9 +417,7 @@ def _template(
         element.attrib.pop("class", None)
         element.attrib.pop("childclass", None)
     motors = "".join(
-        f'<position name="{PREFIX}/{m.name}" joint="{PREFIX}/{m.name}" kp="{m.kp_nm_per_rad:.6g}" '
-        f'kv="{m.kv_nm_s_per_rad:.6g}" forcerange="{-m.max_torque_nm:.6g} {m.max_torque_nm:.6g}" '
-        f'ctrllimited="false"/>'
+        actuator_xml(f"{PREFIX}/{m.name}", f"{PREFIX}/{m.name}", motor_spec(m, manifest))
         for m in manifest.motors
     )
     sensors = (

@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from simulator.errors import ModelError, ModelProblem
+from simulator.world.servos import find_servo, servo_ids
 
 MANIFEST_NAME = "robot_model.json"
 FORMAT_VERSION = 1
@@ -30,14 +31,16 @@ FIELD_CLASSES = ("kid", "adult")
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class MotorEntry:
-    """One joint of the model file driven as an HLVS motor."""
+    """One joint of the model file driven as an HLVS motor: a catalogue servo (``servo``, its
+    figures unless the entry gives lower ones) or free-form figures (``servo`` empty: allowed
+    with a warning in friendlies, refused in official matches)."""
 
     joint: str  # joint name in the model file
     name: str  # HLVS device name (position sensor: name + sensor suffix)
-    kp_nm_per_rad: float
-    kv_nm_s_per_rad: float
-    max_torque_nm: float
-    max_velocity_rad_s: float
+    servo: str  # catalogue id as written in the manifest, or ""
+    max_torque_nm: float | None  # as written (None: the servo's)
+    max_velocity_rad_s: float | None
+    free_gains: tuple[str, ...] = ()  # the free-form keys the entry sets (kp, kv)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -292,20 +295,31 @@ def _motors(r: _Reader, raw: dict[str, Any]) -> tuple[MotorEntry, ...]:
         if name in seen:
             r.problem(f"{p}/name", f"{name!r} is also the name of /motors/{seen[name]}")
         seen[name] = i
-        kp = r.positive(entry, "kp", p)
-        kv = r.get(entry, "kv", (int, float), p, required=False, default=None)
-        torque = r.positive(entry, "max_torque_nm", p)
-        velocity = r.positive(entry, "max_velocity_rad_s", p)
-        if kp is None or torque is None or velocity is None:
+        servo_name = r.get(entry, "servo", str, p, required=False, default="") or ""
+        if servo_name and find_servo(servo_name) is None:
+            r.problem(
+                f"{p}/servo",
+                f"{servo_name!r} is not in the league servo catalogue; known: "
+                f"{', '.join(servo_ids())}",
+            )
+        required = not servo_name
+        torque = r.positive(entry, "max_torque_nm", p, required=required)
+        velocity = r.positive(entry, "max_velocity_rad_s", p, required=required)
+        gains = tuple(k for k in ("kp", "kv") if k in entry)
+        for key in gains:
+            value = entry[key]
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                r.problem(f"{p}/{key}", f"{value!r} is not a number")
+        if required and (torque is None or velocity is None):
             continue
         motors.append(
             MotorEntry(
                 joint=joint,
                 name=name,
-                kp_nm_per_rad=kp,
-                kv_nm_s_per_rad=float(kv) if kv is not None else 0.005 * kp,
+                servo=servo_name,
                 max_torque_nm=torque,
                 max_velocity_rad_s=velocity,
+                free_gains=gains,
             )
         )
     return tuple(motors)

@@ -6,12 +6,13 @@ import copy
 import math
 import threading
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from simulator.world.robots.model import CameraSpec, MotorLookup, MotorSpec, RobotMjcf
 from simulator.world.robots.team.build import PREFIX, Template, build_template
 from simulator.world.robots.team.manifest import Manifest, load_manifest
+from simulator.world.robots.team.servos import motor_spec
 from simulator.world.robots.team.source import load_spec
 
 VISUAL = "/visual:"
@@ -95,14 +96,10 @@ def load_team_model(folder: Path) -> TeamRobotModel:
             field_class=manifest.field_class,
             manifest=manifest,
             motors=tuple(
-                MotorSpec(
-                    name=m.name,
+                replace(
+                    motor_spec(m, manifest),
                     lower_rad=template.ranges[m.name][0],
                     upper_rad=template.ranges[m.name][1],
-                    kp_nm_per_rad=m.kp_nm_per_rad,
-                    kv_nm_s_per_rad=m.kv_nm_s_per_rad,
-                    max_torque_nm=m.max_torque_nm,
-                    max_velocity_rad_s=m.max_velocity_rad_s,
                 )
                 for m in manifest.motors
             ),

@@ -3,22 +3,32 @@ verifier did before a competition.
 
 Measured with every joint at zero (the upright posture of the rules) and the lowest point on the
 ground: ``H`` the robot's height, ``Hleg`` from the ground to the first joint of the leg (the hip),
-``Hhead`` from the shoulder joint to the top, ``Htop = H - Hleg`` the upper body, ``Harm`` from the
-shoulder joint to the farthest point of the arm and hand, and each foot's length and width. The
-bounds are the Humanoid League's (law 4, robot dimensions; the height range is the league
-reference's), cameras at most two with a horizontal field of view of at most 180 degrees.
+``Hhead`` from the shoulder joint to the top, ``Htop = H - Hleg`` the upper body, ``Harm`` per
+arm chain (each link tagged ``arm`` with its subtree) from that chain's first joint to the
+farthest point of its own arm and hand, the longest chain reported, and each foot's length and
+width. The bounds are the Humanoid League's (law 4, robot dimensions; the height range is the
+league reference's), cameras at most two with a horizontal field of view of at most 180 degrees.
+
+The committee's physics checks: every motor's servo from the league catalogue (at most its
+figures; free-form servos and gains are warnings in friendlies, errors in official matches,
+:mod:`.servos`), every motor joint with a range, and each link's mass and inertia plausible for
+its size: density (mass over the volume of the link's shapes' bounding box) within
+``DENSITY_KG_M3`` and each principal inertia between ``MIN_INERTIA_KG_M2`` and the mass times
+the squared diagonal of that box (no point of the link is farther from its centre).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
+from typing import Any
 
 import mujoco
 import numpy as np
 
 from simulator.errors import ModelProblem
 from simulator.world.robots.team.model import TeamRobotModel
+from simulator.world.robots.team.servos import servo_problems
 
 HEIGHT_M = {"kid": (0.40, 1.00), "adult": (1.00, 2.00)}
 LEG_RATIO = (0.35, 0.70)  # Hleg / H
@@ -29,7 +39,9 @@ FOOT_ASPECT = 2.5  # foot length / width
 MAX_CAMERAS = 2
 MAX_FOV_RAD = math.pi
 MARKER = "/visual:marker"  # the team-colour marker we add is not part of the robot
-TORQUE_PER_WEIGHT_M = 5.0  # a servo stronger than 5 x m g H is a unit mistake (N cm, mN m)
+DENSITY_KG_M3 = (50.0, 10000.0)  # foam-light shells to steel, over the bounding box volume
+MIN_INERTIA_KG_M2 = 1e-8
+FRAME_KG = 1e-5  # lighter links are frames (camera, IMU), not parts
 
 
 @dataclass(frozen=True, slots=True)
@@ -38,16 +50,25 @@ class Measurements:
     leg_m: float
     head_m: float
     top_m: float
-    arm_m: float
+    arm_m: float  # the longest arm chain
     foot_length_m: float
     foot_width_m: float
     mass_kg: float
     cameras: int
     max_fov_rad: float
     motors: int
+    arm_chains_m: dict[str, float] = field(default_factory=dict)  # first link -> reach
+    servos: dict[str, str] = field(default_factory=dict)  # motor -> catalogue id ("" free)
 
-    def to_json(self) -> dict[str, float | int]:
-        return {k: (round(v, 4) if isinstance(v, float) else v) for k, v in asdict(self).items()}
+    def to_json(self) -> dict[str, Any]:
+        out: dict[str, Any] = {}
+        for key, value in asdict(self).items():
+            if isinstance(value, float):
+                value = round(value, 4)
+            elif key == "arm_chains_m":
+                value = {k: round(v, 4) for k, v in value.items()}
+            out[key] = value
+        return out
 
 
 def _standalone(robot: TeamRobotModel) -> mujoco.MjModel:
@@ -95,15 +116,7 @@ def measure(robot: TeamRobotModel) -> Measurements:
     leg = max((float(anchors[j][2] - ground) for j in leg_joints), default=0.0)
     shoulder_z = max((float(anchors[j][2]) for j in arm_joints), default=float(points[:, 2].max()))
     head = float(points[:, 2].max() - shoulder_z)
-    arm = 0.0
-    for g in range(model.ngeom):
-        name = model.geom(g).name
-        if not any(name.startswith(f"r/{part}:") for part in ("arm", "hand")):
-            continue
-        for j in arm_joints:
-            arm = max(
-                arm, float(np.linalg.norm(_corners(model, data, g) - anchors[j], axis=1).max())
-            )
+    chains = _arm_chains(robot, model, data)
     foot_length = foot_width = 0.0
     for side in robot.manifest.feet:
         foot = model.body(f"r/link:{side}")
@@ -125,14 +138,62 @@ def measure(robot: TeamRobotModel) -> Measurements:
         leg_m=leg,
         head_m=head,
         top_m=height - leg,
-        arm_m=arm,
+        arm_m=max(chains.values(), default=0.0),
         foot_length_m=foot_length,
         foot_width_m=foot_width,
         mass_kg=float(model.body_subtreemass[1]),
         cameras=len(cams),
         max_fov_rad=max((c.fov_rad for c in cams), default=0.0),
         motors=len(robot.motors),
+        arm_chains_m=chains,
+        servos={m.name: m.servo for m in robot.motors},
     )
+
+
+def _arm_chains(
+    robot: TeamRobotModel, model: mujoco.MjModel, data: mujoco.MjData
+) -> dict[str, float]:
+    """Per arm chain (a link tagged ``arm`` whose parent is not): the distance from its first
+    joint to the farthest corner of the arm and hand shapes in its own subtree."""
+    arm_links = [k for k, v in robot.manifest.parts.items() if v == "arm"]
+    bodies = {}
+    for link in arm_links:
+        try:
+            bodies[link] = model.body(f"r/link:{link}").id
+        except KeyError:
+            continue
+    roots = {
+        link: b
+        for link, b in bodies.items()
+        if not any(_subtree_of(model, b, other) for other in bodies.values() if other != b)
+    }
+    chains: dict[str, float] = {}
+    for link, root in roots.items():
+        anchor = _first_anchor(model, data, root)
+        reach = 0.0
+        for g in range(model.ngeom):
+            name = model.geom(g).name
+            if not any(name.startswith(f"r/{part}:") for part in ("arm", "hand")):
+                continue
+            if not _subtree_of(model, int(model.geom_bodyid[g]), root):
+                continue
+            distances = np.linalg.norm(_corners(model, data, g) - anchor, axis=1)
+            reach = max(reach, float(distances.max()))
+        chains[link] = reach
+    return chains
+
+
+def _first_anchor(model: mujoco.MjModel, data: mujoco.MjData, root: int) -> np.ndarray:
+    """The anchor of the first joint at or below ``root`` (depth first), else the body origin."""
+    stack = [root]
+    while stack:
+        body = stack.pop(0)
+        if model.body_jntnum[body] > 0:
+            anchor: np.ndarray = data.xanchor[int(model.body_jntadr[body])]
+            return anchor
+        stack.extend(b for b in range(model.nbody) if model.body_parentid[b] == body and b != body)
+    origin: np.ndarray = data.xpos[root]
+    return origin
 
 
 def _foot_root(model: mujoco.MjModel, body: int) -> int:
@@ -154,8 +215,11 @@ def _subtree_of(model: mujoco.MjModel, body: int, root: int) -> bool:
     return False
 
 
-def check(robot: TeamRobotModel) -> tuple[Measurements, list[ModelProblem]]:
-    """The measurements and every rule they break (value, limit and rule in each message)."""
+def check(
+    robot: TeamRobotModel, *, official: bool = False
+) -> tuple[Measurements, list[ModelProblem]]:
+    """The measurements and every rule they break (value, limit and rule in each message);
+    warnings (``severity``) for what friendlies allow and ``official`` matches refuse."""
     m = measure(robot)
     source = str(robot.manifest.path)
     problems: list[ModelProblem] = []
@@ -210,13 +274,60 @@ def check(robot: TeamRobotModel) -> tuple[Measurements, list[ModelProblem]]:
                 f"horizontal field of view {cam.fov_rad:.3f} rad "
                 f"({math.degrees(cam.fov_rad):.0f} deg) is above {MAX_FOV_RAD:.3f} rad (180 deg)",
             )
-    weight_limit = TORQUE_PER_WEIGHT_M * m.mass_kg * 9.81 * h
-    for i, motor in enumerate(robot.manifest.motors):
-        if motor.max_torque_nm > weight_limit:
+    problems.extend(servo_problems(robot.manifest, official=official))
+    for motor in robot.motors:
+        if not motor.lower_rad < motor.upper_rad:
             bad(
-                f"/motors/{i}/max_torque_nm",
-                f"{motor.max_torque_nm} N m for {motor.name} is "
-                f"above {weight_limit:.1f} N m (5 x the robot's weight x its height): check the "
-                "unit (N m)",
+                f"joint range of {motor.name}",
+                f"[{motor.lower_rad:g}, {motor.upper_rad:g}] rad: every motor joint needs its "
+                "range (lower < upper) in the model file",
             )
+    problems.extend(_inertia_problems(robot, source))
     return m, problems
+
+
+def _inertia_problems(robot: TeamRobotModel, source: str) -> list[ModelProblem]:
+    """Links whose mass or inertia does not fit their shapes (see the module's rule)."""
+    model = _standalone(robot)
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    out: list[ModelProblem] = []
+    for body in range(1, model.nbody):
+        if not model.body(body).name.startswith("r/link:"):
+            continue  # the frame we add around the model's root
+        mass = float(model.body_mass[body])
+        if mass <= FRAME_KG:
+            continue  # a frame (camera, IMU) without mass of its own
+        name = model.body(body).name.removeprefix("r/").removeprefix("link:")
+        inertia = model.body_inertia[body]
+        geoms = [
+            g
+            for g in range(model.ngeom)
+            if model.geom_bodyid[g] == body and not model.geom(g).name.endswith(MARKER)
+        ]
+        top = math.inf
+        if geoms:
+            rot = data.xmat[body].reshape(3, 3)
+            corners = [(_corners(model, data, g) - data.xpos[body]) @ rot for g in geoms]
+            local = np.concatenate(corners)
+            extent = local.max(axis=0) - local.min(axis=0)
+            density = mass / float(np.prod(np.maximum(extent, 1e-3)))
+            diagonal = float(np.linalg.norm(extent))
+            top = mass * diagonal * diagonal
+            low, high = DENSITY_KG_M3
+            if not low <= density <= high:
+                size = " x ".join(f"{v:.3f}" for v in extent)
+                out.append(ModelProblem(
+                    source=source, where=f"mass of {name}",
+                    reason=f"{mass:.4g} kg in a {size} m box is {density:.0f} kg/m^3, outside "
+                    f"{low:g}-{high:g} kg/m^3 (rule: link masses plausible for their size)",
+                ))  # fmt: skip
+        if inertia.min() < MIN_INERTIA_KG_M2 or inertia.max() > top:
+            bound = f"{top:.3g} kg m^2 (mass x squared size)" if geoms else "-"
+            out.append(ModelProblem(
+                source=source, where=f"inertia of {name}",
+                reason=f"principal inertia {', '.join(f'{v:.3g}' for v in inertia)} kg m^2 of "
+                f"{mass:.4g} kg is outside {MIN_INERTIA_KG_M2:g} - {bound} (rule: link "
+                "inertias plausible for their size)",
+            ))  # fmt: skip
+    return out

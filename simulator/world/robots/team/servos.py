@@ -1,0 +1,105 @@
+"""The servo of each motor of a team model: its catalogue entry (at most the entry's figures),
+or the manifest's free-form figures; and the rule book's verdict on them."""
+
+from __future__ import annotations
+
+from simulator.errors import ModelProblem
+from simulator.world.robots.model import MotorSpec
+from simulator.world.robots.team.manifest import Manifest, MotorEntry
+from simulator.world.servos import find_servo
+
+RULE = "servos from the league catalogue"
+
+
+def motor_spec(entry: MotorEntry, manifest: Manifest) -> MotorSpec:
+    """The motor's figures (joint range 0: :func:`dataclasses.replace` it in). A catalogue
+    servo keeps its figures where the entry asks for more (the rule book refuses that); the
+    manifest's ``joint_damping`` / ``joint_frictionloss`` replace the servo's friction."""
+    found = find_servo(entry.servo) if entry.servo else None
+    if found is not None:
+        spec = MotorSpec.from_servo(entry.name, 0.0, 0.0, found)
+        torque = min(entry.max_torque_nm or spec.max_torque_nm, spec.max_torque_nm)
+        velocity = min(entry.max_velocity_rad_s or spec.max_velocity_rad_s, spec.max_velocity_rad_s)
+    else:
+        spec = MotorSpec(
+            name=entry.name, lower_rad=0.0, upper_rad=0.0, max_torque_nm=1.0, max_velocity_rad_s=1.0
+        )
+        torque = entry.max_torque_nm or 1.0
+        velocity = entry.max_velocity_rad_s or 1.0
+    friction = manifest.joint_frictionloss
+    damping = manifest.joint_damping
+    return MotorSpec(
+        name=entry.name,
+        lower_rad=0.0,
+        upper_rad=0.0,
+        max_torque_nm=torque,
+        max_velocity_rad_s=velocity,
+        full_torque_speed_rad_s=min(spec.full_torque_speed_rad_s, velocity * 0.9),
+        static_friction_nm=spec.static_friction_nm if friction is None else friction,
+        damping_nm_s_per_rad=spec.damping_nm_s_per_rad if damping is None else damping,
+        backlash_rad=spec.backlash_rad,
+        encoder_resolution_rad=spec.encoder_resolution_rad,
+        servo=found.id if found is not None else "",
+    )
+
+
+def servo_problems(manifest: Manifest, *, official: bool) -> list[ModelProblem]:
+    """Motors above their catalogue entry (errors), free-form motors and free-form friction or
+    gains (warnings in friendlies, errors when ``official``)."""
+    source = str(manifest.path)
+    free = "error" if official else "warning"
+    match = "an official match" if official else "friendlies only (refused in official matches)"
+    out: list[ModelProblem] = []
+    for i, entry in enumerate(manifest.motors):
+        at = f"/motors/{i}"
+        found = find_servo(entry.servo) if entry.servo else None
+        if found is None:
+            out.append(
+                ModelProblem(
+                    source=source,
+                    where=f"{at}/servo",
+                    severity=free,
+                    reason=f"{entry.name} (joint {entry.joint}) names no catalogue servo: "
+                    f"free-form max_torque_nm {entry.max_torque_nm} and max_velocity_rad_s "
+                    f"{entry.max_velocity_rad_s} are for {match} (rule: {RULE})",
+                )
+            )
+        else:
+            for key, value, limit in (
+                ("max_torque_nm", entry.max_torque_nm, found.stall_torque_nm),
+                ("max_velocity_rad_s", entry.max_velocity_rad_s, found.no_load_speed_rad_s),
+            ):
+                if value is not None and value > limit * (1 + 1e-6):
+                    out.append(
+                        ModelProblem(
+                            source=source,
+                            where=f"{at}/{key}",
+                            reason=f"{entry.name} (joint {entry.joint}): {key} {value:g} is above "
+                            f"the catalogue's {limit:.4g} for {found.id} (rule: {RULE})",
+                        )
+                    )
+        for key in entry.free_gains:
+            out.append(
+                ModelProblem(
+                    source=source,
+                    where=f"{at}/{key}",
+                    severity=free,
+                    reason=f"{entry.name}: free-form gain {key} is for {match} and has no effect: "
+                    f"position control is Webots' (P, I, D from MotorPID; rule: {RULE})",
+                )
+            )
+    for key, value in (
+        ("joint_damping", manifest.joint_damping),
+        ("joint_frictionloss", manifest.joint_frictionloss),
+    ):
+        if value is not None:
+            out.append(
+                ModelProblem(
+                    source=source,
+                    where=f"/{key}",
+                    severity=free,
+                    reason=f"{key} {value:g} replaces the catalogue servos' friction: for {match} "
+                    f"(rule: {RULE})",
+                )
+            )
+    return out
