@@ -49,7 +49,7 @@ def bench_inprocess(*, rounds: int, block: int, seed: int) -> dict[str, Any]:
     from referee import RobotId, TeamColor
     from simulator.world import MOTOR_NAMES, RobotPlacement, World
 
-    env = gym.make("hlvs/Kick-v0", max_episode_s=1e6)
+    env = gym.make("hlvs/Kick-v0", max_episode_s=3600.0)
     env.reset(seed=seed)
     bare = World.create(
         field_class="kid",
@@ -103,7 +103,7 @@ def bench_vector_inprocess(
     from referee import RobotId, TeamColor
     from simulator.world import MOTOR_NAMES, RobotPlacement, World
 
-    vec = make_vector("hlvs/Kick-v0", remotes=None, num_envs=num_envs, max_episode_s=1e6,
+    vec = make_vector("hlvs/Kick-v0", remotes=None, num_envs=num_envs, max_episode_s=3600.0,
                       steps_per_action=steps_per_action)  # fmt: skip
     vec.reset(seed=seed)
     robot = RobotId(TeamColor.RED, 1)

@@ -68,7 +68,7 @@ def _env_run(
     import envs  # noqa: F401  (registers the ids)
     from benchmarks.envs import _actions
 
-    env = gym.make("hlvs/Kick-v0", remotes=address, max_episode_s=1e6,
+    env = gym.make("hlvs/Kick-v0", remotes=address, max_episode_s=3600.0,
                    steps_per_action=steps_per_action)  # fmt: skip
     try:
         env.reset(seed=seed)
@@ -86,7 +86,7 @@ def _vector_run(
     from envs.vector import make_vector
 
     size = len(addresses)
-    vec = make_vector("hlvs/Kick-v0", remotes=",".join(addresses), max_episode_s=1e6,
+    vec = make_vector("hlvs/Kick-v0", remotes=",".join(addresses), max_episode_s=3600.0,
                       steps_per_action=steps_per_action)  # fmt: skip
     try:
         vec.reset(seed=seed)

@@ -13,6 +13,7 @@ from typing import Any
 
 from cluster import JobState, JobStatus, MatchJob, NodeJob, PoolNode
 from contracts import files
+from contracts.sim_result import PlayRecord
 from contracts.match_results import (
     Failure,
     MatchLimits,
@@ -91,12 +92,18 @@ class FakePool:
 
 
 def fake_results(match_id: str, failure: Failure | None) -> MatchResults:
-    """A played 1-0 with one robot a side that both exited 0 (failed: ``failure``)."""
+    """A played 1-0 with one robot a side that both exited 0 (failed: ``failure``): both
+    halves reached PLAYING, red kicked its goal in."""
+    zero = {"red": 0, "blue": 0}
+    play = PlayRecord(halves_playing=(1, 2), both_halves_playing=True, playing_s=80.0,
+                      kicks={"red": 1, "blue": 0}, shots={"red": 1, "blue": 0},
+                      goals={"red": 1, "blue": 0}, own_goals=zero, falls=zero)
     robots = {key: RobotResult(image="team/image:1", container=f"{match_id}-{key}", exit_code=0)
               for key in ("red-1", "blue-1")}
     return MatchResults(
         match_id=match_id, seed=1, status="failed" if failure else "success", failure=failure,
         final_state="FINISHED", score={"red": 1, "blue": 0}, winner="red", robots=robots,
+        play=None if failure else play,
         limits=MatchLimits(cpus=4.0, memory_gb=16.0, pids=1024, log_folder_gb=10.0,
                            team_api_mb_s=350.0, team_comm_mb_s=1.0, grace_period_s=5.0,
                            allow_internet=False, host_controls=None),

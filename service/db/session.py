@@ -19,7 +19,8 @@ MIGRATIONS = Path(__file__).parent / "migrations"
 
 
 def make_engine(url: str) -> Engine:
-    """An engine for ``url``; SQLite gets WAL, a busy timeout and foreign keys."""
+    """An engine for ``url``; SQLite gets WAL, a busy timeout, foreign keys and real transactions
+    (each one whole, nested blocks included)."""
     if url.startswith("sqlite"):
         if url.startswith("sqlite:///"):
             _private_sqlite(Path(url.removeprefix("sqlite:///")))
@@ -28,11 +29,21 @@ def make_engine(url: str) -> Engine:
 
         @event.listens_for(engine, "connect")
         def _pragmas(dbapi_connection: Any, _record: Any) -> None:
+            # the driver's own transaction handling off: it would start a transaction only at the
+            # first write, and a SAVEPOINT released outside one commits at once (a row inserted
+            # in a nested block became visible before the rest of its transaction)
+            dbapi_connection.isolation_level = None
             cursor = dbapi_connection.cursor()
             cursor.execute("PRAGMA journal_mode=WAL")
             cursor.execute("PRAGMA busy_timeout=30000")
             cursor.execute("PRAGMA foreign_keys=ON")
             cursor.close()
+
+        @event.listens_for(engine, "begin")
+        def _begin(connection: Any) -> None:
+            # IMMEDIATE: the write lock up front (waiting up to the busy timeout), so a
+            # transaction that reads then writes never fails on a snapshot another one changed
+            connection.exec_driver_sql("BEGIN IMMEDIATE")
 
         return engine
     return create_engine(url, pool_size=20, max_overflow=30, pool_pre_ping=True)

@@ -5,8 +5,10 @@ Every link of a robot collides with every other link of the same robot except:
 1. a link and its *collision parent*: the nearest ancestor body that has collision geoms (bodies
    without collision geoms, the small servo-horn links between two joints of a hip or a
    shoulder, are skipped, so the links they join count as adjacent);
-2. links whose collision shapes already touch with every joint at zero or in the model's
-   standing pose (coarse collision boxes of team models that overlap at a joint).
+2. links whose collision shapes touch, or come within :data:`NEAR_M` of each other, with every
+   joint at zero or in the model's standing pose (coarse collision shapes of team models that
+   overlap or all but meet at a joint: the Wolfgang's head hull is half a millimetre above its
+   torso hull, which a real head clears when it looks down).
 
 MuJoCo itself leaves out a body and its parent. The rule is applied the same way to the built-in
 robots and to team models (computed from the model alone, once per model per process).
@@ -22,6 +24,8 @@ import numpy as np
 from simulator.world.robots import AnyRobotModel
 
 _PREFIX = "selfcheck"
+NEAR_M = 0.005
+"""Shapes this close in the reference poses count as touching (rule 2)."""
 _CACHE: dict[str, tuple[tuple[str, str], ...]] = {}
 _LOCK = threading.Lock()
 
@@ -66,6 +70,7 @@ def _compute(model: AnyRobotModel) -> tuple[tuple[str, str], ...]:
             parent = int(mj.body_parentid[parent])
         if parent > 0 and parent != mj.body_parentid[body]:
             pairs.add((min(body, parent), max(body, parent)))
+    mj.geom_margin[:] = NEAR_M  # contacts are reported for shapes closer than the margin
     data = mujoco.MjData(mj)
     joints = [mj.joint(f"{_PREFIX}/{name}") for name in model.motor_names]
     for pose in (np.zeros(len(joints)), np.asarray(model.standing_pose_rad, dtype=float)):

@@ -160,6 +160,14 @@ def check_ok(ran: Ran, root: Path) -> None:
     assert ": ok (" in ran.stdout, ran.describe()
 
 
+def official_model_ok(ran: Ran, root: Path) -> None:
+    exit_zero(ran, root)
+    report = json.loads(ran.stdout)
+    assert report["valid"] is True, ran.describe()
+    servos = report["files"][0]["measurements"]["servos"]
+    assert servos and all("@" in s for s in servos.values()), servos  # catalogue servos only
+
+
 def scrimmage_played(ran: Ran, root: Path) -> None:
     exit_zero(ran, root)
     out = root / "matches" / "scrimmage"
@@ -275,6 +283,7 @@ OUTCOMES: dict[str, Outcome] = {
     "hlvs check --require-images configs/examples/kid_4v4_official/game.json": Outcome(check_ok),
     "hlvs check configs/examples/credentials/sftp_key.json": Outcome(check_ok),
     "hlvs check configs/examples/robots/wolfgang": Outcome(check_ok),
+    "hlvs check --official --json configs/examples/robots/wolfgang": Outcome(official_model_ok),
     "hlvs check configs/examples/schedule/knockout.yaml": Outcome(check_ok),
     "hlvs schedule list configs/examples/schedule/knockout.yaml": Outcome(exit_zero),
     # images/README.md

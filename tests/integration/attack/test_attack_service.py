@@ -101,13 +101,14 @@ def test_password_env_and_keyless_ecr_are_refused_without_telling_whether_a_vari
         assert keyless.status_code == 422
         assert "/registry_auth/ecr" in [p["pointer"] for p in keyless.json()["problems"]]
         assert http.get("/v1/team/files/team_config").json() == []  # nothing stored
-    # the real pre-flight refuses such a file too (one stored under older rules), before any
-    # pull could carry the variable's value to the team's registry
+    # a file stored under older rules is refused too: a submission checks the stored file by
+    # today's rules before its pre-flight, so no pull carries the variable's value anywhere
     from service.preflight import run
+    from service.teamfiles import validated_team
 
     with pytest.raises(InvalidInput) as refused:
-        run(doc | {"registry_auth": {"username": "m", "password_env": present}},
-            settings=settings.with_(preflight="images"))
+        stored = doc | {"registry_auth": {"username": "m", "password_env": present}}
+        run(validated_team(stored), settings=settings.with_(preflight="images"))
     assert "/registry_auth/password_env" in str(refused.value.problems)
     assert listener.received == []
 

@@ -128,7 +128,7 @@ def test_compose_up_gives_robots_their_network_and_environment(
 
     stand_in = json.loads((tmp_path / "out" / "stand_in.json").read_text())
     assert stand_in["peers"] == {"10001": f"10.215.{third}.11", "10021": f"10.215.{third + 1}.11"}
-    for color, offset, port in (("red", 0, 10001), ("blue", 1, 10021)):
+    for color, offset, port, team_id in (("red", 0, 10001, 1), ("blue", 1, 10021, 2)):
         report = stand_in["reports"][str(port)]
         written = json.loads((tmp_path / "logs" / f"{color}-1" / "probe.json").read_text())
         assert written == {k: v for k, v in report.items() if k != "greeting"}
@@ -137,6 +137,7 @@ def test_compose_up_gives_robots_their_network_and_environment(
         assert report["env"] == {
             "ROBOCUP_ROBOT_ID": "1",
             "ROBOCUP_TEAM_COLOR": color,
+            "ROBOCUP_TEAM_ID": str(team_id),  # the team's number in game.json
             "ROBOCUP_SIMULATOR_ADDR": f"{sim}:{port}",
             "ROBOCUP_MIRROR_SERVER_IP": sim,
             "ROBOCUP_GAMECONTROLLER_IP": sim,

@@ -36,8 +36,10 @@ def artifacts_dir() -> Path:
     return folder
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="package")
 def browser() -> Iterator[Any]:
+    """One Chromium for the viewer's tests, closed after them: Playwright's synchronous API keeps
+    an event loop running in the main thread while it is open, where ``asyncio.run`` refuses."""
     if not Path(CHROMIUM).exists():
         pytest.skip(f"needs {CHROMIUM} (Debian's chromium, installed by scripts/setup-system.sh)")
     from playwright.sync_api import sync_playwright

@@ -71,3 +71,14 @@ def test_exclusion_rule_skips_links_without_collision_shapes() -> None:
     assert ("shank_L", "foot_L") in pairs  # the ankle link between them has no shape
     assert not any("thigh_R" in pair and "thigh_L" in pair for pair in pairs)
     assert not any(pair == ("torso", "forearm_L") for pair in pairs)
+
+
+def test_shapes_that_all_but_touch_in_the_reference_pose_count_as_touching() -> None:
+    """The Wolfgang's head hull sits half a millimetre above its torso hull: without rule 2's
+    margin, the head would stick on the torso as soon as it tilts down."""
+    from pathlib import Path
+
+    wolfgang = Path(__file__).resolve().parents[3] / "configs/examples/robots/wolfgang"
+    pairs = set(excluded_pairs(robot_model(str(wolfgang))))
+    assert ("torso", "link:head") in pairs
+    assert ("torso", "link:l_upper_arm") not in pairs  # 15 mm apart: they collide

@@ -98,8 +98,9 @@ def test_accelerometer_noise_and_saturation() -> None:
 
 def test_joint_positions_are_quantised_encoder_readings() -> None:
     world = _world(SensorModel())
-    resolution = 2 * math.pi / 4096
     slot = world.index.by_id[RED_1].motor_slot["Head"]
+    resolution = world.index.by_id[RED_1].model.motors[slot].encoder_resolution_rad
+    assert resolution == pytest.approx(2 * math.pi / 4096, rel=1e-6)  # the catalogue's 4096 counts
     qpos = int(world.index.by_id[RED_1].motor_qpos[slot])
     rng = np.random.default_rng(0)
     noise = _noise(world)
