@@ -13,7 +13,6 @@ from typing import Any
 
 from cluster import JobState, JobStatus, MatchJob, NodeJob, PoolNode
 from contracts import files
-from contracts.sim_result import PlayRecord
 from contracts.match_results import (
     Failure,
     MatchLimits,
@@ -21,6 +20,7 @@ from contracts.match_results import (
     MatchResults,
     RobotResult,
 )
+from contracts.sim_result import PlayRecord
 from orchestrator.private_files import private_dir, write_private
 
 
