@@ -16,7 +16,8 @@ Kid-default link lengths (metres; adult-default multiplies every length by ``ADU
     thigh              0.16  hip point -> knee
     shank              0.16  knee -> ankle point
     ankle height       0.045 ankle point -> sole
-    foot box           0.17 long x 0.09 wide x 0.02 thick, centre 0.01 forward of the ankle
+    foot               0.17 long x 0.09 wide x 0.02 high, centre 0.01 forward of the ankle: a
+                       plate 0.008 thick on four cleats (spheres r 0.006, one in each corner)
     standing height    pelvis centre 0.395 above the ground with every motor at zero
     shoulder           (0, +-0.115, 0.17); upper arm 0.11, forearm 0.11 (hand at its end)
     neck               (0, 0, 0.21); head sphere r 0.06, camera 0.0552 forward of its centre
@@ -88,6 +89,7 @@ class HumanoidGeometry:
     foot_half_width_m: float = 0.045
     foot_half_thickness_m: float = 0.01
     foot_forward_m: float = 0.01
+    cleat_radius_m: float = 0.006  # four spherical cleats under each sole, 2 radii high
     torso_half_size_m: tuple[float, float, float] = (0.055, 0.085, 0.105)
     torso_centre_z_m: float = 0.1
     shoulder_y_m: float = 0.115

@@ -1,6 +1,36 @@
 """The pitch entity: turf (field plus border strip), visual lines, lights and the video camera.
 
 The turf's texture and the lights' strength come from the look (:mod:`simulator.world.look`).
+
+The turf is the league's soft grass. Its contact parameters in the league's Webots world
+(RoboCup-Humanoid-TC/hlvs_webots ``worlds/robocup.wbt``: ``ContactProperties`` of material
+``grass``: ``coulombFriction 0.5``, ``softCFM 0.03``, ``softERP`` left at 0.2, ``basicTimeStep``
+8 ms) are ODE's soft contact, which is a spring and damper per contact point (ODE manual,
+"Soft constraint and constraint force mixing": ``ERP = h kp / (h kp + kd)``,
+``CFM = 1 / (h kp + kd)``)::
+
+    kp = ERP / (h CFM) = 0.2 / (0.008 s * 0.03) = 833 N/m      per contact point
+    kd = (1 - ERP) / CFM = 0.8 / 0.03          = 26.7 N s/m
+
+A KidSize robot of 4.9 kg (``kid-default``) standing on its eight cleats sinks
+``m g / (8 kp)`` = 7.2 mm; on one foot twice that (:data:`GRASS_SINKAGE_M`).
+
+MuJoCo's soft contacts are normalised by mass and let part of the unconstrained acceleration
+through: ``a1 + d (b v + k r) = (1 - d) a0`` (MuJoCo documentation, Computation, "Soft
+constraints"; ``d`` the impedance of ``solimp``, ``k`` and ``b`` from ``solref``), and the
+friction of a contact gets the same softness: a loaded contact creeps sideways at a speed
+proportional to ``(1 - d) / b``. A linear spring of the league's sinkage (constant ``d``) made a
+standing robot's feet creep 10 to 20 cm in a second under a 0.1 g push, rigid turf 1.8 mm. The
+grass is therefore built from the impedance: ``d`` rises from 0 to 0.99 over the first 9 mm of
+depth (``solimp`` width 9 mm, midpoint 0.5, power 2), which is the soft give of the grass, and a
+small stiffness and a large damping (``solref`` in the direct form, -30 s^-2 and -80 s^-1) hold a
+contact where ``d`` is high, so that friction stays firm. Measured
+(``tests/unit/world/test_world_turf.py``): a standing ``kid-default`` sinks about 7 mm (the
+league's 7.2 mm), the same for every robot (MuJoCo's softness does not depend on mass), its
+feet creep about 3.5 mm under the 0.1 g push, and a block sliding on the turf decelerates as
+Coulomb friction of 0.5. The ball keeps its own contact parameters (higher priority,
+:mod:`simulator.world.ball`). The league's ``bounce 0.5`` of robot-grass contacts is not
+modelled (MuJoCo contacts do not restitute beyond their spring and damper).
 """
 
 from __future__ import annotations
@@ -11,9 +41,16 @@ from contracts.field import FieldGeometry
 from simulator.world.look import TURF_TEXTURE
 
 TURF_FRICTION = 0.5
+GRASS_SOLREF = (-30.0, -80.0)  # direct form: -stiffness (1/s^2), -damping (1/s)
+GRASS_SOLIMP = (0.0, 0.99, 0.009, 0.5, 2.0)  # impedance 0 -> 0.99 over the first 9 mm of depth
+GRASS_SINKAGE_M = 0.0072  # league's world: a 4.9 kg robot on eight contact points (see above)
 LINE_HEIGHT_M = 0.001
 LINE_RGBA = "1 1 1 1"
 CIRCLE_SEGMENTS = 48
+
+
+def _f(values: tuple[float, ...]) -> str:
+    return " ".join(f"{v:.9g}" for v in values)
 
 
 def _box(name: str, x: float, y: float, half_x: float, half_y: float, yaw: float = 0.0) -> str:
@@ -65,7 +102,7 @@ def field_bodies(f: FieldGeometry, *, static_bits: tuple[int, int]) -> str:
     parts = [
         f'<geom name="turf" type="plane" size="{tx:.6g} {ty:.6g} 0.1" material="{TURF_TEXTURE}" '
         f'friction="{TURF_FRICTION} 0.005 0.0001" priority="1" contype="{contype}" '
-        f'conaffinity="{conaffinity}"/>',
+        f'conaffinity="{conaffinity}" solref="{_f(GRASS_SOLREF)}" solimp="{_f(GRASS_SOLIMP)}"/>',
         '<light name="sun" directional="true" pos="0 0 10" dir="0.2 0.3 -1" '
         'diffuse="0.7 0.7 0.7" castshadow="false"/>',
         '<light name="fill" directional="true" pos="0 0 10" dir="-0.2 -0.3 -1" '

@@ -1,5 +1,9 @@
 """MJCF of our humanoid (primitive geoms only), parameterised by :class:`HumanoidGeometry`.
 
+Each sole stands on four spherical cleats, one in each corner (``foot:cleat_<side><l|r><b|f>``),
+under a plate (``foot:sole_<side>``) two cleat radii above the ground: four contact points per
+foot on the soft turf (:mod:`simulator.world.field`), each under its corner's force sensor.
+
 Geom names carry their body part for contact reporting: ``<prefix>/<part>:<label>`` where part is
 a :class:`referee.snapshot.BodyPart` value (foot, hand, arm, head, torso, leg). Visual-only geoms
 (markers) use the part ``visual`` and never collide.
@@ -64,7 +68,6 @@ def _leg(w: _Writer, side: str) -> str:
     r_thigh = g.foot_half_width_m * 0.65
     hl, hw, ht = g.foot_half_length_m, g.foot_half_width_m, g.foot_half_thickness_m
     fx, sole = g.foot_forward_m, -g.ankle_height_m
-    foot_z = sole + ht
     sites = []
     letter = side.lower()
     for ny, y_name in ((1.0, "l"), (-1.0, "r")):
@@ -89,13 +92,25 @@ def _leg(w: _Writer, side: str) -> str:
         LIMB_RGBA,
         g.shank_kg,
     )
+    cleat = g.cleat_radius_m
+    plate = ht - cleat  # half thickness of the plate resting on the cleats
     foot = w.geom(
         "foot",
         "sole_" + side,
-        f'type="box" pos="{_f(fx, 0, foot_z)}" size="{_f(hl, hw, ht)}"',
+        f'type="box" pos="{_f(fx, 0, sole + 2 * cleat + plate)}" size="{_f(hl, hw, plate)}"',
         FOOT_RGBA,
         g.foot_kg,
     )
+    for ny, y_name in ((1.0, "l"), (-1.0, "r")):
+        for nx, x_name in ((-1.0, "b"), (1.0, "f")):
+            foot += w.geom(
+                "foot",
+                f"cleat_{side}{y_name}{x_name}",
+                f'type="sphere" pos="{_f(fx + nx * (hl - cleat), ny * (hw - cleat), sole + cleat)}" '
+                f'size="{cleat:.6g}"',
+                FOOT_RGBA,
+                0.0,
+            )
     return f"""
 <body name="{w.p}/hip_yaw_{side}" pos="{_f(0, sign * g.hip_y_m, g.hip_z_m)}">
  {small}{w.joint("PelvY" + side, (0, 0, 1))}

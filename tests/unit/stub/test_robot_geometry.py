@@ -56,8 +56,8 @@ def test_kinematics_match_the_compiled_model(name: str) -> None:
         assert np.linalg.norm(hip - knee) == pytest.approx(kin.leg.thigh_m, abs=1e-9)
         assert np.linalg.norm(knee - ankle) == pytest.approx(kin.leg.shank_m, abs=1e-9)
         assert anchor(f"Foot{side}") == pytest.approx(ankle, abs=1e-9)
-        sole = model.geom(f"r/foot:sole_{side}").id
-        sole_bottom = data.geom_xpos[sole][2] - model.geom_size[sole][2]
+        cleats = [model.geom(f"r/foot:cleat_{side}{y}{x}").id for y in "lr" for x in "bf"]
+        sole_bottom = min(data.geom_xpos[c][2] - model.geom_size[c][0] for c in cleats)
         assert ankle[2] - sole_bottom == pytest.approx(kin.leg.ankle_height_m, abs=1e-9)
         assert sole_bottom == pytest.approx(0.0, abs=1e-9)  # standing on the ground at zero
 

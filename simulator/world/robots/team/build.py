@@ -6,7 +6,9 @@ force sensors, bodies marking the hands and feet for the referee, and a team-col
 Collision geometry is simplified to one box per moving part, around the collision shapes of a
 link and of every link welded to it (``collision: "link-boxes"``, the default: hundreds of small
 shapes cost more than the rest of the world) or kept as it is; visual meshes are kept for
-cameras and video.
+cameras and video. A foot's cleats are kept as the model's own shapes (:func:`_cleats`: the
+Wolfgang's eight spheres), the rest of the foot becomes its box; a foot without cleats stands on
+its box's four corners.
 
 Names follow the world's contract (see :mod:`simulator.world.robots.humanoid`): the root body
 ``<prefix>/torso`` with the free joint ``<prefix>/root``, joints and actuators by HLVS motor name,
@@ -36,6 +38,20 @@ HULL = (
     ("feet", 1, "foot_R"),
 )
 MARKER_RADIUS_M = 0.04
+CLEAT_BAND_M = 0.003
+"""A cleat's lowest point is at most this far above the foot's lowest point (standing pose)."""
+CLEAT_MAX_M = 0.03
+"""A cleat is a primitive shape at most this wide (cleats are small; a sole plate is not)."""
+_PRIMITIVES = frozenset(
+    int(t)
+    for t in (
+        mujoco.mjtGeom.mjGEOM_SPHERE,
+        mujoco.mjtGeom.mjGEOM_CAPSULE,
+        mujoco.mjtGeom.mjGEOM_CYLINDER,
+        mujoco.mjtGeom.mjGEOM_ELLIPSOID,
+        mujoco.mjtGeom.mjGEOM_BOX,
+    )
+)
 
 
 @dataclass(frozen=True, slots=True)
@@ -81,19 +97,57 @@ def _owner(model: mujoco.MjModel, body: int) -> int:
     return body
 
 
+def _cleats(model: mujoco.MjModel, manifest: Manifest) -> set[int]:
+    """Geom ids of the feet's cleats: in each foot (the manifest's foot link and every link
+    welded to it), the small primitive collision shapes (at most :data:`CLEAT_MAX_M` across)
+    whose lowest point in the standing pose is within :data:`CLEAT_BAND_M` of the foot's lowest
+    point, when there are at least three of them (a foot resting on fewer is not on cleats)."""
+    data = mujoco.MjData(model)
+    joints = {m.name: m.joint for m in manifest.motors}
+    for name, rad in manifest.standing_pose_rad.items():
+        data.qpos[model.jnt_qposadr[model.joint(joints[name]).id]] = rad
+    mujoco.mj_kinematics(model, data)
+    out: set[int] = set()
+    for link in manifest.feet:
+        owner = _owner(model, model.body(link).id)
+        bottoms: dict[int, float] = {}
+        for g in range(model.ngeom):
+            if not (model.geom_contype[g] or model.geom_conaffinity[g]):
+                continue
+            if _owner(model, int(model.geom_bodyid[g])) != owner:
+                continue
+            rot = data.geom_xmat[g].reshape(3, 3)
+            centre = data.geom_xpos[g] + rot @ model.geom_aabb[g][:3]
+            bottoms[g] = float(centre[2] - np.abs(rot[2]) @ model.geom_aabb[g][3:])
+        if not bottoms:
+            continue
+        lowest = min(bottoms.values())
+        cleats = {
+            g
+            for g, bottom in bottoms.items()
+            if bottom <= lowest + CLEAT_BAND_M
+            and int(model.geom_type[g]) in _PRIMITIVES
+            and 2 * float(model.geom_aabb[g][3:].max()) <= CLEAT_MAX_M
+        }
+        if len(cleats) >= 3:
+            out |= cleats
+    return out
+
+
 def _collision_boxes(
-    model: mujoco.MjModel, *, merge_welded: bool
+    model: mujoco.MjModel, *, merge_welded: bool, skip: set[int] | None = None
 ) -> dict[int, tuple[np.ndarray, np.ndarray]]:
     """Body id -> (min, max) corners, in that body's frame, of its collision geoms, at the zero
     pose. With ``merge_welded`` a body also takes the geoms of every body welded to it (no joint
     between them): one box per moving part. The feet's cleats, sole plates and frames become one
-    box per foot: a few contacts with the turf where dozens of small shapes made hundreds."""
+    box per foot: a few contacts with the turf where dozens of small shapes made hundreds.
+    Geoms in ``skip`` (the cleats, kept as they are) are left out."""
     data = mujoco.MjData(model)
     mujoco.mj_kinematics(model, data)
     signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
     boxes: dict[int, tuple[np.ndarray, np.ndarray]] = {}
     for g in range(model.ngeom):
-        if not (model.geom_contype[g] or model.geom_conaffinity[g]):
+        if not (model.geom_contype[g] or model.geom_conaffinity[g]) or g in (skip or ()):
             continue
         body = int(model.geom_bodyid[g])
         owner = _owner(model, body) if merge_welded else body
@@ -108,6 +162,28 @@ def _collision_boxes(
     return boxes
 
 
+def _add_cleat(
+    body: mujoco.MjsBody, model: mujoco.MjModel, geom: int, owner: int, name: str
+) -> None:
+    """Copy cleat ``geom`` onto its moving part ``owner`` (the body in the spec), where the
+    part's force sensor sites see its contacts (a touch sensor counts its own body's)."""
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    rot = data.xmat[owner].reshape(3, 3)
+    local = rot.T @ data.geom_xmat[geom].reshape(3, 3)
+    quat = np.zeros(4)
+    mujoco.mju_mat2Quat(quat, local.flatten())
+    cleat = body.add_geom()
+    cleat.name = name
+    cleat.type = mujoco.mjtGeom(int(model.geom_type[geom]))
+    cleat.size = model.geom_size[geom]
+    cleat.pos = rot.T @ (data.geom_xpos[geom] - data.xpos[owner])
+    cleat.quat = quat
+    cleat.group = 3
+    cleat.mass = 0
+    cleat.rgba = (0.5, 0.5, 0.5, 0.0)
+
+
 def _sensor_sites(
     model: mujoco.MjModel,
     manifest: Manifest,
@@ -115,9 +191,10 @@ def _sensor_sites(
 ) -> dict[str, dict[str, tuple[np.ndarray, np.ndarray]]]:
     """Owner link -> sensor link -> (min, max) of its touch sensor site in the owner's frame.
 
-    With one box per foot the turf touches the box's bottom corners, so each force sensor
-    measures the quarter of the sole (split at the box's centre) its link lies in, from 5 mm
-    below to 5 mm above the sole."""
+    The turf touches a foot at its cleats or its box's bottom corners, so each force sensor
+    measures the quarter of the sole (split at the centre of the box around the whole foot,
+    cleats included) its link lies in, from 15 mm below to 5 mm above the sole (the soft turf
+    lets a loaded foot sink about 7 mm, see :mod:`simulator.world.field`)."""
     data = mujoco.MjData(model)
     mujoco.mj_kinematics(model, data)
     out: dict[str, dict[str, tuple[np.ndarray, np.ndarray]]] = {}
@@ -131,7 +208,7 @@ def _sensor_sites(
         mid = (lo + hi) / 2
         site_lo = np.where(centre < mid, lo - 2e-3, mid)
         site_hi = np.where(centre < mid, mid, hi + 2e-3)
-        site_lo[2], site_hi[2] = lo[2] - 5e-3, lo[2] + 5e-3
+        site_lo[2], site_hi[2] = lo[2] - 15e-3, lo[2] + 5e-3
         out.setdefault(model.body(owner).name, {})[link] = (site_lo, site_hi)
     return out
 
@@ -236,8 +313,9 @@ def build_template(spec: mujoco.MjSpec, manifest: Manifest, *, key: str) -> Temp
         raise ModelError(problems)
     original = spec.compile()
     boxes = _collision_boxes(original, merge_welded=False)
-    owner_boxes = _collision_boxes(original, merge_welded=True)
-    sensor_sites = _sensor_sites(original, manifest, owner_boxes)
+    sensor_sites = _sensor_sites(original, manifest, _collision_boxes(original, merge_welded=True))
+    cleats = _cleats(original, manifest) if manifest.collision == "link-boxes" else set()
+    owner_boxes = _collision_boxes(original, merge_welded=True, skip=cleats)
     parts = _parts(spec, manifest)
     root = spec.worldbody.bodies[0]
     root_name = root.name
@@ -280,6 +358,9 @@ def build_template(spec: mujoco.MjSpec, manifest: Manifest, *, key: str) -> Temp
             box.group = 3
             box.mass = 0
             box.rgba = (0.5, 0.5, 0.5, 0.0)
+        own = [g for g in sorted(cleats) if _owner(original, int(original.geom_bodyid[g])) == b]
+        for k, g in enumerate(own):
+            _add_cleat(body, original, g, b, f"{p}/{part}:{link}_cleat_{k}")
         for joint in body.joints:
             motor = motors[joint.name]
             ranges[motor.name] = (float(joint.range[0]), float(joint.range[1]))
