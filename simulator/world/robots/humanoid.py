@@ -103,11 +103,11 @@ def _leg(w: _Writer, side: str) -> str:
     )
     for ny, y_name in ((1.0, "l"), (-1.0, "r")):
         for nx, x_name in ((-1.0, "b"), (1.0, "f")):
+            at = _f(fx + nx * (hl - cleat), ny * (hw - cleat), sole + cleat)
             foot += w.geom(
                 "foot",
                 f"cleat_{side}{y_name}{x_name}",
-                f'type="sphere" pos="{_f(fx + nx * (hl - cleat), ny * (hw - cleat), sole + cleat)}" '
-                f'size="{cleat:.6g}"',
+                f'type="sphere" pos="{at}" size="{cleat:.6g}"',
                 FOOT_RGBA,
                 0.0,
             )
