@@ -25,10 +25,10 @@ grass is therefore built from the impedance: ``d`` rises from 0 to 0.99 over the
 depth (``solimp`` width 9 mm, midpoint 0.5, power 2), which is the soft give of the grass, and a
 small stiffness and a large damping (``solref`` in the direct form, -30 s^-2 and -80 s^-1) hold a
 contact where ``d`` is high, so that friction stays firm. Measured
-(``tests/unit/world/test_world_turf.py``): a standing ``kid-default`` sinks about 7 mm (the
-league's 7.2 mm), the same for every robot (MuJoCo's softness does not depend on mass), its
-feet creep about 3.5 mm under the 0.1 g push, and a block sliding on the turf decelerates as
-Coulomb friction of 0.5. The ball keeps its own contact parameters (higher priority,
+(``tests/unit/world/test_world_turf.py``): a standing ``kid-default`` sinks 6.9 mm (the league's
+7.2 mm), the same for every robot (MuJoCo's softness does not depend on mass), its feet creep
+3.9 mm under the 0.1 g push, and a block sliding on the turf feels a friction force 0.48 times
+its normal force (configured 0.5). The ball keeps its own contact parameters (higher priority,
 :mod:`simulator.world.ball`). The league's ``bounce 0.5`` of robot-grass contacts is not
 modelled (MuJoCo contacts do not restitute beyond their spring and damper).
 """
