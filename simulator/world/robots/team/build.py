@@ -7,8 +7,8 @@ Collision geometry is simplified to one box per moving part, around the collisio
 link and of every link welded to it (``collision: "link-boxes"``, the default: hundreds of small
 shapes cost more than the rest of the world) or kept as it is; visual meshes are kept for
 cameras and video. A foot's cleats are kept as the model's own shapes (:func:`_cleats`: the
-Wolfgang's eight spheres), the rest of the foot becomes its box; a foot without cleats stands on
-its box's four corners.
+Wolfgang's eight spheres), the rest of the foot, less the links carrying the cleats, becomes its
+box; a foot without cleats stands on its box's four corners.
 
 Names follow the world's contract (see :mod:`simulator.world.robots.humanoid`): the root body
 ``<prefix>/torso`` with the free joint ``<prefix>/root``, joints and actuators by HLVS motor name,
@@ -131,6 +131,17 @@ def _cleats(model: mujoco.MjModel, manifest: Manifest) -> set[int]:
         }
         if len(cleats) >= 3:
             out |= cleats
+    return out
+
+
+def _cleat_links(model: mujoco.MjModel, cleats: set[int]) -> set[int]:
+    """The cleats and the other shapes of the links that carry them (a cleat link's stem above
+    its tip): left out of the foot's box, which keeps its sole plate above the grass."""
+    out = set(cleats)
+    for g in cleats:
+        body = int(model.geom_bodyid[g])
+        if _owner(model, body) != body:  # a cleat link welded to the foot, not the foot itself
+            out |= {h for h in range(model.ngeom) if int(model.geom_bodyid[h]) == body}
     return out
 
 
@@ -315,7 +326,7 @@ def build_template(spec: mujoco.MjSpec, manifest: Manifest, *, key: str) -> Temp
     boxes = _collision_boxes(original, merge_welded=False)
     sensor_sites = _sensor_sites(original, manifest, _collision_boxes(original, merge_welded=True))
     cleats = _cleats(original, manifest) if manifest.collision == "link-boxes" else set()
-    owner_boxes = _collision_boxes(original, merge_welded=True, skip=cleats)
+    owner_boxes = _collision_boxes(original, merge_welded=True, skip=_cleat_links(original, cleats))
     parts = _parts(spec, manifest)
     root = spec.worldbody.bodies[0]
     root_name = root.name
