@@ -14,7 +14,7 @@ from .conftest import RED_1, run_steps
 # one motion the left knee lifts and the left hip rolls to its inward limit, swinging the left leg
 # across the stance leg. Passing through it, the swung leg's weight comes over the stance foot and
 # the robot stands on one leg; striking it, the leg stays on the inside, pushes the stance leg out
-# and the robot topples over it (in about 1.5 s, for a weight shift anywhere from 0.065 to 0.085).
+# and the robot topples to its left (1.0 to 1.6 s later, for a weight shift from 0.065 to 0.085).
 WEIGHT_RIGHT = {"PelvL": 0.075, "PelvR": 0.075, "FootL": -0.075, "FootR": -0.075}
 KICK_ACROSS = {"LegUpperL": 0.6, "LegLowerL": 1.2, "AnkleL": 0.6, "PelvL": -0.6}
 
