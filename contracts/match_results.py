@@ -270,6 +270,7 @@ class MatchReport(Versioned):
 __all__ = [
     "SALVAGED_KEYS",
     "AdmissionRecord",
+    "Color",
     "Failure",
     "FailureClass",
     "Forfeit",
@@ -279,6 +280,7 @@ __all__ = [
     "MatchResults",
     "NeededAvailable",
     "RobotResult",
+    "Scalar",
     "Salvage",
     "SalvagedRobot",
 ]

@@ -23,8 +23,7 @@ from envs.frame import SENSOR_NAMES, Frame
 from envs.perception import CameraView, add_noise, field_segments, goal_post_feet
 from envs.randomization import episode_world
 from envs.session_spec import ResetRequest, SessionSpec
-from referee import GameState, Referee, RobotId, TeamColor
-from referee.snapshot import PlaceBall, TeleportRobot
+from referee import GameState, PlaceBall, Referee, RobotId, TeamColor, TeleportRobot
 from simulator.world import MOTOR_NAMES, RobotPlacement, World, robot_model
 
 FloatArray = npt.NDArray[np.float64]

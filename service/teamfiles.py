@@ -25,9 +25,9 @@ from typing import Any
 from sqlalchemy import func, select
 from sqlalchemy.orm import Session
 
+from orchestrator import ConfigError, Problem
 from orchestrator.config import FieldClass, TeamConfig, check_team_document
 from orchestrator.config.robot_models import BUILT_IN_MODELS
-from orchestrator.errors import ConfigError, Problem
 from service.db import TeamFile
 from service.errors import InvalidInput, NotFound
 from service.sealing import PREFIX, Sealer

@@ -25,8 +25,7 @@ from typing import TYPE_CHECKING, Any
 from sqlalchemy import func, select
 from sqlalchemy.orm import Session
 
-from cluster import JobState, JobStatus, MatchJob
-from cluster.errors import PoolError
+from cluster import JobState, JobStatus, MatchJob, PoolError
 from contracts import files
 from contracts.errors import ContractError
 from contracts.match_results import FailureClass, MatchReport
@@ -183,7 +182,7 @@ class QueueWorker:
         """League placement: a node for each robot (0: dense placement)."""
         if self.settings.placement != "league":
             return 0
-        from orchestrator.match.plan import robots_in_game
+        from orchestrator.match import robots_in_game
 
         return robots_in_game(game)
 

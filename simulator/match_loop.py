@@ -37,7 +37,7 @@ from typing import Any, Protocol, cast
 import numpy as np
 
 from contracts.telemetry import StateMessage
-from referee.snapshot import RefereeEvent, WorldCommand, WorldSnapshot
+from referee import RefereeEvent, WorldCommand, WorldSnapshot
 from simulator.api import ApiServer, LockstepSettings, wait_lockstep
 from simulator.api.lockstep import Pipeline
 from simulator.telemetry import POSES_PERIOD_S, STATE_PERIOD_S, Telemetry

@@ -18,8 +18,8 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
+from orchestrator import ConfigError, Problem, ScheduleError
 from orchestrator.config.schedule import PlannedMatch, Schedule, load_schedule, resolve_time
-from orchestrator.errors import ConfigError, Problem, ScheduleError
 from tournament.state import Ledger, ScheduledMatchState
 
 log = logging.getLogger(__name__)

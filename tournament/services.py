@@ -27,6 +27,7 @@ from typing import Any, Protocol
 from contracts import files
 from contracts.errors import ContractError
 from contracts.match_results import MatchReport, MatchResults
+from orchestrator import ScheduleError
 from orchestrator.config.schedule import (
     PlannedMatch,
     Schedule,
@@ -34,7 +35,6 @@ from orchestrator.config.schedule import (
     SchedulePool,
     game_document,
 )
-from orchestrator.errors import ScheduleError
 from tournament.logs import TeamLogs
 
 log = logging.getLogger(__name__)
@@ -271,8 +271,7 @@ class MatchServices:
         """The match as a Slurm job (no requeue: tournament matches wait for the operator).
         A job an earlier scheduler submitted for this match, still in Slurm or finished with
         its report, is adopted instead of playing the match again."""
-        from cluster import JobState, MatchJob
-        from cluster.errors import PoolError
+        from cluster import JobState, MatchJob, PoolError
         from cluster.slurm import HOST_NETNS, SlurmPool
 
         settings = self.schedule.pool
@@ -371,6 +370,6 @@ def _robot_nodes(pool: SchedulePool, game: Path) -> int:
     """League placement: a node for each robot of the match (0: dense placement)."""
     if pool.placement != "league":
         return 0
-    from orchestrator.match.plan import robots_in_game
+    from orchestrator.match import robots_in_game
 
     return robots_in_game(game)

@@ -32,7 +32,7 @@ from fastapi.responses import FileResponse, Response, StreamingResponse
 from fastapi.staticfiles import StaticFiles
 
 from contracts import files
-from simulator.errors import ReplayError
+from simulator import ReplayError
 from simulator.replay import ReplayFile, scene_for
 from simulator.traffic import read_stats
 from viewer.live import FeedFactory, LiveUnavailable, ZenohFeed

@@ -13,8 +13,7 @@ from typing import Any
 from fastapi import APIRouter, FastAPI, Request
 from pydantic import BaseModel
 
-from service.deps import OperatorPrincipal, get_services
-from service.errors import NotFound
+from service import NotFound, OperatorPrincipal, get_services
 from viewer.api import build_router
 from viewer.sources import LiveSource, ReplaySource, live_of
 

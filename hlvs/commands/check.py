@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TextIO
 
-from orchestrator.errors import ConfigError, OrchestratorError, Problem
+from orchestrator import ConfigError, OrchestratorError, Problem
 from orchestrator.exitcodes import ExitCode
 from orchestrator.paths import user_path
 

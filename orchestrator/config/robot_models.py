@@ -50,7 +50,7 @@ def check_model(
     """Problems and measurements of a model package (None when it cannot even be loaded);
     free-form servos are warnings, or errors when ``official``. Imports the simulator's model
     loader (and MuJoCo) on first use."""
-    from simulator.errors import ModelError
+    from simulator import ModelError
     from simulator.world.robots.team import load_team_model
     from simulator.world.robots.team.rulebook import check
 

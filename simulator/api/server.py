@@ -31,7 +31,7 @@ from typing import Any
 from contracts.ids import RobotId
 from contracts.match_spec import NetworkSpec
 from contracts.robot_api import messages_pb2 as pb
-from referee.spoofing import SpoofingLog
+from referee import SpoofingLog
 from simulator.api.batch import StepBatch
 from simulator.api.cameras import MAX_IN_FLIGHT, ImageSource
 from simulator.api.connection import ClientClosed, Connection
