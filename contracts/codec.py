@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any, ClassVar, Literal, TypeVar, Union, get_args, get_origin, get_type_hints
 
 from contracts.errors import ContractError, UnknownVersion
+from contracts.jsontypes import JSONObject
 
 T = TypeVar("T")
 V = TypeVar("V", bound="Versioned")
@@ -170,8 +171,8 @@ class Versioned:
     KIND: ClassVar[str] = "document"
     FILE_MODE: ClassVar[int | None] = None  # permissions of a written file (None: the umask's)
 
-    def to_dict(self) -> dict[str, Any]:
-        data: dict[str, Any] = to_data(self)
+    def to_dict(self) -> JSONObject:
+        data: JSONObject = to_data(self)
         return data
 
     def to_json(self, *, indent: int | None = 2) -> str:

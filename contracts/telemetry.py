@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from typing import Any, Literal, NotRequired, TypedDict
 
 from contracts.codec import from_data, to_data
+from contracts.jsontypes import JSONObject
 
 PREFIX = "hlvs"
 Kind = Literal["state", "events", "poses", "scene"]
@@ -108,8 +109,8 @@ class StateMessage:
     stepping: str
     robots: dict[str, RobotTraffic] | None  # robot API traffic per robot key
 
-    def to_dict(self) -> dict[str, Any]:
-        data: dict[str, Any] = to_data(self)
+    def to_dict(self) -> JSONObject:
+        data: JSONObject = to_data(self)
         return data
 
     @classmethod
