@@ -22,7 +22,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Protocol
 
 from contracts import files
 from contracts.errors import ContractError
@@ -36,6 +36,7 @@ from orchestrator.config.schedule import (
     game_document,
 )
 from tournament.logs import TeamLogs
+from tournament.state import MatchResultRecord
 
 log = logging.getLogger(__name__)
 
@@ -83,7 +84,7 @@ class PlayOutcome:
     cause: str = ""
     shootout: dict[str, int] | None = None  # color -> goals in the penalty shoot-out
 
-    def as_dict(self, ctx: MatchContext) -> dict[str, Any]:
+    def as_dict(self, ctx: MatchContext) -> MatchResultRecord:
         team = {"red": ctx.red.name, "blue": ctx.blue.name}
         return {
             "status": self.status,
