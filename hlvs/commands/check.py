@@ -25,6 +25,7 @@ from orchestrator.paths import user_path
 if TYPE_CHECKING:
     from contracts.field import FieldClass
     from orchestrator.config.detect import Kind
+    from simulator.world.robots.team.rulebook import MeasurementsRecord
 
 log = logging.getLogger(__name__)
 
@@ -91,7 +92,7 @@ class FileReport:
     file: str
     kind: str | None
     problems: list[Problem] = field(default_factory=list)
-    measurements: dict[str, Any] | None = None  # robot model packages
+    measurements: MeasurementsRecord | None = None  # robot model packages
 
     @property
     def errors(self) -> list[Problem]:
