@@ -29,6 +29,7 @@ from typing import Any, Literal, TypedDict
 import yaml
 
 from contracts import files
+from contracts.jsontypes import JSONObject
 from contracts.match_results import MatchResults
 from contracts.match_spec import MatchSpec
 from orchestrator.config import LoadedGame
@@ -217,7 +218,7 @@ def compose_files(
     simulator_image: str,
     subnets: Subnets | None = None,
     cpu_count: int | None = None,
-) -> tuple[ComposeDocument, dict[str, Any]]:
+) -> tuple[ComposeDocument, JSONObject]:
     """(compose document, match_spec.json content) for the validated game ``loaded``."""
     requests = match_requests(
         loaded,

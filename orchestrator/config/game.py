@@ -10,6 +10,7 @@ from __future__ import annotations
 import hashlib
 import os
 import re
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, Literal, cast
 
@@ -191,7 +192,7 @@ def _timing(document: GameDocument, where: Collector, *, fast: bool) -> Timing:
     As in HLVS, a game run as fast as possible (maximum_real_time_factor <= 0) waits only 5 s
     before the first READY and 2 s at half time unless ``timing`` says otherwise.
     """
-    written: dict[str, Any] = dict(document.get("timing", {}))
+    written: dict[str, float] = dict(document.get("timing", {}))
     if fast:
         written.setdefault("wait_before_first_ready_s", FAST_WAIT_BEFORE_FIRST_READY_S)
         written.setdefault("half_time_break_s", FAST_HALF_TIME_BREAK_S)
@@ -241,7 +242,7 @@ def _timing(document: GameDocument, where: Collector, *, fast: bool) -> Timing:
     return timing
 
 
-def _check_play_time(timing: Timing, written: dict[str, Any], game_type: Any,
+def _check_play_time(timing: Timing, written: Mapping[str, float], game_type: Any,
                      where: Collector) -> None:
     """A half whose READY plus SET leaves less than the minimum of play is refused
     (:mod:`contracts.timing`): the match would end 0:0 without a kick."""
@@ -260,7 +261,7 @@ def _check_play_time(timing: Timing, written: dict[str, Any], game_type: Any,
                     f"({timing.minimum_play_s:g} s) <= {name}")
 
 
-def _limits(raw: dict[str, Any]) -> Limits:
+def _limits(raw: dict[str, float]) -> Limits:
     values: dict[str, Any] = {k: (int(v) if k == "pids" else float(v)) for k, v in raw.items()}
     return Limits(**values)
 
