@@ -18,6 +18,7 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
+from collections.abc import Mapping
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -94,7 +95,7 @@ def service_problems(kind: str, document: Any) -> tuple[Any, list[Problem]]:
     return {**document, "credentials": cleaned}, problems
 
 
-def _builtin_models_only(document: dict[str, Any],
+def _builtin_models_only(document: Mapping[str, object],
                          problems: list[Problem]) -> tuple[Any, list[Problem]]:
     """A robot model package is a folder of the host that reads the file: refused (and taken
     out, unread) in the service, which plays the built-in models."""

@@ -13,6 +13,7 @@ import json
 import logging
 import sys
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 from orchestrator.paths import user_path
@@ -35,7 +36,7 @@ def guarded(func: Callable[[argparse.Namespace], int]) -> Callable[[argparse.Nam
 
 def _settings(args: argparse.Namespace) -> Settings:
     settings = Settings.from_env()
-    changes: dict[str, Any] = {}
+    changes: dict[str, Path | str] = {}
     if getattr(args, "data_dir", None) is not None:
         changes["data_dir"] = args.data_dir
     if getattr(args, "database_url", None):
