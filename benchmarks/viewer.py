@@ -32,7 +32,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict
 
 from orchestrator.paths import user_path
 
@@ -47,7 +47,12 @@ LAUNCH_ARGS = [
 ]
 
 
-def write_replay(path: Path, *, half_s: int = HALF_S, seed: int = 7) -> dict[str, Any]:
+class ReplayWritten(TypedDict):
+    write_s: float  # wall time to write the replay
+    bodies: int  # bodies per frame
+
+
+def write_replay(path: Path, *, half_s: int = HALF_S, seed: int = 7) -> ReplayWritten:
     """A 4 v 4 replay of two halves of ``half_s`` seconds (see the module docstring)."""
     import mujoco
     import numpy as np
