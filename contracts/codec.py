@@ -13,7 +13,17 @@ import types
 from dataclasses import MISSING, Field, fields, is_dataclass
 from enum import Enum
 from pathlib import Path
-from typing import Any, ClassVar, Literal, TypeVar, Union, get_args, get_origin, get_type_hints
+from typing import (
+    Any,
+    ClassVar,
+    Literal,
+    TypeVar,
+    Union,
+    get_args,
+    get_origin,
+    get_type_hints,
+    is_typeddict,
+)
 
 from contracts.errors import ContractError, UnknownVersion
 from contracts.jsontypes import JSONObject
@@ -97,6 +107,8 @@ def convert(hint: Any, value: Any, *, source: str, pointer: str) -> Any:
         return value
     if is_dataclass(hint):
         return from_data(hint, value, source=source, pointer=pointer)  # type: ignore[arg-type]
+    if is_typeddict(hint):  # a JSON object of a documented shape: checked as an object only
+        return convert(dict[str, Any], value, source=source, pointer=pointer)
     if isinstance(hint, type) and issubclass(hint, Enum):
         try:
             return hint(value)
