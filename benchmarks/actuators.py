@@ -13,7 +13,6 @@ import json
 import os
 import sys
 import time
-from typing import Any
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -27,7 +26,7 @@ def main(argv: list[str] | None = None) -> int:
     )  # fmt: skip
     parser.add_argument("--json", action="store_true", help="print only the JSON document")
     args = parser.parse_args(argv)
-    from simulator.world.servo_tests import SPEC_ERROR, STEP_ERROR, report
+    from simulator.world.servo_tests import SPEC_ERROR, STEP_ERROR, ServoReport, report
     from simulator.world.servos import find_servo, servo_ids
 
     chosen = args.servo or list(servo_ids())
@@ -37,7 +36,7 @@ def main(argv: list[str] | None = None) -> int:
             f"--servo: {', '.join(unknown)} not in the catalogue ({', '.join(servo_ids())})"
         )
     started = time.perf_counter()
-    servos: list[dict[str, Any]] = []
+    servos: list[ServoReport] = []
     for name in chosen:
         entry = find_servo(name)
         assert entry is not None

@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # the delivery code and the test servers are imported after the arguments
+    from orchestrator.config.documents import S3Document, SftpDocument
     from testkit.s3 import MotoServer, SeaweedServer
 
 __all__ = ["main"]
@@ -104,13 +105,16 @@ def _default_server(target: str) -> str:
     return "seaweedfs" if weed_binary() is not None else "moto"
 
 
-def _start(server: str, workdir: Path) -> tuple[dict[str, Any], Callable[[], None]]:
+def _start(
+    server: str, workdir: Path
+) -> tuple[SftpDocument | S3Document, Callable[[], None]]:
+    """The server running, the ``credentials`` of a credentials.json for it, its stop."""
     from testkit.s3 import MotoServer, SeaweedServer
     from testkit.sftp import AsyncsshServer, SshdServer
 
     if server in ("sshd", "asyncssh"):
         sftp = SshdServer.start() if server == "sshd" else AsyncsshServer.start(workdir)
-        body = {
+        body: SftpDocument = {
             "hostname": "127.0.0.1",
             "port": sftp.port,
             "username": sftp.username,
@@ -134,13 +138,13 @@ def _start(server: str, workdir: Path) -> tuple[dict[str, Any], Callable[[], Non
         endpoint_url=s3.endpoint_url,
     )
     create_bucket(admin)
-    body = {
+    s3_body: S3Document = {
         "access_id": who.access_id,
         "access_secret": who.access_secret,
         "bucket": "bench",
         "endpoint_url": s3.endpoint_url,
     }
-    return body, s3.stop
+    return s3_body, s3.stop
 
 
 def _write_match(match: Path, files: int, total_bytes: int) -> int:

@@ -112,9 +112,9 @@ def main(argv: list[str] | None = None) -> int:
                                 half_s=args.half_duration, stepping=args.stepping,
                                 max_rtf=args.max_rtf)
                 runs[kind].append(float(results.real_time_factor or 0.0))
-                blue = results.robots["blue-1"].api or {}
-                p90 = (blue.get("round_trip_ms") or {}).get("p90")
-                stub[kind].append({"messages_in": blue.get("messages_in"),
+                blue = results.robots["blue-1"].api
+                p90 = (blue.get("round_trip_ms") or {}).get("p90") if blue else None
+                stub[kind].append({"messages_in": blue.get("messages_in") if blue else None,
                                    "round_trip_ms_p90": p90})
                 admission = results.admission
     baseline, hog = statistics.median(runs["baseline"]), statistics.median(runs["hog"])

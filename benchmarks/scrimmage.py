@@ -22,7 +22,7 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict
 
 from contracts.sim_result import PlayRecord
 from orchestrator.errors import OrchestratorError
@@ -33,6 +33,23 @@ log = logging.getLogger(__name__)
 TARGET_WALL_S = 180.0
 TARGET_GOAL_FRACTION = 0.5
 TARGET_OWN_GOALS_PER_MATCH = 0.1
+
+
+class MatchFiguresRecord(TypedDict):
+    """One match of the benchmark (``per_match``); play counts summed over both teams."""
+
+    seed: int
+    match_id: str
+    status: str
+    score: dict[str, int] | None
+    both_halves_playing: bool
+    kicks: int | None
+    shots: int | None
+    goals: int | None
+    own_goals: int | None
+    falls: int | None
+    sim_s: float
+    wall_s: float
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -46,7 +63,7 @@ class MatchFigures:
     sim_s: float
     wall_s: float
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> MatchFiguresRecord:
         play = self.play
         return {
             "seed": self.seed,

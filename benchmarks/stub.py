@@ -16,7 +16,7 @@ import os
 import sys
 import time
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, TypedDict
 
 if TYPE_CHECKING:  # numpy and the world are imported after the arguments (fast --help)
     import numpy as np
@@ -96,7 +96,43 @@ def run_trial(*, seed: int, distance_m: float, time_limit_s: float) -> TrialResu
     )
 
 
-def summarize(results: list[TrialResult], *, seed: int, wall_s: float) -> dict[str, Any]:
+class ReachSummary(TypedDict):
+    """``hlvs bench stub`` (reach): the stub walking to the ball and kicking it."""
+
+    bench: str
+    model: str
+    trials: int
+    successes: int
+    success_rate: float
+    mean_kick_distance_m: float | None
+    mean_time_to_kick_s: float | None
+    falls_per_min: float
+    sim_time_s: float
+    wall_time_s: float
+    seed: int
+    perception: str  # what the stub sees with
+
+
+class ShotsSummary(TypedDict):
+    """``hlvs bench stub --scenario shots``: shots on goal (against a goalie with --goalie)."""
+
+    bench: str
+    scenario: str
+    model: str
+    goalie: bool
+    trials: int
+    goals: int
+    goal_rate: float
+    outcomes: list[str]
+    mean_time_to_goal_s: float | None
+    kicks: int
+    falls_per_min: float
+    sim_time_s: float
+    wall_time_s: float
+    seed: int
+
+
+def summarize(results: list[TrialResult], *, seed: int, wall_s: float) -> ReachSummary:
     kicks = [r.kick_distance_m for r in results if r.success]
     times = [r.time_to_kick_s for r in results if r.success and r.time_to_kick_s is not None]
     sim_s = sum(r.sim_time_s for r in results)
@@ -176,7 +212,7 @@ def _shots(args: argparse.Namespace, start: float) -> int:
 
 def summarize_shots(
     results: list[ShotResult], *, seed: int, goalie: bool, wall_s: float
-) -> dict[str, Any]:
+) -> ShotsSummary:
     goals = [r for r in results if r.goal]
     times = [r.time_to_goal_s for r in goals if r.time_to_goal_s is not None]
     sim_s = sum(r.sim_time_s for r in results)

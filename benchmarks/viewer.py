@@ -32,7 +32,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict
 
 from orchestrator.paths import user_path
 
@@ -47,7 +47,12 @@ LAUNCH_ARGS = [
 ]
 
 
-def write_replay(path: Path, *, half_s: int = HALF_S, seed: int = 7) -> dict[str, Any]:
+class ReplayWritten(TypedDict):
+    write_s: float  # wall time to write the replay
+    bodies: int  # bodies per frame
+
+
+def write_replay(path: Path, *, half_s: int = HALF_S, seed: int = 7) -> ReplayWritten:
     """A 4 v 4 replay of two halves of ``half_s`` seconds (see the module docstring)."""
     import mujoco
     import numpy as np
@@ -93,10 +98,11 @@ def write_replay(path: Path, *, half_s: int = HALF_S, seed: int = 7) -> dict[str
                 team = "red" if (t_ms // 150_000) % 2 else "blue"
                 score[team] += 1
                 recorder.event({"type": "goal", "team": team, "player": 2, "sim_time_ms": t_ms,
-                                "reason": ""})
+                                "reason": "", "placement": None, "details": {}})
             if t_ms == half_s * 1000:
-                recorder.event({"type": "state", "team": None, "reason": "FINISHED",
-                                "sim_time_ms": t_ms})
+                recorder.event({"type": "state", "team": None, "player": None,
+                                "reason": "FINISHED", "sim_time_ms": t_ms, "placement": None,
+                                "details": {}})
             secs = half_s - (t_ms / 1000 - (half - 1) * half_s)
             recorder.record(world, {"state": "PLAYING", "half": half, "score": dict(score),
                                     "secs_remaining": int(secs)})

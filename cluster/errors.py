@@ -12,8 +12,6 @@ The submission service answers a ``PoolError`` met while serving a request with 
 
 from __future__ import annotations
 
-from typing import Any
-
 
 class ClusterError(Exception):
     """Root of every error the cluster package raises."""
@@ -29,7 +27,8 @@ class PoolError(ClusterError):
         self.reason = reason
         super().__init__(f"match pool, job {handle}: {reason}")
 
-    def fields(self) -> dict[str, Any]:
+    def fields(self) -> dict[str, str]:
+        """The fields the error adds to a JSON error body."""
         return {"handle": self.handle, "reason": self.reason}
 
 

@@ -9,10 +9,10 @@ local pool's: a match is running while its ``running`` marker exists.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 from cluster import JobState, JobStatus, MatchJob, NodeJob, PoolNode
 from contracts import files
+from contracts.jsontypes import JSONObject
 from contracts.match_results import (
     Failure,
     MatchLimits,
@@ -72,7 +72,8 @@ class FakePool:
                          slots=self.slots, jobs=jobs)]
 
     # test controls -----------------------------------------------------------------------
-    def finish(self, handle: str, report: dict[str, Any]) -> None:
+    def finish(self, handle: str, report: JSONObject) -> None:
+        """End the match with ``report`` as its report.json (checked as a MatchReport)."""
         out = self.results_dir(handle)
         (out / "teams" / "red" / "1").mkdir(parents=True, exist_ok=True)
         (out / "teams" / "blue" / "1").mkdir(parents=True, exist_ok=True)

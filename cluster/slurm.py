@@ -415,4 +415,4 @@ def _parse_entry(line: str) -> QueueEntry:
                       expected_start=start, nodes=nodes, comment=comment)
 
 
-__all__ = ["QueueEntry", "SlurmPool"]
+__all__ = ["HOST_NETNS", "QueueEntry", "SlurmPool"]

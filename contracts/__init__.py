@@ -12,3 +12,6 @@ it; installs on its own from ``contracts/pyproject.toml``.
 - :mod:`contracts.codec`: the one JSON reader/writer; every top-level document has a ``version``
   and ``from_json`` refuses versions it does not know (:class:`contracts.errors.UnknownVersion`).
 """
+
+# its modules are its faces (ARCHITECTURE.md): a process loads only the ones it uses
+__all__: list[str] = []

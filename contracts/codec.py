@@ -13,9 +13,20 @@ import types
 from dataclasses import MISSING, Field, fields, is_dataclass
 from enum import Enum
 from pathlib import Path
-from typing import Any, ClassVar, Literal, TypeVar, Union, get_args, get_origin, get_type_hints
+from typing import (
+    Any,
+    ClassVar,
+    Literal,
+    TypeVar,
+    Union,
+    get_args,
+    get_origin,
+    get_type_hints,
+    is_typeddict,
+)
 
 from contracts.errors import ContractError, UnknownVersion
+from contracts.jsontypes import JSONObject
 
 T = TypeVar("T")
 V = TypeVar("V", bound="Versioned")
@@ -96,6 +107,8 @@ def convert(hint: Any, value: Any, *, source: str, pointer: str) -> Any:
         return value
     if is_dataclass(hint):
         return from_data(hint, value, source=source, pointer=pointer)  # type: ignore[arg-type]
+    if is_typeddict(hint):  # a JSON object of a documented shape: checked as an object only
+        return convert(dict[str, Any], value, source=source, pointer=pointer)
     if isinstance(hint, type) and issubclass(hint, Enum):
         try:
             return hint(value)
@@ -170,8 +183,8 @@ class Versioned:
     KIND: ClassVar[str] = "document"
     FILE_MODE: ClassVar[int | None] = None  # permissions of a written file (None: the umask's)
 
-    def to_dict(self) -> dict[str, Any]:
-        data: dict[str, Any] = to_data(self)
+    def to_dict(self) -> JSONObject:
+        data: JSONObject = to_data(self)
         return data
 
     def to_json(self, *, indent: int | None = 2) -> str:

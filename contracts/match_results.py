@@ -35,7 +35,8 @@ from dataclasses import dataclass, field
 from typing import Any, ClassVar, Literal
 
 from contracts.codec import Versioned, json_key, omitted_when_none
-from contracts.sim_result import PlayRecord, SpoofingRecord
+from contracts.jsontypes import JSONObject
+from contracts.sim_result import PlayRecord, RobotApiStats, SpoofingRecord
 
 Color = Literal["red", "blue"]
 Status = Literal["success", "failed"]
@@ -102,7 +103,7 @@ class RobotResult:
     sent_bytes: int | None = None
     received_bytes: int | None = None
     limits: dict[str, Scalar] = field(default_factory=dict)  # empty when never started
-    api: dict[str, Any] | None = None  # the simulator's robot API statistics (sim_result)
+    api: RobotApiStats | None = None  # the simulator's robot API statistics (sim_result)
     log_folder: LogFolderCopy | None = None
     spoofing_attempts: int = 0  # messages sent as another robot (from the simulator)
 
@@ -200,7 +201,7 @@ class MatchResults(Versioned):
         if (self.status == "success") != (self.failure is None):
             raise ValueError(f"status {self.status!r} disagrees with failure {self.failure}")
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> JSONObject:
         data = Versioned.to_dict(self)
         if self.salvaged is None:
             del data["salvaged"]
@@ -270,6 +271,7 @@ class MatchReport(Versioned):
 __all__ = [
     "SALVAGED_KEYS",
     "AdmissionRecord",
+    "Color",
     "Failure",
     "FailureClass",
     "Forfeit",
@@ -279,6 +281,7 @@ __all__ = [
     "MatchResults",
     "NeededAvailable",
     "RobotResult",
+    "Scalar",
     "Salvage",
     "SalvagedRobot",
 ]

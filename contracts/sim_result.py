@@ -7,11 +7,47 @@ tests, read by the orchestrator's runner and results; all three use this one typ
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, ClassVar, Literal
+from typing import ClassVar, Literal, TypedDict
 
 from contracts.codec import Versioned
+from contracts.jsontypes import JSONObject
 
 Winner = Literal["red", "blue", "draw"]
+
+
+class RobotApiStats(TypedDict):
+    """One robot's robot API statistics over the whole match (all its connections)."""
+
+    connects: list[float]  # unix s
+    disconnects: list[float]
+    disconnect_reasons: list[str]
+    refused_connections: int
+    messages_in: int
+    bytes_in: int
+    messages_out: int
+    bytes_out: int
+    dropped_out: int
+    dropped_in: dict[str, int]  # requests dropped undecoded, by reason ("size", "rate")
+    dropped_in_bytes: int
+    quota_errors: int
+    bad_frames: int
+    decode_errors: int
+    missed_deadlines: int
+    slow_periods: int
+    warnings_sent: int
+    round_trip_ms: dict[str, float | None]  # p50, p90, p99, max (None without replies)
+    round_trip_samples: int
+
+
+class CameraRecord(TypedDict, total=False):
+    """What the simulator rendered for the robots' cameras, and with which OpenGL (empty from a
+    simulator that did not report it)."""
+
+    frames: int
+    render_s: float
+    gl_backend: str
+    gl_renderer: str  # llvmpipe: the CPU
+    gl_error: str  # no offscreen OpenGL: camera requests failed
 COLORS = ("red", "blue")
 
 
@@ -107,8 +143,8 @@ class SimResult(Versioned):
     real_time_s: float = 0.0
     held_real_s: float = 0.0  # wall time the world was held (waiting for robots)
     real_time_factor: float = 0.0
-    robots: dict[str, dict[str, Any]] = field(default_factory=dict)  # robot key -> API statistics
-    cameras: dict[str, Any] = field(default_factory=dict)
+    robots: dict[str, RobotApiStats] = field(default_factory=dict)  # robot key -> its API use
+    cameras: CameraRecord = field(default_factory=lambda: CameraRecord())
     started_unix_s: float = 0.0
     versions: dict[str, str] = field(default_factory=dict)  # distribution -> version
     spoofing: SpoofingRecord | None = None
@@ -117,7 +153,7 @@ class SimResult(Versioned):
     play: PlayRecord | None = None  # None from a simulator that did not count play
     version: int = VERSION
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> JSONObject:
         data = Versioned.to_dict(self)
         for optional in ("shootout", "coin_toss"):  # only written when there was a shoot-out
             if data[optional] is None:
@@ -129,4 +165,12 @@ class SimResult(Versioned):
         return self.state == "FINISHED"
 
 
-__all__ = ["PlayRecord", "SimResult", "SpoofingAttempt", "SpoofingRecord", "Winner"]
+__all__ = [
+    "CameraRecord",
+    "PlayRecord",
+    "RobotApiStats",
+    "SimResult",
+    "SpoofingAttempt",
+    "SpoofingRecord",
+    "Winner",
+]

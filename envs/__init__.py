@@ -40,7 +40,7 @@ from envs.errors import (
 from envs.frame import Frame
 from envs.match import MatchEnv
 from envs.session import LocalSession
-from envs.session_spec import ResetRequest, SessionSpec, StubSpec
+from envs.session_spec import ResetOptions, ResetRequest, SessionSpec, StubSpec
 from envs.skill import KickEnv
 from envs.stand_kick import StandKickEnv
 
@@ -74,6 +74,7 @@ __all__ = [
     "RemoteCrashed",
     "RemoteError",
     "RemoteStartFailed",
+    "ResetOptions",
     "ResetRequest",
     "Session",
     "SessionSpec",

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Any, Protocol, SupportsFloat
+from typing import Any, Protocol, SupportsFloat, cast
 
 import gymnasium as gym
 import numpy as np
@@ -10,7 +10,7 @@ import numpy.typing as npt
 
 from envs.errors import EnvConfigError, EnvStateError
 from envs.frame import Frame
-from envs.session_spec import ResetRequest, SessionSpec
+from envs.session_spec import ResetOptions, ResetRequest, SessionSpec
 from envs.spaces import action_space, observation_space, observe
 
 FloatArray = npt.NDArray[np.float64]
@@ -104,7 +104,7 @@ class HlvsEnv(gym.Env[dict[str, Any], np.ndarray]):
         if self._closed:
             raise EnvStateError(operation="reset", reason="the environment is closed")
         world_seed = int(self.np_random.integers(0, SEED_LIMIT))
-        request = self.reset_request(world_seed, options or {})
+        request = self.reset_request(world_seed, cast("ResetOptions", options or {}))
         if getattr(self.session, "crashed", False):
             self._replace_crashed()
         self.frame = self.session.reset(request)
@@ -179,7 +179,7 @@ class HlvsEnv(gym.Env[dict[str, Any], np.ndarray]):
 
     # --- for subclasses ----------------------------------------------------------------------
 
-    def reset_request(self, world_seed: int, options: dict[str, Any]) -> ResetRequest:
+    def reset_request(self, world_seed: int, options: ResetOptions) -> ResetRequest:
         return ResetRequest(seed=world_seed)
 
     def on_reset(self, frame: Frame) -> None:

@@ -10,11 +10,12 @@ torso x, y, yaw, the z component of its torso's up axis and its torso height.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TypedDict
 
 import numpy as np
 import numpy.typing as npt
 
+from contracts.telemetry import EventRecord
 from simulator.world import FORCE_SENSORS, MOTOR_NAMES
 
 FloatArray = npt.NDArray[np.float64]
@@ -41,6 +42,32 @@ UP_Z = 9
 TORSO_Z = 10
 
 
+class GameView(TypedDict, total=False):
+    """The learning robot's view of the game (match sessions; see envs.session.game_view, which
+    fills every key). Readers take a frame without one as an empty view."""
+
+    state: str  # GameController state name
+    secondary_state: str
+    score_own: int
+    score_opponent: int
+    secs_remaining: float
+    half: int
+    penalised: bool
+    own_kickoff: bool
+    attack_sign: float  # +1.0 when the robot's team attacks towards +x
+    finished: bool
+
+
+class FrameWire(TypedDict):
+    """A frame on the trainer channel (the sensors and the image travel apart)."""
+
+    sim_time_ms: int
+    truth: list[float]
+    perception: dict[str, list[float]] | None
+    game: GameView | None
+    events: list[EventRecord]
+
+
 @dataclass(slots=True, kw_only=True)
 class Frame:
     sim_time_ms: int
@@ -48,10 +75,10 @@ class Frame:
     truth: FloatArray
     image: npt.NDArray[np.uint8] | None = None  # height x width x 3, B G R (as the robot API)
     perception: dict[str, npt.NDArray[np.float64]] | None = None
-    game: dict[str, Any] | None = None  # match sessions: see envs.session.game_view
-    events: list[dict[str, Any]] = field(default_factory=list)
+    game: GameView | None = None  # match sessions: see envs.session.game_view
+    events: list[EventRecord] = field(default_factory=list)
 
-    def to_wire(self) -> dict[str, Any]:
+    def to_wire(self) -> FrameWire:
         """Plain data for the trainer channel (arrays as lists)."""
         return {
             "sim_time_ms": self.sim_time_ms,
@@ -65,7 +92,7 @@ class Frame:
 
     @classmethod
     def from_wire(
-        cls, data: dict[str, Any], sensors: FloatArray, image: npt.NDArray[np.uint8] | None
+        cls, data: FrameWire, sensors: FloatArray, image: npt.NDArray[np.uint8] | None
     ) -> Frame:
         perception = data.get("perception")
         return cls(

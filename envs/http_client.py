@@ -17,10 +17,11 @@ message.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict
 
 import httpx
 
+from contracts.jsontypes import JSONObject
 from envs.errors import EnvError
 
 
@@ -33,14 +34,24 @@ class EnvApiError(EnvError):
         super().__init__(f"{url}: HTTP {status} {kind}: {message}")
 
 
+class MonitorFileRecord(TypedDict):
+    """A file the service's monitor of an instance wrote."""
+
+    name: str
+    bytes: int
+
+
 class EnvClient:
+    """The service's environment API (gym-http-api's calls). Observations, infos and spaces
+    come as the service answers them: free JSON."""
+
     def __init__(self, base_url: str, *, token: str | None, timeout_s: float = 60.0) -> None:
         headers = {"Authorization": f"Bearer {token}"} if token else {}
         self._http = httpx.Client(base_url=base_url.rstrip("/"), headers=headers,
                                   timeout=timeout_s)  # fmt: skip
         self._directories: dict[str, Path] = {}  # instance -> env_monitor_start's directory
 
-    def _call(self, method: str, path: str, body: dict[str, Any] | None = None) -> Any:
+    def _call(self, method: str, path: str, body: JSONObject | None = None) -> Any:
         try:
             response = self._http.request(method, path, json=body)
         except httpx.HTTPError as exc:
@@ -64,18 +75,18 @@ class EnvClient:
     def env_list_all(self) -> dict[str, str]:
         return dict(self._call("GET", "/v1/envs/")["all_envs"])
 
-    def env_reset(self, instance_id: str, seed: int | None = None) -> dict[str, Any]:
+    def env_reset(self, instance_id: str, seed: int | None = None) -> JSONObject:
         return dict(
             self._call("POST", f"/v1/envs/{instance_id}/reset/", {"seed": seed})["observation"]
         )
 
     def env_step(
         self, instance_id: str, action: list[float]
-    ) -> tuple[dict[str, Any], float, bool, dict[str, Any]]:
+    ) -> tuple[JSONObject, float, bool, JSONObject]:
         data = self._call("POST", f"/v1/envs/{instance_id}/step/", {"action": list(action)})
         return data["observation"], float(data["reward"]), bool(data["done"]), data["info"]
 
-    def env_action_space_info(self, instance_id: str) -> dict[str, Any]:
+    def env_action_space_info(self, instance_id: str) -> JSONObject:
         return dict(self._call("GET", f"/v1/envs/{instance_id}/action_space/")["info"])
 
     def env_monitor_start(
@@ -89,14 +100,14 @@ class EnvClient:
         with ``directory``, :meth:`env_monitor_close` also downloads them into that folder on
         this machine. ``video`` (or a true ``video_callable``) records a video too."""
         record_video = bool(video_callable) if video is None else video
-        body = {"force": force, "resume": resume, "video": record_video}
+        body: JSONObject = {"force": force, "resume": resume, "video": record_video}
         self._call("POST", f"/v1/envs/{instance_id}/monitor/start/", body)
         if directory is None:
             self._directories.pop(instance_id, None)
         else:
             self._directories[instance_id] = Path(directory)
 
-    def env_monitor_close(self, instance_id: str) -> dict[str, Any]:
+    def env_monitor_close(self, instance_id: str) -> JSONObject:
         stats = dict(self._call("POST", f"/v1/envs/{instance_id}/monitor/close/")["stats"])
         directory = self._directories.pop(instance_id, None)
         if directory is not None:
@@ -105,7 +116,7 @@ class EnvClient:
                 self.download(instance_id, str(entry["name"]), directory / str(entry["name"]))
         return stats
 
-    def monitor_files(self, instance_id: str) -> list[dict[str, Any]]:
+    def monitor_files(self, instance_id: str) -> list[MonitorFileRecord]:
         return list(self._call("GET", f"/v1/envs/{instance_id}/monitor/files/")["files"])
 
     def download(self, instance_id: str, name: str, destination: str | Path) -> Path:

@@ -24,7 +24,7 @@ import numpy as np
 from contracts.field import field_for
 from contracts.timing import ENVIRONMENT, MIN_PLAYING_S
 from envs.base import HlvsEnv, Session
-from envs.frame import BALL_POS, UP_Z, Frame
+from envs.frame import BALL_POS, UP_Z, Frame, GameView
 from envs.match_setup import default_stubs
 from envs.session_spec import SessionSpec, StubSpec
 
@@ -71,13 +71,14 @@ class MatchEnv(HlvsEnv):
         self.field = field_for(field_class)
 
     def _ball_to_goal(self, frame: Frame) -> float:
-        game = frame.game or {}
+        game: GameView = frame.game or {}
         goal_x = float(game.get("attack_sign", 1.0)) * self.field.half_length_m
         ball = frame.truth[BALL_POS]
         return float(np.hypot(goal_x - ball[0], ball[1]))
 
     def judge(self, previous: Frame, frame: Frame) -> tuple[float, bool, bool]:
-        before, after = previous.game or {}, frame.game or {}
+        before: GameView = previous.game or {}
+        after: GameView = frame.game or {}
         reward = GOAL_REWARD * (
             (after.get("score_own", 0) - before.get("score_own", 0))
             - (after.get("score_opponent", 0) - before.get("score_opponent", 0))

@@ -14,7 +14,7 @@ import logging
 import shutil
 import subprocess
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict
 
 log = logging.getLogger(__name__)
 
@@ -95,13 +95,13 @@ class Monitor:
             self._video.close()
             self._video = None
 
-    def close(self) -> dict[str, Any]:
+    def close(self) -> MonitorStats:
         if self._video is not None:
             error = self._video.close()
             self.video_error = self.video_error or error
             self._video = None
         self._episodes_file.close()
-        stats = {
+        stats: MonitorStats = {
             "episodes": self.episodes,
             "steps": self.steps,
             "mean_episode_reward": round(sum(self._rewards) / len(self._rewards), 6)
@@ -113,6 +113,17 @@ class Monitor:
         }
         (self.folder / "stats.json").write_text(json.dumps(stats, indent=2), encoding="utf-8")
         return stats
+
+
+class MonitorStats(TypedDict):
+    """What a monitor reports when it closes (also its ``stats.json``)."""
+
+    episodes: int
+    steps: int
+    mean_episode_reward: float | None
+    best_kick_distance_m: float
+    video: bool
+    video_error: str | None
 
 
 class _Video:

@@ -16,7 +16,7 @@ import logging
 import socket
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -38,6 +38,7 @@ from envs.wire import (
     TAG_TRUTH,
     WELCOME,
     FrameReader,
+    TrainerMessage,
     WireError,
     decode_sensors,
     decode_truth,
@@ -211,7 +212,7 @@ class RemoteSession:
         if self.crashed:
             raise EnvStateError(operation="remote", reason=f"{self.address} crashed; reset()")
 
-    def _call(self, request: dict[str, Any], *, operation: str = "") -> dict[str, Any]:
+    def _call(self, request: TrainerMessage, *, operation: str = "") -> TrainerMessage:
         self._check()
         try:
             send_frame(self._sock, TAG_TRAINER, json.dumps(request).encode())
@@ -220,7 +221,7 @@ class RemoteSession:
             raise self._crash(exc) from exc
         return self._answer(answer, operation or str(request.get("op")))
 
-    def _answer(self, answer: dict[str, Any], operation: str) -> dict[str, Any]:
+    def _answer(self, answer: TrainerMessage, operation: str) -> TrainerMessage:
         if answer.get("ok"):
             return answer
         kind, message = str(answer.get("error")), str(answer.get("message"))
@@ -292,7 +293,7 @@ class RemoteSession:
     def drop_ball(self, x_m: float = 0.0, y_m: float = 0.0) -> None:
         self._call({"op": "drop_ball", "args": [x_m, y_m]})
 
-    def health(self) -> dict[str, Any]:
+    def health(self) -> TrainerMessage:
         return self._call({"op": "health"})
 
     def close(self) -> None:

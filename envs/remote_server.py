@@ -19,7 +19,7 @@ import socket
 import sys
 import threading
 from types import FrameType
-from typing import Any
+from typing import cast
 
 from envs.errors import EnvError
 from envs.frame import Frame
@@ -33,6 +33,8 @@ from envs.wire import (
     TAG_TRUTH,
     WELCOME,
     FrameReader,
+    ResetWire,
+    TrainerMessage,
     WireError,
     decode_targets,
     encode_sensors,
@@ -111,7 +113,7 @@ class RemoteServer:
                     continue
                 if tag != TAG_TRAINER:
                     raise WireError(f"unexpected frame tag {tag!r}")
-                request = json.loads(payload)
+                request: TrainerMessage = json.loads(payload)
                 op = request.get("op")
                 if op == "close":  # free the remote before answering: the next client may come
                     if session is not None:
@@ -135,7 +137,8 @@ class RemoteServer:
             log.info("client %s done", where)
 
     def _trainer(
-        self, conn: socket.socket, session: LocalSession | None, op: Any, request: dict[str, Any],
+        self, conn: socket.socket, session: LocalSession | None, op: str | None,
+        request: TrainerMessage,
         compact: bool,
     ) -> LocalSession | None:  # fmt: skip
         try:
@@ -149,11 +152,12 @@ class RemoteServer:
             elif op == "reset":
                 if session is None:
                     raise _NotOpen()
-                r = dict(request.get("request") or {})
+                r: ResetWire = request.get("request") or {}
+                pose, ball = r.get("learner_pose"), r.get("ball_xy")  # as RemoteSession sends
                 reset = ResetRequest(
                     seed=int(r["seed"]),
-                    learner_pose=tuple(r["learner_pose"]) if r.get("learner_pose") else None,
-                    ball_xy=tuple(r["ball_xy"]) if r.get("ball_xy") else None,
+                    learner_pose=cast("tuple[float, float, float]", tuple(pose)) if pose else None,
+                    ball_xy=cast("tuple[float, float]", tuple(ball)) if ball else None,
                 )
                 _reply_frame(conn, session.reset(reset), compact)
             elif op in TRAINER_OPS:
@@ -174,7 +178,7 @@ class _NotOpen(Exception):
     pass
 
 
-def _error(kind: str, message: str) -> dict[str, Any]:
+def _error(kind: str, message: str) -> TrainerMessage:
     return {"ok": False, "error": kind, "message": message}
 
 

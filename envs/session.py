@@ -19,12 +19,11 @@ import numpy.typing as npt
 
 from contracts.field import field_for
 from envs.errors import EnvStateError, TrainerError
-from envs.frame import SENSOR_NAMES, Frame
+from envs.frame import SENSOR_NAMES, Frame, GameView
 from envs.perception import CameraView, add_noise, field_segments, goal_post_feet
 from envs.randomization import episode_world
 from envs.session_spec import ResetRequest, SessionSpec
-from referee import GameState, Referee, RobotId, TeamColor
-from referee.snapshot import PlaceBall, TeleportRobot
+from referee import GameState, PlaceBall, Referee, RobotId, TeamColor, TeleportRobot
 from simulator.world import MOTOR_NAMES, RobotPlacement, World, robot_model
 
 FloatArray = npt.NDArray[np.float64]
@@ -285,7 +284,7 @@ class LocalSession:
         return self.referee
 
 
-def game_view(referee: Referee, learner: RobotId) -> dict[str, Any]:
+def game_view(referee: Referee, learner: RobotId) -> GameView:
     """The learning robot's view of the game: state, secondary state, own and opponent score,
     seconds remaining, half, whether it is penalised, whether its team has the kick-off."""
     gc = referee.gc

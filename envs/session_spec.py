@@ -8,8 +8,9 @@ carry it over the trainer channel of a remote.
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field, fields
-from typing import Any
+from typing import Any, TypedDict
 
+from contracts.jsontypes import JSONObject
 from contracts.timing import ENVIRONMENT, MIN_PLAYING_S, TimingError, fit_ready
 from envs.errors import EnvConfigError
 
@@ -104,7 +105,8 @@ class SessionSpec:
                     choices=ROLES,
                 )  # fmt: skip
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> JSONObject:
+        """The settings as JSON (the remote protocol's ``open``)."""
         return asdict(self)
 
     @classmethod
@@ -122,6 +124,14 @@ class SessionSpec:
         if "learner_pose" in values:
             values["learner_pose"] = tuple(values["learner_pose"])
         return cls(**values)
+
+
+class ResetOptions(TypedDict, total=False):
+    """The ``options`` of ``reset()`` an environment reads (each one its own; see its docs)."""
+
+    ball_x_m: float
+    ball_y_m: float
+    robot_pose: tuple[float, float, float] | list[float]  # x, y, yaw
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -28,7 +28,7 @@ from contracts.field import field_for
 from envs.base import HlvsEnv, Session
 from envs.errors import EnvConfigError
 from envs.frame import BALL_POS, UP_Z, Frame
-from envs.session_spec import ResetRequest, SessionSpec
+from envs.session_spec import ResetOptions, ResetRequest, SessionSpec
 
 APPROACH_WEIGHT = 0.5
 PROGRESS_WEIGHT = 2.0
@@ -90,7 +90,7 @@ class KickEnv(HlvsEnv):
         self._last: tuple[Frame | None, tuple[float, float]] = (None, (0.0, 0.0))
         self._outcome: tuple[Frame | None, tuple[bool, bool, bool]] = (None, (False,) * 3)
 
-    def reset_request(self, world_seed: int, options: dict[str, Any]) -> ResetRequest:
+    def reset_request(self, world_seed: int, options: ResetOptions) -> ResetRequest:
         rng = self.np_random
         bx = float(options.get("ball_x_m", rng.uniform(0.0, 2.5)))
         by = float(options.get("ball_y_m", rng.uniform(-1.5, 1.5)))

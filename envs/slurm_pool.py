@@ -295,7 +295,7 @@ class SlurmLauncher:
 @contextmanager
 def _slurm_errors() -> Iterator[None]:
     """Slurm's commands failing (no cluster, a refused submission) as RemoteStartFailed."""
-    from cluster.errors import PoolError
+    from cluster import PoolError
 
     try:
         yield

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 from gymnasium import spaces
 
-from envs.frame import ACCEL, FORCES, GYRO, JOINTS, Frame
+from envs.frame import ACCEL, FORCES, GYRO, JOINTS, Frame, GameView
 from envs.perception import LINE_COUNT
 from simulator.world import robot_model
 
@@ -100,7 +100,7 @@ def observe(frame: Frame, space: spaces.Dict) -> dict[str, Any]:
             for key, box in sub.spaces.items()
         }
     if "game" in space.spaces:
-        g = frame.game or {}
+        g: GameView = frame.game or {}
         obs["game"] = {
             "state": GAME_STATES.index(str(g.get("state", "INITIAL"))),
             "score": np.array([g.get("score_own", 0), g.get("score_opponent", 0)], np.int64),

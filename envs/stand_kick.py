@@ -33,7 +33,7 @@ from gymnasium import spaces
 from envs.base import Session
 from envs.errors import EnvConfigError
 from envs.frame import BALL_VEL, ROBOT_XY, ROBOT_YAW, Frame
-from envs.session_spec import ResetRequest
+from envs.session_spec import ResetOptions, ResetRequest
 from envs.skill import PROGRESS_WEIGHT, KickEnv
 from envs.spaces import observe
 from robot.learned.policy import KICK_BALL_AHEAD_M, KICK_BALL_RIGHT_M
@@ -85,7 +85,7 @@ class StandKickEnv(KickEnv):
         self._max_speed = 0.0
         self._ball_offset = (BALL_AHEAD_M, BALL_RIGHT_M)
 
-    def reset_request(self, world_seed: int, options: dict[str, Any]) -> ResetRequest:
+    def reset_request(self, world_seed: int, options: ResetOptions) -> ResetRequest:
         rng = self.np_random
         rx, ry = float(rng.uniform(0.5, 1.5)), float(rng.uniform(-1.0, 1.0))
         yaw = math.atan2(-ry, self.goal_xy[0] - rx)

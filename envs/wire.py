@@ -25,13 +25,14 @@ from __future__ import annotations
 import json
 import socket
 import struct
-from typing import Any
+from typing import Any, TypedDict, cast
 
 import numpy as np
 import numpy.typing as npt
 
+from contracts.jsontypes import JSONObject
 from contracts.robot_api import messages_pb2 as pb
-from envs.frame import N_JOINTS, SENSOR_SIZE, TRUTH_SIZE
+from envs.frame import N_JOINTS, SENSOR_SIZE, TRUTH_SIZE, FrameWire
 from simulator.world import FORCE_SENSORS, MOTOR_NAMES
 
 WELCOME = b"Welcome\0"
@@ -43,6 +44,29 @@ TAG_SENSORS = b"S"
 TAG_TRAINER = b"T"
 TAG_TRUTH = b"F"
 _TRUTH = struct.Struct(f"<{TRUTH_SIZE}d")
+
+
+class ResetWire(TypedDict, total=False):
+    """``request`` of a ``reset``: :class:`envs.session_spec.ResetRequest` as JSON."""
+
+    seed: int
+    learner_pose: list[float] | None  # x, y, yaw
+    ball_xy: list[float] | None
+
+
+class TrainerMessage(TypedDict, total=False):
+    """One ``T`` frame: a request (``op`` and its fields) or an answer (``ok`` and its)."""
+
+    op: str  # open, reset, place_ball, place_robot, set_game_state, drop_ball, health, close
+    spec: JSONObject  # open: envs.session_spec.SessionSpec.to_dict()
+    compact: bool  # open: F frames wanted (and, answered, granted)
+    request: ResetWire  # reset
+    args: list[str | int | float]  # the trainer operations' arguments
+    ok: bool
+    frame: FrameWire  # after a step or reset
+    pid: int  # health
+    error: str  # the error's class name
+    message: str
 
 
 class WireError(Exception):
@@ -57,7 +81,7 @@ def send_frames(sock: socket.socket, frames: list[tuple[bytes, bytes]]) -> None:
     sock.sendall(b"".join(HEADER.pack(len(p) + 1) + t + p for t, p in frames))
 
 
-def send_json(sock: socket.socket, data: dict[str, Any]) -> None:
+def send_json(sock: socket.socket, data: TrainerMessage) -> None:
     send_frame(sock, TAG_TRAINER, json.dumps(data).encode())
 
 
@@ -92,11 +116,11 @@ class FrameReader:
             raise WireError(f"expected a {tag.decode()!r} frame, got {got!r}")
         return payload
 
-    def expect_json(self) -> dict[str, Any]:
+    def expect_json(self) -> TrainerMessage:
         return json_object(self.expect(TAG_TRAINER))
 
 
-def json_object(payload: bytes) -> dict[str, Any]:
+def json_object(payload: bytes) -> TrainerMessage:
     """The JSON object of a ``T`` frame (WireError when it is not one)."""
     try:
         data = json.loads(payload)
@@ -104,7 +128,7 @@ def json_object(payload: bytes) -> dict[str, Any]:
         raise WireError(f"undecodable trainer message: {exc}") from exc
     if not isinstance(data, dict):
         raise WireError("a trainer message must be a JSON object")
-    return data
+    return cast("TrainerMessage", data)  # its fields are read where they are used
 
 
 # --- robot API messages ---------------------------------------------------------------------

@@ -10,8 +10,8 @@ from typing import Any
 
 from fastapi import FastAPI
 
-from service.app import create_app as create_service_app
-from service.settings import Settings
+from service import Settings
+from service import create_app as create_service_app
 from viewer import ladder_page, service_pages, tournament_pages
 
 MOUNTS = (  # the ladder before the viewer's /watch/*

@@ -38,7 +38,7 @@ from hlvs.commands import (
     simulator,
     viewer,
 )
-from orchestrator.errors import OrchestratorError
+from orchestrator import OrchestratorError
 from orchestrator.exitcodes import ExitCode
 
 PROG = "hlvs"

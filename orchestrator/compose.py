@@ -24,11 +24,12 @@ import os
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal, TypedDict
 
 import yaml
 
 from contracts import files
+from contracts.jsontypes import JSONObject
 from contracts.match_results import MatchResults
 from contracts.match_spec import MatchSpec
 from orchestrator.config import LoadedGame
@@ -164,13 +165,60 @@ def match_requests(loaded: LoadedGame, *, simulator_image: str, subnets: Subnets
     )  # fmt: skip
 
 
+class ComposeDevice(TypedDict, total=False):
+    """A ``deploy.resources.reservations.devices`` entry (a GPU)."""
+
+    driver: str
+    device_ids: list[str]
+    count: int | Literal["all"]
+    capabilities: list[str]
+
+
+class ComposeDeploy(TypedDict):
+    resources: dict[str, dict[str, list[ComposeDevice]]]  # {"reservations": {"devices": [...]}}
+
+
+class ComposeService(TypedDict, total=False):
+    """One service of the compose document (the keys this renderer writes)."""
+
+    image: str
+    command: list[str]
+    hostname: str | None
+    environment: dict[str, str]
+    labels: dict[str, str]
+    volumes: list[str]
+    read_only: bool
+    tmpfs: list[str]
+    networks: dict[str, dict[str, str]]  # network role -> {"ipv4_address": ...}
+    cap_drop: list[str]
+    security_opt: list[str]
+    deploy: ComposeDeploy
+    depends_on: list[str]
+    cpus: float
+    mem_limit: int | None
+    pids_limit: int | None
+    stop_grace_period: str
+
+
+class ComposeNetwork(TypedDict):
+    driver: str
+    internal: bool
+    labels: dict[str, str]
+    ipam: dict[str, list[dict[str, str]]]  # {"config": [{"subnet": ...}]}
+
+
+class ComposeDocument(TypedDict):
+    services: dict[str, ComposeService]
+    networks: dict[str, ComposeNetwork]
+
+
 def compose_files(
     loaded: LoadedGame,
     *,
     simulator_image: str,
     subnets: Subnets | None = None,
     cpu_count: int | None = None,
-) -> tuple[dict[str, Any], dict[str, Any]]:
+) -> tuple[ComposeDocument, JSONObject]:
     """(compose document, match_spec.json content) for the validated game ``loaded``."""
     requests = match_requests(
         loaded,
@@ -178,7 +226,7 @@ def compose_files(
         subnets=subnets or Subnets.for_match(loaded.game.match_id),
     )
     roles = {request.name: role for role, request in requests.networks.items()}
-    services: dict[str, Any] = {"simulator": _service(requests.simulator, roles)}
+    services: dict[str, ComposeService] = {"simulator": _service(requests.simulator, roles)}
     cpus_here = cpu_count or os.cpu_count() or 1
     for key, (holder, robot) in requests.robots.items():
         services[key] = _robot_service(
@@ -188,7 +236,7 @@ def compose_files(
     return {"services": services, "networks": networks}, requests.spec.to_dict()
 
 
-def _network(request: NetworkRequest) -> dict[str, Any]:
+def _network(request: NetworkRequest) -> ComposeNetwork:
     return {
         "driver": "bridge",
         "internal": request.internal,
@@ -197,7 +245,9 @@ def _network(request: NetworkRequest) -> dict[str, Any]:
     }
 
 
-def _networks(attachments: tuple[Attachment, ...], roles: Mapping[str, str]) -> dict[str, Any]:
+def _networks(
+    attachments: tuple[Attachment, ...], roles: Mapping[str, str]
+) -> dict[str, dict[str, str]]:
     return {roles[a.network]: {"ipv4_address": a.ipv4_address} for a in attachments}
 
 
@@ -210,8 +260,8 @@ def _volume(mount: BindMount) -> str:
     return f"{source}:{mount.target}" + (":ro" if mount.read_only else "")
 
 
-def _service(request: ContainerRequest, roles: Mapping[str, str]) -> dict[str, Any]:
-    service: dict[str, Any] = {"image": request.image}
+def _service(request: ContainerRequest, roles: Mapping[str, str]) -> ComposeService:
+    service: ComposeService = {"image": request.image}
     if request.command:
         service["command"] = list(request.command)
     if request.hostname:
@@ -233,9 +283,9 @@ def _service(request: ContainerRequest, roles: Mapping[str, str]) -> dict[str, A
     return service
 
 
-def _device(request: DeviceRequest) -> dict[str, Any]:
+def _device(request: DeviceRequest) -> ComposeDevice:
     """A device request as a compose ``deploy.resources.reservations.devices`` entry."""
-    device: dict[str, Any] = {}
+    device: ComposeDevice = {}
     if request.driver:
         device["driver"] = request.driver
     if request.device_ids:
@@ -253,7 +303,7 @@ def _robot_service(
     cpu_count: int,
     *,
     grace_s: float,
-) -> dict[str, Any]:
+) -> ComposeService:
     """The robot container with the network identity (address, hostname) of its holder."""
     service = _service(robot, roles)
     service["hostname"] = holder.hostname

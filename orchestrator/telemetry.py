@@ -15,7 +15,7 @@ import sys
 import threading
 import time
 from collections.abc import Callable
-from typing import Any, Protocol, TextIO
+from typing import Any, Protocol, TextIO, cast
 
 import zenoh
 from rich.console import Console
@@ -24,7 +24,8 @@ from rich.table import Table
 
 from contracts import telemetry as topics
 from contracts.errors import ContractError
-from contracts.telemetry import StateMessage
+from contracts.jsontypes import JSONObject
+from contracts.telemetry import EventRecord, StateMessage
 from orchestrator.errors import InfrastructureError
 
 log = logging.getLogger(__name__)
@@ -35,7 +36,7 @@ class TelemetrySource(Protocol):
 
     def last_message_at(self) -> float | None: ...  # time.monotonic() of the last message
 
-    def events(self) -> list[dict[str, Any]]: ...
+    def events(self) -> list[EventRecord]: ...
 
     def close(self) -> None: ...
 
@@ -51,7 +52,7 @@ class ZenohTelemetry:
         self._change: StateMessage | None = None  # first message of a new game state, unread
         self._refused: set[str] = set()  # why state messages were refused (logged once each)
         self._last_at: float | None = None
-        self._events: list[dict[str, Any]] = []
+        self._events: list[EventRecord] = []
         config = zenoh.Config()
         config.insert_json5("mode", '"peer"')
         config.insert_json5("scouting/multicast/enabled", "false")
@@ -74,7 +75,7 @@ class ZenohTelemetry:
             ) from exc
         log.info("telemetry: subscribed to hlvs/%s/* at %s", match_id, endpoint)
 
-    def _decode(self, sample: Any) -> dict[str, Any] | None:
+    def _decode(self, sample: Any) -> JSONObject | None:
         try:
             value = json.loads(sample.payload.to_string())
         except ValueError:
@@ -104,8 +105,8 @@ class ZenohTelemetry:
         value = self._decode(sample)
         with self._lock:
             self._last_at = self._clock()
-            if value is not None:
-                self._events.append(value)
+            if value is not None:  # a referee event as the simulator sends it
+                self._events.append(cast("EventRecord", value))
 
     def latest(self) -> StateMessage | None:
         """The newest state message; but the first message of a new game state (or half) once,
@@ -119,7 +120,7 @@ class ZenohTelemetry:
         with self._lock:
             return self._last_at
 
-    def events(self) -> list[dict[str, Any]]:
+    def events(self) -> list[EventRecord]:
         with self._lock:
             return list(self._events)
 

@@ -52,9 +52,11 @@ from referee.snapshot import (
     RobotState,
     SetLimp,
     TeleportRobot,
+    Vec3,
     WorldCommand,
     WorldSnapshot,
 )
+from referee.spoofing import SpoofingLog
 
 __all__ = [
     "ADULT_FIELD",
@@ -94,12 +96,14 @@ __all__ = [
     "ScenarioError",
     "SecondaryState",
     "SetLimp",
+    "SpoofingLog",
     "SystemClock",
     "TeamColor",
     "TeamMirror",
     "TeamSpec",
     "TeleportRobot",
     "TimingConfig",
+    "Vec3",
     "WorldCommand",
     "WorldSnapshot",
     "decode_game_state",

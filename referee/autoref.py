@@ -15,6 +15,7 @@ from pathlib import Path
 from contracts.geometry import Pose
 from contracts.ids import RobotId, TeamColor
 from contracts.match_spec import GameType
+from contracts.telemetry import GameStateRecord
 from referee import reporting
 from referee.clock import Clock, SystemClock
 from referee.config import RefereeConfig
@@ -130,7 +131,7 @@ class Referee:
         return self._wait_until_s is not None
 
     @property
-    def game_state(self) -> dict[str, object]:
+    def game_state(self) -> GameStateRecord:
         """The telemetry state dict: state, secondary_state, half, secs_remaining, score,
         penalties (and set_play, phase, kickoff, left_team, waiting_for_wall_clock)."""
         return reporting.game_state(

@@ -6,6 +6,7 @@ from collections import Counter
 from collections.abc import Sequence
 
 from contracts.ids import TeamColor
+from contracts.telemetry import GameStateRecord, PenaltyRecord
 from referee.clock import Clock
 from referee.gamecontroller import GameController
 from referee.play_stats import PlayStats
@@ -18,9 +19,9 @@ def score(gc: GameController) -> dict[str, int]:
     return {color.value: gc.score(color) for color in COLORS}
 
 
-def game_state(gc: GameController, *, left_team: TeamColor, waiting: bool) -> dict[str, object]:
+def game_state(gc: GameController, *, left_team: TeamColor, waiting: bool) -> GameStateRecord:
     """The state dict of the telemetry contract (plus set play, phase, kick-off, sides)."""
-    penalties = {
+    penalties: dict[str, PenaltyRecord] = {
         f"{robot.team.value}-{robot.number}": {
             "penalty": gc.robot(robot).penalty.name,
             "secs_till_unpenalised": int(round(gc.robot(robot).secs_till_unpenalised)),

@@ -6,3 +6,5 @@ kicking, getting up for the built-in models), ``robot.stub`` (the stub robot con
 MJCF). Nothing here imports MuJoCo, the simulator server or the referee: the package installs on
 its own with numpy and protobuf (see ``robot/pyproject.toml``).
 """
+
+__all__: list[str] = []  # its public modules are listed in ARCHITECTURE.md (Public faces)

@@ -14,20 +14,24 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from service.app import Services, create_app
+    from service.app import Services, create_app, pool_from_settings
     from service.deps import (
+        DbSession,
         OperatorPrincipal,
         TeamPrincipal,
         get_db,
+        get_services,
         require_operator,
         require_team,
         require_token,
     )
-    from service.errors import ServiceError
+    from service.errors import NotFound, ServiceError
     from service.settings import Settings
     from service.tokens import Principal
 
 _WHERE = {
+    "DbSession": "service.deps",
+    "NotFound": "service.errors",
     "OperatorPrincipal": "service.deps",
     "Principal": "service.tokens",
     "ServiceError": "service.errors",
@@ -36,6 +40,8 @@ _WHERE = {
     "TeamPrincipal": "service.deps",
     "create_app": "service.app",
     "get_db": "service.deps",
+    "get_services": "service.deps",
+    "pool_from_settings": "service.app",
     "require_operator": "service.deps",
     "require_team": "service.deps",
     "require_token": "service.deps",
@@ -51,6 +57,8 @@ def __getattr__(name: str) -> Any:
 
 
 __all__ = [
+    "DbSession",
+    "NotFound",
     "OperatorPrincipal",
     "Principal",
     "ServiceError",
@@ -59,6 +67,8 @@ __all__ = [
     "TeamPrincipal",
     "create_app",
     "get_db",
+    "get_services",
+    "pool_from_settings",
     "require_operator",
     "require_team",
     "require_token",

@@ -19,7 +19,11 @@ in exactly one place (:mod:`service.app`), which also answers the cluster's
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TypeAlias
+
+# The fields an error adds to its JSON body: text, or an invalid input's problems (each with
+# its file, pointer, message...)
+ErrorFields: TypeAlias = dict[str, str | list[dict[str, str]]]
 
 
 class ServiceError(Exception):
@@ -29,7 +33,7 @@ class ServiceError(Exception):
     kind = "internal"
     exit_code = 1
 
-    def fields(self) -> dict[str, Any]:
+    def fields(self) -> ErrorFields:
         return {}
 
 
@@ -52,7 +56,7 @@ class AuthError(ServiceError):
         self.reason = reason  # missing, malformed, unknown, expired, revoked, scope
         super().__init__(message)
 
-    def fields(self) -> dict[str, Any]:
+    def fields(self) -> ErrorFields:
         return {"reason": self.reason}
 
 
@@ -66,7 +70,7 @@ class NotFound(ServiceError):
         self.ident = ident
         super().__init__(f"no {what} {ident!r}")
 
-    def fields(self) -> dict[str, Any]:
+    def fields(self) -> ErrorFields:
         return {"what": self.what, "id": self.ident}
 
 
@@ -79,7 +83,7 @@ class Conflict(ServiceError):
         self.existing_id = existing_id
         super().__init__(message)
 
-    def fields(self) -> dict[str, Any]:
+    def fields(self) -> ErrorFields:
         return {"existing_id": self.existing_id} if self.existing_id else {}
 
 
@@ -92,7 +96,7 @@ class InvalidInput(ServiceError):
         self.problems = list(problems or [])
         super().__init__(message)
 
-    def fields(self) -> dict[str, Any]:
+    def fields(self) -> ErrorFields:
         return {"problems": self.problems} if self.problems else {}
 
 
@@ -106,7 +110,7 @@ class PreflightFailed(ServiceError):
         self.cause = cause
         super().__init__(f"pre-flight check failed at {stage} for image {image}: {cause}")
 
-    def fields(self) -> dict[str, Any]:
+    def fields(self) -> ErrorFields:
         return {"stage": self.stage, "image": self.image, "cause": self.cause}
 
 

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any
 
 from contracts.timing import TEST_MATCH
+from orchestrator.config import TeamDocument
 from orchestrator.match.scrimmage import ScrimmageRequest, game_file, team_file
 from orchestrator.private_files import private_dir, write_private
 from service.settings import Settings
@@ -20,13 +20,13 @@ OWN_COLOR = "red"
 """The submitting team plays red in its test matches (and sees only red's logs)."""
 
 
-def _ports(base: int, team: dict[str, Any]) -> list[int]:
+def _ports(base: int, team: TeamDocument) -> list[int]:
     players = team.get("players") or {}
     return [base + n for n in range(1, max(1, len(players)) + 1)]
 
 
-def write_match(folder: Path, *, match_id: str, team: dict[str, Any],
-                opponent: dict[str, Any] | None, stub_image: str | None,
+def write_match(folder: Path, *, match_id: str, team: TeamDocument,
+                opponent: TeamDocument | None, stub_image: str | None,
                 settings: Settings, seed: int) -> Path:
     """Write the match files into ``folder``; returns the game.json path."""
     if opponent is None:

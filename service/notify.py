@@ -14,7 +14,7 @@ import smtplib
 import threading
 from datetime import timedelta
 from email.message import EmailMessage
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, TypedDict
 
 import httpx
 from sqlalchemy import select
@@ -33,7 +33,60 @@ log = logging.getLogger(__name__)
 MAIL_EVENTS = {"submission.started", "submission.finished", "submission.failed"}
 
 
-def outcome_of(row: Submission, results: dict[str, Any] | None) -> str:
+class PlayView(TypedDict, total=False):
+    """What a notification reads of results.json's ``play`` (contracts.sim_result.PlayRecord)."""
+
+    playing_s: float
+    halves_playing: list[int]
+
+
+class ResultsView(TypedDict, total=False):
+    """What a notification reads of a match's results.json."""
+
+    winner: str | None  # "red", "blue", "draw"; None while not over
+    score: dict[str, int] | None
+    play: PlayView | None
+
+
+class NoticeLinks(TypedDict):
+    status: str
+    report: str
+    results: str
+    logs: str
+
+
+class NoticePages(TypedDict):
+    submissions: str
+    live: str
+    replay: str
+    ladder: str
+
+
+class SubmissionNotice(TypedDict):
+    id: str
+    state: str
+    opponent: str
+    match_id: str | None
+    failure_class: str | None
+    failure_side: str | None
+    cause: str | None
+    charged: bool
+    score: dict[str, int] | None
+    outcome: str
+    playing_s: float | None
+    halves_playing: list[int] | None
+    links: NoticeLinks
+    pages: NoticePages
+
+
+class NotificationPayload(TypedDict):
+    """The data of a mail or webhook (stored as JSON in the outbox)."""
+
+    event: str
+    submission: SubmissionNotice
+
+
+def outcome_of(row: Submission, results: ResultsView | None) -> str:
     """The outcome in words for the submitting team (red): won, drew, lost, or why not played."""
     if row.state == "cancelled":
         return "cancelled"
@@ -48,7 +101,7 @@ def outcome_of(row: Submission, results: dict[str, Any] | None) -> str:
 
 
 def payload(row: Submission, event: str, settings: Settings,
-            results: dict[str, Any] | None = None) -> dict[str, Any]:
+            results: ResultsView | None = None) -> NotificationPayload:
     """The notification's data: the submission, its score and outcome (from ``results``, the
     match's results.json, when it ended), links to the API and to the pages a browser opens."""
     public = settings.public_url.rstrip("/")
@@ -73,7 +126,7 @@ def payload(row: Submission, event: str, settings: Settings,
 
 
 def enqueue(session: Session, row: Submission, event: str, settings: Settings,
-            results: dict[str, Any] | None = None) -> None:
+            results: ResultsView | None = None) -> None:
     """Outbox rows for ``event``: a mail when the team has an address and SMTP is set, a
     webhook when the team has a webhook URL."""
     team = session.get(Team, row.team_id)
@@ -92,7 +145,7 @@ def enqueue(session: Session, row: Submission, event: str, settings: Settings,
                                  given_up=False))
 
 
-def send_mail(settings: Settings, *, to: str, event: str, data: dict[str, Any]) -> None:
+def send_mail(settings: Settings, *, to: str, event: str, data: NotificationPayload) -> None:
     sub = data["submission"]
     message = EmailMessage()
     message["From"] = settings.mail_from
@@ -216,4 +269,12 @@ class Notifier:
                          row.event, row.submission_id, row.attempts, delay, error)
 
 
-__all__ = ["MAIL_EVENTS", "Notifier", "enqueue", "payload", "send_mail"]
+__all__ = [
+    "MAIL_EVENTS",
+    "NotificationPayload",
+    "Notifier",
+    "ResultsView",
+    "enqueue",
+    "payload",
+    "send_mail",
+]

@@ -26,8 +26,8 @@ from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
+from orchestrator import ConfigError, ImageTooLarge, OrchestratorError
 from orchestrator.config import Limits, PlayerConfig, TeamConfig
-from orchestrator.errors import ConfigError, ImageTooLarge, OrchestratorError
 from service.errors import InvalidInput, PreflightFailed
 from service.settings import Settings
 

@@ -22,7 +22,7 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from datetime import datetime
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from openskill.models import PlackettLuce
 from sqlalchemy import exists, func, select
@@ -35,6 +35,9 @@ from service.db import Submission, SubmissionState, Team, now, utc
 from service.db.ladder import RatedMatch
 from service.matchfiles import OWN_COLOR
 from service.submissions import STUB
+
+if TYPE_CHECKING:
+    from tournament import MatchResultRecord
 
 FRIENDLY = "friendly"
 OFFICIAL = "official"
@@ -119,7 +122,7 @@ def record_official(session: Session, state_file: Path) -> int:
     return added
 
 
-def _official_outcome(result: dict[str, Any]) -> Outcome:
+def _official_outcome(result: MatchResultRecord) -> Outcome:
     out_dir = result.get("out_dir")
     if out_dir and (Path(out_dir) / files.RESULTS).is_file():
         return outcome_of(Path(out_dir) / files.RESULTS)

@@ -18,6 +18,7 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
+from collections.abc import Mapping
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -25,9 +26,9 @@ from typing import Any
 from sqlalchemy import func, select
 from sqlalchemy.orm import Session
 
+from orchestrator import ConfigError, Problem
 from orchestrator.config import FieldClass, TeamConfig, check_team_document
 from orchestrator.config.robot_models import BUILT_IN_MODELS
-from orchestrator.errors import ConfigError, Problem
 from service.db import TeamFile
 from service.errors import InvalidInput, NotFound
 from service.sealing import PREFIX, Sealer
@@ -94,7 +95,7 @@ def service_problems(kind: str, document: Any) -> tuple[Any, list[Problem]]:
     return {**document, "credentials": cleaned}, problems
 
 
-def _builtin_models_only(document: dict[str, Any],
+def _builtin_models_only(document: Mapping[str, object],
                          problems: list[Problem]) -> tuple[Any, list[Problem]]:
     """A robot model package is a folder of the host that reads the file: refused (and taken
     out, unread) in the service, which plays the built-in models."""

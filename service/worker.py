@@ -20,13 +20,12 @@ import threading
 import zlib
 from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from sqlalchemy import func, select
 from sqlalchemy.orm import Session
 
-from cluster import JobState, JobStatus, MatchJob
-from cluster.errors import PoolError
+from cluster import JobState, JobStatus, MatchJob, PoolError
 from contracts import files
 from contracts.errors import ContractError
 from contracts.match_results import FailureClass, MatchReport
@@ -40,6 +39,7 @@ from service.matchfiles import OWN_COLOR
 from service.submissions import STUB, failure_side, queue_paused
 
 if TYPE_CHECKING:
+    from orchestrator.config import TeamDocument
     from service.app import Services
 
 log = logging.getLogger(__name__)
@@ -158,7 +158,7 @@ class QueueWorker:
         assert row.match_id is not None
         sealer = self.services.sealer
         team_doc = teamfiles.opened(teamfiles.get_by_id(session, row.team_file_id), sealer)
-        opponent_doc: dict[str, Any] | None = None
+        opponent_doc: TeamDocument | None = None
         if row.opponent != STUB:
             other = session.scalar(select(Team).where(Team.name == row.opponent))
             assert other is not None
@@ -183,7 +183,7 @@ class QueueWorker:
         """League placement: a node for each robot (0: dense placement)."""
         if self.settings.placement != "league":
             return 0
-        from orchestrator.match.plan import robots_in_game
+        from orchestrator.match import robots_in_game
 
         return robots_in_game(game)
 
@@ -313,13 +313,13 @@ class QueueWorker:
                  f" ({failure_class}: {cause})" if failure_class else "")
 
 
-def _results_of(out: Path | None) -> dict[str, Any] | None:
+def _results_of(out: Path | None) -> notify.ResultsView | None:
     """The match's results.json as data (score, winner, play), None when there is none."""
     path = out / files.RESULTS if out is not None else None
     if path is None or not path.is_file():
         return None
     try:
-        data: dict[str, Any] = json.loads(path.read_text(encoding="utf-8"))
+        data: notify.ResultsView = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError) as exc:
         log.warning("unreadable %s: %s", path, exc)
         return None

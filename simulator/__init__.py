@@ -8,14 +8,18 @@ from __future__ import annotations
 
 from simulator.errors import (
     ApiError,
+    ModelError,
     PhysicsDivergence,
+    ReplayError,
     SimulatorError,
     UnknownModelError,
 )
 
 __all__ = [
     "ApiError",
+    "ModelError",
     "PhysicsDivergence",
+    "ReplayError",
     "SimulatorError",
     "UnknownModelError",
 ]

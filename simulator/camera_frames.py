@@ -13,13 +13,16 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 from simulator.errors import ReplayError
 
+if TYPE_CHECKING:
+    from simulator.replay.format import RobotCameraRecord, SceneRecord
 
-def _robot_camera(scene: dict[str, Any], robot: str, path: str) -> dict[str, Any]:
-    cameras: dict[str, dict[str, Any]] = {c["robot"]: c for c in scene.get("robot_cameras", ())}
+
+def _robot_camera(scene: SceneRecord, robot: str, path: str) -> RobotCameraRecord:
+    cameras: dict[str, RobotCameraRecord] = {c["robot"]: c for c in scene.get("robot_cameras", ())}
     camera = cameras.get(robot)
     if camera is None:
         known = ", ".join(sorted(cameras)) or "none (a replay recorded before head cameras were"

@@ -32,12 +32,12 @@ import logging
 import struct
 import time
 from dataclasses import asdict, dataclass
-from typing import Any, Protocol, cast
+from typing import Any, Protocol
 
 import numpy as np
 
-from contracts.telemetry import StateMessage
-from referee.snapshot import RefereeEvent, WorldCommand, WorldSnapshot
+from contracts.telemetry import EventRecord, GameStateRecord, StateMessage
+from referee import RefereeEvent, WorldCommand, WorldSnapshot
 from simulator.api import ApiServer, LockstepSettings, wait_lockstep
 from simulator.api.lockstep import Pipeline
 from simulator.telemetry import POSES_PERIOD_S, STATE_PERIOD_S, Telemetry
@@ -65,7 +65,7 @@ class RefereeLike(Protocol):
     def waiting_for_wall_clock(self) -> bool: ...
 
     @property
-    def game_state(self) -> dict[str, object]: ...
+    def game_state(self) -> GameStateRecord: ...
 
     events: list[RefereeEvent]
 
@@ -85,9 +85,9 @@ class WorldLike(Protocol):
 
 
 class RecorderLike(Protocol):
-    def record(self, world: Any, game_state: dict[str, Any]) -> None: ...
+    def record(self, world: Any, game_state: GameStateRecord) -> None: ...
 
-    def event(self, event: dict[str, Any]) -> None: ...
+    def event(self, event: EventRecord) -> None: ...
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -99,10 +99,18 @@ class LoopSettings:
     max_duration_real_s: float | None
 
 
-def event_dict(event: RefereeEvent) -> dict[str, Any]:
+def event_dict(event: RefereeEvent) -> EventRecord:
+    """The event as the replay and the telemetry carry it (a copy: nothing shared)."""
     data = asdict(event)
-    data["team"] = event.team.value if event.team is not None else None
-    return data
+    return {
+        "sim_time_ms": data["sim_time_ms"],
+        "type": data["type"],
+        "team": event.team.value if event.team is not None else None,
+        "player": data["player"],
+        "reason": data["reason"],
+        "placement": data["placement"],
+        "details": data["details"],
+    }
 
 
 class MatchLoop:
@@ -213,7 +221,7 @@ class MatchLoop:
         pipeline.after_step()
         self.steps += 1
         if self.recorder is not None:
-            self.recorder.record(world, dict(self.referee.game_state))
+            self.recorder.record(world, self.referee.game_state.copy())
         self._publish_state()
 
     def _one_step(self) -> None:
@@ -229,7 +237,7 @@ class MatchLoop:
         server.publish(world.sim_time_ms)
         self.steps += 1
         if self.recorder is not None:
-            self.recorder.record(world, dict(self.referee.game_state))
+            self.recorder.record(world, self.referee.game_state.copy())
         self._publish_state()
 
     def _referee_step(self, snapshot: WorldSnapshot) -> None:
@@ -279,11 +287,11 @@ class MatchLoop:
             StateMessage(
                 sim_time_ms=self.world.sim_time_ms,
                 real_time_factor=round(rtf, 3),
-                state=cast("str | None", game.get("state")),
-                secondary_state=cast("str | None", game.get("secondary_state")),
-                half=cast("int | None", game.get("half")),
-                secs_remaining=cast("float | None", game.get("secs_remaining")),
-                score=cast("dict[str, int] | None", game.get("score")),
+                state=game.get("state"),
+                secondary_state=game.get("secondary_state"),
+                half=game.get("half"),
+                secs_remaining=game.get("secs_remaining"),
+                score=game.get("score"),
                 connected=tuple(self.server.connected()),
                 stepping=self.settings.stepping,
                 robots=robots,

@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import fields
 
 from contracts.match_spec import MatchSpec
-from referee.config import NetworkConfig, RefereeConfig, TimingConfig
+from referee import NetworkConfig, RefereeConfig, TimingConfig
 
 
 def referee_config(spec: MatchSpec) -> RefereeConfig:

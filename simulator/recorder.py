@@ -8,10 +8,11 @@ from __future__ import annotations
 
 import zlib
 from pathlib import Path
-from typing import IO, Any
+from typing import IO
 
 import numpy as np
 
+from contracts.telemetry import EventRecord, GameStateRecord
 from simulator.replay.format import (
     CHUNK,
     FORMAT_VERSION,
@@ -21,6 +22,8 @@ from simulator.replay.format import (
     RECORD_HEAD,
     TRAILER,
     U32,
+    ChunkMeta,
+    HeaderRecord,
     dumps,
     encode_poses,
 )
@@ -33,7 +36,7 @@ ZLIB_LEVEL = 6
 
 def replay_header(
     world: World, *, match_id: str, rate_hz: float, chunk_frames: int
-) -> dict[str, Any]:
+) -> HeaderRecord:
     """The header of a version 3 replay of ``world`` (also the scene sent to live viewers)."""
     return {
         "format": "hlvsrec",
@@ -88,13 +91,13 @@ class Recorder:
         self.chunk_frames = chunk_frames
         self._period_ms = 1000.0 / rate_hz
         self._frames = 0
-        self._events: list[dict[str, Any]] = []
-        self._game: dict[str, Any] = {}
+        self._events: list[EventRecord] = []
+        self._game: GameStateRecord = {}
         self._last_time_ms = -1
-        self._pending: dict[str, list[Any]] = self._empty_chunk()
+        self._pending: ChunkMeta = self._empty_chunk()
         self._poses: list[np.ndarray] = []
         self._index_chunks: list[list[int]] = []
-        self._index_events: list[dict[str, Any]] = []
+        self._index_events: list[EventRecord] = []
         self._offset = 0
         self._out: IO[bytes] | None = self.path.open("wb")
         header = replay_header(world, match_id=match_id, rate_hz=rate_hz, chunk_frames=chunk_frames)
@@ -103,21 +106,21 @@ class Recorder:
         self.record(world, {})  # the initial state
 
     @staticmethod
-    def _empty_chunk() -> dict[str, list[Any]]:
+    def _empty_chunk() -> ChunkMeta:
         return {"times": [], "games": [], "events": []}
 
     @property
     def frames_written(self) -> int:
         return self._frames
 
-    def record(self, world: World, game_state: dict[str, Any]) -> None:
+    def record(self, world: World, game_state: GameStateRecord) -> None:
         self._game = game_state
         if world.sim_time_ms >= self._frames * self._period_ms:
             self._add(world.sim_time_ms, world.data.xpos, world.data.xquat)
             while self._frames * self._period_ms <= world.sim_time_ms:
                 self._frames += 1
 
-    def event(self, event: dict[str, Any]) -> None:
+    def event(self, event: EventRecord) -> None:
         self._events.append(event)
 
     def _emit(self, blob: bytes) -> None:

@@ -31,7 +31,9 @@ if TYPE_CHECKING:  # numpy, MuJoCo and the replay reader are imported after the 
     import numpy as np
     import numpy.typing as npt
 
+    from contracts.telemetry import GameStateRecord
     from simulator.replay import Replay
+    from simulator.replay.format import GeomRecord, SceneRecord
 
     Array = npt.NDArray[np.float64]
 
@@ -102,7 +104,7 @@ def _frames_for(replay: Replay, fps: float) -> Iterator[int]:
         k += 1
 
 
-def caption(game: dict[str, Any]) -> str:
+def caption(game: GameStateRecord) -> str:
     """One line about a frame's game state: ``PLAYING  1st half  09:58  red 1 : 0 blue``."""
     parts = []
     if game.get("state"):
@@ -143,7 +145,7 @@ def _f(values: list[float]) -> str:
     return " ".join(f"{v:.6g}" for v in values)
 
 
-def _geom_xml(geom: dict[str, Any], material: str | None) -> str:
+def _geom_xml(geom: GeomRecord, material: str | None) -> str:
     look = f'material="{material}"' if material else f'rgba="{_f(geom["rgba"])}"'
     return (
         f'<geom type="{geom["type"]}" size="{_f(geom["size"])}" pos="{_f(geom["pos"])}" '
@@ -152,7 +154,7 @@ def _geom_xml(geom: dict[str, Any], material: str | None) -> str:
     )
 
 
-def scene_xml(scene: dict[str, Any]) -> str:
+def scene_xml(scene: SceneRecord) -> str:
     """An MJCF of shapes only (no joints, no physics) with one body per recorded body, in the
     recorded order, so that body ``i`` of the model is body ``i`` of every frame."""
     from simulator.world.look import look_assets, look_from_summary
@@ -211,7 +213,7 @@ def scene_xml(scene: dict[str, Any]) -> str:
 </mujoco>"""
 
 
-def scene_model(scene: dict[str, Any]) -> Any:
+def scene_model(scene: SceneRecord) -> Any:
     """The compiled :func:`scene_xml` of ``scene``, with its look's textures and lights."""
     import mujoco
 

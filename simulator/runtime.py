@@ -119,7 +119,7 @@ def main(argv: list[str]) -> int:
 
 def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
     """Play the match of ``spec``, writing every output file into ``out``; returns the exit code."""
-    from referee.autoref import Referee
+    from referee import Referee
     from simulator.api.world_cameras import world_render_worker
     from simulator.recorder import Recorder, replay_header
     from simulator.world import World

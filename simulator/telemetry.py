@@ -15,10 +15,15 @@ from __future__ import annotations
 import json
 import logging
 import time
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 from contracts import telemetry as topics
+from contracts.jsontypes import JSONObject
+from contracts.telemetry import EventRecord
 from simulator.errors import SimulatorError
+
+if TYPE_CHECKING:
+    from simulator.replay.format import HeaderRecord
 
 log = logging.getLogger(__name__)
 
@@ -35,9 +40,9 @@ class TelemetryError(SimulatorError):
 
 
 class Telemetry(Protocol):
-    def state(self, payload: dict[str, Any]) -> None: ...
+    def state(self, payload: JSONObject) -> None: ...
 
-    def event(self, payload: dict[str, Any]) -> None: ...
+    def event(self, payload: EventRecord) -> None: ...
 
     def poses(self, payload: bytes) -> None: ...
 
@@ -47,10 +52,10 @@ class Telemetry(Protocol):
 class NullTelemetry:
     """Telemetry switched off (no ``telemetry_listen``)."""
 
-    def state(self, payload: dict[str, Any]) -> None:
+    def state(self, payload: JSONObject) -> None:
         return None
 
-    def event(self, payload: dict[str, Any]) -> None:
+    def event(self, payload: EventRecord) -> None:
         return None
 
     def poses(self, payload: bytes) -> None:
@@ -80,7 +85,7 @@ class ZenohTelemetry:
     """Publishes the match state and referee events on a zenoh session."""
 
     def __init__(
-        self, *, match_id: str, listen: str, scene: dict[str, Any] | None = None
+        self, *, match_id: str, listen: str, scene: HeaderRecord | None = None
     ) -> None:
         import zenoh
 
@@ -96,14 +101,14 @@ class ZenohTelemetry:
         self._next_scene_s = 0.0
         log.info("telemetry on %s (keys hlvs/%s/state, hlvs/%s/events)", listen, match_id, match_id)
 
-    def state(self, payload: dict[str, Any]) -> None:
+    def state(self, payload: JSONObject) -> None:
         self._state.put(json.dumps(payload, sort_keys=True))
         now = time.monotonic()
         if self._scene_blob is not None and now >= self._next_scene_s:
             self._next_scene_s = now + SCENE_PERIOD_S
             self._scene.put(self._scene_blob)
 
-    def event(self, payload: dict[str, Any]) -> None:
+    def event(self, payload: EventRecord) -> None:
         self._events.put(json.dumps(payload, sort_keys=True, default=str))
 
     def poses(self, payload: bytes) -> None:
@@ -116,7 +121,7 @@ class ZenohTelemetry:
 
 
 def open_telemetry(
-    *, match_id: str, listen: str | None, scene: dict[str, Any] | None = None
+    *, match_id: str, listen: str | None, scene: HeaderRecord | None = None
 ) -> Telemetry:
     if not listen:
         return NullTelemetry()

@@ -17,9 +17,10 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import IO, Any, Protocol
+from typing import IO, Protocol, cast
 
 from contracts import files
+from contracts.telemetry import RobotTraffic, TrafficSample
 from simulator.api.stats import RobotStats
 
 STATS_FILE = files.API_STATS
@@ -41,7 +42,7 @@ class TrafficLog:
         self._next_s: float | None = None
         self._started_s: float | None = None
         self._seen: dict[str, int] = {}
-        self.latest: dict[str, Any] | None = None
+        self.latest: TrafficSample | None = None
         self._out: IO[str] | None = path.open("w", encoding="utf-8") if path else None
 
     def sample(self, *, now_s: float, sim_time_ms: int, real_time_factor: float) -> None:
@@ -51,7 +52,7 @@ class TrafficLog:
         if self._next_s is not None and now_s < self._next_s:
             return
         self._next_s = now_s + self._period_s
-        robots = {}
+        robots: dict[str, RobotTraffic] = {}
         for key, (connected, stats) in sorted(self._source.traffic().items()):
             seen = self._seen.get(key, 0)
             fresh = stats.round_trip_s[seen:]
@@ -80,14 +81,14 @@ class TrafficLog:
             self._out = None
 
 
-def read_stats(path: Path) -> list[dict[str, Any]]:
+def read_stats(path: Path) -> list[TrafficSample]:
     """The samples of an ``api_stats.jsonl`` file (lines that are not JSON objects skipped)."""
-    samples = []
+    samples: list[TrafficSample] = []
     for line in path.read_text(encoding="utf-8").splitlines():
         try:
             value = json.loads(line)
         except ValueError:
             continue
         if isinstance(value, dict):
-            samples.append(value)
+            samples.append(cast("TrafficSample", value))  # written by TrafficLog
     return samples

@@ -2,3 +2,5 @@
 image and imported by no production package): SFTP (OpenSSH ``sshd`` and asyncssh) and S3
 (moto and SeaweedFS) servers, free ports, and the stub robot controller on an in-process world.
 """
+
+__all__: list[str] = []  # its public modules are listed in ARCHITECTURE.md (Public faces)

@@ -4,8 +4,8 @@
 from __future__ import annotations
 
 import statistics
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
 
 
 @dataclass(frozen=True, slots=True)
@@ -19,19 +19,20 @@ class Target:
             return False
         return self.maximum is None or value <= self.maximum
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, str | float | None]:
+        """``{"figure": name, "min" or "max": bound}``."""
         bound = {"min": self.minimum} if self.minimum is not None else {"max": self.maximum}
         return {"figure": self.figure, **bound}
 
 
-def median_figures(runs: list[dict[str, Any]]) -> dict[str, Any]:
-    """Per numeric figure, the median over the runs that did not fail."""
+def median_figures(runs: Sequence[Mapping[str, object]]) -> dict[str, float]:
+    """Per numeric figure, the median over the runs (figure name -> value) that did not fail."""
     good = [r for r in runs if "error" not in r]
     keys = sorted({k for r in good for k, v in r.items() if isinstance(v, int | float)
                    and not isinstance(v, bool)})  # fmt: skip
-    medians: dict[str, Any] = {}
+    medians: dict[str, float] = {}
     for key in keys:
-        values = [r[key] for r in good if isinstance(r.get(key), int | float)]
+        values = [v for r in good if isinstance(v := r.get(key), int | float)]
         if values:
             medians[key] = round(statistics.median(values), 3)
     return medians

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from tournament.overview import LiveGame
 from tournament.runner import init_state, recover_interrupted, run_schedule
 from tournament.services import (
     MatchContext,
@@ -12,13 +13,22 @@ from tournament.services import (
     write_game_file,
 )
 from tournament.standings import Standing, standings
-from tournament.state import Ledger, MatchRow, ScheduledMatchState
+from tournament.state import (
+    Ledger,
+    MatchResultRecord,
+    MatchRow,
+    OperatorRequest,
+    ScheduledMatchState,
+)
 
 __all__ = [
     "Ledger",
+    "LiveGame",
     "MatchContext",
+    "MatchResultRecord",
     "MatchRow",
     "MatchServices",
+    "OperatorRequest",
     "ScheduledMatchState",
     "PlayOutcome",
     "Standing",

@@ -16,11 +16,10 @@ import logging
 from dataclasses import replace
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
 
+from orchestrator import ConfigError, Problem, ScheduleError
 from orchestrator.config.schedule import PlannedMatch, Schedule, load_schedule, resolve_time
-from orchestrator.errors import ConfigError, Problem, ScheduleError
-from tournament.state import Ledger, ScheduledMatchState
+from tournament.state import Ledger, OperatorRequest, ScheduledMatchState
 
 log = logging.getLogger(__name__)
 S = ScheduledMatchState
@@ -194,7 +193,7 @@ def _state(ledger: Ledger, match_id: str) -> ScheduledMatchState:
         raise ScheduleError(f"no match {match_id!r} in {ledger.path}") from None
 
 
-def abort_request(request: dict[str, Any] | None) -> tuple[str, float] | None:
+def abort_request(request: OperatorRequest | None) -> tuple[str, float] | None:
     """(reason, grace) of a recorded abort request."""
     if not request or request.get("action") != "abort":
         return None

@@ -11,10 +11,20 @@ A match is DELIVERED only when every set was delivered (or there was none).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Literal, NotRequired, TypedDict
 
 LogState = Literal["pending", "delivered", "failed", "retrying", "none", "gone"]
 DONE: frozenset[str] = frozenset({"delivered", "none"})
+
+
+class TeamLogsRecord(TypedDict):
+    """A :class:`TeamLogs` in the ledger (JSON); earlier ledgers may lack the optional keys."""
+
+    team: str
+    state: LogState
+    cause: NotRequired[str]
+    target: NotRequired[str]
+    attempts: NotRequired[int]
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -27,7 +37,7 @@ class TeamLogs:
     target: str = ""
     attempts: int = 0
 
-    def as_dict(self) -> dict[str, Any]:
+    def as_dict(self) -> TeamLogsRecord:
         return {
             "team": self.team,
             "state": self.state,
@@ -37,7 +47,7 @@ class TeamLogs:
         }
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> TeamLogs:
+    def from_dict(cls, data: TeamLogsRecord) -> TeamLogs:
         return cls(
             team=str(data["team"]),
             state=data["state"],

@@ -10,7 +10,7 @@ from collections.abc import Callable
 from dataclasses import replace
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict
 from urllib.parse import quote, urlencode
 
 from contracts import files
@@ -18,14 +18,29 @@ from orchestrator.config.schedule import Schedule
 from tournament.logs import summary
 from tournament.state import Ledger, MatchRow, ScheduledMatchState
 
-Snapshot = Callable[[Path], dict[str, Any] | None]  # a running match's folder -> game state
+
+class LiveGame(TypedDict, total=False):
+    """A running match's game state, as its telemetry's state message gives it."""
+
+    state: str | None  # GameController state name
+    secondary_state: str | None
+    half: int | None
+    phase: str
+    secs_remaining: float | None
+    score: dict[str, int] | None  # {"red": goals, "blue": goals}
+    sim_time_ms: int
+
+
+Snapshot = Callable[[Path], LiveGame | None]  # a running match's folder -> its game state
 
 S = ScheduledMatchState
 
 
 def score_text(row: MatchRow) -> str:
     """``2-1``, ``1-1 (shoot-out 3-2)``, or "" when there is no score."""
-    result = row.result or {}
+    if row.result is None:
+        return ""
+    result = row.result
     score = result.get("score") or {}
     if score.get("red") is None or score.get("blue") is None:
         return ""
@@ -63,7 +78,7 @@ def logs_text(row: MatchRow) -> str:
     return ""
 
 
-def clock_text(live: dict[str, Any] | None) -> str:
+def clock_text(live: LiveGame | None) -> str:
     """``2-1 PLAYING 1st half 07:31`` of a running match's game state."""
     if not live:
         return ""
@@ -81,7 +96,7 @@ def clock_text(live: dict[str, Any] | None) -> str:
     return " ".join(parts)
 
 
-def status_line(row: MatchRow, live: dict[str, Any] | None = None) -> str:
+def status_line(row: MatchRow, live: LiveGame | None = None) -> str:
     score = clock_text(live) if live else score_text(row)
     played = "played" if row.state.played else ""
     parts = [f"{row.id:<12} {row.state.value:<12} {row.red} v {row.blue}"]

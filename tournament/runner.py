@@ -22,8 +22,8 @@ from apscheduler.executors.pool import ThreadPoolExecutor
 from apscheduler.jobstores.sqlalchemy import SQLAlchemyJobStore
 from apscheduler.schedulers.background import BackgroundScheduler
 
+from orchestrator import ScheduleError
 from orchestrator.config.schedule import Schedule, load_schedule, resolve_time
-from orchestrator.errors import ScheduleError
 from tournament.controls import abort_request
 from tournament.state import Ledger, ScheduledMatchState
 

@@ -22,11 +22,12 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Protocol
 
 from contracts import files
 from contracts.errors import ContractError
 from contracts.match_results import MatchReport, MatchResults
+from orchestrator import ScheduleError
 from orchestrator.config.schedule import (
     PlannedMatch,
     Schedule,
@@ -34,8 +35,8 @@ from orchestrator.config.schedule import (
     SchedulePool,
     game_document,
 )
-from orchestrator.errors import ScheduleError
 from tournament.logs import TeamLogs
+from tournament.state import MatchResultRecord
 
 log = logging.getLogger(__name__)
 
@@ -83,7 +84,7 @@ class PlayOutcome:
     cause: str = ""
     shootout: dict[str, int] | None = None  # color -> goals in the penalty shoot-out
 
-    def as_dict(self, ctx: MatchContext) -> dict[str, Any]:
+    def as_dict(self, ctx: MatchContext) -> MatchResultRecord:
         team = {"red": ctx.red.name, "blue": ctx.blue.name}
         return {
             "status": self.status,
@@ -271,8 +272,7 @@ class MatchServices:
         """The match as a Slurm job (no requeue: tournament matches wait for the operator).
         A job an earlier scheduler submitted for this match, still in Slurm or finished with
         its report, is adopted instead of playing the match again."""
-        from cluster import JobState, MatchJob
-        from cluster.errors import PoolError
+        from cluster import JobState, MatchJob, PoolError
         from cluster.slurm import HOST_NETNS, SlurmPool
 
         settings = self.schedule.pool
@@ -371,6 +371,6 @@ def _robot_nodes(pool: SchedulePool, game: Path) -> int:
     """League placement: a node for each robot of the match (0: dense placement)."""
     if pool.placement != "league":
         return 0
-    from orchestrator.match.plan import robots_in_game
+    from orchestrator.match import robots_in_game
 
     return robots_in_game(game)

@@ -77,10 +77,10 @@ def _games(rows: list[MatchRow]) -> list[_Game]:
         if row.kind != "round_robin" or not row.state.played or not result:
             continue
         score = result.get("score") or {}
-        if score.get("red") is None or score.get("blue") is None:
+        red, blue = score.get("red"), score.get("blue")
+        if red is None or blue is None:
             continue
-        games.append(_Game(str(result["red_team"]), str(result["blue_team"]),
-                           int(score["red"]), int(score["blue"])))
+        games.append(_Game(str(result["red_team"]), str(result["blue_team"]), int(red), int(blue)))
     return games
 
 

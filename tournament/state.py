@@ -25,9 +25,32 @@ from dataclasses import dataclass
 from datetime import UTC, datetime
 from enum import StrEnum
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict
 
 from tournament.logs import TeamLogs
+
+
+class MatchResultRecord(TypedDict):
+    """The ledger's result of a played or failed match (``tournament.PlayOutcome.as_dict``)."""
+
+    status: str  # "success" or the failure class of report.json
+    score: dict[str, int | None]  # {"red": goals, "blue": goals}
+    winner: str | None  # "red" | "blue" | "draw" | None
+    red_team: str
+    blue_team: str
+    winner_team: str | None
+    cause: str
+    out_dir: str  # the match's output folder
+    shootout: dict[str, int] | None  # color -> goals in the penalty shoot-out
+
+
+class OperatorRequest(TypedDict):
+    """An operator's pending request that the match's running job acts on."""
+
+    action: str  # "abort"
+    reason: str
+    grace_s: float
+    at: str  # ISO time of the request
 
 
 class ScheduledMatchState(StrEnum):
@@ -85,11 +108,11 @@ class MatchRow:
     deliver_at: datetime
     attempts: int
     note: str
-    result: dict[str, Any] | None
+    result: MatchResultRecord | None
     updated_at: datetime
     not_before: datetime | None = None  # a deferred step waits until then
     logs: tuple[TeamLogs, ...] = ()
-    request: dict[str, Any] | None = None  # an operator's pending request (abort)
+    request: OperatorRequest | None = None  # an operator's pending request (abort)
 
     def as_dict(self) -> dict[str, Any]:
         return {
@@ -199,7 +222,7 @@ class Ledger:
         to: ScheduledMatchState,
         *,
         note: str = "",
-        result: dict[str, Any] | None = None,
+        result: MatchResultRecord | None = None,
         count_attempt: bool = False,
         teams: tuple[str, str] | None = None,
     ) -> bool:
@@ -241,7 +264,7 @@ class Ledger:
                 (json.dumps([e.as_dict() for e in logs]), _now(), match_id),
             )
 
-    def set_request(self, match_id: str, request: dict[str, Any] | None) -> None:
+    def set_request(self, match_id: str, request: OperatorRequest | None) -> None:
         """Record (or clear) an operator's request that the running job acts on."""
         with self._connect() as db:
             db.execute(

@@ -32,8 +32,8 @@ from fastapi.responses import FileResponse, Response, StreamingResponse
 from fastapi.staticfiles import StaticFiles
 
 from contracts import files
-from simulator.errors import ReplayError
-from simulator.replay import ReplayFile, scene_for
+from simulator import ReplayError
+from simulator.replay import ReplayFile, SceneRecord, scene_for
 from simulator.traffic import read_stats
 from viewer.live import FeedFactory, LiveUnavailable, ZenohFeed
 from viewer.sources import Catalog, LiveSource, ReplaySource
@@ -55,12 +55,12 @@ class _OpenReplays:
         self._open = lru_cache(maxsize=16)(self._load)
 
     @staticmethod
-    def _load(path: Path, mtime_ns: int) -> tuple[ReplayFile, dict[str, Any]]:
+    def _load(path: Path, mtime_ns: int) -> tuple[ReplayFile, SceneRecord]:
         del mtime_ns  # part of the cache key: a replay still being written is reopened
         replay = ReplayFile(path)
         return replay, scene_for(replay.header, str(path))
 
-    def get(self, source: ReplaySource) -> tuple[ReplayFile, dict[str, Any]]:
+    def get(self, source: ReplaySource) -> tuple[ReplayFile, SceneRecord]:
         try:
             return self._open(source.path, source.path.stat().st_mtime_ns)
         except OSError as exc:
@@ -173,7 +173,9 @@ def build_router(resolver: Any, *, feed_factory: FeedFactory = ZenohFeed,
 
     @router.get(f"{API_PREFIX}/replays/{{replay_id}}/stats")
     def stats(source: ReplaySource = by_id) -> list[dict[str, Any]]:
-        return read_stats(source.stats_path) if source.stats_path is not None else []
+        # plain dicts for the response (its model is free JSON, as the samples were written)
+        samples = read_stats(source.stats_path) if source.stats_path is not None else []
+        return [dict(sample) for sample in samples]
 
     @router.get(f"{API_PREFIX}/live/{{match_id}}/stream")
     async def stream(live: LiveSource = live_by_id) -> StreamingResponse:

@@ -11,7 +11,7 @@ import socket
 import sys
 from pathlib import Path
 
-from simulator.errors import ReplayError
+from simulator import ReplayError
 from viewer.errors import ExportError, SourceError
 
 

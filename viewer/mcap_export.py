@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any
+from typing import TypedDict
 
 from foxglove_schemas_protobuf.Color_pb2 import Color
 from foxglove_schemas_protobuf.CubePrimitive_pb2 import CubePrimitive
@@ -33,7 +33,7 @@ from google.protobuf.timestamp_pb2 import Timestamp
 from mcap.writer import Writer
 from mcap_protobuf.schema import build_file_descriptor_set
 
-from simulator.replay import ReplayFile, scene_for
+from simulator.replay import GeomRecord, ReplayFile, SceneRecord, scene_for
 from simulator.traffic import read_stats
 from viewer.errors import ExportError
 from viewer.sources import STATS_FILE
@@ -57,7 +57,7 @@ def _pose(pos: list[float], quat: list[float]) -> Pose:
                 orientation=Quaternion(x=x, y=y, z=z, w=w))
 
 
-def _add_shape(entity: SceneEntity, geom: dict[str, Any]) -> None:
+def _add_shape(entity: SceneEntity, geom: GeomRecord) -> None:
     pose = _pose(geom["pos"], geom["quat"])
     r, g, b, a = geom["rgba"]
     color = Color(r=r, g=g, b=b, a=a)
@@ -77,7 +77,7 @@ def _add_shape(entity: SceneEntity, geom: dict[str, Any]) -> None:
             top_scale=1.0, color=color))
 
 
-def scene_update(scene: dict[str, Any]) -> SceneUpdate:
+def scene_update(scene: SceneRecord) -> SceneUpdate:
     bodies = scene["bodies"]
     entities = [
         SceneEntity(timestamp=_stamp(0), frame_id=WORLD_FRAME if i == 0 else name, id=name,
@@ -115,8 +115,14 @@ class _Out:
         self.messages += 1
 
 
+class ExportSummary(TypedDict):
+    messages: int
+    channels: int
+    duration_s: float
+
+
 def export_mcap(replay_path: Path, output: Path, *, stats_path: Path | None = None
-                ) -> dict[str, Any]:
+                ) -> ExportSummary:
     """Write ``replay_path`` as MCAP to ``output``; returns a summary (messages, channels...)."""
     if stats_path is None and (replay_path.parent / STATS_FILE).is_file():
         stats_path = replay_path.parent / STATS_FILE

@@ -18,11 +18,8 @@ from fastapi import Depends, FastAPI, Request
 from sqlalchemy import select, true
 
 from contracts import files
-from service.db import Submission
-from service.db.models import Scope
-from service.deps import DbSession, get_services, require_token
-from service.errors import NotFound
-from service.tokens import Principal
+from service import DbSession, NotFound, Principal, get_services, require_token
+from service.db import Scope, Submission
 from viewer.api import mount_viewer
 from viewer.sources import LiveSource, ReplaySource, live_of
 

@@ -11,11 +11,14 @@ import json
 import logging
 import threading
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, cast
 
 from viewer.errors import SourceError
 from viewer.live import FeedFactory, LiveUnavailable
 from viewer.sources import live_of
+
+if TYPE_CHECKING:
+    from tournament import LiveGame
 
 log = logging.getLogger(__name__)
 
@@ -23,7 +26,7 @@ KEYS = ("state", "secondary_state", "half", "phase", "secs_remaining", "score", 
 
 
 def game_snapshot(folder: Path, *, timeout_s: float = 1.0,
-                  factory: FeedFactory | None = None) -> dict[str, Any] | None:
+                  factory: FeedFactory | None = None) -> LiveGame | None:
     """The game state of the match playing in ``folder`` (its ``simulator/`` has the spec)."""
     try:
         live = live_of(folder)
@@ -36,7 +39,7 @@ def game_snapshot(folder: Path, *, timeout_s: float = 1.0,
 
         factory = ZenohFeed
     got = threading.Event()
-    found: dict[str, Any] = {}
+    found: LiveGame = {}
 
     def on_message(kind: str, payload: bytes) -> None:
         if kind != "state" or got.is_set():
@@ -46,7 +49,8 @@ def game_snapshot(folder: Path, *, timeout_s: float = 1.0,
         except ValueError:
             return
         if isinstance(data, dict):
-            found.update({k: data[k] for k in KEYS if k in data})
+            # the state message's fields (contracts.telemetry.StateMessage)
+            found.update(cast("LiveGame", {k: data[k] for k in KEYS if k in data}))
             got.set()
 
     try:

@@ -8,15 +8,17 @@ schedule's state file (``HLVS_SERVICE_SCHEDULE_STATE``). Operator tokens only.""
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from fastapi import APIRouter, FastAPI, Request
 from pydantic import BaseModel
 
-from service.deps import OperatorPrincipal, get_services
-from service.errors import NotFound
+from service import NotFound, OperatorPrincipal, get_services
 from viewer.api import build_router
 from viewer.sources import LiveSource, ReplaySource, live_of
+
+if TYPE_CHECKING:
+    from tournament import LiveGame
 
 router = APIRouter(prefix="/v1/operator", tags=["operator"])
 VIEWER_PREFIX = "/api/tournament"
@@ -42,7 +44,7 @@ def _ledger(request: Request) -> Any:
     return Ledger(Path(state))
 
 
-def snapshot(folder: Path) -> dict[str, Any] | None:
+def snapshot(folder: Path) -> LiveGame | None:
     """A running match's score and clock (replaced in tests)."""
     from viewer.snapshot import game_snapshot
 

@@ -16,15 +16,16 @@ import re
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, TextIO
+from typing import TYPE_CHECKING, Any, NotRequired, TextIO, TypedDict
 
-from orchestrator.errors import ConfigError, OrchestratorError, Problem
+from orchestrator import ConfigError, OrchestratorError, Problem
 from orchestrator.exitcodes import ExitCode
 from orchestrator.paths import user_path
 
 if TYPE_CHECKING:
     from contracts.field import FieldClass
     from orchestrator.config.detect import Kind
+    from simulator.world.robots.team.rulebook import MeasurementsRecord
 
 log = logging.getLogger(__name__)
 
@@ -84,6 +85,25 @@ def register(sub: Any) -> None:
     parser.set_defaults(func=run)
 
 
+class ProblemRecord(TypedDict):
+    file: str
+    pointer: str
+    message: str
+    expected: str
+    suggestion: str
+    severity: str  # "error" or "warning"
+
+
+class FileReportRecord(TypedDict):
+    """One file of ``hlvs check --json``."""
+
+    measurements: NotRequired[MeasurementsRecord]  # robot model packages (first when there)
+    file: str
+    kind: str | None
+    valid: bool
+    problems: list[ProblemRecord]
+
+
 @dataclass(slots=True)
 class FileReport:
     """The outcome of checking one file."""
@@ -91,7 +111,7 @@ class FileReport:
     file: str
     kind: str | None
     problems: list[Problem] = field(default_factory=list)
-    measurements: dict[str, Any] | None = None  # robot model packages
+    measurements: MeasurementsRecord | None = None  # robot model packages
 
     @property
     def errors(self) -> list[Problem]:
@@ -101,10 +121,8 @@ class FileReport:
     def valid(self) -> bool:
         return not self.errors
 
-    def as_json(self) -> dict[str, Any]:
-        extra = {} if self.measurements is None else {"measurements": self.measurements}
-        return {
-            **extra,
+    def as_json(self) -> FileReportRecord:
+        record: FileReportRecord = {
             "file": self.file,
             "kind": self.kind,
             "valid": self.valid,
@@ -120,6 +138,9 @@ class FileReport:
                 for p in self.problems
             ],
         }
+        if self.measurements is None:
+            return record
+        return {"measurements": self.measurements, **record}
 
 
 def run(args: argparse.Namespace) -> int:

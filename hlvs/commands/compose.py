@@ -14,7 +14,7 @@ import ipaddress
 import json
 from typing import Any
 
-from orchestrator.errors import ConfigError, Problem
+from orchestrator import ConfigError, Problem
 from orchestrator.paths import user_path
 
 

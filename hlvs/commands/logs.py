@@ -18,7 +18,7 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from orchestrator.errors import ConfigError, Problem
+from orchestrator import ConfigError, Problem
 from orchestrator.exitcodes import ExitCode
 from orchestrator.paths import user_path
 

@@ -23,18 +23,20 @@ from types import FrameType
 from typing import Any, TextIO
 
 from contracts import files
+from orchestrator import ConfigError, InfrastructureError, OrchestratorError, Problem
 from orchestrator.config.loader import load_game
 from orchestrator.engine import LABEL_SLURM_JOB
-from orchestrator.errors import ConfigError, InfrastructureError, OrchestratorError, Problem
 from orchestrator.exitcodes import ExitCode
 from orchestrator.image_origin import local_name_reason
 from orchestrator.match import (
     FailureClass,
     HostControl,
+    ImageResolver,
     MatchOutcome,
     MatchPlan,
     MatchRunner,
     RunOptions,
+    clean_match,
     cleanup,
     local_images,
     ownership,
@@ -42,11 +44,9 @@ from orchestrator.match import (
     scrimmage,
 )
 from orchestrator.match.admission import HostResources, admit
-from orchestrator.match.cleanup import clean_match
 from orchestrator.match.gpu import GpuOrigin, SimulatorGpu, simulator_gpu
 from orchestrator.match.ownership import LABEL_RUN
 from orchestrator.match.placement import LeaguePlacement, parse_nodes
-from orchestrator.match.runner import ImageResolver
 from orchestrator.paths import user_path
 
 log = logging.getLogger(__name__)
@@ -293,7 +293,7 @@ def run_cleanup_command(args: argparse.Namespace) -> int:
 
     runtime = DockerRuntime(connect())
     if getattr(args, "dry_run", False):
-        from orchestrator.match.cleanup import plan_cleanup
+        from orchestrator.match import plan_cleanup
 
         planned = plan_cleanup(runtime, match_id=args.match)
         print(json.dumps({

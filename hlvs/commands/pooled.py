@@ -21,7 +21,7 @@ from contracts import files
 from contracts.errors import ContractError
 from contracts.match_results import FailureClass, MatchReport, MatchResults
 from hlvs.commands.play import stop_on_signals, summarize
-from orchestrator.errors import InfrastructureError
+from orchestrator import InfrastructureError
 from orchestrator.match import MatchOutcome
 
 DEFAULT_CONF = "/var/lib/hlvs/slurm/slurm.conf"
@@ -42,8 +42,7 @@ def play_in_pool(
     args: argparse.Namespace, *, game_path: Path, match_id: str, out_dir: Path, official: bool,
     match_args: tuple[str, ...] = (), robot_nodes: int = 0,
 ) -> int:
-    from cluster import JobState, MatchJob
-    from cluster.errors import PoolError
+    from cluster import JobState, MatchJob, PoolError
 
     pool = make_pool(args)
     as_json = bool(getattr(args, "json", False))

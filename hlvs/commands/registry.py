@@ -12,7 +12,7 @@ import os
 import random
 from typing import Any
 
-from orchestrator.errors import ConfigError, Problem
+from orchestrator import ConfigError, Problem
 
 GB = 1_000_000_000
 

@@ -11,7 +11,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from orchestrator.errors import ConfigError, Problem, ScheduleError
+from orchestrator import ConfigError, Problem, ScheduleError
 from orchestrator.paths import user_path
 
 _STATE_HELP = "SQLite state file written by 'hlvs schedule run'"
@@ -92,7 +92,7 @@ def register(sub: Any) -> None:
 
 
 def _ledger(path: Path) -> Any:
-    from tournament.state import Ledger
+    from tournament import Ledger
 
     if not path.is_file():
         raise ConfigError(
@@ -103,7 +103,7 @@ def _ledger(path: Path) -> Any:
 
 def _run(args: argparse.Namespace) -> int:
     from orchestrator.config.schedule_check import check_schedule
-    from tournament.runner import run_schedule
+    from tournament import run_schedule
 
     recorded = args.state.is_file() and _ledger(args.state).get_meta("schedule_text")
     if not recorded:  # the first run: what hlvs check finds is refused before any pull (a
@@ -189,7 +189,7 @@ def _status(args: argparse.Namespace) -> int:
 
 
 def _cancel(args: argparse.Namespace) -> int:
-    from tournament.state import ScheduledMatchState
+    from tournament import ScheduledMatchState
 
     ledger = _ledger(args.state)
     not_started = (
@@ -247,8 +247,8 @@ def _warn_differences(ledger: Any) -> None:
 
 
 def _standings(args: argparse.Namespace) -> int:
+    from tournament import standings
     from tournament.controls import recorded_schedule
-    from tournament.standings import standings
 
     ledger = _ledger(args.state)
     schedule = recorded_schedule(ledger)

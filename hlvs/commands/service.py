@@ -13,11 +13,11 @@ import json
 import logging
 import sys
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 from orchestrator.paths import user_path
-from service.errors import ServiceError
-from service.settings import Settings
+from service import ServiceError, Settings
 
 
 def guarded(func: Callable[[argparse.Namespace], int]) -> Callable[[argparse.Namespace], int]:
@@ -36,7 +36,7 @@ def guarded(func: Callable[[argparse.Namespace], int]) -> Callable[[argparse.Nam
 
 def _settings(args: argparse.Namespace) -> Settings:
     settings = Settings.from_env()
-    changes: dict[str, Any] = {}
+    changes: dict[str, Path | str] = {}
     if getattr(args, "data_dir", None) is not None:
         changes["data_dir"] = args.data_dir
     if getattr(args, "database_url", None):
@@ -141,7 +141,7 @@ def run_serve(args: argparse.Namespace) -> int:
 
 
 def run_team_add(args: argparse.Namespace) -> int:
-    from cluster.errors import PoolError
+    from cluster import PoolError
     from service.admin import add_team
     from service.db import Team, transaction
 
@@ -152,8 +152,8 @@ def run_team_add(args: argparse.Namespace) -> int:
         session.flush()
         result: dict[str, object] = {"team": team.name, "id": team.id}
     if settings.pool == "slurm":  # the team's Slurm account now (else at its first match)
+        from service import pool_from_settings
         from service.accounts import ensure_team_account
-        from service.app import pool_from_settings
 
         with transaction(_sessions(args)) as session:
             row = session.get(Team, team.id)

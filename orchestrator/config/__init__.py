@@ -8,6 +8,7 @@ one way to get a document: ``load_game(path)`` and ``load_team(path)`` read one 
 
 from __future__ import annotations
 
+from orchestrator.config.documents import GameDocument, PlayerDocument, PoseDocument, TeamDocument
 from orchestrator.config.game import default_match_id, default_seed
 from orchestrator.config.loader import (
     check_game,
@@ -48,17 +49,21 @@ __all__ = [
     "EcrAuth",
     "FieldClass",
     "GameConfig",
+    "GameDocument",
     "GameType",
     "Limits",
     "LoadedGame",
     "LoadedTeam",
     "MAX_PLAYERS",
     "PlayerConfig",
+    "PlayerDocument",
+    "PoseDocument",
     "RegistryAuth",
     "SideChoice",
     "StartingPose",
     "SteppingMode",
     "TeamConfig",
+    "TeamDocument",
     "TeamRef",
     "Timing",
     "check_game",

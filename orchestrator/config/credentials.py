@@ -20,10 +20,12 @@ from dataclasses import dataclass, field
 from functools import cache
 from importlib import resources
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, cast
 
 import jsonschema
 
+from contracts.jsontypes import JSONObject
+from orchestrator.config.documents import CredentialsDocument, SftpDocument
 from orchestrator.errors import ConfigError, Problem
 
 __all__ = [
@@ -96,13 +98,13 @@ Credentials = SftpCredentials | S3Credentials
 
 
 @cache
-def _schema() -> dict[str, Any]:
+def _schema() -> JSONObject:
     text = (
         resources.files("orchestrator.config.schemas")
         .joinpath(SCHEMA_FILE)
         .read_text(encoding="utf-8")
     )
-    schema: dict[str, Any] = json.loads(text)
+    schema: JSONObject = json.loads(text)
     return schema
 
 
@@ -143,8 +145,9 @@ def parse_credentials(
     problems = _schema_problems(document, name)
     if problems:
         raise ConfigError(problems)
-    body: dict[str, Any] = document["credentials"]
-    if document["type"] == "s3":
+    checked = cast("CredentialsDocument", document)  # the schema checked it
+    if checked["type"] == "s3":
+        body = checked["credentials"]
         return S3Credentials(
             source=source,
             access_id=body["access_id"],
@@ -155,10 +158,10 @@ def parse_credentials(
             prefix=body.get("prefix", "").strip("/"),
             warnings=warnings,
         )
-    return _parse_sftp(body, source, warnings)
+    return _parse_sftp(checked["credentials"], source, warnings)
 
 
-def _parse_sftp(body: dict[str, Any], source: Path, warnings: tuple[Problem, ...]) -> Credentials:
+def _parse_sftp(body: SftpDocument, source: Path, warnings: tuple[Problem, ...]) -> Credentials:
     name = str(source)
     problems: list[Problem] = []
     notes = list(warnings)

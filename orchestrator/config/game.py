@@ -10,10 +10,12 @@ from __future__ import annotations
 import hashlib
 import os
 import re
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal, cast
 
 from contracts.timing import SET_TO_PLAY_S, timing_problem
+from orchestrator.config.documents import GameDocument, GameTeamDocument
 from orchestrator.config.model import (
     COLORS,
     Color,
@@ -26,7 +28,9 @@ from orchestrator.config.model import (
 from orchestrator.config.problems import Collector, pointer
 from orchestrator.config.schema import validate
 
-LEGACY_RTF = ("minimum_real_time_factor", "real_time_factor")
+LEGACY_RTF: tuple[Literal["minimum_real_time_factor", "real_time_factor"], ...] = (
+    "minimum_real_time_factor", "real_time_factor",
+)
 # Real time, as the league's official matches run; used when game.json names no factor at all
 # (several of the league's own game files have neither the current nor a legacy name).
 DEFAULT_MAXIMUM_REAL_TIME_FACTOR = 1.0
@@ -71,6 +75,7 @@ def build_game(document: Any, where: Collector, *, source: Path) -> GameConfig |
     validate("game", document, where)
     if not isinstance(document, dict):
         return None
+    game = cast("GameDocument", document)  # the schema checked it; the rules read sound parts
     broken = [p.pointer for p in where.errors[before:]]
 
     def sound(*parts: str) -> bool:
@@ -79,62 +84,62 @@ def build_game(document: Any, where: Collector, *, source: Path) -> GameConfig |
     base = source.parent
     rtf = None
     if sound("/maximum_real_time_factor", *(pointer(n) for n in LEGACY_RTF)):
-        rtf = _real_time_factor(document, where)
+        rtf = _real_time_factor(game, where)
     timing = Timing()
     if sound("/timing", "/game_controller_extra_args", "/max_duration"):
-        timing = _timing(document, where, fast=rtf is not None and rtf <= 0)
+        timing = _timing(game, where, fast=rtf is not None and rtf <= 0)
     if sound("/physics_dt_s"):
-        _check_physics_dt(document, where)
-    _check_record(document, where)
+        _check_physics_dt(game, where)
+    _check_record(game, where)
     if sound("/red/id", "/blue/id"):
-        _check_team_ids(document, where)
+        _check_team_ids(game, where)
     if sound("/red/ports", "/blue/ports"):
-        _check_ports(document, where)
+        _check_ports(game, where)
     teams = {
-        color: _team_ref(color, document[color], base, where)
+        color: _team_ref(color, game[color], base, where)
         for color in COLORS
         if sound(pointer(color))
     }
     public_logs = None
     if sound("/public_logs"):
-        public_logs = _existing(document.get("public_logs"), base, "/public_logs", where)
+        public_logs = _existing(game.get("public_logs"), base, "/public_logs", where)
     if len(where.errors) > before or rtf is None:
         return None
     red, blue = teams["red"], teams["blue"]
-    match_id = document.get("match_id") or default_match_id(source, red.team_id, blue.team_id)
-    seed = document.get("seed", document.get("random_seed"))
-    if "seed" not in document and "random_seed" in document:
+    match_id = game.get("match_id") or default_match_id(source, red.team_id, blue.team_id)
+    seed = game.get("seed", game.get("random_seed"))
+    if "seed" not in game and "random_seed" in game:
         where.warn("/random_seed", "legacy field: used as the match seed", expected='"seed"')
     return GameConfig(
         source=source,
         match_id=match_id,
         seed=seed if seed is not None else default_seed(match_id),
-        game_type=document["type"],
-        field_class=FieldClass(str(document["class"]).lower()),
-        host=document["host"],
+        game_type=game["type"],
+        field_class=FieldClass(str(game["class"]).lower()),
+        host=game["host"],
         maximum_real_time_factor=rtf,
         red=red,
         blue=blue,
-        side_left=document.get("side_left", "random"),
-        kickoff=document.get("kickoff", "random"),
-        press_a_key_to_terminate=document.get("press_a_key_to_terminate", False),
-        use_bouncing_server=document.get("use_bouncing_server", False),
-        record_simulation=document.get("record_simulation"),
-        game_controller_extra_args=tuple(document.get("game_controller_extra_args", ())),
-        texture_seed=document.get("texture_seed"),
-        sensors=document.get("sensors", "league"),
-        camera_motion_blur=document.get("camera_motion_blur", False),
-        supervisor=document.get("supervisor"),
-        stepping=document.get("stepping", "async"),
-        physics_dt_s=float(document.get("physics_dt_s", 0.002)),
-        lockstep_deadline_ms=float(document.get("lockstep_deadline_ms", 50.0)),
-        lockstep_time_bank_ms=float(document.get("lockstep_time_bank_ms", 5000.0)),
-        limits=_limits(document.get("limits", {})),
+        side_left=game.get("side_left", "random"),
+        kickoff=game.get("kickoff", "random"),
+        press_a_key_to_terminate=game.get("press_a_key_to_terminate", False),
+        use_bouncing_server=game.get("use_bouncing_server", False),
+        record_simulation=game.get("record_simulation"),
+        game_controller_extra_args=tuple(game.get("game_controller_extra_args", ())),
+        texture_seed=game.get("texture_seed"),
+        sensors=game.get("sensors", "league"),
+        camera_motion_blur=game.get("camera_motion_blur", False),
+        supervisor=game.get("supervisor"),
+        stepping=game.get("stepping", "async"),
+        physics_dt_s=float(game.get("physics_dt_s", 0.002)),
+        lockstep_deadline_ms=float(game.get("lockstep_deadline_ms", 50.0)),
+        lockstep_time_bank_ms=float(game.get("lockstep_time_bank_ms", 5000.0)),
+        limits=_limits(game.get("limits", {})),
         timing=timing,
-        allow_internet=document.get("allow_internet", False),
-        official=document.get("official", False),
-        registry_images=bool(document.get("registry_images", document.get("official", False))),
-        gpu=document.get("gpu", "auto"),
+        allow_internet=game.get("allow_internet", False),
+        official=game.get("official", False),
+        registry_images=bool(game.get("registry_images", game.get("official", False))),
+        gpu=game.get("gpu", "auto"),
         public_logs=public_logs,
     )
 
@@ -147,7 +152,7 @@ def legacy_maximum_real_time_factor(value: float) -> float:
     return 1.0 / value if value > 0 else 0.0
 
 
-def _real_time_factor(document: dict[str, Any], where: Collector) -> float | None:
+def _real_time_factor(document: GameDocument, where: Collector) -> float | None:
     legacy = [name for name in LEGACY_RTF if name in document]
     if "maximum_real_time_factor" in document:
         for name in legacy:
@@ -175,19 +180,19 @@ def _real_time_factor(document: dict[str, Any], where: Collector) -> float | Non
     return DEFAULT_MAXIMUM_REAL_TIME_FACTOR
 
 
-def timing_of(document: dict[str, Any], where: Collector, *, fast: bool) -> Timing:
+def timing_of(document: GameDocument, where: Collector, *, fast: bool) -> Timing:
     """The timing of a game document (``timing``, ``game_controller_extra_args``, ``type``),
     its problems in ``where``; also used for a schedule's ``game_defaults``."""
     return _timing(document, where, fast=fast)
 
 
-def _timing(document: dict[str, Any], where: Collector, *, fast: bool) -> Timing:
+def _timing(document: GameDocument, where: Collector, *, fast: bool) -> Timing:
     """Timing from ``timing`` and the GameController arguments.
 
     As in HLVS, a game run as fast as possible (maximum_real_time_factor <= 0) waits only 5 s
     before the first READY and 2 s at half time unless ``timing`` says otherwise.
     """
-    written: dict[str, Any] = dict(document.get("timing", {}))
+    written: dict[str, float] = dict(document.get("timing", {}))
     if fast:
         written.setdefault("wait_before_first_ready_s", FAST_WAIT_BEFORE_FIRST_READY_S)
         written.setdefault("half_time_break_s", FAST_HALF_TIME_BREAK_S)
@@ -237,7 +242,7 @@ def _timing(document: dict[str, Any], where: Collector, *, fast: bool) -> Timing
     return timing
 
 
-def _check_play_time(timing: Timing, written: dict[str, Any], game_type: Any,
+def _check_play_time(timing: Timing, written: Mapping[str, float], game_type: Any,
                      where: Collector) -> None:
     """A half whose READY plus SET leaves less than the minimum of play is refused
     (:mod:`contracts.timing`): the match would end 0:0 without a kick."""
@@ -256,12 +261,12 @@ def _check_play_time(timing: Timing, written: dict[str, Any], game_type: Any,
                     f"({timing.minimum_play_s:g} s) <= {name}")
 
 
-def _limits(raw: dict[str, Any]) -> Limits:
+def _limits(raw: dict[str, float]) -> Limits:
     values: dict[str, Any] = {k: (int(v) if k == "pids" else float(v)) for k, v in raw.items()}
     return Limits(**values)
 
 
-def _check_physics_dt(document: dict[str, Any], where: Collector) -> None:
+def _check_physics_dt(document: GameDocument, where: Collector) -> None:
     dt = float(document.get("physics_dt_s", 0.002))
     substeps = round(BASIC_TIME_STEP_S / dt)
     if substeps < 1 or abs(substeps * dt - BASIC_TIME_STEP_S) > 1e-9:
@@ -272,7 +277,7 @@ def _check_physics_dt(document: dict[str, Any], where: Collector) -> None:
         )
 
 
-def _check_record(document: dict[str, Any], where: Collector) -> None:
+def _check_record(document: GameDocument, where: Collector) -> None:
     record = document.get("record_simulation")
     if isinstance(record, str) and record.endswith(".html"):
         where.warn(
@@ -282,7 +287,7 @@ def _check_record(document: dict[str, Any], where: Collector) -> None:
         )
 
 
-def _check_team_ids(document: dict[str, Any], where: Collector) -> None:
+def _check_team_ids(document: GameDocument, where: Collector) -> None:
     red_id, blue_id = team_id(document["red"]["id"]), team_id(document["blue"]["id"])
     if red_id == blue_id:
         where.error("/blue/id", f"team id {blue_id} is also the red team's id", expected="two ids")
@@ -302,7 +307,7 @@ SIMULATOR_PORTS = {
 }
 
 
-def _check_ports(document: dict[str, Any], where: Collector) -> None:
+def _check_ports(document: GameDocument, where: Collector) -> None:
     used: dict[int, str] = {}
     for color in COLORS:
         for index, port in enumerate(document[color]["ports"]):
@@ -338,7 +343,7 @@ def locate_team_config(
     return found, tried
 
 
-def _team_ref(color: Color, raw: dict[str, Any], base: Path, where: Collector) -> TeamRef:
+def _team_ref(color: Color, raw: GameTeamDocument, base: Path, where: Collector) -> TeamRef:
     config, _ = locate_team_config(raw["config"], base)
     return TeamRef(
         color=color,

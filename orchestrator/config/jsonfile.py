@@ -7,6 +7,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from contracts.jsontypes import JSONObject
 from orchestrator.config.problems import Collector
 from orchestrator.errors import ConfigError
 
@@ -136,7 +137,7 @@ def read_json(path: Path) -> Any:
     return parse_json(read_text(path), file=str(path))
 
 
-def read_json_object(path: Path) -> dict[str, Any]:
+def read_json_object(path: Path) -> JSONObject:
     value = read_json(path)
     if not isinstance(value, dict):
         where = Collector(str(path))

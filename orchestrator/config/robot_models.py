@@ -11,9 +11,12 @@ from __future__ import annotations
 
 import hashlib
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 from orchestrator.errors import Problem
+
+if TYPE_CHECKING:
+    from simulator.world.robots.team.rulebook import MeasurementsRecord
 
 MODEL_MANIFEST = "robot_model.json"
 MODELS_TARGET = "/opt/hlvs/team-models"
@@ -46,11 +49,11 @@ def spec_model(model: str) -> str:
 
 def check_model(
     path: Path, *, official: bool = False
-) -> tuple[list[Problem], dict[str, Any] | None]:
+) -> tuple[list[Problem], MeasurementsRecord | None]:
     """Problems and measurements of a model package (None when it cannot even be loaded);
     free-form servos are warnings, or errors when ``official``. Imports the simulator's model
     loader (and MuJoCo) on first use."""
-    from simulator.errors import ModelError
+    from simulator import ModelError
     from simulator.world.robots.team import load_team_model
     from simulator.world.robots.team.rulebook import check
 
@@ -64,7 +67,7 @@ def check_model(
     ], measurements.to_json()
 
 
-def describe(measurements: dict[str, Any]) -> str:
+def describe(measurements: MeasurementsRecord) -> str:
     m = measurements
     return (
         f"H {m['height_m']} m, Hleg {m['leg_m']} m, Hhead {m['head_m']} m, Harm {m['arm_m']} m, "

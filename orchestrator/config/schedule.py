@@ -16,11 +16,19 @@ from dataclasses import dataclass
 from datetime import UTC, datetime, timedelta
 from importlib import resources
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, cast
 
 import jsonschema
 import yaml
 
+from contracts.jsontypes import JSONObject
+from orchestrator.config.documents import (
+    GameDocument,
+    KnockoutDocument,
+    RoundRobinDocument,
+    ScheduleDocument,
+    ScheduleMatchDocument,
+)
 from orchestrator.errors import ConfigError, Problem
 
 MatchKind = Literal["round_robin", "knockout"]
@@ -109,7 +117,7 @@ class Schedule:
     public_logs: Path | None
     simulator_slots: int
     timing: ScheduleTiming
-    game_defaults: dict[str, Any]
+    game_defaults: JSONObject  # game.json fields every match gets (checked with its game.json)
     teams: tuple[ScheduledTeam, ...]
     matches: tuple[ScheduledMatch, ...]
     pool: SchedulePool = SchedulePool()
@@ -155,13 +163,13 @@ def game_document(
     blue: ScheduledTeam,
     *,
     game_type: str | None = None,
-) -> dict[str, Any]:
+) -> JSONObject:
     """The game.json of a match: HLVS fields, the schedule's ``game_defaults``, both teams.
 
     The game type follows the match's kind (NORMAL, or KNOCKOUT: overtime, then a penalty
     shoot-out) and is never taken from the defaults; ``game_type`` PENALTY is a shoot-out only.
     """
-    game: dict[str, Any] = {
+    game: JSONObject = {
         "class": match.field_class,
         "host": "127.0.0.1",
         "maximum_real_time_factor": 0,
@@ -170,7 +178,7 @@ def game_document(
     game.update(schedule.game_defaults)
     game["type"] = game_type or ("KNOCKOUT" if match.kind == "knockout" else "NORMAL")
     for color, team, base in (("red", red, 10000), ("blue", blue, 10020)):
-        side: dict[str, Any] = {
+        side: JSONObject = {
             "id": team.team_id,
             "config": str(team.config),
             "hosts": ["127.0.0.1"],
@@ -192,9 +200,9 @@ def resolve_time(text: str, reference: datetime) -> datetime:
     return parsed.astimezone(UTC)
 
 
-def _schema() -> dict[str, Any]:
+def _schema() -> JSONObject:
     text = resources.files("orchestrator.config.schemas").joinpath("schedule.schema.json")
-    loaded: dict[str, Any] = json.loads(text.read_text(encoding="utf-8"))
+    loaded: JSONObject = json.loads(text.read_text(encoding="utf-8"))
     return loaded
 
 
@@ -261,10 +269,11 @@ def load_schedule(path: str | Path, *, text: str | None = None) -> Schedule:
     are still resolved against ``path``'s folder.
     """
     path = Path(path)
-    data = _read(path, text)
-    problems = _schema_problems(path, data)
+    raw = _read(path, text)
+    problems = _schema_problems(path, raw)
     if problems:
         raise ConfigError(problems)
+    data = cast("ScheduleDocument", raw)  # the schema checked it
     base = path.resolve().parent
     teams = tuple(
         ScheduledTeam(
@@ -304,7 +313,7 @@ def load_schedule(path: str | Path, *, text: str | None = None) -> Schedule:
     return schedule
 
 
-def _timing(data: dict[str, Any]) -> ScheduleTiming:
+def _timing(data: dict[str, float]) -> ScheduleTiming:
     values: dict[str, Any] = {k: float(v) for k, v in data.items()}
     if "delivery_attempts" in values:
         values["delivery_attempts"] = int(values["delivery_attempts"])
@@ -324,7 +333,9 @@ def _timing_problems(path: Path, schedule: Schedule) -> list[Problem]:
     rtf = defaults.get("maximum_real_time_factor", 0)
     for kind in sorted({m.kind for m in schedule.matches}):
         document = {**defaults, "type": "KNOCKOUT" if kind == "knockout" else "NORMAL"}
-        timing_of(document, where, fast=isinstance(rtf, int | float) and rtf <= 0)
+        # a partial game.json: the timing reads only its timing fields and type
+        fast = isinstance(rtf, int | float) and rtf <= 0
+        timing_of(cast("GameDocument", document), where, fast=fast)
     seen: set[tuple[str, str]] = set()
     problems = []
     for problem in where.errors:
@@ -342,7 +353,7 @@ def _slot(value: Any) -> Slot:
     return Slot(winner_of=value.get("winner_of"), loser_of=value.get("loser_of"))
 
 
-def _match(m: dict[str, Any]) -> ScheduledMatch:
+def _match(m: ScheduleMatchDocument) -> ScheduledMatch:
     return ScheduledMatch(
         id=m["id"],
         red=_slot(m["red"]),
@@ -364,7 +375,7 @@ def _stream_time(first: str, index: int, interval_s: float) -> str:
     return (start + timedelta(seconds=index * interval_s)).isoformat()
 
 
-def round_robin_fixtures(spec: dict[str, Any]) -> list[ScheduledMatch]:
+def round_robin_fixtures(spec: RoundRobinDocument) -> list[ScheduledMatch]:
     """Every pair once, in rounds (circle method), one stream after another."""
     teams: list[str | None] = list(spec["teams"])
     if len(teams) % 2:
@@ -392,7 +403,7 @@ def round_robin_fixtures(spec: dict[str, Any]) -> list[ScheduledMatch]:
     ]
 
 
-def knockout_fixtures(spec: dict[str, Any]) -> list[ScheduledMatch]:
+def knockout_fixtures(spec: KnockoutDocument) -> list[ScheduledMatch]:
     """A single-elimination bracket: seeds paired in order, winners advance to the next round."""
     seeds = list(spec["seeds"])
     interval = float(spec.get("interval_s", 3600.0))
@@ -420,7 +431,7 @@ def knockout_fixtures(spec: dict[str, Any]) -> list[ScheduledMatch]:
     return matches
 
 
-def _cross_problems(path: Path, schedule: Schedule, data: dict[str, Any]) -> list[Problem]:
+def _cross_problems(path: Path, schedule: Schedule, data: ScheduleDocument) -> list[Problem]:
     file = str(path)
     problems: list[Problem] = []
     names = [t.name for t in schedule.teams]
@@ -449,9 +460,12 @@ def _cross_problems(path: Path, schedule: Schedule, data: dict[str, Any]) -> lis
                     expected="a power of two (2, 4, 8, ...)",
                 )
             )
-    for key, field_name in (("round_robin", "teams"), ("knockout", "seeds")):
-        listed = data.get("fixtures", {}).get(key, {}).get(field_name, [])
-        for j, name in enumerate(listed):
+    fixtures = data.get("fixtures", {})
+    for key, field_name, names_listed in (
+        ("round_robin", "teams", fixtures.get("round_robin", {}).get("teams", [])),
+        ("knockout", "seeds", fixtures.get("knockout", {}).get("seeds", [])),
+    ):
+        for j, name in enumerate(names_listed):
             if name not in names:
                 close = difflib.get_close_matches(name, names, n=1)
                 problems.append(

@@ -12,8 +12,9 @@ from __future__ import annotations
 import logging
 from dataclasses import replace
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
+from orchestrator.config.documents import ScheduleDocument
 from orchestrator.config.schedule import (
     Schedule,
     ScheduledMatch,
@@ -46,7 +47,10 @@ def check_schedule(path: str | Path) -> list[Problem]:
     broken = [p.pointer for p in problems]
     try:
         problems += [
-            p for p in _cross_problems(path, schedule, _sound_fixtures(data))
+            # the parts the schema rejected raise below (and stop the cross-checks)
+            p for p in _cross_problems(
+                path, schedule, cast("ScheduleDocument", _sound_fixtures(data))
+            )
             if not any(p.pointer == b or p.pointer.startswith(b + "/") for b in broken)
         ]
     except (KeyError, TypeError, AttributeError, ValueError):  # a part the schema rejected

@@ -14,6 +14,7 @@ from typing import Any
 from jsonschema import Draft202012Validator
 from jsonschema.exceptions import ValidationError
 
+from contracts.jsontypes import JSONObject
 from orchestrator.config.jsonfile import json_type
 from orchestrator.config.problems import Collector, one_of, pointer, suggest
 
@@ -39,13 +40,13 @@ _ONE_OF_EXPECTED = {
 
 
 @cache
-def load_schema(kind: str) -> dict[str, Any]:
+def load_schema(kind: str) -> JSONObject:
     text = (
         resources.files("orchestrator.config.schemas")
         .joinpath(SCHEMA_FILES[kind])
         .read_text(encoding="utf-8")
     )
-    schema: dict[str, Any] = json.loads(text)
+    schema: JSONObject = json.loads(text)
     return schema
 
 

@@ -4,10 +4,16 @@ from __future__ import annotations
 
 import math
 import shlex
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal, cast
 
+from orchestrator.config.documents import (
+    PoseDocument,
+    RegistryAuthDocument,
+    TeamDocument,
+)
 from orchestrator.config.model import (
     DEFAULT_MODEL,
     MAX_PLAYERS,
@@ -32,7 +38,11 @@ from orchestrator.config.schema import validate
 # (RGrt GOALKEEPER): the league GameController's default, player 1.
 GOALKEEPER_NUMBER = 1
 
-POSE_KEYS = {
+PoseKey = Literal[
+    "halfTimeStartingPose", "reentryStartingPose", "shootoutStartingPose",
+    "goalKeeperStartingPose",
+]
+POSE_KEYS: dict[PoseKey, str] = {
     "halfTimeStartingPose": "half_time_pose",
     "reentryStartingPose": "reentry_pose",
     "shootoutStartingPose": "shootout_pose",
@@ -93,11 +103,12 @@ def build_team(
                     check_goalkeeper_pose(raw_pose, at, where, field_class)
     if not valid:
         return None
-    players = [_player(number, document, field_class) for number in numbers]
+    team = cast("TeamDocument", document)  # the schema checked it
+    players = [_player(number, team, field_class) for number in numbers]
     players = _resolve_models(players, source, where)
     for player in players:
         _check_command(player, where)
-    if not document["players"]:
+    if not team["players"]:
         where.warn(
             "/players", "the team has no players: it plays without robots (like HLVS Invisibles)"
         )
@@ -114,10 +125,10 @@ def build_team(
         return None
     return TeamConfig(
         source=source,
-        name=document["name"],
+        name=team["name"],
         players=tuple(players),
-        image=document.get("image"),
-        registry_auth=_registry_auth(document.get("registry_auth")),
+        image=team.get("image"),
+        registry_auth=_registry_auth(team.get("registry_auth")),
     )
 
 
@@ -152,7 +163,7 @@ def _resolve_models(
     return out
 
 
-def _player(number: int, document: dict[str, Any], field_class: FieldClass | None) -> PlayerConfig:
+def _player(number: int, document: TeamDocument, field_class: FieldClass | None) -> PlayerConfig:
     raw = document["players"][str(number)]
     return PlayerConfig(
         number=number,
@@ -179,7 +190,7 @@ def _check_name(name: object, where: Collector) -> None:
 
 
 def _check_numbers(
-    players: dict[str, Any], where: Collector, field_class: FieldClass | None
+    players: Mapping[str, object], where: Collector, field_class: FieldClass | None
 ) -> list[int]:
     numbers = sorted(int(key) for key in players)
     limit = MAX_PLAYERS[field_class] if field_class else max(MAX_PLAYERS.values())
@@ -202,7 +213,7 @@ def _check_numbers(
     return numbers
 
 
-def _pose(raw: dict[str, Any]) -> StartingPose:
+def _pose(raw: PoseDocument) -> StartingPose:
     t = raw["translation"]
     r = raw["rotation"]
     return StartingPose(
@@ -212,7 +223,7 @@ def _pose(raw: dict[str, Any]) -> StartingPose:
 
 
 def _check_pose(
-    raw: dict[str, Any], at: str, key: str, where: Collector, field_class: FieldClass | None
+    raw: PoseDocument, at: str, key: str, where: Collector, field_class: FieldClass | None
 ) -> None:
     x, y, _ = (float(v) for v in raw["translation"])
     ax, ay, az, angle = (float(v) for v in raw["rotation"])
@@ -247,7 +258,7 @@ def _check_pose(
 
 
 def check_goalkeeper_pose(
-    raw: dict[str, Any], at: str, where: Collector, field_class: FieldClass | None
+    raw: PoseDocument, at: str, where: Collector, field_class: FieldClass | None
 ) -> None:
     """The one goalkeeper pose rule, the same for an upload (no field class yet), ``hlvs check``
     and a match or pre-flight (with its class); for the goalkeeper's pose only.
@@ -307,7 +318,7 @@ def _check_image(player: PlayerConfig, where: Collector) -> None:
         )
 
 
-def _registry_auth(raw: dict[str, Any] | None) -> RegistryAuth | None:
+def _registry_auth(raw: RegistryAuthDocument | None) -> RegistryAuth | None:
     if raw is None:
         return None
     ecr = raw.get("ecr")

@@ -25,9 +25,10 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
-from typing import Any, Literal
+from typing import Literal
 from urllib.parse import quote
 
+from contracts.jsontypes import JSONObject
 from orchestrator.filelock import held
 
 __all__ = [
@@ -106,8 +107,9 @@ class PendingSet:
     def total_bytes(self) -> int:
         return sum(entry.size for entry in self.files)
 
-    def to_json(self) -> dict[str, Any]:
-        data = asdict(self)
+    def to_json(self) -> JSONObject:
+        """The set as JSON (its ``set.json``, with its folder and size added)."""
+        data: JSONObject = asdict(self)
         data["credentials"] = str(self.credentials) if self.credentials else None
         data["root"] = str(self.root)
         data["total_bytes"] = self.total_bytes

@@ -6,7 +6,7 @@ through :class:`Host`; ``hlvs.commands.match`` wires the real implementations.
 
 from __future__ import annotations
 
-from orchestrator.match.cleanup import CleanupReport, cleanup
+from orchestrator.match.cleanup import CleanupReport, clean_match, cleanup, plan_cleanup
 from orchestrator.match.events import (
     AllConnected,
     EventStream,
@@ -18,7 +18,7 @@ from orchestrator.match.events import (
     StateChanged,
 )
 from orchestrator.match.host import Host, HostControl
-from orchestrator.match.plan import MatchPlan, RobotPlan, TeamPlan, plan_from_game
+from orchestrator.match.plan import MatchPlan, RobotPlan, TeamPlan, plan_from_game, robots_in_game
 from orchestrator.match.results import Failure, FailureClass, RobotRecord
 from orchestrator.match.runner import (
     ImageResolver,
@@ -56,7 +56,10 @@ __all__ = [
     "RunOptions",
     "StateChanged",
     "TeamPlan",
+    "clean_match",
     "cleanup",
     "local_images",
+    "plan_cleanup",
     "plan_from_game",
+    "robots_in_game",
 ]

@@ -17,9 +17,9 @@ import math
 import os
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
 
 from contracts.codec import to_data
+from contracts.jsontypes import JSONObject
 from contracts.match_results import AdmissionRecord, NeededAvailable
 from orchestrator.errors import OrchestratorError
 from orchestrator.match.plan import MatchPlan
@@ -88,8 +88,9 @@ class Admission:
             "official), so speeds and results may suffer",
         )
 
-    def to_json(self) -> dict[str, Any]:
-        data: dict[str, Any] = to_data(self.record())
+    def to_json(self) -> JSONObject:
+        """The admission record as JSON (contracts.match_results.AdmissionRecord)."""
+        data: JSONObject = to_data(self.record())
         return data
 
 

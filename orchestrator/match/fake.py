@@ -7,11 +7,10 @@ import itertools
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
 
 from contracts import files
 from contracts.sim_result import SimResult
-from contracts.telemetry import StateMessage
+from contracts.telemetry import EventRecord, StateMessage
 from orchestrator.bandwidth import AppliedShaping, RobotShaping, TrafficCounters
 from orchestrator.match.logfs import LogFolder
 from orchestrator.match.placement import NodeFirewall
@@ -261,7 +260,7 @@ class FakeTelemetry:
     def last_message_at(self) -> float | None:
         return None if self._silent else self._clock()
 
-    def events(self) -> list[dict[str, Any]]:
+    def events(self) -> list[EventRecord]:
         return []
 
     def close(self) -> None:

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 from contracts import files
 from contracts.match_results import (
@@ -24,7 +23,7 @@ from contracts.match_results import (
     Scalar,
 )
 from contracts.match_spec import TimingSpec
-from contracts.sim_result import SimResult
+from contracts.sim_result import RobotApiStats, SimResult
 from contracts.timing import MIN_PLAYING_S, played_enough, timing_problem
 
 COLORS: tuple[Color, Color] = ("red", "blue")
@@ -53,7 +52,7 @@ class RobotRecord:
     limits: dict[str, Scalar] = field(default_factory=dict)
     log_folder: LogFolderCopy | None = None  # what collection copied and skipped
 
-    def result(self, api: dict[str, Any] | None, *, spoofing_attempts: int = 0) -> RobotResult:
+    def result(self, api: RobotApiStats | None, *, spoofing_attempts: int = 0) -> RobotResult:
         return RobotResult(
             image=self.image,
             digest=self.digest,
@@ -90,7 +89,7 @@ def build_results(
     admission: AdmissionRecord | None = None,
 ) -> MatchResults:
     sim = sim_result
-    api_stats: dict[str, dict[str, Any]] = sim.robots if sim is not None else {}
+    api_stats: dict[str, RobotApiStats] = sim.robots if sim is not None else {}
     score = sim.score if sim is not None else None
     winner: str | None = sim.winner if sim is not None else None
     if forfeit is not None:
@@ -156,12 +155,18 @@ def play_failure(sim: SimResult | None, robots: list[RobotRecord],
 
 
 def _never_connected(color: str, robots: list[RobotRecord],
-                     api_stats: dict[str, dict[str, Any]]) -> bool:
+                     api_stats: dict[str, RobotApiStats]) -> bool:
     team = [r for r in robots if r.color == color]
-    return bool(team) and not any((api_stats.get(r.key) or {}).get("connects") for r in team)
+    return bool(team) and not any(_connected(api_stats, r.key) for r in team)
 
 
-def team_warnings(robots: list[RobotRecord], api_stats: dict[str, dict[str, Any]]) -> list[str]:
+def _connected(api_stats: dict[str, RobotApiStats], key: str) -> bool:
+    """Whether the robot ``key`` ever connected to the simulator's robot API."""
+    stats = api_stats.get(key)
+    return bool(stats is not None and stats.get("connects"))
+
+
+def team_warnings(robots: list[RobotRecord], api_stats: dict[str, RobotApiStats]) -> list[str]:
     """What a score alone hides: a team whose started robots all exited during the game, or
     none of which ever connected to the simulator."""
     warnings = []
@@ -173,7 +178,7 @@ def team_warnings(robots: list[RobotRecord], api_stats: dict[str, dict[str, Any]
             warnings.append(f"every robot of {color} exited during the game ("
                             + ", ".join(f"{r.key}: exit code {r.exit_code}" for r in started)
                             + ")")
-        if not any((api_stats.get(r.key) or {}).get("connects") for r in started):
+        if not any(_connected(api_stats, r.key) for r in started):
             warnings.append(f"no robot of {color} ever connected to the simulator")
     return warnings
 

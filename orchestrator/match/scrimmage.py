@@ -18,8 +18,9 @@ import logging
 import uuid
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Protocol
 
+from contracts.match_spec import SteppingMode
 from contracts.timing import (
     MIN_PLAYING_S,
     MIN_READY_S,
@@ -28,6 +29,7 @@ from contracts.timing import (
     TimingError,
     fit_ready,
 )
+from orchestrator.config.documents import GameDocument, PlayerDocument, PoseDocument, TeamDocument
 from orchestrator.config.robot_models import MODEL_MANIFEST, is_model_path
 from orchestrator.errors import ConfigError, Problem
 
@@ -47,7 +49,7 @@ class ScrimmageRequest:
     wait_before_ready_s: float
     grace_s: float
     ready_duration_s: float | None = None
-    stepping: str = "lockstep"
+    stepping: SteppingMode = "lockstep"
     gpu: str = "auto"
     red_image: str | None = None
     blue_image: str | None = None
@@ -113,17 +115,17 @@ ROLES = {
 DEFENDER_HOMES = {"defender-3": (-2.3, 1.0), "defender-4": (-2.3, -1.0)}
 
 
-def _pose(x: float, y: float, yaw: float) -> dict[str, Any]:
+def _pose(x: float, y: float, yaw: float) -> PoseDocument:
     return {"translation": [x, y, 0.43], "rotation": [0, 0, 1, yaw]}
 
 
 def team_file(name: str, image: str, players: int, *, command: str | None = None,
-              goalie_first: bool = False, model: str | None = None) -> dict[str, Any]:
+              goalie_first: bool = False, model: str | None = None) -> TeamDocument:
     """A stub team of ``players`` with the roles of :data:`ROLES`; ``goalie_first`` makes a
     lone player a goalie (an opponent that only defends); ``model`` the robot model of every
     player (a built-in name or a model package folder; default: the class's built-in)."""
     repository, _, tag = image.rpartition(":") if ":" in image.split("/")[-1] else (image, "", "")
-    entries: dict[str, Any] = {}
+    entries: dict[str, PlayerDocument] = {}
     roles = ROLES[players]
     if goalie_first and roles[0] != "goalie":
         roles = ("goalie", *roles[1:])
@@ -167,7 +169,7 @@ def quick_ready(half_duration_s: float, ready_duration_s: float | None,
     return fitted
 
 
-def game_file(request: ScrimmageRequest, match_id: str) -> dict[str, Any]:
+def game_file(request: ScrimmageRequest, match_id: str) -> GameDocument:
     """A quick test's game.json; READY fitted to the half by :func:`quick_ready`."""
     players = request.players
     minimum = request.minimum_play_s

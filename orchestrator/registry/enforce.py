@@ -15,7 +15,7 @@ import logging
 import random
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Literal, TypedDict
 
 from orchestrator.registry.client import RegistryClient, union_bytes
 
@@ -123,6 +123,33 @@ def plan_enforcement(
     return deletions
 
 
+class TeamUsage(TypedDict):
+    images: int
+    before_bytes: int
+    after_bytes: int
+
+
+class DeletedImage(TypedDict):
+    repository: str
+    digest: str
+    tags: list[str]
+    size_bytes: int
+    team: str
+    reason: str
+
+
+class EnforcementReport(TypedDict):
+    """What :func:`enforce` did (or, with ``dry_run``, would do)."""
+
+    registry: str
+    dry_run: bool
+    seed: int
+    image_limit_bytes: int
+    team_limit_bytes: int
+    teams: dict[str, TeamUsage]
+    deleted: list[DeletedImage]
+
+
 def enforce(
     client: RegistryClient,
     *,
@@ -131,7 +158,7 @@ def enforce(
     seed: int,
     team_of: TeamRule,
     dry_run: bool,
-) -> dict[str, Any]:
+) -> EnforcementReport:
     """Apply the limits (or only plan them with ``dry_run``) and return the JSON report."""
     images = registry_images(client, team_of)
     deletions = plan_enforcement(
@@ -141,7 +168,7 @@ def enforce(
         for deletion in deletions:
             client.delete(deletion.image.repository, deletion.image.digest)
     deleted_ids = {id(d.image) for d in deletions}
-    teams: dict[str, dict[str, int]] = {}
+    teams: dict[str, TeamUsage] = {}
     for team in sorted({i.team for i in images}):
         mine = [i for i in images if i.team == team]
         teams[team] = {

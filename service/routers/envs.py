@@ -323,7 +323,7 @@ def monitor_close(instance_id: str, principal: TeamPrincipal, request: Request) 
             raise Conflict("no monitor is running on this instance")
         stats = instance.monitor.close()
         instance.monitor = None
-    return MonitorClosed(stats=stats)
+    return MonitorClosed(stats=dict(stats))
 
 
 @router.get("/{instance_id}/monitor/files/")

@@ -67,7 +67,7 @@ def get_nodes(services: AppServices, principal: OperatorPrincipal,
             submission_id, team, opponent = rows.get(job.match_id, (None, None, None))
             jobs.append(NodeJobView(job_id=job.job_id, state=job.state, match_id=job.match_id,
                                     submission_id=submission_id, team=team, opponent=opponent))
-        views.append(NodeView(**{**node.to_json(), "jobs": jobs}))
+        views.append(NodeView.model_validate({**node.to_json(), "jobs": jobs}))
     return PoolView(pool=services.settings.pool, slots=services.slots(), nodes=views)
 
 

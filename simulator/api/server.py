@@ -26,12 +26,12 @@ from collections import deque
 from collections.abc import Callable, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
-from typing import Any
 
 from contracts.ids import RobotId
 from contracts.match_spec import NetworkSpec
 from contracts.robot_api import messages_pb2 as pb
-from referee.spoofing import SpoofingLog
+from contracts.sim_result import RobotApiStats
+from referee import SpoofingLog
 from simulator.api.batch import StepBatch
 from simulator.api.cameras import MAX_IN_FLIGHT, ImageSource
 from simulator.api.connection import ClientClosed, Connection
@@ -231,7 +231,7 @@ class ApiServer:
         """Each robot's live counters and whether it is connected (cheap: nothing copied)."""
         return {s.session.key: (s.conn is not None, s.stats) for s in self.slots.values()}
 
-    def statistics(self) -> dict[str, dict[str, Any]]:
+    def statistics(self) -> dict[str, RobotApiStats]:
         return {slot.session.key: slot.stats.to_dict() for slot in self.slots.values()}
 
     def connection(self, robot: RobotId) -> Connection | None:

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from array import array
 from dataclasses import dataclass, field
-from typing import Any
+
+from contracts.sim_result import RobotApiStats
 
 
 def percentile(sorted_values: list[float], q: float) -> float:
@@ -44,7 +45,7 @@ class RobotStats:
         self.dropped_in[reason] = self.dropped_in.get(reason, 0) + 1
         self.dropped_in_bytes += size
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> RobotApiStats:
         latencies = sorted(self.round_trip_s)
         ms = {
             f"p{q}": round(percentile(latencies, q) * 1000.0, 3) if latencies else None

@@ -12,10 +12,13 @@ from simulator.replay.format import (
     SUPPORTED_VERSIONS,
     ChunkRef,
     FrameBlock,
+    GeomRecord,
+    HeaderRecord,
     Replay,
     ReplayFrame,
     ReplayHeader,
     RobotEntry,
+    SceneRecord,
 )
 from simulator.replay.reader import ReplayFile, load_replay
 from simulator.replay.scene import scene_for, scene_of
@@ -25,11 +28,14 @@ __all__ = [
     "SUPPORTED_VERSIONS",
     "ChunkRef",
     "FrameBlock",
+    "GeomRecord",
+    "HeaderRecord",
     "Replay",
     "ReplayFile",
     "ReplayFrame",
     "ReplayHeader",
     "RobotEntry",
+    "SceneRecord",
     "load_replay",
     "scene_for",
     "scene_of",

@@ -34,10 +34,13 @@ from __future__ import annotations
 import json
 import struct
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NotRequired, TypedDict
 
 import numpy as np
 import numpy.typing as npt
+
+from contracts.jsontypes import JSONObject
+from contracts.telemetry import EventRecord, GameStateRecord
 
 MAGIC = b"HLVSREC\0"
 INDEX_MAGIC = b"HLVSIDX\0"
@@ -51,6 +54,125 @@ U32 = struct.Struct("<I")
 RECORD_HEAD = struct.Struct("<BI")
 TRAILER = struct.Struct("<Q8s")
 POSE_WIDTH = 7
+
+
+class PatternRecord(TypedDict):
+    """A two-colour texture of a geom, drawn as stripes or checks by the viewer."""
+
+    colors: list[list[float]]  # the two RGB colours
+    repeat: list[float]
+    cube: bool
+
+
+class GeomRecord(TypedDict):
+    name: str
+    body: int
+    type: str  # "plane" | "sphere" | "capsule" | "ellipsoid" | "cylinder" | "box"
+    size: list[float]
+    pos: list[float]
+    quat: list[float]
+    rgba: list[float]
+    group: int
+    texture: NotRequired[str]  # a look's material ("look:...")
+    pattern: NotRequired[PatternRecord]
+
+
+class CameraRecord(TypedDict):
+    """A fixed camera of the field (on the world body)."""
+
+    name: str
+    body: int
+    pos: list[float]
+    quat: list[float]
+    fovy_deg: float
+
+
+class RobotCameraRecord(CameraRecord):
+    """A robot's head camera."""
+
+    robot: str  # robot key, "red-1"
+    width: int
+    height: int
+
+
+class SceneRobotRecord(TypedDict):
+    team: str
+    number: int
+    model: str
+    root_body: int  # index of the robot's root body (-1: not found)
+
+
+class LookRecord(TypedDict):
+    """A match's look, as a viewer draws it simply (``simulator.world.look.Look.summary``)."""
+
+    texture_seed: int
+    turf: int
+    ball: int
+    background: int
+    luminosity: float
+    turf_colors: list[list[float]]  # the two stripe colours
+    stripe_m: float
+    ball_colors: list[list[float]]
+    sky_colors: list[list[float]]  # sky top, horizon, stands
+
+
+class CameraModelRecord(TypedDict):
+    """The figures of a match's robot cameras (``simulator.world.CameraModel``'s fields)."""
+
+    seed: int
+    exposure_gain: float
+    auto_exposure: float
+    noise_std: float
+    motion_blur: bool
+    exposure_s: float
+
+
+class SceneRecord(TypedDict):
+    """What a viewer needs to draw a match (see :mod:`simulator.replay.scene`); replays of
+    earlier versions lack the keys marked ``NotRequired``."""
+
+    bodies: list[str]
+    geoms: list[GeomRecord]
+    cameras: list[CameraRecord]
+    robot_cameras: NotRequired[list[RobotCameraRecord]]
+    robots: list[SceneRobotRecord]
+    field: JSONObject  # contracts.field.FieldGeometry's fields
+    look: NotRequired[LookRecord]
+    camera_model: NotRequired[CameraModelRecord | None]
+
+
+class HeaderRobotRecord(TypedDict):
+    team: str
+    number: int
+    model: str
+    x_m: float
+    y_m: float
+    yaw_rad: float
+
+
+class HeaderRecord(TypedDict):
+    """The header JSON of a replay (also the scene message sent to live viewers)."""
+
+    format: str  # "hlvsrec"
+    version: int
+    match_id: str
+    seed: int
+    field_class: str
+    physics_dt_s: float
+    step_ms: int
+    rate_hz: float
+    chunk_frames: NotRequired[int]
+    robots: list[HeaderRobotRecord]
+    body_names: list[str]
+    scene: NotRequired[SceneRecord]  # versions 2 and 3
+
+
+class ChunkMeta(TypedDict):
+    """The JSON part of a chunk record: one entry per frame."""
+
+    times: list[int]  # sim_time_ms
+    games: list[GameStateRecord]
+    events: list[list[EventRecord]]  # the referee events recorded with each frame
 
 
 def dumps(value: object) -> bytes:
@@ -121,8 +243,8 @@ class ReplayHeader:
     rate_hz: float
     robots: tuple[RobotEntry, ...]
     body_names: tuple[str, ...]
-    scene: dict[str, Any] | None  # None for version 1 (see simulator.replay.scene_for)
-    raw: dict[str, Any]
+    scene: SceneRecord | None  # None for version 1 (see simulator.replay.scene_for)
+    raw: HeaderRecord
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -140,16 +262,16 @@ class FrameBlock:
     """Decoded frames of one chunk."""
 
     times_ms: npt.NDArray[np.int64]
-    games: list[dict[str, Any]]
-    events: list[list[dict[str, Any]]]
+    games: list[GameStateRecord]
+    events: list[list[EventRecord]]
     poses: npt.NDArray[np.float32]  # (frames, bodies, 7)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class ReplayFrame:
     sim_time_ms: int
-    game: dict[str, Any]
-    events: list[dict[str, Any]]
+    game: GameStateRecord
+    events: list[EventRecord]
     poses: npt.NDArray[np.float32]  # (nbody, 7): x y z qw qx qy qz
 
 

@@ -20,10 +20,11 @@ import struct
 import zlib
 from collections.abc import Iterator
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, cast
 
 import numpy as np
 
+from contracts.telemetry import EventRecord, GameStateRecord
 from simulator.errors import ReplayError
 from simulator.replay.format import (
     CHUNK,
@@ -35,8 +36,10 @@ from simulator.replay.format import (
     SUPPORTED_VERSIONS,
     TRAILER,
     U32,
+    ChunkMeta,
     ChunkRef,
     FrameBlock,
+    HeaderRecord,
     Replay,
     ReplayFrame,
     ReplayHeader,
@@ -50,7 +53,7 @@ _V1_FRAME_HEAD = struct.Struct("<II")
 _CORRUPT = (struct.error, zlib.error, ValueError, KeyError, TypeError, IndexError)
 
 
-def _header(data: dict[str, Any]) -> ReplayHeader:
+def _header(data: HeaderRecord) -> ReplayHeader:
     return ReplayHeader(
         version=int(data["version"]),
         match_id=str(data["match_id"]),
@@ -123,10 +126,10 @@ class ReplayFile:
                 f"format version {version!r}; this reader knows versions "
                 f"{', '.join(str(v) for v in SUPPORTED_VERSIONS)} (a newer hlvs-runner wrote it?)"
             )
-        self.header = _header(raw)
+        self.header = _header(cast("HeaderRecord", raw))  # each field converted and checked
         self.nbody = len(self.header.body_names)
         self._data_start = len(MAGIC) + 4 + length
-        self.events: tuple[dict[str, Any], ...] = ()
+        self.events: tuple[EventRecord, ...] = ()
         self._v1_frames: list[list[int]] = []
         if version == 1:
             self.indexed = False
@@ -158,7 +161,7 @@ class ReplayFile:
 
     def _scan_v2(self) -> tuple[ChunkRef, ...]:
         chunks: list[ChunkRef] = []
-        events: list[dict[str, Any]] = []
+        events: list[EventRecord] = []
         offset = self._data_start
         while offset + RECORD_HEAD.size <= self.size:
             kind, length = RECORD_HEAD.unpack(self._read_at(offset, RECORD_HEAD.size))
@@ -178,7 +181,7 @@ class ReplayFile:
         self.events = tuple(events)
         return tuple(chunks)
 
-    def _chunk_meta(self, offset: int) -> tuple[dict[str, Any], int, int]:
+    def _chunk_meta(self, offset: int) -> tuple[ChunkMeta, int, int]:
         kind, length = RECORD_HEAD.unpack(self._read_at(offset, RECORD_HEAD.size))
         if kind != CHUNK:
             raise self._error(f"no chunk record at offset {offset} (kind {kind})")
@@ -208,7 +211,7 @@ class ReplayFile:
 
     def _scan_v1(self) -> tuple[ChunkRef, ...]:
         frames: list[tuple[int, int]] = []  # (offset, sim_time_ms)
-        events: list[dict[str, Any]] = []
+        events: list[EventRecord] = []
         offset = self._data_start
         while offset < self.size:
             (length,) = U32.unpack(self._read_at(offset, 4))
@@ -216,7 +219,8 @@ class ReplayFile:
             if offset + 4 + length > self.size:
                 raise struct.error(f"frame at offset {offset} ends past the end of the file")
             meta = json.loads(self._read_at(offset + 12, meta_len))
-            events.extend({**e, "frame_ms": time_ms} for e in meta["events"])
+            frame_events: list[EventRecord] = meta["events"]
+            events.extend({**e, "frame_ms": time_ms} for e in frame_events)
             frames.append((offset, time_ms))
             offset += 4 + length
         self.events = tuple(events)
@@ -230,7 +234,10 @@ class ReplayFile:
         return tuple(chunks)
 
     def _read_chunk_v1(self, index: int) -> FrameBlock:
-        times, games, events, poses = [], [], [], []
+        times: list[int] = []
+        games: list[GameStateRecord] = []
+        events: list[list[EventRecord]] = []
+        poses = []
         for offset in self._v1_frames[index]:
             (length,) = U32.unpack(self._read_at(offset, 4))
             payload = self._read_at(offset + 4, length)

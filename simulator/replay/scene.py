@@ -28,13 +28,22 @@ checker). ``texture`` names one of the look's materials (``look:turf``, ``look:b
 from __future__ import annotations
 
 from dataclasses import asdict
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 if TYPE_CHECKING:
     import mujoco
 
     from contracts.field import FieldGeometry
-    from simulator.replay.format import ReplayHeader
+    from simulator.replay.format import (
+        CameraModelRecord,
+        CameraRecord,
+        GeomRecord,
+        PatternRecord,
+        ReplayHeader,
+        RobotCameraRecord,
+        SceneRecord,
+        SceneRobotRecord,
+    )
     from simulator.world.camera_model import CameraModel
     from simulator.world.look import Look
     from simulator.world.types import RobotPlacement
@@ -49,7 +58,7 @@ def _round(values: Any, digits: int = 6) -> list[float]:
     return [round(float(v), digits) for v in values]
 
 
-def _pattern(model: mujoco.MjModel, matid: int) -> dict[str, Any] | None:
+def _pattern(model: mujoco.MjModel, matid: int) -> PatternRecord | None:
     texid = int(model.mat_texid[matid][TEXTURE_ROLE_RGB])
     if texid < 0:
         return None
@@ -75,7 +84,7 @@ def _mean_texel(model: mujoco.MjModel, matid: int) -> list[float]:
     return [float(v) / 255.0 for v in texels.mean(axis=0)]
 
 
-def _geom(model: mujoco.MjModel, i: int) -> dict[str, Any]:
+def _geom(model: mujoco.MjModel, i: int) -> GeomRecord:
     gtype = int(model.geom_type[i])
     matid = int(model.geom_matid[i])
     rgba = model.mat_rgba[matid] if matid >= 0 else model.geom_rgba[i]
@@ -87,7 +96,7 @@ def _geom(model: mujoco.MjModel, i: int) -> dict[str, Any]:
         rot = np.zeros(9)
         mujoco.mju_quat2Mat(rot, model.geom_quat[i])
         pos = pos + rot.reshape(3, 3) @ model.geom_aabb[i][:3]
-    geom: dict[str, Any] = {
+    geom: GeomRecord = {
         "name": model.geom(i).name,
         "body": int(model.geom_bodyid[i]),
         "type": "box" if gtype == MESH else GEOM_TYPES.get(gtype, "sphere"),
@@ -134,21 +143,21 @@ def scene_of(
     field: FieldGeometry,
     look: Look | None = None,
     camera_model: CameraModel | None = None,
-) -> dict[str, Any]:
+) -> SceneRecord:
     """The scene description of a compiled world model (see the module docstring) built with
     ``look`` (default: the look of texture seed 0, as :func:`compile_scene`'s)."""
     from simulator.world.look import look_for
     from simulator.world.types import robot_prefix
 
     bodies = [model.body(i).name for i in range(model.nbody)]
-    robots = []
+    robots: list[SceneRobotRecord] = []
     for p in placements:
         prefix = robot_prefix(p.id) + "/"
         root = next((i for i, name in enumerate(bodies) if name.startswith(prefix)), -1)
         robots.append(
             {"team": p.id.team.value, "number": p.id.number, "model": p.model, "root_body": root}
         )
-    cameras = [
+    cameras: list[CameraRecord] = [
         {
             "name": model.camera(i).name,
             "body": int(model.cam_bodyid[i]),
@@ -159,7 +168,7 @@ def scene_of(
         for i in range(model.ncam)
         if int(model.cam_bodyid[i]) == 0
     ]
-    robot_cameras = []
+    robot_cameras: list[RobotCameraRecord] = []
     for p, robot in zip(placements, robots, strict=True):
         prefix = robot_prefix(p.id) + "/"
         for i in range(model.ncam):
@@ -188,11 +197,13 @@ def scene_of(
         "robots": robots,
         "field": field_data,
         "look": (look if look is not None else look_for(0)).summary(),
-        "camera_model": asdict(camera_model) if camera_model is not None else None,
+        "camera_model": (
+            cast("CameraModelRecord", asdict(camera_model)) if camera_model is not None else None
+        ),
     }
 
 
-def scene_for(header: ReplayHeader, path: str) -> dict[str, Any]:
+def scene_for(header: ReplayHeader, path: str) -> SceneRecord:
     """The scene of a replay: its own (versions 2 and 3), or for version 1 the scene of today's
     models for the robots it lists, when those still have the recorded bodies."""
     if header.scene is not None:

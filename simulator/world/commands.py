@@ -10,7 +10,7 @@ import mujoco
 import numpy as np
 
 from contracts.ids import RobotId, TeamColor
-from referee.snapshot import (
+from referee import (
     PlaceBall,
     RemoveRobot,
     RestoreRobot,

@@ -28,7 +28,7 @@ import numpy as np
 import numpy.typing as npt
 
 from contracts.ids import RobotId
-from referee.snapshot import Vec3
+from referee import Vec3
 from simulator.errors import UnknownDeviceError
 from simulator.world.types import DeviceKind
 

@@ -11,7 +11,7 @@ import numpy as np
 import numpy.typing as npt
 
 from contracts.ids import RobotId
-from referee.snapshot import BodyPart
+from referee import BodyPart
 from simulator.world.ball import BALL_GEOM, BALL_JOINT
 from simulator.world.robots import AnyRobotModel, robot_model
 from simulator.world.types import RobotPlacement, robot_prefix

@@ -14,12 +14,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import mujoco
 import numpy as np
 
 from simulator.world import textures
+
+if TYPE_CHECKING:
+    from simulator.replay.format import LookRecord
 
 RGB = tuple[float, float, float]
 
@@ -94,7 +97,7 @@ class Look:
     background: int
     luminosity: float
 
-    def summary(self) -> dict[str, Any]:
+    def summary(self) -> LookRecord:
         """What a viewer needs to draw the same look simply (recorded in the replay's scene):
         the two stripe colours (mean texel colours), the stripe width, the ball's colours and
         the background's sky and stands colours."""
@@ -121,7 +124,7 @@ def _rounded(values: Any) -> list[float]:
     return [round(float(v), 4) for v in values]
 
 
-def look_from_summary(summary: dict[str, Any]) -> Look:
+def look_from_summary(summary: LookRecord) -> Look:
     """The look a :meth:`Look.summary` describes (a replay's scene)."""
     return Look(
         texture_seed=int(summary["texture_seed"]),

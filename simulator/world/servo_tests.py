@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypedDict
 
 import mujoco
 import numpy as np
@@ -168,27 +168,43 @@ def backlash(servo: Servo) -> float:
     return 2 * play(extra) - play(2 * extra)
 
 
-def report(servo: Servo) -> dict[str, Any]:
+class Comparison(TypedDict):
+    measured: float
+    datasheet: float
+    error: float  # relative to the datasheet
+
+
+class ServoReport(TypedDict):
+    servo: str
+    no_load_speed_rad_s: Comparison
+    stall_torque_nm: Comparison
+    static_friction_nm: Comparison
+    backlash_rad: Comparison
+    step_p10_max_error: float
+    ok: bool  # speed, torque and step response within the tolerances
+
+
+def report(servo: Servo) -> ServoReport:
     """Every measurement of ``servo`` with its datasheet figure and relative error."""
 
-    def compare(measured: float, expected: float) -> dict[str, float]:
+    def compare(measured: float, expected: float) -> Comparison:
         return {
             "measured": round(measured, 5),
             "datasheet": round(expected, 5),
             "error": round(abs(measured - expected) / expected, 4) if expected else 0.0,
         }
 
-    out: dict[str, Any] = {
+    speed = compare(no_load_speed(servo), servo.no_load_speed_rad_s)
+    stall = compare(stall_torque(servo), servo.stall_torque_nm)
+    friction = compare(breakaway_torque(servo), servo.static_friction_nm)
+    play = compare(backlash(servo), servo.backlash_rad)
+    step = round(step_error(servo), 4)
+    return {
         "servo": servo.id,
-        "no_load_speed_rad_s": compare(no_load_speed(servo), servo.no_load_speed_rad_s),
-        "stall_torque_nm": compare(stall_torque(servo), servo.stall_torque_nm),
-        "static_friction_nm": compare(breakaway_torque(servo), servo.static_friction_nm),
-        "backlash_rad": compare(backlash(servo), servo.backlash_rad),
-        "step_p10_max_error": round(step_error(servo), 4),
+        "no_load_speed_rad_s": speed,
+        "stall_torque_nm": stall,
+        "static_friction_nm": friction,
+        "backlash_rad": play,
+        "step_p10_max_error": step,
+        "ok": speed["error"] <= SPEC_ERROR and stall["error"] <= SPEC_ERROR and step <= STEP_ERROR,
     }
-    out["ok"] = (
-        out["no_load_speed_rad_s"]["error"] <= SPEC_ERROR
-        and out["stall_torque_nm"]["error"] <= SPEC_ERROR
-        and out["step_p10_max_error"] <= STEP_ERROR
-    )
-    return out

@@ -31,7 +31,7 @@ import mujoco
 import numpy as np
 
 from contracts.ids import RobotId
-from referee.snapshot import BallState, BodyPart, RobotState, WorldSnapshot
+from referee import BallState, BodyPart, RobotState, WorldSnapshot
 from simulator.world.flat import FlatData
 from simulator.world.frozen import slot_constructor
 from simulator.world.indices import (

@@ -26,7 +26,7 @@ import numpy as np
 from contracts.field import FieldGeometry, field_for
 from contracts.ids import RobotId, TeamColor
 from contracts.match_spec import MatchSpec
-from referee.snapshot import WorldCommand, WorldSnapshot
+from referee import WorldCommand, WorldSnapshot
 from simulator.errors import PhysicsDivergence
 from simulator.world import commands
 from simulator.world.camera_model import CameraModel

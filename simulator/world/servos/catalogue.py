@@ -18,10 +18,10 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
-from typing import Any
 
 from simulator.errors import ModelError, ModelProblem
 
@@ -57,7 +57,8 @@ class Servo:
             0.0, self.stall_torque_nm * (1.0 - (speed - self.full_torque_speed_rad_s) / span)
         )
 
-    def to_json(self) -> dict[str, Any]:
+    def to_json(self) -> dict[str, str | float]:
+        """The datasheet figures (numbers) with the servo's id, model and source (text)."""
         return {
             "id": self.id,
             "model": self.model,
@@ -75,7 +76,7 @@ class Servo:
         }
 
 
-def _number(raw: dict[str, Any], key: str, source: str, where: str) -> float:
+def _number(raw: Mapping[str, object], key: str, source: str, where: str) -> float:
     value = raw.get(key)
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not value >= 0:
         raise ModelError(

@@ -15,10 +15,12 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from contracts.jsontypes import JSONObject
 from simulator.errors import ModelError, ModelProblem
 from simulator.world.servos import find_servo, servo_ids
 
@@ -75,7 +77,7 @@ class Manifest:
     joint_damping: float | None = None
     joint_armature: float | None = None
     joint_frictionloss: float | None = None
-    extra: dict[str, Any] = field(default_factory=dict)
+    extra: JSONObject = field(default_factory=dict)  # keys this build does not read
 
     @property
     def folder(self) -> Path:
@@ -92,7 +94,7 @@ class _Reader:
 
     def get(
         self,
-        obj: dict[str, Any],
+        obj: Mapping[str, object],  # a JSON object of the manifest, not yet checked
         key: str,
         kind: type | tuple[type, ...],
         pointer: str,
@@ -115,7 +117,7 @@ class _Reader:
 
     def positive(
         self,
-        obj: dict[str, Any],
+        obj: Mapping[str, object],  # a JSON object of the manifest, not yet checked
         key: str,
         pointer: str,
         *,
@@ -279,7 +281,7 @@ def load_manifest(folder_or_file: Path) -> Manifest:
     )
 
 
-def _motors(r: _Reader, raw: dict[str, Any]) -> tuple[MotorEntry, ...]:
+def _motors(r: _Reader, raw: Mapping[str, object]) -> tuple[MotorEntry, ...]:
     entries = r.get(raw, "motors", list, "") or []
     if not entries and "motors" in raw:
         r.problem("/motors", "no motors: expected at least one joint driven as a motor")
@@ -325,7 +327,7 @@ def _motors(r: _Reader, raw: dict[str, Any]) -> tuple[MotorEntry, ...]:
     return tuple(motors)
 
 
-def _cameras(r: _Reader, raw: dict[str, Any]) -> tuple[CameraEntry, ...]:
+def _cameras(r: _Reader, raw: Mapping[str, object]) -> tuple[CameraEntry, ...]:
     cameras = []
     for i, entry in enumerate(r.get(raw, "cameras", list, "") or []):
         p = f"/cameras/{i}"
@@ -363,7 +365,7 @@ def _cameras(r: _Reader, raw: dict[str, Any]) -> tuple[CameraEntry, ...]:
     return tuple(cameras)
 
 
-def _pair(r: _Reader, raw: dict[str, Any], key: str) -> tuple[str, str]:
+def _pair(r: _Reader, raw: Mapping[str, object], key: str) -> tuple[str, str]:
     obj = r.get(raw, key, dict, "") or {}
     left = r.get(obj, "left", str, f"/{key}") or ""
     right = r.get(obj, "right", str, f"/{key}") or ""

@@ -20,8 +20,8 @@ the squared diagonal of that box (no point of the link is farther from its centr
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
-from typing import Any
+from dataclasses import dataclass, field
+from typing import TypedDict
 
 import mujoco
 import numpy as np
@@ -44,6 +44,24 @@ MIN_INERTIA_KG_M2 = 1e-8
 FRAME_KG = 1e-5  # lighter links are frames (camera, IMU), not parts
 
 
+class MeasurementsRecord(TypedDict):
+    """:class:`Measurements` as JSON (``hlvs check``), lengths rounded to 0.1 mm."""
+
+    height_m: float
+    leg_m: float
+    head_m: float
+    top_m: float
+    arm_m: float
+    foot_length_m: float
+    foot_width_m: float
+    mass_kg: float
+    cameras: int
+    max_fov_rad: float
+    motors: int
+    arm_chains_m: dict[str, float]
+    servos: dict[str, str]
+
+
 @dataclass(frozen=True, slots=True)
 class Measurements:
     height_m: float
@@ -60,15 +78,22 @@ class Measurements:
     arm_chains_m: dict[str, float] = field(default_factory=dict)  # first link -> reach
     servos: dict[str, str] = field(default_factory=dict)  # motor -> catalogue id ("" free)
 
-    def to_json(self) -> dict[str, Any]:
-        out: dict[str, Any] = {}
-        for key, value in asdict(self).items():
-            if isinstance(value, float):
-                value = round(value, 4)
-            elif key == "arm_chains_m":
-                value = {k: round(v, 4) for k, v in value.items()}
-            out[key] = value
-        return out
+    def to_json(self) -> MeasurementsRecord:
+        return {
+            "height_m": round(self.height_m, 4),
+            "leg_m": round(self.leg_m, 4),
+            "head_m": round(self.head_m, 4),
+            "top_m": round(self.top_m, 4),
+            "arm_m": round(self.arm_m, 4),
+            "foot_length_m": round(self.foot_length_m, 4),
+            "foot_width_m": round(self.foot_width_m, 4),
+            "mass_kg": round(self.mass_kg, 4),
+            "cameras": self.cameras,
+            "max_fov_rad": round(self.max_fov_rad, 4),
+            "motors": self.motors,
+            "arm_chains_m": {k: round(v, 4) for k, v in self.arm_chains_m.items()},
+            "servos": dict(self.servos),
+        }
 
 
 def _standalone(robot: TeamRobotModel) -> mujoco.MjModel:
