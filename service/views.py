@@ -88,7 +88,7 @@ class SubmissionReport(BaseModel):
     cause: str | None
     charged: bool
     team_robots: dict[str, TeamRobot]
-    match_report: dict[str, str] | None = Field(
+    match_report: dict[str, str | list[dict[str, str]]] | None = Field(
         description="the match's report.json as written (contracts.match_results.MatchReport)")
 
 

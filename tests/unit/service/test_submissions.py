@@ -448,3 +448,18 @@ def _count_parses(served: Served, token: Callable[..., str],
         wait_for_status(http, created.json()["id"], lambda b: b["state"] == "running")
     assert parsed.count("Alpha") == 1
     assert [plan.red.name for plan in _Runner.plans] == ["Alpha"]
+
+
+def test_a_report_with_cut_logs_is_served(start: Callable[..., Served],
+                                          token: Callable[..., str], pool: FakePool) -> None:
+    """report.json names the logs cut at their size limit (a list): the report answers it."""
+    served = start()
+    with setup_team(served, token("Alpha"), "Alpha") as http:
+        sid = http.post("/v1/submissions", json={}).json()["id"]
+        wait_for_status(http, sid, lambda b: b["state"] == "running")
+        cut = [{"robot": "red-1", "what": "log folder", "reason": "above 10 GB"}]
+        pool.finish(handle_of(served, sid), {"status": "success", "logs_cut": cut})
+        wait_for_status(http, sid, lambda b: b["state"] == "done")
+        answer = http.get(f"/v1/submissions/{sid}/report")
+        assert answer.status_code == 200, answer.text
+        assert answer.json()["match_report"] == {"status": "success", "logs_cut": cut}
