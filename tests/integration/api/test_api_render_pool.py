@@ -7,6 +7,7 @@ import os
 import select
 import time
 
+import mujoco
 import numpy as np
 import pytest
 
@@ -34,6 +35,10 @@ def _world() -> World:
     world = World.create(field_class="kid", robots=placements, seed=3)
     for _ in range(10):
         world.step()
+    # after a step the poses are those of the step's start; the robots still settle into the
+    # grass, so the kinematics of the state handed to the workers are computed here too
+    mujoco.mj_kinematics(world.model, world.data)
+    mujoco.mj_camlight(world.model, world.data)
     return world
 
 

@@ -103,7 +103,7 @@ def test_queue_submissions_replay_standings_and_pool_pages(
     pool.finish(handle, {"status": "success"})
     wait_for_status(clients[0], ids[0], lambda b: b["state"] == "done")
     page.wait_for_function(  # the pool page refreshes by itself: the match left the node
-        "document.querySelector('[data-testid=nodes] tr:nth-child(2) td:nth-child(8)')"
+        "document.querySelector('[data-testid=nodes] tr:nth-child(2) td:nth-child(8)')?"
         ".innerText.startsWith(" + repr(ids[1]) + ")", timeout=20_000)
     public = pool.results_dir(handle) / "public"
     recorded = record_match(tmp_path / "recorded")
@@ -159,7 +159,8 @@ def test_each_page_with_a_team_token_and_with_an_operator_token(
     page.wait_for_selector("[data-testid=sign-in-form]")
     page.locator("[data-testid=token]").fill("hlvs_000000000000_" + "x" * 43)
     page.locator("[data-testid=sign-in]").click()
-    page.wait_for_function("document.querySelector('[data-testid=error]').innerText !== ''")
+    page.wait_for_function("(document.querySelector('[data-testid=error]')?.innerText ?? '')"
+                           " !== ''")
     assert "not signed in, or your token is no longer valid" in _text(page)
 
     _use_token(page, served.url, alpha_secret, "/watch/")
@@ -210,7 +211,7 @@ def test_each_page_with_a_team_token_and_with_an_operator_token(
     page.goto(f"{served.url}/watch/nodes")
     assert _rows(page, "nodes")[0][0] == "fake-node"
     page.goto(f"{served.url}/watch/live/{waiting}")  # the fake pool: no telemetry to watch
-    page.wait_for_function("document.querySelector('[data-testid=live-status]').innerText"
+    page.wait_for_function("document.querySelector('[data-testid=live-status]')?.innerText"
                            ".startsWith('Live view unavailable.')")
     assert page.locator("[data-testid=game-state]").inner_text() == "not started"
     assert page.locator("[data-testid=game-clock]").inner_text() == ""
