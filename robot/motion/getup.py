@@ -37,14 +37,14 @@ FRONT: tuple[Frame, ...] = (
             "ArmLower": -0.1}),  # fold the knees
     (1.09, _CROUCH),  # crouch on hands and feet
     (0.6, _CROUCH),  # hold it: every fall goes on from here
-    (0.84, {"LegUpper": 0.88, "LegLower": 3.09, "Ankle": 1.51, "Shoulder": 1.92,
+    (0.84, {"LegUpper": 0.87, "LegLower": 3.09, "Ankle": 1.51, "Shoulder": 1.92,
             "ArmLower": 1.19}),  # push off the hands onto the toes
-    (0.26, {"LegUpper": 0.48, "LegLower": 3.98, "Ankle": 0.88, "Shoulder": 1.33,
+    (0.26, {"LegUpper": 0.48, "LegLower": 3.98, "Ankle": 0.88, "Shoulder": 1.29,
             "ArmLower": 0.41}),  # rock back ...
-    (0.43, {"LegUpper": 0.32, "LegLower": 2.05, "Ankle": 1.64, "Shoulder": 0.18,
-            "ArmLower": -0.17}),  # ... onto the heels
-    (0.48, {"LegUpper": 1.4, "LegLower": 2.32, "Ankle": 0.88, "Shoulder": 1.48,
-            "ArmLower": -0.55}),  # lean into the squat
+    (0.43, {"LegUpper": 0.37, "LegLower": 2.04, "Ankle": 1.64, "Shoulder": 0.16,
+            "ArmLower": -0.36}),  # ... onto the heels
+    (0.48, {"LegUpper": 1.5, "LegLower": 2.13, "Ankle": 0.88, "Shoulder": 1.32,
+            "ArmLower": -0.5}),  # lean into the squat
 )  # fmt: skip
 BACK_TO_FRONT: tuple[Frame, ...] = (  # roll over the right side onto the front (sides differ)
     (
