@@ -1,7 +1,7 @@
 """Getting up after a fall, from lying on the front or on the back (joint-space keyframes).
 
-Paced for the league's catalogue servos: no target moves faster than three quarters of its
-joint's no-load speed, so the servos' torque-speed line leaves torque to move the body.
+Paced for the league's catalogue servos: no target moves faster than its joint's no-load speed
+(most stay under 0.6 of it), so the servos' torque-speed line leaves torque to move the body.
 
 Front (about 10 s): arms out and forward, push up on them, jackknife into a pike on hands and
 flat feet, fold the knees into a crouch on hands and feet and hold it (a statically stable
@@ -37,14 +37,14 @@ FRONT: tuple[Frame, ...] = (
             "ArmLower": -0.1}),  # fold the knees
     (1.09, _CROUCH),  # crouch on hands and feet
     (0.6, _CROUCH),  # hold it: every fall goes on from here
-    (0.84, {"LegUpper": 0.87, "LegLower": 3.09, "Ankle": 1.51, "Shoulder": 1.92,
-            "ArmLower": 1.19}),  # push off the hands onto the toes
-    (0.26, {"LegUpper": 0.48, "LegLower": 3.98, "Ankle": 0.88, "Shoulder": 1.29,
-            "ArmLower": 0.41}),  # rock back ...
-    (0.43, {"LegUpper": 0.37, "LegLower": 2.04, "Ankle": 1.64, "Shoulder": 0.16,
-            "ArmLower": -0.36}),  # ... onto the heels
-    (0.48, {"LegUpper": 1.5, "LegLower": 2.13, "Ankle": 0.88, "Shoulder": 1.32,
-            "ArmLower": -0.5}),  # lean into the squat
+    (0.84, {"LegUpper": 0.95, "LegLower": 3.42, "Ankle": 1.51, "Shoulder": 1.92,
+            "ArmLower": 1.09}),  # push off the hands onto the toes
+    (0.24, {"LegUpper": 0.47, "LegLower": 3.85, "Ankle": 0.88, "Shoulder": 1.16,
+            "ArmLower": 0.35}),  # rock back ...
+    (0.29, {"LegUpper": 0.55, "LegLower": 2.03, "Ankle": 1.68, "Shoulder": 0.41,
+            "ArmLower": -0.26}),  # ... onto the heels
+    (0.38, {"LegUpper": 1.43, "LegLower": 2.11, "Ankle": 0.91, "Shoulder": 1.32,
+            "ArmLower": -0.75}),  # lean into the squat
 )  # fmt: skip
 BACK_TO_FRONT: tuple[Frame, ...] = (  # roll over the right side onto the front (sides differ)
     (
