@@ -1,9 +1,16 @@
 """Getting up after a fall, from lying on the front or on the back (joint-space keyframes).
 
-Front: push up on the hands, throw the legs under the body and the arms up into a deep squat,
-stand. Back: swing the legs and arms across to roll onto the front and lie flat; the caller
-(the stub controller) then sees a robot lying on its front and runs the front get-up. Angles
-are written for kid-default's motor signs (robot/geometry.py).
+Paced for the league's catalogue servos: no target moves faster than its joint's no-load speed
+(most stay under 0.6 of it), so the servos' torque-speed line leaves torque to move the body.
+
+Front (about 10 s): arms out and forward, push up on them, jackknife into a pike on hands and
+flat feet, fold the knees into a crouch on hands and feet and hold it (a statically stable
+pose: every fall goes on from the same state), push off the hands onto the toes, rock back onto
+the heels, lean into a squat and stand. Back (about 1.8 s): tuck the left leg, push the ground
+behind the back with the left arm and swing the leg across to roll over the right side onto
+the front, and lie flat; the caller (the stub controller) then sees a robot lying on its front
+and runs the front get-up. Angles are written for kid-default's motor signs
+(robot/geometry.py).
 """
 
 from __future__ import annotations
@@ -14,56 +21,53 @@ from robot.motion.posture import standing_posture
 
 Frame = tuple[float, dict[str, float]]  # (duration s, {joint without side suffix: rad})
 
-# Tuned in the MuJoCo world by a search over keyframes from perturbed lying poses. Some targets
-# lie beyond the motor limits on purpose: the motors clamp them, and interpolating towards
-# them makes the joint reach its limit earlier in the move, which is part of the tuned timing.
+# Tuned in the MuJoCo world with the catalogue servos by a search over keyframes within the
+# servos' speed, on robots laid down and pushed over in several directions. Some targets lie
+# beyond the motor limits on purpose: the motors clamp them, and interpolating towards them
+# makes the joint reach its limit earlier in the move, which is part of the tuned timing.
+_CROUCH = {"LegUpper": 2.25, "LegLower": 2.2, "Ankle": 1.81, "Shoulder": 1.06, "ArmLower": 0.08}
 FRONT: tuple[Frame, ...] = (
-    (0.16, {"Shoulder": 0.43, "ArmLower": 2.55, "ArmUpper": 0.92, "LegUpper": 0.57,
-            "LegLower": -1.28, "Ankle": -0.67}),
-    (0.25, {"Shoulder": 2.23, "ArmLower": 0.37, "ArmUpper": 0.18, "LegUpper": 0.03,
-            "LegLower": 0.0, "Ankle": -0.75}),
-    (0.32, {"Shoulder": 1.51, "ArmLower": -0.93, "ArmUpper": -1.2, "LegUpper": 2.62,
-            "LegLower": 2.13, "Ankle": 1.49}),
-    (0.38, {"Shoulder": 3.44, "ArmLower": 0.97, "ArmUpper": -0.22, "LegUpper": 3.27,
-            "LegLower": 2.67, "Ankle": 0.71}),
-    (0.1, {"Shoulder": 1.0, "ArmLower": -0.41, "ArmUpper": 0.62, "LegUpper": 1.35,
-           "LegLower": 2.93, "Ankle": 1.38}),
-    (0.52, {"Shoulder": 0.1, "ArmLower": -0.07, "ArmUpper": 0.34, "LegUpper": 1.45,
-            "LegLower": 2.5, "Ankle": 1.15}),
+    (0.8, {"Shoulder": 0.0, "ArmUpper": 1.5, "ArmLower": 0.0, "LegUpper": 0.0,
+           "LegLower": 0.0, "Ankle": 0.0, "Pelv": 0.0, "Foot": 0.0}),  # arms out, legs straight
+    (1.0, {"Shoulder": 2.06}),  # the arms turn to point ahead
+    (0.59, {"ArmUpper": 0.09}),  # ... and swing down under the chest: push-up
+    (1.2, {"LegUpper": 2.4, "LegLower": -0.78, "Ankle": 0.41, "Shoulder": 3.19,
+           "ArmLower": 0.14}),  # jackknife: pike on hands and flat feet
+    (1.22, {"LegUpper": 1.36, "LegLower": 2.74, "Ankle": 1.15, "Shoulder": 2.85,
+            "ArmLower": -0.1}),  # fold the knees
+    (1.09, _CROUCH),  # crouch on hands and feet
+    (0.6, _CROUCH),  # hold it: every fall goes on from here
+    (0.84, {"LegUpper": 0.95, "LegLower": 3.42, "Ankle": 1.51, "Shoulder": 1.92,
+            "ArmLower": 1.09}),  # push off the hands onto the toes
+    (0.24, {"LegUpper": 0.47, "LegLower": 3.85, "Ankle": 0.88, "Shoulder": 1.16,
+            "ArmLower": 0.35}),  # rock back ...
+    (0.29, {"LegUpper": 0.55, "LegLower": 2.03, "Ankle": 1.68, "Shoulder": 0.41,
+            "ArmLower": -0.26}),  # ... onto the heels
+    (0.38, {"LegUpper": 1.43, "LegLower": 2.11, "Ankle": 0.91, "Shoulder": 1.32,
+            "ArmLower": -0.75}),  # lean into the squat
 )  # fmt: skip
-BACK_TO_FRONT: tuple[Frame, ...] = (  # roll over onto the front (sides differ)
+BACK_TO_FRONT: tuple[Frame, ...] = (  # roll over the right side onto the front (sides differ)
     (
-        1.35,
-        {"ShoulderL": 1.38, "ShoulderR": 1.82, "ArmUpperL": -0.15, "ArmUpperR": 1.15,
-        "ArmLowerL": -0.04, "ArmLowerR": 0.0, "LegUpperL": 1.5, "LegUpperR": 2.39, "LegLowerL":
-        0.31, "LegLowerR": 0.93, "PelvL": -1.03, "PelvR": 0.25, "PelvYL": 0.0, "PelvYR": 0.82},
+        0.51,  # left leg tucked, right leg back and turned in, arms apart
+        {"ShoulderR": 1.48, "ArmUpperR": -0.53, "ArmLowerR": -0.1, "ShoulderL": -0.9,
+         "ArmUpperL": 1.35, "ArmLowerL": 0.53, "LegUpperL": 2.2, "LegLowerL": 2.6, "PelvL": -0.17,
+         "PelvYL": -0.33, "AnkleL": -1.2, "LegUpperR": -1.0, "LegLowerR": 0.33, "PelvR": -0.6,
+         "PelvYR": -0.9, "AnkleR": 0.87},
     ),
+    (0.2, {"ShoulderL": -1.42, "ArmUpperL": 0.72}),  # the left arm pushes the ground behind
     (
-        0.2,
-        {"ShoulderL": 1.5, "ShoulderR": 1.58, "ArmUpperL": -0.3, "ArmUpperR": -2.5, "ArmLowerL":
-        1.1, "ArmLowerR": 0.0, "LegUpperL": 2.22, "LegUpperR": 1.5, "LegLowerL": 1.24,
-        "LegLowerR": 0.12, "PelvL": -0.55, "PelvR": -0.34, "PelvYL": 1.02, "PelvYR": 0.09},
+        0.33,  # ... and the left leg swings across
+        {"ShoulderL": -1.52, "ArmUpperL": -0.3, "LegUpperL": 1.04, "PelvL": 0.37,
+         "PelvYL": -0.9},
     ),
-    (
-        1.21,
-        {"ShoulderL": 0.84, "ShoulderR": 0.94, "ArmUpperL": 0.85, "ArmUpperR": -2.98,
-        "ArmLowerL": -0.53, "ArmLowerR": 0.0, "LegUpperL": 0.5, "LegUpperR": 0.5, "LegLowerL":
-        0.3, "LegLowerR": 0.15, "PelvL": 0.54, "PelvR": -1.82, "PelvYL": 0.93, "PelvYR": -0.5},
-    ),
-    (
-        0.36,
-        {"ShoulderL": 1.53, "ShoulderR": -0.39, "ArmUpperL": 0.56, "ArmUpperR": 1.28,
-        "ArmLowerL": 0.45, "ArmLowerR": 0.0, "LegUpperL": -1.26, "LegUpperR": -1.13,
-        "LegLowerL": -1.23, "LegLowerR": -0.13, "PelvL": 0.0, "PelvR": 0.0, "PelvYL": -0.17,
-        "PelvYR": 0.36},
-    ),
+    (0.2, {"ShoulderL": -2.08, "ArmUpperL": -0.3, "LegUpperL": 0.63, "PelvYL": -0.9}),
 )  # fmt: skip
 LIE_FLAT: Frame = (
     0.6,
     {"Shoulder": 0.0, "ArmLower": 0.0, "ArmUpper": 0.2, "LegUpper": 0.0, "LegLower": 0.0,
      "Ankle": 0.0, "Pelv": 0.0, "PelvY": 0.0, "Foot": 0.0},
 )  # fmt: skip
-STAND_S = 1.0
+STAND_S = 1.5
 MIRRORED = ("ArmUpper", "Pelv", "PelvY", "Foot")  # roll/yaw joints: opposite sign on the right
 
 
