@@ -21,10 +21,11 @@ from robot.motion.posture import standing_posture
 
 Frame = tuple[float, dict[str, float]]  # (duration s, {joint without side suffix: rad})
 
-# Tuned in the MuJoCo world with the catalogue servos by a search over keyframes within the
-# servos' speed, on robots laid down and pushed over in several directions. Some targets lie
-# beyond the motor limits on purpose: the motors clamp them, and interpolating towards them
-# makes the joint reach its limit earlier in the move, which is part of the tuned timing.
+# Tuned in the MuJoCo world (grass turf, cleated feet) with the catalogue servos by a search over
+# keyframes within the servos' speed, on robots laid down and pushed over in several directions.
+# Some targets lie beyond the motor limits on purpose: the motors clamp them, and interpolating
+# towards them makes the joint reach its limit earlier in the move, which is part of the tuned
+# timing.
 _CROUCH = {"LegUpper": 2.25, "LegLower": 2.2, "Ankle": 1.81, "Shoulder": 1.06, "ArmLower": 0.08}
 FRONT: tuple[Frame, ...] = (
     (0.8, {"Shoulder": 0.0, "ArmUpper": 1.5, "ArmLower": 0.0, "LegUpper": 0.0,
@@ -37,14 +38,14 @@ FRONT: tuple[Frame, ...] = (
             "ArmLower": -0.1}),  # fold the knees
     (1.09, _CROUCH),  # crouch on hands and feet
     (0.6, _CROUCH),  # hold it: every fall goes on from here
-    (0.84, {"LegUpper": 0.95, "LegLower": 3.42, "Ankle": 1.51, "Shoulder": 1.92,
+    (0.89, {"LegUpper": 0.83, "LegLower": 3.41, "Ankle": 1.21, "Shoulder": 1.86,
             "ArmLower": 1.09}),  # push off the hands onto the toes
-    (0.24, {"LegUpper": 0.47, "LegLower": 3.85, "Ankle": 0.88, "Shoulder": 1.16,
-            "ArmLower": 0.35}),  # rock back ...
-    (0.29, {"LegUpper": 0.55, "LegLower": 2.03, "Ankle": 1.68, "Shoulder": 0.41,
-            "ArmLower": -0.26}),  # ... onto the heels
-    (0.38, {"LegUpper": 1.43, "LegLower": 2.11, "Ankle": 0.91, "Shoulder": 1.32,
-            "ArmLower": -0.75}),  # lean into the squat
+    (0.37, {"LegUpper": 0.65, "LegLower": 4.0, "Ankle": 0.73, "Shoulder": 1.41,
+            "ArmLower": -0.33}),  # rock back ...
+    (0.29, {"LegUpper": 0.27, "LegLower": 2.14, "Ankle": 1.74, "Shoulder": 0.26,
+            "ArmLower": -0.27}),  # ... onto the heels
+    (0.21, {"LegUpper": 1.36, "LegLower": 1.98, "Ankle": 0.77, "Shoulder": 1.16,
+            "ArmLower": -0.42}),  # lean into the squat
 )  # fmt: skip
 BACK_TO_FRONT: tuple[Frame, ...] = (  # roll over the right side onto the front (sides differ)
     (
