@@ -35,6 +35,10 @@ logger = logging.getLogger(__name__)
 Vec3 = tuple[float, float, float]
 FALL_TILT_RAD = 0.9
 FALL_CONFIRM_S = 0.6
+# which side it lies on: the sign of gravity along the torso's forward axis, averaged this long
+# (the attitude filter lags a tumbling fall by a few tenths of a second and may still read the
+# other side when the fall is confirmed)
+LYING_SIDE_TAU_S = 0.15
 BALL_MEMORY_MS = 4000
 SCAN = [(-0.9, 0.45), (-0.45, 0.5), (0.0, 0.55), (0.45, 0.5), (0.9, 0.45), (0.45, 0.95),
         (0.0, 1.0), (-0.45, 0.95)]  # fmt: skip
@@ -131,6 +135,7 @@ class StubController:
         self._still_s = 0.0
         self._upright_since_fall = True
         self._tilted_s = 0.0
+        self._forward_gravity = 0.0  # accelerometer x, low-passed with LYING_SIDE_TAU_S
         self._motion: KeyframeMotion | PolicyMotion | None = None
         self._motion_kind = ""
         self._last_targets: dict[str, float] = {}
@@ -258,6 +263,8 @@ class StubController:
         self._last_ms = sensors.time_ms
         if sensors.accel is not None and sensors.gyro is not None:
             self.attitude.update(dt, sensors.accel, sensors.gyro)
+            weight = dt / (LYING_SIDE_TAU_S + dt)
+            self._forward_gravity += weight * (sensors.accel[0] - self._forward_gravity)
         att = self.attitude.attitude
         upright = att.tilt_rad < 0.5
         if upright and self._motion is None:
@@ -286,7 +293,7 @@ class StubController:
         if game.penalised:  # limp or being carried: nothing to get up from
             self._tilted_s = 0.0
         elif self._fallen(dt, att.tilt_rad):
-            side = "front" if att.pitch_rad > 0 else "back"
+            side = self._lying_side(att.pitch_rad, sensors.accel is not None)
             if self._upright_since_fall:
                 self.stats.falls += 1  # later attempts while still down are not new falls
             self._upright_since_fall = False
@@ -410,6 +417,12 @@ class StubController:
         self._scan_s += dt
         yaw, pitch = SCAN[int(self._scan_s / SCAN_DWELL_S) % len(SCAN)]
         return self.kin.head_targets(yaw, pitch)
+
+    def _lying_side(self, pitch_rad: float, have_accel: bool) -> str:
+        """The side it lies on: on the front, the specific force points backwards (x < 0)."""
+        if have_accel:
+            return "front" if self._forward_gravity < 0.0 else "back"
+        return "front" if pitch_rad > 0 else "back"
 
     def _fallen(self, dt: float, tilt_rad: float) -> bool:
         self._tilted_s = self._tilted_s + dt if tilt_rad > FALL_TILT_RAD else 0.0
