@@ -38,14 +38,14 @@ FRONT: tuple[Frame, ...] = (
             "ArmLower": -0.1}),  # fold the knees
     (1.09, _CROUCH),  # crouch on hands and feet
     (0.6, _CROUCH),  # hold it: every fall goes on from here
-    (0.89, {"LegUpper": 0.83, "LegLower": 3.41, "Ankle": 1.21, "Shoulder": 1.86,
-            "ArmLower": 1.09}),  # push off the hands onto the toes
-    (0.37, {"LegUpper": 0.65, "LegLower": 4.0, "Ankle": 0.73, "Shoulder": 1.41,
-            "ArmLower": -0.33}),  # rock back ...
-    (0.29, {"LegUpper": 0.27, "LegLower": 2.14, "Ankle": 1.74, "Shoulder": 0.26,
-            "ArmLower": -0.27}),  # ... onto the heels
-    (0.21, {"LegUpper": 1.36, "LegLower": 1.98, "Ankle": 0.77, "Shoulder": 1.16,
-            "ArmLower": -0.42}),  # lean into the squat
+    (0.91, {"LegUpper": 0.75, "LegLower": 3.56, "Ankle": 1.18, "Shoulder": 1.88,
+            "ArmLower": 1.02}),  # push off the hands onto the toes
+    (0.44, {"LegUpper": 0.54, "LegLower": 3.89, "Ankle": 0.74, "Shoulder": 1.36,
+            "ArmLower": -0.2}),  # rock back ...
+    (0.33, {"LegUpper": 0.35, "LegLower": 2.07, "Ankle": 1.93, "Shoulder": 0.29,
+            "ArmLower": -0.29}),  # ... onto the heels
+    (0.19, {"LegUpper": 1.29, "LegLower": 1.87, "Ankle": 0.8, "Shoulder": 1.15,
+            "ArmLower": -0.24}),  # lean into the squat
 )  # fmt: skip
 BACK_TO_FRONT: tuple[Frame, ...] = (  # roll over the right side onto the front (sides differ)
     (
@@ -68,7 +68,7 @@ LIE_FLAT: Frame = (
     {"Shoulder": 0.0, "ArmLower": 0.0, "ArmUpper": 0.2, "LegUpper": 0.0, "LegLower": 0.0,
      "Ankle": 0.0, "Pelv": 0.0, "PelvY": 0.0, "Foot": 0.0},
 )  # fmt: skip
-STAND_S = 1.5
+STAND_S = 1.26
 MIRRORED = ("ArmUpper", "Pelv", "PelvY", "Foot")  # roll/yaw joints: opposite sign on the right
 
 
