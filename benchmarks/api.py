@@ -25,6 +25,7 @@ import os
 import socket
 import sys
 import time
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from contracts.ids import TeamColor
@@ -250,14 +251,38 @@ def _sensor_noise_cost(
     }
 
 
+def _client_targets(world: Any, robots: list[RobotId]) -> Callable[[], None]:
+    """The bench clients' joint targets, written into a reference world one step at a time
+    (one clamped write for all robots, as the API's batch does): the reference moves its joints
+    as the API run's robots do, so the physics of both costs the same (on the soft grass a
+    robot moving its joints costs the solver more than a robot holding still) and the ratio is
+    the server's own cost."""
+    import numpy as np
+
+    plans = [world.motor_targets_plan(r, MOTORS) for r in robots]
+    writer = world.motor_targets_writer(np.concatenate(plans))
+    one = [[0.05 * math.sin(k * 0.008 + i) for i in range(len(MOTORS))]
+           for k in range(CYCLE_STEPS)]
+    cycle = np.tile(np.asarray(one), (1, len(robots)))
+    step = [0]
+
+    def move() -> None:
+        writer(cycle[step[0] % CYCLE_STEPS], finite=True)
+        step[0] += 1
+
+    return move
+
+
 def _world_only(
     robots: list[RobotId], physics_dt: float, sim_seconds: float, sensors: str = "league"
 ) -> tuple[float, float]:
     """(real-time factor, CPU seconds per simulated second) of World.step + snapshot."""
     world = _world(robots, physics_dt, sensors)
+    move = _client_targets(world, robots)
     steps = int(sim_seconds * 1000 / world.step_ms)
     started, started_cpu = time.perf_counter(), time.thread_time()
     for _ in range(steps):
+        move()
         world.step()
         world.snapshot()
     simulated = steps * world.step_ms / 1000.0
@@ -406,6 +431,7 @@ def _api_run(
         # (World.step + snapshot, as bench sim) alternate with chunks of the API run, so that
         # the machine's load falls on both alike: ``ratio_interleaved``
         reference = _world(robots, args.physics_dt, args.sensors) if camera is None else None
+        move_reference = _client_targets(reference, robots) if reference is not None else None
         chunk = max(1, INTERLEAVE_MS // world.step_ms)
         wall = cpu = ref_wall = ref_cpu = 0.0
         done = 0
@@ -417,9 +443,10 @@ def _api_run(
             wall += time.perf_counter() - started
             cpu += time.thread_time() - started_cpu
             done += count
-            if reference is not None:
+            if reference is not None and move_reference is not None:
                 started, started_cpu = time.perf_counter(), time.thread_time()
                 for _ in range(count):
+                    move_reference()
                     reference.step()
                     reference.snapshot()
                 ref_wall += time.perf_counter() - started
