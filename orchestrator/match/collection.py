@@ -1,5 +1,11 @@
 """STOPPING and COLLECTING: grace period, logs, public files, teardown, results, report.
 
+:func:`collect` takes the match's dependencies, its lifecycle (moved on from wherever the match
+got to), the ledger of what was created (:class:`~orchestrator.match.startup.Created`) and how
+the game went (:class:`Played`), and returns the :class:`~contracts.match_results.MatchResults`
+it wrote. It changes none of what it is given but the lifecycle: what it learns about the
+robots, a failure of its own and the logs it had to cut are in the results and ``report.json``.
+
 Every teardown step runs even when an earlier one failed; a teardown failure makes the match an
 ``infrastructure`` failure only when nothing else failed first. ``report.json`` is written last.
 """
@@ -9,40 +15,63 @@ from __future__ import annotations
 import importlib.metadata
 import logging
 import shutil
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from functools import partial
 from pathlib import Path
 
 from contracts import files
 from contracts.errors import ContractError
-from contracts.match_results import MatchLimits, MatchResults
+from contracts.match_results import Forfeit, MatchLimits, MatchResults
 from contracts.match_spec import MatchSpec, TimingSpec
 from contracts.sim_result import SimResult
 from orchestrator.errors import OrchestratorError
 from orchestrator.match import layout
-from orchestrator.match.context import MatchContext
+from orchestrator.match.deps import MatchDeps
 from orchestrator.match.logfs import LogFolder
 from orchestrator.match.results import (
+    Failure,
     FailureClass,
+    RobotRecord,
     build_results,
     play_failure,
     write_report,
     write_results,
 )
+from orchestrator.match.runtime import ContainerRuntime
 from orchestrator.match.safecopy import restrict
-from orchestrator.match.state import MatchState
+from orchestrator.match.startup import Created
+from orchestrator.match.state import Lifecycle, MatchState
 
 log = logging.getLogger(__name__)
 
 PUBLIC_FILES = files.PUBLIC_FILES
 
 
-def read_sim_result(match: MatchContext) -> SimResult | None:
-    """The simulator's ``sim_result.json``; None when it is missing or does not fit the contract
-    (logged with the file, field and reason)."""
-    match_dir = match.started.match_dir
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Played:
+    """How the match went until it stopped (or before it could start): what collection
+    starts from."""
+
+    robots: Mapping[str, RobotRecord]  # robot key -> its image, its start, its exit in the game
+    failure: Failure | None  # the match's failure so far (announced), None: none yet
+    forfeit: Forfeit | None  # a team without a usable image (the match was not played)
+    bringup_s: float | None  # start of STARTING -> every robot connected (from telemetry)
+
+
+def collect(deps: MatchDeps, lifecycle: Lifecycle, created: Created, played: Played
+            ) -> MatchResults:
+    """Stop, collect, remove everything in ``created``, write ``results.json`` and, last,
+    ``report.json``; returns the results (their ``failure`` is the match's: ``played``'s, else
+    the first one collection met). ``lifecycle`` ends in DONE or FAILED. The teardown and the
+    match record happen whatever breaks before them."""
+    return _Collection(deps, lifecycle, created, played).run()
+
+
+def read_sim_result(match_dir: Path | None, *, match_id: str) -> SimResult | None:
+    """The simulator's ``sim_result.json`` in ``match_dir``; None when it is missing or does
+    not fit the contract (logged with the file, field and reason)."""
     if match_dir is None:
         return None
     path = match_dir / files.OUT_DIR / files.SIM_RESULT
@@ -51,201 +80,266 @@ def read_sim_result(match: MatchContext) -> SimResult | None:
     try:
         return SimResult.load(path)
     except ContractError as exc:
-        log.error("match %s: %s", match.plan.match_id, exc)
+        log.error("match %s: %s", match_id, exc)
         return None
 
 
-def simulator_stderr_tail(match: MatchContext) -> str:
-    sim_id = match.started.simulator_id
-    match_dir = match.started.match_dir
-    if sim_id is None or match_dir is None:
+def simulator_stderr_tail(runtime: ContainerRuntime, simulator_id: str | None,
+                          match_dir: Path | None) -> str:
+    """The last line of the simulator's stderr (its console saved into ``match_dir``)."""
+    if simulator_id is None or match_dir is None:
         return ""
     try:
-        match.runtime.save_logs(sim_id, stdout=match_dir / "stdout.log",
-                                 stderr=match_dir / "stderr.log")
+        runtime.save_logs(simulator_id, stdout=match_dir / "stdout.log",
+                          stderr=match_dir / "stderr.log")
         lines = (match_dir / "stderr.log").read_text(errors="replace").strip().splitlines()
     except (OrchestratorError, OSError):
         return ""
     return lines[-1][:300] if lines else ""
 
 
-def _guarded(match: MatchContext, what: str, step: Callable[[], object]) -> None:
-    """Run one step of stopping, collecting or teardown; a failure fails the match (the first
-    one counts) and the next steps still run."""
-    try:
-        step()
-    except (OrchestratorError, OSError) as exc:
-        log.error("match %s: %s failed: %s", match.plan.match_id, what, exc)
-        match.fail(FailureClass.INFRASTRUCTURE, f"{what}: {exc}")
-    except Exception as exc:  # noqa: BLE001 - the steps after this one must still run
-        log.exception("match %s: %s failed", match.plan.match_id, what)
-        match.fail(FailureClass.INFRASTRUCTURE, f"{what}: {type(exc).__name__}: {exc}")
+class _Collection:
+    """One run of :func:`collect`: its own copies of the robots' records, the failure and the
+    logs cut, which end up in the results and the report."""
 
+    def __init__(self, deps: MatchDeps, lifecycle: Lifecycle, created: Created,
+                 played: Played) -> None:
+        self.deps = deps
+        self.lifecycle = lifecycle
+        self.created = created
+        self.played = played
+        self.records = {key: replace(r, limits=dict(r.limits))
+                        for key, r in played.robots.items()}
+        self.failure = played.failure
+        # the teams' logs cut or lost in collection: {"robot", "what", "reason"} (report.json)
+        self.logs_cut: list[dict[str, str]] = []
 
-def _stop_robots(match: MatchContext) -> None:
-    grace = match.plan.grace_period_s
-    ids = match.started.robot_ids
-
-    def stop(item: tuple[str, str]) -> None:
-        key, container_id = item
-        _guarded(match, f"stopping robot {key}",
-                 lambda: match.runtime.stop(container_id, timeout_s=grace))
-
-    if ids:
-        log.info("match %s: stopping %d robots (grace %.0f s)", match.plan.match_id, len(ids),
-                 grace)
-        with ThreadPoolExecutor(max_workers=min(8, len(ids))) as pool:
-            list(pool.map(stop, ids.items()))
-
-
-def _read_counters(match: MatchContext) -> None:
-    for key, applied in match.started.shaping.items():
-        record = match.records[key]
+    def run(self) -> MatchResults:
+        match_id = self.deps.plan.match_id
         try:
-            counters = match.host.counters(applied)
-        except OrchestratorError as exc:
-            log.warning("match %s: no traffic counters for %s: %s", match.plan.match_id, key, exc)
-            continue
-        record.sent_bytes = counters.sent_bytes
-        record.received_bytes = counters.received_bytes
+            self._stop_and_collect()
+        except Exception as exc:  # noqa: BLE001 - the record is written and everything removed
+            log.exception("match %s: collection failed", match_id)
+            self._fail(f"collection failed: {type(exc).__name__}: {exc}")
+        try:
+            self._teardown()
+        except Exception as exc:  # noqa: BLE001
+            log.exception("match %s: teardown failed", match_id)
+            self._fail(f"teardown failed: {type(exc).__name__}: {exc}")
+        return self._write()
 
+    def _fail(self, cause: str) -> None:
+        self.failure = self.deps.fail(self.failure, FailureClass.INFRASTRUCTURE, cause)
 
-def _team_guarded(match: MatchContext, key: str, what: str, step: Callable[[], object]) -> None:
-    """A step that touches what a robot made: an engine failure fails the match (as
-    :func:`_guarded`), anything else costs only this robot's logs, named in report.json."""
-    try:
-        step()
-    except (OrchestratorError, OSError) as exc:
-        log.error("match %s: %s failed: %s", match.plan.match_id, what, exc)
-        match.fail(FailureClass.INFRASTRUCTURE, f"{what}: {exc}")
-    except Exception as exc:  # noqa: BLE001 - a robot's output never breaks the match record
-        log.exception("match %s: %s failed", match.plan.match_id, what)
-        match.logs_cut.append({"robot": key, "what": what,
-                               "reason": f"{type(exc).__name__}: {exc}"})
+    def _guarded(self, what: str, step: Callable[[], object]) -> None:
+        """Run one step of stopping, collecting or teardown; a failure fails the match (the
+        first one counts) and the next steps still run."""
+        try:
+            step()
+        except (OrchestratorError, OSError) as exc:
+            log.error("match %s: %s failed: %s", self.deps.plan.match_id, what, exc)
+            self._fail(f"{what}: {exc}")
+        except Exception as exc:  # noqa: BLE001 - the steps after this one must still run
+            log.exception("match %s: %s failed", self.deps.plan.match_id, what)
+            self._fail(f"{what}: {type(exc).__name__}: {exc}")
 
+    def _team_guarded(self, key: str, what: str, step: Callable[[], object]) -> None:
+        """A step that touches what a robot made: an engine failure fails the match (as
+        :meth:`_guarded`), anything else costs only this robot's logs, named in report.json."""
+        try:
+            step()
+        except (OrchestratorError, OSError) as exc:
+            log.error("match %s: %s failed: %s", self.deps.plan.match_id, what, exc)
+            self._fail(f"{what}: {exc}")
+        except Exception as exc:  # noqa: BLE001 - a robot's output never breaks the match record
+            log.exception("match %s: %s failed", self.deps.plan.match_id, what)
+            self.logs_cut.append({"robot": key, "what": what,
+                                  "reason": f"{type(exc).__name__}: {exc}"})
 
-def _collect_robot(match: MatchContext, key: str, container_id: str) -> None:
-    record = match.records[key]
-    folder = match.options.out_dir / "teams" / record.color / str(record.number)
-    state = match.runtime.inspect(container_id)
-    record.exit_code = state.exit_code
-    record.oom_killed = record.oom_killed or state.oom_killed
-    record.restarts = state.restart_count
-    peaks = match.monitor.peaks(key)
-    record.cpu_peak_percent = peaks.cpu_percent
-    record.memory_peak_bytes = peaks.memory_bytes
-    cap = layout.ROBOT_CONSOLE_BYTES // 2  # per stream (the engine keeps less of a flood)
-    cut = match.runtime.save_logs(container_id, stdout=folder / "stdout.log",
-                                   stderr=folder / "stderr.log", max_bytes=cap)
-    for stream in cut:
-        match.logs_cut.append({"robot": key, "what": f"{stream}.log",
-                               "reason": f"cut at the limit of {cap} bytes"})
+    # STOPPING and COLLECTING --------------------------------------------------------------
+    def _stop_and_collect(self) -> None:
+        deps, created, lifecycle = self.deps, self.created, self.lifecycle
+        if lifecycle.state in (MatchState.PULLING, MatchState.STARTING, MatchState.WAITING,
+                               MatchState.PLAYING):
+            lifecycle.advance(MatchState.STOPPING)
+        if lifecycle.state is MatchState.STOPPING:
+            self._stop_robots()
+            self._read_counters()
+            if created.simulator_id is not None:
+                self._guarded("stopping the simulator", partial(
+                    deps.runtime.stop, created.simulator_id,
+                    timeout_s=deps.options.simulator_stop_s))
+            for key, holder_id in created.holder_ids.items():
+                self._guarded(f"stopping the network holder of {key}",
+                              partial(deps.runtime.kill, holder_id))
+            lifecycle.advance(MatchState.COLLECTING)
+        deps.monitor.join(timeout_s=1.0)
+        for key, container_id in created.robot_ids.items():
+            self._team_guarded(key, f"collecting logs of {key}",
+                               partial(self._collect_robot, key, container_id))
+        if created.simulator_id is not None and created.match_dir is not None:
+            sim_id, match_dir = created.simulator_id, created.match_dir
+            self._guarded("collecting simulator logs", lambda: deps.runtime.save_logs(
+                sim_id, stdout=match_dir / "stdout.log", stderr=match_dir / "stderr.log"))
+        self._guarded("copying public files", self._copy_public)
 
+    def _stop_robots(self) -> None:
+        deps = self.deps
+        grace = deps.plan.grace_period_s
+        ids = self.created.robot_ids
 
-def _copy_public(match: MatchContext) -> None:
-    match_dir = match.started.match_dir
-    public = match.options.out_dir / "public"
-    public.mkdir(parents=True, exist_ok=True)
-    if match_dir is None:
-        return
-    for name in PUBLIC_FILES:
-        source = match_dir / files.OUT_DIR / name
-        if source.is_file():
-            shutil.copy2(source, public / name)
+        def stop(item: tuple[str, str]) -> None:
+            key, container_id = item
+            self._guarded(f"stopping robot {key}",
+                          lambda: deps.runtime.stop(container_id, timeout_s=grace))
 
+        if ids:
+            log.info("match %s: stopping %d robots (grace %.0f s)", deps.plan.match_id,
+                     len(ids), grace)
+            with ThreadPoolExecutor(max_workers=min(8, len(ids))) as pool:
+                list(pool.map(stop, ids.items()))
 
-def _collect_log_folder(match: MatchContext, key: str, folder: LogFolder,
-                        destination: Path) -> None:
-    """What a team wrote never fails the match: only releasing the mount can raise."""
-    limit = int(match.plan.limits.log_folder_gb * 1e9)
-    report = match.host.collect_logs(folder, destination, limit_bytes=limit)
-    match.records[key].log_folder = report.record()
-    if report.stopped:
-        match.logs_cut.append({"robot": key, "what": "robocup-logs", "reason": report.stopped})
-    if report.skipped_count:
-        log.warning("match %s: %s: %d entries of /robocup-logs not collected (%s)",
-                    match.plan.match_id, key, report.skipped_count,
-                    ", ".join(f"{s['path']}: {s['kind']}" for s in report.skipped[:5]))
+    def _read_counters(self) -> None:
+        for key, applied in self.created.shaping.items():
+            record = self.records[key]
+            try:
+                counters = self.deps.host.counters(applied)
+            except OrchestratorError as exc:
+                log.warning("match %s: no traffic counters for %s: %s", self.deps.plan.match_id,
+                            key, exc)
+                continue
+            record.sent_bytes = counters.sent_bytes
+            record.received_bytes = counters.received_bytes
 
+    def _collect_robot(self, key: str, container_id: str) -> None:
+        deps = self.deps
+        record = self.records[key]
+        folder = deps.options.out_dir / "teams" / record.color / str(record.number)
+        state = deps.runtime.inspect(container_id)
+        record.exit_code = state.exit_code
+        record.oom_killed = record.oom_killed or state.oom_killed
+        record.restarts = state.restart_count
+        peaks = deps.monitor.peaks(key)
+        record.cpu_peak_percent = peaks.cpu_percent
+        record.memory_peak_bytes = peaks.memory_bytes
+        cap = layout.ROBOT_CONSOLE_BYTES // 2  # per stream (the engine keeps less of a flood)
+        cut = deps.runtime.save_logs(container_id, stdout=folder / "stdout.log",
+                                     stderr=folder / "stderr.log", max_bytes=cap)
+        for stream in cut:
+            self.logs_cut.append({"robot": key, "what": f"{stream}.log",
+                                  "reason": f"cut at the limit of {cap} bytes"})
 
-def _teardown(match: MatchContext) -> None:
-    started = match.started
-    runtime = match.runtime
-    for key, container_id in list(started.robot_ids.items()) + list(started.holder_ids.items()):
-        _guarded(match, f"removing container of {key}", partial(runtime.remove, container_id))
-    if started.simulator_id is not None:
-        sim_id = started.simulator_id
-        _guarded(match, "removing the simulator", lambda: runtime.remove(sim_id))
-    for key, folder in started.log_folders.items():
-        record = match.records[key]
-        target = match.options.out_dir / "teams" / record.color / str(record.number)
-        _team_guarded(match, key, f"releasing /robocup-logs of {key}",
-                      partial(_collect_log_folder, match, key, folder, target / "robocup-logs"))
-    for key, scratch in started.scratch.items():
-        _guarded(match, f"releasing the scratch space of {key}",
-                 partial(match.host.release, scratch))
-    for applied in started.node_shaping:  # league placement: the nodes outlive the match
-        _guarded(match, f"removing the bandwidth limits of {applied.netns}",
-                 partial(match.host.unshape, applied))
-    for netns in started.node_firewalls:
-        _guarded(match, f"removing the robot node firewall of {netns}",
-                 partial(match.host.remove_node_firewall, netns))
-    for network in started.networks.values():
-        _guarded(match, f"removing network {network.name}",
-                 partial(runtime.remove_network, network.name))
-    _guarded(match, "removing host firewall rules",
-             lambda: match.host.remove_isolation(match_id=match.plan.match_id))
+    def _copy_public(self) -> None:
+        match_dir = self.created.match_dir
+        public = self.deps.options.out_dir / "public"
+        public.mkdir(parents=True, exist_ok=True)
+        if match_dir is None:
+            return
+        for name in PUBLIC_FILES:
+            source = match_dir / files.OUT_DIR / name
+            if source.is_file():
+                shutil.copy2(source, public / name)
 
+    # teardown -----------------------------------------------------------------------------
+    def _teardown(self) -> None:
+        deps, created = self.deps, self.created
+        runtime, host = deps.runtime, deps.host
+        for key, container_id in (list(created.robot_ids.items())
+                                  + list(created.holder_ids.items())):
+            self._guarded(f"removing container of {key}", partial(runtime.remove, container_id))
+        if created.simulator_id is not None:
+            sim_id = created.simulator_id
+            self._guarded("removing the simulator", lambda: runtime.remove(sim_id))
+        for key, folder in created.log_folders.items():
+            record = self.records[key]
+            target = deps.options.out_dir / "teams" / record.color / str(record.number)
+            self._team_guarded(key, f"releasing /robocup-logs of {key}", partial(
+                self._collect_log_folder, key, folder, target / "robocup-logs"))
+        for key, scratch in created.scratch.items():
+            self._guarded(f"releasing the scratch space of {key}", partial(host.release, scratch))
+        for applied in created.node_shaping:  # league placement: the nodes outlive the match
+            self._guarded(f"removing the bandwidth limits of {applied.netns}",
+                          partial(host.unshape, applied))
+        for netns in created.node_firewalls:
+            self._guarded(f"removing the robot node firewall of {netns}",
+                          partial(host.remove_node_firewall, netns))
+        for network in created.networks.values():
+            self._guarded(f"removing network {network.name}",
+                          partial(runtime.remove_network, network.name))
+        self._guarded("removing host firewall rules",
+                      lambda: host.remove_isolation(match_id=deps.plan.match_id))
 
-def _finish(match: MatchContext) -> MatchResults:
-    """Run STOPPING and COLLECTING from wherever the match got to; returns the results. The
-    teardown and the match record (results.json, report.json) happen whatever breaks before."""
-    try:
-        _stop_and_collect(match)
-    except Exception as exc:  # noqa: BLE001 - the record is written and everything removed
-        log.exception("match %s: collection failed", match.plan.match_id)
-        match.fail(FailureClass.INFRASTRUCTURE, f"collection failed: {type(exc).__name__}: {exc}")
-    try:
-        _teardown(match)
-    except Exception as exc:  # noqa: BLE001
-        log.exception("match %s: teardown failed", match.plan.match_id)
-        match.fail(FailureClass.INFRASTRUCTURE, f"teardown failed: {type(exc).__name__}: {exc}")
-    return _write(match)
+    def _collect_log_folder(self, key: str, folder: LogFolder, destination: Path) -> None:
+        """What a team wrote never fails the match: only releasing the mount can raise."""
+        deps = self.deps
+        limit = int(deps.plan.limits.log_folder_gb * 1e9)
+        report = deps.host.collect_logs(folder, destination, limit_bytes=limit)
+        self.records[key].log_folder = report.record()
+        if report.stopped:
+            self.logs_cut.append({"robot": key, "what": "robocup-logs",
+                                  "reason": report.stopped})
+        if report.skipped_count:
+            log.warning("match %s: %s: %d entries of /robocup-logs not collected (%s)",
+                        deps.plan.match_id, key, report.skipped_count,
+                        ", ".join(f"{s['path']}: {s['kind']}" for s in report.skipped[:5]))
 
+    # the match record ---------------------------------------------------------------------
+    def _write(self) -> MatchResults:
+        deps, lifecycle = self.deps, self.lifecycle
+        out: Path = deps.options.out_dir
+        plan = deps.plan
+        limits = plan.limits
+        sim_result = read_sim_result(self.created.match_dir, match_id=plan.match_id)
+        robots = list(self.records.values())
+        if self.failure is None and self.played.forfeit is None:
+            not_played = play_failure(sim_result, robots, self._spec_timing())
+            if not_played is not None:
+                self.failure = deps.fail(None, not_played.failure_class, not_played.cause,
+                                         team=not_played.team)
+        results = build_results(
+            match_id=plan.match_id,
+            seed=plan.seed,
+            sim_result=sim_result,
+            robots=robots,
+            forfeit=self.played.forfeit,
+            limits=MatchLimits(
+                cpus=limits.cpus, memory_gb=limits.memory_gb, pids=limits.pids,
+                log_folder_gb=limits.log_folder_gb, team_api_mb_s=limits.team_api_mb_s,
+                team_comm_mb_s=limits.team_comm_mb_s, grace_period_s=plan.grace_period_s,
+                allow_internet=plan.allow_internet, host_controls=self._host_controls(),
+            ),
+            versions={"hlvs-runner": _version(), **plan.versions},
+            timings_s=dict(lifecycle.timings_s),
+            failure=self.failure,
+            bringup_s=self.played.bringup_s,
+            admission=plan.admission,
+        )
+        write_results(out, results)
+        if lifecycle.state is MatchState.COLLECTING:
+            lifecycle.advance(MatchState.FAILED if self.failure else MatchState.DONE)
+        elif lifecycle.state is MatchState.PENDING:
+            lifecycle.advance(MatchState.FAILED)
+        results = replace(results, timings_s=dict(lifecycle.timings_s))
+        write_results(out, results)
+        restrict(out)  # the teams' logs are theirs: owner-only, as everything else here
+        write_report(out, self.failure, tuple(self.logs_cut))
+        log.info("match %s: %s, results in %s", plan.match_id,
+                 "failed" if self.failure else "done", out)
+        return results
 
-def _stop_and_collect(match: MatchContext) -> None:
-    lifecycle = match.lifecycle
-    if lifecycle.state in (MatchState.PULLING, MatchState.STARTING, MatchState.WAITING,
-                           MatchState.PLAYING):
-        match.advance(MatchState.STOPPING)
-    started = match.started
-    if lifecycle.state is MatchState.STOPPING:
-        _stop_robots(match)
-        _read_counters(match)
-        if started.simulator_id is not None:
-            _guarded(match, "stopping the simulator", partial(
-                match.runtime.stop, started.simulator_id,
-                timeout_s=match.options.simulator_stop_s))
-        for key, holder_id in started.holder_ids.items():
-            _guarded(match, f"stopping the network holder of {key}",
-                     partial(match.runtime.kill, holder_id))
-        match.advance(MatchState.COLLECTING)
-    if match.telemetry is not None:
-        match.telemetry.close()
-    match.monitor.join(timeout_s=1.0)
-    for key, container_id in started.robot_ids.items():
-        _team_guarded(match, key, f"collecting logs of {key}",
-                      partial(_collect_robot, match, key, container_id))
-    if started.simulator_id is not None and started.match_dir is not None:
-        sim_id, match_dir = started.simulator_id, started.match_dir
-        _guarded(match, "collecting simulator logs", lambda: match.runtime.save_logs(
-            sim_id, stdout=match_dir / "stdout.log", stderr=match_dir / "stderr.log"))
-    _guarded(match, "copying public files", lambda: _copy_public(match))
+    def _host_controls(self) -> dict[str, bool] | None:
+        describe = getattr(self.deps.host, "describe", None)
+        return describe() if callable(describe) else None
 
-
-def _host_controls(match: MatchContext) -> dict[str, bool] | None:
-    describe = getattr(match.host, "describe", None)
-    return describe() if callable(describe) else None
+    def _spec_timing(self) -> TimingSpec | None:
+        match_dir = self.created.match_dir
+        if match_dir is None or not (match_dir / files.MATCH_SPEC).is_file():
+            return None
+        try:
+            return MatchSpec.load(match_dir / files.MATCH_SPEC).timing
+        except ContractError as exc:
+            log.warning("match %s: %s", self.deps.plan.match_id, exc)
+            return None
 
 
 def _version() -> str:
@@ -255,70 +349,4 @@ def _version() -> str:
         return "unknown"
 
 
-def _spec_timing(match: MatchContext) -> TimingSpec | None:
-    match_dir = match.started.match_dir
-    if match_dir is None or not (match_dir / files.MATCH_SPEC).is_file():
-        return None
-    try:
-        return MatchSpec.load(match_dir / files.MATCH_SPEC).timing
-    except ContractError as exc:
-        log.warning("match %s: %s", match.plan.match_id, exc)
-        return None
-
-
-def _write(match: MatchContext) -> MatchResults:
-    out: Path = match.options.out_dir
-    plan = match.plan
-    limits = plan.limits
-    sim_result = read_sim_result(match)
-    if match.failure is None and match.forfeit is None:
-        not_played = play_failure(sim_result, list(match.records.values()), _spec_timing(match))
-        if not_played is not None:
-            match.fail(not_played.failure_class, not_played.cause, team=not_played.team)
-    results = build_results(
-        match_id=plan.match_id,
-        seed=plan.seed,
-        sim_result=sim_result,
-        robots=list(match.records.values()),
-        forfeit=match.forfeit,
-        limits=MatchLimits(
-            cpus=limits.cpus, memory_gb=limits.memory_gb, pids=limits.pids,
-            log_folder_gb=limits.log_folder_gb, team_api_mb_s=limits.team_api_mb_s,
-            team_comm_mb_s=limits.team_comm_mb_s, grace_period_s=plan.grace_period_s,
-            allow_internet=plan.allow_internet, host_controls=_host_controls(match),
-        ),
-        versions={"hlvs-runner": _version(), **plan.versions},
-        timings_s=dict(match.lifecycle.timings_s),
-        failure=match.failure,
-        bringup_s=match.bringup_s,
-        admission=plan.admission,
-    )
-    write_results(out, results)
-    lifecycle = match.lifecycle
-    if lifecycle.state is MatchState.COLLECTING:
-        match.advance(MatchState.FAILED if match.failure else MatchState.DONE)
-    elif lifecycle.state is MatchState.PENDING:
-        match.advance(MatchState.FAILED)
-    results = replace(results, timings_s=dict(lifecycle.timings_s))
-    write_results(out, results)
-    restrict(out)  # the teams' logs are theirs: owner-only, as everything else here
-    write_report(out, match.failure, tuple(match.logs_cut))
-    log.info("match %s: %s, results in %s", plan.match_id,
-             "failed" if match.failure else "done", out)
-    return results
-
-
-class CollectionPhase:
-    """STOPPING and COLLECTING from wherever the match got to; returns the results."""
-
-    def __init__(self, match: MatchContext) -> None:
-        self.match = match
-
-
-    def run(self) -> MatchResults:
-        """Stop, collect, remove everything created, write ``results.json`` and, last,
-        ``report.json``; returns the results."""
-        return _finish(self.match)
-
-
-__all__ = ["PUBLIC_FILES", "CollectionPhase", "read_sim_result", "simulator_stderr_tail"]
+__all__ = ["PUBLIC_FILES", "Played", "collect", "read_sim_result", "simulator_stderr_tail"]

@@ -1,8 +1,9 @@
 """The progress of one match as a stream of typed events.
 
-A match (:class:`orchestrator.match.context.MatchContext`) publishes each step as it happens;
-an observer (the service's pre-flight, a console) subscribes before the match runs and reads
-its own queue, instead of polling the match's fields from another thread.
+A match (:class:`orchestrator.match.runner.MatchRunner` and its phases, through
+:attr:`orchestrator.match.deps.MatchDeps.events`) publishes each step as it happens; an
+observer (the service's pre-flight, a console) subscribes before the match runs and reads its
+own queue, instead of polling the match's fields from another thread.
 """
 
 from __future__ import annotations

@@ -1,10 +1,18 @@
 """Runs one match from a :class:`MatchPlan` to a complete output folder.
 
 Phases (see :mod:`orchestrator.match.state`): images are resolved (PULLING); networks, the
-simulator and the robots are started (STARTING); the runner waits for the game to leave INITIAL
-(WAITING) and watches the simulator, its telemetry and the robots (PLAYING) until the simulator
-exits; robots get their grace period (STOPPING); logs and results are collected and every object
-removed (COLLECTING). ``report.json`` is written last, whatever happened.
+simulator and the robots are started (STARTING, :func:`~orchestrator.match.startup.start`); the
+runner waits for the game to leave INITIAL (WAITING) and watches the simulator, its telemetry and
+the robots (PLAYING) until the simulator exits; robots get their grace period (STOPPING); logs
+and results are collected and every object removed (COLLECTING,
+:func:`~orchestrator.match.collection.collect`). ``report.json`` is written last, whatever
+happened.
+
+The runner owns one match's state: the lifecycle, the ledger of what was created
+(:class:`~orchestrator.match.startup.Created`), the robots' records and how the game went so far.
+The phases get what they need as arguments (the read-only
+:class:`~orchestrator.match.deps.MatchDeps` first) and return what they produce; observers
+follow :attr:`MatchRunner.events`.
 
 Bandwidth limits are in place before a robot can send anything: each robot's network namespace
 belongs to a holder container that is started and shaped first; the robot container is then
@@ -22,16 +30,24 @@ from pathlib import Path
 
 from contracts import files
 from contracts.match_results import Color, Forfeit, MatchResults
+from contracts.telemetry import StateMessage
 from orchestrator.errors import OrchestratorError
-from orchestrator.match.collection import CollectionPhase, read_sim_result, simulator_stderr_tail
-from orchestrator.match.context import MatchContext, RunOptions, TelemetryFactory
-from orchestrator.match.events import AllConnected, MatchEnded, RobotExited
+from orchestrator.match.collection import Played, collect, read_sim_result, simulator_stderr_tail
+from orchestrator.match.deps import MatchDeps, RunOptions, TelemetryFactory
+from orchestrator.match.events import (
+    AllConnected,
+    EventStream,
+    MatchEnded,
+    RobotExited,
+    StateChanged,
+)
 from orchestrator.match.host import Host
+from orchestrator.match.monitor import StatsMonitor
 from orchestrator.match.plan import MatchPlan
-from orchestrator.match.results import Failure, FailureClass
+from orchestrator.match.results import Failure, FailureClass, RobotRecord
 from orchestrator.match.runtime import ContainerRuntime
-from orchestrator.match.startup import StartupPhase
-from orchestrator.match.state import MatchState
+from orchestrator.match.startup import Created, StartedMatch, StartupTimes, start
+from orchestrator.match.state import Lifecycle, MatchState
 
 log = logging.getLogger(__name__)
 
@@ -50,6 +66,7 @@ class MatchOutcome:
     out_dir: Path
     results: MatchResults | None  # None: a match played elsewhere left no results.json
     bringup_s: float | None  # start of STARTING -> every robot connected (from telemetry)
+    startup: StartupTimes | None = None  # STARTING's breakdown (None: it did not finish)
 
     @property
     def ok(self) -> bool:
@@ -72,8 +89,25 @@ def local_images(runtime: ContainerRuntime) -> ImageResolver:
     return resolve
 
 
-class MatchRunner(MatchContext):
-    """Runs the phases of one match in order on its :class:`MatchContext`."""
+@dataclass(slots=True)
+class _Game:
+    """How the match has gone so far: the runner's own record, handed to collection as
+    :class:`~orchestrator.match.collection.Played`. The robots' records are filled in as the
+    match runs (images, then starts, then exits during the game)."""
+
+    robots: dict[str, RobotRecord]
+    failure: Failure | None = None  # the first failure (announced when recorded)
+    forfeit: Forfeit | None = None
+    bringup_s: float | None = None
+    startup: StartupTimes | None = None  # STARTING's breakdown, once it is done
+
+    def played(self) -> Played:
+        return Played(robots=self.robots, failure=self.failure, forfeit=self.forfeit,
+                      bringup_s=self.bringup_s)
+
+
+class MatchRunner:
+    """Runs the phases of one match in order; see the module docstring."""
 
     def __init__(
         self,
@@ -87,134 +121,168 @@ class MatchRunner(MatchContext):
         stop_event: threading.Event | None = None,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
-        super().__init__(
-            plan, runtime=runtime, host=host, options=options, telemetry=telemetry,
-            stop_event=stop_event, clock=clock,
-        )  # fmt: skip
-        self.images = images or local_images(runtime)
+        self.events = EventStream()  # the match's progress, for observers in other threads
+        self.stop_event = stop_event or threading.Event()  # set: the match stops (interrupted)
+        self.deps = MatchDeps(
+            plan=plan, runtime=runtime, host=host, options=options, clock=clock,
+            events=self.events, monitor=StatsMonitor(runtime), telemetry=telemetry,
+        )
+        self._images = images or local_images(runtime)
 
     # public -------------------------------------------------------------------------------
     def run(self) -> MatchOutcome:
         """Play the match; :attr:`events` tells observers how it goes, ending with
         :class:`~orchestrator.match.events.MatchEnded`."""
+        plan = self.deps.plan
+        lifecycle = Lifecycle(plan.match_id, clock=self.deps.clock)
+        lifecycle.observers.append(self._entered)
+        game = _Game(robots={
+            r.key: RobotRecord(key=r.key, color=r.color, number=r.number, image=r.image)
+            for r in plan.robots
+        })
         try:
-            return self._run()
+            return self._run(lifecycle, Created(), game)
         finally:
-            self.events.publish(MatchEnded(failure=self.failure))
+            self.events.publish(MatchEnded(failure=game.failure))
 
-    def _run(self) -> MatchOutcome:
-        out = self.options.out_dir
+    # phases run by run() -----------------------------------------------------------------
+    def _run(self, lifecycle: Lifecycle, created: Created, game: _Game) -> MatchOutcome:
+        deps = self.deps
+        out = deps.options.out_dir
         out.mkdir(parents=True, exist_ok=True)
         out.chmod(0o700)  # the teams' logs are theirs: owner-only (see collection)
         (out / files.REPORT).unlink(missing_ok=True)  # a stale one would say "complete"
         try:
-            self.advance(MatchState.PULLING)
-            self._resolve_images()
-            if self.failure is None and self.forfeit is None:
-                self.advance(MatchState.STARTING)
-                started_at = self.clock()
-                StartupPhase(self).run(started_at)
-                if self.failure is None:
-                    self.advance(MatchState.WAITING)
-                    self._watch(started_at)
+            lifecycle.advance(MatchState.PULLING)
+            self._resolve_images(game)
+            if game.failure is None and game.forfeit is None:
+                lifecycle.advance(MatchState.STARTING)
+                started_at = deps.clock()
+                started = start(deps, created, game.robots, started_at)
+                try:
+                    game.failure, game.startup = started.failure, started.times
+                    if game.failure is None:
+                        lifecycle.advance(MatchState.WAITING)
+                        self._watch(lifecycle, started, game, started_at)
+                finally:
+                    if started.telemetry is not None:
+                        started.telemetry.close()
         except OrchestratorError as exc:
-            log.error("match %s: %s", self.plan.match_id, exc)
-            self.fail(FailureClass.INFRASTRUCTURE, str(exc))
+            log.error("match %s: %s", deps.plan.match_id, exc)
+            game.failure = deps.fail(game.failure, FailureClass.INFRASTRUCTURE, str(exc))
         except KeyboardInterrupt:
-            self.fail(FailureClass.INTERRUPTED, "interrupted")
+            game.failure = deps.fail(game.failure, FailureClass.INTERRUPTED, "interrupted")
         except Exception as exc:  # a bug: still stop and remove everything, then re-raise
-            self.fail(FailureClass.INFRASTRUCTURE, f"internal error: {exc!r}")
-            CollectionPhase(self).run()
+            game.failure = deps.fail(game.failure, FailureClass.INFRASTRUCTURE,
+                                     f"internal error: {exc!r}")
+            collect(deps, lifecycle, created, game.played())
             raise
-        results = CollectionPhase(self).run()
+        results = collect(deps, lifecycle, created, game.played())
+        game.failure = results.failure
         return MatchOutcome(
-            match_id=self.plan.match_id, failure=self.failure, out_dir=out, results=results,
-            bringup_s=self.bringup_s,
+            match_id=deps.plan.match_id, failure=results.failure, out_dir=out, results=results,
+            bringup_s=game.bringup_s, startup=game.startup,
         )
 
-    # phases run by run() -----------------------------------------------------------------
-    def _resolve_images(self) -> None:
-        resolved = self.images(self.plan)
+    def _entered(self, state: MatchState) -> None:
+        """The lifecycle entered ``state``: observers and the console are told."""
+        self.events.publish(StateChanged(state=state))
+        self._progress(state, None)
+
+    def _progress(self, state: MatchState, latest: StateMessage | None) -> None:
+        if self.deps.options.progress is not None:
+            self.deps.options.progress(state.value, latest)
+
+    def _resolve_images(self, game: _Game) -> None:
+        """Each robot's image digest or error into its record; a team without any usable
+        image forfeits, both without: the match fails."""
+        plan = self.deps.plan
+        resolved = self._images(plan)
         usable: dict[str, int] = {"red": 0, "blue": 0}
         for key, (digest, error) in resolved.items():
-            record = self.records[key]
+            record = game.robots[key]
             record.digest = digest
             record.image_error = error
             if error is None:
                 usable[record.color] += 1
             else:
                 log.warning("match %s: robot %s has no usable image: %s",
-                            self.plan.match_id, key, error)
+                            plan.match_id, key, error)
         forfeiting: list[Color] = [c for c in ("red", "blue") if usable[c] == 0]
         first_error = {
-            color: next((f"{r.key}: {r.image_error}" for r in self.records.values()
+            color: next((f"{r.key}: {r.image_error}" for r in game.robots.values()
                          if r.color == color and r.image_error), "no players")
             for color in forfeiting
         }
         if len(forfeiting) == 2:
-            self.fail(FailureClass.IMAGE_PULL, "neither team has a usable image ("
-                       + "; ".join(first_error.values()) + ")")
+            game.failure = self.deps.fail(
+                game.failure, FailureClass.IMAGE_PULL,
+                "neither team has a usable image (" + "; ".join(first_error.values()) + ")")
         elif forfeiting:
             loser = forfeiting[0]
             winner: Color = "blue" if loser == "red" else "red"
-            self.forfeit = Forfeit(
+            game.forfeit = Forfeit(
                 team=loser,
                 winner=winner,
                 reason=f"no robot of {loser} has a usable image ({first_error[loser]})",
                 score={winner: 0, loser: 0},
             )
-            log.info("match %s: %s forfeits (no usable image)", self.plan.match_id, loser)
+            log.info("match %s: %s forfeits (no usable image)", plan.match_id, loser)
 
-    def _watch(self, started_at: float) -> None:
-        """Poll the simulator, its telemetry and the robots until the simulator exits."""
-        sim_id = self.started.simulator_id
-        assert sim_id is not None
+    def _watch(self, lifecycle: Lifecycle, started: StartedMatch, game: _Game,
+               started_at: float) -> None:
+        """Poll the simulator, its telemetry and the robots until the simulator exits; what
+        happens goes into ``game`` (the bring-up time, robots' exits, the failure)."""
+        deps = self.deps
+        plan, telemetry = deps.plan, started.telemetry
         last_robot_poll = 0.0
         while True:
             if self.stop_event.is_set():
-                self.fail(FailureClass.INTERRUPTED, "the orchestrator was asked to stop")
+                game.failure = deps.fail(game.failure, FailureClass.INTERRUPTED,
+                                         "the orchestrator was asked to stop")
                 return
-            state = self.runtime.inspect(sim_id)
+            state = deps.runtime.inspect(started.simulator_id)
             if state.exited:
-                self._on_simulator_exit(state.exit_code)
+                self._on_simulator_exit(state.exit_code, started, game)
                 return
-            now = self.clock()
+            now = deps.clock()
             if now - last_robot_poll >= 2.0:
-                self._poll_robots()
+                self._poll_robots(started, game)
                 last_robot_poll = now
-            latest = self.telemetry.latest() if self.telemetry else None
-            if self.lifecycle.state is MatchState.WAITING and (
-                self.telemetry is None
+            latest = telemetry.latest() if telemetry else None
+            if lifecycle.state is MatchState.WAITING and (
+                telemetry is None
                 or (latest is not None and latest.state not in (None, "INITIAL"))
             ):
-                self.advance(MatchState.PLAYING)
-            if self.bringup_s is None and latest is not None:
-                expected = {k for k in self.started.robot_ids}
+                lifecycle.advance(MatchState.PLAYING)
+            if game.bringup_s is None and latest is not None:
+                expected = set(started.robot_ids)
                 if expected and expected <= set(latest.connected):
-                    self.bringup_s = now - started_at
-                    self.events.publish(AllConnected(bringup_s=self.bringup_s))
+                    game.bringup_s = now - started_at
+                    self.events.publish(AllConnected(bringup_s=game.bringup_s))
                     log.info("match %s: all %d robots connected after %.2f s",
-                             self.plan.match_id, len(expected), self.bringup_s)
-            if self.telemetry is not None:
-                heard = self.telemetry.last_message_at() or self.started.simulator_started_at
-                if now - heard > self.plan.telemetry_silence_s:
-                    self.fail(FailureClass.SIMULATOR,
-                               f"telemetry silent for {now - heard:.0f} s")
+                             plan.match_id, len(expected), game.bringup_s)
+            if telemetry is not None:
+                heard = telemetry.last_message_at() or started.simulator_started_at
+                if now - heard > plan.telemetry_silence_s:
+                    game.failure = deps.fail(game.failure, FailureClass.SIMULATOR,
+                                             f"telemetry silent for {now - heard:.0f} s")
                     return
-            self.progress(latest)
-            bringing_up = self.bringup_s is None and now - started_at < BRINGUP_FAST_POLL_S
-            self.stop_event.wait(min(self.options.poll_s, 0.1) if bringing_up
-                                 else self.options.poll_s)
+            self._progress(lifecycle.state, latest)
+            poll_s = deps.options.poll_s
+            bringing_up = game.bringup_s is None and now - started_at < BRINGUP_FAST_POLL_S
+            self.stop_event.wait(min(poll_s, 0.1) if bringing_up else poll_s)
 
-    def _poll_robots(self) -> None:
-        for key, container_id in self.started.robot_ids.items():
-            record = self.records[key]
+    def _poll_robots(self, started: StartedMatch, game: _Game) -> None:
+        match_id = self.deps.plan.match_id
+        for key, container_id in started.robot_ids.items():
+            record = game.robots[key]
             if record.exited_during_game:
                 continue
             try:
-                state = self.runtime.inspect(container_id)
+                state = self.deps.runtime.inspect(container_id)
             except OrchestratorError as exc:
-                log.warning("match %s: cannot inspect robot %s: %s", self.plan.match_id, key, exc)
+                log.warning("match %s: cannot inspect robot %s: %s", match_id, key, exc)
                 continue
             if state.exited:
                 record.exited_during_game = True
@@ -225,25 +293,29 @@ class MatchRunner(MatchContext):
                     exit_code=state.exit_code, oom_killed=state.oom_killed))
                 log.info(
                     "match %s: robot %s exited during the game (code %s%s); the game goes on",
-                    self.plan.match_id, key, state.exit_code,
+                    match_id, key, state.exit_code,
                     ", OOM-killed" if state.oom_killed else "",
                 )
 
-    def _on_simulator_exit(self, exit_code: int | None) -> None:
-        log.info("match %s: simulator exited with code %s", self.plan.match_id, exit_code)
+    def _on_simulator_exit(self, exit_code: int | None, started: StartedMatch, game: _Game
+                           ) -> None:
+        deps = self.deps
+        match_id = deps.plan.match_id
+        log.info("match %s: simulator exited with code %s", match_id, exit_code)
+        sim_result = read_sim_result(started.match_dir, match_id=match_id)
         if exit_code != 0:
-            written = read_sim_result(self)
-            reported = written.error if written is not None else None
-            tail = str(reported) if reported else simulator_stderr_tail(self)
-            self.fail(FailureClass.SIMULATOR,
-                       f"simulator exited with code {exit_code}" + (f": {tail}" if tail else ""))
-            return
-        sim_result = read_sim_result(self)
-        if sim_result is None:
-            self.fail(FailureClass.SIMULATOR, "simulator exited 0 without sim_result.json")
+            reported = sim_result.error if sim_result is not None else None
+            tail = str(reported) if reported else simulator_stderr_tail(
+                deps.runtime, started.simulator_id, started.match_dir)
+            game.failure = deps.fail(
+                game.failure, FailureClass.SIMULATOR,
+                f"simulator exited with code {exit_code}" + (f": {tail}" if tail else ""))
+        elif sim_result is None:
+            game.failure = deps.fail(game.failure, FailureClass.SIMULATOR,
+                                     "simulator exited 0 without sim_result.json")
         elif not sim_result.finished:
-            self.fail(FailureClass.REFEREE,
-                       f"the game ended in state {sim_result.state}, not FINISHED")
+            game.failure = deps.fail(game.failure, FailureClass.REFEREE,
+                                     f"the game ended in state {sim_result.state}, not FINISHED")
 
 
 __all__ = ["ImageResolver", "MatchOutcome", "MatchRunner", "RunOptions", "TelemetryFactory",

@@ -1,6 +1,12 @@
 """STARTING: networks, host firewall, match spec, simulator, then the robots in parallel.
 
-:class:`StartupPhase` runs it on a :class:`~orchestrator.match.context.MatchContext`.
+:func:`start` takes the match's dependencies (:class:`~orchestrator.match.deps.MatchDeps`),
+the ledger of what it creates (:class:`Created`) and the robots' records, and returns a
+:class:`StartedMatch`: what runs, the telemetry, the bring-up breakdown and the failure, if no
+robot of a team could be started. The ledger and the records are the caller's and are filled in
+as each object is created and each robot starts, not at the end: when a step raises half-way,
+the caller's teardown still removes exactly what was made, and the results still say how far
+each robot got.
 """
 
 from __future__ import annotations
@@ -8,9 +14,9 @@ from __future__ import annotations
 import logging
 import shutil
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from contracts import files
@@ -20,134 +26,222 @@ from orchestrator.bandwidth import AppliedShaping, RobotShaping, mb_s_to_bit
 from orchestrator.errors import InfrastructureError, OrchestratorError
 from orchestrator.match import layout
 from orchestrator.match.admission import cpu_sets
-from orchestrator.match.context import MatchContext, Started
+from orchestrator.match.deps import MatchDeps
 from orchestrator.match.events import RobotNotStarted
-from orchestrator.match.logfs import LogFolder, safe_name
+from orchestrator.match.layout import Subnet
+from orchestrator.match.logfs import LogFolder
 from orchestrator.match.placement import (
     ROBOT_CGROUP_PARENT,
     LeaguePlacement,
     Node,
     firewall_for,
 )
-from orchestrator.match.plan import RobotPlan, per_robot_rate_mb_s
-from orchestrator.match.results import FailureClass
-from orchestrator.match.runtime import Attachment, ContainerRequest, SubnetInUse
+from orchestrator.match.plan import MatchPlan, RobotPlan, per_robot_rate_mb_s
+from orchestrator.match.results import Failure, FailureClass, RobotRecord
+from orchestrator.match.runtime import Attachment, ContainerRequest, NetworkInfo, SubnetInUse
+from orchestrator.telemetry import TelemetrySource
 
 log = logging.getLogger(__name__)
 
 NODE_HOLDER_TIMEOUT_S = 20.0
 
 
-def _create_network(match: MatchContext, role: str, internal: bool) -> None:
-    plan = match.plan
-    started = match.started
-    taken = {str(s.network) for s in started.subnets.values()}
+@dataclass(slots=True)
+class Created:
+    """The ledger of everything a match created so far, so that teardown removes exactly that.
+
+    :func:`start` enters each object as soon as the engine or the host has made it; collection
+    (:func:`~orchestrator.match.collection.collect`) reads it to stop, collect and remove.
+    """
+
+    networks: dict[str, NetworkInfo] = field(default_factory=dict)  # role -> network
+    subnets: dict[str, Subnet] = field(default_factory=dict)
+    simulator_id: str | None = None
+    holder_ids: dict[str, str] = field(default_factory=dict)  # robot key -> holder id
+    robot_ids: dict[str, str] = field(default_factory=dict)  # robot key -> container id
+    shaping: dict[str, AppliedShaping] = field(default_factory=dict)
+    log_folders: dict[str, LogFolder] = field(default_factory=dict)
+    scratch: dict[str, LogFolder] = field(default_factory=dict)  # robot key -> scratch space
+    match_dir: Path | None = None  # the simulator's folder, once the match spec is in it
+    # league placement: robot node firewalls made (node netns, None: this network) and the
+    # shaping of robot nodes' interfaces (the nodes outlive the match: both are undone)
+    node_firewalls: list[str | None] = field(default_factory=list)
+    node_shaping: list[AppliedShaping] = field(default_factory=list)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class StartupTimes:
+    """The bring-up breakdown: seconds per step of STARTING (networks, firewall, spec,
+    simulator, containers) and per robot and step of its start."""
+
+    phases_s: Mapping[str, float]
+    robot_steps_s: Mapping[str, Mapping[str, float]]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class StartedMatch:
+    """What STARTING hands on to the watch of the game."""
+
+    simulator_id: str
+    simulator_started_at: float  # the clock's time when the simulator's container ran
+    robot_ids: Mapping[str, str]  # robot key -> container id of every robot created
+    match_dir: Path  # the simulator's folder (match spec in, result files out)
+    telemetry: TelemetrySource | None  # None: no telemetry planned or no factory given
+    failure: Failure | None  # a team none of whose robots could be started (announced)
+    times: StartupTimes
+
+
+def start(deps: MatchDeps, created: Created, robots: Mapping[str, RobotRecord],
+          started_at: float) -> StartedMatch:
+    """Start everything. A robot that cannot start is recorded in its record (and published);
+    a team without any fails the match. ``robots`` are the records of every planned robot
+    (those with an ``image_error`` are not started); ``started_at`` is when STARTING began.
+
+    Raises:
+        OrchestratorError: a step the match cannot go on without failed; ``created`` holds
+            what was made until then.
+    """
+    plan = deps.plan
+    phases_s: dict[str, float] = {}
+    mark = _Marks(deps.clock, phases_s)
+    placement = deps.options.placement
+    if placement is None:
+        request, spec, endpoint = _dense_simulator(deps, created, mark)
+    else:
+        request, spec, endpoint = _league_simulator(deps, created, placement)
+    sets = cpu_sets(stepping=spec.stepping)
+    request = replace(request, cpuset_cpus=sets.simulator)
+    mark("spec")
+    robot_steps_s: dict[str, dict[str, float]] = {
+        key: {} for key, record in robots.items() if record.image_error is None}
+    began, simulator_started_at = _start_containers(
+        deps, created, robots, request, robot_cpuset=sets.robots, robot_steps_s=robot_steps_s)
+    phases_s["simulator"] = round(simulator_started_at - began, 3)
+    mark("containers")
+    telemetry = None
+    if endpoint is not None and deps.telemetry is not None:
+        telemetry = deps.telemetry(endpoint, plan.match_id)
+    failure = _team_failure(deps, robots)
+    log.info("match %s: %d robot containers started in %.2f s", plan.match_id,
+             len(created.robot_ids), deps.clock() - started_at)
+    assert created.simulator_id is not None and created.match_dir is not None
+    return StartedMatch(
+        simulator_id=created.simulator_id, simulator_started_at=simulator_started_at,
+        robot_ids=dict(created.robot_ids), match_dir=created.match_dir, telemetry=telemetry,
+        failure=failure,
+        times=StartupTimes(phases_s=phases_s, robot_steps_s=robot_steps_s),
+    )
+
+
+def _team_failure(deps: MatchDeps, robots: Mapping[str, RobotRecord]) -> Failure | None:
+    failure = None
+    for team in deps.plan.teams:
+        tried = [r for r in team.robots if robots[r.key].image_error is None]
+        failed = [r for r in tried if robots[r.key].startup_error is not None]
+        if tried and len(failed) == len(tried):
+            failure = deps.fail(failure, FailureClass.TEAM_STARTUP,
+                                f"no robot of {team.color} could be started: "
+                                f"{robots[failed[0].key].startup_error}")
+    return failure
+
+
+def _create_network(deps: MatchDeps, created: Created, role: str, internal: bool) -> None:
+    plan = deps.plan
+    taken = {str(s.network) for s in created.subnets.values()}
     for subnet in layout.candidate_subnets(f"{plan.match_id}/{role}"):
         if str(subnet.network) in taken:
             continue
         request = layout.network_request(
-            prefix=started.prefix, role=role, subnet=subnet, internal=internal,
-            match_id=plan.match_id, extra_labels=match.options.extra_labels,
+            prefix=deps.prefix, role=role, subnet=subnet, internal=internal,
+            match_id=plan.match_id, extra_labels=deps.options.extra_labels,
         )
         try:
-            started.networks[role] = match.runtime.create_network(request)
+            created.networks[role] = deps.runtime.create_network(request)
         except SubnetInUse:
             continue
-        started.subnets[role] = subnet
+        created.subnets[role] = subnet
         return
     raise InfrastructureError(f"no free /24 in 10.213.0.0/16 for the {role} network")
 
 
-def _start(match: MatchContext, started_at: float) -> None:
-    plan = match.plan
-    started = match.started
-    started.prefix = f"hlvs-{safe_name(plan.match_id)}"
-    mark = _Marks(match.clock, started.phases_s)
-    placement = match.options.placement
-    if placement is not None:
-        _start_league(match, started_at, placement, mark)
-        return
+def _dense_simulator(deps: MatchDeps, created: Created, mark: _Marks
+                     ) -> tuple[ContainerRequest, MatchSpec, str | None]:
+    """Dense placement: a network per team and one for control (the simulator on all three),
+    the teams' bridges isolated; returns the simulator's request, the spec and the telemetry
+    endpoint."""
+    plan = deps.plan
     roles = (("control", True), ("red", not plan.allow_internet),
              ("blue", not plan.allow_internet))
     with ThreadPoolExecutor(max_workers=len(roles)) as pool:  # side by side (a subnet taken
         # meanwhile by another is SubnetInUse: the next candidate is tried)
-        list(pool.map(lambda role: _create_network(match, *role), roles))
+        list(pool.map(lambda role: _create_network(deps, created, *role), roles))
     mark("networks")
     for color in ("red", "blue"):
-        match.host.isolate_bridge(started.networks[color].bridge_name, match_id=plan.match_id)
+        deps.host.isolate_bridge(created.networks[color].bridge_name, match_id=plan.match_id)
     mark("firewall")
 
     addresses = {
-        team.color: tuple(started.subnets[team.color].robot(r.number) for r in team.robots)
+        team.color: tuple(created.subnets[team.color].robot(r.number) for r in team.robots)
         for team in plan.teams
     }
-    control = started.subnets["control"]
+    control = created.subnets["control"]
     endpoint = f"tcp/{control.simulator}:{layout.TELEMETRY_PORT}" if plan.telemetry else None
-    spec, match_dir = _write_spec(match, addresses, endpoint)
-
+    spec, match_dir = _write_spec(deps, created, addresses, endpoint)
     attachments = tuple(
         Attachment(
-            network=started.networks[role].name,
-            ipv4_address=started.subnets[role].simulator,
+            network=created.networks[role].name,
+            ipv4_address=created.subnets[role].simulator,
             aliases=("simulator",),
         )
         for role in ("control", "red", "blue")
     )
     request = layout.simulator_request(
-        plan, prefix=started.prefix, image=match.options.simulator_image, match_dir=match_dir,
-        attachments=attachments, extra_labels=match.options.extra_labels,
-        command=match.options.simulator_command, model_dirs=plan.model_dirs,
-        gpu=match.options.gpu,
+        plan, prefix=deps.prefix, image=deps.options.simulator_image, match_dir=match_dir,
+        attachments=attachments, extra_labels=deps.options.extra_labels,
+        command=deps.options.simulator_command, model_dirs=plan.model_dirs,
+        gpu=deps.options.gpu,
     )
-    sets = cpu_sets(stepping=spec.stepping)
-    started.cpu_sets = sets
-    request = replace(request, cpuset_cpus=sets.simulator)
-    mark("spec")
-    _start_containers(match, request, started_at, endpoint, mark)
+    return request, spec, endpoint
 
 
-def _write_spec(match: MatchContext, addresses: dict[str, tuple[str, ...]],
+def _write_spec(deps: MatchDeps, created: Created, addresses: dict[str, tuple[str, ...]],
                 endpoint: str | None) -> tuple[MatchSpec, Path]:
-    match_dir = match.options.out_dir / "simulator"
+    match_dir = deps.options.out_dir / "simulator"
     (match_dir / files.OUT_DIR).mkdir(parents=True, exist_ok=True)
     for folder in (match_dir, match_dir / files.OUT_DIR):
         folder.chmod(0o777)
-    match.started.match_dir = match_dir
-    spec = match.plan.spec_builder(addresses, endpoint)
+    created.match_dir = match_dir
+    spec = deps.plan.spec_builder(addresses, endpoint)
     spec.write(match_dir / files.MATCH_SPEC)
     return spec, match_dir
 
 
-def _start_league(match: MatchContext, started_at: float, placement: LeaguePlacement,
-                  mark: _Marks) -> None:
+def _league_simulator(deps: MatchDeps, created: Created, placement: LeaguePlacement
+                      ) -> tuple[ContainerRequest, MatchSpec, str | None]:
     """League placement: no Docker networks; the simulator has its node's network and address,
     each robot its own node's (see :mod:`orchestrator.match.placement`)."""
-    plan = match.plan
+    plan = deps.plan
     addresses = {
         team.color: tuple(placement.robots[r.key].address for r in team.robots)
         for team in plan.teams
     }
     simulator_ip = placement.simulator.address
     endpoint = f"tcp/{simulator_ip}:{layout.TELEMETRY_PORT}" if plan.telemetry else None
-    spec, match_dir = _write_spec(match, addresses, endpoint)
-    holder = _node_holder(match, placement, placement.simulator, key="simulator")
+    spec, match_dir = _write_spec(deps, created, addresses, endpoint)
+    holder = _node_holder(deps, created, placement, placement.simulator, key="simulator")
     request = layout.simulator_request(
-        plan, prefix=match.started.prefix, image=match.options.simulator_image,
-        match_dir=match_dir, attachments=(), extra_labels=match.options.extra_labels,
-        command=match.options.simulator_command, model_dirs=plan.model_dirs,
-        gpu=match.options.gpu,
+        plan, prefix=deps.prefix, image=deps.options.simulator_image,
+        match_dir=match_dir, attachments=(), extra_labels=deps.options.extra_labels,
+        command=deps.options.simulator_command, model_dirs=plan.model_dirs,
+        gpu=deps.options.gpu,
     )
     request = replace(request, network_mode=f"container:{holder}", hostname=None,
                       labels={**request.labels, layout.LABEL_NODE: placement.simulator.name})
-    sets = cpu_sets(stepping=spec.stepping)
-    match.started.cpu_sets = sets
-    request = replace(request, cpuset_cpus=sets.simulator)
-    mark("spec")
-    _start_containers(match, request, started_at, endpoint, mark)
+    return request, spec, endpoint
 
 
-def _node_holder(match: MatchContext, placement: LeaguePlacement, node: Node, *, key: str
-                 ) -> str:
+def _node_holder(deps: MatchDeps, created: Created, placement: LeaguePlacement, node: Node, *,
+                 key: str) -> str:
     """The holder container that gives ``key``'s containers the network of ``node``."""
     netns = placement.netns_of(node)
     if netns is None:
@@ -155,18 +249,19 @@ def _node_holder(match: MatchContext, placement: LeaguePlacement, node: Node, *,
             f"league placement of {key} on node {node.name}: no network namespace of the node "
             "(this orchestrator starts containers on nodes that share its Docker engine)")
     request = layout.node_holder_request(
-        node.name, prefix=match.started.prefix,
-        image=match.options.holder_image or match.options.simulator_image, netns=netns,
-        match_id=match.plan.match_id, extra_labels=match.options.extra_labels,
+        node.name, prefix=deps.prefix,
+        image=deps.options.holder_image or deps.options.simulator_image, netns=netns,
+        match_id=deps.plan.match_id, extra_labels=deps.options.extra_labels,
     )
-    holder_id = match.runtime.create_container(request)
-    match.started.holder_ids[key] = holder_id
-    match.runtime.start(holder_id)
+    runtime = deps.runtime
+    holder_id = runtime.create_container(request)
+    created.holder_ids[key] = holder_id
+    runtime.start(holder_id)
     # a container started in the holder's network joins the namespace the holder's process
     # is in at that moment: wait until nsenter has entered the node's
-    deadline = match.clock() + NODE_HOLDER_TIMEOUT_S
-    while not match.host.in_netns(match.runtime.inspect(holder_id).pid, netns):
-        if match.clock() > deadline or match.runtime.inspect(holder_id).exited:
+    deadline = deps.clock() + NODE_HOLDER_TIMEOUT_S
+    while not deps.host.in_netns(runtime.inspect(holder_id).pid, netns):
+        if deps.clock() > deadline or runtime.inspect(holder_id).exited:
             raise InfrastructureError(
                 f"league placement of {key}: the holder of node {node.name} did not enter "
                 f"{netns} within {NODE_HOLDER_TIMEOUT_S:.0f} s")
@@ -174,79 +269,82 @@ def _node_holder(match: MatchContext, placement: LeaguePlacement, node: Node, *,
     return holder_id
 
 
-def _start_containers(match: MatchContext, request: ContainerRequest, started_at: float,
-                      endpoint: str | None, mark: _Marks) -> None:
-    plan = match.plan
-    started = match.started
-    robots = [r for r in plan.robots if match.records[r.key].image_error is None]
+def _start_containers(
+    deps: MatchDeps, created: Created, robots: Mapping[str, RobotRecord],
+    request: ContainerRequest, *, robot_cpuset: str | None,
+    robot_steps_s: dict[str, dict[str, float]],
+) -> tuple[float, float]:
+    """The simulator and every robot with an image; returns when the simulator's start began
+    and when it was done."""
+    plan = deps.plan
+    startable = [r for r in plan.robots if robots[r.key].image_error is None]
+    team_size = {team.color: len([r for r in team.robots if robots[r.key].image_error is None])
+                 for team in plan.teams}
     # the simulator and the robots start at the same time (robot clients retry until the
     # simulator listens); the simulator is submitted first so that it boots while they start
-    with (ThreadPoolExecutor(max_workers=len(robots) + 1) as pool,
-          ThreadPoolExecutor(max_workers=max(1, len(robots)), thread_name_prefix="folders")
+    with (ThreadPoolExecutor(max_workers=len(startable) + 1) as pool,
+          ThreadPoolExecutor(max_workers=max(1, len(startable)), thread_name_prefix="folders")
           as folders):
-        simulator = pool.submit(_start_simulator, match, request)
-        list(pool.map(lambda robot: _start_robot(match, robot, folders), robots))
-        simulator.result()
-    mark("containers")
-    if endpoint is not None and match.telemetry_factory is not None:
-        match.telemetry = match.telemetry_factory(endpoint, plan.match_id)
-    for team in plan.teams:
-        tried = [r for r in team.robots if match.records[r.key].image_error is None]
-        failed = [r for r in tried if match.records[r.key].startup_error is not None]
-        if tried and len(failed) == len(tried):
-            match.fail(FailureClass.TEAM_STARTUP, f"no robot of {team.color} could be started: "
-                         f"{match.records[failed[0].key].startup_error}")
-    log.info("match %s: %d robot containers started in %.2f s", plan.match_id,
-             len(started.robot_ids), match.clock() - started_at)
+        simulator = pool.submit(_start_simulator, deps, created, request)
+        list(pool.map(lambda robot: _start_robot(
+            deps, created, robot, robots[robot.key], n_robots=team_size[robot.color],
+            cpuset=robot_cpuset, mark=_Marks(deps.clock, robot_steps_s[robot.key]),
+            folders=folders), startable))
+        return simulator.result()
 
 
-def _start_simulator(match: MatchContext, request: ContainerRequest) -> None:
+def _start_simulator(deps: MatchDeps, created: Created, request: ContainerRequest
+                     ) -> tuple[float, float]:
     """Started with the robots, so that it boots while they start (robot clients retry). Under
     ``gpu`` "auto", an engine that refuses the GPU (a driver or toolkit problem that detection
-    could not see) gets the simulator without it: cameras on the CPU, said in the log."""
-    started = match.started
-    began = match.clock()
-    gpu = match.options.gpu
+    could not see) gets the simulator without it: cameras on the CPU, said in the log. Returns
+    when its start began and when it was done."""
+    runtime = deps.runtime
+    began = deps.clock()
+    gpu = deps.options.gpu
     try:
-        started.simulator_id = match.runtime.create_container(request)
-        match.runtime.start(started.simulator_id)
+        created.simulator_id = runtime.create_container(request)
+        runtime.start(created.simulator_id)
     except InfrastructureError as exc:
         if gpu is None or gpu.mode != "auto":
             raise
         log.warning("match %s: the engine refused the simulator the GPU (%s); gpu auto: it "
-                    "renders its cameras on the CPU", match.plan.match_id, exc)
-        if started.simulator_id is not None:
-            match.runtime.remove(started.simulator_id)
-            started.simulator_id = None
+                    "renders its cameras on the CPU", deps.plan.match_id, exc)
+        if created.simulator_id is not None:
+            runtime.remove(created.simulator_id)
+            created.simulator_id = None
         request = gpu.taken_from(request)
-        started.simulator_id = match.runtime.create_container(request)
-        match.runtime.start(started.simulator_id)
-    started.simulator_started_at = match.clock()
-    started.phases_s["simulator"] = round(started.simulator_started_at - began, 3)
-    log.info("match %s: simulator container %s started (%s)", match.plan.match_id,
+        created.simulator_id = runtime.create_container(request)
+        runtime.start(created.simulator_id)
+    started_at = deps.clock()
+    log.info("match %s: simulator container %s started (%s)", deps.plan.match_id,
              request.name, request.image)
-    match.monitor.watch("simulator", started.simulator_id)
+    deps.monitor.watch("simulator", created.simulator_id)
+    return began, started_at
 
 
-def _start_robot(match: MatchContext, robot: RobotPlan, folders: ThreadPoolExecutor) -> None:
-    plan = match.plan
-    started = match.started
-    record = match.records[robot.key]
+def _start_robot(
+    deps: MatchDeps, created: Created, robot: RobotPlan, record: RobotRecord, *,
+    n_robots: int, cpuset: str | None, mark: _Marks, folders: ThreadPoolExecutor,
+) -> None:
+    """Start one robot (``n_robots``: how many of its team start, who share its team's
+    bandwidth); what goes wrong is its ``startup_error``, never an exception."""
+    plan = deps.plan
+    placement = deps.options.placement
     team = plan.red if robot.color == "red" else plan.blue
-    n_robots = len([r for r in team.robots if match.records[r.key].image_error is None])
     limits = plan.limits
-    mark = _Marks(match.clock, started.robot_steps_s.setdefault(robot.key, {}))
     # the capped log and scratch folders are made while the holder starts
-    made = folders.submit(_robot_folders, match, robot)
+    made = folders.submit(_robot_folders, deps, created, robot)
     try:
-        if match.options.placement is not None:
+        if placement is not None:
             holder_id, team_net, applied, cgroup_parent = _league_robot_network(
-                match, robot, match.options.placement, n_robots, mark)
+                deps, created, robot, placement, n_robots, mark)
         else:
-            holder_id, team_net, applied = _dense_robot_network(match, robot, n_robots, mark)
+            holder_id, team_net, applied = _dense_robot_network(
+                deps, created, robot, n_robots, mark)
             cgroup_parent = None
         if applied is not None:
-            started.shaping[robot.key] = applied
+            created.shaping[robot.key] = applied
         mark("shaping")
         folder, scratch = made.result()
         mark("folders")
@@ -268,107 +366,107 @@ def _start_robot(match: MatchContext, robot: RobotPlan, folders: ThreadPoolExecu
         )
         request = layout.robot_request(
             replace(robot, image=record.digest or robot.image),
-            prefix=started.prefix, holder_id=holder_id, environment=environment,
+            prefix=deps.prefix, holder_id=holder_id, environment=environment,
             logs_dir=folder.path, limits=limits, match_id=plan.match_id,
-            extra_labels=match.options.extra_labels,
+            extra_labels=deps.options.extra_labels,
             scratch_dir=scratch.path if scratch is not None else None,
             cgroup_parent=cgroup_parent,
         )
-        request = replace(request, cpuset_cpus=started.cpu_sets.robots)
-        if match.options.placement is not None:  # the node's epilog finds it by this label
-            node = match.options.placement.robots[robot.key].name
+        request = replace(request, cpuset_cpus=cpuset)
+        if placement is not None:  # the node's epilog finds it by this label
+            node = placement.robots[robot.key].name
             request = replace(request, labels={**request.labels, layout.LABEL_NODE: node})
         record.limits["cpuset"] = request.cpuset_cpus
-        container_id = match.runtime.create_container(request)
-        started.robot_ids[robot.key] = container_id
+        container_id = deps.runtime.create_container(request)
+        created.robot_ids[robot.key] = container_id
         record.container = request.name
         mark("create")
-        match.runtime.start(container_id)
+        deps.runtime.start(container_id)
         mark("start")
-        match.monitor.watch(robot.key, container_id)
+        deps.monitor.watch(robot.key, container_id)
         log.info("match %s: robot %s started (%s, %s)", plan.match_id, robot.key, robot.image,
                  team_net.robot(robot.number))
     except OrchestratorError as exc:
         record.startup_error = str(exc)
-        match.events.publish(RobotNotStarted(key=robot.key, color=record.color,
-                                             image=record.image, cause=str(exc)))
+        deps.events.publish(RobotNotStarted(key=robot.key, color=record.color,
+                                            image=record.image, cause=str(exc)))
         log.warning("match %s: robot %s could not be started: %s", plan.match_id, robot.key, exc)
     finally:
         made.exception()  # made and recorded (for the teardown) even when the robot failed
 
 
-def _robot_folders(match: MatchContext, robot: RobotPlan) -> tuple[LogFolder, LogFolder | None]:
+def _robot_folders(deps: MatchDeps, created: Created, robot: RobotPlan
+                   ) -> tuple[LogFolder, LogFolder | None]:
     """The robot's capped /robocup-logs folder and its scratch space."""
-    folder = match.host.log_folder(
-        match_id=match.plan.match_id, name=robot.key,
-        cap_bytes=int(match.plan.limits.log_folder_gb * 1e9),
-        fallback=match.options.out_dir / "teams" / robot.color / str(robot.number)
+    folder = deps.host.log_folder(
+        match_id=deps.plan.match_id, name=robot.key,
+        cap_bytes=int(deps.plan.limits.log_folder_gb * 1e9),
+        fallback=deps.options.out_dir / "teams" / robot.color / str(robot.number)
         / "robocup-logs",
     )
-    match.started.log_folders[robot.key] = folder
-    return folder, _scratch(match, robot)
+    created.log_folders[robot.key] = folder
+    return folder, _scratch(deps, created, robot)
 
 
-def _shaping(match: MatchContext, n_robots: int, *, simulator_ip: str,
+def _shaping(plan: MatchPlan, n_robots: int, *, simulator_ip: str,
              teammate_ips: tuple[str, ...]) -> RobotShaping:
-    limits = match.plan.limits
+    limits = plan.limits
     return RobotShaping(
         api_rate_bit=mb_s_to_bit(per_robot_rate_mb_s(limits.team_api_mb_s, n_robots)),
         comm_rate_bit=mb_s_to_bit(per_robot_rate_mb_s(limits.team_comm_mb_s, n_robots)),
-        simulator_ip=simulator_ip, teammate_ips=teammate_ips, mirror_port=match.plan.mirror_port,
+        simulator_ip=simulator_ip, teammate_ips=teammate_ips, mirror_port=plan.mirror_port,
     )
 
 
-def _dense_robot_network(match: MatchContext, robot: RobotPlan, n_robots: int, mark: _Marks
+def _dense_robot_network(deps: MatchDeps, created: Created, robot: RobotPlan, n_robots: int,
+                         mark: _Marks
                          ) -> tuple[str, layout.TeamAddresses, AppliedShaping | None]:
     """A holder on the team's network with the robot's fixed address, shaped."""
-    plan = match.plan
-    started = match.started
+    plan = deps.plan
     team = plan.red if robot.color == "red" else plan.blue
-    subnet = started.subnets[robot.color]
+    subnet = created.subnets[robot.color]
     holder = layout.holder_request(
-        robot, prefix=started.prefix,
-        image=match.options.holder_image or match.options.simulator_image,
-        network=started.networks[robot.color].name, team_net=subnet, match_id=plan.match_id,
-        extra_labels=match.options.extra_labels,
+        robot, prefix=deps.prefix,
+        image=deps.options.holder_image or deps.options.simulator_image,
+        network=created.networks[robot.color].name, team_net=subnet, match_id=plan.match_id,
+        extra_labels=deps.options.extra_labels,
     )
-    holder_id = match.runtime.create_container(holder)
-    started.holder_ids[robot.key] = holder_id
-    match.runtime.start(holder_id)
-    pid = match.runtime.inspect(holder_id).pid
+    holder_id = deps.runtime.create_container(holder)
+    created.holder_ids[robot.key] = holder_id
+    deps.runtime.start(holder_id)
+    pid = deps.runtime.inspect(holder_id).pid
     mark("holder")
-    shaping = _shaping(match, n_robots, simulator_ip=subnet.simulator, teammate_ips=tuple(
+    shaping = _shaping(plan, n_robots, simulator_ip=subnet.simulator, teammate_ips=tuple(
         subnet.robot(r.number) for r in team.robots if r != robot))
-    return holder_id, subnet, match.host.shape(pid, shaping)
+    return holder_id, subnet, deps.host.shape(pid, shaping)
 
 
 def _league_robot_network(
-    match: MatchContext, robot: RobotPlan, placement: LeaguePlacement, n_robots: int,
-    mark: _Marks,
+    deps: MatchDeps, created: Created, robot: RobotPlan, placement: LeaguePlacement,
+    n_robots: int, mark: _Marks,
 ) -> tuple[str, layout.TeamAddresses, AppliedShaping | None, str | None]:
     """The robot's node: its firewall (before anything of the robot runs), a holder in the
     node's network, the limits on the node's interface."""
-    plan = match.plan
-    started = match.started
+    plan = deps.plan
     team = plan.red if robot.color == "red" else plan.blue
     node = placement.robots[robot.key]
     netns = placement.netns_of(node)
     firewall = firewall_for(placement, color=robot.color, number=robot.number,
                             api_port=robot.port, udp_ports=(plan.mirror_port, GC_RETURN_PORT))
     cgroup_parent = None
-    if match.host.node_firewall(netns, firewall):
-        started.node_firewalls.append(netns)
+    if deps.host.node_firewall(netns, firewall):
+        created.node_firewalls.append(netns)
         cgroup_parent = ROBOT_CGROUP_PARENT
     mark("firewall")
-    holder_id = _node_holder(match, placement, node, key=robot.key)
+    holder_id = _node_holder(deps, created, placement, node, key=robot.key)
     mark("holder")
     applied = None
     if netns is not None:
-        applied = match.host.shape_node(netns, _shaping(
-            match, n_robots, simulator_ip=placement.simulator.address,
+        applied = deps.host.shape_node(netns, _shaping(
+            plan, n_robots, simulator_ip=placement.simulator.address,
             teammate_ips=firewall.teammates))
         if applied is not None:
-            started.node_shaping.append(applied)
+            created.node_shaping.append(applied)
     team_net = placement.addresses(robot.color, [r.number for r in team.robots])
     return holder_id, team_net, applied, cgroup_parent
 
@@ -387,19 +485,19 @@ class _Marks:
         self._last = now
 
 
-def _scratch(match: MatchContext, robot: RobotPlan) -> LogFolder | None:
+def _scratch(deps: MatchDeps, created: Created, robot: RobotPlan) -> LogFolder | None:
     """The robot's capped scratch space with its :data:`layout.SCRATCH_DIRS`, or None when no
     cap can be applied (the robot then gets small tmpfs folders)."""
-    started = match.started
-    cap = int(match.plan.limits.scratch_gb * 1e9)
-    scratch = match.host.log_folder(
-        match_id=match.plan.match_id, name=f"{robot.key}-scratch", cap_bytes=cap,
-        fallback=match.options.out_dir / ".scratch" / robot.key,
+    cap = int(deps.plan.limits.scratch_gb * 1e9)
+    out_dir = deps.options.out_dir
+    scratch = deps.host.log_folder(
+        match_id=deps.plan.match_id, name=f"{robot.key}-scratch", cap_bytes=cap,
+        fallback=out_dir / ".scratch" / robot.key,
     )
     if scratch.cap_bytes is None:
-        shutil.rmtree(match.options.out_dir / ".scratch", ignore_errors=True)
+        shutil.rmtree(out_dir / ".scratch", ignore_errors=True)
         return None
-    started.scratch[robot.key] = scratch
+    created.scratch[robot.key] = scratch
     for name in layout.SCRATCH_DIRS:
         path = scratch.path / name
         path.mkdir(exist_ok=True)
@@ -407,18 +505,4 @@ def _scratch(match: MatchContext, robot: RobotPlan) -> LogFolder | None:
     return scratch
 
 
-class StartupPhase:
-    """STARTING: networks, firewall, match spec, simulator, robots; returns what it created."""
-
-    def __init__(self, match: MatchContext) -> None:
-        self.match = match
-
-
-    def run(self, started_at: float) -> Started:
-        """Start everything; a robot that cannot start is recorded, a team without any fails the
-        match. Returns what was created (also kept in the context for teardown)."""
-        _start(self.match, started_at)
-        return self.match.started
-
-
-__all__ = ["StartupPhase"]
+__all__ = ["Created", "StartedMatch", "StartupTimes", "start"]

@@ -43,18 +43,27 @@ def _plan(*, red_image: str = "team/red:1", blue_image: str = "team/blue:1", n: 
 
 
 def _run(tmp_path: Path, plan: MatchPlan, runtime: FakeRuntime, **kwargs: Any
-         ) -> tuple[MatchRunner, MatchOutcome]:
+         ) -> tuple[list[MatchState], MatchOutcome]:
+    """The match's states (from PENDING, as its events tell them) and its outcome."""
+    from orchestrator.match import StateChanged
+
     runner = MatchRunner(plan, runtime=runtime, host=FakeHost(),
                          options=RunOptions(out_dir=tmp_path, simulator_image="sim:1",
                                             poll_s=0.0), **kwargs)
-    return runner, runner.run()
+    stream = runner.events.subscribe()
+    outcome = runner.run()
+    history = [MatchState.PENDING]
+    while not stream.empty():
+        if isinstance(event := stream.get(), StateChanged):
+            history.append(event.state)
+    return history, outcome
 
 
 def test_success_writes_results_and_report_last(tmp_path: Path) -> None:
     runtime = FakeRuntime()
-    runner, outcome = _run(tmp_path, _plan(), runtime)
+    history, outcome = _run(tmp_path, _plan(), runtime)
     assert outcome.ok
-    assert runner.lifecycle.history[-1] is MatchState.DONE
+    assert history[-1] is MatchState.DONE
     assert json.loads((tmp_path / "report.json").read_text()) == {"status": "success"}
     results = json.loads((tmp_path / "results.json").read_text())
     assert results["score"] == {"red": 2, "blue": 1}
@@ -106,25 +115,24 @@ def test_robot_requests_carry_environment_limits_and_no_privileges(tmp_path: Pat
 
 def test_forfeit_when_a_team_has_no_usable_image(tmp_path: Path) -> None:
     runtime = FakeRuntime(missing_images=("team/blue:1",))
-    runner, outcome = _run(tmp_path, _plan(), runtime)
+    history, outcome = _run(tmp_path, _plan(), runtime)
     assert outcome.ok
     assert outcome.results.forfeit.team == "blue"
     assert outcome.results.winner == "red"
     assert not [c for c in runtime.calls if c[0] == "create_container"]
-    assert runner.lifecycle.history == [MatchState.PENDING, MatchState.PULLING,
-                                        MatchState.STOPPING, MatchState.COLLECTING,
-                                        MatchState.DONE]
+    assert history == [MatchState.PENDING, MatchState.PULLING, MatchState.STOPPING,
+                       MatchState.COLLECTING, MatchState.DONE]
 
 
 def test_simulator_crash_is_a_simulator_failure(tmp_path: Path) -> None:
     runtime = FakeRuntime(simulator_exit_code=2)
-    runner, outcome = _run(tmp_path, _plan(), runtime)
+    history, outcome = _run(tmp_path, _plan(), runtime)
     assert outcome.failure is not None
     assert outcome.failure.failure_class is FailureClass.SIMULATOR
     assert "code 2" in outcome.failure.cause
     report = json.loads((tmp_path / "report.json").read_text())
     assert report["failure_class"] == "simulator"
-    assert runner.lifecycle.state is MatchState.FAILED
+    assert history[-1] is MatchState.FAILED
     assert runtime.containers == {}
 
 
@@ -171,11 +179,11 @@ def test_telemetry_moves_waiting_to_playing_and_measures_bringup(tmp_path: Path)
               _state("INITIAL", "red-1", "red-2", "blue-1", "blue-2"),
               _state("READY", "red-1", "red-2", "blue-1", "blue-2")]
     telemetry = FakeTelemetry(states, clock=clock)
-    runner, outcome = _run(tmp_path, _plan(telemetry=True), runtime,
+    history, outcome = _run(tmp_path, _plan(telemetry=True), runtime,
                            telemetry=lambda endpoint, match_id: telemetry, clock=clock)
     assert outcome.ok
     assert outcome.bringup_s is not None and outcome.bringup_s > 0
-    assert MatchState.PLAYING in runner.lifecycle.history
+    assert MatchState.PLAYING in history
     spec = json.loads((tmp_path / "simulator/match_spec.json").read_text())
     telemetry = spec["network"]["telemetry_listen"]
     assert telemetry.startswith("tcp/10.213.") and telemetry.endswith(":7447")
@@ -224,11 +232,11 @@ def test_team_whose_robots_cannot_start_is_a_team_startup_failure(tmp_path: Path
             raise InfrastructureError("exec: start: executable file not found in $PATH")
 
     runtime.on_start = refuse_red
-    runner, outcome = _run(tmp_path, _plan(), runtime)
+    history, outcome = _run(tmp_path, _plan(), runtime)
     assert outcome.failure is not None
     assert outcome.failure.failure_class is FailureClass.TEAM_STARTUP
     assert "red" in outcome.failure.cause and "executable file not found" in outcome.failure.cause
-    assert MatchState.PLAYING not in runner.lifecycle.history
+    assert MatchState.PLAYING not in history
     assert outcome.results.robots["red-1"].startup_error
     assert outcome.results.robots["blue-1"].startup_error is None
     assert runtime.containers == {} and runtime.networks == {}
