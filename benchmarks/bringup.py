@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import queue
 import tempfile
 import threading
 import time
@@ -47,7 +48,16 @@ def measure(*, robots: int, out: Path, timeout_s: float, robot_image: str | None
     from orchestrator.config.loader import load_game
     from orchestrator.engine import connect
     from orchestrator.engine.containers import DockerRuntime
-    from orchestrator.match import HostControl, MatchRunner, RunOptions, cleanup, plan_from_game
+    from orchestrator.match import (
+        AllConnected,
+        HostControl,
+        MatchEnded,
+        MatchOutcome,
+        MatchRunner,
+        RunOptions,
+        cleanup,
+        plan_from_game,
+    )
     from orchestrator.match.scrimmage import ScrimmageRequest, write_files
     from orchestrator.project_images import project_image
     from orchestrator.telemetry import ZenohTelemetry
@@ -69,17 +79,28 @@ def measure(*, robots: int, out: Path, timeout_s: float, robot_image: str | None
         options=RunOptions(out_dir=out, simulator_image=simulator, poll_s=0.05),
         telemetry=lambda endpoint, match_id: ZenohTelemetry(endpoint=endpoint, match_id=match_id),
     )
-    thread = threading.Thread(target=runner.run, name="bringup-match", daemon=True)
+    events = runner.events.subscribe()  # bring-up is seen as it happens, not polled
+    outcomes: list[MatchOutcome] = []
+    thread = threading.Thread(target=lambda: outcomes.append(runner.run()),
+                              name="bringup-match", daemon=True)
     thread.start()
     deadline = time.monotonic() + timeout_s
-    while runner.bringup_s is None and thread.is_alive() and time.monotonic() < deadline:
-        time.sleep(0.05)
+    while (left := deadline - time.monotonic()) > 0:
+        try:
+            event = events.get(timeout=left)
+        except queue.Empty:
+            break
+        if isinstance(event, AllConnected | MatchEnded):
+            break
     runner.stop_event.set()
     thread.join(timeout=120)
     cleanup(runtime, HostControl.for_current_user(), match_id=plan.match_id)
-    bringup = runner.bringup_s
-    containers = runner.lifecycle.timings_s.get("starting")
-    steps = runner.started.robot_steps_s.values()
+    outcome = outcomes[0] if outcomes else None
+    bringup = outcome.bringup_s if outcome is not None else None
+    timings = outcome.results.timings_s if outcome is not None and outcome.results else {}
+    containers = timings.get("starting")
+    startup = outcome.startup if outcome is not None else None
+    steps = startup.robot_steps_s.values() if startup is not None else []
     names = sorted({name for robot in steps for name in robot})
     return {
         "bench": "bringup",
@@ -91,7 +112,7 @@ def measure(*, robots: int, out: Path, timeout_s: float, robot_image: str | None
         # the slowest robot's time in each step of its start,
         # and what follows STARTING until every robot is connected (the simulator's boot, the
         # robots' processes starting and connecting)
-        "phases_s": dict(runner.started.phases_s),
+        "phases_s": dict(startup.phases_s) if startup is not None else {},
         "robot_steps_max_s": {n: max(r.get(n, 0.0) for r in steps) for n in names},
         "after_containers_s": None if bringup is None or containers is None
         else round(bringup - containers, 3),

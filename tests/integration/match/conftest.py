@@ -6,6 +6,7 @@ from __future__ import annotations
 import hashlib
 import io
 import tarfile
+import threading
 import uuid
 from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
@@ -27,6 +28,7 @@ from orchestrator.match import (
     TeamPlan,
     cleanup,
 )
+from orchestrator.match.runtime import ContainerRequest, NetworkInfo, NetworkRequest
 from orchestrator.telemetry import ZenohTelemetry
 from testkit.specs import match_spec
 from tests.conftest import TEST_LABEL
@@ -107,6 +109,29 @@ MatchFactory = Callable[..., MatchOutcome]
 
 
 @pytest.fixture
+class _Told:
+    """The engine, telling ``on_created`` of each network and container it has created (with
+    the request it was made from), so that a test sees the match's objects as they come."""
+
+    def __init__(self, runtime: Any,
+                 on_created: Callable[[ContainerRequest | NetworkRequest], None]) -> None:
+        self._runtime = runtime
+        self._on_created = on_created
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._runtime, name)
+
+    def create_network(self, request: NetworkRequest) -> NetworkInfo:
+        info: NetworkInfo = self._runtime.create_network(request)
+        self._on_created(request)
+        return info
+
+    def create_container(self, request: ContainerRequest) -> str:
+        container_id: str = self._runtime.create_container(request)
+        self._on_created(request)
+        return container_id
+
+
 def play(runtime: Any, test_image: str, tmp_path: Path) -> Iterator[MatchFactory]:
     """``play(red=[cmd...], blue=[cmd...], sim=("3",), limits=..., ...) -> MatchOutcome``."""
     match_ids: list[str] = []
@@ -116,7 +141,8 @@ def play(runtime: Any, test_image: str, tmp_path: Path) -> Iterator[MatchFactory
         *, red: list[list[str] | None], blue: list[list[str] | None],
         sim: tuple[str, ...] = ("3",), limits: Limits | None = None, grace_s: float = 2.0,
         red_image: str | None = "", blue_image: str | None = "", out: Path | None = None,
-        runner_hook: Callable[[MatchRunner], None] | None = None,
+        on_created: Callable[[ContainerRequest | NetworkRequest], None] | None = None,
+        stop_event: threading.Event | None = None,
         telemetry_silence_s: float | None = None,
     ) -> MatchOutcome:
         match_id = f"t{uuid.uuid4().hex[:8]}"
@@ -138,11 +164,10 @@ def play(runtime: Any, test_image: str, tmp_path: Path) -> Iterator[MatchFactory
             extra_labels={TEST_LABEL: "1"}, poll_s=0.2,
         )
         runner = MatchRunner(
-            plan, runtime=runtime, host=host, options=options,
+            plan, runtime=runtime if on_created is None else _Told(runtime, on_created),
+            host=host, options=options, stop_event=stop_event,
             telemetry=lambda endpoint, mid: ZenohTelemetry(endpoint=endpoint, match_id=mid),
         )
-        if runner_hook is not None:
-            runner_hook(runner)
         return runner.run()
 
     yield factory

@@ -12,8 +12,8 @@ from typing import Any
 
 import pytest
 
-from orchestrator.match import MatchRunner
 from orchestrator.match.logfs import state_dir
+from orchestrator.match.runtime import ContainerRequest, NetworkRequest
 from tests.integration.match.conftest import MatchFactory
 
 pytestmark = [pytest.mark.docker, pytest.mark.root]
@@ -65,21 +65,27 @@ def test_simulator_crash_fails_the_match_and_logs_are_still_collected(
 
 
 def test_stop_request_stops_everything_cleanly(play: MatchFactory, runtime: Any) -> None:
-    holder: list[MatchRunner] = []
+    stop = threading.Event()
+    red_logs: list[Path] = []  # red 1's /robocup-logs on the host, once its container is made
+
+    def note_red_logs(request: ContainerRequest | NetworkRequest) -> None:
+        if isinstance(request, ContainerRequest) and request.name.endswith("-red-1"):
+            red_logs.append(next(m.source for m in request.mounts
+                                 if m.target == "/robocup-logs"))
 
     def interrupt_when_playing() -> None:
         deadline = time.monotonic() + 60
         while time.monotonic() < deadline:
-            folders = holder[0].started.log_folders if holder else {}
-            if "red-1" in folders and (Path(folders["red-1"].path) / "ready.txt").exists():
-                holder[0].stop_event.set()
+            if red_logs and (red_logs[0] / "ready.txt").exists():
+                stop.set()
                 return
             time.sleep(0.05)
 
     thread = threading.Thread(target=interrupt_when_playing, daemon=True)
     thread.start()
     started = time.monotonic()
-    outcome = play(red=[["sigterm"]], blue=[["env"]], sim=("60",), runner_hook=holder.append)
+    outcome = play(red=[["sigterm"]], blue=[["env"]], sim=("60",), on_created=note_red_logs,
+                   stop_event=stop)
     assert time.monotonic() - started < 40
     report = _report(outcome.out_dir)
     assert report["failure_class"] == "interrupted"

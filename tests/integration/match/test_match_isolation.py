@@ -3,15 +3,14 @@ network, not a service the host binds on 0.0.0.0."""
 
 from __future__ import annotations
 
+import ipaddress
 import json
 import socket
-import threading
-import time
-from pathlib import Path
 
 import pytest
 
-from orchestrator.match import MatchRunner
+from orchestrator.match.layout import Subnet
+from orchestrator.match.runtime import ContainerRequest, NetworkRequest
 from tests.integration.match.conftest import MatchFactory
 
 pytestmark = [pytest.mark.docker, pytest.mark.root]
@@ -22,37 +21,34 @@ def test_red_reaches_only_its_simulator_and_teammates(play: MatchFactory) -> Non
     host_server.bind(("0.0.0.0", 0))
     host_server.listen(8)
     host_port = host_server.getsockname()[1]
-    holder: list[MatchRunner] = []
+    subnets: dict[str, Subnet] = {}  # role -> subnet, as the match creates its networks
 
-    def write_targets() -> None:
-        deadline = time.monotonic() + 60
-        while time.monotonic() < deadline:
-            runner = holder[0] if holder else None
-            folders = runner.started.log_folders if runner else {}
-            if runner is not None and len(runner.started.robot_ids) == 3 and "red-1" in folders:
-                subnets = runner.started.subnets
-                targets = {
-                    "simulator": [subnets["red"].simulator, 10001],
-                    "teammate": [subnets["red"].robot(2), 5000],
-                    "blue robot": [subnets["blue"].robot(1), 5000],
-                    "blue simulator address": [subnets["blue"].simulator, 10021],
-                    "control network": [subnets["control"].simulator, 10001],
-                    "host via gateway": [subnets["red"].gateway, host_port],
-                    "host via control gateway": [subnets["control"].gateway, host_port],
-                }
-                path = Path(folders["red-1"].path) / "targets.json"
-                path.write_text(json.dumps(targets))
-                return
-            time.sleep(0.05)
+    def write_targets(request: ContainerRequest | NetworkRequest) -> None:
+        """Once red 1's container is made (every network is by then), before it runs: where
+        its probe is to try to connect, in its /robocup-logs."""
+        if isinstance(request, NetworkRequest):
+            subnets[request.name.rsplit("-", 1)[1]] = Subnet(
+                network=ipaddress.IPv4Network(request.subnet))
+            return
+        if not request.name.endswith("-red-1"):
+            return
+        folder = next(m.source for m in request.mounts if m.target == "/robocup-logs")
+        targets = {
+            "simulator": [subnets["red"].simulator, 10001],
+            "teammate": [subnets["red"].robot(2), 5000],
+            "blue robot": [subnets["blue"].robot(1), 5000],
+            "blue simulator address": [subnets["blue"].simulator, 10021],
+            "control network": [subnets["control"].simulator, 10001],
+            "host via gateway": [subnets["red"].gateway, host_port],
+            "host via control gateway": [subnets["control"].gateway, host_port],
+        }
+        (folder / "targets.json").write_text(json.dumps(targets))
 
-    writer = threading.Thread(target=write_targets, daemon=True)
-    writer.start()
     try:
         outcome = play(red=[["probe"], ["listen"]], blue=[["listen"]], sim=("10",),
-                       runner_hook=holder.append)
+                       on_created=write_targets)
     finally:
         host_server.close()
-    writer.join(timeout=5)
     reach = json.loads((outcome.out_dir / "teams/red/1/robocup-logs/reach.json").read_text())
     assert reach["simulator"] == "connected"
     assert reach["teammate"] == "connected"

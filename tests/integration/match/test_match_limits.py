@@ -9,7 +9,8 @@ import docker
 import pytest
 
 from orchestrator.config import Limits
-from orchestrator.match import MatchRunner
+from orchestrator.engine import LABEL_ROLE
+from orchestrator.match.runtime import ContainerRequest, NetworkRequest
 from tests.integration.match.conftest import MatchFactory
 
 pytestmark = [pytest.mark.docker, pytest.mark.root]
@@ -40,26 +41,14 @@ def test_limits_are_visible_in_docker_inspect(
 ) -> None:
     seen: dict[str, object] = {}
 
-    def capture(runner: MatchRunner) -> None:
-        original = runner.runtime.start
-
-        def start(container_id: str) -> None:
-            original(container_id)
-            attrs = docker_client.api.inspect_container(container_id)
-            if attrs["Config"]["Labels"].get("org.hlvs-runner.role") == "robot":
-                seen[attrs["Name"]] = attrs["HostConfig"]
-
-        runner.runtime = type("Spy", (), {})()  # delegate everything, spy on start
-        for name in ("create_network", "remove_network", "create_container", "stop", "kill",
-                     "remove", "inspect", "wait", "stats_stream", "save_logs", "image_digest",
-                     "list_project"):
-            setattr(runner.runtime, name, getattr(original.__self__, name))
-        runner.runtime.start = start
-        runner.monitor._runtime = runner.runtime
+    def capture(request: ContainerRequest | NetworkRequest) -> None:
+        if isinstance(request, ContainerRequest) and request.labels.get(LABEL_ROLE) == "robot":
+            attrs = docker_client.api.inspect_container(request.name)
+            seen[attrs["Name"]] = attrs["HostConfig"]
 
     limits = Limits(cpus=1.5, memory_gb=0.25, pids=64, log_folder_gb=0.02)
     outcome = play(red=[["env"]], blue=[["env"]], sim=("2",), limits=limits,
-                   runner_hook=capture)
+                   on_created=capture)
     assert outcome.ok
     assert len(seen) == 2
     for host_config in seen.values():
