@@ -108,7 +108,6 @@ def robots(color: str, image: str | None, commands: list[list[str] | None]) -> l
 MatchFactory = Callable[..., MatchOutcome]
 
 
-@pytest.fixture
 class _Told:
     """The engine, telling ``on_created`` of each network and container it has created (with
     the request it was made from), so that a test sees the match's objects as they come."""
@@ -132,6 +131,7 @@ class _Told:
         return container_id
 
 
+@pytest.fixture
 def play(runtime: Any, test_image: str, tmp_path: Path) -> Iterator[MatchFactory]:
     """``play(red=[cmd...], blue=[cmd...], sim=("3",), limits=..., ...) -> MatchOutcome``."""
     match_ids: list[str] = []
