@@ -123,7 +123,7 @@ class MatchRunner:
     ) -> None:
         self.events = EventStream()  # the match's progress, for observers in other threads
         self.stop_event = stop_event or threading.Event()  # set: the match stops (interrupted)
-        self.deps = MatchDeps(
+        self._deps = MatchDeps(
             plan=plan, runtime=runtime, host=host, options=options, clock=clock,
             events=self.events, monitor=StatsMonitor(runtime), telemetry=telemetry,
         )
@@ -133,8 +133,8 @@ class MatchRunner:
     def run(self) -> MatchOutcome:
         """Play the match; :attr:`events` tells observers how it goes, ending with
         :class:`~orchestrator.match.events.MatchEnded`."""
-        plan = self.deps.plan
-        lifecycle = Lifecycle(plan.match_id, clock=self.deps.clock)
+        plan = self._deps.plan
+        lifecycle = Lifecycle(plan.match_id, clock=self._deps.clock)
         lifecycle.observers.append(self._entered)
         game = _Game(robots={
             r.key: RobotRecord(key=r.key, color=r.color, number=r.number, image=r.image)
@@ -147,7 +147,7 @@ class MatchRunner:
 
     # phases run by run() -----------------------------------------------------------------
     def _run(self, lifecycle: Lifecycle, created: Created, game: _Game) -> MatchOutcome:
-        deps = self.deps
+        deps = self._deps
         out = deps.options.out_dir
         out.mkdir(parents=True, exist_ok=True)
         out.chmod(0o700)  # the teams' logs are theirs: owner-only (see collection)
@@ -190,13 +190,13 @@ class MatchRunner:
         self._progress(state, None)
 
     def _progress(self, state: MatchState, latest: StateMessage | None) -> None:
-        if self.deps.options.progress is not None:
-            self.deps.options.progress(state.value, latest)
+        if self._deps.options.progress is not None:
+            self._deps.options.progress(state.value, latest)
 
     def _resolve_images(self, game: _Game) -> None:
         """Each robot's image digest or error into its record; a team without any usable
         image forfeits, both without: the match fails."""
-        plan = self.deps.plan
+        plan = self._deps.plan
         resolved = self._images(plan)
         usable: dict[str, int] = {"red": 0, "blue": 0}
         for key, (digest, error) in resolved.items():
@@ -215,7 +215,7 @@ class MatchRunner:
             for color in forfeiting
         }
         if len(forfeiting) == 2:
-            game.failure = self.deps.fail(
+            game.failure = self._deps.fail(
                 game.failure, FailureClass.IMAGE_PULL,
                 "neither team has a usable image (" + "; ".join(first_error.values()) + ")")
         elif forfeiting:
@@ -233,7 +233,7 @@ class MatchRunner:
                started_at: float) -> None:
         """Poll the simulator, its telemetry and the robots until the simulator exits; what
         happens goes into ``game`` (the bring-up time, robots' exits, the failure)."""
-        deps = self.deps
+        deps = self._deps
         plan, telemetry = deps.plan, started.telemetry
         last_robot_poll = 0.0
         while True:
@@ -274,13 +274,13 @@ class MatchRunner:
             self.stop_event.wait(min(poll_s, 0.1) if bringing_up else poll_s)
 
     def _poll_robots(self, started: StartedMatch, game: _Game) -> None:
-        match_id = self.deps.plan.match_id
+        match_id = self._deps.plan.match_id
         for key, container_id in started.robot_ids.items():
             record = game.robots[key]
             if record.exited_during_game:
                 continue
             try:
-                state = self.deps.runtime.inspect(container_id)
+                state = self._deps.runtime.inspect(container_id)
             except OrchestratorError as exc:
                 log.warning("match %s: cannot inspect robot %s: %s", match_id, key, exc)
                 continue
@@ -299,7 +299,7 @@ class MatchRunner:
 
     def _on_simulator_exit(self, exit_code: int | None, started: StartedMatch, game: _Game
                            ) -> None:
-        deps = self.deps
+        deps = self._deps
         match_id = deps.plan.match_id
         log.info("match %s: simulator exited with code %s", match_id, exit_code)
         sim_result = read_sim_result(started.match_dir, match_id=match_id)
