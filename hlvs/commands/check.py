@@ -24,8 +24,9 @@ from orchestrator.paths import user_path
 
 if TYPE_CHECKING:
     from contracts.field import FieldClass
+    from contracts.jsontypes import JSONObject
     from orchestrator.config.detect import Kind
-    from simulator.world.robots.team.rulebook import MeasurementsRecord
+    from simulator.world.robots.team.rulebook import Measurements
 
 log = logging.getLogger(__name__)
 
@@ -97,7 +98,7 @@ class ProblemRecord(TypedDict):
 class FileReportRecord(TypedDict):
     """One file of ``hlvs check --json``."""
 
-    measurements: NotRequired[MeasurementsRecord]  # robot model packages (first when there)
+    measurements: NotRequired[JSONObject]  # Measurements.to_json() (first when there)
     file: str
     kind: str | None
     valid: bool
@@ -111,7 +112,7 @@ class FileReport:
     file: str
     kind: str | None
     problems: list[Problem] = field(default_factory=list)
-    measurements: MeasurementsRecord | None = None  # robot model packages
+    measurements: Measurements | None = None  # robot model packages
 
     @property
     def errors(self) -> list[Problem]:
@@ -140,7 +141,7 @@ class FileReport:
         }
         if self.measurements is None:
             return record
-        return {"measurements": self.measurements, **record}
+        return {"measurements": self.measurements.to_json(), **record}
 
 
 def run(args: argparse.Namespace) -> int:
