@@ -14,10 +14,11 @@ import json
 import logging
 import re
 import sys
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NotRequired, TextIO, TypedDict
 
+from contracts.codec import to_data
 from orchestrator import ConfigError, OrchestratorError, Problem
 from orchestrator.exitcodes import ExitCode
 from orchestrator.paths import user_path
@@ -86,15 +87,6 @@ def register(sub: Any) -> None:
     parser.set_defaults(func=run)
 
 
-class ProblemRecord(TypedDict):
-    file: str
-    pointer: str
-    message: str
-    expected: str
-    suggestion: str
-    severity: str  # "error" or "warning"
-
-
 class FileReportRecord(TypedDict):
     """One file of ``hlvs check --json``."""
 
@@ -102,7 +94,7 @@ class FileReportRecord(TypedDict):
     file: str
     kind: str | None
     valid: bool
-    problems: list[ProblemRecord]
+    problems: list[JSONObject]  # each a Problem (the root pointer written as "/")
 
 
 @dataclass(slots=True)
@@ -127,17 +119,7 @@ class FileReport:
             "file": self.file,
             "kind": self.kind,
             "valid": self.valid,
-            "problems": [
-                {
-                    "file": p.file,
-                    "pointer": p.pointer or "/",
-                    "message": p.message,
-                    "expected": p.expected,
-                    "suggestion": p.suggestion,
-                    "severity": p.severity,
-                }
-                for p in self.problems
-            ],
+            "problems": [to_data(replace(p, pointer=p.pointer or "/")) for p in self.problems],
         }
         if self.measurements is None:
             return record
