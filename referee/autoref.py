@@ -140,7 +140,7 @@ class Referee:
 
     def result(self) -> dict[str, object]:
         """score, winner (red, blue, draw; None before the end), events_summary {type: count},
-        spoofing {total, attempts}, play (see :class:`referee.play_stats.PlayStats`)."""
+        spoofing {total, attempts}, play (:class:`contracts.sim_result.PlayRecord`)."""
         self._report_spoofing()
         out = reporting.result(
             self.gc, self.events, finished=self._finished, winner=self._winner,
