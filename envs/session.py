@@ -168,9 +168,7 @@ class LocalSession:
             frame.game = game_view(self.referee, self.learner)
             events = self.referee.events
             if self._events_seen < len(events):
-                from simulator.match_loop import event_dict
-
-                frame.events = [event_dict(e) for e in events[self._events_seen :]]
+                frame.events = [e.to_record() for e in events[self._events_seen :]]
                 self._events_seen = len(events)
         return frame
 
