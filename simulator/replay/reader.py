@@ -25,6 +25,7 @@ from typing import IO, cast
 import numpy as np
 
 from contracts.codec import from_data
+from contracts.errors import ContractError
 from contracts.telemetry import EventRecord, GameStateRecord
 from simulator.errors import ReplayError
 from simulator.replay.format import (
@@ -120,8 +121,10 @@ class ReplayFile:
                 f"format version {version!r}; this reader knows versions "
                 f"{', '.join(str(v) for v in SUPPORTED_VERSIONS)} (a newer hlvs-runner wrote it?)"
             )
-        # each field converted and checked
-        self.header = _header(cast("HeaderRecord", raw), source=str(self.path))
+        try:  # each field converted and checked
+            self.header = _header(cast("HeaderRecord", raw), source=str(self.path))
+        except ContractError as exc:
+            raise self._error(f"header: {exc.pointer}: {exc.reason}") from exc
         self.nbody = len(self.header.body_names)
         self._data_start = len(MAGIC) + 4 + length
         self.events: tuple[EventRecord, ...] = ()
