@@ -314,7 +314,7 @@ class Referee:
                     f"{pose.yaw_rad:.2f}).",
                 )
                 commands.append(
-                    TeleportRobot(robot=robot, x_m=pose.x_m, y_m=pose.y_m, yaw_rad=pose.yaw_rad)
+                    TeleportRobot(robot=robot, pose=pose)
                 )
                 if robot in self.limp:
                     commands.append(SetLimp(robot=robot, limp=False))

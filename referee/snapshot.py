@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field
 from enum import Enum
 
+from contracts.geometry import Pose
 from contracts.ids import RobotId, TeamColor
 from contracts.telemetry import EventRecord
 
@@ -97,9 +98,7 @@ class TeleportRobot:
     reset its joints to the standing posture and zero its velocities."""
 
     robot: RobotId
-    x_m: float
-    y_m: float
-    yaw_rad: float
+    pose: Pose
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -122,9 +121,7 @@ class RestoreRobot:
     """Bring a removed robot back at a pose."""
 
     robot: RobotId
-    x_m: float
-    y_m: float
-    yaw_rad: float
+    pose: Pose
 
 
 WorldCommand = PlaceBall | TeleportRobot | SetLimp | RemoveRobot | RestoreRobot
