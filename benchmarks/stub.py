@@ -41,10 +41,10 @@ def run_trial(*, seed: int, distance_m: float, time_limit_s: float) -> TrialResu
     import numpy as np
 
     from contracts.gamecontroller import GameState
+    from contracts.geometry import Pose
     from contracts.ids import RobotId, TeamColor
     from robot.stub.behaviour import GameInfo, Role
     from robot.stub.controller import StubController
-    from robot.stub.world_model import Pose2D
     from simulator.world import CameraRenderer, RobotPlacement, World
     from testkit.stub_world import sense
 
@@ -58,7 +58,7 @@ def run_trial(*, seed: int, distance_m: float, time_limit_s: float) -> TrialResu
         robots=[RobotPlacement(id=robot, model="kid-default", x_m=x, y_m=y, yaw_rad=heading)],
         seed=seed,
     )
-    controller = StubController(role=Role.STRIKER, start_pose=Pose2D(x, y, heading))
+    controller = StubController(role=Role.STRIKER, start_pose=Pose(x_m=x, y_m=y, yaw_rad=heading))
     game = GameInfo(phase=GameState.PLAYING)
     ball_body = world.model.body("ball").id
     kicked_at_s: float | None = None

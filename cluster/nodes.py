@@ -11,7 +11,9 @@ from __future__ import annotations
 import itertools
 import re
 from dataclasses import dataclass, field
-from typing import TypedDict
+
+from contracts.codec import to_data
+from contracts.jsontypes import JSONObject
 
 # sinfo -N: one line per node and partition; the reason last (free text that may hold '|')
 SINFO_FORMAT = "%N|%T|%C|%m|%e|%O|%f|%E"
@@ -23,28 +25,6 @@ MATCH_JOB_PREFIX = "hlvs-"  # the Slurm pool names a match's job hlvs-<match id>
 ENV_REMOTE_COMMENT = "hlvs:environment-remote"
 
 
-class NodeJobRecord(TypedDict):
-    job_id: str
-    match_id: str | None
-    state: str
-
-
-class PoolNodeRecord(TypedDict):
-    """A :class:`PoolNode` as JSON (``hlvs pool nodes --json``, the operators' API)."""
-
-    name: str
-    state: str
-    reason: str
-    features: list[str]
-    cpus: int
-    cpus_allocated: int | None
-    cpu_load: float | None
-    memory_mb: int
-    memory_free_mb: int | None
-    slots: int
-    jobs: list[NodeJobRecord]
-
-
 @dataclass(frozen=True, slots=True, kw_only=True)
 class NodeJob:
     """A job on a node: a Slurm job (``job_id`` its id) or a local match process (its pid)."""
@@ -53,8 +33,9 @@ class NodeJob:
     match_id: str | None  # the match it plays; None for a job that is not a match
     state: str  # RUNNING, COMPLETING... (Slurm's) or "running"
 
-    def to_json(self) -> NodeJobRecord:
-        return {"job_id": self.job_id, "match_id": self.match_id, "state": self.state}
+    def to_json(self) -> JSONObject:
+        data: JSONObject = to_data(self)
+        return data
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -73,14 +54,10 @@ class PoolNode:
     slots: int  # matches the node plays at once
     jobs: tuple[NodeJob, ...] = field(default=())
 
-    def to_json(self) -> PoolNodeRecord:
-        return {
-            "name": self.name, "state": self.state, "reason": self.reason,
-            "features": list(self.features), "cpus": self.cpus,
-            "cpus_allocated": self.cpus_allocated, "cpu_load": self.cpu_load,
-            "memory_mb": self.memory_mb, "memory_free_mb": self.memory_free_mb,
-            "slots": self.slots, "jobs": [j.to_json() for j in self.jobs],
-        }
+    def to_json(self) -> JSONObject:
+        """The node as JSON (``hlvs pool nodes --json``, the operators' API): its fields."""
+        data: JSONObject = to_data(self)
+        return data
 
 
 def match_of_job_name(name: str, comment: str = "") -> str | None:

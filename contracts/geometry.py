@@ -67,6 +67,17 @@ class Pose:
         """This pose (written for the left half) for a team on the left or the right half."""
         return self if left else self.mirrored()
 
+    def to_relative(self, x_m: float, y_m: float) -> tuple[float, float]:
+        """A field point in the robot frame (x forward, y left) of a robot at this pose."""
+        dx, dy = x_m - self.x_m, y_m - self.y_m
+        c, s = math.cos(self.yaw_rad), math.sin(self.yaw_rad)
+        return c * dx + s * dy, -s * dx + c * dy
+
+    def to_field(self, x_m: float, y_m: float) -> tuple[float, float]:
+        """A point in the robot frame of a robot at this pose, on the field."""
+        c, s = math.cos(self.yaw_rad), math.sin(self.yaw_rad)
+        return self.x_m + c * x_m - s * y_m, self.y_m + s * x_m + c * y_m
+
 
 def wrap_angle(angle: float) -> float:
     """``angle`` in [-pi, pi)."""

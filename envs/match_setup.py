@@ -90,7 +90,6 @@ def build_match(
     from robot.motion import SERVO_PID
     from robot.stub.behaviour import Role
     from robot.stub.controller import StubController
-    from robot.stub.world_model import Pose2D
 
     mspec = match_spec(spec, seed)
     episode = episode_world(
@@ -112,7 +111,7 @@ def build_match(
     for stub in spec.stubs:
         controller = StubController(
             role=Role(stub.role) if stub.role != "idle" else Role.STRIKER,
-            start_pose=Pose2D(stub.x_m, stub.y_m, stub.yaw_rad),
+            start_pose=Pose(x_m=stub.x_m, y_m=stub.y_m, yaw_rad=stub.yaw_rad),
             model=spec.model,
             field_class=spec.field_class,
             home=(stub.x_m, stub.y_m) if stub.role == "defender" else None,
@@ -138,7 +137,6 @@ def tick_stub(stub: StubRobot, world: World, referee: Referee, range_m: float) -
     from envs.perception import CameraView
     from robot.stub.behaviour import GameInfo
     from robot.stub.controller import Sensors
-    from robot.stub.world_model import Pose2D
 
     gc = referee.gc
     robot = world.index.by_id[stub.id]
@@ -149,7 +147,8 @@ def tick_stub(stub: StubRobot, world: World, referee: Referee, range_m: float) -
     r = robot.root_qpos
     w, qx, qy, qz = data.qpos[r + 3 : r + 7]
     yaw = math.atan2(2 * (w * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
-    pose = Pose2D(*_team_pose(float(data.qpos[r]), float(data.qpos[r + 1]), yaw, attack))
+    x, y, heading = _team_pose(float(data.qpos[r]), float(data.qpos[r + 1]), yaw, attack)
+    pose = Pose(x_m=x, y_m=y, yaw_rad=heading)
     controller = stub.controller
     controller.world.reset_pose(pose)
     now = world.sim_time_ms

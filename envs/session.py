@@ -18,6 +18,7 @@ import numpy as np
 import numpy.typing as npt
 
 from contracts.field import field_for
+from contracts.geometry import Pose
 from envs.errors import EnvStateError, TrainerError
 from envs.frame import SENSOR_NAMES, Frame, GameView
 from envs.perception import CameraView, add_noise, field_segments, goal_post_feet
@@ -168,9 +169,7 @@ class LocalSession:
             frame.game = game_view(self.referee, self.learner)
             events = self.referee.events
             if self._events_seen < len(events):
-                from simulator.match_loop import event_dict
-
-                frame.events = [event_dict(e) for e in events[self._events_seen :]]
+                frame.events = [e.to_record() for e in events[self._events_seen :]]
                 self._events_seen = len(events)
         return frame
 
@@ -253,7 +252,7 @@ class LocalSession:
         if robot not in world.index.by_id:
             known = ", ".join(str(r) for r in world.robot_ids)
             raise TrainerError(operation="place_robot", reason=f"no {robot} here ({known})")
-        world.apply(TeleportRobot(robot=robot, x_m=x_m, y_m=y_m, yaw_rad=yaw_rad))
+        world.apply(TeleportRobot(robot=robot, pose=Pose(x_m=x_m, y_m=y_m, yaw_rad=yaw_rad)))
 
     def set_game_state(self, state: str) -> None:
         """Put the GameController into ``state`` now (INITIAL, READY, SET, PLAYING, FINISHED),

@@ -14,7 +14,7 @@ import logging
 import boto3
 import botocore.exceptions
 
-from orchestrator.engine.images import RegistryAuth
+from orchestrator.engine.images import RegistryLogin
 from orchestrator.errors import ImagePullError
 
 log = logging.getLogger(__name__)
@@ -27,7 +27,7 @@ def ecr_login(
     access_id: str | None = None,
     access_secret: str | None = None,
     image: str = "",
-) -> RegistryAuth:
+) -> RegistryLogin:
     """User and password for ``registry`` (``<account>.dkr.ecr.<region>.amazonaws.com``)."""
     account = registry.split(".", 1)[0]
     try:
@@ -54,7 +54,7 @@ def ecr_login(
             f"unexpected ECR token answer: {exc}",
         ) from exc
     log.info("ECR token for %s (region %s)", registry, region)
-    return RegistryAuth(username=username, password=password)
+    return RegistryLogin(username=username, password=password)
 
 
 __all__ = ["ecr_login"]

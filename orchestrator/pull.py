@@ -206,10 +206,10 @@ class _Logins:
     def __init__(self, auth: RegistryAuth | None, environ: Mapping[str, str]) -> None:
         self.auth = auth
         self.environ = environ
-        self._engine: dict[str, engine_images.RegistryAuth | None] = {}
+        self._engine: dict[str, engine_images.RegistryLogin | None] = {}
         self._clients: dict[str, RegistryClient] = {}
 
-    def engine_login(self, registry: str, reference: str) -> engine_images.RegistryAuth | None:
+    def engine_login(self, registry: str, reference: str) -> engine_images.RegistryLogin | None:
         if registry not in self._engine:
             self._engine[registry] = _login(registry, reference, self.auth, self.environ)
         return self._engine[registry]
@@ -266,7 +266,7 @@ def _resolve_one(
     registry = engine_images.registry_of(repository)
     attempts = 0
 
-    def pull_once(login: engine_images.RegistryAuth | None) -> engine_images.ImageInfo:
+    def pull_once(login: engine_images.RegistryLogin | None) -> engine_images.ImageInfo:
         nonlocal attempts
         attempts += 1
         task = progress.add(f"pull {reference}", unit="B")
@@ -279,7 +279,7 @@ def _resolve_one(
         task.finish()
         return info
 
-    def pull(login: engine_images.RegistryAuth | None) -> engine_images.ImageInfo:
+    def pull(login: engine_images.RegistryLogin | None) -> engine_images.ImageInfo:
         return retry(
             lambda: pull_once(login),
             transient=lambda exc: isinstance(exc, ImagePullError) and exc.transient,
@@ -332,7 +332,7 @@ def _resolve_one(
 
 def _login(
     registry: str, reference: str, auth: RegistryAuth | None, environ: Mapping[str, str]
-) -> engine_images.RegistryAuth | None:
+) -> engine_images.RegistryLogin | None:
     if auth is None:
         return None
     if auth.ecr is not None:
@@ -354,7 +354,7 @@ def _login(
             reason=f"authentication failed for {registry} (user {auth.username}): "
             f"environment variable {auth.password_env} is not set",
         )
-    return engine_images.RegistryAuth(username=auth.username, password=password)
+    return engine_images.RegistryLogin(username=auth.username, password=password)
 
 
 def _failed(

@@ -140,7 +140,7 @@ class Referee:
 
     def result(self) -> dict[str, object]:
         """score, winner (red, blue, draw; None before the end), events_summary {type: count},
-        spoofing {total, attempts}, play (see :class:`referee.play_stats.PlayStats`)."""
+        spoofing {total, attempts}, play (:class:`contracts.sim_result.PlayRecord`)."""
         self._report_spoofing()
         out = reporting.result(
             self.gc, self.events, finished=self._finished, winner=self._winner,
@@ -314,7 +314,7 @@ class Referee:
                     f"{pose.yaw_rad:.2f}).",
                 )
                 commands.append(
-                    TeleportRobot(robot=robot, x_m=pose.x_m, y_m=pose.y_m, yaw_rad=pose.yaw_rad)
+                    TeleportRobot(robot=robot, pose=pose)
                 )
                 if robot in self.limp:
                     commands.append(SetLimp(robot=robot, limp=False))

@@ -28,16 +28,8 @@ GC_LOG = files.GAMECONTROLLER_LOG
 
 
 def event_json(event: RefereeEvent) -> dict[str, object]:
-    return {
-        "time": round(event.sim_time_ms / 1000.0, 3),
-        "sim_time_ms": event.sim_time_ms,
-        "type": event.type,
-        "team": event.team.value if event.team is not None else None,
-        "player": event.player,
-        "reason": event.reason,
-        "placement": list(event.placement) if event.placement is not None else None,
-        "details": event.details,
-    }
+    """A line of the events log: the event's record and its time in seconds."""
+    return {"time": round(event.sim_time_ms / 1000.0, 3), **event.to_record()}
 
 
 class RefereeLog:

@@ -22,6 +22,7 @@ import math
 from dataclasses import dataclass, field
 
 from contracts.ids import RobotId, TeamColor
+from contracts.sim_result import PlayRecord
 from referee.gamecontroller import GameState, SecondaryState
 from referee.rules.base import GameView
 from referee.snapshot import RefereeEvent, WorldSnapshot
@@ -35,34 +36,6 @@ COLORS = (TeamColor.RED, TeamColor.BLUE)
 
 def _per_team() -> dict[TeamColor, int]:
     return dict.fromkeys(COLORS, 0)
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class PlayStats:
-    """What :class:`PlayTracker` counted (``to_json`` is the ``play`` object of the results)."""
-
-    halves_playing: tuple[int, ...]  # halves of regular time that reached PLAYING
-    playing_s: float  # simulated seconds spent in PLAYING
-    kicks: dict[TeamColor, int]
-    shots: dict[TeamColor, int]
-    goals: dict[TeamColor, int]  # goals credited to the team, own goals included
-    own_goals: dict[TeamColor, int]  # own goals the team's players scored (credited to the other)
-    falls: dict[TeamColor, int]
-
-    def to_json(self) -> dict[str, object]:
-        def teams(values: dict[TeamColor, int]) -> dict[str, int]:
-            return {color.value: values[color] for color in COLORS}
-
-        return {
-            "halves_playing": list(self.halves_playing),
-            "both_halves_playing": {1, 2} <= set(self.halves_playing),
-            "playing_s": round(self.playing_s, 3),
-            "kicks": teams(self.kicks),
-            "shots": teams(self.shots),
-            "goals": teams(self.goals),
-            "own_goals": teams(self.own_goals),
-            "falls": teams(self.falls),
-        }
 
 
 @dataclass(slots=True)
@@ -135,7 +108,8 @@ class PlayTracker:
             if recovered and robot.id not in view.penalised:
                 self.falls[robot.id.team] += 1
 
-    def stats(self, events: list[RefereeEvent]) -> PlayStats:
+    def stats(self, events: list[RefereeEvent]) -> PlayRecord:
+        """What was counted, as the ``play`` record of the results (goals from ``events``)."""
         goals, own_goals = _per_team(), _per_team()
         for event in events:
             if event.type != "goal" or event.team is None:
@@ -143,15 +117,20 @@ class PlayTracker:
             goals[event.team] += 1
             if event.details.get("own_goal"):
                 own_goals[event.team.opponent] += 1
-        return PlayStats(
+        return PlayRecord(
             halves_playing=tuple(sorted(self.halves)),
-            playing_s=self.playing_ms / 1000.0,
-            kicks=dict(self.kicks),
-            shots=dict(self.shots),
-            goals=goals,
-            own_goals=own_goals,
-            falls=dict(self.falls),
+            both_halves_playing={1, 2} <= self.halves,
+            playing_s=round(self.playing_ms / 1000.0, 3),
+            kicks=_teams(self.kicks),
+            shots=_teams(self.shots),
+            goals=_teams(goals),
+            own_goals=_teams(own_goals),
+            falls=_teams(self.falls),
         )
+
+
+def _teams(values: dict[TeamColor, int]) -> dict[str, int]:
+    return {color.value: values[color] for color in COLORS}
 
 
 def _towards_goal(snapshot: WorldSnapshot, view: GameView, team: TeamColor) -> bool:
@@ -165,4 +144,4 @@ def _towards_goal(snapshot: WorldSnapshot, view: GameView, team: TeamColor) -> b
     return abs(y_at_line) < geometry.goal_width_m / 2.0
 
 
-__all__ = ["PlayStats", "PlayTracker"]
+__all__ = ["PlayTracker"]

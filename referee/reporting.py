@@ -5,11 +5,12 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Sequence
 
+from contracts.codec import to_data
 from contracts.ids import TeamColor
+from contracts.sim_result import PlayRecord
 from contracts.telemetry import GameStateRecord, PenaltyRecord
 from referee.clock import Clock
 from referee.gamecontroller import GameController
-from referee.play_stats import PlayStats
 from referee.snapshot import RefereeEvent
 
 COLORS = (TeamColor.RED, TeamColor.BLUE)
@@ -54,7 +55,7 @@ def result(
     winner: TeamColor | None,
     shootout: bool,
     coin_toss: bool,
-    play: PlayStats,
+    play: PlayRecord,
 ) -> dict[str, object]:
     """``winner`` is ``"red"``, ``"blue"``, ``"draw"`` or None while the game is not over."""
     summary = Counter(event.type for event in events)
@@ -63,7 +64,7 @@ def result(
         "score": score(gc),
         "winner": (winner.value if winner is not None else "draw") if finished else None,
         "events_summary": dict(sorted(summary.items())),
-        "play": play.to_json(),
+        "play": to_data(play),
     }
     if shootout:
         out["shootout"] = {

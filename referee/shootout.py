@@ -35,7 +35,7 @@ class KickOutcome:
 
 
 def _teleport(robot: RobotId, pose: Pose) -> TeleportRobot:
-    return TeleportRobot(robot=robot, x_m=pose.x_m, y_m=pose.y_m, yaw_rad=pose.yaw_rad)
+    return TeleportRobot(robot=robot, pose=pose)
 
 
 class Shootout:

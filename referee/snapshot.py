@@ -7,10 +7,12 @@ applies before the next step. Frame: see :mod:`contracts.field`. Angles in radia
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from enum import Enum
 
+from contracts.geometry import Pose
 from contracts.ids import RobotId, TeamColor
+from contracts.telemetry import EventRecord
 
 Vec3 = tuple[float, float, float]
 Vec2 = tuple[float, float]
@@ -96,9 +98,7 @@ class TeleportRobot:
     reset its joints to the standing posture and zero its velocities."""
 
     robot: RobotId
-    x_m: float
-    y_m: float
-    yaw_rad: float
+    pose: Pose
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -121,9 +121,7 @@ class RestoreRobot:
     """Bring a removed robot back at a pose."""
 
     robot: RobotId
-    x_m: float
-    y_m: float
-    yaw_rad: float
+    pose: Pose
 
 
 WorldCommand = PlaceBall | TeleportRobot | SetLimp | RemoveRobot | RestoreRobot
@@ -140,3 +138,17 @@ class RefereeEvent:
     reason: str = ""
     placement: Vec3 | None = None
     details: dict[str, object] = field(default_factory=dict)
+
+    def to_record(self) -> EventRecord:
+        """The event as the replay, the telemetry and the events log carry it (a copy: nothing
+        shared with this event)."""
+        data = asdict(self)
+        return {
+            "sim_time_ms": data["sim_time_ms"],
+            "type": data["type"],
+            "team": self.team.value if self.team is not None else None,
+            "player": data["player"],
+            "reason": data["reason"],
+            "placement": data["placement"],
+            "details": data["details"],
+        }

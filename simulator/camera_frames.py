@@ -45,6 +45,7 @@ def render_camera_frames(
     import mujoco
     import numpy as np
 
+    from contracts.codec import from_data
     from simulator.png import write_png
     from simulator.render import Placer, _frames_for, scene_model
     from simulator.replay import load_replay, scene_for
@@ -58,7 +59,9 @@ def render_camera_frames(
     model = scene_model(scene)
     recorded = scene.get("camera_model")
     camera_model = (
-        CameraModel(**recorded) if recorded and not ideal else CameraModel.ideal()
+        from_data(CameraModel, recorded, source=str(replay_path), pointer="/scene/camera_model")
+        if recorded and not ideal
+        else CameraModel.ideal()
     )
     model.vis.global_.offwidth = max(model.vis.global_.offwidth, width)
     model.vis.global_.offheight = max(model.vis.global_.offheight, height)

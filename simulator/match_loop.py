@@ -31,7 +31,7 @@ from __future__ import annotations
 import logging
 import struct
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
@@ -97,20 +97,6 @@ class LoopSettings:
     lockstep: LockstepSettings
     end_of_game_real_s: float
     max_duration_real_s: float | None
-
-
-def event_dict(event: RefereeEvent) -> EventRecord:
-    """The event as the replay and the telemetry carry it (a copy: nothing shared)."""
-    data = asdict(event)
-    return {
-        "sim_time_ms": data["sim_time_ms"],
-        "type": data["type"],
-        "team": event.team.value if event.team is not None else None,
-        "player": data["player"],
-        "reason": data["reason"],
-        "placement": data["placement"],
-        "details": data["details"],
-    }
 
 
 class MatchLoop:
@@ -247,7 +233,7 @@ class MatchLoop:
         while self._events_seen < len(events):
             if events[self._events_seen].type == "state":
                 self._next_state_s = 0.0  # a new game state is published with this step
-            payload = event_dict(events[self._events_seen])
+            payload = events[self._events_seen].to_record()
             self._events_seen += 1
             if self.recorder is not None:
                 self.recorder.event(payload)

@@ -12,6 +12,7 @@ from typing import IO
 
 import numpy as np
 
+from contracts.codec import to_data
 from contracts.telemetry import EventRecord, GameStateRecord
 from simulator.replay.format import (
     CHUNK,
@@ -24,6 +25,7 @@ from simulator.replay.format import (
     U32,
     ChunkMeta,
     HeaderRecord,
+    RobotEntry,
     dumps,
     encode_poses,
 )
@@ -49,14 +51,16 @@ def replay_header(
         "rate_hz": rate_hz,
         "chunk_frames": chunk_frames,
         "robots": [
-            {
-                "team": p.id.team.value,
-                "number": p.id.number,
-                "model": p.model,
-                "x_m": p.x_m,
-                "y_m": p.y_m,
-                "yaw_rad": p.yaw_rad,
-            }
+            to_data(
+                RobotEntry(
+                    team=p.id.team.value,
+                    number=p.id.number,
+                    model=p.model,
+                    x_m=p.x_m,
+                    y_m=p.y_m,
+                    yaw_rad=p.yaw_rad,
+                )
+            )
             for p in world.placements
         ],
         "body_names": [world.model.body(i).name for i in range(world.model.nbody)],

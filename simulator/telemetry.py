@@ -81,7 +81,7 @@ def zenoh_config(
     return config
 
 
-class ZenohTelemetry:
+class ZenohPublisher:
     """Publishes the match state and referee events on a zenoh session."""
 
     def __init__(
@@ -125,4 +125,4 @@ def open_telemetry(
 ) -> Telemetry:
     if not listen:
         return NullTelemetry()
-    return ZenohTelemetry(match_id=match_id, listen=listen, scene=scene)
+    return ZenohPublisher(match_id=match_id, listen=listen, scene=scene)

@@ -70,18 +70,19 @@ def shot_layout(seed: int) -> tuple[tuple[float, float], tuple[float, float, flo
 
 def run_shot(*, seed: int, time_limit_s: float, goalie: bool) -> ShotResult:
     from contracts.gamecontroller import GameState
+    from contracts.geometry import Pose
     from contracts.ids import RobotId, TeamColor
     from referee.snapshot import PlaceBall
     from robot.motion import SERVO_PID
     from robot.stub.behaviour import GameInfo, Role
     from robot.stub.controller import StubController
-    from robot.stub.world_model import Pose2D
     from simulator.world import CameraRenderer, RobotPlacement, World
 
     ball, (x, y, yaw) = shot_layout(seed)
     striker = RobotId(TeamColor.RED, 1)
     placements = [RobotPlacement(id=striker, model="kid-default", x_m=x, y_m=y, yaw_rad=yaw)]
-    players = [(striker, StubController(role=Role.STRIKER, start_pose=Pose2D(x, y, yaw)))]
+    start = Pose(x_m=x, y_m=y, yaw_rad=yaw)
+    players = [(striker, StubController(role=Role.STRIKER, start_pose=start))]
     if goalie:
         keeper = RobotId(TeamColor.BLUE, 1)
         gx, gyaw = HALF_LENGTH_M - 0.5, math.pi
@@ -89,7 +90,8 @@ def run_shot(*, seed: int, time_limit_s: float, goalie: bool) -> ShotResult:
             RobotPlacement(id=keeper, model="kid-default", x_m=gx, y_m=0.0, yaw_rad=gyaw)
         )
         # the goalie's own frame: it defends x < 0
-        players.append((keeper, StubController(role=Role.GOALIE, start_pose=Pose2D(-gx, 0, 0))))
+        keeper_start = Pose(x_m=-gx, y_m=0, yaw_rad=0)
+        players.append((keeper, StubController(role=Role.GOALIE, start_pose=keeper_start)))
     world = World.create(field_class="kid", robots=placements, seed=seed)
     world.apply(PlaceBall(position=(ball[0], ball[1], world.field.ball_radius_m)))
     for robot, _ in players:

@@ -11,25 +11,19 @@ A match is DELIVERED only when every set was delivered (or there was none).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal, NotRequired, TypedDict
+from typing import Literal
+
+from contracts.codec import from_data, to_data
+from contracts.jsontypes import JSONObject
 
 LogState = Literal["pending", "delivered", "failed", "retrying", "none", "gone"]
 DONE: frozenset[str] = frozenset({"delivered", "none"})
 
 
-class TeamLogsRecord(TypedDict):
-    """A :class:`TeamLogs` in the ledger (JSON); earlier ledgers may lack the optional keys."""
-
-    team: str
-    state: LogState
-    cause: NotRequired[str]
-    target: NotRequired[str]
-    attempts: NotRequired[int]
-
-
 @dataclass(frozen=True, slots=True, kw_only=True)
 class TeamLogs:
-    """One team's (or the public) log set of one match."""
+    """One team's (or the public) log set of one match; in the ledger as JSON (its fields, read
+    by :func:`contracts.codec.from_data`: earlier ledgers may lack the keys with a default)."""
 
     team: str
     state: LogState
@@ -37,24 +31,15 @@ class TeamLogs:
     target: str = ""
     attempts: int = 0
 
-    def as_dict(self) -> TeamLogsRecord:
-        return {
-            "team": self.team,
-            "state": self.state,
-            "cause": self.cause,
-            "target": self.target,
-            "attempts": self.attempts,
-        }
+    def as_dict(self) -> JSONObject:
+        data: JSONObject = to_data(self)
+        return data
 
     @classmethod
-    def from_dict(cls, data: TeamLogsRecord) -> TeamLogs:
-        return cls(
-            team=str(data["team"]),
-            state=data["state"],
-            cause=str(data.get("cause", "")),
-            target=str(data.get("target", "")),
-            attempts=int(data.get("attempts", 0)),
-        )
+    def from_dict(cls, data: object, *, source: str = "ledger") -> TeamLogs:
+        """A set read back; :class:`~contracts.errors.ContractError` names a field that does
+        not fit."""
+        return from_data(cls, data, source=source)
 
     def describe(self) -> str:
         """``ants delivered``, ``bees failed after 3 attempts (unreachable: ...)``."""

@@ -14,18 +14,20 @@ import json
 import logging
 import re
 import sys
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NotRequired, TextIO, TypedDict
 
+from contracts.codec import to_data
 from orchestrator import ConfigError, OrchestratorError, Problem
 from orchestrator.exitcodes import ExitCode
 from orchestrator.paths import user_path
 
 if TYPE_CHECKING:
     from contracts.field import FieldClass
+    from contracts.jsontypes import JSONObject
     from orchestrator.config.detect import Kind
-    from simulator.world.robots.team.rulebook import MeasurementsRecord
+    from simulator.world.robots.team.rulebook import Measurements
 
 log = logging.getLogger(__name__)
 
@@ -85,23 +87,14 @@ def register(sub: Any) -> None:
     parser.set_defaults(func=run)
 
 
-class ProblemRecord(TypedDict):
-    file: str
-    pointer: str
-    message: str
-    expected: str
-    suggestion: str
-    severity: str  # "error" or "warning"
-
-
 class FileReportRecord(TypedDict):
     """One file of ``hlvs check --json``."""
 
-    measurements: NotRequired[MeasurementsRecord]  # robot model packages (first when there)
+    measurements: NotRequired[JSONObject]  # Measurements.to_json() (first when there)
     file: str
     kind: str | None
     valid: bool
-    problems: list[ProblemRecord]
+    problems: list[JSONObject]  # each a Problem (the root pointer written as "/")
 
 
 @dataclass(slots=True)
@@ -111,7 +104,7 @@ class FileReport:
     file: str
     kind: str | None
     problems: list[Problem] = field(default_factory=list)
-    measurements: MeasurementsRecord | None = None  # robot model packages
+    measurements: Measurements | None = None  # robot model packages
 
     @property
     def errors(self) -> list[Problem]:
@@ -126,21 +119,11 @@ class FileReport:
             "file": self.file,
             "kind": self.kind,
             "valid": self.valid,
-            "problems": [
-                {
-                    "file": p.file,
-                    "pointer": p.pointer or "/",
-                    "message": p.message,
-                    "expected": p.expected,
-                    "suggestion": p.suggestion,
-                    "severity": p.severity,
-                }
-                for p in self.problems
-            ],
+            "problems": [to_data(replace(p, pointer=p.pointer or "/")) for p in self.problems],
         }
         if self.measurements is None:
             return record
-        return {"measurements": self.measurements, **record}
+        return {"measurements": self.measurements.to_json(), **record}
 
 
 def run(args: argparse.Namespace) -> int:

@@ -29,7 +29,8 @@ from orchestrator.image_origin import local_name_reason
 
 
 def load_game(path: str | Path, *, images_required: bool = False) -> LoadedGame:
-    """game.json and the two team files it references, validated.
+    """game.json and the two team files it references, validated: the file read and given to
+    :func:`parse_game` (problems name the file).
 
     Args:
         path: the game.json file; team ``config`` paths are relative to its folder.
@@ -42,10 +43,8 @@ def load_game(path: str | Path, *, images_required: bool = False) -> LoadedGame:
     Raises:
         ConfigError: with every problem found in game.json and in both team files.
     """
-    loaded, problems = _game(Path(path), images_required=images_required)
-    raise_if_errors(problems)
-    assert loaded is not None
-    return loaded
+    path = Path(path)
+    return parse_game(read_json(path), source=path, images_required=images_required)
 
 
 def parse_game(
@@ -84,8 +83,8 @@ def parse_team(
 ) -> LoadedTeam:
     """A team_config.json document, validated (pose rules for ``field_class`` when given);
     ``source`` names it in problems and relative model folders resolve next to it."""
-    team, problems = _team_document(document, Path(source), field_class=field_class,
-                                    images_required=images_required)
+    team, problems = check_team_document(document, source=source, field_class=field_class,
+                                         images_required=images_required)
     raise_if_errors(problems)
     assert team is not None
     return LoadedTeam(team=team, warnings=tuple(problems))
@@ -94,11 +93,10 @@ def parse_team(
 def load_team(
     path: str | Path, *, field_class: FieldClass | None = None, images_required: bool = False
 ) -> LoadedTeam:
-    """One team_config.json file, validated (pose rules for ``field_class`` when given)."""
-    team, problems = _team(Path(path), field_class=field_class, images_required=images_required)
-    raise_if_errors(problems)
-    assert team is not None
-    return LoadedTeam(team=team, warnings=tuple(problems))
+    """One team_config.json file, validated: read and given to :func:`parse_team`."""
+    path = Path(path)
+    return parse_team(read_json(path), source=path, field_class=field_class,
+                      images_required=images_required)
 
 
 def check_team_document(
@@ -108,28 +106,41 @@ def check_team_document(
     field_class: FieldClass | None = None,
     images_required: bool = False,
 ) -> tuple[TeamConfig | None, list[Problem]]:
-    """A team document's TeamConfig (None when it has an error) and every problem of it."""
-    return _team_document(document, Path(source), field_class=field_class,
-                          images_required=images_required)
+    """A team document's TeamConfig (None when it has an error) and every problem of it (the
+    one team validation: :func:`parse_team` raises its errors, files are read and given here)."""
+    where = Collector(str(Path(source)))
+    team = build_team(
+        document,
+        where,
+        source=Path(source),
+        field_class=field_class,
+        images_required=images_required,
+    )
+    return team, where.problems
 
 
 def check_game(path: str | Path, *, images_required: bool = False) -> list[Problem]:
     """Every problem (errors and warnings) in game.json and the team files it references."""
-    return _game(Path(path), images_required=images_required)[1]
+    path = Path(path)
+    document, problems = _read(path)
+    if problems:
+        return problems
+    return _game_document(document, path, teams=None, images_required=images_required)[1]
 
 
 def check_team(
     path: str | Path, *, field_class: FieldClass | None = None, images_required: bool = False
 ) -> list[Problem]:
-    return _team(Path(path), field_class=field_class, images_required=images_required)[1]
+    """Every problem (errors and warnings) in one team_config.json file."""
+    return _team_file(Path(path), field_class=field_class, images_required=images_required)[1]
 
 
-def _game(path: Path, *, images_required: bool) -> tuple[LoadedGame | None, list[Problem]]:
+def _read(path: Path) -> tuple[object, list[Problem]]:
+    """The JSON document of a file, or the problem that it cannot be read or parsed."""
     try:
-        document = read_json(path)
+        return read_json(path), []
     except ConfigError as exc:
         return None, exc.problems
-    return _game_document(document, path, teams=None, images_required=images_required)
 
 
 def _game_document(
@@ -177,7 +188,7 @@ def _game_document(
                     severity="warning",
                 )
             )
-        team, team_problems = _team(
+        team, team_problems = _team_file(
             config, field_class=field_class, images_required=images_required
         )
         problems.extend(team_problems)
@@ -197,29 +208,14 @@ def _assembled(
     return LoadedGame(game=game, red=red, blue=blue, warnings=warnings), problems
 
 
-def _team(
+def _team_file(
     path: Path, *, field_class: FieldClass | None, images_required: bool
 ) -> tuple[TeamConfig | None, list[Problem]]:
-    try:
-        document = read_json(path)
-    except ConfigError as exc:
-        return None, exc.problems
-    return _team_document(document, path, field_class=field_class,
-                          images_required=images_required)
-
-
-def _team_document(
-    document: object, path: Path, *, field_class: FieldClass | None, images_required: bool
-) -> tuple[TeamConfig | None, list[Problem]]:
-    where = Collector(str(path))
-    team = build_team(
-        document,
-        where,
-        source=path,
-        field_class=field_class,
-        images_required=images_required,
-    )
-    return team, where.problems
+    document, problems = _read(path)
+    if problems:
+        return None, problems
+    return check_team_document(document, source=path, field_class=field_class,
+                               images_required=images_required)
 
 
 def _cross_checks(game: GameConfig, color: str, team: TeamConfig) -> list[Problem]:

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 from orchestrator.errors import Problem
 
 if TYPE_CHECKING:
-    from simulator.world.robots.team.rulebook import MeasurementsRecord
+    from simulator.world.robots.team.rulebook import Measurements
 
 MODEL_MANIFEST = "robot_model.json"
 MODELS_TARGET = "/opt/hlvs/team-models"
@@ -49,7 +49,7 @@ def spec_model(model: str) -> str:
 
 def check_model(
     path: Path, *, official: bool = False
-) -> tuple[list[Problem], MeasurementsRecord | None]:
+) -> tuple[list[Problem], Measurements | None]:
     """Problems and measurements of a model package (None when it cannot even be loaded);
     free-form servos are warnings, or errors when ``official``. Imports the simulator's model
     loader (and MuJoCo) on first use."""
@@ -64,13 +64,14 @@ def check_model(
         return [Problem(p.source, p.where, p.reason) for p in exc.problems], None
     return [
         Problem(p.source, p.where, p.reason, severity=p.severity) for p in found
-    ], measurements.to_json()
+    ], measurements
 
 
-def describe(measurements: MeasurementsRecord) -> str:
-    m = measurements
+def describe(measurements: Measurements) -> str:
+    """One line of the measurements, rounded as ``hlvs check`` shows them."""
+    m = measurements.rounded()
     return (
-        f"H {m['height_m']} m, Hleg {m['leg_m']} m, Hhead {m['head_m']} m, Harm {m['arm_m']} m, "
-        f"foot {m['foot_length_m']} x {m['foot_width_m']} m, mass {m['mass_kg']} kg, "
-        f"{m['motors']} motors, {m['cameras']} camera(s)"
+        f"H {m.height_m} m, Hleg {m.leg_m} m, Hhead {m.head_m} m, Harm {m.arm_m} m, "
+        f"foot {m.foot_length_m} x {m.foot_width_m} m, mass {m.mass_kg} kg, "
+        f"{m.motors} motors, {m.cameras} camera(s)"
     )

@@ -14,10 +14,12 @@ import json
 import logging
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from pathlib import Path
-from typing import TypedDict, TypeVar
+from typing import TypeVar
 
+from contracts.codec import to_data
+from contracts.jsontypes import JSONObject
 from orchestrator.config.credentials import Credentials, load_credentials
 from orchestrator.console import NullProgress, Progress
 from orchestrator.delivery import store as st
@@ -53,22 +55,6 @@ class RetryPolicy:
     max_delay_s: float = 30.0
 
 
-class DeliveryOutcomeRecord(TypedDict):
-    """A :class:`DeliveryOutcome` as JSON (``hlvs logs deliver --json``)."""
-
-    set_id: str
-    match_id: str
-    team: str
-    target: str
-    delivered: bool
-    uploaded_files: int
-    skipped_files: int
-    uploaded_bytes: int
-    seconds: float
-    error_kind: str | None
-    error_reason: str | None
-
-
 @dataclass(frozen=True, slots=True, kw_only=True)
 class DeliveryOutcome:
     set_id: str
@@ -82,20 +68,15 @@ class DeliveryOutcome:
     seconds: float = 0.0
     error: DeliveryError | None = None
 
-    def to_json(self) -> DeliveryOutcomeRecord:
-        return {
-            "set_id": self.set_id,
-            "match_id": self.match_id,
-            "team": self.team,
-            "target": self.target,
-            "delivered": self.delivered,
-            "uploaded_files": self.uploaded_files,
-            "skipped_files": self.skipped_files,
-            "uploaded_bytes": self.uploaded_bytes,
-            "seconds": self.seconds,
-            "error_kind": self.error.kind if self.error else None,
-            "error_reason": self.error.reason if self.error else None,
+    def to_json(self) -> JSONObject:
+        """The outcome as JSON (``hlvs logs deliver --json``): its fields, the error as its
+        kind and reason."""
+        data: JSONObject = {
+            f.name: to_data(getattr(self, f.name)) for f in fields(self) if f.name != "error"
         }
+        data["error_kind"] = self.error.kind if self.error else None
+        data["error_reason"] = self.error.reason if self.error else None
+        return data
 
 
 def deliver_pending(

@@ -40,7 +40,7 @@ class ImageInfo:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
-class RegistryAuth:
+class RegistryLogin:
     """Credentials for one registry, as the engine's ``auth_config`` wants them."""
 
     username: str
@@ -201,7 +201,7 @@ def remove(client: docker.DockerClient, reference: str) -> None:
 
 
 def push(
-    client: docker.DockerClient, repository: str, tag_name: str, *, auth: RegistryAuth | None
+    client: docker.DockerClient, repository: str, tag_name: str, *, auth: RegistryLogin | None
 ) -> str:
     """Push ``repository:tag`` and return the manifest digest the registry reported."""
     reference = f"{repository}:{tag_name}"
@@ -249,7 +249,7 @@ def pull(
     repository: str,
     tag_name: str,
     *,
-    auth: RegistryAuth | None,
+    auth: RegistryLogin | None,
     on_progress: PullSink | None = None,
 ) -> ImageInfo:
     """Pull ``repository:tag`` and return the local image (its ``repo_digests`` pin it).
@@ -331,7 +331,7 @@ def _transient(message: str) -> bool:
     return any(word in lowered for word in _TRANSIENT)
 
 
-def _classify(reference: str, message: str, auth: RegistryAuth | None) -> str:
+def _classify(reference: str, message: str, auth: RegistryLogin | None) -> str:
     """An engine error message in the words an operator can act on."""
     repository, _, tag_name = reference.rpartition(":")
     registry = registry_of(repository) or "docker.io"
@@ -351,7 +351,7 @@ __all__ = [
     "ImageInfo",
     "PullEvent",
     "PullSink",
-    "RegistryAuth",
+    "RegistryLogin",
     "build",
     "import_rootfs",
     "inspect",

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from referee.gamecontroller.machine import GameController, RobotInfo, SetPlay, TeamInfo, Tick
+from referee.gamecontroller.machine import GameController, RobotStatus, SetPlay, TeamStatus, Tick
 from referee.gamecontroller.packet import game_control_data
 from referee.gamecontroller.states import (
     DROPBALL_TEAM,
@@ -18,10 +18,10 @@ __all__ = [
     "GameController",
     "GameState",
     "Penalty",
-    "RobotInfo",
+    "RobotStatus",
     "SecondaryState",
     "SetPlay",
-    "TeamInfo",
+    "TeamStatus",
     "Tick",
     "game_control_data",
 ]

@@ -28,7 +28,10 @@ EPSILON_S = 1e-6  # timers are sums of 8 ms steps in floating point
 
 
 @dataclass(slots=True)
-class RobotInfo:
+class RobotStatus:
+    """A robot's penalty, cards and role as the GameController keeps them (the wire's
+    ``contracts.gamecontroller.RobotInfo`` is built from it each packet)."""
+
     penalty: Penalty = Penalty.NONE
     secs_till_unpenalised: float = 0.0
     warnings: int = 0
@@ -38,11 +41,14 @@ class RobotInfo:
 
 
 @dataclass(slots=True)
-class TeamInfo:
+class TeamStatus:
+    """A team's score, shoot-out and robots as the GameController keeps them (the wire's
+    ``contracts.gamecontroller.TeamInfo`` is built from it each packet)."""
+
     score: int = 0
     penalty_shots: int = 0  # shoot-out kicks taken
     single_shots: int = 0  # bit i set: kick i scored
-    robots: dict[int, RobotInfo] = field(default_factory=dict)
+    robots: dict[int, RobotStatus] = field(default_factory=dict)
 
 
 @dataclass(frozen=True, slots=True)
@@ -84,8 +90,8 @@ class GameController:
         self.secondary_time = 0.0
         self.period_started = False  # a PLAYING of this period began: READY and SET run the clock
         self.set_play: SetPlay | None = None
-        self.teams: dict[TeamColor, TeamInfo] = {
-            color: TeamInfo(robots={n: RobotInfo() for n in numbers})
+        self.teams: dict[TeamColor, TeamStatus] = {
+            color: TeamStatus(robots={n: RobotStatus() for n in numbers})
             for color, numbers in players.items()
         }
         keepers = goalkeepers or {}
@@ -119,7 +125,7 @@ class GameController:
     def score(self, color: TeamColor) -> int:
         return self.teams[color].score
 
-    def robot(self, robot: RobotId) -> RobotInfo:
+    def robot(self, robot: RobotId) -> RobotStatus:
         return self.teams[robot.team].robots[robot.number]
 
     def penalised(self) -> tuple[RobotId, ...]:

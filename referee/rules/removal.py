@@ -52,7 +52,7 @@ def reentry_pose(
 
 def removal_commands(robot: RobotId, pose: Pose) -> list[WorldCommand]:
     return [
-        TeleportRobot(robot=robot, x_m=pose.x_m, y_m=pose.y_m, yaw_rad=pose.yaw_rad),
+        TeleportRobot(robot=robot, pose=pose),
         SetLimp(robot=robot, limp=True),
     ]
 

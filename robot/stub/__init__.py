@@ -11,13 +11,12 @@ from robot.stub.behaviour import Action, GameInfo, Role, decide
 from robot.stub.controller import Sensors, StubController
 from robot.stub.errors import StubConfigError, StubConnectionError, StubError
 from robot.stub.options import Behaviour, RobotEnv, StubOptions, parse_args, read_env
-from robot.stub.world_model import Pose2D, WorldModel
+from robot.stub.world_model import WorldModel
 
 __all__ = [
     "Action",
     "Behaviour",
     "GameInfo",
-    "Pose2D",
     "RobotEnv",
     "Role",
     "Sensors",

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from enum import StrEnum
 
 from contracts.gamecontroller import GameState
-from robot.stub.world_model import Pose2D
+from contracts.geometry import Pose
 
 
 class Role(StrEnum):
@@ -74,7 +74,7 @@ def decide(
     *,
     role: Role,
     game: GameInfo,
-    pose: Pose2D,
+    pose: Pose,
     ball: tuple[float, float] | None,
     field: Field,
     searching_s: float,
@@ -109,24 +109,24 @@ def _kick_off_aim(field: Field) -> tuple[float, float]:
 
 def _kick_off_position(
     role: Role, game: GameInfo, field: Field, home: tuple[float, float] | None
-) -> Pose2D:
+) -> Pose:
     if role is Role.GOALIE:
-        return Pose2D(-field.half_length_m + 0.5, 0.0, 0.0)
+        return Pose(x_m=-field.half_length_m + 0.5, y_m=0.0, yaw_rad=0.0)
     if role is Role.DEFENDER:
         x, y = home or DEFENDER_HOME
-        return Pose2D(x, y, 0.0)
+        return Pose(x_m=x, y_m=y, yaw_rad=0.0)
     if not game.our_kick_off:
-        return Pose2D(-1.0, 0.0, 0.0)
+        return Pose(x_m=-1.0, y_m=0.0, yaw_rad=0.0)
     # facing along the kick-off pass, the ball a little short of the left foot's kick spot
     ax, ay = _kick_off_aim(field)
     direction = math.atan2(ay, ax)
     c, s = math.cos(direction), math.sin(direction)
     ahead, left = field.kick_x_m + KICK_OFF_SHORT_M, field.foot_y_m
-    return Pose2D(-(c * ahead - s * left), -(s * ahead + c * left), direction)
+    return Pose(x_m=-(c * ahead - s * left), y_m=-(s * ahead + c * left), yaw_rad=direction)
 
 
 def _defender(
-    pose: Pose2D,
+    pose: Pose,
     ball: tuple[float, float] | None,
     field: Field,
     searching_s: float,
@@ -142,11 +142,11 @@ def _defender(
             return _striker(pose, ball, field, searching_s)
     hx, hy = pose.to_relative(*home)
     if math.hypot(hx, hy) > 0.4:
-        return _go_to(pose, Pose2D(home[0], home[1], 0.0), tolerance_m=0.3)
+        return _go_to(pose, Pose(x_m=home[0], y_m=home[1], yaw_rad=0.0), tolerance_m=0.3)
     return _face(ball, tolerance_rad=0.3)
 
 
-def _go_to(pose: Pose2D, target: Pose2D, *, tolerance_m: float = 0.2) -> Action:
+def _go_to(pose: Pose, target: Pose, *, tolerance_m: float = 0.2) -> Action:
     x, y = pose.to_relative(target.x_m, target.y_m)
     distance = math.hypot(x, y)
     if distance < tolerance_m:
@@ -161,7 +161,7 @@ def _go_to(pose: Pose2D, target: Pose2D, *, tolerance_m: float = 0.2) -> Action:
 
 
 def _striker(
-    pose: Pose2D,
+    pose: Pose,
     ball: tuple[float, float] | None,
     field: Field,
     searching_s: float,
@@ -232,9 +232,9 @@ def _approach(bx: float, by: float, goal_bearing: float) -> Action:
 
 
 def _goalie(
-    pose: Pose2D, ball: tuple[float, float] | None, field: Field, searching_s: float
+    pose: Pose, ball: tuple[float, float] | None, field: Field, searching_s: float
 ) -> Action:
-    home = Pose2D(-field.half_length_m + 0.5, 0.0, 0.0)
+    home = Pose(x_m=-field.half_length_m + 0.5, y_m=0.0, yaw_rad=0.0)
     hx, hy = pose.to_relative(home.x_m, home.y_m)
     if math.hypot(hx, hy) > 0.5:
         return _go_to(pose, home, tolerance_m=0.3)

@@ -15,6 +15,7 @@ import numpy as np
 import numpy.typing as npt
 
 from contracts.gamecontroller import GameState
+from contracts.geometry import Pose
 from robot.learned import Policy, PolicyMotion
 from robot.learned.policy import KICK_BALL_AHEAD_M
 from robot.motion import AttitudeFilter, GetUpMotion, KickMotion, WalkEngine, kinematics
@@ -28,7 +29,7 @@ from robot.stub.perception import (
     ground_point,
     white_above_horizon,
 )
-from robot.stub.world_model import Pose2D, WorldModel
+from robot.stub.world_model import WorldModel
 
 logger = logging.getLogger(__name__)
 
@@ -93,7 +94,7 @@ class StubController:
         self,
         *,
         role: Role,
-        start_pose: Pose2D,
+        start_pose: Pose,
         model: str = "kid-default",
         field_class: str = "kid",
         detect_side: bool = False,
@@ -155,7 +156,7 @@ class StubController:
         return self._motion_kind if self._motion is not None else ""
 
     def reset_pose(
-        self, pose: Pose2D, *, check_side: bool = True, expect_mirrored: bool | None = None
+        self, pose: Pose, *, check_side: bool = True, expect_mirrored: bool | None = None
     ) -> None:
         """Start again from ``pose`` (team-file frame when ``check_side``; the turned frame of
         the odometry otherwise). ``expect_mirrored`` applies when the check is undecided.
@@ -234,7 +235,7 @@ class StubController:
             "mirrored pitch" if self.mirrored else "as in the team file",
         )
         if self.mirrored:
-            self.world.reset_pose(Pose2D(pose.x_m, -pose.y_m, -pose.yaw_rad))
+            self.world.reset_pose(Pose(x_m=pose.x_m, y_m=-pose.y_m, yaw_rad=-pose.yaw_rad))
 
     def _side_from_gamecontroller(self, on_left: bool) -> None:
         """The league's GameController puts the TeamInfo of the team playing on the left first:
@@ -245,7 +246,7 @@ class StubController:
                     else "left (as in the team file)")
         if self.mirrored:
             pose = self.world.pose
-            self.world.reset_pose(Pose2D(pose.x_m, -pose.y_m, -pose.yaw_rad))
+            self.world.reset_pose(Pose(x_m=pose.x_m, y_m=-pose.y_m, yaw_rad=-pose.yaw_rad))
 
     def _moved_by_someone_else(self, joints: dict[str, float]) -> bool:
         knees = [name for name in self.kin.motor_names if name.startswith("LegLower")]

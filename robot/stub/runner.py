@@ -20,6 +20,7 @@ from types import FrameType
 import numpy as np
 
 from contracts.gamecontroller import GameState
+from contracts.geometry import Pose
 from contracts.robot_api import messages_pb2 as pb
 from robot.client import ConnectionClosed, RobotClient, RobotClientError
 from robot.client.errors import ReceiveTimeout
@@ -31,7 +32,6 @@ from robot.stub.errors import StubConfigError
 from robot.stub.faults import MirrorFlooder, fill_logs
 from robot.stub.gamestate import GameControllerLink
 from robot.stub.options import Behaviour, RobotEnv, StubOptions, parse_args, read_env
-from robot.stub.world_model import Pose2D
 
 logger = logging.getLogger(__name__)
 
@@ -41,10 +41,10 @@ CONNECT_RETRY_S = 0.25  # a refused connect costs nothing; the simulator may boo
 CRASH_EXIT_CODE = 1
 
 
-def default_start_pose(robot_id: int) -> Pose2D:
+def default_start_pose(robot_id: int) -> Pose:
     """HLVS-style spawn pose in the team's own frame: on the touch line of the own half,
     facing into the field. Pass ``--start-pose`` to match the team file."""
-    return Pose2D(-3.6 + 0.8 * (robot_id - 1), -3.2, math.pi / 2)
+    return Pose(x_m=-3.6 + 0.8 * (robot_id - 1), y_m=-3.2, yaw_rad=math.pi / 2)
 
 
 class StubRobot:
@@ -59,7 +59,9 @@ class StubRobot:
             Behaviour.DEFENDER: Role.DEFENDER,
         }.get(options.behaviour, Role.IDLE)
         self.start_pose = (
-            Pose2D(*options.start_pose) if options.start_pose else default_start_pose(env.robot_id)
+            Pose(x_m=options.start_pose[0], y_m=options.start_pose[1],
+                 yaw_rad=options.start_pose[2])
+            if options.start_pose else default_start_pose(env.robot_id)
         )
         self.controller = StubController(
             role=role,
@@ -201,7 +203,7 @@ class StubRobot:
             if was_penalised and not game.penalised:
                 pose = self.controller.world.pose
                 side = -1.0 if pose.y_m < 0 else 1.0
-                reentry = Pose2D(-3.0, 3.2 * side, -side * math.pi / 2)
+                reentry = Pose(x_m=-3.0, y_m=3.2 * side, yaw_rad=-side * math.pi / 2)
                 self.controller.reset_pose(reentry, check_side=False)
             was_penalised = game.penalised
             targets = self.controller.tick(_sensors(measurement, image), game)

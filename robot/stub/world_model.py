@@ -9,36 +9,20 @@ tolerates (it only needs a rough idea of where the opponent goal is).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import replace
+
+from contracts.geometry import Pose
 
 Vec3 = tuple[float, float, float]
 
 
-@dataclass(frozen=True, slots=True)
-class Pose2D:
-    x_m: float
-    y_m: float
-    yaw_rad: float
-
-    def to_relative(self, x_m: float, y_m: float) -> tuple[float, float]:
-        """A field point in the robot frame (x forward, y left)."""
-        dx, dy = x_m - self.x_m, y_m - self.y_m
-        c, s = math.cos(self.yaw_rad), math.sin(self.yaw_rad)
-        return c * dx + s * dy, -s * dx + c * dy
-
-    def to_field(self, x_m: float, y_m: float) -> tuple[float, float]:
-        """A robot-frame point on the field."""
-        c, s = math.cos(self.yaw_rad), math.sin(self.yaw_rad)
-        return self.x_m + c * x_m - s * y_m, self.y_m + s * x_m + c * y_m
-
-
 class WorldModel:
-    def __init__(self, start: Pose2D) -> None:
+    def __init__(self, start: Pose) -> None:
         self.pose = start
         self.ball_field: tuple[float, float] | None = None
         self.ball_seen_ms: int | None = None
 
-    def reset_pose(self, pose: Pose2D) -> None:
+    def reset_pose(self, pose: Pose) -> None:
         self.pose = pose
         self.ball_field = None
         self.ball_seen_ms = None
@@ -62,10 +46,10 @@ class WorldModel:
             math.sin(self.pose.yaw_rad + turned_rad),
             math.cos(self.pose.yaw_rad + turned_rad),
         )
-        self.pose = Pose2D(
-            self.pose.x_m + (c * vx - s * vy) * dt_s,
-            self.pose.y_m + (s * vx + c * vy) * dt_s,
-            yaw,
+        self.pose = Pose(
+            x_m=self.pose.x_m + (c * vx - s * vy) * dt_s,
+            y_m=self.pose.y_m + (s * vx + c * vy) * dt_s,
+            yaw_rad=yaw,
         )
 
     def forget_ball(self) -> None:
@@ -81,7 +65,7 @@ class WorldModel:
         READY and SET): move the believed position by ``gain`` of the way to where that sighting
         puts the robot (the heading stays the gyro's)."""
         fx, fy = self.pose.to_field(x_rel_m, y_rel_m)
-        self.pose = Pose2D(self.pose.x_m - gain * fx, self.pose.y_m - gain * fy, self.pose.yaw_rad)
+        self.pose = replace(self.pose, x_m=self.pose.x_m - gain * fx, y_m=self.pose.y_m - gain * fy)
         self.ball_field = self.pose.to_field(x_rel_m, y_rel_m)
 
     def ball_relative(self, time_ms: int, *, max_age_ms: int) -> tuple[float, float] | None:

@@ -77,7 +77,7 @@ class GeomRecord(TypedDict):
     pattern: NotRequired[PatternRecord]
 
 
-class CameraRecord(TypedDict):
+class SceneCameraRecord(TypedDict):
     """A fixed camera of the field (on the world body)."""
 
     name: str
@@ -87,7 +87,7 @@ class CameraRecord(TypedDict):
     fovy_deg: float
 
 
-class RobotCameraRecord(CameraRecord):
+class RobotCameraRecord(SceneCameraRecord):
     """A robot's head camera."""
 
     robot: str  # robot key, "red-1"
@@ -116,38 +116,18 @@ class LookRecord(TypedDict):
     sky_colors: list[list[float]]  # sky top, horizon, stands
 
 
-class CameraModelRecord(TypedDict):
-    """The figures of a match's robot cameras (``simulator.world.CameraModel``'s fields)."""
-
-    seed: int
-    exposure_gain: float
-    auto_exposure: float
-    noise_std: float
-    motion_blur: bool
-    exposure_s: float
-
-
 class SceneRecord(TypedDict):
     """What a viewer needs to draw a match (see :mod:`simulator.replay.scene`); replays of
     earlier versions lack the keys marked ``NotRequired``."""
 
     bodies: list[str]
     geoms: list[GeomRecord]
-    cameras: list[CameraRecord]
+    cameras: list[SceneCameraRecord]
     robot_cameras: NotRequired[list[RobotCameraRecord]]
     robots: list[SceneRobotRecord]
     field: JSONObject  # contracts.field.FieldGeometry's fields
     look: NotRequired[LookRecord]
-    camera_model: NotRequired[CameraModelRecord | None]
-
-
-class HeaderRobotRecord(TypedDict):
-    team: str
-    number: int
-    model: str
-    x_m: float
-    y_m: float
-    yaw_rad: float
+    camera_model: NotRequired[JSONObject | None]  # simulator.world.CameraModel (contracts.codec)
 
 
 class HeaderRecord(TypedDict):
@@ -162,7 +142,7 @@ class HeaderRecord(TypedDict):
     step_ms: int
     rate_hz: float
     chunk_frames: NotRequired[int]
-    robots: list[HeaderRobotRecord]
+    robots: list[JSONObject]  # each a RobotEntry (contracts.codec)
     body_names: list[str]
     scene: NotRequired[SceneRecord]  # versions 2 and 3
 
@@ -218,7 +198,8 @@ def decode_poses(blob: bytes, frames: int, bodies: int) -> npt.NDArray[np.float3
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class RobotEntry:
-    """A robot as the replay header lists it (team colour value, number, model, start pose)."""
+    """A robot as the replay header lists it (team colour value, number, model, start pose):
+    the header's ``robots`` entries are these, written and read by :mod:`contracts.codec`."""
 
     team: str
     number: int

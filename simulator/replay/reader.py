@@ -24,6 +24,8 @@ from typing import IO, cast
 
 import numpy as np
 
+from contracts.codec import from_data
+from contracts.errors import ContractError
 from contracts.telemetry import EventRecord, GameStateRecord
 from simulator.errors import ReplayError
 from simulator.replay.format import (
@@ -53,7 +55,7 @@ _V1_FRAME_HEAD = struct.Struct("<II")
 _CORRUPT = (struct.error, zlib.error, ValueError, KeyError, TypeError, IndexError)
 
 
-def _header(data: HeaderRecord) -> ReplayHeader:
+def _header(data: HeaderRecord, *, source: str) -> ReplayHeader:
     return ReplayHeader(
         version=int(data["version"]),
         match_id=str(data["match_id"]),
@@ -63,15 +65,8 @@ def _header(data: HeaderRecord) -> ReplayHeader:
         step_ms=int(data["step_ms"]),
         rate_hz=float(data["rate_hz"]),
         robots=tuple(
-            RobotEntry(
-                team=str(r["team"]),
-                number=int(r["number"]),
-                model=str(r["model"]),
-                x_m=float(r["x_m"]),
-                y_m=float(r["y_m"]),
-                yaw_rad=float(r["yaw_rad"]),
-            )
-            for r in data["robots"]
+            from_data(RobotEntry, r, source=source, pointer=f"/robots/{i}")
+            for i, r in enumerate(data["robots"])
         ),
         body_names=tuple(str(n) for n in data["body_names"]),
         scene=data.get("scene"),
@@ -126,7 +121,10 @@ class ReplayFile:
                 f"format version {version!r}; this reader knows versions "
                 f"{', '.join(str(v) for v in SUPPORTED_VERSIONS)} (a newer hlvs-runner wrote it?)"
             )
-        self.header = _header(cast("HeaderRecord", raw))  # each field converted and checked
+        try:  # each field converted and checked
+            self.header = _header(cast("HeaderRecord", raw), source=str(self.path))
+        except ContractError as exc:
+            raise self._error(f"header: {exc.pointer}: {exc.reason}") from exc
         self.nbody = len(self.header.body_names)
         self._data_start = len(MAGIC) + 4 + length
         self.events: tuple[EventRecord, ...] = ()

@@ -28,19 +28,20 @@ checker). ``texture`` names one of the look's materials (``look:turf``, ``look:b
 from __future__ import annotations
 
 from dataclasses import asdict
-from typing import TYPE_CHECKING, Any, cast
+from typing import TYPE_CHECKING, Any
+
+from contracts.codec import to_data
 
 if TYPE_CHECKING:
     import mujoco
 
     from contracts.field import FieldGeometry
     from simulator.replay.format import (
-        CameraModelRecord,
-        CameraRecord,
         GeomRecord,
         PatternRecord,
         ReplayHeader,
         RobotCameraRecord,
+        SceneCameraRecord,
         SceneRecord,
         SceneRobotRecord,
     )
@@ -157,7 +158,7 @@ def scene_of(
         robots.append(
             {"team": p.id.team.value, "number": p.id.number, "model": p.model, "root_body": root}
         )
-    cameras: list[CameraRecord] = [
+    cameras: list[SceneCameraRecord] = [
         {
             "name": model.camera(i).name,
             "body": int(model.cam_bodyid[i]),
@@ -197,9 +198,7 @@ def scene_of(
         "robots": robots,
         "field": field_data,
         "look": (look if look is not None else look_for(0)).summary(),
-        "camera_model": (
-            cast("CameraModelRecord", asdict(camera_model)) if camera_model is not None else None
-        ),
+        "camera_model": to_data(camera_model) if camera_model is not None else None,
     }
 
 

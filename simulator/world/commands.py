@@ -49,13 +49,13 @@ def apply(world: CommandTarget, command: WorldCommand) -> None:
         return
     number = world.index.by_id[command.robot].number
     if isinstance(command, TeleportRobot):
-        teleport(world, number, command.x_m, command.y_m, command.yaw_rad)
+        teleport(world, number, command.pose.x_m, command.pose.y_m, command.pose.yaw_rad)
     elif isinstance(command, SetLimp):
         set_limp(world, number, command.limp)
     elif isinstance(command, RemoveRobot):
         remove(world, number)
     elif isinstance(command, RestoreRobot):
-        restore(world, number, command.x_m, command.y_m, command.yaw_rad)
+        restore(world, number, command.pose.x_m, command.pose.y_m, command.pose.yaw_rad)
     mujoco.mj_forward(world.model, world.data)
 
 

@@ -129,9 +129,11 @@ def _apply_action(run: Run, action: Action, first: bool) -> None:
         world.apply(
             TeleportRobot(
                 robot=robot,
-                x_m=float(args["x"]),
-                y_m=float(args["y"]),
-                yaw_rad=float(args.get("yaw", 0.0)),
+                pose=Pose(
+                    x_m=float(args["x"]),
+                    y_m=float(args["y"]),
+                    yaw_rad=float(args.get("yaw", 0.0)),
+                ),
             )
         )
     elif action.kind == "push":

@@ -90,7 +90,7 @@ class KinematicWorld:
             return
         robot = self.robots[command.robot]
         if isinstance(command, TeleportRobot | RestoreRobot):
-            robot.x, robot.y, robot.yaw = command.x_m, command.y_m, command.yaw_rad
+            robot.x, robot.y, robot.yaw = command.pose.x_m, command.pose.y_m, command.pose.yaw_rad
             robot.removed = robot.removed and isinstance(command, TeleportRobot)
         elif isinstance(command, SetLimp):
             robot.limp = command.limp

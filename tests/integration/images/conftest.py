@@ -300,8 +300,9 @@ def make_image(docker_client: docker.DockerClient) -> Iterator[MakeImage]:
 
 def push(client: docker.DockerClient, reference: str, user: str, password: str) -> str:
     """Push through the engine with a login; returns the manifest digest."""
-    from orchestrator.engine.images import RegistryAuth
+    from orchestrator.engine.images import RegistryLogin
     from orchestrator.engine.images import push as engine_push
 
     repository, _, tag = reference.rpartition(":")
-    return engine_push(client, repository, tag, auth=RegistryAuth(username=user, password=password))
+    login = RegistryLogin(username=user, password=password)
+    return engine_push(client, repository, tag, auth=login)

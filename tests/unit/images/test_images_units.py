@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from orchestrator.engine.images import RegistryAuth, _classify, registry_of
+from orchestrator.engine.images import RegistryLogin, _classify, registry_of
 from orchestrator.errors import ImagePullError
 from orchestrator.project_images import content_hash
 from orchestrator.pull import split_reference
@@ -81,7 +81,7 @@ def test_split_reference() -> None:
 
 
 def test_classify_engine_messages() -> None:
-    auth = RegistryAuth(username="alpha", password="x")
+    auth = RegistryLogin(username="alpha", password="x")
     ref = "127.0.0.1:5000/alpha/robot:v9"
     assert _classify(ref, "Head ...: no basic auth credentials", auth).startswith(
         "authentication failed for 127.0.0.1:5000 (user alpha)"

@@ -22,8 +22,8 @@ def test_start_teleports_to_half_time_poses_and_places_ball() -> None:
     assert len(teleports) == 4
     red1 = next(t for t in teleports if str(t.robot) == "red player 1")
     blue1 = next(t for t in teleports if str(t.robot) == "blue player 1")
-    assert (red1.x_m, red1.y_m) == (-1.5, -3.1)
-    assert (blue1.x_m, blue1.y_m) == (1.5, -3.1)  # mirrored for the right side
+    assert (red1.pose.x_m, red1.pose.y_m) == (-1.5, -3.1)
+    assert (blue1.pose.x_m, blue1.pose.y_m) == (1.5, -3.1)  # mirrored for the right side
     assert PlaceBall(position=(0.0, 0.0, 0.07)) in commands
 
 

@@ -80,7 +80,7 @@ def test_falls_count_once_per_fall_and_halves_reaching_playing() -> None:
                         _view(half=1 if ms < 100 else 2))
     stats = tracker.stats([])
     assert stats.falls == {RED: 0, BLUE: 2}
-    assert stats.halves_playing == (1, 2) and stats.to_json()["both_halves_playing"] is True
+    assert stats.halves_playing == (1, 2) and stats.both_halves_playing is True
     assert stats.playing_s == pytest.approx(1.548)
 
 

@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 
 from contracts.gamecontroller import GameState
+from contracts.geometry import Pose
 from robot.learned import Policy, PolicyFileError, PolicyMotion, load_policy, save_policy
 from robot.learned.policy import KICK_BALL_AHEAD_M
 from robot.stub import StubConfigError, parse_args
 from robot.stub.behaviour import Field, GameInfo, Role, decide
 from robot.stub.controller import StubController
 from robot.stub.runner import _kick_policy
-from robot.stub.world_model import Pose2D
 
 MOTORS = tuple(f"M{i}" for i in range(20))
 
@@ -90,7 +90,8 @@ def test_stub_with_a_kick_policy_lines_up_for_the_right_foot(tmp_path: Path) -> 
     options = parse_args(["striker", "--kick-policy", str(tmp_path / "kick.npz")])
     policy = _kick_policy(options)
     assert policy is not None and policy.skill == "test-kick"
-    controller = StubController(role=Role.STRIKER, start_pose=Pose2D(0, 0, 0), kick_policy=policy)
+    controller = StubController(role=Role.STRIKER, start_pose=Pose(x_m=0, y_m=0, yaw_rad=0),
+                                kick_policy=policy)
     assert controller.field.kick_x_m == KICK_BALL_AHEAD_M
     assert controller.field.kick_feet == ("right",)
     game = GameInfo(phase=GameState.PLAYING)
@@ -98,10 +99,11 @@ def test_stub_with_a_kick_policy_lines_up_for_the_right_foot(tmp_path: Path) -> 
     # a right-foot policy steps across instead
     field = Field(half_length_m=4.5, foot_y_m=0.075, kick_x_m=KICK_BALL_AHEAD_M)
     ball = (KICK_BALL_AHEAD_M, 0.075)
-    plain = decide(role=Role.STRIKER, game=game, pose=Pose2D(1.0, 0.0, 0.0), ball=ball,
+    at = Pose(x_m=1.0, y_m=0.0, yaw_rad=0.0)
+    plain = decide(role=Role.STRIKER, game=game, pose=at, ball=ball,
                    field=field, searching_s=0.0)  # fmt: skip
     assert plain.kick_foot == "left"
-    right_only = decide(role=Role.STRIKER, game=game, pose=Pose2D(1.0, 0.0, 0.0), ball=ball,
+    right_only = decide(role=Role.STRIKER, game=game, pose=at, ball=ball,
                         field=controller.field, searching_s=0.0)  # fmt: skip
     assert right_only.kick_foot is None and right_only.walk[1] > 0  # side-steps to its left
 

@@ -55,11 +55,12 @@ def test_get_up_rejects_an_unknown_side() -> None:
 @pytest.mark.parametrize("side", ["front", "back"])
 def test_stub_controller_detects_the_fall_and_gets_up(side: str) -> None:
     from contracts.gamecontroller import GameState
-    from robot.stub import GameInfo, Pose2D, Role, StubController
+    from contracts.geometry import Pose
+    from robot.stub import GameInfo, Role, StubController
 
     robot = OneRobot()
     robot.lay_down(side)
-    controller = StubController(role=Role.IDLE, start_pose=Pose2D(0.0, 0.0, 0.0))
+    controller = StubController(role=Role.IDLE, start_pose=Pose(x_m=0.0, y_m=0.0, yaw_rad=0.0))
     game = GameInfo(phase=GameState.PLAYING)
 
     def tick() -> dict[str, float]:
@@ -77,10 +78,11 @@ def test_pushed_over_robot_gets_back_up(direction_rad: float) -> None:
     import math
 
     from contracts.gamecontroller import GameState
-    from robot.stub import GameInfo, Pose2D, Role, StubController
+    from contracts.geometry import Pose
+    from robot.stub import GameInfo, Role, StubController
 
     robot = OneRobot(yaw_rad=1.0)
-    controller = StubController(role=Role.IDLE, start_pose=Pose2D(0.0, 0.0, 1.0))
+    controller = StubController(role=Role.IDLE, start_pose=Pose(x_m=0.0, y_m=0.0, yaw_rad=1.0))
     game = GameInfo(phase=GameState.PLAYING)
     push = robot.world.data.xfrc_applied[robot.torso]
     lowest = 1.0

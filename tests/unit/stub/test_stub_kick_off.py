@@ -8,24 +8,25 @@ import math
 import pytest
 
 from contracts.gamecontroller import GameState
+from contracts.geometry import Pose
 from robot.stub.behaviour import Action, Field, GameInfo, Role, decide
-from robot.stub.world_model import Pose2D, WorldModel
+from robot.stub.world_model import WorldModel
 
 FIELD = Field(half_length_m=4.5, foot_y_m=0.075, kick_x_m=0.165)
 
 
-def _striker(game: GameInfo, pose: Pose2D, ball_field: tuple[float, float]) -> Action:
+def _striker(game: GameInfo, pose: Pose, ball_field: tuple[float, float]) -> Action:
     return decide(role=Role.STRIKER, game=game, pose=pose, ball=pose.to_relative(*ball_field),
                   field=FIELD, searching_s=0.0)  # fmt: skip
 
 
-def _lined_up(heading: float, ball_field: tuple[float, float]) -> Pose2D:
+def _lined_up(heading: float, ball_field: tuple[float, float]) -> Pose:
     """A pose with the ball in front of the right foot, facing ``heading``."""
     bx, by = ball_field
     c, s = math.cos(heading), math.sin(heading)
     # the ball at (kick_x, -foot_y) in the robot frame
-    return Pose2D(bx - c * FIELD.kick_x_m - s * FIELD.foot_y_m,
-                  by - s * FIELD.kick_x_m + c * FIELD.foot_y_m, heading)  # fmt: skip
+    return Pose(x_m=bx - c * FIELD.kick_x_m - s * FIELD.foot_y_m,
+                y_m=by - s * FIELD.kick_x_m + c * FIELD.foot_y_m, yaw_rad=heading)  # fmt: skip
 
 
 def test_own_kick_off_is_played_diagonally_past_the_centre() -> None:
@@ -54,16 +55,16 @@ def test_ready_spot_for_the_own_kick_off_faces_the_pass_with_the_ball_short_of_a
     # the ball 8 cm farther than the kick spot, in front of the left foot
     ahead, left = FIELD.kick_x_m + 0.08, FIELD.foot_y_m
     c, s = math.cos(diagonal), math.sin(diagonal)
-    left_foot = Pose2D(-(c * ahead - s * left), -(s * ahead + c * left), diagonal)
+    left_foot = Pose(x_m=-(c * ahead - s * left), y_m=-(s * ahead + c * left), yaw_rad=diagonal)
     assert _striker(ready, left_foot, (0.0, 0.0)).stands
     bx, by = left_foot.to_relative(0.0, 0.0)
     assert bx == pytest.approx(ahead) and by == pytest.approx(left)
-    assert not _striker(ready, Pose2D(-0.35, 0.0, 0.0), (0.0, 0.0)).stands
+    assert not _striker(ready, Pose(x_m=-0.35, y_m=0.0, yaw_rad=0.0), (0.0, 0.0)).stands
 
 
 def test_centre_spot_ball_pulls_the_believed_position_towards_the_truth() -> None:
-    truth = Pose2D(-1.0, -0.5, 0.3)
-    world = WorldModel(Pose2D(-0.4, 0.2, 0.3))  # odometry 0.9 m off
+    truth = Pose(x_m=-1.0, y_m=-0.5, yaw_rad=0.3)
+    world = WorldModel(Pose(x_m=-0.4, y_m=0.2, yaw_rad=0.3))  # odometry 0.9 m off
     seen = truth.to_relative(0.0, 0.0)  # the ball on the centre spot, as the camera sees it
     before = math.hypot(world.pose.x_m - truth.x_m, world.pose.y_m - truth.y_m)
     world.relocate_from_centre_ball(*seen, gain=0.5)

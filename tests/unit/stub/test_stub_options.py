@@ -7,10 +7,10 @@ from pathlib import Path
 import pytest
 
 from contracts.gamecontroller import GameState
+from contracts.geometry import Pose
 from robot.stub import Behaviour, StubConfigError, parse_args, read_env
 from robot.stub.behaviour import GameInfo, Role, decide
 from robot.stub.runner import StubRobot
-from robot.stub.world_model import Pose2D
 
 ENV = {
     "ROBOCUP_ROBOT_ID": "2",
@@ -105,7 +105,7 @@ def test_role_of_each_behaviour(argv: list[str], role: Role) -> None:
 
 
 def test_behaviour_by_game_state() -> None:
-    pose = Pose2D(-2.0, 0.0, 0.0)
+    pose = Pose(x_m=-2.0, y_m=0.0, yaw_rad=0.0)
     from robot.stub.behaviour import Field
 
     field = Field(half_length_m=4.5, foot_y_m=0.075, kick_x_m=0.165)

@@ -7,7 +7,8 @@ import math
 import pytest
 
 from contracts.gamecontroller import GameState
-from robot.stub import GameInfo, Pose2D, Role, StubController
+from contracts.geometry import Pose
+from robot.stub import GameInfo, Role, StubController
 
 from .motion_world import OneRobot
 
@@ -21,7 +22,7 @@ from .motion_world import OneRobot
     ],
 )
 def test_walks_to_the_kick_off_position_in_ready(role: Role, target: tuple[float, float]) -> None:
-    start = Pose2D(-1.5, -3.2, math.pi / 2)  # on the touch line, facing the field
+    start = Pose(x_m=-1.5, y_m=-3.2, yaw_rad=math.pi / 2)  # on the touch line, facing the field
     robot = OneRobot(x_m=start.x_m, y_m=start.y_m, yaw_rad=start.yaw_rad)
     home = target if role is Role.DEFENDER else None
     controller = StubController(role=role, start_pose=start, home=home)

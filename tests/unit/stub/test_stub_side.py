@@ -7,7 +7,8 @@ import math
 import pytest
 
 from contracts.gamecontroller import GameState
-from robot.stub import GameInfo, Pose2D, Role, StubController
+from contracts.geometry import Pose
+from robot.stub import GameInfo, Role, StubController
 from simulator.world import CameraRenderer
 
 from .motion_world import OneRobot
@@ -15,7 +16,8 @@ from .motion_world import OneRobot
 
 @pytest.mark.parametrize(("world_x", "mirrored"), [(-2.5, False), (2.5, True), (4.0, True)])
 def test_side_check_from_the_own_goal(world_x: float, mirrored: bool) -> None:
-    team_file_pose = Pose2D(-abs(world_x), -3.1, math.pi / 2)  # as if playing on the left
+    # as if playing on the left
+    team_file_pose = Pose(x_m=-abs(world_x), y_m=-3.1, yaw_rad=math.pi / 2)
     robot = OneRobot(x_m=world_x, y_m=-3.1, yaw_rad=math.pi / 2)
     controller = StubController(role=Role.STRIKER, start_pose=team_file_pose, detect_side=True)
     game = GameInfo(phase=GameState.INITIAL)
@@ -33,7 +35,7 @@ def test_side_check_from_the_own_goal(world_x: float, mirrored: bool) -> None:
 @pytest.mark.parametrize("on_left", [True, False])
 def test_side_from_the_gamecontroller_team_order(on_left: bool) -> None:
     """RGme lists the team playing on the left first: the stub needs no look round then."""
-    team_file_pose = Pose2D(-0.8, -3.1, math.pi / 2)
+    team_file_pose = Pose(x_m=-0.8, y_m=-3.1, yaw_rad=math.pi / 2)
     controller = StubController(role=Role.STRIKER, start_pose=team_file_pose, detect_side=True)
     robot = OneRobot(x_m=-0.8 if on_left else 0.8, y_m=-3.1, yaw_rad=math.pi / 2)
     game = GameInfo(phase=GameState.INITIAL, on_left=on_left)

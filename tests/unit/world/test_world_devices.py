@@ -6,6 +6,7 @@ import math
 
 import pytest
 
+from contracts.geometry import Pose
 from contracts.ids import RobotId, TeamColor
 from referee.snapshot import BodyPart, PlaceBall, RemoveRobot, RestoreRobot, SetLimp, TeleportRobot
 from simulator.errors import UnknownDeviceError
@@ -82,7 +83,7 @@ def test_limp_robot_ignores_motors_until_restored(one_robot_world: World) -> Non
     world.apply(SetLimp(robot=RED_1, limp=False))  # the last commands apply again
     run_steps(world, 125)
     assert world.read_position(RED_1, "NeckS") == pytest.approx(1.0, abs=0.05)
-    world.apply(TeleportRobot(robot=RED_1, x_m=2.0, y_m=-1.0, yaw_rad=-1.0))
+    world.apply(TeleportRobot(robot=RED_1, pose=Pose(x_m=2.0, y_m=-1.0, yaw_rad=-1.0)))
     run_steps(world, 250)
     snap = world.snapshot().robots[0]
     assert not snap.limp and not snap.fallen
@@ -99,7 +100,7 @@ def test_remove_and_restore(one_robot_world: World) -> None:
     assert world.is_removed(RED_1) and snap.removed
     assert snap.position[:2] == pytest.approx((50.0, 11.0))  # parked, frozen
     assert snap.ground_contacts == frozenset()
-    world.apply(RestoreRobot(robot=RED_1, x_m=-3.0, y_m=2.0, yaw_rad=0.0))
+    world.apply(RestoreRobot(robot=RED_1, pose=Pose(x_m=-3.0, y_m=2.0, yaw_rad=0.0)))
     run_steps(world, 125)
     snap = world.snapshot().robots[0]
     assert not snap.removed and not snap.fallen

@@ -20,12 +20,13 @@ the squared diagonal of that box (no point of the link is farther from its centr
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
-from typing import TypedDict
+from dataclasses import dataclass, field, fields, replace
 
 import mujoco
 import numpy as np
 
+from contracts.codec import to_data
+from contracts.jsontypes import JSONObject
 from simulator.errors import ModelProblem
 from simulator.world.robots.team.model import TeamRobotModel
 from simulator.world.robots.team.servos import servo_problems
@@ -44,24 +45,6 @@ MIN_INERTIA_KG_M2 = 1e-8
 FRAME_KG = 1e-5  # lighter links are frames (camera, IMU), not parts
 
 
-class MeasurementsRecord(TypedDict):
-    """:class:`Measurements` as JSON (``hlvs check``), lengths rounded to 0.1 mm."""
-
-    height_m: float
-    leg_m: float
-    head_m: float
-    top_m: float
-    arm_m: float
-    foot_length_m: float
-    foot_width_m: float
-    mass_kg: float
-    cameras: int
-    max_fov_rad: float
-    motors: int
-    arm_chains_m: dict[str, float]
-    servos: dict[str, str]
-
-
 @dataclass(frozen=True, slots=True)
 class Measurements:
     height_m: float
@@ -78,22 +61,21 @@ class Measurements:
     arm_chains_m: dict[str, float] = field(default_factory=dict)  # first link -> reach
     servos: dict[str, str] = field(default_factory=dict)  # motor -> catalogue id ("" free)
 
-    def to_json(self) -> MeasurementsRecord:
-        return {
-            "height_m": round(self.height_m, 4),
-            "leg_m": round(self.leg_m, 4),
-            "head_m": round(self.head_m, 4),
-            "top_m": round(self.top_m, 4),
-            "arm_m": round(self.arm_m, 4),
-            "foot_length_m": round(self.foot_length_m, 4),
-            "foot_width_m": round(self.foot_width_m, 4),
-            "mass_kg": round(self.mass_kg, 4),
-            "cameras": self.cameras,
-            "max_fov_rad": round(self.max_fov_rad, 4),
-            "motors": self.motors,
-            "arm_chains_m": {k: round(v, 4) for k, v in self.arm_chains_m.items()},
-            "servos": dict(self.servos),
-        }
+    def rounded(self) -> Measurements:
+        """These measurements with lengths, masses and angles rounded to 4 decimals (0.1 mm),
+        as ``hlvs check`` shows them."""
+        return replace(
+            self,
+            **{f.name: round(getattr(self, f.name), 4)
+               for f in fields(self) if isinstance(getattr(self, f.name), float)},
+            arm_chains_m={k: round(v, 4) for k, v in self.arm_chains_m.items()},
+            servos=dict(self.servos),
+        )  # fmt: skip
+
+    def to_json(self) -> JSONObject:
+        """:meth:`rounded` as JSON (``hlvs check --json``), in field order."""
+        data: JSONObject = to_data(self.rounded())
+        return data
 
 
 def _standalone(robot: TeamRobotModel) -> mujoco.MjModel:
