@@ -11,7 +11,8 @@ fi
 if [ "$(id -u)" = 0 ] && command -v dockerd >/dev/null; then
   mkdir -p /var/log/hlvs
   echo "==> starting dockerd (log: /var/log/hlvs/dockerd.log)"
-  nohup dockerd >>/var/log/hlvs/dockerd.log 2>&1 &
+  # its own session: the engine outlives the shell (and its process group) that started it
+  setsid nohup dockerd >>/var/log/hlvs/dockerd.log 2>&1 </dev/null &
   for _ in $(seq 1 60); do
     docker info >/dev/null 2>&1 && { echo "==> Docker engine ready"; exit 0; }
     sleep 0.5
