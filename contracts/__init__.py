@@ -13,5 +13,6 @@ it; installs on its own from ``contracts/pyproject.toml``.
   and ``from_json`` refuses versions it does not know (:class:`contracts.errors.UnknownVersion`).
 """
 
-# its modules are its faces (ARCHITECTURE.md): a process loads only the ones it uses
-__all__: list[str] = []
+from contracts.lazy import lazy_exports
+
+__all__ = ["lazy_exports"]

@@ -10,8 +10,9 @@ The names are imported on first use, so that ``hlvs --help`` (which reads
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from contracts import lazy_exports
 
 if TYPE_CHECKING:
     from service.app import Services, create_app, pool_from_settings
@@ -28,33 +29,6 @@ if TYPE_CHECKING:
     from service.errors import NotFound, ServiceError
     from service.settings import Settings
     from service.tokens import Principal
-
-_WHERE = {
-    "DbSession": "service.deps",
-    "NotFound": "service.errors",
-    "OperatorPrincipal": "service.deps",
-    "Principal": "service.tokens",
-    "ServiceError": "service.errors",
-    "Services": "service.app",
-    "Settings": "service.settings",
-    "TeamPrincipal": "service.deps",
-    "create_app": "service.app",
-    "get_db": "service.deps",
-    "get_services": "service.deps",
-    "pool_from_settings": "service.app",
-    "require_operator": "service.deps",
-    "require_team": "service.deps",
-    "require_token": "service.deps",
-}
-
-
-def __getattr__(name: str) -> Any:
-    if name not in _WHERE:
-        raise AttributeError(f"module 'service' has no attribute {name!r}")
-    value = getattr(importlib.import_module(_WHERE[name]), name)
-    globals()[name] = value
-    return value
-
 
 __all__ = [
     "DbSession",
@@ -73,3 +47,14 @@ __all__ = [
     "require_team",
     "require_token",
 ]
+
+
+if not TYPE_CHECKING:
+    __getattr__, __dir__ = lazy_exports(__name__, {
+        "service.app": ("Services", "create_app", "pool_from_settings"),
+        "service.deps": ("DbSession", "OperatorPrincipal", "TeamPrincipal", "get_db", "get_services",
+                         "require_operator", "require_team", "require_token"),
+        "service.errors": ("NotFound", "ServiceError"),
+        "service.settings": ("Settings",),
+        "service.tokens": ("Principal",),
+    })
