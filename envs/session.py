@@ -17,7 +17,7 @@ from typing import Any, cast
 import numpy as np
 import numpy.typing as npt
 
-from contracts.field import field_for
+from contracts import field_for
 from envs.errors import EnvStateError, TrainerError
 from envs.frame import SENSOR_NAMES, Frame, GameView
 from envs.perception import CameraView, add_noise, field_segments, goal_post_feet
@@ -168,7 +168,7 @@ class LocalSession:
             frame.game = game_view(self.referee, self.learner)
             events = self.referee.events
             if self._events_seen < len(events):
-                from simulator.match_loop import event_dict
+                from simulator import event_dict
 
                 frame.events = [event_dict(e) for e in events[self._events_seen :]]
                 self._events_seen = len(events)

@@ -5,8 +5,7 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Sequence
 
-from contracts.ids import TeamColor
-from contracts.telemetry import GameStateRecord, PenaltyRecord
+from contracts import GameStateRecord, PenaltyRecord, TeamColor
 from referee.clock import Clock
 from referee.gamecontroller import GameController
 from referee.play_stats import PlayStats

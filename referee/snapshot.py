@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from enum import Enum
 
-from contracts.ids import RobotId, TeamColor
+from contracts import RobotId, TeamColor
 
 Vec3 = tuple[float, float, float]
 Vec2 = tuple[float, float]

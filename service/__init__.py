@@ -15,7 +15,11 @@ from typing import TYPE_CHECKING
 from contracts import lazy_exports
 
 if TYPE_CHECKING:
+    from service import tokens
+    from service.accounts import ensure_team_account
+    from service.admin import add_team, list_tokens
     from service.app import Services, create_app, pool_from_settings
+    from service.client import register
     from service.deps import (
         DbSession,
         OperatorPrincipal,
@@ -39,21 +43,32 @@ __all__ = [
     "Services",
     "Settings",
     "TeamPrincipal",
+    "add_team",
     "create_app",
+    "ensure_team_account",
     "get_db",
     "get_services",
+    "list_tokens",
     "pool_from_settings",
+    "register",
     "require_operator",
     "require_team",
     "require_token",
+    "tokens",
 ]
 
 
 if not TYPE_CHECKING:
     __getattr__, __dir__ = lazy_exports(__name__, {
+        "service": ("tokens",),
+        "service.accounts": ("ensure_team_account",),
+        "service.admin": ("add_team", "list_tokens"),
         "service.app": ("Services", "create_app", "pool_from_settings"),
-        "service.deps": ("DbSession", "OperatorPrincipal", "TeamPrincipal", "get_db", "get_services",
-                         "require_operator", "require_team", "require_token"),
+        "service.client": ("register",),
+        "service.deps": (
+            "DbSession", "OperatorPrincipal", "TeamPrincipal", "get_db", "get_services",
+            "require_operator", "require_team", "require_token",
+        ),
         "service.errors": ("NotFound", "ServiceError"),
         "service.settings": ("Settings",),
         "service.tokens": ("Principal",),

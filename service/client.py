@@ -19,7 +19,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from orchestrator.paths import user_path
+from orchestrator import user_path
 
 DEFAULT_TOKEN_FILE = Path("~/.config/hlvs/token")
 FINAL_STATES = ("done", "failed", "cancelled")

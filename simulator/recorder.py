@@ -12,7 +12,7 @@ from typing import IO
 
 import numpy as np
 
-from contracts.telemetry import EventRecord, GameStateRecord
+from contracts import EventRecord, GameStateRecord
 from simulator.replay.format import (
     CHUNK,
     FORMAT_VERSION,

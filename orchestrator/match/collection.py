@@ -15,11 +15,15 @@ from dataclasses import replace
 from functools import partial
 from pathlib import Path
 
-from contracts import files
-from contracts.errors import ContractError
-from contracts.match_results import MatchLimits, MatchResults
-from contracts.match_spec import MatchSpec, TimingSpec
-from contracts.sim_result import SimResult
+from contracts import (
+    ContractError,
+    MatchLimits,
+    MatchResults,
+    MatchSpec,
+    SimResult,
+    TimingSpec,
+    files,
+)
 from orchestrator.errors import OrchestratorError
 from orchestrator.match import layout
 from orchestrator.match.context import MatchContext

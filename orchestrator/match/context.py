@@ -18,8 +18,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from contracts.match_results import Color, Forfeit
-from contracts.telemetry import StateMessage
+from contracts import Color, Forfeit, StateMessage
 from orchestrator.bandwidth import AppliedShaping
 from orchestrator.match.admission import CpuSets
 from orchestrator.match.events import EventStream, MatchFailed, StateChanged

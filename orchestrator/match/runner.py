@@ -20,8 +20,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from contracts import files
-from contracts.match_results import Color, Forfeit, MatchResults
+from contracts import Color, Forfeit, MatchResults, files
 from orchestrator.errors import OrchestratorError
 from orchestrator.match.collection import CollectionPhase, read_sim_result, simulator_stderr_tail
 from orchestrator.match.context import MatchContext, RunOptions, TelemetryFactory

@@ -9,7 +9,7 @@ import math
 from dataclasses import dataclass
 from enum import StrEnum
 
-from contracts.gamecontroller import GameState
+from contracts import GameState
 from robot.stub.world_model import Pose2D
 
 

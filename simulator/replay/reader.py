@@ -24,7 +24,7 @@ from typing import IO, cast
 
 import numpy as np
 
-from contracts.telemetry import EventRecord, GameStateRecord
+from contracts import EventRecord, GameStateRecord
 from simulator.errors import ReplayError
 from simulator.replay.format import (
     CHUNK,

@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING, Any, cast
 if TYPE_CHECKING:
     import mujoco
 
-    from contracts.field import FieldGeometry
+    from contracts import FieldGeometry
     from simulator.replay.format import (
         CameraModelRecord,
         CameraRecord,
@@ -208,8 +208,7 @@ def scene_for(header: ReplayHeader, path: str) -> SceneRecord:
     models for the robots it lists, when those still have the recorded bodies."""
     if header.scene is not None:
         return header.scene
-    from contracts.field import field_for
-    from contracts.ids import RobotId, TeamColor
+    from contracts import RobotId, TeamColor, field_for
     from simulator.errors import ReplayError, UnknownModelError
     from simulator.world.scene import compile_scene
     from simulator.world.types import RobotPlacement
