@@ -21,7 +21,6 @@ namespace, such as ``contracts.files``). Standard library only: every process im
 
 from __future__ import annotations
 
-import importlib
 import sys
 from collections.abc import Callable, Mapping
 
@@ -43,9 +42,9 @@ def lazy_exports(
         if module is None:
             raise AttributeError(f"module {package!r} has no attribute {name!r}")
         if module == package:
-            value: object = importlib.import_module(f"{package}.{name}")
+            value: object = _load(f"{package}.{name}")
         else:
-            value = getattr(importlib.import_module(module), name)
+            value = getattr(_load(module), name)
         setattr(sys.modules[package], name, value)  # later lookups skip __getattr__
         return value
 
@@ -53,3 +52,10 @@ def lazy_exports(
         return sorted(set(vars(sys.modules[package])) | set(where))
 
     return __getattr__, __dir__
+
+
+def _load(module: str) -> object:
+    """``module``, imported through ``__import__`` (``python -X importtime`` sees the import,
+    which it does not where ``importlib.import_module`` makes it)."""
+    __import__(module)
+    return sys.modules[module]
