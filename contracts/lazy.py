@@ -29,7 +29,8 @@ def lazy_exports(
     package: str, exports: Mapping[str, tuple[str, ...]]
 ) -> tuple[Callable[[str], object], Callable[[], list[str]]]:
     """The module ``__getattr__`` and ``__dir__`` of ``package``, which publishes each name of
-    ``exports[module]`` from ``module``, importing it on first access."""
+    ``exports[module]`` from ``module``: the module is imported on the name's first use, and
+    each use reads the name from it (so a test's patch of the module shows through the face)."""
     where: dict[str, str] = {}
     for module, names in exports.items():
         for name in names:
@@ -42,11 +43,9 @@ def lazy_exports(
         if module is None:
             raise AttributeError(f"module {package!r} has no attribute {name!r}")
         if module == package:
-            value: object = _load(f"{package}.{name}")
-        else:
-            value = getattr(_load(module), name)
-        setattr(sys.modules[package], name, value)  # later lookups skip __getattr__
-        return value
+            return _load(f"{package}.{name}")
+        # not kept in the package: each lookup reads the module, where a test may patch it
+        return getattr(_load(module), name)
 
     def __dir__() -> list[str]:
         return sorted(set(vars(sys.modules[package])) | set(where))
