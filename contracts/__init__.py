@@ -11,6 +11,10 @@ it; installs on its own from ``contracts/pyproject.toml``.
 - :mod:`contracts.robot_api`: the robot API's protobuf messages (the league's ``messages.proto``).
 - :mod:`contracts.codec`: the one JSON reader/writer; every top-level document has a ``version``
   and ``from_json`` refuses versions it does not know (:class:`contracts.errors.UnknownVersion`).
+
+Other packages import the names of ``__all__`` from the package (``from contracts import
+MatchSpec``); each is imported on first use (:func:`contracts.lazy.lazy_exports`), so a process
+loads only the modules it uses.
 """
 
 from typing import TYPE_CHECKING
