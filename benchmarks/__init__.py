@@ -17,9 +17,9 @@ if TYPE_CHECKING:
         pool,
         report,
         scrimmage,
+        service,
         viewer,
     )
-    from benchmarks.service import main
 
 __all__ = [
     "actuators",
@@ -28,11 +28,11 @@ __all__ = [
     "delivery",
     "envs",
     "hog",
-    "main",
     "models",
     "pool",
     "report",
     "scrimmage",
+    "service",
     "viewer",
 ]
 
@@ -41,7 +41,6 @@ if not TYPE_CHECKING:
     __getattr__, __dir__ = lazy_exports(__name__, {
         "benchmarks": (
             "actuators", "bringup", "cli", "delivery", "envs", "hog", "models", "pool", "report",
-            "scrimmage", "viewer",
+            "scrimmage", "service", "viewer",
         ),
-        "benchmarks.service": ("main",),
     })

@@ -112,9 +112,9 @@ def register(sub: Any) -> None:
 
 
 def _bench(args: argparse.Namespace) -> int:
-    from benchmarks import main as bench_main
+    from benchmarks import service as service_bench
 
-    return int(bench_main(list(args.rest)))
+    return int(service_bench.main(list(args.rest)))
 
 
 def _sessions(args: argparse.Namespace) -> Any:
