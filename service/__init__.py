@@ -19,7 +19,7 @@ if TYPE_CHECKING:
     from service.accounts import ensure_team_account
     from service.admin import add_team, list_tokens
     from service.app import Services, create_app, pool_from_settings
-    from service.client import register
+    from service.client import register_client_commands
     from service.deps import (
         DbSession,
         OperatorPrincipal,
@@ -50,7 +50,7 @@ __all__ = [
     "get_services",
     "list_tokens",
     "pool_from_settings",
-    "register",
+    "register_client_commands",
     "require_operator",
     "require_team",
     "require_token",
@@ -64,7 +64,7 @@ if not TYPE_CHECKING:
         "service.accounts": ("ensure_team_account",),
         "service.admin": ("add_team", "list_tokens"),
         "service.app": ("Services", "create_app", "pool_from_settings"),
-        "service.client": ("register",),
+        "service.client": ("register_client_commands",),
         "service.deps": (
             "DbSession", "OperatorPrincipal", "TeamPrincipal", "get_db", "get_services",
             "require_operator", "require_team", "require_token",

@@ -99,7 +99,7 @@ def register(sub: Any) -> None:
     _add_db_options(tlist)
     tlist.set_defaults(func=guarded(run_token_list))
 
-    from service import register as register_client
+    from service import register_client_commands as register_client
 
     register_client(sub, guarded)
     bench = sub.choices.get("bench")
