@@ -14,6 +14,7 @@ as the tests do: their own imports are not checked, but what ``hlvs`` imports fr
 from __future__ import annotations
 
 import ast
+import functools
 import json
 import re
 import subprocess
@@ -62,6 +63,7 @@ def declared_all(path: Path) -> list[str] | None:
     return None
 
 
+@functools.cache
 def cross_package_imports(packages: tuple[str, ...]) -> list[Import]:
     found = []
     for package in packages:
