@@ -211,9 +211,9 @@ def check_report(
 
 def print_text(report: FileReport, *, out: TextIO) -> None:
     if report.measurements is not None:
-        from orchestrator.config import describe_measurements
+        from orchestrator.config import describe
 
-        print(f"{report.file}: {describe_measurements(report.measurements)}", file=out)
+        print(f"{report.file}: {describe(report.measurements)}", file=out)
     for problem in report.errors + [p for p in report.problems if p.severity != "error"]:
         print(str(problem), file=out)
     if report.valid:

@@ -52,7 +52,7 @@ if TYPE_CHECKING:
     from orchestrator.config.robot_models import (
         BUILT_IN_MODELS,
         check_model,
-        describe_measurements,
+        describe,
         is_model_package,
     )
     from orchestrator.config.schedule import (
@@ -105,7 +105,7 @@ __all__ = [
     "check_team_document",
     "default_match_id",
     "default_seed",
-    "describe_measurements",
+    "describe",
     "game_document",
     "is_model_package",
     "kind_by_content",
@@ -130,7 +130,7 @@ if not TYPE_CHECKING:
         "orchestrator.config.detect": ("Kind", "kind_by_content", "kind_by_name"),
         "orchestrator.config.jsonfile": ("parse_json", "read_text"),
         "orchestrator.config.robot_models": (
-            "BUILT_IN_MODELS", "check_model", "describe_measurements", "is_model_package",
+            "BUILT_IN_MODELS", "check_model", "describe", "is_model_package",
         ),
         "orchestrator.config.schedule": (
             "PlannedMatch", "Schedule", "SchedulePool", "ScheduledTeam", "Slot", "game_document",

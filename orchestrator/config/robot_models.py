@@ -66,7 +66,7 @@ def check_model(
     ], measurements.to_json()
 
 
-def describe_measurements(measurements: MeasurementsRecord) -> str:
+def describe(measurements: MeasurementsRecord) -> str:
     m = measurements
     return (
         f"H {m['height_m']} m, Hleg {m['leg_m']} m, Hhead {m['head_m']} m, Harm {m['arm_m']} m, "

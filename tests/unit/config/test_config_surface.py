@@ -42,7 +42,7 @@ EXPECTED = {
     "check_team_document",
     "default_match_id",
     "default_seed",
-    "describe_measurements",
+    "describe",
     "game_document",
     "is_model_package",
     "kind_by_content",
