@@ -18,10 +18,16 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 from cluster.errors import ClusterError, PoolError
 from cluster.nodes import NodeJob, PoolNode
+from contracts import lazy_exports
+
+if TYPE_CHECKING:
+    from cluster.local import process_start_time
+    from cluster.nodes import ENV_REMOTE_COMMENT
+    from cluster.slurm import HOST_NETNS, SlurmPool
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -96,6 +102,8 @@ def make_pool(*, kind: str = "local", slots: int, slurm_conf: str | None = None)
 
 __all__ = [
     "ClusterError",
+    "ENV_REMOTE_COMMENT",
+    "HOST_NETNS",
     "JobState",
     "JobStatus",
     "MatchJob",
@@ -103,5 +111,15 @@ __all__ = [
     "NodeJob",
     "PoolError",
     "PoolNode",
+    "SlurmPool",
     "make_pool",
+    "process_start_time",
 ]
+
+
+if not TYPE_CHECKING:
+    __getattr__, __dir__ = lazy_exports(__name__, {
+        "cluster.local": ("process_start_time",),
+        "cluster.nodes": ("ENV_REMOTE_COMMENT",),
+        "cluster.slurm": ("HOST_NETNS", "SlurmPool"),
+    })

@@ -11,17 +11,17 @@ from __future__ import annotations
 from pathlib import Path
 
 from cluster import JobState, JobStatus, MatchJob, NodeJob, PoolNode
-from contracts import files
-from contracts.jsontypes import JSONObject
-from contracts.match_results import (
+from contracts import (
     Failure,
+    JSONObject,
     MatchLimits,
     MatchReport,
     MatchResults,
+    PlayRecord,
     RobotResult,
+    files,
 )
-from contracts.sim_result import PlayRecord
-from orchestrator.private_files import private_dir, write_private
+from orchestrator import private_dir, write_private
 
 
 class FakePool:

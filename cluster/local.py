@@ -23,7 +23,7 @@ from cluster import JobState, JobStatus, MatchJob
 from cluster.errors import PoolError
 from cluster.nodes import NodeJob, PoolNode
 from contracts import files
-from orchestrator.private_files import open_private_append, write_private
+from orchestrator import open_private_append, write_private
 
 log = logging.getLogger(__name__)
 

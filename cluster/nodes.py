@@ -12,8 +12,7 @@ import itertools
 import re
 from dataclasses import dataclass, field
 
-from contracts.codec import to_data
-from contracts.jsontypes import JSONObject
+from contracts import JSONObject, to_data
 
 # sinfo -N: one line per node and partition; the reason last (free text that may hold '|')
 SINFO_FORMAT = "%N|%T|%C|%m|%e|%O|%f|%E"

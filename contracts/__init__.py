@@ -11,7 +11,213 @@ it; installs on its own from ``contracts/pyproject.toml``.
 - :mod:`contracts.robot_api`: the robot API's protobuf messages (the league's ``messages.proto``).
 - :mod:`contracts.codec`: the one JSON reader/writer; every top-level document has a ``version``
   and ``from_json`` refuses versions it does not know (:class:`contracts.errors.UnknownVersion`).
+
+Other packages import the names of ``__all__`` from the package (``from contracts import
+MatchSpec``); each is imported on first use (:func:`contracts.lazy.lazy_exports`), so a process
+loads only the modules it uses.
 """
 
-# its modules are its faces (ARCHITECTURE.md): a process loads only the ones it uses
-__all__: list[str] = []
+from typing import TYPE_CHECKING
+
+from contracts.lazy import lazy_exports
+
+if TYPE_CHECKING:
+    from contracts import files, gamecontroller, telemetry
+    from contracts.codec import from_data, to_data
+    from contracts.errors import ContractError, ProtocolError
+    from contracts.field import ADULT_FIELD, KID_FIELD, FieldClass, FieldGeometry, field_for
+    from contracts.files import GPU_ENVIRONMENT
+    from contracts.gamecontroller import (
+        DROPBALL_TEAM,
+        GC_DATA_PORT,
+        GC_RETURN_PORT,
+        MAX_PLAYERS,
+        GameControlData,
+        GameState,
+        GameTypeCode,
+        Penalty,
+        ReturnData,
+        ReturnMessage,
+        RobotInfo,
+        SecondaryState,
+        TeamColourCode,
+        TeamInfo,
+        decode_game_state,
+        decode_return,
+        encode_game_state,
+        encode_return,
+        with_packet_number,
+    )
+    from contracts.geometry import StartingPose
+    from contracts.ids import RobotId, TeamColor
+    from contracts.jsontypes import JSONObject
+    from contracts.match_results import (
+        AdmissionRecord,
+        Failure,
+        FailureClass,
+        Forfeit,
+        LogFolderCopy,
+        MatchLimits,
+        MatchReport,
+        MatchResults,
+        NeededAvailable,
+        RobotResult,
+        Salvage,
+        SalvagedRobot,
+        Scalar,
+    )
+    from contracts.match_spec import (
+        Color,
+        GameType,
+        GameTypeName,
+        MatchSpec,
+        NetworkSpec,
+        PlayerSpec,
+        Pose,
+        SteppingMode,
+        TeamSpec,
+        TimingSpec,
+    )
+    from contracts.sim_result import PlayRecord, RobotApiStats, SimResult, SpoofingAttempt
+    from contracts.telemetry import (
+        EventRecord,
+        GameStateRecord,
+        PenaltyRecord,
+        RobotTraffic,
+        StateMessage,
+        TrafficSample,
+    )
+    from contracts.timing import (
+        ENVIRONMENT,
+        MIN_PLAYING_S,
+        MIN_READY_S,
+        OFFICIAL,
+        SCRIMMAGE,
+        SET_TO_PLAY_S,
+        TEST_MATCH,
+        TimingError,
+        fit_ready,
+        played_enough,
+        timing_problem,
+    )
+
+__all__ = [
+    "ADULT_FIELD",
+    "AdmissionRecord",
+    "Color",
+    "ContractError",
+    "DROPBALL_TEAM",
+    "ENVIRONMENT",
+    "EventRecord",
+    "Failure",
+    "FailureClass",
+    "FieldClass",
+    "FieldGeometry",
+    "Forfeit",
+    "GC_DATA_PORT",
+    "GC_RETURN_PORT",
+    "GPU_ENVIRONMENT",
+    "GameControlData",
+    "GameState",
+    "GameStateRecord",
+    "GameType",
+    "GameTypeCode",
+    "GameTypeName",
+    "JSONObject",
+    "KID_FIELD",
+    "LogFolderCopy",
+    "MAX_PLAYERS",
+    "MIN_PLAYING_S",
+    "MIN_READY_S",
+    "MatchLimits",
+    "MatchReport",
+    "MatchResults",
+    "MatchSpec",
+    "NeededAvailable",
+    "NetworkSpec",
+    "OFFICIAL",
+    "Penalty",
+    "PenaltyRecord",
+    "PlayRecord",
+    "PlayerSpec",
+    "Pose",
+    "ProtocolError",
+    "ReturnData",
+    "ReturnMessage",
+    "RobotApiStats",
+    "RobotId",
+    "RobotInfo",
+    "RobotResult",
+    "RobotTraffic",
+    "SCRIMMAGE",
+    "SET_TO_PLAY_S",
+    "Salvage",
+    "SalvagedRobot",
+    "Scalar",
+    "SecondaryState",
+    "SimResult",
+    "SpoofingAttempt",
+    "StartingPose",
+    "StateMessage",
+    "SteppingMode",
+    "TEST_MATCH",
+    "TeamColor",
+    "TeamColourCode",
+    "TeamInfo",
+    "TeamSpec",
+    "TimingError",
+    "TimingSpec",
+    "TrafficSample",
+    "decode_game_state",
+    "decode_return",
+    "encode_game_state",
+    "encode_return",
+    "field_for",
+    "files",
+    "fit_ready",
+    "from_data",
+    "gamecontroller",
+    "lazy_exports",
+    "played_enough",
+    "telemetry",
+    "timing_problem",
+    "to_data",
+    "with_packet_number",
+]
+
+
+if not TYPE_CHECKING:
+    __getattr__, __dir__ = lazy_exports(__name__, {
+        "contracts": ("files", "gamecontroller", "telemetry"),
+        "contracts.codec": ("from_data", "to_data"),
+        "contracts.errors": ("ContractError", "ProtocolError"),
+        "contracts.field": ("ADULT_FIELD", "KID_FIELD", "FieldClass", "FieldGeometry", "field_for"),
+        "contracts.files": ("GPU_ENVIRONMENT",),
+        "contracts.gamecontroller": (
+            "DROPBALL_TEAM", "GC_DATA_PORT", "GC_RETURN_PORT", "MAX_PLAYERS", "GameControlData",
+            "GameState", "GameTypeCode", "Penalty", "ReturnData", "ReturnMessage", "RobotInfo",
+            "SecondaryState", "TeamColourCode", "TeamInfo", "decode_game_state", "decode_return",
+            "encode_game_state", "encode_return", "with_packet_number",
+        ),
+        "contracts.geometry": ("StartingPose",),
+        "contracts.ids": ("RobotId", "TeamColor"),
+        "contracts.jsontypes": ("JSONObject",),
+        "contracts.match_results": (
+            "AdmissionRecord", "Failure", "FailureClass", "Forfeit", "LogFolderCopy", "MatchLimits",
+            "MatchReport", "MatchResults", "NeededAvailable", "RobotResult", "Salvage",
+            "SalvagedRobot", "Scalar",
+        ),
+        "contracts.match_spec": (
+            "Color", "GameType", "GameTypeName", "MatchSpec", "NetworkSpec", "PlayerSpec", "Pose",
+            "SteppingMode", "TeamSpec", "TimingSpec",
+        ),
+        "contracts.sim_result": ("PlayRecord", "RobotApiStats", "SimResult", "SpoofingAttempt"),
+        "contracts.telemetry": (
+            "EventRecord", "GameStateRecord", "PenaltyRecord", "RobotTraffic", "StateMessage",
+            "TrafficSample",
+        ),
+        "contracts.timing": (
+            "ENVIRONMENT", "MIN_PLAYING_S", "MIN_READY_S", "OFFICIAL", "SCRIMMAGE", "SET_TO_PLAY_S",
+            "TEST_MATCH", "TimingError", "fit_ready", "played_enough", "timing_problem",
+        ),
+    })

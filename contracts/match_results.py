@@ -36,9 +36,9 @@ from typing import Any, ClassVar, Literal
 
 from contracts.codec import Versioned, json_key, omitted_when_none
 from contracts.jsontypes import JSONObject
+from contracts.match_spec import Color
 from contracts.sim_result import PlayRecord, RobotApiStats, SpoofingRecord
 
-Color = Literal["red", "blue"]
 Status = Literal["success", "failed"]
 Scalar = int | float | bool | str | None
 

@@ -20,6 +20,9 @@ videos; MuJoCo reads it when first imported).
 from __future__ import annotations
 
 import os
+from typing import TYPE_CHECKING
+
+from contracts import lazy_exports
 
 if not os.environ.get("DISPLAY"):
     os.environ.setdefault("MUJOCO_GL", "osmesa")
@@ -43,6 +46,9 @@ from envs.session import LocalSession
 from envs.session_spec import ResetOptions, ResetRequest, SessionSpec, StubSpec
 from envs.skill import KickEnv
 from envs.stand_kick import StandKickEnv
+
+if TYPE_CHECKING:
+    from envs.monitor import Monitor
 
 ENV_IDS = ("hlvs/Kick-v0", "hlvs/StandKick-v0", "hlvs/Match-v0")
 
@@ -70,7 +76,7 @@ __all__ = [
     "KickEnv",
     "LocalSession",
     "MatchEnv",
-    "register_envs",
+    "Monitor",
     "RemoteCrashed",
     "RemoteError",
     "RemoteStartFailed",
@@ -81,4 +87,11 @@ __all__ = [
     "StandKickEnv",
     "StubSpec",
     "TrainerError",
+    "register_envs",
 ]
+
+
+if not TYPE_CHECKING:
+    __getattr__, __dir__ = lazy_exports(__name__, {
+        "envs.monitor": ("Monitor",),
+    })

@@ -63,7 +63,7 @@ def default_image() -> str:
     name = os.environ.get("HLVS_SIMULATOR_IMAGE")
     if name:
         return name
-    from orchestrator.project_images import ensure_image
+    from orchestrator import ensure_image
 
     return ensure_image("simulator").reference
 

@@ -15,7 +15,7 @@ from typing import TypedDict
 import numpy as np
 import numpy.typing as npt
 
-from contracts.telemetry import EventRecord
+from contracts import EventRecord
 from simulator.world import FORCE_SENSORS, MOTOR_NAMES
 
 FloatArray = npt.NDArray[np.float64]

@@ -21,7 +21,7 @@ from typing import Any, TypedDict
 
 import httpx
 
-from contracts.jsontypes import JSONObject
+from contracts import JSONObject
 from envs.errors import EnvError
 
 

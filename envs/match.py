@@ -21,8 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from contracts.field import field_for
-from contracts.timing import ENVIRONMENT, MIN_PLAYING_S
+from contracts import ENVIRONMENT, MIN_PLAYING_S, field_for
 from envs.base import HlvsEnv, Session
 from envs.frame import BALL_POS, UP_Z, Frame, GameView
 from envs.match_setup import default_stubs

@@ -16,12 +16,11 @@ from typing import Any
 
 import numpy as np
 
-from contracts.match_spec import MatchSpec, PlayerSpec, Pose, TeamSpec, TimingSpec
-from contracts.timing import ENVIRONMENT
+from contracts import ENVIRONMENT, MatchSpec, PlayerSpec, Pose, TeamSpec, TimingSpec
 from envs.randomization import episode_world
 from envs.session_spec import SessionSpec, StubSpec
 from referee import GameState, Referee, RobotId, TeamColor
-from simulator.match_setup import referee_config
+from simulator import referee_config
 from simulator.world import MOTOR_NAMES, World
 
 STUB_LOOK_PERIOD_MS = 96
@@ -88,8 +87,7 @@ def build_match(
     spec: SessionSpec, *, seed: int, clock: Any
 ) -> tuple[World, Referee, list[StubRobot]]:
     from robot.motion import SERVO_PID
-    from robot.stub.behaviour import Role
-    from robot.stub.controller import StubController
+    from robot.stub import Role, StubController
 
     mspec = match_spec(spec, seed)
     episode = episode_world(
@@ -135,8 +133,7 @@ def _team_pose(x: float, y: float, yaw: float, attack_sign: float) -> tuple[floa
 def tick_stub(stub: StubRobot, world: World, referee: Referee, range_m: float) -> None:
     """One control step of a stub robot: sensors in, motor targets out."""
     from envs.perception import CameraView
-    from robot.stub.behaviour import GameInfo
-    from robot.stub.controller import Sensors
+    from robot.stub import GameInfo, Sensors
 
     gc = referee.gc
     robot = world.index.by_id[stub.id]

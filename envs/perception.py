@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from contracts.field import FieldGeometry
+from contracts import FieldGeometry
 
 FloatArray = npt.NDArray[np.float64]
 NEAR_M = 0.05

@@ -17,8 +17,7 @@ from typing import Any, cast
 import numpy as np
 import numpy.typing as npt
 
-from contracts.field import field_for
-from contracts.geometry import Pose
+from contracts import Pose, field_for
 from envs.errors import EnvStateError, TrainerError
 from envs.frame import SENSOR_NAMES, Frame, GameView
 from envs.perception import CameraView, add_noise, field_segments, goal_post_feet

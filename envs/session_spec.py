@@ -10,8 +10,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field, fields
 from typing import Any, TypedDict
 
-from contracts.jsontypes import JSONObject
-from contracts.timing import ENVIRONMENT, MIN_PLAYING_S, TimingError, fit_ready
+from contracts import ENVIRONMENT, MIN_PLAYING_S, JSONObject, TimingError, fit_ready
 from envs.errors import EnvConfigError
 
 LOOKS = ("fixed", "random")

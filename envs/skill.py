@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from contracts.field import field_for
+from contracts import field_for
 from envs.base import HlvsEnv, Session
 from envs.errors import EnvConfigError
 from envs.frame import BALL_POS, UP_Z, Frame

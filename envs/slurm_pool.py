@@ -96,7 +96,7 @@ class SlurmLauncher:
         self, options: SlurmOptions | None = None, *, image: str | None = None,
         python: str = sys.executable, host_network: bool | None = None,
     ) -> None:  # fmt: skip
-        from cluster.slurm import HOST_NETNS, SlurmPool
+        from cluster import HOST_NETNS, SlurmPool
         from envs.docker_pool import default_image
 
         self.options = options or SlurmOptions()
@@ -188,7 +188,7 @@ class SlurmLauncher:
 
     def _submit(self, index: int) -> _Job:
         folder = self.root / f"remote-{index}-{self._submitted}"
-        from cluster.nodes import ENV_REMOTE_COMMENT
+        from cluster import ENV_REMOTE_COMMENT
 
         self._submitted += 1
         folder.mkdir()
@@ -206,7 +206,7 @@ class SlurmLauncher:
         return job
 
     def _script(self, folder: Path) -> str:
-        from cluster.slurm import HOST_NETNS
+        from cluster import HOST_NETNS
 
         prefix = ["nsenter", f"--net={HOST_NETNS}"] if self.host_network else []
         command = [*prefix, self.slurm.python, "-m", "envs.slurm_node", "--image", self.image,

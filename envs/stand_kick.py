@@ -36,7 +36,7 @@ from envs.frame import BALL_VEL, ROBOT_XY, ROBOT_YAW, Frame
 from envs.session_spec import ResetOptions, ResetRequest
 from envs.skill import PROGRESS_WEIGHT, KickEnv
 from envs.spaces import observe
-from robot.learned.policy import KICK_BALL_AHEAD_M, KICK_BALL_RIGHT_M
+from robot.learned import KICK_BALL_AHEAD_M, KICK_BALL_RIGHT_M
 from robot.motion import standing_posture
 from simulator.world import MOTOR_NAMES
 

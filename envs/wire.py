@@ -30,7 +30,7 @@ from typing import Any, TypedDict, cast
 import numpy as np
 import numpy.typing as npt
 
-from contracts.jsontypes import JSONObject
+from contracts import JSONObject
 from contracts.robot_api import messages_pb2 as pb
 from envs.frame import N_JOINTS, SENSOR_SIZE, TRUTH_SIZE, FrameWire
 from simulator.world import FORCE_SENSORS, MOTOR_NAMES

@@ -38,8 +38,7 @@ from hlvs.commands import (
     simulator,
     viewer,
 )
-from orchestrator import OrchestratorError
-from orchestrator.exitcodes import ExitCode
+from orchestrator import ExitCode, OrchestratorError
 
 PROG = "hlvs"
 

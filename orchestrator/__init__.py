@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
+from contracts import lazy_exports
 from orchestrator.errors import (
     ConfigError,
     DeliveryError,
@@ -17,17 +20,67 @@ from orchestrator.errors import (
     TeamImagesTooLarge,
 )
 
+if TYPE_CHECKING:
+    from orchestrator.compose import Subnets, collect_results, write_compose
+    from orchestrator.console import progress
+    from orchestrator.exitcodes import ExitCode
+    from orchestrator.image_origin import local_name_reason
+    from orchestrator.paths import user_path
+    from orchestrator.private_files import (
+        make_private_file,
+        open_private_append,
+        private_dir,
+        write_private,
+    )
+    from orchestrator.project_images import build_all, ensure_image, project_image
+    from orchestrator.pull import pull_game_images, resolve_team_images
+    from orchestrator.telemetry import LiveView, ZenohTelemetry
+
 __all__ = [
     "ConfigError",
     "DeliveryError",
     "EngineUnavailable",
+    "ExitCode",
     "ImageError",
     "ImagePullError",
     "ImageTooLarge",
     "InfrastructureError",
+    "LiveView",
     "MatchFailed",
     "OrchestratorError",
     "Problem",
     "ScheduleError",
+    "Subnets",
     "TeamImagesTooLarge",
+    "ZenohTelemetry",
+    "build_all",
+    "collect_results",
+    "ensure_image",
+    "local_name_reason",
+    "make_private_file",
+    "open_private_append",
+    "private_dir",
+    "progress",
+    "project_image",
+    "pull_game_images",
+    "resolve_team_images",
+    "user_path",
+    "write_compose",
+    "write_private",
 ]
+
+
+if not TYPE_CHECKING:
+    __getattr__, __dir__ = lazy_exports(__name__, {
+        "orchestrator.compose": ("Subnets", "collect_results", "write_compose"),
+        "orchestrator.console": ("progress",),
+        "orchestrator.exitcodes": ("ExitCode",),
+        "orchestrator.image_origin": ("local_name_reason",),
+        "orchestrator.paths": ("user_path",),
+        "orchestrator.private_files": (
+            "make_private_file", "open_private_append", "private_dir", "write_private",
+        ),
+        "orchestrator.project_images": ("build_all", "ensure_image", "project_image"),
+        "orchestrator.pull": ("pull_game_images", "resolve_team_images"),
+        "orchestrator.telemetry": ("LiveView", "ZenohTelemetry"),
+    })

@@ -28,10 +28,7 @@ from typing import Any, Literal, TypedDict
 
 import yaml
 
-from contracts import files
-from contracts.jsontypes import JSONObject
-from contracts.match_results import MatchResults
-from contracts.match_spec import MatchSpec
+from contracts import JSONObject, MatchResults, MatchSpec, files
 from orchestrator.config import LoadedGame
 from orchestrator.match import layout
 from orchestrator.match.gpu import SimulatorGpu
@@ -353,9 +350,7 @@ def collect_results(loaded: LoadedGame, folder: Path) -> MatchResults:
     from the simulator's ``out/sim_result.json``, classified as ``hlvs match`` classifies a
     match (a game that reached FINISHED without football fails as not played). What compose
     does not record (robot exit codes, resource peaks, bandwidth) stays empty."""
-    from contracts.errors import ContractError
-    from contracts.match_results import Failure, FailureClass, MatchLimits
-    from contracts.sim_result import SimResult
+    from contracts import ContractError, Failure, FailureClass, MatchLimits, SimResult
     from orchestrator.match.results import (
         RobotRecord,
         build_results,

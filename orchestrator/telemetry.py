@@ -22,10 +22,8 @@ from rich.console import Console
 from rich.live import Live
 from rich.table import Table
 
+from contracts import ContractError, EventRecord, JSONObject, StateMessage
 from contracts import telemetry as topics
-from contracts.errors import ContractError
-from contracts.jsontypes import JSONObject
-from contracts.telemetry import EventRecord, StateMessage
 from orchestrator.errors import InfrastructureError
 
 log = logging.getLogger(__name__)

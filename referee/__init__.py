@@ -16,19 +16,26 @@ READY, between periods), so a lockstep runtime can hold instead of stepping. Rul
 
 from __future__ import annotations
 
-from contracts.field import ADULT_FIELD, KID_FIELD, FieldClass, FieldGeometry, field_for
-from contracts.gamecontroller import (
+from contracts import (
+    ADULT_FIELD,
+    KID_FIELD,
+    FieldClass,
+    FieldGeometry,
     GameControlData,
+    GameType,
+    PlayerSpec,
+    Pose,
     ReturnData,
     ReturnMessage,
+    RobotId,
+    TeamColor,
+    TeamSpec,
     decode_game_state,
     decode_return,
     encode_game_state,
     encode_return,
+    field_for,
 )
-from contracts.geometry import Pose
-from contracts.ids import RobotId, TeamColor
-from contracts.match_spec import GameType, PlayerSpec, TeamSpec
 from referee.autoref import Referee
 from referee.clock import Clock, FakeClock, SystemClock
 from referee.config import NetworkConfig, RefereeConfig, TimingConfig

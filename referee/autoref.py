@@ -12,10 +12,7 @@ import logging
 from collections.abc import Callable
 from pathlib import Path
 
-from contracts.geometry import Pose
-from contracts.ids import RobotId, TeamColor
-from contracts.match_spec import GameType
-from contracts.telemetry import GameStateRecord
+from contracts import GameStateRecord, GameType, Pose, RobotId, TeamColor
 from referee import reporting
 from referee.clock import Clock, SystemClock
 from referee.config import RefereeConfig

@@ -12,9 +12,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from contracts.field import FieldClass, FieldGeometry, field_for
-from contracts.ids import RobotId, TeamColor
-from contracts.match_spec import GameType, TeamSpec, TimingSpec
+from contracts import (
+    FieldClass,
+    FieldGeometry,
+    GameType,
+    RobotId,
+    TeamColor,
+    TeamSpec,
+    TimingSpec,
+    field_for,
+)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -11,7 +11,7 @@ A GameController datagram that does not decode raises :class:`contracts.errors.P
 
 from __future__ import annotations
 
-from contracts.errors import ProtocolError
+from contracts import ProtocolError
 
 
 class RefereeError(Exception):

@@ -8,8 +8,7 @@ from __future__ import annotations
 
 from typing import Protocol
 
-from contracts.field import FieldGeometry
-from contracts.ids import RobotId, TeamColor
+from contracts import FieldGeometry, RobotId, TeamColor
 from referee.config import RefereeConfig
 from referee.gamecontroller import Card, GameController, GameState, Penalty
 from referee.logs import RefereeLog

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TextIO
 
-from contracts.ids import TeamColor
+from contracts import TeamColor
 from referee.spoofing import SpoofingLog
 
 logger = logging.getLogger(__name__)

@@ -27,8 +27,7 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
-from contracts.gamecontroller import ReturnMessage, decode_return, with_packet_number
-from contracts.ids import RobotId, TeamColor
+from contracts import ReturnMessage, RobotId, TeamColor, decode_return, with_packet_number
 from referee.clock import Clock
 from referee.errors import ProtocolError
 from referee.spoofing import Senders, SpoofingLog, robot_key

@@ -21,8 +21,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from contracts.ids import RobotId, TeamColor
-from contracts.sim_result import PlayRecord
+from contracts import PlayRecord, RobotId, TeamColor
 from referee.gamecontroller import GameState, SecondaryState
 from referee.rules.base import GameView
 from referee.snapshot import RefereeEvent, WorldSnapshot

@@ -10,8 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from contracts.gamecontroller import encode_game_state
-from contracts.ids import TeamColor
+from contracts import TeamColor, encode_game_state
 from referee.clock import Clock
 from referee.gamecontroller import GameController, game_control_data
 from referee.logs import RefereeLog

@@ -5,10 +5,7 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Sequence
 
-from contracts.codec import to_data
-from contracts.ids import TeamColor
-from contracts.sim_result import PlayRecord
-from contracts.telemetry import GameStateRecord, PenaltyRecord
+from contracts import GameStateRecord, PenaltyRecord, PlayRecord, TeamColor, to_data
 from referee.clock import Clock
 from referee.gamecontroller import GameController
 from referee.snapshot import RefereeEvent

@@ -13,8 +13,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from contracts.geometry import Pose
-from contracts.ids import RobotId, TeamColor
+from contracts import Pose, RobotId, TeamColor
 from referee.config import RefereeConfig
 from referee.gamecontroller import GameController
 from referee.rules.ball_out import in_goal, over_goal_line, over_touch_line

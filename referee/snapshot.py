@@ -10,9 +10,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field
 from enum import Enum
 
-from contracts.geometry import Pose
-from contracts.ids import RobotId, TeamColor
-from contracts.telemetry import EventRecord
+from contracts import EventRecord, Pose, RobotId, TeamColor
 
 Vec3 = tuple[float, float, float]
 Vec2 = tuple[float, float]

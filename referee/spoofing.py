@@ -13,8 +13,7 @@ from __future__ import annotations
 import threading
 from collections.abc import Mapping
 
-from contracts.ids import RobotId
-from contracts.sim_result import SpoofingAttempt
+from contracts import RobotId, SpoofingAttempt
 
 MAX_RECORDS = 256  # distinct (channel, sender, claimed, message) kept; the rest only counted
 

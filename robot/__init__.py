@@ -7,4 +7,39 @@ MJCF). Nothing here imports MuJoCo, the simulator server or the referee: the pac
 its own with numpy and protobuf (see ``robot/pyproject.toml``).
 """
 
-__all__: list[str] = []  # its public modules are listed in ARCHITECTURE.md (Public faces)
+from typing import TYPE_CHECKING
+
+from contracts import lazy_exports
+
+if TYPE_CHECKING:
+    from robot.errors import UnknownModelError
+    from robot.geometry import (
+        ADULT_GEOMETRY,
+        ADULT_SCALE,
+        CAMERA_FOV_RAD,
+        KID_GEOMETRY,
+        MOTOR_NAMES,
+        HumanoidGeometry,
+        motor_range,
+    )
+
+__all__ = [
+    "ADULT_GEOMETRY",
+    "ADULT_SCALE",
+    "CAMERA_FOV_RAD",
+    "HumanoidGeometry",
+    "KID_GEOMETRY",
+    "MOTOR_NAMES",
+    "UnknownModelError",
+    "motor_range",
+]
+
+
+if not TYPE_CHECKING:
+    __getattr__, __dir__ = lazy_exports(__name__, {
+        "robot.errors": ("UnknownModelError",),
+        "robot.geometry": (
+            "ADULT_GEOMETRY", "ADULT_SCALE", "CAMERA_FOV_RAD", "KID_GEOMETRY", "MOTOR_NAMES",
+            "HumanoidGeometry", "motor_range",
+        ),
+    })

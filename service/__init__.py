@@ -10,11 +10,16 @@ The names are imported on first use, so that ``hlvs --help`` (which reads
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from contracts import lazy_exports
 
 if TYPE_CHECKING:
+    from service import tokens
+    from service.accounts import ensure_team_account
+    from service.admin import add_team, list_tokens
     from service.app import Services, create_app, pool_from_settings
+    from service.client import register_client_commands
     from service.deps import (
         DbSession,
         OperatorPrincipal,
@@ -29,33 +34,6 @@ if TYPE_CHECKING:
     from service.settings import Settings
     from service.tokens import Principal
 
-_WHERE = {
-    "DbSession": "service.deps",
-    "NotFound": "service.errors",
-    "OperatorPrincipal": "service.deps",
-    "Principal": "service.tokens",
-    "ServiceError": "service.errors",
-    "Services": "service.app",
-    "Settings": "service.settings",
-    "TeamPrincipal": "service.deps",
-    "create_app": "service.app",
-    "get_db": "service.deps",
-    "get_services": "service.deps",
-    "pool_from_settings": "service.app",
-    "require_operator": "service.deps",
-    "require_team": "service.deps",
-    "require_token": "service.deps",
-}
-
-
-def __getattr__(name: str) -> Any:
-    if name not in _WHERE:
-        raise AttributeError(f"module 'service' has no attribute {name!r}")
-    value = getattr(importlib.import_module(_WHERE[name]), name)
-    globals()[name] = value
-    return value
-
-
 __all__ = [
     "DbSession",
     "NotFound",
@@ -65,11 +43,33 @@ __all__ = [
     "Services",
     "Settings",
     "TeamPrincipal",
+    "add_team",
     "create_app",
+    "ensure_team_account",
     "get_db",
     "get_services",
+    "list_tokens",
     "pool_from_settings",
+    "register_client_commands",
     "require_operator",
     "require_team",
     "require_token",
+    "tokens",
 ]
+
+
+if not TYPE_CHECKING:
+    __getattr__, __dir__ = lazy_exports(__name__, {
+        "service": ("tokens",),
+        "service.accounts": ("ensure_team_account",),
+        "service.admin": ("add_team", "list_tokens"),
+        "service.app": ("Services", "create_app", "pool_from_settings"),
+        "service.client": ("register_client_commands",),
+        "service.deps": (
+            "DbSession", "OperatorPrincipal", "TeamPrincipal", "get_db", "get_services",
+            "require_operator", "require_team", "require_token",
+        ),
+        "service.errors": ("NotFound", "ServiceError"),
+        "service.settings": ("Settings",),
+        "service.tokens": ("Principal",),
+    })

@@ -42,9 +42,9 @@ from typing import TYPE_CHECKING
 
 from sqlalchemy import select
 
-from cluster.local import process_start_time
+from cluster import process_start_time
 from contracts import files
-from orchestrator.private_files import open_private_append, private_dir, write_private
+from orchestrator import open_private_append, private_dir, write_private
 from service import teamfiles
 from service.db import MediaState, Submission, Team, TeamFile, transaction
 from service.matchfiles import OWN_COLOR
@@ -171,8 +171,7 @@ class AfterMatch:
 
     def _deliver(self, match_id: str | None, handle: str | None, team: str,
                  content: str | None) -> tuple[MediaState, str]:
-        from orchestrator.delivery import deliver_pending, enqueue_match_logs
-        from orchestrator.delivery.store import list_sets
+        from orchestrator.delivery import deliver_pending, enqueue_match_logs, list_sets
 
         if match_id is None or handle is None or content is None:
             return MediaState.FAILED, "the match left no logs, or no credentials were given"

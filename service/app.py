@@ -137,7 +137,7 @@ def create_app(
 
         # Request handlers run in this many threads: more only fight over the GIL.
         anyio.to_thread.current_default_thread_limiter().total_tokens = settings.threads
-        from orchestrator.private_files import private_dir
+        from orchestrator import private_dir
         from service.sealing import key_file, load_sealer
 
         private_dir(settings.data_dir)  # 0700; the files below it are 0600

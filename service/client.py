@@ -19,13 +19,13 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from orchestrator.paths import user_path
+from orchestrator import user_path
 
 DEFAULT_TOKEN_FILE = Path("~/.config/hlvs/token")
 FINAL_STATES = ("done", "failed", "cancelled")
 
 
-def register(sub: Any, guarded: Callable[[Any], Any]) -> None:
+def register_client_commands(sub: Any, guarded: Callable[[Any], Any]) -> None:
     submit = sub.add_parser("submit", help="ask the league's service for a test match")
     _common(submit)
     submit.add_argument("--team-config", type=user_path, default=None,
@@ -293,4 +293,4 @@ def run_logs(args: argparse.Namespace) -> int:
         api.close()
 
 
-__all__ = ["Api", "register"]
+__all__ = ["Api", "register_client_commands"]

@@ -10,10 +10,10 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from contracts.timing import TEST_MATCH
+from contracts import TEST_MATCH
+from orchestrator import private_dir, write_private
 from orchestrator.config import TeamDocument
-from orchestrator.match.scrimmage import ScrimmageRequest, game_file, team_file
-from orchestrator.private_files import private_dir, write_private
+from orchestrator.match import ScrimmageRequest, game_file, team_file
 from service.settings import Settings
 
 OWN_COLOR = "red"

@@ -71,8 +71,8 @@ def run(team: TeamConfig, *, settings: Settings,
 
     With ``teardowns``, stopping the check's containers happens in a background thread added
     to that list (the answer does not wait for it); without, before returning."""
+    from orchestrator import resolve_team_images
     from orchestrator.engine import connect
-    from orchestrator.pull import resolve_team_images
 
     started = time.monotonic()
     try:
@@ -118,13 +118,19 @@ def _distinct_players(team: TeamConfig) -> TeamConfig:
 
 def _start_and_connect(team: TeamConfig, folder: Path, *, settings: Settings,
                        teardowns: list[threading.Thread] | None) -> None:
+    from orchestrator import ZenohTelemetry, project_image
     from orchestrator.config import parse_game, parse_team
-    from orchestrator.engine import connect
-    from orchestrator.engine.containers import DockerRuntime
-    from orchestrator.match import HostControl, MatchRunner, RunOptions, cleanup, plan_from_game
-    from orchestrator.match.scrimmage import ScrimmageRequest, game_file, team_file
-    from orchestrator.project_images import project_image
-    from orchestrator.telemetry import ZenohTelemetry
+    from orchestrator.engine import DockerRuntime, connect
+    from orchestrator.match import (
+        HostControl,
+        MatchRunner,
+        RunOptions,
+        ScrimmageRequest,
+        cleanup,
+        game_file,
+        plan_from_game,
+        team_file,
+    )
     from service.teamfiles import FIELD_CLASS
 
     checked = _distinct_players(team)

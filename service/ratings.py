@@ -28,9 +28,7 @@ from openskill.models import PlackettLuce
 from sqlalchemy import exists, func, select
 from sqlalchemy.orm import Session
 
-from contracts import files
-from contracts.errors import ContractError
-from contracts.match_results import MatchResults
+from contracts import ContractError, MatchResults, files
 from service.db import Submission, SubmissionState, Team, now, utc
 from service.db.ladder import RatedMatch
 from service.matchfiles import OWN_COLOR

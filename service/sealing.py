@@ -22,7 +22,7 @@ from typing import Any
 
 from cryptography.fernet import Fernet, InvalidToken
 
-from orchestrator.private_files import private_dir
+from orchestrator import private_dir
 from service.errors import SettingsError
 
 log = logging.getLogger(__name__)

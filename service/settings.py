@@ -13,7 +13,7 @@ from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
-from contracts.timing import TEST_MATCH, TimingError, fit_ready
+from contracts import TEST_MATCH, TimingError, fit_ready
 from service.errors import SettingsError
 
 PREFIX = "HLVS_SERVICE_"

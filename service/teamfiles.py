@@ -27,8 +27,7 @@ from sqlalchemy import func, select
 from sqlalchemy.orm import Session
 
 from orchestrator import ConfigError, Problem
-from orchestrator.config import FieldClass, TeamConfig, check_team_document
-from orchestrator.config.robot_models import BUILT_IN_MODELS
+from orchestrator.config import BUILT_IN_MODELS, FieldClass, TeamConfig, check_team_document
 from service.db import TeamFile
 from service.errors import InvalidInput, NotFound
 from service.sealing import PREFIX, Sealer
@@ -134,7 +133,7 @@ def _checked(kind: str, document: Any) -> tuple[TeamConfig | None, list[dict[str
         if any(p.severity == "error" for p in problems):
             team = None
     else:
-        from orchestrator.config.credentials import parse_credentials
+        from orchestrator.config import parse_credentials
 
         try:
             problems += [w for w in parse_credentials(document, source=Path(name)).warnings

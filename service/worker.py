@@ -26,9 +26,7 @@ from sqlalchemy import func, select
 from sqlalchemy.orm import Session
 
 from cluster import JobState, JobStatus, MatchJob, PoolError
-from contracts import files
-from contracts.errors import ContractError
-from contracts.match_results import FailureClass, MatchReport
+from contracts import ContractError, FailureClass, MatchReport, files
 from service import matchfiles, notify, teamfiles
 from service.accounts import ensure_team_account, supports_accounts
 from service.aftermatch import replay_of, team_logs_of
@@ -149,7 +147,7 @@ class QueueWorker:
 
     def _stub(self) -> str:
         if self._stub_image is None:
-            from orchestrator.project_images import project_image
+            from orchestrator import project_image
 
             self._stub_image = project_image("stub")
         return self._stub_image

@@ -6,6 +6,9 @@ typed in the ``contracts`` package.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
+from contracts import lazy_exports
 from simulator.errors import (
     ApiError,
     ModelError,
@@ -15,6 +18,10 @@ from simulator.errors import (
     UnknownModelError,
 )
 
+if TYPE_CHECKING:
+    from simulator.match_setup import referee_config
+    from simulator.traffic import read_stats
+
 __all__ = [
     "ApiError",
     "ModelError",
@@ -22,4 +29,13 @@ __all__ = [
     "ReplayError",
     "SimulatorError",
     "UnknownModelError",
+    "read_stats",
+    "referee_config",
 ]
+
+
+if not TYPE_CHECKING:
+    __getattr__, __dir__ = lazy_exports(__name__, {
+        "simulator.match_setup": ("referee_config",),
+        "simulator.traffic": ("read_stats",),
+    })

@@ -45,7 +45,7 @@ def render_camera_frames(
     import mujoco
     import numpy as np
 
-    from contracts.codec import from_data
+    from contracts import from_data
     from simulator.png import write_png
     from simulator.render import Placer, _frames_for, scene_model
     from simulator.replay import load_replay, scene_for

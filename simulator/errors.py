@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from robot.errors import UnknownModelError
+from robot import UnknownModelError
 
 __all__ = [
     "ApiError",

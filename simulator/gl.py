@@ -25,7 +25,7 @@ import sys
 from collections.abc import Callable, MutableMapping, Sequence
 from dataclasses import dataclass
 
-from contracts.files import GPU_ENVIRONMENT  # on | auto: the orchestrator gave us the GPU
+from contracts import GPU_ENVIRONMENT  # on | auto: the orchestrator gave us the GPU
 from simulator.errors import GpuRenderError, OffscreenGLError
 
 log = logging.getLogger(__name__)

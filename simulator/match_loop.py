@@ -36,7 +36,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from contracts.telemetry import EventRecord, GameStateRecord, StateMessage
+from contracts import EventRecord, GameStateRecord, StateMessage
 from referee import RefereeEvent, WorldCommand, WorldSnapshot
 from simulator.api import ApiServer, LockstepSettings, wait_lockstep
 from simulator.api.lockstep import Pipeline

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import fields
 
-from contracts.match_spec import MatchSpec
+from contracts import MatchSpec
 from referee import NetworkConfig, RefereeConfig, TimingConfig
 
 

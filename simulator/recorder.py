@@ -12,8 +12,7 @@ from typing import IO
 
 import numpy as np
 
-from contracts.codec import to_data
-from contracts.telemetry import EventRecord, GameStateRecord
+from contracts import EventRecord, GameStateRecord, to_data
 from simulator.replay.format import (
     CHUNK,
     FORMAT_VERSION,

@@ -31,7 +31,7 @@ if TYPE_CHECKING:  # numpy, MuJoCo and the replay reader are imported after the 
     import numpy as np
     import numpy.typing as npt
 
-    from contracts.telemetry import GameStateRecord
+    from contracts import GameStateRecord
     from simulator.replay import Replay
     from simulator.replay.format import GeomRecord, SceneRecord
 

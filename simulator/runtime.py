@@ -24,10 +24,7 @@ from pathlib import Path
 from types import FrameType
 from typing import Any
 
-from contracts import files
-from contracts.errors import ContractError
-from contracts.match_spec import MatchSpec
-from contracts.sim_result import SimResult
+from contracts import ContractError, MatchSpec, SimResult, files
 from simulator.api import ApiServer, LockstepSettings, endpoints_from_spec
 from simulator.errors import (
     GpuRenderError,

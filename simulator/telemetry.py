@@ -17,9 +17,8 @@ import logging
 import time
 from typing import TYPE_CHECKING, Any, Protocol
 
+from contracts import EventRecord, JSONObject
 from contracts import telemetry as topics
-from contracts.jsontypes import JSONObject
-from contracts.telemetry import EventRecord
 from simulator.errors import SimulatorError
 
 if TYPE_CHECKING:

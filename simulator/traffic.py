@@ -19,8 +19,7 @@ import json
 from pathlib import Path
 from typing import IO, Protocol, cast
 
-from contracts import files
-from contracts.telemetry import RobotTraffic, TrafficSample
+from contracts import RobotTraffic, TrafficSample, files
 from simulator.api.stats import RobotStats
 
 STATS_FILE = files.API_STATS

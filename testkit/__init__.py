@@ -3,4 +3,4 @@ image and imported by no production package): SFTP (OpenSSH ``sshd`` and asyncss
 (moto and SeaweedFS) servers, free ports, and the stub robot controller on an in-process world.
 """
 
-__all__: list[str] = []  # its public modules are listed in ARCHITECTURE.md (Public faces)
+__all__: list[str] = []  # tests import its modules; no product package imports it

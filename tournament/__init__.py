@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
+from contracts import lazy_exports
 from tournament.overview import LiveGame
 from tournament.runner import init_state, recover_interrupted, run_schedule
 from tournament.services import (
@@ -21,7 +24,25 @@ from tournament.state import (
     ScheduledMatchState,
 )
 
+if TYPE_CHECKING:
+    from tournament.controls import (
+        DEFAULT_ABORT_GRACE_S,
+        abort,
+        apply_file,
+        file_differences,
+        recorded_schedule,
+        reschedule,
+    )
+    from tournament.overview import (
+        Snapshot,
+        match_folder,
+        replay_path,
+        status_lines,
+        tournament_overview,
+    )
+
 __all__ = [
+    "DEFAULT_ABORT_GRACE_S",
     "Ledger",
     "LiveGame",
     "MatchContext",
@@ -29,14 +50,36 @@ __all__ = [
     "MatchRow",
     "MatchServices",
     "OperatorRequest",
-    "ScheduledMatchState",
     "PlayOutcome",
+    "ScheduledMatchState",
+    "Snapshot",
     "Standing",
     "TournamentServices",
+    "abort",
+    "apply_file",
+    "file_differences",
     "init_state",
+    "match_folder",
     "read_outcome",
+    "recorded_schedule",
     "recover_interrupted",
+    "replay_path",
+    "reschedule",
     "run_schedule",
     "standings",
+    "status_lines",
+    "tournament_overview",
     "write_game_file",
 ]
+
+
+if not TYPE_CHECKING:
+    __getattr__, __dir__ = lazy_exports(__name__, {
+        "tournament.controls": (
+            "DEFAULT_ABORT_GRACE_S", "abort", "apply_file", "file_differences", "recorded_schedule",
+            "reschedule",
+        ),
+        "tournament.overview": (
+            "Snapshot", "match_folder", "replay_path", "status_lines", "tournament_overview",
+        ),
+    })

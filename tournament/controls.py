@@ -18,7 +18,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from orchestrator import ConfigError, Problem, ScheduleError
-from orchestrator.config.schedule import PlannedMatch, Schedule, load_schedule, resolve_time
+from orchestrator.config import PlannedMatch, Schedule, load_schedule, resolve_time
 from tournament.state import Ledger, OperatorRequest, ScheduledMatchState
 
 log = logging.getLogger(__name__)
@@ -144,7 +144,7 @@ def apply_file(ledger: Ledger, *, now: datetime | None = None) -> list[str]:
     """Make the schedule file the tournament's schedule: new matches are added, matches not yet
     started take the file's times, matches no longer in the file and not started are cancelled.
     Refuses a file with errors (``hlvs check``). Returns what changed, one sentence each."""
-    from orchestrator.config.schedule_check import check_schedule
+    from orchestrator.config import check_schedule
 
     now = now or datetime.now(UTC)
     path = ledger.get_meta("schedule")

@@ -14,7 +14,7 @@ from datetime import UTC, datetime, timedelta
 from pathlib import Path
 
 from orchestrator import OrchestratorError, ScheduleError
-from orchestrator.config.schedule import PlannedMatch, Schedule, Slot, load_schedule
+from orchestrator.config import PlannedMatch, Schedule, Slot, load_schedule
 from tournament.controls import abort_request
 from tournament.logs import DONE, TeamLogs, all_done, summary, with_retry
 from tournament.services import (

@@ -13,8 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
-from contracts.codec import from_data, to_data
-from contracts.jsontypes import JSONObject
+from contracts import JSONObject, from_data, to_data
 
 LogState = Literal["pending", "delivered", "failed", "retrying", "none", "gone"]
 DONE: frozenset[str] = frozenset({"delivered", "none"})

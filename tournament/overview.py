@@ -14,7 +14,7 @@ from typing import Any, TypedDict
 from urllib.parse import quote, urlencode
 
 from contracts import files
-from orchestrator.config.schedule import Schedule
+from orchestrator.config import Schedule
 from tournament.logs import summary
 from tournament.state import Ledger, MatchRow, ScheduledMatchState
 
@@ -168,7 +168,7 @@ def bracket(schedule: Schedule) -> list[list[str]]:
     return rounds
 
 
-def overview(ledger: Ledger, *, snapshot: Snapshot | None = None,
+def tournament_overview(ledger: Ledger, *, snapshot: Snapshot | None = None,
              links: str = "/watch/tournament") -> dict[str, Any]:
     """Everything the operator's page shows: the tournament's name, every match (state, times,
     score, live clock, log states, links to the live view and the replay), the standings with

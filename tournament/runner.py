@@ -23,7 +23,7 @@ from apscheduler.jobstores.sqlalchemy import SQLAlchemyJobStore
 from apscheduler.schedulers.background import BackgroundScheduler
 
 from orchestrator import ScheduleError
-from orchestrator.config.schedule import Schedule, load_schedule, resolve_time
+from orchestrator.config import Schedule, load_schedule, resolve_time
 from tournament.controls import abort_request
 from tournament.state import Ledger, ScheduledMatchState
 

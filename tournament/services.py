@@ -24,11 +24,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Protocol
 
-from contracts import files
-from contracts.errors import ContractError
-from contracts.match_results import MatchReport, MatchResults
+from contracts import ContractError, MatchReport, MatchResults, files
 from orchestrator import ScheduleError
-from orchestrator.config.schedule import (
+from orchestrator.config import (
     PlannedMatch,
     Schedule,
     ScheduledTeam,
@@ -230,7 +228,7 @@ class MatchServices:
         self.schedule = schedule
 
     def pull(self, ctx: MatchContext) -> str:
-        from orchestrator.pull import pull_game_images
+        from orchestrator import pull_game_images
 
         game = write_game_file(ctx)
         return str(pull_game_images(game))
@@ -272,8 +270,7 @@ class MatchServices:
         """The match as a Slurm job (no requeue: tournament matches wait for the operator).
         A job an earlier scheduler submitted for this match, still in Slurm or finished with
         its report, is adopted instead of playing the match again."""
-        from cluster import JobState, MatchJob, PoolError
-        from cluster.slurm import HOST_NETNS, SlurmPool
+        from cluster import HOST_NETNS, JobState, MatchJob, PoolError, SlurmPool
 
         settings = self.schedule.pool
         pool = SlurmPool(

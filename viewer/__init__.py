@@ -7,7 +7,36 @@ that installing the package needs no Node.js); ``viewer.mcap_export`` writes MCA
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
+from contracts import lazy_exports
 from viewer.errors import ExportError, SourceError, ViewerError
 from viewer.sources import Catalog, LiveSource, ReplaySource
 
-__all__ = ["Catalog", "ExportError", "LiveSource", "ReplaySource", "SourceError", "ViewerError"]
+if TYPE_CHECKING:
+    from viewer import ladder_page, service_pages, tournament_pages
+    from viewer.cli import export, view
+    from viewer.snapshot import game_snapshot
+
+__all__ = [
+    "Catalog",
+    "ExportError",
+    "LiveSource",
+    "ReplaySource",
+    "SourceError",
+    "ViewerError",
+    "export",
+    "game_snapshot",
+    "ladder_page",
+    "service_pages",
+    "tournament_pages",
+    "view",
+]
+
+
+if not TYPE_CHECKING:
+    __getattr__, __dir__ = lazy_exports(__name__, {
+        "viewer": ("ladder_page", "service_pages", "tournament_pages"),
+        "viewer.cli": ("export", "view"),
+        "viewer.snapshot": ("game_snapshot",),
+    })

@@ -32,9 +32,8 @@ from fastapi.responses import FileResponse, Response, StreamingResponse
 from fastapi.staticfiles import StaticFiles
 
 from contracts import files
-from simulator import ReplayError
+from simulator import ReplayError, read_stats
 from simulator.replay import ReplayFile, SceneRecord, scene_for
-from simulator.traffic import read_stats
 from viewer.live import FeedFactory, LiveUnavailable, ZenohFeed
 from viewer.sources import Catalog, LiveSource, ReplaySource
 

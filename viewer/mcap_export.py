@@ -33,8 +33,8 @@ from google.protobuf.timestamp_pb2 import Timestamp
 from mcap.writer import Writer
 from mcap_protobuf.schema import build_file_descriptor_set
 
+from simulator import read_stats
 from simulator.replay import GeomRecord, ReplayFile, SceneRecord, scene_for
-from simulator.traffic import read_stats
 from viewer.errors import ExportError
 from viewer.sources import STATS_FILE
 

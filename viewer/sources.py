@@ -12,9 +12,7 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from contracts import files
-from contracts.errors import ContractError
-from contracts.match_spec import MatchSpec
+from contracts import ContractError, MatchSpec, files
 from viewer.errors import SourceError
 
 STATS_FILE = files.API_STATS

@@ -53,13 +53,13 @@ def snapshot(folder: Path) -> LiveGame | None:
 
 @router.get("/tournament")
 def get_tournament(request: Request, principal: OperatorPrincipal) -> TournamentView:
-    from tournament.overview import overview
+    from tournament import tournament_overview
 
-    return TournamentView(**overview(_ledger(request), snapshot=lambda f: snapshot(f)))
+    return TournamentView(**tournament_overview(_ledger(request), snapshot=lambda f: snapshot(f)))
 
 
 def _folder(request: Request, match_id: str) -> tuple[Any, Path]:
-    from tournament.overview import match_folder
+    from tournament import match_folder
 
     ledger = _ledger(request)
     try:
@@ -75,7 +75,7 @@ class TournamentResolver:
     def replay(self, replay_id: str, request: Request,
                principal: OperatorPrincipal) -> ReplaySource:
         from contracts import files
-        from tournament.overview import replay_path
+        from tournament import replay_path
 
         row, folder = _folder(request, replay_id)
         path = replay_path(folder)

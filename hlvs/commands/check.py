@@ -18,16 +18,13 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NotRequired, TextIO, TypedDict
 
-from contracts.codec import to_data
-from orchestrator import ConfigError, OrchestratorError, Problem
-from orchestrator.exitcodes import ExitCode
-from orchestrator.paths import user_path
+from contracts import to_data
+from orchestrator import ConfigError, ExitCode, OrchestratorError, Problem, user_path
 
 if TYPE_CHECKING:
-    from contracts.field import FieldClass
-    from contracts.jsontypes import JSONObject
-    from orchestrator.config.detect import Kind
-    from simulator.world.robots.team.rulebook import Measurements
+    from contracts import FieldClass, JSONObject
+    from orchestrator.config import Kind
+    from simulator.world.robots.team import Measurements
 
 log = logging.getLogger(__name__)
 
@@ -127,7 +124,7 @@ class FileReport:
 
 
 def run(args: argparse.Namespace) -> int:
-    from contracts.field import FieldClass
+    from contracts import FieldClass
 
     reports = [
         check_report(
@@ -178,7 +175,7 @@ def check_report(
 ) -> FileReport:
     """Check one file (or robot model package) and return every problem found (nothing
     printed); ``official``: model packages as for an official match."""
-    from orchestrator.config.robot_models import check_model, is_model_package
+    from orchestrator.config import check_model, is_model_package
 
     if is_model_package(path):
         problems, measurements = check_model(path, official=official)
@@ -196,7 +193,7 @@ def check_report(
 
 def print_text(report: FileReport, *, out: TextIO) -> None:
     if report.measurements is not None:
-        from orchestrator.config.robot_models import describe
+        from orchestrator.config import describe
 
         print(f"{report.file}: {describe(report.measurements)}", file=out)
     for problem in report.errors + [p for p in report.problems if p.severity != "error"]:
@@ -254,9 +251,14 @@ def _gh_property(text: str) -> str:
 def _check(
     path: Path, *, kind: Kind | None, field_class: FieldClass | None, images_required: bool
 ) -> tuple[Kind | None, list[Problem]]:
-    from orchestrator.config import check_game, check_team
-    from orchestrator.config.detect import kind_by_content, kind_by_name
-    from orchestrator.config.jsonfile import parse_json, read_text
+    from orchestrator.config import (
+        check_game,
+        check_team,
+        kind_by_content,
+        kind_by_name,
+        parse_json,
+        read_text,
+    )
 
     text = read_text(path)  # missing, directory, empty, binary: one clean problem each
     kind = kind or kind_by_name(path)
@@ -298,7 +300,7 @@ def _referenced_credentials(path: Path, document: Any) -> list[Path]:
 
 
 def _check_optional(kind: Kind, path: Path) -> list[Problem]:
-    from orchestrator.config.jsonfile import parse_json, read_text
+    from orchestrator.config import parse_json, read_text
 
     module_name, function = _OPTIONAL_LOADERS[kind]
     try:

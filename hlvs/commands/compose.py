@@ -14,8 +14,7 @@ import ipaddress
 import json
 from typing import Any
 
-from orchestrator import ConfigError, Problem
-from orchestrator.paths import user_path
+from orchestrator import ConfigError, Problem, user_path
 
 
 def register(sub: Any) -> None:
@@ -51,7 +50,7 @@ def register(sub: Any) -> None:
 
 
 def _compose(args: argparse.Namespace) -> int:
-    from orchestrator.compose import Subnets, write_compose
+    from orchestrator import Subnets, write_compose
     from orchestrator.config import load_game
 
     subnets = None
@@ -71,7 +70,7 @@ def _compose(args: argparse.Namespace) -> int:
     if args.simulator_image:
         image = args.simulator_image
     else:
-        from orchestrator.project_images import project_image
+        from orchestrator import project_image
 
         image = project_image("simulator")
     spec = write_compose(loaded, args.output, simulator_image=image, subnets=subnets)
@@ -107,8 +106,7 @@ def _compose(args: argparse.Namespace) -> int:
 
 
 def _collect(args: argparse.Namespace, loaded: Any) -> int:
-    from orchestrator.compose import collect_results
-    from orchestrator.exitcodes import ExitCode
+    from orchestrator import ExitCode, collect_results
 
     results = collect_results(loaded, args.output.parent)
     folder = args.output.parent

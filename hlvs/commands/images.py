@@ -14,8 +14,7 @@ import json
 import time
 from typing import Any
 
-from orchestrator.exitcodes import ExitCode
-from orchestrator.paths import user_path
+from orchestrator import ExitCode, user_path
 
 
 def register(sub: Any) -> None:
@@ -50,8 +49,7 @@ def register(sub: Any) -> None:
 
 
 def _build(args: argparse.Namespace) -> int:
-    from orchestrator.console import progress
-    from orchestrator.project_images import build_all
+    from orchestrator import build_all, progress
 
     started = time.monotonic()
     with progress() as bars:
@@ -73,10 +71,9 @@ def _build(args: argparse.Namespace) -> int:
 
 
 def _pull(args: argparse.Namespace) -> int:
+    from orchestrator import progress, resolve_team_images
     from orchestrator.config import Limits, load_team
-    from orchestrator.console import progress
     from orchestrator.engine import connect
-    from orchestrator.pull import resolve_team_images
 
     loaded = load_team(args.team_config, images_required=True)
     if not args.json:

@@ -18,9 +18,7 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from orchestrator import ConfigError, Problem
-from orchestrator.exitcodes import ExitCode
-from orchestrator.paths import user_path
+from orchestrator import ConfigError, ExitCode, Problem, user_path
 
 if TYPE_CHECKING:
     from orchestrator.delivery import DeliveryOutcome, PendingSet
@@ -88,7 +86,7 @@ def _quiet_libraries() -> None:
 
 
 def _deliver(args: argparse.Namespace) -> int:
-    from orchestrator.console import progress
+    from orchestrator import progress
     from orchestrator.delivery import deliver_pending
 
     _quiet_libraries()

@@ -14,7 +14,7 @@ from typing import Any
 
 from hlvs.commands.scrimmage_args import add_arguments as add_scrimmage_arguments
 from hlvs.commands.scrimmage_args import add_gpu_argument
-from orchestrator.paths import user_path
+from orchestrator import user_path
 
 MATCH_EPILOG = (
     "exit codes: 0 the match played to its end, 1 it failed (see report.json), 2 invalid input, "

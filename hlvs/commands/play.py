@@ -23,31 +23,40 @@ from types import FrameType
 from typing import Any, TextIO
 
 from contracts import files
-from orchestrator import ConfigError, InfrastructureError, OrchestratorError, Problem
-from orchestrator.config.loader import load_game
+from orchestrator import (
+    ConfigError,
+    ExitCode,
+    InfrastructureError,
+    OrchestratorError,
+    Problem,
+    local_name_reason,
+    user_path,
+)
+from orchestrator.config import load_game
 from orchestrator.engine import LABEL_SLURM_JOB
-from orchestrator.exitcodes import ExitCode
-from orchestrator.image_origin import local_name_reason
 from orchestrator.match import (
+    LABEL_RUN,
     FailureClass,
+    GpuOrigin,
     HostControl,
+    HostResources,
     ImageResolver,
+    LeaguePlacement,
     MatchOutcome,
     MatchPlan,
     MatchRunner,
     RunOptions,
+    SimulatorGpu,
+    admit,
     clean_match,
     cleanup,
     local_images,
     ownership,
+    parse_nodes,
     plan_from_game,
     scrimmage,
+    simulator_gpu,
 )
-from orchestrator.match.admission import HostResources, admit
-from orchestrator.match.gpu import GpuOrigin, SimulatorGpu, simulator_gpu
-from orchestrator.match.ownership import LABEL_RUN
-from orchestrator.match.placement import LeaguePlacement, parse_nodes
-from orchestrator.paths import user_path
 
 log = logging.getLogger(__name__)
 
@@ -73,10 +82,10 @@ def stop_on_signals() -> Iterator[threading.Event]:
 
 
 def _pull_resolver(client: Any, loaded: Any) -> ImageResolver:
-    from orchestrator.pull import resolve_team_images
+    from orchestrator import resolve_team_images
 
     def resolve(plan: MatchPlan) -> dict[str, tuple[str | None, str | None]]:
-        from orchestrator.console import progress
+        from orchestrator import progress
 
         found: dict[str, tuple[str | None, str | None]] = {}
         for color in ("red", "blue"):
@@ -105,9 +114,7 @@ def play(
     orchestrator plays it); what a dead earlier run of it left is salvaged and removed. An
     official match that does not fit the host is refused before all that
     (:mod:`orchestrator.match.admission`)."""
-    from orchestrator.engine import connect
-    from orchestrator.engine.containers import DockerRuntime
-    from orchestrator.engine.gpu import detect_nvidia
+    from orchestrator.engine import DockerRuntime, connect, detect_nvidia
 
     verdict = admit(plan, host=HostResources.local(), official=plan.official)
     plan = replace(plan, admission=verdict.record())
@@ -134,8 +141,7 @@ def _play(
     host: HostControl, extra_labels: dict[str, str], view_stream: TextIO | None = None,
     placement: LeaguePlacement | None = None, gpu: SimulatorGpu | None = None,
 ) -> MatchOutcome:
-    from orchestrator.project_images import project_image
-    from orchestrator.telemetry import LiveView, ZenohTelemetry
+    from orchestrator import LiveView, ZenohTelemetry, project_image
 
     simulator_image = project_image("simulator")
     images = _pull_resolver(client, loaded) if pull and loaded is not None else None
@@ -288,8 +294,7 @@ def _in_pool(args: argparse.Namespace, *, game_path: Path, plan: MatchPlan, out:
 
 
 def run_cleanup_command(args: argparse.Namespace) -> int:
-    from orchestrator.engine import connect
-    from orchestrator.engine.containers import DockerRuntime
+    from orchestrator.engine import DockerRuntime, connect
 
     runtime = DockerRuntime(connect())
     if getattr(args, "dry_run", False):

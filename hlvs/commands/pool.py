@@ -16,7 +16,7 @@ import subprocess
 from pathlib import Path
 from typing import Any
 
-from orchestrator.exitcodes import ExitCode
+from orchestrator import ExitCode
 
 SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "ensure-slurm.sh"
 DEFAULT_CONF = "/var/lib/hlvs/slurm/slurm.conf"
@@ -61,7 +61,7 @@ def _down(args: argparse.Namespace) -> int:
 
 
 def _status(args: argparse.Namespace) -> int:
-    from cluster.slurm import SlurmPool
+    from cluster import SlurmPool
 
     pool = SlurmPool(slurm_conf=args.slurm_conf)
     entries = pool.queue()

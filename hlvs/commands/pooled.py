@@ -17,9 +17,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from contracts import files
-from contracts.errors import ContractError
-from contracts.match_results import FailureClass, MatchReport, MatchResults
+from contracts import ContractError, FailureClass, MatchReport, MatchResults, files
 from hlvs.commands.play import stop_on_signals, summarize
 from orchestrator import InfrastructureError
 from orchestrator.match import MatchOutcome
@@ -30,7 +28,7 @@ POLL_S = 1.0
 
 def make_pool(args: argparse.Namespace) -> Any:
     """The Slurm pool the options name; the output goes straight into ``--out``."""
-    from cluster.slurm import HOST_NETNS, SlurmPool
+    from cluster import HOST_NETNS, SlurmPool
 
     conf = args.slurm_conf or os.environ.get("SLURM_CONF") or DEFAULT_CONF
     # The one-machine cluster of 'hlvs pool up' shares this host's Docker engine: its jobs

@@ -11,8 +11,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from orchestrator import ConfigError, Problem, ScheduleError
-from orchestrator.paths import user_path
+from orchestrator import ConfigError, Problem, ScheduleError, user_path
 
 _STATE_HELP = "SQLite state file written by 'hlvs schedule run'"
 
@@ -102,7 +101,7 @@ def _ledger(path: Path) -> Any:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from orchestrator.config.schedule_check import check_schedule
+    from orchestrator.config import check_schedule
     from tournament import run_schedule
 
     recorded = args.state.is_file() and _ledger(args.state).get_meta("schedule_text")
@@ -119,7 +118,7 @@ def _run(args: argparse.Namespace) -> int:
 
 
 def _list(args: argparse.Namespace) -> int:
-    from orchestrator.config.schedule import load_schedule, resolve_time
+    from orchestrator.config import load_schedule, resolve_time
 
     schedule = load_schedule(args.schedule)
     now = datetime.now(UTC)
@@ -157,12 +156,12 @@ def _list(args: argparse.Namespace) -> int:
 
 
 def _status(args: argparse.Namespace) -> int:
-    from tournament.overview import Snapshot, status_lines
+    from tournament import Snapshot, status_lines
 
     ledger = _ledger(args.state)
     snapshot: Snapshot | None = None
     if not args.json:  # a running match's score and clock, from its telemetry
-        from viewer.snapshot import game_snapshot
+        from viewer import game_snapshot
 
         snapshot = game_snapshot
     if not args.watch:
@@ -212,7 +211,7 @@ def _cancel(args: argparse.Namespace) -> int:
 
 
 def _abort(args: argparse.Namespace) -> int:
-    from tournament.controls import DEFAULT_ABORT_GRACE_S, abort
+    from tournament import DEFAULT_ABORT_GRACE_S, abort
 
     grace = DEFAULT_ABORT_GRACE_S if args.grace is None else args.grace
     abort(_ledger(args.state), args.match_id, reason=args.reason, grace_s=grace)
@@ -222,7 +221,7 @@ def _abort(args: argparse.Namespace) -> int:
 
 
 def _reschedule(args: argparse.Namespace) -> int:
-    from tournament.controls import reschedule
+    from tournament import reschedule
 
     planned = reschedule(_ledger(args.state), args.match_id, at=args.at)
     print(f"{args.match_id}: PLANNED, pull {planned.pull_at.isoformat(timespec='seconds')}, "
@@ -231,7 +230,7 @@ def _reschedule(args: argparse.Namespace) -> int:
 
 
 def _apply(args: argparse.Namespace) -> int:
-    from tournament.controls import apply_file
+    from tournament import apply_file
 
     changes = apply_file(_ledger(args.state))
     for change in changes or ["no change"]:
@@ -240,15 +239,14 @@ def _apply(args: argparse.Namespace) -> int:
 
 
 def _warn_differences(ledger: Any) -> None:
-    from tournament.controls import file_differences
+    from tournament import file_differences
 
     for note in file_differences(ledger):
         print(f"warning: {note}", file=sys.stderr)
 
 
 def _standings(args: argparse.Namespace) -> int:
-    from tournament import standings
-    from tournament.controls import recorded_schedule
+    from tournament import recorded_schedule, standings
 
     ledger = _ledger(args.state)
     schedule = recorded_schedule(ledger)

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import argparse
 
-from contracts.timing import MIN_PLAYING_S, MIN_READY_S, SCRIMMAGE, SET_TO_PLAY_S
-from orchestrator.paths import user_path
+from contracts import MIN_PLAYING_S, MIN_READY_S, SCRIMMAGE, SET_TO_PLAY_S
+from orchestrator import user_path
 
 
 def _model(text: str) -> str:

@@ -16,7 +16,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from orchestrator.paths import user_path
+from orchestrator import user_path
 from service import ServiceError, Settings
 
 
@@ -99,7 +99,7 @@ def register(sub: Any) -> None:
     _add_db_options(tlist)
     tlist.set_defaults(func=guarded(run_token_list))
 
-    from service.client import register as register_client
+    from service import register_client_commands as register_client
 
     register_client(sub, guarded)
     bench = sub.choices.get("bench")
@@ -112,13 +112,13 @@ def register(sub: Any) -> None:
 
 
 def _bench(args: argparse.Namespace) -> int:
-    from benchmarks.service import main as bench_main
+    from benchmarks import service as service_bench
 
-    return int(bench_main(list(args.rest)))
+    return int(service_bench.main(list(args.rest)))
 
 
 def _sessions(args: argparse.Namespace) -> Any:
-    from orchestrator.private_files import private_dir
+    from orchestrator import private_dir
     from service.db import make_engine, migrate, session_factory
 
     settings = _settings(args)
@@ -142,7 +142,7 @@ def run_serve(args: argparse.Namespace) -> int:
 
 def run_team_add(args: argparse.Namespace) -> int:
     from cluster import PoolError
-    from service.admin import add_team
+    from service import add_team
     from service.db import Team, transaction
 
     settings = _settings(args)
@@ -152,8 +152,7 @@ def run_team_add(args: argparse.Namespace) -> int:
         session.flush()
         result: dict[str, object] = {"team": team.name, "id": team.id}
     if settings.pool == "slurm":  # the team's Slurm account now (else at its first match)
-        from service import pool_from_settings
-        from service.accounts import ensure_team_account
+        from service import ensure_team_account, pool_from_settings
 
         with transaction(_sessions(args)) as session:
             row = session.get(Team, team.id)
@@ -212,7 +211,7 @@ def run_token_revoke(args: argparse.Namespace) -> int:
 
 
 def run_token_list(args: argparse.Namespace) -> int:
-    from service.admin import list_tokens
+    from service import list_tokens
     from service.db import transaction
 
     with transaction(_sessions(args)) as session:

@@ -84,70 +84,70 @@ def register(sub: Any) -> None:
 
 
 def _envs(args: argparse.Namespace) -> int:
-    from benchmarks.envs import main as envs_main  # gymnasium is imported after the arguments
+    from benchmarks import envs as envs_bench  # gymnasium is imported after the arguments
 
-    return int(envs_main(list(args.rest)))
+    return int(envs_bench.main(list(args.rest)))
 
 
 def _hog(args: argparse.Namespace) -> int:
-    from benchmarks.hog import main as hog_main
+    from benchmarks import hog as hog_bench
 
-    return int(hog_main(list(args.rest)))
+    return int(hog_bench.main(list(args.rest)))
 
 
 def _scrimmage(args: argparse.Namespace) -> int:
-    from benchmarks.scrimmage import main as scrimmage_main
+    from benchmarks import scrimmage as scrimmage_bench
 
-    return int(scrimmage_main(list(args.rest)))
+    return int(scrimmage_bench.main(list(args.rest)))
 
 
 def _report(args: argparse.Namespace) -> int:
-    from benchmarks.report import main as report_main
+    from benchmarks import report as report_bench
 
-    return report_main(args.rest)
+    return report_bench.main(args.rest)
 
 
 def _bringup(args: argparse.Namespace) -> int:
-    from benchmarks.bringup import main as bringup_main
+    from benchmarks import bringup as bringup_bench
 
-    return int(bringup_main(list(args.rest)))
+    return int(bringup_bench.main(list(args.rest)))
 
 
 def _viewer(args: argparse.Namespace) -> int:
     os.environ["HLVS_PROG"] = "hlvs"
-    from benchmarks.viewer import main as viewer_main
+    from benchmarks import viewer as viewer_bench
 
-    return int(viewer_main(list(args.rest)))
+    return int(viewer_bench.main(list(args.rest)))
 
 
 def _pool(args: argparse.Namespace) -> int:
     os.environ["HLVS_PROG"] = "hlvs"
-    from benchmarks.pool import main as pool_main
+    from benchmarks import pool as pool_bench
 
-    return int(pool_main(list(args.rest)))
+    return int(pool_bench.main(list(args.rest)))
 
 
 def _models(args: argparse.Namespace) -> int:
     os.environ["HLVS_PROG"] = "hlvs"
-    from benchmarks.models import main as models_main
+    from benchmarks import models as models_bench
 
-    return int(models_main(list(args.rest)))
+    return int(models_bench.main(list(args.rest)))
 
 
 def _actuators(args: argparse.Namespace) -> int:
     os.environ["HLVS_PROG"] = "hlvs"
-    from benchmarks.actuators import main as actuators_main
+    from benchmarks import actuators as actuators_bench
 
-    return int(actuators_main(list(args.rest)))
+    return int(actuators_bench.main(list(args.rest)))
 
 
 def _cli(args: argparse.Namespace) -> int:
-    from benchmarks.cli import main as cli_main
+    from benchmarks import cli as cli_bench
 
-    return int(cli_main(list(args.rest)))
+    return int(cli_bench.main(list(args.rest)))
 
 
 def _delivery(args: argparse.Namespace) -> int:
-    from benchmarks.delivery import main as delivery_main
+    from benchmarks import delivery as delivery_bench
 
-    return int(delivery_main(list(args.rest)))
+    return int(delivery_bench.main(list(args.rest)))

@@ -6,7 +6,7 @@ import argparse
 import logging
 from typing import Any
 
-from orchestrator.paths import user_path
+from orchestrator import user_path
 
 
 def register(sub: Any) -> None:
@@ -36,13 +36,13 @@ def register(sub: Any) -> None:
 
 
 def _view(args: argparse.Namespace) -> int:
-    from viewer.cli import view
+    from viewer import view
 
     return view(paths=[str(p) for p in args.paths], host=args.host, port=args.port)
 
 
 def _export(args: argparse.Namespace) -> int:
-    from viewer.cli import export
+    from viewer import export
 
     return export(
         replay=str(args.replay), output=str(args.output),

@@ -8,6 +8,9 @@ one way to get a document: ``load_game(path)`` and ``load_team(path)`` read one 
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
+from contracts import lazy_exports
 from orchestrator.config.documents import GameDocument, PlayerDocument, PoseDocument, TeamDocument
 from orchestrator.config.game import default_match_id, default_seed
 from orchestrator.config.loader import (
@@ -42,7 +45,30 @@ from orchestrator.config.model import (
 )
 from orchestrator.config.spec import resolve_sides, to_match_spec
 
+if TYPE_CHECKING:
+    from orchestrator.config.credentials import parse_credentials
+    from orchestrator.config.detect import Kind, kind_by_content, kind_by_name
+    from orchestrator.config.jsonfile import parse_json, read_text
+    from orchestrator.config.robot_models import (
+        BUILT_IN_MODELS,
+        check_model,
+        describe,
+        is_model_package,
+    )
+    from orchestrator.config.schedule import (
+        PlannedMatch,
+        Schedule,
+        ScheduledTeam,
+        SchedulePool,
+        Slot,
+        game_document,
+        load_schedule,
+        resolve_time,
+    )
+    from orchestrator.config.schedule_check import check_schedule
+
 __all__ = [
+    "BUILT_IN_MODELS",
     "COLORS",
     "Color",
     "DEFAULT_MODEL",
@@ -51,15 +77,21 @@ __all__ = [
     "GameConfig",
     "GameDocument",
     "GameType",
+    "Kind",
     "Limits",
     "LoadedGame",
     "LoadedTeam",
     "MAX_PLAYERS",
+    "PlannedMatch",
     "PlayerConfig",
     "PlayerDocument",
     "PoseDocument",
     "RegistryAuth",
+    "Schedule",
+    "SchedulePool",
+    "ScheduledTeam",
     "SideChoice",
+    "Slot",
     "StartingPose",
     "SteppingMode",
     "TeamConfig",
@@ -67,14 +99,42 @@ __all__ = [
     "TeamRef",
     "Timing",
     "check_game",
+    "check_model",
+    "check_schedule",
     "check_team",
     "check_team_document",
     "default_match_id",
     "default_seed",
+    "describe",
+    "game_document",
+    "is_model_package",
+    "kind_by_content",
+    "kind_by_name",
     "load_game",
+    "load_schedule",
     "load_team",
+    "parse_credentials",
     "parse_game",
+    "parse_json",
     "parse_team",
+    "read_text",
     "resolve_sides",
+    "resolve_time",
     "to_match_spec",
 ]
+
+
+if not TYPE_CHECKING:
+    __getattr__, __dir__ = lazy_exports(__name__, {
+        "orchestrator.config.credentials": ("parse_credentials",),
+        "orchestrator.config.detect": ("Kind", "kind_by_content", "kind_by_name"),
+        "orchestrator.config.jsonfile": ("parse_json", "read_text"),
+        "orchestrator.config.robot_models": (
+            "BUILT_IN_MODELS", "check_model", "describe", "is_model_package",
+        ),
+        "orchestrator.config.schedule": (
+            "PlannedMatch", "Schedule", "SchedulePool", "ScheduledTeam", "Slot", "game_document",
+            "load_schedule", "resolve_time",
+        ),
+        "orchestrator.config.schedule_check": ("check_schedule",),
+    })

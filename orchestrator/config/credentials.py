@@ -24,7 +24,7 @@ from typing import Any, Literal, cast
 
 import jsonschema
 
-from contracts.jsontypes import JSONObject
+from contracts import JSONObject
 from orchestrator.config.documents import CredentialsDocument, SftpDocument
 from orchestrator.errors import ConfigError, Problem
 

@@ -9,8 +9,7 @@ from __future__ import annotations
 
 from typing import Literal, NotRequired, TypedDict
 
-from contracts.jsontypes import JSONObject
-from contracts.match_spec import GameTypeName, SteppingMode
+from contracts import GameTypeName, JSONObject, SteppingMode
 
 
 class GameTeamDocument(TypedDict):

@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, Literal, cast
 
-from contracts.timing import SET_TO_PLAY_S, timing_problem
+from contracts import SET_TO_PLAY_S, timing_problem
 from orchestrator.config.documents import GameDocument, GameTeamDocument
 from orchestrator.config.model import (
     COLORS,

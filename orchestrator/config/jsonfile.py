@@ -7,7 +7,7 @@ import math
 from pathlib import Path
 from typing import Any
 
-from contracts.jsontypes import JSONObject
+from contracts import JSONObject
 from orchestrator.config.problems import Collector
 from orchestrator.errors import ConfigError
 

@@ -16,11 +16,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
 
-from contracts.field import FieldClass
-from contracts.geometry import StartingPose
-from contracts.match_spec import Color, SteppingMode
-from contracts.match_spec import GameTypeName as GameType
-from contracts.timing import MIN_PLAYING_S, OFFICIAL
+from contracts import MIN_PLAYING_S, OFFICIAL, Color, FieldClass, StartingPose, SteppingMode
+from contracts import GameTypeName as GameType
 from orchestrator.errors import Problem
 
 SideChoice = Literal["red", "blue", "random"]

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 from orchestrator.errors import Problem
 
 if TYPE_CHECKING:
-    from simulator.world.robots.team.rulebook import Measurements
+    from simulator.world.robots.team import Measurements
 
 MODEL_MANIFEST = "robot_model.json"
 MODELS_TARGET = "/opt/hlvs/team-models"
@@ -54,8 +54,7 @@ def check_model(
     free-form servos are warnings, or errors when ``official``. Imports the simulator's model
     loader (and MuJoCo) on first use."""
     from simulator import ModelError
-    from simulator.world.robots.team import load_team_model
-    from simulator.world.robots.team.rulebook import check
+    from simulator.world.robots.team import check, load_team_model
 
     folder = path if path.is_dir() else path.parent
     try:

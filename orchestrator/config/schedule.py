@@ -21,7 +21,7 @@ from typing import Any, Literal, cast
 import jsonschema
 import yaml
 
-from contracts.jsontypes import JSONObject
+from contracts import JSONObject
 from orchestrator.config.documents import (
     GameDocument,
     KnockoutDocument,

@@ -194,7 +194,7 @@ def _classes_of(schedule: Schedule, team: str) -> set[str]:
 
 
 def _team_problems(schedule: Schedule) -> list[Problem]:
-    from contracts.field import FieldClass
+    from contracts import FieldClass
     from orchestrator.config.loader import check_team
 
     problems: list[Problem] = []

@@ -14,7 +14,7 @@ from typing import Any
 from jsonschema import Draft202012Validator
 from jsonschema.exceptions import ValidationError
 
-from contracts.jsontypes import JSONObject
+from contracts import JSONObject
 from orchestrator.config.jsonfile import json_type
 from orchestrator.config.problems import Collector, one_of, pointer, suggest
 

@@ -10,14 +10,14 @@ from __future__ import annotations
 import random
 from collections.abc import Mapping, Sequence
 
-from contracts import files
-from contracts.geometry import Pose
-from contracts.match_spec import (
+from contracts import (
     MatchSpec,
     NetworkSpec,
     PlayerSpec,
+    Pose,
     TeamSpec,
     TimingSpec,
+    files,
 )
 from orchestrator.config.model import COLORS, Color, LoadedGame, StartingPose
 from orchestrator.config.robot_models import spec_model

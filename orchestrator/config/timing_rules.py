@@ -5,7 +5,7 @@ time, keeps the game's minimum of play (``timing.minimum_play_s``) after its REA
 
 from __future__ import annotations
 
-from contracts.timing import SET_TO_PLAY_S, timing_problem
+from contracts import SET_TO_PLAY_S, timing_problem
 from orchestrator.config.model import Timing
 
 

@@ -8,6 +8,9 @@ what is waiting. Uploaders (``sftp``, ``s3``) sit behind the :class:`Uploader` p
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
+from contracts import lazy_exports
 from orchestrator.delivery.deliver import (
     MANIFEST_NAME,
     DeliveryOutcome,
@@ -28,24 +31,34 @@ from orchestrator.delivery.uploader import (
     is_transient,
 )
 
+if TYPE_CHECKING:
+    from orchestrator.delivery.store import list_sets
+
 __all__ = [
-    "deliver_pending",
-    "deliver_set",
+    "DeliveryFailure",
     "DeliveryOutcome",
-    "enqueue_match_logs",
     "ERROR_KINDS",
     "FakeUploader",
     "FileEntry",
-    "is_transient",
     "KEEP_UNDELIVERED",
     "MANIFEST_NAME",
-    "open_uploader",
     "Opener",
-    "pending_status",
-    "PendingSet",
     "PUBLIC_TEAM",
+    "PendingSet",
     "RetryPolicy",
-    "DeliveryFailure",
     "TRANSIENT_KINDS",
     "Uploader",
+    "deliver_pending",
+    "deliver_set",
+    "enqueue_match_logs",
+    "is_transient",
+    "list_sets",
+    "open_uploader",
+    "pending_status",
 ]
+
+
+if not TYPE_CHECKING:
+    __getattr__, __dir__ = lazy_exports(__name__, {
+        "orchestrator.delivery.store": ("list_sets",),
+    })

@@ -18,8 +18,7 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import TypeVar
 
-from contracts.codec import to_data
-from contracts.jsontypes import JSONObject
+from contracts import JSONObject, to_data
 from orchestrator.config.credentials import Credentials, load_credentials
 from orchestrator.console import NullProgress, Progress
 from orchestrator.delivery import store as st

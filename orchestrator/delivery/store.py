@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Literal
 from urllib.parse import quote
 
-from contracts.jsontypes import JSONObject
+from contracts import JSONObject
 from orchestrator.filelock import held
 
 __all__ = [

@@ -9,11 +9,17 @@ finds it after a crash.
 from __future__ import annotations
 
 import os
+from typing import TYPE_CHECKING
 
 import docker
 import docker.errors
 
+from contracts import lazy_exports
 from orchestrator.errors import EngineUnavailable
+
+if TYPE_CHECKING:
+    from orchestrator.engine.containers import DockerRuntime
+    from orchestrator.engine.gpu import detect_nvidia
 
 LABEL_PROJECT = "org.hlvs-runner"  # value: "1" on everything we create
 LABEL_MATCH = "org.hlvs-runner.match"  # value: match id
@@ -34,5 +40,21 @@ def connect(*, timeout_s: float = 60.0) -> docker.DockerClient:
     return client
 
 
-__all__ = ["LABEL_MATCH", "LABEL_PROJECT", "LABEL_ROBOT", "LABEL_ROLE", "LABEL_SLURM_JOB",
-           "LABEL_TEAM", "connect"]
+__all__ = [
+    "DockerRuntime",
+    "LABEL_MATCH",
+    "LABEL_PROJECT",
+    "LABEL_ROBOT",
+    "LABEL_ROLE",
+    "LABEL_SLURM_JOB",
+    "LABEL_TEAM",
+    "connect",
+    "detect_nvidia",
+]
+
+
+if not TYPE_CHECKING:
+    __getattr__, __dir__ = lazy_exports(__name__, {
+        "orchestrator.engine.containers": ("DockerRuntime",),
+        "orchestrator.engine.gpu": ("detect_nvidia",),
+    })

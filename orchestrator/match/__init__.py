@@ -6,6 +6,9 @@ through :class:`Host`; ``hlvs.commands.match`` wires the real implementations.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
+from contracts import lazy_exports
 from orchestrator.match.cleanup import CleanupReport, clean_match, cleanup, plan_cleanup
 from orchestrator.match.events import (
     AllConnected,
@@ -30,6 +33,14 @@ from orchestrator.match.runner import (
 from orchestrator.match.runtime import ContainerRuntime
 from orchestrator.match.state import IllegalMatchTransition, Lifecycle, MatchState
 
+if TYPE_CHECKING:
+    from orchestrator.match import ownership, scrimmage
+    from orchestrator.match.admission import HostResources, admit
+    from orchestrator.match.gpu import GpuOrigin, SimulatorGpu, simulator_gpu
+    from orchestrator.match.ownership import LABEL_RUN
+    from orchestrator.match.placement import LeaguePlacement, parse_nodes
+    from orchestrator.match.scrimmage import ScrimmageRequest, game_file, team_file
+
 __all__ = [
     "AllConnected",
     "CleanupReport",
@@ -37,10 +48,14 @@ __all__ = [
     "EventStream",
     "Failure",
     "FailureClass",
+    "GpuOrigin",
     "Host",
     "HostControl",
+    "HostResources",
     "IllegalMatchTransition",
     "ImageResolver",
+    "LABEL_RUN",
+    "LeaguePlacement",
     "Lifecycle",
     "MatchEnded",
     "MatchEvent",
@@ -54,12 +69,32 @@ __all__ = [
     "RobotPlan",
     "RobotRecord",
     "RunOptions",
+    "ScrimmageRequest",
+    "SimulatorGpu",
     "StateChanged",
     "TeamPlan",
+    "admit",
     "clean_match",
     "cleanup",
+    "game_file",
     "local_images",
+    "ownership",
+    "parse_nodes",
     "plan_cleanup",
     "plan_from_game",
     "robots_in_game",
+    "scrimmage",
+    "simulator_gpu",
+    "team_file",
 ]
+
+
+if not TYPE_CHECKING:
+    __getattr__, __dir__ = lazy_exports(__name__, {
+        "orchestrator.match": ("ownership", "scrimmage"),
+        "orchestrator.match.admission": ("HostResources", "admit"),
+        "orchestrator.match.gpu": ("GpuOrigin", "SimulatorGpu", "simulator_gpu"),
+        "orchestrator.match.ownership": ("LABEL_RUN",),
+        "orchestrator.match.placement": ("LeaguePlacement", "parse_nodes"),
+        "orchestrator.match.scrimmage": ("ScrimmageRequest", "game_file", "team_file"),
+    })

@@ -18,9 +18,7 @@ import os
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from contracts.codec import to_data
-from contracts.jsontypes import JSONObject
-from contracts.match_results import AdmissionRecord, NeededAvailable
+from contracts import AdmissionRecord, JSONObject, NeededAvailable, to_data
 from orchestrator.errors import OrchestratorError
 from orchestrator.match.plan import MatchPlan
 

@@ -21,11 +21,16 @@ from dataclasses import dataclass, replace
 from functools import partial
 from pathlib import Path
 
-from contracts import files
-from contracts.errors import ContractError
-from contracts.match_results import Forfeit, MatchLimits, MatchResults
-from contracts.match_spec import MatchSpec, TimingSpec
-from contracts.sim_result import SimResult
+from contracts import (
+    ContractError,
+    Forfeit,
+    MatchLimits,
+    MatchResults,
+    MatchSpec,
+    SimResult,
+    TimingSpec,
+    files,
+)
 from orchestrator.errors import OrchestratorError
 from orchestrator.match import layout
 from orchestrator.match.deps import MatchDeps

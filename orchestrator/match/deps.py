@@ -16,8 +16,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from contracts.match_results import Color
-from contracts.telemetry import StateMessage
+from contracts import Color, StateMessage
 from orchestrator.match.events import EventStream, MatchFailed
 from orchestrator.match.gpu import SimulatorGpu
 from orchestrator.match.host import Host

@@ -8,9 +8,7 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from contracts import files
-from contracts.sim_result import SimResult
-from contracts.telemetry import EventRecord, StateMessage
+from contracts import EventRecord, SimResult, StateMessage, files
 from orchestrator.bandwidth import AppliedShaping, RobotShaping, TrafficCounters
 from orchestrator.match.logfs import LogFolder
 from orchestrator.match.placement import NodeFirewall

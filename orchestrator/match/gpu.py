@@ -22,7 +22,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Literal, get_args
 
-from contracts.files import GPU_ENVIRONMENT  # what was asked (on | auto), read by the simulator
+from contracts import GPU_ENVIRONMENT  # what was asked (on | auto), read by the simulator
 from orchestrator.errors import ConfigError, Problem
 from orchestrator.match.runtime import ContainerRequest, DeviceRequest
 

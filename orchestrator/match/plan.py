@@ -12,8 +12,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from contracts.match_results import AdmissionRecord
-from contracts.match_spec import MatchSpec
+from contracts import AdmissionRecord, MatchSpec
 from orchestrator.config import Limits, LoadedGame, PlayerConfig
 from orchestrator.config.robot_models import is_model_path
 from orchestrator.config.spec import to_match_spec

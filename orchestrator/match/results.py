@@ -8,8 +8,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from contracts import files
-from contracts.match_results import (
+from contracts import (
+    MIN_PLAYING_S,
     AdmissionRecord,
     Color,
     Failure,
@@ -19,12 +19,15 @@ from contracts.match_results import (
     MatchLimits,
     MatchReport,
     MatchResults,
+    RobotApiStats,
     RobotResult,
     Scalar,
+    SimResult,
+    TimingSpec,
+    files,
+    played_enough,
+    timing_problem,
 )
-from contracts.match_spec import TimingSpec
-from contracts.sim_result import RobotApiStats, SimResult
-from contracts.timing import MIN_PLAYING_S, played_enough, timing_problem
 
 COLORS: tuple[Color, Color] = ("red", "blue")
 

@@ -28,9 +28,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from contracts import files
-from contracts.match_results import Color, Forfeit, MatchResults
-from contracts.telemetry import StateMessage
+from contracts import Color, Forfeit, MatchResults, StateMessage, files
 from orchestrator.errors import OrchestratorError
 from orchestrator.match.collection import Played, collect, read_sim_result, simulator_stderr_tail
 from orchestrator.match.deps import MatchDeps, RunOptions, TelemetryFactory

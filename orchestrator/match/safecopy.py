@@ -20,7 +20,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from contracts.match_results import LogFolderCopy
+from contracts import LogFolderCopy
 
 log = logging.getLogger(__name__)
 

@@ -12,8 +12,7 @@ import shutil
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from contracts import files
-from contracts.match_results import MatchResults, Salvage, SalvagedRobot
+from contracts import MatchResults, Salvage, SalvagedRobot, files
 from orchestrator.engine import LABEL_ROBOT, LABEL_ROLE, LABEL_TEAM
 from orchestrator.errors import OrchestratorError
 from orchestrator.match import logfs

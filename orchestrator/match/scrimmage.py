@@ -20,12 +20,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
 
-from contracts.match_spec import SteppingMode
-from contracts.timing import (
+from contracts import (
     MIN_PLAYING_S,
     MIN_READY_S,
     SCRIMMAGE,
     SET_TO_PLAY_S,
+    SteppingMode,
     TimingError,
     fit_ready,
 )
@@ -208,7 +208,7 @@ def stub_model_problem(model: str | None) -> str | None:
     built-in robot's, which the stub commands), or None."""
     if model is None or not is_model_path(model):
         return None
-    from robot.geometry import MOTOR_NAMES
+    from robot import MOTOR_NAMES
 
     manifest = Path(model) / MODEL_MANIFEST
     try:

@@ -19,9 +19,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from contracts import files
-from contracts.gamecontroller import GC_RETURN_PORT
-from contracts.match_spec import MatchSpec
+from contracts import GC_RETURN_PORT, MatchSpec, files
 from orchestrator.bandwidth import AppliedShaping, RobotShaping, mb_s_to_bit
 from orchestrator.errors import InfrastructureError, OrchestratorError
 from orchestrator.match import layout

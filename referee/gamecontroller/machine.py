@@ -10,8 +10,7 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass, field
 
-from contracts.ids import RobotId, TeamColor
-from contracts.match_spec import GameType
+from contracts import GameType, RobotId, TeamColor
 from referee.config import TimingConfig
 from referee.errors import IllegalTransition
 from referee.gamecontroller.states import (

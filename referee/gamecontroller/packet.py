@@ -4,9 +4,7 @@ from __future__ import annotations
 
 import math
 
-from contracts.gamecontroller import MAX_PLAYERS, GameControlData, RobotInfo, TeamInfo
-from contracts.ids import TeamColor
-from contracts.match_spec import GameType
+from contracts import MAX_PLAYERS, GameControlData, GameType, RobotInfo, TeamColor, TeamInfo
 from referee.gamecontroller.machine import GameController
 from referee.gamecontroller.states import DROPBALL_TEAM, GameTypeCode, TeamColourCode
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from enum import StrEnum
 
-from contracts.gamecontroller import (
+from contracts import (
     DROPBALL_TEAM,
     GameState,
     GameTypeCode,

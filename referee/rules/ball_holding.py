@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from contracts.ids import TeamColor
+from contracts import TeamColor
 from referee.gamecontroller.states import SecondaryState
 from referee.rules.base import AwardSetPlay, Decision, GameView, distance2d
 from referee.snapshot import Vec2, WorldSnapshot

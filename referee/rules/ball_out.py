@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 
-from contracts.field import FieldGeometry
+from contracts import FieldGeometry
 from referee.gamecontroller.states import SecondaryState
 from referee.rules.base import AwardSetPlay, Decision, GameView
 from referee.snapshot import Vec2, WorldSnapshot

@@ -11,8 +11,7 @@ import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
-from contracts.field import FieldGeometry
-from contracts.ids import RobotId, TeamColor
+from contracts import FieldGeometry, RobotId, TeamColor
 from referee.config import TimingConfig
 from referee.gamecontroller.machine import SetPlay
 from referee.gamecontroller.states import Card, GameState, Penalty, SecondaryState

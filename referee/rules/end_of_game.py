@@ -13,8 +13,7 @@ import random
 from dataclasses import dataclass
 from enum import StrEnum
 
-from contracts.ids import TeamColor
-from contracts.match_spec import GameType
+from contracts import GameType, TeamColor
 from referee.gamecontroller.states import SecondaryState
 
 REGULATION_KICKS = 5

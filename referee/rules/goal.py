@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from enum import StrEnum
 
-from contracts.ids import RobotId
+from contracts import RobotId
 from referee.rules.ball_out import goal_line_restart, in_goal
 from referee.rules.base import Decision, GameView, Goal, distance2d
 from referee.snapshot import WorldSnapshot

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from contracts.ids import RobotId
+from contracts import RobotId
 from referee.gamecontroller.states import Penalty
 from referee.rules.base import Decision, GameView, PenalizeRobot, distance2d
 from referee.snapshot import RobotState, WorldSnapshot

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from contracts.ids import RobotId
+from contracts import RobotId
 from referee.gamecontroller.states import GameState, Penalty
 from referee.rules.base import Decision, GameView, PenalizeRobot, timers
 from referee.snapshot import RobotState, WorldSnapshot

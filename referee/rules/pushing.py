@@ -25,7 +25,7 @@ import math
 from collections import deque
 from dataclasses import dataclass, field
 
-from contracts.ids import RobotId
+from contracts import RobotId
 from referee.gamecontroller.states import GameState, Penalty, SecondaryState
 from referee.rules.base import AwardSetPlay, Decision, GameView, PenalizeRobot, distance2d
 from referee.snapshot import RobotState, Vec3, WorldSnapshot

@@ -15,9 +15,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from contracts.field import FieldGeometry
-from contracts.geometry import Pose
-from contracts.ids import RobotId
+from contracts import FieldGeometry, Pose, RobotId
 from referee.snapshot import RemoveRobot, SetLimp, TeleportRobot, Vec2, WorldCommand
 
 

@@ -12,16 +12,16 @@ import socket
 import time
 from dataclasses import dataclass
 
-from contracts import gamecontroller as wire
-from contracts.errors import ProtocolError
-from contracts.gamecontroller import (
+from contracts import (
     GC_DATA_PORT,
     GC_RETURN_PORT,
     GameState,
+    ProtocolError,
     ReturnData,
     ReturnMessage,
     SecondaryState,
 )
+from contracts import gamecontroller as wire
 from robot.client.errors import RobotClientError
 
 

@@ -6,7 +6,27 @@ runs the MLP with numpy (:class:`Policy`), so a robot image needs no training li
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
+from contracts import lazy_exports
 from robot.learned.motion import PolicyMotion
 from robot.learned.policy import Policy, PolicyFileError, load_policy, save_policy
 
-__all__ = ["Policy", "PolicyFileError", "PolicyMotion", "load_policy", "save_policy"]
+if TYPE_CHECKING:
+    from robot.learned.policy import KICK_BALL_AHEAD_M, KICK_BALL_RIGHT_M
+
+__all__ = [
+    "KICK_BALL_AHEAD_M",
+    "KICK_BALL_RIGHT_M",
+    "Policy",
+    "PolicyFileError",
+    "PolicyMotion",
+    "load_policy",
+    "save_policy",
+]
+
+
+if not TYPE_CHECKING:
+    __getattr__, __dir__ = lazy_exports(__name__, {
+        "robot.learned.policy": ("KICK_BALL_AHEAD_M", "KICK_BALL_RIGHT_M"),
+    })

@@ -9,8 +9,7 @@ import math
 from dataclasses import dataclass
 from enum import StrEnum
 
-from contracts.gamecontroller import GameState
-from contracts.geometry import Pose
+from contracts import GameState, Pose
 
 
 class Role(StrEnum):

@@ -14,8 +14,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import numpy.typing as npt
 
-from contracts.gamecontroller import GameState
-from contracts.geometry import Pose
+from contracts import GameState, Pose
 from robot.learned import Policy, PolicyMotion
 from robot.learned.policy import KICK_BALL_AHEAD_M
 from robot.motion import AttitudeFilter, GetUpMotion, KickMotion, WalkEngine, kinematics

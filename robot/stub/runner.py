@@ -19,8 +19,7 @@ from types import FrameType
 
 import numpy as np
 
-from contracts.gamecontroller import GameState
-from contracts.geometry import Pose
+from contracts import GameState, Pose
 from contracts.robot_api import messages_pb2 as pb
 from robot.client import ConnectionClosed, RobotClient, RobotClientError
 from robot.client.errors import ReceiveTimeout

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
-from contracts.geometry import Pose
+from contracts import Pose
 
 Vec3 = tuple[float, float, float]
 

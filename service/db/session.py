@@ -52,7 +52,7 @@ def make_engine(url: str) -> Engine:
 def _private_sqlite(path: Path) -> None:
     """The database file (and its WAL files, which SQLite creates with the file's mode) 0600;
     a missing folder is created 0700."""
-    from orchestrator.private_files import make_private_file, private_dir
+    from orchestrator import make_private_file, private_dir
 
     if path.name in ("", ":memory:"):
         return

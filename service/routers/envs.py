@@ -38,8 +38,7 @@ from fastapi import APIRouter, FastAPI, Request
 from fastapi.responses import FileResponse
 from pydantic import BaseModel, Field
 
-from envs.errors import EnvConfigError, EnvError
-from envs.monitor import Monitor
+from envs import EnvConfigError, EnvError, Monitor
 from service import TeamPrincipal
 from service.errors import Conflict, InvalidInput, NotFound
 

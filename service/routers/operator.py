@@ -120,7 +120,7 @@ def list_teams(principal: OperatorPrincipal, session: DbSession) -> list[TeamSum
 def get_schedule(services: AppServices, principal: OperatorPrincipal) -> ScheduleView:
     """The tournament's matches (state, times, results) and the standings, read from the
     schedule's state file (``HLVS_SERVICE_SCHEDULE_STATE``)."""
-    from orchestrator.config.schedule import load_schedule
+    from orchestrator.config import load_schedule
     from tournament import Ledger, standings
 
     state = services.settings.schedule_state

@@ -16,9 +16,7 @@ from sqlalchemy import select
 from starlette.concurrency import run_in_threadpool
 from starlette.responses import Response
 
-from contracts import files
-from contracts.errors import ContractError
-from contracts.match_results import MatchReport, MatchResults
+from contracts import ContractError, MatchReport, MatchResults, files
 from service import submissions, teamfiles
 from service.aftermatch import PARTIAL_VIDEO_FILE
 from service.db import ACTIVE_STATES, Submission

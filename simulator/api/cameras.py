@@ -19,7 +19,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
-from contracts.ids import RobotId
+from contracts import RobotId
 from simulator.api.session import CameraJob
 
 log = logging.getLogger(__name__)

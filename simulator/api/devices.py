@@ -13,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any, Protocol
 
-from contracts.ids import RobotId, TeamColor
+from contracts import RobotId, TeamColor
 
 Vec3 = tuple[float, float, float]
 

@@ -7,8 +7,7 @@ import socket
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
-from contracts.ids import RobotId, TeamColor
-from contracts.match_spec import MatchSpec
+from contracts import MatchSpec, RobotId, TeamColor
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

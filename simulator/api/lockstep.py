@@ -16,7 +16,7 @@ from __future__ import annotations
 import logging
 import time
 
-from contracts.ids import RobotId
+from contracts import RobotId
 from simulator.api.server import ApiServer, LockstepSettings, Request
 
 log = logging.getLogger(__name__)

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from multiprocessing.connection import Connection
 from typing import TYPE_CHECKING, Any
 
-from contracts.ids import RobotId
+from contracts import RobotId
 from simulator.api.cameras import CompletedImages
 from simulator.api.session import CameraJob
 

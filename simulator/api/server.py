@@ -27,10 +27,8 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 
-from contracts.ids import RobotId
-from contracts.match_spec import NetworkSpec
+from contracts import NetworkSpec, RobotApiStats, RobotId
 from contracts.robot_api import messages_pb2 as pb
-from contracts.sim_result import RobotApiStats
 from referee import SpoofingLog
 from simulator.api.batch import StepBatch
 from simulator.api.cameras import MAX_IN_FLIGHT, ImageSource

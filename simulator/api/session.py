@@ -14,7 +14,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from contracts.ids import RobotId
+from contracts import RobotId
 from contracts.robot_api import messages_pb2 as pb
 from simulator.api.devices import (
     ACCELEROMETER,

@@ -5,7 +5,7 @@ from __future__ import annotations
 from array import array
 from dataclasses import dataclass, field
 
-from contracts.sim_result import RobotApiStats
+from contracts import RobotApiStats
 
 
 def percentile(sorted_values: list[float], q: float) -> float:

@@ -12,7 +12,7 @@ from __future__ import annotations
 from types import SimpleNamespace
 from typing import TYPE_CHECKING, Any
 
-from contracts.ids import RobotId
+from contracts import RobotId
 from simulator.api.cameras import ImageSource, RenderFn, RenderWorker
 
 if TYPE_CHECKING:

@@ -39,8 +39,7 @@ from typing import Any, NotRequired, TypedDict
 import numpy as np
 import numpy.typing as npt
 
-from contracts.jsontypes import JSONObject
-from contracts.telemetry import EventRecord, GameStateRecord
+from contracts import EventRecord, GameStateRecord, JSONObject
 
 MAGIC = b"HLVSREC\0"
 INDEX_MAGIC = b"HLVSIDX\0"

@@ -24,9 +24,7 @@ from typing import IO, cast
 
 import numpy as np
 
-from contracts.codec import from_data
-from contracts.errors import ContractError
-from contracts.telemetry import EventRecord, GameStateRecord
+from contracts import ContractError, EventRecord, GameStateRecord, from_data
 from simulator.errors import ReplayError
 from simulator.replay.format import (
     CHUNK,

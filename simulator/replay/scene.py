@@ -30,12 +30,12 @@ from __future__ import annotations
 from dataclasses import asdict
 from typing import TYPE_CHECKING, Any
 
-from contracts.codec import to_data
+from contracts import to_data
 
 if TYPE_CHECKING:
     import mujoco
 
-    from contracts.field import FieldGeometry
+    from contracts import FieldGeometry
     from simulator.replay.format import (
         GeomRecord,
         PatternRecord,
@@ -207,8 +207,7 @@ def scene_for(header: ReplayHeader, path: str) -> SceneRecord:
     models for the robots it lists, when those still have the recorded bodies."""
     if header.scene is not None:
         return header.scene
-    from contracts.field import field_for
-    from contracts.ids import RobotId, TeamColor
+    from contracts import RobotId, TeamColor, field_for
     from simulator.errors import ReplayError, UnknownModelError
     from simulator.world.scene import compile_scene
     from simulator.world.types import RobotPlacement

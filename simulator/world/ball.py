@@ -10,7 +10,7 @@ within 6 s.
 
 from __future__ import annotations
 
-from contracts.field import FieldGeometry
+from contracts import FieldGeometry
 from simulator.world.look import BALL_TEXTURE
 
 BALL_BODY = "ball"

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
-from contracts.ids import RobotId
+from contracts import RobotId
 from simulator.errors import UnknownDeviceError
 from simulator.world.camera_model import CameraEffects, CameraModel, blur_px_of
 

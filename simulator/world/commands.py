@@ -9,7 +9,7 @@ from typing import Protocol
 import mujoco
 import numpy as np
 
-from contracts.ids import RobotId, TeamColor
+from contracts import RobotId, TeamColor
 from referee import (
     PlaceBall,
     RemoveRobot,

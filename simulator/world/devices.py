@@ -27,7 +27,7 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 
-from contracts.ids import RobotId
+from contracts import RobotId
 from referee import Vec3
 from simulator.errors import UnknownDeviceError
 from simulator.world.types import DeviceKind

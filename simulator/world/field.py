@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import math
 
-from contracts.field import FieldGeometry
+from contracts import FieldGeometry
 from simulator.world.look import TURF_TEXTURE
 
 TURF_FRICTION = 0.5

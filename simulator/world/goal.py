@@ -7,7 +7,7 @@ box's faces by the local x and y, so only the faces normal to z show the net's f
 
 from __future__ import annotations
 
-from contracts.field import FieldGeometry
+from contracts import FieldGeometry
 from simulator.world.look import NET_TEXTURE
 
 POST_RGBA = "1 1 1 1"

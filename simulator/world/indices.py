@@ -10,7 +10,7 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 
-from contracts.ids import RobotId
+from contracts import RobotId
 from referee import BodyPart
 from simulator.world.ball import BALL_GEOM, BALL_JOINT
 from simulator.world.robots import AnyRobotModel, robot_model

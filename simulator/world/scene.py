@@ -13,8 +13,7 @@ from collections.abc import Sequence
 import mujoco
 import numpy as np
 
-from contracts.field import FieldGeometry
-from contracts.ids import TeamColor
+from contracts import FieldGeometry, TeamColor
 from simulator.world.ball import BALL_GEOM, BALL_JOINT, ball_body, ball_damping
 from simulator.world.field import field_bodies
 from simulator.world.goal import goal_bodies

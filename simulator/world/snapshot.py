@@ -30,7 +30,7 @@ from collections.abc import Sequence
 import mujoco
 import numpy as np
 
-from contracts.ids import RobotId
+from contracts import RobotId
 from referee import BallState, BodyPart, RobotState, WorldSnapshot
 from simulator.world.flat import FlatData
 from simulator.world.frozen import slot_constructor

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from enum import StrEnum
 from typing import Literal
 
-from contracts.ids import RobotId, TeamColor
+from contracts import RobotId, TeamColor
 
 FieldClassName = Literal["kid", "adult"]
 DivergencePolicy = Literal["fail", "reset_robot"]

@@ -23,9 +23,7 @@ from collections.abc import Sequence
 import mujoco
 import numpy as np
 
-from contracts.field import FieldGeometry, field_for
-from contracts.ids import RobotId, TeamColor
-from contracts.match_spec import MatchSpec
+from contracts import FieldGeometry, MatchSpec, RobotId, TeamColor, field_for
 from referee import WorldCommand, WorldSnapshot
 from simulator.errors import PhysicsDivergence
 from simulator.world import commands

@@ -5,13 +5,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from robot.errors import UnknownModelError
-from robot.geometry import (
+from robot import (
     ADULT_GEOMETRY,
     ADULT_SCALE,
     KID_GEOMETRY,
     MOTOR_NAMES,
     HumanoidGeometry,
+    UnknownModelError,
     motor_range,
 )
 from simulator.world.robots.model import (

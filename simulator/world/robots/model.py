@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from robot.geometry import CAMERA_FOV_RAD, HumanoidGeometry
+from robot import CAMERA_FOV_RAD, HumanoidGeometry
 from simulator.world.servos import Servo
 
 FORCE_SENSORS = ("llb", "llf", "lrf", "lrb", "rlb", "rlf", "rrf", "rrb")

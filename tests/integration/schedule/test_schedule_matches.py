@@ -27,7 +27,7 @@ from testkit.s3 import MotoServer
 from testkit.sftp import free_port
 from tournament import Ledger, ScheduledMatchState, run_schedule, standings
 from tournament.controls import abort, reschedule
-from tournament.overview import overview, status_lines
+from tournament.overview import status_lines, tournament_overview
 
 pytestmark = [pytest.mark.docker, pytest.mark.slow]
 
@@ -174,7 +174,7 @@ def test_compressed_tournament_of_real_matches(tmp_path: Path, s3: MotoServer) -
         assert f"{match_id}/{team}/MANIFEST.json" in keys, keys
 
     # the operator's overview: each played match links its replay (hlvs match's public/)
-    view = overview(ledger)
+    view = tournament_overview(ledger)
     for match in view["matches"]:
         assert match["watch"] == {
             "replay": f"/watch/tournament/replay/{match['id']}?red={match['red']}"

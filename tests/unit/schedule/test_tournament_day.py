@@ -164,7 +164,7 @@ def test_overview_and_status_watch(
 ) -> None:
     from hlvs.cli import main
     from tournament import init_state
-    from tournament.overview import overview
+    from tournament.overview import tournament_overview
 
     path = write_schedule(
         tmp_path,
@@ -176,7 +176,7 @@ def test_overview_and_status_watch(
     ledger = Ledger(state)
     assert ledger.transition("ko-r1-1", (S.PLANNED,), S.PLAYING)
     live = {"state": "PLAYING", "half": 1, "secs_remaining": 75, "score": {"red": 1, "blue": 0}}
-    view = overview(ledger, snapshot=lambda folder: live)
+    view = tournament_overview(ledger, snapshot=lambda folder: live)
     assert view["name"] == "test cup" and view["warnings"] == []
     assert view["bracket"] == [["ko-r1-1", "ko-r1-2"], ["third", "ko-r2-1"]]
     playing = view["matches"][0]

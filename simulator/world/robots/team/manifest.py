@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from contracts.jsontypes import JSONObject
+from contracts import JSONObject
 from simulator.errors import ModelError, ModelProblem
 from simulator.world.servos import find_servo, servo_ids
 

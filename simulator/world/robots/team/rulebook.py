@@ -25,8 +25,7 @@ from dataclasses import dataclass, field, fields, replace
 import mujoco
 import numpy as np
 
-from contracts.codec import to_data
-from contracts.jsontypes import JSONObject
+from contracts import JSONObject, to_data
 from simulator.errors import ModelProblem
 from simulator.world.robots.team.model import TeamRobotModel
 from simulator.world.robots.team.servos import servo_problems
