@@ -15,6 +15,8 @@ and runs the front get-up. Angles are written for kid-default's motor signs
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from robot.motion.keyframes import Keyframe, KeyframeMotion
 from robot.motion.models import kinematics
 from robot.motion.posture import standing_posture
@@ -84,6 +86,52 @@ def _both_sides(joints: dict[str, float]) -> dict[str, float]:
     return out
 
 
+@dataclass(frozen=True, slots=True, kw_only=True)
+class GetUpScript:
+    """The keyframes of one model: ``front`` ends in a squat, from which the robot stands up
+    (its standing posture) in ``stand_s``; ``back_to_front`` and ``lie_flat`` roll it over."""
+
+    front: tuple[Frame, ...]
+    stand_s: float
+    back_to_front: tuple[Frame, ...]
+    lie_flat: Frame
+
+
+KID = GetUpScript(front=FRONT, stand_s=STAND_S, back_to_front=BACK_TO_FRONT, lie_flat=LIE_FLAT)
+
+
+def _stretched(script: GetUpScript, factor: float) -> GetUpScript:
+    def frames(seq: tuple[Frame, ...]) -> tuple[Frame, ...]:
+        return tuple((d * factor, j) for d, j in seq)
+
+    return GetUpScript(
+        front=frames(script.front),
+        stand_s=script.stand_s * factor,
+        back_to_front=frames(script.back_to_front),
+        lie_flat=frames((script.lie_flat,))[0],
+    )
+
+
+_ADULT_STRETCHED = _stretched(KID, 2.7)
+ADULT_FRONT: tuple[Frame, ...] = (
+    *_ADULT_STRETCHED.front[:4],  # arms out, forward, push-up, jackknife into a pike
+    (1.5, {"Shoulder": 1.5}),
+    (0.5, {}),
+    (1.5, {"Ankle": 0.0, "LegLower": 0.0}),  # legs upright: the weight onto the feet
+    (0.5, {}),
+    (1.5, {"LegUpper": 2.2, "LegLower": 0.6, "Ankle": 0.0, "Shoulder": 0.5, "ArmLower": 0.0}),
+    (1.5, {"LegUpper": 2.2, "LegLower": 1.4, "Ankle": 0.4}),
+    (1.5, {"LegUpper": 2.0, "LegLower": 2.6, "Ankle": 1.2}),  # squat
+)
+ADULT = GetUpScript(
+    front=ADULT_FRONT,
+    stand_s=3.0,
+    back_to_front=_ADULT_STRETCHED.back_to_front,
+    lie_flat=_ADULT_STRETCHED.lie_flat,
+)
+SCRIPTS: dict[str, GetUpScript] = {"kid-default": KID, "adult-default": ADULT}
+
+
 class GetUpMotion(KeyframeMotion):
     """Get up from lying on ``side`` ("front" or "back"); ``start`` is the current posture."""
 
@@ -93,16 +141,19 @@ class GetUpMotion(KeyframeMotion):
         if side not in ("front", "back"):
             raise ValueError(f"side must be 'front' or 'back', not {side!r}")
         self.side = side
-        kin = kinematics(model)
+        kin = kinematics(model)  # unknown models raise UnknownModelError
+        script = SCRIPTS[model]
         stand = standing_posture(model)
         frames: list[Keyframe] = []
         current = dict(stand)
         current.update(kin.head_targets(0.0, 0.0))
-        script = FRONT if side == "front" else (*BACK_TO_FRONT, LIE_FLAT)
-        for duration, joints in script:
+        frames_of_side = (
+            script.front if side == "front" else (*script.back_to_front, script.lie_flat)
+        )
+        for duration, joints in frames_of_side:
             current = dict(current)
             current.update(_both_sides(joints))
             frames.append(Keyframe(duration_s=duration, targets=current))
         if side == "front":
-            frames.append(Keyframe(duration_s=STAND_S, targets=stand))
+            frames.append(Keyframe(duration_s=script.stand_s, targets=stand))
         super().__init__(frames, start=start or stand)

@@ -10,21 +10,32 @@ import numpy as np
 
 from contracts.ids import RobotId, TeamColor
 from referee.snapshot import PlaceBall
+from robot.geometry import KID_GEOMETRY
 from robot.motion import SERVO_PID, standing_posture
 from robot.stub.controller import Sensors
 from simulator.world import RobotPlacement, World
+from simulator.world.robots import RobotModel, robot_model
 from testkit.stub_world import sense
 
 RED1 = RobotId(TeamColor.RED, 1)
 
 
 class OneRobot:
-    def __init__(self, *, x_m: float = 0.0, y_m: float = 0.0, yaw_rad: float = 0.0) -> None:
+    def __init__(
+        self,
+        *,
+        x_m: float = 0.0,
+        y_m: float = 0.0,
+        yaw_rad: float = 0.0,
+        model: str = "kid-default",
+    ) -> None:
+        built_in = robot_model(model)
+        assert isinstance(built_in, RobotModel)
+        self.model = model
+        self.scale = built_in.geometry.thigh_m / KID_GEOMETRY.thigh_m
         self.world = World.create(
-            field_class="kid",
-            robots=[
-                RobotPlacement(id=RED1, model="kid-default", x_m=x_m, y_m=y_m, yaw_rad=yaw_rad)
-            ],
+            field_class=built_in.field_class,
+            robots=[RobotPlacement(id=RED1, model=model, x_m=x_m, y_m=y_m, yaw_rad=yaw_rad)],
             seed=3,
         )
         for name in self.world.motor_names(RED1):
@@ -38,7 +49,7 @@ class OneRobot:
             self.world.set_motor_position(RED1, name, value)
 
     def stand(self, seconds: float = 1.0) -> None:
-        posture = standing_posture()
+        posture = standing_posture(self.model)
         for _ in range(int(seconds / 0.008)):
             self.command(posture)
             self.world.step()
@@ -87,7 +98,8 @@ class OneRobot:
         return self.world.data.geom_xpos[geom].copy()
 
     def lay_down(self, side: str, *, settle_s: float = 1.2) -> None:
-        """Put the robot on its front or back (torso 0.15 m up, falling flat), joints standing."""
+        """Put the robot on its front or back (torso 0.15 m up on the kid, scaled with the model,
+        falling flat), joints standing."""
         import mujoco
 
         adr = self.world.model.joint("red_1/root").qposadr[0]
@@ -97,7 +109,7 @@ class OneRobot:
         qy = np.array([math.cos(angle / 2), 0.0, math.sin(angle / 2), 0.0])
         quat = np.zeros(4)
         mujoco.mju_mulQuat(quat, qz, qy)
-        self.world.data.qpos[adr + 2] = 0.15
+        self.world.data.qpos[adr + 2] = 0.15 * self.scale
         self.world.data.qpos[adr + 3 : adr + 7] = quat
         self.world.data.qvel[:] = 0.0
         mujoco.mj_forward(self.world.model, self.world.data)
