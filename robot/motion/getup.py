@@ -123,11 +123,31 @@ ADULT_FRONT: tuple[Frame, ...] = (
     (1.5, {"LegUpper": 2.2, "LegLower": 1.4, "Ankle": 0.4}),
     (1.5, {"LegUpper": 2.0, "LegLower": 2.6, "Ankle": 1.2}),  # squat
 )
+ADULT_BACK_TO_FRONT: tuple[Frame, ...] = (  # roll over the right side onto the front
+    (
+        1.28,  # left leg up and turned out, right leg back, wide and turned in, arms apart
+        {"AnkleL": -2.67, "AnkleR": 1.88, "ArmLowerL": 1.58, "ArmLowerR": 0.42, "ArmUpperL": 1.24,
+         "ArmUpperR": -0.7, "LegLowerL": 0.48, "LegLowerR": 1.14, "LegUpperL": 2.09,
+         "LegUpperR": -0.81, "PelvL": -0.28, "PelvR": -1.04, "PelvYL": 0.57, "PelvYR": -2.06,
+         "ShoulderL": -0.85, "ShoulderR": 0.59},
+    ),
+    (0.29, {"ArmUpperL": 1.4, "ShoulderL": -0.91}),  # the left arm pushes the ground behind
+    (
+        0.81,  # ... and the left leg swings across
+        {"ArmUpperL": -0.63, "LegUpperL": 0.83, "PelvL": 0.91, "PelvYL": -0.15, "ShoulderL": -1.53},
+    ),
+    (0.33, {"ArmUpperL": -0.8, "LegUpperL": 1.45, "PelvYL": -0.25, "ShoulderL": -0.84}),
+)  # fmt: skip
+ADULT_LIE_FLAT: Frame = (
+    1.23,
+    {"Ankle": 0.59, "ArmLower": -0.43, "ArmUpper": 0.19, "Foot": 0.43, "LegLower": 0.39,
+     "LegUpper": 0.67, "Pelv": 0.97, "PelvY": 0.99, "Shoulder": 0.18},
+)  # fmt: skip
 ADULT = GetUpScript(
     front=ADULT_FRONT,
     stand_s=3.0,
-    back_to_front=_ADULT_STRETCHED.back_to_front,
-    lie_flat=_ADULT_STRETCHED.lie_flat,
+    back_to_front=ADULT_BACK_TO_FRONT,
+    lie_flat=ADULT_LIE_FLAT,
 )
 SCRIPTS: dict[str, GetUpScript] = {"kid-default": KID, "adult-default": ADULT}
 
