@@ -117,7 +117,7 @@ ADULT_FRONT: tuple[Frame, ...] = (
     *_ADULT_STRETCHED.front[:4],  # arms out, forward, push-up, jackknife into a pike
     (1.5, {"Shoulder": 1.5}),
     (0.5, {}),
-    (1.5, {"Ankle": 0.0, "LegLower": 0.0}),  # legs upright: the weight onto the feet
+    (1.5, {"Ankle": -0.3, "LegLower": 0.0}),  # legs upright: the weight onto the feet
     (0.5, {}),
     (1.5, {"LegUpper": 2.2, "LegLower": 0.6, "Ankle": 0.0, "Shoulder": 0.5, "ArmLower": 0.0}),
     (1.5, {"LegUpper": 2.2, "LegLower": 1.4, "Ankle": 0.4}),
