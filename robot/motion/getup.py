@@ -125,23 +125,23 @@ ADULT_FRONT: tuple[Frame, ...] = (
 )
 ADULT_BACK_TO_FRONT: tuple[Frame, ...] = (  # roll over the right side onto the front
     (
-        1.28,  # left leg up and turned out, right leg back, wide and turned in, arms apart
-        {"AnkleL": -2.67, "AnkleR": 1.88, "ArmLowerL": 1.58, "ArmLowerR": 0.42, "ArmUpperL": 1.24,
-         "ArmUpperR": -0.7, "LegLowerL": 0.48, "LegLowerR": 1.14, "LegUpperL": 2.09,
-         "LegUpperR": -0.81, "PelvL": -0.28, "PelvR": -1.04, "PelvYL": 0.57, "PelvYR": -2.06,
-         "ShoulderL": -0.85, "ShoulderR": 0.59},
+        1.62,  # left leg up and turned out, right leg back, wide and turned in, arms apart
+        {"AnkleL": -1.2, "AnkleR": 1.2, "ArmLowerL": 2.06, "ArmLowerR": 0.91, "ArmUpperL": 1.24,
+         "ArmUpperR": -0.38, "LegLowerL": 0.55, "LegLowerR": 0.72, "LegUpperL": 1.79,
+         "LegUpperR": -0.76, "PelvL": -0.47, "PelvR": -0.6, "PelvYL": 0.9, "PelvYR": -0.9,
+         "ShoulderL": -0.91, "ShoulderR": 0.88},
     ),
-    (0.29, {"ArmUpperL": 1.4, "ShoulderL": -0.91}),  # the left arm pushes the ground behind
+    (0.39, {"ArmUpperL": 1.38, "ShoulderL": -0.9}),  # the left arm pushes the ground behind
     (
-        0.81,  # ... and the left leg swings across
-        {"ArmUpperL": -0.63, "LegUpperL": 0.83, "PelvL": 0.91, "PelvYL": -0.15, "ShoulderL": -1.53},
+        0.78,  # ... and the left leg swings across
+        {"ArmUpperL": -0.3, "LegUpperL": 0.84, "PelvL": 0.6, "PelvYL": 0.66, "ShoulderL": -1.72},
     ),
-    (0.33, {"ArmUpperL": -0.8, "LegUpperL": 1.45, "PelvYL": -0.25, "ShoulderL": -0.84}),
+    (0.62, {"ArmUpperL": -0.3, "LegUpperL": 1.83, "PelvYL": -0.38, "ShoulderL": -1.05}),
 )  # fmt: skip
 ADULT_LIE_FLAT: Frame = (
     1.23,
-    {"Ankle": 0.59, "ArmLower": -0.43, "ArmUpper": 0.19, "Foot": 0.43, "LegLower": 0.39,
-     "LegUpper": 0.67, "Pelv": 0.97, "PelvY": 0.99, "Shoulder": 0.18},
+    {"Ankle": 0.59, "ArmLower": -0.1, "ArmUpper": 0.49, "Foot": 0.6, "LegLower": 0.37,
+     "LegUpper": 0.67, "Pelv": 0.6, "PelvY": 0.9, "Shoulder": -1.5},
 )  # fmt: skip
 ADULT = GetUpScript(
     front=ADULT_FRONT,
