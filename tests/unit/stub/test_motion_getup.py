@@ -91,20 +91,36 @@ def test_stub_controller_detects_the_fall_and_gets_up(side: str, model: str) -> 
     assert robot.position[2] > 0.3 * robot.scale
 
 
+# the kid is pushed by 60 N for 0.15 s; the adult (8 times the mass) by 300 N for 0.2 s, standing
+# up first from the straight legs it is placed with
+PUSHES = {"kid-default": (60.0, 0.15, 20.0), "adult-default": (300.0, 0.2, 34.0)}
+
+
+@pytest.mark.parametrize("model", MODELS)
 @pytest.mark.parametrize("direction_rad", [0.3, 2.2, -2.5])
-def test_pushed_over_robot_gets_back_up(direction_rad: float) -> None:
+def test_pushed_over_robot_gets_back_up(direction_rad: float, model: str) -> None:
     from contracts.gamecontroller import GameState
     from robot.stub import GameInfo, Pose2D, Role, StubController
 
-    robot = OneRobot(yaw_rad=1.0)
-    controller = StubController(role=Role.IDLE, start_pose=Pose2D(0.0, 0.0, 1.0))
+    robot = OneRobot(yaw_rad=1.0, model=model)
+    if model != "kid-default":
+        robot.rise()
+    controller = StubController(
+        role=Role.IDLE,
+        start_pose=Pose2D(0.0, 0.0, 1.0),
+        model=model,
+        field_class="kid" if model == "kid-default" else "adult",
+    )
     game = GameInfo(phase=GameState.PLAYING)
+    force, push_s, seconds = PUSHES[model]
     push = robot.world.data.xfrc_applied[robot.torso]
     lowest = 1.0
-    for step in range(int(20.0 / 0.008)):
+    for step in range(int(seconds / 0.008)):
         t = step * 0.008
         push[:3] = (
-            (60 * math.cos(direction_rad), 60 * math.sin(direction_rad), 0) if 2 <= t < 2.15 else 0
+            (force * math.cos(direction_rad), force * math.sin(direction_rad), 0)
+            if 2 <= t < 2 + push_s
+            else 0
         )
         sensors = robot.sensors()
         robot.command(controller.tick(sensors, game))
