@@ -100,29 +100,22 @@ class GetUpScript:
 KID = GetUpScript(front=FRONT, stand_s=STAND_S, back_to_front=BACK_TO_FRONT, lie_flat=LIE_FLAT)
 
 
-def _stretched(script: GetUpScript, factor: float) -> GetUpScript:
-    def frames(seq: tuple[Frame, ...]) -> tuple[Frame, ...]:
-        return tuple((d * factor, j) for d, j in seq)
-
-    return GetUpScript(
-        front=frames(script.front),
-        stand_s=script.stand_s * factor,
-        back_to_front=frames(script.back_to_front),
-        lie_flat=frames((script.lie_flat,))[0],
-    )
-
-
-_ADULT_STRETCHED = _stretched(KID, 2.7)
+# adult-default: the kid's first frames (arms forward, jackknife into a pike), then the legs stand
+# upright under the pike and the knees bend under the hips into a squat (see the module docstring)
 ADULT_FRONT: tuple[Frame, ...] = (
-    *_ADULT_STRETCHED.front[:4],  # arms out, forward, push-up, jackknife into a pike
-    (1.5, {"Shoulder": 1.5}),
-    (0.5, {}),
-    (1.5, {"Ankle": -0.3, "LegLower": 0.0}),  # legs upright: the weight onto the feet
-    (0.5, {}),
-    (1.5, {"LegUpper": 2.2, "LegLower": 0.6, "Ankle": 0.0, "Shoulder": 0.5, "ArmLower": 0.0}),
-    (1.5, {"LegUpper": 2.2, "LegLower": 1.4, "Ankle": 0.4}),
-    (1.5, {"LegUpper": 2.0, "LegLower": 2.6, "Ankle": 1.2}),  # squat
-)
+    (1.3, FRONT[0][1]),  # arms out, legs straight
+    (1.62, FRONT[1][1]),  # the arms turn to point ahead
+    (0.96, FRONT[2][1]),  # ... and swing down under the chest (they cannot lift it)
+    (1.95, FRONT[3][1]),  # jackknife: pike on hands and flat feet
+    (0.9, {"Shoulder": 1.5}),
+    (0.3, {}),
+    (0.9, {"Ankle": -0.3, "LegLower": 0.0}),  # legs upright, leaning back: weight on the feet
+    (0.3, {}),
+    (0.9, {"LegUpper": 2.2, "LegLower": 0.6, "Ankle": 0.0, "Shoulder": 0.5,
+           "ArmLower": 0.0}),  # knees bend, shins upright: the hips go back over the heels
+    (0.9, {"LegUpper": 2.2, "LegLower": 1.4, "Ankle": 0.4}),
+    (0.9, {"LegUpper": 2.0, "LegLower": 2.6, "Ankle": 1.2}),  # squat
+)  # fmt: skip
 ADULT_BACK_TO_FRONT: tuple[Frame, ...] = (  # roll over the right side onto the front
     (
         1.62,  # left leg up and turned out, right leg back, wide and turned in, arms apart
@@ -145,7 +138,7 @@ ADULT_LIE_FLAT: Frame = (
 )  # fmt: skip
 ADULT = GetUpScript(
     front=ADULT_FRONT,
-    stand_s=3.0,
+    stand_s=1.8,
     back_to_front=ADULT_BACK_TO_FRONT,
     lie_flat=ADULT_LIE_FLAT,
 )
