@@ -1,16 +1,29 @@
 """Getting up after a fall, from lying on the front or on the back (joint-space keyframes).
 
-Paced for the league's catalogue servos: no target moves faster than its joint's no-load speed
-(most stay under 0.6 of it), so the servos' torque-speed line leaves torque to move the body.
+One script per built-in model (:data:`SCRIPTS`), paced for its catalogue servos: no target moves
+faster than its joint's no-load speed, so the servos' torque-speed line leaves torque to move
+the body. Angles are written for the built-in models' motor signs (robot/geometry.py).
 
-Front (about 10 s): arms out and forward, push up on them, jackknife into a pike on hands and
-flat feet, fold the knees into a crouch on hands and feet and hold it (a statically stable
-pose: every fall goes on from the same state), push off the hands onto the toes, rock back onto
-the heels, lean into a squat and stand. Back (about 1.8 s): tuck the left leg, push the ground
-behind the back with the left arm and swing the leg across to roll over the right side onto
-the front, and lie flat; the caller (the stub controller) then sees a robot lying on its front
-and runs the front get-up. Angles are written for kid-default's motor signs
-(robot/geometry.py).
+kid-default, front (about 10 s): arms out and forward, push up on them, jackknife into a pike on
+hands and flat feet, fold the knees into a crouch on hands and feet and hold it (a statically
+stable pose: every fall goes on from the same state), push off the hands onto the toes, rock
+back onto the heels, lean into a squat and stand. Back (about 1.8 s): tuck the left leg, push
+the ground behind the back with the left arm and swing the leg across to roll over the right
+side onto the front, and lie flat; the caller (the stub controller) then sees a robot lying on
+its front and runs the front get-up.
+
+adult-default cannot move like that: scaled up twice it weighs 8 times as much, so its joints
+need 16 times the kid's torque, and its Dynamixel-P servos give the legs about a third of that
+and the arms about a fifth (PH54-200 44.7 N m, PH54-100 25.3 N m against the kid's 8.3 and
+7.3), at 3.5 rad/s instead of 9.2. Its arms cannot push it up, nor push off from the crouch on
+hands and knees, and the kid's quick push-off and rock back would outrun its servos. So its front
+get-up (about 12.7 s) gets the weight onto the feet with the legs alone: the kid's first frames
+into the pike (the push-up frame lifts nothing, the jackknife does the work), then the legs
+straighten and lean back under the pike until the weight is on the feet and the hands come off
+the ground, the knees bend with the shins upright so that the hips go back over the heels, into
+a squat, and it stands. Its roll from the back (about 4.6 s, then the front get-up) has its own
+frames: left leg up and turned out, right leg back and wide, the left arm pushing the ground
+and the left leg swinging across.
 """
 
 from __future__ import annotations
@@ -24,7 +37,8 @@ from robot.motion.posture import standing_posture
 Frame = tuple[float, dict[str, float]]  # (duration s, {joint without side suffix: rad})
 
 # Tuned in the MuJoCo world (grass turf, cleated feet) with the catalogue servos by a search over
-# keyframes within the servos' speed, on robots laid down and pushed over in several directions.
+# keyframes within the servos' speed, on robots laid down and pushed over in several directions
+# (both models).
 # Some targets lie beyond the motor limits on purpose: the motors clamp them, and interpolating
 # towards them makes the joint reach its limit earlier in the move, which is part of the tuned
 # timing.
