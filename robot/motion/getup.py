@@ -132,23 +132,23 @@ ADULT_FRONT: tuple[Frame, ...] = (
 )  # fmt: skip
 ADULT_BACK_TO_FRONT: tuple[Frame, ...] = (  # roll over the right side onto the front
     (
-        1.62,  # left leg up and turned out, right leg back, wide and turned in, arms apart
-        {"AnkleL": -1.2, "AnkleR": 1.2, "ArmLowerL": 2.06, "ArmLowerR": 0.91, "ArmUpperL": 1.24,
-         "ArmUpperR": -0.38, "LegLowerL": 0.55, "LegLowerR": 0.72, "LegUpperL": 1.79,
-         "LegUpperR": -0.76, "PelvL": -0.47, "PelvR": -0.6, "PelvYL": 0.9, "PelvYR": -0.9,
-         "ShoulderL": -0.91, "ShoulderR": 0.88},
+        0.81,  # left leg up and turned out, right leg back, wide and turned in, arms apart
+        {"AnkleL": -0.03, "AnkleR": 1.17, "ArmLowerL": 1.34, "ArmLowerR": 1.53, "ArmUpperL": 1.67,
+         "ArmUpperR": -1.38, "LegLowerL": 0.12, "LegLowerR": 1.11, "LegUpperL": 2.2,
+         "LegUpperR": -1.0, "PelvL": 0.21, "PelvR": -0.6, "PelvYL": 0.9, "PelvYR": -0.77,
+         "ShoulderL": -0.43, "ShoulderR": 0.73},
     ),
-    (0.39, {"ArmUpperL": 1.38, "ShoulderL": -0.9}),  # the left arm pushes the ground behind
+    (0.6, {"ArmUpperL": 1.19, "ShoulderL": -1.19}),  # the left arm pushes the ground behind
     (
-        0.78,  # ... and the left leg swings across
-        {"ArmUpperL": -0.3, "LegUpperL": 0.84, "PelvL": 0.6, "PelvYL": 0.66, "ShoulderL": -1.72},
+        0.47,  # ... and the left leg swings across
+        {"ArmUpperL": 0.47, "LegUpperL": 1.2, "PelvL": 0.6, "PelvYL": 0.45, "ShoulderL": -1.94},
     ),
-    (0.62, {"ArmUpperL": -0.3, "LegUpperL": 1.83, "PelvYL": -0.38, "ShoulderL": -1.05}),
+    (0.51, {"ArmUpperL": -0.3, "LegUpperL": 1.64, "PelvYL": -0.64, "ShoulderL": -1.12}),
 )  # fmt: skip
 ADULT_LIE_FLAT: Frame = (
-    1.23,
-    {"Ankle": 0.59, "ArmLower": -0.1, "ArmUpper": 0.49, "Foot": 0.6, "LegLower": 0.37,
-     "LegUpper": 0.67, "Pelv": 0.6, "PelvY": 0.9, "Shoulder": -1.5},
+    0.78,
+    {"Ankle": 1.01, "ArmLower": -0.1, "ArmUpper": 0.76, "Foot": 0.18, "LegLower": 0.4,
+     "LegUpper": 0.67, "Pelv": 0.6, "PelvY": 0.85, "Shoulder": -0.78},
 )  # fmt: skip
 ADULT = GetUpScript(
     front=ADULT_FRONT,
