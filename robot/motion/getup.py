@@ -132,23 +132,23 @@ ADULT_FRONT: tuple[Frame, ...] = (
 )  # fmt: skip
 ADULT_BACK_TO_FRONT: tuple[Frame, ...] = (  # roll over the right side onto the front
     (
-        0.81,  # left leg up and turned out, right leg back, wide and turned in, arms apart
-        {"AnkleL": -0.03, "AnkleR": 1.17, "ArmLowerL": 1.34, "ArmLowerR": 1.53, "ArmUpperL": 1.67,
-         "ArmUpperR": -1.38, "LegLowerL": 0.12, "LegLowerR": 1.11, "LegUpperL": 2.2,
-         "LegUpperR": -1.0, "PelvL": 0.21, "PelvR": -0.6, "PelvYL": 0.9, "PelvYR": -0.77,
-         "ShoulderL": -0.43, "ShoulderR": 0.73},
+        0.81,  # left leg up and out, right leg back, wide and turned in, arms apart
+        {"AnkleL": 0.42, "AnkleR": 1.2, "ArmLowerL": 1.34, "ArmLowerR": 0.41, "ArmUpperL": 1.12,
+         "ArmUpperR": -1.07, "LegLowerL": 0.6, "LegLowerR": 0.62, "LegUpperL": 2.2,
+         "LegUpperR": -1.0, "PelvL": 0.6, "PelvR": -0.6, "PelvYL": 0.9, "PelvYR": -0.77,
+         "ShoulderL": -0.52, "ShoulderR": 0.69},
     ),
-    (0.6, {"ArmUpperL": 1.19, "ShoulderL": -1.19}),  # the left arm pushes the ground behind
+    (0.32, {"ArmUpperL": 1.06, "ShoulderL": -1.21}),  # the left arm pushes the ground behind
     (
-        0.47,  # ... and the left leg swings across
-        {"ArmUpperL": 0.47, "LegUpperL": 1.2, "PelvL": 0.6, "PelvYL": 0.45, "ShoulderL": -1.94},
+        0.38,  # ... and the left leg swings across
+        {"ArmUpperL": 0.59, "LegUpperL": 1.63, "PelvL": 0.6, "PelvYL": 0.09, "ShoulderL": -1.66},
     ),
-    (0.51, {"ArmUpperL": -0.3, "LegUpperL": 1.64, "PelvYL": -0.64, "ShoulderL": -1.12}),
+    (0.47, {"ArmUpperL": -0.3, "LegUpperL": 1.87, "PelvYL": -0.9, "ShoulderL": -1.24}),
 )  # fmt: skip
 ADULT_LIE_FLAT: Frame = (
-    0.78,
-    {"Ankle": 1.01, "ArmLower": -0.1, "ArmUpper": 0.76, "Foot": 0.18, "LegLower": 0.4,
-     "LegUpper": 0.67, "Pelv": 0.6, "PelvY": 0.85, "Shoulder": -0.78},
+    0.79,
+    {"Ankle": 1.2, "ArmLower": -0.1, "ArmUpper": 0.98, "Foot": 0.13, "LegLower": 0.55,
+     "LegUpper": 0.2, "Pelv": 0.6, "PelvY": 0.27, "Shoulder": -0.69},
 )  # fmt: skip
 ADULT = GetUpScript(
     front=ADULT_FRONT,
