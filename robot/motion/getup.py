@@ -123,12 +123,12 @@ ADULT_FRONT: tuple[Frame, ...] = (
     (1.95, FRONT[3][1]),  # jackknife: pike on hands and flat feet
     (0.9, {"Shoulder": 1.5}),
     (0.3, {}),
-    (0.9, {"Ankle": -0.3, "LegLower": 0.0}),  # legs upright, leaning back: weight on the feet
+    (0.9, {"Ankle": -0.25, "LegLower": 0.0}),  # legs upright, leaning back: weight on the feet
     (0.3, {}),
     (0.9, {"LegUpper": 2.2, "LegLower": 0.6, "Ankle": 0.0, "Shoulder": 0.5,
            "ArmLower": 0.0}),  # knees bend, shins upright: the hips go back over the heels
-    (0.9, {"LegUpper": 2.2, "LegLower": 1.4, "Ankle": 0.4}),
-    (0.9, {"LegUpper": 2.0, "LegLower": 2.6, "Ankle": 1.2}),  # squat
+    (0.9, {"LegUpper": 2.1, "LegLower": 1.4, "Ankle": 0.4}),
+    (0.9, {"LegUpper": 1.55, "LegLower": 2.2, "Ankle": 1.0}),  # squat
 )  # fmt: skip
 ADULT_BACK_TO_FRONT: tuple[Frame, ...] = (  # roll over the right side onto the front
     (
