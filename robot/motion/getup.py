@@ -21,9 +21,11 @@ get-up (about 12.7 s) gets the weight onto the feet with the legs alone: the kid
 into the pike (the push-up frame lifts nothing, the jackknife does the work), then the legs
 straighten and lean back under the pike until the weight is on the feet and the hands come off
 the ground, the knees bend with the shins upright so that the hips go back over the heels, into
-a squat, and it stands. Its roll from the back (about 4.6 s, then the front get-up) has its own
-frames: left leg up and turned out, right leg back and wide, the left arm pushing the ground
-and the left leg swinging across.
+a squat, and it stands. Its roll from the back (about 2.8 s, then the front get-up: about 16 s
+from the start of the roll to standing) has its own frames: left leg up and turned out, right
+leg back and wide, the left arm pushing the ground and the left leg swinging across. Both stay
+within the referee's 20 s for a fallen robot (the fallen flag of the world's snapshot stays on
+for at most about 14.3 s from the back, 10.9 s from the front).
 """
 
 from __future__ import annotations
@@ -121,10 +123,10 @@ ADULT_FRONT: tuple[Frame, ...] = (
     (1.62, FRONT[1][1]),  # the arms turn to point ahead
     (0.96, FRONT[2][1]),  # ... and swing down under the chest (they cannot lift it)
     (1.95, FRONT[3][1]),  # jackknife: pike on hands and flat feet
-    (0.9, {"Shoulder": 1.5}),
-    (0.3, {}),
+    (0.9, {"Shoulder": 1.5}),  # arms back towards the feet (they move once the hands are free)
+    (0.3, {}),  # hold
     (0.9, {"Ankle": -0.25, "LegLower": 0.0}),  # legs upright, leaning back: weight on the feet
-    (0.3, {}),
+    (0.3, {}),  # hold: standing on the feet alone, bent over
     (0.9, {"LegUpper": 2.2, "LegLower": 0.6, "Ankle": 0.0, "Shoulder": 0.5,
            "ArmLower": 0.0}),  # knees bend, shins upright: the hips go back over the heels
     (0.9, {"LegUpper": 2.1, "LegLower": 1.4, "Ankle": 0.4}),
@@ -145,7 +147,7 @@ ADULT_BACK_TO_FRONT: tuple[Frame, ...] = (  # roll over the right side onto the 
     ),
     (0.47, {"ArmUpperL": -0.3, "LegUpperL": 1.87, "PelvYL": -0.9, "ShoulderL": -1.24}),
 )  # fmt: skip
-ADULT_LIE_FLAT: Frame = (
+ADULT_LIE_FLAT: Frame = (  # on the front: the front get-up's first frame sets every joint
     0.79,
     {"Ankle": 1.2, "ArmLower": -0.1, "ArmUpper": 0.98, "Foot": 0.13, "LegLower": 0.55,
      "LegUpper": 0.2, "Pelv": 0.6, "PelvY": 0.27, "Shoulder": -0.69},
