@@ -1,19 +1,36 @@
 """Getting up after a fall, from lying on the front or on the back (joint-space keyframes).
 
-Paced for the league's catalogue servos: no target moves faster than its joint's no-load speed
-(most stay under 0.6 of it), so the servos' torque-speed line leaves torque to move the body.
+One script per built-in model (:data:`SCRIPTS`), paced for its catalogue servos: no target moves
+faster than its joint's no-load speed, so the servos' torque-speed line leaves torque to move
+the body. Angles are written for the built-in models' motor signs (robot/geometry.py).
 
-Front (about 10 s): arms out and forward, push up on them, jackknife into a pike on hands and
-flat feet, fold the knees into a crouch on hands and feet and hold it (a statically stable
-pose: every fall goes on from the same state), push off the hands onto the toes, rock back onto
-the heels, lean into a squat and stand. Back (about 1.8 s): tuck the left leg, push the ground
-behind the back with the left arm and swing the leg across to roll over the right side onto
-the front, and lie flat; the caller (the stub controller) then sees a robot lying on its front
-and runs the front get-up. Angles are written for kid-default's motor signs
-(robot/geometry.py).
+kid-default, front (about 10 s): arms out and forward, push up on them, jackknife into a pike on
+hands and flat feet, fold the knees into a crouch on hands and feet and hold it (a statically
+stable pose: every fall goes on from the same state), push off the hands onto the toes, rock
+back onto the heels, lean into a squat and stand. Back (about 1.8 s): tuck the left leg, push
+the ground behind the back with the left arm and swing the leg across to roll over the right
+side onto the front, and lie flat; the caller (the stub controller) then sees a robot lying on
+its front and runs the front get-up.
+
+adult-default cannot move like that: scaled up twice it weighs 8 times as much, so its joints
+need 16 times the kid's torque, and its Dynamixel-P servos give the legs about a third of that
+and the arms about a fifth (PH54-200 44.7 N m, PH54-100 25.3 N m against the kid's 8.3 and
+7.3), at 3.5 rad/s instead of 9.2. Its arms cannot push it up, nor push off from the crouch on
+hands and knees, and the kid's quick push-off and rock back would outrun its servos. So its front
+get-up (about 12.7 s) gets the weight onto the feet with the legs alone: the kid's first frames
+into the pike (the push-up frame lifts nothing, the jackknife does the work), then the legs
+straighten and lean back under the pike until the weight is on the feet and the hands come off
+the ground, the knees bend with the shins upright so that the hips go back over the heels, into
+a squat, and it stands. Its roll from the back (about 2.8 s, then the front get-up: about 16 s
+from the start of the roll to standing) has its own frames: left leg up and turned out, right
+leg back and wide, the left arm pushing the ground and the left leg swinging across. Both stay
+within the referee's 20 s for a fallen robot (the fallen flag of the world's snapshot stays on
+for at most about 14.3 s from the back, 10.9 s from the front).
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 from robot.motion.keyframes import Keyframe, KeyframeMotion
 from robot.motion.models import kinematics
@@ -22,7 +39,8 @@ from robot.motion.posture import standing_posture
 Frame = tuple[float, dict[str, float]]  # (duration s, {joint without side suffix: rad})
 
 # Tuned in the MuJoCo world (grass turf, cleated feet) with the catalogue servos by a search over
-# keyframes within the servos' speed, on robots laid down and pushed over in several directions.
+# keyframes within the servos' speed, on robots laid down and pushed over in several directions
+# (both models).
 # Some targets lie beyond the motor limits on purpose: the motors clamp them, and interpolating
 # towards them makes the joint reach its limit earlier in the move, which is part of the tuned
 # timing.
@@ -84,6 +102,65 @@ def _both_sides(joints: dict[str, float]) -> dict[str, float]:
     return out
 
 
+@dataclass(frozen=True, slots=True, kw_only=True)
+class GetUpScript:
+    """The keyframes of one model: ``front`` ends in a squat, from which the robot stands up
+    (its standing posture) in ``stand_s``; ``back_to_front`` and ``lie_flat`` roll it over."""
+
+    front: tuple[Frame, ...]
+    stand_s: float
+    back_to_front: tuple[Frame, ...]
+    lie_flat: Frame
+
+
+KID = GetUpScript(front=FRONT, stand_s=STAND_S, back_to_front=BACK_TO_FRONT, lie_flat=LIE_FLAT)
+
+
+# adult-default: the kid's first frames (arms forward, jackknife into a pike), then the legs stand
+# upright under the pike and the knees bend under the hips into a squat (see the module docstring)
+ADULT_FRONT: tuple[Frame, ...] = (
+    (1.3, FRONT[0][1]),  # arms out, legs straight
+    (1.62, FRONT[1][1]),  # the arms turn to point ahead
+    (0.96, FRONT[2][1]),  # ... and swing down under the chest (they cannot lift it)
+    (1.95, FRONT[3][1]),  # jackknife: pike on hands and flat feet
+    (0.9, {"Shoulder": 1.5}),  # arms back towards the feet (they move once the hands are free)
+    (0.3, {}),  # hold
+    (0.9, {"Ankle": -0.25, "LegLower": 0.0}),  # legs upright, leaning back: weight on the feet
+    (0.3, {}),  # hold: standing on the feet alone, bent over
+    (0.9, {"LegUpper": 2.2, "LegLower": 0.6, "Ankle": 0.0, "Shoulder": 0.5,
+           "ArmLower": 0.0}),  # knees bend, shins upright: the hips go back over the heels
+    (0.9, {"LegUpper": 2.1, "LegLower": 1.4, "Ankle": 0.4}),
+    (0.9, {"LegUpper": 1.55, "LegLower": 2.2, "Ankle": 1.0}),  # squat
+)  # fmt: skip
+ADULT_BACK_TO_FRONT: tuple[Frame, ...] = (  # roll over the right side onto the front
+    (
+        0.81,  # left leg up and out, right leg back, wide and turned in, arms apart
+        {"AnkleL": 0.42, "AnkleR": 1.2, "ArmLowerL": 1.34, "ArmLowerR": 0.41, "ArmUpperL": 1.12,
+         "ArmUpperR": -1.07, "LegLowerL": 0.6, "LegLowerR": 0.62, "LegUpperL": 2.2,
+         "LegUpperR": -1.0, "PelvL": 0.6, "PelvR": -0.6, "PelvYL": 0.9, "PelvYR": -0.77,
+         "ShoulderL": -0.52, "ShoulderR": 0.69},
+    ),
+    (0.32, {"ArmUpperL": 1.06, "ShoulderL": -1.21}),  # the left arm pushes the ground behind
+    (
+        0.38,  # ... and the left leg swings across
+        {"ArmUpperL": 0.59, "LegUpperL": 1.63, "PelvL": 0.6, "PelvYL": 0.09, "ShoulderL": -1.66},
+    ),
+    (0.47, {"ArmUpperL": -0.3, "LegUpperL": 1.87, "PelvYL": -0.9, "ShoulderL": -1.24}),
+)  # fmt: skip
+ADULT_LIE_FLAT: Frame = (  # on the front: the front get-up's first frame sets every joint
+    0.79,
+    {"Ankle": 1.2, "ArmLower": -0.1, "ArmUpper": 0.98, "Foot": 0.13, "LegLower": 0.55,
+     "LegUpper": 0.2, "Pelv": 0.6, "PelvY": 0.27, "Shoulder": -0.69},
+)  # fmt: skip
+ADULT = GetUpScript(
+    front=ADULT_FRONT,
+    stand_s=1.8,
+    back_to_front=ADULT_BACK_TO_FRONT,
+    lie_flat=ADULT_LIE_FLAT,
+)
+SCRIPTS: dict[str, GetUpScript] = {"kid-default": KID, "adult-default": ADULT}
+
+
 class GetUpMotion(KeyframeMotion):
     """Get up from lying on ``side`` ("front" or "back"); ``start`` is the current posture."""
 
@@ -93,16 +170,19 @@ class GetUpMotion(KeyframeMotion):
         if side not in ("front", "back"):
             raise ValueError(f"side must be 'front' or 'back', not {side!r}")
         self.side = side
-        kin = kinematics(model)
+        kin = kinematics(model)  # unknown models raise UnknownModelError
+        script = SCRIPTS[model]
         stand = standing_posture(model)
         frames: list[Keyframe] = []
         current = dict(stand)
         current.update(kin.head_targets(0.0, 0.0))
-        script = FRONT if side == "front" else (*BACK_TO_FRONT, LIE_FLAT)
-        for duration, joints in script:
+        frames_of_side = (
+            script.front if side == "front" else (*script.back_to_front, script.lie_flat)
+        )
+        for duration, joints in frames_of_side:
             current = dict(current)
             current.update(_both_sides(joints))
             frames.append(Keyframe(duration_s=duration, targets=current))
         if side == "front":
-            frames.append(Keyframe(duration_s=STAND_S, targets=stand))
+            frames.append(Keyframe(duration_s=script.stand_s, targets=stand))
         super().__init__(frames, start=start or stand)
