@@ -114,6 +114,9 @@ class RobotKinematics:
     arm_rest: ArmPose
     camera: CameraMount
     walk_overrides: dict[str, float] = field(default_factory=dict)
+    # seconds to ease from straight legs (as placed by the referee) into the standing posture;
+    # 0: straight into it at the servos' full speed
+    rise_s: float = 0.0
 
     @property
     def motor_names(self) -> tuple[str, ...]:
@@ -181,7 +184,9 @@ _LEG_SIGNS = {
 _ARM_SIGNS = {"shoulder_pitch": -1.0, "shoulder_roll": 1.0, "elbow": -1.0}
 
 
-def _humanoid(name: str, geometry: HumanoidGeometry, scale: float) -> RobotKinematics:
+def _humanoid(
+    name: str, geometry: HumanoidGeometry, scale: float, *, rise_s: float = 0.0
+) -> RobotKinematics:
     g = geometry
     return RobotKinematics(
         name=name,
@@ -208,6 +213,7 @@ def _humanoid(name: str, geometry: HumanoidGeometry, scale: float) -> RobotKinem
             fov_rad=CAMERA_FOV_RAD,
         ),
         walk_overrides=_scaled_walk(scale),
+        rise_s=rise_s,
     )
 
 
@@ -246,7 +252,8 @@ def _kid_default() -> RobotKinematics:
 
 
 def _adult_default() -> RobotKinematics:
-    return _humanoid("adult-default", ADULT_GEOMETRY, ADULT_SCALE)
+    # its knees bent at the servos' full speed from straight legs throw it over backwards
+    return _humanoid("adult-default", ADULT_GEOMETRY, ADULT_SCALE, rise_s=1.0)
 
 
 _MODELS = {"kid-default": _kid_default, "adult-default": _adult_default}

@@ -19,7 +19,8 @@ from robot.learned import Policy, PolicyMotion
 from robot.learned.policy import KICK_BALL_AHEAD_M
 from robot.motion import AttitudeFilter, GetUpMotion, KickMotion, WalkEngine, kinematics
 from robot.motion.imu import GRAVITY_M_S2
-from robot.motion.keyframes import KeyframeMotion
+from robot.motion.keyframes import Keyframe, KeyframeMotion
+from robot.motion.posture import standing_posture
 from robot.motion.walk import default_walk_params
 from robot.stub.behaviour import Action, Field, GameInfo, Role, decide
 from robot.stub.perception import (
@@ -132,6 +133,7 @@ class StubController:
             )
         self._last_ms: int | None = None
         self._settle_until_ms: int | None = None
+        self._rise_pending = True  # look whether the legs are far from the stance
         self._still_s = 0.0
         self._upright_since_fall = True
         self._tilted_s = 0.0
@@ -151,7 +153,7 @@ class StubController:
 
     @property
     def busy(self) -> str:
-        """ "kick", "get-up" or "" (walking or standing)."""
+        """ "kick", "get-up", "rise" or "" (walking or standing)."""
         return self._motion_kind if self._motion is not None else ""
 
     def reset_pose(
@@ -169,6 +171,7 @@ class StubController:
             self._motion_kind = ""
             self._tilted_s = 0.0
             self.walk.reset()
+        self._rise_pending = True
         self._expect_mirrored = expect_mirrored
         if self._detect_side and check_side:
             self._side_check_s = 0.0
@@ -241,8 +244,10 @@ class StubController:
         a team on the right is placed at the mirror image of its team-file poses."""
         self._side_check_s = None
         self.mirrored = not on_left
-        logger.info("side from the GameController: %s", "right (mirrored pitch)" if self.mirrored
-                    else "left (as in the team file)")
+        logger.info(
+            "side from the GameController: %s",
+            "right (mirrored pitch)" if self.mirrored else "left (as in the team file)",
+        )
         if self.mirrored:
             pose = self.world.pose
             self.world.reset_pose(Pose(x_m=pose.x_m, y_m=-pose.y_m, yaw_rad=-pose.yaw_rad))
@@ -283,6 +288,10 @@ class StubController:
         if self._motion is None and self._moved_by_someone_else(sensors.joints):
             # teleported (half time, penalty) or limp: joints are not where we put them
             self.settle(sensors.time_ms)
+            self._rise_pending = True
+        if self._motion is None and self._rise_pending:
+            self._rise_pending = False
+            self._rise(sensors)
         if self._motion is not None:
             if isinstance(self._motion, PolicyMotion):
                 self._motion.sense(sensors.joints, sensors.accel, sensors.gyro)
@@ -355,6 +364,25 @@ class StubController:
         return self._remember(targets)
 
     # --- parts ---------------------------------------------------------------------------------
+
+    def _rise(self, sensors: Sensors) -> None:
+        """Ease into the stance as a motion (the model's ``rise_s``) when the knees are far
+        from it (placed with straight legs); stand still for the settle time after it."""
+        rise_s = self.kin.rise_s
+        if rise_s <= 0.0:
+            return
+        stance = standing_posture(self.model)
+        knees = [name for name in stance if name.startswith("LegLower")]
+        if not any(
+            name in sensors.joints and abs(sensors.joints[name] - stance[name]) > KNEE_RESET_RAD
+            for name in knees
+        ):
+            return
+        logger.info("legs far from the stance; rising into it over %.1f s", rise_s)
+        rise = KeyframeMotion([Keyframe(duration_s=rise_s, targets=stance)], start=sensors.joints)
+        self._start(rise, "rise")
+        until = sensors.time_ms + int((rise_s + SETTLE_S) * 1000)
+        self._settle_until_ms = max(self._settle_until_ms or 0, until)
 
     def _commit_kick(
         self, time_ms: int, action: Action, ball: tuple[float, float] | None
