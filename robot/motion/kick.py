@@ -6,7 +6,7 @@ Times are in seconds and were tuned in the MuJoCo world on kid-default.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from robot.motion.ik import FootTarget
 from robot.motion.keyframes import Keyframe, KeyframeMotion, body_pose
@@ -29,6 +29,7 @@ class KickParams:
     down_s: float = 0.35
     unshift_s: float = 0.5
     support_roll_rad: float = 0.05  # extra outward roll of the support hip
+    lean_rad: float = 0.0  # more forward lean than the standing posture's, until the unshift
 
 
 class KickMotion(KeyframeMotion):
@@ -48,7 +49,7 @@ class KickMotion(KeyframeMotion):
         self.foot = foot
         kin = kinematics(model)
         walk = default_walk_params(model)
-        k = params or KickParams()
+        k = params or replace(KickParams(), **kin.kick_overrides)
         scale = kin.leg.thigh_m / 0.16
         sign = 1.0 if foot == "right" else -1.0  # torso moves towards +y for a right kick
         z = -walk.hip_height_m
@@ -62,7 +63,11 @@ class KickMotion(KeyframeMotion):
             kicking = FootTarget(x0 + kx * scale, -sign * y0 - shift + ky, z + kz * scale)
             left, right = (support, kicking) if foot == "right" else (kicking, support)
             targets = body_pose(
-                kin, left=left, right=right, torso_pitch_rad=walk.torso_pitch_rad, arms=arms
+                kin,
+                left=left,
+                right=right,
+                torso_pitch_rad=walk.torso_pitch_rad + k.lean_rad,
+                arms=arms,
             )
             support_motor = (kin.left_leg if foot == "right" else kin.right_leg).motors["hip_roll"]
             targets[support_motor] += sign * support_roll

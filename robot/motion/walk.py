@@ -32,6 +32,7 @@ class WalkParams:
     foot_x_offset_m: float = -0.005
     foot_y_offset_m: float = 0.012  # added to the hip offset, per foot
     torso_pitch_rad: float = 0.15  # forward lean
+    walk_lean_rad: float = 0.0  # more forward lean while stepping (at the full gait amplitude)
     max_vx_m_s: float = 0.25
     max_vy_m_s: float = 0.08
     max_vyaw_rad_s: float = 0.8
@@ -135,6 +136,7 @@ class WalkEngine:
         """Motor targets at a gait ``phase`` in [0, 1) with the current velocity and amplitude."""
         p, leg = self.params, self.kin.leg
         vx, vy, vyaw = self._v
+        lean = p.torso_pitch_rad + p.walk_lean_rad * self._gait
         sway = self._gait * p.sway_m * math.sin(2.0 * math.pi * (phase + p.sway_phase_lead))
         canonical: dict[str, dict[str, float]] = {}
         lifts = {
@@ -153,11 +155,11 @@ class WalkEngine:
                 vyaw * half_cycle * travel,
             )
             angles = leg_ik(leg, target)
-            angles["hip_pitch"] -= p.torso_pitch_rad
+            angles["hip_pitch"] -= lean
             angles["hip_roll"] += sign * p.hip_roll_comp_rad * other_lift * self._gait
             if tilt is not None:  # balance feedback while stepping only
                 roll_err = tilt[0] * self._gait
-                pitch_err = (tilt[1] - p.torso_pitch_rad) * self._gait
+                pitch_err = (tilt[1] - lean) * self._gait
                 angles["ankle_pitch"] += p.tilt_pitch_ankle_gain * pitch_err
                 angles["hip_pitch"] += p.tilt_pitch_hip_gain * pitch_err
                 angles["ankle_roll"] += p.tilt_roll_ankle_gain * roll_err

@@ -63,6 +63,9 @@ KICK_HOLD_Y_M = 0.08
 # sighting nearer than this moves the believed position by the gain towards what it implies)
 CENTRE_BALL_MAX_M = 1.5  # farther, the ball's distance is underestimated by up to a third
 CENTRE_BALL_GAIN = 0.2
+# rise into the stance only when standing this upright (placed by the referee), not while
+# tipping over (when the knees lag their targets too)
+RISE_MAX_TILT_RAD = 0.2
 SETTLE_S = 1.0  # stand still this long after start and after getting up
 # after a reset of the pose (half time, end of a penalty) the referee may still be placing the
 # robot: its orientation is taken from gravity afresh for this long, without counting turns
@@ -289,7 +292,7 @@ class StubController:
             # teleported (half time, penalty) or limp: joints are not where we put them
             self.settle(sensors.time_ms)
             self._rise_pending = True
-        if self._motion is None and self._rise_pending:
+        if self._motion is None and self._rise_pending and att.tilt_rad < RISE_MAX_TILT_RAD:
             self._rise_pending = False
             self._rise(sensors)
         if self._motion is not None:
