@@ -59,6 +59,7 @@ KICK_COMMIT_MS = 2500  # keep to a kick decided this long ago while the ball sta
 # ball estimate jumps by several centimetres; re-aligning on it restarts the gait for ever
 KICK_HOLD_X_M = 0.12
 KICK_HOLD_Y_M = 0.08
+KID_THIGH_M = 0.16  # kid-default's; the hold above and the kick spot scale with the thigh
 # READY and SET: the ball lies on the centre spot, a landmark that corrects the odometry (each
 # sighting nearer than this moves the believed position by the gain towards what it implies)
 CENTRE_BALL_MAX_M = 1.5  # farther, the ball's distance is underestimated by up to a third
@@ -124,8 +125,11 @@ class StubController:
         self.field = Field(
             half_length_m=FIELD_HALF_LENGTH_M[field_class],
             foot_y_m=self.kin.leg.hip_offset_y_m + walk.foot_y_offset_m + KICK_BALL_OUTSIDE_M,
-            kick_x_m=0.165 * self.kin.leg.thigh_m / 0.16,
+            kick_x_m=0.165 * self.kin.leg.thigh_m / KID_THIGH_M,
         )
+        # the model's size against kid-default's (1.0 there): the ball estimate of a taller
+        # robot, whose camera sits higher, jumps by more while it sways
+        self._size = self.kin.leg.thigh_m / KID_THIGH_M
         self.kick_policy = kick_policy
         if kick_policy is not None:
             self.field = replace(
@@ -402,7 +406,8 @@ class StubController:
             return action
         bx, by = ball
         side = self.field.foot_y_m if committed[0] == "left" else -self.field.foot_y_m
-        if abs(bx - self.field.kick_x_m) < KICK_HOLD_X_M and abs(by - side) < KICK_HOLD_Y_M:
+        hold_x, hold_y = KICK_HOLD_X_M * self._size, KICK_HOLD_Y_M * self._size
+        if abs(bx - self.field.kick_x_m) < hold_x and abs(by - side) < hold_y:
             return Action(kick_foot=committed[0])
         self._kick_committed = None
         return action
