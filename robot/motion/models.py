@@ -118,6 +118,9 @@ class RobotKinematics:
     # 0: straight into it at the servos' full speed
     rise_s: float = 0.0
     kick_overrides: dict[str, float] = field(default_factory=dict)  # KickParams fields
+    # how far each ball sighting moves the believed ball (1: all the way); a tall robot's torso
+    # sways by more while stepping, and the ball in its images with it
+    ball_gain: float = 1.0
 
     @property
     def motor_names(self) -> tuple[str, ...]:
@@ -193,6 +196,7 @@ def _humanoid(
     rise_s: float = 0.0,
     walk_overrides: dict[str, float] | None = None,
     kick_overrides: dict[str, float] | None = None,
+    ball_gain: float = 1.0,
 ) -> RobotKinematics:
     g = geometry
     return RobotKinematics(
@@ -222,6 +226,7 @@ def _humanoid(
         walk_overrides={**_scaled_walk(scale), **(walk_overrides or {})},
         rise_s=rise_s,
         kick_overrides=dict(kick_overrides or {}),
+        ball_gain=ball_gain,
     )
 
 
@@ -268,6 +273,7 @@ def _adult_default() -> RobotKinematics:
         rise_s=1.0,
         walk_overrides=_ADULT_WALK,
         kick_overrides=_ADULT_KICK,
+        ball_gain=0.3,
     )
 
 

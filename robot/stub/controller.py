@@ -115,7 +115,7 @@ class StubController:
         self.model = model
         self.kin = kinematics(model)
         self.walk = WalkEngine(model=model)
-        self.world = WorldModel(start_pose)
+        self.world = WorldModel(start_pose, ball_gain=self.kin.ball_gain)
         self.attitude = AttitudeFilter()
         self._heading = HeadingTracker()
         self.stats = Stats()

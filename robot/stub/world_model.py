@@ -14,11 +14,18 @@ from dataclasses import replace
 from contracts import Pose
 
 Vec3 = tuple[float, float, float]
+# a sighting is averaged with the ball believed so far only if that was seen this recently and
+# lies this near (a ball that was kicked or rolled away is taken as seen)
+BALL_TRACK_MS = 500
+BALL_TRACK_M = 0.3
 
 
 class WorldModel:
-    def __init__(self, start: Pose) -> None:
+    def __init__(self, start: Pose, *, ball_gain: float = 1.0) -> None:
+        """``ball_gain``: how far each sighting moves the believed ball from where it was (1:
+        all the way; less averages out a robot's sway, which moves the ball in its images)."""
         self.pose = start
+        self.ball_gain = ball_gain
         self.ball_field: tuple[float, float] | None = None
         self.ball_seen_ms: int | None = None
 
@@ -57,7 +64,21 @@ class WorldModel:
         self.ball_seen_ms = None
 
     def see_ball(self, time_ms: int, x_rel_m: float, y_rel_m: float) -> None:
-        self.ball_field = self.pose.to_field(x_rel_m, y_rel_m)
+        seen = self.pose.to_field(x_rel_m, y_rel_m)
+        before, before_ms = self.ball_field, self.ball_seen_ms
+        if (
+            self.ball_gain < 1.0
+            and before is not None
+            and before_ms is not None
+            and time_ms - before_ms <= BALL_TRACK_MS
+            and math.dist(seen, before) < BALL_TRACK_M
+        ):
+            gain = self.ball_gain
+            seen = (
+                before[0] + gain * (seen[0] - before[0]),
+                before[1] + gain * (seen[1] - before[1]),
+            )
+        self.ball_field = seen
         self.ball_seen_ms = time_ms
 
     def relocate_from_centre_ball(self, x_rel_m: float, y_rel_m: float, *, gain: float) -> None:

@@ -5,10 +5,14 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
+import pytest
+
 from contracts.gamecontroller import GameState
 from contracts.geometry import Pose
 from robot.motion import KickMotion, WalkEngine, standing_posture
 from robot.stub import GameInfo, Role, StubController
+from robot.stub.world_model import WorldModel
+from simulator.world import CameraRenderer
 
 from .motion_world import OneRobot
 
@@ -75,3 +79,44 @@ def test_kicks_without_falling() -> None:
     kick = KickMotion(foot="right", model=ADULT, start=standing_posture(ADULT))
     assert robot.run(kick.duration_s + 1.5, lambda: kick.step(0.008)), "fell kicking"
     assert robot.ball_position[0] > -2.0 + 0.36 + 1.0
+
+
+def test_striker_walks_to_the_ball_and_kicks_it() -> None:
+    """Placed with straight legs 2 m behind the ball, turned away from it, the adult striker
+    rises, walks to the ball by its head camera and kicks it towards the opponent goal (first
+    kick after 13.3 s here; on six more starts between 11.6 and 15.7 s, never falling)."""
+    start = Pose(x_m=-3.0, y_m=0.5, yaw_rad=0.3)
+    robot = OneRobot(x_m=start.x_m, y_m=start.y_m, yaw_rad=start.yaw_rad, model=ADULT)
+    robot.place_ball(-1.0, 0.0)
+    controller = StubController(
+        role=Role.STRIKER, start_pose=start, model=ADULT, field_class="adult"
+    )
+    game = GameInfo(phase=GameState.PLAYING)
+    with CameraRenderer(robot.world, 320, 240) as camera:
+        for _ in range(int(20.0 / 0.008)):
+            robot.command(controller.tick(robot.sensors(camera), game))
+            robot.world.step()
+            if controller.stats.kicks and not controller.busy:
+                break
+    assert controller.stats.falls == 0
+    assert controller.stats.kicks >= 1
+    assert robot.up > 0.9
+    assert robot.ball_position[0] > -1.0 + 1.0  # kicked at least 1 m towards the goal
+
+
+def test_ball_sightings_are_averaged_with_a_gain_below_one() -> None:
+    """The adult averages its ball sightings (its sway moves the ball in its images by several
+    centimetres); a ball seen far from where it was, or after a while, is taken as seen."""
+    exact = WorldModel(Pose(x_m=0.0, y_m=0.0, yaw_rad=0.0))
+    exact.see_ball(0, 1.0, 0.0)
+    exact.see_ball(96, 1.0, 0.1)
+    assert exact.ball_field == (1.0, 0.1)
+    averaged = WorldModel(Pose(x_m=0.0, y_m=0.0, yaw_rad=0.0), ball_gain=0.3)
+    averaged.see_ball(0, 1.0, 0.0)
+    averaged.see_ball(96, 1.0, 0.1)
+    assert averaged.ball_field is not None
+    assert averaged.ball_field[1] == pytest.approx(0.03)
+    averaged.see_ball(192, 2.0, 0.0)  # kicked away
+    assert averaged.ball_field == (2.0, 0.0)
+    averaged.see_ball(2000, 2.0, 0.2)  # not seen for 1.8 s
+    assert averaged.ball_field == (2.0, 0.2)
