@@ -9,12 +9,13 @@ import pytest
 
 from contracts.gamecontroller import GameState
 from contracts.geometry import Pose
+from referee.snapshot import TeleportRobot
 from robot.motion import KickMotion, WalkEngine, standing_posture
 from robot.stub import GameInfo, Role, StubController
 from robot.stub.world_model import WorldModel
 from simulator.world import CameraRenderer
 
-from .motion_world import OneRobot
+from .motion_world import RED1, OneRobot
 
 ADULT = "adult-default"
 
@@ -27,7 +28,8 @@ def walker(
 
 def test_rises_from_straight_legs_without_falling() -> None:
     """Placed with all joints at zero, it eases into the stance instead of bending its knees at
-    the servos' full speed (which throws it over backwards)."""
+    the servos' full speed (which throws it over backwards after about 1.5 s), at the start and
+    after every teleport."""
     robot = OneRobot(x_m=-2.0, model=ADULT)
     controller = StubController(
         role=Role.STRIKER,
@@ -47,6 +49,12 @@ def test_rises_from_straight_legs_without_falling() -> None:
     assert "rise" in busy
     assert controller.stats.falls == 0
     assert robot.up > 0.9
+    # the referee moves it (kick-off, penalty): joints back to zero, it rises again
+    robot.world.apply(TeleportRobot(robot=RED1, pose=Pose(x_m=-3.0, y_m=1.0, yaw_rad=1.0)))
+    busy.clear()
+    assert robot.run(4.0, tick), "fell after being moved"
+    assert "rise" in busy
+    assert controller.stats.falls == 0
 
 
 def test_walks_forward_for_10_s_without_falling() -> None:
