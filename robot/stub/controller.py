@@ -260,11 +260,15 @@ class StubController:
             self.world.reset_pose(Pose(x_m=pose.x_m, y_m=-pose.y_m, yaw_rad=-pose.yaw_rad))
 
     def _moved_by_someone_else(self, joints: dict[str, float]) -> bool:
+        return self._knees_away(joints, self._last_targets)
+
+    def _knees_away(self, joints: dict[str, float], targets: dict[str, float]) -> bool:
+        """Whether a knee is more than :data:`KNEE_RESET_RAD` from its angle in ``targets``."""
         knees = [name for name in self.kin.motor_names if name.startswith("LegLower")]
         return any(
             name in joints
-            and name in self._last_targets
-            and abs(joints[name] - self._last_targets[name]) > KNEE_RESET_RAD
+            and name in targets
+            and abs(joints[name] - targets[name]) > KNEE_RESET_RAD
             for name in knees
         )
 
@@ -379,11 +383,7 @@ class StubController:
         if rise_s <= 0.0:
             return
         stance = standing_posture(self.model)
-        knees = [name for name in stance if name.startswith("LegLower")]
-        if not any(
-            name in sensors.joints and abs(sensors.joints[name] - stance[name]) > KNEE_RESET_RAD
-            for name in knees
-        ):
+        if not self._knees_away(sensors.joints, stance):
             return
         logger.info("legs far from the stance; rising into it over %.1f s", rise_s)
         rise = KeyframeMotion([Keyframe(duration_s=rise_s, targets=stance)], start=sensors.joints)
