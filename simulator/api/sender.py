@@ -1,7 +1,7 @@
-"""A thread that does the clients' socket I/O in async stepping.
+"""A thread that does the clients' socket I/O in async and pipelined stepping.
 
 A kernel ``send`` and ``recv`` per client per step are most of the robot API's cost on the
-step thread. In async mode the step thread only appends each framed measurement to its
+step thread. With this thread the step thread only appends each framed measurement to its
 connection's bounded queue (:meth:`simulator.api.connection.Connection.send`), wakes this thread
 and takes the requests this thread has decoded (:meth:`Connection.take_requests`); the writes
 and reads happen while the step thread is back in the physics (MuJoCo releases the GIL while it
@@ -10,12 +10,18 @@ dropped and counted as before). A socket error, end of stream or bad frame is le
 connection (``error``) for the step thread to drop it, logged once there.
 
 Waking this thread costs the step thread a write to a pipe that another CPU sleeps on: about
-18 us on our virtual machines (the idle CPU halts, and the wake-up is an interrupt between
-processors that exits to the host), 2% of an eight-robot step. When the steps come faster than
-``POLL_BELOW_S`` apart (a world running faster than real time) and ``poll`` is on, the thread
-instead sleeps half the last interval between steps and looks at the queues by itself: the step
-thread writes nothing, and a measurement leaves at most half a step's wall time later (about
-0.5 ms at eight times real time). Slower steps (a match paced to real time) wake it as before.
+14 us of CPU on our virtual machines (the idle CPU halts, and the wake-up is an interrupt
+between processors that exits to the host), 2% of an eight-robot step. When the steps come
+faster than ``POLL_BELOW_S`` apart (a world running faster than real time) and ``poll`` is on,
+the thread instead learns the period of the steps from when their frames were queued and sleeps
+until ``POLL_LATE_S`` after the next step's frames are due: the step thread writes nothing, and
+a measurement leaves about that much later (then every ``POLL_MIN_S`` while a step is late).
+Slower steps (a match paced to real time) wake it as before.
+
+Its selector is ``select(2)``, whose timeout has microsecond resolution: ``epoll_wait`` counts
+whole milliseconds, which would hold each polled measurement back a millisecond, longer than
+an eight-robot step. (A descriptor number over ``select``'s limit switches it to the default
+selector.)
 """
 
 from __future__ import annotations
@@ -37,6 +43,9 @@ log = logging.getLogger(__name__)
 IDLE_WAIT_S = 0.05  # the longest the thread sleeps without being woken
 POLL_BELOW_S = 0.002  # steps closer than this: the thread polls (when ``poll`` is on)
 POLL_MIN_S = 0.0001  # shortest sleep between polls
+POLL_LATE_S = 0.00003  # polled this long after a step's frames are due (the step's jitter)
+PERIOD_SAMPLES = 6  # the period of the steps: the median of the last intervals between them
+SELECT_FD_LIMIT = 1024  # FD_SETSIZE: select(2) takes descriptor numbers below it
 READ = selectors.EVENT_READ
 WRITE = selectors.EVENT_WRITE
 
@@ -52,9 +61,9 @@ class SendThread:
         poll: bool = False,
     ) -> None:
         """``on_news``: called (on this thread) after a read that brought requests or found a
-        failure, so that a step thread waiting for answers (lockstep) wakes up. ``poll``: look
-        at the queues every half step instead of being woken when steps come fast (async
-        stepping, where nobody waits for the answers)."""
+        failure, so that a step thread waiting for answers (pipelined lockstep) wakes up.
+        ``poll``: when steps come fast, look at the queues right after each step's frames are
+        due instead of being woken."""
         self._on_news = on_news
         self._ready: deque[Connection] = deque()
         self._changes: deque[tuple[bool, Connection]] = deque()  # (add?, connection)
@@ -113,11 +122,14 @@ class SendThread:
                 log.warning("robot API I/O thread: cannot run on CPUs %s: %s",
                             sorted(self._cpus), exc)  # fmt: skip
         masks: dict[Connection, int] = {}
-        with selectors.DefaultSelector() as selector:
-            selector.register(self._wake_r, READ, None)
+        selector: selectors.BaseSelector = selectors.SelectSelector()
+        selector.register(self._wake_r, READ, None)
+        try:
             on_news = self._on_news
             poll = self._poll
             last_frames = interval = 0.0  # when frames were last found queued, and the step
+            queued: deque[float] = deque(maxlen=PERIOD_SAMPLES)  # when the step thread queued
+            period = 0.0
             while not self._stop:
                 news = False
                 if poll:  # decided before the queues are looked at, as ``_sleeping``
@@ -127,8 +139,8 @@ class SendThread:
                 busy = bool(self._ready or self._changes)
                 if busy:
                     timeout = 0.0
-                elif self._polling:
-                    timeout = max(POLL_MIN_S, interval / 2)
+                elif self._polling:  # just after the step thread queues the next frames
+                    timeout = max(POLL_MIN_S, queued[-1] + period + POLL_LATE_S - now)
                 else:
                     timeout = IDLE_WAIT_S
                 ready = selector.select(timeout)
@@ -136,6 +148,7 @@ class SendThread:
                 if poll and self._ready:
                     now = time.monotonic()
                     interval, last_frames = now - last_frames, now
+                    period = self._learn_period(queued)
                 for key, events in ready:
                     conn = key.data
                     if conn is None:  # drain, then clear: a wake-up after this is not lost
@@ -151,17 +164,36 @@ class SendThread:
                         self._ready.append(conn)
                 if news and on_news is not None:
                     on_news()
-                self._apply_changes(selector, masks)
+                selector = self._apply_changes(selector, masks)
                 self._write_ready(selector, masks)
+        finally:
+            selector.close()
+
+    def _learn_period(self, queued: deque[float]) -> float:
+        """Note when the step thread queued the frames just found (the newest connection's
+        ``enqueued_at``); the median interval between the latest such times, the period of the
+        steps."""
+        at = self._ready[-1].enqueued_at
+        if not queued or at > queued[-1]:
+            queued.append(at)
+        if len(queued) < 2:
+            return 0.0
+        times = list(queued)
+        gaps = sorted(b - a for a, b in zip(times, times[1:], strict=False))
+        return gaps[len(gaps) // 2]
 
     def _apply_changes(
         self, selector: selectors.BaseSelector, masks: dict[Connection, int]
-    ) -> None:
+    ) -> selectors.BaseSelector:
+        """Register and unregister the connections added and removed; the selector to use
+        from now on."""
         while self._changes:
             add, conn = self._changes.popleft()
             if add:
                 if conn.closed:
                     continue
+                if conn.fd >= SELECT_FD_LIMIT and isinstance(selector, selectors.SelectSelector):
+                    selector = self._without_select(selector, masks)
                 try:
                     selector.register(conn.fd, READ, conn)
                     masks[conn] = READ
@@ -173,6 +205,20 @@ class SendThread:
                     selector.unregister(conn.fd)
                 except (KeyError, ValueError, OSError):
                     pass  # closed already: the kernel forgot it
+        return selector
+
+    def _without_select(
+        self, selector: selectors.BaseSelector, masks: dict[Connection, int]
+    ) -> selectors.BaseSelector:
+        """The default selector watching what ``selector`` watched (which is closed)."""
+        log.info("robot API I/O thread: a descriptor above %d, polled in whole milliseconds",
+                 SELECT_FD_LIMIT - 1)  # fmt: skip
+        replacement = selectors.DefaultSelector()
+        replacement.register(self._wake_r, READ, None)
+        for conn, mask in masks.items():
+            replacement.register(conn.fd, mask, conn)
+        selector.close()
+        return replacement
 
     def _write_ready(
         self, selector: selectors.BaseSelector, masks: dict[Connection, int]

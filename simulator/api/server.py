@@ -171,7 +171,7 @@ class ApiServer:
                     os.set_blocking(fd, False)
                 self._selector.register(self._wake[0], selectors.EVENT_READ, "wake")
             self._sender = SendThread(
-                cpus=self._send_cpus, on_news=self._news, poll=self._lockstep is None
+                cpus=self._send_cpus, on_news=self._news, poll=True
             )
         host = self._network.api_bind_host
         for slot in self.slots.values():

@@ -1,6 +1,9 @@
-"""The I/O thread of async stepping: frames queued by the step thread all reach the client, in
-order; when steps come fast the thread polls and the step thread stops waking it (no write to
-the wake pipe), when they come slowly (a match paced to real time) every step wakes it."""
+"""The I/O thread of async and pipelined stepping: frames queued by the step thread all reach
+the client, in order; when steps come fast the thread polls and the step thread stops waking it
+(no write to the wake pipe), and a polled frame leaves before the next step's (the poll follows
+the steps' period with sub-millisecond timeouts); when steps come slowly (a match paced to real
+time) every step wakes it. A socket whose descriptor number ``select`` cannot watch is served
+too."""
 
 from __future__ import annotations
 
@@ -32,9 +35,10 @@ def pair() -> Iterator[tuple[Connection, socket.socket]]:
 
 def _run(
     conn: Connection, client: socket.socket, *, poll: bool, steps: int, gap_s: float,
-    monkeypatch: pytest.MonkeyPatch,
+    monkeypatch: pytest.MonkeyPatch, arrived: list[bool] | None = None,
 ) -> int:  # fmt: skip
-    """Queue one frame per step, ``gap_s`` apart; the number of wake-up writes."""
+    """Queue one frame per step, ``gap_s`` apart; the number of wake-up writes. ``arrived``:
+    per step, whether its frame had reached the client when the next one was queued."""
     wakes = [0]
     real_write = os.write
     thread = SendThread(poll=poll)
@@ -47,13 +51,23 @@ def _run(
     monkeypatch.setattr(sender_module.os, "write", write)
     thread.add(conn)
     frames = [len(str(k)).to_bytes(4, "big") + str(k).encode() for k in range(steps)]
+    received = b""
+    sent = 0
     try:
         for frame in frames:
+            if arrived is not None:  # what reached the client of the frames queued so far
+                client.setblocking(False)
+                try:
+                    received += client.recv(65536)
+                except BlockingIOError:
+                    pass
+                if sent:
+                    arrived.append(len(received) == sent)
             conn.send_threaded(frame, time.monotonic())
+            sent += len(frame)
             thread.wake([conn])
             time.sleep(gap_s)  # a step of physics (which releases the GIL, as sleeping does)
         expected = b"".join(frames)
-        received = b""
         client.settimeout(5.0)
         while len(received) < len(expected):
             received += client.recv(65536)
@@ -89,3 +103,38 @@ def test_without_poll_fast_steps_wake_the_thread(
     conn, client = pair
     wakes = _run(conn, client, poll=False, steps=100, gap_s=0.001, monkeypatch=monkeypatch)
     assert wakes >= 50, wakes  # the thread sleeps between steps: woken (most) every step
+
+
+def test_polled_frames_leave_within_the_step(
+    pair: tuple[Connection, socket.socket], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Steps 0.5 ms apart (a world 16 times faster than real time): the thread polls just
+    after each step's frames are due, so a frame has reached the client before the next one is
+    queued (all 299 on our machine). Polled with millisecond timeouts, as ``epoll`` counts
+    them, about half left a step late."""
+    conn, client = pair
+    arrived: list[bool] = []
+    wakes = _run(conn, client, poll=True, steps=300, gap_s=0.0005, monkeypatch=monkeypatch,
+                 arrived=arrived)  # fmt: skip
+    assert wakes < 150, wakes  # polled, not woken
+    assert sum(arrived) >= 0.85 * len(arrived), f"{sum(arrived)} of {len(arrived)} in time"
+
+
+def test_a_descriptor_beyond_select_is_served(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A connection whose socket's descriptor number is above what ``select(2)`` takes (a
+    process with many files open): the thread moves to the default selector and serves it."""
+    ours, theirs = socket.socketpair()
+    high = os.dup2(ours.fileno(), sender_module.SELECT_FD_LIMIT + 10)
+    ours.close()
+    sock = socket.socket(fileno=high)
+    sock.setblocking(False)
+    conn = Connection(
+        sock=sock, peer="test", key="red 1", stats=RobotStats(), queue_limit=1000,
+        time_bank_s=1.0, threaded=True,
+    )  # fmt: skip
+    try:
+        _run(conn, theirs, poll=True, steps=50, gap_s=0.0005, monkeypatch=monkeypatch)
+        assert conn.error is None
+    finally:
+        sock.close()
+        theirs.close()
