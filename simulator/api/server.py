@@ -571,29 +571,7 @@ class ApiServer:
     def _send(
         self, slot: RobotSlot, conn: Connection, measurement: Measurement, now: float
     ) -> None:
-        real_time = measurement.real_time
-        quota = slot.quota
-        frame = measurement.frame
-        if frame is not None:  # built whole by the step's batch
-            size = len(frame) - HEADER.size
-        else:
-            head, sensors = measurement.head(), measurement.sensors
-            size = len(head) + len(sensors)
-        if quota.admit(size, real_time):
-            if frame is None:
-                frame = b"".join((HEADER.pack(size), head, sensors))
-            warnings = measurement.message_count
-        else:
-            slot.stats.quota_errors += 1
-            header = pb.SensorMeasurements(time=measurement.time, real_time=real_time)
-            header.messages.add(message_type=ERROR, text=quota.error_text)
-            payload = header.SerializeToString()
-            size = len(payload)
-            frame = HEADER.pack(size) + payload
-            warnings = 1
-            quota.record(size, real_time)
-        if warnings:
-            slot.stats.warnings_sent += warnings
+        frame = self._framed(slot, measurement)
         if conn.threaded:  # queued for the I/O thread (woken once per step by _flush_all)
             conn.send_threaded(frame, now)
             self._woken.append(conn)
@@ -602,6 +580,35 @@ class ApiServer:
             conn.send(frame, now)
         except ClientClosed as exc:
             self._drop(slot, exc.reason)
+
+    def _framed(self, slot: RobotSlot, measurement: Measurement) -> bytes:
+        """The measurement's framed message, counted in the robot's quota, or the quota's
+        ERROR message in its place."""
+        frame = measurement.frame
+        if frame is not None:  # built whole by the step's batch: no header, no message
+            if slot.quota.admit(len(frame) - HEADER.size, measurement.real_time):
+                return frame
+            return self._quota_error(slot, measurement)
+        head, sensors = measurement.head(), measurement.sensors
+        size = len(head) + len(sensors)
+        if not slot.quota.admit(size, measurement.real_time):
+            return self._quota_error(slot, measurement)
+        warnings = measurement.message_count
+        if warnings:
+            slot.stats.warnings_sent += warnings
+        return b"".join((HEADER.pack(size), head, sensors))
+
+    def _quota_error(self, slot: RobotSlot, measurement: Measurement) -> bytes:
+        """The framed ERROR message that replaces a measurement over the robot's quota."""
+        real_time = measurement.real_time
+        quota = slot.quota
+        slot.stats.quota_errors += 1
+        header = pb.SensorMeasurements(time=measurement.time, real_time=real_time)
+        header.messages.add(message_type=ERROR, text=quota.error_text)
+        payload = header.SerializeToString()
+        quota.record(len(payload), real_time)
+        slot.stats.warnings_sent += 1
+        return HEADER.pack(len(payload)) + payload
 
     def _flush_all(self) -> None:
         if self._sender is not None:
