@@ -605,7 +605,7 @@ class ApiServer:
         slot.stats.quota_errors += 1
         header = pb.SensorMeasurements(time=measurement.time, real_time=real_time)
         header.messages.add(message_type=ERROR, text=quota.error_text)
-        payload = header.SerializeToString()
+        payload: bytes = header.SerializeToString()
         quota.record(len(payload), real_time)
         slot.stats.warnings_sent += 1
         return HEADER.pack(len(payload)) + payload
