@@ -129,10 +129,14 @@ def team_file(name: str, image: str, players: int, *, command: str | None = None
     roles = ROLES[players]
     if goalie_first and roles[0] != "goalie":
         roles = ("goalie", *roles[1:])
+    # the stub drives the model it is told (gait, kick and get-up are per model), on the
+    # scrimmage's kid-size field whatever the model's size class
+    driven = f" --model {model} --field-class kid" if model and not is_model_path(model) else ""
     for n, slot in enumerate(roles, start=1):
         x, y, yaw = POSES_KID[slot]
         role = slot.split("-")[0]
         extra = " --home {} {}".format(*DEFENDER_HOMES[slot]) if slot in DEFENDER_HOMES else ""
+        extra += driven
         entries[str(n)] = {
             # The stub cannot see where it was placed: its dockerCmd tells it (team-file frame).
             "dockerCmd": command or f"{role} --start-pose {x} {y} {yaw}{extra}",

@@ -45,7 +45,15 @@ class StubOptions:
     gc_return_port: int = 3939
     mirror_port: int = 3737
     model: str = "kid-default"
+    field_class: str | None = None  # "kid" | "adult"; None: the model's size class
     kick_policy: Path | None = None  # a learned kick (robot.learned policy file)
+
+    @property
+    def field(self) -> str:
+        """The field the robot plays on: as given, else the one of its model's size class."""
+        if self.field_class is not None:
+            return self.field_class
+        return "adult" if self.model.startswith("adult") else "kid"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -74,6 +82,7 @@ def parse_args(argv: list[str]) -> StubOptions:
     parser.add_argument("--gc-return-port", type=int, default=3939)
     parser.add_argument("--mirror-port", type=int, default=3737)
     parser.add_argument("--model", default="kid-default")
+    parser.add_argument("--field-class", choices=("kid", "adult"), default=None)
     parser.add_argument("--kick-policy", default=os.environ.get(KICK_POLICY_ENV) or None)
     try:
         ns, unknown = parser.parse_known_args(argv)
@@ -111,6 +120,7 @@ def parse_args(argv: list[str]) -> StubOptions:
         gc_return_port=ns.gc_return_port,
         mirror_port=ns.mirror_port,
         model=ns.model,
+        field_class=ns.field_class,
         kick_policy=Path(ns.kick_policy) if ns.kick_policy else None,
     )
 

@@ -66,7 +66,7 @@ class StubRobot:
             role=role,
             start_pose=self.start_pose,
             model=options.model,
-            field_class="adult" if options.model.startswith("adult") else "kid",
+            field_class=options.field,
             detect_side=role is not Role.IDLE,
             home=options.home,
             kick_policy=_kick_policy(options),

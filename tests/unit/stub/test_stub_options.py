@@ -128,3 +128,14 @@ def test_behaviour_by_game_state() -> None:
         searching_s=0.0,
     )
     assert close.kick_foot == "right"
+
+
+def test_model_and_field_class_from_argv() -> None:
+    """The field defaults to the model's size class; ``--field-class`` puts an adult robot on
+    the kid-size field (the scrimmage's), and an unknown class is refused."""
+    assert parse_args(["striker"]).field == "kid"
+    assert parse_args(["striker", "--model", "adult-default"]).field == "adult"
+    options = parse_args(["striker", "--model", "adult-default", "--field-class", "kid"])
+    assert (options.model, options.field) == ("adult-default", "kid")
+    with pytest.raises(StubConfigError):
+        parse_args(["striker", "--field-class", "huge"])
