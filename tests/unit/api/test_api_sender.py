@@ -8,6 +8,7 @@ too."""
 from __future__ import annotations
 
 import os
+import resource
 import socket
 import time
 from collections.abc import Iterator
@@ -123,18 +124,27 @@ def test_polled_frames_leave_within_the_step(
 def test_a_descriptor_beyond_select_is_served(monkeypatch: pytest.MonkeyPatch) -> None:
     """A connection whose socket's descriptor number is above what ``select(2)`` takes (a
     process with many files open): the thread moves to the default selector and serves it."""
+    high_fd = sender_module.SELECT_FD_LIMIT + 10
+    soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+    if soft <= high_fd:  # a descriptor that high needs the limit above it
+        if hard != resource.RLIM_INFINITY and hard <= high_fd:
+            pytest.skip(f"the hard limit of open files ({hard}) is below {high_fd + 1}")
+        resource.setrlimit(resource.RLIMIT_NOFILE, (high_fd + 1, hard))
     ours, theirs = socket.socketpair()
-    high = os.dup2(ours.fileno(), sender_module.SELECT_FD_LIMIT + 10)
-    ours.close()
-    sock = socket.socket(fileno=high)
-    sock.setblocking(False)
-    conn = Connection(
-        sock=sock, peer="test", key="red 1", stats=RobotStats(), queue_limit=1000,
-        time_bank_s=1.0, threaded=True,
-    )  # fmt: skip
     try:
-        _run(conn, theirs, poll=True, steps=50, gap_s=0.0005, monkeypatch=monkeypatch)
-        assert conn.error is None
+        high = os.dup2(ours.fileno(), high_fd)
+        ours.close()
+        sock = socket.socket(fileno=high)
+        sock.setblocking(False)
+        conn = Connection(
+            sock=sock, peer="test", key="red 1", stats=RobotStats(), queue_limit=1000,
+            time_bank_s=1.0, threaded=True,
+        )  # fmt: skip
+        try:
+            _run(conn, theirs, poll=True, steps=50, gap_s=0.0005, monkeypatch=monkeypatch)
+            assert conn.error is None
+        finally:
+            sock.close()
     finally:
-        sock.close()
         theirs.close()
+        resource.setrlimit(resource.RLIMIT_NOFILE, (soft, hard))
