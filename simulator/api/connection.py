@@ -232,15 +232,9 @@ class Connection:
     def send_threaded(self, frame: bytes, now: float) -> None:
         """:meth:`send` of a threaded connection: queue the frame for the I/O thread (never
         raises: a failure is left in ``error``)."""
-        outbox = self.outbox
-        if len(outbox) >= self.queue_limit:
+        if len(self.outbox) >= self.queue_limit:
             self.write_queued()  # the I/O thread is behind: the socket may still take them
-            self.enqueue(frame, now)
-            return
-        outbox.append(frame)  # :meth:`enqueue` with room in the queue (every step)
-        self.answered = False
-        self.last_sent_at = now
-        self.enqueued_at = now
+        self.enqueue(frame, now)
 
     def write_queued(self) -> bool:
         """:meth:`flush` for the I/O thread (and for the step thread when the I/O thread is

@@ -43,19 +43,11 @@ class NetworkQuota:
         return size + self._total <= self._limit
 
     def admit(self, size: int, now_ms: int) -> bool:
-        """:meth:`allows`, and :meth:`record` the message when it does (one call per message,
-        the usual path written out: it runs for every robot every step)."""
-        total = self._total + size
-        if total > self._limit:  # counting expired entries: expire them and look again
-            self._expire(now_ms)
-            total = self._total + size
-            if total > self._limit:
-                return False
-        history = self._history
-        history.append((now_ms, size))
-        self._total = total
-        if len(history) > 1024:  # keep the history short when nothing needed expiring
-            self._expire(now_ms)
+        """:meth:`allows`, and :meth:`record` the message when it does (one call per message
+        on the usual path)."""
+        if not self.allows(size, now_ms):
+            return False
+        self.record(size, now_ms)
         return True
 
     def record(self, size: int, now_ms: int) -> None:
