@@ -143,7 +143,12 @@ class SendThread:
                     timeout = max(POLL_MIN_S, queued[-1] + period + POLL_LATE_S - now)
                 else:
                     timeout = IDLE_WAIT_S
-                ready = selector.select(timeout)
+                try:
+                    ready = selector.select(timeout)
+                except OSError:  # a socket closed before its removal reached this thread
+                    self._sleeping = False
+                    selector = self._forget_closed(selector, masks)
+                    continue
                 self._sleeping = False
                 if poll and self._ready:
                     now = time.monotonic()
@@ -205,6 +210,21 @@ class SendThread:
                     selector.unregister(conn.fd)
                 except (KeyError, ValueError, OSError):
                     pass  # closed already: the kernel forgot it
+        return selector
+
+    def _forget_closed(
+        self, selector: selectors.BaseSelector, masks: dict[Connection, int]
+    ) -> selectors.BaseSelector:
+        """Unregister the connections the step thread has closed. ``select(2)`` fails on a
+        closed descriptor (``epoll`` forgets it by itself), and the step thread closes a
+        dropped connection right after asking this thread to forget it."""
+        selector = self._apply_changes(selector, masks)
+        for conn in [conn for conn in masks if conn.closed]:
+            del masks[conn]
+            try:
+                selector.unregister(conn.fd)
+            except (KeyError, ValueError, OSError):
+                pass
         return selector
 
     def _without_select(

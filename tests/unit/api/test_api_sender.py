@@ -148,3 +148,41 @@ def test_a_descriptor_beyond_select_is_served(monkeypatch: pytest.MonkeyPatch) -
     finally:
         theirs.close()
         resource.setrlimit(resource.RLIMIT_NOFILE, (soft, hard))
+
+
+def test_a_connection_closed_before_its_removal_arrives_does_not_stop_the_thread() -> None:
+    """The step thread drops a client by asking the thread to forget it and closing the socket
+    at once; ``select(2)`` fails on the closed descriptor if the thread is already waiting on
+    it. The thread forgets it and goes on serving the other clients (it used to die, and every
+    robot's measurements stopped)."""
+    thread = SendThread(poll=False)
+    pairs = [socket.socketpair() for _ in range(2)]
+    conns = []
+    for ours, _ in pairs:
+        ours.setblocking(False)
+        conns.append(Connection(
+            sock=ours, peer="test", key="red 1", stats=RobotStats(), queue_limit=1000,
+            time_bank_s=1.0, threaded=True,
+        ))  # fmt: skip
+    try:
+        for conn in conns:
+            thread.add(conn)
+        time.sleep(0.1)  # both registered; the thread waits in select on them
+        # closed before the thread takes its removal (when the thread was busy as the step
+        # thread asked): its next select sees a closed descriptor
+        conns[0].close()
+        time.sleep(2 * sender_module.IDLE_WAIT_S)
+        thread.remove(conns[0])
+        time.sleep(0.1)
+        assert thread._thread.is_alive()
+        frame = b"\0\0\0\x05hello"
+        conns[1].send_threaded(frame, time.monotonic())
+        thread.wake([conns[1]])
+        client = pairs[1][1]
+        client.settimeout(5.0)
+        assert client.recv(64) == frame
+    finally:
+        thread.close()
+        for ours, theirs in pairs:
+            ours.close()
+            theirs.close()
