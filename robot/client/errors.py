@@ -33,9 +33,15 @@ class ProtocolViolation(RobotClientError):
 
 
 class ConnectionClosed(RobotClientError):
-    def __init__(self, *, address: str) -> None:
+    """The connection is gone: closed by the simulator, reset, or closed here (``reason``)."""
+
+    def __init__(self, *, address: str, reason: str | None = None) -> None:
         self.address = address
-        super().__init__(f"{address} closed the connection")
+        self.reason = reason
+        if reason is None:
+            super().__init__(f"{address} closed the connection")
+        else:
+            super().__init__(f"connection to {address} lost: {reason}")
 
 
 class ReceiveTimeout(RobotClientError, TimeoutError):

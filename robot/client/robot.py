@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import math
 import os
+import select
 import socket
 import struct
+import threading
 import time
 from collections.abc import Iterator, Mapping
 from types import TracebackType
@@ -24,6 +27,7 @@ from robot.client.errors import (
 _HEADER = struct.Struct(">I")
 MAX_MESSAGE_BYTES = 1920 * 1080 * 3 + 1000
 ENV_ADDRESS = "ROBOCUP_SIMULATOR_ADDR"
+_FD_SETSIZE = 1024
 
 
 class RobotClient:
@@ -46,6 +50,9 @@ class RobotClient:
         self.retry_interval_s = retry_interval_s
         self._sock: socket.socket | None = None
         self._buffer = bytearray()
+        # one frame at a time: ``sendall`` may take several writes and lets other threads run
+        # between them, so two threads sending at once would interleave their bytes
+        self._send_lock = threading.Lock()
 
     @property
     def address(self) -> str:
@@ -115,7 +122,7 @@ class RobotClient:
 
     def _socket(self) -> socket.socket:
         if self._sock is None:
-            raise ConnectionClosed(address=self.address)
+            raise ConnectionClosed(address=self.address, reason="closed by this client")
         return self._sock
 
     # --- sending ----------------------------------------------------------------------------
@@ -123,10 +130,11 @@ class RobotClient:
     def send(self, request: pb.ActuatorRequests) -> None:
         payload = request.SerializeToString()
         try:
-            self._socket().sendall(_HEADER.pack(len(payload)) + payload)
+            with self._send_lock:
+                self._socket().sendall(_HEADER.pack(len(payload)) + payload)
         except OSError as exc:
             self.close()
-            raise ConnectionClosed(address=self.address) from exc
+            raise ConnectionClosed(address=self.address, reason=f"send failed: {exc}") from exc
 
     def enable(self, sensor_name: str, period_ms: int) -> None:
         """Enable a sensor every ``period_ms`` (a multiple of 8; 0 disables it)."""
@@ -174,18 +182,15 @@ class RobotClient:
                 return msg
             if deadline is not None:
                 remaining = deadline - time.monotonic()
-                if remaining <= 0:
+                if remaining <= 0 or not _readable(sock, remaining):
                     raise ReceiveTimeout(address=self.address, timeout_s=timeout or 0.0)
-                sock.settimeout(remaining)
-            else:
-                sock.settimeout(None)
             try:
                 data = sock.recv(1 << 20)
-            except TimeoutError:
-                raise ReceiveTimeout(address=self.address, timeout_s=timeout or 0.0) from None
             except OSError as exc:
                 self.close()
-                raise ConnectionClosed(address=self.address) from exc
+                raise ConnectionClosed(
+                    address=self.address, reason=f"receive failed: {exc}"
+                ) from exc
             if not data:
                 self.close()
                 raise ConnectionClosed(address=self.address)
@@ -212,6 +217,21 @@ class RobotClient:
                 yield self.receive()
             except ConnectionClosed:
                 return
+
+
+def _readable(sock: socket.socket, timeout_s: float) -> bool:
+    """Whether ``sock`` has data (or its end) within ``timeout_s``. The wait is a poll, not a
+    socket timeout, so a thread sending on the same client never inherits a receive's
+    timeout (a blocked ``sendall`` with a 0.5 ms timeout would fail and drop the connection).
+    """
+    try:
+        if sock.fileno() < _FD_SETSIZE:  # select waits in microseconds, poll in milliseconds
+            return bool(select.select([sock], [], [], timeout_s)[0])
+        poller = select.poll()
+        poller.register(sock, select.POLLIN)
+        return bool(poller.poll(math.ceil(timeout_s * 1000)))
+    except (OSError, ValueError):
+        return True  # closed under us: recv reports it
 
 
 def _recv_exact(sock: socket.socket, size: int, address: str) -> bytes:

@@ -171,13 +171,15 @@ class StubRobot:
             for name in self._motors:
                 request.motor_positions.add(name=name, position=0.0)
         sent = 0
+        ended = "stopped"
         while not self.stop.is_set():
             try:
                 client.send(request)
-            except (ConnectionClosed, OSError):
+            except (ConnectionClosed, OSError) as exc:
+                ended = str(exc)
                 break
             sent += 1
-        logger.info("flood: sent %d oversized requests to the simulator", sent)
+        logger.info("flood: sent %d oversized requests to the simulator: %s", sent, ended)
 
     def _play(self, client: RobotClient) -> int | None:
         """Control loop; returns an exit code, or None to reconnect."""
