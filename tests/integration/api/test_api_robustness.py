@@ -122,3 +122,32 @@ def test_arbitrary_bytes_never_break_the_server(chunks: list[bytes]) -> None:
             t0 = other.receive(timeout=5).time
             assert other.receive(timeout=5).time == t0 + 8
         assert driver.error is None
+
+
+@pytest.mark.filterwarnings("error::pytest.PytestUnhandledThreadExceptionWarning")
+def test_clients_coming_and_going_never_stop_the_others_measurements() -> None:
+    """Async stepping, clients' I/O on the I/O thread: one robot's client connects and leaves
+    a hundred times (sometimes with requests still unread, so the server sees a reset) while
+    another reads on. Every drop closes a socket the I/O thread may be waiting on; the other
+    robot's measurements keep coming, one per step (the thread once died of this, and every
+    robot's measurements stopped; an exception in any thread fails the test)."""
+    world = FakeDeviceWorld((RED1, RED2))
+    with running_server(pause_s=0.0005, world=world) as (driver, ports):
+        with _client(ports[RED1]) as reader:
+            reader.enable("NeckS", 8)
+            previous = reader.receive(timeout=5).time
+            for k in range(100):
+                leaving = _client(ports[RED2])
+                leaving.enable("NeckS", 8)
+                if k % 2:
+                    leaving.set_positions({"Neck": 0.1})
+                leaving.receive(timeout=5)
+                leaving.close()
+                wait_until(lambda n=k: len(driver.server.statistics()["red-2"]["disconnects"]) > n)
+                for _ in range(3):
+                    time_ms = reader.receive(timeout=5).time
+                    assert time_ms > previous
+                    previous = time_ms
+        stats = driver.server.statistics()
+        assert len(stats["red-2"]["connects"]) == 100
+        assert stats["red-1"]["disconnects"] == []
