@@ -80,6 +80,9 @@ class SendThread:
         self._polling = False
         self._poll = poll
         self._stop = False
+        # what ended the thread early; the step thread raises it (every client's measurements
+        # would stop otherwise, and the match go on blind)
+        self.failure: Exception | None = None
         self._cpus = frozenset(cpus) if cpus else None
         self._thread = threading.Thread(target=self._run, name="api-io", daemon=True)
         self._thread.start()
@@ -171,6 +174,11 @@ class SendThread:
                     on_news()
                 selector = self._apply_changes(selector, masks)
                 self._write_ready(selector, masks)
+        except Exception as exc:  # no client would hear from the simulator again: say so
+            self.failure = exc
+            log.exception("robot API I/O thread failed")
+            if self._on_news is not None:
+                self._on_news()  # a step thread waiting for answers wakes and finds it
         finally:
             selector.close()
 

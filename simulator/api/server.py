@@ -61,6 +61,17 @@ Request = pb.ActuatorRequests | PositionTargets
 POLL_EVERY_STEPS = 4
 
 
+class IoThreadFailed(ApiError):
+    """The thread doing the clients' socket I/O stopped on an unexpected error."""
+
+    def __init__(self, failure: Exception) -> None:
+        self.failure = failure
+        super().__init__(
+            f"the robot API I/O thread failed ({failure!r}): no robot would receive"
+            " measurements any more, so the match stops here"
+        )
+
+
 class PortUnavailable(ApiError):
     def __init__(self, *, host: str, port: int, reason: str) -> None:
         self.host = host
@@ -612,6 +623,8 @@ class ApiServer:
 
     def _flush_all(self) -> None:
         if self._sender is not None:
+            if self._sender.failure is not None:
+                raise IoThreadFailed(self._sender.failure) from self._sender.failure
             if self._woken:
                 self._sender.wake(self._woken)
                 self._woken = []

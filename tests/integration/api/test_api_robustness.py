@@ -12,6 +12,8 @@ from hypothesis import strategies as st
 from contracts.match_spec import NetworkSpec
 from robot.client import RobotClient
 from simulator.api import FakeDeviceWorld, LockstepSettings
+from simulator.api.connection import Connection
+from simulator.api.server import IoThreadFailed
 from tests.integration.api.harness import BLUE1, RED1, RED2, running_server, wait_until
 
 
@@ -148,6 +150,28 @@ def test_clients_coming_and_going_never_stop_the_others_measurements() -> None:
                     time_ms = reader.receive(timeout=5).time
                     assert time_ms > previous
                     previous = time_ms
-        stats = driver.server.statistics()
+            stats = driver.server.statistics()  # before the reader leaves too
         assert len(stats["red-2"]["connects"]) == 100
         assert stats["red-1"]["disconnects"] == []
+
+
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnhandledThreadExceptionWarning")
+def test_a_failed_io_thread_stops_the_match_with_its_error(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Should the I/O thread meet an unexpected error, the next step raises it (the simulator
+    exits with the error in its log) instead of playing on with robots that hear nothing."""
+
+    def broken(self: Connection, now: float) -> bool:
+        raise RuntimeError("a bug in the I/O thread")
+
+    monkeypatch.setattr(Connection, "read_threaded", broken)
+    world = FakeDeviceWorld((RED1,))
+    with pytest.raises(IoThreadFailed, match="a bug in the I/O thread"):  # the step's error
+        with running_server(pause_s=0.001, world=world, robots=[RED1]) as (driver, ports):
+            with _client(ports[RED1]) as client:
+                client.enable("NeckS", 8)
+                wait_until(lambda: driver.error is not None, 10)
+            steps = driver.steps
+            time.sleep(0.05)
+            assert driver.steps == steps  # no step after it

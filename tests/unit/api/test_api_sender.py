@@ -186,3 +186,28 @@ def test_a_connection_closed_before_its_removal_arrives_does_not_stop_the_thread
         for ours, theirs in pairs:
             ours.close()
             theirs.close()
+
+
+def test_an_unexpected_error_is_kept_for_the_step_thread(
+    pair: tuple[Connection, socket.socket], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A bug in the thread's loop ends it, but not silently: the error is logged, kept in
+    ``failure`` and the step thread's wait is woken (the server raises it on its next step)."""
+    conn, client = pair
+    news: list[bool] = []
+    thread = SendThread(poll=False, on_news=lambda: news.append(True))
+
+    def broken(now: float) -> bool:
+        raise RuntimeError("a bug")
+
+    monkeypatch.setattr(conn, "read_threaded", broken)
+    try:
+        thread.add(conn)
+        client.sendall(b"\0\0\0\x02ab")
+        deadline = time.monotonic() + 5
+        while thread._thread.is_alive() and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert isinstance(thread.failure, RuntimeError)
+        assert news == [True]
+    finally:
+        thread.close()
