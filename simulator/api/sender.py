@@ -7,7 +7,9 @@ and takes the requests this thread has decoded (:meth:`Connection.take_requests`
 and reads happen while the step thread is back in the physics (MuJoCo releases the GIL while it
 steps). A client that does not read only fills its own queue (the oldest measurements are
 dropped and counted as before). A socket error, end of stream or bad frame is left on the
-connection (``error``) for the step thread to drop it, logged once there.
+connection (``error``) for the step thread to drop it, logged once there. An unexpected error
+ends the thread and is kept in ``failure``; the server raises it at its next step
+(:class:`simulator.api.server.IoThreadFailed`), as no client would hear from it again.
 
 Waking this thread costs the step thread a write to a pipe that another CPU sleeps on: about
 14 us of CPU on our virtual machines (the idle CPU halts, and the wake-up is an interrupt
