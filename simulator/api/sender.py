@@ -151,6 +151,8 @@ class SendThread:
                 try:
                     ready = selector.select(timeout)
                 except OSError:  # a socket closed before its removal reached this thread
+                    if not any(conn.closed for conn in masks):
+                        raise  # not that: retrying would spin, so the thread fails loudly
                     self._sleeping = False
                     selector = self._forget_closed(selector, masks)
                     continue
@@ -215,11 +217,7 @@ class SendThread:
                 except (KeyError, ValueError, OSError) as exc:
                     conn.error = f"cannot watch the socket: {exc}"
             elif conn in masks:
-                del masks[conn]
-                try:
-                    selector.unregister(conn.fd)
-                except (KeyError, ValueError, OSError):
-                    pass  # closed already: the kernel forgot it
+                _unwatch(selector, masks, conn)
         return selector
 
     def _forget_closed(
@@ -230,11 +228,7 @@ class SendThread:
         dropped connection right after asking this thread to forget it."""
         selector = self._apply_changes(selector, masks)
         for conn in [conn for conn in masks if conn.closed]:
-            del masks[conn]
-            try:
-                selector.unregister(conn.fd)
-            except (KeyError, ValueError, OSError):
-                pass
+            _unwatch(selector, masks, conn)
         return selector
 
     def _without_select(
@@ -265,3 +259,13 @@ class SendThread:
                     selector.modify(conn.fd, wanted, conn)
                 except (KeyError, ValueError, OSError):
                     pass  # closed meanwhile; its removal follows
+
+
+def _unwatch(
+    selector: selectors.BaseSelector, masks: dict[Connection, int], conn: Connection
+) -> None:
+    del masks[conn]
+    try:
+        selector.unregister(conn.fd)
+    except (KeyError, ValueError, OSError):
+        pass  # closed already: the kernel forgot it

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import resource
+import selectors
 import socket
 import time
 from collections.abc import Iterator
@@ -209,5 +210,26 @@ def test_an_unexpected_error_is_kept_for_the_step_thread(
             time.sleep(0.01)
         assert isinstance(thread.failure, RuntimeError)
         assert news == [True]
+    finally:
+        thread.close()
+
+
+def test_a_select_failure_without_a_closed_socket_fails_the_thread(
+    pair: tuple[Connection, socket.socket], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A ``select`` error that no closed connection explains is the thread's failure (kept for
+    the step thread), not retried forever."""
+    conn, _client = pair
+
+    def failing(self: object, timeout: float | None = None) -> list[object]:
+        raise OSError(22, "Invalid argument")
+
+    monkeypatch.setattr(selectors.SelectSelector, "select", failing)
+    thread = SendThread(poll=False)
+    try:
+        thread.add(conn)
+        thread._thread.join(timeout=5)
+        assert not thread._thread.is_alive()
+        assert isinstance(thread.failure, OSError)
     finally:
         thread.close()
