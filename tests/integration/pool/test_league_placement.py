@@ -187,6 +187,9 @@ def test_league_2v2_on_four_robot_nodes_connects_plays_and_is_isolated(
     proc = _scrimmage(cluster, out, match_id, half_s=10)
     try:
         robots = _robots(client, match_id, proc)
+        # the robots start beside the simulator, which listens once its world is built: the
+        # probes wait until every robot's own client got through (the simulator listens)
+        _connected(robots)
         env = {key: _env(c) for key, c in robots.items()}
         simulator, api_port = env["red-1"]["ROBOCUP_SIMULATOR_ADDR"].split(":")
         node = {key: e[f"ROBOCUP_TEAM_PLAYER{key[-1]}_IP"] for key, e in env.items()}
