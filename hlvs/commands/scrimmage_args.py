@@ -58,7 +58,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         default="lockstep",
                         help="lockstep (default): each step waits for the robots; pipelined: "
                         "they think while the next step runs (one step more latency); async: "
-                        "the simulation never waits (HLVS)")
+                        "the simulation never waits (HLVS), paced to real time")
     parser.add_argument("--seed", type=int, default=42,
                         help="seed of the simulation and the referee (default 42)")
     parser.add_argument("--stub", action="store_true",

@@ -85,6 +85,16 @@ def build_game(document: Any, where: Collector, *, source: Path) -> GameConfig |
     rtf = None
     if sound("/maximum_real_time_factor", *(pointer(n) for n in LEGACY_RTF)):
         rtf = _real_time_factor(game, where)
+    if rtf is not None and rtf <= 0 and game.get("stepping", "async") == "async":
+        said = next((n for n in ("maximum_real_time_factor", *LEGACY_RTF) if n in game),
+                    "maximum_real_time_factor")
+        where.warn(
+            pointer(said),
+            "as fast as possible with async stepping: the simulation never waits for the "
+            "robots and runs as fast as this host can, so the robots get fewer control steps "
+            "the faster it is",
+            expected='1 (real time, as the league plays) or "stepping": "lockstep"',
+        )
     timing = Timing()
     if sound("/timing", "/game_controller_extra_args", "/max_duration"):
         timing = _timing(game, where, fast=rtf is not None and rtf <= 0)

@@ -182,7 +182,10 @@ def game_file(request: ScrimmageRequest, match_id: str) -> GameDocument:
         "type": "NORMAL",
         "class": "KID",
         "host": "127.0.0.1",
-        "maximum_real_time_factor": 0,
+        # lockstep and pipelined wait for the robots: as fast as possible. Async never waits:
+        # paced to real time, so that robots get the steps they would on a real robot (as
+        # fast as possible, a fast host would leave them a fraction of the control steps)
+        "maximum_real_time_factor": 1 if request.stepping == "async" else 0,
         "side_left": "red",
         "kickoff": "red",
         "match_id": match_id,

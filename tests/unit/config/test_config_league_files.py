@@ -38,6 +38,25 @@ def test_a_legacy_name_still_wins_over_the_default(game_files: GameFiles) -> Non
     assert "/maximum_real_time_factor" not in pointers
 
 
+@pytest.mark.parametrize("stepping", [None, "async", "lockstep", "pipelined"])
+def test_async_as_fast_as_possible_is_warned_about(game_files: GameFiles,
+                                                   stepping: str | None) -> None:
+    """Async never waits for the robots: as fast as possible, a faster host leaves them fewer
+    control steps. Lockstep and pipelined wait for them; real time is the league's."""
+    game_files.game["maximum_real_time_factor"] = 0
+    if stepping is not None:
+        game_files.game["stepping"] = stepping
+    fast = [w for w in load_game(game_files.write()).warnings
+            if w.pointer == "/maximum_real_time_factor"]
+    if stepping in (None, "async"):
+        assert len(fast) == 1 and "fewer control steps" in fast[0].message, fast
+    else:
+        assert fast == []
+    game_files.game["maximum_real_time_factor"] = 1
+    assert not [w for w in load_game(game_files.write()).warnings
+                if w.pointer == "/maximum_real_time_factor"]
+
+
 @pytest.mark.parametrize(
     ("name", "value", "maximum"),
     [

@@ -96,6 +96,22 @@ def test_a_scrimmage_with_a_short_half_gets_a_short_ready_with_a_warning(
         write_files(_request(parser, ["--half-duration", "10"]), tmp_path, stub_image="s:1")
 
 
+def test_an_async_scrimmage_is_paced_to_real_time_and_a_lockstep_one_is_not(
+        tmp_path: Path) -> None:
+    """Async never waits for the robots: as fast as possible, a fast host would leave the
+    robots a fraction of their control steps (a stub then never reaches the ball)."""
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    paced = {}
+    for stepping in ("async", "lockstep", "pipelined"):
+        game = write_files(_request(parser, ["--stepping", stepping]), tmp_path / stepping,
+                           stub_image="stub:1")
+        loaded = load_game(game).game
+        assert loaded.stepping == stepping
+        paced[stepping] = loaded.maximum_real_time_factor
+    assert paced == {"async": 1.0, "lockstep": 0.0, "pipelined": 0.0}
+
+
 def test_service_test_matches_play_and_too_short_halves_are_refused(tmp_path: Path) -> None:
     settings = Settings()
     team = {"name": "A", "image": "a/robot", "players": {"1": {"dockerTag": "1"}}}
