@@ -12,6 +12,7 @@ from __future__ import annotations
 import difflib
 import json
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass
 from datetime import UTC, datetime, timedelta
 from importlib import resources
@@ -156,6 +157,14 @@ class Schedule:
         return planned
 
 
+def default_real_time_factor(game_defaults: Mapping[str, Any]) -> float:
+    """A match's ``maximum_real_time_factor`` when ``game_defaults`` do not say: as fast as
+    possible in lockstep and pipelined stepping, which wait for the robots; real time in async
+    stepping (the default), which never waits: as fast as possible, the faster the host, the
+    fewer control steps the robots would get."""
+    return 1.0 if game_defaults.get("stepping", "async") == "async" else 0.0
+
+
 def game_document(
     schedule: Schedule,
     match: ScheduledMatch,
@@ -172,7 +181,7 @@ def game_document(
     game: JSONObject = {
         "class": match.field_class,
         "host": "127.0.0.1",
-        "maximum_real_time_factor": 0,
+        "maximum_real_time_factor": default_real_time_factor(schedule.game_defaults),
         "match_id": match.id,
     }
     game.update(schedule.game_defaults)
@@ -330,7 +339,7 @@ def _timing_problems(path: Path, schedule: Schedule) -> list[Problem]:
     if not isinstance(defaults.get("timing", {}), dict):
         return []  # the schema reports it
     where = Collector(str(path))
-    rtf = defaults.get("maximum_real_time_factor", 0)
+    rtf = defaults.get("maximum_real_time_factor", default_real_time_factor(defaults))
     for kind in sorted({m.kind for m in schedule.matches}):
         document = {**defaults, "type": "KNOCKOUT" if kind == "knockout" else "NORMAL"}
         # a partial game.json: the timing reads only its timing fields and type

@@ -59,6 +59,24 @@ def test_round_robin_fixtures_pair_every_team_once() -> None:
     assert [m.stream_start for m in matches[:3]] == ["+10s", "+15s", "+20s"]
 
 
+@pytest.mark.parametrize(("defaults", "expected"), [
+    ("", 1.0),  # async, the default: never waits for the robots, so real time
+    ("game_defaults: {stepping: async}\n", 1.0),
+    ("game_defaults: {stepping: lockstep}\n", 0.0),  # waits for them: as fast as possible
+    ("game_defaults: {stepping: pipelined}\n", 0.0),
+    ("game_defaults: {stepping: async, maximum_real_time_factor: 2}\n", 2.0),
+])
+def test_a_matchs_pace_follows_its_stepping_unless_the_schedule_says(
+        tmp_path: Path, defaults: str, expected: float) -> None:
+    from orchestrator.config.schedule import game_document
+
+    match = "matches:\n  - {id: m1, red: alpha, blue: bravo, stream_start: '+1s'}\n"
+    schedule = load_schedule(write_schedule(tmp_path, defaults + match))
+    red, blue = schedule.teams[0], schedule.teams[1]
+    game = game_document(schedule, schedule.matches[0], red, blue)
+    assert game["maximum_real_time_factor"] == expected
+
+
 def test_schedule_errors_name_the_field(tmp_path: Path) -> None:
     path = write_schedule(
         tmp_path,
