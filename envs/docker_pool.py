@@ -186,13 +186,28 @@ class DockerLauncher:
             for address in self._candidates(cid):
                 try:
                     probe(address)
-                    return address
                 except (OSError, WireError) as exc:
                     reason = f"{address}: {exc}"
+                    continue
+                return self._nearest(cid, address)
             time.sleep(0.2)
         raise RemoteStartFailed(
             address=cid[:12], reason=f"not healthy after {self.health_timeout_s:g} s: {reason}"
         )
+
+    def _nearest(self, cid: str, answered: RemoteAddress) -> RemoteAddress:
+        """The remote's Unix socket when it has one, else ``answered``. The remote binds its
+        socket before its port, so once the port answers the socket is there, even when it
+        was not yet when the candidates were listed."""
+        path = self.sockets.get(cid)
+        if answered.path is not None or not path or not os.path.exists(path):
+            return answered
+        unix = RemoteAddress("", 0, path)
+        try:
+            probe(unix)
+        except (OSError, WireError):
+            return answered
+        return unix
 
     def replace(self, index: int) -> RemoteAddress:
         old = self.containers[index]
