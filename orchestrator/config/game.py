@@ -85,16 +85,6 @@ def build_game(document: Any, where: Collector, *, source: Path) -> GameConfig |
     rtf = None
     if sound("/maximum_real_time_factor", *(pointer(n) for n in LEGACY_RTF)):
         rtf = _real_time_factor(game, where)
-    if rtf is not None and rtf <= 0 and game.get("stepping", "async") == "async":
-        said = next((n for n in ("maximum_real_time_factor", *LEGACY_RTF) if n in game),
-                    "maximum_real_time_factor")
-        where.warn(
-            pointer(said),
-            "as fast as possible with async stepping: the simulation never waits for the "
-            "robots and runs as fast as this host can, so the robots get fewer control steps "
-            "the faster it is",
-            expected='1 (real time, as the league plays) or "stepping": "lockstep"',
-        )
     timing = Timing()
     if sound("/timing", "/game_controller_extra_args", "/max_duration"):
         timing = _timing(game, where, fast=rtf is not None and rtf <= 0)
@@ -162,14 +152,39 @@ def legacy_maximum_real_time_factor(value: float) -> float:
     return 1.0 / value if value > 0 else 0.0
 
 
-def _real_time_factor(document: GameDocument, where: Collector) -> float | None:
+def default_real_time_factor(stepping: str) -> float:
+    """The pace of a match whose file we write (a scrimmage, a schedule's match) when nothing
+    else sets it: real time in async stepping, which never waits for the robots (as fast as
+    possible, the faster the host, the fewer control steps they would get); as fast as possible
+    in lockstep and pipelined stepping, which wait for them."""
+    return DEFAULT_MAXIMUM_REAL_TIME_FACTOR if stepping == "async" else 0.0
+
+
+def _real_time_factor(document: GameDocument, where: Collector) -> float:
+    """The game's maximum real-time factor (problems with its fields in ``where``), warned
+    about when it is as fast as possible in async stepping."""
+    name, rtf = _read_real_time_factor(document, where)
+    if rtf <= 0 and document.get("stepping", "async") == "async":
+        where.warn(
+            pointer(name),
+            "as fast as possible with async stepping: the simulation never waits for the "
+            "robots and runs as fast as this host can, so the robots get fewer control steps "
+            "the faster it is",
+            expected='1 (real time, as the league plays) or "stepping": "lockstep"',
+        )
+    return rtf
+
+
+def _read_real_time_factor(document: GameDocument, where: Collector) -> tuple[str, float]:
+    """The field the factor was read from (the league's default: ``maximum_real_time_factor``)
+    and the factor."""
     legacy = [name for name in LEGACY_RTF if name in document]
     if "maximum_real_time_factor" in document:
         for name in legacy:
             where.warn(
                 pointer(name), "legacy field: ignored", expected='"maximum_real_time_factor"'
             )
-        return float(document["maximum_real_time_factor"])
+        return "maximum_real_time_factor", float(document["maximum_real_time_factor"])
     if legacy:
         name = legacy[0]
         value = float(document[name])
@@ -181,13 +196,13 @@ def _real_time_factor(document: GameDocument, where: Collector) -> float | None:
             else f"{value:g} runs as fast as possible (maximum_real_time_factor 0)"
         )
         where.warn(pointer(name), f"legacy field: {meaning}", expected='"maximum_real_time_factor"')
-        return maximum
+        return name, maximum
     where.warn(
         "/maximum_real_time_factor",
         f"missing: the league's default {DEFAULT_MAXIMUM_REAL_TIME_FACTOR:g} (real time) is used",
         expected="a number (<= 0: as fast as possible)",
     )
-    return DEFAULT_MAXIMUM_REAL_TIME_FACTOR
+    return "maximum_real_time_factor", DEFAULT_MAXIMUM_REAL_TIME_FACTOR
 
 
 def timing_of(document: GameDocument, where: Collector, *, fast: bool) -> Timing:

@@ -12,7 +12,6 @@ from __future__ import annotations
 import difflib
 import json
 import re
-from collections.abc import Mapping
 from dataclasses import dataclass
 from datetime import UTC, datetime, timedelta
 from importlib import resources
@@ -30,6 +29,7 @@ from orchestrator.config.documents import (
     ScheduleDocument,
     ScheduleMatchDocument,
 )
+from orchestrator.config.game import default_real_time_factor
 from orchestrator.errors import ConfigError, Problem
 
 MatchKind = Literal["round_robin", "knockout"]
@@ -157,14 +157,6 @@ class Schedule:
         return planned
 
 
-def default_real_time_factor(game_defaults: Mapping[str, Any]) -> float:
-    """A match's ``maximum_real_time_factor`` when ``game_defaults`` do not say: as fast as
-    possible in lockstep and pipelined stepping, which wait for the robots; real time in async
-    stepping (the default), which never waits: as fast as possible, the faster the host, the
-    fewer control steps the robots would get."""
-    return 1.0 if game_defaults.get("stepping", "async") == "async" else 0.0
-
-
 def game_document(
     schedule: Schedule,
     match: ScheduledMatch,
@@ -181,7 +173,8 @@ def game_document(
     game: JSONObject = {
         "class": match.field_class,
         "host": "127.0.0.1",
-        "maximum_real_time_factor": default_real_time_factor(schedule.game_defaults),
+        "maximum_real_time_factor": default_real_time_factor(
+            str(schedule.game_defaults.get("stepping", "async"))),
         "match_id": match.id,
     }
     game.update(schedule.game_defaults)
@@ -339,7 +332,8 @@ def _timing_problems(path: Path, schedule: Schedule) -> list[Problem]:
     if not isinstance(defaults.get("timing", {}), dict):
         return []  # the schema reports it
     where = Collector(str(path))
-    rtf = defaults.get("maximum_real_time_factor", default_real_time_factor(defaults))
+    rtf = defaults.get("maximum_real_time_factor",
+                       default_real_time_factor(str(defaults.get("stepping", "async"))))
     for kind in sorted({m.kind for m in schedule.matches}):
         document = {**defaults, "type": "KNOCKOUT" if kind == "knockout" else "NORMAL"}
         # a partial game.json: the timing reads only its timing fields and type

@@ -30,6 +30,7 @@ from contracts import (
     fit_ready,
 )
 from orchestrator.config.documents import GameDocument, PlayerDocument, PoseDocument, TeamDocument
+from orchestrator.config.game import default_real_time_factor
 from orchestrator.config.robot_models import MODEL_MANIFEST, is_model_path
 from orchestrator.errors import ConfigError, Problem
 
@@ -182,10 +183,7 @@ def game_file(request: ScrimmageRequest, match_id: str) -> GameDocument:
         "type": "NORMAL",
         "class": "KID",
         "host": "127.0.0.1",
-        # lockstep and pipelined wait for the robots: as fast as possible. Async never waits:
-        # paced to real time, so that robots get the steps they would on a real robot (as
-        # fast as possible, a fast host would leave them a fraction of the control steps)
-        "maximum_real_time_factor": 1 if request.stepping == "async" else 0,
+        "maximum_real_time_factor": default_real_time_factor(request.stepping),
         "side_left": "red",
         "kickoff": "red",
         "match_id": match_id,
