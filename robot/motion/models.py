@@ -238,11 +238,15 @@ def _scaled_walk(scale: float) -> dict[str, float]:
         "hip_height_m": 0.30,
         "foot_x_offset_m": 0.01,
         "foot_y_offset_m": 0.02,
-        "max_vx_m_s": 0.3,
+        "max_vx_m_s": 0.4,
         "max_vy_m_s": 0.05,
     }
     out = {key: value * scale for key, value in lengths.items()}
     out.update(
+        # kid-default with its catalogue servos on the league's soft grass, 14 s straight ahead
+        # from standing: 0.21 m/s commanded 0.3, 0.30 m/s commanded 0.4, no fall; a striker at
+        # 0.3 reached a kick-off pass (3.4 m) with too little of a 40 s half left to shoot
+        cruise_vx_m_s=0.4,
         period_s=0.7 * scale**0.5,
         double_support_ratio=0.35,
         sway_phase_lead=0.025,
@@ -282,6 +286,8 @@ def _adult_default() -> RobotKinematics:
 # walks straight, turning and sideways (the stance keeps the kid's lean: the get-up ends in it)
 _ADULT_WALK = {
     "walk_lean_rad": 0.1,
+    "max_vx_m_s": 0.3 * ADULT_SCALE,  # the kid's 0.3 m/s scaled, as before the kid's 0.4
+    "cruise_vx_m_s": 0.3,  # the speed its lean and stride were measured at (below)
     # walked / commanded with that lean (net displacement over whole gait cycles): 0.98 straight
     # ahead at 0.15 and 0.3 m/s, 0.97-0.99 at 0.2-0.3 m/s turning at 0.2-0.3 rad/s, 0.95 sideways
     "stride_efficiency_x": 0.98,

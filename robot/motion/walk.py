@@ -34,6 +34,7 @@ class WalkParams:
     torso_pitch_rad: float = 0.15  # forward lean
     walk_lean_rad: float = 0.0  # more forward lean while stepping (at the full gait amplitude)
     max_vx_m_s: float = 0.25
+    cruise_vx_m_s: float = 0.25  # what a behaviour walks at over distance (at most max_vx_m_s)
     max_vy_m_s: float = 0.08
     max_vyaw_rad_s: float = 0.8
     accel_m_s2: float = 0.3

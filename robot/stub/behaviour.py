@@ -46,7 +46,7 @@ STAND = Action()
 APPROACH_M = 0.55  # nearer than this the striker lines up and kicks
 BEHIND_M = 0.35  # where it heads for: this far behind the ball, on the goal line through it
 ROUND_M = 0.5  # how wide it goes round a ball it is in front of
-FAST_M_S = 0.3
+FAST_M_S = 0.3  # walking over distance, unless the model's gait says otherwise (Field.fast_m_s)
 AIM_HALF_WIDTH_M = 0.8  # aim this close to the goal centre (posts at 1.3 m)
 # At its own kick-off the striker plays the ball diagonally forward, past the opponents' kick-off
 # spot in front of the centre circle (a ball kicked straight at the goal hits the opponent who
@@ -67,6 +67,7 @@ class Field:
     foot_y_m: float  # lateral distance of each foot from the centre line
     kick_x_m: float  # best ball distance in front of the pelvis for a kick
     kick_feet: tuple[str, ...] = ("left", "right")  # the feet it kicks with
+    fast_m_s: float = FAST_M_S  # forward speed over distance (the gait's cruise speed)
 
 
 def decide(
@@ -87,7 +88,7 @@ def decide(
     if game.phase is GameState.FINISHED:
         return STAND
     if game.phase is GameState.READY:
-        return _go_to(pose, _kick_off_position(role, game, field, home))
+        return _go_to(pose, _kick_off_position(role, game, field, home), fast_m_s=field.fast_m_s)
     # PLAYING
     if not game.our_kick_off and game.ball_free_in_s > 0:
         return STAND  # the opponents' kick-off: keep out of the centre circle
@@ -141,11 +142,18 @@ def _defender(
             return _striker(pose, ball, field, searching_s)
     hx, hy = pose.to_relative(*home)
     if math.hypot(hx, hy) > 0.4:
-        return _go_to(pose, Pose(x_m=home[0], y_m=home[1], yaw_rad=0.0), tolerance_m=0.3)
+        return _go_to(
+            pose,
+            Pose(x_m=home[0], y_m=home[1], yaw_rad=0.0),
+            tolerance_m=0.3,
+            fast_m_s=field.fast_m_s,
+        )
     return _face(ball, tolerance_rad=0.3)
 
 
-def _go_to(pose: Pose, target: Pose, *, tolerance_m: float = 0.2) -> Action:
+def _go_to(
+    pose: Pose, target: Pose, *, tolerance_m: float = 0.2, fast_m_s: float = FAST_M_S
+) -> Action:
     x, y = pose.to_relative(target.x_m, target.y_m)
     distance = math.hypot(x, y)
     if distance < tolerance_m:
@@ -155,7 +163,7 @@ def _go_to(pose: Pose, target: Pose, *, tolerance_m: float = 0.2) -> Action:
         return Action(walk=(0.0, 0.0, _clip(1.2 * error, 0.5)))
     bearing = math.atan2(y, x)
     # full speed while far: from the opponent goal back to the own half takes most of READY
-    forward = (FAST_M_S if distance > 1.0 else 0.15) if abs(bearing) < 0.35 else 0.0
+    forward = (fast_m_s if distance > 1.0 else 0.15) if abs(bearing) < 0.35 else 0.0
     return Action(walk=(forward, 0.0, _clip(1.5 * bearing, 0.6)))
 
 
@@ -181,7 +189,7 @@ def _striker(
     ux, uy = math.cos(heading_error), math.sin(heading_error)
     behind = -(bx * ux + by * uy) < -0.1  # the robot is on the far side of the ball from goal
     if distance > APPROACH_M or not behind or abs(bearing) > 1.2:
-        return _approach(bx, by, heading_error)
+        return _approach(bx, by, heading_error, field.fast_m_s)
     if abs(heading_error) > 0.35:
         # circle around the ball: side-step while turning, keep about 0.3 m away
         return Action(
@@ -211,7 +219,7 @@ def _striker(
     )
 
 
-def _approach(bx: float, by: float, goal_bearing: float) -> Action:
+def _approach(bx: float, by: float, goal_bearing: float, fast_m_s: float) -> Action:
     """Walk to a point behind the ball on the line from the goal centre through the ball (the
     robot frame; ``goal_bearing`` the direction from the ball to the goal). When the robot is
     on the goal side of the ball, go round it first, on the side it is already on, so that it
@@ -226,7 +234,7 @@ def _approach(bx: float, by: float, goal_bearing: float) -> Action:
     else:
         px, py = bx - BEHIND_M * ux, by - BEHIND_M * uy
     target = math.atan2(py, px)
-    forward = FAST_M_S if abs(target) < 0.3 else (0.06 if abs(target) < 0.7 else 0.0)
+    forward = fast_m_s if abs(target) < 0.3 else (0.06 if abs(target) < 0.7 else 0.0)
     return Action(walk=(forward, 0.0, _clip(1.5 * target, 0.7)))
 
 
@@ -236,7 +244,7 @@ def _goalie(
     home = Pose(x_m=-field.half_length_m + 0.5, y_m=0.0, yaw_rad=0.0)
     hx, hy = pose.to_relative(home.x_m, home.y_m)
     if math.hypot(hx, hy) > 0.5:
-        return _go_to(pose, home, tolerance_m=0.3)
+        return _go_to(pose, home, tolerance_m=0.3, fast_m_s=field.fast_m_s)
     if ball is not None:
         bx, by = ball
         ball_field = pose.to_field(bx, by)

@@ -37,6 +37,23 @@ def test_walks_forward_for_10_s_without_falling() -> None:
     assert abs(moved[1]) < 0.5 * moved[0]
 
 
+def test_walks_at_its_cruise_speed_and_turning_without_falling() -> None:
+    """The speed a striker crosses the pitch at (the gait's cruise speed, 0.4 m/s commanded):
+    at least 0.25 m/s straight ahead on the soft grass, and it stays up while turning at it."""
+    from robot.motion.walk import default_walk_params
+
+    cruise = default_walk_params("kid-default").cruise_vx_m_s
+    assert cruise == pytest.approx(0.4)
+    robot = OneRobot(x_m=-3.5)
+    robot.stand()
+    start = robot.position
+    engine = WalkEngine(model="kid-default")
+    assert robot.run(10.0, walker(robot, engine, cruise, 0.0, 0.0)), "fell at cruise speed"
+    moved = robot.position - start
+    assert moved[0] >= 2.5, moved  # >= 0.25 m/s including the start from standing
+    assert robot.run(6.0, walker(robot, engine, cruise, 0.0, 0.3)), "fell turning at cruise speed"
+
+
 def test_turns_on_the_spot() -> None:
     robot = OneRobot()
     robot.stand()

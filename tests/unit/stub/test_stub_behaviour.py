@@ -49,3 +49,24 @@ def test_defender_kick_off_position_is_its_home() -> None:
     action = decide(role=Role.DEFENDER, game=ready, pose=elsewhere, ball=None, field=FIELD,
                     searching_s=0.0, home=HOME)  # fmt: skip
     assert action.walk[0] > 0.0
+
+
+def test_a_far_ball_is_walked_to_at_the_models_cruise_speed() -> None:
+    """Over distance the striker (and READY's walk) goes at the gait's cruise speed: the kid's
+    0.4 m/s, the adult's 0.3 m/s (what its gait was measured at)."""
+    from contracts.geometry import Pose as P
+    from robot.stub.controller import StubController
+
+    start = P(x_m=0.0, y_m=0.0, yaw_rad=0.0)
+    speeds = {}
+    for model, field_class in (("kid-default", "kid"), ("adult-default", "adult")):
+        field = StubController(role=Role.STRIKER, start_pose=start, model=model,
+                               field_class=field_class).field  # fmt: skip
+        far = decide(role=Role.STRIKER, game=PLAYING, pose=start, ball=(3.0, 0.0), field=field,
+                     searching_s=0.0)  # fmt: skip
+        ready = decide(role=Role.STRIKER, game=GameInfo(phase=GameState.READY, our_kick_off=False),
+                       pose=P(x_m=-4.0, y_m=0.0, yaw_rad=0.0), ball=None, field=field,
+                       searching_s=0.0)  # fmt: skip
+        assert far.walk[0] == ready.walk[0] == field.fast_m_s  # type: ignore[attr-defined]
+        speeds[model] = field.fast_m_s
+    assert speeds == {"kid-default": 0.4, "adult-default": 0.3}
