@@ -151,9 +151,7 @@ def _defender(
     return _face(ball, tolerance_rad=0.3)
 
 
-def _go_to(
-    pose: Pose, target: Pose, *, tolerance_m: float = 0.2, fast_m_s: float = FAST_M_S
-) -> Action:
+def _go_to(pose: Pose, target: Pose, *, fast_m_s: float, tolerance_m: float = 0.2) -> Action:
     x, y = pose.to_relative(target.x_m, target.y_m)
     distance = math.hypot(x, y)
     if distance < tolerance_m:
