@@ -32,7 +32,8 @@ def test_match_command_plays_a_game_file(tmp_path: Path, test_image: str, runtim
     parser = argparse.ArgumentParser()
     add_arguments(parser)
     args = parser.parse_args([
-        "--players", "2", "--half-duration", "3", "--minimum-play", "0", "--wait-before-ready", "1",
+        "--players", "2", "--half-duration", "3", "--ready-duration", "2", "--minimum-play", "0",
+        "--wait-before-ready", "1",
         "--match-id", "cmd-test", "--red-image", test_image, "--blue-image", test_image,
         "--robot-command", "python3 /opt/t/robot.py env",
     ])

@@ -39,8 +39,8 @@ def _scrimmage(match_id: str, out: Path, *, half_duration_s: int) -> int:
     """A short default scrimmage; its containers are removed whatever happens."""
     try:
         return hlvs(["scrimmage", "--out", str(out), "--half-duration", str(half_duration_s),
-                     "--minimum-play", "0", "--wait-before-ready", "1", "--grace", "2",
-                     "--match-id", match_id])
+                     "--ready-duration", "2", "--minimum-play", "0", "--wait-before-ready", "1",
+                     "--grace", "2", "--match-id", match_id])
     finally:
         hlvs(["cleanup", "--match", match_id])
 

@@ -32,7 +32,7 @@ def test_short_scrimmage_plays_to_finished(tmp_path: Path, runtime: Any,
     monkeypatch.chdir(tmp_path)
     try:
         code = hlvs(["scrimmage", "--out", "matches/scrim", "--half-duration", "4",
-                     "--minimum-play", "0",
+                     "--ready-duration", "2", "--minimum-play", "0",
                      "--wait-before-ready", "1", "--grace", "2", "--match-id", match_id])
     finally:
         hlvs(["cleanup", "--match", match_id])
@@ -75,7 +75,7 @@ def test_scrimmage_with_a_team_of_wolfgang_models_plays_to_the_end(
     monkeypatch.chdir(tmp_path)
     try:
         code = hlvs(["scrimmage", "--out", "wolf", "--red-model", str(wolfgang),
-                     "--half-duration", "4",
+                     "--half-duration", "4", "--ready-duration", "2",
                      "--minimum-play", "0", "--wait-before-ready", "1", "--grace", "2",
                      "--match-id", match_id, "--json"])
         printed = capsys.readouterr()

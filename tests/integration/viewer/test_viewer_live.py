@@ -40,7 +40,7 @@ def test_live_view_follows_a_running_scrimmage_and_its_replay_plays(
     match_id = f"viewer-live-{uuid.uuid4().hex[:6]}"
     scrimmage = subprocess.Popen(
         [HLVS, "scrimmage", "--out", str(out), "--half-duration", "5",
-         "--minimum-play", "0", "--wait-before-ready",
+         "--ready-duration", "8", "--minimum-play", "0", "--wait-before-ready",
          "1", "--grace", "2", "--match-id", match_id],
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
     )  # fmt: skip
