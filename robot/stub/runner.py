@@ -46,6 +46,40 @@ def default_start_pose(robot_id: int) -> Pose:
     return Pose(x_m=-3.6 + 0.8 * (robot_id - 1), y_m=-3.2, yaw_rad=math.pi / 2)
 
 
+class RefereePlacement:
+    """The poses the referee puts the robot at, told to the controller as they happen.
+
+    - A new half: the half-time starting pose of the team file, on the side the team now
+      plays (sides change, so the mirror image of the previous half's).
+    - The end of a penalty during a half: the re-entry point on the touch line of the own
+      half, on the side the robot was nearer to.
+
+    A penalty the half's end cuts short is lifted together with the new half's placement (in
+    the same GameController packet or in the INITIAL that follows): the robot stands at its
+    half-time pose then, not at a re-entry point.
+    """
+
+    def __init__(self, start_pose: Pose) -> None:
+        self.start_pose = start_pose
+        self._first_half: bool | None = None
+        self._penalised = False
+
+    def follow(self, controller: StubController, game: GameInfo) -> None:
+        new_half = self._first_half is not None and game.first_half != self._first_half
+        if new_half:
+            before = controller.mirrored
+            controller.reset_pose(
+                self.start_pose, expect_mirrored=None if before is None else not before
+            )
+        elif self._penalised and not game.penalised and game.phase is not GameState.INITIAL:
+            pose = controller.world.pose
+            side = -1.0 if pose.y_m < 0 else 1.0
+            reentry = Pose(x_m=-3.0, y_m=3.2 * side, yaw_rad=-side * math.pi / 2)
+            controller.reset_pose(reentry, check_side=False)
+        self._first_half = game.first_half
+        self._penalised = game.penalised
+
+
 class StubRobot:
     def __init__(self, options: StubOptions, env: RobotEnv, *, gc_data_port: int = 3838,
                  gc_return_port: int = 3939) -> None:  # fmt: skip
@@ -183,8 +217,8 @@ class StubRobot:
 
     def _play(self, client: RobotClient) -> int | None:
         """Control loop; returns an exit code, or None to reconnect."""
-        previous_half: bool | None = None
-        was_penalised = False
+        placement = RefereePlacement(self.start_pose)
+        previous_phase: GameState | None = None
         while not self.stop.is_set():
             if self._crash_due():
                 return CRASH_EXIT_CODE
@@ -196,18 +230,11 @@ class StubRobot:
                 logger.warning("lost the simulator connection: %s", exc)
                 return None
             game = self.gc.info() or GameInfo(phase=GameState.INITIAL)
-            if previous_half is not None and game.first_half != previous_half:
-                before = self.controller.mirrored  # sides change at half time
-                expect = None if before is None else not before
-                self.controller.reset_pose(self.start_pose, expect_mirrored=expect)
-            previous_half = game.first_half
-            if was_penalised and not game.penalised:
-                pose = self.controller.world.pose
-                side = -1.0 if pose.y_m < 0 else 1.0
-                reentry = Pose(x_m=-3.0, y_m=3.2 * side, yaw_rad=-side * math.pi / 2)
-                self.controller.reset_pose(reentry, check_side=False)
-            was_penalised = game.penalised
+            placement.follow(self.controller, game)
             targets = self.controller.tick(_sensors(measurement, image), game)
+            if game.phase is not previous_phase:
+                self._log_belief(game.phase)
+                previous_phase = game.phase
             if self.options.behaviour is Behaviour.IGNORE_SIGTERM or targets:
                 try:
                     client.set_positions(targets)
@@ -215,6 +242,13 @@ class StubRobot:
                     logger.warning("lost the simulator connection: %s", exc)
                     return None
         return 0
+
+    def _log_belief(self, phase: GameState) -> None:
+        """Where the robot believes it is when the game state changes (in the frame of its own
+        odometry: the team file's, turned by pi when it plays on the mirrored side)."""
+        pose = self.controller.world.pose
+        logger.info("%s: pose belief (%.2f, %.2f, %.2f)", phase.name, pose.x_m, pose.y_m,
+                    pose.yaw_rad)
 
 
 def _kick_policy(options: StubOptions) -> Policy | None:
