@@ -53,7 +53,9 @@ AIM_HALF_WIDTH_M = 0.8  # aim this close to the goal centre (posts at 1.3 m)
 # stands there), towards this point (fractions of the half length: 3 m, 1 m on the kid field)
 KICK_OFF_AIM = (0.67, 0.22)
 KICK_OFF_AIM_TOLERANCE_RAD = 0.12
-KICK_OFF_SHORT_M = 0.08  # READY: the ball this much farther than the kick spot (no touching)
+KICK_OFF_PLACE_M = 0.06  # READY: the kick-off striker's place against the ball, this close
+KICK_OFF_YAW_RAD = 0.08  # ... and its heading this close to the kick-off pass
+KICK_OFF_SHORT_M = 0.04  # READY: the ball this much farther than the kick spot (no touching)
 CENTRE_SPOT_M = 0.3  # a ball this close to the centre spot is a kick-off ball
 SEARCH_TURN_AFTER_S = 2.0
 DEFENDER_HOME = (-2.3, 0.0)  # when none is given
@@ -88,7 +90,18 @@ def decide(
     if game.phase is GameState.FINISHED:
         return STAND
     if game.phase is GameState.READY:
-        return _go_to(pose, _kick_off_position(role, game, field, home), fast_m_s=field.fast_m_s)
+        target = _kick_off_position(role, game, field, home)
+        if role is Role.STRIKER and game.our_kick_off and ball is not None:
+            ball_field = pose.to_field(*ball)
+            if math.hypot(*ball_field) < CENTRE_SPOT_M:
+                # The ball on the centre spot is a landmark: place against it, not against the
+                # odometry (a few centimetres off after the walk), so that the kick-off comes
+                # at once in PLAYING instead of after seconds of lining up.
+                target = Pose(x_m=target.x_m + ball_field[0], y_m=target.y_m + ball_field[1],
+                              yaw_rad=target.yaw_rad)
+                return _go_to(pose, target, fast_m_s=field.fast_m_s,
+                              tolerance_m=KICK_OFF_PLACE_M, yaw_tolerance_rad=KICK_OFF_YAW_RAD)
+        return _go_to(pose, target, fast_m_s=field.fast_m_s)
     # PLAYING
     if not game.our_kick_off and game.ball_free_in_s > 0:
         return STAND  # the opponents' kick-off: keep out of the centre circle
@@ -151,17 +164,26 @@ def _defender(
     return _face(ball, tolerance_rad=0.3)
 
 
-def _go_to(pose: Pose, target: Pose, *, fast_m_s: float, tolerance_m: float = 0.2) -> Action:
+def _go_to(pose: Pose, target: Pose, *, fast_m_s: float, tolerance_m: float = 0.2,
+           yaw_tolerance_rad: float = 0.2) -> Action:
+    """Walk to ``target`` facing where it walks, then turn to the target's heading.
+
+    Near the target (within twice the tolerance) it turns to the final heading and steps the
+    last centimetres forwards, backwards and sideways: turning in place moves the robot a
+    little, and walking back to the target's centre would undo the turn each time."""
     x, y = pose.to_relative(target.x_m, target.y_m)
     distance = math.hypot(x, y)
+    error = _wrap(target.yaw_rad - pose.yaw_rad)
     if distance < tolerance_m:
-        error = _wrap(target.yaw_rad - pose.yaw_rad)
-        if abs(error) < 0.2:
+        if abs(error) < yaw_tolerance_rad:
             return STAND
         return Action(walk=(0.0, 0.0, _clip(1.2 * error, 0.5)))
+    if distance < 2.0 * tolerance_m:
+        return Action(walk=(_clip(0.6 * x, 0.12, low=-0.05), _clip(0.6 * y, 0.05),
+                            _clip(1.2 * error, 0.5)))
     bearing = math.atan2(y, x)
-    # full speed while far: from the opponent goal back to the own half takes most of READY
-    forward = (fast_m_s if distance > 1.0 else 0.15) if abs(bearing) < 0.35 else 0.0
+    # full speed while far, slowing down over the last metre to stop on the target
+    forward = min(fast_m_s, max(0.12, 0.6 * distance)) if abs(bearing) < 0.35 else 0.0
     return Action(walk=(forward, 0.0, _clip(1.5 * bearing, 0.6)))
 
 

@@ -70,3 +70,37 @@ def test_a_far_ball_is_walked_to_at_the_models_cruise_speed() -> None:
         assert far.walk[0] == ready.walk[0] == field.fast_m_s  # type: ignore[attr-defined]
         speeds[model] = field.fast_m_s
     assert speeds == {"kid-default": 0.4, "adult-default": 0.3}
+
+
+def test_near_its_ready_spot_it_turns_to_the_final_heading_while_stepping_the_rest() -> None:
+    """Just outside the spot's tolerance, behind it and facing the wrong way (a turn in place
+    drifted it): it keeps turning to the spot's heading (the opponent goal) and steps the last
+    centimetres, rather than turning back to face the spot's centre and undoing the turn."""
+    ready = GameInfo(phase=GameState.READY, our_kick_off=False)
+    spot = (-1.0, 0.0)  # facing the opponent goal (yaw 0)
+    pose = Pose(x_m=spot[0], y_m=spot[1] - 0.25, yaw_rad=1.2)  # 0.25 m short, facing left
+    action = decide(role=Role.STRIKER, game=ready, pose=pose, ball=None, field=FIELD,
+                    searching_s=0.0)  # fmt: skip
+    vx, vy, vyaw = action.walk  # type: ignore[attr-defined]
+    assert vyaw < 0.0  # towards yaw 0, although the spot's centre is ahead and to the left
+    assert vx > 0.0 and vy > 0.0  # the spot is ahead and to the left: stepped there
+    far = Pose(x_m=spot[0], y_m=spot[1] - 1.5, yaw_rad=1.4)
+    walk = decide(role=Role.STRIKER, game=ready, pose=far, ball=None, field=FIELD,
+                  searching_s=0.0).walk  # type: ignore[attr-defined]  # fmt: skip
+    assert walk[0] > 0.0 and walk[2] > 0.0  # far: walks to the spot, facing it
+
+
+def test_the_kick_off_striker_places_itself_against_the_ball_it_sees() -> None:
+    """READY of its own kick-off: the odometry puts the robot on its spot, but the ball (on the
+    centre spot) is seen 10 cm further to the right than the odometry says: it steps right."""
+    from robot.stub.behaviour import _kick_off_position
+
+    ready = GameInfo(phase=GameState.READY, our_kick_off=True)
+    spot = _kick_off_position(Role.STRIKER, ready, FIELD, None)
+    ball_seen = spot.to_relative(0.0, -0.10)  # the ball 10 cm right of the centre spot
+    assert decide(role=Role.STRIKER, game=ready, pose=spot, ball=spot.to_relative(0.0, 0.0),
+                  field=FIELD, searching_s=0.0) == STAND  # fmt: skip
+    action = decide(role=Role.STRIKER, game=ready, pose=spot, ball=ball_seen, field=FIELD,
+                    searching_s=0.0)  # fmt: skip
+    assert action.walk[1] < 0.0  # type: ignore[attr-defined]  # side-steps to the right
+

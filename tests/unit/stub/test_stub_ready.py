@@ -1,4 +1,5 @@
-"""In READY the stub walks from the touch line to its kick-off position by odometry alone."""
+"""In READY the stub walks from the touch line to its kick-off position by odometry, and the
+kick-off striker places itself against the ball it sees."""
 
 from __future__ import annotations
 
@@ -8,7 +9,10 @@ import pytest
 
 from contracts.gamecontroller import GameState
 from contracts.geometry import Pose
+from contracts.timing import SCRIMMAGE
 from robot.stub import GameInfo, Role, StubController
+from robot.stub.behaviour import KICK_OFF_AIM, KICK_OFF_SHORT_M
+from simulator.world import CameraRenderer
 
 from .motion_world import OneRobot
 
@@ -37,3 +41,29 @@ def test_walks_to_the_kick_off_position_in_ready(role: Role, target: tuple[float
     assert math.hypot(x - target[0], y - target[1]) < 0.5
     assert abs(robot.yaw) < 0.4  # facing the opponent goal
     assert controller.last_action is not None and controller.last_action.stands
+
+
+def test_the_kick_off_striker_stands_at_the_ball_before_a_short_ready_ends() -> None:
+    """From the scrimmage's touch-line spot, in the scrimmage's 20 s READY: the striker of the
+    kicking team walks to the ball on the centre spot and places itself against the ball it
+    sees (not by odometry alone), facing the kick-off pass with the ball in front of its left
+    foot, so that PLAYING starts with the kick rather than with seconds of lining up."""
+    start = Pose(x_m=-0.8, y_m=-3.1, yaw_rad=math.pi / 2)
+    robot = OneRobot(x_m=start.x_m, y_m=start.y_m, yaw_rad=start.yaw_rad)
+    robot.place_ball(0.0, 0.0)
+    controller = StubController(role=Role.STRIKER, start_pose=start)
+    game = GameInfo(phase=GameState.READY, our_kick_off=True, on_left=True)
+    field = controller.field
+    with CameraRenderer(robot.world, 320, 240) as camera:
+        assert robot.run(SCRIMMAGE.ready_duration_s,
+                         lambda: controller.tick(robot.sensors(camera), game)), "fell"
+    assert controller.last_action is not None and controller.last_action.stands
+    ball = robot.ball_position
+    assert math.hypot(ball[0], ball[1]) < 0.01  # not touched
+    dx, dy = ball[0] - robot.position[0], ball[1] - robot.position[1]
+    c, s = math.cos(robot.yaw), math.sin(robot.yaw)
+    ahead, left = c * dx + s * dy, -s * dx + c * dy  # the ball in the robot's frame
+    assert abs(ahead - (field.kick_x_m + KICK_OFF_SHORT_M)) < 0.05, (ahead, left)
+    assert abs(left - field.foot_y_m) < 0.04, (ahead, left)
+    aim_x, aim_y = KICK_OFF_AIM[0] * field.half_length_m, KICK_OFF_AIM[1] * field.half_length_m
+    assert abs(math.remainder(robot.yaw - math.atan2(aim_y, aim_x), math.tau)) < 0.15
