@@ -64,6 +64,10 @@ KID_THIGH_M = 0.16  # kid-default's; the hold above and the kick spot scale with
 # sighting nearer than this moves the believed position by the gain towards what it implies)
 CENTRE_BALL_MAX_M = 1.5  # farther, the ball's distance is underestimated by up to a third
 CENTRE_BALL_GAIN = 0.2
+# ... and only a sighting this close to the centre spot by the odometry counts: something else
+# that looks like a ball (a goal's black and white net, seen by a goalie walking past it) would
+# drag the believed position metres away
+CENTRE_BALL_GATE_M = 1.0
 # rise into the stance only when standing this upright (placed by the referee), not while
 # tipping over (when the knees lag their targets too)
 RISE_MAX_TILT_RAD = 0.2
@@ -296,7 +300,8 @@ class StubController:
             seen = self._look(sensors)
             on_centre_spot = game.phase in (GameState.READY, GameState.SET) and not game.penalised
             if seen is not None and on_centre_spot and math.hypot(*seen) < CENTRE_BALL_MAX_M:
-                self.world.relocate_from_centre_ball(*seen, gain=CENTRE_BALL_GAIN)
+                if math.hypot(*self.world.pose.to_field(*seen)) < CENTRE_BALL_GATE_M:
+                    self.world.relocate_from_centre_ball(*seen, gain=CENTRE_BALL_GAIN)
         if self._motion is None and self._moved_by_someone_else(sensors.joints):
             # teleported (half time, penalty) or limp: joints are not where we put them
             self.settle(sensors.time_ms)
