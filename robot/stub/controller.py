@@ -178,6 +178,7 @@ class StubController:
         with the robot down) is dropped and the orientation is taken afresh from gravity."""
         self.world.reset_pose(pose)
         self._heading = HeadingTracker(hold_s=RESET_HOLD_S)
+        self.attitude.reset()  # placed upright: the filter would take a second to forget a fall
         if self._motion is not None:
             self._motion = None
             self._motion_kind = ""

@@ -57,3 +57,34 @@ def test_a_penalty_that_ends_during_play_puts_the_robot_at_its_reentry_point() -
         placement.follow(controller, game)
     pose = controller.world.pose  # the touch line of its own half it was nearer to
     assert (pose.x_m, pose.y_m, pose.yaw_rad) == pytest.approx((-3.0, -3.2, math.pi / 2))
+
+
+def test_a_robot_placed_upright_while_getting_up_knows_at_once_it_stands() -> None:
+    """A half ends while the robot gets up; the referee places it upright at its half-time
+    pose. With the new half (its pose reset) the get-up is dropped and the attitude is taken
+    from the accelerometer afresh: it walks its READY without falling, instead of balancing for
+    a second against the fall it remembers."""
+    from referee.snapshot import TeleportRobot
+
+    from .motion_world import RED1
+
+    robot = OneRobot(x_m=-1.0, y_m=-2.0, yaw_rad=math.pi / 2)
+    controller = StubController(role=Role.STRIKER, start_pose=TEAM_FILE_POSE)
+    playing = GameInfo(phase=GameState.PLAYING, on_left=True)
+    robot.lay_down("front")
+    assert robot.run(1.5, lambda: controller.tick(robot.sensors(), playing),
+                     stop_on_fall=False)
+    assert controller.busy == "get-up"
+    assert controller.attitude.attitude.pitch_rad > 0.3  # it knows it is not upright
+    robot.world.apply(TeleportRobot(robot=RED1, pose=Pose(x_m=0.8, y_m=-3.1,
+                                                           yaw_rad=math.pi / 2)))
+    second_half = GameInfo(phase=GameState.READY, first_half=False, on_left=False,
+                           our_kick_off=False)
+    placement = RefereePlacement(TEAM_FILE_POSE)
+    placement.follow(controller, playing)
+    placement.follow(controller, second_half)
+    assert controller.busy == ""
+    robot.command(controller.tick(robot.sensors(), second_half))
+    att = controller.attitude.attitude
+    assert abs(att.pitch_rad) < 0.1 and abs(att.roll_rad) < 0.1
+    assert robot.run(6.0, lambda: controller.tick(robot.sensors(), second_half)), "fell"
