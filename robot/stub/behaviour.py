@@ -91,16 +91,15 @@ def decide(
         return STAND
     if game.phase is GameState.READY:
         target = _kick_off_position(role, game, field, home)
-        if role is Role.STRIKER and game.our_kick_off and ball is not None:
-            ball_field = pose.to_field(*ball)
-            if math.hypot(*ball_field) < CENTRE_SPOT_M:
-                # The ball on the centre spot is a landmark: place against it, not against the
-                # odometry (a few centimetres off after the walk), so that the kick-off comes
-                # at once in PLAYING instead of after seconds of lining up.
-                target = Pose(x_m=target.x_m + ball_field[0], y_m=target.y_m + ball_field[1],
-                              yaw_rad=target.yaw_rad)
-                return _go_to(pose, target, fast_m_s=field.fast_m_s,
-                              tolerance_m=KICK_OFF_PLACE_M, yaw_tolerance_rad=KICK_OFF_YAW_RAD)
+        ball_field = _kick_off_ball(pose, ball) if game.our_kick_off else None
+        if role is Role.STRIKER and ball_field is not None:
+            # The ball on the centre spot is a landmark: place against it, not against the
+            # odometry (a few centimetres off after the walk), so that the kick-off comes at
+            # once in PLAYING instead of after seconds of lining up.
+            target = Pose(x_m=target.x_m + ball_field[0], y_m=target.y_m + ball_field[1],
+                          yaw_rad=target.yaw_rad)
+            return _go_to(pose, target, fast_m_s=field.fast_m_s,
+                          tolerance_m=KICK_OFF_PLACE_M, yaw_tolerance_rad=KICK_OFF_YAW_RAD)
         return _go_to(pose, target, fast_m_s=field.fast_m_s)
     # PLAYING
     if not game.our_kick_off and game.ball_free_in_s > 0:
@@ -109,11 +108,18 @@ def decide(
         return _goalie(pose, ball, field, searching_s)
     if role is Role.DEFENDER:
         return _defender(pose, ball, field, searching_s, home or DEFENDER_HOME)
-    if game.our_kick_off and ball is not None:
-        ball_field = pose.to_field(*ball)
-        if math.hypot(*ball_field) < CENTRE_SPOT_M:
-            return _striker(pose, ball, field, searching_s, aim=_kick_off_aim(field))
+    if game.our_kick_off and _kick_off_ball(pose, ball) is not None:
+        return _striker(pose, ball, field, searching_s, aim=_kick_off_aim(field))
     return _striker(pose, ball, field, searching_s)
+
+
+def _kick_off_ball(pose: Pose, ball: tuple[float, float] | None) -> tuple[float, float] | None:
+    """The ball's field position when it is seen on the centre spot (a kick-off ball), else
+    None."""
+    if ball is None:
+        return None
+    ball_field = pose.to_field(*ball)
+    return ball_field if math.hypot(*ball_field) < CENTRE_SPOT_M else None
 
 
 def _kick_off_aim(field: Field) -> tuple[float, float]:

@@ -11,7 +11,7 @@ from contracts.gamecontroller import GameState
 from contracts.geometry import Pose
 from contracts.timing import SCRIMMAGE
 from robot.stub import GameInfo, Role, StubController
-from robot.stub.behaviour import KICK_OFF_AIM, KICK_OFF_SHORT_M
+from robot.stub.behaviour import KICK_OFF_SHORT_M, _kick_off_aim
 from simulator.world import CameraRenderer
 
 from .motion_world import OneRobot
@@ -65,7 +65,7 @@ def test_the_kick_off_striker_stands_at_the_ball_before_a_short_ready_ends() -> 
     ahead, left = c * dx + s * dy, -s * dx + c * dy  # the ball in the robot's frame
     assert abs(ahead - (field.kick_x_m + KICK_OFF_SHORT_M)) < 0.05, (ahead, left)
     assert abs(left - field.foot_y_m) < 0.04, (ahead, left)
-    aim_x, aim_y = KICK_OFF_AIM[0] * field.half_length_m, KICK_OFF_AIM[1] * field.half_length_m
+    aim_x, aim_y = _kick_off_aim(field)
     assert abs(math.remainder(robot.yaw - math.atan2(aim_y, aim_x), math.tau)) < 0.15
 
 
