@@ -9,6 +9,8 @@ PY     := $(VENV)/bin/python
 HLVS   := $(VENV)/bin/hlvs
 BUILD  := .build
 PYTEST_ARGS ?=
+# pytest-xdist workers for `make test` (tests/conftest.py says what may run at once); 0: one process
+TEST_WORKERS ?= 2
 
 .PHONY: cluster scrimmage test setup venv system engine postgres images lint typecheck clean-build web
 
@@ -16,7 +18,7 @@ scrimmage: setup
 	$(HLVS) scrimmage --out matches/scrimmage
 
 test: setup postgres lint typecheck
-	$(PY) -m pytest $(PYTEST_ARGS)
+	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadgroup --no-loadscope-reorder $(PYTEST_ARGS)
 
 setup: venv system engine images
 

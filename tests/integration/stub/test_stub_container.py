@@ -23,13 +23,17 @@ def stub_image() -> str:
     return str(project_image("stub"))
 
 
+# the label value of this run's containers: the fixture removes these and no other test's
+_RUN = uuid.uuid4().hex[:12]
+
+
 @pytest.fixture()
 def engine() -> Iterator[Any]:
     from orchestrator.engine import connect
 
     client = connect()
     yield client
-    for container in client.containers.list(all=True, filters={"label": f"{TEST_LABEL}=1"}):
+    for container in client.containers.list(all=True, filters={"label": f"{TEST_LABEL}={_RUN}"}):
         container.remove(force=True)
     client.close()
 
@@ -42,7 +46,7 @@ def _run(engine: Any, image: str, command: list[str], logs: Path) -> Any:
         command=command,
         detach=True,
         name=f"hlvs-test-stub-{uuid.uuid4().hex[:8]}",
-        labels={TEST_LABEL: "1"},
+        labels={TEST_LABEL: _RUN},
         network_mode="none",
         environment={
             "ROBOCUP_ROBOT_ID": "3",
