@@ -422,6 +422,14 @@ def test_the_readmes_have_commands_and_each_is_known_or_marked() -> None:
     assert not set(OUTCOMES) - keys, "OUTCOMES for commands no README has any more"
 
 
+# Each command is bounded by its own outcome's timeout (and those of the commands it runs after),
+# not by the suite's 600 s per test: the README's render runs longer while another test runs.
+LONGEST_S = max(
+    o.timeout_s + sum(OUTCOMES[k].timeout_s for k in o.after) for o in OUTCOMES.values()
+)
+
+
+@pytest.mark.timeout(LONGEST_S + 60)
 @pytest.mark.parametrize("command", COMMANDS, ids=[c.id for c in COMMANDS])
 def test_readme_command(command: Command, session: Session) -> None:
     if command.skip is not None:
