@@ -91,8 +91,9 @@ def decide(
         return STAND
     if game.phase is GameState.READY:
         target = _kick_off_position(role, game, field, home)
-        ball_field = _kick_off_ball(pose, ball) if game.our_kick_off else None
-        if role is Role.STRIKER and ball_field is not None:
+        kicks_off = role is Role.STRIKER and game.our_kick_off
+        ball_field = _kick_off_ball(pose, ball) if kicks_off else None
+        if ball_field is not None:
             # The ball on the centre spot is a landmark: place against it, not against the
             # odometry (a few centimetres off after the walk), so that the kick-off comes at
             # once in PLAYING instead of after seconds of lining up.
