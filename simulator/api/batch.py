@@ -5,10 +5,12 @@ once per robot. A :class:`StepBatch` makes them once per step:
 
 - the regular sensors of every measurement of the step: one gather from the world
   (:meth:`simulator.world.World.sensor_gatherer` over the robots' concatenated
-  :meth:`~simulator.world.World.sensor_sources`), one scatter of the values and
-  one write of the step's head (time, real time) into a buffer of the concatenated framed
+  :meth:`~simulator.world.World.sensor_sources`), then one scatter of the values and
+  one write of the step's head (time, real time) into a copy of the concatenated framed
   templates (length prefix, head, :class:`simulator.api.encode.SensorLayout`; the fixed bytes
-  stay in place from step to step), cut into each robot's framed message;
+  are in the template), cut into each robot's framed message. The two parts can run on two
+  threads (:meth:`StepBatch.gather` reads the world on the step thread; the I/O thread writes
+  the bytes with :meth:`Gathered.write` while the next step is computed);
 - the position targets of every robot that sent the usual request (the same motor names as
   before, robot active): one clamped write (:meth:`simulator.world.World.motor_targets_writer`;
   the I/O thread made each robot's targets an array as it read them).
@@ -46,7 +48,8 @@ class _Encoding:
     for every robot of a step): the framed messages of robots without messages or cameras are
     cut out whole; the others take their sensors only."""
 
-    __slots__ = ("gather", "buffer", "array", "byte_index", "heads", "frames", "sensors")
+    __slots__ = ("gather", "template", "byte_index", "rows", "head_index", "head_size",
+                 "frames", "sensors")  # fmt: skip
 
     def __init__(
         self,
@@ -88,28 +91,63 @@ class _Encoding:
 
         # the values of every robot's due sensors in order: one call per step
         self.gather = gatherer((joined(out_q), joined(src_q), joined(out_s), joined(src_s)))
-        # the wire bytes, written in place every step (the fixed bytes never change)
-        self.buffer = bytearray(np.concatenate(templates).tobytes())
-        self.array = np.frombuffer(self.buffer, dtype=np.uint8)
+        # the wire bytes: the fixed ones in place; each step writes values and heads into a
+        # copy (steps may be written on the I/O thread while the next one is gathered)
+        self.template = np.concatenate(templates)
+        self.template.flags.writeable = False
         self.byte_index = joined(byte_index)
+        self.head_size = head_size
         spans = {end - start for start, end in frames}
-        if len(spans) == 1:  # robots with the same sensors: the heads are one strided view
-            span = spans.pop()
-            rows = self.array.reshape(len(plans), span)
-            self.heads: npt.NDArray[np.uint8] | npt.NDArray[np.int64] = rows[
-                :, HEADER.size : HEADER.size + head_size
-            ]
-        else:
-            self.heads = joined(head_index).reshape(len(plans), head_size)
+        # robots with the same sensors: the heads are one strided view of the rows
+        self.rows = len(plans) if len(spans) == 1 else 0
+        self.head_index = joined(head_index).reshape(len(plans), head_size)
         self.frames = tuple(frames)
         self.sensors = tuple(sensors)
 
-    def write_head(self, head: bytes) -> None:
-        values = np.frombuffer(head, dtype=np.uint8)
-        if self.heads.dtype == np.uint8:
-            self.heads[:] = values
-        else:
-            self.array[self.heads] = values
+    def write(
+        self, values: npt.NDArray[np.float64], head: bytes, measurements: Sequence[Measurement]
+    ) -> None:
+        """Write one step's ``values`` (from :attr:`gather`) and ``head`` into a copy of the
+        template and give each measurement its frame (a plain one) or its sensors."""
+        array = self.template.copy()
+        array[self.byte_index] = values.astype("<f8", copy=False).view(np.uint8)
+        if head:
+            head_bytes = np.frombuffer(head, dtype=np.uint8)
+            if self.rows:
+                size = self.head_size
+                array.reshape(self.rows, -1)[:, HEADER.size : HEADER.size + size] = head_bytes
+            else:
+                array[self.head_index] = head_bytes
+        raw = array.tobytes()
+        for measurement, frame, sensors in zip(
+            measurements, self.frames, self.sensors, strict=True
+        ):
+            if measurement.plain:
+                measurement.set_frame(raw[frame[0] : frame[1]])
+            else:
+                measurement.sensors = raw[sensors[0] : sensors[1]]
+
+
+class Gathered:
+    """One step's sensor values read from the world, not yet written as wire bytes:
+    :meth:`write` (on any thread: the world is not read again) fills the measurements."""
+
+    __slots__ = ("_encoding", "_values", "_head", "_measurements")
+
+    def __init__(
+        self,
+        encoding: _Encoding,
+        values: npt.NDArray[np.float64],
+        head: bytes,
+        measurements: list[Measurement],
+    ) -> None:
+        self._encoding = encoding
+        self._values = values
+        self._head = head
+        self._measurements = measurements
+
+    def write(self) -> None:
+        self._encoding.write(self._values, self._head, self._measurements)
 
 
 def _cached(cache: dict[K, V], key: K, build: Callable[[], V]) -> V:
@@ -144,25 +182,18 @@ class StepBatch:
         """Fill ``sensors`` of each measurement with the encoding of its plan (every plan has
         ``sources``), and ``frame`` of those without header (``head``: the step's
         :func:`~simulator.api.session.header_bytes`)."""
+        self.gather(items, head).write()
+
+    def gather(self, items: Sequence[tuple[Measurement, DuePlan]], head: bytes) -> Gathered:
+        """:meth:`encode` in two parts: the values are read from the world now, the bytes
+        are written by the result's :meth:`Gathered.write`."""
         plans = tuple([plan for _, plan in items])
         encoding = _cached(
             self._encodings,
             (plans, len(head)),
             lambda: _Encoding(plans, len(head), self._gatherer),
         )
-        values = encoding.gather()
-        encoding.array[encoding.byte_index] = values.astype("<f8", copy=False).view(np.uint8)
-        if head:
-            encoding.write_head(head)
-        raw = memoryview(encoding.buffer)
-        for (measurement, _), frame, sensors in zip(
-            items, encoding.frames, encoding.sensors, strict=True
-        ):
-            if measurement.plain:
-                measurement.set_frame(bytes(raw[frame[0] : frame[1]]))
-            else:
-                measurement.sensors = bytes(raw[sensors[0] : sensors[1]])
-        raw.release()
+        return Gathered(encoding, encoding.gather(), head, [m for m, _ in items])
 
     def set_targets(self, items: Sequence[tuple[TargetPlan, TargetValues]]) -> None:
         """Write the position targets of several robots (distinct actuators) at once."""

@@ -1,11 +1,13 @@
 """A thread that does the clients' socket I/O in async and pipelined stepping.
 
 A kernel ``send`` and ``recv`` per client per step are most of the robot API's cost on the
-step thread. With this thread the step thread only appends each framed measurement to its
-connection's bounded queue (:meth:`simulator.api.connection.Connection.send`), wakes this thread
-and takes the requests this thread has decoded (:meth:`Connection.take_requests`); the writes
-and reads happen while the step thread is back in the physics (MuJoCo releases the GIL while it
-steps). A client that does not read only fills its own queue (the oldest measurements are
+step thread. With this thread the step thread only reads the step's sensor values, hands the
+step's measurements over (:meth:`SendThread.submit`: this thread writes their wire bytes, frames
+them, counts them in each robot's quota and appends each to its connection's bounded queue) and
+takes the requests this thread has decoded (:meth:`Connection.take_requests`); that work, the
+writes and the reads happen while the step thread is back in the physics (MuJoCo releases the
+GIL while it steps). A step thread more than ``MAX_JOBS`` steps ahead waits for this thread.
+A client that does not read only fills its own queue (the oldest measurements are
 dropped and counted as before). A socket error, end of stream or bad frame is left on the
 connection (``error``) for the step thread to drop it, logged once there. An unexpected error
 ends the thread and is kept in ``failure``; the server raises it at its next step
@@ -46,6 +48,7 @@ IDLE_WAIT_S = 0.05  # the longest the thread sleeps without being woken
 POLL_BELOW_S = 0.002  # steps closer than this: the thread polls (when ``poll`` is on)
 POLL_MIN_S = 0.0001  # shortest sleep between polls
 POLL_LATE_S = 0.00003  # polled this long after a step's frames are due (the step's jitter)
+MAX_JOBS = 2  # jobs waiting before submit waits (this step's, and the previous one still running)
 PERIOD_SAMPLES = 6  # the period of the steps: the median of the last intervals between them
 SELECT_FD_LIMIT = 1024  # FD_SETSIZE: select(2) takes descriptor numbers below it
 READ = selectors.EVENT_READ
@@ -68,6 +71,7 @@ class SendThread:
         due instead of being woken."""
         self._on_news = on_news
         self._ready: deque[Connection] = deque()
+        self._jobs: deque[Callable[[], Iterable[Connection]]] = deque()
         self._changes: deque[tuple[bool, Connection]] = deque()  # (add?, connection)
         self._wake_r, self._wake_w = os.pipe()
         os.set_blocking(self._wake_r, False)
@@ -102,6 +106,17 @@ class SendThread:
         """The connections have new frames queued."""
         self._ready.extend(connections)
         self._signal()
+
+    def submit(self, job: Callable[[], Iterable[Connection]]) -> None:
+        """Run ``job`` on this thread (jobs in the order submitted), then write to the
+        connections it returns: the step thread hands over a step's framing and queueing.
+        When this thread is more than ``MAX_JOBS`` jobs behind, the caller waits for it (the
+        steps then go at the pace this thread delivers them, and the jobs waiting are
+        bounded)."""
+        self._jobs.append(job)
+        self._signal()
+        while len(self._jobs) > MAX_JOBS and self.failure is None and self._thread.is_alive():
+            time.sleep(POLL_MIN_S)  # releases the GIL: this thread catches up
 
     def close(self) -> None:
         self._stop = True
@@ -141,7 +156,7 @@ class SendThread:
                     now = time.monotonic()
                     self._polling = interval < POLL_BELOW_S and now - last_frames < POLL_BELOW_S
                 self._sleeping = True  # before the queues are looked at: see _signal
-                busy = bool(self._ready or self._changes)
+                busy = bool(self._ready or self._changes or self._jobs)
                 if busy:
                     timeout = 0.0
                 elif self._polling:  # just after the step thread queues the next frames
@@ -157,6 +172,8 @@ class SendThread:
                     selector = self._forget_closed(selector, masks)
                     continue
                 self._sleeping = False
+                while self._jobs:
+                    self._ready.extend(self._jobs.popleft()())
                 if poll and self._ready:
                     now = time.monotonic()
                     interval, last_frames = now - last_frames, now

@@ -5,7 +5,8 @@ All socket I/O is non-blocking and runs on the step thread at three points of ea
 physics step, :meth:`ApiServer.publish` after it), so the world is only touched by one thread and
 a client can never block the step (except with ``blocking_send``, the HLVS behaviour). In async
 stepping the clients' reads and writes go to an I/O thread (:mod:`simulator.api.sender`): the
-step thread queues measurements, takes decoded requests and goes back to the physics.
+step thread reads the step's sensor values, hands the measurements over (framed and queued
+there), takes decoded requests and goes back to the physics.
 
 Per step: every complete request received is applied (later ones override earlier targets),
 then one ``SensorMeasurements`` per connected robot is queued. Lockstep: :meth:`wait_lockstep`
@@ -26,11 +27,12 @@ from collections import deque
 from collections.abc import Callable, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
+from functools import partial
 
 from contracts import NetworkSpec, RobotApiStats, RobotId
 from contracts.robot_api import messages_pb2 as pb
 from referee import SpoofingLog
-from simulator.api.batch import StepBatch
+from simulator.api.batch import Gathered, StepBatch
 from simulator.api.cameras import MAX_IN_FLIGHT, ImageSource
 from simulator.api.connection import ClientClosed, Connection
 from simulator.api.devices import DeviceWorld
@@ -86,6 +88,16 @@ class _Pending:
 
     measurement: Measurement
     missing: int
+
+
+@dataclass(slots=True)
+class Prepared:
+    """The measurements of one step (:meth:`ApiServer.prepare`) and, with the I/O thread,
+    their sensor values read but not yet written as wire bytes (``unwritten``: the I/O thread
+    writes them before it queues the frames)."""
+
+    items: list[tuple[RobotSlot, Measurement]]
+    unwritten: Gathered | None = None
 
 
 @dataclass(slots=True, eq=False)
@@ -152,7 +164,10 @@ class ApiServer:
         self._wake_sent = False
         self._step_polls = 0
         self.connection_changes = 0  # clients welcomed or dropped so far
-        self._woken: list[Connection] = []
+        # with the I/O thread: this step's measurements to frame and queue there, in order
+        self._outgoing: list[tuple[RobotSlot, Connection, Measurement]] = []
+        self._unwritten: Gathered | None = None
+        self._sent_at = 0.0
         self._hold_told: set[tuple[int, int]] = set()  # (connection id, held sim time) told
         self.slots: dict[RobotId, RobotSlot] = {}
         for endpoint in endpoints:
@@ -531,10 +546,11 @@ class ApiServer:
         """Queue the measurement of the step that ended at ``time_ms`` for every client."""
         self.publish_prepared(self.prepare(time_ms))
 
-    def prepare(self, time_ms: int) -> list[tuple[RobotSlot, Measurement]]:
+    def prepare(self, time_ms: int) -> Prepared:
         """The measurements of the step that ended at ``time_ms`` for the connected clients,
-        read and encoded but not queued: :meth:`publish_prepared` queues them. Pipelined
-        stepping builds them before it waits for the answers to the previous ones."""
+        read but not queued: :meth:`publish_prepared` queues them. Pipelined stepping builds
+        them before it waits for the answers to the previous ones. Without the I/O thread they
+        are encoded here; with it the wire bytes are written there (``unwritten``)."""
         real_time = self._unix_ms()  # one instant for the whole step
         prepared: list[tuple[RobotSlot, Measurement]] = []
         batched: list[tuple[Measurement, DuePlan]] = []
@@ -550,28 +566,36 @@ class ApiServer:
                 batched.append((measurement, plan))
             else:
                 measurement.sensors = session.encode(plan)
-        if batched:
-            assert self._batch is not None
-            self._batch.encode(batched, header_bytes(time_ms, real_time))
-        return prepared
+        if not batched:
+            return Prepared(prepared)
+        assert self._batch is not None
+        gathered = self._batch.gather(batched, header_bytes(time_ms, real_time))
+        if self._sender is None:
+            gathered.write()
+            return Prepared(prepared)
+        return Prepared(prepared, gathered)
 
-    def publish_prepared(self, prepared: list[tuple[RobotSlot, Measurement]]) -> None:
+    def publish_prepared(self, prepared: Prepared) -> None:
         """Queue measurements made by :meth:`prepare` (a client dropped meanwhile gets none)."""
         jobs_all = []
         now = time.monotonic()
-        for slot, measurement in prepared:
+        unwritten = prepared.unwritten
+        for slot, measurement in prepared.items:
             conn = slot.conn
             if conn is None:
                 continue
             jobs = measurement.jobs
             conn.answered = False
-            if jobs:
-                jobs_all.extend(jobs)
+            if jobs or slot.pending:  # sent by this thread when its images are in
+                if unwritten is not None:
+                    unwritten.write()
+                    unwritten = None
+                if jobs:
+                    jobs_all.extend(jobs)
                 slot.pending.append(_Pending(measurement, len(jobs)))
-            elif slot.pending:
-                slot.pending.append(_Pending(measurement, 0))
             else:
                 self._send(slot, conn, measurement, now)
+        self._unwritten = unwritten
         if jobs_all:
             assert self._cameras is not None, "camera enabled without a render worker"
             self._cameras.submit(jobs_all)
@@ -582,11 +606,11 @@ class ApiServer:
     def _send(
         self, slot: RobotSlot, conn: Connection, measurement: Measurement, now: float
     ) -> None:
-        frame = self._framed(slot, measurement)
-        if conn.threaded:  # queued for the I/O thread (woken once per step by _flush_all)
-            conn.send_threaded(frame, now)
-            self._woken.append(conn)
+        if conn.threaded:  # framed and queued on the I/O thread (handed over by _flush_all)
+            self._outgoing.append((slot, conn, measurement))
+            self._sent_at = now
             return
+        frame = self._framed(slot, measurement)
         try:
             conn.send(frame, now)
         except ClientClosed as exc:
@@ -625,9 +649,11 @@ class ApiServer:
         if self._sender is not None:
             if self._sender.failure is not None:
                 raise IoThreadFailed(self._sender.failure) from self._sender.failure
-            if self._woken:
-                self._sender.wake(self._woken)
-                self._woken = []
+            if self._outgoing or self._unwritten is not None:
+                self._sender.submit(partial(self._deliver, self._outgoing, self._unwritten,
+                                            self._sent_at))  # fmt: skip
+                self._outgoing = []
+                self._unwritten = None
             return
         blocking = self._network.blocking_send
         for slot in self.slots.values():
@@ -636,6 +662,25 @@ class ApiServer:
             self._flush(slot)
             if blocking:
                 self._flush_blocking(slot)
+
+    def _deliver(
+        self,
+        outgoing: list[tuple[RobotSlot, Connection, Measurement]],
+        unwritten: Gathered | None,
+        now: float,
+    ) -> list[Connection]:
+        """I/O thread: write the step's wire bytes, frame each measurement (counted in its
+        robot's quota) and queue it; the connections to write to. The step thread is back in
+        the physics meanwhile (MuJoCo releases the GIL while it steps)."""
+        if unwritten is not None:
+            unwritten.write()
+        queued = []
+        for slot, conn, measurement in outgoing:
+            if conn.closed or conn.error is not None:
+                continue  # dropped since: the step thread forgets it
+            conn.send_threaded(self._framed(slot, measurement), now)
+            queued.append(conn)
+        return queued
 
     def _flush_blocking(self, slot: RobotSlot) -> None:
         """HLVS behaviour: wait until the client has taken everything (stalls the step)."""

@@ -10,9 +10,11 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from contracts.match_spec import NetworkSpec
+from contracts.robot_api import messages_pb2 as pb
 from robot.client import RobotClient
 from simulator.api import FakeDeviceWorld, LockstepSettings
 from simulator.api.connection import Connection
+from simulator.api.devices import KID_MOTORS
 from simulator.api.server import IoThreadFailed
 from tests.integration.api.harness import BLUE1, RED1, RED2, running_server, wait_until
 
@@ -28,6 +30,13 @@ def test_never_reading_client_does_not_stall_the_others() -> None:
         stalled = socket.create_connection(("127.0.0.1", ports[RED2]), timeout=5)
         stalled.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
         assert stalled.recv(8) == b"Welcome\0"
+        # every sensor at every step, then it never reads: large measurements fill the
+        # kernel's buffers within seconds, then its own queue
+        enable = pb.ActuatorRequests()
+        for name in [f"{m}S" for m in KID_MOTORS] + ["Accelerometer", "Gyro"]:
+            enable.sensor_time_steps.add(name=name, timeStep=8)
+        payload = enable.SerializeToString()
+        stalled.sendall(len(payload).to_bytes(4, "big") + payload)
         with _client(ports[RED1]) as reader:
             reader.enable_many({f"{m}S": 8 for m in ("Neck", "Head", "PelvL", "PelvR")})
             steps_before = driver.steps

@@ -11,7 +11,7 @@ from contracts.robot_api import messages_pb2 as pb
 from simulator.api.batch import StepBatch
 from simulator.api.fastreq import PositionTargets
 from simulator.api.framing import HEADER
-from simulator.api.session import RobotSession, header_bytes
+from simulator.api.session import DuePlan, Measurement, RobotSession, header_bytes
 from simulator.world import FORCE_SENSORS, MOTOR_NAMES, RobotPlacement, World
 
 ROBOTS = [RobotId(TeamColor.RED, 1), RobotId(TeamColor.RED, 2), RobotId(TeamColor.BLUE, 1)]
@@ -128,3 +128,38 @@ def test_a_limp_or_removed_robot_is_not_batched() -> None:
     world.removed[0] = True
     session.update_limp()
     assert session.take_targets([request]) is None
+
+
+def test_gathered_values_are_written_as_read_even_after_the_world_moves_on() -> None:
+    """With the I/O thread the values are read on the step thread and written as wire bytes
+    there later: the bytes are those of the step they were read in, and two gathered steps
+    written in any order do not share a buffer."""
+    world = _world()
+    sessions = _sessions(world)
+    for session in sessions:
+        _enable(session, {f"{m}S": 8 for m in MOTOR_NAMES} | {"Gyro": 8})
+    batch = StepBatch(world)
+
+    def measured() -> tuple[list[tuple[Measurement, DuePlan]], bytes, list[bytes]]:
+        while True:  # (the step that enabled them reports none)
+            world.step()
+            time_ms = world.sim_time_ms
+            due = [session.begin_measure(time_ms, 1234) for session in sessions]
+            items = [(m, plan) for m, plan in due if plan is not None]
+            if len(items) == len(sessions):
+                break
+        head = header_bytes(time_ms, 1234)
+        expected = [s.encode(plan) for s, (_, plan) in zip(sessions, items, strict=True)]
+        return items, head, expected
+
+    first_items, first_head, first_expected = measured()
+    first = batch.gather(first_items, first_head)
+    second_items, second_head, second_expected = measured()  # the world has moved on
+    second = batch.gather(second_items, second_head)
+    assert first_expected != second_expected
+    second.write()
+    first.write()
+    for items, head, expected in ((first_items, first_head, first_expected),
+                                  (second_items, second_head, second_expected)):  # fmt: skip
+        for (measurement, _), sensors in zip(items, expected, strict=True):
+            assert measurement.frame == HEADER.pack(len(head) + len(sensors)) + head + sensors

@@ -11,6 +11,7 @@ import os
 import resource
 import selectors
 import socket
+import threading
 import time
 from collections.abc import Iterator
 
@@ -232,4 +233,68 @@ def test_a_select_failure_without_a_closed_socket_fails_the_thread(
         assert not thread._thread.is_alive()
         assert isinstance(thread.failure, OSError)
     finally:
+        thread.close()
+
+
+def test_submitted_jobs_run_in_order_and_their_frames_are_written(
+    pair: tuple[Connection, socket.socket],
+) -> None:
+    """The step thread hands a step's framing over as a job: the jobs run on the thread in
+    the order submitted, and the connections they return are written to."""
+    conn, client = pair
+    thread = SendThread(poll=True)
+    thread.add(conn)
+    ran: list[int] = []
+    frames = [len(str(k)).to_bytes(4, "big") + str(k).encode() for k in range(200)]
+
+    def job(k: int) -> list[Connection]:
+        ran.append(k)
+        conn.send_threaded(frames[k], time.monotonic())
+        return [conn]
+
+    try:
+        for k in range(len(frames)):
+            thread.submit(lambda k=k: job(k))
+            time.sleep(0.0003)
+        expected = b"".join(frames)
+        received = b""
+        client.settimeout(5.0)
+        while len(received) < len(expected):
+            received += client.recv(65536)
+        assert received == expected
+        assert ran == list(range(len(frames)))
+    finally:
+        thread.close()
+
+
+def test_submit_waits_while_the_thread_is_behind() -> None:
+    """A thread more than ``MAX_JOBS`` jobs behind holds the step thread back: the jobs
+    waiting stay bounded (a world much faster than the thread would queue without end)."""
+    thread = SendThread(poll=False)
+    release = threading.Event()
+    waiting: list[int] = []
+
+    def slow() -> list[Connection]:
+        release.wait(5.0)
+        return []
+
+    try:
+        thread.submit(slow)  # the thread runs it and blocks
+        time.sleep(0.05)
+        for _ in range(sender_module.MAX_JOBS):
+            thread.submit(lambda: [])
+        done = threading.Event()
+
+        def one_more() -> None:
+            thread.submit(lambda: [])
+            waiting.append(len(thread._jobs))
+            done.set()
+
+        threading.Thread(target=one_more, daemon=True).start()
+        assert not done.wait(0.2)  # held back while the thread is behind
+        release.set()
+        assert done.wait(5.0)
+        assert waiting[0] <= sender_module.MAX_JOBS
+    finally:
+        release.set()
         thread.close()
