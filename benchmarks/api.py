@@ -58,7 +58,9 @@ def _parser() -> argparse.ArgumentParser:
         "--camera-robots", type=int, default=0, help="robots that enable the camera (0 = all)"
     )
     parser.add_argument(
-        "--render-processes", type=int, default=0, help="camera render processes (0: a thread)"
+        "--render-processes", type=int, default=-1,
+        help="camera render processes (0: a thread; default: as a match chooses, one per CPU "
+        "when the cameras render on the CPU)"
     )
     parser.add_argument("--stalled-client", action="store_true",
                         help="one more client that connects and never reads")
@@ -372,6 +374,8 @@ def _api_run(
         for r, p in zip(robots, ports, strict=True)
     ]
     stalled_robot = robots[-1] if stalled else None
+    if args.render_processes < 0:
+        args.render_processes = world_cameras.render_processes()
     cameras = world_cameras.world_render_worker(world, processes=args.render_processes)
     server = ApiServer(
         world=world,

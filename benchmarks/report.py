@@ -10,8 +10,10 @@ kind alike), each benchmark as a child process with small sizes:
   same run, so that a change of load between the two does not show as a ratio; also the ratio
   to a ``bench sim`` run and to a world-only run before it, the CPU ratios and the share of
   time the step waited for its clients;
-- ``cameras``: ``bench api --mode async`` with every robot's camera at 320x240 every 32 ms
-  (the real-time factor is the figure: rendering is most of the cost);
+- ``cameras``: ``bench api --mode async`` with every robot's camera at 320x240 every 32 ms,
+  rendered as a match renders them (``render_processes``: worker processes on the CPU
+  renderer, one per CPU; 0: one thread) (the real-time factor is the figure: rendering is most
+  of the cost);
 - ``bringup``: ``bench bringup`` (a real match of stub robots in Docker, images cached), once
   per run at most (``--bringup-repeats``); needs Docker and the project's images.
 
@@ -137,6 +139,7 @@ def _runners(args: argparse.Namespace) -> dict[str, Callable[[], dict[str, Any]]
             # what rendered: osmesa / llvmpipe is the CPU; egl with a GPU's name is the GPU
             "gl_backend": result.get("gl_backend"),
             "gl_renderer": result.get("gl_renderer"),
+            "render_processes": result.get("render_processes"),  # 0: one render thread
         }
 
     def bringup() -> dict[str, Any]:

@@ -45,6 +45,7 @@ class CameraRecord(TypedDict, total=False):
 
     frames: int
     render_s: float
+    render_processes: int  # 0: one render thread in the simulator process
     gl_backend: str
     gl_renderer: str  # llvmpipe: the CPU
     gl_error: str  # no offscreen OpenGL: camera requests failed

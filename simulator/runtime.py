@@ -117,7 +117,7 @@ def main(argv: list[str]) -> int:
 def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
     """Play the match of ``spec``, writing every output file into ``out``; returns the exit code."""
     from referee import Referee
-    from simulator.api.world_cameras import world_render_worker
+    from simulator.api.world_cameras import render_processes, world_render_worker
     from simulator.recorder import Recorder, replay_header
     from simulator.world import World
 
@@ -138,7 +138,10 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
     with ExitStack() as stack:
         referee = Referee(config=referee_config(spec), log_dir=out)
         stack.callback(referee.close)
-        cameras = world_render_worker(world)
+        processes = render_processes()
+        if processes:
+            log.info("robot cameras render in %d worker processes", processes)
+        cameras = world_render_worker(world, processes=processes)
         stack.callback(cameras.close)
         server = ApiServer(
             world=world,
@@ -210,7 +213,7 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
             "real_time_factor": _rtf(world.sim_time_ms, loop.real_time_s - loop.held_s),
             "robots": server.statistics(),
             "cameras": {"frames": cameras.frames, "render_s": round(cameras.render_s, 3),
-                        **camera_gl},
+                        "render_processes": processes, **camera_gl},
             "started_unix_s": round(started, 3),
             "versions": versions(),
         }

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import signal
 import subprocess
 import sys
@@ -201,3 +202,44 @@ def test_invalid_spec_exits_2_naming_file_and_field(tmp_path: Path) -> None:
     assert proc.returncode == 2
     assert str(spec_path) in proc.stderr and "/stepping" in proc.stderr
     assert "Traceback" not in proc.stderr
+
+
+def _camera_loop(port: int, images: list[bytes]) -> None:
+    """A client that enables the head camera and keeps every image."""
+    client = RobotClient("127.0.0.1", port, retries=200, retry_interval_s=0.02).connect()
+    try:
+        client.enable_many({"NeckS": 8, "Camera": 32})
+        for msg in client:
+            images.extend(bytes(camera.image) for camera in msg.cameras)
+            client.set_positions({"Neck": 0.0})
+    except ConnectionClosed:
+        pass
+    finally:
+        client.close()
+
+
+def test_a_match_renders_cameras_in_worker_processes_on_the_cpu(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """On the CPU renderer with two CPUs or more a match renders the robot cameras in worker
+    processes (one per CPU, at most four): the robot gets its images and ``sim_result.json``
+    says how they were rendered."""
+    monkeypatch.setenv("MUJOCO_GL", "osmesa")
+    cpus = len(os.sched_getaffinity(0))
+    spec = short_spec(stepping="lockstep")
+    images: list[bytes] = []
+    ports = [p.port for p in spec.red.players + spec.blue.players]
+    threads = [threading.Thread(target=_camera_loop, args=(ports[0], images)),
+               threading.Thread(target=_robot_loop, args=(ports[1], []))]  # fmt: skip
+    for thread in threads:
+        thread.start()
+    assert run_match(spec, tmp_path, gc_network=False) == 0
+    for thread in threads:
+        thread.join(timeout=10)
+    result = json.loads((tmp_path / "sim_result.json").read_text())
+    cameras = result["cameras"]
+    assert cameras["render_processes"] == (min(cpus, 4) if cpus >= 2 else 0)
+    assert cameras["gl_backend"] == "osmesa" and cameras["frames"] >= 10
+    assert len(images) >= 10
+    assert all(len(image) == 320 * 240 * 3 for image in images)
+    assert all(max(image) > 0 for image in images)  # not a black image from a failed worker

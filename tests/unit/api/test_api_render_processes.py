@@ -1,0 +1,28 @@
+"""How many processes render a match's robot cameras: one per CPU on the CPU renderer (at most
+four), a thread on the GPU or on a single CPU."""
+
+from __future__ import annotations
+
+import pytest
+
+from simulator.api import world_cameras
+from simulator.api.world_cameras import MAX_RENDER_PROCESSES, render_processes
+
+
+@pytest.mark.parametrize(
+    ("gl", "cpus", "expected"),
+    [
+        ("osmesa", 2, 2),
+        ("osmesa", 3, 3),
+        ("osmesa", 16, MAX_RENDER_PROCESSES),
+        ("osmesa", 1, 0),  # a simulator pinned to one CPU: the thread
+        ("egl", 16, 0),  # the GPU renders a frame in under a millisecond on one thread
+        ("", 16, 0),  # no offscreen back end chosen: the thread (as before)
+    ],
+)
+def test_render_processes(
+    monkeypatch: pytest.MonkeyPatch, gl: str, cpus: int, expected: int
+) -> None:
+    monkeypatch.setenv("MUJOCO_GL", gl)
+    monkeypatch.setattr(world_cameras.os, "sched_getaffinity", lambda pid: set(range(cpus)))
+    assert render_processes() == expected
