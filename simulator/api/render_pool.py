@@ -2,12 +2,12 @@
 
 A drop-in for :class:`simulator.api.cameras.RenderWorker` (same ``submit`` / ``completed`` /
 ``wake_fd`` / ``in_flight`` / ``close`` surface): each worker process gets a pickled copy of the
-world model at start, then per batch the joint state of the step the images are due for
-(``qpos``, ``mocap_pos``, ``mocap_quat``) and its share of the batch's jobs (round robin). It
-recomputes the kinematics and renders with :class:`simulator.world.CameraRenderer`; the images
-come back through a pipe, read by one thread per worker on the parent side. Threads in one
-process do not render in parallel (measured: two render threads were slower than one); separate
-processes do, with a core each.
+world model through its pipe at start, then per batch the joint state of the step the images
+are due for (``qpos``, ``mocap_pos``, ``mocap_quat``) and its share of the batch's jobs (round
+robin). It recomputes the kinematics and renders with :class:`simulator.world.CameraRenderer`;
+the images come back through a pipe, read by one thread per worker on the parent side. Threads
+in one process do not render in parallel (measured: two render threads were slower than one);
+separate processes do, with a core each.
 """
 
 from __future__ import annotations
@@ -36,16 +36,19 @@ class _Batch:
     remaining: int
 
 
-def _serve(
-    conn: Connection, model: Any, cameras: dict[RobotId, int], camera_model: Any, look: Any
-) -> None:
-    """Worker process body: render jobs until ``None`` or the parent is gone."""
+def _serve(conn: Connection) -> None:
+    """Worker process body: take the world (model, cameras, camera model, look), then render
+    jobs until ``None`` or the parent is gone."""
     from types import SimpleNamespace
 
     import mujoco
 
     from simulator.world import CameraRenderer
 
+    try:
+        model, cameras, camera_model, look = conn.recv()
+    except (EOFError, OSError):
+        return
     data = mujoco.MjData(model)
     index = SimpleNamespace(by_id={r: SimpleNamespace(camera=c) for r, c in cameras.items()})
     view = SimpleNamespace(
@@ -108,15 +111,19 @@ class RenderPool:
         ctx = mp.get_context("spawn")  # a clean process: no inherited threads or GL state
         for n in range(self._count):
             parent, child = ctx.Pipe()
-            proc = ctx.Process(
-                target=_serve,
-                args=(child, self._world.model, self._cameras, self._world.camera_model,
-                      self._world.look),
-                name=f"camera-render-{n}",
-                daemon=True,
-            )
+            # the world goes through the pipe, not the process's arguments: a worker that dies
+            # while it starts would leave the parent writing those to a pipe that the
+            # parent itself still holds open (multiprocessing's spawn), waiting for ever
+            proc = ctx.Process(target=_serve, args=(child,), name=f"camera-render-{n}",
+                               daemon=True)  # fmt: skip
             proc.start()
             child.close()
+            try:
+                parent.send((self._world.model, self._cameras, self._world.camera_model,
+                             self._world.look))  # fmt: skip
+            except OSError as exc:  # it died before it took the world: its jobs come back black
+                log.error("camera render process %d did not start: %s", n, exc)
+                self.error = exc
             reader = threading.Thread(
                 target=self._collect, args=(parent,), name=f"camera-results-{n}", daemon=True
             )

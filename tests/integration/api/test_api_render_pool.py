@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import os
 import select
+import sys
 import time
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -89,6 +91,26 @@ def test_dead_worker_gives_black_images() -> None:
         pool.submit(_jobs(world.sim_time_ms + 8))
         images = _collect(pool, 2)
         assert images and all(image == bytes(320 * 240 * 3) for image in images.values())
+        assert pool.error is not None and pool.in_flight == 0
+    finally:
+        pool.close()
+
+
+def test_a_worker_that_dies_while_it_starts_gives_black_images(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A worker that dies while it starts, before it took the world (the kernel's OOM killer
+    could do that): the pool does not wait for it (it used to wait for ever, writing the world
+    into a pipe it held open itself), its images come back black and the error is kept."""
+    (tmp_path / "sitecustomize.py").write_text("import os\nos._exit(1)\n")  # every new interpreter
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(tmp_path), *sys.path]))
+    world = _world()
+    pool = RenderPool(world, processes=2)
+    try:
+        pool.submit(_jobs(world.sim_time_ms))
+        images = _collect(pool, 2)
+        assert set(images) == {RED_1, BLUE_1}
+        assert all(image == bytes(320 * 240 * 3) for image in images.values())
         assert pool.error is not None and pool.in_flight == 0
     finally:
         pool.close()
