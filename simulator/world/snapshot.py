@@ -29,6 +29,7 @@ from collections.abc import Sequence
 
 import mujoco
 import numpy as np
+import numpy.typing as npt
 
 from contracts import RobotId
 from referee import BallState, BodyPart, RobotState, WorldSnapshot
@@ -58,16 +59,33 @@ _HEAD = 6  # ball position and velocity at the start of the gathered values
 _PER_ROBOT = 18  # x y z, up (torso z axis' z), centre of mass xyz, its velocity xyz, hull 4 x xy
 
 
-def ball_toucher(data: mujoco.MjData, index: WorldIndex) -> int:
-    """Robot number touching the ball in the last substep (lowest number), or -1.
+class BallToucher:
+    """The robot touching the ball in the last substep (lowest number), or -1: one contact
+    sensor per robot (MuJoCo counts the contacts in C). The robots' sensors are laid out
+    alike, so their ball-touch counts are one strided view of ``sensordata``, made once (MuJoCo
+    never moves the array): a step in which no robot touches the ball costs one ``any``, where
+    a fancy index and ``flatnonzero`` cost about 12 us right after ``mj_step``."""
 
-    Reads one contact sensor per robot (MuJoCo counts the contacts in C), which is much cheaper
-    than scanning the contact list in Python every step.
-    """
-    if index.ball_touch.size == 0:
-        return -1
-    touching = np.flatnonzero(data.sensordata[index.ball_touch])
-    return int(touching[0]) if touching.size else -1
+    def __init__(self, data: mujoco.MjData, index: WorldIndex) -> None:
+        adr = index.ball_touch
+        self._sensors = data.sensordata
+        self._adr: npt.NDArray[np.int64] | None = adr  # irregular addresses: gathered per read
+        self._counts: npt.NDArray[np.float64] | None = None
+        steps = set(np.diff(adr).tolist())
+        if adr.size == 1 or (len(steps) == 1 and min(steps) > 0):
+            stride = steps.pop() if steps else 1
+            self._counts = self._sensors[int(adr[0]) :: stride][: adr.size]
+            self._adr = None
+
+    def __call__(self) -> int:
+        counts = self._counts
+        if counts is None:
+            if self._adr is None or self._adr.size == 0:
+                return -1
+            counts = self._sensors[self._adr]
+        if not counts.any():
+            return -1
+        return int(np.flatnonzero(counts)[0])
 
 
 # per robot: bits of the parts on the turf, bits of the parts on the ball, robots touched

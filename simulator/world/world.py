@@ -37,7 +37,7 @@ from simulator.world.motors import MotorBank
 from simulator.world.robots import robot_model
 from simulator.world.scene import compile_scene
 from simulator.world.sensor_noise import SensorModel, SensorNoise
-from simulator.world.snapshot import SnapshotBuilder, ball_toucher
+from simulator.world.snapshot import BallToucher, SnapshotBuilder
 from simulator.world.types import DivergencePolicy, FieldClassName, RobotPlacement
 
 logger = logging.getLogger(__name__)
@@ -132,6 +132,7 @@ class World(DeviceAccess):
             self._readings = self.sensor_noise.values
         self._watch = DivergenceWatch(self.data)
         self._snapshots = SnapshotBuilder(self.data, self.index, self.robot_ids)
+        self._ball_toucher = BallToucher(self.data, self.index)
         self._saved = self._save()
 
     @classmethod
@@ -232,7 +233,7 @@ class World(DeviceAccess):
         divergence = self._watch.check(self.data)
         if divergence is not None:
             self._diverged(divergence.text(self._dof_name(divergence.info)), divergence.info)
-        toucher = ball_toucher(self.data, self.index)
+        toucher = self._ball_toucher()
         if toucher >= 0:
             self.last_ball_toucher = self.robot_ids[toucher]
             self.last_ball_touch_ms = self.sim_time_ms

@@ -27,6 +27,7 @@ from referee.snapshot import (
 )
 from simulator.world import RobotPlacement, World, robot_prefix
 from simulator.world.frozen import slot_constructor
+from simulator.world.snapshot import BallToucher
 
 RED_1, RED_2 = RobotId(TeamColor.RED, 1), RobotId(TeamColor.RED, 2)
 BLUE_1, BLUE_2, BLUE_3 = (RobotId(TeamColor.BLUE, n) for n in (1, 2, 3))
@@ -197,3 +198,27 @@ def test_slot_constructor_refuses_what_it_cannot_copy() -> None:
     for cls in (Mutable, NotSlotted, Checked):
         with pytest.raises(TypeError, match=cls.__name__):
             slot_constructor(cls)
+
+
+def test_ball_toucher_reads_the_lowest_robot_touching_the_ball() -> None:
+    """The strided view of the robots' ball-touch sensors (made once) reads what a gather of
+    their addresses reads, and sees later steps (MuJoCo never moves ``sensordata``)."""
+    world = World.create(
+        field_class="kid",
+        robots=[RobotPlacement(id=RobotId(TeamColor.RED if i % 2 else TeamColor.BLUE, i // 2 + 1),
+                               model="kid-default", x_m=-2.0 + i, y_m=1.0, yaw_rad=0.0)
+                for i in range(5)],  # fmt: skip
+        seed=1,
+    )
+    toucher = BallToucher(world.data, world.index)
+    adr = world.index.ball_touch
+    rng = np.random.default_rng(2)
+    for _ in range(50):
+        world.step()
+        world.data.sensordata[adr] = rng.integers(0, 2, adr.size) * rng.integers(1, 4, adr.size)
+        touching = np.flatnonzero(world.data.sensordata[adr])
+        assert toucher() == (int(touching[0]) if touching.size else -1)
+    world.data.sensordata[adr] = 0.0
+    assert toucher() == -1
+    empty = World.create(field_class="kid", robots=[], seed=1)
+    assert BallToucher(empty.data, empty.index)() == -1
