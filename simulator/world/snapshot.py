@@ -20,7 +20,10 @@ did not; eight robots moving every joint by a few degrees (the targets of ``benc
 to five sets of pairs in 1500 steps: 33 us per snapshot against 41 us when only the previous step's
 list was kept. With the stub striker and goalie playing (``run_shot`` of ``testkit.stub_world``,
 contacts reused in 41% of the steps) a two-robot snapshot costs 31 us against the previous
-builder's 87 us (medians, the same steps).
+builder's 87 us (medians, the same steps). With the cleats (a contact per cleat: 65 contacts for
+eight standing robots) making the set of pairs cost 8 us, the contact list's bytes are looked up
+first: ``contacts`` 15.3 -> 1.8 us and the snapshot 33 -> 20 us with warm caches; right after
+``mj_step`` the snapshot went from 4.4-4.8 % of the step's ``mj_step`` time to 3.0-3.5 %.
 """
 
 from __future__ import annotations
@@ -140,6 +143,7 @@ class SnapshotBuilder:
         self._none: ContactSets = ([0] * n, [0] * n, [_NOBODY] * n)
         # the classification of each set of geom pairs in contact seen lately
         self._known: dict[frozenset[int], ContactSets] = {}
+        self._listed: dict[bytes, ContactSets] = {}  # the same, by the contact list's bytes
 
     def build(
         self,
@@ -212,12 +216,19 @@ class SnapshotBuilder:
         if ncon == 0:
             return self._none
         geom = data.contact.geom[:ncon]
-        # the pairs in contact (each pair's two int32 as one int64), whatever their order and
-        # how many contacts each pair has: the classification depends on that set alone
+        # first the contact list itself, as bytes (a few hundred: hashed and compared in C):
+        # robots standing or moving their joints repeat it step after step
+        listed = geom.tobytes()
+        seen = self._listed.get(listed)
+        if seen is not None:
+            return seen
+        # then the pairs in contact (each pair's two int32 as one int64), whatever their order
+        # and how many contacts each pair has: the classification depends on that set alone
         pairs = frozenset(geom.view(np.int64).ravel().tolist())
         known = self._known
         seen = known.get(pairs)
         if seen is not None:
+            self._remember(listed, seen)
             return seen
         flags = np.zeros(self._bins, dtype=np.bool_)
         flags[self._own_code[geom] + self._other_code[geom[:, ::-1]]] = True
@@ -239,4 +250,10 @@ class SnapshotBuilder:
         if len(known) >= KNOWN_PAIR_SETS:
             known.clear()
         known[pairs] = sets
+        self._remember(listed, sets)
         return sets
+
+    def _remember(self, listed: bytes, sets: ContactSets) -> None:
+        if len(self._listed) >= KNOWN_PAIR_SETS:
+            self._listed.clear()
+        self._listed[listed] = sets
