@@ -28,7 +28,7 @@ first: ``contacts`` 15.3 -> 1.8 us and the snapshot 33 -> 20 us with warm caches
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import mujoco
 import numpy as np
@@ -71,21 +71,17 @@ class BallToucher:
 
     def __init__(self, data: mujoco.MjData, index: WorldIndex) -> None:
         adr = index.ball_touch
-        self._sensors = data.sensordata
-        self._adr: npt.NDArray[np.int64] | None = adr  # irregular addresses: gathered per read
-        self._counts: npt.NDArray[np.float64] | None = None
-        steps = set(np.diff(adr).tolist())
-        if adr.size == 1 or (len(steps) == 1 and min(steps) > 0):
-            stride = steps.pop() if steps else 1
-            self._counts = self._sensors[int(adr[0]) :: stride][: adr.size]
-            self._adr = None
+        sensors = data.sensordata
+        strides = np.unique(np.diff(adr))
+        self._counts: Callable[[], npt.NDArray[np.float64]]
+        if adr.size == 1 or (strides.size == 1 and strides[0] > 0):
+            view = sensors[int(adr[0]) :: int(strides[0]) if strides.size else 1][: adr.size]
+            self._counts = lambda: view
+        else:  # no robot, or irregular addresses: gathered per read
+            self._counts = lambda: sensors[adr]
 
     def __call__(self) -> int:
-        counts = self._counts
-        if counts is None:
-            if self._adr is None or self._adr.size == 0:
-                return -1
-            counts = self._sensors[self._adr]
+        counts = self._counts()
         if not counts.any():
             return -1
         return int(np.flatnonzero(counts)[0])
