@@ -5,6 +5,7 @@ import os
 import signal
 import socket
 import sys
+import threading
 import time
 
 LOGS = "/robocup-logs"
@@ -110,12 +111,23 @@ def main(argv):
         time.sleep(0.2)
         targets = json.load(open(path))
         reach = {}
-        for name, (host, port) in targets.items():
-            until = time.monotonic() + 5  # a teammate may still be starting: refused, retry
+
+        def probe(name, host, port):
+            """The simulator and teammates start side by side with this robot: until they are
+            up, a connection is refused, or times out while their address is not on the network
+            yet. Retry any failure for a while; a target that is walled off fails every time."""
+            until = time.monotonic() + 5
             reach[name] = try_connect(host, port)
-            while "refused" in reach[name] and time.monotonic() < until:
+            while reach[name] != "connected" and time.monotonic() < until:
                 time.sleep(0.2)
                 reach[name] = try_connect(host, port)
+
+        probes = [threading.Thread(target=probe, args=(name, host, port))
+                  for name, (host, port) in targets.items()]
+        for thread in probes:
+            thread.start()
+        for thread in probes:
+            thread.join()
         log("reach.json", reach)
         print("probe done", flush=True)
         wait_forever()
