@@ -436,6 +436,11 @@ def _api_run(
         # the machine's load falls on both alike: ``ratio_interleaved``
         reference = _world(robots, args.physics_dt, args.sensors) if camera is None else None
         move_reference = _client_targets(reference, robots) if reference is not None else None
+        if reference is not None and move_reference is not None:
+            for _ in range(50):  # the same warm-up as the API run's
+                move_reference()
+                reference.step()
+                reference.snapshot()
         chunk = max(1, INTERLEAVE_MS // world.step_ms)
         wall = cpu = ref_wall = ref_cpu = 0.0
         done = 0

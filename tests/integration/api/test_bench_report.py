@@ -13,7 +13,8 @@ from testkit.figures import median_figures as _median
 def test_report_runs_the_kinds_and_judges_medians_against_targets() -> None:
     proc = subprocess.run(
         [sys.executable, "-m", "hlvs", "bench", "report", "--only", "sim,pipelined",
-         "--repeats", "2", "--robots", "2", "--sim-seconds", "0.25", "--json"],
+         "--repeats", "2", "--robots", "2", "--sim-seconds", "0.25", "--world-seconds", "0.5",
+         "--json"],
         capture_output=True, text=True, timeout=300,
     )  # fmt: skip
     assert proc.returncode == 0, proc.stderr[-2000:]
