@@ -27,9 +27,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         "a robot model package folder (default: kid-default)")
     parser.add_argument("--blue-model", default=None, type=_model,
                         help="robot model of every blue robot (as --red-model)")
+    parser.add_argument("--class", dest="field_class", choices=("kid", "adult"), default=None,
+                        help="field size: kid (9 x 6 m, up to 4 players) or adult (14 x 9 m, up "
+                             "to 3); default: adult when a team plays adult-default, else kid")
     parser.add_argument("--players", type=int, default=1, choices=(1, 2, 3, 4),
                         help="robots per team: a striker, then a goalie, then defenders "
-                             "(default 1)")
+                             "(default 1; at most 3 on the adult field)")
     parser.add_argument("--half-duration", type=float, default=SCRIMMAGE.half_duration_s,
                         help="simulated seconds of game clock per half; READY and SET before the "
                         "half's kick-off stop the clock (default "

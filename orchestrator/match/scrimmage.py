@@ -21,16 +21,21 @@ from pathlib import Path
 from typing import Protocol
 
 from contracts import (
+    ADULT_FIELD,
+    KID_FIELD,
     MIN_PLAYING_S,
     MIN_READY_S,
     SCRIMMAGE,
     SET_TO_PLAY_S,
+    FieldClass,
+    FieldGeometry,
     SteppingMode,
     TimingError,
     fit_ready,
 )
 from orchestrator.config.documents import GameDocument, PlayerDocument, PoseDocument, TeamDocument
 from orchestrator.config.game import default_real_time_factor
+from orchestrator.config.model import DEFAULT_MODEL, MAX_PLAYERS
 from orchestrator.config.robot_models import MODEL_MANIFEST, is_model_path
 from orchestrator.errors import ConfigError, Problem
 
@@ -42,7 +47,8 @@ class ScrimmageRequest:
     """What the generated files depend on. ``ready_duration_s`` None: the scrimmage's READY
     (:data:`contracts.timing.SCRIMMAGE`), fitted to the half; ``minimum_play_s`` 0: a match not
     meant to play; images None play the project's stub image; models None the class's built-in
-    model."""
+    model; ``field_class`` None: the size class of the built-in models named (adult when a team
+    plays ``adult-default``), else kid."""
 
     players: int
     seed: int
@@ -59,6 +65,15 @@ class ScrimmageRequest:
     red_model: str | None = None
     blue_model: str | None = None
     minimum_play_s: float = MIN_PLAYING_S
+    field_class: FieldClass | None = None
+
+    @property
+    def field(self) -> FieldClass:
+        """The field the scrimmage is played on (``field_class``, else the models')."""
+        if self.field_class is not None:
+            return self.field_class
+        adult = DEFAULT_MODEL[FieldClass.ADULT]
+        return FieldClass.ADULT if adult in (self.red_model, self.blue_model) else FieldClass.KID
 
     @classmethod
     def from_options(cls, options: ScrimmageOptions) -> ScrimmageRequest:
@@ -77,6 +92,8 @@ class ScrimmageRequest:
             blue_model=getattr(options, "blue_model", None),
             minimum_play_s=MIN_PLAYING_S if getattr(options, "minimum_play", None) is None
             else options.minimum_play,  # type: ignore[attr-defined]
+            field_class=FieldClass(options.field_class)  # type: ignore[attr-defined]
+            if getattr(options, "field_class", None) else None,
         )
 
 
@@ -95,16 +112,6 @@ class ScrimmageOptions(Protocol):
     robot_command: str | None
 
 
-# Starting poses as if playing on the left (x < 0), on the own touch line facing the field;
-# the striker starts near the halfway line, so that it reaches its kick-off spot within the
-# scrimmage's READY.
-POSES_KID = {
-    "goalie": (-4.0, -3.1, 1.57),
-    "striker": (-0.8, -3.1, 1.57),
-    "defender-3": (-2.0, -3.1, 1.57),
-    "defender-4": (-3.0, -3.1, 1.57),
-}
-
 # Who plays, by team size: one striker alone; then a goalie; players 3 and 4 defend from spots
 # in the own half (several strikers chasing one ball mostly knock each other over).
 ROLES = {
@@ -113,38 +120,82 @@ ROLES = {
     3: ("goalie", "striker", "defender-3"),
     4: ("goalie", "striker", "defender-3", "defender-4"),
 }
-DEFENDER_HOMES = {"defender-3": (-2.3, 1.0), "defender-4": (-2.3, -1.0)}
 
 
-def _pose(x: float, y: float, yaw: float) -> PoseDocument:
-    return {"translation": [x, y, 0.43], "rotation": [0, 0, 1, yaw]}
+@dataclass(frozen=True, slots=True)
+class Spots:
+    """Where a field class's stub players stand, as if playing on the left (x < 0).
+
+    ``start``: on the own touch line facing the field (the striker near the halfway line, so
+    that it reaches its kick-off spot within the scrimmage's READY); ``homes``: the defenders'
+    spots in the own half; ``height_m``: the poses' z; ``goalkeeper_x_m``, ``shootout_x_m``:
+    the goal line pose and the penalty shoot-out's."""
+
+    start: dict[str, tuple[float, float, float]]
+    homes: dict[str, tuple[float, float]]
+    height_m: float
+    goalkeeper_x_m: float
+    shootout_x_m: float
+
+
+def _spots(field: FieldGeometry, height_m: float) -> Spots:
+    """The kid spots (measured with the stub) scaled to ``field``: x with the half length, y
+    with the half width, the touch line pose just outside the line."""
+    sx = field.half_length_m / KID_FIELD.half_length_m
+    sy = field.half_width_m / KID_FIELD.half_width_m
+    touch = round(-(field.half_width_m + 0.1), 2)
+    return Spots(
+        start={
+            "goalie": (round(-4.0 * sx, 2), touch, 1.57),
+            "striker": (round(-(field.centre_circle_radius_m + 0.05), 2), touch, 1.57),
+            "defender-3": (round(-2.0 * sx, 2), touch, 1.57),
+            "defender-4": (round(-3.0 * sx, 2), touch, 1.57),
+        },
+        homes={"defender-3": (round(-2.3 * sx, 2), sy), "defender-4": (round(-2.3 * sx, 2), -sy)},
+        height_m=height_m,
+        goalkeeper_x_m=round(-(field.half_length_m - 0.05), 2),
+        shootout_x_m=round(field.half_length_m - field.penalty_mark_distance_m - 0.4, 2),
+    )
+
+
+SPOTS = {FieldClass.KID: _spots(KID_FIELD, 0.43), FieldClass.ADULT: _spots(ADULT_FIELD, 0.9)}
+
+
+def _pose(x: float, y: float, yaw: float, z: float) -> PoseDocument:
+    return {"translation": [x, y, z], "rotation": [0, 0, 1, yaw]}
 
 
 def team_file(name: str, image: str, players: int, *, command: str | None = None,
-              goalie_first: bool = False, model: str | None = None) -> TeamDocument:
-    """A stub team of ``players`` with the roles of :data:`ROLES`; ``goalie_first`` makes a
-    lone player a goalie (an opponent that only defends); ``model`` the robot model of every
-    player (a built-in name or a model package folder; default: the class's built-in)."""
+              goalie_first: bool = False, model: str | None = None,
+              field_class: FieldClass = FieldClass.KID) -> TeamDocument:
+    """A stub team of ``players`` with the roles of :data:`ROLES` on a ``field_class`` field;
+    ``goalie_first`` makes a lone player a goalie (an opponent that only defends); ``model`` the
+    robot model of every player (a built-in name or a model package folder; default: the
+    class's built-in)."""
     repository, _, tag = image.rpartition(":") if ":" in image.split("/")[-1] else (image, "", "")
     entries: dict[str, PlayerDocument] = {}
     roles = ROLES[players]
     if goalie_first and roles[0] != "goalie":
         roles = ("goalie", *roles[1:])
-    # the stub drives the model it is told (gait, kick and get-up are per model), on the
-    # scrimmage's kid-size field whatever the model's size class
-    driven = f" --model {model} --field-class kid" if model and not is_model_path(model) else ""
+    spots = SPOTS[field_class]
+    # the stub drives the built-in model it is told (gait, kick and get-up are per model; a
+    # team's package is not one it knows) on the scrimmage's field
+    driven = f" --field-class {field_class.value}"
+    if model is None or not is_model_path(model):
+        driven = f" --model {model or DEFAULT_MODEL[field_class]}{driven}"
+    z = spots.height_m
     for n, slot in enumerate(roles, start=1):
-        x, y, yaw = POSES_KID[slot]
+        x, y, yaw = spots.start[slot]
         role = slot.split("-")[0]
-        extra = " --home {} {}".format(*DEFENDER_HOMES[slot]) if slot in DEFENDER_HOMES else ""
+        extra = " --home {:g} {:g}".format(*spots.homes[slot]) if slot in spots.homes else ""
         extra += driven
         entries[str(n)] = {
             # The stub cannot see where it was placed: its dockerCmd tells it (team-file frame).
-            "dockerCmd": command or f"{role} --start-pose {x} {y} {yaw}{extra}",
-            "halfTimeStartingPose": _pose(x, y, yaw),
-            "reentryStartingPose": _pose(x, y, yaw),
-            "shootoutStartingPose": _pose(2.6, 0.0, 0.0),
-            "goalKeeperStartingPose": _pose(-4.45, 0.0, 0.0),
+            "dockerCmd": command or f"{role} --start-pose {x:g} {y:g} {yaw:g}{extra}",
+            "halfTimeStartingPose": _pose(x, y, yaw, z),
+            "reentryStartingPose": _pose(x, y, yaw, z),
+            "shootoutStartingPose": _pose(spots.shootout_x_m, 0.0, 0.0, z),
+            "goalKeeperStartingPose": _pose(spots.goalkeeper_x_m, 0.0, 0.0, z),
         }
         if tag:
             entries[str(n)]["dockerTag"] = tag
@@ -181,7 +232,7 @@ def game_file(request: ScrimmageRequest, match_id: str) -> GameDocument:
     ready = quick_ready(request.half_duration_s, request.ready_duration_s, minimum)
     return {
         "type": "NORMAL",
-        "class": "KID",
+        "class": "ADULT" if request.field is FieldClass.ADULT else "KID",
         "host": "127.0.0.1",
         "maximum_real_time_factor": default_real_time_factor(request.stepping),
         "side_left": "red",
@@ -234,7 +285,14 @@ def write_files(request: ScrimmageRequest, folder: Path, *, stub_image: str | No
     """Write game.json and the two team files into ``folder``; returns the game.json path.
 
     A stub robot given a team model with other motor names would stand still: said loudly (a
-    WARNING, shown whatever the log level)."""
+    WARNING, shown whatever the log level). More players than the field's class allows is a
+    :class:`~orchestrator.errors.ConfigError` naming ``--players``."""
+    most = MAX_PLAYERS[request.field]
+    if request.players > most:
+        raise ConfigError([Problem(
+            file="hlvs scrimmage", pointer="--players",
+            message=f"{request.players} players per team on the {request.field.value} field",
+            expected=f"at most {most} (the {request.field.value}-size rules)")])
     for color, image, model in (("red", request.red_image, request.red_model),
                                 ("blue", request.blue_image, request.blue_model)):
         problem = stub_model_problem(model) if image is None else None
@@ -253,14 +311,16 @@ def write_files(request: ScrimmageRequest, folder: Path, *, stub_image: str | No
     files = {
         "game.json": game_file(request, match_id),
         "team_red.json": team_file("Stub Red", red_image, request.players,
-                                   command=request.robot_command, model=request.red_model),
+                                   command=request.robot_command, model=request.red_model,
+                                   field_class=request.field),
         "team_blue.json": team_file("Stub Blue", blue_image, request.players,
-                                    command=request.robot_command, model=request.blue_model),
+                                    command=request.robot_command, model=request.blue_model,
+                                    field_class=request.field),
     }
     for name, content in files.items():
         (folder / name).write_text(json.dumps(content, indent=2) + "\n", encoding="utf-8")
     return folder / "game.json"
 
 
-__all__ = ["ScrimmageOptions", "ScrimmageRequest", "game_file", "quick_ready",
+__all__ = ["SPOTS", "ScrimmageOptions", "ScrimmageRequest", "game_file", "quick_ready",
            "stub_model_problem", "team_file", "write_files"]

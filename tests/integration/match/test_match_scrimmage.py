@@ -96,3 +96,40 @@ def test_scrimmage_with_a_team_of_wolfgang_models_plays_to_the_end(
     team = json.loads((out / "config" / "team_red.json").read_text())
     assert team["players"]["1"]["model"] == str(wolfgang)
     assert runtime.list_project(match_id=match_id) == []
+
+
+def test_adult_scrimmage_plays_adult_robots_on_the_adult_field(
+    tmp_path: Path, runtime: Any, capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """``--class adult``: an ADULT game.json, the simulator builds the 14 x 9 m field, both
+    teams play the adult-size built-in robot, placed on the adult touch line."""
+    try:
+        from orchestrator.project_images import project_image
+
+        project_image("simulator")
+        project_image("stub")
+    except (ImportError, OrchestratorError) as exc:
+        pytest.skip(f"project images unavailable: {exc}")
+    match_id = "scrim-adult"
+    monkeypatch.chdir(tmp_path)
+    try:
+        code = hlvs(["scrimmage", "--out", "adult", "--class", "adult", "--half-duration", "4",
+                     "--ready-duration", "2", "--minimum-play", "0", "--wait-before-ready", "1",
+                     "--grace", "2", "--match-id", match_id])
+        printed = capsys.readouterr()
+    finally:
+        hlvs(["cleanup", "--match", match_id])
+    assert code == 0, printed.err[-3000:]
+    out = tmp_path / "adult"
+    results = json.loads((out / "results.json").read_text())
+    assert results["final_state"] == "FINISHED" and results["status"] == "success"
+    assert json.loads((out / "config" / "game.json").read_text())["class"] == "ADULT"
+    spec = json.loads((out / "simulator" / "match_spec.json").read_text())
+    assert spec["field_class"] == "adult"
+    for team in (spec["red"], spec["blue"]):
+        (player,) = team["players"]
+        assert player["model"] == "adult-default"
+        assert player["half_time_pose"]["y_m"] == -4.6  # outside the adult touch line
+    assert runtime.list_project(match_id=match_id) == []
+

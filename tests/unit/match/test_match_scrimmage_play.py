@@ -15,6 +15,7 @@ from contracts.match_results import MatchLimits
 from contracts.sim_result import SimResult
 from hlvs.commands.scrimmage_args import add_arguments
 from orchestrator.config.loader import load_game
+from orchestrator.errors import ConfigError
 from orchestrator.match.results import build_results
 from orchestrator.match.scrimmage import ScrimmageRequest, write_files
 
@@ -54,6 +55,37 @@ def test_larger_scrimmage_teams_add_a_goalie_then_defenders(tmp_path: Path) -> N
     _game, red = _scrimmage(tmp_path, "--players", "4")
     roles = [p["dockerCmd"].split()[0] for p in red["players"].values()]
     assert roles == ["goalie", "striker", "defender", "defender"]
+
+
+def test_adult_models_play_on_the_adult_field(tmp_path: Path) -> None:
+    """A scrimmage of adult-default robots is an ADULT game: the config check passes it (robot
+    heights and poses of the adult field) and every stub is told the field and the model."""
+    game, red = _scrimmage(tmp_path, "--red-model", "adult-default", "--blue-model",
+                           "adult-default", "--players", "3")
+    assert game["class"] == "ADULT"
+    loaded = load_game(tmp_path / "game.json")
+    assert loaded.game.field_class.value == "adult"
+    assert {p.model for t in (loaded.red, loaded.blue) for p in t.players} == {"adult-default"}
+    for player in red["players"].values():
+        assert player["dockerCmd"].endswith(" --model adult-default --field-class adult")
+        x, y, z = player["halfTimeStartingPose"]["translation"]
+        assert -7.0 < x < 0 and y == -4.6 and z == 0.9  # the own half's touch line, outside
+    striker = red["players"]["2"]["dockerCmd"].split()
+    assert striker[:5] == ["striker", "--start-pose", "-1.55", "-4.6", "1.57"]
+
+
+def test_adult_class_given_alone_plays_the_adult_built_in(tmp_path: Path) -> None:
+    game, red = _scrimmage(tmp_path, "--class", "adult")
+    assert game["class"] == "ADULT"
+    loaded = load_game(tmp_path / "game.json")
+    assert {p.model for p in loaded.red.players} == {"adult-default"}
+    assert red["players"]["1"]["dockerCmd"].endswith(" --model adult-default --field-class adult")
+
+
+def test_four_players_do_not_fit_the_adult_field(tmp_path: Path) -> None:
+    with pytest.raises(ConfigError) as raised:
+        _scrimmage(tmp_path, "--class", "adult", "--players", "4")
+    assert "--players" in str(raised.value) and "3" in str(raised.value)
 
 
 def test_official_timings_are_the_rules(tmp_path: Path) -> None:

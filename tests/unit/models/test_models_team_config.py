@@ -63,14 +63,18 @@ def _plan_stub() -> object:
 
 
 def test_scrimmage_stub_is_told_the_built_in_model_it_drives(tmp_path: Path) -> None:
-    """A stub robot runs the gait of the model on its command line: a scrimmage of adult robots
-    tells every stub ``--model adult-default`` (and the scrimmage's kid-size field); a team's
-    model package is not a model the stub knows, so nothing is added."""
-    adult = team_file("Bots", "registry.example/bots:1", 2, model="adult-default")
+    """A stub robot runs the gait of the model on its command line and plays on the field it is
+    told: every stub of an adult team is told ``--model adult-default`` and the field; a team's
+    model package is not a model the stub knows, so only the field is added."""
+    adult = team_file("Bots", "registry.example/bots:1", 2, model="adult-default",
+                      field_class=FieldClass.ADULT)
     commands = [p["dockerCmd"] for p in adult["players"].values()]
-    assert all(c.endswith(" --model adult-default --field-class kid") for c in commands), commands
+    assert all(c.endswith(" --model adult-default --field-class adult") for c in commands), commands
     box_robot(tmp_path / "box", height_m=0.7)
     package = team_file("Bots", "registry.example/bots:1", 2, model=str(tmp_path / "box"))
-    assert not any("--model" in p["dockerCmd"] for p in package["players"].values())
+    commands = [p["dockerCmd"] for p in package["players"].values()]
+    assert not any("--model" in c for c in commands)
+    assert all(c.endswith(" --field-class kid") for c in commands), commands
     plain = team_file("Bots", "registry.example/bots:1", 2)
-    assert not any("--model" in p["dockerCmd"] for p in plain["players"].values())
+    commands = [p["dockerCmd"] for p in plain["players"].values()]
+    assert all(c.endswith(" --model kid-default --field-class kid") for c in commands), commands
