@@ -7,7 +7,8 @@ is played with a warning recorded in ``results.json`` (``admission``). Whatever 
 simulator container gets :data:`SIMULATOR_CPU_SHARES` (robots keep Docker's 1024), so under
 contention the kernel gives it its share first, and in async stepping on a local engine with
 more CPUs than the simulator needs the CPUs are split (:func:`cpu_sets`): the simulator's own,
-which no robot may use, and the robots'. A team cannot starve the simulator.
+which no robot may use (with the spare CPUs for its camera render processes when the cameras
+render on the CPU), and the robots'. A team cannot starve the simulator.
 """
 
 from __future__ import annotations
@@ -27,6 +28,9 @@ log = logging.getLogger(__name__)
 SIMULATOR_CPUS = 1.0  # the step thread needs a core of its own
 SIMULATOR_MEMORY_GB = 2.0
 SIMULATOR_CPU_SHARES = 8192  # 8x a robot's weight when CPUs are contended
+# the robot cameras' render processes at most, when they render on the CPU (the simulator's
+# simulator.api.world_cameras.MAX_RENDER_PROCESSES)
+RENDER_CPUS = 4
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -98,15 +102,23 @@ class CpuSets:
     robots: str | None  # cpuset of every robot container
 
 
-def cpu_sets(*, stepping: str = "async") -> CpuSets:
+def cpu_sets(*, stepping: str = "async", robot_cpus: float = 0.0,
+             render_cpus: int = 0) -> CpuSets:
     """In ``async`` stepping (the league's: the simulation never waits), the first
     ``ceil(SIMULATOR_CPUS)`` CPUs this process may use go to the simulator, the rest to the
     robots. No pinning in ``lockstep`` (simulator and robots take turns, so they share every
     CPU best, and results do not depend on speed), with a remote engine (``DOCKER_HOST`` not a
-    local socket) or when no CPU would be left for the robots."""
+    local socket) or when no CPU would be left for the robots.
+
+    ``render_cpus``: the robot cameras render on the CPU, in up to that many worker processes
+    of the simulator (one per CPU it may use): the CPUs the robots' limits (``robot_cpus`` in
+    all) leave spare go to the simulator too, up to ``render_cpus`` more. The robots' CPUs are
+    never given away: on a machine without spare CPUs the cameras render on the simulator's."""
     remote = os.environ.get("DOCKER_HOST", "unix://")
     allowed = sorted(os.sched_getaffinity(0))
     reserved = math.ceil(SIMULATOR_CPUS)
+    spare = len(allowed) - reserved - math.ceil(robot_cpus - 1e-9)
+    reserved += max(0, min(render_cpus, spare))
     if stepping != "async" or not remote.startswith("unix://") or len(allowed) <= reserved:
         return CpuSets(simulator=None, robots=None)
     return CpuSets(simulator=",".join(map(str, allowed[:reserved])),
@@ -149,5 +161,5 @@ def admit(plan: MatchPlan, *, host: HostResources, official: bool) -> Admission:
 
 __all__ = [
     "Admission", "AdmissionRefused", "CpuSets", "HostResources", "SIMULATOR_CPUS",
-    "SIMULATOR_CPU_SHARES", "SIMULATOR_MEMORY_GB", "admit", "cpu_sets",
+    "RENDER_CPUS", "SIMULATOR_CPU_SHARES", "SIMULATOR_MEMORY_GB", "admit", "cpu_sets",
 ]

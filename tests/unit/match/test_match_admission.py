@@ -38,6 +38,29 @@ def test_a_match_that_fits_has_no_warning() -> None:
     assert verdict.to_json()["cpus"] == {"needed": 2.0, "available": 2.0}
 
 
+@pytest.mark.parametrize(("cpus", "robot_cpus", "render_cpus", "simulator", "robots"), [
+    (16, 8.0, 4, "0,1,2,3,4", "5,6,7,8,9,10,11,12,13,14,15"),  # spare CPUs: 4 more to render
+    (4, 1.0, 4, "0,1,2", "3"),  # two spare CPUs after the simulator's and the robots' own
+    (4, 2.5, 4, "0", "1,2,3"),  # 2.5 CPUs of limits take three whole CPUs: nothing spare
+    (2, 2.0, 4, "0", "1"),  # the robots' CPU is never given to the cameras
+    (16, 8.0, 0, "0", "1,2,3,4,5,6,7,8,9,10,11,12,13,14,15"),  # cameras on a GPU
+])
+def test_cameras_on_the_cpu_get_the_cpus_the_robots_leave_spare(
+    monkeypatch: pytest.MonkeyPatch, cpus: int, robot_cpus: float, render_cpus: int,
+    simulator: str, robots: str,
+) -> None:
+    import os
+
+    from orchestrator.match.admission import cpu_sets
+
+    monkeypatch.setattr(os, "sched_getaffinity", lambda _pid: set(range(cpus)))
+    monkeypatch.delenv("DOCKER_HOST", raising=False)
+    sets = cpu_sets(stepping="async", robot_cpus=robot_cpus, render_cpus=render_cpus)
+    assert (sets.simulator, sets.robots) == (simulator, robots)
+    assert cpu_sets(stepping="lockstep", robot_cpus=robot_cpus, render_cpus=render_cpus
+                    ).simulator is None
+
+
 def test_async_matches_give_the_simulator_cpus_of_its_own() -> None:
     import os
 
