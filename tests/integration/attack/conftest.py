@@ -56,9 +56,10 @@ def attack_image(docker_client: docker.DockerClient, project_images: dict[str, s
             info.size = len(data)
             tar.addfile(info, io.BytesIO(data))
     buffer.seek(0)
-    docker_client.images.build(fileobj=buffer, custom_context=True, tag=tag, rm=True,
+    docker_client.images.build(fileobj=buffer, custom_context=True, tag=tag,
                                network_mode="none",
-                               labels={"org.hlvs-runner.test-image": "attacker"})
+                               labels={"org.hlvs-runner.test-image": "attacker"},
+                               rm=True, forcerm=True)
     return tag
 
 

@@ -39,8 +39,8 @@ def test_cleanup_leaves_a_foreign_container_that_carries_our_labels(
         tar.addfile(info, io.BytesIO(dockerfile))
     buffer.seek(0)
     tag = f"hlvs-runner-test/labelled:{match_id}"
-    docker_client.images.build(fileobj=buffer, custom_context=True, tag=tag, rm=True,
-                               network_mode="none")
+    docker_client.images.build(fileobj=buffer, custom_context=True, tag=tag,
+                               network_mode="none", rm=True, forcerm=True)
     foreign = docker_client.containers.run(tag, ["sleep", "300"], detach=True,
                                            name=f"{match_id}-foreign", network_mode="none")
     runtime = DockerRuntime(docker_client)

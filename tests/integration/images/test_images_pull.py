@@ -64,7 +64,8 @@ def test_team_image_on_team_base_is_pushed_pulled_pinned_and_runs(
     )
     repository = f"{registry.host}/alpha/robot"
     docker_client.images.build(
-        path=str(tmp_path), tag=f"{repository}:v1", network_mode="none", labels={TEST_LABEL: "1"}
+        path=str(tmp_path), tag=f"{repository}:v1", network_mode="none", labels={TEST_LABEL: "1"},
+        rm=True, forcerm=True,
     )
     pushed = push(docker_client, f"{repository}:v1", "alpha", registry.users["alpha"])
     docker_client.images.remove(f"{repository}:v1")  # the match host starts from nothing

@@ -66,8 +66,8 @@ def layered_image(
             info.size = len(data)
             tar.addfile(info, io.BytesIO(data))
     context.seek(0)
-    docker_client.images.build(fileobj=context, custom_context=True, tag=reference, rm=True,
-                               network_mode="none")
+    docker_client.images.build(fileobj=context, custom_context=True, tag=reference,
+                               network_mode="none", rm=True, forcerm=True)
     return reference
 
 

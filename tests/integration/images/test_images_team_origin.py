@@ -50,7 +50,7 @@ def test_an_image_with_a_volume_is_refused(docker_client: docker.DockerClient,
     tag = f"hlvs-runner-test/volume-{uuid.uuid4().hex[:8]}:v1"
     (tmp_path / "Dockerfile").write_text("FROM scratch\nVOLUME /data /more\n")
     docker_client.images.build(path=str(tmp_path), tag=tag, network_mode="none",
-                               labels={TEST_LABEL: "1"})
+                               labels={TEST_LABEL: "1"}, rm=True, forcerm=True)
     try:
         repository, _, name_tag = tag.rpartition(":")
         resolved = resolve_team_images(docker_client, team(repository, name_tag, None),

@@ -81,8 +81,8 @@ def test_image(docker_client: docker.DockerClient) -> str:
             info.size = len(data)
             tar.addfile(info, io.BytesIO(data))
     buffer.seek(0)
-    docker_client.images.build(fileobj=buffer, custom_context=True, tag=tag, rm=True,
-                               network_mode="none", labels={TEST_LABEL: "1"})
+    docker_client.images.build(fileobj=buffer, custom_context=True, tag=tag,
+                               network_mode="none", labels={TEST_LABEL: "1"}, rm=True, forcerm=True)
     return tag
 
 
