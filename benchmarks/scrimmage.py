@@ -91,6 +91,8 @@ def _parse(argv: Sequence[str]) -> argparse.Namespace:
                         help="keep the match folders here (default: a temporary folder)")
     parser.add_argument("--stepping", choices=("lockstep", "pipelined", "async"),
                         default="lockstep", help="stepping of the scrimmages (default lockstep)")
+    parser.add_argument("--class", dest="field_class", choices=("kid", "adult"), default="kid",
+                        help="field size and built-in robots (default kid)")
     parser.add_argument("--json", action="store_true", help="print only the JSON document")
     args = parser.parse_args(list(argv))
     if args.matches < 1:
@@ -99,9 +101,10 @@ def _parse(argv: Sequence[str]) -> argparse.Namespace:
 
 
 def play_one(*, seed: int, out: Path, players: int | None,
-             stop: threading.Event | None = None, stepping: str = "lockstep") -> MatchFigures:
-    """One default scrimmage with ``seed`` played into ``out``; its figures. ``stop`` set:
-    the match stops (and is collected) as on SIGINT."""
+             stop: threading.Event | None = None, stepping: str = "lockstep",
+             field_class: str = "kid") -> MatchFigures:
+    """One default scrimmage with ``seed`` played into ``out`` on the ``field_class`` field;
+    its figures. ``stop`` set: the match stops (and is collected) as on SIGINT."""
     from hlvs.commands.scrimmage_args import add_arguments
     from orchestrator.config.loader import load_game
     from orchestrator.engine import connect
@@ -114,7 +117,8 @@ def play_one(*, seed: int, out: Path, players: int | None,
     scrim = argparse.ArgumentParser()
     add_arguments(scrim)
     match_id = f"bench-scrim-{int(time.time())}-{seed}"
-    argv = ["--seed", str(seed), "--match-id", match_id, "--stepping", stepping]
+    argv = ["--seed", str(seed), "--match-id", match_id, "--stepping", stepping,
+            "--class", field_class]
     if players is not None:
         argv += ["--players", str(players)]
     args = scrim.parse_args(argv)
@@ -183,7 +187,7 @@ def summarize(matches: list[MatchFigures]) -> dict[str, Any]:
 
 
 def run(*, matches: int, seed: int, players: int | None, folder: Path,
-        quiet: bool, stepping: str = "lockstep") -> dict[str, Any]:
+        quiet: bool, stepping: str = "lockstep", field_class: str = "kid") -> dict[str, Any]:
     """Play the scrimmages; SIGINT / SIGTERM stop the one playing and skip the rest (the
     summary covers the matches played so far, the interrupted one included)."""
     from hlvs.commands.play import stop_on_signals
@@ -192,7 +196,7 @@ def run(*, matches: int, seed: int, players: int | None, folder: Path,
     with stop_on_signals() as stop:
         for i in range(matches):
             figure = play_one(seed=seed + i, out=folder / f"match-{i + 1}", players=players,
-                              stop=stop, stepping=stepping)
+                              stop=stop, stepping=stepping, field_class=field_class)
             figures.append(figure)
             if not quiet:
                 print(json.dumps(figure.to_json()), file=sys.stderr)
@@ -201,6 +205,7 @@ def run(*, matches: int, seed: int, players: int | None, folder: Path,
     result = summarize(figures)
     result["interrupted"] = len(figures) < matches or stop.is_set()
     result["stepping"] = stepping
+    result["field_class"] = field_class
     return result
 
 
@@ -209,11 +214,13 @@ def main(argv: Sequence[str]) -> int:
     try:
         if args.keep is not None:
             result = run(matches=args.matches, seed=args.seed, players=args.players,
-                         folder=args.keep, quiet=args.json, stepping=args.stepping)
+                         folder=args.keep, quiet=args.json, stepping=args.stepping,
+                         field_class=args.field_class)
         else:
             with tempfile.TemporaryDirectory(prefix="hlvs-bench-scrimmage-") as folder:
                 result = run(matches=args.matches, seed=args.seed, players=args.players,
-                             folder=Path(folder), quiet=args.json, stepping=args.stepping)
+                             folder=Path(folder), quiet=args.json, stepping=args.stepping,
+                             field_class=args.field_class)
     except OrchestratorError as exc:
         print(json.dumps({"bench": "scrimmage", "error": str(exc)}))
         return exc.exit_code
