@@ -7,7 +7,6 @@ with ``kind`` one of ``state events poses scene`` and ``payload`` the message by
 
 from __future__ import annotations
 
-import json
 import logging
 from collections.abc import Callable
 from typing import Any, Protocol
@@ -38,14 +37,10 @@ class ZenohFeed:
     def __init__(self, endpoint: str, match_id: str, callback: Callback) -> None:
         import zenoh
 
-        config = zenoh.Config()
-        config.insert_json5("mode", '"peer"')
-        config.insert_json5("scouting/multicast/enabled", "false")
-        config.insert_json5("scouting/gossip/enabled", "false")
-        config.insert_json5("transport/shared_memory/enabled", "false")
-        config.insert_json5("connect/endpoints", json.dumps([endpoint]))
+        from orchestrator.telemetry import subscriber_config
+
         try:
-            self._session: Any = zenoh.open(config)
+            self._session: Any = zenoh.open(subscriber_config(endpoint))
             self._subs = [
                 self._session.declare_subscriber(
                     topics.topic(match_id, kind), _forward(kind, callback)

@@ -108,3 +108,16 @@ def test_the_progress_line_shows_the_seconds_left_with_one_decimal() -> None:
     state = _message(state="PLAYING", half=2, secs_remaining=60, score={"red": 0, "blue": 0})
     assert describe(state).startswith("PLAYING half 2 60.0 s left")
     assert " ? s left" in describe(replace(state, secs_remaining=None))
+
+
+def test_subscribers_retry_the_simulator_often_while_it_starts() -> None:
+    """The orchestrator's and the live viewer's subscriber start while the simulator boots:
+    retried every 0.1 s at first and never more than 0.5 s apart (zenoh's 1, 2, 4 s made
+    the bring-up up to 3 s longer), to the one endpoint, without scouting."""
+    from orchestrator.telemetry import subscriber_config
+
+    config = subscriber_config("tcp/10.0.0.2:7447")
+    retry = json.loads(config.get_json("connect/retry"))
+    assert retry["period_init_ms"] == 100 and retry["period_max_ms"] == 500
+    assert json.loads(config.get_json("connect/endpoints")) == ["tcp/10.0.0.2:7447"]
+    assert json.loads(config.get_json("scouting/multicast/enabled")) is False
