@@ -57,6 +57,7 @@ KICK_OFF_PLACE_M = 0.06  # READY: the kick-off striker's place against the ball,
 KICK_OFF_YAW_RAD = 0.08  # ... and its heading this close to the kick-off pass
 KICK_OFF_SHORT_M = 0.04  # READY: the ball this much farther than the kick spot (no touching)
 CENTRE_SPOT_M = 0.3  # a ball this close to the centre spot is a kick-off ball
+OUTSIDE_CIRCLE_M = 0.25  # READY at the opponents' kick-off: this far outside the centre circle
 SEARCH_TURN_AFTER_S = 2.0
 DEFENDER_HOME = (-2.3, 0.0)  # when none is given
 DEFENDER_ENGAGE_M = 1.2  # a defender plays a ball this close to its home spot
@@ -66,6 +67,7 @@ DEFENDER_NEAR_M = 0.8  # ... or this close to itself
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Field:
     half_length_m: float
+    centre_circle_m: float  # radius of the centre circle (0.75 m kid, 1.5 m adult)
     foot_y_m: float  # lateral distance of each foot from the centre line
     kick_x_m: float  # best ball distance in front of the pelvis for a kick
     kick_feet: tuple[str, ...] = ("left", "right")  # the feet it kicks with
@@ -135,8 +137,8 @@ def _kick_off_position(
     if role is Role.DEFENDER:
         x, y = home or DEFENDER_HOME
         return Pose(x_m=x, y_m=y, yaw_rad=0.0)
-    if not game.our_kick_off:
-        return Pose(x_m=-1.0, y_m=0.0, yaw_rad=0.0)
+    if not game.our_kick_off:  # the opponents' kick-off: just outside the centre circle
+        return Pose(x_m=-(field.centre_circle_m + OUTSIDE_CIRCLE_M), y_m=0.0, yaw_rad=0.0)
     # facing along the kick-off pass, the ball a little short of the left foot's kick spot
     ax, ay = _kick_off_aim(field)
     direction = math.atan2(ay, ax)

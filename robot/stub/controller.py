@@ -14,7 +14,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import numpy.typing as npt
 
-from contracts import GameState, Pose
+from contracts import GameState, Pose, field_for
 from robot.learned import Policy, PolicyMotion
 from robot.learned.policy import KICK_BALL_AHEAD_M
 from robot.motion import AttitudeFilter, GetUpMotion, KickMotion, WalkEngine, kinematics
@@ -75,8 +75,6 @@ SETTLE_S = 1.0  # stand still this long after start and after getting up
 # after a reset of the pose (half time, end of a penalty) the referee may still be placing the
 # robot: its orientation is taken from gravity afresh for this long, without counting turns
 RESET_HOLD_S = 0.6
-FIELD_HALF_LENGTH_M = {"kid": 4.5, "adult": 7.0}
-BALL_RADIUS_M = {"kid": 0.07, "adult": 0.1125}
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -125,9 +123,11 @@ class StubController:
         self.stats = Stats()
         walk = default_walk_params(model)
         self._pelvis_height_m = walk.hip_height_m + self.kin.camera.hip_below_pelvis_m
-        self._ball_radius_m = BALL_RADIUS_M[field_class]
+        geometry = field_for(field_class)
+        self._ball_radius_m = geometry.ball_radius_m
         self.field = Field(
-            half_length_m=FIELD_HALF_LENGTH_M[field_class],
+            half_length_m=geometry.half_length_m,
+            centre_circle_m=geometry.centre_circle_radius_m,
             foot_y_m=self.kin.leg.hip_offset_y_m + walk.foot_y_offset_m + KICK_BALL_OUTSIDE_M,
             kick_x_m=0.165 * self.kin.leg.thigh_m / KID_THIGH_M,
             fast_m_s=min(walk.cruise_vx_m_s, walk.max_vx_m_s),

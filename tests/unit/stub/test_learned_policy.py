@@ -97,7 +97,8 @@ def test_stub_with_a_kick_policy_lines_up_for_the_right_foot(tmp_path: Path) -> 
     game = GameInfo(phase=GameState.PLAYING)
     # ball lined up in front of the LEFT foot: a plain stub kicks with the left foot, one with
     # a right-foot policy steps across instead
-    field = Field(half_length_m=4.5, foot_y_m=0.075, kick_x_m=KICK_BALL_AHEAD_M)
+    field = Field(half_length_m=4.5, centre_circle_m=0.75, foot_y_m=0.075,
+                  kick_x_m=KICK_BALL_AHEAD_M)
     ball = (KICK_BALL_AHEAD_M, 0.075)
     at = Pose(x_m=1.0, y_m=0.0, yaw_rad=0.0)
     plain = decide(role=Role.STRIKER, game=game, pose=at, ball=ball,

@@ -8,7 +8,7 @@ from contracts.gamecontroller import GameState
 from contracts.geometry import Pose
 from robot.stub.behaviour import STAND, Field, GameInfo, Role, decide
 
-FIELD = Field(half_length_m=4.5, foot_y_m=0.06, kick_x_m=0.165)
+FIELD = Field(half_length_m=4.5, centre_circle_m=0.75, foot_y_m=0.06, kick_x_m=0.165)
 PLAYING = GameInfo(phase=GameState.PLAYING)
 HOME = (-2.3, 1.0)
 
@@ -104,3 +104,20 @@ def test_the_kick_off_striker_places_itself_against_the_ball_it_sees() -> None:
                     searching_s=0.0)  # fmt: skip
     assert action.walk[1] < 0.0  # type: ignore[attr-defined]  # side-steps to the right
 
+
+
+def test_at_the_opponents_kick_off_it_waits_outside_the_centre_circle_of_its_field() -> None:
+    """READY of the opponents' kick-off: 0.25 m outside the centre circle, 1.0 m from the
+    centre spot on the kid field (radius 0.75 m), 1.75 m on the adult one (1.5 m), where the
+    kid spot was a penalty for being inside the circle."""
+    from robot.stub.behaviour import _kick_off_position
+    from robot.stub.controller import StubController
+
+    theirs = GameInfo(phase=GameState.READY, our_kick_off=False)
+    spots = {}
+    for model, field_class in (("kid-default", "kid"), ("adult-default", "adult")):
+        field = StubController(role=Role.STRIKER, start_pose=Pose(x_m=0.0, y_m=0.0, yaw_rad=0.0),
+                               model=model, field_class=field_class).field  # fmt: skip
+        spot = _kick_off_position(Role.STRIKER, theirs, field, None)
+        spots[field_class] = (spot.x_m, spot.y_m)
+    assert spots == {"kid": (-1.0, 0.0), "adult": (-1.75, 0.0)}

@@ -12,7 +12,7 @@ from contracts.geometry import Pose
 from robot.stub.behaviour import Action, Field, GameInfo, Role, decide
 from robot.stub.world_model import WorldModel
 
-FIELD = Field(half_length_m=4.5, foot_y_m=0.075, kick_x_m=0.165)
+FIELD = Field(half_length_m=4.5, centre_circle_m=0.75, foot_y_m=0.075, kick_x_m=0.165)
 
 
 def _striker(game: GameInfo, pose: Pose, ball_field: tuple[float, float]) -> Action:

@@ -108,7 +108,7 @@ def test_behaviour_by_game_state() -> None:
     pose = Pose(x_m=-2.0, y_m=0.0, yaw_rad=0.0)
     from robot.stub.behaviour import Field
 
-    field = Field(half_length_m=4.5, foot_y_m=0.075, kick_x_m=0.165)
+    field = Field(half_length_m=4.5, centre_circle_m=0.75, foot_y_m=0.075, kick_x_m=0.165)
     args = {"pose": pose, "ball": (1.0, 0.0), "field": field, "searching_s": 0.0}
     for phase in (GameState.INITIAL, GameState.SET, GameState.FINISHED):
         assert decide(role=Role.STRIKER, game=GameInfo(phase=phase), **args).stands

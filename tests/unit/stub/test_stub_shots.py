@@ -10,7 +10,7 @@ from contracts.geometry import Pose
 from robot.stub.behaviour import Field, GameInfo, Role, decide
 from testkit.stub_world import run_shot, shot_layout
 
-FIELD = Field(half_length_m=4.5, foot_y_m=0.075, kick_x_m=0.165)
+FIELD = Field(half_length_m=4.5, centre_circle_m=0.75, foot_y_m=0.075, kick_x_m=0.165)
 PLAYING = GameInfo(phase=GameState.PLAYING)
 
 
