@@ -34,7 +34,7 @@ if TYPE_CHECKING:
     )
     from orchestrator.project_images import build_all, ensure_image, project_image
     from orchestrator.pull import pull_game_images, resolve_team_images
-    from orchestrator.telemetry import LiveView, ZenohTelemetry
+    from orchestrator.telemetry import LiveView, ZenohTelemetry, subscriber_config
 
 __all__ = [
     "ConfigError",
@@ -64,6 +64,7 @@ __all__ = [
     "project_image",
     "pull_game_images",
     "resolve_team_images",
+    "subscriber_config",
     "user_path",
     "write_compose",
     "write_private",
@@ -82,5 +83,5 @@ if not TYPE_CHECKING:
         ),
         "orchestrator.project_images": ("build_all", "ensure_image", "project_image"),
         "orchestrator.pull": ("pull_game_images", "resolve_team_images"),
-        "orchestrator.telemetry": ("LiveView", "ZenohTelemetry"),
+        "orchestrator.telemetry": ("LiveView", "ZenohTelemetry", "subscriber_config"),
     })

@@ -37,7 +37,7 @@ class ZenohFeed:
     def __init__(self, endpoint: str, match_id: str, callback: Callback) -> None:
         import zenoh
 
-        from orchestrator.telemetry import subscriber_config
+        from orchestrator import subscriber_config
 
         try:
             self._session: Any = zenoh.open(subscriber_config(endpoint))
