@@ -292,7 +292,7 @@ def write_files(request: ScrimmageRequest, folder: Path, *, stub_image: str | No
         raise ConfigError([Problem(
             file="hlvs scrimmage", pointer="--players",
             message=f"{request.players} players per team on the {request.field.value} field",
-            expected=f"at most {most} (the {request.field.value}-size rules)")])
+            expected=f"at most {most}, as the {request.field.value}-size rules allow")])
     for color, image, model in (("red", request.red_image, request.red_model),
                                 ("blue", request.blue_image, request.blue_model)):
         problem = stub_model_problem(model) if image is None else None
