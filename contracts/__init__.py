@@ -78,7 +78,13 @@ if TYPE_CHECKING:
         TeamSpec,
         TimingSpec,
     )
-    from contracts.sim_result import PlayRecord, RobotApiStats, SimResult, SpoofingAttempt
+    from contracts.sim_result import (
+        MAX_RENDER_PROCESSES,
+        PlayRecord,
+        RobotApiStats,
+        SimResult,
+        SpoofingAttempt,
+    )
     from contracts.telemetry import (
         EventRecord,
         GameStateRecord,
@@ -127,6 +133,7 @@ __all__ = [
     "KID_FIELD",
     "LogFolderCopy",
     "MAX_PLAYERS",
+    "MAX_RENDER_PROCESSES",
     "MIN_PLAYING_S",
     "MIN_READY_S",
     "MatchLimits",
@@ -211,7 +218,8 @@ if not TYPE_CHECKING:
             "Color", "GameType", "GameTypeName", "MatchSpec", "NetworkSpec", "PlayerSpec", "Pose",
             "SteppingMode", "TeamSpec", "TimingSpec",
         ),
-        "contracts.sim_result": ("PlayRecord", "RobotApiStats", "SimResult", "SpoofingAttempt"),
+        "contracts.sim_result": ("MAX_RENDER_PROCESSES", "PlayRecord", "RobotApiStats", "SimResult",
+                                 "SpoofingAttempt"),
         "contracts.telemetry": (
             "EventRecord", "GameStateRecord", "PenaltyRecord", "RobotTraffic", "StateMessage",
             "TrafficSample",

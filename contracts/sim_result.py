@@ -39,13 +39,18 @@ class RobotApiStats(TypedDict):
     round_trip_samples: int
 
 
+# the simulator's camera render processes at most (one per CPU it may use, on the CPU renderer);
+# the orchestrator gives an async match's simulator up to this many spare CPUs for them
+MAX_RENDER_PROCESSES = 4
+
+
 class CameraRecord(TypedDict, total=False):
     """What the simulator rendered for the robots' cameras, and with which OpenGL (empty from a
     simulator that did not report it)."""
 
     frames: int
     render_s: float
-    render_processes: int  # 0: one render thread in the simulator process
+    render_processes: int  # 0: one render thread in the simulator process; <= MAX_RENDER_PROCESSES
     gl_backend: str
     gl_renderer: str  # llvmpipe: the CPU
     gl_error: str  # no offscreen OpenGL: camera requests failed
@@ -167,6 +172,7 @@ class SimResult(Versioned):
 
 
 __all__ = [
+    "MAX_RENDER_PROCESSES",
     "CameraRecord",
     "PlayRecord",
     "RobotApiStats",

@@ -28,9 +28,6 @@ log = logging.getLogger(__name__)
 SIMULATOR_CPUS = 1.0  # the step thread needs a core of its own
 SIMULATOR_MEMORY_GB = 2.0
 SIMULATOR_CPU_SHARES = 8192  # 8x a robot's weight when CPUs are contended
-# the robot cameras' render processes at most, when they render on the CPU (the simulator's
-# simulator.api.world_cameras.MAX_RENDER_PROCESSES)
-RENDER_CPUS = 4
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -161,5 +158,5 @@ def admit(plan: MatchPlan, *, host: HostResources, official: bool) -> Admission:
 
 __all__ = [
     "Admission", "AdmissionRefused", "CpuSets", "HostResources", "SIMULATOR_CPUS",
-    "RENDER_CPUS", "SIMULATOR_CPU_SHARES", "SIMULATOR_MEMORY_GB", "admit", "cpu_sets",
+    "SIMULATOR_CPU_SHARES", "SIMULATOR_MEMORY_GB", "admit", "cpu_sets",
 ]

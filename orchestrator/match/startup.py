@@ -19,11 +19,11 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from contracts import GC_RETURN_PORT, MatchSpec, files
+from contracts import GC_RETURN_PORT, MAX_RENDER_PROCESSES, MatchSpec, files
 from orchestrator.bandwidth import AppliedShaping, RobotShaping, mb_s_to_bit
 from orchestrator.errors import InfrastructureError, OrchestratorError
 from orchestrator.match import layout
-from orchestrator.match.admission import RENDER_CPUS, cpu_sets
+from orchestrator.match.admission import cpu_sets
 from orchestrator.match.deps import MatchDeps
 from orchestrator.match.events import RobotNotStarted
 from orchestrator.match.layout import Subnet
@@ -104,7 +104,7 @@ def start(deps: MatchDeps, created: Created, robots: Mapping[str, RobotRecord],
         request, spec, endpoint = _league_simulator(deps, created, placement)
     # cameras on the CPU render in worker processes, one per CPU the simulator may use
     sets = cpu_sets(stepping=spec.stepping, robot_cpus=len(plan.robots) * plan.limits.cpus,
-                    render_cpus=RENDER_CPUS if deps.options.gpu is None else 0)
+                    render_cpus=MAX_RENDER_PROCESSES if deps.options.gpu is None else 0)
     request = replace(request, cpuset_cpus=sets.simulator)
     mark("spec")
     robot_steps_s: dict[str, dict[str, float]] = {

@@ -13,14 +13,11 @@ import os
 from types import SimpleNamespace
 from typing import TYPE_CHECKING, Any
 
-from contracts import RobotId
+from contracts import MAX_RENDER_PROCESSES, RobotId
 from simulator.api.cameras import ImageSource, RenderFn, RenderWorker
 
 if TYPE_CHECKING:
     from simulator.world import World
-
-MAX_RENDER_PROCESSES = 4
-
 
 def render_processes() -> int:
     """Worker processes for a match's robot cameras: when they render on the CPU (OSMesa) and

@@ -5,8 +5,9 @@ from __future__ import annotations
 
 import pytest
 
+from contracts import MAX_RENDER_PROCESSES
 from simulator.api import world_cameras
-from simulator.api.world_cameras import MAX_RENDER_PROCESSES, render_processes
+from simulator.api.world_cameras import render_processes
 
 
 @pytest.mark.parametrize(
