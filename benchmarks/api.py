@@ -40,6 +40,8 @@ MOTORS = (
 )  # fmt: skip
 CYCLE_STEPS = 125  # pre-encoded requests of the bench clients: one second of targets
 INTERLEAVE_MS = 250  # simulated time per chunk of the API run and of the reference world
+WARMUP_STEPS = 50  # untimed steps first, of the API run and of its reference world alike:
+# sensors enabled, caches hot, the robots settled
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -424,7 +426,7 @@ def _api_run(
             world.snapshot()
             server.publish(world.sim_time_ms)
 
-        for _ in range(50):  # warm-up: sensors enabled, caches hot
+        for _ in range(WARMUP_STEPS):
             one_step()
         waited[0] = 0.0
         if pipeline is not None:
@@ -436,11 +438,16 @@ def _api_run(
         # the machine's load falls on both alike: ``ratio_interleaved``
         reference = _world(robots, args.physics_dt, args.sensors) if camera is None else None
         move_reference = _client_targets(reference, robots) if reference is not None else None
-        if reference is not None and move_reference is not None:
-            for _ in range(50):  # the same warm-up as the API run's
+
+        def reference_steps(count: int) -> None:
+            assert reference is not None and move_reference is not None
+            for _ in range(count):
                 move_reference()
                 reference.step()
                 reference.snapshot()
+
+        if reference is not None:
+            reference_steps(WARMUP_STEPS)
         chunk = max(1, INTERLEAVE_MS // world.step_ms)
         wall = cpu = ref_wall = ref_cpu = 0.0
         done = 0
@@ -452,12 +459,9 @@ def _api_run(
             wall += time.perf_counter() - started
             cpu += time.thread_time() - started_cpu
             done += count
-            if reference is not None and move_reference is not None:
+            if reference is not None:
                 started, started_cpu = time.perf_counter(), time.thread_time()
-                for _ in range(count):
-                    move_reference()
-                    reference.step()
-                    reference.snapshot()
+                reference_steps(count)
                 ref_wall += time.perf_counter() - started
                 ref_cpu += time.thread_time() - started_cpu
         if pipeline is not None:
