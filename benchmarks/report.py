@@ -15,8 +15,9 @@ kind alike), each benchmark as a child process with small sizes:
   rendered as a match renders them (``render_processes``: worker processes on the CPU
   renderer, one per CPU; 0: one thread) (the real-time factor is the figure: rendering is most
   of the cost);
-- ``bringup``: ``bench bringup`` (a real match of stub robots in Docker, images cached), once
-  per run at most (``--bringup-repeats``); needs Docker and the project's images.
+- ``bringup``: ``bench bringup`` (a real match of stub robots in Docker, images cached), in
+  ``--bringup-repeats`` of the runs (default all: one bring-up is Docker starting 17 containers
+  and spreads by a second on a small host); needs Docker and the project's images.
 
 Prints one JSON document: per kind its runs, the median of each figure, the target and whether
 the median meets it; the load average before and after, so that a figure is read with the load
@@ -63,8 +64,9 @@ def _parser() -> argparse.ArgumentParser:
                              "2 s runs spread 0.88-1.05 where 8 s runs gave 0.96-1.0)")
     parser.add_argument("--camera-seconds", type=float, default=1.0,
                         help="simulated seconds per camera run (default 1)")
-    parser.add_argument("--bringup-repeats", type=int, default=1,
-                        help="bring-up runs (real matches in Docker; default 1)")
+    parser.add_argument("--bringup-repeats", type=int, default=None,
+                        help="bring-up runs (real matches in Docker, about 10 s each; default "
+                             "--repeats)")
     parser.add_argument("--only", default=",".join(KINDS),
                         help=f"comma-separated kinds to run (default all: {','.join(KINDS)})")
     parser.add_argument("--json", action="store_true", help="print only the JSON document")
@@ -178,6 +180,11 @@ def _kinds(text: str) -> list[str]:
     return [k.strip() for k in text.split(",") if k.strip()]
 
 
+def _bringup_repeats(args: argparse.Namespace) -> int:
+    repeats: int = args.repeats if args.bringup_repeats is None else args.bringup_repeats
+    return repeats
+
+
 def run(args: argparse.Namespace, progress: Callable[[str], None]) -> dict[str, Any]:
     kinds = _kinds(args.only)
     runners = _runners(args)
@@ -186,7 +193,7 @@ def run(args: argparse.Namespace, progress: Callable[[str], None]) -> dict[str, 
     load_before = _load()
     for repeat in range(max(1, args.repeats)):
         for kind in kinds:
-            if kind == "bringup" and repeat >= args.bringup_repeats:
+            if kind == "bringup" and repeat >= _bringup_repeats(args):
                 continue
             progress(f"{kind} run {repeat + 1} (load {_load()[0]})")
             result = runners[kind]()
@@ -196,6 +203,7 @@ def run(args: argparse.Namespace, progress: Callable[[str], None]) -> dict[str, 
         "bench": "report",
         "robots": args.robots,
         "repeats": args.repeats,
+        "bringup_repeats": _bringup_repeats(args),
         "sim_seconds": args.sim_seconds,
         "world_seconds": args.world_seconds,
         "cpus": len(os.sched_getaffinity(0)),

@@ -24,6 +24,7 @@ def test_report_runs_the_kinds_and_judges_medians_against_targets() -> None:
     assert report["bench"] == "report" and report["errors"] == 0
     assert len(report["load_average_before"]) == 3
     assert "async" not in report and "bringup" not in report
+    assert report["bringup_repeats"] == 2  # as many bring-ups as --repeats unless told
     sim, pipelined = report["sim"], report["pipelined"]
     assert len(sim["runs"]) == 2 and len(pipelined["runs"]) == 2
     assert sim["target"] == {"figure": "ratio", "min": 0.95}
