@@ -94,6 +94,7 @@ if TYPE_CHECKING:
         TrafficSample,
     )
     from contracts.timing import (
+        ADULT_SCRIMMAGE,
         ENVIRONMENT,
         MIN_PLAYING_S,
         MIN_READY_S,
@@ -109,6 +110,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "ADULT_FIELD",
+    "ADULT_SCRIMMAGE",
     "AdmissionRecord",
     "Color",
     "ContractError",
@@ -225,7 +227,8 @@ if not TYPE_CHECKING:
             "TrafficSample",
         ),
         "contracts.timing": (
-            "ENVIRONMENT", "MIN_PLAYING_S", "MIN_READY_S", "OFFICIAL", "SCRIMMAGE", "SET_TO_PLAY_S",
-            "TEST_MATCH", "TimingError", "fit_ready", "played_enough", "timing_problem",
+            "ADULT_SCRIMMAGE", "ENVIRONMENT", "MIN_PLAYING_S", "MIN_READY_S", "OFFICIAL",
+            "SCRIMMAGE", "SET_TO_PLAY_S", "TEST_MATCH", "TimingError", "fit_ready", "played_enough",
+            "timing_problem",
         ),
     })

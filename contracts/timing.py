@@ -53,6 +53,14 @@ SCRIMMAGE = TimingPreset(half_duration_s=40.0, ready_duration_s=20.0,
                          wait_before_first_ready_s=3.0, half_time_break_s=1.0, grace_period_s=5.0)
 """``hlvs scrimmage`` (local or ``--pool slurm``): 40 s of PLAYING per half when no goal is
 scored (READY and SET before a half's kick-off stop the clock), about 65 s simulated."""
+ADULT_SCRIMMAGE = TimingPreset(half_duration_s=60.0, ready_duration_s=30.0,
+                               wait_before_first_ready_s=3.0, half_time_break_s=1.0,
+                               grace_period_s=5.0)
+"""``hlvs scrimmage`` on the adult field: :data:`SCRIMMAGE`'s half and READY times 1.5. The adult
+field is 14 m long against the kid's 9 m and the adult stub walks at the kid's 0.4 m/s, so every
+walk takes half again as long: with the kid's timing a striker reached its kick-off spot at the
+end of READY without having turned, kicked off late, and a 40 s half ended about when it reached
+the kick-off pass (4 matches, 0 goals, one shot each)."""
 TEST_MATCH = TimingPreset(half_duration_s=40.0, ready_duration_s=10.0,
                           wait_before_first_ready_s=3.0, half_time_break_s=1.0,
                           grace_period_s=5.0)
@@ -123,6 +131,7 @@ def played_enough(halves_playing: tuple[int, ...] | list[int], playing_s: float,
 
 
 __all__ = [
+    "ADULT_SCRIMMAGE",
     "ENVIRONMENT",
     "MIN_PLAYING_S",
     "MIN_READY_S",

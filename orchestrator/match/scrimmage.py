@@ -7,8 +7,10 @@ Defaults make a short game a newcomer can watch in two to three minutes: one str
 lockstep stepping and the timing of :data:`contracts.timing.SCRIMMAGE` (two halves of 40 s of game
 clock with READY shortened to 20 s: READY and SET before a half's kick-off stop the clock, as the
 league's GameController does, so a half lasts about 65 s of simulated time; 3 s before the first
-READY and 1 s at half time). A half too short for its READY gets a shorter READY with a warning
-(:func:`quick_ready`); official matches keep the rules' timings (45 s READY, 10 min halves).
+READY and 1 s at half time); on the adult field :data:`contracts.timing.ADULT_SCRIMMAGE` (60 s
+halves, 30 s READY: the field is half again as long). A half too short for its READY gets a
+shorter READY with a warning (:func:`quick_ready`); official matches keep the rules' timings
+(45 s READY, 10 min halves).
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from typing import Protocol
 
 from contracts import (
     ADULT_FIELD,
+    ADULT_SCRIMMAGE,
     KID_FIELD,
     MIN_PLAYING_S,
     MIN_READY_S,
@@ -41,20 +44,23 @@ from orchestrator.errors import ConfigError, Problem
 
 log = logging.getLogger(__name__)
 
+TIMING = {FieldClass.KID: SCRIMMAGE, FieldClass.ADULT: ADULT_SCRIMMAGE}
+"""A scrimmage's timing by field (its halves and READY unless the request names them)."""
+
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class ScrimmageRequest:
-    """What the generated files depend on. ``ready_duration_s`` None: the scrimmage's READY
-    (:data:`contracts.timing.SCRIMMAGE`), fitted to the half; ``minimum_play_s`` 0: a match not
-    meant to play; images None play the project's stub image; models None the class's built-in
-    model; ``field_class`` None: the size class of the built-in models named (adult when a team
-    plays ``adult-default``), else kid."""
+    """What the generated files depend on. ``half_duration_s`` and ``ready_duration_s`` None:
+    the field's scrimmage timing (:data:`TIMING`), READY fitted to the half; ``minimum_play_s``
+    0: a match not meant to play; images None play the project's stub image; models None the
+    class's built-in model; ``field_class`` None: the size class of the built-in models named
+    (adult when a team plays ``adult-default``), else kid."""
 
     players: int
     seed: int
-    half_duration_s: float
     wait_before_ready_s: float
     grace_s: float
+    half_duration_s: float | None = None
     ready_duration_s: float | None = None
     stepping: SteppingMode = "lockstep"
     gpu: str = "auto"
@@ -75,13 +81,20 @@ class ScrimmageRequest:
         adult = DEFAULT_MODEL[FieldClass.ADULT]
         return FieldClass.ADULT if adult in (self.red_model, self.blue_model) else FieldClass.KID
 
+    @property
+    def half_s(self) -> float:
+        """Simulated seconds of game clock per half (``half_duration_s``, else the field's)."""
+        if self.half_duration_s is not None:
+            return self.half_duration_s
+        return TIMING[self.field].half_duration_s
+
     @classmethod
     def from_options(cls, options: ScrimmageOptions) -> ScrimmageRequest:
         """The request of ``hlvs scrimmage``'s parsed options (or any object with their
         attributes; ``ready_duration``, ``stepping``, ``gpu`` and the models when present)."""
         return cls(
             players=options.players, seed=options.seed,
-            half_duration_s=options.half_duration,
+            half_duration_s=getattr(options, "half_duration", None),
             wait_before_ready_s=options.wait_before_ready, grace_s=options.grace,
             ready_duration_s=getattr(options, "ready_duration", None),
             stepping=getattr(options, "stepping", None) or "lockstep",
@@ -103,7 +116,6 @@ class ScrimmageOptions(Protocol):
 
     players: int
     seed: int
-    half_duration: float
     wait_before_ready: float
     grace: float
     red_image: str | None
@@ -205,13 +217,14 @@ def team_file(name: str, image: str, players: int, *, command: str | None = None
 
 
 def quick_ready(half_duration_s: float, ready_duration_s: float | None,
-                minimum_play_s: float = MIN_PLAYING_S) -> float:
-    """The READY of a quick test (:mod:`contracts.timing`): the scrimmage's unless given,
+                minimum_play_s: float = MIN_PLAYING_S, *,
+                default_s: float = SCRIMMAGE.ready_duration_s) -> float:
+    """The READY of a quick test (:mod:`contracts.timing`): ``default_s`` unless given,
     shortened with a warning when the half would keep less than the minimum of play.
 
     Raises :class:`~orchestrator.errors.ConfigError` (at ``/timing/half_duration_s``) when the
     half is too short even for the shortest READY."""
-    ready = SCRIMMAGE.ready_duration_s if ready_duration_s is None else ready_duration_s
+    ready = default_s if ready_duration_s is None else ready_duration_s
     try:
         fitted, warning = fit_ready(half_duration_s, ready, minimum_s=minimum_play_s)
     except TimingError as exc:
@@ -229,7 +242,8 @@ def game_file(request: ScrimmageRequest, match_id: str) -> GameDocument:
     """A quick test's game.json; READY fitted to the half by :func:`quick_ready`."""
     players = request.players
     minimum = request.minimum_play_s
-    ready = quick_ready(request.half_duration_s, request.ready_duration_s, minimum)
+    ready = quick_ready(request.half_s, request.ready_duration_s, minimum,
+                        default_s=TIMING[request.field].ready_duration_s)
     return {
         "type": "NORMAL",
         "class": "ADULT" if request.field is FieldClass.ADULT else "KID",
@@ -248,7 +262,7 @@ def game_file(request: ScrimmageRequest, match_id: str) -> GameDocument:
         "blue": {"id": 2, "config": "team_blue.json", "hosts": ["127.0.0.1"],
                  "ports": [10020 + n for n in range(1, players + 1)]},
         "timing": {
-            "half_duration_s": request.half_duration_s,
+            "half_duration_s": request.half_s,
             "ready_duration_s": ready,
             "minimum_play_s": minimum,
             "wait_before_first_ready_s": request.wait_before_ready_s,
@@ -322,5 +336,5 @@ def write_files(request: ScrimmageRequest, folder: Path, *, stub_image: str | No
     return folder / "game.json"
 
 
-__all__ = ["SPOTS", "ScrimmageOptions", "ScrimmageRequest", "game_file", "quick_ready",
+__all__ = ["SPOTS", "TIMING", "ScrimmageOptions", "ScrimmageRequest", "game_file", "quick_ready",
            "stub_model_problem", "team_file", "write_files"]

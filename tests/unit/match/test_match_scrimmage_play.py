@@ -82,6 +82,19 @@ def test_adult_class_given_alone_plays_the_adult_built_in(tmp_path: Path) -> Non
     assert red["players"]["1"]["dockerCmd"].endswith(" --model adult-default --field-class adult")
 
 
+def test_adult_scrimmage_halves_and_ready_are_longer_unless_given(tmp_path: Path) -> None:
+    """The adult field is half again as long as the kid's and the stubs walk as fast: its
+    scrimmage plays 60 s halves with a 30 s READY; given durations are played as given."""
+    game, _red = _scrimmage(tmp_path, "--red-model", "adult-default")
+    assert game["timing"]["half_duration_s"] == 60 and game["timing"]["ready_duration_s"] == 30
+    timing = load_game(tmp_path / "game.json").game.timing
+    assert timing.half_duration_s == 60.0 and timing.ready_duration_s == 30.0
+    game, _red = _scrimmage(tmp_path, "--class", "adult", "--half-duration", "40")
+    assert game["timing"]["half_duration_s"] == 40 and game["timing"]["ready_duration_s"] == 25
+    game, _red = _scrimmage(tmp_path, "--class", "adult", "--ready-duration", "12")
+    assert game["timing"]["half_duration_s"] == 60 and game["timing"]["ready_duration_s"] == 12
+
+
 def test_four_players_do_not_fit_the_adult_field(tmp_path: Path) -> None:
     with pytest.raises(ConfigError) as raised:
         _scrimmage(tmp_path, "--class", "adult", "--players", "4")

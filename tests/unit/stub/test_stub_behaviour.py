@@ -52,8 +52,8 @@ def test_defender_kick_off_position_is_its_home() -> None:
 
 
 def test_a_far_ball_is_walked_to_at_the_models_cruise_speed() -> None:
-    """Over distance the striker (and READY's walk) goes at the gait's cruise speed: the kid's
-    0.4 m/s, the adult's 0.3 m/s (what its gait was measured at)."""
+    """Over distance the striker (and READY's walk) goes at the gait's cruise speed: 0.4 m/s for
+    both built-in models (what their gaits were measured at)."""
     from contracts.geometry import Pose as P
     from robot.stub.controller import StubController
 
@@ -69,7 +69,7 @@ def test_a_far_ball_is_walked_to_at_the_models_cruise_speed() -> None:
                        searching_s=0.0)  # fmt: skip
         assert far.walk[0] == ready.walk[0] == field.fast_m_s  # type: ignore[attr-defined]
         speeds[model] = field.fast_m_s
-    assert speeds == {"kid-default": 0.4, "adult-default": 0.3}
+    assert speeds == {"kid-default": 0.4, "adult-default": 0.4}
 
 
 def test_near_its_ready_spot_it_turns_to_the_final_heading_while_stepping_the_rest() -> None:
