@@ -78,8 +78,9 @@ def register(sub: Any) -> None:
     parser.add_argument(
         "--official",
         action="store_true",
-        help="robot model packages as for an official match: free-form servos and gains "
-        "(no catalogue servo) are errors, not warnings",
+        help="robot model packages and team files as for an official match: free-form servos "
+        "and gains (no catalogue servo), and a team file's robots of another size class than "
+        "--class, are errors, not warnings (a game.json says so itself with \"official\")",
     )
     parser.set_defaults(func=run)
 
@@ -174,7 +175,7 @@ def check_report(
     official: bool = False,
 ) -> FileReport:
     """Check one file (or robot model package) and return every problem found (nothing
-    printed); ``official``: model packages as for an official match."""
+    printed); ``official``: model packages and team files as for an official match."""
     from orchestrator.config import check_model, is_model_package
 
     if is_model_package(path):
@@ -182,7 +183,8 @@ def check_report(
         return FileReport(str(path), "robot model", problems, measurements)
     try:
         found_kind, problems = _check(
-            path, kind=kind, field_class=field_class, images_required=images_required
+            path, kind=kind, field_class=field_class, images_required=images_required,
+            official=official,
         )
     except ConfigError as exc:
         found_kind, problems = kind, exc.problems
@@ -249,7 +251,12 @@ def _gh_property(text: str) -> str:
 
 
 def _check(
-    path: Path, *, kind: Kind | None, field_class: FieldClass | None, images_required: bool
+    path: Path,
+    *,
+    kind: Kind | None,
+    field_class: FieldClass | None,
+    images_required: bool,
+    official: bool = False,
 ) -> tuple[Kind | None, list[Problem]]:
     from orchestrator.config import (
         check_game,
@@ -280,7 +287,8 @@ def _check(
             problems.extend(_check_optional("credentials", credentials))
         return kind, problems
     if kind == "team":
-        return kind, check_team(path, field_class=field_class, images_required=images_required)
+        return kind, check_team(path, field_class=field_class, images_required=images_required,
+                                official=official)
     return kind, _check_optional(kind, path)
 
 

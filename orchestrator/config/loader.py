@@ -105,9 +105,11 @@ def check_team_document(
     source: str | Path,
     field_class: FieldClass | None = None,
     images_required: bool = False,
+    official: bool = False,
 ) -> tuple[TeamConfig | None, list[Problem]]:
     """A team document's TeamConfig (None when it has an error) and every problem of it (the
-    one team validation: :func:`parse_team` raises its errors, files are read and given here)."""
+    one team validation: :func:`parse_team` raises its errors, files are read and given here);
+    ``official``: as the team of an official match (see :func:`build_team`)."""
     where = Collector(str(Path(source)))
     team = build_team(
         document,
@@ -115,6 +117,7 @@ def check_team_document(
         source=Path(source),
         field_class=field_class,
         images_required=images_required,
+        official=official,
     )
     return team, where.problems
 
@@ -129,10 +132,16 @@ def check_game(path: str | Path, *, images_required: bool = False) -> list[Probl
 
 
 def check_team(
-    path: str | Path, *, field_class: FieldClass | None = None, images_required: bool = False
+    path: str | Path,
+    *,
+    field_class: FieldClass | None = None,
+    images_required: bool = False,
+    official: bool = False,
 ) -> list[Problem]:
-    """Every problem (errors and warnings) in one team_config.json file."""
-    return _team_file(Path(path), field_class=field_class, images_required=images_required)[1]
+    """Every problem (errors and warnings) in one team_config.json file; ``official``: as the
+    team of an official match."""
+    return _team_file(Path(path), field_class=field_class, images_required=images_required,
+                      official=official)[1]
 
 
 def _read(path: Path) -> tuple[object, list[Problem]]:
@@ -157,6 +166,7 @@ def _game_document(
         return _assembled(game, teams.get("red"), teams.get("blue"), problems)
     found: dict[str, TeamConfig | None] = {}
     field_class = _field_class(document)
+    official = isinstance(document, dict) and document.get("official") is True
     for color in COLORS:
         located = _team_path(document, color, path.parent)
         if located is None:
@@ -189,7 +199,7 @@ def _game_document(
                 )
             )
         team, team_problems = _team_file(
-            config, field_class=field_class, images_required=images_required
+            config, field_class=field_class, images_required=images_required, official=official
         )
         problems.extend(team_problems)
         found[color] = team
@@ -209,13 +219,13 @@ def _assembled(
 
 
 def _team_file(
-    path: Path, *, field_class: FieldClass | None, images_required: bool
+    path: Path, *, field_class: FieldClass | None, images_required: bool, official: bool = False
 ) -> tuple[TeamConfig | None, list[Problem]]:
     document, problems = _read(path)
     if problems:
         return None, problems
     return check_team_document(document, source=path, field_class=field_class,
-                               images_required=images_required)
+                               images_required=images_required, official=official)
 
 
 def _cross_checks(game: GameConfig, color: str, team: TeamConfig) -> list[Problem]:

@@ -33,6 +33,7 @@ from orchestrator.config.robot_models import (
     is_model_path,
 )
 from orchestrator.config.schema import validate
+from orchestrator.errors import Problem
 
 # The robot the GameController marks as goalkeeper unless a robot declares itself goalkeeper
 # (RGrt GOALKEEPER): the league GameController's default, player 1.
@@ -74,11 +75,14 @@ def build_team(
     source: Path,
     field_class: FieldClass | None,
     images_required: bool,
+    official: bool = False,
 ) -> TeamConfig | None:
     """Validate one team document; the TeamConfig when it has no error (problems in ``where``).
 
     The numbering and pose rules also run on the parts the schema found sound, so one pass
-    reports as many problems as possible.
+    reports as many problems as possible. ``official``: the team plays an official match, where
+    what friendlies allow with a warning (free-form servos, a model of the other size class) is
+    an error.
     """
     before = len(where.errors)
     valid = validate("team", document, where)
@@ -105,7 +109,8 @@ def build_team(
         return None
     team = cast("TeamDocument", document)  # the schema checked it
     players = [_player(number, team, field_class) for number in numbers]
-    players = _resolve_models(players, source, where)
+    players = _resolve_models(players, source, where, field_class=field_class,
+                              official=official)
     for player in players:
         _check_command(player, where)
     if not team["players"]:
@@ -133,17 +138,27 @@ def build_team(
 
 
 def _resolve_models(
-    players: list[PlayerConfig], source: Path, where: Collector
+    players: list[PlayerConfig],
+    source: Path,
+    where: Collector,
+    *,
+    field_class: FieldClass | None,
+    official: bool,
 ) -> list[PlayerConfig]:
     """Model package paths made absolute (relative to the team file) and checked against the
-    rule book, once per folder; a model that cannot be used is an error of its player."""
-    checked: dict[Path, list[str]] = {}
+    rule book, once per folder (``official``: as for an official match); a model that cannot be
+    used is an error of its player, what friendlies allow a warning. A model of another size
+    class than the game's (``field_class``) is an error in an official match, a warning in a
+    friendly."""
+    checked: dict[Path, tuple[list[Problem], str | None]] = {}
     out = []
     for player in players:
+        at = pointer("players", str(player.number), "model")
         if not is_model_path(player.model):
+            _check_size_class(BUILT_IN_CLASS[player.model], at, player.model, where,
+                              field_class=field_class, official=official)
             out.append(player)
             continue
-        at = pointer("players", str(player.number), "model")
         folder = (source.parent / player.model).resolve()
         if not is_model_package(folder):
             where.error(
@@ -154,13 +169,48 @@ def _resolve_models(
             )
             continue
         if folder not in checked:
-            checked[folder] = [
-                str(problem) for problem in check_model(folder)[0] if problem.severity == "error"
-            ]
-        for problem in checked[folder]:
-            where.error(at, f"the robot model cannot be used: {problem}")
+            found, measurements = check_model(folder, official=official)
+            checked[folder] = (found, measurements.size_class if measurements else None)
+        found, size_class = checked[folder]
+        for problem in found:
+            text = f"{problem.file}: {problem.pointer}: {problem.message}"
+            if problem.severity == "error":
+                where.error(at, f"the robot model cannot be used: {text}")
+            else:
+                where.warn(at, f"the robot model is for friendlies only: {text}")
+        if size_class is not None:
+            _check_size_class(FieldClass(size_class), at, str(folder), where,
+                              field_class=field_class, official=official)
         out.append(replace(player, model=str(folder)))
     return out
+
+
+BUILT_IN_CLASS = {model: size for size, model in DEFAULT_MODEL.items()}
+"""The size class of each built-in robot model."""
+
+
+def _check_size_class(
+    size_class: FieldClass,
+    at: str,
+    model: str,
+    where: Collector,
+    *,
+    field_class: FieldClass | None,
+    official: bool,
+) -> None:
+    """A robot of the other size class than the game's: refused in an official match (the rule
+    book's size classes), a warning in a friendly."""
+    if field_class is None or size_class is field_class:
+        return
+    message = (f"{model} is a robot model of the {size_class.value} size class in a game of the "
+               f"{field_class.value} size class")
+    expected = (f"a model of the {field_class.value} size class: {DEFAULT_MODEL[field_class]}, "
+                f'or a model package whose {MODEL_MANIFEST} says "class": "{field_class.value}"')
+    if official:
+        where.error(at, f"{message} (each size class plays its own robots)", expected=expected)
+    else:
+        where.warn(at, f"{message}: allowed in friendlies, refused in official matches",
+                   expected=expected)
 
 
 def _player(number: int, document: TeamDocument, field_class: FieldClass | None) -> PlayerConfig:

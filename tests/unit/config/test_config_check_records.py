@@ -9,6 +9,7 @@ from orchestrator.config.robot_models import describe
 from simulator.world.robots.team.rulebook import Measurements
 
 MEASURED = Measurements(
+    size_class="kid",
     height_m=0.822849, leg_m=0.45104, head_m=0.16833, top_m=0.37181, arm_m=0.29277,
     foot_length_m=0.19, foot_width_m=0.10604, mass_kg=6.116749, cameras=1, max_fov_rad=1.04,
     motors=20, arm_chains_m={"l_shoulder": 0.29277}, servos={"LKnee": "XM540-W270@14.8V"},
@@ -32,6 +33,7 @@ def test_measurements_are_written_rounded_and_first() -> None:
     record = FileReport(file="wolfgang", kind="robot model", measurements=MEASURED).as_json()
     assert list(record)[0] == "measurements"
     measurements = record["measurements"]
+    assert measurements["size_class"] == "kid"
     assert measurements["height_m"] == 0.8228 and measurements["mass_kg"] == 6.1167
     assert measurements["arm_chains_m"] == {"l_shoulder": 0.2928}
     assert measurements["motors"] == 20 and measurements["servos"] == {"LKnee": "XM540-W270@14.8V"}

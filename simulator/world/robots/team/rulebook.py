@@ -46,6 +46,7 @@ FRAME_KG = 1e-5  # lighter links are frames (camera, IMU), not parts
 
 @dataclass(frozen=True, slots=True)
 class Measurements:
+    size_class: str  # the class the manifest declares ("kid", "adult"), whose rules were applied
     height_m: float
     leg_m: float
     head_m: float
@@ -140,6 +141,7 @@ def measure(robot: TeamRobotModel) -> Measurements:
             foot_width = max(foot_width, float(min(extent[0], extent[1])))
     cams = robot.manifest.cameras
     return Measurements(
+        size_class=robot.field_class,
         height_m=height,
         leg_m=leg,
         head_m=head,

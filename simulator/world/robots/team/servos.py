@@ -48,7 +48,8 @@ def servo_problems(manifest: Manifest, *, official: bool) -> list[ModelProblem]:
     gains (warnings in friendlies, errors when ``official``)."""
     source = str(manifest.path)
     free = "error" if official else "warning"
-    match = "an official match" if official else "friendlies only (refused in official matches)"
+    match = "not for an official match" if official else (
+        "for friendlies only (refused in official matches)")
     out: list[ModelProblem] = []
     for i, entry in enumerate(manifest.motors):
         at = f"/motors/{i}"
@@ -61,7 +62,7 @@ def servo_problems(manifest: Manifest, *, official: bool) -> list[ModelProblem]:
                     severity=free,
                     reason=f"{entry.name} (joint {entry.joint}) names no catalogue servo: "
                     f"free-form max_torque_nm {entry.max_torque_nm} and max_velocity_rad_s "
-                    f"{entry.max_velocity_rad_s} are for {match} (rule: {RULE})",
+                    f"{entry.max_velocity_rad_s} are {match} (rule: {RULE})",
                 )
             )
         else:
@@ -84,7 +85,7 @@ def servo_problems(manifest: Manifest, *, official: bool) -> list[ModelProblem]:
                     source=source,
                     where=f"{at}/{key}",
                     severity=free,
-                    reason=f"{entry.name}: free-form gain {key} is for {match} and has no effect: "
+                    reason=f"{entry.name}: free-form gain {key} is {match} and has no effect: "
                     f"position control is Webots' (P, I, D from MotorPID; rule: {RULE})",
                 )
             )
@@ -98,7 +99,7 @@ def servo_problems(manifest: Manifest, *, official: bool) -> list[ModelProblem]:
                     source=source,
                     where=f"/{key}",
                     severity=free,
-                    reason=f"{key} {value:g} replaces the catalogue servos' friction: for {match} "
+                    reason=f"{key} {value:g} replaces the catalogue servos' friction: {match} "
                     f"(rule: {RULE})",
                 )
             )
