@@ -198,6 +198,7 @@ def _team_problems(schedule: Schedule) -> list[Problem]:
     from orchestrator.config.loader import check_team
 
     problems: list[Problem] = []
+    official = schedule.game_defaults.get("official") is True  # as each match's game.json says
     for team in schedule.teams:
         if not team.config.is_file():
             continue  # reported by the cross-checks
@@ -205,7 +206,7 @@ def _team_problems(schedule: Schedule) -> list[Problem]:
         for field_class in classes:
             problems += check_team(  # the schedule says KID / ADULT, as game.json does
                 team.config, field_class=FieldClass(field_class.lower()) if field_class else None,
-                images_required=True)
+                images_required=True, official=official)
     return problems
 
 

@@ -77,3 +77,22 @@ def test_schedule_run_refuses_what_check_refuses(tmp_path: Path) -> None:
     path = _cup(tmp_path, BROKEN)
     assert main(["schedule", "run", str(path), "--state", str(tmp_path / "s.sqlite")]) == 2
     assert not (tmp_path / "s.sqlite").exists()
+
+
+def test_an_official_schedule_checks_its_teams_as_official(tmp_path: Path) -> None:
+    """``official: true`` in game_defaults makes every match official: a team of adult-default
+    robots on the kid field is refused before the tournament starts, not at its match."""
+    fixed = (BROKEN.replace("simulator_slots: 0", "simulator_slots: 1")
+             .replace("lockstp", "lockstep").replace("half_duraton_s: 8", "half_duration_s: 60")
+             .replace(", credentials: nope.json", "").replace("bess", "bees"))
+    path = _cup(tmp_path, fixed)
+    team = json.loads((tmp_path / "ants.json").read_text())
+    for player in team["players"].values():
+        player["model"] = "adult-default"
+    (tmp_path / "bees.json").write_text(json.dumps(team))
+    friendly = check_schedule(path)
+    assert friendly and {p.severity for p in friendly} == {"warning"}
+    path.write_text(fixed.replace("  stepping: lockstep", "  stepping: lockstep\n  official: true"))
+    official = [p for p in check_schedule(path) if p.severity == "error"]
+    assert official and all(Path(p.file).name == "bees.json" and "adult size class" in p.message
+                            for p in official), official
