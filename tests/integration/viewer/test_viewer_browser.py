@@ -62,6 +62,22 @@ def test_robots_and_ball_are_drawn_where_the_replay_has_them(page: Any, match: P
         screenshot(page, "replay-sought")
 
 
+PAUSE_PAST = """(t) => new Promise((resolve, reject) => {
+    const until = performance.now() + 15000;
+    const tick = () => {
+        if (window.hlvsViewer.time > t) {
+            document.querySelector("[data-testid=play]").click();
+            resolve();
+        } else if (performance.now() > until) {
+            reject(new Error(`playback never passed ${t} ms`));
+        } else {
+            requestAnimationFrame(tick);
+        }
+    };
+    tick();
+})"""
+
+
 def test_the_timeline_jumps_to_the_goal_and_playback_runs(page: Any, match: Path) -> None:
     with hlvs_view(match) as urls:
         _open(page, urls[0])
@@ -71,8 +87,9 @@ def test_the_timeline_jumps_to_the_goal_and_playback_runs(page: Any, match: Path
         assert page.evaluate("window.hlvsViewer.time") == GOAL_MS - 2000
         page.locator("[data-testid=speed]").select_option("0.5")
         page.locator("[data-testid=play]").click()
-        page.wait_for_function(f"window.hlvsViewer.time > {GOAL_MS + 40}", timeout=15_000)
-        page.locator("[data-testid=play]").click()  # pause (0.5x: 0.7 s of wall time left)
+        # pause just past the goal, from within the page: 0.5x leaves 0.7 s of wall time before
+        # the replay's end, which a click sent from here after a wait could miss on a busy host
+        page.evaluate(PAUSE_PAST, GOAL_MS + 40)
         paused_at = page.evaluate("window.hlvsViewer.time")
         assert GOAL_MS < paused_at < 3000
         page.wait_for_timeout(100)  # the last frame of the playback is drawn
