@@ -45,6 +45,7 @@ class Action:
 STAND = Action()
 APPROACH_M = 0.55  # nearer than this the striker lines up and kicks
 BEHIND_M = 0.35  # where it heads for: this far behind the ball, on the goal line through it
+BEHIND_KICK_M = 0.05  # ... and at least this much farther than its kick spot
 ROUND_M = 0.5  # how wide it goes round a ball it is in front of
 FAST_M_S = 0.3  # walking over distance, unless the model's gait says otherwise (Field.fast_m_s)
 AIM_HALF_WIDTH_M = 0.8  # aim this close to the goal centre (posts at 1.3 m)
@@ -218,7 +219,7 @@ def _striker(
     ux, uy = math.cos(heading_error), math.sin(heading_error)
     behind = -(bx * ux + by * uy) < -0.1  # the robot is on the far side of the ball from goal
     if distance > APPROACH_M or not behind or abs(bearing) > 1.2:
-        return _approach(bx, by, heading_error, field.fast_m_s)
+        return _approach(bx, by, heading_error, field)
     if abs(heading_error) > 0.35:
         # circle around the ball: side-step while turning, keep about 0.3 m away
         return Action(
@@ -248,9 +249,10 @@ def _striker(
     )
 
 
-def _approach(bx: float, by: float, goal_bearing: float, fast_m_s: float) -> Action:
+def _approach(bx: float, by: float, goal_bearing: float, field: Field) -> Action:
     """Walk to a point behind the ball on the line from the goal centre through the ball (the
-    robot frame; ``goal_bearing`` the direction from the ball to the goal). When the robot is
+    robot frame; ``goal_bearing`` the direction from the ball to the goal), a little farther
+    than the kick spot (it steps back only slowly). When the robot is
     on the goal side of the ball, go round it first, on the side it is already on, so that it
     neither pushes the ball towards its own goal nor has to circle it for long."""
     ux, uy = math.cos(goal_bearing), math.sin(goal_bearing)
@@ -261,9 +263,10 @@ def _approach(bx: float, by: float, goal_bearing: float, fast_m_s: float) -> Act
         px = bx - 0.25 * ux - side * ROUND_M * uy
         py = by - 0.25 * uy + side * ROUND_M * ux
     else:
-        px, py = bx - BEHIND_M * ux, by - BEHIND_M * uy
+        behind = max(BEHIND_M, field.kick_x_m + BEHIND_KICK_M)
+        px, py = bx - behind * ux, by - behind * uy
     target = math.atan2(py, px)
-    forward = fast_m_s if abs(target) < 0.3 else (0.06 if abs(target) < 0.7 else 0.0)
+    forward = field.fast_m_s if abs(target) < 0.3 else (0.06 if abs(target) < 0.7 else 0.0)
     return Action(walk=(forward, 0.0, _clip(1.5 * target, 0.7)))
 
 

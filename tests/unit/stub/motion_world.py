@@ -104,7 +104,8 @@ class OneRobot:
         return np.array(self.world.data.xpos[self.ball], dtype=np.float64)
 
     def place_ball(self, x_m: float, y_m: float) -> None:
-        self.world.apply(PlaceBall(position=(x_m, y_m, 0.07)))
+        """The ball at rest on the grass at (``x_m``, ``y_m``)."""
+        self.world.apply(PlaceBall(position=(x_m, y_m, self.world.field.ball_radius_m)))
 
     def sole(self, side: str) -> np.ndarray:
         geom = self.world.model.geom(f"red_1/foot:sole_{side}").id

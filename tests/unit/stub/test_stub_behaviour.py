@@ -121,3 +121,41 @@ def test_at_the_opponents_kick_off_it_waits_outside_the_centre_circle_of_its_fie
         spot = _kick_off_position(Role.STRIKER, theirs, field, None)
         spots[field_class] = (spot.x_m, spot.y_m)
     assert spots == {"kid": (-1.0, 0.0), "adult": (-1.75, 0.0)}
+
+
+def _walk_to_kick(
+    field: Field, start: Pose, ball_field: tuple[float, float]
+) -> tuple[float, float]:
+    """The striker's decisions with its walk commands followed exactly (steps of 50 ms) until it
+    kicks: (seconds until the kick, metres stepped backwards)."""
+    pose, backwards, t, dt = start, 0.0, 0.0, 0.05
+    while t < 30.0:
+        ball = pose.to_relative(*ball_field)
+        action = decide(role=Role.STRIKER, game=PLAYING, pose=pose, ball=ball, field=field,
+                        searching_s=0.0)  # fmt: skip
+        if action.kick_foot is not None:
+            return t, backwards
+        vx, vy, vyaw = action.walk
+        backwards += max(0.0, -vx) * dt
+        c, s = math.cos(pose.yaw_rad), math.sin(pose.yaw_rad)
+        pose = Pose(x_m=pose.x_m + (vx * c - vy * s) * dt, y_m=pose.y_m + (vx * s + vy * c) * dt,
+                    yaw_rad=pose.yaw_rad + vyaw * dt)  # fmt: skip
+        t += dt
+    raise AssertionError(f"no kick from {start} in 30 s")
+
+
+def test_a_striker_with_a_far_kick_spot_comes_in_behind_it() -> None:
+    """The adult kicks a ball 0.41 m ahead of its pelvis, farther than the 0.35 m behind the ball
+    the kid heads for: it heads for a point beyond its kick spot, so that it lines up walking
+    forwards (it steps back only at 0.05 m/s). From three starts at an angle to the ball it
+    kicks within 10 s, hardly stepping back (heading for 0.35 m: 9.2, 10.3 and 10.5 s)."""
+    adult = Field(half_length_m=7.0, centre_circle_m=1.5, foot_y_m=0.17, kick_x_m=0.41,
+                  fast_m_s=0.4)  # fmt: skip
+    starts = (
+        (Pose(x_m=-1.0, y_m=0.3, yaw_rad=0.0), (2.0, 0.0)),
+        (Pose(x_m=0.0, y_m=-1.0, yaw_rad=0.8), (2.0, 0.5)),
+        (Pose(x_m=3.0, y_m=1.0, yaw_rad=3.0), (2.0, 0.0)),  # in front of the ball: goes round
+    )
+    runs = [_walk_to_kick(adult, start, ball) for start, ball in starts]
+    assert all(seconds < 10.0 for seconds, _ in runs), runs
+    assert sum(backwards for _, backwards in runs) <= 0.05, runs
