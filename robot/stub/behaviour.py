@@ -26,7 +26,16 @@ class GameInfo:
     our_kick_off: bool = True
     first_half: bool = True
     on_left: bool | None = None  # the team's TeamInfo comes first in RGme: it plays on the left
-    ball_free_in_s: float = 0.0  # PLAYING: the opponents' kick-off is still protected this long
+    # PLAYING: the last restart (kick-off, or a set play just taken) is protected this long ...
+    ball_free_in_s: float = 0.0
+    # ... and it was ours (None: the kick-off's, ``our_kick_off``)
+    restart_ours: bool | None = None
+    # a set play (goal kick, corner kick, throw-in, free kick, penalty kick) being prepared: ours
+    # (True) or the opponents' (False); None when none is
+    set_play_ours: bool | None = None
+    # its sub-phase: 0 the ball placed, robots still; 1 robots position; 2 robots freeze (the
+    # GameController's secondaryStateInfo[1]); the set play is taken when 2 ends
+    set_play_phase: int = 0
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -59,6 +68,8 @@ KICK_OFF_YAW_RAD = 0.08  # ... and its heading this close to the kick-off pass
 KICK_OFF_SHORT_M = 0.04  # READY: the ball this much farther than the kick spot (no touching)
 CENTRE_SPOT_M = 0.3  # a ball this close to the centre spot is a kick-off ball
 OUTSIDE_CIRCLE_M = 0.25  # READY at the opponents' kick-off: this far outside the centre circle
+SET_PLAY_MARGIN_M = 0.2  # at the opponents' set play: backs off when nearer than the distance
+# and this, to the distance and twice this
 SEARCH_TURN_AFTER_S = 2.0
 DEFENDER_HOME = (-2.3, 0.0)  # when none is given
 DEFENDER_ENGAGE_M = 1.2  # a defender plays a ball this close to its home spot
@@ -73,6 +84,7 @@ class Field:
     kick_x_m: float  # best ball distance in front of the pelvis for a kick
     kick_feet: tuple[str, ...] = ("left", "right")  # the feet it kicks with
     fast_m_s: float = FAST_M_S  # forward speed over distance (the gait's cruise speed)
+    opponent_distance_m: float = 0.75  # keep this far from the ball at the opponents' set plays
 
 
 def decide(
@@ -106,8 +118,11 @@ def decide(
                           tolerance_m=KICK_OFF_PLACE_M, yaw_tolerance_rad=KICK_OFF_YAW_RAD)
         return _go_to(pose, target, fast_m_s=field.fast_m_s)
     # PLAYING
-    if not game.our_kick_off and game.ball_free_in_s > 0:
-        return STAND  # the opponents' kick-off: keep out of the centre circle
+    if game.set_play_ours is not None:
+        return _set_play(role, game, pose, ball, field, searching_s)
+    restart_ours = game.our_kick_off if game.restart_ours is None else game.restart_ours
+    if not restart_ours and game.ball_free_in_s > 0:
+        return STAND  # the opponents' kick-off or set play: keep away until the ball is free
     if role is Role.GOALIE:
         return _goalie(pose, ball, field, searching_s)
     if role is Role.DEFENDER:
@@ -115,6 +130,38 @@ def decide(
     if game.our_kick_off and _kick_off_ball(pose, ball) is not None:
         return _striker(pose, ball, field, searching_s, aim=_kick_off_aim(field))
     return _striker(pose, ball, field, searching_s)
+
+
+def _set_play(
+    role: Role,
+    game: GameInfo,
+    pose: Pose,
+    ball: tuple[float, float] | None,
+    field: Field,
+    searching_s: float,
+) -> Action:
+    """While a set play is prepared: at the opponents', keep the set-play distance from the ball
+    (backing off towards the own goal when nearer) and wait; at ours, stand while the robots
+    must (sub-phases 0 and 2) and let the striker line up behind the ball in sub-phase 1,
+    without kicking before the set play is taken."""
+    if not game.set_play_ours:
+        if role is Role.GOALIE or ball is None:
+            return _face(ball, tolerance_rad=0.4)
+        ball_field = pose.to_field(*ball)
+        if math.hypot(*ball) >= field.opponent_distance_m + SET_PLAY_MARGIN_M:
+            return _face(ball, tolerance_rad=0.4)
+        # the spot on the way from the ball to the own goal, just beyond the distance
+        gx, gy = -field.half_length_m - ball_field[0], -ball_field[1]
+        away = math.hypot(gx, gy) or 1.0
+        keep = field.opponent_distance_m + 2.0 * SET_PLAY_MARGIN_M
+        spot = (ball_field[0] + keep * gx / away, ball_field[1] + keep * gy / away)
+        facing = math.atan2(ball_field[1] - spot[1], ball_field[0] - spot[0])
+        return _go_to(pose, Pose(x_m=spot[0], y_m=spot[1], yaw_rad=facing),
+                      fast_m_s=field.fast_m_s, tolerance_m=SET_PLAY_MARGIN_M)  # fmt: skip
+    if role is not Role.STRIKER or game.set_play_phase != 1:
+        return _face(ball, tolerance_rad=0.4) if game.set_play_phase == 1 else STAND
+    action = _striker(pose, ball, field, searching_s)
+    return STAND if action.kick_foot is not None else action
 
 
 def _kick_off_ball(pose: Pose, ball: tuple[float, float] | None) -> tuple[float, float] | None:

@@ -131,6 +131,7 @@ class StubController:
             foot_y_m=self.kin.leg.hip_offset_y_m + walk.foot_y_offset_m + KICK_BALL_OUTSIDE_M,
             kick_x_m=self.kin.kick_ball_x_m or 0.165 * self.kin.leg.thigh_m / KID_THIGH_M,
             fast_m_s=min(walk.cruise_vx_m_s, walk.max_vx_m_s),
+            opponent_distance_m=geometry.opponent_distance_m,
         )
         # the model's size against kid-default's (1.0 there): the ball estimate of a taller
         # robot, whose camera sits higher, jumps by more while it sways

@@ -39,6 +39,9 @@ class GameControllerLink:
         self._listener = GameControllerListener(port=data_port, gamecontroller=gamecontroller_ip)
         self._replier: GameControllerReplier | None = None
         self._latest: GameControlData | None = None
+        # the team number of the last set play seen since the last kick-off: the protection
+        # after it is taken (secondaryTime counts on, secondaryState is NORMAL again) is theirs
+        self._set_play_team: int | None = None
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name="gamecontroller", daemon=True)
@@ -66,20 +69,23 @@ class GameControllerLink:
     def info(self) -> GameInfo | None:
         """The game as the GameController last described it; None before the first packet."""
         with self._lock:
-            data = self._latest
+            data, set_play_team = self._latest, self._set_play_team
         if data is None:
             return None
         team = self.team_number(data)
         penalty = data.own_penalty(team, self._player) if team is not None else None
+        playing = data.state is GameState.PLAYING
+        set_play = playing and data.secondary_state.is_set_play
         return GameInfo(
             phase=data.state,
             penalised=bool(penalty),
             our_kick_off=team is not None and data.kick_off_team == team,
             first_half=data.first_half,
             on_left=None if team is None else data.teams[0].team_number == team,
-            ball_free_in_s=float(max(data.secondary_time, 0))
-            if data.state is GameState.PLAYING
-            else 0.0,
+            ball_free_in_s=float(max(data.secondary_time, 0)) if playing else 0.0,
+            restart_ours=None if set_play_team is None else set_play_team == team,
+            set_play_ours=data.secondary_state_info[0] == team if set_play else None,
+            set_play_phase=data.secondary_state_info[1] if set_play else 0,
         )
 
     def _run(self) -> None:
@@ -90,6 +96,10 @@ class GameControllerLink:
             if data is not None:
                 with self._lock:
                     self._latest = data
+                    if data.state is not GameState.PLAYING:
+                        self._set_play_team = None  # a kick-off comes next
+                    elif data.secondary_state.is_set_play:
+                        self._set_play_team = data.secondary_state_info[0]
                 if data.state != previous_state:
                     logger.info(
                         "GameController %s: state %s", self._listener.sender, data.state.name
