@@ -38,6 +38,7 @@ from referee.snapshot import (
     RefereeEvent,
     SetLimp,
     TeleportRobot,
+    Vec2,
     WorldCommand,
     WorldSnapshot,
 )
@@ -95,6 +96,7 @@ class Referee:
         self._set_since_ms: int | None = None
         self._shootout: Shootout | None = None
         self.ball_in_play = False
+        self.set_play_spot: Vec2 | None = None  # where the set play in preparation put the ball
         self.play = PlayTracker()
         self.reset_memories()
         self._network: GameControllerNetwork | None = None

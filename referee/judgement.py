@@ -14,6 +14,7 @@ from referee.gamecontroller import Card, GameController, GameState, Penalty
 from referee.logs import RefereeLog
 from referee.rules import removal
 from referee.rules.base import (
+    AbortSetPlay,
     AwardSetPlay,
     BallInPlay,
     Decision,
@@ -21,6 +22,7 @@ from referee.rules.base import (
     GiveCard,
     Goal,
     PenalizeRobot,
+    RetakeSetPlay,
 )
 from referee.snapshot import PlaceBall, RefereeEvent, Vec2, WorldCommand, WorldSnapshot
 
@@ -41,6 +43,7 @@ class RefereeCore(Protocol):
     ignored_robots: set[RobotId]
     ball_in_play: bool
     left_team: TeamColor
+    set_play_spot: Vec2 | None  # where the set play in preparation placed the ball
 
     def emit(self, event: RefereeEvent) -> None: ...
 
@@ -74,6 +77,9 @@ def apply_decisions(
         elif isinstance(decision, AwardSetPlay):
             stopped = True
             commands += _set_play(ref, decision, snapshot)
+        elif isinstance(decision, RetakeSetPlay | AbortSetPlay):
+            stopped = True
+            commands += _touched_set_play(ref, decision, snapshot)
         elif isinstance(decision, DropBall):
             stopped = True
             ref.gc.dropped_ball()
@@ -125,7 +131,7 @@ def _goal(ref: RefereeCore, goal: Goal, snapshot: WorldSnapshot) -> list[WorldCo
 def _set_play(ref: RefereeCore, play: AwardSetPlay, snapshot: WorldSnapshot) -> list[WorldCommand]:
     ref.gc.begin_set_play(play.kind, play.team)
     ref.ball_in_play = False
-    x, y = play.position
+    ref.set_play_spot = x, y = play.position
     ref.log.info(
         snapshot.sim_time_ms,
         f"{play.kind.name} for the {play.team.value} team at ({x:.2f}, {y:.2f}): {play.reason}.",
@@ -136,6 +142,39 @@ def _set_play(ref: RefereeCore, play: AwardSetPlay, snapshot: WorldSnapshot) -> 
             reason=play.reason, placement=(x, y, ref.field.ball_radius_m),
         )
     )
+    return [ref.ball_at(x, y)]
+
+
+def _touched_set_play(
+    ref: RefereeCore, decision: RetakeSetPlay | AbortSetPlay, snapshot: WorldSnapshot
+) -> list[WorldCommand]:
+    """The ball touched before the set play was taken: RETAKE (the ball placed again) or ABORT
+    (the ball in play)."""
+    play = ref.gc.set_play
+    if play is None:
+        return []
+    now = snapshot.sim_time_ms
+    what = "RETAKE" if isinstance(decision, RetakeSetPlay) else "ABORT"
+    ref.log.info(now, f"{play.kind.name} for {play.team.value}: {what}, {decision.robot} "
+                 f"{decision.reason}.")  # fmt: skip
+    if isinstance(decision, AbortSetPlay):
+        ref.gc.abort_set_play()
+        ref.set_play_spot = None
+        ref.ball_in_play = True
+        ref.emit(RefereeEvent(sim_time_ms=now, type="set_play_aborted", team=play.team,
+                              player=decision.robot.number, reason=decision.reason))  # fmt: skip
+        ref.emit(RefereeEvent(sim_time_ms=now, type="ball_in_play",
+                              reason=f"{play.kind.name.lower()} aborted"))  # fmt: skip
+        return []
+    ref.gc.retake_set_play()
+    x, y = ref.set_play_spot or (snapshot.ball.position[0], snapshot.ball.position[1])
+    ref.emit(
+        RefereeEvent(
+            sim_time_ms=now, type="set_play_retaken", team=play.team,
+            player=decision.robot.number, reason=decision.reason,
+            placement=(x, y, ref.field.ball_radius_m),
+        )
+    )  # fmt: skip
     return [ref.ball_at(x, y)]
 
 

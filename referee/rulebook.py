@@ -1,8 +1,9 @@
 """The rules in the order the referee applies them, with their memories.
 
-Order: ball in play, goal (else ball out), kick-off, fallen, outside turf, ball holding,
-pushing, inactive goalkeeper, dropped ball. (Kick-off positions at SET and set-play compliance
-at EXECUTE are judged once, when the GameController enters those phases.) Each rule is a pure
+Order: ball in play, goal (else ball out), touches before a set play is taken, kick-off,
+fallen, outside turf, ball holding, pushing, inactive goalkeeper, dropped ball. (Kick-off
+positions at SET and set-play compliance at EXECUTE are judged once, when the GameController
+enters those phases.) Each rule is a pure
 function; this class only keeps each rule's memory from one step to the next.
 """
 
@@ -19,6 +20,7 @@ from referee.rules import (
     kickoff,
     outside_turf,
     pushing,
+    set_play,
 )
 from referee.rules.base import Decision, GameView
 from referee.snapshot import WorldSnapshot
@@ -46,6 +48,7 @@ class RuleBook:
         decisions += found
         found, self.goal = goal.judge(snapshot, view, self.goal)
         decisions += found or ball_out.judge(snapshot, view)
+        decisions += set_play.judge_touch(snapshot, view)
         decisions += kickoff.judge_before_in_play(snapshot, view)
         found, self.fallen = fallen.judge(snapshot, view, self.fallen)
         decisions += found

@@ -188,6 +188,21 @@ class GameController:
         self.set_play = SetPlay(kind, team, 0)
         self.secondary_time = self.timing.set_play_phase0_s
 
+    def retake_set_play(self) -> None:
+        """RETAKE: the set play in preparation starts again from sub-phase 0."""
+        play = self.set_play
+        if play is None:
+            raise IllegalTransition(current=self.state.name, requested="RETAKE")
+        self.set_play = SetPlay(play.kind, play.team, 0)
+        self.secondary_time = self.timing.set_play_phase0_s
+
+    def abort_set_play(self) -> None:
+        """ABORT: the set play in preparation is cancelled; play goes on."""
+        if self.set_play is None:
+            raise IllegalTransition(current=self.state.name, requested="ABORT")
+        self.set_play = None
+        self.secondary_time = 0.0
+
     def next_period(self) -> SecondaryState:
         """From FINISHED, start the next period; returns its phase. Caller checks it exists."""
         self.transition(GameState.INITIAL)

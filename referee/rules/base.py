@@ -91,7 +91,28 @@ class BallInPlay:
     reason: str
 
 
-Decision = Goal | AwardSetPlay | PenalizeRobot | GiveCard | DropBall | BallInPlay
+@dataclass(frozen=True, slots=True)
+class RetakeSetPlay:
+    """An opponent of the set-play team touched the ball before the set play was taken: it
+    starts again from sub-phase 0, the ball placed again (the GameController's RETAKE)."""
+
+    robot: RobotId
+    reason: str
+
+
+@dataclass(frozen=True, slots=True)
+class AbortSetPlay:
+    """The set-play team touched the ball before the set play was taken: it is cancelled and
+    the ball is in play (the GameController's ABORT)."""
+
+    robot: RobotId
+    reason: str
+
+
+Decision = (
+    Goal | AwardSetPlay | PenalizeRobot | GiveCard | DropBall | BallInPlay | RetakeSetPlay
+    | AbortSetPlay
+)
 
 
 def distance2d(a: Vec2 | Vec3, b: Vec2 | Vec3) -> float:

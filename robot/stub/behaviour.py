@@ -142,8 +142,9 @@ def _set_play(
 ) -> Action:
     """While a set play is prepared: at the opponents', keep the set-play distance from the ball
     (backing off towards the own goal when nearer) and wait; at ours, stand while the robots
-    must (sub-phases 0 and 2) and let the striker line up behind the ball in sub-phase 1,
-    without kicking before the set play is taken."""
+    must (sub-phases 0 and 2) and let the striker walk up behind the ball in sub-phase 1, to
+    within about 0.75 m of it: the league's referee aborts a set play whose team touches the
+    ball before it is taken (and warns the robot), so it lines up only then."""
     if not game.set_play_ours:
         if role is Role.GOALIE or ball is None:
             return _face(ball, tolerance_rad=0.4)
@@ -160,8 +161,10 @@ def _set_play(
                       fast_m_s=field.fast_m_s, tolerance_m=SET_PLAY_MARGIN_M)  # fmt: skip
     if role is not Role.STRIKER or game.set_play_phase != 1:
         return _face(ball, tolerance_rad=0.4) if game.set_play_phase == 1 else STAND
-    action = _striker(pose, ball, field, searching_s)
-    return STAND if action.kick_foot is not None else action
+    if ball is not None and math.hypot(*ball) < APPROACH_M + SET_PLAY_MARGIN_M:
+        # near enough to line up once it is taken: touching the ball now would abort it
+        return STAND
+    return _striker(pose, ball, field, searching_s)
 
 
 def _kick_off_ball(pose: Pose, ball: tuple[float, float] | None) -> tuple[float, float] | None:

@@ -57,7 +57,9 @@ def test_at_the_opponents_set_play_it_backs_off_towards_its_own_goal() -> None:
     assert _striker(theirs, far, ball) == STAND
 
 
-def test_at_its_own_set_play_it_lines_up_but_kicks_only_once_it_is_taken() -> None:
+def test_at_its_own_set_play_it_walks_up_but_lines_up_and_kicks_only_once_it_is_taken() -> None:
+    """Touching the ball before its own set play is taken would abort it (and earn a warning):
+    in sub-phase 1 the striker walks up to about 0.75 m from the ball and waits."""
     ball = (2.0, 0.0)
     on_the_spot = Pose(x_m=2.0 - ADULT.kick_x_m, y_m=-ADULT.foot_y_m, yaw_rad=0.0)
     playing = _striker(_playing(), on_the_spot, ball)
@@ -68,6 +70,8 @@ def test_at_its_own_set_play_it_lines_up_but_kicks_only_once_it_is_taken() -> No
     behind = Pose(x_m=0.0, y_m=0.0, yaw_rad=0.0)
     positioning = _striker(_playing(set_play_ours=True, set_play_phase=1), behind, ball)
     assert positioning.walk[0] > 0.0  # type: ignore[attr-defined]  # walks to the ball
+    near = Pose(x_m=2.0 - 0.6, y_m=0.0, yaw_rad=0.0)  # ... but not into it
+    assert _striker(_playing(set_play_ours=True, set_play_phase=1), near, ball) == STAND
     frozen = _striker(_playing(set_play_ours=True, set_play_phase=2), behind, ball)
     assert frozen == STAND
     # taken: the protection that follows is ours, so it plays (its kick-off team or not)
