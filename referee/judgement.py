@@ -60,11 +60,7 @@ def apply_decisions(
     occupied: list[Vec2] = [(r.position[0], r.position[1]) for r in snapshot.robots]
     for decision in decisions:
         if isinstance(decision, BallInPlay):
-            if not ref.ball_in_play:
-                ref.ball_in_play = True
-                ref.log.info(snapshot.sim_time_ms, f"Ball in play: {decision.reason}.")
-                ref.emit(RefereeEvent(sim_time_ms=snapshot.sim_time_ms, type="ball_in_play",
-                                      reason=decision.reason))
+            _ball_in_play(ref, decision.reason, snapshot)
         elif isinstance(decision, PenalizeRobot):
             commands += _penalize(ref, decision, snapshot, occupied)
         elif isinstance(decision, GiveCard):
@@ -145,6 +141,14 @@ def _set_play(ref: RefereeCore, play: AwardSetPlay, snapshot: WorldSnapshot) -> 
     return [ref.ball_at(x, y)]
 
 
+def _ball_in_play(ref: RefereeCore, reason: str, snapshot: WorldSnapshot) -> None:
+    if not ref.ball_in_play:
+        ref.ball_in_play = True
+        ref.log.info(snapshot.sim_time_ms, f"Ball in play: {reason}.")
+        ref.emit(RefereeEvent(sim_time_ms=snapshot.sim_time_ms, type="ball_in_play",
+                              reason=reason))  # fmt: skip
+
+
 def _touched_set_play(
     ref: RefereeCore, decision: RetakeSetPlay | AbortSetPlay, snapshot: WorldSnapshot
 ) -> list[WorldCommand]:
@@ -160,11 +164,9 @@ def _touched_set_play(
     if isinstance(decision, AbortSetPlay):
         ref.gc.abort_set_play()
         ref.set_play_spot = None
-        ref.ball_in_play = True
         ref.emit(RefereeEvent(sim_time_ms=now, type="set_play_aborted", team=play.team,
                               player=decision.robot.number, reason=decision.reason))  # fmt: skip
-        ref.emit(RefereeEvent(sim_time_ms=now, type="ball_in_play",
-                              reason=f"{play.kind.name.lower()} aborted"))  # fmt: skip
+        _ball_in_play(ref, f"{play.kind.name.lower()} aborted", snapshot)
         return []
     ref.gc.retake_set_play()
     x, y = ref.set_play_spot or (snapshot.ball.position[0], snapshot.ball.position[1])

@@ -193,8 +193,7 @@ class GameController:
         play = self.set_play
         if play is None:
             raise IllegalTransition(current=self.state.name, requested="RETAKE")
-        self.set_play = SetPlay(play.kind, play.team, 0)
-        self.secondary_time = self.timing.set_play_phase0_s
+        self.begin_set_play(play.kind, play.team)
 
     def abort_set_play(self) -> None:
         """ABORT: the set play in preparation is cancelled; play goes on."""

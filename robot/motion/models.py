@@ -99,6 +99,8 @@ class CameraMount:
     fov_rad: float
 
 
+KID_KICK_BALL_X_M = 0.165  # kid-default kicks a ball this far in front of its pelvis
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class RobotKinematics:
     name: str
@@ -121,9 +123,9 @@ class RobotKinematics:
     # how far each ball sighting moves the believed ball (1: all the way); a tall robot's torso
     # sways by more while stepping, and the ball in its images with it
     ball_gain: float = 1.0
-    # the ball's best distance in front of the pelvis for a kick; None: kid-default's 0.165 m
-    # scaled by the thigh
-    kick_ball_x_m: float | None = None
+    # the ball's best distance in front of the pelvis for a kick (kid-default's, scaled, unless
+    # the model says otherwise)
+    kick_ball_x_m: float = KID_KICK_BALL_X_M
 
     @property
     def motor_names(self) -> tuple[str, ...]:
@@ -231,7 +233,7 @@ def _humanoid(
         rise_s=rise_s,
         kick_overrides=dict(kick_overrides or {}),
         ball_gain=ball_gain,
-        kick_ball_x_m=kick_ball_x_m,
+        kick_ball_x_m=KID_KICK_BALL_X_M * scale if kick_ball_x_m is None else kick_ball_x_m,
     )
 
 

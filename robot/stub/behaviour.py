@@ -148,9 +148,9 @@ def _set_play(
     if not game.set_play_ours:
         if role is Role.GOALIE or ball is None:
             return _face(ball, tolerance_rad=0.4)
-        ball_field = pose.to_field(*ball)
         if math.hypot(*ball) >= field.opponent_distance_m + SET_PLAY_MARGIN_M:
             return _face(ball, tolerance_rad=0.4)
+        ball_field = pose.to_field(*ball)
         # the spot on the way from the ball to the own goal, just beyond the distance
         gx, gy = -field.half_length_m - ball_field[0], -ball_field[1]
         away = math.hypot(gx, gy) or 1.0

@@ -59,7 +59,7 @@ KICK_COMMIT_MS = 2500  # keep to a kick decided this long ago while the ball sta
 # ball estimate jumps by several centimetres; re-aligning on it restarts the gait for ever
 KICK_HOLD_X_M = 0.12
 KICK_HOLD_Y_M = 0.08
-KID_THIGH_M = 0.16  # kid-default's; the hold above and the kick spot scale with the thigh
+KID_THIGH_M = 0.16  # kid-default's; the hold above scales with the thigh
 # READY and SET: the ball lies on the centre spot, a landmark that corrects the odometry (each
 # sighting nearer than this moves the believed position by the gain towards what it implies)
 CENTRE_BALL_MAX_M = 1.5  # farther, the ball's distance is underestimated by up to a third
@@ -129,7 +129,7 @@ class StubController:
             half_length_m=geometry.half_length_m,
             centre_circle_m=geometry.centre_circle_radius_m,
             foot_y_m=self.kin.leg.hip_offset_y_m + walk.foot_y_offset_m + KICK_BALL_OUTSIDE_M,
-            kick_x_m=self.kin.kick_ball_x_m or 0.165 * self.kin.leg.thigh_m / KID_THIGH_M,
+            kick_x_m=self.kin.kick_ball_x_m,
             fast_m_s=min(walk.cruise_vx_m_s, walk.max_vx_m_s),
             opponent_distance_m=geometry.opponent_distance_m,
         )
