@@ -24,6 +24,7 @@ from robot.motion.posture import standing_posture
 from robot.motion.walk import default_walk_params
 from robot.stub.behaviour import Action, Field, GameInfo, Role, decide
 from robot.stub.perception import (
+    BallSighting,
     CameraPose,
     find_ball_blobs,
     ground_point,
@@ -59,7 +60,19 @@ KICK_COMMIT_MS = 2500  # keep to a kick decided this long ago while the ball sta
 # ball estimate jumps by several centimetres; re-aligning on it restarts the gait for ever
 KICK_HOLD_X_M = 0.12
 KICK_HOLD_Y_M = 0.08
-KID_THIGH_M = 0.16  # kid-default's; the hold above scales with the thigh
+KID_THIGH_M = 0.16  # kid-default's; the hold above and the own body below scale with the thigh
+# Looking down, the head camera sees the robot's own shins, feet and hands, whose dark shading
+# and light highlights the detector can take for the ball (in a third of the images of a 20 s
+# search without a ball in view). A ball cannot lie where they are: its centre stays a ball's
+# radius clear of the feet (kid-default: toes 0.10 m ahead of the pelvis, outer edges 0.10 m
+# to the side, ball radius 0.07 m). A sighting in front of the feet nearer than this (pelvis
+# frame, the margin left for the estimate's error) ...
+OWN_FEET_X_M = 0.14
+OWN_FEET_Y_M = 0.14
+# ... or beside the legs, under the hands (where the hands, seen from above, land on the ground),
+# is the robot itself and is not taken
+OWN_HANDS_X_M = 0.08
+OWN_HANDS_Y_M = 0.32
 # READY and SET: the ball lies on the centre spot, a landmark that corrects the odometry (each
 # sighting nearer than this moves the believed position by the gain towards what it implies)
 CENTRE_BALL_MAX_M = 1.5  # farther, the ball's distance is underestimated by up to a third
@@ -442,11 +455,17 @@ class StubController:
                 height_px=height,
                 ball_radius_m=self._ball_radius_m,
             )
-            if seen is not None and seen.distance_m < 8.0:
+            if seen is not None and seen.distance_m < 8.0 and not self._own_body(seen):
                 self.world.see_ball(sensors.time_ms, seen.x_m, seen.y_m)
                 self.stats.ball_sightings += 1
                 return seen.x_m, seen.y_m
         return None
+
+    def _own_body(self, seen: BallSighting) -> bool:
+        """Whether a sighting lies where the robot's own feet or hands are (see OWN_FEET_X_M)."""
+        x, y = seen.x_m / self._size, abs(seen.y_m) / self._size
+        feet = x < OWN_FEET_X_M and y < OWN_FEET_Y_M
+        return feet or (abs(x) < OWN_HANDS_X_M and y < OWN_HANDS_Y_M)
 
     def _head(
         self, dt: float, ball: tuple[float, float] | None, action: Action, torso_pitch: float

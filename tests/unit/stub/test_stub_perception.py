@@ -5,7 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from contracts import GameState, Pose
 from robot.motion import kinematics, standing_posture
+from robot.stub import GameInfo, Role, StubController
 from robot.stub.perception import CameraPose, find_ball_blobs, ground_point
 from simulator.world import CameraRenderer
 
@@ -54,3 +56,44 @@ def test_no_ball_in_an_empty_field_image() -> None:
     with CameraRenderer(robot.world, 320, 240) as camera:
         image = np.frombuffer(camera.render(RED1), np.uint8).reshape(240, 320, 3)
     assert find_ball_blobs(image) == []
+
+
+def _search(model: str, ball: tuple[float, float], seconds: float) -> tuple[int, int]:
+    """A striker searching for the ball in PLAYING (head scan, then turning): how many frames
+    put the believed ball within 0.3 m of the true one, and how many put it elsewhere."""
+    robot = OneRobot(model=model)
+    robot.place_ball(*ball)
+    start = Pose(x_m=0.0, y_m=0.0, yaw_rad=0.0)
+    field_class = "adult" if model.startswith("adult") else "kid"
+    controller = StubController(
+        role=Role.STRIKER, start_pose=start, model=model, field_class=field_class
+    )
+    game = GameInfo(phase=GameState.PLAYING)
+    true = wrong = 0
+    with CameraRenderer(robot.world, 320, 240) as camera:
+        for _ in range(int(seconds / 0.008)):
+            sightings = controller.stats.ball_sightings
+            robot.command(controller.tick(robot.sensors(camera), game))
+            robot.world.step()
+            if controller.stats.ball_sightings > sightings:
+                seen = controller.world.ball_field
+                assert seen is not None
+                near = np.hypot(*(np.array(seen) - robot.ball_position[:2])) < 0.3
+                true, wrong = true + int(near), wrong + int(not near)
+    return true, wrong
+
+
+@pytest.mark.parametrize("model", ["kid-default", "adult-default"])
+def test_the_robot_does_not_take_its_own_feet_and_hands_for_the_ball(model: str) -> None:
+    # Scanning low, the camera sees the robot's own shins, feet and hands; taken for the ball
+    # (47-63 of some 200 frames of a 20 s search), they kept it from turning to look elsewhere.
+    true, wrong = _search(model, (-30.0, 30.0), 12.0)  # no ball in view anywhere
+    assert (true, wrong) == (0, 0)
+
+
+def test_a_ball_behind_the_robot_is_found() -> None:
+    # Before, the kid saw its own legs in every low scan and never turned: no sighting of this
+    # ball in 20 s.
+    true, wrong = _search("kid-default", (-1.0, 1.0), 12.0)
+    assert true >= 20
+    assert wrong <= true // 10
