@@ -18,7 +18,7 @@ from contracts import GameState, Pose, field_for
 from robot.learned import Policy, PolicyMotion
 from robot.learned.policy import KICK_BALL_AHEAD_M
 from robot.motion import AttitudeFilter, GetUpMotion, KickMotion, WalkEngine, kinematics
-from robot.motion.imu import GRAVITY_M_S2
+from robot.motion.imu import GRAVITY_M_S2, GyroBias
 from robot.motion.keyframes import Keyframe, KeyframeMotion
 from robot.motion.posture import standing_posture
 from robot.motion.walk import default_walk_params
@@ -81,6 +81,10 @@ CENTRE_BALL_GAIN = 0.2
 # that looks like a ball (a goal's black and white net, seen by a goalie walking past it) would
 # drag the believed position metres away
 CENTRE_BALL_GATE_M = 1.0
+# the gyro's bias is learnt from the readings of a robot standing still this long, each axis
+# turning slower than this
+GYRO_STILL_S = 0.3
+GYRO_STILL_RAD_S = 0.05
 # rise into the stance only when standing this upright (placed by the referee), not while
 # tipping over (when the knees lag their targets too)
 RISE_MAX_TILT_RAD = 0.2
@@ -132,6 +136,8 @@ class StubController:
         self.walk = WalkEngine(model=model)
         self.world = WorldModel(start_pose, ball_gain=self.kin.ball_gain)
         self.attitude = AttitudeFilter()
+        self._gyro_bias = GyroBias()
+        self._gyro_still_s = 0.0
         self._heading = HeadingTracker()
         self.stats = Stats()
         walk = default_walk_params(model)
@@ -297,6 +303,8 @@ class StubController:
         if self._settle_until_ms is None:
             self._settle_until_ms = sensors.time_ms + int(SETTLE_S * 1000)
         self._last_ms = sensors.time_ms
+        if sensors.gyro is not None:
+            sensors = replace(sensors, gyro=self._gyro_unbiased(dt, sensors.gyro, game))
         if sensors.accel is not None and sensors.gyro is not None:
             self.attitude.update(dt, sensors.accel, sensors.gyro)
             weight = dt / (LYING_SIDE_TAU_S + dt)
@@ -384,7 +392,12 @@ class StubController:
                     kick = PolicyMotion(self.kick_policy)
                     kick.sense(sensors.joints, sensors.accel, sensors.gyro)
                 else:
-                    logger.info("kicking with the %s foot", action.kick_foot)
+                    pose = self.world.pose
+                    logger.info(
+                        "kicking with the %s foot from (%.2f, %.2f, %.2f) believed, ball at"
+                        " (%.2f, %.2f) ahead",
+                        action.kick_foot, pose.x_m, pose.y_m, pose.yaw_rad, *(ball or (0, 0)),
+                    )  # fmt: skip
                     kick = KickMotion(
                         foot=action.kick_foot, model=self.model, start=self._last_targets
                     )
@@ -460,6 +473,22 @@ class StubController:
                 self.stats.ball_sightings += 1
                 return seen.x_m, seen.y_m
         return None
+
+    def _gyro_unbiased(self, dt: float, gyro: Vec3, game: GameInfo) -> Vec3:
+        """The gyro reading less its bias, learnt while the robot stands still on its own feet:
+        upright, neither walking nor in a motion, not being carried (penalised) and not
+        swaying, for :data:`GYRO_STILL_S`."""
+        still = (
+            self._motion is None
+            and not self.walk.walking
+            and not game.penalised
+            and self.attitude.attitude.tilt_rad < 0.5
+            and max(abs(g) for g in self._gyro_bias.corrected(gyro)) < GYRO_STILL_RAD_S
+        )
+        self._gyro_still_s = self._gyro_still_s + dt if still else 0.0
+        if self._gyro_still_s >= GYRO_STILL_S:
+            self._gyro_bias.learn(dt, gyro)
+        return self._gyro_bias.corrected(gyro)
 
     def _own_body(self, seen: BallSighting) -> bool:
         """Whether a sighting lies where the robot's own feet or hands are (see OWN_FEET_X_M)."""
