@@ -68,6 +68,7 @@ KICK_OFF_YAW_RAD = 0.08  # ... and its heading this close to the kick-off pass
 KICK_OFF_SHORT_M = 0.04  # READY: the ball this much farther than the kick spot (no touching)
 CENTRE_SPOT_M = 0.3  # a ball this close to the centre spot is a kick-off ball
 OUTSIDE_CIRCLE_M = 0.25  # READY at the opponents' kick-off: this far outside the centre circle
+HALFWAY_MARGIN_M = 0.5  # ... and, beside the circle, this far behind the halfway line
 SET_PLAY_MARGIN_M = 0.2  # at the opponents' set play: backs off when nearer than the distance
 # and this, to the distance and twice this
 SEARCH_TURN_AFTER_S = 2.0
@@ -105,7 +106,7 @@ def decide(
     if game.phase is GameState.FINISHED:
         return STAND
     if game.phase is GameState.READY:
-        target = _kick_off_position(role, game, field, home)
+        target = _kick_off_position(role, game, field, home, pose)
         kicks_off = role is Role.STRIKER and game.our_kick_off
         ball_field = _kick_off_ball(pose, ball) if kicks_off else None
         if ball_field is not None:
@@ -181,15 +182,29 @@ def _kick_off_aim(field: Field) -> tuple[float, float]:
 
 
 def _kick_off_position(
-    role: Role, game: GameInfo, field: Field, home: tuple[float, float] | None
+    role: Role,
+    game: GameInfo,
+    field: Field,
+    home: tuple[float, float] | None,
+    pose: Pose | None = None,
 ) -> Pose:
+    """Where to stand at the kick-off (``pose``: where the robot is now)."""
     if role is Role.GOALIE:
         return Pose(x_m=-field.half_length_m + 0.5, y_m=0.0, yaw_rad=0.0)
     if role is Role.DEFENDER:
         x, y = home or DEFENDER_HOME
         return Pose(x_m=x, y_m=y, yaw_rad=0.0)
     if not game.our_kick_off:  # the opponents' kick-off: just outside the centre circle
-        return Pose(x_m=-(field.centre_circle_m + OUTSIDE_CIRCLE_M), y_m=0.0, yaw_rad=0.0)
+        outside = field.centre_circle_m + OUTSIDE_CIRCLE_M
+        if pose is not None and pose.x_m > -outside and abs(pose.y_m) < 2.0 * outside:
+            # In front of the spot behind the circle, in the middle of the field (coming back
+            # from the opponents' half after scoring): beside the circle, on the side it comes
+            # from. The way to the spot behind it runs through the middle, into the kick-off
+            # team's striker at the ball; adult strikers fell there or were still in the circle
+            # at SET after half their goals.
+            side = 1.0 if pose.y_m >= 0.0 else -1.0
+            return Pose(x_m=-HALFWAY_MARGIN_M, y_m=side * outside, yaw_rad=0.0)
+        return Pose(x_m=-outside, y_m=0.0, yaw_rad=0.0)
     # facing along the kick-off pass, the ball a little short of the left foot's kick spot
     ax, ay = _kick_off_aim(field)
     direction = math.atan2(ay, ax)

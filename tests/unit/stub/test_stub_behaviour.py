@@ -159,3 +159,35 @@ def test_a_striker_with_a_far_kick_spot_comes_in_behind_it() -> None:
     runs = [_walk_to_kick(adult, start, ball) for start, ball in starts]
     assert all(seconds < 10.0 for seconds, _ in runs), runs
     assert sum(backwards for _, backwards in runs) <= 0.05, runs
+
+
+def test_back_from_the_opponents_half_it_goes_round_the_kick_off_team_at_the_ball() -> None:
+    """READY of the opponents' kick-off after scoring: the spot behind the circle lies beyond
+    the centre, where the kick-off striker stands at the ball (the adult scorers ran into it
+    and fell, or were still in the circle at SET). Coming from the opponents' half it stands
+    beside the circle on the side it comes from, in its own half, and its way there keeps
+    clear of the kick-off striker's spot."""
+    adult = Field(half_length_m=7.0, centre_circle_m=1.5, foot_y_m=0.17, kick_x_m=0.41,
+                  fast_m_s=0.3)  # fmt: skip
+    ready = GameInfo(phase=GameState.READY, our_kick_off=False)
+    for start in (Pose(x_m=4.0, y_m=1.3, yaw_rad=0.0), Pose(x_m=6.0, y_m=-0.4, yaw_rad=0.3)):
+        pose, t, dt, nearest = start, 0.0, 0.05, math.inf
+        while t < 30.0:
+            action = decide(role=Role.STRIKER, game=ready, pose=pose, ball=None, field=adult,
+                            searching_s=0.0)  # fmt: skip
+            vx, vy, vyaw = action.walk
+            c, s = math.cos(pose.yaw_rad), math.sin(pose.yaw_rad)
+            pose = Pose(x_m=pose.x_m + (vx * c - vy * s) * dt,
+                        y_m=pose.y_m + (vx * s + vy * c) * dt,
+                        yaw_rad=pose.yaw_rad + vyaw * dt)  # fmt: skip
+            # the kick-off striker stands about 0.5 m behind the ball, in the other half
+            nearest = min(nearest, math.hypot(pose.x_m - 0.5, pose.y_m))
+            t += dt
+        assert pose.x_m < -0.3, (start, pose)  # in its own half
+        assert math.hypot(pose.x_m, pose.y_m) > 1.6, (start, pose)  # outside the circle
+        assert math.copysign(1.0, pose.y_m) == math.copysign(1.0, start.y_m)
+        assert nearest > 1.0, (start, nearest)
+    # from its own half it still waits behind the circle
+    spot = decide(role=Role.STRIKER, game=ready, pose=Pose(x_m=-3.0, y_m=-2.0, yaw_rad=0.0),
+                  ball=None, field=adult, searching_s=0.0)  # fmt: skip
+    assert spot.walk[0] >= 0.0
