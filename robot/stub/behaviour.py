@@ -67,7 +67,10 @@ KICK_OFF_PLACE_M = 0.06  # READY: the kick-off striker's place against the ball,
 KICK_OFF_YAW_RAD = 0.08  # ... and its heading this close to the kick-off pass
 KICK_OFF_SHORT_M = 0.04  # READY: the ball this much farther than the kick spot (no touching)
 CENTRE_SPOT_M = 0.3  # a ball this close to the centre spot is a kick-off ball
-OUTSIDE_CIRCLE_M = 0.25  # READY at the opponents' kick-off: this far outside the centre circle
+# READY at the opponents' kick-off: outside the centre circle by this fraction of its radius
+# (0.25 m kid, 0.5 m adult: the adult's believed position was off by up to 0.5 m there after a
+# match's walking, and 0.25 m left it inside the circle at SET)
+OUTSIDE_CIRCLE_FRACTION = 1.0 / 3.0
 HALFWAY_MARGIN_M = 0.5  # ... and, beside the circle, this far behind the halfway line
 SET_PLAY_MARGIN_M = 0.2  # at the opponents' set play: backs off when nearer than the distance
 # and this, to the distance and twice this
@@ -195,7 +198,7 @@ def _kick_off_position(
         x, y = home or DEFENDER_HOME
         return Pose(x_m=x, y_m=y, yaw_rad=0.0)
     if not game.our_kick_off:  # the opponents' kick-off: just outside the centre circle
-        outside = field.centre_circle_m + OUTSIDE_CIRCLE_M
+        outside = field.centre_circle_m * (1.0 + OUTSIDE_CIRCLE_FRACTION)
         if pose is not None and pose.x_m > -outside and abs(pose.y_m) < 2.0 * outside:
             # In front of the spot behind the circle, in the middle of the field (coming back
             # from the opponents' half after scoring): beside the circle, on the side it comes

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 
+import pytest
+
 from contracts.gamecontroller import GameState
 from contracts.geometry import Pose
 from robot.stub.behaviour import STAND, Field, GameInfo, Role, decide
@@ -107,9 +109,10 @@ def test_the_kick_off_striker_places_itself_against_the_ball_it_sees() -> None:
 
 
 def test_at_the_opponents_kick_off_it_waits_outside_the_centre_circle_of_its_field() -> None:
-    """READY of the opponents' kick-off: 0.25 m outside the centre circle, 1.0 m from the
-    centre spot on the kid field (radius 0.75 m), 1.75 m on the adult one (1.5 m), where the
-    kid spot was a penalty for being inside the circle."""
+    """READY of the opponents' kick-off: a third of the circle's radius outside the centre
+    circle, 1.0 m from the centre spot on the kid field (radius 0.75 m), 2.0 m on the adult one
+    (1.5 m), where the kid spot was a penalty for being inside the circle (and 1.75 m left the
+    adult inside it at SET when its believed position was 0.5 m off)."""
     from robot.stub.behaviour import _kick_off_position
     from robot.stub.controller import StubController
 
@@ -120,7 +123,8 @@ def test_at_the_opponents_kick_off_it_waits_outside_the_centre_circle_of_its_fie
                                model=model, field_class=field_class).field  # fmt: skip
         spot = _kick_off_position(Role.STRIKER, theirs, field, None)
         spots[field_class] = (spot.x_m, spot.y_m)
-    assert spots == {"kid": (-1.0, 0.0), "adult": (-1.75, 0.0)}
+    assert spots["kid"] == pytest.approx((-1.0, 0.0))
+    assert spots["adult"] == pytest.approx((-2.0, 0.0))
 
 
 def _walk_to_kick(
