@@ -9,6 +9,7 @@ periods) use the injected clock and are visible as ``waiting_for_wall_clock``.
 from __future__ import annotations
 
 import logging
+import math
 from collections.abc import Callable
 from pathlib import Path
 
@@ -47,6 +48,7 @@ from referee.spoofing import Senders, SpoofingLog, robot_key
 logger = logging.getLogger(__name__)
 
 Action = Callable[[WorldSnapshot], list[WorldCommand]]
+BALL_ON_SPOT_M = 0.01  # a ball farther from the centre spot at SET was moved in READY (logged)
 _PREDECESSOR = {
     GameState.INITIAL: GameState.FINISHED,
     GameState.READY: GameState.PLAYING,
@@ -350,6 +352,7 @@ class Referee:
         if tick.auto_set:
             self._set_since_ms = now
             self.state_event(snapshot, "SET")
+            commands += self._place_kick_off_ball(snapshot)
             commands += self._apply(kickoff.judge_set(snapshot, self.view()), snapshot)
         if tick.set_play_phase is not None and self.gc.set_play is not None:
             play = self.gc.set_play
@@ -366,6 +369,16 @@ class Referee:
         if tick.period_over and self.gc.phase is not SecondaryState.PENALTYSHOOT:
             commands += self._end_period(snapshot)
         return commands
+
+    def _place_kick_off_ball(self, snapshot: WorldSnapshot) -> list[WorldCommand]:
+        """SET begins: the ball is put on the centre spot, as the league's referee places it for
+        the kick-off (or the dropped ball) when SET begins, wherever a robot pushed it in
+        READY."""
+        x, y = snapshot.ball.position[0], snapshot.ball.position[1]
+        if math.hypot(x, y) > BALL_ON_SPOT_M:
+            self.log.info(snapshot.sim_time_ms, f"Ball moved in READY to ({x:.2f}, {y:.2f}); "
+                          "placed on the centre spot.")  # fmt: skip
+        return [self.ball_at(0.0, 0.0)]
 
     def _play_step(self, snapshot: WorldSnapshot) -> list[WorldCommand]:
         gc = self.gc
