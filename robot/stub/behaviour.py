@@ -66,6 +66,8 @@ KICK_OFF_AIM_TOLERANCE_RAD = 0.12
 KICK_OFF_PLACE_M = 0.06  # READY: the kick-off striker's place against the ball, this close
 KICK_OFF_YAW_RAD = 0.08  # ... and its heading this close to the kick-off pass
 KICK_OFF_SHORT_M = 0.04  # READY: the ball this much farther than the kick spot (no touching)
+KICK_OFF_ARRIVE_RAD = 1.2  # READY: the kick-off striker comes to its place within this of behind
+KICK_OFF_ROUND_BACK = 0.8  # ... else by a point this many centre-circle radii behind its place
 CENTRE_SPOT_M = 0.3  # a ball this close to the centre spot is a kick-off ball
 # READY at the opponents' kick-off: outside the centre circle by this fraction of its radius
 # (0.25 m kid, 0.5 m adult: the adult's believed position was off by up to 0.5 m there after a
@@ -118,6 +120,11 @@ def decide(
             # once in PLAYING instead of after seconds of lining up.
             target = Pose(x_m=target.x_m + ball_field[0], y_m=target.y_m + ball_field[1],
                           yaw_rad=target.yaw_rad)
+        if kicks_off:
+            way = _kick_off_way(pose, target, field)
+            if way is not target:
+                return _go_to(pose, way, fast_m_s=field.fast_m_s)
+        if ball_field is not None:
             return _go_to(pose, target, fast_m_s=field.fast_m_s,
                           tolerance_m=KICK_OFF_PLACE_M, yaw_tolerance_rad=KICK_OFF_YAW_RAD)
         return _go_to(pose, target, fast_m_s=field.fast_m_s)
@@ -169,6 +176,23 @@ def _set_play(
         # near enough to line up once it is taken: touching the ball now would abort it
         return STAND
     return _striker(pose, ball, field, searching_s)
+
+
+def _kick_off_way(pose: Pose, target: Pose, field: Field) -> Pose:
+    """READY, the kick-off striker: its place (``target``), when it comes to it from behind
+    (within :data:`KICK_OFF_ARRIVE_RAD` of straight behind, along the kick-off pass); else a
+    point :data:`KICK_OFF_ROUND_BACK` centre-circle radii behind its place, so that it does not
+    walk past the ball and push it, as adult strikers coming from the side did (and followed it
+    into the opponents' half, a penalty at SET)."""
+    rx, ry = pose.x_m - target.x_m, pose.y_m - target.y_m
+    distance = math.hypot(rx, ry)
+    if distance < 2.0 * KICK_OFF_PLACE_M:
+        return target
+    dx, dy = math.cos(target.yaw_rad), math.sin(target.yaw_rad)
+    if -(rx * dx + ry * dy) / distance >= math.cos(KICK_OFF_ARRIVE_RAD):
+        return target
+    back = KICK_OFF_ROUND_BACK * field.centre_circle_m
+    return Pose(x_m=target.x_m - back * dx, y_m=target.y_m - back * dy, yaw_rad=target.yaw_rad)
 
 
 def _kick_off_ball(pose: Pose, ball: tuple[float, float] | None) -> tuple[float, float] | None:

@@ -195,3 +195,46 @@ def test_back_from_the_opponents_half_it_goes_round_the_kick_off_team_at_the_bal
     spot = decide(role=Role.STRIKER, game=ready, pose=Pose(x_m=-3.0, y_m=-2.0, yaw_rad=0.0),
                   ball=None, field=adult, searching_s=0.0)  # fmt: skip
     assert spot.walk[0] >= 0.0
+
+
+def _ready_walk(
+    field: Field, start: Pose, place: Pose, seconds: float = 40.0
+) -> tuple[Pose, float]:
+    """The kick-off striker's READY decisions followed exactly, the ball seen on the centre
+    spot: (where it ends, its pelvis' nearest approach to the ball while more than 0.3 m from
+    its ``place``)."""
+    ready = GameInfo(phase=GameState.READY, our_kick_off=True)
+    pose, t, dt, nearest = start, 0.0, 0.05, math.inf
+    while t < seconds:
+        action = decide(role=Role.STRIKER, game=ready, pose=pose, ball=pose.to_relative(0.0, 0.0),
+                        field=field, searching_s=0.0)  # fmt: skip
+        vx, vy, vyaw = action.walk
+        c, s = math.cos(pose.yaw_rad), math.sin(pose.yaw_rad)
+        pose = Pose(x_m=pose.x_m + (vx * c - vy * s) * dt,
+                    y_m=pose.y_m + (vx * s + vy * c) * dt,
+                    yaw_rad=pose.yaw_rad + vyaw * dt)  # fmt: skip
+        if math.hypot(pose.x_m - place.x_m, pose.y_m - place.y_m) > 0.3:
+            nearest = min(nearest, math.hypot(pose.x_m, pose.y_m))
+        t += dt
+    return pose, nearest
+
+
+def test_the_kick_off_striker_comes_to_the_ball_from_behind() -> None:
+    """READY of its own kick-off: coming from beside the ball (after conceding), the straight
+    way to its place runs past the ball, which the adult pushed 0.9 m into the opponents' half
+    and followed (a penalty at SET); it goes round by a point behind its place. From its start
+    on the touch line (behind-side) it walks straight in as before."""
+    from robot.stub.behaviour import _kick_off_position
+
+    adult = Field(half_length_m=7.0, centre_circle_m=1.5, foot_y_m=0.17, kick_x_m=0.41,
+                  fast_m_s=0.3)  # fmt: skip
+    ours = GameInfo(phase=GameState.READY, our_kick_off=True)
+    place = _kick_off_position(Role.STRIKER, ours, adult, None)
+    end, nearest = _ready_walk(adult, Pose(x_m=-0.7, y_m=2.15, yaw_rad=-1.6), place)
+    assert math.hypot(end.x_m - place.x_m, end.y_m - place.y_m) < 0.15
+    # the straight way passed the ball at 0.42 m (its feet reach 0.2 m, the ball's radius is
+    # 0.11 m): a little odometry error and it pushed the ball; round the back, 0.6 m
+    assert nearest > 0.55, nearest
+    kid_place = _kick_off_position(Role.STRIKER, ours, FIELD, None)
+    end, _ = _ready_walk(FIELD, Pose(x_m=-0.8, y_m=-3.1, yaw_rad=1.57), kid_place, seconds=20.0)
+    assert math.hypot(end.x_m - kid_place.x_m, end.y_m - kid_place.y_m) < 0.1
