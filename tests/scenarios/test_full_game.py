@@ -62,11 +62,14 @@ def _roll(x: float, y: float, vx: float) -> Script:
 
 @pytest.mark.slow
 def test_scripted_ball_gives_the_expected_score() -> None:
+    # Each roll in PLAYING (after a goal, READY 45 s and SET 5 s; a ball still for 120 s is
+    # dropped, READY and SET again): the referee puts the ball on the centre spot when SET
+    # begins, so a ball rolled in READY scores nothing.
     script = {
         200_000: _roll(3.8, 0.3, 2.0),  # first half: red plays left, scores on the right
-        400_000: _roll(-3.8, -0.5, -2.0),  # blue scores on the left
-        500_000: _roll(3.8, 1.0, 2.0),  # red again
-        1_000_000: _roll(3.8, 0.0, 2.0),  # second half: blue plays left now, scores right
+        300_000: _roll(-3.8, -0.5, -2.0),  # blue scores on the left
+        400_000: _roll(3.8, 1.0, 2.0),  # red again
+        900_000: _roll(3.8, 0.0, 2.0),  # second half: blue plays left now, scores right
         1_200_000: _roll(2.0, 2.8, 0.0),  # not a goal
     }
     referee = play(league_config(), script)
