@@ -85,6 +85,7 @@ CENTRE_BALL_GATE_M = 1.0
 # turning slower than this
 GYRO_STILL_S = 0.3
 GYRO_STILL_RAD_S = 0.05
+UPRIGHT_MAX_TILT_RAD = 0.5  # the torso tilted less than this: the robot is on its feet
 # rise into the stance only when standing this upright (placed by the referee), not while
 # tipping over (when the knees lag their targets too)
 RISE_MAX_TILT_RAD = 0.2
@@ -310,7 +311,7 @@ class StubController:
             weight = dt / (LYING_SIDE_TAU_S + dt)
             self._forward_gravity += weight * (sensors.accel[0] - self._forward_gravity)
         att = self.attitude.attitude
-        upright = att.tilt_rad < 0.5
+        upright = att.tilt_rad < UPRIGHT_MAX_TILT_RAD
         if upright and self._motion is None:
             self._upright_since_fall = True
         self.world.integrate(
@@ -482,12 +483,14 @@ class StubController:
             self._motion is None
             and not self.walk.walking
             and not game.penalised
-            and self.attitude.attitude.tilt_rad < 0.5
-            and max(abs(g) for g in self._gyro_bias.corrected(gyro)) < GYRO_STILL_RAD_S
+            and self.attitude.attitude.tilt_rad < UPRIGHT_MAX_TILT_RAD
         )
+        corrected = self._gyro_bias.corrected(gyro)
+        still = still and max(abs(g) for g in corrected) < GYRO_STILL_RAD_S
         self._gyro_still_s = self._gyro_still_s + dt if still else 0.0
-        if self._gyro_still_s >= GYRO_STILL_S:
-            self._gyro_bias.learn(dt, gyro)
+        if self._gyro_still_s < GYRO_STILL_S:
+            return corrected
+        self._gyro_bias.learn(dt, gyro)
         return self._gyro_bias.corrected(gyro)
 
     def _own_body(self, seen: BallSighting) -> bool:
