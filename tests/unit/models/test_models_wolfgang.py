@@ -17,7 +17,9 @@ from referee.snapshot import BodyPart
 from simulator.world import RobotPlacement, World
 from simulator.world.camera import CameraRenderer
 from simulator.world.robots.team import load_team_model
+from simulator.world.robots.team.manifest import load_manifest
 from simulator.world.robots.team.rulebook import check
+from simulator.world.robots.team.source import load_spec
 from simulator.world.types import DeviceKind
 from tests.unit.models.conftest import WOLFGANG
 
@@ -116,6 +118,25 @@ def test_referee_parts_and_hull_bodies_are_tagged() -> None:
     for hull in ("hand_L", "hand_R", "foot_L", "foot_R"):
         assert model.body(f"red_1/{hull}").id > 0
     assert mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, "red_1/Camera") >= 0
+
+
+def test_link_boxes_and_cleats_replace_the_models_own_collision_geoms() -> None:
+    original = load_spec(load_manifest(WOLFGANG)).compile()
+    own = [g for g in range(original.ngeom)
+           if original.geom_contype[g] or original.geom_conaffinity[g]]  # fmt: skip
+    links = {original.body(b).name for b in range(1, original.nbody)}
+    world = _world()
+    model = world.model
+    geoms = world.index.robots[0].geoms
+    colliding = [model.geom(g).name for g in geoms
+                 if model.geom_contype[g] or model.geom_conaffinity[g]]  # fmt: skip
+    # one box per link ("red_1/leg:l_knee"), the sole's cleats ("..._cleat_0"), none of the
+    # authors' own shapes (which would be "red_1/leg:l_knee_3")
+    for name in colliding:
+        link = name.split(":", 1)[1]
+        assert link in links or "_cleat_" in link, name
+    assert 0 < len(colliding) < len(own)
+    assert not any("DROPPED" in model.geom(g).name for g in geoms)
 
 
 def test_replay_scene_records_meshes_as_their_bounding_boxes() -> None:
