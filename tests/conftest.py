@@ -14,6 +14,8 @@ leaves idle. Every other test module is a group of its own (its module fixtures 
 from __future__ import annotations
 
 import os
+import time
+from collections.abc import Iterator
 from pathlib import PurePosixPath
 from typing import Any
 
@@ -59,3 +61,37 @@ def pytest_xdist_make_scheduler(config: pytest.Config, log: Any) -> Any:
             return worker_group(nodeid)
 
     return GroupScheduling(config, log)
+
+
+# A deadline for the whole run (seconds since the epoch, set by .ci/run): past it no test starts,
+# and a test that starts before it gets at most the time left, so a run that cannot finish in
+# time (a slow machine, a hung engine) still ends with its report: what passed, what failed and
+# why, and how many tests it left.
+DEADLINE_ENV = "HLVS_TEST_DEADLINE"
+
+
+def _deadline() -> float | None:
+    value = os.environ.get(DEADLINE_ENV, "").strip()
+    try:
+        return float(value) if value else None
+    except ValueError:
+        message = f"{DEADLINE_ENV}={value!r}: expected seconds since the epoch"
+        raise pytest.UsageError(message) from None
+
+
+@pytest.hookimpl(wrapper=True, tryfirst=True)
+def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> Iterator[None]:
+    """Outside pytest-timeout's own wrapper, which sets the test's timer."""
+    deadline = _deadline()
+    left = None if deadline is None else deadline - time.time()
+    if left is not None and left <= 0:
+        item.session.shouldstop = f"{DEADLINE_ENV} passed: no further test started"
+        item.add_marker(pytest.mark.skip(reason=f"{DEADLINE_ENV} passed before it started"))
+    elif left is not None:
+        marker = item.get_closest_marker("timeout")
+        own = item.config.getini("timeout")
+        if marker is not None:
+            own = marker.args[0] if marker.args else marker.kwargs.get("timeout", own)
+        if not own or float(own) > left:
+            item.add_marker(pytest.mark.timeout(max(1, int(left))), append=False)
+    return (yield)
