@@ -16,7 +16,7 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Iterator
-from pathlib import PurePosixPath
+from pathlib import Path, PurePosixPath
 from typing import Any
 
 import pytest
@@ -95,3 +95,48 @@ def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> 
         if not own or float(own) > left:
             item.add_marker(pytest.mark.timeout(max(1, int(left))), append=False)
     return (yield)
+
+
+MACHINE_AT_START = pytest.StashKey[str]()
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    if not hasattr(config, "workerinput"):  # the controller of an xdist run, or a plain run
+        config.stash[MACHINE_AT_START] = _machine_speed()
+
+
+def pytest_terminal_summary(terminalreporter: Any, config: pytest.Config) -> None:
+    """The machine's speed at the start and at the end, last in the report (what a CI log
+    shows), for a reader who compares a slow run with a good one."""
+    if MACHINE_AT_START in config.stash:
+        terminalreporter.write_line(f"machine at the start: {config.stash[MACHINE_AT_START]}")
+        terminalreporter.write_line(f"machine at the end: {_machine_speed()}")
+
+
+def _machine_speed() -> str:
+    """A fixed Python loop's time, and the CPU time the hypervisor took meanwhile (``steal`` in
+    /proc/stat)."""
+    steal_before = _cpu_times()
+    wall, cpu = time.perf_counter(), time.process_time()
+    total = 0
+    for i in range(2_000_000):
+        total += i
+    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+    steal_after = _cpu_times()
+    stolen = ""
+    if steal_before and steal_after:
+        spent = sum(steal_after) - sum(steal_before)
+        share = (steal_after[7] - steal_before[7]) / spent if spent > 0 else 0.0
+        stolen = f", {share:.0%} of the CPUs' time stolen meanwhile"
+    load = ", ".join(f"{value:.1f}" for value in os.getloadavg())
+    return (f"{os.cpu_count()} CPUs, load average {load}; a 2e6-step Python loop took "
+            f"{wall:.2f} s ({cpu:.2f} s of CPU){stolen}")
+
+
+def _cpu_times() -> list[int] | None:
+    """The machine's CPU times (user, nice, system, idle, iowait, irq, softirq, steal, ...)."""
+    try:
+        fields = Path("/proc/stat").read_text().split("\n", 1)[0].split()[1:]
+        return [int(field) for field in fields]
+    except (OSError, ValueError):
+        return None

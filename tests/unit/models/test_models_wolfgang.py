@@ -17,6 +17,7 @@ from referee.snapshot import BodyPart
 from simulator.world import RobotPlacement, World
 from simulator.world.camera import CameraRenderer
 from simulator.world.robots.team import load_team_model
+from simulator.world.robots.team.build import DROPPED
 from simulator.world.robots.team.manifest import load_manifest
 from simulator.world.robots.team.rulebook import check
 from simulator.world.robots.team.source import load_spec
@@ -136,7 +137,7 @@ def test_link_boxes_and_cleats_replace_the_models_own_collision_geoms() -> None:
         link = name.split(":", 1)[1]
         assert link in links or "_cleat_" in link, name
     assert 0 < len(colliding) < len(own)
-    assert not any("DROPPED" in model.geom(g).name for g in geoms)
+    assert not any(DROPPED in model.geom(g).name for g in geoms)
 
 
 def test_replay_scene_records_meshes_as_their_bounding_boxes() -> None:

@@ -1,4 +1,5 @@
-"""``HLVS_TEST_DEADLINE`` (tests/conftest.py): a run past its deadline ends with its report."""
+"""How a run of the suite ends (tests/conftest.py): past ``HLVS_TEST_DEADLINE`` with its report,
+and with the machine's speed in it."""
 
 from __future__ import annotations
 
@@ -7,6 +8,8 @@ import re
 import subprocess
 import sys
 from pathlib import Path
+
+from tests.conftest import _machine_speed
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -61,3 +64,11 @@ def test_a_deadline_that_is_not_a_time_is_a_usage_error(tmp_path: Path) -> None:
     assert done.returncode != 0
     assert "HLVS_TEST_DEADLINE='tomorrow': expected seconds since the epoch" in (
         done.stdout + done.stderr)
+
+
+def test_the_report_says_how_fast_the_machine_was() -> None:
+    speed = _machine_speed()
+    assert re.fullmatch(
+        r"\d+ CPUs, load average [0-9.]+, [0-9.]+, [0-9.]+; a 2e6-step Python loop took "
+        r"[0-9.]+ s \([0-9.]+ s of CPU\)(, \d+% of the CPUs' time stolen meanwhile)?", speed
+    ), speed
