@@ -106,8 +106,8 @@ def pytest_configure(config: pytest.Config) -> None:
 
 
 def pytest_terminal_summary(terminalreporter: Any, config: pytest.Config) -> None:
-    """The machine's speed at the start and at the end, last in the report (what a CI log
-    shows), for a reader who compares a slow run with a good one."""
+    """The machine's speed at the start and at the end, near the end of the report (what a CI
+    log keeps), for a reader who compares a slow run with a good one."""
     if MACHINE_AT_START in config.stash:
         terminalreporter.write_line(f"machine at the start: {config.stash[MACHINE_AT_START]}")
         terminalreporter.write_line(f"machine at the end: {_machine_speed()}")
@@ -124,8 +124,8 @@ def _machine_speed() -> str:
     wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
     steal_after = _cpu_times()
     stolen = ""
-    if steal_before and steal_after:
-        spent = sum(steal_after) - sum(steal_before)
+    if steal_before and steal_after and len(steal_after) > 7:
+        spent = sum(steal_after[:8]) - sum(steal_before[:8])
         share = (steal_after[7] - steal_before[7]) / spent if spent > 0 else 0.0
         stolen = f", {share:.0%} of the CPUs' time stolen meanwhile"
     load = ", ".join(f"{value:.1f}" for value in os.getloadavg())
