@@ -68,6 +68,7 @@ def pytest_xdist_make_scheduler(config: pytest.Config, log: Any) -> Any:
 # time (a slow machine, a hung engine) still ends with its report: what passed, what failed and
 # why, and how many tests it left.
 DEADLINE_ENV = "HLVS_TEST_DEADLINE"
+DEADLINE = pytest.StashKey[float | None]()
 
 
 def _deadline() -> float | None:
@@ -82,7 +83,7 @@ def _deadline() -> float | None:
 @pytest.hookimpl(wrapper=True, tryfirst=True)
 def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> Iterator[None]:
     """Outside pytest-timeout's own wrapper, which sets the test's timer."""
-    deadline = _deadline()
+    deadline = item.config.stash.get(DEADLINE, None)
     left = None if deadline is None else deadline - time.time()
     if left is not None and left <= 0:
         item.session.shouldstop = f"{DEADLINE_ENV} passed: no further test started"
@@ -101,7 +102,10 @@ MACHINE_AT_START = pytest.StashKey[str]()
 
 
 def pytest_configure(config: pytest.Config) -> None:
-    if not hasattr(config, "workerinput"):  # the controller of an xdist run, or a plain run
+    """The deadline, read once (a value that is not a time stops the run before it starts);
+    the machine's speed, measured once by the controller of an xdist run or a plain run."""
+    config.stash[DEADLINE] = _deadline()
+    if not hasattr(config, "workerinput"):
         config.stash[MACHINE_AT_START] = _machine_speed()
 
 

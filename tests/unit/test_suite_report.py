@@ -15,14 +15,13 @@ REPO = Path(__file__).resolve().parents[2]
 
 # The deadline is set once the tests are collected: pytest itself may take seconds to start.
 CONFTEST = '''
-import os
 import time
 
-from tests.conftest import pytest_runtest_protocol
+from tests.conftest import DEADLINE, pytest_runtest_protocol
 
 
 def pytest_collection_finish(session):
-    os.environ["HLVS_TEST_DEADLINE"] = str(time.time() + 10)
+    session.config.stash[DEADLINE] = time.time() + 10
 '''
 
 TESTS = '''
@@ -54,7 +53,8 @@ def test_a_test_gets_the_time_left_and_none_starts_after_the_deadline(tmp_path: 
 
 
 def test_a_deadline_that_is_not_a_time_is_a_usage_error(tmp_path: Path) -> None:
-    (tmp_path / "conftest.py").write_text("from tests.conftest import pytest_runtest_protocol\n")
+    (tmp_path / "conftest.py").write_text(
+        "from tests.conftest import pytest_configure, pytest_runtest_protocol\n")
     (tmp_path / "test_sample.py").write_text("def test_one():\n    pass\n")
     env = {**os.environ, "PYTHONPATH": str(REPO), "HLVS_TEST_DEADLINE": "tomorrow"}
     done = subprocess.run(
