@@ -14,6 +14,9 @@ TEST_WORKERS ?= 2
 
 .PHONY: cluster scrimmage test setup venv system engine postgres images lint typecheck clean-build web
 
+# What lint and typecheck read: they run again only when one of these changed.
+CHECKED := pyproject.toml $(wildcard $(shell git ls-files --cached --others --exclude-standard '*.py' 2>/dev/null))
+
 scrimmage: setup
 	$(HLVS) scrimmage --out matches/scrimmage
 
@@ -56,13 +59,19 @@ BASE_IMAGE ?=
 images: venv engine
 	$(HLVS) images build $(if $(BASE_IMAGE),--base $(BASE_IMAGE),)
 
-lint:
+lint: $(BUILD)/lint.ok
+
+$(BUILD)/lint.ok: $(VENV)/.installed $(CHECKED)
 	$(VENV)/bin/ruff check hlvs viewer service envs tournament cluster orchestrator simulator \
 	  referee robot contracts benchmarks testkit examples tests
 	$(VENV)/bin/lint-imports
+	touch $@
 
-typecheck:
+typecheck: $(BUILD)/typecheck.ok
+
+$(BUILD)/typecheck.ok: $(VENV)/.installed $(CHECKED)
 	$(VENV)/bin/mypy
+	touch $@
 
 clean-build:
 	rm -rf $(BUILD)

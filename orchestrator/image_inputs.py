@@ -153,6 +153,18 @@ def ensure_wheels(requirements: Sequence[str], *, cache_dir: Path) -> Path:
     shutil.rmtree(partial, ignore_errors=True)
     partial.mkdir(parents=True)
     log_path = cache_dir / f"{key}.log"
+    if requirements:
+        _download_wheels(requirements, target=partial, log_path=log_path)
+    (partial / "requirements.txt").write_text(
+        "".join(f"{line}\n" for line in requirements), encoding="utf-8"
+    )
+    (partial / ".complete").write_text("ok\n", encoding="utf-8")
+    shutil.rmtree(target, ignore_errors=True)
+    os.replace(partial, target)
+    return target
+
+
+def _download_wheels(requirements: Sequence[str], *, target: Path, log_path: Path) -> None:
     log.info("wheels: pip download %s (log: %s)", " ".join(requirements), log_path)
     command = [
         sys.executable,
@@ -163,15 +175,10 @@ def ensure_wheels(requirements: Sequence[str], *, cache_dir: Path) -> Path:
         "--only-binary=:all:",
         f"--python-version={IMAGE_PYTHON_VERSION}",
         "-d",
-        str(partial),
+        str(target),
         *requirements,
     ]
     _run_logged(command, log_path=log_path, image="(wheels)")
-    (partial / "requirements.txt").write_text("\n".join(requirements) + "\n", encoding="utf-8")
-    (partial / ".complete").write_text("ok\n", encoding="utf-8")
-    shutil.rmtree(target, ignore_errors=True)
-    os.replace(partial, target)
-    return target
 
 
 def source_files(repo_root: Path, packages: Sequence[str]) -> Iterator[Path]:

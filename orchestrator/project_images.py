@@ -53,6 +53,7 @@ class ImageRecipe:
     base: image_inputs.BaseRecipe  # used when no base image is given
     requirements: tuple[str, ...]  # distributions, pinned to the host's versions
     packages: tuple[str, ...]  # package folders copied to /opt/hlvs/src
+    parent: str | None = None  # a project image built on instead of ``base`` (and --base)
 
     @property
     def dockerfile(self) -> Path:
@@ -78,17 +79,19 @@ RECIPES: dict[str, ImageRecipe] = {
         packages=("simulator", "referee", "robot", "contracts", "envs"),
     ),
     # Robot images carry the robot package and its own dependency list only (no MuJoCo).
-    "stub": ImageRecipe(
-        name="stub",
-        base=ROBOT_BASE,
-        requirements=ROBOT_REQUIREMENTS,
-        packages=image_inputs.ROBOT_PACKAGES,
-    ),
     "team-base": ImageRecipe(
         name="team-base",
         base=ROBOT_BASE,
         requirements=ROBOT_REQUIREMENTS,
         packages=image_inputs.ROBOT_PACKAGES,
+    ),
+    # The stub is a team image like any other: team-base with its start command.
+    "stub": ImageRecipe(
+        name="stub",
+        base=ROBOT_BASE,
+        requirements=(),
+        packages=image_inputs.ROBOT_PACKAGES,
+        parent="team-base",
     ),
 }
 IMAGE_NAMES = tuple(RECIPES)
@@ -133,8 +136,15 @@ def ensure_image(
     recipe = _recipe(name)
     client = client or connect()
     started = time.monotonic()
+    parent = None
+    if recipe.parent is not None:
+        parent = ensure_image(recipe.parent, base=base, client=client, progress=progress)
     with _build_lock():
-        base_ref, base_id, network_mode = _ensure_base(client, recipe, base)
+        network_mode: str | None
+        if parent is not None:
+            base_ref, base_id, network_mode = parent.reference, parent.image_id, "none"
+        else:
+            base_ref, base_id, network_mode = _ensure_base(client, recipe, base)
         wheel_dir = image_inputs.ensure_wheels(
             image_inputs.pinned_requirements(recipe.requirements), cache_dir=BUILD_DIR / "wheels"
         )

@@ -113,8 +113,24 @@ def pytest_terminal_summary(terminalreporter: Any, config: pytest.Config) -> Non
     """The machine's speed at the start and at the end, near the end of the report (what a CI
     log keeps), for a reader who compares a slow run with a good one."""
     if MACHINE_AT_START in config.stash:
+        setup = _setup_times()
+        if setup:
+            terminalreporter.write_line(f"set-up before the tests: {setup}")
         terminalreporter.write_line(f"machine at the start: {config.stash[MACHINE_AT_START]}")
         terminalreporter.write_line(f"machine at the end: {_machine_speed()}")
+
+
+SETUP_TIMES_ENV = "HLVS_SETUP_TIMES"  # a file of "<step> <seconds> s" lines (.ci/run)
+
+
+def _setup_times() -> str:
+    """The set-up steps' times from :data:`SETUP_TIMES_ENV`, on one line ("" without it)."""
+    name = os.environ.get(SETUP_TIMES_ENV, "")
+    try:
+        lines = Path(name).read_text(encoding="utf-8").splitlines() if name else []
+    except OSError:
+        return ""
+    return ", ".join(line.strip() for line in lines if line.strip())
 
 
 def _machine_speed() -> str:

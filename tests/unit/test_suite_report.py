@@ -72,3 +72,20 @@ def test_the_report_says_how_fast_the_machine_was() -> None:
         r"\d+ CPUs, load average [0-9.]+, [0-9.]+, [0-9.]+; a 2e6-step Python loop took "
         r"[0-9.]+ s \([0-9.]+ s of CPU\)(, \d+% of the CPUs' time stolen meanwhile)?", speed
     ), speed
+
+
+def test_the_report_ends_with_the_set_up_times(tmp_path: Path) -> None:
+    times = tmp_path / "setup-times.txt"
+    times.write_text("venv 412 s\nimages 1290 s\n")
+    (tmp_path / "conftest.py").write_text(
+        "from tests.conftest import pytest_configure, pytest_terminal_summary\n")
+    (tmp_path / "test_sample.py").write_text("def test_one():\n    pass\n")
+    env = {name: value for name, value in os.environ.items() if name != "HLVS_TEST_DEADLINE"}
+    env.update(PYTHONPATH=str(REPO), HLVS_SETUP_TIMES=str(times))
+    done = subprocess.run(
+        [sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "--rootdir", str(tmp_path),
+         str(tmp_path)],
+        capture_output=True, text=True, timeout=300, env=env, cwd=tmp_path, check=False)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "set-up before the tests: venv 412 s, images 1290 s\n" in done.stdout, done.stdout
+    assert "machine at the end: " in done.stdout, done.stdout

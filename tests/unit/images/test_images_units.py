@@ -146,3 +146,23 @@ def test_ecr_login_failure_is_an_auth_error(monkeypatch: pytest.MonkeyPatch) -> 
     assert caught.value.reason.startswith(
         "authentication failed for 123456789012.dkr.ecr.us-east-1.amazonaws.com (user AWS)"
     )
+
+
+def test_the_stub_is_built_on_team_base_and_downloads_nothing(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from orchestrator import image_inputs
+    from orchestrator.project_images import RECIPES
+
+    assert RECIPES["stub"].parent == "team-base" and RECIPES["stub"].requirements == ()
+    assert RECIPES["team-base"].parent is None
+    assert "FROM ${BASE_IMAGE}" in RECIPES["stub"].dockerfile.read_text()
+
+    def no_download(*args: object, **kwargs: object) -> None:
+        raise AssertionError("pip download ran for an empty requirement list")
+
+    monkeypatch.setattr(image_inputs, "_run_logged", no_download)
+    wheels = image_inputs.ensure_wheels((), cache_dir=tmp_path)
+    assert (wheels / "requirements.txt").read_text() == ""
+    assert not list(wheels.glob("*.whl"))
+    assert image_inputs.ensure_wheels((), cache_dir=tmp_path) == wheels
