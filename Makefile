@@ -37,7 +37,7 @@ $(VENV)/.installed: pyproject.toml
 	  { tail -n 40 $(BUILD)/logs/pip.log; exit 1; }
 	touch $@
 
-# Host packages (Docker engine, registry, sshd, ffmpeg, OSMesa, debootstrap) on Debian/Ubuntu as root.
+# Host packages (Docker engine, registry, sshd, ffmpeg, OSMesa, mmdebstrap) on Debian/Ubuntu as root.
 system: $(BUILD)/system.ok
 
 $(BUILD)/system.ok: scripts/setup-system.sh
@@ -54,7 +54,7 @@ postgres: system
 	@bash scripts/ensure-postgres.sh
 
 # Content-tagged images: rebuilt only when their inputs change. BASE_IMAGE=python:3.11-slim uses
-# a registry's base instead of the one made locally with debootstrap.
+# a registry's base instead of the one made locally with mmdebstrap.
 BASE_IMAGE ?=
 images: venv engine
 	$(HLVS) images build $(if $(BASE_IMAGE),--base $(BASE_IMAGE),)

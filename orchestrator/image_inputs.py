@@ -1,7 +1,7 @@
 """The inputs of a project image build, prepared on the host.
 
-- Base images made without any container registry: ``debootstrap`` a Debian root file system
-  and ``docker import`` it, cached by the debootstrap parameters
+- Base images made without any container registry: ``mmdebstrap`` a Debian root file system
+  and ``docker import`` it, cached by the mmdebstrap parameters
   (``hlvs-runner/base:<flavour>-<suite>-<hash>``).
 - Python wheels downloaded once with ``pip download`` (cached by the pinned requirement list), so
   the image build installs them with ``--no-index`` and no network.
@@ -17,7 +17,6 @@ import re
 import shutil
 import subprocess
 import sys
-import tempfile
 import tomllib
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
@@ -59,7 +58,7 @@ def package_requirements(packages: Sequence[str]) -> tuple[str, ...]:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class BaseRecipe:
-    """A Debian root file system made by debootstrap; its parameters are its cache key."""
+    """A Debian root file system made by mmdebstrap; its parameters are its cache key."""
 
     flavour: str  # "robot" or "sim"
     suite: str = "bookworm"
@@ -68,7 +67,10 @@ class BaseRecipe:
     mirror: str = "http://deb.debian.org/debian"
 
     def key(self) -> str:
-        text = "|".join((self.suite, self.variant, ",".join(self.packages), self.mirror))
+        text = "|".join(
+            ("mmdebstrap", self.suite, self.variant, ",".join(self.packages), self.mirror,
+             ",".join(_DPKG_PATHS))
+        )
         return hashlib.sha256(text.encode()).hexdigest()[:12]
 
     @property
@@ -80,38 +82,48 @@ class BaseRecipe:
         return f"{BASE_REPOSITORY}:{self.tag}"
 
 
-def debootstrap_rootfs(recipe: BaseRecipe, *, work_dir: Path, log_path: Path) -> Path:
-    """Run debootstrap for ``recipe`` and return a tarball of the root file system."""
-    if shutil.which("debootstrap") is None:
+# What an image needs of no package, left out as Debian's own slim images leave it out (the
+# copyright files stay).
+_DPKG_PATHS = (
+    "path-exclude=/usr/share/man/*",
+    "path-exclude=/usr/share/info/*",
+    "path-exclude=/usr/share/locale/*",
+    "path-exclude=/usr/share/doc/*",
+    "path-include=/usr/share/doc/*/copyright",
+)
+
+
+def make_rootfs(recipe: BaseRecipe, *, work_dir: Path, log_path: Path) -> Path:
+    """A tarball of the root file system of ``recipe``, made by mmdebstrap.
+
+    mmdebstrap writes the tarball itself, without the package lists and downloaded packages,
+    and dpkg runs without an fsync per file and without manuals, translations and documents:
+    the robot base took 872 s where debootstrap alone took 1427 s, on one slow machine."""
+    if shutil.which("mmdebstrap") is None:
         raise ImageError(
             image=recipe.reference,
-            reason="debootstrap is not installed (Debian/Ubuntu: apt-get install debootstrap); "
+            reason="mmdebstrap is not installed (Debian/Ubuntu: apt-get install mmdebstrap); "
             "or pass --base with an image that has python3 3.11 and python3-venv",
         )
     work_dir.mkdir(parents=True, exist_ok=True)
-    root = Path(tempfile.mkdtemp(prefix=f"rootfs-{recipe.flavour}-", dir=work_dir))
+    partial = work_dir / f"{recipe.tag}.partial.tar"
     tarball = work_dir / f"{recipe.tag}.tar"
     command = [
-        "debootstrap",
+        "mmdebstrap",
         f"--variant={recipe.variant}",
         f"--include={','.join(recipe.packages)}",
+        "--dpkgopt=force-unsafe-io",
+        *(f"--dpkgopt={rule}" for rule in _DPKG_PATHS),
         recipe.suite,
-        str(root),
+        str(partial),
         recipe.mirror,
     ]
-    log.info("base %s: debootstrap (about a minute; log: %s)", recipe.tag, log_path)
+    log.info("base %s: mmdebstrap (minutes; log: %s)", recipe.tag, log_path)
     try:
         _run_logged(command, log_path=log_path, image=recipe.reference)
-        for cache in ("var/cache/apt/archives", "var/lib/apt/lists"):
-            for entry in (root / cache).glob("*.deb" if "archives" in cache else "*_*"):
-                entry.unlink()
-        _run_logged(
-            ["tar", "-C", str(root), "-cf", str(tarball), "."],
-            log_path=log_path,
-            image=recipe.reference,
-        )
+        os.replace(partial, tarball)
     finally:
-        shutil.rmtree(root, ignore_errors=True)
+        partial.unlink(missing_ok=True)
     return tarball
 
 
@@ -244,7 +256,7 @@ __all__ = [
     "ROBOT_PACKAGES",
     "BaseRecipe",
     "assemble_context",
-    "debootstrap_rootfs",
+    "make_rootfs",
     "ensure_wheels",
     "package_requirements",
     "pinned_requirements",

@@ -3,8 +3,8 @@
 ``hlvs-runner/<name>:<hash>`` where the hash covers the Dockerfile, every source file copied in,
 the pinned requirements, the wheel file names, the base image id and the build arguments. An
 image whose tag exists is never rebuilt, so ``project_image()`` costs a few inspect calls when
-nothing changed. Without a base image given, the base is made locally with debootstrap
-(no container registry needed) and cached by its debootstrap parameters.
+nothing changed. Without a base image given, the base is made locally with mmdebstrap
+(no container registry needed) and cached by its mmdebstrap parameters.
 """
 
 from __future__ import annotations
@@ -284,7 +284,7 @@ def _ensure_base(
         started = time.monotonic()
         work_dir = BUILD_DIR / "rootfs"
         log_path = BUILD_DIR / "logs" / f"base-{base_recipe.tag}.log"
-        tarball = image_inputs.debootstrap_rootfs(base_recipe, work_dir=work_dir, log_path=log_path)
+        tarball = image_inputs.make_rootfs(base_recipe, work_dir=work_dir, log_path=log_path)
         try:
             info = engine_images.import_rootfs(
                 client,

@@ -17,6 +17,9 @@ export SLURM_CONF=$DIR/slurm.conf
 LOG=/var/log/hlvs
 mkdir -p "$LOG"
 
+# dpkg without an fsync per file (scripts/setup-system.sh says why)
+UNSAFE_IO=-oDpkg::Options::=--force-unsafe-io
+
 need_packages() {
   local need=()
   for pkg in slurm-wlm slurmdbd munge mariadb-server; do
@@ -24,9 +27,9 @@ need_packages() {
   done
   if [ ${#need[@]} -gt 0 ]; then
     echo "==> installing ${need[*]} (log: $LOG/apt.log)"
-    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${need[@]}" \
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $UNSAFE_IO "${need[@]}" \
       >>"$LOG/apt.log" 2>&1 || { apt-get update -qq >>"$LOG/apt.log" 2>&1;
-      DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${need[@]}" \
+      DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $UNSAFE_IO "${need[@]}" \
       >>"$LOG/apt.log" 2>&1; }
     systemctl disable --now slurmctld slurmd slurmdbd munge mariadb >/dev/null 2>&1 || true
   fi

@@ -28,7 +28,7 @@ def register(sub: Any) -> None:
         "--base",
         metavar="IMAGE",
         help="base image with Python 3.11 (e.g. python:3.11-slim); "
-        "default: a Debian bookworm base made locally with debootstrap",
+        "default: a Debian bookworm base made locally with mmdebstrap",
     )
     build.add_argument("--json", action="store_true", help="print one JSON object")
     build.set_defaults(func=_build)

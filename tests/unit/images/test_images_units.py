@@ -166,3 +166,18 @@ def test_the_stub_is_built_on_team_base_and_downloads_nothing(
     assert (wheels / "requirements.txt").read_text() == ""
     assert not list(wheels.glob("*.whl"))
     assert image_inputs.ensure_wheels((), cache_dir=tmp_path) == wheels
+
+
+def test_a_missing_mmdebstrap_is_a_clear_error(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from orchestrator import image_inputs
+    from orchestrator.errors import ImageError
+
+    monkeypatch.setattr(image_inputs.shutil, "which", lambda name: None)
+    recipe = image_inputs.BaseRecipe(flavour="robot")
+    with pytest.raises(ImageError) as raised:
+        image_inputs.make_rootfs(recipe, work_dir=tmp_path, log_path=tmp_path / "log")
+    assert "apt-get install mmdebstrap" in str(raised.value)
+    assert recipe.reference in str(raised.value)
+    assert recipe.key() != image_inputs.BaseRecipe(flavour="robot", suite="trixie").key()
