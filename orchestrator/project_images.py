@@ -90,7 +90,7 @@ RECIPES: dict[str, ImageRecipe] = {
         name="stub",
         base=ROBOT_BASE,
         requirements=(),
-        packages=image_inputs.ROBOT_PACKAGES,
+        packages=(),  # team-base has them; its id is in the stub's content hash
         parent="team-base",
     ),
 }

@@ -155,6 +155,7 @@ def test_the_stub_is_built_on_team_base_and_downloads_nothing(
     from orchestrator.project_images import RECIPES
 
     assert RECIPES["stub"].parent == "team-base" and RECIPES["stub"].requirements == ()
+    assert RECIPES["stub"].packages == ()
     assert RECIPES["team-base"].parent is None
     assert "FROM ${BASE_IMAGE}" in RECIPES["stub"].dockerfile.read_text()
 
