@@ -13,6 +13,7 @@ leaves idle. Every other test module is a group of its own (its module fixtures 
 
 from __future__ import annotations
 
+import math
 import os
 import time
 from collections.abc import Iterator
@@ -94,7 +95,8 @@ def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> 
         if marker is not None:
             own = marker.args[0] if marker.args else marker.kwargs.get("timeout", own)
         if not own or float(own) > left:
-            item.add_marker(pytest.mark.timeout(max(1, int(left))), append=False)
+            # Rounded up: a timer that fires before the deadline would let the next test start.
+            item.add_marker(pytest.mark.timeout(math.ceil(left)), append=False)
     return (yield)
 
 
