@@ -31,10 +31,15 @@ $(VENV)/.installed: pyproject.toml
 	@echo "==> virtual environment in $(VENV) (log: $(BUILD)/logs/pip.log)"
 	@mkdir -p $(BUILD)/logs
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	@$(PY) -m pip install --upgrade pip > $(BUILD)/logs/pip.log 2>&1 || \
-	  { tail -n 40 $(BUILD)/logs/pip.log; exit 1; }
-	@$(PY) -m pip install -e '.[dev,learn]' >> $(BUILD)/logs/pip.log 2>&1 || \
-	  { tail -n 40 $(BUILD)/logs/pip.log; exit 1; }
+	@: > $(BUILD)/logs/pip.log
+	@# uv fetches the packages side by side (21 s here where pip took 57 s, the same versions);
+	@# pip installs them when uv cannot be had or fails.
+	@{ $(PY) -m pip install 'uv>=0.4,<1' && \
+	   $(VENV)/bin/uv pip install --python $(PY) --compile-bytecode -e '.[dev,learn]'; \
+	 } >> $(BUILD)/logs/pip.log 2>&1 || \
+	 { echo "==> uv failed (see $(BUILD)/logs/pip.log): pip installs the environment"; \
+	   $(PY) -m pip install -e '.[dev,learn]' >> $(BUILD)/logs/pip.log 2>&1; } || \
+	 { tail -n 40 $(BUILD)/logs/pip.log; exit 1; }
 	touch $@
 
 # Host packages (Docker engine, registry, sshd, ffmpeg, OSMesa, mmdebstrap) on Debian/Ubuntu as root.
