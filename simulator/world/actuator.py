@@ -112,7 +112,10 @@ class ActuatorParams:
     half_play: FloatArray  # half the backlash, rad
     minus_half_play: FloatArray
     has_play: npt.NDArray[np.bool_]
-    minus_motor_torque: FloatArray
+    minus_gain: FloatArray  # -K, the velocity bias of position control
+    line_bounds: FloatArray  # (n, 2): -reach, reach (the force range before the clamps)
+    bounds_low: FloatArray  # (n, 2): -motor torque, 0
+    bounds_high: FloatArray  # (n, 2): 0, motor torque
 
 
 def _compact(values: list[int]) -> slice | IntArray:
@@ -131,6 +134,10 @@ def actuator_params(model: mujoco.MjModel, specs: Sequence[tuple[int, Any]]) -> 
     def array(values: list[float]) -> FloatArray:
         return np.array(values, dtype=np.float64)
 
+    torque = array([c.motor_torque_nm for c in constants])
+    reach = array([c.motor_torque_nm * c.line_speed_rad_s / c.line_span_rad_s for c in constants])
+    zero = np.zeros_like(torque)
+    gain = array([c.gain_nm_s_per_rad for c in constants])
     return ActuatorParams(
         actuators=_compact(ids),
         qpos=_compact([int(model.jnt_qposadr[j]) for j in joints]),
@@ -139,14 +146,15 @@ def actuator_params(model: mujoco.MjModel, specs: Sequence[tuple[int, Any]]) -> 
         max_velocity=array([s.max_velocity_rad_s for _, s in ordered]),
         lower=array([s.lower_rad for _, s in ordered]),
         upper=array([s.upper_rad for _, s in ordered]),
-        motor_torque=array([c.motor_torque_nm for c in constants]),
-        line_reach=array(
-            [c.motor_torque_nm * c.line_speed_rad_s / c.line_span_rad_s for c in constants]
-        ),
+        motor_torque=torque,
+        line_reach=reach,
         line_slope=array([c.motor_torque_nm / c.line_span_rad_s for c in constants]),
-        gain=array([c.gain_nm_s_per_rad for c in constants]),
+        gain=gain,
         half_play=array([s.backlash_rad / 2 for _, s in ordered]),
         minus_half_play=array([-s.backlash_rad / 2 for _, s in ordered]),
         has_play=np.array([s.backlash_rad > 0 for _, s in ordered], dtype=bool),
-        minus_motor_torque=array([-c.motor_torque_nm for c in constants]),
+        minus_gain=-gain,
+        line_bounds=np.stack([-reach, reach], axis=1),
+        bounds_low=np.stack([-torque, zero], axis=1),
+        bounds_high=np.stack([zero, torque], axis=1),
     )

@@ -76,8 +76,10 @@ class MotorBank:
         self._gain = model.actuator_gainprm[:, 0]
         self._bias_q = model.actuator_biasprm[:, 1]
         self._bias_v = model.actuator_biasprm[:, 2]
-        self._range_lo = model.actuator_forcerange[:, 0]
-        self._range_hi = model.actuator_forcerange[:, 1]
+        self._force_range = model.actuator_forcerange
+        self._gain_is_k = False  # gain K of every actuator in ``params`` (the common case)
+        self._neg_kp: FloatArray | None = None  # -K P, the position bias (None: P changed)
+        self._any_d = False
         self._any_velocity = False
         self._any_torque = False
         self._any_limp = False
@@ -156,6 +158,8 @@ class MotorBank:
         self.d[actuator] = max(d, 0.0)
         self.integral[actuator] = 0.0
         self._any_integral = bool(self.i.any())
+        self._any_d = bool(self.d.any())
+        self._neg_kp = None
 
     def set_limp(self, actuators: npt.NDArray[np.int64], limp: bool) -> None:
         self.limp[actuators] = limp
@@ -181,12 +185,55 @@ class MotorBank:
         """Kept for callers that reset MuJoCo's state: every step writes everything anyway."""
 
     def apply(self, data: mujoco.MjData) -> None:
-        """Choose each actuator's mode and write gain, bias and ``ctrl`` for the next basic
-        step, from the joints' positions and velocities now (about twenty numpy operations
-        on the arrays of all actuators; the rare modes only when some actuator is in them)."""
-        ids, par = self._ids, self.params
+        """Choose each actuator's mode and write bias, ``ctrl`` and force range (and the gain
+        where a rare mode needs it) for the next basic step, from the joints' positions and
+        velocities now. Right after ``mj_step`` each numpy call costs a few microseconds, so the
+        common case (every actuator in position control with ``D`` 0, none held or limp) takes
+        its own path of about thirty calls; the rare modes take the general one."""
         q = data.qpos[self._qpos]
         qdot = data.qvel[self._dof]
+        rare = self._any_held or self._any_integral or self._any_d
+        rare = rare or self._any_velocity or self._any_torque or self._any_limp
+        if rare:
+            self._apply_general(data, q, qdot)
+        else:
+            self._apply_position(data, q, qdot)
+        self._write_force_range(qdot)
+
+    def _apply_position(self, data: mujoco.MjData, q: FloatArray, qdot: FloatArray) -> None:
+        """Position control of every actuator with ``I`` and ``D`` 0: the values of
+        :meth:`_apply_general` in that case, the gain left at ``K`` (an actuator that gives no
+        torque gets ``ctrl`` and bias 0 instead of gain 0: the same force, 0)."""
+        ids, par = self._ids, self.params
+        if not self._gain_is_k:
+            self._gain[ids] = par.gain
+            self._gain_is_k = True
+        if self._neg_kp is None:
+            self._neg_kp = -par.gain * self.p[ids]
+        p = self.p[ids]
+        target = self.target[ids]
+        limit = self.velocity_limit[ids]
+        error = target - q
+        shift = np.maximum(error, par.minus_half_play)
+        np.minimum(shift, par.half_play, out=shift)  # backlash: see the general path
+        error -= shift
+        wanted = p * error
+        saturated = np.abs(wanted) > limit
+        ctrl = target - shift
+        ctrl *= p
+        np.copyto(ctrl, np.copysign(limit, wanted), where=saturated)
+        off = error == 0.0
+        off &= par.has_play
+        np.copyto(ctrl, 0.0, where=off)
+        saturated |= off
+        self._bias_q[ids] = np.where(saturated, 0.0, self._neg_kp)
+        self._bias_v[ids] = np.where(off, 0.0, par.minus_gain)
+        data.ctrl[ids] = ctrl
+
+    def _apply_general(self, data: mujoco.MjData, q: FloatArray, qdot: FloatArray) -> None:
+        """Every mode: held, integral, velocity, torque, limp, ``D``."""
+        ids, par = self._ids, self.params
+        self._gain_is_k = False
         p = self.p[ids]
         target = self.target[ids]
         held = self.held[ids] if self._any_held else None
@@ -241,18 +288,21 @@ class MotorBank:
         gain[off] = 0.0
         bias_q[off] = 0.0
         bias_v[off] = 0.0
-        # the torque-speed line at this speed bounds the force for the step: full torque
-        # against the motion, the line's torque with it
-        drive = par.line_reach - par.line_slope * np.abs(qdot)
-        np.minimum(drive, par.motor_torque, out=drive)
-        np.maximum(drive, 0.0, out=drive)
-        forward = qdot > 0
-        self._range_hi[ids] = np.where(forward, drive, par.motor_torque)
-        self._range_lo[ids] = np.where(forward, par.minus_motor_torque, -drive)
         self._gain[ids] = gain
         self._bias_q[ids] = bias_q
         self._bias_v[ids] = bias_v
         data.ctrl[ids] = ctrl
+
+    def _write_force_range(self, qdot: FloatArray) -> None:
+        """The torque-speed line at the joint's speed bounds the force for the step: full
+        torque against the motion, the line's torque (at least 0) with it. Both bounds in four
+        calls: ``(-reach, reach) - slope qdot`` clamped to ``[-T, 0]`` and ``[0, T]`` (moving
+        forward the lower bound is below ``-T``, backward the upper one above ``T``)."""
+        par = self.params
+        bounds = par.line_bounds - (par.line_slope * qdot)[:, None]
+        np.minimum(bounds, par.bounds_high, out=bounds)
+        np.maximum(bounds, par.bounds_low, out=bounds)
+        self._force_range[self._ids] = bounds
 
 
 class PositionWriter:

@@ -86,3 +86,46 @@ def test_limp_servo_gives_no_torque() -> None:
     r.bank.set_position(0, 1.0)
     r.run(0.5)
     assert r.data.actuator_force[0] == 0.0 and abs(r.data.qpos[0]) < 1e-6
+
+
+def test_common_position_path_gives_the_forces_of_the_general_path() -> None:
+    """Two identical worlds of walking-size robots, the same joint states and targets; in one
+    a joint is held at its own target (the general path: same law), in the other nothing is
+    (the common path: gain left at K, no torque as ctrl and bias 0). Every actuator's force
+    law and force range agree, for joints inside the backlash, saturated and unsaturated."""
+    from benchmarks.sim import placements
+    from simulator.world import World
+
+    rng = np.random.default_rng(3)
+    worlds = [
+        World.create(field_class="kid", robots=placements(2, "kid-default"), seed=0)
+        for _ in range(2)
+    ]
+    common, general = worlds
+    ids = common.motors._ids
+    n = len(common.motors.params.gain)
+    qpos = common.data.qpos[common.motors._qpos] + rng.normal(0.0, 0.05, n)
+    qvel = rng.normal(0.0, 3.0, n)
+    targets = qpos + rng.normal(0.0, 0.02, n) * (rng.random(n) < 0.6)  # 40 % in the play
+    laws = []
+    for world in worlds:
+        world.data.qpos[world.motors._qpos] = qpos
+        world.data.qvel[world.motors._dof] = qvel
+        world.motors.set_positions(ids, targets)
+    general.motors.set_held(np.array([0]), targets[:1])
+    for world in worlds:
+        world.motors.apply(world.data)
+        m, u = world.model, world.data.ctrl[ids]
+        laws.append(
+            np.stack([
+                m.actuator_gainprm[ids, 0] * u + m.actuator_biasprm[ids, 1] * qpos
+                + m.actuator_biasprm[ids, 2] * qvel,
+                m.actuator_forcerange[ids, 0],
+                m.actuator_forcerange[ids, 1],
+            ])
+        )  # fmt: skip
+    assert not common.motors._any_held and general.motors._any_held
+    np.testing.assert_allclose(laws[0], laws[1], rtol=0, atol=1e-12)
+    force = laws[0][0]
+    assert (force == 0.0).sum() >= 0.2 * n  # inside the play: no torque
+    assert (np.abs(force) > 0).sum() >= 0.2 * n
