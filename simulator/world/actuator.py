@@ -112,6 +112,7 @@ class ActuatorParams:
     half_play: FloatArray  # half the backlash, rad
     minus_half_play: FloatArray
     has_play: npt.NDArray[np.bool_]
+    no_play: npt.NDArray[np.bool_]
     minus_gain: FloatArray  # -K, the velocity bias of position control
     line_bounds: FloatArray  # (n, 2): -reach, reach (the force range before the clamps)
     bounds_low: FloatArray  # (n, 2): -motor torque, 0
@@ -153,6 +154,7 @@ def actuator_params(model: mujoco.MjModel, specs: Sequence[tuple[int, Any]]) -> 
         half_play=array([s.backlash_rad / 2 for _, s in ordered]),
         minus_half_play=array([-s.backlash_rad / 2 for _, s in ordered]),
         has_play=np.array([s.backlash_rad > 0 for _, s in ordered], dtype=bool),
+        no_play=np.array([s.backlash_rad <= 0 for _, s in ordered], dtype=bool),
         minus_gain=-gain,
         line_bounds=np.stack([-reach, reach], axis=1),
         bounds_low=np.stack([-torque, zero], axis=1),

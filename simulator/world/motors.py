@@ -218,17 +218,19 @@ class MotorBank:
         np.minimum(shift, par.half_play, out=shift)  # backlash: see the general path
         error -= shift
         wanted = p * error
-        saturated = np.abs(wanted) > limit
+        free = np.abs(wanted) <= limit  # not saturated
         ctrl = target - shift
         ctrl *= p
-        np.copyto(ctrl, np.copysign(limit, wanted), where=saturated)
-        off = error == 0.0
-        off &= par.has_play
-        np.copyto(ctrl, 0.0, where=off)
-        saturated |= off
-        self._bias_q[ids] = np.where(saturated, 0.0, self._neg_kp)
-        self._bias_v[ids] = np.where(off, 0.0, par.minus_gain)
-        data.ctrl[ids] = ctrl
+        limited = np.copysign(limit, wanted)
+        np.copyto(limited, ctrl, where=free)
+        # masks as factors (ufuncs: ``np.where`` and ``np.copyto`` dispatch through Python)
+        on = error != 0.0  # off: within the play (the shift took the whole error)
+        on |= par.no_play
+        limited *= on
+        free &= on
+        self._bias_q[ids] = self._neg_kp * free
+        self._bias_v[ids] = par.minus_gain * on
+        data.ctrl[ids] = limited
 
     def _apply_general(self, data: mujoco.MjData, q: FloatArray, qdot: FloatArray) -> None:
         """Every mode: held, integral, velocity, torque, limp, ``D``."""

@@ -177,7 +177,8 @@ class SensorNoise:
         np.multiply(q, self._inverse_resolution, out=q)
         np.rint(q, out=q)
         np.multiply(q, self._resolution, out=q)
-        np.clip(v, self._low, self._high, out=v)
+        np.maximum(v, self._low, out=v)  # (``np.clip`` is the same through Python wrappers)
+        np.minimum(v, self._high, out=v)
         f = v[nq + self._nimu :]
         f[f < self._dead_band] = 0.0
         self.values.put(self._index, v)

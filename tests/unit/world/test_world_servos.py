@@ -93,14 +93,15 @@ def test_common_position_path_gives_the_forces_of_the_general_path() -> None:
     a joint is held at its own target (the general path: same law), in the other nothing is
     (the common path: gain left at K, no torque as ctrl and bias 0). Every actuator's force
     law and force range agree, for joints inside the backlash, saturated and unsaturated."""
-    from benchmarks.sim import placements
-    from simulator.world import World
+    from contracts.ids import RobotId, TeamColor
+    from simulator.world import RobotPlacement, World
 
     rng = np.random.default_rng(3)
-    worlds = [
-        World.create(field_class="kid", robots=placements(2, "kid-default"), seed=0)
-        for _ in range(2)
+    robots = [
+        RobotPlacement(id=RobotId(team, 1), model="kid-default", x_m=x, y_m=0.0, yaw_rad=0.0)
+        for team, x in ((TeamColor.RED, -1.0), (TeamColor.BLUE, 1.0))
     ]
+    worlds = [World.create(field_class="kid", robots=robots, seed=0) for _ in range(2)]
     common, general = worlds
     ids = common.motors._ids
     n = len(common.motors.params.gain)
