@@ -42,14 +42,14 @@ V = TypeVar("V")
 MAX_COMBINATIONS = 64  # distinct combinations kept (robots enabling sensors at other periods)
 
 
-class _Encoding:
+class Encoding:
     """The concatenated plans of one combination of robots. Each robot's span is
     ``[4-byte length][head][sensors]`` with room for a head of ``head_size`` bytes (the same
     for every robot of a step): the framed messages of robots without messages or cameras are
     cut out whole; the others take their sensors only."""
 
     __slots__ = ("gather", "template", "byte_index", "rows", "head_index", "head_size",
-                 "frames", "sensors")  # fmt: skip
+                 "frames_at", "sensors")  # fmt: skip
 
     def __init__(
         self,
@@ -101,7 +101,7 @@ class _Encoding:
         # robots with the same sensors: the heads are one strided view of the rows
         self.rows = len(plans) if len(spans) == 1 else 0
         self.head_index = joined(head_index).reshape(len(plans), head_size)
-        self.frames = tuple(frames)
+        self.frames_at = tuple(frames)
         self.sensors = tuple(sensors)
 
     def write(
@@ -109,6 +109,24 @@ class _Encoding:
     ) -> None:
         """Write one step's ``values`` (from :attr:`gather`) and ``head`` into a copy of the
         template and give each measurement its frame (a plain one) or its sensors."""
+        raw = self._raw(values, head)
+        for measurement, frame, sensors in zip(
+            measurements, self.frames_at, self.sensors, strict=True
+        ):
+            if measurement.plain:
+                measurement.set_frame(raw[frame[0] : frame[1]])
+            else:
+                measurement.sensors = raw[sensors[0] : sensors[1]]
+
+
+    def frames(self, values: npt.NDArray[np.float64], head: bytes) -> list[bytes]:
+        """Every robot's framed message of one step, all plain (no message, no camera)."""
+        raw = self._raw(values, head)
+        return [raw[start:end] for start, end in self.frames_at]
+
+    def _raw(self, values: npt.NDArray[np.float64], head: bytes) -> bytes:
+        """The concatenated frames of one step: ``values`` and ``head`` written into a copy
+        of the template."""
         array = self.template.copy()
         array[self.byte_index] = values.astype("<f8", copy=False).view(np.uint8)
         if head:
@@ -118,14 +136,7 @@ class _Encoding:
                 array.reshape(self.rows, -1)[:, HEADER.size : HEADER.size + size] = head_bytes
             else:
                 array[self.head_index] = head_bytes
-        raw = array.tobytes()
-        for measurement, frame, sensors in zip(
-            measurements, self.frames, self.sensors, strict=True
-        ):
-            if measurement.plain:
-                measurement.set_frame(raw[frame[0] : frame[1]])
-            else:
-                measurement.sensors = raw[sensors[0] : sensors[1]]
+        return array.tobytes()
 
 
 class Gathered:
@@ -136,7 +147,7 @@ class Gathered:
 
     def __init__(
         self,
-        encoding: _Encoding,
+        encoding: Encoding,
         values: npt.NDArray[np.float64],
         head: bytes,
         measurements: list[Measurement],
@@ -167,7 +178,7 @@ class StepBatch:
     def __init__(self, world: Any) -> None:
         self._gatherer = world.sensor_gatherer
         self._writer = world.motor_targets_writer
-        self._encodings: dict[tuple[tuple[DuePlan, ...], int], _Encoding] = {}
+        self._encodings: dict[tuple[tuple[DuePlan, ...], int], Encoding] = {}
         self._targets: dict[tuple[TargetPlan, ...], PositionWriter] = {}
 
     @staticmethod
@@ -188,12 +199,22 @@ class StepBatch:
         """:meth:`encode` in two parts: the values are read from the world now, the bytes
         are written by the result's :meth:`Gathered.write`."""
         plans = tuple([plan for _, plan in items])
-        encoding = _cached(
+        return self.gather_plans(plans, [m for m, _ in items], head)
+
+    def gather_plans(
+        self, plans: tuple[DuePlan, ...], measurements: list[Measurement], head: bytes
+    ) -> Gathered:
+        """:meth:`gather` of ``measurements`` and their ``plans`` (in the same order)."""
+        encoding = self.encoding(plans, len(head))
+        return Gathered(encoding, encoding.gather(), head, measurements)
+
+    def encoding(self, plans: tuple[DuePlan, ...], head_size: int) -> Encoding:
+        """The concatenated ``plans`` with room for a head of ``head_size`` bytes (cached)."""
+        return _cached(
             self._encodings,
-            (plans, len(head)),
-            lambda: _Encoding(plans, len(head), self._gatherer),
+            (plans, head_size),
+            lambda: Encoding(plans, head_size, self._gatherer),
         )
-        return Gathered(encoding, encoding.gather(), head, [m for m, _ in items])
 
     def set_targets(self, items: Sequence[tuple[TargetPlan, TargetValues]]) -> None:
         """Write the position targets of several robots (distinct actuators) at once."""

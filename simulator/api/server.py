@@ -29,10 +29,13 @@ from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from functools import partial
 
+import numpy as np
+import numpy.typing as npt
+
 from contracts import NetworkSpec, RobotApiStats, RobotId
 from contracts.robot_api import messages_pb2 as pb
 from referee import SpoofingLog
-from simulator.api.batch import Gathered, StepBatch
+from simulator.api.batch import Encoding, Gathered, StepBatch
 from simulator.api.cameras import MAX_IN_FLIGHT, ImageSource
 from simulator.api.connection import ClientClosed, Connection
 from simulator.api.devices import DeviceWorld
@@ -47,6 +50,7 @@ from simulator.api.session import (
     DuePlan,
     Measurement,
     RobotSession,
+    SteadyChanges,
     TargetPlan,
     header_bytes,
 )
@@ -90,14 +94,53 @@ class _Pending:
     missing: int
 
 
+@dataclass(frozen=True, slots=True)
+class _SteadyStep:
+    """The connected robots of a step whose every measurement was a steady session's
+    (:attr:`RobotSession.steady`), all due at the same steps (one period, starts that differ by
+    whole periods: robots that enabled their sensors at different steps). While no client
+    connects or leaves, no robot is removed and no session's steady state changes,
+    :meth:`ApiServer.prepare` builds a step due by it without asking each session: one gather
+    of ``plans``, one plain measurement per robot, what the sessions would give."""
+
+    connection_changes: int
+    steady_changes: int
+    slots: tuple[RobotSlot, ...]
+    conns: tuple[Connection, ...]
+    plans: tuple[DuePlan, ...]
+    period: int
+    phase: int  # due when the step's time modulo ``period`` is ``phase``
+
+
+@dataclass(frozen=True, slots=True)
+class _SteadyValues:
+    """One step's sensor values gathered by a :class:`_SteadyStep`, not yet wire bytes."""
+
+    step: _SteadyStep
+    encoding: Encoding
+    values: npt.NDArray[np.float64]
+    time_ms: int
+    real_time: int
+    head: bytes
+
+    def measurements(self) -> list[tuple[RobotSlot, Measurement]]:
+        """The step's measurements robot by robot, written (as :meth:`ApiServer.prepare`
+        makes them without the steady form)."""
+        measurements = [Measurement(self.time_ms, self.real_time) for _ in self.step.slots]
+        self.encoding.write(self.values, self.head, measurements)
+        return list(zip(self.step.slots, measurements, strict=True))
+
+
 @dataclass(slots=True)
 class Prepared:
     """The measurements of one step (:meth:`ApiServer.prepare`) and, with the I/O thread,
     their sensor values read but not yet written as wire bytes (``unwritten``: the I/O thread
-    writes them before it queues the frames)."""
+    writes them before it queues the frames); or, in a steady step, the values alone
+    (``steady``: the I/O thread frames them for every robot)."""
 
     items: list[tuple[RobotSlot, Measurement]]
     unwritten: Gathered | None = None
+    steady: _SteadyValues | None = None
 
 
 @dataclass(slots=True, eq=False)
@@ -169,7 +212,16 @@ class ApiServer:
         self._unwritten: Gathered | None = None
         self._sent_at = 0.0
         self._hold_told: set[tuple[int, int]] = set()  # (connection id, held sim time) told
+        # the steady form of the last step built robot by robot (None: not every robot steady)
+        self._steady_step: _SteadyStep | None = None
+        # the world's removed flags (changed in place), when it has them: a removed robot's
+        # measurement is not its steady one
+        flags = getattr(world, "robot_flags", None)
+        self._removed_flags: list[bool] | None = (
+            flags(endpoints[0].robot)[1] if flags is not None and endpoints else None
+        )
         self.slots: dict[RobotId, RobotSlot] = {}
+        self._steady_changes = SteadyChanges()
         for endpoint in endpoints:
             team_size = max(1, endpoint.team_size)
             session = RobotSession(
@@ -177,6 +229,7 @@ class ApiServer:
                 world=world,
                 rendering_quota_mb_s=network.rendering_quota_mb_s / team_size,
                 clock_ms=unix_ms,
+                steady_changes=self._steady_changes,
             )
             self.slots[endpoint.robot] = RobotSlot(
                 endpoint=endpoint,
@@ -550,8 +603,27 @@ class ApiServer:
         """The measurements of the step that ended at ``time_ms`` for the connected clients,
         read but not queued: :meth:`publish_prepared` queues them. Pipelined stepping builds
         them before it waits for the answers to the previous ones. Without the I/O thread they
-        are encoded here; with it the wire bytes are written there (``unwritten``)."""
+        are encoded here; with it the wire bytes are written there (``unwritten``, or
+        ``steady`` when every robot is steady: see :class:`_SteadyStep`)."""
         real_time = self._unix_ms()  # one instant for the whole step
+        steady = self._steady_step
+        if steady is not None and self._still_steady(steady, time_ms):
+            assert self._batch is not None  # (a steady step is only recorded with the batch)
+            head = header_bytes(time_ms, real_time)
+            encoding = self._batch.encoding(steady.plans, len(head))
+            values = _SteadyValues(steady, encoding, encoding.gather(), time_ms, real_time, head)
+            return Prepared([], steady=values)
+        items, gathered = self._prepare_each(time_ms, real_time)
+        if gathered is not None and self._sender is None:
+            gathered.write()
+            gathered = None
+        return Prepared(items, gathered)
+
+    def _prepare_each(
+        self, time_ms: int, real_time: int
+    ) -> tuple[list[tuple[RobotSlot, Measurement]], Gathered | None]:
+        """:meth:`prepare` robot by robot (each session's :meth:`RobotSession.begin_measure`);
+        records the step's steady form when every robot is steady."""
         prepared: list[tuple[RobotSlot, Measurement]] = []
         batched: list[tuple[Measurement, DuePlan]] = []
         for slot in self.slots.values():
@@ -566,17 +638,65 @@ class ApiServer:
                 batched.append((measurement, plan))
             else:
                 measurement.sensors = session.encode(plan)
+        self._steady_step = self._steady_form(prepared, batched)
         if not batched:
-            return Prepared(prepared)
+            return prepared, None
         assert self._batch is not None
-        gathered = self._batch.gather(batched, header_bytes(time_ms, real_time))
-        if self._sender is None:
-            gathered.write()
-            return Prepared(prepared)
-        return Prepared(prepared, gathered)
+        return prepared, self._batch.gather(batched, header_bytes(time_ms, real_time))
+
+    def _steady_form(
+        self,
+        prepared: list[tuple[RobotSlot, Measurement]],
+        batched: list[tuple[Measurement, DuePlan]],
+    ) -> _SteadyStep | None:
+        """The :class:`_SteadyStep` of a step built robot by robot, or None when some robot
+        was not steady, due at other steps than the others or still owed a camera image."""
+        if self._removed_flags is None or not batched or len(batched) != len(prepared):
+            return None
+        first = prepared[0][0].session.steady
+        if first is None:
+            return None
+        period, phase = first[0], first[1] % first[0]  # due when time % period is phase
+        conns: list[Connection] = []
+        for (slot, _), (_, plan) in zip(prepared, batched, strict=True):
+            steady = slot.session.steady
+            if steady is None or steady[2] is not plan or slot.pending or slot.conn is None:
+                return None
+            if steady[0] != period or steady[1] % period != phase:
+                return None
+            conns.append(slot.conn)
+        return _SteadyStep(
+            connection_changes=self.connection_changes,
+            steady_changes=self._steady_changes.count,
+            slots=tuple([slot for slot, _ in prepared]),
+            conns=tuple(conns),
+            plans=tuple([plan for _, plan in batched]),
+            period=period,
+            phase=phase,
+        )
+
+    def _still_steady(self, steady: _SteadyStep, time_ms: int) -> bool:
+        """``steady`` holds for the step that ended at ``time_ms``: due by it, the same
+        clients, no robot removed, no session's steady state changed."""
+        return (
+            time_ms % steady.period == steady.phase
+            and steady.connection_changes == self.connection_changes
+            and steady.steady_changes == self._steady_changes.count
+            and self._removed_flags is not None
+            and True not in self._removed_flags
+        )
 
     def publish_prepared(self, prepared: Prepared) -> None:
         """Queue measurements made by :meth:`prepare` (a client dropped meanwhile gets none)."""
+        steady = prepared.steady
+        if steady is not None:
+            if self._sender is not None and (
+                steady.step.connection_changes == self.connection_changes
+            ):
+                self._publish_steady(steady)
+                return
+            prepared = Prepared(steady.measurements())  # without the I/O thread, or a client
+            # left since: robot by robot
         jobs_all = []
         now = time.monotonic()
         unwritten = prepared.unwritten
@@ -603,6 +723,16 @@ class ApiServer:
                 self.poll(0.05)  # rendering is behind: let it catch up (results end the poll)
         self._flush_all()
 
+    def _publish_steady(self, steady: _SteadyValues) -> None:
+        """Hand a steady step's values to the I/O thread, which frames and queues them for
+        every robot (:meth:`_deliver_steady`): what the step thread does per robot is the
+        lockstep flag."""
+        assert self._sender is not None
+        for conn in steady.step.conns:
+            conn.answered = False
+        self._flush_all()  # anything queued before, in order
+        self._sender.submit(partial(self._deliver_steady, steady, time.monotonic()))
+
     def _send(
         self, slot: RobotSlot, conn: Connection, measurement: Measurement, now: float
     ) -> None:
@@ -621,24 +751,28 @@ class ApiServer:
         ERROR message in its place."""
         frame = measurement.frame
         if frame is not None:  # built whole by the step's batch: no header, no message
-            if slot.quota.admit(len(frame) - HEADER.size, measurement.real_time):
-                return frame
-            return self._quota_error(slot, measurement)
+            return self._admitted(slot, frame, measurement.time, measurement.real_time)
         head, sensors = measurement.head(), measurement.sensors
         size = len(head) + len(sensors)
         if not slot.quota.admit(size, measurement.real_time):
-            return self._quota_error(slot, measurement)
+            return self._quota_error(slot, measurement.time, measurement.real_time)
         warnings = measurement.message_count
         if warnings:
             slot.stats.warnings_sent += warnings
         return b"".join((HEADER.pack(size), head, sensors))
 
-    def _quota_error(self, slot: RobotSlot, measurement: Measurement) -> bytes:
+    def _admitted(self, slot: RobotSlot, frame: bytes, time_ms: int, real_time: int) -> bytes:
+        """A plain measurement's whole ``frame``, counted in the robot's quota, or the quota's
+        ERROR message in its place."""
+        if slot.quota.admit(len(frame) - HEADER.size, real_time):
+            return frame
+        return self._quota_error(slot, time_ms, real_time)
+
+    def _quota_error(self, slot: RobotSlot, time_ms: int, real_time: int) -> bytes:
         """The framed ERROR message that replaces a measurement over the robot's quota."""
-        real_time = measurement.real_time
         quota = slot.quota
         slot.stats.quota_errors += 1
-        header = pb.SensorMeasurements(time=measurement.time, real_time=real_time)
+        header = pb.SensorMeasurements(time=time_ms, real_time=real_time)
         header.messages.add(message_type=ERROR, text=quota.error_text)
         payload: bytes = header.SerializeToString()
         quota.record(len(payload), real_time)
@@ -679,6 +813,19 @@ class ApiServer:
             if conn.closed or conn.error is not None:
                 continue  # dropped since: the step thread forgets it
             conn.send_threaded(self._framed(slot, measurement), now)
+            queued.append(conn)
+        return queued
+
+    def _deliver_steady(self, steady: _SteadyValues, now: float) -> list[Connection]:
+        """I/O thread: :meth:`_deliver` of a steady step: the wire bytes of every robot's plain
+        measurement written at once, each counted in its robot's quota and queued."""
+        step = steady.step
+        frames = steady.encoding.frames(steady.values, steady.head)
+        queued = []
+        for slot, conn, frame in zip(step.slots, step.conns, frames, strict=True):
+            if conn.closed or conn.error is not None:
+                continue  # dropped since: the step thread forgets it
+            conn.send_threaded(self._admitted(slot, frame, steady.time_ms, steady.real_time), now)
             queued.append(conn)
         return queued
 

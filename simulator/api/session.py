@@ -181,6 +181,17 @@ class TargetPlan:
         self.actuators = actuators
 
 
+class SteadyChanges:
+    """A count shared by the sessions of one server, raised whenever the steady state of one
+    of them changes (:attr:`RobotSession.steady`): a step tells that none changed from one
+    number instead of asking every session."""
+
+    __slots__ = ("count",)
+
+    def __init__(self) -> None:
+        self.count = 0
+
+
 class RobotSession:
     """Sensor enabling, command application and measurement building for one robot."""
 
@@ -191,8 +202,10 @@ class RobotSession:
         world: DeviceWorld,
         rendering_quota_mb_s: float,
         clock_ms: Callable[[], int],
+        steady_changes: SteadyChanges | None = None,
     ) -> None:
         self.robot = robot
+        self.steady_changes = steady_changes if steady_changes is not None else SteadyChanges()
         self.key = robot_key(robot)
         self._world = world
         self._rendering_quota_mb_s = rendering_quota_mb_s
@@ -247,7 +260,7 @@ class RobotSession:
                 return
             self._warned.add(text)
         self._pending.append((kind, text))
-        self._steady = None
+        self._set_steady(None)
 
     def apply(self, request: pb.ActuatorRequests | PositionTargets, *, step_time_ms: int) -> None:
         """Apply one request; ``step_time_ms`` is the time of the measurement this step sends."""
@@ -415,7 +428,7 @@ class RobotSession:
             self._sensors.pop(name, None)
             self._new_sensors.discard(name)
             self._groups = None
-            self._steady = None
+            self._set_steady(None)
             return
         if period < minimum:
             self.warn(
@@ -445,7 +458,7 @@ class RobotSession:
         self._sensors[name] = period
         self._enabled_at[name] = now_ms
         self._groups = None
-        self._steady = None
+        self._set_steady(None)
         log.debug("%s: %s enabled every %d ms", self.key, name, period)
 
     def update_limp(self) -> None:
@@ -497,7 +510,7 @@ class RobotSession:
             self._sensors.clear()
             self._new_sensors.clear()
             self._groups = None
-            self._steady = None
+            self._set_steady(None)
             return out, None
         if self._new_sensors:
             due = self._due_slow(out, time_ms)
@@ -511,8 +524,22 @@ class RobotSession:
         groups = self._groups
         if groups is not None and len(groups) == 1 and not self._camera_sensors:
             if not self._new_sensors and not self._pending:
-                self._steady = (groups[0][0], groups[0][1], plan)
+                self._set_steady((groups[0][0], groups[0][1], plan))
         return out, plan
+
+    @property
+    def steady(self) -> tuple[int, int, DuePlan] | None:
+        """``(period, start, plan)`` while every regular sensor of the robot has one period and
+        one start and nothing else is going on (no message, no camera, no sensor just enabled);
+        a new tuple whenever that changes. At a step due by it (``(time - start) % period``
+        0), an active robot's :meth:`begin_measure` is a plain measurement and ``plan``.
+        Each change raises :attr:`steady_changes`."""
+        return self._steady
+
+    def _set_steady(self, steady: tuple[int, int, DuePlan] | None) -> None:
+        if steady != self._steady:
+            self._steady = steady
+            self.steady_changes.count += 1
 
     def _removed(self) -> bool:
         flags = self._flags
