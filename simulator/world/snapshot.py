@@ -142,6 +142,8 @@ class SnapshotBuilder:
         # the classification of each set of geom pairs in contact seen lately
         self._known: dict[frozenset[int], ContactSets] = {}
         self._listed: dict[bytes, ContactSets] = {}  # the same, by the contact list's bytes
+        self._arena_bytes = int(data.narena)
+        self._geoms: npt.NDArray[np.int32] | None = None  # see _contact_geoms
 
     def build(
         self,
@@ -213,7 +215,7 @@ class SnapshotBuilder:
         ncon = data.ncon
         if ncon == 0:
             return self._none
-        geom = data.contact.geom[:ncon]
+        geom = self._contact_geoms()[:ncon]
         # first the contact list itself, as bytes (a few hundred: hashed and compared in C):
         # robots standing or moving their joints repeat it step after step
         listed = geom.tobytes()
@@ -250,6 +252,22 @@ class SnapshotBuilder:
         known[pairs] = sets
         self._remember(listed, sets)
         return sets
+
+    def _contact_geoms(self) -> npt.NDArray[np.int32]:
+        """The geom pairs of every contact the arena can hold (slice the first ``ncon``): a
+        view made once. MuJoCo always lays the contacts at the start of the ``MjData``'s arena
+        (``mj_clearEfc``: ``d->contact = d->arena``), which never moves, and
+        ``data.contact.geom`` builds a wrapper with every field of the list each time (5 us
+        right after ``mj_step``, against a slice of this view)."""
+        view = self._geoms
+        if view is None:
+            geom = self._data.contact.geom  # (needs a contact: the row stride is mjContact's)
+            stride = geom.strides[0]
+            rows = max(len(geom), self._arena_bytes // stride)
+            view = self._geoms = np.lib.stride_tricks.as_strided(
+                geom, shape=(rows, 2), strides=geom.strides, writeable=False
+            )
+        return view
 
     def _remember(self, listed: bytes, sets: ContactSets) -> None:
         if len(self._listed) >= KNOWN_PAIR_SETS:

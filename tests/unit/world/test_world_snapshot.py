@@ -222,3 +222,29 @@ def test_ball_toucher_reads_the_lowest_robot_touching_the_ball() -> None:
     assert toucher() == -1
     empty = World.create(field_class="kid", robots=[], seed=1)
     assert BallToucher(empty.data, empty.index)() == -1
+
+
+def test_contact_view_is_the_contact_list_through_a_reset() -> None:
+    """The snapshot's view of the contacts' geom pairs (made once over the arena) reads what
+    ``data.contact.geom`` reads, every step, also after ``mj_resetData`` and a reload."""
+    import mujoco
+
+    world = World.create(
+        field_class="kid",
+        robots=[RobotPlacement(id=RED_1, model="kid-default", x_m=0.0, y_m=0.0, yaw_rad=0.0)],
+        seed=2,
+    )
+    builder = world._snapshots
+    compared = 0
+    for step in range(300):
+        if step == 150:
+            mujoco.mj_resetData(world.model, world.data)
+            mujoco.mj_forward(world.model, world.data)
+        world.step()
+        world.snapshot()
+        ncon = world.data.ncon
+        if ncon:
+            assert np.array_equal(builder._contact_geoms()[:ncon], world.data.contact.geom)
+            compared += 1
+    assert compared >= 250  # (after the reset the robot drops from its model pose: none)
+    assert not builder._contact_geoms().flags.writeable
