@@ -217,9 +217,11 @@ class ApiServer:
         # the world's removed flags (changed in place), when it has them: a removed robot's
         # measurement is not its steady one
         flags = getattr(world, "robot_flags", None)
-        self._removed_flags: list[bool] | None = (
-            flags(endpoints[0].robot)[1] if flags is not None and endpoints else None
-        )
+        world_flags = flags(endpoints[0].robot) if flags is not None and endpoints else None
+        self._removed_flags: list[bool] | None = world_flags[1] if world_flags else None
+        # the world's limp flags (changed in place) and a copy as the sessions last saw them
+        self._limp_flags: list[bool] | None = world_flags[0] if world_flags else None
+        self._limp_seen: list[bool] | None = None
         self.slots: dict[RobotId, RobotSlot] = {}
         self._steady_changes = SteadyChanges()
         for endpoint in endpoints:
@@ -511,10 +513,10 @@ class ApiServer:
     def apply_requests(self, step_time_ms: int) -> None:
         """Read what is available, then apply every received request in arrival order."""
         self._poll_before_step()
+        self._update_limps()
         received: list[tuple[RobotSession, list[Request]]] = []
         for slot in self.slots.values():
             session = slot.session
-            session.update_limp()
             conn = slot.conn
             if conn is None:
                 continue
@@ -528,6 +530,17 @@ class ApiServer:
                 received.append((session, conn.requests))
                 conn.requests = []
         self._apply(received, step_time_ms)
+
+    def _update_limps(self) -> None:
+        """Every session follows the world's limp flags (:meth:`RobotSession.update_limp`);
+        one comparison with the flags seen last when the world has them in a list."""
+        limp = self._limp_flags
+        if limp is not None and limp == self._limp_seen:
+            return
+        for slot in self.slots.values():
+            slot.session.update_limp()
+        if limp is not None:
+            self._limp_seen = list(limp)
 
     def take_requests(self) -> dict[RobotId, list[Request]]:
         """Pipelined stepping: read what is available and detach every client's received
@@ -548,8 +561,7 @@ class ApiServer:
     def apply_taken(self, taken: dict[RobotId, list[Request]], step_time_ms: int) -> None:
         """Pipelined stepping: apply requests detached by :meth:`take_requests` in arrival
         order (a robot's requests apply even when its client left since)."""
-        for slot in self.slots.values():
-            slot.session.update_limp()
+        self._update_limps()
         slots = self.slots
         self._apply(
             [(slots[robot].session, requests) for robot, requests in taken.items() if requests],
@@ -728,8 +740,9 @@ class ApiServer:
         every robot (:meth:`_deliver_steady`): what the step thread does per robot is the
         lockstep flag."""
         assert self._sender is not None
-        for conn in steady.step.conns:
-            conn.answered = False
+        if self._lockstep is not None:  # (the flag lockstep waits on; async never waits)
+            for conn in steady.step.conns:
+                conn.answered = False
         self._flush_all()  # anything queued before, in order
         self._sender.submit(partial(self._deliver_steady, steady, time.monotonic()))
 

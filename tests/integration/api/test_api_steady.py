@@ -8,6 +8,7 @@ from __future__ import annotations
 import socket
 import time
 from collections.abc import Callable
+from functools import partial
 from typing import Any
 
 from contracts.ids import RobotId, TeamColor
@@ -24,7 +25,7 @@ JOINTS = ("NeckS", "HeadS", "AnkleLS", "AnkleRS", "LegUpperLS")
 
 
 def _frame(request: pb.ActuatorRequests) -> bytes:
-    payload = request.SerializeToString()
+    payload: bytes = request.SerializeToString()
     return HEADER.pack(len(payload)) + payload
 
 
@@ -49,6 +50,12 @@ def _frames(data: bytes) -> list[bytes]:
         at += HEADER.size + size
     assert at == len(data), "a partial frame at the end"
     return out
+
+
+def _connected(server: ApiServer, robot: RobotId, connected: bool = True) -> bool:
+    """Serve the server's sockets once; whether ``robot`` has (or has no) client now."""
+    server.poll(0.01)
+    return (server.connection(robot) is not None) is connected
 
 
 class _Client:
@@ -97,7 +104,7 @@ def _play(steady: bool) -> tuple[dict[RobotId, list[bytes]], int]:
     try:
         for robot, port in zip(ROBOTS, ports, strict=True):
             clients[robot] = _Client(port)
-            wait_until(lambda r=robot: (server.poll(0.01), server.connection(r) is not None)[1])
+            wait_until(partial(_connected, server, robot))
             clients[robot].welcome()
 
         def send(robot: RobotId, frame: bytes) -> None:
@@ -122,7 +129,7 @@ def _play(steady: bool) -> tuple[dict[RobotId, list[bytes]], int]:
             if step in actions:
                 actions[step]()
             if step == 46:
-                wait_until(lambda: (server.poll(0.01), server.connection(blue1) is None)[1])
+                wait_until(lambda: _connected(server, blue1, connected=False))
             server.apply_requests(world.sim_time_ms + world.step_ms)
             world.step()
             world.snapshot()
@@ -154,3 +161,51 @@ def test_steady_steps_give_the_robot_by_robot_bytes() -> None:
     removed = [pb.SensorMeasurements.FromString(f) for f in red1[30:34]]
     assert all(not m.position_sensors for m in removed)
     assert len(pb.SensorMeasurements.FromString(red1[-1]).position_sensors) == len(JOINTS)
+
+
+def test_a_real_worlds_limp_flags_hold_and_release_the_targets() -> None:
+    """The server follows the world's limp list (one comparison a step when nothing changed):
+    targets sent while limp are kept, not applied, and applied on release."""
+    from referee.snapshot import SetLimp
+
+    robot = ROBOTS[0]
+    world = real_world([robot])
+    (port,) = free_ports(1)
+    server = ApiServer(
+        world=world,
+        endpoints=[PlayerEndpoint(robot=robot, port=port, hosts=("127.0.0.1",), team_size=4)],
+        network=NetworkSpec(api_bind_host="127.0.0.1"),
+    )
+    server.start()
+    client = _Client(port)
+    neck = int(world.motor_targets_plan(robot, ("Neck",))[0])
+
+    def step_with(position: float | None) -> None:
+        if position is not None:
+            request = pb.ActuatorRequests()
+            request.motor_positions.add(name="Neck", position=position)
+            client.sock.sendall(_frame(request))
+            wait_until(lambda: (conn := server.connection(robot)) is not None and conn.requests)
+        server.apply_requests(world.sim_time_ms + world.step_ms)
+        world.step()
+        server.publish(world.sim_time_ms)
+
+    try:
+        wait_until(lambda: _connected(server, robot))
+        client.welcome()
+        for _ in range(3):
+            step_with(0.5)
+        assert world.motors.target[neck] == 0.5
+        world.apply(SetLimp(robot=robot, limp=True))
+        for _ in range(3):
+            step_with(-0.4)
+        assert world.motors.target[neck] == 0.5  # limp: kept, not applied
+        step_with(None)
+        world.apply(SetLimp(robot=robot, limp=False))
+        step_with(None)
+        assert world.motors.target[neck] == -0.4  # released: the latest target
+        step_with(0.2)
+        assert world.motors.target[neck] == 0.2
+    finally:
+        client.sock.close()
+        server.close()
