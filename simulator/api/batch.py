@@ -118,7 +118,6 @@ class Encoding:
             else:
                 measurement.sensors = raw[sensors[0] : sensors[1]]
 
-
     def frames(self, values: npt.NDArray[np.float64], head: bytes) -> list[bytes]:
         """Every robot's framed message of one step, all plain (no message, no camera)."""
         raw = self._raw(values, head)

@@ -105,8 +105,6 @@ class ActuatorParams:
     max_velocity: FloatArray
     lower: FloatArray
     upper: FloatArray
-    motor_torque: FloatArray
-    line_reach: FloatArray  # the line's torque extrapolated to zero speed (>= motor torque)
     line_slope: FloatArray  # N m per rad/s
     gain: FloatArray
     half_play: FloatArray  # half the backlash, rad
@@ -114,7 +112,9 @@ class ActuatorParams:
     has_play: npt.NDArray[np.bool_]
     no_play: npt.NDArray[np.bool_]
     minus_gain: FloatArray  # -K, the velocity bias of position control
-    line_bounds: FloatArray  # (n, 2): -reach, reach (the force range before the clamps)
+    # (n, 2): -reach, reach (the force range before the clamps; reach: the line's torque
+    # extrapolated to zero speed, at least the motor torque)
+    line_bounds: FloatArray
     bounds_low: FloatArray  # (n, 2): -motor torque, 0
     bounds_high: FloatArray  # (n, 2): 0, motor torque
 
@@ -147,8 +147,6 @@ def actuator_params(model: mujoco.MjModel, specs: Sequence[tuple[int, Any]]) -> 
         max_velocity=array([s.max_velocity_rad_s for _, s in ordered]),
         lower=array([s.lower_rad for _, s in ordered]),
         upper=array([s.upper_rad for _, s in ordered]),
-        motor_torque=torque,
-        line_reach=reach,
         line_slope=array([c.motor_torque_nm / c.line_span_rad_s for c in constants]),
         gain=gain,
         half_play=array([s.backlash_rad / 2 for _, s in ordered]),

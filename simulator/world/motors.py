@@ -189,7 +189,7 @@ class MotorBank:
         where a rare mode needs it) for the next basic step, from the joints' positions and
         velocities now. Right after ``mj_step`` each numpy call costs a few microseconds, so the
         common case (every actuator in position control with ``D`` 0, none held or limp) takes
-        its own path of about thirty calls; the rare modes take the general one."""
+        its own path of about twenty calls; the rare modes take the general one."""
         q = data.qpos[self._qpos]
         qdot = data.qvel[self._dof]
         rare = self._any_held or self._any_integral or self._any_d
