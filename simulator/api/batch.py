@@ -217,9 +217,12 @@ class StepBatch:
 
     def set_targets(self, items: Sequence[tuple[TargetPlan, TargetValues]]) -> None:
         """Write the position targets of several robots (distinct actuators) at once."""
-        plans = tuple([plan for plan, _ in items])
-        write = _cached(
-            self._targets, plans, lambda: self._writer(np.concatenate([p.actuators for p in plans]))
-        )
+        write = self.targets_writer(tuple([plan for plan, _ in items]))
         # every robot's values were read finite (:meth:`RobotSession.take_targets`)
         write(np.concatenate([values for _, values in items]), finite=True)
+
+    def targets_writer(self, plans: tuple[TargetPlan, ...]) -> PositionWriter:
+        """The writer of the concatenated targets of ``plans`` (cached)."""
+        return _cached(
+            self._targets, plans, lambda: self._writer(np.concatenate([p.actuators for p in plans]))
+        )

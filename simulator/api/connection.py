@@ -7,6 +7,7 @@ import socket
 import threading
 import time
 from collections import deque
+from typing import TYPE_CHECKING
 
 from google.protobuf.message import DecodeError
 
@@ -15,6 +16,9 @@ from simulator.api.bounds import READ_PER_CALL_BYTES, RequestBounds
 from simulator.api.fastreq import PositionTargets, PositionTemplate, scan_positions
 from simulator.api.framing import FrameDecoder, FramingError
 from simulator.api.stats import RobotStats
+
+if TYPE_CHECKING:
+    from simulator.api.board import BoardSlot
 
 log = logging.getLogger(__name__)
 
@@ -49,17 +53,20 @@ class Connection:
         queue_limit: int,
         time_bank_s: float,
         threaded: bool = False,
+        requests_lock: threading.Lock | None = None,
     ) -> None:
         """``threaded``: a :class:`simulator.api.sender.SendThread` reads the socket and writes
         the queue; the step thread only appends to the queue (:meth:`send`), takes the decoded
-        requests (:meth:`take_requests`) and drops the client when ``error`` is set."""
+        requests (:meth:`take_requests`) and drops the client when ``error`` is set.
+        ``requests_lock``: guards ``requests`` and ``board`` (the server shares one between its
+        connections: :mod:`simulator.api.board`)."""
         self.sock = sock
         self.fd = sock.fileno()
         self.threaded = threaded
         self.closed = False
         self.error: str | None = None  # set by the I/O thread: the step thread drops the client
         self._lock = threading.Lock()  # the I/O thread's reads and writes against close()
-        self._requests_lock = threading.Lock()
+        self.requests_lock = requests_lock if requests_lock is not None else threading.Lock()
         self.peer = peer
         self.key = key
         self.stats = stats
@@ -67,6 +74,9 @@ class Connection:
         self.decoder = FrameDecoder()
         self.bounds = RequestBounds(time.monotonic())
         self.requests: list[pb.ActuatorRequests | PositionTargets] = []
+        # where the usual requests go instead of ``requests`` while the server's target board
+        # is armed (:mod:`simulator.api.board`); set and cleared by the step thread
+        self.board: BoardSlot | None = None
         self._template: PositionTemplate | None = None
         self.outbox: deque[bytes] = deque()
         self._partial: memoryview | None = None
@@ -123,8 +133,12 @@ class Connection:
                     decoded.append(self._parse(frame))
                     template = self._template
             if decoded:
-                with self._requests_lock:
-                    self.requests.extend(decoded)
+                with self.requests_lock:
+                    board = self.board
+                    if board is None:
+                        self.requests.extend(decoded)
+                    else:
+                        board.post(decoded, self.requests)
             if len(data) < RECV_CHUNK or taken >= READ_PER_CALL_BYTES:
                 break
         if count:
@@ -165,7 +179,7 @@ class Connection:
 
     def take_requests(self) -> list[pb.ActuatorRequests | PositionTargets]:
         """The requests received since the last call, in arrival order."""
-        with self._requests_lock:
+        with self.requests_lock:
             requests, self.requests = self.requests, []
         return requests
 

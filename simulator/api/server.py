@@ -22,6 +22,7 @@ import logging
 import os
 import selectors
 import socket
+import threading
 import time
 from collections import deque
 from collections.abc import Callable, Sequence
@@ -36,6 +37,7 @@ from contracts import NetworkSpec, RobotApiStats, RobotId
 from contracts.robot_api import messages_pb2 as pb
 from referee import SpoofingLog
 from simulator.api.batch import Encoding, Gathered, StepBatch
+from simulator.api.board import TargetBoard
 from simulator.api.cameras import MAX_IN_FLIGHT, ImageSource
 from simulator.api.connection import ClientClosed, Connection
 from simulator.api.devices import DeviceWorld
@@ -222,6 +224,10 @@ class ApiServer:
         # the world's limp flags (changed in place) and a copy as the sessions last saw them
         self._limp_flags: list[bool] | None = world_flags[0] if world_flags else None
         self._limp_seen: list[bool] | None = None
+        # with the I/O thread: every robot's usual targets in one array (simulator.api.board),
+        # and the lock of every connection's requests and board slot
+        self._board: TargetBoard | None = None
+        self._requests_lock = threading.Lock()
         self.slots: dict[RobotId, RobotSlot] = {}
         self._steady_changes = SteadyChanges()
         for endpoint in endpoints:
@@ -442,6 +448,7 @@ class ApiServer:
             queue_limit=self._network.send_queue_messages,
             time_bank_s=bank,
             threaded=self._sender is not None,
+            requests_lock=self._requests_lock,
         )
         slot.pending.clear()
         slot.stats.connects.append(time.time())
@@ -511,15 +518,25 @@ class ApiServer:
         self.poll(0.0)
 
     def apply_requests(self, step_time_ms: int) -> None:
-        """Read what is available, then apply every received request in arrival order."""
+        """Read what is available, then apply every received request in arrival order.
+        While the target board is armed that is one write of what the I/O thread posted on it
+        (:mod:`simulator.api.board`); a step that applies the usual request of every connected
+        robot arms it."""
         self._poll_before_step()
+        board = self._board
+        if board is not None:
+            if self._board_holds(board) and board.apply(self._requests_lock):
+                return
+            self._end_board()
         self._update_limps()
         received: list[tuple[RobotSession, list[Request]]] = []
+        connections: list[Connection] = []
         for slot in self.slots.values():
             session = slot.session
             conn = slot.conn
             if conn is None:
                 continue
+            connections.append(conn)
             if conn.threaded:
                 if conn.error is not None:  # found by the I/O thread
                     self._drop(slot, conn.error)
@@ -529,7 +546,52 @@ class ApiServer:
             elif conn.requests:
                 received.append((session, conn.requests))
                 conn.requests = []
-        self._apply(received, step_time_ms)
+        usual = self._apply(received, step_time_ms)
+        if usual and len(usual) == len(connections) and self._limp_flags is not None:
+            self._arm_board(connections, [session for session, _ in received], usual)
+
+    def _board_holds(self, board: TargetBoard) -> bool:
+        """Nothing that ends the target board happened since it was armed: the same clients,
+        none failed, no robot made limp, released or removed (the requests it queued are
+        counted by :meth:`TargetBoard.apply`)."""
+        if board.connection_changes != self.connection_changes:
+            return False
+        if self._limp_flags != self._limp_seen:
+            return False
+        if self._removed_flags != board.removed:
+            return False
+        for conn in board.conns:
+            if conn.error is not None:
+                return False
+        return True
+
+    def _arm_board(
+        self,
+        connections: list[Connection],
+        sessions: list[RobotSession],
+        usual: list[tuple[TargetPlan, TargetValues]],
+    ) -> None:
+        """Arm the target board after a step that wrote every connected robot's usual
+        targets (with the I/O thread and the world's limp and removed flags)."""
+        if self._sender is None or self._batch is None or self._removed_flags is None:
+            return
+        board = TargetBoard(
+            [(conn, session, plan, values)
+             for conn, session, (plan, values) in zip(connections, sessions, usual, strict=True)],
+            self._batch,
+            connection_changes=self.connection_changes,
+            removed=list(self._removed_flags),
+        )  # fmt: skip
+        if board.attach(self._requests_lock):
+            self._board = board
+
+    def _end_board(self) -> None:
+        """End the target board, if armed: the robot-by-robot path goes on from what it
+        held (:meth:`TargetBoard.end`)."""
+        board = self._board
+        if board is not None:
+            self._board = None
+            board.end(self._requests_lock)
 
     def _update_limps(self) -> None:
         """Every session follows the world's limp flags (:meth:`RobotSession.update_limp`);
@@ -546,6 +608,7 @@ class ApiServer:
         """Pipelined stepping: read what is available and detach every client's received
         requests, to be applied later by :meth:`apply_taken` (the step after next)."""
         self._poll_before_step()
+        self._end_board()
         taken: dict[RobotId, list[Request]] = {}
         for robot, slot in self.slots.items():
             conn = slot.conn
@@ -561,6 +624,7 @@ class ApiServer:
     def apply_taken(self, taken: dict[RobotId, list[Request]], step_time_ms: int) -> None:
         """Pipelined stepping: apply requests detached by :meth:`take_requests` in arrival
         order (a robot's requests apply even when its client left since)."""
+        self._end_board()
         self._update_limps()
         slots = self.slots
         self._apply(
@@ -570,20 +634,24 @@ class ApiServer:
 
     def _apply(
         self, received: list[tuple[RobotSession, list[Request]]], step_time_ms: int
-    ) -> None:
+    ) -> list[tuple[TargetPlan, TargetValues]] | None:
         """Apply each robot's requests (after its :meth:`RobotSession.update_limp`): the usual
-        ones of every robot in one batched write, the others robot by robot."""
+        ones of every robot in one batched write, the others robot by robot. The batched
+        robots' plans and values when every robot's were usual, else None."""
         batch = self._batch
         targets: list[tuple[TargetPlan, TargetValues]] = []
+        every = True
         for session, requests in received:
             usual = session.take_targets(requests) if batch is not None else None
             if usual is not None:
                 targets.append(usual)
             else:
+                every = False
                 session.apply_all(requests, step_time_ms=step_time_ms)
         if targets:
             assert batch is not None
             batch.set_targets(targets)
+        return targets if every else None
 
     def hold_notice(self, time_ms: int, text: str) -> int:
         """While the lockstep loop holds at ``time_ms`` (the referee waits for wall-clock time):

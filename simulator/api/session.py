@@ -313,6 +313,11 @@ class RobotSession:
         self._held = (names, values)
         return plan, values
 
+    def hold_targets(self, names: tuple[str, ...], values: TargetValues) -> None:
+        """Targets of the held name list written for the robot by the server's target board
+        (:mod:`simulator.api.board`): held as :meth:`take_targets` holds them."""
+        self._held = (names, values)
+
     def _plan_targets(self, names: tuple[str, ...]) -> TargetPlan | None:
         if self._targets_plan is None or names not in self._valid_names:
             return None

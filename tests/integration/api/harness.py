@@ -46,6 +46,22 @@ def real_world(robots: Sequence[RobotId]) -> Any:
     return World.create(field_class="kid", robots=placements, seed=11)
 
 
+def local_server(
+    world: Any, robots: Sequence[RobotId], **options: Any
+) -> tuple[ApiServer, list[int]]:
+    """A server (not started) of ``robots`` in ``world`` on free ports of 127.0.0.1, in async
+    stepping unless ``options`` say otherwise; and its ports, in the order of ``robots``."""
+    ports = free_ports(len(robots))
+    server = ApiServer(
+        world=world,
+        endpoints=[PlayerEndpoint(robot=r, port=p, hosts=("127.0.0.1",), team_size=4)
+                   for r, p in zip(robots, ports, strict=True)],  # fmt: skip
+        network=NetworkSpec(api_bind_host="127.0.0.1"),
+        **options,
+    )
+    return server, ports
+
+
 def wait_until(predicate: Callable[[], Any], timeout_s: float = 10.0) -> Any:
     deadline = time.monotonic() + timeout_s
     while time.monotonic() < deadline:

@@ -18,7 +18,7 @@ from simulator.api import ApiServer, PlayerEndpoint
 from simulator.api.endpoints import free_ports
 from simulator.api.framing import HEADER, WELCOME
 from simulator.api.server import ApiServer as ServerClass
-from tests.integration.api.harness import real_world, wait_until
+from tests.integration.api.harness import local_server, real_world, wait_until
 
 ROBOTS = (RobotId(TeamColor.RED, 1), RobotId(TeamColor.RED, 2), RobotId(TeamColor.BLUE, 1))
 JOINTS = ("NeckS", "HeadS", "AnkleLS", "AnkleRS", "LegUpperLS")
@@ -58,6 +58,16 @@ def _connected(server: ApiServer, robot: RobotId, connected: bool = True) -> boo
     return (server.connection(robot) is not None) is connected
 
 
+def _send_read(server: ApiServer, robot: RobotId, sock: socket.socket, frame: bytes) -> None:
+    """Send one request and wait until the server has read it (queued, or posted on the
+    target board: :mod:`simulator.api.board`)."""
+    conn = server.connection(robot)
+    assert conn is not None
+    read = conn.stats.messages_in
+    sock.sendall(frame)
+    wait_until(lambda: conn.stats.messages_in > read)
+
+
 class _Client:
     def __init__(self, port: int) -> None:
         self.sock = socket.create_connection(("127.0.0.1", port), timeout=5.0)
@@ -79,14 +89,8 @@ def _play(steady: bool) -> tuple[dict[RobotId, list[bytes]], int]:
     """The scenario, in async stepping with the I/O thread; the frames each client received
     and the number of steps built robot by robot."""
     world = real_world(ROBOTS)
-    ports = free_ports(len(ROBOTS))
-    server = ApiServer(
-        world=world,
-        endpoints=[PlayerEndpoint(robot=r, port=p, hosts=("127.0.0.1",), team_size=4)
-                   for r, p in zip(ROBOTS, ports, strict=True)],  # fmt: skip
-        network=NetworkSpec(api_bind_host="127.0.0.1"),
-        unix_ms=lambda: 1_700_000_000_000,  # one real time: both runs give the same bytes
-    )
+    # one real time: both runs give the same bytes
+    server, ports = local_server(world, ROBOTS, unix_ms=lambda: 1_700_000_000_000)
     built_each = 0
     each = ServerClass._prepare_each
 
@@ -108,9 +112,7 @@ def _play(steady: bool) -> tuple[dict[RobotId, list[bytes]], int]:
             clients[robot].welcome()
 
         def send(robot: RobotId, frame: bytes) -> None:
-            clients[robot].sock.sendall(frame)
-            conn = server.connection(robot)
-            wait_until(lambda: conn is not None and conn.requests)
+            _send_read(server, robot, clients[robot].sock, frame)
 
         red1, red2, blue1 = ROBOTS
         actions: dict[int, Callable[[], None]] = {
@@ -184,8 +186,7 @@ def test_a_real_worlds_limp_flags_hold_and_release_the_targets() -> None:
         if position is not None:
             request = pb.ActuatorRequests()
             request.motor_positions.add(name="Neck", position=position)
-            client.sock.sendall(_frame(request))
-            wait_until(lambda: (conn := server.connection(robot)) is not None and conn.requests)
+            _send_read(server, robot, client.sock, _frame(request))
         server.apply_requests(world.sim_time_ms + world.step_ms)
         world.step()
         server.publish(world.sim_time_ms)
