@@ -216,6 +216,7 @@ class ApiServer:
         self._hold_told: set[tuple[int, int]] = set()  # (connection id, held sim time) told
         # the steady form of the last step built robot by robot (None: not every robot steady)
         self._steady_step: _SteadyStep | None = None
+        self._steady_encoding: tuple[_SteadyStep, Encoding] | None = None  # its last encoding
         # the world's removed flags (changed in place), when it has them: a removed robot's
         # measurement is not its steady one
         flags = getattr(world, "robot_flags", None)
@@ -690,7 +691,12 @@ class ApiServer:
         if steady is not None and self._still_steady(steady, time_ms):
             assert self._batch is not None  # (a steady step is only recorded with the batch)
             head = header_bytes(time_ms, real_time)
-            encoding = self._batch.encoding(steady.plans, len(head))
+            known = self._steady_encoding  # (no lookup by the tuple of plans each step)
+            if known is not None and known[0] is steady and known[1].head_size == len(head):
+                encoding = known[1]
+            else:
+                encoding = self._batch.encoding(steady.plans, len(head))
+                self._steady_encoding = (steady, encoding)
             values = _SteadyValues(steady, encoding, encoding.gather(), time_ms, real_time, head)
             return Prepared([], steady=values)
         items, gathered = self._prepare_each(time_ms, real_time)
