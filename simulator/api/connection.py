@@ -7,7 +7,8 @@ import socket
 import threading
 import time
 from collections import deque
-from typing import TYPE_CHECKING
+from collections.abc import Sequence
+from typing import Protocol
 
 from google.protobuf.message import DecodeError
 
@@ -17,12 +18,20 @@ from simulator.api.fastreq import PositionTargets, PositionTemplate, scan_positi
 from simulator.api.framing import FrameDecoder, FramingError
 from simulator.api.stats import RobotStats
 
-if TYPE_CHECKING:
-    from simulator.api.board import BoardSlot
-
 log = logging.getLogger(__name__)
 
 RECV_CHUNK = 1 << 16
+
+
+class BoardPost(Protocol):
+    """Where a connection's decoded requests go while the server's target board is armed
+    (:class:`simulator.api.board.BoardSlot`)."""
+
+    def post(
+        self,
+        decoded: Sequence[pb.ActuatorRequests | PositionTargets],
+        queue: list[pb.ActuatorRequests | PositionTargets],
+    ) -> None: ...
 
 
 class ClientClosed(Exception):
@@ -76,7 +85,7 @@ class Connection:
         self.requests: list[pb.ActuatorRequests | PositionTargets] = []
         # where the usual requests go instead of ``requests`` while the server's target board
         # is armed (:mod:`simulator.api.board`); set and cleared by the step thread
-        self.board: BoardSlot | None = None
+        self.board: BoardPost | None = None
         self._template: PositionTemplate | None = None
         self.outbox: deque[bytes] = deque()
         self._partial: memoryview | None = None
