@@ -142,7 +142,7 @@ class Gathered:
     """One step's sensor values read from the world, not yet written as wire bytes:
     :meth:`write` (on any thread: the world is not read again) fills the measurements."""
 
-    __slots__ = ("_encoding", "_values", "_head", "_measurements")
+    __slots__ = ("encoding", "_values", "_head", "_measurements")
 
     def __init__(
         self,
@@ -151,13 +151,13 @@ class Gathered:
         head: bytes,
         measurements: list[Measurement],
     ) -> None:
-        self._encoding = encoding
+        self.encoding = encoding
         self._values = values
         self._head = head
         self._measurements = measurements
 
     def write(self) -> None:
-        self._encoding.write(self._values, self._head, self._measurements)
+        self.encoding.write(self._values, self._head, self._measurements)
 
 
 def _cached(cache: dict[K, V], key: K, build: Callable[[], V]) -> V:

@@ -64,9 +64,12 @@ log = logging.getLogger(__name__)
 Request = pb.ActuatorRequests | PositionTargets
 
 # With the I/O thread the step thread's own selector only accepts connections (and takes camera
-# images): before a step it is polled every POLL_EVERY_STEPS steps, and every step while a
-# measurement waits for an image or a name lookup runs (a syscall less on most steps).
-POLL_EVERY_STEPS = 4
+# images): before a step it is polled when POLL_INTERVAL_S of wall time has passed since the last
+# poll, and every step while a measurement waits for an image or a name lookup runs. A world that
+# steps faster than real time makes no syscall on most steps (a select between two physics steps
+# costs the step thread the select and the memory it touches); a client is still welcomed within
+# that interval.
+POLL_INTERVAL_S = 0.01
 
 
 class IoThreadFailed(ApiError):
@@ -112,24 +115,38 @@ class _SteadyStep:
     plans: tuple[DuePlan, ...]
     period: int
     phase: int  # due when the step's time modulo ``period`` is ``phase``
+    # the encoding of ``plans`` the step was recorded with: its gather reads every step's
+    # values; a head of another size (a time with more varint bytes) takes another encoding
+    encoding: Encoding
+
+    def encoding_for(self, batch: StepBatch, head: bytes) -> Encoding:
+        """The encoding of ``plans`` with room for ``head``."""
+        if self.encoding.head_size == len(head):
+            return self.encoding
+        return batch.encoding(self.plans, len(head))
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class _SteadyValues:
-    """One step's sensor values gathered by a :class:`_SteadyStep`, not yet wire bytes."""
+    """One step's sensor values gathered by a :class:`_SteadyStep`, not yet wire bytes (the
+    head of the step's time is written with them, on the I/O thread)."""
 
     step: _SteadyStep
-    encoding: Encoding
     values: npt.NDArray[np.float64]
     time_ms: int
     real_time: int
-    head: bytes
 
-    def measurements(self) -> list[tuple[RobotSlot, Measurement]]:
+    def frames(self, batch: StepBatch) -> list[bytes]:
+        """Every robot's framed plain measurement of the step."""
+        head = header_bytes(self.time_ms, self.real_time)
+        return self.step.encoding_for(batch, head).frames(self.values, head)
+
+    def measurements(self, batch: StepBatch) -> list[tuple[RobotSlot, Measurement]]:
         """The step's measurements robot by robot, written (as :meth:`ApiServer.prepare`
         makes them without the steady form)."""
         measurements = [Measurement(self.time_ms, self.real_time) for _ in self.step.slots]
-        self.encoding.write(self.values, self.head, measurements)
+        head = header_bytes(self.time_ms, self.real_time)
+        self.step.encoding_for(batch, head).write(self.values, head, measurements)
         return list(zip(self.step.slots, measurements, strict=True))
 
 
@@ -207,7 +224,7 @@ class ApiServer:
         self.awaiting_answers = False
         self._wake: tuple[int, int] | None = None
         self._wake_sent = False
-        self._step_polls = 0
+        self._next_poll = 0.0  # with the I/O thread: when the step thread polls its selector next
         self.connection_changes = 0  # clients welcomed or dropped so far
         # with the I/O thread: this step's measurements to frame and queue there, in order
         self._outgoing: list[tuple[RobotSlot, Connection, Measurement]] = []
@@ -216,7 +233,6 @@ class ApiServer:
         self._hold_told: set[tuple[int, int]] = set()  # (connection id, held sim time) told
         # the steady form of the last step built robot by robot (None: not every robot steady)
         self._steady_step: _SteadyStep | None = None
-        self._steady_encoding: tuple[_SteadyStep, Encoding] | None = None  # its last encoding
         # the world's removed flags (changed in place), when it has them: a removed robot's
         # measurement is not its steady one
         flags = getattr(world, "robot_flags", None)
@@ -509,13 +525,14 @@ class ApiServer:
 
     def _poll_before_step(self) -> None:
         if self._sender is not None:
-            self._step_polls += 1
-            if self._step_polls % POLL_EVERY_STEPS and (
+            now = time.monotonic()
+            if now < self._next_poll and (
                 # measurements wait for images only with cameras, names only with lookups
                 (self._cameras is None and self._lookups is None)
                 or not any(slot.pending or slot.checking for slot in self.slots.values())
             ):
                 return
+            self._next_poll = now + POLL_INTERVAL_S
         self.poll(0.0)
 
     def apply_requests(self, step_time_ms: int) -> None:
@@ -685,20 +702,13 @@ class ApiServer:
         read but not queued: :meth:`publish_prepared` queues them. Pipelined stepping builds
         them before it waits for the answers to the previous ones. Without the I/O thread they
         are encoded here; with it the wire bytes are written there (``unwritten``, or
-        ``steady`` when every robot is steady: see :class:`_SteadyStep`)."""
+        ``steady`` when every robot is steady: see :class:`_SteadyStep`; then the step thread
+        only reads the values)."""
         real_time = self._unix_ms()  # one instant for the whole step
         steady = self._steady_step
         if steady is not None and self._still_steady(steady, time_ms):
-            assert self._batch is not None  # (a steady step is only recorded with the batch)
-            head = header_bytes(time_ms, real_time)
-            known = self._steady_encoding  # (no lookup by the tuple of plans each step)
-            if known is not None and known[0] is steady and known[1].head_size == len(head):
-                encoding = known[1]
-            else:
-                encoding = self._batch.encoding(steady.plans, len(head))
-                self._steady_encoding = (steady, encoding)
-            values = _SteadyValues(steady, encoding, encoding.gather(), time_ms, real_time, head)
-            return Prepared([], steady=values)
+            values = steady.encoding.gather()
+            return Prepared([], steady=_SteadyValues(steady, values, time_ms, real_time))
         items, gathered = self._prepare_each(time_ms, real_time)
         if gathered is not None and self._sender is None:
             gathered.write()
@@ -724,20 +734,24 @@ class ApiServer:
                 batched.append((measurement, plan))
             else:
                 measurement.sensors = session.encode(plan)
-        self._steady_step = self._steady_form(prepared, batched)
         if not batched:
+            self._steady_step = None
             return prepared, None
         assert self._batch is not None
-        return prepared, self._batch.gather(batched, header_bytes(time_ms, real_time))
+        gathered = self._batch.gather(batched, header_bytes(time_ms, real_time))
+        self._steady_step = self._steady_form(prepared, batched, gathered.encoding)
+        return prepared, gathered
 
     def _steady_form(
         self,
         prepared: list[tuple[RobotSlot, Measurement]],
         batched: list[tuple[Measurement, DuePlan]],
+        encoding: Encoding,
     ) -> _SteadyStep | None:
-        """The :class:`_SteadyStep` of a step built robot by robot, or None when some robot
-        was not steady, due at other steps than the others or still owed a camera image."""
-        if self._removed_flags is None or not batched or len(batched) != len(prepared):
+        """The :class:`_SteadyStep` of a step built robot by robot (``batched``, gathered
+        with ``encoding``), or None when some robot was not steady, due at other steps than the
+        others or still owed a camera image."""
+        if self._removed_flags is None or len(batched) != len(prepared):
             return None
         first = prepared[0][0].session.steady
         if first is None:
@@ -759,6 +773,7 @@ class ApiServer:
             plans=tuple([plan for _, plan in batched]),
             period=period,
             phase=phase,
+            encoding=encoding,
         )
 
     def _still_steady(self, steady: _SteadyStep, time_ms: int) -> bool:
@@ -781,8 +796,9 @@ class ApiServer:
             ):
                 self._publish_steady(steady)
                 return
-            prepared = Prepared(steady.measurements())  # without the I/O thread, or a client
-            # left since: robot by robot
+            # without the I/O thread, or a client left since: robot by robot
+            assert self._batch is not None  # (a steady step is only recorded with the batch)
+            prepared = Prepared(steady.measurements(self._batch))
         jobs_all = []
         now = time.monotonic()
         unwritten = prepared.unwritten
@@ -906,8 +922,9 @@ class ApiServer:
     def _deliver_steady(self, steady: _SteadyValues, now: float) -> list[Connection]:
         """I/O thread: :meth:`_deliver` of a steady step: the wire bytes of every robot's plain
         measurement written at once, each counted in its robot's quota and queued."""
+        assert self._batch is not None
         step = steady.step
-        frames = steady.encoding.frames(steady.values, steady.head)
+        frames = steady.frames(self._batch)
         queued = []
         for slot, conn, frame in zip(step.slots, step.conns, frames, strict=True):
             if conn.closed or conn.error is not None:

@@ -11,6 +11,8 @@ from collections.abc import Callable
 from functools import partial
 from typing import Any
 
+import pytest
+
 from contracts.ids import RobotId, TeamColor
 from contracts.match_spec import NetworkSpec
 from contracts.robot_api import messages_pb2 as pb
@@ -85,12 +87,14 @@ class _Client:
             pass
 
 
-def _play(steady: bool) -> tuple[dict[RobotId, list[bytes]], int]:
+def _play(steady: bool, real_time_at: int = 1_700_000_000_000) -> tuple[
+    dict[RobotId, list[bytes]], int
+]:
     """The scenario, in async stepping with the I/O thread; the frames each client received
-    and the number of steps built robot by robot."""
+    and the number of steps built robot by robot. The real time is ``real_time_at`` plus the
+    world's time (both runs give the same bytes)."""
     world = real_world(ROBOTS)
-    # one real time: both runs give the same bytes
-    server, ports = local_server(world, ROBOTS, unix_ms=lambda: 1_700_000_000_000)
+    server, ports = local_server(world, ROBOTS, unix_ms=lambda: real_time_at + world.sim_time_ms)
     built_each = 0
     each = ServerClass._prepare_each
 
@@ -146,9 +150,19 @@ def _play(steady: bool) -> tuple[dict[RobotId, list[bytes]], int]:
         server.close()
 
 
-def test_steady_steps_give_the_robot_by_robot_bytes() -> None:
-    steady, built_steady = _play(steady=True)
-    each, built_each = _play(steady=False)
+@pytest.mark.parametrize(
+    "real_time_at",
+    [
+        1_700_000_000_000,
+        # the real time needs a seventh varint byte from step 41 on (sim time 336 ms), in a
+        # steady stretch: the measurement's head grows by a byte while the robots stay steady
+        2**42 - 330,
+    ],
+    ids=["same-head", "head-grows"],
+)
+def test_steady_steps_give_the_robot_by_robot_bytes(real_time_at: int) -> None:
+    steady, built_steady = _play(steady=True, real_time_at=real_time_at)
+    each, built_each = _play(steady=False, real_time_at=real_time_at)
     assert built_each == 60  # the reference: every step robot by robot
     assert 60 - built_steady >= 20  # steady steps in every quiet stretch
     assert steady.keys() == each.keys() and len(steady) == 2  # blue 1 left
@@ -158,6 +172,7 @@ def test_steady_steps_give_the_robot_by_robot_bytes() -> None:
     red1, red2 = steady[ROBOTS[0]], steady[ROBOTS[1]]
     parsed = [pb.SensorMeasurements.FromString(f) for f in red2]
     assert [m.time for m in parsed] == [8 * (k + 1) for k in range(60)]
+    assert [m.real_time for m in parsed] == [real_time_at + 8 * (k + 1) for k in range(60)]
     assert sum(1 for m in parsed if m.messages) == 1  # the warning, once
     assert len(parsed[-1].position_sensors) == 2
     removed = [pb.SensorMeasurements.FromString(f) for f in red1[30:34]]
