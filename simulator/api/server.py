@@ -225,6 +225,9 @@ class ApiServer:
         self._wake: tuple[int, int] | None = None
         self._wake_sent = False
         self._next_poll = 0.0  # with the I/O thread: when the step thread polls its selector next
+        # set when a measurement starts waiting for images or a client for its name lookup (the
+        # step thread polls every step until none waits: :meth:`_waiting`)
+        self._maybe_waiting = False
         self.connection_changes = 0  # clients welcomed or dropped so far
         # with the I/O thread: this step's measurements to frame and queue there, in order
         self._outgoing: list[tuple[RobotSlot, Connection, Measurement]] = []
@@ -419,6 +422,7 @@ class ApiServer:
             names = sorted(slot.endpoint.allowed_names)
             future = self._lookups.submit(peer_allowed_by_name, ip, names)
             slot.checking = (sock, peer, future)
+            self._maybe_waiting = True
 
     def _finish_lookups(self) -> None:
         for slot in self.slots.values():
@@ -526,14 +530,18 @@ class ApiServer:
     def _poll_before_step(self) -> None:
         if self._sender is not None:
             now = time.monotonic()
-            if now < self._next_poll and (
-                # measurements wait for images only with cameras, names only with lookups
-                (self._cameras is None and self._lookups is None)
-                or not any(slot.pending or slot.checking for slot in self.slots.values())
-            ):
+            if now < self._next_poll and not (self._maybe_waiting and self._waiting()):
                 return
             self._next_poll = now + POLL_INTERVAL_S
         self.poll(0.0)
+
+    def _waiting(self) -> bool:
+        """Some measurement waits for a camera image, or some client for its name lookup (then
+        the step thread polls every step); clears ``_maybe_waiting`` when none does."""
+        if any(slot.pending or slot.checking for slot in self.slots.values()):
+            return True
+        self._maybe_waiting = False
+        return False
 
     def apply_requests(self, step_time_ms: int) -> None:
         """Read what is available, then apply every received request in arrival order.
@@ -815,6 +823,7 @@ class ApiServer:
                 if jobs:
                     jobs_all.extend(jobs)
                 slot.pending.append(_Pending(measurement, len(jobs)))
+                self._maybe_waiting = True
             else:
                 self._send(slot, conn, measurement, now)
         self._unwritten = unwritten
