@@ -197,15 +197,8 @@ class StepBatch:
     def gather(self, items: Sequence[tuple[Measurement, DuePlan]], head: bytes) -> Gathered:
         """:meth:`encode` in two parts: the values are read from the world now, the bytes
         are written by the result's :meth:`Gathered.write`."""
-        plans = tuple([plan for _, plan in items])
-        return self.gather_plans(plans, [m for m, _ in items], head)
-
-    def gather_plans(
-        self, plans: tuple[DuePlan, ...], measurements: list[Measurement], head: bytes
-    ) -> Gathered:
-        """:meth:`gather` of ``measurements`` and their ``plans`` (in the same order)."""
-        encoding = self.encoding(plans, len(head))
-        return Gathered(encoding, encoding.gather(), head, measurements)
+        encoding = self.encoding(tuple([plan for _, plan in items]), len(head))
+        return Gathered(encoding, encoding.gather(), head, [m for m, _ in items])
 
     def encoding(self, plans: tuple[DuePlan, ...], head_size: int) -> Encoding:
         """The concatenated ``plans`` with room for a head of ``head_size`` bytes (cached)."""

@@ -147,13 +147,14 @@ class TargetBoard:
             if True not in fresh:
                 return True
             self.fresh = [False] * len(fresh)
-            if False not in fresh:  # every robot: one write of the whole board
+            whole = False not in fresh  # every robot posted: one write of the whole board
+            if whole:
                 self.applied = values = self.values.copy()
             else:
                 posted = [slot for slot, new in zip(self.slots, fresh, strict=True) if new]
                 for slot in posted:
                     self.applied[slot.start : slot.end] = self.values[slot.start : slot.end]
-        if False not in fresh:
+        if whole:
             self._write_all(values, finite=True)
         else:
             applied = self.applied
