@@ -19,6 +19,12 @@ class Target:
             return False
         return self.maximum is None or value <= self.maximum
 
+    def scaled(self, factor: float) -> Target:
+        """The same target with its bound multiplied by ``factor`` (three decimals)."""
+        minimum = None if self.minimum is None else round(self.minimum * factor, 3)
+        maximum = None if self.maximum is None else round(self.maximum * factor, 3)
+        return Target(self.figure, minimum, maximum)
+
     def to_dict(self) -> dict[str, str | float | None]:
         """``{"figure": name, "min" or "max": bound}``."""
         bound = {"min": self.minimum} if self.minimum is not None else {"max": self.maximum}

@@ -6,6 +6,7 @@ import json
 import subprocess
 import sys
 
+from benchmarks.report import machine_target
 from testkit.figures import Target
 from testkit.figures import median_figures as _median
 
@@ -30,7 +31,10 @@ def test_report_runs_the_kinds_and_judges_medians_against_targets() -> None:
     assert sim["target"] == {"figure": "ratio", "min": 0.95}
     assert sim["meets_target"] == (sim["median"]["ratio"] >= 0.95)
     ratio = pipelined["median"]["ratio_interleaved"]
-    assert ratio > 0 and pipelined["meets_target"] == (ratio >= 0.9)
+    assert ratio > 0 and pipelined["meets_target"] == (ratio >= 0.92)
+    bare = sim["median"]["bare_real_time_factor"]
+    assert report["bare_real_time_factor"] == bare > 0
+    assert report["reference_bare_real_time_factor"] == 12.0
     assert 0 <= pipelined["median"]["client_wait_share"] < 1
 
 
@@ -47,3 +51,21 @@ def test_median_skips_failed_runs_and_targets_have_a_bound() -> None:
     assert _median(runs) == {"ratio": 0.9}
     assert Target("bringup_s", maximum=5.0).met(4.9) and not Target("s", maximum=5.0).met(5.1)
     assert not Target("ratio", minimum=0.9).met(0.89)
+
+
+def test_targets_are_the_performance_goals_and_scale_with_the_machine() -> None:
+    """The report's targets are the goals (lockstep 0.85, async and pipelined 0.92, sim 0.95,
+    cameras 1.0 x real time and bring-up 3 s on a machine whose bare loop runs 12x real time),
+    so that a run that misses a goal cannot print ``meets_target: true``."""
+    assert machine_target("lockstep", 6.0) == Target("ratio_interleaved", minimum=0.85)
+    assert machine_target("async", None) == Target("ratio_interleaved", minimum=0.92)
+    assert machine_target("pipelined", 30.0) == Target("ratio_interleaved", minimum=0.92)
+    assert machine_target("sim", 6.0) == Target("ratio", minimum=0.95)
+    assert not machine_target("lockstep", 12.0).met(0.749)  # type: ignore[union-attr]
+    # cameras: the minimum moves with the machine's speed, the bring-up's maximum against it
+    assert machine_target("cameras", 12.0) == Target("real_time_factor", minimum=1.0)
+    assert machine_target("cameras", 6.0) == Target("real_time_factor", minimum=0.5)
+    assert machine_target("cameras", None) == Target("real_time_factor", minimum=1.0)
+    assert machine_target("bringup", 12.0) == Target("bringup_s", maximum=3.0)
+    assert machine_target("bringup", 4.0) == Target("bringup_s", maximum=9.0)
+    assert not machine_target("bringup", 12.0).met(3.35)  # type: ignore[union-attr]
