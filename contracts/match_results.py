@@ -179,8 +179,11 @@ class MatchResults(Versioned):
     warnings: tuple[str, ...] = ()
     forfeit: Forfeit | None = None
     final_state: str | None = None  # the simulator's GameController state at its end
-    score: dict[str, int] | None = None
+    score: dict[str, int] | None = None  # the match's goals (halves and extra time)
     winner: str | None = None  # "red" | "blue" | "draw"
+    # goals of each colour in the penalty shoot-out (the GameController counts them in its
+    # score; here they are kept apart from the match's): present only after a shoot-out
+    shootout: dict[str, int] | None = field(default=None, metadata=omitted_when_none())
     events_summary: dict[str, int] = field(default_factory=dict)
     play: PlayRecord | None = None  # how much football was played, None when not counted
     sim_time_ms: int | None = None

@@ -183,7 +183,8 @@ def _die_with_parent() -> None:  # pragma: no cover - runs in the child before e
 
 
 def read_outcome(out_dir: Path) -> PlayOutcome:
-    """The outcome of a finished ``hlvs match`` from its report.json and results.json."""
+    """The outcome of a finished ``hlvs match`` from its report.json and results.json: the
+    match's goals, and those of its penalty shoot-out apart (``0-0 (shoot-out 3-2)``)."""
     report_path, results_path = out_dir / files.REPORT, out_dir / files.RESULTS
     if not report_path.is_file():
         return PlayOutcome(
@@ -199,13 +200,21 @@ def read_outcome(out_dir: Path) -> PlayOutcome:
     except ContractError as exc:
         return PlayOutcome(status="infrastructure", score_red=None, score_blue=None,
                            winner=None, cause=str(exc))
+    score_red = results.team_score("red") if results is not None else None
+    score_blue = results.team_score("blue") if results is not None else None
+    shootout = results.shootout if results is not None else None
+    if shootout is None:  # a results.json without the shoot-out kept apart: its score has them
+        shootout = shootout_goals(out_dir / "public" / files.SIM_RESULT)
+        if shootout is not None and score_red is not None and score_blue is not None:
+            score_red -= shootout.get("red", 0)
+            score_blue -= shootout.get("blue", 0)
     return PlayOutcome(
         status=report.status,
-        score_red=results.team_score("red") if results is not None else None,
-        score_blue=results.team_score("blue") if results is not None else None,
+        score_red=score_red,
+        score_blue=score_blue,
         winner=results.winner if results is not None else None,
         cause=report.cause or "",
-        shootout=shootout_goals(out_dir / "public" / files.SIM_RESULT),
+        shootout=shootout,
     )
 
 

@@ -95,8 +95,11 @@ def build_results(
     api_stats: dict[str, RobotApiStats] = sim.robots if sim is not None else {}
     score = sim.score if sim is not None else None
     winner: str | None = sim.winner if sim is not None else None
+    shootout = shootout_goals(sim)
+    if score is not None and shootout is not None:  # the GameController's score counts them
+        score = {color: goals - shootout.get(color, 0) for color, goals in score.items()}
     if forfeit is not None:
-        score, winner = forfeit.score, forfeit.winner
+        score, winner, shootout = forfeit.score, forfeit.winner, None
     spoofing = sim.spoofing if sim is not None else None
     spoofed = spoofing.per_sender() if spoofing is not None else {}
     return MatchResults(
@@ -109,6 +112,7 @@ def build_results(
         final_state=sim.state if sim is not None else None,
         score=score,
         winner=winner,
+        shootout=shootout,
         events_summary=sim.events_summary if sim is not None else {},
         play=sim.play if sim is not None else None,
         sim_time_ms=sim.sim_time_ms if sim is not None else None,
@@ -122,6 +126,13 @@ def build_results(
         bringup_s=bringup_s,
         admission=admission,
     )
+
+
+def shootout_goals(sim: SimResult | None) -> dict[str, int] | None:
+    """Goals of each colour in the referee's penalty shoot-out (None when there was none)."""
+    if sim is None or sim.shootout is None:
+        return None
+    return {color: int(kicks.get("scored", 0)) for color, kicks in sim.shootout.items()}
 
 
 def play_failure(sim: SimResult | None, robots: list[RobotRecord],

@@ -48,3 +48,22 @@ def test_a_forfeit_sets_score_and_winner_without_a_simulator() -> None:
     assert (results.score, results.winner, results.final_state) == (forfeit.score, "red", None)
     assert results.versions == {"hlvs-runner": "1", "simulator": None}
     assert results.robots["blue-1"].image_error == "image b not found"
+
+
+def test_the_shootout_goals_are_kept_apart_from_the_match_goals() -> None:
+    """The GameController's score counts the shoot-out's goals (a 0-0 decided 3-2 on
+    penalties ends 3-2); results.json keeps the match's 0-0 and the shoot-out's 3-2 apart."""
+    sim = SimResult(match_id="m", seed=1, state="FINISHED", score={"red": 4, "blue": 3},
+                    winner="red", shootout={"red": {"kicks": 5, "scored": 3},
+                                            "blue": {"kicks": 5, "scored": 2}}, coin_toss=False)
+    results = build_results(match_id="m", seed=1, sim_result=sim, robots=[], forfeit=None,
+                            limits=LIMITS, versions={}, timings_s={}, failure=None)
+    assert (results.score, results.shootout, results.winner) == (
+        {"red": 1, "blue": 1}, {"red": 3, "blue": 2}, "red")
+    data = json.loads(results.to_json())
+    assert data["score"] == {"red": 1, "blue": 1} and data["shootout"] == {"red": 3, "blue": 2}
+    assert MatchResults.from_json(results.to_json()) == results
+    plain = build_results(match_id="m", seed=1, sim_result=SimResult(
+        match_id="m", seed=1, state="FINISHED", score={"red": 2, "blue": 0}, winner="red"),
+        robots=[], forfeit=None, limits=LIMITS, versions={}, timings_s={}, failure=None)
+    assert plain.shootout is None and "shootout" not in json.loads(plain.to_json())

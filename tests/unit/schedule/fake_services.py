@@ -88,3 +88,38 @@ class FakeServices:
             return TeamLogs(team=team, state="failed", target="sftp://127.0.0.1:9",
                             cause="unreachable: connection refused")
         return TeamLogs(team=team, state="delivered", target="s3://logs")
+
+
+class MatchFolderServices(FakeServices):
+    """Plays as ``hlvs match`` leaves a match: report.json, results.json (built by the
+    orchestrator's own :func:`orchestrator.match.results.build_results`) and the public
+    sim_result.json, read back by :func:`tournament.services.read_outcome`. A match in
+    ``DRAWN`` ends 0-0 after extra time and the referee's shoot-out 3-2 (the GameController's
+    score, 3-2, counts the shoot-out's goals)."""
+
+    def play(self, ctx: MatchContext) -> PlayOutcome:
+        from contracts import MatchReport, files
+        from contracts.sim_result import SimResult
+        from orchestrator.match.results import build_results
+        from tests.unit.match.test_match_results_build import LIMITS
+        from tournament.services import read_outcome
+
+        _log(self.schedule, "play-start", ctx.match_id)
+        out = ctx.out_dir / "match"
+        (out / "public").mkdir(parents=True, exist_ok=True)
+        if ctx.match_id in DRAWN:
+            sim = SimResult(match_id=ctx.match_id, seed=1, state="FINISHED",
+                            score={"red": 3, "blue": 2}, winner="red",
+                            shootout={"red": {"kicks": 5, "scored": 3},
+                                      "blue": {"kicks": 5, "scored": 2}}, coin_toss=False)
+        else:
+            red, blue = goals(ctx.red.name), goals(ctx.blue.name) + 4
+            sim = SimResult(match_id=ctx.match_id, seed=1, state="FINISHED",
+                            score={"red": red, "blue": blue}, winner="blue")
+        sim.write(out / "public" / files.SIM_RESULT)
+        build_results(match_id=ctx.match_id, seed=1, sim_result=sim, robots=[], forfeit=None,
+                      limits=LIMITS, versions={}, timings_s={}, failure=None,
+                      ).write(out / files.RESULTS)
+        MatchReport.of(None).write(out / files.REPORT)
+        _log(self.schedule, "play-end", ctx.match_id)
+        return read_outcome(out)

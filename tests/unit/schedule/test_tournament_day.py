@@ -208,3 +208,56 @@ def test_the_referees_shootout_is_read_from_the_public_sim_result(tmp_path: Path
     path.write_text(json.dumps({"shootout": {"red": {"kicks": 5, "scored": 4},
                                              "blue": {"kicks": 5, "scored": 3}}}))
     assert shootout_goals(path) == {"red": 4, "blue": 3}
+
+
+def test_a_knockout_decided_on_penalties_keeps_the_match_goals_apart(
+    tmp_path: Path, fake: None
+) -> None:
+    """The referee's shoot-out (a KNOCKOUT game drawn after extra time): the GameController's
+    score counts the kicks, the tournament shows the match's goals and the shoot-out's apart."""
+    from tournament.overview import tournament_overview
+
+    fake_services.DRAWN.add("ko-r1-1")
+    path = write_schedule(
+        tmp_path,
+        COMPRESSED + "fixtures:\n  knockout: {seeds: [alpha, bravo], first_stream: '+4s',"
+        " stream_length_s: 0.3}\n",
+    )
+    state = tmp_path / "state.sqlite"
+    services = "tests.unit.schedule.fake_services:MatchFolderServices"
+    assert run_schedule(path, state, services=services, exit_when_done=True, poll_s=0.1) == 0
+    results = json.loads((tmp_path / "out" / "ko-r1-1" / "match" / "results.json").read_text())
+    assert results["score"] == {"red": 0, "blue": 0}
+    assert results["shootout"] == {"red": 3, "blue": 2} and results["winner"] == "red"
+    row = Ledger(state).row("ko-r1-1")
+    assert row.result is not None and row.result["score"] == {"red": 0, "blue": 0}
+    assert row.result["winner_team"] == "alpha"
+    assert "ko-r1-1" in "".join(status_lines(Ledger(state)))
+    assert "0-0 (shoot-out 3-2)" in "\n".join(status_lines(Ledger(state)))
+    page = tournament_overview(Ledger(state))
+    assert [m["score_text"] for m in page["matches"]] == ["0-0 (shoot-out 3-2)"]
+    assert page["bracket"] == [["ko-r1-1"]]
+    assert [w for w, m, _ in services_log(path) if m == "ko-r1-1"].count("shootout") == 0
+
+
+def test_a_results_file_written_before_the_shootout_was_kept_apart_reads_right(
+    tmp_path: Path,
+) -> None:
+    """A match folder of an earlier version: results.json's score counts the shoot-out's
+    goals and has no ``shootout``; the public sim_result.json says how many they were."""
+    from contracts import MatchReport
+    from tournament.services import read_outcome
+
+    (tmp_path / "public").mkdir()
+    (tmp_path / "public" / "sim_result.json").write_text(json.dumps(
+        {"shootout": {"red": {"kicks": 5, "scored": 2}, "blue": {"kicks": 5, "scored": 4}}}))
+    results = {"version": 1, "match_id": "m", "status": "success", "failure": None, "seed": 1,
+               "score": {"red": 3, "blue": 5}, "winner": "blue",
+               "limits": {"cpus": 1.0, "memory_gb": 1.0, "pids": 1, "log_folder_gb": 1.0,
+                          "team_api_mb_s": 1.0, "team_comm_mb_s": 1.0, "grace_period_s": 1.0,
+                          "allow_internet": False, "host_controls": None}}
+    (tmp_path / "results.json").write_text(json.dumps(results))
+    MatchReport.of(None).write(tmp_path / "report.json")
+    outcome = read_outcome(tmp_path)
+    assert (outcome.score_red, outcome.score_blue, outcome.shootout, outcome.winner) == (
+        1, 1, {"red": 2, "blue": 4}, "blue")
