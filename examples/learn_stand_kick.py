@@ -394,9 +394,16 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--eval-episodes", type=int, default=50, help="episodes per evaluation")
     args = parser.parse_args(argv)
 
+    import jax
+    from skrl import config as skrl_config
     from skrl.envs.wrappers.jax import wrap_env
     from skrl.trainers.jax import SequentialTrainer
     from skrl.utils import set_seed
+
+    # skrl's default JAX device is "cuda:0" whatever the machine has; on a CPU machine it warns
+    # "Invalid device specification (cuda:0)" and falls back. JAX's own first device is the GPU
+    # where one is present and the CPU otherwise.
+    skrl_config.jax.device = jax.devices()[0]
 
     out: Path = args.out
     out.mkdir(parents=True, exist_ok=True)

@@ -32,6 +32,8 @@ def trained(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, o
     )  # fmt: skip
     assert run.returncode == 0, run.stderr[-3000:]
     assert "steps " in run.stdout and "episodes" in run.stdout  # progress lines
+    # the default device is one the machine has: no "Invalid device specification (cuda:0)"
+    assert "Invalid device" not in run.stderr, run.stderr[-2000:]
     return out, json.loads(run.stdout.strip().splitlines()[-1])
 
 
