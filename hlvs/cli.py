@@ -82,8 +82,28 @@ class _VersionAction(argparse.Action):
         parser.exit()
 
 
+class Parser(argparse.ArgumentParser):
+    """An argument parser whose invalid choice (a mistyped command, action or value) comes with
+    "did you mean ...?" when a choice is close; its sub-command parsers are of this class too."""
+
+    def _check_value(self, action: argparse.Action, value: Any) -> None:
+        choices = action.choices
+        if choices is None or value in choices:
+            return
+        import difflib
+
+        names = [str(c) for c in choices]
+        close = difflib.get_close_matches(str(value), names, n=1, cutoff=0.6)
+        if not close:  # a prefix: "sched" for "schedule"
+            close = [n for n in names if n.startswith(str(value))][:1] if value else []
+        hint = f"; did you mean {close[0]!r}?" if close else ""
+        raise argparse.ArgumentError(
+            action, f"invalid choice: {value!r}{hint} (choose from {', '.join(names)})"
+        )
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog=PROG,
         description="Run RoboCup Humanoid League virtual soccer matches.",
         epilog=EPILOG,

@@ -37,7 +37,8 @@ class OrchestratorError(Exception):
 class Problem:
     """One problem in one file.
 
-    Printed as ``file: pointer: message (expected ...; did you mean ...?)``.
+    Printed as ``file: pointer: message (expected ...; did you mean ...?)``; a problem of the
+    whole file (the empty pointer: missing, unreadable, not JSON) as ``file: message``.
     """
 
     file: str
@@ -48,7 +49,7 @@ class Problem:
     severity: str = "error"  # or "warning"
 
     def __str__(self) -> str:
-        text = f"{self.file}: {self.pointer or '/'}: {self.message}"
+        text = f"{self.file}: {self.pointer + ': ' if self.pointer else ''}{self.message}"
         extras = []
         if self.expected:
             extras.append(f"expected {self.expected}")

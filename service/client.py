@@ -74,11 +74,13 @@ def register_client_commands(sub: Any, guarded: Callable[[Any], Any]) -> None:
 
 
 def _common(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--server", default=None,
-                        help="the service's URL (default: $HLVS_SERVER)")
-    parser.add_argument("--token-file", type=user_path, default=None,
-                        help="file holding the team token (default: $HLVS_TOKEN, then "
-                             "~/.config/hlvs/token)")
+    parser.add_argument("--server", default=None, metavar="URL",
+                        help="the service's URL, e.g. https://hlvs.example.org "
+                             "(default: $HLVS_SERVER)")
+    parser.add_argument("--token-file", type=user_path, default=None, metavar="FILE",
+                        help="a file holding the team token; without this option the token "
+                             "is the value of the variable HLVS_TOKEN, else the content of "
+                             "the file ~/.config/hlvs/token")
 
 
 class Api:
@@ -126,6 +128,7 @@ def _api(args: argparse.Namespace) -> Api:
     server = args.server or os.environ.get("HLVS_SERVER")
     if not server:
         raise InvalidInput("no server: give --server URL or set HLVS_SERVER")
+    server = server_url(server, given="--server" if args.server else "$HLVS_SERVER")
     token: str | None
     if args.token_file is not None:
         token = _read_token(args.token_file)
@@ -138,6 +141,22 @@ def _api(args: argparse.Namespace) -> Api:
         raise InvalidInput("no token: give --token-file FILE, set HLVS_TOKEN or write it to "
                            "~/.config/hlvs/token")
     return Api(server, token)
+
+
+def server_url(text: str, *, given: str) -> str:
+    """``text`` as the service's base URL; InvalidInput (exit 2) for one without ``http://`` or
+    ``https://`` and a host, naming where it came from (``given``: the option or variable)."""
+    from urllib.parse import urlsplit
+
+    from service.errors import InvalidInput
+
+    url = text.strip()
+    parts = urlsplit(url)
+    if parts.scheme not in ("http", "https") or not parts.netloc:
+        hint = f"; did you mean http://{url}?" if "://" not in url and url else ""
+        raise InvalidInput(f"{given}: {text!r} is not the service's URL: expected http:// or "
+                           f"https:// then the host, e.g. http://127.0.0.1:8000{hint}")
+    return url
 
 
 def _read_token(path: Path) -> str:

@@ -4,7 +4,9 @@
 per image (tag, size, rebuilt or cached). ``pull TEAM_CONFIG [--image-limit-gb GB] [--json]``
 checks every player's image in its registry (login, tag, size, the team's total with each layer
 once), pulls it with retries and a progress bar, pins it by digest and checks its size, as the
-runner does before a match; it exits 1 when a player has no usable image.
+runner does before a match; it exits 1 when a player has no usable image, 3 when every image
+that failed did so for a reason of the infrastructure (registry unreachable, a 5xx answer, a
+broken connection: trying again later may work).
 """
 
 from __future__ import annotations
@@ -12,9 +14,13 @@ from __future__ import annotations
 import argparse
 import json
 import time
-from typing import Any
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any
 
 from orchestrator import ExitCode, user_path
+
+if TYPE_CHECKING:
+    from orchestrator.pull import ResolvedImage
 
 
 def register(sub: Any) -> None:
@@ -106,4 +112,17 @@ def _pull(args: argparse.Namespace) -> int:
                       f"{retried})")
             else:
                 print(f"player {number}: {image.error}")
-    return ExitCode.OK if ok else ExitCode.FAILED
+    return pull_exit_code(resolved)
+
+
+def pull_exit_code(resolved: Mapping[int, ResolvedImage]) -> int:
+    """0 when every player has its image; 3 (infrastructure) when every failure is one that
+    trying again may cure (the registry unreachable, a 5xx, a broken connection); else 1."""
+    from orchestrator import ImagePullError
+
+    errors = [image.error for image in resolved.values() if image.error is not None]
+    if not errors:
+        return ExitCode.OK
+    if all(isinstance(e, ImagePullError) and e.transient for e in errors):
+        return ExitCode.INFRASTRUCTURE
+    return ExitCode.FAILED

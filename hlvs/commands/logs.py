@@ -32,7 +32,8 @@ def default_store() -> Path:
 
 def register(sub: Any) -> None:
     parser: argparse.ArgumentParser = sub.add_parser(
-        "logs", help="deliver match logs to the teams' SFTP/S3 targets"
+        "logs", help="match logs: deliver them to the teams' SFTP/S3 targets (deliver, "
+        "status, enqueue); a team downloads a test match's from the service (logs fetch)"
     )
     actions = parser.add_subparsers(dest="logs_command", metavar="ACTION")
     actions.required = True

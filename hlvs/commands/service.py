@@ -2,7 +2,9 @@
 
 ``hlvs admin`` works on the service's database directly (same settings as ``hlvs serve``:
 ``HLVS_SERVICE_*`` variables, or ``--data-dir`` / ``--database-url``), so the first operator
-token can be issued before the service runs.
+token can be issued before the service runs. Without any of them it uses ``./service-data``
+only when a database is there already: run from another folder than the service, it would
+otherwise make a new, empty database and issue tokens the service never sees.
 """
 
 from __future__ import annotations
@@ -47,7 +49,8 @@ def _settings(args: argparse.Namespace) -> Settings:
 def _add_db_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--data-dir", type=user_path, default=None,
                         help="folder of the service's files (default: $HLVS_SERVICE_DATA_DIR "
-                             "or ./service-data)")
+                             "or ./service-data, which hlvs admin uses only when a database "
+                             "is there already)")
     parser.add_argument("--database-url", default=None,
                         help="SQLAlchemy URL (default: $HLVS_SERVICE_DATABASE_URL or SQLite in "
                              "the data folder)")
@@ -117,11 +120,42 @@ def _bench(args: argparse.Namespace) -> int:
     return int(service_bench.main(list(args.rest)))
 
 
+def _told_where(args: argparse.Namespace) -> bool:
+    """Whether the command was told which database to use (an option or a variable), rather
+    than taking ``./service-data`` of whatever folder it runs in."""
+    import os
+
+    given = (getattr(args, "data_dir", None) is not None, getattr(args, "database_url", None))
+    names = ("HLVS_SERVICE_DATA_DIR", "HLVS_SERVICE_DATABASE_URL")
+    return any(given) or any(os.environ.get(name) for name in names)
+
+
+def _check_database(args: argparse.Namespace, settings: Settings) -> None:
+    """Refuse to make a new, empty database in the current folder by accident: ``hlvs admin``
+    run from another folder than ``hlvs serve`` would issue tokens the service never sees."""
+    from orchestrator import ConfigError, Problem
+
+    if settings.database_url or _told_where(args):
+        return
+    database = (settings.data_dir / "service.sqlite").resolve()
+    if database.is_file():
+        return
+    raise ConfigError([Problem(
+        "(command line)", "--data-dir",
+        f"no service database at {database}: hlvs admin works on the database of hlvs serve, "
+        "which is ./service-data of the folder the service runs in unless "
+        "HLVS_SERVICE_DATA_DIR or HLVS_SERVICE_DATABASE_URL says otherwise",
+        expected="this command run from the service's folder, or --data-dir DIR (a new folder "
+        "makes a new database)",
+    )])
+
+
 def _sessions(args: argparse.Namespace) -> Any:
     from orchestrator import private_dir
     from service.db import make_engine, migrate, session_factory
 
     settings = _settings(args)
+    _check_database(args, settings)
     private_dir(settings.data_dir)
     engine = make_engine(settings.db_url)
     migrate(engine)

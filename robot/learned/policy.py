@@ -15,6 +15,7 @@ count), ``w0``, ``b0``, ``w1``, ``b1``, ... (``w`` of shape inputs x outputs), `
 from __future__ import annotations
 
 import math
+import zipfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -117,9 +118,17 @@ def load_policy(path: Path) -> Policy:
     try:
         with np.load(path, allow_pickle=False) as data:
             arrays = {key: data[key] for key in data.files}
-    except (OSError, ValueError) as exc:
+    except FileNotFoundError as exc:
+        raise PolicyFileError(path=path, field="/", expected="an existing file (none is there)"
+                              ) from exc
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else \
+            str(exc).split(". ")[0]
+        if isinstance(exc, ValueError) and "pickled" in reason:  # numpy's guess for any file
+            reason = "not a .npz archive"
         raise PolicyFileError(
-            path=path, field="/", expected=f"a readable .npz file ({exc})"
+            path=path, field="/",
+            expected=f"a .npz file written by save_policy (not readable as one: {reason})",
         ) from exc
     if str(arrays.get("format", "")) != FORMAT:
         raise PolicyFileError(path=path, field="/format", expected=repr(FORMAT))

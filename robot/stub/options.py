@@ -72,21 +72,45 @@ class RobotEnv:
 
 
 def parse_args(argv: list[str]) -> StubOptions:
-    parser = argparse.ArgumentParser(prog="python -m robot.stub", exit_on_error=False)
-    parser.add_argument("behaviour", choices=[b.value for b in Behaviour])
-    parser.add_argument("seconds", nargs="?", type=float, default=None)
-    parser.add_argument("--fill-cap-bytes", type=int, default=None)
-    parser.add_argument("--start-pose", nargs=3, type=float, metavar=("X", "Y", "YAW"))
-    parser.add_argument("--home", nargs=2, type=float, metavar=("X", "Y"))
-    parser.add_argument("--gc-data-port", type=int, default=3838)
-    parser.add_argument("--gc-return-port", type=int, default=3939)
-    parser.add_argument("--mirror-port", type=int, default=3737)
-    parser.add_argument("--model", default="kid-default")
-    parser.add_argument("--field-class", choices=("kid", "adult"), default=None)
-    parser.add_argument("--kick-policy", default=os.environ.get(KICK_POLICY_ENV) or None)
+    parser = argparse.ArgumentParser(
+        prog="python -m robot.stub", exit_on_error=False,
+        description="The stub robot controller of an HLVS robot container: it connects to the "
+        "robot API at $ROBOCUP_SIMULATOR_ADDR as robot $ROBOCUP_ROBOT_ID of team "
+        "$ROBOCUP_TEAM_COLOR and plays by the GameController's packets.",
+    )
+    parser.add_argument("behaviour", choices=[b.value for b in Behaviour], metavar="BEHAVIOUR",
+                        help="striker, goalie, defender or idle; or a fault for tests: "
+                        "crash-after SECONDS, ignore-sigterm, flood, fill-logs")
+    parser.add_argument("seconds", nargs="?", type=float, default=None, metavar="SECONDS",
+                        help="crash-after only: seconds before the process exits 1")
+    parser.add_argument("--fill-cap-bytes", type=int, default=None, metavar="BYTES",
+                        help="fill-logs only: stop after this many bytes (default: the disk)")
+    parser.add_argument("--start-pose", nargs=3, type=float, metavar=("X", "Y", "YAW"),
+                        help="the pose the robot starts at, own-half frame (m, m, rad); "
+                        "default: on the touch line by its number")
+    parser.add_argument("--home", nargs=2, type=float, metavar=("X", "Y"),
+                        help="defender only: its spot in the own half (m)")
+    parser.add_argument("--gc-data-port", type=int, default=3838, metavar="PORT",
+                        help="UDP port of the GameController's packets (default 3838)")
+    parser.add_argument("--gc-return-port", type=int, default=3939, metavar="PORT",
+                        help="UDP port of the GameController's return packets (default 3939)")
+    parser.add_argument("--mirror-port", type=int, default=3737, metavar="PORT",
+                        help="UDP port of the team mirror (default 3737)")
+    parser.add_argument("--model", default="kid-default",
+                        help=f"built-in robot model: {', '.join(known_models())} "
+                        "(default kid-default)")
+    parser.add_argument("--field-class", choices=("kid", "adult"), default=None,
+                        help="the field it plays on (default: its model's size class)")
+    parser.add_argument("--kick-policy", default=os.environ.get(KICK_POLICY_ENV) or None,
+                        metavar="FILE", help="a learned kick (.npz of robot.learned) instead of "
+                        f"the keyframe kick (default: ${KICK_POLICY_ENV})")
     try:
         ns, unknown = parser.parse_known_args(argv)
-    except (argparse.ArgumentError, SystemExit) as exc:
+    except SystemExit as exc:
+        if exc.code in (0, None):  # --help was printed: exit 0 as any command's help
+            raise
+        raise StubConfigError(field="argv", value=" ".join(argv), expected=_usage()) from exc
+    except argparse.ArgumentError as exc:
         raise StubConfigError(field="argv", value=" ".join(argv), expected=_usage()) from exc
     if unknown:
         raise StubConfigError(field="argv", value=" ".join(unknown), expected=_usage())

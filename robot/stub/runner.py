@@ -258,10 +258,10 @@ def _kick_policy(options: StubOptions) -> Policy | None:
     try:
         policy = load_policy(options.kick_policy)
     except PolicyFileError as exc:
+        where = "" if exc.field == "/" else f" (at {exc.field})"
         raise StubConfigError(
-            field="--kick-policy",
-            value=str(options.kick_policy),
-            expected=f"a policy file ({exc.field}: {exc.expected})",
+            field="--kick-policy", value=str(options.kick_policy),
+            expected=f"{exc.expected}{where}",
         ) from exc
     logger.info("learned kick %s from %s", policy.skill, options.kick_policy)
     return policy
@@ -331,7 +331,11 @@ def main(argv: list[str]) -> int:
         return 2
     _setup_logging(env)
     gc_ports = (options.gc_data_port, options.gc_return_port)
-    robot = StubRobot(options, env, gc_data_port=gc_ports[0], gc_return_port=gc_ports[1])
+    try:
+        robot = StubRobot(options, env, gc_data_port=gc_ports[0], gc_return_port=gc_ports[1])
+    except StubConfigError as exc:  # a bad --kick-policy file: one line, no traceback
+        print(str(exc), file=sys.stderr)
+        return 2
 
     def on_signal(signum: int, frame: FrameType | None) -> None:
         logger.info("received %s", signal.Signals(signum).name)

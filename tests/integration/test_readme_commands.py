@@ -252,6 +252,7 @@ def compose_written(ran: Ran, root: Path) -> None:
 
 
 SCRIMMAGE = "make scrimmage"
+ADMIN_FIRST = "hlvs admin team add 'Red Robots' --email red@example.org --data-dir service-data"
 OUTCOMES: dict[str, Outcome] = {
     # README.md
     SCRIMMAGE: Outcome(scrimmage_played, timeout_s=900),
@@ -271,11 +272,11 @@ OUTCOMES: dict[str, Outcome] = {
         mcap_written, after=(SCRIMMAGE,)
     ),
     "hlvs bench envs --rounds 2 --block 200 --json": Outcome(bench_json),
-    "hlvs admin team add 'Red Robots' --email red@example.org": Outcome(team_added),
+    ADMIN_FIRST: Outcome(team_added),
     "hlvs admin token issue --team 'Red Robots' --days 90": Outcome(
-        token_printed, after=("hlvs admin team add 'Red Robots' --email red@example.org",)
+        token_printed, after=(ADMIN_FIRST,)
     ),
-    "hlvs admin token issue --operator": Outcome(token_printed),
+    "hlvs admin token issue --operator": Outcome(token_printed, after=(ADMIN_FIRST,)),
     # configs/README.md
     "hlvs check configs/examples/kid_4v4_official/team_red.json": Outcome(check_ok),
     "hlvs check --class KID configs/examples/kid_4v4_official/team_red.json": Outcome(check_ok),

@@ -26,7 +26,7 @@ def test_one_bad_file_makes_the_exit_code_2(game_files: GameFiles, hlvs_check: A
     run = hlvs_check(game, bad)
     assert run.code == 2
     assert f"{game}: ok (game)" in run.out
-    assert f"{bad}: /: invalid JSON at line 1 column 2" in run.out
+    assert f"{bad}: invalid JSON at line 1 column 2" in run.out
 
 
 def test_missing_file_and_directory_are_one_line_each(tmp_path: Path, hlvs_check: Any) -> None:
@@ -34,8 +34,8 @@ def test_missing_file_and_directory_are_one_line_each(tmp_path: Path, hlvs_check
     assert run.code == 2
     lines = run.out.splitlines()
     assert lines == [
-        f"{tmp_path / 'missing.json'}: /: file not found",
-        f"{tmp_path}: /: is a directory (expected a file)",
+        f"{tmp_path / 'missing.json'}: file not found",
+        f"{tmp_path}: is a directory (expected a file)",
     ]
 
 
@@ -105,7 +105,7 @@ def test_schedule_file_is_checked(tmp_path: Path, hlvs_check: Any) -> None:
 def test_device_file_is_not_read(hlvs_check: Any) -> None:
     run = hlvs_check("/dev/zero")
     assert run.code == 2
-    assert run.out.splitlines() == ["/dev/zero: /: not a regular file (expected a file)"]
+    assert run.out.splitlines() == ["/dev/zero: not a regular file (expected a file)"]
 
 
 def test_game_check_includes_referenced_credentials(game_files: GameFiles, hlvs_check: Any) -> None:
@@ -119,4 +119,4 @@ def test_game_check_includes_referenced_credentials(game_files: GameFiles, hlvs_
     creds.write_bytes(b"\xff\xfe\x00binary")
     run = hlvs_check(game_files.write())
     assert run.code == 2
-    assert f"{creds}: /: binary file" in run.out
+    assert f"{creds}: binary file" in run.out

@@ -84,6 +84,6 @@ def test_unknown_links_and_joints_get_a_suggestion(wolfgang_copy: Path) -> None:
 def test_not_json_and_no_manifest(tmp_path: Path, wolfgang_copy: Path) -> None:
     (wolfgang_copy / "robot_model.json").write_text("{not json")
     code, out = _check(wolfgang_copy)
-    assert code == 2 and "robot_model.json: /: not JSON" in out
+    assert code == 2 and "robot_model.json: not JSON" in out
     with pytest.raises(ModelError, match="no robot_model.json here"):
         load_team_model(tmp_path)

@@ -107,7 +107,7 @@ def test_uncancel_and_file_time_warnings(
                  new.isoformat()]) == 0
     assert ledger.row("m1").stream_start == new
     assert main(["schedule", "reschedule", "m1", "--state", str(state), "--at", "soon"]) == 2
-    assert "--at: /: 'soon' is not a time (expected ISO 8601" in capsys.readouterr().err
+    assert "--at: 'soon' is not a time (expected ISO 8601" in capsys.readouterr().err
 
 
 def test_an_edited_schedule_applies_only_when_the_operator_says_so(
