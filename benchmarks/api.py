@@ -7,7 +7,9 @@ clients share the machine's cores with the server being measured). Prints one JS
 the API run's real-time factor, the world-only real-time factor of the same world
 (``World.step`` + ``snapshot``, what ``bench sim`` measures) and their ratio.
 ``--stalled-client`` adds a run in which one more client connects and never reads, and reports
-both runs.
+both runs. ``--client league`` runs clients written like the league's own test client (each
+request's length and body in two writes, no ``TCP_NODELAY``: :mod:`testkit.league_client`) and
+reports their requests per second and round trips seen from both ends (``league_client``).
 
 Without cameras, on a machine with two or more CPUs, the step thread runs on CPU 0 in every
 measurement (the world-only and ``bench sim`` figures too) and the client processes on the
@@ -63,6 +65,15 @@ def _parser() -> argparse.ArgumentParser:
         "--render-processes", type=int, default=-1,
         help="camera render processes (0: a thread; default: as a match chooses, one per CPU "
         "when the cameras render on the CPU)"
+    )
+    parser.add_argument(
+        "--client", choices=("bench", "league"), default="bench",
+        help="bench: framed requests in one write, TCP_NODELAY (default); league: written like "
+        "the league's test client (length and body in two writes, no TCP_NODELAY)",
+    )
+    parser.add_argument(
+        "--think-ms", type=float, default=0.0,
+        help="--client league: milliseconds each client takes to answer (default 0)",
     )
     parser.add_argument("--stalled-client", action="store_true",
                         help="one more client that connects and never reads")
@@ -194,6 +205,52 @@ def _client(port: int, camera_period: int, stalled: bool, cpus: frozenset[int]) 
                 filled -= start
     except OSError:
         pass
+    os._exit(0)
+
+
+def _league_client(port: int, think_ms: float, cpus: frozenset[int], report: Any) -> None:
+    """Client process body of ``--client league``: enables the sensors, then answers every
+    measurement as the league's test client sends (the length, then the body: two writes, no
+    ``TCP_NODELAY``) with the bench's 20 joint targets, after ``think_ms``. When the server
+    closes, sends its medians (seconds) and count through ``report``."""
+    import statistics
+
+    from contracts.robot_api import messages_pb2 as pb
+    from testkit.league_client import LeagueStyleClient
+
+    if cpus:
+        os.sched_setaffinity(0, cpus)
+    for _ in range(240):
+        try:
+            client = LeagueStyleClient("127.0.0.1", port, timeout_s=30.0).connect()
+            break
+        except OSError:
+            time.sleep(0.25)
+    else:
+        raise SystemExit(f"bench league client: no session on port {port}")
+    enable = pb.ActuatorRequests()
+    for name in [f"{m}S" for m in MOTORS] + ["Accelerometer", "Gyro"]:
+        enable.sensor_time_steps.add(name=name, timeStep=8)
+    cycle = []
+    for k in range(CYCLE_STEPS):
+        request = pb.ActuatorRequests()
+        for i, motor in enumerate(MOTORS):
+            request.motor_positions.add(name=motor, position=0.05 * math.sin(k * 0.008 + i))
+        cycle.append(request.SerializeToString())
+    think = (lambda: time.sleep(think_ms / 1000.0)) if think_ms > 0 else None
+    answered = 0
+    try:
+        assert client.sock is not None
+        client.sock.settimeout(None)
+        client.send(enable.SerializeToString())
+        while True:
+            client.exchange(cycle[answered % CYCLE_STEPS], think)
+            answered += 1
+    except (OSError, ConnectionError):
+        pass
+    medians = [statistics.median(values) if values else None
+               for values in (client.answer_s, client.round_trip_s)]  # fmt: skip
+    report.send((answered, *medians))
     os._exit(0)
 
 
@@ -390,8 +447,18 @@ def _api_run(
     server.start()
     ctx = mp.get_context("fork")
     camera_robots = args.camera_robots or len(endpoints)
-    procs = [
-        ctx.Process(
+    reports = []  # the league clients' figures, sent when the server closes
+    procs = []
+    for i, e in enumerate(endpoints):
+        if args.client == "league" and e.robot != stalled_robot:
+            receive, send = ctx.Pipe(duplex=False)
+            reports.append(receive)
+            procs.append(ctx.Process(
+                target=_league_client, args=(e.port, args.think_ms, args.client_cpus, send),
+                daemon=True,
+            ))  # fmt: skip
+            continue
+        procs.append(ctx.Process(
             target=_client,
             args=(
                 e.port,
@@ -400,9 +467,7 @@ def _api_run(
                 args.client_cpus,
             ),
             daemon=True,
-        )
-        for i, e in enumerate(endpoints)
-    ]
+        ))  # fmt: skip
     for proc in procs:
         proc.start()
     try:
@@ -449,6 +514,8 @@ def _api_run(
         if reference is not None:
             reference_steps(WARMUP_STEPS)
         chunk = max(1, INTERLEAVE_MS // world.step_ms)
+        requests_before = sum(slot.stats.messages_in for slot in server.slots.values())
+        requests = 0
         wall = cpu = ref_wall = ref_cpu = 0.0
         done = 0
         while done < steps:
@@ -458,23 +525,47 @@ def _api_run(
                 one_step()
             wall += time.perf_counter() - started
             cpu += time.thread_time() - started_cpu
+            requests_after = sum(slot.stats.messages_in for slot in server.slots.values())
+            requests += requests_after - requests_before
             done += count
             if reference is not None:
                 started, started_cpu = time.perf_counter(), time.thread_time()
                 reference_steps(count)
                 ref_wall += time.perf_counter() - started
                 ref_cpu += time.thread_time() - started_cpu
+            requests_before = sum(slot.stats.messages_in for slot in server.slots.values())
         if pipeline is not None:
             waited[0] = pipeline.waited_s
         stats = server.statistics()
     finally:
         server.close()
         cameras.close()
+        league = [receive.recv() for receive in reports if receive.poll(10.0)]
         for proc in procs:
             proc.kill()
             proc.join(timeout=5)
     rtts = [s["round_trip_ms"]["p50"] for s in stats.values() if s["round_trip_ms"]["p50"]]
+    league_client = None
+    if args.client == "league":
+        def median_ms(index: int) -> float | None:
+            values = sorted(report[index] for report in league if report[index] is not None)
+            return round(values[len(values) // 2] * 1000.0, 3) if values else None
+
+        league_client = {
+            "clients": len(reports),
+            "reported": len(league),
+            "think_ms": args.think_ms,
+            # requests the server received per second of the API run's wall time
+            "requests_per_s": round(requests / wall, 1),
+            # the server's round trip: measurement sent to answer received (p50, robots' median)
+            "round_trip_p50_ms": round(sorted(rtts)[len(rtts) // 2], 3) if rtts else None,
+            # the client's part of it: measurement arrived to answer written
+            "client_answer_p50_ms": median_ms(1),
+            # the client's own wait: answer written to next measurement arrived (the step)
+            "client_round_trip_p50_ms": median_ms(2),
+        }
     return {
+        "league_client": league_client,
         "real_time_factor": round((world.sim_time_ms - start_ms) / 1000.0 / wall, 3),
         "cpu_s_per_sim_s": cpu / ((world.sim_time_ms - start_ms) / 1000.0),
         "wait_share": round(waited[0] / wall, 3),
@@ -550,7 +641,10 @@ def main(argv: list[str]) -> int:
         "client_wait_share": api["wait_share"],
         "step_thread_cpus": sorted(os.sched_getaffinity(0)),
         "client_cpus": sorted(args.client_cpus) or "shared",
+        "client": args.client,
     }
+    if api["league_client"] is not None:
+        result["league_client"] = api["league_client"]
     if camera is not None:  # the camera path against a bare render of the same scene
         from simulator.gl import read_gl_info
 

@@ -347,8 +347,11 @@ class ApiServer:
     def poll(self, timeout_s: float = 0.0) -> None:
         """Serve sockets: accept, handshake, read requests, write queued measurements (with
         the I/O thread: drop the clients it found failed)."""
+        ready = self._selector.select(max(0.0, timeout_s))
+        # after the select: a request that arrives while it blocks is stamped when it arrived
+        # (its round trip and its lockstep answer time), not when the wait began
         now = time.monotonic()
-        for key, events in self._selector.select(max(0.0, timeout_s)):
+        for key, events in ready:
             data = key.data
             if data == "cameras":
                 self._camera_results()

@@ -119,6 +119,7 @@ def running_server(
     pause_s: float = 0.002,
     team_size: int = 4,
     hold: bool = False,
+    send_thread: bool | None = None,
 ) -> Iterator[tuple[Driver, dict[RobotId, int]]]:
     world = world if world is not None else real_world(robots)
     ports = dict(zip(robots, free_ports(len(robots)), strict=True))
@@ -132,7 +133,8 @@ def running_server(
             make_render=lambda: lambda _s, r, w, h: FakeCameraRenderer(None, w, h).render(r),
         )
     server = ApiServer(
-        world=world, endpoints=endpoints, network=network, lockstep=lockstep, cameras=worker
+        world=world, endpoints=endpoints, network=network, lockstep=lockstep, cameras=worker,
+        send_thread=send_thread,
     )
     server.start()
     driver = Driver(server, world, lockstep, pause_s)

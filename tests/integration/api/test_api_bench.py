@@ -49,3 +49,17 @@ def test_bench_api_camera_and_stalled_client() -> None:
     stalled = result["stalled_client"]
     assert isinstance(stalled, dict) and stalled["real_time_factor"] > 0
     assert stalled["cpu_ratio"] > 0
+
+
+def test_bench_api_league_clients_report_their_rate_and_both_round_trips() -> None:
+    result = _bench("--mode", "lockstep", "--client", "league", "--sim-seconds", "0.5")
+    assert result["client"] == "league"
+    league = result["league_client"]
+    assert isinstance(league, dict)
+    assert league["clients"] == 2 and league["reported"] == 2
+    # one request per robot and step: requests per second of the API run are its steps'
+    steps_per_s = float(result["real_time_factor"]) * 1000.0 / 8
+    assert league["requests_per_s"] == pytest.approx(2 * steps_per_s, rel=0.1)
+    for key in ("round_trip_p50_ms", "client_answer_p50_ms", "client_round_trip_p50_ms"):
+        assert isinstance(league[key], float) and league[key] > 0, key
+    assert result["slow_periods"] == 0
