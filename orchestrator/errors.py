@@ -57,8 +57,8 @@ class Problem:
             extras.append(f"did you mean {self.suggestion}?")
         if extras:
             text += f" ({'; '.join(extras)})"
-        if self.severity == "warning":
-            text = "warning: " + text
+        if self.severity in ("warning", "note"):
+            text = f"{self.severity}: " + text
         return text
 
 

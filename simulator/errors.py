@@ -40,8 +40,6 @@ class SimulatorError(Exception):
     """Root of every error the simulator package raises."""
 
 
-
-
 @dataclass(frozen=True, slots=True, kw_only=True)
 class ModelProblem:
     """One problem of a team robot model: the file, where in it, and what is wrong."""
@@ -49,11 +47,12 @@ class ModelProblem:
     source: str
     where: str  # JSON pointer in the manifest, or the element / link / rule
     reason: str
-    severity: str = "error"  # or "warning": allowed in friendlies, refused in official matches
+    severity: str = "error"  # "warning": allowed in friendlies, refused in official matches;
+    # "note": what of the file the world leaves out or replaces (never refused)
 
     def __str__(self) -> str:
         text = f"{self.source}: {self.where or '/'}: {self.reason}"
-        return f"warning: {text}" if self.severity == "warning" else text
+        return f"{self.severity}: {text}" if self.severity in ("warning", "note") else text
 
 
 class ModelError(SimulatorError):

@@ -201,15 +201,17 @@ def print_text(report: FileReport, *, out: TextIO) -> None:
     for problem in report.errors + [p for p in report.problems if p.severity != "error"]:
         print(str(problem), file=out)
     if report.valid:
-        warnings = len(report.problems)
+        warnings = len([p for p in report.problems if p.severity == "warning"])
+        notes = len(report.problems) - warnings
         note = f", {warnings} warning{'s' if warnings != 1 else ''}" if warnings else ""
+        note += f", {notes} note{'s' if notes != 1 else ''}" if notes else ""
         print(f"{report.file}: ok ({report.kind}{note})", file=out)
 
 
 def print_github(report: FileReport, *, out: TextIO) -> None:
     """GitHub Actions workflow commands (``::error file=...,line=...,title=...::message``)."""
     for problem in report.problems:
-        level = "error" if problem.severity == "error" else "warning"
+        level = {"error": "error", "note": "notice"}.get(problem.severity, "warning")
         title = f"{problem.pointer or '/'}"
         text = str(problem).removeprefix("warning: ")
         line = line_of(Path(problem.file), problem.pointer)

@@ -12,7 +12,6 @@ FORCE_SENSORS = ("llb", "llf", "lrf", "lrb", "rlb", "rlf", "rrf", "rrb")
 """Sole corner force sensors: first letter foot (l/r), then side (l/r), then back/front."""
 
 
-
 @dataclass(frozen=True, slots=True, kw_only=True)
 class MotorSpec:
     """One motor (a hinge joint and its servo): the servo's figures at the joint, from the
@@ -32,6 +31,7 @@ class MotorSpec:
     # get 2 pi / 4096 rad, the 4096-count encoder of the league's Dynamixel servos
     encoder_resolution_rad: float = 2.0 * math.pi / 4096.0
     servo: str = ""  # catalogue id (MX-106@14.8V); empty for free-form figures
+    armature_kg_m2: float = 0.0  # the servo's reflected rotor inertia at the joint
 
     @classmethod
     def from_servo(cls, name: str, lower_rad: float, upper_rad: float, servo: Servo) -> MotorSpec:
@@ -47,6 +47,7 @@ class MotorSpec:
             backlash_rad=servo.backlash_rad,
             encoder_resolution_rad=servo.encoder_resolution_rad,
             servo=servo.id,
+            armature_kg_m2=servo.armature_kg_m2,
         )
 
 

@@ -7,11 +7,15 @@ of the same family, take every figure from the maker's page, record the page as 
 run ``hlvs bench actuators --json`` (it measures the new entry against its figures).
 
 Per model: ``gear_ratio``, ``backlash_rad``, ``encoder_resolution_rad`` (one encoder count at the
-output), ``mass_kg``, ``static_friction_nm`` and ``viscous_damping_nm_s_per_rad`` (league
-defaults where the datasheet is silent; ``friction_source`` says which), and ``variants``: each
-with ``voltage_v``, ``stall_torque_nm``, ``no_load_speed_rpm`` and, for servos rated by a
-continuous point instead of a stall torque, ``full_torque_speed_rpm`` (the torque is available
-in full up to that speed, then falls linearly to the no-load speed).
+output), ``mass_kg``, ``rotor_inertia_kg_m2`` (the motor's rotor and first gear stage; the
+joint's armature, its reflected inertia, is that times the gear ratio squared:
+:attr:`Servo.armature_kg_m2`; ``rotor_inertia_source`` says where the figure comes from, or how
+it was estimated where the maker publishes none), ``static_friction_nm`` and
+``viscous_damping_nm_s_per_rad`` (league defaults where the datasheet is silent;
+``friction_source`` says which), and ``variants``: each with ``voltage_v``,
+``stall_torque_nm``, ``no_load_speed_rpm`` and, for servos rated by a continuous point
+instead of a stall torque, ``full_torque_speed_rpm`` (the torque is available in full up to that
+speed, then falls linearly to the no-load speed).
 """
 
 from __future__ import annotations
@@ -46,6 +50,12 @@ class Servo:
     static_friction_nm: float
     viscous_damping_nm_s_per_rad: float
     source: str
+    rotor_inertia_kg_m2: float = 0.0
+
+    @property
+    def armature_kg_m2(self) -> float:
+        """The rotor's inertia reflected through the gearbox: rotor inertia x gear ratio^2."""
+        return self.rotor_inertia_kg_m2 * self.gear_ratio * self.gear_ratio
 
     def available_torque_nm(self, speed_rad_s: float) -> float:
         """The datasheet's torque at the output when turning at ``speed_rad_s`` (>= 0)."""
@@ -70,6 +80,8 @@ class Servo:
             "backlash_rad": self.backlash_rad,
             "encoder_resolution_rad": self.encoder_resolution_rad,
             "mass_kg": self.mass_kg,
+            "rotor_inertia_kg_m2": self.rotor_inertia_kg_m2,
+            "armature_kg_m2": round(self.armature_kg_m2, 6),
             "static_friction_nm": self.static_friction_nm,
             "viscous_damping_nm_s_per_rad": self.viscous_damping_nm_s_per_rad,
             "source": self.source,
@@ -111,6 +123,7 @@ def _load(path: Path) -> list[Servo]:
             "backlash_rad",
             "encoder_resolution_rad",
             "mass_kg",
+            "rotor_inertia_kg_m2",
             "static_friction_nm",
             "viscous_damping_nm_s_per_rad",
         )

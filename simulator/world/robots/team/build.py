@@ -26,7 +26,7 @@ import mujoco
 import numpy as np
 
 from simulator.errors import ModelError, ModelProblem
-from simulator.world.actuator import actuator_xml
+from simulator.world.actuator import actuator_xml, line_constants
 from simulator.world.robots.team.manifest import Manifest
 from simulator.world.robots.team.servos import motor_spec
 
@@ -277,14 +277,30 @@ def _validate(spec: mujoco.MjSpec, manifest: Manifest) -> list[ModelProblem]:
                     manifest, f"/motors/{i}/joint", f"joint {motor.joint!r} is not a revolute joint"
                 )
             )
-        elif not joint.limited and not (joint.range[0] < joint.range[1]):
-            problems.append(
-                _problem(
-                    manifest,
-                    f"/motors/{i}/joint",
-                    f"joint {motor.joint!r} has no limits (rule: every motor joint has a range)",
+        elif motor.range_rad is not None and joint.limited and joint.range[0] < joint.range[1]:
+            lo, hi = float(joint.range[0]), float(joint.range[1])
+            if motor.range_rad[0] < lo - 1e-9 or motor.range_rad[1] > hi + 1e-9:
+                problems.append(
+                    _problem(
+                        manifest,
+                        f"/motors/{i}/range_rad",
+                        f"[{motor.range_rad[0]:g}, {motor.range_rad[1]:g}] rad is wider than "
+                        f"the model file's range [{lo:g}, {hi:g}] of joint {motor.joint!r} (the "
+                        "manifest may narrow a joint's range, never widen it)",
+                    )
                 )
-            )
+    roots = list(spec.worldbody.bodies)
+    for body in _bodies(spec):
+        for joint in body.joints:
+            if joint.type == mujoco.mjtJoint.mjJNT_FREE and body not in roots:
+                problems.append(
+                    _problem(
+                        manifest,
+                        "model_file",
+                        f"link {body.name!r} has a free joint but is not the root link: a robot "
+                        "is one tree of joints (only its root may float)",
+                    )
+                )
     for name, joint in joints.items():
         if name not in motor_joints and joint.type != mujoco.mjtJoint.mjJNT_FREE:
             problems.append(
@@ -295,6 +311,7 @@ def _validate(spec: mujoco.MjSpec, manifest: Manifest) -> list[ModelProblem]:
                     "motors (unactuated joints are not allowed)",
                 )
             )
+    problems += _line_problems(manifest)
     named: list[tuple[str, str]] = [("/imu/link", manifest.imu_link)]
     named += [(f"/cameras/{i}/link", c.link) for i, c in enumerate(manifest.cameras)]
     named += [(f"/force_sensors/{k}", v) for k, v in manifest.force_sensors.items()]
@@ -313,6 +330,33 @@ def _validate(spec: mujoco.MjSpec, manifest: Manifest) -> list[ModelProblem]:
                 )
             )
     return problems
+
+
+def _line_problems(manifest: Manifest) -> list[ModelProblem]:
+    """Friction and damping that leave a servo no torque before its no-load speed (the
+    manifest's ``joint_damping`` / ``joint_frictionloss`` replacing the catalogue's)."""
+    failing = []
+    for motor in manifest.motors:
+        spec = motor_spec(motor, manifest)
+        try:
+            line_constants(spec)
+        except ValueError:
+            room = (spec.max_torque_nm - spec.static_friction_nm) / spec.max_velocity_rad_s
+            failing.append(f"{motor.name} (at most {max(room, 0.0):.3g} N m s/rad)")
+    if not failing:
+        return []
+    where = "/joint_damping" if manifest.joint_damping is not None else "/joint_frictionloss"
+    if manifest.joint_damping is None and manifest.joint_frictionloss is None:
+        where = "/motors"
+    return [
+        _problem(
+            manifest,
+            where,
+            "friction and damping would take a servo's whole stall torque before it reaches its "
+            f"no-load speed: {', '.join(failing)}; lower joint_damping / joint_frictionloss "
+            "or leave them out to take the catalogue servos' own",
+        )
+    ]
 
 
 def _did_you_mean(name: str, known: object) -> str:
@@ -378,14 +422,18 @@ def build_template(spec: mujoco.MjSpec, manifest: Manifest, *, key: str) -> Temp
         for k, g in enumerate(own):
             _add_cleat(body, original, g, b, f"{p}/{part}:{link}_cleat_{k}")
         for joint in body.joints:
+            if joint.type == mujoco.mjtJoint.mjJNT_FREE:
+                continue  # the file's own free base (replaced below)
             motor = motors[joint.name]
+            if motor.range_rad is not None:
+                joint.range = motor.range_rad
+                joint.limited = mujoco.mjtLimited.mjLIMITED_TRUE
             ranges[motor.name] = (float(joint.range[0]), float(joint.range[1]))
             joint.name = f"{p}/{motor.name}"
             physics = motor_spec(motor, manifest)
             joint.damping = [physics.damping_nm_s_per_rad, 0.0, 0.0]
             joint.frictionloss = physics.static_friction_nm
-            if manifest.joint_armature is not None:
-                joint.armature = manifest.joint_armature
+            joint.armature = physics.armature_kg_m2
         if link == manifest.imu_link:
             site = body.add_site()
             site.name = f"{p}/site:imu"
@@ -504,6 +552,54 @@ def _standing_height(spec: mujoco.MjSpec, pose: dict[str, float]) -> float:
     return root_z - lowest
 
 
+def _expand_defaults(doc: ET.Element) -> None:
+    """Write every attribute an element takes from its default class (``class``, an ancestor's
+    ``childclass``, else ``main``) onto the element itself: the template leaves the classes out
+    (the world has its own), and MJCF files such as the MuJoCo Menagerie's set mesh scales,
+    collision flags and geom types there."""
+    classes: dict[str, dict[str, dict[str, str]]] = {}
+
+    def collect(node: ET.Element, inherited: dict[str, dict[str, str]]) -> None:
+        name = node.get("class", "main")
+        own = {tag: dict(attrs) for tag, attrs in inherited.items()}
+        for child in node:
+            if child.tag != "default":
+                own[child.tag] = {**own.get(child.tag, {}), **child.attrib}
+        classes[name] = own
+        for child in node:
+            if child.tag == "default":
+                collect(child, own)
+
+    for top in doc.findall("default"):
+        collect(top, {})
+        doc.remove(top)
+    if not classes:
+        return
+
+    def fill(element: ET.Element, active: str) -> None:
+        for child in element:
+            own = child.get("class", active)
+            values = classes.get(own, classes.get("main", {})).get(child.tag, {})
+            for key, value in values.items():
+                if key not in child.attrib and not _conflicts(child, key):
+                    child.set(key, value)
+            fill(child, child.get("childclass", active) if child.tag == "body" else active)
+
+    for section in doc:
+        fill(section, "main")
+
+
+def _conflicts(element: ET.Element, key: str) -> bool:
+    """A default attribute the element's own attributes replace (MJCF: ``fromto`` sets a
+    geom's position and length; an orientation is given in one of several forms)."""
+    orientations = {"quat", "euler", "axisangle", "xyaxes", "zaxis"}
+    if key in orientations:
+        return bool(orientations & set(element.attrib))
+    if key in ("pos", "size") and "fromto" in element.attrib and element.tag == "geom":
+        return key == "pos"
+    return False
+
+
 def _template(
     xml: str,
     manifest: Manifest,
@@ -515,6 +611,7 @@ def _template(
     trunk: str,
 ) -> Template:
     doc = ET.fromstring(xml)
+    _expand_defaults(doc)
     asset = doc.find("asset")
     assets = "".join(
         ET.tostring(e, encoding="unicode") for e in (asset if asset is not None else [])

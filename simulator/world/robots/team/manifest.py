@@ -43,6 +43,7 @@ class MotorEntry:
     max_torque_nm: float | None  # as written (None: the servo's)
     max_velocity_rad_s: float | None
     free_gains: tuple[str, ...] = ()  # the free-form keys the entry sets (kp, kv)
+    range_rad: tuple[float, float] | None = None  # the joint's range where the file has none
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -254,9 +255,9 @@ def load_manifest(folder_or_file: Path) -> Manifest:
             r.problem(f"/standing_pose_rad/{key}", "not the name of a motor in /motors")
         elif isinstance(value, bool) or not isinstance(value, (int, float)):
             r.problem(f"/standing_pose_rad/{key}", f"{value!r} is not a number (rad)")
-    damping = r.get(raw, "joint_damping", (int, float), "", required=False)
-    armature = r.get(raw, "joint_armature", (int, float), "", required=False)
-    friction = r.get(raw, "joint_frictionloss", (int, float), "", required=False)
+    damping = _non_negative(r, raw, "joint_damping")
+    armature = _non_negative(r, raw, "joint_armature")
+    friction = _non_negative(r, raw, "joint_frictionloss")
     if r.problems:
         raise ModelError(r.problems)
     return Manifest(
@@ -279,6 +280,16 @@ def load_manifest(folder_or_file: Path) -> Manifest:
         joint_armature=None if armature is None else float(armature),
         joint_frictionloss=None if friction is None else float(friction),
     )
+
+
+def _non_negative(r: _Reader, raw: Mapping[str, object], key: str) -> float | None:
+    value = r.get(raw, key, (int, float), "", required=False)
+    if value is None:
+        return None
+    if not math.isfinite(float(value)) or float(value) < 0:
+        r.problem(f"/{key}", f"{value!r} must be a number >= 0")
+        return None
+    return float(value)
 
 
 def _motors(r: _Reader, raw: Mapping[str, object]) -> tuple[MotorEntry, ...]:
@@ -307,6 +318,7 @@ def _motors(r: _Reader, raw: Mapping[str, object]) -> tuple[MotorEntry, ...]:
         required = not servo_name
         torque = r.positive(entry, "max_torque_nm", p, required=required)
         velocity = r.positive(entry, "max_velocity_rad_s", p, required=required)
+        range_rad = _range(r, entry, p)
         gains = tuple(k for k in ("kp", "kv") if k in entry)
         for key in gains:
             value = entry[key]
@@ -322,9 +334,27 @@ def _motors(r: _Reader, raw: Mapping[str, object]) -> tuple[MotorEntry, ...]:
                 max_torque_nm=torque,
                 max_velocity_rad_s=velocity,
                 free_gains=gains,
+                range_rad=range_rad,
             )
         )
     return tuple(motors)
+
+
+def _range(r: _Reader, entry: Mapping[str, object], pointer: str) -> tuple[float, float] | None:
+    """A motor's ``range_rad``: ``[lower, upper]`` in rad, lower below upper (or None)."""
+    value = entry.get("range_rad")
+    if value is None:
+        return None
+    if (
+        isinstance(value, list)
+        and len(value) == 2
+        and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
+        and all(math.isfinite(float(v)) for v in value)
+        and float(value[0]) < float(value[1])
+    ):
+        return (float(value[0]), float(value[1]))
+    r.problem(f"{pointer}/range_rad", f"{value!r} is not [lower, upper] in rad with lower < upper")
+    return None
 
 
 def _cameras(r: _Reader, raw: Mapping[str, object]) -> tuple[CameraEntry, ...]:

@@ -9,11 +9,12 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from simulator.errors import ModelProblem
 from simulator.world.robots.model import CameraSpec, MotorLookup, MotorSpec, RobotMjcf
 from simulator.world.robots.team.build import PREFIX, Template, build_template
 from simulator.world.robots.team.manifest import Manifest, load_manifest
 from simulator.world.robots.team.servos import motor_spec
-from simulator.world.robots.team.source import load_spec
+from simulator.world.robots.team.source import load_spec_with_notes
 
 VISUAL = "/visual:"
 
@@ -29,6 +30,7 @@ class TeamRobotModel(MotorLookup):
     camera: CameraSpec
     force_sensors: tuple[str, ...]
     template: Template
+    notes: tuple[ModelProblem, ...] = ()  # what of the model file the world leaves out
 
     @property
     def standing_height_m(self) -> float:
@@ -89,7 +91,8 @@ def load_team_model(folder: Path) -> TeamRobotModel:
             return cached
         manifest = load_manifest(folder)
         key = manifest.name or folder.name
-        template = build_template(load_spec(manifest), manifest, key=key)
+        spec, notes = load_spec_with_notes(manifest)
+        template = build_template(spec, manifest, key=key)
         camera = manifest.cameras[0]
         model = TeamRobotModel(
             name=str(folder),
@@ -108,6 +111,7 @@ def load_team_model(folder: Path) -> TeamRobotModel:
             ),
             force_sensors=tuple(manifest.force_sensors),
             template=template,
+            notes=tuple(notes),
         )
         _CACHE[folder] = model
         return model

@@ -288,9 +288,11 @@ def check(
             bad(
                 f"joint range of {motor.name}",
                 f"[{motor.lower_rad:g}, {motor.upper_rad:g}] rad: every motor joint needs its "
-                "range (lower < upper) in the model file",
+                "range (lower < upper): in the model file, or, where the file has none, as "
+                f'"range_rad": [lower, upper] (rad) in this motor\'s entry of /motors',
             )
     problems.extend(_inertia_problems(robot, source))
+    problems.extend(robot.notes)
     return m, problems
 
 

@@ -9,6 +9,23 @@ from simulator.world.robots.team.manifest import Manifest, MotorEntry
 from simulator.world.servos import find_servo
 
 RULE = "servos from the league catalogue"
+ARMATURE_BOUND = 2.0
+"""``joint_armature`` may be at most this factor above or below a catalogue servo's armature
+(its reflected rotor inertia): a gearbox's inertia is known to within that, not more."""
+ARMATURE_RULE = "armature within a factor 2 of the catalogue servo's reflected rotor inertia"
+
+
+def armature_of(entry: MotorEntry, manifest: Manifest) -> float:
+    """The joint's armature: the catalogue servo's, or the manifest's ``joint_armature`` held
+    within :data:`ARMATURE_BOUND` of it (free-form motors: the manifest's, else 0)."""
+    found = find_servo(entry.servo) if entry.servo else None
+    wanted = manifest.joint_armature
+    if found is None:
+        return wanted or 0.0
+    own = found.armature_kg_m2
+    if wanted is None:
+        return own
+    return min(max(wanted, own / ARMATURE_BOUND), own * ARMATURE_BOUND)
 
 
 def motor_spec(entry: MotorEntry, manifest: Manifest) -> MotorSpec:
@@ -40,6 +57,7 @@ def motor_spec(entry: MotorEntry, manifest: Manifest) -> MotorSpec:
         backlash_rad=spec.backlash_rad,
         encoder_resolution_rad=spec.encoder_resolution_rad,
         servo=found.id if found is not None else "",
+        armature_kg_m2=armature_of(entry, manifest),
     )
 
 
@@ -48,8 +66,11 @@ def servo_problems(manifest: Manifest, *, official: bool) -> list[ModelProblem]:
     gains (warnings in friendlies, errors when ``official``)."""
     source = str(manifest.path)
     free = "error" if official else "warning"
-    match = "not for an official match" if official else (
-        "for friendlies only (refused in official matches)")
+    match = (
+        "not for an official match"
+        if official
+        else ("for friendlies only (refused in official matches)")
+    )
     out: list[ModelProblem] = []
     for i, entry in enumerate(manifest.motors):
         at = f"/motors/{i}"
@@ -89,6 +110,24 @@ def servo_problems(manifest: Manifest, *, official: bool) -> list[ModelProblem]:
                     f"position control is Webots' (P, I, D from MotorPID; rule: {RULE})",
                 )
             )
+    if manifest.joint_armature is not None:
+        for entry in manifest.motors:
+            found = find_servo(entry.servo) if entry.servo else None
+            if found is None:
+                continue
+            own = found.armature_kg_m2
+            wanted = manifest.joint_armature
+            if not own / ARMATURE_BOUND * (1 - 1e-6) <= wanted <= own * ARMATURE_BOUND * (1 + 1e-6):
+                out.append(
+                    ModelProblem(
+                        source=source,
+                        where="/joint_armature",
+                        reason=f"{wanted:g} kg m^2 on {entry.name} ({found.id}) is outside "
+                        f"{own / ARMATURE_BOUND:.4g}-{own * ARMATURE_BOUND:.4g} kg m^2, a factor "
+                        f"{ARMATURE_BOUND:g} around the servo's {own:.4g} (rule: {ARMATURE_RULE}; "
+                        "leave joint_armature out to take each servo's own)",
+                    )
+                )
     for key, value in (
         ("joint_damping", manifest.joint_damping),
         ("joint_frictionloss", manifest.joint_frictionloss),

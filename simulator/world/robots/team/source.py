@@ -2,8 +2,17 @@
 
 URDF from ROS names meshes ``package://<package>/<path>``; they are resolved against the
 manifest's ``packages`` (or a folder of that name beside the manifest or the model file), and
-relative paths against the model file's folder. A mesh that is missing or unreadable is a
+relative paths against the model file's folder. MJCF files name them relative to the
+``<compiler>``'s ``meshdir`` / ``texturedir`` (or ``assetdir``), themselves relative to the
+file's folder, as MuJoCo reads them. A mesh that is missing or unreadable is a
 :class:`ModelProblem` naming the element and the path tried.
+
+A published MJCF file describes a scene as well as a robot: a ground plane, lights, a skybox,
+its own actuators, sensors, keyframes and contact exclusions, the solver options. The league's
+world provides all of these, so they are left out, each kind with a note (a problem of severity
+``note``, :data:`IGNORED`) naming the element and why; the robot's root body may keep the free
+joint the file gives it. What cannot be left out without changing the robot (equality
+constraints, tendons, included files) is an error naming the element and what to do.
 """
 
 from __future__ import annotations
@@ -17,11 +26,32 @@ from simulator.errors import ModelError, ModelProblem
 from simulator.world.robots.team.manifest import Manifest
 
 PACKAGE_SCHEME = "package://"
+IGNORED = "note"
+"""Severity of an element of the file that the league's world replaces (it is left out)."""
+_SCENE_SECTIONS = {
+    "actuator": "the motors are the manifest's catalogue servos (/motors)",
+    "sensor": "the sensors are the league's: IMU, cameras, force sensors and joint positions "
+    "named in the manifest",
+    "keyframe": "the robot is placed in the manifest's standing_pose_rad",
+    "contact": "self-collision follows the league's rule (docs/physics.md), the same for "
+    "every robot",
+    "option": "the world's physics options (time step, solver) are the league's",
+    "size": "the world's sizes are the league's",
+    "visual": "rendering is the league's",
+    "statistic": "the world's statistics are computed from the whole scene",
+}
+_UNSUPPORTED = {
+    "equality": "equality constraints (closed loops, coupled joints) are not supported: "
+    "describe the robot as a tree with one joint per motor",
+    "tendon": "tendons are not supported: describe the robot as a tree with one joint per motor",
+    "include": "included files are not read: put their content in the model file",
+}
 
 
-def _resolve(manifest: Manifest, ref: str) -> list[Path]:
-    """Candidate files for a mesh reference, in the order they are tried."""
-    base = manifest.model_file.parent
+def _resolve(manifest: Manifest, ref: str, base: Path | None = None) -> list[Path]:
+    """Candidate files for a mesh reference, in the order they are tried (relative paths
+    against ``base``, by default the model file's folder)."""
+    base = base or manifest.model_file.parent
     if ref.startswith(PACKAGE_SCHEME):
         package, _, rest = ref[len(PACKAGE_SCHEME) :].partition("/")
         roots = [manifest.packages[package]] if package in manifest.packages else []
@@ -33,6 +63,105 @@ def _resolve(manifest: Manifest, ref: str) -> list[Path]:
         ref = ref[len("file://") :]
     path = Path(ref)
     return [path] if path.is_absolute() else [base / path]
+
+
+def _asset_dirs(root: ET.Element, model_file: Path) -> dict[str, Path]:
+    """Element tag -> folder its ``file`` is relative to (MJCF ``<compiler>``: ``meshdir`` and
+    ``texturedir``, each defaulting to ``assetdir``, all relative to the file's folder)."""
+    base = model_file.parent
+    dirs = {"mesh": base, "texture": base, "hfield": base, "skin": base}
+    if root.tag != "mujoco":
+        return dirs
+    for compiler in root.iter("compiler"):
+        asset = compiler.get("assetdir")
+        mesh = compiler.get("meshdir", asset)
+        texture = compiler.get("texturedir", asset)
+        if mesh is not None:
+            for tag in ("mesh", "hfield", "skin"):
+                dirs[tag] = base / mesh
+        if texture is not None:
+            dirs["texture"] = base / texture
+        for key in ("assetdir", "meshdir", "texturedir"):
+            compiler.attrib.pop(key, None)
+    return dirs
+
+
+def _scene_notes(
+    manifest: Manifest, root: ET.Element
+) -> tuple[list[ModelProblem], list[ModelProblem]]:
+    """Leave out of an MJCF file what the league's world provides (notes) and report what
+    cannot be left out (errors); ``root`` is edited."""
+    source = str(manifest.model_file)
+    notes: list[ModelProblem] = []
+    errors: list[ModelProblem] = []
+    if root.tag != "mujoco":
+        return notes, errors
+
+    def note(where: str, reason: str) -> None:
+        notes.append(ModelProblem(source=source, where=where, reason=reason, severity=IGNORED))
+
+    for element in list(root):
+        if element.tag in _SCENE_SECTIONS:
+            count = len(list(element))
+            what = f" ({count} element{'s' if count != 1 else ''})" if count else ""
+            note(f"<{element.tag}>", f"ignored{what}: {_SCENE_SECTIONS[element.tag]}")
+            root.remove(element)
+        elif element.tag in ("equality", "tendon") and len(element):
+            errors.append(
+                ModelProblem(
+                    source=source, where=f"<{element.tag}>", reason=_UNSUPPORTED[element.tag]
+                )
+            )
+    for parent in root.iter():
+        for child in list(parent):
+            if child.tag == "include":
+                errors.append(
+                    ModelProblem(
+                        source=source,
+                        where=f"<include file={child.get('file')!r}>",
+                        reason=_UNSUPPORTED["include"],
+                    )
+                )
+    for asset in root.findall("asset"):
+        for texture in [t for t in asset.findall("texture") if t.get("type") == "skybox"]:
+            note(f"<texture type='skybox'{_named(texture)}>", "ignored: the sky is the league's")
+            asset.remove(texture)
+    for worldbody in root.findall("worldbody"):
+        for element in list(worldbody):
+            if element.tag in ("body", "frame"):
+                continue
+            detail = f" type={element.get('type')!r}" if element.get("type") else ""
+            reason = {
+                "geom": "the ground is the league's field",
+                "light": "the lights are the league's",
+                "camera": "cameras are the manifest's /cameras, on the robot's links",
+                "site": "a site outside the robot",
+            }.get(element.tag, "outside the robot")
+            note(f"<worldbody><{element.tag}{_named(element)}{detail}>", f"ignored: {reason}")
+            worldbody.remove(element)
+        for parent in worldbody.iter():
+            for light in [c for c in parent if c.tag == "light"]:
+                note(f"<light{_named(light)}> in <body{_named(parent)}>",
+                     "ignored: the lights are the league's")  # fmt: skip
+                parent.remove(light)
+    counted: dict[tuple[str, str], int] = {}
+    for n in notes:
+        counted[(n.where, n.reason)] = counted.get((n.where, n.reason), 0) + 1
+    notes = [
+        ModelProblem(
+            source=source,
+            where=where if count == 1 else f"{where} x{count}",
+            reason=reason,
+            severity=IGNORED,
+        )
+        for (where, reason), count in counted.items()
+    ]
+    return notes, errors
+
+
+def _named(element: ET.Element) -> str:
+    name = element.get("name")
+    return f" name={name!r}" if name else ""
 
 
 def _parse(manifest: Manifest) -> ET.Element:
@@ -55,23 +184,26 @@ def _parse(manifest: Manifest) -> ET.Element:
 
 
 def _check_meshes(manifest: Manifest, root: ET.Element) -> list[ModelProblem]:
-    """Rewrite every mesh ``filename``/``file`` to an absolute path; report missing ones."""
+    """Rewrite every mesh (texture, height field) ``filename``/``file`` to an absolute path;
+    report missing ones."""
     problems = []
     source = str(manifest.model_file)
-    for element in root.iter("mesh"):
+    dirs = _asset_dirs(root, manifest.model_file)
+    elements = [e for tag in ("mesh", "texture", "hfield", "skin") for e in root.iter(tag)]
+    for element in elements:
         attr = "filename" if "filename" in element.attrib else "file"
         ref = element.get(attr)
         if ref is None:
             continue
-        candidates = _resolve(manifest, ref)
+        candidates = _resolve(manifest, ref, dirs.get(element.tag))
         found = next((p for p in candidates if p.is_file()), None)
         if found is None:
             tried = ", ".join(str(p) for p in candidates)
             problems.append(
                 ModelProblem(
                     source=source,
-                    where=f"<mesh {attr}={ref!r}>",
-                    reason=f"mesh file not found (tried {tried})",
+                    where=f"<{element.tag} {attr}={ref!r}>",
+                    reason=f"{element.tag} file not found (tried {tried})",
                 )
             )
             continue
@@ -82,8 +214,8 @@ def _check_meshes(manifest: Manifest, root: ET.Element) -> list[ModelProblem]:
             problems.append(
                 ModelProblem(
                     source=source,
-                    where=f"<mesh {attr}={ref!r}>",
-                    reason=f"mesh file not readable: {exc}",
+                    where=f"<{element.tag} {attr}={ref!r}>",
+                    reason=f"{element.tag} file not readable: {exc}",
                 )
             )
             continue
@@ -93,8 +225,14 @@ def _check_meshes(manifest: Manifest, root: ET.Element) -> list[ModelProblem]:
 
 def load_spec(manifest: Manifest) -> mujoco.MjSpec:
     """The model file as an editable MuJoCo spec (visual meshes kept, nothing fused)."""
+    return load_spec_with_notes(manifest)[0]
+
+
+def load_spec_with_notes(manifest: Manifest) -> tuple[mujoco.MjSpec, list[ModelProblem]]:
+    """:func:`load_spec` and the notes on what of the file was left out (see the module)."""
     root = _parse(manifest)
-    problems = _check_meshes(manifest, root)
+    notes, problems = _scene_notes(manifest, root)
+    problems += _check_meshes(manifest, root)
     if problems:
         raise ModelError(problems)
     is_urdf = root.tag == "robot"
@@ -122,11 +260,6 @@ def load_spec(manifest: Manifest) -> mujoco.MjSpec:
                 "balanceinertia": "true",
             },
         )
-    else:
-        compiler = root.find("compiler")
-        if compiler is None:
-            compiler = ET.SubElement(root, "compiler")
-        compiler.set("meshdir", str(manifest.model_file.parent))
     text = ET.tostring(root, encoding="unicode")
     try:
         spec = mujoco.MjSpec.from_string(text)
@@ -141,4 +274,4 @@ def load_spec(manifest: Manifest) -> mujoco.MjSpec:
                 )
             ]
         ) from None
-    return spec
+    return spec, notes
