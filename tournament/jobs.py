@@ -32,6 +32,9 @@ log = logging.getLogger(__name__)
 S = ScheduledMatchState
 STOPPING = threading.Event()
 """Set when the scheduler process stops: a match that ends then was interrupted, not failed."""
+DEFAULT_STOP_GRACE_S = 60.0
+"""Seconds a playing match has to stop and collect its logs when the scheduler is stopped
+(SIGTERM, Ctrl-C) before it is killed; ``hlvs schedule run --stop-grace``."""
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -95,12 +98,20 @@ class Tournament:
             red=self.schedule.team(red),
             blue=self.schedule.team(blue),
             out_dir=self.schedule.output_dir / match_id,
-            abort=lambda: self.abort_requested(match_id),
+            abort=lambda: self.stop_or_abort(match_id),
         )
 
     def abort_requested(self, match_id: str) -> Abort | None:
         request = abort_request(self.ledger.row(match_id).request)
         return None if request is None else Abort(reason=request[0], grace_s=request[1])
+
+    def stop_or_abort(self, match_id: str) -> Abort | None:
+        """What a playing match polls: the scheduler's stop, else the operator's abort."""
+        if STOPPING.is_set():
+            grace = self.ledger.get_meta("stop_grace_s")
+            return Abort(reason="the scheduler is stopping", stop=True,
+                         grace_s=float(grace) if grace else DEFAULT_STOP_GRACE_S)
+        return self.abort_requested(match_id)
 
     def planned_now(self, match_id: str) -> PlannedMatch:
         """The match as the ledger has it now (its times may have been rescheduled)."""
@@ -199,9 +210,12 @@ def play_job(state_path: str, match_id: str) -> None:
         log.warning("match %s: aborted by the operator: %s", match_id, aborted.reason)
         return
     if STOPPING.is_set() and outcome.status not in PLAYED_STATUSES:
-        # the scheduler is stopping (Ctrl-C, SIGTERM): the match died with it; it stays
-        # PLAYING, and the next start replays it into a new attempt folder
+        # the scheduler is stopping (Ctrl-C, SIGTERM): the match was stopped with it; it stays
+        # PLAYING (marked interrupted), and the next start replays it into a new attempt folder
         log.warning("match %s: interrupted by the scheduler's stop (%s)", match_id, outcome.cause)
+        t.ledger.transition(match_id, (S.PLAYING,), S.PLAYING,
+                            note=f"interrupted by the scheduler's stop ({outcome.status}: "
+                            f"{outcome.cause}); played again at the next start")
         return
     if _needs_shootout(ctx, outcome):
         outcome = _shootout(t, ctx, outcome)

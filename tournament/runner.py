@@ -11,13 +11,22 @@ still useful (a match whose stream started is marked MISSED with the reason).
 from __future__ import annotations
 
 import logging
+import math
 import signal
 import threading
+import time
 from datetime import UTC, datetime, timedelta
 from pathlib import Path
 from typing import Any
 
-from apscheduler.events import EVENT_JOB_ERROR, EVENT_JOB_EXECUTED, JobExecutionEvent
+from apscheduler.events import (
+    EVENT_JOB_ERROR,
+    EVENT_JOB_EXECUTED,
+    EVENT_JOB_MISSED,
+    EVENT_JOB_SUBMITTED,
+    JobEvent,
+    JobExecutionEvent,
+)
 from apscheduler.executors.pool import ThreadPoolExecutor
 from apscheduler.jobstores.sqlalchemy import SQLAlchemyJobStore
 from apscheduler.schedulers.background import BackgroundScheduler
@@ -135,14 +144,61 @@ def recover_interrupted(ledger: Ledger) -> list[str]:
     return recovered
 
 
-def reconcile(scheduler: Any, ledger: Ledger, state_path: str) -> None:
-    """One job for the next step of every unfinished match (none while a step runs)."""
+class RunningJobs:
+    """The jobs handed to an executor and not finished: running, or queued for a simulator
+    slot. A queued job is not in APScheduler's store any more; adding it again would make
+    APScheduler skip it ("maximum number of running instances reached") at every pass."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._count: dict[str, int] = {}
+
+    def listen(self, event: JobEvent) -> None:
+        # a counter: a job may finish before its submission event is dispatched
+        step = 1 if event.code == EVENT_JOB_SUBMITTED else -1
+        with self._lock:
+            count = self._count.get(event.job_id, 0) + step
+            if count:
+                self._count[event.job_id] = count
+            else:
+                self._count.pop(event.job_id, None)
+
+    def ids(self) -> set[str]:
+        with self._lock:
+            return {job_id for job_id, count in self._count.items() if count > 0}
+
+
+class _OncePerMinute(logging.Filter):
+    """APScheduler's "skipped: maximum number of running instances reached" once a minute per
+    job at most (it may repeat every second while a match waits for a simulator slot)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self._last: dict[str, float] = {}
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        if "maximum number of running instances" not in record.msg:
+            return True
+        key = str(record.args[0]) if isinstance(record.args, tuple) and record.args else ""
+        now = time.monotonic()
+        if now - self._last.get(key, -math.inf) < 60.0:
+            return False
+        self._last[key] = now
+        return True
+
+
+def reconcile(scheduler: Any, ledger: Ledger, state_path: str,
+              running: set[str] | None = None) -> None:
+    """One job for the next step of every unfinished match (none while a step runs or waits
+    for its executor: ``running``)."""
     for row in ledger.rows():
         step = NEXT_STEP.get(row.state)
         if step is None:
             continue
         kind, attr = step
         job_id = f"{kind}:{row.id}"
+        if running and job_id in running:
+            continue
         run_at: datetime = getattr(row, attr)
         if row.not_before is not None and row.not_before > run_at:
             run_at = row.not_before
@@ -189,10 +245,21 @@ def run_schedule(
     exit_when_done: bool = False,
     poll_s: float = 1.0,
     stop: threading.Event | None = None,
+    stop_grace_s: float | None = None,
 ) -> int:
-    """Run the tournament until every match is final (with ``exit_when_done``) or a signal."""
+    """Run the tournament until every match is final (with ``exit_when_done``) or a signal.
+
+    SIGTERM or SIGINT stops it: a playing match gets SIGTERM (it stops and collects what was
+    played), SIGKILL after ``stop_grace_s`` (default :data:`tournament.jobs.DEFAULT_STOP_GRACE_S`,
+    kept in the state file), stays PLAYING marked interrupted, and is played again at the next
+    start. The call returns once the running steps ended (or a little after the grace period)."""
+    from tournament.jobs import DEFAULT_STOP_GRACE_S, STOPPING
+
+    STOPPING.clear()
     state = str(Path(state_path).resolve())
     schedule, ledger = init_state(schedule_path, state, services=services, pool=pool)
+    if stop_grace_s is not None:
+        ledger.set_meta("stop_grace_s", repr(float(stop_grace_s)))
     recover_interrupted(ledger)
     stop = stop or threading.Event()
     wake = threading.Event()
@@ -213,7 +280,12 @@ def run_schedule(
             log.error("job %s failed: %r", event.job_id, event.exception)
         wake.set()  # its match may have a next step now
 
+    running = RunningJobs()
+    scheduler.add_listener(running.listen, EVENT_JOB_SUBMITTED | EVENT_JOB_EXECUTED
+                           | EVENT_JOB_ERROR | EVENT_JOB_MISSED)
     scheduler.add_listener(job_done, EVENT_JOB_EXECUTED | EVENT_JOB_ERROR)
+    quiet = _OncePerMinute()
+    logging.getLogger("apscheduler.scheduler").addFilter(quiet)
     scheduler.start()
     log.info(
         "schedule %s: %d matches, %d simulator slot(s), state in %s",
@@ -225,7 +297,7 @@ def run_schedule(
     last: dict[str, str] = {}
     try:
         while not stop.is_set():
-            reconcile(scheduler, ledger, state)
+            reconcile(scheduler, ledger, state, running.ids())
             rows = ledger.rows()
             for row in rows:
                 if last.get(row.id) != row.state.value:
@@ -240,5 +312,23 @@ def run_schedule(
             wake.wait(poll_s)
             wake.clear()
     finally:
-        scheduler.shutdown(wait=not stop.is_set())
+        if STOPPING.is_set():
+            scheduler.shutdown(wait=False)
+            grace = ledger.get_meta("stop_grace_s")
+            _wait_for_steps(running, (float(grace) if grace else DEFAULT_STOP_GRACE_S) + 15.0)
+        else:
+            scheduler.shutdown(wait=not stop.is_set())
+        logging.getLogger("apscheduler.scheduler").removeFilter(quiet)
     return 0
+
+
+def _wait_for_steps(running: RunningJobs, timeout_s: float) -> None:
+    """Wait for the steps in progress (a stopping match collects its logs) up to ``timeout_s``."""
+    deadline = time.monotonic() + timeout_s
+    if running.ids():
+        log.info("waiting for %s to end", ", ".join(sorted(running.ids())))
+    while running.ids() and time.monotonic() < deadline:
+        time.sleep(0.1)
+    if running.ids():
+        log.warning("still running after %g s: %s; left to the next start", timeout_s,
+                    ", ".join(sorted(running.ids())))

@@ -50,6 +50,7 @@ class Abort:
 
     reason: str
     grace_s: float  # after SIGTERM (the match stops and collects its logs), then SIGKILL
+    stop: bool = False  # the scheduler itself stops (SIGTERM): the match is played again later
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -155,8 +156,9 @@ def keep_earlier_attempt(out: Path) -> Path | None:
 
 
 def _wait_or_abort(ctx: MatchContext, proc: subprocess.Popen[bytes]) -> None:
-    """Wait for ``hlvs match``; on an abort request SIGTERM it (it stops the match and
-    collects what was played), and SIGKILL it when the grace period has passed."""
+    """Wait for ``hlvs match``; on an abort request, or when the scheduler stops, SIGTERM it
+    (it stops the match and collects what was played), and SIGKILL it when the grace period
+    has passed."""
     while proc.poll() is None:
         abort = ctx.abort()
         if abort is None:
@@ -165,8 +167,8 @@ def _wait_or_abort(ctx: MatchContext, proc: subprocess.Popen[bytes]) -> None:
             except subprocess.TimeoutExpired:
                 pass
             continue
-        log.warning("match %s: aborting (%s); %g s of grace", ctx.match_id, abort.reason,
-                    abort.grace_s)
+        log.warning("match %s: %s (%s); %g s of grace", ctx.match_id,
+                    "stopping" if abort.stop else "aborting", abort.reason, abort.grace_s)
         proc.terminate()
         try:
             proc.wait(timeout=abort.grace_s)
@@ -304,6 +306,12 @@ class MatchServices:
                 if status.state in (JobState.FINISHED, JobState.LOST):
                     break
                 abort = ctx.abort()
+                if abort is not None and abort.stop:  # the job runs on; the next start adopts it
+                    log.warning("match %s: the scheduler stops; Slurm job %s runs on",
+                                ctx.match_id, pool.job_id(handle))
+                    return PlayOutcome(status="interrupted", score_red=None, score_blue=None,
+                                       winner=None, cause=f"{abort.reason}; Slurm job "
+                                       f"{pool.job_id(handle)} runs on")
                 if abort is not None and not cancelled:
                     log.warning("match %s: aborting Slurm job %s (%s)", ctx.match_id,
                                 pool.job_id(handle), abort.reason)

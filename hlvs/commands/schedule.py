@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import os
 import sys
 from datetime import UTC, datetime
 from pathlib import Path
@@ -34,6 +35,11 @@ def register(sub: Any) -> None:
                      help="where matches run: this host's Docker engine or one Slurm job per "
                      "match (default: the schedule's pool section, else local); remembered in "
                      "the state file")
+    run.add_argument("--stop-grace", type=float, default=None, metavar="S",
+                     help="on SIGTERM or Ctrl-C, seconds a playing match has to stop and collect "
+                     "its logs before it is killed (default 60; a supervisor's stop timeout, "
+                     "e.g. systemd's TimeoutStopSec, should be longer); remembered in the state "
+                     "file. The match is played again at the next start")
     run.set_defaults(func=_run, log_level=logging.INFO)
 
     plan = verbs.add_parser("list", help="what is planned, with absolute times")
@@ -111,10 +117,24 @@ def _run(args: argparse.Namespace) -> int:
         if any(p.severity == "error" for p in problems):
             raise ConfigError(problems)
 
-    return run_schedule(
+    if args.stop_grace is not None and args.stop_grace < 0:
+        raise ConfigError([Problem("--stop-grace", "", f"{args.stop_grace:g}",
+                                   expected="seconds, 0 or more")])
+    code = run_schedule(
         args.schedule, args.state, services=args.services, pool=args.pool,
-        exit_when_done=args.exit_when_done,
+        exit_when_done=args.exit_when_done, stop_grace_s=args.stop_grace,
     )
+    from tournament.jobs import STOPPING
+
+    if STOPPING.is_set():
+        # stopped by a signal: a step that cannot be interrupted (an image pull) must not keep
+        # the process; the state file is consistent at any instant and the next start takes
+        # the step up again
+        logging.shutdown()
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    return code
 
 
 def _list(args: argparse.Namespace) -> int:

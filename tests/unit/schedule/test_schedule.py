@@ -262,3 +262,49 @@ def test_reference_time_is_fixed_at_first_run(tmp_path: Path) -> None:
     first = ledger.row("m1").stream_start
     _, ledger = init_state(path, state, now=datetime(2031, 1, 1, tzinfo=UTC))
     assert ledger.row("m1").stream_start == first == datetime(2030, 1, 1, 1, tzinfo=UTC)
+
+
+def test_sigterm_stops_a_playing_match_within_the_grace_then_restart_replays_it(
+    tmp_path: Path,
+) -> None:
+    """A supervisor (systemd, Slurm) stops the scheduler with SIGTERM: the playing match is
+    asked to stop at once, the scheduler exits within the grace period, the match is marked
+    interrupted and played again (to its end, once) at the next start."""
+    path = write_schedule(
+        tmp_path,
+        COMPRESSED.replace("pull_lead_round_robin_s: 3.0", "pull_lead_round_robin_s: 14.0")
+        + "matches:\n  - {id: m1, red: alpha, blue: bravo, stream_start: '+15s',"
+        " stream_length_s: 0.2}\n",
+    )
+    state = tmp_path / "state.sqlite"
+    cmd = [sys.executable, "-m", "hlvs.cli", "schedule", "run", str(path), "--state",
+           str(state), "--exit-when-done", "--services", FAKE, "--stop-grace", "5"]
+    first = subprocess.Popen(cmd, env={**os.environ, "HLVS_FAKE_PLAY_S": "120"},
+                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 60
+    while not any(w == "play-start" for w, _, _ in services_log(path)):
+        if time.monotonic() > deadline or first.poll() is not None:
+            first.kill()
+            pytest.fail("the match never started")
+        time.sleep(0.05)
+    first.send_signal(signal.SIGTERM)
+    asked = time.monotonic()
+    try:
+        first.wait(timeout=20)
+    except subprocess.TimeoutExpired:
+        first.kill()
+        first.wait()
+        pytest.fail("the scheduler was still running 20 s after SIGTERM")
+    assert time.monotonic() - asked < 20 and first.returncode == 0
+    assert [w for w, _, _ in services_log(path)] == ["pull", "play-start", "play-stopped"]
+    row = Ledger(state).row("m1")
+    assert row.state is ScheduledMatchState.PLAYING
+    assert row.note.startswith("interrupted by the scheduler's stop")
+    second = subprocess.run(cmd, env={**os.environ, "HLVS_FAKE_PLAY_S": "0.3"},
+                            capture_output=True, text=True, timeout=120)
+    assert second.returncode == 0, second.stderr
+    assert Ledger(state).row("m1").state is ScheduledMatchState.DELIVERED
+    assert [w for w, _, _ in services_log(path)].count("play-end") == 1
+    notes = [note for *_, note in Ledger(state).history("m1")]
+    assert any(n.startswith("interrupted by the scheduler's stop") for n in notes)
+    assert "PLAYING interrupted by a restart" in notes

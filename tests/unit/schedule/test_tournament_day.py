@@ -261,3 +261,35 @@ def test_a_results_file_written_before_the_shootout_was_kept_apart_reads_right(
     outcome = read_outcome(tmp_path)
     assert (outcome.score_red, outcome.score_blue, outcome.shootout, outcome.winner) == (
         1, 1, {"red": 2, "blue": 4}, "blue")
+
+
+def test_a_match_waiting_for_the_simulator_slot_does_not_flood_the_log(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """Two matches due at once, one simulator slot: the second waits in the executor's queue;
+    the runner must not add its job again at every pass (APScheduler would log "skipped:
+    maximum number of running instances reached" each time), and such a line is not repeated
+    for a job within a minute."""
+    import logging
+
+    before = fake_services.PLAY_SECONDS
+    fake_services.PLAY_SECONDS = 2.0
+    path = write_schedule(
+        tmp_path,
+        COMPRESSED + "matches:\n  - {id: m1, red: alpha, blue: bravo, stream_start: '+6s',"
+        " stream_length_s: 0.2}\n  - {id: m2, red: charlie, blue: delta,"
+        " stream_start: '+6s', stream_length_s: 0.2}\n",
+    )
+    state = tmp_path / "state.sqlite"
+    try:
+        with caplog.at_level(logging.WARNING, logger="apscheduler"):
+            assert run_schedule(path, state, services=FAKE, exit_when_done=True,
+                                poll_s=0.05) == 0
+    finally:
+        fake_services.PLAY_SECONDS = before
+    assert {r.state for r in Ledger(state).rows()} == {S.DELIVERED}
+    starts = [(m, at) for w, m, at in services_log(path) if w == "play-start"]
+    assert len(starts) == 2 and (starts[1][1] - starts[0][1]).total_seconds() >= 1.9
+    flood = [str(r.args[0]).split(" (")[0] for r in caplog.records  # type: ignore[index]
+             if "maximum number of running instances" in r.msg]
+    assert len(flood) == len(set(flood)), flood  # a job is queued, never added again and again
