@@ -142,7 +142,9 @@ def file_differences(ledger: Ledger) -> list[str]:
 
 def apply_file(ledger: Ledger, *, now: datetime | None = None) -> list[str]:
     """Make the schedule file the tournament's schedule: new matches are added, matches not yet
-    started take the file's times, matches no longer in the file and not started are cancelled.
+    started whose time the edit changed take the file's time (unless it has passed; a match
+    rescheduled by hand keeps its time when the edit left it alone), matches no longer in the
+    file and not started are cancelled.
     Refuses a file with errors (``hlvs check``). Returns what changed, one sentence each."""
     from orchestrator.config import check_schedule
 
@@ -157,7 +159,9 @@ def apply_file(ledger: Ledger, *, now: datetime | None = None) -> list[str]:
     schedule = load_schedule(path, text=text)
     changes = []
     rows = {row.id: row for row in ledger.rows()}
-    planned_all = schedule.plan(reference_of(ledger))
+    reference = reference_of(ledger)
+    planned_all = schedule.plan(reference)
+    before = {p.match.id: p.stream_start for p in recorded_schedule(ledger).plan(reference)}
     for planned in planned_all:
         row = rows.get(planned.match.id)
         if row is None:
@@ -165,7 +169,15 @@ def apply_file(ledger: Ledger, *, now: datetime | None = None) -> list[str]:
                            "red": str(planned.match.red), "blue": str(planned.match.blue),
                            **_times(planned)})
             changes.append(f"match {planned.match.id}: added")
-        elif row.state in (S.PLANNED, S.PULLED) and planned.stream_start != row.stream_start:
+        elif (row.state not in (S.PLANNED, S.PULLED) or planned.stream_start == row.stream_start
+              or before.get(row.id) == planned.stream_start):
+            continue  # the file did not move it: a time given by hand (reschedule) is kept
+        elif planned.stream_start <= now:
+            changes.append(
+                f"match {row.id}: the file's stream {_at(planned.stream_start)} has passed; "
+                f"it keeps {_at(row.stream_start)} ('hlvs schedule reschedule {row.id} --at "
+                "TIME' to move it)")
+        else:
             ledger.reschedule(row.id, _times(planned), note="times from the applied schedule")
             changes.append(f"match {row.id}: stream {_at(planned.stream_start)}")
     listed = {p.match.id for p in planned_all}

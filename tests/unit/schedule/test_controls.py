@@ -199,3 +199,33 @@ def test_a_match_that_dies_with_a_stopping_scheduler_is_replayed_not_failed(
                 assert ledger.row("m1").note == "infrastructure: report.json was not written"
     finally:
         fake_services.BROKEN.clear()
+
+
+def test_apply_of_an_unrelated_edit_keeps_the_times_given_by_hand(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A half's length edited and applied: a match rescheduled by hand keeps its new time; a
+    match whose time the edit changed takes it, unless the file's time has passed."""
+    path = write_schedule(
+        tmp_path, "game_defaults: {seed: 1}\n"
+        "matches:\n  - {id: m1, red: alpha, blue: bravo, stream_start: '+2h'}\n"
+        "  - {id: m2, red: charlie, blue: delta, stream_start: '+3h'}\n"
+        "  - {id: m3, red: alpha, blue: charlie, stream_start: '+4h'}\n")
+    state = tmp_path / "state.sqlite"
+    init_state(path, state)
+    ledger = Ledger(state)
+    moved = (datetime.now(UTC) + timedelta(hours=6)).replace(microsecond=0)
+    assert main(["schedule", "reschedule", "m1", "--state", str(state), "--at",
+                 moved.isoformat()]) == 0
+    m2, m3 = ledger.row("m2").stream_start, ledger.row("m3").stream_start
+    past = (datetime.now(UTC) - timedelta(hours=1)).replace(microsecond=0).isoformat()
+    path.write_text(path.read_text().replace("seed: 1", "seed: 2").replace("'+3h'", "'+5h'")
+                    .replace("'+4h'", f"'{past}'"))
+    capsys.readouterr()
+    assert main(["schedule", "apply", "--state", str(state)]) == 0
+    out = capsys.readouterr().out
+    assert ledger.row("m1").stream_start == moved and "m1" not in out
+    assert ledger.row("m2").stream_start == m2 + timedelta(hours=2)
+    assert "match m2: stream" in out
+    assert ledger.row("m3").stream_start == m3 and ledger.row("m3").state is S.PLANNED
+    assert "match m3: the file's stream" in out and "has passed" in out
