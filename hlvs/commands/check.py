@@ -89,6 +89,7 @@ class FileReportRecord(TypedDict):
     """One file of ``hlvs check --json``."""
 
     measurements: NotRequired[JSONObject]  # Measurements.to_json() (first when there)
+    devices: NotRequired[dict[str, list[str]]]  # a model's device names by kind
     file: str
     kind: str | None
     valid: bool
@@ -103,6 +104,7 @@ class FileReport:
     kind: str | None
     problems: list[Problem] = field(default_factory=list)
     measurements: Measurements | None = None  # robot model packages
+    devices: dict[str, list[str]] = field(default_factory=dict)  # their device names by kind
 
     @property
     def errors(self) -> list[Problem]:
@@ -121,7 +123,7 @@ class FileReport:
         }
         if self.measurements is None:
             return record
-        return {"measurements": self.measurements.to_json(), **record}
+        return {"measurements": self.measurements.to_json(), "devices": self.devices, **record}
 
 
 def run(args: argparse.Namespace) -> int:
@@ -176,11 +178,12 @@ def check_report(
 ) -> FileReport:
     """Check one file (or robot model package) and return every problem found (nothing
     printed); ``official``: model packages and team files as for an official match."""
-    from orchestrator.config import check_model, is_model_package
+    from orchestrator.config import check_model, is_model_package, model_devices
 
     if is_model_package(path):
         problems, measurements = check_model(path, official=official)
-        return FileReport(str(path), "robot model", problems, measurements)
+        devices = model_devices(path) if measurements is not None else {}
+        return FileReport(str(path), "robot model", problems, measurements, devices)
     try:
         found_kind, problems = _check(
             path, kind=kind, field_class=field_class, images_required=images_required,
@@ -198,6 +201,9 @@ def print_text(report: FileReport, *, out: TextIO) -> None:
         from orchestrator.config import describe
 
         print(f"{report.file}: {describe(report.measurements)}", file=out)
+        for kind, names in report.devices.items():
+            listed = ", ".join(json.dumps(name, ensure_ascii=False) for name in names)
+            print(f"  {_KIND_LABELS.get(kind, kind)} ({len(names)}): {listed}", file=out)
     for problem in report.errors + [p for p in report.problems if p.severity != "error"]:
         print(str(problem), file=out)
     if report.valid:
@@ -206,6 +212,16 @@ def print_text(report: FileReport, *, out: TextIO) -> None:
         note = f", {warnings} warning{'s' if warnings != 1 else ''}" if warnings else ""
         note += f", {notes} note{'s' if notes != 1 else ''}" if notes else ""
         print(f"{report.file}: ok ({report.kind}{note})", file=out)
+
+
+_KIND_LABELS = {
+    "motor": "motors",
+    "position_sensor": "position sensors",
+    "accelerometer": "accelerometers",
+    "gyro": "gyros",
+    "camera": "camera",
+    "force": "force sensors",
+}
 
 
 def print_github(report: FileReport, *, out: TextIO) -> None:

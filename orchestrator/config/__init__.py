@@ -54,6 +54,7 @@ if TYPE_CHECKING:
         check_model,
         describe,
         is_model_package,
+        model_devices,
     )
     from orchestrator.config.schedule import (
         PlannedMatch,
@@ -113,6 +114,7 @@ __all__ = [
     "load_game",
     "load_schedule",
     "load_team",
+    "model_devices",
     "parse_credentials",
     "parse_game",
     "parse_json",
@@ -130,7 +132,7 @@ if not TYPE_CHECKING:
         "orchestrator.config.detect": ("Kind", "kind_by_content", "kind_by_name"),
         "orchestrator.config.jsonfile": ("parse_json", "read_text"),
         "orchestrator.config.robot_models": (
-            "BUILT_IN_MODELS", "check_model", "describe", "is_model_package",
+            "BUILT_IN_MODELS", "check_model", "describe", "is_model_package", "model_devices",
         ),
         "orchestrator.config.schedule": (
             "PlannedMatch", "Schedule", "SchedulePool", "ScheduledTeam", "Slot", "game_document",

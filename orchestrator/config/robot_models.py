@@ -54,16 +54,33 @@ def check_model(
     free-form servos are warnings, or errors when ``official``. Imports the simulator's model
     loader (and MuJoCo) on first use."""
     from simulator import ModelError
-    from simulator.world.robots.team import check, load_team_model
+    from simulator.world.robots.team import check, load_team_model, unserved_cameras
 
     folder = path if path.is_dir() else path.parent
     try:
-        measurements, found = check(load_team_model(folder), official=official)
+        model = load_team_model(folder)
+        measurements, found = check(model, official=official)
     except ModelError as exc:
         return [Problem(p.source, p.where, p.reason) for p in exc.problems], None
+    found = [*found, *unserved_cameras(model.manifest)]
     return [
         Problem(p.source, p.where, p.reason, severity=p.severity) for p in found
     ], measurements
+
+
+def model_devices(path: Path) -> dict[str, list[str]]:
+    """The device names a model package's robot answers to on the robot API, by kind
+    (``motor``, ``position_sensor``, ``accelerometer``, ``gyro``, ``camera``, ``force``); empty
+    when the package cannot be loaded (:func:`check_model` says why)."""
+    from simulator import ModelError
+    from simulator.world.robots.team import load_team_model
+
+    folder = path if path.is_dir() else path.parent
+    try:
+        devices = load_team_model(folder).devices
+    except ModelError:
+        return {}
+    return {str(kind): list(names) for kind, names in devices.by_kind().items()}
 
 
 def describe(measurements: Measurements) -> str:

@@ -1,8 +1,12 @@
 """The device interface the robot API server needs from the world.
 
-:class:`DeviceWorld` is the subset of ``simulator.world.World`` used by the server (names and
-semantics as HLVS: motors by name, position sensors ``<motor>S``, IMU, foot force sensors and a
-head camera). :class:`FakeDeviceWorld` implements it without MuJoCo for unit tests. A world may
+:class:`DeviceWorld` is the subset of ``simulator.world.World`` used by the server (semantics as
+HLVS: motors, position sensors, IMUs, foot force sensors and a head camera, each found by the
+name ``devices(robot)`` gives it: the robot model's, as its team's robot file names it; the
+built-in models' are the league's sample robot's, ``<motor>S``, ``Accelerometer``, ``Gyro``,
+``Camera``). :class:`FakeDeviceWorld` implements it without MuJoCo for unit tests, with the
+sample robot's names. The one-by-one reads (``read_accelerometer``, ``read_gyro``) are the
+first IMU's; a robot with more IMUs is read by name through ``read_sensors``. A world may
 also offer the batch forms ``set_motor_positions(robot, names, rads)`` and
 ``read_sensors(robot, names) -> flat values`` (``simulator.world.World`` does); sessions use them
 when present, with the same results as the one-by-one calls.

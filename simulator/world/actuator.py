@@ -32,6 +32,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
+from xml.sax.saxutils import quoteattr
 
 import mujoco
 import numpy as np
@@ -83,9 +84,9 @@ def actuator_xml(name: str, joint: str, spec: MotorSpec) -> str:
     k = c.gain_nm_s_per_rad
     t = c.motor_torque_nm
     return (
-        f'<general name="{name}" joint="{joint}" gaintype="fixed" biastype="affine" '
-        f'gainprm="{k:.6g}" biasprm="0 0 {-k:.6g}" ctrllimited="false" forcelimited="true" '
-        f'forcerange="{-t:.6g} {t:.6g}"/>'
+        f'<general name={quoteattr(name)} joint={quoteattr(joint)} gaintype="fixed" '
+        f'biastype="affine" gainprm="{k:.6g}" biasprm="0 0 {-k:.6g}" ctrllimited="false" '
+        f'forcelimited="true" forcerange="{-t:.6g} {t:.6g}"/>'
     )
 
 

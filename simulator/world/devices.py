@@ -1,7 +1,10 @@
-"""Robot devices for the robot API: motors, position sensors, IMU, foot forces, camera info.
+"""Robot devices for the robot API: motors, position sensors, IMUs, foot forces, camera info.
 
-Names are HLVS device names (``Neck``, ``NeckS``, ``Accelerometer``, ``Gyro``, ``Camera``,
-``llb``...). Unknown names raise :class:`simulator.errors.UnknownDeviceError`. Batch forms:
+Names are the robot model's device names (:class:`simulator.world.robots.devices.DeviceNames`):
+the built-in models answer to the league's sample robot's (``Neck``, ``NeckS``,
+``Accelerometer``, ``Gyro``, ``Camera``, ``llb``...), a team model to its manifest's (bit-bots'
+Wolfgang: ``HeadPan``, ``HeadPan_sensor``, ``imu accelerometer``, ``imu_head gyro``,
+``camera``...). Unknown names raise :class:`simulator.errors.UnknownDeviceError`. Batch forms:
 :meth:`DeviceAccess.read_positions` (name -> rad), :meth:`DeviceAccess.read_position_array`
 (numpy array in ``motor_names(robot)`` order), :meth:`DeviceAccess.set_motor_positions` (many
 targets in one vectorised write) and :meth:`DeviceAccess.read_sensors` (the values of named
@@ -73,14 +76,8 @@ class DeviceAccess:
         return int(r.actuators[slot])
 
     def devices(self, robot: RobotId) -> dict[str, DeviceKind]:
-        r = self._robot(robot)
-        out = {name: DeviceKind.MOTOR for name in r.model.motor_names}
-        out.update({f"{name}S": DeviceKind.POSITION_SENSOR for name in r.model.motor_names})
-        out["Accelerometer"] = DeviceKind.ACCELEROMETER
-        out["Gyro"] = DeviceKind.GYRO
-        out[r.model.camera.name] = DeviceKind.CAMERA
-        out.update({name: DeviceKind.FORCE for name in r.model.force_sensors})
-        return out
+        """Every device name the robot answers to, and its kind."""
+        return self._robot(robot).devices.kinds()
 
     def motor_names(self, robot: RobotId) -> tuple[str, ...]:
         return self._robot(robot).model.motor_names
@@ -139,10 +136,10 @@ class DeviceAccess:
         self.motors.set_pid(self._actuator(robot, name), float(p), float(i), float(d))
 
     def read_position(self, robot: RobotId, sensor_name: str) -> float:
-        """Joint angle (rad) of ``<motor>S`` (the motor name alone is accepted too)."""
+        """Joint angle (rad) of a position sensor (``NeckS``; the motor's name is accepted
+        too)."""
         r = self._robot(robot)
-        motor = sensor_name[:-1] if sensor_name.endswith("S") else sensor_name
-        slot = r.motor_slot.get(motor)
+        slot = r.position_slot.get(sensor_name, r.motor_slot.get(sensor_name))
         if slot is None:
             raise UnknownDeviceError(robot=str(robot), name=sensor_name, kind="position sensor")
         return float(self._readings[self._sensor_span.offset("qpos") + int(r.motor_qpos[slot])])
@@ -155,14 +152,14 @@ class DeviceAccess:
         return np.asarray(self._joint_readings(self._robot(robot)), dtype=np.float64)
 
     def read_positions(self, robot: RobotId) -> dict[str, float]:
-        """``{"NeckS": rad, ...}`` for every position sensor."""
+        """``{"NeckS": rad, ...}`` for every position sensor (by its device name)."""
         r = self._robot(robot)
         values = self._joint_readings(r).tolist()
-        return {f"{n}S": v for n, v in zip(r.model.motor_names, values, strict=True)}
+        return dict(zip(r.devices.position_sensors, values, strict=True))
 
     def read_sensors(self, robot: RobotId, names: Sequence[str]) -> npt.NDArray[np.float64]:
-        """The values of ``names`` in order, flat: one per position (``<motor>S``) and force
-        sensor, three per ``Accelerometer`` and ``Gyro`` (x, y, z)."""
+        """The values of ``names`` in order, flat: one per position and force sensor, three
+        per accelerometer and gyro (x, y, z)."""
         return self.gather_sensors(self.sensor_sources(robot, names))
 
     def sensor_sources(
@@ -215,15 +212,15 @@ class DeviceAccess:
         src_s: list[int] = []
         for name in names:
             at = len(out_q) + len(out_s)
-            if name in ("Accelerometer", "Gyro"):
-                adr = r.accelerometer if name == "Accelerometer" else r.gyro
+            adr = r.imu_sensors.get(name)
+            if adr is not None:
                 out_s.extend((at, at + 1, at + 2))
                 src_s.extend((adr, adr + 1, adr + 2))
             elif name in r.forces:
                 out_s.append(at)
                 src_s.append(r.forces[name])
             else:
-                slot = r.motor_slot.get(name[:-1] if name.endswith("S") else name)
+                slot = r.position_slot.get(name, r.motor_slot.get(name))
                 if slot is None:
                     raise UnknownDeviceError(robot=str(robot), name=name, kind="sensor")
                 out_q.append(at)
@@ -248,15 +245,16 @@ class DeviceAccess:
         return (x, y, z)
 
     def read_accelerometer(self, robot: RobotId) -> Vec3:
-        """Proper acceleration in the torso frame, m/s^2 (+9.81 on z when standing still)."""
+        """Proper acceleration in the first IMU's frame (the torso's), m/s^2 (+9.81 on z when
+        standing still)."""
         return self._vec3(self._robot(robot).accelerometer)
 
     def read_gyro(self, robot: RobotId) -> Vec3:
-        """Angular velocity in the torso frame, rad/s."""
+        """Angular velocity in the first IMU's frame (the torso's), rad/s."""
         return self._vec3(self._robot(robot).gyro)
 
     def read_force(self, robot: RobotId, name: str) -> float:
-        """Normal force (N) on one sole corner (``llb`` ... ``rrb``)."""
+        """Normal force (N) of one force sensor (a sole corner: ``llb`` ... ``rrb``)."""
         r = self._robot(robot)
         adr = r.forces.get(name)
         if adr is None:

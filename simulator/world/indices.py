@@ -14,7 +14,8 @@ from contracts import RobotId
 from referee import BodyPart
 from simulator.world.ball import BALL_GEOM, BALL_JOINT
 from simulator.world.robots import AnyRobotModel, robot_model
-from simulator.world.types import RobotPlacement, robot_prefix
+from simulator.world.robots.devices import DeviceNames, imu_sensor
+from simulator.world.types import DeviceKind, RobotPlacement, robot_prefix
 
 IntArray = npt.NDArray[np.int64]
 PARTS: tuple[BodyPart, ...] = tuple(BodyPart)
@@ -44,13 +45,17 @@ class RobotIndex:
     torso_body: int
     hull_bodies: IntArray
     geoms: IntArray
-    accelerometer: int  # sensordata address (3 values)
+    accelerometer: int  # sensordata address (3 values) of the first IMU's
     gyro: int
     com_velocity: int
-    forces: dict[str, int]
+    forces: dict[str, int]  # force sensor's device name -> sensordata address
     camera: int
     qpos_range: tuple[int, int]
     dof_range: tuple[int, int]
+    devices: DeviceNames  # the names the robot answers to on the robot API
+    position_slot: dict[str, int]  # position sensor's device name -> slot (as motor_slot)
+    imus: tuple[tuple[int, int], ...]  # sensordata addresses (accelerometer, gyro) per IMU
+    imu_sensors: dict[str, int]  # accelerometer's or gyro's device name -> address (3 values)
 
 
 @dataclass(frozen=True, slots=True)
@@ -94,6 +99,15 @@ def _robot_index(
         return int(model.sensor(f"{prefix}/{name}").adr[0])
 
     geoms = [i for i, g in enumerate(geom_names) if g.startswith(prefix + "/")]
+    devices = spec.devices
+    imus = tuple(
+        (sensor(imu_sensor(k, DeviceKind.ACCELEROMETER)), sensor(imu_sensor(k, DeviceKind.GYRO)))
+        for k in range(len(devices.imus))
+    )
+    imu_sensors: dict[str, int] = {}
+    for imu, (accelerometer, gyro) in zip(devices.imus, imus, strict=True):
+        imu_sensors[imu.accelerometer] = accelerometer
+        imu_sensors[imu.gyro] = gyro
     qpos_start = int(root.qposadr[0])
     dof_start = int(root.dofadr[0])
     return RobotIndex(
@@ -110,13 +124,20 @@ def _robot_index(
         torso_body=torso,
         hull_bodies=np.array([model.body(f"{prefix}/{b}").id for b in HULL_BODIES], dtype=np.int64),
         geoms=np.array(geoms, dtype=np.int64),
-        accelerometer=sensor("Accelerometer"),
-        gyro=sensor("Gyro"),
+        accelerometer=imus[0][0],
+        gyro=imus[0][1],
         com_velocity=sensor("com_velocity"),
-        forces={name: sensor(name) for name in spec.force_sensors},
+        forces={
+            name: sensor(mjcf)
+            for name, mjcf in zip(devices.forces, devices.force_mjcf, strict=True)
+        },
         camera=model.camera(f"{prefix}/{spec.camera.name}").id,
         qpos_range=(qpos_start, qpos_start + 7 + len(names)),
         dof_range=(dof_start, dof_start + 6 + len(names)),
+        devices=devices,
+        position_slot={name: i for i, name in enumerate(devices.position_sensors)},
+        imus=imus,
+        imu_sensors=imu_sensors,
     )
 
 

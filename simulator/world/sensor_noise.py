@@ -94,14 +94,17 @@ class SensorNoise:
         self._flat = flat
         self.values: npt.NDArray[np.float64] = np.array(flat.values, dtype=np.float64)
         q_src = np.concatenate([r.motor_qpos for r in index.robots] or [np.zeros(0, np.int64)])
-        imu: list[int] = []
+        imu: list[int] = []  # every IMU's gyro, robot by robot, then every accelerometer
         for r in index.robots:
-            imu.extend(range(r.gyro, r.gyro + 3))
+            for _accelerometer, gyro in r.imus:
+                imu.extend(range(gyro, gyro + 3))
+        ngyro = len(imu)
         for r in index.robots:
-            imu.extend(range(r.accelerometer, r.accelerometer + 3))
+            for accelerometer, _gyro in r.imus:
+                imu.extend(range(accelerometer, accelerometer + 3))
         forces = [adr for r in index.robots for adr in r.forces.values()]
         self._nq = len(q_src)
-        self._ngyro = 3 * len(index.robots)
+        self._ngyro = ngyro
         self._nimu = len(imu)
         self._index = np.concatenate(
             [
@@ -147,7 +150,8 @@ class SensorNoise:
 
     @property
     def imu_bias(self) -> npt.NDArray[np.float64]:
-        """The biases of the last readings: gyro x y z of every robot, then accelerometer."""
+        """The biases of the last readings: gyro x y z of every robot's IMUs, then
+        accelerometer."""
         row: npt.NDArray[np.float64] = self._bias_rows[self._row - 1]
         return row
 

@@ -6,6 +6,7 @@ import math
 from dataclasses import dataclass
 
 from robot import CAMERA_FOV_RAD, HumanoidGeometry
+from simulator.world.robots.devices import DeviceNames
 from simulator.world.servos import Servo
 
 FORCE_SENSORS = ("llb", "llf", "lrf", "lrb", "rlb", "rlf", "rrf", "rrb")
@@ -102,6 +103,13 @@ class RobotModel(MotorLookup):
     @property
     def standing_height_m(self) -> float:
         return self.geometry.standing_height_m
+
+    @property
+    def devices(self) -> DeviceNames:
+        """The league's sample robot's names: ``<motor>S``, ``Accelerometer``, ``Gyro``."""
+        return DeviceNames.league(
+            self.motor_names, camera=self.camera.name, forces=self.force_sensors
+        )
 
     @property
     def standing_pose_rad(self) -> tuple[float, ...]:

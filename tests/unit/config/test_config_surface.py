@@ -50,6 +50,7 @@ EXPECTED = {
     "load_game",
     "load_schedule",
     "load_team",
+    "model_devices",
     "parse_credentials",
     "parse_game",
     "parse_json",

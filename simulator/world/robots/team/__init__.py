@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from contracts import lazy_exports
+from simulator.world.robots.team.devices import unserved_cameras
 from simulator.world.robots.team.manifest import MANIFEST_NAME, Manifest, load_manifest
 from simulator.world.robots.team.model import TeamRobotModel, load_team_model
 
@@ -19,6 +20,7 @@ __all__ = [
     "check",
     "load_manifest",
     "load_team_model",
+    "unserved_cameras",
 ]
 
 

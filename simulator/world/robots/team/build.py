@@ -21,14 +21,18 @@ from __future__ import annotations
 import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
+from xml.sax.saxutils import quoteattr
 
 import mujoco
 import numpy as np
 
 from simulator.errors import ModelError, ModelProblem
 from simulator.world.actuator import actuator_xml, line_constants
+from simulator.world.robots.devices import imu_sensor, imu_site
+from simulator.world.robots.team.devices import force_mjcf, imus_of
 from simulator.world.robots.team.manifest import Manifest
 from simulator.world.robots.team.servos import motor_spec
+from simulator.world.types import DeviceKind
 
 PREFIX = "@ROBOT@"
 HULL = (
@@ -312,7 +316,7 @@ def _validate(spec: mujoco.MjSpec, manifest: Manifest) -> list[ModelProblem]:
                 )
             )
     problems += _line_problems(manifest)
-    named: list[tuple[str, str]] = [("/imu/link", manifest.imu_link)]
+    named: list[tuple[str, str]] = [(f"{i.where}/link", i.link) for i in imus_of(manifest)]
     named += [(f"/cameras/{i}/link", c.link) for i, c in enumerate(manifest.cameras)]
     named += [(f"/force_sensors/{k}", v) for k, v in manifest.force_sensors.items()]
     named += [(f"/parts ({part})", link) for link, part in manifest.parts.items()]
@@ -434,9 +438,9 @@ def build_template(spec: mujoco.MjSpec, manifest: Manifest, *, key: str) -> Temp
             joint.damping = [physics.damping_nm_s_per_rad, 0.0, 0.0]
             joint.frictionloss = physics.static_friction_nm
             joint.armature = physics.armature_kg_m2
-        if link == manifest.imu_link:
-            site = body.add_site()
-            site.name = f"{p}/site:imu"
+        for k, imu in enumerate(imus_of(manifest)):
+            if imu.link == link:
+                body.add_site().name = f"{p}/{imu_site(k)}"
         for sensor, sensor_link in manifest.force_sensors.items():
             if manifest.collision == "link-boxes" and sensor_link in sensor_sites.get(link, {}):
                 lo, hi = sensor_sites[link][sensor_link]
@@ -446,7 +450,7 @@ def build_template(spec: mujoco.MjSpec, manifest: Manifest, *, key: str) -> Temp
             else:
                 continue
             site = body.add_site()
-            site.name = f"{p}/site:{sensor}"
+            site.name = f"{p}/site:{force_mjcf(sensor)}"
             site.type = mujoco.mjtGeom.mjGEOM_BOX
             site.pos = (lo + hi) / 2
             site.size = (hi - lo) / 2
@@ -630,12 +634,17 @@ def _template(
         actuator_xml(f"{PREFIX}/{m.name}", f"{PREFIX}/{m.name}", motor_spec(m, manifest))
         for m in manifest.motors
     )
-    sensors = (
-        f'<accelerometer name="{PREFIX}/Accelerometer" site="{PREFIX}/site:imu"/>'
-        f'<gyro name="{PREFIX}/Gyro" site="{PREFIX}/site:imu"/>'
+    sensors = "".join(
+        f'<accelerometer name="{PREFIX}/{imu_sensor(k, DeviceKind.ACCELEROMETER)}" '
+        f'site="{PREFIX}/{imu_site(k)}"/>'
+        f'<gyro name="{PREFIX}/{imu_sensor(k, DeviceKind.GYRO)}" site="{PREFIX}/{imu_site(k)}"/>'
+        for k in range(len(imus_of(manifest)))
+    ) + (
         f'<subtreelinvel name="{PREFIX}/com_velocity" body="{PREFIX}/torso"/>'
         + "".join(
-            f'<touch name="{PREFIX}/{n}" site="{PREFIX}/site:{n}"/>' for n in manifest.force_sensors
+            f"<touch name={quoteattr(f'{PREFIX}/{force_mjcf(n)}')} "
+            f"site={quoteattr(f'{PREFIX}/site:{force_mjcf(n)}')}/>"
+            for n in manifest.force_sensors
         )
     )
     return Template(

@@ -22,6 +22,7 @@ from typing import Any
 
 from contracts import JSONObject
 from simulator.errors import ModelError, ModelProblem
+from simulator.world.robots.team.devices import device_name_problems
 from simulator.world.servos import find_servo, servo_ids
 
 MANIFEST_NAME = "robot_model.json"
@@ -44,6 +45,18 @@ class MotorEntry:
     max_velocity_rad_s: float | None
     free_gains: tuple[str, ...] = ()  # the free-form keys the entry sets (kp, kv)
     range_rad: tuple[float, float] | None = None  # the joint's range where the file has none
+    sensor: str = ""  # its position sensor's device name as written ("": name + sensor_suffix)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ImuEntry:
+    """One IMU: the link it sits in (at the link's origin, axes as the link's) and the device
+    names of its accelerometer and gyro. ``where``: its JSON pointer (``/imu`` or ``/imu/K``)."""
+
+    link: str
+    accelerometer: str = "Accelerometer"
+    gyro: str = "Gyro"
+    where: str = "/imu"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -78,6 +91,7 @@ class Manifest:
     joint_damping: float | None = None
     joint_armature: float | None = None
     joint_frictionloss: float | None = None
+    imus: tuple[ImuEntry, ...] = ()  # every IMU, the first in ``imu_link``
     extra: JSONObject = field(default_factory=dict)  # keys this build does not read
 
     @property
@@ -225,8 +239,8 @@ def load_manifest(folder_or_file: Path) -> Manifest:
             r.problem(f"/packages/{pkg}", f"{rel!r}: no such folder ({folder})")
         packages[pkg] = folder
     motors = _motors(r, raw)
-    imu = r.get(raw, "imu", dict, "") or {}
-    imu_link = r.get(imu, "link", str, "/imu") or ""
+    sensor_suffix = r.get(raw, "sensor_suffix", str, "", required=False, default="S")
+    imus = _imus(r, raw)
     cameras = _cameras(r, raw)
     forces = r.get(raw, "force_sensors", dict, "", required=False, default={}) or {}
     for key, link in forces.items():
@@ -260,15 +274,15 @@ def load_manifest(folder_or_file: Path) -> Manifest:
     friction = _non_negative(r, raw, "joint_frictionloss")
     if r.problems:
         raise ModelError(r.problems)
-    return Manifest(
+    manifest = Manifest(
         path=path,
         name=name,
         field_class=field_class,
         model_file=model_file,
         packages=packages,
         motors=motors,
-        sensor_suffix=str(raw.get("sensor_suffix", "S")),
-        imu_link=imu_link,
+        sensor_suffix=sensor_suffix,
+        imu_link=imus[0].link,
         cameras=cameras,
         force_sensors={str(k): str(v) for k, v in forces.items()},
         parts=parts,
@@ -279,7 +293,12 @@ def load_manifest(folder_or_file: Path) -> Manifest:
         joint_damping=None if damping is None else float(damping),
         joint_armature=None if armature is None else float(armature),
         joint_frictionloss=None if friction is None else float(friction),
+        imus=imus,
     )
+    problems = device_name_problems(manifest)
+    if problems:
+        raise ModelError(problems)
+    return manifest
 
 
 def _non_negative(r: _Reader, raw: Mapping[str, object], key: str) -> float | None:
@@ -319,6 +338,7 @@ def _motors(r: _Reader, raw: Mapping[str, object]) -> tuple[MotorEntry, ...]:
         torque = r.positive(entry, "max_torque_nm", p, required=required)
         velocity = r.positive(entry, "max_velocity_rad_s", p, required=required)
         range_rad = _range(r, entry, p)
+        sensor = r.get(entry, "sensor", str, p, required=False, default="") or ""
         gains = tuple(k for k in ("kp", "kv") if k in entry)
         for key in gains:
             value = entry[key]
@@ -335,6 +355,7 @@ def _motors(r: _Reader, raw: Mapping[str, object]) -> tuple[MotorEntry, ...]:
                 max_velocity_rad_s=velocity,
                 free_gains=gains,
                 range_rad=range_rad,
+                sensor=sensor,
             )
         )
     return tuple(motors)
@@ -355,6 +376,34 @@ def _range(r: _Reader, entry: Mapping[str, object], pointer: str) -> tuple[float
         return (float(value[0]), float(value[1]))
     r.problem(f"{pointer}/range_rad", f"{value!r} is not [lower, upper] in rad with lower < upper")
     return None
+
+
+def _imus(r: _Reader, raw: Mapping[str, object]) -> tuple[ImuEntry, ...]:
+    """``imu``: one IMU (an object) or several (an array of objects, the first the trunk's)."""
+    value = r.get(raw, "imu", (dict, list), "")
+    entries: list[tuple[str, object]] = (
+        [(f"/imu/{k}", e) for k, e in enumerate(value)]
+        if isinstance(value, list)
+        else [("/imu", value if value is not None else {})]
+    )
+    if not entries:
+        r.problem("/imu", "an empty array; expected at least one IMU")
+    imus = []
+    for k, (p, entry) in enumerate(entries):
+        if not isinstance(entry, dict):
+            r.problem(p, "expected an object with link (and accelerometer, gyro: device names)")
+            continue
+        for key in sorted(set(entry) - {"link", "accelerometer", "gyro"}):
+            r.problem(f"{p}/{key}", "unknown field; known fields: accelerometer, gyro, link")
+        link = r.get(entry, "link", str, p) or ""
+        # the first IMU answers to the league's names unless it names its own; others must
+        names = [
+            r.get(entry, key, str, p, required=k > 0, default=default if k == 0 else "")
+            for key, default in (("accelerometer", "Accelerometer"), ("gyro", "Gyro"))
+        ]
+        accelerometer, gyro = (n if n is not None else "" for n in names)
+        imus.append(ImuEntry(link=link, accelerometer=accelerometer, gyro=gyro, where=p))
+    return tuple(imus) or (ImuEntry(link=""),)
 
 
 def _cameras(r: _Reader, raw: Mapping[str, object]) -> tuple[CameraEntry, ...]:

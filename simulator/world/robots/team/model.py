@@ -10,8 +10,10 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from simulator.errors import ModelProblem
+from simulator.world.robots.devices import DeviceNames
 from simulator.world.robots.model import CameraSpec, MotorLookup, MotorSpec, RobotMjcf
 from simulator.world.robots.team.build import PREFIX, Template, build_template
+from simulator.world.robots.team.devices import device_names
 from simulator.world.robots.team.manifest import Manifest, load_manifest
 from simulator.world.robots.team.servos import motor_spec
 from simulator.world.robots.team.source import load_spec_with_notes
@@ -35,6 +37,11 @@ class TeamRobotModel(MotorLookup):
     @property
     def standing_height_m(self) -> float:
         return self.template.standing_height_m
+
+    @property
+    def devices(self) -> DeviceNames:
+        """The names the robot answers to on the robot API, as its manifest gives them."""
+        return device_names(self.manifest)
 
     @property
     def standing_pose_rad(self) -> tuple[float, ...]:
