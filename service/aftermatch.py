@@ -27,6 +27,7 @@ there, and renders again (once) when an earlier render stopped without one.
 
 from __future__ import annotations
 
+import functools
 import json
 import logging
 import os
@@ -48,6 +49,7 @@ from orchestrator import open_private_append, private_dir, write_private
 from service import teamfiles
 from service.db import MediaState, Submission, Team, TeamFile, transaction
 from service.matchfiles import OWN_COLOR
+from service.settings import LOG_TARGET_ALLOW_SETTING, log_target_networks
 
 if TYPE_CHECKING:
     from service.app import Services
@@ -171,12 +173,23 @@ class AfterMatch:
 
     def _deliver(self, match_id: str | None, handle: str | None, team: str,
                  content: str | None) -> tuple[MediaState, str]:
-        from orchestrator.delivery import deliver_pending, enqueue_match_logs, list_sets
+        """Deliver the team's logs; the detail the team sees. A target's address obeys the
+        webhooks' rules (``HLVS_SERVICE_LOG_TARGET_ALLOW``), checked again here and pinned
+        for the connection; what a server answered (an error body, a host key) is never in
+        the detail, only the kind of failure (the service's log has the whole cause)."""
+        from orchestrator.delivery import (
+            ERROR_KINDS,
+            deliver_pending,
+            enqueue_match_logs,
+            list_sets,
+            open_uploader,
+        )
 
         if match_id is None or handle is None or content is None:
             return MediaState.FAILED, "the match left no logs, or no credentials were given"
+        allowed = log_target_networks(self.settings)
         document = self.services.sealer.open_document("credentials", json.loads(content))
-        _, refused = teamfiles.service_problems("credentials", document)
+        _, refused = teamfiles.service_problems("credentials", document, allowed=allowed)
         if refused:  # stored before the service's rules: never read the host's files for it
             return MediaState.FAILED, str(refused[0]).replace(refused[0].file, CREDENTIALS_FILE)
         out = self.services.pool.results_dir(handle)
@@ -189,7 +202,10 @@ class AfterMatch:
                                       public_target=None, store=store, move_team_logs=False)
             if not made:
                 return MediaState.FAILED, "the team's robots left no log files"
-        outcomes = [o for o in deliver_pending(store, team=team) if o.match_id == match_id]
+        opener = functools.partial(open_uploader, allowed=allowed,
+                                   allow_setting=LOG_TARGET_ALLOW_SETTING)
+        outcomes = [o for o in deliver_pending(store, team=team, opener=opener)
+                    if o.match_id == match_id]
         if not outcomes:
             return MediaState.FAILED, "the log set is being delivered by another process"
         outcome = outcomes[-1]
@@ -199,7 +215,12 @@ class AfterMatch:
                 f"there), {outcome.uploaded_bytes / 1e6:.2f} MB to {outcome.target}/{match_id}/"
                 f"{team} in {outcome.seconds:.1f} s")
         error = outcome.error
-        cause = f"{error.kind}: {error.reason}" if error is not None else "unknown error"
+        if error is None:
+            cause = "unknown error"
+        elif error.kind == "address":
+            cause = f"{error.kind}: {error.reason}"  # the service's own words, no answer
+        else:
+            cause = f"{error.kind}: {ERROR_KINDS.get(error.kind, 'failed')}"
         return MediaState.FAILED, (f"upload to {outcome.target} failed ({cause}); the logs "
                                    "wait in the service's log store")
 

@@ -7,43 +7,43 @@ operator allows a network (``HLVS_SERVICE_WEBHOOK_ALLOW``). The URL is checked w
 address it resolves to must be allowed, and the request goes to the address that was checked
 (the name is kept for the Host header and TLS), so a name that resolves to a public address
 when checked and to a private one a moment later (DNS rebinding) reaches nothing.
+
+The rules are those of :mod:`orchestrator.delivery.addresses`, which a team's log target
+obeys too (``HLVS_SERVICE_LOG_TARGET_ALLOW``, :func:`log_target_networks`).
 """
 
 from __future__ import annotations
 
-import ipaddress
-import socket
 from collections.abc import Mapping
 
 import httpx
 
+from orchestrator.delivery.addresses import (
+    AddressRefused,
+    IPAddress,
+    IPNetwork,
+    address_allowed,
+    literal_problem,
+)
+from orchestrator.delivery.addresses import resolve as _resolve
 from service.errors import InvalidInput
-from service.settings import IPNetwork, Settings, webhook_networks
+from service.settings import (
+    LOG_TARGET_ALLOW_SETTING,
+    Settings,
+    log_target_networks,
+    webhook_networks,
+)
+from service.settings import WEBHOOK_ALLOW_SETTING as ALLOW_SETTING
 
-IPAddress = ipaddress.IPv4Address | ipaddress.IPv6Address
-ALLOW_SETTING = "HLVS_SERVICE_WEBHOOK_ALLOW"
-
-
-class Refused(ValueError):
-    """The address is not one the service may send to."""
+Refused = AddressRefused
 
 
 def allowed_networks(settings: Settings) -> tuple[IPNetwork, ...]:
     return webhook_networks(settings)
 
 
-def address_allowed(address: IPAddress, allowed: tuple[IPNetwork, ...]) -> bool:
-    """A public unicast address, or one in a network the operator allows."""
-    if isinstance(address, ipaddress.IPv6Address) and address.ipv4_mapped is not None:
-        address = address.ipv4_mapped
-    if any(address.version == n.version and address in n for n in allowed):
-        return True
-    return address.is_global and not address.is_multicast
-
-
-def _refusal(host: str, address: IPAddress) -> str:
-    return (f"{host} is {address}, not a public address (the league's own networks are not "
-            f"reachable; an operator may allow a network with {ALLOW_SETTING})")
+def allowed_log_networks(settings: Settings) -> tuple[IPNetwork, ...]:
+    return log_target_networks(settings)
 
 
 def check_url(url: str, allowed: tuple[IPNetwork, ...], *, field: str) -> None:
@@ -54,15 +54,7 @@ def check_url(url: str, allowed: tuple[IPNetwork, ...], *, field: str) -> None:
     if parsed.scheme not in ("http", "https"):
         problem = f"scheme {parsed.scheme!r} is not accepted"
     else:
-        host = parsed.host.lower().rstrip(".")
-        try:
-            address: IPAddress | None = ipaddress.ip_address(host)
-        except ValueError:
-            address = None
-        if address is not None and not address_allowed(address, allowed):
-            problem = _refusal(host, address)
-        elif address is None and (host == "localhost" or host.endswith(".localhost")):
-            problem = f"{host} is this host, not a public address"
+        problem = literal_problem(parsed.host, allowed, ALLOW_SETTING)
     if problem is not None:
         raise InvalidInput(f"{field}: {problem}", problems=[{
             "where": "body", "pointer": field, "message": problem,
@@ -72,21 +64,7 @@ def check_url(url: str, allowed: tuple[IPNetwork, ...], *, field: str) -> None:
 def resolve(host: str, port: int, allowed: tuple[IPNetwork, ...]) -> IPAddress:
     """The address to connect to for ``host``; :class:`Refused` when any address the name
     resolves to is not allowed (or it resolves to none)."""
-    try:
-        infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)
-    except (OSError, UnicodeError) as exc:
-        raise Refused(f"{host} does not resolve: {exc}") from None
-    addresses: list[IPAddress] = []
-    for info in infos:
-        address = ipaddress.ip_address(str(info[4][0]).split("%")[0])
-        if address not in addresses:
-            addresses.append(address)
-    if not addresses:
-        raise Refused(f"{host} resolves to no address")
-    for address in addresses:
-        if not address_allowed(address, allowed):
-            raise Refused(_refusal(host, address))
-    return addresses[0]
+    return _resolve(host, port, allowed, ALLOW_SETTING)
 
 
 def post(client: httpx.Client, url: str, *, content: bytes, headers: Mapping[str, str],
@@ -104,5 +82,5 @@ def post(client: httpx.Client, url: str, *, content: bytes, headers: Mapping[str
                        extensions=extensions)
 
 
-__all__ = ["ALLOW_SETTING", "Refused", "address_allowed", "allowed_networks", "check_url",
-           "post", "resolve"]
+__all__ = ["ALLOW_SETTING", "LOG_TARGET_ALLOW_SETTING", "Refused", "address_allowed",
+           "allowed_log_networks", "allowed_networks", "check_url", "post", "resolve"]

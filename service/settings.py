@@ -6,7 +6,6 @@ Every default lives here. ``Settings.from_env()`` is called by the entrypoint (`
 
 from __future__ import annotations
 
-import ipaddress
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
@@ -14,10 +13,12 @@ from pathlib import Path
 from typing import Any
 
 from contracts import TEST_MATCH, TimingError, fit_ready
+from orchestrator.delivery.addresses import IPNetwork, networks
 from service.errors import SettingsError
 
 PREFIX = "HLVS_SERVICE_"
-IPNetwork = ipaddress.IPv4Network | ipaddress.IPv6Network
+WEBHOOK_ALLOW_SETTING = PREFIX + "WEBHOOK_ALLOW"
+LOG_TARGET_ALLOW_SETTING = PREFIX + "LOG_TARGET_ALLOW"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -87,6 +88,10 @@ class Settings:
     webhook_allow: str = ""
     """Networks a webhook may reach besides public addresses, comma-separated CIDRs (e.g.
     ``10.20.0.0/16``); empty: public addresses only (no loopback, private, link-local)."""
+    log_target_allow: str = ""
+    """Networks a team's log target (SFTP ``hostname``, S3 ``endpoint_url``) may reach besides
+    public addresses, comma-separated CIDRs; empty: public addresses only. For a league's own
+    log server, or a test server on loopback (``127.0.0.0/8``)."""
     secret_key: str = field(default="", repr=False)
     """The key that seals the secrets stored in the database (a Fernet key); empty: the key
     file."""
@@ -137,8 +142,12 @@ class Settings:
 
 def webhook_networks(settings: Settings) -> tuple[IPNetwork, ...]:
     """The networks of ``webhook_allow``; ValueError for one that is not a network."""
-    return tuple(ipaddress.ip_network(part.strip(), strict=False)
-                 for part in settings.webhook_allow.split(",") if part.strip())
+    return networks(settings.webhook_allow)
+
+
+def log_target_networks(settings: Settings) -> tuple[IPNetwork, ...]:
+    """The networks of ``log_target_allow``; ValueError for one that is not a network."""
+    return networks(settings.log_target_allow)
 
 
 def _convert(name: str, raw: str, current: object) -> object:
@@ -175,12 +184,13 @@ def _check(settings: Settings) -> None:
         if getattr(settings, name) <= 0:
             raise SettingsError(name=PREFIX + name.upper(), value=str(getattr(settings, name)),
                                 expected="a positive number")
-    try:
-        webhook_networks(settings)
-    except ValueError as exc:
-        raise SettingsError(name=PREFIX + "WEBHOOK_ALLOW", value=settings.webhook_allow,
-                            expected=f"comma-separated networks, e.g. 10.0.0.0/8 ({exc})"
-                            ) from None
+    for name in ("webhook_allow", "log_target_allow"):
+        try:
+            networks(getattr(settings, name))
+        except ValueError as exc:
+            raise SettingsError(name=PREFIX + name.upper(), value=getattr(settings, name),
+                                expected=f"comma-separated networks, e.g. 10.0.0.0/8 ({exc})"
+                                ) from None
     if settings.ladder_every_s < 0:
         raise SettingsError(name=PREFIX + "LADDER_EVERY_S", value=str(settings.ladder_every_s),
                             expected="0 (off) or a positive number of seconds")
@@ -195,4 +205,5 @@ def _check(settings: Settings) -> None:
                             expected=f"a longer half: {exc}") from None
 
 
-__all__ = ["Settings", "webhook_networks"]
+__all__ = ["IPNetwork", "LOG_TARGET_ALLOW_SETTING", "Settings", "WEBHOOK_ALLOW_SETTING",
+           "log_target_networks", "webhook_networks"]

@@ -18,6 +18,7 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
+import urllib.parse
 from collections.abc import Mapping
 from dataclasses import asdict
 from pathlib import Path
@@ -28,9 +29,11 @@ from sqlalchemy.orm import Session
 
 from orchestrator import ConfigError, Problem
 from orchestrator.config import BUILT_IN_MODELS, FieldClass, TeamConfig, check_team_document
+from orchestrator.delivery.addresses import IPNetwork, literal_problem
 from service.db import TeamFile
 from service.errors import InvalidInput, NotFound
 from service.sealing import PREFIX, Sealer
+from service.settings import LOG_TARGET_ALLOW_SETTING
 
 log = logging.getLogger(__name__)
 
@@ -44,10 +47,12 @@ PLACEHOLDER_KEY = ("-----BEGIN OPENSSH PRIVATE KEY-----\n(refused)\n"
                    "-----END OPENSSH PRIVATE KEY-----")
 
 
-def service_problems(kind: str, document: Any) -> tuple[Any, list[Problem]]:
+def service_problems(kind: str, document: Any, *, allowed: tuple[IPNetwork, ...] = ()
+                     ) -> tuple[Any, list[Problem]]:
     """The service's own rules: ``(document to check further, problems)``. The document
     returned has every refused host reference taken out, so that checking it further reads
-    nothing of the host."""
+    nothing of the host. ``allowed``: the networks a log target may reach besides public
+    addresses (``HLVS_SERVICE_LOG_TARGET_ALLOW``)."""
     name = KINDS[kind]
     problems: list[Problem] = []
     if not isinstance(document, dict):
@@ -70,6 +75,7 @@ def service_problems(kind: str, document: Any) -> tuple[Any, list[Problem]]:
                 "the team's own access_id and access_secret (stored encrypted)"))
         return _builtin_models_only(document, problems)
     body = document.get("credentials")
+    problems += _target_address_problems(document, allowed)
     if document.get("type") != "sftp" or not isinstance(body, dict):
         return document, problems
     cleaned = dict(body)
@@ -94,6 +100,33 @@ def service_problems(kind: str, document: Any) -> tuple[Any, list[Problem]]:
     return {**document, "credentials": cleaned}, problems
 
 
+def _target_address_problems(document: Mapping[str, object],
+                             allowed: tuple[IPNetwork, ...]) -> list[Problem]:
+    """A log target obeys the webhooks' address rules (:mod:`orchestrator.delivery.addresses`):
+    an address literal of the league's own networks, or ``localhost``, is refused here; a name
+    is resolved and checked again at every delivery, which connects to the address checked."""
+    body = document.get("credentials")
+    if not isinstance(body, dict):
+        return []
+    where, host = "", None
+    if document.get("type") == "sftp" and isinstance(body.get("hostname"), str):
+        where, host = "/credentials/hostname", body["hostname"]
+    elif document.get("type") == "s3" and isinstance(body.get("endpoint_url"), str):
+        where = "/credentials/endpoint_url"
+        try:
+            host = urllib.parse.urlsplit(body["endpoint_url"]).hostname or ""
+        except ValueError:
+            return []  # the schema's check names what is wrong with it
+    if host is None:
+        return []
+    problem = literal_problem(host, allowed, LOG_TARGET_ALLOW_SETTING)
+    if problem is None:
+        return []
+    return [Problem(KINDS["credentials"], where, problem,
+                    "a public address or host name (the league's own networks are not a log "
+                    "target)")]
+
+
 def _builtin_models_only(document: Mapping[str, object],
                          problems: list[Problem]) -> tuple[Any, list[Problem]]:
     """A robot model package is a folder of the host that reads the file: refused (and taken
@@ -113,18 +146,20 @@ def _builtin_models_only(document: Mapping[str, object],
     return {**document, "players": kept}, problems
 
 
-def check(kind: str, document: Any) -> list[dict[str, str]]:
+def check(kind: str, document: Any, *, allowed: tuple[IPNetwork, ...] = ()
+          ) -> list[dict[str, str]]:
     """Every problem of ``document`` as ``hlvs check`` finds it plus the service's rules
     (errors and warnings), with the file named as the team knows it (``team_config.json`` /
     ``credentials.json``). Never raises for a bad document."""
-    return _checked(kind, document)[1]
+    return _checked(kind, document, allowed=allowed)[1]
 
 
-def _checked(kind: str, document: Any) -> tuple[TeamConfig | None, list[dict[str, str]]]:
+def _checked(kind: str, document: Any, *, allowed: tuple[IPNetwork, ...] = ()
+             ) -> tuple[TeamConfig | None, list[dict[str, str]]]:
     """The team (for ``team_config`` without an error) and the problems of :func:`check`: the
     document itself is validated, no file is written or read."""
     name = KINDS[kind]
-    document, problems = service_problems(kind, document)
+    document, problems = service_problems(kind, document, allowed=allowed)
     team: TeamConfig | None = None
     if kind == "team_config":
         team, found = check_team_document(document, source=name, field_class=FIELD_CLASS,
@@ -149,9 +184,10 @@ def _checked(kind: str, document: Any) -> tuple[TeamConfig | None, list[dict[str
     return team, out
 
 
-def raise_if_invalid(kind: str, document: Any) -> list[dict[str, str]]:
+def raise_if_invalid(kind: str, document: Any, *, allowed: tuple[IPNetwork, ...] = ()
+                     ) -> list[dict[str, str]]:
     """The problems of ``document`` (warnings); :class:`InvalidInput` when one is an error."""
-    return _raise_if_errors(kind, _checked(kind, document)[1])
+    return _raise_if_errors(kind, _checked(kind, document, allowed=allowed)[1])
 
 
 def validated_team(document: Any) -> TeamConfig:
@@ -173,12 +209,12 @@ def _raise_if_errors(kind: str, problems: list[dict[str, str]]) -> list[dict[str
 
 
 def store(session: Session, *, team_id: int, kind: str, document: Any,
-          sealer: Sealer) -> TeamFile:
+          sealer: Sealer, allowed: tuple[IPNetwork, ...] = ()) -> TeamFile:
     """Check and store a new version, its secrets sealed; :class:`InvalidInput` with the
     problems when invalid."""
     if kind not in KINDS:
         raise NotFound(what="file kind", ident=kind)
-    problems = raise_if_invalid(kind, document)
+    problems = raise_if_invalid(kind, document, allowed=allowed)
     content = json.dumps(sealer.seal_document(kind, document), indent=2, sort_keys=False)
     latest = session.scalar(select(func.max(TeamFile.version)).where(
         TeamFile.team_id == team_id, TeamFile.kind == kind)) or 0

@@ -97,6 +97,7 @@ class QueueWorker:
         """One round; True when it changed a submission."""
         sessions = self.services.sessions
         changed = False
+        self._stub_if_needed()
         with transaction(sessions) as session:
             active = list(session.scalars(select(Submission).where(Submission.state.in_(
                 [SubmissionState.STARTING.value, SubmissionState.RUNNING.value])).order_by(
@@ -107,6 +108,7 @@ class QueueWorker:
                 changed |= before != (row.state, row.attempts, row.cancel_requested,
                                       row.pool_detail)
         while not self._stop.is_set():
+            self._stub_if_needed()
             with transaction(sessions) as session:
                 if queue_paused(session):
                     return changed
@@ -144,6 +146,20 @@ class QueueWorker:
     # helpers -----------------------------------------------------------------------------
     def _work_dir(self, match_id: str) -> Path:
         return (self.settings.matches_dir / match_id).resolve()
+
+    def _stub_if_needed(self) -> None:
+        """Find (or build) the stub image before the transaction that starts a match against
+        it: a build takes minutes, and a transaction holds SQLite's write lock (every other
+        request would wait, then fail with "database is locked")."""
+        if self._stub_image is not None:
+            return
+        with transaction(self.services.sessions) as session:
+            opponent = session.scalar(select(Submission.opponent).where(
+                Submission.state.in_([SubmissionState.QUEUED.value,
+                                      SubmissionState.STARTING.value])).order_by(
+                Submission.seq).limit(1))
+        if opponent == STUB:
+            self._stub()
 
     def _stub(self) -> str:
         if self._stub_image is None:

@@ -9,6 +9,8 @@ the file is simply uploaded again.
 from __future__ import annotations
 
 import logging
+import urllib.parse
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -17,8 +19,10 @@ import botocore.config
 import botocore.exceptions
 from boto3.exceptions import S3UploadFailedError
 from boto3.s3.transfer import TransferConfig
+from botocore.awsrequest import AWSHTTPConnectionPool, AWSHTTPSConnectionPool
 
 from orchestrator.config.credentials import S3Credentials
+from orchestrator.delivery.addresses import AddressRefused, IPNetwork, resolve
 from orchestrator.errors import DeliveryError
 
 __all__ = ["S3Uploader", "create_bucket"]
@@ -60,8 +64,23 @@ class S3Uploader:
         return self._credentials.describe()
 
     @classmethod
-    def connect(cls, credentials: S3Credentials, *, team: str) -> S3Uploader:
-        client = _client(credentials)
+    def connect(cls, credentials: S3Credentials, *, team: str,
+                allowed: tuple[IPNetwork, ...] | None = None,
+                allow_setting: str = "") -> S3Uploader:
+        """Open a client; with ``allowed``, the ``endpoint_url`` host is resolved and checked
+        now and every connection of the client goes to the address checked
+        (:func:`orchestrator.delivery.targets.open_uploader`)."""
+        pin: tuple[str, str] | None = None
+        if allowed is not None and credentials.endpoint_url:
+            parsed = urllib.parse.urlsplit(credentials.endpoint_url)
+            host = parsed.hostname or ""
+            try:
+                port = parsed.port or (443 if parsed.scheme == "https" else 80)
+                pin = (host, str(resolve(host, port, allowed, allow_setting)))
+            except (AddressRefused, ValueError) as exc:
+                raise DeliveryError(team=team, target=credentials.describe(), kind="address",
+                                    reason=str(exc)) from None
+        client = _client(credentials, pin=pin)
         uploader = cls(client=client, credentials=credentials, team=team)
         uploader._check_bucket()
         log.info("team %s: connected to %s", team, uploader.target)
@@ -141,7 +160,9 @@ def create_bucket(credentials: S3Credentials) -> None:
         client.close()
 
 
-def _client(credentials: S3Credentials) -> Any:
+def _client(credentials: S3Credentials, *, pin: tuple[str, str] | None = None) -> Any:
+    """A boto3 client; ``pin`` = (host name, address): its connections go to that address
+    (the name stays in the Host header and TLS), and to no other host."""
     config = botocore.config.Config(
         connect_timeout=CONNECT_TIMEOUT_S,
         read_timeout=READ_TIMEOUT_S,
@@ -149,7 +170,7 @@ def _client(credentials: S3Credentials) -> Any:
         s3={"addressing_style": "path" if credentials.endpoint_url else "auto"},
         max_pool_connections=16,
     )
-    return boto3.client(
+    client = boto3.client(
         "s3",
         aws_access_key_id=credentials.access_id,
         aws_secret_access_key=credentials.access_secret,
@@ -157,6 +178,38 @@ def _client(credentials: S3Credentials) -> Any:
         endpoint_url=credentials.endpoint_url,
         config=config,
     )
+    if pin is not None:
+        _pin_connections(client, *pin)
+    return client
+
+
+def _pin_connections(client: Any, name: str, address: str) -> None:
+    """Every new connection of ``client`` to ``name`` goes to ``address``; one to any other
+    host (a redirect) is refused. The name is kept for the Host header, SNI and the
+    certificate check: only the socket's address changes."""
+    session = client._endpoint.http_session
+    pools = {}
+    for scheme, base in (("http", AWSHTTPConnectionPool), ("https", AWSHTTPSConnectionPool)):
+        pinned_class = type(f"Pinned{base.ConnectionCls.__name__}", (base.ConnectionCls,),
+                            {"_new_conn": _pinned_new_conn(name, address)})
+        pools[scheme] = type(f"Pinned{base.__name__}", (base,),
+                             {"ConnectionCls": pinned_class})
+    session._pool_classes_by_scheme = pools
+    session._manager.pool_classes_by_scheme = pools
+
+
+def _pinned_new_conn(name: str, address: str) -> Callable[[Any], Any]:
+    def _new_conn(self: Any) -> Any:
+        original = self._dns_host
+        host = str(original).rstrip(".").lower()
+        if host != name.rstrip(".").lower():
+            raise OSError(f"a connection to {host} was refused (only {name} is reachable)")
+        self._dns_host = address
+        try:
+            return super(type(self), self)._new_conn()
+        finally:
+            self._dns_host = original
+    return _new_conn
 
 
 def _code(exc: botocore.exceptions.ClientError) -> str:

@@ -21,6 +21,7 @@ from typing import Protocol
 import paramiko
 
 from orchestrator.config.credentials import SftpCredentials
+from orchestrator.delivery.addresses import AddressRefused, IPNetwork, resolve
 from orchestrator.errors import DeliveryError
 
 __all__ = ["SftpUploader"]
@@ -64,16 +65,25 @@ class SftpUploader:
         return self._credentials.describe()
 
     @classmethod
-    def connect(cls, credentials: SftpCredentials, *, team: str) -> SftpUploader:
+    def connect(cls, credentials: SftpCredentials, *, team: str,
+                allowed: tuple[IPNetwork, ...] | None = None,
+                allow_setting: str = "") -> SftpUploader:
+        """Open a session; with ``allowed``, to the checked address of the host name only
+        (:func:`orchestrator.delivery.targets.open_uploader`)."""
         target = credentials.describe()
 
         def fail(kind: str, reason: str) -> DeliveryError:
             return DeliveryError(team=team, target=target, kind=kind, reason=reason)
 
+        host = credentials.hostname
+        if allowed is not None:
+            try:
+                host = str(resolve(credentials.hostname, credentials.port, allowed,
+                                   allow_setting))
+            except AddressRefused as exc:
+                raise fail("address", str(exc)) from None
         try:
-            sock = socket.create_connection(
-                (credentials.hostname, credentials.port), timeout=CONNECT_TIMEOUT_S
-            )
+            sock = socket.create_connection((host, credentials.port), timeout=CONNECT_TIMEOUT_S)
         except socket.gaierror as exc:
             raise fail("unreachable", f"unknown host name: {exc.strerror}") from exc
         except OSError as exc:

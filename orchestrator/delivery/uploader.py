@@ -32,6 +32,7 @@ ERROR_KINDS = {
     "access_denied": "the account may not write there",
     "path": "the remote folder cannot be created or written",
     "unreachable": "no server answers at that address",
+    "address": "the target's address is not one the league delivers to (not public)",
     "transient": "the connection broke or the server had an internal error",
     "config": "the credentials file is missing or invalid",
     "store": "a file of the set is missing or changed in the local store",

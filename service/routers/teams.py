@@ -119,8 +119,10 @@ async def upload_file(kind: str, request: Request, services: AppServices,
     def store() -> FileVersion:
         with services.sessions() as session, session.begin():
             assert principal.team_id is not None
-            return _version(teamfiles.store(session, team_id=principal.team_id, kind=kind,
-                                            document=document, sealer=services.sealer))
+            return _version(teamfiles.store(
+                session, team_id=principal.team_id, kind=kind, document=document,
+                sealer=services.sealer,
+                allowed=outbound.allowed_log_networks(services.settings)))
 
     return await run_in_threadpool(store)
 
@@ -133,7 +135,8 @@ async def check_file(kind: str, request: Request, services: AppServices,
         raise NotFound(what="file kind", ident=kind)
     document = await read_json_body(request, limit_bytes=services.settings.max_upload_bytes,
                                     name=teamfiles.KINDS[kind])
-    problems = teamfiles.check(kind, document)
+    problems = teamfiles.check(kind, document,
+                               allowed=outbound.allowed_log_networks(services.settings))
     return CheckResult(valid=not any(p["severity"] == "error" for p in problems),
                        problems=[Problem(**p) for p in problems])
 

@@ -8,6 +8,7 @@ from typing import Any
 
 import boto3
 import botocore.exceptions
+import pytest
 
 from orchestrator.config.credentials import S3Credentials
 from orchestrator.delivery import (
@@ -200,3 +201,54 @@ def test_seaweedfs_dies_and_comes_back(seaweed: SeaweedServer, tmp_path: Path) -
     [again] = deliver_pending(store, retry=RetryPolicy(attempts=5, initial_delay_s=0.5))
     assert again.delivered, again.error
     check_manifest(read_bucket(url, seaweed.admin, "crash-logs", "hlvs/2026"), "crash/Alpha")
+
+
+def test_with_address_rules_the_endpoint_is_resolved_once_and_every_connection_pinned(
+    moto: MotoServer, tmp_path: Path, monkeypatch: Any
+) -> None:
+    """The service's opener (``allowed``): the endpoint's name is resolved and checked when
+    the client opens, and its connections go to that address; the name resolving elsewhere
+    afterwards (DNS rebinding) changes nothing. A name resolving to a refused address is
+    refused before any request."""
+    import ipaddress
+    import socket
+
+    from orchestrator.delivery import open_uploader
+    from orchestrator.errors import DeliveryError
+
+    ensure_bucket(moto.endpoint_url, moto.admin, "pinned")
+    real = socket.getaddrinfo
+    looked_up: list[str] = []
+
+    def getaddrinfo(host: Any, *args: Any, **kwargs: Any) -> Any:
+        if host == "logstore":
+            looked_up.append(host)
+            if len(looked_up) > 1:  # every later look-up: gone (or elsewhere)
+                raise socket.gaierror(socket.EAI_NONAME, "Name or service not known")
+            return real("127.0.0.1", *args, **kwargs)
+        return real(host, *args, **kwargs)
+
+    monkeypatch.setattr(socket, "getaddrinfo", getaddrinfo)
+    credentials = S3Credentials(
+        source=Path("test"), access_id=moto.admin.access_id,
+        access_secret=moto.admin.access_secret, bucket="pinned",
+        endpoint_url=moto.endpoint_url.replace("127.0.0.1", "logstore"), prefix="p")
+    loopback = (ipaddress.ip_network("127.0.0.0/8"),)
+    uploader = open_uploader(credentials, "Alpha", allowed=loopback, allow_setting="X_ALLOW")
+    local = tmp_path / "a.log"
+    local.write_bytes(b"pinned\n" * 1000)
+    try:
+        for n in range(3):
+            uploader.upload(local, f"m/Alpha/{n}.log")
+    finally:
+        uploader.close()
+    assert looked_up == ["logstore"]
+    assert set(read_bucket(moto.endpoint_url, moto.admin, "pinned", "p")) == {
+        f"m/Alpha/{n}.log" for n in range(3)}
+
+    looked_up.clear()
+    with pytest.raises(DeliveryError) as refused:
+        open_uploader(credentials, "Alpha", allowed=(), allow_setting="X_ALLOW")
+    assert refused.value.kind == "address"
+    assert "logstore is 127.0.0.1, not a public address" in refused.value.reason
+    assert "X_ALLOW" in refused.value.reason

@@ -244,3 +244,48 @@ def test_a_server_that_never_answers_times_out_and_is_retried(
     assert outcome.error is not None and outcome.error.kind == "transient"
     assert 1.0 <= time.monotonic() - started < 10  # two attempts of 0.5 s each
     assert pending_status(store)[0].last_error.kind == "transient"  # type: ignore[union-attr]
+
+
+def test_with_address_rules_the_host_is_resolved_and_the_connection_pinned(
+    asyncssh_server: AsyncsshServer, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The service's opener (``allowed``): the SFTP host name is resolved and checked once
+    and the connection goes to that address; refused (kind ``address``) when it resolves to
+    a network that is not allowed, before anything is sent."""
+    import ipaddress
+    import socket
+
+    from orchestrator.config.credentials import parse_credentials
+    from orchestrator.delivery import open_uploader
+    from orchestrator.errors import DeliveryError
+
+    real = socket.getaddrinfo
+    looked_up: list[str] = []
+
+    def getaddrinfo(host: Any, *args: Any, **kwargs: Any) -> Any:
+        if host == "sftp.example.org":
+            looked_up.append(host)
+            return real("127.0.0.1", *args, **kwargs)
+        return real(host, *args, **kwargs)
+
+    connected: list[Any] = []
+    real_connect = socket.create_connection
+
+    def create_connection(address: Any, *args: Any, **kwargs: Any) -> Any:
+        connected.append(address[0])
+        return real_connect(address, *args, **kwargs)
+
+    monkeypatch.setattr(socket, "getaddrinfo", getaddrinfo)
+    monkeypatch.setattr(socket, "create_connection", create_connection)
+    document = {"type": "sftp", "credentials": sftp_body(asyncssh_server,
+                                                         hostname="sftp.example.org")}
+    credentials = parse_credentials(document, source=Path("credentials.json"))
+    uploader = open_uploader(credentials, "Alpha",
+                             allowed=(ipaddress.ip_network("127.0.0.1/32"),))
+    uploader.close()
+    assert looked_up == ["sftp.example.org"] and connected == ["127.0.0.1"]
+    connected.clear()
+    with pytest.raises(DeliveryError) as refused:
+        open_uploader(credentials, "Alpha", allowed=())
+    assert refused.value.kind == "address" and connected == []
+    assert "sftp.example.org is 127.0.0.1, not a public address" in refused.value.reason

@@ -76,7 +76,8 @@ def real_settings(settings: Settings, docker_client: Any) -> Settings:
     # the service's own test-match timing (contracts.timing.TEST_MATCH: 40 s halves, 10 s READY)
     return settings.with_(worker_poll_s=0.3, test_grace_s=2.0,
                           preflight_timeout_s=25.0, video_width=320, video_height=180,
-                          video_fps=2.0)  # 90 s of match: few frames to render
+                          video_fps=2.0,  # 90 s of match: few frames to render
+                          log_target_allow="127.0.0.0/8")  # the test's S3 server is local
 
 
 def _hlvs(*argv: str) -> subprocess.Popen[str]:
