@@ -38,14 +38,14 @@ import numpy as np
 import numpy.typing as npt
 
 from contracts.robot_api import messages_pb2 as pb
-from simulator.api.fastreq import PositionTargets, TargetValues
+from simulator.api.fastreq import Notice, PositionTargets, TargetValues
 from simulator.api.session import RobotSession, TargetPlan
 
 if TYPE_CHECKING:
     from simulator.api.batch import StepBatch
     from simulator.api.connection import Connection
 
-Request = pb.ActuatorRequests | PositionTargets
+Request = pb.ActuatorRequests | PositionTargets | Notice
 
 
 class BoardSlot:

@@ -14,12 +14,13 @@ from google.protobuf.message import DecodeError
 
 from contracts.robot_api import messages_pb2 as pb
 from simulator.api.bounds import READ_PER_CALL_BYTES, RequestBounds
-from simulator.api.fastreq import PositionTargets, PositionTemplate, scan_positions
+from simulator.api.fastreq import Notice, PositionTargets, PositionTemplate, scan_positions
 from simulator.api.framing import FrameDecoder, FramingError
 from simulator.api.stats import RobotStats
 
 log = logging.getLogger(__name__)
 
+Request = pb.ActuatorRequests | PositionTargets | Notice
 RECV_CHUNK = 1 << 16
 # Linux: acknowledge at once, not after the delayed-ACK timer (the kernel clears it again)
 TCP_QUICKACK: int | None = getattr(socket, "TCP_QUICKACK", None)
@@ -31,8 +32,8 @@ class BoardPost(Protocol):
 
     def post(
         self,
-        decoded: Sequence[pb.ActuatorRequests | PositionTargets],
-        queue: list[pb.ActuatorRequests | PositionTargets],
+        decoded: Sequence[Request],
+        queue: list[Request],
     ) -> None: ...
 
 
@@ -84,7 +85,7 @@ class Connection:
         self.queue_limit = max(1, queue_limit)
         self.decoder = FrameDecoder()
         self.bounds = RequestBounds(time.monotonic())
-        self.requests: list[pb.ActuatorRequests | PositionTargets] = []
+        self.requests: list[Request] = []
         # where the usual requests go instead of ``requests`` while the server's target board
         # is armed (:mod:`simulator.api.board`); set and cleared by the step thread
         self.board: BoardPost | None = None
@@ -98,6 +99,7 @@ class Connection:
         self.slow = False
         self.bank_s = time_bank_s
         self.want_write = False
+        self._told = False  # a request dropped with a notice since the last read's end
 
     def fileno(self) -> int:
         return self.sock.fileno()
@@ -130,9 +132,10 @@ class Connection:
             except FramingError as exc:
                 self.stats.bad_frames += 1
                 raise ClientClosed(f"out of sync: {exc}") from exc
-            frames = self._within_bounds(frames, now)
+            decoded: list[Request] = []
+            if frames:
+                frames = self._within_bounds(frames, now, decoded)
             template = self._template
-            decoded: list[pb.ActuatorRequests | PositionTargets] = []
             for frame in frames:
                 count += 1
                 if not frame:  # an empty ActuatorRequests: an answer with nothing to apply
@@ -156,6 +159,8 @@ class Connection:
             self._quick_ack()
         if count:
             self.stats.messages_in += count
+        if count or self._told:
+            self._told = False
             self.answered = True
             self.answered_at = now
             if self.last_sent_at is not None:
@@ -181,9 +186,13 @@ class Connection:
         except OSError:
             pass  # the socket is failing: the next read says so
 
-    def _within_bounds(self, frames: list[bytes], now: float) -> list[bytes]:
+    def _within_bounds(
+        self, frames: list[bytes], now: float, notices: list[Request]
+    ) -> list[bytes]:
         """The frames within the client's bounds (``frames`` itself when all are); the others
-        are dropped and counted."""
+        are dropped and counted. A request over the size limit is an answer all the same
+        (lockstep does not wait for another) and the client is told, in its next
+        measurement, why nothing of it was applied (a :class:`Notice` in ``notices``)."""
         admit = self.bounds.admit
         kept = frames
         for index, frame in enumerate(frames):
@@ -192,6 +201,12 @@ class Connection:
                 if kept is frames:
                     kept = frames[:index]
                 self.stats.drop_in(dropped, len(frame))
+                if dropped == "size":
+                    notices.append(Notice(
+                        f"ActuatorRequests of {len(frame)} bytes is above the limit of"
+                        f" {self.bounds.max_bytes} bytes, ignored."
+                    ))  # fmt: skip
+                    self._told = True
             elif kept is not frames:
                 kept.append(frame)
         return kept
@@ -208,7 +223,7 @@ class Connection:
                 self.error = exc.reason
                 return True
 
-    def take_requests(self) -> list[pb.ActuatorRequests | PositionTargets]:
+    def take_requests(self) -> list[Request]:
         """The requests received since the last call, in arrival order."""
         with self.requests_lock:
             requests, self.requests = self.requests, []

@@ -38,6 +38,17 @@ class PositionTargets:
         self.finite = finite
 
 
+class Notice:
+    """A warning the reader owes the client, queued with its requests so that it reaches the
+    client's session in order (a request dropped before decoding: :mod:`simulator.api.bounds`);
+    the session sends ``text`` in its next measurement."""
+
+    __slots__ = ("text",)
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+
+
 class PositionTemplate:
     """The wire layout of one request made of ``motor_positions`` only."""
 

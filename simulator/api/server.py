@@ -42,7 +42,7 @@ from simulator.api.cameras import MAX_IN_FLIGHT, ImageSource
 from simulator.api.connection import ClientClosed, Connection
 from simulator.api.devices import DeviceWorld
 from simulator.api.endpoints import PlayerEndpoint, peer_allowed_by_name
-from simulator.api.fastreq import PositionTargets, TargetValues
+from simulator.api.fastreq import Notice, PositionTargets, TargetValues
 from simulator.api.framing import HEADER, REFUSED, WELCOME
 from simulator.api.quota import NetworkQuota
 from simulator.api.sender import SendThread
@@ -61,7 +61,7 @@ from simulator.errors import ApiError
 
 log = logging.getLogger(__name__)
 
-Request = pb.ActuatorRequests | PositionTargets
+Request = pb.ActuatorRequests | PositionTargets | Notice
 
 # With the I/O thread the step thread's own selector only accepts connections (and takes camera
 # images): before a step it is polled when POLL_INTERVAL_S of wall time has passed since the last

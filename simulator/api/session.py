@@ -36,7 +36,7 @@ from simulator.api.encode import (
     SensorLayout,
     varint,
 )
-from simulator.api.fastreq import PositionTargets, TargetValues
+from simulator.api.fastreq import Notice, PositionTargets, TargetValues
 from simulator.api.framing import HEADER
 
 log = logging.getLogger(__name__)
@@ -49,6 +49,15 @@ _FIELDS[POSITION_SENSOR] = (POSITION_SENSORS, 1)
 CAMERA_MIN_TIME_STEP_MS = 16
 WARNING = pb.Message.WARNING_MESSAGE
 ERROR = pb.Message.ERROR_MESSAGE
+Request = pb.ActuatorRequests | PositionTargets | Notice
+# Warnings repeat on every request that earns one, as the league's server sends them
+# (``warn`` in controllers/player/player.cpp:213, called per request in processBuffer,
+# :452-589, and sent with the next measurement, :709-742), bounded so that a client cannot
+# make the server build and send without limit: at most MAX_WARNINGS per measurement (then one
+# line telling how many more were not sent), each at most MAX_WARNING_CHARS characters (a
+# longer one, such as a 200 kB device name echoed back, keeps its start and its end).
+MAX_WARNINGS = 16
+MAX_WARNING_CHARS = 240
 
 
 def rendering_bandwidth_mb_s(width: int, height: int, period_ms: int) -> float:
@@ -242,7 +251,7 @@ class RobotSession:
         self._order: list[str] = []
         self._camera_sensors: list[tuple[str, int, int]] = []
         self._pending: list[tuple[int, str]] = []
-        self._warned: set[str] = set()  # warnings already sent: each distinct one goes out once
+        self._unsent_warnings = 0  # warnings over MAX_WARNINGS since the last measurement
         self._limp = False
         self._camera_size: tuple[int, int] | None = None
         if CAMERA in self._kinds.values():
@@ -252,17 +261,19 @@ class RobotSession:
     # --- commands ---------------------------------------------------------------------------
 
     def warn(self, text: str, *, kind: int = WARNING) -> None:
-        """Queue a message for the next measurement. A warning goes out once per distinct text
-        (a client repeating a bad request every step is told once, as the league's server
-        does); errors go out every time."""
-        if kind == WARNING:
-            if text in self._warned:
-                return
-            self._warned.add(text)
+        """Queue a message for the next measurement: every request that earns a warning gets
+        it, as from the league's server, up to :data:`MAX_WARNINGS` per measurement (the
+        others are counted and told in one line); errors always go out."""
+        if len(text) > MAX_WARNING_CHARS:
+            half = (MAX_WARNING_CHARS - 1) // 2
+            text = f"{text[:half]}\u2026{text[-half:]}"
+        if kind == WARNING and len(self._pending) >= MAX_WARNINGS:
+            self._unsent_warnings += 1
+            return
         self._pending.append((kind, text))
         self._set_steady(None)
 
-    def apply(self, request: pb.ActuatorRequests | PositionTargets, *, step_time_ms: int) -> None:
+    def apply(self, request: Request, *, step_time_ms: int) -> None:
         """Apply one request; ``step_time_ms`` is the time of the measurement this step sends."""
         world, robot = self._world, self.robot
         if world.is_removed(robot):
@@ -270,7 +281,7 @@ class RobotSession:
         self._apply_one(request, step_time_ms, not world.is_limp(robot))
 
     def apply_all(
-        self, requests: list[pb.ActuatorRequests | PositionTargets], *, step_time_ms: int
+        self, requests: list[Request], *, step_time_ms: int
     ) -> None:
         """:meth:`apply` each request in order, right after :meth:`update_limp` (whose limp flag
         it uses: one world query per step instead of two per request)."""
@@ -284,7 +295,7 @@ class RobotSession:
                 self._apply_one(request, step_time_ms, active)
 
     def take_targets(
-        self, requests: list[pb.ActuatorRequests | PositionTargets]
+        self, requests: list[Request]
     ) -> tuple[TargetPlan, TargetValues] | None:
         """The usual step, for a batched write: when every request is position targets in the
         held name list, read finite from the wire, and the robot is active, they are taken (the
@@ -342,10 +353,13 @@ class RobotSession:
             self._apply_checked(names, values, active)
 
     def _apply_one(
-        self, request: pb.ActuatorRequests | PositionTargets, step_time_ms: int, active: bool
+        self, request: Request, step_time_ms: int, active: bool
     ) -> None:
         if type(request) is PositionTargets:
             self._apply_positions(request.names, request.values, active)
+            return
+        if type(request) is Notice:
+            self.warn(request.text)
             return
         assert isinstance(request, pb.ActuatorRequests)
         world, robot = self._world, self.robot
@@ -511,6 +525,12 @@ class RobotSession:
             for message_type, text in self._pending:
                 msg.messages.add(message_type=message_type, text=text)
             self._pending.clear()
+            if self._unsent_warnings:
+                msg.messages.add(message_type=WARNING, text=(
+                    f"{self._unsent_warnings} more warnings since the last measurement not"
+                    f" sent (at most {MAX_WARNINGS} per measurement)."
+                ))  # fmt: skip
+                self._unsent_warnings = 0
         if self._removed():
             self._sensors.clear()
             self._new_sensors.clear()

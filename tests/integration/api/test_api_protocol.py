@@ -109,7 +109,7 @@ def test_warnings_use_hlvs_texts() -> None:
             'Time step for "Camera" should be greater or equal to 16, ignoring 8 value.',
             'Device "Lidar" not found, time step command, ignored.',
         ]
-        assert not client.receive(timeout=5).messages  # warned once
+        assert not client.receive(timeout=5).messages  # one request, its warnings once
 
 
 def test_positions_reach_the_world_and_later_requests_override() -> None:

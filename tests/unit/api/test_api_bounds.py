@@ -7,6 +7,7 @@ import socket
 from contracts.robot_api import messages_pb2 as pb
 from simulator.api.bounds import RequestBounds, TokenBucket
 from simulator.api.connection import Connection
+from simulator.api.fastreq import Notice
 from simulator.api.framing import encode_frame
 from simulator.api.stats import RobotStats
 
@@ -42,7 +43,11 @@ def test_a_connection_drops_and_counts_what_is_over_its_bounds() -> None:
     theirs.sendall(encode_frame(large.SerializeToString())
                    + encode_frame(small.SerializeToString()) * 5)
     assert conn.read(0.0) == 3
-    assert len(conn.take_requests()) == 3
+    notice, *requests = conn.take_requests()  # the oversize one is told, not decoded
+    assert isinstance(notice, Notice) and notice.text == (
+        f"ActuatorRequests of {large.ByteSize()} bytes is above the limit of 200 bytes, ignored."
+    )
+    assert len(requests) == 3
     assert stats.dropped_in == {"size": 1, "rate": 2}
     assert stats.to_dict()["dropped_in"] == {"size": 1, "rate": 2}
     assert stats.dropped_in_bytes == large.ByteSize() + 2 * small.ByteSize()

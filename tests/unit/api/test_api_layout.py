@@ -106,7 +106,8 @@ def test_batch_world_gives_the_same_measurements_as_single_calls() -> None:
     assert [s.name for s in msg.position_sensors] == ["NeckS", "HeadS"]
     assert msg.position_sensors[0].value == 0.5
     assert (len(msg.accelerometers), len(msg.gyros), len(msg.forces)) == (1, 0, 1)
-    assert not msg.messages  # the repeated bad target was warned about once
+    # the bad target is in every request: warned about in every measurement
+    assert [m.text for m in msg.messages] == ['Motor "Tail" not found, position command ignored.']
 
 
 def test_sensors_of_several_periods_keep_their_enabling_order() -> None:

@@ -1,0 +1,48 @@
+"""A request over the size limit, over real sockets: the client is told in its next
+measurement, and lockstep takes it as the answer (it is not waited for, nor charged as slow)."""
+
+from __future__ import annotations
+
+import time
+
+from contracts.robot_api import messages_pb2 as pb
+from simulator.api import FakeDeviceWorld, LockstepSettings
+from simulator.api.bounds import MAX_REQUEST_BYTES
+from testkit.league_client import LeagueStyleClient, neck_request
+from tests.integration.api.harness import RED1, running_server, wait_until
+
+
+def _oversize() -> bytes:
+    request = pb.ActuatorRequests()
+    request.motor_positions.add(name="x" * (MAX_REQUEST_BYTES + 1000), position=1.0)
+    body: bytes = request.SerializeToString()
+    return body
+
+
+def test_an_oversize_request_is_answered_with_a_warning_and_counts_as_the_answer() -> None:
+    lockstep = LockstepSettings(deadline_s=0.05, time_bank_s=0.2)
+    body = _oversize()
+    with running_server(robots=(RED1,), lockstep=lockstep, world=FakeDeviceWorld((RED1,)),
+                        pause_s=0.0) as (driver, ports):  # fmt: skip
+        with LeagueStyleClient("127.0.0.1", ports[RED1], split_writes=False) as client:
+            client.send(neck_request(0.0, enable=True))
+            wait_until(lambda: driver.server.connected())
+            for k in range(5):
+                client.exchange(neck_request(0.01 * k))
+            client.exchange(body)  # answers a measurement with 257 kB
+            started = time.monotonic()
+            told = pb.SensorMeasurements.FromString(client.exchange(neck_request(0.1)))
+            waited_s = time.monotonic() - started
+            after = [pb.SensorMeasurements.FromString(client.exchange(neck_request(0.2)))
+                     for _ in range(3)]  # fmt: skip
+        stats = driver.server.statistics()["red-1"]
+    assert [(m.message_type, m.text) for m in told.messages] == [(
+        pb.Message.WARNING_MESSAGE,
+        f"ActuatorRequests of {len(body)} bytes is above the limit of {MAX_REQUEST_BYTES}"
+        " bytes, ignored.",
+    )]  # fmt: skip
+    assert all(not m.messages and m.position_sensors for m in after)
+    assert stats["dropped_in"] == {"size": 1} and stats["decode_errors"] == 0
+    assert stats["slow_periods"] == 0 and stats["missed_deadlines"] == 0
+    assert waited_s < lockstep.deadline_s, waited_s  # not held for another answer
+    assert stats["disconnects"] == []
