@@ -56,8 +56,9 @@ class FakePool:
     def cancel(self, handle: str) -> None:
         self.cancelled.append(handle)
         if (Path(handle) / "running").exists():
+            # stopped after kick-off: the simulator writes the play up to the stop
             self.finish(handle, {"status": "failed", "failure_class": "interrupted",
-                                 "cause": "the orchestrator was asked to stop"})
+                                 "cause": "the orchestrator was asked to stop"}, played=True)
 
     def results_dir(self, handle: str) -> Path:
         return Path(handle) / "out"
@@ -72,8 +73,10 @@ class FakePool:
                          slots=self.slots, jobs=jobs)]
 
     # test controls -----------------------------------------------------------------------
-    def finish(self, handle: str, report: JSONObject) -> None:
-        """End the match with ``report`` as its report.json (checked as a MatchReport)."""
+    def finish(self, handle: str, report: JSONObject, *, played: bool | None = None) -> None:
+        """End the match with ``report`` as its report.json (checked as a MatchReport);
+        ``played``: results.json has the play of both halves (default: when it did not
+        fail)."""
         out = self.results_dir(handle)
         (out / "teams" / "red" / "1").mkdir(parents=True, exist_ok=True)
         (out / "teams" / "blue" / "1").mkdir(parents=True, exist_ok=True)
@@ -83,7 +86,7 @@ class FakePool:
         (out / "public" / "referee.log").write_text("referee\n")
         match_report = MatchReport.from_dict(report, source="FakePool.finish(report=...)")
         failure = match_report.failure
-        fake_results(Path(handle).name, failure).write(out / files.RESULTS)
+        fake_results(Path(handle).name, failure, played=played).write(out / files.RESULTS)
         (out / "public" / files.REPLAY).write_bytes(b"HLVSREC fake replay")
         match_report.write(out / files.REPORT)
         (Path(handle) / "running").unlink(missing_ok=True)
@@ -92,9 +95,11 @@ class FakePool:
         (Path(handle) / "running").unlink(missing_ok=True)
 
 
-def fake_results(match_id: str, failure: Failure | None) -> MatchResults:
+def fake_results(match_id: str, failure: Failure | None, *,
+                 played: bool | None = None) -> MatchResults:
     """A played 1-0 with one robot a side that both exited 0 (failed: ``failure``): both
-    halves reached PLAYING, red kicked its goal in."""
+    halves reached PLAYING, red kicked its goal in (``play`` left out of a failed match unless
+    ``played``)."""
     zero = {"red": 0, "blue": 0}
     play = PlayRecord(halves_playing=(1, 2), both_halves_playing=True, playing_s=80.0,
                       kicks={"red": 1, "blue": 0}, shots={"red": 1, "blue": 0},
@@ -104,7 +109,7 @@ def fake_results(match_id: str, failure: Failure | None) -> MatchResults:
     return MatchResults(
         match_id=match_id, seed=1, status="failed" if failure else "success", failure=failure,
         final_state="FINISHED", score={"red": 1, "blue": 0}, winner="red", robots=robots,
-        play=None if failure else play,
+        play=play if (failure is None if played is None else played) else None,
         limits=MatchLimits(cpus=4.0, memory_gb=16.0, pids=1024, log_folder_gb=10.0,
                            team_api_mb_s=350.0, team_comm_mb_s=1.0, grace_period_s=5.0,
                            allow_internet=False, host_controls=None),

@@ -3,6 +3,11 @@
 The submitting team plays red with the team file version it submitted; the opponent plays blue
 (the project's stub team, or the newest team file of a team that accepts friendlies). Test
 matches are short, lockstep scrimmages (see :class:`service.settings.Settings`).
+
+Both sides field the same number of robots: the service's ``test_players``
+(``HLVS_SERVICE_TEST_PLAYERS``, 1 by default), the lowest-numbered players of each team file
+(:func:`fielded`); when a team file has fewer, both sides field that many. A team's file with
+more players is never an advantage.
 """
 
 from __future__ import annotations
@@ -25,6 +30,19 @@ def _ports(base: int, team: TeamDocument) -> list[int]:
     return [base + n for n in range(1, max(1, len(players)) + 1)]
 
 
+def player_count(team: TeamDocument) -> int:
+    return len(team.get("players") or {})
+
+
+def fielded(team: TeamDocument, count: int) -> TeamDocument:
+    """``team`` with its ``count`` lowest-numbered players only."""
+    players = team.get("players") or {}
+    kept = sorted(players, key=lambda number: (not number.isdigit(),
+                                               int(number) if number.isdigit() else 0,
+                                               number))[:count]
+    return {**team, "players": {number: players[number] for number in kept}}
+
+
 def write_match(folder: Path, *, match_id: str, team: TeamDocument,
                 opponent: TeamDocument | None, stub_image: str | None,
                 settings: Settings, seed: int) -> Path:
@@ -32,6 +50,8 @@ def write_match(folder: Path, *, match_id: str, team: TeamDocument,
     if opponent is None:
         assert stub_image is not None
         opponent = team_file("Stub", stub_image, settings.test_players, goalie_first=True)
+    count = min(settings.test_players, player_count(team), player_count(opponent))
+    team, opponent = fielded(team, count), fielded(opponent, count)
     request = ScrimmageRequest(players=settings.test_players, seed=seed,
                                half_duration_s=settings.test_half_duration_s,
                                ready_duration_s=settings.test_ready_duration_s,
@@ -48,4 +68,4 @@ def write_match(folder: Path, *, match_id: str, team: TeamDocument,
     return folder / "game.json"
 
 
-__all__ = ["OWN_COLOR", "write_match"]
+__all__ = ["OWN_COLOR", "fielded", "player_count", "write_match"]

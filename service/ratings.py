@@ -1,11 +1,17 @@
 """The ladder's ratings: every played match between two teams, rated with OpenSkill.
 
-Which matches count: friendlies (a finished test match whose opponent is a team) and, when the
+Which matches count: friendlies (a test match whose opponent is a team) and, when the
 service is given the tournament's state (``HLVS_SERVICE_SCHEDULE_STATE``), the official matches
 of the schedule. A match counts only when football was played: its ``results.json`` has a half
 that reached PLAYING and some time in PLAYING (``play.halves_playing``, ``play.playing_s``). A
 win, a draw and a loss are the ranks of the two teams (a draw ties them); the goals only fill the
 table.
+
+A friendly that got past kick-off is rated whatever happens after it (:func:`friendly_outcome`):
+finished, its score; cancelled by the asking team, the asking team forfeits (the opponent wins,
+recorded 0:0 as ``hlvs match`` records a forfeit); failed, the team the failure is on forfeits,
+and a failure on no team's side (the league's) leaves the score as it stood. Only a friendly
+that never reached kick-off is not rated.
 
 Each match is recorded once (:class:`service.db.ladder.RatedMatch`, unique by source and id,
 written in the transaction that finds it), so a restart or a second look never counts it twice.
@@ -82,21 +88,55 @@ def _winner(winner: str | None, red: int, blue: int) -> str:
     return "red" if red > blue else "blue" if blue > red else "draw"
 
 
+def forfeit_by(color: str) -> Outcome:
+    """The other colour wins by forfeit, recorded 0:0 (as ``hlvs match`` records a forfeit,
+    :class:`contracts.Forfeit`)."""
+    return Outcome(0, 0, "blue" if color == "red" else "red", None)
+
+
+def friendly_outcome(results_path: Path, state: str, *, cancelled: bool) -> Outcome:
+    """A friendly's outcome for the ladder by how it ended (``state`` of its submission;
+    ``cancelled``: the asking team asked to stop it). Past kick-off it is always rated."""
+    played = outcome_of(results_path)
+    try:
+        results: MatchResults | None = MatchResults.load(results_path)
+    except ContractError:
+        results = None
+    play = results.play if results is not None else None
+    kicked_off = play is not None and bool(play.halves_playing) and play.playing_s > 0
+    if state == SubmissionState.DONE.value or not kicked_off:
+        return played
+    if state == SubmissionState.CANCELLED.value or cancelled:
+        return forfeit_by(OWN_COLOR)
+    failure = results.failure if results is not None else None
+    if failure is not None and failure.team in ("red", "blue"):
+        return forfeit_by(failure.team)
+    if played.red_goals is None or played.blue_goals is None:
+        return Outcome(None, None, None, "the match stopped with no score")
+    return Outcome(played.red_goals, played.blue_goals,
+                   _winner(None, played.red_goals, played.blue_goals), None)
+
+
 # recording --------------------------------------------------------------------------------
+ENDED = (SubmissionState.DONE.value, SubmissionState.CANCELLED.value,
+         SubmissionState.FAILED.value)
+
+
 def record_friendlies(session: Session, results_dir: Callable[[str], Path]) -> int:
-    """Record every finished friendly not considered yet; the number recorded.
+    """Record every ended friendly not considered yet; the number recorded.
 
     ``results_dir(pool_handle)`` is the pool's output folder of a match.
     """
     seen = exists().where(RatedMatch.source == FRIENDLY, RatedMatch.ref == Submission.id)
     rows = session.execute(select(Submission, Team.name).join(
         Team, Team.id == Submission.team_id).where(
-        Submission.state == SubmissionState.DONE.value, Submission.opponent != STUB,
+        Submission.state.in_(ENDED), Submission.opponent != STUB,
         Submission.pool_handle.is_not(None), ~seen).order_by(Submission.finished_at,
                                                              Submission.seq)).all()
     for row, team in rows:
         assert row.pool_handle is not None
-        outcome = outcome_of(results_dir(row.pool_handle) / files.RESULTS)
+        outcome = friendly_outcome(results_dir(row.pool_handle) / files.RESULTS, row.state,
+                                   cancelled=bool(row.cancel_requested))
         teams = {OWN_COLOR: team, OTHER_COLOR: row.opponent}
         _add(session, source=FRIENDLY, ref=row.id, red=teams["red"], blue=teams["blue"],
              outcome=outcome, played_at=utc(row.finished_at) if row.finished_at else now())

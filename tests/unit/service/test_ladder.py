@@ -22,6 +22,7 @@ from service.db import Submission, SubmissionState, make_engine, session_factory
 from service.db.ladder import RatedMatch
 from service.ratings import outcome_of
 from tests.integration.service.harness import Served
+from tests.unit.service.conftest import wait_for_status
 from tests.unit.service.test_submissions import setup_team
 
 STRENGTH = {"Anchors": 4, "Bravo": 3, "Comets": 2, "Dingos": 1}
@@ -219,3 +220,85 @@ def test_official_matches_of_the_tournament_are_rated_once(
     assert all(m["replay_url"] is None for m in matches)
     time.sleep(0.3)  # further rounds of the ladder thread
     assert rated_count(served) == 3
+
+
+def test_a_friendly_cancelled_after_kick_off_is_rated_as_the_askers_forfeit(
+    start: Callable[..., Served], token: Callable[..., str], pool: FakePool,
+) -> None:
+    """As found: the asking team, leading or not, cancels its running friendly after both
+    halves played; it is rated all the same, as its forfeit (the opponent wins)."""
+    served = start()
+    secrets = {name: token(name, accepts_friendlies=True) for name in ("Alpha", "Beta")}
+    clients = {n: setup_team(served, s, n) for n, s in secrets.items()}
+    sid = clients["Alpha"].post("/v1/submissions", json={"opponent": "Beta"}).json()["id"]
+    running_match(served)
+    assert clients["Alpha"].post(f"/v1/submissions/{sid}/cancel").status_code == 200
+    # the fake pool stops it as a real one does: interrupted, with the play up to then (both
+    # halves, red, the asker, ahead 1-0)
+    ended = wait_for_status(clients["Alpha"], sid, lambda b: b["state"] == "cancelled")
+    assert ended["state"] == "cancelled"
+    wait_rated(served, 1)
+    ladder = clients["Beta"].get("/v1/ladder").json()
+    assert ladder["matches_rated"] == 1, ladder
+    table = {t["team"]: t for t in ladder["teams"]}
+    assert (table["Beta"]["won"], table["Alpha"]["lost"]) == (1, 1), table
+    assert table["Beta"]["rating"] > table["Alpha"]["rating"]
+
+
+def test_a_friendly_that_never_kicked_off_is_not_rated_and_a_failure_forfeits_its_side(
+    tmp_path: Path,
+) -> None:
+    from contracts import Failure, FailureClass
+    from service.ratings import friendly_outcome
+
+    path = tmp_path / "results.json"
+    before = replace(fake_results("m", Failure(failure_class=FailureClass.INTERRUPTED,
+                                               cause="stop")), play=None)
+    before.write(path)
+    assert not friendly_outcome(path, "cancelled", cancelled=True).counted
+    failed = replace(fake_results("m", Failure(failure_class=FailureClass.TEAM_CRASH,
+                                               cause="crash", team="red"), played=True),
+                     score={"red": 3, "blue": 0})
+    failed.write(path)
+    outcome = friendly_outcome(path, "failed", cancelled=False)
+    assert outcome.counted and outcome.winner == "blue"
+    league = replace(failed, failure=Failure(failure_class=FailureClass.INFRASTRUCTURE,
+                                             cause="node lost"))
+    league.write(path)
+    outcome = friendly_outcome(path, "failed", cancelled=False)
+    assert outcome.counted and (outcome.red_goals, outcome.blue_goals, outcome.winner) == (
+        3, 0, "red")
+
+
+def test_both_sides_of_a_friendly_field_the_services_number_of_players(
+    start: Callable[..., Served], token: Callable[..., str], pool: FakePool,
+) -> None:
+    """As found: each side brought its own team file's count (2 robots against 1). Both field
+    the service's number (``test_players``), the lowest-numbered players of each file."""
+    import json
+
+    from tests.unit.service.conftest import team_doc
+
+    served = start(test_players=2)
+    secrets = {name: token(name, accepts_friendlies=True) for name in ("Alpha", "Beta")}
+    docs = {}
+    for name, count in (("Alpha", 3), ("Beta", 2)):
+        doc = team_doc(name)
+        first = doc["players"]["1"]
+        doc["players"] = {str(n): dict(first) for n in range(count, 0, -1)}
+        docs[name] = doc
+        with served.client(secrets[name]) as http:
+            stored = http.put("/v1/team/files/team_config", json=doc)
+            assert stored.status_code == 201, stored.text
+    with served.client(secrets["Alpha"]) as http:
+        created = http.post("/v1/submissions", json={"opponent": "Beta"})
+        assert created.status_code == 201, created.text
+        sid, _, _, _ = running_match(served)
+    match_dirs = list((served.settings.matches_dir).glob(f"{sid}-a1"))
+    assert match_dirs, list(served.settings.matches_dir.iterdir())
+    config = match_dirs[0] / "config"
+    red = json.loads((config / "team_red.json").read_text())
+    blue = json.loads((config / "team_blue.json").read_text())
+    game = json.loads((config / "game.json").read_text())
+    assert sorted(red["players"]) == sorted(blue["players"]) == ["1", "2"]
+    assert len(game["red"]["ports"]) == len(game["blue"]["ports"]) == 2
