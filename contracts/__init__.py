@@ -9,6 +9,7 @@ it; installs on its own from ``contracts/pyproject.toml``.
 - :mod:`contracts.ids`: ``TeamColor``, ``RobotId``; :mod:`contracts.geometry`: ``Pose`` and its
   mirror; :mod:`contracts.field`: the field dimensions.
 - :mod:`contracts.robot_api`: the robot API's protobuf messages (the league's ``messages.proto``).
+- :mod:`contracts.webhooks`: how a signed webhook is signed and checked.
 - :mod:`contracts.codec`: the one JSON reader/writer; every top-level document has a ``version``
   and ``from_json`` refuses versions it does not know (:class:`contracts.errors.UnknownVersion`).
 
@@ -22,7 +23,7 @@ from typing import TYPE_CHECKING
 from contracts.lazy import lazy_exports
 
 if TYPE_CHECKING:
-    from contracts import files, gamecontroller, telemetry
+    from contracts import files, gamecontroller, telemetry, webhooks
     from contracts.codec import from_data, to_data
     from contracts.errors import ContractError, ProtocolError
     from contracts.field import ADULT_FIELD, KID_FIELD, FieldClass, FieldGeometry, field_for
@@ -191,13 +192,14 @@ __all__ = [
     "telemetry",
     "timing_problem",
     "to_data",
+    "webhooks",
     "with_packet_number",
 ]
 
 
 if not TYPE_CHECKING:
     __getattr__, __dir__ = lazy_exports(__name__, {
-        "contracts": ("files", "gamecontroller", "telemetry"),
+        "contracts": ("files", "gamecontroller", "telemetry", "webhooks"),
         "contracts.codec": ("from_data", "to_data"),
         "contracts.errors": ("ContractError", "ProtocolError"),
         "contracts.field": ("ADULT_FIELD", "KID_FIELD", "FieldClass", "FieldGeometry", "field_for"),

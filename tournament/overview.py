@@ -172,11 +172,14 @@ def tournament_overview(ledger: Ledger, *, snapshot: Snapshot | None = None,
              links: str = "/watch/tournament") -> dict[str, Any]:
     """Everything the operator's page shows: the tournament's name, every match (state, times,
     score, live clock, log states, links to the live view and the replay), the standings with
-    their tie-breaks, the knockout bracket, and the warnings about the schedule file."""
+    their tie-breaks, the knockout bracket, whether a scheduler runs (its heartbeat), and the
+    warnings: "scheduler not running since ..." and those about the schedule file."""
     from tournament.controls import file_differences, recorded_schedule
+    from tournament.notify import scheduler_state
     from tournament.standings import standings
 
     schedule = recorded_schedule(ledger)
+    alive = scheduler_state(ledger)
     rows = ledger.rows()
     waiting = waiting_sets(schedule)
     matches = []
@@ -207,5 +210,6 @@ def tournament_overview(ledger: Ledger, *, snapshot: Snapshot | None = None,
         "standings": [s.as_dict() for s in standings(
             rows, [t.name for t in schedule.teams], seed=schedule.name)],
         "bracket": bracket(schedule),
-        "warnings": file_differences(ledger),
+        "scheduler": alive.as_dict(),
+        "warnings": ([alive.text] if alive.waiting else []) + file_differences(ledger),
     }

@@ -246,20 +246,29 @@ def run_schedule(
     poll_s: float = 1.0,
     stop: threading.Event | None = None,
     stop_grace_s: float | None = None,
+    notify: str | None = None,
 ) -> int:
     """Run the tournament until every match is final (with ``exit_when_done``) or a signal.
 
     SIGTERM or SIGINT stops it: a playing match gets SIGTERM (it stops and collects what was
     played), SIGKILL after ``stop_grace_s`` (default :data:`tournament.jobs.DEFAULT_STOP_GRACE_S`,
     kept in the state file), stays PLAYING marked interrupted, and is played again at the next
-    start. The call returns once the running steps ended (or a little after the grace period)."""
+    start. The call returns once the running steps ended (or a little after the grace period).
+
+    ``notify``: the operators' notification settings
+    (:meth:`tournament.notify.NotifySettings.recorded`), kept in the state file; the scheduler
+    writes its heartbeat there and sends the notices (:mod:`tournament.notify`)."""
     from tournament.jobs import DEFAULT_STOP_GRACE_S, STOPPING
+    from tournament.notify import HEARTBEAT_S, beat, stopped
 
     STOPPING.clear()
     state = str(Path(state_path).resolve())
     schedule, ledger = init_state(schedule_path, state, services=services, pool=pool)
     if stop_grace_s is not None:
         ledger.set_meta("stop_grace_s", repr(float(stop_grace_s)))
+    if notify is not None:
+        ledger.set_meta("notify", notify)
+    beat(ledger)
     recover_interrupted(ledger)
     stop = stop or threading.Event()
     wake = threading.Event()
@@ -295,8 +304,16 @@ def run_schedule(
         state,
     )
     last: dict[str, str] = {}
+    notices = threading.Event()
+    notifier = threading.Thread(target=_notify_loop, args=(ledger, notices), name="notices",
+                                daemon=True)
+    notifier.start()
+    beaten = time.monotonic()
     try:
         while not stop.is_set():
+            if time.monotonic() - beaten >= HEARTBEAT_S:
+                beat(ledger)
+                beaten = time.monotonic()
             reconcile(scheduler, ledger, state, running.ids())
             rows = ledger.rows()
             for row in rows:
@@ -319,7 +336,29 @@ def run_schedule(
         else:
             scheduler.shutdown(wait=not stop.is_set())
         logging.getLogger("apscheduler.scheduler").removeFilter(quiet)
+        notices.set()
+        notifier.join(timeout=15)
+        stopped(ledger)
     return 0
+
+
+def _notify_loop(ledger: Ledger, done: threading.Event, every_s: float = 2.0) -> None:
+    """Queue and send the operators' notices until ``done`` (then one last round)."""
+    from tournament.notify import Outbox, recorded_settings
+
+    settings = recorded_settings(ledger)
+    if not settings.any:
+        return
+    outbox = Outbox(ledger, settings)
+    while True:
+        finished = done.wait(every_s)
+        try:
+            outbox.scan()
+            outbox.send_due()
+        except Exception:  # noqa: BLE001 - the notifier thread's boundary: retried next round
+            log.exception("notices: a round failed; retrying")
+        if finished:
+            return
 
 
 def _wait_for_steps(running: RunningJobs, timeout_s: float) -> None:

@@ -31,6 +31,7 @@ class TournamentView(BaseModel):
     matches: list[dict[str, Any]]
     standings: list[dict[str, Any]]
     bracket: list[list[str]]
+    scheduler: dict[str, Any] | None = None  # running, since (its last heartbeat), text
     warnings: list[str]
 
 

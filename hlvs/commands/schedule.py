@@ -40,6 +40,19 @@ def register(sub: Any) -> None:
                      "its logs before it is killed (default 60; a supervisor's stop timeout, "
                      "e.g. systemd's TimeoutStopSec, should be longer); remembered in the state "
                      "file. The match is played again at the next start")
+    run.add_argument("--notify-mail", action="append", default=[], metavar="ADDRESS",
+                     help="mail the operators at ADDRESS (repeatable) when a match is FAILED, "
+                     "MISSED or LOGS_FAILED, still running when its stream starts, or the "
+                     "scheduler stopped; remembered in the state file")
+    run.add_argument("--notify-webhook", action="append", default=[], metavar="URL",
+                     help="POST the same notices, signed as the service's webhooks "
+                     "(X-HLVS-Signature), to URL (repeatable; needs --notify-webhook-secret-file)")
+    run.add_argument("--notify-webhook-secret-file", type=user_path, metavar="FILE",
+                     help="file holding the webhooks' shared secret")
+    run.add_argument("--smtp", default="localhost:25", metavar="HOST[:PORT]",
+                     help="SMTP server of the mails (default localhost:25)")
+    run.add_argument("--mail-from", default="hlvs@localhost", metavar="ADDRESS",
+                     help="sender of the mails (default hlvs@localhost)")
     run.set_defaults(func=_run, log_level=logging.INFO)
 
     plan = verbs.add_parser("list", help="what is planned, with absolute times")
@@ -123,6 +136,7 @@ def _run(args: argparse.Namespace) -> int:
     code = run_schedule(
         args.schedule, args.state, services=args.services, pool=args.pool,
         exit_when_done=args.exit_when_done, stop_grace_s=args.stop_grace,
+        notify=_notify_settings(args),
     )
     from tournament.jobs import STOPPING
 
@@ -135,6 +149,40 @@ def _run(args: argparse.Namespace) -> int:
         sys.stderr.flush()
         os._exit(code)
     return code
+
+
+def _notify_settings(args: argparse.Namespace) -> str | None:
+    """The --notify-* options as the state file records them (None: keep the recorded ones)."""
+    from tournament.notify import NotifySettings, Webhook
+
+    if not args.notify_mail and not args.notify_webhook:
+        return None
+    problems = []
+    for i, url in enumerate(args.notify_webhook):
+        if not url.startswith(("http://", "https://")):
+            problems.append(Problem("--notify-webhook", f"/{i}", f"{url!r} is not a URL",
+                                    expected="an http:// or https:// URL"))
+    secret_file: Path | None = args.notify_webhook_secret_file
+    if args.notify_webhook and secret_file is None:
+        problems.append(Problem("--notify-webhook-secret-file", "", "missing",
+                                expected="a file holding the webhooks' shared secret"))
+    elif secret_file is not None and not secret_file.is_file():
+        problems.append(Problem(str(secret_file), "", "file not found",
+                                expected="a file holding the webhooks' shared secret"))
+    for address in args.notify_mail:
+        if "@" not in address:
+            problems.append(Problem("--notify-mail", "", f"{address!r} is not a mail address",
+                                    expected="user@host"))
+    host, _, port = args.smtp.partition(":")
+    if not host or (port and not port.isdigit()):
+        problems.append(Problem("--smtp", "", f"{args.smtp!r}", expected="HOST or HOST:PORT"))
+    if problems:
+        raise ConfigError(problems)
+    settings = NotifySettings(
+        mail_to=tuple(args.notify_mail), smtp_host=host, smtp_port=int(port or 25),
+        mail_from=args.mail_from,
+        webhooks=tuple(Webhook(url=u, secret="") for u in args.notify_webhook))
+    return settings.recorded(secret_file.resolve() if secret_file else None)
 
 
 def _list(args: argparse.Namespace) -> int:
@@ -177,27 +225,36 @@ def _list(args: argparse.Namespace) -> int:
 
 def _status(args: argparse.Namespace) -> int:
     from tournament import Snapshot, status_lines
+    from tournament.notify import scheduler_state
 
-    ledger = _ledger(args.state)
     snapshot: Snapshot | None = None
     if not args.json:  # a running match's score and clock, from its telemetry
         from viewer import game_snapshot
 
         snapshot = game_snapshot
     if not args.watch:
+        ledger = _ledger(args.state)
         if args.json:
             print(json.dumps([r.as_dict() for r in ledger.rows()], indent=2))
         else:
-            print("\n".join(status_lines(ledger, snapshot=snapshot)))
+            alive = scheduler_state(ledger)
+            print("\n".join(([alive.text] if alive.text else [])
+                            + status_lines(ledger, snapshot=snapshot)))
         _warn_differences(ledger)
         return 0
     import time
 
     try:
+        ledger = _wait_for_state(args.state, args.every)
         while True:
-            text = (json.dumps([r.as_dict() for r in ledger.rows()]) if args.json
-                    else "\n".join(status_lines(ledger, snapshot=snapshot)))
-            if not args.json:
+            alive = scheduler_state(ledger)
+            if not alive.running:
+                _notify_dead(ledger, alive)
+            if args.json:
+                text = json.dumps([r.as_dict() for r in ledger.rows()])
+            else:
+                text = "\n".join(([alive.text] if alive.text else [])
+                                 + status_lines(ledger, snapshot=snapshot))
                 print("\x1b[H\x1b[2J", end="")  # clear the terminal, as watch(1) does
                 print(f"{datetime.now(UTC).isoformat(timespec='seconds')}"
                       f"  (every {args.every:g} s, Ctrl-C to stop)")
@@ -205,6 +262,36 @@ def _status(args: argparse.Namespace) -> int:
             time.sleep(args.every)
     except KeyboardInterrupt:
         return 0
+
+
+def _wait_for_state(path: Path, every_s: float) -> Any:
+    """``status --watch`` started before ``run``: wait until the state file is written."""
+    import time
+
+    from tournament import Ledger
+
+    said = False
+    while not path.is_file() or not Ledger(path).get_meta("schedule_text"):
+        if not said:
+            print(f"waiting for {path} (written by 'hlvs schedule run'; Ctrl-C to stop)",
+                  flush=True)
+            said = True
+        time.sleep(every_s)
+    return Ledger(path)
+
+
+def _notify_dead(ledger: Any, alive: Any) -> None:
+    """A scheduler that stopped beating cannot tell: the watching operator's command does,
+    with the notification settings the scheduler recorded."""
+    from tournament.notify import Outbox, recorded_settings
+
+    settings = recorded_settings(ledger)
+    if settings.any and alive.waiting and alive.since is not None:
+        outbox = Outbox(ledger, settings)
+        outbox.add(f"scheduler.stopped|{alive.since.isoformat()}", "scheduler.stopped",
+                   {"tournament": outbox.name, "text": alive.text,
+                    "since": alive.since.isoformat()})
+        outbox.send_due()
 
 
 def _cancel(args: argparse.Namespace) -> int:
