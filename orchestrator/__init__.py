@@ -33,7 +33,7 @@ if TYPE_CHECKING:
         write_private,
     )
     from orchestrator.project_images import build_all, ensure_image, project_image
-    from orchestrator.pull import pull_game_images, resolve_team_images
+    from orchestrator.pull import ResolvedImage, pull_game_images, resolve_team_images
     from orchestrator.telemetry import LiveView, ZenohTelemetry, subscriber_config
 
 __all__ = [
@@ -49,6 +49,7 @@ __all__ = [
     "MatchFailed",
     "OrchestratorError",
     "Problem",
+    "ResolvedImage",
     "ScheduleError",
     "Subnets",
     "TeamImagesTooLarge",
@@ -82,6 +83,6 @@ if not TYPE_CHECKING:
             "make_private_file", "open_private_append", "private_dir", "write_private",
         ),
         "orchestrator.project_images": ("build_all", "ensure_image", "project_image"),
-        "orchestrator.pull": ("pull_game_images", "resolve_team_images"),
+        "orchestrator.pull": ("ResolvedImage", "pull_game_images", "resolve_team_images"),
         "orchestrator.telemetry": ("LiveView", "ZenohTelemetry", "subscriber_config"),
     })

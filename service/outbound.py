@@ -18,14 +18,14 @@ from collections.abc import Mapping
 
 import httpx
 
-from orchestrator.delivery.addresses import (
+from orchestrator.delivery import (
     AddressRefused,
     IPAddress,
     IPNetwork,
     address_allowed,
     literal_problem,
 )
-from orchestrator.delivery.addresses import resolve as _resolve
+from orchestrator.delivery import resolve as _resolve
 from service.errors import InvalidInput
 from service.settings import (
     LOG_TARGET_ALLOW_SETTING,

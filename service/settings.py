@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from contracts import TEST_MATCH, TimingError, fit_ready
-from orchestrator.delivery.addresses import IPNetwork, networks
+from orchestrator.delivery import IPNetwork, networks
 from service.errors import SettingsError
 
 PREFIX = "HLVS_SERVICE_"

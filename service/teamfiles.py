@@ -29,7 +29,7 @@ from sqlalchemy.orm import Session
 
 from orchestrator import ConfigError, Problem
 from orchestrator.config import BUILT_IN_MODELS, FieldClass, TeamConfig, check_team_document
-from orchestrator.delivery.addresses import IPNetwork, literal_problem
+from orchestrator.delivery import IPNetwork, literal_problem
 from service.db import TeamFile
 from service.errors import InvalidInput, NotFound
 from service.sealing import PREFIX, Sealer

@@ -31,6 +31,35 @@ class Target:
         return {"figure": self.figure, **bound}
 
 
+# The targets of ``hlvs bench report``, per kind: the performance goals.
+TARGETS = {
+    "sim": Target("ratio", minimum=0.95),
+    "async": Target("ratio_interleaved", minimum=0.92),
+    "lockstep": Target("ratio_interleaved", minimum=0.85),
+    "pipelined": Target("ratio_interleaved", minimum=0.92),
+    "cameras": Target("real_time_factor", minimum=1.0),
+    "bringup": Target("bringup_s", maximum=3.0),
+}
+
+# The speed of the bare 8-robot ``mj_step`` loop (times real time) of the machine the cameras' and
+# the bring-up's targets are set for. Both depend on the machine's speed, so on another machine
+# their bounds scale by its own bare loop (``bench sim``'s ``bare_real_time_factor``): the
+# cameras' minimum with it, the bring-up's maximum against it.
+REFERENCE_BARE_REAL_TIME_FACTOR = 12.0
+MACHINE_SCALED = {"cameras": "with", "bringup": "against"}
+
+
+def machine_target(kind: str, bare_real_time_factor: float | None) -> Target | None:
+    """The target of ``kind`` on a machine whose bare loop runs ``bare_real_time_factor`` times
+    real time (None: not measured, the reference machine's bound)."""
+    target = TARGETS.get(kind)
+    how = MACHINE_SCALED.get(kind)
+    if target is None or how is None or not bare_real_time_factor:
+        return target
+    speed = bare_real_time_factor / REFERENCE_BARE_REAL_TIME_FACTOR
+    return target.scaled(speed if how == "with" else 1.0 / speed)
+
+
 def median_figures(runs: Sequence[Mapping[str, object]]) -> dict[str, float]:
     """Per numeric figure, the median over the runs (figure name -> value) that did not fail."""
     good = [r for r in runs if "error" not in r]
@@ -45,4 +74,11 @@ def median_figures(runs: Sequence[Mapping[str, object]]) -> dict[str, float]:
 
 
 
-__all__ = ["Target", "median_figures"]
+__all__ = [
+    "MACHINE_SCALED",
+    "REFERENCE_BARE_REAL_TIME_FACTOR",
+    "TARGETS",
+    "Target",
+    "machine_target",
+    "median_figures",
+]

@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from contracts import lazy_exports
+from tournament.jobs import STOPPING
 from tournament.overview import LiveGame
 from tournament.runner import init_state, recover_interrupted, run_schedule
 from tournament.services import (
@@ -43,6 +44,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "DEFAULT_ABORT_GRACE_S",
+    "STOPPING",
     "Ledger",
     "LiveGame",
     "MatchContext",

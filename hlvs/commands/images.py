@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 from orchestrator import ExitCode, user_path
 
 if TYPE_CHECKING:
-    from orchestrator.pull import ResolvedImage
+    from orchestrator import ResolvedImage
 
 
 def register(sub: Any) -> None:

@@ -138,7 +138,7 @@ def _run(args: argparse.Namespace) -> int:
         exit_when_done=args.exit_when_done, stop_grace_s=args.stop_grace,
         notify=_notify_settings(args),
     )
-    from tournament.jobs import STOPPING
+    from tournament import STOPPING
 
     if STOPPING.is_set():
         # stopped by a signal: a step that cannot be interrupted (an image pull) must not keep

@@ -11,6 +11,15 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from contracts import lazy_exports
+from orchestrator.delivery.addresses import (
+    AddressRefused,
+    IPAddress,
+    IPNetwork,
+    address_allowed,
+    literal_problem,
+    networks,
+    resolve,
+)
 from orchestrator.delivery.deliver import (
     MANIFEST_NAME,
     DeliveryOutcome,
@@ -35,11 +44,14 @@ if TYPE_CHECKING:
     from orchestrator.delivery.store import list_sets
 
 __all__ = [
+    "AddressRefused",
     "DeliveryFailure",
     "DeliveryOutcome",
     "ERROR_KINDS",
     "FakeUploader",
     "FileEntry",
+    "IPAddress",
+    "IPNetwork",
     "KEEP_UNDELIVERED",
     "MANIFEST_NAME",
     "Opener",
@@ -48,13 +60,17 @@ __all__ = [
     "RetryPolicy",
     "TRANSIENT_KINDS",
     "Uploader",
+    "address_allowed",
     "deliver_pending",
     "deliver_set",
     "enqueue_match_logs",
     "is_transient",
     "list_sets",
+    "literal_problem",
+    "networks",
     "open_uploader",
     "pending_status",
+    "resolve",
 ]
 
 

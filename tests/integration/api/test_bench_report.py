@@ -6,8 +6,7 @@ import json
 import subprocess
 import sys
 
-from benchmarks.report import machine_target
-from testkit.figures import Target
+from testkit.figures import Target, machine_target
 from testkit.figures import median_figures as _median
 
 

@@ -22,7 +22,6 @@ from typing import Any
 
 from contracts import JSONObject
 from simulator.errors import ModelError, ModelProblem
-from simulator.world.robots.team.devices import device_name_problems
 from simulator.world.servos import find_servo, servo_ids
 
 MANIFEST_NAME = "robot_model.json"
@@ -295,6 +294,9 @@ def load_manifest(folder_or_file: Path) -> Manifest:
         joint_frictionloss=None if friction is None else float(friction),
         imus=imus,
     )
+    # devices.py reads the Manifest type this module defines: imported here, not at the top
+    from simulator.world.robots.team.devices import device_name_problems
+
     problems = device_name_problems(manifest)
     if problems:
         raise ModelError(problems)
