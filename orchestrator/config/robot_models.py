@@ -88,6 +88,13 @@ def describe(measurements: Measurements) -> str:
     m = measurements.rounded()
     return (
         f"H {m.height_m} m, Hleg {m.leg_m} m, Hhead {m.head_m} m, Harm {m.arm_m} m, "
-        f"foot {m.foot_length_m} x {m.foot_width_m} m, mass {m.mass_kg} kg, "
-        f"{m.motors} motors, {m.cameras} camera(s)"
+        f"foot {m.foot_length_m} x {m.foot_width_m} m, mass {m.mass_kg} kg "
+        f"(servos {m.servo_mass_kg} kg; {_split(m.mass_split_kg)}), "
+        f"{m.motors} motors, {m.cameras} camera(s), "
+        f"reach per chain {_split(m.arm_chains_m, ' m')}, "
+        f"{round(100 * m.collision_coverage, 1):g} % of the mass in collision shapes"
     )
+
+
+def _split(values: dict[str, float], unit: str = "") -> str:
+    return ", ".join(f"{k} {v:g}{unit}" for k, v in values.items())

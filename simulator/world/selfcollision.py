@@ -5,10 +5,15 @@ Every link of a robot collides with every other link of the same robot except:
 1. a link and its *collision parent*: the nearest ancestor body that has collision geoms (bodies
    without collision geoms, the small servo-horn links between two joints of a hip or a
    shoulder, are skipped, so the links they join count as adjacent);
-2. links whose collision shapes touch, or come within :data:`NEAR_M` of each other, with every
-   joint at zero or in the model's standing pose (coarse collision shapes of team models that
-   overlap or all but meet at a joint: the Wolfgang's head hull is half a millimetre above its
-   torso hull, which a real head clears when it looks down).
+2. links of one chain (one an ancestor of the other) whose collision shapes touch, or come
+   within :data:`NEAR_M` of each other, with every joint at zero or in the model's standing pose
+   (coarse collision shapes of team models that overlap or all but meet at a joint: the
+   Wolfgang's head hull is half a millimetre above its torso hull, which a real head clears when
+   it looks down). Links of different chains (the two legs) always collide, whatever their
+   shapes: a shape made to reach the other leg cannot switch the legs' collisions off (the
+   model check refuses shapes that overlap across chains). The built-in robots, whose shapes
+   are the league's own, keep the exclusion of every touching pair (their hands hang against
+   their thighs at zero).
 
 MuJoCo itself leaves out a body and its parent. The rule is applied the same way to the built-in
 robots and to team models (computed from the model alone, once per model per process).
@@ -22,6 +27,7 @@ import mujoco
 import numpy as np
 
 from simulator.world.robots import AnyRobotModel
+from simulator.world.robots.model import RobotModel
 
 _PREFIX = "selfcheck"
 NEAR_M = 0.005
@@ -56,6 +62,7 @@ def _standalone(model: AnyRobotModel) -> mujoco.MjModel:
 
 
 def _compute(model: AnyRobotModel) -> tuple[tuple[str, str], ...]:
+    built_in = isinstance(model, RobotModel)
     mj = _standalone(model)
     colliding = np.zeros(mj.nbody, dtype=bool)
     for g in range(mj.ngeom):
@@ -79,7 +86,16 @@ def _compute(model: AnyRobotModel) -> tuple[tuple[str, str], ...]:
         mujoco.mj_forward(mj, data)
         for g1, g2 in data.contact.geom[: data.ncon].tolist():
             a, b = int(mj.geom_bodyid[g1]), int(mj.geom_bodyid[g2])
-            if a != b:
+            if a != b and (built_in or _ancestor(mj, a, b) or _ancestor(mj, b, a)):
                 pairs.add((min(a, b), max(a, b)))
     start = len(_PREFIX) + 1
     return tuple(sorted((mj.body(a).name[start:], mj.body(b).name[start:]) for a, b in pairs))
+
+
+def _ancestor(mj: mujoco.MjModel, ancestor: int, body: int) -> bool:
+    """Whether ``ancestor`` is ``body``'s parent, grandparent ..."""
+    while body > 0:
+        body = int(mj.body_parentid[body])
+        if body == ancestor:
+            return True
+    return False

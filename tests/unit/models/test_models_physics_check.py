@@ -21,7 +21,9 @@ def test_wolfgang_reach_is_its_own_arm() -> None:
     measurements, problems = check(load_team_model(WOLFGANG))
     assert problems == []
     assert 0.28 < measurements.arm_m < 0.30  # each arm's own chain, not shoulder to other hand
-    assert set(measurements.arm_chains_m) == {"l_shoulder", "r_shoulder"}
+    # every chain from the torso without a foot: both arms and the head
+    assert set(measurements.arm_chains_m) == {"l_shoulder", "r_shoulder", "neck"}
+    assert measurements.arm_chains_m["neck"] < 0.2
     assert measurements.servos["LKnee"] == "XM540-W270@14.8V"
 
 

@@ -32,7 +32,8 @@ def test_missing_package_names_the_folder_and_what_was_expected(tmp_path: Path) 
     text = [str(p) for p in problems]
     assert any(
         "/players/1/model: no robot model package at " + str(tmp_path / "nowhere") in t
-        and "kid-default" in t and "robot_model.json" in t
+        and "kid-default" in t
+        and "robot_model.json" in t
         for t in text
     ), text
 
@@ -47,8 +48,13 @@ def test_the_simulator_container_reads_each_package_once_read_only(tmp_path: Pat
     from orchestrator.match.plan import plan_from_game  # noqa: F401  (import check)
 
     request = simulator_request(
-        _plan_stub(), prefix="hlvs-x", image="sim:1", match_dir=tmp_path, attachments=(),
-        extra_labels={}, model_dirs=(WOLFGANG,),
+        _plan_stub(),
+        prefix="hlvs-x",
+        image="sim:1",
+        match_dir=tmp_path,
+        attachments=(),
+        extra_labels={},
+        model_dirs=(WOLFGANG,),
     )
     models = [m for m in request.mounts if m.target.startswith("/opt/hlvs/team-models/")]
     assert [(m.source, m.read_only) for m in models] == [(WOLFGANG, True)]
@@ -66,8 +72,9 @@ def test_scrimmage_stub_is_told_the_built_in_model_it_drives(tmp_path: Path) -> 
     """A stub robot runs the gait of the model on its command line and plays on the field it is
     told: every stub of an adult team is told ``--model adult-default`` and the field; a team's
     model package is not a model the stub knows, so only the field is added."""
-    adult = team_file("Bots", "registry.example/bots:1", 2, model="adult-default",
-                      field_class=FieldClass.ADULT)
+    adult = team_file(
+        "Bots", "registry.example/bots:1", 2, model="adult-default", field_class=FieldClass.ADULT
+    )
     commands = [p["dockerCmd"] for p in adult["players"].values()]
     assert all(c.endswith(" --model adult-default --field-class adult") for c in commands), commands
     box_robot(tmp_path / "box", height_m=0.7)
@@ -93,14 +100,19 @@ def test_free_servos_are_refused_for_an_official_match_and_a_warning_in_a_friend
     official = check_team(team, field_class=FieldClass.KID, official=True)
     errors = [str(p) for p in official if p.severity == "error"]
     assert any(
-        "/players/1/model: the robot model cannot be used" in e and "hip_l (joint hip_l)" in e
-        and "not for an official match" in e and "servos from the league catalogue" in e
+        "/players/1/model: the robot model cannot be used" in e
+        and "hip_l (joint hip_l)" in e
+        and "not for an official match" in e
+        and "servos from the league catalogue" in e
         for e in errors
     ), errors
     friendly = check_team(team, field_class=FieldClass.KID)
     assert not [p for p in friendly if p.severity == "error"]
-    assert any("for friendlies only (refused in official matches)" in str(p)
-               for p in friendly if p.severity == "warning")
+    assert any(
+        "for friendlies only (refused in official matches)" in str(p)
+        for p in friendly
+        if p.severity == "warning"
+    )
 
 
 def test_robots_of_the_other_size_class_are_refused_for_an_official_match(
@@ -111,8 +123,9 @@ def test_robots_of_the_other_size_class_are_refused_for_an_official_match(
     adult = _team(tmp_path, "adult-default")
     errors = [str(p) for p in check_team(adult, field_class=FieldClass.KID, official=True)]
     assert len(errors) == 2 and all(
-        "adult-default is a robot model of the adult size class in a game of the kid size "
-        "class" in e and "expected a model of the kid size class: kid-default" in e
+        "adult-default is a robot model of the adult size class in a game of the kid size class"
+        in e
+        and "expected a model of the kid size class: kid-default" in e
         for e in errors
     ), errors
     warnings = check_team(adult, field_class=FieldClass.KID)
