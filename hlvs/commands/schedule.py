@@ -126,7 +126,7 @@ def _run(args: argparse.Namespace) -> int:
     recorded = args.state.is_file() and _ledger(args.state).get_meta("schedule_text")
     if not recorded:  # the first run: what hlvs check finds is refused before any pull (a
         # restart runs the copy checked then; an edit waits for 'hlvs schedule apply')
-        problems = check_schedule(args.schedule)
+        problems = check_schedule(args.schedule, now=datetime.now(UTC))
         if any(p.severity == "error" for p in problems):
             raise ConfigError(problems)
 

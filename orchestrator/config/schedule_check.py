@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import replace
+from datetime import UTC, datetime, timedelta
 from pathlib import Path
 from typing import Any, cast
 
@@ -26,6 +27,7 @@ from orchestrator.config.schedule import (
     _slot,
     game_document,
     knockout_fixtures,
+    resolve_time,
     round_robin_fixtures,
 )
 from orchestrator.errors import ConfigError, Problem
@@ -33,8 +35,11 @@ from orchestrator.errors import ConfigError, Problem
 log = logging.getLogger(__name__)
 
 
-def check_schedule(path: str | Path) -> list[Problem]:
-    """Every problem (errors and warnings) of a schedule and of the files its matches use."""
+def check_schedule(path: str | Path, *, now: datetime | None = None) -> list[Problem]:
+    """Every problem (errors and warnings) of a schedule and of the files its matches use.
+
+    ``now``: refuse matches whose stream starts before it (``hlvs check`` and the first ``hlvs
+    schedule run``; not ``hlvs schedule apply``, where the day's earlier matches are past)."""
     path = Path(path)
     try:
         data = _read(path)
@@ -56,6 +61,7 @@ def check_schedule(path: str | Path) -> list[Problem]:
     except (KeyError, TypeError, AttributeError, ValueError):  # a part the schema rejected
         log.debug("cross-checks of %s stopped early", path, exc_info=True)
     problems += _timing_problems(path, schedule)
+    problems += _plan_problems(path, schedule, data, now)
     problems += _team_problems(schedule)
     problems += _credentials_problems(schedule)
     problems += _game_problems(path, schedule)
@@ -181,6 +187,64 @@ def _timing_problems(path: Path, schedule: Schedule) -> list[Problem]:
                 f"({name} {timing.pull_lead_s(kind):g} s): {kind} matches are played at the "  # type: ignore[arg-type]
                 "stream's start, with no margin",
                 expected=f"less than {name}", severity="warning"))
+    return problems
+
+
+def _plan_problems(path: Path, schedule: Schedule, data: dict[str, Any],
+                   now: datetime | None) -> list[Problem]:
+    """What would go wrong on the day: a team whose logs have nowhere to go, a match whose
+    stream has started (with ``now``), two streams of one team at once, fixtures whose streams
+    overlap (an interval shorter than a stream)."""
+    file = str(path)
+    problems = []
+    for i, team in enumerate(schedule.teams):
+        if team.credentials is None:
+            problems.append(Problem(
+                file, f"/teams/{i}/credentials", f"team {team.name!r} has no log target: its "
+                "logs would wait in the log store after every match",
+                expected="credentials: the team's credentials.json (SFTP or S3)"))
+    fixtures = _sound_fixtures(data)["fixtures"]
+    for kind, spec in fixtures.items():
+        interval = float(spec.get("interval_s", 3600.0))
+        length = float(spec.get("stream_length_s", 1800.0))
+        if interval < length:
+            problems.append(Problem(
+                file, f"/fixtures/{kind}/interval_s", f"{interval:g} s between two streams is "
+                f"shorter than a stream ({length:g} s): streams would overlap",
+                expected=f"at least stream_length_s ({length:g})"))
+    start = data.get("start")
+    reference = datetime.now(UTC)
+    try:
+        if isinstance(start, str) and start != "now":
+            reference = resolve_time(start, reference)
+    except ValueError:
+        return problems  # reported by the cross-checks
+    listed = len(data.get("matches") or [])
+    streams: list[tuple[datetime, datetime, ScheduledMatch, str]] = []
+    for i, match in enumerate(schedule.matches):
+        pointer = f"/matches/{i}" if i < listed else f"(fixture {match.id})"
+        try:
+            begin = resolve_time(match.stream_start, reference)
+        except ValueError:
+            continue  # reported by the cross-checks
+        if now is not None and begin <= now:
+            problems.append(Problem(
+                file, f"{pointer}/stream_start", f"match {match.id}: its stream starts "
+                f"{begin.isoformat(timespec='seconds')}, in the past",
+                expected="a time after now (or an offset from start: now)"))
+        streams.append((begin, begin + timedelta(seconds=match.stream_length_s), match,
+                        pointer))
+    for k, (begin, end, match, pointer) in enumerate(streams):
+        teams = {t for t in (match.red.team, match.blue.team) if t is not None}
+        for other_begin, other_end, other, _ in streams[:k]:
+            both = teams & {t for t in (other.red.team, other.blue.team) if t is not None}
+            if both and begin < other_end and other_begin < end:
+                problems.append(Problem(
+                    file, f"{pointer}/stream_start", f"match {match.id}: {sorted(both)[0]!r} "
+                    f"also plays {other.id}, whose stream "
+                    f"({other_begin.isoformat(timespec='minutes')} for "
+                    f"{(other_end - other_begin).total_seconds():g} s) overlaps this one",
+                    expected="streams of one team one after the other"))
     return problems
 
 

@@ -23,11 +23,21 @@ FAKE = "tests.unit.schedule.fake_services:FakeServices"
 TEAMS = ["alpha", "bravo", "charlie", "delta"]
 
 
+def write_credentials(path: Path) -> Path:
+    """A team's log target (S3) that the fake services never reach."""
+    path.write_text(json.dumps({"type": "s3", "credentials": {
+        "access_id": "hlvs", "access_secret": "x", "bucket": "logs", "region": "us-east-1"}}))
+    path.chmod(0o600)
+    return path
+
+
 def write_schedule(tmp: Path, body: str) -> Path:
     for name in TEAMS:
         (tmp / f"{name}.json").write_text(json.dumps({"name": name, "players": {}}))
+    write_credentials(tmp / "logs.json")
     teams = "\n".join(
-        f"  - {{name: {n}, id: {i + 1}, config: {n}.json}}" for i, n in enumerate(TEAMS)
+        f"  - {{name: {n}, id: {i + 1}, config: {n}.json, credentials: logs.json}}"
+        for i, n in enumerate(TEAMS)
     )
     path = tmp / "schedule.yaml"
     path.write_text(f"name: test cup\noutput_dir: out\nteams:\n{teams}\n{body}")
