@@ -32,6 +32,7 @@ from hlvs.commands import (
     logs,
     match,
     pool,
+    referee,
     registry,
     schedule,
     service,
@@ -54,6 +55,7 @@ COMMAND_MODULES = (
     viewer,
     pool,
     service,
+    referee,
 )
 
 EPILOG = (

@@ -47,6 +47,16 @@ from referee.gamecontroller import (
     Penalty,
     SecondaryState,
 )
+from referee.league_scenario import (
+    LeagueAction,
+    LeagueScenario,
+    LeagueStep,
+    LeagueTarget,
+    LeagueTest,
+    LeagueTiming,
+    load_league_scenario,
+    parse_league_scenario,
+)
 from referee.mirror import MirrorStats, TeamMirror
 from referee.net import GameControllerNetwork, NetworkStats, RobotLink
 from referee.snapshot import (
@@ -81,6 +91,12 @@ __all__ = [
     "GameType",
     "IllegalTransition",
     "KID_FIELD",
+    "LeagueAction",
+    "LeagueScenario",
+    "LeagueStep",
+    "LeagueTarget",
+    "LeagueTest",
+    "LeagueTiming",
     "MirrorStats",
     "NetworkConfig",
     "NetworkStats",
@@ -118,4 +134,6 @@ __all__ = [
     "encode_game_state",
     "encode_return",
     "field_for",
+    "load_league_scenario",
+    "parse_league_scenario",
 ]

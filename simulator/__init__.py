@@ -19,11 +19,14 @@ from simulator.errors import (
 )
 
 if TYPE_CHECKING:
+    from simulator.league_tests import LeagueOutcome, LeagueTestOutcome, run_league_scenario
     from simulator.match_setup import referee_config
     from simulator.traffic import read_stats
 
 __all__ = [
     "ApiError",
+    "LeagueOutcome",
+    "LeagueTestOutcome",
     "ModelError",
     "PhysicsDivergence",
     "ReplayError",
@@ -31,11 +34,13 @@ __all__ = [
     "UnknownModelError",
     "read_stats",
     "referee_config",
+    "run_league_scenario",
 ]
 
 
 if not TYPE_CHECKING:
     __getattr__, __dir__ = lazy_exports(__name__, {
+        "simulator.league_tests": ("LeagueOutcome", "LeagueTestOutcome", "run_league_scenario"),
         "simulator.match_setup": ("referee_config",),
         "simulator.traffic": ("read_stats",),
     })

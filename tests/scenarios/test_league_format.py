@@ -1,0 +1,125 @@
+"""``hlvs referee test`` on scenario files of ours written in the league's format
+(``tests/scenarios/league_format/<case>/``: test_scenario.json, game.json and two team files, as
+hlvs_webots lays out ``controllers/referee/tests``): real runs in the MuJoCo world with our
+referee, a deliberately failing expectation, and malformed input."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from hlvs.cli import main
+
+ROOT = Path(__file__).parent / "league_format"
+
+
+def run(capsys: pytest.CaptureFixture[str], *args: object) -> tuple[int, str, str]:
+    code = main(["referee", "test", *(str(a) for a in args)])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_every_action_and_test_kind_passes(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run(capsys, ROOT / "throw_in", ROOT / "goal", "--json")
+    report = json.loads(out)
+    assert code == 0 and report["ok"] is True, out
+    assert (report["files"], report["files_passed"]) == (2, 2)
+    by_name = {Path(s["path"]).parent.name: s for s in report["scenarios"]}
+    throw_in, goal = by_name["throw_in"], by_name["goal"]
+    # every step ran to its end, every test passed (none skipped)
+    assert (throw_in["tests"], throw_in["passed"], throw_in["ending"]) == (12, 12, "finished")
+    assert (goal["tests"], goal["passed"], goal["ending"]) == (5, 5, "finished")
+    assert all(r["status"] == "pass" for s in (throw_in, goal) for r in s["results"])
+    # keys the league's runner does not check are listed, not checked
+    ignored = {r["name"]: r["ignored_keys"] for r in throw_in["results"] if r["ignored_keys"]}
+    assert ignored == {"Red 1 where it was put": ["rotation"], "Still PLAYING": ["comment"]}
+    # the goal scenario ends once its last step (2 s into the second PLAYING) is over
+    assert 20.0 < goal["sim_time_s"] < 40.0
+
+
+def test_a_failed_expectation_names_file_step_and_expectation(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    code, out, _ = run(capsys, ROOT / "failing")
+    assert code == 1
+    path = ROOT / "failing" / "test_scenario.json"
+    assert f"FAIL 1/2 {path}" in out
+    failure = [line.strip() for line in out.splitlines() if "never scored" in line]
+    assert failure == [
+        f"{path}: step 0 (/0/tests/1) 'A goal that was never scored': score of red: expected 1, "
+        "received 0 (sim 16.000 s, 1 s after PLAYING#1 (Simulated))"
+    ]
+    assert out.splitlines()[-1].startswith("0/1 files passed, 1/2 tests")
+
+
+def test_the_failure_in_json(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run(capsys, ROOT / "failing", "--json")
+    report = json.loads(out)
+    assert code == 1 and report["ok"] is False
+    results = report["scenarios"][0]["results"]
+    assert [(r["pointer"], r["status"]) for r in results] == [
+        ("/0/tests/0", "pass"), ("/0/tests/1", "fail"),
+    ]  # fmt: skip
+    assert "score of red: expected 1, received 0" in results[1]["failures"][0]
+
+
+def _copy(tmp_path: Path, case: str = "failing") -> Path:
+    target = tmp_path / case
+    shutil.copytree(ROOT / case, target)
+    return target
+
+
+BAD_SCENARIOS = [
+    ("[{\"timing\": {\"time\": 1}", "", "not JSON"),
+    ("{\"timing\": {\"time\": 1}}", "", "expected a list of steps"),
+    ("[{\"tests\": []}]", "/0", "a step needs a 'timing'"),
+    ("[{\"timing\": {\"time\": 1, \"state\": \"PLAY\"}}]", "/0/timing/state",
+     "expected one of INITIAL, READY, SET, PLAYING, FINISHED, got 'PLAY'"),
+    ("[{\"timing\": {\"time\": [1, 2, 3]}}]", "/0/timing/time", "an interval is [start, end]"),
+    ("[{\"timing\": {\"time\": 1, \"secondary_state\": \"THROWIN\"}}]", "/0/timing/phase",
+     "a secondary_state timing needs its phase"),
+    ("[{\"timing\": {\"time\": 1}, \"tests\": [{\"name\": \"x\", \"penalty\": 0}]}]",
+     "/0/tests/0", "a test of 'penalty' needs a 'target'"),
+    ("[{\"timing\": {\"time\": 1}, \"actions\": [{\"target\": \"GREEN_PLAYER_1\"}]}]",
+     "/0/actions/0/target", "expected BALL, RED, BLUE or RED_PLAYER_<n>"),
+    ("[{\"timing\": {\"time\": 1}, \"actions\": [{\"target\": \"BALL\", \"force\": [1, 2]}]}]",
+     "/0/actions/0/force", "expected a list of 3 numbers"),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(("text", "pointer", "reason"), BAD_SCENARIOS)
+def test_a_malformed_scenario_is_invalid_input(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], text: str, pointer: str, reason: str
+) -> None:
+    case = _copy(tmp_path)
+    (case / "test_scenario.json").write_text(text)
+    code, out, err = run(capsys, case)
+    assert code == 2 and out == ""  # nothing played
+    assert f"hlvs referee test: {case / 'test_scenario.json'}: {pointer or '/'}: {reason}" in err
+    assert "Traceback" not in err
+
+
+def test_a_missing_game_or_team_file_is_invalid_input(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    case = _copy(tmp_path)
+    (case / "team_2.json").unlink()
+    code, out, err = run(capsys, case / "test_scenario.json", "--json")
+    assert code == 2
+    assert json.loads(out)["ok"] is False
+    assert f"{case / 'game.json'}: /blue/config: file not found" in err
+    (case / "game.json").unlink()
+    code, _, err = run(capsys, case)
+    assert code == 2 and f"no game.json beside it ({case / 'game.json'})" in err
+
+
+def test_a_folder_without_scenarios_is_invalid_input(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, out, err = run(capsys, tmp_path, tmp_path / "absent.json")
+    assert code == 2 and out == ""
+    assert f"{tmp_path}: no test_scenario.json in this folder" in err
+    assert f"{tmp_path / 'absent.json'}: no such file or folder" in err
