@@ -5,7 +5,10 @@ Builds three worlds on the kid field: no robots (the field and the ball), ``--ro
 ``kid-default`` robots, and ``--robots`` robots of the team model (default: the Wolfgang example
 package), every robot standing in its pose under position control, and times ``--steps`` world
 steps of each, ``--repeats`` times, interleaved. The cost per robot is the world's step time
-minus the empty world's, divided by the number of robots (medians). Prints one JSON line.
+minus the empty world's, divided by the number of robots (medians). Also times what a match
+start pays for the model before the first step: loading the package (``load_s``, once per
+process) and the model check of the team file (``check_s``: the rule book's measurements and
+physics checks, run on every match start). Prints one JSON line.
 """
 
 from __future__ import annotations
@@ -44,6 +47,17 @@ def _world(model: str | None, robots: int) -> Any:
     return World.create(field_class="kid", robots=placements, seed=1)
 
 
+def _check_cost(folder: Path) -> tuple[float, float]:
+    """Seconds to load the model package (first time in this process) and to check it."""
+    from simulator.world.robots.team import check, load_team_model
+
+    start = time.perf_counter()
+    robot = load_team_model(folder)
+    loaded = time.perf_counter()
+    check(robot, official=True)
+    return loaded - start, time.perf_counter() - loaded
+
+
 def _time_steps(world: Any, steps: int) -> float:
     start = time.perf_counter()
     for _ in range(steps):
@@ -72,6 +86,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeats", type=int, default=5, help="timed repeats (default 5)")
     parser.add_argument("--json", action="store_true", help="accepted: the output is JSON")
     args = parser.parse_args(argv)
+    load_s, check_s = _check_cost(args.model.resolve())
     worlds = {
         "empty": _world(None, 0),
         "built_in": _world("kid-default", args.robots),
@@ -105,6 +120,8 @@ def main(argv: list[str] | None = None) -> int:
             )
         ),
         "team_robots_fallen_at_end": fallen,
+        "load_s": round(load_s, 3),
+        "check_s": round(check_s, 3),
     }
     print(json.dumps(result))
     return 0

@@ -120,3 +120,28 @@ def test_what_the_world_replaces_is_a_note_naming_the_element(tmp_path: Path) ->
     problems, _ = check_model(package("menagerie_op3", tmp_path), official=True)
     notes = {p.pointer: p.message for p in problems if p.severity == "note"}
     assert "self-collision follows the league's rule" in notes["<contact>"]
+
+
+def test_robots_of_several_published_models_share_one_world(tmp_path: Path) -> None:
+    """Two OP3 (whose file names a site ``torso`` and a camera) and a K1 and a T1 (both with a
+    ``matplane`` material and ``texplane`` texture): names that are the file's, not the robot's,
+    would repeat in the world."""
+    op3, k1, t1 = (package(n, tmp_path) for n in ("menagerie_op3", "booster_k1", "booster_t1"))
+    models = [op3, op3, k1, t1]
+    world = World.create(
+        field_class="kid",
+        robots=[
+            RobotPlacement(
+                id=RobotId(TeamColor.RED if i % 2 == 0 else TeamColor.BLUE, i // 2 + 1),
+                model=str(folder),
+                x_m=-2.0 + 1.2 * i,
+                y_m=0.0,
+                yaw_rad=0.0,
+            )
+            for i, folder in enumerate(models)
+        ],
+        seed=1,
+    )
+    for _ in range(125):
+        world.step()
+    assert [r.fallen for r in world.snapshot().robots] == [False] * 4

@@ -388,6 +388,14 @@ def build_template(spec: mujoco.MjSpec, manifest: Manifest, *, key: str) -> Temp
     p = PREFIX
     for mesh in spec.meshes:
         mesh.name = f"{key}:{mesh.name}"
+    # materials and textures are shared by the model's robots like its meshes: named by the key,
+    # so that two models that both have a "black" material can play each other
+    for texture in spec.textures:
+        if texture.name:
+            texture.name = f"{key}:{texture.name}"
+    for material in spec.materials:
+        material.name = f"{key}:{material.name}"
+        material.textures = [f"{key}:{t}" if t else t for t in material.textures]
     for body in [root, *_bodies(spec)[1:]]:
         b = original.body(body.name).id
         link = body.name
@@ -412,6 +420,12 @@ def build_template(spec: mujoco.MjSpec, manifest: Manifest, *, key: str) -> Temp
             geom.density = 0
             if geom.type == mujoco.mjtGeom.mjGEOM_MESH:
                 geom.meshname = f"{key}:{geom.meshname}"
+            if geom.material:
+                geom.material = f"{key}:{geom.material}"
+        # the file's own sites and cameras: the world's are the manifest's (/imu, /cameras), and
+        # their names, not the robot's, would repeat in a world of several robots
+        for own in [*body.sites, *body.cameras]:
+            spec.delete(own)
         if manifest.collision == "link-boxes" and b in owner_boxes:
             lo, hi = owner_boxes[b]
             box = body.add_geom()
