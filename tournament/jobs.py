@@ -275,7 +275,8 @@ def deliver_job(state_path: str, match_id: str) -> None:
     except OrchestratorError as exc:  # the store itself failed: nothing was delivered
         found = [TeamLogs(team=name, state="failed", cause=f"store: {exc}")
                  for name in (ctx.red.name, ctx.blue.name)]
-    logs = _merge(previous, found, retry=retry)
+    logs = _merge(previous, found, retry=retry,
+                  by_hand=_receipts(t.schedule.log_store, match_id) if retry else {})
     attempts = max((e.attempts for e in logs if e.state == "failed"), default=0)
     if all_done(logs):
         t.ledger.set_logs(match_id, logs)
@@ -293,8 +294,10 @@ def deliver_job(state_path: str, match_id: str) -> None:
     log.warning("match %s: %s", match_id, summary(logs))
 
 
-def _merge(previous: dict[str, TeamLogs], found: list[TeamLogs], *, retry: bool) -> list[TeamLogs]:
-    """This attempt's states over the earlier ones; a retried set that left the store is gone."""
+def _merge(previous: dict[str, TeamLogs], found: list[TeamLogs], *, retry: bool,
+           by_hand: dict[str, str] | None = None) -> list[TeamLogs]:
+    """This attempt's states over the earlier ones; a retried set that left the store was
+    delivered (``by_hand``: team -> target of its receipt) or else is gone (pruned)."""
     merged = dict(previous) if retry else {}
     tried = {entry.team for entry in found}
     for entry in found:
@@ -306,8 +309,47 @@ def _merge(previous: dict[str, TeamLogs], found: list[TeamLogs], *, retry: bool)
     if retry:
         for team, entry in previous.items():
             if team not in tried and entry.state not in (*DONE, "gone"):
-                merged[team] = replace(
-                    entry, state="gone",
-                    cause="no longer in the log store (delivered by 'hlvs logs deliver' or "
-                    "pruned)")
+                merged[team] = _left_the_store(entry, (by_hand or {}).get(team))
     return list(merged.values())
+
+
+def _left_the_store(entry: TeamLogs, receipt_target: str | None) -> TeamLogs:
+    if receipt_target is not None:
+        return replace(entry, state="delivered", target=receipt_target,
+                       cause="delivered by 'hlvs logs deliver'")
+    return replace(entry, state="gone",
+                   cause="no longer in the log store and never delivered (pruned)")
+
+
+def _receipts(store: Path, match_id: str | None = None) -> dict[str, str]:
+    """team -> target of the delivered sets of ``match_id`` (their receipts in the store)."""
+    from orchestrator.delivery import delivered_receipts
+
+    return {r.team: r.target for r in delivered_receipts(store, match_id)}
+
+
+def settle_hand_deliveries(ledger: Ledger, store: Path) -> list[str]:
+    """LOGS_FAILED matches whose failed sets were delivered since (``hlvs logs deliver`` after
+    a fix): their sets become delivered, and the match DELIVERED once every set is; a set that
+    left the store without a receipt is gone (pruned). Returns the matches now DELIVERED."""
+    from orchestrator.delivery import pending_status
+
+    rows = [r for r in ledger.rows() if r.state is S.LOGS_FAILED]
+    if not rows:
+        return []
+    waiting = {(s.match_id, s.team) for s in pending_status(store)}
+    settled = []
+    for row in rows:
+        by_hand = _receipts(store, row.id)
+        logs = [e if e.state in (*DONE, "gone") or (row.id, e.team) in waiting
+                else _left_the_store(e, by_hand.get(e.team)) for e in row.logs]
+        if logs == list(row.logs):
+            continue
+        ledger.set_logs(row.id, logs)
+        if all_done(logs):
+            if ledger.transition(row.id, (S.LOGS_FAILED,), S.DELIVERED, note=summary(logs)):
+                log.info("match %s: %s", row.id, summary(logs))
+                settled.append(row.id)
+        else:  # the note says what the logs say
+            ledger.transition(row.id, (S.LOGS_FAILED,), S.LOGS_FAILED, note=summary(logs))
+    return settled

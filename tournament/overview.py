@@ -52,8 +52,9 @@ def score_text(row: MatchRow) -> str:
 
 
 def with_store(row: MatchRow, waiting: set[tuple[str, str]]) -> MatchRow:
-    """The row with each failed set that is no longer in the log store marked ``gone`` (it was
-    delivered by ``hlvs logs deliver`` since, or pruned): the ledger cannot know which."""
+    """The row with each failed set that is no longer in the log store marked ``gone`` (a
+    retry not yet made will tell whether it was delivered by hand or pruned; a LOGS_FAILED
+    match is settled first, :func:`tournament.jobs.settle_hand_deliveries`)."""
     if not any(e.state in ("failed", "retrying") for e in row.logs):
         return row
     logs = tuple(
@@ -62,6 +63,12 @@ def with_store(row: MatchRow, waiting: set[tuple[str, str]]) -> MatchRow:
         if e.state in ("failed", "retrying") and (row.id, e.team) not in waiting else e
         for e in row.logs)
     return replace(row, logs=logs)
+
+
+def settle(ledger: Ledger, schedule: Schedule) -> None:
+    from tournament.jobs import settle_hand_deliveries
+
+    settle_hand_deliveries(ledger, schedule.log_store)
 
 
 def waiting_sets(schedule: Schedule) -> set[tuple[str, str]]:
@@ -116,7 +123,9 @@ def status_lines(ledger: Ledger, *, snapshot: Snapshot | None = None) -> list[st
     :func:`viewer.snapshot.game_snapshot`) can read its telemetry."""
     from tournament.controls import recorded_schedule
 
-    waiting = waiting_sets(recorded_schedule(ledger))
+    schedule = recorded_schedule(ledger)
+    settle(ledger, schedule)
+    waiting = waiting_sets(schedule)
     lines = []
     for row in ledger.rows():
         row = with_store(row, waiting)
@@ -180,6 +189,7 @@ def tournament_overview(ledger: Ledger, *, snapshot: Snapshot | None = None,
 
     schedule = recorded_schedule(ledger)
     alive = scheduler_state(ledger)
+    settle(ledger, schedule)
     rows = ledger.rows()
     waiting = waiting_sets(schedule)
     matches = []

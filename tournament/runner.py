@@ -258,7 +258,7 @@ def run_schedule(
     ``notify``: the operators' notification settings
     (:meth:`tournament.notify.NotifySettings.recorded`), kept in the state file; the scheduler
     writes its heartbeat there and sends the notices (:mod:`tournament.notify`)."""
-    from tournament.jobs import DEFAULT_STOP_GRACE_S, STOPPING
+    from tournament.jobs import DEFAULT_STOP_GRACE_S, STOPPING, settle_hand_deliveries
     from tournament.notify import HEARTBEAT_S, beat, stopped
 
     STOPPING.clear()
@@ -313,6 +313,7 @@ def run_schedule(
         while not stop.is_set():
             if time.monotonic() - beaten >= HEARTBEAT_S:
                 beat(ledger)
+                settle_hand_deliveries(ledger, schedule.log_store)  # hlvs logs deliver
                 beaten = time.monotonic()
             reconcile(scheduler, ledger, state, running.ids())
             rows = ledger.rows()

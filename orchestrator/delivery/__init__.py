@@ -41,12 +41,13 @@ from orchestrator.delivery.uploader import (
 )
 
 if TYPE_CHECKING:
-    from orchestrator.delivery.store import list_sets
+    from orchestrator.delivery.store import DeliveryReceipt, delivered_receipts, list_sets
 
 __all__ = [
     "AddressRefused",
     "DeliveryFailure",
     "DeliveryOutcome",
+    "DeliveryReceipt",
     "ERROR_KINDS",
     "FakeUploader",
     "FileEntry",
@@ -63,6 +64,7 @@ __all__ = [
     "address_allowed",
     "deliver_pending",
     "deliver_set",
+    "delivered_receipts",
     "enqueue_match_logs",
     "is_transient",
     "list_sets",
@@ -76,5 +78,5 @@ __all__ = [
 
 if not TYPE_CHECKING:
     __getattr__, __dir__ = lazy_exports(__name__, {
-        "orchestrator.delivery.store": ("list_sets",),
+        "orchestrator.delivery.store": ("DeliveryReceipt", "delivered_receipts", "list_sets"),
     })

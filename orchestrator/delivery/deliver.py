@@ -183,6 +183,7 @@ def deliver_set(
             session.close()
     task.finish()
     st.remove_set(pending)
+    st.record_delivered(pending, target)
     seconds = time.monotonic() - started
     log.info(
         "match %s: delivered the logs of %s to %s (%d files uploaded, %d already there, "

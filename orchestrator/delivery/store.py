@@ -7,6 +7,8 @@ Layout::
     <store>/sets/<set_id>/set.json  the set's state (team, target file, files with SHA-256,
                                     attempts, last error); rewritten atomically
     <store>/sets/<set_id>/files/    the files, as they will appear under <match_id>/<team>/
+    <store>/delivered/<set_id>.json a receipt of each delivered set (match, team, target, time):
+                                    a set that left the store was delivered, or else pruned
 
 A set appears atomically (built under ``sets/.incoming-*`` and renamed), so a crash while
 enqueueing never leaves a half-filled set behind that would be delivered.
@@ -216,6 +218,44 @@ def save_set(
 
 def remove_set(pending: PendingSet) -> None:
     shutil.rmtree(pending.root, ignore_errors=True)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class DeliveryReceipt:
+    """A set that was delivered (and left the store): by whom is not known, only where."""
+
+    set_id: str
+    match_id: str
+    team: str
+    target: str
+    at: float  # Unix time
+
+
+def record_delivered(pending: PendingSet, target: str) -> None:
+    """Leave a receipt of a delivered set (``<store>/delivered/<set_id>.json``)."""
+    folder = pending.root.parent.parent / "delivered"
+    folder.mkdir(exist_ok=True)
+    receipt = DeliveryReceipt(set_id=pending.set_id, match_id=pending.match_id,
+                              team=pending.team, target=target, at=time.time())
+    tmp = folder / f".{pending.root.name}.json.tmp"
+    tmp.write_text(json.dumps(asdict(receipt)) + "\n", encoding="utf-8")
+    os.replace(tmp, folder / f"{pending.root.name}.json")
+
+
+def delivered_receipts(store: Path, match_id: str | None = None) -> list[DeliveryReceipt]:
+    """The receipts of the sets delivered from ``store`` (of one match)."""
+    folder = store / "delivered"
+    if not folder.is_dir():
+        return []
+    found = []
+    for path in sorted(folder.glob("*.json")):
+        try:
+            receipt = DeliveryReceipt(**json.loads(path.read_text(encoding="utf-8")))
+        except (OSError, ValueError, TypeError):
+            continue  # a receipt half written by a crash: the set counts as gone
+        if match_id is None or receipt.match_id == match_id:
+            found.append(receipt)
+    return found
 
 
 def _write_state(folder: Path, pending: PendingSet) -> None:

@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 
 from orchestrator.delivery.store import PendingSet, create_set, remove_set
+from orchestrator.delivery.store import list_sets as pending_sets
 from tests.unit.schedule import fake_services
 from tests.unit.schedule.test_schedule import COMPRESSED, FAKE, services_log, write_schedule
 from tournament import Ledger, ScheduledMatchState, run_schedule, standings
@@ -293,3 +294,48 @@ def test_a_match_waiting_for_the_simulator_slot_does_not_flood_the_log(
     flood = [str(r.args[0]).split(" (")[0] for r in caplog.records  # type: ignore[index]
              if "maximum number of running instances" in r.msg]
     assert len(flood) == len(set(flood)), flood  # a job is queued, never added again and again
+
+
+def test_logs_delivered_by_hand_after_a_fix_clear_logs_failed(tmp_path: Path, fake: None) -> None:
+    """A team's target was down for every attempt (LOGS_FAILED); the operator fixes it and
+    runs 'hlvs logs deliver': the set is delivered, its receipt stays in the store, and the
+    match becomes DELIVERED, its note and its logs saying the same."""
+    from orchestrator.delivery import FakeUploader, RetryPolicy, deliver_pending
+    from tests.unit.schedule.test_schedule import write_credentials
+
+    fake_services.DEAD_TEAMS.add("bravo")
+    path = write_schedule(
+        tmp_path,
+        COMPRESSED.replace("retry_s: 0.2", "retry_s: 0.2, delivery_attempts: 1")
+        + "matches:\n  - {id: m1, red: alpha, blue: bravo, stream_start: '+3.5s',"
+        " stream_length_s: 0.2}\n  - {id: m2, red: charlie, blue: bravo,"
+        " stream_start: '+3.9s', stream_length_s: 0.2}\n",
+    )
+    state = tmp_path / "state.sqlite"
+    assert run_schedule(path, state, services=FAKE, exit_when_done=True, poll_s=0.1) == 0
+    ledger = Ledger(state)
+    assert ledger.row("m1").state is S.LOGS_FAILED and ledger.row("m2").state is S.LOGS_FAILED
+    store = tmp_path / "out" / "log-store"
+    credentials = write_credentials(tmp_path / "bravo-logs.json")
+    source = tmp_path / "robot.log"
+    source.write_text("log\n")
+    for match_id in ("m1", "m2"):  # as the real services leave a failed set in the store
+        create_set(store, match_id=match_id, team="bravo", kind="team", credentials=credentials,
+                   sources=[(source, "robot.log")], move=False)
+    assert "m1" in "\n".join(status_lines(ledger))
+    assert ledger.row("m1").state is S.LOGS_FAILED  # still waiting in the store
+    uploader = FakeUploader()
+    [outcome] = deliver_pending(store, match_id="m1", opener=lambda creds, team: uploader,
+                                retry=RetryPolicy(attempts=1, initial_delay_s=0.0, factor=1.0,
+                                                  max_delay_s=0.0))
+    assert outcome.delivered
+    for pending in [s for s in pending_sets(store) if s.match_id == "m2"]:
+        remove_set(pending)  # m2's set was pruned, never delivered
+    lines = "\n".join(status_lines(ledger))
+    m1, m2 = ledger.row("m1"), ledger.row("m2")
+    assert m1.state is S.DELIVERED, m1
+    assert {e.team: e.state for e in m1.logs} == {"alpha": "delivered", "bravo": "delivered"}
+    assert m1.note == "logs: alpha delivered; bravo delivered" and "m1" in lines
+    assert m2.state is S.LOGS_FAILED and {e.team: e.state for e in m2.logs}["bravo"] == "gone"
+    assert "never delivered (pruned)" in m2.note
+    assert [to for _, _, _, to, _ in ledger.history("m1")][-1] == "DELIVERED"
