@@ -74,8 +74,7 @@ def enqueue_match_logs(
                 shutil.rmtree(folder)  # only empty folders are left
             log.info("match %s: queued %d log files of team %s", match_id, len(sources), team)
             _prune(store, team)
-        public = ([f for f in _files_under(match_dir, exclude=match_dir / TEAMS_FOLDER)
-                   if not _earlier_team_file(f[1])] if public_target is not None else [])
+        public = (_public_files(match_dir) if public_target is not None else [])
         if public_target is not None and not public:
             log.warning("match %s: no public log files: no set made", match_id)
         elif public_target is not None:
@@ -92,6 +91,19 @@ def enqueue_match_logs(
             )
             log.info("match %s: queued %d public log files", match_id, len(public))
     return created
+
+
+def _public_files(match_dir: Path) -> list[tuple[Path, str]]:
+    """The public set's files: the match's ``public/`` folder at the set's top (delivered to
+    ``<match>/public/...``, not ``<match>/public/public/...``), the rest beside it."""
+    found = [f for f in _files_under(match_dir, exclude=match_dir / TEAMS_FOLDER)
+             if not _earlier_team_file(f[1])]
+    names = {rel for _, rel in found}
+    out = []
+    for path, rel in found:
+        inner = rel.removeprefix(f"{PUBLIC_TEAM}/")
+        out.append((path, inner if inner != rel and inner not in names else rel))
+    return out
 
 
 def _earlier_team_file(rel: str) -> bool:

@@ -271,3 +271,20 @@ def test_reenqueueing_a_match_makes_no_empty_set_and_keeps_the_real_ones(
     empty.mkdir()
     assert enqueue_match_logs(empty, match_id="e", teams={"red": ("Alpha", creds)},
                               public_target=creds, store=store) == []
+
+
+def test_the_matchs_public_folder_is_the_public_sets_top(tmp_path: Path, creds: Path) -> None:
+    """``hlvs match`` leaves the public files in ``<match>/public/``: they are delivered to
+    ``<match id>/public/<file>``, not ``<match id>/public/public/<file>``."""
+    match = make_match(tmp_path, "m1")
+    (match / "public").mkdir()
+    (match / "public" / "replay.jsonl").write_text("{}\n")
+    (match / "public" / "referee.log").write_text("the same name as one beside it\n")
+    enqueue_match_logs(match, match_id="m1", teams={}, public_target=creds,
+                       store=tmp_path / "store")
+    fake = FakeUploader()
+    assert all(o.delivered for o in deliver_pending(tmp_path / "store", opener=Opener(fake),
+                                                    retry=FAST, sleep=lambda s: None))
+    assert "m1/public/replay.jsonl" in fake.files
+    assert "m1/public/referee.log" in fake.files and "m1/public/public/referee.log" in fake.files
+    assert not any(c.startswith("m1/public/public/replay") for c in fake.calls)
