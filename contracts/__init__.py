@@ -47,6 +47,7 @@ if TYPE_CHECKING:
         decode_return,
         encode_game_state,
         encode_return,
+        send_period_s,
         with_packet_number,
     )
     from contracts.geometry import StartingPose
@@ -100,6 +101,7 @@ if TYPE_CHECKING:
         MIN_PLAYING_S,
         MIN_READY_S,
         OFFICIAL,
+        REMOVAL_PENALTY_S,
         SCRIMMAGE,
         SET_TO_PLAY_S,
         TEST_MATCH,
@@ -139,6 +141,7 @@ __all__ = [
     "MAX_RENDER_PROCESSES",
     "MIN_PLAYING_S",
     "MIN_READY_S",
+    "REMOVAL_PENALTY_S",
     "MatchLimits",
     "MatchReport",
     "MatchResults",
@@ -192,6 +195,7 @@ __all__ = [
     "telemetry",
     "timing_problem",
     "to_data",
+    "send_period_s",
     "webhooks",
     "with_packet_number",
 ]
@@ -208,7 +212,7 @@ if not TYPE_CHECKING:
             "DROPBALL_TEAM", "GC_DATA_PORT", "GC_RETURN_PORT", "MAX_PLAYERS", "GameControlData",
             "GameState", "GameTypeCode", "Penalty", "ReturnData", "ReturnMessage", "RobotInfo",
             "SecondaryState", "TeamColourCode", "TeamInfo", "decode_game_state", "decode_return",
-            "encode_game_state", "encode_return", "with_packet_number",
+            "encode_game_state", "encode_return", "send_period_s", "with_packet_number",
         ),
         "contracts.geometry": ("StartingPose",),
         "contracts.ids": ("RobotId", "TeamColor"),
@@ -230,7 +234,7 @@ if not TYPE_CHECKING:
         ),
         "contracts.timing": (
             "ADULT_SCRIMMAGE", "ENVIRONMENT", "MIN_PLAYING_S", "MIN_READY_S", "OFFICIAL",
-            "SCRIMMAGE", "SET_TO_PLAY_S", "TEST_MATCH", "TimingError", "fit_ready", "played_enough",
-            "timing_problem",
+            "REMOVAL_PENALTY_S", "SCRIMMAGE", "SET_TO_PLAY_S", "TEST_MATCH", "TimingError",
+            "fit_ready", "played_enough", "timing_problem",
         ),
     })

@@ -8,8 +8,9 @@ Little-endian, packed, layout of ``RoboCupGameControlData.h``: a 24-byte header,
 a coach and 11 players of 6-byte RobotInfo.
 
 As the league's GameController (``controller/net/Sender.java``) sends it: one ``RGme`` at a
-fixed rate (every 500 ms), never an extra one on a state change, ``packetNumber`` + 1 per packet
-sent (mod 256, :func:`with_packet_number` stamps it at sending).
+fixed rate (every 500 ms, every 50 ms in a game not paced to real time: :func:`send_period_s`),
+never an extra one on a state change, ``packetNumber`` + 1 per packet sent (mod 256,
+:func:`with_packet_number` stamps it at sending).
 """
 
 from __future__ import annotations
@@ -28,6 +29,17 @@ RETURN_HEADER = b"RGrt"
 RETURN_VERSION = 2
 MAX_PLAYERS = 11
 DROP_IN_TIME_NONE = 0xFFFF
+SEND_PERIOD_S = 0.5  # Sender.java:63, UPDATEFREQUENCY 500 ms
+FAST_SEND_PERIOD_S = 0.05  # GameControllerSimulator.java:386-387, --fast: 50 ms
+
+
+def send_period_s(maximum_real_time_factor: float) -> float:
+    """Wall seconds between two ``RGme`` packets in a game with this real-time factor limit:
+    the league's referee starts its GameController with ``--fast`` when the game is not paced
+    to real time (``maximum_real_time_factor`` <= 0, as fast as possible, or above 1;
+    hlvs_webots ``referee.py:1949-1950``), which then sends every 50 ms."""
+    fast = maximum_real_time_factor <= 0.0 or maximum_real_time_factor > 1.0
+    return FAST_SEND_PERIOD_S if fast else SEND_PERIOD_S
 
 _HEADER = struct.Struct("<4sH7B4sBHhh")  # 24 bytes
 _TEAM = struct.Struct("<BBBBHB253s")  # 260 bytes, then coach + 11 players

@@ -18,7 +18,7 @@ from contracts.codec import Versioned
 from contracts.field import FieldClass
 from contracts.geometry import Pose
 from contracts.ids import TeamColor
-from contracts.timing import MIN_PLAYING_S, SET_TO_PLAY_S
+from contracts.timing import MIN_PLAYING_S, REMOVAL_PENALTY_S, SET_TO_PLAY_S
 
 SPEC_VERSION = 1
 
@@ -79,7 +79,7 @@ class TimingSpec:
     set_to_play_s: float = SET_TO_PLAY_S
     wait_before_first_ready_real_s: float = 120.0
     half_time_break_real_s: float = 15.0
-    removal_penalty_s: float = 10.0
+    removal_penalty_s: float = REMOVAL_PENALTY_S
     end_of_game_real_s: float = 5.0
     max_duration_real_s: float | None = None  # stop the game after this wall time
     minimum_play_s: float = MIN_PLAYING_S  # less PLAYING: not played (0: not meant to play)

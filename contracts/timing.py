@@ -25,6 +25,10 @@ MIN_PLAYING_S = 10.0
 and SET, and that a match must have played in all to count as played. A game sets its own with
 ``timing.minimum_play_s``; 0 marks a match not meant to play football (a test of the match's
 lifecycle: containers, logs, signals), which is neither refused nor failed for want of play."""
+REMOVAL_PENALTY_S = 30.0
+"""A removal penalty's simulated seconds: the league GameController's for every penalty its
+referee gives (``Penalties.java:15-17``, ``HL_BALL_MANIPULATION``, ``HL_PHYSICAL_CONTACT``,
+``HL_PICKUP_OR_INCAPABLE``: 30), and the league referee's ``REMOVAL_PENALTY_TIMEOUT``."""
 MIN_READY_S = 5.0
 """The shortest READY a quick test is shortened to (robots need a moment to stand up)."""
 
@@ -136,6 +140,7 @@ __all__ = [
     "MIN_PLAYING_S",
     "MIN_READY_S",
     "OFFICIAL",
+    "REMOVAL_PENALTY_S",
     "SCRIMMAGE",
     "SET_TO_PLAY_S",
     "TEST_MATCH",

@@ -18,6 +18,7 @@ from referee import reporting
 from referee.clock import Clock, SystemClock
 from referee.config import RefereeConfig
 from referee.gamecontroller import (
+    LEAGUE_PLAYERS_PER_TEAM,
     GameController,
     GameState,
     SecondaryState,
@@ -112,10 +113,9 @@ class Referee:
         self._publisher = Publisher(
             gc=self.gc,
             team_numbers={c: config.team(c).team_id for c in (TeamColor.RED, TeamColor.BLUE)},
-            players_per_team=self.field.players_per_team,
+            players_per_team=LEAGUE_PLAYERS_PER_TEAM[config.field_class],
             left_team=lambda: self.left_team,
             log=self.log,
-            clock=self._clock,
         )
         self._status = reporting.StatusReporter(
             clock=self._clock, period_s=config.timing.status_period_real_s
@@ -212,7 +212,7 @@ class Referee:
         now = snapshot.sim_time_ms
         if not self._started:
             commands += self._start(snapshot)
-        dt_s = 0.0 if self._last_ms is None else max(0, now - self._last_ms) / 1000.0
+        dt_ms = 0 if self._last_ms is None else max(0, now - self._last_ms)
         self._last_ms = now
         for line in self._status.lines(self.gc, snapshot.sim_time_ms):
             self.log.info(snapshot.sim_time_ms, line)
@@ -226,12 +226,13 @@ class Referee:
             return commands
         if self._wait_until_s is not None:
             if self._clock.monotonic() < self._wait_until_s:
+                self.gc.advance_ms(dt_ms)  # INITIAL: the GameController's time runs on
                 self._publish()
                 return commands
             action, self._after_wait, self._wait_until_s = self._after_wait, None, None
             if action is not None:
                 commands += action(snapshot)
-        tick = self.gc.advance(dt_s)
+        tick = self.gc.advance_ms(dt_ms)
         commands += self._on_tick(tick, snapshot)
         if not self._finished and self._wait_until_s is None:
             if self.gc.phase is SecondaryState.PENALTYSHOOT:

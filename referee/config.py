@@ -48,7 +48,7 @@ class NetworkConfig:
     gc_data_port: int = 3838
     gc_return_port: int = 3939
     mirror_port: int = 3737
-    send_rate_hz: float = 2.0
+    send_rate_hz: float = 2.0  # 20 when not paced to real time (contracts.send_period_s)
     mirror_max_bytes: int = 1024
 
 

@@ -1,8 +1,9 @@
 """GameController network: ``RGme`` to every robot on UDP 3838, ``RGrt`` from robots on 3939.
 
-One background thread sends one packet to every robot address at a fixed rate (2 Hz,
-configurable) and never between, as the league GameController's ``Sender`` does (a packet every
-500 ms, ``packetNumber`` + 1 per packet, mod 256, stamped as it is sent). Each packet is the
+One background thread sends one packet to every robot address at a fixed rate (2 Hz; 20 Hz in a
+game not paced to real time, :func:`contracts.send_period_s`) and never between, as the league
+GameController's ``Sender`` does (a packet every 500 ms, every 50 ms with ``--fast``,
+``packetNumber`` + 1 per packet, mod 256, stamped as it is sent). Each packet is the
 latest state, except that a game state the robots have not been sent yet goes out first, at its
 own tick: the league's referee waits until the GameController has broadcast a state (FINISHED
 at the end of a half) before it commands the next one, so robots always see it; here FINISHED

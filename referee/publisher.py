@@ -2,8 +2,11 @@
 
 Every change of state, secondary state, set play, half, kick-off team, score, penalties or
 sides is one line in ``gamecontroller.log`` and hands the packet to the sender thread at once;
-otherwise the packet is refreshed every 0.1 s of wall time. The thread sends at its fixed rate
-(2 Hz) and numbers the packets (:mod:`referee.net`); nothing is sent on a change by itself.
+so does every change of a time on the wire (``secsRemaining``, ``secondaryTime``, a penalty's
+seconds), which the GameController computes exactly from simulated time: the packet the thread
+sends is never more than one step old, as the league's ``Sender`` computes its times at each
+send (``Sender.java:164``, ``updateTimes``). The thread sends at its fixed rate and numbers the
+packets (:mod:`referee.net`); nothing is sent on a change by itself.
 """
 
 from __future__ import annotations
@@ -11,12 +14,9 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from contracts import TeamColor, encode_game_state
-from referee.clock import Clock
 from referee.gamecontroller import GameController, game_control_data
 from referee.logs import RefereeLog
 from referee.net import GameControllerNetwork
-
-REFRESH_PERIOD_REAL_S = 0.1
 
 
 class Publisher:
@@ -28,7 +28,6 @@ class Publisher:
         players_per_team: int,
         left_team: Callable[[], TeamColor],
         log: RefereeLog,
-        clock: Clock,
     ) -> None:
         """``left_team`` tells which team plays on the left now: its TeamInfo goes first."""
         self._gc = gc
@@ -36,9 +35,8 @@ class Publisher:
         self._team_numbers = dict(team_numbers)
         self._players_per_team = players_per_team
         self._log = log
-        self._clock = clock
         self._signature: tuple[object, ...] = ()
-        self._published_real_s = float("-inf")
+        self._times: tuple[int, ...] = ()
         self._state: tuple[object, ...] = ()  # game state and half last handed to the network
         self.network: GameControllerNetwork | None = None
 
@@ -73,9 +71,9 @@ class Publisher:
             )
         if self.network is None:
             return
-        real = self._clock.monotonic()
-        if changed or force or real - self._published_real_s >= REFRESH_PERIOD_REAL_S:
-            self._published_real_s = real
+        times = gc.wire_times()
+        if changed or force or times != self._times:
+            self._times = times
             state = (gc.state, gc.half, gc.phase)
             self.network.publish(self.packet(), state_changed=state != self._state)
             self._state = state

@@ -8,6 +8,7 @@ from collections.abc import Sequence
 from contracts import GameStateRecord, PenaltyRecord, PlayRecord, TeamColor, to_data
 from referee.clock import Clock
 from referee.gamecontroller import GameController
+from referee.gamecontroller.machine import wire_seconds
 from referee.snapshot import RefereeEvent
 
 COLORS = (TeamColor.RED, TeamColor.BLUE)
@@ -22,7 +23,7 @@ def game_state(gc: GameController, *, left_team: TeamColor, waiting: bool) -> Ga
     penalties: dict[str, PenaltyRecord] = {
         f"{robot.team.value}-{robot.number}": {
             "penalty": gc.robot(robot).penalty.name,
-            "secs_till_unpenalised": int(round(gc.robot(robot).secs_till_unpenalised)),
+            "secs_till_unpenalised": wire_seconds(gc.robot(robot).left_ms),
         }
         for robot in gc.penalised()
     }
@@ -35,7 +36,7 @@ def game_state(gc: GameController, *, left_team: TeamColor, waiting: bool) -> Ga
         else {"team": play.team.value, "sub_phase": play.sub_phase},
         "half": gc.half,
         "phase": gc.phase.name,
-        "secs_remaining": int(round(gc.secs_remaining)),
+        "secs_remaining": gc.wire_secs_remaining(),
         "kickoff": gc.kickoff_team.value if gc.kickoff_team is not None else "dropped_ball",
         "left_team": left_team.value,
         "score": score(gc),
@@ -94,5 +95,5 @@ class StatusReporter:
         return [
             f"STATUS: Avg speed factor: {factor:.3f} (over last {elapsed:.2f} seconds)",
             f"STATUS: state: STATE_{gc.state.name}, remaining time: "
-            f"{int(round(gc.secs_remaining))}",
+            f"{gc.wire_secs_remaining()}",
         ]

@@ -16,7 +16,15 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
 
-from contracts import MIN_PLAYING_S, OFFICIAL, Color, FieldClass, StartingPose, SteppingMode
+from contracts import (
+    MIN_PLAYING_S,
+    OFFICIAL,
+    REMOVAL_PENALTY_S,
+    Color,
+    FieldClass,
+    StartingPose,
+    SteppingMode,
+)
 from contracts import GameTypeName as GameType
 from orchestrator.errors import Problem
 
@@ -56,7 +64,7 @@ class Timing:
     wait_before_first_ready_s: float = OFFICIAL.wait_before_first_ready_s
     half_time_break_s: float = OFFICIAL.half_time_break_s  # wall time
     grace_period_s: float = OFFICIAL.grace_period_s  # wall time given to robots to stop
-    removal_penalty_s: float = 10.0
+    removal_penalty_s: float = REMOVAL_PENALTY_S
     max_duration_s: float | None = None  # HLVS max_duration: stop the game after this wall time
     minimum_play_s: float = MIN_PLAYING_S  # simulated s of PLAYING per half (0: not meant to play)
 

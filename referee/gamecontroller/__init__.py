@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from referee.gamecontroller.machine import GameController, RobotStatus, SetPlay, TeamStatus, Tick
-from referee.gamecontroller.packet import game_control_data
+from referee.gamecontroller.packet import LEAGUE_PLAYERS_PER_TEAM, game_control_data
 from referee.gamecontroller.states import (
     DROPBALL_TEAM,
     Card,
@@ -14,6 +14,7 @@ from referee.gamecontroller.states import (
 
 __all__ = [
     "DROPBALL_TEAM",
+    "LEAGUE_PLAYERS_PER_TEAM",
     "Card",
     "GameController",
     "GameState",

@@ -3,6 +3,19 @@
 It holds what the league GameController holds (state, periods, score, set plays, penalties,
 cards, shoot-out shots) and advances its timers when the referee feeds it the simulated time
 of each snapshot. It makes no judgement: the AutoRef decides, this machine records and times.
+
+Time is counted in whole milliseconds of simulated time (the league's GameController counts
+milliseconds of the time its referee sends, ``SystemClock.setTime``), so that the seconds on the
+wire are exact: a half of 600 s shows 600 until 1000 ms have been played, then 599
+(``AdvancedData.getSecondsSince``: ``(int) (getTime() - millis) / 1000``). Two clocks run:
+
+- the simulated time itself (the league's ``SystemClock``), which drives the set plays'
+  preparation clock (``ExtraClock``);
+- the GameController's own time (the league's ``AdvancedData.getTime()``), which stands still
+  while a set play is prepared: ``GameInterruption.java:60`` pauses it at the interruption
+  (``ClockPause``, ``AdvancedData.getTime`` returns the moment of the pause) and
+  ``GameInterruption.java:81`` runs it again at EXECUTE. The game clock, the penalties and the
+  times since a state began all read this time.
 """
 
 from __future__ import annotations
@@ -23,7 +36,21 @@ from referee.gamecontroller.states import (
 
 logger = logging.getLogger(__name__)
 
-EPSILON_S = 1e-6  # timers are sums of 8 ms steps in floating point
+PAUSE_S = 0
+"""The league's ``pauseTime`` and ``pauseOverTime`` in the simulation leagues (``HLSim.java:38``,
+``:40``): the secondary time of a half-time INITIAL counts down from 0 into negative values."""
+
+
+def to_ms(seconds: float) -> int:
+    """Seconds of a configured duration as whole milliseconds."""
+    return round(seconds * 1000.0)
+
+
+def wire_seconds(ms: int) -> int:
+    """Whole seconds left of ``ms`` milliseconds as the league's GameController shows them: a
+    duration of ``d`` s after ``e`` ms shows ``d - e // 1000`` (``getRemainingSeconds``), that
+    is ``ms / 1000`` rounded up, exactly, in integers."""
+    return -(-ms // 1000)
 
 
 @dataclass(slots=True)
@@ -32,11 +59,15 @@ class RobotStatus:
     ``contracts.gamecontroller.RobotInfo`` is built from it each packet)."""
 
     penalty: Penalty = Penalty.NONE
-    secs_till_unpenalised: float = 0.0
+    left_ms: int = 0  # of the penalty, on the GameController's time
     warnings: int = 0
     yellow_cards: int = 0
     red_cards: int = 0
     goalkeeper: bool = False
+
+    @property
+    def secs_till_unpenalised(self) -> float:
+        return self.left_ms / 1000.0
 
 
 @dataclass(slots=True)
@@ -85,10 +116,16 @@ class GameController:
         self.half = 1
         self.first_kickoff = kickoff
         self.kickoff_team: TeamColor | None = kickoff  # None: dropped ball
-        self.secs_remaining = timing.half_duration_s
-        self.secondary_time = 0.0
+        self._remaining_ms = to_ms(timing.half_duration_s)  # of the game clock
+        self._timer_ms = 0  # the referee's own countdown: READY, set-play sub-phases, blocked
         self.period_started = False  # a PLAYING of this period began: READY and SET run the clock
         self.set_play: SetPlay | None = None
+        self.clock_paused = False  # a set play is prepared: the GameController's time stands
+        self.sim_ms = 0  # simulated time fed so far (the league's SystemClock)
+        self.gc_ms = 0  # the GameController's own time (the league's AdvancedData.getTime)
+        self._state_began_gc_ms = 0  # whenCurrentGameStateBegan
+        self._set_play_ended_gc_ms: int | None = None  # whenCurrentSecondaryGameStateEnded
+        self._preparation_began_sim_ms: int | None = None  # the set play's secondary clock
         self.teams: dict[TeamColor, TeamStatus] = {
             color: TeamStatus(robots={n: RobotStatus() for n in numbers})
             for color, numbers in players.items()
@@ -100,9 +137,25 @@ class GameController:
                 team.robots[keeper].goalkeeper = True
         if game_type is GameType.PENALTY:
             self.phase = SecondaryState.PENALTYSHOOT
-            self.secs_remaining = timing.shootout_kick_s
+            self._remaining_ms = to_ms(timing.shootout_kick_s)
 
     # --- views ---------------------------------------------------------------------------
+
+    @property
+    def secs_remaining(self) -> float:
+        """Seconds left on the game clock (the wire shows :meth:`wire_secs_remaining`)."""
+        return self._remaining_ms / 1000.0
+
+    @secs_remaining.setter
+    def secs_remaining(self, seconds: float) -> None:
+        self._remaining_ms = to_ms(seconds)
+
+    @property
+    def secondary_time(self) -> float:
+        """Seconds left on the referee's own countdown: READY, the set play's sub-phase, the
+        ball blocked after a kick-off or a set play (the wire shows
+        :meth:`wire_secondary_time`, the league's)."""
+        return self._timer_ms / 1000.0
 
     @property
     def secondary_state(self) -> SecondaryState:
@@ -114,7 +167,10 @@ class GameController:
         ``AdvancedData.getRemainingGameTime``: it runs in PLAYING; in READY and SET only once a
         PLAYING of this period has begun (``timeBeforeCurrentGameState != 0``), so every period
         starts its first PLAYING with its full time and, after a goal or a dropped ball, READY
-        and SET count as played (no added time); in the penalty shoot-out only in PLAYING."""
+        and SET count as played (no added time); in the penalty shoot-out only in PLAYING.
+        It stands still while a set play is prepared (``GameInterruption.java:60``)."""
+        if self.clock_paused:
+            return False
         if self.state is GameState.PLAYING:
             return True
         if self.state not in (GameState.READY, GameState.SET):
@@ -141,6 +197,72 @@ class GameController:
                 return number
         return None
 
+    # --- the wire's times, as the league's GameController computes them ------------------
+
+    def wire_secs_remaining(self) -> int:
+        """``secsRemaining``: the half's seconds less the whole seconds played
+        (``AdvancedData.java:282`` ``getRemainingGameTime``), exact in integer milliseconds."""
+        return wire_seconds(self._remaining_ms)
+
+    def wire_secondary_time(self) -> int:
+        """``secondaryTime`` as ``AdvancedData.java:421`` ``getSecondaryTime(0)`` computes it
+        (``updateTimes``, ``AdvancedData.java:226-231``: no secondary time is 0):
+
+        - in a set play, the secondary clock: none in sub-phases 0 and 2
+          (``GameInterruption.java:57``, ``:72``), in sub-phase 1 the preparation time counting
+          down on simulated time, negative once over (``GameInterruption.java:68``,
+          ``ExtraClock.getRemainingSeconds``);
+        - in READY, the READY time left (``:444``);
+        - in PLAYING outside the shoot-out, the kick-off's blocked time while positive (none
+          after a dropped ball, ``:435``), then (``:453``) the ten seconds after a set play's
+          EXECUTE (``whenCurrentSecondaryGameStateEnded``);
+        - otherwise the pause (``getRemainingPauseTime``, ``:307``): in the INITIAL before a
+          second half and in a first half's FINISHED, ``pauseTime`` (0 s) less the seconds
+          since, so it counts 0, -1, -2...; else none."""
+        if self.set_play is not None:
+            began = self._preparation_began_sim_ms
+            if began is None:
+                return 0
+            return wire_seconds(to_ms(self.timing.set_play_ready_s) - (self.sim_ms - began))
+        since_state_ms = self.gc_ms - self._state_began_gc_ms
+        if self.state is GameState.READY:
+            return wire_seconds(to_ms(self.timing.ready_duration_s) - since_state_ms)
+        if self.state is GameState.PLAYING:
+            blocked_ms = to_ms(self.timing.kickoff_blocked_s)
+            if self.phase is not SecondaryState.PENALTYSHOOT:
+                kickoff = 0 if self.kickoff_team is None else wire_seconds(
+                    blocked_ms - since_state_ms)
+                if kickoff >= 0:
+                    return kickoff
+            ended = self._set_play_ended_gc_ms
+            if ended is not None:
+                free_kick = wire_seconds(blocked_ms - (self.gc_ms - ended))
+                if free_kick >= 0:
+                    return free_kick
+            return 0
+        pause = (
+            self.phase is not SecondaryState.PENALTYSHOOT
+            and (
+                (self.state is GameState.INITIAL and self.half == 2)
+                or (self.state is GameState.FINISHED and self.half == 1)
+            )
+        )
+        return wire_seconds(to_ms(PAUSE_S) - since_state_ms) if pause else 0
+
+    def wire_times(self) -> tuple[int, ...]:
+        """Every time on the wire (``secsRemaining``, ``secondaryTime``, each penalised robot's
+        seconds): the packet must be built again when it changes."""
+        return (
+            self.wire_secs_remaining(),
+            self.wire_secondary_time(),
+            *(
+                wire_seconds(info.left_ms)
+                for team in self.teams.values()
+                for info in team.robots.values()
+                if info.penalty is not Penalty.NONE
+            ),
+        )
+
     # --- state changes -------------------------------------------------------------------
 
     def transition(self, new_state: GameState) -> None:
@@ -148,27 +270,35 @@ class GameController:
             raise IllegalTransition(current=self.state.name, requested=new_state.name)
         logger.debug("game state %s -> %s", self.state.name, new_state.name)
         self.state = new_state
+        self._state_began_gc_ms = self.gc_ms
         if new_state is GameState.READY:
-            self.secondary_time = self.timing.ready_duration_s
-            self.set_play = None
+            self._timer_ms = to_ms(self.timing.ready_duration_s)
+            self._end_set_play()
         elif new_state is GameState.SET:
-            self.secondary_time = 0.0
+            self._timer_ms = 0
         elif new_state is GameState.PLAYING:
             self.period_started = True
-            self.secondary_time = (
+            self._timer_ms = to_ms(
                 self.timing.shootout_kick_s
                 if self.phase is SecondaryState.PENALTYSHOOT
                 else self.timing.kickoff_blocked_s
             )
         elif new_state is GameState.FINISHED:
-            self.set_play = None
-            self.secondary_time = 0.0
-            self.secs_remaining = 0.0  # as the league's GameController shows a finished period
+            self._end_set_play()
+            self._timer_ms = 0
+            self._remaining_ms = 0  # as the league's GameController shows a finished period
             for team in self.teams.values():
                 for info in team.robots.values():
                     if info.red_cards == 0:
                         info.penalty = Penalty.NONE
-                        info.secs_till_unpenalised = 0.0
+                        info.left_ms = 0
+
+    def _end_set_play(self) -> None:
+        """A set play in preparation ends without EXECUTE (a goal, a dropped ball, the end of
+        the period): the GameController's time runs again."""
+        self.set_play = None
+        self.clock_paused = False
+        self._preparation_began_sim_ms = None
 
     def goal(self, scoring: TeamColor) -> None:
         """A valid goal: score, kick-off for the conceding team, READY."""
@@ -181,26 +311,32 @@ class GameController:
         self.transition(GameState.READY)
 
     def begin_set_play(self, kind: SecondaryState, team: TeamColor) -> None:
+        """The interruption: sub-phase 0, no secondary clock, and the GameController's time
+        stops (``GameInterruption.java:55-60``, ``ClockPause``)."""
         if not kind.is_set_play:
             raise ValueError(f"{kind.name} is not a set play")
         if self.state is not GameState.PLAYING:
             raise IllegalTransition(current=self.state.name, requested=kind.name)
         self.set_play = SetPlay(kind, team, 0)
-        self.secondary_time = self.timing.set_play_phase0_s
+        self._timer_ms = to_ms(self.timing.set_play_phase0_s)
+        self._preparation_began_sim_ms = None
+        self.clock_paused = True
 
     def retake_set_play(self) -> None:
-        """RETAKE: the set play in preparation starts again from sub-phase 0."""
+        """RETAKE: the set play in preparation starts again from sub-phase 0, its secondary
+        clock cleared, the time still stopped (``RetakeGameInterruption.java``)."""
         play = self.set_play
         if play is None:
             raise IllegalTransition(current=self.state.name, requested="RETAKE")
         self.begin_set_play(play.kind, play.team)
 
     def abort_set_play(self) -> None:
-        """ABORT: the set play in preparation is cancelled; play goes on."""
+        """ABORT: the set play in preparation is cancelled; play goes on and the time runs
+        again (``AbortGameInterruption.java``)."""
         if self.set_play is None:
             raise IllegalTransition(current=self.state.name, requested="ABORT")
-        self.set_play = None
-        self.secondary_time = 0.0
+        self._end_set_play()
+        self._timer_ms = 0
 
     def next_period(self) -> SecondaryState:
         """From FINISHED, start the next period; returns its phase. Caller checks it exists."""
@@ -231,14 +367,14 @@ class GameController:
     def penalize(self, robot: RobotId, penalty: Penalty, seconds: float | None = None) -> None:
         info = self.robot(robot)
         info.penalty = penalty
-        info.secs_till_unpenalised = self.timing.removal_penalty_s if seconds is None else seconds
+        info.left_ms = to_ms(self.timing.removal_penalty_s if seconds is None else seconds)
 
     def unpenalize(self, robot: RobotId) -> None:
         info = self.robot(robot)
         if info.red_cards:
             return
         info.penalty = Penalty.NONE
-        info.secs_till_unpenalised = 0.0
+        info.left_ms = 0
 
     def card(self, robot: RobotId, card: Card) -> Card:
         """Record a card; 2 warnings make a yellow, 2 yellows a red. Returns the card given."""
@@ -256,7 +392,7 @@ class GameController:
             card = Card.RED
         info.red_cards += 1
         info.penalty = Penalty.SUBSTITUTE
-        info.secs_till_unpenalised = 0.0
+        info.left_ms = 0
         return Card.RED
 
     def set_goalkeeper(self, robot: RobotId) -> None:
@@ -275,48 +411,63 @@ class GameController:
     # --- time ----------------------------------------------------------------------------
 
     def advance(self, dt_s: float) -> Tick:
-        """Run the timers for ``dt_s`` seconds of simulated time."""
-        if self.state in (GameState.INITIAL, GameState.FINISHED) or dt_s <= 0:
+        """Run the timers for ``dt_s`` seconds of simulated time (whole milliseconds)."""
+        return self.advance_ms(to_ms(dt_s))
+
+    def advance_ms(self, dt_ms: int) -> Tick:
+        """Run the timers for ``dt_ms`` milliseconds of simulated time. The GameController's
+        own time, and with it the game clock and the penalties, stands still while a set play
+        is prepared; the referee's countdowns (READY, the set play's sub-phases) run on."""
+        if dt_ms <= 0:
+            return Tick()
+        self.sim_ms += dt_ms
+        if not self.clock_paused:
+            self.gc_ms += dt_ms
+        if self.state in (GameState.INITIAL, GameState.FINISHED):
             return Tick()
         period_over = False
         if self.clock_running:
-            before = self.secs_remaining
-            self.secs_remaining -= dt_s
-            period_over = before > EPSILON_S >= self.secs_remaining
+            before = self._remaining_ms
+            self._remaining_ms -= dt_ms
+            period_over = before > 0 >= self._remaining_ms
         unpenalised = []
-        for color, team in self.teams.items():
-            for number, info in sorted(team.robots.items()):
-                if info.penalty is Penalty.NONE or info.red_cards:
-                    continue
-                info.secs_till_unpenalised -= dt_s
-                if info.secs_till_unpenalised <= EPSILON_S:
-                    info.penalty = Penalty.NONE
-                    info.secs_till_unpenalised = 0.0
-                    unpenalised.append(RobotId(color, number))
-        self.secondary_time = max(0.0, self.secondary_time - dt_s)
+        if not self.clock_paused:
+            for color, team in self.teams.items():
+                for number, info in sorted(team.robots.items()):
+                    if info.penalty is Penalty.NONE or info.red_cards:
+                        continue
+                    info.left_ms -= dt_ms
+                    if info.left_ms <= 0:
+                        info.penalty = Penalty.NONE
+                        info.left_ms = 0
+                        unpenalised.append(RobotId(color, number))
+        self._timer_ms = max(0, self._timer_ms - dt_ms)
         auto_set = False
         phase: int | None = None
         executed: SetPlay | None = None
-        if self.state is GameState.READY and self.secondary_time <= EPSILON_S:
+        if self.state is GameState.READY and self._timer_ms <= 0:
             self.transition(GameState.SET)
             auto_set = True
-        elif self.set_play is not None and self.secondary_time <= EPSILON_S:
+        elif self.set_play is not None and self._timer_ms <= 0:
             play = self.set_play
             if play.sub_phase == 0:
                 phase = 1
                 ready_s = self.timing.set_play_ready_s
                 if play.kind is SecondaryState.PENALTYKICK:
                     ready_s *= 2
-                self.secondary_time = ready_s
+                self._timer_ms = to_ms(ready_s)
+                self._preparation_began_sim_ms = self.sim_ms  # GameInterruption.java:68
             elif play.sub_phase == 1:
                 phase = 2
-                self.secondary_time = self.timing.set_play_prepare_s
+                self._timer_ms = to_ms(self.timing.set_play_prepare_s)
+                self._preparation_began_sim_ms = None  # GameInterruption.java:72
             if phase is not None:
                 self.set_play = SetPlay(play.kind, play.team, phase)
             else:
                 executed = play
-                self.set_play = None
-                self.secondary_time = self.timing.kickoff_blocked_s
+                self._end_set_play()  # GameInterruption.java:76-81: the time runs again
+                self._set_play_ended_gc_ms = self.gc_ms
+                self._timer_ms = to_ms(self.timing.kickoff_blocked_s)
         return Tick(
             auto_set=auto_set,
             set_play_phase=phase,

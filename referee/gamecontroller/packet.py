@@ -2,29 +2,44 @@
 
 from __future__ import annotations
 
-import math
+from contracts import (
+    MAX_PLAYERS,
+    FieldClass,
+    GameControlData,
+    GameType,
+    RobotInfo,
+    TeamColor,
+    TeamInfo,
+)
+from referee.gamecontroller.machine import GameController, wire_seconds
+from referee.gamecontroller.states import DROPBALL_TEAM, GameTypeCode, Penalty, TeamColourCode
 
-from contracts import MAX_PLAYERS, GameControlData, GameType, RobotInfo, TeamColor, TeamInfo
-from referee.gamecontroller.machine import GameController
-from referee.gamecontroller.states import DROPBALL_TEAM, GameTypeCode, TeamColourCode
+LEAGUE_PLAYERS_PER_TEAM: dict[FieldClass, int] = {FieldClass.KID: 4, FieldClass.ADULT: 2}
+"""``playersPerTeam`` as the league's GameController sends it: its rules' ``teamSize``
+(``GameControlData.java:62``), 4 for ``HLSimulationKid`` (``HLSimulationKid.java:17``) and 2 for
+``HLSimulationAdult`` (``HLSimulationAdult.java:17``). Every player slot from this number on
+carries the penalty SUBSTITUTE (``AdvancedData.java:143-146``, ``robotsPlaying``, the same
+numbers)."""
 
 
-def _seconds(value: float, low: int, high: int) -> int:
-    return max(low, min(high, math.ceil(value)))
+def _clamp(value: int, low: int, high: int) -> int:
+    return max(low, min(high, value))
 
 
-def _team(gc: GameController, color: TeamColor, number: int) -> TeamInfo:
+def _team(gc: GameController, color: TeamColor, number: int, players_per_team: int) -> TeamInfo:
     team = gc.teams[color]
     players = []
     for n in range(1, MAX_PLAYERS + 1):
         info = team.robots.get(n)
         if info is None:
-            players.append(RobotInfo())
+            # AdvancedData.java:144: the slots past the league's robotsPlaying are substitutes
+            substitute = n > players_per_team
+            players.append(RobotInfo(penalty=int(Penalty.SUBSTITUTE) if substitute else 0))
             continue
         players.append(
             RobotInfo(
                 penalty=int(info.penalty),
-                secs_till_unpenalised=_seconds(info.secs_till_unpenalised, 0, 255),
+                secs_till_unpenalised=_clamp(wire_seconds(info.left_ms), 0, 255),
                 number_of_warnings=min(info.warnings, 255),
                 yellow_card_count=min(info.yellow_cards, 255),
                 red_card_count=min(info.red_cards, 255),
@@ -54,7 +69,10 @@ def game_control_data(
 
     ``teams[0]`` is the team playing on the left (``left_team``) and ``teams[1]`` the other; the
     two entries swap when the sides change at half time, and robots find their own entry by
-    ``teamNumber``.
+    ``teamNumber``. ``players_per_team`` is the league's (:data:`LEAGUE_PLAYERS_PER_TEAM`): the
+    empty slots past it carry SUBSTITUTE; a robot of the match keeps its own status in any slot.
+    The times are the league's, exact (:meth:`GameController.wire_secs_remaining`,
+    :meth:`GameController.wire_secondary_time`).
     """
     kickoff = DROPBALL_TEAM if gc.kickoff_team is None else team_numbers[gc.kickoff_team]
     info = (0, 0, 0, 0)
@@ -71,10 +89,10 @@ def game_control_data(
         kick_off_team=kickoff,
         secondary_state=int(gc.secondary_state),
         secondary_state_info=info,
-        secs_remaining=_seconds(gc.secs_remaining, -32768, 32767),
-        secondary_time=_seconds(gc.secondary_time, -32768, 32767),
+        secs_remaining=_clamp(gc.wire_secs_remaining(), -32768, 32767),
+        secondary_time=_clamp(gc.wire_secondary_time(), -32768, 32767),
         teams=(
-            _team(gc, order[0], team_numbers[order[0]]),
-            _team(gc, order[1], team_numbers[order[1]]),
+            _team(gc, order[0], team_numbers[order[0]], players_per_team),
+            _team(gc, order[1], team_numbers[order[1]], players_per_team),
         ),
     )

@@ -149,7 +149,7 @@ def test_defaults_of_our_additions(game_files: GameFiles) -> None:
     assert (game.stepping, game.physics_dt_s, game.allow_internet) == ("async", 0.002, False)
     assert (game.side_left, game.kickoff) == ("random", "random")
     assert game.limits.cpus == 4 and game.limits.team_comm_mb_s == 1
-    assert game.timing.removal_penalty_s == 10 and game.timing.grace_period_s == 120
+    assert game.timing.removal_penalty_s == 30 and game.timing.grace_period_s == 120
 
 
 def test_player_image_override_model_and_display_name(game_files: GameFiles) -> None:
