@@ -6,9 +6,10 @@ An entry that a robot names is a voltage variant of a model, written ``MODEL@VOL
 of the same family, take every figure from the maker's page, record the page as ``source``, and
 run ``hlvs bench actuators --json`` (it measures the new entry against its figures).
 
-Per model: ``gear_ratio``, ``backlash_rad``, ``encoder_resolution_rad`` (one encoder count at the
-output), ``mass_kg``, ``rotor_inertia_kg_m2`` (the motor's rotor and first gear stage; the
-joint's armature, its reflected inertia, is that times the gear ratio squared:
+Per model: ``aliases`` (optional: other names of the same servo, ``MX-64(2.0)``),
+``gear_ratio``, ``backlash_rad``, ``encoder_resolution_rad`` (one encoder count at the output),
+``mass_kg``, ``rotor_inertia_kg_m2`` (the motor's rotor and first gear stage; the joint's
+armature, its reflected inertia, is that times the gear ratio squared:
 :attr:`Servo.armature_kg_m2`; ``rotor_inertia_source`` says where the figure comes from, or how
 it was estimated where the maker publishes none), ``static_friction_nm`` and
 ``viscous_damping_nm_s_per_rad`` (league defaults where the datasheet is silent;
@@ -182,9 +183,26 @@ def servo_ids() -> tuple[str, ...]:
     return tuple(sorted(catalogue()))
 
 
+@cache
+def aliases() -> dict[str, str]:
+    """Other names of a model (``aliases`` in its file: ``MX-64(2.0)``, the same servo with the
+    protocol 2.0 firmware) -> the model."""
+    out: dict[str, str] = {}
+    for path in sorted(FOLDER.glob("*.json")):
+        raw = json.loads(path.read_text(encoding="utf-8"))
+        for alias in raw.get("aliases", []) if isinstance(raw, dict) else []:
+            if isinstance(alias, str) and isinstance(raw.get("model"), str):
+                out[alias] = raw["model"]
+    return out
+
+
 def find_servo(name: str) -> Servo | None:
-    """The entry called ``name`` (``MX-106@14.8V``, or ``MX-106`` for its highest voltage)."""
+    """The entry called ``name`` (``MX-106@14.8V``, or ``MX-106`` for its highest voltage; an
+    alias such as ``MX-106(2.0)`` names the same entry)."""
     entries = catalogue()
+    model, at, voltage = name.partition("@")
+    if model in aliases():
+        name = aliases()[model] + at + voltage
     if name in entries:
         return entries[name]
     variants = [s for s in entries.values() if s.model == name]
