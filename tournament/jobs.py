@@ -276,7 +276,7 @@ def deliver_job(state_path: str, match_id: str) -> None:
         found = [TeamLogs(team=name, state="failed", cause=f"store: {exc}")
                  for name in (ctx.red.name, ctx.blue.name)]
     logs = _merge(previous, found, retry=retry,
-                  by_hand=_receipts(t.schedule.log_store, match_id) if retry else {})
+                  by_hand=_receipts(t.schedule.log_store, ctx.league_id) if retry else {})
     attempts = max((e.attempts for e in logs if e.state == "failed"), default=0)
     if all_done(logs):
         t.ledger.set_logs(match_id, logs)
@@ -328,7 +328,7 @@ def _receipts(store: Path, match_id: str | None = None) -> dict[str, str]:
     return {r.team: r.target for r in delivered_receipts(store, match_id)}
 
 
-def settle_hand_deliveries(ledger: Ledger, store: Path) -> list[str]:
+def settle_hand_deliveries(ledger: Ledger, schedule: Schedule) -> list[str]:
     """LOGS_FAILED matches whose failed sets were delivered since (``hlvs logs deliver`` after
     a fix): their sets become delivered, and the match DELIVERED once every set is; a set that
     left the store without a receipt is gone (pruned). Returns the matches now DELIVERED."""
@@ -337,11 +337,13 @@ def settle_hand_deliveries(ledger: Ledger, store: Path) -> list[str]:
     rows = [r for r in ledger.rows() if r.state is S.LOGS_FAILED]
     if not rows:
         return []
+    store = schedule.log_store
     waiting = {(s.match_id, s.team) for s in pending_status(store)}
     settled = []
     for row in rows:
-        by_hand = _receipts(store, row.id)
-        logs = [e if e.state in (*DONE, "gone") or (row.id, e.team) in waiting
+        league_id = schedule.league_match_id(row.id)
+        by_hand = _receipts(store, league_id)
+        logs = [e if e.state in (*DONE, "gone") or (league_id, e.team) in waiting
                 else _left_the_store(e, by_hand.get(e.team)) for e in row.logs]
         if logs == list(row.logs):
             continue

@@ -68,13 +68,17 @@ def with_store(row: MatchRow, waiting: set[tuple[str, str]]) -> MatchRow:
 def settle(ledger: Ledger, schedule: Schedule) -> None:
     from tournament.jobs import settle_hand_deliveries
 
-    settle_hand_deliveries(ledger, schedule.log_store)
+    settle_hand_deliveries(ledger, schedule)
 
 
 def waiting_sets(schedule: Schedule) -> set[tuple[str, str]]:
+    """(match id, team) of the sets waiting in the log store (the store has the matches'
+    league ids, :meth:`~orchestrator.config.Schedule.league_match_id`)."""
     from orchestrator.delivery import pending_status
 
-    return {(s.match_id, s.team) for s in pending_status(schedule.log_store)}
+    ours = {schedule.league_match_id(m.id): m.id for m in schedule.matches}
+    return {(ours[s.match_id], s.team) for s in pending_status(schedule.log_store)
+            if s.match_id in ours}
 
 
 def logs_text(row: MatchRow) -> str:

@@ -313,7 +313,7 @@ def run_schedule(
         while not stop.is_set():
             if time.monotonic() - beaten >= HEARTBEAT_S:
                 beat(ledger)
-                settle_hand_deliveries(ledger, schedule.log_store)  # hlvs logs deliver
+                settle_hand_deliveries(ledger, schedule)  # hlvs logs deliver
                 beaten = time.monotonic()
             reconcile(scheduler, ledger, state, running.ids())
             rows = ledger.rows()

@@ -68,6 +68,11 @@ class MatchContext:
         return self.planned.match.id
 
     @property
+    def league_id(self) -> str:
+        """The match's id outside the tournament (game.json, log sets, the teams' folders)."""
+        return self.schedule.league_match_id(self.match_id)
+
+    @property
     def game_path(self) -> Path:
         return self.out_dir / "game.json"
 
@@ -295,7 +300,7 @@ class MatchServices:
                 log.info("match %s: adopting Slurm job %s", ctx.match_id, pool.job_id(handle))
             else:
                 keep_earlier_attempt(out)
-                handle = pool.submit(MatchJob(match_id=ctx.match_id, game_path=game,
+                handle = pool.submit(MatchJob(match_id=ctx.league_id, game_path=game,
                                               work_dir=out, account=settings.account,
                                               robot_nodes=_robot_nodes(settings, game)))
                 log.info("match %s: Slurm job %s", ctx.match_id, pool.job_id(handle))
@@ -336,14 +341,14 @@ class MatchServices:
 
         store = self.schedule.log_store
         # sets queued by a delivery that a restart interrupted (their files left the match)
-        earlier = {s.team for s in pending_status(store) if s.match_id == ctx.match_id}
+        earlier = {s.team for s in pending_status(store) if s.match_id == ctx.league_id}
         teams = {
             "red": (ctx.red.name, ctx.red.credentials),
             "blue": (ctx.blue.name, ctx.blue.credentials),
         }
         created = enqueue_match_logs(
             ctx.out_dir / "match",
-            match_id=ctx.match_id,
+            match_id=ctx.league_id,
             teams=teams,
             public_target=self.schedule.public_logs,
             store=store,
@@ -364,8 +369,8 @@ class MatchServices:
         from orchestrator.delivery import deliver_pending, pending_status
 
         store = self.schedule.log_store
-        waiting = {s.team for s in pending_status(store) if s.match_id == ctx.match_id}
-        outcomes = {o.team: o for o in deliver_pending(store, match_id=ctx.match_id)}
+        waiting = {s.team for s in pending_status(store) if s.match_id == ctx.league_id}
+        outcomes = {o.team: o for o in deliver_pending(store, match_id=ctx.league_id)}
         found = []
         for team in sorted(waiting):
             outcome = outcomes.get(team)

@@ -10,6 +10,7 @@ reference time is known (``start: now`` is fixed at the first run and kept in th
 from __future__ import annotations
 
 import difflib
+import hashlib
 import json
 import re
 from dataclasses import dataclass
@@ -135,6 +136,18 @@ class Schedule:
                 return match
         raise KeyError(match_id)
 
+    def league_match_id(self, match_id: str) -> str:
+        """The match's id outside the tournament (its game.json, containers, Slurm job, log
+        sets and the folders the teams receive): the tournament's name, then the match's id
+        (``example-cup-rr-1``), so two tournaments on one host or one team's log server never
+        meet on ``rr-1``. At most 64 characters, as game.json's ``match_id``."""
+        slug = re.sub(r"[^a-z0-9]+", "-", self.name.lower()).strip("-")[:24].strip("-")
+        text = f"{slug}-{match_id}" if slug else match_id
+        if len(text) > 64 or not re.match(r"^[A-Za-z0-9]", text):
+            digest = hashlib.sha256(text.encode()).hexdigest()[:8]
+            text = f"m{digest}-{match_id}"[:64]
+        return text
+
     def plan(self, reference: datetime) -> list[PlannedMatch]:
         """Absolute times of every match, relative offsets counted from ``reference``."""
         planned = []
@@ -175,7 +188,7 @@ def game_document(
         "host": "127.0.0.1",
         "maximum_real_time_factor": default_real_time_factor(
             str(schedule.game_defaults.get("stepping", "async"))),
-        "match_id": match.id,
+        "match_id": schedule.league_match_id(match.id),
     }
     game.update(schedule.game_defaults)
     game["type"] = game_type or ("KNOCKOUT" if match.kind == "knockout" else "NORMAL")

@@ -158,7 +158,7 @@ def test_compressed_tournament_of_real_matches(tmp_path: Path, s3: MotoServer) -
     assert {e.team: e.state for e in rows["m2"].logs} == {"bees": "delivered",
                                                           "dogs": "delivered"}
     waiting = [s for s in pending_status(tmp_path / "out" / "log-store")]
-    assert [(s.match_id, s.team) for s in waiting] == [("m1", "cats")]
+    assert [(s.match_id, s.team) for s in waiting] == [("compressed-cup-m1", "cats")]
     status = "\n".join(status_lines(ledger))
     assert "cats failed after 2 attempts (unreachable: cannot connect" in status, status
 
@@ -171,7 +171,7 @@ def test_compressed_tournament_of_real_matches(tmp_path: Path, s3: MotoServer) -
     )
     for team, match_id in (("ants", "m1"), ("bees", "m2"), ("dogs", "m2")):
         keys = [o["Key"] for o in client.list_objects_v2(Bucket=f"logs-{team}").get("Contents", [])]
-        assert f"{match_id}/{team}/MANIFEST.json" in keys, keys
+        assert f"compressed-cup-{match_id}/{team}/MANIFEST.json" in keys, keys
 
     # the operator's overview: each played match links its replay (hlvs match's public/)
     view = tournament_overview(ledger)

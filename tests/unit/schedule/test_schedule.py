@@ -318,3 +318,25 @@ def test_sigterm_stops_a_playing_match_within_the_grace_then_restart_replays_it(
     notes = [note for *_, note in Ledger(state).history("m1")]
     assert any(n.startswith("interrupted by the scheduler's stop") for n in notes)
     assert "PLAYING interrupted by a restart" in notes
+
+
+def test_two_tournaments_on_one_host_never_meet_on_a_match_id(tmp_path: Path) -> None:
+    """Both have an ``rr-1``: their game.json (containers, Slurm jobs), log sets and the folders
+    a team receives carry the tournament's name too."""
+    from orchestrator.config.schedule import game_document
+
+    ids = []
+    for name in ("Spring Cup 2026", "Autumn Cup 2026"):
+        folder = tmp_path / name.split()[0]
+        folder.mkdir()
+        path = write_schedule(folder, "fixtures:\n  round_robin: {teams: [alpha, bravo],"
+                              " first_stream: '+1h'}\n")
+        path.write_text(path.read_text().replace("name: test cup", f"name: {name}"))
+        schedule = load_schedule(path)
+        match = schedule.match("rr-1")
+        game = game_document(schedule, match, schedule.team("alpha"), schedule.team("bravo"))
+        ids.append(game["match_id"])
+        assert schedule.league_match_id("rr-1") == game["match_id"]
+    assert ids == ["spring-cup-2026-rr-1", "autumn-cup-2026-rr-1"]
+    long = load_schedule(path)
+    assert len(long.league_match_id("x" * 60)) <= 64

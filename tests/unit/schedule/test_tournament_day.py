@@ -23,7 +23,9 @@ S = ScheduledMatchState
 
 
 def queue_set(store: Path, match_id: str, team: str) -> PendingSet:
-    """A team's log set waiting in the store (the fake services deliver nothing)."""
+    """A team's log set waiting in the store (the fake services deliver nothing), under the
+    match's league id (the tournament's name, then its id)."""
+    match_id = f"test-cup-{match_id}"
     source = store.parent / f"{match_id}-{team}.log"
     source.parent.mkdir(parents=True, exist_ok=True)
     source.write_text("log\n")
@@ -320,16 +322,17 @@ def test_logs_delivered_by_hand_after_a_fix_clear_logs_failed(tmp_path: Path, fa
     source = tmp_path / "robot.log"
     source.write_text("log\n")
     for match_id in ("m1", "m2"):  # as the real services leave a failed set in the store
-        create_set(store, match_id=match_id, team="bravo", kind="team", credentials=credentials,
+        create_set(store, match_id=f"test-cup-{match_id}", team="bravo", kind="team",
+                   credentials=credentials,
                    sources=[(source, "robot.log")], move=False)
     assert "m1" in "\n".join(status_lines(ledger))
     assert ledger.row("m1").state is S.LOGS_FAILED  # still waiting in the store
     uploader = FakeUploader()
-    [outcome] = deliver_pending(store, match_id="m1", opener=lambda creds, team: uploader,
+    [outcome] = deliver_pending(store, match_id="test-cup-m1", opener=lambda creds, team: uploader,
                                 retry=RetryPolicy(attempts=1, initial_delay_s=0.0, factor=1.0,
                                                   max_delay_s=0.0))
     assert outcome.delivered
-    for pending in [s for s in pending_sets(store) if s.match_id == "m2"]:
+    for pending in [s for s in pending_sets(store) if s.match_id == "test-cup-m2"]:
         remove_set(pending)  # m2's set was pruned, never delivered
     lines = "\n".join(status_lines(ledger))
     m1, m2 = ledger.row("m1"), ledger.row("m2")
