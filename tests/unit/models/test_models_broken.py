@@ -87,3 +87,37 @@ def test_not_json_and_no_manifest(tmp_path: Path, wolfgang_copy: Path) -> None:
     assert code == 2 and "robot_model.json: not JSON" in out
     with pytest.raises(ModelError, match="no robot_model.json here"):
         load_team_model(tmp_path)
+
+
+@pytest.mark.parametrize(
+    ("edit", "severity", "where", "reason"),
+    [
+        ('<include file="arm.xml"/>', "error", "<include file='arm.xml'>", "included files are"),
+        (
+            '<equality><joint joint1="hip_l" joint2="hip_r"/></equality>',
+            "error",
+            "<equality>",
+            "equality constraints (closed loops, coupled joints) are not supported",
+        ),
+        ('<keyframe><key name="k"/></keyframe>', "note", "<keyframe>", "ignored (1 element)"),
+        (
+            '<asset><texture name="t" type="2d" file="skin.png"/></asset>',
+            "error",
+            "<texture file='skin.png'>",
+            "texture file not found",
+        ),
+    ],
+)
+def test_mjcf_elements_the_world_cannot_use_are_problem_lines(
+    tmp_path: Path, edit: str, severity: str, where: str, reason: str
+) -> None:
+    folder = box_robot(tmp_path / "extra", height_m=0.7)
+    xml = (folder / "robot.xml").read_text()
+    (folder / "robot.xml").write_text(xml.replace("<worldbody>", edit + "<worldbody>", 1))
+    try:
+        problems = list(load_team_model(folder).notes)
+    except ModelError as exc:
+        problems = exc.problems
+    assert any(
+        p.severity == severity and p.where == where and reason in p.reason for p in problems
+    ), problems

@@ -128,7 +128,8 @@ def _scene_notes(
             asset.remove(texture)
     for worldbody in root.findall("worldbody"):
         for element in list(worldbody):
-            if element.tag in ("body", "frame"):
+            holds_robot = element.tag == "frame" and element.find(".//body") is not None
+            if element.tag == "body" or holds_robot:
                 continue
             detail = f" type={element.get('type')!r}" if element.get("type") else ""
             reason = {
