@@ -242,6 +242,8 @@ def _inspect(reference: str, logins: _Logins) -> RemoteImage | None:
             raise ImagePullError(
                 image=reference, reason=f"tag {tag_name} not found in {repository}"
             ) from exc
+        if exc.kind == "deadline":  # a registry that answers too slowly is not pulled from
+            raise ImagePullError(image=reference, reason=f"{registry}: {exc.reason}") from exc
         if exc.transient:
             raise ImagePullError(
                 image=reference, reason=f"registry {registry} unreachable: {exc.reason}",

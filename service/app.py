@@ -23,6 +23,7 @@ from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from sqlalchemy import Engine
+from sqlalchemy.exc import OperationalError
 from sqlalchemy.orm import Session, sessionmaker
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
@@ -232,6 +233,21 @@ def _install_error_handlers(app: FastAPI) -> None:
         log.error("%s %s: %s", request.method, request.url.path, exc)
         body = {"error": exc.kind, "message": str(exc), **exc.fields()}
         return JSONResponse(body, status_code=503)
+
+    @app.exception_handler(OperationalError)
+    async def database_error(request: Request, exc: OperationalError) -> JSONResponse:
+        """A database too busy to answer in time (SQLite's lock past its busy timeout, a
+        PostgreSQL lock or serialization failure) is a 503 to retry, never a 500."""
+        text = str(exc.orig).lower()
+        busy = any(word in text for word in ("locked", "busy", "deadlock", "serializ",
+                                              "lock timeout", "could not obtain lock"))
+        log.error("%s %s: database error: %s", request.method, request.url.path, exc.orig)
+        if busy:
+            return JSONResponse({"error": "busy", "message": "the database is busy; try "
+                                 "again in a moment"}, status_code=503,
+                                headers={"Retry-After": "1"})
+        return JSONResponse({"error": "internal", "message": "database error"},
+                            status_code=500)
 
     @app.exception_handler(ServiceError)
     async def service_error(request: Request, exc: ServiceError) -> JSONResponse:

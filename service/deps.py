@@ -13,10 +13,13 @@ Routers of other packages require a team token with::
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from typing import Annotated
+import functools
+import inspect
+from collections.abc import Callable, Iterator
+from typing import Annotated, Any
 
 from fastapi import Depends, Request
+from fastapi.routing import APIRoute
 from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
 from sqlalchemy.orm import Session
 
@@ -54,6 +57,40 @@ def get_db(request: Request) -> Iterator[Session]:
 
 
 DbSession = Annotated[Session, Depends(get_db)]
+
+
+class SessionRoute(APIRoute):
+    """A route whose handler ends its database transaction as it returns, in its own thread.
+
+    Without it a handler that read after its last commit would return with a transaction
+    open (on SQLite a write lock: every transaction begins IMMEDIATE) until FastAPI has
+    validated the answer, which takes one of the request threads; with every thread waiting
+    for that lock, nothing moved until SQLite's busy timeout answered 500 "database is
+    locked". The service's routers use it (``APIRouter(route_class=SessionRoute)``)."""
+
+    def __init__(self, path: str, endpoint: Callable[..., Any], **kwargs: Any) -> None:
+        super().__init__(path, _ending_transactions(endpoint), **kwargs)
+
+
+def _ending_transactions(endpoint: Callable[..., Any]) -> Callable[..., Any]:
+    if inspect.iscoroutinefunction(endpoint):
+        return endpoint  # an async handler uses its sessions in threads of its own
+
+    @functools.wraps(endpoint)
+    def ended(*args: Any, **kwargs: Any) -> Any:
+        sessions = [v for v in kwargs.values() if isinstance(v, Session)]
+        try:
+            result = endpoint(*args, **kwargs)
+        except BaseException:
+            for session in sessions:
+                session.rollback()
+            raise
+        for session in sessions:
+            if session.in_transaction():
+                session.commit()
+        return result
+
+    return ended
 
 
 def require_token(
@@ -94,6 +131,7 @@ __all__ = [
     "AppServices",
     "DbSession",
     "OperatorPrincipal",
+    "SessionRoute",
     "TeamPrincipal",
     "get_db",
     "bearer",

@@ -8,11 +8,14 @@ partial unique index keeps that true even for simultaneous requests.
 
 from __future__ import annotations
 
+import asyncio
 import heapq
 import logging
 import secrets
 import threading
 import time
+from collections.abc import AsyncIterator
+from contextlib import asynccontextmanager
 from dataclasses import dataclass
 from datetime import datetime, timedelta
 
@@ -127,6 +130,21 @@ def cancel(session: Session, row: Submission) -> Submission:
         raise Conflict(f"submission {row.id} has already ended ({row.state})",
                        existing_id=row.id)
     return row
+
+
+class PreflightClaims:
+    """At most one pre-flight check per team at a time: a team's second submission while its
+    first is being checked waits for it (in the event loop: no request thread is held) and is
+    then answered as any later one (409 naming the submission that got in first)."""
+
+    def __init__(self) -> None:
+        self._locks: dict[int, asyncio.Lock] = {}
+
+    @asynccontextmanager
+    async def claim(self, team_id: int) -> AsyncIterator[None]:
+        lock = self._locks.setdefault(team_id, asyncio.Lock())
+        async with lock:
+            yield
 
 
 def queue_paused(session: Session) -> bool:

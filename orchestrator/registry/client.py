@@ -4,13 +4,21 @@ Authentication follows the registry's ``WWW-Authenticate`` challenge (Basic, or 
 from its token service; see :mod:`orchestrator.registry.auth`). Listings (catalog, tags) follow
 ``Link: <...>; rel="next"`` pages. Unreachable registries and 429/5xx answers are retried with
 backoff and jitter. Every failure becomes one :class:`RegistryError`, translated here only.
+
+Every request has a deadline (``deadline_s``, 60 s by default) for the whole of it: connect,
+headers and body. A registry that answers a byte at a time (a tarpit) is cut off at the
+deadline (its socket shut), a failure of kind ``deadline`` that is not retried; an answer over
+:data:`MAX_BODY_BYTES` is refused the same way.
 """
 
 from __future__ import annotations
 
 import hashlib
+import http.client
 import json
 import logging
+import socket
+import threading
 import time
 import urllib.error
 import urllib.parse
@@ -34,12 +42,15 @@ MANIFEST_TYPES = (
 INDEX_TYPES = MANIFEST_TYPES[2:]
 TRANSIENT_STATUS = (429, 500, 502, 503, 504)
 USER_AGENT = "hlvs-runner"
+DEADLINE_S = 60.0
+MAX_BODY_BYTES = 16 << 20
+"""The largest answer read from a registry (manifests, listings and tokens are small)."""
 
 
 class RegistryError(InfrastructureError):
     """A registry request failed: ``url``, HTTP ``status`` (0 when unreachable), ``reason`` and
     ``kind``: auth, denied, not_found, platform (no image for the machine's platform),
-    unreachable, transient or failed."""
+    unreachable, transient, deadline (the request outlived its deadline) or failed."""
 
     def __init__(
         self, *, url: str, status: int, reason: str, kind: str = "failed",
@@ -108,6 +119,7 @@ class RegistryClient:
         backoff: Backoff | None = None,
         clock: Callable[[], float] = time.monotonic,
         timeout_s: float = 30.0,
+        deadline_s: float = DEADLINE_S,
     ) -> None:
         self.url = url.rstrip("/")
         if credentials is None and username:
@@ -116,6 +128,7 @@ class RegistryClient:
         self.page_size = page_size
         self.backoff = backoff or Backoff(attempts=4, base_s=0.5, cap_s=8.0)
         self.timeout_s = timeout_s
+        self.deadline_s = deadline_s
         self.tokens = TokenCache(clock=clock)
         self.token_requests = 0  # token service calls made (tokens are cached per scope)
         self._basic = False  # the registry asked for Basic: send it on every request
@@ -300,14 +313,112 @@ class RegistryClient:
             request.add_header(name, value)
         if authorization:
             request.add_header("Authorization", authorization)
+        watch = _Deadline(self.deadline_s)
+        opener = urllib.request.build_opener(_HTTPHandler(watch), _HTTPSHandler(watch))
         try:
-            with urllib.request.urlopen(request, timeout=self.timeout_s) as answer:
-                return _Response(answer.status, answer.read(), _lower(answer.headers.items()))
+            with opener.open(request, timeout=min(self.timeout_s, self.deadline_s)) as answer:
+                return _Response(answer.status, _read(answer, watch, url),
+                                 _lower(answer.headers.items()))
         except urllib.error.HTTPError as exc:
-            return _Response(exc.code, exc.read(), _lower(exc.headers.items()))
-        except (urllib.error.URLError, OSError) as exc:
+            return _Response(exc.code, _read(exc, watch, url), _lower(exc.headers.items()))
+        except (urllib.error.URLError, OSError, http.client.HTTPException) as exc:
+            if watch.expired:
+                raise self._deadline_error(url) from None
             reason = getattr(exc, "reason", exc)
             raise RegistryError(url=url, status=0, reason=str(reason), kind="unreachable") from exc
+        finally:
+            watch.cancel()
+
+    def _deadline_error(self, url: str) -> RegistryError:
+        return RegistryError(url=url, status=0, kind="deadline", reason=(
+            f"no whole answer within {self.deadline_s:g} s (the registry is too slow)"))
+
+
+class _Deadline:
+    """Shuts the sockets of one request when its deadline passes (blocking reads then fail)."""
+
+    def __init__(self, seconds: float) -> None:
+        self.expired = False
+        self._sockets: list[socket.socket] = []
+        self._lock = threading.Lock()
+        self._timer = threading.Timer(seconds, self._expire)
+        self._timer.daemon = True
+        self._timer.start()
+
+    def watch(self, sock: socket.socket | None) -> None:
+        with self._lock:
+            if sock is not None:
+                self._sockets.append(sock)
+            if self.expired:
+                self._shut()
+
+    def _expire(self) -> None:
+        with self._lock:
+            self.expired = True
+            self._shut()
+
+    def _shut(self) -> None:
+        for sock in self._sockets:
+            try:
+                sock.shutdown(socket.SHUT_RDWR)
+            except OSError:
+                pass
+
+    def cancel(self) -> None:
+        self._timer.cancel()
+
+
+def _watched(base: type[http.client.HTTPConnection], watch: _Deadline
+             ) -> type[http.client.HTTPConnection]:
+    class Watched(base):  # type: ignore[misc,valid-type]
+        def connect(self) -> None:
+            super().connect()
+            watch.watch(self.sock)
+    return Watched
+
+
+class _HTTPHandler(urllib.request.HTTPHandler):
+    def __init__(self, watch: _Deadline) -> None:
+        super().__init__()
+        self._class = _watched(http.client.HTTPConnection, watch)
+
+    def http_open(self, req: urllib.request.Request) -> http.client.HTTPResponse:
+        return self.do_open(self._class, req)
+
+
+class _HTTPSHandler(urllib.request.HTTPSHandler):
+    def __init__(self, watch: _Deadline) -> None:
+        super().__init__()
+        self._class = _watched(http.client.HTTPSConnection, watch)
+
+    def https_open(self, req: urllib.request.Request) -> http.client.HTTPResponse:
+        return self.do_open(self._class, req, context=self._context)  # type: ignore[attr-defined]
+
+
+def _read(answer: Any, watch: _Deadline, url: str) -> bytes:
+    """The body, at most :data:`MAX_BODY_BYTES`; a deadline error when the deadline cut it."""
+    chunks: list[bytes] = []
+    size = 0
+    try:
+        while True:
+            chunk = answer.read(65536)
+            if not chunk:
+                break
+            size += len(chunk)
+            if size > MAX_BODY_BYTES:
+                raise RegistryError(url=url, status=0, kind="failed", reason=(
+                    f"the answer is over {MAX_BODY_BYTES >> 20} MB"))
+            chunks.append(chunk)
+    except (OSError, http.client.HTTPException) as exc:
+        if watch.expired:
+            raise RegistryError(url=url, status=0, kind="deadline", reason=(
+                "no whole answer within the request's deadline (the registry is too slow)"
+            )) from None
+        raise RegistryError(url=url, status=0, reason=str(exc), kind="unreachable") from exc
+    if watch.expired:
+        raise RegistryError(url=url, status=0, kind="deadline", reason=(
+            "no whole answer within the request's deadline (the registry is too slow)"))
+    return b"".join(chunks)
 
 
 def _retry_after(value: str) -> float | None:

@@ -40,9 +40,10 @@ from pydantic import BaseModel, Field
 
 from envs import EnvConfigError, EnvError, Monitor
 from service import TeamPrincipal
+from service.deps import SessionRoute
 from service.errors import Conflict, InvalidInput, NotFound
 
-router = APIRouter(prefix="/v1/envs", tags=["envs"])
+router = APIRouter(prefix="/v1/envs", tags=["envs"], route_class=SessionRoute)
 
 ALLOWED_KWARGS = frozenset({
     "perception", "perception_noise", "steps_per_action", "max_episode_s", "ball_distance_m",

@@ -16,11 +16,11 @@ from sqlalchemy import select
 from service import submissions
 from service.db import ACTIVE_STATES, Submission
 from service.db.models import Scope
-from service.deps import DbSession, get_services, require_token
+from service.deps import DbSession, SessionRoute, get_services, require_token
 from service.tokens import Principal
 from service.views import SubmissionView, view_of
 
-router = APIRouter(prefix="/v1", tags=["everyone"])
+router = APIRouter(prefix="/v1", tags=["everyone"], route_class=SessionRoute)
 AnyPrincipal = Annotated[Principal, Depends(require_token)]
 HIDDEN = "another team"
 MATCH_LIST_LIMIT = 200

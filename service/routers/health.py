@@ -6,9 +6,9 @@ from fastapi import APIRouter, FastAPI
 from pydantic import BaseModel
 from sqlalchemy import text
 
-from service.deps import DbSession
+from service.deps import DbSession, SessionRoute
 
-router = APIRouter(prefix="/v1", tags=["health"])
+router = APIRouter(prefix="/v1", tags=["health"], route_class=SessionRoute)
 
 
 class Health(BaseModel):

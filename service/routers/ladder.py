@@ -10,11 +10,11 @@ from fastapi import APIRouter, Depends, FastAPI, Request
 from pydantic import BaseModel, Field
 
 from service import tokens
-from service.deps import DbSession, get_services, require_token
+from service.deps import DbSession, SessionRoute, get_services, require_token
 from service.errors import NotFound
 from service.ratings import FRIENDLY, Ladder, LadderCache, RatedGame, TeamRating
 
-router = APIRouter(prefix="/v1/ladder", tags=["ladder"])
+router = APIRouter(prefix="/v1/ladder", tags=["ladder"], route_class=SessionRoute)
 AnyPrincipal = Annotated[tokens.Principal, Depends(require_token)]
 
 

@@ -9,10 +9,10 @@ from pydantic import BaseModel, Field
 from sqlalchemy import select
 
 from service.db import Submission, Team
-from service.deps import AppServices, DbSession, OperatorPrincipal
+from service.deps import AppServices, DbSession, OperatorPrincipal, SessionRoute
 from service.errors import NotFound
 
-router = APIRouter(prefix="/v1/operator", tags=["operator"])
+router = APIRouter(prefix="/v1/operator", tags=["operator"], route_class=SessionRoute)
 
 
 class NodeJobView(BaseModel):

@@ -12,11 +12,11 @@ from sqlalchemy import select
 
 from service import submissions
 from service.db import ACTIVE_STATES, Submission, SubmissionState, Team
-from service.deps import AppServices, DbSession, OperatorPrincipal, get_services
+from service.deps import AppServices, DbSession, OperatorPrincipal, SessionRoute, get_services
 from service.errors import Conflict, NotFound
 from service.views import SubmissionView, view_of
 
-router = APIRouter(prefix="/v1/operator", tags=["operator"])
+router = APIRouter(prefix="/v1/operator", tags=["operator"], route_class=SessionRoute)
 
 
 class QueueView(BaseModel):

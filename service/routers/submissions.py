@@ -8,6 +8,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
+import anyio
+import anyio.to_thread
 from fastapi import APIRouter, Depends, FastAPI, Request
 from fastapi.responses import FileResponse
 from fastapi.security import HTTPAuthorizationCredentials
@@ -23,6 +25,7 @@ from service.db import ACTIVE_STATES, Submission
 from service.deps import (
     AppServices,
     DbSession,
+    SessionRoute,
     TeamPrincipal,
     bearer,
     get_services,
@@ -40,9 +43,12 @@ from service.views import (
 )
 
 if TYPE_CHECKING:
+    from orchestrator.config import TeamConfig
     from service.app import Services
+    from service.tokens import Principal
 
-router = APIRouter(prefix="/v1/submissions", tags=["submissions"])
+router = APIRouter(prefix="/v1/submissions", tags=["submissions"],
+                   route_class=SessionRoute)
 ACTIVE_VALUES = frozenset(state.value for state in ACTIVE_STATES)
 
 
@@ -55,36 +61,70 @@ class LogListing(BaseModel):
 @router.post("", status_code=201, responses={
     409: {"description": "the team already has an active test match (its id is in the body)"},
     422: {"description": "invalid body, unknown opponent or failed pre-flight check"}})
-def create_submission(body: SubmissionCreate, request: Request, services: AppServices,
-                      principal: TeamPrincipal, session: DbSession) -> SubmissionView:
-    """Check the team's images (pre-flight) and queue a test match."""
+async def create_submission(body: SubmissionCreate, request: Request, services: AppServices,
+                            principal: TeamPrincipal) -> SubmissionView:
+    """Check the team's images (pre-flight) and queue a test match.
+
+    One pre-flight per team at a time (a second submission meanwhile waits for the first,
+    without a thread), run in threads of their own: a slow registry never holds the threads
+    that answer requests."""
     team_id = principal.team_id
     assert team_id is not None
-    submissions.check_opponent(session, team_id=team_id, opponent=body.opponent)
-    submissions.refuse_if_active(session, team_id)
-    team_file = teamfiles.get(session, team_id=team_id, kind="team_config",
-                              version=body.team_config_version)
-    file_id, document = team_file.id, teamfiles.opened(team_file, services.sealer)
-    credentials = teamfiles.newest_id(session, team_id=team_id, kind="credentials")
-    session.commit()  # no connection is held during the pre-flight check
-    assert services.preflight is not None
-    team = teamfiles.validated_team(document)  # the upload's check, today's rules
-    try:
-        elapsed = services.preflight(team, services.settings)
-    except PreflightFailed as failed:
+    claims: submissions.PreflightClaims = services.extras.setdefault(
+        "preflight_claims", submissions.PreflightClaims())
+    async with claims.claim(team_id):
+        team, file_id, credentials = await run_in_threadpool(
+            _before_preflight, services, team_id, body)
+        assert services.preflight is not None
+        limiter = services.extras.get("preflight_limiter")
+        if limiter is None:
+            limiter = services.extras.setdefault(
+                "preflight_limiter", anyio.CapacityLimiter(max(1, services.settings.threads)))
+        try:
+            elapsed = await anyio.to_thread.run_sync(services.preflight, team,
+                                                     services.settings, limiter=limiter)
+        except PreflightFailed as failed:
+            await run_in_threadpool(_refuse, services, file_id, failed)
+            raise
+        return await run_in_threadpool(_after_preflight, services, request, principal, body,
+                                       file_id, credentials, elapsed)
+
+
+def _before_preflight(services: Services, team_id: int, body: SubmissionCreate
+                      ) -> tuple[TeamConfig, int, int | None]:
+    """The checks made before the pre-flight: (the team, its file's id, its credentials'
+    id); no connection is held during the pre-flight."""
+    with services.sessions() as session, session.begin():
+        submissions.check_opponent(session, team_id=team_id, opponent=body.opponent)
+        submissions.refuse_if_active(session, team_id)
+        team_file = teamfiles.get(session, team_id=team_id, kind="team_config",
+                                  version=body.team_config_version)
+        file_id, document = team_file.id, teamfiles.opened(team_file, services.sealer)
+        credentials = teamfiles.newest_id(session, team_id=team_id, kind="credentials")
+    return teamfiles.validated_team(document), file_id, credentials  # today's rules
+
+
+def _refuse(services: Services, file_id: int, failed: PreflightFailed) -> None:
+    with services.sessions() as session, session.begin():
         teamfiles.refuse(session, teamfiles.get_by_id(session, file_id), stage=failed.stage,
                          cause=failed.cause)
-        session.commit()
-        raise
-    row = submissions.create(session, team_id=team_id, opponent=body.opponent,
-                             team_file_id=file_id, credentials_file_id=credentials,
-                             preflight_s=elapsed)
-    session.commit()
-    services.changed(row.id)
-    if services.worker is not None:
-        services.worker.wake()
-    view = view_of(request, session, row, principal.team_name)
-    services.status.put(row.id, team_id, view.model_dump_json().encode())
+
+
+def _after_preflight(services: Services, request: Request, principal: Principal,
+                     body: SubmissionCreate, file_id: int, credentials: int | None,
+                     elapsed: float) -> SubmissionView:
+    assert principal.team_id is not None
+    with services.sessions() as session:
+        with session.begin():
+            row = submissions.create(session, team_id=principal.team_id,
+                                     opponent=body.opponent, team_file_id=file_id,
+                                     credentials_file_id=credentials, preflight_s=elapsed)
+        services.changed(row.id)
+        if services.worker is not None:
+            services.worker.wake()
+        with session.begin():
+            view = view_of(request, session, row, principal.team_name)
+    services.status.put(row.id, principal.team_id, view.model_dump_json().encode())
     return view
 
 

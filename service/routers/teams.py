@@ -14,10 +14,10 @@ from starlette.concurrency import run_in_threadpool
 from service import outbound, sealing, teamfiles
 from service.bodies import read_json_body
 from service.db import Team, utc
-from service.deps import AppServices, DbSession, TeamPrincipal
+from service.deps import AppServices, DbSession, SessionRoute, TeamPrincipal
 from service.errors import NotFound
 
-router = APIRouter(prefix="/v1/team", tags=["team"])
+router = APIRouter(prefix="/v1/team", tags=["team"], route_class=SessionRoute)
 
 
 class TeamView(BaseModel):
