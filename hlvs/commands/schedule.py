@@ -58,7 +58,8 @@ def register(sub: Any) -> None:
     plan = verbs.add_parser("list", help="what is planned, with absolute times")
     plan.add_argument("schedule", type=user_path, help="schedule file (YAML)")
     plan.add_argument(
-        "--state", type=user_path, help="use the reference time recorded in this state file"
+        "--state", type=user_path, help="the times this tournament's state file keeps "
+        "(rescheduled and applied ones), with each match's state"
     )
     plan.add_argument("--json", action="store_true", help="print a JSON array")
     plan.set_defaults(func=_list)
@@ -191,13 +192,29 @@ def _list(args: argparse.Namespace) -> int:
     schedule = load_schedule(args.schedule)
     now = datetime.now(UTC)
     reference = now
-    if args.state:
-        recorded = _ledger(args.state).get_meta("reference")
-        reference = datetime.fromisoformat(recorded) if recorded else now
-    elif schedule.start not in (None, "now"):
+    if schedule.start not in (None, "now"):
         reference = resolve_time(str(schedule.start), now)
     if args.state:
-        _warn_differences(_ledger(args.state))
+        ledger = _ledger(args.state)
+        _warn_differences(ledger)
+        classes = {m.id: m.field_class for m in schedule.matches}
+        rows = [  # the times the tournament keeps (rescheduled, applied), not the file's
+            {
+                "id": r.id,
+                "kind": r.kind,
+                "class": classes.get(r.id, ""),
+                "red": r.red,
+                "blue": r.blue,
+                "pull_at": r.pull_at.isoformat(timespec="seconds"),
+                "play_at": r.play_at.isoformat(timespec="seconds"),
+                "stream_start": r.stream_start.isoformat(timespec="seconds"),
+                "deliver_at": r.deliver_at.isoformat(timespec="seconds"),
+                "state": r.state.value,
+            }
+            for r in ledger.rows()
+        ]
+        _print_plan(rows, as_json=args.json)
+        return 0
     rows = [
         {
             "id": p.match.id,
@@ -212,15 +229,20 @@ def _list(args: argparse.Namespace) -> int:
         }
         for p in sorted(schedule.plan(reference), key=lambda p: (p.stream_start, p.match.id))
     ]
-    if args.json:
-        print(json.dumps(rows, indent=2))
-    else:
-        for r in rows:
-            print(
-                f"{r['id']:<12} {r['kind']:<11} {r['red']} v {r['blue']}: pull {r['pull_at']},"
-                f" play {r['play_at']}, stream {r['stream_start']}"
-            )
+    _print_plan(rows, as_json=args.json)
     return 0
+
+
+def _print_plan(rows: list[dict[str, str]], *, as_json: bool) -> None:
+    if as_json:
+        print(json.dumps(rows, indent=2))
+        return
+    for r in rows:
+        state = f" ({r['state']})" if "state" in r else ""
+        print(
+            f"{r['id']:<12} {r['kind']:<11} {r['red']} v {r['blue']}: pull {r['pull_at']},"
+            f" play {r['play_at']}, stream {r['stream_start']}{state}"
+        )
 
 
 def _status(args: argparse.Namespace) -> int:

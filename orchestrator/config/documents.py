@@ -124,7 +124,7 @@ ScheduleMatchDocument = TypedDict(
         "stream_start": str,
         "stream_length_s": NotRequired[float],
         "class": NotRequired[Literal["KID", "ADULT"]],
-        "kind": NotRequired[Literal["round_robin", "knockout"]],
+        "kind": NotRequired[Literal["round_robin", "knockout", "friendly"]],
     },
 )
 

@@ -33,7 +33,9 @@ from orchestrator.config.documents import (
 from orchestrator.config.game import default_real_time_factor
 from orchestrator.errors import ConfigError, Problem
 
-MatchKind = Literal["round_robin", "knockout"]
+MatchKind = Literal["round_robin", "knockout", "friendly"]
+"""round_robin: counts in the standings; knockout: a KNOCKOUT game (extra time, shoot-out);
+friendly: a NORMAL game that counts nowhere."""
 _OFFSET = re.compile(r"^\+(\d+(?:\.\d+)?)([smhd])$")
 _UNIT_S = {"s": 1.0, "m": 60.0, "h": 3600.0, "d": 86400.0}
 

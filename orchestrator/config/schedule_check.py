@@ -155,7 +155,7 @@ def _lenient_match(m: dict[str, Any]) -> ScheduledMatch:
         red=_slot(m["red"]),
         blue=_slot(m["blue"]),
         field_class=field_class if field_class in ("KID", "ADULT") else "KID",
-        kind=kind if kind in ("round_robin", "knockout") else "round_robin",
+        kind=kind if kind in ("round_robin", "knockout", "friendly") else "round_robin",
         stream_start=str(m["stream_start"]),
         stream_length_s=float(m.get("stream_length_s", 1800.0)),
     )
@@ -178,8 +178,8 @@ def _timing_problems(path: Path, schedule: Schedule) -> list[Problem]:
     timing = schedule.timing
     for kind, name in (("round_robin", "pull_lead_round_robin_s"),
                        ("knockout", "pull_lead_knockout_s")):
-        if not any(m.kind == kind for m in schedule.matches):
-            continue
+        if not any((m.kind == "knockout") == (kind == "knockout") for m in schedule.matches):
+            continue  # friendly matches are pulled as round-robin ones
         if timing.play_after_pull_s >= timing.pull_lead_s(kind):  # type: ignore[arg-type]
             problems.append(Problem(
                 str(path), "/timing/play_after_pull_s",

@@ -229,3 +229,51 @@ def test_apply_of_an_unrelated_edit_keeps_the_times_given_by_hand(
     assert "match m2: stream" in out
     assert ledger.row("m3").stream_start == m3 and ledger.row("m3").state is S.PLANNED
     assert "match m3: the file's stream" in out and "has passed" in out
+
+
+def test_list_with_a_state_prints_the_times_the_state_keeps(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = write_schedule(
+        tmp_path, "matches:\n  - {id: m1, red: alpha, blue: bravo, stream_start: '+2h'}\n")
+    state = tmp_path / "state.sqlite"
+    init_state(path, state)
+    moved = (datetime.now(UTC) + timedelta(hours=7)).replace(microsecond=0)
+    assert main(["schedule", "reschedule", "m1", "--state", str(state), "--at",
+                 moved.isoformat()]) == 0
+    capsys.readouterr()
+    assert main(["schedule", "list", str(path), "--state", str(state), "--json"]) == 0
+    [row] = json.loads(capsys.readouterr().out)
+    assert row["stream_start"] == moved.isoformat() and row["state"] == "PLANNED"
+    assert main(["schedule", "list", str(path), "--state", str(state)]) == 0
+    assert f"stream {moved.isoformat()} (PLANNED)" in capsys.readouterr().out
+
+
+def test_status_watch_started_before_run_waits_for_the_state_file(tmp_path: Path) -> None:
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    path = write_schedule(
+        tmp_path, "matches:\n  - {id: m1, red: alpha, blue: bravo, stream_start: '+2h'}\n")
+    state = tmp_path / "state.sqlite"
+    watch = subprocess.Popen(
+        [sys.executable, "-m", "hlvs.cli", "schedule", "status", "--state", str(state),
+         "--watch", "--every", "0.2"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+        text=True, env={**os.environ, "PYTHONUNBUFFERED": "1"})
+    try:
+        assert watch.stdout is not None
+        first = watch.stdout.readline()
+        assert first.startswith(f"waiting for {state}"), first
+        time.sleep(1.0)
+        assert watch.poll() is None  # still waiting, not exited
+        init_state(path, state)
+        deadline = time.monotonic() + 30
+        seen = ""
+        while "m1" not in seen and time.monotonic() < deadline:
+            seen += watch.stdout.readline()
+        assert "m1" in seen and "PLANNED" in seen
+    finally:
+        watch.send_signal(signal.SIGINT)
+        watch.wait(timeout=10)

@@ -340,3 +340,25 @@ def test_two_tournaments_on_one_host_never_meet_on_a_match_id(tmp_path: Path) ->
     assert ids == ["spring-cup-2026-rr-1", "autumn-cup-2026-rr-1"]
     long = load_schedule(path)
     assert len(long.league_match_id("x" * 60)) <= 64
+
+
+def test_a_friendly_match_plays_a_normal_game_and_counts_nowhere(tmp_path: Path) -> None:
+    from orchestrator.config.schedule import game_document
+
+    path = write_schedule(
+        tmp_path,
+        COMPRESSED + "matches:\n  - {id: f1, kind: friendly, red: alpha, blue: bravo,"
+        " stream_start: '+3.5s', stream_length_s: 0.2}\n"
+        "  - {id: m1, red: charlie, blue: delta, stream_start: '+3.8s', stream_length_s: 0.2}\n")
+    schedule = load_schedule(path)
+    friendly = schedule.match("f1")
+    assert friendly.kind == "friendly"
+    assert game_document(schedule, friendly, schedule.team("alpha"),
+                         schedule.team("bravo"))["type"] == "NORMAL"
+    state = tmp_path / "state.sqlite"
+    assert run_schedule(path, state, services=FAKE, exit_when_done=True, poll_s=0.1) == 0
+    rows = Ledger(state).rows()
+    assert {r.id: r.state for r in rows} == {"f1": ScheduledMatchState.DELIVERED,
+                                             "m1": ScheduledMatchState.DELIVERED}
+    table = {s.team: s.played for s in standings(rows, TEAMS)}
+    assert table == {"alpha": 0, "bravo": 0, "charlie": 1, "delta": 1}
