@@ -12,12 +12,13 @@ from fastapi import FastAPI
 
 from service import Settings
 from service import create_app as create_service_app
-from viewer import ladder_page, service_pages, tournament_pages
+from viewer import api_docs, ladder_page, service_pages, tournament_pages
 
 MOUNTS = (  # the ladder before the viewer's /watch/*
     ladder_page.mount,
     service_pages.mount,
     tournament_pages.mount,  # the tournament's overview, replays and live views (operators)
+    api_docs.mount,  # /docs from the package's Swagger UI (no CDN)
 )
 
 

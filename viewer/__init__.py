@@ -14,7 +14,7 @@ from viewer.errors import ExportError, SourceError, ViewerError
 from viewer.sources import Catalog, LiveSource, ReplaySource
 
 if TYPE_CHECKING:
-    from viewer import ladder_page, service_pages, tournament_pages
+    from viewer import api_docs, ladder_page, service_pages, tournament_pages
     from viewer.cli import export, view
     from viewer.snapshot import game_snapshot
 
@@ -25,6 +25,7 @@ __all__ = [
     "ReplaySource",
     "SourceError",
     "ViewerError",
+    "api_docs",
     "export",
     "game_snapshot",
     "ladder_page",
@@ -36,7 +37,7 @@ __all__ = [
 
 if not TYPE_CHECKING:
     __getattr__, __dir__ = lazy_exports(__name__, {
-        "viewer": ("ladder_page", "service_pages", "tournament_pages"),
+        "viewer": ("api_docs", "ladder_page", "service_pages", "tournament_pages"),
         "viewer.cli": ("export", "view"),
         "viewer.snapshot": ("game_snapshot",),
     })

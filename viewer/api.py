@@ -7,13 +7,15 @@ the page from the path. API under ``/api/viewer``:
 - ``GET index``: the replays and live matches known;
 - ``GET replays/<id>/meta``: match id, format version, frame rate, duration, body count, the
   scene (``simulator.replay.scene``), the chunk index ``[[first_ms, last_ms, frames]...]``, the
-  referee events (each with the ``frame_ms`` it was recorded with) and whether statistics exist;
+  referee events (each with the ``frame_ms`` it was recorded with), whether statistics exist
+  and the teams' names (``{"red": ..., "blue": ...}``, null when not known);
 - ``GET replays/<id>/chunks/<k>``: one chunk of frames, binary: u32 JSON length, JSON
   ``{"times": [...], "games": [...]}``, zero padding to 4 bytes, then float32 poses
   (frames x bodies x 7, little-endian);
 - ``GET replays/<id>/stats``: the ``api_stats.jsonl`` samples as a JSON list;
-- ``GET live/<id>/stream``: server-sent events ``scene``, ``state``, ``event``, ``poses``
-  (base64 of the telemetry's binary poses) from the match's telemetry.
+- ``GET live/<id>/stream``: server-sent events ``teams`` (first, when the names are known),
+  ``scene``, ``state``, ``event``, ``poses`` (base64 of the telemetry's binary poses) from the
+  match's telemetry.
 """
 
 from __future__ import annotations
@@ -35,7 +37,7 @@ from contracts import files
 from simulator import ReplayError, read_stats
 from simulator.replay import ReplayFile, SceneRecord, scene_for
 from viewer.live import FeedFactory, LiveUnavailable, ZenohFeed
-from viewer.sources import Catalog, LiveSource, ReplaySource
+from viewer.sources import Catalog, LiveSource, ReplaySource, Teams
 
 STATIC = Path(__file__).parent / "static"
 API_PREFIX = "/api/viewer"
@@ -93,7 +95,7 @@ class CatalogResolver:
             folder = live.replay_path.parents[2]
             for path in (folder / "public" / files.REPLAY, live.replay_path):
                 if path.is_file():
-                    source = self.catalog.add_replay(path, id=replay_id)
+                    source = self.catalog.add_replay(path, id=replay_id, teams=live.teams)
                     break
         if source is None:
             raise _missing("replay", replay_id, list(self.catalog.replays))
@@ -131,8 +133,10 @@ def build_router(resolver: Any, *, feed_factory: FeedFactory = ZenohFeed,
             except HTTPException:
                 continue
             listing.append({"id": source.id, "match_id": replay.header.match_id,
-                            "duration_ms": replay.duration_ms, "version": replay.header.version})
-        return {"replays": listing, "live": [{"id": source.id} for source in live]}
+                            "duration_ms": replay.duration_ms, "version": replay.header.version,
+                            "teams": _teams(source.teams)})
+        return {"replays": listing,
+                "live": [{"id": source.id, "teams": _teams(source.teams)} for source in live]}
 
     @router.get(f"{API_PREFIX}/replays/{{replay_id}}/meta")
     def meta(source: ReplaySource = by_id) -> dict[str, Any]:
@@ -149,6 +153,7 @@ def build_router(resolver: Any, *, feed_factory: FeedFactory = ZenohFeed,
             "events": list(replay.events),
             "scene": scene,
             "has_stats": source.stats_path is not None,
+            "teams": _teams(source.teams),
         }
 
     @router.get(f"{API_PREFIX}/replays/{{replay_id}}/chunks/{{index}}")
@@ -179,7 +184,8 @@ def build_router(resolver: Any, *, feed_factory: FeedFactory = ZenohFeed,
     @router.get(f"{API_PREFIX}/live/{{match_id}}/stream")
     async def stream(live: LiveSource = live_by_id) -> StreamingResponse:
         return StreamingResponse(
-            _sse(live.endpoint, live.match_id, feed_factory), media_type="text/event-stream",
+            _sse(live.endpoint, live.match_id, feed_factory, teams=live.teams),
+            media_type="text/event-stream",
             headers={"Cache-Control": "no-cache"},
         )
 
@@ -196,7 +202,12 @@ def build_router(resolver: Any, *, feed_factory: FeedFactory = ZenohFeed,
 _SSE_NAMES = {"state": "state", "events": "event", "poses": "poses", "scene": "scene"}
 
 
-async def _sse(endpoint: str, match_id: str, factory: FeedFactory) -> AsyncIterator[bytes]:
+def _teams(teams: Teams | None) -> dict[str, str] | None:
+    return teams.as_json() if teams is not None else None
+
+
+async def _sse(endpoint: str, match_id: str, factory: FeedFactory, *,
+               teams: Teams | None = None) -> AsyncIterator[bytes]:
     loop = asyncio.get_running_loop()
     queue: asyncio.Queue[tuple[str, bytes]] = asyncio.Queue(maxsize=256)
 
@@ -216,6 +227,8 @@ async def _sse(endpoint: str, match_id: str, factory: FeedFactory) -> AsyncItera
         return
     try:
         yield b": connected\n\n"
+        if teams is not None:
+            yield f"event: teams\ndata: {json.dumps(teams.as_json())}\n\n".encode()
         while True:
             try:
                 kind, payload = await asyncio.wait_for(queue.get(), KEEPALIVE_S)

@@ -22,10 +22,22 @@ _REPLAY_PLACES = (f"public/{files.REPLAY}", f"simulator/{files.OUT_DIR}/{files.R
 
 
 @dataclass(frozen=True, slots=True)
+class Teams:
+    """The teams' names, as the pages' scoreboard shows them."""
+
+    red: str
+    blue: str
+
+    def as_json(self) -> dict[str, str]:
+        return {"red": self.red, "blue": self.blue}
+
+
+@dataclass(frozen=True, slots=True)
 class ReplaySource:
     id: str
     path: Path
     stats_path: Path | None
+    teams: Teams | None = None  # None: not known (a replay file alone)
 
 
 @dataclass(frozen=True, slots=True)
@@ -34,6 +46,7 @@ class LiveSource:
     match_id: str  # telemetry keys hlvs/<match_id>/...
     endpoint: str  # zenoh endpoint, e.g. tcp/10.213.4.2:7447
     replay_path: Path | None  # where the replay is being written (shown once the match is over)
+    teams: Teams | None = None
 
 
 @dataclass(slots=True)
@@ -43,12 +56,14 @@ class Catalog:
     replays: dict[str, ReplaySource] = field(default_factory=dict)
     live: dict[str, LiveSource] = field(default_factory=dict)
 
-    def add_replay(self, path: Path, *, id: str | None = None) -> ReplaySource:
+    def add_replay(self, path: Path, *, id: str | None = None,
+                   teams: Teams | None = None) -> ReplaySource:
         stats = path.with_name(STATS_FILE)
         source = ReplaySource(
             id=self._unique(id or _slug(path)),
             path=path,
             stats_path=stats if stats.is_file() else None,
+            teams=teams or teams_of(_match_folder_of(path)),
         )
         self.replays[source.id] = source
         return source
@@ -91,6 +106,34 @@ class Catalog:
         return opened
 
 
+def _match_folder_of(replay: Path) -> Path:
+    """The match folder of a replay at ``public/`` or ``simulator/out/`` of it (else its own
+    folder)."""
+    if replay.parent.name == "public":
+        return replay.parent.parent
+    if replay.parent.name == files.OUT_DIR and replay.parent.parent.name == "simulator":
+        return replay.parent.parent.parent
+    return replay.parent
+
+
+def teams_of(folder: Path) -> Teams | None:
+    """The teams' names of a match folder, from ``simulator/match_spec.json`` (None when it has
+    none or it cannot be read: the pages then say RED and BLUE)."""
+    spec_path = folder / "simulator" / files.MATCH_SPEC
+    if not spec_path.is_file():
+        return None
+    try:
+        spec = MatchSpec.load(spec_path)
+    except ContractError:
+        return None
+    return _teams(spec)
+
+
+def _teams(spec: MatchSpec) -> Teams | None:
+    red, blue = spec.red.name, spec.blue.name
+    return Teams(red=red, blue=blue) if red and blue else None
+
+
 def _slug_text(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9._-]+", "-", text).strip("-") or "replay"
 
@@ -109,7 +152,7 @@ def live_of(folder: Path, *, id: str | None = None) -> LiveSource | None:
     live = _live_of(folder)
     if live is not None and id is not None:
         return LiveSource(id=id, match_id=live.match_id, endpoint=live.endpoint,
-                          replay_path=live.replay_path)
+                          replay_path=live.replay_path, teams=live.teams)
     return live
 
 
@@ -126,5 +169,6 @@ def _live_of(folder: Path) -> LiveSource | None:
         return None
     replay = folder / "simulator" / files.OUT_DIR / files.REPLAY
     return LiveSource(
-        id=_slug_text(match_id), match_id=match_id, endpoint=str(endpoint), replay_path=replay
+        id=_slug_text(match_id), match_id=match_id, endpoint=str(endpoint), replay_path=replay,
+        teams=_teams(spec),
     )

@@ -7,6 +7,7 @@ schedule's state file (``HLVS_SERVICE_SCHEDULE_STATE``). Operator tokens only.""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -15,7 +16,7 @@ from pydantic import BaseModel
 
 from service import NotFound, OperatorPrincipal, get_services
 from viewer.api import build_router
-from viewer.sources import LiveSource, ReplaySource, live_of
+from viewer.sources import LiveSource, ReplaySource, Teams, live_of
 
 if TYPE_CHECKING:
     from tournament import LiveGame
@@ -83,14 +84,15 @@ class TournamentResolver:
         if path is None:
             raise NotFound(what="replay of tournament match", ident=f"{row.id} ({row.state})")
         stats = path.with_name(files.API_STATS)
-        return ReplaySource(id=row.id, path=path, stats_path=stats if stats.is_file() else None)
+        return ReplaySource(id=row.id, path=path, stats_path=stats if stats.is_file() else None,
+                            teams=Teams(red=row.red, blue=row.blue))
 
     def live(self, match_id: str, request: Request, principal: OperatorPrincipal) -> LiveSource:
         row, folder = _folder(request, match_id)
         live = live_of(folder, id=row.id) if row.state.value == "PLAYING" else None
         if live is None:
             raise NotFound(what="running tournament match", ident=f"{row.id} ({row.state})")
-        return live
+        return replace(live, teams=Teams(red=row.red, blue=row.blue))
 
     def listing(self, request: Request, principal: OperatorPrincipal
                 ) -> tuple[list[ReplaySource], list[LiveSource]]:

@@ -14,13 +14,13 @@ from __future__ import annotations
 import argparse
 import json
 import time
-from collections.abc import Mapping
+from collections.abc import Iterable
 from typing import TYPE_CHECKING, Any
 
 from orchestrator import ExitCode, user_path
 
 if TYPE_CHECKING:
-    from orchestrator import ResolvedImage
+    from orchestrator import ImageError
 
 
 def register(sub: Any) -> None:
@@ -112,15 +112,16 @@ def _pull(args: argparse.Namespace) -> int:
                       f"{retried})")
             else:
                 print(f"player {number}: {image.error}")
-    return pull_exit_code(resolved)
+    return pull_exit_code(image.error for image in resolved.values())
 
 
-def pull_exit_code(resolved: Mapping[int, ResolvedImage]) -> int:
-    """0 when every player has its image; 3 (infrastructure) when every failure is one that
-    trying again may cure (the registry unreachable, a 5xx, a broken connection); else 1."""
+def pull_exit_code(errors: Iterable[ImageError | None]) -> int:
+    """0 when every player has its image (each error None); 3 (infrastructure) when every
+    failure is one that trying again may cure (the registry unreachable, a 5xx, a broken
+    connection); else 1."""
     from orchestrator import ImagePullError
 
-    errors = [image.error for image in resolved.values() if image.error is not None]
+    errors = [error for error in errors if error is not None]
     if not errors:
         return ExitCode.OK
     if all(isinstance(e, ImagePullError) and e.transient for e in errors):

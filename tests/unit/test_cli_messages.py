@@ -10,9 +10,8 @@ from pathlib import Path
 import pytest
 
 from hlvs.cli import build_parser, main
-from orchestrator import ImageError, ImagePullError, Problem
+from orchestrator import ImagePullError, Problem
 from orchestrator.exitcodes import ExitCode
-from orchestrator.pull import ResolvedImage
 
 TEAM = Path(__file__).parents[2] / "configs" / "examples" / "scrimmage_1v1" / "team_red.json"
 
@@ -24,20 +23,15 @@ def _closed_port() -> int:
     return port
 
 
-def _resolved(error: ImageError | None) -> ResolvedImage:
-    return ResolvedImage(number=1, reference="r/x:1", digest="", image_id="", size_bytes=0,
-                         error=error)
-
-
 def test_pull_exit_codes_tell_the_registry_s_failure_from_the_team_s() -> None:
     from hlvs.commands.images import pull_exit_code
 
     unreachable = ImagePullError(image="r/x:1", reason="registry r unreachable", transient=True)
     unknown_tag = ImagePullError(image="r/x:1", reason="tag 1 not found in r/x")
-    assert pull_exit_code({1: _resolved(None)}) == ExitCode.OK
-    assert pull_exit_code({1: _resolved(unreachable), 2: _resolved(unreachable)}) == 3
-    assert pull_exit_code({1: _resolved(unreachable), 2: _resolved(unknown_tag)}) == 1
-    assert pull_exit_code({1: _resolved(unknown_tag)}) == 1
+    assert pull_exit_code([None, None]) == ExitCode.OK
+    assert pull_exit_code([unreachable, None, unreachable]) == ExitCode.INFRASTRUCTURE
+    assert pull_exit_code([unreachable, unknown_tag]) == ExitCode.FAILED
+    assert pull_exit_code([unknown_tag]) == ExitCode.FAILED
 
 
 def test_images_pull_from_an_unreachable_registry_exits_3(

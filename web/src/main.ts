@@ -4,6 +4,7 @@
 import { livePage } from "./pages/live";
 import { indexPage } from "./pages/index";
 import { replayPage } from "./pages/replay";
+import { ladderPage } from "./pages/ladder";
 import { tablePage } from "./pages/tables";
 import { TOURNAMENT_API, tournamentPage } from "./pages/tournament";
 import { type Who, el, signInForm, signOut, token, whoAmI } from "./ui";
@@ -46,11 +47,12 @@ async function route(): Promise<void> {
   }
   const parts = location.pathname.replace(/^\/watch\/?/, "").split("/").filter(Boolean).map(decodeURIComponent);
   try {
-    if (parts[0] === "tournament" && parts[1] === "replay" && parts[2]) await replayPage(root, TOURNAMENT_API, parts[2]);
+    if (parts[0] === "tournament" && parts[1] === "replay" && parts[2]) await replayPage(root, TOURNAMENT_API, parts[2], "/watch/tournament");
     else if (parts[0] === "tournament" && parts[1] === "live" && parts[2]) livePage(root, TOURNAMENT_API, parts[2], "/watch/tournament/replay");
     else if (parts[0] === "tournament") await tournamentPage(root);
     else if (parts[0] === "replay" && parts[1]) await replayPage(root, API, parts[1]);
     else if (parts[0] === "live" && parts[1]) livePage(root, API, parts[1]);
+    else if (parts[0] === "ladder" && service) await ladderPage(root, parts[1]);
     else if (parts[0] && SERVICE_PAGES.includes(parts[0])) await tablePage(root, parts[0], parts[1], who);
     else await indexPage(root, API);
   } catch (error) {

@@ -2,7 +2,7 @@
 // frames on demand, so that opening and seeking never read the whole replay.
 
 import type { SceneSpec } from "./scene";
-import { authFetch } from "./ui";
+import { PageError, type TeamNames, authFetch, sentence } from "./ui";
 
 export interface RefereeEvent {
   type: string;
@@ -34,6 +34,7 @@ export interface ReplayMeta {
   events: RefereeEvent[];
   scene: SceneSpec;
   has_stats: boolean;
+  teams?: TeamNames | null;
 }
 
 interface Chunk {
@@ -53,7 +54,7 @@ export class ReplayData {
 
   static async open(base: string): Promise<ReplayData> {
     const response = await authFetch(`${base}/meta`);
-    if (!response.ok) throw new Error(`${base}/meta: ${response.status} ${await response.text()}`);
+    if (!response.ok) throw new PageError(await sentence(response, `${base}/meta`), response.status);
     return new ReplayData(base, (await response.json()) as ReplayMeta);
   }
 

@@ -28,8 +28,13 @@ export function teamNames(): { red: string | null; blue: string | null } {
   return { red: query.get("red"), blue: query.get("blue") };
 }
 
+/** The teams' names of a match (the viewer API's `teams`), when known. */
+export interface TeamNames { red?: string | null; blue?: string | null }
+
 export class Scoreboard {
   readonly root = el("div", { class: "scoreboard", "data-testid": "scoreboard" });
+  private readonly redName: HTMLElement;
+  private readonly blueName: HTMLElement;
   private readonly red = el("span", { class: "score red", "data-testid": "score-red" }, "0");
   private readonly blue = el("span", { class: "score blue", "data-testid": "score-blue" }, "0");
   // before the first state arrives: the game has not started (no "-" and "--:--" placeholders)
@@ -37,17 +42,27 @@ export class Scoreboard {
   private readonly clockText = el("span", { class: "clock", "data-testid": "game-clock" }, "");
 
   /** `names`: the teams' names (default: the page's `?red=...&blue=...`, else RED and BLUE). */
-  constructor(title: string, names: { red?: string | null; blue?: string | null } = teamNames()) {
+  constructor(title: string, names: TeamNames | null = null) {
+    this.redName = el("span", { class: "team red", "data-testid": "team-red", title: "red" });
+    this.blueName = el("span", { class: "team blue", "data-testid": "team-blue", title: "blue" });
+    this.setNames(names);
     this.root.append(
       el("span", { class: "title" }, title),
-      el("span", { class: "team red", "data-testid": "team-red" }, names.red || "RED"),
+      this.redName,
       this.red,
       el("span", { class: "colon" }, ":"),
       this.blue,
-      el("span", { class: "team blue", "data-testid": "team-blue" }, names.blue || "BLUE"),
+      this.blueName,
       this.state,
       this.clockText,
     );
+  }
+
+  /** The teams' names, as the server knows them; else those the page was linked with. */
+  setNames(names: TeamNames | null): void {
+    const linked = teamNames();
+    setText(this.redName, names?.red || linked.red || "RED");
+    setText(this.blueName, names?.blue || linked.blue || "BLUE");
   }
 
   /** Called every frame: touches the page only where a text changed (no layout otherwise). */
@@ -155,11 +170,23 @@ export async function sentence(response: Response, url: string): Promise<string>
   return message ? `The service refused: ${message}.` : `The service answered ${response.status} for ${url}.`;
 }
 
-/** An error whose message is a sentence for a person. */
-export class PageError extends Error {}
+/** An error whose message is a sentence for a person; `status`: the HTTP status behind it. */
+export class PageError extends Error {
+  constructor(message: string, readonly status = 0) {
+    super(message);
+  }
+}
+
+/** A table, or the sentence `empty` in its place when there is no row (never a bare header). */
+export function table(testid: string, columns: string[], rows: (string | Node)[][], empty = ""): HTMLElement {
+  if (!rows.length && empty) return el("p", { class: "empty", "data-testid": `${testid}-empty` }, empty);
+  return el("table", { "data-testid": testid },
+    el("tr", {}, ...columns.map((c) => el("th", {}, c))),
+    ...rows.map((cells) => el("tr", {}, ...cells.map((c) => el("td", {}, c)))));
+}
 
 export async function getJson<T>(url: string): Promise<T> {
   const response = await authFetch(url);
-  if (!response.ok) throw new PageError(await sentence(response, url));
+  if (!response.ok) throw new PageError(await sentence(response, url), response.status);
   return (await response.json()) as T;
 }

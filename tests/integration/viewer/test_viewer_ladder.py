@@ -29,6 +29,13 @@ def _rows(page: Any, testid: str) -> list[list[str]]:
     return rows
 
 
+def _sign_in(page: Any, secret: str) -> None:
+    page.wait_for_selector("[data-testid=sign-in-form]")
+    page.locator("[data-testid=token]").fill(secret)
+    page.locator("[data-testid=sign-in]").click()
+    page.wait_for_selector("[data-testid=who]")
+
+
 def test_ladder_page_table_team_history_and_replay(
     start: Callable[..., Served], token: Callable[..., str], pool: FakePool, page: Any,
     tmp_path: Path,
@@ -53,11 +60,12 @@ def test_ladder_page_table_team_history_and_replay(
         expected = http.get("/v1/ladder").json()["teams"]
 
     page.goto(f"{served.url}/watch/ladder")
-    page.wait_for_selector("[data-testid=error]")  # no token yet: a sentence, not JSON
-    error = page.locator("[data-testid=error]").inner_text()
-    assert error.startswith("The ladder needs a team or operator token") and "{" not in error
-    page.locator("[data-testid=token]").fill(secrets["Ant"])
-    page.locator("[data-testid=token-save]").click()
+    page.wait_for_selector("[data-testid=sign-in-form]")  # no token yet: the sign-in, no JSON
+    assert "{" not in page.locator("main").inner_text()
+    _sign_in(page, secrets["Ant"])
+    assert page.locator("nav a").all_inner_texts() == [
+        "live and replays", "our matches", "queue", "ladder"]  # the bar of every page
+    assert page.locator("[data-testid=who]").inner_text().startswith("team Ant")
     rows = _rows(page, "ladder")
     assert [r[1] for r in rows] == [t["team"] for t in expected]
     ratings = [float(r[2]) for r in rows]
@@ -68,8 +76,8 @@ def test_ladder_page_table_team_history_and_replay(
 
     sid, team, opponent = first
     page.goto(f"{served.url}/watch/ladder/{opponent}")  # the opponent of the first friendly
-    page.locator("[data-testid=token]").fill(secrets[opponent])
-    page.locator("[data-testid=token-save]").click()
+    page.locator("[data-testid=sign-out]").click()
+    _sign_in(page, secrets[opponent])
     matches = _rows(page, "ladder-matches")
     assert page.locator("[data-testid=ladder-history] polyline").count() == 1
     oldest = matches[-1]

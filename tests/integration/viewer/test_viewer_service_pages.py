@@ -168,18 +168,47 @@ def test_each_page_with_a_team_token_and_with_an_operator_token(
     nav = page.locator("nav a").all_inner_texts()
     assert nav == ["live and replays", "our matches", "queue", "ladder"]
     page.wait_for_selector("[data-testid=replay-list] li")
-    assert page.locator("[data-testid=replay-list] li").count() == 1
+    assert page.locator("[data-testid=replay-list] li").all_inner_texts() == [
+        "Alpha v Beta: viewer-test (3 s, format 3)"]
+    assert page.locator("[data-testid=live-list-empty]").inner_text() == \
+        "No match is being played now."
     screenshot(page, "role-team-index")
     page.goto(f"{served.url}/watch/submissions")
-    assert [r[0] for r in _rows(page, "submissions")] == [friendly]
+    (mine,) = _rows(page, "submissions")  # a won match says so, with its score
+    assert (mine[0], mine[7], mine[8]) == (friendly, "Alpha 1 : 0 Beta", "won 1-0")
     screenshot(page, "role-team-matches")
+    page.goto(f"{served.url}/watch/replay/{friendly}")  # the scoreboard names the teams
+    page.wait_for_function("window.hlvsViewer && window.hlvsViewer.ready", timeout=30_000)
+    assert page.locator("[data-testid=team-red]").inner_text() == "Alpha"
+    assert page.locator("[data-testid=team-blue]").inner_text() == "Beta"
+    screenshot(page, "role-team-replay-names")
+    page.goto(f"{served.url}/watch/live/{friendly}")  # over: a link to its replay, no empty scene
+    page.wait_for_selector("[data-testid=replay-link]")
+    assert page.locator("[data-testid=live-status]").inner_text().startswith(
+        "This match has ended (Alpha v Beta).")
+    assert page.locator("canvas").count() == 0
+    assert page.locator("[data-testid=scoreboard]").count() == 0
+    screenshot(page, "role-team-live-ended")
+    page.locator("[data-testid=replay-link]").click()
+    page.wait_for_function("window.hlvsViewer && window.hlvsViewer.ready", timeout=30_000)
+    for missing, sentence in (
+            ("replay", 'There is no replay "sub_000000000000" that you may watch.'),
+            ("live", "This match is not being played now, and it has no replay yet")):
+        page.goto(f"{served.url}/watch/{missing}/sub_000000000000")
+        page.wait_for_selector("[data-testid=back-link]")
+        text = _text(page)
+        assert sentence in text and "404" not in text and "/meta" not in text, text
+        screenshot(page, f"role-team-no-such-{missing}")
     page.goto(f"{served.url}/watch/queue")
     (entry,) = _rows(page, "queue")
     assert (entry[1], entry[2], entry[3]) == ("-", "another team", "-")
     screenshot(page, "role-team-queue")
-    page.goto(f"{served.url}/watch/ladder")  # the ladder's own page, signed in already
+    page.goto(f"{served.url}/watch/ladder")  # the ladder, signed in already
     assert [(r[0], r[1], r[5], r[6]) for r in _rows(page, "ladder")] == [
         ("1", "Alpha", "1", "1"), ("2", "Beta", "1", "0")]
+    assert page.locator("nav a").all_inner_texts() == nav  # the same bar as every page
+    assert page.locator("[data-testid=sign-out]").count() == 1
+    assert page.locator("nav input").count() == 0  # no second token box
     screenshot(page, "role-team-ladder")
     page.locator("[data-testid=ladder] a", has_text="Alpha").click()
     (played,) = _rows(page, "ladder-matches")
@@ -193,13 +222,30 @@ def test_each_page_with_a_team_token_and_with_an_operator_token(
         assert words in _text(page), path
     screenshot(page, "role-team-operator-page")
 
+    _use_token(page, served.url, beta_secret, "/watch/submissions")  # the opponent's view
+    row = next(r for r in _rows(page, "submissions") if r[0] == friendly)
+    assert (row[7], row[8]) == ("Alpha 1 : 0 Beta", "lost 0-1")
+    gamma = token("Gamma")  # a team without matches: sentences, not empty tables
+    _use_token(page, served.url, gamma, "/watch/submissions")
+    assert "No matches yet" in page.locator("[data-testid=submissions-empty]").inner_text()
+    page.goto(f"{served.url}/watch/")
+    assert "No replay yet" in page.locator("[data-testid=replay-list-empty]").inner_text()
+    screenshot(page, "role-team-empty-index")
+    page.goto(f"{served.url}/watch/replay/{friendly}")  # another team's match
+    text = _text(page)
+    assert f'There is no replay "{friendly}" that you may watch.' in text, text
+    screenshot(page, "role-team-forbidden-replay")
+
     _use_token(page, served.url, token(operator=True), "/watch/")
     assert page.locator("nav a").all_inner_texts()[-3:] == ["tournament", "standings", "pool"]
     page.wait_for_selector("[data-testid=replay-list] li")
     assert page.locator("[data-testid=replay-list] li").count() == 1
     screenshot(page, "role-operator-index")
     page.goto(f"{served.url}/watch/submissions")
-    assert {r[1] for r in _rows(page, "submissions")} == {friendly, waiting}
+    every = {r[1]: r for r in _rows(page, "submissions")}
+    assert set(every) == {friendly, waiting}
+    assert (every[friendly][8], every[friendly][9]) == ("Alpha 1 : 0 Beta", "Alpha won 1-0")
+    assert (every[waiting][8], every[waiting][9]) == ("-", "-")
     screenshot(page, "role-operator-matches")
     page.goto(f"{served.url}/watch/queue")
     assert [r[1] for r in _rows(page, "queue")] == [waiting]
@@ -210,14 +256,36 @@ def test_each_page_with_a_team_token_and_with_an_operator_token(
     screenshot(page, "role-operator-tournament")
     page.goto(f"{served.url}/watch/nodes")
     assert _rows(page, "nodes")[0][0] == "fake-node"
-    page.goto(f"{served.url}/watch/live/{waiting}")  # the fake pool: no telemetry to watch
+    page.goto(f"{served.url}/watch/live/{waiting}")  # queued: not started, nothing to watch
     page.wait_for_function("document.querySelector('[data-testid=live-status]')?.innerText"
-                           ".startsWith('Live view unavailable.')")
-    assert page.locator("[data-testid=game-state]").inner_text() == "not started"
-    assert page.locator("[data-testid=game-clock]").inner_text() == ""
-    assert "no running match of submission" in _text(page)
+                           ".startsWith('This match is not being played now')")
+    assert page.locator("canvas").count() == 0
+    assert page.locator("[data-testid=scoreboard]").count() == 0
+    assert "it may not have started" in _text(page)
     screenshot(page, "role-operator-live-not-started")
     page.goto(f"{served.url}/watch/replay/{friendly}")
     page.wait_for_function("window.hlvsViewer && window.hlvsViewer.ready", timeout=30_000)
     alpha.close()
     beta.close()
+
+
+def test_docs_render_without_the_internet(start: Callable[..., Served], page: Any) -> None:
+    """/docs draws the API from the package's Swagger UI with every request off this host
+    refused (a machine without the internet)."""
+    served = start()
+    outside: list[str] = []
+
+    def only_here(route: Any) -> None:
+        if route.request.url.startswith(served.url):
+            route.continue_()
+        else:
+            outside.append(route.request.url)
+            route.abort()
+
+    page.route("**/*", only_here)
+    page.goto(f"{served.url}/docs")
+    page.wait_for_selector(".opblock", timeout=30_000)
+    assert page.locator(".opblock").count() > 10
+    assert "submission service" in page.locator(".title").first.inner_text()
+    assert outside == []
+    screenshot(page, "service-docs-offline")

@@ -140,14 +140,33 @@ def test_the_live_stream_relays_telemetry_as_server_sent_events(tmp_path: Path) 
                 kind = line[7:]
             elif line.startswith("data: "):
                 events.append((kind, line[6:]))
-                if len(events) == 4:
+                if len(events) == 5:
                     break
-    assert [k for k, _ in events] == ["scene", "state", "poses", "event"]
-    assert events[1][1] == '{"sim_time_ms": 1234}'
+    assert [k for k, _ in events] == ["teams", "scene", "state", "poses", "event"]
+    assert json.loads(events[0][1]) == {"red": spec.red.name, "blue": spec.blue.name}
+    assert events[2][1] == '{"sim_time_ms": 1234}'
     import base64
 
-    raw = base64.b64decode(events[2][1])
+    raw = base64.b64decode(events[3][1])
     assert struct.unpack_from("<I", raw)[0] == 1234 and len(raw) == 4 + 14 * 4
+
+
+def test_meta_and_index_name_the_teams_of_a_match_folder(tmp_path: Path) -> None:
+    folder = tmp_path / "named"
+    record_match(folder, seconds=1.0)
+    spec = to_match_spec(load_game(EXAMPLES / "scrimmage_1v1" / "game.json"), robot_addresses={},
+                         telemetry_listen="")
+    spec = replace(spec, red=replace(spec.red, name="Ants"), blue=replace(spec.blue, name="Bees"))
+    spec.write(folder / "simulator" / "match_spec.json")
+    bare = tmp_path / "bare"
+    record_match(bare, seconds=1.0)
+    client, pages = _client(folder, bare / "public" / "replay.hlvsrec")
+    assert pages == ["/watch/replay/named", "/watch/replay/bare"]
+    teams = {"red": "Ants", "blue": "Bees"}
+    assert client.get("/api/viewer/replays/named/meta").json()["teams"] == teams
+    assert client.get("/api/viewer/replays/bare/meta").json()["teams"] is None
+    listing = client.get("/api/viewer/index").json()["replays"]
+    assert [(r["id"], r["teams"]) for r in listing] == [("named", teams), ("bare", None)]
 
 
 def test_hlvs_view_names_a_path_without_a_replay(tmp_path: Path) -> None:

@@ -1,9 +1,17 @@
 // The index: replays and live matches this server knows.
-import { el, getJson } from "../ui";
+import { type TeamNames, el, getJson } from "../ui";
 
 interface Listing {
-  replays: { id: string; match_id: string; duration_ms: number; version: number }[];
-  live: { id: string }[];
+  replays: { id: string; match_id: string; duration_ms: number; version: number; teams?: TeamNames | null }[];
+  live: { id: string; teams?: TeamNames | null }[];
+}
+
+function versus(teams: TeamNames | null | undefined): string {
+  return teams?.red && teams.blue ? `${teams.red} v ${teams.blue}: ` : "";
+}
+
+function list(testid: string, items: HTMLElement[], empty: string): HTMLElement {
+  return items.length ? el("ul", { "data-testid": testid }, ...items) : el("p", { class: "empty", "data-testid": `${testid}-empty` }, empty);
 }
 
 export async function indexPage(root: HTMLElement, api: string): Promise<void> {
@@ -11,9 +19,11 @@ export async function indexPage(root: HTMLElement, api: string): Promise<void> {
   root.append(
     el("h1", {}, "hlvs-runner"),
     el("h2", {}, "Live"),
-    el("ul", { "data-testid": "live-list" }, ...listing.live.map((m) => el("li", {}, el("a", { href: `/watch/live/${encodeURIComponent(m.id)}` }, m.id)))),
+    list("live-list", listing.live.map((m) => el("li", {}, el("a", { href: `/watch/live/${encodeURIComponent(m.id)}` }, `${versus(m.teams)}${m.id}`))),
+      "No match is being played now."),
     el("h2", {}, "Replays"),
-    el("ul", { "data-testid": "replay-list" }, ...listing.replays.map((r) =>
-      el("li", {}, el("a", { href: `/watch/replay/${encodeURIComponent(r.id)}` }, `${r.match_id} (${Math.round(r.duration_ms / 1000)} s, format ${r.version})`)))),
+    list("replay-list", listing.replays.map((r) =>
+      el("li", {}, el("a", { href: `/watch/replay/${encodeURIComponent(r.id)}` }, `${versus(r.teams)}${r.match_id} (${Math.round(r.duration_ms / 1000)} s, format ${r.version})`))),
+    "No replay yet: a match's replay appears here when it ends."),
   );
 }

@@ -2,16 +2,17 @@
 // from the viewer API), the real-time factor and each robot's connection health.
 import type { GameState, RefereeEvent } from "../replay";
 import { SceneView, type SceneSpec } from "../scene";
-import { Scoreboard, authFetch, authHeaders, clock, describeEvent, el, sentence } from "../ui";
+import { Scoreboard, type TeamNames, authFetch, authHeaders, clock, describeEvent, el, sentence } from "../ui";
 
 type Handler = (data: string) => void;
 
 /** Server-sent events read with fetch, so that the token goes in a header (EventSource
- * cannot send one). Calls `handlers[event]` with each message's data. */
-async function readEvents(url: string, handlers: Record<string, Handler>, status: HTMLElement): Promise<void> {
+ * cannot send one). Calls `handlers[event]` with each message's data; `refused` with the
+ * answer when the server has no stream to give. */
+async function readEvents(url: string, handlers: Record<string, Handler>, refused: (response: Response) => Promise<void>): Promise<void> {
   const response = await fetch(url, { headers: { ...authHeaders(), Accept: "text/event-stream" } });
   if (!response.ok || !response.body) {
-    status.textContent = `Live view unavailable. ${await sentence(response, url)}`;
+    await refused(response);
     return;
   }
   const reader = response.body.pipeThrough(new TextDecoderStream()).getReader();
@@ -49,6 +50,25 @@ function decodePoses(b64: string): { timeMs: number; poses: Float32Array } {
   return { timeMs: view.getUint32(0, true), poses: new Float32Array(bytes.buffer.slice(4)) };
 }
 
+/** No live view: the match has ended (a link to its replay), or is not playing now. The page
+ * shows this sentence alone, not an empty scoreboard over an empty scene. */
+async function notLive(root: HTMLElement, api: string, matchId: string, replayBase: string, response: Response, url: string): Promise<void> {
+  const replay = await authFetch(`${api}/replays/${encodeURIComponent(matchId)}/meta`).catch(() => null);
+  const title = el("h1", {}, `${matchId}`);
+  if (replay?.ok) {
+    const teams = ((await replay.json()) as { teams?: TeamNames | null }).teams;
+    root.replaceChildren(title, el("p", { "data-testid": "live-status" },
+      `This match has ended${teams?.red && teams.blue ? ` (${teams.red} v ${teams.blue})` : ""}. `,
+      el("a", { href: `${replayBase}/${encodeURIComponent(matchId)}${location.search}`, "data-testid": "replay-link" }, "Watch its replay"), "."));
+    return;
+  }
+  const text = response.status === 404
+    ? "This match is not being played now, and it has no replay yet: it may not have started (reload this page when it has), it may have ended without one, or it may be another team's."
+    : `Live view unavailable. ${await sentence(response, url)}`;
+  root.replaceChildren(title, el("p", { class: "error", "data-testid": "live-status" }, text),
+    el("p", {}, el("a", { href: "/watch/", "data-testid": "back-link" }, "the matches you may watch")));
+}
+
 export function livePage(root: HTMLElement, api: string, matchId: string, replayBase = "/watch/replay"): void {
   const board = new Scoreboard(`${matchId} (live)`);
   const status = el("div", { class: "live-status", "data-testid": "live-status" }, "waiting for telemetry...");
@@ -66,6 +86,7 @@ export function livePage(root: HTMLElement, api: string, matchId: string, replay
   let simTimeMs = 0;
   let rtf = 0;
   const handlers: Record<string, Handler> = {};
+  handlers.teams = (data) => board.setNames(JSON.parse(data) as TeamNames);
   handlers.scene = (data) => {
     if (view) return;
     const header = JSON.parse(data) as { scene: SceneSpec };
@@ -108,7 +129,8 @@ export function livePage(root: HTMLElement, api: string, matchId: string, replay
   handlers.end = () => {
     status.textContent += "  (stream closed)";
   };
-  readEvents(`${api}/live/${encodeURIComponent(matchId)}/stream`, handlers, status).catch((error) => {
+  const streamUrl = `${api}/live/${encodeURIComponent(matchId)}/stream`;
+  readEvents(streamUrl, handlers, (response) => notLive(root, api, matchId, replayBase, response, streamUrl)).catch((error) => {
     status.textContent += `  (stream lost: ${error})`;
   });
   // When the telemetry falls silent, the match is over (or stopped): offer its replay.

@@ -2,17 +2,38 @@
 // referee's events on a clickable timeline.
 import { ReplayData, type RefereeEvent } from "../replay";
 import { SceneView } from "../scene";
-import { Scoreboard, clock, describeEvent, el, setText } from "../ui";
+import { PageError, Scoreboard, clock, describeEvent, el, setText } from "../ui";
 import { drawStats } from "./plots";
 
 const SPEEDS = [0.25, 0.5, 1, 2, 4, 8, 16];
 const EVENT_LEAD_MS = 2000; // clicking an event shows the 2 s before it
 const TIMELINE_TYPES = new Set(["goal", "penalty", "card", "ball_out", "kickoff", "dropped_ball", "state"]);
 
-export async function replayPage(root: HTMLElement, api: string, replayId: string): Promise<void> {
-  const data = await ReplayData.open(`${api}/replays/${encodeURIComponent(replayId)}`);
+/** Why a replay cannot be shown, as a sentence and a way on (never the API's raw answer). */
+function unavailable(root: HTMLElement, replayId: string, error: unknown, back: string): void {
+  const status = error instanceof PageError ? error.status : 0;
+  const text = status === 404
+    ? `There is no replay "${replayId}" that you may watch. The match may not have ended yet (its replay is written when it ends), it may be another team's, or the link may be mistyped.`
+    : status === 422
+      ? `The replay of "${replayId}" cannot be read: its file is damaged or of an unknown format.`
+      : error instanceof Error ? error.message : String(error);
+  root.replaceChildren(
+    el("h1", {}, "Replay not available"),
+    el("p", { class: "error", "data-testid": "error" }, text),
+    el("p", {}, el("a", { href: back, "data-testid": "back-link" }, "the matches you may watch")),
+  );
+}
+
+export async function replayPage(root: HTMLElement, api: string, replayId: string, back = "/watch/"): Promise<void> {
+  let data: ReplayData;
+  try {
+    data = await ReplayData.open(`${api}/replays/${encodeURIComponent(replayId)}`);
+  } catch (error) {
+    unavailable(root, replayId, error, back);
+    return;
+  }
   const meta = data.meta;
-  const board = new Scoreboard(meta.match_id);
+  const board = new Scoreboard(meta.match_id, meta.teams ?? null);
   const canvas = el("canvas", { class: "view", "data-testid": "scene" });
   const play = el("button", { "data-testid": "play" }, "Play");
   const speed = el("select", { "data-testid": "speed" });

@@ -3,7 +3,9 @@
 // expected start, why it waits, results, replay and live links), the queue (other teams'
 // entries anonymised for a team), and for
 // operators the tournament schedule and standings and the pool.
-import { PageError, type Who, el, getJson } from "../ui";
+import { PageError, type Who, el, getJson, table } from "../ui";
+
+export { table };
 
 interface Submission {
   id: string;
@@ -37,12 +39,6 @@ function when(iso: string | null): string {
   return iso ? new Date(iso).toISOString().replace("T", " ").slice(0, 19) + " UTC" : "-";
 }
 
-export function table(testid: string, columns: string[], rows: (string | Node)[][]): HTMLTableElement {
-  return el("table", { "data-testid": testid },
-    el("tr", {}, ...columns.map((c) => el("th", {}, c))),
-    ...rows.map((cells) => el("tr", {}, ...cells.map((c) => el("td", {}, c)))));
-}
-
 function watchLinks(s: Submission): Node {
   const links = el("span", {});
   if (s.state === "running") links.append(el("a", { href: `/watch/live/${encodeURIComponent(s.id)}` }, "live"), " ");
@@ -52,30 +48,58 @@ function watchLinks(s: Submission): Node {
 
 const QUEUE_COLUMNS = ["position", "submission", "team", "opponent", "state", "expected start", "reason"];
 
-async function score(s: Submission): Promise<string> {
-  if (s.state !== "done") return "-";
-  try {
-    const results = await getJson<{ score?: { red: number; blue: number } }>(`/v1/submissions/${encodeURIComponent(s.id)}/results`);
-    return results.score ? `${s.team} ${results.score.red} : ${results.score.blue} ${s.opponent}` : "-";
-  } catch {
-    return "-";
-  }
+/** A finished match's result as /api/viewer/results gives it (red: the submitting team). */
+export interface MatchResult {
+  red: string;
+  blue: string;
+  score: { red: number; blue: number };
+  shootout: { red: number; blue: number } | null;
+  winner: "red" | "blue" | "draw" | null;
+}
+
+/** "2-1", with the shoot-out's goals apart: "0-0 (shoot-out 3-2)"; `first`: whose goals lead. */
+export function scoreText(r: MatchResult, first: "red" | "blue" = "red"): string {
+  const other = first === "red" ? "blue" : "red";
+  const shootout = r.shootout ? ` (shoot-out ${r.shootout[first]}-${r.shootout[other]})` : "";
+  return `${r.score[first]}-${r.score[other]}${shootout}`;
+}
+
+/** The result in words: for a team, its own ("won 2-1", "lost 0-1", "draw 1-1"); for an operator,
+ * the winner's ("Ants won 2-1"). */
+export function outcomeText(r: MatchResult, team: string | null): string {
+  const own = team === r.red ? "red" : team === r.blue ? "blue" : null;
+  if (r.winner === "draw" || r.winner === null) return `draw ${scoreText(r)}`;
+  if (own === null) return `${r[r.winner]} won ${scoreText(r, r.winner)}`;
+  return `${r.winner === own ? "won" : "lost"} ${scoreText(r, own)}`;
+}
+
+function outcome(s: Submission, result: MatchResult | undefined, team: string | null): string {
+  if (result) return outcomeText(result, team);
+  if (s.failure_class) return `${s.failure_class}: ${s.cause ?? ""}`;
+  if (s.state === "cancelled") return s.cause ? `cancelled: ${s.cause}` : "cancelled";
+  if (s.state === "done") return s.cause ?? "played (no score recorded)";
+  return "-";
 }
 
 async function submissionsPage(root: HTMLElement, who: Who | null): Promise<void> {
-  const rows = await getJson<Submission[]>("/v1/matches");
+  const [rows, results] = await Promise.all([
+    getJson<Submission[]>("/v1/matches"),
+    getJson<Record<string, MatchResult>>("/api/viewer/results"),
+  ]);
   const operator = who?.scope === "operator";
-  const scores = await Promise.all(rows.map((s) => (operator ? Promise.resolve("-") : score(s))));
-  root.append(el("h1", {}, operator ? "All matches" : "Your matches"), rows.length === 0
-    ? el("p", { "data-testid": "empty" }, "No matches yet: submit one with hlvs submit.")
-    : table("submissions", [
-      ...(operator ? ["team"] : []), "submission", "opponent", "state", "queue position", "expected start", "reason", "finished", "result", "outcome", "watch",
-    ], rows.map((s, i) => [
+  const team = operator ? null : (who?.team ?? null);
+  root.append(el("h1", {}, operator ? "All matches" : "Your matches"), table("submissions", [
+    ...(operator ? ["team"] : []), "submission", "opponent", "state", "queue position", "expected start", "reason", "finished", "result", "outcome", "watch",
+  ], rows.map((s) => {
+    const result = results[s.id];
+    return [
       ...(operator ? [s.team] : []),
       s.id, s.opponent, s.state, s.queue_position === null ? "-" : String(s.queue_position), when(s.expected_start),
-      s.waiting_reason ?? "-", when(s.finished_at), scores[i],
-      s.failure_class ? `${s.failure_class}: ${s.cause ?? ""}` : (s.cause ?? "-"), watchLinks(s),
-    ])));
+      s.waiting_reason ?? "-", when(s.finished_at),
+      result ? `${result.red} ${result.score.red} : ${result.score.blue} ${result.blue}${result.shootout ? ` (shoot-out ${result.shootout.red}-${result.shootout.blue})` : ""}` : "-",
+      outcome(s, result, team), watchLinks(s),
+    ];
+  }), operator ? "No team has asked for a test match yet." : "No matches yet: ask for one with hlvs submit (see the README's Submission service)."));
 }
 
 interface QueueEntry {
@@ -97,7 +121,7 @@ async function queuePage(root: HTMLElement): Promise<void> {
     table("queue", QUEUE_COLUMNS, queue.active.map((e) => [
       e.position === null ? "-" : String(e.position), e.id ?? "-", e.team, e.opponent, e.state,
       when(e.expected_start), e.waiting_reason ?? "-",
-    ])),
+    ]), "The queue is empty: no match is waiting or playing. A match asked for now starts at once."),
   );
 }
 
@@ -118,13 +142,14 @@ async function standingsPage(root: HTMLElement): Promise<void> {
   root.append(
     el("h1", { "data-testid": "standings-title" }, schedule.name ? `${schedule.name}: standings` : "Standings"),
     el("p", {}, el("a", { href: "/watch/tournament", "data-testid": "overview-link" }, "the tournament's live overview")),
-    table("standings", ["#", ...labels], schedule.standings.map((s, i) => [String(i + 1), ...standingColumns.map((c) => String(s[c] ?? ""))])),
+    table("standings", ["#", ...labels], schedule.standings.map((s, i) => [String(i + 1), ...standingColumns.map((c) => String(s[c] ?? ""))]),
+      "No standings yet: the table fills as the round robin's matches are played."),
     el("h1", {}, "Schedule"),
     table("schedule", ["match", "kind", "red", "blue", "plays at", "state", "score"], schedule.matches.map((m) => {
       const result = m.result as { score?: { red: number; blue: number } } | null;
       return [String(m.id), String(m.kind), String(m.red), String(m.blue), when(String(m.play_at)), String(m.state),
         result?.score ? `${result.score.red} : ${result.score.blue}` : "-"];
-    })),
+    }), "The schedule has no matches."),
   );
 }
 
@@ -179,11 +204,13 @@ async function poolSection(): Promise<HTMLElement> {
   const [queue, pool] = await Promise.all([getJson<Queue>("/v1/operator/queue"), getJson<PoolNodes>("/v1/operator/nodes")]);
   const running = queue.active.filter((s) => s.state === "running" || s.state === "starting");
   const down = pool.nodes.filter((n) => n.reason !== "").length;
-  const nodes = table("nodes", ["node", "state", "reason", "features", "CPUs", "memory", "matches", "running"], nodeRows(pool.nodes));
-  pool.nodes.forEach((n, i) => { if (n.reason !== "") nodes.rows[i + 1].classList.add("down"); });
+  const nodes = table("nodes", ["node", "state", "reason", "features", "CPUs", "memory", "matches", "running"], nodeRows(pool.nodes),
+    "The pool reports no nodes: no match can start until one is up.");
+  if (nodes instanceof HTMLTableElement) pool.nodes.forEach((n, i) => { if (n.reason !== "") nodes.rows[i + 1].classList.add("down"); });
   return el("div", { "data-testid": "pool-section" },
     el("p", { "data-testid": "pool-summary" }, `${queue.slots} match slot(s), ${running.length} in use${queue.paused ? ", queue paused" : ""}`),
-    table("pool", ["slot", "submission", "team", "state", "started"], running.map((s, i) => [String(i + 1), s.id, s.team, s.state, when(s.started_at)])),
+    table("pool", ["slot", "submission", "team", "state", "started"], running.map((s, i) => [String(i + 1), s.id, s.team, s.state, when(s.started_at)]),
+      "No match is playing now."),
     el("h2", {}, `Nodes (${pool.pool} pool)`),
     el("p", { "data-testid": "nodes-summary" }, `${pool.nodes.length} node(s), ${down} out of service`),
     nodes,
