@@ -145,3 +145,12 @@ def test_robots_of_several_published_models_share_one_world(tmp_path: Path) -> N
     for _ in range(125):
         world.step()
     assert [r.fallen for r in world.snapshot().robots] == [False] * 4
+
+
+@pytest.mark.parametrize("name", [name for name, _ in ROBOTS])
+def test_published_manifests_follow_the_schema(name: str) -> None:
+    import jsonschema
+
+    schema = Path(__file__).resolve().parents[3] / "configs" / "schemas" / "robot_model.schema.json"
+    manifest = json.loads((PUBLISHED / name / "robot_model.json").read_text())
+    jsonschema.validate(manifest, json.loads(schema.read_text()))
