@@ -35,6 +35,8 @@ def test_every_entry_has_its_sources_mass_and_rotor_inertia() -> None:
         ("MX-64(2.0)@14.8V", 7.3, 78, 200, 0.135),  # the protocol 2.0 firmware, same servo
         ("MX-106(2.0)", 10.0, 55, 225, 0.153),
         ("XM540-W270@14.8V", 12.9, 37, 272.5, 0.165),
+        ("PM54-060-S250-R", 10.1, 33.1, 251.417, 0.855),  # continuous torque to 28.3 rpm
+        ("PM54-040-S250-R", 3.9, 28.4, 251.417, 0.71),
     ],
 )
 def test_datasheet_figures(
