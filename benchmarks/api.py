@@ -10,6 +10,9 @@ the API run's real-time factor, the world-only real-time factor of the same worl
 both runs. ``--client league`` runs clients written like the league's own test client (each
 request's length and body in two writes, no ``TCP_NODELAY``: :mod:`testkit.league_client`) and
 reports their requests per second and round trips seen from both ends (``league_client``).
+``--flood`` adds two runs, the last robot standing without a client and then flooding its port
+with small valid requests, and reports the other robots' real-time factor and round trip with
+the flood against without (``flood``).
 
 Without cameras, on a machine with two or more CPUs, the step thread runs on CPU 0 in every
 measurement (the world-only and ``bench sim`` figures too) and the client processes on the
@@ -74,6 +77,11 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument(
         "--think-ms", type=float, default=0.0,
         help="--client league: milliseconds each client takes to answer (default 0)",
+    )
+    parser.add_argument(
+        "--flood", action="store_true",
+        help="two more runs: the last robot without a client, then flooding its port with small "
+        "valid requests; reports the other robots' figures with the flood against without",
     )
     parser.add_argument("--stalled-client", action="store_true",
                         help="one more client that connects and never reads")
@@ -404,9 +412,25 @@ def _bench_sim(robots: int, physics_dt: float, sim_seconds: float) -> dict[str, 
     return {k: result[k] for k in ("real_time_factor", "bare_real_time_factor") if k in result}
 
 
+def _flood_client(port: int, cpus: frozenset[int]) -> None:
+    """Client process body of the flooding robot (``--flood``): small valid requests without
+    pause (:func:`testkit.flood_client.flood`) until killed."""
+    import threading
+
+    from testkit.flood_client import flood
+
+    if cpus:
+        os.sched_setaffinity(0, cpus)
+    flood(port, threading.Event(), [0])
+    os._exit(0)
+
+
 def _api_run(
-    args: argparse.Namespace, camera: tuple[int, int, int] | None, stalled: bool
+    args: argparse.Namespace, camera: tuple[int, int, int] | None, stalled: bool,
+    last: str = "",
 ) -> dict[str, Any]:
+    """One API run; ``last``: what the last robot's client does, "" as the others, "flood"
+    (:func:`_flood_client`) or "absent" (no client: the robot stands)."""
     from contracts.match_spec import NetworkSpec
     from simulator.api import (
         ApiServer,
@@ -450,6 +474,11 @@ def _api_run(
     reports = []  # the league clients' figures, sent when the server closes
     procs = []
     for i, e in enumerate(endpoints):
+        if last and e.robot == robots[-1]:
+            if last == "flood":
+                procs.append(ctx.Process(target=_flood_client, args=(e.port, args.client_cpus),
+                                         daemon=True))  # fmt: skip
+            continue
         if args.client == "league" and e.robot != stalled_robot:
             receive, send = ctx.Pipe(duplex=False)
             reports.append(receive)
@@ -472,7 +501,8 @@ def _api_run(
         proc.start()
     try:
         deadline = time.monotonic() + 120
-        while len(server.connected()) < len(endpoints) and time.monotonic() < deadline:
+        clients = len(endpoints) - (last == "absent")
+        while len(server.connected()) < clients and time.monotonic() < deadline:
             server.poll(0.05)
         pipeline = Pipeline(server, lockstep) if args.mode == "pipelined" else None
         waited = [0.0]
@@ -545,6 +575,9 @@ def _api_run(
             proc.kill()
             proc.join(timeout=5)
     rtts = [s["round_trip_ms"]["p50"] for s in stats.values() if s["round_trip_ms"]["p50"]]
+    last_key = robots[-1].key
+    honest = [s["round_trip_ms"]["p50"] for key, s in stats.items()
+              if s["round_trip_ms"]["p50"] and not (last and key == last_key)]  # fmt: skip
     league_client = None
     if args.client == "league":
         def median_ms(index: int) -> float | None:
@@ -565,6 +598,8 @@ def _api_run(
             "client_round_trip_p50_ms": median_ms(2),
         }
     return {
+        "honest_round_trip_p50_ms": round(sorted(honest)[len(honest) // 2], 3) if honest else None,
+        "last_robot": stats.get(last_key),
         "league_client": league_client,
         "real_time_factor": round((world.sim_time_ms - start_ms) / 1000.0 / wall, 3),
         "cpu_s_per_sim_s": cpu / ((world.sim_time_ms - start_ms) / 1000.0),
@@ -580,6 +615,39 @@ def _api_run(
         "render_ms_per_frame": round(cameras.render_s * 1000 / cameras.frames, 2)
         if cameras.frames
         else None,
+    }
+
+
+def _flood_figures(
+    args: argparse.Namespace, camera: tuple[int, int, int] | None
+) -> dict[str, Any]:
+    """The honest robots' figures with the last robot flooding its port beside them, against
+    the same run with that robot standing without a client (run first)."""
+    without = _api_run(args, camera, stalled=False, last="absent")
+    flooded = _api_run(args, camera, stalled=False, last="flood")
+
+    def ratio(a: float | None, b: float | None) -> float | None:
+        return round(a / b, 3) if a and b else None
+
+    flooder = flooded["last_robot"] or {}
+    return {
+        "honest_robots": args.robots - 1,
+        "real_time_factor": flooded["real_time_factor"],
+        "real_time_factor_without": without["real_time_factor"],
+        # with / without: 1.0 when the flooding robot costs the others nothing
+        "ratio": ratio(flooded["real_time_factor"], without["real_time_factor"]),
+        # the same from the runs' interleaved ratios (the machine's load falls on both alike)
+        "ratio_interleaved": ratio(flooded["ratio_interleaved"], without["ratio_interleaved"]),
+        "round_trip_p50_ms": flooded["honest_round_trip_p50_ms"],
+        "round_trip_p50_ms_without": without["honest_round_trip_p50_ms"],
+        # without / with: 1.0 when the honest robots' round trip is as without the flood
+        "round_trip_ratio": ratio(without["honest_round_trip_p50_ms"],
+                                  flooded["honest_round_trip_p50_ms"]),  # fmt: skip
+        "honest_slow_periods": flooded["slow_periods"] - flooder.get("slow_periods", 0),
+        # the flooding robot: its requests taken, its bytes read, the times it was marked slow
+        "flooder_messages_in": flooder.get("messages_in"),
+        "flooder_bytes_in": flooder.get("bytes_in"),
+        "flooder_slow_periods": flooder.get("slow_periods"),
     }
 
 
@@ -660,6 +728,8 @@ def main(argv: list[str]) -> int:
             "cpu_ratio": round(api["cpu_s_per_sim_s"] / stalled["cpu_s_per_sim_s"], 3),
             "dropped_out": stalled["dropped_out"],
         }
+    if args.flood:
+        result["flood"] = _flood_figures(args, camera)
     print(json.dumps(result, sort_keys=True), flush=True)
     return 0
 

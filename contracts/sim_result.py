@@ -27,7 +27,7 @@ class RobotApiStats(TypedDict):
     messages_out: int
     bytes_out: int
     dropped_out: int
-    dropped_in: dict[str, int]  # requests dropped undecoded, by reason ("size", "rate")
+    dropped_in: dict[str, int]  # requests dropped undecoded, by reason ("size")
     dropped_in_bytes: int
     quota_errors: int
     bad_frames: int

@@ -13,7 +13,13 @@ from typing import Protocol
 from google.protobuf.message import DecodeError
 
 from contracts.robot_api import messages_pb2 as pb
-from simulator.api.bounds import READ_PER_CALL_BYTES, RequestBounds
+from simulator.api.bounds import (
+    BYTE_COST,
+    FRAME_COST,
+    MAX_REQUEST_BYTES,
+    READ_PER_CALL_BYTES,
+    ReadBudget,
+)
 from simulator.api.fastreq import Notice, PositionTargets, PositionTemplate, scan_positions
 from simulator.api.framing import FrameDecoder, FramingError
 from simulator.api.stats import RobotStats
@@ -84,7 +90,12 @@ class Connection:
         self.stats = stats
         self.queue_limit = max(1, queue_limit)
         self.decoder = FrameDecoder()
-        self.bounds = RequestBounds(time.monotonic())
+        self.budget = ReadBudget(time.monotonic())
+        self.max_request_bytes = MAX_REQUEST_BYTES
+        # the budget is spent: the socket is not read (nor watched) until it refills
+        self.paused = False
+        self.measurements = 0  # queued so far (each refills the budget)
+        self._paused_logged = 0.0  # when a pause was last logged (one line per 10 s)
         self.requests: list[Request] = []
         # where the usual requests go instead of ``requests`` while the server's target board
         # is armed (:mod:`simulator.api.board`); set and cleared by the step thread
@@ -107,55 +118,55 @@ class Connection:
     # --- reading ----------------------------------------------------------------------------
 
     def read(self, now: float) -> int:
-        """Read what is available, at most :data:`READ_PER_CALL_BYTES` (the rest waits for the
-        next call); returns the number of requests decoded. Requests over the client's bounds
-        (:mod:`simulator.api.bounds`) are dropped undecoded and counted.
+        """Read what is available and the budget pays for (:mod:`simulator.api.bounds`), at
+        most :data:`READ_PER_CALL_BYTES` (the rest waits for the next call); returns the number
+        of requests taken. Bytes are charged as they are received and frames as they are cut
+        out, before anything else is done with them; when the budget is spent the connection is
+        ``paused`` (not read until :meth:`resume` says it refilled) and marked slow. A request
+        over the size limit is dropped undecoded, counted and told to the client.
 
         Raises:
             ClientClosed: on EOF, a socket error, a framing error or an undecodable message.
         """
         count = 0
         taken = 0
-        while True:
-            try:
-                data = self.sock.recv(RECV_CHUNK)
-            except (BlockingIOError, InterruptedError):
-                break
-            except OSError as exc:
-                raise ClientClosed(f"receive failed: {exc}") from exc
-            if not data:
-                raise ClientClosed("client disconnected")
-            self.stats.bytes_in += len(data)
-            taken += len(data)
-            try:
-                frames = self.decoder.feed(data)
-            except FramingError as exc:
-                self.stats.bad_frames += 1
-                raise ClientClosed(f"out of sync: {exc}") from exc
-            decoded: list[Request] = []
-            if frames:
-                frames = self._within_bounds(frames, now, decoded)
-            template = self._template
-            for frame in frames:
-                count += 1
-                if not frame:  # an empty ActuatorRequests: an answer with nothing to apply
-                    continue
-                targets = template.match(frame) if template is not None else None
-                if targets is not None:
-                    decoded.append(targets)
+        budget = self.budget
+        level = budget.refill(now, self.measurements)
+        decoder = self.decoder
+        try:
+            while True:
+                if level < FRAME_COST:
+                    self._pause(now)
+                    break
+                if decoder.held:  # frames the budget did not pay for last time: no receive
+                    data = b""
                 else:
-                    decoded.append(self._parse(frame))
-                    template = self._template
-            if decoded:
-                with self.requests_lock:
-                    board = self.board
-                    if board is None:
-                        self.requests.extend(decoded)
-                    else:
-                        board.post(decoded, self.requests)
-            if len(data) < RECV_CHUNK or taken >= READ_PER_CALL_BYTES:
-                break
-        if self.decoder.buffered:
+                    try:
+                        data = self.sock.recv(RECV_CHUNK)
+                    except (BlockingIOError, InterruptedError):
+                        break
+                    except OSError as exc:
+                        raise ClientClosed(f"receive failed: {exc}") from exc
+                    if not data:
+                        raise ClientClosed("client disconnected")
+                    self.stats.bytes_in += len(data)
+                    taken += len(data)
+                    level -= len(data) * BYTE_COST
+                try:
+                    frames = decoder.feed(data, int(level // FRAME_COST))
+                except FramingError as exc:
+                    self.stats.bad_frames += 1
+                    raise ClientClosed(f"out of sync: {exc}") from exc
+                if frames:
+                    level -= len(frames) * FRAME_COST
+                    count += self._take(frames)
+                if decoder.held:
+                    continue  # more frames buffered: taken while the budget pays
+                if len(data) < RECV_CHUNK or taken >= READ_PER_CALL_BYTES:
+                    break
+        finally:
+            budget.level = level
+        if decoder.buffered:
             self._quick_ack()
         if count:
             self.stats.messages_in += count
@@ -186,30 +197,63 @@ class Connection:
         except OSError:
             pass  # the socket is failing: the next read says so
 
-    def _within_bounds(
-        self, frames: list[bytes], now: float, notices: list[Request]
-    ) -> list[bytes]:
-        """The frames within the client's bounds (``frames`` itself when all are); the others
-        are dropped and counted. A request over the size limit is an answer all the same
-        (lockstep does not wait for another) and the client is told, in its next
-        measurement, why nothing of it was applied (a :class:`Notice` in ``notices``)."""
-        admit = self.bounds.admit
-        kept = frames
-        for index, frame in enumerate(frames):
-            dropped = admit(len(frame), now)
-            if dropped is not None:
-                if kept is frames:
-                    kept = frames[:index]
-                self.stats.drop_in(dropped, len(frame))
-                if dropped == "size":
-                    notices.append(Notice(
-                        f"ActuatorRequests of {len(frame)} bytes is above the limit of"
-                        f" {self.bounds.max_bytes} bytes, ignored."
-                    ))  # fmt: skip
-                    self._told = True
-            elif kept is not frames:
-                kept.append(frame)
-        return kept
+    def _take(self, frames: list[bytes]) -> int:
+        """Decode ``frames`` (paid for) and queue them, or post them on the server's target
+        board; returns how many answered (all but those over the size limit)."""
+        template = self._template
+        decoded: list[Request] = []
+        answers = 0
+        for frame in frames:
+            if len(frame) > self.max_request_bytes:
+                self.stats.drop_in("size", len(frame))
+                decoded.append(Notice(
+                    f"ActuatorRequests of {len(frame)} bytes is above the limit of"
+                    f" {self.max_request_bytes} bytes, ignored."
+                ))  # fmt: skip
+                self._told = True  # an answer all the same: lockstep waits for no other
+                continue
+            answers += 1
+            if not frame:  # an empty ActuatorRequests: an answer with nothing to apply
+                continue
+            targets = template.match(frame) if template is not None else None
+            if targets is not None:
+                decoded.append(targets)
+            else:
+                decoded.append(self._parse(frame))
+                template = self._template
+        if decoded:
+            with self.requests_lock:
+                board = self.board
+                if board is None:
+                    self.requests.extend(decoded)
+                else:
+                    board.post(decoded, self.requests)
+        return answers
+
+    def _pause(self, now: float) -> None:
+        """The budget is spent: stop reading (the caller stops watching the socket) and mark
+        the robot slow, as lockstep marks a robot out of time."""
+        self.paused = True
+        if self.slow:
+            return
+        self.slow = True
+        self.stats.slow_periods += 1
+        if now - self._paused_logged >= 10.0:
+            self._paused_logged = now
+            log.warning(
+                "%s: sends more requests than its budget of %g a second and %g a measurement"
+                " pays for: not read until the budget refills, and not waited for in lockstep"
+                " meanwhile (%d times so far)",
+                self.key, self.budget.rate, self.budget.per_measurement, self.stats.slow_periods,
+            )  # fmt: skip
+
+    def resume(self, now: float) -> bool:
+        """A paused connection whose budget refilled is no longer paused: True, and the caller
+        watches its socket again and reads it (frames may be buffered)."""
+        if self.budget.refill(now, self.measurements) < FRAME_COST:
+            return False
+        self.paused = False
+        return True
 
     def read_threaded(self, now: float) -> bool:
         """I/O thread: :meth:`read`, leaving a failure in ``error`` for the step thread.
@@ -254,6 +298,7 @@ class Connection:
                 break
             self.stats.dropped_out += 1
         outbox.append(frame)
+        self.measurements += 1
         self.answered = False
         self.last_sent_at = now
         self.enqueued_at = now
@@ -273,6 +318,7 @@ class Connection:
             self.enqueue(frame, now)
             self.flush()
             return
+        self.measurements += 1
         self.answered = False
         self.last_sent_at = now
         self.enqueued_at = now

@@ -36,29 +36,37 @@ def encode_frame(payload: bytes) -> bytes:
 class FrameDecoder:
     """Incremental frame decoder. Not thread-safe; one per connection."""
 
-    __slots__ = ("_buffer", "_limit")
+    __slots__ = ("_buffer", "_limit", "held")
 
     def __init__(self, *, limit: int = MAX_FRAME_BYTES) -> None:
         self._buffer = bytearray()
         self._limit = limit
+        # the last feed stopped at ``max_frames``: complete frames may be buffered still
+        self.held = False
 
     @property
     def buffered(self) -> int:
         return len(self._buffer)
 
-    def feed(self, data: bytes) -> list[bytes]:
-        """Add received bytes; return the payloads of every frame now complete, in order
-        (``b""`` for an empty frame)."""
+    def feed(self, data: bytes, max_frames: int = 1 << 62) -> list[bytes]:
+        """Add received bytes; return the payloads of the frames now complete, in order
+        (``b""`` for an empty frame), at most ``max_frames`` of them: the others stay buffered
+        (``held``) for a later call, which may add no bytes."""
         buffer = self._buffer
-        if not buffer and len(data) >= 4:  # the usual case: exactly one frame, nothing buffered
+        if not buffer and len(data) >= 4 and max_frames > 0:  # the usual case: one frame
             (length,) = HEADER.unpack_from(data)
             if len(data) == 4 + length and 0 < length <= self._limit:
+                self.held = False
                 return [data[4:]]
         buffer += data
         frames: list[bytes] = []
         offset = 0
         size = len(buffer)
+        held = False
         while size - offset >= 4:
+            if len(frames) >= max_frames:
+                held = True
+                break
             (length,) = HEADER.unpack_from(buffer, offset)
             if length > self._limit:
                 del buffer[:offset]
@@ -70,4 +78,5 @@ class FrameDecoder:
             offset = end
         if offset:
             del buffer[:offset]
+        self.held = held
         return frames

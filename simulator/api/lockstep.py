@@ -5,6 +5,8 @@ measurement was queued, when a camera image delayed it) is free; time beyond it 
 taken from the client's time bank (a chess clock with a per-move allowance). A client whose bank
 runs out is marked slow (logged, counted) and the step goes on without it; it is waited for
 again, with a full bank, once it has answered the latest measurement and its send queue is empty.
+A client that sends more than its budget (:mod:`simulator.api.bounds`) is marked slow the same
+way and is not waited for while it is not read.
 
 :class:`Pipeline` is pipelined lockstep: the same wait, but for the answers to the measurement
 sent before the step just computed, so the clients think while the next step is computed and
@@ -60,7 +62,7 @@ def _wait(
             if conn is None:
                 continue
             if conn.slow:
-                if conn.answered and conn.idle:
+                if conn.answered and conn.idle and not conn.paused:
                     conn.slow = False
                     conn.bank_s = settings.time_bank_s
                     log.info("%s: caught up, lockstep waits for it again", slot.session.key)

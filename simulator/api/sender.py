@@ -48,6 +48,7 @@ IDLE_WAIT_S = 0.05  # the longest the thread sleeps without being woken
 POLL_BELOW_S = 0.002  # steps closer than this: the thread polls (when ``poll`` is on)
 POLL_MIN_S = 0.0001  # shortest sleep between polls
 POLL_LATE_S = 0.00003  # polled this long after a step's frames are due (the step's jitter)
+PAUSED_WAIT_S = 0.002  # the longest sleep while a client is paused for its budget
 MAX_JOBS = 2  # jobs waiting before submit waits (this step's, and the previous one still running)
 PERIOD_SAMPLES = 6  # the period of the steps: the median of the last intervals between them
 SELECT_FD_LIMIT = 1024  # FD_SETSIZE: select(2) takes descriptor numbers below it
@@ -150,6 +151,7 @@ class SendThread:
             last_frames = interval = 0.0  # when frames were last found queued, and the step
             queued: deque[float] = deque(maxlen=PERIOD_SAMPLES)  # when the step thread queued
             period = 0.0
+            paused: list[Connection] = []  # clients whose budget is spent, not read for now
             while not self._stop:
                 news = False
                 if poll:  # decided before the queues are looked at, as ``_sleeping``
@@ -163,6 +165,8 @@ class SendThread:
                     timeout = max(POLL_MIN_S, queued[-1] + period + POLL_LATE_S - now)
                 else:
                     timeout = IDLE_WAIT_S
+                if paused and timeout > PAUSED_WAIT_S:
+                    timeout = PAUSED_WAIT_S  # read again soon after the budget refills
                 try:
                     ready = selector.select(timeout)
                 except OSError:  # a socket closed before its removal reached this thread
@@ -189,8 +193,13 @@ class SendThread:
                         continue
                     if events & READ and conn.error is None:
                         news = conn.read_threaded(time.monotonic()) or news
+                        if conn.paused:  # its budget is spent: not watched until it refills
+                            paused.append(conn)
+                            self._set_mask(selector, masks, conn)
                     if events & WRITE:
                         self._ready.append(conn)
+                if paused:
+                    news = self._resume(selector, masks, paused) or news
                 if news and on_news is not None:
                     on_news()
                 selector = self._apply_changes(selector, masks)
@@ -202,6 +211,57 @@ class SendThread:
                 self._on_news()  # a step thread waiting for answers wakes and finds it
         finally:
             selector.close()
+
+    def _resume(
+        self,
+        selector: selectors.BaseSelector,
+        masks: dict[Connection, int],
+        paused: list[Connection],
+    ) -> bool:
+        """Read again the paused connections whose budget refilled (``paused`` keeps the
+        others); True when that brought requests or a failure."""
+        news = False
+        now = time.monotonic()
+        waiting = [conn for conn in paused if conn in masks and not conn.closed]
+        paused.clear()
+        for conn in waiting:
+            if not conn.resume(now):
+                paused.append(conn)
+                continue
+            self._set_mask(selector, masks, conn)
+            news = conn.read_threaded(now) or news  # frames may be buffered: select cannot tell
+            if conn.paused:
+                paused.append(conn)
+                self._set_mask(selector, masks, conn)
+        return news
+
+    def _set_mask(
+        self,
+        selector: selectors.BaseSelector,
+        masks: dict[Connection, int],
+        conn: Connection,
+        writing: bool | None = None,
+    ) -> None:
+        """Watch ``conn`` for reading unless paused, and for writing when ``writing`` (None:
+        as now); a socket watched for neither is unregistered."""
+        old = masks.get(conn)
+        if old is None:
+            return  # removed
+        if writing is None:
+            writing = bool(old & WRITE)
+        wanted = (0 if conn.paused else READ) | (WRITE if writing else 0)
+        if wanted == old:
+            return
+        masks[conn] = wanted
+        try:
+            if not old:
+                selector.register(conn.fd, wanted, conn)
+            elif not wanted:
+                selector.unregister(conn.fd)
+            else:
+                selector.modify(conn.fd, wanted, conn)
+        except (KeyError, ValueError, OSError):
+            pass  # closed meanwhile; its removal follows
 
     def _learn_period(self, queued: deque[float]) -> float:
         """Note when the step thread queued the frames just found (the newest connection's
@@ -257,7 +317,8 @@ class SendThread:
         replacement = selectors.DefaultSelector()
         replacement.register(self._wake_r, READ, None)
         for conn, mask in masks.items():
-            replacement.register(conn.fd, mask, conn)
+            if mask:  # (0: a paused connection with nothing to write)
+                replacement.register(conn.fd, mask, conn)
         selector.close()
         return replacement
 
@@ -266,16 +327,9 @@ class SendThread:
     ) -> None:
         while self._ready:
             conn = self._ready.popleft()
-            mask = masks.get(conn)
-            if mask is None:
+            if conn not in masks:
                 continue  # removed
-            wanted = READ if conn.write_queued() else READ | WRITE
-            if wanted != mask:
-                masks[conn] = wanted
-                try:
-                    selector.modify(conn.fd, wanted, conn)
-                except (KeyError, ValueError, OSError):
-                    pass  # closed meanwhile; its removal follows
+            self._set_mask(selector, masks, conn, writing=not conn.write_queued())
 
 
 def _unwatch(

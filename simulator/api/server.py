@@ -70,6 +70,8 @@ Request = pb.ActuatorRequests | PositionTargets | Notice
 # costs the step thread the select and the memory it touches); a client is still welcomed within
 # that interval.
 POLL_INTERVAL_S = 0.01
+# while a client is paused for its budget (simulator.api.bounds), the longest a poll sleeps
+PAUSED_POLL_S = 0.002
 
 
 class IoThreadFailed(ApiError):
@@ -228,6 +230,8 @@ class ApiServer:
         # set when a measurement starts waiting for images or a client for its name lookup (the
         # step thread polls every step until none waits: :meth:`_waiting`)
         self._maybe_waiting = False
+        # step-thread clients whose budget is spent (simulator.api.bounds), not read for now
+        self._paused: list[RobotSlot] = []
         self.connection_changes = 0  # clients welcomed or dropped so far
         # with the I/O thread: this step's measurements to frame and queue there, in order
         self._outgoing: list[tuple[RobotSlot, Connection, Measurement]] = []
@@ -347,6 +351,8 @@ class ApiServer:
     def poll(self, timeout_s: float = 0.0) -> None:
         """Serve sockets: accept, handshake, read requests, write queued measurements (with
         the I/O thread: drop the clients it found failed)."""
+        if self._paused and timeout_s > PAUSED_POLL_S:
+            timeout_s = PAUSED_POLL_S  # a paused client is read again soon after it refills
         ready = self._selector.select(max(0.0, timeout_s))
         # after the select: a request that arrives while it blocks is stamped when it arrived
         # (its round trip and its lockstep answer time), not when the wait began
@@ -367,6 +373,8 @@ class ApiServer:
                     self._read(slot, now)
                 if slot.conn is not None and events & selectors.EVENT_WRITE:
                     self._flush(slot)
+        if self._paused:
+            self._resume_paused(now)
         if self._lookups is not None:
             self._finish_lookups()
         if self._sender is not None:
@@ -489,11 +497,29 @@ class ApiServer:
         )  # fmt: skip
 
     def _read(self, slot: RobotSlot, now: float) -> None:
-        assert slot.conn is not None
+        conn = slot.conn
+        assert conn is not None
         try:
-            slot.conn.read(now)
+            conn.read(now)
         except ClientClosed as exc:
             self._drop(slot, exc.reason)
+            return
+        if conn.paused:  # its budget is spent: its socket is not watched until it refills
+            self._paused.append(slot)
+            self._watch(slot, conn)
+
+    def _resume_paused(self, now: float) -> None:
+        """Read again the paused clients whose budget refilled (:mod:`simulator.api.bounds`)."""
+        paused, self._paused = self._paused, []
+        for slot in paused:
+            conn = slot.conn
+            if conn is None or not conn.paused:
+                continue  # dropped, or a new client since
+            if not conn.resume(now):
+                self._paused.append(slot)
+                continue
+            self._watch(slot, conn)
+            self._read(slot, now)  # frames may be buffered: the socket would not say so
 
     def _flush(self, slot: RobotSlot) -> None:
         conn = slot.conn
@@ -503,9 +529,23 @@ class ApiServer:
         except ClientClosed as exc:
             self._drop(slot, exc.reason)
             return
-        mask = selectors.EVENT_READ | (selectors.EVENT_WRITE if conn.want_write else 0)
-        if mask != slot.mask:
-            slot.mask = mask
+        self._watch(slot, conn)
+
+    def _watch(self, slot: RobotSlot, conn: Connection) -> None:
+        """Watch the client's socket for what it needs: reading unless paused, writing while
+        frames wait (a socket with neither is not registered)."""
+        mask = (0 if conn.paused else selectors.EVENT_READ) | (
+            selectors.EVENT_WRITE if conn.want_write else 0
+        )
+        old = slot.mask
+        if mask == old:
+            return
+        slot.mask = mask
+        if not old:
+            self._selector.register(conn.sock, mask, ("conn", slot))
+        elif not mask:
+            self._selector.unregister(conn.sock)
+        else:
             self._selector.modify(conn.sock, mask, ("conn", slot))
 
     def _drop(self, slot: RobotSlot, reason: str) -> None:

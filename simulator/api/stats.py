@@ -36,8 +36,8 @@ class RobotStats:
     slow_periods: int = 0
     warnings_sent: int = 0
     round_trip_s: array[float] = field(default_factory=lambda: array("d"))
-    # requests dropped undecoded, by reason ("size": over the request limit, "rate": over the
-    # client's byte or message budget; see simulator.api.bounds)
+    # requests dropped undecoded, by reason ("size": over the request limit; see
+    # simulator.api.bounds: requests beyond the client's budget are not dropped but left unread)
     dropped_in: dict[str, int] = field(default_factory=dict)
     dropped_in_bytes: int = 0
 

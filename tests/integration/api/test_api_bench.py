@@ -63,3 +63,17 @@ def test_bench_api_league_clients_report_their_rate_and_both_round_trips() -> No
     for key in ("round_trip_p50_ms", "client_answer_p50_ms", "client_round_trip_p50_ms"):
         assert isinstance(league[key], float) and league[key] > 0, key
     assert result["slow_periods"] == 0
+
+
+def test_bench_api_flood_reports_the_honest_robots_with_and_without_it() -> None:
+    result = _bench("--mode", "lockstep", "--sim-seconds", "0.5", "--flood")
+    flood = result["flood"]
+    assert isinstance(flood, dict) and flood["honest_robots"] == 1
+    assert flood["flooder_slow_periods"] >= 1 and flood["honest_slow_periods"] == 0
+    assert flood["flooder_messages_in"] > 0
+    for key in ("real_time_factor", "real_time_factor_without", "ratio", "ratio_interleaved",
+                "round_trip_p50_ms", "round_trip_p50_ms_without", "round_trip_ratio"):
+        assert isinstance(flood[key], float) and flood[key] > 0, key
+    assert flood["ratio"] == pytest.approx(
+        flood["real_time_factor"] / flood["real_time_factor_without"], abs=0.01
+    )
