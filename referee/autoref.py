@@ -225,8 +225,10 @@ class Referee:
         if self._finished:
             return commands
         if self._wait_until_s is not None:
+            # INITIAL: the GameController's time runs on, this step's before the wait's end
+            self.gc.advance_ms(dt_ms)
+            dt_ms = 0
             if self._clock.monotonic() < self._wait_until_s:
-                self.gc.advance_ms(dt_ms)  # INITIAL: the GameController's time runs on
                 self._publish()
                 return commands
             action, self._after_wait, self._wait_until_s = self._after_wait, None, None

@@ -50,7 +50,7 @@ def test_a_failed_expectation_names_file_step_and_expectation(
     failure = [line.strip() for line in out.splitlines() if "never scored" in line]
     assert failure == [
         f"{path}: step 0 (/0/tests/1) 'A goal that was never scored': score of red: expected 1, "
-        "received 0 (sim 16.000 s, 1 s after PLAYING#1 (Simulated))"
+        "received 0 (sim 16.008 s, 1 s after PLAYING#1 (Simulated))"
     ]
     assert out.splitlines()[-1].startswith("0/1 files passed, 1/2 tests")
 
