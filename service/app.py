@@ -270,8 +270,28 @@ def _install_error_handlers(app: FastAPI) -> None:
         return JSONResponse({"error": "invalid_input", "message": summary, "problems": problems},
                             status_code=422)
 
+    @app.exception_handler(UnicodeEncodeError)
+    async def not_text(request: Request, exc: UnicodeEncodeError) -> JSONResponse:
+        """A string of the body with a lone surrogate (valid JSON, not text) is refused."""
+        message = "a lone surrogate (\\ud800-\\udfff) in the body is not text"
+        return JSONResponse({"error": "invalid_input", "message": message, "problems": [
+            {"where": "body", "pointer": "/", "message": message,
+             "expected": "text that is valid Unicode"}]}, status_code=422)
+
     @app.exception_handler(StarletteHTTPException)
     async def http_error(request: Request, exc: StarletteHTTPException) -> JSONResponse:
+        if exc.status_code == 400 and isinstance(exc.__cause__, RecursionError):
+            # the route's JSON parser gave up on the nesting: the same answer as a file upload
+            from service.bodies import MAX_DEPTH, deep_pointer
+            from service.middleware import BODY_KEY
+
+            pointer = deep_pointer(b"".join(request.scope.get(BODY_KEY, ())), MAX_DEPTH) or "/"
+            message = f"nested deeper than {MAX_DEPTH} levels"
+            return JSONResponse({"error": "invalid_input", "message": f"body {pointer}: "
+                                 f"{message}", "problems": [
+                                     {"where": "body", "pointer": pointer, "message": message,
+                                      "expected": f"at most {MAX_DEPTH} levels of nesting"}]},
+                                status_code=422)
         kind = {404: "not_found", 405: "method_not_allowed", 413: "too_large",
                 415: "unsupported_media_type"}.get(exc.status_code, "http_error")
         return JSONResponse({"error": kind, "message": str(exc.detail)},

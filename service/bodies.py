@@ -46,7 +46,8 @@ async def read_json_body(request: Request, *, limit_bytes: int, name: str) -> An
                                   f"{exc.msg}"}],
         ) from None
     except RecursionError:
-        raise _unreadable(name, "", f"nested deeper than {MAX_DEPTH} levels",
+        raise _unreadable(name, deep_pointer(raw, MAX_DEPTH) or "",
+                          f"nested deeper than {MAX_DEPTH} levels",
                           f"at most {MAX_DEPTH} levels of nesting") from None
     except _BadNumber as exc:
         raise _unreadable(name, "", str(exc), "a finite number of at most "
@@ -55,6 +56,11 @@ async def read_json_body(request: Request, *, limit_bytes: int, name: str) -> An
     if deep is not None:
         raise _unreadable(name, deep, f"nested deeper than {MAX_DEPTH} levels",
                           f"at most {MAX_DEPTH} levels of nesting")
+    lone = surrogate_pointer(document)
+    if lone is not None:
+        raise _unreadable(name, lone, "a lone surrogate (\\ud800-\\udfff) is not text",
+                          "text that is valid Unicode (a character, not half of a UTF-16 "
+                          "pair)")
     return document
 
 
@@ -100,6 +106,75 @@ def _too_deep(document: Any) -> str | None:
     return None
 
 
+def deep_pointer(raw: bytes, limit: int = MAX_DEPTH) -> str | None:
+    """The JSON pointer of the first array or object nested deeper than ``limit`` in the JSON
+    text ``raw``, found by scanning its structure (a document too deep for the parser has one
+    all the same); None when there is none."""
+    # each open container: [is an object, current index or key, a key is expected next]
+    stack: list[list[Any]] = []
+    i, n = 0, len(raw)
+    while i < n:
+        c = raw[i]
+        if c == 0x22:  # a string: a key when an object expects one
+            j = i + 1
+            while j < n and raw[j] != 0x22:
+                j += 2 if raw[j] == 0x5C else 1
+            if stack and stack[-1][0] and stack[-1][2]:
+                try:
+                    stack[-1][1] = json.loads(raw[i:j + 1])
+                except ValueError:
+                    stack[-1][1] = raw[i + 1:j].decode("utf-8", "replace")
+                stack[-1][2] = False
+            i = j + 1
+            continue
+        if c in (0x5B, 0x7B):  # [ {
+            if len(stack) > limit:
+                return "".join(f"/{_escape(str(entry[1]))}" for entry in stack)
+            stack.append([c == 0x7B, None if c == 0x7B else 0, c == 0x7B])
+        elif c in (0x5D, 0x7D) and stack:  # ] }
+            stack.pop()
+        elif c == 0x2C and stack:  # ,
+            if stack[-1][0]:
+                stack[-1][2] = True
+            else:
+                stack[-1][1] += 1
+        i += 1
+    return None
+
+
+def surrogate_pointer(document: Any) -> str | None:
+    """The JSON pointer of a key or string holding a lone surrogate (``"\\udc80"`` is valid
+    JSON but no text: it cannot be stored, sealed or sent), None when none does."""
+    stack: list[tuple[Any, str]] = [(document, "")]
+    while stack:
+        value, at = stack.pop()
+        if isinstance(value, str):
+            if _has_surrogate(value):
+                return _printable(at)
+        elif isinstance(value, dict):
+            for k, v in value.items():
+                where = f"{at}/{_escape(str(k))}"
+                if _has_surrogate(str(k)):
+                    return _printable(where)
+                stack.append((v, where))
+        elif isinstance(value, list):
+            stack.extend((v, f"{at}/{i}") for i, v in enumerate(value))
+    return None
+
+
+def _has_surrogate(text: str) -> bool:
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        return True
+    return False
+
+
+def _printable(pointer: str) -> str:
+    """A pointer that can be sent back: its lone surrogates as ``\\udXXX``."""
+    return pointer.encode("utf-8", "backslashreplace").decode("utf-8")
+
+
 def _escape(key: str) -> str:
     return key.replace("~", "~0").replace("/", "~1")
 
@@ -109,4 +184,4 @@ def _unreadable(name: str, pointer: str, message: str, expected: str) -> Invalid
         {"file": name, "pointer": pointer, "message": message, "expected": expected}])
 
 
-__all__ = ["read_json_body"]
+__all__ = ["MAX_DEPTH", "deep_pointer", "read_json_body", "surrogate_pointer"]

@@ -293,23 +293,82 @@ def run_results(args: argparse.Namespace) -> int:
 
 
 def run_logs(args: argparse.Namespace) -> int:
+    """Download the listed logs into ``--out``. A listed name is written only when it is a
+    relative path under ``--out`` that passes no symlink: an absolute name, ``..``, an empty
+    or ``.`` part, a NUL, or a folder on the way that is a symlink is refused (named on
+    stderr, exit 2), and nothing is written for it."""
+    from service.errors import ClientError
+
     api = _api(args)
     out: Path = args.out or Path(args.submission) / "logs"
     try:
         listing = api.call("GET", f"/v1/submissions/{args.submission}/logs")
-        written = []
+        written: list[str] = []
+        refused: list[dict[str, str]] = []
         for part in ("team", "public"):
             for name in listing[part]:
+                problem = unsafe_name(name)
+                if problem is not None:
+                    refused.append({"name": f"{part}/{name}", "reason": problem})
+                    continue
                 data = api.call("GET", f"/v1/submissions/{args.submission}/logs/{part}/{name}")
-                target = out / part / name
-                target.parent.mkdir(parents=True, exist_ok=True)
-                target.write_bytes(data if isinstance(data, bytes) else
-                                   json.dumps(data).encode())
+                problem = write_under(out, f"{part}/{name}", data if isinstance(data, bytes)
+                                      else json.dumps(data).encode())
+                if problem is not None:
+                    refused.append({"name": f"{part}/{name}", "reason": problem})
+                    continue
                 written.append(f"{part}/{name}")
-        _print({"submission": args.submission, "folder": str(out), "files": written})
+        for entry in refused:
+            print(f"hlvs: {entry['name']!a}: not written: {entry['reason']}", file=sys.stderr)
+        _print({"submission": args.submission, "folder": str(out), "files": written,
+                "refused": refused})
+        if refused:
+            raise ClientError(url=f"/v1/submissions/{args.submission}/logs", status=422,
+                              message=f"{len(refused)} listed name(s) refused (not under "
+                                      f"{out})")
         return 0
     finally:
         api.close()
+
+
+def unsafe_name(name: object) -> str | None:
+    """Why a listed log name may not be written under the output folder (None: it may)."""
+    if not isinstance(name, str) or not name:
+        return "not a file name"
+    if "\0" in name:
+        return "a NUL in the name"
+    if name.startswith("/") or (len(name) > 1 and name[1] == ":"):
+        return "an absolute path"
+    parts = name.split("/")
+    if any(p in ("", ".", "..") for p in parts):
+        return "an empty, '.' or '..' part (outside the output folder)"
+    return None
+
+
+def write_under(root: Path, name: str, data: bytes) -> str | None:
+    """Write ``data`` to ``root/name`` without following a symlink anywhere below ``root``;
+    why not, when it cannot be."""
+    folder = root
+    folder.mkdir(parents=True, exist_ok=True)
+    *parents, leaf = name.split("/")
+    for part in parents:
+        folder = folder / part
+        if folder.is_symlink():
+            return f"{folder} is a symlink"
+        try:
+            folder.mkdir(exist_ok=True)
+        except FileExistsError:
+            return f"{folder} is not a folder"
+        if not folder.is_dir() or folder.is_symlink():
+            return f"{folder} is not a folder"
+    target = folder / leaf
+    try:
+        fd = os.open(target, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_NOFOLLOW, 0o644)
+    except OSError as exc:
+        return f"{target}: {exc.strerror}"
+    with os.fdopen(fd, "wb") as handle:
+        handle.write(data)
+    return None
 
 
 __all__ = ["Api", "register_client_commands"]

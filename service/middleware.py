@@ -23,6 +23,9 @@ from service.db import Scope as TokenScope
 if TYPE_CHECKING:
     from service.app import Services
 
+BODY_KEY = "hlvs.body"
+"""The chunks of a request's body as read (in its scope): a body the route's parser could not
+read (JSON nested too deep for it) is looked at again for the error's pointer."""
 STATUS_PATH = re.compile(r"^/v1/submissions/([A-Za-z0-9_]{1,32})$")
 
 
@@ -59,11 +62,13 @@ class BodyLimit:
             return
         received = 0
         started = False
+        kept: list[bytes] = scope.setdefault(BODY_KEY, [])
 
         async def counted() -> Message:
             nonlocal received
             message = await receive()
             if message["type"] == "http.request":
+                kept.append(message.get("body", b""))
                 received += len(message.get("body", b""))
                 if received > self.max_bytes:
                     raise BodyTooLarge(self.max_bytes)
@@ -128,4 +133,4 @@ async def _send_json(send: Send, status: int, content: dict[str, str]) -> None:
     await send({"type": "http.response.body", "body": body})
 
 
-__all__ = ["BodyLimit", "BodyTooLarge", "STATUS_PATH", "StatusFastPath"]
+__all__ = ["BODY_KEY", "BodyLimit", "BodyTooLarge", "STATUS_PATH", "StatusFastPath"]

@@ -88,7 +88,21 @@ def list_matches(request: Request, principal: AnyPrincipal,
     if not _is_operator(principal):
         query = query.where((Submission.team_id == principal.team_id)
                             | (Submission.opponent == principal.team_name))
-    return [view_of(request, session, row) for row in session.scalars(query)]
+    views = []
+    for row in session.scalars(query):
+        view = view_of(request, session, row)
+        if not _is_operator(principal) and row.team_id != principal.team_id:
+            view = as_opponent(view)
+        views.append(view)
+    return views
+
+
+def as_opponent(view: SubmissionView) -> SubmissionView:
+    """A friendly as its opponent sees it: without what is the asking team's own (where its
+    logs go, its pre-flight, the cause of a failure on its side)."""
+    return view.model_copy(update={
+        "log_delivery": None, "preflight_s": None, "waiting_reason": None,
+        "cause": view.cause if view.failure_side == "league" else None})
 
 
 def mount(app: FastAPI) -> None:

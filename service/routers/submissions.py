@@ -5,6 +5,10 @@ Another team's submission id answers 404 exactly like an unknown one, so ids do 
 
 from __future__ import annotations
 
+import json
+import os
+import re
+import stat
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -249,9 +253,59 @@ def get_report(submission_id: str, request: Request, principal: TeamPrincipal,
 
 @router.get("/{submission_id}/results")
 def get_results(submission_id: str, request: Request, principal: TeamPrincipal,
-                session: DbSession) -> FileResponse:
+                session: DbSession) -> Response:
+    """The match's ``results.json`` as the team may see it: the other side's robots without
+    their image, digest, container and errors (another team's images are its own; an operator
+    reads the file itself)."""
     row, out = _own(request, principal, session, submission_id)
-    return _file(out / files.RESULTS, "results of submission", row, "application/json")
+    path = out / files.RESULTS
+    if not path.is_file():
+        raise NotFound(what="results of submission", ident=f"{row.id} ({row.state})")
+    return Response(json.dumps(own_view_of_results(json.loads(path.read_text("utf-8"))),
+                               indent=2) + "\n", media_type="application/json")
+
+
+OTHER_SIDE_HIDDEN = ("image", "digest", "image_error", "startup_error", "container",
+                     "log_folder")
+
+
+def own_view_of_results(results: dict[str, Any]) -> dict[str, Any]:
+    """``results.json`` without the other side's image names and digests: its robots'
+    identifying fields are null, and a cause, forfeit reason or warning that names one of its
+    images says only that it was the other team's."""
+    robots = results.get("robots")
+    if not isinstance(robots, dict):
+        return results
+    secrets_of_other: set[str] = set()
+    kept: dict[str, Any] = {}
+    for key, robot in robots.items():
+        if key.startswith(OWN_COLOR + "-") or not isinstance(robot, dict):
+            kept[key] = robot
+            continue
+        for name in ("image", "digest"):
+            value = robot.get(name)
+            if isinstance(value, str) and value:
+                secrets_of_other.add(value)
+                repository = value.split("@", 1)[0]
+                if ":" in repository.split("/")[-1]:
+                    repository = repository.rpartition(":")[0]
+                if "/" in repository:
+                    secrets_of_other.add(repository)
+        kept[key] = {**robot, **{name: None for name in OTHER_SIDE_HIDDEN if name in robot}}
+    view = {**results, "robots": kept}
+
+    def hidden(text: object) -> object:
+        if isinstance(text, str) and any(s and s in text for s in secrets_of_other):
+            return "(about the other team's images: not shown)"
+        return text
+
+    for name in ("failure", "forfeit"):
+        entry = view.get(name)
+        if isinstance(entry, dict):
+            view[name] = {k: hidden(v) for k, v in entry.items()}
+    if isinstance(view.get("warnings"), list):
+        view["warnings"] = [hidden(w) for w in view["warnings"]]
+    return view
 
 
 @router.get("/{submission_id}/replay")
@@ -275,11 +329,42 @@ def get_video(submission_id: str, request: Request, principal: TeamPrincipal,
 
 
 def _listing(root: Path) -> list[str]:
-    """Every finished file under ``root`` (a video still being rendered is not one)."""
+    """Every finished regular file under ``root`` (not a symlink, nor a file under a linked
+    folder; a video still being rendered is not one). A name that is not UTF-8 (a robot may
+    write any bytes) is listed with its bytes escaped as ``\\xNN`` (:func:`_unescaped` reads
+    it back)."""
     if not root.is_dir():
         return []
-    return sorted(str(p.relative_to(root)) for p in root.rglob("*")
-                  if p.is_file() and p.name != PARTIAL_VIDEO_FILE)
+    names = []
+    for path in root.rglob("*"):
+        if path.name == PARTIAL_VIDEO_FILE or not stat.S_ISREG(path.lstat().st_mode):
+            continue
+        relative = path.relative_to(root)
+        if any(parent.is_symlink() for parent in (root / relative).parents
+               if parent != root and parent.is_relative_to(root)):
+            continue
+        names.append(_escaped(relative))
+    return sorted(names)
+
+
+def _escaped(relative: Path) -> str:
+    text = str(relative)
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        return os.fsencode(relative).decode("utf-8", "backslashreplace")
+    return text
+
+
+_ESCAPE = re.compile(rb"\\x([0-9a-f]{2})")
+
+
+def _unescaped(name: str) -> str:
+    """A listed name back to the file's own name (its ``\\xNN`` escapes as bytes)."""
+    if "\\x" not in name:
+        return name
+    raw = _ESCAPE.sub(lambda m: bytes([int(m.group(1), 16)]), name.encode("utf-8"))
+    return os.fsdecode(raw)
 
 
 @router.get("/{submission_id}/logs")
@@ -300,10 +385,13 @@ def get_log(submission_id: str, part: str, path: str, request: Request,
         raise NotFound(what="log folder", ident=part)
     root = roots[part].resolve()
     target = (root / path).resolve()
+    if not target.is_file() and "\\x" in path:
+        target = (root / _unescaped(path)).resolve()
     if not target.is_relative_to(root) or not target.is_file() or \
             target.name == PARTIAL_VIDEO_FILE:
         raise NotFound(what="log file", ident=f"{part}/{path}")
-    return FileResponse(target, media_type="application/octet-stream", filename=target.name)
+    return FileResponse(target, media_type="application/octet-stream",
+                        filename=_escaped(Path(target.name)))
 
 
 def mount(app: FastAPI) -> None:
