@@ -182,3 +182,27 @@ def test_a_log_name_that_is_not_utf8_is_listed_escaped_and_downloads(
         assert "1/passwd" not in names
         got = http.get(f"/v1/submissions/{sid}/logs/team/1/bad\\xff\\xfe.log")
         assert got.status_code == 200 and got.text == "raw bytes name\n"
+
+
+def test_deep_json_gets_422_with_a_pointer_on_every_route_with_a_body(
+        start: Callable[..., Served], token: Callable[..., str]) -> None:
+    """5,000 levels, as sent in the attack: every route that reads a body answers 422 with
+    the pointer of the first value nested too deep (a typed route's parser gives up on it)."""
+    served = start(max_upload_bytes=400_000)
+    deep = b"[" * 5000 + b"]" * 5000
+    headers = {"Content-Type": "application/json"}
+    routes = [("PUT", "/v1/team/files/team_config"), ("POST", "/v1/team/files/credentials/check"),
+              ("PATCH", "/v1/team"), ("POST", "/v1/submissions"), ("POST", "/v1/envs/"),
+              ("POST", "/v1/envs/x/reset/"), ("POST", "/v1/envs/x/step/"),
+              ("POST", "/v1/envs/x/monitor/start/")]
+    schema = httpx.get(served.url + "/openapi.json").json()
+    with_body = {(m.upper(), p) for p, ops in schema["paths"].items() for m, op in ops.items()
+                 if "requestBody" in op}
+    assert with_body <= {(m, p.replace("x", "{instance_id}")) if "envs/x" in p else (m, p)
+                         for m, p in routes}, with_body
+    with served.client(token("Mallory")) as http:
+        for method, path in routes:
+            answer = http.request(method, path, content=deep, headers=headers)
+            assert answer.status_code == 422, (path, answer.status_code, answer.text[:200])
+            pointer = answer.json()["problems"][0]["pointer"]
+            assert pointer == "/0" * 65, (path, pointer[:80])
