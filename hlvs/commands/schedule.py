@@ -1,5 +1,5 @@
-"""``hlvs schedule run|list|status|cancel|abort|reschedule|apply|standings``: a tournament from
-one schedule file, and the operator's controls over it."""
+"""``hlvs schedule run|list|status|cancel|abort|reschedule|apply|standings|export``: a
+tournament from one schedule file, the operator's controls over it, and its results."""
 
 from __future__ import annotations
 
@@ -103,6 +103,18 @@ def register(sub: Any) -> None:
         "recorded at the start runs on)")
     apply.add_argument("--state", type=user_path, required=True, help=_STATE_HELP)
     apply.set_defaults(func=_apply)
+
+    export = verbs.add_parser(
+        "export", help="the results for the league's website: matches (scores, shoot-outs), "
+        "standings, bracket")
+    export.add_argument("--state", type=user_path, required=True, help=_STATE_HELP)
+    export.add_argument("--format", choices=("json", "csv"), default="json",
+                        help="json: one document with every table (default); csv: one table")
+    export.add_argument("--table", choices=("matches", "standings"), default="matches",
+                        help="the table --format csv writes (default matches)")
+    export.add_argument("--out", type=user_path, metavar="FILE",
+                        help="write to FILE (default: standard output)")
+    export.set_defaults(func=_export)
 
     table = verbs.add_parser("standings", help="points, goal difference and goals")
     table.add_argument("--state", type=user_path, required=True, help=_STATE_HELP)
@@ -372,6 +384,31 @@ def _warn_differences(ledger: Any) -> None:
 
     for note in file_differences(ledger):
         print(f"warning: {note}", file=sys.stderr)
+
+
+def _export(args: argparse.Namespace) -> int:
+    import io
+
+    from tournament.export import export_document, write_csv
+
+    document = export_document(_ledger(args.state))
+    if args.format == "json":
+        text = json.dumps(document, indent=2) + "\n"
+    else:
+        buffer = io.StringIO()
+        write_csv(document, args.table, buffer)
+        text = buffer.getvalue()
+    if args.out is None:
+        sys.stdout.write(text)
+        return 0
+    try:
+        args.out.write_text(text, encoding="utf-8")
+    except OSError as exc:
+        raise ConfigError([Problem(str(args.out), "", f"cannot be written: {exc.strerror}",
+                                   expected="a file in a folder that exists")]) from None
+    table = args.table if args.format == "csv" else "matches"
+    print(f"{args.out}: {len(document[table])} {table}")
+    return 0
 
 
 def _standings(args: argparse.Namespace) -> int:

@@ -223,7 +223,8 @@ def test_a_knockout_decided_on_penalties_keeps_the_match_goals_apart(
     fake_services.DRAWN.add("ko-r1-1")
     path = write_schedule(
         tmp_path,
-        COMPRESSED + "fixtures:\n  knockout: {seeds: [alpha, bravo], first_stream: '+4s',"
+        COMPRESSED.replace("pull_lead_knockout_s: 3.5", "pull_lead_knockout_s: 10.0")
+        + "fixtures:\n  knockout: {seeds: [alpha, bravo], first_stream: '+10.5s',"
         " stream_length_s: 0.3}\n",
     )
     state = tmp_path / "state.sqlite"
@@ -342,3 +343,55 @@ def test_logs_delivered_by_hand_after_a_fix_clear_logs_failed(tmp_path: Path, fa
     assert m2.state is S.LOGS_FAILED and {e.team: e.state for e in m2.logs}["bravo"] == "gone"
     assert "never delivered (pruned)" in m2.note
     assert [to for _, _, _, to, _ in ledger.history("m1")][-1] == "DELIVERED"
+
+
+def test_export_gives_scores_shootouts_and_standings_as_json_and_csv(
+    tmp_path: Path, fake: None, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import csv
+    import io
+
+    from hlvs.cli import main
+
+    fake_services.DRAWN.add("ko-r1-1")
+    path = write_schedule(
+        tmp_path,
+        # long windows: the test is about the export, not about misses on a loaded machine
+        COMPRESSED.replace("pull_lead_knockout_s: 3.5", "pull_lead_knockout_s: 10.0")
+        .replace("pull_lead_round_robin_s: 3.0", "pull_lead_round_robin_s: 10.0")
+        + "matches:\n  - {id: m1, red: charlie, blue: delta, stream_start: '+10.2s',"
+        " stream_length_s: 0.2}\n"
+        "fixtures:\n  knockout: {seeds: [alpha, bravo], first_stream: '+10.5s',"
+        " stream_length_s: 0.3}\n",
+    )
+    state = tmp_path / "state.sqlite"
+    services = "tests.unit.schedule.fake_services:MatchFolderServices"
+    assert run_schedule(path, state, services=services, exit_when_done=True, poll_s=0.1) == 0
+    capsys.readouterr()
+    assert main(["schedule", "export", "--state", str(state)]) == 0
+    document = json.loads(capsys.readouterr().out)
+    assert document["name"] == "test cup" and document["bracket"] == [["ko-r1-1"]]
+    final = next(m for m in document["matches"] if m["id"] == "ko-r1-1")
+    assert (final["red_goals"], final["blue_goals"], final["shootout_red"],
+            final["shootout_blue"], final["winner"], final["score"]) == (
+        0, 0, 3, 2, "alpha", "0-0 (shoot-out 3-2)")
+    m1 = next(m for m in document["matches"] if m["id"] == "m1")
+    assert (m1["red_goals"], m1["blue_goals"]) == (fake_services.goals("charlie"),
+                                                   fake_services.goals("delta") + 4)
+    assert m1["shootout_red"] is None and m1["winner"] == "delta"
+    table = {s["team"]: s for s in document["standings"]}
+    assert table["delta"]["points"] == 3 and table["delta"]["rank"] == 1
+    assert table["alpha"]["played"] == 0  # a knockout match is not in the table
+    out = tmp_path / "matches.csv"
+    assert main(["schedule", "export", "--state", str(state), "--format", "csv", "--out",
+                 str(out)]) == 0
+    rows = {r["id"]: r for r in csv.DictReader(io.StringIO(out.read_text()))}
+    assert rows["ko-r1-1"]["score"] == "0-0 (shoot-out 3-2)"
+    assert rows["ko-r1-1"]["shootout_red"] == "3" and rows["m1"]["shootout_red"] == ""
+    assert rows["ko-r1-1"]["played"] == "true"
+    assert capsys.readouterr().out == f"{out}: 2 matches\n"
+    assert main(["schedule", "export", "--state", str(state), "--format", "csv", "--table",
+                 "standings"]) == 0
+    standings_csv = list(csv.DictReader(io.StringIO(capsys.readouterr().out)))
+    assert [r["team"] for r in standings_csv][0] == "delta" and len(standings_csv) == 4
+    assert main(["schedule", "export", "--state", str(tmp_path / "none.sqlite")]) == 2
