@@ -1,7 +1,8 @@
 """Every command of the READMEs, run as written from a fresh copy of the repository.
 
 The commands are read from the ``sh`` (``shell``, ``bash``) and ``python`` code blocks of
-README.md, configs/README.md and images/README.md, in order, and run with the working directory
+README.md, configs/README.md, images/README.md and docs/tournament.md (the tournament operator's
+guide), in order, and run with the working directory
 at the root of a copy of the repository (tracked and new files, no build output), the project's
 virtual environment linked in as ``.venv`` and on PATH (as after ``. .venv/bin/activate``) and no
 ``MUJOCO_GL`` (the program must choose). ``make X`` runs the recipe of ``X`` from the Makefile
@@ -31,7 +32,7 @@ from pathlib import Path
 import pytest
 
 REPO = Path(__file__).resolve().parents[2]
-READMES = ("README.md", "configs/README.md", "images/README.md")
+READMES = ("README.md", "configs/README.md", "images/README.md", "docs/tournament.md")
 SHELL_FENCES = {"sh", "shell", "bash"}
 MARKER = re.compile(r"#\s*not run in CI:\s*(?P<reason>.*\S)\s*$")
 FENCE = re.compile(r"^```\s*(?P<info>[\w-]*)\s*$")
@@ -287,6 +288,13 @@ OUTCOMES: dict[str, Outcome] = {
     "hlvs check --official --json configs/examples/robots/wolfgang": Outcome(official_model_ok),
     "hlvs check configs/examples/schedule/knockout.yaml": Outcome(check_ok),
     "hlvs schedule list configs/examples/schedule/knockout.yaml": Outcome(exit_zero),
+    # docs/tournament.md (the operator's guide; make scrimmage, the activation, the operator
+    # token and the credentials check are README.md's and configs/README.md's commands)
+    "chmod 600 'configs/examples/credentials/*.json' configs/examples/credentials/id_ed25519": (
+        Outcome(exit_zero)),
+    "hlvs check configs/examples/schedule/tournament.yaml": Outcome(check_ok),
+    "hlvs schedule list configs/examples/schedule/tournament.yaml": Outcome(exit_zero),
+    "hlvs logs status --store matches/example-cup/log-store": Outcome(exit_zero),
     # images/README.md
     "hlvs compose configs/examples/scrimmage_1v1/game.json -o match/docker-compose.yml": Outcome(
         compose_written
