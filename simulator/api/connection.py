@@ -257,12 +257,14 @@ class Connection:
 
     def read_threaded(self, now: float) -> bool:
         """I/O thread: :meth:`read`, leaving a failure in ``error`` for the step thread.
-        True when the step thread has something new: requests or a failure."""
+        True when the step thread has something new: requests, an answer dropped for its size
+        (its notice), or a failure."""
         with self._lock:
             if self.closed or self.error is not None:
                 return False
+            answered_at = self.answered_at
             try:
-                return self.read(now) > 0
+                return self.read(now) > 0 or self.answered_at != answered_at
             except ClientClosed as exc:
                 self.error = exc.reason
                 return True

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import time
 
+import pytest
+
 from contracts.robot_api import messages_pb2 as pb
 from simulator.api import FakeDeviceWorld, LockstepSettings
 from simulator.api.bounds import MAX_REQUEST_BYTES
@@ -19,11 +21,14 @@ def _oversize() -> bytes:
     return body
 
 
-def test_an_oversize_request_is_answered_with_a_warning_and_counts_as_the_answer() -> None:
+@pytest.mark.parametrize("send_thread", [False, True], ids=["step-thread-io", "io-thread"])
+def test_an_oversize_request_is_answered_with_a_warning_and_counts_as_the_answer(
+    send_thread: bool,
+) -> None:
     lockstep = LockstepSettings(deadline_s=0.05, time_bank_s=0.2)
     body = _oversize()
     with running_server(robots=(RED1,), lockstep=lockstep, world=FakeDeviceWorld((RED1,)),
-                        pause_s=0.0) as (driver, ports):  # fmt: skip
+                        pause_s=0.0, send_thread=send_thread) as (driver, ports):  # fmt: skip
         with LeagueStyleClient("127.0.0.1", ports[RED1], split_writes=False) as client:
             client.send(neck_request(0.0, enable=True))
             wait_until(lambda: driver.server.connected())
