@@ -10,11 +10,13 @@ import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from contracts import TEST_MATCH, TimingError, fit_ready
-from orchestrator.delivery import IPNetwork, networks
 from service.errors import SettingsError
+
+if TYPE_CHECKING:
+    from orchestrator.delivery import IPNetwork
 
 PREFIX = "HLVS_SERVICE_"
 WEBHOOK_ALLOW_SETTING = PREFIX + "WEBHOOK_ALLOW"
@@ -142,11 +144,15 @@ class Settings:
 
 def webhook_networks(settings: Settings) -> tuple[IPNetwork, ...]:
     """The networks of ``webhook_allow``; ValueError for one that is not a network."""
+    from orchestrator.delivery import networks  # not while the command line builds its parser
+
     return networks(settings.webhook_allow)
 
 
 def log_target_networks(settings: Settings) -> tuple[IPNetwork, ...]:
     """The networks of ``log_target_allow``; ValueError for one that is not a network."""
+    from orchestrator.delivery import networks
+
     return networks(settings.log_target_allow)
 
 
@@ -184,6 +190,8 @@ def _check(settings: Settings) -> None:
         if getattr(settings, name) <= 0:
             raise SettingsError(name=PREFIX + name.upper(), value=str(getattr(settings, name)),
                                 expected="a positive number")
+    from orchestrator.delivery import networks
+
     for name in ("webhook_allow", "log_target_allow"):
         try:
             networks(getattr(settings, name))
@@ -205,5 +213,5 @@ def _check(settings: Settings) -> None:
                             expected=f"a longer half: {exc}") from None
 
 
-__all__ = ["IPNetwork", "LOG_TARGET_ALLOW_SETTING", "Settings", "WEBHOOK_ALLOW_SETTING",
+__all__ = ["LOG_TARGET_ALLOW_SETTING", "Settings", "WEBHOOK_ALLOW_SETTING",
            "log_target_networks", "webhook_networks"]

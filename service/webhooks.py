@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
-from contracts.webhooks import WebhookRejected, sign, verify
+from contracts import webhooks as _contract
+
+WebhookRejected = _contract.WebhookRejected
+sign = _contract.sign
+verify = _contract.verify
 
 __all__ = ["WebhookRejected", "sign", "verify"]

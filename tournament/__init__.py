@@ -34,6 +34,13 @@ if TYPE_CHECKING:
         recorded_schedule,
         reschedule,
     )
+    from tournament.notify import (
+        NotifySettings,
+        Outbox,
+        Webhook,
+        recorded_settings,
+        scheduler_state,
+    )
     from tournament.overview import (
         Snapshot,
         match_folder,
@@ -44,19 +51,22 @@ if TYPE_CHECKING:
 
 __all__ = [
     "DEFAULT_ABORT_GRACE_S",
-    "STOPPING",
     "Ledger",
     "LiveGame",
     "MatchContext",
     "MatchResultRecord",
     "MatchRow",
     "MatchServices",
+    "NotifySettings",
     "OperatorRequest",
+    "Outbox",
     "PlayOutcome",
+    "STOPPING",
     "ScheduledMatchState",
     "Snapshot",
     "Standing",
     "TournamentServices",
+    "Webhook",
     "abort",
     "apply_file",
     "file_differences",
@@ -64,10 +74,12 @@ __all__ = [
     "match_folder",
     "read_outcome",
     "recorded_schedule",
+    "recorded_settings",
     "recover_interrupted",
     "replay_path",
     "reschedule",
     "run_schedule",
+    "scheduler_state",
     "standings",
     "status_lines",
     "tournament_overview",
@@ -80,6 +92,9 @@ if not TYPE_CHECKING:
         "tournament.controls": (
             "DEFAULT_ABORT_GRACE_S", "abort", "apply_file", "file_differences", "recorded_schedule",
             "reschedule",
+        ),
+        "tournament.notify": (
+            "NotifySettings", "Outbox", "Webhook", "recorded_settings", "scheduler_state",
         ),
         "tournament.overview": (
             "Snapshot", "match_folder", "replay_path", "status_lines", "tournament_overview",

@@ -166,7 +166,7 @@ def _run(args: argparse.Namespace) -> int:
 
 def _notify_settings(args: argparse.Namespace) -> str | None:
     """The --notify-* options as the state file records them (None: keep the recorded ones)."""
-    from tournament.notify import NotifySettings, Webhook
+    from tournament import NotifySettings, Webhook
 
     if not args.notify_mail and not args.notify_webhook:
         return None
@@ -258,8 +258,7 @@ def _print_plan(rows: list[dict[str, str]], *, as_json: bool) -> None:
 
 
 def _status(args: argparse.Namespace) -> int:
-    from tournament import Snapshot, status_lines
-    from tournament.notify import scheduler_state
+    from tournament import Snapshot, scheduler_state, status_lines
 
     snapshot: Snapshot | None = None
     if not args.json:  # a running match's score and clock, from its telemetry
@@ -317,7 +316,7 @@ def _wait_for_state(path: Path, every_s: float) -> Any:
 def _notify_dead(ledger: Any, alive: Any) -> None:
     """A scheduler that stopped beating cannot tell: the watching operator's command does,
     with the notification settings the scheduler recorded."""
-    from tournament.notify import Outbox, recorded_settings
+    from tournament import Outbox, recorded_settings
 
     settings = recorded_settings(ledger)
     if settings.any and alive.waiting and alive.since is not None:

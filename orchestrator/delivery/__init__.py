@@ -20,28 +20,34 @@ from orchestrator.delivery.addresses import (
     networks,
     resolve,
 )
-from orchestrator.delivery.deliver import (
-    MANIFEST_NAME,
-    DeliveryOutcome,
-    Opener,
-    RetryPolicy,
-    deliver_pending,
-    deliver_set,
-    pending_status,
-)
-from orchestrator.delivery.enqueue import KEEP_UNDELIVERED, PUBLIC_TEAM, enqueue_match_logs
-from orchestrator.delivery.store import DeliveryFailure, FileEntry, PendingSet
-from orchestrator.delivery.targets import open_uploader
-from orchestrator.delivery.uploader import (
-    ERROR_KINDS,
-    TRANSIENT_KINDS,
-    FakeUploader,
-    Uploader,
-    is_transient,
-)
 
 if TYPE_CHECKING:
-    from orchestrator.delivery.store import DeliveryReceipt, delivered_receipts, list_sets
+    from orchestrator.delivery.deliver import (
+        MANIFEST_NAME,
+        DeliveryOutcome,
+        Opener,
+        RetryPolicy,
+        deliver_pending,
+        deliver_set,
+        pending_status,
+    )
+    from orchestrator.delivery.enqueue import KEEP_UNDELIVERED, PUBLIC_TEAM, enqueue_match_logs
+    from orchestrator.delivery.store import (
+        DeliveryFailure,
+        DeliveryReceipt,
+        FileEntry,
+        PendingSet,
+        delivered_receipts,
+        list_sets,
+    )
+    from orchestrator.delivery.targets import open_uploader
+    from orchestrator.delivery.uploader import (
+        ERROR_KINDS,
+        TRANSIENT_KINDS,
+        FakeUploader,
+        Uploader,
+        is_transient,
+    )
 
 __all__ = [
     "AddressRefused",
@@ -76,7 +82,21 @@ __all__ = [
 ]
 
 
+# The address rules are light (the service's settings read them while the command line builds its
+# parser); the rest loads the configuration and the uploaders, so it is imported when first used.
 if not TYPE_CHECKING:
     __getattr__, __dir__ = lazy_exports(__name__, {
-        "orchestrator.delivery.store": ("DeliveryReceipt", "delivered_receipts", "list_sets"),
+        "orchestrator.delivery.deliver": (
+            "MANIFEST_NAME", "DeliveryOutcome", "Opener", "RetryPolicy", "deliver_pending",
+            "deliver_set", "pending_status",
+        ),
+        "orchestrator.delivery.enqueue": ("KEEP_UNDELIVERED", "PUBLIC_TEAM", "enqueue_match_logs"),
+        "orchestrator.delivery.store": (
+            "DeliveryFailure", "DeliveryReceipt", "FileEntry", "PendingSet", "delivered_receipts",
+            "list_sets",
+        ),
+        "orchestrator.delivery.targets": ("open_uploader",),
+        "orchestrator.delivery.uploader": (
+            "ERROR_KINDS", "TRANSIENT_KINDS", "FakeUploader", "Uploader", "is_transient",
+        ),
     })
