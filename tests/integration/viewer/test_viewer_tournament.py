@@ -120,6 +120,9 @@ def test_operator_overview_of_a_tournament(
     assert page.locator("[data-testid=live-show]").get_attribute("href") == (
         "/watch/tournament/live/show?red=alpha&blue=charlie")
     assert seen == [cup.parent / "out" / "show" / "match"]
+    # the scheduler stopped with "show" left PLAYING: the page says nobody runs it
+    assert page.locator("[data-testid=warnings]").inner_text().startswith(
+        "scheduler not running since ")
     # the bracket: the shoot-out's winner is in the final
     final = ledger.row("ko-r2-1")
     winner = semi.result["winner_team"]

@@ -1,7 +1,8 @@
 """Services for scheduler tests: a 'match' is a short sleep with a score derived from the names.
 
 ``HLVS_FAKE_DRAWN`` (match ids) ends those matches 1-1; ``HLVS_FAKE_DEAD_TEAMS`` (team names)
-makes those teams' log deliveries fail as an unreachable target would. Both are read when the
+makes those teams' log deliveries fail as an unreachable target would (the set stays in the log
+store). Both are read when the
 module is imported (set them before the scheduler's first job, or in a child's environment).
 
 Every step appends a line to ``<output_dir>/services.log`` (``pull|play-start|play-end|deliver
@@ -76,7 +77,20 @@ class FakeServices:
 
     def deliver(self, ctx: MatchContext) -> list[TeamLogs]:
         _log(self.schedule, "deliver", ctx.match_id)
+        for team in (ctx.red.name, ctx.blue.name):
+            if team in DEAD_TEAMS:
+                self._leave_in_store(ctx, team)
         return [self._one(ctx.red.name), self._one(ctx.blue.name)]
+
+    def _leave_in_store(self, ctx: MatchContext, team: str) -> None:
+        """A set that failed stays in the log store, as the real services leave it."""
+        from orchestrator.delivery.store import create_set
+
+        source = ctx.out_dir / f"{team}.log"
+        source.parent.mkdir(parents=True, exist_ok=True)
+        source.write_text("log\n")
+        create_set(self.schedule.log_store, match_id=ctx.league_id, team=team, kind="team",
+                   credentials=None, sources=[(source, "robot.log")], move=False)
 
     def redeliver(self, ctx: MatchContext) -> list[TeamLogs]:
         _log(self.schedule, "redeliver", ctx.match_id)
