@@ -17,8 +17,12 @@ have no controller. Differences from Webots, all of the world and none of the ru
   height in the league's world) and put at ours; a tested robot height is converted back.
 - A ball placed lower than its radius rests on the ground (both engines push it out; MuJoCo's
   push would throw it).
-- The "System" clock is the referee's wall clock, which moves with simulated time here (the
-  league's runs at its host's speed).
+- The "System" clock is the referee's wall clock (its real-time waits: before the first READY,
+  the half-time break), driven by the simulated one at the pace of the league's world: at the
+  game's maximum real-time factor (the league's referee holds each step to it, referee.py:2457-
+  2470), or :data:`FAST_SPEED` times real time for a game run as fast as possible (the league's
+  world then runs at its host's speed: its scenarios expect a 2 s half-time break,
+  referee.py:1913-1916, to last more than 5 simulated seconds).
 - The packet is read the step it is made (the league's arrives by UDP, a step or more later).
 
 The league's world lets resting bodies sleep (``worlds/robocup.wbt:24-26``: physics disabled
@@ -61,6 +65,7 @@ SECONDARY_NAMES = {
 }  # fmt: skip
 STATE_NAMES = {0: "INITIAL", 1: "READY", 2: "SET", 3: "PLAYING", 4: "FINISHED"}
 END_OF_GAME_S = 5.0  # referee_config.yaml END_OF_GAME_TIMEOUT: the league's world runs on
+FAST_SPEED = 10.0  # simulated seconds per wall second of a game run as fast as possible
 SLEEP_SPEED = 0.1  # robocup.wbt: physicsDisableLinearThreshold / physicsDisableAngularThreshold
 SLEEP_AFTER_MS = 100  # robocup.wbt: physicsDisableTime 0.1
 LEAGUE_STANDING_Z_M = 0.24  # a RobocupRobot's halfTimeStartingPose height in the league's files
@@ -220,6 +225,8 @@ class LeagueTestRunner:
             physics_dt_s=spec.physics_dt_s,
         )
         self.clock = FakeClock()
+        rtf = spec.maximum_real_time_factor
+        self.speed = rtf if rtf > 0 else FAST_SPEED  # simulated seconds per wall second
         config = referee_config(spec)
         config = replace(config, timing=replace(config.timing, status_period_real_s=1e9))
         self.referee = Referee(config=config, clock=self.clock)
@@ -401,7 +408,7 @@ class LeagueTestRunner:
                 world.data.xfrc_applied[:] = 0.0
                 slow = float(np.abs(world.data.qvel).max(initial=0.0)) < SLEEP_SPEED
                 slow_ms = slow_ms + world.step_ms if slow else 0
-            self.clock.advance(world.step_ms / 1000)
+            self.clock.advance(world.step_ms / 1000 / self.speed)
         referee.close()
         waiting_pointers = {step.index for step in waiting}
         for outcome in self._outcomes.values():

@@ -11,7 +11,7 @@ import numpy as np
 
 from contracts import TeamColor
 from referee.gamecontroller.states import SecondaryState
-from referee.rules.base import AwardSetPlay, Decision, GameView, distance2d
+from referee.rules.base import Decision, GameView, distance2d, free_kick
 from referee.snapshot import Vec2, WorldSnapshot
 
 WINDOW_S = 5.0
@@ -104,11 +104,9 @@ def judge(
         if held_ms > WINDOW_S * 1000 / 2:
             ball = snapshot.ball.position
             decisions.append(
-                AwardSetPlay(
-                    SecondaryState.DIRECT_FREEKICK, team.opponent, (ball[0], ball[1]),
-                    f"ball holding by the {team.value} team",
-                )
-            )
+                free_kick(team.opponent, (ball[0], ball[1]), ball, game,
+                          f"ball holding by the {team.value} team")
+            )  # fmt: skip
             intervals = []
         holding[team] = tuple(intervals)
     return decisions, BallHoldingMemory(holding, now)

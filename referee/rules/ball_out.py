@@ -3,7 +3,8 @@
 The ball is out when it is fully beyond the outer edge of the line (the lines belong to the
 field). Throw-in: for the opponents of the last toucher, ball on the touch line at the x where it
 left. Goal line: corner kick (at the corner on the side where it left) when a defender touched
-it last, otherwise goal kick (ball on the corner of the goal area on that side). Without any
+it last, otherwise goal kick (ball where the halfway line meets the touch line on that side, as
+the league's referee places it). Without any
 recorded touch the team defending the half the ball left from gets the restart.
 """
 
@@ -43,10 +44,10 @@ def corner_spot(goal_sign: float, y_sign: float, field: FieldGeometry) -> Vec2:
 
 
 def goal_kick_spot(goal_sign: float, y_sign: float, field: FieldGeometry) -> Vec2:
-    return (
-        goal_sign * (field.half_length_m - field.goal_area_length_m),
-        y_sign * field.goal_area_width_m / 2.0,
-    )
+    """Where the halfway line meets the touch line on the side the ball left, as the league's
+    referee places a goal kick's ball (hlvs_webots referee.py:1747-1752, ``goal_kick``)."""
+    del goal_sign  # the same spot whichever goal line the ball crossed
+    return (0.0, y_sign * field.half_width_m)
 
 
 def goal_line_restart(

@@ -119,6 +119,27 @@ def distance2d(a: Vec2 | Vec3, b: Vec2 | Vec3) -> float:
     return math.hypot(a[0] - b[0], a[1] - b[1])
 
 
+def free_kick(
+    team: TeamColor, spot: Vec2, ball: Vec2 | Vec3, game: GameView, reason: str
+) -> AwardSetPlay:
+    """A direct free kick for ``team`` at ``spot``, or a penalty kick (on the penalty mark)
+    when the ball lies fully inside the penalty area ``team`` attacks, as the league's referee
+    decides a free kick (hlvs_webots referee.py:1682-1704 with field.py:55-58)."""
+    f = game.field
+    r = f.ball_radius_m
+    attacked = -game.side_sign(team)  # the sign of x of the goal team attacks
+    x, y = ball[0] * attacked, ball[1]
+    inside = (
+        x - r > f.half_length_m - f.penalty_area_length_m
+        and x + r < f.half_length_m
+        and abs(y) + r < f.penalty_area_width_m / 2.0
+    )
+    if inside:
+        mark = (attacked * f.penalty_mark_x_m, 0.0)
+        return AwardSetPlay(SecondaryState.PENALTYKICK, team, mark, reason)
+    return AwardSetPlay(SecondaryState.DIRECT_FREEKICK, team, spot, reason)
+
+
 def timers(
     active: Iterable[RobotId], since: Mapping[RobotId, int], now_ms: int, limit_s: float
 ) -> tuple[list[RobotId], dict[RobotId, int]]:

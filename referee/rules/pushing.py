@@ -15,7 +15,8 @@ referee) starts the average again.
 
 Consequence, for the pusher, as in the virtual league (no card): when the ball is in play and
 the pusher is within 1 m of it, a direct free kick for the other team at the victim's position
-(a penalty kick when the pusher stands in its own penalty area); otherwise removal for
+(a penalty kick when the ball lies fully inside the penalty area the other team attacks, as the
+league decides it, :func:`referee.rules.base.free_kick`); otherwise removal for
 PHYSICAL_CONTACT. A pair is immune for 2 s after a foul.
 """
 
@@ -27,7 +28,7 @@ from dataclasses import dataclass, field
 
 from contracts import RobotId
 from referee.gamecontroller.states import GameState, Penalty, SecondaryState
-from referee.rules.base import AwardSetPlay, Decision, GameView, PenalizeRobot, distance2d
+from referee.rules.base import Decision, GameView, PenalizeRobot, distance2d, free_kick
 from referee.snapshot import RobotState, Vec3, WorldSnapshot
 
 PERIOD_MS = 2000
@@ -110,30 +111,14 @@ def _sustained_pusher(a: RobotState, b: RobotState, ball: tuple[float, float]) -
     return a if da > db else b
 
 
-def _in_own_penalty_area(robot: RobotState, game: GameView) -> bool:
-    f = game.field
-    x = robot.position[0] * game.side_sign(robot.id.team)
-    return x >= f.half_length_m - f.penalty_area_length_m and abs(robot.position[1]) <= (
-        f.penalty_area_width_m / 2.0
-    )
-
-
 def _consequence(
     pusher: RobotState, victim: RobotState, game: GameView, ball: tuple[float, float], why: str
 ) -> list[Decision]:
     decisions: list[Decision] = []
     near = distance2d(pusher.position, ball) <= FREE_KICK_RANGE_M
     if game.running and game.ball_in_play and near:
-        if _in_own_penalty_area(pusher, game):
-            mark = game.side_sign(pusher.id.team) * game.field.penalty_mark_x_m
-            decisions.append(
-                AwardSetPlay(SecondaryState.PENALTYKICK, victim.id.team, (mark, 0.0), why)
-            )
-        else:
-            spot = (victim.position[0], victim.position[1])
-            decisions.append(
-                AwardSetPlay(SecondaryState.DIRECT_FREEKICK, victim.id.team, spot, why)
-            )
+        spot = (victim.position[0], victim.position[1])
+        decisions.append(free_kick(victim.id.team, spot, ball, game, why))
     else:
         decisions.append(PenalizeRobot(pusher.id, Penalty.PHYSICAL_CONTACT, why))
     return decisions

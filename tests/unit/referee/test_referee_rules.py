@@ -27,7 +27,15 @@ from referee.rules import (
     pushing,
     removal,
 )
-from referee.rules.base import AwardSetPlay, DropBall, GameView, GiveCard, Goal, PenalizeRobot
+from referee.rules.base import (
+    AwardSetPlay,
+    DropBall,
+    GameView,
+    GiveCard,
+    Goal,
+    PenalizeRobot,
+    free_kick,
+)
 from tests.unit.referee.referee_helpers import BLUE, RED, robot, snapshot
 
 R1, R2, B1, B2 = RobotId(RED, 1), RobotId(RED, 2), RobotId(BLUE, 1), RobotId(BLUE, 2)
@@ -122,13 +130,15 @@ def test_throw_in_placement_at_exit_x() -> None:
 
 
 def test_corner_and_goal_kick_spots() -> None:
+    """A goal kick's ball where the halfway line meets the touch line on the side the ball
+    left, as hlvs_webots places it (referee.py:1747-1752)."""
     corner = ball_out.judge(snapshot(1, ball=(-4.6, 2.0, 0.07), toucher=R1), view())
     assert corner[0] == AwardSetPlay(
         SecondaryState.CORNER_KICK, BLUE, (-4.5, 3.0), "ball over the goal line"
     )
     kick = ball_out.judge(snapshot(1, ball=(-4.6, -2.0, 0.07), toucher=B1), view())
     assert kick[0] == AwardSetPlay(
-        SecondaryState.GOAL_KICK, RED, (-3.5, -1.5), "ball over the goal line"
+        SecondaryState.GOAL_KICK, RED, (0.0, -3.0), "ball over the goal line"
     )
 
 
@@ -363,3 +373,20 @@ def test_shootout_coin_toss_is_seeded() -> None:
     assert again.coin_toss and again.winner is end_of_game.shootout_status(
         taken={RED: 10, BLUE: 10}, scored={RED: 1, BLUE: 1}, seed=4
     ).winner
+
+
+def test_a_free_kick_with_the_ball_fully_in_the_penalty_area_is_a_penalty_kick() -> None:
+    """hlvs_webots referee.py:1682-1704 (field.py:55-58): a free kick awarded while the ball
+    lies fully inside the penalty area of the offenders becomes a penalty kick on the penalty
+    mark; the ball touching the area's line keeps it a direct free kick."""
+    game = view()  # red defends x < 0
+    inside = free_kick(BLUE, (-3.0, -0.4), (-3.0, -0.65, 0.07), game, "ball holding")
+    assert inside == AwardSetPlay(SecondaryState.PENALTYKICK, BLUE, (-3.0, 0.0), "ball holding")
+    on_line = free_kick(BLUE, (-2.5, 0.0), (-2.52, 0.0, 0.07), game, "ball holding")
+    assert on_line == AwardSetPlay(
+        SecondaryState.DIRECT_FREEKICK, BLUE, (-2.5, 0.0), "ball holding"
+    )
+    # red attacks x > 0: a foul by blue with the ball in blue's area is red's penalty kick
+    ball = (3.6, 1.0, 0.07)
+    assert free_kick(RED, (3.5, 1.0), ball, game, "x").kind is SecondaryState.PENALTYKICK
+    assert free_kick(BLUE, (3.5, 1.0), ball, game, "x").kind is SecondaryState.DIRECT_FREEKICK

@@ -67,7 +67,7 @@ def test_the_referee_retakes_then_aborts_a_goal_kick() -> None:
     play = ref.gc.set_play
     assert play is not None and play.kind is SecondaryState.GOAL_KICK and play.team is BLUE
     spot = ref.set_play_spot
-    assert spot is not None
+    assert spot == (0.0, 3.0)  # the halfway line on the touch line, on the side the ball left
     ball = (spot[0], spot[1], 0.07)
     while ref.gc.set_play is not None and ref.gc.set_play.sub_phase == 0:
         _step(ref, clock, ms, (red_far, blue_far), ball)
