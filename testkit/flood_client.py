@@ -62,3 +62,9 @@ def flood(port: int, stop: threading.Event, sent: list[int], host: str = "127.0.
 
 
 __all__ = ["flood", "flood_frames"]
+
+
+if __name__ == "__main__":  # python -m testkit.flood_client PORT: flood until killed
+    import sys
+
+    flood(int(sys.argv[1]), threading.Event(), [0])
