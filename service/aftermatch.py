@@ -37,7 +37,9 @@ import subprocess
 import sys
 import threading
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
+from datetime import UTC, datetime, timedelta
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -62,6 +64,9 @@ RENDER_STATE = "render.json"
 RENDER_LOG = "render.log"
 MAX_RENDERS = 2  # renders of one video (a second one after a restart killed the first)
 POLL_S = 1.0
+RENDER_PER_MATCH_S = 5.0
+"""Seconds of render per second the match played, until a render of this service process was
+timed (then that one's ratio): the pending video's detail says when it is expected."""
 
 
 LOG_STORE = "log-store"  # in the service's data folder
@@ -96,6 +101,7 @@ class AfterMatch:
         self.settings = services.settings
         self.python = python
         self._render: _Render | None = None
+        self._render_per_match_s = RENDER_PER_MATCH_S
         self._stop = threading.Event()
         self._wake = threading.Event()
         self._thread: threading.Thread | None = None
@@ -148,6 +154,7 @@ class AfterMatch:
                 self._render = None  # its submission was requeued meanwhile
             for row in pending:
                 self._video(row)
+            self._expect([row for row in pending if row.video_state == MediaState.PENDING.value])
 
     # logs ----------------------------------------------------------------------------------
     def _deliveries(self) -> None:
@@ -303,6 +310,9 @@ class AfterMatch:
         self._render = None
         if code == 0 and render.partial.is_file():
             render.partial.replace(render.video)
+            played_s = _played_s(row)
+            if played_s is not None and played_s > 0:
+                self._render_per_match_s = elapsed / played_s
             s = self.settings
             self._set(row, MediaState.READY, f"{render.video.stat().st_size} bytes, "
                       f"{s.video_width}x{s.video_height} at {s.video_fps:g} fps, rendered "
@@ -313,11 +323,62 @@ class AfterMatch:
         self._set(row, MediaState.FAILED, f"hlvs render exited with code {code}"
                   + _tail(work / RENDER_LOG).replace(f"{out}/", ""))
 
+    def _expect(self, pending: Sequence[Submission]) -> None:
+        """Each pending video's detail says when it is expected: the render under way first,
+        then the others in their order, each taking its match's length times the ratio."""
+        render = self._render
+        rendering = render.submission_id if render is not None else None
+        queue = sorted(pending, key=lambda r: r.id != rendering)  # stable: the rest in order
+        details = pending_details(
+            [(row.id, _played_s(row) or self.settings.expected_match_s) for row in queue],
+            now=datetime.now(UTC), rendering_id=rendering,
+            rendering_elapsed_s=time.monotonic() - render.started if render is not None else 0.0,
+            render_per_match_s=self._render_per_match_s)
+        for row in queue:
+            if row.video_detail != details[row.id]:
+                row.video_detail = details[row.id]
+
     def _set(self, row: Submission, state: MediaState, detail: str) -> None:
         row.video_state = state.value
         row.video_detail = detail
         log.log(logging.WARNING if state is MediaState.FAILED else logging.INFO,
                 "submission %s: video %s (%s)", row.id, state.value, detail)
+
+
+def _played_s(row: Submission) -> float | None:
+    """The match's wall time, start to end (the length of its replay, near enough)."""
+    if row.started_at is None or row.finished_at is None:
+        return None
+    return max(0.0, (row.finished_at - row.started_at).total_seconds())
+
+
+def pending_details(queue: Sequence[tuple[str, float]], *, now: datetime,
+                    rendering_id: str | None, rendering_elapsed_s: float,
+                    render_per_match_s: float) -> dict[str, str]:
+    """The detail of each pending video, by submission id: when its render is expected to end
+    (to the minute, UTC). ``queue``: (submission id, the match's wall seconds) in render
+    order, the render under way (``rendering_id``, running ``rendering_elapsed_s``) first."""
+    details: dict[str, str] = {}
+    at = now
+    for ahead, (submission_id, played_s) in enumerate(queue):
+        estimate_s = played_s * render_per_match_s
+        if submission_id == rendering_id:
+            started = now - timedelta(seconds=rendering_elapsed_s)
+            at = now + timedelta(seconds=max(estimate_s - rendering_elapsed_s, 60.0))
+            details[submission_id] = (f"rendering since {started:%H:%M} UTC; expected by about "
+                                      f"{_minute(at)} UTC")
+            continue
+        at += timedelta(seconds=estimate_s)
+        waiting = "next" if ahead == 0 else f"{ahead} ahead of it"
+        details[submission_id] = (f"waiting for the render ({waiting}); expected by about "
+                                  f"{_minute(at)} UTC")
+    return details
+
+
+def _minute(at: datetime) -> str:
+    """``at`` rounded up to the minute, as HH:MM (a promise kept rather than missed)."""
+    up = at + timedelta(seconds=59.999)
+    return f"{up:%H:%M}"
 
 
 def _stop_group(process: subprocess.Popen[bytes], timeout_s: float = 5.0) -> None:

@@ -21,6 +21,7 @@ interface Submission {
   match_id: string | null;
   failure_class: string | null;
   cause: string | null;
+  video: { state: string; detail: string | null } | null;
 }
 
 interface Queue {
@@ -73,6 +74,14 @@ export function outcomeText(r: MatchResult, team: string | null): string {
   return `${r.winner === own ? "won" : "lost"} ${scoreText(r, own)}`;
 }
 
+/** The video: when it is expected while pending (the service's detail), else its state. */
+function videoText(s: Submission): string {
+  if (!s.video) return "-";
+  if (s.video.state === "pending") return s.video.detail ? `pending: ${s.video.detail}` : "pending";
+  if (s.video.state === "ready") return "ready (hlvs results downloads it)";
+  return s.video.state;
+}
+
 function outcome(s: Submission, result: MatchResult | undefined, team: string | null): string {
   if (result) return outcomeText(result, team);
   if (s.failure_class) return `${s.failure_class}: ${s.cause ?? ""}`;
@@ -89,7 +98,7 @@ async function submissionsPage(root: HTMLElement, who: Who | null): Promise<void
   const operator = who?.scope === "operator";
   const team = operator ? null : (who?.team ?? null);
   root.append(el("h1", {}, operator ? "All matches" : "Your matches"), table("submissions", [
-    ...(operator ? ["team"] : []), "submission", "opponent", "state", "queue position", "expected start", "reason", "finished", "result", "outcome", "watch",
+    ...(operator ? ["team"] : []), "submission", "opponent", "state", "queue position", "expected start", "reason", "finished", "result", "outcome", "video", "watch",
   ], rows.map((s) => {
     const result = results[s.id];
     return [
@@ -97,7 +106,7 @@ async function submissionsPage(root: HTMLElement, who: Who | null): Promise<void
       s.id, s.opponent, s.state, s.queue_position === null ? "-" : String(s.queue_position), when(s.expected_start),
       s.waiting_reason ?? "-", when(s.finished_at),
       result ? `${result.red} ${result.score.red} : ${result.score.blue} ${result.blue}${result.shootout ? ` (shoot-out ${result.shootout.red}-${result.shootout.blue})` : ""}` : "-",
-      outcome(s, result, team), watchLinks(s),
+      outcome(s, result, team), videoText(s), watchLinks(s),
     ];
   }), operator ? "No team has asked for a test match yet." : "No matches yet: ask for one with hlvs submit (see the README's Submission service)."));
 }

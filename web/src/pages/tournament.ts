@@ -106,7 +106,7 @@ async function section(): Promise<HTMLElement> {
   if (t.warnings.length) parts.push(el("ul", { class: "warnings", "data-testid": "warnings" }, ...t.warnings.map((w) => el("li", {}, w))));
   parts.push(el("h2", {}, "Matches"), table("tournament-matches", [
     "match", "kind", "red", "blue", "plays at", "stream", "state", "played", "score", "logs", "attempts", "note", "watch",
-  ], matchRows(t.matches)));
+  ], matchRows(t.matches), "The schedule has no matches yet."));
   if (t.bracket.length) parts.push(el("h2", {}, "Bracket"), bracketSection(t));
   if (t.standings.some((s) => s.played > 0)) {
     parts.push(el("h2", {}, "Standings"), table("tournament-standings", STANDING_COLUMNS, standingRows(t.standings)),
