@@ -289,3 +289,28 @@ def test_docs_render_without_the_internet(start: Callable[..., Served], page: An
     assert "submission service" in page.locator(".title").first.inner_text()
     assert outside == []
     screenshot(page, "service-docs-offline")
+
+
+def test_a_new_service_s_pages_say_that_they_are_empty(
+        start: Callable[..., Served], token: Callable[..., str], page: Any) -> None:
+    """Before any match, every list is a sentence saying why it is empty, never a bare table
+    header (operator token: every page)."""
+    served = start()
+    _use_token(page, served.url, token(operator=True), "/watch/")
+    sentences = {
+        "/watch/": [("live-list-empty", "No match is being played now."),
+                    ("replay-list-empty", "No replay yet")],
+        "/watch/submissions": [("submissions-empty", "No team has asked for a test match yet.")],
+        "/watch/queue": [("queue-empty", "The queue is empty")],
+        "/watch/nodes": [("pool-empty", "No match is playing now.")],
+        "/watch/ladder": [("ladder-empty", "No team is on the ladder yet")],
+    }
+    for path, expected in sentences.items():
+        page.goto(f"{served.url}{path}")
+        for testid, words in expected:
+            page.wait_for_selector(f"[data-testid={testid}]")
+            assert words in page.locator(f"[data-testid={testid}]").inner_text(), path
+        assert page.locator("main table th").count() == 0 or path == "/watch/nodes", path
+        _text(page)  # no raw JSON
+        screenshot(page, "empty-" + (path.strip("/").replace("watch/", "").replace("/", "-")
+                                     or "index").replace("watch", "index"))
