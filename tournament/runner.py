@@ -179,7 +179,8 @@ class _OncePerMinute(logging.Filter):
     def filter(self, record: logging.LogRecord) -> bool:
         if "maximum number of running instances" not in record.msg:
             return True
-        key = str(record.args[0]) if isinstance(record.args, tuple) and record.args else ""
+        job = record.args[0] if isinstance(record.args, tuple) and record.args else None
+        key = str(getattr(job, "id", job))  # the job's id, not its text (it has its next run)
         now = time.monotonic()
         if now - self._last.get(key, -math.inf) < 60.0:
             return False

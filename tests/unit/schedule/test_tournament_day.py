@@ -395,3 +395,24 @@ def test_export_gives_scores_shootouts_and_standings_as_json_and_csv(
     standings_csv = list(csv.DictReader(io.StringIO(capsys.readouterr().out)))
     assert [r["team"] for r in standings_csv][0] == "delta" and len(standings_csv) == 4
     assert main(["schedule", "export", "--state", str(tmp_path / "none.sqlite")]) == 2
+
+
+def test_the_max_instances_line_is_logged_once_a_minute_per_job() -> None:
+    import logging
+    from types import SimpleNamespace
+
+    from tournament.runner import _OncePerMinute
+
+    quiet = _OncePerMinute()
+    message = ('Execution of job "%s" skipped: maximum number of running instances reached '
+               "(%d)")
+
+    def record(job_id: str) -> logging.LogRecord:
+        job = SimpleNamespace(id=job_id)  # its text changes with its next run time
+        return logging.LogRecord("apscheduler.scheduler", logging.WARNING, "", 0, message,
+                                 (job, 1), None)
+
+    assert [quiet.filter(record(j)) for j in ("play:m2", "play:m2", "play:m3", "play:m2")] == [
+        True, False, True, False]
+    other = logging.LogRecord("apscheduler.scheduler", logging.WARNING, "", 0, "other", (), None)
+    assert quiet.filter(other) and quiet.filter(other)
