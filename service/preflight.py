@@ -34,6 +34,21 @@ from service.settings import Settings
 log = logging.getLogger(__name__)
 
 
+PROJECT_PREFIX = "hlvs-runner/"
+"""The project's own images (``orchestrator.project_images``): never a team's robot."""
+
+
+def project_image_name(repository: str | None) -> bool:
+    """Whether ``repository`` names one of the project's own images (with or without a
+    registry part such as ``docker.io/``)."""
+    if not repository:
+        return False
+    name = repository.lower()
+    for prefix in ("docker.io/", "index.docker.io/", "registry-1.docker.io/"):
+        name = name.removeprefix(prefix)
+    return name.startswith(PROJECT_PREFIX)
+
+
 def official_limits() -> Limits:
     return replace(Limits(), cpus=min(Limits().cpus, float(os.cpu_count() or 1)))
 
@@ -75,6 +90,12 @@ def run(team: TeamConfig, *, settings: Settings,
     from orchestrator.engine import connect
 
     started = time.monotonic()
+    for player in team.players:
+        if project_image_name(player.image_repository):
+            raise PreflightFailed(stage="pull", image=player.image or "(none)", cause=(
+                f"{PROJECT_PREFIX}* images are the league's own (its simulator, stub and "
+                "tools), not a team's: push the team's image to its registry and name it "
+                "there"))
     try:
         engine = engine or connect()
         resolved = resolve_team_images(engine, team, limits=official_limits(),
@@ -220,4 +241,4 @@ def _connected_or_failure(events: queue.SimpleQueue[Any], *, timeout_s: float,
             return PreflightFailed(stage="start", image="(simulator)", cause=cause)
 
 
-__all__ = ["PreflightChecker", "official_limits", "run"]
+__all__ = ["PROJECT_PREFIX", "PreflightChecker", "official_limits", "project_image_name", "run"]

@@ -202,6 +202,18 @@ def _check(settings: Settings) -> None:
     if settings.ladder_every_s < 0:
         raise SettingsError(name=PREFIX + "LADDER_EVERY_S", value=str(settings.ladder_every_s),
                             expected="0 (off) or a positive number of seconds")
+    if not 1 <= settings.test_players <= 4:
+        raise SettingsError(name=PREFIX + "TEST_PLAYERS", value=str(settings.test_players),
+                            expected="1 to 4 robots a side (both sides field this many)")
+    for name in ("threads", "slurm_max_queued", "webhook_attempts"):
+        if getattr(settings, name) < 1:
+            raise SettingsError(name=PREFIX + name.upper(), value=str(getattr(settings, name)),
+                                expected="at least 1")
+    for name in ("worker_poll_s", "preflight_timeout_s", "webhook_timeout_s",
+                 "expected_match_s", "keep_alive_s", "token_days"):
+        if not 0 < getattr(settings, name) < 1e9:
+            raise SettingsError(name=PREFIX + name.upper(), value=str(getattr(settings, name)),
+                                expected="a positive number of seconds (days for TOKEN_DAYS)")
     if settings.match_slots < 1:
         raise SettingsError(name=PREFIX + "MATCH_SLOTS", value=str(settings.match_slots),
                             expected="at least 1")

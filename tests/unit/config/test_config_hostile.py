@@ -95,3 +95,22 @@ def test_match_stops_before_creating_anything(tmp_path: Path,
     assert hlvs(["match", str(game), "--out", str(out)]) == 2
     assert "log_folder_gb" in capsys.readouterr().err
     assert not out.exists()
+
+
+@pytest.mark.parametrize(("pointer", "value"), [
+    ("/texture_seed", -1), ("/texture_seed", 1e30), ("/maximum_real_time_factor", 1e30),
+    ("/lockstep_deadline_ms", 1e30), ("/lockstep_time_bank_ms", 1e30),
+    ("/timing/half_duration_s", 1e30), ("/timing/ready_duration_s", 1e30),
+    ("/timing/grace_period_s", 1e30), ("/timing/minimum_play_s", 1e30),
+    ("/timing/wait_before_first_ready_s", 1e30), ("/timing/removal_penalty_s", 1e30),
+    ("/timing/half_time_break_s", 1e30), ("/timing/overtime_half_duration_s", 1e30),
+])
+def test_operator_fields_out_of_range_fail_the_check(
+        tmp_path: Path, pointer: str, value: float, capsys: pytest.CaptureFixture[str]) -> None:
+    """As found: texture_seed -1 or 1e30 passed hlvs check and failed in the simulator."""
+    game = _files(tmp_path)
+    parts = pointer.strip("/").split("/")
+    _edit(game, **({parts[0]: value} if len(parts) == 1 else {parts[0]: {parts[1]: value}}))
+    code, lines = _check(game, capsys)
+    assert code == 2, lines
+    assert any(pointer in line for line in lines), lines

@@ -114,3 +114,28 @@ def test_webhooks_are_signed_retried_and_not_replayable(
     with pytest.raises(webhooks.WebhookRejected) as wrong_key:
         webhooks.verify("another-secret-entirely", headers, body, seen=lambda _d: False)
     assert wrong_key.value.reason == "signature"
+
+
+def test_a_captured_delivery_does_not_verify_under_a_new_id_with_a_cut_body() -> None:
+    """As found: the signature's input joined timestamp, id and body with '.', so moving the
+    start of the body into the id kept the signature. The length-delimited signature (and the
+    first form, accepted for the transition only where no field can hold a '.') refuse it."""
+    body = b'{"event": "submission.finished", "score": {"red": 0, "blue": 3}}'
+    headers = webhooks.sign(SECRET, delivery_id="9f" * 16, event="submission.finished",
+                            body=body)
+    assert webhooks.verify(SECRET, headers, body, seen=lambda _d: False) == "9f" * 16
+    forged = {**headers, "X-HLVS-Delivery": "9f" * 16 + "." + body[:10].decode()}
+    cut = body[11:]
+    with pytest.raises(webhooks.WebhookRejected) as both:
+        webhooks.verify(SECRET, forged, cut, seen=lambda _d: False)
+    assert both.value.reason == "signature"
+    legacy_only = {k: v for k, v in forged.items() if k != "X-HLVS-Signature-V2"}
+    with pytest.raises(webhooks.WebhookRejected) as old:
+        webhooks.verify(SECRET, legacy_only, cut, seen=lambda _d: False)
+    assert old.value.reason == "signature"
+    # the transition: a receiver still sent only the first form verifies a genuine delivery
+    genuine = {k: v for k, v in headers.items() if k != "X-HLVS-Signature-V2"}
+    assert webhooks.verify(SECRET, genuine, body, seen=lambda _d: False) == "9f" * 16
+    with pytest.raises(webhooks.WebhookRejected) as ended:
+        webhooks.verify(SECRET, genuine, body, seen=lambda _d: False, legacy=False)
+    assert ended.value.reason == "missing"

@@ -306,3 +306,29 @@ def test_the_service_does_not_start_with_a_key_that_opens_nothing(
     served.stop()
     with pytest.raises(RuntimeError):  # the lifespan fails: the service does not start
         start(secret_key=Fernet.generate_key().decode())
+
+
+@pytest.mark.parametrize(("name", "value"), [
+    ("HLVS_SERVICE_TEST_PLAYERS", "0"), ("HLVS_SERVICE_TEST_PLAYERS", "9"),
+    ("HLVS_SERVICE_THREADS", "0"), ("HLVS_SERVICE_PREFLIGHT_TIMEOUT_S", "-1"),
+    ("HLVS_SERVICE_WORKER_POLL_S", "1e30"), ("HLVS_SERVICE_LOG_TARGET_ALLOW", "10.0.0.0/40"),
+])
+def test_operator_settings_out_of_range_are_refused_at_start(name: str, value: str) -> None:
+    with pytest.raises(SettingsError, match=name):
+        Settings.from_env({name: value})
+
+
+@pytest.mark.parametrize("image", ["hlvs-runner/simulator", "hlvs-runner/stub",
+                                   "docker.io/hlvs-runner/stub",
+                                   "index.docker.io/hlvs-runner/tools"])
+def test_the_projects_own_images_fail_a_teams_preflight(image: str, tmp_path: Path) -> None:
+    """As found: a team naming the league's own image passed the pre-flight. Refused before
+    anything is pulled or the engine is asked."""
+    from service.errors import PreflightFailed
+    from service.preflight import run
+
+    doc = team_doc("Mallory", image=image)
+    with pytest.raises(PreflightFailed) as failed:
+        run(teamfiles.validated_team(doc),
+            settings=Settings(data_dir=tmp_path, preflight="images"), engine=object())
+    assert failed.value.stage == "pull" and "league's own" in failed.value.cause
