@@ -327,9 +327,12 @@ class SendThread:
     ) -> None:
         while self._ready:
             conn = self._ready.popleft()
-            if conn not in masks:
+            mask = masks.get(conn)
+            if mask is None:
                 continue  # removed
-            self._set_mask(selector, masks, conn, writing=not conn.write_queued())
+            wanted = (0 if conn.paused else READ) | (0 if conn.write_queued() else WRITE)
+            if wanted != mask:
+                self._set_mask(selector, masks, conn, writing=bool(wanted & WRITE))
 
 
 def _unwatch(
