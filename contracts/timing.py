@@ -3,12 +3,14 @@
 Official matches, ``hlvs scrimmage`` (local and on the Slurm pool), the service's test matches,
 ``hlvs compose``, tournament schedules and the Gymnasium environments all start from a preset of
 this module and pass :func:`check_half` (or :func:`fit_ready` for quick tests), so that a game
-whose READY plus SET does not leave time to play is refused before it starts.
+whose halves leave no time to play is refused before it starts.
 
-The rule is written for the worst case, a half clock that runs through READY and SET (as after a
-goal, and in HLVS before every kick-off): each half must keep at least :data:`MIN_PLAYING_S`
-simulated seconds of PLAYING after its READY and SET. A GameController that stops the clock
-before the first kick-off of a half only plays longer.
+The rule counts the clock that really runs: the game clock stands still in READY and SET before
+each half's kick-off (the league's GameController, ``AdvancedData.getRemainingGameTime``:
+``timeBeforeCurrentGameState == 0``), so a half keeps all of its time for PLAYING until a goal
+is scored, however long its READY; each half must be at least :data:`MIN_PLAYING_S` simulated
+seconds. READY and SET after a goal count as played, but a goal is football already played.
+The league's own tests play 20 s halves with the rules' 45 s READY (``--halftimeduration 20``).
 
 After the match, :func:`played_enough` tells a match that played football from one that did not:
 no half reached PLAYING, or fewer than :data:`MIN_PLAYING_S` seconds were played in all.
@@ -21,8 +23,9 @@ from dataclasses import dataclass
 SET_TO_PLAY_S = 5.0
 """Simulated seconds from SET to PLAYING (the automatic referee's, as the GameController's)."""
 MIN_PLAYING_S = 10.0
-"""The documented minimum of play: simulated seconds of PLAYING each half must leave after READY
-and SET, and that a match must have played in all to count as played. A game sets its own with
+"""The documented minimum of play: simulated seconds of PLAYING each half must keep (its length:
+READY and SET before the kick-off stop the clock), and that a match must have played in all to
+count as played. A game sets its own with
 ``timing.minimum_play_s``; 0 marks a match not meant to play football (a test of the match's
 lifecycle: containers, logs, signals), which is neither refused nor failed for want of play."""
 REMOVAL_PENALTY_S = 30.0
@@ -30,7 +33,7 @@ REMOVAL_PENALTY_S = 30.0
 referee gives (``Penalties.java:15-17``, ``HL_BALL_MANIPULATION``, ``HL_PHYSICAL_CONTACT``,
 ``HL_PICKUP_OR_INCAPABLE``: 30), and the league referee's ``REMOVAL_PENALTY_TIMEOUT``."""
 MIN_READY_S = 5.0
-"""The shortest READY a quick test is shortened to (robots need a moment to stand up)."""
+"""The shortest READY a quick test uses (robots need a moment to stand up)."""
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -46,7 +49,7 @@ class TimingPreset:
 
     @property
     def playing_per_half_s(self) -> float:
-        return playing_per_half_s(self.half_duration_s, self.ready_duration_s)
+        return playing_per_half_s(self.half_duration_s)
 
 
 OFFICIAL = TimingPreset(half_duration_s=600.0, ready_duration_s=45.0,
@@ -82,49 +85,41 @@ class TimingError(ValueError):
     """A timing that leaves a half no time to play; the message is a sentence saying why."""
 
 
-def playing_per_half_s(half_s: float, ready_s: float, set_s: float = SET_TO_PLAY_S) -> float:
-    """Simulated seconds of PLAYING a half keeps when its clock runs through READY and SET."""
-    return half_s - ready_s - set_s
+def playing_per_half_s(half_s: float) -> float:
+    """Simulated seconds of PLAYING a half keeps until a goal: all of it, since the clock stands
+    still in READY and SET before the half's kick-off, however long they last."""
+    return half_s
 
 
-def timing_problem(half_s: float, ready_s: float, *, set_s: float = SET_TO_PLAY_S,
-                   minimum_s: float = MIN_PLAYING_S, what: str = "half") -> str | None:
-    """Why a half of ``half_s`` with this READY and SET cannot be played, or None.
-    ``minimum_s`` 0: a match not meant to play (a lifecycle test), never a problem."""
-    left = playing_per_half_s(half_s, ready_s, set_s)
+def timing_problem(half_s: float, *, minimum_s: float = MIN_PLAYING_S,
+                   what: str = "half") -> str | None:
+    """Why a half of ``half_s`` cannot be played, or None: it keeps less than ``minimum_s`` of
+    PLAYING. ``minimum_s`` 0: a match not meant to play (a lifecycle test), never a problem."""
+    left = playing_per_half_s(half_s)
     if minimum_s <= 0 or left >= minimum_s:
         return None
-    return (f"READY ({ready_s:g} s) plus SET ({set_s:g} s) leaves {max(left, 0.0):g} s of play "
-            f"in a {what} of {half_s:g} s; at least {minimum_s:g} s are needed "
-            f"(a {what} of at least {ready_s + set_s + minimum_s:g} s, or a shorter READY)")
+    return (f"a {what} of {half_s:g} s leaves {max(left, 0.0):g} s of play (the clock stands "
+            f"still in READY and SET before its kick-off); at least {minimum_s:g} s are needed "
+            f"(a {what} of at least {minimum_s:g} s)")
 
 
-def check_half(half_s: float, ready_s: float, *, set_s: float = SET_TO_PLAY_S,
-               minimum_s: float = MIN_PLAYING_S) -> None:
-    """Raise :class:`TimingError` when the half leaves less than the minimum of play."""
-    problem = timing_problem(half_s, ready_s, set_s=set_s, minimum_s=minimum_s)
+def check_half(half_s: float, *, minimum_s: float = MIN_PLAYING_S) -> None:
+    """Raise :class:`TimingError` when the half keeps less than the minimum of play."""
+    problem = timing_problem(half_s, minimum_s=minimum_s)
     if problem is not None:
         raise TimingError(problem)
 
 
-def fit_ready(half_s: float, ready_s: float, *, set_s: float = SET_TO_PLAY_S,
+def fit_ready(half_s: float, ready_s: float, *,
               minimum_s: float = MIN_PLAYING_S) -> tuple[float, str | None]:
-    """For quick tests: READY shortened so that the half keeps the minimum of play.
-
-    Returns the READY to use and a warning when it was shortened; raises :class:`TimingError`
-    when even a READY of :data:`MIN_READY_S` does not fit.
+    """For quick tests: the READY to use and a warning when it was changed. READY never eats
+    into the half (the clock stands still in it), so it is kept; raises :class:`TimingError`
+    when the half itself is shorter than the minimum of play.
     """
-    if timing_problem(half_s, ready_s, set_s=set_s, minimum_s=minimum_s) is None:
-        return ready_s, None
-    fitted = half_s - set_s - minimum_s
-    if fitted < MIN_READY_S:
-        shortest = MIN_READY_S + set_s + minimum_s
-        raise TimingError(
-            f"a half of {half_s:g} s is too short to play: READY (at least {MIN_READY_S:g} s) "
-            f"plus SET ({set_s:g} s) plus the minimum of play ({minimum_s:g} s) need "
-            f"{shortest:g} s")
-    return fitted, (f"READY shortened from {ready_s:g} s to {fitted:g} s so that each half of "
-                    f"{half_s:g} s keeps {minimum_s:g} s of play")
+    problem = timing_problem(half_s, minimum_s=minimum_s)
+    if problem is not None:
+        raise TimingError(f"a half of {half_s:g} s is too short to play: {problem}")
+    return ready_s, None
 
 
 def played_enough(halves_playing: tuple[int, ...] | list[int], playing_s: float,

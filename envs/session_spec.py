@@ -92,8 +92,8 @@ class SessionSpec:
 
     @property
     def ready_duration_s(self) -> float:
-        """READY of this session's halves (:data:`contracts.timing.ENVIRONMENT`), shortened
-        when the half would keep less than ``minimum_play_s`` of play."""
+        """READY of this session's halves (:data:`contracts.timing.ENVIRONMENT`); the clock
+        stands still in it, so it never eats into the half."""
         ready, _warning = fit_ready(self.half_duration_s, ENVIRONMENT.ready_duration_s,
                                     minimum_s=self.minimum_play_s)
         return ready

@@ -62,9 +62,9 @@ class Settings:
     worker_poll_s: float = 1.0
     test_half_duration_s: float = TEST_MATCH.half_duration_s
     test_ready_duration_s: float = TEST_MATCH.ready_duration_s
-    """READY of a test match; shortened with a warning when the half would keep less than the
-    minimum of play (:mod:`contracts.timing`). Before each half's kick-off the GameController's
-    clock stands still in it, so it adds to the match's length."""
+    """READY of a test match (:mod:`contracts.timing`). Before each half's kick-off the
+    GameController's clock stands still in it, so it adds to the match's length and takes
+    nothing from the half."""
     test_players: int = 1
     test_grace_s: float = TEST_MATCH.grace_period_s
     expected_match_s: float = 120.0

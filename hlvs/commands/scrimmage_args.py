@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from contracts import ADULT_SCRIMMAGE, MIN_PLAYING_S, MIN_READY_S, SCRIMMAGE, SET_TO_PLAY_S
+from contracts import ADULT_SCRIMMAGE, MIN_PLAYING_S, SCRIMMAGE
 from orchestrator import user_path
 
 
@@ -37,14 +37,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="simulated seconds of game clock per half; READY and SET before the "
                         "half's kick-off stop the clock (default "
                         f"{SCRIMMAGE.half_duration_s:g}, {ADULT_SCRIMMAGE.half_duration_s:g} on "
-                        "the adult field; at least "
-                        f"{MIN_READY_S + SET_TO_PLAY_S + MIN_PLAYING_S:g}: each half keeps "
+                        f"the adult field; at least {MIN_PLAYING_S:g}: each half keeps "
                         f"{MIN_PLAYING_S:g} s of play)")
     parser.add_argument("--ready-duration", type=float, default=None,
                         help="simulated seconds of READY in this scrimmage (default "
                         f"{SCRIMMAGE.ready_duration_s:g}, {ADULT_SCRIMMAGE.ready_duration_s:g} on "
-                        "the adult field, shortened with a warning when the half would keep less "
-                        "than the minimum of play; matches: 45)")
+                        "the adult field; the clock stands still in READY before each half's "
+                        "kick-off, so it does not shorten the half; matches: 45)")
     parser.add_argument("--minimum-play", type=float, default=MIN_PLAYING_S,
                         help="simulated seconds of PLAYING each half keeps and the match must "
                         f"play to count (default {MIN_PLAYING_S:g}); 0: a match not meant to "

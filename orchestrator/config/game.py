@@ -10,11 +10,10 @@ from __future__ import annotations
 import hashlib
 import os
 import re
-from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, Literal, cast
 
-from contracts import SET_TO_PLAY_S, timing_problem
+from contracts import timing_problem
 from orchestrator.config.documents import GameDocument, GameTeamDocument
 from orchestrator.config.model import (
     COLORS,
@@ -263,27 +262,23 @@ def _timing(document: GameDocument, where: Collector, *, fast: bool) -> Timing:
     timing = Timing(
         **durations, max_duration_s=float(max_duration) if max_duration is not None else None
     )
-    _check_play_time(timing, written, document.get("type"), where)
+    _check_play_time(timing, document.get("type"), where)
     return timing
 
 
-def _check_play_time(timing: Timing, written: Mapping[str, float], game_type: Any,
-                     where: Collector) -> None:
-    """A half whose READY plus SET leaves less than the minimum of play is refused
-    (:mod:`contracts.timing`): the match would end 0:0 without a kick."""
+def _check_play_time(timing: Timing, game_type: Any, where: Collector) -> None:
+    """A half shorter than the minimum of play is refused (:mod:`contracts.timing`): the match
+    would end without football. READY and SET do not count: the clock stands still in them
+    before each half's kick-off, so a half of 20 s with the rules' 45 s READY plays 20 s."""
     halves = [("half_duration_s", timing.half_duration_s, "half")]
     if game_type == "KNOCKOUT":
         halves.append(("overtime_half_duration_s", timing.overtime_half_duration_s,
                        "half of extra time"))
     for name, seconds, what in halves:
-        problem = timing_problem(seconds, timing.ready_duration_s, what=what,
-                                 minimum_s=timing.minimum_play_s)
-        if problem is None:
-            continue
-        at = "ready_duration_s" if "ready_duration_s" in written else name
-        where.error(pointer("timing", at), problem,
-                    expected=f"ready_duration_s + {SET_TO_PLAY_S:g} s (SET) + minimum_play_s "
-                    f"({timing.minimum_play_s:g} s) <= {name}")
+        problem = timing_problem(seconds, what=what, minimum_s=timing.minimum_play_s)
+        if problem is not None:
+            where.error(pointer("timing", name), problem,
+                        expected=f"minimum_play_s ({timing.minimum_play_s:g} s) <= {name}")
 
 
 def _limits(raw: dict[str, float]) -> Limits:

@@ -149,8 +149,7 @@ def play_failure(sim: SimResult | None, robots: list[RobotRecord],
     played = (f"{play.playing_s:g} s of PLAYING, halves in PLAYING: "
               f"{list(play.halves_playing) or 'none'}; the minimum of play is {minimum:g} s")
     if timing is not None:
-        problem = timing_problem(timing.half_duration_s, timing.ready_duration_s,
-                                 set_s=timing.set_to_play_s, minimum_s=minimum)
+        problem = timing_problem(timing.half_duration_s, minimum_s=minimum)
         if problem is not None:
             return Failure(failure_class=FailureClass.NOT_PLAYED,
                            cause=f"the match did not play ({played}): the league's timing: "

@@ -5,12 +5,12 @@ played exactly like ``hlvs match`` would play them, so a team can rerun or edit 
 
 Defaults make a short game a newcomer can watch in two to three minutes: one striker per team,
 lockstep stepping and the timing of :data:`contracts.timing.SCRIMMAGE` (two halves of 40 s of game
-clock with READY shortened to 20 s: READY and SET before a half's kick-off stop the clock, as the
+clock with a READY of 20 s: READY and SET before a half's kick-off stop the clock, as the
 league's GameController does, so a half lasts about 65 s of simulated time; 3 s before the first
 READY and 1 s at half time); on the adult field :data:`contracts.timing.ADULT_SCRIMMAGE` (60 s
-halves, 30 s READY: the field is half again as long). A half too short for its READY gets a
-shorter READY with a warning (:func:`quick_ready`); official matches keep the rules' timings
-(45 s READY, 10 min halves).
+halves, 30 s READY: the field is half again as long). A half shorter than the minimum of play is
+refused (:func:`quick_ready`); official matches keep the rules' timings (45 s READY, 10 min
+halves).
 """
 
 from __future__ import annotations
@@ -27,9 +27,7 @@ from contracts import (
     ADULT_SCRIMMAGE,
     KID_FIELD,
     MIN_PLAYING_S,
-    MIN_READY_S,
     SCRIMMAGE,
-    SET_TO_PLAY_S,
     FieldClass,
     FieldGeometry,
     SteppingMode,
@@ -219,19 +217,18 @@ def team_file(name: str, image: str, players: int, *, command: str | None = None
 def quick_ready(half_duration_s: float, ready_duration_s: float | None,
                 minimum_play_s: float = MIN_PLAYING_S, *,
                 default_s: float = SCRIMMAGE.ready_duration_s) -> float:
-    """The READY of a quick test (:mod:`contracts.timing`): ``default_s`` unless given,
-    shortened with a warning when the half would keep less than the minimum of play.
+    """The READY of a quick test (:mod:`contracts.timing`): ``default_s`` unless given (the
+    clock stands still in READY, so it never eats into the half).
 
     Raises :class:`~orchestrator.errors.ConfigError` (at ``/timing/half_duration_s``) when the
-    half is too short even for the shortest READY."""
+    half is shorter than the minimum of play."""
     ready = default_s if ready_duration_s is None else ready_duration_s
     try:
         fitted, warning = fit_ready(half_duration_s, ready, minimum_s=minimum_play_s)
     except TimingError as exc:
-        shortest = MIN_READY_S + SET_TO_PLAY_S + minimum_play_s
         raise ConfigError([Problem(file="game.json", pointer="/timing/half_duration_s",
                                    message=str(exc),
-                                   expected=f"a half of at least {shortest:g} s (or "
+                                   expected=f"a half of at least {minimum_play_s:g} s (or "
                                    "--minimum-play 0 for a match not meant to play)")]) from exc
     if warning is not None:
         log.warning("%s", warning)

@@ -138,3 +138,27 @@ def test_missing_team_file_names_every_place_tried(
     assert [p.pointer for p in check_game(path) if p.severity == "error"] == [
         "/red/config", "/blue/config",
     ]
+
+
+def test_the_leagues_knockout_test_shape_is_accepted(game_files: GameFiles,
+                                                      hlvs_check: Any) -> None:
+    """hlvs_webots ``tests/game_phases/knockout/game.json``: 20 s halves and halves of extra
+    time (``--halftimeduration 20 --overtimeduration 20``) with the rules' 45 s READY. The
+    clock stands still in READY and SET before each kick-off (league GameController
+    ``AdvancedData.java:291-294``), so each half plays 20 s: not refused."""
+    game_files.game.update({
+        "type": "KNOCKOUT", "supervisor": "test_supervisor", "minimum_real_time_factor": 0,
+        "game_controller_extra_args": ["--halftimeduration", "20", "--overtimeduration", "20"],
+    })
+    del game_files.game["maximum_real_time_factor"]
+    game_files.game.pop("timing", None)
+    path = game_files.write()
+    loaded = load_game(path)
+    timing = loaded.game.timing
+    assert (timing.half_duration_s, timing.overtime_half_duration_s) == (20, 20)
+    assert timing.ready_duration_s == 45
+    run = hlvs_check(path)
+    assert run.code == 0, run.out
+    game_files.game["game_controller_extra_args"] = ["--halftimeduration", "8"]
+    run = hlvs_check(game_files.write())
+    assert run.code == 2 and "/timing/half_duration_s: a half of 8 s leaves 8 s" in run.out

@@ -41,20 +41,22 @@ def _request(parser: argparse.ArgumentParser, argv: list[str]) -> ScrimmageReque
 
 
 def test_every_preset_leaves_the_minimum_of_play() -> None:
-    for half, ready in ((600, 45), (SCRIMMAGE.half_duration_s, SCRIMMAGE.ready_duration_s),
-                        (TEST_MATCH.half_duration_s, TEST_MATCH.ready_duration_s)):
-        check_half(half, ready)
-    assert TEST_MATCH.playing_per_half_s == 25.0
-    with pytest.raises(TimingError, match=r"READY \(45 s\) plus SET \(5 s\) leaves 0 s"):
-        check_half(30, 45)
+    """Only the clock that runs counts: it stands still in READY and SET before each half's
+    kick-off (league GameController ``AdvancedData.java:291-294``), so a half keeps all of its
+    time for PLAYING, however long its READY."""
+    for half in (600, SCRIMMAGE.half_duration_s, TEST_MATCH.half_duration_s, 20, 10):
+        check_half(half)
+    assert TEST_MATCH.playing_per_half_s == 40.0
+    with pytest.raises(TimingError, match=r"a half of 8 s leaves 8 s of play"):
+        check_half(8)
+    check_half(8, minimum_s=0)  # a match not meant to play
 
 
-def test_quick_tests_shorten_ready_or_refuse() -> None:
+def test_quick_tests_keep_their_ready_or_refuse_a_half_too_short() -> None:
     assert fit_ready(65, 20) == (20, None)
-    ready, warning = fit_ready(30, 45)
-    assert ready == 15 and warning is not None and "shortened from 45 s to 15 s" in warning
+    assert fit_ready(30, 45) == (45, None)  # READY does not take from the half
     with pytest.raises(TimingError, match="too short to play"):
-        fit_ready(10, 20)
+        fit_ready(8, 20)
 
 
 def _game(tmp_path: Path, timing: dict[str, Any], game_type: str = "NORMAL") -> Path:
@@ -68,32 +70,35 @@ def _game(tmp_path: Path, timing: dict[str, Any], game_type: str = "NORMAL") -> 
     return game_path
 
 
-def test_a_game_whose_ready_is_longer_than_its_half_is_refused(tmp_path: Path) -> None:
+def test_a_half_shorter_than_the_minimum_of_play_is_refused_not_one_shorter_than_ready(
+        tmp_path: Path) -> None:
+    """READY and SET before the kick-off do not count (the clock stands still in them): a half
+    of 30 s with the rules' 45 s READY plays 30 s; a half of 8 s is refused."""
+    assert load_game(_game(tmp_path, {"half_duration_s": 30}))  # READY: the rules' 45 s
     with pytest.raises(ConfigError) as info:
-        load_game(_game(tmp_path, {"half_duration_s": 30}))  # READY: the rules' 45 s
+        load_game(_game(tmp_path, {"half_duration_s": 8, "ready_duration_s": 20}))
     problem = info.value.problems[0]
     assert problem.pointer == "/timing/half_duration_s"
-    assert "leaves 0 s of play in a half of 30 s" in problem.message
-    with pytest.raises(ConfigError) as info:
-        load_game(_game(tmp_path, {"half_duration_s": 30, "ready_duration_s": 20}))
-    assert info.value.problems[0].pointer == "/timing/ready_duration_s"
-    knockout = {"half_duration_s": 65, "ready_duration_s": 20, "overtime_half_duration_s": 30}
+    assert "a half of 8 s leaves 8 s of play" in problem.message
+    assert problem.expected == "minimum_play_s (10 s) <= half_duration_s"
+    knockout = {"half_duration_s": 65, "ready_duration_s": 20, "overtime_half_duration_s": 8}
     with pytest.raises(ConfigError, match="half of extra time"):
         load_game(_game(tmp_path, knockout, "KNOCKOUT"))
-    assert load_game(_game(tmp_path, {"half_duration_s": 35, "ready_duration_s": 20}))
+    knockout["overtime_half_duration_s"] = 20
+    assert load_game(_game(tmp_path, knockout, "KNOCKOUT"))
 
 
-def test_a_scrimmage_with_a_short_half_gets_a_short_ready_with_a_warning(
+def test_a_scrimmage_with_a_short_half_keeps_its_ready_and_one_too_short_is_refused(
         tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
     parser = argparse.ArgumentParser()
     add_arguments(parser)
     with caplog.at_level(logging.WARNING):
-        game = write_files(_request(parser, ["--half-duration", "25"]), tmp_path,
+        game = write_files(_request(parser, ["--half-duration", "15"]), tmp_path,
                            stub_image="stub:1")
-    assert "READY shortened from 20 s to 10 s" in caplog.text
-    assert load_game(game).game.timing.ready_duration_s == 10
+    assert "READY" not in caplog.text
+    assert load_game(game).game.timing.ready_duration_s == 20
     with pytest.raises(ConfigError, match="too short to play"):
-        write_files(_request(parser, ["--half-duration", "10"]), tmp_path, stub_image="s:1")
+        write_files(_request(parser, ["--half-duration", "8"]), tmp_path, stub_image="s:1")
 
 
 def test_an_async_scrimmage_is_paced_to_real_time_and_a_lockstep_one_is_not(
@@ -120,14 +125,14 @@ def test_service_test_matches_play_and_too_short_halves_are_refused(tmp_path: Pa
     timing = json.loads(game.read_text())["timing"]
     assert timing["half_duration_s"] == 40 and timing["ready_duration_s"] == 10
     with pytest.raises(SettingsError, match="HLVS_SERVICE_TEST_HALF_DURATION_S"):
-        Settings.from_env({"HLVS_SERVICE_TEST_HALF_DURATION_S": "12"})
+        Settings.from_env({"HLVS_SERVICE_TEST_HALF_DURATION_S": "8"})
 
 
 def test_environment_matches_are_checked() -> None:
     assert SessionSpec(referee=True).ready_duration_s == 15
-    assert SessionSpec(referee=True, half_duration_s=20).ready_duration_s == 5  # shortened
+    assert SessionSpec(referee=True, half_duration_s=20).ready_duration_s == 15  # kept
     with pytest.raises(EnvConfigError, match="half_duration_s"):
-        SessionSpec(referee=True, half_duration_s=12)
+        SessionSpec(referee=True, half_duration_s=8)
     assert SessionSpec(referee=True, half_duration_s=5, minimum_play_s=0).ready_duration_s == 15
 
 
@@ -160,7 +165,7 @@ def test_a_match_that_played_is_not_a_failure() -> None:
 
 
 def test_no_play_by_the_leagues_timing_is_the_leagues() -> None:
-    timing = TimingSpec(half_duration_s=30.0, ready_duration_s=45.0)
+    timing = TimingSpec(half_duration_s=8.0, ready_duration_s=45.0)
     failure = play_failure(_sim(0.0, [], BOTH), ROBOTS, timing)
     assert failure is not None and failure.failure_class is FailureClass.NOT_PLAYED
     assert failure.team is None and "the league's timing" in failure.cause
@@ -233,12 +238,12 @@ def test_a_schedule_whose_game_timing_leaves_no_play_is_refused(tmp_path: Path) 
     fixtures = ("fixtures:\n  round_robin: {teams: [alpha, bravo], first_stream: '+1h', "
                 "interval_s: 60}\n")
     short = write_schedule(tmp_path, COMPRESSED + fixtures +
-                           "game_defaults:\n  timing: {half_duration_s: 30}\n")
+                           "game_defaults:\n  timing: {half_duration_s: 8}\n")
     with pytest.raises(ConfigError) as info:
         load_schedule(short)
     (problem,) = info.value.problems
     assert problem.pointer == "/game_defaults/timing/half_duration_s"
-    assert "leaves 0 s of play in a half of 30 s" in problem.message
-    fitted = write_schedule(tmp_path, COMPRESSED + fixtures + "game_defaults:\n  timing: "
-                            "{half_duration_s: 30, ready_duration_s: 15}\n")
-    assert load_schedule(fitted).game_defaults["timing"]["ready_duration_s"] == 15
+    assert "a half of 8 s leaves 8 s of play" in problem.message
+    league = write_schedule(tmp_path, COMPRESSED + fixtures + "game_defaults:\n  timing: "
+                            "{half_duration_s: 20}\n")  # with the rules' 45 s READY
+    assert load_schedule(league).game_defaults["timing"]["half_duration_s"] == 20

@@ -58,7 +58,8 @@ def test_every_problem_is_reported_at_once(tmp_path: Path) -> None:
     assert all(p.severity == "error" for p in found.values())
 
 
-def test_ready_must_fit_in_the_half(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_half_must_keep_the_minimum_of_play(tmp_path: Path,
+                                              capsys: pytest.CaptureFixture[str]) -> None:
     fixed = (BROKEN.replace("simulator_slots: 0", "simulator_slots: 1")
              .replace("lockstp", "lockstep").replace("half_duraton_s", "half_duration_s")
              .replace(", credentials: nope.json", ", credentials: logs.json")
@@ -69,8 +70,7 @@ def test_ready_must_fit_in_the_half(tmp_path: Path, capsys: pytest.CaptureFixtur
     problems = check_schedule(path)
     assert [(p.pointer, p.severity) for p in problems] == [
         ("/game_defaults/timing/half_duration_s", "error")]
-    assert "READY (45 s) plus SET (5 s) leaves 0 s of play in a half of 8 s" in (
-        problems[0].message)
+    assert "a half of 8 s leaves 8 s of play" in problems[0].message
     assert main(["check", str(path)]) == 2
     assert "/game_defaults/timing/half_duration_s" in capsys.readouterr().out
     path.write_text(fixed.replace("half_duration_s: 8", "half_duration_s: 60"))
