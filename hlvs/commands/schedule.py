@@ -278,7 +278,7 @@ def _status(args: argparse.Namespace) -> int:
     import time
 
     try:
-        ledger = _wait_for_state(args.state, args.every)
+        ledger = _wait_for_state(args.state, args.every, quiet_stdout=args.json)
         while True:
             alive = scheduler_state(ledger)
             if not alive.running:
@@ -297,8 +297,9 @@ def _status(args: argparse.Namespace) -> int:
         return 0
 
 
-def _wait_for_state(path: Path, every_s: float) -> Any:
-    """``status --watch`` started before ``run``: wait until the state file is written."""
+def _wait_for_state(path: Path, every_s: float, *, quiet_stdout: bool = False) -> Any:
+    """``status --watch`` started before ``run``: wait until the state file is written (the
+    line saying so goes to stderr with ``--json``, which keeps stdout JSON only)."""
     import time
 
     from tournament import Ledger
@@ -307,7 +308,7 @@ def _wait_for_state(path: Path, every_s: float) -> Any:
     while not path.is_file() or not Ledger(path).get_meta("schedule_text"):
         if not said:
             print(f"waiting for {path} (written by 'hlvs schedule run'; Ctrl-C to stop)",
-                  flush=True)
+                  file=sys.stderr if quiet_stdout else sys.stdout, flush=True)
             said = True
         time.sleep(every_s)
     return Ledger(path)
