@@ -209,16 +209,18 @@ def play_job(state_path: str, match_id: str) -> None:
         t.ledger.set_request(match_id, None)
         log.warning("match %s: aborted by the operator: %s", match_id, aborted.reason)
         return
-    if STOPPING.is_set() and outcome.status not in PLAYED_STATUSES:
-        # the scheduler is stopping (Ctrl-C, SIGTERM): the match was stopped with it; it stays
-        # PLAYING (marked interrupted), and the next start replays it into a new attempt folder
+    if _needs_shootout(ctx, outcome) and not STOPPING.is_set():
+        outcome = _shootout(t, ctx, outcome)
+    if STOPPING.is_set() and (outcome.status not in PLAYED_STATUSES
+                              or _needs_shootout(ctx, outcome)):
+        # the scheduler is stopping (Ctrl-C, SIGTERM): the match (or its shoot-out) was
+        # stopped with it; it stays PLAYING (marked interrupted), and the next start replays it
+        # into a new attempt folder
         log.warning("match %s: interrupted by the scheduler's stop (%s)", match_id, outcome.cause)
         t.ledger.transition(match_id, (S.PLAYING,), S.PLAYING,
                             note=f"interrupted by the scheduler's stop ({outcome.status}: "
-                            f"{outcome.cause}); played again at the next start")
+                            f"{outcome.cause or 'not decided'}); played again at the next start")
         return
-    if _needs_shootout(ctx, outcome):
-        outcome = _shootout(t, ctx, outcome)
     result = outcome.as_dict(ctx)
     if outcome.status in PLAYED_STATUSES:
         t.ledger.transition(match_id, (S.PLAYING,), S.PLAYED, result=result, note=outcome.status)

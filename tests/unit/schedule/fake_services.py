@@ -25,6 +25,7 @@ PLAY_SECONDS = float(os.environ.get("HLVS_FAKE_PLAY_S", "0.3"))
 DEAD_TEAMS = set(filter(None, os.environ.get("HLVS_FAKE_DEAD_TEAMS", "").split(",")))
 DRAWN = set(filter(None, os.environ.get("HLVS_FAKE_DRAWN", "").split(",")))
 BROKEN: set[str] = set()  # match ids whose play fails as a killed match process does
+STOP_AFTER_PLAY: set[str] = set()  # match ids after whose play the scheduler is stopped
 
 
 def _log(schedule: Schedule, what: str, match_id: str) -> None:
@@ -65,6 +66,10 @@ class FakeServices:
         if ctx.planned.match.id in DRAWN:
             red = blue = 1
         _log(self.schedule, "play-end", ctx.match_id)
+        if ctx.planned.match.id in STOP_AFTER_PLAY:  # SIGTERM as the match ends
+            from tournament.jobs import STOPPING
+
+            STOPPING.set()
         winner = "red" if red > blue else "blue" if blue > red else "draw"
         return PlayOutcome(status="success", score_red=red, score_blue=blue, winner=winner)
 

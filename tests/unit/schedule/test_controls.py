@@ -277,3 +277,33 @@ def test_status_watch_started_before_run_waits_for_the_state_file(tmp_path: Path
     finally:
         watch.send_signal(signal.SIGINT)
         watch.wait(timeout=10)
+
+
+def test_a_stop_before_the_shootout_leaves_the_knockout_match_to_be_replayed(
+    tmp_path: Path,
+) -> None:
+    """SIGTERM just as a knockout match ended in a draw: no shoot-out is started and the match
+    is not FAILED; it stays PLAYING, marked interrupted, for the next start."""
+    from tournament import jobs
+    from tournament.runner import recover_interrupted
+
+    path = write_schedule(
+        tmp_path, COMPRESSED + "matches:\n  - {id: k1, kind: knockout, red: alpha, blue: bravo,"
+        " stream_start: '+1h'}\n")
+    state = tmp_path / "state.sqlite"
+    init_state(path, state, services=FAKE)
+    ledger = Ledger(state)
+    fake_services.DRAWN.add("k1")
+    fake_services.STOP_AFTER_PLAY.add("k1")
+    try:
+        ledger.reschedule("k1", {"pull_at": datetime.now(UTC).isoformat(),
+                                 "play_at": datetime.now(UTC).isoformat()}, note="now")
+        jobs.play_job(str(state), "k1")
+    finally:
+        jobs.STOPPING.clear()
+        fake_services.DRAWN.clear()
+        fake_services.STOP_AFTER_PLAY.clear()
+    row = ledger.row("k1")
+    assert row.state is S.PLAYING and row.note.startswith("interrupted by the scheduler's stop")
+    assert "shootout" not in [w for w, _, _ in services_log(path)]
+    assert recover_interrupted(ledger) == ["k1"] and ledger.row("k1").state is S.PULLED
