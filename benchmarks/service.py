@@ -258,6 +258,7 @@ def main(argv: Sequence[str]) -> int:
         tokens, operator = _setup(database, data, args.pollers + args.submitters)
         port = args.port or _free_port()
         env = {**os.environ, "HLVS_SERVICE_PREFLIGHT": "images",
+               "HLVS_SERVICE_TEAM_PROJECT_IMAGES": "1",  # the teams play the project's stub
                "HLVS_SERVICE_DATA_DIR": str(data), "HLVS_SERVICE_DATABASE_URL": database}
         log_path = data / "serve.log"
         with log_path.open("wb") as log_file:

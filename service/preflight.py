@@ -91,11 +91,11 @@ def run(team: TeamConfig, *, settings: Settings,
 
     started = time.monotonic()
     for player in team.players:
-        if project_image_name(player.image_repository):
+        if not settings.team_project_images and project_image_name(player.image_repository):
             raise PreflightFailed(stage="pull", image=player.image or "(none)", cause=(
                 f"{PROJECT_PREFIX}* images are the league's own (its simulator, stub and "
                 "tools), not a team's: push the team's image to its registry and name it "
-                "there"))
+                "there (HLVS_SERVICE_TEAM_PROJECT_IMAGES=1 allows them for tests)"))
     try:
         engine = engine or connect()
         resolved = resolve_team_images(engine, team, limits=official_limits(),

@@ -80,6 +80,10 @@ class Settings:
     preflight: str = "full"
     """``full``: pull, size, start and connect to a simulator; ``images``: pull and size only."""
     preflight_timeout_s: float = 25.0
+    team_project_images: bool = False
+    """Let a team's file name the project's own ``hlvs-runner/*`` images (the stub) as its
+    robots: for the project's tests and demonstrations on one machine only; a league leaves it
+    off, and the pre-flight refuses them."""
     smtp_host: str = ""
     """Empty: no mail is sent."""
     smtp_port: int = 25

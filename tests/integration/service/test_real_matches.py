@@ -77,7 +77,8 @@ def real_settings(settings: Settings, docker_client: Any) -> Settings:
     return settings.with_(worker_poll_s=0.3, test_grace_s=2.0,
                           preflight_timeout_s=25.0, video_width=320, video_height=180,
                           video_fps=2.0,  # 90 s of match: few frames to render
-                          log_target_allow="127.0.0.0/8")  # the test's S3 server is local
+                          log_target_allow="127.0.0.0/8",  # the test's S3 server is local
+                          team_project_images=True)  # teams play the project's stub
 
 
 def _hlvs(*argv: str) -> subprocess.Popen[str]:

@@ -332,3 +332,4 @@ def test_the_projects_own_images_fail_a_teams_preflight(image: str, tmp_path: Pa
         run(teamfiles.validated_team(doc),
             settings=Settings(data_dir=tmp_path, preflight="images"), engine=object())
     assert failed.value.stage == "pull" and "league's own" in failed.value.cause
+    assert Settings.from_env({}).team_project_images is False  # a league's default
