@@ -26,6 +26,7 @@ import jsonschema
 
 from contracts import JSONObject
 from orchestrator.config.documents import CredentialsDocument, SftpDocument
+from orchestrator.config.jsonfile import huge_integer_problems, parse_int
 from orchestrator.errors import ConfigError, Problem
 
 __all__ = [
@@ -123,10 +124,13 @@ def load_credentials(path: Path | str) -> Credentials:
             [Problem(name, "", f"cannot read the file: {exc.strerror or exc}", "a readable file")]
         ) from exc
     try:
-        document = json.loads(text)
+        document = json.loads(text, parse_int=parse_int)
     except json.JSONDecodeError as exc:
         problem = Problem(name, "", f"not valid JSON: {exc.msg} at line {exc.lineno}", "JSON")
         raise ConfigError([problem]) from exc
+    huge = huge_integer_problems(document, file=name)
+    if huge:
+        raise ConfigError(huge)
     warnings = _permission_warnings(path)
     try:
         credentials = parse_credentials(document, source=path, warnings=warnings)

@@ -4,14 +4,56 @@ from __future__ import annotations
 
 import json
 import math
+import sys
 from pathlib import Path
 from typing import Any
 
 from contracts import JSONObject
 from orchestrator.config.problems import Collector
-from orchestrator.errors import ConfigError
+from orchestrator.errors import ConfigError, Problem
 
 MAX_FILE_BYTES = 16 * 1024 * 1024
+
+
+class HugeInteger(str):
+    """An integer written with more digits than Python reads into a number (its int-string
+    limit, 4300 digits by default): kept as its text so that the reader can name where it is
+    (:func:`huge_integer_problems`) instead of failing with a traceback."""
+
+
+def parse_int(literal: str) -> int | HugeInteger:
+    """An integer literal of a JSON or YAML file: its value, or :class:`HugeInteger`."""
+    try:
+        return int(literal)
+    except ValueError:
+        return HugeInteger(literal)
+
+
+def _huge(value: Any, pointer: str) -> list[tuple[str, HugeInteger]]:
+    if isinstance(value, HugeInteger):
+        return [(pointer, value)]
+    found: list[tuple[str, HugeInteger]] = []
+    if isinstance(value, dict):
+        for key, item in value.items():
+            at = f"{pointer}/{str(key).replace('~', '~0').replace('/', '~1')}"
+            if isinstance(key, HugeInteger):
+                found.append((at, key))
+            found += _huge(item, at)
+    elif isinstance(value, list):
+        for index, item in enumerate(value):
+            found += _huge(item, f"{pointer}/{index}")
+    return found
+
+
+def huge_integer_problems(value: Any, *, file: str) -> list[Problem]:
+    """A problem for each :class:`HugeInteger` in a parsed document, at its JSON pointer."""
+    limit = sys.get_int_max_str_digits() or 4300
+    problems = []
+    for pointer, literal in _huge(value, ""):
+        digits = sum(ch.isdigit() for ch in literal)
+        problems.append(Problem(file, pointer, f"an integer of {digits} digits, too long to read",
+                                expected=f"a number of at most {limit} digits"))
+    return problems
 
 
 def read_text(path: Path) -> str:
@@ -54,7 +96,8 @@ def read_text(path: Path) -> str:
 def parse_json(text: str, *, file: str) -> Any:
     """Parse JSON text; invalid JSON becomes a problem with line and column."""
     try:
-        value = json.loads(text, parse_constant=_reject_constant, parse_float=_finite_float)
+        value = json.loads(text, parse_constant=_reject_constant, parse_float=_finite_float,
+                           parse_int=parse_int)
     except json.JSONDecodeError as exc:
         where = Collector(file)
         where.error("", f"invalid JSON at line {exc.lineno} column {exc.colno}: {exc.msg}")
@@ -67,6 +110,9 @@ def parse_json(text: str, *, file: str) -> Any:
         where = Collector(file)
         where.error("", "invalid JSON: nested too deeply")
         raise ConfigError(where.problems) from None
+    huge = huge_integer_problems(value, file=file)
+    if huge:
+        raise ConfigError(huge)
     duplicates = duplicate_keys(text)
     if duplicates:
         where = Collector(file)

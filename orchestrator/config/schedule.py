@@ -31,6 +31,7 @@ from orchestrator.config.documents import (
     ScheduleMatchDocument,
 )
 from orchestrator.config.game import default_real_time_factor
+from orchestrator.config.jsonfile import HugeInteger, huge_integer_problems
 from orchestrator.errors import ConfigError, Problem
 
 MatchKind = Literal["round_robin", "knockout", "friendly"]
@@ -243,12 +244,32 @@ def _read(path: Path, text: str | None = None) -> Any:
             [Problem(str(path), "", "not a text file (invalid UTF-8)", expected="a YAML schedule")]
         ) from None
     try:
-        return yaml.safe_load(text)
+        data = yaml.load(text, Loader=_Loader)  # noqa: S506 (safe: SafeLoader's constructors)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         problem = getattr(exc, "problem", None) or str(exc)
         raise ConfigError([Problem(str(path), "", f"invalid YAML{where}: {problem}")]) from None
+    huge = huge_integer_problems(data, file=str(path))
+    if huge:
+        raise ConfigError(huge)
+    return data
+
+
+class _Loader(yaml.SafeLoader):
+    """YAML's safe loader, but an integer too long to read is kept as its text
+    (:class:`~orchestrator.config.jsonfile.HugeInteger`) to be reported where it is."""
+
+
+def _construct_int(loader: yaml.SafeLoader, node: yaml.ScalarNode) -> int | HugeInteger:
+    try:
+        value: int = yaml.SafeLoader.construct_yaml_int(loader, node)
+    except ValueError:
+        return HugeInteger(str(node.value))
+    return value
+
+
+_Loader.add_constructor("tag:yaml.org,2002:int", _construct_int)
 
 
 def _schema_problems(path: Path, data: Any) -> list[Problem]:
