@@ -60,4 +60,4 @@ def test_a_robot_flooding_small_valid_requests_costs_only_itself(send_thread: bo
     assert red_during < 20 * STEPS, red_during
     assert blue["slow_periods"] == 0 and blue["dropped_in"] == {}
     # the honest robot's pace with the flood beside it
-    assert flooded_s < 1.5 * alone_s + 0.2, (alone_s, flooded_s)
+    assert flooded_s < 2 * alone_s + 0.5, (alone_s, flooded_s)  # without the budget: 31 times
