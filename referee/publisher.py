@@ -1,12 +1,13 @@
 """Hands the GameController's state to the network and logs its changes.
 
 Every change of state, secondary state, set play, half, kick-off team, score, penalties or
-sides is one line in ``gamecontroller.log`` and hands the packet to the sender thread at once;
-so does every change of a time on the wire (``secsRemaining``, ``secondaryTime``, a penalty's
-seconds), which the GameController computes exactly from simulated time: the packet the thread
-sends is never more than one step old, as the league's ``Sender`` computes its times at each
-send (``Sender.java:164``, ``updateTimes``). The thread sends at its fixed rate and numbers the
-packets (:mod:`referee.net`); nothing is sent on a change by itself.
+sides is one line in ``gamecontroller.log`` and hands the packet to the sender thread at once.
+Every change of another value on the wire hands it too, without a line: ``secsRemaining``,
+``secondaryTime`` and a penalty's seconds (computed exactly from simulated time), cards,
+goalkeepers and shoot-out kicks. So the packet the thread sends is never more than one step old,
+as the league's ``Sender`` computes its times at each send (``Sender.java:164``,
+``updateTimes``). The thread sends at its fixed rate and numbers the packets
+(:mod:`referee.net`); nothing is sent on a change by itself.
 """
 
 from __future__ import annotations
@@ -36,7 +37,7 @@ class Publisher:
         self._players_per_team = players_per_team
         self._log = log
         self._signature: tuple[object, ...] = ()
-        self._times: tuple[int, ...] = ()
+        self._values: tuple[int, ...] = ()
         self._state: tuple[object, ...] = ()  # game state and half last handed to the network
         self.network: GameControllerNetwork | None = None
 
@@ -71,9 +72,9 @@ class Publisher:
             )
         if self.network is None:
             return
-        times = gc.wire_times()
-        if changed or force or times != self._times:
-            self._times = times
+        values = gc.wire_values()
+        if changed or force or values != self._values:
+            self._values = values
             state = (gc.state, gc.half, gc.phase)
             self.network.publish(self.packet(), state_changed=state != self._state)
             self._state = state

@@ -249,19 +249,19 @@ class GameController:
         )
         return wire_seconds(to_ms(PAUSE_S) - since_state_ms) if pause else 0
 
-    def wire_times(self) -> tuple[int, ...]:
-        """Every time on the wire (``secsRemaining``, ``secondaryTime``, each penalised robot's
-        seconds): the packet must be built again when it changes."""
-        return (
-            self.wire_secs_remaining(),
-            self.wire_secondary_time(),
-            *(
-                wire_seconds(info.left_ms)
-                for team in self.teams.values()
-                for info in team.robots.values()
-                if info.penalty is not Penalty.NONE
-            ),
-        )
+    def wire_values(self) -> tuple[int, ...]:
+        """The values on the wire that change without a change of state, score or penalties:
+        the times (``secsRemaining``, ``secondaryTime``, each penalised robot's seconds), the
+        cards, the goalkeepers and the shoot-out's kicks. The packet must be built again when
+        they change."""
+        values = [self.wire_secs_remaining(), self.wire_secondary_time()]
+        for team in self.teams.values():
+            values += (team.penalty_shots, team.single_shots)
+            for info in team.robots.values():
+                values += (info.warnings, info.yellow_cards, info.red_cards, info.goalkeeper)
+                if info.penalty is not Penalty.NONE:
+                    values.append(wire_seconds(info.left_ms))
+        return tuple(values)
 
     # --- state changes -------------------------------------------------------------------
 

@@ -17,12 +17,14 @@ from contracts.match_spec import GameType, MatchSpec
 from referee import FakeClock, Referee
 from referee.config import TimingConfig
 from referee.gamecontroller import (
+    Card,
     GameController,
     GameState,
     Penalty,
     SecondaryState,
     game_control_data,
 )
+from referee.logs import RefereeLog
 from referee.publisher import Publisher
 from simulator.match_setup import referee_config
 from tests.unit.referee.referee_helpers import BLUE, FAST_TIMING, RED, make_config, robot, snapshot
@@ -233,8 +235,6 @@ def test_the_packet_handed_to_the_sender_follows_every_change_of_a_time() -> Non
     """``Sender.java:164``: the league computes the times when it sends (``updateTimes``);
     here the packet is rebuilt whenever a time on the wire changes, whatever the wall clock
     does (it stands still in this test)."""
-    from referee.logs import RefereeLog
-
     clock = FakeClock()
     gc = _playing(_gc(half_duration_s=600.0))
     publisher = Publisher(gc=gc, team_numbers=TEAMS, players_per_team=4, left_team=lambda: RED,
@@ -250,3 +250,26 @@ def test_the_packet_handed_to_the_sender_follows_every_change_of_a_time() -> Non
         assert sent.secs_remaining == 600 - ms // 1000
         assert sent.secondary_time == max(0, 10 - ms // 1000)
     assert len(network.packets) == 1 + 5  # the first, then one at each whole second
+
+
+def test_a_goalkeeper_or_a_card_is_handed_to_the_sender_while_the_clock_stands() -> None:
+    """In INITIAL no time on the wire moves; a new goalkeeper and a warning still reach the
+    packet the sender sends (``Sender.java:164`` sends the GameController's data as it is)."""
+    clock = FakeClock()
+    gc = _gc()
+    publisher = Publisher(gc=gc, team_numbers=TEAMS, players_per_team=4, left_team=lambda: RED,
+                          log=RefereeLog(clock=clock))  # fmt: skip
+    network = _Network()
+    publisher.network = network  # type: ignore[assignment]
+    publisher.publish(0)
+    gc.advance_ms(8)
+    publisher.publish(8)
+    assert len(network.packets) == 1  # nothing changed
+    gc.set_goalkeeper(RobotId(RED, 2))
+    publisher.publish(16)
+    players = decode_game_state(network.packets[-1]).teams[0].players
+    assert (players[0].goal_keeper, players[1].goal_keeper) == (False, True)
+    gc.card(RobotId(BLUE, 1), Card.WARNING)
+    publisher.publish(24)
+    assert decode_game_state(network.packets[-1]).teams[1].players[0].number_of_warnings == 1
+    assert len(network.packets) == 3
