@@ -126,6 +126,7 @@ class GameController:
         self._state_began_gc_ms = 0  # whenCurrentGameStateBegan
         self._set_play_ended_gc_ms: int | None = None  # whenCurrentSecondaryGameStateEnded
         self._preparation_began_sim_ms: int | None = None  # the set play's secondary clock
+        self.revision = 0  # + 1 at each card, goalkeeper and shoot-out kick (wire_values)
         self.teams: dict[TeamColor, TeamStatus] = {
             color: TeamStatus(robots={n: RobotStatus() for n in numbers})
             for color, numbers in players.items()
@@ -254,14 +255,17 @@ class GameController:
         the times (``secsRemaining``, ``secondaryTime``, each penalised robot's seconds), the
         cards, the goalkeepers and the shoot-out's kicks. The packet must be built again when
         they change."""
-        values = [self.wire_secs_remaining(), self.wire_secondary_time()]
-        for team in self.teams.values():
-            values += (team.penalty_shots, team.single_shots)
-            for info in team.robots.values():
-                values += (info.warnings, info.yellow_cards, info.red_cards, info.goalkeeper)
-                if info.penalty is not Penalty.NONE:
-                    values.append(wire_seconds(info.left_ms))
-        return tuple(values)
+        return (
+            self.wire_secs_remaining(),
+            self.wire_secondary_time(),
+            self.revision,
+            *(
+                wire_seconds(info.left_ms)
+                for team in self.teams.values()
+                for info in team.robots.values()
+                if info.penalty is not Penalty.NONE
+            ),
+        )
 
     # --- state changes -------------------------------------------------------------------
 
@@ -379,6 +383,7 @@ class GameController:
     def card(self, robot: RobotId, card: Card) -> Card:
         """Record a card; 2 warnings make a yellow, 2 yellows a red. Returns the card given."""
         info = self.robot(robot)
+        self.revision += 1
         if card is Card.WARNING:
             info.warnings += 1
             if info.warnings < 2:
@@ -396,6 +401,7 @@ class GameController:
         return Card.RED
 
     def set_goalkeeper(self, robot: RobotId) -> None:
+        self.revision += 1
         for number, info in self.teams[robot.team].robots.items():
             info.goalkeeper = number == robot.number
 
@@ -403,6 +409,7 @@ class GameController:
 
     def shootout_kick(self, team: TeamColor, scored: bool) -> None:
         info = self.teams[team]
+        self.revision += 1
         if scored:
             info.single_shots |= 1 << info.penalty_shots
             info.score += 1
