@@ -7,8 +7,9 @@ the page from the path. API under ``/api/viewer``:
 - ``GET index``: the replays and live matches known;
 - ``GET replays/<id>/meta``: match id, format version, frame rate, duration, body count, the
   scene (``simulator.replay.scene``), the chunk index ``[[first_ms, last_ms, frames]...]``, the
-  referee events (each with the ``frame_ms`` it was recorded with), whether statistics exist
-  and the teams' names (``{"red": ..., "blue": ...}``, null when not known);
+  referee events (each with the ``frame_ms`` it was recorded with), whether statistics exist,
+  the teams' names (``{"red": ..., "blue": ...}``, null when not known) and whether the replay
+  is complete (its recorder closed it: the match is over);
 - ``GET replays/<id>/chunks/<k>``: one chunk of frames, binary: u32 JSON length, JSON
   ``{"times": [...], "games": [...]}``, zero padding to 4 bytes, then float32 poses
   (frames x bodies x 7, little-endian);
@@ -90,11 +91,15 @@ class CatalogResolver:
     def replay(self, replay_id: str) -> ReplaySource:
         source = self.catalog.replays.get(replay_id)
         live = self.catalog.live.get(replay_id)
-        if source is None and live is not None and live.replay_path is not None:
-            # a match watched live: its replay once written (the public copy when collected)
+        if live is not None and live.replay_path is not None:
+            # a match watched live: its replay as written so far, the public copy once
+            # collected (asked again each time: the copy being written goes away then)
             folder = live.replay_path.parents[2]
             for path in (folder / "public" / files.REPLAY, live.replay_path):
+                if source is not None and source.path == path:
+                    break
                 if path.is_file():
+                    self.catalog.replays.pop(replay_id, None)
                     source = self.catalog.add_replay(path, id=replay_id, teams=live.teams)
                     break
         if source is None:
@@ -105,10 +110,27 @@ class CatalogResolver:
         live = self.catalog.live.get(match_id)
         if live is None:
             raise _missing("live match", match_id, list(self.catalog.live))
+        if _over(live):
+            raise HTTPException(status_code=404, detail=f"the match {match_id!r} is over: its "
+                                "replay is complete")
         return live
 
     def listing(self) -> tuple[list[ReplaySource], list[LiveSource]]:
         return list(self.catalog.replays.values()), list(self.catalog.live.values())
+
+
+def _over(live: LiveSource) -> bool:
+    """Whether a match known by its folder has ended: its output collected (the public
+    replay), or its replay closed by the recorder (a match whose output was not collected)."""
+    if live.replay_path is None:
+        return False
+    if (live.replay_path.parents[2] / "public" / files.REPLAY).is_file():
+        return True
+    try:
+        with ReplayFile(live.replay_path) as replay:
+            return replay.indexed
+    except (OSError, ReplayError):
+        return False
 
 
 def build_router(resolver: Any, *, feed_factory: FeedFactory = ZenohFeed,
@@ -154,6 +176,7 @@ def build_router(resolver: Any, *, feed_factory: FeedFactory = ZenohFeed,
             "scene": scene,
             "has_stats": source.stats_path is not None,
             "teams": _teams(source.teams),
+            "complete": replay.indexed,  # closed by its recorder: the match is over
         }
 
     @router.get(f"{API_PREFIX}/replays/{{replay_id}}/chunks/{{index}}")

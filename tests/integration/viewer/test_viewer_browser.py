@@ -177,3 +177,40 @@ def test_event_list_timeline_and_plots_line_up(page: Any, busy_match: Path) -> N
         expected = 36 + GOAL_MS / 3000 * (420 - 36 - 8)
         assert abs(float(head.get_attribute("x1")) - expected) < 0.5
         screenshot(page, "replay-events-timeline-plots")
+
+
+def test_the_live_page_of_a_match_that_is_over_links_its_replay(
+        page: Any, tmp_path: Path) -> None:
+    """``hlvs view`` of a match folder whose telemetry is gone but whose replay was written
+    (the match ended, its output not collected): the live page says it ended and links the
+    replay, with the teams' names, instead of an empty scene."""
+    import socket
+    from dataclasses import replace
+
+    from orchestrator.config import load_game, to_match_spec
+    from tests.unit.config.conftest import EXAMPLES
+
+    folder = tmp_path / "ended"
+    recorded = record_match(tmp_path / "recorded", seconds=1.0)
+    out = folder / "simulator" / "out"
+    out.mkdir(parents=True)
+    recorded.replace(out / "replay.hlvsrec")
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        port = sock.getsockname()[1]
+    spec = to_match_spec(load_game(EXAMPLES / "scrimmage_1v1" / "game.json"),
+                         robot_addresses={}, telemetry_listen=f"tcp/127.0.0.1:{port}")
+    spec = replace(spec, match_id="ended-1", red=replace(spec.red, name="Ants"),
+                   blue=replace(spec.blue, name="Bees"))
+    spec.write(folder / "simulator" / "match_spec.json")
+    with hlvs_view(folder) as urls:
+        live = next(u for u in urls if "/watch/live/" in u)
+        page.goto(live)
+        page.wait_for_selector("[data-testid=replay-link]", timeout=60_000)
+        assert page.locator("[data-testid=live-status]").inner_text().startswith(
+            "This match has ended (Ants v Bees).")
+        assert page.locator("canvas").count() == 0
+        screenshot(page, "view-live-ended")
+        page.locator("[data-testid=replay-link]").click()
+        page.wait_for_function("window.hlvsViewer && window.hlvsViewer.ready", timeout=30_000)
+        assert page.locator("[data-testid=team-red]").inner_text() == "Ants"

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import shutil
 import struct
 import threading
 from collections.abc import Iterator
@@ -163,10 +164,39 @@ def test_meta_and_index_name_the_teams_of_a_match_folder(tmp_path: Path) -> None
     client, pages = _client(folder, bare / "public" / "replay.hlvsrec")
     assert pages == ["/watch/replay/named", "/watch/replay/bare"]
     teams = {"red": "Ants", "blue": "Bees"}
-    assert client.get("/api/viewer/replays/named/meta").json()["teams"] == teams
+    named = client.get("/api/viewer/replays/named/meta").json()
+    assert named["teams"] == teams and named["complete"] is True  # closed by its recorder
     assert client.get("/api/viewer/replays/bare/meta").json()["teams"] is None
     listing = client.get("/api/viewer/index").json()["replays"]
     assert [(r["id"], r["teams"]) for r in listing] == [("named", teams), ("bare", None)]
+
+
+def test_a_live_match_s_replay_follows_its_file_to_the_public_copy(tmp_path: Path) -> None:
+    """Asked for while the match runs, the replay is the one being written; once the match's
+    output is collected (that file gone, the public copy there) it is the public copy."""
+    folder = tmp_path / "running"
+    recorded = record_match(tmp_path / "recorded", seconds=1.0)
+    out = folder / "simulator" / "out"
+    out.mkdir(parents=True)
+    shutil.copy(recorded, out / "replay.hlvsrec")
+    spec = to_match_spec(load_game(EXAMPLES / "scrimmage_1v1" / "game.json"),
+                         robot_addresses={}, telemetry_listen="tcp/10.0.0.2:7447")
+    replace(spec, match_id="m2").write(folder / "simulator" / "match_spec.json")
+    client, pages = _client(folder)
+    assert "/watch/live/m2" in pages
+    assert client.get("/api/viewer/replays/m2/meta").status_code == 200
+    (folder / "public").mkdir()
+    (out / "replay.hlvsrec").replace(folder / "public" / "replay.hlvsrec")
+    meta = client.get("/api/viewer/replays/m2/meta")
+    assert meta.status_code == 200 and meta.json()["complete"] is True
+
+
+def test_a_replay_its_writer_left_open_is_not_complete(tmp_path: Path) -> None:
+    path = record_match(tmp_path / "open", seconds=1.0)
+    path.write_bytes(path.read_bytes()[:-40])  # no index, no trailer: the recorder died
+    client, _ = _client(path)
+    meta = client.get("/api/viewer/replays/open/meta").json()
+    assert meta["complete"] is False and meta["duration_ms"] > 0
 
 
 def test_hlvs_view_names_a_path_without_a_replay(tmp_path: Path) -> None:

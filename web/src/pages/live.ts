@@ -124,7 +124,11 @@ export function livePage(root: HTMLElement, api: string, matchId: string, replay
       el("span", {}, `${clock(event.sim_time_ms)} ${describeEvent(event)}`)));
   };
   handlers.failure = (data) => {
+    // the telemetry cannot be reached: a match that is over (its replay written) says so
     status.textContent = `live view unavailable: ${JSON.parse(data)}`;
+    void authFetch(`${api}/replays/${encodeURIComponent(matchId)}/meta`).then((answer) => {
+      if (answer.ok) void notLive(root, api, matchId, replayBase, answer, "");
+    }).catch(() => undefined);
   };
   handlers.end = () => {
     status.textContent += "  (stream closed)";
