@@ -397,7 +397,12 @@ class Referee:
                 self.state_event(snapshot, "PLAYING")
         if gc.state not in (GameState.READY, GameState.SET, GameState.PLAYING):
             return commands
-        decisions = self.rules.judge(snapshot, self.view())
+        view = self.view()
+        decisions = self.rules.judge(snapshot, view)
+        if gc.state is GameState.SET:
+            # kick-off positions hold through SET: the league's referee checks them every step
+            # of SET, not only when it begins (hlvs_webots referee.py:2358-2365)
+            decisions += kickoff.judge_set(snapshot, view)
         return commands + self._apply(decisions, snapshot)
 
     def give_card(

@@ -2,8 +2,8 @@
 
 Order: ball in play, goal (else ball out), touches before a set play is taken, kick-off,
 fallen, outside turf, ball holding, pushing, inactive goalkeeper, dropped ball. (Kick-off
-positions at SET and set-play compliance at EXECUTE are judged once, when the GameController
-enters those phases.) Each rule is a pure function; this class only keeps each rule's memory
+positions are judged by the referee through SET, set-play compliance at EXECUTE once, when the
+GameController enters it.) Each rule is a pure function; this class only keeps each rule's memory
 from one step to the next.
 """
 

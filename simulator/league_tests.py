@@ -394,7 +394,9 @@ class LeagueTestRunner:
                 break
             if referee.finished:
                 over_at_s = over_at_s if over_at_s is not None else world.sim_time_ms / 1000
-                if world.sim_time_ms / 1000 - over_at_s >= END_OF_GAME_S:
+                # the league's referee steps END_OF_GAME_TIMEOUT more, then once before it
+                # quits (referee.py:174-178, 193)
+                if world.sim_time_ms / 1000 - over_at_s > END_OF_GAME_S:
                     ending = "game_over"
                     break
             if woken:

@@ -1,8 +1,9 @@
 """Kick-off positions and the kick-off before the ball is in play.
 
-At SET (checked once, when SET begins) every robot must be inside the field, in its own half,
-and robots of the defending team (all robots after a dropped ball) outside the centre circle;
-illegally placed robots are removed (INCAPABLE). Until the ball is in play, a defending robot
+Through SET (checked every step, as the league's referee checks them, hlvs_webots
+referee.py:2358-2365) every robot must be inside the field, in its own half, and robots of the
+defending team (all robots after a dropped ball) outside the centre circle; illegally placed
+robots are removed (INCAPABLE). Until the ball is in play, a defending robot
 that enters the centre circle or touches the ball is removed too.
 """
 
@@ -29,7 +30,7 @@ def _illegal_position(robot: RobotState, game: GameView) -> str | None:
 
 
 def judge_set(snapshot: WorldSnapshot, game: GameView) -> list[Decision]:
-    """Called once when SET begins (kick-off or dropped ball)."""
+    """Called when SET begins and on every step of SET (kick-off or dropped ball)."""
     decisions: list[Decision] = []
     for robot in snapshot.robots:
         if not game.active(robot):
