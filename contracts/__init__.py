@@ -52,7 +52,13 @@ if TYPE_CHECKING:
     )
     from contracts.geometry import StartingPose
     from contracts.ids import RobotId, TeamColor
-    from contracts.jsontypes import JSONObject
+    from contracts.jsontypes import (
+        HugeInteger,
+        JSONObject,
+        huge_integer_reason,
+        huge_integers,
+        parse_int,
+    )
     from contracts.match_results import (
         AdmissionRecord,
         Failure,
@@ -134,6 +140,7 @@ __all__ = [
     "GameType",
     "GameTypeCode",
     "GameTypeName",
+    "HugeInteger",
     "JSONObject",
     "KID_FIELD",
     "LogFolderCopy",
@@ -191,6 +198,9 @@ __all__ = [
     "from_data",
     "gamecontroller",
     "lazy_exports",
+    "huge_integer_reason",
+    "huge_integers",
+    "parse_int",
     "played_enough",
     "telemetry",
     "timing_problem",
@@ -216,7 +226,9 @@ if not TYPE_CHECKING:
         ),
         "contracts.geometry": ("StartingPose",),
         "contracts.ids": ("RobotId", "TeamColor"),
-        "contracts.jsontypes": ("JSONObject",),
+        "contracts.jsontypes": (
+            "HugeInteger", "JSONObject", "huge_integer_reason", "huge_integers", "parse_int",
+        ),
         "contracts.match_results": (
             "AdmissionRecord", "Failure", "FailureClass", "Forfeit", "LogFolderCopy", "MatchLimits",
             "MatchReport", "MatchResults", "NeededAvailable", "RobotResult", "Salvage",

@@ -24,9 +24,9 @@ from typing import Any, Literal, cast
 
 import jsonschema
 
-from contracts import JSONObject
+from contracts import JSONObject, parse_int
 from orchestrator.config.documents import CredentialsDocument, SftpDocument
-from orchestrator.config.jsonfile import huge_integer_problems, parse_int
+from orchestrator.config.jsonfile import huge_integer_problems
 from orchestrator.errors import ConfigError, Problem
 
 __all__ = [

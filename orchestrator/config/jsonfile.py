@@ -4,55 +4,23 @@ from __future__ import annotations
 
 import json
 import math
-import sys
 from pathlib import Path
 from typing import Any
 
-from contracts import JSONObject
+from contracts import JSONObject, huge_integer_reason, huge_integers, parse_int
 from orchestrator.config.problems import Collector
 from orchestrator.errors import ConfigError, Problem
 
 MAX_FILE_BYTES = 16 * 1024 * 1024
 
 
-class HugeInteger(str):
-    """An integer written with more digits than Python reads into a number (its int-string
-    limit, 4300 digits by default): kept as its text so that the reader can name where it is
-    (:func:`huge_integer_problems`) instead of failing with a traceback."""
-
-
-def parse_int(literal: str) -> int | HugeInteger:
-    """An integer literal of a JSON or YAML file: its value, or :class:`HugeInteger`."""
-    try:
-        return int(literal)
-    except ValueError:
-        return HugeInteger(literal)
-
-
-def _huge(value: Any, pointer: str) -> list[tuple[str, HugeInteger]]:
-    if isinstance(value, HugeInteger):
-        return [(pointer, value)]
-    found: list[tuple[str, HugeInteger]] = []
-    if isinstance(value, dict):
-        for key, item in value.items():
-            at = f"{pointer}/{str(key).replace('~', '~0').replace('/', '~1')}"
-            if isinstance(key, HugeInteger):
-                found.append((at, key))
-            found += _huge(item, at)
-    elif isinstance(value, list):
-        for index, item in enumerate(value):
-            found += _huge(item, f"{pointer}/{index}")
-    return found
-
-
 def huge_integer_problems(value: Any, *, file: str) -> list[Problem]:
-    """A problem for each :class:`HugeInteger` in a parsed document, at its JSON pointer."""
-    limit = sys.get_int_max_str_digits() or 4300
+    """A problem for each integer too long to read (:class:`contracts.jsontypes.HugeInteger`)
+    in a parsed document, at its JSON pointer."""
     problems = []
-    for pointer, literal in _huge(value, ""):
-        digits = sum(ch.isdigit() for ch in literal)
-        problems.append(Problem(file, pointer, f"an integer of {digits} digits, too long to read",
-                                expected=f"a number of at most {limit} digits"))
+    for pointer, literal in huge_integers(value):
+        message, expected = huge_integer_reason(literal)
+        problems.append(Problem(file, pointer, message, expected=expected))
     return problems
 
 

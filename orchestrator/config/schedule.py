@@ -22,7 +22,7 @@ from typing import Any, Literal, cast
 import jsonschema
 import yaml
 
-from contracts import JSONObject
+from contracts import HugeInteger, JSONObject
 from orchestrator.config.documents import (
     GameDocument,
     KnockoutDocument,
@@ -31,7 +31,7 @@ from orchestrator.config.documents import (
     ScheduleMatchDocument,
 )
 from orchestrator.config.game import default_real_time_factor
-from orchestrator.config.jsonfile import HugeInteger, huge_integer_problems
+from orchestrator.config.jsonfile import huge_integer_problems
 from orchestrator.errors import ConfigError, Problem
 
 MatchKind = Literal["round_robin", "knockout", "friendly"]

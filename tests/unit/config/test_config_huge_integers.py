@@ -92,3 +92,10 @@ def test_an_integer_of_4300_digits_is_read_as_a_number(game_files: GameFiles,
     run = hlvs_check(path)
     assert "too long to read" not in run.out
     assert "/red/id" in run.out  # refused as a team number, by its value
+
+
+def test_in_a_robot_model_manifest(tmp_path: Path, hlvs_check: Any) -> None:
+    manifest = tmp_path / "robot_model.json"
+    manifest.write_text('{"format_version": ' + HUGE + ', "name": "huge"}')
+    run = hlvs_check(tmp_path)
+    assert run.code == 2 and f"{manifest}: /format_version: {EXPECTED}" in run.out

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from contracts import JSONObject
+from contracts import JSONObject, huge_integer_reason, huge_integers, parse_int
 from simulator.errors import ModelError, ModelProblem
 from simulator.world.servos import find_servo, servo_ids
 
@@ -202,11 +202,18 @@ def load_manifest(folder_or_file: Path) -> Manifest:
             ]
         )
     try:
-        raw = json.loads(path.read_text(encoding="utf-8"))
+        raw = json.loads(path.read_text(encoding="utf-8"), parse_int=parse_int)
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise ModelError(
             [ModelProblem(source=str(path), where="", reason=f"not JSON: {exc}")]
         ) from None
+    huge = huge_integers(raw)
+    if huge:
+        raise ModelError([
+            ModelProblem(source=str(path), where=pointer,
+                         reason="{} (expected {})".format(*huge_integer_reason(literal)))
+            for pointer, literal in huge
+        ])
     if not isinstance(raw, dict):
         raise ModelError([ModelProblem(source=str(path), where="", reason="expected an object")])
     r = _Reader(path)
