@@ -34,6 +34,7 @@ if TYPE_CHECKING:
         recorded_schedule,
         reschedule,
     )
+    from tournament.export import export_document, write_csv
     from tournament.notify import (
         NotifySettings,
         Outbox,
@@ -69,6 +70,7 @@ __all__ = [
     "Webhook",
     "abort",
     "apply_file",
+    "export_document",
     "file_differences",
     "init_state",
     "match_folder",
@@ -83,6 +85,7 @@ __all__ = [
     "standings",
     "status_lines",
     "tournament_overview",
+    "write_csv",
     "write_game_file",
 ]
 
@@ -93,6 +96,7 @@ if not TYPE_CHECKING:
             "DEFAULT_ABORT_GRACE_S", "abort", "apply_file", "file_differences", "recorded_schedule",
             "reschedule",
         ),
+        "tournament.export": ("export_document", "write_csv"),
         "tournament.notify": (
             "NotifySettings", "Outbox", "Webhook", "recorded_settings", "scheduler_state",
         ),

@@ -389,7 +389,7 @@ def _warn_differences(ledger: Any) -> None:
 def _export(args: argparse.Namespace) -> int:
     import io
 
-    from tournament.export import export_document, write_csv
+    from tournament import export_document, write_csv
 
     document = export_document(_ledger(args.state))
     if args.format == "json":
