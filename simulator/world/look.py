@@ -16,9 +16,11 @@ Here the same elements, in MuJoCo:
   league's directions, colours and intensities (a pink dawn, a weak sunset sun), times the
   luminosity, times :data:`LIGHT_GAIN` (MuJoCo's lights add Lambert terms where Webots renders
   physically based with tone mapping: the gain makes the league's brightest scenes bright, not
-  clipped). The image-based light becomes the ambient light: the background's mean colour
+  clipped); the main and off lights, of one colour and nearly one direction, are drawn as one
+  (:func:`lighting`). The image-based light becomes the ambient light: the background's mean colour
   times :data:`ENVIRONMENT_GAIN` times the luminosity. The background's texels are scaled by
-  the luminosity too. The main light casts shadows. Nothing compensates: a robot camera whose
+  the luminosity too. The main light casts shadows (robot cameras: on a GPU,
+  :mod:`simulator.world.camera`). Nothing compensates: a robot camera whose
   model declares auto-exposure (:mod:`simulator.world.camera_model`) evens out a share of it.
 - **Backgrounds**: seven kinds of surroundings generated procedurally, one per league
   background's light set (:data:`BACKGROUNDS`), with bright skies, buildings, grass and earth
@@ -63,7 +65,7 @@ LINE_TEXTURE = "look:line"
 BALL_TEXTURE = "look:ball"
 SKY_TEXTURE = "look:sky"
 NET_TEXTURE = "look:net"
-LIGHT_NAMES = ("look:main", "look:off", "look:top")
+LIGHT_NAMES = ("look:key", "look:top")
 TURF_PX = 512
 LINE_PX = 128
 LINE_TILE_M = 0.5
@@ -75,7 +77,7 @@ NET_CORD_M = 0.01  # cord thickness
 LUMINOSITY_RANGE = (0.75, 1.25)
 LIGHT_GAIN = 0.1  # MuJoCo diffuse per unit of the league's light intensity
 ENVIRONMENT_GAIN = 1.0  # ambient light per unit of the background's mean texel (0..1)
-SHADOW_LIGHTS = (True, False, False)  # the main light casts shadows
+SHADOW_LIGHTS = (True, False)  # the key light (the main and off lights) casts shadows
 
 
 @dataclass(frozen=True, slots=True)
@@ -174,6 +176,7 @@ def _background(
 _BLUE_WHITE = (0.95, 0.95, 1.0)
 _W = (1.0, 1.0, 1.0)
 _DAWN = (1.0, 0.6, 0.8)
+_PALE_BLUE = (0.9, 0.9, 1.0)
 # the league's light sets, RoboCupMainLight/OffLight/TopLight.proto, in the referee's order
 _LIGHTS = {
     "stadium_dry": (
@@ -193,12 +196,12 @@ _LIGHTS = {
         Light((0.0, -1.0, 0.0), _W, 1.5),
     ),
     "sepulchral_chapel_rotunda": (
-        Light((0.3, -0.25, 0.025), _BLUE_WHITE, 1.5), Light((0.3, -0.25, 0.025), (0.9, 0.9, 1.0), 0.75),
+        Light((0.3, -0.25, 0.025), _BLUE_WHITE, 1.5), Light((0.3, -0.25, 0.025), _PALE_BLUE, 0.75),
         Light((0.0, -1.0, 0.0), _BLUE_WHITE, 1.75),
     ),
     "paul_lobe_haus": (
-        Light((0.2, -0.5, 0.025), (0.9, 0.9, 1.0), 1.0), Light((0.2, -1.0, -0.2), (0.9, 0.9, 1.0), 0.75),
-        Light((0.0, -1.0, 0.0), (0.9, 0.9, 1.0), 1.5),
+        Light((0.2, -0.5, 0.025), _PALE_BLUE, 1.0), Light((0.2, -1.0, -0.2), _PALE_BLUE, 0.75),
+        Light((0.0, -1.0, 0.0), _PALE_BLUE, 1.5),
     ),
     "kiara_1_dawn": (
         Light((-2.8, -1.0, 2.1), _DAWN, 2.0), Light((-2.775, -1.025, 2.1), _DAWN, 2.0),
@@ -420,12 +423,30 @@ def _environment_rgb(variant: int) -> RGB:
     return (float(mean[0]), float(mean[1]), float(mean[2]))
 
 
+def _merged(first: Light, second: Light) -> Light:
+    """One light for two: along ``I1 d1 + I2 d2``, of that vector's length, of their colours
+    weighted by intensity. Lambert's term of every surface that both light is the same
+    (``n . (I1 d1 + I2 d2)``, exactly so for one colour)."""
+    a, b = np.array(first.direction()), np.array(second.direction())
+    total = first.intensity * a + second.intensity * b
+    strength = float(np.linalg.norm(total))
+    x, y, z = (float(v) for v in total / strength)
+    w1, w2 = first.intensity, second.intensity
+    r, g, bl = (
+        (w1 * c1 + w2 * c2) / (w1 + w2) for c1, c2 in zip(first.rgb, second.rgb, strict=True)
+    )
+    return Light((y, z, x), (r, g, bl), strength)
+
+
 def lighting(look: Look) -> Lighting:
     """The lights of ``look``: the league's light set of its background, scaled by its
-    luminosity (see the module's docstring)."""
+    luminosity (see the module's docstring). The main and off lights of every league set have
+    about one colour and directions within 2.5 degrees (17 for ``paul_lobe_haus``): they are
+    one light here, the
+    key light (:func:`_merged`; one shadow pass instead of two), the top light the other."""
     bg = BACKGROUNDS[look.background]
     lum = look.luminosity
-    lights = bg.light.lights()
+    lights = (_merged(bg.light.main, bg.light.off), bg.light.top)
     diffuse = tuple(
         (lum * LIGHT_GAIN * lt.intensity * lt.rgb[0], lum * LIGHT_GAIN * lt.intensity * lt.rgb[1],
          lum * LIGHT_GAIN * lt.intensity * lt.rgb[2])

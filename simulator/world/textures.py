@@ -498,8 +498,8 @@ def _ground(
         paved = reach < (14.0 if kind == "stadium" else 30.0)
         stones = np.array([0.5, 0.48, 0.45]) * (0.9 + 0.1 * tufts)[..., None]
         ground = np.where(paved[..., None], stones, ground)
-    if kind == "stadium":  # the running track
-        track = reach < 9.0
+    if kind == "stadium":  # the running track round the pitch's surround
+        track = (reach > 4.0) & (reach < 9.0)
         ground = np.where(track[..., None], np.array([0.55, 0.26, 0.2]), ground)
     if kind == "riverside":  # the river, then the far bank
         water = (reach > 25.0) & (reach < 120.0) & (np.cos(np.radians(az - 250.0)) > 0.2)

@@ -111,7 +111,10 @@ def test_lines_are_textured_and_never_clip_to_white(world: World) -> None:
     assert white.mean() < 0.01, white.mean()
 
 
-def _ball_frames(world: World, spots: list[tuple[float, float]]) -> list[tuple[np.ndarray, np.ndarray]]:
+Frames = list[tuple[np.ndarray, np.ndarray]]
+
+
+def _ball_frames(world: World, spots: list[tuple[float, float]]) -> Frames:
     """(frame, ball mask) with the ball at each of ``spots`` in front of a robot's eye."""
     ball = world.model.geom(BALL_GEOM).id
     out = []
@@ -155,7 +158,7 @@ def test_a_colour_ball_finder_tuned_on_one_look_loses_balls_on_the_others(world:
     v_min = float(np.quantile(v_all[panels], 0.1))
     s_max = float(np.quantile(s_all[panels], 0.9))
 
-    def recall(frames: list[tuple[np.ndarray, np.ndarray]]) -> float:
+    def recall(frames: Frames) -> float:
         found = 0
         for rgb, mask in frames:
             v, s = _hsv(rgb)
