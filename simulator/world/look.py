@@ -17,8 +17,10 @@ Here the same elements, in MuJoCo:
   luminosity, times :data:`LIGHT_GAIN` (MuJoCo's lights add Lambert terms where Webots renders
   physically based with tone mapping: the gain makes the league's brightest scenes bright, not
   clipped); the main and off lights, of one colour and nearly one direction, are drawn as one
-  (:func:`lighting`). The image-based light becomes the ambient light: the background's mean colour
-  times :data:`ENVIRONMENT_GAIN` times the luminosity. The background's texels are scaled by
+  (:func:`lighting`). The image-based light is the background's mean colour times
+  :data:`ENVIRONMENT_GAIN` times the luminosity, half of it from above (added to the top
+  light: the sky lights what faces up, a ball's underside is in its own shade) and half from
+  all around (MuJoCo's ambient light). The background's texels are scaled by
   the luminosity too. The main light casts shadows (robot cameras: on a GPU,
   :mod:`simulator.world.camera`). Nothing compensates: a robot camera whose
   model declares auto-exposure (:mod:`simulator.world.camera_model`) evens out a share of it.
@@ -76,7 +78,8 @@ NET_MESH_M = 0.1
 NET_CORD_M = 0.01  # cord thickness
 LUMINOSITY_RANGE = (0.75, 1.25)
 LIGHT_GAIN = 0.1  # MuJoCo diffuse per unit of the league's light intensity
-ENVIRONMENT_GAIN = 1.0  # ambient light per unit of the background's mean texel (0..1)
+ENVIRONMENT_GAIN = 1.0  # environment light per unit of the background's mean texel (0..1)
+SKY_SHARE = 0.5  # of the environment's light, the share that comes from above (the sky)
 SHADOW_LIGHTS = (True, False)  # the key light (the main and off lights) casts shadows
 
 
@@ -452,13 +455,17 @@ def lighting(look: Look) -> Lighting:
          lum * LIGHT_GAIN * lt.intensity * lt.rgb[2])
         for lt in lights
     )  # fmt: skip
-    specular = tuple((0.3 * d[0], 0.3 * d[1], 0.3 * d[2]) for d in diffuse)
-    env = _environment_rgb(look.background)
+    key = diffuse[0]
+    specular = ((0.3 * key[0], 0.3 * key[1], 0.3 * key[2]), (0.0, 0.0, 0.0))  # a glint of the sun
+    env = [lum * ENVIRONMENT_GAIN * c for c in _environment_rgb(look.background)]
     ambient = (
-        lum * ENVIRONMENT_GAIN * env[0], lum * ENVIRONMENT_GAIN * env[1],
-        lum * ENVIRONMENT_GAIN * env[2],
+        (1 - SKY_SHARE) * env[0], (1 - SKY_SHARE) * env[1], (1 - SKY_SHARE) * env[2]
     )  # fmt: skip
-    return Lighting(tuple(lt.direction() for lt in lights), diffuse, specular, ambient)
+    top = diffuse[1]
+    sky = (top[0] + SKY_SHARE * env[0], top[1] + SKY_SHARE * env[1], top[2] + SKY_SHARE * env[2])
+    return Lighting(
+        tuple(lt.direction() for lt in lights), (diffuse[0], sky), specular, ambient
+    )
 
 
 def apply_look(model: mujoco.MjModel, look: Look) -> None:

@@ -100,11 +100,11 @@ def turf_tile(
 
 def line_tile(*, seed: int, size_px: int) -> Image:
     """A ``size_px`` square of white-painted turf: blade texture, a green cast, albedo about
-    0.78 (the lights make it bright, not clipped)."""
+    0.63 (the brightest light makes it bright, not clipped)."""
     rng = np.random.default_rng(seed)
     shade, patches = _blades(rng, size_px)
     shade = np.clip(shade, 0.8, 1.15)
-    base = np.array([0.7, 0.73, 0.68])
+    base = np.array([0.62, 0.65, 0.6])
     rgb = base * shade[..., None] * (1.0 + 0.02 * patches[..., None])
     return _to_image(rgb)
 
