@@ -88,7 +88,7 @@ def test_turf_has_mowing_stripes_and_blades() -> None:
 def test_the_ideal_camera_has_no_noise_and_the_league_camera_has() -> None:
     ideal = _camera_image(21, camera=CameraModel.ideal()).astype(int)
     noisy = _camera_image(
-        21, camera=CameraModel(seed=2, exposure_gain=1.0, auto_exposure=1.0, noise_std=3.0)
+        21, camera=CameraModel(seed=2, exposure_gain=1.0, auto_exposure=0.0, noise_std=3.0)
     )
     diff = noisy.astype(int) - ideal
     assert diff.std() == pytest.approx(3.0, rel=0.2)
