@@ -90,7 +90,8 @@ def test_adult_scrimmage_halves_and_ready_are_longer_unless_given(tmp_path: Path
     timing = load_game(tmp_path / "game.json").game.timing
     assert timing.half_duration_s == 60.0 and timing.ready_duration_s == 30.0
     game, _red = _scrimmage(tmp_path, "--class", "adult", "--half-duration", "40")
-    assert game["timing"]["half_duration_s"] == 40 and game["timing"]["ready_duration_s"] == 25
+    # the clock stands still in READY, so a shorter half keeps its READY (no longer cut to fit)
+    assert game["timing"]["half_duration_s"] == 40 and game["timing"]["ready_duration_s"] == 30
     game, _red = _scrimmage(tmp_path, "--class", "adult", "--ready-duration", "12")
     assert game["timing"]["half_duration_s"] == 60 and game["timing"]["ready_duration_s"] == 12
 
