@@ -270,7 +270,10 @@ def rate(matches: Iterable[RatedMatch], teams: Iterable[str] = ()) -> Ladder:
 
 
 class LadderCache:
-    """The ladder, recomputed only when a match was recorded or a team added since."""
+    """The ladder, recomputed only when a match was recorded or the teams on it changed since.
+
+    The key holds the names of the teams that accept friendlies (not their count): a team
+    renamed, or one team leaving as another joins, changes the table as well."""
 
     def __init__(self) -> None:
         self._lock = threading.Lock()
@@ -280,15 +283,14 @@ class LadderCache:
     def get(self, session: Session) -> Ladder:
         key = (session.scalar(select(func.count(RatedMatch.id))),
                session.scalar(select(func.max(RatedMatch.id))),
-               session.scalar(select(func.count(Team.id)).where(
-                   Team.accepts_friendlies.is_(True))))
+               tuple(session.scalars(select(Team.name).where(
+                   Team.accepts_friendlies.is_(True)).order_by(Team.name))))
         with self._lock:
             if key == self._key:
                 return self._ladder
         matches = session.scalars(select(RatedMatch).where(RatedMatch.counted.is_(True))
                                   .order_by(RatedMatch.id))
-        teams = session.scalars(select(Team.name).where(Team.accepts_friendlies.is_(True)))
-        ladder = rate(matches, teams)
+        ladder = rate(matches, key[2])
         with self._lock:
             self._key, self._ladder = key, ladder
         return ladder

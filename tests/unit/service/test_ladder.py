@@ -302,3 +302,30 @@ def test_both_sides_of_a_friendly_field_the_services_number_of_players(
     game = json.loads((config / "game.json").read_text())
     assert sorted(red["players"]) == sorted(blue["players"]) == ["1", "2"]
     assert len(game["red"]["ports"]) == len(game["blue"]["ports"]) == 2
+
+
+def test_the_ladders_team_list_follows_teams_joining_and_leaving_at_the_same_count(
+    start: Callable[..., Served], token: Callable[..., str],
+) -> None:
+    """As found: the table was cached by the number of teams on the ladder, so one team
+    leaving as another joined (or a rename) left the old names on the table."""
+    served = start()
+    secrets = {"Alpha": token("Alpha", accepts_friendlies=True),
+               "Beta": token("Beta", accepts_friendlies=True), "Gamma": token("Gamma")}
+    http = {name: served.client(secret) for name, secret in secrets.items()}
+    assert [t["team"] for t in http["Alpha"].get("/v1/ladder").json()["teams"]] == [
+        "Alpha", "Beta"]
+    assert http["Beta"].patch("/v1/team", json={"accepts_friendlies": False}).status_code == 200
+    assert http["Gamma"].patch("/v1/team", json={"accepts_friendlies": True}).status_code == 200
+    assert [t["team"] for t in http["Alpha"].get("/v1/ladder").json()["teams"]] == [
+        "Alpha", "Gamma"]
+    engine = make_engine(served.settings.db_url)
+    with transaction(session_factory(engine)) as session:  # an operator renames a team
+        from service.db import Team
+        team = session.scalar(select(Team).where(Team.name == "Gamma"))
+        assert team is not None
+        team.name = "Gamma United"
+    engine.dispose()
+    assert [t["team"] for t in http["Alpha"].get("/v1/ladder").json()["teams"]] == [
+        "Alpha", "Gamma United"]
+    assert http["Alpha"].get("/v1/ladder/Gamma").status_code == 404
