@@ -34,6 +34,7 @@ from service import ratings, submissions
 from service.db import ACTIVE_STATES, Submission, SubmissionState, Team, TeamFile, now, transaction
 from service.db import utc as as_utc
 from service.db.ladder import LadderFixture
+from service.matchfiles import OWN_COLOR
 from service.ratings import LadderCache
 
 if TYPE_CHECKING:
@@ -59,6 +60,19 @@ def watchable(session: Session, *, team_id: int, team_name: str | None,
             team_name is not None and row.opponent == team_name)):
         return row
     return submissions.get_own(session, team_id=team_id, submission_id=submission_id)
+
+
+def logs_side(session: Session, *, team_id: int, team_name: str | None,
+              submission_id: str) -> tuple[Submission, str]:
+    """The submission and the colour whose robots' logs the team may read: its own (red), or
+    blue in a friendly the ladder scheduled against it (never the other side's); anything else
+    is 'not found', like an unknown id."""
+    row = session.scalar(select(Submission).where(Submission.id == submission_id))
+    if row is not None and row.team_id != team_id and team_name is not None:
+        fixture = session.get(LadderFixture, submission_id)
+        if fixture is not None and fixture.blue_team == team_name:
+            return row, "blue"
+    return submissions.get_own(session, team_id=team_id, submission_id=submission_id), OWN_COLOR
 
 
 class LadderThread:
@@ -180,4 +194,4 @@ def _newest(session: Session, team_id: int, kind: str) -> int | None:
         .order_by(TeamFile.version.desc()).limit(1))
 
 
-__all__ = ["LadderThread", "is_fixture", "watchable"]
+__all__ = ["LadderThread", "is_fixture", "logs_side", "watchable"]

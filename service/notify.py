@@ -3,6 +3,10 @@ the :class:`Notifier` thread with retries (so a restart loses none).
 
 Webhooks are signed (see :mod:`service.webhooks`); mail goes through the SMTP server of the
 settings (none configured: no mail rows are written).
+
+A friendly the ladder scheduled (:class:`service.db.ladder.LadderFixture`) is told to both
+teams, each from its own side (``side``: the submitting team plays red, the opponent blue), and
+says that the ladder scheduled it (``ladder``) and against whom.
 """
 
 from __future__ import annotations
@@ -14,7 +18,7 @@ import smtplib
 import threading
 from datetime import timedelta
 from email.message import EmailMessage
-from typing import TYPE_CHECKING, TypedDict
+from typing import TYPE_CHECKING, NotRequired, TypedDict
 
 import httpx
 from sqlalchemy import select
@@ -22,6 +26,7 @@ from sqlalchemy.orm import Session
 
 from service import outbound, webhooks
 from service.db import Notification, Submission, Team, now, transaction, utc
+from service.db.ladder import LadderFixture
 from service.matchfiles import OWN_COLOR
 from service.settings import Settings
 
@@ -49,9 +54,11 @@ class ResultsView(TypedDict, total=False):
 
 
 class NoticeLinks(TypedDict):
-    status: str
-    report: str
-    results: str
+    """The API's links; the opponent of a ladder friendly gets only ``logs`` (its own)."""
+
+    status: NotRequired[str]
+    report: NotRequired[str]
+    results: NotRequired[str]
     logs: str
 
 
@@ -65,7 +72,9 @@ class NoticePages(TypedDict):
 class SubmissionNotice(TypedDict):
     id: str
     state: str
-    opponent: str
+    opponent: str  # the other team, as the notified team sees it
+    side: str  # the notified team's colour: red (the submitting team) or blue (the opponent)
+    ladder: bool  # a friendly the ladder scheduled (not charged)
     match_id: str | None
     failure_class: str | None
     failure_side: str | None
@@ -86,10 +95,14 @@ class NotificationPayload(TypedDict):
     submission: SubmissionNotice
 
 
-def outcome_of(row: Submission, results: ResultsView | None) -> str:
-    """The outcome in words for the submitting team (red): won, drew, lost, or why not played."""
+def outcome_of(row: Submission, results: ResultsView | None, side: str = OWN_COLOR) -> str:
+    """The outcome in words for the team playing ``side`` (the submitting team plays red): won,
+    drew, lost, or why not played."""
     if row.state == "cancelled":
         return "cancelled"
+    if row.state == "failed" and side != OWN_COLOR:
+        where = " on the league's side" if row.failure_side == "league" else ""
+        return f"not counted: {row.failure_class}{where}"
     if row.state == "failed":
         side = "the league's side (not charged)" if row.failure_side == "league" else \
             "your team's side"
@@ -97,26 +110,34 @@ def outcome_of(row: Submission, results: ResultsView | None) -> str:
     winner = (results or {}).get("winner")
     if row.state != "done" or winner is None:
         return row.state
-    return {OWN_COLOR: "won", "draw": "draw"}.get(winner, "lost")
+    return {side: "won", "draw": "draw"}.get(winner, "lost")
 
 
 def payload(row: Submission, event: str, settings: Settings,
-            results: ResultsView | None = None) -> NotificationPayload:
+            results: ResultsView | None = None, *, side: str = OWN_COLOR,
+            opponent: str | None = None, ladder: bool = False) -> NotificationPayload:
     """The notification's data: the submission, its score and outcome (from ``results``, the
-    match's results.json, when it ended), links to the API and to the pages a browser opens."""
+    match's results.json, when it ended), links to the API and to the pages a browser opens.
+    ``side`` is the notified team's colour and ``opponent`` the other team (by default the
+    submission's opponent); the blue side is not told the submitting team's own details."""
     public = settings.public_url.rstrip("/")
     base = f"{public}/v1/submissions/{row.id}"
     play = (results or {}).get("play") or {}
+    own = side == OWN_COLOR
+    links: NoticeLinks = {"status": base, "report": base + "/report",
+                          "results": base + "/results", "logs": base + "/logs"} if own else \
+        {"logs": base + "/logs"}
     return {
         "event": event,
         "submission": {
-            "id": row.id, "state": row.state, "opponent": row.opponent, "match_id": row.match_id,
+            "id": row.id, "state": row.state, "opponent": opponent or row.opponent,
+            "side": side, "ladder": ladder, "match_id": row.match_id,
             "failure_class": row.failure_class, "failure_side": row.failure_side,
-            "cause": row.cause, "charged": row.charged,
-            "score": (results or {}).get("score"), "outcome": outcome_of(row, results),
+            "cause": row.cause if own or row.failure_side == "league" else None,
+            "charged": row.charged if own else False,
+            "score": (results or {}).get("score"), "outcome": outcome_of(row, results, side),
             "playing_s": play.get("playing_s"), "halves_playing": play.get("halves_playing"),
-            "links": {"status": base, "report": base + "/report", "results": base + "/results",
-                      "logs": base + "/logs"},
+            "links": links,
             "pages": {"submissions": f"{public}/watch/submissions",
                       "live": f"{public}/watch/live/{row.id}",
                       "replay": f"{public}/watch/replay/{row.id}",
@@ -128,11 +149,26 @@ def payload(row: Submission, event: str, settings: Settings,
 def enqueue(session: Session, row: Submission, event: str, settings: Settings,
             results: ResultsView | None = None) -> None:
     """Outbox rows for ``event``: a mail when the team has an address and SMTP is set, a
-    webhook when the team has a webhook URL."""
+    webhook when the team has a webhook URL; for a friendly the ladder scheduled, to both
+    teams, each from its side."""
     team = session.get(Team, row.team_id)
     if team is None:
         return
-    body = json.dumps(payload(row, event, settings, results), sort_keys=True)
+    fixture = session.get(LadderFixture, row.id)
+    _enqueue_to(session, team, row, event, settings,
+                payload(row, event, settings, results, ladder=fixture is not None))
+    if fixture is None:
+        return
+    other = session.scalar(select(Team).where(Team.name == fixture.blue_team))
+    if other is not None and other.id != team.id:
+        _enqueue_to(session, other, row, event, settings,
+                    payload(row, event, settings, results, side="blue", opponent=team.name,
+                            ladder=True))
+
+
+def _enqueue_to(session: Session, team: Team, row: Submission, event: str, settings: Settings,
+                data: NotificationPayload) -> None:
+    body = json.dumps(data, sort_keys=True)
     channels = []
     if team.email and settings.smtp_host and event in MAIL_EVENTS:
         channels.append("mail")
@@ -151,13 +187,21 @@ def send_mail(settings: Settings, *, to: str, event: str, data: NotificationPayl
     message["From"] = settings.mail_from
     message["To"] = to
     what = event.split(".", 1)[1]
-    message["Subject"] = f"[hlvs] test match {sub['id']} {what}"
+    side = sub.get("side") or OWN_COLOR
+    other = "blue" if side == "red" else "red"
     pages = sub.get("pages") or {}
-    lines = [f"Your test match {sub['id']} against {sub['opponent']} {what}.", "",
-             f"state:   {sub['state']}"]
+    if sub.get("ladder"):
+        message["Subject"] = f"[hlvs] ladder friendly {sub['id']} against {sub['opponent']} " \
+            f"{what}"
+        lines = [f"The ladder scheduled a friendly {sub['id']} of your team ({side}) against "
+                 f"{sub['opponent']}; it {what}. It is not charged to your team.", ""]
+    else:
+        message["Subject"] = f"[hlvs] test match {sub['id']} {what}"
+        lines = [f"Your test match {sub['id']} against {sub['opponent']} {what}.", ""]
+    lines.append(f"state:   {sub['state']}")
     score = sub.get("score")
     if score:
-        lines.append(f"score:   you (red) {score['red']} : {score['blue']} {sub['opponent']}")
+        lines.append(f"score:   you ({side}) {score[side]} : {score[other]} {sub['opponent']}")
     if event != "submission.started":
         lines.append(f"outcome: {sub.get('outcome') or sub['state']}")
     if sub.get("playing_s") is not None:
@@ -172,8 +216,11 @@ def send_mail(settings: Settings, *, to: str, event: str, data: NotificationPayl
         lines.append(f"  replay:       {pages.get('replay', '')}")
     lines += [f"  your matches: {pages.get('submissions', '')}",
               f"  ladder:       {pages.get('ladder', '')}",
-              "", "For scripts (API, Authorization: Bearer <token>):",
-              f"  results: {sub['links']['results']}", f"  logs:    {sub['links']['logs']}"]
+              "", "For scripts (API, Authorization: Bearer <token>):"]
+    if "results" in sub["links"]:
+        lines.append(f"  results: {sub['links']['results']}")
+    lines.append(f"  logs:    {sub['links']['logs']}" + (
+        "  (your team's robots' logs)" if side != OWN_COLOR else ""))
     message.set_content("\n".join(lines) + "\n")
     with smtplib.SMTP(settings.smtp_host, settings.smtp_port, timeout=10) as smtp:
         smtp.send_message(message)

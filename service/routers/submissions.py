@@ -23,7 +23,7 @@ from starlette.concurrency import run_in_threadpool
 from starlette.responses import Response
 
 from contracts import ContractError, MatchReport, MatchResults, files
-from service import submissions, teamfiles
+from service import ladder, submissions, teamfiles
 from service.aftermatch import PARTIAL_VIDEO_FILE
 from service.db import ACTIVE_STATES, Submission
 from service.deps import (
@@ -371,16 +371,25 @@ def _unescaped(name: str) -> str:
 def list_logs(submission_id: str, request: Request, principal: TeamPrincipal,
               session: DbSession) -> LogListing:
     """The team's own logs (its robots' stdout/stderr and /robocup-logs) and the public logs;
-    download one with ``/logs/team/<path>`` or ``/logs/public/<path>``."""
-    _, out = _own(request, principal, session, submission_id)
-    return LogListing(team=_listing(out / "teams" / OWN_COLOR), public=_listing(out / "public"))
+    download one with ``/logs/team/<path>`` or ``/logs/public/<path>``. The opponent in a
+    friendly the ladder scheduled reads its own robots' logs (blue) here too."""
+    _, out, color = _logs_of(request, principal, session, submission_id)
+    return LogListing(team=_listing(out / "teams" / color), public=_listing(out / "public"))
+
+
+def _logs_of(request: Request, principal: TeamPrincipal, session: Any, submission_id: str
+             ) -> tuple[Submission, Path, str]:
+    assert principal.team_id is not None
+    row, color = ladder.logs_side(session, team_id=principal.team_id,
+                                  team_name=principal.team_name, submission_id=submission_id)
+    return row, _match_dir(request, row), color
 
 
 @router.get("/{submission_id}/logs/{part}/{path:path}")
 def get_log(submission_id: str, part: str, path: str, request: Request,
             principal: TeamPrincipal, session: DbSession) -> FileResponse:
-    row, out = _own(request, principal, session, submission_id)
-    roots = {"team": out / "teams" / OWN_COLOR, "public": out / "public"}
+    _, out, color = _logs_of(request, principal, session, submission_id)
+    roots = {"team": out / "teams" / color, "public": out / "public"}
     if part not in roots:
         raise NotFound(what="log folder", ident=part)
     root = roots[part].resolve()
