@@ -9,8 +9,9 @@ the teams' own test matches never wait for the ladder.
 The pairing: among the teams that accept friendlies, have a team file and no active test match,
 the team that waited longest since its last ladder match plays, against the team of the
 closest rating (then the one it met least often on the ladder, then by name). It plays with its
-latest team file, as the submitting (red) team; the opponent's newest file is used as for any
-friendly. The submission is a normal test match of the team, marked as a ladder fixture
+current team file (:func:`service.teamfiles.current`: the newest whose pre-flight passed), as
+the submitting (red) team; the opponent's current file is used as for any friendly. The
+submission is a normal test match of the team, marked as a ladder fixture
 (:class:`service.db.ladder.LadderFixture`): it is not charged to the team.
 
 Restart safety: the time of the last fixture is read from the database, and a match is recorded
@@ -30,7 +31,7 @@ from typing import TYPE_CHECKING
 from sqlalchemy import func, select
 from sqlalchemy.orm import Session
 
-from service import ratings, submissions
+from service import ratings, submissions, teamfiles
 from service.db import ACTIVE_STATES, Submission, SubmissionState, Team, TeamFile, now, transaction
 from service.db import utc as as_utc
 from service.db.ladder import LadderFixture
@@ -161,9 +162,9 @@ class LadderThread:
         teams: list[Team] = []
         for team in session.scalars(select(Team).where(Team.accepts_friendlies.is_(True))
                                     .order_by(Team.name)):
-            newest = _newest(session, team.id, "team_config")
-            if newest is not None and team.id not in active:
-                files[team.id] = newest
+            current = teamfiles.current(session, team_id=team.id)
+            if current is not None and team.id not in active:
+                files[team.id] = current.id
                 teams.append(team)
         if len(teams) < 2:
             return None

@@ -30,7 +30,7 @@ from sqlalchemy.orm import Session
 from orchestrator import ConfigError, Problem
 from orchestrator.config import BUILT_IN_MODELS, FieldClass, TeamConfig, check_team_document
 from orchestrator.delivery import IPNetwork, literal_problem
-from service.db import TeamFile
+from service.db import Submission, TeamFile
 from service.errors import InvalidInput, NotFound
 from service.sealing import PREFIX, Sealer
 from service.settings import LOG_TARGET_ALLOW_SETTING
@@ -245,6 +245,19 @@ def get(session: Session, *, team_id: int, kind: str, version: int | None = None
     return row
 
 
+def current(session: Session, *, team_id: int, kind: str = "team_config") -> TeamFile | None:
+    """The version another team's friendly or the ladder plays: the newest valid one whose
+    pre-flight passed (a submission was made with it after its check), so a newer upload not
+    checked yet (or one that fails its check) never displaces it; while no version has passed
+    one, the newest valid one."""
+    valid = select(TeamFile).where(TeamFile.team_id == team_id, TeamFile.kind == kind,
+                                   TeamFile.valid.is_(True)).order_by(TeamFile.version.desc())
+    passed = session.scalar(valid.where(select(Submission.id).where(
+        Submission.team_file_id == TeamFile.id, Submission.preflight_s.is_not(None))
+        .exists()).limit(1))
+    return passed if passed is not None else session.scalar(valid.limit(1))
+
+
 def refuse(session: Session, row: TeamFile, *, stage: str, cause: str) -> None:
     """A version that failed the pre-flight check never becomes current: marked invalid, with
     the failure among its problems (the previous valid version stays current)."""
@@ -310,5 +323,6 @@ def newest_id(session: Session, *, team_id: int, kind: str) -> int | None:
         .order_by(TeamFile.version.desc()).limit(1))
 
 
-__all__ = ["KINDS", "check", "get", "get_by_id", "newest_id", "opened", "raise_if_invalid",
-           "refuse", "seal_stored", "service_problems", "store", "validated_team", "versions"]
+__all__ = ["KINDS", "check", "current", "get", "get_by_id", "newest_id", "opened",
+           "raise_if_invalid", "refuse", "seal_stored", "service_problems", "store",
+           "validated_team", "versions"]

@@ -31,7 +31,7 @@ from service import matchfiles, notify, teamfiles
 from service.accounts import ensure_team_account, supports_accounts
 from service.aftermatch import replay_of, team_logs_of
 from service.db import MediaState, Submission, SubmissionState, Team, now, transaction
-from service.errors import ServiceError
+from service.errors import NotFound, ServiceError
 from service.ladder import is_fixture
 from service.matchfiles import OWN_COLOR
 from service.submissions import STUB, failure_side, queue_paused
@@ -176,8 +176,11 @@ class QueueWorker:
         if row.opponent != STUB:
             other = session.scalar(select(Team).where(Team.name == row.opponent))
             assert other is not None
-            opponent_doc = teamfiles.opened(teamfiles.get(session, team_id=other.id,
-                                                          kind="team_config"), sealer)
+            current = teamfiles.current(session, team_id=other.id)
+            if current is None:
+                raise NotFound(what="uploaded file that passed its checks",
+                               ident=f"{row.opponent}'s team_config.json")
+            opponent_doc = teamfiles.opened(current, sealer)
         for doc, failure_class, whose in ((team_doc, "team_startup", "the team file"),
                                           (opponent_doc, "infrastructure", "the opponent's")):
             _, refused = teamfiles.service_problems("team_config", doc)

@@ -35,7 +35,7 @@ from service.deps import (
     get_services,
     require_team,
 )
-from service.errors import NotFound, PreflightFailed
+from service.errors import InvalidInput, NotFound, PreflightFailed
 from service.matchfiles import OWN_COLOR
 from service.views import (
     SubmissionCreate,
@@ -88,7 +88,10 @@ async def create_submission(body: SubmissionCreate, request: Request, services: 
             elapsed = await anyio.to_thread.run_sync(services.preflight, team,
                                                      services.settings, limiter=limiter)
         except PreflightFailed as failed:
-            await run_in_threadpool(_refuse, services, file_id, failed)
+            await run_in_threadpool(_refuse, services, file_id, failed.stage, failed.cause)
+            raise
+        except InvalidInput as invalid:  # a problem of the file that only the check found
+            await run_in_threadpool(_refuse, services, file_id, "config", str(invalid))
             raise
         return await run_in_threadpool(_after_preflight, services, request, principal, body,
                                        file_id, credentials, elapsed)
@@ -108,10 +111,10 @@ def _before_preflight(services: Services, team_id: int, body: SubmissionCreate
     return teamfiles.validated_team(document), file_id, credentials  # today's rules
 
 
-def _refuse(services: Services, file_id: int, failed: PreflightFailed) -> None:
+def _refuse(services: Services, file_id: int, stage: str, cause: str) -> None:
     with services.sessions() as session, session.begin():
-        teamfiles.refuse(session, teamfiles.get_by_id(session, file_id), stage=failed.stage,
-                         cause=failed.cause)
+        teamfiles.refuse(session, teamfiles.get_by_id(session, file_id), stage=stage,
+                         cause=cause)
 
 
 def _after_preflight(services: Services, request: Request, principal: Principal,

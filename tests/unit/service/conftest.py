@@ -16,7 +16,7 @@ from cluster.fake import FakePool
 from orchestrator.config import TeamConfig
 from service import Settings
 from service.db import Scope, make_engine, migrate, session_factory, transaction
-from service.errors import PreflightFailed
+from service.errors import InvalidInput, PreflightFailed
 from service.tokens import issue
 from tests.integration.service.harness import Served, serve
 
@@ -46,7 +46,8 @@ def team_doc(name: str = "Alpha", image: str = "hlvs-runner/stub") -> dict[str, 
 
 
 class FakePreflight:
-    """Passes, unless the image's name contains 'bad'."""
+    """Passes, unless the image's name contains 'bad' (fails at pull) or 'unfit' (a problem of
+    the file that only the check finds)."""
 
     def __init__(self) -> None:
         self.calls = 0
@@ -55,6 +56,8 @@ class FakePreflight:
         self.calls += 1
         if "bad" in str(team.image):
             raise PreflightFailed(stage="pull", image=str(team.image), cause="manifest unknown")
+        if "unfit" in str(team.image):
+            raise InvalidInput("team_config.json has 1 problem(s): /image: unfit for the match")
         return 0.01
 
 

@@ -5,8 +5,10 @@ from __future__ import annotations
 import json
 from collections.abc import Callable
 
+from cluster.fake import FakePool
 from tests.integration.service.harness import Served
-from tests.unit.service.conftest import team_doc
+from tests.unit.service.conftest import team_doc, wait_for_status
+from tests.unit.service.test_submissions import handle_of, setup_team
 
 
 def test_upload_check_and_versions(start: Callable[..., Served],
@@ -96,3 +98,38 @@ def test_credentials_are_checked_stored_and_shown_masked(start: Callable[..., Se
         refused = http.put("/v1/team/files/credentials", json=broken)
         assert refused.status_code == 422
         assert any(p["file"] == "credentials.json" for p in refused.json()["problems"])
+
+
+def test_only_a_file_whose_preflight_passed_is_played_by_others_and_a_refused_one_is_kept(
+        start: Callable[..., Served], token: Callable[..., str], pool: FakePool) -> None:
+    """As found: a new upload was the team's current file at once, before (and whatever) its
+    pre-flight, and a problem of the file that only the pre-flight found left it current."""
+    served = start()
+    alpha = setup_team(served, token("Alpha", accepts_friendlies=True), "Alpha")
+    beta = setup_team(served, token("Beta", accepts_friendlies=True), "Beta")
+    first = alpha.post("/v1/submissions", json={})  # version 1 passes its pre-flight
+    assert first.status_code == 201, first.text
+    wait_for_status(alpha, first.json()["id"], lambda b: b["state"] == "running")
+    pool.finish(handle_of(served, first.json()["id"]), {"status": "success"})
+    wait_for_status(alpha, first.json()["id"], lambda b: b["state"] == "done")
+    unchecked = team_doc("Alpha", image="127.0.0.1:1/bad/image")
+    assert alpha.put("/v1/team/files/team_config", json=unchecked).status_code == 201
+    friendly = beta.post("/v1/submissions", json={"opponent": "Alpha"})
+    assert friendly.status_code == 201, friendly.text
+    sid = friendly.json()["id"]
+    wait_for_status(beta, sid, lambda b: b["state"] == "running")
+    blue = json.loads(next(served.settings.matches_dir.glob(f"{sid}-a1"))
+                      .joinpath("config", "team_blue.json").read_text())
+    assert blue["image"] == team_doc("Alpha")["image"], blue["image"]  # version 1, checked
+    pool.finish(handle_of(served, sid), {"status": "success"})
+    wait_for_status(beta, sid, lambda b: b["state"] == "done")
+    # a problem of the file that only the pre-flight finds: refused, kept with its failure
+    assert alpha.put("/v1/team/files/team_config",
+                     json=team_doc("Alpha", image="league/unfit")).status_code == 201
+    refused = alpha.post("/v1/submissions", json={})
+    assert refused.status_code == 422, refused.text
+    versions = {v["version"]: v for v in alpha.get("/v1/team/files/team_config").json()}
+    assert versions[3]["valid"] is False, versions[3]
+    assert "pre-flight check failed at config" in versions[3]["problems"][-1]["text"]
+    assert "unfit for the match" in versions[3]["problems"][-1]["text"]
+    assert alpha.get("/v1/team/files/team_config/3").status_code == 200  # still in the history
