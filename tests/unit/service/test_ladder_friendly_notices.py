@@ -9,6 +9,7 @@ from email import message_from_bytes, policy
 from email.message import EmailMessage
 from typing import Any
 
+import httpx
 import pytest
 
 from cluster.fake import FakePool
@@ -53,26 +54,35 @@ def _wait_mails(inbox: Inbox, count: int, timeout_s: float = 15.0) -> None:
         time.sleep(0.05)
 
 
-def test_both_teams_of_a_ladder_friendly_are_told_and_read_their_own_logs(
+ADDRESS = {name: f"{name.lower()}@example.org" for name in ("Alpha", "Beta")}
+
+
+def _played_friendly(served: Served, token: Callable[..., str], pool: FakePool
+                     ) -> tuple[dict[str, httpx.Client], str, str, str]:
+    """Two teams; the ladder's friendly between them played to its end (red wins 1-0):
+    (their clients, the submission id, the submitting team, its opponent)."""
+    http = {name: setup_team(served, token(name, accepts_friendlies=True, email=ADDRESS[name]),
+                             name) for name in ADDRESS}
+    sid, handle, team, opponent = running_match(served)
+    pool.finish(handle, {"status": "success"})
+    wait_for_status(http[team], sid, lambda b: b["state"] == "done")
+    return http, sid, team, opponent
+
+
+def test_both_teams_of_a_ladder_friendly_are_told_from_their_side_that_the_ladder_set_it(
     start: Callable[..., Served], token: Callable[..., str], pool: FakePool,
     inbox: tuple[Inbox, int],
 ) -> None:
-    """As found: only the submitting team got mail (which did not say the ladder scheduled
-    it), and the opponent could not read its own robots' logs of the match."""
+    """As found: only the submitting team got mail, and it did not say that the ladder
+    scheduled the match."""
     mails, port = inbox
     served = start(ladder_every_s=3600.0, smtp_host="127.0.0.1", smtp_port=port)
-    address = {name: f"{name.lower()}@example.org" for name in ("Alpha", "Beta")}
-    http = {name: setup_team(served, token(name, accepts_friendlies=True, email=address[name]),
-                             name) for name in address}
-    outsider = served.client(token("Gamma"))
-    sid, handle, team, opponent = running_match(served)
-    pool.finish(handle, {"status": "success"})  # red (the ladder's submitting team) wins 1-0
-    wait_for_status(http[team], sid, lambda b: b["state"] == "done")
+    _, sid, team, opponent = _played_friendly(served, token, pool)
     _wait_mails(mails, 4)
 
     for name, other, side, line in ((team, opponent, "red", "you (red) 1 : 0"),
                                     (opponent, team, "blue", "you (blue) 0 : 1")):
-        got = mails.to(address[name])
+        got = mails.to(ADDRESS[name])
         subjects = sorted(str(m["Subject"]) for m in got)
         assert subjects == [f"[hlvs] ladder friendly {sid} against {other} finished",
                             f"[hlvs] ladder friendly {sid} against {other} started"], subjects
@@ -83,6 +93,14 @@ def test_both_teams_of_a_ladder_friendly_are_told_and_read_their_own_logs(
         assert ("outcome: won" if side == "red" else "outcome: lost") in finished, finished
         assert f"/v1/submissions/{sid}/logs" in finished
 
+
+def test_each_team_of_a_ladder_friendly_reads_its_own_robots_logs_never_the_others(
+    start: Callable[..., Served], token: Callable[..., str], pool: FakePool,
+) -> None:
+    """As found: the opponent could not read its own robots' logs of the match."""
+    served = start(ladder_every_s=3600.0)
+    http, sid, team, opponent = _played_friendly(served, token, pool)
+    outsider = served.client(token("Gamma"))
     for name, own, theirs in ((team, "red", "blue"), (opponent, "blue", "red")):
         listing = http[name].get(f"/v1/submissions/{sid}/logs")
         assert listing.status_code == 200, listing.text
