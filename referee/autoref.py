@@ -34,7 +34,7 @@ from referee.publisher import Publisher
 from referee.rulebook import RuleBook
 from referee.rules import end_of_game, goal, kickoff, set_play
 from referee.rules.base import Decision, GameView, GiveCard
-from referee.shootout import Shootout
+from referee.shootout import KickOutcome, Shootout
 from referee.snapshot import (
     PlaceBall,
     RefereeEvent,
@@ -497,14 +497,31 @@ class Referee:
     # --- penalty shoot-out ---------------------------------------------------------------
 
     def _begin_shootout(self, snapshot: WorldSnapshot) -> list[WorldCommand]:
-        self._shootout = Shootout(config=self.config, first=self.config.kickoff)
+        self._shootout = Shootout(
+            config=self.config, first=self.config.kickoff, left=self.left_team
+        )
         self.log.info(snapshot.sim_time_ms, "Penalty shoot-out begins.")
         return self._setup_kick(snapshot)
 
     def _setup_kick(self, snapshot: WorldSnapshot) -> list[WorldCommand]:
+        """SET for the next kick. A team with no player to kick loses its turn at once, as
+        the league's referee skips it (``next_penalty_shootout``, hlvs_webots referee.py:
+        1648-1654): the kick counts as missed and the other team's kick is set up in the
+        same SET."""
         assert self._shootout is not None
         shootout = self._shootout
-        self.left_team = shootout.attacker
+        while True:
+            keeper = self.gc.goalkeeper(shootout.attacker.opponent)
+            placing = shootout.setup_kick(snapshot, self.red_carded, keeper=keeper)
+            if shootout.kicker is not None:
+                break
+            skipped = KickOutcome(
+                shootout.attacker, RobotId(shootout.attacker, 0), False, "no kicker"
+            )
+            if self._record_kick(snapshot, skipped):
+                return []
+            shootout.attacker = shootout.attacker.opponent
+        self.left_team = shootout.left_team
         self.gc.kickoff_team = shootout.attacker
         self.gc.secs_remaining = self.config.timing.shootout_kick_s
         self.gc.transition(GameState.SET)
@@ -513,27 +530,15 @@ class Referee:
             SetLimp(robot=r, limp=False) for r in sorted(self.limp, key=str)
         ]
         self.limp.clear()
-        keeper = self.gc.goalkeeper(shootout.attacker.opponent)
-        commands += shootout.setup_kick(snapshot, self.red_carded, keeper=keeper)
+        commands += placing
         self.state_event(snapshot, "SET", kicker=str(shootout.kicker))
         return commands
 
-    def _shootout_step(self, snapshot: WorldSnapshot) -> list[WorldCommand]:
-        if self._shootout is None:
-            return []
+    def _record_kick(self, snapshot: WorldSnapshot, outcome: KickOutcome) -> bool:
+        """Count a kick; True when it decided the shoot-out (the game is then over)."""
+        assert self._shootout is not None
         gc = self.gc
         now = snapshot.sim_time_ms
-        if gc.state is GameState.SET and self._set_since_ms is not None:
-            if now - self._set_since_ms >= self.config.timing.shootout_set_to_play_s * 1000.0:
-                gc.transition(GameState.PLAYING)
-                self._set_since_ms = None
-                self.state_event(snapshot, "PLAYING")
-            return []
-        if gc.state is not GameState.PLAYING:
-            return []
-        outcome = self._shootout.judge(snapshot, gc.secs_remaining)
-        if outcome is None:
-            return []
         status = self._shootout.record(gc, outcome, seed=self.config.seed)
         kicks = gc.teams[outcome.team].penalty_shots
         verdict = "scored" if outcome.scored else f"missed ({outcome.reason})"
@@ -545,13 +550,39 @@ class Referee:
                 details={"scored": outcome.scored, "kick": kicks},
             )
         )
-        if status.decided:
+        if not status.decided:
+            return False
+        if gc.state is not GameState.FINISHED:
             gc.transition(GameState.FINISHED)
-            self._coin_toss = status.coin_toss
-            self._finish(snapshot, status.winner)
+        self._coin_toss = status.coin_toss
+        self._finish(snapshot, status.winner)
+        return True
+
+    def _shootout_step(self, snapshot: WorldSnapshot) -> list[WorldCommand]:
+        if self._shootout is None:
+            return []
+        gc = self.gc
+        now = snapshot.sim_time_ms
+        commands: list[WorldCommand] = []
+        if gc.state in (GameState.SET, GameState.PLAYING):
+            penalized = set(gc.penalised())
+            decisions = self._shootout.judge_goalkeeper(snapshot, penalized=penalized)
+            commands += self._apply(list(decisions), snapshot)
+        if gc.state is GameState.SET and self._set_since_ms is not None:
+            if now - self._set_since_ms >= self.config.timing.shootout_set_to_play_s * 1000.0:
+                gc.transition(GameState.PLAYING)
+                self._set_since_ms = None
+                self.state_event(snapshot, "PLAYING")
+            return commands
+        if gc.state is not GameState.PLAYING:
+            return commands
+        outcome = self._shootout.judge(snapshot, gc.secs_remaining)
+        if outcome is None:
+            return commands
+        if self._record_kick(snapshot, outcome):
             return []
         self._shootout.attacker = self._shootout.attacker.opponent
-        return self._setup_kick(snapshot)
+        return commands + self._setup_kick(snapshot)
 
     # --- outputs -------------------------------------------------------------------------
 

@@ -123,3 +123,26 @@ def test_a_folder_without_scenarios_is_invalid_input(
     assert code == 2 and out == ""
     assert f"{tmp_path}: no test_scenario.json in this folder" in err
     assert f"{tmp_path / 'absent.json'}: no such file or folder" in err
+
+
+def test_the_shootout_kicks_on_the_goal_and_poses_the_league_gives(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """Blue on the left, red first: all kicks on the goal at x < 0, the poses mirrored only for
+    the team on the right, a goalkeeper off its line in SET removed, a ball at rest in the goal
+    area ends the kick (hlvs_webots referee.py:1574-1605, 1657-1677, 2178-2185)."""
+    code, out, _ = run(capsys, ROOT / "shootout", "--json")
+    report = json.loads(out)
+    assert code == 0 and report["ok"] is True, out
+    (scenario,) = report["scenarios"]
+    assert (scenario["tests"], scenario["passed"], scenario["ending"]) == (14, 14, "finished")
+
+
+def test_a_team_without_a_kicker_loses_its_turns(capsys: pytest.CaptureFixture[str]) -> None:
+    """Red kicks first with no player: each of its kicks is skipped and blue's set up in the
+    same SET (hlvs_webots referee.py:1648-1654)."""
+    code, out, _ = run(capsys, ROOT / "shootout_no_kicker", "--json")
+    report = json.loads(out)
+    assert code == 0 and report["ok"] is True, out
+    (scenario,) = report["scenarios"]
+    assert (scenario["tests"], scenario["passed"], scenario["ending"]) == (7, 7, "finished")
