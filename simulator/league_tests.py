@@ -24,6 +24,9 @@ have no controller. Differences from Webots, all of the world and none of the ru
   world then runs at its host's speed: its scenarios expect a 2 s half-time break,
   referee.py:1913-1916, to last more than 5 simulated seconds).
 - The packet is read the step it is made (the league's arrives by UDP, a step or more later).
+- The ball is the league's (:func:`simulator.world.ball.use_league_ball`: Webots' damping of
+  ``protos/RobocupTexturedSoccerBall.proto``, no rolling friction), as the scenarios' pushes
+  were tuned to it, unless the match ball is asked for; matches always play the match ball.
 
 The league's world lets resting bodies sleep (``worlds/robocup.wbt:24-26``: physics disabled
 for a body slower than 0.1 m/s and 0.1 rad/s for 0.1 s); here the whole world sleeps when every
@@ -55,7 +58,7 @@ from referee import (
 )
 from simulator.match_setup import referee_config
 from simulator.world import World
-from simulator.world.ball import BALL_BODY
+from simulator.world.ball import BALL_BODY, use_league_ball
 
 # rc_testing.py:26 (VALID_SEC_STATES) with the wire codes of gamestate.py:78-90
 SECONDARY_NAMES = {
@@ -70,6 +73,7 @@ SLEEP_SPEED = 0.1  # robocup.wbt: physicsDisableLinearThreshold / physicsDisable
 SLEEP_AFTER_MS = 100  # robocup.wbt: physicsDisableTime 0.1
 LEAGUE_STANDING_Z_M = 0.24  # a RobocupRobot's halfTimeStartingPose height in the league's files
 Ending = Literal["finished", "critical", "game_over", "time_limit"]
+BallKind = Literal["league", "match"]
 
 
 @dataclass
@@ -213,6 +217,7 @@ class LeagueTestRunner:
         *,
         league_standing_z: Mapping[RobotId, float] | None = None,
         max_sim_s: float = 3600.0,
+        ball: BallKind = "league",
     ) -> None:
         self.spec = spec
         self.scenario = scenario
@@ -224,6 +229,8 @@ class LeagueTestRunner:
             seed=spec.seed,
             physics_dt_s=spec.physics_dt_s,
         )
+        if ball == "league":
+            use_league_ball(self.world.model)
         self.clock = FakeClock()
         rtf = spec.maximum_real_time_factor
         self.speed = rtf if rtf > 0 else FAST_SPEED  # simulated seconds per wall second
@@ -463,8 +470,10 @@ def run_league_scenario(
     *,
     league_standing_z: Mapping[RobotId, float] | None = None,
     max_sim_s: float = 3600.0,
+    ball: BallKind = "league",
 ) -> LeagueOutcome:
-    """Play ``scenario`` in the match of ``spec`` (its game and teams) and return the outcome."""
+    """Play ``scenario`` in the match of ``spec`` (its game and teams) and return the outcome;
+    ``ball``: the league's ball, as the scenarios were written for (default), or ours."""
     return LeagueTestRunner(
-        spec, scenario, league_standing_z=league_standing_z, max_sim_s=max_sim_s
+        spec, scenario, league_standing_z=league_standing_z, max_sim_s=max_sim_s, ball=ball
     ).run()

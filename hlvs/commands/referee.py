@@ -53,6 +53,11 @@ def register(sub: Any) -> None:
         "--max-sim-s", type=float, default=3600.0,
         help="stop a scenario after this many simulated seconds (default 3600)",
     )  # fmt: skip
+    test.add_argument(
+        "--ball", choices=("league", "match"), default="league",
+        help="league: the league's ball, as the scenarios were written for (its Webots "
+        "damping, 77 %% of its speed lost a second; default); match: the match ball",
+    )  # fmt: skip
     test.set_defaults(func=_test)
 
 
@@ -189,7 +194,8 @@ def _test(args: argparse.Namespace) -> int:
     outcomes = []
     for scenario, spec, heights in ready:
         outcome = run_league_scenario(
-            spec, scenario, league_standing_z=heights, max_sim_s=args.max_sim_s
+            spec, scenario, league_standing_z=heights, max_sim_s=args.max_sim_s,
+            ball=args.ball,
         )
         outcomes.append(outcome)
         if not args.json:

@@ -10,6 +10,10 @@ within 6 s.
 
 from __future__ import annotations
 
+import math
+
+import mujoco
+
 from contracts import FieldGeometry
 from simulator.world.look import BALL_TEXTURE
 
@@ -40,3 +44,25 @@ def ball_body(f: FieldGeometry, *, bits: tuple[int, int]) -> str:
 def ball_damping(f: FieldGeometry) -> tuple[float, float]:
     """(linear, angular) damping of the ball's free joint, set on the compiled model."""
     return BALL_LINEAR_DAMPING_PER_KG * f.ball_mass_kg, BALL_ANGULAR_DAMPING
+
+
+# The league's ball (hlvs_webots ``protos/RobocupTexturedSoccerBall.proto:54-57``):
+# ``Damping { linear 0.77 angular 0.77 }``, the fraction of its speed a body loses every
+# second; Webots gives ODE 1 - (1 - d) ** dt per step (``WbWorldInfo::applyToOdeGlobalDamping``,
+# the same for a body's own damping), so v(t) = v0 * 0.23 ** t. No rolling friction
+# (``worlds/robocup.wbt:35-43``: grass and ball, Coulomb friction 0.5).
+LEAGUE_BALL_DAMPING_PER_S = 0.77
+LEAGUE_BALL_FRICTION = (0.5, 0.0, 0.0)
+
+
+def use_league_ball(model: mujoco.MjModel) -> None:
+    """Give the compiled world the league's ball: its speed and spin decay as Webots damps them
+    (v *= 0.23 ** t: a rate of -ln 0.23 = 1.47 per second, damping = rate x mass, rate x
+    inertia on each axis), with sliding friction only. For the league's referee test scenarios,
+    whose pushes were tuned to this ball; matches keep the match ball."""
+    rate = -math.log(1.0 - LEAGUE_BALL_DAMPING_PER_S)
+    body = model.body(BALL_BODY).id
+    adr = int(model.joint(BALL_JOINT).dofadr[0])
+    model.dof_damping[adr : adr + 3] = rate * float(model.body_mass[body])
+    model.dof_damping[adr + 3 : adr + 6] = rate * model.body_inertia[body]
+    model.geom_friction[model.geom(BALL_GEOM).id] = LEAGUE_BALL_FRICTION

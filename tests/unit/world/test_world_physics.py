@@ -115,3 +115,23 @@ def test_divergence_reset_robot_policy_keeps_running() -> None:
     assert blue.position[:2] == pytest.approx((1.0, 1.0), abs=0.02)
     assert not blue.fallen
     assert np.isfinite(world.data.qpos).all()
+
+
+@pytest.mark.parametrize(("league", "kept"), [(True, (0.21, 0.25)), (False, (0.5, 1.0))])
+def test_the_league_ball_loses_77_percent_of_its_speed_a_second(
+    league: bool, kept: tuple[float, float]
+) -> None:
+    """``use_league_ball`` (for ``hlvs referee test``): Webots' ``Damping { linear 0.77 angular
+    0.77 }``, v *= 0.23 ** t, on a ball rolling at 3 m/s; the match ball keeps most of it."""
+    from simulator.world.ball import BALL_JOINT, use_league_ball
+
+    world = World.create(field_class="kid", robots=[], seed=1)
+    if league:
+        use_league_ball(world.model)
+    r = world.field.ball_radius_m
+    world.apply(PlaceBall(position=(-3.0, 0.0, r), velocity=(3.0, 0.0, 0.0)))
+    adr = int(world.model.joint(BALL_JOINT).dofadr[0])
+    world.data.qvel[adr + 4] = 3.0 / r  # rolling, not sliding
+    run_steps(world, 125)  # 1 s
+    ball = world.snapshot().ball
+    assert kept[0] < math.hypot(ball.velocity[0], ball.velocity[1]) / 3.0 < kept[1]
