@@ -13,6 +13,14 @@ worlds, each given its targets and stepped ``--steps-per-action`` times per envi
 (the same robots, the same control period), alternating in the same way; its ``ratio`` is the
 target of the vector environment (>= 0.8).
 
+With ``--mjx-envs N`` (needs ``mujoco-mjx``, the ``[learn]`` extra), it also measures
+``hlvs/StandKick-v0`` batched on MJX (``envs.mjx_vector.MjxStandKickVector``, N environments in
+one ``jax.vmap``) on JAX's first device (``mjx.device``: ``cpu`` unless a GPU is installed):
+``compile_s`` (building the world and the first ``jax.jit`` of its step, with the first reset),
+then ``--mjx-steps`` batched steps near the stance, in environment steps per second of wall
+time and of the process's CPU time (JAX uses every core). Off by default: the compile takes
+minutes on a CPU.
+
 With ``--remotes N`` (needs Docker and the simulator image), it also measures one remote over
 TCP and a vector environment over 1, 2, ... N remotes (``--vector 1,2,4``, each size
 ``--repeats`` times, interleaved), with the client's and the remotes' CPU time per step, at the
@@ -146,6 +154,40 @@ def bench_vector_inprocess(
     }
 
 
+def bench_mjx(*, num_envs: int, steps: int, seed: int) -> dict[str, Any]:
+    import jax
+
+    from envs.mjx_vector import MjxStandKickVector
+
+    began = time.perf_counter()
+    vec = MjxStandKickVector(num_envs)
+    built_s = time.perf_counter() - began
+    vec.reset(seed=seed)
+    assert vec.compile_s is not None
+    actions = vec.stance + _actions(num_envs, seed)
+    vec.step(actions)  # the first call after the compile
+    c0, w0 = time.process_time(), time.perf_counter()
+    for _ in range(steps):
+        vec.step(actions)
+    c1, w1 = time.process_time(), time.perf_counter()
+    vec.close()
+    device = jax.devices()[0]
+    total = steps * num_envs
+    return {
+        "env": "hlvs/StandKick-v0",
+        "device": f"{device.platform}:{getattr(device, 'device_kind', '')}",
+        "num_envs": num_envs,
+        "steps_per_action": vec.steps_per_action,
+        "build_s": round(built_s, 1),
+        "compile_s": vec.compile_s,
+        "compile_cpu_s": vec.compile_cpu_s,
+        "compiles": vec.compiles(),
+        "env_steps_per_s_wall": round(total / (w1 - w0), 1),
+        "env_steps_per_s_cpu": round(total / max(c1 - c0, 1e-9), 1),
+        "steps": total,
+    }
+
+
 def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(prog="hlvs bench envs")
     parser.add_argument("--rounds", type=int, default=10, help="alternating rounds")
@@ -156,6 +198,10 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--steps-per-action", type=int, default=4,
                         help="8 ms world steps per environment step of the vector environment "
                         "(default 4: the 32 ms of examples/learn_stand_kick.py)")
+    parser.add_argument("--mjx-envs", type=int, default=0,
+                        help="also measure hlvs/StandKick-v0 batched on MJX with N environments "
+                        "(compiles for minutes on a CPU; default 0: not measured)")
+    parser.add_argument("--mjx-steps", type=int, default=20, help="batched MJX steps timed")
     parser.add_argument("--remotes", type=int, default=0, help="also measure N remotes (Docker)")
     parser.add_argument("--vector", default="1,2,4", help="vector sizes over remotes")
     parser.add_argument("--remote-steps", type=int, default=1000, help="steps per remote run")
@@ -173,6 +219,11 @@ def main(argv: list[str]) -> int:
         rounds=args.rounds, block=max(1, args.block // args.num_envs), seed=args.seed,
         num_envs=args.num_envs, steps_per_action=args.steps_per_action,
     )  # fmt: skip
+    if args.mjx_envs < 0 or args.mjx_steps < 1:
+        print("--mjx-envs: expected an integer >= 0; --mjx-steps: >= 1", file=sys.stderr)
+        return 2
+    if args.mjx_envs > 0:
+        out["mjx"] = bench_mjx(num_envs=args.mjx_envs, steps=args.mjx_steps, seed=args.seed)
     if args.remotes > 0:
         from benchmarks.envs_remote import bench_remotes
 
