@@ -144,12 +144,28 @@ class MjxStandKickVector(VectorEnv):
             bias_v = -servo["gain"] * on
             bounds = servo["line_bounds"] - (servo["line_slope"] * qd)[:, None]
             bounds = jnp.maximum(jnp.minimum(bounds, servo["bounds_high"]), servo["bounds_low"])
-            m = mx.replace(
-                actuator_biasprm=mx.actuator_biasprm.at[act, 1].set(bias_q).at[act, 2].set(bias_v),
-                actuator_forcerange=jnp.asarray(mx.actuator_forcerange).at[act].set(bounds),
-            )
-            d = d.replace(ctrl=d.ctrl.at[act].set(ctrl))
-            return jax.lax.fori_loop(0, substeps, lambda _, dd: mjx.step(m, dd), d)
+            gain = servo["gain"]
+            low, high = bounds[:, 0], bounds[:, 1]
+
+            def substep(_: Any, dd: Any) -> Any:
+                # MuJoCo leaves a force clamped by its range out of the implicit integrator's
+                # velocity derivative; MJX does not, so a clamped actuator becomes a plain torque
+                force = gain * ctrl + bias_q * dd.qpos[mq] + bias_v * dd.qvel[md]
+                clamped = (force < low) | (force > high)
+                m = mx.replace(
+                    actuator_gainprm=mx.actuator_gainprm.at[act, 0].set(
+                        jnp.where(clamped, 1.0, gain)
+                    ),
+                    actuator_biasprm=mx.actuator_biasprm.at[act, 1]
+                    .set(jnp.where(clamped, 0.0, bias_q))
+                    .at[act, 2]
+                    .set(jnp.where(clamped, 0.0, bias_v)),
+                    actuator_forcerange=jnp.asarray(mx.actuator_forcerange).at[act].set(bounds),
+                )
+                torque = jnp.where(clamped, jnp.clip(force, low, high), ctrl)
+                return mjx.step(m, dd.replace(ctrl=dd.ctrl.at[act].set(torque)))
+
+            return jax.lax.fori_loop(0, substeps, substep, d)
 
         def truth(d: Any) -> Any:
             w, x, y, z = (d.qpos[root_q + 3 + i] for i in range(4))
@@ -282,9 +298,10 @@ class MjxStandKickVector(VectorEnv):
     def _run(
         self, state: dict[str, Any], actions: np.ndarray, fresh: np.ndarray
     ) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
-        new, obs, reward, terminated, truncated, info = self._advance(
-            state, self._jnp.asarray(actions), self._jnp.asarray(fresh)
-        )
+        # every argument committed to the device, as the step's outputs are: JAX keys its
+        # compiled versions on that too, and a mix would compile the physics again
+        args = self._jax.device_put((state, actions, fresh), self._jax.devices()[0])
+        new, obs, reward, terminated, truncated, info = self._advance(*args)
         self._state = new
         joints, sensors, elapsed = (np.asarray(v, dtype=np.float32) for v in obs)
         terminated, truncated = np.asarray(terminated), np.asarray(truncated)
