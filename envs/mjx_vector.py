@@ -23,7 +23,6 @@ and ``sim_time_ms`` (numpy arrays, one value per environment).
 
 from __future__ import annotations
 
-import logging
 import math
 import time
 from typing import Any
@@ -44,14 +43,12 @@ DEFAULT_P = 10.0
 
 
 def _quiet_import() -> Any:
-    """``mujoco.mjx`` without its note that the optional Warp backend is missing."""
-    root = logging.getLogger()
-    level = root.level
-    root.setLevel(logging.ERROR)
-    try:
+    """``mujoco.mjx`` without the lines it prints when the optional Warp backend is missing."""
+    import contextlib
+    import io
+
+    with contextlib.redirect_stdout(io.StringIO()):
         from mujoco import mjx
-    finally:
-        root.setLevel(level)
     return mjx
 
 
