@@ -24,9 +24,11 @@ have no controller. Differences from Webots, all of the world and none of the ru
   world then runs at its host's speed: its scenarios expect a 2 s half-time break,
   referee.py:1913-1916, to last more than 5 simulated seconds).
 - The packet is read the step it is made (the league's arrives by UDP, a step or more later).
-- The ball is the league's (:func:`simulator.world.ball.use_league_ball`: Webots' damping of
+- The ball is the match ball, or on request the league's (``ball="league"``,
+  :func:`simulator.world.ball.use_league_ball`: Webots' damping of
   ``protos/RobocupTexturedSoccerBall.proto``, no rolling friction), as the scenarios' pushes
-  were tuned to it, unless the match ball is asked for; matches always play the match ball.
+  were tuned to it; our robots and contacts are not Webots', and with it fewer of the league's
+  files pass (README); matches always play the match ball.
 
 The league's world lets resting bodies sleep (``worlds/robocup.wbt:24-26``: physics disabled
 for a body slower than 0.1 m/s and 0.1 rad/s for 0.1 s); here the whole world sleeps when every
@@ -217,7 +219,7 @@ class LeagueTestRunner:
         *,
         league_standing_z: Mapping[RobotId, float] | None = None,
         max_sim_s: float = 3600.0,
-        ball: BallKind = "league",
+        ball: BallKind = "match",
     ) -> None:
         self.spec = spec
         self.scenario = scenario
@@ -470,10 +472,10 @@ def run_league_scenario(
     *,
     league_standing_z: Mapping[RobotId, float] | None = None,
     max_sim_s: float = 3600.0,
-    ball: BallKind = "league",
+    ball: BallKind = "match",
 ) -> LeagueOutcome:
     """Play ``scenario`` in the match of ``spec`` (its game and teams) and return the outcome;
-    ``ball``: the league's ball, as the scenarios were written for (default), or ours."""
+    ``ball``: the match ball (default) or the league's, as the scenarios were written for."""
     return LeagueTestRunner(
         spec, scenario, league_standing_z=league_standing_z, max_sim_s=max_sim_s, ball=ball
     ).run()
