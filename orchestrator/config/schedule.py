@@ -144,7 +144,7 @@ class Schedule:
         sets and the folders the teams receive): the tournament's name, then the match's id
         (``example-cup-rr-1``), so two tournaments on one host or one team's log server never
         meet on ``rr-1``. At most 64 characters, as game.json's ``match_id``."""
-        slug = re.sub(r"[^a-z0-9]+", "-", self.name.lower()).strip("-")[:24].strip("-")
+        slug = name_slug(self.name)
         text = f"{slug}-{match_id}" if slug else match_id
         if len(text) > 64 or not re.match(r"^[A-Za-z0-9]", text):
             digest = hashlib.sha256(text.encode()).hexdigest()[:8]
@@ -299,6 +299,20 @@ def _schema_problems(path: Path, data: Any) -> list[Problem]:
     return problems
 
 
+def name_slug(name: str) -> str:
+    """A tournament's name in lower-case letters, digits and dashes, at most 24 characters
+    (``Example Cup`` -> ``example-cup``); empty when the name has none of them."""
+    return re.sub(r"[^a-z0-9]+", "-", name.lower()).strip("-")[:24].strip("-")
+
+
+def default_output_dir(name: str) -> str:
+    """``tournament/<name slug>``, so that two schedule files in one folder that name no
+    ``output_dir`` keep their match folders apart (``tournament`` for a name without letters or
+    digits)."""
+    slug = name_slug(name)
+    return f"tournament/{slug}" if slug else "tournament"
+
+
 def load_schedule(path: str | Path, *, text: str | None = None) -> Schedule:
     """Validate and load a schedule file; raises ConfigError listing every problem.
 
@@ -328,7 +342,7 @@ def load_schedule(path: str | Path, *, text: str | None = None) -> Schedule:
         matches += round_robin_fixtures(fixtures["round_robin"])
     if "knockout" in fixtures:
         matches += knockout_fixtures(fixtures["knockout"])
-    output_dir = (base / data.get("output_dir", "tournament")).resolve()
+    output_dir = (base / data.get("output_dir", default_output_dir(data["name"]))).resolve()
     schedule = Schedule(
         source=path.resolve(),
         name=data["name"],

@@ -342,6 +342,22 @@ def test_two_tournaments_on_one_host_never_meet_on_a_match_id(tmp_path: Path) ->
     assert len(long.league_match_id("x" * 60)) <= 64
 
 
+def test_two_schedules_in_one_folder_keep_their_match_folders_apart(tmp_path: Path) -> None:
+    """Without ``output_dir``, match folders and log stores are under ``tournament/<name>``:
+    two schedule files side by side never share ``tournament/rr-1``."""
+    schedules = []
+    for name, file in (("Spring Cup", "spring.yaml"), ("Autumn Cup", "autumn.yaml")):
+        path = write_schedule(tmp_path, "fixtures:\n  round_robin: {teams: [alpha, bravo],"
+                              " first_stream: '+1h'}\n")
+        text = path.read_text().replace("name: test cup\noutput_dir: out\n", f"name: {name}\n")
+        (tmp_path / file).write_text(text)
+        schedules.append(load_schedule(tmp_path / file))
+    spring, autumn = schedules
+    assert spring.output_dir == (tmp_path / "tournament" / "spring-cup").resolve()
+    assert autumn.output_dir == (tmp_path / "tournament" / "autumn-cup").resolve()
+    assert spring.log_store != autumn.log_store
+
+
 def test_a_friendly_match_plays_a_normal_game_and_counts_nowhere(tmp_path: Path) -> None:
     from orchestrator.config.schedule import game_document
 
