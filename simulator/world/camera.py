@@ -4,8 +4,9 @@ Images are raw B,G,R bytes, rows top to bottom, as the HLVS robot API sends them
 main light casts shadows (:mod:`simulator.world.look`) when the cameras render on a GPU; on a
 CPU renderer (llvmpipe) MuJoCo's shadows (a depth pass and a second lit pass) cost 3.4 times
 the frame (15 to 53 ms of CPU per 320x240 frame of eight robots), so they are off there unless
-``HLVS_CAMERA_SHADOWS=on`` (``off`` turns them off on a GPU too); the match video and
-``hlvs render --camera`` frames always have them. Reflections are off. Spheres,
+``HLVS_CAMERA_SHADOWS=on`` (``off`` turns them off on a GPU too); ``hlvs render --camera``
+frames always have them, the match video on a GPU or with ``HLVS_VIDEO_SHADOWS=on``
+(:func:`simulator.render.video_shadows`). Reflections are off. Spheres,
 capsules and cylinders are tessellated more coarsely than MuJoCo's defaults (12 slices, 6
 stacks instead of 28 and 16; planes and boxes in one quad): on a software renderer that cuts a
 320x240 frame from about 10 ms to 4.5 ms with no visible difference at robot camera resolution.
@@ -47,7 +48,7 @@ def camera_shadows(software_gl: bool) -> bool:
     return not software_gl
 
 
-def _software_gl() -> bool:
+def software_gl() -> bool:
     """Whether the current GL context is a CPU rasteriser (its ``GL_RENDERER`` string)."""
     from OpenGL import GL
 
@@ -84,7 +85,7 @@ class CameraRenderer:
         self._option = mujoco.MjvOption()
         self._option.geomgroup[4] = 0  # sites and helper geoms stay invisible
         scene = self._renderer.scene
-        self.shadows = camera_shadows(_software_gl())
+        self.shadows = camera_shadows(software_gl())
         scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = self.shadows
         scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = False
         camera_model = getattr(world, "camera_model", None) or CameraModel.ideal()
