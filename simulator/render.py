@@ -157,7 +157,7 @@ def _geom_xml(geom: GeomRecord, material: str | None) -> str:
 def scene_xml(scene: SceneRecord) -> str:
     """An MJCF of shapes only (no joints, no physics) with one body per recorded body, in the
     recorded order, so that body ``i`` of the model is body ``i`` of every frame."""
-    from simulator.world.look import light_xml, look_assets, look_from_summary
+    from simulator.world.look import look_assets, look_from_summary
 
     bodies = scene["bodies"]
     geoms: list[list[str]] = [[] for _ in bodies]
@@ -201,12 +201,13 @@ def scene_xml(scene: SceneRecord) -> str:
 <visual>
  <global offwidth="1920" offheight="1080"/>
  <quality shadowsize="2048" offsamples="0"/>
- <headlight ambient="0.35 0.35 0.35" diffuse="0 0 0" specular="0 0 0"/>
+ <headlight ambient="0.35 0.35 0.35" diffuse="0.3 0.3 0.3" specular="0 0 0"/>
  <map znear="0.01" zfar="100"/>
 </visual>
 <asset>{"".join(assets)}</asset>
 <worldbody>
-{light_xml()}
+<light directional="true" pos="0 0 10" dir="0.2 0.3 -1" diffuse="0.7 0.7 0.7" castshadow="false"/>
+<light directional="true" pos="0 0 10" dir="-0.2 -0.3 -1" diffuse="0.3 0.3 0.3" castshadow="false"/>
 {cameras}{"".join(geoms[0])}{children}
 </worldbody>
 </mujoco>"""
@@ -222,24 +223,6 @@ def scene_model(scene: SceneRecord) -> Any:
     if scene.get("look") is not None:
         apply_look(model, look_from_summary(scene["look"]))
     return model
-
-
-VIDEO_SHADOWS_ENV = "HLVS_VIDEO_SHADOWS"
-
-
-def video_shadows() -> bool:
-    """Whether the match video has the key light's shadows (with the renderer's context
-    current): ``HLVS_VIDEO_SHADOWS`` ``on`` or ``off``, else on a GPU only. On a CPU renderer a
-    1280x720 frame with shadows took 290 ms where it took 135 ms without (osmesa, a kid
-    scrimmage), which would double a match video's wait."""
-    from simulator.world.camera import software_gl
-
-    wanted = os.environ.get(VIDEO_SHADOWS_ENV, "").strip().lower()
-    if wanted in ("on", "1", "true"):
-        return True
-    if wanted in ("off", "0", "false"):
-        return False
-    return not software_gl()
 
 
 def render_video(
@@ -265,8 +248,11 @@ def render_video(
     if ffmpeg is None:
         raise RenderError(output=str(output), reason="ffmpeg not found on PATH")
     replay = load_replay(replay_path)
+    from simulator.world.look import apply_luminosity, look_from_summary
+
     scene = scene_for(replay.header, str(replay_path))
     model = scene_model(scene)
+    luminosity = look_from_summary(scene["look"]).luminosity if scene.get("look") else 1.0
     if model.nbody != len(replay.header.body_names):
         raise ReplayError(
             path=str(replay_path),
@@ -276,7 +262,7 @@ def render_video(
     mujoco.mj_forward(model, data)
     place = Placer(model, data)
     renderer = mujoco.Renderer(model, height=height, width=width)
-    renderer.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = video_shadows()
+    renderer.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = False
     renderer.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = False
     option = mujoco.MjvOption()
     option.geomgroup[4] = 0
@@ -298,7 +284,7 @@ def render_video(
         for i in indices:
             place(replay.frames[i].poses.astype(np.float64))
             renderer.update_scene(data, camera="overview", scene_option=option)
-            proc.stdin.write(renderer.render().tobytes())
+            proc.stdin.write(apply_luminosity(renderer.render(), luminosity).tobytes())
             count += 1
             if on_frame is not None:
                 on_frame(count, len(indices))
