@@ -41,9 +41,11 @@ def test_team_matches_run_under_its_account_and_wait_with_slurms_reason(
     name = f"Alpha {os.getpid()}"
     settings = Settings(data_dir=tmp_path / "data", pool="slurm", slurm_conf=cluster,
                         preflight="images", worker_poll_s=0.5, video=False,
-                        slurm_max_queued=3)
+                        slurm_max_queued=3,
+                        team_project_images=True)  # the teams play the project's stub
     env = {**os.environ, "HLVS_SERVICE_POOL": "slurm", "HLVS_SERVICE_SLURM_CONF": cluster,
            "HLVS_SERVICE_DATA_DIR": str(settings.data_dir),
+           "HLVS_SERVICE_TEAM_PROJECT_IMAGES": "1",
            "HLVS_SERVICE_SLURM_MAX_QUEUED": "3"}
     added = subprocess.run([sys.executable, "-m", "hlvs", "admin", "team", "add", name],
                            env=env, capture_output=True, text=True, timeout=120, check=False)
