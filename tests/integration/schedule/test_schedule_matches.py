@@ -4,7 +4,9 @@ Four teams of one stub robot play two matches; images are the project's local st
 (pulled as local images). Three teams' logs go to an S3 API server on 127.0.0.1; the fourth
 team's SFTP server is down (nothing listens on its port): its logs are retried, then failed with
 the cause, and never shown delivered. The schedule is compressed to seconds: pulls 60 s before
-each stream, play right after the pull, delivery after the stream.
+each stream, play right after the pull, delivery after the stream. m2 waits for the one
+simulator slot while m1 plays (about 40 s on a quiet machine, 80 s on a loaded one); its window
+closes at its stream start, 88 s after m1's.
 """
 
 from __future__ import annotations
@@ -112,7 +114,7 @@ teams:
   - {name: dogs, id: 4, config: dogs.json, credentials: dogs-credentials.json}
 matches:
   - {id: m1, red: ants, blue: cats, stream_start: "+62s", stream_length_s: 2}
-  - {id: m2, red: bees, blue: dogs, stream_start: "+75s", stream_length_s: 2}
+  - {id: m2, red: bees, blue: dogs, stream_start: "+150s", stream_length_s: 2}
 """
     )
     return schedule
