@@ -22,6 +22,7 @@ pytestmark = [pytest.mark.docker, pytest.mark.root, pytest.mark.slow]
 ROOT = Path(__file__).resolve().parents[3]
 EXAMPLES = ROOT / "configs" / "examples" / "scrimmage_1v1"
 SERVICES = "tests.integration.pool.slurm_services:SlurmTestServices"
+HOST_KEY = "ssh-ed25519 AAAAC3NzaC1lZDI1NTE5AAAAILxD7/6Y8WqDP6ruY81+KhRD3hE1yx9rKAmI0vF5eFKN"
 
 
 def _schedule(tmp: Path, conf: str, ids: tuple[str, str]) -> Path:
@@ -29,6 +30,13 @@ def _schedule(tmp: Path, conf: str, ids: tuple[str, str]) -> Path:
         team = json.loads((EXAMPLES / source).read_text())
         team["name"] = name
         (tmp / f"{name}.json").write_text(json.dumps(team))
+        # a log target, as the schedule check asks of every team; the test's services record
+        # the delivery without connecting to it
+        creds = tmp / f"{name}-credentials.json"
+        creds.write_text(json.dumps({"type": "sftp", "credentials": {
+            "hostname": "127.0.0.1", "port": 2222, "username": "hlvs", "password": "change-me",
+            "path": "hlvs-logs", "host_key": HOST_KEY}}))
+        creds.chmod(0o600)
     path = tmp / "cup.yaml"
     path.write_text(f"""
 name: slurm cup
@@ -44,8 +52,8 @@ game_defaults:
            half_time_break_s: 1, grace_period_s: 2}}
   limits: {{cpus: 1, memory_gb: 1, pids: 256}}
 teams:
-  - {{name: ants, id: 1, config: ants.json}}
-  - {{name: bees, id: 2, config: bees.json}}
+  - {{name: ants, id: 1, config: ants.json, credentials: ants-credentials.json}}
+  - {{name: bees, id: 2, config: bees.json, credentials: bees-credentials.json}}
 matches:
   - {{id: {ids[0]}, red: ants, blue: bees, stream_start: "+62s", stream_length_s: 1}}
   - {{id: {ids[1]}, red: bees, blue: ants, stream_start: "+64s", stream_length_s: 1}}
@@ -67,19 +75,24 @@ def test_scheduler_killed_mid_match_then_restarted_plays_each_match_once(
     state = tmp_path / "state.sqlite"
     cmd = [sys.executable, "-m", "hlvs.cli", "schedule", "run", str(path), "--state",
            str(state), "--exit-when-done", "--services", SERVICES]
-    first = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    first_log = (tmp_path / "first-scheduler.log").open("w")
+    first = subprocess.Popen(cmd, stdout=first_log, stderr=subprocess.STDOUT)
     record = tmp_path / "out" / ids[0] / "match" / "slurm.json"
     deadline = time.monotonic() + 180
-    job_id = ""
-    while time.monotonic() < deadline:  # kill the scheduler once its first match runs
+    job_id, running = "", False
+    while time.monotonic() < deadline and first.poll() is None:  # until its first match runs
         if record.is_file():
             job_id = json.loads(record.read_text())["job_id"]
             if _job_state(cluster, job_id) == "RUNNING":
+                running = True
                 break
         time.sleep(0.5)
-    else:
+    if not running:
         first.kill()
-        pytest.fail(f"the first match never ran in Slurm (job {job_id or 'not submitted'})")
+        first.wait()
+        said = (tmp_path / "first-scheduler.log").read_text()[-3000:]
+        pytest.fail(f"the first match never ran in Slurm (job {job_id or 'not submitted'}); "
+                    f"the scheduler said:\n{said}")
     first.send_signal(signal.SIGKILL)
     first.wait()
     assert Ledger(state).row(ids[0]).state is ScheduledMatchState.PLAYING
