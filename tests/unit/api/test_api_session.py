@@ -106,3 +106,30 @@ def test_render_worker_threads_complete_every_job() -> None:
         (t, n) for t in (8, 16) for n in (1, 2, 3)
     ]
     assert all(len(image) == 4 * 2 * 3 for _, image in done)
+
+
+def test_motor_forces_drive_a_rotational_motor_as_its_torque() -> None:
+    """The league's player calls ``setForce`` for ``motor_forces`` and ``setTorque`` for
+    ``motor_torques`` (hlvs_webots ``controllers/player/player.cpp:478-496``). In Webots'
+    controller library ``wb_motor_set_torque`` is ``wb_motor_set_force`` (``motor.c``, the
+    aliases), and both switch the motor from its PID to that torque: on a rotational motor
+    (every joint of a humanoid) a force request is the same torque request. Held while limp
+    and applied again, as a torque is."""
+    world = FakeDeviceWorld([RED1])
+    session = _session(world)
+    forces = pb.ActuatorRequests()
+    forces.motor_forces.add(name="Head", force=0.7)
+    session.apply(forces, step_time_ms=8)
+    torques = pb.ActuatorRequests()
+    torques.motor_torques.add(name="Head", torque=0.7)
+    session.apply(torques, step_time_ms=16)
+    assert world.calls[0] == world.calls[1]
+    assert world.calls[0] == ("torque", RED1, "Head", (0.7,))
+    world.calls.clear()
+    world.limp.add(RED1)
+    session.update_limp()
+    session.apply(forces, step_time_ms=24)
+    assert world.calls == []
+    world.limp.discard(RED1)
+    session.update_limp()
+    assert [call[0] for call in world.calls] == ["torque"]
