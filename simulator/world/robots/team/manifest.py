@@ -22,6 +22,7 @@ from typing import Any
 
 from contracts import JSONObject, huge_integer_reason, huge_integers, parse_int
 from simulator.errors import ModelError, ModelProblem
+from simulator.world.robots.team.package import LIMITS, inside, outside_reason, size_problem
 from simulator.world.servos import find_servo, servo_ids
 
 MANIFEST_NAME = "robot_model.json"
@@ -188,8 +189,13 @@ _KNOWN_KEYS = {
 
 def load_manifest(folder_or_file: Path) -> Manifest:
     """Read and validate a model package's manifest. Raises :class:`ModelError`."""
-    path = folder_or_file / MANIFEST_NAME if folder_or_file.is_dir() else folder_or_file
-    path = path.resolve()
+    if folder_or_file.is_dir():
+        folder, name = folder_or_file.resolve(), MANIFEST_NAME
+    else:
+        folder, name = folder_or_file.parent.resolve(), folder_or_file.name
+    path = folder / name
+    if not inside(folder, path):
+        raise ModelError([ModelProblem(source=str(path), where="", reason=outside_reason(name))])
     if not path.is_file():
         raise ModelError(
             [
@@ -201,6 +207,9 @@ def load_manifest(folder_or_file: Path) -> Manifest:
                 )
             ]
         )
+    too_big = size_problem(str(path), "", "the manifest", path, LIMITS.manifest_bytes)
+    if too_big is not None:
+        raise ModelError([too_big])
     try:
         raw = json.loads(path.read_text(encoding="utf-8"), parse_int=parse_int)
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
@@ -230,8 +239,10 @@ def load_manifest(folder_or_file: Path) -> Manifest:
     if field_class not in FIELD_CLASSES:
         r.problem("/class", f"{field_class!r} is not one of {', '.join(FIELD_CLASSES)}")
     model_rel = r.get(raw, "model_file", str, "") or ""
-    model_file = (path.parent / model_rel).resolve()
-    if model_rel and not model_file.is_file():
+    model_file = (folder / model_rel).resolve()
+    if model_rel and not inside(folder, folder / model_rel):
+        r.problem("/model_file", outside_reason(repr(model_rel)))
+    elif model_rel and not model_file.is_file():
         r.problem("/model_file", f"{model_rel!r}: no such file ({model_file})")
     elif model_rel and model_file.suffix.lower() not in (".urdf", ".xml", ".mjcf"):
         r.problem("/model_file", f"{model_rel!r}: expected a .urdf, .xml or .mjcf file")
@@ -240,10 +251,13 @@ def load_manifest(folder_or_file: Path) -> Manifest:
         if not isinstance(rel, str):
             r.problem(f"/packages/{pkg}", f"{rel!r} is not a string (a folder)")
             continue
-        folder = (path.parent / rel).resolve()
-        if not folder.is_dir():
-            r.problem(f"/packages/{pkg}", f"{rel!r}: no such folder ({folder})")
-        packages[pkg] = folder
+        if not inside(folder, folder / rel):
+            r.problem(f"/packages/{pkg}", outside_reason(repr(rel)))
+            continue
+        package = (folder / rel).resolve()
+        if not package.is_dir():
+            r.problem(f"/packages/{pkg}", f"{rel!r}: no such folder ({package})")
+        packages[pkg] = package
     motors = _motors(r, raw)
     sensor_suffix = r.get(raw, "sensor_suffix", str, "", required=False, default="S")
     imus = _imus(r, raw)

@@ -24,6 +24,16 @@ import mujoco
 
 from simulator.errors import ModelError, ModelProblem
 from simulator.world.robots.team.manifest import Manifest
+from simulator.world.robots.team.package import (
+    ASSET_FILE_ATTRIBUTES,
+    LIMITS,
+    count_problems,
+    image_problem,
+    inside,
+    outside_reason,
+    package_problems,
+    size_problem,
+)
 
 PACKAGE_SCHEME = "package://"
 IGNORED = "note"
@@ -45,12 +55,19 @@ _UNSUPPORTED = {
     "describe the robot as a tree with one joint per motor",
     "tendon": "tendons are not supported: describe the robot as a tree with one joint per motor",
     "include": "included files are not read: put their content in the model file",
+    "model": "other model files are not read: put their content in the model file",
+    "attach": "other model files are not read: put their content in the model file",
+    "composite": "soft bodies are not supported: a robot is rigid links",
+    "flexcomp": "soft bodies are not supported: a robot is rigid links",
+    "flex": "soft bodies are not supported: a robot is rigid links",
 }
+_REFUSED_ANYWHERE = ("include", "model", "attach", "composite", "flexcomp", "flex")
 
 
 def _resolve(manifest: Manifest, ref: str, base: Path | None = None) -> list[Path]:
     """Candidate files for a mesh reference, in the order they are tried (relative paths
-    against ``base``, by default the model file's folder)."""
+    against ``base``, by default the model file's folder), those outside the package left out
+    (none is looked at: see :mod:`~simulator.world.robots.team.package`)."""
     base = base or manifest.model_file.parent
     if ref.startswith(PACKAGE_SCHEME):
         package, _, rest = ref[len(PACKAGE_SCHEME) :].partition("/")
@@ -58,32 +75,48 @@ def _resolve(manifest: Manifest, ref: str, base: Path | None = None) -> list[Pat
         roots += [manifest.folder / package]
         roots += [parent / package for parent in base.parents if parent != manifest.folder]
         roots += [p for p in base.parents if p.name == package]
-        return [root / rest for root in dict.fromkeys(roots)]
-    if ref.startswith("file://"):
-        ref = ref[len("file://") :]
-    path = Path(ref)
-    return [path] if path.is_absolute() else [base / path]
+        candidates = [root / rest for root in dict.fromkeys(roots)]
+    else:
+        if ref.startswith("file://"):
+            ref = ref[len("file://") :]
+        path = Path(ref)
+        candidates = [path] if path.is_absolute() else [base / path]
+    return [c for c in candidates if inside(manifest.folder, c)]
 
 
-def _asset_dirs(root: ET.Element, model_file: Path) -> dict[str, Path]:
+def _asset_dirs(
+    root: ET.Element, manifest: Manifest
+) -> tuple[dict[str, Path | None], list[ModelProblem]]:
     """Element tag -> folder its ``file`` is relative to (MJCF ``<compiler>``: ``meshdir`` and
-    ``texturedir``, each defaulting to ``assetdir``, all relative to the file's folder)."""
-    base = model_file.parent
-    dirs = {"mesh": base, "texture": base, "hfield": base, "skin": base}
+    ``texturedir``, each defaulting to ``assetdir``, all relative to the file's folder), and a
+    problem for each of these folders outside the package (its tags then map to None)."""
+    base = manifest.model_file.parent
+    dirs: dict[str, Path | None] = {"mesh": base, "texture": base, "hfield": base, "skin": base}
+    problems: list[ModelProblem] = []
     if root.tag != "mujoco":
-        return dirs
+        return dirs, problems
     for compiler in root.iter("compiler"):
-        asset = compiler.get("assetdir")
-        mesh = compiler.get("meshdir", asset)
-        texture = compiler.get("texturedir", asset)
-        if mesh is not None:
-            for tag in ("mesh", "hfield", "skin"):
-                dirs[tag] = base / mesh
-        if texture is not None:
-            dirs["texture"] = base / texture
+        reported = set()
+        for own, tags in (("meshdir", ("mesh", "hfield", "skin")), ("texturedir", ("texture",))):
+            key = own if compiler.get(own) is not None else "assetdir"
+            value = compiler.get(key)
+            if value is None:
+                continue
+            outside = not inside(manifest.folder, base / value)
+            for tag in tags:
+                dirs[tag] = None if outside else base / value
+            if outside and key not in reported:
+                reported.add(key)
+                problems.append(
+                    ModelProblem(
+                        source=str(manifest.model_file),
+                        where=f"<compiler {key}={value!r}>",
+                        reason=outside_reason(f"the folder {value!r}"),
+                    )
+                )
         for key in ("assetdir", "meshdir", "texturedir"):
             compiler.attrib.pop(key, None)
-    return dirs
+    return dirs, problems
 
 
 def _scene_notes(
@@ -114,12 +147,15 @@ def _scene_notes(
             )
     for parent in root.iter():
         for child in list(parent):
-            if child.tag == "include":
+            if child.tag in _REFUSED_ANYWHERE:
+                detail = "".join(
+                    f" {key}={child.get(key)!r}" for key in ("file", "model") if child.get(key)
+                )
                 errors.append(
                     ModelProblem(
                         source=source,
-                        where=f"<include file={child.get('file')!r}>",
-                        reason=_UNSUPPORTED["include"],
+                        where=f"<{child.tag}{detail}>",
+                        reason=_UNSUPPORTED[child.tag],
                     )
                 )
     for asset in root.findall("asset"):
@@ -167,6 +203,12 @@ def _named(element: ET.Element) -> str:
 
 def _parse(manifest: Manifest) -> ET.Element:
     source = str(manifest.model_file)
+    too_big = [
+        *package_problems(manifest.folder),
+        size_problem(source, "", "the model file", manifest.model_file, LIMITS.model_file_bytes),
+    ]
+    if any(too_big):
+        raise ModelError([p for p in too_big if p is not None])
     try:
         return ET.parse(manifest.model_file).getroot()
     except ET.ParseError as exc:
@@ -185,43 +227,57 @@ def _parse(manifest: Manifest) -> ET.Element:
 
 
 def _check_meshes(manifest: Manifest, root: ET.Element) -> list[ModelProblem]:
-    """Rewrite every mesh (texture, height field) ``filename``/``file`` to an absolute path;
-    report missing ones."""
-    problems = []
-    source = str(manifest.model_file)
-    dirs = _asset_dirs(root, manifest.model_file)
-    elements = [e for tag in ("mesh", "texture", "hfield", "skin") for e in root.iter(tag)]
-    for element in elements:
-        attr = "filename" if "filename" in element.attrib else "file"
-        ref = element.get(attr)
-        if ref is None:
-            continue
-        candidates = _resolve(manifest, ref, dirs.get(element.tag))
-        found = next((p for p in candidates if p.is_file()), None)
-        if found is None:
-            tried = ", ".join(str(p) for p in candidates)
-            problems.append(
-                ModelProblem(
-                    source=source,
-                    where=f"<{element.tag} {attr}={ref!r}>",
-                    reason=f"{element.tag} file not found (tried {tried})",
-                )
-            )
-            continue
-        try:
-            with found.open("rb") as handle:
-                handle.read(1)
-        except OSError as exc:
-            problems.append(
-                ModelProblem(
-                    source=source,
-                    where=f"<{element.tag} {attr}={ref!r}>",
-                    reason=f"{element.tag} file not readable: {exc}",
-                )
-            )
-            continue
-        element.set(attr, str(found.resolve()))
+    """Rewrite every mesh (texture, height field, skin) ``filename``/``file`` to an absolute
+    path; report those outside the package, missing, unreadable or above the size limits."""
+    dirs, problems = _asset_dirs(root, manifest)
+    for tag, attributes in ASSET_FILE_ATTRIBUTES.items():
+        for element in root.iter(tag):
+            for attr in attributes:
+                ref = element.get(attr)
+                base = dirs[tag]
+                if ref is None or (base is None and not _names_its_folder(ref)):
+                    continue  # its folder outside the package is the problem reported
+                where = f"<{tag} {attr}={ref!r}>"
+                found = _asset_file(manifest, tag, ref, where, base)
+                if isinstance(found, Path):
+                    element.set(attr, str(found.resolve()))
+                else:
+                    problems.append(found)
     return problems
+
+
+def _names_its_folder(ref: str) -> bool:
+    """A reference that is not relative to ``meshdir`` / ``texturedir``."""
+    return ref.startswith((PACKAGE_SCHEME, "file://")) or Path(ref).is_absolute()
+
+
+def _asset_file(
+    manifest: Manifest, tag: str, ref: str, where: str, base: Path | None
+) -> ModelProblem | Path:
+    """The file ``ref`` of a ``tag`` element, or the problem with it."""
+    source = str(manifest.model_file)
+    candidates = _resolve(manifest, ref, base)
+    if not candidates:
+        return ModelProblem(source=source, where=where, reason=outside_reason("the file"))
+    found = next((p for p in candidates if p.is_file()), None)
+    if found is None:
+        tried = ", ".join(str(p) for p in candidates)
+        return ModelProblem(
+            source=source, where=where, reason=f"{tag} file not found (tried {tried})"
+        )
+    too_big = size_problem(source, where, f"the {tag} file", found, LIMITS.asset_file_bytes)
+    if too_big is None and tag in ("texture", "hfield"):
+        too_big = image_problem(source, where, f"the {tag} image", found)
+    if too_big is not None:
+        return too_big
+    try:
+        with found.open("rb") as handle:
+            handle.read(1)
+    except OSError as exc:
+        return ModelProblem(
+            source=source, where=where, reason=f"{tag} file not readable: {exc}"
+        )
+    return found
 
 
 def load_spec(manifest: Manifest) -> mujoco.MjSpec:
@@ -232,6 +288,9 @@ def load_spec(manifest: Manifest) -> mujoco.MjSpec:
 def load_spec_with_notes(manifest: Manifest) -> tuple[mujoco.MjSpec, list[ModelProblem]]:
     """:func:`load_spec` and the notes on what of the file was left out (see the module)."""
     root = _parse(manifest)
+    counted = count_problems(str(manifest.model_file), root)
+    if counted:
+        raise ModelError(counted)
     notes, problems = _scene_notes(manifest, root)
     problems += _check_meshes(manifest, root)
     if problems:
