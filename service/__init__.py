@@ -31,6 +31,7 @@ if TYPE_CHECKING:
         require_token,
     )
     from service.errors import NotFound, ServiceError
+    from service.results import stored_many
     from service.settings import Settings
     from service.tokens import Principal
 
@@ -54,6 +55,7 @@ __all__ = [
     "require_operator",
     "require_team",
     "require_token",
+    "stored_many",
     "tokens",
 ]
 
@@ -70,6 +72,7 @@ if not TYPE_CHECKING:
             "require_operator", "require_team", "require_token",
         ),
         "service.errors": ("NotFound", "ServiceError"),
+        "service.results": ("stored_many",),
         "service.settings": ("Settings",),
         "service.tokens": ("Principal",),
     })

@@ -109,7 +109,7 @@ class LadderThread:
     def round(self) -> str | None:
         """Record finished matches, then perhaps schedule one; the new submission's id."""
         with transaction(self.services.sessions) as session:
-            recorded = ratings.record_friendlies(session, self.services.pool.results_dir)
+            recorded = ratings.record_friendlies(session)
             state = self.settings.schedule_state
             if state and Path(state).is_file() and \
                     time.monotonic() - self._ledger_read >= OFFICIAL_EVERY_S:

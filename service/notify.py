@@ -28,6 +28,7 @@ from service import outbound, webhooks
 from service.db import Notification, Submission, Team, now, transaction, utc
 from service.db.ladder import LadderFixture
 from service.matchfiles import OWN_COLOR
+from service.results import MatchSummary
 from service.settings import Settings
 
 if TYPE_CHECKING:
@@ -36,21 +37,6 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 MAIL_EVENTS = {"submission.started", "submission.finished", "submission.failed"}
-
-
-class PlayView(TypedDict, total=False):
-    """What a notification reads of results.json's ``play`` (contracts.sim_result.PlayRecord)."""
-
-    playing_s: float
-    halves_playing: list[int]
-
-
-class ResultsView(TypedDict, total=False):
-    """What a notification reads of a match's results.json."""
-
-    winner: str | None  # "red", "blue", "draw"; None while not over
-    score: dict[str, int] | None
-    play: PlayView | None
 
 
 class NoticeLinks(TypedDict):
@@ -95,7 +81,7 @@ class NotificationPayload(TypedDict):
     submission: SubmissionNotice
 
 
-def outcome_of(row: Submission, results: ResultsView | None, side: str = OWN_COLOR) -> str:
+def outcome_of(row: Submission, results: MatchSummary | None, side: str = OWN_COLOR) -> str:
     """The outcome in words for the team playing ``side`` (the submitting team plays red): won,
     drew, lost, or why not played."""
     if row.state == "cancelled":
@@ -107,22 +93,22 @@ def outcome_of(row: Submission, results: ResultsView | None, side: str = OWN_COL
         side = "the league's side (not charged)" if row.failure_side == "league" else \
             "your team's side"
         return f"not counted: {row.failure_class} on {side}"
-    winner = (results or {}).get("winner")
+    winner = results.winner if results is not None else None
     if row.state != "done" or winner is None:
         return row.state
     return {side: "won", "draw": "draw"}.get(winner, "lost")
 
 
 def payload(row: Submission, event: str, settings: Settings,
-            results: ResultsView | None = None, *, side: str = OWN_COLOR,
+            results: MatchSummary | None = None, *, side: str = OWN_COLOR,
             opponent: str | None = None, ladder: bool = False) -> NotificationPayload:
     """The notification's data: the submission, its score and outcome (from ``results``, the
-    match's results.json, when it ended), links to the API and to the pages a browser opens.
+    match's result as the database keeps it, when it ended), links to the API and to the pages
+    a browser opens.
     ``side`` is the notified team's colour and ``opponent`` the other team (by default the
     submission's opponent); the blue side is not told the submitting team's own details."""
     public = settings.public_url.rstrip("/")
     base = f"{public}/v1/submissions/{row.id}"
-    play = (results or {}).get("play") or {}
     own = side == OWN_COLOR
     links: NoticeLinks = {"status": base, "report": base + "/report",
                           "results": base + "/results", "logs": base + "/logs"} if own else \
@@ -135,8 +121,11 @@ def payload(row: Submission, event: str, settings: Settings,
             "failure_class": row.failure_class, "failure_side": row.failure_side,
             "cause": row.cause if own or row.failure_side == "league" else None,
             "charged": row.charged if own else False,
-            "score": (results or {}).get("score"), "outcome": outcome_of(row, results, side),
-            "playing_s": play.get("playing_s"), "halves_playing": play.get("halves_playing"),
+            "score": results.score if results is not None else None,
+            "outcome": outcome_of(row, results, side),
+            "playing_s": results.playing_s if results is not None else None,
+            "halves_playing": list(results.halves_playing)
+            if results is not None and results.halves_playing is not None else None,
             "links": links,
             "pages": {"submissions": f"{public}/watch/submissions",
                       "live": f"{public}/watch/live/{row.id}",
@@ -147,7 +136,7 @@ def payload(row: Submission, event: str, settings: Settings,
 
 
 def enqueue(session: Session, row: Submission, event: str, settings: Settings,
-            results: ResultsView | None = None) -> None:
+            results: MatchSummary | None = None) -> None:
     """Outbox rows for ``event``: a mail when the team has an address and SMTP is set, a
     webhook when the team has a webhook URL; for a friendly the ladder scheduled, to both
     teams, each from its side."""
@@ -320,7 +309,6 @@ __all__ = [
     "MAIL_EVENTS",
     "NotificationPayload",
     "Notifier",
-    "ResultsView",
     "enqueue",
     "payload",
     "send_mail",

@@ -2,10 +2,10 @@
 
 Which matches count: friendlies (a test match whose opponent is a team) and, when the
 service is given the tournament's state (``HLVS_SERVICE_SCHEDULE_STATE``), the official matches
-of the schedule. A match counts only when football was played: its ``results.json`` has a half
-that reached PLAYING and some time in PLAYING (``play.halves_playing``, ``play.playing_s``). A
-win, a draw and a loss are the ranks of the two teams (a draw ties them); the goals only fill the
-table.
+of the schedule. A match counts only when football was played: its result (recorded by the
+queue worker from ``results.json``, :mod:`service.results`) has a half that reached PLAYING
+and some time in PLAYING (``play.halves_playing``, ``play.playing_s``). A win, a draw and a
+loss are the ranks of the two teams (a draw ties them); the goals only fill the table.
 
 A friendly that got past kick-off is rated whatever happens after it (:func:`friendly_outcome`):
 finished, its score; cancelled by the asking team, the asking team forfeits (the opponent wins,
@@ -24,7 +24,7 @@ becomes certain.
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable, Iterable
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from datetime import datetime
 from pathlib import Path
@@ -38,6 +38,7 @@ from contracts import ContractError, MatchResults, files
 from service.db import Submission, SubmissionState, Team, now, utc
 from service.db.ladder import RatedMatch
 from service.matchfiles import OWN_COLOR
+from service.results import MatchSummary, stored_many
 from service.submissions import STUB
 
 if TYPE_CHECKING:
@@ -65,21 +66,28 @@ class Outcome:
         return self.note is None
 
 
-def outcome_of(results_path: Path) -> Outcome:
-    """The outcome of a match from its ``results.json``; a match that did not play, or left no
-    readable results, is not counted (``note`` says why)."""
-    try:
-        results = MatchResults.load(results_path)
-    except ContractError as exc:
-        return Outcome(None, None, None, f"no readable {files.RESULTS}: {exc}")
+def outcome_of(results: MatchSummary | None) -> Outcome:
+    """The outcome of a match from its recorded result; a match that did not play, or left no
+    result, is not counted (``note`` says why)."""
+    if results is None:
+        return Outcome(None, None, None, f"no result recorded (no readable {files.RESULTS})")
     score = results.score or {}
     red, blue = score.get("red"), score.get("blue")
-    play = results.play
-    if play is None or not play.halves_playing or play.playing_s <= 0:
+    if not results.kicked_off:
         return Outcome(red, blue, None, "the match did not play (no half reached PLAYING)")
     if red is None or blue is None:
         return Outcome(red, blue, None, "the match has no score")
     return Outcome(red, blue, _winner(results.winner, red, blue), None)
+
+
+def outcome_of_file(results_path: Path) -> Outcome:
+    """The outcome of a match from its ``results.json`` (an official match of the tournament,
+    whose results the service does not keep)."""
+    try:
+        results = MatchResults.load(results_path)
+    except ContractError as exc:
+        return Outcome(None, None, None, f"no readable {files.RESULTS}: {exc}")
+    return outcome_of(MatchSummary.of(results, {}))
 
 
 def _winner(winner: str | None, red: int, blue: int) -> str:
@@ -94,23 +102,16 @@ def forfeit_by(color: str) -> Outcome:
     return Outcome(0, 0, "blue" if color == "red" else "red", None)
 
 
-def friendly_outcome(results_path: Path, state: str, *, cancelled: bool) -> Outcome:
+def friendly_outcome(results: MatchSummary | None, state: str, *, cancelled: bool) -> Outcome:
     """A friendly's outcome for the ladder by how it ended (``state`` of its submission;
     ``cancelled``: the asking team asked to stop it). Past kick-off it is always rated."""
-    played = outcome_of(results_path)
-    try:
-        results: MatchResults | None = MatchResults.load(results_path)
-    except ContractError:
-        results = None
-    play = results.play if results is not None else None
-    kicked_off = play is not None and bool(play.halves_playing) and play.playing_s > 0
-    if state == SubmissionState.DONE.value or not kicked_off:
+    played = outcome_of(results)
+    if results is None or state == SubmissionState.DONE.value or not results.kicked_off:
         return played
     if state == SubmissionState.CANCELLED.value or cancelled:
         return forfeit_by(OWN_COLOR)
-    failure = results.failure if results is not None else None
-    if failure is not None and failure.team in ("red", "blue"):
-        return forfeit_by(failure.team)
+    if results.failure_team in ("red", "blue"):
+        return forfeit_by(results.failure_team)
     if played.red_goals is None or played.blue_goals is None:
         return Outcome(None, None, None, "the match stopped with no score")
     return Outcome(played.red_goals, played.blue_goals,
@@ -122,20 +123,18 @@ ENDED = (SubmissionState.DONE.value, SubmissionState.CANCELLED.value,
          SubmissionState.FAILED.value)
 
 
-def record_friendlies(session: Session, results_dir: Callable[[str], Path]) -> int:
-    """Record every ended friendly not considered yet; the number recorded.
-
-    ``results_dir(pool_handle)`` is the pool's output folder of a match.
-    """
+def record_friendlies(session: Session) -> int:
+    """Record every ended friendly not considered yet, from the results the worker recorded
+    (:mod:`service.results`); the number recorded."""
     seen = exists().where(RatedMatch.source == FRIENDLY, RatedMatch.ref == Submission.id)
     rows = session.execute(select(Submission, Team.name).join(
         Team, Team.id == Submission.team_id).where(
         Submission.state.in_(ENDED), Submission.opponent != STUB,
         Submission.pool_handle.is_not(None), ~seen).order_by(Submission.finished_at,
                                                              Submission.seq)).all()
+    results = stored_many(session, [row.id for row, _ in rows])
     for row, team in rows:
-        assert row.pool_handle is not None
-        outcome = friendly_outcome(results_dir(row.pool_handle) / files.RESULTS, row.state,
+        outcome = friendly_outcome(results.get(row.id), row.state,
                                    cancelled=bool(row.cancel_requested))
         teams = {OWN_COLOR: team, OTHER_COLOR: row.opponent}
         _add(session, source=FRIENDLY, ref=row.id, red=teams["red"], blue=teams["blue"],
@@ -163,7 +162,7 @@ def record_official(session: Session, state_file: Path) -> int:
 def _official_outcome(result: MatchResultRecord) -> Outcome:
     out_dir = result.get("out_dir")
     if out_dir and (Path(out_dir) / files.RESULTS).is_file():
-        return outcome_of(Path(out_dir) / files.RESULTS)
+        return outcome_of_file(Path(out_dir) / files.RESULTS)
     score = result.get("score") or {}
     red, blue = score.get("red"), score.get("blue")
     if not isinstance(red, int) or not isinstance(blue, int):
@@ -306,6 +305,7 @@ __all__ = [
     "RatedGame",
     "TeamRating",
     "outcome_of",
+    "outcome_of_file",
     "rate",
     "record_friendlies",
     "record_official",

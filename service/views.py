@@ -3,15 +3,19 @@ them)."""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from datetime import datetime
 
 from fastapi import Request
 from pydantic import BaseModel, ConfigDict, Field
 from sqlalchemy.orm import Session
 
-from service.db import Submission, Team, utc
+from service.db import ACTIVE_STATES, Submission, Team, utc
+from service.results import MatchSummary, stored
 from service.settings import Settings
 from service.submissions import QueueBoard
+
+ACTIVE_VALUES = frozenset(state.value for state in ACTIVE_STATES)
 
 
 class Links(BaseModel):
@@ -28,6 +32,52 @@ class Product(BaseModel):
 
     state: str = Field(description="pending | ready (video) | delivered (logs) | failed")
     detail: str | None
+
+
+class SideResult(BaseModel):
+    """One side of a finished match: its goals, what the referee counted of its play (null
+    when no football was played) and how its robots ended."""
+
+    team: str
+    goals: int | None
+    kicks: int | None
+    shots: int | None
+    own_goals: int | None
+    falls: int | None
+    robots: int
+    robots_exited: int = Field(description="robots that exited during the game")
+    robots_oom_killed: int
+
+
+class MatchResultView(BaseModel):
+    """The result of a finished match, as the service recorded it from its ``results.json``
+    (the submitting team plays red, its opponent blue)."""
+
+    score: dict[str, int] | None = Field(description="goals by colour (halves and extra time)")
+    shootout: dict[str, int] | None = Field(description="penalty shoot-out goals by colour; "
+                                            "null without a shoot-out")
+    winner: str | None = Field(description="red | blue | draw")
+    final_state: str | None
+    halves_playing: list[int] | None = Field(description="halves that reached PLAYING; null "
+                                             "when no football was played")
+    playing_s: float | None = Field(description="simulated seconds in PLAYING")
+    sim_time_ms: int | None
+    real_time_factor: float | None
+    teams: dict[str, SideResult] = Field(description="by colour: red, blue")
+
+
+def result_view(summary: MatchSummary) -> MatchResultView:
+    return MatchResultView(
+        score=summary.score, shootout=summary.shootout, winner=summary.winner,
+        final_state=summary.final_state,
+        halves_playing=list(summary.halves_playing) if summary.halves_playing is not None
+        else None, playing_s=summary.playing_s, sim_time_ms=summary.sim_time_ms,
+        real_time_factor=summary.real_time_factor,
+        teams={color: SideResult(
+            team=side.team, goals=side.goals, kicks=side.kicks, shots=side.shots,
+            own_goals=side.own_goals, falls=side.falls, robots=side.robots,
+            robots_exited=side.robots_exited, robots_oom_killed=side.robots_oom_killed)
+            for color, side in summary.sides.items()})
 
 
 class SubmissionView(BaseModel):
@@ -57,6 +107,9 @@ class SubmissionView(BaseModel):
     log_delivery: Product | None = Field(description="the upload of the team's logs to the "
                                          "target of its credentials.json; null when the team "
                                          "had uploaded none when it submitted")
+    result: MatchResultView | None = Field(
+        default=None, description="the score, play and each side's figures of the ended match; "
+        "null while it has not ended or when it left no results")
     links: Links
 
 
@@ -102,8 +155,14 @@ class SubmissionCreate(BaseModel):
 
 
 def submission_view(session: Session, row: Submission, settings: Settings, *,
-                    slots: int, queue: QueueBoard, team_name: str | None = None
-                    ) -> SubmissionView:
+                    slots: int, queue: QueueBoard, team_name: str | None = None,
+                    results: Mapping[str, MatchSummary] | None = None) -> SubmissionView:
+    """The view of ``row``; its result from ``results`` (by submission id) when given, else
+    looked up (only for an ended submission: the status board renders active ones)."""
+    if results is not None:
+        summary = results.get(row.id)
+    else:
+        summary = None if row.state in ACTIVE_VALUES else stored(session, row.id)
     if team_name is None:
         team = session.get(Team, row.team_id)
         team_name = team.name if team else "?"
@@ -123,29 +182,34 @@ def submission_view(session: Session, row: Submission, settings: Settings, *,
         if row.video_state else None,
         log_delivery=Product(state=row.delivery_state, detail=row.delivery_detail)
         if row.delivery_state else None,
+        result=result_view(summary) if summary is not None else None,
         links=Links(status=base, report=base + "/report", results=base + "/results",
                     logs=base + "/logs", replay=base + "/replay", video=base + "/video"),
     )
 
 
 def view_of(request: Request, session: Session, row: Submission,
-            team_name: str | None = None) -> SubmissionView:
+            team_name: str | None = None,
+            results: Mapping[str, MatchSummary] | None = None) -> SubmissionView:
     """The view of ``row`` with the app's settings, pool slots and match-time cache."""
     from service.deps import get_services
 
     services = get_services(request)
     slots = services.pool.slots if services.pool is not None else services.settings.match_slots
     return submission_view(session, row, services.settings, slots=slots, queue=services.queue,
-                           team_name=team_name)
+                           team_name=team_name, results=results)
 
 
 __all__ = [
     "Links",
+    "MatchResultView",
     "Product",
+    "SideResult",
     "SubmissionCreate",
     "SubmissionReport",
     "SubmissionView",
     "TeamRobot",
+    "result_view",
     "submission_view",
     "view_of",
 ]

@@ -14,7 +14,6 @@ is queued again at its old place, with a new attempt number (nothing is lost).
 
 from __future__ import annotations
 
-import json
 import logging
 import threading
 import zlib
@@ -34,6 +33,7 @@ from service.db import MediaState, Submission, SubmissionState, Team, now, trans
 from service.errors import NotFound, ServiceError
 from service.ladder import is_fixture
 from service.matchfiles import OWN_COLOR
+from service.results import MatchSummary, backfill, read_results, record, stored, teams_of
 from service.submissions import STUB, failure_side, queue_paused
 
 if TYPE_CHECKING:
@@ -62,6 +62,7 @@ class QueueWorker:
         self._wake = threading.Event()
         self._thread: threading.Thread | None = None
         self._cancel_sent: set[str] = set()
+        self._backfilled = False  # the results of matches ended before the results tables
         self.notifier = notify.Notifier(services)
 
     # lifecycle ---------------------------------------------------------------------------
@@ -97,6 +98,10 @@ class QueueWorker:
         """One round; True when it changed a submission."""
         sessions = self.services.sessions
         changed = False
+        if not self._backfilled:
+            with transaction(sessions) as session:
+                changed = backfill(session, self.pool.results_dir) > 0
+            self._backfilled = True
         self._stub_if_needed()
         with transaction(sessions) as session:
             active = list(session.scalars(select(Submission).where(Submission.state.in_(
@@ -325,22 +330,12 @@ class QueueWorker:
         event = {SubmissionState.DONE: "submission.finished",
                  SubmissionState.FAILED: "submission.failed",
                  SubmissionState.CANCELLED: "submission.cancelled"}[state]
-        notify.enqueue(session, row, event, self.settings, results=_results_of(out))
+        results = read_results(out) if out is not None else None
+        if results is not None:  # read once, here; everything after reads the database
+            record(session, row.id, MatchSummary.of(results, teams_of(session, row)))
+        notify.enqueue(session, row, event, self.settings, results=stored(session, row.id))
         log.info("submission %s %s%s", row.id, state.value,
                  f" ({failure_class}: {cause})" if failure_class else "")
-
-
-def _results_of(out: Path | None) -> notify.ResultsView | None:
-    """The match's results.json as data (score, winner, play), None when there is none."""
-    path = out / files.RESULTS if out is not None else None
-    if path is None or not path.is_file():
-        return None
-    try:
-        data: notify.ResultsView = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
-        log.warning("unreadable %s: %s", path, exc)
-        return None
-    return data
 
 
 __all__ = ["MAX_ATTEMPTS", "QueueWorker"]

@@ -7,12 +7,11 @@ team's submission answers 404 like an unknown one. An operator sees every match.
 the queue, the matches, the ladder (routed by :mod:`viewer.ladder_page`), the tournament and
 the pool are the same front end, reading the service's own ``/v1`` API with that token;
 ``/api/viewer/results`` gives those pages the score of every finished match the token may
-watch.
+watch, from the service's database.
 """
 
 from __future__ import annotations
 
-import json
 from dataclasses import replace
 from pathlib import Path
 from typing import Annotated, Any
@@ -21,7 +20,7 @@ from fastapi import APIRouter, Depends, FastAPI, Request
 from sqlalchemy import select, true
 
 from contracts import files
-from service import DbSession, NotFound, Principal, get_services, require_token
+from service import DbSession, NotFound, Principal, get_services, require_token, stored_many
 from service.db import Scope, Submission, Team
 from viewer.api import API_PREFIX, mount_viewer
 from viewer.sources import LiveSource, ReplaySource, Teams, live_of
@@ -116,25 +115,20 @@ def match_results(request: Request, principal: AnyPrincipal,
                   session: DbSession) -> dict[str, dict[str, Any]]:
     """The score of every finished match the caller may watch (newest 200), by submission id,
     for the matches pages: ``{"red", "blue"}`` (the teams), ``score``, ``shootout`` (null
-    without one) and ``winner`` (red, blue, draw or null), read from the match's
-    ``results.json``. A match without one (failed before it played) is left out."""
-    rows = session.scalars(select(Submission).where(_visible(principal),
-                                                    Submission.state == "done")
-                           .order_by(Submission.seq.desc()).limit(LISTING_LIMIT))
+    without one) and ``winner`` (red, blue, draw or null), as the service recorded them from
+    the match's ``results.json``. A match without a score (failed before it played) is left
+    out."""
+    rows = list(session.scalars(select(Submission).where(_visible(principal),
+                                                         Submission.state == "done")
+                                .order_by(Submission.seq.desc()).limit(LISTING_LIMIT)))
+    recorded = stored_many(session, [row.id for row in rows])
     found: dict[str, dict[str, Any]] = {}
     for row in rows:
-        out = _match_dir(request, row)
-        if out is None:
+        result = recorded.get(row.id)
+        if result is None or result.score is None:
             continue
-        try:
-            results = json.loads((out / files.RESULTS).read_text(encoding="utf-8"))
-        except (OSError, ValueError):
-            continue
-        score = results.get("score") if isinstance(results, dict) else None
-        if not isinstance(score, dict):
-            continue
-        found[row.id] = {**_teams(session, row).as_json(), "score": score,
-                         "shootout": results.get("shootout"), "winner": results.get("winner")}
+        found[row.id] = {**_teams(session, row).as_json(), "score": result.score,
+                         "shootout": result.shootout, "winner": result.winner}
     return found
 
 

@@ -17,6 +17,7 @@ from service import submissions
 from service.db import ACTIVE_STATES, Submission
 from service.db.models import Scope
 from service.deps import DbSession, SessionRoute, get_services, require_token
+from service.results import stored_many
 from service.tokens import Principal
 from service.views import SubmissionView, view_of
 
@@ -83,14 +84,17 @@ def public_queue(request: Request, principal: AnyPrincipal, session: DbSession) 
 def list_matches(request: Request, principal: AnyPrincipal,
                  session: DbSession) -> list[SubmissionView]:
     """A team's own matches (and friendlies it was the opponent in); every match for an
-    operator; newest first, at most 200."""
+    operator; newest first, at most 200. An ended match's score, play and each side's figures
+    are in ``result``, from the database (the match folder is not read)."""
     query = select(Submission).order_by(Submission.seq.desc()).limit(MATCH_LIST_LIMIT)
     if not _is_operator(principal):
         query = query.where((Submission.team_id == principal.team_id)
                             | (Submission.opponent == principal.team_name))
+    rows = list(session.scalars(query))
+    results = stored_many(session, [row.id for row in rows])  # one query for the scores
     views = []
-    for row in session.scalars(query):
-        view = view_of(request, session, row)
+    for row in rows:
+        view = view_of(request, session, row, results=results)
         if not _is_operator(principal) and row.team_id != principal.team_id:
             view = as_opponent(view)
         views.append(view)

@@ -20,7 +20,8 @@ from contracts.match_results import MatchReport
 from contracts.sim_result import PlayRecord
 from service.db import Submission, SubmissionState, make_engine, session_factory, transaction
 from service.db.ladder import RatedMatch
-from service.ratings import outcome_of
+from service.ratings import outcome_of, outcome_of_file
+from service.results import MatchSummary
 from tests.integration.service.harness import Served
 from tests.unit.service.conftest import wait_for_status
 from tests.unit.service.test_submissions import setup_team
@@ -181,15 +182,19 @@ def test_ladder_off_waits_for_a_free_slot_and_survives_a_restart(
 
 
 def test_a_match_without_play_or_results_is_not_counted(tmp_path: Path) -> None:
-    missing = outcome_of(tmp_path / "results.json")
+    missing = outcome_of_file(tmp_path / "results.json")
     assert not missing.counted and "results.json" in (missing.note or "")
+    unrecorded = outcome_of(None)
+    assert not unrecorded.counted and "no result recorded" in (unrecorded.note or "")
     path = tmp_path / "played.json"
     results: Any = replace(fake_results("m", None), score={"red": 0, "blue": 2}, winner="blue",
                            play=_play({"red": 0, "blue": 2}))
     results.write(path)
-    played = outcome_of(path)
-    assert played.counted and (played.red_goals, played.blue_goals, played.winner) == (0, 2,
-                                                                                        "blue")
+    for played in (outcome_of_file(path), outcome_of(MatchSummary.of(results, {}))):
+        assert played.counted and (played.red_goals, played.blue_goals, played.winner) == (
+            0, 2, "blue")
+    unplayed = outcome_of(MatchSummary.of(replace(results, play=None), {}))
+    assert not unplayed.counted and "did not play" in (unplayed.note or "")
 
 
 def test_official_matches_of_the_tournament_are_rated_once(
@@ -246,26 +251,25 @@ def test_a_friendly_cancelled_after_kick_off_is_rated_as_the_askers_forfeit(
 
 
 def test_a_friendly_that_never_kicked_off_is_not_rated_and_a_failure_forfeits_its_side(
-    tmp_path: Path,
 ) -> None:
     from contracts import Failure, FailureClass
     from service.ratings import friendly_outcome
 
-    path = tmp_path / "results.json"
+    def summary(results: Any) -> MatchSummary:
+        return MatchSummary.of(results, {"red": "Alpha", "blue": "Beta"})
+
     before = replace(fake_results("m", Failure(failure_class=FailureClass.INTERRUPTED,
                                                cause="stop")), play=None)
-    before.write(path)
-    assert not friendly_outcome(path, "cancelled", cancelled=True).counted
+    assert not friendly_outcome(summary(before), "cancelled", cancelled=True).counted
+    assert not friendly_outcome(None, "failed", cancelled=False).counted
     failed = replace(fake_results("m", Failure(failure_class=FailureClass.TEAM_CRASH,
                                                cause="crash", team="red"), played=True),
                      score={"red": 3, "blue": 0})
-    failed.write(path)
-    outcome = friendly_outcome(path, "failed", cancelled=False)
+    outcome = friendly_outcome(summary(failed), "failed", cancelled=False)
     assert outcome.counted and outcome.winner == "blue"
     league = replace(failed, failure=Failure(failure_class=FailureClass.INFRASTRUCTURE,
                                              cause="node lost"))
-    league.write(path)
-    outcome = friendly_outcome(path, "failed", cancelled=False)
+    outcome = friendly_outcome(summary(league), "failed", cancelled=False)
     assert outcome.counted and (outcome.red_goals, outcome.blue_goals, outcome.winner) == (
         3, 0, "red")
 

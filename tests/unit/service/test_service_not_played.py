@@ -56,8 +56,14 @@ def test_the_mail_says_score_outcome_and_links_to_pages(
     settings = Settings(public_url="https://league.example.org/")
     row = Submission(id="sub_1", state="done", opponent="stub", match_id="m", charged=True,
                      failure_class=None, failure_side=None, cause=None)
-    results = {"score": {"red": 2, "blue": 1}, "winner": "red",
-               "play": {"playing_s": 50.0, "halves_playing": [1, 2]}}
+    from dataclasses import replace
+
+    from cluster.fake import fake_results
+    from service.results import MatchSummary
+
+    results = MatchSummary.of(replace(fake_results("m", None), score={"red": 2, "blue": 1}),
+                              {"red": "Alpha", "blue": "stub"})
+    results = replace(results, playing_s=50.0)
     data = notify.payload(row, "submission.finished", settings, results)
     assert data["submission"]["outcome"] == "won"
     sent: list[bytes] = []

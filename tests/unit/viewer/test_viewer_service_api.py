@@ -42,6 +42,8 @@ def test_results_and_replay_meta_name_the_teams_for_whoever_may_watch(
         assert http.get(f"/api/viewer/replays/{friendly}/meta").status_code == 404
     with served.client() as http:
         assert http.get("/api/viewer/results").status_code == 401
+    shutil.rmtree(handle)  # the scores are the database's: the match folder is not needed
+    assert alpha.get("/api/viewer/results").json() == {friendly: expected}
     alpha.close()
 
 
