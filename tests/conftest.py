@@ -111,9 +111,31 @@ def pytest_configure(config: pytest.Config) -> None:
         config.stash[MACHINE_AT_START] = _machine_speed()
 
 
+GROUP_SECONDS: dict[str, list[float]] = {}  # worker group: [seconds of its tests, tests]
+
+
+def pytest_runtest_logreport(report: pytest.TestReport) -> None:
+    """Each test's set-up, call and teardown time, added to its worker group's (on the
+    controller, which hears every worker's reports)."""
+    entry = GROUP_SECONDS.setdefault(worker_group(report.nodeid), [0.0, 0])
+    entry[0] += report.duration
+    if report.when == "call":
+        entry[1] += 1
+
+
+def _slowest_groups(count: int = 8) -> str:
+    """The groups that took longest, on one line: a group runs on one worker from start to end,
+    so the longest bounds the run's wall time."""
+    ranked = sorted(GROUP_SECONDS.items(), key=lambda item: -item[1][0])[:count]
+    return ", ".join(f"{group} {seconds:.0f} s ({int(tests)} tests)"
+                     for group, (seconds, tests) in ranked)
+
+
 def pytest_terminal_summary(terminalreporter: Any, config: pytest.Config) -> None:
     """The machine's speed at the start and at the end, near the end of the report (what a CI
-    log keeps), for a reader who compares a slow run with a good one."""
+    log keeps), for a reader who compares a slow run with a good one; the slowest worker groups."""
+    if GROUP_SECONDS:
+        terminalreporter.write_line(f"slowest test groups: {_slowest_groups()}")
     if MACHINE_AT_START in config.stash:
         setup = _setup_times()
         if setup:
