@@ -23,13 +23,20 @@ from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from sqlalchemy import Engine
-from sqlalchemy.exc import OperationalError
+from sqlalchemy.exc import DBAPIError
 from sqlalchemy.orm import Session, sessionmaker
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from cluster import MatchPool, PoolError, make_pool
 from orchestrator.config import TeamConfig
-from service.db import make_engine, migrate, session_factory
+from service.db import (
+    UNAVAILABLE_RETRY_S,
+    database_busy,
+    database_unavailable,
+    make_engine,
+    migrate,
+    session_factory,
+)
 from service.errors import AuthError, ServiceError
 from service.settings import Settings
 
@@ -234,18 +241,21 @@ def _install_error_handlers(app: FastAPI) -> None:
         body = {"error": exc.kind, "message": str(exc), **exc.fields()}
         return JSONResponse(body, status_code=503)
 
-    @app.exception_handler(OperationalError)
-    async def database_error(request: Request, exc: OperationalError) -> JSONResponse:
+    @app.exception_handler(DBAPIError)
+    async def database_error(request: Request, exc: DBAPIError) -> JSONResponse:
         """A database too busy to answer in time (SQLite's lock past its busy timeout, a
-        PostgreSQL lock or serialization failure) is a 503 to retry, never a 500."""
-        text = str(exc.orig).lower()
-        busy = any(word in text for word in ("locked", "busy", "deadlock", "serializ",
-                                              "lock timeout", "could not obtain lock"))
+        PostgreSQL lock or serialization failure), or one that cannot be reached (PostgreSQL
+        restarting, stopped or unreachable: the connection refused, closed or timed out) is a
+        503 to retry, never a 500."""
         log.error("%s %s: database error: %s", request.method, request.url.path, exc.orig)
-        if busy:
+        if database_busy(exc):
             return JSONResponse({"error": "busy", "message": "the database is busy; try "
                                  "again in a moment"}, status_code=503,
                                 headers={"Retry-After": "1"})
+        if database_unavailable(exc):
+            return JSONResponse({"error": "unavailable", "message": "the database cannot be "
+                                 "reached; try again in a moment"}, status_code=503,
+                                headers={"Retry-After": str(UNAVAILABLE_RETRY_S)})
         return JSONResponse({"error": "internal", "message": "database error"},
                             status_code=500)
 

@@ -17,7 +17,15 @@ from service.db.models import (
     now,
     utc,
 )
-from service.db.session import make_engine, migrate, session_factory, transaction
+from service.db.session import (
+    UNAVAILABLE_RETRY_S,
+    database_busy,
+    database_unavailable,
+    make_engine,
+    migrate,
+    session_factory,
+    transaction,
+)
 
 __all__ = [
     "ACTIVE_STATES",
@@ -31,6 +39,9 @@ __all__ = [
     "Team",
     "TeamFile",
     "Token",
+    "UNAVAILABLE_RETRY_S",
+    "database_busy",
+    "database_unavailable",
     "make_engine",
     "migrate",
     "now",

@@ -11,6 +11,7 @@ from typing import Any
 from alembic import command
 from alembic.config import Config
 from sqlalchemy import Engine, create_engine, event
+from sqlalchemy.exc import DBAPIError, InterfaceError, OperationalError
 from sqlalchemy.orm import Session, sessionmaker
 
 log = logging.getLogger(__name__)
@@ -46,7 +47,36 @@ def make_engine(url: str) -> Engine:
             connection.exec_driver_sql("BEGIN IMMEDIATE")
 
         return engine
-    return create_engine(url, pool_size=20, max_overflow=30, pool_pre_ping=True)
+    return create_engine(url, pool_size=20, max_overflow=30, pool_pre_ping=True,
+                         connect_args={"connect_timeout": CONNECT_TIMEOUT_S})
+
+
+CONNECT_TIMEOUT_S = 5
+"""How long a new PostgreSQL connection may take (an unreachable server answers 503 then)."""
+UNAVAILABLE_RETRY_S = 5
+"""The ``Retry-After`` of a request answered while the database cannot be reached."""
+_BUSY = ("locked", "busy", "deadlock", "serializ", "lock timeout", "could not obtain lock")
+_UNAVAILABLE = ("connection failed", "connection refused", "could not connect",
+                "server closed the connection", "shutting down", "starting up",
+                "terminating connection", "timeout expired", "connection is closed",
+                "connection timed out", "consuming input failed", "the connection is lost",
+                "no connection to the server", "in recovery mode")
+
+
+def database_busy(exc: DBAPIError) -> bool:
+    """A database too busy to answer in time (SQLite's lock past its busy timeout, a
+    PostgreSQL lock or serialization failure): the request may be retried at once."""
+    text = str(exc.orig).lower()
+    return isinstance(exc, OperationalError) and any(word in text for word in _BUSY)
+
+
+def database_unavailable(exc: DBAPIError) -> bool:
+    """A database that cannot be reached now (a PostgreSQL server stopped, restarting or
+    unreachable): the request may be retried in a moment."""
+    text = str(exc.orig).lower()
+    return exc.connection_invalidated or (
+        isinstance(exc, OperationalError | InterfaceError)
+        and any(phrase in text for phrase in _UNAVAILABLE))
 
 
 def _private_sqlite(path: Path) -> None:
