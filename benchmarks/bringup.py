@@ -44,7 +44,7 @@ def _parse(argv: Sequence[str]) -> argparse.Namespace:
 
 def measure(*, robots: int, out: Path, timeout_s: float, robot_image: str | None = None,
             robot_command: str | None = None) -> dict[str, object]:
-    from hlvs.commands.scrimmage_args import add_arguments
+    from orchestrator import add_scrimmage_arguments as add_arguments
     from orchestrator.config.loader import load_game
     from orchestrator.engine import connect
     from orchestrator.engine.containers import DockerRuntime

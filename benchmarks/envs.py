@@ -33,20 +33,9 @@ import argparse
 import json
 import sys
 import time
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
-if TYPE_CHECKING:  # numpy and gymnasium are imported after the arguments (fast --help)
-    import numpy as np
-
-ACTION_AMPLITUDE_RAD = 0.05
-
-
-def _actions(count: int, seed: int) -> np.ndarray:
-    """Small motor targets around the standing posture (the robot stays up)."""
-    import numpy as np
-
-    rng = np.random.default_rng(seed)
-    return rng.uniform(-ACTION_AMPLITUDE_RAD, ACTION_AMPLITUDE_RAD, (count, 20)).astype(np.float32)
+from benchmarks.envs_actions import actions as random_actions
 
 
 def bench_inprocess(*, rounds: int, block: int, seed: int) -> dict[str, Any]:
@@ -69,7 +58,7 @@ def bench_inprocess(*, rounds: int, block: int, seed: int) -> dict[str, Any]:
         seed=seed,
     )
     robot = RobotId(TeamColor.RED, 1)
-    actions = _actions(block, seed)
+    actions = random_actions(block, seed)
     bare_actions = actions.astype(np.float64)
     totals = {"env_cpu": 0.0, "env_wall": 0.0, "bare_cpu": 0.0, "bare_wall": 0.0}
     for _ in range(rounds):
@@ -120,7 +109,7 @@ def bench_vector_inprocess(
             RobotPlacement(id=robot, model="kid-default", x_m=0.0, y_m=0.0, yaw_rad=0.0)])
         for i in range(num_envs)
     ]  # fmt: skip
-    actions = _actions(block * num_envs, seed).reshape(block, num_envs, 20)
+    actions = random_actions(block * num_envs, seed).reshape(block, num_envs, 20)
     bare_actions = actions.astype(np.float64)
     totals = {"env_cpu": 0.0, "env_wall": 0.0, "bare_cpu": 0.0, "bare_wall": 0.0}
     for _ in range(rounds):
@@ -164,7 +153,7 @@ def bench_mjx(*, num_envs: int, steps: int, seed: int) -> dict[str, Any]:
     built_s = time.perf_counter() - began
     vec.reset(seed=seed)
     assert vec.compile_s is not None
-    actions = vec.stance + _actions(num_envs, seed)
+    actions = vec.stance + random_actions(num_envs, seed)
     vec.step(actions)  # the first call after the compile
     c0, w0 = time.process_time(), time.perf_counter()
     for _ in range(steps):

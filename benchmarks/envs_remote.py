@@ -66,13 +66,13 @@ def _env_run(
     import gymnasium as gym
 
     import envs  # noqa: F401  (registers the ids)
-    from benchmarks.envs import _actions
+    from benchmarks.envs_actions import actions
 
     env = gym.make("hlvs/Kick-v0", remotes=address, max_episode_s=3600.0,
                    steps_per_action=steps_per_action)  # fmt: skip
     try:
         env.reset(seed=seed)
-        return _run(env, _actions(steps, seed), container, steps)
+        return _run(env, actions(steps, seed), container, steps)
     finally:
         env.close()
 
@@ -82,7 +82,7 @@ def _vector_run(
 ) -> dict[str, Any]:
     import numpy as np
 
-    from benchmarks.envs import _actions
+    from benchmarks.envs_actions import actions
     from envs.vector import make_vector
 
     size = len(addresses)
@@ -90,7 +90,7 @@ def _vector_run(
                       steps_per_action=steps_per_action)  # fmt: skip
     try:
         vec.reset(seed=seed)
-        batch = np.repeat(_actions(steps, seed)[:, None, :], size, axis=1)
+        batch = np.repeat(actions(steps, seed)[:, None, :], size, axis=1)
         return _run(vec, batch, containers, steps * size)
     finally:
         vec.close()

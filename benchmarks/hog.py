@@ -44,12 +44,12 @@ def _hog_command(processes: int) -> str:
 
 def _files(folder: Path, *, match_id: str, red_command: str, cpus: float, half_s: float,
            stepping: str, max_rtf: float) -> Path:
-    from hlvs.commands import scrimmage_args
+    from orchestrator import add_scrimmage_arguments
     from orchestrator.match import scrimmage
     from orchestrator.project_images import project_image
 
     parser = argparse.ArgumentParser()
-    scrimmage_args.add_arguments(parser)
+    add_scrimmage_arguments(parser)
     args = parser.parse_args([
         "--match-id", match_id, "--half-duration", str(half_s), "--ready-duration", "5",
         "--minimum-play", "0",

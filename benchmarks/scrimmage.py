@@ -105,7 +105,7 @@ def play_one(*, seed: int, out: Path, players: int | None,
              field_class: str = "kid") -> MatchFigures:
     """One default scrimmage with ``seed`` played into ``out`` on the ``field_class`` field;
     its figures. ``stop`` set: the match stops (and is collected) as on SIGINT."""
-    from hlvs.commands.scrimmage_args import add_arguments
+    from orchestrator import add_scrimmage_arguments as add_arguments
     from orchestrator.config.loader import load_game
     from orchestrator.engine import connect
     from orchestrator.engine.containers import DockerRuntime
@@ -190,7 +190,7 @@ def run(*, matches: int, seed: int, players: int | None, folder: Path,
         quiet: bool, stepping: str = "lockstep", field_class: str = "kid") -> dict[str, Any]:
     """Play the scrimmages; SIGINT / SIGTERM stop the one playing and skip the rest (the
     summary covers the matches played so far, the interrupted one included)."""
-    from hlvs.commands.play import stop_on_signals
+    from orchestrator import stop_on_signals
 
     figures = []
     with stop_on_signals() as stop:

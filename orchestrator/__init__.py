@@ -34,6 +34,8 @@ if TYPE_CHECKING:
     )
     from orchestrator.project_images import build_all, ensure_image, project_image
     from orchestrator.pull import ResolvedImage, pull_game_images, resolve_team_images
+    from orchestrator.scrimmage_options import add_gpu_argument, add_scrimmage_arguments
+    from orchestrator.signals import stop_on_signals
     from orchestrator.telemetry import LiveView, ZenohTelemetry, subscriber_config
 
 __all__ = [
@@ -54,6 +56,8 @@ __all__ = [
     "Subnets",
     "TeamImagesTooLarge",
     "ZenohTelemetry",
+    "add_gpu_argument",
+    "add_scrimmage_arguments",
     "build_all",
     "collect_results",
     "ensure_image",
@@ -65,6 +69,7 @@ __all__ = [
     "project_image",
     "pull_game_images",
     "resolve_team_images",
+    "stop_on_signals",
     "subscriber_config",
     "user_path",
     "write_compose",
@@ -84,5 +89,7 @@ if not TYPE_CHECKING:
         ),
         "orchestrator.project_images": ("build_all", "ensure_image", "project_image"),
         "orchestrator.pull": ("ResolvedImage", "pull_game_images", "resolve_team_images"),
+        "orchestrator.scrimmage_options": ("add_gpu_argument", "add_scrimmage_arguments"),
+        "orchestrator.signals": ("stop_on_signals",),
         "orchestrator.telemetry": ("LiveView", "ZenohTelemetry", "subscriber_config"),
     })

@@ -34,7 +34,7 @@ from orchestrator.match import layout
 from orchestrator.match.gpu import SimulatorGpu
 from orchestrator.match.logfs import safe_name
 from orchestrator.match.plan import MatchPlan, plan_from_game
-from orchestrator.match.runtime import (
+from orchestrator.runtime.port import (
     Attachment,
     BindMount,
     ContainerRequest,

@@ -21,4 +21,10 @@ def user_path(text: str | os.PathLike[str]) -> Path:
     return Path(os.path.abspath(os.path.expanduser(os.fspath(text))))
 
 
-__all__ = ["user_path"]
+def state_dir() -> Path:
+    """The runner's state on this host (``$HLVS_STATE_DIR``, default ``/var/lib/hlvs-runner``):
+    the ledger of created objects, run records, capped log folders."""
+    return Path(os.environ.get("HLVS_STATE_DIR", "/var/lib/hlvs-runner"))
+
+
+__all__ = ["state_dir", "user_path"]

@@ -47,8 +47,8 @@ def render_camera_frames(
 
     from contracts import from_data
     from simulator.png import write_png
-    from simulator.render import Placer, _frames_for, scene_model
     from simulator.replay import load_replay, scene_for
+    from simulator.scene_model import Placer, frames_for, scene_model
     from simulator.world.camera_model import CameraEffects, CameraModel
     from simulator.world.look import look_from_summary
 
@@ -78,7 +78,7 @@ def render_camera_frames(
     renderer.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = False
     option = mujoco.MjvOption()
     option.geomgroup[4] = 0
-    indices = list(_frames_for(replay, fps))
+    indices = list(frames_for(replay, fps))
     written: list[Path] = []
     try:
         for k, i in enumerate(indices):

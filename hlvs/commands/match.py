@@ -12,9 +12,7 @@ import argparse
 import logging
 from typing import Any
 
-from hlvs.commands.scrimmage_args import add_arguments as add_scrimmage_arguments
-from hlvs.commands.scrimmage_args import add_gpu_argument
-from orchestrator import user_path
+from orchestrator import add_gpu_argument, add_scrimmage_arguments, user_path
 
 MATCH_EPILOG = (
     "exit codes: 0 the match played to its end, 1 it failed (see report.json), 2 invalid input, "

@@ -12,31 +12,25 @@ import argparse
 import json
 import logging
 import os
-import signal
 import sys
-import threading
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
-from types import FrameType
 from typing import Any, TextIO
 
-from contracts import files
+from hlvs.commands.outcome import summarize
 from orchestrator import (
     ConfigError,
     ExitCode,
-    InfrastructureError,
     OrchestratorError,
     Problem,
     local_name_reason,
+    stop_on_signals,
     user_path,
 )
 from orchestrator.config import load_game
 from orchestrator.engine import LABEL_SLURM_JOB
 from orchestrator.match import (
     LABEL_RUN,
-    FailureClass,
     GpuOrigin,
     HostControl,
     HostResources,
@@ -59,26 +53,6 @@ from orchestrator.match import (
 )
 
 log = logging.getLogger(__name__)
-
-
-@contextmanager
-def stop_on_signals() -> Iterator[threading.Event]:
-    """SIGINT / SIGTERM set the event (the runner then stops and collects everything)."""
-    event = threading.Event()
-    owner = os.getpid()
-
-    def handler(signum: int, frame: FrameType | None) -> None:
-        if os.getpid() != owner:  # a forked helper (pyroute2's netns worker) inherits this
-            os._exit(0)
-        log.warning("received %s: stopping the match", signal.Signals(signum).name)
-        event.set()
-
-    previous = {s: signal.signal(s, handler) for s in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        yield event
-    finally:
-        for sig, old in previous.items():
-            signal.signal(sig, old)
 
 
 def _pull_resolver(client: Any, loaded: Any) -> ImageResolver:
@@ -164,66 +138,6 @@ def _play(
         finally:
             view.close()
     return outcome
-
-
-def _shown(path: Path) -> str:
-    """``path`` relative to the current directory when it is below it, else absolute."""
-    try:
-        return str(path.relative_to(Path.cwd()))
-    except ValueError:
-        return str(path)
-
-
-def watch_hint(out_dir: Path) -> list[str]:
-    """Where to watch a played match: the viewer and the video command (empty: no replay)."""
-    replay = out_dir / "public" / files.REPLAY
-    if not replay.is_file():
-        return []
-    return [
-        f"watch it in the browser:  hlvs view {_shown(out_dir)}",
-        f"or as a video:            hlvs render {_shown(replay)} -o match.mp4",
-    ]
-
-
-def summarize(outcome: MatchOutcome, *, as_json: bool = False) -> int:
-    """Print the outcome (one line, or results.json with ``as_json``) and return its exit code:
-    0 played, 4 decided by forfeit, 1 failed, 3 infrastructure, 130 interrupted."""
-    results = outcome.results
-    score = (results.score if results is not None else None) or {}
-    failure = outcome.failure
-    forfeit = results.forfeit if results is not None else None
-    if failure is None:
-        code = ExitCode.FORFEIT if forfeit else ExitCode.OK
-    elif failure.failure_class is FailureClass.INTERRUPTED:
-        code = ExitCode.INTERRUPTED
-    elif failure.failure_class is FailureClass.INFRASTRUCTURE:
-        code = ExitCode(InfrastructureError.exit_code)
-    else:
-        code = ExitCode.FAILED
-    if as_json:
-        document = results.to_dict() if results is not None else {}
-        document.setdefault("match_id", outcome.match_id)
-        document["out_dir"] = str(outcome.out_dir)
-        document["exit_code"] = int(code)
-        if failure is not None:
-            document.setdefault(
-                "failure", {"class": failure.failure_class.value, "cause": failure.cause}
-            )
-        print(json.dumps(document, indent=2, sort_keys=True, default=str))
-        return code
-    if failure is None:
-        if forfeit:
-            what = f"{forfeit.team} forfeits, winner {forfeit.winner}"
-        else:
-            winner = results.winner if results is not None else None
-            what = f"red {score.get('red')} - {score.get('blue')} blue, winner {winner}"
-        print(f"match {outcome.match_id}: {what}; results in {outcome.out_dir}")
-        for line in watch_hint(outcome.out_dir):
-            print(line)
-        return code
-    print(f"match {outcome.match_id} failed ({failure.failure_class.value}): {failure.cause}; "
-          f"results in {outcome.out_dir}", file=sys.stderr)
-    return code
 
 
 def run_match_command(args: argparse.Namespace) -> int:
@@ -319,7 +233,4 @@ def run_cleanup_command(args: argparse.Namespace) -> int:
     return ExitCode.OK
 
 
-__all__ = [
-    "play", "run_cleanup_command", "run_match_command", "run_scrimmage_command",
-    "stop_on_signals", "summarize",
-]
+__all__ = ["play", "run_cleanup_command", "run_match_command", "run_scrimmage_command"]

@@ -18,8 +18,8 @@ from pathlib import Path
 from typing import Any
 
 from contracts import ContractError, FailureClass, MatchReport, MatchResults, files
-from hlvs.commands.play import stop_on_signals, summarize
-from orchestrator import InfrastructureError
+from hlvs.commands.outcome import summarize
+from orchestrator import InfrastructureError, stop_on_signals
 from orchestrator.match import MatchOutcome
 
 DEFAULT_CONF = "/var/lib/hlvs/slurm/slurm.conf"

@@ -1,6 +1,6 @@
 """Docker adapter for the match: containers (and, through ``networks``, networks).
 
-:class:`DockerRuntime` implements :class:`orchestrator.match.runtime.ContainerRuntime`.
+:class:`DockerRuntime` implements :class:`orchestrator.runtime.port.ContainerRuntime`.
 Docker SDK errors become orchestrator errors in :func:`translate` and nowhere else.
 """
 
@@ -22,8 +22,8 @@ import requests.exceptions
 from orchestrator.engine import LABEL_MATCH, LABEL_PROJECT
 from orchestrator.engine import networks as _networks
 from orchestrator.errors import InfrastructureError
-from orchestrator.match import ledger
-from orchestrator.match.runtime import (
+from orchestrator.runtime import ledger
+from orchestrator.runtime.port import (
     ContainerRequest,
     ContainerState,
     NetworkInfo,

@@ -19,7 +19,7 @@ from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
-from orchestrator.match.gpu import GpuDetection
+from orchestrator.runtime.port import GpuDetection
 
 log = logging.getLogger(__name__)
 

@@ -20,7 +20,7 @@ import subprocess
 import docker
 
 from orchestrator.errors import InfrastructureError
-from orchestrator.match.runtime import NetworkInfo, NetworkRequest, SubnetInUse
+from orchestrator.runtime.port import NetworkInfo, NetworkRequest, SubnetInUse
 
 log = logging.getLogger(__name__)
 

@@ -18,7 +18,7 @@ import subprocess
 from pathlib import Path
 
 from orchestrator.errors import InfrastructureError
-from orchestrator.match.placement import ROBOT_CGROUP, ROBOT_CGROUP_PARENT, NodeFirewall
+from orchestrator.runtime.port import ROBOT_CGROUP, ROBOT_CGROUP_PARENT, NodeFirewall
 
 log = logging.getLogger(__name__)
 

@@ -30,8 +30,8 @@ from orchestrator.match.runner import (
     RunOptions,
     local_images,
 )
-from orchestrator.match.runtime import ContainerRuntime
 from orchestrator.match.state import IllegalMatchTransition, Lifecycle, MatchState
+from orchestrator.runtime.port import ContainerRuntime
 
 if TYPE_CHECKING:
     from orchestrator.match import ownership, scrimmage

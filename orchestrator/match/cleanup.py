@@ -1,6 +1,6 @@
 """Remove what matches left behind (after a crash or kill -9), found by our labels.
 
-Only objects in this runner's records are touched (:mod:`orchestrator.match.ledger`: labels
+Only objects in this runner's records are touched (:mod:`orchestrator.runtime.ledger`: labels
 alone prove nothing, a team's image can carry them), and only of matches whose orchestrator is
 gone (see :mod:`orchestrator.match.ownership`), or of one match named by the operator (refused
 while its orchestrator runs). Before anything is
@@ -20,8 +20,8 @@ from orchestrator.errors import OrchestratorError
 from orchestrator.match import logfs, ownership
 from orchestrator.match.host import Host
 from orchestrator.match.ownership import LABEL_RUN, MatchRunning, RunRecord
-from orchestrator.match.runtime import ContainerRuntime, ObjectNotFound, ProjectObject
 from orchestrator.match.salvage import salvage
+from orchestrator.runtime.port import ContainerRuntime, ObjectNotFound, ProjectObject
 
 log = logging.getLogger(__name__)
 

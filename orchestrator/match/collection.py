@@ -44,10 +44,10 @@ from orchestrator.match.results import (
     write_report,
     write_results,
 )
-from orchestrator.match.runtime import ContainerRuntime
 from orchestrator.match.safecopy import restrict
 from orchestrator.match.startup import Created
 from orchestrator.match.state import Lifecycle, MatchState
+from orchestrator.runtime.port import ContainerRuntime
 
 log = logging.getLogger(__name__)
 

@@ -26,8 +26,8 @@ from orchestrator.match.monitor import StatsMonitor
 from orchestrator.match.placement import LeaguePlacement
 from orchestrator.match.plan import MatchPlan
 from orchestrator.match.results import Failure, FailureClass
-from orchestrator.match.runtime import ContainerRuntime
 from orchestrator.paths import user_path
+from orchestrator.runtime.port import ContainerRuntime
 from orchestrator.telemetry import TelemetrySource
 
 log = logging.getLogger(__name__)

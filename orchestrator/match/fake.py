@@ -12,7 +12,8 @@ from contracts import EventRecord, SimResult, StateMessage, files
 from orchestrator.bandwidth import AppliedShaping, RobotShaping, TrafficCounters
 from orchestrator.match.logfs import LogFolder
 from orchestrator.match.placement import NodeFirewall
-from orchestrator.match.runtime import (
+from orchestrator.match.safecopy import CopyReport
+from orchestrator.runtime.port import (
     ContainerRequest,
     ContainerState,
     NetworkInfo,
@@ -22,7 +23,6 @@ from orchestrator.match.runtime import (
     StatsSample,
     SubnetInUse,
 )
-from orchestrator.match.safecopy import CopyReport
 
 
 @dataclass(slots=True)

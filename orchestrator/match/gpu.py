@@ -18,13 +18,18 @@ adapter's business (:mod:`orchestrator.engine.gpu`); this module only decides.
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Literal, get_args
 
 from contracts import GPU_ENVIRONMENT  # what was asked (on | auto), read by the simulator
 from orchestrator.errors import ConfigError, Problem
-from orchestrator.match.runtime import ContainerRequest, DeviceRequest
+from orchestrator.runtime.port import (
+    Access,
+    ContainerRequest,
+    DeviceRequest,
+    GpuDetection,
+    GpuProbe,
+)
 
 log = logging.getLogger(__name__)
 
@@ -37,25 +42,6 @@ EGL_DEVICE_ID = 0
 DRIVER_CAPABILITIES = "graphics,compute,utility"  # graphics: the EGL/OpenGL driver libraries
 CDI_ALL_GPUS = "nvidia.com/gpu=all"
 
-Access = Literal["device-request", "cdi"]
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class GpuDetection:
-    """What the host offers: ``access`` is how Docker hands the GPU to a container (None: it
-    cannot, ``reason`` says why), ``devices`` the NVIDIA device files found."""
-
-    access: Access | None
-    devices: tuple[str, ...] = ()
-    reason: str = ""
-    via: str = ""  # what made the engine able to do it ("the nvidia runtime", "CDI spec ...")
-
-    @property
-    def usable(self) -> bool:
-        return self.access is not None
-
-
-GpuProbe = Callable[[], GpuDetection]
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -32,7 +32,7 @@ from orchestrator.engine import (
 from orchestrator.match.admission import SIMULATOR_CPU_SHARES
 from orchestrator.match.gpu import SimulatorGpu
 from orchestrator.match.plan import MatchPlan, RobotPlan
-from orchestrator.match.runtime import (
+from orchestrator.runtime.port import (
     Attachment,
     BindMount,
     ContainerRequest,

@@ -21,6 +21,7 @@ from pathlib import Path
 
 from orchestrator.errors import InfrastructureError
 from orchestrator.match.safecopy import CopyReport, copy_tree, remove_tree, sweep
+from orchestrator.paths import state_dir
 
 log = logging.getLogger(__name__)
 
@@ -38,10 +39,6 @@ def safe_name(text: str) -> str:
     cleaned = re.sub(r"[^A-Za-z0-9_.-]", "-", text)[:40]
     digest = hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()[:32]
     return f"_{cleaned}-{digest}"
-
-
-def state_dir() -> Path:
-    return Path(os.environ.get("HLVS_STATE_DIR", "/var/lib/hlvs-runner"))
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -8,7 +8,7 @@ import time
 from dataclasses import dataclass
 
 from orchestrator.errors import InfrastructureError
-from orchestrator.match.runtime import ContainerRuntime
+from orchestrator.runtime.port import ContainerRuntime
 
 log = logging.getLogger(__name__)
 

@@ -21,10 +21,9 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from orchestrator.errors import ConfigError, Problem
+from orchestrator.runtime.port import ROBOT_CGROUP, ROBOT_CGROUP_PARENT, NodeFirewall
 
 NODES_OPTION = "--league-nodes"
-ROBOT_CGROUP = "hlvs-robots"  # robot containers' parent cgroup, relative to the cgroup v2 root
-ROBOT_CGROUP_PARENT = f"/{ROBOT_CGROUP}"  # as Docker's --cgroup-parent (cgroupfs driver)
 NETNS_OPTION = "--node-netns"
 
 
@@ -66,19 +65,6 @@ class NodeAddresses:
 
     def robot(self, number: int) -> str:
         return self.robots[number]
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class NodeFirewall:
-    """What the robot processes on a robot node may reach: their own API port, the mirror and
-    the GameController's return port on the simulator node, and the teammates' nodes; anything
-    from the opponents' nodes is refused on the way in."""
-
-    simulator: str
-    api_port: int
-    udp_ports: tuple[int, ...]  # on the simulator node: mirror, GameController return
-    teammates: tuple[str, ...]
-    opponents: tuple[str, ...]
 
 
 def parse_nodes(text: str, robot_keys: Sequence[str], *, netns: str | None = None

@@ -43,9 +43,9 @@ from orchestrator.match.host import Host
 from orchestrator.match.monitor import StatsMonitor
 from orchestrator.match.plan import MatchPlan
 from orchestrator.match.results import Failure, FailureClass, RobotRecord
-from orchestrator.match.runtime import ContainerRuntime
 from orchestrator.match.startup import Created, StartedMatch, StartupTimes, start
 from orchestrator.match.state import Lifecycle, MatchState
+from orchestrator.runtime.port import ContainerRuntime
 
 log = logging.getLogger(__name__)
 

@@ -19,8 +19,8 @@ from orchestrator.match import logfs
 from orchestrator.match.layout import ROBOT_CONSOLE_BYTES
 from orchestrator.match.ownership import RunRecord
 from orchestrator.match.results import Failure, FailureClass, write_report, write_results
-from orchestrator.match.runtime import ContainerRuntime, ProjectObject
 from orchestrator.match.safecopy import copy_tree, restrict
+from orchestrator.runtime.port import ContainerRuntime, ProjectObject
 
 log = logging.getLogger(__name__)
 

@@ -109,7 +109,7 @@ class ScrimmageRequest:
 
 
 class ScrimmageOptions(Protocol):
-    """``hlvs scrimmage``'s parsed options (:mod:`hlvs.commands.scrimmage_args`), as
+    """``hlvs scrimmage``'s parsed options (:mod:`orchestrator.scrimmage_options`), as
     :meth:`ScrimmageRequest.from_options` reads them."""
 
     players: int

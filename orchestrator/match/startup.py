@@ -31,7 +31,7 @@ from orchestrator.match.logfs import LogFolder
 from orchestrator.match.placement import ROBOT_CGROUP_PARENT, LeaguePlacement, Node, firewall_for
 from orchestrator.match.plan import MatchPlan, RobotPlan, per_robot_rate_mb_s
 from orchestrator.match.results import Failure, FailureClass, RobotRecord
-from orchestrator.match.runtime import Attachment, ContainerRequest, NetworkInfo, SubnetInUse
+from orchestrator.runtime.port import Attachment, ContainerRequest, NetworkInfo, SubnetInUse
 from orchestrator.telemetry import TelemetrySource
 
 log = logging.getLogger(__name__)

@@ -39,8 +39,7 @@ from fastapi.responses import FileResponse
 from pydantic import BaseModel, Field
 
 from envs import EnvConfigError, EnvError, Monitor
-from service import TeamPrincipal
-from service.deps import SessionRoute
+from service.deps import SessionRoute, TeamPrincipal
 from service.errors import Conflict, InvalidInput, NotFound
 
 router = APIRouter(prefix="/v1/envs", tags=["envs"], route_class=SessionRoute)

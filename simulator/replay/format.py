@@ -34,12 +34,15 @@ from __future__ import annotations
 import json
 import struct
 from dataclasses import dataclass
-from typing import Any, NotRequired, TypedDict
+from typing import TYPE_CHECKING, Any, NotRequired, TypedDict
 
 import numpy as np
 import numpy.typing as npt
 
 from contracts import EventRecord, GameStateRecord, JSONObject
+
+if TYPE_CHECKING:  # the world's own record of its look (the world stays below the replay)
+    from simulator.world.look import LookRecord
 
 MAGIC = b"HLVSREC\0"
 INDEX_MAGIC = b"HLVSIDX\0"
@@ -99,20 +102,6 @@ class SceneRobotRecord(TypedDict):
     number: int
     model: str
     root_body: int  # index of the robot's root body (-1: not found)
-
-
-class LookRecord(TypedDict):
-    """A match's look, as a viewer draws it simply (``simulator.world.look.Look.summary``)."""
-
-    texture_seed: int
-    turf: int
-    ball: int
-    background: int
-    luminosity: float
-    turf_colors: list[list[float]]  # the two stripe colours
-    stripe_m: float
-    ball_colors: list[list[float]]
-    sky_colors: list[list[float]]  # sky top, horizon, stands
 
 
 class SceneRecord(TypedDict):

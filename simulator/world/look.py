@@ -14,15 +14,28 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import TYPE_CHECKING, Any
+from typing import Any, TypedDict
 
 import mujoco
 import numpy as np
 
 from simulator.world import textures
 
-if TYPE_CHECKING:
-    from simulator.replay.format import LookRecord
+
+class LookRecord(TypedDict):
+    """A match's look, as a viewer draws it simply (:meth:`Look.summary`); the ``look`` of a
+    replay's scene (:class:`simulator.replay.format.SceneRecord`)."""
+
+    texture_seed: int
+    turf: int
+    ball: int
+    background: int
+    luminosity: float
+    turf_colors: list[list[float]]  # the two stripe colours
+    stripe_m: float
+    ball_colors: list[list[float]]
+    sky_colors: list[list[float]]  # sky top, horizon, stands
+
 
 RGB = tuple[float, float, float]
 

@@ -201,7 +201,7 @@ def test_match_exit_codes_and_json(
     failure: tuple[str, str] | None, code: ExitCode,
 ) -> None:
     from contracts.match_results import MatchLimits, MatchResults
-    from hlvs.commands.play import summarize
+    from hlvs.commands.outcome import summarize
     from orchestrator.match import Failure, FailureClass, MatchOutcome
 
     failed = Failure(failure_class=FailureClass(failure[0]), cause=failure[1]) if failure \

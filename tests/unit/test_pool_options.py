@@ -10,7 +10,7 @@ from typing import Any
 import pytest
 
 from contracts.match_results import Forfeit, MatchLimits, MatchReport, MatchResults
-from hlvs.commands.play import summarize
+from hlvs.commands.outcome import summarize
 from hlvs.commands.pooled import read_outcome
 from orchestrator.config.schedule import load_schedule
 from orchestrator.errors import ConfigError

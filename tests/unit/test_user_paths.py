@@ -88,7 +88,7 @@ def test_schedule_status_names_the_resolved_state_file(
 def test_watch_hint_names_the_replay_as_seen_from_the_cwd(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from hlvs.commands.play import watch_hint
+    from hlvs.commands.outcome import watch_hint
 
     out = tmp_path / "matches" / "scrimmage"
     assert watch_hint(out) == []  # nothing to watch without a replay

@@ -18,7 +18,7 @@ import pytest
 from orchestrator.engine import LABEL_MATCH, LABEL_PROJECT, LABEL_ROLE
 from orchestrator.engine.containers import DockerRuntime
 from orchestrator.match.ownership import LABEL_RUN
-from orchestrator.match.runtime import ContainerRequest
+from orchestrator.runtime.port import ContainerRequest
 from tests.conftest import TEST_LABEL
 from tests.integration.attack.conftest import REPO
 

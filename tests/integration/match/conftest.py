@@ -28,7 +28,7 @@ from orchestrator.match import (
     TeamPlan,
     cleanup,
 )
-from orchestrator.match.runtime import ContainerRequest, NetworkInfo, NetworkRequest
+from orchestrator.runtime.port import ContainerRequest, NetworkInfo, NetworkRequest
 from orchestrator.telemetry import ZenohTelemetry
 from testkit.specs import match_spec
 from tests.conftest import TEST_LABEL

@@ -11,7 +11,7 @@ from typing import Any
 import pytest
 
 from hlvs.cli import main as hlvs
-from hlvs.commands.scrimmage_args import add_arguments
+from orchestrator import add_scrimmage_arguments as add_arguments
 from orchestrator.errors import OrchestratorError
 from orchestrator.match.logfs import state_dir
 from orchestrator.match.scrimmage import ScrimmageRequest, write_files

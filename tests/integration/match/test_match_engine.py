@@ -10,7 +10,7 @@ from typing import Any
 import pytest
 
 from orchestrator.errors import InfrastructureError
-from orchestrator.match.runtime import (
+from orchestrator.runtime.port import (
     ContainerRequest,
     NetworkRequest,
     ObjectNotFound,

@@ -13,7 +13,7 @@ from typing import Any
 import pytest
 
 from orchestrator.match.logfs import state_dir
-from orchestrator.match.runtime import ContainerRequest, NetworkRequest
+from orchestrator.runtime.port import ContainerRequest, NetworkRequest
 from tests.integration.match.conftest import MatchFactory
 
 pytestmark = [pytest.mark.docker, pytest.mark.root]

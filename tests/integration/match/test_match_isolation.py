@@ -10,7 +10,7 @@ import socket
 import pytest
 
 from orchestrator.match.layout import Subnet
-from orchestrator.match.runtime import ContainerRequest, NetworkRequest
+from orchestrator.runtime.port import ContainerRequest, NetworkRequest
 from tests.integration.match.conftest import MatchFactory
 
 pytestmark = [pytest.mark.docker, pytest.mark.root]

@@ -10,7 +10,7 @@ import pytest
 
 from orchestrator.config import Limits
 from orchestrator.engine import LABEL_ROLE
-from orchestrator.match.runtime import ContainerRequest, NetworkRequest
+from orchestrator.runtime.port import ContainerRequest, NetworkRequest
 from tests.integration.match.conftest import MatchFactory
 
 pytestmark = [pytest.mark.docker, pytest.mark.root]

@@ -10,13 +10,13 @@ from pathlib import Path
 import pytest
 
 from hlvs.cli import main as hlvs
-from hlvs.commands import scrimmage_args
+from orchestrator import add_scrimmage_arguments
 from orchestrator.match import scrimmage
 
 
 def _files(folder: Path) -> Path:
     parser = argparse.ArgumentParser()
-    scrimmage_args.add_arguments(parser)
+    add_scrimmage_arguments(parser)
     args = parser.parse_args(["--red-image", "team/red:1", "--blue-image", "team/blue:1",
                               "--match-id", "hostile-config"])
     return scrimmage.write_files(scrimmage.ScrimmageRequest.from_options(args), folder)

@@ -19,7 +19,7 @@ from orchestrator.match import MatchRunner, RunOptions
 from orchestrator.match.fake import FakeHost, FakeRuntime
 from orchestrator.match.gpu import GpuDetection, GpuOrigin, SimulatorGpu, simulator_gpu
 from orchestrator.match.layout import simulator_request
-from orchestrator.match.runtime import ContainerRequest, DeviceRequest
+from orchestrator.runtime.port import ContainerRequest, DeviceRequest
 from tests.unit.match.test_match_runner import _plan
 
 GPU_FILES = ("/dev/nvidia0", CONTROL_DEVICE)

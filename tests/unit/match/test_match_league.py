@@ -158,7 +158,7 @@ def test_schedule_pool_section_takes_a_placement(tmp_path: Path) -> None:
 def test_league_schedule_asks_a_node_per_robot(tmp_path: Path) -> None:
     import argparse
 
-    from hlvs.commands.scrimmage_args import add_arguments
+    from orchestrator import add_scrimmage_arguments as add_arguments
     from orchestrator.config.schedule import SchedulePool
     from orchestrator.match import scrimmage
     from tournament.services import _robot_nodes
@@ -192,7 +192,7 @@ def test_service_worker_asks_a_node_per_robot_in_league_placement(tmp_path: Path
     import argparse
     from types import SimpleNamespace
 
-    from hlvs.commands.scrimmage_args import add_arguments
+    from orchestrator import add_scrimmage_arguments as add_arguments
     from orchestrator.match import scrimmage
     from service.settings import Settings
     from service.worker import QueueWorker

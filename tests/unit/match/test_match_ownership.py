@@ -17,7 +17,7 @@ from orchestrator.match.cleanup import cleanup, plan_cleanup
 from orchestrator.match.fake import FakeHost, FakeRuntime
 from orchestrator.match.layout import labels
 from orchestrator.match.ownership import LABEL_RUN, MatchRunning, RunRecord
-from orchestrator.match.runtime import ContainerRequest
+from orchestrator.runtime.port import ContainerRequest
 
 
 @pytest.fixture(autouse=True)
@@ -118,7 +118,7 @@ def test_cleanup_leaves_a_container_that_only_carries_our_labels(tmp_path: Path)
 
 
 def test_ledger_records_ids_and_forgets_them(state: Path) -> None:
-    from orchestrator.match import ledger
+    from orchestrator.runtime import ledger
 
     cid = "ab" * 32
     assert not ledger.created(cid)

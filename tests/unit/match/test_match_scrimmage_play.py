@@ -13,7 +13,7 @@ import pytest
 from contracts.errors import ContractError
 from contracts.match_results import MatchLimits
 from contracts.sim_result import SimResult
-from hlvs.commands.scrimmage_args import add_arguments
+from orchestrator import add_scrimmage_arguments as add_arguments
 from orchestrator.config.loader import load_game
 from orchestrator.errors import ConfigError
 from orchestrator.match.results import build_results

@@ -25,7 +25,7 @@ from contracts.timing import (
 )
 from envs.errors import EnvConfigError
 from envs.session_spec import SessionSpec
-from hlvs.commands.scrimmage_args import add_arguments
+from orchestrator import add_scrimmage_arguments as add_arguments
 from orchestrator.config.loader import load_game
 from orchestrator.errors import ConfigError
 from orchestrator.match.results import RobotRecord, play_failure

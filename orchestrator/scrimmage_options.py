@@ -1,12 +1,14 @@
-"""The options of ``hlvs scrimmage`` (also used by ``hlvs bench bringup``); standard library only,
-so that ``hlvs --help`` does not import the match machinery."""
+"""The command-line options of a scrimmage (``hlvs scrimmage``, and the benchmarks that play
+one: ``hlvs bench bringup``, ``hog``, ``scrimmage``), parsed into a
+:class:`orchestrator.match.ScrimmageRequest`; standard library only, so that ``hlvs --help``
+does not import the match machinery."""
 
 from __future__ import annotations
 
 import argparse
 
 from contracts import ADULT_SCRIMMAGE, MIN_PLAYING_S, SCRIMMAGE
-from orchestrator import user_path
+from orchestrator.paths import user_path
 
 
 def _model(text: str) -> str:
@@ -15,7 +17,7 @@ def _model(text: str) -> str:
     return text if text in ("adult-default", "kid-default") else str(user_path(text))
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
+def add_scrimmage_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", type=user_path, default="matches/scrimmage",
                         help="output folder (default: matches/scrimmage)")
     parser.add_argument("--red-image", default=None,
@@ -79,4 +81,4 @@ def add_gpu_argument(parser: argparse.ArgumentParser, *, default: str | None) ->
                         + (default or "gpu of game.json, else auto") + ")")
 
 
-__all__ = ["add_arguments", "add_gpu_argument"]
+__all__ = ["add_gpu_argument", "add_scrimmage_arguments"]

@@ -1,4 +1,5 @@
-"""The container runtime boundary: what the match runner asks of a container engine.
+"""The container runtime boundary: what the match runner asks of a container engine, and what
+the engine finds on the host (:class:`GpuDetection`).
 
 The real implementation is :class:`orchestrator.engine.containers.DockerRuntime` (the only code
 that imports ``docker``); :class:`orchestrator.match.fake.FakeRuntime` stands in for unit tests.
@@ -8,10 +9,10 @@ engine fails; ``NotFound`` is reported as :class:`ObjectNotFound`.
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Protocol
+from typing import Literal, Protocol
 
 from orchestrator.errors import InfrastructureError
 
@@ -151,7 +152,7 @@ class ProjectObject:
     id: str
     name: str
     labels: Mapping[str, str]
-    created: bool = True  # in this runner's records (:mod:`orchestrator.match.ledger`)
+    created: bool = True  # in this runner's records (:mod:`orchestrator.runtime.ledger`)
 
 
 class ContainerRuntime(Protocol):
@@ -185,15 +186,60 @@ class ContainerRuntime(Protocol):
     def list_project(self, *, match_id: str | None = None) -> list[ProjectObject]: ...
 
 
+Access = Literal["device-request", "cdi"]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class GpuDetection:
+    """What the host offers (:func:`orchestrator.engine.detect_nvidia`): ``access`` is how
+    Docker hands the GPU to a container (None: it cannot, ``reason`` says why), ``devices``
+    the NVIDIA device files found."""
+
+    access: Access | None
+    devices: tuple[str, ...] = ()
+    reason: str = ""
+    via: str = ""  # what made the engine able to do it ("the nvidia runtime", "CDI spec ...")
+
+    @property
+    def usable(self) -> bool:
+        return self.access is not None
+
+
+GpuProbe = Callable[[], GpuDetection]
+
+
+ROBOT_CGROUP = "hlvs-robots"  # robot containers' parent cgroup, relative to the cgroup v2 root
+ROBOT_CGROUP_PARENT = f"/{ROBOT_CGROUP}"  # as Docker's --cgroup-parent (cgroupfs driver)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class NodeFirewall:
+    """What the robot processes on a robot node may reach: their own API port, the mirror and
+    the GameController's return port on the simulator node, and the teammates' nodes; anything
+    from the opponents' nodes is refused on the way in."""
+
+    simulator: str
+    api_port: int
+    udp_ports: tuple[int, ...]  # on the simulator node: mirror, GameController return
+    teammates: tuple[str, ...]
+    opponents: tuple[str, ...]
+
+
 __all__ = [
+    "ROBOT_CGROUP",
+    "ROBOT_CGROUP_PARENT",
+    "Access",
     "Attachment",
     "BindMount",
     "ContainerRequest",
     "ContainerRuntime",
     "ContainerState",
     "DeviceRequest",
+    "GpuDetection",
+    "GpuProbe",
     "NetworkInfo",
     "NetworkRequest",
+    "NodeFirewall",
     "ObjectNotFound",
     "ProjectObject",
     "StatsSample",

@@ -15,7 +15,7 @@ import os
 import re
 from pathlib import Path
 
-from orchestrator.match.logfs import state_dir
+from orchestrator.paths import state_dir
 
 log = logging.getLogger(__name__)
 
