@@ -1,8 +1,8 @@
 """The I/O thread of async and pipelined stepping: frames queued by the step thread all reach
 the client, in order; when steps come fast the thread polls and the step thread stops waking it
 (no write to the wake pipe), and its polled waits follow the steps' period with sub-millisecond
-timeouts; when steps come slowly (a match paced to real time) every step wakes it. A socket whose descriptor number ``select`` cannot watch is served
-too."""
+timeouts; when steps come slowly (a match paced to real time) every step wakes it. A socket
+whose descriptor number ``select`` cannot watch is served too."""
 
 from __future__ import annotations
 
