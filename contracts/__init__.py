@@ -93,6 +93,7 @@ if TYPE_CHECKING:
         SimResult,
         SpoofingAttempt,
     )
+    from contracts.tally import Tally
     from contracts.telemetry import (
         EventRecord,
         GameStateRecord,
@@ -181,6 +182,7 @@ __all__ = [
     "StateMessage",
     "SteppingMode",
     "TEST_MATCH",
+    "Tally",
     "TeamColor",
     "TeamColourCode",
     "TeamInfo",
@@ -244,6 +246,7 @@ if not TYPE_CHECKING:
             "EventRecord", "GameStateRecord", "PenaltyRecord", "RobotTraffic", "StateMessage",
             "TrafficSample",
         ),
+        "contracts.tally": ("Tally",),
         "contracts.timing": (
             "ADULT_SCRIMMAGE", "ENVIRONMENT", "MIN_PLAYING_S", "MIN_READY_S", "OFFICIAL",
             "REMOVAL_PENALTY_S", "SCRIMMAGE", "SET_TO_PLAY_S", "TEST_MATCH", "TimingError",

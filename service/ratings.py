@@ -34,7 +34,7 @@ from openskill.models import PlackettLuce
 from sqlalchemy import exists, func, select
 from sqlalchemy.orm import Session
 
-from contracts import ContractError, MatchResults, files
+from contracts import ContractError, MatchResults, Tally, files
 from service.db import Submission, SubmissionState, Team, now, utc
 from service.db.ladder import RatedMatch
 from service.matchfiles import OWN_COLOR
@@ -181,16 +181,12 @@ def _add(session: Session, *, source: str, ref: str, red: str, blue: str, outcom
 
 # the table ----------------------------------------------------------------------------------
 @dataclass(slots=True)
-class TeamRating:
-    team: str
+class TeamRating(Tally):
+    """A team on the ladder: its :class:`contracts.Tally` of rated matches and its OpenSkill
+    rating."""
+
     mu: float = MODEL.mu
     sigma: float = MODEL.sigma
-    played: int = 0
-    won: int = 0
-    drawn: int = 0
-    lost: int = 0
-    goals_for: int = 0
-    goals_against: int = 0
 
     @property
     def rating(self) -> float:
@@ -250,15 +246,9 @@ def rate(matches: Iterable[RatedMatch], teams: Iterable[str] = ()) -> Ladder:
                 (red, new_red, match.red_goals, match.blue_goals, "red"),
                 (blue, new_blue, match.blue_goals, match.red_goals, "blue")):
             me.mu, me.sigma = float(new.mu), float(new.sigma)
-            me.played += 1
-            me.goals_for += goals_for
-            me.goals_against += goals_against
-            if winner == "draw":
-                me.drawn += 1
-            elif winner == color:
-                me.won += 1
-            else:
-                me.lost += 1
+            # the winner, not the goals: a forfeit is recorded 0:0
+            me.count(goals_for, goals_against,
+                     "drawn" if winner == "draw" else "won" if winner == color else "lost")
         ladder.games.append(RatedGame(
             id=match.id, source=match.source, ref=match.ref, played_at=utc(match.played_at),
             winner=winner,

@@ -20,6 +20,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from itertools import groupby
 
+from contracts import Tally
 from tournament.state import MatchRow
 
 HEAD_TO_HEAD = "head-to-head"
@@ -29,23 +30,14 @@ LOTS = "drawing of lots"
 
 
 @dataclass(slots=True)
-class Standing:
-    team: str
-    played: int = 0
-    won: int = 0
-    drawn: int = 0
-    lost: int = 0
-    goals_for: int = 0
-    goals_against: int = 0
+class Standing(Tally):
+    """A team's line of the table: its :class:`contracts.Tally`, points and the tie-break."""
+
     decided_by: str = ""  # the tie-break that placed this team above the next one
 
     @property
     def points(self) -> int:
         return 3 * self.won + self.drawn
-
-    @property
-    def goal_difference(self) -> int:
-        return self.goals_for - self.goals_against
 
     def as_dict(self) -> dict[str, int | str]:
         return {
@@ -89,17 +81,8 @@ def _table(games: Iterable[_Game], teams: Iterable[str]) -> dict[str, Standing]:
     for game in games:
         red = table.setdefault(game.red, Standing(team=game.red))
         blue = table.setdefault(game.blue, Standing(team=game.blue))
-        for me, goals_for, goals_against in ((red, game.red_goals, game.blue_goals),
-                                             (blue, game.blue_goals, game.red_goals)):
-            me.played += 1
-            me.goals_for += goals_for
-            me.goals_against += goals_against
-            if goals_for > goals_against:
-                me.won += 1
-            elif goals_for < goals_against:
-                me.lost += 1
-            else:
-                me.drawn += 1
+        red.count(game.red_goals, game.blue_goals)
+        blue.count(game.blue_goals, game.red_goals)
     return table
 
 
