@@ -350,7 +350,14 @@ def collect_results(loaded: LoadedGame, folder: Path) -> MatchResults:
     from the simulator's ``out/sim_result.json``, classified as ``hlvs match`` classifies a
     match (a game that reached FINISHED without football fails as not played). What compose
     does not record (robot exit codes, resource peaks, bandwidth) stays empty."""
-    from contracts import ContractError, Failure, FailureClass, MatchLimits, SimResult
+    from contracts import (
+        ContractError,
+        Failure,
+        FailureClass,
+        MatchLimits,
+        RobotResult,
+        SimResult,
+    )
     from orchestrator.match.results import (
         RobotRecord,
         build_results,
@@ -369,7 +376,7 @@ def collect_results(loaded: LoadedGame, folder: Path) -> MatchResults:
         failure = Failure(failure_class=FailureClass.SIMULATOR,
                           cause=f"no usable {sim_path}: {exc} (did `docker compose up` run?)")
     robots = [RobotRecord(key=f"{r.color}-{r.number}", color=r.color, number=r.number,
-                          image=r.image) for r in plan.robots]
+                          entry=RobotResult(image=r.image)) for r in plan.robots]
     if sim is not None and not sim.finished:
         failure = Failure(failure_class=FailureClass.REFEREE,
                           cause=f"the game ended in state {sim.state}, not FINISHED")

@@ -113,8 +113,7 @@ class _Collection:
         self.lifecycle = lifecycle
         self.created = created
         self.played = played
-        self.records = {key: replace(r, limits=dict(r.limits))
-                        for key, r in played.robots.items()}
+        self.records = {key: replace(r) for key, r in played.robots.items()}
         self.failure = played.failure
         # the teams' logs cut or lost in collection: {"robot", "what", "reason"} (report.json)
         self.logs_cut: list[dict[str, str]] = []
@@ -213,20 +212,19 @@ class _Collection:
                 log.warning("match %s: no traffic counters for %s: %s", self.deps.plan.match_id,
                             key, exc)
                 continue
-            record.sent_bytes = counters.sent_bytes
-            record.received_bytes = counters.received_bytes
+            record.entry = replace(record.entry, sent_bytes=counters.sent_bytes,
+                                   received_bytes=counters.received_bytes)
 
     def _collect_robot(self, key: str, container_id: str) -> None:
         deps = self.deps
         record = self.records[key]
         folder = deps.options.out_dir / "teams" / record.color / str(record.number)
         state = deps.runtime.inspect(container_id)
-        record.exit_code = state.exit_code
-        record.oom_killed = record.oom_killed or state.oom_killed
-        record.restarts = state.restart_count
         peaks = deps.monitor.peaks(key)
-        record.cpu_peak_percent = peaks.cpu_percent
-        record.memory_peak_bytes = peaks.memory_bytes
+        record.entry = replace(record.entry, exit_code=state.exit_code,
+                               oom_killed=record.entry.oom_killed or state.oom_killed,
+                               restarts=state.restart_count, cpu_peak_percent=peaks.cpu_percent,
+                               memory_peak_bytes=peaks.memory_bytes)
         cap = layout.ROBOT_CONSOLE_BYTES // 2  # per stream (the engine keeps less of a flood)
         cut = deps.runtime.save_logs(container_id, stdout=folder / "stdout.log",
                                      stderr=folder / "stderr.log", max_bytes=cap)
@@ -279,7 +277,8 @@ class _Collection:
         deps = self.deps
         limit = int(deps.plan.limits.log_folder_gb * 1e9)
         report = deps.host.collect_logs(folder, destination, limit_bytes=limit)
-        self.records[key].log_folder = report.record()
+        record = self.records[key]
+        record.entry = replace(record.entry, log_folder=report.record())
         if report.stopped:
             self.logs_cut.append({"robot": key, "what": "robocup-logs",
                                   "reason": report.stopped})

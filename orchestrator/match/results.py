@@ -5,7 +5,7 @@ match recorded: :class:`RobotRecord` per robot (filled in as the match runs), th
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from contracts import (
@@ -15,13 +15,11 @@ from contracts import (
     Failure,
     FailureClass,
     Forfeit,
-    LogFolderCopy,
     MatchLimits,
     MatchReport,
     MatchResults,
     RobotApiStats,
     RobotResult,
-    Scalar,
     SimResult,
     TimingSpec,
     files,
@@ -34,47 +32,20 @@ COLORS: tuple[Color, Color] = ("red", "blue")
 
 @dataclass(slots=True, kw_only=True)
 class RobotRecord:
-    """Everything recorded about one robot during the match (filled in as the match runs)."""
+    """One robot during the match: who it is, and its entry of ``results.json`` as recorded so
+    far (:class:`contracts.RobotResult`, replaced as the match runs: its image's digest, its
+    container and limits, its exit, its peaks, its traffic, its log folder)."""
 
     key: str
     color: str
     number: int
-    image: str | None
-    digest: str | None = None
-    image_error: str | None = None
-    container: str | None = None  # container name when one was started
-    startup_error: str | None = None
-    exit_code: int | None = None
-    oom_killed: bool = False
-    restarts: int = 0
-    exited_during_game: bool = False
-    cpu_peak_percent: float = 0.0
-    memory_peak_bytes: int = 0
-    sent_bytes: int | None = None
-    received_bytes: int | None = None
-    limits: dict[str, Scalar] = field(default_factory=dict)
-    log_folder: LogFolderCopy | None = None  # what collection copied and skipped
+    entry: RobotResult
 
     def result(self, api: RobotApiStats | None, *, spoofing_attempts: int = 0) -> RobotResult:
-        return RobotResult(
-            image=self.image,
-            digest=self.digest,
-            image_error=self.image_error,
-            container=self.container,
-            startup_error=self.startup_error,
-            exit_code=self.exit_code,
-            oom_killed=self.oom_killed,
-            restarts=self.restarts,
-            exited_during_game=self.exited_during_game,
-            cpu_peak_percent=round(self.cpu_peak_percent, 1),
-            memory_peak_bytes=self.memory_peak_bytes,
-            sent_bytes=self.sent_bytes,
-            received_bytes=self.received_bytes,
-            limits=dict(self.limits),
-            api=api,
-            log_folder=self.log_folder,
-            spoofing_attempts=spoofing_attempts,
-        )
+        """The robot's entry of ``results.json``, with what the simulator saw of it."""
+        return replace(self.entry, cpu_peak_percent=round(self.entry.cpu_peak_percent, 1),
+                       limits=dict(self.entry.limits), api=api,
+                       spoofing_attempts=spoofing_attempts)
 
 
 def build_results(
@@ -184,12 +155,13 @@ def team_warnings(robots: list[RobotRecord], api_stats: dict[str, RobotApiStats]
     none of which ever connected to the simulator."""
     warnings = []
     for color in ("red", "blue"):
-        started = [r for r in robots if r.color == color and r.container is not None]
+        started = [r for r in robots if r.color == color and r.entry.container is not None]
         if not started:
             continue
-        if all(r.exited_during_game for r in started):
+        if all(r.entry.exited_during_game for r in started):
             warnings.append(f"every robot of {color} exited during the game ("
-                            + ", ".join(f"{r.key}: exit code {r.exit_code}" for r in started)
+                            + ", ".join(f"{r.key}: exit code {r.entry.exit_code}"
+                                        for r in started)
                             + ")")
         if not any(_connected(api_stats, r.key) for r in started):
             warnings.append(f"no robot of {color} ever connected to the simulator")

@@ -25,10 +25,10 @@ import logging
 import threading
 import time
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
-from contracts import Color, Forfeit, MatchResults, StateMessage, files
+from contracts import Color, Forfeit, MatchResults, RobotResult, StateMessage, files
 from orchestrator.errors import OrchestratorError
 from orchestrator.match.collection import Played, collect, read_sim_result, simulator_stderr_tail
 from orchestrator.match.deps import MatchDeps, RunOptions, TelemetryFactory
@@ -135,7 +135,8 @@ class MatchRunner:
         lifecycle = Lifecycle(plan.match_id, clock=self._deps.clock)
         lifecycle.observers.append(self._entered)
         game = _Game(robots={
-            r.key: RobotRecord(key=r.key, color=r.color, number=r.number, image=r.image)
+            r.key: RobotRecord(key=r.key, color=r.color, number=r.number,
+                               entry=RobotResult(image=r.image))
             for r in plan.robots
         })
         try:
@@ -199,8 +200,7 @@ class MatchRunner:
         usable: dict[str, int] = {"red": 0, "blue": 0}
         for key, (digest, error) in resolved.items():
             record = game.robots[key]
-            record.digest = digest
-            record.image_error = error
+            record.entry = replace(record.entry, digest=digest, image_error=error)
             if error is None:
                 usable[record.color] += 1
             else:
@@ -208,8 +208,8 @@ class MatchRunner:
                             plan.match_id, key, error)
         forfeiting: list[Color] = [c for c in ("red", "blue") if usable[c] == 0]
         first_error = {
-            color: next((f"{r.key}: {r.image_error}" for r in game.robots.values()
-                         if r.color == color and r.image_error), "no players")
+            color: next((f"{r.key}: {r.entry.image_error}" for r in game.robots.values()
+                         if r.color == color and r.entry.image_error), "no players")
             for color in forfeiting
         }
         if len(forfeiting) == 2:
@@ -275,7 +275,7 @@ class MatchRunner:
         match_id = self._deps.plan.match_id
         for key, container_id in started.robot_ids.items():
             record = game.robots[key]
-            if record.exited_during_game:
+            if record.entry.exited_during_game:
                 continue
             try:
                 state = self._deps.runtime.inspect(container_id)
@@ -283,11 +283,10 @@ class MatchRunner:
                 log.warning("match %s: cannot inspect robot %s: %s", match_id, key, exc)
                 continue
             if state.exited:
-                record.exited_during_game = True
-                record.exit_code = state.exit_code
-                record.oom_killed = state.oom_killed
+                record.entry = replace(record.entry, exited_during_game=True,
+                                       exit_code=state.exit_code, oom_killed=state.oom_killed)
                 self.events.publish(RobotExited(
-                    key=key, color=record.color, image=record.image,
+                    key=key, color=record.color, image=record.entry.image,
                     exit_code=state.exit_code, oom_killed=state.oom_killed))
                 log.info(
                     "match %s: robot %s exited during the game (code %s%s); the game goes on",

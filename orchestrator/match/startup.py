@@ -19,7 +19,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from contracts import GC_RETURN_PORT, MAX_RENDER_PROCESSES, MatchSpec, files
+from contracts import GC_RETURN_PORT, MAX_RENDER_PROCESSES, MatchSpec, Scalar, files
 from orchestrator.bandwidth import AppliedShaping, RobotShaping, mb_s_to_bit
 from orchestrator.errors import InfrastructureError, OrchestratorError
 from orchestrator.match import layout
@@ -108,7 +108,7 @@ def start(deps: MatchDeps, created: Created, robots: Mapping[str, RobotRecord],
     request = replace(request, cpuset_cpus=sets.simulator)
     mark("spec")
     robot_steps_s: dict[str, dict[str, float]] = {
-        key: {} for key, record in robots.items() if record.image_error is None}
+        key: {} for key, record in robots.items() if record.entry.image_error is None}
     began, simulator_started_at = _start_containers(
         deps, created, robots, request, robot_cpuset=sets.robots, robot_steps_s=robot_steps_s)
     phases_s["simulator"] = round(simulator_started_at - began, 3)
@@ -131,12 +131,12 @@ def start(deps: MatchDeps, created: Created, robots: Mapping[str, RobotRecord],
 def _team_failure(deps: MatchDeps, robots: Mapping[str, RobotRecord]) -> Failure | None:
     failure = None
     for team in deps.plan.teams:
-        tried = [r for r in team.robots if robots[r.key].image_error is None]
-        failed = [r for r in tried if robots[r.key].startup_error is not None]
+        tried = [r for r in team.robots if robots[r.key].entry.image_error is None]
+        failed = [r for r in tried if robots[r.key].entry.startup_error is not None]
         if tried and len(failed) == len(tried):
             failure = deps.fail(failure, FailureClass.TEAM_STARTUP,
                                 f"no robot of {team.color} could be started: "
-                                f"{robots[failed[0].key].startup_error}")
+                                f"{robots[failed[0].key].entry.startup_error}")
     return failure
 
 
@@ -272,8 +272,9 @@ def _start_containers(
     """The simulator and every robot with an image; returns when the simulator's start began
     and when it was done."""
     plan = deps.plan
-    startable = [r for r in plan.robots if robots[r.key].image_error is None]
-    team_size = {team.color: len([r for r in team.robots if robots[r.key].image_error is None])
+    startable = [r for r in plan.robots if robots[r.key].entry.image_error is None]
+    team_size = {team.color: len([r for r in team.robots
+                                  if robots[r.key].entry.image_error is None])
                  for team in plan.teams}
     # the simulator and the robots start at the same time (robot clients retry until the
     # simulator listens); the simulator is submitted first so that it boots while they start
@@ -343,7 +344,7 @@ def _start_robot(
         mark("shaping")
         folder, scratch = made.result()
         mark("folders")
-        record.limits = {
+        robot_limits: dict[str, Scalar] = {
             "nano_cpus": int(limits.cpus * 1e9),
             "memory_bytes": int(limits.memory_gb * 1e9),
             "pids": limits.pids,
@@ -360,7 +361,7 @@ def _start_robot(
             gamecontroller_ip=team_net.simulator,
         )
         request = layout.robot_request(
-            replace(robot, image=record.digest or robot.image),
+            replace(robot, image=record.entry.digest or robot.image),
             prefix=deps.prefix, holder_id=holder_id, environment=environment,
             logs_dir=folder.path, limits=limits, match_id=plan.match_id,
             extra_labels=deps.options.extra_labels,
@@ -371,10 +372,11 @@ def _start_robot(
         if placement is not None:  # the node's epilog finds it by this label
             node = placement.robots[robot.key].name
             request = replace(request, labels={**request.labels, layout.LABEL_NODE: node})
-        record.limits["cpuset"] = request.cpuset_cpus
+        robot_limits["cpuset"] = request.cpuset_cpus
+        record.entry = replace(record.entry, limits=robot_limits)
         container_id = deps.runtime.create_container(request)
         created.robot_ids[robot.key] = container_id
-        record.container = request.name
+        record.entry = replace(record.entry, container=request.name)
         mark("create")
         deps.runtime.start(container_id)
         mark("start")
@@ -382,9 +384,9 @@ def _start_robot(
         log.info("match %s: robot %s started (%s, %s)", plan.match_id, robot.key, robot.image,
                  team_net.robot(robot.number))
     except OrchestratorError as exc:
-        record.startup_error = str(exc)
+        record.entry = replace(record.entry, startup_error=str(exc))
         deps.events.publish(RobotNotStarted(key=robot.key, color=record.color,
-                                            image=record.image, cause=str(exc)))
+                                            image=record.entry.image, cause=str(exc)))
         log.warning("match %s: robot %s could not be started: %s", plan.match_id, robot.key, exc)
     finally:
         made.exception()  # made and recorded (for the teardown) even when the robot failed

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 
+from contracts import RobotResult
 from orchestrator.errors import InfrastructureError, OrchestratorError
 from orchestrator.match import EventStream, FailureClass, MatchFailed, MatchState, RobotRecord
 from orchestrator.match.collection import Played, collect
@@ -31,8 +32,9 @@ def _deps(tmp_path: Path, runtime: FakeRuntime, host: FakeHost) -> MatchDeps:
 
 
 def _robots(deps: MatchDeps) -> dict[str, RobotRecord]:
-    return {r.key: RobotRecord(key=r.key, color=r.color, number=r.number, image=r.image,
-                               digest=f"sha256:{r.key}") for r in deps.plan.robots}
+    return {r.key: RobotRecord(key=r.key, color=r.color, number=r.number,
+                               entry=RobotResult(image=r.image, digest=f"sha256:{r.key}"))
+            for r in deps.plan.robots}
 
 
 def _starting(deps: MatchDeps) -> Lifecycle:
@@ -53,13 +55,13 @@ def test_collect_turns_a_played_record_into_the_results(tmp_path: Path) -> None:
     assert sorted(created.networks) == ["blue", "control", "red"]
     assert set(started.times.phases_s) == {"networks", "firewall", "spec", "simulator",
                                            "containers"}
-    assert robots["red-2"].container == "hlvs-u1-red-2"  # filled in as it started
+    assert robots["red-2"].entry.container == "hlvs-u1-red-2"  # filled in as it started
     # the game: red 1 is killed for its memory, then the simulator ends it
     runtime.exit(started.robot_ids["red-1"], 137, oom=True)
     assert runtime.inspect(started.simulator_id).exited
     played = Played(
-        robots={**robots, "red-1": replace(robots["red-1"], exited_during_game=True,
-                                           exit_code=137, oom_killed=True)},
+        robots={**robots, "red-1": replace(robots["red-1"], entry=replace(
+            robots["red-1"].entry, exited_during_game=True, exit_code=137, oom_killed=True))},
         failure=None, forfeit=None, bringup_s=1.5,
     )
     results = collect(deps, lifecycle, created, played)
@@ -68,7 +70,7 @@ def test_collect_turns_a_played_record_into_the_results(tmp_path: Path) -> None:
     red1, red2 = results.robots["red-1"], results.robots["red-2"]
     assert red1.exited_during_game and red1.oom_killed and red1.exit_code == 137
     assert red2.sent_bytes == 110 and red2.cpu_peak_percent == 150.0
-    assert played.robots["red-2"].sent_bytes is None  # what it was given is left as it was
+    assert played.robots["red-2"].entry.sent_bytes is None  # what it was given is left as it was
     assert lifecycle.state is MatchState.DONE
     assert set(results.timings_s) >= {"pulling", "starting", "stopping", "collecting"}
     assert runtime.containers == {} and runtime.networks == {} and host.isolated == []

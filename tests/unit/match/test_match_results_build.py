@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 
-from contracts.match_results import Forfeit, MatchLimits, MatchResults
+from contracts.match_results import Forfeit, MatchLimits, MatchResults, RobotResult
 from contracts.sim_result import SimResult, SpoofingAttempt, SpoofingRecord
 from orchestrator.match.results import RobotRecord, build_results
 
@@ -25,7 +25,8 @@ def test_spoofing_is_counted_per_sending_robot() -> None:
         spoofing=SpoofingRecord(total=7, attempts=(_attempt("red-1", 5), _attempt("red-1", 1),
                                                    _attempt(None, 1))),
     )  # fmt: skip
-    robots = [RobotRecord(key=k, color=k[:-2], number=1, image="i", container=f"c-{k}")
+    robots = [RobotRecord(key=k, color=k[:-2], number=1,
+                          entry=RobotResult(image="i", container=f"c-{k}"))
               for k in ("red-1", "blue-1")]
     results = build_results(match_id="m", seed=1, sim_result=sim, robots=robots, forfeit=None,
                             limits=LIMITS, versions={}, timings_s={}, failure=None)
@@ -40,8 +41,8 @@ def test_spoofing_is_counted_per_sending_robot() -> None:
 def test_a_forfeit_sets_score_and_winner_without_a_simulator() -> None:
     forfeit = Forfeit(team="blue", winner="red", reason="no usable image",
                       score={"red": 0, "blue": 0})
-    robots = [RobotRecord(key="blue-1", color="blue", number=1, image="b",
-                          image_error="image b not found")]
+    robots = [RobotRecord(key="blue-1", color="blue", number=1,
+                          entry=RobotResult(image="b", image_error="image b not found"))]
     results = build_results(match_id="m", seed=1, sim_result=None, robots=robots,
                             forfeit=forfeit, limits=LIMITS, versions={"hlvs-runner": "1"},
                             timings_s={"pulling": 0.1}, failure=None)

@@ -11,7 +11,7 @@ from typing import Any
 
 import pytest
 
-from contracts.match_results import FailureClass, MatchReport
+from contracts.match_results import FailureClass, MatchReport, RobotResult
 from contracts.match_spec import TimingSpec
 from contracts.sim_result import SimResult
 from contracts.timing import (
@@ -153,8 +153,8 @@ def _sim(playing_s: float, halves: list[int], connected: tuple[str, ...]) -> Sim
                  "own_goals": zero, "falls": zero}})
 
 
-ROBOTS = [RobotRecord(key="red-1", color="red", number=1, image="r"),
-          RobotRecord(key="blue-1", color="blue", number=1, image="b")]
+ROBOTS = [RobotRecord(key="red-1", color="red", number=1, entry=RobotResult(image="r")),
+          RobotRecord(key="blue-1", color="blue", number=1, entry=RobotResult(image="b"))]
 BOTH = ("red-1", "blue-1")
 
 
