@@ -164,6 +164,7 @@ def create_app(
             from service.preflight import PreflightChecker
 
             checker = PreflightChecker()
+            checker.reclaim()  # what checks of a killed service process left
         from service.statusboard import StatusBoard
         from service.submissions import MatchTimes, QueueBoard
         from service.tokens import TokenCache

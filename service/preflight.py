@@ -15,10 +15,12 @@ robots against one stub robot, stopped as soon as every robot has connected. Wit
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
 import queue
 import secrets
+import shutil
 import tempfile
 import threading
 import time
@@ -34,6 +36,9 @@ from service.settings import Settings
 log = logging.getLogger(__name__)
 
 
+PREFLIGHT_MATCH_PREFIX = "preflight-"
+"""The match id of every pre-flight check starts so."""
+PREFLIGHT_FOLDER_PREFIX = "hlvs-preflight-"
 PROJECT_PREFIX = "hlvs-runner/"
 """The project's own images (``orchestrator.project_images``): never a team's robot."""
 
@@ -74,6 +79,21 @@ class PreflightChecker:
                     raise PreflightFailed(stage="pull", image="(all)", cause=str(exc)) from exc
         return run(team, settings=settings, teardowns=self._teardowns, engine=self._engine)
 
+    def reclaim(self) -> None:
+        """:func:`reclaim_leftovers` in a background thread (a check's answer never waits for
+        it: the new checks' match ids are new)."""
+
+        def run_reclaim() -> None:
+            try:
+                reclaim_leftovers()
+            except (OrchestratorError, OSError) as exc:
+                log.warning("pre-flight leftovers not reclaimed: %s", exc)
+
+        thread = threading.Thread(target=run_reclaim, name="preflight-reclaim", daemon=True)
+        thread.start()
+        with self._lock:
+            self._teardowns.append(thread)
+
     def close(self) -> None:
         for thread in list(self._teardowns):
             thread.join(timeout=120)
@@ -109,11 +129,39 @@ def run(team: TeamConfig, *, settings: Settings,
             raise PreflightFailed(stage=stage, image=image.reference or "(none)",
                                   cause=image.error.reason)
     if settings.preflight == "full":
-        with tempfile.TemporaryDirectory(prefix="hlvs-preflight-") as folder:
+        with tempfile.TemporaryDirectory(prefix=PREFLIGHT_FOLDER_PREFIX) as folder:
             _start_and_connect(team, Path(folder), settings=settings, teardowns=teardowns)
     elapsed = time.monotonic() - started
     log.info("pre-flight of %s passed in %.1f s", team.name, elapsed)
     return elapsed
+
+
+def reclaim_leftovers() -> list[str]:
+    """Remove what the pre-flight checks of a service process that died (killed, crashed, the
+    host's power lost) left behind: their containers, networks and host rules, and their
+    temporary folders; run when the service starts. Only checks whose service process is gone
+    are touched (a check has a run record naming its process, see
+    :mod:`orchestrator.match.ownership`). Returns the checks' match ids."""
+    from orchestrator.engine import DockerRuntime, connect
+    from orchestrator.match import HostControl, clean_match, ownership
+
+    dead = [r for r in ownership.records()
+            if r.match_id.startswith(PREFLIGHT_MATCH_PREFIX) and not ownership.owner_alive(r)]
+    if not dead:
+        return []
+    runtime = DockerRuntime(connect())
+    host = HostControl.for_current_user()
+    for record in dead:
+        report = clean_match(runtime, host, match_id=record.match_id, record=None)
+        ownership.forget(record)
+        folder = Path(record.out_dir).parent
+        if folder.name.startswith(PREFLIGHT_FOLDER_PREFIX):
+            shutil.rmtree(folder, ignore_errors=True)
+        log.warning("pre-flight %s of a service process that is gone: removed %d containers, "
+                    "%d networks%s", record.match_id, len(report.containers),
+                    len(report.networks), f" ({'; '.join(report.errors)})" if report.errors
+                    else "")
+    return [r.match_id for r in dead]
 
 
 def _invalid(exc: ConfigError) -> InvalidInput:
@@ -147,15 +195,16 @@ def _start_and_connect(team: TeamConfig, folder: Path, *, settings: Settings,
         MatchRunner,
         RunOptions,
         ScrimmageRequest,
-        cleanup,
+        clean_match,
         game_file,
+        ownership,
         plan_from_game,
         team_file,
     )
     from service.teamfiles import FIELD_CLASS
 
     checked = _distinct_players(team)
-    match_id = "preflight-" + secrets.token_hex(4)
+    match_id = PREFLIGHT_MATCH_PREFIX + secrets.token_hex(4)
     request = ScrimmageRequest(players=1, seed=1, half_duration_s=60.0, wait_before_ready_s=120.0,
                                grace_s=1.0)
     game = game_file(request, match_id)
@@ -182,6 +231,8 @@ def _start_and_connect(team: TeamConfig, folder: Path, *, settings: Settings,
         telemetry=lambda endpoint, mid: ZenohTelemetry(endpoint=endpoint, match_id=mid),
     )
     events = runner.events.subscribe()
+    owned = contextlib.ExitStack()  # a run record: a service killed now leaves what to reclaim
+    owned.enter_context(ownership.claim(match_id, folder / "out"))
     thread = threading.Thread(target=runner.run, name=match_id, daemon=True)
     thread.start()
     failure: PreflightFailed | None = None
@@ -193,7 +244,8 @@ def _start_and_connect(team: TeamConfig, folder: Path, *, settings: Settings,
 
         def teardown() -> None:
             thread.join(timeout=120)
-            cleanup(runtime, host, match_id=match_id)
+            with owned:  # the record goes once nothing of the check is left
+                clean_match(runtime, host, match_id=match_id, record=None)
 
         if teardowns is None:
             teardown()
@@ -241,4 +293,7 @@ def _connected_or_failure(events: queue.SimpleQueue[Any], *, timeout_s: float,
             return PreflightFailed(stage="start", image="(simulator)", cause=cause)
 
 
-__all__ = ["PROJECT_PREFIX", "PreflightChecker", "official_limits", "project_image_name", "run"]
+__all__ = [
+    "PREFLIGHT_MATCH_PREFIX", "PROJECT_PREFIX", "PreflightChecker", "official_limits",
+    "project_image_name", "reclaim_leftovers", "run",
+]
