@@ -4,7 +4,8 @@
 ``MOTOR_NAMES`` order, accelerometer (x, y, z, m/s^2), gyro (x, y, z, rad/s) and the eight sole
 force sensors (N) in ``FORCE_SENSORS`` order. ``truth`` is ground truth for rewards and
 statistics (never part of the observation): ball position and velocity, the learning robot's
-torso x, y, yaw, the z component of its torso's up axis and its torso height.
+torso x, y, yaw, the z component of its torso's up axis, its torso height and its right toe
+(x, y, z of the front centre of the right sole).
 """
 
 from __future__ import annotations
@@ -33,13 +34,15 @@ ACCEL = slice(N_JOINTS, N_JOINTS + 3)
 GYRO = slice(N_JOINTS + 3, N_JOINTS + 6)
 FORCES = slice(N_JOINTS + 6, SENSOR_SIZE)
 
-TRUTH_SIZE = 11
+TRUTH_SIZE = 14
 BALL_POS = slice(0, 3)
 BALL_VEL = slice(3, 6)
 ROBOT_XY = slice(6, 8)
 ROBOT_YAW = 8
 UP_Z = 9
 TORSO_Z = 10
+TOE_R = slice(11, 14)
+RIGHT_SOLE = "foot:sole_R"  # the robot's geom whose front edge is TOE_R (front centre, mid-plate)
 
 
 class GameView(TypedDict, total=False):

@@ -2,9 +2,12 @@
 
 ``MjxStandKickVector(num_envs)`` is a :class:`gymnasium.vector.VectorEnv` with the spaces,
 observations and reward of ``hlvs/StandKick-v0`` (:mod:`envs.stand_kick`): the robot API's
-sensors and ``time``; reward ``2 x`` the ball's progress towards the goal centre, minus the fall
-penalty; terminated on a fall, a goal or the ball out, truncated after ``max_episode_s``. The
-world is :func:`envs.mjx_world.mjx_scene` (its module says where it differs from the CPU world).
+sensors and ``time``; the shaped reward of :func:`envs.stand_kick.stand_kick_reward` (the ball's
+progress towards the goal centre, the toe's approach and the touch bonus, the cost of standing
+still and of a fall); terminated on a fall, a goal or the ball out, truncated after
+``max_episode_s``. It takes the CPU environment's settings
+(:class:`envs.stand_kick.StandKickConfig`, fixed for the vector's life). The world is
+:func:`envs.mjx_world.mjx_scene` (its module says where it differs from the CPU world).
 
 Episodes start as the CPU environment's do, with one shortcut: the robot's settling in its
 stance is computed once (:func:`envs.mjx_world.settled_state`, by the CPU world) and moved to
@@ -17,8 +20,8 @@ episode (the action given then is ignored; reward 0, neither terminated nor trun
 jitted function does a step and the resets, so the physics compiles once (its time is
 ``compile_s`` and ``compile_cpu_s`` after the first :meth:`reset`; :meth:`compiles` counts
 the compiled versions, 1 once stepping). ``infos`` hold ``kick_distance_m``,
-``ball_to_goal_m``, ``ball_speed_m_s``, ``max_ball_speed_m_s``, ``goal``, ``fallen``, ``out``
-and ``sim_time_ms`` (numpy arrays, one value per environment).
+``ball_to_goal_m``, ``ball_speed_m_s``, ``max_ball_speed_m_s``, ``toe_to_ball_m``, ``touched``,
+``goal``, ``fallen``, ``out`` and ``sim_time_ms`` (numpy arrays, one value per environment).
 """
 
 from __future__ import annotations
@@ -34,9 +37,17 @@ from gymnasium.vector.utils import batch_space
 
 from contracts import field_for
 from envs.errors import EnvConfigError
-from envs.skill import FALLEN_UP_Z, PROGRESS_WEIGHT
+from envs.frame import RIGHT_SOLE
+from envs.skill import FALLEN_UP_Z
 from envs.spaces import ACCEL_LIMIT, FORCE_LIMIT, GYRO_LIMIT, action_space, observation_space
-from envs.stand_kick import BALL_AHEAD_M, BALL_RIGHT_M, STAND_FALL_PENALTY, TIME_LIMIT_S
+from envs.stand_kick import (
+    BALL_AHEAD_M,
+    BALL_RIGHT_M,
+    TIME_LIMIT_S,
+    TOUCH_SPEED_M_S,
+    StandKickConfig,
+    stand_kick_reward,
+)
 
 STEP_MS = 8
 DEFAULT_P = 10.0
@@ -57,35 +68,23 @@ class MjxStandKickVector(VectorEnv):
 
     metadata: dict[str, Any] = {"autoreset_mode": AutoresetMode.NEXT_STEP}
 
-    def __init__(
-        self,
-        num_envs: int,
-        *,
-        model: str = "kid-default",
-        steps_per_action: int = 4,
-        max_episode_s: float = 1.5,
-        settle_s: float = 0.5,
-        ball_noise_m: float = 0.02,
-        heading_noise_rad: float = 0.15,
-        fall_penalty: float = STAND_FALL_PENALTY,
-        self_collision: bool = False,
-    ) -> None:
+    def __init__(self, num_envs: int, *, self_collision: bool = False, **options: Any) -> None:
+        """``options``: the settings of :class:`envs.stand_kick.StandKickConfig`."""
         if num_envs < 1:
             raise EnvConfigError(field="num_envs", value=num_envs, expected="an integer >= 1")
-        if not 0.0 <= ball_noise_m <= 0.05:
-            raise EnvConfigError(field="ball_noise_m", value=ball_noise_m, expected="0..0.05 m")
-        if steps_per_action < 1:
-            raise EnvConfigError(field="steps_per_action", value=steps_per_action,
-                                 expected="an integer >= 1")  # fmt: skip
+        config = self.config = StandKickConfig.of(options)
+        model, steps_per_action = config.model, config.steps_per_action
+        ball_noise_m, heading_noise_rad = config.ball_noise_m, config.heading_noise_rad
         import jax
         import jax.numpy as jnp
 
-        from envs.mjx_world import mjx_scene, settled_state
+        from envs.mjx_world import LEARNER, mjx_scene, settled_state
+        from simulator.world import robot_prefix
 
         mjx = _quiet_import()
         self.num_envs = num_envs
         self.steps_per_action = steps_per_action
-        self.max_steps = math.ceil(max_episode_s * 1000 / (STEP_MS * steps_per_action))
+        self.max_steps = math.ceil(config.max_episode_s * 1000 / (STEP_MS * steps_per_action))
         single = observation_space(model, camera=False, perception=False, other_robots=0,
                                    game=False)  # fmt: skip
         self.single_observation_space = spaces.Dict(
@@ -99,7 +98,7 @@ class MjxStandKickVector(VectorEnv):
         self.layout = layout = scene.layout
         servo = {k: jnp.asarray(v) for k, v in scene.servo.items()}
         qpos0, qvel0, stance = settled_state(model=model, steps_per_action=steps_per_action,
-                                             settle_s=settle_s)  # fmt: skip
+                                             settle_s=config.settle_s)  # fmt: skip
         self.stance = stance.astype(np.float32)
         mx = mjx.put_model(self.compiled)
         d0 = mjx.make_data(mx)
@@ -123,7 +122,10 @@ class MjxStandKickVector(VectorEnv):
         high = jnp.asarray([ACCEL_LIMIT] * 3 + [GYRO_LIMIT] * 3 + [FORCE_LIMIT] * 8)
         spa = steps_per_action
         max_steps = self.max_steps
-        penalty = float(fall_penalty)
+        penalty = float(config.fall_penalty)
+        sole = self.compiled.geom(f"{robot_prefix(LEARNER)}/{RIGHT_SOLE}").id
+        half_length = float(self.compiled.geom_size[sole][0])
+        ball_ahead = BALL_AHEAD_M - config.ball_closer_m
 
         def basic_step(d: Any, target: Any) -> Any:
             """MotorBank's position path, then the substeps (simulator.world.motors)."""
@@ -170,16 +172,18 @@ class MjxStandKickVector(VectorEnv):
             up = d.xmat[torso, 2, 2]
             return d.qpos[bq : bq + 3], d.qvel[bv : bv + 3], d.qpos[root_q : root_q + 2], yaw, up
 
-        def measures(d: Any) -> tuple[Any, Any, Any, Any, Any]:
+        def measures(d: Any) -> tuple[Any, Any, Any, Any, Any, Any]:
             ball, vel, _, _, up = truth(d)
             bg = jnp.hypot(goal_x - ball[0], ball[1])
+            toe = d.geom_xpos[sole] + half_length * d.geom_xmat[sole][:, 0]
+            gap = jnp.maximum(0.0, jnp.linalg.norm(toe - ball) - radius)
             x, y, z = ball[0], ball[1], ball[2]
             goal = (x - radius > goal_x) & (jnp.abs(y) < field.goal_width_m / 2)
             goal = goal & (z < field.goal_height_m)
             out = ~goal & (
                 (jnp.abs(x) - radius > goal_x) | (jnp.abs(y) - radius > field.half_width_m)
             )
-            return bg, goal, up < FALLEN_UP_Z, out, jnp.hypot(vel[0], vel[1])
+            return bg, goal, up < FALLEN_UP_Z, out, jnp.hypot(vel[0], vel[1]), gap
 
         def start(key: Any) -> Any:
             """The episode's first state (before its stance step): the settled robot moved."""
@@ -188,7 +192,7 @@ class MjxStandKickVector(VectorEnv):
             ry = jax.random.uniform(k[1], (), minval=-1.0, maxval=1.0)
             yaw = jnp.arctan2(-ry, goal_x - rx) + jax.random.uniform(
                 k[2], (), minval=-heading_noise_rad, maxval=heading_noise_rad)  # fmt: skip
-            ahead = BALL_AHEAD_M + jax.random.uniform(k[3], (), minval=-ball_noise_m,
+            ahead = ball_ahead + jax.random.uniform(k[3], (), minval=-ball_noise_m,
                                                       maxval=ball_noise_m)  # fmt: skip
             right = BALL_RIGHT_M + jax.random.uniform(k[4], (), minval=-ball_noise_m,
                                                       maxval=ball_noise_m)  # fmt: skip
@@ -224,9 +228,17 @@ class MjxStandKickVector(VectorEnv):
             d = jax.tree_util.tree_map(lambda a, b: jnp.where(fresh, a, b), start(sub), state["d"])
             target = jnp.where(fresh, stance_j, jnp.clip(action, servo["lower"], servo["upper"]))
             d = jax.lax.fori_loop(0, spa, lambda _, dd: basic_step(dd, target), d)
-            bg, goal, fallen, out, speed = measures(d)
+            bg, goal, fallen, out, speed, gap = measures(d)
             steps = jnp.where(fresh, 0, state["steps"] + 1)
-            reward = PROGRESS_WEIGHT * (state["bg"] - bg) - penalty * fallen
+            before = jnp.where(fresh, False, state["touched"])
+            touched = before | (speed >= TOUCH_SPEED_M_S)
+            f32 = jnp.float32
+            reward = stand_kick_reward(
+                config, progress=state["bg"] - bg, gap_before=state["gap"], gap_after=gap,
+                touched_before=before.astype(f32), touched=touched.astype(f32),
+                fallen=fallen.astype(f32), fall_penalty=penalty,
+            )  # fmt: skip
+            touched = touched & ~fresh
             terminated = (goal | fallen | out) & ~fresh
             truncated = ~terminated & (steps >= max_steps) & ~fresh
             t0 = jnp.where(fresh, d.time, state["t0"])
@@ -238,9 +250,10 @@ class MjxStandKickVector(VectorEnv):
             d = jax.tree_util.tree_map(lambda a, b: a.astype(b.dtype), d, d0)  # no weak types
             new = {"key": key, "d": d, "steps": steps.astype(jnp.int32),
                    "bg": bg.astype(jnp.float32), "t0": t0.astype(jnp.float32),
-                   "ball0": ball0.astype(jnp.float32), "top": top.astype(jnp.float32)}  # fmt: skip
+                   "ball0": ball0.astype(jnp.float32), "top": top.astype(jnp.float32),
+                   "gap": gap.astype(jnp.float32), "touched": touched}  # fmt: skip
             obs = (joints, sensors, d.time - t0)
-            info = (jnp.hypot(*(ball - ball0)), bg, speed, top, goal, fallen, out)
+            info = (jnp.hypot(*(ball - ball0)), bg, speed, top, gap, touched, goal, fallen, out)
             return new, obs, jnp.where(fresh, 0.0, reward), terminated, truncated, info
 
         self._advance = jax.jit(jax.vmap(one))
@@ -262,7 +275,8 @@ class MjxStandKickVector(VectorEnv):
         f32 = jnp.float32
         state = {"key": keys, "d": batched, "steps": jnp.zeros(n, jnp.int32),
                 "bg": jnp.zeros(n, f32), "t0": jnp.zeros(n, f32), "ball0": jnp.zeros((n, 2), f32),
-                "top": jnp.zeros(n, f32)}  # fmt: skip
+                "top": jnp.zeros(n, f32), "gap": jnp.zeros(n, f32),
+                "touched": jnp.zeros(n, bool)}  # fmt: skip
         return state
 
     def reset(
@@ -304,7 +318,7 @@ class MjxStandKickVector(VectorEnv):
         terminated, truncated = np.asarray(terminated), np.asarray(truncated)
         self._ended = terminated | truncated
         sim_ms = np.rint(np.asarray(new["d"].time) * 1000).astype(np.int64)
-        kick, bg, speed, top, goal, fallen, out = (np.asarray(v) for v in info)
+        kick, bg, speed, top, gap, touched, goal, fallen, out = (np.asarray(v) for v in info)
         observation = {
             "joints": joints, "accelerometer": sensors[:, 0:3], "gyro": sensors[:, 3:6],
             "forces": sensors[:, 6:14], "time": elapsed.reshape(-1, 1),
@@ -313,6 +327,7 @@ class MjxStandKickVector(VectorEnv):
             "kick_distance_m": kick.astype(np.float64), "ball_to_goal_m": bg.astype(np.float64),
             "ball_speed_m_s": speed.astype(np.float64),
             "max_ball_speed_m_s": top.astype(np.float64),
+            "toe_to_ball_m": gap.astype(np.float64), "touched": touched,
             "goal": goal, "fallen": fallen, "out": out, "sim_time_ms": sim_ms,
         }  # fmt: skip
         return observation, np.asarray(reward, dtype=np.float64), terminated, truncated, infos

@@ -14,12 +14,13 @@ import math
 from collections.abc import Sequence
 from typing import Any, cast
 
+import mujoco
 import numpy as np
 import numpy.typing as npt
 
 from contracts import Pose, field_for
 from envs.errors import EnvStateError, TrainerError
-from envs.frame import SENSOR_NAMES, Frame, GameView
+from envs.frame import RIGHT_SOLE, SENSOR_NAMES, Frame, GameView
 from envs.perception import CameraView, add_noise, field_segments, goal_post_feet
 from envs.randomization import episode_world
 from envs.session_spec import ResetRequest, SessionSpec
@@ -54,7 +55,7 @@ class LocalSession:
         self._segments = field_segments(self.field)
         self._camera = robot_model(spec.model).camera
         self._closed = False
-        self._plan: tuple[World, Any, Any, slice, int, int] | None = None
+        self._plan: tuple[World, Any, Any, slice, int, int, int, float] | None = None
 
     # --- lifecycle ---------------------------------------------------------------------------
 
@@ -181,7 +182,7 @@ class LocalSession:
         plan = self._plan
         if plan is None or plan[0] is not world:
             plan = self._plan = self._read_plan(world)
-        _, qpos_at, sensordata_at, ball_dof, up_z, n = plan
+        _, qpos_at, sensordata_at, ball_dof, up_z, n, sole, half_length = plan
         data = world.data
         q = data.qpos[qpos_at]
         sensors = np.concatenate((q[:n], data.sensordata[sensordata_at]))
@@ -189,9 +190,12 @@ class LocalSession:
         vx, vy, vz = data.qvel[ball_dof].tolist()
         yaw = math.atan2(2 * (w * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
         up = float(data.xmat.reshape(-1)[up_z])
-        return sensors, np.array([bx, by, bz, vx, vy, vz, x, y, yaw, up, z])
+        # the right toe: the front centre of the right sole, along the sole's forward axis
+        forward = data.geom_xmat[sole].reshape(3, 3)[:, 0]
+        tx, ty, tz = (data.geom_xpos[sole] + half_length * forward).tolist()
+        return sensors, np.array([bx, by, bz, vx, vy, vz, x, y, yaw, up, z, tx, ty, tz])
 
-    def _read_plan(self, world: World) -> tuple[World, Any, Any, slice, int, int]:
+    def _read_plan(self, world: World) -> tuple[World, Any, Any, slice, int, int, int, float]:
         index = world.index
         robot = index.by_id[self.learner]
         q, d, r = index.ball_qpos, index.ball_dof, robot.root_qpos
@@ -201,7 +205,13 @@ class LocalSession:
         forces = [robot.forces[name] for name in SENSOR_NAMES[len(robot.motor_qpos) + 2 :]]
         sensordata_at = np.array([a, a + 1, a + 2, g, g + 1, g + 2, *forces], dtype=np.int64)
         up_z = robot.torso_body * 9 + 8
-        return world, qpos_at, sensordata_at, slice(d, d + 3), up_z, len(robot.motor_qpos)
+        geom = mujoco.mjtObj.mjOBJ_GEOM
+        sole = mujoco.mj_name2id(world.model, geom, f"{robot.prefix}/{RIGHT_SOLE}")
+        if sole < 0:
+            raise EnvStateError(operation="observe", reason=f"the robot has no {RIGHT_SOLE} geom")
+        half_length = float(world.model.geom_size[sole][0])
+        return (world, qpos_at, sensordata_at, slice(d, d + 3), up_z, len(robot.motor_qpos),
+                sole, half_length)  # fmt: skip
 
     def attack_sign(self, color: TeamColor) -> float:
         """+1 when ``color`` attacks the goal at x > 0 now."""

@@ -16,7 +16,7 @@ and the payload (the length counts both):
   class name, "message": text}``;
 - ``F`` remote -> client, in place of ``T`` after a step or reset when the client opened with
   ``"compact": true`` (the remote's ``open`` answer says ``"compact": true`` back) and the frame
-  has nothing but ground truth (no perception, game or events): the truth as 11 little-endian
+  has nothing but ground truth (no perception, game or events): the truth as 14 little-endian
   doubles (:data:`envs.frame.TRUTH_SIZE`), no JSON to write or read at every step.
 """
 
