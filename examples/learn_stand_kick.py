@@ -2,27 +2,34 @@
 
 PPO is skrl's (JAX on the CPU; ``pip install '.[learn]'``), over the project's vectorised
 environment (``envs.vector.make_vector``: in this process, or ``--remotes N`` simulator
-containers). The policy moves the robot's 12 leg motors around the walking stance (arms and
-head stay), one decision per 32 ms, from what the robot API reports: joint angles,
-accelerometer, gyro and the time since the skill started (no ball or robot position). It writes
-to ``--out``:
+containers). The policy moves the robot's 12 leg motors around the walking stance (the
+kicking leg's hip and knee pitch by up to 1 rad, the other joints less; arms and head stay), one
+decision per 32 ms, from what the robot API reports: joint angles, accelerometer, gyro and the
+time since the skill started (no ball or robot position). It writes to ``--out``:
 
 - ``episodes.csv``: one row per finished episode (environment steps so far, return, kick
-  distance, fastest ball speed, fallen, the fall penalty then), and progress lines on the
-  terminal;
+  distance, fastest ball speed, fallen, touched the ball, the fall penalty and the curriculum's
+  ball offset then), and progress lines on the terminal;
 - ``skrl/``: skrl's TensorBoard event files and checkpoints;
 - ``policy.npz``: the policy's weights for the robot (:mod:`robot.learned`; numpy only), written
   at every progress line and at the end;
 - ``learning_curve.png``: the return per episode over training against a random policy, and
   the kick distance, the share of fast balls (>= 1 m/s) and of falls;
-- ``summary.json``: the evaluation of the learned policy (the ``policy.npz`` run by the robot's
-  own code, deterministic) and of a random policy on the same seeded episodes.
+- ``summary.json``: the training episodes' figures over the first and the last 200 (ball
+  travel, return, shares touched, fast, fallen), the evaluation of the learned policy (the
+  ``policy.npz`` run by the robot's own code, deterministic) and of a random policy on the same
+  seeded episodes.
 
-The reward is 2 x the ball's progress towards the goal (m); a fall costs 1 until 40 % of the
-steps, then more, up to 3 from 80 % on (``--fall-penalty``, ``--fall-penalty-end``): first
-reach the ball at all, then kick without falling.
+The reward is the environment's shaped one (:mod:`envs.stand_kick`: the toe's approach to the
+ball, a bonus for the first touch, the ball's progress towards the goal, a cost for standing
+still and for a fall); a fall costs 1 until 40 % of the steps, then more, up to 3 from 80 % on
+(``--fall-penalty``, ``--fall-penalty-end``). A curriculum starts the ball 3 cm nearer the toe
+and moves it back to where the skill finds it over the first 30 % of the steps
+(``--curriculum-m``, ``--curriculum-until``): first touch the ball at all, then reach it, then
+kick without falling.
 
     python examples/learn_stand_kick.py --seed 1 --out runs/stand_kick
+    python examples/learn_stand_kick.py --plot-runs runs/s1 runs/s2 runs/s3 --out seeds.png
 """
 
 from __future__ import annotations
@@ -54,10 +61,12 @@ EPISODE_S = 1.5
 HIDDEN = (64, 64)
 # network input scale: joints (rad) as they are, accelerometer / 10, gyro / 4, time / episode
 OBS_SCALE = np.array([1.0] * 20 + [0.1] * 3 + [0.25] * 3 + [1.0 / EPISODE_S])
-# how far (rad) the policy may move each motor from the stance: the legs' pitch joints most,
-# their roll and yaw joints less; arms and head stay still
-JOINT_SCALES = {"LegUpper": 0.4, "LegLower": 0.4, "Ankle": 0.4, "Pelv": 0.2, "Foot": 0.2,
-                "PelvY": 0.1}  # fmt: skip
+# how far (rad) the policy may move each motor from the stance: the kicking (right) leg's hip
+# and knee pitch most (a kick draws the foot back and swings it through, about 0.9 rad each),
+# its ankle and the standing leg's pitch joints less, the roll and yaw joints least; arms and
+# head stay still
+JOINT_SCALES = {"LegUpperR": 1.0, "LegLowerR": 1.0, "AnkleR": 0.5, "LegUpper": 0.4,
+                "LegLower": 0.4, "Ankle": 0.4, "Pelv": 0.2, "Foot": 0.2, "PelvY": 0.1}  # fmt: skip
 ACTION_SCALE = np.array(
     [next((v for k, v in sorted(JOINT_SCALES.items(), key=lambda kv: -len(kv[0]))
            if name.startswith(k)), 0.0) for name in MOTOR_NAMES]
@@ -97,18 +106,33 @@ class FallPenalty:
         return self.start + (self.end - self.start) * done
 
 
+class Curriculum:
+    """How much nearer the toe the ball starts (m) over training: ``start`` at first, down
+    linearly to 0 at ``until`` of the steps (first touch the ball at all, then reach it)."""
+
+    def __init__(self, start: float, until: float, total_steps: int) -> None:
+        self.start, self.until, self.total = start, until, max(1, total_steps)
+
+    def at(self, steps: int) -> float:
+        if self.until <= 0:
+            return 0.0
+        return self.start * max(0.0, 1.0 - steps / (self.until * self.total))
+
+
 class PolicyInputs(gym.vector.VectorWrapper):
     """The vector environment as the learner sees it: flat scaled observations, actions in
     [-1, 1] mapped to targets around the stance; logs every finished episode and sets the fall
-    penalty of the moment."""
+    penalty and the ball's start of the moment."""
 
     def __init__(
-        self, env: gym.vector.VectorEnv, template: Policy, log: EpisodeLog, penalty: FallPenalty
-    ) -> None:
+        self, env: gym.vector.VectorEnv, template: Policy, log: EpisodeLog, penalty: FallPenalty,
+        curriculum: Curriculum,
+    ) -> None:  # fmt: skip
         super().__init__(env)
         self.template = template
         self.log = log
         self.penalty = penalty
+        self.curriculum = curriculum
         n = len(OBS_SCALE)
         self.single_observation_space = gym.spaces.Box(-np.inf, np.inf, (n,), np.float32)
         self.observation_space = gym.vector.utils.batch_space(
@@ -130,9 +154,12 @@ class PolicyInputs(gym.vector.VectorWrapper):
     def step(self, actions: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
         targets = self.template.targets(np.asarray(actions, np.float64)).astype(np.float32)
         penalty = self.penalty.at(self.log.steps)
+        closer = self.curriculum.at(self.log.steps)
         for env in self.env.unwrapped.envs:  # type: ignore[attr-defined]
             env.fall_penalty = penalty
+            env.ball_closer_m = closer  # read by the next reset
         self.log.fall_penalty = penalty
+        self.log.ball_closer_m = closer
         obs, rewards, terminated, truncated, infos = self.env.step(targets)
         self._returns += rewards
         ended = np.logical_or(terminated, truncated)
@@ -141,7 +168,8 @@ class PolicyInputs(gym.vector.VectorWrapper):
             for i in np.flatnonzero(ended).tolist():
                 self.log.episode(float(self._returns[i]), _item(final, "kick_distance_m", i),
                                  _item(final, "max_ball_speed_m_s", i),
-                                 bool(_item(final, "fallen", i)))  # fmt: skip
+                                 bool(_item(final, "fallen", i)),
+                                 bool(_item(final, "touched", i)))  # fmt: skip
                 self._returns[i] = 0.0
         self.log.steps += self.num_envs
         return self._scaled(obs), rewards, terminated, truncated, infos
@@ -159,34 +187,37 @@ class EpisodeLog:
         self.file = (out / "episodes.csv").open("w", newline="")
         self.csv = csv.writer(self.file)
         self.csv.writerow(["env_steps", "episode", "return", "kick_distance_m",
-                           "max_ball_speed_m_s", "fallen", "fall_penalty", "wall_s"])  # fmt: skip
+                           "max_ball_speed_m_s", "fallen", "touched", "fall_penalty",
+                           "ball_closer_m", "wall_s"])  # fmt: skip
         self.steps = 0
         self.fall_penalty = 0.0
+        self.ball_closer_m = 0.0
         self.episodes = 0
-        self.recent: deque[tuple[float, float, float, bool]] = deque(maxlen=200)
+        self.recent: deque[tuple[float, float, float, bool, bool]] = deque(maxlen=200)
         self.started = time.perf_counter()
         self.every_s = every_s
         self.export = export
         self._last_print = self.started
 
-    def episode(self, ret: float, kick: float, speed: float, fallen: bool) -> None:
+    def episode(self, ret: float, kick: float, speed: float, fallen: bool, touched: bool) -> None:
         self.episodes += 1
         wall = time.perf_counter() - self.started
         self.csv.writerow([self.steps, self.episodes, round(ret, 4), round(kick, 4),
-                           round(speed, 3), int(fallen), round(self.fall_penalty, 3),
-                           round(wall, 1)])  # fmt: skip
-        self.recent.append((ret, kick, speed, fallen))
+                           round(speed, 3), int(fallen), int(touched), round(self.fall_penalty, 3),
+                           round(self.ball_closer_m, 4), round(wall, 1)])  # fmt: skip
+        self.recent.append((ret, kick, speed, fallen, touched))
         if time.perf_counter() - self._last_print >= self.every_s:
             self.progress()
 
     def progress(self) -> None:
         self._last_print = time.perf_counter()
         wall = self._last_print - self.started
-        r = np.array(self.recent, dtype=np.float64).reshape(-1, 4)
+        r = np.array(self.recent, dtype=np.float64).reshape(-1, 5)
         print(f"steps {self.steps:>8} ({self.steps / max(wall, 1e-9):5.0f}/s)  episodes "
               f"{self.episodes:>6}  last {len(r)}: return {r[:, 0].mean():+.3f}  kick "
-              f"{r[:, 1].mean():.2f} m  ball >= 1 m/s {np.mean(r[:, 2] >= 1.0):4.0%}  "
-              f"falls {r[:, 3].mean():4.0%}  {wall:6.0f} s", flush=True)  # fmt: skip
+              f"{r[:, 1].mean():.2f} m  touched {r[:, 4].mean():4.0%}  ball >= 1 m/s "
+              f"{np.mean(r[:, 2] >= 1.0):4.0%}  falls {r[:, 3].mean():4.0%}  {wall:6.0f} s",
+              flush=True)  # fmt: skip
         self.file.flush()
         self.export()
 
@@ -245,7 +276,7 @@ def build_agent(env: Any, args: argparse.Namespace, out: Path) -> Any:
         model.init_state_dict(role=role)
     cfg = PPO_CFG()
     cfg.rollouts = args.rollouts
-    cfg.learning_epochs = 5
+    cfg.learning_epochs = args.epochs
     cfg.mini_batches = 4
     cfg.discount_factor = 0.98
     cfg.gae_lambda = 0.95
@@ -319,6 +350,27 @@ def evaluate(
             "fall_share": round(float(r[:, 3].mean()), 3)}  # fmt: skip
 
 
+def training_figures(path: Path, n: int = 200) -> dict[str, dict[str, float]]:
+    """The training episodes' figures over the first and the last ``n`` (the exploring
+    policy): mean ball travel, return, shares touched, with the ball >= 1 m/s, fallen."""
+    with path.open() as f:
+        rows = list(csv.DictReader(f))
+    figures = {}
+    for name, part in (("first", rows[:n]), ("last", rows[-n:])):
+        if not part:
+            continue
+        col = {k: np.array([float(r[k]) for r in part]) for k in part[0] if k != "episode"}
+        figures[name] = {
+            "episodes": len(part),
+            "mean_kick_distance_m": round(float(col["kick_distance_m"].mean()), 3),
+            "mean_return": round(float(col["return"].mean()), 3),
+            "touched_share": round(float(col["touched"].mean()), 3),
+            "ball_1m_s_share": round(float(np.mean(col["max_ball_speed_m_s"] >= 1.0)), 3),
+            "fall_share": round(float(col["fallen"].mean()), 3),
+        }
+    return figures
+
+
 def plot(out: Path, random_return: float, learned_return: float) -> Path:
     import matplotlib
 
@@ -363,6 +415,44 @@ def plot(out: Path, random_return: float, learned_return: float) -> Path:
     return path
 
 
+def plot_runs(runs: list[Path], path: Path, window: int = 200) -> Path:
+    """The learning curves of several runs (seeds) in one figure: the ball's travel and the
+    share of episodes touching the ball, each a mean of ``window`` training episodes."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (ax, bx) = plt.subplots(2, 1, figsize=(7, 6), dpi=110, sharex=True)
+    for run in runs:
+        with (run / "episodes.csv").open() as f:
+            rows = list(csv.DictReader(f))
+        summary = json.loads((run / "summary.json").read_text())
+        steps = np.array([float(r["env_steps"]) for r in rows])
+        w = max(1, min(window, len(rows)))
+
+        def mean(key: str, rows: list[dict[str, str]] = rows, w: int = w) -> np.ndarray:
+            values = np.array([float(r[key]) for r in rows])
+            return np.convolve(values, np.ones(w) / w, mode="valid")
+
+        label = f"seed {summary['seed']}"
+        ax.plot(steps[w - 1 :], mean("kick_distance_m"), label=label)
+        bx.plot(steps[w - 1 :], mean("touched"), label=label)
+    ax.axhline(1.0, color="gray", ls=":", lw=1)
+    ax.set_ylabel(f"ball travel (m), mean of {window} episodes")
+    ax.set_title("hlvs/StandKick-v0, PPO (skrl, JAX CPU): training episodes")
+    ax.legend(loc="upper left", fontsize=8)
+    ax.grid(alpha=0.3)
+    bx.set_ylabel(f"share touching the ball, of {window}")
+    bx.set_xlabel(f"environment steps ({8 * STEPS_PER_ACTION} ms each)")
+    bx.grid(alpha=0.3)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path)
+    plt.close(fig)
+    return path
+
+
 def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seed", type=int, default=1, help="seed of the networks and episodes")
@@ -370,7 +460,7 @@ def main(argv: list[str]) -> int:
     parser.add_argument(
         "--env-steps",
         type=int,
-        default=250_000,
+        default=48_000,
         help="environment steps to train for (all environments together)",
     )
     parser.add_argument("--envs", type=int, default=16, help="environments in the vector")
@@ -380,19 +470,38 @@ def main(argv: list[str]) -> int:
         default=0,
         help="run the environments in this many simulator containers (0: here)",
     )
-    parser.add_argument("--rollouts", type=int, default=32, help="steps per environment per update")
-    parser.add_argument("--learning-rate", type=float, default=3e-4)
-    parser.add_argument("--init-log-std", type=float, default=-2.3, help="initial exploration")
+    parser.add_argument("--rollouts", type=int, default=16, help="steps per environment per update")
+    parser.add_argument("--learning-rate", type=float, default=1e-3)
+    parser.add_argument("--epochs", type=int, default=8, help="PPO epochs per update")
+    parser.add_argument("--init-log-std", type=float, default=-1.2, help="initial exploration")
     parser.add_argument("--fall-penalty", type=float, default=1.0,
                         help="reward lost by a fall, until 40 %% of the steps")  # fmt: skip
     parser.add_argument("--fall-penalty-end", type=float, default=3.0,
                         help="... rising to this at 80 %% (default 3)")  # fmt: skip
     parser.add_argument("--ball-noise", type=float, default=0.01, help="ball placement noise (m)")
     parser.add_argument(
+        "--curriculum-m",
+        type=float,
+        default=0.03,
+        help="the ball starts this much nearer the toe at first (m) ...",
+    )
+    parser.add_argument(
+        "--curriculum-until",
+        type=float,
+        default=0.3,
+        help="... and where it stands in the skill from this share of the steps",
+    )
+    parser.add_argument(
         "--progress-s", type=float, default=30.0, help="seconds between progress lines"
     )
     parser.add_argument("--eval-episodes", type=int, default=50, help="episodes per evaluation")
+    parser.add_argument("--plot-runs", type=Path, nargs="+", metavar="OUT",
+                        help="plot these finished runs' learning curves in one figure "
+                        "(to --out, a .png) instead of training")  # fmt: skip
     args = parser.parse_args(argv)
+    if args.plot_runs:
+        print(plot_runs(args.plot_runs, args.out))
+        return 0
 
     import jax
     from skrl import config as skrl_config
@@ -423,7 +532,8 @@ def main(argv: list[str]) -> int:
     )
     end = args.fall_penalty_end
     penalty = FallPenalty(args.fall_penalty, end, args.timesteps * num_envs)
-    env = wrap_env(PolicyInputs(vec, template, log, penalty), wrapper="gymnasium")
+    curriculum = Curriculum(args.curriculum_m, args.curriculum_until, args.timesteps * num_envs)
+    env = wrap_env(PolicyInputs(vec, template, log, penalty, curriculum), wrapper="gymnasium")
     agent = build_agent(env, args, out)
     holder["agent"] = agent
     print(f"training {ENV_ID}: {args.timesteps * num_envs} environment steps over {num_envs} "
@@ -449,7 +559,8 @@ def main(argv: list[str]) -> int:
     summary = {
         "example": "learn_stand_kick", "env": ENV_ID, "seed": args.seed,
         "env_steps": log.steps, "episodes": log.episodes, "fall_penalty": [args.fall_penalty, end],
-        "train_wall_s": round(train_s, 1),
+        "curriculum_m": [args.curriculum_m, args.curriculum_until],
+        "train_wall_s": round(train_s, 1), "training": training_figures(out / "episodes.csv"),
         "steps_per_s": round(log.steps / train_s, 1), "learned": learned, "random": baseline,
         "policy": str(out / "policy.npz"), "plot": str(png),
         "wall_s": round(time.perf_counter() - started, 1),
