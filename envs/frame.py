@@ -5,7 +5,8 @@
 force sensors (N) in ``FORCE_SENSORS`` order. ``truth`` is ground truth for rewards and
 statistics (never part of the observation): ball position and velocity, the learning robot's
 torso x, y, yaw, the z component of its torso's up axis, its torso height and its right toe
-(x, y, z of the front centre of the right sole).
+(x, y, z of the front centre of the right sole; NaN for a robot model without the project's
+sole geoms).
 """
 
 from __future__ import annotations

@@ -191,8 +191,11 @@ class LocalSession:
         yaw = math.atan2(2 * (w * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
         up = float(data.xmat.reshape(-1)[up_z])
         # the right toe: the front centre of the right sole, along the sole's forward axis
-        forward = data.geom_xmat[sole].reshape(3, 3)[:, 0]
-        tx, ty, tz = (data.geom_xpos[sole] + half_length * forward).tolist()
+        if sole >= 0:
+            forward = data.geom_xmat[sole].reshape(3, 3)[:, 0]
+            tx, ty, tz = (data.geom_xpos[sole] + half_length * forward).tolist()
+        else:
+            tx = ty = tz = math.nan
         return sensors, np.array([bx, by, bz, vx, vy, vz, x, y, yaw, up, z, tx, ty, tz])
 
     def _read_plan(self, world: World) -> tuple[World, Any, Any, slice, int, int, int, float]:
@@ -207,9 +210,8 @@ class LocalSession:
         up_z = robot.torso_body * 9 + 8
         geom = mujoco.mjtObj.mjOBJ_GEOM
         sole = mujoco.mj_name2id(world.model, geom, f"{robot.prefix}/{RIGHT_SOLE}")
-        if sole < 0:
-            raise EnvStateError(operation="observe", reason=f"the robot has no {RIGHT_SOLE} geom")
-        half_length = float(world.model.geom_size[sole][0])
+        # a robot model without the project's sole (an imported one) has no toe: NaN
+        half_length = float(world.model.geom_size[sole][0]) if sole >= 0 else math.nan
         return (world, qpos_at, sensordata_at, slice(d, d + 3), up_z, len(robot.motor_qpos),
                 sole, half_length)  # fmt: skip
 
