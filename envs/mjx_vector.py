@@ -21,7 +21,8 @@ jitted function does a step and the resets, so the physics compiles once (its ti
 ``compile_s`` and ``compile_cpu_s`` after the first :meth:`reset`; :meth:`compiles` counts
 the compiled versions, 1 once stepping). ``infos`` hold ``kick_distance_m``,
 ``ball_to_goal_m``, ``ball_speed_m_s``, ``max_ball_speed_m_s``, ``toe_to_ball_m``, ``touched``,
-``goal``, ``fallen``, ``out`` and ``sim_time_ms`` (numpy arrays, one value per environment).
+``ball_closer_m``, ``goal``, ``fallen``, ``out`` and ``sim_time_ms`` (numpy arrays, one value per
+environment).
 """
 
 from __future__ import annotations
@@ -328,6 +329,7 @@ class MjxStandKickVector(VectorEnv):
             "ball_speed_m_s": speed.astype(np.float64),
             "max_ball_speed_m_s": top.astype(np.float64),
             "toe_to_ball_m": gap.astype(np.float64), "touched": touched,
+            "ball_closer_m": np.full(self.num_envs, self.config.ball_closer_m),
             "goal": goal, "fallen": fallen, "out": out, "sim_time_ms": sim_ms,
         }  # fmt: skip
         return observation, np.asarray(reward, dtype=np.float64), terminated, truncated, infos

@@ -31,7 +31,8 @@ earlier versions (progress and falls).
 The episode terminates when the ball leaves the field (a goal included) and is truncated after
 ``max_episode_s`` of simulated time. ``info`` carries ``kick_distance_m``, ``ball_speed_m_s``
 (horizontal), ``max_ball_speed_m_s`` (in this episode), ``ball_to_goal_m``, ``toe_to_ball_m``
-(the gap), ``touched``, ``goal``, ``fallen``, ``out`` and ``sim_time_ms``.
+(the gap), ``touched``, ``ball_closer_m`` (the episode's), ``goal``, ``fallen``, ``out`` and
+``sim_time_ms``.
 
 :class:`StandKickConfig` holds the settings, shared with the MJX vector
 (:class:`envs.mjx_vector.MjxStandKickVector`); :func:`stand_kick_reward` is the reward both
@@ -169,13 +170,15 @@ class StandKickEnv(KickEnv):
         self._max_speed = 0.0
         self._touched = False
         self._ball_offset = (BALL_AHEAD_M, BALL_RIGHT_M)
+        self._closer = 0.0  # the episode's ball_closer_m
 
     def reset_request(self, world_seed: int, options: ResetOptions) -> ResetRequest:
         rng = self.np_random
         rx, ry = float(rng.uniform(0.5, 1.5)), float(rng.uniform(-1.0, 1.0))
         yaw = math.atan2(-ry, self.goal_xy[0] - rx)
         yaw += float(rng.uniform(-self.heading_noise_rad, self.heading_noise_rad))
-        ahead = BALL_AHEAD_M - check_ball_closer(self.ball_closer_m)
+        self._closer = check_ball_closer(self.ball_closer_m)
+        ahead = BALL_AHEAD_M - self._closer
         self._ball_offset = (
             ahead + float(rng.uniform(-self.ball_noise_m, self.ball_noise_m)),
             BALL_RIGHT_M + float(rng.uniform(-self.ball_noise_m, self.ball_noise_m)),
@@ -247,6 +250,7 @@ class StandKickEnv(KickEnv):
         out["max_ball_speed_m_s"] = self._max_speed
         out["toe_to_ball_m"] = self.gap(frame)
         out["touched"] = self._touched
+        out["ball_closer_m"] = self._closer
         return out
 
 

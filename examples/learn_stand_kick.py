@@ -146,20 +146,24 @@ class PolicyInputs(gym.vector.VectorWrapper):
         scaled: np.ndarray = (flat_observation(obs) * OBS_SCALE).astype(np.float32)
         return scaled
 
-    def reset(self, **kwargs: Any) -> tuple[Any, dict[str, Any]]:
-        obs, info = self.env.reset(**kwargs)
-        self._returns[:] = 0.0
-        return self._scaled(obs), info
-
-    def step(self, actions: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
-        targets = self.template.targets(np.asarray(actions, np.float64)).astype(np.float32)
+    def _schedule(self) -> None:
+        """The fall penalty and the ball's start of the moment, into every environment."""
         penalty = self.penalty.at(self.log.steps)
         closer = self.curriculum.at(self.log.steps)
         for env in self.env.unwrapped.envs:  # type: ignore[attr-defined]
             env.fall_penalty = penalty
             env.ball_closer_m = closer  # read by the next reset
         self.log.fall_penalty = penalty
-        self.log.ball_closer_m = closer
+
+    def reset(self, **kwargs: Any) -> tuple[Any, dict[str, Any]]:
+        self._schedule()
+        obs, info = self.env.reset(**kwargs)
+        self._returns[:] = 0.0
+        return self._scaled(obs), info
+
+    def step(self, actions: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
+        targets = self.template.targets(np.asarray(actions, np.float64)).astype(np.float32)
+        self._schedule()
         obs, rewards, terminated, truncated, infos = self.env.step(targets)
         self._returns += rewards
         ended = np.logical_or(terminated, truncated)
@@ -169,7 +173,8 @@ class PolicyInputs(gym.vector.VectorWrapper):
                 self.log.episode(float(self._returns[i]), _item(final, "kick_distance_m", i),
                                  _item(final, "max_ball_speed_m_s", i),
                                  bool(_item(final, "fallen", i)),
-                                 bool(_item(final, "touched", i)))  # fmt: skip
+                                 bool(_item(final, "touched", i)),
+                                 _item(final, "ball_closer_m", i))  # fmt: skip
                 self._returns[i] = 0.0
         self.log.steps += self.num_envs
         return self._scaled(obs), rewards, terminated, truncated, infos
@@ -191,7 +196,6 @@ class EpisodeLog:
                            "ball_closer_m", "wall_s"])  # fmt: skip
         self.steps = 0
         self.fall_penalty = 0.0
-        self.ball_closer_m = 0.0
         self.episodes = 0
         self.recent: deque[tuple[float, float, float, bool, bool]] = deque(maxlen=200)
         self.started = time.perf_counter()
@@ -199,12 +203,14 @@ class EpisodeLog:
         self.export = export
         self._last_print = self.started
 
-    def episode(self, ret: float, kick: float, speed: float, fallen: bool, touched: bool) -> None:
+    def episode(
+        self, ret: float, kick: float, speed: float, fallen: bool, touched: bool, closer: float
+    ) -> None:
         self.episodes += 1
         wall = time.perf_counter() - self.started
         self.csv.writerow([self.steps, self.episodes, round(ret, 4), round(kick, 4),
                            round(speed, 3), int(fallen), int(touched), round(self.fall_penalty, 3),
-                           round(self.ball_closer_m, 4), round(wall, 1)])  # fmt: skip
+                           round(closer, 4), round(wall, 1)])  # fmt: skip
         self.recent.append((ret, kick, speed, fallen, touched))
         if time.perf_counter() - self._last_print >= self.every_s:
             self.progress()

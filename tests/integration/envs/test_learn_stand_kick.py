@@ -48,7 +48,7 @@ def test_a_short_run_touches_and_moves_the_ball(
         rows = list(csv.DictReader(f))
     touched = [r for r in rows if r["touched"] == "1"]
     assert len(touched) >= len(rows) // 4, f"{len(touched)} of {len(rows)} episodes touched"
-    assert float(rows[0]["ball_closer_m"]) == pytest.approx(0.03, abs=1e-3)
+    assert float(rows[0]["ball_closer_m"]) == 0.03  # the first episodes start at 3 cm
     assert float(rows[-1]["ball_closer_m"]) == 0.0  # the ball where the skill finds it
     moved = [float(r["kick_distance_m"]) for r in touched]
     assert max(moved) > 0.1 and float(np.mean(moved)) > 0.02

@@ -116,6 +116,7 @@ def test_the_curriculum_brings_the_ball_nearer_the_toe() -> None:
         env.ball_closer_m = 0.02  # as a trainer sets it between episodes
         _, near = env.reset(seed=4)
         assert far["toe_to_ball_m"] - near["toe_to_ball_m"] == pytest.approx(0.02, abs=0.006)
+        assert (far["ball_closer_m"], near["ball_closer_m"]) == (0.0, 0.02)
         env.ball_closer_m = 0.2
         with pytest.raises(EnvConfigError) as caught:
             env.reset(seed=4)
