@@ -43,6 +43,33 @@ class BoardPost(Protocol):
     ) -> None: ...
 
 
+class AnswerBook:
+    """Who lockstep waits for, kept as it changes so that "has every client answered?" is one
+    look whatever the number of robots: ``owing``, the connections not slow whose latest
+    measurement is not answered yet, and ``slow``, those lockstep does not wait for. A
+    connection moves between them itself (:meth:`Connection.owe`, its reads, its
+    :meth:`Connection.mark_slow`); an add or a discard on a set is one operation under the GIL,
+    so the I/O thread's reads may move one while the step thread looks."""
+
+    __slots__ = ("owing", "slow")
+
+    def __init__(self) -> None:
+        self.owing: set[Connection] = set()
+        self.slow: set[Connection] = set()
+
+    def forget(self, conn: Connection) -> None:
+        """``conn`` is dropped: nobody waits for it."""
+        self.owing.discard(conn)
+        self.slow.discard(conn)
+
+    def reconcile(self) -> None:
+        """Take out of ``owing`` what a race between the two threads left there (a connection
+        marked slow while it was being owed, or closed); the flags are the authority."""
+        for conn in tuple(self.owing):
+            if conn.slow or conn.answered or conn.closed:
+                self.owing.discard(conn)
+
+
 class ClientClosed(Exception):
     """Internal signal: the client must be dropped; ``reason`` says why (logged once)."""
 
@@ -108,6 +135,8 @@ class Connection:
         self.last_sent_at: float | None = None
         self.enqueued_at = 0.0  # monotonic time the latest measurement was queued
         self.slow = False
+        # lockstep's book of who owes an answer (None without lockstep); set by the server
+        self.book: AnswerBook | None = None
         self.bank_s = time_bank_s
         self.want_write = False
         self._told = False  # a request dropped with a notice since the last read's end
@@ -174,6 +203,9 @@ class Connection:
             self._told = False
             self.answered = True
             self.answered_at = now
+            book = self.book
+            if book is not None:
+                book.owing.discard(self)
             if self.last_sent_at is not None:
                 self.stats.round_trip_s.append(now - self.last_sent_at)
                 self.last_sent_at = None
@@ -236,7 +268,7 @@ class Connection:
         self.paused = True
         if self.slow:
             return
-        self.slow = True
+        self.mark_slow(True)
         self.stats.slow_periods += 1
         if now - self._paused_logged >= 10.0:
             self._paused_logged = now
@@ -246,6 +278,28 @@ class Connection:
                 " meanwhile (%d times so far)",
                 self.key, self.budget.rate, self.budget.per_measurement, self.stats.slow_periods,
             )  # fmt: skip
+
+    def owe(self) -> None:
+        """A measurement was queued: the client owes its answer (lockstep waits for it unless
+        it is slow)."""
+        self.answered = False
+        book = self.book
+        if book is not None and not self.slow:
+            book.owing.add(self)
+
+    def mark_slow(self, slow: bool) -> None:
+        """Lockstep stops (True) or starts again (False) waiting for this client."""
+        self.slow = slow
+        book = self.book
+        if book is None:
+            return
+        if slow:
+            book.slow.add(self)
+            book.owing.discard(self)
+        else:
+            book.slow.discard(self)
+            if not self.answered:
+                book.owing.add(self)
 
     def resume(self, now: float) -> bool:
         """A paused connection whose budget refilled is no longer paused: True, and the caller
@@ -301,7 +355,7 @@ class Connection:
             self.stats.dropped_out += 1
         outbox.append(frame)
         self.measurements += 1
-        self.answered = False
+        self.owe()
         self.last_sent_at = now
         self.enqueued_at = now
 
@@ -321,7 +375,7 @@ class Connection:
             self.flush()
             return
         self.measurements += 1
-        self.answered = False
+        self.owe()
         self.last_sent_at = now
         self.enqueued_at = now
         stats = self.stats

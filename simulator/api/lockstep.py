@@ -25,28 +25,40 @@ log = logging.getLogger(__name__)
 
 
 def wait_lockstep(server: ApiServer, settings: LockstepSettings) -> float:
-    """Block until every awaited client has answered (or ran out of time); returns seconds."""
-    for slot in server.slots.values():
-        conn = slot.conn
-        if conn is not None and (conn.slow or not conn.answered):
-            break
-    else:  # every client answered before the wait (pipelined, usually): nothing to charge
+    """Block until every awaited client has answered (or ran out of time); returns seconds.
+
+    The usual wait is one look at the server's :class:`~simulator.api.connection.AnswerBook`
+    per wake-up, whatever the number of robots: until the deadline nobody can be late, so the
+    clients are looked at one by one (:func:`_wait`: deadlines, time banks, slow clients
+    catching up) only once it has passed or while some client is slow."""
+    book = server.answers
+    assert book is not None, "lockstep without the server's lockstep settings"
+    owing = book.owing
+    if not owing and not book.slow:  # every client answered before the wait (pipelined)
         return 0.0
     start = time.monotonic()
     deadline = settings.deadline_s
-    missed: set[str] = set()
-    server.awaiting_answers = True  # before the flags are read: an answer after wakes the poll
+    due = start + deadline  # the earliest any client's free time ends
+    server.awaiting_answers = True  # before the book is read: an answer after wakes the poll
     try:
-        _wait(server, settings, start, deadline, missed)
+        while owing and not book.slow and not server.stop_requested:
+            remaining = due - time.monotonic()
+            if remaining <= 0:
+                break
+            server.poll(min(remaining, 0.05))
+        if owing or book.slow:  # past the deadline, or slow clients: client by client
+            _wait(server, settings, start, deadline, set())
+            book.reconcile()
     finally:
         server.awaiting_answers = False
     end = time.monotonic()
-    for slot in server.slots.values():
-        conn = slot.conn
-        if conn is not None and not conn.slow and conn.answered:
-            late = conn.answered_at - max(start, conn.enqueued_at) - deadline
-            if late > 0:
-                conn.bank_s = max(0.0, conn.bank_s - late)
+    if end >= due:  # before ``due`` every answer was within its free time: nothing to charge
+        for slot in server.slots.values():
+            conn = slot.conn
+            if conn is not None and not conn.slow and conn.answered:
+                late = conn.answered_at - max(start, conn.enqueued_at) - deadline
+                if late > 0:
+                    conn.bank_s = max(0.0, conn.bank_s - late)
     return end - start
 
 
@@ -63,7 +75,7 @@ def _wait(
                 continue
             if conn.slow:
                 if conn.answered and conn.idle and not conn.paused:
-                    conn.slow = False
+                    conn.mark_slow(False)
                     conn.bank_s = settings.time_bank_s
                     log.info("%s: caught up, lockstep waits for it again", slot.session.key)
                 continue
@@ -79,7 +91,7 @@ def _wait(
                     slot.stats.missed_deadlines += 1
                 if over >= conn.bank_s:
                     conn.bank_s = 0.0
-                    conn.slow = True
+                    conn.mark_slow(True)
                     slot.stats.slow_periods += 1
                     log.warning(
                         "%s: too slow for lockstep (time bank of %.1f s used up), "

@@ -39,7 +39,7 @@ from referee import SpoofingLog
 from simulator.api.batch import Encoding, Gathered, StepBatch
 from simulator.api.board import TargetBoard
 from simulator.api.cameras import MAX_IN_FLIGHT, ImageSource
-from simulator.api.connection import ClientClosed, Connection
+from simulator.api.connection import AnswerBook, ClientClosed, Connection
 from simulator.api.devices import DeviceWorld
 from simulator.api.endpoints import PlayerEndpoint, peer_allowed_by_name
 from simulator.api.fastreq import Notice, PositionTargets, TargetValues
@@ -211,6 +211,8 @@ class ApiServer:
         self._spoofing = spoofing or SpoofingLog()
         self._network = network
         self._lockstep = lockstep
+        # lockstep: who owes an answer and who is slow, kept as it changes (one look per wait)
+        self.answers: AnswerBook | None = AnswerBook() if lockstep is not None else None
         self._cameras = cameras
         self._unix_ms = unix_ms
         self._selector = selectors.DefaultSelector()
@@ -482,6 +484,9 @@ class ApiServer:
             threaded=self._sender is not None,
             requests_lock=self._requests_lock,
         )
+        if self.answers is not None:
+            slot.conn.book = self.answers
+            slot.conn.owe()  # a new client owes its first request
         slot.pending.clear()
         slot.stats.connects.append(time.time())
         self.connection_changes += 1
@@ -557,6 +562,8 @@ class ApiServer:
         slot.stats.disconnect_reasons.append(reason)
         slot.conn = None
         slot.pending.clear()
+        if self.answers is not None:
+            self.answers.forget(conn)
         self.connection_changes += 1
         if conn.threaded and self._sender is not None:
             self._sender.remove(conn)
@@ -858,7 +865,7 @@ class ApiServer:
             if conn is None:
                 continue
             jobs = measurement.jobs
-            conn.answered = False
+            conn.owe()
             if jobs or slot.pending:  # sent by this thread when its images are in
                 if unwritten is not None:
                     unwritten.write()
@@ -884,7 +891,7 @@ class ApiServer:
         assert self._sender is not None
         if self._lockstep is not None:  # (the flag lockstep waits on; async never waits)
             for conn in steady.step.conns:
-                conn.answered = False
+                conn.owe()
         self._flush_all()  # anything queued before, in order
         self._sender.submit(partial(self._deliver_steady, steady, time.monotonic()))
 

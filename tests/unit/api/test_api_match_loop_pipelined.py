@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from contracts.ids import RobotId, TeamColor
 from simulator.api import LockstepSettings
+from simulator.api.connection import AnswerBook
 from simulator.match_loop import LoopSettings, MatchLoop
 from simulator.telemetry import NullTelemetry
 from tests.unit.api.test_api_match_loop_pacing import _Referee, _World
@@ -21,6 +22,7 @@ class _PipelineServer:
     def __init__(self, world: _World) -> None:
         self.world = world
         self.slots: dict[RobotId, object] = {}  # wait_lockstep: nobody to wait for
+        self.answers = AnswerBook()
         self.sent: list[int] = []
         self.calls: list[str] = []
         self.applied: list[tuple[int, list[str]]] = []
