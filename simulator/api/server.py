@@ -345,6 +345,12 @@ class ApiServer:
     def statistics(self) -> dict[str, RobotApiStats]:
         return {slot.session.key: slot.stats.to_dict() for slot in self.slots.values()}
 
+    @property
+    def io_wakes(self) -> int:
+        """Wake-ups of the I/O thread the step thread has paid for so far (a write to its pipe
+        each: :mod:`simulator.api.sender`); 0 without the thread."""
+        return self._sender.wakes if self._sender is not None else 0
+
     def connection(self, robot: RobotId) -> Connection | None:
         return self.slots[robot].conn
 

@@ -1,8 +1,9 @@
 """The I/O thread of async and pipelined stepping: frames queued by the step thread all reach
 the client, in order; when steps come fast the thread polls and the step thread stops waking it
 (no write to the wake pipe), and its polled waits follow the steps' period with sub-millisecond
-timeouts; when steps come slowly (a match paced to real time) every step wakes it. A socket
-whose descriptor number ``select`` cannot watch is served too."""
+timeouts; when steps come slowly (a match paced to real time) a step wakes it unless the thread
+looks at the queues by itself in a moment. A socket whose descriptor number ``select`` cannot
+watch is served too."""
 
 from __future__ import annotations
 
@@ -89,14 +90,33 @@ def test_fast_steps_are_polled_without_waking(
     assert wakes < 150, wakes
 
 
-def test_slow_steps_wake_the_thread_every_time(
+def test_slow_steps_skip_the_wake_up_when_the_thread_looks_in_a_moment(
     pair: tuple[Connection, socket.socket], monkeypatch: pytest.MonkeyPatch
 ) -> None:
+    """Steps 5 ms apart: the thread plans a look at the queues 30 us after the next step is
+    due, and a step thread whose frames come within ``LOOK_AHEAD_S`` of that look (or later,
+    while the thread looks again every ``POLL_MIN_S``) does not wake it. With a look-ahead of
+    a whole step no step wakes it once it knows the period (each one did before)."""
     conn, client = pair
+    monkeypatch.setattr(sender_module, "LOOK_AHEAD_S", 0.006)
     wakes = _run(conn, client, poll=True, steps=20, gap_s=0.005, monkeypatch=monkeypatch)
-    # steps 5 ms apart: no polling, each one wakes the thread (but when a loaded machine kept
-    # the thread busy past the next step; with polling: 2 or 3)
-    assert wakes >= 12, wakes
+    assert wakes < 10, wakes  # the first steps, before the period is known
+
+
+@pytest.mark.parametrize(
+    ("since", "interval", "period", "looked"),
+    [
+        (0.0005, 0.0008, 0.0008, False),  # fast steps: polled instead
+        (0.0040, 0.0050, 0.0050, True),  # slower steps: looked for when the step is due
+        (0.0056, 0.0050, 0.0050, True),  # ... and until an eighth of a period late
+        (0.0057, 0.0050, 0.0050, False),  # later: woken by the step thread
+        (0.0010, 0.0500, 0.0, False),  # no period known yet: woken
+    ],
+)
+def test_when_the_thread_plans_a_look(
+    since: float, interval: float, period: float, looked: bool
+) -> None:
+    assert sender_module.looks(since, interval, period) is looked
 
 
 def test_without_poll_fast_steps_wake_the_thread(
