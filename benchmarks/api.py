@@ -34,6 +34,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from contracts.ids import TeamColor
+from testkit.figures import FLOOD_TARGET, TARGETS, judged
 
 if TYPE_CHECKING:
     from contracts.ids import RobotId
@@ -545,6 +546,7 @@ def _api_run(
             reference_steps(WARMUP_STEPS)
         chunk = max(1, INTERLEAVE_MS // world.step_ms)
         requests_before = sum(slot.stats.messages_in for slot in server.slots.values())
+        wakes_before = server.io_wakes
         requests = 0
         wall = cpu = ref_wall = ref_cpu = 0.0
         done = 0
@@ -566,6 +568,7 @@ def _api_run(
             requests_before = sum(slot.stats.messages_in for slot in server.slots.values())
         if pipeline is not None:
             waited[0] = pipeline.waited_s
+        io_wakes = server.io_wakes - wakes_before
         stats = server.statistics()
     finally:
         server.close()
@@ -604,6 +607,7 @@ def _api_run(
         "real_time_factor": round((world.sim_time_ms - start_ms) / 1000.0 / wall, 3),
         "cpu_s_per_sim_s": cpu / ((world.sim_time_ms - start_ms) / 1000.0),
         "wait_share": round(waited[0] / wall, 3),
+        "io_wakes_per_step": round(io_wakes / steps, 3),
         "ratio_interleaved": round(ref_wall / wall, 3) if ref_wall else None,
         "cpu_ratio_interleaved": round(ref_cpu / cpu, 3) if ref_cpu else None,
         "connected": len(stats),
@@ -707,12 +711,16 @@ def main(argv: list[str]) -> int:
         "dropped_in": api["dropped_in"],
         # share of the API run's wall time the step thread waited for the clients (lockstep)
         "client_wait_share": api["wait_share"],
+        # wake-ups of the I/O thread the step thread paid for (a pipe write each), per step
+        "io_wakes_per_step": api["io_wakes_per_step"],
         "step_thread_cpus": sorted(os.sched_getaffinity(0)),
         "client_cpus": sorted(args.client_cpus) or "shared",
         "client": args.client,
     }
-    if api["league_client"] is not None:
-        result["league_client"] = api["league_client"]
+    if api["league_client"] is not None:  # judged against the mode's target, as the report does
+        league = dict(api["league_client"], ratio_interleaved=api["ratio_interleaved"])
+        league.update(judged(TARGETS[args.mode], league))
+        result["league_client"] = league
     if camera is not None:  # the camera path against a bare render of the same scene
         from simulator.gl import read_gl_info
 
@@ -729,7 +737,9 @@ def main(argv: list[str]) -> int:
             "dropped_out": stalled["dropped_out"],
         }
     if args.flood:
-        result["flood"] = _flood_figures(args, camera)
+        flood = _flood_figures(args, camera)
+        flood.update(judged(FLOOD_TARGET, flood))
+        result["flood"] = flood
     print(json.dumps(result, sort_keys=True), flush=True)
     return 0
 

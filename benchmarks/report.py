@@ -11,6 +11,10 @@ kind alike), each benchmark as a child process with small sizes:
   same run, so that a change of load between the two does not show as a ratio; also the ratio
   to a ``bench sim`` run and to a world-only run before it, the CPU ratios and the share of
   time the step waited for its clients;
+- ``lockstep_league``: ``bench api --mode lockstep --client league``: the same figures with
+  clients written like the league's own (each request's length and body in two writes, no
+  ``TCP_NODELAY``: :mod:`testkit.league_client`), and their requests per second and round
+  trips; judged against the lockstep target;
 - ``cameras``: ``bench api --mode async`` with every robot's camera at 320x240 every 32 ms,
   rendered as a match renders them (``render_processes``: worker processes on the CPU
   renderer, one per CPU; 0: one thread) (the real-time factor is the figure: rendering is most
@@ -42,7 +46,7 @@ from testkit.figures import (
     median_figures,
 )
 
-KINDS = ("sim", "async", "lockstep", "pipelined", "cameras", "bringup")
+KINDS = ("sim", "async", "lockstep", "lockstep_league", "pipelined", "cameras", "bringup")
 
 
 
@@ -118,6 +122,17 @@ def _runners(args: argparse.Namespace) -> dict[str, Callable[[], dict[str, Any]]
 
         return run
 
+    def lockstep_league() -> dict[str, Any]:
+        result = _child([*api, "--mode", "lockstep", "--client", "league",
+                         "--sim-seconds", sim_s], 600)  # fmt: skip
+        if "error" in result:
+            return result
+        league = result.get("league_client") or {}
+        figures = _api_figures(result)
+        for key in ("requests_per_s", "client_answer_p50_ms", "client_round_trip_p50_ms"):
+            figures[key] = league.get(key)
+        return figures
+
     def sim() -> dict[str, Any]:
         result = _child(["-m", "benchmarks", "sim", "--robots", robots,
                          "--sim-seconds", str(args.world_seconds), "--json"], 600)  # fmt: skip
@@ -163,6 +178,7 @@ def _runners(args: argparse.Namespace) -> dict[str, Callable[[], dict[str, Any]]
         "sim": sim,
         "async": api_mode("async"),
         "lockstep": api_mode("lockstep"),
+        "lockstep_league": lockstep_league,
         "pipelined": api_mode("pipelined"),
         "cameras": cameras,
         "bringup": bringup,

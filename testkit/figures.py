@@ -36,10 +36,25 @@ TARGETS = {
     "sim": Target("ratio", minimum=0.95),
     "async": Target("ratio_interleaved", minimum=0.92),
     "lockstep": Target("ratio_interleaved", minimum=0.85),
+    # lockstep with clients written like the league's (no TCP_NODELAY, a request in two writes)
+    "lockstep_league": Target("ratio_interleaved", minimum=0.85),
     "pipelined": Target("ratio_interleaved", minimum=0.92),
     "cameras": Target("real_time_factor", minimum=1.0),
     "bringup": Target("bringup_s", maximum=3.0),
 }
+
+# ``bench api --flood``: the other robots' pace with a robot flooding its port over their pace
+# without it (``ratio_interleaved``, 1.0: the flood costs them nothing)
+FLOOD_TARGET = Target("ratio_interleaved", minimum=0.9)
+
+
+def judged(target: Target, figures: Mapping[str, object]) -> dict[str, object]:
+    """``target`` and whether ``figures`` meet it (None: the figure is missing), to add to a
+    benchmark's JSON beside the figures."""
+    value = figures.get(target.figure)
+    met = target.met(value) if isinstance(value, int | float) else None
+    return {"target": target.to_dict(), "meets_target": met}
+
 
 # The speed of the bare 8-robot ``mj_step`` loop (times real time) of the machine the cameras' and
 # the bring-up's targets are set for. Both depend on the machine's speed, so on another machine
@@ -75,10 +90,12 @@ def median_figures(runs: Sequence[Mapping[str, object]]) -> dict[str, float]:
 
 
 __all__ = [
+    "FLOOD_TARGET",
     "MACHINE_SCALED",
     "REFERENCE_BARE_REAL_TIME_FACTOR",
     "TARGETS",
     "Target",
+    "judged",
     "machine_target",
     "median_figures",
 ]

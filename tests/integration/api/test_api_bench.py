@@ -63,6 +63,11 @@ def test_bench_api_league_clients_report_their_rate_and_both_round_trips() -> No
     for key in ("round_trip_p50_ms", "client_answer_p50_ms", "client_round_trip_p50_ms"):
         assert isinstance(league[key], float) and league[key] > 0, key
     assert result["slow_periods"] == 0
+    # judged as the report judges lockstep: the run's ratio to the world alone
+    assert league["ratio_interleaved"] == result["ratio_interleaved"]
+    assert league["target"] == {"figure": "ratio_interleaved", "min": 0.85}
+    ratio = result["ratio_interleaved"]
+    assert isinstance(ratio, float) and league["meets_target"] == (ratio >= 0.85)
 
 
 def test_bench_api_flood_reports_the_honest_robots_with_and_without_it() -> None:
@@ -77,3 +82,6 @@ def test_bench_api_flood_reports_the_honest_robots_with_and_without_it() -> None
     assert flood["ratio"] == pytest.approx(
         flood["real_time_factor"] / flood["real_time_factor_without"], abs=0.01
     )
+    # the honest robots' pace with the flood over without: at least 0.9 meets the target
+    assert flood["target"] == {"figure": "ratio_interleaved", "min": 0.9}
+    assert flood["meets_target"] == (flood["ratio_interleaved"] >= 0.9)

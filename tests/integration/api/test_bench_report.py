@@ -6,7 +6,7 @@ import json
 import subprocess
 import sys
 
-from testkit.figures import Target, machine_target
+from testkit.figures import FLOOD_TARGET, Target, judged, machine_target
 from testkit.figures import median_figures as _median
 
 
@@ -37,6 +37,37 @@ def test_report_runs_the_kinds_and_judges_medians_against_targets() -> None:
     assert 0 <= pipelined["median"]["client_wait_share"] < 1
 
 
+def test_report_runs_lockstep_with_clients_written_like_the_leagues() -> None:
+    """``lockstep_league``: a lockstep run whose clients write each request's length and body
+    in two writes without ``TCP_NODELAY``, judged against the lockstep target (shape only: the
+    figures of two robots for a quarter of a second say nothing of the speed)."""
+    proc = subprocess.run(
+        [sys.executable, "-m", "hlvs", "bench", "report", "--only", "lockstep_league",
+         "--repeats", "1", "--robots", "2", "--sim-seconds", "0.25", "--json"],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    report = json.loads(proc.stdout)
+    assert report["errors"] == 0 and "lockstep" not in report and "sim" not in report
+    league = report["lockstep_league"]
+    assert league["target"] == {"figure": "ratio_interleaved", "min": 0.85}
+    [run] = league["runs"]
+    median = league["median"]
+    for key in ("ratio_interleaved", "requests_per_s", "client_answer_p50_ms",
+                "client_round_trip_p50_ms", "round_trip_p50_ms", "client_wait_share"):
+        assert isinstance(run[key], float) and run[key] > 0, key
+        assert median[key] == run[key], key
+    assert league["meets_target"] == (median["ratio_interleaved"] >= 0.85)
+
+
+def test_a_judged_figure_names_its_target() -> None:
+    assert judged(Target("ratio", minimum=0.85), {"ratio": 0.84}) == {
+        "target": {"figure": "ratio", "min": 0.85}, "meets_target": False}
+    assert judged(Target("s", maximum=3.0), {"s": 2.5})["meets_target"] is True
+    assert judged(FLOOD_TARGET, {"ratio_interleaved": None}) == {
+        "target": {"figure": "ratio_interleaved", "min": 0.9}, "meets_target": None}
+
+
 def test_bad_kind_is_named() -> None:
     proc = subprocess.run(
         [sys.executable, "-m", "hlvs", "bench", "report", "--only", "sim,gpu"],
@@ -57,6 +88,7 @@ def test_targets_are_the_performance_goals_and_scale_with_the_machine() -> None:
     cameras 1.0 x real time and bring-up 3 s on a machine whose bare loop runs 12x real time),
     so that a run that misses a goal cannot print ``meets_target: true``."""
     assert machine_target("lockstep", 6.0) == Target("ratio_interleaved", minimum=0.85)
+    assert machine_target("lockstep_league", 6.0) == Target("ratio_interleaved", minimum=0.85)
     assert machine_target("async", None) == Target("ratio_interleaved", minimum=0.92)
     assert machine_target("pipelined", 30.0) == Target("ratio_interleaved", minimum=0.92)
     assert machine_target("sim", 6.0) == Target("ratio", minimum=0.95)
