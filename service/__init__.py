@@ -18,7 +18,7 @@ if TYPE_CHECKING:
     from service import tokens
     from service.accounts import ensure_team_account
     from service.admin import add_team, list_tokens
-    from service.app import Services, create_app, pool_from_settings
+    from service.app import create_app, pool_from_settings
     from service.client import register_client_commands
     from service.deps import (
         DbSession,
@@ -32,6 +32,7 @@ if TYPE_CHECKING:
     )
     from service.errors import NotFound, ServiceError
     from service.results import stored_many
+    from service.services import Services
     from service.settings import Settings
     from service.tokens import Principal
 
@@ -65,7 +66,8 @@ if not TYPE_CHECKING:
         "service": ("tokens",),
         "service.accounts": ("ensure_team_account",),
         "service.admin": ("add_team", "list_tokens"),
-        "service.app": ("Services", "create_app", "pool_from_settings"),
+        "service.app": ("create_app", "pool_from_settings"),
+        "service.services": ("Services",),
         "service.client": ("register_client_commands",),
         "service.deps": (
             "DbSession", "OperatorPrincipal", "TeamPrincipal", "get_db", "get_services",

@@ -54,7 +54,7 @@ from service.matchfiles import OWN_COLOR
 from service.settings import LOG_TARGET_ALLOW_SETTING, log_target_networks
 
 if TYPE_CHECKING:
-    from service.app import Services
+    from service.services import Services
 
 log = logging.getLogger(__name__)
 

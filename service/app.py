@@ -16,19 +16,15 @@ import gc
 import logging
 from collections.abc import AsyncIterator, Callable, Sequence
 from contextlib import asynccontextmanager
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING
 
 from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
-from sqlalchemy import Engine
 from sqlalchemy.exc import DBAPIError
-from sqlalchemy.orm import Session, sessionmaker
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from cluster import MatchPool, PoolError, make_pool
-from orchestrator.config import TeamConfig
 from service.db import (
     UNAVAILABLE_RETRY_S,
     database_busy,
@@ -38,13 +34,11 @@ from service.db import (
     session_factory,
 )
 from service.errors import AuthError, ServiceError
+from service.services import PoolFactory, Preflight, Services
 from service.settings import Settings
 
 if TYPE_CHECKING:
-    from service.sealing import Sealer
-    from service.statusboard import StatusBoard
-    from service.submissions import QueueBoard
-    from service.tokens import TokenCache
+    pass
 
 log = logging.getLogger(__name__)
 
@@ -75,55 +69,6 @@ def service_routers() -> tuple[Mount, ...]:
         envs.mount,  # the HTTP environment API (learning environments)
         ladder.mount,  # the league table of ratings
     )
-
-
-class Background(Protocol):
-    """A thread of the service that waits for work (the queue worker, the after-match
-    delivery); :meth:`wake` tells it there is some now."""
-
-    def start(self) -> None: ...
-
-    def wake(self) -> None: ...
-
-    def stop(self) -> None: ...
-
-
-@dataclass(slots=True, kw_only=True)
-class Services:
-    """What request handlers and the worker share; built by the lifespan (routers get it, or
-    one of its parts, through the accessors of :mod:`service.deps`)."""
-
-    settings: Settings
-    engine: Engine
-    sessions: sessionmaker[Session]
-    pool: MatchPool  # the port: a local-Docker or Slurm pool, a fake in unit tests
-    queue: QueueBoard
-    tokens: TokenCache
-    status: StatusBoard
-    sealer: Sealer  # the secrets stored in the database
-    preflight: Preflight | None = None
-    worker: Background | None = None  # service.worker.QueueWorker; None when the app serves
-    aftermatch: Background | None = None  # service.aftermatch.AfterMatch  without matches
-
-    def slots(self) -> int:
-        return int(self.pool.slots) if self.pool is not None else self.settings.match_slots
-
-    def changed(self, submission_id: str | None = None) -> None:
-        """This process changed one submission (or, without an id, the queue as a whole)."""
-        if self.queue is not None:
-            self.queue.invalidate()
-        if self.status is not None:
-            if submission_id is None:
-                self.status.invalidate()
-            else:
-                self.status.forget(submission_id)
-    extras: dict[str, Any] = field(default_factory=dict)
-
-
-PoolFactory = Callable[[Settings], MatchPool]
-Preflight = Callable[[TeamConfig, Settings], float]
-"""(the submitted team, checked; settings) -> seconds taken; raises
-service.errors.PreflightFailed."""
 
 
 def create_app(

@@ -24,15 +24,15 @@ from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
 from sqlalchemy.orm import Session
 
 from service import tokens
-from service.app import Services
 from service.db import Scope
 from service.errors import AuthError
+from service.services import Services
 
 bearer = HTTPBearer(auto_error=False, description="a team or operator token: hlvs_<id>_<secret>")
 
 
 def get_services(request: Request) -> Services:
-    """The app's :class:`service.app.Services` (built by its lifespan); a handler takes it as
+    """The app's :class:`service.services.Services` (built by its lifespan); a handler takes it as
     ``services: AppServices``."""
     services: Services = request.app.state.services
     return services

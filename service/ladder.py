@@ -39,7 +39,7 @@ from service.matchfiles import OWN_COLOR
 from service.ratings import LadderCache
 
 if TYPE_CHECKING:
-    from service.app import Services
+    from service.services import Services
 
 log = logging.getLogger(__name__)
 

@@ -21,7 +21,7 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 from service.db import Scope as TokenScope
 
 if TYPE_CHECKING:
-    from service.app import Services
+    from service.services import Services
 
 BODY_KEY = "hlvs.body"
 """The chunks of a request's body as read (in its scope): a body the route's parser could not

@@ -32,7 +32,7 @@ from service.results import MatchSummary
 from service.settings import Settings
 
 if TYPE_CHECKING:
-    from service.app import Services
+    from service.services import Services
 
 log = logging.getLogger(__name__)
 

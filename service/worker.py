@@ -38,7 +38,7 @@ from service.submissions import STUB, failure_side, queue_paused
 
 if TYPE_CHECKING:
     from orchestrator.config import TeamDocument
-    from service.app import Services
+    from service.services import Services
 
 log = logging.getLogger(__name__)
 

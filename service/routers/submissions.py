@@ -48,7 +48,7 @@ from service.views import (
 
 if TYPE_CHECKING:
     from orchestrator.config import TeamConfig
-    from service.app import Services
+    from service.services import Services
     from service.tokens import Principal
 
 router = APIRouter(prefix="/v1/submissions", tags=["submissions"],

@@ -25,16 +25,6 @@ PACKAGES = ("hlvs", "viewer", "service", "envs", "tournament", "cluster", "orche
             "simulator", "referee", "robot", "contracts", "benchmarks", "testkit")
 
 KNOWN: dict[str, frozenset[str]] = {
-    # The service's threads and routers take the whole `service.app.Services` container, which
-    # names them all (the worker, the after-match thread, the ladder, the status board): the
-    # knot goes when each thread takes the collaborators it uses.
-    "service": frozenset({
-        "service.aftermatch", "service.app", "service.deps", "service.ladder",
-        "service.middleware", "service.notify", "service.routers", "service.routers.envs",
-        "service.routers.everyone", "service.routers.health", "service.routers.ladder",
-        "service.routers.nodes", "service.routers.operator", "service.routers.submissions",
-        "service.routers.teams", "service.views", "service.worker",
-    }),
     # Remote environments: the Docker and Slurm pools start `envs.remote` servers, and
     # `envs.remote` starts the pools for its client side.
     "envs": frozenset({"envs.docker_pool", "envs.remote", "envs.slurm_node",
