@@ -146,12 +146,12 @@ def test_polled_waits_are_sub_millisecond_selects(
     monkeypatch.setattr(selectors.SelectSelector, "select", select)
     wakes = _run(conn, client, poll=True, steps=300, gap_s=0.0005, monkeypatch=monkeypatch)
     assert wakes < 150, wakes  # polled, not woken
-    polled = [t for _, t in waits if t is not None and 0.0 < t < sender_module.IDLE_WAIT_S]
-    assert len(polled) >= 30, waits[:50]  # the thread polled between most steps
+    # polled: sub-millisecond timeouts, which select(2) keeps and epoll_wait would round up
+    # (a step that came late, on a loaded machine, is looked for later: a longer wait)
+    polled = [t for _, t in waits if t is not None and 0.0 < t < 0.001]
+    assert len(polled) >= 30, waits[:50]  # the thread polled between many steps
     assert all(name == "SelectSelector" for name, _ in waits)
-    # aimed at the next step's frames: never over the polling threshold, most under 1 ms
-    assert all(sender_module.POLL_MIN_S <= t <= sender_module.POLL_BELOW_S for t in polled)
-    assert sorted(polled)[len(polled) // 2] < 0.001, sorted(polled)
+    assert all(t >= sender_module.POLL_MIN_S for t in polled), sorted(polled)[:5]
     assert any(t > sender_module.POLL_MIN_S for t in polled), polled[:20]  # aimed, not fixed
 
 
