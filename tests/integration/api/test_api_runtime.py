@@ -29,8 +29,9 @@ CONTRACT_FILES = (
 
 
 def _robot_loop(port: int, trace: list[tuple[int, float]]) -> None:
-    """A deterministic controller: joint targets from time and sensor feedback."""
-    client = RobotClient("127.0.0.1", port, retries=200, retry_interval_s=0.02).connect()
+    """A deterministic controller: joint targets from time and sensor feedback. It tries to
+    connect for 30 s: on a loaded machine the server listens only after more than 4 s."""
+    client = RobotClient("127.0.0.1", port, retries=1500, retry_interval_s=0.02).connect()
     try:
         client.enable_many({"NeckS": 8, "LegUpperLS": 8, "Accelerometer": 8})
         for msg in client:
@@ -124,7 +125,7 @@ def test_sigterm_stops_cleanly_with_results(tmp_path: Path) -> None:
     spec = replace(spec, timing=replace(spec.timing, half_duration_s=600.0))
     proc = _spawn(spec, tmp_path / "out")
     with RobotClient(
-        "127.0.0.1", spec.red.players[0].port, retries=200, retry_interval_s=0.05
+        "127.0.0.1", spec.red.players[0].port, retries=600, retry_interval_s=0.05
     ) as c:
         c.receive(timeout=30)
         proc.send_signal(signal.SIGTERM)
@@ -206,7 +207,7 @@ def test_invalid_spec_exits_2_naming_file_and_field(tmp_path: Path) -> None:
 
 def _camera_loop(port: int, images: list[bytes]) -> None:
     """A client that enables the head camera and keeps every image."""
-    client = RobotClient("127.0.0.1", port, retries=200, retry_interval_s=0.02).connect()
+    client = RobotClient("127.0.0.1", port, retries=1500, retry_interval_s=0.02).connect()
     try:
         client.enable_many({"NeckS": 8, "Camera": 32})
         for msg in client:
