@@ -6,6 +6,8 @@ seeking) is described in :mod:`simulator.replay.format`; reading is :mod:`simula
 
 from __future__ import annotations
 
+import contextlib
+import logging
 import zlib
 from pathlib import Path
 from typing import IO
@@ -31,6 +33,8 @@ from simulator.replay.format import (
 from simulator.replay.reader import load_replay
 from simulator.replay.scene import scene_of
 from simulator.world import World
+
+log = logging.getLogger(__name__)
 
 ZLIB_LEVEL = 6
 
@@ -74,7 +78,12 @@ class Recorder:
     frame when one is due at ``rate_hz`` of simulated time), :meth:`event` for referee events
     (stored with the next frame) and :meth:`close` at the end. The first frame, written on
     creation, holds the initial state with an empty game state. Frames are written in chunks of
-    ``chunk_frames`` (flushed to disk as each chunk completes)."""
+    ``chunk_frames`` (flushed to disk as each chunk completes).
+
+    A write that fails (the disk full, the folder gone) cuts the replay, never the match: the
+    file keeps its whole chunks (a reader scans a file without an index, see
+    :mod:`simulator.replay.reader`), :attr:`cut` says where and why, and the recorder writes
+    nothing more."""
 
     def __init__(
         self,
@@ -102,6 +111,8 @@ class Recorder:
         self._index_chunks: list[list[int]] = []
         self._index_events: list[EventRecord] = []
         self._offset = 0
+        self.cut = ""
+        """Empty, or why and at which simulated time the replay was cut short."""
         self._out: IO[bytes] | None = self.path.open("wb")
         header = replay_header(world, match_id=match_id, rate_hz=rate_hz, chunk_frames=chunk_frames)
         blob = dumps(header)
@@ -117,6 +128,8 @@ class Recorder:
         return self._frames
 
     def record(self, world: World, game_state: GameStateRecord) -> None:
+        if self.cut:
+            return
         self._game = game_state
         if world.sim_time_ms >= self._frames * self._period_ms:
             self._add(world.sim_time_ms, world.data.xpos, world.data.xquat)
@@ -124,16 +137,35 @@ class Recorder:
                 self._frames += 1
 
     def event(self, event: EventRecord) -> None:
-        self._events.append(event)
+        if not self.cut:
+            self._events.append(event)
 
-    def _emit(self, blob: bytes) -> None:
+    def _emit(self, blob: bytes, *, flush: bool = False) -> None:
         if self._out is None:
             raise ValueError(f"{self.path}: recorder is closed")
-        self._out.write(blob)
+        try:
+            self._out.write(blob)
+            if flush:
+                self._out.flush()
+        except OSError as exc:
+            self._cut_short(exc)
+            return
         self._offset += len(blob)
+
+    def _cut_short(self, exc: OSError) -> None:
+        at = max(self._last_time_ms, 0)
+        self.cut = (f"{self.path}: {exc.strerror or exc}: the replay ends before {at} ms of "
+                    "simulated time (the match went on)")
+        log.error("replay cut short: %s", self.cut)
+        out, self._out = self._out, None
+        if out is not None:
+            with contextlib.suppress(OSError):  # what is buffered cannot be written either
+                out.close()
 
     def _add(self, sim_time_ms: int, xpos: np.ndarray, xquat: np.ndarray) -> None:
         if self._out is None:
+            if self.cut:
+                return
             raise ValueError(f"{self.path}: recorder is closed")
         chunk = self._pending
         chunk["times"].append(sim_time_ms)
@@ -155,9 +187,7 @@ class Recorder:
         payload = U32.pack(len(meta)) + meta + poses
         times = chunk["times"]
         self._index_chunks.append([self._offset, times[0], times[-1], len(times)])
-        self._emit(RECORD_HEAD.pack(CHUNK, len(payload)) + payload)
-        assert self._out is not None
-        self._out.flush()
+        self._emit(RECORD_HEAD.pack(CHUNK, len(payload)) + payload, flush=True)
         self._pending = self._empty_chunk()
         self._poses = []
 
@@ -169,6 +199,8 @@ class Recorder:
         if self._events and world is not None and world.sim_time_ms != self._last_time_ms:
             self._add(world.sim_time_ms, world.data.xpos, world.data.xquat)
         self._flush_chunk()
+        if self._out is None:  # cut short by the last chunk
+            return
         index = dumps(
             {
                 "chunks": self._index_chunks,
@@ -178,8 +210,14 @@ class Recorder:
             }
         )
         at = self._offset
-        self._emit(RECORD_HEAD.pack(INDEX, len(index)) + index + TRAILER.pack(at, INDEX_MAGIC))
-        self._out.close()
+        self._emit(RECORD_HEAD.pack(INDEX, len(index)) + index + TRAILER.pack(at, INDEX_MAGIC),
+                   flush=True)
+        if self._out is None:  # cut short by the last writes
+            return
+        try:
+            self._out.close()
+        except OSError as exc:
+            self._cut_short(exc)
         self._out = None
 
     def __enter__(self) -> Recorder:
