@@ -54,10 +54,15 @@ def register(sub: Any) -> None:
         help="stop a scenario after this many simulated seconds (default 3600)",
     )  # fmt: skip
     test.add_argument(
+        "--world", choices=("league", "match"), default="league",
+        help="league: the league's test robot the scenarios push the ball and robots into (its "
+        "crouched Darwin-OP's body; default); match: our robots; matches never use the league's",
+    )  # fmt: skip
+    test.add_argument(
         "--ball", choices=("league", "match"), default="match",
-        help="match: the match ball (default); league: the league's ball, as the scenarios "
-        "were written for (its Webots damping, 77 %% of its speed lost a second, no rolling "
-        "friction); on hlvs_webots 87829b1 it passes fewer files than the match ball",
+        help="match: the match ball (default); league: the league's ball (its Webots damping, "
+        "77 %% of its speed lost a second, no rolling friction); on hlvs_webots 87829b1 it "
+        "passes fewer files than the match ball",
     )  # fmt: skip
     test.set_defaults(func=_test)
 
@@ -195,8 +200,12 @@ def _test(args: argparse.Namespace) -> int:
     outcomes = []
     for scenario, spec, heights in ready:
         outcome = run_league_scenario(
-            spec, scenario, league_standing_z=heights, max_sim_s=args.max_sim_s,
+            spec,
+            scenario,
+            league_standing_z=heights,
+            max_sim_s=args.max_sim_s,
             ball=args.ball,
+            world=args.world,
         )
         outcomes.append(outcome)
         if not args.json:

@@ -66,6 +66,21 @@ def test_the_failure_in_json(capsys: pytest.CaptureFixture[str]) -> None:
     assert "score of red: expected 1, received 0" in results[1]["failures"][0]
 
 
+@pytest.mark.parametrize(("world", "code"), [("league", 0), ("match", 1)])
+def test_the_league_world_sends_the_ball_back_off_its_robot_s_legs(
+    capsys: pytest.CaptureFixture[str], world: str, code: int
+) -> None:
+    """``--world league``: the league's crouched test robot (its knees 0.11 m in front of it at
+    the ball's height) sends a ball pushed into it back past 1.8 m, as the league's kick-off
+    scenario needs; our straight-legged robot sends it back to 1.25 m."""
+    got, out, _ = run(capsys, ROOT / "knee_bounce", "--world", world, "--json")
+    report = json.loads(out)
+    assert got == code, out
+    ball = report["scenarios"][0]["results"][0]
+    assert ball["name"] == "The ball came back"
+    assert ball["status"] == ("pass" if code == 0 else "fail")
+
+
 def _copy(tmp_path: Path, case: str = "failing") -> Path:
     target = tmp_path / case
     shutil.copytree(ROOT / case, target)

@@ -14,6 +14,7 @@ from robot import (
     UnknownModelError,
     motor_range,
 )
+from simulator.world.robots.league import LEAGUE_TEST_KID_NAME, league_test_kid
 from simulator.world.robots.model import (
     FORCE_SENSORS,
     CameraSpec,
@@ -81,6 +82,10 @@ ADULT_DEFAULT = RobotModel(
 )
 
 _MODELS = {model.name: model for model in (KID_DEFAULT, ADULT_DEFAULT)}
+# the league's test robot (:mod:`simulator.world.robots.league`): resolved by name for the
+# league's referee test scenarios, never listed among the models a team may choose
+LEAGUE_TEST_KID = league_test_kid(KID_DEFAULT)
+_TEST_MODELS = {LEAGUE_TEST_KID.name: LEAGUE_TEST_KID}
 
 
 def known_models() -> tuple[str, ...]:
@@ -101,7 +106,7 @@ def robot_model(name: str) -> AnyRobotModel:
     if is_model_path(name):
         return load_team_model(Path(name))
     try:
-        return _MODELS[name]
+        return _MODELS[name] if name in _MODELS else _TEST_MODELS[name]
     except KeyError:
         raise UnknownModelError(name=name, known=list(_MODELS)) from None
 
@@ -111,6 +116,8 @@ __all__ = [
     "AnyRobotModel",
     "FORCE_SENSORS",
     "KID_DEFAULT",
+    "LEAGUE_TEST_KID",
+    "LEAGUE_TEST_KID_NAME",
     "MOTOR_NAMES",
     "CameraSpec",
     "HumanoidGeometry",

@@ -212,7 +212,7 @@ def build_humanoid(
         f'fovy="{fovy_deg:.6g}"/>'
     )
     body = f"""
-<body name="{p}/torso" pos="{_f(x, y, g.standing_height_m)}" euler="0 0 {yaw:.9g}">
+<body name="{p}/torso" pos="{_f(x, y, model.standing_height_m)}" euler="0 0 {yaw:.9g}">
  <freejoint name="{p}/root"/>
  {torso}{chest}
  <site name="{p}/site:imu" pos="0 0 {g.torso_centre_z_m:.6g}" size="0.01"/>

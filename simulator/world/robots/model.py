@@ -99,10 +99,18 @@ class RobotModel(MotorLookup):
     joint_armature: float
     camera: CameraSpec = CameraSpec()
     force_sensors: tuple[str, ...] = FORCE_SENSORS
+    # the robot stands crouched (``LegUpper = q, LegLower = 2 q, Ankle = q``: torso upright, feet
+    # flat) with q = ``crouch_rad``; 0 for the built-in robots, which stand straight
+    crouch_rad: float = 0.0
 
     @property
     def standing_height_m(self) -> float:
-        return self.geometry.standing_height_m
+        """Height of the root body's origin above the ground in the standing pose."""
+        g = self.geometry
+        if not self.crouch_rad:
+            return g.standing_height_m
+        legs = (g.thigh_m + g.shank_m) * math.cos(self.crouch_rad)
+        return -g.hip_z_m + legs + g.ankle_height_m
 
     @property
     def devices(self) -> DeviceNames:
@@ -113,8 +121,11 @@ class RobotModel(MotorLookup):
 
     @property
     def standing_pose_rad(self) -> tuple[float, ...]:
-        """Joint positions (``motor_names`` order) the robot stands in when placed: all zero."""
-        return (0.0,) * len(self.motors)
+        """Joint positions (``motor_names`` order) the robot stands in when placed: all zero, or
+        the crouch of ``crouch_rad``."""
+        q = self.crouch_rad
+        crouch = {"LegUpper": q, "LegLower": 2.0 * q, "Ankle": q}
+        return tuple(crouch.get(m.name[:-1], 0.0) for m in self.motors)
 
     def mjcf(
         self,

@@ -1,0 +1,74 @@
+"""The league's test robot, for the league's referee test scenarios only (``hlvs referee test``).
+
+The league's referee tests play the league's sample robot, ``RobocupRobot``: a Darwin-OP
+(hlvs_webots ``protos/robots/RoboCupRobot/Darwin-opHinge2Robocup.proto``) that has no controller
+and so keeps the pose its proto stores: a deep crouch (``LegUpper`` 1.15, ``LegLower`` -2.25,
+``Ankle`` -1.23 rad, lines 808-810, 870-872, 919-921), its origin 0.24 m above the ground (the
+team files' ``halfTimeStartingPose``). Its scenarios push the ball into its legs and its legs into
+each other's, so where a ball or a robot stops depends on that body. This model is our humanoid
+with the Darwin-OP's dimensions taken from the proto's bounding objects and masses (2.93 kg in
+all) and the same crouch:
+
+    root            the Darwin-OP's origin (torso centre), 0.24 m above the ground standing
+    hip point       (0, +-0.045, -0.122): PelvY anchors at (-0.005, +-0.037, -0.1222), line 718
+    thigh, shank    0.093 each (the knee and ankle anchors, lines 871, 920); crouched at 1.126
+                    rad the knee reaches 0.106 forward of the origin (the proto's knee boxes:
+                    0.109), the legs leave no gap a ball can pass
+    foot            0.105 long x 0.068 wide (box ``0.066 0.013 0.105``, line 1020)
+    torso           0.112 x 0.114 x 0.116 box (the body's boxes, 0.1 x 0.058 x 0.091 ...)
+    arms            shoulders at (0, +-0.082, 0) hanging to 0.137 below it (lines 1552-1746)
+    head            a sphere r 0.045 above the neck at 0.051 (capsule r 0.042, lines 436-441)
+
+The robot is never a team's choice: the configuration's built-in models do not name it
+(:data:`orchestrator.config.BUILT_IN_MODELS`) and matches never play it.
+"""
+
+from __future__ import annotations
+
+from robot import HumanoidGeometry
+from simulator.world.robots.model import RobotModel
+
+LEAGUE_TEST_KID_NAME = "league-test-kid"
+
+LEAGUE_TEST_KID_GEOMETRY = HumanoidGeometry(
+    hip_y_m=0.045,
+    hip_z_m=-0.122,
+    thigh_m=0.093,
+    shank_m=0.093,
+    ankle_height_m=0.038,
+    foot_half_length_m=0.0525,
+    foot_half_width_m=0.034,
+    foot_half_thickness_m=0.007,
+    foot_forward_m=0.0,
+    cleat_radius_m=0.004,
+    torso_half_size_m=(0.056, 0.057, 0.058),
+    torso_centre_z_m=-0.03,
+    shoulder_y_m=0.1,
+    shoulder_z_m=0.0,
+    upper_arm_m=0.065,
+    forearm_m=0.07,
+    neck_z_m=0.051,
+    head_radius_m=0.045,
+    head_centre_z_m=0.03,
+    torso_kg=0.98,
+    head_kg=0.34,
+    thigh_kg=0.14,
+    shank_kg=0.1,
+    foot_kg=0.22,
+    joint_link_kg=0.04,
+    upper_arm_kg=0.17,
+    forearm_kg=0.06,
+)
+LEAGUE_TEST_KID_CROUCH_RAD = 1.126  # the knee 0.080 above the ankle as in the proto
+
+
+def league_test_kid(base: RobotModel) -> RobotModel:
+    """The league's test robot, with the motors of ``base`` (the kid-size built-in robot)."""
+    return RobotModel(
+        name=LEAGUE_TEST_KID_NAME,
+        field_class="kid",
+        geometry=LEAGUE_TEST_KID_GEOMETRY,
+        motors=base.motors,
+        joint_armature=base.joint_armature,
+        crouch_rad=LEAGUE_TEST_KID_CROUCH_RAD,
+    )
