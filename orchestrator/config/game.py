@@ -282,7 +282,10 @@ def _check_play_time(timing: Timing, game_type: Any, where: Collector) -> None:
 
 
 def _limits(raw: dict[str, float]) -> Limits:
-    values: dict[str, Any] = {k: (int(v) if k == "pids" else float(v)) for k, v in raw.items()}
+    values: dict[str, Any] = {
+        k: (int(v) if k == "pids" else str(v) if k == "robot_runtime" else float(v))
+        for k, v in raw.items()
+    }
     return Limits(**values)
 
 

@@ -51,6 +51,7 @@ class Limits:
     team_images_gb: float = 40.0  # all images of one team
     team_api_mb_s: float = 350.0  # robot API traffic of one team, split evenly per robot
     team_comm_mb_s: float = 1.0  # total traffic between the robots of one team
+    robot_runtime: str = ""  # the engine's OCI runtime for robots ("runsc": gVisor); "": default
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -107,6 +107,7 @@ class DockerRuntime:
             ] or None,
             "network_mode": request.network_mode
             or (request.networks[0].network if request.networks else "none"),
+            "runtime": request.runtime,
         }
         api = self._client.api
         networking = None

@@ -235,6 +235,7 @@ def robot_request(
         security_opt=("no-new-privileges",),
         cgroup_parent=cgroup_parent,
         console_max_bytes=ROBOT_CONSOLE_BYTES,
+        runtime=limits.robot_runtime or None,
     )
 
 

@@ -117,6 +117,7 @@ class ContainerRequest:
     # the engine keeps at most this much of stdout and stderr together (two rotated files of
     # half of it); None: the engine's default (no cap)
     console_max_bytes: int | None = None
+    runtime: str | None = None  # the engine's OCI runtime by name (e.g. "runsc"); None: default
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
