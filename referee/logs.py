@@ -11,6 +11,7 @@ Without a folder the lines only go to :mod:`logging`.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 from pathlib import Path
@@ -49,8 +50,15 @@ class RefereeLog:
     def _write(self, name: str, line: str) -> None:
         handle = self._files.get(name)
         if handle is not None:
-            handle.write(line + "\n")
-            handle.flush()
+            try:
+                handle.write(line + "\n")
+                handle.flush()
+            except OSError as exc:  # the disk full: this log stops, the match goes on
+                del self._files[name]
+                with contextlib.suppress(OSError):
+                    handle.close()
+                logger.error("%s cut short: %s (the match went on)", handle.name,
+                             exc.strerror or exc)
 
     def info(self, sim_time_ms: int, message: str) -> None:
         self._write(HUMAN_LOG, f"{self._prefix(sim_time_ms)} Info: {message}")
@@ -73,5 +81,6 @@ class RefereeLog:
 
     def close(self) -> None:
         for handle in self._files.values():
-            handle.close()
+            with contextlib.suppress(OSError):
+                handle.close()
         self._files.clear()

@@ -15,12 +15,16 @@ replay, which holds nothing measured on the wall clock.
 
 from __future__ import annotations
 
+import contextlib
 import json
+import logging
 from pathlib import Path
 from typing import IO, Protocol, cast
 
 from contracts import RobotTraffic, TrafficSample, files
 from simulator.api.stats import RobotStats
+
+log = logging.getLogger(__name__)
 
 STATS_FILE = files.API_STATS
 SAMPLE_PERIOD_S = 1.0
@@ -71,12 +75,20 @@ class TrafficLog:
             "robots": robots,
         }
         if self._out is not None:
-            self._out.write(json.dumps(self.latest, sort_keys=True) + "\n")
-            self._out.flush()
+            try:
+                self._out.write(json.dumps(self.latest, sort_keys=True) + "\n")
+                self._out.flush()
+            except OSError as exc:  # the disk full: the statistics stop, the match goes on
+                log.error("%s cut at %d ms of simulated time: %s", self._out.name, sim_time_ms,
+                          exc.strerror or exc)
+                with contextlib.suppress(OSError):
+                    self._out.close()
+                self._out = None
 
     def close(self) -> None:
         if self._out is not None:
-            self._out.close()
+            with contextlib.suppress(OSError):
+                self._out.close()
             self._out = None
 
 

@@ -10,9 +10,13 @@ the replay's tail, named."""
 
 from __future__ import annotations
 
+import contextlib
+import json
 import logging
 import os
 import subprocess
+import threading
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -28,18 +32,33 @@ pytestmark = [pytest.mark.root, pytest.mark.slow,
               pytest.mark.skipif(os.geteuid() != 0, reason="mounts a tmpfs")]
 
 
+def _nearly_full(mount: Path, left_bytes: int) -> Path:
+    """A 4 MiB tmpfs mounted at ``mount`` with about ``left_bytes`` left."""
+    mount.mkdir()
+    subprocess.run(["mount", "-t", "tmpfs", "-o", "size=4m", "tmpfs", str(mount)], check=True)
+    free = os.statvfs(mount).f_bavail * os.statvfs(mount).f_frsize
+    (mount / "filler").write_bytes(b"\0" * (free - left_bytes))
+    return mount
+
+
 @pytest.fixture
 def full_disk(tmp_path: Path) -> Iterator[Path]:
-    """A 1 MiB tmpfs with about 40 KiB left (the replay's header takes about 27 KiB)."""
-    mount = tmp_path / "disk"
-    mount.mkdir()
-    subprocess.run(["mount", "-t", "tmpfs", "-o", "size=1m", "tmpfs", str(mount)], check=True)
+    """About 40 KiB left (the replay's header takes about 27 KiB)."""
     try:
-        free = os.statvfs(mount).f_bavail * os.statvfs(mount).f_frsize
-        (mount / "filler").write_bytes(b"\0" * (free - 40 * 1024))
-        yield mount
+        yield _nearly_full(tmp_path / "disk", 40 * 1024)
     finally:
-        subprocess.run(["umount", "--lazy", str(mount)], check=True)
+        subprocess.run(["umount", "--lazy", str(tmp_path / "disk")], check=True)
+
+
+@pytest.fixture
+def filling_disk(tmp_path: Path) -> Iterator[Path]:
+    """Room for the simulator's reserve for its results and about 1 MiB more."""
+    from simulator.runtime import RESERVE_BYTES
+
+    try:
+        yield _nearly_full(tmp_path / "disk", RESERVE_BYTES + 1024 * 1024)
+    finally:
+        subprocess.run(["umount", "--lazy", str(tmp_path / "disk")], check=True)
 
 
 def test_a_full_disk_cuts_the_replay_never_the_match(
@@ -64,3 +83,40 @@ def test_a_full_disk_cuts_the_replay_never_the_match(
     times = [f.sim_time_ms for f in replay.frames]
     assert times[0] == 0 and times == sorted(times)
     assert 0 < times[-1] <= cut_ms
+
+
+def test_a_match_on_a_full_disk_plays_to_its_end_with_its_results(filling_disk: Path) -> None:
+    """The simulator itself (robots on loopback), its disk filling during the match: the match
+    plays out and its results are written (in the space reserved for them at the start); the
+    replay and the referee's logs are cut and the log says so."""
+    from tests.integration.api.match_specs import short_spec
+    from tests.integration.api.test_api_runtime import _play
+
+    spec = short_spec(stepping="lockstep")
+    replay_path = filling_disk / "out" / "replay.hlvsrec"
+    filled = threading.Event()
+
+    def fill_once_recording() -> None:  # the disk fills once the replay has a chunk or two
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:
+            if replay_path.exists() and replay_path.stat().st_size > 40 * 1024:
+                with contextlib.suppress(OSError), (filling_disk / "more").open("wb") as more:
+                    while True:
+                        more.write(b"\0" * 4096)
+                        more.flush()
+                filled.set()
+                return
+            time.sleep(0.005)
+
+    filler = threading.Thread(target=fill_once_recording)
+    filler.start()
+    code, trace = _play(spec, filling_disk / "out")
+    filler.join()
+    assert filled.is_set()
+    assert code == 0
+    assert len(trace) > 100  # the robot was served to the end
+    result = json.loads((filling_disk / "out" / "sim_result.json").read_text())
+    assert result["state"] == "FINISHED" and result["stop_reason"] == "finished", result
+    replay = load_replay(filling_disk / "out" / "replay.hlvsrec")
+    assert replay.frames[-1].sim_time_ms < result["sim_time_ms"]
+    assert not (filling_disk / "out" / ".results-reserve").exists()
