@@ -1,20 +1,26 @@
 """Writes the README's pictures of the league's look (``docs/look/*.png``).
 
 ``python scripts/look_frames.py [--out docs/look]``: red player 1 stands in front of the ball
-facing the blue goal; its head camera's frame is written with the league's camera model
-(exposure and noise of the match seed) for two texture seeds and in the ideal mode, with the
-match video's overview camera. Everything is procedural (:mod:`simulator.world.textures`): the
-pictures are this script's output, nothing else.
+facing the blue goal while a short replay is recorded, once per texture seed; ``hlvs render
+REPLAY --camera red-1`` then writes what its head camera saw (the league's camera model of the
+match seed: exposure and noise; the look's light with the main light's shadows), and the last
+frame is kept as ``camera_seed_N.png``. The match video's overview camera of the first seed is
+``overview.png``. Everything is procedural (:mod:`simulator.world.textures`): the pictures are
+this script's output, nothing else.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import shutil
+import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
+SEEDS = (19, 16, 9)  # a bright day, the pink dawn, the dim chapel hall
 
 
 def main(argv: list[str]) -> int:
@@ -26,15 +32,14 @@ def main(argv: list[str]) -> int:
 
     choose_offscreen_gl()
     import mujoco
-    import numpy as np
 
     from contracts.ids import RobotId, TeamColor
     from referee.snapshot import PlaceBall
     from robot.motion import standing_posture
     from simulator.png import write_png
-    from simulator.world import CameraRenderer, RobotPlacement, World
+    from simulator.recorder import Recorder
+    from simulator.world import RobotPlacement, World
     from simulator.world.camera_model import CameraModel
-    from simulator.world.look import apply_luminosity
 
     red1 = RobotId(TeamColor.RED, 1)
     placements = [
@@ -44,36 +49,37 @@ def main(argv: list[str]) -> int:
         ),
     ]
     args.out.mkdir(parents=True, exist_ok=True)
-    shots = (
-        ("league", 1, CameraModel.league(7)),
-        ("league_seed_7", 7, CameraModel.league(7)),
-        ("ideal", 1, CameraModel.ideal()),
-    )
-    for name, texture_seed, camera in shots:
-        world = World.create(
-            field_class="kid", robots=placements, seed=7, texture_seed=texture_seed,
-            camera_model=camera,
-        )  # fmt: skip
-        world.apply(PlaceBall(position=(2.5, 0.38, 0.07), velocity=(0.0, 0.0, 0.0)))
-        posture = standing_posture()
-        posture["Head"] = 0.1
-        for _ in range(60):
-            for robot in world.robot_ids:
-                world.set_motor_positions(robot, list(posture), list(posture.values()))
-            world.step()
-        with CameraRenderer(world, 320, 240) as renderer:
-            bgr = renderer.render(red1, sim_time_ms=world.sim_time_ms)
-        rgb = np.frombuffer(bgr, np.uint8).reshape(240, 320, 3)[:, :, ::-1]
-        write_png(args.out / f"camera_{name}.png", np.ascontiguousarray(rgb))
-        if name == "ideal":
-            with mujoco.Renderer(world.model, 270, 480) as overview:
-                overview.update_scene(world.data, camera="overview")
-                write_png(
-                    args.out / "overview.png",
-                    apply_luminosity(overview.render(), world.look.luminosity),
-                )
-    print(f"wrote {', '.join(f'camera_{name}.png' for name, *_ in shots)} and overview.png "
-          f"to {args.out}")
+    env = dict(os.environ, PYTHONPATH=str(REPO))
+    with tempfile.TemporaryDirectory() as tmp:
+        for texture_seed in SEEDS:
+            world = World.create(
+                field_class="kid", robots=placements, seed=7, texture_seed=texture_seed,
+                camera_model=CameraModel.league(7),
+            )  # fmt: skip
+            world.apply(PlaceBall(position=(2.8, 0.3, 0.07), velocity=(0.0, 0.0, 0.0)))
+            posture = standing_posture()
+            posture["Head"] = 0.1
+            replay = Path(tmp) / f"seed_{texture_seed}.hlvsrec"
+            with Recorder(replay, world, match_id=f"look-{texture_seed}", rate_hz=5.0) as rec:
+                for _ in range(60):
+                    for robot in world.robot_ids:
+                        world.set_motor_positions(robot, list(posture), list(posture.values()))
+                    world.step()
+                    rec.record(world, {"state": "PLAYING"})
+            frames = Path(tmp) / f"frames_{texture_seed}"
+            subprocess.run(
+                [sys.executable, "-m", "hlvs", "render", str(replay), "--camera", "red-1",
+                 "-o", str(frames), "--fps", "5"],
+                check=True, env=env, cwd=REPO,
+            )  # fmt: skip
+            last = sorted(frames.glob("red-1_*.png"))[-1]
+            shutil.copyfile(last, args.out / f"camera_seed_{texture_seed}.png")
+            if texture_seed == SEEDS[0]:
+                with mujoco.Renderer(world.model, 270, 480) as overview:
+                    overview.update_scene(world.data, camera="overview")
+                    write_png(args.out / "overview.png", overview.render())
+    names = ", ".join(f"camera_seed_{seed}.png" for seed in SEEDS)
+    print(f"wrote {names} and overview.png to {args.out}")
     return 0
 
 

@@ -3,9 +3,9 @@
 The replay's scene (:mod:`simulator.replay.scene`) carries the match's look, the robots' head
 cameras (resolution and field of view) and the camera model; each frame's body poses place
 the camera and the world, and every video frame becomes ``DIR/red-1_00000.png`` (RGB, the
-camera's resolution), with the match's exposure (and the luminosity its auto-exposure leaves)
-and per-pixel noise (motion blur needs the
-robots' velocities, which replays do not keep). Imports nothing that imports MuJoCo at its top
+camera's resolution), lit as the match was (the luminosity is in the lights), with the
+match's exposure and per-pixel noise (motion blur needs the robots' velocities, which replays
+do not keep). Imports nothing that imports MuJoCo at its top
 (the offscreen back end is chosen first).
 """
 
@@ -74,7 +74,6 @@ def render_camera_frames(
     out = Path(output_dir)
     out.mkdir(parents=True, exist_ok=True)
     renderer = mujoco.Renderer(model, height=height, width=width)
-    renderer.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = False
     renderer.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = False
     option = mujoco.MjvOption()
     option.geomgroup[4] = 0

@@ -98,7 +98,7 @@ def _geom_xml(geom: GeomRecord, material: str | None) -> str:
 def scene_xml(scene: SceneRecord) -> str:
     """An MJCF of shapes only (no joints, no physics) with one body per recorded body, in the
     recorded order, so that body ``i`` of the model is body ``i`` of every frame."""
-    from simulator.world.look import look_assets, look_from_summary
+    from simulator.world.look import light_xml, look_assets, look_from_summary
 
     bodies = scene["bodies"]
     geoms: list[list[str]] = [[] for _ in bodies]
@@ -142,13 +142,12 @@ def scene_xml(scene: SceneRecord) -> str:
 <visual>
  <global offwidth="1920" offheight="1080"/>
  <quality shadowsize="2048" offsamples="0"/>
- <headlight ambient="0.35 0.35 0.35" diffuse="0.3 0.3 0.3" specular="0 0 0"/>
+ <headlight ambient="0.35 0.35 0.35" diffuse="0 0 0" specular="0 0 0"/>
  <map znear="0.01" zfar="100"/>
 </visual>
 <asset>{"".join(assets)}</asset>
 <worldbody>
-<light directional="true" pos="0 0 10" dir="0.2 0.3 -1" diffuse="0.7 0.7 0.7" castshadow="false"/>
-<light directional="true" pos="0 0 10" dir="-0.2 -0.3 -1" diffuse="0.3 0.3 0.3" castshadow="false"/>
+{light_xml()}
 {cameras}{"".join(geoms[0])}{children}
 </worldbody>
 </mujoco>"""

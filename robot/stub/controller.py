@@ -27,8 +27,8 @@ from robot.stub.perception import (
     BallSighting,
     CameraPose,
     find_ball_blobs,
+    goal_below_horizon,
     ground_point,
-    white_above_horizon,
 )
 from robot.stub.world_model import WorldModel
 
@@ -47,7 +47,7 @@ SCAN = [(-0.9, 0.45), (-0.45, 0.5), (0.0, 0.55), (0.45, 0.5), (0.9, 0.45), (0.45
 SCAN_DWELL_S = 0.35
 SIDE_LOOK_S = 0.45  # per head position, when checking which side the own goal is on
 SIDE_LOOK_YAWS_RAD = (0.55, 1.3, -0.55, -1.3)  # left first, then right; 60 deg field of view
-SIDE_LOOK_PITCH_RAD = -0.15  # slightly up: goal posts stand above the horizon
+SIDE_LOOK_PITCH_RAD = -0.15  # slightly up: a far goal within the margin below the horizon
 SIDE_MIN_PIXELS = 30
 KNEE_RESET_RAD = 0.5  # knee this far from its target: the robot was reset or is limp
 KICK_SETTLE_S = 0.5  # stand still this long before a kick
@@ -217,7 +217,7 @@ class StubController:
         self.walk.reset()
 
     def _side_check(self, dt: float, sensors: Sensors) -> dict[str, float]:
-        """Stand and look left, then right; count white pixels above the horizon."""
+        """Stand and look left, then right; count the near goal's pixels below the horizon."""
         assert self._side_check_s is not None
         self._side_check_s += dt
         slot = min(int(self._side_check_s / SIDE_LOOK_S), len(SIDE_LOOK_YAWS_RAD) - 1)
@@ -234,7 +234,7 @@ class StubController:
                 torso_pitch_rad=att.pitch_rad,
                 pelvis_height_m=self._pelvis_height_m,
             )
-            pixels = white_above_horizon(sensors.image_bgr, pose, self.kin.camera, margin_rad=0.06)
+            pixels = goal_below_horizon(sensors.image_bgr, pose, self.kin.camera, margin_rad=0.09)
             self._side_pixels[0 if looking_left else 1] += pixels
         if self._side_check_s >= len(SIDE_LOOK_YAWS_RAD) * SIDE_LOOK_S:
             self._finish_side_check()

@@ -1,12 +1,17 @@
 """What the stub robot sees: the ball in its head camera, projected onto the ground.
 
-The ball is white with dark patches (the league's pentagon pattern, patches black or nearly)
-on a textured green turf; field lines and goal posts are white only, robots grey, black, team
-coloured. Images come through the camera model (exposure, pixel noise). The detector keeps
-connected regions of non-green pixels that hold both clearly white and clearly black pixels,
-are about as wide as tall and fill their bounding box like a disc, and whose size matches the
-ball's expected size at the distance the region's position implies. It works on every second
-pixel (160x120 from the 320x240 camera) in numpy.
+The league's balls are white-panelled with dark marks of five designs (classic pentagons,
+three-lobed, eight-panel, curved-panel, triad), lit by tinted lights whose strength varies
+about 4x between matches, on a green turf with hue and wear patches; field lines are textured
+white turf, goal posts and nets grey or shaded, robots grey, black and team coloured. So the
+detector holds to what does not change with the light: colour as a *share* of brightness, and
+shape. Grass is what is about as green (green share ``g / (b + g + r)``) as the image's own
+field; everything else is a region, and the ball is a disc inside one: nearly all not-grass,
+ringed by grass (a line through the ring covers a fair part of it), with bright panels that do
+not fill it (a line's or a white mark's do) and dark marks or shade. Whether the disc's size
+fits a ball at the ground point it implies is checked from the camera pose
+(:func:`ground_point`). It works on every second pixel (160x120 from the 320x240 camera) in
+numpy.
 """
 
 from __future__ import annotations
@@ -19,7 +24,8 @@ import numpy.typing as npt
 
 from robot.motion.models import CameraMount
 
-CELL = 4  # pixels per grid cell side, on the subsampled image
+MAX_DEPTH = 24  # the deepest a region is measured (radius, in pixels of the subsampled image)
+MAX_CANDIDATES = 400  # depth peaks looked at, deepest first
 
 
 @dataclass(frozen=True, slots=True)
@@ -48,86 +54,139 @@ class BallSighting:
 def find_ball_blobs(image_bgr: npt.NDArray[np.uint8]) -> list[BlobSighting]:
     """Candidate ball regions in a ``height x width x 3`` B,G,R image, best first.
 
-    Seeds are connected regions of black pixels; around each, the disc that holds about twice
-    as many pixels (the white half of the ball) must be mostly white or black and hold a fair
-    share of both. Field lines (white only) and dark robot parts (no white) are rejected.
+    On every second pixel: the pixels that are not grass (:func:`_not_grass`), how deep each
+    lies inside its region (:func:`_depth`), and at the deepest points of those regions a disc
+    that must be nearly all not-grass, ringed mostly by grass and hold the ball's contrast
+    (:func:`_ball_disc`).
     """
-    small = image_bgr[::2, ::2].astype(np.int16)
-    b, g, r = small[..., 0], small[..., 1], small[..., 2]
-    high = np.maximum(np.maximum(b, g), r)
-    low = np.minimum(np.minimum(b, g), r)
-    white = (low > 150) & (high - low < 45)
-    black = high < 70
-    rows, cols = white.shape
-    rows_c, cols_c = rows // CELL, cols // CELL
-    black_c = (
-        black[: rows_c * CELL, : cols_c * CELL].reshape(rows_c, CELL, cols_c, CELL).sum((1, 3))
-    )
-    either = white | black
+    small = image_bgr[::2, ::2].astype(np.int32)
+    not_grass, value, grass_value = _not_grass(small)
+    depth = _depth(not_grass)
+    rows, cols = depth.shape
+    padded = np.pad(depth, 1)
+    peak = (depth >= 2) & (depth < MAX_DEPTH)
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            if dy or dx:
+                peak &= depth >= padded[1 + dy : 1 + dy + rows, 1 + dx : 1 + dx + cols]
+    ys, xs = np.nonzero(peak)
+    # cheap first cut: at 1.6 radii around the peak, grass in most of eight directions
+    reach = 1.6 * depth[ys, xs] + 1.5
+    grass_around = np.zeros(len(ys), np.int32)
+    for k in range(8):
+        angle = k * math.pi / 4.0
+        oy = np.clip(np.rint(ys + reach * math.sin(angle)).astype(np.int64), 0, rows - 1)
+        ox = np.clip(np.rint(xs + reach * math.cos(angle)).astype(np.int64), 0, cols - 1)
+        grass_around += ~not_grass[oy, ox]
+    keep = grass_around >= 6
+    ys, xs = ys[keep], xs[keep]
+    order = np.argsort(-depth[ys, xs], kind="stable")
+    taken = np.zeros(depth.shape, np.bool_)
     blobs: list[tuple[float, BlobSighting]] = []
-    for cells in _components(black_c >= 2):
-        y0 = min(c[0] for c in cells) * CELL
-        y1 = (max(c[0] for c in cells) + 1) * CELL
-        x0 = min(c[1] for c in cells) * CELL
-        x1 = (max(c[1] for c in cells) + 1) * CELL
-        seed = black[y0:y1, x0:x1]
-        area = int(seed.sum())
-        if area < 6:
+    for index in order[:MAX_CANDIDATES]:
+        cy, cx = int(ys[index]), int(xs[index])
+        if taken[cy, cx]:
             continue
-        sy, sx = np.nonzero(seed)
-        cy, cx = y0 + sy.mean(), x0 + sx.mean()
-        radius = math.sqrt(2.0 * area / math.pi)
-        # re-centre on the ball pixels near the seed (robust to a line through the window)
-        near, (wy, wx) = _disc(either.shape, cy, cx, 1.6 * radius)
-        ball_px = either[wy, wx] & near
-        if ball_px.sum() < 8:
-            continue
-        py, px = np.nonzero(ball_px)
-        cy, cx = wy.start + float(np.median(py)), wx.start + float(np.median(px))
-        disc, (wy, wx) = _disc(either.shape, cy, cx, radius)
-        n_disc = int(disc.sum())
-        n_white = int((white[wy, wx] & disc).sum())
-        n_black = int((black[wy, wx] & disc).sum())
-        if n_disc == 0 or (n_white + n_black) < 0.6 * n_disc:
-            continue
-        if min(n_white, n_black) < 0.2 * n_disc:
-            continue
-        score = (n_white + n_black) / n_disc * min(n_white, n_black) / max(n_white, n_black)
-        blobs.append((score, BlobSighting(cx * 2.0 + 1.0, cy * 2.0 + 1.0, radius * 2.0)))
+        d = int(depth[cy, cx])
+        taken[max(cy - d - 1, 0) : cy + d + 2, max(cx - d - 1, 0) : cx + d + 2] = True
+        found = _ball_disc(not_grass, value, grass_value, cy, cx, d)
+        if found is not None:
+            score, y, x, radius = found
+            blobs.append((score, BlobSighting(x * 2.0 + 1.0, y * 2.0 + 1.0, radius * 2.0)))
     blobs.sort(key=lambda item: -item[0])
     return [blob for _, blob in blobs]
 
 
-def _disc(
-    shape: tuple[int, ...], cy: float, cx: float, radius: float
-) -> tuple[npt.NDArray[np.bool_], tuple[slice, slice]]:
-    """A disc mask in the window around (cy, cx) that it covers, and that window."""
-    y0, y1 = max(int(cy - radius), 0), min(int(cy + radius) + 2, shape[0])
-    x0, x1 = max(int(cx - radius), 0), min(int(cx + radius) + 2, shape[1])
-    yy, xx = np.mgrid[y0:y1, x0:x1]
-    mask = (yy - cy) ** 2 + (xx - cx) ** 2 <= radius**2
-    return mask, (slice(y0, y1), slice(x0, x1))
+def _not_grass(
+    small: npt.NDArray[np.int32],
+) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.int32], float]:
+    """Pixels whose green share ``g / (b + g + r)`` is clearly below the grass's, their
+    brightness (the largest channel) and the grass's median brightness.
+
+    The grass's share is the median of the pixels where green is the largest channel (a
+    robot's view is mostly field): a threshold 60 % of the way from it to a grey's 1/3 holds
+    for dark and bright scenes, tinted light and wear patches alike."""
+    b, g, r = small[..., 0], small[..., 1], small[..., 2]
+    share = (g * 1024) // (b + g + r + 3)
+    value = np.maximum(np.maximum(b, g), r)
+    sample = share[::2, ::2]
+    green = (g[::2, ::2] > r[::2, ::2]) & (g[::2, ::2] > b[::2, ::2])
+    field = sample[green]
+    grass_share = float(np.median(field)) / 1024.0 if field.size > 0.05 * sample.size else 0.55
+    cut = grass_share - 0.6 * (grass_share - 1.0 / 3.0)
+    grass = share >= cut * 1024.0
+    grass_values = value[::2, ::2][grass[::2, ::2]]
+    grass_value = float(np.median(grass_values)) if grass_values.size else 128.0
+    return ~grass, value, grass_value
 
 
-def _components(mask: npt.NDArray[np.bool_]) -> list[list[tuple[int, int]]]:
-    seen = np.zeros_like(mask)
-    out: list[list[tuple[int, int]]] = []
-    rows, cols = mask.shape
-    for start in zip(*np.nonzero(mask), strict=True):
-        if seen[start]:
-            continue
-        stack = [(int(start[0]), int(start[1]))]
-        seen[start] = True
-        cells = []
-        while stack:
-            y, x = stack.pop()
-            cells.append((y, x))
-            for ny, nx in ((y + 1, x), (y - 1, x), (y, x + 1), (y, x - 1)):
-                if 0 <= ny < rows and 0 <= nx < cols and mask[ny, nx] and not seen[ny, nx]:
-                    seen[ny, nx] = True
-                    stack.append((ny, nx))
-        out.append(cells)
-    return out
+def _depth(mask: npt.NDArray[np.bool_]) -> npt.NDArray[np.int16]:
+    """For each pixel of ``mask``, how many erosions (4-neighbour) it survives, up to
+    :data:`MAX_DEPTH`: about the radius of the largest disc round it inside the mask."""
+    depth = np.zeros(mask.shape, np.int16)
+    inside = mask.copy()
+    inside[0], inside[-1], inside[:, 0], inside[:, -1] = False, False, False, False
+    for _ in range(MAX_DEPTH):
+        depth += inside
+        eroded = inside.copy()
+        eroded[1:] &= inside[:-1]
+        eroded[:-1] &= inside[1:]
+        eroded[:, 1:] &= inside[:, :-1]
+        eroded[:, :-1] &= inside[:, 1:]
+        inside = eroded
+        if not inside.any():
+            break
+    return depth
+
+
+def _ball_disc(
+    not_grass: npt.NDArray[np.bool_],
+    value: npt.NDArray[np.int32],
+    grass_value: float,
+    cy: int,
+    cx: int,
+    depth: int,
+) -> tuple[float, float, float, float] | None:
+    """The ball's disc round a depth peak — (score, row, column, radius) on the subsampled
+    image — or None: the disc grown while its edge stays not-grass, re-centred, must be
+    nearly all not-grass (a line is narrower than its depth's disc only where it widens),
+    ringed by grass at 1.3-1.8 radii (a line crossing the ring covers about 40 % of it), with
+    bright panels (not brighter than most of it, as a line's or a white mark's) and dark
+    marks or shade."""
+    rows, cols = not_grass.shape
+    radius = max(depth - 0.5, 1.0)
+    half = int(2.0 * radius + 6)
+    y0, y1 = max(cy - half, 0), min(cy + half + 1, rows)
+    x0, x1 = max(cx - half, 0), min(cx + half + 1, cols)
+    yy, xx = np.ogrid[y0:y1, x0:x1]
+    window = not_grass[y0:y1, x0:x1]
+    dist = np.sqrt((yy - cy) ** 2 + (xx - cx) ** 2)
+    for _ in range(4):
+        shell = (dist > radius) & (dist <= radius + 1.0)
+        if np.count_nonzero(window & shell) < 0.7 * np.count_nonzero(shell):
+            break
+        radius += 1.0
+    py, px = np.nonzero(window & (dist <= radius))
+    cy_f, cx_f = y0 + float(py.mean()), x0 + float(px.mean())
+    dist = np.sqrt((yy - cy_f) ** 2 + (xx - cx_f) ** 2)
+    disc = dist <= radius
+    n_disc = np.count_nonzero(disc)
+    inner, outer = 1.3 * radius + 0.5, 1.8 * radius + 1.5
+    ring = (dist > inner) & (dist <= outer)
+    n_ring = np.count_nonzero(ring)
+    inside = radius <= cy_f <= rows - 1 - radius and radius <= cx_f <= cols - 1 - radius
+    if not inside or n_ring < 0.9 * math.pi * (outer**2 - inner**2):
+        return None  # cut by the image's edge: too little of it or its ring to judge
+    fill = np.count_nonzero(window & disc) / n_disc
+    ring_grass = 1.0 - np.count_nonzero(window & ring) / n_ring
+    if fill < 0.8 or ring_grass < 0.8:
+        return None
+    values = np.sort(value[y0:y1, x0:x1][window & disc])
+    high, low = values[(len(values) * 9) // 10], values[len(values) // 10]
+    bright = np.count_nonzero(values > 0.75 * high) / len(values)
+    if high < 0.6 * grass_value or low > 0.6 * high or bright > 0.65:
+        return None
+    return ring_grass * fill, cy_f, cx_f, radius
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -190,20 +249,21 @@ def _rot_z(a: float) -> npt.NDArray[np.float64]:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
-def white_above_horizon(
+def goal_below_horizon(
     image_bgr: npt.NDArray[np.uint8], pose: CameraPose, mount: CameraMount, *, margin_rad: float
 ) -> int:
-    """White pixels clearly above the horizon (goal posts and crossbars; field lines lie below
-    it and robot heads around it), on every second pixel."""
+    """Pixels of the near field, more than ``margin_rad`` below the horizon, that are neither
+    grass nor brighter than it (field lines are), on every second pixel: the foot of a near
+    goal (posts, net cords and frame stand on the field there) where a far goal lies within
+    the margin. Above the horizon a bright sky or building outshines a goal post."""
     height, width = image_bgr.shape[0], image_bgr.shape[1]
     focal = (width / 2.0) / math.tan(mount.fov_rad / 2.0)
     # the camera looks down by head pitch + torso pitch; the horizon is that far above centre
     down = pose.head_pitch_rad + pose.torso_pitch_rad
-    horizon_row = height / 2.0 - focal * math.tan(down)
-    last_row = int(horizon_row - focal * math.tan(margin_rad))
-    if last_row <= 0:
+    first_row = int(height / 2.0 - focal * math.tan(down - margin_rad))
+    if first_row >= height:
         return 0
-    top = image_bgr[: min(last_row, height) : 2, ::2].astype(np.int16)
-    low = top.min(axis=2)
-    high = top.max(axis=2)
-    return int(((low > 200) & (high - low < 30)).sum())
+    small = image_bgr[::2, ::2].astype(np.int32)
+    not_grass, value, grass_value = _not_grass(small)
+    rows = slice(max(first_row, 0) // 2, None)
+    return int(np.count_nonzero(not_grass[rows] & (value[rows] <= 1.15 * grass_value)))

@@ -1,7 +1,12 @@
 """Robot head cameras rendered offscreen (``MUJOCO_GL=osmesa`` or ``egl`` without a display).
 
-Images are raw B,G,R bytes, rows top to bottom, as the HLVS robot API sends them. Shadows and
-reflections are off: they cost about twice the time of a frame on a CPU renderer. Spheres,
+Images are raw B,G,R bytes, rows top to bottom, as the HLVS robot API sends them. The look's
+main light casts shadows (:mod:`simulator.world.look`) when the cameras render on a GPU; on a
+CPU renderer (llvmpipe) MuJoCo's shadows (a depth pass and a second lit pass) cost 3.4 times
+the frame (15 to 53 ms of CPU per 320x240 frame of eight robots), so they are off there unless
+``HLVS_CAMERA_SHADOWS=on`` (``off`` turns them off on a GPU too); ``hlvs render --camera``
+frames always have them, the match video on a GPU or with ``HLVS_VIDEO_SHADOWS=on``
+(:func:`simulator.render.video_shadows`). Reflections are off. Spheres,
 capsules and cylinders are tessellated more coarsely than MuJoCo's defaults (12 slices, 6
 stacks instead of 28 and 16; planes and boxes in one quad): on a software renderer that cuts a
 320x240 frame from about 10 ms to 4.5 ms with no visible difference at robot camera resolution.
@@ -14,6 +19,7 @@ the ideal image.
 from __future__ import annotations
 
 import copy
+import os
 from typing import TYPE_CHECKING
 
 import mujoco
@@ -28,6 +34,30 @@ if TYPE_CHECKING:
 
 # (numslices, numstacks, numquads) of the robot cameras' render context
 ROBOT_CAMERA_QUALITY = (12, 6, 1)
+SHADOWS_ENV = "HLVS_CAMERA_SHADOWS"
+# GL_RENDERER of Mesa's CPU rasterisers and other software renderers (simulator.gl's list: the
+# world sits below the GL probe and does not import it)
+SOFTWARE_RENDERERS = ("llvmpipe", "softpipe", "swrast", "software")
+
+
+def camera_shadows(software_gl: bool) -> bool:
+    """Whether robot cameras render shadows: ``HLVS_CAMERA_SHADOWS`` ``on`` or ``off``, else
+    on a GPU only."""
+    wanted = os.environ.get(SHADOWS_ENV, "").strip().lower()
+    if wanted in ("on", "1", "true"):
+        return True
+    if wanted in ("off", "0", "false"):
+        return False
+    return not software_gl
+
+
+def software_gl() -> bool:
+    """Whether the current GL context is a CPU rasteriser (its ``GL_RENDERER`` string)."""
+    from OpenGL import GL
+
+    name = GL.glGetString(GL.GL_RENDERER)
+    text = name.decode(errors="replace") if isinstance(name, bytes) else str(name or "")
+    return any(soft in text.lower() for soft in SOFTWARE_RENDERERS)
 
 
 def robot_camera_model(model: mujoco.MjModel) -> mujoco.MjModel:
@@ -56,7 +86,8 @@ class CameraRenderer:
         self._option = mujoco.MjvOption()
         self._option.geomgroup[4] = 0  # sites and helper geoms stay invisible
         scene = self._renderer.scene
-        scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = False
+        self.shadows = camera_shadows(software_gl())
+        scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = self.shadows
         scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = False
         camera_model = getattr(world, "camera_model", None) or CameraModel.ideal()
         look = getattr(world, "look", None)

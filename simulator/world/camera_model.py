@@ -1,9 +1,11 @@
 """The robot camera as a real one delivers images: exposure, per-pixel noise, motion blur.
 
-- **Exposure**: a gain on the rendered image: the camera's own (one per match, from the match
-  seed) times what its auto-exposure leaves of the scene's luminosity (the look's, 0.75 to
-  1.25: ``luminosity ** (1 - auto_exposure)``; 0.8 of a change is compensated), clipped at
-  full scale.
+- **Exposure**: a gain on the rendered image, clipped at full scale: the camera's own (one per
+  match, from the match seed). The scene's luminosity (the look's, 0.75 to 1.25) is in the
+  rendered image already (it scales the lights, :mod:`simulator.world.look`), as the league's
+  cameras, which have no auto-exposure, see it; a camera model that declares auto-exposure
+  (``auto_exposure`` > 0) evens out that share of it: the gain is multiplied by
+  ``luminosity ** -auto_exposure``.
 - **Per-pixel noise**: zero-mean Gaussian read noise of ``noise_std`` grey levels on every byte,
   cut from a bank of noise drawn once per renderer; the cut's offset is a hash of the match seed,
   the robot and the simulated time, so the same match gives the same images whatever thread or
@@ -34,15 +36,15 @@ class CameraModel:
 
     seed: int = 0
     exposure_gain: float = 1.0
-    auto_exposure: float = 0.8  # share of the scene's luminosity change compensated
+    auto_exposure: float = 0.0  # share of the scene's luminosity change compensated
     noise_std: float = 2.0  # grey levels (0..255) per byte
     motion_blur: bool = False
     exposure_s: float = 0.01
 
     @classmethod
     def ideal(cls) -> CameraModel:
-        """Exact images: the scene at its own colours, no noise, no blur."""
-        return cls(noise_std=0.0, exposure_gain=1.0, auto_exposure=1.0, motion_blur=False)
+        """Exact images: the scene as it is lit, no noise, no blur."""
+        return cls(noise_std=0.0, exposure_gain=1.0, auto_exposure=0.0, motion_blur=False)
 
     @classmethod
     def league(cls, seed: int, *, motion_blur: bool = False) -> CameraModel:
@@ -54,12 +56,12 @@ class CameraModel:
     def is_ideal(self) -> bool:
         return (
             self.noise_std <= 0 and not self.motion_blur and self.exposure_gain == 1.0
-            and self.auto_exposure == 1.0
+            and self.auto_exposure == 0.0
         )  # fmt: skip
 
     def gain(self, luminosity: float) -> float:
         """The image's gain in a scene of ``luminosity``."""
-        return float(self.exposure_gain * luminosity ** (1.0 - self.auto_exposure))
+        return float(self.exposure_gain * luminosity ** -self.auto_exposure)
 
 
 def _mix(*values: int) -> int:

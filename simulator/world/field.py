@@ -1,6 +1,7 @@
 """The pitch entity: turf (field plus border strip), visual lines, lights and the video camera.
 
-The turf's texture and the lights' strength come from the look (:mod:`simulator.world.look`).
+The turf's and the lines' textures and the lights come from the look
+(:mod:`simulator.world.look`).
 
 The turf is the league's soft grass. Its contact parameters in the league's Webots world
 (RoboCup-Humanoid-TC/hlvs_webots ``worlds/robocup.wbt``: ``ContactProperties`` of material
@@ -38,14 +39,13 @@ from __future__ import annotations
 import math
 
 from contracts import FieldGeometry
-from simulator.world.look import TURF_TEXTURE
+from simulator.world.look import LINE_TEXTURE, TURF_TEXTURE, light_xml
 
 TURF_FRICTION = 0.5
 GRASS_SOLREF = (-30.0, -80.0)  # direct form: -stiffness (1/s^2), -damping (1/s)
 GRASS_SOLIMP = (0.0, 0.99, 0.009, 0.5, 2.0)  # impedance 0 -> 0.99 over the first 9 mm of depth
 GRASS_SINKAGE_M = 0.0072  # league's world: a 4.9 kg robot on eight contact points (see above)
 LINE_HEIGHT_M = 0.001
-LINE_RGBA = "1 1 1 1"
 CIRCLE_SEGMENTS = 48
 
 
@@ -57,7 +57,7 @@ def _box(name: str, x: float, y: float, half_x: float, half_y: float, yaw: float
     return (
         f'<geom name="line:{name}" type="box" pos="{x:.9g} {y:.9g} {LINE_HEIGHT_M}" '
         f'size="{half_x:.9g} {half_y:.9g} {LINE_HEIGHT_M}" euler="0 0 {yaw:.9g}" '
-        f'rgba="{LINE_RGBA}" contype="0" conaffinity="0" group="1" mass="0"/>'
+        f'material="{LINE_TEXTURE}" contype="0" conaffinity="0" group="1" mass="0"/>'
     )
 
 
@@ -103,10 +103,7 @@ def field_bodies(f: FieldGeometry, *, static_bits: tuple[int, int]) -> str:
         f'<geom name="turf" type="plane" size="{tx:.6g} {ty:.6g} 0.1" material="{TURF_TEXTURE}" '
         f'friction="{TURF_FRICTION} 0.005 0.0001" priority="1" contype="{contype}" '
         f'conaffinity="{conaffinity}" solref="{_f(GRASS_SOLREF)}" solimp="{_f(GRASS_SOLIMP)}"/>',
-        '<light name="sun" directional="true" pos="0 0 10" dir="0.2 0.3 -1" '
-        'diffuse="0.7 0.7 0.7" castshadow="false"/>',
-        '<light name="fill" directional="true" pos="0 0 10" dir="-0.2 -0.3 -1" '
-        'diffuse="0.3 0.3 0.3" castshadow="false"/>',
+        light_xml(),
         f'<camera name="overview" pos="0 {-distance:.6g} {height:.6g}" '
         f'xyaxes="1 0 0 0 {height / norm:.6g} {distance / norm:.6g}" fovy="55"/>',
     ]

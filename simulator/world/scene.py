@@ -89,7 +89,7 @@ def scene_xml(
 <visual>
  <global offwidth="1920" offheight="1080"/>
  <quality shadowsize="2048" offsamples="0"/>
- <headlight ambient="0.35 0.35 0.35" diffuse="0.3 0.3 0.3" specular="0 0 0"/>
+ <headlight ambient="0.35 0.35 0.35" diffuse="0 0 0" specular="0 0 0"/>
  <map znear="0.01" zfar="100"/>
 </visual>
 <asset>{look_assets(look)}{"".join(assets.values())}</asset>
