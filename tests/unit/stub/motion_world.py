@@ -29,6 +29,7 @@ class OneRobot:
         y_m: float = 0.0,
         yaw_rad: float = 0.0,
         model: str = "kid-default",
+        seed: int = 3,
     ) -> None:
         built_in = robot_model(model)
         assert isinstance(built_in, RobotModel)
@@ -38,7 +39,7 @@ class OneRobot:
         self.world = World.create(
             field_class=field_class,
             robots=[RobotPlacement(id=RED1, model=model, x_m=x_m, y_m=y_m, yaw_rad=yaw_rad)],
-            seed=3,
+            seed=seed,
         )
         for name in self.world.motor_names(RED1):
             self.world.set_motor_pid(RED1, name, *SERVO_PID)
