@@ -26,6 +26,11 @@ from robot.motion.models import CameraMount
 
 MAX_DEPTH = 24  # the deepest a region is measured (radius, in pixels of the subsampled image)
 MAX_CANDIDATES = 400  # depth peaks looked at, deepest first
+# the ball's mean green share: grey is 1/3, the league's tinted lights (pink, orange) bring it
+# lower; a worn patch of turf (its yellow-brown blended half over the grass) holds more in a
+# white light. Measured over texture_seed 1..20: balls 0.29 to 0.33; a worn patch in a dim
+# sunset 0.40. (Under the pink dawn light a worn patch's share falls to a ball's.)
+BALL_MAX_GREEN_SHARE = 0.37
 
 
 @dataclass(frozen=True, slots=True)
@@ -60,7 +65,7 @@ def find_ball_blobs(image_bgr: npt.NDArray[np.uint8]) -> list[BlobSighting]:
     (:func:`_ball_disc`).
     """
     small = image_bgr[::2, ::2].astype(np.int32)
-    not_grass, value, grass_value = _not_grass(small)
+    not_grass, value, grass_value, share = _not_grass(small)
     depth = _depth(not_grass)
     rows, cols = depth.shape
     padded = np.pad(depth, 1)
@@ -89,7 +94,7 @@ def find_ball_blobs(image_bgr: npt.NDArray[np.uint8]) -> list[BlobSighting]:
             continue
         d = int(depth[cy, cx])
         taken[max(cy - d - 1, 0) : cy + d + 2, max(cx - d - 1, 0) : cx + d + 2] = True
-        found = _ball_disc(not_grass, value, grass_value, cy, cx, d)
+        found = _ball_disc(not_grass, value, grass_value, share, cy, cx, d)
         if found is not None:
             score, y, x, radius = found
             blobs.append((score, BlobSighting(x * 2.0 + 1.0, y * 2.0 + 1.0, radius * 2.0)))
@@ -99,9 +104,10 @@ def find_ball_blobs(image_bgr: npt.NDArray[np.uint8]) -> list[BlobSighting]:
 
 def _not_grass(
     small: npt.NDArray[np.int32],
-) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.int32], float]:
+) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.int32], float, npt.NDArray[np.int32]]:
     """Pixels whose green share ``g / (b + g + r)`` is clearly below the grass's, their
-    brightness (the largest channel) and the grass's median brightness.
+    brightness (the largest channel), the grass's median brightness and the green share (in
+    1/1024).
 
     The grass's share is the median of the pixels where green is the largest channel (a
     robot's view is mostly field): a threshold 60 % of the way from it to a grey's 1/3 holds
@@ -117,7 +123,7 @@ def _not_grass(
     grass = share >= cut * 1024.0
     grass_values = value[::2, ::2][grass[::2, ::2]]
     grass_value = float(np.median(grass_values)) if grass_values.size else 128.0
-    return ~grass, value, grass_value
+    return ~grass, value, grass_value, share
 
 
 def _depth(mask: npt.NDArray[np.bool_]) -> npt.NDArray[np.int16]:
@@ -143,6 +149,7 @@ def _ball_disc(
     not_grass: npt.NDArray[np.bool_],
     value: npt.NDArray[np.int32],
     grass_value: float,
+    share: npt.NDArray[np.int32],
     cy: int,
     cx: int,
     depth: int,
@@ -152,7 +159,8 @@ def _ball_disc(
     nearly all not-grass (a line is narrower than its depth's disc only where it widens),
     ringed by grass at 1.3-1.8 radii (a line crossing the ring covers about 40 % of it), with
     bright panels (not brighter than most of it, as a line's or a white mark's) and dark
-    marks or shade."""
+    marks or shade, and about as green as grey on the whole (a worn patch of turf in a dim
+    light passes the rest, but half of it is grass)."""
     rows, cols = not_grass.shape
     radius = max(depth - 0.5, 1.0)
     half = int(2.0 * radius + 6)
@@ -185,6 +193,8 @@ def _ball_disc(
     high, low = values[(len(values) * 9) // 10], values[len(values) // 10]
     bright = np.count_nonzero(values > 0.75 * high) / len(values)
     if high < 0.6 * grass_value or low > 0.6 * high or bright > 0.65:
+        return None
+    if share[y0:y1, x0:x1][window & disc].mean() > BALL_MAX_GREEN_SHARE * 1024:
         return None
     return ring_grass * fill, cy_f, cx_f, radius
 
@@ -264,6 +274,6 @@ def goal_below_horizon(
     if first_row >= height:
         return 0
     small = image_bgr[::2, ::2].astype(np.int32)
-    not_grass, value, grass_value = _not_grass(small)
+    not_grass, value, grass_value, _ = _not_grass(small)
     rows = slice(max(first_row, 0) // 2, None)
     return int(np.count_nonzero(not_grass[rows] & (value[rows] <= 1.15 * grass_value)))

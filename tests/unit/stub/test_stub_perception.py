@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 import pytest
@@ -143,3 +144,77 @@ def test_a_ball_behind_the_robot_is_found() -> None:
     true, wrong = _search("kid-default", (-1.0, 1.0), 12.0)
     assert true >= 20
     assert wrong <= true // 10
+
+
+def _turf_image(light: float, tint: tuple[float, float, float]) -> np.ndarray:
+    """320x240 B,G,R of mottled green turf under a light of strength ``light`` and colour
+    ``tint`` (R, G, B)."""
+    rng = np.random.default_rng(7)
+    rgb = np.array([0.2, 0.55, 0.18]) * (0.85 + 0.3 * rng.random((240, 320, 1)))
+    return _lit(rgb, light, tint)
+
+
+def _lit(rgb: np.ndarray, light: float, tint: tuple[float, float, float]) -> np.ndarray:
+    return np.clip(rgb * np.array(tint) * light * 255.0, 0, 255)[..., ::-1].astype(np.uint8)
+
+
+def _paint_disc(
+    image: np.ndarray, centre: tuple[int, int], radius: int, rgb_of: Callable[..., np.ndarray],
+    light: float, tint: tuple[float, float, float],
+) -> None:  # fmt: skip
+    yy, xx = np.mgrid[0:240, 0:320]
+    dy, dx = yy - centre[0], xx - centre[1]
+    inside = dy**2 + dx**2 <= radius**2
+    image[inside] = _lit(rgb_of(dy[inside], dx[inside]), light, tint)
+
+
+def _ball_rgb(dy: np.ndarray, dx: np.ndarray) -> np.ndarray:
+    """A ball of radius 12 px: panels of albedo 0.8 with dark patches, lit from above and in
+    front (Lambert) and by a little ambient light."""
+    nx, ny = dx / 12.5, -dy / 12.5
+    nz = np.sqrt(np.clip(1.0 - nx**2 - ny**2, 0.0, 1.0))
+    shade = 0.25 + 0.75 * np.clip(0.6 * ny + 0.8 * nz, 0.0, 1.0)
+    mark = (np.sin(dx * 0.5) * np.sin(dy * 0.5)) > 0.45
+    return (np.where(mark, 0.06, 0.8) * shade)[:, None] * np.ones(3)
+
+
+def _worn_rgb(dy: np.ndarray, dx: np.ndarray) -> np.ndarray:
+    """Worn turf, mottled: brown with as much green as red (as measured in a dim sunset)."""
+    rng = np.random.default_rng(3)
+    return np.array([0.4, 0.42, 0.23]) * (0.6 + 0.6 * rng.random((len(dy), 1)))
+
+
+@pytest.mark.parametrize(
+    ("light", "tint"),
+    [
+        (1.2, (1.0, 1.0, 1.0)),
+        (0.45, (1.0, 1.0, 1.0)),
+        (0.4, (1.0, 0.75, 0.55)),
+        (1.0, (1.0, 0.6, 0.8)),
+    ],
+    ids=["bright", "dim", "dim-orange", "pink-dawn"],
+)
+def test_the_ball_and_not_a_line_in_any_light(
+    light: float, tint: tuple[float, float, float]
+) -> None:
+    image = _turf_image(light, tint)
+    image[60:66, :] = _lit(np.full((6, 320, 3), 0.63), light, tint)  # a field line
+    assert find_ball_blobs(image) == []
+    _paint_disc(image, (160, 230), 12, _ball_rgb, light, tint)
+    blobs = find_ball_blobs(image)
+    assert len(blobs) == 1
+    assert (blobs[0].u_px, blobs[0].v_px) == pytest.approx((230, 160), abs=3)
+    assert blobs[0].radius_px == pytest.approx(12, abs=4)
+
+
+@pytest.mark.parametrize(
+    ("light", "tint"),
+    [(1.2, (1.0, 1.0, 1.0)), (0.45, (1.0, 1.0, 1.0)), (0.9, (0.95, 0.95, 1.0))],
+    ids=["bright", "dim", "blue-white"],
+)
+def test_a_worn_patch_is_not_the_ball(light: float, tint: tuple[float, float, float]) -> None:
+    # A worn patch of turf in a dim sunset once passed for the ball (the striker of a shot
+    # trial turned away from the real ball towards it and never kicked).
+    image = _turf_image(light, tint)
+    _paint_disc(image, (150, 80), 14, _worn_rgb, light, tint)
+    assert find_ball_blobs(image) == []
