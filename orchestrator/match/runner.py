@@ -30,7 +30,13 @@ from pathlib import Path
 
 from contracts import Color, Forfeit, MatchResults, RobotResult, StateMessage, files
 from orchestrator.errors import OrchestratorError
-from orchestrator.match.collection import Played, collect, read_sim_result, simulator_stderr_tail
+from orchestrator.match.collection import (
+    Played,
+    collect,
+    read_sim_result,
+    reserve_space,
+    simulator_stderr_tail,
+)
 from orchestrator.match.deps import MatchDeps, RunOptions, TelemetryFactory
 from orchestrator.match.events import (
     AllConnected,
@@ -151,6 +157,7 @@ class MatchRunner:
         out.mkdir(parents=True, exist_ok=True)
         out.chmod(0o700)  # the teams' logs are theirs: owner-only (see collection)
         (out / files.REPORT).unlink(missing_ok=True)  # a stale one would say "complete"
+        reserve_space(out)  # the results find room on a disk that fills during the match
         try:
             lifecycle.advance(MatchState.PULLING)
             self._resolve_images(game)

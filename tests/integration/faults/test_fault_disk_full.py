@@ -19,6 +19,7 @@ import threading
 import time
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -120,3 +121,35 @@ def test_a_match_on_a_full_disk_plays_to_its_end_with_its_results(filling_disk: 
     replay = load_replay(filling_disk / "out" / "replay.hlvsrec")
     assert replay.frames[-1].sim_time_ms < result["sim_time_ms"]
     assert not (filling_disk / "out" / ".results-reserve").exists()
+
+
+def test_the_orchestrator_on_a_disk_that_fills_writes_its_results_and_report(
+        tmp_path: Path) -> None:
+    """The runner (engine and simulator faked, the disk real) whose output folder's disk fills
+    as the simulator ends: collection names each copy it could not make and still writes
+    ``results.json`` and ``report.json`` (before, writing them raised ``OSError`` out of the
+    runner)."""
+    from orchestrator.match.collection import RESERVE_BYTES, RESERVE_FILE
+    from orchestrator.match.fake import FakeRuntime
+    from tests.unit.match.test_match_runner import _plan, _run
+
+    disk = _nearly_full(tmp_path / "disk", RESERVE_BYTES + 256 * 1024)
+    try:
+        class FillingRuntime(FakeRuntime):
+            def _finish_simulator(self, found: Any) -> None:
+                super()._finish_simulator(found)  # its results, then the disk is full
+                with contextlib.suppress(OSError), (disk / "more").open("wb") as more:
+                    while True:
+                        more.write(b"\0" * 4096)
+                        more.flush()
+
+        runtime = FillingRuntime()
+        _, outcome = _run(disk / "out", _plan(), runtime)
+        report = json.loads((disk / "out" / "report.json").read_text())
+        results = json.loads((disk / "out" / "results.json").read_text())
+        assert report["status"] == "failed", report  # the logs could not be collected
+        assert results["match_id"] == "u1" and results["final_state"] == "FINISHED", results
+        assert outcome.failure is not None and "No space left" in outcome.failure.cause
+        assert not (disk / "out" / RESERVE_FILE).exists()
+    finally:
+        subprocess.run(["umount", "--lazy", str(disk)], check=True)
