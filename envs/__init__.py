@@ -45,7 +45,7 @@ from envs.match import MatchEnv
 from envs.session import LocalSession
 from envs.session_spec import ResetOptions, ResetRequest, SessionSpec, StubSpec
 from envs.skill import KickEnv
-from envs.stand_kick import StandKickEnv
+from envs.stand_kick import StandKickConfig, StandKickEnv
 
 if TYPE_CHECKING:
     from envs.monitor import Monitor
@@ -84,6 +84,7 @@ __all__ = [
     "ResetRequest",
     "Session",
     "SessionSpec",
+    "StandKickConfig",
     "StandKickEnv",
     "StubSpec",
     "TrainerError",

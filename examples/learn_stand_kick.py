@@ -398,7 +398,7 @@ def plot(out: Path, random_return: float, learned_return: float) -> Path:
     ax.plot(steps[window - 1 :], smooth, color="tab:blue", label=f"mean of {window} episodes")
     ax.axhline(random_return, color="tab:red", ls="--", label="random policy")
     ax.axhline(learned_return, color="tab:green", ls=":", label="learned policy (robot runner)")
-    ax.set_ylabel("return (2 x ball progress in m\n- fall penalty then in force)")
+    ax.set_ylabel("return (shaped: ball progress, toe\napproach, touch, - still, - falls)")
     ax.set_title("hlvs/StandKick-v0, PPO (skrl, JAX CPU)")
     ax.legend(loc="lower right", fontsize=8)
     ax.grid(alpha=0.3)
