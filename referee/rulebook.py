@@ -36,11 +36,16 @@ class RuleBook:
         self.pushing = pushing.PushingMemory()
         self.keeper = goalkeeper.GoalkeeperMemory()
         self.dropped = dropped_ball.DroppedBallMemory()
+        self.after_kickoff = False  # the last restart was a kick-off
 
     def restart(self, snapshot: WorldSnapshot, restriction: goal.Restriction | None) -> None:
         """The ball is about to be in play again (kick-off or set play executed)."""
         self.in_play = ball_in_play.arm(snapshot)
         self.goal = goal.restart(restriction)
+        # the kick-off's own rules (the defenders keep off the ball and out of the circle
+        # until it is in play) hold after a kick-off only, not after a set play (hlvs_webots
+        # referee.py:2136-2138: `self.game.phase == 'KICKOFF'`)
+        self.after_kickoff = restriction is goal.Restriction.KICKOFF
 
     def judge(self, snapshot: WorldSnapshot, view: GameView) -> list[Decision]:
         decisions: list[Decision] = []
@@ -49,7 +54,8 @@ class RuleBook:
         found, self.goal = goal.judge(snapshot, view, self.goal)
         decisions += found or ball_out.judge(snapshot, view)
         decisions += set_play.judge_touch(snapshot, view)
-        decisions += kickoff.judge_before_in_play(snapshot, view)
+        if self.after_kickoff:
+            decisions += kickoff.judge_before_in_play(snapshot, view)
         found, self.fallen = fallen.judge(snapshot, view, self.fallen)
         decisions += found
         found, self.turf = outside_turf.judge(snapshot, view, self.turf)

@@ -112,6 +112,24 @@ def test_no_goal_directly_from_indirect_free_kick_until_another_robot_touches() 
     assert decisions == [Goal(RED, R2, False)]
 
 
+def test_the_kick_off_rules_do_not_hold_after_a_set_play() -> None:
+    """hlvs_webots referee.py:2136-2138: the defending team's touch before the ball is in play
+    is judged in the kick-off's phase only. After a throw-in the team that did not kick off
+    takes it, touching the ball before it is in play, and is not removed."""
+    from referee.rulebook import RuleBook
+
+    rules = RuleBook()
+    taker = robot(BLUE, 2, -1.0, 2.8, ball_contact=True)
+    at = snapshot(10, (taker,), ball=(-1.0, 2.9, 0.07))
+    in_throw_in = view(ball_in_play=False, kickoff_team=RED)
+    rules.restart(at, goal.Restriction.THROW_IN)
+    assert not [d for d in rules.judge(at, in_throw_in) if isinstance(d, PenalizeRobot)]
+    rules.restart(at, goal.Restriction.KICKOFF)  # the same touch after a kick-off: removed
+    found = [d for d in rules.judge(at, in_throw_in) if isinstance(d, PenalizeRobot)]
+    assert [(d.robot, d.reason) for d in found] == [
+        (RobotId(BLUE, 2), "touched the ball before it was in play")]
+
+
 def test_throw_in_into_own_goal_gives_corner() -> None:
     memory = goal.restart(goal.Restriction.THROW_IN)
     decisions, _ = goal.judge(snapshot(20, ball=(-4.6, 0.3, 0.07), toucher=R1), view(), memory)
