@@ -14,7 +14,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from contracts import GameStateRecord, GameType, Pose, RobotId, TeamColor
-from referee import reporting
+from referee import placement, reporting
 from referee.clock import Clock, SystemClock
 from referee.config import RefereeConfig
 from referee.gamecontroller import (
@@ -25,15 +25,15 @@ from referee.gamecontroller import (
     Tick,
 )
 from referee.gamecontroller.states import Card
-from referee.judgement import apply_decisions
+from referee.judgement import apply_decisions, penalised_back_in_field
 from referee.logs import RefereeLog
 from referee.mirror import TeamMirror
 from referee.net import GameControllerNetwork
 from referee.play_stats import PlayTracker
 from referee.publisher import Publisher
 from referee.rulebook import RuleBook
-from referee.rules import end_of_game, goal, kickoff, set_play
-from referee.rules.base import Decision, GameView, GiveCard
+from referee.rules import end_of_game, goal, kickoff, removal, set_play
+from referee.rules.base import AbortSetPlay, Decision, GameView, GiveCard, RetakeSetPlay
 from referee.shootout import KickOutcome, Shootout
 from referee.snapshot import (
     PlaceBall,
@@ -50,6 +50,9 @@ logger = logging.getLogger(__name__)
 
 Action = Callable[[WorldSnapshot], list[WorldCommand]]
 BALL_ON_SPOT_M = 0.01  # a ball farther from the centre spot at SET was moved in READY (logged)
+# Where the ball is held before a kick-off, off the field, as the league's referee holds it
+# "in its hand" (hlvs_webots referee.py:1756-1760, ``move_ball_away``)
+BALL_AWAY_XY = (100.0, 100.0)
 _PREDECESSOR = {
     GameState.INITIAL: GameState.FINISHED,
     GameState.READY: GameState.PLAYING,
@@ -99,7 +102,9 @@ class Referee:
         self._set_since_ms: int | None = None
         self._shootout: Shootout | None = None
         self.ball_in_play = False
-        self.set_play_spot: Vec2 | None = None  # where the set play in preparation put the ball
+        self.set_play_spot: Vec2 | None = None  # where the set play in preparation puts the ball
+        self._placed_ms: int | None = None  # when a set play's ball was last placed
+        self._placed_at_start_ms: int | None = None  # when robots were last put at start poses
         self.play = PlayTracker()
         self.reset_memories()
         self._network: GameControllerNetwork | None = None
@@ -209,6 +214,8 @@ class Referee:
 
     def step(self, snapshot: WorldSnapshot) -> list[WorldCommand]:
         commands: list[WorldCommand] = []
+        # robots penalised before this step: this snapshot shows where they were put
+        penalised = frozenset(self.gc.penalised())
         now = snapshot.sim_time_ms
         if not self._started:
             commands += self._start(snapshot)
@@ -236,6 +243,11 @@ class Referee:
                 commands += action(snapshot)
         tick = self.gc.advance_ms(dt_ms)
         commands += self._on_tick(tick, snapshot)
+        if self.gc.state is not GameState.INITIAL and not self._finished:
+            # every step, in and out of the shoot-out (hlvs_webots referee.py:2436, 2437-2438)
+            still = penalised & frozenset(self.gc.penalised())
+            for robot in removal.penalised_in_field(snapshot, still, self.field):
+                commands += penalised_back_in_field(self, robot, snapshot)
         if not self._finished and self._wait_until_s is None:
             if self.gc.phase is SecondaryState.PENALTYSHOOT:
                 commands += self._shootout_step(snapshot)
@@ -276,6 +288,12 @@ class Referee:
     def ball_at(self, x_m: float, y_m: float) -> PlaceBall:
         return PlaceBall(position=(x_m, y_m, self.field.ball_radius_m))
 
+    def ball_away(self) -> PlaceBall:
+        """The ball held off the field until SET places it for the kick-off: in INITIAL and READY
+        before each period and after a goal, as the league's referee holds it there
+        (hlvs_webots referee.py:1762-1768, ``kickoff`` calling ``move_ball_away``)."""
+        return self.ball_at(*BALL_AWAY_XY)
+
     def emit(self, event: RefereeEvent) -> None:
         self.events.append(event)
         self.log.event(event)
@@ -296,6 +314,7 @@ class Referee:
             f" {self.left_team.value} on the left, kick-off {cfg.kickoff.value}.",
         )
         commands = self._starting_positions(snapshot.sim_time_ms)
+        self._placed_at_start_ms = snapshot.sim_time_ms
         if cfg.game_type is GameType.PENALTY:
             self._wait(cfg.timing.wait_before_first_ready_real_s, self._begin_shootout,
                        "before the penalty shoot-out", snapshot.sim_time_ms)
@@ -323,13 +342,17 @@ class Referee:
                 if robot in self.limp:
                     commands.append(SetLimp(robot=robot, limp=False))
         self.limp.clear()
-        commands.append(self.ball_at(0.0, 0.0))
+        commands.append(self.ball_away())
         return commands
 
     def _to_ready(self, snapshot: WorldSnapshot) -> list[WorldCommand]:
         self.gc.transition(GameState.READY)
         self.state_event(snapshot, "READY")
-        return []
+        if snapshot.sim_time_ms == self._placed_at_start_ms:
+            # no wait before READY: the robots are put at their start positions this very step,
+            # and this snapshot shows them where they were before
+            return []
+        return self._apply(kickoff.judge_start(snapshot, self.view()), snapshot)
 
     def state_event(self, snapshot: WorldSnapshot, what: str, **details: object) -> None:
         gc = self.gc
@@ -360,6 +383,12 @@ class Referee:
         if tick.set_play_phase is not None and self.gc.set_play is not None:
             play = self.gc.set_play
             self.log.info(now, f"{play.kind.name} for {play.team.value}: phase {play.sub_phase}.")
+            if play.sub_phase == 1:
+                spot = self.set_play_spot
+                if spot is None:
+                    spot = (snapshot.ball.position[0], snapshot.ball.position[1])
+                commands += placement.place_set_play_ball(self, snapshot, play, spot)
+                self._placed_ms = now
         if tick.set_play_executed is not None:
             play = tick.set_play_executed
             self.log.info(now, f"{play.kind.name} for {play.team.value}: execute.")
@@ -368,7 +397,7 @@ class Referee:
                 SecondaryState.THROW_IN: goal.Restriction.THROW_IN,
                 SecondaryState.INDIRECT_FREEKICK: goal.Restriction.INDIRECT_FREE_KICK,
             }.get(play.kind)
-            self.rules.restart(snapshot, restriction)
+            self.rules.restart(snapshot, restriction, play.team)
         if tick.period_over and self.gc.phase is not SecondaryState.PENALTYSHOOT:
             commands += self._end_period(snapshot)
         return commands
@@ -378,7 +407,9 @@ class Referee:
         the kick-off (or the dropped ball) when SET begins, wherever a robot pushed it in
         READY."""
         x, y = snapshot.ball.position[0], snapshot.ball.position[1]
-        if math.hypot(x, y) > BALL_ON_SPOT_M:
+        field = self.field
+        on_field = abs(x) <= field.turf_half_length_m and abs(y) <= field.turf_half_width_m
+        if on_field and math.hypot(x, y) > BALL_ON_SPOT_M:
             self.log.info(snapshot.sim_time_ms, f"Ball moved in READY to ({x:.2f}, {y:.2f}); "
                           "placed on the centre spot.")  # fmt: skip
         return [self.ball_at(0.0, 0.0)]
@@ -399,6 +430,10 @@ class Referee:
             return commands
         view = self.view()
         decisions = self.rules.judge(snapshot, view)
+        if self._placed_ms == now:
+            # the ball was placed this step: a touch seen in this snapshot was of the ball where
+            # it lay in sub-phase 0, where touching it is allowed
+            decisions = [d for d in decisions if not isinstance(d, RetakeSetPlay | AbortSetPlay)]
         if gc.state is GameState.SET:
             # kick-off positions hold through SET: the league's referee checks them every step
             # of SET, not only when it begins (hlvs_webots referee.py:2358-2365)
@@ -472,6 +507,7 @@ class Referee:
                 snapshot.sim_time_ms, f"Sides changed: {self.left_team.value} on the left."
             )
             commands = self._starting_positions(snapshot.sim_time_ms)
+            self._placed_at_start_ms = snapshot.sim_time_ms
             after = self._to_ready
         self._wait(self.config.timing.half_time_break_real_s, after,
                    f"before the {following.value}", snapshot.sim_time_ms)
@@ -526,6 +562,10 @@ class Referee:
         self.gc.secs_remaining = self.config.timing.shootout_kick_s
         self.gc.transition(GameState.SET)
         self._set_since_ms = snapshot.sim_time_ms
+        # the league's GameController has been FINISHED between the kicks (after a goal, or
+        # sent by its referee, hlvs_webots referee.py:1636-1638), which clears every penalty
+        for robot in self.gc.penalised():
+            self.gc.unpenalize(robot)
         commands: list[WorldCommand] = [
             SetLimp(robot=r, limp=False) for r in sorted(self.limp, key=str)
         ]

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Protocol
 
-from contracts import FieldGeometry, RobotId, TeamColor
+from contracts import FieldGeometry, Pose, RobotId, TeamColor
 from referee.config import RefereeConfig
 from referee.gamecontroller import Card, GameController, GameState, Penalty
 from referee.logs import RefereeLog
@@ -49,6 +49,8 @@ class RefereeCore(Protocol):
 
     def ball_at(self, x_m: float, y_m: float) -> PlaceBall: ...
 
+    def ball_away(self) -> PlaceBall: ...
+
     def state_event(self, snapshot: WorldSnapshot, what: str, **details: object) -> None: ...
 
 
@@ -62,7 +64,7 @@ def apply_decisions(
         if isinstance(decision, BallInPlay):
             _ball_in_play(ref, decision.reason, snapshot)
         elif isinstance(decision, PenalizeRobot):
-            commands += _penalize(ref, decision, snapshot, occupied)
+            commands += penalize(ref, decision, snapshot, occupied)
         elif isinstance(decision, GiveCard):
             commands += _card(ref, decision, snapshot)
         elif stopped or ref.gc.state is not GameState.PLAYING:
@@ -121,12 +123,14 @@ def _goal(ref: RefereeCore, goal: Goal, snapshot: WorldSnapshot) -> list[WorldCo
         )
     )
     ref.state_event(snapshot, "READY")
-    return [ref.ball_at(0.0, 0.0)]
+    return [ref.ball_away()]
 
 
 def _set_play(ref: RefereeCore, play: AwardSetPlay, snapshot: WorldSnapshot) -> list[WorldCommand]:
     ref.gc.begin_set_play(play.kind, play.team)
     ref.ball_in_play = False
+    # the ball stays where it is through sub-phase 0 and is placed on this spot when it ends
+    # (referee.placement), as the league's referee places it (hlvs_webots referee.py:2425-2430)
     ref.set_play_spot = x, y = play.position
     ref.log.info(
         snapshot.sim_time_ms,
@@ -138,7 +142,7 @@ def _set_play(ref: RefereeCore, play: AwardSetPlay, snapshot: WorldSnapshot) -> 
             reason=play.reason, placement=(x, y, ref.field.ball_radius_m),
         )
     )
-    return [ref.ball_at(x, y)]
+    return []
 
 
 def _ball_in_play(ref: RefereeCore, reason: str, snapshot: WorldSnapshot) -> None:
@@ -152,8 +156,8 @@ def _ball_in_play(ref: RefereeCore, reason: str, snapshot: WorldSnapshot) -> Non
 def _touched_set_play(
     ref: RefereeCore, decision: RetakeSetPlay | AbortSetPlay, snapshot: WorldSnapshot
 ) -> list[WorldCommand]:
-    """The ball touched before the set play was taken: RETAKE (the ball placed again) or ABORT
-    (the ball in play)."""
+    """The ball touched before the set play was taken: RETAKE (sub-phase 0 again, at whose end
+    the ball is placed again, hlvs_webots referee.py:1366-1372) or ABORT (the ball in play)."""
     play = ref.gc.set_play
     if play is None:
         return []
@@ -169,7 +173,9 @@ def _touched_set_play(
         _ball_in_play(ref, f"{play.kind.name.lower()} aborted", snapshot)
         return []
     ref.gc.retake_set_play()
-    x, y = ref.set_play_spot or (snapshot.ball.position[0], snapshot.ball.position[1])
+    if ref.set_play_spot is None:
+        ref.set_play_spot = (snapshot.ball.position[0], snapshot.ball.position[1])
+    x, y = ref.set_play_spot
     ref.emit(
         RefereeEvent(
             sim_time_ms=now, type="set_play_retaken", team=play.team,
@@ -177,10 +183,25 @@ def _touched_set_play(
             placement=(x, y, ref.field.ball_radius_m),
         )
     )  # fmt: skip
-    return [ref.ball_at(x, y)]
+    return []
 
 
-def _penalize(
+def reentry_pose(
+    ref: RefereeCore, robot: RobotId, snapshot: WorldSnapshot, occupied: list[Vec2]
+) -> Pose:
+    """Where a removed robot is put: its team file's re-entry pose, on the side away from the
+    ball, clear of the ``occupied`` spots (:func:`referee.rules.removal.reentry_pose`)."""
+    player = ref.config.team(robot.team).player(robot.number)
+    return removal.reentry_pose(
+        template=player.reentry_pose,
+        side_sign=-1.0 if robot.team is ref.left_team else 1.0,
+        ball_y_m=snapshot.ball.position[1],
+        occupied=occupied,
+        field=ref.field,
+    )
+
+
+def penalize(
     ref: RefereeCore, decision: PenalizeRobot, snapshot: WorldSnapshot, occupied: list[Vec2]
 ) -> list[WorldCommand]:
     robot = decision.robot
@@ -190,16 +211,9 @@ def _penalize(
     if info.penalty is not Penalty.NONE or robot in ref.red_carded:
         return []
     ref.gc.penalize(robot, decision.penalty)
-    player = ref.config.team(robot.team).player(robot.number)
     others = [r.position for r in snapshot.robots if r.id != robot]
     taken = [(p[0], p[1]) for p in others] + occupied[len(snapshot.robots) :]
-    pose = removal.reentry_pose(
-        template=player.reentry_pose,
-        side_sign=-1.0 if robot.team is ref.left_team else 1.0,
-        ball_y_m=snapshot.ball.position[1],
-        occupied=taken,
-        field=ref.field,
-    )
+    pose = reentry_pose(ref, robot, snapshot, taken)
     occupied.append((pose.x_m, pose.y_m))
     ref.limp.add(robot)
     name = PENALTY_NAMES.get(decision.penalty, decision.penalty.name)
@@ -234,3 +248,19 @@ def _card(ref: RefereeCore, decision: GiveCard, snapshot: WorldSnapshot) -> list
     ref.red_carded.add(robot)
     ref.limp.discard(robot)
     return removal.red_card_commands(robot)
+
+
+def penalised_back_in_field(
+    ref: RefereeCore, robot: RobotId, snapshot: WorldSnapshot
+) -> list[WorldCommand]:
+    """A penalised robot back on the field: a yellow card (a second one is a red card, which
+    sends it off), else it is removed again with its penalty time counted anew, as the league's
+    referee sends the penalty again (hlvs_webots referee.py:1297-1299, 1435-1454)."""
+    reason = "penalised robot re-entered the field"
+    commands = _card(ref, GiveCard(robot, Card.YELLOW, reason), snapshot)
+    if robot in ref.red_carded:
+        return commands
+    ref.gc.unpenalize(robot)
+    occupied = [(r.position[0], r.position[1]) for r in snapshot.robots]
+    decision = PenalizeRobot(robot, Penalty.PICKUP_OR_INCAPABLE, reason)
+    return commands + penalize(ref, decision, snapshot, occupied)

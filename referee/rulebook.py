@@ -1,6 +1,7 @@
 """The rules in the order the referee applies them, with their memories.
 
-Order: ball in play, goal (else ball out), touches before a set play is taken, kick-off,
+Order: ball in play, goal (else ball out), touches before a set play is taken, opponents near
+the ball after a set play was taken, kick-off,
 fallen, outside turf, ball holding, pushing, inactive goalkeeper, dropped ball. (Kick-off
 positions are judged by the referee through SET, set-play compliance at EXECUTE once, when the
 GameController enters it.) Each rule is a pure function; this class only keeps each rule's memory
@@ -9,6 +10,7 @@ from one step to the next.
 
 from __future__ import annotations
 
+from contracts import TeamColor
 from referee.rules import (
     ball_holding,
     ball_in_play,
@@ -37,15 +39,23 @@ class RuleBook:
         self.keeper = goalkeeper.GoalkeeperMemory()
         self.dropped = dropped_ball.DroppedBallMemory()
         self.after_kickoff = False  # the last restart was a kick-off
+        self.set_play_team: TeamColor | None = None  # whose set play was taken last
 
-    def restart(self, snapshot: WorldSnapshot, restriction: goal.Restriction | None) -> None:
-        """The ball is about to be in play again (kick-off or set play executed)."""
+    def restart(
+        self,
+        snapshot: WorldSnapshot,
+        restriction: goal.Restriction | None,
+        set_play_team: TeamColor | None = None,
+    ) -> None:
+        """The ball is about to be in play again (kick-off, or ``set_play_team``'s set play
+        executed)."""
         self.in_play = ball_in_play.arm(snapshot)
         self.goal = goal.restart(restriction)
         # the kick-off's own rules (the defenders keep off the ball and out of the circle
         # until it is in play) hold after a kick-off only, not after a set play (hlvs_webots
         # referee.py:2136-2138: `self.game.phase == 'KICKOFF'`)
         self.after_kickoff = restriction is goal.Restriction.KICKOFF
+        self.set_play_team = set_play_team
 
     def judge(self, snapshot: WorldSnapshot, view: GameView) -> list[Decision]:
         decisions: list[Decision] = []
@@ -54,6 +64,7 @@ class RuleBook:
         found, self.goal = goal.judge(snapshot, view, self.goal)
         decisions += found or ball_out.judge(snapshot, view)
         decisions += set_play.judge_touch(snapshot, view)
+        decisions += set_play.judge_before_in_play(snapshot, view, self.set_play_team)
         if self.after_kickoff:
             decisions += kickoff.judge_before_in_play(snapshot, view)
         found, self.fallen = fallen.judge(snapshot, view, self.fallen)

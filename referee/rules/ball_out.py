@@ -4,8 +4,9 @@ The ball is out when it is fully beyond the outer edge of the line (the lines be
 field). Throw-in: for the opponents of the last toucher, ball on the touch line at the x where it
 left. Goal line: corner kick (at the corner on the side where it left) when a defender touched
 it last, otherwise goal kick (ball where the halfway line meets the touch line on that side, as
-the league's referee places it). Without any
-recorded touch the team defending the half the ball left from gets the restart.
+the league's referee places it). Every spot is on the middle of its line, as the league's
+referee puts it. Without any recorded touch the team defending the half the ball left from gets
+the restart.
 """
 
 from __future__ import annotations
@@ -39,15 +40,23 @@ def in_goal(position: tuple[float, float, float], field: FieldGeometry) -> bool:
     )
 
 
+def on_line(field: FieldGeometry) -> float:
+    """How far in from the field's edge a set play's ball is put: the middle of the line, as
+    the league's referee puts it (``size - line_half_width``, hlvs_webots referee.py:1731,
+    1740-1751)."""
+    return field.line_width_m / 2.0
+
+
 def corner_spot(goal_sign: float, y_sign: float, field: FieldGeometry) -> Vec2:
-    return (goal_sign * field.half_length_m, y_sign * field.half_width_m)
+    inset = on_line(field)
+    return (goal_sign * (field.half_length_m - inset), y_sign * (field.half_width_m - inset))
 
 
 def goal_kick_spot(goal_sign: float, y_sign: float, field: FieldGeometry) -> Vec2:
     """Where the halfway line meets the touch line on the side the ball left, as the league's
     referee places a goal kick's ball (hlvs_webots referee.py:1747-1752, ``goal_kick``)."""
     del goal_sign  # the same spot whichever goal line the ball crossed
-    return (0.0, y_sign * field.half_width_m)
+    return (0.0, y_sign * (field.half_width_m - on_line(field)))
 
 
 def goal_line_restart(
@@ -77,7 +86,7 @@ def judge(snapshot: WorldSnapshot, game: GameView) -> list[Decision]:
             else game.team_on_side(_sign(position[0]))
         )
         x = max(-field.half_length_m, min(field.half_length_m, position[0]))
-        y = math.copysign(field.half_width_m, position[1])
+        y = math.copysign(field.half_width_m - on_line(field), position[1])
         return [AwardSetPlay(SecondaryState.THROW_IN, team, (x, y), "ball over the touch line")]
     if over_goal_line(position, field) and not in_goal(position, field):
         return [goal_line_restart(snapshot, game, _sign(position[0]), "ball over the goal line")]

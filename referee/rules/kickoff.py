@@ -1,4 +1,7 @@
-"""Kick-off positions and the kick-off before the ball is in play.
+"""Start positions, kick-off positions and the kick-off before the ball is in play.
+
+When a period's READY begins, robots at their start positions must stand fully outside the
+field on their own side; illegally placed robots are removed (INCAPABLE).
 
 Through SET (checked every step, as the league's referee checks them, hlvs_webots
 referee.py:2358-2365) every robot must be inside the field, in its own half, and robots of the
@@ -27,6 +30,32 @@ def _illegal_position(robot: RobotState, game: GameView) -> str | None:
     if defending and distance2d(robot.position, (0.0, 0.0)) < field.centre_circle_radius_m:
         return "inside the centre circle at the opponents' kick-off"
     return None
+
+
+def judge_start(snapshot: WorldSnapshot, game: GameView) -> list[Decision]:
+    """The game goes to READY at the start of a period: a robot at its ``halfTimeStartingPose``
+    must stand fully outside the field and fully on its own side of the halfway line, else it
+    is removed (INCAPABLE), as the league's referee checks it then (hlvs_webots referee.py:
+    1212-1228, ``check_start_position``, with 746-772). The league reads the contacts of the
+    feet with the ground (one on a line is on the field); here the torso and the feet and hands
+    (``hull_points``): one of them on the field, lines included, or beyond the middle of the
+    halfway line is enough."""
+    field = game.field
+    half_line = field.line_width_m / 2.0
+    decisions: list[Decision] = []
+    for robot in snapshot.robots:
+        if not game.active(robot):
+            continue
+        points = [(robot.position[0], robot.position[1]), *robot.hull_points]
+        sign = game.side_sign(robot.id.team)
+        reason = None
+        if any(abs(x) <= field.half_length_m and abs(y) <= field.half_width_m for x, y in points):
+            reason = "halfTimeStartingPose inside the field"
+        elif any(x * sign < half_line for x, _ in points):
+            reason = "halfTimeStartingPose outside its team's side"
+        if reason is not None:
+            decisions.append(PenalizeRobot(robot.id, Penalty.PICKUP_OR_INCAPABLE, reason))
+    return decisions
 
 
 def judge_set(snapshot: WorldSnapshot, game: GameView) -> list[Decision]:

@@ -16,7 +16,14 @@ import math
 from collections.abc import Sequence
 
 from contracts import FieldGeometry, Pose, RobotId
-from referee.snapshot import RemoveRobot, SetLimp, TeleportRobot, Vec2, WorldCommand
+from referee.snapshot import (
+    RemoveRobot,
+    SetLimp,
+    TeleportRobot,
+    Vec2,
+    WorldCommand,
+    WorldSnapshot,
+)
 
 
 def reentry_pose(
@@ -61,3 +68,21 @@ def return_commands(robot: RobotId) -> list[WorldCommand]:
 
 def red_card_commands(robot: RobotId) -> list[WorldCommand]:
     return [RemoveRobot(robot=robot)]
+
+
+def penalised_in_field(
+    snapshot: WorldSnapshot, penalised: frozenset[RobotId], field: FieldGeometry
+) -> list[RobotId]:
+    """Penalised robots (not sent off) back on the field, which the league's referee shows a
+    yellow card, removes again and, the second time, sends off (hlvs_webots referee.py:
+    1287-1302, ``check_team_penalized_in_field``, with ``send_penalty`` 894-897 letting the new
+    penalty through). The league reads the feet's contacts (one on the field or a line is in);
+    here the torso, more than a line's width inside the field, so that a robot standing at its
+    re-entry spot on a touch line is not in."""
+    inside_x = field.half_length_m - field.line_width_m
+    inside_y = field.half_width_m - field.line_width_m
+    return [
+        robot.id for robot in snapshot.robots
+        if robot.id in penalised and not robot.removed
+        and abs(robot.position[0]) < inside_x and abs(robot.position[1]) < inside_y
+    ]  # fmt: skip

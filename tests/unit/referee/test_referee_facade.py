@@ -9,6 +9,7 @@ from pathlib import Path
 
 from contracts.match_spec import GameType
 from referee import FakeClock, PlaceBall, Referee, SetLimp, TeleportRobot
+from referee.snapshot import RobotState
 from tests.unit.referee.referee_helpers import FAST_TIMING, RED, make_config, robot, snapshot
 
 LINE = re.compile(r"^\[\d{4}\.\d{3}\|\d{4}\.\d{3}\] (Info|Warning|Error): .+$")
@@ -24,7 +25,7 @@ def test_start_teleports_to_half_time_poses_and_places_ball() -> None:
     blue1 = next(t for t in teleports if str(t.robot) == "blue player 1")
     assert (red1.pose.x_m, red1.pose.y_m) == (-1.5, -3.1)
     assert (blue1.pose.x_m, blue1.pose.y_m) == (1.5, -3.1)  # mirrored for the right side
-    assert PlaceBall(position=(0.0, 0.0, 0.07)) in commands
+    assert PlaceBall(position=(100.0, 100.0, 0.07)) in commands  # held off the field
 
 
 def test_wall_clock_wait_before_first_ready() -> None:
@@ -45,11 +46,17 @@ def test_wall_clock_wait_before_first_ready() -> None:
     assert ref.game_state["secs_remaining"] == 60  # the clock did not run while waiting
 
 
-def _play(ref: Referee, clock: FakeClock, robots: tuple[object, ...], limit_ms: int) -> int:
+def _play(ref: Referee, clock: FakeClock, robots: tuple[RobotState, ...], limit_ms: int) -> int:
+    """Steps the referee with robots that stand where it puts them (a penalised robot at its
+    re-entry spot, not back on the field)."""
     ms = 0
+    at = {r.id: r for r in robots}
     while not ref.finished and ms < limit_ms:
-        for command in ref.step(snapshot(ms, robots)):  # type: ignore[arg-type]
+        for command in ref.step(snapshot(ms, tuple(at.values()))):
             assert isinstance(command, TeleportRobot | PlaceBall | SetLimp)
+            if isinstance(command, TeleportRobot) and command.robot in at:
+                pose = command.pose
+                at[command.robot] = replace(at[command.robot], position=(pose.x_m, pose.y_m, 0.3))
         ms += 8
         clock.advance(0.008)
     return ms

@@ -15,9 +15,10 @@ from dataclasses import replace
 
 from contracts.gamecontroller import GameControlData, decode_game_state
 from contracts.ids import RobotId
-from referee import FakeClock, PlaceBall, Referee
+from referee import FakeClock, PlaceBall, Referee, TeleportRobot
 from referee.config import TimingConfig
 from referee.gamecontroller import GameState, Penalty
+from referee.snapshot import RobotState
 from tests.unit.referee.league_gc_model import (
     FINISHED,
     INITIAL,
@@ -53,13 +54,14 @@ class Match:
         self.ms = 0
         self.ball = (0.0, 0.0, 0.07)
         self.fallen_blue_2 = True  # from the start: removed in READY, 2 s later
+        self.carried: dict[RobotId, tuple[float, float]] = {}
 
     def step(self, *, touch: RobotId | None = None, ball: tuple[float, float] | None = None,
              toucher: RobotId | None = None) -> GameControlData:  # fmt: skip
         if ball is not None:
             self.ball = (ball[0], ball[1], 0.07)
         bx, by = self.ball[0], self.ball[1]
-        robots = (
+        robots: tuple[RobotState, ...] = (
             robot(RED, 1, bx - 0.15, by, ball_contact=True) if touch == RobotId(RED, 1)
             else robot(RED, 1, -2.0, 0.5),
             robot(RED, 2, -1.0, -1.5),
@@ -67,9 +69,18 @@ class Match:
             else robot(BLUE, 1, 2.0, -0.5),
             robot(BLUE, 2, 1.0, 1.5, fallen=self.fallen_blue_2),
         )  # fmt: skip
+        # a penalised robot stands where the referee carried it, off the field
+        robots = tuple(
+            replace(r, position=(*self.carried[r.id], 0.3))
+            if r.id in self.carried and self.ref.gc.robot(r.id).penalty is not Penalty.NONE
+            else r
+            for r in robots
+        )
         for command in self.ref.step(snapshot(self.ms, robots, ball=self.ball, toucher=toucher)):
             if isinstance(command, PlaceBall):
                 self.ball = command.position
+            if isinstance(command, TeleportRobot):
+                self.carried[command.robot] = (command.pose.x_m, command.pose.y_m)
         if self.ref.gc.robot(RobotId(BLUE, 2)).penalty is not Penalty.NONE:
             self.fallen_blue_2 = False  # carried off, stands up
         self.ms += STEP_MS

@@ -141,9 +141,11 @@ def test_throw_in_into_own_goal_gives_corner() -> None:
 
 
 def test_throw_in_placement_at_exit_x() -> None:
+    """On the middle of the touch line, as the league's referee puts it (size_y -
+    line_half_width, hlvs_webots referee.py:1731)."""
     decisions = ball_out.judge(snapshot(1, ball=(1.25, -3.08, 0.07), toucher=B1), view())
     assert decisions == [
-        AwardSetPlay(SecondaryState.THROW_IN, RED, (1.25, -3.0), "ball over the touch line")
+        AwardSetPlay(SecondaryState.THROW_IN, RED, (1.25, -2.975), "ball over the touch line")
     ]
 
 
@@ -152,11 +154,11 @@ def test_corner_and_goal_kick_spots() -> None:
     left, as hlvs_webots places it (referee.py:1747-1752)."""
     corner = ball_out.judge(snapshot(1, ball=(-4.6, 2.0, 0.07), toucher=R1), view())
     assert corner[0] == AwardSetPlay(
-        SecondaryState.CORNER_KICK, BLUE, (-4.5, 3.0), "ball over the goal line"
+        SecondaryState.CORNER_KICK, BLUE, (-4.475, 2.975), "ball over the goal line"
     )
     kick = ball_out.judge(snapshot(1, ball=(-4.6, -2.0, 0.07), toucher=B1), view())
     assert kick[0] == AwardSetPlay(
-        SecondaryState.GOAL_KICK, RED, (0.0, -3.0), "ball over the goal line"
+        SecondaryState.GOAL_KICK, RED, (0.0, -2.975), "ball over the goal line"
     )
 
 

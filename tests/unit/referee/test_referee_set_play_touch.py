@@ -1,5 +1,6 @@
 """A ball touched before a set play is taken, as the league's referee judges it: by an opponent
-of the set-play team, the set play is retaken (RETAKE, the ball placed again); by the set-play
+of the set-play team, the set play is retaken (RETAKE, the ball placed again when sub-phase 0
+ends); by the set-play
 team, it is aborted and the ball is in play (ABORT); a warning either way. Touching it in
 sub-phase 0 is allowed."""
 
@@ -53,8 +54,8 @@ def _step(ref: Referee, clock: FakeClock, ms: int, robots: tuple[RobotState, ...
 
 def test_the_referee_retakes_then_aborts_a_goal_kick() -> None:
     """Red (on the left) plays the ball over blue's goal line: a goal kick for blue. Red touches
-    the ball in sub-phase 1: it is retaken from sub-phase 0, the ball placed again, red 1
-    warned. Blue touches it in sub-phase 1: aborted, the ball in play, blue 1 warned."""
+    the ball in sub-phase 1: it is retaken from sub-phase 0, the ball placed again when that
+    ends, red 1 warned. Blue touches it in sub-phase 1: aborted, the ball in play, blue 1 warned."""
     clock = FakeClock()
     ref = Referee(config=make_config(side_left=RED), clock=clock)
     red_far, blue_far = robot(RED, 1, -2.0, 0.0), robot(BLUE, 1, 2.0, 0.0)
@@ -67,21 +68,27 @@ def test_the_referee_retakes_then_aborts_a_goal_kick() -> None:
     play = ref.gc.set_play
     assert play is not None and play.kind is SecondaryState.GOAL_KICK and play.team is BLUE
     spot = ref.set_play_spot
-    assert spot == (0.0, 3.0)  # the halfway line on the touch line, on the side the ball left
+    # the halfway line on the middle of the touch line, on the side the ball left
+    assert spot == (0.0, 2.975)
     ball = (spot[0], spot[1], 0.07)
+    placed = PlaceBall(position=(spot[0], spot[1], KID_FIELD.ball_radius_m))
+    commands = []
     while ref.gc.set_play is not None and ref.gc.set_play.sub_phase == 0:
-        _step(ref, clock, ms, (red_far, blue_far), ball)
+        commands += _step(ref, clock, ms, (red_far, blue_far), ball)
         ms += 8
+    assert commands == [placed]  # placed once, when sub-phase 0 ends
     red_touch = robot(RED, 1, spot[0] - 0.1, spot[1], ball_contact=True)
     commands = _step(ref, clock, ms, (red_touch, blue_far), ball)
     ms += 8
     play = ref.gc.set_play
     assert play is not None and play.sub_phase == 0 and play.team is BLUE
-    assert PlaceBall(position=(spot[0], spot[1], KID_FIELD.ball_radius_m)) in commands
+    assert placed not in commands  # left where it is in sub-phase 0 again
     assert ref.gc.robot(R1).warnings == 1
+    commands = []
     while ref.gc.set_play is not None and ref.gc.set_play.sub_phase == 0:
-        _step(ref, clock, ms, (red_far, blue_far), ball)
+        commands += _step(ref, clock, ms, (red_far, blue_far), ball)
         ms += 8
+    assert commands == [placed]
     blue_touch = robot(BLUE, 1, spot[0] + 0.1, spot[1], ball_contact=True)
     _step(ref, clock, ms, (red_far, blue_touch), ball)
     assert ref.gc.set_play is None and ref.ball_in_play
