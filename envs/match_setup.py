@@ -103,7 +103,9 @@ def build_match(
         camera_model=episode.camera_model,
     )
     config = referee_config(mspec)
-    config = replace(config, timing=replace(config.timing, status_period_real_s=1e9))
+    # the robots start on the field (their half-time poses are their episode's start poses)
+    config = replace(config, timing=replace(config.timing, status_period_real_s=1e9),
+                     start_positions_checked=False)  # fmt: skip
     referee = Referee(config=config, clock=clock)
     stubs = []
     for stub in spec.stubs:

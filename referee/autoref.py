@@ -104,6 +104,7 @@ class Referee:
         self.ball_in_play = False
         self.set_play_spot: Vec2 | None = None  # where the set play in preparation puts the ball
         self._placed_ms: int | None = None  # when a set play's ball was last placed
+        self.carried: dict[RobotId, Vec2] = {}  # where the referee last put a penalised robot
         self._placed_at_start_ms: int | None = None  # when robots were last put at start poses
         self.play = PlayTracker()
         self.reset_memories()
@@ -246,7 +247,7 @@ class Referee:
         if self.gc.state is not GameState.INITIAL and not self._finished:
             # every step, in and out of the shoot-out (hlvs_webots referee.py:2436, 2437-2438)
             still = penalised & frozenset(self.gc.penalised())
-            for robot in removal.penalised_in_field(snapshot, still, self.field):
+            for robot in removal.penalised_in_field(snapshot, still, self.field, self.carried):
                 commands += penalised_back_in_field(self, robot, snapshot)
         if not self._finished and self._wait_until_s is None:
             if self.gc.phase is SecondaryState.PENALTYSHOOT:
@@ -348,6 +349,8 @@ class Referee:
     def _to_ready(self, snapshot: WorldSnapshot) -> list[WorldCommand]:
         self.gc.transition(GameState.READY)
         self.state_event(snapshot, "READY")
+        if not self.config.start_positions_checked:
+            return []
         if snapshot.sim_time_ms == self._placed_at_start_ms:
             # no wait before READY: the robots are put at their start positions this very step,
             # and this snapshot shows them where they were before

@@ -64,6 +64,10 @@ class RefereeConfig:
     network: NetworkConfig = field(default_factory=NetworkConfig)
     match_id: str = "match"
     seed: int = 0  # coin toss after an undecided extended shoot-out
+    # the league's check of the start positions when a period's READY begins (robots off the
+    # field on their own side); off for setups that start robots on the field by design (the
+    # learning environments, the referee's scenario tests)
+    start_positions_checked: bool = True
 
     @property
     def field(self) -> FieldGeometry:

@@ -44,6 +44,7 @@ class RefereeCore(Protocol):
     ball_in_play: bool
     left_team: TeamColor
     set_play_spot: Vec2 | None  # where the set play in preparation placed the ball
+    carried: dict[RobotId, Vec2]  # where the referee last put each penalised robot
 
     def emit(self, event: RefereeEvent) -> None: ...
 
@@ -215,6 +216,7 @@ def penalize(
     taken = [(p[0], p[1]) for p in others] + occupied[len(snapshot.robots) :]
     pose = reentry_pose(ref, robot, snapshot, taken)
     occupied.append((pose.x_m, pose.y_m))
+    ref.carried[robot] = (pose.x_m, pose.y_m)
     ref.limp.add(robot)
     name = PENALTY_NAMES.get(decision.penalty, decision.penalty.name)
     ref.log.info(snapshot.sim_time_ms, f"{name} penalty for {robot}: {decision.reason}.")

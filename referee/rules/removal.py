@@ -13,7 +13,7 @@ from the world.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 from contracts import FieldGeometry, Pose, RobotId
 from referee.snapshot import (
@@ -71,18 +71,29 @@ def red_card_commands(robot: RobotId) -> list[WorldCommand]:
 
 
 def penalised_in_field(
-    snapshot: WorldSnapshot, penalised: frozenset[RobotId], field: FieldGeometry
+    snapshot: WorldSnapshot,
+    penalised: frozenset[RobotId],
+    field: FieldGeometry,
+    carried: Mapping[RobotId, Vec2],
 ) -> list[RobotId]:
     """Penalised robots (not sent off) back on the field, which the league's referee shows a
     yellow card, removes again and, the second time, sends off (hlvs_webots referee.py:
     1287-1302, ``check_team_penalized_in_field``, with ``send_penalty`` 894-897 letting the new
     penalty through). The league reads the feet's contacts (one on the field or a line is in);
     here the torso, more than a line's width inside the field, so that a robot standing at its
-    re-entry spot on a touch line is not in."""
+    re-entry spot on a touch line is not in; nor is one standing where the referee put it
+    (``carried``: within a robot's radius), should its team's re-entry pose be on the field."""
     inside_x = field.half_length_m - field.line_width_m
     inside_y = field.half_width_m - field.line_width_m
-    return [
-        robot.id for robot in snapshot.robots
-        if robot.id in penalised and not robot.removed
-        and abs(robot.position[0]) < inside_x and abs(robot.position[1]) < inside_y
-    ]  # fmt: skip
+    found = []
+    for robot in snapshot.robots:
+        if robot.id not in penalised or robot.removed:
+            continue
+        x, y = robot.position[0], robot.position[1]
+        if abs(x) >= inside_x or abs(y) >= inside_y:
+            continue
+        put = carried.get(robot.id)
+        if put is not None and math.hypot(x - put[0], y - put[1]) < field.robot_radius_m:
+            continue
+        found.append(robot.id)
+    return found

@@ -91,6 +91,7 @@ def build_config(scenario: Scenario) -> RefereeConfig:
         timing=timing,
         match_id=scenario.name,
         seed=int(game.get("seed", 0)),
+        start_positions_checked=False,  # a scenario's robots start where it puts them, on the field
     )
 
 

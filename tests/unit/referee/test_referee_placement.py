@@ -233,7 +233,17 @@ def test_a_penalised_robot_back_on_the_field_gets_a_yellow_then_a_red_card() -> 
         snapshot(game.ms, (RED_FAR, BLUE_FAR)),
     )
     at_reentry = robot(RED, 1, -3.0, -3.0)
-    assert removal.penalised_in_field(snapshot(0, (at_reentry,)), frozenset({R1}), KID_FIELD) == []
+    assert removal.penalised_in_field(
+        snapshot(0, (at_reentry,)), frozenset({R1}), KID_FIELD, {}
+    ) == []
+    # a team whose re-entry pose is on the field: standing where the referee put it is no entry
+    put_there = robot(RED, 1, -2.0, -1.0)
+    assert removal.penalised_in_field(
+        snapshot(0, (put_there,)), frozenset({R1}), KID_FIELD, {R1: (-2.0, -1.1)}
+    ) == []
+    assert removal.penalised_in_field(
+        snapshot(0, (put_there,)), frozenset({R1}), KID_FIELD, {R1: (-3.0, -3.1)}
+    ) == [R1]
     commands = game.step((at_reentry, BLUE_FAR), (0.0, 0.0, 0.07))
     assert game.ref.gc.robot(R1).yellow_cards == 0 and commands == []
     commands = game.step((RED_FAR, BLUE_FAR), (0.0, 0.0, 0.07))  # walked back in
