@@ -276,7 +276,9 @@ class LocalSession:
             raise TrainerError(
                 operation="set_game_state", reason=f"{state!r} is not one of {names}"
             ) from None
-        referee.force_state(target, self._live_world("set_game_state").snapshot())
+        world = self._live_world("set_game_state")
+        for command in referee.force_state(target, world.snapshot()):
+            world.apply(command)
 
     def drop_ball(self, x_m: float = 0.0, y_m: float = 0.0) -> None:
         """A dropped ball at (x, y): the ball is placed there, the game goes to READY with no

@@ -11,6 +11,7 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 from contracts import GameStateRecord, GameType, Pose, RobotId, TeamColor
@@ -36,6 +37,7 @@ from referee.rules import end_of_game, goal, kickoff, removal, set_play
 from referee.rules.base import AbortSetPlay, Decision, GameView, GiveCard, RetakeSetPlay
 from referee.shootout import KickOutcome, Shootout
 from referee.snapshot import (
+    BallState,
     PlaceBall,
     RefereeEvent,
     SetLimp,
@@ -450,11 +452,21 @@ class Referee:
         automatic rules give none). Escalates like every card; a red card removes the robot."""
         return self._apply([GiveCard(robot, card, reason)], snapshot)
 
-    def force_state(self, state: GameState, snapshot: WorldSnapshot) -> None:
+    def force_state(self, state: GameState, snapshot: WorldSnapshot) -> list[WorldCommand]:
         """Put the game into ``state`` now, as a trainer may (learning environments): cancels a
         pending wall-clock wait and skips the transitions a match would take. READY goes on to
         SET when its time is up, SET to PLAYING after ``set_to_play_s``; PLAYING starts with the
-        ball in play as after a dropped ball's SET."""
+        ball in play as after a dropped ball's SET. Returns the world commands to apply: the ball
+        held off the field before a kick-off is put on the centre spot for SET or PLAYING, as
+        SET would have put it."""
+        commands: list[WorldCommand] = []
+        x, y = snapshot.ball.position[0], snapshot.ball.position[1]
+        away = abs(x) > self.field.turf_half_length_m or abs(y) > self.field.turf_half_width_m
+        if away and state in (GameState.SET, GameState.PLAYING):
+            placed = self.ball_at(0.0, 0.0)
+            commands.append(placed)
+            snapshot = replace(snapshot, ball=BallState(position=placed.position,
+                                                        velocity=(0.0, 0.0, 0.0)))  # fmt: skip
         gc = self.gc
         self._started = True
         self._wait_until_s = None
@@ -466,6 +478,7 @@ class Referee:
         if state is GameState.PLAYING:
             self.rules.restart(snapshot, None)
         self.log.info(snapshot.sim_time_ms, f"State {state.name} set by the trainer.")
+        return commands
 
     def _apply(self, decisions: list[Decision], snapshot: WorldSnapshot) -> list[WorldCommand]:
         return apply_decisions(self, decisions, snapshot) if decisions else []
