@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import socket
 import threading
+import time
 
 from contracts.robot_api import messages_pb2 as pb
 
@@ -34,7 +35,16 @@ def _drain(sock: socket.socket, stop: threading.Event) -> None:
 def flood(port: int, stop: threading.Event, sent: list[int], host: str = "127.0.0.1") -> None:
     """Flood ``host:port`` until ``stop`` is set; ``sent[0]`` counts the frames written."""
     blob = flood_frames()
-    with socket.create_connection((host, port), timeout=5) as sock:
+    deadline = time.monotonic() + 30.0  # the simulator may listen only after seconds
+    while True:
+        try:
+            sock = socket.create_connection((host, port), timeout=5)
+            break
+        except ConnectionRefusedError:
+            if time.monotonic() > deadline or stop.is_set():
+                raise
+            time.sleep(0.05)
+    with sock:
         greeting = b""
         while len(greeting) < 8:
             chunk = sock.recv(8 - len(greeting))

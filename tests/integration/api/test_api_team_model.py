@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import shutil
 import time
 from pathlib import Path
 
@@ -111,9 +112,9 @@ def bridge_named_wolfgang(folder: Path) -> Path:
          "gyro": "imu_head gyro"},
     ]  # fmt: skip
     manifest["cameras"][0]["name"] = "camera"
-    manifest["model_file"] = str(WOLFGANG / manifest["model_file"])
-    manifest["packages"] = {k: str(WOLFGANG / v) for k, v in manifest["packages"].items()}
-    folder.mkdir(parents=True, exist_ok=True)
+    # a package of its own: the example's files copied beside the new manifest (a model's
+    # files must lie inside its package's folder)
+    shutil.copytree(WOLFGANG, folder, dirs_exist_ok=True)
     (folder / "robot_model.json").write_text(json.dumps(manifest))
     return folder
 

@@ -105,8 +105,12 @@ def test_head_moves_by_its_hlvs_name_and_the_camera_sees_the_opponent() -> None:
         world.step()
     with CameraRenderer(world, 320, 240) as renderer:
         image = np.frombuffer(renderer.render(RED_1), dtype=np.uint8).reshape(240, 320, 3)
-    bluish = (image[:, :, 0] > 150) & (image[:, :, 2] < 80)  # B,G,R: the blue robot's torso
-    assert bluish.sum() > 30
+    pixels = image.astype(int)
+    b, g, r = pixels[:, :, 0], pixels[:, :, 1], pixels[:, :, 2]
+    # B,G,R: the blue robot's body by its hue (the match light varies in brightness), below
+    # the sky's rows
+    bluish = (b > r + 40) & (b > g + 20) & (b > 90)
+    assert bluish[60:].sum() > 200
     assert len(np.unique(image.reshape(-1, 3), axis=0)) > 50
 
 

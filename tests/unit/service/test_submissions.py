@@ -418,6 +418,7 @@ def test_a_submissions_team_file_is_parsed_once(settings: Settings, token: Calla
                         staticmethod(lambda: None))
     monkeypatch.setattr(orchestrator.match, "MatchRunner", _Runner)
     monkeypatch.setattr(orchestrator.match, "cleanup", lambda *a, **k: None)
+    monkeypatch.setattr(orchestrator.match, "clean_match", lambda *a, **k: None)
     monkeypatch.setattr(orchestrator.project_images, "project_image",
                         lambda name: f"hlvs-runner/{name}:test")
     served = serve(settings.with_(preflight="full"), start_worker=True,
