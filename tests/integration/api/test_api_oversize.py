@@ -40,7 +40,7 @@ def test_an_oversize_request_is_answered_with_a_warning_and_counts_as_the_answer
             waited_s = time.monotonic() - started
             after = [pb.SensorMeasurements.FromString(client.exchange(neck_request(0.2)))
                      for _ in range(3)]  # fmt: skip
-        stats = driver.server.statistics()["red-1"]
+            stats = driver.server.statistics()["red-1"]  # while connected: its close is no fault
     assert [(m.message_type, m.text) for m in told.messages] == [(
         pb.Message.WARNING_MESSAGE,
         f"ActuatorRequests of {len(body)} bytes is above the limit of {MAX_REQUEST_BYTES}"
