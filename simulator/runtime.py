@@ -155,7 +155,7 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
         stack.callback(server.close)
         if gc_network:
             referee.start_network()
-        reserve = _reserve_space(out)
+        reserve = files.reserve_space(out, log)
         recorder = Recorder(
             out / REPLAY_FILE, world, match_id=spec.match_id, rate_hz=spec.recorder_rate_hz
         )
@@ -231,26 +231,6 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
     if spec.record_video:
         _render_video(out / REPLAY_FILE, out / spec.record_video)
     return exit_code
-
-
-RESERVE_FILE = ".results-reserve"
-RESERVE_BYTES = 1 << 20
-"""Space kept at the start for the results (sim_result.json is a few KB; 8 robots' statistics
-and cameras stay far below 1 MiB), given back just before they are written."""
-
-
-def _reserve_space(out: Path) -> Path:
-    """A file of :data:`RESERVE_BYTES` in ``out`` (written, so that its blocks are allocated):
-    when the disk fills during the match, the replay and the logs are cut, and the results
-    still find room. A disk already too full for it gets none (and says so)."""
-    path = out / RESERVE_FILE
-    try:
-        with path.open("wb") as handle:
-            handle.write(b"\0" * RESERVE_BYTES)
-    except OSError as exc:
-        log.warning("no space reserved for the results in %s: %s", out, exc.strerror or exc)
-        path.unlink(missing_ok=True)
-    return path
 
 
 def _camera_gl() -> dict[str, str]:

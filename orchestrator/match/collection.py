@@ -74,22 +74,11 @@ def collect(deps: MatchDeps, lifecycle: Lifecycle, created: Created, played: Pla
     return _Collection(deps, lifecycle, created, played).run()
 
 
-RESERVE_FILE = ".results-reserve"
-RESERVE_BYTES = 1 << 20
-"""Space the runner keeps in the output folder from the start for ``results.json`` and
-``report.json`` (tens of KB), given back just before they are written: a disk that fills
-during the match still takes the match's outcome."""
-
-
 def reserve_space(out: Path) -> None:
-    """Allocate :data:`RESERVE_FILE` in ``out`` (a disk already too full gets none, said so)."""
-    path = out / RESERVE_FILE
-    try:
-        with path.open("wb") as handle:
-            handle.write(b"\0" * RESERVE_BYTES)
-    except OSError as exc:
-        log.warning("no space reserved for the results in %s: %s", out, exc.strerror or exc)
-        path.unlink(missing_ok=True)
+    """Space the runner keeps in the output folder from the start for ``results.json`` and
+    ``report.json`` (tens of KB), given back just before they are written: a disk that fills
+    during the match still takes the match's outcome (a disk already too full gets none)."""
+    files.reserve_space(out, log)
 
 
 def read_sim_result(match_dir: Path | None, *, match_id: str) -> SimResult | None:
@@ -336,7 +325,7 @@ class _Collection:
             bringup_s=self.played.bringup_s,
             admission=plan.admission,
         )
-        (out / RESERVE_FILE).unlink(missing_ok=True)  # its space is the results'
+        (out / files.RESERVE_FILE).unlink(missing_ok=True)  # its space is the results'
         write_results(out, results)
         if lifecycle.state is MatchState.COLLECTING:
             lifecycle.advance(MatchState.FAILED if self.failure else MatchState.DONE)

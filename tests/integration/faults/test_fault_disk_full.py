@@ -68,7 +68,7 @@ def full_disk(tmp_path: Path) -> Iterator[Path]:
 @pytest.fixture
 def filling_disk(tmp_path: Path) -> Iterator[Path]:
     """Room for the simulator's reserve for its results and about 1 MiB more."""
-    from simulator.runtime import RESERVE_BYTES
+    from contracts.files import RESERVE_BYTES
 
     try:
         yield _nearly_full(tmp_path / "disk", RESERVE_BYTES + 1024 * 1024)
@@ -148,7 +148,7 @@ def test_the_orchestrator_on_a_disk_that_fills_writes_its_results_and_report(
     as the simulator ends: collection names each copy it could not make and still writes
     ``results.json`` and ``report.json`` (before, writing them raised ``OSError`` out of the
     runner)."""
-    from orchestrator.match.collection import RESERVE_BYTES, RESERVE_FILE
+    from contracts.files import RESERVE_BYTES, RESERVE_FILE
     from orchestrator.match.fake import FakeRuntime
     from tests.unit.match.test_match_runner import _plan, _run
 
