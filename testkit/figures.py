@@ -44,8 +44,8 @@ TARGETS = {
 }
 
 # ``bench api --flood``: the other robots' pace with a robot flooding its port over their pace
-# without it (``ratio_interleaved``, 1.0: the flood costs them nothing)
-FLOOD_TARGET = Target("ratio_interleaved", minimum=0.9)
+# without it (``ratio_interleaved``, 1.0: the flood costs them nothing; at least 0.8)
+FLOOD_TARGET = Target("ratio_interleaved", minimum=0.8)
 
 
 def judged(target: Target, figures: Mapping[str, object]) -> dict[str, object]:
