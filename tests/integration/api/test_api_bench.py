@@ -82,6 +82,6 @@ def test_bench_api_flood_reports_the_honest_robots_with_and_without_it() -> None
     assert flood["ratio"] == pytest.approx(
         flood["real_time_factor"] / flood["real_time_factor_without"], abs=0.01
     )
-    # the honest robots' pace with the flood over without: at least 0.9 meets the target
-    assert flood["target"] == {"figure": "ratio_interleaved", "min": 0.9}
-    assert flood["meets_target"] == (flood["ratio_interleaved"] >= 0.9)
+    # the honest robots' pace with the flood over without: at least 0.8 meets the target
+    assert flood["target"] == {"figure": "ratio_interleaved", "min": 0.8}
+    assert flood["meets_target"] == (flood["ratio_interleaved"] >= 0.8)
