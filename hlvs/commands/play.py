@@ -42,6 +42,7 @@ from orchestrator.match import (
     RunOptions,
     SimulatorGpu,
     admit,
+    check_robot_runtime,
     clean_match,
     cleanup,
     local_images,
@@ -87,12 +88,20 @@ def play(
     match id is claimed first (:class:`~orchestrator.match.ownership.MatchRunning` while another
     orchestrator plays it); what a dead earlier run of it left is salvaged and removed. An
     official match that does not fit the host is refused before all that
-    (:mod:`orchestrator.match.admission`)."""
-    from orchestrator.engine import DockerRuntime, connect, detect_nvidia
+    (:mod:`orchestrator.match.admission`), and so is a match whose ``limits.robot_runtime``
+    the engine does not have (:mod:`orchestrator.match.robot_runtime`)."""
+    from orchestrator.engine import (
+        DockerRuntime,
+        connect,
+        detect_nvidia,
+        engine_endpoint,
+        engine_runtimes,
+    )
 
     verdict = admit(plan, host=HostResources.local(), official=plan.official)
     plan = replace(plan, admission=verdict.record())
     client = connect()
+    check_robot_runtime(plan, engine=engine_endpoint(), runtimes=lambda: engine_runtimes(client))
     gpu = simulator_gpu(plan.gpu, lambda: detect_nvidia(client), origin=plan.gpu_origin)
     runtime = DockerRuntime(client)
     host = HostControl.for_current_user()

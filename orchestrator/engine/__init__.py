@@ -29,15 +29,29 @@ LABEL_ROBOT = "org.hlvs-runner.robot"  # player number
 LABEL_SLURM_JOB = "org.hlvs-runner.slurm-job"  # the Slurm job a match runs in (its epilog)
 
 
+def engine_endpoint() -> str:
+    """Where the engine is: ``DOCKER_HOST``, or the local socket."""
+    return os.environ.get("DOCKER_HOST") or "unix:///var/run/docker.sock"
+
+
 def connect(*, timeout_s: float = 60.0) -> docker.DockerClient:
     """A client for the engine at ``DOCKER_HOST`` (or the local socket) that answered a ping."""
-    endpoint = os.environ.get("DOCKER_HOST", "unix:///var/run/docker.sock")
+    endpoint = engine_endpoint()
     try:
         client = docker.DockerClient(base_url=endpoint, timeout=int(timeout_s))
         client.ping()
     except (docker.errors.DockerException, OSError) as exc:
         raise EngineUnavailable(endpoint=endpoint, reason=str(exc)) from exc
     return client
+
+
+def engine_runtimes(client: docker.DockerClient) -> tuple[str, ...]:
+    """The OCI runtimes the engine knows by name (``runc``, and those of its daemon.json)."""
+    try:
+        info = client.info()
+    except (docker.errors.DockerException, OSError) as exc:
+        raise EngineUnavailable(endpoint=engine_endpoint(), reason=str(exc)) from exc
+    return tuple(sorted(info.get("Runtimes") or {}))
 
 
 __all__ = [
@@ -49,6 +63,8 @@ __all__ = [
     "LABEL_SLURM_JOB",
     "LABEL_TEAM",
     "connect",
+    "engine_endpoint",
+    "engine_runtimes",
     "detect_nvidia",
 ]
 

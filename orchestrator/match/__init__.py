@@ -39,6 +39,7 @@ if TYPE_CHECKING:
     from orchestrator.match.gpu import GpuOrigin, SimulatorGpu, simulator_gpu
     from orchestrator.match.ownership import LABEL_RUN
     from orchestrator.match.placement import LeaguePlacement, parse_nodes
+    from orchestrator.match.robot_runtime import check_robot_runtime
     from orchestrator.match.scrimmage import ScrimmageRequest, game_file, team_file
 
 __all__ = [
@@ -74,6 +75,7 @@ __all__ = [
     "StateChanged",
     "TeamPlan",
     "admit",
+    "check_robot_runtime",
     "clean_match",
     "cleanup",
     "game_file",
@@ -96,5 +98,6 @@ if not TYPE_CHECKING:
         "orchestrator.match.gpu": ("GpuOrigin", "SimulatorGpu", "simulator_gpu"),
         "orchestrator.match.ownership": ("LABEL_RUN",),
         "orchestrator.match.placement": ("LeaguePlacement", "parse_nodes"),
+        "orchestrator.match.robot_runtime": ("check_robot_runtime",),
         "orchestrator.match.scrimmage": ("ScrimmageRequest", "game_file", "team_file"),
     })

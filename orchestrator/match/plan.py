@@ -55,6 +55,7 @@ class MatchPlan:
     official: bool = False
     gpu: str = "auto"  # auto | on | off (orchestrator.match.gpu)
     gpu_origin: GpuOrigin = field(default_factory=GpuOrigin)  # where ``gpu`` was set
+    game_file: str = "game.json"  # where the match's settings were read (for their errors)
     admission: AdmissionRecord | None = None  # the admission verdict, copied into results
     grace_period_s: float = 120.0
     telemetry: bool = True  # ask the simulator for zenoh telemetry on the control network
@@ -103,6 +104,7 @@ def plan_from_game(loaded: LoadedGame, *, grace_period_s: float | None = None) -
         official=game.official,
         gpu=game.gpu,
         gpu_origin=GpuOrigin(file=str(game.source), pointer="/gpu"),
+        game_file=str(game.source),
         grace_period_s=game.timing.grace_period_s if grace_period_s is None else grace_period_s,
         model_dirs=tuple(
             dict.fromkeys(

@@ -4,14 +4,20 @@ Under gVisor the container sees gVisor's kernel (it reports Linux 4.4.0), not th
 
 from __future__ import annotations
 
+import argparse
+import json
 import os
+import time
 import uuid
 from pathlib import Path
 from typing import Any
 
 import pytest
 
+from hlvs.cli import main as hlvs
+from orchestrator import add_scrimmage_arguments
 from orchestrator.engine import LABEL_MATCH, LABEL_PROJECT
+from orchestrator.match.scrimmage import ScrimmageRequest, write_files
 from orchestrator.runtime.port import ContainerRequest
 
 pytestmark = [pytest.mark.docker]
@@ -43,3 +49,35 @@ def test_a_robot_container_runs_under_the_named_runtime(
         assert kernel == "4.4.0", kernel  # gVisor's own kernel
     else:
         assert kernel == os.uname().release
+
+
+def test_a_runtime_the_engine_lacks_refuses_the_match_before_any_container(
+        docker_client: Any, runtime: Any, test_image: str, tmp_path: Path,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    """Before, each robot's start failed with the engine's message once the networks and the
+    simulator were up; now ``hlvs match`` exits 2 naming the setting and the engine, and the
+    engine has nothing of the match."""
+    match_id = f"rt-{uuid.uuid4().hex[:8]}"
+    parser = argparse.ArgumentParser()
+    add_scrimmage_arguments(parser)
+    write_files(ScrimmageRequest.from_options(parser.parse_args([
+        "--players", "1", "--half-duration", "3", "--minimum-play", "0", "--match-id", match_id,
+        "--red-image", test_image, "--blue-image", test_image])), tmp_path / "config")
+    game_path = tmp_path / "config" / "game.json"
+    game = json.loads(game_path.read_text())
+    game.setdefault("limits", {})["robot_runtime"] = "no-such-runtime"
+    game_path.write_text(json.dumps(game))
+    began = int(time.time()) - 1
+    try:
+        code = hlvs(["match", str(game_path), "--out", str(tmp_path / "out")])
+    finally:
+        hlvs(["cleanup", "--match", match_id])
+    seen = [f"{e.get('Type')} {e.get('Action')}" for e in docker_client.events(
+        since=began, until=int(time.time()) + 1, decode=True,
+        filters={"label": f"{LABEL_MATCH}={match_id}"})]
+    err = capsys.readouterr().err
+    assert code == 2, err[-2000:]
+    assert str(game_path) in err and "/limits/robot_runtime" in err, err
+    assert "'no-such-runtime'" in err and "Docker engine at unix://" in err, err
+    assert "Traceback" not in err
+    assert seen == [], seen  # no network, no container: not even created

@@ -7,6 +7,8 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
+import pytest
+
 from orchestrator.config.game import _limits
 from orchestrator.match.fake import FakeRuntime
 from tests.unit.match.test_match_runner import _plan, _run
@@ -37,3 +39,32 @@ def test_robots_run_under_the_league_runtime_and_nothing_else_does(tmp_path: Pat
 def test_game_json_names_the_runtime_as_a_string() -> None:
     assert _limits({"robot_runtime": "runsc", "pids": 64}).robot_runtime == "runsc"
     assert _limits({}).robot_runtime == ""
+
+
+def _asking(runtime_name: str) -> Any:
+    plan = _plan()
+    return replace(plan, limits=replace(plan.limits, robot_runtime=runtime_name),
+                   game_file="/srv/league/game.json")
+
+
+def test_a_runtime_the_engine_lacks_is_refused_naming_the_setting_and_the_engine() -> None:
+    from orchestrator.errors import ConfigError
+    from orchestrator.match import check_robot_runtime
+
+    with pytest.raises(ConfigError) as refused:
+        check_robot_runtime(_asking("runsc"), engine="unix:///run/other.sock",
+                            runtimes=lambda: ["runc", "io.containerd.runc.v2"])
+    (problem,) = refused.value.problems
+    assert (problem.file, problem.pointer) == ("/srv/league/game.json", "/limits/robot_runtime")
+    text = str(refused.value)
+    assert "'runsc'" in text and "unix:///run/other.sock" in text
+    assert "io.containerd.runc.v2, runc" in text and "no container was started" in text
+
+
+def test_a_runtime_the_engine_has_and_the_default_pass() -> None:
+    from orchestrator.match import check_robot_runtime
+
+    check_robot_runtime(_asking("runsc"), engine="e", runtimes=lambda: ["runc", "runsc"])
+    asked: list[int] = []
+    check_robot_runtime(_asking(""), engine="e", runtimes=lambda: asked.append(1) or [])
+    assert asked == []  # the engine's default: the engine is not asked
