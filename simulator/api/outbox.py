@@ -1,0 +1,245 @@
+"""The step's measurements sent out: framed, counted in each robot's quota and queued on its
+client, after each physics step.
+
+:class:`Outbox` queues what :meth:`ApiServer.prepare` built. Without the I/O thread it frames
+each measurement here and writes what the sockets take (``blocking_send``: waits until they took
+everything, the HLVS behaviour). With it the step thread hands the step over
+(:meth:`Outbox.flush`) and the I/O thread writes the wire bytes, frames and queues them
+(:meth:`Outbox._deliver`; a steady step's values framed for every robot at once:
+:meth:`Outbox._deliver_steady`). A measurement with a camera waits for its images (and the
+robot's later ones behind it) and goes out when the render worker gives them back
+(:meth:`Outbox.camera_results`).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Mapping
+from functools import partial
+
+from contracts import NetworkSpec, RobotId
+from contracts.robot_api import messages_pb2 as pb
+from simulator.api.batch import Gathered, StepBatch
+from simulator.api.cameras import MAX_IN_FLIGHT, ImageSource
+from simulator.api.connection import ClientClosed, Connection
+from simulator.api.framing import HEADER
+from simulator.api.ports import Ports
+from simulator.api.session import ERROR, WARNING, Measurement
+from simulator.api.slots import IoThreadFailed, Pending, RobotSlot
+from simulator.api.steady import Prepared, SteadyValues
+
+
+class Outbox:
+    """Sends the measurements of the slots served by ``ports``."""
+
+    def __init__(
+        self,
+        *,
+        slots: Mapping[RobotId, RobotSlot],
+        ports: Ports,
+        network: NetworkSpec,
+        lockstep: bool,
+        batch: StepBatch | None,
+        cameras: ImageSource | None,
+        unix_ms: Callable[[], int],
+    ) -> None:
+        self._slots = slots
+        self._ports = ports
+        self._blocking = network.blocking_send
+        self._lockstep = lockstep
+        self._batch = batch
+        self._cameras = cameras
+        self._unix_ms = unix_ms
+        # with the I/O thread: this step's measurements to frame and queue there, in order
+        self._outgoing: list[tuple[RobotSlot, Connection, Measurement]] = []
+        self._unwritten: Gathered | None = None
+        self._sent_at = 0.0
+        self._hold_told: set[tuple[int, int]] = set()  # (connection id, held sim time) told
+
+    def hold_notice(self, time_ms: int, text: str) -> int:
+        """See :meth:`ApiServer.hold_notice`."""
+        real_time = self._unix_ms()
+        now = time.monotonic()
+        told = 0
+        for slot in self._slots.values():
+            conn = slot.conn
+            if conn is None or (id(conn), time_ms) in self._hold_told:
+                continue
+            self._hold_told.add((id(conn), time_ms))
+            notice = Measurement(time_ms, real_time)
+            notice.header.messages.add(message_type=WARNING, text=text)
+            self._send(slot, conn, notice, now)
+            told += 1
+        if told:
+            self.flush()
+        return told
+
+    def publish(self, prepared: Prepared) -> None:
+        """Queue measurements made by :meth:`ApiServer.prepare` (a client dropped meanwhile
+        gets none)."""
+        steady = prepared.steady
+        if steady is not None:
+            if self._ports.sender is not None and (
+                steady.step.connection_changes == self._ports.connection_changes
+            ):
+                self._publish_steady(steady)
+                return
+            # without the I/O thread, or a client left since: robot by robot
+            assert self._batch is not None  # (a steady step is only recorded with the batch)
+            prepared = Prepared(steady.measurements(self._batch))
+        jobs_all = []
+        now = time.monotonic()
+        unwritten = prepared.unwritten
+        for slot, measurement in prepared.items:
+            conn = slot.conn
+            if conn is None:
+                continue
+            jobs = measurement.jobs
+            conn.owe()
+            if jobs or slot.pending:  # sent by this thread when its images are in
+                if unwritten is not None:
+                    unwritten.write()
+                    unwritten = None
+                if jobs:
+                    jobs_all.extend(jobs)
+                slot.pending.append(Pending(measurement, len(jobs)))
+                self._ports.maybe_waiting = True
+            else:
+                self._send(slot, conn, measurement, now)
+        self._unwritten = unwritten
+        if jobs_all:
+            assert self._cameras is not None, "camera enabled without a render worker"
+            self._cameras.submit(jobs_all)
+            while self._cameras.in_flight > MAX_IN_FLIGHT and not self._ports.stop_requested:
+                self._ports.poll(0.05)  # rendering is behind: let it catch up (results end it)
+        self.flush()
+
+    def _publish_steady(self, steady: SteadyValues) -> None:
+        """Hand a steady step's values to the I/O thread, which frames and queues them for
+        every robot (:meth:`_deliver_steady`): what the step thread does per robot is the
+        lockstep flag."""
+        sender = self._ports.sender
+        assert sender is not None
+        if self._lockstep:  # (the flag lockstep waits on; async never waits)
+            for conn in steady.step.conns:
+                conn.owe()
+        self.flush()  # anything queued before, in order
+        sender.submit(partial(self._deliver_steady, steady, time.monotonic()))
+
+    def _send(
+        self, slot: RobotSlot, conn: Connection, measurement: Measurement, now: float
+    ) -> None:
+        if conn.threaded:  # framed and queued on the I/O thread (handed over by flush)
+            self._outgoing.append((slot, conn, measurement))
+            self._sent_at = now
+            return
+        frame = self._framed(slot, measurement)
+        try:
+            conn.send(frame, now)
+        except ClientClosed as exc:
+            self._ports.drop(slot, exc.reason)
+
+    def _framed(self, slot: RobotSlot, measurement: Measurement) -> bytes:
+        """The measurement's framed message, counted in the robot's quota, or the quota's
+        ERROR message in its place."""
+        frame = measurement.frame
+        if frame is not None:  # built whole by the step's batch: no header, no message
+            return self._admitted(slot, frame, measurement.time, measurement.real_time)
+        head, sensors = measurement.head(), measurement.sensors
+        size = len(head) + len(sensors)
+        if not slot.quota.admit(size, measurement.real_time):
+            return self._quota_error(slot, measurement.time, measurement.real_time)
+        warnings = measurement.message_count
+        if warnings:
+            slot.stats.warnings_sent += warnings
+        return b"".join((HEADER.pack(size), head, sensors))
+
+    def _admitted(self, slot: RobotSlot, frame: bytes, time_ms: int, real_time: int) -> bytes:
+        """A plain measurement's whole ``frame``, counted in the robot's quota, or the quota's
+        ERROR message in its place."""
+        if slot.quota.admit(len(frame) - HEADER.size, real_time):
+            return frame
+        return self._quota_error(slot, time_ms, real_time)
+
+    def _quota_error(self, slot: RobotSlot, time_ms: int, real_time: int) -> bytes:
+        """The framed ERROR message that replaces a measurement over the robot's quota."""
+        quota = slot.quota
+        slot.stats.quota_errors += 1
+        header = pb.SensorMeasurements(time=time_ms, real_time=real_time)
+        header.messages.add(message_type=ERROR, text=quota.error_text)
+        payload: bytes = header.SerializeToString()
+        quota.record(len(payload), real_time)
+        slot.stats.warnings_sent += 1
+        return HEADER.pack(len(payload)) + payload
+
+    def flush(self) -> None:
+        """Send what was queued: hand it to the I/O thread (raising its failure, if it
+        stopped on one), or write what each socket takes."""
+        sender = self._ports.sender
+        if sender is not None:
+            if sender.failure is not None:
+                raise IoThreadFailed(sender.failure) from sender.failure
+            if self._outgoing or self._unwritten is not None:
+                sender.submit(partial(self._deliver, self._outgoing, self._unwritten,
+                                      self._sent_at))  # fmt: skip
+                self._outgoing = []
+                self._unwritten = None
+            return
+        for slot in self._slots.values():
+            if slot.conn is None or slot.conn.idle:
+                continue
+            self._ports.flush(slot)
+            if self._blocking:
+                self._ports.flush_blocking(slot)
+
+    def _deliver(
+        self,
+        outgoing: list[tuple[RobotSlot, Connection, Measurement]],
+        unwritten: Gathered | None,
+        now: float,
+    ) -> list[Connection]:
+        """I/O thread: write the step's wire bytes, frame each measurement (counted in its
+        robot's quota) and queue it; the connections to write to. The step thread is back in
+        the physics meanwhile (MuJoCo releases the GIL while it steps)."""
+        if unwritten is not None:
+            unwritten.write()
+        queued = []
+        for slot, conn, measurement in outgoing:
+            if conn.closed or conn.error is not None:
+                continue  # dropped since: the step thread forgets it
+            conn.send_threaded(self._framed(slot, measurement), now)
+            queued.append(conn)
+        return queued
+
+    def _deliver_steady(self, steady: SteadyValues, now: float) -> list[Connection]:
+        """I/O thread: :meth:`_deliver` of a steady step: the wire bytes of every robot's plain
+        measurement written at once, each counted in its robot's quota and queued."""
+        assert self._batch is not None
+        step = steady.step
+        frames = steady.frames(self._batch)
+        queued = []
+        for slot, conn, frame in zip(step.slots, step.conns, frames, strict=True):
+            if conn.closed or conn.error is not None:
+                continue  # dropped since: the step thread forgets it
+            conn.send_threaded(self._admitted(slot, frame, steady.time_ms, steady.real_time), now)
+            queued.append(conn)
+        return queued
+
+    def camera_results(self) -> None:
+        """Take the rendered images and send the measurements they completed, in order."""
+        assert self._cameras is not None
+        touched: set[RobotId] = set()
+        for job, image in self._cameras.completed():
+            slot = self._slots[job.robot]
+            job.measurement.image = image
+            for pending in slot.pending:
+                if pending.measurement.time == job.time_ms and pending.missing:
+                    pending.missing -= 1
+                    break
+            touched.add(job.robot)
+        now = time.monotonic()
+        for robot in touched:
+            slot = self._slots[robot]
+            while slot.pending and slot.pending[0].missing == 0 and slot.conn is not None:
+                self._send(slot, slot.conn, slot.pending.popleft().measurement, now)
+        self.flush()
