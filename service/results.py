@@ -19,6 +19,7 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
+from pydantic import BaseModel, ConfigDict, Field
 from sqlalchemy import exists, select
 from sqlalchemy.orm import Session
 
@@ -33,11 +34,13 @@ ENDED = (SubmissionState.DONE.value, SubmissionState.FAILED.value,
          SubmissionState.CANCELLED.value)
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
-class SideFigures:
-    """One side of a finished match. The play counts are None when no football was played."""
+class SideResult(BaseModel):
+    """One side of a finished match: its goals, what the referee counted of its play (null
+    when no football was played) and how its robots ended. The same figures are kept in the
+    database (:class:`~service.db.results.MatchTeamRow`) and answered by the API."""
 
-    color: str
+    model_config = ConfigDict(frozen=True)
+
     team: str
     goals: int | None
     kicks: int | None
@@ -45,7 +48,7 @@ class SideFigures:
     own_goals: int | None
     falls: int | None
     robots: int
-    robots_exited: int  # exited during the game
+    robots_exited: int = Field(description="robots that exited during the game")
     robots_oom_killed: int
 
 
@@ -65,7 +68,7 @@ class MatchSummary:
     playing_s: float | None
     sim_time_ms: int | None
     real_time_factor: float | None
-    sides: dict[str, SideFigures]
+    sides: dict[str, SideResult]  # by colour: red, blue
 
     @property
     def kicked_off(self) -> bool:
@@ -84,8 +87,8 @@ class MatchSummary:
         sides = {}
         for color in COLORS:
             robots = [r for key, r in results.robots.items() if key.startswith(f"{color}-")]
-            sides[color] = SideFigures(
-                color=color, team=teams.get(color, "?"),
+            sides[color] = SideResult(
+                team=teams.get(color, "?"),
                 goals=score.get(color) if score is not None else None,
                 kicks=play.kicks.get(color) if play else None,
                 shots=play.shots.get(color) if play else None,
@@ -112,8 +115,8 @@ class MatchSummary:
             "red": row.red_shootout, "blue": row.blue_shootout}
         halves = None if row.halves_playing is None else tuple(
             int(half) for half in row.halves_playing.split(",") if half)
-        sides = {t.color: SideFigures(
-            color=t.color, team=t.team, goals=t.goals, kicks=t.kicks, shots=t.shots,
+        sides = {t.color: SideResult(
+            team=t.team, goals=t.goals, kicks=t.kicks, shots=t.shots,
             own_goals=t.own_goals, falls=t.falls, robots=t.robots,
             robots_exited=t.robots_exited, robots_oom_killed=t.robots_oom_killed)
             for t in row.teams}
@@ -153,10 +156,10 @@ def record(session: Session, submission_id: str, summary: MatchSummary) -> None:
         playing_s=summary.playing_s, sim_time_ms=summary.sim_time_ms,
         real_time_factor=summary.real_time_factor)
     row.teams = [MatchTeamRow(
-        color=side.color, team=side.team, goals=side.goals, kicks=side.kicks, shots=side.shots,
+        color=color, team=side.team, goals=side.goals, kicks=side.kicks, shots=side.shots,
         own_goals=side.own_goals, falls=side.falls, robots=side.robots,
         robots_exited=side.robots_exited, robots_oom_killed=side.robots_oom_killed)
-        for side in summary.sides.values()]
+        for color, side in summary.sides.items()]
     session.add(row)
     session.flush()
 
@@ -204,7 +207,7 @@ def backfill(session: Session, results_dir: Callable[[str], Path]) -> int:
 
 __all__ = [
     "MatchSummary",
-    "SideFigures",
+    "SideResult",
     "backfill",
     "read_results",
     "record",

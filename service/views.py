@@ -11,7 +11,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from sqlalchemy.orm import Session
 
 from service.db import ACTIVE_STATES, Submission, Team, utc
-from service.results import MatchSummary, stored
+from service.results import MatchSummary, SideResult, stored
 from service.settings import Settings
 from service.submissions import QueueBoard
 
@@ -32,21 +32,6 @@ class Product(BaseModel):
 
     state: str = Field(description="pending | ready (video) | delivered (logs) | failed")
     detail: str | None
-
-
-class SideResult(BaseModel):
-    """One side of a finished match: its goals, what the referee counted of its play (null
-    when no football was played) and how its robots ended."""
-
-    team: str
-    goals: int | None
-    kicks: int | None
-    shots: int | None
-    own_goals: int | None
-    falls: int | None
-    robots: int
-    robots_exited: int = Field(description="robots that exited during the game")
-    robots_oom_killed: int
 
 
 class MatchResultView(BaseModel):
@@ -73,11 +58,7 @@ def result_view(summary: MatchSummary) -> MatchResultView:
         halves_playing=list(summary.halves_playing) if summary.halves_playing is not None
         else None, playing_s=summary.playing_s, sim_time_ms=summary.sim_time_ms,
         real_time_factor=summary.real_time_factor,
-        teams={color: SideResult(
-            team=side.team, goals=side.goals, kicks=side.kicks, shots=side.shots,
-            own_goals=side.own_goals, falls=side.falls, robots=side.robots,
-            robots_exited=side.robots_exited, robots_oom_killed=side.robots_oom_killed)
-            for color, side in summary.sides.items()})
+        teams=dict(summary.sides))
 
 
 class SubmissionView(BaseModel):
