@@ -137,8 +137,8 @@ def create_app(
             services.worker.start()
             from service.ladder import LadderThread
 
-            services.extras["ladder_thread"] = LadderThread(services)
-            services.extras["ladder_thread"].start()
+            services.ladder_thread = LadderThread(services)
+            services.ladder_thread.start()
         # Everything loaded so far lives as long as the process: kept out of the collector's
         # full passes, which would otherwise stop every request for tens of milliseconds.
         gc.collect()
@@ -146,8 +146,8 @@ def create_app(
         try:
             yield
         finally:
-            if "ladder_thread" in services.extras:
-                services.extras["ladder_thread"].stop()
+            if services.ladder_thread is not None:
+                services.ladder_thread.stop()
             if services.worker is not None:
                 services.worker.stop()
             if services.aftermatch is not None:

@@ -80,7 +80,7 @@ class LadderThread:
     def __init__(self, services: Services) -> None:
         self.services = services
         self.settings = services.settings
-        self.cache: LadderCache = services.extras.setdefault("ladder", LadderCache())
+        self.cache: LadderCache = services.ladder
         self._stop = threading.Event()
         self._wake = threading.Event()
         self._thread: threading.Thread | None = None
@@ -89,6 +89,10 @@ class LadderThread:
     def start(self) -> None:
         self._thread = threading.Thread(target=self._run, name="ladder", daemon=True)
         self._thread.start()
+
+    def wake(self) -> None:
+        """Run a round now rather than at the next poll."""
+        self._wake.set()
 
     def stop(self) -> None:
         self._stop.set()

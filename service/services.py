@@ -6,16 +6,20 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Protocol
 
 from sqlalchemy import Engine
 from sqlalchemy.orm import Session, sessionmaker
 
 from cluster import MatchPool
 from orchestrator.config import TeamConfig
+from service.ratings import LadderCache
 from service.settings import Settings
+from service.submissions import PreflightClaims
 
 if TYPE_CHECKING:
+    from anyio import CapacityLimiter
+
     from service.sealing import Sealer
     from service.statusboard import StatusBoard
     from service.submissions import QueueBoard
@@ -49,6 +53,12 @@ class Services:
     preflight: Preflight | None = None
     worker: Background | None = None  # service.worker.QueueWorker; None when the app serves
     aftermatch: Background | None = None  # service.aftermatch.AfterMatch  without matches
+    ladder_thread: Background | None = None  # service.ladder.LadderThread
+    ladder: LadderCache = field(default_factory=LadderCache)  # the table the pages answer
+    # one pre-flight check per team at a time, and at most ``settings.threads`` at once (the
+    # limiter is made in the event loop, by the first submission)
+    preflight_claims: PreflightClaims = field(default_factory=PreflightClaims)
+    preflight_limiter: CapacityLimiter | None = None
 
     def slots(self) -> int:
         return int(self.pool.slots) if self.pool is not None else self.settings.match_slots
@@ -62,7 +72,6 @@ class Services:
                 self.status.invalidate()
             else:
                 self.status.forget(submission_id)
-    extras: dict[str, Any] = field(default_factory=dict)
 
 
 PoolFactory = Callable[[Settings], MatchPool]

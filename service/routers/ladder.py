@@ -12,7 +12,7 @@ from pydantic import BaseModel, Field
 from service import tokens
 from service.deps import DbSession, SessionRoute, get_services, require_token
 from service.errors import NotFound
-from service.ratings import FRIENDLY, Ladder, LadderCache, RatedGame, TeamRating
+from service.ratings import FRIENDLY, Ladder, RatedGame, TeamRating
 
 router = APIRouter(prefix="/v1/ladder", tags=["ladder"], route_class=SessionRoute)
 AnyPrincipal = Annotated[tokens.Principal, Depends(require_token)]
@@ -69,8 +69,7 @@ class TeamLadderView(BaseModel):
 
 
 def _ladder(request: Request, session: DbSession) -> Ladder:
-    cache: LadderCache = get_services(request).extras.setdefault("ladder", LadderCache())
-    return cache.get(session)
+    return get_services(request).ladder.get(session)
 
 
 def _row(rank: int, t: TeamRating) -> LadderRow:

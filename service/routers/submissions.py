@@ -74,16 +74,14 @@ async def create_submission(body: SubmissionCreate, request: Request, services: 
     that answer requests."""
     team_id = principal.team_id
     assert team_id is not None
-    claims: submissions.PreflightClaims = services.extras.setdefault(
-        "preflight_claims", submissions.PreflightClaims())
-    async with claims.claim(team_id):
+    async with services.preflight_claims.claim(team_id):
         team, file_id, credentials = await run_in_threadpool(
             _before_preflight, services, team_id, body)
         assert services.preflight is not None
-        limiter = services.extras.get("preflight_limiter")
+        limiter = services.preflight_limiter
         if limiter is None:
-            limiter = services.extras.setdefault(
-                "preflight_limiter", anyio.CapacityLimiter(max(1, services.settings.threads)))
+            limiter = services.preflight_limiter = anyio.CapacityLimiter(
+                max(1, services.settings.threads))
         try:
             elapsed = await anyio.to_thread.run_sync(services.preflight, team,
                                                      services.settings, limiter=limiter)
