@@ -12,9 +12,12 @@ from __future__ import annotations
 import argparse
 import ipaddress
 import json
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from orchestrator import ConfigError, Problem, user_path
+
+if TYPE_CHECKING:
+    from orchestrator.config import LoadedGame
 
 
 def register(sub: Any) -> None:
@@ -105,7 +108,7 @@ def _compose(args: argparse.Namespace) -> int:
     return 0
 
 
-def _collect(args: argparse.Namespace, loaded: Any) -> int:
+def _collect(args: argparse.Namespace, loaded: LoadedGame) -> int:
     from orchestrator import ExitCode, collect_results
 
     results = collect_results(loaded, args.output.parent)

@@ -15,7 +15,7 @@ import os
 import sys
 from dataclasses import replace
 from pathlib import Path
-from typing import Any, TextIO
+from typing import TYPE_CHECKING, TextIO
 
 from hlvs.commands.outcome import summarize
 from orchestrator import (
@@ -39,6 +39,7 @@ from orchestrator.match import (
     MatchOutcome,
     MatchPlan,
     MatchRunner,
+    RegistryAccess,
     RunOptions,
     SimulatorGpu,
     admit,
@@ -53,10 +54,15 @@ from orchestrator.match import (
     simulator_gpu,
 )
 
+if TYPE_CHECKING:
+    from docker import DockerClient
+
+    from orchestrator.engine import DockerRuntime
+
 log = logging.getLogger(__name__)
 
 
-def _pull_resolver(client: Any, loaded: Any) -> ImageResolver:
+def _pull_resolver(client: DockerClient, registry: RegistryAccess) -> ImageResolver:
     from orchestrator import resolve_team_images
 
     def resolve(plan: MatchPlan) -> dict[str, tuple[str | None, str | None]]:
@@ -66,8 +72,8 @@ def _pull_resolver(client: Any, loaded: Any) -> ImageResolver:
         for color in ("red", "blue"):
             with progress(allow_rich=False) as bars:  # under the match's live view
                 resolved = resolve_team_images(
-                    client, loaded.team(color), limits=loaded.game.limits, progress=bars,
-                    registry_only=loaded.game.registry_images,
+                    client, registry.team(color), limits=plan.limits, progress=bars,
+                    registry_only=registry.registry_only,
                 )
             for number, image in resolved.items():
                 key = f"{color}-{number}"
@@ -80,7 +86,7 @@ def _pull_resolver(client: Any, loaded: Any) -> ImageResolver:
 
 
 def play(
-    plan: MatchPlan, *, out_dir: Path, pull: bool, loaded: Any = None,
+    plan: MatchPlan, *, out_dir: Path, pull: bool,
     extra_labels: dict[str, str] | None = None, view_stream: TextIO | None = None,
     placement: LeaguePlacement | None = None,
 ) -> MatchOutcome:
@@ -89,7 +95,8 @@ def play(
     orchestrator plays it); what a dead earlier run of it left is salvaged and removed. An
     official match that does not fit the host is refused before all that
     (:mod:`orchestrator.match.admission`), and so is a match whose ``limits.robot_runtime``
-    the engine does not have (:mod:`orchestrator.match.robot_runtime`)."""
+    the engine does not have (:mod:`orchestrator.match.robot_runtime`). ``pull``: the team
+    images are pulled from the plan's registries (:attr:`MatchPlan.registry`)."""
     from orchestrator.engine import (
         DockerRuntime,
         connect,
@@ -114,20 +121,21 @@ def play(
         labels = {**(extra_labels or {}), LABEL_RUN: claim.record.run_id}
         if os.environ.get("SLURM_JOB_ID", "").isdigit():  # the cluster's epilog removes them
             labels[LABEL_SLURM_JOB] = os.environ["SLURM_JOB_ID"]
-        return _play(plan, out_dir=out_dir, pull=pull, loaded=loaded, client=client,
+        return _play(plan, out_dir=out_dir, pull=pull, client=client,
                      runtime=runtime, host=host, extra_labels=labels, view_stream=view_stream,
                      placement=placement, gpu=gpu)
 
 
 def _play(
-    plan: MatchPlan, *, out_dir: Path, pull: bool, loaded: Any, client: Any, runtime: Any,
+    plan: MatchPlan, *, out_dir: Path, pull: bool, client: DockerClient, runtime: DockerRuntime,
     host: HostControl, extra_labels: dict[str, str], view_stream: TextIO | None = None,
     placement: LeaguePlacement | None = None, gpu: SimulatorGpu | None = None,
 ) -> MatchOutcome:
     from orchestrator import LiveView, ZenohTelemetry, project_image
 
     simulator_image = project_image("simulator")
-    images = _pull_resolver(client, loaded) if pull and loaded is not None else None
+    registry = plan.registry
+    images = _pull_resolver(client, registry) if pull and registry is not None else None
     view = LiveView(match_id=plan.match_id, stream=view_stream)
     with stop_on_signals() as stop_event:
         options = RunOptions(
@@ -157,7 +165,7 @@ def run_match_command(args: argparse.Namespace) -> int:
     out = args.out or user_path(Path("matches") / plan.match_id)
     if getattr(args, "pool", "local") == "slurm":
         return _in_pool(args, game_path=args.game, plan=plan, out=out)
-    outcome = play(plan, out_dir=out, pull=True, loaded=loaded,
+    outcome = play(plan, out_dir=out, pull=True,
                    view_stream=sys.stderr if getattr(args, "json", False) else None,
                    placement=_placement(args, plan))
     return summarize(outcome, as_json=getattr(args, "json", False))
@@ -176,7 +184,7 @@ def run_scrimmage_command(args: argparse.Namespace) -> int:
     plan = _gpu_option(args, plan_from_game(loaded, grace_period_s=args.grace))
     if getattr(args, "pool", "local") == "slurm":
         return _in_pool(args, game_path=game_path, plan=plan, out=out)
-    outcome = play(plan, out_dir=out, pull=False, loaded=loaded,
+    outcome = play(plan, out_dir=out, pull=False,
                    view_stream=sys.stderr if getattr(args, "json", False) else None,
                    placement=_placement(args, plan))
     return summarize(outcome, as_json=getattr(args, "json", False))

@@ -21,7 +21,14 @@ from orchestrator.match.events import (
     StateChanged,
 )
 from orchestrator.match.host import Host, HostControl
-from orchestrator.match.plan import MatchPlan, RobotPlan, TeamPlan, plan_from_game, robots_in_game
+from orchestrator.match.plan import (
+    MatchPlan,
+    RegistryAccess,
+    RobotPlan,
+    TeamPlan,
+    plan_from_game,
+    robots_in_game,
+)
 from orchestrator.match.results import Failure, FailureClass, RobotRecord
 from orchestrator.match.runner import (
     ImageResolver,
@@ -65,6 +72,7 @@ __all__ = [
     "MatchPlan",
     "MatchRunner",
     "MatchState",
+    "RegistryAccess",
     "RobotExited",
     "RobotNotStarted",
     "RobotPlan",

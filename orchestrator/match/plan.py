@@ -13,7 +13,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from contracts import AdmissionRecord, MatchSpec
-from orchestrator.config import Limits, LoadedGame, PlayerConfig
+from orchestrator.config import Limits, LoadedGame, PlayerConfig, TeamConfig
 from orchestrator.config.robot_models import is_model_path
 from orchestrator.config.spec import to_match_spec
 from orchestrator.match.gpu import GpuOrigin
@@ -44,6 +44,20 @@ class TeamPlan:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class RegistryAccess:
+    """What pulling a match's team images needs: each team's file (its players' images,
+    its registry credentials) and whether the images must come from a registry
+    (``registry_images`` of game.json)."""
+
+    red: TeamConfig
+    blue: TeamConfig
+    registry_only: bool = False
+
+    def team(self, color: str) -> TeamConfig:
+        return self.red if color == "red" else self.blue
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class MatchPlan:
     match_id: str
     seed: int
@@ -63,6 +77,8 @@ class MatchPlan:
     mirror_port: int = 3737
     versions: Mapping[str, str] = field(default_factory=dict)
     model_dirs: tuple[Path, ...] = ()  # team robot model packages the simulator must read
+    # the teams' registries, to pull their images from (None: the engine has them already)
+    registry: RegistryAccess | None = None
 
     @property
     def teams(self) -> tuple[TeamPlan, TeamPlan]:
@@ -106,6 +122,8 @@ def plan_from_game(loaded: LoadedGame, *, grace_period_s: float | None = None) -
         gpu_origin=GpuOrigin(file=str(game.source), pointer="/gpu"),
         game_file=str(game.source),
         grace_period_s=game.timing.grace_period_s if grace_period_s is None else grace_period_s,
+        registry=RegistryAccess(red=loaded.red, blue=loaded.blue,
+                                registry_only=game.registry_images),
         model_dirs=tuple(
             dict.fromkeys(
                 Path(p.model)

@@ -7,6 +7,8 @@ import argparse
 import json
 from pathlib import Path
 
+import pytest
+
 from orchestrator.config.loader import check_game, load_game
 from orchestrator.match import scrimmage
 
@@ -45,3 +47,29 @@ def test_registry_names_and_local_matches_pass(tmp_path: Path) -> None:
     opted_out = _game(tmp_path / "c", red="my-robot:dev",
                       game={"official": True, "registry_images": False})
     assert not load_game(opted_out, images_required=True).game.registry_images
+
+
+def test_the_plan_carries_the_registries_hlvs_match_pulls_from(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import orchestrator
+    from hlvs.commands.play import _pull_resolver
+    from orchestrator.match import plan_from_game
+
+    path = _game(tmp_path, red="127.0.0.1:5000/red/robot:v1", game={"registry_images": True})
+    loaded = load_game(path, images_required=True)
+    plan = plan_from_game(loaded)
+    assert plan.registry is not None
+    asked: list[tuple[object, ...]] = []
+
+    def resolve(client: object, team: object, *, limits: object, progress: object,
+                registry_only: bool) -> dict[int, object]:
+        asked.append((client, team, limits, registry_only))
+        return {}
+
+    monkeypatch.setattr(orchestrator, "resolve_team_images", resolve)
+    client = object()
+    found = _pull_resolver(client, plan.registry)(plan)
+    assert asked == [(client, loaded.red, loaded.game.limits, True),
+                     (client, loaded.blue, loaded.game.limits, True)]
+    assert found == {robot.key: (None, "no image named for this player") for robot in plan.robots}
