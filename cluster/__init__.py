@@ -25,7 +25,7 @@ from cluster.nodes import NodeJob, PoolNode
 from contracts import lazy_exports
 
 if TYPE_CHECKING:
-    from cluster.local import process_start_time
+    from cluster.local import process_start_time, start_match
     from cluster.nodes import ENV_REMOTE_COMMENT
     from cluster.slurm import HOST_NETNS, SlurmPool
 
@@ -114,12 +114,13 @@ __all__ = [
     "SlurmPool",
     "make_pool",
     "process_start_time",
+    "start_match",
 ]
 
 
 if not TYPE_CHECKING:
     __getattr__, __dir__ = lazy_exports(__name__, {
-        "cluster.local": ("process_start_time",),
+        "cluster.local": ("process_start_time", "start_match"),
         "cluster.nodes": ("ENV_REMOTE_COMMENT",),
         "cluster.slurm": ("HOST_NETNS", "SlurmPool"),
     })

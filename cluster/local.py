@@ -4,11 +4,13 @@ The process runs in its own session, so it outlives a restart of the service; it
 start time are written to ``<work_dir>/pool.json`` before ``submit`` returns, and a later
 service process reads them back to tell a running match from a finished or lost one. Cancel
 sends SIGTERM, which ``hlvs match`` answers with a graceful stop and a complete report.
-The handle is the work folder.
+The handle is the work folder. :func:`start_match` is how every ``hlvs match`` process is
+started, here and by the tournament scheduler.
 """
 
 from __future__ import annotations
 
+import ctypes
 import json
 import logging
 import os
@@ -17,7 +19,9 @@ import socket
 import subprocess
 import sys
 import threading
+from collections.abc import Sequence
 from pathlib import Path
+from typing import IO
 
 from cluster import JobState, JobStatus, MatchJob
 from cluster.errors import PoolError
@@ -57,6 +61,38 @@ def _memory_mb() -> tuple[int, int | None]:
     return values.get("MemTotal", 0), values.get("MemAvailable")
 
 
+def start_match(
+    game_path: Path,
+    out: Path,
+    output: IO[bytes],
+    *,
+    python: str = sys.executable,
+    hlvs_args: Sequence[str] = (),
+    match_args: Sequence[str] = (),
+    own_session: bool = False,
+    die_with_parent: bool = False,
+) -> subprocess.Popen[bytes]:
+    """Start ``hlvs match GAME --out OUT`` in a child process writing to ``output``.
+    ``hlvs_args``: options of ``hlvs`` itself, before the command; ``match_args``: more options
+    of ``hlvs match``. ``own_session``: the child has a session of its own and outlives this
+    process (a pool's match, adopted by a restarted service); ``die_with_parent``: it gets
+    SIGTERM, which stops the match and collects what was played, when this process dies
+    (Linux; the tournament scheduler). Raises OSError when it cannot be started."""
+    command = [python, "-m", "hlvs", *hlvs_args, "match", str(game_path), "--out", str(out),
+               *match_args]
+    return subprocess.Popen(
+        command, stdout=output, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+        start_new_session=own_session,
+        preexec_fn=_die_with_parent if die_with_parent and sys.platform == "linux" else None,
+    )
+
+
+def _die_with_parent() -> None:  # pragma: no cover - runs in the child before exec
+    """Linux: the child gets SIGTERM when its parent dies."""
+    libc = ctypes.CDLL("libc.so.6", use_errno=True)
+    libc.prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+
+
 class LocalDockerPool:
     def __init__(self, *, slots: int = 1, python: str = sys.executable,
                  extra_args: tuple[str, ...] = ()) -> None:
@@ -76,12 +112,11 @@ class LocalDockerPool:
                 return handle
             out = self.results_dir(handle)
             out.mkdir(parents=True, exist_ok=True)
-            command = [self.python, "-m", "hlvs", *self.extra_args, "match",
-                       str(job.game_path.resolve()), "--out", str(out)]
             with os.fdopen(open_private_append(job.work_dir / LOG_FILE), "ab") as log_file:
                 try:
-                    child = subprocess.Popen(command, stdout=log_file, stderr=subprocess.STDOUT,
-                                             stdin=subprocess.DEVNULL, start_new_session=True)
+                    child = start_match(job.game_path.resolve(), out, log_file,
+                                        python=self.python, hlvs_args=self.extra_args,
+                                        match_args=job.match_args, own_session=True)
                 except OSError as exc:
                     raise PoolError(handle=handle, reason=f"cannot start hlvs match: {exc}") \
                         from exc

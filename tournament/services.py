@@ -10,20 +10,18 @@ through :mod:`orchestrator.delivery`). Tests may plug in their own through a
 
 from __future__ import annotations
 
-import ctypes
 import importlib
 import json
 import logging
 import os
-import signal
 import subprocess
-import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Protocol
 
+from cluster import start_match
 from contracts import ContractError, MatchReport, MatchResults, files
 from orchestrator import ScheduleError
 from orchestrator.config import (
@@ -183,12 +181,6 @@ def _wait_or_abort(ctx: MatchContext, proc: subprocess.Popen[bytes]) -> None:
             proc.wait()
 
 
-def _die_with_parent() -> None:  # pragma: no cover - runs in the child before exec
-    """Linux: the match process gets SIGTERM (and cleans up) if the scheduler dies."""
-    libc = ctypes.CDLL("libc.so.6", use_errno=True)
-    libc.prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
-
-
 def read_outcome(out_dir: Path) -> PlayOutcome:
     """The outcome of a finished ``hlvs match`` from its report.json and results.json: the
     match's goals, and those of its penalty shoot-out apart (``0-0 (shoot-out 3-2)``)."""
@@ -260,16 +252,10 @@ class MatchServices:
         if self.schedule.pool.kind == "slurm":
             return self._play_in_slurm(ctx, game, out)
         keep_earlier_attempt(out)
-        cmd = [sys.executable, "-m", "hlvs.cli", "match", str(game), "--out", str(out)]
-        log.info("match %s: %s", ctx.match_id, " ".join(cmd))
         with open(ctx.out_dir / "match.log", "ab") as sink:
-            proc = subprocess.Popen(
-                cmd,
-                stdout=sink,
-                stderr=subprocess.STDOUT,
-                preexec_fn=_die_with_parent if sys.platform == "linux" else None,
-                env=os.environ.copy(),
-            )
+            proc = start_match(game, out, sink, die_with_parent=True)
+            log.info("match %s: hlvs match %s --out %s (pid %d)", ctx.match_id, game, out,
+                     proc.pid)
             _wait_or_abort(ctx, proc)
         outcome = read_outcome(out)
         log.info(
