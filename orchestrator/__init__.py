@@ -8,6 +8,7 @@ from contracts import lazy_exports
 from orchestrator.errors import (
     ConfigError,
     DeliveryError,
+    EngineLost,
     EngineUnavailable,
     ImageError,
     ImagePullError,
@@ -41,6 +42,7 @@ if TYPE_CHECKING:
 __all__ = [
     "ConfigError",
     "DeliveryError",
+    "EngineLost",
     "EngineUnavailable",
     "ExitCode",
     "ImageError",

@@ -6,6 +6,7 @@ Tree::
     ├── ConfigError              a configuration file is invalid (carries every problem found)
     ├── InfrastructureError      the Docker engine, a network or the host failed us
     │   ├── EngineUnavailable    no Docker engine answers
+    │   │   └── EngineLost       the engine stopped answering while in use (stopped, restarted)
     │   └── RegistryError        the registry API refused or failed (registry/client.py)
     ├── ImageError               an image cannot be used for a robot
     │   ├── ImagePullError       pull failed (auth, unknown tag, unreachable registry)
@@ -82,6 +83,18 @@ class EngineUnavailable(InfrastructureError):
             f"no Docker engine answers at {endpoint}: {reason}. "
             "Start one (make setup starts the local engine) or set DOCKER_HOST."
         )
+
+
+class EngineLost(EngineUnavailable):
+    """The engine stopped answering in the middle of a call: it was stopped, restarted or
+    crashed (its socket is gone, refuses or closed the connection)."""
+
+    def __init__(self, *, endpoint: str, doing: str, reason: str) -> None:
+        self.doing = doing
+        InfrastructureError.__init__(
+            self, f"the Docker engine at {endpoint} stopped answering ({doing}): {reason}")
+        self.endpoint = endpoint
+        self.reason = reason
 
 
 class ImageError(OrchestratorError):

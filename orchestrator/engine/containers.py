@@ -18,10 +18,11 @@ import docker
 import docker.errors
 import docker.types
 import requests.exceptions
+import urllib3.exceptions
 
-from orchestrator.engine import LABEL_MATCH, LABEL_PROJECT
+from orchestrator.engine import LABEL_MATCH, LABEL_PROJECT, engine_endpoint
 from orchestrator.engine import networks as _networks
-from orchestrator.errors import InfrastructureError
+from orchestrator.errors import EngineLost, InfrastructureError
 from orchestrator.runtime import ledger
 from orchestrator.runtime.port import (
     ContainerRequest,
@@ -36,11 +37,14 @@ from orchestrator.runtime.port import (
 log = logging.getLogger(__name__)
 
 _WAIT_TIMEOUTS = (requests.exceptions.ConnectionError, requests.exceptions.Timeout)
+# the engine went away: its socket is gone or refuses, or it closed a connection mid-answer
+_LOST = (requests.exceptions.ConnectionError, urllib3.exceptions.ProtocolError)
 
 
 @contextlib.contextmanager
 def translate(kind: str, name: str) -> Iterator[None]:
-    """Turn Docker SDK and transport errors into :mod:`orchestrator.errors`."""
+    """Turn Docker SDK and transport errors into :mod:`orchestrator.errors`; an engine that
+    stopped answering is :class:`~orchestrator.errors.EngineLost`, naming the engine."""
     try:
         yield
     except docker.errors.NotFound as exc:
@@ -48,6 +52,9 @@ def translate(kind: str, name: str) -> Iterator[None]:
     except docker.errors.APIError as exc:
         detail = exc.explanation or str(exc)
         raise InfrastructureError(f"Docker engine refused on {kind} {name}: {detail}") from exc
+    except _LOST as exc:
+        raise EngineLost(endpoint=engine_endpoint(), doing=f"{kind} {name}",
+                         reason=str(exc)) from exc
     except (docker.errors.DockerException, requests.exceptions.RequestException, OSError) as exc:
         raise InfrastructureError(f"Docker engine failed on {kind} {name}: {exc}") from exc
 
@@ -57,6 +64,19 @@ class DockerRuntime:
 
     def __init__(self, client: docker.DockerClient) -> None:
         self._client = client
+
+    # the engine -----------------------------------------------------------------------------
+    def endpoint(self) -> str:
+        """Where the engine is, for messages (``DOCKER_HOST`` or the local socket)."""
+        return engine_endpoint()
+
+    def answering(self) -> bool:
+        """Whether the engine answers a ping now (False: stopped, restarting or crashed)."""
+        try:
+            return bool(self._client.ping())
+        except (docker.errors.DockerException, requests.exceptions.RequestException,
+                urllib3.exceptions.HTTPError, OSError):
+            return False
 
     # networks -------------------------------------------------------------------------------
     def create_network(self, request: NetworkRequest) -> NetworkInfo:
@@ -202,12 +222,16 @@ class DockerRuntime:
         return int(result.get("StatusCode", -1))
 
     def stats_stream(self, container_id: str) -> Iterator[StatsSample]:
-        """Samples about once a second until the container stops."""
+        """Samples about once a second until the container stops (or the engine does)."""
         with translate("container", container_id):
-            for raw in self._client.api.stats(container_id, stream=True, decode=True):
-                sample = _sample(raw)
-                if sample is not None:
-                    yield sample
+            try:
+                for raw in self._client.api.stats(container_id, stream=True, decode=True):
+                    sample = _sample(raw)
+                    if sample is not None:
+                        yield sample
+            except ValueError as exc:  # the stream cut mid-chunk (urllib3 reads a bad length)
+                raise InfrastructureError(
+                    f"the stats of container {container_id} broke off: {exc}") from exc
 
     def save_logs(self, container_id: str, *, stdout: Path, stderr: Path,
                   max_bytes: int | None = None) -> tuple[str, ...]:

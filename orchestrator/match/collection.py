@@ -8,6 +8,14 @@ robots, a failure of its own and the logs it had to cut are in the results and `
 
 Every teardown step runs even when an earlier one failed; a teardown failure makes the match an
 ``infrastructure`` failure only when nothing else failed first. ``report.json`` is written last.
+
+An engine that stops answering (:class:`~orchestrator.errors.EngineLost`: stopped, restarted or
+crashed) is waited for, at most ``engine_wait_s`` in all, and the step that met it is tried
+again: an engine that comes back still holds the stopped containers' consoles, which are
+collected, and everything of the match is removed. The match fails naming the engine (a
+simulator that ended as the engine went down is not blamed); an engine that does not come back
+leaves the match's containers and networks on it, named in the cause with the command that
+removes them.
 """
 
 from __future__ import annotations
@@ -15,6 +23,7 @@ from __future__ import annotations
 import importlib.metadata
 import logging
 import shutil
+import threading
 from collections.abc import Callable, Mapping
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
@@ -31,7 +40,7 @@ from contracts import (
     TimingSpec,
     files,
 )
-from orchestrator.errors import OrchestratorError
+from orchestrator.errors import EngineLost, OrchestratorError
 from orchestrator.match import layout
 from orchestrator.match.deps import MatchDeps
 from orchestrator.match.logfs import LogFolder
@@ -124,6 +133,9 @@ class _Collection:
         self.failure = played.failure
         # the teams' logs cut or lost in collection: {"robot", "what", "reason"} (report.json)
         self.logs_cut: list[dict[str, str]] = []
+        self.engine_lost: EngineLost | None = None  # the engine stopped answering meanwhile
+        self.engine_deadline = 0.0  # until when it is waited for (clock time)
+        self._engine_lock = threading.Lock()  # robots are stopped in parallel
 
     def run(self) -> MatchResults:
         match_id = self.deps.plan.match_id
@@ -137,7 +149,58 @@ class _Collection:
         except Exception as exc:  # noqa: BLE001
             log.exception("match %s: teardown failed", match_id)
             self._fail(f"teardown failed: {type(exc).__name__}: {exc}")
+        if self.engine_lost is not None and not self.deps.runtime.answering():
+            self._engine_gone()
         return self._write()
+
+    def _engine_back(self, lost: EngineLost) -> bool:
+        """The engine stopped answering: the match fails naming it, and it is waited for (at
+        most ``engine_wait_s`` over the whole collection). True: it answers again."""
+        deps = self.deps
+        with self._engine_lock:
+            self._engine_first_lost(lost)
+        wait = threading.Event()
+        while not deps.runtime.answering():
+            if deps.clock() >= self.engine_deadline:
+                return False
+            wait.wait(deps.options.poll_s)
+        return True
+
+    def _engine_first_lost(self, lost: EngineLost) -> None:
+        deps = self.deps
+        if self.engine_lost is None:
+            self.engine_lost = lost
+            self.engine_deadline = deps.clock() + deps.options.engine_wait_s
+            log.warning("match %s: %s; waiting up to %.0f s for it to answer again",
+                        deps.plan.match_id, lost, deps.options.engine_wait_s)
+            if self.failure is not None and self.failure.failure_class is FailureClass.SIMULATOR:
+                # the simulator ended as the engine went down: the engine stopped it
+                log.info("match %s: the simulator's end (%s) was the engine's doing",
+                         deps.plan.match_id, self.failure.cause)
+                self.failure = deps.fail(None, FailureClass.INFRASTRUCTURE, (
+                    f"{lost}; it stopped the match's containers (the simulator's end: "
+                    f"{self.failure.cause})"))
+            else:
+                self._fail(str(lost))
+
+    def _engine_gone(self) -> None:
+        """The engine never answered again: what the match left on it is named."""
+        deps, match_id = self.deps, self.deps.plan.match_id
+        left = (f"the engine did not answer again within {deps.options.engine_wait_s:.0f} s: "
+                f"the match's containers and networks are left on it; `hlvs cleanup --match "
+                f"{match_id}` removes them once it answers")
+        log.error("match %s: %s", match_id, left)
+        if self.failure is not None and self.failure.failure_class is FailureClass.INFRASTRUCTURE:
+            self.failure = replace(self.failure, cause=f"{self.failure.cause}; {left}")
+
+    def _engine_step(self, step: Callable[[], object]) -> None:
+        """``step``, once more after the engine came back if it met an engine gone away."""
+        try:
+            step()
+        except EngineLost as exc:
+            if not self._engine_back(exc):
+                raise
+            step()
 
     def _fail(self, cause: str) -> None:
         self.failure = self.deps.fail(self.failure, FailureClass.INFRASTRUCTURE, cause)
@@ -146,7 +209,7 @@ class _Collection:
         """Run one step of stopping, collecting or teardown; a failure fails the match (the
         first one counts) and the next steps still run."""
         try:
-            step()
+            self._engine_step(step)
         except (OrchestratorError, OSError) as exc:
             log.error("match %s: %s failed: %s", self.deps.plan.match_id, what, exc)
             self._fail(f"{what}: {exc}")
@@ -158,7 +221,7 @@ class _Collection:
         """A step that touches what a robot made: an engine failure fails the match (as
         :meth:`_guarded`), anything else costs only this robot's logs, named in report.json."""
         try:
-            step()
+            self._engine_step(step)
         except (OrchestratorError, OSError) as exc:
             log.error("match %s: %s failed: %s", self.deps.plan.match_id, what, exc)
             self._fail(f"{what}: {exc}")

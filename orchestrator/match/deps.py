@@ -44,6 +44,9 @@ class RunOptions:
     extra_labels: Mapping[str, str] = field(default_factory=dict)
     poll_s: float = 0.5
     simulator_stop_s: float = 10.0
+    # an engine that stops answering during collection (stopped, restarted) is waited for this
+    # long in all, so that the logs it still holds are collected and the match's objects removed
+    engine_wait_s: float = 60.0
     progress: Callable[[str, StateMessage | None], None] | None = None
     # league placement: the simulator and each robot on a node of its own (None: dense, the
     # whole match on this host's engine with a network per team)

@@ -10,6 +10,7 @@ from pathlib import Path
 
 from contracts import EventRecord, SimResult, StateMessage, files
 from orchestrator.bandwidth import AppliedShaping, RobotShaping, TrafficCounters
+from orchestrator.errors import EngineLost
 from orchestrator.match.logfs import LogFolder
 from orchestrator.match.placement import NodeFirewall
 from orchestrator.match.safecopy import CopyReport
@@ -52,6 +53,29 @@ class FakeRuntime:
         self._ids = itertools.count(1)
         self.on_start: Callable[[FakeContainer], None] | None = None
         self.foreign: set[str] = set()  # started outside the runner (not in its records)
+        self.down_for = 0  # the engine is down: this many more pings fail, every call raises
+
+    def endpoint(self) -> str:
+        return "fake://engine"
+
+    def answering(self) -> bool:
+        if self.down_for > 0:
+            self.down_for -= 1
+            return False
+        return True
+
+    def restart_engine(self, *, down_for_pings: int) -> None:
+        """The engine stops every container (its stop: code 137) and stops answering until
+        ``down_for_pings`` pings have failed; the containers and networks stay, exited."""
+        for container_id, found in self.containers.items():
+            if found.state.running:
+                self.exit(container_id, 137)
+        self.down_for = down_for_pings
+
+    def _answer(self, doing: str) -> None:
+        if self.down_for > 0:
+            raise EngineLost(endpoint=self.endpoint(), doing=doing,
+                             reason="('Connection aborted.', FileNotFoundError(2))")
 
     def create_network(self, request: NetworkRequest) -> NetworkInfo:
         self.calls.append(("create_network", request.name))
@@ -64,6 +88,7 @@ class FakeRuntime:
 
     def remove_network(self, name: str) -> None:
         self.calls.append(("remove_network", name))
+        self._answer(f"network {name}")
         found = [n for n, r in self.networks.items() if n == name]
         if not found:
             raise ObjectNotFound(kind="network", name=name)
@@ -81,6 +106,7 @@ class FakeRuntime:
         return container_id
 
     def _get(self, container_id: str) -> FakeContainer:
+        self._answer(f"container {container_id}")
         if container_id not in self.containers:
             raise ObjectNotFound(kind="container", name=container_id)
         return self.containers[container_id]
@@ -162,6 +188,7 @@ class FakeRuntime:
         return None if image in self.missing_images else f"sha256:{abs(hash(image)):x}"
 
     def list_project(self, *, match_id: str | None = None) -> list[ProjectObject]:
+        self._answer("containers labelled")
         found = [ProjectObject(kind="container", id=cid, name=c.request.name,
                                labels=c.request.labels, created=cid not in self.foreign)
                  for cid, c in self.containers.items()]

@@ -29,7 +29,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from contracts import Color, Forfeit, MatchResults, RobotResult, StateMessage, files
-from orchestrator.errors import OrchestratorError
+from orchestrator.errors import EngineLost, OrchestratorError
 from orchestrator.match.collection import (
     Played,
     collect,
@@ -169,7 +169,7 @@ class MatchRunner:
                     game.failure, game.startup = started.failure, started.times
                     if game.failure is None:
                         lifecycle.advance(MatchState.WAITING)
-                        self._watch(lifecycle, started, game, started_at)
+                        self._watch(lifecycle, started, game, started_at, created)
                 finally:
                     if started.telemetry is not None:
                         started.telemetry.close()
@@ -235,7 +235,7 @@ class MatchRunner:
             log.info("match %s: %s forfeits (no usable image)", plan.match_id, loser)
 
     def _watch(self, lifecycle: Lifecycle, started: StartedMatch, game: _Game,
-               started_at: float) -> None:
+               started_at: float, created: Created) -> None:
         """Poll the simulator, its telemetry and the robots until the simulator exits; what
         happens goes into ``game`` (the bring-up time, robots' exits, the failure)."""
         deps = self._deps
@@ -248,7 +248,7 @@ class MatchRunner:
                 return
             state = deps.runtime.inspect(started.simulator_id)
             if state.exited:
-                self._on_simulator_exit(state.exit_code, started, game)
+                self._on_simulator_exit(state.exit_code, started, game, created)
                 return
             now = deps.clock()
             if now - last_robot_poll >= 2.0:
@@ -301,13 +301,18 @@ class MatchRunner:
                     ", OOM-killed" if state.oom_killed else "",
                 )
 
-    def _on_simulator_exit(self, exit_code: int | None, started: StartedMatch, game: _Game
-                           ) -> None:
+    def _on_simulator_exit(self, exit_code: int | None, started: StartedMatch, game: _Game,
+                           created: Created) -> None:
         deps = self._deps
         match_id = deps.plan.match_id
         log.info("match %s: simulator exited with code %s", match_id, exit_code)
         sim_result = read_sim_result(started.match_dir, match_id=match_id)
-        if exit_code != 0:
+        stopped_by = self._engine_stopped(created) if exit_code != 0 else None
+        if stopped_by is not None:
+            game.failure = deps.fail(
+                game.failure, FailureClass.INFRASTRUCTURE,
+                f"{stopped_by} (the simulator ended with code {exit_code})")
+        elif exit_code != 0:
             reported = sim_result.error if sim_result is not None else None
             tail = str(reported) if reported else simulator_stderr_tail(
                 deps.runtime, started.simulator_id, started.match_dir)
@@ -320,6 +325,27 @@ class MatchRunner:
         elif not sim_result.finished:
             game.failure = deps.fail(game.failure, FailureClass.REFEREE,
                                      f"the game ended in state {sim_result.state}, not FINISHED")
+
+    def _engine_stopped(self, created: Created) -> str | None:
+        """Why the simulator's end was the engine's doing, None: it was the simulator's own.
+
+        A network holder only sleeps and never exits by itself: when one has ended with the
+        simulator, something outside the match stopped its containers (the engine stopping or
+        restarting stops them all); an engine that no longer answers says so too."""
+        runtime = self._deps.runtime
+        for key, holder_id in created.holder_ids.items():
+            try:
+                state = runtime.inspect(holder_id)
+            except EngineLost as exc:
+                return f"{exc}; it stopped the match's containers"
+            except OrchestratorError:
+                continue
+            if state.exited:
+                return (f"the Docker engine at {runtime.endpoint()} stopped the match's "
+                        f"containers (it was stopped or restarted, or they were stopped from "
+                        f"outside the runner): the network holder of {key} ended with code "
+                        f"{state.exit_code} as well")
+        return None
 
 
 __all__ = ["ImageResolver", "MatchOutcome", "MatchRunner", "RunOptions", "TelemetryFactory",

@@ -157,6 +157,10 @@ class ProjectObject:
 
 
 class ContainerRuntime(Protocol):
+    def endpoint(self) -> str: ...  # where the engine is, for messages
+
+    def answering(self) -> bool: ...  # whether the engine answers now
+
     def create_network(self, request: NetworkRequest) -> NetworkInfo: ...
 
     def remove_network(self, name: str) -> None: ...
