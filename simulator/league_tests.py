@@ -297,7 +297,7 @@ class LeagueTestRunner:
                 data.qpos[b.qpos + 3 : b.qpos + 7] = (math.cos(angle / 2), ax * s, ay * s, az * s)
             if action.force is not None:
                 data.xfrc_applied[b.body, 0:3] += action.force
-            if action.velocity is not None:
+            if action.velocity is not None and b.robot is None:
                 linear, angular = np.array(action.velocity[:3]), np.array(action.velocity[3:])
                 quat = data.qpos[b.qpos + 3 : b.qpos + 7]
                 local = np.zeros(3)
@@ -310,6 +310,33 @@ class LeagueTestRunner:
                     start, end = info.qpos_range
                     world.parked_qpos[info.number] = data.qpos[start:end].copy()
         mujoco.mj_forward(world.model, data)
+        for action in step.actions:
+            b = self.body(action.target)
+            if action.velocity is not None and b.robot is not None:
+                self._set_root_velocity(b, action.velocity)
+
+    def _set_root_velocity(self, b: _Body, velocity: tuple[float, ...]) -> None:
+        """``setVelocity`` on a robot, as Webots does it: the velocity of the robot's root solid
+        alone (its torso's ODE body, ``WbSupervisorUtilities`` C_SUPERVISOR_NODE_SET_VELOCITY
+        -> ``WbSolid::setLinearVelocity``/``setAngularVelocity`` -> ``dBodySetLinearVel``),
+        the bodies hinged to it keeping theirs; the joints then share the change with them in
+        the step. Setting a body's velocity is an impulse of its mass times the change; here
+        that impulse is applied to the torso over the next step (so a robot set to 0.24 m/s
+        upward every step, as the scenarios do, is nearly weightless and slides on its feet:
+        the Darwin-OP's torso is a third of its mass, 0.98 kg x 0.24 m/s against 2.93 kg x g x
+        8 ms, and does not fly off as a whole robot set to that speed would)."""
+        world = self.world
+        model, data = world.model, world.data
+        current = np.zeros(6)  # angular, linear at the torso's centre of mass, world axes
+        mujoco.mj_objectVelocity(model, data, mujoco.mjtObj.mjOBJ_BODY, b.body, current, 0)
+        dt = world.step_ms / 1000.0
+        mass = float(model.body_mass[b.body])
+        linear = np.array(velocity[:3], dtype=float)
+        angular = np.array(velocity[3:6], dtype=float)
+        frame = data.ximat[b.body].reshape(3, 3)  # the torso's principal axes
+        inertia = frame @ np.diag(model.body_inertia[b.body]) @ frame.T
+        data.xfrc_applied[b.body, 0:3] += mass * (linear - current[3:6]) / dt
+        data.xfrc_applied[b.body, 3:6] += inertia @ (angular - current[0:3]) / dt
 
     # --- the tests ---------------------------------------------------------------------------
 

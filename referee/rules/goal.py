@@ -1,9 +1,19 @@
 """Goals: the ball fully over the goal line, between the posts, under the bar.
 
-A goal may not be scored directly from a kick-off (until the ball left the centre circle or was
-touched by a player other than the kicker), a throw-in or an indirect free kick (until a player
-other than the taker touched it). Such a ball in the opponents' goal gives a goal kick, in the
-taker's own goal a corner kick. Own goals count otherwise.
+A goal may not be scored directly from a kick-off, a throw-in or an indirect free kick. Such a
+ball in the opponents' goal gives a goal kick, in the taker's own goal a corner kick. Own goals
+count otherwise.
+
+* After a kick-off, as the league's referee decides it (hlvs_webots
+  ``controllers/referee/referee.py:2150-2168``): a goal counts once the ball was touched by a
+  robot of the defending team, by a robot other than the first to touch it (the kicker), or by
+  any robot after the ball had left the centre circle (its distance from the centre spot over
+  the circle's radius plus the ball's, 2150-2154). A ball that merely rolls out of the circle
+  and in does not score (2292-2295).
+* After a throw-in or an indirect free kick: once a robot other than the taker touched it.
+
+A touch is a robot's contact with the ball in a snapshot, or the world's last toucher changing
+its time between two snapshots (a touch between them).
 """
 
 from __future__ import annotations
@@ -28,26 +38,47 @@ class GoalMemory:
     restriction: Restriction | None = None
     taker: RobotId | None = None  # first robot to touch the ball after the restart
     cleared: bool = False  # the restriction no longer applies
+    left_circle: bool = False  # a kick-off's ball has left the centre circle
+    touch_ms: int | None = None  # the world's last touch time seen
 
 
-def restart(restriction: Restriction | None) -> GoalMemory:
-    return GoalMemory(restriction=restriction)
+def restart(restriction: Restriction | None, snapshot: WorldSnapshot | None = None) -> GoalMemory:
+    """The memory of a restart; ``snapshot``, the world when it is taken, so that a touch
+    before it is not counted as one after it."""
+    touch_ms = snapshot.last_ball_touch_ms if snapshot is not None else None
+    return GoalMemory(restriction=restriction, touch_ms=touch_ms)
+
+
+def _touches(snapshot: WorldSnapshot, memory: GoalMemory) -> list[RobotId]:
+    touching = [r.id for r in snapshot.robots if r.ball_contacts]
+    toucher = snapshot.last_ball_toucher
+    touched_between = (
+        snapshot.last_ball_touch_ms is not None and snapshot.last_ball_touch_ms != memory.touch_ms
+    )
+    if toucher is not None and touched_between and toucher not in touching:
+        touching.append(toucher)
+    return touching
 
 
 def _update(snapshot: WorldSnapshot, game: GameView, memory: GoalMemory) -> GoalMemory:
     if memory.restriction is None or memory.cleared:
         return memory
-    touching = [r.id for r in snapshot.robots if r.ball_contacts]
+    touching = _touches(snapshot, memory)
+    memory = replace(memory, touch_ms=snapshot.last_ball_touch_ms)
+    kickoff = memory.restriction is Restriction.KICKOFF
     taker = memory.taker
     for robot in touching:
+        if kickoff and (memory.left_circle or robot.team is not game.kickoff_team):
+            # 2158-2161, 2164-2168: a touch after the ball left the circle, or the defenders'
+            return replace(memory, taker=taker or robot, cleared=True)
         if taker is None:
             taker = robot
         elif robot != taker:
             return replace(memory, taker=taker, cleared=True)
-    if memory.restriction is Restriction.KICKOFF:
+    if kickoff and not memory.left_circle:
         radius = game.field.centre_circle_radius_m + game.field.ball_radius_m
-        if distance2d(snapshot.ball.position, (0.0, 0.0)) > radius:
-            return replace(memory, taker=taker, cleared=True)
+        if distance2d(snapshot.ball.position, (0.0, 0.0)) > radius:  # 2150-2154
+            return replace(memory, taker=taker, left_circle=True)
     return replace(memory, taker=taker)
 
 

@@ -1,23 +1,33 @@
-"""Pushing (forceful contact), the documented subset of the virtual league's rule we judge.
+"""Forceful contact (pushing, charging), decided as the virtual league's referee decides it.
 
-Only contacts between opponents count, and only while PLAYING (not in the shoot-out).
+Only contacts between opponents count, and only while PLAYING outside a set play's sub-phase 0
+(not in the shoot-out). Every step two opponents touch, the league's decision tree runs for the
+red robot as the possible offender, then for the blue one (hlvs_webots
+``controllers/referee/referee.py:948-1011``, ``check_team_forceful_contacts``; called from
+1019-1027 and 2127-2129). With ``d1`` the offender's distance to the ball and ``d2`` its
+opponent's, the offender commits a foul when:
 
-* Sustained contact: a pair of opponents in contact for more than 1 s within the last 2 s,
-  both within 2 m of the ball, one at least 0.1 m farther from the ball than the other: the
-  farther one pushes.
-* Charging: when a contact begins, a robot moving at least 0.2 m/s faster than the other,
-  towards it, and more than 30 degrees away from the direction of the ball, charges.
+1. its opponent is a goalkeeper inside its own goal area (962-965);
+2. the two touched for more than 1 s of the last 2 s (``forceful_contact_matrix.py``), ``d1`` is
+   under 2 m and ``d1 - d2`` over 0.1 m: the farther one pushes (973-981);
+3. otherwise only an offender faster than 0.2 m/s can foul (986-987); then
+   * near the ball (``d1`` under 2 m), when its opponent moves to the ball (slower than
+     0.2 m/s, or within 30 degrees of the ball's direction, 933-942): if the offender does not
+     move to the ball it charges (995-999); if it does but is more than 0.1 m farther from the
+     ball, it charges from behind (1000-1006);
+   * away from the ball, when it is faster than its opponent by more than 0.2 m/s: a violent
+     collision (1007-1011).
 
-Speeds are those of the virtual league's referee: the centre of mass's average velocity over
-the last second (:class:`VelocityTracks`), so the sway of a walk or the first instants of a fall
-are not a charge. A jump of more than 0.5 m between two snapshots (a robot placed by the
-referee) starts the average again.
+Speeds are those of the virtual league's referee: the average velocity over the last second
+(:class:`VelocityTracks`, 661-668), so the sway of a walk or the first instants of a fall are
+not a charge. A jump of more than 0.5 m between two snapshots (a robot placed by the referee)
+starts the average again.
 
-Consequence, for the pusher, as in the virtual league (no card): when the ball is in play and
-the pusher is within 1 m of it, a direct free kick for the other team at the victim's position
-(a penalty kick when the ball lies fully inside the penalty area the other team attacks, as the
-league decides it, :func:`referee.rules.base.free_kick`); otherwise removal for
-PHYSICAL_CONTACT. A pair is immune for 2 s after a foul.
+Consequence, for the offender, as in the virtual league (no card, 904-928): when the ball is in
+play and the offender is within 1 m of it, a direct free kick for the other team at the
+offender's position (a penalty kick when the ball lies fully inside the penalty area the other
+team attacks, as the league decides it, :func:`referee.rules.base.free_kick`); otherwise removal
+for PHYSICAL_CONTACT. Both robots are then immune for 2 s and the contact history is cleared.
 """
 
 from __future__ import annotations
@@ -29,20 +39,21 @@ from dataclasses import dataclass, field
 from contracts import RobotId
 from referee.gamecontroller.states import GameState, Penalty, SecondaryState
 from referee.rules.base import Decision, GameView, PenalizeRobot, distance2d, free_kick
+from referee.rules.goalkeeper import in_own_goal_area
 from referee.snapshot import RobotState, Vec3, WorldSnapshot
 
-PERIOD_MS = 2000
-CONTACT_MS = 1000
-BALL_RANGE_M = 2.0
-FARTHER_M = 0.1
-CHARGE_SPEED_M_S = 0.2
-CHARGE_ANGLE_RAD = math.radians(30.0)
-FREE_KICK_RANGE_M = 1.0
-IMMUNITY_MS = 2000
+PERIOD_MS = 2000  # FOUL_PUSHING_PERIOD (referee_config.yaml)
+CONTACT_MS = 1000  # FOUL_PUSHING_TIME
+VICINITY_M = 2.0  # FOUL_VINCITY_DISTANCE
+FARTHER_M = 0.1  # FOUL_DISTANCE_THRESHOLD
+SPEED_M_S = 0.2  # FOUL_SPEED_THRESHOLD
+DIRECTION_RAD = 0.523599  # FOUL_DIRECTION_THRESHOLD, 30 degrees
+FREE_KICK_RANGE_M = 1.0  # FOUL_BALL_DISTANCE
+IMMUNITY_MS = 2000  # FOUL_PENALTY_IMMUNITY
 AVERAGE_MS = 1000  # speeds are averaged over this long
 JUMP_M = 0.5  # a larger move between two snapshots is a placement, not motion
 
-Pair = tuple[RobotId, RobotId]
+Pair = tuple[RobotId, RobotId]  # (red, blue)
 
 
 class VelocityTracks:
@@ -75,53 +86,83 @@ class VelocityTracks:
 @dataclass(frozen=True, slots=True)
 class PushingMemory:
     contacts: dict[Pair, tuple[tuple[int, int], ...]] = field(default_factory=dict)
-    immune_until: dict[Pair, int] = field(default_factory=dict)
+    immune_until: dict[RobotId, int] = field(default_factory=dict)
     last_ms: int | None = None
     tracks: VelocityTracks = field(default_factory=VelocityTracks)
 
 
 def _pair(a: RobotId, b: RobotId) -> Pair:
-    key_a, key_b = (a.team.value, a.number), (b.team.value, b.number)
-    return (a, b) if key_a <= key_b else (b, a)
+    """The pair as the league's contact matrix holds it: the red robot first."""
+    return (a, b) if a.team.value == "red" else (b, a)
 
 
-def _charging(
-    pusher: RobotState, victim: RobotState, ball: tuple[float, float], tracks: VelocityTracks
-) -> bool:
-    vx, vy, _ = tracks.velocity(pusher.id)
-    victim_velocity = tracks.velocity(victim.id)
+def _moves_to_ball(robot: RobotState, velocity: Vec3, ball: tuple[float, float]) -> bool:
+    """Slower than the speed threshold, or moving within 30 degrees of the ball's direction
+    (referee.py:933-942, ``moves_to_ball``)."""
+    vx, vy = velocity[0], velocity[1]
     speed = math.hypot(vx, vy)
-    if speed - math.hypot(victim_velocity[0], victim_velocity[1]) <= CHARGE_SPEED_M_S:
-        return False
-    to_victim = (victim.position[0] - pusher.position[0], victim.position[1] - pusher.position[1])
-    if vx * to_victim[0] + vy * to_victim[1] <= 0:
-        return False
-    to_ball = (ball[0] - pusher.position[0], ball[1] - pusher.position[1])
-    norm = math.hypot(*to_ball)
-    if norm < 1e-6:
-        return False
-    cos = (vx * to_ball[0] + vy * to_ball[1]) / (speed * norm)
-    return math.acos(max(-1.0, min(1.0, cos))) > CHARGE_ANGLE_RAD
+    if speed < SPEED_M_S:
+        return True
+    rx, ry = ball[0] - robot.position[0], ball[1] - robot.position[1]
+    norm = math.hypot(rx, ry)
+    if norm < 1e-9:
+        return True  # on the ball: the league's formula divides by zero here
+    cos = (rx * vx + ry * vy) / (norm * speed)
+    return math.acos(max(-1.0, min(1.0, cos))) < DIRECTION_RAD
 
 
-def _sustained_pusher(a: RobotState, b: RobotState, ball: tuple[float, float]) -> RobotState | None:
-    da, db = distance2d(a.position, ball), distance2d(b.position, ball)
-    if da > BALL_RANGE_M or db > BALL_RANGE_M or abs(da - db) < FARTHER_M:
+def _foul(
+    offender: RobotState,
+    opponent: RobotState,
+    ball: tuple[float, float],
+    long_collision: bool,
+    game: GameView,
+    tracks: VelocityTracks,
+) -> str | None:
+    """Why ``offender`` commits a forceful contact foul on ``opponent``, or None
+    (referee.py:948-1011, ``check_team_forceful_contacts``, one direction)."""
+    d1 = distance2d(offender.position, ball)
+    d2 = distance2d(opponent.position, ball)
+    if opponent.id in game.goalkeepers and in_own_goal_area(opponent, game):  # 962-965
+        return f"contact with goalkeeper {opponent.id} in its goal area"
+    if long_collision and d1 < VICINITY_M and d1 - d2 > FARTHER_M:  # 973-981
+        return f"pushing {opponent.id}"
+    v1, v2 = tracks.velocity(offender.id), tracks.velocity(opponent.id)
+    speed1, speed2 = math.hypot(v1[0], v1[1]), math.hypot(v2[0], v2[1])
+    if not speed1 > SPEED_M_S:  # 986-987
         return None
-    return a if da > db else b
+    if d1 < VICINITY_M:  # 992-1006
+        if _moves_to_ball(opponent, v2, ball):
+            if not _moves_to_ball(offender, v1, ball):
+                return f"charging {opponent.id}, which moves to the ball"
+            if d1 - d2 > FARTHER_M:
+                return f"charging {opponent.id} from behind"
+        return None
+    if speed1 - speed2 > SPEED_M_S:  # 1007-1011
+        return f"charging {opponent.id}: violent collision, {speed1:.2f} m/s against {speed2:.2f}"
+    return None
 
 
 def _consequence(
-    pusher: RobotState, victim: RobotState, game: GameView, ball: tuple[float, float], why: str
-) -> list[Decision]:
-    decisions: list[Decision] = []
-    near = distance2d(pusher.position, ball) <= FREE_KICK_RANGE_M
+    offender: RobotState,
+    opponent: RobotState,
+    game: GameView,
+    ball: tuple[float, float],
+    why: str,
+) -> Decision:
+    """referee.py:904-928 (``forceful_contact_foul``): a free kick at the offender's position
+    near a ball in play, else a removal penalty."""
+    near = distance2d(offender.position, ball) <= FREE_KICK_RANGE_M
     if game.running and game.ball_in_play and near:
-        spot = (victim.position[0], victim.position[1])
-        decisions.append(free_kick(victim.id.team, spot, ball, game, why))
-    else:
-        decisions.append(PenalizeRobot(pusher.id, Penalty.PHYSICAL_CONTACT, why))
-    return decisions
+        spot = (offender.position[0], offender.position[1])
+        return free_kick(opponent.id.team, spot, ball, game, why)
+    return PenalizeRobot(offender.id, Penalty.PHYSICAL_CONTACT, why)
+
+
+def _early_set_play(game: GameView) -> bool:
+    """A set play's sub-phase 0, where the league checks no contact (2127,
+    ``is_early_game_interruption``, 1348-1354)."""
+    return game.set_play is not None and game.set_play.sub_phase == 0
 
 
 def judge(
@@ -141,34 +182,29 @@ def judge(
                 touching.add(_pair(robot.id, other))
     ball = (snapshot.ball.position[0], snapshot.ball.position[1])
     contacts: dict[Pair, tuple[tuple[int, int], ...]] = {}
-    immune = {p: t for p, t in memory.immune_until.items() if t > now}
-    decisions: list[Decision] = []
-    for pair in sorted(touching | set(memory.contacts), key=lambda p: str(p)):
+    for pair in touching | set(memory.contacts):
         intervals = [iv for iv in memory.contacts.get(pair, ()) if iv[1] > now - PERIOD_MS]
-        onset = False
         if pair in touching:
             if intervals and intervals[-1][1] == previous:
                 intervals[-1] = (intervals[-1][0], now)
             else:
                 intervals.append((previous, now))
-                onset = True
-        if pair in immune or pair not in touching:
-            if intervals:
-                contacts[pair] = tuple(intervals)
-            continue
-        a, b = robots[pair[0]], robots[pair[1]]
-        pusher: RobotState | None = None
-        why = ""
-        if onset and _charging(a, b, ball, tracks):
-            pusher, why = a, "charging"
-        elif onset and _charging(b, a, ball, tracks):
-            pusher, why = b, "charging"
-        elif sum(end - max(start, now - PERIOD_MS) for start, end in intervals) > CONTACT_MS:
-            pusher, why = _sustained_pusher(a, b, ball), "pushing"
-        if pusher is None:
+        if intervals:
             contacts[pair] = tuple(intervals)
-            continue
-        victim = b if pusher is a else a
-        decisions.extend(_consequence(pusher, victim, game, ball, f"{why} {victim.id}"))
-        immune[pair] = now + IMMUNITY_MS
-    return decisions, PushingMemory(contacts, immune, now, tracks)
+    immune = {r: t for r, t in memory.immune_until.items() if t > now}
+    if _early_set_play(game):
+        return [], PushingMemory(contacts, immune, now, tracks)
+    for pair in sorted(touching, key=lambda p: (p[0].number, p[1].number)):
+        touched = sum(end - max(start, now - PERIOD_MS) for start, end in contacts.get(pair, ()))
+        red, blue = robots[pair[0]], robots[pair[1]]
+        for offender, opponent in ((red, blue), (blue, red)):
+            if offender.id in immune:  # 951-955: no check, the other direction is tried
+                continue
+            why = _foul(offender, opponent, ball, touched > CONTACT_MS, game, tracks)
+            if why is None:
+                continue
+            immune[offender.id] = immune[opponent.id] = now + IMMUNITY_MS  # 909-911
+            # 907: the contact matrix is cleared, so no other pair is checked in this step
+            decision = _consequence(offender, opponent, game, ball, why)
+            return [decision], PushingMemory({}, immune, now, tracks)
+    return [], PushingMemory(contacts, immune, now, tracks)

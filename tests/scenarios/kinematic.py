@@ -51,6 +51,12 @@ class KinematicWorld:
         self.robots = {rid: _Robot(*pose) for rid, pose in robots.items()}
         self.ball: Vec3 = (0.0, 0.0, field.ball_radius_m)
         self.ball_velocity: Vec3 = (0.0, 0.0, 0.0)
+        self.last_ball_toucher: RobotId | None = None
+        self.last_ball_touch_ms: int | None = None
+
+    def touch(self, robot: RobotId) -> None:
+        """``robot`` touches the ball now (as the world records the last toucher)."""
+        self.last_ball_toucher, self.last_ball_touch_ms = robot, self.sim_time_ms
 
     def step(self) -> None:
         dt = self.step_ms / 1000.0
@@ -82,6 +88,8 @@ class KinematicWorld:
             sim_time_ms=self.sim_time_ms,
             ball=BallState(position=self.ball, velocity=self.ball_velocity),
             robots=robots,
+            last_ball_toucher=self.last_ball_toucher,
+            last_ball_touch_ms=self.last_ball_touch_ms,
         )
 
     def apply(self, command: WorldCommand) -> None:

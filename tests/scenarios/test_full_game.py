@@ -53,24 +53,39 @@ def test_still_robots_play_two_halves_to_a_goalless_draw() -> None:
     assert halves[-1].sim_time_ms == pytest.approx(1_435_000, abs=100)
 
 
-def _roll(x: float, y: float, vx: float) -> Script:
+def _place(x: float, y: float) -> Script:
     def action(world: KinematicWorld) -> None:
-        world.ball, world.ball_velocity = (x, y, 0.07), (vx, 0.0, 0.0)
+        world.ball, world.ball_velocity = (x, y, 0.07), (0.0, 0.0, 0.0)
 
     return action
 
 
+def _kick(kicker: RobotId, vx: float) -> Script:
+    def action(world: KinematicWorld) -> None:
+        world.ball_velocity = (vx, 0.0, 0.0)
+        world.touch(kicker)
+
+    return action
+
+
+def _shot(at_ms: int, x: float, y: float, vx: float, kicker: RobotId) -> dict[int, Script]:
+    """The ball out of the centre circle at (x, y), then kicked by ``kicker`` a step later (a
+    goal counts after a kick-off once a robot touched the ball out of the circle)."""
+    return {at_ms - 8: _place(x, y), at_ms: _kick(kicker, vx)}
+
+
 @pytest.mark.slow
 def test_scripted_ball_gives_the_expected_score() -> None:
-    # Each roll in PLAYING (after a goal, READY 45 s and SET 5 s; a ball still for 120 s is
+    # Each shot in PLAYING (after a goal, READY 45 s and SET 5 s; a ball still for 120 s is
     # dropped, READY and SET again): the referee puts the ball on the centre spot when SET
     # begins, so a ball rolled in READY scores nothing.
+    red, blue = RobotId(TeamColor.RED, 2), RobotId(TeamColor.BLUE, 2)
     script = {
-        200_000: _roll(3.8, 0.3, 2.0),  # first half: red plays left, scores on the right
-        300_000: _roll(-3.8, -0.5, -2.0),  # blue scores on the left
-        400_000: _roll(3.8, 1.0, 2.0),  # red again
-        900_000: _roll(3.8, 0.0, 2.0),  # second half: blue plays left now, scores right
-        1_200_000: _roll(2.0, 2.8, 0.0),  # not a goal
+        **_shot(200_000, 3.8, 0.3, 2.0, red),  # first half: red plays left, scores on the right
+        **_shot(300_000, -3.8, -0.5, -2.0, blue),  # blue scores on the left
+        **_shot(400_000, 3.8, 1.0, 2.0, red),  # red again
+        **_shot(900_000, 3.8, 0.0, 2.0, blue),  # second half: blue plays left now, scores right
+        **_shot(1_200_000, 2.0, 2.8, 0.0, red),  # not a goal
     }
     referee = play(league_config(), script)
     result = referee.result()

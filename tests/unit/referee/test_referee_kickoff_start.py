@@ -55,8 +55,12 @@ def test_the_ball_is_held_off_the_field_until_set_then_put_on_the_centre_spot() 
         clock.advance(0.008)
     assert placed == [(GameState.INITIAL, AWAY), (GameState.SET, CENTRE)]
     # after a goal: READY again, the ball held off the field until SET
-    for ball in ((0.0, 0.0, 0.07), (1.0, 0.0, 0.07), (-4.8, 0.0, 0.07)):  # kicked into red's goal
-        commands = ref.step(snapshot(ms, robots, ball=ball))
+    # out of the centre circle, kicked there by blue 1, into red's goal
+    touch_ms: int | None = None
+    for ball in ((0.0, 0.0, 0.07), (1.0, 0.0, 0.07), (0.9, 0.0, 0.07), (-4.8, 0.0, 0.07)):
+        touch_ms = ms if ball[0] == 0.9 else touch_ms
+        at = snapshot(ms, robots, ball=ball, toucher=RobotId(BLUE, 1) if touch_ms else None)
+        commands = ref.step(replace(at, last_ball_touch_ms=touch_ms))
         ms += 8
     assert ref.game_state["state"] == "READY" and AWAY in commands
 

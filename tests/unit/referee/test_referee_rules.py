@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import replace
 
 import pytest
 
@@ -36,6 +37,7 @@ from referee.rules.base import (
     PenalizeRobot,
     free_kick,
 )
+from referee.snapshot import RobotState
 from tests.unit.referee.referee_helpers import BLUE, RED, robot, snapshot
 
 R1, R2, B1, B2 = RobotId(RED, 1), RobotId(RED, 2), RobotId(BLUE, 1), RobotId(BLUE, 2)
@@ -128,6 +130,55 @@ def test_the_kick_off_rules_do_not_hold_after_a_set_play() -> None:
     found = [d for d in rules.judge(at, in_throw_in) if isinstance(d, PenalizeRobot)]
     assert [(d.robot, d.reason) for d in found] == [
         (RobotId(BLUE, 2), "touched the ball before it was in play")]
+
+
+Touch = tuple[int, RobotState | None, tuple[float, float]]
+
+
+def _kick_off_goal(touches: list[Touch]) -> list[object]:
+    """Red kicked off; each (ms, robot touching or None, ball xy) is a snapshot; then the ball
+    lies in blue's goal."""
+    memory = goal.restart(goal.Restriction.KICKOFF)
+    for ms, toucher, (x, y) in touches:
+        robots = (toucher,) if toucher is not None else ()
+        _, memory = goal.judge(snapshot(ms, robots, ball=(x, y, 0.07)), view(), memory)
+    decisions, _ = goal.judge(snapshot(900, ball=(4.6, 0.2, 0.07), toucher=R1), view(), memory)
+    return list(decisions)
+
+
+def test_kick_off_ball_out_of_the_circle_and_in_without_a_touch_is_no_goal() -> None:
+    """hlvs_webots referee.py:2158-2163, 2292-2295: leaving the circle alone does not make a
+    kick-off's goal count; the kicker's touch inside it neither."""
+    kicker = robot(RED, 1, -0.2, 0.0, ball_contact=True)
+    decisions = _kick_off_goal([(10, kicker, (0.0, 0.0)), (20, None, (1.0, 0.0)),
+                                (30, None, (3.0, 0.2))])  # fmt: skip
+    assert len(decisions) == 1 and isinstance(decisions[0], AwardSetPlay)
+    assert decisions[0].kind is SecondaryState.GOAL_KICK
+
+
+def test_kick_off_goal_counts_after_a_touch_out_of_the_circle() -> None:
+    """referee.py:2164-2168: the kicker touching the ball again after it left the circle."""
+    kicker_at_centre = robot(RED, 1, -0.2, 0.0, ball_contact=True)
+    kicker_out = robot(RED, 1, 2.9, 0.2, ball_contact=True)
+    decisions = _kick_off_goal([(10, kicker_at_centre, (0.0, 0.0)), (20, None, (3.0, 0.2)),
+                                (30, kicker_out, (3.0, 0.2))])  # fmt: skip
+    assert decisions == [Goal(RED, R1, False)]
+
+
+def test_kick_off_goal_counts_after_a_touch_by_the_defending_team() -> None:
+    """referee.py:2158-2159: an opponent of the kick-off team touched it (inside the circle)."""
+    defender = robot(BLUE, 2, 0.2, 0.0, ball_contact=True)
+    decisions = _kick_off_goal([(10, defender, (0.1, 0.0))])
+    assert decisions == [Goal(RED, R1, False)]
+
+
+def test_kick_off_touch_recorded_between_snapshots_counts() -> None:
+    """A touch the world recorded between two snapshots (its last toucher's time changed)."""
+    memory = goal.restart(goal.Restriction.KICKOFF, snapshot(0))
+    _, memory = goal.judge(snapshot(10, ball=(3.0, 0.2, 0.07)), view(), memory)
+    touched = replace(snapshot(20, ball=(3.2, 0.2, 0.07), toucher=R1), last_ball_touch_ms=16)
+    _, memory = goal.judge(touched, view(), memory)
+    assert memory.cleared
 
 
 def test_throw_in_into_own_goal_gives_corner() -> None:
@@ -320,6 +371,94 @@ def test_a_placed_robot_starts_its_average_again() -> None:
     # teleported 3 m at 500 ms, then still: the jump is not a speed
     decisions = _approach(lambda ms: 3.7 if ms < 500 else 0.6, 1000, ball=(0.5, 0.5, 0.07))
     assert not [d for d in decisions if isinstance(d, AwardSetPlay | PenalizeRobot)]
+
+
+def _contact(
+    a_track: Callable[[int], tuple[float, float]],
+    b_track: Callable[[int], tuple[float, float]],
+    touch_ms: int,
+    ball: tuple[float, float, float],
+    *,
+    a: RobotId = B2,
+    b: RobotId = R2,
+    end_ms: int | None = None,
+    **changes: object,
+) -> list[tuple[int, object]]:
+    """Robots ``a`` and ``b`` on their tracks (ms -> xy), touching from ``touch_ms``."""
+    memory = pushing.PushingMemory()
+    found: list[tuple[int, object]] = []
+    for ms in range(0, (end_ms or touch_ms) + 8, 8):
+        touching = ms >= touch_ms
+        ra = robot(a.team, a.number, *a_track(ms), contacts=(b,) if touching else ())
+        rb = robot(b.team, b.number, *b_track(ms), contacts=(a,) if touching else ())
+        decisions, memory = pushing.judge(snapshot(ms, (ra, rb), ball=ball), view(**changes),
+                                          memory)  # fmt: skip
+        found += [(ms, d) for d in decisions]
+    return found
+
+
+def test_charging_from_behind_on_the_way_to_the_ball() -> None:
+    """referee.py:1000-1006: both move to the ball, blue 2 (0.4 m/s) more than 0.1 m farther:
+    it charges from behind; 1.4 m from the ball, a removal (904-928)."""
+    found = _contact(
+        lambda ms: (0.0, -0.2 + 0.4 * ms / 1000.0),  # blue 2 behind, faster
+        lambda ms: (0.0, 0.3 + 0.1 * ms / 1000.0),
+        1000,
+        ball=(0.0, 1.6, 0.07),
+    )
+    assert [d for _, d in found] == [
+        PenalizeRobot(B2, Penalty.PHYSICAL_CONTACT, "charging red player 2 from behind")]
+
+
+def test_violent_collision_away_from_the_ball() -> None:
+    """referee.py:1007-1011: more than 2 m from the ball, 0.2 m/s faster than the other."""
+    found = _contact(lambda ms: (0.5 - 0.5 * ms / 1000.0, 0.0),
+                     lambda ms: (-0.2, 0.0), 1000, ball=(3.0, 2.0, 0.07))  # fmt: skip
+    assert len(found) == 1 and isinstance(found[0][1], PenalizeRobot)
+    assert found[0][1].robot == B2 and "violent collision" in found[0][1].reason
+
+
+def test_a_slow_robot_away_from_the_ball_is_no_foul() -> None:
+    found = _contact(lambda ms: (0.15 - 0.15 * ms / 1000.0, 0.0),
+                     lambda ms: (-0.2, 0.0), 1000, ball=(3.0, 2.0, 0.07))  # fmt: skip
+    assert found == []
+
+
+def test_touching_a_goalkeeper_in_its_goal_area_is_a_foul() -> None:
+    """referee.py:962-965: any contact with a goalkeeper inside its own goal area, at any
+    speed; blue 1 is blue's goalkeeper, blue defends x > 0 (red on the left)."""
+    found = _contact(lambda ms: (3.6, 0.2), lambda ms: (4.0, 0.2), 500, ball=(3.0, 0.0, 0.07),
+                     a=R2, b=B1)  # fmt: skip
+    assert len(found) == 1 and isinstance(found[0][1], AwardSetPlay)
+    assert found[0][1].team is BLUE and "goalkeeper" in found[0][1].reason
+    assert found[0][1].kind is SecondaryState.DIRECT_FREEKICK
+
+
+def test_every_step_of_a_contact_is_judged() -> None:
+    """referee.py:1019-1027: the tree runs on every step two robots touch, not only when the
+    contact begins: blue 2 leans on red 2 slowly, then speeds up away from the ball (before
+    the contact lasted the 1 s of a sustained push)."""
+    def blue(ms: int) -> tuple[float, float]:
+        return (0.0, 0.6 - (0.05 * ms if ms < 1500 else 75.0 + 0.8 * (ms - 1500)) / 1000.0)
+
+    found = _contact(blue, lambda ms: (0.0, 0.3), 1000, ball=(0.5, 0.5, 0.07), end_ms=1900)
+    assert found and found[0][0] > 1500
+    kick = found[0][1]
+    assert isinstance(kick, AwardSetPlay) and kick.kind is SecondaryState.DIRECT_FREEKICK
+
+
+def test_the_free_kick_is_taken_where_the_offender_stood() -> None:
+    """referee.py:926-928: ``offence_location`` is the offender's position."""
+    found = _contact(lambda ms: (0.0, 1.4 - 0.8 * ms / 1000.0), lambda ms: (0.0, 0.3), 1000,
+                     ball=(0.5, 0.5, 0.07))  # fmt: skip
+    kick = found[0][1]
+    assert isinstance(kick, AwardSetPlay) and kick.position == pytest.approx((0.0, 0.6))
+
+
+def test_both_robots_are_immune_for_two_seconds_after_a_foul() -> None:
+    found = _contact(lambda ms: (0.0, 1.4 - 0.8 * min(ms, 1000) / 1000.0), lambda ms: (0.0, 0.3),
+                     1000, ball=(0.5, 0.5, 0.07), end_ms=2900)  # fmt: skip
+    assert [ms for ms, _ in found] == [1000]
 
 
 # --- removal and end of game ----------------------------------------------------------------
