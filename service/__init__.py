@@ -19,7 +19,6 @@ if TYPE_CHECKING:
     from service.accounts import ensure_team_account
     from service.admin import add_team, list_tokens
     from service.app import create_app, pool_from_settings
-    from service.client import register_client_commands
     from service.deps import (
         DbSession,
         OperatorPrincipal,
@@ -30,20 +29,24 @@ if TYPE_CHECKING:
         require_team,
         require_token,
     )
-    from service.errors import NotFound, ServiceError
+    from service.errors import ClientError, InvalidInput, NotFound, ServiceError
     from service.results import stored_many
     from service.services import Services
     from service.settings import Settings
     from service.tokens import Principal
+    from service.views import SubmissionReport
 
 __all__ = [
+    "ClientError",
     "DbSession",
+    "InvalidInput",
     "NotFound",
     "OperatorPrincipal",
     "Principal",
     "ServiceError",
     "Services",
     "Settings",
+    "SubmissionReport",
     "TeamPrincipal",
     "add_team",
     "create_app",
@@ -52,7 +55,6 @@ __all__ = [
     "get_services",
     "list_tokens",
     "pool_from_settings",
-    "register_client_commands",
     "require_operator",
     "require_team",
     "require_token",
@@ -68,13 +70,13 @@ if not TYPE_CHECKING:
         "service.admin": ("add_team", "list_tokens"),
         "service.app": ("create_app", "pool_from_settings"),
         "service.services": ("Services",),
-        "service.client": ("register_client_commands",),
         "service.deps": (
             "DbSession", "OperatorPrincipal", "TeamPrincipal", "get_db", "get_services",
             "require_operator", "require_team", "require_token",
         ),
-        "service.errors": ("NotFound", "ServiceError"),
+        "service.errors": ("ClientError", "InvalidInput", "NotFound", "ServiceError"),
         "service.results": ("stored_many",),
         "service.settings": ("Settings",),
         "service.tokens": ("Principal",),
+        "service.views": ("SubmissionReport",),
     })

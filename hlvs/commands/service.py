@@ -102,9 +102,9 @@ def register(sub: Any) -> None:
     _add_db_options(tlist)
     tlist.set_defaults(func=guarded(run_token_list))
 
-    from service import register_client_commands as register_client
+    from hlvs.commands.client import register_client_commands
 
-    register_client(sub, guarded)
+    register_client_commands(sub, guarded)
     bench = sub.choices.get("bench")
     if bench is not None:
         from hlvs.commands.forwarding import forward

@@ -284,7 +284,7 @@ def test_files_stored_by_an_older_version_are_sealed_and_checked_again(
 
 
 def test_hlvs_submit_sends_a_key_file_as_its_text(tmp_path: Path) -> None:
-    from service.client import inline_key
+    from hlvs.commands.client import inline_key
 
     key = "-----BEGIN OPENSSH PRIVATE KEY-----\nk\n-----END OPENSSH PRIVATE KEY-----\n"
     (tmp_path / "id_team").write_text(key)

@@ -99,7 +99,7 @@ class Api:
     def call(self, method: str, path: str, **kwargs: Any) -> Any:
         import httpx
 
-        from service.errors import ClientError
+        from service import ClientError
 
         try:
             answer = self._http.request(method, path, **kwargs)
@@ -123,7 +123,7 @@ class Api:
 
 
 def _api(args: argparse.Namespace) -> Api:
-    from service.errors import InvalidInput
+    from service import InvalidInput
 
     server = args.server or os.environ.get("HLVS_SERVER")
     if not server:
@@ -148,7 +148,7 @@ def server_url(text: str, *, given: str) -> str:
     ``https://`` and a host, naming where it came from (``given``: the option or variable)."""
     from urllib.parse import urlsplit
 
-    from service.errors import InvalidInput
+    from service import InvalidInput
 
     url = text.strip()
     parts = urlsplit(url)
@@ -160,7 +160,7 @@ def server_url(text: str, *, given: str) -> str:
 
 
 def _read_token(path: Path) -> str:
-    from service.errors import InvalidInput
+    from service import InvalidInput
 
     try:
         return path.expanduser().read_text(encoding="utf-8").strip()
@@ -169,7 +169,7 @@ def _read_token(path: Path) -> str:
 
 
 def _load_json(path: Path) -> Any:
-    from service.errors import InvalidInput
+    from service import InvalidInput
 
     try:
         return json.loads(path.read_text(encoding="utf-8"))
@@ -258,8 +258,7 @@ def run_results(args: argparse.Namespace) -> int:
     from pydantic import ValidationError
 
     from contracts import files
-    from service.errors import ClientError
-    from service.views import SubmissionReport
+    from service import ClientError, SubmissionReport
 
     api = _api(args)
     out: Path = args.out or Path(args.submission)
@@ -297,7 +296,7 @@ def run_logs(args: argparse.Namespace) -> int:
     relative path under ``--out`` that passes no symlink: an absolute name, ``..``, an empty
     or ``.`` part, a NUL, or a folder on the way that is a symlink is refused (named on
     stderr, exit 2), and nothing is written for it."""
-    from service.errors import ClientError
+    from service import ClientError
 
     api = _api(args)
     out: Path = args.out or Path(args.submission) / "logs"
