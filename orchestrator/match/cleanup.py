@@ -13,6 +13,7 @@ that match is named.
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from orchestrator.engine import LABEL_MATCH
@@ -60,27 +61,11 @@ def cleanup(runtime: ContainerRuntime, host: Host, *, match_id: str | None = Non
             ) -> CleanupReport:
     """Clean ``match_id`` (refused while its orchestrator runs), or every match whose
     orchestrator is gone."""
-    totals = _Totals()
-    if match_id is not None:
-        record = ownership.read(match_id)
-        if record is not None and ownership.owner_alive(record):
-            raise MatchRunning(record)
-        clean_match(runtime, host, match_id=match_id, record=record, totals=totals)
-        return totals.report()
-    owned: dict[str, RunRecord] = {}
-    for record in ownership.records():
-        owned[record.match_id] = record
-        if ownership.owner_alive(record):
-            totals.skipped.append(f"{record.match_id}: its orchestrator (pid {record.pid} on "
-                                  f"{record.hostname}) is running")
-            continue
-        clean_match(runtime, host, match_id=record.match_id, record=record, totals=totals)
-    for obj in runtime.list_project():
-        other = obj.labels.get(LABEL_MATCH)
-        if other and other not in owned:
-            totals.skipped.append(f"{other}: no run record (name it: hlvs cleanup --match "
-                                  f"{other})")
-    return totals.report()
+
+    def clean(one: str, record: RunRecord | None, totals: _Totals) -> None:
+        clean_match(runtime, host, match_id=one, record=record, totals=totals)
+
+    return _sweep(runtime, match_id, clean)
 
 
 def plan_cleanup(runtime: ContainerRuntime, *, match_id: str | None = None) -> CleanupReport:
@@ -88,9 +73,8 @@ def plan_cleanup(runtime: ContainerRuntime, *, match_id: str | None = None) -> C
     and networks it would remove, the output folders it would salvage logs into, the matches it
     would leave alone and why, and the mounted log and scratch folders it would unmount.
     """
-    totals = _Totals()
 
-    def plan(one: str, record: RunRecord | None) -> None:
+    def plan(one: str, record: RunRecord | None, totals: _Totals) -> None:
         found = _ours(runtime.list_project(match_id=one), totals)
         mounts = logfs.mounted(match_id=one)
         leftover_logs = (logfs.state_dir() / "logfs" / logfs.safe_name(one)).is_dir()
@@ -101,11 +85,21 @@ def plan_cleanup(runtime: ContainerRuntime, *, match_id: str | None = None) -> C
         totals.host_objects += len(mounts)
         totals.mounts += mounts
 
+    return _sweep(runtime, match_id, plan)
+
+
+def _sweep(runtime: ContainerRuntime, match_id: str | None,
+           each: Callable[[str, RunRecord | None, _Totals], None]) -> CleanupReport:
+    """The matches a cleanup handles, each given to ``each`` (which removes what it left, or,
+    in a dry run, lists it) with the totals: ``match_id`` (refused while its orchestrator
+    runs), or every match whose orchestrator is gone; the matches left alone are listed with
+    the reason."""
+    totals = _Totals()
     if match_id is not None:
         record = ownership.read(match_id)
         if record is not None and ownership.owner_alive(record):
             raise MatchRunning(record)
-        plan(match_id, record)
+        each(match_id, record, totals)
         return totals.report()
     owned: dict[str, RunRecord] = {}
     for record in ownership.records():
@@ -114,7 +108,7 @@ def plan_cleanup(runtime: ContainerRuntime, *, match_id: str | None = None) -> C
             totals.skipped.append(f"{record.match_id}: its orchestrator (pid {record.pid} on "
                                   f"{record.hostname}) is running")
             continue
-        plan(record.match_id, record)
+        each(record.match_id, record, totals)
     for obj in runtime.list_project():
         other = obj.labels.get(LABEL_MATCH)
         if other and other not in owned:
