@@ -31,6 +31,21 @@ MAX_CANDIDATES = 400  # depth peaks looked at, deepest first
 # white light. Measured over texture_seed 1..20: balls 0.29 to 0.33; a worn patch in a dim
 # sunset 0.40. (Under the pink dawn light a worn patch's share falls to a ball's.)
 BALL_MAX_GREEN_SHARE = 0.37
+# Nothing this dark against the grass's median brightness is grass, whatever its green share:
+# a black mark's few grey levels of noise make its share anything (the marks of a near ball
+# counted as grass cut the ball's region into rings, and its disc came out half its size)
+DARK_FRACTION = 0.25
+# Bright not-grass in the ring round a disc is a field line: a ball lying on a line, or where
+# lines cross, is ringed by grass and line (a line through the ring of a near ball covers up to
+# half of it); at least this much of the ring must still be grass. Only round discs this large
+# (radius in pixels of the subsampled image: a ball nearer than about 2.4 m): far away, a goal
+# post's foot on the goal line is a small disc of not-grass that a line rings as well
+LINE_FRACTION = 1.1  # a line is brighter than this times the grass's median
+RING_MIN_GRASS = 0.45
+LINE_RING_MIN_RADIUS = 4.0
+# panels brighter than 3/4 of the ball's brightest: at most this share of the disc (a line or a
+# white mark is bright all over, 0.9 and more; a near ball's marks cover less of it, 0.6-0.7)
+BALL_MAX_BRIGHT = 0.78
 
 
 @dataclass(frozen=True, slots=True)
@@ -123,6 +138,7 @@ def _not_grass(
     grass = share >= cut * 1024.0
     grass_values = value[::2, ::2][grass[::2, ::2]]
     grass_value = float(np.median(grass_values)) if grass_values.size else 128.0
+    grass &= value >= DARK_FRACTION * grass_value
     return ~grass, value, grass_value, share
 
 
@@ -157,7 +173,8 @@ def _ball_disc(
     """The ball's disc round a depth peak — (score, row, column, radius) on the subsampled
     image — or None: the disc grown while its edge stays not-grass, re-centred, must be
     nearly all not-grass (a line is narrower than its depth's disc only where it widens),
-    ringed by grass at 1.3-1.8 radii (a line crossing the ring covers about 40 % of it), with
+    ringed by grass at 1.3-1.8 radii (a near disc: grass and bright line, at least
+    :data:`RING_MIN_GRASS` of it grass, as round a ball lying on a line), with
     bright panels (not brighter than most of it, as a line's or a white mark's) and dark
     marks or shade, and about as green as grey on the whole (a worn patch of turf in a dim
     light passes the rest, but half of it is grass)."""
@@ -187,16 +204,20 @@ def _ball_disc(
         return None  # cut by the image's edge: too little of it or its ring to judge
     fill = np.count_nonzero(window & disc) / n_disc
     ring_grass = 1.0 - np.count_nonzero(window & ring) / n_ring
-    if fill < 0.8 or ring_grass < 0.8:
+    ring_clear = ring_grass
+    if radius >= LINE_RING_MIN_RADIUS:
+        line = window & ring & (value[y0:y1, x0:x1] > LINE_FRACTION * grass_value)
+        ring_clear += np.count_nonzero(line) / n_ring
+    if fill < 0.8 or ring_clear < 0.8 or ring_grass < RING_MIN_GRASS:
         return None
     values = np.sort(value[y0:y1, x0:x1][window & disc])
     high, low = values[(len(values) * 9) // 10], values[len(values) // 10]
     bright = np.count_nonzero(values > 0.75 * high) / len(values)
-    if high < 0.6 * grass_value or low > 0.6 * high or bright > 0.65:
+    if high < 0.6 * grass_value or low > 0.6 * high or bright > BALL_MAX_BRIGHT:
         return None
     if share[y0:y1, x0:x1][window & disc].mean() > BALL_MAX_GREEN_SHARE * 1024:
         return None
-    return ring_grass * fill, cy_f, cx_f, radius
+    return ring_clear * fill, cy_f, cx_f, radius
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

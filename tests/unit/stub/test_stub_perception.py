@@ -13,23 +13,26 @@ from robot.motion import kinematics, standing_posture
 from robot.stub import GameInfo, Role, StubController
 from robot.stub.perception import BallSighting, CameraPose, find_ball_blobs, ground_point
 from simulator.world import CameraRenderer
+from simulator.world.camera_model import CameraModel
 from simulator.world.look import BACKGROUNDS, BALLS, look_for
 
 from .motion_world import RED1, OneRobot
 
 
-def _sighting(robot: OneRobot, head: float) -> BallSighting | None:
+def _sighting(robot: OneRobot, head: float, neck: float = 0.0) -> BallSighting | None:
     """What the stub's ball finder makes of the robot's camera image, standing with the head
-    pitched ``head``."""
+    pitched ``head`` and the neck turned ``neck`` (left)."""
+    kid = kinematics("kid-default")
     posture = standing_posture()
-    posture["Head"] = head
+    posture.update(kid.head_targets(neck, head))
     robot.run(0.6, lambda: posture)
     with CameraRenderer(robot.world, 320, 240) as camera:
         image = np.frombuffer(camera.render(RED1), np.uint8).reshape(240, 320, 3)
     m = robot.world.data.xmat[robot.torso].reshape(3, 3)
+    joints = robot.world.read_positions(RED1)
     pose = CameraPose(
-        neck_yaw_rad=0.0,
-        head_pitch_rad=robot.world.read_positions(RED1)["HeadS"],
+        neck_yaw_rad=joints[f"{kid.neck_motor}S"],
+        head_pitch_rad=kid.head_down_sign * joints[f"{kid.head_motor}S"],
         torso_roll_rad=float(np.arctan2(m[2, 1], m[2, 2])),
         torso_pitch_rad=float(np.arcsin(-m[2, 0])),
         pelvis_height_m=float(robot.position[2]),
@@ -38,7 +41,7 @@ def _sighting(robot: OneRobot, head: float) -> BallSighting | None:
         seen = ground_point(
             blob,
             pose,
-            kinematics("kid-default").camera,
+            kid.camera,
             width_px=320,
             height_px=240,
             ball_radius_m=0.07,
@@ -57,6 +60,31 @@ def test_sees_the_ball_where_it_is(ball_x: float, ball_y: float, head: float) ->
     true_x = robot.ball_position[0] - robot.position[0]
     assert seen.x_m == pytest.approx(true_x, abs=0.1 * true_x + 0.03)
     assert seen.y_m == pytest.approx(ball_y, abs=0.05)
+
+
+@pytest.mark.parametrize(
+    ("seed", "robot_x", "ball_x", "ball_y"),
+    [(3, -0.17, 0.17, 0.1), (3, -0.25, 0.25, 0.12), (1, -0.2, 0.2, 0.0), (1, -0.3, 0.3, -0.05),
+     (6, -0.17, 0.17, -0.1)],
+)
+def test_sees_a_near_ball_on_the_lines_and_its_dark_marks(
+    seed: int, robot_x: float, ball_x: float, ball_y: float
+) -> None:
+    # A ball at the feet on the halfway line beside the centre circle (lines in the ring round
+    # it, with the feet), or with black marks that a few grey levels of noise made as green as
+    # grass (the ball's region split into rings): none was found, and the striker walked on by
+    # its memory of the ball, kicked short of it and searched. The head pitched as the striker
+    # pitches it for a ball that near; the robot 0.5 m beside the centre spot (at robot_x -2, on
+    # plain grass).
+    robot = OneRobot(x_m=robot_x, y_m=0.5, seed=seed)
+    robot.world.camera_model = CameraModel.league(seed)  # a match's: exposure and noise
+    robot.place_ball(robot_x + ball_x, 0.5 + ball_y)
+    down = min(math.atan2(0.47, math.hypot(ball_x, ball_y)), 1.15)
+    seen = _sighting(robot, down, math.atan2(ball_y, ball_x))
+    assert seen is not None, "no ball found"
+    true = robot.ball_position - robot.position  # the torso, settled into the stance
+    assert seen.x_m == pytest.approx(true[0], abs=0.04)
+    assert seen.y_m == pytest.approx(true[1], abs=0.04)
 
 
 def _seeds_showing_every_variant() -> list[int]:
