@@ -16,6 +16,7 @@ if TYPE_CHECKING:
         models,
         pool,
         report,
+        runtime,
         scrimmage,
         service,
         viewer,
@@ -31,6 +32,7 @@ __all__ = [
     "models",
     "pool",
     "report",
+    "runtime",
     "scrimmage",
     "service",
     "viewer",
@@ -41,6 +43,6 @@ if not TYPE_CHECKING:
     __getattr__, __dir__ = lazy_exports(__name__, {
         "benchmarks": (
             "actuators", "bringup", "cli", "delivery", "envs", "hog", "models", "pool", "report",
-            "scrimmage", "service", "viewer",
+            "runtime", "scrimmage", "service", "viewer",
         ),
     })

@@ -1,6 +1,6 @@
-"""``hlvs render`` and ``hlvs bench sim|api|stub|envs|bringup|delivery|cli|viewer|scrimmage|hog``:
-commands with parsers of their own, to which the arguments are forwarded unread (``--help``
-included).
+"""``hlvs render`` and ``hlvs bench
+sim|api|stub|envs|bringup|delivery|cli|viewer|scrimmage|hog|runtime``: commands with parsers of
+their own, to which the arguments are forwarded unread (``--help`` included).
 
 The orchestrator does not import the simulator; ``render`` and the simulator's (or the learning
 environments') benchmarks run ``python -m simulator`` (``python -m envs``) with the same
@@ -78,6 +78,9 @@ def register(sub: Any) -> None:
     forward(kinds, "hog",
             help="a CPU-hogging robot: the others' real-time factor against a match without "
             "it, under the admission rules (JSON)", func=_hog)
+    forward(kinds, "runtime",
+            help="the robots under another OCI runtime (gVisor's runsc): real-time factor and "
+            "the stubs' control loop against the engine's default (JSON)", func=_runtime)
     forward(kinds, "scrimmage",
             help="K default scrimmages: halves reaching PLAYING, kicks, goals, wall time (JSON)",
             func=_scrimmage)
@@ -93,6 +96,12 @@ def _hog(args: argparse.Namespace) -> int:
     from benchmarks import hog as hog_bench
 
     return int(hog_bench.main(list(args.rest)))
+
+
+def _runtime(args: argparse.Namespace) -> int:
+    from benchmarks import runtime as runtime_bench
+
+    return int(runtime_bench.main(list(args.rest)))
 
 
 def _scrimmage(args: argparse.Namespace) -> int:
