@@ -26,14 +26,14 @@ from referee.gamecontroller import (
     Tick,
 )
 from referee.gamecontroller.states import Card
-from referee.judgement import apply_decisions, penalised_back_in_field
+from referee.judgement import apply_decisions, penalised_robots
 from referee.logs import RefereeLog
 from referee.mirror import TeamMirror
 from referee.net import GameControllerNetwork
 from referee.play_stats import PlayTracker
 from referee.publisher import Publisher
 from referee.rulebook import RuleBook
-from referee.rules import end_of_game, goal, kickoff, removal, set_play
+from referee.rules import end_of_game, goal, kickoff, set_play
 from referee.rules.base import AbortSetPlay, Decision, GameView, GiveCard, RetakeSetPlay
 from referee.shootout import KickOutcome, Shootout
 from referee.snapshot import (
@@ -107,6 +107,7 @@ class Referee:
         self.set_play_spot: Vec2 | None = None  # where the set play in preparation puts the ball
         self._placed_ms: int | None = None  # when a set play's ball was last placed
         self.carried: dict[RobotId, Vec2] = {}  # where the referee last put a penalised robot
+        self.settling: dict[RobotId, tuple[int, Pose]] = {}  # to be put there again, still
         self._placed_at_start_ms: int | None = None  # when robots were last put at start poses
         self.play = PlayTracker()
         self.reset_memories()
@@ -247,10 +248,7 @@ class Referee:
         tick = self.gc.advance_ms(dt_ms)
         commands += self._on_tick(tick, snapshot)
         if self.gc.state is not GameState.INITIAL and not self._finished:
-            # every step, in and out of the shoot-out (hlvs_webots referee.py:2436, 2437-2438)
-            still = penalised & frozenset(self.gc.penalised())
-            for robot in removal.penalised_in_field(snapshot, still, self.field, self.carried):
-                commands += penalised_back_in_field(self, robot, snapshot)
+            commands += penalised_robots(self, snapshot, penalised)
         if not self._finished and self._wait_until_s is None:
             if self.gc.phase is SecondaryState.PENALTYSHOOT:
                 commands += self._shootout_step(snapshot)

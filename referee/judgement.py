@@ -24,7 +24,16 @@ from referee.rules.base import (
     PenalizeRobot,
     RetakeSetPlay,
 )
-from referee.snapshot import PlaceBall, RefereeEvent, Vec2, WorldCommand, WorldSnapshot
+from referee.snapshot import (
+    PlaceBall,
+    RefereeEvent,
+    TeleportRobot,
+    Vec2,
+    WorldCommand,
+    WorldSnapshot,
+)
+
+SETTLE_MS = 40  # 5 of the league's 8 ms steps (referee.py:1512, `player['stabilize'] = 5`)
 
 PENALTY_NAMES = {
     Penalty.PICKUP_OR_INCAPABLE: "INCAPABLE",
@@ -45,6 +54,7 @@ class RefereeCore(Protocol):
     left_team: TeamColor
     set_play_spot: Vec2 | None  # where the set play in preparation placed the ball
     carried: dict[RobotId, Vec2]  # where the referee last put each penalised robot
+    settling: dict[RobotId, tuple[int, Pose]]  # put there again at that time (SETTLE_MS)
 
     def emit(self, event: RefereeEvent) -> None: ...
 
@@ -217,6 +227,7 @@ def penalize(
     pose = reentry_pose(ref, robot, snapshot, taken)
     occupied.append((pose.x_m, pose.y_m))
     ref.carried[robot] = (pose.x_m, pose.y_m)
+    ref.settling[robot] = (snapshot.sim_time_ms + SETTLE_MS, pose)
     ref.limp.add(robot)
     name = PENALTY_NAMES.get(decision.penalty, decision.penalty.name)
     ref.log.info(snapshot.sim_time_ms, f"{name} penalty for {robot}: {decision.reason}.")
@@ -250,6 +261,28 @@ def _card(ref: RefereeCore, decision: GiveCard, snapshot: WorldSnapshot) -> list
     ref.red_carded.add(robot)
     ref.limp.discard(robot)
     return removal.red_card_commands(robot)
+
+
+def penalised_robots(
+    ref: RefereeCore, snapshot: WorldSnapshot, before: frozenset[RobotId]
+) -> list[WorldCommand]:
+    """Every step, in and out of the shoot-out: a robot the referee removed is put on its spot
+    again, still, :data:`SETTLE_MS` later, as the league's referee ``stabilize``s a robot it put
+    somewhere 5 steps later (hlvs_webots referee.py:1512-1514, 1460-1474, every step 2117):
+    whatever pushed it meanwhile (a collision, a velocity set on it) is undone; then penalised
+    robots (``before`` this step and still) back on the field are judged (2436-2438)."""
+    commands: list[WorldCommand] = []
+    now = snapshot.sim_time_ms
+    for robot, (due_ms, pose) in list(ref.settling.items()):
+        if now < due_ms:
+            continue
+        del ref.settling[robot]
+        if ref.gc.robot(robot).penalty is not Penalty.NONE and robot not in ref.red_carded:
+            commands.append(TeleportRobot(robot=robot, pose=pose))
+    still = before & frozenset(ref.gc.penalised())
+    for robot in removal.penalised_in_field(snapshot, still, ref.field, ref.carried):
+        commands += penalised_back_in_field(ref, robot, snapshot)
+    return commands
 
 
 def penalised_back_in_field(

@@ -257,3 +257,21 @@ def test_a_penalised_robot_back_on_the_field_gets_a_yellow_then_a_red_card() -> 
     assert [e.details.get("card") for e in game.ref.events if e.type == "card"] == [
         Card.YELLOW.value, Card.RED.value,
     ]  # fmt: skip
+
+
+def test_a_removed_robot_is_put_on_its_spot_again_five_steps_later() -> None:
+    """referee.py:1512-1514 with 1460-1474: the league's referee puts a robot it placed on its
+    spot again, physics reset, 5 steps (40 ms) later, whatever moved it meanwhile."""
+    game = Game()
+    while game.ref.gc.state is not GameState.PLAYING:
+        game.step((RED_FAR, BLUE_FAR), (0.0, 0.0, 0.07))
+    placed = game.ref._apply(  # noqa: SLF001
+        [PenalizeRobot(R1, Penalty.PICKUP_OR_INCAPABLE, "test")],
+        snapshot(game.ms, (RED_FAR, BLUE_FAR)),
+    )
+    [spot] = [c for c in placed if isinstance(c, TeleportRobot)]
+    again = []
+    for _ in range(8):  # pushed a little after it was put there (still off the field)
+        commands = game.step((robot(RED, 1, -3.0, -3.05), BLUE_FAR), (0.0, 0.0, 0.07))
+        again.append([c for c in commands if isinstance(c, TeleportRobot)])
+    assert again == [[]] * 5 + [[spot]] + [[]] * 2  # the first step is the one it was put at
