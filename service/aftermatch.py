@@ -54,7 +54,11 @@ from service.matchfiles import OWN_COLOR
 from service.settings import LOG_TARGET_ALLOW_SETTING, log_target_networks
 
 if TYPE_CHECKING:
-    from service.services import Services
+    from sqlalchemy.orm import Session, sessionmaker
+
+    from cluster import MatchPool
+    from service.sealing import Sealer
+    from service.settings import Settings
 
 log = logging.getLogger(__name__)
 
@@ -96,9 +100,14 @@ class _Render:
 
 
 class AfterMatch:
-    def __init__(self, services: Services, *, python: str = sys.executable) -> None:
-        self.services = services
-        self.settings = services.settings
+    def __init__(
+        self, *, settings: Settings, sessions: sessionmaker[Session], pool: MatchPool,
+        sealer: Sealer, python: str = sys.executable,
+    ) -> None:
+        self.settings = settings
+        self._sessions = sessions
+        self._pool = pool
+        self._sealer = sealer
         self.python = python
         self._render: _Render | None = None
         self._render_per_match_s = RENDER_PER_MATCH_S
@@ -145,7 +154,7 @@ class AfterMatch:
     # one round ---------------------------------------------------------------------------
     def round(self) -> None:
         self._deliveries()
-        with transaction(self.services.sessions) as session:
+        with transaction(self._sessions) as session:
             pending = list(session.scalars(select(Submission).where(
                 Submission.video_state == MediaState.PENDING.value).order_by(Submission.seq)))
             render = self._render
@@ -159,7 +168,7 @@ class AfterMatch:
     # logs ----------------------------------------------------------------------------------
     def _deliveries(self) -> None:
         """Every pending delivery, oldest first; the uploads run outside any transaction."""
-        with transaction(self.services.sessions) as session:
+        with transaction(self._sessions) as session:
             rows = session.execute(select(Submission, Team.name, TeamFile.content).join(
                 Team, Team.id == Submission.team_id).outerjoin(
                 TeamFile, TeamFile.id == Submission.credentials_file_id).where(
@@ -171,7 +180,7 @@ class AfterMatch:
             if self._stop.is_set():
                 return
             state, detail = self._deliver(match_id, handle, team, content)
-            with transaction(self.services.sessions) as session:
+            with transaction(self._sessions) as session:
                 row = session.get(Submission, seq)
                 if row is not None and row.delivery_state == MediaState.PENDING.value:
                     row.delivery_state, row.delivery_detail = state.value, detail
@@ -195,11 +204,11 @@ class AfterMatch:
         if match_id is None or handle is None or content is None:
             return MediaState.FAILED, "the match left no logs, or no credentials were given"
         allowed = log_target_networks(self.settings)
-        document = self.services.sealer.open_document("credentials", json.loads(content))
+        document = self._sealer.open_document("credentials", json.loads(content))
         _, refused = teamfiles.service_problems("credentials", document, allowed=allowed)
         if refused:  # stored before the service's rules: never read the host's files for it
             return MediaState.FAILED, str(refused[0]).replace(refused[0].file, CREDENTIALS_FILE)
-        out = self.services.pool.results_dir(handle)
+        out = self._pool.results_dir(handle)
         work = private_dir((self.settings.matches_dir / match_id).resolve())
         credentials = write_private(work / CREDENTIALS_FILE, json.dumps(document))
         store = private_dir(self.settings.data_dir.resolve() / LOG_STORE)
@@ -240,7 +249,7 @@ class AfterMatch:
         if row.pool_handle is None or row.match_id is None:
             self._set(row, MediaState.FAILED, "the match left no output")
             return
-        out = self.services.pool.results_dir(row.pool_handle)
+        out = self._pool.results_dir(row.pool_handle)
         work = self._work_dir(row)
         render = self._render
         if render is not None and render.submission_id == row.id:

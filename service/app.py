@@ -71,6 +71,27 @@ def service_routers() -> tuple[Mount, ...]:
     )
 
 
+def _start_threads(services: Services) -> None:
+    """Start the service's threads, each given the parts it uses: the after-match work, the
+    queue worker (which wakes it) and the ladder (which wakes the worker)."""
+    from service.aftermatch import AfterMatch
+    from service.ladder import LadderThread
+    from service.worker import QueueWorker
+
+    settings, sessions = services.settings, services.sessions
+    services.aftermatch = AfterMatch(settings=settings, sessions=sessions, pool=services.pool,
+                                     sealer=services.sealer)
+    services.aftermatch.start()
+    services.worker = QueueWorker(settings=settings, pool=services.pool, sessions=sessions,
+                                  sealer=services.sealer, changed=services.changed,
+                                  aftermatch=services.aftermatch)
+    services.worker.start()
+    services.ladder_thread = LadderThread(settings=settings, sessions=sessions,
+                                          cache=services.ladder, changed=services.changed,
+                                          slots=services.slots, worker=services.worker)
+    services.ladder_thread.start()
+
+
 def create_app(
     settings: Settings,
     *,
@@ -128,17 +149,7 @@ def create_app(
         status.start(services.sessions)
         app.state.services = services
         if start_worker:
-            from service.aftermatch import AfterMatch
-            from service.worker import QueueWorker
-
-            services.aftermatch = AfterMatch(services)
-            services.aftermatch.start()
-            services.worker = QueueWorker(services)
-            services.worker.start()
-            from service.ladder import LadderThread
-
-            services.ladder_thread = LadderThread(services)
-            services.ladder_thread.start()
+            _start_threads(services)
         # Everything loaded so far lives as long as the process: kept out of the collector's
         # full passes, which would otherwise stop every request for tens of milliseconds.
         gc.collect()

@@ -24,6 +24,7 @@ import logging
 import threading
 import time
 from collections import Counter
+from collections.abc import Callable
 from datetime import timedelta
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -39,7 +40,10 @@ from service.matchfiles import OWN_COLOR
 from service.ratings import LadderCache
 
 if TYPE_CHECKING:
-    from service.services import Services
+    from sqlalchemy.orm import sessionmaker
+
+    from service.services import Background
+    from service.settings import Settings
 
 log = logging.getLogger(__name__)
 
@@ -77,10 +81,19 @@ def logs_side(session: Session, *, team_id: int, team_name: str | None,
 
 
 class LadderThread:
-    def __init__(self, services: Services) -> None:
-        self.services = services
-        self.settings = services.settings
-        self.cache: LadderCache = services.ladder
+    def __init__(
+        self, *, settings: Settings, sessions: sessionmaker[Session], cache: LadderCache,
+        changed: Callable[[], None], slots: Callable[[], int],
+        worker: Background | None = None,
+    ) -> None:
+        """``changed``: told when a friendly was queued; ``slots``: the matches that may
+        play at once; ``worker``: woken when a friendly was queued."""
+        self.settings = settings
+        self._sessions = sessions
+        self.cache = cache
+        self._changed = changed
+        self._slots = slots
+        self._worker = worker
         self._stop = threading.Event()
         self._wake = threading.Event()
         self._thread: threading.Thread | None = None
@@ -112,7 +125,7 @@ class LadderThread:
     # one round ---------------------------------------------------------------------------
     def round(self) -> str | None:
         """Record finished matches, then perhaps schedule one; the new submission's id."""
-        with transaction(self.services.sessions) as session:
+        with transaction(self._sessions) as session:
             recorded = ratings.record_friendlies(session)
             state = self.settings.schedule_state
             if state and Path(state).is_file() and \
@@ -123,11 +136,11 @@ class LadderThread:
             log.info("ladder: %d finished match(es) recorded", recorded)
         if self.settings.ladder_every_s <= 0:
             return None
-        with transaction(self.services.sessions) as session:
+        with transaction(self._sessions) as session:
             sid = self._schedule(session)
         if sid is not None:
-            self.services.changed()
-            worker = self.services.worker
+            self._changed()
+            worker = self._worker
             if worker is not None:
                 worker.wake()
         return sid
@@ -144,7 +157,7 @@ class LadderThread:
         busy = session.scalar(select(func.count()).select_from(Submission).where(
             Submission.state.in_([SubmissionState.STARTING.value,
                                   SubmissionState.RUNNING.value]))) or 0
-        if busy >= self.services.slots():
+        if busy >= self._slots():
             return None
         pair = self._pair(session)
         if pair is None:

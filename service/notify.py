@@ -32,7 +32,9 @@ from service.results import MatchSummary
 from service.settings import Settings
 
 if TYPE_CHECKING:
-    from service.services import Services
+    from sqlalchemy.orm import Session, sessionmaker
+
+    from service.sealing import Sealer
 
 log = logging.getLogger(__name__)
 
@@ -218,9 +220,12 @@ def send_mail(settings: Settings, *, to: str, event: str, data: NotificationPayl
 class Notifier:
     """Sends due outbox rows; failures are retried with exponential back-off."""
 
-    def __init__(self, services: Services) -> None:
-        self.services = services
-        self.settings = services.settings
+    def __init__(
+        self, *, settings: Settings, sessions: sessionmaker[Session], sealer: Sealer
+    ) -> None:
+        self.settings = settings
+        self._sessions = sessions
+        self._sealer = sealer
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         # no proxy from the environment and no redirect: a delivery goes to the address that
@@ -249,7 +254,7 @@ class Notifier:
 
     def round(self) -> int:
         """Send every due notification once; returns how many were sent."""
-        with transaction(self.services.sessions) as session:
+        with transaction(self._sessions) as session:
             due = list(session.scalars(select(Notification).where(
                 Notification.sent_at.is_(None), Notification.given_up.is_(False),
                 Notification.next_attempt_at <= now()).order_by(Notification.id).limit(50)))
@@ -270,7 +275,7 @@ class Notifier:
                 else:
                     if not url:
                         raise ValueError("the team has no webhook URL any more")
-                    key = self.services.sealer.open(secret) if secret else ""
+                    key = self._sealer.open(secret) if secret else ""
                     headers = webhooks.sign(key, delivery_id=delivery_id, event=event,
                                             body=body.encode())
                     answer = outbound.post(self._http, url, content=body.encode(),
@@ -284,7 +289,7 @@ class Notifier:
         return sent
 
     def _record(self, ident: int, error: str | None) -> None:
-        with transaction(self.services.sessions) as session:
+        with transaction(self._sessions) as session:
             row = session.get(Notification, ident)
             assert row is not None
             row.attempts += 1

@@ -1,6 +1,7 @@
 """The parts of the running service, built by the app's lifespan (:func:`service.app.create_app`)
-and shared by the request handlers and the service's threads: :class:`Services`. This module
-imports none of the threads or routers that use it, so that they need not import the app."""
+and shared by the request handlers: :class:`Services` (the service's threads are given only the
+parts they use). This module imports none of the threads or routers, so that they need not
+import the app."""
 
 from __future__ import annotations
 

@@ -17,6 +17,7 @@ from __future__ import annotations
 import logging
 import threading
 import zlib
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -37,8 +38,13 @@ from service.results import MatchSummary, backfill, read_results, record, stored
 from service.submissions import STUB, failure_side, queue_paused
 
 if TYPE_CHECKING:
+    from sqlalchemy.orm import sessionmaker
+
+    from cluster import MatchPool
     from orchestrator.config import TeamDocument
-    from service.services import Services
+    from service.sealing import Sealer
+    from service.services import Background
+    from service.settings import Settings
 
 log = logging.getLogger(__name__)
 
@@ -53,17 +59,26 @@ class _Refused(Exception):
 
 
 class QueueWorker:
-    def __init__(self, services: Services) -> None:
-        self.services = services
-        self.settings = services.settings
-        self.pool = services.pool
-        self._stub_image = services.settings.stub_image or None
+    def __init__(
+        self, *, settings: Settings, pool: MatchPool, sessions: sessionmaker[Session],
+        sealer: Sealer, changed: Callable[[str | None], None],
+        aftermatch: Background | None = None,
+    ) -> None:
+        """``changed``: told of each submission changed (None: the queue as a whole);
+        ``aftermatch``: woken when a match has ended."""
+        self.settings = settings
+        self.pool = pool
+        self._sessions = sessions
+        self._sealer = sealer
+        self._changed = changed
+        self._aftermatch = aftermatch
+        self._stub_image = settings.stub_image or None
         self._stop = threading.Event()
         self._wake = threading.Event()
         self._thread: threading.Thread | None = None
         self._cancel_sent: set[str] = set()
         self._backfilled = False  # the results of matches ended before the results tables
-        self.notifier = notify.Notifier(services)
+        self.notifier = notify.Notifier(settings=settings, sessions=sessions, sealer=sealer)
 
     # lifecycle ---------------------------------------------------------------------------
     def start(self) -> None:
@@ -86,17 +101,17 @@ class QueueWorker:
         while not self._stop.is_set():
             try:
                 if self.round():
-                    self.services.changed()
+                    self._changed(None)
             except Exception:  # process boundary of the worker thread: log, keep serving
                 log.exception("queue worker round failed; retrying")
-                self.services.changed()
+                self._changed(None)
             self._wake.wait(self.settings.worker_poll_s)
             self._wake.clear()
 
     # one round ---------------------------------------------------------------------------
     def round(self) -> bool:
         """One round; True when it changed a submission."""
-        sessions = self.services.sessions
+        sessions = self._sessions
         changed = False
         if not self._backfilled:
             with transaction(sessions) as session:
@@ -138,7 +153,7 @@ class QueueWorker:
                 except _Refused as exc:  # a file stored before the service's rules
                     self._end(session, row, SubmissionState.FAILED, cause=exc.cause,
                               failure_class=exc.failure_class)
-                    self.services.changed(row.id)
+                    self._changed(row.id)
                     continue
                 row.pool_handle = None
                 seq = row.seq
@@ -158,7 +173,7 @@ class QueueWorker:
         request would wait, then fail with "database is locked")."""
         if self._stub_image is not None:
             return
-        with transaction(self.services.sessions) as session:
+        with transaction(self._sessions) as session:
             opponent = session.scalar(select(Submission.opponent).where(
                 Submission.state.in_([SubmissionState.QUEUED.value,
                                       SubmissionState.STARTING.value])).order_by(
@@ -175,7 +190,7 @@ class QueueWorker:
 
     def _prepare(self, session: Session, row: Submission) -> MatchJob:
         assert row.match_id is not None
-        sealer = self.services.sealer
+        sealer = self._sealer
         team_doc = teamfiles.opened(teamfiles.get_by_id(session, row.team_file_id), sealer)
         opponent_doc: TeamDocument | None = None
         if row.opponent != STUB:
@@ -322,8 +337,8 @@ class QueueWorker:
                 team_logs_of(out, OWN_COLOR).is_dir():
             row.delivery_state = MediaState.PENDING.value
             row.delivery_detail = "waiting to be uploaded"
-        if self.services.aftermatch is not None and out is not None:
-            self.services.aftermatch.wake()
+        if self._aftermatch is not None and out is not None:
+            self._aftermatch.wake()
         if row.failure_side == "league":
             row.charged = False  # the league's fault costs the team nothing
         self._cancel_sent.discard(row.id)

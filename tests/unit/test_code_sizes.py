@@ -54,8 +54,6 @@ LONG_FUNCTIONS: dict[str, tuple[int, str]] = {
         "signals, heartbeat and notices"),
     "hlvs/commands/schedule.py::register": (
         103, "the `hlvs schedule` verbs' argparse declarations"),
-    "service/app.py::create_app": (
-        101, "the service's composition root: settings, database, pool, routers and pages"),
 }
 
 

@@ -190,7 +190,6 @@ def test_service_placement_setting(tmp_path: Path) -> None:
 
 def test_service_worker_asks_a_node_per_robot_in_league_placement(tmp_path: Path) -> None:
     import argparse
-    from types import SimpleNamespace
 
     from orchestrator import add_scrimmage_arguments as add_arguments
     from orchestrator.match import scrimmage
@@ -205,7 +204,8 @@ def test_service_worker_asks_a_node_per_robot_in_league_placement(tmp_path: Path
     for env, nodes in (({"HLVS_SERVICE_POOL": "slurm", "HLVS_SERVICE_PLACEMENT": "league"}, 6),
                        ({"HLVS_SERVICE_POOL": "slurm"}, 0)):
         settings = Settings.from_env({"HLVS_SERVICE_DATA_DIR": str(tmp_path), **env})
-        worker = QueueWorker(SimpleNamespace(settings=settings, pool=None))  # type: ignore[arg-type]
+        worker = QueueWorker(settings=settings, pool=None, sessions=None, sealer=None,  # type: ignore[arg-type]
+                             changed=lambda _: None)
         assert worker._robot_nodes(game) == nodes
 
 

@@ -119,7 +119,8 @@ def test_a_render_under_way_ends_with_the_service_and_its_partial_video_is_not_s
     out, work = tmp_path / "out", tmp_path / "work"
     (out / "public").mkdir(parents=True)
     (out / "public" / "replay.hlvsrec").write_bytes(b"replay")
-    after = AfterMatch(SimpleNamespace(settings=settings), python=str(renderer))  # type: ignore[arg-type]
+    after = AfterMatch(settings=settings, sessions=None, pool=None, sealer=None,  # type: ignore[arg-type]
+                       python=str(renderer))
     after._start(SimpleNamespace(id="sub_1", match_id="m1"), out, work, 1)  # type: ignore[arg-type]
     render = after._render
     assert render is not None

@@ -34,7 +34,6 @@ def test_an_overdue_render_is_expected_a_minute_on_and_the_next_waits_for_it() -
 
 def test_the_after_match_thread_writes_the_expectation_into_each_pending_video() -> None:
     from datetime import timedelta
-    from types import SimpleNamespace
 
     from service import Settings
     from service.aftermatch import AfterMatch
@@ -44,7 +43,7 @@ def test_the_after_match_thread_writes_the_expectation_into_each_pending_video()
     rows = [Submission(id=f"sub_{n}", started_at=start, finished_at=start + timedelta(seconds=60),
                        video_state="pending", video_detail="waiting for the render")
             for n in range(2)]
-    after = AfterMatch(SimpleNamespace(settings=Settings()))  # type: ignore[arg-type]
+    after = AfterMatch(settings=Settings(), sessions=None, pool=None, sealer=None)  # type: ignore[arg-type]
     after._expect(rows)
     assert [r.video_detail.split(";")[0] for r in rows] == [
         "waiting for the render (next)", "waiting for the render (1 ahead of it)"]
