@@ -77,7 +77,7 @@ class TeamRef:
     color: Color
     team_id: int  # GameController team number
     config: Path  # team_config.json, resolved against the game.json folder
-    hosts: tuple[str, ...]  # IPv4 addresses allowed on this team's API ports
+    hosts: tuple[str, ...]  # allowed on its API ports outside hlvs match (schema: game.json)
     ports: tuple[int, ...]  # robot API port of player n = ports[n - 1]
     credentials: Path | None = None  # log delivery target of this team (credentials.json)
 

@@ -42,6 +42,7 @@ def to_match_spec(
     robot_addresses: Mapping[str, Sequence[str]],
     telemetry_listen: str | None,
     api_bind_host: str = "0.0.0.0",
+    game_hosts: bool = True,
 ) -> MatchSpec:
     """The match spec of ``loaded``.
 
@@ -51,6 +52,11 @@ def to_match_spec(
             run (GameController packets go there; they are also allowed on the API ports).
         telemetry_listen: zenoh endpoint the simulator listens on, None for no telemetry.
         api_bind_host: address the robot API server binds.
+        game_hosts: each team's ``hosts`` of game.json are allowed on its API ports besides
+            ``robot_addresses`` (a simulator in a network laid out elsewhere: ``hlvs referee``,
+            the league's own set-up). False: ``robot_addresses`` alone (``hlvs match`` and
+            ``hlvs compose`` start each robot at an address of their own, and no other address
+            may speak as a robot).
     """
     game = loaded.game
     side_left, kickoff = resolve_sides(loaded)
@@ -62,8 +68,8 @@ def to_match_spec(
         field_class=game.field_class.value,
         side_left=side_left,
         kickoff=kickoff,
-        red=_team(loaded, "red", robot_addresses.get("red", ())),
-        blue=_team(loaded, "blue", robot_addresses.get("blue", ())),
+        red=_team(loaded, "red", robot_addresses.get("red", ()), game_hosts),
+        blue=_team(loaded, "blue", robot_addresses.get("blue", ()), game_hosts),
         stepping=game.stepping,
         maximum_real_time_factor=game.maximum_real_time_factor,
         physics_dt_s=game.physics_dt_s,
@@ -95,10 +101,12 @@ def to_match_spec(
     )
 
 
-def _team(loaded: LoadedGame, color: Color, addresses: Sequence[str]) -> TeamSpec:
+def _team(
+    loaded: LoadedGame, color: Color, addresses: Sequence[str], game_hosts: bool
+) -> TeamSpec:
     ref = loaded.game.team(color)
     team = loaded.team(color)
-    hosts = tuple(dict.fromkeys([*ref.hosts, *addresses]))
+    hosts = tuple(dict.fromkeys([*(ref.hosts if game_hosts else ()), *addresses]))
     return TeamSpec(
         color=color,
         team_id=ref.team_id,

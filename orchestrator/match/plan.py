@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from contracts import AdmissionRecord, MatchSpec
@@ -139,20 +139,12 @@ def match_spec(
     loaded: LoadedGame, addresses: Mapping[str, tuple[str, ...]], telemetry: str | None
 ) -> MatchSpec:
     """The match spec from the config layer, with this run's addresses: the robots' fixed IPs
-    are the team's allowed hosts and GameController targets."""
-    spec = to_match_spec(
+    are the team's allowed hosts (game.json's ``hosts`` are not: each robot has an address of
+    its own here) and GameController targets."""
+    return to_match_spec(
         loaded, robot_addresses={c: list(a) for c, a in addresses.items()},
-        telemetry_listen=telemetry,
+        telemetry_listen=telemetry, game_hosts=False,
     )
-    teams = {
-        color: replace(
-            spec.team(color),
-            hosts=tuple(addresses.get(color, ())),
-            robot_addresses=tuple(addresses.get(color, ())),
-        )
-        for color in ("red", "blue")
-    }
-    return replace(spec, red=teams["red"], blue=teams["blue"])
 
 
 def robots_in_game(game_path: Path) -> int:

@@ -78,3 +78,22 @@ def test_spec_module_does_not_import_the_simulator() -> None:
     code = "import sys, orchestrator.config.spec; print('simulator' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+def test_game_hosts_are_allowed_only_where_the_match_is_laid_out_elsewhere() -> None:
+    """``hosts`` of game.json reach the spec of a simulator run outside ``hlvs match``; the
+    match's own spec (its plan's builder) allows each robot's address alone."""
+    from orchestrator.match import plan_from_game
+
+    loaded = load_game(EXAMPLES / "scrimmage_1v1" / "game.json")
+    addresses = {"red": ["172.30.1.1"], "blue": ["172.30.2.1"]}
+    game_hosts = {color: loaded.game.team(color).hosts for color in ("red", "blue")}
+    assert all(game_hosts.values())  # the example names its hosts
+    elsewhere = to_match_spec(loaded, robot_addresses=addresses, telemetry_listen=None)
+    laid_out = plan_from_game(loaded).spec_builder(
+        {color: tuple(a) for color, a in addresses.items()}, None)
+    for color in ("red", "blue"):
+        assert elsewhere.team(color).hosts == tuple(
+            dict.fromkeys([*game_hosts[color], *addresses[color]]))
+        assert laid_out.team(color).hosts == tuple(addresses[color])
+        assert laid_out.team(color).robot_addresses == tuple(addresses[color])
