@@ -23,7 +23,11 @@ def register(sub: Any) -> None:
     )
     verbs = parser.add_subparsers(dest="verb", metavar="VERB")
     verbs.required = True
+    for add in (_add_run, _add_views, _add_controls, _add_results):  # in the help's order
+        add(verbs)
 
+
+def _add_run(verbs: Any) -> None:
     run = verbs.add_parser("run", help="run the schedule; survives restarts")
     run.add_argument("schedule", type=user_path, help="schedule file (YAML)")
     run.add_argument(
@@ -55,6 +59,9 @@ def register(sub: Any) -> None:
                      help="sender of the mails (default hlvs@localhost)")
     run.set_defaults(func=_run, log_level=logging.INFO)
 
+
+def _add_views(verbs: Any) -> None:
+    """list and status."""
     plan = verbs.add_parser("list", help="what is planned, with absolute times")
     plan.add_argument("schedule", type=user_path, help="schedule file (YAML)")
     plan.add_argument(
@@ -73,6 +80,9 @@ def register(sub: Any) -> None:
                         help="seconds between two prints with --watch (default 2)")
     status.set_defaults(func=_status)
 
+
+def _add_controls(verbs: Any) -> None:
+    """The operator's controls: cancel, abort, reschedule, apply."""
     cancel = verbs.add_parser("cancel", help="cancel a match that is not played yet")
     cancel.add_argument("match_id", help="id of the match in the schedule")
     cancel.add_argument("--state", type=user_path, required=True, help=_STATE_HELP)
@@ -104,6 +114,9 @@ def register(sub: Any) -> None:
     apply.add_argument("--state", type=user_path, required=True, help=_STATE_HELP)
     apply.set_defaults(func=_apply)
 
+
+def _add_results(verbs: Any) -> None:
+    """export and standings."""
     export = verbs.add_parser(
         "export", help="the results for the league's website: matches (scores, shoot-outs), "
         "standings, bracket")

@@ -52,8 +52,6 @@ LONG_FUNCTIONS: dict[str, tuple[int, str]] = {
     "tournament/runner.py::run_schedule": (
         105, "the scheduler's main loop: state restored, matches started and stopped on "
         "signals, heartbeat and notices"),
-    "hlvs/commands/schedule.py::register": (
-        103, "the `hlvs schedule` verbs' argparse declarations"),
 }
 
 
