@@ -30,6 +30,7 @@ from robot.stub.perception import (
     goal_below_horizon,
     ground_point,
 )
+from robot.stub.side import SIDE_LOOK_PITCH_RAD, SideCheck, turned
 from robot.stub.world_model import WorldModel
 
 logger = logging.getLogger(__name__)
@@ -45,10 +46,6 @@ BALL_MEMORY_MS = 4000
 SCAN = [(-0.9, 0.45), (-0.45, 0.5), (0.0, 0.55), (0.45, 0.5), (0.9, 0.45), (0.45, 0.95),
         (0.0, 1.0), (-0.45, 0.95)]  # fmt: skip
 SCAN_DWELL_S = 0.35
-SIDE_LOOK_S = 0.45  # per head position, when checking which side the own goal is on
-SIDE_LOOK_YAWS_RAD = (0.55, 1.3, -0.55, -1.3)  # left first, then right; 60 deg field of view
-SIDE_LOOK_PITCH_RAD = -0.15  # slightly up: a far goal within the margin below the horizon
-SIDE_MIN_PIXELS = 30
 KNEE_RESET_RAD = 0.5  # knee this far from its target: the robot was reset or is limp
 KICK_SETTLE_S = 0.5  # stand still this long before a kick
 # where the keyframe kick wants the ball across: this far outside the kicking sole's centre (a
@@ -126,7 +123,7 @@ class StubController:
         kick_policy: Policy | None = None,
     ) -> None:
         """``detect_side``: before moving, look left and right for the own goal to find out
-        whether the pitch is mirrored for this team (see :meth:`_finish_side_check`);
+        whether the pitch is mirrored for this team (see :mod:`robot.stub.side`);
         ``home``: a defender's spot in the own half; ``kick_policy``: a learned right-foot kick
         from a stand (:mod:`robot.learned`) played instead of the keyframe kick (the striker
         then lines up for the right foot only, the ball where the policy learnt it)."""
@@ -179,8 +176,7 @@ class StubController:
         self._kick_committed: tuple[str, int] | None = None  # foot, when lined up
         self.last_action: Action | None = None
         self._detect_side = detect_side
-        self._side_check_s: float | None = 0.0 if detect_side else None
-        self._side_pixels = [0, 0]  # left, right
+        self._side = SideCheck(running=detect_side)
         self.mirrored: bool | None = None
         self._expect_mirrored: bool | None = None
 
@@ -208,8 +204,7 @@ class StubController:
         self._rise_pending = True
         self._expect_mirrored = expect_mirrored
         if self._detect_side and check_side:
-            self._side_check_s = 0.0
-            self._side_pixels = [0, 0]
+            self._side.start()
 
     def settle(self, time_ms: int) -> None:
         """Stand still for a moment before moving again (after a reset of the robot)."""
@@ -218,11 +213,7 @@ class StubController:
 
     def _side_check(self, dt: float, sensors: Sensors) -> dict[str, float]:
         """Stand and look left, then right; count the near goal's pixels below the horizon."""
-        assert self._side_check_s is not None
-        self._side_check_s += dt
-        slot = min(int(self._side_check_s / SIDE_LOOK_S), len(SIDE_LOOK_YAWS_RAD) - 1)
-        yaw = SIDE_LOOK_YAWS_RAD[slot]
-        looking_left = yaw > 0
+        yaw, over = self._side.advance(dt)
         neck = sensors.joints.get(self.kin.neck_motor)
         if sensors.image_bgr is not None and neck is not None and abs(neck - yaw) < 0.1:
             att = self.attitude.attitude
@@ -235,56 +226,20 @@ class StubController:
                 pelvis_height_m=self._pelvis_height_m,
             )
             pixels = goal_below_horizon(sensors.image_bgr, pose, self.kin.camera, margin_rad=0.09)
-            self._side_pixels[0 if looking_left else 1] += pixels
-        if self._side_check_s >= len(SIDE_LOOK_YAWS_RAD) * SIDE_LOOK_S:
-            self._finish_side_check()
+            self._side.count(yaw > 0, pixels)
+        if over:
+            self._set_mirrored(self._side.decide(self.world.pose, self.field.half_length_m))
         targets = self.walk.step(dt, 0.0, 0.0, 0.0, accel=sensors.accel, gyro=sensors.gyro)
         targets.update(self.kin.head_targets(yaw, SIDE_LOOK_PITCH_RAD))
         return targets
 
-    def _finish_side_check(self) -> None:
-        """Decide whether this team's pitch is mirrored.
-
-        HLVS gives starting poses as if the team played on the left half; the team on the right
-        is placed at the mirror image (x -> -x, yaw -> pi - yaw). A mirror image cannot be
-        reached by turning, so odometry only works in a frame turned by pi, where the mirrored
-        start pose is (x, -y, -yaw). The own goal is nearer than the other: if it shows up on
-        the other side than the team-file pose predicts, the pitch is mirrored.
-        """
-        self._side_check_s = None
-        left, right = self._side_pixels
-        if max(left, right) < SIDE_MIN_PIXELS:
-            logger.info(
-                "side check: no goal in sight (%d/%d px); keeping the start pose", left, right
-            )
+    def _set_mirrored(self, mirrored: bool | None) -> None:
+        """The side found (:mod:`robot.stub.side`; None: undecided, the start pose kept)."""
+        if mirrored is None:
             return
-        pose = self.world.pose
-        gx, gy = pose.to_relative(-self.field.half_length_m, 0.0)
-        predicted_left = math.atan2(gy, gx) > 0
-        seen_left = left > right
-        self.mirrored = predicted_left != seen_left
-        logger.info(
-            "side check: own goal on the %s (%d/%d px): %s",
-            "left" if seen_left else "right",
-            left,
-            right,
-            "mirrored pitch" if self.mirrored else "as in the team file",
-        )
-        if self.mirrored:
-            self.world.reset_pose(Pose(x_m=pose.x_m, y_m=-pose.y_m, yaw_rad=-pose.yaw_rad))
-
-    def _side_from_gamecontroller(self, on_left: bool) -> None:
-        """The league's GameController puts the TeamInfo of the team playing on the left first:
-        a team on the right is placed at the mirror image of its team-file poses."""
-        self._side_check_s = None
-        self.mirrored = not on_left
-        logger.info(
-            "side from the GameController: %s",
-            "right (mirrored pitch)" if self.mirrored else "left (as in the team file)",
-        )
-        if self.mirrored:
-            pose = self.world.pose
-            self.world.reset_pose(Pose(x_m=pose.x_m, y_m=-pose.y_m, yaw_rad=-pose.yaw_rad))
+        self.mirrored = mirrored
+        if mirrored:
+            self.world.reset_pose(turned(self.world.pose))
 
     def _moved_by_someone_else(self, joints: dict[str, float]) -> bool:
         return self._knees_away(joints, self._last_targets)
@@ -361,9 +316,9 @@ class StubController:
             if self._missing_since_ms is None
             else (sensors.time_ms - self._missing_since_ms) / 1000.0
         )
-        if self._side_check_s is not None and game.on_left is not None:
-            self._side_from_gamecontroller(game.on_left)
-        if self._side_check_s is not None and not game.penalised:
+        if self._side.running and game.on_left is not None:
+            self._set_mirrored(self._side.from_gamecontroller(game.on_left))
+        if self._side.running and not game.penalised:
             if sensors.time_ms >= self._settle_until_ms:
                 return self._remember(self._side_check(dt, sensors))
         action = decide(

@@ -30,8 +30,6 @@ LONG_CLASSES: dict[str, tuple[int, str]] = {
     "simulator/api/session.py::RobotSession": (
         458, "one robot's API session: sensor periods, requests applied, measurements "
         "built and their steady plan, all on the hot path of the step"),
-    "robot/stub/controller.py::StubController": (
-        430, "the stub robots' whole behaviour (look, walk, kick, get up) on one tick"),
 }
 LONG_FUNCTIONS: dict[str, tuple[int, str]] = {
     "envs/mjx_vector.py::MjxStandKickVector.__init__": (
