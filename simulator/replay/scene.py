@@ -53,6 +53,7 @@ GEOM_TYPES = {0: "plane", 2: "sphere", 3: "capsule", 4: "ellipsoid", 5: "cylinde
 MESH = 7  # a mesh (team robot models' visual parts) travels as its bounding box
 TEXTURE_ROLE_RGB = 1
 LOOK_PREFIX = "look:"
+JERSEY_PREFIX = "jersey:"  # simulator.world.jersey's materials
 
 
 def _round(values: Any, digits: int = 6) -> list[float]:
@@ -115,9 +116,11 @@ def _geom(model: mujoco.MjModel, i: int) -> GeomRecord:
     }
     material = model.material(matid).name if matid >= 0 else ""
     look = material.startswith(LOOK_PREFIX)
-    pattern = _pattern(model, matid) if matid >= 0 and not look else None
+    jersey = material.startswith(JERSEY_PREFIX)  # drawn in the shirt's mean colour
+    pattern = _pattern(model, matid) if matid >= 0 and not (look or jersey) else None
     if look:
         geom["texture"] = material
+    if look or jersey:
         geom["rgba"] = _round([*_mean_texel(model, matid), float(rgba[3])], 4)
     if pattern is not None:
         mean = [(a + b) / 2 for a, b in zip(*pattern["colors"], strict=True)]

@@ -17,8 +17,9 @@ from contracts import FieldGeometry, TeamColor
 from simulator.world.ball import BALL_GEOM, BALL_JOINT, ball_body, ball_damping
 from simulator.world.field import field_bodies
 from simulator.world.goal import goal_bodies
+from simulator.world.jersey import apply_jerseys, jersey_assets, jersey_material
 from simulator.world.look import Look, apply_look, look_assets, look_for
-from simulator.world.robots import robot_model
+from simulator.world.robots import RobotModel, robot_model
 from simulator.world.selfcollision import exclude_xml
 from simulator.world.types import RobotPlacement, robot_prefix
 
@@ -26,6 +27,11 @@ STATIC_BIT = 1 << 30
 BALL_BIT = 1 << 29
 MAX_ROBOTS = 29
 TEAM_RGBA = {TeamColor.RED: "0.85 0.12 0.1 1", TeamColor.BLUE: "0.1 0.25 0.9 1"}
+
+
+def _team_rgb(team: TeamColor) -> tuple[float, float, float]:
+    r, g, b, _ = (float(v) for v in TEAM_RGBA[team].split())
+    return (r, g, b)
 
 
 def robot_conaffinity(robots: int) -> int:
@@ -66,13 +72,18 @@ def scene_xml(
     for i, placement in enumerate(robots):
         model = robot_model(placement.model)
         bit = 1 << i
+        prefix = robot_prefix(placement.id)
+        jersey = isinstance(model, RobotModel)  # the built-in robots wear the team's jersey
         parts = model.mjcf(
-            prefix=robot_prefix(placement.id),
+            prefix=prefix,
             rgba=TEAM_RGBA[placement.id.team],
             contype=bit,
             conaffinity=robot_conaffinity(len(robots)),
             pose=(placement.x_m, placement.y_m, placement.yaw_rad),
+            jersey=jersey_material(prefix) if jersey else None,
         )
+        if jersey:
+            assets[jersey_material(prefix)] = jersey_assets(prefix)
         bodies.append(parts.body)
         excludes.append(exclude_xml(model, robot_prefix(placement.id)))
         if parts.assets:
@@ -114,6 +125,10 @@ def compile_scene(
         scene_xml(field, robots, physics_dt_s=physics_dt_s, look=look)
     )
     apply_look(model, look)
+    apply_jerseys(
+        model,
+        ((robot_prefix(p.id), p.id.number, _team_rgb(p.id.team)) for p in robots),
+    )
     linear, angular = ball_damping(field)
     adr = int(model.joint(BALL_JOINT).dofadr[0])
     model.dof_damping[adr : adr + 3] = linear

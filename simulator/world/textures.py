@@ -15,6 +15,9 @@ the scene's lights (:mod:`simulator.world.look`) make them brighter or darker.
 - **Ball**: five families of designs drawn on the sphere by direction (no texture seams at the
   cube edges): classic panels (12 pentagons, 20 hexagons), three-lobed marks, eight curved
   panels with coloured triangles, curved panels with crescents, and triads forming twelve rings.
+- **Jersey**: a robot's shirt in its team colour, cloth with a faint weave, its player number
+  in large white digits (as the league's jersey textures, e.g. ``protos/robots/RoboCupRobot``'s
+  ``RobotisJersey.proto``: a team-coloured shirt with the number on it).
 - **Background**: a scene around the pitch at infinity, one of seven kinds (open stadium,
   riverside towers, old town with a cathedral spire, city at sunset, domed chapel hall, modern
   government building with a lawn, meadow at dawn): a sky with a sun glow and clouds, the
@@ -106,6 +109,51 @@ def line_tile(*, seed: int, size_px: int) -> Image:
     shade = np.clip(shade, 0.8, 1.15)
     base = np.array([0.62, 0.65, 0.6])
     rgb = base * shade[..., None] * (1.0 + 0.02 * patches[..., None])
+    return _to_image(rgb)
+
+
+# Digits as 5 x 7 cells (rows top to bottom), the bold block figures of a shirt number
+_DIGITS = {
+    "0": ("01110", "11011", "11011", "11011", "11011", "11011", "01110"),
+    "1": ("00110", "01110", "11110", "00110", "00110", "00110", "11111"),
+    "2": ("01110", "11011", "00011", "00110", "01100", "11000", "11111"),
+    "3": ("11110", "00011", "00011", "01110", "00011", "00011", "11110"),
+    "4": ("00110", "01110", "11010", "11011", "11111", "00011", "00011"),
+    "5": ("11111", "11000", "11110", "00011", "00011", "11011", "01110"),
+    "6": ("01110", "11000", "11000", "11110", "11011", "11011", "01110"),
+    "7": ("11111", "00011", "00110", "00110", "01100", "01100", "01100"),
+    "8": ("01110", "11011", "11011", "01110", "11011", "11011", "01110"),
+    "9": ("01110", "11011", "11011", "01111", "00011", "00011", "01110"),
+}
+
+
+def number_mask(number: int, size_px: int) -> npt.NDArray[np.bool_]:
+    """A ``size_px`` square with ``number``'s digits set, centred, 0.7 of its height (narrower
+    for two digits or more, to fit 0.9 of its width); the digits' cells drawn as blocks, one
+    cell apart."""
+    text = str(number)
+    cell = max(1, min(int(size_px * 0.7) // 7, int(size_px * 0.9) // (len(text) * 6 - 1)))
+    width = (len(text) * 6 - 1) * cell
+    if width > size_px:
+        raise ValueError(f"number {number} does not fit a {size_px} px jersey")
+    mask = np.zeros((size_px, size_px), np.bool_)
+    top, left = (size_px - 7 * cell) // 2, (size_px - width) // 2
+    for k, digit in enumerate(text):
+        for row, bits in enumerate(_DIGITS[digit]):
+            for col, bit in enumerate(bits):
+                if bit == "1":
+                    y, x = top + row * cell, left + (k * 6 + col) * cell
+                    mask[y : y + cell, x : x + cell] = True
+    return mask
+
+
+def jersey_tile(*, number: int, team_rgb: RGB, size_px: int) -> Image:
+    """A ``size_px`` square of a team's shirt (albedo ``team_rgb`` with a faint weave) with
+    ``number`` in white (albedo 0.85) in the middle, upright in the image's rows."""
+    rng = np.random.default_rng(0x7E55 + number)
+    weave = 1.0 + 0.04 * _periodic_noise(rng, size_px, 0.7)
+    rgb = np.array(team_rgb) * weave[..., None]
+    rgb[number_mask(number, size_px)] = 0.85
     return _to_image(rgb)
 
 

@@ -182,9 +182,12 @@ def build_humanoid(
     contype: int,
     conaffinity: int,
     pose: tuple[float, float, float],
+    jersey: str | None = None,
 ) -> RobotMjcf:
     """The robot's body tree (root ``<prefix>/torso`` with a free joint, standing at ``pose`` =
-    (x, y, yaw) in the world frame), its actuators and sensors."""
+    (x, y, yaw) in the world frame), its actuators and sensors. ``jersey``: the material of the
+    team shirt, a plate on the chest and one on the back (:mod:`simulator.world.jersey`); None:
+    a white chest plate."""
     w = _Writer(model, prefix, contype, conaffinity)
     x, y, yaw = pose
     g = model.geometry
@@ -197,11 +200,23 @@ def build_humanoid(
     torso = w.geom(
         "torso", "torso", f'type="box" pos="0 0 {cz:.6g}" size="{_f(tx, ty, tz)}"', rgba, g.torso_kg
     )
-    chest = w.visual(
-        "chest",
-        f'type="box" pos="{_f(tx, 0, cz + tz * 0.3)}" size="{_f(tx * 0.05, ty * 0.6, tz * 0.35)}"',
-        "1 1 1 1",
-    )
+    if jersey is None:
+        chest = w.visual(
+            "chest",
+            f'type="box" pos="{_f(tx, 0, cz + tz * 0.3)}" '
+            f'size="{_f(tx * 0.05, ty * 0.6, tz * 0.35)}"',
+            "1 1 1 1",
+        )
+    else:
+        # a plate on each side, turned so that the texture's rows run down and the number
+        # reads from in front of it (x of the plate's frame out of the torso)
+        half = _f(ty * 0.8, tz * 0.8, tx * 0.04)
+        chest = "".join(
+            f'<geom name="{p}/visual:jersey_{side}" type="box" pos="{_f(sign * tx * 1.02, 0, cz)}" '
+            f'xyaxes="{axes}" size="{half}" material="{jersey}" mass="0" contype="0" '
+            f'conaffinity="0" group="1"/>'
+            for side, sign, axes in (("front", 1.0, "0 1 0 0 0 1"), ("back", -1.0, "0 -1 0 0 0 1"))
+        )
     marker = w.visual(
         "marker",
         f'type="cylinder" pos="0 0 {hr * 0.95:.6g}" size="{_f(hr * 0.6, hr * 0.08)}"',

@@ -135,9 +135,13 @@ class RobotModel(MotorLookup):
         contype: int,
         conaffinity: int,
         pose: tuple[float, float, float],
+        jersey: str | None = None,
     ) -> RobotMjcf:
+        """``jersey``: the material of the team shirt worn on the chest and back (None: a
+        white chest plate)."""
         from simulator.world.robots.humanoid import build_humanoid
 
         return build_humanoid(
-            self, prefix=prefix, rgba=rgba, contype=contype, conaffinity=conaffinity, pose=pose
+            self, prefix=prefix, rgba=rgba, contype=contype, conaffinity=conaffinity, pose=pose,
+            jersey=jersey,
         )

@@ -57,10 +57,11 @@ class TeamRobotModel(MotorLookup):
         contype: int,
         conaffinity: int,
         pose: tuple[float, float, float],
+        jersey: str | None = None,
     ) -> RobotMjcf:
         """The robot's body at ``pose`` (x, y, yaw), its servos and sensors, named by ``prefix``;
         collision geoms get ``contype``/``conaffinity``, the marker and the trunk's visuals the
-        team colour ``rgba``."""
+        team colour ``rgba``. ``jersey`` is not worn: a team model keeps its own meshes."""
         body = copy.deepcopy(self.template.body)
         x, y, yaw = pose
         body.set("pos", f"{x:.9g} {y:.9g} {self.standing_height_m:.9g}")
