@@ -98,6 +98,7 @@ def _geom_xml(geom: GeomRecord, material: str | None) -> str:
 def scene_xml(scene: SceneRecord) -> str:
     """An MJCF of shapes only (no joints, no physics) with one body per recorded body, in the
     recorded order, so that body ``i`` of the model is body ``i`` of every frame."""
+    from simulator.world.jersey import JERSEY_PREFIX, jersey_assets
     from simulator.world.look import light_xml, look_assets, look_from_summary
 
     bodies = scene["bodies"]
@@ -109,8 +110,14 @@ def scene_xml(scene: SceneRecord) -> str:
             '<texture name="sky" type="skybox" builtin="gradient" rgb1="0.55 0.7 0.9" '
             'rgb2="0.1 0.15 0.25" width="64" height="64"/>'
         ]
+    jerseys = sorted(
+        {g["texture"] for g in scene["geoms"] if g.get("texture", "").startswith(JERSEY_PREFIX)}
+    )
+    assets += [jersey_assets(name.removeprefix(JERSEY_PREFIX)) for name in jerseys]
     for i, geom in enumerate(scene["geoms"]):
         material = geom.get("texture") if scene.get("look") is not None else None
+        if geom.get("texture", "").startswith(JERSEY_PREFIX):
+            material = geom["texture"]
         pattern = geom.get("pattern")
         if pattern is not None:
             material = f"m{i}"
@@ -157,11 +164,14 @@ def scene_model(scene: SceneRecord) -> Any:
     """The compiled :func:`scene_xml` of ``scene``, with its look's textures and lights."""
     import mujoco
 
+    from simulator.world.jersey import apply_jerseys
     from simulator.world.look import apply_look, look_from_summary
+    from simulator.world.scene import robot_jerseys
 
     model = mujoco.MjModel.from_xml_string(scene_xml(scene))
     if scene.get("look") is not None:
         apply_look(model, look_from_summary(scene["look"]))
+    apply_jerseys(model, robot_jerseys((r["team"], r["number"]) for r in scene["robots"]))
     return model
 
 

@@ -8,12 +8,12 @@ the ball, the turf, the goals and its own non-adjacent links (the exclusion rule
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 
 import mujoco
 import numpy as np
 
-from contracts import FieldGeometry, TeamColor
+from contracts import FieldGeometry, RobotId, TeamColor
 from simulator.world.ball import BALL_GEOM, BALL_JOINT, ball_body, ball_damping
 from simulator.world.field import field_bodies
 from simulator.world.goal import goal_bodies
@@ -32,6 +32,17 @@ TEAM_RGBA = {TeamColor.RED: "0.85 0.12 0.1 1", TeamColor.BLUE: "0.1 0.25 0.9 1"}
 def _team_rgb(team: TeamColor) -> tuple[float, float, float]:
     r, g, b, _ = (float(v) for v in TEAM_RGBA[team].split())
     return (r, g, b)
+
+
+def robot_jerseys(
+    robots: Iterable[tuple[str, int]],
+) -> list[tuple[str, int, tuple[float, float, float]]]:
+    """The jerseys of robots given as (team colour value, number), as the match's world filled
+    them (prefix, number, team colour: :func:`simulator.world.jersey.apply_jerseys`)."""
+    return [
+        (robot_prefix(RobotId(TeamColor(team), number)), number, _team_rgb(TeamColor(team)))
+        for team, number in robots
+    ]
 
 
 def robot_conaffinity(robots: int) -> int:

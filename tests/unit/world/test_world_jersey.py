@@ -11,6 +11,7 @@ import pytest
 from contracts.ids import RobotId, TeamColor
 from robot.motion import SERVO_PID, standing_posture
 from simulator.replay.scene import scene_of
+from simulator.scene_model import scene_model
 from simulator.world import CameraRenderer, RobotPlacement, World
 from simulator.world.textures import _DIGITS, jersey_tile, number_mask
 
@@ -107,7 +108,9 @@ def test_an_opponent_finds_the_jerseys_and_reads_the_numbers(texture_seed: int) 
     assert _read_jerseys(image) == ["3", "2"]  # blue 3's front, blue 2's back
 
 
-def test_replays_draw_the_jerseys_in_the_shirts_colour() -> None:
+def test_replays_show_the_jerseys() -> None:
+    # hlvs render and the match video rebuild the scene from the replay: the shirts with their
+    # numbers (the viewer draws them in the shirt's mean colour)
     world = _scene(19)
     scene = scene_of(world.model, tuple(world.placements), world.field, world.look)
     jerseys = [g for g in scene["geoms"] if "/visual:jersey_" in g["name"]]
@@ -115,3 +118,10 @@ def test_replays_draw_the_jerseys_in_the_shirts_colour() -> None:
     for geom in jerseys:
         r, g, b, _ = geom["rgba"]
         assert (b > r) if geom["name"].startswith("blue") else (r > b)
+    model = scene_model(scene)
+    for name, number in (("jersey:blue_3", 3), ("jersey:red_1", 1)):
+        texid = int(model.texture(name).id)
+        adr, channels = int(model.tex_adr[texid]), int(model.tex_nchannel[texid])
+        texels = model.tex_data[adr : adr + 64 * 64 * channels].reshape(64, 64, channels)
+        white = texels[..., :3].min(-1) > 200
+        assert (white == number_mask(number, 64)).all()
