@@ -34,7 +34,7 @@ from apscheduler.schedulers.background import BackgroundScheduler
 from orchestrator import ScheduleError
 from orchestrator.config import Schedule, load_schedule, resolve_time
 from tournament.controls import abort_request
-from tournament.state import Ledger, ScheduledMatchState
+from tournament.state import Ledger, MatchRow, ScheduledMatchState
 
 log = logging.getLogger(__name__)
 S = ScheduledMatchState
@@ -237,6 +237,43 @@ def _stop_now(stop: threading.Event, wake: threading.Event) -> None:
     wake.set()
 
 
+def _scheduler(state: str, slots: int, running: RunningJobs,
+               wake: threading.Event) -> BackgroundScheduler:
+    """The job scheduler of the state file ``state``: ``slots`` matches played at once; the
+    jobs running kept in ``running``, ``wake`` set when one ended (its match may have a next
+    step now)."""
+    scheduler = BackgroundScheduler(
+        jobstores={"default": SQLAlchemyJobStore(url=f"sqlite:///{state}")},
+        executors={
+            "default": ThreadPoolExecutor(2),
+            "play": ThreadPoolExecutor(slots),
+        },
+        timezone=UTC,
+    )
+
+    def job_done(event: JobExecutionEvent) -> None:
+        if event.exception is not None:
+            log.error("job %s failed: %r", event.job_id, event.exception)
+        wake.set()
+
+    scheduler.add_listener(running.listen, EVENT_JOB_SUBMITTED | EVENT_JOB_EXECUTED
+                           | EVENT_JOB_ERROR | EVENT_JOB_MISSED)
+    scheduler.add_listener(job_done, EVENT_JOB_EXECUTED | EVENT_JOB_ERROR)
+    return scheduler
+
+
+def _print_changes(rows: list[MatchRow], last: dict[str, str]) -> None:
+    """Print each match whose state changed since ``last`` (updated), one line each."""
+    for row in rows:
+        if last.get(row.id) != row.state.value:
+            last[row.id] = row.state.value
+            print(
+                f"{datetime.now(UTC).isoformat(timespec='seconds')} {row.id}: "
+                f"{row.state.value} {row.note}".rstrip(),
+                flush=True,
+            )
+
+
 def run_schedule(
     schedule_path: str | Path,
     state_path: str | Path,
@@ -276,24 +313,8 @@ def run_schedule(
     if threading.current_thread() is threading.main_thread():
         for sig in (signal.SIGINT, signal.SIGTERM):
             signal.signal(sig, lambda *_: _stop_now(stop, wake))
-    scheduler = BackgroundScheduler(
-        jobstores={"default": SQLAlchemyJobStore(url=f"sqlite:///{state}")},
-        executors={
-            "default": ThreadPoolExecutor(2),
-            "play": ThreadPoolExecutor(schedule.simulator_slots),
-        },
-        timezone=UTC,
-    )
-
-    def job_done(event: JobExecutionEvent) -> None:
-        if event.exception is not None:
-            log.error("job %s failed: %r", event.job_id, event.exception)
-        wake.set()  # its match may have a next step now
-
     running = RunningJobs()
-    scheduler.add_listener(running.listen, EVENT_JOB_SUBMITTED | EVENT_JOB_EXECUTED
-                           | EVENT_JOB_ERROR | EVENT_JOB_MISSED)
-    scheduler.add_listener(job_done, EVENT_JOB_EXECUTED | EVENT_JOB_ERROR)
+    scheduler = _scheduler(state, schedule.simulator_slots, running, wake)
     quiet = _OncePerMinute()
     logging.getLogger("apscheduler.scheduler").addFilter(quiet)
     scheduler.start()
@@ -318,14 +339,7 @@ def run_schedule(
                 beaten = time.monotonic()
             reconcile(scheduler, ledger, state, running.ids())
             rows = ledger.rows()
-            for row in rows:
-                if last.get(row.id) != row.state.value:
-                    last[row.id] = row.state.value
-                    print(
-                        f"{datetime.now(UTC).isoformat(timespec='seconds')} {row.id}: "
-                        f"{row.state.value} {row.note}".rstrip(),
-                        flush=True,
-                    )
+            _print_changes(rows, last)
             if exit_when_done and all(row.state.final for row in rows):
                 break
             wake.wait(poll_s)

@@ -340,31 +340,36 @@ class StubController:
             if self.walk.walking or self._still_s < KICK_SETTLE_S or swaying:
                 targets = self.walk.step(dt, 0.0, 0.0, 0.0, accel=sensors.accel, gyro=sensors.gyro)
             else:
-                self.stats.kicks += 1
-                kick: KeyframeMotion | PolicyMotion
-                if self.kick_policy is not None and action.kick_foot == "right":
-                    self.stats.learned_kicks += 1
-                    logger.info("kicking with the learned policy (%s)", self.kick_policy.skill)
-                    kick = PolicyMotion(self.kick_policy)
-                    kick.sense(sensors.joints, sensors.accel, sensors.gyro)
-                else:
-                    pose = self.world.pose
-                    logger.info(
-                        "kicking with the %s foot from (%.2f, %.2f, %.2f) believed, ball at"
-                        " (%.2f, %.2f) ahead",
-                        action.kick_foot, pose.x_m, pose.y_m, pose.yaw_rad, *(ball or (0, 0)),
-                    )  # fmt: skip
-                    kick = KickMotion(
-                        foot=action.kick_foot, model=self.model, start=self._last_targets
-                    )
-                self._start(kick, "kick")
-                return self._remember(kick.step(dt))
+                return self._remember(self._kick(dt, sensors, action.kick_foot, ball))
         else:
             targets = self.walk.step(dt, *action.walk, accel=sensors.accel, gyro=sensors.gyro)
         targets.update(self._head(dt, ball, action, att.pitch_rad))
         return self._remember(targets)
 
     # --- parts ---------------------------------------------------------------------------------
+    def _kick(
+        self, dt: float, sensors: Sensors, foot: str, ball: tuple[float, float] | None
+    ) -> dict[str, float]:
+        """Start a kick with ``foot`` (the learned policy for the right foot, when the robot
+        has one; else the keyframe kick); its first targets."""
+        self.stats.kicks += 1
+        kick: KeyframeMotion | PolicyMotion
+        if self.kick_policy is not None and foot == "right":
+            self.stats.learned_kicks += 1
+            logger.info("kicking with the learned policy (%s)", self.kick_policy.skill)
+            kick = PolicyMotion(self.kick_policy)
+            kick.sense(sensors.joints, sensors.accel, sensors.gyro)
+        else:
+            pose = self.world.pose
+            logger.info(
+                "kicking with the %s foot from (%.2f, %.2f, %.2f) believed, ball at"
+                " (%.2f, %.2f) ahead",
+                foot, pose.x_m, pose.y_m, pose.yaw_rad, *(ball or (0, 0)),
+            )  # fmt: skip
+            kick = KickMotion(foot=foot, model=self.model, start=self._last_targets)
+        self._start(kick, "kick")
+        return kick.step(dt)
+
 
     def _rise(self, sensors: Sensors) -> None:
         """Ease into the stance as a motion (the model's ``rise_s``) when the knees are far

@@ -44,12 +44,6 @@ LONG_FUNCTIONS: dict[str, tuple[int, str]] = {
     "simulator/runtime.py::run_match": (
         117, "the simulator's composition root: the world, referee, API server, "
         "recorder and cameras built and torn down in one place"),
-    "robot/stub/controller.py::StubController.tick": (
-        109, "one control step of the stub robot: attitude, localisation, look, then the "
-        "motion chosen, in the order each needs the one before"),
-    "tournament/runner.py::run_schedule": (
-        105, "the scheduler's main loop: state restored, matches started and stopped on "
-        "signals, heartbeat and notices"),
 }
 
 
