@@ -8,6 +8,9 @@ own goals per match, falls per robot-minute of simulated time, wall seconds per 
 whole ``hlvs scrimmage``: start, game, stop and collection; images are built beforehand and not
 timed), and whether the targets hold (every match reaches PLAYING in both halves, goals in at
 least half of the matches, at most one own goal in ten matches, at most 180 s per match).
+``--red-image`` / ``--blue-image`` play a team's robots from another image (as ``hlvs
+scrimmage``'s options: a learned kick's image against the stub, say); ``matches_scored``
+counts the matches in which each team scored.
 """
 
 from __future__ import annotations
@@ -93,6 +96,10 @@ def _parse(argv: Sequence[str]) -> argparse.Namespace:
                         default="lockstep", help="stepping of the scrimmages (default lockstep)")
     parser.add_argument("--class", dest="field_class", choices=("kid", "adult"), default="kid",
                         help="field size and built-in robots (default kid)")
+    parser.add_argument("--red-image", default=None,
+                        help="image of the red robots (default: the project's stub image)")
+    parser.add_argument("--blue-image", default=None,
+                        help="image of the blue robots (default: the project's stub image)")
     parser.add_argument("--json", action="store_true", help="print only the JSON document")
     args = parser.parse_args(list(argv))
     if args.matches < 1:
@@ -102,9 +109,11 @@ def _parse(argv: Sequence[str]) -> argparse.Namespace:
 
 def play_one(*, seed: int, out: Path, players: int | None,
              stop: threading.Event | None = None, stepping: str = "lockstep",
-             field_class: str = "kid") -> MatchFigures:
-    """One default scrimmage with ``seed`` played into ``out`` on the ``field_class`` field;
-    its figures. ``stop`` set: the match stops (and is collected) as on SIGINT."""
+             field_class: str = "kid", red_image: str | None = None,
+             blue_image: str | None = None) -> MatchFigures:
+    """One default scrimmage with ``seed`` played into ``out`` on the ``field_class`` field
+    (a team's robots from ``red_image`` / ``blue_image``, else the stub image); its figures.
+    ``stop`` set: the match stops (and is collected) as on SIGINT."""
     from orchestrator import add_scrimmage_arguments as add_arguments
     from orchestrator.config.loader import load_game
     from orchestrator.engine import connect
@@ -121,6 +130,9 @@ def play_one(*, seed: int, out: Path, players: int | None,
             "--class", field_class]
     if players is not None:
         argv += ["--players", str(players)]
+    for option, image in (("--red-image", red_image), ("--blue-image", blue_image)):
+        if image is not None:
+            argv += [option, image]
     args = scrim.parse_args(argv)
     started = time.monotonic()
     request = ScrimmageRequest.from_options(args)
@@ -169,6 +181,10 @@ def summarize(matches: list[MatchFigures]) -> dict[str, Any]:
         "shots_per_match": per_match(sum(sum(p.shots.values()) for p in played)),
         "goals_per_match": per_match(sum(sum(p.goals.values()) for p in played)),
         "matches_with_goals_fraction": round(with_goals / count, 3),
+        "matches_scored": {
+            team: sum(1 for m in matches if m.score is not None and m.score.get(team, 0) > 0)
+            for team in ("red", "blue")
+        },
         "own_goals": own_goals,
         "own_goals_per_match": per_match(own_goals),
         "falls_per_robot_minute": round(
@@ -187,7 +203,8 @@ def summarize(matches: list[MatchFigures]) -> dict[str, Any]:
 
 
 def run(*, matches: int, seed: int, players: int | None, folder: Path,
-        quiet: bool, stepping: str = "lockstep", field_class: str = "kid") -> dict[str, Any]:
+        quiet: bool, stepping: str = "lockstep", field_class: str = "kid",
+        red_image: str | None = None, blue_image: str | None = None) -> dict[str, Any]:
     """Play the scrimmages; SIGINT / SIGTERM stop the one playing and skip the rest (the
     summary covers the matches played so far, the interrupted one included)."""
     from orchestrator import stop_on_signals
@@ -196,7 +213,8 @@ def run(*, matches: int, seed: int, players: int | None, folder: Path,
     with stop_on_signals() as stop:
         for i in range(matches):
             figure = play_one(seed=seed + i, out=folder / f"match-{i + 1}", players=players,
-                              stop=stop, stepping=stepping, field_class=field_class)
+                              stop=stop, stepping=stepping, field_class=field_class,
+                              red_image=red_image, blue_image=blue_image)
             figures.append(figure)
             if not quiet:
                 print(json.dumps(figure.to_json()), file=sys.stderr)
@@ -206,6 +224,7 @@ def run(*, matches: int, seed: int, players: int | None, folder: Path,
     result["interrupted"] = len(figures) < matches or stop.is_set()
     result["stepping"] = stepping
     result["field_class"] = field_class
+    result["images"] = {"red": red_image, "blue": blue_image}
     return result
 
 
@@ -215,12 +234,14 @@ def main(argv: Sequence[str]) -> int:
         if args.keep is not None:
             result = run(matches=args.matches, seed=args.seed, players=args.players,
                          folder=args.keep, quiet=args.json, stepping=args.stepping,
-                         field_class=args.field_class)
+                         field_class=args.field_class, red_image=args.red_image,
+                         blue_image=args.blue_image)
         else:
             with tempfile.TemporaryDirectory(prefix="hlvs-bench-scrimmage-") as folder:
                 result = run(matches=args.matches, seed=args.seed, players=args.players,
                              folder=Path(folder), quiet=args.json, stepping=args.stepping,
-                             field_class=args.field_class)
+                             field_class=args.field_class, red_image=args.red_image,
+                             blue_image=args.blue_image)
     except OrchestratorError as exc:
         print(json.dumps({"bench": "scrimmage", "error": str(exc)}))
         return exc.exit_code
