@@ -13,11 +13,12 @@ from robot.learned.motion import PolicyMotion
 from robot.learned.policy import Policy, PolicyFileError, load_policy, save_policy
 
 if TYPE_CHECKING:
-    from robot.learned.policy import KICK_BALL_AHEAD_M, KICK_BALL_RIGHT_M
+    from robot.learned.policy import KICK_BALL_AHEAD_M, KICK_BALL_RIGHT_M, LEARNT_SERVO_PID
 
 __all__ = [
     "KICK_BALL_AHEAD_M",
     "KICK_BALL_RIGHT_M",
+    "LEARNT_SERVO_PID",
     "Policy",
     "PolicyFileError",
     "PolicyMotion",
@@ -28,5 +29,5 @@ __all__ = [
 
 if not TYPE_CHECKING:
     __getattr__, __dir__ = lazy_exports(__name__, {
-        "robot.learned.policy": ("KICK_BALL_AHEAD_M", "KICK_BALL_RIGHT_M"),
+        "robot.learned.policy": ("KICK_BALL_AHEAD_M", "KICK_BALL_RIGHT_M", "LEARNT_SERVO_PID"),
     })

@@ -15,14 +15,15 @@ import numpy as np
 import numpy.typing as npt
 
 from contracts import GameState, Pose, field_for
-from robot.learned import Policy, PolicyMotion
+from robot.learned import Policy
 from robot.learned.policy import KICK_BALL_AHEAD_M
-from robot.motion import AttitudeFilter, GetUpMotion, KickMotion, WalkEngine, kinematics
+from robot.motion import SERVO_PID, AttitudeFilter, GetUpMotion, KickMotion, WalkEngine, kinematics
 from robot.motion.imu import GRAVITY_M_S2, GyroBias
 from robot.motion.keyframes import Keyframe, KeyframeMotion
 from robot.motion.posture import standing_posture
 from robot.motion.walk import default_walk_params
 from robot.stub.behaviour import Action, Field, GameInfo, Role, decide
+from robot.stub.learned_kick import LearnedKick
 from robot.stub.perception import (
     BallSighting,
     CameraPose,
@@ -168,7 +169,7 @@ class StubController:
         self._upright_since_fall = True
         self._tilted_s = 0.0
         self._forward_gravity = 0.0  # accelerometer x, low-passed with LYING_SIDE_TAU_S
-        self._motion: KeyframeMotion | PolicyMotion | None = None
+        self._motion: KeyframeMotion | LearnedKick | None = None
         self._motion_kind = ""
         self._last_targets: dict[str, float] = {}
         self._missing_since_ms: int | None = None
@@ -179,6 +180,11 @@ class StubController:
         self._side = SideCheck(running=detect_side)
         self.mirrored: bool | None = None
         self._expect_mirrored: bool | None = None
+
+    @property
+    def servo_pid(self) -> tuple[float, float, float]:
+        """The servo gains (P, I, D) every motor should have now (a learned kick's its own)."""
+        return self._motion.servo_pid if isinstance(self._motion, LearnedKick) else SERVO_PID
 
     @property
     def busy(self) -> str:
@@ -289,7 +295,7 @@ class StubController:
             self._rise_pending = False
             self._rise(sensors)
         if self._motion is not None:
-            if isinstance(self._motion, PolicyMotion):
+            if isinstance(self._motion, LearnedKick):
                 self._motion.sense(sensors.joints, sensors.accel, sensors.gyro)
             targets = self._motion.step(dt)
             if self._motion.done:
@@ -353,12 +359,12 @@ class StubController:
         """Start a kick with ``foot`` (the learned policy for the right foot, when the robot
         has one; else the keyframe kick); its first targets."""
         self.stats.kicks += 1
-        kick: KeyframeMotion | PolicyMotion
+        kick: KeyframeMotion | LearnedKick
         if self.kick_policy is not None and foot == "right":
             self.stats.learned_kicks += 1
             logger.info("kicking with the learned policy (%s)", self.kick_policy.skill)
-            kick = PolicyMotion(self.kick_policy)
-            kick.sense(sensors.joints, sensors.accel, sensors.gyro)
+            kick = LearnedKick(self.kick_policy, start=self._last_targets,
+                               stance=standing_posture(self.model))
         else:
             pose = self.world.pose
             logger.info(
@@ -483,7 +489,7 @@ class StubController:
         self._tilted_s = self._tilted_s + dt if tilt_rad > FALL_TILT_RAD else 0.0
         return self._tilted_s >= FALL_CONFIRM_S
 
-    def _start(self, motion: KeyframeMotion | PolicyMotion, kind: str) -> None:
+    def _start(self, motion: KeyframeMotion | LearnedKick, kind: str) -> None:
         self._motion = motion
         self._motion_kind = kind
         self.walk.reset()

@@ -113,6 +113,7 @@ class StubRobot:
             return_port=gc_return_port,
         )
         self._motors = kinematics(options.model).motor_names
+        self._servo_pid = SERVO_PID  # the gains last sent
         self._threads: list[threading.Thread] = []
         self._started = time.monotonic()
         self._crashed = False
@@ -194,6 +195,7 @@ class StubRobot:
                 periods["Camera"] = CAMERA_PERIOD_MS
             client.enable_many(periods)
             client.set_pids({name: SERVO_PID for name in self._motors})
+            self._servo_pid = SERVO_PID
             if self.options.behaviour is Behaviour.FLOOD:
                 self._spawn("flood-simulator", functools.partial(self._flood_simulator, client))
             return client
@@ -232,6 +234,14 @@ class StubRobot:
             game = self.gc.info() or GameInfo(phase=GameState.INITIAL)
             placement.follow(self.controller, game)
             targets = self.controller.tick(_sensors(measurement, image), game)
+            if self.controller.servo_pid != self._servo_pid:
+                # a learned kick plays with the gains it learnt with (robot.stub.learned_kick)
+                self._servo_pid = self.controller.servo_pid
+                try:
+                    client.set_pids({name: self._servo_pid for name in self._motors})
+                except ConnectionClosed as exc:
+                    logger.warning("lost the simulator connection: %s", exc)
+                    return None
             if game.phase is not previous_phase:
                 self._log_belief(game.phase)
                 previous_phase = game.phase

@@ -166,3 +166,18 @@ def test_settings_are_checked_and_shared_with_the_mjx_vector() -> None:
     with pytest.raises(EnvConfigError) as mjx_bad:
         MjxStandKickVector(2, ball_noise_m=0.5)  # checked before the world is built
     assert mjx_bad.value.field == "ball_noise_m"
+
+
+def test_the_policies_learn_with_the_servo_gains_the_robot_plays_them_with() -> None:
+    """The environment never sends MotorPID: its robot has the simulator's default gains, which
+    a robot playing the policy asks for (``robot.learned.LEARNT_SERVO_PID``)."""
+    from robot.learned import LEARNT_SERVO_PID
+
+    env = _make()
+    env.reset(seed=3)
+    env.step(env.action_space.sample())
+    world = env.session.world
+    assert world is not None
+    assert set(world.motors.p.tolist()) == {LEARNT_SERVO_PID[0]}
+    assert LEARNT_SERVO_PID == (10.0, 0.0, 0.0)
+    env.close()

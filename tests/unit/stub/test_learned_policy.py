@@ -9,11 +9,20 @@ import pytest
 
 from contracts.gamecontroller import GameState
 from contracts.geometry import Pose
-from robot.learned import Policy, PolicyFileError, PolicyMotion, load_policy, save_policy
+from robot.learned import (
+    LEARNT_SERVO_PID,
+    Policy,
+    PolicyFileError,
+    PolicyMotion,
+    load_policy,
+    save_policy,
+)
 from robot.learned.policy import KICK_BALL_AHEAD_M
+from robot.motion import SERVO_PID
 from robot.stub import StubConfigError, parse_args
 from robot.stub.behaviour import Field, GameInfo, Role, decide
 from robot.stub.controller import StubController
+from robot.stub.learned_kick import HOLD_S, PREPARE_S, RECOVER_S, LearnedKick
 from robot.stub.runner import _kick_policy
 
 MOTORS = tuple(f"M{i}" for i in range(20))
@@ -114,3 +123,40 @@ def test_a_bad_kick_policy_is_a_configuration_error(tmp_path: Path) -> None:
     with pytest.raises(StubConfigError) as err:
         _kick_policy(parse_args(["striker", "--kick-policy", str(tmp_path / "junk.npz")]))
     assert err.value.field == "--kick-policy" and "junk.npz" in err.value.value
+
+
+def test_the_learned_kick_plays_the_policy_from_the_stance_and_returns_to_it() -> None:
+    policy = make_policy(duration_s=0.2)
+    stance = dict.fromkeys(MOTORS, 0.1)
+    start = dict.fromkeys(MOTORS, 0.6)  # the head down at the ball, say
+    start["M0"] = 1.0
+    kick = LearnedKick(policy, start=start, stance=stance)
+    joints = dict.fromkeys(MOTORS, 0.0)
+    seen: list[tuple[float, int, dict[str, float]]] = []
+    gains = []
+    while not kick.done:
+        kick.sense(joints, (0.0, 0.0, 9.8), (0.0, 0.0, 0.0))
+        seen.append((kick.elapsed_s, kick.policy.decisions, kick.step(0.008)))
+        gains.append((kick.policy.done, kick.servo_pid))
+        assert len(seen) < 1000
+    # the learnt gains until the policy has played, the stub's own for the recovery
+    assert {g for done, g in gains if not done} == {LEARNT_SERVO_PID}
+    assert gains[-1][1] == SERVO_PID
+    ready = PREPARE_S + HOLD_S
+    before = [(d, t) for s, d, t in seen if s < ready - 0.008]
+    assert all(d == 0 for d, _ in before)  # no decision before the stance is reached and held
+    assert before[0][1]["M0"] < 1.0 and before[0][1]["M0"] > 0.1  # eased, not jumped
+    assert before[-1][1] == pytest.approx(stance)  # held
+    assert kick.policy.decisions == 7  # 0.2 s of 32 ms decisions
+    assert seen[-1][2] == pytest.approx(stance)  # back in the stance
+    assert kick.elapsed_s == pytest.approx(ready + 0.2 + RECOVER_S, abs=0.02)
+
+
+def test_the_stub_plays_a_learned_kick_with_the_servo_gains_it_learnt_with() -> None:
+    controller = StubController(role=Role.STRIKER, start_pose=Pose(x_m=0, y_m=0, yaw_rad=0),
+                                kick_policy=make_policy())  # fmt: skip
+    assert controller.servo_pid == SERVO_PID
+    controller._start(LearnedKick(make_policy(), start={}, stance={}), "kick")
+    assert controller.servo_pid == LEARNT_SERVO_PID != SERVO_PID
+    controller._finish_motion()
+    assert controller.servo_pid == SERVO_PID

@@ -1,0 +1,84 @@
+"""The striker's learned kick: the policy played as it learnt it.
+
+The kick policy (:mod:`robot.learned`) learnt in an environment whose robot stands in its
+walking stance, head straight, with the simulator's default servo gains
+(:data:`robot.learned.LEARNT_SERVO_PID`, P = 10), and whose episode ends with the policy
+(1.5 s). A striker lining up looks down at the ball at its feet (head pitched about 1 rad) and
+tunes its servos to P = 30 (:data:`robot.motion.SERVO_PID`): played from there, the policy's
+targets, chosen for a slower servo, threw the robot over within 1.3 s of every learned kick
+(in-process shots: torso tilted 80 degrees 1.2 s into the kick with P = 30, at most 10 with
+P = 10). :class:`LearnedKick` eases into the stance (:data:`PREPARE_S`) and holds it
+(:data:`HOLD_S`), plays the policy, then eases back into the stance (:data:`RECOVER_S`); the
+controller asks for the learnt gains while it plays (:attr:`StubController.servo_pid`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+from robot.learned import LEARNT_SERVO_PID, Policy, PolicyMotion
+from robot.motion import SERVO_PID
+from robot.motion.keyframes import Keyframe, KeyframeMotion
+
+PREPARE_S = 0.3  # ease into the stance the policy learnt from (the head straight)
+HOLD_S = 0.2  # ... and hold it
+RECOVER_S = 0.5  # after the policy, ease back into the stance
+
+
+class LearnedKick:
+    """A motion (call :meth:`sense` then :meth:`step` every control tick until :attr:`done`):
+    stance, policy, stance."""
+
+    def __init__(
+        self, policy: Policy, *, start: Mapping[str, float], stance: Mapping[str, float]
+    ) -> None:
+        self.policy = PolicyMotion(policy)
+        self._stance = dict(stance)
+        frames = [Keyframe(duration_s=PREPARE_S, targets=self._stance),
+                  Keyframe(duration_s=HOLD_S, targets=self._stance)]  # fmt: skip
+        self._prepare = KeyframeMotion(frames, start=dict(start))
+        self._recover: KeyframeMotion | None = None
+        self._last = dict(start)
+        self._elapsed_s = 0.0
+
+    @property
+    def done(self) -> bool:
+        return self._recover is not None and self._recover.done
+
+    @property
+    def recovering(self) -> bool:
+        """Whether the policy has played (easing back into the stance now)."""
+        return self._recover is not None
+
+    @property
+    def servo_pid(self) -> tuple[float, float, float]:
+        """The gains the motors should have now: the policy's until it has played."""
+        return SERVO_PID if self.recovering else LEARNT_SERVO_PID
+
+    @property
+    def elapsed_s(self) -> float:
+        return self._elapsed_s
+
+    def sense(
+        self, joints: Mapping[str, float], accel: Sequence[float] | None,
+        gyro: Sequence[float] | None,
+    ) -> None:  # fmt: skip
+        """The readings of this tick (the policy's, while it plays)."""
+        self.policy.sense(joints, accel, gyro)
+
+    def step(self, dt_s: float) -> dict[str, float]:
+        self._elapsed_s += dt_s
+        if not self._prepare.done:
+            out = self._prepare.step(dt_s)
+        elif not self.policy.done:
+            out = self.policy.step(dt_s)
+        else:
+            if self._recover is None:
+                frame = Keyframe(duration_s=RECOVER_S, targets=self._stance)
+                self._recover = KeyframeMotion([frame], start=self._last)
+            out = self._recover.step(dt_s)
+        self._last.update(out)
+        return dict(self._last)
+
+
+__all__ = ["HOLD_S", "PREPARE_S", "RECOVER_S", "LearnedKick"]
