@@ -232,11 +232,14 @@ def _kick_off_position(
             side = 1.0 if pose.y_m >= 0.0 else -1.0
             return Pose(x_m=-HALFWAY_MARGIN_M, y_m=side * outside, yaw_rad=0.0)
         return Pose(x_m=-outside, y_m=0.0, yaw_rad=0.0)
-    # facing along the kick-off pass, the ball a little short of the left foot's kick spot
+    # facing along the kick-off pass, the ball a little short of the kick spot of the left foot
+    # (of the right one for a robot that kicks with it alone: a learned right-foot kick; from
+    # the left foot's spot it side-stepped at the kick-off and struck the ball's right side)
     ax, ay = _kick_off_aim(field)
     direction = math.atan2(ay, ax)
     c, s = math.cos(direction), math.sin(direction)
-    ahead, left = field.kick_x_m + KICK_OFF_SHORT_M, field.foot_y_m
+    ahead = field.kick_x_m + KICK_OFF_SHORT_M
+    left = field.foot_y_m if "left" in field.kick_feet else -field.foot_y_m
     return Pose(x_m=-(c * ahead - s * left), y_m=-(s * ahead + c * left), yaw_rad=direction)
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +21,14 @@ from robot.learned import (
 from robot.learned.policy import KICK_BALL_AHEAD_M
 from robot.motion import SERVO_PID
 from robot.stub import StubConfigError, parse_args
-from robot.stub.behaviour import Field, GameInfo, Role, decide
+from robot.stub.behaviour import (
+    KICK_OFF_SHORT_M,
+    Field,
+    GameInfo,
+    Role,
+    _kick_off_position,
+    decide,
+)
 from robot.stub.controller import StubController
 from robot.stub.learned_kick import HOLD_S, PREPARE_S, RECOVER_S, LearnedKick
 from robot.stub.runner import _kick_policy
@@ -160,3 +168,18 @@ def test_the_stub_plays_a_learned_kick_with_the_servo_gains_it_learnt_with() -> 
     assert controller.servo_pid == LEARNT_SERVO_PID != SERVO_PID
     controller._finish_motion()
     assert controller.servo_pid == SERVO_PID
+
+
+def test_a_right_footed_kick_off_striker_places_the_ball_at_its_right_foot() -> None:
+    """In READY the kick-off striker stands with the ball short of its kick spot: the left
+    foot's for the stub, the right foot's for one whose learned kick plays with it alone (from
+    the left foot's spot it side-stepped at the kick-off and struck the ball's right side)."""
+    game = GameInfo(phase=GameState.READY, our_kick_off=True)
+    for feet, side in ((("left", "right"), 1.0), (("right",), -1.0)):
+        field = Field(half_length_m=4.5, centre_circle_m=0.75, foot_y_m=0.075,
+                      kick_x_m=KICK_BALL_AHEAD_M, kick_feet=feet)  # fmt: skip
+        spot = _kick_off_position(Role.STRIKER, game, field, None)
+        c, s = math.cos(spot.yaw_rad), math.sin(spot.yaw_rad)
+        ahead, left = c * -spot.x_m + s * -spot.y_m, -s * -spot.x_m + c * -spot.y_m  # the ball
+        assert ahead == pytest.approx(KICK_BALL_AHEAD_M + KICK_OFF_SHORT_M)
+        assert left == pytest.approx(side * 0.075)
