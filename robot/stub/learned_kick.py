@@ -8,8 +8,9 @@ tunes its servos to P = 30 (:data:`robot.motion.SERVO_PID`): played from there, 
 targets, chosen for a slower servo, threw the robot over within 1.3 s of every learned kick
 (in-process shots: torso tilted 80 degrees 1.2 s into the kick with P = 30, at most 10 with
 P = 10). :class:`LearnedKick` eases into the stance (:data:`PREPARE_S`) and holds it
-(:data:`HOLD_S`), plays the policy, then eases back into the stance (:data:`RECOVER_S`); the
-controller asks for the learnt gains while it plays (:attr:`StubController.servo_pid`).
+(:data:`HOLD_S`), plays the policy, then eases back into the stance (:data:`RECOVER_S`); it
+asks for the learnt gains until the policy has played and for the stub's own for the recovery
+(:attr:`LearnedKick.servo_pid`, which the stub's runner sends as MotorPID).
 """
 
 from __future__ import annotations
