@@ -209,13 +209,19 @@ def build_humanoid(
         )
     else:
         # a plate on each side, turned so that the texture's rows run down and the number
-        # reads from in front of it (x of the plate's frame out of the torso)
-        half = _f(ty * 0.8, tz * 0.8, tx * 0.04)
+        # reads from in front of it (x of the plate's frame out of the torso). The front one
+        # where the white chest plate was and no larger: the head camera looking down at the
+        # feet sees its top edge, and a taller one put red in the ring round a ball at the
+        # feet (the stub's ball finder lost it); the back one larger
+        plates = (
+            ("front", 1.0, "0 1 0 0 0 1", cz + tz * 0.3, _f(ty * 0.6, tz * 0.35, tx * 0.05)),
+            ("back", -1.0, "0 -1 0 0 0 1", cz, _f(ty * 0.75, tz * 0.6, tx * 0.05)),
+        )
         chest = "".join(
-            f'<geom name="{p}/visual:jersey_{side}" type="box" pos="{_f(sign * tx * 1.02, 0, cz)}" '
+            f'<geom name="{p}/visual:jersey_{side}" type="box" pos="{_f(sign * tx, 0, z)}" '
             f'xyaxes="{axes}" size="{half}" material="{jersey}" mass="0" contype="0" '
             f'conaffinity="0" group="1"/>'
-            for side, sign, axes in (("front", 1.0, "0 1 0 0 0 1"), ("back", -1.0, "0 -1 0 0 0 1"))
+            for side, sign, axes, z, half in plates
         )
     marker = w.visual(
         "marker",
