@@ -30,7 +30,7 @@ from robot.stub.behaviour import (
     decide,
 )
 from robot.stub.controller import StubController
-from robot.stub.learned_kick import HOLD_S, PREPARE_S, RECOVER_S, LearnedKick
+from robot.stub.learned_kick import HOLD_S, PLAY_S, PREPARE_S, RECOVER_S, LearnedKick
 from robot.stub.runner import _kick_policy
 
 MOTORS = tuple(f"M{i}" for i in range(20))
@@ -158,6 +158,13 @@ def test_the_learned_kick_plays_the_policy_from_the_stance_and_returns_to_it() -
     assert kick.policy.decisions == 7  # 0.2 s of 32 ms decisions
     assert seen[-1][2] == pytest.approx(stance)  # back in the stance
     assert kick.elapsed_s == pytest.approx(ready + 0.2 + RECOVER_S, abs=0.02)
+    # a policy longer than PLAY_S plays its first PLAY_S only
+    long_kick = LearnedKick(make_policy(duration_s=1.5), start=start, stance=stance)
+    while not long_kick.done:
+        long_kick.sense(joints, (0.0, 0.0, 9.8), (0.0, 0.0, 0.0))
+        long_kick.step(0.008)
+    assert long_kick.policy.elapsed_s == pytest.approx(PLAY_S, abs=0.009)
+    assert long_kick.elapsed_s == pytest.approx(ready + PLAY_S + RECOVER_S, abs=0.02)
 
 
 def test_the_stub_plays_a_learned_kick_with_the_servo_gains_it_learnt_with() -> None:
