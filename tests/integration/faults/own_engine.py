@@ -2,7 +2,9 @@
 pid file, socket and containerd (a namespace and a process of its own), so that a test may stop
 and restart it without touching the shared engine other tests' containers run on. Needs root.
 
-It must not fight the shared engine: no default bridge (``--bridge=none``) and no iptables
+It must not fight the shared engine: a default bridge of its own, made here (``--bridge``; with
+``--bridge=none`` an engine deletes the host's ``docker0`` as it starts, and the shared engine's
+default network is gone until that engine restarts), and no iptables
 rules of its own (``--iptables=false``: starting, an engine that writes iptables rules deletes
 and remakes the DOCKER chains, the shared engine's too). Without its rules, traffic between the
 containers of one of its bridges meets the host's ``FORWARD`` policy (the shared engine sets it
@@ -42,6 +44,7 @@ class OwnEngine:
         self.log_path = self.folder / "dockerd.log"
         self.process: subprocess.Popen[bytes] | None = None
         self._rules: list[list[str]] = []
+        self.bridge = f"hlvsown{os.getpid() % 100000}"  # at most 15 characters
         (self.folder / "daemon.json").write_text("{}")  # not the host's daemon.json
 
     @property
@@ -57,12 +60,29 @@ class OwnEngine:
             "--exec-root", str(self.folder / "run"),
             "--pidfile", str(self.folder / "docker.pid"),
             "-H", self.url,
-            "--bridge=none", "--iptables=false", "--ip6tables=false",
+            f"--bridge={self.bridge}", "--iptables=false", "--ip6tables=false",
             "--containerd-namespace", name, "--containerd-plugins-namespace", f"{name}-plugins",
             "--cgroup-parent", f"/{name}",
         ]
 
+    def _make_bridge(self) -> None:
+        """The engine's default bridge: a link with a private address of its own (the engine
+        reads its subnet from the link's address)."""
+        if subprocess.run(["ip", "link", "show", self.bridge], capture_output=True).returncode == 0:
+            return
+        used = subprocess.run(["ip", "-4", "route"], capture_output=True, text=True).stdout
+        third = next((n for n in range(200, 250) if f"10.251.{n}." not in used), None)
+        if third is None:
+            raise EngineDidNotStart("no free 10.251.x.0/24 subnet for the engine's bridge")
+        for argv in (["ip", "link", "add", self.bridge, "type", "bridge"],
+                     ["ip", "addr", "add", f"10.251.{third}.1/24", "dev", self.bridge],
+                     ["ip", "link", "set", self.bridge, "up"]):
+            done = subprocess.run(argv, capture_output=True, text=True)
+            if done.returncode != 0:
+                raise EngineDidNotStart(f"{' '.join(argv)}: {done.stderr.strip()}")
+
     def start(self, timeout_s: float = 60.0) -> None:
+        self._make_bridge()
         with self.log_path.open("ab") as log:
             self.process = subprocess.Popen(self._argv(), stdout=log, stderr=subprocess.STDOUT,
                                             start_new_session=True)
@@ -134,4 +154,5 @@ class OwnEngine:
                         container.remove(force=True)
         finally:
             self.stop()
+            subprocess.run(["ip", "link", "delete", self.bridge], capture_output=True)
             shutil.rmtree(self.folder, ignore_errors=True)

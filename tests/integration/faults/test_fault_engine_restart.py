@@ -58,6 +58,7 @@ def _project_images() -> list[str]:
 
 @pytest.fixture
 def engine(docker_client: docker.DockerClient) -> Iterator[OwnEngine]:
+    had_docker0 = Path("/sys/class/net/docker0").exists()
     own = OwnEngine()
     try:
         try:
@@ -68,6 +69,9 @@ def engine(docker_client: docker.DockerClient) -> Iterator[OwnEngine]:
         yield own
     finally:
         own.close()
+    # the shared engine keeps its default bridge (an engine started with --bridge=none deletes
+    # it, and every later container on the default network failed to start)
+    assert Path("/sys/class/net/docker0").exists() or not had_docker0
 
 
 def _match_objects(engine: OwnEngine, match_id: str) -> list[str]:
