@@ -21,14 +21,12 @@ import argparse
 import json
 import os
 import statistics
-import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
 from typing import Any
 
-from contracts import files
+from benchmarks.short_match import play, scrimmage_files
 from contracts.codec import to_data
 from contracts.match_results import AdmissionRecord, MatchResults
 
@@ -42,45 +40,20 @@ def _hog_command(processes: int) -> str:
             "\\nwhile True: pass')\"")
 
 
-def _files(folder: Path, *, match_id: str, red_command: str, cpus: float, half_s: float,
-           stepping: str, max_rtf: float) -> Path:
-    from orchestrator import add_scrimmage_arguments
-    from orchestrator.match import scrimmage
+def _play(work: Path, name: str, *, red_command: str, cpus: float, half_s: float,
+          stepping: str, max_rtf: float) -> MatchResults:
     from orchestrator.project_images import project_image
 
-    parser = argparse.ArgumentParser()
-    add_scrimmage_arguments(parser)
-    args = parser.parse_args([
-        "--match-id", match_id, "--half-duration", str(half_s), "--ready-duration", "5",
-        "--minimum-play", "0",
-        "--wait-before-ready", "1", "--grace", "1", "--red-image", project_image("team-base"),
-    ])
-    game = scrimmage.write_files(scrimmage.ScrimmageRequest.from_options(args), folder)
-    data = json.loads(game.read_text())
-    data["official"] = True
-    data["stepping"] = stepping
-    data["maximum_real_time_factor"] = max_rtf
-    data["limits"].update({"cpus": cpus, "memory_gb": 1})
-    game.write_text(json.dumps(data, indent=2))
+    match_id = f"bench-hog-{name}-{os.getpid()}"
+    folder = work / f"{name}-config"
+    game = scrimmage_files(folder, match_id=match_id, half_s=half_s, stepping=stepping,
+                           max_rtf=max_rtf, options=("--red-image", project_image("team-base")),
+                           fields={"official": True}, limits={"cpus": cpus, "memory_gb": 1})
     team = json.loads((folder / "team_red.json").read_text())
     for entry in team["players"].values():
         entry["dockerCmd"] = red_command
     (folder / "team_red.json").write_text(json.dumps(team, indent=2))
-    return game
-
-
-def _play(work: Path, name: str, *, red_command: str, cpus: float, half_s: float,
-          stepping: str, max_rtf: float) -> MatchResults:
-    match_id = f"bench-hog-{name}-{os.getpid()}"
-    game = _files(work / f"{name}-config", match_id=match_id, red_command=red_command,
-                  cpus=cpus, half_s=half_s, stepping=stepping, max_rtf=max_rtf)
-    out = work / name
-    done = subprocess.run([sys.executable, "-m", "hlvs", "match", str(game), "--out",
-                           str(out)], capture_output=True, text=True, timeout=900, check=False)
-    if done.returncode != 0:
-        raise SystemExit(f"hlvs bench hog: match {match_id} failed ({done.returncode}): "
-                         f"{done.stderr.strip().splitlines()[-1:]}")
-    return MatchResults.load(out / files.RESULTS)
+    return play("hog", game, work / name, match_id=match_id)
 
 
 def main(argv: list[str] | None = None) -> int:

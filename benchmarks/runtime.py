@@ -20,50 +20,21 @@ import argparse
 import json
 import os
 import statistics
-import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
 from typing import Any
 
-from contracts import files
+from benchmarks.short_match import play, scrimmage_files
 from contracts.match_results import MatchResults
-
-
-def _files(folder: Path, *, match_id: str, runtime: str, half_s: float, stepping: str,
-           max_rtf: float) -> Path:
-    from orchestrator import add_scrimmage_arguments
-    from orchestrator.match import scrimmage
-
-    parser = argparse.ArgumentParser()
-    add_scrimmage_arguments(parser)
-    args = parser.parse_args([
-        "--match-id", match_id, "--half-duration", str(half_s), "--ready-duration", "5",
-        "--minimum-play", "0", "--wait-before-ready", "1", "--grace", "1",
-    ])
-    game = scrimmage.write_files(scrimmage.ScrimmageRequest.from_options(args), folder)
-    data = json.loads(game.read_text())
-    data["stepping"] = stepping
-    data["maximum_real_time_factor"] = max_rtf
-    data.setdefault("limits", {})["robot_runtime"] = runtime
-    game.write_text(json.dumps(data, indent=2))
-    return game
 
 
 def _play(work: Path, name: str, *, runtime: str, half_s: float, stepping: str,
           max_rtf: float) -> MatchResults:
     match_id = f"bench-runtime-{name}-{os.getpid()}"
-    game = _files(work / f"{name}-config", match_id=match_id, runtime=runtime, half_s=half_s,
-                  stepping=stepping, max_rtf=max_rtf)
-    out = work / name
-    done = subprocess.run([sys.executable, "-m", "hlvs", "match", str(game), "--out", str(out),
-                           "--gpu", "off"], capture_output=True, text=True, timeout=900,
-                          check=False)
-    if done.returncode != 0:
-        raise SystemExit(f"hlvs bench runtime: match {match_id} failed ({done.returncode}): "
-                         f"{done.stderr.strip().splitlines()[-1:]}")
-    return MatchResults.load(out / files.RESULTS)
+    game = scrimmage_files(work / f"{name}-config", match_id=match_id, half_s=half_s,
+                           stepping=stepping, max_rtf=max_rtf, limits={"robot_runtime": runtime})
+    return play("runtime", game, work / name, match_id=match_id, match_args=("--gpu", "off"))
 
 
 def _loop(results: MatchResults) -> dict[str, Any]:

@@ -206,7 +206,7 @@ def test_function_level_and_face_imports_count() -> None:
     lazy face."""
     graph = build()
     # inside a function, through the lazy face of `orchestrator`: the module that defines it
-    assert "orchestrator.scrimmage_options" in graph.edges["benchmarks.hog"]
+    assert "orchestrator.scrimmage_options" in graph.edges["benchmarks.short_match"]
     assert "orchestrator.signals" in graph.edges["benchmarks.scrimmage"]
     # under TYPE_CHECKING
     assert "simulator.world.look" in graph.edges["simulator.replay.format"]
