@@ -18,9 +18,32 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+from typing import Any
 
 REPO = Path(__file__).resolve().parents[1]
 SEEDS = (19, 16, 9)  # a bright day, the pink dawn, the dim chapel hall
+
+
+def scene(texture_seed: int) -> Any:
+    """The README frames' world of ``texture_seed`` (match seed 7, the league's camera model):
+    red player 1 at (1.6, 0.5) facing the blue goal, blue player 1 at (3.9, -0.3) facing it.
+    Call after :func:`simulator.gl.choose_offscreen_gl`."""
+    from contracts.ids import RobotId, TeamColor
+    from simulator.world import RobotPlacement, World
+    from simulator.world.camera_model import CameraModel
+
+    placements = [
+        RobotPlacement(
+            id=RobotId(TeamColor.RED, 1), model="kid-default", x_m=1.6, y_m=0.5, yaw_rad=-0.12
+        ),
+        RobotPlacement(
+            id=RobotId(TeamColor.BLUE, 1), model="kid-default", x_m=3.9, y_m=-0.3, yaw_rad=3.0
+        ),
+    ]
+    return World.create(
+        field_class="kid", robots=placements, seed=7, texture_seed=texture_seed,
+        camera_model=CameraModel.league(7),
+    )  # fmt: skip
 
 
 def main(argv: list[str]) -> int:
@@ -33,29 +56,16 @@ def main(argv: list[str]) -> int:
     choose_offscreen_gl()
     import mujoco
 
-    from contracts.ids import RobotId, TeamColor
     from referee.snapshot import PlaceBall
     from robot.motion import standing_posture
     from simulator.png import write_png
     from simulator.recorder import Recorder
-    from simulator.world import RobotPlacement, World
-    from simulator.world.camera_model import CameraModel
 
-    red1 = RobotId(TeamColor.RED, 1)
-    placements = [
-        RobotPlacement(id=red1, model="kid-default", x_m=1.6, y_m=0.5, yaw_rad=-0.12),
-        RobotPlacement(
-            id=RobotId(TeamColor.BLUE, 1), model="kid-default", x_m=3.9, y_m=-0.3, yaw_rad=3.0
-        ),
-    ]
     args.out.mkdir(parents=True, exist_ok=True)
     env = dict(os.environ, PYTHONPATH=str(REPO))
     with tempfile.TemporaryDirectory() as tmp:
         for texture_seed in SEEDS:
-            world = World.create(
-                field_class="kid", robots=placements, seed=7, texture_seed=texture_seed,
-                camera_model=CameraModel.league(7),
-            )  # fmt: skip
+            world = scene(texture_seed)
             world.apply(PlaceBall(position=(2.8, 0.3, 0.07), velocity=(0.0, 0.0, 0.0)))
             posture = standing_posture()
             posture["Head"] = 0.1

@@ -39,27 +39,18 @@ def main(argv: list[str]) -> int:
     choose_offscreen_gl()
     import mujoco
     import numpy as np
+    from look_frames import scene
 
     from contracts.ids import RobotId, TeamColor
     from referee.snapshot import PlaceBall
     from robot.motion import standing_posture
-    from simulator.world import CameraRenderer, RobotPlacement, World
-    from simulator.world.camera_model import CameraModel
+    from simulator.world import CameraRenderer
     from simulator.world.look import BACKGROUNDS
 
     red1 = RobotId(TeamColor.RED, 1)
-    placements = [
-        RobotPlacement(id=red1, model="kid-default", x_m=1.6, y_m=0.5, yaw_rad=-0.12),
-        RobotPlacement(
-            id=RobotId(TeamColor.BLUE, 1), model="kid-default", x_m=3.9, y_m=-0.3, yaw_rad=3.0
-        ),
-    ]
     rows = []
     for seed in args.seeds:
-        world = World.create(
-            field_class="kid", robots=placements, seed=7, texture_seed=seed,
-            camera_model=CameraModel.league(7),
-        )  # fmt: skip
+        world = scene(seed)
         posture = standing_posture()
         posture["Head"] = 0.35
         for _ in range(60):
