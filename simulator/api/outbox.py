@@ -79,12 +79,14 @@ class Outbox:
         gets none)."""
         steady = prepared.steady
         if steady is not None:
-            if self._ports.sender is not None and (
-                steady.step.connection_changes == self._ports.connection_changes
-            ):
-                self._publish_steady(steady)
-                return
-            # without the I/O thread, or a client left since: robot by robot
+            if steady.step.connection_changes == self._ports.connection_changes:
+                if self._ports.sender is not None:
+                    self._publish_steady(steady)
+                    return
+                if not self._blocking:
+                    self._send_steady(steady)
+                    return
+            # blocking sends, or a client left since: robot by robot
             assert self._batch is not None  # (a steady step is only recorded with the batch)
             prepared = Prepared(steady.measurements(self._batch))
         jobs_all = []
@@ -125,6 +127,23 @@ class Outbox:
                 conn.owe()
         self.flush()  # anything queued before, in order
         sender.submit(partial(self._deliver_steady, steady, time.monotonic()))
+
+    def _send_steady(self, steady: SteadyValues) -> None:
+        """Without the I/O thread (plain lockstep): a steady step's frames written for every
+        robot at once and sent, each counted in its robot's quota, without a measurement per
+        robot (what :meth:`_deliver_steady` does on the I/O thread)."""
+        assert self._batch is not None
+        step = steady.step
+        time_ms, real_time = steady.time_ms, steady.real_time
+        now = time.monotonic()
+        admitted = self._admitted
+        for slot, conn, frame in zip(step.slots, step.conns, steady.frames(self._batch),
+                                     strict=True):  # fmt: skip
+            try:
+                conn.send(admitted(slot, frame, time_ms, real_time), now)
+            except ClientClosed as exc:
+                self._ports.drop(slot, exc.reason)
+        self.flush()
 
     def _send(
         self, slot: RobotSlot, conn: Connection, measurement: Measurement, now: float

@@ -1,7 +1,9 @@
 """Steady steps (every robot steady: the server builds the step without asking each session and
 the I/O thread frames it) give the clients the bytes of the robot-by-robot path, through every
 change that ends a steady run: a client enabling its sensors later, a warning, a second period,
-a removal, a client leaving. Real world, real sockets, the I/O thread; the step is driven here."""
+a removal, a client leaving. Real world, real sockets, with the I/O thread (which frames a steady
+step) and without it (the step thread sends a steady step's frames, as in plain lockstep); the step
+is driven here."""
 
 from __future__ import annotations
 
@@ -67,7 +69,10 @@ def _send_read(server: ApiServer, robot: RobotId, sock: socket.socket, frame: by
     assert conn is not None
     read = conn.stats.messages_in
     sock.sendall(frame)
-    wait_until(lambda: conn.stats.messages_in > read)
+    if server._sender is None:  # the step thread reads: serve the sockets meanwhile
+        wait_until(lambda: server.poll(0.001) or conn.stats.messages_in > read)
+    else:
+        wait_until(lambda: conn.stats.messages_in > read)
 
 
 class _Client:
@@ -87,14 +92,15 @@ class _Client:
             pass
 
 
-def _play(steady: bool, real_time_at: int = 1_700_000_000_000) -> tuple[
+def _play(steady: bool, real_time_at: int = 1_700_000_000_000, threaded: bool = True) -> tuple[
     dict[RobotId, list[bytes]], int
 ]:
-    """The scenario, in async stepping with the I/O thread; the frames each client received
-    and the number of steps built robot by robot. The real time is ``real_time_at`` plus the
-    world's time (both runs give the same bytes)."""
+    """The scenario, in async stepping with the I/O thread (``threaded``) or without it; the
+    frames each client received and the number of steps built robot by robot. The real time is
+    ``real_time_at`` plus the world's time (both runs give the same bytes)."""
     world = real_world(ROBOTS)
-    server, ports = local_server(world, ROBOTS, unix_ms=lambda: real_time_at + world.sim_time_ms)
+    server, ports = local_server(world, ROBOTS, unix_ms=lambda: real_time_at + world.sim_time_ms,
+                                 send_thread=threaded)  # fmt: skip
     built_each = 0
     each = ServerClass._prepare_each
 
@@ -140,6 +146,8 @@ def _play(steady: bool, real_time_at: int = 1_700_000_000_000) -> tuple[
             world.step()
             world.snapshot()
             server.publish(world.sim_time_ms)
+            if not threaded:
+                server.poll(0.0)  # (the step thread writes what a socket did not take)
         time.sleep(0.2)
         for client in clients.values():
             client.drain()
@@ -160,9 +168,10 @@ def _play(steady: bool, real_time_at: int = 1_700_000_000_000) -> tuple[
     ],
     ids=["same-head", "head-grows"],
 )
-def test_steady_steps_give_the_robot_by_robot_bytes(real_time_at: int) -> None:
-    steady, built_steady = _play(steady=True, real_time_at=real_time_at)
-    each, built_each = _play(steady=False, real_time_at=real_time_at)
+@pytest.mark.parametrize("threaded", [True, False], ids=["io-thread", "step-thread"])
+def test_steady_steps_give_the_robot_by_robot_bytes(real_time_at: int, threaded: bool) -> None:
+    steady, built_steady = _play(steady=True, real_time_at=real_time_at, threaded=threaded)
+    each, built_each = _play(steady=False, real_time_at=real_time_at, threaded=threaded)
     assert built_each == 60  # the reference: every step robot by robot
     assert 60 - built_steady >= 20  # steady steps in every quiet stretch
     assert steady.keys() == each.keys() and len(steady) == 2  # blue 1 left
