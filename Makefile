@@ -12,7 +12,7 @@ PYTEST_ARGS ?=
 # pytest-xdist workers for `make test` (tests/conftest.py says what may run at once); 0: one process
 TEST_WORKERS ?= 2
 
-.PHONY: cluster scrimmage test setup venv system engine postgres images lint typecheck clean-build web
+.PHONY: cluster scrimmage test setup venv system engine postgres gvisor images lint typecheck clean-build web
 
 # What lint and typecheck read: they run again only when one of these changed.
 CHECKED := pyproject.toml $(wildcard $(shell git ls-files --cached --others --exclude-standard '*.py' 2>/dev/null))
@@ -20,7 +20,7 @@ CHECKED := pyproject.toml $(wildcard $(shell git ls-files --cached --others --ex
 scrimmage: setup
 	$(HLVS) scrimmage --out matches/scrimmage
 
-test: setup postgres lint typecheck
+test: setup postgres gvisor lint typecheck
 	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadgroup --no-loadscope-reorder $(PYTEST_ARGS)
 
 setup: venv system engine images
@@ -57,6 +57,11 @@ engine:
 # Debian's PostgreSQL on 127.0.0.1 with a test role, for the service's tests (root only).
 postgres: system
 	@bash scripts/ensure-postgres.sh
+
+# gVisor's runsc registered with the engine, for the tests that play robots under it (root only;
+# without it they skip). Running containers are not touched.
+gvisor: engine
+	@bash scripts/ensure-gvisor.sh
 
 # Content-tagged images: rebuilt only when their inputs change. BASE_IMAGE=python:3.11-slim uses
 # a registry's base instead of the one made locally with mmdebstrap.

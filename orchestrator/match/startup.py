@@ -351,6 +351,8 @@ def _start_robot(
             "log_folder_bytes": folder.cap_bytes,
             "scratch_bytes": scratch.cap_bytes if scratch is not None else None,
             "read_only_root": True,
+            # the OCI runtime the robot ran under ("runsc": gVisor), None: the engine's default
+            "runtime": limits.robot_runtime or None,
             "console_bytes": layout.ROBOT_CONSOLE_BYTES,  # what the engine keeps of its output
             "api_rate_bit_s": applied.api_rate_bit if applied else None,
             "comm_rate_bit_s": applied.comm_rate_bit if applied else None,

@@ -154,3 +154,18 @@ def left_behind(client: docker.DockerClient, match_id: str) -> list[str]:
     mounts = Path("/proc/mounts").read_text().split("\n")
     found += [line for line in mounts if f"/logfs/{match_id}/" in line]
     return found
+
+
+# The module fixtures that play a hostile match play it twice: with the robots under the
+# engine's default runtime and under gVisor's runsc (registered by ``make test``).
+RUNTIMES = {"params": [None, "runsc"], "ids": ["default-runtime", "gvisor"]}
+
+
+def under_runtime(runtime: str | None, docker_client: docker.DockerClient,
+                  limits: dict[str, Any]) -> dict[str, Any]:
+    """``limits`` with ``robot_runtime`` set to ``runtime``; skips when the engine lacks it."""
+    if runtime is None:
+        return limits
+    if runtime not in docker_client.info().get("Runtimes", {}):
+        pytest.skip(f"the engine has no {runtime} runtime (see configs/README.md)")
+    return {**limits, "robot_runtime": runtime}

@@ -20,7 +20,14 @@ import pytest
 
 from orchestrator.match import logfs
 from orchestrator.match.layout import ROBOT_CONSOLE_BYTES
-from tests.integration.attack.conftest import REPO, Prepare, Prepared, left_behind
+from tests.integration.attack.conftest import (
+    REPO,
+    RUNTIMES,
+    Prepare,
+    Prepared,
+    left_behind,
+    under_runtime,
+)
 
 pytestmark = [pytest.mark.docker, pytest.mark.root]
 
@@ -28,13 +35,15 @@ LOG_FOLDER_GB = 0.05
 FLOOD_MB = 48
 
 
-@pytest.fixture(scope="module")
-def hoarder(prepare: Prepare, docker_client: docker.DockerClient
-            ) -> tuple[Prepared, Any, list[str]]:
-    """The match, and while it plays ``hlvs cleanup --match`` of ids that differ from its id
-    only in punctuation or spaces (the cleanup reports are kept in ``done.cleanups``)."""
+@pytest.fixture(scope="module", **RUNTIMES)
+def hoarder(request: pytest.FixtureRequest, prepare: Prepare,
+            docker_client: docker.DockerClient) -> tuple[Prepared, Any, list[str]]:
+    """The match (robots under the engine's default runtime, then under gVisor's runsc), and
+    while it plays ``hlvs cleanup --match`` of ids that differ from its id only in punctuation
+    or spaces (the cleanup reports are kept in ``done.cleanups``)."""
+    limits = under_runtime(request.param, docker_client, {"log_folder_gb": LOG_FOLDER_GB})
     match = prepare("nest=1500", "sparse=5", f"flood={FLOOD_MB}", half_s=5.0,
-                    game={"limits": {"log_folder_gb": LOG_FOLDER_GB}})
+                    game={"limits": limits})
     process = match.start()
     mount = logfs.state_dir() / "logfs" / logfs.safe_name(match.match_id) / "red-1"
     deadline = time.monotonic() + 120
