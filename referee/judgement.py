@@ -6,6 +6,7 @@ order; removals and cards are all applied, each robot at most once.
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from typing import Protocol
 
 from contracts import FieldGeometry, Pose, RobotId, TeamColor
@@ -27,6 +28,7 @@ from referee.rules.base import (
 from referee.snapshot import (
     PlaceBall,
     RefereeEvent,
+    SetLimp,
     TeleportRobot,
     Vec2,
     WorldCommand,
@@ -42,19 +44,42 @@ PENALTY_NAMES = {
 }
 
 
+@dataclass(slots=True)
+class PenaltyBook:
+    """The referee's records of the robots it removed, sent off or ignores."""
+
+    limp: set[RobotId] = field(default_factory=set)  # made limp by a removal, not yet revived
+    red_carded: set[RobotId] = field(default_factory=set)  # sent off for the rest of the game
+    ignored: set[RobotId] = field(default_factory=set)  # in the world, not in the configuration
+    carried: dict[RobotId, Vec2] = field(default_factory=dict)  # where each was last put
+    # put there again, still, at that time (:data:`SETTLE_MS`)
+    settling: dict[RobotId, tuple[int, Pose]] = field(default_factory=dict)
+
+    def revive_all(self) -> list[WorldCommand]:
+        """Every limp robot's limbs back, in the order of their names."""
+        commands: list[WorldCommand] = [
+            SetLimp(robot=r, limp=False) for r in sorted(self.limp, key=str)
+        ]
+        self.limp.clear()
+        return commands
+
+    def penalty_over(self, robot: RobotId) -> list[WorldCommand]:
+        """``robot``'s penalty is over: its limbs back if it was limp."""
+        if robot not in self.limp:
+            return []
+        self.limp.discard(robot)
+        return [SetLimp(robot=robot, limp=False)]
+
+
 class RefereeCore(Protocol):
     config: RefereeConfig
     field: FieldGeometry
     gc: GameController
     log: RefereeLog
-    limp: set[RobotId]
-    red_carded: set[RobotId]
-    ignored_robots: set[RobotId]
+    book: PenaltyBook
     ball_in_play: bool
     left_team: TeamColor
     set_play_spot: Vec2 | None  # where the set play in preparation placed the ball
-    carried: dict[RobotId, Vec2]  # where the referee last put each penalised robot
-    settling: dict[RobotId, tuple[int, Pose]]  # put there again at that time (SETTLE_MS)
 
     def emit(self, event: RefereeEvent) -> None: ...
 
@@ -105,8 +130,8 @@ def _known(ref: RefereeCore, robot: RobotId, snapshot: WorldSnapshot) -> bool:
     """Robots of the world that the configuration does not list are not judged."""
     if robot.number in ref.gc.teams[robot.team].robots:
         return True
-    if robot not in ref.ignored_robots:
-        ref.ignored_robots.add(robot)
+    if robot not in ref.book.ignored:
+        ref.book.ignored.add(robot)
         ref.log.warning(
             snapshot.sim_time_ms, f"{robot} is not in the team configuration; ignored."
         )
@@ -219,16 +244,16 @@ def penalize(
     if not _known(ref, robot, snapshot):
         return []
     info = ref.gc.robot(robot)
-    if info.penalty is not Penalty.NONE or robot in ref.red_carded:
+    if info.penalty is not Penalty.NONE or robot in ref.book.red_carded:
         return []
     ref.gc.penalize(robot, decision.penalty)
     others = [r.position for r in snapshot.robots if r.id != robot]
     taken = [(p[0], p[1]) for p in others] + occupied[len(snapshot.robots) :]
     pose = reentry_pose(ref, robot, snapshot, taken)
     occupied.append((pose.x_m, pose.y_m))
-    ref.carried[robot] = (pose.x_m, pose.y_m)
-    ref.settling[robot] = (snapshot.sim_time_ms + SETTLE_MS, pose)
-    ref.limp.add(robot)
+    ref.book.carried[robot] = (pose.x_m, pose.y_m)
+    ref.book.settling[robot] = (snapshot.sim_time_ms + SETTLE_MS, pose)
+    ref.book.limp.add(robot)
     name = PENALTY_NAMES.get(decision.penalty, decision.penalty.name)
     ref.log.info(snapshot.sim_time_ms, f"{name} penalty for {robot}: {decision.reason}.")
     ref.emit(
@@ -245,7 +270,7 @@ def penalize(
 
 def _card(ref: RefereeCore, decision: GiveCard, snapshot: WorldSnapshot) -> list[WorldCommand]:
     robot = decision.robot
-    if robot in ref.red_carded or not _known(ref, robot, snapshot):
+    if robot in ref.book.red_carded or not _known(ref, robot, snapshot):
         return []
     given = ref.gc.card(robot, decision.card)
     ref.log.info(snapshot.sim_time_ms, f"{given.value.capitalize()} card for {robot}: "
@@ -258,8 +283,8 @@ def _card(ref: RefereeCore, decision: GiveCard, snapshot: WorldSnapshot) -> list
     )
     if given is not Card.RED:
         return []
-    ref.red_carded.add(robot)
-    ref.limp.discard(robot)
+    ref.book.red_carded.add(robot)
+    ref.book.limp.discard(robot)
     return removal.red_card_commands(robot)
 
 
@@ -273,14 +298,14 @@ def penalised_robots(
     robots (``before`` this step and still) back on the field are judged (2436-2438)."""
     commands: list[WorldCommand] = []
     now = snapshot.sim_time_ms
-    for robot, (due_ms, pose) in list(ref.settling.items()):
+    for robot, (due_ms, pose) in list(ref.book.settling.items()):
         if now < due_ms:
             continue
-        del ref.settling[robot]
-        if ref.gc.robot(robot).penalty is not Penalty.NONE and robot not in ref.red_carded:
+        del ref.book.settling[robot]
+        if ref.gc.robot(robot).penalty is not Penalty.NONE and robot not in ref.book.red_carded:
             commands.append(TeleportRobot(robot=robot, pose=pose))
     still = before & frozenset(ref.gc.penalised())
-    for robot in removal.penalised_in_field(snapshot, still, ref.field, ref.carried):
+    for robot in removal.penalised_in_field(snapshot, still, ref.field, ref.book.carried):
         commands += penalised_back_in_field(ref, robot, snapshot)
     return commands
 
@@ -293,7 +318,7 @@ def penalised_back_in_field(
     referee sends the penalty again (hlvs_webots referee.py:1297-1299, 1435-1454)."""
     reason = "penalised robot re-entered the field"
     commands = _card(ref, GiveCard(robot, Card.YELLOW, reason), snapshot)
-    if robot in ref.red_carded:
+    if robot in ref.book.red_carded:
         return commands
     ref.gc.unpenalize(robot)
     occupied = [(r.position[0], r.position[1]) for r in snapshot.robots]

@@ -116,7 +116,7 @@ def place_set_play_ball(
             for robot in (r for r in close if r in penalised):
                 taken = [p for r, p in where.items() if r != robot]
                 pose = reentry_pose(ref, robot, snapshot, taken)
-                where[robot] = ref.carried[robot] = (pose.x_m, pose.y_m)
+                where[robot] = ref.book.carried[robot] = (pose.x_m, pose.y_m)
                 commands.append(TeleportRobot(robot=robot, pose=pose))
                 ref.log.info(now, f"{robot} (penalised) put at its re-entry spot again to place "
                              "the ball.")  # fmt: skip

@@ -1,15 +1,16 @@
-"""What the referee reports: the telemetry state dict, the match result, STATUS lines."""
+"""What the referee reports: the telemetry state dict, the match result, STATUS lines, who
+touched the ball."""
 
 from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Sequence
 
-from contracts import GameStateRecord, PenaltyRecord, PlayRecord, TeamColor, to_data
+from contracts import GameStateRecord, PenaltyRecord, PlayRecord, RobotId, TeamColor, to_data
 from referee.clock import Clock
 from referee.gamecontroller import GameController
 from referee.gamecontroller.machine import wire_seconds
-from referee.snapshot import RefereeEvent
+from referee.snapshot import RefereeEvent, WorldSnapshot
 
 COLORS = (TeamColor.RED, TeamColor.BLUE)
 
@@ -97,3 +98,20 @@ class StatusReporter:
             f"STATUS: state: STATE_{gc.state.name}, remaining time: "
             f"{gc.wire_secs_remaining()}",
         ]
+
+
+class TouchReporter:
+    """A line for each new toucher of the ball (a robot touching it again after another)."""
+
+    def __init__(self) -> None:
+        self._last_toucher: RobotId | None = None
+        self._last_touch_ms: int | None = None
+
+    def line(self, snapshot: WorldSnapshot) -> str | None:
+        toucher = snapshot.last_ball_toucher
+        if toucher is None or snapshot.last_ball_touch_ms == self._last_touch_ms:
+            return None
+        new = toucher != self._last_toucher or self._last_touch_ms is None
+        self._last_toucher = toucher
+        self._last_touch_ms = snapshot.last_ball_touch_ms
+        return f"Ball touched by {toucher}." if new else None

@@ -24,9 +24,6 @@ FUNCTION_LINES = 100
 
 # "path::Qualified.name": (lines today, why)
 LONG_CLASSES: dict[str, tuple[int, str]] = {
-    "referee/autoref.py::Referee": (
-        612, "the automatic referee: every rule it judges reads and changes one game state "
-        "(set plays' placement is already in referee.placement)"),
     "simulator/api/session.py::RobotSession": (
         458, "one robot's API session: sensor periods, requests applied, measurements "
         "built and their steady plan, all on the hot path of the step"),

@@ -157,7 +157,7 @@ def test_a_free_kick_spot_taken_by_robots_moves_the_ball_towards_the_attacked_go
         game.step((RED_FAR, BLUE_FAR), (0.0, 0.0, 0.07))
     from referee.rules.base import AwardSetPlay
 
-    game.ref._apply(  # noqa: SLF001 - a free kick, as the ball-holding rule awards it
+    game.ref.apply(  # a free kick, as the ball-holding rule awards it
         [AwardSetPlay(SecondaryState.DIRECT_FREEKICK, BLUE, (1.0, 2.0), "test")],
         snapshot(game.ms, (RED_FAR, BLUE_FAR), ball=(1.0, 2.0, 0.07)),
     )
@@ -228,7 +228,7 @@ def test_a_penalised_robot_back_on_the_field_gets_a_yellow_then_a_red_card() -> 
     game = Game()
     while game.ref.gc.state is not GameState.PLAYING:
         game.step((RED_FAR, BLUE_FAR), (0.0, 0.0, 0.07))
-    game.ref._apply(  # noqa: SLF001
+    game.ref.apply(
         [PenalizeRobot(R1, Penalty.PICKUP_OR_INCAPABLE, "test")],
         snapshot(game.ms, (RED_FAR, BLUE_FAR)),
     )
@@ -253,7 +253,7 @@ def test_a_penalised_robot_back_on_the_field_gets_a_yellow_then_a_red_card() -> 
     assert any(isinstance(c, TeleportRobot) and c.robot == R1 for c in commands)
     game.step((RED_FAR, BLUE_FAR), (0.0, 0.0, 0.07))
     info = game.ref.gc.robot(R1)
-    assert info.red_cards == 1 and R1 in game.ref.red_carded
+    assert info.red_cards == 1 and R1 in game.ref.book.red_carded
     assert [e.details.get("card") for e in game.ref.events if e.type == "card"] == [
         Card.YELLOW.value, Card.RED.value,
     ]  # fmt: skip
@@ -265,7 +265,7 @@ def test_a_removed_robot_is_put_on_its_spot_again_five_steps_later() -> None:
     game = Game()
     while game.ref.gc.state is not GameState.PLAYING:
         game.step((RED_FAR, BLUE_FAR), (0.0, 0.0, 0.07))
-    placed = game.ref._apply(  # noqa: SLF001
+    placed = game.ref.apply(
         [PenalizeRobot(R1, Penalty.PICKUP_OR_INCAPABLE, "test")],
         snapshot(game.ms, (RED_FAR, BLUE_FAR)),
     )
