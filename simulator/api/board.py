@@ -1,14 +1,16 @@
 """Every robot's usual position targets, from the I/O thread to the world in one write.
 
-With the I/O thread (async and pipelined stepping) nearly every request of a playing robot is the
-usual one: position targets for the motor names it sent before, read finite. Once a step has
-applied such a request from every connected robot (in one batched write:
-:class:`simulator.api.batch.StepBatch`), the server arms a :class:`TargetBoard`: one array of
-every robot's targets in the order of that write. From then on the I/O thread writes each usual
-request's values into its robot's span (:meth:`BoardSlot.post`) instead of queueing it, and the
-step thread writes the spans posted since the last step in one call (:meth:`TargetBoard.apply`)
-without looking at any session or connection queue: the Python work, and the memory it touches
-between two physics steps, of one robot's request is gone from the step thread.
+Nearly every request of a playing robot is the usual one: position targets for the motor names
+it sent before, read finite. Once a step has applied such a request from every connected robot
+(in one batched write: :class:`simulator.api.batch.StepBatch`), the server arms a
+:class:`TargetBoard`: one array of every robot's targets in the order of that write. From then on
+whoever reads the requests (the I/O thread in async and pipelined stepping, the step thread while
+it waits in plain lockstep) writes each usual request's values into its robot's span
+(:meth:`BoardSlot.post`) instead of queueing it, and the step thread writes the spans posted since
+the last step in one call (:meth:`TargetBoard.apply`) without looking at any session or
+connection queue: with the I/O thread the Python work, and the memory it touches between two
+physics steps, of one robot's request is gone from the step thread; without it what is left per
+robot is the span's write as the request is read.
 
 Anything else ends the board (:meth:`TargetBoard.end`) before the step's requests are applied
 robot by robot: a request of another kind or name list (queued as before and counted in
@@ -73,9 +75,10 @@ class BoardSlot:
         self.session = session
 
     def post(self, decoded: Sequence[Request], queue: list[Request]) -> None:
-        """I/O thread, under the lock: each usual request of ``decoded`` (in order) onto the
-        board while the connection's ``queue`` is empty; any other request, and everything
-        after it, into ``queue`` (the board ends at the next step)."""
+        """The reader (the I/O thread, or the step thread without it), under the lock: each
+        usual request of ``decoded`` (in order) onto the board while the connection's ``queue``
+        is empty; any other request, and everything after it, into ``queue`` (the board ends at
+        the next step)."""
         board = self.board
         for request in decoded:
             if (

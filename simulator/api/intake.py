@@ -3,9 +3,10 @@
 :class:`Intake` takes what each connected client sent and applies it in arrival order (later
 targets override earlier ones): the usual requests of every robot (the motor names of its
 previous one, robot active) in one batched write (:class:`~simulator.api.batch.StepBatch`), the
-others robot by robot. With the I/O thread, once a step applied the usual request of every
-connected robot, the target board is armed (:mod:`simulator.api.board`): the I/O thread posts
-the targets there and a step applies them with one write, until something ends it (a client
+others robot by robot. Once a step applied the usual request of every connected robot, the
+target board is armed (:mod:`simulator.api.board`): whoever reads the requests (the I/O thread,
+or the step thread in plain lockstep) posts the targets there and a step applies them with one
+write, until something ends it (a client
 comes or goes or fails, a robot is made limp, released or removed). Pipelined stepping detaches
 the requests first (:meth:`Intake.take`) and applies them a step later
 (:meth:`Intake.apply_taken`).
@@ -105,8 +106,8 @@ class Intake:
 
     def arm_board(self, every: EveryUsual) -> None:
         """Arm the target board after a step that wrote every connected robot's usual
-        targets (with the I/O thread and the world's limp and removed flags)."""
-        if self._ports.sender is None or self._batch is None or self._removed_flags is None:
+        targets (with the world's limp and removed flags)."""
+        if self._batch is None or self._removed_flags is None:
             return
         board = TargetBoard(
             [(conn, session, plan, values)

@@ -234,7 +234,7 @@ class ApiServer:
 
     def apply_requests(self, step_time_ms: int) -> None:
         """Read what is available, then apply every received request in arrival order.
-        While the target board is armed that is one write of what the I/O thread posted on it
+        While the target board is armed that is one write of what the reader posted on it
         (:mod:`simulator.api.board`); a step that applies the usual request of every connected
         robot arms it."""
         self._poll_before_step()

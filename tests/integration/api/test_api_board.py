@@ -2,7 +2,8 @@
 in one call) gives the world the motor targets of the robot-by-robot path, step by step, through
 everything that ends it: a robot that sends nothing for a while, another name list, an unknown
 motor, a robot made limp and released, a robot removed and back, a client leaving. Real world,
-real sockets, the I/O thread; the step is driven here."""
+real sockets, with the I/O thread and without it (the step thread reads and posts, as in plain
+lockstep); the step is driven here."""
 
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ from functools import partial
 from typing import Any
 
 import numpy as np
+import pytest
 
 from contracts.ids import RobotId, TeamColor
 from contracts.robot_api import messages_pb2 as pb
@@ -50,11 +52,12 @@ def _connected(server: ApiServer, robot: RobotId, connected: bool = True) -> boo
     return (server.connection(robot) is not None) is connected
 
 
-def _play(board: bool) -> tuple[list[np.ndarray], int]:
-    """The scenario; the world's motor targets after each step's requests are applied, and the
-    number of steps the board wrote."""
+def _play(board: bool, threaded: bool = True) -> tuple[list[np.ndarray], int]:
+    """The scenario, with the I/O thread reading the requests (``threaded``) or the step thread
+    (as in plain lockstep); the world's motor targets after each step's requests are applied,
+    and the number of steps the board wrote."""
     world = real_world(ROBOTS)
-    server, ports = local_server(world, ROBOTS)
+    server, ports = local_server(world, ROBOTS, send_thread=threaded)
     if not board:
         server._arm_board = lambda *args: None  # type: ignore[method-assign]
     written = 0
@@ -80,7 +83,10 @@ def _play(board: bool) -> tuple[list[np.ndarray], int]:
             assert conn is not None
             read = conn.stats.messages_in
             socks[robot].sendall(frame)
-            wait_until(lambda: conn.stats.messages_in > read)
+            if threaded:
+                wait_until(lambda: conn.stats.messages_in > read)
+            else:  # the step thread reads: serve the sockets meanwhile
+                wait_until(lambda: server.poll(0.001) or conn.stats.messages_in > read)
 
         red1, red2, blue1 = ROBOTS
         number = {robot: world.index.by_id[robot].number for robot in ROBOTS}
@@ -120,9 +126,10 @@ def _play(board: bool) -> tuple[list[np.ndarray], int]:
         server.close()
 
 
-def test_the_board_gives_the_world_the_robot_by_robot_targets() -> None:
-    with_board, written = _play(board=True)
-    each, never = _play(board=False)
+@pytest.mark.parametrize("threaded", [True, False], ids=["io-thread", "step-thread"])
+def test_the_board_gives_the_world_the_robot_by_robot_targets(threaded: bool) -> None:
+    with_board, written = _play(board=True, threaded=threaded)
+    each, never = _play(board=False, threaded=threaded)
     assert never == 0  # the reference: every step robot by robot
     assert written >= 30  # the board wrote in every quiet stretch
     assert len(with_board) == len(each) == STEPS
