@@ -19,7 +19,7 @@ from simulator.world.field import field_bodies
 from simulator.world.goal import goal_bodies
 from simulator.world.jersey import apply_jerseys, jersey_assets, jersey_material
 from simulator.world.look import Look, apply_look, look_assets, look_for
-from simulator.world.robots import RobotModel, robot_model
+from simulator.world.robots import robot_model
 from simulator.world.selfcollision import exclude_xml
 from simulator.world.types import RobotPlacement, robot_prefix
 
@@ -84,7 +84,7 @@ def scene_xml(
         model = robot_model(placement.model)
         bit = 1 << i
         prefix = robot_prefix(placement.id)
-        jersey = isinstance(model, RobotModel)  # the built-in robots wear the team's jersey
+        jersey = model.wears_jersey  # built-in robots, team models whose manifest says where
         parts = model.mjcf(
             prefix=prefix,
             rgba=TEAM_RGBA[placement.id.team],

@@ -113,6 +113,11 @@ class RobotModel(MotorLookup):
         return -g.hip_z_m + legs + g.ankle_height_m
 
     @property
+    def wears_jersey(self) -> bool:
+        """The built-in robots wear the team's jersey on the chest and the back."""
+        return True
+
+    @property
     def devices(self) -> DeviceNames:
         """The league's sample robot's names: ``<motor>S``, ``Accelerometer``, ``Gyro``."""
         return DeviceNames.league(

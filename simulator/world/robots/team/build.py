@@ -319,6 +319,7 @@ def _validate(spec: mujoco.MjSpec, manifest: Manifest) -> list[ModelProblem]:
     named: list[tuple[str, str]] = [(f"{i.where}/link", i.link) for i in imus_of(manifest)]
     named += [(f"/cameras/{i}/link", c.link) for i, c in enumerate(manifest.cameras)]
     named += [(f"/force_sensors/{k}", v) for k, v in manifest.force_sensors.items()]
+    named += [("/jersey/link", manifest.jersey.link)] if manifest.jersey is not None else []
     named += [(f"/parts ({part})", link) for link, part in manifest.parts.items()]
     named += [
         ("/hands/left", manifest.hands[0]),

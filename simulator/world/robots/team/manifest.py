@@ -70,6 +70,27 @@ class CameraEntry:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class JerseyPlate:
+    """One side of a team model's jersey: a plate centred at ``pos_m`` (link frame), ``size_m``
+    wide (along the link's y) and high (along its z)."""
+
+    pos_m: tuple[float, float, float]
+    size_m: tuple[float, float]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class JerseyEntry:
+    """Where a team model wears the team's jersey with the player number (the league's robots
+    wear a shirt texture per team colour and number, hlvs_webots
+    ``protos/robots/RoboCupRobot/RobotisJersey.proto``): plates fixed to ``link``, the front
+    facing the link's +x, the back its -x, the number upright along its +z."""
+
+    link: str
+    front: JerseyPlate | None
+    back: JerseyPlate | None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Manifest:
     """A validated ``robot_model.json``; paths are absolute."""
 
@@ -92,6 +113,7 @@ class Manifest:
     joint_armature: float | None = None
     joint_frictionloss: float | None = None
     imus: tuple[ImuEntry, ...] = ()  # every IMU, the first in ``imu_link``
+    jersey: JerseyEntry | None = None  # None: the robot wears no jersey
     extra: JSONObject = field(default_factory=dict)  # keys this build does not read
 
     @property
@@ -184,7 +206,10 @@ _KNOWN_KEYS = {
     "joint_frictionloss",
     "description",
     "standing_pose_rad",
+    "jersey",
 }
+_JOINT_KEYS = ("joint_damping", "joint_armature", "joint_frictionloss")
+JERSEY_MAX_M = 0.5  # the largest plate side, and the farthest a plate's centre from its link
 
 
 def load_manifest(folder_or_file: Path) -> Manifest:
@@ -289,9 +314,8 @@ def load_manifest(folder_or_file: Path) -> Manifest:
             r.problem(f"/standing_pose_rad/{key}", "not the name of a motor in /motors")
         elif isinstance(value, bool) or not isinstance(value, (int, float)):
             r.problem(f"/standing_pose_rad/{key}", f"{value!r} is not a number (rad)")
-    damping = _non_negative(r, raw, "joint_damping")
-    armature = _non_negative(r, raw, "joint_armature")
-    friction = _non_negative(r, raw, "joint_frictionloss")
+    damping, armature, friction = (_non_negative(r, raw, key) for key in _JOINT_KEYS)
+    jersey = _jersey(r, raw)
     if r.problems:
         raise ModelError(r.problems)
     manifest = Manifest(
@@ -314,6 +338,7 @@ def load_manifest(folder_or_file: Path) -> Manifest:
         joint_armature=None if armature is None else float(armature),
         joint_frictionloss=None if friction is None else float(friction),
         imus=imus,
+        jersey=jersey,
     )
     # devices.py reads the Manifest type this module defines: imported here, not at the top
     from simulator.world.robots.team.devices import device_name_problems
@@ -465,6 +490,59 @@ def _cameras(r: _Reader, raw: Mapping[str, object]) -> tuple[CameraEntry, ...]:
             )
         )
     return tuple(cameras)
+
+
+def _jersey(r: _Reader, raw: Mapping[str, object]) -> JerseyEntry | None:
+    """``jersey``: the link that wears it and its ``front`` and ``back`` plates (one at least)."""
+    entry = r.get(raw, "jersey", dict, "", required=False)
+    if entry is None:
+        return None
+    for key in sorted(set(entry) - {"link", "front", "back"}):
+        r.problem(f"/jersey/{key}", "unknown field; known fields: back, front, link")
+    link = r.get(entry, "link", str, "/jersey") or ""
+    if "front" not in entry and "back" not in entry:
+        r.problem("/jersey", "no plate; expected front, back or both")
+    front, back = (_plate(r, entry, side) for side in ("front", "back"))
+    return JerseyEntry(link=link, front=front, back=back)
+
+
+def _plate(r: _Reader, entry: Mapping[str, object], side: str) -> JerseyPlate | None:
+    p = f"/jersey/{side}"
+    plate = r.get(entry, side, dict, "/jersey", required=False)
+    if plate is None:
+        return None
+    for key in sorted(set(plate) - {"pos_m", "size_m"}):
+        r.problem(f"{p}/{key}", "unknown field; known fields: pos_m, size_m")
+    pos = r.get(plate, "pos_m", list, p)
+    size = r.get(plate, "size_m", list, p)
+    numbers = (int, float)
+    if pos is not None and not (
+        len(pos) == 3
+        and all(isinstance(v, numbers) and not isinstance(v, bool) for v in pos)
+        and all(math.isfinite(float(v)) and abs(float(v)) <= JERSEY_MAX_M for v in pos)
+    ):
+        r.problem(
+            f"{p}/pos_m",
+            f"{pos!r} is not [x, y, z] in metres, each within {JERSEY_MAX_M:g} of the link",
+        )
+        pos = None
+    if size is not None and not (
+        len(size) == 2
+        and all(isinstance(v, numbers) and not isinstance(v, bool) for v in size)
+        and all(math.isfinite(float(v)) and 0 < float(v) <= JERSEY_MAX_M for v in size)
+    ):
+        r.problem(
+            f"{p}/size_m",
+            f"{size!r} is not [width, height] in metres, each above 0 and at most "
+            f"{JERSEY_MAX_M:g}",
+        )
+        size = None
+    if pos is None or size is None:
+        return None
+    return JerseyPlate(
+        pos_m=(float(pos[0]), float(pos[1]), float(pos[2])),
+        size_m=(float(size[0]), float(size[1])),
+    )
 
 
 def _pair(r: _Reader, raw: Mapping[str, object], key: str) -> tuple[str, str]:

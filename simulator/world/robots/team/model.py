@@ -14,7 +14,7 @@ from simulator.world.robots.devices import DeviceNames
 from simulator.world.robots.model import CameraSpec, MotorLookup, MotorSpec, RobotMjcf
 from simulator.world.robots.team.build import PREFIX, Template, build_template
 from simulator.world.robots.team.devices import device_names
-from simulator.world.robots.team.manifest import Manifest, load_manifest
+from simulator.world.robots.team.manifest import JerseyEntry, Manifest, load_manifest
 from simulator.world.robots.team.servos import motor_spec
 from simulator.world.robots.team.source import load_spec_with_notes
 
@@ -44,6 +44,11 @@ class TeamRobotModel(MotorLookup):
         return device_names(self.manifest)
 
     @property
+    def wears_jersey(self) -> bool:
+        """Whether the manifest says where the robot wears the team's jersey."""
+        return self.manifest.jersey is not None
+
+    @property
     def standing_pose_rad(self) -> tuple[float, ...]:
         """Joint positions (``motor_names`` order) the robot stands in when placed."""
         pose = self.manifest.standing_pose_rad
@@ -61,7 +66,8 @@ class TeamRobotModel(MotorLookup):
     ) -> RobotMjcf:
         """The robot's body at ``pose`` (x, y, yaw), its servos and sensors, named by ``prefix``;
         collision geoms get ``contype``/``conaffinity``, the marker and the trunk's visuals the
-        team colour ``rgba``. ``jersey`` is not worn: a team model keeps its own meshes."""
+        team colour ``rgba``. The model keeps its own meshes; ``jersey`` (the material of the
+        team's shirt) is worn where the manifest's ``jersey`` says (:meth:`wears_jersey`)."""
         body = copy.deepcopy(self.template.body)
         x, y, yaw = pose
         body.set("pos", f"{x:.9g} {y:.9g} {self.standing_height_m:.9g}")
@@ -76,6 +82,8 @@ class TeamRobotModel(MotorLookup):
                     continue
                 geom.set("contype", str(contype))
                 geom.set("conaffinity", str(conaffinity))
+        if jersey is not None and self.manifest.jersey is not None:
+            _add_jersey(body, self.manifest.jersey, self.template.root_body, jersey)
         text = ET.tostring(body, encoding="unicode").replace(PREFIX, prefix)
         return RobotMjcf(
             body=text,
@@ -84,6 +92,29 @@ class TeamRobotModel(MotorLookup):
             assets=self.template.assets,
             asset_key=self.template.key,
         )
+
+
+JERSEY_HALF_THICKNESS_M = 0.002
+
+
+def _add_jersey(body: ET.Element, entry: JerseyEntry, root_link: str, material: str) -> None:
+    """The jersey's plates as visual boxes of ``material`` in the body of ``entry.link``: each
+    turned so that the texture's rows run down the link's z and the number reads from in front
+    of the plate (as the built-in robots' plates,
+    :func:`simulator.world.robots.humanoid.build_humanoid`)."""
+    name = f"{PREFIX}/torso" if entry.link == root_link else f"{PREFIX}/link:{entry.link}"
+    wearer = next(b for b in body.iter("body") if b.get("name") == name)
+    for side, plate, axes in (("front", entry.front, "0 1 0 0 0 1"),
+                              ("back", entry.back, "0 -1 0 0 0 1")):  # fmt: skip
+        if plate is None:
+            continue
+        width, height = plate.size_m
+        ET.SubElement(wearer, "geom", {
+            "name": f"{PREFIX}/visual:jersey_{side}", "type": "box",
+            "pos": " ".join(f"{v:.9g}" for v in plate.pos_m), "xyaxes": axes,
+            "size": f"{width / 2:.9g} {height / 2:.9g} {JERSEY_HALF_THICKNESS_M:g}",
+            "material": material, "mass": "0", "contype": "0", "conaffinity": "0", "group": "1",
+        })  # fmt: skip
 
 
 _CACHE: dict[Path, TeamRobotModel] = {}
