@@ -302,14 +302,20 @@ class Referee:
             )
         )
 
-    def _on_tick(self, tick: Tick, snapshot: WorldSnapshot) -> list[WorldCommand]:
+    def _released(self, robots: tuple[RobotId, ...], now: int) -> list[WorldCommand]:
+        """Robots whose penalty is over (served, or lifted as PLAYING begins): their motors
+        back, an event each."""
         commands: list[WorldCommand] = []
-        now = snapshot.sim_time_ms
-        for robot in tick.unpenalised:
+        for robot in robots:
             commands += self.book.penalty_over(robot)
             self.log.info(now, f"Penalty of {robot} is over.")
             self.emit(RefereeEvent(sim_time_ms=now, type="unpenalised", team=robot.team,
                                    player=robot.number))
+        return commands
+
+    def _on_tick(self, tick: Tick, snapshot: WorldSnapshot) -> list[WorldCommand]:
+        now = snapshot.sim_time_ms
+        commands = self._released(tick.unpenalised, now)
         if tick.auto_set:
             self.set_since_ms = now
             self.state_event(snapshot, "SET")
@@ -343,7 +349,7 @@ class Referee:
         commands: list[WorldCommand] = []
         if gc.state is GameState.SET and self.set_since_ms is not None:
             if now - self.set_since_ms >= self.config.timing.set_to_play_s * 1000.0:
-                gc.transition(GameState.PLAYING)
+                commands += self._released(gc.play(), now)
                 self.set_since_ms = None
                 self.ball_in_play = False
                 restriction = goal.Restriction.KICKOFF if gc.kickoff_team is not None else None

@@ -315,10 +315,13 @@ def penalised_back_in_field(
 ) -> list[WorldCommand]:
     """A penalised robot back on the field: a yellow card (a second one is a red card, which
     sends it off), else it is removed again with its penalty time counted anew, as the league's
-    referee sends the penalty again (hlvs_webots referee.py:1297-1299, 1435-1454)."""
+    referee sends the penalty again (hlvs_webots referee.py:1297-1299, 1435-1454). It sends the
+    penalty after a second yellow card too: the robot sent off carries a new INCAPABLE penalty
+    (34), not SUBSTITUTE, in the GameController's packet (1438-1448)."""
     reason = "penalised robot re-entered the field"
     commands = _card(ref, GiveCard(robot, Card.YELLOW, reason), snapshot)
     if robot in ref.book.red_carded:
+        ref.gc.penalize(robot, Penalty.PICKUP_OR_INCAPABLE)
         return commands
     ref.gc.unpenalize(robot)
     occupied = [(r.position[0], r.position[1]) for r in snapshot.robots]

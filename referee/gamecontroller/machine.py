@@ -99,6 +99,19 @@ class Tick:
     period_over: bool = False  # secs_remaining reached 0 while the clock ran
 
 
+def reset_penalties(teams: dict[TeamColor, TeamStatus]) -> tuple[RobotId, ...]:
+    """``AdvancedData.resetPenalties`` (``AdvancedData.java:342-365``): every penalty but
+    SUBSTITUTE lifted, a sent-off robot's too (its red card stays). Returns the robots."""
+    lifted = []
+    for color, team in teams.items():
+        for number, info in sorted(team.robots.items()):
+            if info.penalty not in (Penalty.NONE, Penalty.SUBSTITUTE):
+                info.penalty = Penalty.NONE
+                info.left_ms = 0
+                lifted.append(RobotId(color, number))
+    return tuple(lifted)
+
+
 class GameController:
     def __init__(
         self,
@@ -291,11 +304,19 @@ class GameController:
             self._end_set_play()
             self._timer_ms = 0
             self._remaining_ms = 0  # as the league's GameController shows a finished period
-            for team in self.teams.values():
-                for info in team.robots.values():
-                    if info.red_cards == 0:
-                        info.penalty = Penalty.NONE
-                        info.left_ms = 0
+            reset_penalties(self.teams)  # STATE:FINISH, SimulatorUpdateComponent.java:348-352
+
+    def play(self) -> tuple[RobotId, ...]:
+        """SET to PLAYING, as the league's referee commands it (``STATE:PLAY``, hlvs_webots
+        referee.py:2366-2368, 2451-2452): the league's GameController then lifts every penalty
+        but SUBSTITUTE, served or not, outside the penalty shoot-out
+        (``SimulatorUpdateComponent.java:337-346``: ``resetPenaltyTimes``, ``resetPenalties``),
+        so that a robot removed in READY or SET plays from the kick-off. Returns the robots
+        whose penalty was lifted."""
+        self.transition(GameState.PLAYING)
+        if self.phase is SecondaryState.PENALTYSHOOT:
+            return ()
+        return reset_penalties(self.teams)
 
     def _end_set_play(self) -> None:
         """A set play in preparation ends without EXECUTE (a goal, a dropped ball, the end of
@@ -375,13 +396,14 @@ class GameController:
 
     def unpenalize(self, robot: RobotId) -> None:
         info = self.robot(robot)
-        if info.red_cards:
-            return
         info.penalty = Penalty.NONE
         info.left_ms = 0
 
     def card(self, robot: RobotId, card: Card) -> Card:
-        """Record a card; 2 warnings make a yellow, 2 yellows a red. Returns the card given."""
+        """Record a card; 2 warnings make a yellow, 2 yellows a red, each count back to 0 as it
+        makes the next (``CardIncrease.java:28-64``). Returns the card given. A card leaves the
+        penalty as it is: the league's referee sends the penalty with the card and its
+        GameController keeps it, a red card's too (hlvs_webots referee.py:1438-1448)."""
         info = self.robot(robot)
         self.revision += 1
         if card is Card.WARNING:
@@ -394,10 +416,9 @@ class GameController:
             info.yellow_cards += 1
             if info.yellow_cards < 2:
                 return Card.YELLOW
+            info.yellow_cards = 0
             card = Card.RED
-        info.red_cards += 1
-        info.penalty = Penalty.SUBSTITUTE
-        info.left_ms = 0
+        info.red_cards = 1
         return Card.RED
 
     def set_goalkeeper(self, robot: RobotId) -> None:
@@ -441,7 +462,7 @@ class GameController:
         if not self.clock_paused:
             for color, team in self.teams.items():
                 for number, info in sorted(team.robots.items()):
-                    if info.penalty is Penalty.NONE or info.red_cards:
+                    if info.penalty in (Penalty.NONE, Penalty.SUBSTITUTE):
                         continue
                     info.left_ms -= dt_ms
                     if info.left_ms <= 0:

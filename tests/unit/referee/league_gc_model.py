@@ -27,7 +27,7 @@ INITIAL, READY, SET, PLAYING, FINISHED = 0, 1, 2, 3, 4
 NORMAL, PENALTYSHOOT, OVERTIME = 0, 1, 2
 INTERRUPTIONS = range(4, 10)  # DIRECT_FREEKICK .. THROW_IN
 NONE, SUBSTITUTE, MANUAL = 0, 14, 15
-PENALTY_TIME_S = {30: 30, 31: 30, 34: 30, 35: 60}  # Penalties.java:15-18
+PENALTY_TIME_S = {0: -1, 30: 30, 31: 30, 34: 30, 35: 60}  # Penalties.java:10, 15-18
 DROPBALL = 128
 
 
@@ -175,13 +175,19 @@ class LeagueGameController:
         self.when_state_began = self.get_time()
         self.state = SET
 
-    def play(self) -> None:  # state/Play.java
+    def play(self) -> None:  # STATE:PLAY, SimulatorUpdateComponent.java:337-346
         if self.state == PLAYING:
             return
-        if self.time_before_current_state != 0:
+        if self.time_before_current_state != 0:  # state/Play.java
             self.add_time_in_current_state()
         self.when_state_began = self.get_time()
         self.state = PLAYING
+        if self.sec_state != PENALTYSHOOT:  # resetPenaltyTimes, resetPenalties
+            for team in self.team:
+                for player in team.players:
+                    if player.penalty != SUBSTITUTE:
+                        player.penalty = NONE
+                    player.when_penalized = 0
 
     def finish(self) -> None:  # state/Finish.java
         if self.state == FINISHED:

@@ -151,11 +151,40 @@ def test_cards_escalate() -> None:
     assert gc.card(robot, Card.WARNING) is Card.WARNING
     assert gc.card(robot, Card.WARNING) is Card.YELLOW
     assert (gc.robot(robot).warnings, gc.robot(robot).yellow_cards) == (0, 1)
+    gc.penalize(robot, Penalty.PICKUP_OR_INCAPABLE)
     assert gc.card(robot, Card.YELLOW) is Card.RED
     info = gc.robot(robot)
-    assert info.red_cards == 1 and info.penalty is Penalty.SUBSTITUTE
-    gc.unpenalize(robot)
-    assert gc.robot(robot).penalty is Penalty.SUBSTITUTE  # a red card stays
+    # CardIncrease.java:47-50: the second yellow card is counted back to 0 as it makes the red
+    # one; the card leaves the penalty the referee sent (hlvs_webots referee.py:1438-1448)
+    assert (info.yellow_cards, info.red_cards) == (0, 1)
+    assert info.penalty is Penalty.PICKUP_OR_INCAPABLE
+
+
+def test_play_lifts_every_penalty_but_substitute() -> None:
+    """STATE:PLAY (hlvs_webots referee.py:2451-2452) makes the league's GameController lift
+    every penalty, served or not (SimulatorUpdateComponent.java:337-346, resetPenalties)."""
+    gc = make()
+    gc.transition(GameState.READY)
+    gc.transition(GameState.SET)
+    removed, sent_off, spare = RobotId(RED, 2), RobotId(BLUE, 1), RobotId(BLUE, 2)
+    gc.penalize(removed, Penalty.PICKUP_OR_INCAPABLE)
+    gc.penalize(sent_off, Penalty.PICKUP_OR_INCAPABLE)
+    gc.card(sent_off, Card.RED)
+    gc.penalize(spare, Penalty.SUBSTITUTE)
+    run(gc, 1.0)
+    assert gc.play() == (removed, sent_off)
+    assert gc.penalised() == (spare,)
+    assert gc.robot(sent_off).red_cards == 1
+
+
+def test_play_in_the_shootout_keeps_penalties() -> None:
+    gc = make()
+    gc.phase = SecondaryState.PENALTYSHOOT
+    gc.transition(GameState.SET)
+    robot = RobotId(RED, 2)
+    gc.penalize(robot, Penalty.PICKUP_OR_INCAPABLE)
+    assert gc.play() == ()
+    assert gc.penalised() == (robot,)
 
 
 def test_set_play_sub_phases_and_timing() -> None:
