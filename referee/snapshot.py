@@ -7,6 +7,7 @@ applies before the next step. Frame: see :mod:`contracts.field`. Angles in radia
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass, field
 from enum import Enum
 
@@ -39,7 +40,10 @@ class RobotState:
 
     ``ground_contacts`` and ``ball_contacts`` hold the body parts that touch the ground (turf) or
     the ball in this step; ``robot_contacts`` the other robots touched. ``hull_points`` are the XY
-    positions of the hand and foot solids (for the ball-holding rule). ``fallen`` is the
+    positions of the hand and foot solids (for the ball-holding rule): hands left, right, then
+    feet left, right. ``sole_outline`` is the rectangle the left foot's solids cover in the
+    foot's frame (x back, x front, y right, y left, m; the right foot mirrors it), from which
+    :meth:`sole_corners` places the soles' corners on the ground. ``fallen`` is the
     simulator's judgement that a non-foot part touches the ground or the torso is tilted more
     than 60 degrees.
     """
@@ -53,9 +57,26 @@ class RobotState:
     ball_contacts: frozenset[BodyPart] = frozenset()
     robot_contacts: frozenset[RobotId] = frozenset()
     hull_points: tuple[Vec2, ...] = ()
+    sole_outline: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
     fallen: bool = False
     limp: bool = False  # penalised: actuators off, sensors on
     removed: bool = False  # red card: out of the world
+
+    def sole_corners(self) -> tuple[Vec2, ...]:
+        """The XY corners of both soles (four each): a foot's ``sole_outline`` around its
+        position in ``hull_points``, turned by the robot's yaw (a standing robot's feet point
+        where its torso does); none without the feet's positions."""
+        if len(self.hull_points) < 4:
+            return ()
+        back, front, right, left = self.sole_outline
+        c, s = math.cos(self.yaw_rad), math.sin(self.yaw_rad)
+        corners = []
+        for (fx, fy), sides in zip(self.hull_points[2:4], ((right, left), (-left, -right)),
+                                   strict=True):  # fmt: skip
+            for dx in (back, front):
+                for dy in sides:
+                    corners.append((fx + c * dx - s * dy, fy + s * dx + c * dy))
+        return tuple(corners)
 
     @property
     def touches_ground_outside_feet(self) -> bool:

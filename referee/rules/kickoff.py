@@ -37,16 +37,20 @@ def judge_start(snapshot: WorldSnapshot, game: GameView) -> list[Decision]:
     must stand fully outside the field and fully on its own side of the halfway line, else it
     is removed (INCAPABLE), as the league's referee checks it then (hlvs_webots referee.py:
     1212-1228, ``check_start_position``, with 746-772). The league reads the contacts of the
-    feet with the ground (one on a line is on the field); here the torso and the feet and hands
+    feet with the ground, which Webots puts at the corners of the foot boxes (686-770; one on a
+    line is on the field, ``field.py`` ``point_inside``); here the soles' corners
+    (:meth:`~referee.snapshot.RobotState.sole_corners`), with the torso and the hands and feet
     (``hull_points``): one of them on the field, lines included, or beyond the middle of the
-    halfway line is enough."""
+    halfway line is enough. A robot at y 3.02 facing the field has its toes 5 cm further in,
+    on the touch line."""
     field = game.field
     half_line = field.line_width_m / 2.0
     decisions: list[Decision] = []
     for robot in snapshot.robots:
         if not game.active(robot):
             continue
-        points = [(robot.position[0], robot.position[1]), *robot.hull_points]
+        points = [(robot.position[0], robot.position[1]), *robot.hull_points,
+                  *robot.sole_corners()]  # fmt: skip
         sign = game.side_sign(robot.id.team)
         reason = None
         if any(abs(x) <= field.half_length_m and abs(y) <= field.half_width_m for x, y in points):

@@ -22,6 +22,7 @@ PARTS: tuple[BodyPart, ...] = tuple(BodyPart)
 PART_BIT = {part: 1 << i for i, part in enumerate(PARTS)}
 FOOT_BIT = PART_BIT[BodyPart.FOOT]
 HULL_BODIES = ("hand_L", "hand_R", "foot_L", "foot_R")
+SOLE_BAND_M = 0.01  # a foot's solids whose bottom is this close to its lowest touch the ground
 # what a robot geom can touch, for contact classification (0: anything else)
 KIND_TURF, KIND_BALL, KIND_ROBOT = 1, 2, 3
 KINDS = 4
@@ -56,6 +57,7 @@ class RobotIndex:
     position_slot: dict[str, int]  # position sensor's device name -> slot (as motor_slot)
     imus: tuple[tuple[int, int], ...]  # sensordata addresses (accelerometer, gyro) per IMU
     imu_sensors: dict[str, int]  # accelerometer's or gyro's device name -> address (3 values)
+    sole_outline: tuple[float, float, float, float]  # RobotState.sole_outline
 
 
 @dataclass(frozen=True, slots=True)
@@ -138,6 +140,37 @@ def _robot_index(
         position_slot={name: i for i, name in enumerate(devices.position_sensors)},
         imus=imus,
         imu_sensors=imu_sensors,
+        sole_outline=sole_outline(model, model.body(f"{prefix}/{HULL_BODIES[2]}").id),
+    )
+
+
+def sole_outline(model: mujoco.MjModel, foot_body: int) -> tuple[float, float, float, float]:
+    """The rectangle (x back, x front, y right, y left) the colliding solids of ``foot_body``
+    that reach the ground cover in its frame (those whose bottom is within :data:`SOLE_BAND_M`
+    of the lowest): each geom's bounding box (``geom_aabb``) turned into the body's frame.
+    The league reads the feet's contact points with the ground (hlvs_webots referee.py:
+    686-770), where Webots puts them at the corners of its robots' foot boxes."""
+    boxes = []
+    turn = np.zeros(9)
+    for geom in range(model.ngeom):
+        if model.geom_bodyid[geom] != foot_body:
+            continue
+        if not (model.geom_contype[geom] or model.geom_conaffinity[geom]):
+            continue
+        mujoco.mju_quat2Mat(turn, model.geom_quat[geom])
+        r = turn.reshape(3, 3)
+        centre = model.geom_pos[geom] + r @ model.geom_aabb[geom, :3]
+        half = np.abs(r) @ model.geom_aabb[geom, 3:]
+        boxes.append((centre - half, centre + half))
+    if not boxes:
+        return (0.0, 0.0, 0.0, 0.0)
+    bottom = min(lo[2] for lo, _ in boxes)
+    sole = [(lo, hi) for lo, hi in boxes if lo[2] <= bottom + SOLE_BAND_M]
+    return (
+        float(min(lo[0] for lo, _ in sole)),
+        float(max(hi[0] for _, hi in sole)),
+        float(min(lo[1] for lo, _ in sole)),
+        float(max(hi[1] for _, hi in sole)),
     )
 
 

@@ -139,6 +139,7 @@ class SnapshotBuilder:
         self._other_code = index.geom_kind_code.astype(np.intp)
         self._bins = sink + KINDS * PART_SLOTS
         self._none: ContactSets = ([0] * n, [0] * n, [_NOBODY] * n)
+        self._soles = tuple(index.by_id[r].sole_outline for r in self._ids)
         # the classification of each set of geom pairs in contact seen lately
         self._known: dict[frozenset[int], ContactSets] = {}
         self._listed: dict[bytes, ContactSets] = {}  # the same, by the contact list's bytes
@@ -190,6 +191,7 @@ class SnapshotBuilder:
                         (v[k + 14], v[k + 15]),
                         (v[k + 16], v[k + 17]),
                     ),
+                    self._soles[i],  # sole_outline
                     bool(gbits & ~FOOT_BIT) or v[k + 3] < FALLEN_TILT_COS,  # fallen
                     limp[i],  # limp
                     removed[i],  # removed

@@ -5,7 +5,10 @@ checked when READY begins (1212-1228, ``check_start_position``)."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
+
+import pytest
 
 from contracts.field import KID_FIELD
 from contracts.ids import RobotId
@@ -14,7 +17,7 @@ from referee.config import TimingConfig
 from referee.gamecontroller import GameState, Penalty, SecondaryState
 from referee.rules import kickoff
 from referee.rules.base import GameView, PenalizeRobot
-from referee.snapshot import PlaceBall
+from referee.snapshot import PlaceBall, RobotState
 from tests.unit.referee.referee_helpers import (
     BLUE,
     FAST_TIMING,
@@ -84,6 +87,32 @@ def test_start_positions_must_be_off_the_field_on_the_own_side() -> None:
     assert [d.robot for d in kickoff.judge_start(snapshot(0, (on_line,)), _view())] == [  # type: ignore[union-attr]
         RobotId(RED, 2)
     ]
+
+
+def test_a_toe_on_the_line_is_on_the_field() -> None:
+    """The league reads the feet's contact points with the ground, the corners of its robots'
+    foot boxes (hlvs_webots referee.py:686-770): its positioning/initial scenario's red 2 at
+    y 3.02 facing the field and blue 2 at x -4.55 facing it have a toe on the line. Feet at
+    the torso's x and y, soles 0.105 m long: the toes 0.0525 m in front."""
+    sole = (-0.0525, 0.0525, -0.034, 0.034)
+
+    def standing(number: int, x: float, y: float, yaw: float) -> RobotState:
+        left = (x - 0.045 * math.sin(yaw), y + 0.045 * math.cos(yaw))
+        right = (x + 0.045 * math.sin(yaw), y - 0.045 * math.cos(yaw))
+        return replace(robot(BLUE, number, x, y), yaw_rad=yaw, sole_outline=sole,
+                       hull_points=(left, right, left, right))  # fmt: skip
+
+    toe_on_touch_line = standing(2, 4.0, 3.02, -math.pi / 2)
+    corners = toe_on_touch_line.sole_corners()
+    assert len(corners) == 8
+    assert min(y for _, y in corners) == pytest.approx(3.02 - 0.0525)
+    toe_on_goal_line = standing(3, 4.55, 2.06, math.pi)
+    heel_on_touch_line = standing(4, 3.0, 3.0 + 0.0525 - 0.001, math.pi / 2)  # facing out
+    clear = standing(1, 4.7, -2.06, math.pi)  # its toes at x 4.6475
+    decisions = kickoff.judge_start(
+        snapshot(0, (toe_on_touch_line, toe_on_goal_line, heel_on_touch_line, clear)), _view())
+    assert [d.robot for d in decisions] == [  # type: ignore[union-attr]
+        RobotId(BLUE, 2), RobotId(BLUE, 3), RobotId(BLUE, 4)]
 
 
 def test_the_referee_checks_start_positions_when_ready_begins() -> None:

@@ -12,6 +12,7 @@ from __future__ import annotations
 import dataclasses
 import math
 
+import mujoco
 import numpy as np
 import pytest
 
@@ -33,6 +34,23 @@ RED_1, RED_2 = RobotId(TeamColor.RED, 1), RobotId(TeamColor.RED, 2)
 BLUE_1, BLUE_2, BLUE_3 = (RobotId(TeamColor.BLUE, n) for n in (1, 2, 3))
 PARTS_BY_NAME = {part.value: part for part in BodyPart}
 HULL_BODIES = ("hand_L", "hand_R", "foot_L", "foot_R")
+
+
+def reference_sole(model: mujoco.MjModel, body: int) -> tuple[float, float, float, float]:
+    """The foot's colliding boxes and spheres (unturned, as the built-in robots' are) as the
+    rectangle they cover: x back, x front, y right, y left."""
+    xs: list[float] = []
+    ys: list[float] = []
+    for geom in range(model.ngeom):
+        if model.geom_bodyid[geom] != body:  # (all of them collide; a removed robot's don't)
+            continue
+        pos, size = model.geom_pos[geom], model.geom_size[geom]
+        box, sphere = int(mujoco.mjtGeom.mjGEOM_BOX), int(mujoco.mjtGeom.mjGEOM_SPHERE)
+        assert int(model.geom_type[geom]) in (box, sphere)
+        hx, hy = (size[0], size[1]) if int(model.geom_type[geom]) == box else (size[0], size[0])
+        xs += [pos[0] - hx, pos[0] + hx]
+        ys += [pos[1] - hy, pos[1] + hy]
+    return (float(min(xs)), float(max(xs)), float(min(ys)), float(max(ys)))
 
 
 def reference_snapshot(world: World) -> WorldSnapshot:
@@ -99,6 +117,7 @@ def reference_snapshot(world: World) -> WorldSnapshot:
                 ball_contacts=frozenset(on_ball[number]),
                 robot_contacts=frozenset(touching[number]),
                 hull_points=tuple((float(p[0]), float(p[1])) for p in hull),
+                sole_outline=reference_sole(model, model.body(f"{prefix}/foot_L").id),
                 fallen=any(p is not BodyPart.FOOT for p in ground[number])
                 or float(data.xmat[torso][8]) < 0.5,
                 limp=world.is_limp(robot_id),
