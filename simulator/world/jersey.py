@@ -1,13 +1,15 @@
-"""Team jerseys with the player's number on the built-in robots.
+"""Team jerseys with the player's number on the built-in robots and on team models.
 
 The league's robots wear a shirt in the team colour with the player number on it (hlvs_webots
 ``protos/robots/RoboCupRobot/RobotisJersey.proto``: a ``jerseyTexture`` per team colour and
 number, such as ``robotis-op2_1_red.png``; the referee sets the colour and number of each
-robot it spawns). Ours wear a plate on the chest and one on the back, each showing the shirt
-texture of :func:`simulator.world.textures.jersey_tile`: the number upright, read from in front
-of the plate. The textures are blank in the MJCF (:func:`jersey_assets`) and filled after
-compiling (:func:`apply_jerseys`), as the look's are. Replays keep the plates in the shirt's
-mean colour (:mod:`simulator.replay.scene`).
+robot it spawns). The built-in robots wear a plate on the chest and one on the back, team
+models the plates their manifest's ``jersey`` places on a link
+(:mod:`simulator.world.robots.team.manifest`); each plate shows the shirt texture of
+:func:`simulator.world.textures.jersey_tile`: the number upright, read from in front of it.
+The textures are blank in the MJCF (:func:`jersey_assets`) and filled after compiling
+(:func:`apply_jerseys`), as the look's are. Replays keep the plates in the shirt's mean colour
+(:mod:`simulator.replay.scene`).
 """
 
 from __future__ import annotations
@@ -44,7 +46,7 @@ def apply_jerseys(
     model: mujoco.MjModel, robots: Iterable[tuple[str, int, tuple[float, float, float]]]
 ) -> None:
     """Fill the jersey textures of ``robots``: (robot prefix, number, team RGB) each; robots
-    without a jersey in ``model`` (team models) are skipped."""
+    without a jersey in ``model`` (team models whose manifest places none) are skipped."""
     for prefix, number, rgb in robots:
         name = jersey_material(prefix)
         try:
