@@ -8,8 +8,9 @@ from simulator.api.endpoints import PlayerEndpoint, endpoints_from_spec
 from simulator.api.framing import MAX_FRAME_BYTES, FrameDecoder, FramingError, encode_frame
 from simulator.api.lockstep import Pipeline, wait_lockstep
 from simulator.api.quota import NetworkQuota
+from simulator.api.schedule import rendering_bandwidth_mb_s
 from simulator.api.server import ApiServer, LockstepSettings, PortUnavailable
-from simulator.api.session import RobotSession, rendering_bandwidth_mb_s
+from simulator.api.session import RobotSession
 
 __all__ = [
     "MAX_FRAME_BYTES",

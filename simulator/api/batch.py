@@ -31,7 +31,8 @@ import numpy.typing as npt
 
 from simulator.api.fastreq import TargetValues
 from simulator.api.framing import HEADER
-from simulator.api.session import DuePlan, Measurement, TargetPlan
+from simulator.api.measurement import DuePlan, Measurement
+from simulator.api.session import TargetPlan
 
 if TYPE_CHECKING:
     from simulator.world.motors import PositionWriter
@@ -191,7 +192,7 @@ class StepBatch:
     def encode(self, items: Sequence[tuple[Measurement, DuePlan]], head: bytes) -> None:
         """Fill ``sensors`` of each measurement with the encoding of its plan (every plan has
         ``sources``), and ``frame`` of those without header (``head``: the step's
-        :func:`~simulator.api.session.header_bytes`)."""
+        :func:`~simulator.api.measurement.header_bytes`)."""
         self.gather(items, head).write()
 
     def gather(self, items: Sequence[tuple[Measurement, DuePlan]], head: bytes) -> Gathered:

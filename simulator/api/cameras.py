@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 from contracts import RobotId
-from simulator.api.session import CameraJob
+from simulator.api.measurement import CameraJob
 
 log = logging.getLogger(__name__)
 

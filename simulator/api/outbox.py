@@ -23,8 +23,9 @@ from simulator.api.batch import Gathered, StepBatch
 from simulator.api.cameras import MAX_IN_FLIGHT, ImageSource
 from simulator.api.connection import ClientClosed, Connection
 from simulator.api.framing import HEADER
+from simulator.api.measurement import Measurement
 from simulator.api.ports import Ports
-from simulator.api.session import ERROR, WARNING, Measurement
+from simulator.api.session import ERROR, WARNING
 from simulator.api.slots import IoThreadFailed, Pending, RobotSlot
 from simulator.api.steady import Prepared, SteadyValues
 

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Any
 
 from contracts import RobotId
 from simulator.api.cameras import CompletedImages
-from simulator.api.session import CameraJob
+from simulator.api.measurement import CameraJob
 
 if TYPE_CHECKING:
     from simulator.world import World

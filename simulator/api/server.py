@@ -36,11 +36,12 @@ from simulator.api.connection import AnswerBook, Connection
 from simulator.api.devices import DeviceWorld
 from simulator.api.endpoints import PlayerEndpoint
 from simulator.api.intake import EveryUsual, Intake
+from simulator.api.measurement import DuePlan, Measurement, header_bytes
 from simulator.api.outbox import Outbox
 from simulator.api.ports import Ports
 from simulator.api.quota import NetworkQuota
 from simulator.api.sender import SendThread
-from simulator.api.session import DuePlan, Measurement, RobotSession, SteadyChanges, header_bytes
+from simulator.api.session import RobotSession, SteadyChanges
 from simulator.api.slots import (
     IoThreadFailed,
     LockstepSettings,

@@ -9,9 +9,7 @@ Camera images are filled in later by the caller (see :mod:`simulator.api.cameras
 
 from __future__ import annotations
 
-import logging
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
 from contracts import RobotId
@@ -19,34 +17,17 @@ from contracts.robot_api import messages_pb2 as pb
 from simulator.api.devices import (
     ACCELEROMETER,
     CAMERA,
-    FORCE,
     GYRO,
     MOTOR,
     POSITION_SENSOR,
-    SENSOR_KINDS,
     DeviceWorld,
     kind_name,
     robot_key,
 )
-from simulator.api.encode import (
-    ACCELEROMETERS,
-    FORCES,
-    GYROS,
-    POSITION_SENSORS,
-    SensorLayout,
-    varint,
-)
 from simulator.api.fastreq import Notice, PositionTargets, TargetValues
-from simulator.api.framing import HEADER
+from simulator.api.measurement import DuePlan, Measurement
+from simulator.api.schedule import MAX_LAYOUTS, SensorSchedule
 
-log = logging.getLogger(__name__)
-
-BASIC_TIME_STEP_MS = 8
-MAX_LAYOUTS = 64
-# protobuf field and number of values of each regular sensor kind (cameras are separate)
-_FIELDS = {ACCELEROMETER: (ACCELEROMETERS, 3), FORCE: (FORCES, 1), GYRO: (GYROS, 3)}
-_FIELDS[POSITION_SENSOR] = (POSITION_SENSORS, 1)
-CAMERA_MIN_TIME_STEP_MS = 16
 WARNING = pb.Message.WARNING_MESSAGE
 ERROR = pb.Message.ERROR_MESSAGE
 Request = pb.ActuatorRequests | PositionTargets | Notice
@@ -58,125 +39,6 @@ Request = pb.ActuatorRequests | PositionTargets | Notice
 # longer one, such as a 200 kB device name echoed back, keeps its start and its end).
 MAX_WARNINGS = 16
 MAX_WARNING_CHARS = 240
-
-
-def rendering_bandwidth_mb_s(width: int, height: int, period_ms: int) -> float:
-    """HLVS rendering bandwidth of one camera: w*h*3 bytes per period, in MB/s (2^20)."""
-    return width * height * 3 * 1000.0 / period_ms / 2**20
-
-
-@dataclass(slots=True)
-class CameraJob:
-    """A camera image owed to a measurement of this robot."""
-
-    robot: RobotId
-    name: str
-    width: int
-    height: int
-    time_ms: int
-    measurement: pb.CameraMeasurement
-
-
-class Measurement:
-    """One step's measurement: ``time``, ``real_time``, the encoded regular ``sensors`` and the
-    camera ``jobs``. The protobuf ``header`` (time, real_time, messages, cameras) is only made
-    when a message or a camera needs it; otherwise :meth:`head` is hand-encoded. ``frame``: the
-    whole framed message (length prefix, head, sensors) when the step's batch built it (a
-    measurement without header), else None."""
-
-    __slots__ = ("time", "real_time", "_sensors", "jobs", "frame", "_header")
-
-    def __init__(self, time: int, real_time: int, sensors: bytes = b"") -> None:
-        self.time = time
-        self.real_time = real_time
-        self._sensors: bytes | None = sensors
-        self.jobs: list[CameraJob] = []
-        self.frame: bytes | None = None
-        self._header: pb.SensorMeasurements | None = None
-
-    @property
-    def sensors(self) -> bytes:
-        """The encoded regular sensors (cut from ``frame`` when only the frame was built)."""
-        if self._sensors is None:
-            assert self.frame is not None
-            self._sensors = self.frame[HEADER.size + len(self.head()) :]
-        return self._sensors
-
-    @sensors.setter
-    def sensors(self, value: bytes) -> None:
-        self._sensors = value
-
-    def set_frame(self, frame: bytes) -> None:
-        """The whole framed message of a measurement without header (its sensors are cut
-        from it when asked for)."""
-        self.frame = frame
-        self._sensors = None
-
-    @property
-    def plain(self) -> bool:
-        """No header: no message and no camera (the head is :func:`header_bytes`)."""
-        return self._header is None
-
-    @property
-    def header(self) -> pb.SensorMeasurements:
-        if self._header is None:
-            self._header = pb.SensorMeasurements(time=self.time, real_time=self.real_time)
-        return self._header
-
-    @property
-    def message_count(self) -> int:
-        return 0 if self._header is None else len(self._header.messages)
-
-    def head(self) -> bytes:
-        """The serialized header (everything but the regular sensors)."""
-        if self._header is None:
-            return header_bytes(self.time, self.real_time)
-        return bytes(self._header.SerializeToString())
-
-    def size(self) -> int:
-        return len(self.head()) + len(self.sensors)
-
-    def payload(self) -> bytes:
-        return self.head() + self.sensors
-
-    def parsed(self) -> pb.SensorMeasurements:
-        """The whole measurement as a message (for tests and tools; slow path)."""
-        msg = pb.SensorMeasurements()
-        msg.ParseFromString(self.payload())
-        return msg
-
-
-_last_head: list[tuple[int, int, bytes]] = [(-1, -1, b"")]  # all robots of a step share it
-
-
-def header_bytes(time_ms: int, real_time_ms: int) -> bytes:
-    """``SensorMeasurements(time=time_ms, real_time=real_time_ms).SerializeToString()``."""
-    last = _last_head[0]
-    if last[0] == time_ms and last[1] == real_time_ms:
-        return last[2]
-    if not (0 <= time_ms < 2**32 and 0 <= real_time_ms < 2**64):  # protobuf says what is wrong
-        return bytes(
-            pb.SensorMeasurements(time=time_ms, real_time=real_time_ms).SerializeToString()
-        )
-    head = (b"\x08" + varint(time_ms) if time_ms else b"") + (
-        b"\x10" + varint(real_time_ms) if real_time_ms else b""
-    )
-    _last_head[0] = (time_ms, real_time_ms, head)
-    return head
-
-
-class DuePlan:
-    """The due regular sensors of a measurement: ``names`` in message order, their wire
-    ``layout`` and, when the world has the batch form, where their values come from
-    (``sources``, :meth:`simulator.world.World.sensor_sources`). Compared and hashed by
-    identity: one object per robot and name list, reused every step."""
-
-    __slots__ = ("names", "layout", "sources")
-
-    def __init__(self, names: tuple[str, ...], layout: SensorLayout, sources: Any) -> None:
-        self.names = names
-        self.layout = layout
-        self.sources = sources
 
 
 class TargetPlan:
@@ -217,12 +79,8 @@ class RobotSession:
         self.steady_changes = steady_changes if steady_changes is not None else SteadyChanges()
         self.key = robot_key(robot)
         self._world = world
-        self._rendering_quota_mb_s = rendering_quota_mb_s
         self._clock_ms = clock_ms
         self._kinds = {name: kind_name(kind) for name, kind in world.devices(robot).items()}
-        self._sensors: dict[str, int] = {}  # name -> period ms
-        self._new_sensors: set[str] = set()  # enabled during this step, reported from the next
-        self._enabled_at: dict[str, int] = {}
         self._motor_names = frozenset(n for n, k in self._kinds.items() if k == MOTOR)
         self._positions: dict[str, float] = {}  # last commands, re-applied after a penalty
         # the latest targets of a known name list, not yet merged into _positions
@@ -240,23 +98,22 @@ class RobotSession:
         # the due plan while every regular sensor has one period and one start and nothing
         # else is going on (no message, no camera, no sensor just enabled): (period, start, plan)
         self._steady: tuple[int, int, DuePlan] | None = None
-        self._sensor_sources = getattr(world, "sensor_sources", None)
         self._targets_plan = getattr(world, "motor_targets_plan", None)
-        self._layouts: dict[tuple[str, ...], DuePlan] = {}
         # the actuators of the held name list, for batched writes (None: not batchable)
         self._batch_targets: TargetPlan | None = None
         self._valid_names: set[tuple[str, ...]] = set()  # motor name lists known to be fine
-        # sensors by (period, start): (period, start, names, positions in enabling order)
-        self._groups: list[tuple[int, int, tuple[str, ...], list[int]]] | None = None
-        self._order: list[str] = []
-        self._camera_sensors: list[tuple[str, int, int]] = []
         self._pending: list[tuple[int, str]] = []
         self._unsent_warnings = 0  # warnings over MAX_WARNINGS since the last measurement
         self._limp = False
-        self._camera_size: tuple[int, int] | None = None
+        camera_size: tuple[int, int] | None = None
         if CAMERA in self._kinds.values():
             width, height, _fov = world.camera_info(robot)
-            self._camera_size = (width, height)
+            camera_size = (width, height)
+        self._schedule = SensorSchedule(
+            robot=robot, kinds=self._kinds, camera_size=camera_size,
+            rendering_quota_mb_s=rendering_quota_mb_s,
+            sensor_sources=getattr(world, "sensor_sources", None), key=self.key,
+        )
 
     # --- commands ---------------------------------------------------------------------------
 
@@ -435,50 +292,8 @@ class RobotSession:
                 self._world.set_motor_position(self.robot, name, value)
 
     def _time_step(self, name: str, period: int, now_ms: int) -> None:
-        kind = self._kinds.get(name)
-        if kind is None:
-            self.warn(f'Device "{name}" not found, time step command, ignored.')
-            return
-        if kind not in SENSOR_KINDS:
-            self.warn(f'Device "{name}" is not supported, time step command, ignored.')
-            return
-        minimum = CAMERA_MIN_TIME_STEP_MS if kind == CAMERA else BASIC_TIME_STEP_MS
-        if period == 0:
-            self._sensors.pop(name, None)
-            self._new_sensors.discard(name)
-            self._groups = None
+        if self._schedule.set_period(name, period, now_ms, self.warn):
             self._set_steady(None)
-            return
-        if period < minimum:
-            self.warn(
-                f'Time step for "{name}" should be greater or equal to {minimum}, '
-                f"ignoring {period} value."
-            )
-            return
-        if period % BASIC_TIME_STEP_MS:
-            self.warn(
-                f'Time step for "{name}" should be a multiple of {BASIC_TIME_STEP_MS}, '
-                f"ignoring {period} value."
-            )
-            return
-        if kind == CAMERA and self._camera_size is not None:
-            width, height = self._camera_size
-            requested = rendering_bandwidth_mb_s(width, height, period)
-            if requested > self._rendering_quota_mb_s:
-                self.warn(
-                    "requested rendering bandwidth is above the limit "
-                    f"({round(requested)}MB/s > {round(self._rendering_quota_mb_s)}MB/s)"
-                )
-                return
-        if name not in self._sensors:
-            self._new_sensors.add(name)
-        elif self._sensors[name] == period:
-            return
-        self._sensors[name] = period
-        self._enabled_at[name] = now_ms
-        self._groups = None
-        self._set_steady(None)
-        log.debug("%s: %s enabled every %d ms", self.key, name, period)
 
     def update_limp(self) -> None:
         """Follow the world's limp flag; re-apply cached commands when the robot is released."""
@@ -502,7 +317,7 @@ class RobotSession:
 
     @property
     def enabled(self) -> dict[str, int]:
-        return dict(self._sensors)
+        return dict(self._schedule.periods)
 
     def measure(self, time_ms: int) -> Measurement:
         """The measurement of the step that ended at ``time_ms`` (camera images still empty)."""
@@ -531,24 +346,20 @@ class RobotSession:
                     f" sent (at most {MAX_WARNINGS} per measurement)."
                 ))  # fmt: skip
                 self._unsent_warnings = 0
+        schedule = self._schedule
         if self._removed():
-            self._sensors.clear()
-            self._new_sensors.clear()
-            self._groups = None
+            schedule.clear()
             self._set_steady(None)
             return out, None
-        if self._new_sensors:
-            due = self._due_slow(out, time_ms)
-        else:
-            due = self._due(out, time_ms)
+        due = schedule.due(out, time_ms)
         if not due:
             return out, None
-        plan = self._layouts.get(due)
+        plan = schedule.layouts.get(due)
         if plan is None:
-            plan = self._layout(due)
-        groups = self._groups
-        if groups is not None and len(groups) == 1 and not self._camera_sensors:
-            if not self._new_sensors and not self._pending:
+            plan = schedule.plan(due)
+        groups = schedule.groups
+        if groups is not None and len(groups) == 1 and not schedule.cameras:
+            if not schedule.new and not self._pending:
                 self._set_steady((groups[0][0], groups[0][1], plan))
         return out, plan
 
@@ -569,74 +380,6 @@ class RobotSession:
     def _removed(self) -> bool:
         flags = self._flags
         return flags[1][flags[2]] if flags is not None else self._world.is_removed(self.robot)
-
-    def _due(self, out: Measurement, time_ms: int) -> tuple[str, ...]:
-        """Due regular sensors (in enabling order); camera jobs added. Sensors sharing a period
-        and a start are checked as one group."""
-        if self._groups is None:
-            self._group_sensors()
-        assert self._groups is not None
-        due = [group for group in self._groups if not (time_ms - group[1]) % group[0]]
-        for name, period, start in self._camera_sensors:
-            if not (time_ms - start) % period:
-                self._camera_job(out, name, time_ms)
-        if len(due) == 1:
-            return due[0][2]
-        if not due:
-            return ()
-        order = self._order
-        return tuple([order[i] for i in sorted(i for group in due for i in group[3])])
-
-    def _group_sensors(self) -> None:
-        groups: dict[tuple[int, int], list[int]] = {}
-        self._order = list(self._sensors)
-        self._camera_sensors = []
-        for i, (name, period) in enumerate(self._sensors.items()):
-            start = self._enabled_at[name]
-            if self._kinds[name] == CAMERA:
-                self._camera_sensors.append((name, period, start))
-            else:
-                groups.setdefault((period, start), []).append(i)
-        self._groups = [
-            (period, start, tuple(self._order[i] for i in members), members)
-            for (period, start), members in groups.items()
-        ]
-
-    def _due_slow(self, out: Measurement, time_ms: int) -> tuple[str, ...]:
-        """:meth:`_due` in a step that enabled sensors (those are not reported in it)."""
-        new, kinds, enabled_at = self._new_sensors, self._kinds, self._enabled_at
-        due: list[str] = []
-        for name, period in self._sensors.items():
-            if name in new or (time_ms - enabled_at[name]) % period:
-                continue
-            if kinds[name] != CAMERA:
-                due.append(name)
-            else:
-                self._camera_job(out, name, time_ms)
-        new.clear()
-        return tuple(due)
-
-    def _camera_job(self, out: Measurement, name: str, time_ms: int) -> None:
-        if self._camera_size is not None:
-            width, height = self._camera_size
-            camera = out.header.cameras.add(name=name, width=width, height=height, quality=-1)
-            out.jobs.append(CameraJob(self.robot, name, width, height, time_ms, camera))
-
-    def _layout(self, due: tuple[str, ...]) -> DuePlan:
-        """Due sensors in field-number order (the order of the message) and their layout."""
-        if len(self._layouts) >= MAX_LAYOUTS:
-            self._layouts.clear()
-        kinds = self._kinds
-        names = tuple(sorted(due, key=lambda n: _FIELDS[kinds[n]][0]))  # stable within a kind
-        entries = []
-        for name in names:
-            field, width = _FIELDS[kinds[name]]
-            entries.append((field, name, width))
-        sources = None
-        if self._sensor_sources is not None:
-            sources = self._sensor_sources(self.robot, names)
-        plan = self._layouts[due] = DuePlan(names, SensorLayout(entries), sources)
-        return plan
 
     def encode(self, plan: DuePlan) -> bytes:
         """The regular sensors of ``plan`` read and encoded (one robot; see

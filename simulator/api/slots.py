@@ -18,8 +18,9 @@ from contracts.robot_api import messages_pb2 as pb
 from simulator.api.connection import Connection
 from simulator.api.endpoints import PlayerEndpoint
 from simulator.api.fastreq import Notice, PositionTargets
+from simulator.api.measurement import Measurement
 from simulator.api.quota import NetworkQuota
-from simulator.api.session import Measurement, RobotSession
+from simulator.api.session import RobotSession
 from simulator.api.stats import RobotStats
 from simulator.errors import ApiError
 

@@ -12,7 +12,7 @@ import numpy.typing as npt
 
 from simulator.api.batch import Encoding, Gathered, StepBatch
 from simulator.api.connection import Connection
-from simulator.api.session import DuePlan, Measurement, header_bytes
+from simulator.api.measurement import DuePlan, Measurement, header_bytes
 from simulator.api.slots import RobotSlot
 
 

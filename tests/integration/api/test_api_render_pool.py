@@ -15,8 +15,8 @@ import pytest
 
 from contracts.ids import RobotId, TeamColor
 from contracts.robot_api import messages_pb2 as pb
+from simulator.api.measurement import CameraJob
 from simulator.api.render_pool import RenderPool
-from simulator.api.session import CameraJob
 from simulator.world import CameraRenderer, RobotPlacement, World
 
 RED_1, BLUE_1 = RobotId(TeamColor.RED, 1), RobotId(TeamColor.BLUE, 1)

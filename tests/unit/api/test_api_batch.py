@@ -11,7 +11,8 @@ from contracts.robot_api import messages_pb2 as pb
 from simulator.api.batch import StepBatch
 from simulator.api.fastreq import PositionTargets
 from simulator.api.framing import HEADER
-from simulator.api.session import DuePlan, Measurement, RobotSession, header_bytes
+from simulator.api.measurement import DuePlan, Measurement, header_bytes
+from simulator.api.session import RobotSession
 from simulator.world import FORCE_SENSORS, MOTOR_NAMES, RobotPlacement, World
 
 ROBOTS = [RobotId(TeamColor.RED, 1), RobotId(TeamColor.RED, 2), RobotId(TeamColor.BLUE, 1)]

@@ -86,7 +86,7 @@ def test_render_worker_threads_complete_every_job() -> None:
     import select
 
     from simulator.api import FakeCameraRenderer, RenderWorker
-    from simulator.api.session import CameraJob
+    from simulator.api.measurement import CameraJob
 
     worker = RenderWorker(
         capture=lambda: None,

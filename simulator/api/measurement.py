@@ -1,0 +1,132 @@
+"""A step's measurement of one robot as it goes on the wire, and the plan of its due regular
+sensors.
+
+:class:`Measurement` holds the encoded regular sensors beside a protobuf header made only when a
+message or a camera needs it (:func:`header_bytes` hand-encodes the plain one); :class:`DuePlan`
+is the due sensors' names, wire layout and value sources, one object per robot and name list
+reused every step; :class:`CameraJob` an image owed to a measurement.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from contracts import RobotId
+from contracts.robot_api import messages_pb2 as pb
+from simulator.api.encode import SensorLayout, varint
+from simulator.api.framing import HEADER
+
+
+@dataclass(slots=True)
+class CameraJob:
+    """A camera image owed to a measurement of this robot."""
+
+    robot: RobotId
+    name: str
+    width: int
+    height: int
+    time_ms: int
+    measurement: pb.CameraMeasurement
+
+
+class Measurement:
+    """One step's measurement: ``time``, ``real_time``, the encoded regular ``sensors`` and the
+    camera ``jobs``. The protobuf ``header`` (time, real_time, messages, cameras) is only made
+    when a message or a camera needs it; otherwise :meth:`head` is hand-encoded. ``frame``: the
+    whole framed message (length prefix, head, sensors) when the step's batch built it (a
+    measurement without header), else None."""
+
+    __slots__ = ("time", "real_time", "_sensors", "jobs", "frame", "_header")
+
+    def __init__(self, time: int, real_time: int, sensors: bytes = b"") -> None:
+        self.time = time
+        self.real_time = real_time
+        self._sensors: bytes | None = sensors
+        self.jobs: list[CameraJob] = []
+        self.frame: bytes | None = None
+        self._header: pb.SensorMeasurements | None = None
+
+    @property
+    def sensors(self) -> bytes:
+        """The encoded regular sensors (cut from ``frame`` when only the frame was built)."""
+        if self._sensors is None:
+            assert self.frame is not None
+            self._sensors = self.frame[HEADER.size + len(self.head()) :]
+        return self._sensors
+
+    @sensors.setter
+    def sensors(self, value: bytes) -> None:
+        self._sensors = value
+
+    def set_frame(self, frame: bytes) -> None:
+        """The whole framed message of a measurement without header (its sensors are cut
+        from it when asked for)."""
+        self.frame = frame
+        self._sensors = None
+
+    @property
+    def plain(self) -> bool:
+        """No header: no message and no camera (the head is :func:`header_bytes`)."""
+        return self._header is None
+
+    @property
+    def header(self) -> pb.SensorMeasurements:
+        if self._header is None:
+            self._header = pb.SensorMeasurements(time=self.time, real_time=self.real_time)
+        return self._header
+
+    @property
+    def message_count(self) -> int:
+        return 0 if self._header is None else len(self._header.messages)
+
+    def head(self) -> bytes:
+        """The serialized header (everything but the regular sensors)."""
+        if self._header is None:
+            return header_bytes(self.time, self.real_time)
+        return bytes(self._header.SerializeToString())
+
+    def size(self) -> int:
+        return len(self.head()) + len(self.sensors)
+
+    def payload(self) -> bytes:
+        return self.head() + self.sensors
+
+    def parsed(self) -> pb.SensorMeasurements:
+        """The whole measurement as a message (for tests and tools; slow path)."""
+        msg = pb.SensorMeasurements()
+        msg.ParseFromString(self.payload())
+        return msg
+
+
+_last_head: list[tuple[int, int, bytes]] = [(-1, -1, b"")]  # all robots of a step share it
+
+
+def header_bytes(time_ms: int, real_time_ms: int) -> bytes:
+    """``SensorMeasurements(time=time_ms, real_time=real_time_ms).SerializeToString()``."""
+    last = _last_head[0]
+    if last[0] == time_ms and last[1] == real_time_ms:
+        return last[2]
+    if not (0 <= time_ms < 2**32 and 0 <= real_time_ms < 2**64):  # protobuf says what is wrong
+        return bytes(
+            pb.SensorMeasurements(time=time_ms, real_time=real_time_ms).SerializeToString()
+        )
+    head = (b"\x08" + varint(time_ms) if time_ms else b"") + (
+        b"\x10" + varint(real_time_ms) if real_time_ms else b""
+    )
+    _last_head[0] = (time_ms, real_time_ms, head)
+    return head
+
+
+class DuePlan:
+    """The due regular sensors of a measurement: ``names`` in message order, their wire
+    ``layout`` and, when the world has the batch form, where their values come from
+    (``sources``, :meth:`simulator.world.World.sensor_sources`). Compared and hashed by
+    identity: one object per robot and name list, reused every step."""
+
+    __slots__ = ("names", "layout", "sources")
+
+    def __init__(self, names: tuple[str, ...], layout: SensorLayout, sources: Any) -> None:
+        self.names = names
+        self.layout = layout
+        self.sources = sources
