@@ -21,7 +21,15 @@ kind alike), each benchmark as a child process with small sizes:
   of the cost);
 - ``bringup``: ``bench bringup`` (a real match of stub robots in Docker, images cached), in
   ``--bringup-repeats`` of the runs (default all: one bring-up is Docker starting 17 containers
-  and spreads by a second on a small host); needs Docker and the project's images.
+  and spreads by a second on a small host); needs Docker and the project's images;
+- ``match``: a whole match, in ``--match-repeats`` of the runs (default 1: minutes each): 4 v 4
+  stub robots in Docker, each with its 320x240 camera, ``async`` stepping uncapped, halves of
+  ``--match-half-duration`` simulated seconds (``hlvs match`` of a scrimmage's files, as ``bench
+  hog``); its simulator's real-time factor, the wall seconds per simulated minute, the wall
+  seconds outside the game, and from them what a match of the league's length and timing
+  (two 10 min halves, 45 s READYs, the referee's wall waits, paced to real time at most) takes
+  on this machine and how many such matches a core-hour plays
+  (:func:`testkit.figures.league_match_figures`); no target. Needs Docker and the images.
 
 Prints one JSON document: per kind its runs, the median of each figure, the target and whether
 the median meets it; the load average before and after, so that a figure is read with the load
@@ -35,18 +43,23 @@ import json
 import os
 import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import Any
 
+from contracts import files
 from testkit.figures import (
     MACHINE_SCALED,
     REFERENCE_BARE_REAL_TIME_FACTOR,
+    league_match_figures,
     machine_target,
     median_figures,
 )
 
-KINDS = ("sim", "async", "lockstep", "lockstep_league", "pipelined", "cameras", "bringup")
+KINDS = ("sim", "async", "lockstep", "lockstep_league", "pipelined", "cameras", "bringup",
+         "match")
 
 
 
@@ -68,6 +81,10 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--bringup-repeats", type=int, default=None,
                         help="bring-up runs (real matches in Docker, about 10 s each; default "
                              "--repeats)")
+    parser.add_argument("--match-repeats", type=int, default=1,
+                        help="whole-match runs (4 v 4 in Docker, minutes each; default 1)")
+    parser.add_argument("--match-half-duration", type=float, default=10.0,
+                        help="simulated seconds per half of the whole match (default 10)")
     parser.add_argument("--only", default=",".join(KINDS),
                         help=f"comma-separated kinds to run (default all: {','.join(KINDS)})")
     parser.add_argument("--json", action="store_true", help="print only the JSON document")
@@ -174,6 +191,9 @@ def _runners(args: argparse.Namespace) -> dict[str, Callable[[], dict[str, Any]]
                 figures[key] = value
         return figures
 
+    def match() -> dict[str, Any]:
+        return _whole_match(args.match_half_duration)
+
     return {
         "sim": sim,
         "async": api_mode("async"),
@@ -182,6 +202,42 @@ def _runners(args: argparse.Namespace) -> dict[str, Callable[[], dict[str, Any]]
         "pipelined": api_mode("pipelined"),
         "cameras": cameras,
         "bringup": bringup,
+        "match": match,
+    }
+
+
+def _whole_match(half_s: float) -> dict[str, Any]:
+    """The ``match`` kind: one 4 v 4 stub match in Docker (cameras 320x240), async uncapped."""
+    from benchmarks.short_match import play, scrimmage_files
+
+    match_id = f"bench-report-match-{os.getpid()}-{time.monotonic_ns() % 10**6}"
+    with tempfile.TemporaryDirectory(prefix="hlvs-bench-match-") as tmp:
+        game = scrimmage_files(Path(tmp) / "config", match_id=match_id, half_s=half_s,
+                               stepping="async", max_rtf=0.0, options=("--players", "4"))
+        started = time.monotonic()
+        try:
+            results = play("report", game, Path(tmp) / "match", match_id=match_id)
+        except SystemExit as exc:  # the match failed: its reason, as the other kinds' errors
+            return {"error": str(exc)}
+        wall = time.monotonic() - started
+        sim_results = sorted((Path(tmp) / "match").rglob(files.SIM_RESULT))
+        cameras = json.loads(sim_results[0].read_text()).get("cameras") or {} if sim_results else {}
+    rtf = results.real_time_factor or 0.0
+    if rtf <= 0 or not results.sim_time_ms:
+        return {"error": f"match {match_id}: no real-time factor in its results"}
+    phases = dict(results.timings_s)
+    outside = sum(phases.values()) - phases.get("playing", 0.0)
+    cpus = len(os.sched_getaffinity(0))
+    return {
+        "real_time_factor": rtf,
+        "sim_s": round(results.sim_time_ms / 1000.0, 1),
+        "wall_s": round(wall, 1),
+        "outside_play_s": round(outside, 1),
+        "bringup_s": None if results.bringup_s is None else round(results.bringup_s, 2),
+        "camera_frames": cameras.get("frames"),
+        "render_processes": cameras.get("render_processes"),
+        "gl_renderer": cameras.get("gl_renderer"),
+        **league_match_figures(rtf, outside, cpus),
     }
 
 
@@ -208,6 +264,8 @@ def run(args: argparse.Namespace, progress: Callable[[str], None]) -> dict[str, 
         for kind in kinds:
             if kind == "bringup" and repeat >= _bringup_repeats(args):
                 continue
+            if kind == "match" and repeat >= args.match_repeats:
+                continue
             progress(f"{kind} run {repeat + 1} (load {_load()[0]})")
             result = runners[kind]()
             result["load_1min"] = _load()[0]
@@ -217,6 +275,7 @@ def run(args: argparse.Namespace, progress: Callable[[str], None]) -> dict[str, 
         "robots": args.robots,
         "repeats": args.repeats,
         "bringup_repeats": _bringup_repeats(args),
+        "match_repeats": args.match_repeats,
         "sim_seconds": args.sim_seconds,
         "world_seconds": args.world_seconds,
         "cpus": len(os.sched_getaffinity(0)),

@@ -7,6 +7,8 @@ import statistics
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
+from contracts.timing import OFFICIAL, SET_TO_PLAY_S
+
 
 @dataclass(frozen=True, slots=True)
 class Target:
@@ -75,6 +77,35 @@ def machine_target(kind: str, bare_real_time_factor: float | None) -> Target | N
     return target.scaled(speed if how == "with" else 1.0 / speed)
 
 
+# A match at the league's timing (``contracts.timing.OFFICIAL``): simulated seconds without a goal
+# (two halves of 600 s of PLAYING, each after a 45 s READY and SET_TO_PLAY_S of SET; the clock
+# stands still in both) and wall seconds the referee waits whatever the speed (before the first
+# READY, at half time)
+LEAGUE_MATCH_SIM_S = 2 * (OFFICIAL.half_duration_s + OFFICIAL.ready_duration_s + SET_TO_PLAY_S)
+LEAGUE_MATCH_WAITS_S = OFFICIAL.wait_before_first_ready_s + OFFICIAL.half_time_break_s
+
+
+def league_match_figures(
+    real_time_factor: float, outside_play_s: float, cpus: int
+) -> dict[str, float]:
+    """What a match of the league's length costs on this machine, from a short bench match:
+    ``real_time_factor`` (its simulator's), ``outside_play_s`` (its wall seconds outside the
+    game: starting the containers, the robots connecting, stopping, collecting) and ``cpus``
+    (the host's, all of which the match may use). The game is paced to real time at most, as
+    the league's are: ``league_match_wall_s`` is ``outside_play_s`` plus the referee's wall
+    waits plus :data:`LEAGUE_MATCH_SIM_S` at ``min(real_time_factor, 1)``;
+    ``matches_per_core_hour`` is 3600 over that times ``cpus``."""
+    if real_time_factor <= 0 or cpus < 1:
+        raise ValueError(f"expected a real-time factor above 0 and at least one CPU, got "
+                         f"{real_time_factor} and {cpus}")
+    wall = outside_play_s + LEAGUE_MATCH_WAITS_S + LEAGUE_MATCH_SIM_S / min(real_time_factor, 1.0)
+    return {
+        "wall_s_per_sim_minute": round(60.0 / real_time_factor, 2),
+        "league_match_wall_s": round(wall, 1),
+        "matches_per_core_hour": round(3600.0 / (wall * cpus), 3),
+    }
+
+
 def median_figures(runs: Sequence[Mapping[str, object]]) -> dict[str, float]:
     """Per numeric figure, the median over the runs (figure name -> value) that did not fail."""
     good = [r for r in runs if "error" not in r]
@@ -91,11 +122,14 @@ def median_figures(runs: Sequence[Mapping[str, object]]) -> dict[str, float]:
 
 __all__ = [
     "FLOOD_TARGET",
+    "LEAGUE_MATCH_SIM_S",
+    "LEAGUE_MATCH_WAITS_S",
     "MACHINE_SCALED",
     "REFERENCE_BARE_REAL_TIME_FACTOR",
     "TARGETS",
     "Target",
     "judged",
+    "league_match_figures",
     "machine_target",
     "median_figures",
 ]

@@ -53,7 +53,7 @@ def register(sub: Any) -> None:
     forward(kinds, "bringup", help="time from hlvs match to the kick-off (JSON)", func=_bringup)
     forward(
         kinds, "report", help="the performance matrix (sim, async, lockstep, pipelined, "
-        "cameras, bring-up) with every ratio and its target in one JSON document",
+        "cameras, bring-up, a whole match) with every ratio and its target in one JSON document",
         func=_report,
     )
     forward(kinds, "delivery", help="log delivery throughput to SFTP and S3 (JSON)",

@@ -6,7 +6,17 @@ import json
 import subprocess
 import sys
 
-from testkit.figures import FLOOD_TARGET, Target, judged, machine_target
+import pytest
+
+from testkit.figures import (
+    FLOOD_TARGET,
+    LEAGUE_MATCH_SIM_S,
+    LEAGUE_MATCH_WAITS_S,
+    Target,
+    judged,
+    league_match_figures,
+    machine_target,
+)
 from testkit.figures import median_figures as _median
 
 
@@ -100,3 +110,18 @@ def test_targets_are_the_performance_goals_and_scale_with_the_machine() -> None:
     assert machine_target("bringup", 12.0) == Target("bringup_s", maximum=3.0)
     assert machine_target("bringup", 4.0) == Target("bringup_s", maximum=9.0)
     assert not machine_target("bringup", 12.0).met(3.35)  # type: ignore[union-attr]
+
+
+def test_a_league_match_is_costed_from_a_short_one_at_the_leagues_pace() -> None:
+    """The ``match`` kind's figures: a league match (two 600 s halves after 45 s READYs and 5 s
+    SETs, 1300 s simulated, and 135 s of the referee's wall waits) paced to real time at most."""
+    assert (LEAGUE_MATCH_SIM_S, LEAGUE_MATCH_WAITS_S) == (1300.0, 135.0)
+    slow = league_match_figures(0.25, 30.0, 2)  # a quarter of real time on two CPUs
+    assert slow == {"wall_s_per_sim_minute": 240.0, "league_match_wall_s": 5365.0,
+                    "matches_per_core_hour": 0.336}
+    fast = league_match_figures(4.0, 10.0, 16)  # faster than real time: held to it
+    assert fast["league_match_wall_s"] == 1445.0 and fast["wall_s_per_sim_minute"] == 15.0
+    assert fast["matches_per_core_hour"] == round(3600 / (1445.0 * 16), 3)
+    for bad in ((0.0, 10.0, 2), (1.0, 10.0, 0)):
+        with pytest.raises(ValueError, match="expected a real-time factor above 0"):
+            league_match_figures(*bad)
