@@ -115,7 +115,7 @@ def bench_remotes(
     steps_per_action: int = 1,
 ) -> dict[str, Any]:
     from envs.docker_pool import DockerLauncher
-    from envs.remote import RemotePool
+    from envs.remote_pool import RemotePool
 
     count = max([remotes, *sizes])
     load_before = os.getloadavg()

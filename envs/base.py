@@ -48,7 +48,7 @@ def open_session(spec: SessionSpec, remotes: int | str | None) -> tuple[Session,
         from envs.session import LocalSession
 
         return LocalSession(spec), None
-    from envs.remote import RemotePool
+    from envs.remote_pool import RemotePool
 
     pool = RemotePool.open(remotes)
     try:

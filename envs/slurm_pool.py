@@ -90,7 +90,7 @@ class _Job:
 
 
 class SlurmLauncher:
-    """The :class:`envs.remote.Launcher` of remotes that Slurm jobs run."""
+    """The :class:`envs.remote_pool.Launcher` of remotes that Slurm jobs run."""
 
     def __init__(
         self, options: SlurmOptions | None = None, *, image: str | None = None,

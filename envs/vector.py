@@ -20,7 +20,8 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space, concatenate, create_empty_array
 
 from envs.base import HlvsEnv
-from envs.remote import RemotePool, RemoteSession
+from envs.remote import RemoteSession
+from envs.remote_pool import RemotePool
 
 _NUMBERS = (int, float, bool, np.float64, np.int64, np.bool_)
 

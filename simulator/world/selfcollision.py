@@ -27,7 +27,7 @@ import mujoco
 import numpy as np
 
 from simulator.world.robots import AnyRobotModel
-from simulator.world.robots.model import RobotModel
+from simulator.world.robots.humanoid import RobotModel
 
 _PREFIX = "selfcheck"
 NEAR_M = 0.005

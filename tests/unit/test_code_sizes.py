@@ -33,7 +33,7 @@ LONG_FUNCTIONS: dict[str, tuple[int, str]] = {
         147, "one pass of edits over a team's MjSpec, each step needing the previous "
         "one's compiled model"),
     "simulator/world/robots/team/manifest.py::load_manifest": (
-        135, "reads and validates every field of a model's manifest, each with its own "
+        132, "reads and validates every field of a model's manifest, each with its own "
         "error naming the file and field"),
     "simulator/runtime.py::run_match": (
         117, "the simulator's composition root: the world, referee, API server, "

@@ -14,13 +14,13 @@ from robot import (
     UnknownModelError,
     motor_range,
 )
+from simulator.world.robots.humanoid import RobotModel
 from simulator.world.robots.league import LEAGUE_TEST_KID_NAME, league_test_kid
 from simulator.world.robots.model import (
     FORCE_SENSORS,
     CameraSpec,
     MotorSpec,
     RobotMjcf,
-    RobotModel,
 )
 from simulator.world.robots.team import TeamRobotModel, load_team_model
 from simulator.world.servos import servo

@@ -1,4 +1,5 @@
-"""MJCF of our humanoid (primitive geoms only), parameterised by :class:`HumanoidGeometry`.
+"""Our humanoid: the built-in robot model (:class:`RobotModel`) and its MJCF (primitive geoms
+only), parameterised by :class:`HumanoidGeometry`.
 
 Each sole stands on four spherical cleats, one in each corner (``foot:cleat_<side><l|r><b|f>``),
 under a plate (``foot:sole_<side>``) two cleat radii above the ground: four contact points per
@@ -12,13 +13,18 @@ a :class:`referee.snapshot.BodyPart` value (foot, hand, arm, head, torso, leg). 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from dataclasses import dataclass
 
+from robot import HumanoidGeometry
 from simulator.world.actuator import actuator_xml, joint_attributes
-from simulator.world.robots.model import RobotMjcf
-
-if TYPE_CHECKING:
-    from simulator.world.robots.model import RobotModel
+from simulator.world.robots.devices import DeviceNames
+from simulator.world.robots.model import (
+    FORCE_SENSORS,
+    CameraSpec,
+    MotorLookup,
+    MotorSpec,
+    RobotMjcf,
+)
 
 LIMB_RGBA = "0.3 0.3 0.33 1"
 FOOT_RGBA = "0.12 0.12 0.12 1"
@@ -255,3 +261,65 @@ def build_humanoid(
         + "".join(f'<touch name="{p}/{n}" site="{p}/site:{n}"/>' for n in model.force_sensors)
     )
     return RobotMjcf(body=body, actuators=actuators, sensors=sensors)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RobotModel(MotorLookup):
+    """A built-in robot model: its shape, motors and sensors."""
+
+    name: str
+    field_class: str  # "kid" | "adult"
+    geometry: HumanoidGeometry
+    motors: tuple[MotorSpec, ...]
+    joint_armature: float
+    camera: CameraSpec = CameraSpec()
+    force_sensors: tuple[str, ...] = FORCE_SENSORS
+    # the robot stands crouched (``LegUpper = q, LegLower = 2 q, Ankle = q``: torso upright, feet
+    # flat) with q = ``crouch_rad``; 0 for the built-in robots, which stand straight
+    crouch_rad: float = 0.0
+
+    @property
+    def standing_height_m(self) -> float:
+        """Height of the root body's origin above the ground in the standing pose."""
+        g = self.geometry
+        if not self.crouch_rad:
+            return g.standing_height_m
+        legs = (g.thigh_m + g.shank_m) * math.cos(self.crouch_rad)
+        return -g.hip_z_m + legs + g.ankle_height_m
+
+    @property
+    def wears_jersey(self) -> bool:
+        """The built-in robots wear the team's jersey on the chest and the back."""
+        return True
+
+    @property
+    def devices(self) -> DeviceNames:
+        """The league's sample robot's names: ``<motor>S``, ``Accelerometer``, ``Gyro``."""
+        return DeviceNames.league(
+            self.motor_names, camera=self.camera.name, forces=self.force_sensors
+        )
+
+    @property
+    def standing_pose_rad(self) -> tuple[float, ...]:
+        """Joint positions (``motor_names`` order) the robot stands in when placed: all zero, or
+        the crouch of ``crouch_rad``."""
+        q = self.crouch_rad
+        crouch = {"LegUpper": q, "LegLower": 2.0 * q, "Ankle": q}
+        return tuple(crouch.get(m.name[:-1], 0.0) for m in self.motors)
+
+    def mjcf(
+        self,
+        *,
+        prefix: str,
+        rgba: str,
+        contype: int,
+        conaffinity: int,
+        pose: tuple[float, float, float],
+        jersey: str | None = None,
+    ) -> RobotMjcf:
+        """``jersey``: the material of the team shirt worn on the chest and back (None: a
+        white chest plate)."""
+        return build_humanoid(
+            self, prefix=prefix, rgba=rgba, contype=contype, conaffinity=conaffinity, pose=pose,
+            jersey=jersey,
+        )

@@ -26,7 +26,7 @@ The robot is never a team's choice: the configuration's built-in models do not n
 from __future__ import annotations
 
 from robot import HumanoidGeometry
-from simulator.world.robots.model import RobotModel
+from simulator.world.robots.humanoid import RobotModel
 
 LEAGUE_TEST_KID_NAME = "league-test-kid"
 

@@ -1,12 +1,13 @@
-"""Robot model descriptions: motors, sensors and the MJCF they produce."""
+"""What the built-in and the team robot models share: their motors, camera and the MJCF
+fragments they produce (the built-in humanoid: :mod:`simulator.world.robots.humanoid`; a team's
+model: :mod:`simulator.world.robots.team`)."""
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
 
-from robot import CAMERA_FOV_RAD, HumanoidGeometry
-from simulator.world.robots.devices import DeviceNames
+from robot import CAMERA_FOV_RAD
 from simulator.world.servos import Servo
 
 FORCE_SENSORS = ("llb", "llf", "lrf", "lrb", "rlb", "rlf", "rrf", "rrb")
@@ -86,67 +87,3 @@ class MotorLookup:
             if motor.name == name:
                 return motor
         raise KeyError(name)
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class RobotModel(MotorLookup):
-    """A built-in robot model: its shape, motors and sensors."""
-
-    name: str
-    field_class: str  # "kid" | "adult"
-    geometry: HumanoidGeometry
-    motors: tuple[MotorSpec, ...]
-    joint_armature: float
-    camera: CameraSpec = CameraSpec()
-    force_sensors: tuple[str, ...] = FORCE_SENSORS
-    # the robot stands crouched (``LegUpper = q, LegLower = 2 q, Ankle = q``: torso upright, feet
-    # flat) with q = ``crouch_rad``; 0 for the built-in robots, which stand straight
-    crouch_rad: float = 0.0
-
-    @property
-    def standing_height_m(self) -> float:
-        """Height of the root body's origin above the ground in the standing pose."""
-        g = self.geometry
-        if not self.crouch_rad:
-            return g.standing_height_m
-        legs = (g.thigh_m + g.shank_m) * math.cos(self.crouch_rad)
-        return -g.hip_z_m + legs + g.ankle_height_m
-
-    @property
-    def wears_jersey(self) -> bool:
-        """The built-in robots wear the team's jersey on the chest and the back."""
-        return True
-
-    @property
-    def devices(self) -> DeviceNames:
-        """The league's sample robot's names: ``<motor>S``, ``Accelerometer``, ``Gyro``."""
-        return DeviceNames.league(
-            self.motor_names, camera=self.camera.name, forces=self.force_sensors
-        )
-
-    @property
-    def standing_pose_rad(self) -> tuple[float, ...]:
-        """Joint positions (``motor_names`` order) the robot stands in when placed: all zero, or
-        the crouch of ``crouch_rad``."""
-        q = self.crouch_rad
-        crouch = {"LegUpper": q, "LegLower": 2.0 * q, "Ankle": q}
-        return tuple(crouch.get(m.name[:-1], 0.0) for m in self.motors)
-
-    def mjcf(
-        self,
-        *,
-        prefix: str,
-        rgba: str,
-        contype: int,
-        conaffinity: int,
-        pose: tuple[float, float, float],
-        jersey: str | None = None,
-    ) -> RobotMjcf:
-        """``jersey``: the material of the team shirt worn on the chest and back (None: a
-        white chest plate)."""
-        from simulator.world.robots.humanoid import build_humanoid
-
-        return build_humanoid(
-            self, prefix=prefix, rgba=rgba, contype=contype, conaffinity=conaffinity, pose=pose,
-            jersey=jersey,
-        )

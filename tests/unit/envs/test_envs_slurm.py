@@ -10,7 +10,8 @@ from pathlib import Path
 import pytest
 
 from envs.errors import EnvConfigError
-from envs.remote import RemotePool, parse_remotes, parse_slurm
+from envs.remote import parse_remotes, parse_slurm
+from envs.remote_pool import RemotePool
 from envs.slurm_node import Lease
 from envs.slurm_pool import LEASE_S, SlurmLauncher, SlurmOptions
 

@@ -6,7 +6,8 @@ from typing import TYPE_CHECKING
 
 from contracts import lazy_exports
 from simulator.world.robots.team.devices import unserved_cameras
-from simulator.world.robots.team.manifest import MANIFEST_NAME, Manifest, load_manifest
+from simulator.world.robots.team.entries import Manifest
+from simulator.world.robots.team.manifest import MANIFEST_NAME, load_manifest
 from simulator.world.robots.team.model import TeamRobotModel, load_team_model
 
 if TYPE_CHECKING:

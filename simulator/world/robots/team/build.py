@@ -30,7 +30,7 @@ from simulator.errors import ModelError, ModelProblem
 from simulator.world.actuator import actuator_xml, line_constants
 from simulator.world.robots.devices import imu_sensor, imu_site
 from simulator.world.robots.team.devices import force_mjcf, imus_of
-from simulator.world.robots.team.manifest import Manifest
+from simulator.world.robots.team.entries import Manifest
 from simulator.world.robots.team.servos import motor_spec
 from simulator.world.types import DeviceKind
 

@@ -15,13 +15,9 @@ no device name can clash with the simulator's own sensors and sites.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 from simulator.errors import ModelProblem
 from simulator.world.robots.devices import DeviceNames, ImuNames
-
-if TYPE_CHECKING:
-    from simulator.world.robots.team.manifest import ImuEntry, Manifest
+from simulator.world.robots.team.entries import ImuEntry, Manifest
 
 MAX_NAME_CHARS = 100
 RESERVED_MOTOR_NAMES = frozenset({"root"})  # the free base's joint, <prefix>/root
@@ -36,8 +32,6 @@ def imus_of(manifest: Manifest) -> tuple[ImuEntry, ...]:
     """The manifest's IMUs, the first one the trunk's (``imu_link``)."""
     if manifest.imus:
         return manifest.imus
-    from simulator.world.robots.team.manifest import ImuEntry
-
     return (ImuEntry(link=manifest.imu_link),)
 
 

@@ -14,7 +14,8 @@ from simulator.world.robots.devices import DeviceNames
 from simulator.world.robots.model import CameraSpec, MotorLookup, MotorSpec, RobotMjcf
 from simulator.world.robots.team.build import PREFIX, Template, build_template
 from simulator.world.robots.team.devices import device_names
-from simulator.world.robots.team.manifest import JerseyEntry, Manifest, load_manifest
+from simulator.world.robots.team.entries import JerseyEntry, Manifest
+from simulator.world.robots.team.manifest import load_manifest
 from simulator.world.robots.team.servos import motor_spec
 from simulator.world.robots.team.source import load_spec_with_notes
 

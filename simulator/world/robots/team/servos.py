@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from simulator.errors import ModelProblem
 from simulator.world.robots.model import MotorSpec
-from simulator.world.robots.team.manifest import Manifest, MotorEntry
+from simulator.world.robots.team.entries import Manifest, MotorEntry
 from simulator.world.servos import find_servo
 
 RULE = "servos from the league catalogue"

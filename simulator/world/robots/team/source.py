@@ -23,7 +23,7 @@ from pathlib import Path
 import mujoco
 
 from simulator.errors import ModelError, ModelProblem
-from simulator.world.robots.team.manifest import Manifest
+from simulator.world.robots.team.entries import Manifest
 from simulator.world.robots.team.package import (
     ASSET_FILE_ATTRIBUTES,
     LIMITS,
