@@ -18,7 +18,9 @@ have no controller. Differences from Webots, all of the world and none of the ru
   ``world="league"`` (the default) every robot of a kid-size game is the league's test robot
   (:mod:`simulator.world.robots.league`: the Darwin-OP's size, mass and stored crouch, its legs
   where the scenarios push the ball and the other robot; 26 of the league's 47 files pass with
-  it, 24 with our robots, README); matches never play it.
+  it, 24 with our robots, README), and the ball bounces at 0.76 off the grass and the robots, as
+  the league's world bounces it (:func:`simulator.world.ball.use_league_bounce`; the match ball:
+  0.84); matches never play either.
 - A ball placed lower than its radius rests on the ground (both engines push it out; MuJoCo's
   push would throw it).
 - The "System" clock is the referee's wall clock (its real-time waits: before the first READY,
@@ -64,7 +66,7 @@ from referee import (
 )
 from simulator.match_setup import referee_config
 from simulator.world import World
-from simulator.world.ball import BALL_BODY, use_league_ball
+from simulator.world.ball import BALL_BODY, use_league_ball, use_league_bounce
 from simulator.world.robots import LEAGUE_TEST_KID_NAME
 
 # rc_testing.py:26 (VALID_SEC_STATES) with the wire codes of gamestate.py:78-90
@@ -241,6 +243,8 @@ class LeagueTestRunner:
             seed=spec.seed,
             physics_dt_s=spec.physics_dt_s,
         )
+        if world == "league":
+            use_league_bounce(self.world.model)
         if ball == "league":
             use_league_ball(self.world.model)
         self.clock = FakeClock()

@@ -135,3 +135,21 @@ def test_the_league_ball_loses_77_percent_of_its_speed_a_second(
     run_steps(world, 125)  # 1 s
     ball = world.snapshot().ball
     assert kept[0] < math.hypot(ball.velocity[0], ball.velocity[1]) / 3.0 < kept[1]
+
+
+@pytest.mark.parametrize(("league", "kept"), [(True, (0.73, 0.79)), (False, (0.81, 0.87))])
+def test_the_league_world_bounces_the_ball_at_0_76(league: bool, kept: tuple[float, float]) -> None:
+    """``use_league_bounce`` (``hlvs referee test``, the league's world): ``bounce 0.76`` of
+    hlvs_webots ``worlds/robocup.wbt``, 0.76 of the normal speed back off the grass (and off a
+    robot); the match ball keeps 0.84. Without gravity, so that only the contact acts."""
+    from simulator.world.ball import use_league_bounce
+
+    world = World.create(field_class="kid", robots=[], seed=1)
+    if league:
+        use_league_bounce(world.model)
+    world.model.opt.gravity[:] = 0.0
+    r = world.field.ball_radius_m
+    world.apply(PlaceBall(position=(0.0, 0.0, r + 0.01), velocity=(0.0, 0.0, -2.0)))
+    run_steps(world, 10)  # 80 ms: down 1 cm, the contact, and away
+    vz = world.snapshot().ball.velocity[2]
+    assert kept[0] < vz / 2.0 < kept[1], vz
