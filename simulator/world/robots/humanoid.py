@@ -107,6 +107,15 @@ def _leg(w: _Writer, side: str) -> str:
         FOOT_RGBA,
         g.foot_kg,
     )
+    if w.model.ankle_box_m is not None:
+        bx, bz, bhl, bhw, bhh = w.model.ankle_box_m
+        foot += w.geom(
+            "foot",
+            "ankle_" + side,
+            f'type="box" pos="{_f(bx, 0, bz)}" size="{_f(bhl, bhw, bhh)}"',
+            FOOT_RGBA,
+            0.0,
+        )
     for ny, y_name in ((1.0, "l"), (-1.0, "r")):
         for nx, x_name in ((-1.0, "b"), (1.0, "f")):
             at = _f(fx + nx * (hl - cleat), ny * (hw - cleat), sole + cleat)
@@ -277,6 +286,10 @@ class RobotModel(MotorLookup):
     # the robot stands crouched (``LegUpper = q, LegLower = 2 q, Ankle = q``: torso upright, feet
     # flat) with q = ``crouch_rad``; 0 for the built-in robots, which stand straight
     crouch_rad: float = 0.0
+    # a box on each foot above its sole, (x, z of its centre, half length, half width, half
+    # height) in the foot's frame (x forward, z up, the ankle at 0); None for the built-in robots.
+    # The league's test robot carries its ankle servos there
+    ankle_box_m: tuple[float, float, float, float, float] | None = None
 
     @property
     def standing_height_m(self) -> float:

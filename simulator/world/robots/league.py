@@ -15,6 +15,10 @@ all) and the same crouch:
                     rad the knee reaches 0.106 forward of the origin (the proto's knee boxes:
                     0.109), the legs leave no gap a ball can pass
     foot            0.105 long x 0.068 wide (box ``0.066 0.013 0.105``, line 1020)
+    ankle servos    a box on the foot, 0.083 long x 0.036 wide x 0.045 high, from 0.062 behind
+                    the ankle to 0.021 in front of it, 0.021 to 0.066 above the ground (the
+                    foot's ``Motors`` box ``0.036 0.045 0.083`` at ``0 0.01 -0.0205``, lines
+                    1006-1012): a ball rolling into the robot's heel stops against it
     torso           0.112 x 0.114 x 0.116 box (the body's boxes, 0.1 x 0.058 x 0.091 ...)
     arms            shoulders at (0, +-0.082, 0) hanging to 0.137 below it (lines 1552-1746)
     head            a sphere r 0.045 above the neck at 0.051 (capsule r 0.042, lines 436-441)
@@ -60,6 +64,10 @@ LEAGUE_TEST_KID_GEOMETRY = HumanoidGeometry(
     forearm_kg=0.06,
 )
 LEAGUE_TEST_KID_CROUCH_RAD = 1.126  # the knee 0.080 above the ankle as in the proto
+# the ankle servos' box (x, z of its centre, half sizes) in the foot's frame: its centre 0.0437
+# above the ground as in the proto (0.01 above the ankle, whose foot box reaches 0.0337 below it)
+_ANKLE_BOX_Z_M = 0.0437 - LEAGUE_TEST_KID_GEOMETRY.ankle_height_m
+LEAGUE_TEST_KID_ANKLE_BOX_M = (-0.0205, _ANKLE_BOX_Z_M, 0.0415, 0.018, 0.0225)
 
 
 def league_test_kid(base: RobotModel) -> RobotModel:
@@ -71,4 +79,5 @@ def league_test_kid(base: RobotModel) -> RobotModel:
         motors=base.motors,
         joint_armature=base.joint_armature,
         crouch_rad=LEAGUE_TEST_KID_CROUCH_RAD,
+        ankle_box_m=LEAGUE_TEST_KID_ANKLE_BOX_M,
     )

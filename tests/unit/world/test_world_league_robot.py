@@ -71,3 +71,24 @@ def test_no_team_can_choose_it() -> None:
     assert robot_model(LEAGUE).name == LEAGUE
     assert robot_model("kid-default").crouch_rad == 0.0
     assert not any(robot_model("kid-default").standing_pose_rad)
+
+
+def test_a_ball_rolled_into_its_heel_stops_against_its_ankle_servos() -> None:
+    """The Darwin-OP's foot carries its ankle servos' box, 0.062 m behind the ankle and 0.021 to
+    0.066 m above the ground (Darwin-opHinge2Robocup.proto:1006-1012): a ball pushed into the
+    robot's heel (throw_in/ball_distance, blue standing behind the touch line with its back to
+    the ball) stops against it, where it would ride up a 13 mm sole and roll on."""
+    world = _world(LEAGUE)  # facing +x, the ball behind it
+    run_steps(world, 125)
+    r = world.field.ball_radius_m
+    world.apply(PlaceBall(position=(0.85, 0.0, r), velocity=(0.6, 0.0, 0.0)))
+    xs, zs = [], []
+    for _ in range(100):
+        world.step()
+        ball = world.snapshot().ball.position
+        xs.append(float(ball[0]))
+        zs.append(float(ball[2]))
+    heel = 1.0 - 0.062  # the box's back face (the soft contact lets the ball in about 1 cm)
+    assert heel - r < max(xs) < heel - r + 0.02, max(xs)
+    assert xs[-1] < max(xs) - 0.1  # sent back
+    assert max(zs) < r + 0.005, max(zs)
