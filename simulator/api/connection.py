@@ -390,6 +390,8 @@ class Connection:
         if sent < len(frame):
             self._partial = memoryview(frame)[sent:]
             self.want_write = True
+        else:
+            self.last_sent_at = monotonic()  # written: the client's part starts now
 
     def send_threaded(self, frame: bytes, now: float) -> None:
         """:meth:`send` of a threaded connection: queue the frame for the I/O thread (never
@@ -438,6 +440,7 @@ class Connection:
             self.stats.bytes_out += sent
             if sent == len(self._partial):
                 self._partial = None
+                self.last_sent_at = monotonic()  # written: the client's part starts now
             else:
                 self._partial = self._partial[sent:]
 

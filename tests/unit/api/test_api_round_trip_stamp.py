@@ -1,0 +1,57 @@
+"""The server's round trip (``round_trip_ms``) starts when a measurement's last byte is written
+to the client's socket, not when the step queued it: the time the measurement waited in the
+queue for the I/O thread (or its frame to be built) is the server's, not a wait the client
+caused."""
+
+from __future__ import annotations
+
+import socket
+import time
+from collections.abc import Iterator
+
+import pytest
+
+from contracts.robot_api import messages_pb2 as pb
+from simulator.api.connection import Connection
+from simulator.api.framing import encode_frame
+from simulator.api.stats import RobotStats
+
+
+@pytest.fixture(params=[False, True], ids=["step-thread-io", "io-thread"])
+def pair(request: pytest.FixtureRequest) -> Iterator[tuple[Connection, socket.socket]]:
+    ours, theirs = socket.socketpair()
+    ours.setblocking(False)
+    conn = Connection(sock=ours, peer="test", key="red 1", stats=RobotStats(), queue_limit=10,
+                      time_bank_s=1.0, threaded=request.param)  # fmt: skip
+    try:
+        yield conn, theirs
+    finally:
+        ours.close()
+        theirs.close()
+
+
+def _answer(conn: Connection, theirs: socket.socket) -> None:
+    request = pb.ActuatorRequests()
+    request.motor_positions.add(name="HeadYaw", position=0.1)
+    theirs.sendall(encode_frame(request.SerializeToString()))
+    for _ in range(200):
+        if conn.read(time.monotonic()):
+            return
+        time.sleep(0.005)
+    raise AssertionError("the request did not arrive")
+
+
+def test_the_round_trip_starts_when_the_measurement_is_written(
+    pair: tuple[Connection, socket.socket],
+) -> None:
+    conn, theirs = pair
+    queued_at = time.monotonic() - 5.0  # queued long before it is written
+    conn.send(encode_frame(b"\x08\x01"), queued_at)
+    if conn.threaded:  # the I/O thread writes it
+        assert conn.last_sent_at == queued_at
+        assert conn.write_queued()
+    written = conn.last_sent_at
+    assert written is not None and written > queued_at + 4.0
+    _answer(conn, theirs)
+    (round_trip,) = conn.stats.round_trip_s
+    assert 0.0 <= round_trip < 4.0, round_trip  # not the 5 s the frame waited in the queue
