@@ -436,9 +436,8 @@ def _api_run(
     from simulator.api import (
         ApiServer,
         LockstepSettings,
-        Pipeline,
         PlayerEndpoint,
-        wait_lockstep,
+        stepping_for,
         world_cameras,
     )
     from simulator.api.endpoints import free_ports
@@ -505,28 +504,17 @@ def _api_run(
         clients = len(endpoints) - (last == "absent")
         while len(server.connected()) < clients and time.monotonic() < deadline:
             server.poll(0.05)
-        pipeline = Pipeline(server, lockstep) if args.mode == "pipelined" else None
-        waited = [0.0]
+        stepping = stepping_for(args.mode, server, lockstep)  # as a match's loop steps
 
         def one_step() -> None:
-            if pipeline is not None:
-                pipeline.before_step(world.sim_time_ms, world.sim_time_ms + world.step_ms)
-                world.step()
-                world.snapshot()
-                pipeline.after_step()
-                return
-            if args.mode == "lockstep":
-                waited[0] += wait_lockstep(server, lockstep)
-            server.apply_requests(world.sim_time_ms + world.step_ms)
+            stepping.before_step(world.sim_time_ms, world.sim_time_ms + world.step_ms)
             world.step()
             world.snapshot()
-            server.publish(world.sim_time_ms)
+            stepping.after_step(world.sim_time_ms)
 
         for _ in range(WARMUP_STEPS):
             one_step()
-        waited[0] = 0.0
-        if pipeline is not None:
-            pipeline.waited_s = 0.0
+        stepping.waited_s = 0.0
         steps = int(args.sim_seconds * 1000 / world.step_ms)
         start_ms = world.sim_time_ms
         # without cameras (whose render thread would run on), chunks of a reference world
@@ -566,8 +554,7 @@ def _api_run(
                 ref_wall += time.perf_counter() - started
                 ref_cpu += time.thread_time() - started_cpu
             requests_before = sum(slot.stats.messages_in for slot in server.slots.values())
-        if pipeline is not None:
-            waited[0] = pipeline.waited_s
+        waited = stepping.waited_s
         io_wakes = server.io_wakes - wakes_before
         stats = server.statistics()
     finally:
@@ -606,7 +593,7 @@ def _api_run(
         "league_client": league_client,
         "real_time_factor": round((world.sim_time_ms - start_ms) / 1000.0 / wall, 3),
         "cpu_s_per_sim_s": cpu / ((world.sim_time_ms - start_ms) / 1000.0),
-        "wait_share": round(waited[0] / wall, 3),
+        "wait_share": round(waited / wall, 3),
         "io_wakes_per_step": round(io_wakes / steps, 3),
         "ratio_interleaved": round(ref_wall / wall, 3) if ref_wall else None,
         "cpu_ratio_interleaved": round(ref_cpu / cpu, 3) if ref_cpu else None,

@@ -23,7 +23,9 @@ still served) so its result does not depend on machine speed: the number of step
 wait, and the step at which each robot connects within it, would depend on how fast the machine
 and the robots are, and so would every simulated time and pose after it. A client connected
 while a plain lockstep match holds gets one measurement of the held time with a warning that
-says so (:func:`hold_text`); a pipelined match sends it the held step's measurement.
+says so (:func:`simulator.api.stepping.hold_text`); a pipelined match sends it the held
+step's measurement. How a step meets the clients is the stepping policy's
+(:mod:`simulator.api.stepping`).
 """
 
 from __future__ import annotations
@@ -38,23 +40,11 @@ import numpy as np
 
 from contracts import EventRecord, GameStateRecord, StateMessage
 from referee import RefereeEvent, WorldCommand, WorldSnapshot
-from simulator.api import ApiServer, LockstepSettings, wait_lockstep
-from simulator.api.lockstep import Pipeline
+from simulator.api import ApiServer, LockstepSettings, stepping_for
 from simulator.telemetry import POSES_PERIOD_S, STATE_PERIOD_S, Telemetry
 from simulator.traffic import TrafficLog
 
 log = logging.getLogger(__name__)
-
-
-def hold_text(sim_time_ms: int) -> str:
-    """The warning a lockstep client gets while the match holds for a wall-clock wait."""
-    return (
-        f"lockstep: simulated time holds at {sim_time_ms} ms while the referee waits for "
-        "wall-clock time (before the first READY, between periods); the next measurement "
-        "comes with the next step. The wait is not simulated so that the match replays "
-        "identically (its steps would depend on machine speed and connection times); "
-        "async stepping keeps stepping during the wait, as in the league."
-    )
 
 
 class RefereeLike(Protocol):
@@ -131,9 +121,7 @@ class MatchLoop:
         self._next_poses_s = 0.0
         self._rtf_window: tuple[float, int] = (0.0, 0)
         self._rtf = 0.0
-        self._pipeline = (
-            Pipeline(server, settings.lockstep) if settings.stepping == "pipelined" else None
-        )
+        self.stepping = stepping_for(settings.stepping, server, settings.lockstep)
 
     def request_stop(self, reason: str) -> None:
         self.stop_requested = True
@@ -143,7 +131,7 @@ class MatchLoop:
     @property
     def lockstep(self) -> bool:
         """Lockstep or pipelined: steps wait for the clients and the wall-clock waits hold."""
-        return self.settings.stepping in ("lockstep", "pipelined")
+        return self.stepping.holds
 
     def run(self) -> str:
         """Play; returns why the loop ended: finished, max_duration or the stop reason."""
@@ -167,12 +155,10 @@ class MatchLoop:
                 if now - finished_at >= self.settings.end_of_game_real_s:
                     self.stop_reason = "finished"
                     break
-            if self.lockstep and (self.referee.waiting_for_wall_clock or finished_at is not None):
-                if self._pipeline is not None and self._pipeline.unsent:
-                    self._pipeline.send(self.world.sim_time_ms)  # the state they wait in
-                elif self._pipeline is None and finished_at is None:
-                    held_ms = self.world.sim_time_ms
-                    self.server.hold_notice(held_ms, hold_text(held_ms))
+            if self.stepping.holds and (
+                self.referee.waiting_for_wall_clock or finished_at is not None
+            ):
+                self.stepping.hold(self.world.sim_time_ms, finished=finished_at is not None)
                 self._hold(0.02)
                 pace_origin = (time.monotonic(), self.world.sim_time_ms)
                 continue
@@ -186,8 +172,8 @@ class MatchLoop:
                 while wait > 0:  # a socket event ends a poll early: wait until due
                     self.server.poll(wait)
                     wait = due - time.monotonic()
-        if self._pipeline is not None and self._pipeline.unsent and not self.stop_requested:
-            self.server.publish(self.world.sim_time_ms)  # the last step's, as in lockstep
+        if not self.stop_requested:
+            self.stepping.end(self.world.sim_time_ms)
         self.real_time_s = time.monotonic() - start
         self._publish_state(force=True)
         return self.stop_reason
@@ -199,28 +185,12 @@ class MatchLoop:
         self._publish_state()
         self.held_s += time.monotonic() - began
 
-    def _one_step_pipelined(self, pipeline: Pipeline) -> None:
-        world = self.world
-        pipeline.before_step(world.sim_time_ms, world.sim_time_ms + world.step_ms)
-        world.step()
-        self._referee_step(world.snapshot())
-        pipeline.after_step()
-        self.steps += 1
-        if self.recorder is not None:
-            self.recorder.record(world, self.referee.game_state.copy())
-        self._publish_state()
-
     def _one_step(self) -> None:
-        world, server = self.world, self.server
-        if self._pipeline is not None:
-            self._one_step_pipelined(self._pipeline)
-            return
-        if self.lockstep:
-            wait_lockstep(server, self.settings.lockstep)
-        server.apply_requests(world.sim_time_ms + world.step_ms)
+        world, stepping = self.world, self.stepping
+        stepping.before_step(world.sim_time_ms, world.sim_time_ms + world.step_ms)
         world.step()
         self._referee_step(world.snapshot())
-        server.publish(world.sim_time_ms)
+        stepping.after_step(world.sim_time_ms)
         self.steps += 1
         if self.recorder is not None:
             self.recorder.record(world, self.referee.game_state.copy())

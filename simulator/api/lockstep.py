@@ -8,9 +8,7 @@ again, with a full bank, once it has answered the latest measurement and its sen
 A client that sends more than its budget (:mod:`simulator.api.bounds`) is marked slow the same
 way and is not waited for while it is not read.
 
-:class:`Pipeline` is pipelined lockstep: the same wait, but for the answers to the measurement
-sent before the step just computed, so the clients think while the next step is computed and
-their actions apply one step later than in lockstep (a fixed latency: still deterministic).
+The lockstep and pipelined stepping policies (:mod:`simulator.api.stepping`) wait with it.
 """
 
 from __future__ import annotations
@@ -18,8 +16,7 @@ from __future__ import annotations
 import logging
 import time
 
-from contracts import RobotId
-from simulator.api.server import ApiServer, LockstepSettings, Request
+from simulator.api.server import ApiServer, LockstepSettings
 
 log = logging.getLogger(__name__)
 
@@ -106,53 +103,3 @@ def _wait(
         if not waiting:
             break
         server.poll(max(0.0, min(next_event, 0.05)))
-
-
-class Pipeline:
-    """Pipelined lockstep around a step loop::
-
-        pipeline.before_step(world.sim_time_ms, world.sim_time_ms + world.step_ms)
-        world.step()  # step N+1: the clients compute their answers to step N meanwhile
-        ...           # referee
-        pipeline.after_step()
-
-    :meth:`before_step` sends the measurement of step N only after waiting for and taking the
-    answers to the measurement of step N-1, then applies those: no answer to step N can be among
-    them whatever the timing, and the answers to step N apply at step N+2 (lockstep: N+1). Right
-    before a step the answers are taken and applied in one pass
-    (:meth:`ApiServer.apply_requests`, before the measurement goes out: nothing can have
-    answered it yet); a send during a hold keeps them for the next step.
-    """
-
-    def __init__(self, server: ApiServer, settings: LockstepSettings) -> None:
-        self._server = server
-        self._settings = settings
-        self._taken: dict[RobotId, list[Request]] = {}
-        self.unsent = False  # the latest step's measurement is not sent yet
-        self.waited_s = 0.0  # total time spent waiting for the clients
-
-    def send(self, time_ms: int, step_time_ms: int | None = None) -> None:
-        """Wait for the answers to the measurement sent last, take them, send the latest one
-        (read and encoded before the wait: the world does not change until it is sent). With
-        ``step_time_ms`` (right before that step) the answers are applied at once."""
-        server = self._server
-        prepared = server.prepare(time_ms)
-        self.waited_s += wait_lockstep(server, self._settings)
-        if step_time_ms is not None and not self._taken:
-            server.apply_requests(step_time_ms)  # takes what arrived and applies it
-        else:
-            for robot, requests in server.take_requests().items():
-                self._taken.setdefault(robot, []).extend(requests)
-        server.publish_prepared(prepared)
-        self.unsent = False
-
-    def before_step(self, time_ms: int, step_time_ms: int) -> None:
-        if self.unsent:
-            self.send(time_ms, step_time_ms)  # applies the answers unless some were kept
-            if not self._taken:
-                return
-        taken, self._taken = self._taken, {}
-        self._server.apply_taken(taken, step_time_ms)
-
-    def after_step(self) -> None:
-        self.unsent = True

@@ -9,7 +9,7 @@ from contracts.match_spec import NetworkSpec
 from robot.client import RobotClient
 from simulator.api import ApiServer, FakeDeviceWorld, LockstepSettings, PlayerEndpoint
 from simulator.api.endpoints import free_ports
-from simulator.match_loop import hold_text
+from simulator.api.stepping import hold_text
 from tests.integration.api.harness import RED1, wait_until
 
 
