@@ -62,18 +62,8 @@ class World(DeviceAccess):
         sensor_model: SensorModel | None = None,
         camera_model: CameraModel | None = None,
     ) -> None:
-        substeps = step_ms / 1000.0 / physics_dt_s
-        if physics_dt_s <= 0 or step_ms <= 0 or abs(substeps - round(substeps)) > 1e-6:
-            raise ValueError(
-                f"step_ms ({step_ms}) must be a positive multiple of physics_dt_s ({physics_dt_s})"
-            )
-        if divergence_policy not in ("fail", "reset_robot"):
-            raise ValueError(
-                f"divergence_policy must be 'fail' or 'reset_robot', not {divergence_policy!r}"
-            )
+        substeps = _checked_substeps(physics_dt_s, step_ms, divergence_policy, placements)
         ids = [p.id for p in placements]
-        if len(set(ids)) != len(ids):
-            raise ValueError(f"robot ids must be unique: {[str(i) for i in ids]}")
         self.field = field
         self.placements = tuple(placements)
         self.seed = seed
@@ -104,6 +94,22 @@ class World(DeviceAccess):
         self.sim_time_ms = 0
         self.last_ball_toucher: RobotId | None = None
         self.last_ball_touch_ms: int | None = None
+        self._stand_robots(initial_joint_noise_rad)
+        mujoco.mj_forward(self.model, self.data)
+        self._sensor_span = FlatData(self.data, ("qpos", "sensordata"))
+        self.sensor_model = sensor_model if sensor_model is not None else SensorModel.ideal()
+        self.sensor_noise = self._sensor_noise(seed)
+        self._readings = (
+            self._sensor_span.values if self.sensor_noise is None else self.sensor_noise.values
+        )
+        self._watch = DivergenceWatch(self.data)
+        self._snapshots = SnapshotBuilder(self.data, self.index, self.robot_ids)
+        self._ball_toucher = BallToucher(self.data, self.index)
+        self._saved = self._save()
+
+    def _stand_robots(self, initial_joint_noise_rad: float) -> None:
+        """Every robot's joints and servo targets in its standing pose, each joint moved by up
+        to ``initial_joint_noise_rad`` drawn from the world's generator (robot by robot)."""
         for robot in self.index.robots:
             pose = np.asarray(robot.model.standing_pose_rad, dtype=np.float64)
             if initial_joint_noise_rad > 0:
@@ -113,27 +119,21 @@ class World(DeviceAccess):
             if pose.any():
                 self.data.qpos[robot.motor_qpos] = pose
                 self.motors.hold(robot.actuators, pose)
-        mujoco.mj_forward(self.model, self.data)
-        self._sensor_span = FlatData(self.data, ("qpos", "sensordata"))
-        self.sensor_model = sensor_model if sensor_model is not None else SensorModel.ideal()
-        self.sensor_noise: SensorNoise | None = None
-        self._readings = self._sensor_span.values
-        if self.sensor_model.enabled:
-            self.sensor_noise = SensorNoise(
-                model=self.sensor_model,
-                flat=self._sensor_span,
-                index=self.index,
-                encoder_resolution_rad=np.array(
-                    [m.encoder_resolution_rad for r in self.index.robots for m in r.model.motors]
-                ),
-                seed=seed,
-                step_s=step_ms / 1000.0,
-            )
-            self._readings = self.sensor_noise.values
-        self._watch = DivergenceWatch(self.data)
-        self._snapshots = SnapshotBuilder(self.data, self.index, self.robot_ids)
-        self._ball_toucher = BallToucher(self.data, self.index)
-        self._saved = self._save()
+
+    def _sensor_noise(self, seed: int) -> SensorNoise | None:
+        """The noisy readings of :attr:`sensor_model`; None when it is ideal."""
+        if not self.sensor_model.enabled:
+            return None
+        return SensorNoise(
+            model=self.sensor_model,
+            flat=self._sensor_span,
+            index=self.index,
+            encoder_resolution_rad=np.array(
+                [m.encoder_resolution_rad for r in self.index.robots for m in r.model.motors]
+            ),
+            seed=seed,
+            step_s=self.step_ms / 1000.0,
+        )
 
     @classmethod
     def create(
@@ -292,3 +292,26 @@ class World(DeviceAccess):
             commands.place_ball(self, (0.0, 0.0, self.field.ball_radius_m), (0.0, 0.0, 0.0))
             logger.warning("physics diverged at %d ms (%s); reset the ball", self.sim_time_ms, text)
         mujoco.mj_forward(self.model, self.data)
+
+
+def _checked_substeps(
+    physics_dt_s: float,
+    step_ms: int,
+    divergence_policy: str,
+    placements: Sequence[RobotPlacement],
+) -> float:
+    """Physics substeps in a basic step; raises ValueError when ``step_ms`` is not a multiple
+    of ``physics_dt_s``, the divergence policy is unknown or two robots share an id."""
+    substeps = step_ms / 1000.0 / physics_dt_s
+    if physics_dt_s <= 0 or step_ms <= 0 or abs(substeps - round(substeps)) > 1e-6:
+        raise ValueError(
+            f"step_ms ({step_ms}) must be a positive multiple of physics_dt_s ({physics_dt_s})"
+        )
+    if divergence_policy not in ("fail", "reset_robot"):
+        raise ValueError(
+            f"divergence_policy must be 'fail' or 'reset_robot', not {divergence_policy!r}"
+        )
+    ids = [p.id for p in placements]
+    if len(set(ids)) != len(ids):
+        raise ValueError(f"robot ids must be unique: {[str(i) for i in ids]}")
+    return substeps

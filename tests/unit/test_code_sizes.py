@@ -29,12 +29,6 @@ LONG_FUNCTIONS: dict[str, tuple[int, str]] = {
     "envs/mjx_vector.py::MjxStandKickVector.__init__": (
         197, "builds the batched JAX step and reset as closures over the compiled model "
         "(jit-compiled functions that capture the arrays they close over)"),
-    "simulator/world/robots/team/build.py::build_template": (
-        147, "one pass of edits over a team's MjSpec, each step needing the previous "
-        "one's compiled model"),
-    "simulator/world/robots/team/manifest.py::load_manifest": (
-        132, "reads and validates every field of a model's manifest, each with its own "
-        "error naming the file and field"),
     "simulator/runtime.py::run_match": (
         117, "the simulator's composition root: the world, referee, API server, "
         "recorder and cameras built and torn down in one place"),

@@ -215,29 +215,7 @@ def build_humanoid(
     torso = w.geom(
         "torso", "torso", f'type="box" pos="0 0 {cz:.6g}" size="{_f(tx, ty, tz)}"', rgba, g.torso_kg
     )
-    if jersey is None:
-        chest = w.visual(
-            "chest",
-            f'type="box" pos="{_f(tx, 0, cz + tz * 0.3)}" '
-            f'size="{_f(tx * 0.05, ty * 0.6, tz * 0.35)}"',
-            "1 1 1 1",
-        )
-    else:
-        # a plate on each side, turned so that the texture's rows run down and the number
-        # reads from in front of it (x of the plate's frame out of the torso). The front one
-        # where the white chest plate was and no larger: the head camera looking down at the
-        # feet sees its top edge, and a taller one put red in the ring round a ball at the
-        # feet (the stub's ball finder lost it); the back one larger
-        plates = (
-            ("front", 1.0, "0 1 0 0 0 1", cz + tz * 0.3, _f(ty * 0.6, tz * 0.35, tx * 0.05)),
-            ("back", -1.0, "0 -1 0 0 0 1", cz, _f(ty * 0.75, tz * 0.6, tx * 0.05)),
-        )
-        chest = "".join(
-            f'<geom name="{p}/visual:jersey_{side}" type="box" pos="{_f(sign * tx, 0, z)}" '
-            f'xyaxes="{axes}" size="{half}" material="{jersey}" mass="0" contype="0" '
-            f'conaffinity="0" group="1"/>'
-            for side, sign, axes, z, half in plates
-        )
+    chest = _chest(w, model, jersey)
     marker = w.visual(
         "marker",
         f'type="cylinder" pos="0 0 {hr * 0.95:.6g}" size="{_f(hr * 0.6, hr * 0.08)}"',
@@ -263,13 +241,48 @@ def build_humanoid(
  </body>
 </body>"""
     actuators = "".join(actuator_xml(f"{p}/{m.name}", f"{p}/{m.name}", m) for m in model.motors)
-    sensors = (
+    return RobotMjcf(body=body, actuators=actuators, sensors=_sensors(model, p))
+
+
+def _chest(w: _Writer, model: RobotModel, jersey: str | None) -> str:
+    """The chest's visuals: the jersey's two plates wearing ``jersey`` (a material), or without
+    one a white chest plate."""
+    g = model.geometry
+    p = w.p
+    tx, ty, tz = g.torso_half_size_m
+    cz = g.torso_centre_z_m
+    if jersey is None:
+        return w.visual(
+            "chest",
+            f'type="box" pos="{_f(tx, 0, cz + tz * 0.3)}" '
+            f'size="{_f(tx * 0.05, ty * 0.6, tz * 0.35)}"',
+            "1 1 1 1",
+        )
+    # a plate on each side, turned so that the texture's rows run down and the number
+    # reads from in front of it (x of the plate's frame out of the torso). The front one
+    # where the white chest plate was and no larger: the head camera looking down at the
+    # feet sees its top edge, and a taller one put red in the ring round a ball at the
+    # feet (the stub's ball finder lost it); the back one larger
+    plates = (
+        ("front", 1.0, "0 1 0 0 0 1", cz + tz * 0.3, _f(ty * 0.6, tz * 0.35, tx * 0.05)),
+        ("back", -1.0, "0 -1 0 0 0 1", cz, _f(ty * 0.75, tz * 0.6, tx * 0.05)),
+    )
+    return "".join(
+        f'<geom name="{p}/visual:jersey_{side}" type="box" pos="{_f(sign * tx, 0, z)}" '
+        f'xyaxes="{axes}" size="{half}" material="{jersey}" mass="0" contype="0" '
+        f'conaffinity="0" group="1"/>'
+        for side, sign, axes, z, half in plates
+    )
+
+
+def _sensors(model: RobotModel, p: str) -> str:
+    """The IMU's accelerometer and gyro, the body's velocity, the feet's touch sensors."""
+    return (
         f'<accelerometer name="{p}/Accelerometer" site="{p}/site:imu"/>'
         f'<gyro name="{p}/Gyro" site="{p}/site:imu"/>'
         f'<subtreelinvel name="{p}/com_velocity" body="{p}/torso"/>'
         + "".join(f'<touch name="{p}/{n}" site="{p}/site:{n}"/>' for n in model.force_sensors)
     )
-    return RobotMjcf(body=body, actuators=actuators, sensors=sensors)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

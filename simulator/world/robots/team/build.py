@@ -248,10 +248,23 @@ def _parts(spec: mujoco.MjSpec, manifest: Manifest) -> dict[str, str]:
 
 
 def _validate(spec: mujoco.MjSpec, manifest: Manifest) -> list[ModelProblem]:
-    problems = []
-    links = {b.name for b in _bodies(spec)}
+    """Every problem of the model file against its manifest, in the order a reader fixes them:
+    the tree, the motors' joints, joints no motor drives, the servos' lines, the named links."""
     joints = {j.name: j for b in _bodies(spec) for j in b.joints}
-    motor_joints = {m.joint for m in manifest.motors}
+    return [
+        *_tree_problems(spec, manifest, joints),
+        *_motor_joint_problems(manifest, joints),
+        *_joint_problems(spec, manifest, joints),
+        *_line_problems(manifest),
+        *_link_problems(spec, manifest),
+    ]
+
+
+def _tree_problems(
+    spec: mujoco.MjSpec, manifest: Manifest, joints: dict[str, mujoco.MjsJoint]
+) -> list[ModelProblem]:
+    """One tree of links, with something to move."""
+    problems = []
     if len(spec.worldbody.bodies) != 1:
         problems.append(
             _problem(
@@ -266,6 +279,14 @@ def _validate(spec: mujoco.MjSpec, manifest: Manifest) -> list[ModelProblem]:
                 manifest, "model_file", "the model has no movable joints (a robot needs motors)"
             )
         )
+    return problems
+
+
+def _motor_joint_problems(
+    manifest: Manifest, joints: dict[str, mujoco.MjsJoint]
+) -> list[ModelProblem]:
+    """Each motor's joint: there, revolute, and its manifest range within the file's."""
+    problems = []
     for i, motor in enumerate(manifest.motors):
         joint = joints.get(motor.joint)
         if joint is None:
@@ -293,6 +314,14 @@ def _validate(spec: mujoco.MjSpec, manifest: Manifest) -> list[ModelProblem]:
                         "manifest may narrow a joint's range, never widen it)",
                     )
                 )
+    return problems
+
+
+def _joint_problems(
+    spec: mujoco.MjSpec, manifest: Manifest, joints: dict[str, mujoco.MjsJoint]
+) -> list[ModelProblem]:
+    """Free joints below the root, and movable joints no motor drives."""
+    problems = []
     roots = list(spec.worldbody.bodies)
     for body in _bodies(spec):
         for joint in body.joints:
@@ -305,6 +334,7 @@ def _validate(spec: mujoco.MjSpec, manifest: Manifest) -> list[ModelProblem]:
                         "is one tree of joints (only its root may float)",
                     )
                 )
+    motor_joints = {m.joint for m in manifest.motors}
     for name, joint in joints.items():
         if name not in motor_joints and joint.type != mujoco.mjtJoint.mjJNT_FREE:
             problems.append(
@@ -315,7 +345,12 @@ def _validate(spec: mujoco.MjSpec, manifest: Manifest) -> list[ModelProblem]:
                     "motors (unactuated joints are not allowed)",
                 )
             )
-    problems += _line_problems(manifest)
+    return problems
+
+
+def _link_problems(spec: mujoco.MjSpec, manifest: Manifest) -> list[ModelProblem]:
+    """Every link the manifest names (IMUs, cameras, force sensors, jersey, parts, hands, feet)."""
+    links = {b.name for b in _bodies(spec)}
     named: list[tuple[str, str]] = [(f"{i.where}/link", i.link) for i in imus_of(manifest)]
     named += [(f"/cameras/{i}/link", c.link) for i, c in enumerate(manifest.cameras)]
     named += [(f"/force_sensors/{k}", v) for k, v in manifest.force_sensors.items()]
@@ -327,14 +362,11 @@ def _validate(spec: mujoco.MjSpec, manifest: Manifest) -> list[ModelProblem]:
         ("/feet/left", manifest.feet[0]),
         ("/feet/right", manifest.feet[1]),
     ]
-    for where, link in named:
-        if link not in links:
-            problems.append(
-                _problem(
-                    manifest, where, f"no link {link!r} in the model{_did_you_mean(link, links)}"
-                )
-            )
-    return problems
+    return [
+        _problem(manifest, where, f"no link {link!r} in the model{_did_you_mean(link, links)}")
+        for where, link in named
+        if link not in links
+    ]
 
 
 def _line_problems(manifest: Manifest) -> list[ModelProblem]:
@@ -371,144 +403,60 @@ def _did_you_mean(name: str, known: object) -> str:
     return f"; did you mean {close[0]!r}?" if close else ""
 
 
+@dataclass(frozen=True, slots=True)
+class _Shapes:
+    """What the edits read of the model file as it was compiled before them (zero pose)."""
+
+    original: mujoco.MjModel
+    boxes: dict[int, tuple[np.ndarray, np.ndarray]]  # body id -> its own collision box
+    owner_boxes: dict[int, tuple[np.ndarray, np.ndarray]]  # moving part -> its link box
+    sensor_sites: dict[str, dict[str, tuple[np.ndarray, np.ndarray]]]  # see _sensor_sites
+    cleats: set[int]  # geom ids kept as the feet's own shapes
+
+    @classmethod
+    def of(cls, original: mujoco.MjModel, manifest: Manifest) -> _Shapes:
+        cleats = _cleats(original, manifest) if manifest.collision == "link-boxes" else set()
+        return cls(
+            original=original,
+            boxes=_collision_boxes(original, merge_welded=False),
+            sensor_sites=_sensor_sites(
+                original, manifest, _collision_boxes(original, merge_welded=True)
+            ),
+            owner_boxes=_collision_boxes(
+                original, merge_welded=True, skip=_cleat_links(original, cleats)
+            ),
+            cleats=cleats,
+        )
+
+
 def build_template(spec: mujoco.MjSpec, manifest: Manifest, *, key: str) -> Template:
-    """Edit ``spec`` (consumed) into the world's robot template. Raises :class:`ModelError`."""
+    """Edit ``spec`` (consumed) into the world's robot template. Raises :class:`ModelError`.
+
+    The steps, in order: validate, measure the file's shapes (:class:`_Shapes`), name the
+    shared assets by ``key``, edit each link (:func:`_edit_body`), replace the file's base by
+    the world's free joint and add the team marker, drop the file's actuators and sensors (the
+    world writes its own), then measure the standing height and write the template."""
     problems = _validate(spec, manifest)
     if problems:
         raise ModelError(problems)
-    original = spec.compile()
-    boxes = _collision_boxes(original, merge_welded=False)
-    sensor_sites = _sensor_sites(original, manifest, _collision_boxes(original, merge_welded=True))
-    cleats = _cleats(original, manifest) if manifest.collision == "link-boxes" else set()
-    owner_boxes = _collision_boxes(original, merge_welded=True, skip=_cleat_links(original, cleats))
+    shapes = _Shapes.of(spec.compile(), manifest)
     parts = _parts(spec, manifest)
     root = spec.worldbody.bodies[0]
     root_name = root.name
-    motors = {m.joint: m for m in manifest.motors}
     ranges: dict[str, tuple[float, float]] = {}
-    p = PREFIX
-    for mesh in spec.meshes:
-        mesh.name = f"{key}:{mesh.name}"
-    # materials and textures are shared by the model's robots like its meshes: named by the key,
-    # so that two models that both have a "black" material can play each other
-    for texture in spec.textures:
-        if texture.name:
-            texture.name = f"{key}:{texture.name}"
-    for material in spec.materials:
-        material.name = f"{key}:{material.name}"
-        material.textures = [f"{key}:{t}" if t else t for t in material.textures]
+    _name_assets(spec, key)
     for body in [root, *_bodies(spec)[1:]]:
-        b = original.body(body.name).id
-        link = body.name
-        body.explicitinertial = True
-        body.mass = max(float(original.body_mass[b]), 1e-6)
-        body.ipos = original.body_ipos[b]
-        body.iquat = original.body_iquat[b]
-        body.inertia = np.maximum(original.body_inertia[b], 1e-9)
-        body.fullinertia = np.full(6, np.nan)
-        part = parts[link]
-        visuals = 0
-        for i, geom in enumerate(list(body.geoms)):
-            if _is_collision(geom):
-                if manifest.collision == "link-boxes":
-                    _drop(geom, f"{link}_{i}")
-                    continue
-                geom.name = f"{p}/{part}:{link}_{i}"
-            else:
-                geom.name = f"{p}/visual:{link}_{visuals}"
-                visuals += 1
-            geom.mass = 0
-            geom.density = 0
-            if geom.type == mujoco.mjtGeom.mjGEOM_MESH:
-                geom.meshname = f"{key}:{geom.meshname}"
-            if geom.material:
-                geom.material = f"{key}:{geom.material}"
-        # the file's own sites and cameras: the world's are the manifest's (/imu, /cameras), and
-        # their names, not the robot's, would repeat in a world of several robots
-        for own in [*body.sites, *body.cameras]:
-            spec.delete(own)
-        if manifest.collision == "link-boxes" and b in owner_boxes:
-            lo, hi = owner_boxes[b]
-            box = body.add_geom()
-            box.name = f"{p}/{part}:{link}"
-            box.type = mujoco.mjtGeom.mjGEOM_BOX
-            box.pos = (lo + hi) / 2
-            box.size = np.maximum((hi - lo) / 2, 1e-3)
-            box.group = 3
-            box.mass = 0
-            box.rgba = (0.5, 0.5, 0.5, 0.0)
-        own = [g for g in sorted(cleats) if _owner(original, int(original.geom_bodyid[g])) == b]
-        for k, g in enumerate(own):
-            _add_cleat(body, original, g, b, f"{p}/{part}:{link}_cleat_{k}")
-        for joint in body.joints:
-            if joint.type == mujoco.mjtJoint.mjJNT_FREE:
-                continue  # the file's own free base (replaced below)
-            motor = motors[joint.name]
-            if motor.range_rad is not None:
-                joint.range = motor.range_rad
-                joint.limited = mujoco.mjtLimited.mjLIMITED_TRUE
-            ranges[motor.name] = (float(joint.range[0]), float(joint.range[1]))
-            joint.name = f"{p}/{motor.name}"
-            physics = motor_spec(motor, manifest)
-            joint.damping = [physics.damping_nm_s_per_rad, 0.0, 0.0]
-            joint.frictionloss = physics.static_friction_nm
-            joint.armature = physics.armature_kg_m2
-        for k, imu in enumerate(imus_of(manifest)):
-            if imu.link == link:
-                body.add_site().name = f"{p}/{imu_site(k)}"
-        for sensor, sensor_link in manifest.force_sensors.items():
-            if manifest.collision == "link-boxes" and sensor_link in sensor_sites.get(link, {}):
-                lo, hi = sensor_sites[link][sensor_link]
-            elif sensor_link == link and manifest.collision != "link-boxes":
-                lo, hi = boxes.get(b, (np.full(3, -0.01), np.full(3, 0.01)))
-                lo, hi = lo - 2e-3, hi + 2e-3
-            else:
-                continue
-            site = body.add_site()
-            site.name = f"{p}/site:{force_mjcf(sensor)}"
-            site.type = mujoco.mjtGeom.mjGEOM_BOX
-            site.pos = (lo + hi) / 2
-            site.size = (hi - lo) / 2
-            site.group = 4
-        for group, side, hull in HULL:
-            if getattr(manifest, group)[side] == link:
-                marker = body.add_body()
-                marker.name = f"{p}/{hull}"
-                lo, hi = boxes.get(b, (np.zeros(3), np.zeros(3)))
-                marker.pos = (lo + hi) / 2
-        for camera in manifest.cameras:
-            if camera.link == link:
-                cam = body.add_camera()
-                cam.name = f"{p}/{camera.name}"
-                cam.pos = camera.pos_m
-                cam.alt.type = mujoco.mjtOrientation.mjORIENTATION_XYAXES
-                cam.alt.xyaxes = (0, -1, 0, 0, 0, 1)
-                cam.fovy = math.degrees(
-                    2 * math.atan(math.tan(camera.fov_rad / 2) * camera.height / camera.width)
-                )
-        body.name = f"{p}/torso" if body is root else f"{p}/link:{link}"
-    for joint in root.joints:
-        spec.delete(joint)
-    root.add_freejoint().name = f"{p}/root"
-    top = _top_of(original, manifest)
-    head = root if top[0] == root_name else spec.body(f"{p}/link:{top[0]}")
-    marker = head.add_geom()
-    marker.name = f"{p}/visual:marker"
-    marker.type = mujoco.mjtGeom.mjGEOM_CYLINDER
-    marker.size = (MARKER_RADIUS_M, 0.006, 0)
-    marker.pos = top[1]
-    marker.contype = marker.conaffinity = 0
-    marker.group = 1
-    marker.mass = 0
+        ranges |= _edit_body(spec, body, shapes, manifest, part=parts[body.name], key=key)
+        body.name = f"{PREFIX}/torso" if body is root else f"{PREFIX}/link:{body.name}"
+    _add_base_and_marker(spec, root, shapes.original, manifest, root_name=root_name)
     for actuator in list(spec.actuators):
         spec.delete(actuator)
     for sensor in list(spec.sensors):
         spec.delete(sensor)
     standing = _standing_height(spec, manifest.standing_pose_rad)
     xml = spec.to_xml()
-    heaviest = int(np.argmax(original.body_mass))
-    trunk = original.body(heaviest).name
-    trunk_name = f"{p}/torso" if trunk == root_name else f"{p}/link:{trunk}"
+    trunk = shapes.original.body(int(np.argmax(shapes.original.body_mass))).name
+    trunk_name = f"{PREFIX}/torso" if trunk == root_name else f"{PREFIX}/link:{trunk}"
     return _template(
         xml,
         manifest,
@@ -518,6 +466,190 @@ def build_template(spec: mujoco.MjSpec, manifest: Manifest, *, key: str) -> Temp
         ranges=ranges,
         trunk=trunk_name,
     )
+
+
+def _name_assets(spec: mujoco.MjSpec, key: str) -> None:
+    """Meshes, textures and materials are shared by the model's robots: named by the key, so
+    that two models that both have a "black" material can play each other."""
+    for mesh in spec.meshes:
+        mesh.name = f"{key}:{mesh.name}"
+    for texture in spec.textures:
+        if texture.name:
+            texture.name = f"{key}:{texture.name}"
+    for material in spec.materials:
+        material.name = f"{key}:{material.name}"
+        material.textures = [f"{key}:{t}" if t else t for t in material.textures]
+
+
+def _edit_body(
+    spec: mujoco.MjSpec,
+    body: mujoco.MjsBody,
+    shapes: _Shapes,
+    manifest: Manifest,
+    *,
+    part: str,
+    key: str,
+) -> dict[str, tuple[float, float]]:
+    """One link made the world's: its inertia fixed, its geoms renamed (or dropped for its
+    box), its collision box and cleats, its joints made servos, then the devices and markers
+    the manifest puts on it. Returns the ranges (rad) of its motors by motor name."""
+    b = shapes.original.body(body.name).id
+    _fix_inertia(body, shapes.original, b)
+    _name_geoms(body, manifest, part=part, key=key)
+    # the file's own sites and cameras: the world's are the manifest's (/imu, /cameras), and
+    # their names, not the robot's, would repeat in a world of several robots
+    for own in [*body.sites, *body.cameras]:
+        spec.delete(own)
+    _add_collision(body, shapes, manifest, b, part=part)
+    ranges = _make_servos(body, manifest)
+    _add_sensor_sites(body, shapes, manifest, b)
+    _add_hulls_and_cameras(body, shapes, manifest, b)
+    return ranges
+
+
+def _fix_inertia(body: mujoco.MjsBody, original: mujoco.MjModel, b: int) -> None:
+    """The compiled inertia written explicitly (the geoms lose their mass), kept above zero."""
+    body.explicitinertial = True
+    body.mass = max(float(original.body_mass[b]), 1e-6)
+    body.ipos = original.body_ipos[b]
+    body.iquat = original.body_iquat[b]
+    body.inertia = np.maximum(original.body_inertia[b], 1e-9)
+    body.fullinertia = np.full(6, np.nan)
+
+
+def _name_geoms(body: mujoco.MjsBody, manifest: Manifest, *, part: str, key: str) -> None:
+    """Collision geoms named by body part (dropped under ``link-boxes``), the rest visuals;
+    massless, their meshes and materials by the model's key."""
+    link = body.name
+    visuals = 0
+    for i, geom in enumerate(list(body.geoms)):
+        if _is_collision(geom):
+            if manifest.collision == "link-boxes":
+                _drop(geom, f"{link}_{i}")
+                continue
+            geom.name = f"{PREFIX}/{part}:{link}_{i}"
+        else:
+            geom.name = f"{PREFIX}/visual:{link}_{visuals}"
+            visuals += 1
+        geom.mass = 0
+        geom.density = 0
+        if geom.type == mujoco.mjtGeom.mjGEOM_MESH:
+            geom.meshname = f"{key}:{geom.meshname}"
+        if geom.material:
+            geom.material = f"{key}:{geom.material}"
+
+
+def _add_collision(
+    body: mujoco.MjsBody, shapes: _Shapes, manifest: Manifest, b: int, *, part: str
+) -> None:
+    """Under ``link-boxes``: the moving part's box, then the cleats it carries."""
+    link = body.name
+    if manifest.collision == "link-boxes" and b in shapes.owner_boxes:
+        lo, hi = shapes.owner_boxes[b]
+        box = body.add_geom()
+        box.name = f"{PREFIX}/{part}:{link}"
+        box.type = mujoco.mjtGeom.mjGEOM_BOX
+        box.pos = (lo + hi) / 2
+        box.size = np.maximum((hi - lo) / 2, 1e-3)
+        box.group = 3
+        box.mass = 0
+        box.rgba = (0.5, 0.5, 0.5, 0.0)
+    original = shapes.original
+    own = [g for g in sorted(shapes.cleats) if _owner(original, int(original.geom_bodyid[g])) == b]
+    for k, g in enumerate(own):
+        _add_cleat(body, original, g, b, f"{PREFIX}/{part}:{link}_cleat_{k}")
+
+
+def _make_servos(body: mujoco.MjsBody, manifest: Manifest) -> dict[str, tuple[float, float]]:
+    """The link's joints named by motor, narrowed to the manifest's range and given the servo's
+    damping, friction and armature; the file's own free base is left (replaced later)."""
+    motors = {m.joint: m for m in manifest.motors}
+    ranges: dict[str, tuple[float, float]] = {}
+    for joint in body.joints:
+        if joint.type == mujoco.mjtJoint.mjJNT_FREE:
+            continue
+        motor = motors[joint.name]
+        if motor.range_rad is not None:
+            joint.range = motor.range_rad
+            joint.limited = mujoco.mjtLimited.mjLIMITED_TRUE
+        ranges[motor.name] = (float(joint.range[0]), float(joint.range[1]))
+        joint.name = f"{PREFIX}/{motor.name}"
+        physics = motor_spec(motor, manifest)
+        joint.damping = [physics.damping_nm_s_per_rad, 0.0, 0.0]
+        joint.frictionloss = physics.static_friction_nm
+        joint.armature = physics.armature_kg_m2
+    return ranges
+
+
+def _add_sensor_sites(body: mujoco.MjsBody, shapes: _Shapes, manifest: Manifest, b: int) -> None:
+    """The IMU sites and the force sensors' touch sites on this link."""
+    link = body.name
+    for k, imu in enumerate(imus_of(manifest)):
+        if imu.link == link:
+            body.add_site().name = f"{PREFIX}/{imu_site(k)}"
+    for sensor, sensor_link in manifest.force_sensors.items():
+        if manifest.collision == "link-boxes" and sensor_link in shapes.sensor_sites.get(link, {}):
+            lo, hi = shapes.sensor_sites[link][sensor_link]
+        elif sensor_link == link and manifest.collision != "link-boxes":
+            lo, hi = shapes.boxes.get(b, (np.full(3, -0.01), np.full(3, 0.01)))
+            lo, hi = lo - 2e-3, hi + 2e-3
+        else:
+            continue
+        site = body.add_site()
+        site.name = f"{PREFIX}/site:{force_mjcf(sensor)}"
+        site.type = mujoco.mjtGeom.mjGEOM_BOX
+        site.pos = (lo + hi) / 2
+        site.size = (hi - lo) / 2
+        site.group = 4
+
+
+def _add_hulls_and_cameras(
+    body: mujoco.MjsBody, shapes: _Shapes, manifest: Manifest, b: int
+) -> None:
+    """The bodies marking hands and feet for the referee, and the manifest's cameras (looking
+    along the link's x axis, the vertical field of view from the horizontal one)."""
+    link = body.name
+    for group, side, hull in HULL:
+        if getattr(manifest, group)[side] == link:
+            marker = body.add_body()
+            marker.name = f"{PREFIX}/{hull}"
+            lo, hi = shapes.boxes.get(b, (np.zeros(3), np.zeros(3)))
+            marker.pos = (lo + hi) / 2
+    for camera in manifest.cameras:
+        if camera.link == link:
+            cam = body.add_camera()
+            cam.name = f"{PREFIX}/{camera.name}"
+            cam.pos = camera.pos_m
+            cam.alt.type = mujoco.mjtOrientation.mjORIENTATION_XYAXES
+            cam.alt.xyaxes = (0, -1, 0, 0, 0, 1)
+            cam.fovy = math.degrees(
+                2 * math.atan(math.tan(camera.fov_rad / 2) * camera.height / camera.width)
+            )
+
+
+def _add_base_and_marker(
+    spec: mujoco.MjSpec,
+    root: mujoco.MjsBody,
+    original: mujoco.MjModel,
+    manifest: Manifest,
+    *,
+    root_name: str,
+) -> None:
+    """The world's free joint in place of the root's own joints, and the team-coloured marker
+    on top of the link holding the robot's highest point."""
+    for joint in root.joints:
+        spec.delete(joint)
+    root.add_freejoint().name = f"{PREFIX}/root"
+    top = _top_of(original, manifest)
+    head = root if top[0] == root_name else spec.body(f"{PREFIX}/link:{top[0]}")
+    marker = head.add_geom()
+    marker.name = f"{PREFIX}/visual:marker"
+    marker.type = mujoco.mjtGeom.mjGEOM_CYLINDER
+    marker.size = (MARKER_RADIUS_M, 0.006, 0)
+    marker.pos = top[1]
+    marker.contype = marker.conaffinity = 0
+    marker.group = 1
+    marker.mass = 0
 
 
 def _top_of(model: mujoco.MjModel, manifest: Manifest) -> tuple[str, np.ndarray]:

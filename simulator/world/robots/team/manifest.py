@@ -132,7 +132,79 @@ JERSEY_MAX_M = 0.5  # the largest plate side, and the farthest a plate's centre 
 
 
 def load_manifest(folder_or_file: Path) -> Manifest:
-    """Read and validate a model package's manifest. Raises :class:`ModelError`."""
+    """Read and validate a model package's manifest. Raises :class:`ModelError`.
+
+    A file that cannot be read as one JSON object stops at its first problem
+    (:func:`_read_raw`); the fields are then read in the manifest's order, every problem
+    collected, and the device names checked last, on the whole manifest."""
+    path, raw = _read_raw(folder_or_file)
+    folder = path.parent
+    r = _Reader(path)
+    for key in sorted(set(raw) - _KNOWN_KEYS):
+        r.problem(f"/{key}", f"unknown field; known fields: {', '.join(sorted(_KNOWN_KEYS))}")
+    version = r.get(raw, "format_version", int, "")
+    if version is not None and version != FORMAT_VERSION:
+        r.problem(
+            "/format_version",
+            f"{version} is not a version this program reads (expected {FORMAT_VERSION})",
+        )
+    name = r.get(raw, "name", str, "") or ""
+    field_class = r.get(raw, "class", str, "") or "kid"
+    if field_class not in FIELD_CLASSES:
+        r.problem("/class", f"{field_class!r} is not one of {', '.join(FIELD_CLASSES)}")
+    model_file = _model_file(r, raw, folder)
+    packages = _packages(r, raw, folder)
+    motors = _motors(r, raw)
+    sensor_suffix = r.get(raw, "sensor_suffix", str, "", required=False, default="S")
+    imus = _imus(r, raw)
+    cameras = _cameras(r, raw)
+    forces = r.get(raw, "force_sensors", dict, "", required=False, default={}) or {}
+    for key, link in forces.items():
+        if not isinstance(link, str):
+            r.problem(f"/force_sensors/{key}", f"{link!r} is not a string (a link name)")
+    parts = _parts(r, raw)
+    hands = _pair(r, raw, "hands")
+    feet = _pair(r, raw, "feet")
+    collision = r.get(raw, "collision", str, "", required=False, default="link-boxes")
+    if collision not in COLLISION_MODES:
+        r.problem("/collision", f"{collision!r} is not one of {', '.join(COLLISION_MODES)}")
+    standing = _standing_pose(r, raw, motors)
+    damping, armature, friction = (_non_negative(r, raw, key) for key in _JOINT_KEYS)
+    jersey = _jersey(r, raw)
+    if r.problems:
+        raise ModelError(r.problems)
+    manifest = Manifest(
+        path=path,
+        name=name,
+        field_class=field_class,
+        model_file=model_file,
+        packages=packages,
+        motors=motors,
+        sensor_suffix=sensor_suffix,
+        imu_link=imus[0].link,
+        cameras=cameras,
+        force_sensors={str(k): str(v) for k, v in forces.items()},
+        parts=parts,
+        hands=hands,
+        feet=feet,
+        collision=str(collision),
+        standing_pose_rad={str(k): float(v) for k, v in standing.items()},
+        joint_damping=None if damping is None else float(damping),
+        joint_armature=None if armature is None else float(armature),
+        joint_frictionloss=None if friction is None else float(friction),
+        imus=imus,
+        jersey=jersey,
+    )
+    problems = device_name_problems(manifest)
+    if problems:
+        raise ModelError(problems)
+    return manifest
+
+
+def _read_raw(folder_or_file: Path) -> tuple[Path, dict[str, object]]:
+    """The manifest's absolute path and its JSON object: inside its folder, there, within its
+    size limit, JSON without oversized integers, an object. Raises :class:`ModelError` with the
+    first problem found."""
     if folder_or_file.is_dir():
         folder, name = folder_or_file.resolve(), MANIFEST_NAME
     else:
@@ -169,19 +241,11 @@ def load_manifest(folder_or_file: Path) -> Manifest:
         ])
     if not isinstance(raw, dict):
         raise ModelError([ModelProblem(source=str(path), where="", reason="expected an object")])
-    r = _Reader(path)
-    for key in sorted(set(raw) - _KNOWN_KEYS):
-        r.problem(f"/{key}", f"unknown field; known fields: {', '.join(sorted(_KNOWN_KEYS))}")
-    version = r.get(raw, "format_version", int, "")
-    if version is not None and version != FORMAT_VERSION:
-        r.problem(
-            "/format_version",
-            f"{version} is not a version this program reads (expected {FORMAT_VERSION})",
-        )
-    name = r.get(raw, "name", str, "") or ""
-    field_class = r.get(raw, "class", str, "") or "kid"
-    if field_class not in FIELD_CLASSES:
-        r.problem("/class", f"{field_class!r} is not one of {', '.join(FIELD_CLASSES)}")
+    return path, raw
+
+
+def _model_file(r: _Reader, raw: Mapping[str, object], folder: Path) -> Path:
+    """``/model_file`` resolved: inside the package, there, a URDF or MJCF file."""
     model_rel = r.get(raw, "model_file", str, "") or ""
     model_file = (folder / model_rel).resolve()
     if model_rel and not inside(folder, folder / model_rel):
@@ -190,6 +254,11 @@ def load_manifest(folder_or_file: Path) -> Manifest:
         r.problem("/model_file", f"{model_rel!r}: no such file ({model_file})")
     elif model_rel and model_file.suffix.lower() not in (".urdf", ".xml", ".mjcf"):
         r.problem("/model_file", f"{model_rel!r}: expected a .urdf, .xml or .mjcf file")
+    return model_file
+
+
+def _packages(r: _Reader, raw: Mapping[str, object], folder: Path) -> dict[str, Path]:
+    """``/packages``: ROS package name -> its folder inside the model package."""
     packages: dict[str, Path] = {}
     for pkg, rel in (r.get(raw, "packages", dict, "", required=False, default={}) or {}).items():
         if not isinstance(rel, str):
@@ -202,17 +271,13 @@ def load_manifest(folder_or_file: Path) -> Manifest:
         if not package.is_dir():
             r.problem(f"/packages/{pkg}", f"{rel!r}: no such folder ({package})")
         packages[pkg] = package
-    motors = _motors(r, raw)
-    sensor_suffix = r.get(raw, "sensor_suffix", str, "", required=False, default="S")
-    imus = _imus(r, raw)
-    cameras = _cameras(r, raw)
-    forces = r.get(raw, "force_sensors", dict, "", required=False, default={}) or {}
-    for key, link in forces.items():
-        if not isinstance(link, str):
-            r.problem(f"/force_sensors/{key}", f"{link!r} is not a string (a link name)")
-    parts_raw = r.get(raw, "parts", dict, "") or {}
+    return packages
+
+
+def _parts(r: _Reader, raw: Mapping[str, object]) -> dict[str, str]:
+    """``/parts`` turned round: link -> body part."""
     parts: dict[str, str] = {}
-    for part, links in parts_raw.items():
+    for part, links in (r.get(raw, "parts", dict, "") or {}).items():
         if part not in PART_NAMES:
             r.problem(f"/parts/{part}", f"unknown part; expected one of {', '.join(PART_NAMES)}")
             continue
@@ -221,48 +286,23 @@ def load_manifest(folder_or_file: Path) -> Manifest:
             continue
         for link in links:
             parts[link] = part
-    hands = _pair(r, raw, "hands")
-    feet = _pair(r, raw, "feet")
-    collision = r.get(raw, "collision", str, "", required=False, default="link-boxes")
-    if collision not in COLLISION_MODES:
-        r.problem("/collision", f"{collision!r} is not one of {', '.join(COLLISION_MODES)}")
-    standing = r.get(raw, "standing_pose_rad", dict, "", required=False, default={}) or {}
+    return parts
+
+
+def _standing_pose(
+    r: _Reader, raw: Mapping[str, object], motors: tuple[MotorEntry, ...]
+) -> dict[str, Any]:
+    """``/standing_pose_rad`` as written: motor names of ``/motors``, numbers."""
+    standing: dict[str, Any] = (
+        r.get(raw, "standing_pose_rad", dict, "", required=False, default={}) or {}
+    )
     motor_names = {m.name for m in motors}
     for key, value in standing.items():
         if key not in motor_names:
             r.problem(f"/standing_pose_rad/{key}", "not the name of a motor in /motors")
         elif isinstance(value, bool) or not isinstance(value, (int, float)):
             r.problem(f"/standing_pose_rad/{key}", f"{value!r} is not a number (rad)")
-    damping, armature, friction = (_non_negative(r, raw, key) for key in _JOINT_KEYS)
-    jersey = _jersey(r, raw)
-    if r.problems:
-        raise ModelError(r.problems)
-    manifest = Manifest(
-        path=path,
-        name=name,
-        field_class=field_class,
-        model_file=model_file,
-        packages=packages,
-        motors=motors,
-        sensor_suffix=sensor_suffix,
-        imu_link=imus[0].link,
-        cameras=cameras,
-        force_sensors={str(k): str(v) for k, v in forces.items()},
-        parts=parts,
-        hands=hands,
-        feet=feet,
-        collision=str(collision),
-        standing_pose_rad={str(k): float(v) for k, v in standing.items()},
-        joint_damping=None if damping is None else float(damping),
-        joint_armature=None if armature is None else float(armature),
-        joint_frictionloss=None if friction is None else float(friction),
-        imus=imus,
-        jersey=jersey,
-    )
-    problems = device_name_problems(manifest)
-    if problems:
-        raise ModelError(problems)
-    return manifest
+    return standing
 
 
 def _non_negative(r: _Reader, raw: Mapping[str, object], key: str) -> float | None:

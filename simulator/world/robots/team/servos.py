@@ -64,7 +64,6 @@ def motor_spec(entry: MotorEntry, manifest: Manifest) -> MotorSpec:
 def servo_problems(manifest: Manifest, *, official: bool) -> list[ModelProblem]:
     """Motors above their catalogue entry (errors), free-form motors and free-form friction or
     gains (warnings in friendlies, errors when ``official``)."""
-    source = str(manifest.path)
     free = "error" if official else "warning"
     match = (
         "not for an official match"
@@ -73,61 +72,9 @@ def servo_problems(manifest: Manifest, *, official: bool) -> list[ModelProblem]:
     )
     out: list[ModelProblem] = []
     for i, entry in enumerate(manifest.motors):
-        at = f"/motors/{i}"
-        found = find_servo(entry.servo) if entry.servo else None
-        if found is None:
-            out.append(
-                ModelProblem(
-                    source=source,
-                    where=f"{at}/servo",
-                    severity=free,
-                    reason=f"{entry.name} (joint {entry.joint}) names no catalogue servo: "
-                    f"free-form max_torque_nm {entry.max_torque_nm} and max_velocity_rad_s "
-                    f"{entry.max_velocity_rad_s} are {match} (rule: {RULE})",
-                )
-            )
-        else:
-            for key, value, limit in (
-                ("max_torque_nm", entry.max_torque_nm, found.stall_torque_nm),
-                ("max_velocity_rad_s", entry.max_velocity_rad_s, found.no_load_speed_rad_s),
-            ):
-                if value is not None and value > limit * (1 + 1e-6):
-                    out.append(
-                        ModelProblem(
-                            source=source,
-                            where=f"{at}/{key}",
-                            reason=f"{entry.name} (joint {entry.joint}): {key} {value:g} is above "
-                            f"the catalogue's {limit:.4g} for {found.id} (rule: {RULE})",
-                        )
-                    )
-        for key in entry.free_gains:
-            out.append(
-                ModelProblem(
-                    source=source,
-                    where=f"{at}/{key}",
-                    severity=free,
-                    reason=f"{entry.name}: free-form gain {key} is {match} and has no effect: "
-                    f"position control is Webots' (P, I, D from MotorPID; rule: {RULE})",
-                )
-            )
+        out += _motor_problems(manifest, i, entry, free=free, match=match)
     if manifest.joint_armature is not None:
-        for entry in manifest.motors:
-            found = find_servo(entry.servo) if entry.servo else None
-            if found is None:
-                continue
-            own = found.armature_kg_m2
-            wanted = manifest.joint_armature
-            if not own / ARMATURE_BOUND * (1 - 1e-6) <= wanted <= own * ARMATURE_BOUND * (1 + 1e-6):
-                out.append(
-                    ModelProblem(
-                        source=source,
-                        where="/joint_armature",
-                        reason=f"{wanted:g} kg m^2 on {entry.name} ({found.id}) is outside "
-                        f"{own / ARMATURE_BOUND:.4g}-{own * ARMATURE_BOUND:.4g} kg m^2, a factor "
-                        f"{ARMATURE_BOUND:g} around the servo's {own:.4g} (rule: {ARMATURE_RULE}; "
-                        "leave joint_armature out to take each servo's own)",
-                    )
-                )
+        out += _armature_problems(manifest, manifest.joint_armature)
     for key, value in (
         ("joint_damping", manifest.joint_damping),
         ("joint_frictionloss", manifest.joint_frictionloss),
@@ -135,11 +82,80 @@ def servo_problems(manifest: Manifest, *, official: bool) -> list[ModelProblem]:
         if value is not None:
             out.append(
                 ModelProblem(
-                    source=source,
+                    source=str(manifest.path),
                     where=f"/{key}",
                     severity=free,
                     reason=f"{key} {value:g} replaces the catalogue servos' friction: {match} "
                     f"(rule: {RULE})",
+                )
+            )
+    return out
+
+
+def _motor_problems(
+    manifest: Manifest, i: int, entry: MotorEntry, *, free: str, match: str
+) -> list[ModelProblem]:
+    """Motor ``i``: free-form (severity ``free``), above its catalogue servo, free-form gains.
+    ``match``: whom free-form figures are for."""
+    source = str(manifest.path)
+    at = f"/motors/{i}"
+    out: list[ModelProblem] = []
+    found = find_servo(entry.servo) if entry.servo else None
+    if found is None:
+        out.append(
+            ModelProblem(
+                source=source,
+                where=f"{at}/servo",
+                severity=free,
+                reason=f"{entry.name} (joint {entry.joint}) names no catalogue servo: "
+                f"free-form max_torque_nm {entry.max_torque_nm} and max_velocity_rad_s "
+                f"{entry.max_velocity_rad_s} are {match} (rule: {RULE})",
+            )
+        )
+    else:
+        for key, value, limit in (
+            ("max_torque_nm", entry.max_torque_nm, found.stall_torque_nm),
+            ("max_velocity_rad_s", entry.max_velocity_rad_s, found.no_load_speed_rad_s),
+        ):
+            if value is not None and value > limit * (1 + 1e-6):
+                out.append(
+                    ModelProblem(
+                        source=source,
+                        where=f"{at}/{key}",
+                        reason=f"{entry.name} (joint {entry.joint}): {key} {value:g} is above "
+                        f"the catalogue's {limit:.4g} for {found.id} (rule: {RULE})",
+                    )
+                )
+    for key in entry.free_gains:
+        out.append(
+            ModelProblem(
+                source=source,
+                where=f"{at}/{key}",
+                severity=free,
+                reason=f"{entry.name}: free-form gain {key} is {match} and has no effect: "
+                f"position control is Webots' (P, I, D from MotorPID; rule: {RULE})",
+            )
+        )
+    return out
+
+
+def _armature_problems(manifest: Manifest, wanted: float) -> list[ModelProblem]:
+    """``joint_armature`` outside :data:`ARMATURE_BOUND` of a catalogue servo's own."""
+    out: list[ModelProblem] = []
+    for entry in manifest.motors:
+        found = find_servo(entry.servo) if entry.servo else None
+        if found is None:
+            continue
+        own = found.armature_kg_m2
+        if not own / ARMATURE_BOUND * (1 - 1e-6) <= wanted <= own * ARMATURE_BOUND * (1 + 1e-6):
+            out.append(
+                ModelProblem(
+                    source=str(manifest.path),
+                    where="/joint_armature",
+                    reason=f"{wanted:g} kg m^2 on {entry.name} ({found.id}) is outside "
+                    f"{own / ARMATURE_BOUND:.4g}-{own * ARMATURE_BOUND:.4g} kg m^2, a factor "
+                    f"{ARMATURE_BOUND:g} around the servo's {own:.4g} (rule: {ARMATURE_RULE}; "
+                    "leave joint_armature out to take each servo's own)",
                 )
             )
     return out
