@@ -22,7 +22,7 @@ import time
 from contextlib import ExitStack
 from pathlib import Path
 from types import FrameType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from contracts import ContractError, MatchSpec, SimResult, files
 from simulator.api import ApiServer, LockstepSettings, endpoints_from_spec
@@ -36,8 +36,14 @@ from simulator.errors import (
 from simulator.gl import read_gl_info, select_match_gl
 from simulator.match_loop import LoopSettings, MatchLoop
 from simulator.match_setup import referee_config
-from simulator.telemetry import TelemetryError, open_telemetry
+from simulator.telemetry import Telemetry, TelemetryError, open_telemetry
 from simulator.traffic import STATS_FILE, TrafficLog
+
+if TYPE_CHECKING:
+    from referee import Referee
+    from simulator.api.cameras import ImageSource
+    from simulator.recorder import Recorder
+    from simulator.world import World
 
 log = logging.getLogger(__name__)
 
@@ -118,7 +124,6 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
     """Play the match of ``spec``, writing every output file into ``out``; returns the exit code."""
     from referee import Referee
     from simulator.api.world_cameras import render_processes, world_render_worker
-    from simulator.recorder import Recorder, replay_header
     from simulator.world import World
 
     log.info(
@@ -134,7 +139,6 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
         pipelined=spec.stepping == "pipelined",
     )
     started = time.time()
-    exit_code = 1
     with ExitStack() as stack:
         referee = Referee(config=referee_config(spec), log_dir=out)
         stack.callback(referee.close)
@@ -156,19 +160,7 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
         if gc_network:
             referee.start_network()
         reserve = files.reserve_space(out, log)
-        recorder = Recorder(
-            out / REPLAY_FILE, world, match_id=spec.match_id, rate_hz=spec.recorder_rate_hz
-        )
-        telemetry = open_telemetry(
-            match_id=spec.match_id,
-            listen=spec.network.telemetry_listen,
-            scene=replay_header(
-                world, match_id=spec.match_id, rate_hz=spec.recorder_rate_hz, chunk_frames=1
-            ),
-        )
-        stack.callback(telemetry.close)
-        traffic = TrafficLog(server, path=out / STATS_FILE)
-        stack.callback(traffic.close)
+        recorder, telemetry, traffic = _open_outputs(spec, out, world, server, stack)
         loop = MatchLoop(
             world=world,
             referee=referee,
@@ -185,42 +177,14 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
             ),
         )
         stack.enter_context(_stop_on_signals(loop))
-        error = ""
-        try:
-            reason = loop.run()
-        except PhysicsDivergence as exc:
-            reason = "physics_divergence"
-            error = str(exc)
-            log.error("%s", exc)
-        except Exception as exc:  # process boundary: the results still record the state reached
-            reason = "internal_error"
-            error = f"{type(exc).__name__}: {exc}"
-            log.exception("match loop failed")
+        reason, error = _play(loop)
         recorder.close(world)
-        if reason == "finished":
-            exit_code = 0
-        elif reason in ("SIGTERM", "SIGINT"):
-            exit_code = 130
-        fields: dict[str, Any] = {
-            "match_id": spec.match_id,
-            "seed": spec.seed,
-            **referee.result(),
-            "stop_reason": reason,
-            "error": error,
-            "stepping": spec.stepping,
-            "sim_time_ms": world.sim_time_ms,
-            "real_time_s": round(loop.real_time_s, 3),
-            "held_real_s": round(loop.held_s, 3),
-            "real_time_factor": _rtf(world.sim_time_ms, loop.real_time_s - loop.held_s),
-            "robots": server.statistics(),
-            "cameras": {"frames": cameras.frames, "render_s": round(cameras.render_s, 3),
-                        "render_processes": processes, **camera_gl},
-            "started_unix_s": round(started, 3),
-            "versions": versions(),
-        }
-        result = SimResult.from_dict(
-            json.loads(json.dumps(fields, default=str)), source=str(out / RESULT_FILE)
-        )
+        exit_code = _EXIT_CODES.get(reason, 1)
+        result = _result(
+            spec, out, world=world, referee=referee, loop=loop, server=server, reason=reason,
+            error=error, cameras=cameras, processes=processes, camera_gl=camera_gl,
+            started=started,
+        )  # fmt: skip
     reserve.unlink(missing_ok=True)  # its space is the results' on a disk that filled
     result.write(out / RESULT_FILE)
     log.info(
@@ -231,6 +195,84 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
     if spec.record_video:
         _render_video(out / REPLAY_FILE, out / spec.record_video)
     return exit_code
+
+
+_EXIT_CODES = {"finished": 0, "SIGTERM": 130, "SIGINT": 130}
+"""The process's exit code by the loop's stop reason; any other reason: 1."""
+
+
+def _open_outputs(
+    spec: MatchSpec, out: Path, world: World, server: ApiServer, stack: ExitStack
+) -> tuple[Recorder, Telemetry, TrafficLog]:
+    """The replay recorder (closed by the caller with the world's last state), the telemetry
+    stream and the API traffic log (both closed by ``stack``)."""
+    from simulator.recorder import Recorder, replay_header
+
+    recorder = Recorder(
+        out / REPLAY_FILE, world, match_id=spec.match_id, rate_hz=spec.recorder_rate_hz
+    )
+    telemetry = open_telemetry(
+        match_id=spec.match_id,
+        listen=spec.network.telemetry_listen,
+        scene=replay_header(
+            world, match_id=spec.match_id, rate_hz=spec.recorder_rate_hz, chunk_frames=1
+        ),
+    )
+    stack.callback(telemetry.close)
+    traffic = TrafficLog(server, path=out / STATS_FILE)
+    stack.callback(traffic.close)
+    return recorder, telemetry, traffic
+
+
+def _play(loop: MatchLoop) -> tuple[str, str]:
+    """Run the loop; its stop reason and the error that stopped it (empty when none)."""
+    try:
+        return loop.run(), ""
+    except PhysicsDivergence as exc:
+        log.error("%s", exc)
+        return "physics_divergence", str(exc)
+    except Exception as exc:  # process boundary: the results still record the state reached
+        log.exception("match loop failed")
+        return "internal_error", f"{type(exc).__name__}: {exc}"
+
+
+def _result(
+    spec: MatchSpec,
+    out: Path,
+    *,
+    world: World,
+    referee: Referee,
+    loop: MatchLoop,
+    server: ApiServer,
+    reason: str,
+    error: str,
+    cameras: ImageSource,
+    processes: int,
+    camera_gl: dict[str, str],
+    started: float,
+) -> SimResult:
+    """The match's ``sim_result.json``: the referee's result, why and when the loop stopped,
+    its timing, the robots' API statistics, the cameras' figures and the versions."""
+    fields: dict[str, Any] = {
+        "match_id": spec.match_id,
+        "seed": spec.seed,
+        **referee.result(),
+        "stop_reason": reason,
+        "error": error,
+        "stepping": spec.stepping,
+        "sim_time_ms": world.sim_time_ms,
+        "real_time_s": round(loop.real_time_s, 3),
+        "held_real_s": round(loop.held_s, 3),
+        "real_time_factor": _rtf(world.sim_time_ms, loop.real_time_s - loop.held_s),
+        "robots": server.statistics(),
+        "cameras": {"frames": cameras.frames, "render_s": round(cameras.render_s, 3),
+                    "render_processes": processes, **camera_gl},
+        "started_unix_s": round(started, 3),
+        "versions": versions(),
+    }  # fmt: skip
+    return SimResult.from_dict(
+        json.loads(json.dumps(fields, default=str)), source=str(out / RESULT_FILE)
+    )
 
 
 def _camera_gl() -> dict[str, str]:

@@ -153,12 +153,9 @@ class SendThread:
             pass  # the pipe is full of wake-ups already
 
     def _run(self) -> None:
-        if self._cpus:
-            try:
-                os.sched_setaffinity(0, self._cpus)  # this thread only
-            except OSError as exc:
-                log.warning("robot API I/O thread: cannot run on CPUs %s: %s",
-                            sorted(self._cpus), exc)  # fmt: skip
+        """The thread's loop: plan the next look (polling), wait on the sockets and the wake-up
+        pipe, run the step thread's jobs, read and write the ready sockets (see the module)."""
+        self._pin_cpus()
         masks: dict[Connection, int] = {}
         selector: selectors.BaseSelector = selectors.SelectSelector()
         selector.register(self._wake_r, READ, None)
@@ -170,7 +167,6 @@ class SendThread:
             period = 0.0
             paused: list[Connection] = []  # clients whose budget is spent, not read for now
             while not self._stop:
-                news = False
                 look = NO_LOOK
                 if poll:  # decided before the queues are looked at, as ``_sleeping``
                     now = time.monotonic()
@@ -206,22 +202,7 @@ class SendThread:
                     now = time.monotonic()
                     interval, last_frames = now - last_frames, now
                     period = self._learn_period(queued)
-                for key, events in ready:
-                    conn = key.data
-                    if conn is None:  # drain, then clear: a wake-up after this is not lost
-                        try:
-                            os.read(self._wake_r, 4096)
-                        except BlockingIOError:
-                            pass
-                        self._woken = False
-                        continue
-                    if events & READ and conn.error is None:
-                        news = conn.read_threaded(time.monotonic()) or news
-                        if conn.paused:  # its budget is spent: not watched until it refills
-                            paused.append(conn)
-                            self._set_mask(selector, masks, conn)
-                    if events & WRITE:
-                        self._ready.append(conn)
+                news = self._on_ready(ready, selector, masks, paused)
                 if paused:
                     news = self._resume(selector, masks, paused) or news
                 if news and on_news is not None:
@@ -235,6 +216,44 @@ class SendThread:
                 self._on_news()  # a step thread waiting for answers wakes and finds it
         finally:
             selector.close()
+
+    def _pin_cpus(self) -> None:
+        """Run this thread only on the CPUs it was given (a warning when it cannot)."""
+        if self._cpus:
+            try:
+                os.sched_setaffinity(0, self._cpus)  # this thread only
+            except OSError as exc:
+                log.warning("robot API I/O thread: cannot run on CPUs %s: %s",
+                            sorted(self._cpus), exc)  # fmt: skip
+
+    def _on_ready(
+        self,
+        ready: list[tuple[selectors.SelectorKey, int]],
+        selector: selectors.BaseSelector,
+        masks: dict[Connection, int],
+        paused: list[Connection],
+    ) -> bool:
+        """Handle what ``select`` found: drain the wake-up pipe, read the readable clients
+        (pausing those whose budget is spent), queue the writable ones for writing. True when
+        a read brought requests."""
+        news = False
+        for key, events in ready:
+            conn = key.data
+            if conn is None:  # drain, then clear: a wake-up after this is not lost
+                try:
+                    os.read(self._wake_r, 4096)
+                except BlockingIOError:
+                    pass
+                self._woken = False
+                continue
+            if events & READ and conn.error is None:
+                news = conn.read_threaded(time.monotonic()) or news
+                if conn.paused:  # its budget is spent: not watched until it refills
+                    paused.append(conn)
+                    self._set_mask(selector, masks, conn)
+            if events & WRITE:
+                self._ready.append(conn)
+        return news
 
     def _resume(
         self,

@@ -29,9 +29,6 @@ LONG_FUNCTIONS: dict[str, tuple[int, str]] = {
     "envs/mjx_vector.py::MjxStandKickVector.__init__": (
         197, "builds the batched JAX step and reset as closures over the compiled model "
         "(jit-compiled functions that capture the arrays they close over)"),
-    "simulator/runtime.py::run_match": (
-        117, "the simulator's composition root: the world, referee, API server, "
-        "recorder and cameras built and torn down in one place"),
 }
 
 
