@@ -38,7 +38,9 @@ from service.services import PoolFactory, Preflight, Services
 from service.settings import Settings
 
 if TYPE_CHECKING:
-    pass
+    from sqlalchemy.engine import Engine
+
+    from service.sealing import Sealer
 
 log = logging.getLogger(__name__)
 
@@ -111,20 +113,7 @@ def create_app(
 
         # Request handlers run in this many threads: more only fight over the GIL.
         anyio.to_thread.current_default_thread_limiter().total_tokens = settings.threads
-        from orchestrator import private_dir
-        from service.sealing import key_file, load_sealer
-
-        private_dir(settings.data_dir)  # 0700; the files below it are 0600
-        private_dir(settings.matches_dir)
-        sealer = load_sealer(key=settings.secret_key,
-                             key_path=key_file(settings.data_dir, settings.secret_key_file))
-        engine = make_engine(settings.db_url)
-        migrate(engine)
-        from service.db import transaction
-        from service.teamfiles import seal_stored
-
-        with transaction(session_factory(engine)) as session:
-            seal_stored(session, sealer)  # secrets stored in the clear by an older version
+        engine, sealer = _open_storage(settings)
         checker = None
         if preflight is None:
             from service.preflight import PreflightChecker
@@ -157,13 +146,7 @@ def create_app(
         try:
             yield
         finally:
-            if services.ladder_thread is not None:
-                services.ladder_thread.stop()
-            if services.worker is not None:
-                services.worker.stop()
-            if services.aftermatch is not None:
-                services.aftermatch.stop()
-            services.status.stop()
+            _stop(services)
             if checker is not None:
                 checker.close()
             engine.dispose()
@@ -183,6 +166,38 @@ def create_app(
     for mount in (*service_routers(), *mounts):
         mount(app)
     return app
+
+
+def _open_storage(settings: Settings) -> tuple[Engine, Sealer]:
+    """The private data and match folders, the sealer of stored secrets, and the database
+    migrated to this version (secrets an older version stored in the clear sealed)."""
+    from orchestrator import private_dir
+    from service.db import transaction
+    from service.sealing import key_file, load_sealer
+    from service.teamfiles import seal_stored
+
+    private_dir(settings.data_dir)  # 0700; the files below it are 0600
+    private_dir(settings.matches_dir)
+    sealer = load_sealer(
+        key=settings.secret_key, key_path=key_file(settings.data_dir, settings.secret_key_file)
+    )
+    engine = make_engine(settings.db_url)
+    migrate(engine)
+    with transaction(session_factory(engine)) as session:
+        seal_stored(session, sealer)  # secrets stored in the clear by an older version
+    return engine, sealer
+
+
+def _stop(services: Services) -> None:
+    """Stop the service's threads: the ladder, the worker, the after-match work, the status
+    board."""
+    if services.ladder_thread is not None:
+        services.ladder_thread.stop()
+    if services.worker is not None:
+        services.worker.stop()
+    if services.aftermatch is not None:
+        services.aftermatch.stop()
+    services.status.stop()
 
 
 def pool_from_settings(settings: Settings) -> MatchPool:

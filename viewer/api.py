@@ -147,55 +147,17 @@ def build_router(resolver: Any, *, feed_factory: FeedFactory = ZenohFeed,
 
     @router.get(f"{API_PREFIX}/index")
     def index(found: tuple[list[ReplaySource], list[LiveSource]] = found_all) -> dict[str, Any]:
-        listing = []
-        sources, live = found
-        for source in sources:
-            try:
-                replay, _ = replays.get(source)
-            except HTTPException:
-                continue
-            listing.append({"id": source.id, "match_id": replay.header.match_id,
-                            "duration_ms": replay.duration_ms, "version": replay.header.version,
-                            "teams": _teams(source.teams)})
-        return {"replays": listing,
-                "live": [{"id": source.id, "teams": _teams(source.teams)} for source in live]}
+        return _index(replays, *found)
 
     @router.get(f"{API_PREFIX}/replays/{{replay_id}}/meta")
     def meta(source: ReplaySource = by_id) -> dict[str, Any]:
         replay, scene = replays.get(source)
-        return {
-            "id": source.id,
-            "match_id": replay.header.match_id,
-            "version": replay.header.version,
-            "rate_hz": replay.header.rate_hz,
-            "duration_ms": replay.duration_ms,
-            "body_count": replay.nbody,
-            "robots": [r.key for r in replay.header.robots],
-            "chunks": [[c.first_ms, c.last_ms, c.frames] for c in replay.chunks],
-            "events": list(replay.events),
-            "scene": scene,
-            "has_stats": source.stats_path is not None,
-            "teams": _teams(source.teams),
-            "complete": replay.indexed,  # closed by its recorder: the match is over
-        }
+        return _meta(source, replay, scene)
 
     @router.get(f"{API_PREFIX}/replays/{{replay_id}}/chunks/{{index}}")
     def chunk(index: int, source: ReplaySource = by_id) -> Response:
         replay, _ = replays.get(source)
-        if not 0 <= index < len(replay.chunks):
-            raise HTTPException(
-                status_code=404, detail=f"chunk {index} out of range 0..{len(replay.chunks) - 1}"
-            )
-        try:
-            block = replay.read_chunk(index)
-        except ReplayError as exc:
-            raise HTTPException(status_code=422, detail=str(exc)) from exc
-        head = json.dumps(
-            {"times": block.times_ms.tolist(), "games": block.games}, separators=(",", ":")
-        ).encode()
-        pad = b"\0" * ((4 - len(head) % 4) % 4)
-        body = struct.pack("<I", len(head)) + head + pad + block.poses.astype("<f4").tobytes()
-        return Response(body, media_type="application/octet-stream",
+        return Response(_chunk_bytes(replay, index), media_type="application/octet-stream",
                         headers={"Cache-Control": "max-age=60"})
 
     @router.get(f"{API_PREFIX}/replays/{{replay_id}}/stats")
@@ -220,6 +182,61 @@ def build_router(resolver: Any, *, feed_factory: FeedFactory = ZenohFeed,
             return FileResponse(STATIC / "index.html")
 
     return router
+
+
+def _index(
+    replays: _OpenReplays, sources: list[ReplaySource], live: list[LiveSource]
+) -> dict[str, Any]:
+    """The replays that open (one that does not is left out) and the live matches."""
+    listing = []
+    for source in sources:
+        try:
+            replay, _ = replays.get(source)
+        except HTTPException:
+            continue
+        listing.append({"id": source.id, "match_id": replay.header.match_id,
+                        "duration_ms": replay.duration_ms, "version": replay.header.version,
+                        "teams": _teams(source.teams)})
+    return {"replays": listing,
+            "live": [{"id": source.id, "teams": _teams(source.teams)} for source in live]}
+
+
+def _meta(source: ReplaySource, replay: ReplayFile, scene: SceneRecord) -> dict[str, Any]:
+    """A replay's description for the player: its match, timing, chunks, events and scene."""
+    return {
+        "id": source.id,
+        "match_id": replay.header.match_id,
+        "version": replay.header.version,
+        "rate_hz": replay.header.rate_hz,
+        "duration_ms": replay.duration_ms,
+        "body_count": replay.nbody,
+        "robots": [r.key for r in replay.header.robots],
+        "chunks": [[c.first_ms, c.last_ms, c.frames] for c in replay.chunks],
+        "events": list(replay.events),
+        "scene": scene,
+        "has_stats": source.stats_path is not None,
+        "teams": _teams(source.teams),
+        "complete": replay.indexed,  # closed by its recorder: the match is over
+    }
+
+
+def _chunk_bytes(replay: ReplayFile, index: int) -> bytes:
+    """Chunk ``index`` of ``replay`` on the wire: the JSON head's length (4 bytes, little
+    endian), the head (frame times and game states) padded to 4 bytes, then the poses as
+    little-endian float32. 404 for a chunk out of range, 422 for one that cannot be read."""
+    if not 0 <= index < len(replay.chunks):
+        raise HTTPException(
+            status_code=404, detail=f"chunk {index} out of range 0..{len(replay.chunks) - 1}"
+        )
+    try:
+        block = replay.read_chunk(index)
+    except ReplayError as exc:
+        raise HTTPException(status_code=422, detail=str(exc)) from exc
+    head = json.dumps(
+        {"times": block.times_ms.tolist(), "games": block.games}, separators=(",", ":")
+    ).encode()
+    pad = b"\0" * ((4 - len(head) % 4) % 4)
+    return struct.pack("<I", len(head)) + head + pad + block.poses.astype("<f4").tobytes()
 
 
 _SSE_NAMES = {"state": "state", "events": "event", "poses": "poses", "scene": "scene"}
