@@ -145,20 +145,9 @@ def ensure_image(
             base_ref, base_id, network_mode = parent.reference, parent.image_id, "none"
         else:
             base_ref, base_id, network_mode = _ensure_base(client, recipe, base)
-        wheel_dir = image_inputs.ensure_wheels(
-            image_inputs.pinned_requirements(recipe.requirements), cache_dir=BUILD_DIR / "wheels"
-        )
         # The hash is taken over the assembled context, so the tag names exactly what is built
         # even when sources change meanwhile.
-        context_dir = BUILD_DIR / "context" / name
-        image_inputs.assemble_context(
-            context_dir=context_dir,
-            dockerfile=recipe.dockerfile,
-            extra_files=recipe.build_files,
-            wheel_dir=wheel_dir,
-            repo_root=REPO_ROOT,
-            sources=list(image_inputs.source_files(REPO_ROOT, recipe.packages)),
-        )
+        context_dir = _assemble(name, recipe)
         build_args = {"BASE_IMAGE": base_ref}
         content = content_hash(recipe.name, context_dir, base_id, build_args)
         reference = f"{recipe.repository}:{content}"
@@ -176,30 +165,11 @@ def ensure_image(
             )
         log_path = BUILD_DIR / "logs" / f"{name}-{content}.log"
         log.info("building %s (build log: %s)", reference, log_path)
-        task = (progress or NullProgress()).add(f"build {name}", unit="steps")
-        tracker = StepTracker(task)
-
-        def steps(line: str) -> None:
-            log.info("%s: %s", name, line)
-            tracker(line)
-
-        try:
-            info = engine_images.build(
-                client,
-                context_dir=context_dir,
-                tag=reference,
-                build_args=build_args,
-                # LABEL_PROJECT marks what a match creates; containers inherit image labels, so
-                # images clear it (older bases still carry it).
-                labels={LABEL_PROJECT: "", LABEL_IMAGE: name, LABEL_CONTENT: content},
-                log_path=log_path,
-                network_mode=network_mode,
-                on_step=steps,
-            )
-        except ImageError:
-            task.finish("failed")
-            raise
-        task.finish()
+        info = _build(
+            client, name, context_dir=context_dir, reference=reference, content=content,
+            build_args=build_args, log_path=log_path, network_mode=network_mode,
+            progress=progress,
+        )  # fmt: skip
         seconds = time.monotonic() - started
         log.info("built %s in %.1f s (%.0f MB)", reference, seconds, info.size_bytes / 1e6)
         _tag_latest(client, recipe, reference, info)
@@ -213,6 +183,65 @@ def ensure_image(
             seconds=seconds,
             build_log=log_path,
         )
+
+
+def _assemble(name: str, recipe: ImageRecipe) -> Path:
+    """The image's build context (Dockerfile, build files, wheels of its pinned requirements,
+    the project packages it carries), assembled afresh; its folder."""
+    wheel_dir = image_inputs.ensure_wheels(
+        image_inputs.pinned_requirements(recipe.requirements), cache_dir=BUILD_DIR / "wheels"
+    )
+    context_dir = BUILD_DIR / "context" / name
+    image_inputs.assemble_context(
+        context_dir=context_dir,
+        dockerfile=recipe.dockerfile,
+        extra_files=recipe.build_files,
+        wheel_dir=wheel_dir,
+        repo_root=REPO_ROOT,
+        sources=list(image_inputs.source_files(REPO_ROOT, recipe.packages)),
+    )
+    return context_dir
+
+
+def _build(
+    client: DockerClient,
+    name: str,
+    *,
+    context_dir: Path,
+    reference: str,
+    content: str,
+    build_args: dict[str, str],
+    log_path: Path,
+    network_mode: str | None,
+    progress: Progress | None,
+) -> engine_images.ImageInfo:
+    """Build ``context_dir`` as ``reference``, labelled with the image's name and content
+    hash, its steps logged and shown as progress. Raises :class:`ImageError`."""
+    task = (progress or NullProgress()).add(f"build {name}", unit="steps")
+    tracker = StepTracker(task)
+
+    def steps(line: str) -> None:
+        log.info("%s: %s", name, line)
+        tracker(line)
+
+    try:
+        info = engine_images.build(
+            client,
+            context_dir=context_dir,
+            tag=reference,
+            build_args=build_args,
+            # LABEL_PROJECT marks what a match creates; containers inherit image labels, so
+            # images clear it (older bases still carry it).
+            labels={LABEL_PROJECT: "", LABEL_IMAGE: name, LABEL_CONTENT: content},
+            log_path=log_path,
+            network_mode=network_mode,
+            on_step=steps,
+        )
+    except ImageError:
+        task.finish("failed")
+        raise
+    task.finish()
+    return info
 
 
 def build_all(

@@ -485,7 +485,19 @@ def knockout_fixtures(spec: KnockoutDocument) -> list[ScheduledMatch]:
 
 
 def _cross_problems(path: Path, schedule: Schedule, data: ScheduleDocument) -> list[Problem]:
+    """What the schema cannot see: teams listed twice or their files missing, fixtures naming
+    unknown teams, matches naming unknown teams or matches not listed before them."""
     file = str(path)
+    names = [t.name for t in schedule.teams]
+    return [
+        *_team_problems(file, schedule),
+        *_fixture_problems(file, data, names),
+        *_match_problems(file, schedule, data, names),
+    ]
+
+
+def _team_problems(file: str, schedule: Schedule) -> list[Problem]:
+    """Names and ids used twice; team and credentials files not found."""
     problems: list[Problem] = []
     names = [t.name for t in schedule.teams]
     for i, name in enumerate(names):
@@ -502,6 +514,12 @@ def _cross_problems(path: Path, schedule: Schedule, data: ScheduleDocument) -> l
             problems.append(
                 Problem(file, f"/teams/{i}/credentials", f"file not found: {team.credentials}")
             )
+    return problems
+
+
+def _fixture_problems(file: str, data: ScheduleDocument, names: list[str]) -> list[Problem]:
+    """A knockout's seeds not a power of two; fixtures naming teams not in ``names``."""
+    problems: list[Problem] = []
     if "knockout" in data.get("fixtures", {}):
         n = len(data["fixtures"]["knockout"]["seeds"])
         if n & (n - 1):
@@ -530,6 +548,16 @@ def _cross_problems(path: Path, schedule: Schedule, data: ScheduleDocument) -> l
                         suggestion=f'"{close[0]}"' if close else "",
                     )
                 )
+    return problems
+
+
+def _match_problems(
+    file: str, schedule: Schedule, data: ScheduleDocument, names: list[str]
+) -> list[Problem]:
+    """Each match (listed, then generated from the fixtures): its id used twice, a team not in
+    ``names`` or playing itself, a winner or loser of a match not listed before it, a stream
+    start that is not a time."""
+    problems: list[Problem] = []
     ids_seen: list[str] = []
     listed = len(data.get("matches") or [])
     generated = {m.id for m in schedule.matches[listed:]}  # fixtures: any match may follow them

@@ -20,7 +20,7 @@ from typing import TypeVar
 
 from contracts import JSONObject, to_data
 from orchestrator.config.credentials import Credentials, load_credentials
-from orchestrator.console import NullProgress, Progress
+from orchestrator.console import NullProgress, Progress, Task
 from orchestrator.delivery import store as st
 from orchestrator.delivery.targets import open_uploader
 from orchestrator.delivery.uploader import Uploader, is_transient
@@ -131,32 +131,16 @@ def deliver_set(
     started = time.monotonic()
     target = str(pending.credentials) if pending.credentials else "(no credentials)"
     session: _Session | None = None
-    uploaded = skipped = uploaded_bytes = 0
+    counts = _Counts()
     total_bytes = sum(entry.size for entry in pending.files)
     task = (progress or NullProgress()).add(
         f"upload {pending.match_id} {pending.team}", total=total_bytes, unit="B"
     )
-    done_bytes = 0
     try:
         credentials = _credentials_of(pending)
         target = credentials.describe()
         session = _Session(credentials, pending.team, opener or open_uploader, retry, sleep)
-        base = f"{_folder_name(pending.match_id)}/{_folder_name(pending.team)}"
-        for entry in pending.files:
-            remote = f"{base}/{entry.path}"
-            local = pending.files_dir / entry.path
-            done_bytes += entry.size
-            if session.run(functools.partial(_exists, remote=remote, size=entry.size)):
-                skipped += 1
-                task.update(completed=done_bytes)
-                continue
-            _check_local(pending, local, entry.size)
-            session.run(functools.partial(_upload, local=local, remote=remote))
-            uploaded += 1
-            uploaded_bytes += entry.size
-            task.update(completed=done_bytes)
-        manifest = _write_manifest(pending)
-        session.run(functools.partial(_upload, local=manifest, remote=f"{base}/{MANIFEST_NAME}"))
+        _upload_set(pending, session, task, counts)
     except DeliveryError as exc:
         task.finish("failed")
         error = DeliveryError(team=pending.team, target=target, kind=exc.kind, reason=exc.reason)
@@ -166,18 +150,7 @@ def deliver_set(
             last_error=st.DeliveryFailure(error.kind, error.reason, time.time()),
         )
         log.warning("match %s: %s", pending.match_id, error)
-        return DeliveryOutcome(
-            set_id=pending.set_id,
-            match_id=pending.match_id,
-            team=pending.team,
-            target=target,
-            delivered=False,
-            uploaded_files=uploaded,
-            skipped_files=skipped,
-            uploaded_bytes=uploaded_bytes,
-            seconds=time.monotonic() - started,
-            error=error,
-        )
+        return counts.outcome(pending, target, time.monotonic() - started, error=error)
     finally:
         if session is not None:
             session.close()
@@ -191,22 +164,65 @@ def deliver_set(
         pending.match_id,
         pending.team,
         target,
-        uploaded,
-        skipped,
-        uploaded_bytes / 1e6,
+        counts.uploaded,
+        counts.skipped,
+        counts.uploaded_bytes / 1e6,
         seconds,
     )
-    return DeliveryOutcome(
-        set_id=pending.set_id,
-        match_id=pending.match_id,
-        team=pending.team,
-        target=target,
-        delivered=True,
-        uploaded_files=uploaded,
-        skipped_files=skipped,
-        uploaded_bytes=uploaded_bytes,
-        seconds=seconds,
-    )
+    return counts.outcome(pending, target, seconds)
+
+
+@dataclass(slots=True)
+class _Counts:
+    """What a delivery has done so far: kept when it fails half way."""
+
+    uploaded: int = 0
+    skipped: int = 0  # already there with the same size
+    uploaded_bytes: int = 0
+
+    def outcome(
+        self,
+        pending: st.PendingSet,
+        target: str,
+        seconds: float,
+        *,
+        error: DeliveryError | None = None,
+    ) -> DeliveryOutcome:
+        """The set's outcome: delivered unless ``error``."""
+        return DeliveryOutcome(
+            set_id=pending.set_id,
+            match_id=pending.match_id,
+            team=pending.team,
+            target=target,
+            delivered=error is None,
+            uploaded_files=self.uploaded,
+            skipped_files=self.skipped,
+            uploaded_bytes=self.uploaded_bytes,
+            seconds=seconds,
+            error=error,
+        )
+
+
+def _upload_set(pending: st.PendingSet, session: _Session, task: Task, counts: _Counts) -> None:
+    """Upload the set's files that are not there yet (same size), then its manifest, last:
+    a folder with the manifest is complete. Raises :class:`DeliveryError`."""
+    base = f"{_folder_name(pending.match_id)}/{_folder_name(pending.team)}"
+    done_bytes = 0
+    for entry in pending.files:
+        remote = f"{base}/{entry.path}"
+        local = pending.files_dir / entry.path
+        done_bytes += entry.size
+        if session.run(functools.partial(_exists, remote=remote, size=entry.size)):
+            counts.skipped += 1
+            task.update(completed=done_bytes)
+            continue
+        _check_local(pending, local, entry.size)
+        session.run(functools.partial(_upload, local=local, remote=remote))
+        counts.uploaded += 1
+        counts.uploaded_bytes += entry.size
+        task.update(completed=done_bytes)
+    manifest = _write_manifest(pending)
+    session.run(functools.partial(_upload, local=manifest, remote=f"{base}/{MANIFEST_NAME}"))
 
 
 class _Session:
