@@ -296,18 +296,13 @@ def run_schedule(
     ``notify``: the operators' notification settings
     (:meth:`tournament.notify.NotifySettings.recorded`), kept in the state file; the scheduler
     writes its heartbeat there and sends the notices (:mod:`tournament.notify`)."""
-    from tournament.jobs import DEFAULT_STOP_GRACE_S, STOPPING, settle_hand_deliveries
+    from tournament.jobs import STOPPING, settle_hand_deliveries
     from tournament.notify import HEARTBEAT_S, beat, stopped
 
     STOPPING.clear()
     state = str(Path(state_path).resolve())
-    schedule, ledger = init_state(schedule_path, state, services=services, pool=pool)
-    if stop_grace_s is not None:
-        ledger.set_meta("stop_grace_s", repr(float(stop_grace_s)))
-    if notify is not None:
-        ledger.set_meta("notify", notify)
-    beat(ledger)
-    recover_interrupted(ledger)
+    schedule, ledger = _open_state(schedule_path, state, services=services, pool=pool,
+                                   stop_grace_s=stop_grace_s, notify=notify)  # fmt: skip
     stop = stop or threading.Event()
     wake = threading.Event()
     if threading.current_thread() is threading.main_thread():
@@ -345,17 +340,51 @@ def run_schedule(
             wake.wait(poll_s)
             wake.clear()
     finally:
-        if STOPPING.is_set():
-            scheduler.shutdown(wait=False)
-            grace = ledger.get_meta("stop_grace_s")
-            _wait_for_steps(running, (float(grace) if grace else DEFAULT_STOP_GRACE_S) + 15.0)
-        else:
-            scheduler.shutdown(wait=not stop.is_set())
+        _shut_down(scheduler, running, ledger, stopped_by_user=stop.is_set())
         logging.getLogger("apscheduler.scheduler").removeFilter(quiet)
         notices.set()
         notifier.join(timeout=15)
         stopped(ledger)
     return 0
+
+
+def _open_state(
+    schedule_path: str | Path,
+    state: str,
+    *,
+    services: str | None,
+    pool: str | None,
+    stop_grace_s: float | None,
+    notify: str | None,
+) -> tuple[Schedule, Ledger]:
+    """The schedule and its state file, this run's settings kept in it, a first heartbeat
+    written and the matches an earlier run left playing marked interrupted."""
+    from tournament.notify import beat
+
+    schedule, ledger = init_state(schedule_path, state, services=services, pool=pool)
+    if stop_grace_s is not None:
+        ledger.set_meta("stop_grace_s", repr(float(stop_grace_s)))
+    if notify is not None:
+        ledger.set_meta("notify", notify)
+    beat(ledger)
+    recover_interrupted(ledger)
+    return schedule, ledger
+
+
+def _shut_down(
+    scheduler: BackgroundScheduler, running: RunningJobs, ledger: Ledger, *, stopped_by_user: bool
+) -> None:
+    """Stop the scheduler. On SIGTERM or SIGINT the running steps get the stop grace (the
+    state file's, else the default) and 15 s more to end; otherwise the scheduler waits for
+    them unless ``stopped_by_user`` (the ``stop`` event)."""
+    from tournament.jobs import DEFAULT_STOP_GRACE_S, STOPPING
+
+    if STOPPING.is_set():
+        scheduler.shutdown(wait=False)
+        grace = ledger.get_meta("stop_grace_s")
+        _wait_for_steps(running, (float(grace) if grace else DEFAULT_STOP_GRACE_S) + 15.0)
+    else:
+        scheduler.shutdown(wait=not stopped_by_user)
 
 
 def _notify_loop(ledger: Ledger, done: threading.Event, every_s: float = 2.0) -> None:

@@ -17,7 +17,15 @@ import numpy.typing as npt
 from contracts import GameState, Pose, field_for
 from robot.learned import Policy
 from robot.learned.policy import KICK_BALL_AHEAD_M
-from robot.motion import SERVO_PID, AttitudeFilter, GetUpMotion, KickMotion, WalkEngine, kinematics
+from robot.motion import (
+    SERVO_PID,
+    Attitude,
+    AttitudeFilter,
+    GetUpMotion,
+    KickMotion,
+    WalkEngine,
+    kinematics,
+)
 from robot.motion.imu import GRAVITY_M_S2, GyroBias
 from robot.motion.keyframes import Keyframe, KeyframeMotion
 from robot.motion.posture import standing_posture
@@ -222,15 +230,7 @@ class StubController:
         yaw, over = self._side.advance(dt)
         neck = sensors.joints.get(self.kin.neck_motor)
         if sensors.image_bgr is not None and neck is not None and abs(neck - yaw) < 0.1:
-            att = self.attitude.attitude
-            pose = CameraPose(
-                neck_yaw_rad=neck,
-                head_pitch_rad=self.kin.head_down_sign
-                * sensors.joints.get(self.kin.head_motor, 0.0),
-                torso_roll_rad=att.roll_rad,
-                torso_pitch_rad=att.pitch_rad,
-                pelvis_height_m=self._pelvis_height_m,
-            )
+            pose = self._camera_pose(sensors.joints)
             pixels = goal_below_horizon(sensors.image_bgr, pose, self.kin.camera, margin_rad=0.09)
             self._side.count(yaw > 0, pixels)
         if over:
@@ -261,32 +261,13 @@ class StubController:
         )
 
     def tick(self, sensors: Sensors, game: GameInfo) -> dict[str, float]:
+        """One control step: sense (:meth:`_sense`), carry on a motion or get up after a fall,
+        check the side the team plays on, then decide and act. Returns the joint targets."""
         dt = 0.008 if self._last_ms is None else max(sensors.time_ms - self._last_ms, 1) / 1000.0
         if self._settle_until_ms is None:
             self._settle_until_ms = sensors.time_ms + int(SETTLE_S * 1000)
         self._last_ms = sensors.time_ms
-        if sensors.gyro is not None:
-            sensors = replace(sensors, gyro=self._gyro_unbiased(dt, sensors.gyro, game))
-        if sensors.accel is not None and sensors.gyro is not None:
-            self.attitude.update(dt, sensors.accel, sensors.gyro)
-            weight = dt / (LYING_SIDE_TAU_S + dt)
-            self._forward_gravity += weight * (sensors.accel[0] - self._forward_gravity)
-        att = self.attitude.attitude
-        upright = att.tilt_rad < UPRIGHT_MAX_TILT_RAD
-        if upright and self._motion is None:
-            self._upright_since_fall = True
-        self.world.integrate(
-            dt,
-            self.walk.velocity if upright else (0.0, 0.0, 0.0),
-            None,
-            turned_rad=self._heading.heading_change(dt, sensors.accel, sensors.gyro),
-        )
-        if sensors.image_bgr is not None and upright and self._motion is None:
-            seen = self._look(sensors)
-            on_centre_spot = game.phase in (GameState.READY, GameState.SET) and not game.penalised
-            if seen is not None and on_centre_spot and math.hypot(*seen) < CENTRE_BALL_MAX_M:
-                if math.hypot(*self.world.pose.to_field(*seen)) < CENTRE_BALL_GATE_M:
-                    self.world.relocate_from_centre_ball(*seen, gain=CENTRE_BALL_GAIN)
+        sensors, att = self._sense(dt, sensors, game)
         if self._motion is None and self._moved_by_someone_else(sensors.joints):
             # teleported (half time, penalty) or limp: joints are not where we put them
             self.settle(sensors.time_ms)
@@ -351,6 +332,34 @@ class StubController:
             targets = self.walk.step(dt, *action.walk, accel=sensors.accel, gyro=sensors.gyro)
         targets.update(self._head(dt, ball, action, att.pitch_rad))
         return self._remember(targets)
+
+    def _sense(self, dt: float, sensors: Sensors, game: GameInfo) -> tuple[Sensors, Attitude]:
+        """The gyro's bias taken off, the attitude and the world model brought forward, the
+        ball looked for and the pose corrected from it on the centre spot (READY, SET).
+        Returns the sensors with the unbiased gyro, and the attitude."""
+        if sensors.gyro is not None:
+            sensors = replace(sensors, gyro=self._gyro_unbiased(dt, sensors.gyro, game))
+        if sensors.accel is not None and sensors.gyro is not None:
+            self.attitude.update(dt, sensors.accel, sensors.gyro)
+            weight = dt / (LYING_SIDE_TAU_S + dt)
+            self._forward_gravity += weight * (sensors.accel[0] - self._forward_gravity)
+        att = self.attitude.attitude
+        upright = att.tilt_rad < UPRIGHT_MAX_TILT_RAD
+        if upright and self._motion is None:
+            self._upright_since_fall = True
+        self.world.integrate(
+            dt,
+            self.walk.velocity if upright else (0.0, 0.0, 0.0),
+            None,
+            turned_rad=self._heading.heading_change(dt, sensors.accel, sensors.gyro),
+        )
+        if sensors.image_bgr is not None and upright and self._motion is None:
+            seen = self._look(sensors)
+            on_centre_spot = game.phase in (GameState.READY, GameState.SET) and not game.penalised
+            if seen is not None and on_centre_spot and math.hypot(*seen) < CENTRE_BALL_MAX_M:
+                if math.hypot(*self.world.pose.to_field(*seen)) < CENTRE_BALL_GATE_M:
+                    self.world.relocate_from_centre_ball(*seen, gain=CENTRE_BALL_GAIN)
+        return sensors, att
 
     # --- parts ---------------------------------------------------------------------------------
     def _kick(
@@ -417,14 +426,7 @@ class StubController:
         """Look for the ball in the image; the sighting (robot frame) or None."""
         image = sensors.image_bgr
         assert image is not None
-        att = self.attitude.attitude
-        pose = CameraPose(
-            neck_yaw_rad=sensors.joints.get(self.kin.neck_motor, 0.0),
-            head_pitch_rad=self.kin.head_down_sign * sensors.joints.get(self.kin.head_motor, 0.0),
-            torso_roll_rad=att.roll_rad,
-            torso_pitch_rad=att.pitch_rad,
-            pelvis_height_m=self._pelvis_height_m,
-        )
+        pose = self._camera_pose(sensors.joints)
         height, width = image.shape[0], image.shape[1]
         for blob in find_ball_blobs(image):
             seen = ground_point(
@@ -435,7 +437,7 @@ class StubController:
                 height_px=height,
                 ball_radius_m=self._ball_radius_m,
             )
-            if seen is not None and seen.distance_m < 8.0 and not self._own_body(seen):
+            if seen is not None and seen.distance_m < 8.0 and not _own_body(seen, self._size):
                 self.world.see_ball(sensors.time_ms, seen.x_m, seen.y_m)
                 self.stats.ball_sightings += 1
                 return seen.x_m, seen.y_m
@@ -459,11 +461,16 @@ class StubController:
         self._gyro_bias.learn(dt, gyro)
         return self._gyro_bias.corrected(gyro)
 
-    def _own_body(self, seen: BallSighting) -> bool:
-        """Whether a sighting lies where the robot's own feet or hands are (see OWN_FEET_X_M)."""
-        x, y = seen.x_m / self._size, abs(seen.y_m) / self._size
-        feet = x < OWN_FEET_X_M and y < OWN_FEET_Y_M
-        return feet or (abs(x) < OWN_HANDS_X_M and y < OWN_HANDS_Y_M)
+    def _camera_pose(self, joints: dict[str, float]) -> CameraPose:
+        """The head camera's pose from the neck and head joints and the torso's attitude."""
+        att = self.attitude.attitude
+        return CameraPose(
+            neck_yaw_rad=joints.get(self.kin.neck_motor, 0.0),
+            head_pitch_rad=self.kin.head_down_sign * joints.get(self.kin.head_motor, 0.0),
+            torso_roll_rad=att.roll_rad,
+            torso_pitch_rad=att.pitch_rad,
+            pelvis_height_m=self._pelvis_height_m,
+        )
 
     def _head(
         self, dt: float, ball: tuple[float, float] | None, action: Action, torso_pitch: float
@@ -568,6 +575,14 @@ class HeadingTracker:
         before = self._heading if self._heading is not None else heading
         self._heading = heading
         return math.atan2(math.sin(heading - before), math.cos(heading - before))
+
+
+def _own_body(seen: BallSighting, size: float) -> bool:
+    """Whether a sighting lies where the robot's own feet or hands are (see OWN_FEET_X_M);
+    ``size``: the robot's thigh against kid-default's."""
+    x, y = seen.x_m / size, abs(seen.y_m) / size
+    feet = x < OWN_FEET_X_M and y < OWN_FEET_Y_M
+    return feet or (abs(x) < OWN_HANDS_X_M and y < OWN_HANDS_Y_M)
 
 
 def _tilt_quaternion(ux: float, uy: float, uz: float) -> tuple[float, float, float, float]:
