@@ -70,12 +70,16 @@ class MjxStandKickVector(VectorEnv):
     metadata: dict[str, Any] = {"autoreset_mode": AutoresetMode.NEXT_STEP}
 
     def __init__(self, num_envs: int, *, self_collision: bool = False, **options: Any) -> None:
-        """``options``: the settings of :class:`envs.stand_kick.StandKickConfig`."""
+        """``options``: the settings of :class:`envs.stand_kick.StandKickConfig`.
+
+        The step is built from named pieces, each a function traced into the one jitted step:
+        :func:`_servo_step` (the servos and substeps), :func:`_measures` (the ball, the toe and
+        the episode's end), :func:`_episode_start` (an episode's first state) and
+        :func:`_env_step` (one environment step with its autoreset)."""
         if num_envs < 1:
             raise EnvConfigError(field="num_envs", value=num_envs, expected="an integer >= 1")
         config = self.config = StandKickConfig.of(options)
         model, steps_per_action = config.model, config.steps_per_action
-        ball_noise_m, heading_noise_rad = config.ball_noise_m, config.heading_noise_rad
         import jax
         import jax.numpy as jnp
 
@@ -104,159 +108,19 @@ class MjxStandKickVector(VectorEnv):
         mx = mjx.put_model(self.compiled)
         d0 = mjx.make_data(mx)
         substeps = round(STEP_MS / 1000.0 / self.compiled.opt.timestep)
-        field = field_for("kid")
-        goal_x = field.half_length_m
-        radius = field.ball_radius_m
-        act = jnp.asarray(layout.actuators)
-        mq, md = jnp.asarray(layout.motor_qpos), jnp.asarray(layout.motor_dof)
-        root_q, root_v, bq, bv = (
-            layout.root_qpos,
-            layout.root_dof,
-            layout.ball_qpos,
-            layout.ball_dof,
-        )
-        torso = layout.torso_body
-        sensor_at = jnp.asarray(layout.sensors)
-        template_q, template_v = jnp.asarray(qpos0), jnp.asarray(qvel0)
-        stance_j = jnp.asarray(stance)
-        low = jnp.asarray([-ACCEL_LIMIT] * 3 + [-GYRO_LIMIT] * 3 + [0.0] * 8)
-        high = jnp.asarray([ACCEL_LIMIT] * 3 + [GYRO_LIMIT] * 3 + [FORCE_LIMIT] * 8)
-        spa = steps_per_action
-        max_steps = self.max_steps
-        penalty = float(config.fall_penalty)
         sole = self.compiled.geom(f"{robot_prefix(LEARNER)}/{RIGHT_SOLE}").id
         half_length = float(self.compiled.geom_size[sole][0])
-        ball_ahead = BALL_AHEAD_M - config.ball_closer_m
-
-        def basic_step(d: Any, target: Any) -> Any:
-            """MotorBank's position path, then the substeps (simulator.world.motors)."""
-            q, qd = d.qpos[mq], d.qvel[md]
-            error = target - q
-            shift = jnp.clip(error, -servo["half_play"], servo["half_play"])
-            error = error - shift
-            wanted = DEFAULT_P * error
-            limit = servo["velocity_limit"]
-            free = jnp.abs(wanted) <= limit
-            ctrl = jnp.where(free, DEFAULT_P * (target - shift), jnp.copysign(limit, wanted))
-            on = (error != 0.0) | servo["no_play"]
-            ctrl = ctrl * on
-            bias_q = -servo["gain"] * DEFAULT_P * (free & on)
-            bias_v = -servo["gain"] * on
-            bounds = servo["line_bounds"] - (servo["line_slope"] * qd)[:, None]
-            bounds = jnp.maximum(jnp.minimum(bounds, servo["bounds_high"]), servo["bounds_low"])
-            gain = servo["gain"]
-            low, high = bounds[:, 0], bounds[:, 1]
-
-            def substep(_: Any, dd: Any) -> Any:
-                # MuJoCo leaves a force clamped by its range out of the implicit integrator's
-                # velocity derivative; MJX does not, so a clamped actuator becomes a plain torque
-                force = gain * ctrl + bias_q * dd.qpos[mq] + bias_v * dd.qvel[md]
-                clamped = (force < low) | (force > high)
-                m = mx.replace(
-                    actuator_gainprm=mx.actuator_gainprm.at[act, 0].set(
-                        jnp.where(clamped, 1.0, gain)
-                    ),
-                    actuator_biasprm=mx.actuator_biasprm.at[act, 1]
-                    .set(jnp.where(clamped, 0.0, bias_q))
-                    .at[act, 2]
-                    .set(jnp.where(clamped, 0.0, bias_v)),
-                    actuator_forcerange=jnp.asarray(mx.actuator_forcerange).at[act].set(bounds),
-                )
-                torque = jnp.where(clamped, jnp.clip(force, low, high), ctrl)
-                return mjx.step(m, dd.replace(ctrl=dd.ctrl.at[act].set(torque)))
-
-            return jax.lax.fori_loop(0, substeps, substep, d)
-
-        def truth(d: Any) -> Any:
-            w, x, y, z = (d.qpos[root_q + 3 + i] for i in range(4))
-            yaw = jnp.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
-            up = d.xmat[torso, 2, 2]
-            return d.qpos[bq : bq + 3], d.qvel[bv : bv + 3], d.qpos[root_q : root_q + 2], yaw, up
-
-        def measures(d: Any) -> tuple[Any, Any, Any, Any, Any, Any]:
-            ball, vel, _, _, up = truth(d)
-            bg = jnp.hypot(goal_x - ball[0], ball[1])
-            toe = d.geom_xpos[sole] + half_length * d.geom_xmat[sole][:, 0]
-            gap = jnp.maximum(0.0, jnp.linalg.norm(toe - ball) - radius)
-            x, y, z = ball[0], ball[1], ball[2]
-            goal = (x - radius > goal_x) & (jnp.abs(y) < field.goal_width_m / 2)
-            goal = goal & (z < field.goal_height_m)
-            out = ~goal & (
-                (jnp.abs(x) - radius > goal_x) | (jnp.abs(y) - radius > field.half_width_m)
-            )
-            return bg, goal, up < FALLEN_UP_Z, out, jnp.hypot(vel[0], vel[1]), gap
-
-        def start(key: Any) -> Any:
-            """The episode's first state (before its stance step): the settled robot moved."""
-            k = jax.random.split(key, 6)
-            rx = jax.random.uniform(k[0], (), minval=0.5, maxval=1.5)
-            ry = jax.random.uniform(k[1], (), minval=-1.0, maxval=1.0)
-            yaw = jnp.arctan2(-ry, goal_x - rx) + jax.random.uniform(
-                k[2], (), minval=-heading_noise_rad, maxval=heading_noise_rad)  # fmt: skip
-            ahead = ball_ahead + jax.random.uniform(k[3], (), minval=-ball_noise_m,
-                                                      maxval=ball_noise_m)  # fmt: skip
-            right = BALL_RIGHT_M + jax.random.uniform(k[4], (), minval=-ball_noise_m,
-                                                      maxval=ball_noise_m)  # fmt: skip
-            c, s = jnp.cos(yaw), jnp.sin(yaw)
-            qpos, qvel = template_q, template_v
-            x0, y0 = qpos[root_q], qpos[root_q + 1]
-            px, py = rx + c * x0 - s * y0, ry + s * x0 + c * y0
-            half = jnp.array([jnp.cos(yaw / 2), 0.0, 0.0, jnp.sin(yaw / 2)])
-            q0 = qpos[root_q + 3 : root_q + 7]
-            quat = jnp.array([
-                half[0] * q0[0] - half[3] * q0[3],
-                half[0] * q0[1] - half[3] * q0[2],
-                half[0] * q0[2] + half[3] * q0[1],
-                half[0] * q0[3] + half[3] * q0[0],
-            ])  # fmt: skip
-            qpos = (
-                qpos.at[root_q].set(px).at[root_q + 1].set(py).at[root_q + 3 : root_q + 7].set(quat)
-            )
-            vx, vy = qvel[root_v], qvel[root_v + 1]
-            qvel = qvel.at[root_v].set(c * vx - s * vy).at[root_v + 1].set(s * vx + c * vy)
-            w, _, _, z = quat[0], quat[1], quat[2], quat[3]
-            ry2 = jnp.arctan2(2 * (w * z + quat[1] * quat[2]),
-                              1 - 2 * (quat[2] ** 2 + z * z))  # fmt: skip
-            cy, sy = jnp.cos(ry2), jnp.sin(ry2)
-            bx, by = px + ahead * cy + right * sy, py + ahead * sy - right * cy
-            qpos = qpos.at[bq : bq + 3].set(jnp.array([bx, by, radius]))
-            qpos = qpos.at[bq + 3 : bq + 7].set(jnp.array([1.0, 0.0, 0.0, 0.0]))
-            qvel = qvel.at[bv : bv + 6].set(0.0)
-            return d0.replace(qpos=qpos.astype(d0.qpos.dtype), qvel=qvel.astype(d0.qvel.dtype))
-
-        def one(state: dict[str, Any], action: Any, fresh: Any) -> tuple[Any, ...]:
-            key, sub = jax.random.split(state["key"])
-            d = jax.tree_util.tree_map(lambda a, b: jnp.where(fresh, a, b), start(sub), state["d"])
-            target = jnp.where(fresh, stance_j, jnp.clip(action, servo["lower"], servo["upper"]))
-            d = jax.lax.fori_loop(0, spa, lambda _, dd: basic_step(dd, target), d)
-            bg, goal, fallen, out, speed, gap = measures(d)
-            steps = jnp.where(fresh, 0, state["steps"] + 1)
-            before = jnp.where(fresh, False, state["touched"])
-            touched = before | (speed >= TOUCH_SPEED_M_S)
-            f32 = jnp.float32
-            reward = stand_kick_reward(
-                config, progress=state["bg"] - bg, gap_before=state["gap"], gap_after=gap,
-                touched_before=before.astype(f32), touched=touched.astype(f32),
-                fallen=fallen.astype(f32), fall_penalty=penalty,
-            )  # fmt: skip
-            touched = touched & ~fresh
-            terminated = (goal | fallen | out) & ~fresh
-            truncated = ~terminated & (steps >= max_steps) & ~fresh
-            t0 = jnp.where(fresh, d.time, state["t0"])
-            ball = d.qpos[bq : bq + 2]
-            ball0 = jnp.where(fresh, ball, state["ball0"])
-            top = jnp.where(fresh, 0.0, jnp.maximum(state["top"], speed))
-            sensors = jnp.clip(d.sensordata[sensor_at], low, high)
-            joints = jnp.clip(d.qpos[mq], -jnp.pi, jnp.pi)
-            d = jax.tree_util.tree_map(lambda a, b: a.astype(b.dtype), d, d0)  # no weak types
-            new = {"key": key, "d": d, "steps": steps.astype(jnp.int32),
-                   "bg": bg.astype(jnp.float32), "t0": t0.astype(jnp.float32),
-                   "ball0": ball0.astype(jnp.float32), "top": top.astype(jnp.float32),
-                   "gap": gap.astype(jnp.float32), "touched": touched}  # fmt: skip
-            obs = (joints, sensors, d.time - t0)
-            info = (jnp.hypot(*(ball - ball0)), bg, speed, top, gap, touched, goal, fallen, out)
-            return new, obs, jnp.where(fresh, 0.0, reward), terminated, truncated, info
-
+        one = _env_step(
+            config,
+            layout,
+            servo=servo,
+            stance=stance,
+            d0=d0,
+            max_steps=self.max_steps,
+            basic_step=_servo_step(mx, servo, layout, substeps=substeps),
+            measures=_measures(layout, sole=sole, half_length=half_length),
+            start=_episode_start(config, layout, d0=d0, qpos0=qpos0, qvel0=qvel0),
+        )
         self._advance = jax.jit(jax.vmap(one))
         self._jnp = jnp
         self._jax = jax
@@ -358,3 +222,208 @@ class MjxStandKickVector(VectorEnv):
 
     def close(self, **kwargs: Any) -> None:
         self._state = None
+
+
+def _servo_step(mx: Any, servo: dict[str, Any], layout: Any, *, substeps: int) -> Any:
+    """``basic_step(d, target)``: one basic step of ``substeps`` physics substeps with the
+    servos driving the motors to ``target``."""
+    import jax
+    import jax.numpy as jnp
+
+    mjx = _quiet_import()
+    act = jnp.asarray(layout.actuators)
+    mq, md = jnp.asarray(layout.motor_qpos), jnp.asarray(layout.motor_dof)
+
+    def basic_step(d: Any, target: Any) -> Any:
+        """MotorBank's position path, then the substeps (simulator.world.motors)."""
+        q, qd = d.qpos[mq], d.qvel[md]
+        error = target - q
+        shift = jnp.clip(error, -servo["half_play"], servo["half_play"])
+        error = error - shift
+        wanted = DEFAULT_P * error
+        limit = servo["velocity_limit"]
+        free = jnp.abs(wanted) <= limit
+        ctrl = jnp.where(free, DEFAULT_P * (target - shift), jnp.copysign(limit, wanted))
+        on = (error != 0.0) | servo["no_play"]
+        ctrl = ctrl * on
+        bias_q = -servo["gain"] * DEFAULT_P * (free & on)
+        bias_v = -servo["gain"] * on
+        bounds = servo["line_bounds"] - (servo["line_slope"] * qd)[:, None]
+        bounds = jnp.maximum(jnp.minimum(bounds, servo["bounds_high"]), servo["bounds_low"])
+        gain = servo["gain"]
+        low, high = bounds[:, 0], bounds[:, 1]
+
+        def substep(_: Any, dd: Any) -> Any:
+            # MuJoCo leaves a force clamped by its range out of the implicit integrator's
+            # velocity derivative; MJX does not, so a clamped actuator becomes a plain torque
+            force = gain * ctrl + bias_q * dd.qpos[mq] + bias_v * dd.qvel[md]
+            clamped = (force < low) | (force > high)
+            m = mx.replace(
+                actuator_gainprm=mx.actuator_gainprm.at[act, 0].set(
+                    jnp.where(clamped, 1.0, gain)
+                ),
+                actuator_biasprm=mx.actuator_biasprm.at[act, 1]
+                .set(jnp.where(clamped, 0.0, bias_q))
+                .at[act, 2]
+                .set(jnp.where(clamped, 0.0, bias_v)),
+                actuator_forcerange=jnp.asarray(mx.actuator_forcerange).at[act].set(bounds),
+            )
+            torque = jnp.where(clamped, jnp.clip(force, low, high), ctrl)
+            return mjx.step(m, dd.replace(ctrl=dd.ctrl.at[act].set(torque)))
+
+        return jax.lax.fori_loop(0, substeps, substep, d)
+
+    return basic_step
+
+
+def _measures(layout: Any, *, sole: int, half_length: float) -> Any:
+    """``measures(d)``: the ball's distance to the goal centre, goal, fallen, out, the ball's
+    speed and the gap between the right toe (``half_length`` ahead of the ``sole`` geom's
+    centre) and the ball."""
+    import jax.numpy as jnp
+
+    field = field_for("kid")
+    goal_x = field.half_length_m
+    radius = field.ball_radius_m
+    root_q, bq, bv = layout.root_qpos, layout.ball_qpos, layout.ball_dof
+    torso = layout.torso_body
+
+    def truth(d: Any) -> Any:
+        w, x, y, z = (d.qpos[root_q + 3 + i] for i in range(4))
+        yaw = jnp.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+        up = d.xmat[torso, 2, 2]
+        return d.qpos[bq : bq + 3], d.qvel[bv : bv + 3], d.qpos[root_q : root_q + 2], yaw, up
+
+    def measures(d: Any) -> tuple[Any, Any, Any, Any, Any, Any]:
+        ball, vel, _, _, up = truth(d)
+        bg = jnp.hypot(goal_x - ball[0], ball[1])
+        toe = d.geom_xpos[sole] + half_length * d.geom_xmat[sole][:, 0]
+        gap = jnp.maximum(0.0, jnp.linalg.norm(toe - ball) - radius)
+        x, y, z = ball[0], ball[1], ball[2]
+        goal = (x - radius > goal_x) & (jnp.abs(y) < field.goal_width_m / 2)
+        goal = goal & (z < field.goal_height_m)
+        out = ~goal & (
+            (jnp.abs(x) - radius > goal_x) | (jnp.abs(y) - radius > field.half_width_m)
+        )
+        return bg, goal, up < FALLEN_UP_Z, out, jnp.hypot(vel[0], vel[1]), gap
+
+    return measures
+
+
+def _episode_start(
+    config: StandKickConfig, layout: Any, *, d0: Any, qpos0: np.ndarray, qvel0: np.ndarray
+) -> Any:
+    """``start(key)``: an episode's first state, the settled robot (``qpos0``, ``qvel0``)
+    moved to a random pose facing the goal and the ball at its right foot."""
+    import jax
+    import jax.numpy as jnp
+
+    field = field_for("kid")
+    goal_x = field.half_length_m
+    radius = field.ball_radius_m
+    root_q, root_v, bq, bv = layout.root_qpos, layout.root_dof, layout.ball_qpos, layout.ball_dof
+    template_q, template_v = jnp.asarray(qpos0), jnp.asarray(qvel0)
+    ball_noise_m, heading_noise_rad = config.ball_noise_m, config.heading_noise_rad
+    ball_ahead = BALL_AHEAD_M - config.ball_closer_m
+
+    def start(key: Any) -> Any:
+        """The episode's first state (before its stance step): the settled robot moved."""
+        k = jax.random.split(key, 6)
+        rx = jax.random.uniform(k[0], (), minval=0.5, maxval=1.5)
+        ry = jax.random.uniform(k[1], (), minval=-1.0, maxval=1.0)
+        yaw = jnp.arctan2(-ry, goal_x - rx) + jax.random.uniform(
+            k[2], (), minval=-heading_noise_rad, maxval=heading_noise_rad)  # fmt: skip
+        ahead = ball_ahead + jax.random.uniform(k[3], (), minval=-ball_noise_m,
+                                                  maxval=ball_noise_m)  # fmt: skip
+        right = BALL_RIGHT_M + jax.random.uniform(k[4], (), minval=-ball_noise_m,
+                                                  maxval=ball_noise_m)  # fmt: skip
+        c, s = jnp.cos(yaw), jnp.sin(yaw)
+        qpos, qvel = template_q, template_v
+        x0, y0 = qpos[root_q], qpos[root_q + 1]
+        px, py = rx + c * x0 - s * y0, ry + s * x0 + c * y0
+        half = jnp.array([jnp.cos(yaw / 2), 0.0, 0.0, jnp.sin(yaw / 2)])
+        q0 = qpos[root_q + 3 : root_q + 7]
+        quat = jnp.array([
+            half[0] * q0[0] - half[3] * q0[3],
+            half[0] * q0[1] - half[3] * q0[2],
+            half[0] * q0[2] + half[3] * q0[1],
+            half[0] * q0[3] + half[3] * q0[0],
+        ])  # fmt: skip
+        qpos = (
+            qpos.at[root_q].set(px).at[root_q + 1].set(py).at[root_q + 3 : root_q + 7].set(quat)
+        )
+        vx, vy = qvel[root_v], qvel[root_v + 1]
+        qvel = qvel.at[root_v].set(c * vx - s * vy).at[root_v + 1].set(s * vx + c * vy)
+        w, _, _, z = quat[0], quat[1], quat[2], quat[3]
+        ry2 = jnp.arctan2(2 * (w * z + quat[1] * quat[2]),
+                          1 - 2 * (quat[2] ** 2 + z * z))  # fmt: skip
+        cy, sy = jnp.cos(ry2), jnp.sin(ry2)
+        bx, by = px + ahead * cy + right * sy, py + ahead * sy - right * cy
+        qpos = qpos.at[bq : bq + 3].set(jnp.array([bx, by, radius]))
+        qpos = qpos.at[bq + 3 : bq + 7].set(jnp.array([1.0, 0.0, 0.0, 0.0]))
+        qvel = qvel.at[bv : bv + 6].set(0.0)
+        return d0.replace(qpos=qpos.astype(d0.qpos.dtype), qvel=qvel.astype(d0.qvel.dtype))
+
+    return start
+
+
+def _env_step(
+    config: StandKickConfig,
+    layout: Any,
+    *,
+    servo: dict[str, Any],
+    stance: np.ndarray,
+    d0: Any,
+    max_steps: int,
+    basic_step: Any,
+    measures: Any,
+    start: Any,
+) -> Any:
+    """``one(state, action, fresh)``: one environment's step (``steps_per_action`` basic
+    steps), or where ``fresh`` the start of its next episode and its stance step; the new
+    state, the observation, the reward, terminated, truncated and the info values."""
+    import jax
+    import jax.numpy as jnp
+
+    spa = config.steps_per_action
+    penalty = float(config.fall_penalty)
+    mq, bq = jnp.asarray(layout.motor_qpos), layout.ball_qpos
+    sensor_at = jnp.asarray(layout.sensors)
+    stance_j = jnp.asarray(stance)
+    low = jnp.asarray([-ACCEL_LIMIT] * 3 + [-GYRO_LIMIT] * 3 + [0.0] * 8)
+    high = jnp.asarray([ACCEL_LIMIT] * 3 + [GYRO_LIMIT] * 3 + [FORCE_LIMIT] * 8)
+
+    def one(state: dict[str, Any], action: Any, fresh: Any) -> tuple[Any, ...]:
+        key, sub = jax.random.split(state["key"])
+        d = jax.tree_util.tree_map(lambda a, b: jnp.where(fresh, a, b), start(sub), state["d"])
+        target = jnp.where(fresh, stance_j, jnp.clip(action, servo["lower"], servo["upper"]))
+        d = jax.lax.fori_loop(0, spa, lambda _, dd: basic_step(dd, target), d)
+        bg, goal, fallen, out, speed, gap = measures(d)
+        steps = jnp.where(fresh, 0, state["steps"] + 1)
+        before = jnp.where(fresh, False, state["touched"])
+        touched = before | (speed >= TOUCH_SPEED_M_S)
+        f32 = jnp.float32
+        reward = stand_kick_reward(
+            config, progress=state["bg"] - bg, gap_before=state["gap"], gap_after=gap,
+            touched_before=before.astype(f32), touched=touched.astype(f32),
+            fallen=fallen.astype(f32), fall_penalty=penalty,
+        )  # fmt: skip
+        touched = touched & ~fresh
+        terminated = (goal | fallen | out) & ~fresh
+        truncated = ~terminated & (steps >= max_steps) & ~fresh
+        t0 = jnp.where(fresh, d.time, state["t0"])
+        ball = d.qpos[bq : bq + 2]
+        ball0 = jnp.where(fresh, ball, state["ball0"])
+        top = jnp.where(fresh, 0.0, jnp.maximum(state["top"], speed))
+        sensors = jnp.clip(d.sensordata[sensor_at], low, high)
+        joints = jnp.clip(d.qpos[mq], -jnp.pi, jnp.pi)
+        d = jax.tree_util.tree_map(lambda a, b: a.astype(b.dtype), d, d0)  # no weak types
+        new = {"key": key, "d": d, "steps": steps.astype(jnp.int32),
+               "bg": bg.astype(jnp.float32), "t0": t0.astype(jnp.float32),
+               "ball0": ball0.astype(jnp.float32), "top": top.astype(jnp.float32),
+               "gap": gap.astype(jnp.float32), "touched": touched}  # fmt: skip
+        obs = (joints, sensors, d.time - t0)
+        info = (jnp.hypot(*(ball - ball0)), bg, speed, top, gap, touched, goal, fallen, out)
+        return new, obs, jnp.where(fresh, 0.0, reward), terminated, truncated, info
+
+    return one
