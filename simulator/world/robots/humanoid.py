@@ -72,18 +72,6 @@ def _leg(w: _Writer, side: str) -> str:
     sign = 1.0 if side == "L" else -1.0
     small = _inertial(g.joint_link_kg, g.foot_half_width_m / 2)
     r_thigh = g.foot_half_width_m * 0.65
-    hl, hw, ht = g.foot_half_length_m, g.foot_half_width_m, g.foot_half_thickness_m
-    fx, sole = g.foot_forward_m, -g.ankle_height_m
-    sites = []
-    letter = side.lower()
-    for ny, y_name in ((1.0, "l"), (-1.0, "r")):
-        for nx, x_name in ((-1.0, "b"), (1.0, "f")):
-            name = f"{letter}{y_name}{x_name}"
-            sites.append(
-                f'<site name="{w.p}/site:{name}" type="box" group="4" '
-                f'pos="{_f(fx + nx * hl / 2, ny * hw / 2, sole)}" '
-                f'size="{_f(hl / 2 + 1e-3, hw / 2 + 1e-3, ht * 1.5)}"/>'
-            )
     thigh = w.geom(
         "leg",
         "thigh_" + side,
@@ -98,6 +86,37 @@ def _leg(w: _Writer, side: str) -> str:
         LIMB_RGBA,
         g.shank_kg,
     )
+    return f"""
+<body name="{w.p}/hip_yaw_{side}" pos="{_f(0, sign * g.hip_y_m, g.hip_z_m)}">
+ {small}{w.joint("PelvY" + side, (0, 0, 1))}
+ <body name="{w.p}/hip_roll_{side}">
+  {small}{w.joint("Pelv" + side, (1, 0, 0))}
+  <body name="{w.p}/thigh_{side}">
+   {w.joint("LegUpper" + side, (0, -1, 0))}
+   {thigh}
+   <body name="{w.p}/shank_{side}" pos="{_f(0, 0, -g.thigh_m)}">
+    {w.joint("LegLower" + side, (0, 1, 0))}
+    {shank}
+    <body name="{w.p}/ankle_{side}" pos="{_f(0, 0, -g.shank_m)}">
+     {small}{w.joint("Ankle" + side, (0, -1, 0))}
+     <body name="{w.p}/foot_{side}">
+      {w.joint("Foot" + side, (1, 0, 0))}
+      {_foot(w, side)}
+      {_foot_sites(w, side)}
+     </body>
+    </body>
+   </body>
+  </body>
+ </body>
+</body>"""
+
+
+def _foot(w: _Writer, side: str) -> str:
+    """The foot's geoms: the sole plate resting on four cleats at its corners, and the league's
+    test robot's ankle box above it."""
+    g = w.model.geometry
+    hl, hw, ht = g.foot_half_length_m, g.foot_half_width_m, g.foot_half_thickness_m
+    fx, sole = g.foot_forward_m, -g.ankle_height_m
     cleat = g.cleat_radius_m
     plate = ht - cleat  # half thickness of the plate resting on the cleats
     foot = w.geom(
@@ -126,29 +145,27 @@ def _leg(w: _Writer, side: str) -> str:
                 FOOT_RGBA,
                 0.0,
             )
-    return f"""
-<body name="{w.p}/hip_yaw_{side}" pos="{_f(0, sign * g.hip_y_m, g.hip_z_m)}">
- {small}{w.joint("PelvY" + side, (0, 0, 1))}
- <body name="{w.p}/hip_roll_{side}">
-  {small}{w.joint("Pelv" + side, (1, 0, 0))}
-  <body name="{w.p}/thigh_{side}">
-   {w.joint("LegUpper" + side, (0, -1, 0))}
-   {thigh}
-   <body name="{w.p}/shank_{side}" pos="{_f(0, 0, -g.thigh_m)}">
-    {w.joint("LegLower" + side, (0, 1, 0))}
-    {shank}
-    <body name="{w.p}/ankle_{side}" pos="{_f(0, 0, -g.shank_m)}">
-     {small}{w.joint("Ankle" + side, (0, -1, 0))}
-     <body name="{w.p}/foot_{side}">
-      {w.joint("Foot" + side, (1, 0, 0))}
-      {foot}
-      {"".join(sites)}
-     </body>
-    </body>
-   </body>
-  </body>
- </body>
-</body>"""
+    return foot
+
+
+def _foot_sites(w: _Writer, side: str) -> str:
+    """The foot's four force sensors' touch sites, each under a quarter of the sole, named by
+    the foot (``l``, ``r``), then left or right (``l``, ``r``), then back or front (``b``,
+    ``f``)."""
+    g = w.model.geometry
+    hl, hw, ht = g.foot_half_length_m, g.foot_half_width_m, g.foot_half_thickness_m
+    fx, sole = g.foot_forward_m, -g.ankle_height_m
+    sites = []
+    letter = side.lower()
+    for ny, y_name in ((1.0, "l"), (-1.0, "r")):
+        for nx, x_name in ((-1.0, "b"), (1.0, "f")):
+            name = f"{letter}{y_name}{x_name}"
+            sites.append(
+                f'<site name="{w.p}/site:{name}" type="box" group="4" '
+                f'pos="{_f(fx + nx * hl / 2, ny * hw / 2, sole)}" '
+                f'size="{_f(hl / 2 + 1e-3, hw / 2 + 1e-3, ht * 1.5)}"/>'
+            )
+    return "".join(sites)
 
 
 def _arm(w: _Writer, side: str) -> str:
