@@ -10,12 +10,11 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from dataclasses import replace
 from pathlib import Path
 
 from contracts import GameStateRecord, GameType, RobotId, TeamColor
 from referee import placement, positions, reporting
-from referee.clock import Clock, SystemClock
+from referee.clock import Clock, SystemClock, WallClockWait
 from referee.config import RefereeConfig
 from referee.gamecontroller import (
     GameController,
@@ -35,7 +34,6 @@ from referee.rules import end_of_game, goal, kickoff, set_play
 from referee.rules.base import AbortSetPlay, Decision, GameView, GiveCard, RetakeSetPlay
 from referee.shootout_play import ShootoutPlay
 from referee.snapshot import (
-    BallState,
     PlaceBall,
     RefereeEvent,
     Vec2,
@@ -113,8 +111,7 @@ class Referee:
         self._touches = reporting.TouchReporter()
         self._started = False
         self._last_ms: int | None = None
-        self._wait_until_s: float | None = None
-        self._after_wait: Action | None = None
+        self._waiting: WallClockWait[Action] = WallClockWait(self._clock)
         self._finished = False
         self._winner: TeamColor | None = None
         self._coin_toss = False
@@ -142,7 +139,7 @@ class Referee:
 
     @property
     def waiting_for_wall_clock(self) -> bool:
-        return self._wait_until_s is not None
+        return self._waiting.pending
 
     @property
     def game_state(self) -> GameStateRecord:
@@ -210,21 +207,21 @@ class Referee:
         self.link.take_goalkeeper_claims(now)
         if self._finished:
             return commands
-        if self._wait_until_s is not None:
+        if self._waiting.pending:
             # INITIAL: the GameController's time runs on, this step's before the wait's end
             self.gc.advance_ms(dt_ms)
             dt_ms = 0
-            if self._clock.monotonic() < self._wait_until_s:
+            if not self._waiting.over():
                 self._publish()
                 return commands
-            action, self._after_wait, self._wait_until_s = self._after_wait, None, None
+            action = self._waiting.take()
             if action is not None:
                 commands += action(snapshot)
         tick = self.gc.advance_ms(dt_ms)
         commands += self._on_tick(tick, snapshot)
         if self.gc.state is not GameState.INITIAL and not self._finished:
             commands += penalised_robots(self, snapshot, penalised)
-        if not self._finished and self._wait_until_s is None:
+        if not self._finished and not self._waiting.pending:
             if self.gc.phase is SecondaryState.PENALTYSHOOT:
                 commands += self._shootout_step(snapshot)
             else:
@@ -256,8 +253,7 @@ class Referee:
         self.log.event(event)
 
     def _wait(self, seconds: float, action: Action, why: str, sim_ms: int) -> None:
-        self._wait_until_s = self._clock.monotonic() + seconds
-        self._after_wait = action
+        self._waiting.start(seconds, action)
         self.log.info(sim_ms, f"Waiting {seconds:g} s of real time {why}.")
 
     def _start(self, snapshot: WorldSnapshot) -> list[WorldCommand]:
@@ -384,17 +380,11 @@ class Referee:
         held off the field before a kick-off is put on the centre spot for SET or PLAYING, as
         SET would have put it."""
         commands: list[WorldCommand] = []
-        x, y = snapshot.ball.position[0], snapshot.ball.position[1]
-        away = abs(x) > self.field.turf_half_length_m or abs(y) > self.field.turf_half_width_m
-        if away and state in (GameState.SET, GameState.PLAYING):
-            placed = self.ball_at(0.0, 0.0)
-            commands.append(placed)
-            snapshot = replace(snapshot, ball=BallState(position=placed.position,
-                                                        velocity=(0.0, 0.0, 0.0)))  # fmt: skip
+        if state in (GameState.SET, GameState.PLAYING):
+            commands, snapshot = positions.ball_held_placed(self, snapshot)
         gc = self.gc
         self._started = True
-        self._wait_until_s = None
-        self._after_wait = None
+        self._waiting.cancel()
         self.set_since_ms = snapshot.sim_time_ms if state is GameState.SET else None
         self.ball_in_play = False
         gc.state = _PREDECESSOR[state]  # a state from which the transition is allowed
@@ -458,19 +448,12 @@ class Referee:
         self._coin_toss = coin_toss
         self._finished = True
         self._winner = winner
-        red, blue = self.gc.score(TeamColor.RED), self.gc.score(TeamColor.BLUE)
-        self.log.info(snapshot.sim_time_ms, f"FINAL SCORE: {red}-{blue}")
-        if winner is None:
-            self.log.info(snapshot.sim_time_ms, "The game ended in a draw.")
-        else:
-            self.log.info(snapshot.sim_time_ms, f"The winner is the {winner.value} team.")
-        self.emit(
-            RefereeEvent(
-                sim_time_ms=snapshot.sim_time_ms, type="game_over", team=winner,
-                reason="draw" if winner is None else "winner",
-                details={"score": {"red": red, "blue": blue}, "coin_toss": self._coin_toss},
-            )
+        lines, event = reporting.game_over(
+            self.gc, winner, coin_toss=coin_toss, sim_time_ms=snapshot.sim_time_ms
         )
+        for line in lines:
+            self.log.info(snapshot.sim_time_ms, line)
+        self.emit(event)
 
     # --- penalty shoot-out ---------------------------------------------------------------
 

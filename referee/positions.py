@@ -10,10 +10,11 @@ ball is put on the centre spot, wherever a robot pushed it in READY.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 from contracts import RobotId, TeamColor
 from referee.judgement import RefereeCore
-from referee.snapshot import TeleportRobot, WorldCommand, WorldSnapshot
+from referee.snapshot import BallState, TeleportRobot, WorldCommand, WorldSnapshot
 
 BALL_ON_SPOT_M = 0.01  # a ball farther from the centre spot at SET was moved in READY (logged)
 # Where the ball is held before a kick-off, off the field, as the league's referee holds it
@@ -54,3 +55,18 @@ def kick_off_ball(ref: RefereeCore, snapshot: WorldSnapshot) -> list[WorldComman
         ref.log.info(snapshot.sim_time_ms, f"Ball moved in READY to ({x:.2f}, {y:.2f}); "
                      "placed on the centre spot.")  # fmt: skip
     return [ref.ball_at(0.0, 0.0)]
+
+
+def ball_held_placed(
+    ref: RefereeCore, snapshot: WorldSnapshot
+) -> tuple[list[WorldCommand], WorldSnapshot]:
+    """A trainer puts the game into SET or PLAYING: a ball held off the field before a kick-off
+    is put on the centre spot, as SET would have put it. Returns the commands and the snapshot
+    as it will be (the ball on the spot, still)."""
+    x, y = snapshot.ball.position[0], snapshot.ball.position[1]
+    field = ref.field
+    if abs(x) <= field.turf_half_length_m and abs(y) <= field.turf_half_width_m:
+        return [], snapshot
+    placed = ref.ball_at(0.0, 0.0)
+    still = BallState(position=placed.position, velocity=(0.0, 0.0, 0.0))
+    return [placed], replace(snapshot, ball=still)

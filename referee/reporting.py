@@ -115,3 +115,21 @@ class TouchReporter:
         self._last_toucher = toucher
         self._last_touch_ms = snapshot.last_ball_touch_ms
         return f"Ball touched by {toucher}." if new else None
+
+
+def game_over(
+    gc: GameController, winner: TeamColor | None, *, coin_toss: bool, sim_time_ms: int
+) -> tuple[list[str], RefereeEvent]:
+    """The log lines (final score, winner or draw) and the ``game_over`` event of the end."""
+    red, blue = gc.score(TeamColor.RED), gc.score(TeamColor.BLUE)
+    lines = [f"FINAL SCORE: {red}-{blue}"]
+    if winner is None:
+        lines.append("The game ended in a draw.")
+    else:
+        lines.append(f"The winner is the {winner.value} team.")
+    event = RefereeEvent(
+        sim_time_ms=sim_time_ms, type="game_over", team=winner,
+        reason="draw" if winner is None else "winner",
+        details={"score": {"red": red, "blue": blue}, "coin_toss": coin_toss},
+    )
+    return lines, event

@@ -114,3 +114,20 @@ def test_robot_missing_from_the_configuration_is_not_judged(tmp_path: Path) -> N
     assert not [e for e in ref.events if e.type == "penalty" and e.player == 9]
     log = (tmp_path / "referee.log").read_text()
     assert log.count("red player 9 is not in the team configuration") == 1
+
+
+def test_a_trainer_s_set_or_playing_puts_a_held_ball_on_the_centre_spot() -> None:
+    """force_state: the ball held off the field before a kick-off goes on the centre spot for
+    SET or PLAYING, as SET would put it; a ball on the field, or READY, is left where it is."""
+    from referee import GameState
+
+    ref = Referee(config=make_config(side_left=RED), clock=FakeClock())
+    held = ref.step(snapshot(0, STILL))
+    assert PlaceBall(position=(100.0, 100.0, 0.07)) in held
+    away = snapshot(8, STILL, ball=(100.0, 100.0, 0.07))
+    assert ref.force_state(GameState.READY, away) == []
+    assert ref.force_state(GameState.SET, away) == [PlaceBall(position=(0.0, 0.0, 0.07))]
+    assert ref.game_state["state"] == "SET" and not ref.waiting_for_wall_clock
+    on_field = snapshot(16, STILL, ball=(1.0, -0.5, 0.07))
+    assert ref.force_state(GameState.PLAYING, on_field) == []
+    assert ref.game_state["state"] == "PLAYING"
