@@ -8,8 +8,9 @@ decision per 32 ms, from what the robot API reports: joint angles, accelerometer
 time since the skill started (no ball or robot position). It writes to ``--out``:
 
 - ``episodes.csv``: one row per finished episode (environment steps so far, return, kick
-  distance, fastest ball speed, fallen, touched the ball, the fall penalty and the curriculum's
-  ball offset then), and progress lines on the terminal;
+  distance, fastest ball speed, fallen, touched the ball, the fall penalty, the curriculum's
+  ball offset and the policy's mean log standard deviation then), and progress lines on the
+  terminal;
 - ``skrl/``: skrl's TensorBoard event files and checkpoints;
 - ``policy.npz``: the policy's weights for the robot (:mod:`robot.learned`; numpy only), written
   at every progress line and at the end;
@@ -26,7 +27,10 @@ still and for a fall); a fall costs 1 until 40 % of the steps, then more, up to 
 (``--fall-penalty``, ``--fall-penalty-end``). A curriculum starts the ball 3 cm nearer the toe
 and moves it back to where the skill finds it over the first 30 % of the steps
 (``--curriculum-m``, ``--curriculum-until``): first touch the ball at all, then reach it, then
-kick without falling.
+kick without falling. The policy's exploration (the log standard deviation of its actions,
+learnt by PPO from ``--init-log-std``) is capped from 40 % of the steps, the cap falling to
+``--final-log-std`` at 80 %: the last episodes it learns from are nearly the kick it will play,
+not the same kick shaken into a fall.
 
     python examples/learn_stand_kick.py --seed 1 --out runs/stand_kick
     python examples/learn_stand_kick.py --plot-runs runs/s1 runs/s2 runs/s3 --out seeds.png
@@ -94,16 +98,24 @@ def policy_template() -> Policy:
     )  # fmt: skip
 
 
-class FallPenalty:
-    """The fall penalty over training: ``start`` until 40 % of the steps, then rising linearly
-    to ``end`` at 80 % (first learn to touch the ball at all, then to stay up while kicking)."""
+def _ramp(share: float, span: tuple[float, float]) -> float:
+    """0 until ``span[0]`` of the steps, 1 from ``span[1]`` on, linear between."""
+    return min(max((share - span[0]) / max(span[1] - span[0], 1e-9), 0.0), 1.0)
 
-    def __init__(self, start: float, end: float, total_steps: int) -> None:
+
+class FallPenalty:
+    """The fall penalty over training: ``start`` until ``span[0]`` of the steps, then rising
+    linearly to ``end`` at ``span[1]`` (first learn to touch the ball at all, then to stay up
+    while kicking)."""
+
+    def __init__(
+        self, start: float, end: float, total_steps: int, span: tuple[float, float] = (0.4, 0.8)
+    ) -> None:
         self.start, self.end, self.total = start, end, max(1, total_steps)
+        self.span = span
 
     def at(self, steps: int) -> float:
-        done = min(max((steps / self.total - 0.4) / 0.4, 0.0), 1.0)
-        return self.start + (self.end - self.start) * done
+        return self.start + (self.end - self.start) * _ramp(steps / self.total, self.span)
 
 
 class Curriculum:
@@ -119,6 +131,39 @@ class Curriculum:
         return self.start * max(0.0, 1.0 - steps / (self.until * self.total))
 
 
+class ExplorationCap:
+    """The most the policy's exploration (the log of its actions' standard deviation) may be
+    over training: ``start`` until ``span[0]`` of the steps, then falling linearly to ``end`` at
+    ``span[1]`` (explore widely while learning to touch and kick, then refine the kick with less
+    noise, so that the episodes it learns from are nearly those it will play)."""
+
+    def __init__(
+        self, start: float, end: float, total_steps: int, span: tuple[float, float] = (0.4, 0.8)
+    ) -> None:
+        self.start, self.end, self.total = start, end, max(1, total_steps)
+        self.span = span
+
+    def at(self, steps: int) -> float:
+        if self.end >= self.start:  # no cap
+            return math.inf
+        return self.start + (self.end - self.start) * _ramp(steps / self.total, self.span)
+
+    def apply(self, agent: Any, steps: int) -> float:
+        """Lower the policy's learnt log standard deviations to the cap of the moment; their
+        mean after that."""
+        import jax.numpy as jnp
+
+        cap = self.at(steps)
+        model = agent.models["policy"]
+        params = model.state_dict.params
+        log_std = params["params"]["log_std"]
+        if float(jnp.max(log_std)) > cap:
+            log_std = jnp.minimum(log_std, cap)
+            capped = {**params["params"], "log_std": log_std}
+            model.state_dict = model.state_dict.replace(params={**params, "params": capped})
+        return float(jnp.mean(log_std))
+
+
 class PolicyInputs(gym.vector.VectorWrapper):
     """The vector environment as the learner sees it: flat scaled observations, actions in
     [-1, 1] mapped to targets around the stance; logs every finished episode and sets the fall
@@ -126,9 +171,11 @@ class PolicyInputs(gym.vector.VectorWrapper):
 
     def __init__(
         self, env: gym.vector.VectorEnv, template: Policy, log: EpisodeLog, penalty: FallPenalty,
-        curriculum: Curriculum,
+        curriculum: Curriculum, exploration: ExplorationCap, holder: dict[str, Any],
     ) -> None:  # fmt: skip
         super().__init__(env)
+        self.exploration = exploration
+        self.holder = holder
         self.template = template
         self.log = log
         self.penalty = penalty
@@ -154,6 +201,8 @@ class PolicyInputs(gym.vector.VectorWrapper):
             env.fall_penalty = penalty
             env.ball_closer_m = closer  # read by the next reset
         self.log.fall_penalty = penalty
+        if "agent" in self.holder:
+            self.log.log_std = self.exploration.apply(self.holder["agent"], self.log.steps)
 
     def reset(self, **kwargs: Any) -> tuple[Any, dict[str, Any]]:
         self._schedule()
@@ -193,9 +242,10 @@ class EpisodeLog:
         self.csv = csv.writer(self.file)
         self.csv.writerow(["env_steps", "episode", "return", "kick_distance_m",
                            "max_ball_speed_m_s", "fallen", "touched", "fall_penalty",
-                           "ball_closer_m", "wall_s"])  # fmt: skip
+                           "ball_closer_m", "log_std", "wall_s"])  # fmt: skip
         self.steps = 0
         self.fall_penalty = 0.0
+        self.log_std = 0.0
         self.episodes = 0
         self.recent: deque[tuple[float, float, float, bool, bool]] = deque(maxlen=200)
         self.started = time.perf_counter()
@@ -210,7 +260,7 @@ class EpisodeLog:
         wall = time.perf_counter() - self.started
         self.csv.writerow([self.steps, self.episodes, round(ret, 4), round(kick, 4),
                            round(speed, 3), int(fallen), int(touched), round(self.fall_penalty, 3),
-                           round(closer, 4), round(wall, 1)])  # fmt: skip
+                           round(closer, 4), round(self.log_std, 3), round(wall, 1)])  # fmt: skip
         self.recent.append((ret, kick, speed, fallen, touched))
         if time.perf_counter() - self._last_print >= self.every_s:
             self.progress()
@@ -410,6 +460,9 @@ def plot(out: Path, random_return: float, learned_return: float) -> Path:
     bx.plot(x, mean(column["fallen"]), color="tab:red", label="share fallen")
     if "fall_penalty" in column:
         bx.plot(steps, column["fall_penalty"], color="gray", ls=":", label="fall penalty")
+    if "log_std" in column:
+        bx.plot(steps, np.exp(column["log_std"]), color="tab:purple", ls="--",
+                label="exploration (std of the actions, in [-1, 1])")  # fmt: skip
     bx.set_xlabel(f"environment steps ({8 * STEPS_PER_ACTION} ms each)")
     bx.set_ylabel(f"mean of {window} episodes")
     bx.legend(loc="upper left", fontsize=8)
@@ -423,13 +476,14 @@ def plot(out: Path, random_return: float, learned_return: float) -> Path:
 
 def plot_runs(runs: list[Path], path: Path, window: int = 200) -> Path:
     """The learning curves of several runs (seeds) in one figure: the ball's travel and the
-    share of episodes touching the ball, each a mean of ``window`` training episodes."""
+    shares of episodes touching the ball and falling, each a mean of ``window`` training
+    episodes."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, (ax, bx) = plt.subplots(2, 1, figsize=(7, 6), dpi=110, sharex=True)
+    fig, (ax, bx, cx) = plt.subplots(3, 1, figsize=(7, 8), dpi=110, sharex=True)
     for run in runs:
         with (run / "episodes.csv").open() as f:
             rows = list(csv.DictReader(f))
@@ -444,14 +498,17 @@ def plot_runs(runs: list[Path], path: Path, window: int = 200) -> Path:
         label = f"seed {summary['seed']}"
         ax.plot(steps[w - 1 :], mean("kick_distance_m"), label=label)
         bx.plot(steps[w - 1 :], mean("touched"), label=label)
+        cx.plot(steps[w - 1 :], mean("fallen"), label=label)
     ax.axhline(1.0, color="gray", ls=":", lw=1)
     ax.set_ylabel(f"ball travel (m), mean of {window} episodes")
     ax.set_title("hlvs/StandKick-v0, PPO (skrl, JAX CPU): training episodes")
     ax.legend(loc="upper left", fontsize=8)
     ax.grid(alpha=0.3)
     bx.set_ylabel(f"share touching the ball, of {window}")
-    bx.set_xlabel(f"environment steps ({8 * STEPS_PER_ACTION} ms each)")
     bx.grid(alpha=0.3)
+    cx.set_ylabel(f"share fallen, of {window}")
+    cx.set_xlabel(f"environment steps ({8 * STEPS_PER_ACTION} ms each)")
+    cx.grid(alpha=0.3)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path)
@@ -480,10 +537,18 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--learning-rate", type=float, default=1e-3)
     parser.add_argument("--epochs", type=int, default=8, help="PPO epochs per update")
     parser.add_argument("--init-log-std", type=float, default=-1.2, help="initial exploration")
+    parser.add_argument("--final-log-std", type=float, default=-2.0,
+                        help="the exploration's cap falls to this from --refine-from to "
+                        "--refine-until (not below --init-log-std: no cap)")  # fmt: skip
     parser.add_argument("--fall-penalty", type=float, default=1.0,
-                        help="reward lost by a fall, until 40 %% of the steps")  # fmt: skip
+                        help="reward lost by a fall, until --refine-from")  # fmt: skip
     parser.add_argument("--fall-penalty-end", type=float, default=3.0,
-                        help="... rising to this at 80 %% (default 3)")  # fmt: skip
+                        help="... rising to this at --refine-until (default 3)")  # fmt: skip
+    parser.add_argument("--refine-from", type=float, default=0.4,
+                        help="share of the steps where the fall penalty starts rising and the "
+                        "exploration's cap falling ...")  # fmt: skip
+    parser.add_argument("--refine-until", type=float, default=0.8,
+                        help="... and where they reach their ends")  # fmt: skip
     parser.add_argument("--ball-noise", type=float, default=0.01, help="ball placement noise (m)")
     parser.add_argument(
         "--curriculum-m",
@@ -537,9 +602,14 @@ def main(argv: list[str]) -> int:
         export=lambda: export_policy(holder["agent"], template, out / "policy.npz"),
     )
     end = args.fall_penalty_end
-    penalty = FallPenalty(args.fall_penalty, end, args.timesteps * num_envs)
+    span = (args.refine_from, args.refine_until)
+    penalty = FallPenalty(args.fall_penalty, end, args.timesteps * num_envs, span)
     curriculum = Curriculum(args.curriculum_m, args.curriculum_until, args.timesteps * num_envs)
-    env = wrap_env(PolicyInputs(vec, template, log, penalty, curriculum), wrapper="gymnasium")
+    exploration = ExplorationCap(
+        args.init_log_std, args.final_log_std, args.timesteps * num_envs, span
+    )
+    inputs = PolicyInputs(vec, template, log, penalty, curriculum, exploration, holder)
+    env = wrap_env(inputs, wrapper="gymnasium")
     agent = build_agent(env, args, out)
     holder["agent"] = agent
     print(f"training {ENV_ID}: {args.timesteps * num_envs} environment steps over {num_envs} "
@@ -566,6 +636,8 @@ def main(argv: list[str]) -> int:
         "example": "learn_stand_kick", "env": ENV_ID, "seed": args.seed,
         "env_steps": log.steps, "episodes": log.episodes, "fall_penalty": [args.fall_penalty, end],
         "curriculum_m": [args.curriculum_m, args.curriculum_until],
+        "log_std": [args.init_log_std, args.final_log_std],
+        "refine": [args.refine_from, args.refine_until],
         "train_wall_s": round(train_s, 1), "training": training_figures(out / "episodes.csv"),
         "steps_per_s": round(log.steps / train_s, 1), "learned": learned, "random": baseline,
         "policy": str(out / "policy.npz"), "plot": str(png),
