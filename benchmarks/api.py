@@ -565,6 +565,7 @@ def _api_run(
             proc.kill()
             proc.join(timeout=5)
     rtts = [s["round_trip_ms"]["p50"] for s in stats.values() if s["round_trip_ms"]["p50"]]
+    replies = sorted(s["reply_ms"]["p50"] for s in stats.values() if s["reply_ms"]["p50"])
     last_key = robots[-1].key
     honest = [s["round_trip_ms"]["p50"] for key, s in stats.items()
               if s["round_trip_ms"]["p50"] and not (last and key == last_key)]  # fmt: skip
@@ -586,7 +587,15 @@ def _api_run(
             "client_answer_p50_ms": median_ms(1),
             # the client's own wait: answer written to next measurement arrived (the step)
             "client_round_trip_p50_ms": median_ms(2),
+            # the same wait seen by the server: the answer's first byte received to the next
+            # measurement's last byte written (robots' median)
+            "server_reply_p50_ms": replies[len(replies) // 2] if replies else None,
         }
+        client_wait, server_wait = (league_client["client_round_trip_p50_ms"],
+                                    league_client["server_reply_p50_ms"])
+        # the server's figure over the client's: 1 when the server sees the wait the client has
+        league_client["server_over_client"] = (
+            round(server_wait / client_wait, 3) if client_wait and server_wait else None)
     return {
         "honest_round_trip_p50_ms": round(sorted(honest)[len(honest) // 2], 3) if honest else None,
         "last_robot": stats.get(last_key),

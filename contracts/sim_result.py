@@ -37,6 +37,10 @@ class RobotApiStats(TypedDict):
     warnings_sent: int
     round_trip_ms: dict[str, float | None]  # p50, p90, p99, max (None without replies)
     round_trip_samples: int
+    # the client's round trip seen from the server: its request's first byte received to the
+    # next measurement's last byte written; p50, p90, p99, max (None without replies)
+    reply_ms: dict[str, float | None]
+    reply_samples: int
 
 
 # the simulator's camera render processes at most (one per CPU it may use, on the CPU renderer);

@@ -133,6 +133,11 @@ class Connection:
         self.answered = False
         self.answered_at = 0.0
         self.last_sent_at: float | None = None
+        # the client's round trip seen from here (``stats.reply_s``): when the first byte of
+        # the oldest request not yet followed by a measurement arrived, and when the first
+        # byte of the frame still being received arrived
+        self._request_began: float | None = None
+        self._frame_began: float | None = None
         self.enqueued_at = 0.0  # monotonic time the latest measurement was queued
         self.slow = False
         # lockstep's book of who owes an answer (None without lockstep); set by the server
@@ -162,6 +167,7 @@ class Connection:
         budget = self.budget
         level = budget.refill(now, self.measurements)
         decoder = self.decoder
+        began = self._frame_began if decoder.buffered and self._frame_began else now
         try:
             while True:
                 if level < FRAME_COST:
@@ -197,8 +203,13 @@ class Connection:
             budget.level = level
         if decoder.buffered:
             self._quick_ack()
+            self._frame_began = now if count else began
+        else:
+            self._frame_began = None
         if count:
             self.stats.messages_in += count
+            if self._request_began is None:
+                self._request_began = began
         if count or self._told:
             self._told = False
             self.answered = True
@@ -391,7 +402,7 @@ class Connection:
             self._partial = memoryview(frame)[sent:]
             self.want_write = True
         else:
-            self.last_sent_at = monotonic()  # written: the client's part starts now
+            self._written(monotonic())
 
     def send_threaded(self, frame: bytes, now: float) -> None:
         """:meth:`send` of a threaded connection: queue the frame for the I/O thread (never
@@ -440,9 +451,20 @@ class Connection:
             self.stats.bytes_out += sent
             if sent == len(self._partial):
                 self._partial = None
-                self.last_sent_at = monotonic()  # written: the client's part starts now
+                self._written(monotonic())
             else:
                 self._partial = self._partial[sent:]
+
+    def _written(self, at: float) -> None:
+        """A measurement's last byte is written at ``at``: the client's part of the round trip
+        starts, and the client's round trip as seen here (``reply_s``: from its request's
+        first byte to this measurement written, what a client that waits for each
+        measurement measures less the two transits) ends."""
+        self.last_sent_at = at
+        began = self._request_began
+        if began is not None:
+            self.stats.reply_s.append(at - began)
+            self._request_began = None
 
     @property
     def idle(self) -> bool:

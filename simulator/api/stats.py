@@ -36,6 +36,9 @@ class RobotStats:
     slow_periods: int = 0
     warnings_sent: int = 0
     round_trip_s: array[float] = field(default_factory=lambda: array("d"))
+    # the client's round trip seen from the server: a request's first byte received to the
+    # next measurement's last byte written (simulator.api.connection.Connection._written)
+    reply_s: array[float] = field(default_factory=lambda: array("d"))
     # requests dropped undecoded, by reason ("size": over the request limit; see
     # simulator.api.bounds: requests beyond the client's budget are not dropped but left unread)
     dropped_in: dict[str, int] = field(default_factory=dict)
@@ -47,11 +50,8 @@ class RobotStats:
 
     def to_dict(self) -> RobotApiStats:
         latencies = sorted(self.round_trip_s)
-        ms = {
-            f"p{q}": round(percentile(latencies, q) * 1000.0, 3) if latencies else None
-            for q in (50, 90, 99)
-        }
-        ms["max"] = round(latencies[-1] * 1000.0, 3) if latencies else None
+        ms = _quantiles_ms(latencies)
+        replies = sorted(self.reply_s)
         return {
             "connects": [round(t, 3) for t in self.connects],
             "disconnects": [round(t, 3) for t in self.disconnects],
@@ -72,4 +72,16 @@ class RobotStats:
             "warnings_sent": self.warnings_sent,
             "round_trip_ms": ms,
             "round_trip_samples": len(latencies),
+            "reply_ms": _quantiles_ms(replies),
+            "reply_samples": len(replies),
         }
+
+
+def _quantiles_ms(ordered: list[float]) -> dict[str, float | None]:
+    """p50, p90, p99 and max of sorted seconds, in milliseconds (None without samples)."""
+    ms: dict[str, float | None] = {
+        f"p{q}": round(percentile(ordered, q) * 1000.0, 3) if ordered else None
+        for q in (50, 90, 99)
+    }
+    ms["max"] = round(ordered[-1] * 1000.0, 3) if ordered else None
+    return ms

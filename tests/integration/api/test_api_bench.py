@@ -60,8 +60,12 @@ def test_bench_api_league_clients_report_their_rate_and_both_round_trips() -> No
     # one request per robot and step: requests per second of the API run are its steps'
     steps_per_s = float(result["real_time_factor"]) * 1000.0 / 8
     assert league["requests_per_s"] == pytest.approx(2 * steps_per_s, rel=0.1)
-    for key in ("round_trip_p50_ms", "client_answer_p50_ms", "client_round_trip_p50_ms"):
+    for key in ("round_trip_p50_ms", "client_answer_p50_ms", "client_round_trip_p50_ms",
+                "server_reply_p50_ms"):
         assert isinstance(league[key], float) and league[key] > 0, key
+    # the server's view of the client's wait against the client's own (the transits apart)
+    assert league["server_over_client"] == round(
+        league["server_reply_p50_ms"] / league["client_round_trip_p50_ms"], 3)
     assert result["slow_periods"] == 0
     # judged as the report judges lockstep: the run's ratio to the world alone
     assert league["ratio_interleaved"] == result["ratio_interleaved"]

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import statistics
 import time
+from typing import Any
 
 import pytest
 
@@ -58,4 +59,42 @@ def test_server_round_trip_is_the_wait_the_client_causes(
     client_ms = statistics.median(client.answer_s) * 1000.0
     server_ms = stats["round_trip_ms"]["p50"]
     assert client_ms >= think_s * 1000.0
+    assert server_ms == pytest.approx(client_ms, rel=0.2), (server_ms, client_ms)
+
+
+class _SlowStep:
+    """A world whose step takes ``step_s`` of wall time (the server's part of the cycle)."""
+
+    def __init__(self, world: Any, step_s: float) -> None:
+        self._world, self._step_s = world, step_s
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._world, name)
+
+    def step(self) -> None:
+        time.sleep(self._step_s)
+        self._world.step()
+
+
+@pytest.mark.parametrize("split_writes", [True, False], ids=["two-writes", "one-write"])
+@pytest.mark.parametrize("send_thread", [False, True], ids=["step-thread-io", "io-thread"])
+def test_server_reply_is_the_wait_the_client_has(send_thread: bool, split_writes: bool) -> None:
+    """The server's step takes 10 ms: the client's own wait (answer written to the next
+    measurement, what the league's client waits for in ``receive``) is those 10 ms and the
+    transits, and the server's ``reply_ms`` (the answer's first byte received to the next
+    measurement written) says the same within 20 %."""
+    step_s = 0.010
+    world = _SlowStep(FakeDeviceWorld((RED1,)), step_s)
+    with running_server(robots=(RED1,), lockstep=LOCKSTEP, world=world, pause_s=0.0,
+                        send_thread=send_thread) as (driver, ports):
+        with LeagueStyleClient("127.0.0.1", ports[RED1], split_writes=split_writes) as client:
+            client.send(neck_request(0.0, enable=True))
+            wait_until(lambda: driver.server.connected())
+            for k in range(60):
+                client.exchange(neck_request(0.001 * k))
+        stats = driver.server.statistics()["red-1"]
+    client_ms = statistics.median(client.round_trip_s) * 1000.0
+    server_ms = stats["reply_ms"]["p50"]
+    assert client_ms >= step_s * 1000.0
+    assert stats["reply_samples"] >= 50
     assert server_ms == pytest.approx(client_ms, rel=0.2), (server_ms, client_ms)
