@@ -182,7 +182,7 @@ class SendThread:
                 elif self._polling:  # just after the step thread queues the next frames
                     timeout = max(POLL_MIN_S, queued[-1] + period + POLL_LATE_S - now)
                 elif look != NO_LOOK:  # slower steps: the planned look (``now`` is set)
-                    timeout = look - now
+                    timeout = max(POLL_MIN_S, look - now)  # (now + x) - now may be under x
                 else:
                     timeout = IDLE_WAIT_S
                 if paused and timeout > PAUSED_WAIT_S:
