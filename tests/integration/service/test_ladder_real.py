@@ -10,6 +10,7 @@ from typing import Any
 
 import pytest
 
+from contracts import MIN_PLAYING_S, MIN_READY_S
 from service import Settings
 from tests.integration.service.conftest import TokenMaker
 from tests.integration.service.harness import serve
@@ -23,7 +24,12 @@ pytestmark = [pytest.mark.docker, pytest.mark.slow,
 @pytest.mark.parametrize("db_url", ["sqlite"], indirect=True)
 def test_ladder_plays_a_real_friendly_and_rates_it(
         real_settings: Settings, make_token: TokenMaker) -> None:  # noqa: F811
-    settings = real_settings.with_(ladder_every_s=3600.0, preflight="images", video=False)
+    # What is checked is that a friendly the ladder scheduled is played and rated, not how long
+    # it plays: halves of the documented minimum of play and the shortest READY (the service's
+    # own test matches keep 40 s halves, as test_real_matches.py plays them).
+    settings = real_settings.with_(ladder_every_s=3600.0, preflight="images", video=False,
+                                   test_half_duration_s=MIN_PLAYING_S,
+                                   test_ready_duration_s=MIN_READY_S)
     served = serve(settings, start_worker=True)
     clients: dict[str, Any] = {}
     try:
