@@ -10,7 +10,9 @@ from typing import Any
 import pytest
 
 from hlvs.cli import main as hlvs
+from orchestrator.engine.gpu import device_files
 from orchestrator.errors import OrchestratorError
+from orchestrator.match import gpu
 
 pytestmark = [pytest.mark.docker, pytest.mark.root]
 
@@ -19,7 +21,9 @@ def test_short_scrimmage_plays_to_finished(tmp_path: Path, runtime: Any,
                                            capsys: pytest.CaptureFixture[str],
                                            monkeypatch: pytest.MonkeyPatch) -> None:
     """From a working directory with a relative ``--out``, as ``make scrimmage`` runs it: the
-    folders reach Docker as absolute bind-mount sources."""
+    folders reach Docker as absolute bind-mount sources. On a host without an NVIDIA GPU the
+    default ``gpu`` setting (``auto``) plays it with the cameras on the CPU and says so once (the
+    other ``gpu`` cases are in test_match_gpu.py)."""
     try:
         from orchestrator.project_images import project_image
 
@@ -29,6 +33,8 @@ def test_short_scrimmage_plays_to_finished(tmp_path: Path, runtime: Any,
         pytest.skip(f"project images unavailable: {exc}")
     out = tmp_path / "matches" / "scrim"
     match_id = "scrim-test"
+    without_gpu = not device_files()
+    monkeypatch.setattr(gpu, "_said", set())  # said once per process: this test's process
     monkeypatch.chdir(tmp_path)
     try:
         code = hlvs(["scrimmage", "--out", "matches/scrim", "--half-duration", "4",
@@ -55,6 +61,17 @@ def test_short_scrimmage_plays_to_finished(tmp_path: Path, runtime: Any,
         assert (out / "teams" / color / "1" / "robocup-logs").is_dir()
     assert (out / "config" / "game.json").is_file()
     assert runtime.list_project(match_id=match_id) == []
+    if without_gpu:
+        said = [line for line in printed.err.splitlines() if "gpu auto" in line]
+        assert len(said) == 1, printed.err[-3000:]
+        assert said[0].endswith("gpu auto: no NVIDIA device file (/dev/nvidia0, ...) on this "
+                                "host; the simulator renders cameras on the CPU (OSMesa)")
+        cameras = json.loads((out / "public" / "sim_result.json").read_text())["cameras"]
+        assert cameras["frames"] > 0  # the stubs asked for images and got them
+        assert cameras["gl_backend"] == "osmesa"
+        assert "llvmpipe" in cameras["gl_renderer"] and cameras["gl_vendor"]
+        simulator_log = (out / "simulator" / "stderr.log").read_text()
+        assert "robot cameras render with osmesa: llvmpipe" in simulator_log
 
 
 def test_scrimmage_with_a_team_of_wolfgang_models_plays_to_the_end(
