@@ -176,7 +176,7 @@ def _game_copy(tmp_path: Path, *, robot_image: str, robot_cmd: str | None) -> Pa
     source = EXAMPLE.parent
     game = json.loads((source / "game.json").read_text())
     game["match_id"] = f"compose-{uuid.uuid4().hex[:6]}"
-    game["timing"].update({"half_duration_s": 10, "ready_duration_s": 1, "grace_period_s": 1,
+    game["timing"].update({"half_duration_s": 4, "ready_duration_s": 1, "grace_period_s": 1,
                            "minimum_play_s": 0})
     (tmp_path / "game.json").write_text(json.dumps(game))
     for name in ("team_red.json", "team_blue.json"):
