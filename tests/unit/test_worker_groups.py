@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tests.conftest import ONE_OF_A_KIND, worker_group
+from tests.conftest import LONG_GROUPS_FIRST, ONE_OF_A_KIND, worker_group
 
 TESTS = Path(__file__).resolve().parents[1]
 
@@ -39,3 +39,11 @@ def test_every_test_file_on_the_slurm_cluster_outside_its_folder_is_in_its_group
     assert users, "no test outside tests/integration/pool uses the cluster: is the import gone?"
     assert {path: ONE_OF_A_KIND.get(path) for path in users} == dict.fromkeys(
         users, "integration/pool")
+
+
+def test_the_groups_handed_out_first_are_groups_that_exist() -> None:
+    """A renamed folder would silently fall back to collection order."""
+    for group in LONG_GROUPS_FIRST:
+        assert (TESTS / group).exists(), group
+        assert worker_group(f"tests/{group}" + ("" if group.endswith(".py") else "/test_x.py")
+                            + "::test") == group
