@@ -103,10 +103,9 @@ def _ramp(share: float, span: tuple[float, float]) -> float:
     return min(max((share - span[0]) / max(span[1] - span[0], 1e-9), 0.0), 1.0)
 
 
-class FallPenalty:
-    """The fall penalty over training: ``start`` until ``span[0]`` of the steps, then rising
-    linearly to ``end`` at ``span[1]`` (first learn to touch the ball at all, then to stay up
-    while kicking)."""
+class _Schedule:
+    """A value over training: ``start`` until ``span[0]`` of the steps, then linearly to ``end``
+    at ``span[1]``, and ``end`` after."""
 
     def __init__(
         self, start: float, end: float, total_steps: int, span: tuple[float, float] = (0.4, 0.8)
@@ -116,6 +115,12 @@ class FallPenalty:
 
     def at(self, steps: int) -> float:
         return self.start + (self.end - self.start) * _ramp(steps / self.total, self.span)
+
+
+class FallPenalty(_Schedule):
+    """The fall penalty over training: ``start`` until ``span[0]`` of the steps, then rising
+    linearly to ``end`` at ``span[1]`` (first learn to touch the ball at all, then to stay up
+    while kicking)."""
 
 
 class Curriculum:
@@ -131,22 +136,16 @@ class Curriculum:
         return self.start * max(0.0, 1.0 - steps / (self.until * self.total))
 
 
-class ExplorationCap:
+class ExplorationCap(_Schedule):
     """The most the policy's exploration (the log of its actions' standard deviation) may be
     over training: ``start`` until ``span[0]`` of the steps, then falling linearly to ``end`` at
     ``span[1]`` (explore widely while learning to touch and kick, then refine the kick with less
     noise, so that the episodes it learns from are nearly those it will play)."""
 
-    def __init__(
-        self, start: float, end: float, total_steps: int, span: tuple[float, float] = (0.4, 0.8)
-    ) -> None:
-        self.start, self.end, self.total = start, end, max(1, total_steps)
-        self.span = span
-
     def at(self, steps: int) -> float:
         if self.end >= self.start:  # no cap
             return math.inf
-        return self.start + (self.end - self.start) * _ramp(steps / self.total, self.span)
+        return super().at(steps)
 
     def apply(self, agent: Any, steps: int) -> float:
         """Lower the policy's learnt log standard deviations to the cap of the moment; their

@@ -167,7 +167,8 @@ class Connection:
         budget = self.budget
         level = budget.refill(now, self.measurements)
         decoder = self.decoder
-        began = self._frame_began if decoder.buffered and self._frame_began else now
+        began = (self._frame_began if decoder.buffered and self._frame_began is not None
+                 else now)
         try:
             while True:
                 if level < FRAME_COST:
