@@ -36,7 +36,8 @@ Here the same elements, in MuJoCo:
   and ``:90-98``, net colour 0.3 on a net texture with holes): here cords of 1 cm every 10 cm,
   :mod:`simulator.world.goal`).
 
-Each texture depends on its variant alone, so it is generated once per process. The textures
+Each texture depends on its variant alone, so it is generated once per process (and once per
+simulator image: :mod:`simulator.world.texture_cache`). The textures
 are procedural (:mod:`simulator.world.textures`, numpy only, nothing downloaded or shipped):
 the model declares them as placeholders of the right size (:func:`look_assets`) and
 :func:`apply_look` writes the generated texels and the lights into the compiled model, before
@@ -49,12 +50,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import lru_cache
+from pathlib import Path
 from typing import Any, TypedDict
 
 import mujoco
 import numpy as np
 
-from simulator.world import textures
+from simulator.world import texture_cache, textures
 from simulator.world.textures import Surroundings
 
 
@@ -337,10 +339,10 @@ def look_for(texture_seed: int) -> Look:
 @lru_cache(maxsize=len(TURFS))
 def turf_image(variant: int) -> textures.Image:
     v = TURFS[variant]
-    return textures.turf_tile(
+    return texture_cache.cached("turf", variant, lambda: textures.turf_tile(
         seed=0x7F4F + variant, size_px=TURF_PX, base_rgb=v.base_rgb,
         stripe_contrast=v.stripe_contrast, wear=v.wear, hue_spread=v.hue_spread,
-    )  # fmt: skip
+    ))  # fmt: skip
 
 
 @lru_cache(maxsize=1)
@@ -351,17 +353,41 @@ def line_image() -> textures.Image:
 @lru_cache(maxsize=len(BALLS))
 def ball_image(variant: int) -> textures.Image:
     v = BALLS[variant]
-    return textures.ball_cube(
+    return texture_cache.cached("ball", variant, lambda: textures.ball_cube(
         face_px=BALL_FACE_PX, family=v.family, panel_rgb=v.panel_rgb, mark_rgb=v.mark_rgb,
         accent_rgb=v.accent_rgb, turn_rad=0.3 * variant,
-    )  # fmt: skip
+    ))  # fmt: skip
 
 
 @lru_cache(maxsize=len(BACKGROUNDS))
 def sky_image(variant: int) -> textures.Image:
-    return textures.background_cube(
+    return texture_cache.cached("sky", variant, lambda: textures.background_cube(
         seed=0x5747 + variant, face_px=SKY_FACE_PX, look=BACKGROUNDS[variant].surroundings
-    )
+    ))  # fmt: skip
+
+
+def fill_texture_cache() -> list[Path]:
+    """Make every variant's textures into the texture cache's folder (the simulator image's
+    build, :mod:`simulator.world.texture_cache`); returns the files, which exist afterwards.
+
+    Raises:
+        RuntimeError: the folder is not set, or did not take every file.
+    """
+    where = texture_cache.folder()
+    if where is None:
+        raise RuntimeError(f"{texture_cache.CACHE_ENV} is not set: no folder to fill")
+    for variant in range(len(TURFS)):
+        turf_image(variant)
+    for variant in range(len(BALLS)):
+        ball_image(variant)
+    for variant in range(len(BACKGROUNDS)):
+        sky_image(variant)
+        environment_rgb(variant)
+    files = sorted(where.glob(f"*-{texture_cache.code_key()}.npy"))
+    expected = len(TURFS) + len(BALLS) + 2 * len(BACKGROUNDS)
+    if len(files) != expected:
+        raise RuntimeError(f"{where}: {len(files)} texture files written, expected {expected}")
+    return files
 
 
 def look_assets(look: Look) -> str:
@@ -430,13 +456,17 @@ class Lighting:
 
 
 @lru_cache(maxsize=len(BACKGROUNDS))
-def _environment_rgb(variant: int) -> RGB:
+def environment_rgb(variant: int) -> RGB:
     """The background's mean colour above 5 degrees below the horizon (what lights the
     pitch; the ground under the pitch is hidden by it)."""
-    texels = sky_image(variant).reshape(-1, 3)
-    around = textures.cube_elevations(SKY_FACE_PX).reshape(-1) > -5.0
-    mean = texels[around].mean(axis=0) / 255.0
-    return (float(mean[0]), float(mean[1]), float(mean[2]))
+
+    def mean() -> np.ndarray:
+        texels = sky_image(variant).reshape(-1, 3)
+        around = textures.cube_elevations(SKY_FACE_PX).reshape(-1) > -5.0
+        return np.asarray(texels[around].mean(axis=0) / 255.0, dtype=np.float64)
+
+    rgb = texture_cache.cached("environment", variant, mean)
+    return (float(rgb[0]), float(rgb[1]), float(rgb[2]))
 
 
 def _merged(first: Light, second: Light) -> Light:
@@ -470,7 +500,7 @@ def lighting(look: Look) -> Lighting:
     )  # fmt: skip
     key = diffuse[0]
     specular = ((0.3 * key[0], 0.3 * key[1], 0.3 * key[2]), (0.0, 0.0, 0.0))  # a glint of the sun
-    env = [lum * ENVIRONMENT_GAIN * c for c in _environment_rgb(look.background)]
+    env = [lum * ENVIRONMENT_GAIN * c for c in environment_rgb(look.background)]
     ambient = (
         (1 - SKY_SHARE) * env[0], (1 - SKY_SHARE) * env[1], (1 - SKY_SHARE) * env[2]
     )  # fmt: skip
