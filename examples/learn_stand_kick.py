@@ -5,7 +5,9 @@ environment (``envs.vector.make_vector``: in this process, or ``--remotes N`` si
 containers). The policy moves the robot's 12 leg motors around the walking stance (the
 kicking leg's hip and knee pitch by up to 1 rad, the other joints less; arms and head stay), one
 decision per 32 ms, from what the robot API reports: joint angles, accelerometer, gyro and the
-time since the skill started (no ball or robot position). It writes to ``--out``:
+time since the skill started (no ball or robot position), each input standardised by its
+running mean and standard deviation (``--obs-norm``, folded into the first layer of the policy
+file). It writes to ``--out``:
 
 - ``episodes.csv``: one row per finished episode (environment steps so far, return, kick
   distance, fastest ball speed, fallen, touched the ball, the fall penalty, the curriculum's
@@ -63,6 +65,7 @@ ENV_ID = "hlvs/StandKick-v0"
 STEPS_PER_ACTION = 4  # 32 ms per decision
 EPISODE_S = 1.5
 HIDDEN = (64, 64)
+OBS_NORM_EPSILON = 0.01  # inputs that hardly vary (the arms' joints) are not blown up to noise
 # network input scale: joints (rad) as they are, accelerometer / 10, gyro / 4, time / episode
 OBS_SCALE = np.array([1.0] * 20 + [0.1] * 3 + [0.25] * 3 + [1.0 / EPISODE_S])
 # how far (rad) the policy may move each motor from the stance: the kicking (right) leg's hip
@@ -189,7 +192,8 @@ class PolicyInputs(gym.vector.VectorWrapper):
         self._returns = np.zeros(self.num_envs)
 
     def _scaled(self, obs: dict[str, Any]) -> np.ndarray:
-        scaled: np.ndarray = (flat_observation(obs) * OBS_SCALE).astype(np.float32)
+        self.last_raw = flat_observation(obs)
+        scaled: np.ndarray = (self.last_raw * OBS_SCALE).astype(np.float32)
         return scaled
 
     def _schedule(self) -> None:
@@ -337,6 +341,12 @@ def build_agent(env: Any, args: argparse.Namespace, out: Path) -> Any:
     cfg.gae_lambda = 0.95
     cfg.learning_rate = args.learning_rate
     cfg.value_preprocessor = RunningStandardScaler
+    if args.obs_norm:
+        # no clipping, so that export_policy folds the standardisation into the first layer
+        cfg.observation_preprocessor = RunningStandardScaler
+        cfg.observation_preprocessor_kwargs = {"size": env.observation_space, "device": device,
+                                               "epsilon": OBS_NORM_EPSILON,
+                                               "clip_threshold": 1e9}  # fmt: skip
     cfg.value_preprocessor_kwargs = {"size": 1, "device": device}
     cfg.grad_norm_clip = 1.0
     cfg.entropy_loss_scale = 0.0
@@ -360,9 +370,24 @@ def export_policy(agent: Any, template: Policy, path: Path) -> Policy:
         layers.append(
             (np.asarray(dense["kernel"], np.float64), np.asarray(dense["bias"], np.float64))
         )
+    scaler = getattr(agent, "_observation_preprocessor", None)
+    if hasattr(scaler, "running_mean"):  # (x - mean) / (std + eps), folded into the first layer
+        mean = np.asarray(scaler.running_mean, np.float64)
+        std = np.sqrt(np.asarray(scaler.running_variance, np.float64)) + scaler.epsilon
+        kernel, bias = layers[0]
+        layers[0] = (kernel / std[:, None], bias - (mean / std) @ kernel)
     policy = Policy(**{**_fields(template), "layers": tuple(layers)})
     save_policy(policy, path)
     return policy
+
+
+def export_error(agent: Any, policy: Policy, raw: np.ndarray) -> float:
+    """The largest difference between the agent's mean actions and the exported policy's on
+    raw observations (the policy file holds the inputs' standardisation in its first layer)."""
+    model = agent.models["policy"]
+    scaled = agent._observation_preprocessor((raw * OBS_SCALE).astype(np.float32))
+    mean, _ = model.apply(model.state_dict.params, {"observations": scaled}, "policy")
+    return float(np.max(np.abs(np.asarray(mean, np.float64) - policy.mean_action(raw))))
 
 
 def _fields(policy: Policy) -> dict[str, Any]:
@@ -535,6 +560,9 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--rollouts", type=int, default=16, help="steps per environment per update")
     parser.add_argument("--learning-rate", type=float, default=1e-3)
     parser.add_argument("--epochs", type=int, default=8, help="PPO epochs per update")
+    parser.add_argument("--obs-norm", action=argparse.BooleanOptionalAction, default=True,
+                        help="standardise the policy's inputs by their running mean and std "
+                        "(--no-obs-norm: the fixed scales alone)")  # fmt: skip
     parser.add_argument("--init-log-std", type=float, default=-1.2, help="initial exploration")
     parser.add_argument("--final-log-std", type=float, default=-2.0,
                         help="the exploration's cap falls to this from --refine-from to "
@@ -625,6 +653,7 @@ def main(argv: list[str]) -> int:
     env.close()
     train_s = time.perf_counter() - started
     policy = load_policy(out / "policy.npz")  # what the robot would load
+    exported = export_error(agent, policy, inputs.last_raw.astype(np.float64))
     eval_seed = 10_000 + args.seed
     same: dict[str, Any] = {"episodes": args.eval_episodes, "seed": eval_seed,
                             "fall_penalty": end, "ball_noise": args.ball_noise}  # fmt: skip
@@ -636,10 +665,10 @@ def main(argv: list[str]) -> int:
         "env_steps": log.steps, "episodes": log.episodes, "fall_penalty": [args.fall_penalty, end],
         "curriculum_m": [args.curriculum_m, args.curriculum_until],
         "log_std": [args.init_log_std, args.final_log_std],
-        "refine": [args.refine_from, args.refine_until],
+        "refine": [args.refine_from, args.refine_until], "obs_norm": args.obs_norm,
         "train_wall_s": round(train_s, 1), "training": training_figures(out / "episodes.csv"),
         "steps_per_s": round(log.steps / train_s, 1), "learned": learned, "random": baseline,
-        "policy": str(out / "policy.npz"), "plot": str(png),
+        "policy": str(out / "policy.npz"), "export_max_error": exported, "plot": str(png),
         "wall_s": round(time.perf_counter() - started, 1),
     }  # fmt: skip
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")

@@ -52,8 +52,11 @@ def test_a_short_run_touches_and_moves_the_ball(
     assert float(rows[-1]["ball_closer_m"]) == 0.0  # the ball where the skill finds it
     moved = [float(r["kick_distance_m"]) for r in touched]
     assert max(moved) > 0.1 and float(np.mean(moved)) > 0.02
-    untouched = [float(r["kick_distance_m"]) for r in rows if r["touched"] == "0"]
-    assert all(d < 0.05 for d in untouched)  # the ball lies still until the robot touches it
+    # the ball lies still until the robot touches it; a robot falling onto it may push it a
+    # little more slowly than a touch (0.1 m/s)
+    untouched = [(float(r["kick_distance_m"]), r["fallen"] == "1") for r in rows
+                 if r["touched"] == "0"]  # fmt: skip
+    assert all(d < (0.1 if fell else 0.05) for d, fell in untouched), untouched
     first = summary["training"]["first"]  # type: ignore[index]
     share = sum(r["touched"] == "1" for r in rows[:200]) / len(rows[:200])
     assert first["touched_share"] == pytest.approx(share, abs=0.001)
@@ -87,6 +90,10 @@ def test_training_writes_logs_checkpoints_policy_and_plot(
     assert list((runs / "checkpoints").glob("*.pickle")), "no skrl checkpoints"
     policy = load_policy(out / "policy.npz")
     assert policy.motors == MOTOR_NAMES and len(policy.layers) == 3
+    # the inputs' running standardisation is folded into the file's first layer: the robot's
+    # numpy runner gives the trained network's mean actions
+    assert summary["obs_norm"] is True
+    assert summary["export_max_error"] < 1e-4, summary["export_max_error"]
     assert (out / "learning_curve.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     learned, random = summary["learned"], summary["random"]
     assert isinstance(learned, dict) and isinstance(random, dict)
