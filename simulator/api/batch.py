@@ -50,7 +50,7 @@ class Encoding:
     cut out whole; the others take their sensors only."""
 
     __slots__ = ("gather", "template", "byte_index", "rows", "head_index", "head_size",
-                 "frames_at", "sensors")  # fmt: skip
+                 "frames_at", "sensors", "_reused")  # fmt: skip
 
     def __init__(
         self,
@@ -104,6 +104,7 @@ class Encoding:
         self.head_index = joined(head_index).reshape(len(plans), head_size)
         self.frames_at = tuple(frames)
         self.sensors = tuple(sensors)
+        self._reused: npt.NDArray[np.uint8] | None = None  # :meth:`frames_in_place`'s buffer
 
     def write(
         self, values: npt.NDArray[np.float64], head: bytes, measurements: Sequence[Measurement]
@@ -124,10 +125,28 @@ class Encoding:
         raw = self._raw(values, head)
         return [raw[start:end] for start, end in self.frames_at]
 
+    def frames_in_place(self, values: npt.NDArray[np.float64], head: bytes) -> memoryview:
+        """:meth:`frames` written into one buffer kept from step to step (no copy of the
+        template, no bytes made): the concatenated frames, cut at :attr:`frames_at`. The
+        caller is done with it before the next call (plain lockstep sends it at once; what a
+        socket does not take is copied)."""
+        array = self._reused
+        if array is None:
+            array = self._reused = self.template.copy()
+        self._fill(array, values, head)
+        return array.data
+
     def _raw(self, values: npt.NDArray[np.float64], head: bytes) -> bytes:
         """The concatenated frames of one step: ``values`` and ``head`` written into a copy
         of the template."""
         array = self.template.copy()
+        self._fill(array, values, head)
+        return array.tobytes()
+
+    def _fill(
+        self, array: npt.NDArray[np.uint8], values: npt.NDArray[np.float64], head: bytes
+    ) -> None:
+        """Write one step's ``values`` and ``head`` into ``array`` (the template's bytes)."""
         array[self.byte_index] = values.astype("<f8", copy=False).view(np.uint8)
         if head:
             head_bytes = np.frombuffer(head, dtype=np.uint8)
@@ -136,7 +155,6 @@ class Encoding:
                 array.reshape(self.rows, -1)[:, HEADER.size : HEADER.size + size] = head_bytes
             else:
                 array[self.head_index] = head_bytes
-        return array.tobytes()
 
 
 class Gathered:

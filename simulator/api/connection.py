@@ -405,6 +405,36 @@ class Connection:
         else:
             self._written(monotonic())
 
+    def send_view(self, frame: memoryview, now: float) -> None:
+        """:meth:`send` of a frame that is a view of a buffer the caller reuses (plain
+        lockstep's steady step): what the socket does not take now (a queue before it, or the
+        rest of a partial write) is copied first.
+
+        Raises:
+            ClientClosed: on a fatal send error.
+        """
+        if self.threaded or self._partial is not None or self.outbox:
+            self.send(frame.tobytes(), now)  # kept: a copy of its own
+            return
+        self.measurements += 1
+        self.owe()
+        self.last_sent_at = now
+        self.enqueued_at = now
+        stats = self.stats
+        stats.messages_out += 1
+        try:
+            sent = self.sock.send(frame)
+        except (BlockingIOError, InterruptedError):
+            sent = 0
+        except OSError as exc:
+            raise ClientClosed(f"send failed: {exc}") from exc
+        stats.bytes_out += sent
+        if sent < len(frame):
+            self._partial = memoryview(frame[sent:].tobytes())
+            self.want_write = True
+        else:
+            self._written(monotonic())
+
     def send_threaded(self, frame: bytes, now: float) -> None:
         """:meth:`send` of a threaded connection: queue the frame for the I/O thread (never
         raises: a failure is left in ``error``)."""

@@ -131,20 +131,31 @@ class Outbox:
 
     def _send_steady(self, steady: SteadyValues) -> None:
         """Without the I/O thread (plain lockstep): a steady step's frames written for every
-        robot at once and sent, each counted in its robot's quota, without a measurement per
-        robot (what :meth:`_deliver_steady` does on the I/O thread)."""
+        robot at once, into a buffer kept from step to step, and each robot's sent straight
+        from it (a view, no copy: :meth:`Connection.send_view`), counted in its robot's quota,
+        without a measurement per robot (what :meth:`_deliver_steady` does on the I/O
+        thread). Only a client whose socket did not take its frame is flushed again."""
         assert self._batch is not None
         step = steady.step
-        time_ms, real_time = steady.time_ms, steady.real_time
+        real_time = steady.real_time
         now = time.monotonic()
-        admitted = self._admitted
-        for slot, conn, frame in zip(step.slots, step.conns, steady.frames(self._batch),
-                                     strict=True):  # fmt: skip
+        frames, spans = steady.frames_in_place(self._batch)
+        behind = None
+        for slot, conn, (start, end) in zip(step.slots, step.conns, spans, strict=True):
+            if slot.quota.admit(end - start - HEADER.size, real_time):
+                frame = frames[start:end]
+            else:
+                frame = memoryview(self._quota_error(slot, steady.time_ms, real_time))
             try:
-                conn.send(admitted(slot, frame, time_ms, real_time), now)
+                conn.send_view(frame, now)
             except ClientClosed as exc:
                 self._ports.drop(slot, exc.reason)
-        self.flush()
+                continue
+            if conn.want_write:
+                behind = [slot] if behind is None else [*behind, slot]
+        for slot in behind or ():
+            if slot.conn is not None:
+                self._ports.flush(slot)
 
     def _send(
         self, slot: RobotSlot, conn: Connection, measurement: Measurement, now: float

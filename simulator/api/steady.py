@@ -113,6 +113,13 @@ class SteadyValues:
         head = header_bytes(self.time_ms, self.real_time)
         return self.step.encoding_for(batch, head).frames(self.values, head)
 
+    def frames_in_place(self, batch: StepBatch) -> tuple[memoryview, tuple[tuple[int, int], ...]]:
+        """:meth:`frames` as one view of a buffer the encoding reuses every step, and each
+        robot's frame's span in it (:meth:`~simulator.api.batch.Encoding.frames_in_place`)."""
+        head = header_bytes(self.time_ms, self.real_time)
+        encoding = self.step.encoding_for(batch, head)
+        return encoding.frames_in_place(self.values, head), encoding.frames_at
+
     def measurements(self, batch: StepBatch) -> list[tuple[RobotSlot, Measurement]]:
         """The step's measurements robot by robot, written (as :meth:`ApiServer.prepare`
         makes them without the steady form)."""
