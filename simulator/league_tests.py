@@ -31,10 +31,12 @@ have no controller. Differences from Webots, all of the world and none of the ru
   referee.py:1913-1916, to last more than 5 simulated seconds).
 - The packet is read the step it is made (the league's arrives by UDP, a step or more later).
 - The ball is the match ball, or on request the league's (``ball="league"``,
-  :func:`simulator.world.ball.use_league_ball`: Webots' damping of
-  ``protos/RobocupTexturedSoccerBall.proto``, no rolling friction), as the scenarios' pushes
-  were tuned to it; our robots and contacts are not Webots', and with it fewer of the league's
-  files pass (README); matches always play the match ball.
+  :func:`simulator.world.ball.use_league_ball`: the 0.0791 kg Webots gives ODE for the scaled
+  ``protos/RobocupTexturedSoccerBall.proto``, its damping, no rolling friction), as the
+  scenarios' pushes were tuned to it; our robots and contacts are not Webots', and with it fewer
+  of the league's files pass (README); matches always play the match ball. A ``force`` acts
+  for one basic step, as Webots' does (``WbSupervisorUtilities``: ADD_FORCE calls
+  ``dBodyAddForceAtRelPos`` once; ODE clears a body's forces after every step).
 
 The league's world lets resting bodies sleep (``worlds/robocup.wbt:24-26``: physics disabled
 for a body slower than 0.1 m/s and 0.1 rad/s for 0.1 s); here the whole world sleeps when every
@@ -246,7 +248,7 @@ class LeagueTestRunner:
         if world == "league":
             use_league_bounce(self.world.model)
         if ball == "league":
-            use_league_ball(self.world.model)
+            use_league_ball(self.world.model, self.world.field)
         self.clock = FakeClock()
         rtf = spec.maximum_real_time_factor
         self.speed = rtf if rtf > 0 else FAST_SPEED  # simulated seconds per wall second

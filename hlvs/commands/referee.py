@@ -60,9 +60,10 @@ def register(sub: Any) -> None:
     )  # fmt: skip
     test.add_argument(
         "--ball", choices=("league", "match"), default="match",
-        help="match: the match ball (default); league: the league's ball (its Webots damping, "
-        "77 %% of its speed lost a second, no rolling friction); on hlvs_webots 87829b1 it "
-        "passes fewer files than the match ball",
+        help="match: the match ball (default); league: the league's ball as Webots simulates "
+        "it (0.0791 kg, its proto's scale cubed times 0.205 kg; 77 %% of its speed lost a "
+        "second; no rolling friction); on hlvs_webots 87829b1 it passes fewer files than the "
+        "match ball",
     )  # fmt: skip
     test.set_defaults(func=_test)
 

@@ -49,23 +49,47 @@ def ball_damping(f: FieldGeometry) -> tuple[float, float]:
 
 # The league's ball (hlvs_webots ``protos/RobocupTexturedSoccerBall.proto:54-57``):
 # ``Damping { linear 0.77 angular 0.77 }``, the fraction of its speed a body loses every
-# second; Webots gives ODE 1 - (1 - d) ** dt per step (``WbWorldInfo::applyToOdeGlobalDamping``,
-# the same for a body's own damping), so v(t) = v0 * 0.23 ** t. No rolling friction
+# second; Webots gives ODE 1 - (1 - d) ** dt per step (``WbSolidMerger::setOdeDamping``, the same
+# for the world's global damping), so v(t) = v0 * 0.23 ** t. No rolling friction
 # (``worlds/robocup.wbt:35-43``: grass and ball, Coulomb friction 0.5).
 LEAGUE_BALL_DAMPING_PER_S = 0.77
 LEAGUE_BALL_FRICTION = (0.5, 0.0, 0.0)
+# Its mass in ODE: the proto scales its Solid by radius x 10.4 and gives ``mass`` the FIFA mass
+# (``RobocupTexturedSoccerBall.proto:17-21, 26, 47, 51``: ``scale``, the bounding sphere's
+# radius / scale, 0.205 kg for size 1; Webots' own ``RobocupSoccerBall.proto`` of R2022a the
+# same), and Webots hands ODE scale^3 x mass for a scaled Solid (cyberbotics/webots
+# ``src/webots/nodes/WbSolid.cpp``, ``WbSolid::createOdeMass``: ``actualMass = s * s2 * mass``,
+# ``s = absoluteScale().x()``; the league's world is R2022b, ``worlds/robocup.wbt:1``) with the
+# inertia of a solid sphere of the scaled radius (``WbSolidUtilities::addMass``:
+# ``sphere->scaledRadius()``). Size 1: 0.728^3 x 0.205 = 0.0791 kg, so each ``addForce`` push
+# (one 8 ms step: ODE clears a body's forces after every step, ``src/ode/ode/src/step.cpp``
+# "zero all force accumulators") moves it 2.6 times as fast as a 0.205 kg ball would go.
+LEAGUE_BALL_SCALE_PER_M = 10.4
 
 
-def use_league_ball(model: mujoco.MjModel) -> None:
-    """Give the compiled world the league's ball: its speed and spin decay as Webots damps them
-    (v *= 0.23 ** t: a rate of -ln 0.23 = 1.47 per second, damping = rate x mass, rate x
-    inertia on each axis), with sliding friction only. For the league's referee test scenarios,
-    whose pushes were tuned to this ball; matches keep the match ball."""
-    rate = -math.log(1.0 - LEAGUE_BALL_DAMPING_PER_S)
+def league_ball_mass_kg(f: FieldGeometry) -> float:
+    """The mass ODE gives the league's ball in Webots (:data:`LEAGUE_BALL_SCALE_PER_M`): the
+    field's FIFA ball mass times the proto's scale cubed (0.0791 kg on the kid field)."""
+    scale = f.ball_radius_m * LEAGUE_BALL_SCALE_PER_M
+    return f.ball_mass_kg * scale**3
+
+
+def use_league_ball(model: mujoco.MjModel, f: FieldGeometry) -> None:
+    """Give the compiled world the league's ball as Webots simulates it: the mass ODE gives it
+    (:func:`league_ball_mass_kg`, a solid sphere of the field's radius), its speed and spin
+    decaying as Webots damps them (v *= 0.23 ** t: a rate of -ln 0.23 = 1.47 per second, damping
+    = rate x mass, rate x inertia on each axis), with sliding friction only. For the league's
+    referee test scenarios, whose pushes were tuned to this ball; matches keep the match ball."""
     body = model.body(BALL_BODY).id
+    mass = league_ball_mass_kg(f)
+    inertia = 0.4 * mass * f.ball_radius_m**2
+    model.body_mass[body] = mass
+    model.body_inertia[body] = (inertia, inertia, inertia)
+    mujoco.mj_setConst(model, mujoco.MjData(model))  # the solver's weights of the new mass
+    rate = -math.log(1.0 - LEAGUE_BALL_DAMPING_PER_S)
     adr = int(model.joint(BALL_JOINT).dofadr[0])
-    model.dof_damping[adr : adr + 3] = rate * float(model.body_mass[body])
-    model.dof_damping[adr + 3 : adr + 6] = rate * model.body_inertia[body]
+    model.dof_damping[adr : adr + 3] = rate * mass
+    model.dof_damping[adr + 3 : adr + 6] = rate * inertia
     model.geom_friction[model.geom(BALL_GEOM).id] = LEAGUE_BALL_FRICTION
 
 

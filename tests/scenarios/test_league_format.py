@@ -81,6 +81,22 @@ def test_the_league_world_sends_the_ball_back_off_its_robot_s_legs(
     assert ball["status"] == ("pass" if code == 0 else "fail")
 
 
+@pytest.mark.parametrize(("ball", "code"), [("league", 0), ("match", 1)])
+def test_a_push_moves_the_league_ball_as_far_as_webots_moves_it(
+    capsys: pytest.CaptureFixture[str], ball: str, code: int
+) -> None:
+    """``--ball league``: the league's ball as Webots simulates it, 0.0791 kg (its proto scales
+    the Solid by 0.728 and ``WbSolid::createOdeMass`` gives ODE scale^3 x 0.205 kg), pushed with
+    10 N for one 8 ms step (``addForce``, ``rc_testing.py:615-616``), rolls 0.5 m, past the
+    0.32 m the league's ``scoring/goal`` needs of that push; the match ball stops at 0.34 m."""
+    got, out, _ = run(capsys, ROOT / "push", "--ball", ball, "--json")
+    report = json.loads(out)
+    assert got == code, out
+    rolled = report["scenarios"][0]["results"][0]
+    assert rolled["name"] == "The ball rolled"
+    assert rolled["status"] == ("pass" if code == 0 else "fail")
+
+
 def test_a_robot_s_velocity_is_set_on_its_torso_as_webots_sets_it(
     capsys: pytest.CaptureFixture[str],
 ) -> None:

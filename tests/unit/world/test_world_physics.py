@@ -127,7 +127,7 @@ def test_the_league_ball_loses_77_percent_of_its_speed_a_second(
 
     world = World.create(field_class="kid", robots=[], seed=1)
     if league:
-        use_league_ball(world.model)
+        use_league_ball(world.model, world.field)
     r = world.field.ball_radius_m
     world.apply(PlaceBall(position=(-3.0, 0.0, r), velocity=(3.0, 0.0, 0.0)))
     adr = int(world.model.joint(BALL_JOINT).dofadr[0])
@@ -135,6 +135,32 @@ def test_the_league_ball_loses_77_percent_of_its_speed_a_second(
     run_steps(world, 125)  # 1 s
     ball = world.snapshot().ball
     assert kept[0] < math.hypot(ball.velocity[0], ball.velocity[1]) / 3.0 < kept[1]
+
+
+@pytest.mark.parametrize(("league", "speed"), [(True, 1.01), (False, 0.39)])
+def test_a_push_moves_the_league_ball_as_webots_moves_its_scaled_ball(
+    league: bool, speed: float
+) -> None:
+    """The league's ball proto scales its Solid by 0.728 and Webots gives ODE 0.728^3 x 0.205 kg
+    = 0.0791 kg (``WbSolid::createOdeMass``, ``actualMass = s * s2 * mass``): the league's
+    scenarios push it with ``addForce`` for one 8 ms step, 10 N sends it off at 1.01 m/s; the
+    match ball (0.205 kg) at 0.39 m/s. Without gravity, so that only the push acts."""
+    from simulator.world.ball import BALL_BODY, league_ball_mass_kg, use_league_ball
+
+    world = World.create(field_class="kid", robots=[], seed=1)
+    if league:
+        use_league_ball(world.model, world.field)
+    assert league_ball_mass_kg(world.field) == pytest.approx(0.0791, abs=1e-4)
+    body = int(world.model.body(BALL_BODY).id)
+    want_mass = 0.0791 if league else 0.205
+    assert float(world.model.body_mass[body]) == pytest.approx(want_mass, abs=1e-4)
+    world.model.opt.gravity[:] = 0.0
+    r = world.field.ball_radius_m
+    world.apply(PlaceBall(position=(0.0, 0.0, r + 0.05), velocity=(0.0, 0.0, 0.0)))
+    world.data.xfrc_applied[body, 0] = 10.0
+    world.step()
+    world.data.xfrc_applied[body, 0] = 0.0
+    assert world.snapshot().ball.velocity[0] == pytest.approx(speed, rel=0.02)
 
 
 @pytest.mark.parametrize(("league", "kept"), [(True, (0.73, 0.79)), (False, (0.81, 0.87))])
