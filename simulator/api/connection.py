@@ -371,19 +371,19 @@ class Connection:
         self.last_sent_at = now
         self.enqueued_at = now
 
-    def send(self, frame: bytes, now: float) -> None:
+    def send(self, frame: bytes | memoryview, now: float) -> None:
         """:meth:`enqueue` and :meth:`flush`, but a frame with nothing queued before it goes
-        straight to the socket (the usual case: no queue, no view). Threaded: only
-        :meth:`enqueue`; the I/O thread writes.
+        straight to the socket (the usual case). Threaded: only :meth:`enqueue`. A view is of
+        a buffer the caller reuses (plain lockstep): what the socket does not take is copied.
 
         Raises:
             ClientClosed: on a fatal send error.
         """
-        if self.threaded:
-            self.send_threaded(frame, now)
-            return
-        if self._partial is not None or self.outbox:
-            self.enqueue(frame, now)
+        if self.threaded or self._partial is not None or self.outbox:
+            kept = frame if isinstance(frame, bytes) else frame.tobytes()
+            if self.threaded:
+                return self.send_threaded(kept, now)
+            self.enqueue(kept, now)
             self.flush()
             return
         self.measurements += 1
@@ -400,37 +400,7 @@ class Connection:
             raise ClientClosed(f"send failed: {exc}") from exc
         stats.bytes_out += sent
         if sent < len(frame):
-            self._partial = memoryview(frame)[sent:]
-            self.want_write = True
-        else:
-            self._written(monotonic())
-
-    def send_view(self, frame: memoryview, now: float) -> None:
-        """:meth:`send` of a frame that is a view of a buffer the caller reuses (plain
-        lockstep's steady step): what the socket does not take now (a queue before it, or the
-        rest of a partial write) is copied first.
-
-        Raises:
-            ClientClosed: on a fatal send error.
-        """
-        if self.threaded or self._partial is not None or self.outbox:
-            self.send(frame.tobytes(), now)  # kept: a copy of its own
-            return
-        self.measurements += 1
-        self.owe()
-        self.last_sent_at = now
-        self.enqueued_at = now
-        stats = self.stats
-        stats.messages_out += 1
-        try:
-            sent = self.sock.send(frame)
-        except (BlockingIOError, InterruptedError):
-            sent = 0
-        except OSError as exc:
-            raise ClientClosed(f"send failed: {exc}") from exc
-        stats.bytes_out += sent
-        if sent < len(frame):
-            self._partial = memoryview(frame[sent:].tobytes())
+            self._partial = memoryview(bytes(frame[sent:]))  # a view's rest is copied
             self.want_write = True
         else:
             self._written(monotonic())

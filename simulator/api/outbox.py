@@ -132,9 +132,10 @@ class Outbox:
     def _send_steady(self, steady: SteadyValues) -> None:
         """Without the I/O thread (plain lockstep): a steady step's frames written for every
         robot at once, into a buffer kept from step to step, and each robot's sent straight
-        from it (a view, no copy: :meth:`Connection.send_view`), counted in its robot's quota,
-        without a measurement per robot (what :meth:`_deliver_steady` does on the I/O
-        thread). Only a client whose socket did not take its frame is flushed again."""
+        from it (a view, no copy: :meth:`Connection.send` copies what the socket does not
+        take), counted in its robot's quota, without a measurement per robot (what
+        :meth:`_deliver_steady` does on the I/O thread). Only a client whose socket did not
+        take its frame is flushed again."""
         assert self._batch is not None
         step = steady.step
         real_time = steady.real_time
@@ -147,7 +148,7 @@ class Outbox:
             else:
                 frame = memoryview(self._quota_error(slot, steady.time_ms, real_time))
             try:
-                conn.send_view(frame, now)
+                conn.send(frame, now)
             except ClientClosed as exc:
                 self._ports.drop(slot, exc.reason)
                 continue

@@ -1,6 +1,7 @@
 """Plain lockstep sends a steady step's frames as views of one buffer the next step overwrites
-(:meth:`Connection.send_view`): what the socket does not take at once is copied, so the client
-gets the bytes of the step it was sent, whole and in order, whatever the buffer holds later."""
+(:meth:`Connection.send` of a ``memoryview``): what the socket does not take at once is
+copied, so the client gets the bytes of the step it was sent, whole and in order, whatever the
+buffer holds later."""
 
 from __future__ import annotations
 
@@ -46,11 +47,11 @@ def test_a_partly_written_view_is_sent_as_it_was(pair: tuple[Connection, socket.
     conn, theirs = pair
     size = 1 << 20  # far above the socket's buffer: a partial write
     buffer = _framed(1, size)
-    conn.send_view(memoryview(buffer), 0.0)
+    conn.send(memoryview(buffer), 0.0)
     assert conn.want_write and not conn.idle  # the rest is kept
     buffer[:] = _framed(2, size)  # the next step overwrites the buffer
     second = _framed(3, 100)
-    conn.send_view(memoryview(second), 0.0)  # queued behind the first: copied too
+    conn.send(memoryview(second), 0.0)  # queued behind the first: copied too
     second[:] = _framed(4, 100)
     received = b""
     while not conn.idle:
@@ -71,7 +72,7 @@ def test_a_partly_written_view_is_sent_as_it_was(pair: tuple[Connection, socket.
 def test_a_whole_write_keeps_nothing(pair: tuple[Connection, socket.socket]) -> None:
     conn, theirs = pair
     buffer = _framed(5, 200)
-    conn.send_view(memoryview(buffer)[: HEADER.size + 200], 0.0)
+    conn.send(memoryview(buffer)[: HEADER.size + 200], 0.0)
     assert conn.idle and not conn.want_write and conn.last_sent_at is not None
     assert _receive(theirs, HEADER.size + 200) == bytes(_framed(5, 200))
     assert not conn.answered  # the client owes its answer
