@@ -1,12 +1,16 @@
 """Robot head cameras rendered offscreen (``MUJOCO_GL=osmesa`` or ``egl`` without a display).
 
 Images are raw B,G,R bytes, rows top to bottom, as the HLVS robot API sends them. The look's
-main light casts shadows (:mod:`simulator.world.look`) when the cameras render on a GPU; on a
-CPU renderer (llvmpipe) MuJoCo's shadows (a depth pass and a second lit pass) cost 3.4 times
-the frame (15 to 53 ms of CPU per 320x240 frame of eight robots), so they are off there unless
-``HLVS_CAMERA_SHADOWS=on`` (``off`` turns them off on a GPU too); ``hlvs render --camera``
-frames always have them, the match video on a GPU or with ``HLVS_VIDEO_SHADOWS=on``
-(:func:`simulator.render.video_shadows`). Reflections are off. Spheres,
+main light casts shadows (:mod:`simulator.world.look`) when the cameras render on a GPU. On a
+CPU renderer (llvmpipe) MuJoCo's shadows draw the scene twice more (the light's depth map and
+a second lit pass): even with the cameras' cheaper scene (:mod:`simulator.world.camera_scene`:
+a small depth map over the turf, only robots, ball and goal posts in it, geoms out of view
+left out) a 320x240 frame of eight robots takes 12.6 ms of CPU with them against 4.9 without
+(24 against 6.8 with the whole scene), about half a match's real-time factor, so they are off
+there unless ``HLVS_CAMERA_SHADOWS=on`` (``off`` turns them off on a GPU too);
+``hlvs render --camera`` frames always have them, the match video on a GPU or with
+``HLVS_VIDEO_SHADOWS=on`` (:func:`simulator.render.video_shadows`); both keep the scene's own
+depth map. Reflections are off. Spheres,
 capsules and cylinders are tessellated more coarsely than MuJoCo's defaults (12 slices, 6
 stacks instead of 28 and 16; planes and boxes in one quad): on a software renderer that cuts a
 320x240 frame from about 10 ms to 4.5 ms with no visible difference at robot camera resolution.
@@ -28,6 +32,7 @@ import numpy as np
 from contracts import RobotId
 from simulator.errors import UnknownDeviceError
 from simulator.world.camera_model import CameraEffects, CameraModel, blur_px_of
+from simulator.world.camera_scene import SceneCut, cheap_shadows
 
 if TYPE_CHECKING:
     from simulator.world.world import World
@@ -61,11 +66,14 @@ def software_gl() -> bool:
 
 
 def robot_camera_model(model: mujoco.MjModel) -> mujoco.MjModel:
-    """A copy of ``model`` with :data:`ROBOT_CAMERA_QUALITY` tessellation (read by MuJoCo when
-    the render context is made; the copy has the same layout, so the world's data fits it)."""
+    """A copy of ``model`` with :data:`ROBOT_CAMERA_QUALITY` tessellation and the cameras'
+    shadow map and turf grid (:func:`~simulator.world.camera_scene.cheap_shadows`; read by
+    MuJoCo when the render context is made; the copy has the same layout, so the world's data
+    fits it)."""
     cheap = copy.copy(model)
     quality = cheap.vis.quality
     quality.numslices, quality.numstacks, quality.numquads = ROBOT_CAMERA_QUALITY
+    cheap_shadows(cheap)
     return cheap
 
 
@@ -80,15 +88,15 @@ class CameraRenderer:
         self._world = world
         self.width = width
         self.height = height
-        self._renderer = mujoco.Renderer(
-            robot_camera_model(world.model), height=height, width=width
-        )
+        model = robot_camera_model(world.model)
+        self._renderer = mujoco.Renderer(model, height=height, width=width)
         self._option = mujoco.MjvOption()
         self._option.geomgroup[4] = 0  # sites and helper geoms stay invisible
         scene = self._renderer.scene
         self.shadows = camera_shadows(software_gl())
         scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = self.shadows
         scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = False
+        self._cut = SceneCut(model, width, height, self.shadows)
         camera_model = getattr(world, "camera_model", None) or CameraModel.ideal()
         look = getattr(world, "look", None)
         self._effects = CameraEffects(
@@ -103,7 +111,9 @@ class CameraRenderer:
         if index is None:
             raise UnknownDeviceError(robot=str(robot), name="Camera", kind="camera")
         data = self._world.data
+        self._cut.before(data, index.camera)
         self._renderer.update_scene(data, camera=index.camera, scene_option=self._option)
+        self._cut.after(self._renderer.scene)
         rgb = self._renderer.render()
         effects = self._effects
         blur = (0.0, 0.0)
