@@ -564,7 +564,7 @@ def main(argv: list[str]) -> int:
                         help="standardise the policy's inputs by their running mean and std "
                         "(--no-obs-norm: the fixed scales alone)")  # fmt: skip
     parser.add_argument("--init-log-std", type=float, default=-1.2, help="initial exploration")
-    parser.add_argument("--final-log-std", type=float, default=-2.0,
+    parser.add_argument("--final-log-std", type=float, default=-2.5,
                         help="the exploration's cap falls to this from --refine-from to "
                         "--refine-until (not below --init-log-std: no cap)")  # fmt: skip
     parser.add_argument("--fall-penalty", type=float, default=1.0,
