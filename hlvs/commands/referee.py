@@ -65,6 +65,13 @@ def register(sub: Any) -> None:
         "second; no rolling friction); on hlvs_webots 87829b1 it passes fewer files than the "
         "match ball",
     )  # fmt: skip
+    test.add_argument(
+        "--contacts", choices=("ode", "spring"), default="spring",
+        help="spring: the ball's contacts a spring and damper that bounce it at 0.76 in the "
+        "league world (default); ode: as ODE makes the league's (its soft grass takes a dropped "
+        "ball dead, restitution 0.74 off the robots, friction 0.5 on the grass and 1 on the "
+        "robots, no rolling friction)",
+    )  # fmt: skip
     test.set_defaults(func=_test)
 
 
@@ -207,6 +214,7 @@ def _test(args: argparse.Namespace) -> int:
             max_sim_s=args.max_sim_s,
             ball=args.ball,
             world=args.world,
+            contacts=args.contacts,
         )
         outcomes.append(outcome)
         if not args.json:

@@ -118,3 +118,64 @@ def use_league_bounce(model: mujoco.MjModel) -> None:
     geom = model.geom(BALL_GEOM).id
     stiffness = -float(model.geom_solref[geom][0])
     model.geom_solref[geom][1] = -bounce_damping(stiffness, LEAGUE_BALL_BOUNCE)
+
+
+# The league's ball's contacts as ODE makes them (hlvs_webots ``worlds/robocup.wbt:30-45``; the
+# defaults of a ``ContactProperties`` field the world leaves out: coulombFriction 1,
+# bounceVelocity 0.01, softERP 0.2, softCFM 0.001, cyberbotics/webots
+# ``docs/reference/contactproperties.md``). An ODE contact is a constraint on the normal
+# velocity, softened by ERP and CFM: ``J v' = c - CFM f`` with ``c = ERP depth / h`` (ODE
+# ``joint.cpp``, ``dxJointContact::getInfo2``; ``step.cpp`` scales CFM by 1/h), and with a
+# bounce ``c`` is raised to ``bounce`` times the approaching speed (when above
+# bounceVelocity). That is a spring and damper per contact, ``kp = ERP / (h CFM)``,
+# ``kd = (1 - ERP) / CFM`` (ODE manual, "Soft constraint and constraint force mixing"), plus the
+# bounce's kick, which reaches only ``(h/m) / (h/m + CFM)`` of its target in a step:
+#
+# - ball and grass (``coulombFriction 0.5, bounce 0.76, softCFM 0.05``): kp = 500 N/m,
+#   kd = 16 N s/m, for the 0.0791 kg ball 6,320 s^-2 and 202 s^-1, over-damped (the spring
+#   alone does not bounce); the kick reaches 67 % of its target, so the ball leaves the grass
+#   at 0 to 0.17 of the speed it came at, depending on how deep the 8 ms step found it
+#   (dropped from 0.5 m, 1 m and 1.5 m: 0.05, 0.08, 0.09 of it on average over the step's
+#   phase): the grass takes a dropped ball dead. Here the pair ball-turf is that spring and
+#   damper in MuJoCo's direct form (per kg of ball), which keeps 0.08 to 0.10 of a normal
+#   speed of 0.5 to 4 m/s, with sliding friction 0.5 and no rolling friction.
+# - ball and anything else, the robots among it (``bounce 0.76``, softCFM 0.001): the kick
+#   reaches 99 % of its target, the ball leaves at 0.742 of the relative speed it came at
+#   (0.76 x 0.99 - 0.01), with Coulomb friction 1 and no rolling friction. Here the ball's
+#   contact spring keeps the match ball's stiffness and its damping keeps 0.74 of the normal
+#   speed at 1 to 8 m/s (fitted on a 0.0791 kg sphere dropped on a plane at a 2 ms step:
+#   0.73 to 0.75).
+BALL_TURF_PAIR = "ball:turf"
+ODE_STEP_S = 0.008  # worlds/robocup.wbt:23, basicTimeStep 8
+ODE_SOFT_ERP = 0.2
+LEAGUE_GRASS_BALL_SOFT_CFM = 0.05
+LEAGUE_GRASS_BALL_FRICTION = 0.5
+LEAGUE_BALL_ROBOT_FRICTION = 1.0
+LEAGUE_BALL_ROBOT_SOLREF = (-10000.0, -21.0)  # restitution 0.74 (see above)
+
+
+def ode_contact_spring(mass_kg: float, soft_cfm: float) -> tuple[float, float]:
+    """(stiffness, damping) per kg of ``mass_kg`` of ODE's soft contact of ``soft_cfm`` at the
+    league's ERP and step: ``kp = ERP / (h CFM)``, ``kd = (1 - ERP) / CFM``."""
+    kp = ODE_SOFT_ERP / (ODE_STEP_S * soft_cfm)
+    kd = (1.0 - ODE_SOFT_ERP) / soft_cfm
+    return kp / mass_kg, kd / mass_kg
+
+
+def use_league_contacts(model: mujoco.MjModel) -> None:
+    """Give the compiled world (built with the ball-turf pair, :data:`BALL_TURF_PAIR`) the
+    league's ball contacts as ODE makes them (above): with the turf ODE's soft contact spring
+    for the ball's present mass, sliding friction 0.5; with the robots and goals restitution
+    0.74, Coulomb friction 1; no rolling or torsional friction on either (condim 3). For the
+    league's referee test scenarios; matches keep the match ball's contacts."""
+    geom = model.geom(BALL_GEOM).id
+    mass = float(model.body_mass[model.body(BALL_BODY).id])
+    model.geom_condim[geom] = 3
+    model.geom_solref[geom] = LEAGUE_BALL_ROBOT_SOLREF
+    model.geom_friction[geom] = (LEAGUE_BALL_ROBOT_FRICTION, 0.0, 0.0)
+    pair = model.pair(BALL_TURF_PAIR).id
+    stiffness, damping = ode_contact_spring(mass, LEAGUE_GRASS_BALL_SOFT_CFM)
+    model.pair_dim[pair] = 3
+    model.pair_solref[pair] = (-stiffness, -damping)
+    model.pair_solimp[pair] = model.geom_solimp[geom]
+    model.pair_friction[pair] = (LEAGUE_GRASS_BALL_FRICTION,) * 2 + (0.0,) * 3

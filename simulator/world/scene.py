@@ -14,7 +14,13 @@ import mujoco
 import numpy as np
 
 from contracts import FieldGeometry, RobotId, TeamColor
-from simulator.world.ball import BALL_GEOM, BALL_JOINT, ball_body, ball_damping
+from simulator.world.ball import (
+    BALL_GEOM,
+    BALL_JOINT,
+    BALL_TURF_PAIR,
+    ball_body,
+    ball_damping,
+)
 from simulator.world.field import field_bodies
 from simulator.world.goal import goal_bodies
 from simulator.world.jersey import apply_jerseys, jersey_assets, jersey_material
@@ -61,6 +67,7 @@ def scene_xml(
     *,
     physics_dt_s: float,
     look: Look | None = None,
+    ball_turf_pair: bool = False,
 ) -> str:
     """The world MJCF (its look's textures still blank: :func:`compile_scene` fills them).
     Raises UnknownModelError for a model name we do not ship."""
@@ -116,10 +123,17 @@ def scene_xml(
 </visual>
 <asset>{look_assets(look)}{"".join(assets.values())}</asset>
 <worldbody>{"".join(bodies)}</worldbody>
-<contact>{"".join(excludes)}</contact>
+<contact>{_ball_turf_pair() if ball_turf_pair else ""}{"".join(excludes)}</contact>
 <actuator>{"".join(actuators)}</actuator>
 <sensor>{"".join(sensors)}</sensor>
 </mujoco>"""
+
+
+def _ball_turf_pair() -> str:
+    """The ball's contact with the turf as an explicit pair (MuJoCo then skips the pair's
+    dynamic contact), whose parameters the league's test world sets apart from the ball's with
+    the robots (:func:`simulator.world.ball.use_league_contacts`); matches have no such pair."""
+    return f'<pair name="{BALL_TURF_PAIR}" geom1="{BALL_GEOM}" geom2="turf" condim="3"/>'
 
 
 def compile_scene(
@@ -128,12 +142,15 @@ def compile_scene(
     *,
     physics_dt_s: float,
     look: Look | None = None,
+    ball_turf_pair: bool = False,
 ) -> mujoco.MjModel:
     """Compile the world model, with the ball's per-axis damping applied and ``look`` (default:
     the look of texture seed 0) in its textures and lights."""
     look = look if look is not None else look_for(0)
     model = mujoco.MjModel.from_xml_string(
-        scene_xml(field, robots, physics_dt_s=physics_dt_s, look=look)
+        scene_xml(
+            field, robots, physics_dt_s=physics_dt_s, look=look, ball_turf_pair=ball_turf_pair
+        )
     )
     apply_look(model, look)
     apply_jerseys(

@@ -61,6 +61,7 @@ class World(DeviceAccess):
         texture_seed: int | None = None,
         sensor_model: SensorModel | None = None,
         camera_model: CameraModel | None = None,
+        ball_turf_pair: bool = False,
     ) -> None:
         substeps = _checked_substeps(physics_dt_s, step_ms, divergence_policy, placements)
         ids = [p.id for p in placements]
@@ -73,7 +74,13 @@ class World(DeviceAccess):
         self.divergence_policy: DivergencePolicy = divergence_policy
         self.rng = np.random.default_rng(seed)
         self.look = look_for(seed if texture_seed is None else texture_seed)
-        self.model = compile_scene(field, placements, physics_dt_s=physics_dt_s, look=self.look)
+        self.model = compile_scene(
+            field,
+            placements,
+            physics_dt_s=physics_dt_s,
+            look=self.look,
+            ball_turf_pair=ball_turf_pair,
+        )
         self.camera_model = camera_model if camera_model is not None else CameraModel.ideal()
         self.data = mujoco.MjData(self.model)
         self._opt = self.model.opt  # a view of the model's options (one wrapper, not one a step)
@@ -149,9 +156,12 @@ class World(DeviceAccess):
         texture_seed: int | None = None,
         sensor_model: SensorModel | None = None,
         camera_model: CameraModel | None = None,
+        ball_turf_pair: bool = False,
     ) -> World:
         """A world on the ``field_class`` pitch with ``robots`` standing at their poses (world
         frame), the ball on the centre spot. Unknown model names raise UnknownModelError.
+        ``ball_turf_pair``: the ball's contact with the turf is an explicit pair of its own
+        parameters (:data:`simulator.world.ball.BALL_TURF_PAIR`), for the league's test world.
 
         The look comes from ``texture_seed`` (default: ``seed``); sensors and cameras are ideal
         unless ``sensor_model`` / ``camera_model`` say otherwise (:meth:`from_spec` gives a
@@ -169,6 +179,7 @@ class World(DeviceAccess):
             texture_seed=texture_seed,
             sensor_model=sensor_model,
             camera_model=camera_model,
+            ball_turf_pair=ball_turf_pair,
         )
 
     @staticmethod

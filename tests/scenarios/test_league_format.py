@@ -97,6 +97,41 @@ def test_a_push_moves_the_league_ball_as_far_as_webots_moves_it(
     assert rolled["status"] == ("pass" if code == 0 else "fail")
 
 
+@pytest.mark.parametrize(
+    ("ball", "contacts", "code"),
+    [("league", "ode", 0), ("match", "ode", 0), ("league", "spring", 1), ("match", "spring", 1)],
+)
+def test_the_grass_takes_a_dropped_ball_dead_as_ode_s_does(
+    capsys: pytest.CaptureFixture[str], ball: str, contacts: str, code: int
+) -> None:
+    """``--contacts ode``: the league's grass contact with the ball (``bounce 0.76`` at
+    ``softCFM 0.05``, ``worlds/robocup.wbt:35-42``) is in ODE an over-damped spring whose bounce
+    reaches 67 % of its target in a step: a ball dropped from 1 m leaves it at 0 to 0.17 of its
+    speed and lies on the grass 0.75 s after it was let go; bounced at 0.76 it is 0.3-0.5 m up."""
+    got, out, _ = run(capsys, ROOT / "drop", "--ball", ball, "--contacts", contacts, "--json")
+    report = json.loads(out)
+    assert got == code, out
+    [result] = report["scenarios"][0]["results"]
+    assert result["name"] == "The ball lies on the grass"
+    assert result["status"] == ("pass" if code == 0 else "fail")
+
+
+def test_a_ball_pushed_into_a_standing_robot_comes_back_as_ode_sends_it(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """``--ball league --contacts ode``: pushed with 20 N for one step into the knees of a robot
+    0.6 m away, the league's ball meets them at 0.83 m/s rolling, leaves at 0.742 of it (ODE:
+    ``bounce 0.76`` at softCFM 0.001) with the spin the knees' friction leaves it, rolls back
+    at 0.45 of it and stops at x = 0.17 m, as computed for ODE (the scenario's last step)."""
+    code, out, _ = run(
+        capsys, ROOT / "robot_rebound", "--ball", "league", "--contacts", "ode", "--json"
+    )
+    report = json.loads(out)
+    assert code == 0, out
+    [result] = report["scenarios"][0]["results"]
+    assert (result["name"], result["status"]) == ("The ball came back", "pass")
+
+
 def test_a_robot_s_velocity_is_set_on_its_torso_as_webots_sets_it(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
