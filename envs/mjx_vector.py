@@ -79,6 +79,10 @@ class MjxStandKickVector(VectorEnv):
         if num_envs < 1:
             raise EnvConfigError(field="num_envs", value=num_envs, expected="an integer >= 1")
         config = self.config = StandKickConfig.of(options)
+        if config.robot_class != "kid":
+            raise EnvConfigError(field="robot_class", value=config.robot_class,
+                                 expected="'kid' (the MJX world is the kid pitch's)",
+                                 choices=("kid",))  # fmt: skip
         model, steps_per_action = config.model, config.steps_per_action
         import jax
         import jax.numpy as jnp

@@ -1,12 +1,19 @@
 """``hlvs/StandKick-v0``: kick the ball towards the goal from a stand, with the right foot.
 
 The skill a striker plays once it has lined up behind the ball: at reset the robot stands in
-its walking stance (``robot.motion.standing_posture``, held for ``settle_s`` so that it has
-settled), facing the opponent goal within ``heading_noise_rad``, with the ball where the stub
-striker lines it up for a right-foot kick (``BALL_AHEAD_M`` in front of the torso and
-``BALL_RIGHT_M`` to its right, each within ``ball_noise_m``; ``ball_closer_m`` nearer, for a
-curriculum that starts with the ball at the toe). The robot stands somewhere between ``x`` 0.5
-and 1.5 m of the attacking half.
+its walking stance (``robot.motion.standing_posture``, eased into over the model's ``rise_s``
+and held for ``settle_s`` so that it has settled), facing the opponent goal within
+``heading_noise_rad``, with the ball where the stub striker lines it up for a right-foot kick
+(``robot.learned.kick_ball_offset`` of the model: for kid-default ``BALL_AHEAD_M`` in front of
+the torso and ``BALL_RIGHT_M`` to its right, each within ``ball_noise_m``; ``ball_closer_m``
+nearer, for a curriculum that starts with the ball at the toe). The robot stands somewhere
+between ``x`` 0.5 and 1.5 m of the attacking half.
+
+``robot_class`` (``"kid"``, the default, or ``"adult"``) picks the pitch, its ball and goal, and
+the class's default robot (``model`` names another); adult-default stands 1 s rising from the
+straight legs it is placed with (bent at once, it tips over backwards) and finds the size-5
+ball 0.33 m ahead and 0.15 m right of its torso, 3-4 cm in front of its right toe as the kid's.
+The observation is laid out as the kid's: both models have the same 20 motors.
 
 Observation: the robot API's sensors (as ``hlvs/Kick-v0``) and ``time``, the seconds since the
 episode started (the robot API's clock, which a robot running the skill counts itself).
@@ -51,15 +58,15 @@ from gymnasium import spaces
 from envs.base import Session
 from envs.errors import EnvConfigError
 from envs.frame import BALL_POS, BALL_VEL, ROBOT_XY, ROBOT_YAW, TOE_R, Frame
-from envs.session_spec import ResetOptions, ResetRequest
+from envs.session_spec import FIELD_CLASSES, ResetOptions, ResetRequest
 from envs.skill import PROGRESS_WEIGHT, KickEnv
 from envs.spaces import observe
-from robot.learned import KICK_BALL_AHEAD_M, KICK_BALL_RIGHT_M
-from robot.motion import standing_posture
+from robot.learned import KICK_BALL_AHEAD_M, KICK_BALL_RIGHT_M, KICK_MODELS, kick_ball_offset
+from robot.motion import kinematics, standing_posture
 from simulator.world import MOTOR_NAMES
 
 BALL_AHEAD_M = KICK_BALL_AHEAD_M  # the stub striker lines the ball up there for the policy
-BALL_RIGHT_M = KICK_BALL_RIGHT_M
+BALL_RIGHT_M = KICK_BALL_RIGHT_M  # (kid-default's; robot.learned.kick_ball_offset per model)
 STAND_FALL_PENALTY = 3.0
 APPROACH_WEIGHT = 1.0
 TOUCH_BONUS = 0.5
@@ -73,7 +80,8 @@ TIME_LIMIT_S = 1e4
 class StandKickConfig:
     """The settings of ``hlvs/StandKick-v0`` (see the module), checked when made."""
 
-    model: str = "kid-default"
+    robot_class: str = "kid"
+    model: str = ""  # "": the class's default robot, "<robot_class>-default"
     steps_per_action: int = 4
     max_episode_s: float = 1.5
     settle_s: float = 0.5
@@ -86,6 +94,17 @@ class StandKickConfig:
     still_penalty: float = STILL_PENALTY
 
     def __post_init__(self) -> None:
+        if self.robot_class not in FIELD_CLASSES:
+            raise EnvConfigError(field="robot_class", value=self.robot_class,
+                                 expected="'kid' or 'adult'", choices=FIELD_CLASSES)  # fmt: skip
+        if not self.model:
+            object.__setattr__(self, "model", f"{self.robot_class}-default")
+        try:
+            kick_ball_offset(self.model)
+        except KeyError:
+            raise EnvConfigError(field="model", value=self.model,
+                                 expected="a robot model with a stand-kick ball spot: "
+                                 + ", ".join(KICK_MODELS), choices=KICK_MODELS) from None
         if not isinstance(self.steps_per_action, int) or self.steps_per_action < 1:
             raise EnvConfigError(field="steps_per_action", value=self.steps_per_action,
                                  expected="an integer >= 1")  # fmt: skip
@@ -149,7 +168,7 @@ class StandKickEnv(KickEnv):
     ) -> None:
         config = StandKickConfig.of(options)
         super().__init__(
-            field_class="kid", model=config.model, camera=camera,
+            field_class=config.robot_class, model=config.model, camera=camera,
             steps_per_action=config.steps_per_action, max_episode_s=config.max_episode_s,
             heading_noise_rad=config.heading_noise_rad, remotes=remotes,
             render_mode=render_mode, session=session,
@@ -163,13 +182,16 @@ class StandKickEnv(KickEnv):
         self.ball_noise_m = config.ball_noise_m
         self.fall_penalty = float(config.fall_penalty)  # a trainer may change it between steps
         self.ball_closer_m = config.ball_closer_m  # and this between episodes (a curriculum)
-        self.settle_steps = math.ceil(config.settle_s * 1000 / (8 * config.steps_per_action))
+        step_ms = 8 * config.steps_per_action
+        self.settle_steps = math.ceil(config.settle_s * 1000 / step_ms)
+        self.rise_steps = math.ceil(kinematics(config.model).rise_s * 1000 / step_ms)
         stance = standing_posture(config.model)
         self.stance = np.array([stance.get(name, 0.0) for name in MOTOR_NAMES])
         self._start_ms = 0
         self._max_speed = 0.0
         self._touched = False
-        self._ball_offset = (BALL_AHEAD_M, BALL_RIGHT_M)
+        self.ball_spot = kick_ball_offset(config.model)  # (ahead, right) of the torso
+        self._ball_offset = self.ball_spot
         self._closer = 0.0  # the episode's ball_closer_m
 
     def reset_request(self, world_seed: int, options: ResetOptions) -> ResetRequest:
@@ -178,10 +200,10 @@ class StandKickEnv(KickEnv):
         yaw = math.atan2(-ry, self.goal_xy[0] - rx)
         yaw += float(rng.uniform(-self.heading_noise_rad, self.heading_noise_rad))
         self._closer = check_ball_closer(self.ball_closer_m)
-        ahead = BALL_AHEAD_M - self._closer
+        ahead, right = self.ball_spot
         self._ball_offset = (
-            ahead + float(rng.uniform(-self.ball_noise_m, self.ball_noise_m)),
-            BALL_RIGHT_M + float(rng.uniform(-self.ball_noise_m, self.ball_noise_m)),
+            ahead - self._closer + float(rng.uniform(-self.ball_noise_m, self.ball_noise_m)),
+            right + float(rng.uniform(-self.ball_noise_m, self.ball_noise_m)),
         )
         # the ball waits far away while the robot settles, then goes to its foot
         return ResetRequest(seed=world_seed, learner_pose=(rx, ry, yaw), ball_xy=(-3.0, 0.0))
@@ -192,7 +214,13 @@ class StandKickEnv(KickEnv):
         super().reset(seed=seed, options=options)
         frame = self.frame
         assert frame is not None
-        for _ in range(self.settle_steps):  # into the stance before the skill starts
+        # into the stance before the skill starts: eased in over the model's rise (adult-default
+        # bent at the servos' full speed from straight legs tips over backwards), then held
+        space: Any = self.observation_space
+        start = np.asarray(observe(frame, space)["joints"], np.float64)
+        for k in range(self.rise_steps):
+            frame = self.session.step(start + (k + 1) / self.rise_steps * (self.stance - start))
+        for _ in range(self.settle_steps):
             frame = self.session.step(self.stance)
         rx, ry = frame.truth[ROBOT_XY].tolist()
         yaw = float(frame.truth[ROBOT_YAW])

@@ -34,7 +34,11 @@ learnt by PPO from ``--init-log-std``) is capped from 40 % of the steps, the cap
 ``--final-log-std`` at 80 %: the last episodes it learns from are nearly the kick it will play,
 not the same kick shaken into a fall.
 
+``--class adult`` trains adult-default on the adult pitch with its ball (``robot_class`` of the
+environment); the inputs, actions and their scales are the kid's.
+
     python examples/learn_stand_kick.py --seed 1 --out runs/stand_kick
+    python examples/learn_stand_kick.py --class adult --seed 1 --out runs/stand_kick_adult
     python examples/learn_stand_kick.py --plot-runs runs/s1 runs/s2 runs/s3 --out seeds.png
 """
 
@@ -86,9 +90,9 @@ def flat_observation(obs: dict[str, Any]) -> np.ndarray:
     return np.concatenate([np.asarray(p, np.float32) for p in parts], axis=-1)
 
 
-def policy_template() -> Policy:
+def policy_template(robot_class: str = "kid") -> Policy:
     """The mapping of actions to motor targets, without weights (filled in by export)."""
-    env = gym.make(ENV_ID).unwrapped
+    env = gym.make(ENV_ID, robot_class=robot_class).unwrapped
     space = env.action_space
     assert isinstance(space, gym.spaces.Box)
     stance = np.asarray(env.stance, np.float64)  # type: ignore[attr-defined]
@@ -395,13 +399,15 @@ def _fields(policy: Policy) -> dict[str, Any]:
 
 
 def evaluate(
-    policy: Policy | None, *, episodes: int, seed: int, fall_penalty: float, ball_noise: float
+    policy: Policy | None, *, episodes: int, seed: int, fall_penalty: float, ball_noise: float,
+    robot_class: str = "kid",
 ) -> dict[str, float]:
     """Seeded episodes of the policy run by the robot's own code (``PolicyMotion``, fed the
     readings as a robot gets them), or of random actions in [-1, 1] when ``policy`` is None."""
-    template = policy or policy_template()
-    env = gym.make(ENV_ID, steps_per_action=STEPS_PER_ACTION, max_episode_s=EPISODE_S,
-                   fall_penalty=fall_penalty, ball_noise_m=ball_noise)  # fmt: skip
+    template = policy or policy_template(robot_class)
+    env = gym.make(ENV_ID, robot_class=robot_class, steps_per_action=STEPS_PER_ACTION,
+                   max_episode_s=EPISODE_S, fall_penalty=fall_penalty,
+                   ball_noise_m=ball_noise)  # fmt: skip
     rng = np.random.default_rng(seed)
     rows = []
     for episode in range(episodes):
@@ -544,6 +550,8 @@ def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seed", type=int, default=1, help="seed of the networks and episodes")
     parser.add_argument("--out", type=Path, default=Path("runs/stand_kick"), help="output folder")
+    parser.add_argument("--class", dest="robot_class", choices=("kid", "adult"), default="kid",
+                        help="the robot class: its default robot, ball and pitch")  # fmt: skip
     parser.add_argument(
         "--env-steps",
         type=int,
@@ -617,9 +625,10 @@ def main(argv: list[str]) -> int:
     set_seed(args.seed)
     num_envs = args.remotes or args.envs
     args.timesteps = math.ceil(args.env_steps / num_envs)
-    template = policy_template()
+    template = policy_template(args.robot_class)
     started = time.perf_counter()
     vec = make_vector(ENV_ID, remotes=args.remotes or None, num_envs=num_envs,
+                      robot_class=args.robot_class,
                       steps_per_action=STEPS_PER_ACTION, max_episode_s=EPISODE_S,
                       fall_penalty=args.fall_penalty, ball_noise_m=args.ball_noise)  # fmt: skip
     holder: dict[str, Any] = {}
@@ -639,9 +648,9 @@ def main(argv: list[str]) -> int:
     env = wrap_env(inputs, wrapper="gymnasium")
     agent = build_agent(env, args, out)
     holder["agent"] = agent
-    print(f"training {ENV_ID}: {args.timesteps * num_envs} environment steps over {num_envs} "
-          f"environments ({'remotes' if args.remotes else 'in-process'}), seed {args.seed}, "
-          f"output in {out}", flush=True)  # fmt: skip
+    print(f"training {ENV_ID} ({args.robot_class}): {args.timesteps * num_envs} environment "
+          f"steps over {num_envs} environments ({'remotes' if args.remotes else 'in-process'}), "
+          f"seed {args.seed}, output in {out}", flush=True)  # fmt: skip
     trainer = SequentialTrainer(
         env=env, agents=agent,
         cfg={"timesteps": args.timesteps, "headless": True, "disable_progressbar": True,
@@ -656,12 +665,14 @@ def main(argv: list[str]) -> int:
     exported = export_error(agent, policy, inputs.last_raw.astype(np.float64))
     eval_seed = 10_000 + args.seed
     same: dict[str, Any] = {"episodes": args.eval_episodes, "seed": eval_seed,
-                            "fall_penalty": end, "ball_noise": args.ball_noise}  # fmt: skip
+                            "fall_penalty": end, "ball_noise": args.ball_noise,
+                            "robot_class": args.robot_class}  # fmt: skip
     learned = evaluate(policy, **same)
     baseline = evaluate(None, **same)
     png = plot(out, baseline["mean_return"], learned["mean_return"])
     summary = {
-        "example": "learn_stand_kick", "env": ENV_ID, "seed": args.seed,
+        "example": "learn_stand_kick", "env": ENV_ID, "robot_class": args.robot_class,
+        "seed": args.seed,
         "env_steps": log.steps, "episodes": log.episodes, "fall_penalty": [args.fall_penalty, end],
         "curriculum_m": [args.curriculum_m, args.curriculum_until],
         "log_std": [args.init_log_std, args.final_log_std],

@@ -13,15 +13,23 @@ from robot.learned.motion import PolicyMotion
 from robot.learned.policy import Policy, PolicyFileError, load_policy, save_policy
 
 if TYPE_CHECKING:
-    from robot.learned.policy import KICK_BALL_AHEAD_M, KICK_BALL_RIGHT_M, LEARNT_SERVO_PID
+    from robot.learned.policy import (
+        KICK_BALL_AHEAD_M,
+        KICK_BALL_RIGHT_M,
+        KICK_MODELS,
+        LEARNT_SERVO_PID,
+        kick_ball_offset,
+    )
 
 __all__ = [
     "KICK_BALL_AHEAD_M",
     "KICK_BALL_RIGHT_M",
+    "KICK_MODELS",
     "LEARNT_SERVO_PID",
     "Policy",
     "PolicyFileError",
     "PolicyMotion",
+    "kick_ball_offset",
     "load_policy",
     "save_policy",
 ]
@@ -29,5 +37,6 @@ __all__ = [
 
 if not TYPE_CHECKING:
     __getattr__, __dir__ = lazy_exports(__name__, {
-        "robot.learned.policy": ("KICK_BALL_AHEAD_M", "KICK_BALL_RIGHT_M", "LEARNT_SERVO_PID"),
+        "robot.learned.policy": ("KICK_BALL_AHEAD_M", "KICK_BALL_RIGHT_M", "KICK_MODELS",
+                                 "LEARNT_SERVO_PID", "kick_ball_offset"),
     })

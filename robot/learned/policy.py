@@ -30,12 +30,24 @@ FORMAT = "hlvs-policy/1"
 # in front of the right toe of kid-default in its stance) and one foot's width to the right
 KICK_BALL_AHEAD_M = 0.185
 KICK_BALL_RIGHT_M = 0.075
+# the same spot for each robot model: (ahead, right) of the torso (m)
+KICK_BALL_SPOTS: dict[str, tuple[float, float]] = {
+    "kid-default": (KICK_BALL_AHEAD_M, KICK_BALL_RIGHT_M),
+    "adult-default": (0.33, 0.15),
+}
+KICK_MODELS = tuple(KICK_BALL_SPOTS)
 # the servo gains (P, I, D) the policies learn with: the learning environments never send the
 # robot API's MotorPID, so their robot has the simulator's defaults, Webots' P = 10 (1/s); a
 # robot that tunes its servos otherwise (the stub's 30) plays a policy with these, or the
 # policy's targets, chosen for a slower servo, throw it over
 LEARNT_SERVO_PID: tuple[float, float, float] = (10.0, 0.0, 0.0)
 FloatArray = npt.NDArray[np.float64]
+
+
+def kick_ball_offset(model: str) -> tuple[float, float]:
+    """Where a learned right-foot kick of ``model`` expects the ball: (ahead, right) of the
+    torso (m); a model without one is a KeyError."""
+    return KICK_BALL_SPOTS[model]
 
 
 class PolicyFileError(RobotError):

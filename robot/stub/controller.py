@@ -16,7 +16,7 @@ import numpy.typing as npt
 
 from contracts import GameState, Pose, field_for
 from robot.learned import Policy
-from robot.learned.policy import KICK_BALL_AHEAD_M
+from robot.learned.policy import kick_ball_offset
 from robot.motion import (
     SERVO_PID,
     Attitude,
@@ -167,7 +167,7 @@ class StubController:
             self.field = replace(
                 self.field,
                 foot_y_m=self.kin.leg.hip_offset_y_m + walk.foot_y_offset_m,
-                kick_x_m=KICK_BALL_AHEAD_M,
+                kick_x_m=kick_ball_offset(model)[0],
                 kick_feet=("right",),
             )
         self._last_ms: int | None = None

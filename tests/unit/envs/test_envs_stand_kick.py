@@ -181,3 +181,50 @@ def test_the_policies_learn_with_the_servo_gains_the_robot_plays_them_with() -> 
     assert set(world.motors.p.tolist()) == {LEARNT_SERVO_PID[0]}
     assert LEARNT_SERVO_PID == (10.0, 0.0, 0.0)
     env.close()
+
+
+def test_the_adult_class_stands_its_robot_behind_the_adult_ball() -> None:
+    """``robot_class="adult"``: adult-default eased into its stance on the adult pitch, the
+    adult ball at its right toe, the observation laid out as the kid's (the same 20 motors)."""
+    from contracts import field_for
+    from robot.learned import kick_ball_offset
+    from simulator.world.ball import BALL_BODY, BALL_GEOM
+
+    adult = field_for("adult")
+    with pytest.raises(EnvConfigError) as caught:
+        StandKickConfig(robot_class="teen")
+    assert caught.value.field == "robot_class"
+    with pytest.raises(EnvConfigError) as unknown:
+        StandKickConfig(robot_class="adult", model="giant-default")
+    assert unknown.value.field == "model"
+    env = _make(robot_class="adult", ball_noise_m=0.0)
+    try:
+        assert env.config.model == "adult-default"
+        assert env.ball_spot == kick_ball_offset("adult-default")
+        kid = _make()
+        try:
+            assert kid.observation_space == env.observation_space  # the kid's layout
+            assert kid.ball_spot[0] < env.ball_spot[0]  # (the stances: the same angles, scaled)
+        finally:
+            kid.close()
+        check_env(env, skip_render_check=True)
+        obs, info = env.reset(seed=3)
+        world = env.session.world  # type: ignore[attr-defined]
+        assert world is not None
+        model = world.model
+        assert model.geom(BALL_GEOM).size[0] == pytest.approx(adult.ball_radius_m)
+        assert model.body(BALL_BODY).mass[0] == pytest.approx(adult.ball_mass_kg)
+        assert env.goal_xy[0] == adult.half_length_m
+        ball = env.frame.truth[BALL_POS]  # type: ignore[union-attr]
+        assert ball[2] == pytest.approx(adult.ball_radius_m, abs=0.02)  # resting on the grass
+        assert 0.0 < info["toe_to_ball_m"] < 0.06 and not info["fallen"]  # at the toe, upright
+        for _ in range(env.max_steps):  # standing in the stance: upright, the ball untouched
+            obs, reward, terminated, truncated, info = env.step(env.stance.astype(np.float32))
+            assert obs["joints"].shape == (len(MOTOR_NAMES),)
+            if terminated or truncated:
+                break
+        assert truncated and not info["fallen"] and not info["touched"]
+        rewards, infos, _ = _kick(env, seed=5)  # the kid's scripted kick moves the adult ball
+        assert max(i["max_ball_speed_m_s"] for i in infos) > 0.1
+    finally:
+        env.close()

@@ -18,7 +18,7 @@ from robot.learned import (
     load_policy,
     save_policy,
 )
-from robot.learned.policy import KICK_BALL_AHEAD_M
+from robot.learned.policy import KICK_BALL_AHEAD_M, kick_ball_offset
 from robot.motion import SERVO_PID
 from robot.stub import StubConfigError, parse_args
 from robot.stub.behaviour import (
@@ -111,6 +111,12 @@ def test_stub_with_a_kick_policy_lines_up_for_the_right_foot(tmp_path: Path) -> 
                                 kick_policy=policy)
     assert controller.field.kick_x_m == KICK_BALL_AHEAD_M
     assert controller.field.kick_feet == ("right",)
+    # adult-default lines the ball up where hlvs/StandKick-v0 puts it for that model
+    adult = StubController(role=Role.STRIKER, start_pose=Pose(x_m=0, y_m=0, yaw_rad=0),
+                           model="adult-default", field_class="adult", kick_policy=policy)
+    ahead, right = kick_ball_offset("adult-default")
+    assert adult.field.kick_x_m == ahead > KICK_BALL_AHEAD_M
+    assert adult.field.foot_y_m == pytest.approx(right)
     game = GameInfo(phase=GameState.PLAYING)
     # ball lined up in front of the LEFT foot: a plain stub kicks with the left foot, one with
     # a right-foot policy steps across instead
