@@ -166,6 +166,9 @@ def test_settings_are_checked_and_shared_with_the_mjx_vector() -> None:
     with pytest.raises(EnvConfigError) as mjx_bad:
         MjxStandKickVector(2, ball_noise_m=0.5)  # checked before the world is built
     assert mjx_bad.value.field == "ball_noise_m"
+    with pytest.raises(EnvConfigError) as mjx_adult:
+        MjxStandKickVector(2, robot_class="adult")  # its world is the kid pitch's
+    assert mjx_adult.value.field == "robot_class"
 
 
 def test_the_policies_learn_with_the_servo_gains_the_robot_plays_them_with() -> None:
