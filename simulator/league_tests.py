@@ -18,9 +18,10 @@ have no controller. Differences from Webots, all of the world and none of the ru
   ``world="league"`` (the default) every robot of a kid-size game is the league's test robot
   (:mod:`simulator.world.robots.league`: the Darwin-OP's size, mass and stored crouch, its legs
   where the scenarios push the ball and the other robot; 26 of the league's 47 files pass with
-  it, 24 with our robots, README), and the ball bounces at 0.76 off the grass and the robots, as
-  the league's world bounces it (:func:`simulator.world.ball.use_league_bounce`; the match ball:
-  0.84); matches never play either.
+  it, 24 with our robots, README, before the ball's contacts below), and with spring contacts
+  the ball bounces at 0.76 off the grass and the robots, as the league's world sets its bounce
+  (:func:`simulator.world.ball.use_league_bounce`; the match ball: 0.84); matches never play
+  either.
 - A ball placed lower than its radius rests on the ground (both engines push it out; MuJoCo's
   push would throw it).
 - The "System" clock is the referee's wall clock (its real-time waits: before the first READY,
@@ -30,18 +31,18 @@ have no controller. Differences from Webots, all of the world and none of the ru
   world then runs at its host's speed: its scenarios expect a 2 s half-time break,
   referee.py:1913-1916, to last more than 5 simulated seconds).
 - The packet is read the step it is made (the league's arrives by UDP, a step or more later).
-- The ball is the match ball, or on request the league's (``ball="league"``,
+- The ball is the league's (``ball="league"``, the default,
   :func:`simulator.world.ball.use_league_ball`: the 0.0791 kg Webots gives ODE for the scaled
   ``protos/RobocupTexturedSoccerBall.proto``, its damping, no rolling friction), as the
-  scenarios' pushes were tuned to it; our robots and contacts are not Webots', and with it fewer
-  of the league's files pass (README); matches always play the match ball. A ``force`` acts
-  for one basic step, as Webots' does (``WbSupervisorUtilities``: ADD_FORCE calls
-  ``dBodyAddForceAtRelPos`` once; ODE clears a body's forces after every step).
-- The ball's contacts are springs and dampers (``contacts="spring"``, the default), or on
-  request as ODE makes the league's (``contacts="ode"``,
+  scenarios' pushes were tuned to it, or on request the match ball; matches always play the
+  match ball. A ``force`` acts for one basic step, as Webots' does (``WbSupervisorUtilities``:
+  ADD_FORCE calls ``dBodyAddForceAtRelPos`` once; ODE clears a body's forces after every step).
+- The ball's contacts are as ODE makes the league's (``contacts="ode"``, the default,
   :func:`simulator.world.ball.use_league_contacts`: the grass's soft contact, which takes a
-  dropped ball dead, restitution 0.74 and Coulomb friction 1 off the robots, no rolling
-  friction); with our robots' legs it passes fewer of the league's files (README).
+  dropped ball dead, restitution 0.74 and Coulomb friction 1 off the robots and goals, no
+  rolling friction), or on request springs and dampers (``contacts="spring"``: the ball bounces
+  at 0.76 off everything in the league's world). With the league's ball, these contacts and the
+  league's test robot 44 of the league's 47 files pass (README).
 
 The league's world lets resting bodies sleep (``worlds/robocup.wbt:24-26``: physics disabled
 for a body slower than 0.1 m/s and 0.1 rad/s for 0.1 s); here the whole world sleeps when every
@@ -240,9 +241,9 @@ class LeagueTestRunner:
         *,
         league_standing_z: Mapping[RobotId, float] | None = None,
         max_sim_s: float = 3600.0,
-        ball: BallKind = "match",
+        ball: BallKind = "league",
         world: WorldKind = "league",
-        contacts: ContactKind = "spring",
+        contacts: ContactKind = "ode",
     ) -> None:
         self.spec = spec
         self.scenario = scenario
@@ -530,12 +531,13 @@ def run_league_scenario(
     *,
     league_standing_z: Mapping[RobotId, float] | None = None,
     max_sim_s: float = 3600.0,
-    ball: BallKind = "match",
+    ball: BallKind = "league",
     world: WorldKind = "league",
-    contacts: ContactKind = "spring",
+    contacts: ContactKind = "ode",
 ) -> LeagueOutcome:
     """Play ``scenario`` in the match of ``spec`` (its game and teams) and return the outcome;
-    ``ball``: the match ball (default) or the league's; ``world``: the league's test robot
+    ``ball``: the league's (default) or the match ball; ``contacts``: the ball's as ODE makes
+    them (default) or springs and dampers; ``world``: the league's test robot
     (``"league"``, default: :mod:`simulator.world.robots.league`) or our robots (``"match"``)."""
     return LeagueTestRunner(
         spec,

@@ -59,18 +59,17 @@ def register(sub: Any) -> None:
         "crouched Darwin-OP's body; default); match: our robots; matches never use the league's",
     )  # fmt: skip
     test.add_argument(
-        "--ball", choices=("league", "match"), default="match",
-        help="match: the match ball (default); league: the league's ball as Webots simulates "
-        "it (0.0791 kg, its proto's scale cubed times 0.205 kg; 77 %% of its speed lost a "
-        "second; no rolling friction); on hlvs_webots 87829b1 it passes fewer files than the "
-        "match ball",
+        "--ball", choices=("league", "match"), default="league",
+        help="league: the league's ball as Webots simulates it (0.0791 kg, its proto's scale "
+        "cubed times 0.205 kg; 77 %% of its speed lost a second; no rolling friction; "
+        "default); match: the match ball",
     )  # fmt: skip
     test.add_argument(
-        "--contacts", choices=("ode", "spring"), default="spring",
-        help="spring: the ball's contacts a spring and damper that bounce it at 0.76 in the "
-        "league world (default); ode: as ODE makes the league's (its soft grass takes a dropped "
+        "--contacts", choices=("ode", "spring"), default="ode",
+        help="ode: the ball's contacts as ODE makes the league's (its soft grass takes a dropped "
         "ball dead, restitution 0.74 off the robots, friction 0.5 on the grass and 1 on the "
-        "robots, no rolling friction)",
+        "robots, no rolling friction; default); spring: a spring and damper that bounce it at "
+        "0.76 in the league world",
     )  # fmt: skip
     test.set_defaults(func=_test)
 

@@ -71,8 +71,9 @@ def test_the_league_world_sends_the_ball_back_off_its_robot_s_legs(
     capsys: pytest.CaptureFixture[str], world: str, code: int
 ) -> None:
     """``--world league``: the league's crouched test robot (its knees 0.11 m in front of it at
-    the ball's height) sends a ball pushed into it back past 1.8 m, as the league's kick-off
-    scenario needs; our straight-legged robot sends it back to 1.25 m."""
+    the ball's height, as wide as the Darwin-OP's) sends the league's ball pushed into it back
+    past 1.8 m, as the league's kick-off scenario needs; our straight-legged robot lets it
+    through between its legs."""
     got, out, _ = run(capsys, ROOT / "knee_bounce", "--world", world, "--json")
     report = json.loads(out)
     assert got == code, out
@@ -81,15 +82,18 @@ def test_the_league_world_sends_the_ball_back_off_its_robot_s_legs(
     assert ball["status"] == ("pass" if code == 0 else "fail")
 
 
-@pytest.mark.parametrize(("ball", "code"), [("league", 0), ("match", 1)])
+@pytest.mark.parametrize(
+    ("ball", "contacts", "code"), [("league", "ode", 0), ("match", "spring", 1)]
+)
 def test_a_push_moves_the_league_ball_as_far_as_webots_moves_it(
-    capsys: pytest.CaptureFixture[str], ball: str, code: int
+    capsys: pytest.CaptureFixture[str], ball: str, contacts: str, code: int
 ) -> None:
     """``--ball league``: the league's ball as Webots simulates it, 0.0791 kg (its proto scales
     the Solid by 0.728 and ``WbSolid::createOdeMass`` gives ODE scale^3 x 0.205 kg), pushed with
     10 N for one 8 ms step (``addForce``, ``rc_testing.py:615-616``), rolls 0.5 m, past the
-    0.32 m the league's ``scoring/goal`` needs of that push; the match ball stops at 0.34 m."""
-    got, out, _ = run(capsys, ROOT / "push", "--ball", ball, "--json")
+    0.32 m the league's ``scoring/goal`` needs of that push; the match ball with its rolling
+    friction stops at 0.34 m."""
+    got, out, _ = run(capsys, ROOT / "push", "--ball", ball, "--contacts", contacts, "--json")
     report = json.loads(out)
     assert got == code, out
     rolled = report["scenarios"][0]["results"][0]
@@ -116,16 +120,15 @@ def test_the_grass_takes_a_dropped_ball_dead_as_ode_s_does(
     assert result["status"] == ("pass" if code == 0 else "fail")
 
 
-def test_a_ball_pushed_into_a_standing_robot_comes_back_as_ode_sends_it(
+def test_a_ball_pushed_into_a_post_comes_back_as_ode_sends_it(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    """``--ball league --contacts ode``: pushed with 20 N for one step into the knees of a robot
-    0.6 m away, the league's ball meets them at 0.83 m/s rolling, leaves at 0.742 of it (ODE:
-    ``bounce 0.76`` at softCFM 0.001) with the spin the knees' friction leaves it, rolls back
-    at 0.45 of it and stops at x = 0.17 m, as computed for ODE (the scenario's last step)."""
-    code, out, _ = run(
-        capsys, ROOT / "robot_rebound", "--ball", "league", "--contacts", "ode", "--json"
-    )
+    """The league's ball and contacts (the defaults): pushed with 20 N for one step into a goal
+    post 0.42 m away (a vertical face where the ball meets it; ODE's contact with anything but
+    the grass, as with a robot's legs), the ball meets it at 0.83 m/s rolling, leaves at 0.742
+    of it (``bounce 0.76`` at softCFM 0.001) with the spin the post's friction leaves it, rolls
+    back at 0.45 of it and stops at x = 4.13 m, as computed for ODE (the scenario's last step)."""
+    code, out, _ = run(capsys, ROOT / "post_rebound", "--json")
     report = json.loads(out)
     assert code == 0, out
     [result] = report["scenarios"][0]["results"]

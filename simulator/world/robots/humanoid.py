@@ -72,20 +72,21 @@ def _leg(w: _Writer, side: str) -> str:
     sign = 1.0 if side == "L" else -1.0
     small = _inertial(g.joint_link_kg, g.foot_half_width_m / 2)
     r_thigh = g.foot_half_width_m * 0.65
-    thigh = w.geom(
-        "leg",
-        "thigh_" + side,
-        f'type="capsule" fromto="{_f(0, 0, -r_thigh, 0, 0, -g.thigh_m)}" size="{r_thigh:.6g}"',
-        LIMB_RGBA,
-        g.thigh_kg,
+    thigh_shape = (
+        f'type="capsule" fromto="{_f(0, 0, -r_thigh, 0, 0, -g.thigh_m)}" size="{r_thigh:.6g}"'
     )
-    shank = w.geom(
-        "leg",
-        "shank_" + side,
-        f'type="capsule" fromto="{_f(0, 0, 0, 0, 0, -g.shank_m)}" size="{r_thigh * 0.9:.6g}"',
-        LIMB_RGBA,
-        g.shank_kg,
+    shank_shape = (
+        f'type="capsule" fromto="{_f(0, 0, 0, 0, 0, -g.shank_m)}" size="{r_thigh * 0.9:.6g}"'
     )
+    if w.model.leg_box_m is not None:
+        depth, width, forward, above_knee = w.model.leg_box_m
+        thigh_shape, shank_shape = (
+            f'type="box" pos="{_f(forward, 0, top - length / 2)}" '
+            f'size="{_f(depth, width, length / 2)}"'
+            for top, length in ((0.0, g.thigh_m), (above_knee, g.shank_m + above_knee))
+        )
+    thigh = w.geom("leg", "thigh_" + side, thigh_shape, LIMB_RGBA, g.thigh_kg)
+    shank = w.geom("leg", "shank_" + side, shank_shape, LIMB_RGBA, g.shank_kg)
     return f"""
 <body name="{w.p}/hip_yaw_{side}" pos="{_f(0, sign * g.hip_y_m, g.hip_z_m)}">
  {small}{w.joint("PelvY" + side, (0, 0, 1))}
@@ -320,6 +321,11 @@ class RobotModel(MotorLookup):
     # height) in the foot's frame (x forward, z up, the ankle at 0); None for the built-in robots.
     # The league's test robot carries its ankle servos there
     ankle_box_m: tuple[float, float, float, float, float] | None = None
+    # the thigh and the shank as boxes instead of capsules, (half depth, half width, centre
+    # forward of the leg's axis, length the shank's reaches above the knee), each along its
+    # segment; None for the built-in robots. The league's test robot's legs are the Darwin-OP's
+    # boxes, as wide as the knee a ball meets
+    leg_box_m: tuple[float, float, float, float] | None = None
 
     @property
     def standing_height_m(self) -> float:
@@ -363,6 +369,11 @@ class RobotModel(MotorLookup):
         """``jersey``: the material of the team shirt worn on the chest and back (None: a
         white chest plate)."""
         return build_humanoid(
-            self, prefix=prefix, rgba=rgba, contype=contype, conaffinity=conaffinity, pose=pose,
+            self,
+            prefix=prefix,
+            rgba=rgba,
+            contype=contype,
+            conaffinity=conaffinity,
+            pose=pose,
             jersey=jersey,
         )

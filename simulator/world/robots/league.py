@@ -12,8 +12,11 @@ all) and the same crouch:
     root            the Darwin-OP's origin (torso centre), 0.24 m above the ground standing
     hip point       (0, +-0.045, -0.122): PelvY anchors at (-0.005, +-0.037, -0.1222), line 718
     thigh, shank    0.093 each (the knee and ankle anchors, lines 871, 920); crouched at 1.126
-                    rad the knee reaches 0.106 forward of the origin (the proto's knee boxes:
-                    0.109), the legs leave no gap a ball can pass
+                    rad the knees' front reaches 0.112 forward of the origin (the proto's knee
+                    boxes: 0.109); boxes 0.05 deep and 0.062 wide, the shank's from 0.0165
+                    above the knee (the shank's boxes, lines 1033-1050), which leave 0.028 m
+                    between the legs, so that a ball pushed into the knees meets their fronts
+                    (capsules of radius 0.022 took it between them and held it there)
     foot            0.105 long x 0.068 wide (box ``0.066 0.013 0.105``, line 1020)
     ankle servos    a box on the foot, 0.083 long x 0.036 wide x 0.045 high, from 0.062 behind
                     the ankle to 0.021 in front of it, 0.021 to 0.066 above the ground (the
@@ -68,6 +71,13 @@ LEAGUE_TEST_KID_CROUCH_RAD = 1.126  # the knee 0.080 above the ankle as in the p
 # above the ground as in the proto (0.01 above the ankle, whose foot box reaches 0.0337 below it)
 _ANKLE_BOX_Z_M = 0.0437 - LEAGUE_TEST_KID_GEOMETRY.ankle_height_m
 LEAGUE_TEST_KID_ANKLE_BOX_M = (-0.0205, _ANKLE_BOX_Z_M, 0.0415, 0.018, 0.0225)
+# the thighs and shanks as boxes 0.05 deep and 0.062 wide, 0.004 forward of the leg's axis, the
+# shank's reaching 0.0165 above the knee (the shank's boxes ``0.064 0.034 0.041`` at
+# ``0 -0.058 -0.001`` and ``0.062 0.073 0.027`` at ``0 -0.02 0.016``, lines 1033-1050: 0.021
+# behind its axis to 0.0295 in front, the second from 0.0165 above the knee): the knees' front
+# 0.112 in front of the origin crouched (the proto's 0.109), and with the hips at 0.045 they
+# leave 0.028 m between the legs, so a ball pushed into the knees meets their fronts
+LEAGUE_TEST_KID_LEG_BOX_M = (0.025, 0.031, 0.004, 0.0165)
 
 
 def league_test_kid(base: RobotModel) -> RobotModel:
@@ -80,4 +90,5 @@ def league_test_kid(base: RobotModel) -> RobotModel:
         joint_armature=base.joint_armature,
         crouch_rad=LEAGUE_TEST_KID_CROUCH_RAD,
         ankle_box_m=LEAGUE_TEST_KID_ANKLE_BOX_M,
+        leg_box_m=LEAGUE_TEST_KID_LEG_BOX_M,
     )

@@ -41,12 +41,11 @@ def test_it_stands_crouched_where_the_league_robot_stands() -> None:
     # the knees reach about 0.11 m in front of the origin at the ball's height (the proto's
     # knee boxes: 0.109), the body weighs about the Darwin-OP's 2.93 kg
     front = max(
-        d.geom_xpos[g][0] + sign * d.geom_xmat[g][2] * m.geom_size[g][1] + m.geom_size[g][0]
+        d.geom_xpos[g][0] + sum(abs(d.geom_xmat[g][k]) * m.geom_size[g][k] for k in range(3))
         for g in range(m.ngeom)
-        for sign in (-1.0, 1.0)
-        if m.geom(g).name.startswith("red_1/leg:")  # thigh and shank capsules
+        if m.geom(g).name.startswith("red_1/leg:")  # thigh and shank boxes: their front corner
     )
-    assert front - 1.0 == pytest.approx(0.106, abs=0.01)
+    assert front - 1.0 == pytest.approx(0.109, abs=0.005)
     mass = float(m.body_subtreemass[info.torso_body])
     assert mass == pytest.approx(2.93, abs=0.2)
 
