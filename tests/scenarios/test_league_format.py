@@ -22,6 +22,17 @@ def run(capsys: pytest.CaptureFixture[str], *args: object) -> tuple[int, str, st
     return code, out, err
 
 
+def results_of(
+    capsys: pytest.CaptureFixture[str], case: str, *args: object, code: int = 0
+) -> list[dict[str, object]]:
+    """``case`` played with ``args`` and ``--json``, which must exit with ``code``: its (one)
+    scenario's results."""
+    got, out, _ = run(capsys, ROOT / case, *args, "--json")
+    assert got == code, out
+    results: list[dict[str, object]] = json.loads(out)["scenarios"][0]["results"]
+    return results
+
+
 def test_every_action_and_test_kind_passes(capsys: pytest.CaptureFixture[str]) -> None:
     code, out, _ = run(capsys, ROOT / "throw_in", ROOT / "goal", "--json")
     report = json.loads(out)
@@ -74,10 +85,7 @@ def test_the_league_world_sends_the_ball_back_off_its_robot_s_legs(
     the ball's height, as wide as the Darwin-OP's) sends the league's ball pushed into it back
     past 1.8 m, as the league's kick-off scenario needs; our straight-legged robot lets it
     through between its legs."""
-    got, out, _ = run(capsys, ROOT / "knee_bounce", "--world", world, "--json")
-    report = json.loads(out)
-    assert got == code, out
-    ball = report["scenarios"][0]["results"][0]
+    ball = results_of(capsys, "knee_bounce", "--world", world, code=code)[0]
     assert ball["name"] == "The ball came back"
     assert ball["status"] == ("pass" if code == 0 else "fail")
 
@@ -93,10 +101,7 @@ def test_a_push_moves_the_league_ball_as_far_as_webots_moves_it(
     10 N for one 8 ms step (``addForce``, ``rc_testing.py:615-616``), rolls 0.5 m, past the
     0.32 m the league's ``scoring/goal`` needs of that push; the match ball with its rolling
     friction stops at 0.34 m."""
-    got, out, _ = run(capsys, ROOT / "push", "--ball", ball, "--contacts", contacts, "--json")
-    report = json.loads(out)
-    assert got == code, out
-    rolled = report["scenarios"][0]["results"][0]
+    rolled = results_of(capsys, "push", "--ball", ball, "--contacts", contacts, code=code)[0]
     assert rolled["name"] == "The ball rolled"
     assert rolled["status"] == ("pass" if code == 0 else "fail")
 
@@ -112,10 +117,7 @@ def test_the_grass_takes_a_dropped_ball_dead_as_ode_s_does(
     ``softCFM 0.05``, ``worlds/robocup.wbt:35-42``) is in ODE an over-damped spring whose bounce
     reaches 67 % of its target in a step: a ball dropped from 1 m leaves it at 0 to 0.17 of its
     speed and lies on the grass 0.75 s after it was let go; bounced at 0.76 it is 0.3-0.5 m up."""
-    got, out, _ = run(capsys, ROOT / "drop", "--ball", ball, "--contacts", contacts, "--json")
-    report = json.loads(out)
-    assert got == code, out
-    [result] = report["scenarios"][0]["results"]
+    [result] = results_of(capsys, "drop", "--ball", ball, "--contacts", contacts, code=code)
     assert result["name"] == "The ball lies on the grass"
     assert result["status"] == ("pass" if code == 0 else "fail")
 
@@ -128,10 +130,7 @@ def test_a_ball_pushed_into_a_post_comes_back_as_ode_sends_it(
     the grass, as with a robot's legs), the ball meets it at 0.83 m/s rolling, leaves at 0.742
     of it (``bounce 0.76`` at softCFM 0.001) with the spin the post's friction leaves it, rolls
     back at 0.45 of it and stops at x = 4.13 m, as computed for ODE (the scenario's last step)."""
-    code, out, _ = run(capsys, ROOT / "post_rebound", "--json")
-    report = json.loads(out)
-    assert code == 0, out
-    [result] = report["scenarios"][0]["results"]
+    [result] = results_of(capsys, "post_rebound")
     assert (result["name"], result["status"]) == ("The ball came back", "pass")
 
 
@@ -142,10 +141,7 @@ def test_a_robot_s_velocity_is_set_on_its_torso_as_webots_sets_it(
     upward among it; Webots sets its root solid's alone (the torso's, a third of the robot's
     mass), so the robot, nearly weightless, slides on its feet at the speed set. Moved as a
     whole at that speed, it rose 0.19 m in the first second."""
-    code, out, _ = run(capsys, ROOT / "robot_velocity", "--json")
-    report = json.loads(out)
-    assert code == 0, out
-    [result] = report["scenarios"][0]["results"]
+    [result] = results_of(capsys, "robot_velocity")
     assert (result["name"], result["status"]) == ("Red 1 slides on the ground", "pass")
 
 
