@@ -141,7 +141,7 @@ class Outbox:
         real_time = steady.real_time
         now = time.monotonic()
         frames, spans = steady.frames_in_place(self._batch)
-        behind = None
+        behind: list[RobotSlot] = []
         for slot, conn, (start, end) in zip(step.slots, step.conns, spans, strict=True):
             if slot.quota.admit(end - start - HEADER.size, real_time):
                 frame = frames[start:end]
@@ -153,8 +153,8 @@ class Outbox:
                 self._ports.drop(slot, exc.reason)
                 continue
             if conn.want_write:
-                behind = [slot] if behind is None else [*behind, slot]
-        for slot in behind or ():
+                behind.append(slot)
+        for slot in behind:
             if slot.conn is not None:
                 self._ports.flush(slot)
 
