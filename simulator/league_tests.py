@@ -42,7 +42,7 @@ have no controller. Differences from Webots, all of the world and none of the ru
   dropped ball dead, restitution 0.74 and Coulomb friction 1 off the robots and goals, no
   rolling friction), or on request springs and dampers (``contacts="spring"``: the ball bounces
   at 0.76 off everything in the league's world). With the league's ball, these contacts and the
-  league's test robot 44 of the league's 47 files pass (README).
+  league's test robot 43 of the league's 47 files pass (README).
 
 The league's world lets resting bodies sleep (``worlds/robocup.wbt:24-26``: physics disabled
 for a body slower than 0.1 m/s and 0.1 rad/s for 0.1 s); here the whole world sleeps when every
