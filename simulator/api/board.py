@@ -74,6 +74,18 @@ class BoardSlot:
         self.conn = conn
         self.session = session
 
+    def post_values(self, names: tuple[str, ...], values: Sequence[float]) -> bool:
+        """The reader, under the lock, with nothing queued on the connection: one usual
+        request's finite ``values`` for ``names`` onto the board (what :meth:`post` does with a
+        :class:`PositionTargets` of them, without making one); False when ``names`` is not the
+        list of this span (the caller queues the request the usual way)."""
+        if names is not self.names:
+            return False
+        board = self.board
+        board.values[self.start : self.end] = values
+        board.fresh[self.index] = True
+        return True
+
     def post(self, decoded: Sequence[Request], queue: list[Request]) -> None:
         """The reader (the I/O thread, or the step thread without it), under the lock: each
         usual request of ``decoded`` (in order) onto the board while the connection's ``queue``

@@ -42,6 +42,8 @@ class BoardPost(Protocol):
         queue: list[Request],
     ) -> None: ...
 
+    def post_values(self, names: tuple[str, ...], values: Sequence[float]) -> bool: ...
+
 
 class AnswerBook:
     """Who lockstep waits for, kept as it changes so that "has every client answered?" is one
@@ -124,8 +126,7 @@ class Connection:
         self.measurements = 0  # queued so far (each refills the budget)
         self._paused_logged = 0.0  # when a pause was last logged (one line per 10 s)
         self.requests: list[Request] = []
-        # where the usual requests go instead of ``requests`` while the server's target board
-        # is armed (:mod:`simulator.api.board`); set and cleared by the step thread
+        # usual requests go there, not to ``requests``, while the target board is armed (board.py)
         self.board: BoardPost | None = None
         self._template: PositionTemplate | None = None
         self.outbox: deque[bytes] = deque()
@@ -167,8 +168,7 @@ class Connection:
         budget = self.budget
         level = budget.refill(now, self.measurements)
         decoder = self.decoder
-        began = (self._frame_began if decoder.buffered and self._frame_began is not None
-                 else now)
+        began = self._frame_began if decoder.buffered and self._frame_began is not None else now
         try:
             while True:
                 if level < FRAME_COST:
@@ -244,6 +244,8 @@ class Connection:
     def _take(self, frames: list[bytes]) -> int:
         """Decode ``frames`` (paid for) and queue them, or post them on the server's target
         board; returns how many answered (all but those over the size limit)."""
+        if _onto_board(self, frames):
+            return 1
         template = self._template
         decoded: list[Request] = []
         answers = 0
@@ -478,6 +480,25 @@ class Connection:
                 self.sock.close()
             except OSError:  # already gone; nothing left to release
                 pass
+
+
+def _onto_board(conn: Connection, frames: list[bytes]) -> bool:
+    """One frame of the usual request of a robot on the server's target board straight onto
+    its span (no request object made: :meth:`BoardPost.post_values`), when it has the layout
+    of the connection's template, every target is finite and nothing is queued before it;
+    False otherwise (the caller takes it the usual way)."""
+    template = conn._template
+    if len(frames) != 1 or template is None or conn.board is None:
+        return False
+    frame = frames[0]
+    if len(frame) > conn.max_request_bytes:
+        return False
+    values = template.finite_values(frame)
+    if values is None:
+        return False
+    with conn.requests_lock:
+        span = conn.board
+        return span is not None and not conn.requests and span.post_values(template.names, values)
 
 
 def monotonic() -> float:

@@ -61,6 +61,17 @@ class PositionTemplate:
         self._unpack = layout.unpack
         self.size = layout.size
 
+    def finite_values(self, frame: bytes) -> tuple[float, ...] | None:
+        """The targets of ``frame`` when it has this layout and all of them are finite, else
+        None: :meth:`match` without the objects, for a target board's span."""
+        if len(frame) != self.size:
+            return None
+        parts = self._unpack(frame)
+        if parts[0::2] != self._fixed:
+            return None
+        values: tuple[float, ...] = parts[1::2]
+        return values if math.isfinite(sum(values)) else None
+
     def match(self, frame: bytes) -> PositionTargets | None:
         """The targets of ``frame`` when it has this layout, else None."""
         if len(frame) != self.size:

@@ -139,3 +139,15 @@ def test_session_applies_decoded_targets_like_requests() -> None:
         ("position", red1, "Head", (0.8,)),
         ("position", red1, "Neck", (0.7,)),
     ]
+
+
+def test_finite_values_are_the_values_match_takes_when_all_are_finite() -> None:
+    template = _template()
+    values = [-1.5, 1e-300, 2.0, 3.0, -0.125]
+    frame = _request(list(zip(NAMES, values, strict=True)))
+    targets = template.match(frame)
+    assert targets is not None
+    assert template.finite_values(frame) == tuple(values) == tuple(targets.values)
+    for bad in ([-1.5, math.nan, 2.0, 3.0, -0.125], [1e308, 1e308, 2.0, 3.0, -0.125]):
+        assert template.finite_values(_request(list(zip(NAMES, bad, strict=True)))) is None
+    assert template.finite_values(_request([(n, 1.0) for n in reversed(NAMES)])) is None
