@@ -10,6 +10,8 @@ the API run's real-time factor, the world-only real-time factor of the same worl
 both runs. ``--client league`` runs clients written like the league's own test client (each
 request's length and body in two writes, no ``TCP_NODELAY``: :mod:`testkit.league_client`) and
 reports their requests per second and round trips seen from both ends (``league_client``).
+``--client one-process`` serves every robot from one client process
+(:mod:`benchmarks.api_clients`) instead of one process per robot.
 ``--flood`` adds two runs, the last robot standing without a client and then flooding its port
 with small valid requests, and reports the other robots' real-time factor and round trip with
 the flood against without (``flood``).
@@ -71,9 +73,11 @@ def _parser() -> argparse.ArgumentParser:
         "when the cameras render on the CPU)"
     )
     parser.add_argument(
-        "--client", choices=("bench", "league"), default="bench",
-        help="bench: framed requests in one write, TCP_NODELAY (default); league: written like "
-        "the league's test client (length and body in two writes, no TCP_NODELAY)",
+        "--client", choices=("bench", "one-process", "league"), default="bench",
+        help="bench: framed requests in one write, TCP_NODELAY, one process per robot "
+        "(default); one-process: the same, every robot's client in one process; league: "
+        "written like the league's test client (length and body in two writes, no "
+        "TCP_NODELAY, one process per robot)",
     )
     parser.add_argument(
         "--think-ms", type=float, default=0.0,
@@ -150,12 +154,52 @@ def _frame(request: Any) -> bytes:
     return len(payload).to_bytes(4, "big") + payload
 
 
-def _client(port: int, camera_period: int, stalled: bool, cpus: frozenset[int]) -> None:
-    """Client process body: enables the sensors, then answers every measurement with 20 joint
-    targets (a 1 s cycle of pre-encoded requests: the bench measures the server, so the clients
-    sharing its cores skip decoding). The stalled client connects, enables, and never reads."""
+def _enable(camera_period: int) -> Any:
+    """The request that enables every joint sensor and the IMU at 8 ms (and the camera)."""
     from contracts.robot_api import messages_pb2 as pb
 
+    enable = pb.ActuatorRequests()
+    periods = {f"{m}S": 8 for m in MOTORS} | {"Accelerometer": 8, "Gyro": 8}
+    if camera_period:
+        periods["Camera"] = camera_period
+    for name, period in periods.items():
+        enable.sensor_time_steps.add(name=name, timeStep=period)
+    return enable
+
+
+def _answers() -> list[bytes]:
+    """The bench clients' framed answers: 20 joint targets, a one-second cycle."""
+    from contracts.robot_api import messages_pb2 as pb
+
+    cycle = []
+    for k in range(CYCLE_STEPS):
+        request = pb.ActuatorRequests()
+        for i, motor in enumerate(MOTORS):
+            request.motor_positions.add(name=motor, position=0.05 * math.sin(k * 0.008 + i))
+        cycle.append(_frame(request))
+    return cycle
+
+
+def _clients(ports: list[int], camera_periods: list[int], cpus: frozenset[int]) -> None:
+    """Client process body of ``--client one-process``: one process answers every robot
+    (:mod:`benchmarks.api_clients`)."""
+    from benchmarks.api_clients import serve_all
+
+    if cpus:
+        os.sched_setaffinity(0, cpus)
+    socks = []
+    for port, camera_period in zip(ports, camera_periods, strict=True):
+        sock = _connect(port)
+        sock.sendall(_frame(_enable(camera_period)))
+        socks.append(sock)
+    serve_all(socks, _answers())
+
+
+def _client(port: int, camera_period: int, stalled: bool, cpus: frozenset[int]) -> None:
+    """Client process body of ``--client bench`` (default, one process per robot): enables the
+    sensors, then answers every measurement with 20 joint targets (a 1 s cycle of pre-encoded
+    requests: the bench measures the server, so the clients sharing its cores skip decoding).
+    The stalled client connects, enables, and never reads."""
     if cpus:
         os.sched_setaffinity(0, cpus)
 
@@ -168,26 +212,12 @@ def _client(port: int, camera_period: int, stalled: bool, cpus: frozenset[int]) 
                 break
             except OSError:
                 time.sleep(0.25)
-        enable = pb.ActuatorRequests()
-        for name in [f"{m}S" for m in MOTORS] + ["Accelerometer", "Gyro"]:
-            enable.sensor_time_steps.add(name=name, timeStep=8)
-        raw.sendall(_frame(enable))
+        raw.sendall(_frame(_enable(0)))
         while True:
             time.sleep(3600)
     sock = _connect(port)
-    enable = pb.ActuatorRequests()
-    periods = {f"{m}S": 8 for m in MOTORS} | {"Accelerometer": 8, "Gyro": 8}
-    if camera_period:
-        periods["Camera"] = camera_period
-    for name, period in periods.items():
-        enable.sensor_time_steps.add(name=name, timeStep=period)
-    sock.sendall(_frame(enable))
-    cycle = []
-    for k in range(CYCLE_STEPS):
-        request = pb.ActuatorRequests()
-        for i, motor in enumerate(MOTORS):
-            request.motor_positions.add(name=motor, position=0.05 * math.sin(k * 0.008 + i))
-        cycle.append(_frame(request))
+    sock.sendall(_frame(_enable(camera_period)))
+    cycle = _answers()
     buffer = bytearray(1 << 20)  # received bytes land in place: no allocation per receive
     view = memoryview(buffer)
     filled = answered = 0
@@ -473,6 +503,7 @@ def _api_run(
     camera_robots = args.camera_robots or len(endpoints)
     reports = []  # the league clients' figures, sent when the server closes
     procs = []
+    together: list[tuple[int, int]] = []  # (port, camera period) of --client one-process
     for i, e in enumerate(endpoints):
         if last and e.robot == robots[-1]:
             if last == "flood":
@@ -487,16 +518,19 @@ def _api_run(
                 daemon=True,
             ))  # fmt: skip
             continue
+        camera_period = camera[2] if camera and i < camera_robots else 0
+        if args.client == "one-process" and e.robot != stalled_robot:
+            together.append((e.port, camera_period))
+            continue
         procs.append(ctx.Process(
             target=_client,
-            args=(
-                e.port,
-                camera[2] if camera and i < camera_robots else 0,
-                e.robot == stalled_robot,
-                args.client_cpus,
-            ),
+            args=(e.port, camera_period, e.robot == stalled_robot, args.client_cpus),
             daemon=True,
         ))  # fmt: skip
+    if together:  # every robot's client in one process
+        ports_together, periods = (list(column) for column in zip(*together, strict=True))
+        procs.append(ctx.Process(target=_clients, args=(ports_together, periods,
+                                                        args.client_cpus), daemon=True))
     for proc in procs:
         proc.start()
     try:

@@ -89,3 +89,12 @@ def test_bench_api_flood_reports_the_honest_robots_with_and_without_it() -> None
     # the honest robots' pace with the flood over without: at least 0.8 meets the target
     assert flood["target"] == {"figure": "ratio_interleaved", "min": 0.8}
     assert flood["meets_target"] == (flood["ratio_interleaved"] >= 0.8)
+
+
+def test_bench_api_clients_in_one_process_answer_every_robot() -> None:
+    result = _bench("--mode", "lockstep", "--client", "one-process", "--sim-seconds", "0.5")
+    assert result["client"] == "one-process"
+    assert result["slow_periods"] == 0  # both robots' answers came, every step
+    assert result["round_trip_p50_ms"] is not None
+    interleaved = result["ratio_interleaved"]
+    assert isinstance(interleaved, float) and interleaved > 0
