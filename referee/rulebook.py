@@ -50,7 +50,7 @@ class RuleBook:
         """The ball is about to be in play again (kick-off, or ``set_play_team``'s set play
         executed)."""
         self.in_play = ball_in_play.arm(snapshot)
-        self.goal = goal.restart(restriction, snapshot)
+        self.goal = goal.restart(restriction, snapshot, set_play_team)
         # the kick-off's own rules (the defenders keep off the ball and out of the circle
         # until it is in play) hold after a kick-off only, not after a set play (hlvs_webots
         # referee.py:2136-2138: `self.game.phase == 'KICKOFF'`)

@@ -39,10 +39,11 @@ have no controller. Differences from Webots, all of the world and none of the ru
   ADD_FORCE calls ``dBodyAddForceAtRelPos`` once; ODE clears a body's forces after every step).
 - The ball's contacts are as ODE makes the league's (``contacts="ode"``, the default,
   :func:`simulator.world.ball.use_league_contacts`: the grass's soft contact, which takes a
-  dropped ball dead, restitution 0.74 and Coulomb friction 1 off the robots and goals, no
-  rolling friction), or on request springs and dampers (``contacts="spring"``: the ball bounces
-  at 0.76 off everything in the league's world). With the league's ball, these contacts and the
-  league's test robot 43 of the league's 47 files pass (README).
+  dropped ball dead, restitution 0.74 and Coulomb friction 1 off the robots and goals, the ball
+  gone from a robot within about one basic step as ODE's is, no rolling friction), or on
+  request springs and dampers (``contacts="spring"``: the ball bounces at 0.76 off everything in
+  the league's world). With the league's ball, these contacts and the league's test robot 45 of
+  the league's 47 files pass (README).
 
 The league's world lets resting bodies sleep (``worlds/robocup.wbt:24-26``: physics disabled
 for a body slower than 0.1 m/s and 0.1 rad/s for 0.1 s); here the whole world sleeps when every

@@ -141,17 +141,23 @@ def use_league_bounce(model: mujoco.MjModel) -> None:
 #   speed of 0.5 to 4 m/s, with sliding friction 0.5 and no rolling friction.
 # - ball and anything else, the robots among it (``bounce 0.76``, softCFM 0.001): the kick
 #   reaches 99 % of its target, the ball leaves at 0.742 of the relative speed it came at
-#   (0.76 x 0.99 - 0.01), with Coulomb friction 1 and no rolling friction. Here the ball's
-#   contact spring keeps the match ball's stiffness and its damping keeps 0.74 of the normal
-#   speed at 1 to 8 m/s (fitted on a 0.0791 kg sphere dropped on a plane at a 2 ms step:
-#   0.73 to 0.75).
+#   (0.76 x 0.99 - 0.01), with Coulomb friction 1 and no rolling friction; kp = 25,000 N/m,
+#   316,000 s^-2 for the ball, and the bounce met in the one 8 ms step that finds the contact:
+#   the ball leaves a robot in that step. Here the ball's contact spring is 100,000 s^-2 (the
+#   stiffest at which MuJoCo's 2 ms step keeps the restitution steady: at 316,000 it came back
+#   at 0.57 to 0.83 of 0.5 to 8 m/s, at 200,000 at 0.69 to 0.77), its damping keeping 0.73 to
+#   0.76 of the normal speed at 0.5 to 8 m/s (fitted on a 0.0791 kg sphere thrown at a fixed
+#   box at a 2 ms step): the contact lasts 10 ms, 2.7 mm deep per m/s. The match ball's
+#   10,000 s^-2 held it 32 ms, 8 mm deep per m/s: pushed into a robot's knees it touched
+#   them for four basic steps (the league's referee then saw it touched once it was in play,
+#   ``referee.py:2162``, where ODE's ball had left) and sank far enough to meet both legs.
 BALL_TURF_PAIR = "ball:turf"
 ODE_STEP_S = 0.008  # worlds/robocup.wbt:23, basicTimeStep 8
 ODE_SOFT_ERP = 0.2
 LEAGUE_GRASS_BALL_SOFT_CFM = 0.05
 LEAGUE_GRASS_BALL_FRICTION = 0.5
 LEAGUE_BALL_ROBOT_FRICTION = 1.0
-LEAGUE_BALL_ROBOT_SOLREF = (-10000.0, -21.0)  # restitution 0.74 (see above)
+LEAGUE_BALL_ROBOT_SOLREF = (-100000.0, -57.0)  # restitution 0.74, 10 ms (see above)
 
 
 def ode_contact_spring(mass_kg: float, soft_cfm: float) -> tuple[float, float]:
@@ -166,8 +172,9 @@ def use_league_contacts(model: mujoco.MjModel) -> None:
     """Give the compiled world (built with the ball-turf pair, :data:`BALL_TURF_PAIR`) the
     league's ball contacts as ODE makes them (above): with the turf ODE's soft contact spring
     for the ball's present mass, sliding friction 0.5; with the robots and goals restitution
-    0.74, Coulomb friction 1; no rolling or torsional friction on either (condim 3). For the
-    league's referee test scenarios; matches keep the match ball's contacts."""
+    0.74 within about one basic step, Coulomb friction 1; no rolling or torsional friction on
+    either (condim 3). For the league's referee test scenarios; matches keep the match ball's
+    contacts."""
     geom = model.geom(BALL_GEOM).id
     mass = float(model.body_mass[model.body(BALL_BODY).id])
     model.geom_condim[geom] = 3

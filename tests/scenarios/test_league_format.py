@@ -83,8 +83,9 @@ def test_the_league_world_sends_the_ball_back_off_its_robot_s_legs(
 ) -> None:
     """``--world league``: the league's crouched test robot (its knees 0.11 m in front of it at
     the ball's height, as wide as the Darwin-OP's) sends the league's ball pushed into it back
-    past 1.8 m, as the league's kick-off scenario needs; our straight-legged robot lets it
-    through between its legs."""
+    past 1.4 m, in front of the knees of a robot put at 1.2 m, as the league's kick-off
+    scenario needs (1.46 m with ODE's contacts); our straight-legged robot lets it through
+    between its legs."""
     ball = results_of(capsys, "knee_bounce", "--world", world, code=code)[0]
     assert ball["name"] == "The ball came back"
     assert ball["status"] == ("pass" if code == 0 else "fail")

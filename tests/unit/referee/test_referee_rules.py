@@ -188,6 +188,60 @@ def test_throw_in_into_own_goal_gives_corner() -> None:
     assert decisions[0].kind is SecondaryState.CORNER_KICK and decisions[0].team is BLUE
 
 
+def _own_goal_after_goal_kick(touches: list[tuple[int, bool, bool]]) -> list[object]:
+    """Blue took a goal kick (the league's ``interruption``: ``can_score_own`` False,
+    referee.py:1709); each (ms, blue 1 touching, ball in play) is a snapshot; then the ball lies
+    in blue's own goal (on the right: red on the left), last touched by blue 1."""
+    memory = goal.restart(None, snapshot(0), BLUE)
+    for ms, touching, in_play in touches:
+        robots = (robot(BLUE, 1, 0.2, -2.9, ball_contact=True),) if touching else ()
+        _, memory = goal.judge(snapshot(ms, robots), view(ball_in_play=in_play), memory)
+    decisions, _ = goal.judge(snapshot(900, ball=(4.6, 0.3, 0.07), toucher=B1), view(), memory)
+    return list(decisions)
+
+
+def test_own_goal_straight_from_a_set_play_gives_a_corner_kick() -> None:
+    """hlvs_webots referee.py:2305-2314: the taker touched the ball before it was in play and
+    not since, so ``can_score_own`` is still False: no goal, a corner kick for the opponents
+    (the league's ``goal_kick/scoring/own_goal`` and ``corner/scoring/own_goal``)."""
+    decisions = _own_goal_after_goal_kick([(10, True, False), (20, False, False),
+                                           (30, False, True)])  # fmt: skip
+    assert len(decisions) == 1 and isinstance(decisions[0], AwardSetPlay)
+    assert decisions[0].kind is SecondaryState.CORNER_KICK and decisions[0].team is RED
+
+
+def test_own_goal_counts_once_the_ball_was_touched_in_play() -> None:
+    """referee.py:2162, 2172-2174: a touch after the ball came into play (``in_play <
+    ball_last_touch_time``) makes an own goal count (the league's ``scoring/own_goal``)."""
+    decisions = _own_goal_after_goal_kick([(10, True, False), (20, False, True),
+                                           (30, True, True)])  # fmt: skip
+    assert decisions == [Goal(RED, B1, True)]
+
+
+def test_own_goal_counts_once_an_opponent_touched_the_ball() -> None:
+    """referee.py:2156-2157, 2173: a touch by the team that does not restart."""
+    memory = goal.restart(None, snapshot(0), BLUE)
+    opponent = robot(RED, 1, 0.2, -2.9, ball_contact=True)
+    _, memory = goal.judge(snapshot(10, (opponent,)), view(ball_in_play=False), memory)
+    assert memory.own_cleared
+    decisions, _ = goal.judge(snapshot(900, ball=(4.6, 0.3, 0.07), toucher=B1), view(), memory)
+    assert decisions == [Goal(RED, B1, True)]
+
+
+def test_ball_in_play_counts_the_move_along_the_ground() -> None:
+    """hlvs_webots referee.py:2140-2142: ``distance2`` (geometry.py:20-21, x and y) of the ball
+    from its spot over ``BALL_IN_PLAY_MOVE`` 0.05: a ball lifted 6 cm where it lies is not in
+    play; moved 5 cm along the ground it is."""
+    from referee.rules import ball_in_play
+
+    memory = ball_in_play.arm(snapshot(0, ball=(0.0, -2.975, 0.07)))
+    waiting = view(ball_in_play=False)
+    found, memory = ball_in_play.judge(snapshot(8, ball=(0.03, -2.975, 0.13)), waiting, memory)
+    assert not found
+    found, _ = ball_in_play.judge(snapshot(16, ball=(0.0, -2.924, 0.07)), waiting, memory)
+    assert len(found) == 1
+
+
 # --- ball out -------------------------------------------------------------------------------
 
 

@@ -181,6 +181,36 @@ def test_the_league_world_bounces_the_ball_at_0_76(league: bool, kept: tuple[flo
     assert kept[0] < vz / 2.0 < kept[1], vz
 
 
+def test_the_league_ball_leaves_a_post_within_about_one_basic_step_as_in_ode() -> None:
+    """ODE's contact with a robot or a goal (softCFM 0.001, ERP 0.2: a spring of 25,000 N/m,
+    and the bounce's velocity target met in the one 8 ms step that finds the contact) sends
+    the ball away in that step; the match ball's contact spring (10,000 m/s^2 per m) held the
+    0.0791 kg ball for 32 ms, 1.7 cm deep at 2 m/s, so a ball pushed into a robot's knee
+    touched it for four basic steps and reached the other leg. Here (``use_league_contacts``:
+    100,000 per m, 0.74 kept) it touches a post at 2 m/s in at most two basic steps, under
+    6 mm deep."""
+    from simulator.world.ball import BALL_BODY, use_league_ball, use_league_contacts
+
+    world = World.create(field_class="kid", robots=[], seed=1, ball_turf_pair=True)
+    use_league_ball(world.model, world.field)
+    use_league_contacts(world.model)
+    world.model.opt.gravity[:] = 0.0
+    r = world.field.ball_radius_m
+    world.apply(PlaceBall(position=(4.5 - 0.05 - r - 0.01, 1.35, 0.3), velocity=(2.0, 0.0, 0.0)))
+    ball = world.model.body(BALL_BODY).id
+    touching, deepest = 0, 0.0
+    for _ in range(10):
+        world.step()
+        depths = [
+            c.dist for c in world.data.contact[: world.data.ncon]
+            if ball in (world.model.geom_bodyid[c.geom1], world.model.geom_bodyid[c.geom2])
+        ]  # fmt: skip
+        touching += bool(depths)
+        deepest = min([deepest, *depths])
+    assert 1 <= touching <= 2 and -0.006 < deepest, (touching, deepest)
+    assert world.snapshot().ball.velocity[0] < -1.2  # and away (0.742 of it, damped 80 ms)
+
+
 @pytest.mark.parametrize(("target", "kept"), [("turf", (0.05, 0.13)), ("post", (0.72, 0.78))])
 def test_the_league_test_world_makes_the_ball_s_contacts_as_ode_makes_them(
     target: str, kept: tuple[float, float]
