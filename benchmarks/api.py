@@ -392,12 +392,13 @@ def _world_only(
 
 def _render_costs(
     robots: list[RobotId], physics_dt: float, width: int, height: int, frames: int = 60
-) -> dict[str, float]:
+) -> dict[str, float | str]:
     """CPU ms per frame of a bare offscreen render (``mujoco.Renderer`` with the model's own
     settings, update_scene + render) against the robot camera path (:class:`CameraRenderer`:
-    coarser tessellation, no shadows or reflections, B,G,R bytes) on the same scene, from the
-    robots' head cameras in turn. Same process, same run: the ratio is what the camera path adds
-    to (or saves on) what the renderer costs."""
+    coarser tessellation, its shadows (``camera_shadows``: planar on a CPU renderer unless
+    ``HLVS_CAMERA_SHADOWS`` says otherwise), no reflections, B,G,R bytes) on the same scene,
+    from the robots' head cameras in turn. Same process, same run: the ratio is what the camera
+    path adds to (or saves on) what the renderer costs."""
     import mujoco
 
     from simulator.world import CameraRenderer
@@ -423,6 +424,7 @@ def _render_costs(
 
         bare_ms = timed(bare_frame)
         ours_ms = timed(lambda k: ours.render(robots[k]))
+        shadows = ours.shadows
     finally:
         bare.close()
         ours.close()
@@ -430,6 +432,7 @@ def _render_costs(
         "bare_render_ms_per_frame": round(bare_ms, 2),
         "camera_path_ms_per_frame": round(ours_ms, 2),
         "render_cost_ratio": round(ours_ms / bare_ms, 3) if bare_ms > 0 else float("nan"),
+        "camera_shadows": shadows,
     }
 
 

@@ -90,7 +90,7 @@ def team_models_frame(path: Path) -> None:
                 robot, [m.name for m in stand.motors], list(stand.standing_pose_rad)
             )
         world.step()
-    os.environ[SHADOWS_ENV] = "on"  # as hlvs render --camera draws the other frames
+    os.environ[SHADOWS_ENV] = "map"  # as hlvs render --camera draws the other frames
     with CameraRenderer(world, 320, 240) as camera:
         bgr = np.frombuffer(camera.render(red1), np.uint8).reshape(240, 320, 3)
     write_png(path, np.ascontiguousarray(bgr[..., ::-1]))

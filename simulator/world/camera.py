@@ -1,14 +1,17 @@
 """Robot head cameras rendered offscreen (``MUJOCO_GL=osmesa`` or ``egl`` without a display).
 
 Images are raw B,G,R bytes, rows top to bottom, as the HLVS robot API sends them. The look's
-main light casts shadows (:mod:`simulator.world.look`) when the cameras render on a GPU. On a
-CPU renderer (llvmpipe) MuJoCo's shadows draw the scene twice more (the light's depth map and
-a second lit pass): even with the cameras' cheaper scene (:mod:`simulator.world.camera_scene`:
-a small depth map over the turf, only robots, ball and goal posts in it, geoms out of view
-left out) a 320x240 frame of eight robots takes 12.6 ms of CPU with them against 4.9 without
-(24 against 6.8 with the whole scene), about half a match's real-time factor, so they are off
-there unless ``HLVS_CAMERA_SHADOWS=on`` (``off`` turns them off on a GPU too);
-``hlvs render --camera`` frames always have them, the match video on a GPU or with
+main light casts shadows (:mod:`simulator.world.look`). On a GPU the cameras draw MuJoCo's
+shadow map. On a CPU renderer (llvmpipe) that map draws the scene twice more (the light's
+depth map and a second lit pass): even with the cameras' cheaper scene
+(:mod:`simulator.world.camera_scene`: a small depth map over the turf, only robots, ball and
+goal posts in it, geoms out of view left out) a 320x240 frame of eight robots took 12.6 ms of
+CPU with it against 4.9 without, about half a match's real-time factor; there the cameras
+draw planar shadows instead (:class:`~simulator.world.camera_scene.PlanarShadows`: each
+caster's shadow one flattened box on the turf, in the turf's colour without the key light):
+6.8 to 8.6 ms against 6.1 to 7.7 without in the same runs (README, "Light").
+``HLVS_CAMERA_SHADOWS`` ``map``, ``planar`` or ``off`` picks one anywhere;
+``hlvs render --camera`` frames always have the map, the match video on a GPU or with
 ``HLVS_VIDEO_SHADOWS=on`` (:func:`simulator.render.video_shadows`); both keep the scene's own
 depth map. Reflections are off. Spheres,
 capsules and cylinders are tessellated more coarsely than MuJoCo's defaults (12 slices, 6
@@ -45,15 +48,17 @@ SHADOWS_ENV = "HLVS_CAMERA_SHADOWS"
 SOFTWARE_RENDERERS = ("llvmpipe", "softpipe", "swrast", "software")
 
 
-def camera_shadows(software_gl: bool) -> bool:
-    """Whether robot cameras render shadows: ``HLVS_CAMERA_SHADOWS`` ``on`` or ``off``, else
-    on a GPU only."""
+def camera_shadows(software_gl: bool) -> str:
+    """How robot cameras draw the key light's shadows (a kind of
+    :data:`~simulator.world.camera_scene.SHADOW_KINDS`): ``HLVS_CAMERA_SHADOWS`` ``map``,
+    ``planar`` or ``off``; anything else (``on``, unset) is MuJoCo's shadow map on a GPU and planar
+    shadows on a CPU renderer."""
     wanted = os.environ.get(SHADOWS_ENV, "").strip().lower()
-    if wanted in ("on", "1", "true"):
-        return True
     if wanted in ("off", "0", "false"):
-        return False
-    return not software_gl
+        return "off"
+    if wanted in ("map", "planar"):
+        return wanted
+    return "planar" if software_gl else "map"
 
 
 def software_gl() -> bool:
@@ -94,7 +99,7 @@ class CameraRenderer:
         self._option.geomgroup[4] = 0  # sites and helper geoms stay invisible
         scene = self._renderer.scene
         self.shadows = camera_shadows(software_gl())
-        scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = self.shadows
+        scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = self.shadows == "map"
         scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = False
         self._cut = SceneCut(model, width, height, self.shadows)
         camera_model = getattr(world, "camera_model", None) or CameraModel.ideal()
@@ -113,7 +118,7 @@ class CameraRenderer:
         data = self._world.data
         self._cut.before(data, index.camera)
         self._renderer.update_scene(data, camera=index.camera, scene_option=self._option)
-        self._cut.after(self._renderer.scene)
+        self._cut.after(self._renderer.scene, data, index.camera)
         rgb = self._renderer.render()
         effects = self._effects
         blur = (0.0, 0.0)

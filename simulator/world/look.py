@@ -21,9 +21,9 @@ Here the same elements, in MuJoCo:
   :data:`ENVIRONMENT_GAIN` times the luminosity, half of it from above (added to the top
   light: the sky lights what faces up, a ball's underside is in its own shade) and half from
   all around (MuJoCo's ambient light). The background's texels are scaled by
-  the luminosity too. The main light casts shadows (robot cameras: on a GPU,
-  :mod:`simulator.world.camera`, with their own cheaper depth map,
-  :mod:`simulator.world.camera_scene`). Nothing compensates: a robot camera whose
+  the luminosity too. The main light casts shadows (robot cameras, :mod:`simulator.world.camera`:
+  MuJoCo's shadow map on a GPU, with their own cheaper depth map, and planar shadows on a CPU
+  renderer, :mod:`simulator.world.camera_scene`). Nothing compensates: a robot camera whose
   model declares auto-exposure (:mod:`simulator.world.camera_model`) evens out a share of it.
 - **Backgrounds**: seven kinds of surroundings generated procedurally, one per league
   background's light set (:data:`BACKGROUNDS`), with bright skies, buildings, grass and earth
