@@ -350,6 +350,9 @@ class _KeyLight:
         return cls(direction, flatten, _without(key, others))
 
 
+_SPREAD = np.array([(0.0, 0.0), (1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)])
+
+
 class PlanarShadows:
     """The key light's shadows on the turf without MuJoCo's shadow map: each caster drawn once
     more as a box, flattened along the light onto the turf (:data:`SHADOW_LIFT_M` above it,
@@ -435,7 +438,12 @@ class PlanarShadows:
         frames = self._frames(data, casters, which, light.direction)
         mats = (light.flatten @ frames).reshape(-1, 9)
         rgba = np.ones((len(casters), 4), dtype=np.float32)
-        rgba[:, :3] = self._turf.under(pos[:, :2]) * light.shade
+        # the turf's colour over the shadow's breadth (its centre and four points half its
+        # bounding radius away), so a shadow across two mowing stripes takes their blend
+        reach = 0.5 * self.rbound[which, None]
+        spots = pos[None, :, :2] + _SPREAD[:, None, :] * reach[None, :, :]
+        under = self._turf.under(spots.reshape(-1, 2)).reshape(len(_SPREAD), len(casters), 3)
+        rgba[:, :3] = under.mean(axis=0) * light.shade
         geoms, first = scene.geoms, scene.ngeom
         types, sizes, dataids = self._types, self._sizes, self._dataids
         init = mujoco.mjv_initGeom

@@ -396,7 +396,9 @@ def look_assets(look: Look) -> str:
     and the materials that use them (``look:turf``, ``look:line``, ``look:ball``; ``look:net``
     for replays of earlier versions, whose nets were boxes with a texture)."""
     stripe = TURFS[look.turf].stripe_m
-    repeat = 1.0 / (2.0 * stripe)  # one tile spans two stripes; per metre with texuniform
+    # one tile spans two stripes; with texuniform MuJoCo's renderer lays a plane's tile over
+    # 2 / texrepeat metres (measured on rendered frames, as camera_scene's _TurfColours reads it)
+    repeat = 1.0 / stripe
     line_repeat = 1.0 / LINE_TILE_M
     return (
         f'<texture name="{SKY_TEXTURE}" type="skybox" builtin="flat" rgb1="0.4 0.5 0.6" '
@@ -519,7 +521,7 @@ def apply_look(model: mujoco.MjModel, look: Look) -> None:
     The luminosity scales the lights, the ambient light and the background's texels; light
     directions take effect at the next ``mj_forward``."""
     _write_texture(model, TURF_TEXTURE, turf_image(look.turf))
-    repeat = 1.0 / (2.0 * TURFS[look.turf].stripe_m)
+    repeat = 1.0 / TURFS[look.turf].stripe_m  # a tile of two stripes over 2 / repeat metres
     model.mat_texrepeat[model.material(TURF_TEXTURE).id] = (repeat, repeat)
     _write_texture(model, LINE_TEXTURE, line_image())
     _write_texture(model, BALL_TEXTURE, ball_image(look.ball))

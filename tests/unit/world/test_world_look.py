@@ -85,6 +85,31 @@ def test_turf_has_mowing_stripes_and_blades() -> None:
     assert turf[..., 1].min() > 75 and turf[..., 0].max() < 150
 
 
+def test_mowing_stripes_on_the_rendered_field_are_as_wide_as_the_look_says() -> None:
+    """A tile of the turf texture holds two stripes, and MuJoCo's renderer lays a plane's tile
+    over 2 / texrepeat metres: seen from straight above, between the centre circle and the
+    penalty area where no line is, the stripes are ``stripe_m`` wide (they were twice that)."""
+    from simulator.world.look import Look, apply_look
+
+    world = World.create(field_class="kid", robots=[], seed=1, texture_seed=1)
+    size, distance = 240, 1.5
+    metres_per_px = 2 * distance * np.tan(np.radians(world.model.vis.global_.fovy / 2)) / size
+    for turf in (0, 1):
+        apply_look(world.model, Look(1, turf, 0, 0, 1.0))
+        mujoco.mj_forward(world.model, world.data)
+        with mujoco.Renderer(world.model, size, size) as renderer:
+            camera = mujoco.MjvCamera()
+            camera.lookat[:] = (-1.25, 1.5, 0.0)  # x -1.87..-0.63, y 0.88..2.12: no line
+            camera.distance, camera.elevation, camera.azimuth = distance, -90.0, 90.0
+            renderer.update_scene(world.data, camera=camera)
+            green = renderer.render()[..., 1].astype(float)
+        profile = np.convolve(green.mean(axis=0), np.ones(15) / 15, mode="valid")
+        light = profile > (profile.max() + profile.min()) / 2
+        edges = np.flatnonzero(np.diff(light.astype(int))) * metres_per_px
+        assert len(edges) >= 2, (turf, edges)
+        assert np.diff(edges)[0] == pytest.approx(TURFS[turf].stripe_m, rel=0.1), (turf, edges)
+
+
 def test_the_ideal_camera_has_no_noise_and_the_league_camera_has() -> None:
     ideal = _camera_image(21, camera=CameraModel.ideal()).astype(int)
     noisy = _camera_image(
