@@ -373,7 +373,7 @@ class StubController:
             self.stats.learned_kicks += 1
             logger.info("kicking with the learned policy (%s)", self.kick_policy.skill)
             kick = LearnedKick(self.kick_policy, start=self._last_targets,
-                               stance=standing_posture(self.model))
+                               stance=standing_posture(self.model), rise_s=self.kin.rise_s)
         else:
             pose = self.world.pose
             logger.info(

@@ -29,8 +29,16 @@ from robot.stub.behaviour import (
     _kick_off_position,
     decide,
 )
-from robot.stub.controller import StubController
-from robot.stub.learned_kick import HOLD_S, PLAY_S, PREPARE_S, RECOVER_S, LearnedKick
+from robot.stub.controller import Sensors, StubController
+from robot.stub.learned_kick import (
+    HOLD_S,
+    PLAY_S,
+    PREPARE_S,
+    RECOVER_S,
+    RISEN_HOLD_S,
+    LearnedKick,
+    handover_s,
+)
 from robot.stub.runner import _kick_policy
 
 MOTORS = tuple(f"M{i}" for i in range(20))
@@ -171,6 +179,36 @@ def test_the_learned_kick_plays_the_policy_from_the_stance_and_returns_to_it() -
         long_kick.step(0.008)
     assert long_kick.policy.elapsed_s == pytest.approx(PLAY_S, abs=0.009)
     assert long_kick.elapsed_s == pytest.approx(ready + PLAY_S + RECOVER_S, abs=0.02)
+
+
+def test_a_rising_model_is_handed_over_to_the_policy_as_the_environment_started_it() -> None:
+    """adult-default's environment eases it into the stance over its 1 s rise and holds it
+    0.5 s: the kick does the same before the policy's first decision; kid-default's is short."""
+    assert handover_s(0.0) == (PREPARE_S, HOLD_S)
+    assert handover_s(1.0) == (1.0, RISEN_HOLD_S)
+    stance = dict.fromkeys(MOTORS, 0.1)
+    start = dict.fromkeys(MOTORS, 0.6)
+    joints = dict.fromkeys(MOTORS, 0.0)
+    kick = LearnedKick(make_policy(duration_s=0.2), start=start, stance=stance, rise_s=1.0)
+    first_decision_s, halfway = None, None
+    while not kick.done and first_decision_s is None:
+        kick.sense(joints, (0.0, 0.0, 9.8), (0.0, 0.0, 0.0))
+        at = kick.elapsed_s
+        targets = kick.step(0.008)
+        if halfway is None and at >= 0.5:
+            halfway = targets["M0"]
+        if kick.policy.decisions:
+            first_decision_s = at
+    assert halfway == pytest.approx(0.35, abs=0.01)  # halfway from 0.6 to 0.1 after 0.5 s
+    assert first_decision_s == pytest.approx(1.0 + RISEN_HOLD_S, abs=0.009)
+    # the stub hands its model's rise to the kick
+    adult = StubController(role=Role.STRIKER, start_pose=Pose(x_m=0, y_m=0, yaw_rad=0),
+                           model="adult-default", field_class="adult",
+                           kick_policy=make_policy())  # fmt: skip
+    assert adult.kin.rise_s == 1.0
+    adult._kick(0.008, Sensors(time_ms=0, joints={}), "right", None)
+    assert isinstance(adult._motion, LearnedKick)
+    assert adult._motion._prepare.duration_s == pytest.approx(1.0 + RISEN_HOLD_S)
 
 
 def test_the_stub_plays_a_learned_kick_with_the_servo_gains_it_learnt_with() -> None:
