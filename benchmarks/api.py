@@ -35,6 +35,9 @@ import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
+# imported here, before the clients fork: a forked child importing it could wait forever on an
+# import lock that one of the server's threads held at the fork
+from benchmarks import api_clients
 from contracts.ids import TeamColor
 from testkit.figures import FLOOD_TARGET, TARGETS, judged
 
@@ -183,8 +186,6 @@ def _answers() -> list[bytes]:
 def _clients(ports: list[int], camera_periods: list[int], cpus: frozenset[int]) -> None:
     """Client process body of ``--client one-process``: one process answers every robot
     (:mod:`benchmarks.api_clients`)."""
-    from benchmarks.api_clients import serve_all
-
     if cpus:
         os.sched_setaffinity(0, cpus)
     socks = []
@@ -192,7 +193,7 @@ def _clients(ports: list[int], camera_periods: list[int], cpus: frozenset[int]) 
         sock = _connect(port)
         sock.sendall(_frame(_enable(camera_period)))
         socks.append(sock)
-    serve_all(socks, _answers())
+    api_clients.serve_all(socks, _answers())
 
 
 def _client(port: int, camera_period: int, stalled: bool, cpus: frozenset[int]) -> None:
