@@ -13,7 +13,8 @@ from contracts.robot_api import messages_pb2 as pb
 from simulator.api import LockstepSettings, wait_lockstep
 from simulator.api.connection import AnswerBook, Connection
 from simulator.api.framing import encode_frame
-from simulator.api.stats import RobotStats
+
+from .conftest import connection_pair
 
 # a deadline no answer here comes near, however loaded the machine (the test times nothing)
 SETTINGS = LockstepSettings(deadline_s=60.0, time_bank_s=1.0)
@@ -21,17 +22,10 @@ SETTINGS = LockstepSettings(deadline_s=60.0, time_bank_s=1.0)
 
 @pytest.fixture
 def pair() -> Iterator[tuple[Connection, socket.socket, AnswerBook]]:
-    ours, theirs = socket.socketpair()
-    ours.setblocking(False)
     book = AnswerBook()
-    conn = Connection(sock=ours, peer="test", key="red 1", stats=RobotStats(),
-                      queue_limit=10, time_bank_s=1.0)  # fmt: skip
-    conn.book = book
-    try:
+    with connection_pair() as (conn, theirs):
+        conn.book = book
         yield conn, theirs, book
-    finally:
-        ours.close()
-        theirs.close()
 
 
 def _answer(conn: Connection, theirs: socket.socket) -> None:

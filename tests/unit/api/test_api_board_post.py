@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import math
 import socket
-import time
 from collections.abc import Iterator, Sequence
 
 import pytest
@@ -15,7 +14,8 @@ from contracts.robot_api import messages_pb2 as pb
 from simulator.api.connection import Connection, Request
 from simulator.api.fastreq import PositionTargets
 from simulator.api.framing import encode_frame
-from simulator.api.stats import RobotStats
+
+from .conftest import connection_pair, read_sent
 
 NAMES = ("Neck", "Head", "AnkleL")
 
@@ -47,25 +47,8 @@ def _frame(values: Sequence[float], names: Sequence[str] = NAMES) -> bytes:
 
 @pytest.fixture
 def pair() -> Iterator[tuple[Connection, socket.socket]]:
-    ours, theirs = socket.socketpair()
-    ours.setblocking(False)
-    conn = Connection(sock=ours, peer="test", key="red 1", stats=RobotStats(),
-                      queue_limit=10, time_bank_s=1.0)  # fmt: skip
-    try:
-        yield conn, theirs
-    finally:
-        ours.close()
-        theirs.close()
-
-
-def _read(conn: Connection, theirs: socket.socket, frame: bytes) -> int:
-    theirs.sendall(frame)
-    for _ in range(200):
-        taken = conn.read(time.monotonic())
-        if taken:
-            return taken
-        time.sleep(0.005)
-    raise AssertionError("the request did not arrive")
+    with connection_pair() as both:
+        yield both
 
 
 def test_a_usual_request_goes_straight_onto_the_span(
@@ -73,12 +56,12 @@ def test_a_usual_request_goes_straight_onto_the_span(
 ) -> None:
     conn, theirs = pair
     span = _Span()
-    assert _read(conn, theirs, _frame([0.1, 0.2, 0.3])) == 1  # the first: protobuf, a template
+    assert read_sent(conn, theirs, _frame([0.1, 0.2, 0.3])) == 1  # the first: protobuf, a template
     assert conn.requests and conn._template is not None
     conn.requests.clear()
     span.names = conn._template.names
     conn.board = span
-    assert _read(conn, theirs, _frame([0.4, -0.5, 0.6])) == 1
+    assert read_sent(conn, theirs, _frame([0.4, -0.5, 0.6])) == 1
     assert span.values == [[0.4, -0.5, 0.6]] and not span.posted and not conn.requests
     assert conn.answered and conn.stats.messages_in == 2
 
@@ -88,13 +71,13 @@ def test_a_request_not_finite_takes_the_usual_way(
     pair: tuple[Connection, socket.socket], values: list[float],
 ) -> None:
     conn, theirs = pair
-    _read(conn, theirs, _frame([0.1, 0.2, 0.3]))
+    read_sent(conn, theirs, _frame([0.1, 0.2, 0.3]))
     conn.requests.clear()
     assert conn._template is not None
     span = _Span()
     span.names = conn._template.names
     conn.board = span
-    assert _read(conn, theirs, _frame(values)) == 1
+    assert read_sent(conn, theirs, _frame(values)) == 1
     assert not span.values
     (posted,) = span.posted
     assert isinstance(posted, PositionTargets) and not posted.finite
@@ -104,15 +87,15 @@ def test_other_names_or_a_queue_take_the_usual_way(
     pair: tuple[Connection, socket.socket],
 ) -> None:
     conn, theirs = pair
-    _read(conn, theirs, _frame([0.1, 0.2, 0.3]))
+    read_sent(conn, theirs, _frame([0.1, 0.2, 0.3]))
     conn.requests.clear()
     span = _Span()
     span.names = ("Neck", "Head", "AnkleL")  # equal, but not the session's own list
     conn.board = span
-    _read(conn, theirs, _frame([0.4, 0.5, 0.6]))
+    read_sent(conn, theirs, _frame([0.4, 0.5, 0.6]))
     assert not span.values and len(span.posted) == 1
     assert conn._template is not None
     span.names = conn._template.names
     conn.requests.append(PositionTargets(NAMES, [0.0, 0.0, 0.0]))  # something queued first
-    _read(conn, theirs, _frame([0.7, 0.8, 0.9]))
+    read_sent(conn, theirs, _frame([0.7, 0.8, 0.9]))
     assert not span.values and len(span.posted) == 2  # behind what is queued, in order

@@ -15,20 +15,15 @@ from simulator.api.fastreq import Notice
 from simulator.api.framing import FrameDecoder, encode_frame
 from simulator.api.stats import RobotStats
 
+from .conftest import connection_pair
+
 
 @contextmanager
 def _connection(budget: ReadBudget) -> Iterator[tuple[Connection, socket.socket, RobotStats]]:
-    ours, theirs = socket.socketpair()
-    ours.setblocking(False)
     stats = RobotStats()
-    conn = Connection(sock=ours, peer="test", key="red-1", stats=stats, queue_limit=4,
-                      time_bank_s=1.0)  # fmt: skip
-    conn.budget = budget
-    try:
+    with connection_pair(key="red-1", queue_limit=4, stats=stats) as (conn, theirs):
+        conn.budget = budget
         yield conn, theirs, stats
-    finally:
-        ours.close()
-        theirs.close()
 
 
 def _small() -> bytes:

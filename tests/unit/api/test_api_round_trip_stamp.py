@@ -14,31 +14,20 @@ import pytest
 from contracts.robot_api import messages_pb2 as pb
 from simulator.api.connection import Connection
 from simulator.api.framing import encode_frame
-from simulator.api.stats import RobotStats
+
+from .conftest import connection_pair, read_sent
 
 
 @pytest.fixture(params=[False, True], ids=["step-thread-io", "io-thread"])
 def pair(request: pytest.FixtureRequest) -> Iterator[tuple[Connection, socket.socket]]:
-    ours, theirs = socket.socketpair()
-    ours.setblocking(False)
-    conn = Connection(sock=ours, peer="test", key="red 1", stats=RobotStats(), queue_limit=10,
-                      time_bank_s=1.0, threaded=request.param)  # fmt: skip
-    try:
-        yield conn, theirs
-    finally:
-        ours.close()
-        theirs.close()
+    with connection_pair(threaded=request.param) as both:
+        yield both
 
 
 def _answer(conn: Connection, theirs: socket.socket) -> None:
     request = pb.ActuatorRequests()
     request.motor_positions.add(name="HeadYaw", position=0.1)
-    theirs.sendall(encode_frame(request.SerializeToString()))
-    for _ in range(200):
-        if conn.read(time.monotonic()):
-            return
-        time.sleep(0.005)
-    raise AssertionError("the request did not arrive")
+    read_sent(conn, theirs, encode_frame(request.SerializeToString()))
 
 
 def test_the_round_trip_starts_when_the_measurement_is_written(

@@ -12,21 +12,14 @@ import pytest
 
 from simulator.api.connection import Connection
 from simulator.api.framing import HEADER
-from simulator.api.stats import RobotStats
+
+from .conftest import connection_pair
 
 
 @pytest.fixture
 def pair() -> Iterator[tuple[Connection, socket.socket]]:
-    ours, theirs = socket.socketpair()
-    ours.setblocking(False)
-    ours.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, 4096)  # a frame the socket cannot take
-    conn = Connection(sock=ours, peer="test", key="red 1", stats=RobotStats(), queue_limit=10,
-                      time_bank_s=1.0)  # fmt: skip
-    try:
-        yield conn, theirs
-    finally:
-        ours.close()
-        theirs.close()
+    with connection_pair(send_buffer=4096) as both:  # a frame the socket cannot take
+        yield both
 
 
 def _framed(fill: int, size: int) -> bytearray:
