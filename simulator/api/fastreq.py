@@ -61,25 +61,27 @@ class PositionTemplate:
         self._unpack = layout.unpack
         self.size = layout.size
 
-    def finite_values(self, frame: bytes) -> tuple[float, ...] | None:
-        """The targets of ``frame`` when it has this layout and all of them are finite, else
-        None: :meth:`match` without the objects, for a target board's span."""
-        if len(frame) != self.size:
-            return None
-        parts = self._unpack(frame)
-        if parts[0::2] != self._fixed:
-            return None
-        values: tuple[float, ...] = parts[1::2]
-        return values if math.isfinite(sum(values)) else None
-
-    def match(self, frame: bytes) -> PositionTargets | None:
+    def _values(self, frame: bytes) -> tuple[float, ...] | None:
         """The targets of ``frame`` when it has this layout, else None."""
         if len(frame) != self.size:
             return None
         parts = self._unpack(frame)
         if parts[0::2] != self._fixed:
             return None
-        values = parts[1::2]
+        values: tuple[float, ...] = parts[1::2]
+        return values
+
+    def finite_values(self, frame: bytes) -> tuple[float, ...] | None:
+        """The targets of ``frame`` when it has this layout and all of them are finite, else
+        None: :meth:`match` without the objects, for a target board's span."""
+        values = self._values(frame)
+        return values if values is not None and math.isfinite(sum(values)) else None
+
+    def match(self, frame: bytes) -> PositionTargets | None:
+        """The targets of ``frame`` when it has this layout, else None."""
+        values = self._values(frame)
+        if values is None:
+            return None
         # a sum that is finite has no NaN nor infinity (a huge one that overflows: checked later)
         finite = math.isfinite(sum(values))
         return PositionTargets(self.names, np.array(values, dtype=np.float64), finite)
