@@ -204,7 +204,7 @@ def test_official_matches_of_the_tournament_are_rated_once(
     from tournament import Ledger, run_schedule, standings
 
     path = write_schedule(tmp_path, COMPRESSED + "fixtures:\n  round_robin: {teams: [alpha, "
-                          "bravo, charlie], first_stream: '+1.5s', interval_s: 0.5, "
+                          "bravo, charlie], first_stream: '+4s', interval_s: 0.5, "
                           "stream_length_s: 0.3}\n")
     state = tmp_path / "state.sqlite"
     assert run_schedule(path, state, services=FAKE, exit_when_done=True, poll_s=0.1) == 0

@@ -213,7 +213,7 @@ def test_operators_read_the_tournament_schedule_and_standings(
 
     schedule = write_schedule(
         tmp_path, COMPRESSED + "fixtures:\n  round_robin: {teams: [alpha, bravo, charlie], "
-        "first_stream: '+2s', interval_s: 0.5, stream_length_s: 0.3}\n")
+        "first_stream: '+4s', interval_s: 0.5, stream_length_s: 0.3}\n")
     state = tmp_path / "state.sqlite"
     assert run_schedule(schedule, state, services=FAKE, exit_when_done=True, poll_s=0.1) == 0
     served = start(schedule_state=str(state))
