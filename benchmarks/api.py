@@ -105,6 +105,9 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--sensors", choices=("league", "ideal"), default="league",
                         help="league: sensor noise and camera model as in a match (default); "
                         "ideal: exact sensors and images")
+    parser.add_argument("--prefetch", choices=("on", "off"), default="on",
+                        help="lockstep and pipelined: the next step's position stage computed "
+                        "while the step waits for the answers (default on, as a match)")
     parser.add_argument("--json", action="store_true", help="print only the JSON line")
     return parser
 
@@ -542,7 +545,8 @@ def _api_run(
         clients = len(endpoints) - (last == "absent")
         while len(server.connected()) < clients and time.monotonic() < deadline:
             server.poll(0.05)
-        stepping = stepping_for(args.mode, server, lockstep)  # as a match's loop steps
+        stepping = stepping_for(args.mode, server, lockstep,  # as a match's loop steps
+                                prefetch=world.prefetch if args.prefetch == "on" else None)
 
         def one_step() -> None:
             stepping.before_step(world.sim_time_ms, world.sim_time_ms + world.step_ms)

@@ -121,7 +121,10 @@ class MatchLoop:
         self._next_poses_s = 0.0
         self._rtf_window: tuple[float, int] = (0.0, 0)
         self._rtf = 0.0
-        self.stepping = stepping_for(settings.stepping, server, settings.lockstep)
+        # the next step's position stage is computed while lockstep waits (a world without
+        # one, as the scenarios' kinematic world, computes each step whole)
+        self.stepping = stepping_for(settings.stepping, server, settings.lockstep,
+                                     prefetch=getattr(world, "prefetch", None))
 
     def request_stop(self, reason: str) -> None:
         self.stop_requested = True

@@ -24,6 +24,7 @@ game is over, a policy that :attr:`~Stepping.holds` stops stepping and the loop 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Protocol
 
 from contracts import RobotId
@@ -87,14 +88,22 @@ class AsyncStepping:
 
 
 class LockstepStepping:
+    """``prefetch`` (the world's :meth:`~simulator.world.World.prefetch`): called as the wait
+    for the answers begins, so that the next step's first position stage is computed
+    meanwhile."""
+
     holds = True
 
-    def __init__(self, server: ApiServer, settings: LockstepSettings) -> None:
+    def __init__(self, server: ApiServer, settings: LockstepSettings,
+                 prefetch: Callable[[], None] | None = None) -> None:
         self._server = server
         self._settings = settings
+        self._prefetch = prefetch
         self.waited_s = 0.0
 
     def before_step(self, time_ms: int, step_time_ms: int) -> None:
+        if self._prefetch is not None:
+            self._prefetch()
         self.waited_s += wait_lockstep(self._server, self._settings)
         self._server.apply_requests(step_time_ms)
 
@@ -117,13 +126,16 @@ class PipelinedStepping:
     answer to step N can be among them whatever the timing, and the answers to step N apply at
     step N+2 (lockstep: N+1). Right before a step the answers are taken and applied in one pass
     (:meth:`ApiServer.apply_requests`, before the measurement goes out: nothing can have
-    answered it yet); a send during a hold keeps them for the next step."""
+    answered it yet); a send during a hold keeps them for the next step. ``prefetch`` as for
+    :class:`LockstepStepping`: called once the measurement is read, when a step follows."""
 
     holds = True
 
-    def __init__(self, server: ApiServer, settings: LockstepSettings) -> None:
+    def __init__(self, server: ApiServer, settings: LockstepSettings,
+                 prefetch: Callable[[], None] | None = None) -> None:
         self._server = server
         self._settings = settings
+        self._prefetch = prefetch
         self._taken: dict[RobotId, list[Request]] = {}
         self.unsent = False  # the latest step's measurement is not sent yet
         self.waited_s = 0.0
@@ -134,6 +146,8 @@ class PipelinedStepping:
         ``step_time_ms`` (right before that step) the answers are applied at once."""
         server = self._server
         prepared = server.prepare(time_ms)
+        if step_time_ms is not None and self._prefetch is not None:
+            self._prefetch()
         self.waited_s += wait_lockstep(server, self._settings)
         if step_time_ms is not None and not self._taken:
             server.apply_requests(step_time_ms)  # takes what arrived and applies it
@@ -165,12 +179,14 @@ class PipelinedStepping:
             self._server.publish(time_ms)
 
 
-def stepping_for(mode: str, server: ApiServer, settings: LockstepSettings) -> Stepping:
-    """The policy of ``mode`` (one of :data:`STEPPINGS`)."""
+def stepping_for(mode: str, server: ApiServer, settings: LockstepSettings,
+                 prefetch: Callable[[], None] | None = None) -> Stepping:
+    """The policy of ``mode`` (one of :data:`STEPPINGS`); ``prefetch``: the world's
+    :meth:`~simulator.world.World.prefetch`, for the policies that wait for answers."""
     if mode == "pipelined":
-        return PipelinedStepping(server, settings)
+        return PipelinedStepping(server, settings, prefetch)
     if mode == "lockstep":
-        return LockstepStepping(server, settings)
+        return LockstepStepping(server, settings, prefetch)
     if mode == "async":
         return AsyncStepping(server)
     raise ValueError(f"stepping {mode!r}: expected one of {', '.join(STEPPINGS)}")

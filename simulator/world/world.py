@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import logging
 import math
+import weakref
 from collections.abc import Sequence
 
 import mujoco
@@ -34,6 +35,7 @@ from simulator.world.flat import FlatData
 from simulator.world.indices import build_index
 from simulator.world.look import look_for
 from simulator.world.motors import MotorBank
+from simulator.world.prefetch import PositionStage
 from simulator.world.robots import robot_model
 from simulator.world.scene import compile_scene
 from simulator.world.sensor_noise import SensorModel, SensorNoise
@@ -113,6 +115,7 @@ class World(DeviceAccess):
         self._snapshots = SnapshotBuilder(self.data, self.index, self.robot_ids)
         self._ball_toucher = BallToucher(self.data, self.index)
         self._saved = self._save()
+        self._stage: PositionStage | None = None
 
     def _stand_robots(self, initial_joint_noise_rad: float) -> None:
         """Every robot's joints and servo targets in its standing pose, each joint moved by up
@@ -224,8 +227,32 @@ class World(DeviceAccess):
 
     # --- stepping ------------------------------------------------------------------------------
 
+    def prefetch(self) -> None:
+        """Begin the next step's first ``mj_step1`` on a worker thread while the caller waits
+        (lockstep, for its clients' answers); :meth:`step` finishes it. Nothing but device
+        readings and motor targets may be used until then (:meth:`snapshot` and :meth:`apply`
+        finish it first). Only with two substeps or more: the first runs without sensors, so
+        the readings the robots are sent stay as they are (:mod:`simulator.world.prefetch`)."""
+        if self.substeps < 2:
+            return
+        if self._stage is None:
+            self._stage = PositionStage(self.model, self.data)
+            weakref.finalize(self, self._stage.close)
+        self._opt.disableflags |= _SENSOR_OFF
+        self._stage.start()
+
+    def _settle(self) -> bool:
+        """Finish a prefetched stage (and turn the sensors back on); True when the data holds
+        ``mj_step1`` of the state."""
+        if self._stage is None:
+            return False
+        done = self._stage.finish()
+        self._opt.disableflags &= ~_SENSOR_OFF
+        return done
+
     def step(self) -> None:
         """Advance one basic step (``step_ms`` of simulated time)."""
+        prefetched = self._settle()
         if self.divergence_policy == "reset_robot":
             self._saved = self._save()
         self.motors.apply(self.data)
@@ -233,7 +260,12 @@ class World(DeviceAccess):
             # Sensors are read once per basic step: skip them in all but the last substep.
             opt = self._opt
             opt.disableflags |= _SENSOR_OFF
-            mujoco.mj_step(self.model, self.data, nstep=self.substeps - 1)
+            rest = self.substeps - 1
+            if prefetched:  # the first substep's mj_step1 is done: its mj_step2 (the actuation)
+                mujoco.mj_step2(self.model, self.data)
+                rest -= 1
+            if rest:
+                mujoco.mj_step(self.model, self.data, nstep=rest)
             opt.disableflags &= ~_SENSOR_OFF
         mujoco.mj_step(self.model, self.data)
         if self.parked_qpos:
@@ -250,6 +282,7 @@ class World(DeviceAccess):
             self.last_ball_touch_ms = self.sim_time_ms
 
     def snapshot(self) -> WorldSnapshot:
+        self._settle()
         return self._snapshots.build(
             sim_time_ms=self.sim_time_ms,
             limp=self.limp,
@@ -260,6 +293,7 @@ class World(DeviceAccess):
 
     def apply(self, command: WorldCommand) -> None:
         """Apply a referee command now (before the next step)."""
+        self._settle()
         commands.apply(self, command)
 
     # --- divergence ----------------------------------------------------------------------------

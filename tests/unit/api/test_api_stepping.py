@@ -150,3 +150,22 @@ def test_stepping_for_names_each_policy() -> None:
     assert isinstance(stepping_for("pipelined", server, SETTINGS), PipelinedStepping)  # type: ignore[arg-type]
     with pytest.raises(ValueError, match="async, lockstep, pipelined"):
         stepping_for("free", server, SETTINGS)  # type: ignore[arg-type]
+
+
+def test_the_waiting_policies_prefetch_the_next_step_only_when_a_step_follows() -> None:
+    """Lockstep begins the next step's position stage as its wait begins; pipelined once the
+    measurement is read, and only when a step follows (a hold's send computes nothing)."""
+    for cls in (LockstepStepping, PipelinedStepping):
+        server = _Server()
+        marks: list[int] = []
+        stepping = cls(server, SETTINGS, prefetch=lambda s=server, m=marks: m.append(
+            len(s.calls)))  # type: ignore[arg-type, misc]
+        time_ms = _steps(stepping, 3)
+        stepping.hold(time_ms, finished=False)
+        if cls is LockstepStepping:  # before each step's wait and its answers taken
+            assert marks == [0, 2, 4] and server.calls[0] == ("take+apply", 8)
+        else:  # the first step sends nothing; then before the wait that precedes each send
+            assert [server.calls[m] for m in marks] == [("take+apply", 16), ("take+apply", 24)]
+    server = _Server()
+    assert stepping_for("lockstep", server, SETTINGS,  # type: ignore[arg-type]
+                        prefetch=lambda: None)._prefetch is not None  # type: ignore[attr-defined]
