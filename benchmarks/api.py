@@ -106,8 +106,8 @@ def _parser() -> argparse.ArgumentParser:
                         help="league: sensor noise and camera model as in a match (default); "
                         "ideal: exact sensors and images")
     parser.add_argument("--prefetch", choices=("on", "off"), default="on",
-                        help="lockstep and pipelined: the next step's position stage computed "
-                        "while the step waits for the answers (default on, as a match)")
+                        help="lockstep: the next step's position stage computed while the step "
+                        "waits for the answers (default on, as a match)")
     parser.add_argument("--json", action="store_true", help="print only the JSON line")
     return parser
 

@@ -126,16 +126,15 @@ class PipelinedStepping:
     answer to step N can be among them whatever the timing, and the answers to step N apply at
     step N+2 (lockstep: N+1). Right before a step the answers are taken and applied in one pass
     (:meth:`ApiServer.apply_requests`, before the measurement goes out: nothing can have
-    answered it yet); a send during a hold keeps them for the next step. ``prefetch`` as for
-    :class:`LockstepStepping`: called once the measurement is read, when a step follows."""
+    answered it yet); a send during a hold keeps them for the next step. No prefetch (as
+    :class:`LockstepStepping` has): its wait is short, and the worker took the CPU its clients
+    think on during the step (README, performance)."""
 
     holds = True
 
-    def __init__(self, server: ApiServer, settings: LockstepSettings,
-                 prefetch: Callable[[], None] | None = None) -> None:
+    def __init__(self, server: ApiServer, settings: LockstepSettings) -> None:
         self._server = server
         self._settings = settings
-        self._prefetch = prefetch
         self._taken: dict[RobotId, list[Request]] = {}
         self.unsent = False  # the latest step's measurement is not sent yet
         self.waited_s = 0.0
@@ -146,8 +145,6 @@ class PipelinedStepping:
         ``step_time_ms`` (right before that step) the answers are applied at once."""
         server = self._server
         prepared = server.prepare(time_ms)
-        if step_time_ms is not None and self._prefetch is not None:
-            self._prefetch()
         self.waited_s += wait_lockstep(server, self._settings)
         if step_time_ms is not None and not self._taken:
             server.apply_requests(step_time_ms)  # takes what arrived and applies it
@@ -182,9 +179,9 @@ class PipelinedStepping:
 def stepping_for(mode: str, server: ApiServer, settings: LockstepSettings,
                  prefetch: Callable[[], None] | None = None) -> Stepping:
     """The policy of ``mode`` (one of :data:`STEPPINGS`); ``prefetch``: the world's
-    :meth:`~simulator.world.World.prefetch`, for the policies that wait for answers."""
+    :meth:`~simulator.world.World.prefetch`, used by lockstep."""
     if mode == "pipelined":
-        return PipelinedStepping(server, settings, prefetch)
+        return PipelinedStepping(server, settings)
     if mode == "lockstep":
         return LockstepStepping(server, settings, prefetch)
     if mode == "async":

@@ -152,20 +152,17 @@ def test_stepping_for_names_each_policy() -> None:
         stepping_for("free", server, SETTINGS)  # type: ignore[arg-type]
 
 
-def test_the_waiting_policies_prefetch_the_next_step_only_when_a_step_follows() -> None:
-    """Lockstep begins the next step's position stage as its wait begins; pipelined once the
-    measurement is read, and only when a step follows (a hold's send computes nothing)."""
-    for cls in (LockstepStepping, PipelinedStepping):
-        server = _Server()
-        marks: list[int] = []
-        stepping = cls(server, SETTINGS, prefetch=lambda s=server, m=marks: m.append(
-            len(s.calls)))  # type: ignore[arg-type, misc]
-        time_ms = _steps(stepping, 3)
-        stepping.hold(time_ms, finished=False)
-        if cls is LockstepStepping:  # before each step's wait and its answers taken
-            assert marks == [0, 2, 4] and server.calls[0] == ("take+apply", 8)
-        else:  # the first step sends nothing; then before the wait that precedes each send
-            assert [server.calls[m] for m in marks] == [("take+apply", 16), ("take+apply", 24)]
+def test_lockstep_prefetches_the_next_step_as_its_wait_begins() -> None:
+    """Lockstep begins the next step's position stage before its wait and the answers taken;
+    pipelined (whose wait is short) is given none."""
     server = _Server()
-    assert stepping_for("lockstep", server, SETTINGS,  # type: ignore[arg-type]
-                        prefetch=lambda: None)._prefetch is not None  # type: ignore[attr-defined]
+    marks: list[int] = []
+    stepping = stepping_for("lockstep", server, SETTINGS,  # type: ignore[arg-type]
+                            prefetch=lambda: marks.append(len(server.calls)))
+    time_ms = _steps(stepping, 3)
+    stepping.hold(time_ms, finished=False)  # a hold computes nothing ahead
+    assert marks == [0, 2, 4] and server.calls[0] == ("take+apply", 8)
+    pipelined = stepping_for("pipelined", _Server(), SETTINGS,  # type: ignore[arg-type]
+                             prefetch=lambda: marks.append(-1))
+    _steps(pipelined, 3)
+    assert -1 not in marks
