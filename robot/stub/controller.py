@@ -31,7 +31,7 @@ from robot.motion.keyframes import Keyframe, KeyframeMotion
 from robot.motion.posture import standing_posture
 from robot.motion.walk import default_walk_params
 from robot.stub.behaviour import Action, Field, GameInfo, Role, decide
-from robot.stub.learned_kick import LearnedKick
+from robot.stub.learned_kick import SHOT_RANGE_M, KickChoice, LearnedKick
 from robot.stub.perception import (
     BallSighting,
     CameraPose,
@@ -163,13 +163,12 @@ class StubController:
         # robot, whose camera sits higher, jumps by more while it sways
         self._size = self.kin.leg.thigh_m / KID_THIGH_M
         self.kick_policy = kick_policy
-        if kick_policy is not None:
-            self.field = replace(
-                self.field,
-                foot_y_m=self.kin.leg.hip_offset_y_m + walk.foot_y_offset_m,
-                kick_x_m=kick_ball_offset(model)[0],
-                kick_feet=("right",),
-            )
+        learned = self.field if kick_policy is None else replace(  # right foot, policy's spot
+            self.field, foot_y_m=self.kin.leg.hip_offset_y_m + walk.foot_y_offset_m,
+            kick_x_m=kick_ball_offset(model)[0], kick_feet=("right",))  # fmt: skip
+        self._kick_choice = KickChoice(keyframe=self.field, learned=learned, range_m=None
+                                       if kick_policy is None else SHOT_RANGE_M.get(model))
+        self.field = self._kick_choice.field
         self._last_ms: int | None = None
         self._settle_until_ms: int | None = None
         self._rise_pending = True  # look whether the legs are far from the stance
@@ -308,6 +307,7 @@ class StubController:
         if self._side.running and not game.penalised:
             if sensors.time_ms >= self._settle_until_ms:
                 return self._remember(self._side_check(dt, sensors))
+        self.field = self._kick_choice.update(ball and self.world.pose.to_field(*ball))
         action = decide(
             role=self.role,
             game=game,
@@ -369,7 +369,7 @@ class StubController:
         has one; else the keyframe kick); its first targets."""
         self.stats.kicks += 1
         kick: KeyframeMotion | LearnedKick
-        if self.kick_policy is not None and foot == "right":
+        if self.kick_policy is not None and foot == "right" and self._kick_choice.learned:
             self.stats.learned_kicks += 1
             logger.info("kicking with the learned policy (%s)", self.kick_policy.skill)
             kick = LearnedKick(self.kick_policy, start=self._last_targets,

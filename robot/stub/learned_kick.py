@@ -18,11 +18,13 @@ gains until the policy has played and for the stub's own for the recovery
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 
 from robot.learned import LEARNT_SERVO_PID, Policy, PolicyMotion
 from robot.motion import SERVO_PID
 from robot.motion.keyframes import Keyframe, KeyframeMotion
+from robot.stub.behaviour import Field
 
 PREPARE_S = 0.3  # ease into the stance the policy learnt from (the head straight)
 HOLD_S = 0.2  # ... and hold it
@@ -40,6 +42,16 @@ RISEN_HOLD_S = 0.5
 # whole episode fell in 14, the policy's first 0.7 s in 2 (the ball 1.61 m against 1.47).
 PLAY_S = 0.7
 RECOVER_S = 0.3  # after the policy, ease back into the stance
+# A model whose learned kick is a shot only: the striker plays it with the ball within this
+# distance of the opponent goal's centre and the keyframe kick (both feet) farther out; a model
+# not listed plays the learned kick anywhere (kid-default). The adult policy rolls the ball
+# about 1.6 m where the adult keyframe kick rolls it 3-4 m: played everywhere, red's learned
+# kicks were clearances from its kick-off and it reached the goal rarely (0 of 8 scrimmages
+# scored); in-process shots 2 to 4 m from the goal scored in 8 of 14.
+SHOT_RANGE_M: dict[str, float] = {"adult-default": 4.0}
+# once lined up for the learned kick, the ball must be this much farther out to go back to the
+# keyframe kick (the ball estimate jitters while lining up; switching feet would start again)
+SHOT_RANGE_MARGIN_M = 0.4
 
 
 def handover_s(rise_s: float) -> tuple[float, float]:
@@ -113,12 +125,54 @@ class LearnedKick:
         return dict(self._last)
 
 
+def in_shot_range(
+    ball_field: tuple[float, float], half_length_m: float, range_m: float | None, *,
+    now: bool,
+) -> bool:  # fmt: skip
+    """Whether the learned kick is the one to line up for, the ball at ``ball_field`` (the
+    team's frame: the opponent goal at ``+half_length_m``), ``now`` whether it is already:
+    within ``range_m`` of the goal's centre, or within :data:`SHOT_RANGE_MARGIN_M` more when it
+    is already; anywhere for ``range_m`` None."""
+    if range_m is None:
+        return True
+    distance = math.hypot(half_length_m - ball_field[0], ball_field[1])
+    return distance < range_m + (SHOT_RANGE_MARGIN_M if now else 0.0)
+
+
+class KickChoice:
+    """The striker's kick with a learned policy: the field it lines the ball up with
+    (:attr:`field`: the learned kick's spot and right foot, or the keyframe kick's) and whether
+    a kick now is the learned one (:attr:`learned`), chosen by :func:`in_shot_range`."""
+
+    def __init__(self, *, keyframe: Field, learned: Field, range_m: float | None) -> None:
+        self._keyframe = keyframe
+        self._learned = learned
+        self.range_m = range_m
+        # a model with a range starts at its kick-off, far from the goal
+        self.learned = range_m is None
+
+    @property
+    def field(self) -> Field:
+        return self._learned if self.learned else self._keyframe
+
+    def update(self, ball_field: tuple[float, float] | None) -> Field:
+        """The ball seen at ``ball_field`` (None: not seen, the choice kept); the field now."""
+        if ball_field is not None:
+            self.learned = in_shot_range(ball_field, self._keyframe.half_length_m,
+                                         self.range_m, now=self.learned)  # fmt: skip
+        return self.field
+
+
 __all__ = [
     "HOLD_S",
     "PLAY_S",
     "PREPARE_S",
     "RECOVER_S",
     "RISEN_HOLD_S",
+    "SHOT_RANGE_M",
+    "SHOT_RANGE_MARGIN_M",
+    "KickChoice",
     "LearnedKick",
     "handover_s",
+    "in_shot_range",
 ]

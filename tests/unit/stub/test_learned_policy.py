@@ -36,8 +36,11 @@ from robot.stub.learned_kick import (
     PREPARE_S,
     RECOVER_S,
     RISEN_HOLD_S,
+    SHOT_RANGE_M,
+    SHOT_RANGE_MARGIN_M,
     LearnedKick,
     handover_s,
+    in_shot_range,
 )
 from robot.stub.runner import _kick_policy
 
@@ -119,9 +122,11 @@ def test_stub_with_a_kick_policy_lines_up_for_the_right_foot(tmp_path: Path) -> 
                                 kick_policy=policy)
     assert controller.field.kick_x_m == KICK_BALL_AHEAD_M
     assert controller.field.kick_feet == ("right",)
-    # adult-default lines the ball up where hlvs/StandKick-v0 puts it for that model
+    # adult-default lines the ball up where hlvs/StandKick-v0 puts it for that model (near the
+    # goal: its learned kick is a shot, test_the_adult_learned_kick_is_a_shot)
     adult = StubController(role=Role.STRIKER, start_pose=Pose(x_m=0, y_m=0, yaw_rad=0),
                            model="adult-default", field_class="adult", kick_policy=policy)
+    adult.field = adult._kick_choice.update((6.0, 0.0))
     ahead, right = kick_ball_offset("adult-default")
     assert adult.field.kick_x_m == ahead > KICK_BALL_AHEAD_M
     assert adult.field.foot_y_m == pytest.approx(right)
@@ -206,6 +211,7 @@ def test_a_rising_model_is_handed_over_to_the_policy_as_the_environment_started_
                            model="adult-default", field_class="adult",
                            kick_policy=make_policy())  # fmt: skip
     assert adult.kin.rise_s == 1.0
+    adult._kick_choice.update((6.0, 0.0))  # the ball 1 m from the goal: a learned shot
     adult._kick(0.008, Sensors(time_ms=0, joints={}), "right", None)
     assert isinstance(adult._motion, LearnedKick)
     assert adult._motion._prepare.duration_s == pytest.approx(1.0 + RISEN_HOLD_S)
@@ -234,3 +240,50 @@ def test_a_right_footed_kick_off_striker_places_the_ball_at_its_right_foot() -> 
         ahead, left = c * -spot.x_m + s * -spot.y_m, -s * -spot.x_m + c * -spot.y_m  # the ball
         assert ahead == pytest.approx(KICK_BALL_AHEAD_M + KICK_OFF_SHORT_M)
         assert left == pytest.approx(side * 0.075)
+
+
+def test_the_adult_learned_kick_is_a_shot() -> None:
+    """adult-default plays its learned kick within SHOT_RANGE_M of the opponent goal and the
+    keyframe kick (either foot, at its own kick spot) farther out; kid-default plays it
+    anywhere. Once lined up for the learned kick it keeps to it up to the margin beyond."""
+    range_m = SHOT_RANGE_M["adult-default"]
+    assert in_shot_range((7.0 - range_m + 0.1, 0.0), 7.0, range_m, now=False)
+    assert not in_shot_range((7.0 - range_m - 0.1, 0.0), 7.0, range_m, now=False)
+    assert not in_shot_range((6.0, range_m), 7.0, range_m, now=False)  # beside the goal, far
+    assert in_shot_range((7.0 - range_m - 0.1, 0.0), 7.0, range_m, now=True)  # the margin
+    beyond = 7.0 - range_m - SHOT_RANGE_MARGIN_M - 0.1
+    assert not in_shot_range((beyond, 0.0), 7.0, range_m, now=True)
+    assert in_shot_range((-4.0, 0.0), 7.0, None, now=False)  # no range: anywhere
+    assert "kid-default" not in SHOT_RANGE_M
+
+    at = Pose(x_m=0.0, y_m=0.0, yaw_rad=0.0)
+    game = GameInfo(phase=GameState.PLAYING, our_kick_off=False)
+    adult = StubController(role=Role.STRIKER, start_pose=at, model="adult-default",
+                           field_class="adult", kick_policy=make_policy())  # fmt: skip
+    keyframe_field = adult.field
+    assert keyframe_field.kick_feet == ("left", "right")  # at its kick-off, far from the goal
+    ahead, right = kick_ball_offset("adult-default")
+    # the ball this far beyond the range from the goal's centre, in this order
+    for beyond, learned in ((2.0, False), (0.2, False), (-0.5, True), (0.2, True),
+                            (SHOT_RANGE_MARGIN_M + 0.1, False)):  # fmt: skip
+        adult.field = adult._kick_choice.update((7.0 - range_m - beyond, 0.0))
+        assert adult._kick_choice.learned is learned, beyond
+        assert (adult.field.kick_x_m == ahead) is learned
+        adult._kick(0.008, Sensors(time_ms=0, joints={}), "right", None)
+        assert isinstance(adult._motion, LearnedKick) is learned, beyond
+        adult._motion = None
+    # far out, a ball in front of the left foot is kicked with it (the keyframe kick) ...
+    left_ball = (keyframe_field.kick_x_m, keyframe_field.foot_y_m)
+    far = decide(role=Role.STRIKER, game=game, pose=at, ball=left_ball, field=adult.field,
+                 searching_s=0.0)  # fmt: skip
+    assert far.kick_foot == "left"
+    # ... near the goal the striker lines it up for the learned right-foot kick instead
+    near_pose = Pose(x_m=5.0, y_m=0.0, yaw_rad=0.0)
+    adult.field = adult._kick_choice.update(near_pose.to_field(*left_ball))
+    near = decide(role=Role.STRIKER, game=game, pose=near_pose, ball=left_ball,
+                  field=adult.field, searching_s=0.0)  # fmt: skip
+    assert near.kick_foot is None and near.walk[1] > 0  # side-steps to its left
+    # kid-default: the learned kick everywhere, from its kick-off on
+    kid = StubController(role=Role.STRIKER, start_pose=at, kick_policy=make_policy())
+    assert kid._kick_choice.learned and kid.field.kick_feet == ("right",)
+    assert kid._kick_choice.update((-4.0, 0.0)).kick_feet == ("right",)
