@@ -105,9 +105,9 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--sensors", choices=("league", "ideal"), default="league",
                         help="league: sensor noise and camera model as in a match (default); "
                         "ideal: exact sensors and images")
-    parser.add_argument("--prefetch", choices=("on", "off"), default="on",
-                        help="lockstep: the next step's position stage computed while the step "
-                        "waits for the answers (default on, as a match)")
+    parser.add_argument("--prefetch", choices=("on", "off"), default="off",
+                        help="lockstep: the next step's position stage computed on a worker "
+                        "thread while the step waits for the answers (default off, as a match)")
     parser.add_argument("--json", action="store_true", help="print only the JSON line")
     return parser
 
