@@ -11,7 +11,10 @@ both runs. ``--client league`` runs clients written like the league's own test c
 request's length and body in two writes, no ``TCP_NODELAY``: :mod:`testkit.league_client`) and
 reports their requests per second and round trips seen from both ends (``league_client``).
 ``--client one-process`` serves every robot from one client process
-(:mod:`benchmarks.api_clients`) instead of one process per robot.
+(:mod:`benchmarks.api_clients`) instead of one process per robot. ``--native`` runs the bench
+or league clients as compiled code (:mod:`benchmarks.native_clients`), which the report's
+lockstep runs use: Python clients sharing the bench machine's CPUs hold a lockstep server back
+by their own cost.
 ``--flood`` adds two runs, the last robot standing without a client and then flooding its port
 with small valid requests, and reports the other robots' real-time factor and round trip with
 the flood against without (``flood``).
@@ -31,13 +34,15 @@ import multiprocessing as mp
 import os
 import socket
 import sys
+import tempfile
 import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 # imported here, before the clients fork: a forked child importing it could wait forever on an
 # import lock that one of the server's threads held at the fork
-from benchmarks import api_clients
+from benchmarks import api_clients, native_clients
 from contracts.ids import TeamColor
 from testkit.figures import FLOOD_TARGET, TARGETS, judged
 
@@ -81,6 +86,11 @@ def _parser() -> argparse.ArgumentParser:
         "(default); one-process: the same, every robot's client in one process; league: "
         "written like the league's test client (length and body in two writes, no "
         "TCP_NODELAY, one process per robot)",
+    )
+    parser.add_argument(
+        "--native", action="store_true",
+        help="--client bench or league: the clients compiled from C (built once with the "
+        "machine's C compiler), so that their own cost holds the server back less",
     )
     parser.add_argument(
         "--think-ms", type=float, default=0.0,
@@ -511,7 +521,17 @@ def _api_run(
     reports = []  # the league clients' figures, sent when the server closes
     procs = []
     together: list[tuple[int, int]] = []  # (port, camera period) of --client one-process
+    natives = []  # --native: the compiled clients
     for i, e in enumerate(endpoints):
+        if args.native_frames is not None and e.robot != stalled_robot and (
+            not last or e.robot != robots[-1]
+        ):
+            camera_period = camera[2] if camera and i < camera_robots else 0
+            natives.append(native_clients.start(
+                args.native_program, e.port, args.native_frames[camera_period],
+                "league" if args.client == "league" else "framed", args.client_cpus,
+            ))  # fmt: skip
+            continue
         if last and e.robot == robots[-1]:
             if last == "flood":
                 procs.append(ctx.Process(target=_flood_client, args=(e.port, args.client_cpus),
@@ -606,6 +626,12 @@ def _api_run(
         for proc in procs:
             proc.kill()
             proc.join(timeout=5)
+        for native in natives:  # each ends when the server closes its socket
+            try:
+                native.communicate(timeout=10)
+            except Exception:
+                native.kill()
+                native.communicate()
     rtts = [s["round_trip_ms"]["p50"] for s in stats.values() if s["round_trip_ms"]["p50"]]
     replies = sorted(s["reply_ms"]["p50"] for s in stats.values() if s["reply_ms"]["p50"])
     last_key = robots[-1].key
@@ -618,7 +644,7 @@ def _api_run(
             return round(values[len(values) // 2] * 1000.0, 3) if values else None
 
         league_client = {
-            "clients": len(reports),
+            "clients": len(reports) or len(natives),
             "reported": len(league),
             "think_ms": args.think_ms,
             # requests the server received per second of the API run's wall time
@@ -638,7 +664,14 @@ def _api_run(
         # the server's figure over the client's: 1 when the server sees the wait the client has
         league_client["server_over_client"] = (
             round(server_wait / client_wait, 3) if client_wait and server_wait else None)
+    messages_out = sum(s["messages_out"] for s in stats.values())
     return {
+        # what the lockstep floor is given (--native): the reference world's wall time a step
+        # and the measurements' mean body size
+        "reference_step_us": ref_wall / steps * 1e6 if ref_wall else None,
+        "measurement_bytes": round(sum(s["bytes_out"] for s in stats.values()) / messages_out)
+        - 4 if messages_out else None,
+        "steps": steps,
         "honest_round_trip_p50_ms": round(sorted(honest)[len(honest) // 2], 3) if honest else None,
         "last_robot": stats.get(last_key),
         "league_client": league_client,
@@ -715,9 +748,60 @@ def main(argv: list[str]) -> int:
     if not args.shared_cpus and camera is None and len(available) >= 2:
         os.sched_setaffinity(0, {available[0]})  # this (the step) thread only
         args.client_cpus = frozenset(available[1:])
-    world_rtf, world_cpu = _world_only(
-        robots, args.physics_dt, min(args.sim_seconds, 10.0), args.sensors
-    )
+    with tempfile.TemporaryDirectory(prefix="hlvs-bench-api-") as work:
+        args.native_frames = _native_frames(args, camera, Path(work))
+        world_rtf, world_cpu = _world_only(
+            robots, args.physics_dt, min(args.sim_seconds, 10.0), args.sensors
+        )
+        result = _measure(args, camera, robots, world_rtf, world_cpu)
+    print(json.dumps(result, sort_keys=True), flush=True)
+    return 0
+
+
+def _native_frames(
+    args: argparse.Namespace, camera: tuple[int, int, int] | None, work: Path
+) -> dict[int, Path] | None:
+    """``--native``: the compiled client (built now if needed) and its frames files in ``work``,
+    by camera period; None without ``--native``."""
+    if not args.native:
+        return None
+    if args.client not in ("bench", "league"):
+        raise SystemExit(f"--native: runs --client bench or league, not {args.client}")
+    from simulator.api.framing import WELCOME
+
+    args.native_program = native_clients.binary()
+    frames = {}
+    for period in {0, camera[2] if camera else 0}:
+        folder = work / str(period)
+        folder.mkdir()
+        frames[period] = native_clients.frames_file(
+            folder, WELCOME, _frame(_enable(period)), _answers()
+        )
+    return frames
+
+
+def _lockstep_floor(args: argparse.Namespace, api: dict[str, Any]) -> dict[str, Any]:
+    """``--native`` lockstep: the serial floor on this machine with the same clients
+    (:func:`benchmarks.native_clients.lockstep_floor`), its server on the step thread's CPU,
+    a busy loop of the reference world's step; ``of_floor``: the API run's interleaved ratio
+    over the floor's."""
+    step_cpus = sorted(os.sched_getaffinity(0))
+    floor = native_clients.lockstep_floor(
+        args.native_frames[0], "league" if args.client == "league" else "framed",
+        robots=args.robots, step_us=api["reference_step_us"],
+        measurement_bytes=api["measurement_bytes"], steps=api["steps"],
+        server_cpu=step_cpus[0] if args.client_cpus else None, client_cpus=args.client_cpus,
+    )  # fmt: skip
+    if "ratio" in floor and api["ratio_interleaved"]:
+        floor["of_floor"] = round(api["ratio_interleaved"] / floor["ratio"], 3)
+    return floor
+
+
+def _measure(
+    args: argparse.Namespace, camera: tuple[int, int, int] | None, robots: list[RobotId],
+    world_rtf: float, world_cpu: float,
+) -> dict[str, Any]:
+    """The API runs asked for, and their figures against the world's alone."""
     api = _api_run(args, camera, stalled=False)
     result: dict[str, Any] = {
         "bench": "api",
@@ -754,7 +838,10 @@ def main(argv: list[str]) -> int:
         "step_thread_cpus": sorted(os.sched_getaffinity(0)),
         "client_cpus": sorted(args.client_cpus) or "shared",
         "client": args.client,
+        "native_clients": args.native,
     }
+    if args.native_frames is not None and args.mode == "lockstep" and api["reference_step_us"]:
+        result["lockstep_floor"] = _lockstep_floor(args, api)
     if api["league_client"] is not None:  # judged against the mode's target, as the report does
         league = dict(api["league_client"], ratio_interleaved=api["ratio_interleaved"])
         league.update(judged(TARGETS[args.mode], league))
@@ -778,8 +865,7 @@ def main(argv: list[str]) -> int:
         flood = _flood_figures(args, camera)
         flood.update(judged(FLOOD_TARGET, flood))
         result["flood"] = flood
-    print(json.dumps(result, sort_keys=True), flush=True)
-    return 0
+    return result
 
 
 if __name__ == "__main__":

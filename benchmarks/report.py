@@ -15,6 +15,10 @@ kind alike), each benchmark as a child process with small sizes:
   clients written like the league's own (each request's length and body in two writes, no
   ``TCP_NODELAY``: :mod:`testkit.league_client`), and their requests per second and round
   trips; judged against the lockstep target;
+- ``lockstep`` and ``lockstep_league`` run compiled clients (``bench api --native``) when the
+  machine has a C compiler (``native_clients`` says which ran), and with them the serial floor
+  of lockstep on this machine (``floor_ratio``: a C server stepping a busy loop as long as the
+  world's step with the same clients; ``of_floor``: the API run's ratio over it);
 - ``cameras``: ``bench api --mode async`` with every robot's camera at 320x240 every 32 ms,
   rendered as a match renders them (``render_processes``: worker processes on the CPU
   renderer, one per CPU; 0: one thread) (the real-time factor is the figure: rendering is most
@@ -49,6 +53,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+from benchmarks import native_clients
 from contracts import files
 from testkit.figures import (
     MACHINE_SCALED,
@@ -124,6 +129,9 @@ def _api_figures(result: dict[str, Any]) -> dict[str, Any]:
         "client_wait_share": result.get("client_wait_share"),
         "round_trip_p50_ms": result.get("round_trip_p50_ms"),
         "slow_periods": result.get("slow_periods"),
+        "native_clients": result.get("native_clients"),
+        "floor_ratio": (result.get("lockstep_floor") or {}).get("ratio"),
+        "of_floor": (result.get("lockstep_floor") or {}).get("of_floor"),
     }
 
 
@@ -132,15 +140,21 @@ def _runners(args: argparse.Namespace) -> dict[str, Callable[[], dict[str, Any]]
     sim_s = str(args.sim_seconds)
     api = ["-m", "benchmarks", "api", "--robots", robots, "--json"]
 
+    # lockstep's clients compiled when a C compiler is here (their own cost on the bench
+    # machine's CPUs holds a lockstep server back): see benchmarks.native_clients
+    native = ["--native"] if native_clients.compiler() else []
+
     def api_mode(mode: str) -> Callable[[], dict[str, Any]]:
+        extra = native if mode == "lockstep" else []
+
         def run() -> dict[str, Any]:
-            result = _child([*api, "--mode", mode, "--sim-seconds", sim_s], 600)
+            result = _child([*api, "--mode", mode, *extra, "--sim-seconds", sim_s], 600)
             return result if "error" in result else _api_figures(result)
 
         return run
 
     def lockstep_league() -> dict[str, Any]:
-        result = _child([*api, "--mode", "lockstep", "--client", "league",
+        result = _child([*api, "--mode", "lockstep", "--client", "league", *native,
                          "--sim-seconds", sim_s], 600)  # fmt: skip
         if "error" in result:
             return result

@@ -3,7 +3,7 @@
 set -euo pipefail
 need=()
 have() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "ok installed"; }
-for pkg in docker.io docker-compose docker-registry apache2-utils mmdebstrap libosmesa6 ffmpeg openssh-server iproute2 postgresql chromium; do
+for pkg in docker.io docker-compose docker-registry apache2-utils mmdebstrap libosmesa6 ffmpeg openssh-server iproute2 postgresql chromium gcc libc6-dev; do
   have "$pkg" || need+=("$pkg")
 done
 if [ ${#need[@]} -eq 0 ]; then

@@ -98,3 +98,41 @@ def test_bench_api_clients_in_one_process_answer_every_robot() -> None:
     assert result["round_trip_p50_ms"] is not None
     interleaved = result["ratio_interleaved"]
     assert isinstance(interleaved, float) and interleaved > 0
+
+
+def test_bench_api_native_clients_and_the_lockstep_floor() -> None:
+    result = _bench("--mode", "lockstep", "--native", "--sim-seconds", "0.5")
+    assert result["native_clients"] is True and result["client"] == "bench"
+    assert result["slow_periods"] == 0 and result["dropped_in"] == 0  # every step answered
+    assert result["round_trip_p50_ms"] is not None
+    floor = result["lockstep_floor"]
+    assert isinstance(floor, dict), floor
+    assert floor["clients"] == 2 and floor["steps"] > 0
+    assert 0 < floor["ratio"] <= 1
+    assert floor["measurement_bytes"] > 100  # the API run's measurements, not a token size
+    assert floor["of_floor"] == pytest.approx(result["ratio_interleaved"] / floor["ratio"],
+                                              abs=0.01)  # fmt: skip
+
+
+def test_bench_api_native_league_clients_meet_no_delayed_ack_stall() -> None:
+    """Compiled clients written like the league's (length and body in two writes, no
+    TCP_NODELAY) against the API server and against the floor: a 40 ms delayed-ACK stall a
+    step would put either far below these figures."""
+    result = _bench("--mode", "lockstep", "--client", "league", "--native", "--sim-seconds", "0.5")
+    league = result["league_client"]
+    assert isinstance(league, dict) and league["clients"] == 2
+    steps_per_s = float(result["real_time_factor"]) * 1000.0 / 8  # type: ignore[arg-type]
+    assert league["requests_per_s"] == pytest.approx(2 * steps_per_s, rel=0.15)
+    assert league["round_trip_p50_ms"] < 20
+    floor = result["lockstep_floor"]
+    assert isinstance(floor, dict) and floor["wait_us_per_step"] < 20_000, floor
+
+
+def test_bench_api_native_refuses_the_one_process_client() -> None:
+    proc = subprocess.run(
+        [sys.executable, "-m", "benchmarks", "api", "--client", "one-process", "--native",
+         "--json"],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert proc.returncode != 0
+    assert "--native: runs --client bench or league, not one-process" in proc.stderr
