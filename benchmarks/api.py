@@ -622,16 +622,13 @@ def _api_run(
     finally:
         server.close()
         cameras.close()
+        # the league clients' figures: (answers, answer_s median, round_trip_s median)
         league = [receive.recv() for receive in reports if receive.poll(10.0)]
         for proc in procs:
             proc.kill()
             proc.join(timeout=5)
         for native in natives:  # each ends when the server closes its socket
-            try:
-                native.communicate(timeout=10)
-            except Exception:
-                native.kill()
-                native.communicate()
+            league.extend(native_clients.figures(native))
     rtts = [s["round_trip_ms"]["p50"] for s in stats.values() if s["round_trip_ms"]["p50"]]
     replies = sorted(s["reply_ms"]["p50"] for s in stats.values() if s["reply_ms"]["p50"])
     last_key = robots[-1].key

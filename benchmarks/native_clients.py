@@ -91,6 +91,23 @@ def start(
     return subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
 
 
+def figures(client: subprocess.Popen[bytes]) -> list[tuple[int, float | None, float | None]]:
+    """Wait for a client that the server closed and read what it printed: [(answers, median
+    of answer_s, median of round_trip_s)] (seconds), or [] when it printed nothing (killed
+    after 10 s: it did not end)."""
+    try:
+        out, _ = client.communicate(timeout=10)
+    except subprocess.TimeoutExpired:
+        client.kill()
+        client.communicate()
+        return []
+    try:
+        printed = json.loads(out.decode().strip().splitlines()[-1])
+    except (IndexError, ValueError):
+        return []
+    return [(printed["answered"], printed["answer_s"], printed["round_trip_s"])]
+
+
 def lockstep_floor(
     frames: Path, style: str, *, robots: int, step_us: float, measurement_bytes: int,
     steps: int, server_cpu: int | None, client_cpus: Iterable[int] = (),
@@ -119,11 +136,7 @@ def lockstep_floor(
         out, err = server.communicate()
     finally:
         for proc in clients:
-            try:
-                proc.communicate(timeout=10)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.communicate()
+            figures(proc)
     if server.returncode != 0 or not out.strip():
         return {"error": f"lockstep floor: exit code {server.returncode}: {err.strip()[-200:]}"}
     result: dict[str, Any] = json.loads(out.strip().splitlines()[-1])

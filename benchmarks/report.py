@@ -15,8 +15,9 @@ kind alike), each benchmark as a child process with small sizes:
   clients written like the league's own (each request's length and body in two writes, no
   ``TCP_NODELAY``: :mod:`testkit.league_client`), and their requests per second and round
   trips; judged against the lockstep target;
-- ``lockstep`` and ``lockstep_league`` run compiled clients (``bench api --native``) when the
-  machine has a C compiler (``native_clients`` says which ran), and with them the serial floor
+- every ``bench api`` kind runs compiled clients (``bench api --native``) when the machine
+  has a C compiler (``native_clients`` says which ran: the clients share the bench machine's
+  CPUs with the server they measure), and the lockstep kinds give with them the serial floor
   of lockstep on this machine (``floor_ratio``: a C server stepping a busy loop as long as the
   world's step with the same clients; ``of_floor``: the API run's ratio over it);
 - ``cameras``: ``bench api --mode async`` with every robot's camera at 320x240 every 32 ms,
@@ -140,21 +141,20 @@ def _runners(args: argparse.Namespace) -> dict[str, Callable[[], dict[str, Any]]
     sim_s = str(args.sim_seconds)
     api = ["-m", "benchmarks", "api", "--robots", robots, "--json"]
 
-    # lockstep's clients compiled when a C compiler is here (their own cost on the bench
-    # machine's CPUs holds a lockstep server back): see benchmarks.native_clients
-    native = ["--native"] if native_clients.compiler() else []
+    # the clients compiled when a C compiler is here (their own cost on the bench machine's
+    # CPUs holds the server back): see benchmarks.native_clients
+    if native_clients.compiler():
+        api.append("--native")
 
     def api_mode(mode: str) -> Callable[[], dict[str, Any]]:
-        extra = native if mode == "lockstep" else []
-
         def run() -> dict[str, Any]:
-            result = _child([*api, "--mode", mode, *extra, "--sim-seconds", sim_s], 600)
+            result = _child([*api, "--mode", mode, "--sim-seconds", sim_s], 600)
             return result if "error" in result else _api_figures(result)
 
         return run
 
     def lockstep_league() -> dict[str, Any]:
-        result = _child([*api, "--mode", "lockstep", "--client", "league", *native,
+        result = _child([*api, "--mode", "lockstep", "--client", "league",
                          "--sim-seconds", sim_s], 600)  # fmt: skip
         if "error" in result:
             return result
@@ -190,6 +190,7 @@ def _runners(args: argparse.Namespace) -> dict[str, Callable[[], dict[str, Any]]
             "gl_backend": result.get("gl_backend"),
             "gl_renderer": result.get("gl_renderer"),
             "render_processes": result.get("render_processes"),  # 0: one render thread
+            "native_clients": result.get("native_clients"),
         }
 
     def bringup() -> dict[str, Any]:

@@ -13,8 +13,12 @@
  *                league's robot_client.cpp)
  *   CPU,...      the CPUs it may run on (default: any)
  * It connects (retrying while the server starts), reads the greeting, sends the enable request
- * and answers until the server closes; then prints the answers sent and exits 0. Exit 2: bad
- * arguments or frames file; 3: no session on the port within 60 s.
+ * and answers until the server closes; then prints one JSON line and exits 0: the answers sent,
+ * the median of answer_s (a measurement's arrival to its answer's last write returned: this
+ * client's part of the server's round trip) and of round_trip_s (that return to the next
+ * measurement's arrival: what the league's client waits for in RobotClient::receive), as the
+ * bench's Python league-style clients report them. Exit 2: bad arguments or frames file; 3: no
+ * session on the port within 60 s.
  */
 #define _GNU_SOURCE
 #include <arpa/inet.h>
@@ -27,6 +31,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <time.h>
 #include <unistd.h>
 
 typedef struct {
@@ -55,6 +60,39 @@ static int send_frame(int fd, const frame_t *frame, int league) {
 
 static uint32_t be32(const unsigned char *p) {
     return (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | (uint32_t)p[3];
+}
+
+static double now_s(void) {
+    struct timespec now;
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    return (double)now.tv_sec + (double)now.tv_nsec * 1e-9;
+}
+
+typedef struct {
+    double *values;
+    size_t count, capacity;
+} samples_t;
+
+static void add(samples_t *samples, double value) {
+    if (samples->count == samples->capacity) {
+        samples->capacity = samples->capacity ? samples->capacity * 2 : 4096;
+        samples->values = realloc(samples->values, samples->capacity * sizeof(double));
+    }
+    samples->values[samples->count++] = value;
+}
+
+static int ascending(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static void print_median(const char *name, samples_t *samples) {
+    if (samples->count == 0) {
+        printf("\"%s\": null", name);
+        return;
+    }
+    qsort(samples->values, samples->count, sizeof(double), ascending);
+    printf("\"%s\": %.9f", name, samples->values[samples->count / 2]);
 }
 
 static int read_exact(int fd, unsigned char *into, size_t size) {
@@ -145,18 +183,24 @@ int main(int argc, char **argv) {
     size_t size = 1 << 16, filled = 0;
     unsigned char *buffer = malloc(size);
     unsigned long answered = 0;
+    samples_t answer_s = {0}, round_trip_s = {0};
+    double written = 0; /* when the last answer's last write returned */
     for (;;) {
         if (filled == size) buffer = realloc(buffer, size *= 2); /* a camera image */
         ssize_t got = recv(fd, buffer + filled, size - filled, 0);
         if (got < 0 && errno == EINTR) continue;
         if (got <= 0) break;
+        double arrived = now_s();
         filled += (size_t)got;
         size_t start = 0;
         while (filled - start >= 4) {
             size_t end = start + 4 + be32(buffer + start);
             if (end > filled) break;
             start = end;
+            if (written > 0) add(&round_trip_s, arrived - written);
             if (send_frame(fd, &frames[1 + answered % (count - 1)], league) < 0) goto closed;
+            written = now_s();
+            add(&answer_s, written - arrived);
             answered++;
         }
         if (start) {
@@ -165,6 +209,10 @@ int main(int argc, char **argv) {
         }
     }
 closed:
-    printf("%lu\n", answered);
+    printf("{\"answered\": %lu, ", answered);
+    print_median("answer_s", &answer_s);
+    printf(", ");
+    print_median("round_trip_s", &round_trip_s);
+    printf("}\n");
     return 0;
 }

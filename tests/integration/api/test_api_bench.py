@@ -120,7 +120,9 @@ def test_bench_api_native_league_clients_meet_no_delayed_ack_stall() -> None:
     step would put either far below these figures."""
     result = _bench("--mode", "lockstep", "--client", "league", "--native", "--sim-seconds", "0.5")
     league = result["league_client"]
-    assert isinstance(league, dict) and league["clients"] == 2
+    assert isinstance(league, dict) and league["clients"] == 2 and league["reported"] == 2
+    for key in ("client_answer_p50_ms", "client_round_trip_p50_ms", "server_reply_p50_ms"):
+        assert isinstance(league[key], float) and 0 < league[key] < 20, key
     steps_per_s = float(result["real_time_factor"]) * 1000.0 / 8  # type: ignore[arg-type]
     assert league["requests_per_s"] == pytest.approx(2 * steps_per_s, rel=0.15)
     assert league["round_trip_p50_ms"] < 20

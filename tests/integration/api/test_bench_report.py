@@ -45,6 +45,8 @@ def test_report_runs_the_kinds_and_judges_medians_against_targets() -> None:
     assert report["bare_real_time_factor"] == bare > 0
     assert report["reference_bare_real_time_factor"] == 12.0
     assert 0 <= pipelined["median"]["client_wait_share"] < 1
+    # this machine has a C compiler (make setup installs one): the compiled clients ran
+    assert all(run["native_clients"] is True for run in pipelined["runs"])
 
 
 def test_report_runs_lockstep_with_clients_written_like_the_leagues() -> None:
@@ -68,6 +70,8 @@ def test_report_runs_lockstep_with_clients_written_like_the_leagues() -> None:
         assert isinstance(run[key], float) and run[key] > 0, key
         assert median[key] == run[key], key
     assert league["meets_target"] == (median["ratio_interleaved"] >= 0.85)
+    assert run["native_clients"] is True  # compiled, as the league's own client is
+    assert 0 < run["floor_ratio"] <= 1 and run["of_floor"] > 0  # the floor beside it
 
 
 def test_a_judged_figure_names_its_target() -> None:
