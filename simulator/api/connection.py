@@ -165,6 +165,7 @@ class Connection:
         """
         count = 0
         taken = 0
+        acked = False  # an ACK was sent since the last bytes were received
         budget = self.budget
         level = budget.refill(now, self.measurements)
         decoder = self.decoder
@@ -185,6 +186,7 @@ class Connection:
                         raise ClientClosed(f"receive failed: {exc}") from exc
                     if not data:
                         raise ClientClosed("client disconnected")
+                    acked = False
                     self.stats.bytes_in += len(data)
                     taken += len(data)
                     level -= len(data) * BYTE_COST
@@ -199,11 +201,19 @@ class Connection:
                 if decoder.held:
                     continue  # more frames buffered: taken while the budget pays
                 if len(data) < RECV_CHUNK or taken >= READ_PER_CALL_BYTES:
+                    if decoder.buffered and not acked and taken < READ_PER_CALL_BYTES:
+                        # inside a frame: acknowledge it now, and look once more: a client
+                        # that held the rest back for this ACK (Nagle) has usually sent it on
+                        # loopback by the time the call returns
+                        self._quick_ack()
+                        acked = True
+                        continue
                     break
         finally:
             budget.level = level
         if decoder.buffered:
-            self._quick_ack()
+            if not acked:
+                self._quick_ack()
             self._frame_began = now if count else began
         else:
             self._frame_began = None
@@ -231,8 +241,11 @@ class Connection:
         body through a ``FileOutputStream``, ``:178-179``), holds the body back (Nagle) until
         the length is acknowledged, and a server with nothing to send back delays that ACK:
         every request would wait 40 ms. Setting ``TCP_QUICKACK`` while an ACK is pending sends
-        it at once, so the body follows one loopback round trip later. Done only when a read
-        ends inside a frame: a client that writes whole frames costs no system call."""
+        it at once, and on loopback the body has usually arrived by the time the call returns:
+        :meth:`read` looks once more, so the request is taken in the same read, not a wake-up
+        later (the server's round trip p50 with the league-style clients fell from 0.195-0.275
+        to 0.137-0.212 ms in six alternated pairs). Done only when a read ends inside a frame: a
+        client that writes whole frames costs no system call."""
         option = TCP_QUICKACK
         if option is None:
             return
