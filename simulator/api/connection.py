@@ -158,13 +158,9 @@ class Connection:
         of requests taken. Bytes are charged as they are received and frames as they are cut
         out, before anything else is done with them; when the budget is spent the connection is
         ``paused`` (not read until :meth:`resume` says it refilled) and marked slow. A request
-        over the size limit is dropped undecoded, counted and told to the client.
-
-        Raises:
-            ClientClosed: on EOF, a socket error, a framing error or an undecodable message.
-        """
-        count = 0
-        taken = 0
+        over the size limit is dropped undecoded, counted and told to the client. Raises
+        ClientClosed on EOF, a socket error, a framing error or an undecodable message."""
+        count = taken = 0
         acked = False  # an ACK was sent since the last bytes were received
         budget = self.budget
         level = budget.refill(now, self.measurements)
@@ -202,10 +198,7 @@ class Connection:
                     continue  # more frames buffered: taken while the budget pays
                 if len(data) < RECV_CHUNK or taken >= READ_PER_CALL_BYTES:
                     if decoder.buffered and not acked and taken < READ_PER_CALL_BYTES:
-                        # inside a frame: acknowledge it now, and look once more: a client
-                        # that held the rest back for this ACK (Nagle) has usually sent it on
-                        # loopback by the time the call returns
-                        self._quick_ack()
+                        self._quick_ack()  # inside a frame: the rest may follow the ACK at once
                         acked = True
                         continue
                     break
@@ -234,18 +227,11 @@ class Connection:
         return count
 
     def _quick_ack(self) -> None:
-        """Acknowledge what was received now, not after the kernel's delayed-ACK timer (40 ms
-        on Linux). A client that writes a request's length and its body in two writes without
-        ``TCP_NODELAY``, as the league's own ``RobotClient::sendRequest`` does
-        (``controllers/player/robot_client.cpp:171``: ``send`` of the 4-byte size, then the
-        body through a ``FileOutputStream``, ``:178-179``), holds the body back (Nagle) until
-        the length is acknowledged, and a server with nothing to send back delays that ACK:
-        every request would wait 40 ms. Setting ``TCP_QUICKACK`` while an ACK is pending sends
-        it at once, and on loopback the body has usually arrived by the time the call returns:
-        :meth:`read` looks once more, so the request is taken in the same read, not a wake-up
-        later (the server's round trip p50 with the league-style clients fell from 0.195-0.275
-        to 0.137-0.212 ms in six alternated pairs). Done only when a read ends inside a frame: a
-        client that writes whole frames costs no system call."""
+        """Acknowledge what was received now, not after the delayed-ACK timer (40 ms on
+        Linux): the league's client (``robot_client.cpp:171-179``) writes the length and the
+        body apart without ``TCP_NODELAY``, so Nagle holds the body until that ACK. On loopback
+        the body has usually arrived when the call returns: :meth:`read` looks once more
+        (``simulator/api/README.md``). Only when a read ends inside a frame."""
         option = TCP_QUICKACK
         if option is None:
             return
