@@ -52,7 +52,9 @@ class OwnEngine:
         return f"unix://{self.folder / 'docker.sock'}"
 
     def _argv(self) -> list[str]:
-        name = self.folder.name
+        # containerd's namespaces are alphanumeric runs joined by single '.', '_' or '-': the
+        # folder's random part may end in '_' ("hlvs-engine-fgycgyl_" was refused)
+        name = self.folder.name.replace("_", "0")
         return [
             shutil.which("dockerd") or "dockerd",
             "--config-file", str(self.folder / "daemon.json"),
