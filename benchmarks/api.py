@@ -529,7 +529,7 @@ def _api_run(
             camera_period = camera[2] if camera and i < camera_robots else 0
             natives.append(native_clients.start(
                 args.native_program, e.port, args.native_frames[camera_period],
-                "league" if args.client == "league" else "framed", args.client_cpus,
+                _native_style(args), args.client_cpus,
             ))  # fmt: skip
             continue
         if last and e.robot == robots[-1]:
@@ -777,6 +777,11 @@ def _native_frames(
     return frames
 
 
+def _native_style(args: argparse.Namespace) -> str:
+    """The compiled clients' way of writing (:data:`benchmarks.native_clients.STYLES`)."""
+    return "league" if args.client == "league" else "framed"
+
+
 def _lockstep_floor(args: argparse.Namespace, api: dict[str, Any]) -> dict[str, Any]:
     """``--native`` lockstep: the serial floor on this machine with the same clients
     (:func:`benchmarks.native_clients.lockstep_floor`), its server on the step thread's CPU,
@@ -784,7 +789,7 @@ def _lockstep_floor(args: argparse.Namespace, api: dict[str, Any]) -> dict[str, 
     over the floor's."""
     step_cpus = sorted(os.sched_getaffinity(0))
     floor = native_clients.lockstep_floor(
-        args.native_frames[0], "league" if args.client == "league" else "framed",
+        args.native_frames[0], _native_style(args),
         robots=args.robots, step_us=api["reference_step_us"],
         measurement_bytes=api["measurement_bytes"], steps=api["steps"],
         server_cpu=step_cpus[0] if args.client_cpus else None, client_cpus=args.client_cpus,

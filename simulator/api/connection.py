@@ -200,7 +200,8 @@ class Connection:
                     if decoder.buffered and not acked and taken < READ_PER_CALL_BYTES:
                         self._quick_ack()  # inside a frame: the rest may follow the ACK at once
                         acked = True
-                        continue
+                        if level >= FRAME_COST:  # a second look, not a pause, when spent
+                            continue
                     break
         finally:
             budget.level = level
