@@ -269,17 +269,26 @@ def _bringup_repeats(args: argparse.Namespace) -> int:
     return repeats
 
 
+def _runs_of(kind: str, args: argparse.Namespace) -> int:
+    """How many runs of ``kind``: ``--bringup-repeats`` and ``--match-repeats`` for theirs
+    (even above ``--repeats``: the rounds go on until each kind has its own), ``--repeats``
+    for the others, at least one."""
+    if kind == "bringup":
+        return max(1, _bringup_repeats(args))
+    repeats: int = args.match_repeats if kind == "match" else args.repeats
+    return max(1, repeats)
+
+
 def run(args: argparse.Namespace, progress: Callable[[str], None]) -> dict[str, Any]:
     kinds = _kinds(args.only)
     runners = _runners(args)
     runs: dict[str, list[dict[str, Any]]] = {k: [] for k in kinds}
     started = time.monotonic()
     load_before = _load()
-    for repeat in range(max(1, args.repeats)):
+    wanted = {kind: _runs_of(kind, args) for kind in kinds}
+    for repeat in range(max(wanted.values(), default=1)):
         for kind in kinds:
-            if kind == "bringup" and repeat >= _bringup_repeats(args):
-                continue
-            if kind == "match" and repeat >= args.match_repeats:
+            if repeat >= wanted[kind]:
                 continue
             progress(f"{kind} run {repeat + 1} (load {_load()[0]})")
             result = runners[kind]()
