@@ -62,6 +62,7 @@ from testkit.figures import (
     league_match_figures,
     machine_target,
     median_figures,
+    report_rounds,
 )
 
 KINDS = ("sim", "async", "lockstep", "lockstep_league", "pipelined", "cameras", "bringup",
@@ -269,27 +270,16 @@ def _bringup_repeats(args: argparse.Namespace) -> int:
     return repeats
 
 
-def _runs_of(kind: str, args: argparse.Namespace) -> int:
-    """How many runs of ``kind``: ``--bringup-repeats`` and ``--match-repeats`` for theirs
-    (even above ``--repeats``: the rounds go on until each kind has its own), ``--repeats``
-    for the others, at least one."""
-    if kind == "bringup":
-        return max(1, _bringup_repeats(args))
-    repeats: int = args.match_repeats if kind == "match" else args.repeats
-    return max(1, repeats)
-
-
 def run(args: argparse.Namespace, progress: Callable[[str], None]) -> dict[str, Any]:
     kinds = _kinds(args.only)
     runners = _runners(args)
     runs: dict[str, list[dict[str, Any]]] = {k: [] for k in kinds}
     started = time.monotonic()
     load_before = _load()
-    wanted = {kind: _runs_of(kind, args) for kind in kinds}
-    for repeat in range(max(wanted.values(), default=1)):
-        for kind in kinds:
-            if repeat >= wanted[kind]:
-                continue
+    wanted = {kind: args.repeats for kind in kinds}
+    wanted.update(bringup=_bringup_repeats(args), match=args.match_repeats)
+    for repeat, kinds_now in enumerate(report_rounds(kinds, wanted)):
+        for kind in kinds_now:
             progress(f"{kind} run {repeat + 1} (load {_load()[0]})")
             result = runners[kind]()
             result["load_1min"] = _load()[0]

@@ -119,6 +119,15 @@ def median_figures(runs: Sequence[Mapping[str, object]]) -> dict[str, float]:
     return medians
 
 
+def report_rounds(kinds: Sequence[str], runs: Mapping[str, int]) -> list[list[str]]:
+    """The order ``hlvs bench report`` runs its kinds in: rounds of every kind that still has
+    runs to do (``runs``: how many each wants, at least one), interleaved so that the machine's
+    load falls on all alike, until each has all its own (a kind wanting more than the others,
+    the match's ``--match-repeats``, goes on alone)."""
+    wanted = {kind: max(1, runs.get(kind, 1)) for kind in kinds}
+    rounds = max(wanted.values(), default=0)
+    return [[kind for kind in kinds if wanted[kind] > turn] for turn in range(rounds)]
+
 
 __all__ = [
     "FLOOD_TARGET",
@@ -132,4 +141,5 @@ __all__ = [
     "league_match_figures",
     "machine_target",
     "median_figures",
+    "report_rounds",
 ]

@@ -16,6 +16,7 @@ from testkit.figures import (
     judged,
     league_match_figures,
     machine_target,
+    report_rounds,
 )
 from testkit.figures import median_figures as _median
 
@@ -129,3 +130,15 @@ def test_a_league_match_is_costed_from_a_short_one_at_the_leagues_pace() -> None
     for bad in ((0.0, 10.0, 2), (1.0, 10.0, 0)):
         with pytest.raises(ValueError, match="expected a real-time factor above 0"):
             league_match_figures(*bad)
+
+
+def test_every_kind_gets_its_own_number_of_runs_interleaved() -> None:
+    """``--match-repeats`` and ``--bringup-repeats`` above ``--repeats`` are all run (the
+    rounds once stopped at ``--repeats``: ``--repeats 1 --match-repeats 3`` played one match)."""
+    kinds = ["sim", "bringup", "match"]
+    assert report_rounds(kinds, {"sim": 1, "bringup": 2, "match": 3}) == [
+        ["sim", "bringup", "match"], ["bringup", "match"], ["match"]]
+    assert report_rounds(kinds, {"sim": 2, "bringup": 2, "match": 1}) == [
+        ["sim", "bringup", "match"], ["sim", "bringup"]]
+    assert report_rounds(["sim"], {"sim": 0}) == [["sim"]]  # at least one run
+    assert report_rounds([], {}) == []
