@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import logging
+import os
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -81,13 +82,19 @@ def database_unavailable(exc: DBAPIError) -> bool:
 
 def _private_sqlite(path: Path) -> None:
     """The database file (and its WAL files, which SQLite creates with the file's mode) 0600;
-    a missing folder is created 0700."""
-    from orchestrator import make_private_file, private_dir
+    a missing folder is created 0700. An existing file is not opened: closing any descriptor of
+    it drops every POSIX lock this process holds on it, those of its open SQLite connections
+    too, and another process closing its last connection would then take the database for
+    unused and delete its WAL under them ("disk I/O error")."""
+    from orchestrator import private_dir
 
     if path.name in ("", ":memory:"):
         return
     private_dir(path.parent, only_if_new=True)
-    make_private_file(path)
+    try:
+        os.close(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
+    except FileExistsError:
+        path.chmod(0o600)
     for extra in ("-wal", "-shm", "-journal"):
         companion = path.with_name(path.name + extra)
         if companion.exists():
