@@ -18,7 +18,7 @@ if TYPE_CHECKING:
     from service import tokens
     from service.accounts import ensure_team_account
     from service.admin import add_team, list_tokens
-    from service.app import create_app, pool_from_settings
+    from service.app import check_storage, create_app, pool_from_settings
     from service.deps import (
         DbSession,
         OperatorPrincipal,
@@ -32,7 +32,7 @@ if TYPE_CHECKING:
     from service.errors import ClientError, InvalidInput, NotFound, ServiceError
     from service.results import stored_many
     from service.services import Services
-    from service.settings import Settings
+    from service.settings import Settings, open_database
     from service.tokens import Principal
     from service.views import SubmissionReport
 
@@ -49,11 +49,13 @@ __all__ = [
     "SubmissionReport",
     "TeamPrincipal",
     "add_team",
+    "check_storage",
     "create_app",
     "ensure_team_account",
     "get_db",
     "get_services",
     "list_tokens",
+    "open_database",
     "pool_from_settings",
     "require_operator",
     "require_team",
@@ -68,7 +70,7 @@ if not TYPE_CHECKING:
         "service": ("tokens",),
         "service.accounts": ("ensure_team_account",),
         "service.admin": ("add_team", "list_tokens"),
-        "service.app": ("create_app", "pool_from_settings"),
+        "service.app": ("check_storage", "create_app", "pool_from_settings"),
         "service.services": ("Services",),
         "service.deps": (
             "DbSession", "OperatorPrincipal", "TeamPrincipal", "get_db", "get_services",
@@ -76,7 +78,7 @@ if not TYPE_CHECKING:
         ),
         "service.errors": ("ClientError", "InvalidInput", "NotFound", "ServiceError"),
         "service.results": ("stored_many",),
-        "service.settings": ("Settings",),
+        "service.settings": ("Settings", "open_database"),
         "service.tokens": ("Principal",),
         "service.views": ("SubmissionReport",),
     })

@@ -29,13 +29,11 @@ from service.db import (
     UNAVAILABLE_RETRY_S,
     database_busy,
     database_unavailable,
-    make_engine,
-    migrate,
     session_factory,
 )
 from service.errors import AuthError, ServiceError
 from service.services import PoolFactory, Preflight, Services
-from service.settings import Settings
+from service.settings import Settings, open_database
 
 if TYPE_CHECKING:
     from sqlalchemy.engine import Engine
@@ -181,11 +179,19 @@ def _open_storage(settings: Settings) -> tuple[Engine, Sealer]:
     sealer = load_sealer(
         key=settings.secret_key, key_path=key_file(settings.data_dir, settings.secret_key_file)
     )
-    engine = make_engine(settings.db_url)
-    migrate(engine)
+    engine = open_database(settings)
     with transaction(session_factory(engine)) as session:
         seal_stored(session, sealer)  # secrets stored in the clear by an older version
     return engine, sealer
+
+
+def check_storage(settings: Settings) -> None:
+    """Open what the service's start opens (its folders, the key of the stored secrets, the
+    database) and close it again: ``hlvs serve`` calls it before the server starts, so that a
+    wrong key or an unreachable database is one line naming the setting, not a traceback in
+    the server's startup log."""
+    engine, _ = _open_storage(settings)
+    engine.dispose()
 
 
 def _stop(services: Services) -> None:

@@ -16,6 +16,8 @@ from contracts import TEST_MATCH, TimingError, fit_ready
 from service.errors import SettingsError
 
 if TYPE_CHECKING:
+    from sqlalchemy import Engine
+
     from orchestrator.delivery import IPNetwork
 
 PREFIX = "HLVS_SERVICE_"
@@ -153,6 +155,31 @@ def webhook_networks(settings: Settings) -> tuple[IPNetwork, ...]:
     return networks(settings.webhook_allow)
 
 
+def open_database(settings: Settings) -> Engine:
+    """The service's database (``db_url``), migrated to the newest schema; one that cannot be
+    reached is a :class:`SettingsError` naming the URL (its password hidden) and the driver's
+    reason: one line for the operator rather than the driver's traceback."""
+    from sqlalchemy.engine import make_url
+    from sqlalchemy.exc import InterfaceError, OperationalError
+
+    from service.db import make_engine, migrate
+
+    url = settings.db_url
+    engine = make_engine(url)
+    try:
+        migrate(engine)
+    except (OperationalError, InterfaceError) as exc:  # no connection (a query's error is not)
+        engine.dispose()
+        text = str(exc.orig).strip()
+        reason = text.splitlines()[0] if text else type(exc.orig).__name__
+        raise SettingsError(
+            name=PREFIX + "DATABASE_URL",
+            value=make_url(url).render_as_string(hide_password=True),
+            expected=f"a database that answers ({reason})",
+        ) from exc
+    return engine
+
+
 def log_target_networks(settings: Settings) -> tuple[IPNetwork, ...]:
     """The networks of ``log_target_allow``; ValueError for one that is not a network."""
     from orchestrator.delivery import networks
@@ -230,4 +257,4 @@ def _check(settings: Settings) -> None:
 
 
 __all__ = ["LOG_TARGET_ALLOW_SETTING", "Settings", "WEBHOOK_ALLOW_SETTING",
-           "log_target_networks", "webhook_networks"]
+           "log_target_networks", "open_database", "webhook_networks"]

@@ -152,22 +152,23 @@ def _check_database(args: argparse.Namespace, settings: Settings) -> None:
 
 def _sessions(args: argparse.Namespace) -> Any:
     from orchestrator import private_dir
-    from service.db import make_engine, migrate, session_factory
+    from service import open_database
+    from service.db import session_factory
 
     settings = _settings(args)
     _check_database(args, settings)
     private_dir(settings.data_dir)
-    engine = make_engine(settings.db_url)
-    migrate(engine)
-    return session_factory(engine)
+    return session_factory(open_database(settings))
 
 
 def run_serve(args: argparse.Namespace) -> int:
     import uvicorn
 
     from hlvs.app import create_app
+    from service import check_storage
 
     settings = _settings(args)
+    check_storage(settings)
     app = create_app(settings, start_worker=not args.no_worker)
     uvicorn.run(app, host=args.host, port=args.port, log_level="info", access_log=False,
                 timeout_keep_alive=int(settings.keep_alive_s))

@@ -49,7 +49,15 @@ def serve(settings: Settings, *, start_worker: bool = False, port: int | None = 
     config = uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning",
                             lifespan="on")
     server = uvicorn.Server(config)
-    thread = threading.Thread(target=server.run, name=f"service-{port}", daemon=True)
+    exits: list[int | str | None] = []
+
+    def run() -> None:
+        try:
+            server.run()
+        except SystemExit as exc:  # uvicorn's way of saying the app did not start
+            exits.append(exc.code)
+
+    thread = threading.Thread(target=run, name=f"service-{port}", daemon=True)
     thread.start()
     url = f"http://127.0.0.1:{port}"
     deadline = time.monotonic() + 30
@@ -59,4 +67,5 @@ def serve(settings: Settings, *, start_worker: bool = False, port: int | None = 
         if not thread.is_alive():
             break
         time.sleep(0.02)
-    raise RuntimeError(f"the service did not start on {url}")
+    told = f" (uvicorn exited with {exits[0]})" if exits else ""
+    raise RuntimeError(f"the service did not start on {url}{told}")
