@@ -13,6 +13,7 @@ import argparse
 import functools
 import json
 import logging
+import socket
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -168,11 +169,46 @@ def run_serve(args: argparse.Namespace) -> int:
     from service import check_storage
 
     settings = _settings(args)
-    check_storage(settings)
-    app = create_app(settings, start_worker=not args.no_worker)
-    uvicorn.run(app, host=args.host, port=args.port, log_level="info", access_log=False,
-                timeout_keep_alive=int(settings.keep_alive_s))
+    listener = _listen(args.host, args.port)  # before anything starts: a busy port is one line
+    try:
+        check_storage(settings)
+        app = create_app(settings, start_worker=not args.no_worker)
+        config = uvicorn.Config(app, host=args.host, port=args.port, log_level="info",
+                                access_log=False, timeout_keep_alive=int(settings.keep_alive_s))
+        shown = f"[{args.host}]" if ":" in args.host else args.host
+        logging.getLogger("hlvs.serve").info(
+            "the service listens on http://%s:%d (Ctrl+C stops it)", shown, args.port)
+        uvicorn.Server(config).run(sockets=[listener])
+    finally:
+        listener.close()
     return 0
+
+
+def _listen(host: str, port: int) -> socket.socket:
+    """The service's listening socket on ``host``:``port``, bound before the service starts
+    (uvicorn binds after the app's startup, whose worker may already have taken a queued
+    match when the port turns out to be taken)."""
+    from orchestrator import ConfigError, Problem
+
+    try:
+        family, kind, proto, _, address = socket.getaddrinfo(
+            host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)[0]
+        listener = socket.socket(family, kind, proto)
+    except OSError as exc:
+        raise ConfigError([Problem("(command line)", "--host", f"{host!r}: {exc}",
+                                   expected="an address of this host")]) from exc
+    try:
+        listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        listener.bind(address)
+        listener.listen(2048)
+    except OSError as exc:
+        listener.close()
+        raise ConfigError([Problem(
+            "(command line)", "--port", f"cannot listen on {host}:{port}: {exc.strerror or exc}",
+            expected="a port nothing else listens on (another hlvs serve?)",
+        )]) from exc
+    listener.set_inheritable(True)
+    return listener
 
 
 def run_team_add(args: argparse.Namespace) -> int:

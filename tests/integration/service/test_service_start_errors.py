@@ -107,3 +107,18 @@ def test_a_wrong_password_of_the_real_server_is_one_line(tmp_path: Path) -> None
     line = _one_line(proc, "HLVS_SERVICE_DATABASE_URL", "a database that answers")
     assert "not-its-password" not in proc.stderr and "password" in line.lower()
     assert json.dumps(line)  # one printable line
+
+
+def test_a_busy_port_is_one_line_before_anything_starts(tmp_path: Path) -> None:
+    """uvicorn binds after the app's startup, whose worker could have taken a queued match by
+    then: ``hlvs serve`` binds first."""
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        data = tmp_path / "service-data"
+        proc = _run(["serve", "--port", str(port)], {"HLVS_SERVICE_DATA_DIR": str(data)},
+                    tmp_path)
+    _one_line(proc, "--port", f"127.0.0.1:{port}", "in use")
+    assert not data.exists()  # nothing opened, no worker started
+    assert "Application startup" not in proc.stderr
