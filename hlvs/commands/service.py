@@ -10,6 +10,7 @@ otherwise make a new, empty database and issue tokens the service never sees.
 from __future__ import annotations
 
 import argparse
+import errno
 import functools
 import json
 import logging
@@ -176,8 +177,9 @@ def run_serve(args: argparse.Namespace) -> int:
         config = uvicorn.Config(app, host=args.host, port=args.port, log_level="info",
                                 access_log=False, timeout_keep_alive=int(settings.keep_alive_s))
         shown = f"[{args.host}]" if ":" in args.host else args.host
+        port = listener.getsockname()[1]  # (--port 0: the one the system chose)
         logging.getLogger("hlvs.serve").info(
-            "the service listens on http://%s:%d (Ctrl+C stops it)", shown, args.port)
+            "the service listens on http://%s:%d (Ctrl+C stops it)", shown, port)
         uvicorn.Server(config).run(sockets=[listener])
     finally:
         listener.close()
@@ -203,11 +205,13 @@ def _listen(host: str, port: int) -> socket.socket:
         listener.listen(2048)
     except OSError as exc:
         listener.close()
+        busy = exc.errno == errno.EADDRINUSE
         raise ConfigError([Problem(
-            "(command line)", "--port", f"cannot listen on {host}:{port}: {exc.strerror or exc}",
-            expected="a port nothing else listens on (another hlvs serve?)",
+            "(command line)", "--port" if busy else "--host",
+            f"cannot listen on {host}:{port}: {exc.strerror or exc}",
+            expected="a port nothing else listens on (another hlvs serve?)" if busy
+            else "an address of this host and a port this user may open",
         )]) from exc
-    listener.set_inheritable(True)
     return listener
 
 
