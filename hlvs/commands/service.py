@@ -192,16 +192,11 @@ def _listen(host: str, port: int) -> socket.socket:
     match when the port turns out to be taken)."""
     from orchestrator import ConfigError, Problem
 
-    try:
-        family, kind, proto, _, address = socket.getaddrinfo(
-            host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)[0]
-        listener = socket.socket(family, kind, proto)
-    except OSError as exc:
-        raise ConfigError([Problem("(command line)", "--host", f"{host!r}: {exc}",
-                                   expected="an address of this host")]) from exc
+    # as uvicorn binds: IPv6 for an address with a colon, else IPv4 ("localhost" is 127.0.0.1)
+    listener = socket.socket(socket.AF_INET6 if ":" in host else socket.AF_INET)
     try:
         listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        listener.bind(address)
+        listener.bind((host, port))
         listener.listen(2048)
     except OSError as exc:
         listener.close()
