@@ -18,7 +18,7 @@ if TYPE_CHECKING:
     from service import tokens
     from service.accounts import ensure_team_account
     from service.admin import add_team, list_tokens
-    from service.app import check_storage, create_app, pool_from_settings
+    from service.app import create_app, open_storage, pool_from_settings
     from service.deps import (
         DbSession,
         OperatorPrincipal,
@@ -49,13 +49,13 @@ __all__ = [
     "SubmissionReport",
     "TeamPrincipal",
     "add_team",
-    "check_storage",
     "create_app",
     "ensure_team_account",
     "get_db",
     "get_services",
     "list_tokens",
     "open_database",
+    "open_storage",
     "pool_from_settings",
     "require_operator",
     "require_team",
@@ -70,7 +70,7 @@ if not TYPE_CHECKING:
         "service": ("tokens",),
         "service.accounts": ("ensure_team_account",),
         "service.admin": ("add_team", "list_tokens"),
-        "service.app": ("check_storage", "create_app", "pool_from_settings"),
+        "service.app": ("create_app", "open_storage", "pool_from_settings"),
         "service.services": ("Services",),
         "service.deps": (
             "DbSession", "OperatorPrincipal", "TeamPrincipal", "get_db", "get_services",

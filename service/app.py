@@ -99,11 +99,15 @@ def create_app(
     preflight: Preflight | None = None,
     start_worker: bool = True,
     mounts: Sequence[Mount] = (),
+    storage: tuple[Engine, Sealer] | None = None,
 ) -> FastAPI:
     """The service's app. ``pool_factory`` defaults to the local Docker pool and ``preflight``
     to :func:`service.preflight.run`; unit tests pass fakes. ``start_worker=False`` serves the
     API without starting matches. ``mounts`` adds routers of packages above the service (see
-:func:`hlvs.app.create_app`, which adds the pages and the environment API)."""
+:func:`hlvs.app.create_app`, which adds the pages and the environment API). ``storage``: what
+:func:`open_storage` opened before the server started, used by the first start instead of
+opening it again."""
+    opened = [storage] if storage is not None else []
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
@@ -111,7 +115,7 @@ def create_app(
 
         # Request handlers run in this many threads: more only fight over the GIL.
         anyio.to_thread.current_default_thread_limiter().total_tokens = settings.threads
-        engine, sealer = _open_storage(settings)
+        engine, sealer = opened.pop() if opened else open_storage(settings)
         checker = None
         if preflight is None:
             from service.preflight import PreflightChecker
@@ -166,9 +170,12 @@ def create_app(
     return app
 
 
-def _open_storage(settings: Settings) -> tuple[Engine, Sealer]:
+def open_storage(settings: Settings) -> tuple[Engine, Sealer]:
     """The private data and match folders, the sealer of stored secrets, and the database
-    migrated to this version (secrets an older version stored in the clear sealed)."""
+    migrated to this version (secrets an older version stored in the clear sealed). ``hlvs
+    serve`` opens it before the server starts (and hands it to :func:`create_app`), so that a
+    wrong key or an unreachable database is one line naming the setting, not a traceback in
+    the server's startup log."""
     from orchestrator import private_dir
     from service.db import transaction
     from service.sealing import key_file, load_sealer
@@ -183,15 +190,6 @@ def _open_storage(settings: Settings) -> tuple[Engine, Sealer]:
     with transaction(session_factory(engine)) as session:
         seal_stored(session, sealer)  # secrets stored in the clear by an older version
     return engine, sealer
-
-
-def check_storage(settings: Settings) -> None:
-    """Open what the service's start opens (its folders, the key of the stored secrets, the
-    database) and close it again: ``hlvs serve`` calls it before the server starts, so that a
-    wrong key or an unreachable database is one line naming the setting, not a traceback in
-    the server's startup log."""
-    engine, _ = _open_storage(settings)
-    engine.dispose()
 
 
 def _stop(services: Services) -> None:

@@ -167,13 +167,13 @@ def run_serve(args: argparse.Namespace) -> int:
     import uvicorn
 
     from hlvs.app import create_app
-    from service import check_storage
+    from service import open_storage
 
     settings = _settings(args)
     listener = _listen(args.host, args.port)  # before anything starts: a busy port is one line
     try:
-        check_storage(settings)
-        app = create_app(settings, start_worker=not args.no_worker)
+        storage = open_storage(settings)
+        app = create_app(settings, start_worker=not args.no_worker, storage=storage)
         config = uvicorn.Config(app, host=args.host, port=args.port, log_level="info",
                                 access_log=False, timeout_keep_alive=int(settings.keep_alive_s))
         shown = f"[{args.host}]" if ":" in args.host else args.host
