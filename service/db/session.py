@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import logging
-import os
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -86,15 +85,15 @@ def _private_sqlite(path: Path) -> None:
     it drops every POSIX lock this process holds on it, those of its open SQLite connections
     too, and another process closing its last connection would then take the database for
     unused and delete its WAL under them ("disk I/O error")."""
-    from orchestrator import private_dir
+    from orchestrator import make_private_file, private_dir
 
     if path.name in ("", ":memory:"):
         return
     private_dir(path.parent, only_if_new=True)
-    try:
-        os.close(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
-    except FileExistsError:
+    if path.exists():
         path.chmod(0o600)
+    else:  # no connection of this process can hold a lock on a file not made yet
+        make_private_file(path)
     for extra in ("-wal", "-shm", "-journal"):
         companion = path.with_name(path.name + extra)
         if companion.exists():
