@@ -16,18 +16,11 @@ import pytest
 from cryptography.fernet import Fernet
 
 from service import Settings
-from tests.integration.service.conftest import TokenMaker, make_token, settings  # noqa: F401
-from tests.integration.service.harness import serve
+from tests.integration.service.conftest import TokenMaker
+from tests.integration.service.harness import free_port, serve
 from tests.unit.service.conftest import team_doc
 
 HLVS = [sys.executable, "-m", "hlvs"]
-
-
-def _closed_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        port: int = sock.getsockname()[1]
-    return port  # closed again: nothing listens there
 
 
 def _run(argv: list[str], env: dict[str, str], cwd: Path) -> subprocess.CompletedProcess[str]:
@@ -47,7 +40,7 @@ def _one_line(proc: subprocess.CompletedProcess[str], *words: str) -> str:
 
 @pytest.mark.parametrize("db_url", ["sqlite"], indirect=True)
 def test_serve_with_another_secret_key_says_which_setting_and_keeps_the_secrets(
-    tmp_path: Path, settings: Settings, make_token: TokenMaker,  # noqa: F811
+    tmp_path: Path, settings: Settings, make_token: TokenMaker
 ) -> None:
     key = Fernet.generate_key().decode()
     sealed = settings.with_(secret_key=key)
@@ -61,7 +54,7 @@ def test_serve_with_another_secret_key_says_which_setting_and_keeps_the_secrets(
         served.stop()
     env = {"HLVS_SERVICE_DATA_DIR": str(settings.data_dir),
            "HLVS_SERVICE_DATABASE_URL": settings.db_url}
-    wrong = _run(["serve", "--port", str(_closed_port()), "--no-worker"],
+    wrong = _run(["serve", "--port", str(free_port()), "--no-worker"],
                  {**env, "HLVS_SERVICE_SECRET_KEY": Fernet.generate_key().decode()}, tmp_path)
     _one_line(wrong, "HLVS_SERVICE_SECRET_KEY", "the key the stored secrets were sealed with")
     # the right key still opens what was stored
@@ -82,9 +75,9 @@ def test_serve_with_another_secret_key_says_which_setting_and_keeps_the_secrets(
 def test_an_unreachable_database_is_one_line_with_its_password_hidden(
     tmp_path: Path, command: list[str]
 ) -> None:
-    port = _closed_port()
+    port = free_port()
     url = f"postgresql+psycopg://hlvs:pw-not-shown@127.0.0.1:{port}/league"
-    argv = [*command, "--port", str(_closed_port())] if command[0] == "serve" else command
+    argv = [*command, "--port", str(free_port())] if command[0] == "serve" else command
     proc = _run(argv, {"HLVS_SERVICE_DATABASE_URL": url}, tmp_path)
     line = _one_line(proc, "HLVS_SERVICE_DATABASE_URL", f"127.0.0.1:{port}/league",
                      "a database that answers", "refused")
