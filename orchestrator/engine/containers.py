@@ -32,6 +32,7 @@ from orchestrator.runtime.port import (
     ObjectNotFound,
     ProjectObject,
     StatsSample,
+    SubnetInUse,
 )
 
 log = logging.getLogger(__name__)
@@ -80,16 +81,17 @@ class DockerRuntime:
 
     # networks -------------------------------------------------------------------------------
     def create_network(self, request: NetworkRequest) -> NetworkInfo:
-        with translate("network", request.name):
+        with translate("network", request.name), _intended("network", request.name):
             info = _networks.create_network(self._client, request)
         ledger.note(info.id)
         return info
 
     def remove_network(self, name: str) -> None:
         with translate("network", name):
-            network_id = str(self._client.api.inspect_network(name).get("Id", ""))
+            found = self._client.api.inspect_network(name)
             _networks.remove_network(self._client, name)
-        ledger.forget(network_id)
+        ledger.forget(str(found.get("Id", "")))
+        ledger.forget_name("network", str(found.get("Name", "")))
 
     # containers -----------------------------------------------------------------------------
     def create_container(self, request: ContainerRequest) -> str:
@@ -140,7 +142,7 @@ class DockerRuntime:
                     )
                 }
             )
-        with translate("container", request.name):
+        with translate("container", request.name), _intended("container", request.name):
             created = api.create_container(
                 image=request.image,
                 command=list(request.command) if request.command is not None else None,
@@ -185,9 +187,10 @@ class DockerRuntime:
 
     def remove(self, container_id: str) -> None:
         with translate("container", container_id):
-            full_id = str(self._client.api.inspect_container(container_id).get("Id", ""))
+            found = self._client.api.inspect_container(container_id)
             self._client.api.remove_container(container_id, force=True, v=True)
-        ledger.forget(full_id)
+        ledger.forget(str(found.get("Id", "")))
+        ledger.forget_name("container", str(found.get("Name", "")).lstrip("/"))
 
     def inspect(self, container_id: str) -> ContainerState:
         with translate("container", container_id):
@@ -292,17 +295,36 @@ class DockerRuntime:
                 found.append(
                     ProjectObject(
                         kind="container", id=str(c["Id"]), name=name, labels=c["Labels"] or {},
-                        created=ledger.created(str(c["Id"])),
+                        created=ledger.created(str(c["Id"]))
+                        or ledger.intended("container", name),
                     )
                 )
             for n in self._client.api.networks(filters={"label": labels}):
                 found.append(
                     ProjectObject(
                         kind="network", id=str(n["Id"]), name=str(n["Name"]),
-                        labels=n.get("Labels") or {}, created=ledger.created(str(n["Id"])),
+                        labels=n.get("Labels") or {},
+                        created=ledger.created(str(n["Id"]))
+                        or ledger.intended("network", str(n["Name"])),
                     )
                 )
         return found
+
+
+@contextlib.contextmanager
+def _intended(kind: str, name: str) -> Iterator[None]:
+    """The name of an object about to be created in the ledger (see
+    :mod:`orchestrator.runtime.ledger`) for as long as the engine may hold it: kept when the
+    request succeeds or ends without an answer from the engine, dropped when the engine
+    refuses it (unless an earlier request of ours made the name already)."""
+    earlier = ledger.intended(kind, name)
+    ledger.intend(kind, name)
+    try:
+        yield
+    except (docker.errors.APIError, SubnetInUse):  # answered: the engine made nothing
+        if not earlier:
+            ledger.forget_name(kind, name)
+        raise
 
 
 def _sample(raw: dict[str, Any]) -> StatsSample | None:

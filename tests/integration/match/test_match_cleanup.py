@@ -105,3 +105,69 @@ def test_cleanup_after_kill_9(runtime: Any, test_image: str, tmp_path: Path,
         if process.poll() is None:
             process.kill()
         hlvs(["cleanup", "--match", match_id])
+
+
+def test_objects_whose_creation_answer_was_lost_are_still_cleaned_up(
+        runtime: Any, test_image: str, monkeypatch: pytest.MonkeyPatch,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    """A runner killed while the engine creates (the request sent, the answer never read) has
+    no id for the object; it entered the name first, so cleanup still removes it."""
+    import requests.exceptions
+
+    from orchestrator.engine import LABEL_MATCH, LABEL_PROJECT
+    from orchestrator.runtime.port import ContainerRequest, NetworkRequest
+
+    match_id = f"lost{uuid.uuid4().hex[:8]}"
+    labels = {LABEL_PROJECT: "1", LABEL_MATCH: match_id}
+    api = runtime._client.api
+    for method in ("create_container", "create_network"):
+        real = getattr(api, method)
+
+        def answer_lost(*args: Any, _real: Any = real, **kwargs: Any) -> Any:
+            _real(*args, **kwargs)  # the engine makes it ...
+            raise requests.exceptions.ConnectionError("the runner died before the answer")
+
+        monkeypatch.setattr(api, method, answer_lost)
+    third = int(match_id[-4:], 16) % 150 + 20  # own_engine.py takes 200-249
+    try:
+        with pytest.raises(Exception, match="died before the answer"):
+            runtime.create_container(ContainerRequest(
+                name=f"hlvs-{match_id}-robot", image=test_image, command=("sleep", "60"),
+                labels=labels))
+        with pytest.raises(Exception, match="died before the answer"):
+            runtime.create_network(NetworkRequest(
+                name=f"hlvs-{match_id}-net", subnet=f"10.251.{third}.0/24",
+                gateway=f"10.251.{third}.1", internal=True, bridge_name=f"hl{match_id[-8:]}",
+                labels=labels))
+        monkeypatch.undo()
+        found = runtime.list_project(match_id=match_id)
+        assert sorted((o.kind, o.created) for o in found) == [("container", True),
+                                                              ("network", True)]
+        capsys.readouterr()
+        assert hlvs(["cleanup", "--match", match_id]) == 0
+        removed = json.loads(capsys.readouterr().out)
+        assert removed["containers"] == [f"hlvs-{match_id}-robot"]
+        assert removed["networks"] == [f"hlvs-{match_id}-net"]
+        assert runtime.list_project(match_id=match_id) == []
+        from orchestrator.runtime import ledger
+
+        assert not ledger.intended("container", f"hlvs-{match_id}-robot")
+        assert not ledger.intended("network", f"hlvs-{match_id}-net")
+    finally:
+        monkeypatch.undo()
+        for obj in runtime.list_project(match_id=match_id):
+            (runtime.remove if obj.kind == "container" else runtime.remove_network)(obj.id)
+
+
+def test_a_refused_creation_leaves_no_name_behind(runtime: Any) -> None:
+    """The engine answered "no" (an image it does not have): nothing was made, nothing of the
+    request stays in the ledger."""
+    from orchestrator.errors import OrchestratorError
+    from orchestrator.runtime import ledger
+    from orchestrator.runtime.port import ContainerRequest
+
+    name = f"hlvs-refused{uuid.uuid4().hex[:8]}"
+    with pytest.raises(OrchestratorError):
+        runtime.create_container(ContainerRequest(
+            name=name, image="hlvs-runner-test/no-such-image:none", command=("true",)))
+    assert not ledger.intended("container", name)
