@@ -380,11 +380,24 @@ def _shut_down(
     from tournament.jobs import DEFAULT_STOP_GRACE_S, STOPPING
 
     if STOPPING.is_set():
-        scheduler.shutdown(wait=False)
+        stop_scheduler(scheduler, wait=False)
         grace = ledger.get_meta("stop_grace_s")
         _wait_for_steps(running, (float(grace) if grace else DEFAULT_STOP_GRACE_S) + 15.0)
     else:
-        scheduler.shutdown(wait=not stopped_by_user)
+        stop_scheduler(scheduler, wait=not stopped_by_user)
+
+
+def stop_scheduler(scheduler: BackgroundScheduler, *, wait: bool) -> None:
+    """Shut ``scheduler`` down once its pass over the job store has ended.
+
+    APScheduler removes a one-time job from its store after handing it to an executor; a
+    shutdown in between (a quick job, ``deliver``, ended the tournament meanwhile) made that
+    removal fail in the scheduler's thread (``JobLookupError``) and left the job in the state
+    file. Paused first, the scheduler starts no new pass; listing the jobs waits for the pass
+    under way (both take the job stores' lock)."""
+    scheduler.pause()
+    scheduler.get_jobs()
+    scheduler.shutdown(wait=wait)
 
 
 def _notify_loop(ledger: Ledger, done: threading.Event, every_s: float = 2.0) -> None:

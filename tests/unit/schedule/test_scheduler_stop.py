@@ -1,0 +1,68 @@
+"""The tournament's scheduler stops cleanly when a one-time job ends the tournament while the
+scheduler is still between handing that job to its executor and removing it from the store."""
+
+from __future__ import annotations
+
+import threading
+import time
+from datetime import UTC, datetime
+from typing import Any
+
+import pytest
+from apscheduler.executors.pool import ThreadPoolExecutor
+from apscheduler.jobstores.memory import MemoryJobStore
+from apscheduler.schedulers.background import BackgroundScheduler
+
+from tournament.runner import stop_scheduler
+
+
+class _SlowToReturn(ThreadPoolExecutor):
+    """Submits the job, then takes a while before the scheduler may go on (and remove it)."""
+
+    def submit_job(self, job: Any, run_times: Any) -> None:
+        super().submit_job(job, run_times)
+        time.sleep(0.5)
+
+
+def _job(done: threading.Event) -> None:
+    done.set()
+
+
+@pytest.mark.parametrize("wait", [True, False])
+def test_a_stop_during_the_schedulers_pass_waits_for_it(
+        wait: bool, monkeypatch: pytest.MonkeyPatch) -> None:
+    failures: list[BaseException | None] = []
+    monkeypatch.setattr(threading, "excepthook", lambda args: failures.append(args.exc_value))
+    scheduler = BackgroundScheduler(jobstores={"default": MemoryJobStore()},
+                                    executors={"default": _SlowToReturn(1)}, timezone=UTC)
+    done = threading.Event()
+    scheduler.add_job(_job, "date", run_date=datetime.now(UTC), args=[done], id="deliver:m1",
+                      misfire_grace_time=None)
+    scheduler.start()
+    assert done.wait(10), "the job did not run"
+    thread = scheduler._thread
+    stop_scheduler(scheduler, wait=wait)  # the scheduler is still in submit_job
+    assert not thread.is_alive()  # shutdown joins the scheduler's thread
+    assert failures == []
+    assert scheduler._jobstores["default"].get_all_jobs() == []  # removed, not left for later
+
+
+def test_a_plain_shutdown_there_fails_in_the_schedulers_thread(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """What :func:`stop_scheduler` prevents (APScheduler 3's behaviour): if this starts to pass,
+    the library changed and the workaround may go."""
+    from apscheduler.jobstores.base import JobLookupError
+
+    failures: list[BaseException | None] = []
+    monkeypatch.setattr(threading, "excepthook", lambda args: failures.append(args.exc_value))
+    scheduler = BackgroundScheduler(jobstores={"default": MemoryJobStore()},
+                                    executors={"default": _SlowToReturn(1)}, timezone=UTC)
+    done = threading.Event()
+    scheduler.add_job(_job, "date", run_date=datetime.now(UTC), args=[done], id="deliver:m1",
+                      misfire_grace_time=None)
+    scheduler.start()
+    assert done.wait(10)
+    thread = scheduler._thread
+    scheduler.shutdown(wait=False)
+    assert not thread.is_alive()
+    assert len(failures) == 1 and isinstance(failures[0], JobLookupError)
