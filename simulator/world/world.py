@@ -30,7 +30,7 @@ from simulator.errors import PhysicsDivergence
 from simulator.world import commands
 from simulator.world.camera_model import CameraModel
 from simulator.world.devices import DeviceAccess
-from simulator.world.divergence import DivergenceWatch
+from simulator.world.divergence import DivergenceWatch, route_mujoco_warnings
 from simulator.world.flat import FlatData
 from simulator.world.indices import build_index
 from simulator.world.look import look_for
@@ -66,6 +66,7 @@ class World(DeviceAccess):
         ball_turf_pair: bool = False,
     ) -> None:
         substeps = _checked_substeps(physics_dt_s, step_ms, divergence_policy, placements)
+        route_mujoco_warnings()
         ids = [p.id for p in placements]
         self.field = field
         self.placements = tuple(placements)

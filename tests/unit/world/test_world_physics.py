@@ -96,6 +96,41 @@ def test_divergence_fails_with_the_typed_error(one_robot_world: World) -> None:
     assert caught.value.sim_time_ms == 8
 
 
+def test_mujoco_s_warnings_go_to_the_log_not_to_a_file_in_the_working_folder(
+        one_robot_world: World, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+        caplog: pytest.LogCaptureFixture) -> None:
+    import logging
+
+    import mujoco
+
+    from simulator.world import divergence
+
+    monkeypatch.chdir(tmp_path)
+    world = one_robot_world
+    world.data.qvel[world.model.joint("red_1/Neck").dofadr[0]] = np.nan
+    with caplog.at_level(logging.DEBUG, logger="simulator.mujoco"):
+        with pytest.raises(PhysicsDivergence):
+            world.step()
+        assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+        said = [r for r in caplog.records if r.name == "simulator.mujoco"]
+        assert [r.levelno for r in said] == [logging.DEBUG]  # the world reports it itself
+        assert "Nan, Inf or huge value in QVEL" in said[0].getMessage()
+        caplog.clear()
+        monkeypatch.setattr(divergence, "_last_said", {})
+        handler = mujoco.get_mju_user_warning()
+        assert handler is not None
+        for n in (100, 101, 102):  # the same kind three times: said once
+            handler(f"Pre-allocated constraint buffer is full. Increase memory to {n}M.")
+        handler("Something else entirely")
+    said = [(r.levelno, r.getMessage()) for r in caplog.records if r.name == "simulator.mujoco"]
+    assert said == [
+        (logging.WARNING, "MuJoCo: Pre-allocated constraint buffer is full. Increase memory "
+                          "to 100M."),
+        (logging.WARNING, "MuJoCo: Something else entirely"),
+    ]
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+
+
 def test_divergence_reset_robot_policy_keeps_running() -> None:
     robots = [
         RobotPlacement(id=RED_1, model="kid-default", x_m=-1.0, y_m=0.0, yaw_rad=0.0),
