@@ -4,6 +4,11 @@ The server's host key is checked against the pinned ``host_key``, else the ``kno
 of the credentials, else the operator's ``~/.ssh/known_hosts``; an unknown key is refused (no
 auto-add). Files are written to ``.<name>.part`` and renamed into place, so a file with its final
 name is always complete.
+
+A session's failure is reported once, as a :class:`DeliveryError` naming the team and the
+target; paramiko's own warnings and errors from the session's reading thread (the traceback it
+logs when a silent server's banner never comes, or the socket is closed under it) go to this
+module's log at debug level.
 """
 
 from __future__ import annotations
@@ -15,6 +20,7 @@ import logging
 import posixpath
 import socket
 import stat
+import threading
 from pathlib import Path
 from typing import Protocol
 
@@ -31,6 +37,28 @@ log = logging.getLogger(__name__)
 CONNECT_TIMEOUT_S = 10.0
 IO_TIMEOUT_S = 30.0
 WINDOW_BYTES = 8 << 20
+_OURS = "hlvs_session"  # set on the transports this module opens
+
+
+class _ReportedByUs(logging.Filter):
+    """paramiko's warnings and errors from the reading thread of a transport this module
+    opened go to this module's log at debug level: every failure of such a session reaches
+    the caller as a :class:`DeliveryError` (a traceback of paramiko's besides it, when a
+    silent server's banner never came, said the same thing twice)."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        if record.levelno < logging.WARNING:
+            return True
+        thread = next((t for t in threading.enumerate() if t.ident == record.thread), None)
+        if not getattr(thread, _OURS, False):
+            return True
+        log.debug("SSH session (%s): %s", record.levelname.lower(), record.getMessage())
+        return False
+
+
+logging.getLogger("paramiko.transport").addFilter(_ReportedByUs())
+
+
 _KEY_CLASSES: tuple[type[paramiko.PKey], ...] = (
     paramiko.Ed25519Key,
     paramiko.ECDSAKey,
@@ -89,6 +117,7 @@ class SftpUploader:
         except OSError as exc:
             raise fail("unreachable", f"cannot connect: {exc.strerror or exc}") from exc
         transport = paramiko.Transport(sock, default_window_size=WINDOW_BYTES)
+        setattr(transport, _OURS, True)
         transport.banner_timeout = CONNECT_TIMEOUT_S
         transport.auth_timeout = CONNECT_TIMEOUT_S
         try:
