@@ -32,7 +32,7 @@ if TYPE_CHECKING:
     from service.errors import ClientError, InvalidInput, NotFound, ServiceError
     from service.results import stored_many
     from service.services import Services
-    from service.settings import Settings, open_database
+    from service.settings import Settings, open_data_dir, open_database
     from service.tokens import Principal
     from service.views import SubmissionReport
 
@@ -54,6 +54,7 @@ __all__ = [
     "get_db",
     "get_services",
     "list_tokens",
+    "open_data_dir",
     "open_database",
     "open_storage",
     "pool_from_settings",
@@ -78,7 +79,7 @@ if not TYPE_CHECKING:
         ),
         "service.errors": ("ClientError", "InvalidInput", "NotFound", "ServiceError"),
         "service.results": ("stored_many",),
-        "service.settings": ("Settings", "open_database"),
+        "service.settings": ("Settings", "open_data_dir", "open_database"),
         "service.tokens": ("Principal",),
         "service.views": ("SubmissionReport",),
     })

@@ -33,7 +33,7 @@ from service.db import (
 )
 from service.errors import AuthError, ServiceError
 from service.services import PoolFactory, Preflight, Services
-from service.settings import Settings, open_database
+from service.settings import Settings, open_data_dir, open_database
 
 if TYPE_CHECKING:
     from sqlalchemy.engine import Engine
@@ -176,13 +176,11 @@ def open_storage(settings: Settings) -> tuple[Engine, Sealer]:
     serve`` opens it before the server starts (and hands it to :func:`create_app`), so that a
     wrong key or an unreachable database is one line naming the setting, not a traceback in
     the server's startup log."""
-    from orchestrator import private_dir
     from service.db import transaction
     from service.sealing import key_file, load_sealer
     from service.teamfiles import seal_stored
 
-    private_dir(settings.data_dir)  # 0700; the files below it are 0600
-    private_dir(settings.matches_dir)
+    open_data_dir(settings)  # 0700; the files below it are 0600
     sealer = load_sealer(
         key=settings.secret_key, key_path=key_file(settings.data_dir, settings.secret_key_file)
     )

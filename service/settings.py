@@ -155,6 +155,27 @@ def webhook_networks(settings: Settings) -> tuple[IPNetwork, ...]:
     return networks(settings.webhook_allow)
 
 
+def open_data_dir(settings: Settings) -> Path:
+    """The service's data folder (and its matches folder), created 0700 if missing; one that
+    cannot be made or written is a :class:`SettingsError` naming ``HLVS_SERVICE_DATA_DIR`` and
+    the system's reason."""
+    from orchestrator import private_dir
+
+    try:
+        private_dir(settings.data_dir)
+        private_dir(settings.matches_dir)
+    except OSError as exc:
+        if isinstance(exc, FileExistsError | NotADirectoryError) and exc.filename:
+            reason = f"{exc.filename} is a file, not a folder"
+        else:
+            reason = f"{exc.strerror or exc}" + (f" ({exc.filename})" if exc.filename else "")
+        raise SettingsError(
+            name=PREFIX + "DATA_DIR", value=str(settings.data_dir),
+            expected=f"a folder the service can create and write: {reason}",
+        ) from exc
+    return settings.data_dir
+
+
 def open_database(settings: Settings) -> Engine:
     """The service's database (``db_url``), migrated to the newest schema; one that cannot be
     reached is a :class:`SettingsError` naming the URL (its password hidden) and the driver's
@@ -257,4 +278,4 @@ def _check(settings: Settings) -> None:
 
 
 __all__ = ["LOG_TARGET_ALLOW_SETTING", "Settings", "WEBHOOK_ALLOW_SETTING",
-           "log_target_networks", "open_database", "webhook_networks"]
+           "log_target_networks", "open_data_dir", "open_database", "webhook_networks"]

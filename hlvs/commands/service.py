@@ -153,13 +153,12 @@ def _check_database(args: argparse.Namespace, settings: Settings) -> None:
 
 
 def _sessions(args: argparse.Namespace) -> Any:
-    from orchestrator import private_dir
-    from service import open_database
+    from service import open_data_dir, open_database
     from service.db import session_factory
 
     settings = _settings(args)
     _check_database(args, settings)
-    private_dir(settings.data_dir)
+    open_data_dir(settings)
     return session_factory(open_database(settings))
 
 

@@ -115,3 +115,18 @@ def test_a_busy_port_is_one_line_before_anything_starts(tmp_path: Path) -> None:
     _one_line(proc, "--port", f"127.0.0.1:{port}", "in use")
     assert not data.exists()  # nothing opened, no worker started
     assert "Application startup" not in proc.stderr
+
+
+@pytest.mark.parametrize("command", [["serve", "--no-worker"], ["admin", "team", "list"]])
+@pytest.mark.parametrize("where", ["a file", "below a file"])
+def test_a_data_folder_that_cannot_be_made_is_one_line(
+    tmp_path: Path, command: list[str], where: str
+) -> None:
+    in_the_way = tmp_path / "service-data"
+    in_the_way.write_text("an operator's notes\n")
+    data = in_the_way if where == "a file" else in_the_way / "league"
+    argv = [*command, "--port", str(free_port())] if command[0] == "serve" else command
+    proc = _run(argv, {"HLVS_SERVICE_DATA_DIR": str(data)}, tmp_path)
+    _one_line(proc, "HLVS_SERVICE_DATA_DIR", str(data), "a folder the service can create",
+              f"{in_the_way} is a file, not a folder")
+    assert in_the_way.read_text() == "an operator's notes\n"  # nothing lost
