@@ -218,6 +218,7 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--fps", type=float, default=25.0, help="frames per second (default 25)")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
+    logging.getLogger("OpenGL").setLevel(logging.WARNING)  # its INFO lines are noise here
     if args.width <= 0 or args.height <= 0 or args.fps <= 0:
         print("error: --width, --height and --fps must be positive", file=sys.stderr)
         return 2
