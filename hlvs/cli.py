@@ -8,7 +8,9 @@ Rules every command follows (a unit test checks them for every command that exis
   else is imported inside the function that runs the command, so ``hlvs --help`` stays fast.
 - Every sub-command and every option or argument has a ``help=`` text.
 - It returns an :class:`~orchestrator.exitcodes.ExitCode` or raises an ``OrchestratorError``;
-  the mapping of errors to codes is here, once.
+  the mapping of errors to codes is here, once. An ``OSError`` that names a file (an output
+  folder that cannot be made, a full disk) is one line naming it, exit 2 (3 for the host's
+  trouble: a full or read-only disk).
 - Logging: WARNING by default, since most commands print their result on stdout; commands that
   run for long (a match, a schedule) ``set_defaults(log_level=logging.INFO)``. ``-v`` lowers the
   level by one step, ``-q`` raises it, before or after the command name.
@@ -19,6 +21,7 @@ Rules every command follows (a unit test checks them for every command that exis
 from __future__ import annotations
 
 import argparse
+import errno
 import logging
 import os
 import sys
@@ -205,6 +208,30 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:  # `hlvs ... | head`
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return ExitCode.OK
+    except OSError as exc:
+        if exc.filename is None:  # not about a file or folder: a defect, with its traceback
+            raise
+        return _file_error(exc)
+
+
+_HOST_TROUBLE = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EIO, errno.EROFS})
+
+
+def _file_error(exc: OSError) -> int:
+    """A file or folder the command could not read or write (an output folder where none can
+    be made, a full disk): one line naming it, the traceback at debug level (``-vv``)."""
+    logging.getLogger(__name__).debug("file error", exc_info=exc)
+    names = str(exc.filename) + (f" -> {exc.filename2}" if exc.filename2 else "")
+    reason = exc.strerror or str(exc)
+    if exc.errno in (errno.EEXIST, errno.ENOTDIR):  # a file where a folder was to be
+        from pathlib import Path
+
+        path = Path(os.fsdecode(exc.filename))
+        found = next((p for p in (path, *path.parents) if p.exists()), None)
+        if found is not None and not found.is_dir():
+            names, reason = str(found), "a file where a folder is needed"
+    print(f"{PROG}: {names}: {reason}", file=sys.stderr)
+    return ExitCode.INFRASTRUCTURE if exc.errno in _HOST_TROUBLE else ExitCode.INVALID
 
 
 if __name__ == "__main__":

@@ -185,6 +185,38 @@ def test_compose_json_names_the_files_and_both_compose_commands(
     assert "version:" not in output.read_text()
 
 
+def test_an_output_folder_that_cannot_be_made_is_one_line_naming_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    game = Path(__file__).parents[2] / "configs" / "examples" / "scrimmage_1v1" / "game.json"
+    in_the_way = tmp_path / "notes.txt"
+    in_the_way.write_text("kept\n")
+    output = in_the_way / "docker-compose.yml"
+    code = main(["compose", str(game), "-o", str(output), "--simulator-image", "sim:x"])
+    assert code == ExitCode.INVALID
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert [line for line in err.splitlines() if line] == [
+        f"hlvs: {in_the_way}: a file where a folder is needed"]
+    assert in_the_way.read_text() == "kept\n"
+
+
+def test_a_full_disk_is_the_host_s_trouble(monkeypatch: pytest.MonkeyPatch,
+                                          capsys: pytest.CaptureFixture[str]) -> None:
+    import errno
+
+    from hlvs.commands import check
+
+    def full(args: argparse.Namespace) -> int:
+        raise OSError(errno.ENOSPC, "No space left on device", "/srv/matches/m1/replay.hlvsrec")
+
+    monkeypatch.setattr(check, "run", full)  # the parser is built at each call of main
+    code = main(["check", "x.json"])
+    assert code == ExitCode.INFRASTRUCTURE, capsys.readouterr().err
+    assert capsys.readouterr().err.strip() == (
+        "hlvs: /srv/matches/m1/replay.hlvsrec: No space left on device")
+
+
 @pytest.mark.parametrize(
     ("results", "failure", "code"),
     [
