@@ -91,8 +91,13 @@ def _deliver(args: argparse.Namespace) -> int:
     from orchestrator.delivery import deliver_pending
 
     _quiet_libraries()
+    store = args.store or default_store()
+    if not store.is_dir():  # not made here: a mistyped --store would leave an empty one
+        if not args.json:  # (--json: one line per outcome, none here)
+            print("nothing to deliver" + _no_store(store))
+        return ExitCode.OK
     with progress() as bars:
-        outcomes = deliver_pending(args.store or default_store(), team=args.team, progress=bars)
+        outcomes = deliver_pending(store, team=args.team, progress=bars)
     for outcome in outcomes:
         print(json.dumps(outcome.to_json()) if args.json else _describe_outcome(outcome))
     if not outcomes and not args.json:
@@ -123,10 +128,19 @@ def _status(args: argparse.Namespace) -> int:
         print(json.dumps([s.to_json() for s in sets], indent=2))
         return ExitCode.OK
     if not sets:
-        print("no log sets are waiting")
+        print("no log sets are waiting" + _no_store(args.store or default_store()))
     for pending in sets:
         print(_describe_set(pending))
     return ExitCode.OK
+
+
+def _no_store(store: Path) -> str:
+    """Said after "nothing waiting" when the store folder is not there (a command run from
+    another folder than the match's, whose default store is ./log-store)."""
+    if store.is_dir():
+        return ""
+    return (f": there is no log store at {store} (--store DIR or ${STORE_ENV} names the one "
+            "the matches queued to)")
 
 
 def _describe_set(pending: PendingSet) -> str:

@@ -84,3 +84,25 @@ def test_deliver_without_credentials_fails_with_the_cause(
     assert outcome["team"] == "Big Feet" and outcome["error_kind"] == "config"
     assert main(["logs", "status"]) == 0
     assert "last error (config)" in capsys.readouterr().out
+
+
+def test_a_store_that_is_not_there_is_said_and_not_made(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Run from another folder than the matches' (the default store is ./log-store), or with a
+    mistyped --store: "nothing waiting" says where it looked, and no empty store is left."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delenv("HLVS_LOG_STORE", raising=False)
+    assert main(["logs", "status"]) == 0
+    assert capsys.readouterr().out.strip() == (
+        f"no log sets are waiting: there is no log store at {tmp_path / 'log-store'} "
+        "(--store DIR or $HLVS_LOG_STORE names the one the matches queued to)")
+    typo = tmp_path / "log-stroe"
+    assert main(["logs", "deliver", "--store", str(typo)]) == 0
+    assert f"nothing to deliver: there is no log store at {typo}" in capsys.readouterr().out
+    assert main(["logs", "deliver", "--store", str(typo), "--json"]) == 0
+    assert capsys.readouterr().out == ""
+    assert not typo.exists() and not (tmp_path / "log-store").exists()
+    typo.mkdir()  # an empty store: nothing to add
+    assert main(["logs", "status", "--store", str(typo)]) == 0
+    assert capsys.readouterr().out.strip() == "no log sets are waiting"
