@@ -28,9 +28,10 @@ def _job(done: threading.Event) -> None:
     done.set()
 
 
-@pytest.mark.parametrize("wait", [True, False])
-def test_a_stop_during_the_schedulers_pass_waits_for_it(
-        wait: bool, monkeypatch: pytest.MonkeyPatch) -> None:
+def _in_its_pass(monkeypatch: pytest.MonkeyPatch
+                 ) -> tuple[BackgroundScheduler, list[BaseException | None]]:
+    """A scheduler whose one-time job has run while the scheduler is still handing it over
+    (before removing it from the store), and the exceptions of its threads."""
     failures: list[BaseException | None] = []
     monkeypatch.setattr(threading, "excepthook", lambda args: failures.append(args.exc_value))
     scheduler = BackgroundScheduler(jobstores={"default": MemoryJobStore()},
@@ -40,6 +41,13 @@ def test_a_stop_during_the_schedulers_pass_waits_for_it(
                       misfire_grace_time=None)
     scheduler.start()
     assert done.wait(10), "the job did not run"
+    return scheduler, failures
+
+
+@pytest.mark.parametrize("wait", [True, False])
+def test_a_stop_during_the_schedulers_pass_waits_for_it(
+        wait: bool, monkeypatch: pytest.MonkeyPatch) -> None:
+    scheduler, failures = _in_its_pass(monkeypatch)
     thread = scheduler._thread
     stop_scheduler(scheduler, wait=wait)  # the scheduler is still in submit_job
     assert not thread.is_alive()  # shutdown joins the scheduler's thread
@@ -53,15 +61,7 @@ def test_a_plain_shutdown_there_fails_in_the_schedulers_thread(
     the library changed and the workaround may go."""
     from apscheduler.jobstores.base import JobLookupError
 
-    failures: list[BaseException | None] = []
-    monkeypatch.setattr(threading, "excepthook", lambda args: failures.append(args.exc_value))
-    scheduler = BackgroundScheduler(jobstores={"default": MemoryJobStore()},
-                                    executors={"default": _SlowToReturn(1)}, timezone=UTC)
-    done = threading.Event()
-    scheduler.add_job(_job, "date", run_date=datetime.now(UTC), args=[done], id="deliver:m1",
-                      misfire_grace_time=None)
-    scheduler.start()
-    assert done.wait(10)
+    scheduler, failures = _in_its_pass(monkeypatch)
     thread = scheduler._thread
     scheduler.shutdown(wait=False)
     assert not thread.is_alive()
