@@ -262,6 +262,32 @@ def _scheduler(state: str, slots: int, running: RunningJobs,
     return scheduler
 
 
+def scheduler_alive(scheduler: BackgroundScheduler) -> bool:
+    """Whether the scheduler's thread still runs. An error APScheduler does not catch in its
+    pass over the job store (the state file busy beyond SQLite's timeout while it removes a
+    job, say) ends that thread, and the scheduler would go on looking as if it ran: nothing
+    would be started again, silently."""
+    thread = getattr(scheduler, "_thread", None)  # BackgroundScheduler's thread (APScheduler 3)
+    return thread is None or thread.is_alive()
+
+
+def _restarted(old: BackgroundScheduler, state: str, slots: int, running: RunningJobs,
+               wake: threading.Event) -> BackgroundScheduler:
+    """A new scheduler on the same state file in place of ``old``, whose thread ended. The steps
+    ``old`` runs go on in its executors (``running`` still follows them); a job it left in the
+    store runs again, and its step finds itself done (each step moves the match's state on
+    only from where it expects it)."""
+    log.error("the job scheduler's thread ended (its error is above); starting a new one on "
+              "%s", state)
+    try:
+        old.shutdown(wait=False)
+    except Exception:  # noqa: BLE001 - the dead scheduler's own state: the new one is what counts
+        log.exception("the ended scheduler did not shut down cleanly")
+    scheduler = _scheduler(state, slots, running, wake)
+    scheduler.start()
+    return scheduler
+
+
 def _print_changes(rows: list[MatchRow], last: dict[str, str]) -> None:
     """Print each match whose state changed since ``last`` (updated), one line each."""
     for row in rows:
@@ -332,6 +358,8 @@ def run_schedule(
                 beat(ledger)
                 settle_hand_deliveries(ledger, schedule)  # hlvs logs deliver
                 beaten = time.monotonic()
+            if not scheduler_alive(scheduler):
+                scheduler = _restarted(scheduler, state, schedule.simulator_slots, running, wake)
             reconcile(scheduler, ledger, state, running.ids())
             rows = ledger.rows()
             _print_changes(rows, last)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import threading
 import time
 from datetime import UTC, datetime
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -66,3 +67,50 @@ def test_a_plain_shutdown_there_fails_in_the_schedulers_thread(
     scheduler.shutdown(wait=False)
     assert not thread.is_alive()
     assert len(failures) == 1 and isinstance(failures[0], JobLookupError)
+
+
+def test_a_scheduler_thread_that_died_is_replaced_and_the_tournament_ends(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    """The state file busy beyond SQLite's timeout while APScheduler removes a job it handed
+    over: the error ends APScheduler's thread (it does not catch it there). The runner sees the
+    thread gone, starts a new scheduler on the same state file, and every match is played and
+    delivered once."""
+    import logging
+
+    from apscheduler.jobstores.sqlalchemy import SQLAlchemyJobStore
+    from sqlalchemy.exc import OperationalError
+
+    from tests.unit.schedule.test_schedule import COMPRESSED, FAKE, services_log, write_schedule
+    from tournament import Ledger, ScheduledMatchState, run_schedule
+
+    failures: list[BaseException | None] = []
+    monkeypatch.setattr(threading, "excepthook", lambda args: failures.append(args.exc_value))
+    real_remove = SQLAlchemyJobStore.remove_job
+    busy = {"left": 1}
+
+    def remove_job(store: SQLAlchemyJobStore, job_id: str) -> None:
+        if job_id.startswith("pull:") and busy["left"]:
+            busy["left"] -= 1
+            raise OperationalError("DELETE FROM apscheduler_jobs", {}, Exception("locked"))
+        real_remove(store, job_id)
+
+    monkeypatch.setattr(SQLAlchemyJobStore, "remove_job", remove_job)
+    path = write_schedule(tmp_path, COMPRESSED + "matches:\n  - {id: m1, red: alpha, "
+                          "blue: bravo, stream_start: '+3.5s', stream_length_s: 0.2}\n")
+    state = tmp_path / "state.sqlite"
+    finished: list[int] = []
+    with caplog.at_level(logging.ERROR, logger="tournament.runner"):
+        runner = threading.Thread(target=lambda: finished.append(run_schedule(
+            path, state, services=FAKE, exit_when_done=True, poll_s=0.1)))
+        runner.start()
+        runner.join(timeout=30)
+        assert not runner.is_alive(), "the tournament stalled with its scheduler's thread gone"
+    assert finished == [0]
+    assert busy["left"] == 0 and len(failures) == 1
+    assert isinstance(failures[0], OperationalError)
+    assert any("the job scheduler's thread ended" in r.getMessage() for r in caplog.records)
+    row = Ledger(state).row("m1")
+    assert row.state is ScheduledMatchState.DELIVERED and row.attempts == 1
+    steps = [what for what, match, _ in services_log(path) if match == "m1"]
+    assert steps == ["pull", "play-start", "play-end", "deliver"]  # each step once
