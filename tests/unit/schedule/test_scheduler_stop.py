@@ -13,16 +13,21 @@ import pytest
 from apscheduler.executors.pool import ThreadPoolExecutor
 from apscheduler.jobstores.memory import MemoryJobStore
 from apscheduler.schedulers.background import BackgroundScheduler
+from apscheduler.schedulers.base import STATE_RUNNING
 
 from tournament.runner import stop_scheduler
 
 
 class _SlowToReturn(ThreadPoolExecutor):
-    """Submits the job, then takes a while before the scheduler may go on (and remove it)."""
+    """Submits the job, then lets the scheduler go on (and remove it) only once it is no
+    longer running (paused or stopped): the stop always comes in between, however slow the
+    machine."""
 
     def submit_job(self, job: Any, run_times: Any) -> None:
         super().submit_job(job, run_times)
-        time.sleep(0.5)
+        deadline = time.monotonic() + 10.0
+        while self._scheduler.state == STATE_RUNNING and time.monotonic() < deadline:
+            time.sleep(0.01)
 
 
 def _job(done: threading.Event) -> None:
