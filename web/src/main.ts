@@ -35,10 +35,30 @@ function navigation(nav: HTMLElement, who: Who | null, service: boolean): void {
   }
 }
 
+/** GET `url`, tried again when the network fails (a connection the server closed as the
+ * browser reused it, a server busy starting): a passing failure is not a blank page. */
+async function fetchRetried(url: string, tries = 4): Promise<Response> {
+  for (let attempt = 1; ; attempt += 1) {
+    try {
+      return await fetch(url);
+    } catch (error) {
+      if (attempt >= tries) throw error;
+      await new Promise((resolve) => setTimeout(resolve, 500 * attempt));
+    }
+  }
+}
+
 async function route(): Promise<void> {
   const root = document.getElementById("app")!;
   const nav = document.querySelector("nav");
-  const service = (await fetch("/v1/health")).status !== 404;
+  let service: boolean;
+  try {
+    service = (await fetchRetried("/v1/health")).status !== 404;
+  } catch (error) {
+    root.append(el("p", { class: "error", "data-testid": "error" },
+      `The server does not answer (${error instanceof Error ? error.message : String(error)}): reload this page when it is back.`));
+    return;
+  }
   const who = service ? await whoAmI() : null;
   if (nav) navigation(nav, who, service);
   if (service && !who) {

@@ -214,3 +214,30 @@ def test_the_live_page_of_a_match_that_is_over_links_its_replay(
         page.locator("[data-testid=replay-link]").click()
         page.wait_for_function("window.hlvsViewer && window.hlvsViewer.ready", timeout=30_000)
         assert page.locator("[data-testid=team-red]").inner_text() == "Ants"
+
+
+def test_a_failed_first_request_is_tried_again_and_a_dead_server_is_said(
+        page: Any, match: Path) -> None:
+    """The page's first request (is this the service?) failing at the network (a connection
+    the server closed as the browser reused it): tried again, the replay shows; failing every
+    time, the page says so instead of staying blank (and raises nothing)."""
+    aborted: list[str] = []
+
+    def flaky(route: Any) -> None:
+        if len(aborted) < 2:
+            aborted.append(route.request.url)
+            route.abort("connectionreset")
+        else:
+            route.continue_()
+
+    with hlvs_view(match) as urls:
+        page.route("**/v1/health", flaky)
+        _open(page, urls[0])
+        assert len(aborted) == 2
+        page.unroute("**/v1/health")
+        page.route("**/v1/health", lambda route: route.abort("connectionrefused"))
+        page.goto(urls[0])
+        error = page.locator("[data-testid=error]")
+        error.wait_for(timeout=30_000)
+        assert error.inner_text().startswith("The server does not answer (")
+        assert page.evaluate("window.hlvsViewer === undefined")
