@@ -237,12 +237,45 @@ def _stop_now(stop: threading.Event, wake: threading.Event) -> None:
     wake.set()
 
 
+class TournamentScheduler(BackgroundScheduler):  # type: ignore[misc]
+    """APScheduler's background scheduler with a shutdown that never meets a pass over the
+    job store half done.
+
+    APScheduler removes a one-time job from its store after handing it to an executor; a
+    shutdown in between (a quick job, ``deliver``, ended the tournament meanwhile) made that
+    removal fail in the scheduler's thread (``JobLookupError``) and left the job in the state
+    file. Here each pass runs under a lock of ours, after a check whether the scheduler
+    closes: :meth:`close` takes the lock (waiting for a pass under way), marks the scheduler
+    closing, and only then shuts it down. (Pausing, then listing the jobs to wait for the
+    pass, left a window: a pass that had checked for the pause but not yet taken the job
+    stores' lock.)"""
+
+    def __init__(self, **options: Any) -> None:
+        super().__init__(**options)
+        self._pass = threading.Lock()
+        self._closing = False
+
+    def _process_jobs(self) -> float | None:
+        with self._pass:
+            if self._closing:
+                return None  # until the shutdown's wake-up
+            wait: float | None = super()._process_jobs()
+            return wait
+
+    def close(self, *, wait: bool) -> None:
+        """Shut down once no pass over the job store is under way (``wait``: for the running
+        jobs too, as :meth:`shutdown`)."""
+        with self._pass:
+            self._closing = True
+        self.shutdown(wait=wait)
+
+
 def _scheduler(state: str, slots: int, running: RunningJobs,
                wake: threading.Event) -> BackgroundScheduler:
     """The job scheduler of the state file ``state``: ``slots`` matches played at once; the
     jobs running kept in ``running``, ``wake`` set when one ended (its match may have a next
     step now)."""
-    scheduler = BackgroundScheduler(
+    scheduler = TournamentScheduler(
         jobstores={"default": SQLAlchemyJobStore(url=f"sqlite:///{state}")},
         executors={
             "default": ThreadPoolExecutor(2),
@@ -416,16 +449,12 @@ def _shut_down(
 
 
 def stop_scheduler(scheduler: BackgroundScheduler, *, wait: bool) -> None:
-    """Shut ``scheduler`` down once its pass over the job store has ended.
-
-    APScheduler removes a one-time job from its store after handing it to an executor; a
-    shutdown in between (a quick job, ``deliver``, ended the tournament meanwhile) made that
-    removal fail in the scheduler's thread (``JobLookupError``) and left the job in the state
-    file. Paused first, the scheduler starts no new pass; listing the jobs waits for the pass
-    under way (both take the job stores' lock)."""
-    scheduler.pause()
-    scheduler.get_jobs()
-    scheduler.shutdown(wait=wait)
+    """Shut ``scheduler`` down: a :class:`TournamentScheduler` once its pass over the job
+    store has ended, any other as it is."""
+    if isinstance(scheduler, TournamentScheduler):
+        scheduler.close(wait=wait)
+    else:
+        scheduler.shutdown(wait=wait)
 
 
 def _notify_loop(ledger: Ledger, done: threading.Event, every_s: float = 2.0) -> None:

@@ -15,18 +15,31 @@ from apscheduler.jobstores.memory import MemoryJobStore
 from apscheduler.schedulers.background import BackgroundScheduler
 from apscheduler.schedulers.base import STATE_RUNNING
 
-from tournament.runner import stop_scheduler
+from tournament.runner import TournamentScheduler, stop_scheduler
+
+
+class _Watched(TournamentScheduler):  # type: ignore[misc]
+    """The tournament's scheduler, telling when it is asked to close."""
+
+    def __init__(self, **options: Any) -> None:
+        super().__init__(**options)
+        self.asked = threading.Event()
+
+    def close(self, *, wait: bool) -> None:
+        self.asked.set()
+        super().close(wait=wait)
 
 
 class _SlowToReturn(ThreadPoolExecutor):
-    """Submits the job, then lets the scheduler go on (and remove it) only once it is no
-    longer running (paused or stopped): the stop always comes in between, however slow the
-    machine."""
+    """Submits the job, then lets the scheduler go on (and remove it) only once it was asked
+    to close or stopped: the stop always comes in between, however slow the machine."""
 
     def submit_job(self, job: Any, run_times: Any) -> None:
         super().submit_job(job, run_times)
+        asked = getattr(self._scheduler, "asked", threading.Event())
         deadline = time.monotonic() + 10.0
-        while self._scheduler.state == STATE_RUNNING and time.monotonic() < deadline:
+        while (self._scheduler.state == STATE_RUNNING and not asked.is_set()
+               and time.monotonic() < deadline):
             time.sleep(0.01)
 
 
@@ -34,14 +47,14 @@ def _job(done: threading.Event) -> None:
     done.set()
 
 
-def _in_its_pass(monkeypatch: pytest.MonkeyPatch
+def _in_its_pass(monkeypatch: pytest.MonkeyPatch, kind: type[BackgroundScheduler]
                  ) -> tuple[BackgroundScheduler, list[BaseException | None]]:
     """A scheduler whose one-time job has run while the scheduler is still handing it over
     (before removing it from the store), and the exceptions of its threads."""
     failures: list[BaseException | None] = []
     monkeypatch.setattr(threading, "excepthook", lambda args: failures.append(args.exc_value))
-    scheduler = BackgroundScheduler(jobstores={"default": MemoryJobStore()},
-                                    executors={"default": _SlowToReturn(1)}, timezone=UTC)
+    scheduler = kind(jobstores={"default": MemoryJobStore()},
+                     executors={"default": _SlowToReturn(1)}, timezone=UTC)
     done = threading.Event()
     scheduler.add_job(_job, "date", run_date=datetime.now(UTC), args=[done], id="deliver:m1",
                       misfire_grace_time=None)
@@ -53,9 +66,11 @@ def _in_its_pass(monkeypatch: pytest.MonkeyPatch
 @pytest.mark.parametrize("wait", [True, False])
 def test_a_stop_during_the_schedulers_pass_waits_for_it(
         wait: bool, monkeypatch: pytest.MonkeyPatch) -> None:
-    scheduler, failures = _in_its_pass(monkeypatch)
+    scheduler, failures = _in_its_pass(monkeypatch, _Watched)
     thread = scheduler._thread
+    started = time.monotonic()
     stop_scheduler(scheduler, wait=wait)  # the scheduler is still in submit_job
+    assert time.monotonic() - started < 5.0  # not the slow executor's 10 s deadline
     assert not thread.is_alive()  # shutdown joins the scheduler's thread
     assert failures == []
     assert scheduler._jobstores["default"].get_all_jobs() == []  # removed, not left for later
@@ -67,7 +82,7 @@ def test_a_plain_shutdown_there_fails_in_the_schedulers_thread(
     the library changed and the workaround may go."""
     from apscheduler.jobstores.base import JobLookupError
 
-    scheduler, failures = _in_its_pass(monkeypatch)
+    scheduler, failures = _in_its_pass(monkeypatch, BackgroundScheduler)
     thread = scheduler._thread
     scheduler.shutdown(wait=False)
     assert not thread.is_alive()
