@@ -33,19 +33,21 @@ def ledger_dir() -> Path:
     return state_dir() / "created"
 
 
-def note(object_id: str) -> None:
-    """Enter ``object_id`` (best effort: a state folder that cannot be written only means that
-    cleanup will not remove the object, and says so)."""
-    if not _ID.fullmatch(object_id):
-        return
+def _enter(entry: Path, what: str) -> None:
+    """Make the empty file ``entry`` in the ledger (best effort: a state folder that cannot be
+    written only means that cleanup will not remove the object, and says so)."""
     try:
-        folder = ledger_dir()
-        folder.mkdir(parents=True, exist_ok=True, mode=0o700)
-        fd = os.open(folder / object_id, os.O_WRONLY | os.O_CREAT | os.O_NOFOLLOW, 0o600)
-        os.close(fd)
+        entry.parent.mkdir(parents=True, exist_ok=True, mode=0o700)
+        os.close(os.open(entry, os.O_WRONLY | os.O_CREAT | os.O_NOFOLLOW, 0o600))
     except OSError as exc:
-        log.warning("cannot record %s in %s (cleanup will leave it): %s", object_id[:12],
-                    ledger_dir(), exc)
+        log.warning("cannot record %s in %s (cleanup will leave it): %s", what, entry.parent,
+                    exc)
+
+
+def note(object_id: str) -> None:
+    """Enter ``object_id`` (best effort, see :func:`_enter`)."""
+    if _ID.fullmatch(object_id):
+        _enter(ledger_dir() / object_id, object_id[:12])
 
 
 def created(object_id: str) -> bool:
@@ -67,16 +69,10 @@ def _name_entry(kind: str, name: str) -> Path | None:
 
 def intend(kind: str, name: str) -> None:
     """Enter the name of a ``kind`` object ("container" or "network") about to be created
-    (best effort, as :func:`note`)."""
+    (best effort, see :func:`_enter`)."""
     entry = _name_entry(kind, name)
-    if entry is None:
-        return
-    try:
-        entry.parent.mkdir(parents=True, exist_ok=True, mode=0o700)
-        os.close(os.open(entry, os.O_WRONLY | os.O_CREAT | os.O_NOFOLLOW, 0o600))
-    except OSError as exc:
-        log.warning("cannot record %s %s in %s (cleanup may leave it): %s", kind, name,
-                    ledger_dir(), exc)
+    if entry is not None:
+        _enter(entry, f"{kind} {name}")
 
 
 def intended(kind: str, name: str) -> bool:
