@@ -269,9 +269,17 @@ class TournamentScheduler(BackgroundScheduler):  # type: ignore[misc]
             self._closing = True
         self.shutdown(wait=wait)
 
+    def alive(self) -> bool:
+        """Whether the scheduler's thread still runs. An error APScheduler does not catch in
+        its pass over the job store (the state file busy beyond SQLite's timeout while it
+        removes a job, say) ends that thread, and the scheduler would go on looking as if it
+        ran: nothing would be started again, silently."""
+        thread = getattr(self, "_thread", None)  # BackgroundScheduler's thread (APScheduler 3)
+        return thread is None or thread.is_alive()
+
 
 def _scheduler(state: str, slots: int, running: RunningJobs,
-               wake: threading.Event) -> BackgroundScheduler:
+               wake: threading.Event) -> TournamentScheduler:
     """The job scheduler of the state file ``state``: ``slots`` matches played at once; the
     jobs running kept in ``running``, ``wake`` set when one ended (its match may have a next
     step now)."""
@@ -295,17 +303,8 @@ def _scheduler(state: str, slots: int, running: RunningJobs,
     return scheduler
 
 
-def scheduler_alive(scheduler: BackgroundScheduler) -> bool:
-    """Whether the scheduler's thread still runs. An error APScheduler does not catch in its
-    pass over the job store (the state file busy beyond SQLite's timeout while it removes a
-    job, say) ends that thread, and the scheduler would go on looking as if it ran: nothing
-    would be started again, silently."""
-    thread = getattr(scheduler, "_thread", None)  # BackgroundScheduler's thread (APScheduler 3)
-    return thread is None or thread.is_alive()
-
-
-def _restarted(old: BackgroundScheduler, state: str, slots: int, running: RunningJobs,
-               wake: threading.Event) -> BackgroundScheduler:
+def _restarted(old: TournamentScheduler, state: str, slots: int, running: RunningJobs,
+               wake: threading.Event) -> TournamentScheduler:
     """A new scheduler on the same state file in place of ``old``, whose thread ended. The steps
     ``old`` runs go on in its executors (``running`` still follows them); a job it left in the
     store runs again, and its step finds itself done (each step moves the match's state on
@@ -391,7 +390,7 @@ def run_schedule(
                 beat(ledger)
                 settle_hand_deliveries(ledger, schedule)  # hlvs logs deliver
                 beaten = time.monotonic()
-            if not scheduler_alive(scheduler):
+            if not scheduler.alive():
                 scheduler = _restarted(scheduler, state, schedule.simulator_slots, running, wake)
             reconcile(scheduler, ledger, state, running.ids())
             rows = ledger.rows()
@@ -433,7 +432,7 @@ def _open_state(
 
 
 def _shut_down(
-    scheduler: BackgroundScheduler, running: RunningJobs, ledger: Ledger, *, stopped_by_user: bool
+    scheduler: TournamentScheduler, running: RunningJobs, ledger: Ledger, *, stopped_by_user: bool
 ) -> None:
     """Stop the scheduler. On SIGTERM or SIGINT the running steps get the stop grace (the
     state file's, else the default) and 15 s more to end; otherwise the scheduler waits for
@@ -441,20 +440,11 @@ def _shut_down(
     from tournament.jobs import DEFAULT_STOP_GRACE_S, STOPPING
 
     if STOPPING.is_set():
-        stop_scheduler(scheduler, wait=False)
+        scheduler.close(wait=False)
         grace = ledger.get_meta("stop_grace_s")
         _wait_for_steps(running, (float(grace) if grace else DEFAULT_STOP_GRACE_S) + 15.0)
     else:
-        stop_scheduler(scheduler, wait=not stopped_by_user)
-
-
-def stop_scheduler(scheduler: BackgroundScheduler, *, wait: bool) -> None:
-    """Shut ``scheduler`` down: a :class:`TournamentScheduler` once its pass over the job
-    store has ended, any other as it is."""
-    if isinstance(scheduler, TournamentScheduler):
-        scheduler.close(wait=wait)
-    else:
-        scheduler.shutdown(wait=wait)
+        scheduler.close(wait=not stopped_by_user)
 
 
 def _notify_loop(ledger: Ledger, done: threading.Event, every_s: float = 2.0) -> None:

@@ -15,7 +15,7 @@ from apscheduler.jobstores.memory import MemoryJobStore
 from apscheduler.schedulers.background import BackgroundScheduler
 from apscheduler.schedulers.base import STATE_RUNNING
 
-from tournament.runner import TournamentScheduler, stop_scheduler
+from tournament.runner import TournamentScheduler
 
 
 class _Watched(TournamentScheduler):  # type: ignore[misc]
@@ -69,7 +69,7 @@ def test_a_stop_during_the_schedulers_pass_waits_for_it(
     scheduler, failures = _in_its_pass(monkeypatch, _Watched)
     thread = scheduler._thread
     started = time.monotonic()
-    stop_scheduler(scheduler, wait=wait)  # the scheduler is still in submit_job
+    scheduler.close(wait=wait)  # the scheduler is still in submit_job
     assert time.monotonic() - started < 5.0  # not the slow executor's 10 s deadline
     assert not thread.is_alive()  # shutdown joins the scheduler's thread
     assert failures == []
@@ -78,8 +78,8 @@ def test_a_stop_during_the_schedulers_pass_waits_for_it(
 
 def test_a_plain_shutdown_there_fails_in_the_schedulers_thread(
         monkeypatch: pytest.MonkeyPatch) -> None:
-    """What :func:`stop_scheduler` prevents (APScheduler 3's behaviour): if this starts to pass,
-    the library changed and the workaround may go."""
+    """What :meth:`TournamentScheduler.close` prevents (APScheduler 3's behaviour): if this
+    starts to pass, the library changed and the workaround may go."""
     from apscheduler.jobstores.base import JobLookupError
 
     scheduler, failures = _in_its_pass(monkeypatch, BackgroundScheduler)
