@@ -223,13 +223,11 @@ def _file_error(exc: OSError) -> int:
     logging.getLogger(__name__).debug("file error", exc_info=exc)
     names = str(exc.filename) + (f" -> {exc.filename2}" if exc.filename2 else "")
     reason = exc.strerror or str(exc)
-    if exc.errno in (errno.EEXIST, errno.ENOTDIR):  # a file where a folder was to be
-        from pathlib import Path
+    from orchestrator import file_in_the_way
 
-        path = Path(os.fsdecode(exc.filename))
-        found = next((p for p in (path, *path.parents) if p.exists()), None)
-        if found is not None and not found.is_dir():
-            names, reason = str(found), "a file where a folder is needed"
+    found = file_in_the_way(exc)
+    if found is not None:
+        names, reason = str(found), "a file where a folder is needed"
     print(f"{PROG}: {names}: {reason}", file=sys.stderr)
     return ExitCode.INFRASTRUCTURE if exc.errno in _HOST_TROUBLE else ExitCode.INVALID
 

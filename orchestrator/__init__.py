@@ -26,7 +26,7 @@ if TYPE_CHECKING:
     from orchestrator.console import progress
     from orchestrator.exitcodes import ExitCode
     from orchestrator.image_origin import local_name_reason
-    from orchestrator.paths import user_path
+    from orchestrator.paths import file_in_the_way, user_path
     from orchestrator.private_files import (
         make_private_file,
         open_private_append,
@@ -63,6 +63,7 @@ __all__ = [
     "build_all",
     "collect_results",
     "ensure_image",
+    "file_in_the_way",
     "local_name_reason",
     "make_private_file",
     "open_private_append",
@@ -85,7 +86,7 @@ if not TYPE_CHECKING:
         "orchestrator.console": ("progress",),
         "orchestrator.exitcodes": ("ExitCode",),
         "orchestrator.image_origin": ("local_name_reason",),
-        "orchestrator.paths": ("user_path",),
+        "orchestrator.paths": ("file_in_the_way", "user_path"),
         "orchestrator.private_files": (
             "make_private_file", "open_private_append", "private_dir", "write_private",
         ),

@@ -8,6 +8,7 @@ absolute bind-mount source and every message names the file it really means.
 
 from __future__ import annotations
 
+import errno
 import os
 from pathlib import Path
 
@@ -27,4 +28,15 @@ def state_dir() -> Path:
     return Path(os.environ.get("HLVS_STATE_DIR", "/var/lib/hlvs-runner"))
 
 
-__all__ = ["state_dir", "user_path"]
+def file_in_the_way(exc: OSError) -> Path | None:
+    """The file where a folder was to be, when ``exc`` (a folder that could not be made, a path
+    through a file) comes from one: ``exc``'s path or the nearest of its parents that exists,
+    if that is not a folder."""
+    if exc.errno not in (errno.EEXIST, errno.ENOTDIR) or not exc.filename:
+        return None
+    path = Path(os.fsdecode(exc.filename))
+    found = next((p for p in (path, *path.parents) if p.exists()), None)
+    return found if found is not None and not found.is_dir() else None
+
+
+__all__ = ["file_in_the_way", "state_dir", "user_path"]

@@ -159,14 +159,15 @@ def open_data_dir(settings: Settings) -> Path:
     """The service's data folder (and its matches folder), created 0700 if missing; one that
     cannot be made or written is a :class:`SettingsError` naming ``HLVS_SERVICE_DATA_DIR`` and
     the system's reason."""
-    from orchestrator import private_dir
+    from orchestrator import file_in_the_way, private_dir
 
     try:
         private_dir(settings.data_dir)
         private_dir(settings.matches_dir)
     except OSError as exc:
-        if isinstance(exc, FileExistsError | NotADirectoryError) and exc.filename:
-            reason = f"{exc.filename} is a file, not a folder"
+        in_the_way = file_in_the_way(exc)
+        if in_the_way is not None:
+            reason = f"{in_the_way} is a file, not a folder"
         else:
             reason = f"{exc.strerror or exc}" + (f" ({exc.filename})" if exc.filename else "")
         raise SettingsError(
