@@ -123,12 +123,13 @@ def _describe_outcome(outcome: DeliveryOutcome) -> str:
 def _status(args: argparse.Namespace) -> int:
     from orchestrator.delivery import pending_status
 
-    sets = pending_status(args.store or default_store())
+    store = args.store or default_store()
+    sets = pending_status(store)
     if args.json:
         print(json.dumps([s.to_json() for s in sets], indent=2))
         return ExitCode.OK
     if not sets:
-        print("no log sets are waiting" + _no_store(args.store or default_store()))
+        print("no log sets are waiting" + _no_store(store))
     for pending in sets:
         print(_describe_set(pending))
     return ExitCode.OK
