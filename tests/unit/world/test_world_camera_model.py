@@ -49,3 +49,31 @@ def test_a_turning_head_blurs_its_camera_image_when_asked() -> None:
         return float(np.abs(np.diff(image, axis=1)).mean())
 
     assert detail(blurred) < 0.8 * detail(sharp)
+
+
+@pytest.mark.parametrize(
+    "model",
+    [CameraModel.ideal(), CameraModel.league(7), CameraModel(seed=3, exposure_gain=1.0),
+     CameraModel(seed=5, exposure_gain=1.3, noise_std=0.0, motion_blur=True)],
+    ids=["ideal", "league", "noise-only", "gain-blur"],
+)
+@pytest.mark.parametrize("size", [(160, 120), (161, 121)], ids=["160x120", "161x121"])
+def test_frames_read_in_camera_order_are_the_frames_turned(
+    model: CameraModel, size: tuple[int, int]
+) -> None:
+    """The robot cameras read their frames from OpenGL in B,G,R order, bottom row first, and
+    view them upside down: the same bytes as MuJoCo's R,G,B frame with its channels turned,
+    whatever the camera model does to them and whatever the width (an odd one: rows unpadded)."""
+    world = World.create(field_class="kid", robots=eight_robots()[:2], seed=2, camera_model=model)
+    r = world.index.by_id[RED_1]
+    neck = world.model.jnt_dofadr[world.model.actuator_trnid[r.actuators[r.motor_slot["Neck"]], 0]]
+    world.data.qvel[neck] = 4.0  # blur, where the model has it
+    width, height = size
+    with CameraRenderer(world, width, height) as renderer:
+        assert renderer._read_bgr is not None  # noqa: SLF001 - the way under test
+        read = renderer.render(RED_1, sim_time_ms=96)
+        renderer._read_bgr = None  # noqa: SLF001 - MuJoCo's frame, turned
+        turned = renderer.render(RED_1, sim_time_ms=96)
+    assert len(read) == width * height * 3
+    assert read == turned
+    assert len(set(read)) > 20  # a picture, not a blank
