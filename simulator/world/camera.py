@@ -156,14 +156,14 @@ class CameraRenderer:
         blur = (0.0, 0.0)
         if effects.model.motion_blur:
             blur = self._blur_px(index.camera)
-        noise_id = robot.number + 32 * (robot.team.value == "blue")
         if self._read_bgr is None:
-            return effects.bgr_bytes(
-                self._renderer.render(), robot=noise_id, sim_time_ms=sim_time_ms, blur_px=blur
-            )
+            bgr = self._renderer.render()[:, :, ::-1]
+        else:
+            bgr = self._read_bgr(self._frame)
         return effects.of_bgr(
-            self._read_bgr(self._frame), robot=noise_id, sim_time_ms=sim_time_ms, blur_px=blur
-        )
+            bgr, robot=robot.number + 32 * (robot.team.value == "blue"),
+            sim_time_ms=sim_time_ms, blur_px=blur,
+        )  # fmt: skip
 
     def _blur_px(self, camera: int) -> tuple[float, float]:
         """Image motion during the exposure from the camera's angular velocity (the data's

@@ -26,13 +26,19 @@ def test_image_motion_follows_the_turn() -> None:
     assert dy == 0.0
 
 
+def _neck_dof(world: World) -> int:
+    """The index in ``qvel`` of red player 1's neck joint."""
+    r = world.index.by_id[RED_1]
+    actuator = r.actuators[r.motor_slot["Neck"]]
+    return int(world.model.jnt_dofadr[world.model.actuator_trnid[actuator, 0]])
+
+
 def _frame(*, blur: bool, neck_rad_s: float) -> np.ndarray:
     model = CameraModel(noise_std=0.0, auto_exposure=1.0, motion_blur=blur, exposure_s=0.02)
     world = World.create(
         field_class="kid", robots=eight_robots()[:1], seed=1, camera_model=model
     )
-    r = world.index.by_id[RED_1]
-    neck = world.model.jnt_dofadr[world.model.actuator_trnid[r.actuators[r.motor_slot["Neck"]], 0]]
+    neck = _neck_dof(world)
     world.data.qvel[neck] = neck_rad_s
     with CameraRenderer(world, 160, 120) as renderer:
         raw = renderer.render(RED_1)
@@ -65,8 +71,7 @@ def test_frames_read_in_camera_order_are_the_frames_turned(
     view them upside down: the same bytes as MuJoCo's R,G,B frame with its channels turned,
     whatever the camera model does to them and whatever the width (an odd one: rows unpadded)."""
     world = World.create(field_class="kid", robots=eight_robots()[:2], seed=2, camera_model=model)
-    r = world.index.by_id[RED_1]
-    neck = world.model.jnt_dofadr[world.model.actuator_trnid[r.actuators[r.motor_slot["Neck"]], 0]]
+    neck = _neck_dof(world)
     world.data.qvel[neck] = 4.0  # blur, where the model has it
     width, height = size
     with CameraRenderer(world, width, height) as renderer:
