@@ -150,6 +150,7 @@ def scene_of(
     """The scene description of a compiled world model (see the module docstring) built with
     ``look`` (default: the look of texture seed 0, as :func:`compile_scene`'s)."""
     from simulator.world.look import look_for
+    from simulator.world.merged import is_merged
     from simulator.world.types import robot_prefix
 
     bodies = [model.body(i).name for i in range(model.nbody)]
@@ -194,7 +195,10 @@ def scene_of(
     field_data = {k: v.value if k == "field_class" else v for k, v in asdict(field).items()}
     return {
         "bodies": bodies,
-        "geoms": [_geom(model, i) for i in range(model.ngeom)],
+        # the lines' and cords' meshes of the robot cameras stay out: their boxes are here
+        "geoms": [
+            _geom(model, i) for i in range(model.ngeom) if not is_merged(model.geom(i).name)
+        ],
         "cameras": cameras,
         "robot_cameras": robot_cameras,
         "robots": robots,

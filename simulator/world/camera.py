@@ -37,6 +37,7 @@ from contracts import RobotId
 from simulator.errors import UnknownDeviceError
 from simulator.world.camera_model import CameraEffects, CameraModel, blur_px_of
 from simulator.world.camera_scene import SceneCut, cheap_shadows
+from simulator.world.merged import show_merged
 
 if TYPE_CHECKING:
     from simulator.world.world import World
@@ -72,14 +73,16 @@ def software_gl() -> bool:
 
 
 def robot_camera_model(model: mujoco.MjModel) -> mujoco.MjModel:
-    """A copy of ``model`` with :data:`ROBOT_CAMERA_QUALITY` tessellation and the cameras'
+    """A copy of ``model`` with :data:`ROBOT_CAMERA_QUALITY` tessellation, the cameras'
     shadow map and turf grid (:func:`~simulator.world.camera_scene.cheap_shadows`; read by
-    MuJoCo when the render context is made; the copy has the same layout, so the world's data
-    fits it)."""
+    MuJoCo when the render context is made) and the lines and nets drawn as one mesh each
+    (:func:`~simulator.world.merged.show_merged`); the copy has the same layout, so the world's
+    data fits it."""
     cheap = copy.copy(model)
     quality = cheap.vis.quality
     quality.numslices, quality.numstacks, quality.numquads = ROBOT_CAMERA_QUALITY
     cheap_shadows(cheap)
+    show_merged(cheap)
     return cheap
 
 

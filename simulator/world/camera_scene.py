@@ -37,6 +37,8 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from simulator.world.merged import merged_groups
+
 ROBOT_SHADOW_SIZE = 1024
 PLANE_GRID_M = 1.0
 FLAT_M = 0.005  # static geoms whose top is at most this high cast no shadow (field lines)
@@ -80,7 +82,8 @@ def cheap_shadows(model: mujoco.MjModel) -> None:
 
 def no_shadow_geoms(model: mujoco.MjModel) -> np.ndarray:
     """Which geoms cast no shadow worth drawing in the depth map (see the module's docstring):
-    planes, and static geoms lying flat on the turf or thinner than :data:`THIN_M`."""
+    planes, static geoms lying flat on the turf or thinner than :data:`THIN_M`, and the meshes
+    of the lines and cords (:mod:`simulator.world.merged`)."""
     data = mujoco.MjData(model)
     mujoco.mj_kinematics(model, data)
     static = model.body_weldid[model.geom_bodyid] == 0
@@ -91,7 +94,9 @@ def no_shadow_geoms(model: mujoco.MjModel) -> np.ndarray:
                        model.geom_size)  # fmt: skip
     flat = static & boxes & (data.geom_xpos[:, 2] + half_z <= FLAT_M)
     thin = static & boxes & (np.sort(model.geom_size, axis=1)[:, 1] <= THIN_M)
-    return np.asarray(planes | flat | thin)
+    merged = np.zeros(model.ngeom, dtype=bool)  # the lines' and cords' meshes: as their boxes
+    merged[[g for g, _ in merged_groups(model)]] = True
+    return np.asarray(planes | flat | thin | merged)
 
 
 def planar_casters(model: mujoco.MjModel) -> np.ndarray:

@@ -36,10 +36,18 @@ modelled (MuJoCo contacts do not restitute beyond their spring and damper).
 
 from __future__ import annotations
 
+import functools
 import math
 
 from contracts import FieldGeometry
-from simulator.world.look import LINE_TEXTURE, TURF_TEXTURE, light_xml
+from simulator.world.look import (
+    LINE_MESH_MATERIAL,
+    LINE_TEXTURE,
+    LINE_TILE_M,
+    TURF_TEXTURE,
+    light_xml,
+)
+from simulator.world.merged import MERGED_PREFIX, Box, box_mesh_xml, merged_geom_xml
 
 TURF_FRICTION = 0.5
 GRASS_SOLREF = (-30.0, -80.0)  # direct form: -stiffness (1/s^2), -damping (1/s)
@@ -47,21 +55,36 @@ GRASS_SOLIMP = (0.0, 0.99, 0.009, 0.5, 2.0)  # impedance 0 -> 0.99 over the firs
 GRASS_SINKAGE_M = 0.0072  # league's world: a 4.9 kg robot on eight contact points (see above)
 LINE_HEIGHT_M = 0.001
 CIRCLE_SEGMENTS = 48
+LINES = "line:"  # the line geoms' names begin so
 
 
 def _f(values: tuple[float, ...]) -> str:
     return " ".join(f"{v:.9g}" for v in values)
 
 
-def _box(name: str, x: float, y: float, half_x: float, half_y: float, yaw: float = 0.0) -> str:
+def _box(name: str, x: float, y: float, half_x: float, half_y: float,
+         yaw: float = 0.0) -> tuple[str, Box]:  # fmt: skip
+    return name, Box((x, y, LINE_HEIGHT_M), (half_x, half_y, LINE_HEIGHT_M), yaw)
+
+
+def _line_xml(name: str, box: Box) -> str:
+    (x, y, z), (half_x, half_y, half_z) = box.centre, box.half
     return (
-        f'<geom name="line:{name}" type="box" pos="{x:.9g} {y:.9g} {LINE_HEIGHT_M}" '
-        f'size="{half_x:.9g} {half_y:.9g} {LINE_HEIGHT_M}" euler="0 0 {yaw:.9g}" '
+        f'<geom name="{LINES}{name}" type="box" pos="{x:.9g} {y:.9g} {z}" '
+        f'size="{half_x:.9g} {half_y:.9g} {half_z}" euler="0 0 {box.yaw:.9g}" '
         f'material="{LINE_TEXTURE}" contype="0" conaffinity="0" group="1" mass="0"/>'
     )
 
 
-def _lines(f: FieldGeometry) -> list[str]:
+@functools.lru_cache(maxsize=4)
+def line_mesh_xml(f: FieldGeometry) -> str:
+    """The lines as one mesh (:mod:`simulator.world.merged`; their bottoms left out), for the
+    assets."""
+    boxes = [box for _, box in _lines(f)]
+    return box_mesh_xml(MERGED_PREFIX + LINES, boxes, texrepeat=1.0 / LINE_TILE_M, bottoms=False)
+
+
+def _lines(f: FieldGeometry) -> list[tuple[str, Box]]:
     w = f.line_width_m / 2
     lx, ly = f.half_length_m, f.half_width_m
     out = [
@@ -107,5 +130,6 @@ def field_bodies(f: FieldGeometry, *, static_bits: tuple[int, int]) -> str:
         f'<camera name="overview" pos="0 {-distance:.6g} {height:.6g}" '
         f'xyaxes="1 0 0 0 {height / norm:.6g} {distance / norm:.6g}" fovy="55"/>',
     ]
-    parts.extend(_lines(f))
+    parts.extend(_line_xml(name, box) for name, box in _lines(f))
+    parts.append(merged_geom_xml(MERGED_PREFIX + LINES, material=LINE_MESH_MATERIAL))
     return "".join(parts)

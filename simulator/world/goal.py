@@ -8,8 +8,11 @@ cords of :data:`~simulator.world.look.NET_CORD_M` every
 
 from __future__ import annotations
 
+import functools
+
 from contracts import FieldGeometry
 from simulator.world.look import NET_CORD_M, NET_MESH_M, NET_RGBA
+from simulator.world.merged import MERGED_PREFIX, Box, box_mesh_xml, merged_geom_xml
 
 POST_RGBA = "0.82 0.82 0.82 1"  # white paint: bright under the lights, not clipped
 NET_HALF_THICKNESS_M = 0.01
@@ -22,10 +25,11 @@ def _spans(low: float, high: float) -> list[float]:
     return [low + (high - low) * k / n for k in range(n + 1)]
 
 
-def _cord(name: str, centre: tuple[float, float, float], half: tuple[float, float, float]) -> str:
+def _cord(name: str, box: Box) -> str:
+    (x, y, z), (hx, hy, hz) = box.centre, box.half
     return (
-        f'<geom name="{name}" type="box" pos="{centre[0]:.6g} {centre[1]:.6g} {centre[2]:.6g}" '
-        f'size="{half[0]:.6g} {half[1]:.6g} {half[2]:.6g}" rgba="{NET_RGBA}" contype="0" '
+        f'<geom name="{name}" type="box" pos="{x:.6g} {y:.6g} {z:.6g}" '
+        f'size="{hx:.6g} {hy:.6g} {hz:.6g}" rgba="{NET_RGBA}" contype="0" '
         f'conaffinity="0" group="1" mass="0"/>'
     )
 
@@ -33,7 +37,7 @@ def _cord(name: str, centre: tuple[float, float, float], half: tuple[float, floa
 def _net_cords(
     name: str, axes: tuple[int, int], ranges: tuple[tuple[float, float], tuple[float, float]],
     fixed: tuple[int, float],
-) -> list[str]:  # fmt: skip
+) -> list[tuple[str, Box]]:  # fmt: skip
     """The cords of one flat net: it spans ``ranges`` along the two ``axes`` (0 x, 1 y, 2 z)
     and sits at ``fixed`` (axis, coordinate); one cord along each axis at every mesh step of
     the other."""
@@ -48,13 +52,52 @@ def _net_cords(
             centre[axes[along]] = (lo + hi) / 2
             half[axes[along]] = abs(hi - lo) / 2
             centre[axes[across]] = pos
-            out.append(_cord(f"{name}_{along}{k}", (centre[0], centre[1], centre[2]),
-                             (half[0], half[1], half[2])))  # fmt: skip
+            # rounded as the geoms' XML rounds them: the mesh's boxes are the geoms'
+            out.append((f"{name}_{along}{k}",
+                        Box((_r(centre[0]), _r(centre[1]), _r(centre[2])),
+                            (_r(half[0]), _r(half[1]), _r(half[2])))))  # fmt: skip
     return out
 
 
+def _r(value: float) -> float:
+    return float(f"{value:.6g}")
+
+
+def _goal_cords(f: FieldGeometry, *, sign: float, name: str) -> list[tuple[str, Box]]:
+    """Every cord of the goal's nets (sides, back, top), named."""
+    r = f.goal_post_radius_m
+    x = sign * f.half_length_m
+    half_w = f.goal_width_m / 2 + r  # post centres
+    h = f.goal_height_m
+    back_x = sign * (f.half_length_m + f.goal_depth_m)
+    t = NET_HALF_THICKNESS_M
+    cords = []
+    for ys, label in ((1.0, "a"), (-1.0, "b")):
+        cords += _net_cords(
+            f"{name}:net_side_{label}_cord", (0, 2), ((x, back_x), (0.0, h)),
+            (1, ys * (half_w + r + t)),
+        )  # fmt: skip
+    cords += _net_cords(
+        f"{name}:net_back_cord", (1, 2), ((-half_w - r, half_w + r), (0.0, h)),
+        (0, back_x + sign * t),
+    )  # fmt: skip
+    cords += _net_cords(
+        f"{name}:net_top_cord", (0, 1), ((x, back_x), (-half_w - r, half_w + r)), (2, h + t)
+    )
+    return cords
+
+
+@functools.lru_cache(maxsize=8)
+def net_mesh_xml(f: FieldGeometry, *, sign: float, name: str) -> str:
+    """The goal's cords as one mesh (:mod:`simulator.world.merged`), for the assets."""
+    return box_mesh_xml(
+        f"{MERGED_PREFIX}{name}:net", [box for _, box in _goal_cords(f, sign=sign, name=name)]
+    )
+
+
 def goal_bodies(f: FieldGeometry, *, sign: float, name: str, static_bits: tuple[int, int]) -> str:
-    """Static geoms of the goal behind the goal line at ``x = sign * half_length``."""
+    """Static geoms of the goal behind the goal line at ``x = sign * half_length``: posts, bars,
+    the nets' invisible boxes, their cords and the cords' mesh (:func:`net_mesh_xml`)."""
     contype, conaffinity = static_bits
     col = f'contype="{contype}" conaffinity="{conaffinity}"'
     r = f.goal_post_radius_m
@@ -78,10 +121,6 @@ def goal_bodies(f: FieldGeometry, *, sign: float, name: str, static_bits: tuple[
             f'size="{d / 2:.6g} {h / 2:.6g} {t}" euler="1.5707963 0 0" '
             f'rgba="{NET_BOX_RGBA}" {col}/>'
         )
-        geoms += _net_cords(
-            f"{name}:net_side_{label}_cord", (0, 2), ((x, back_x), (0.0, h)),
-            (1, ys * (half_w + r + t)),
-        )  # fmt: skip
     geoms.append(
         f'<geom name="{name}:crossbar" type="cylinder" '
         f'fromto="{x:.6g} {-half_w:.6g} {h + r:.6g} {x:.6g} {half_w:.6g} {h + r:.6g}" '
@@ -92,10 +131,6 @@ def goal_bodies(f: FieldGeometry, *, sign: float, name: str, static_bits: tuple[
         f'size="{h / 2:.6g} {half_w + r:.6g} {t}" euler="0 1.5707963 0" '
         f'rgba="{NET_BOX_RGBA}" {col}/>'
     )
-    geoms += _net_cords(
-        f"{name}:net_back_cord", (1, 2), ((-half_w - r, half_w + r), (0.0, h)),
-        (0, back_x + sign * t),
-    )  # fmt: skip
     geoms.append(
         f'<geom name="{name}:back_bar" type="cylinder" '
         f'fromto="{back_x:.6g} {-half_w:.6g} {h:.6g} {back_x:.6g} {half_w:.6g} {h:.6g}" '
@@ -105,7 +140,6 @@ def goal_bodies(f: FieldGeometry, *, sign: float, name: str, static_bits: tuple[
         f'<geom name="{name}:net_top" type="box" pos="{mid_x:.6g} 0 {h + t:.6g}" '
         f'size="{d / 2:.6g} {half_w + r:.6g} {t}" rgba="{NET_BOX_RGBA}" {col}/>'
     )
-    geoms += _net_cords(
-        f"{name}:net_top_cord", (0, 1), ((x, back_x), (-half_w - r, half_w + r)), (2, h + t)
-    )
+    geoms += [_cord(cord, box) for cord, box in _goal_cords(f, sign=sign, name=name)]
+    geoms.append(merged_geom_xml(f"{MERGED_PREFIX}{name}:net"))
     return "".join(geoms)

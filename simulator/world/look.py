@@ -80,6 +80,7 @@ RGB = tuple[float, float, float]
 
 TURF_TEXTURE = "look:turf"
 LINE_TEXTURE = "look:line"
+LINE_MESH_MATERIAL = "look:line_mesh"  # the lines' mesh (simulator.world.merged): its own UVs
 BALL_TEXTURE = "look:ball"
 SKY_TEXTURE = "look:sky"
 NET_TEXTURE = "look:net"
@@ -411,6 +412,8 @@ def look_assets(look: Look) -> str:
         f'width="{LINE_PX}" height="{LINE_PX}"/>'
         f'<material name="{LINE_TEXTURE}" texture="{LINE_TEXTURE}" texuniform="true" '
         f'texrepeat="{line_repeat:.6g} {line_repeat:.6g}" reflectance="0" specular="0.05"/>'
+        f'<material name="{LINE_MESH_MATERIAL}" texture="{LINE_TEXTURE}" texrepeat="1 1" '
+        f'reflectance="0" specular="0.05"/>'
         f'<texture name="{BALL_TEXTURE}" type="cube" builtin="flat" rgb1="1 1 1" '
         f'width="{BALL_FACE_PX}" height="{BALL_FACE_PX}"/>'
         f'<material name="{BALL_TEXTURE}" texture="{BALL_TEXTURE}" rgba="0.8 0.8 0.8 1" '

@@ -21,8 +21,8 @@ from simulator.world.ball import (
     ball_body,
     ball_damping,
 )
-from simulator.world.field import field_bodies
-from simulator.world.goal import goal_bodies
+from simulator.world.field import field_bodies, line_mesh_xml
+from simulator.world.goal import goal_bodies, net_mesh_xml
 from simulator.world.jersey import apply_jerseys, jersey_assets, jersey_material
 from simulator.world.look import Look, apply_look, look_assets, look_for
 from simulator.world.robots import robot_model
@@ -112,6 +112,10 @@ def scene_xml(
             f'<contact name="{ball_touch_sensor(placement)}" subtree1="{robot_prefix(placement.id)}'
             f'/torso" geom2="{BALL_GEOM}" data="found" num="1"/>'
         )
+    merged = (
+        line_mesh_xml(field) + net_mesh_xml(field, sign=-1.0, name="goal_left")
+        + net_mesh_xml(field, sign=1.0, name="goal_right")
+    )  # fmt: skip
     return f"""<mujoco model="hlvs-{field.field_class.value}">
 <compiler angle="radian" autolimits="true"/>
 <option timestep="{physics_dt_s!r}" integrator="implicitfast" cone="pyramidal"/>
@@ -121,7 +125,7 @@ def scene_xml(
  <headlight ambient="0.35 0.35 0.35" diffuse="0 0 0" specular="0 0 0"/>
  <map znear="0.01" zfar="100"/>
 </visual>
-<asset>{look_assets(look)}{"".join(assets.values())}</asset>
+<asset>{look_assets(look)}{merged}{"".join(assets.values())}</asset>
 <worldbody>{"".join(bodies)}</worldbody>
 <contact>{_ball_turf_pair() if ball_turf_pair else ""}{"".join(excludes)}</contact>
 <actuator>{"".join(actuators)}</actuator>
