@@ -130,7 +130,8 @@ class CameraRenderer:
         model = robot_camera_model(world.model)
         self._renderer = mujoco.Renderer(model, height=height, width=width)
         self._option = mujoco.MjvOption()
-        self._option.geomgroup[4] = 0  # sites and helper geoms stay invisible
+        self._option.geomgroup[4] = 0  # helper geoms stay invisible
+        self._option.sitegroup[:] = 0  # sites are frames, not things (an IMU's inside a torso)
         scene = self._renderer.scene
         self.shadows = camera_shadows(software_gl())
         scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = self.shadows == "map"

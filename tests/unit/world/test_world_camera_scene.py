@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from contracts.ids import RobotId, TeamColor
-from simulator.world import CameraRenderer, RobotPlacement, World
+from simulator.world import CameraRenderer, RobotPlacement, World, camera_scene
 from simulator.world.camera import SHADOWS_ENV, camera_shadows, robot_camera_model
 from simulator.world.camera_scene import (
     ROBOT_SHADOW_SIZE,
@@ -52,11 +52,26 @@ def _frames(world: World, *, shadows: str, cut: bool) -> tuple[np.ndarray, list[
 
 
 @pytest.mark.parametrize("shadows", ["off", "map", "planar"])
-def test_culling_leaves_the_picture_as_it_was(world: World, shadows: str) -> None:
+def test_culling_leaves_the_picture_as_it_was(
+    world: World, shadows: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(camera_scene, "MIN_RADIUS_PX", 0.0)  # what is out of view only
     cut, drawn = _frames(world, shadows=shadows, cut=True)
     whole, all_drawn = _frames(world, shadows=shadows, cut=False)
     assert max(drawn) < min(all_drawn)  # geoms were left out of every camera's scene
     assert np.abs(cut - whole).max() <= 2  # the same image (it is identical with llvmpipe)
+
+
+@pytest.mark.parametrize("shadows", ["off", "planar"])
+def test_geoms_smaller_than_a_pixel_are_left_out_for_a_pixel_or_two(
+    world: World, shadows: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    small, drawn = _frames(world, shadows=shadows, cut=True)
+    monkeypatch.setattr(camera_scene, "MIN_RADIUS_PX", 0.0)
+    every, all_drawn = _frames(world, shadows=shadows, cut=True)
+    assert sum(all_drawn) - sum(drawn) > 8 * len(drawn)  # cleats, mostly, left out
+    changed = (np.abs(small - every).max(axis=3) > 8).sum(axis=(1, 2))
+    assert changed.max() <= 0.0005 * W * H  # 9 pixels of 19,200 at most
 
 
 def test_only_turf_lines_and_net_cords_skip_the_depth_map(world: World) -> None:
