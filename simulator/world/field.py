@@ -1,7 +1,8 @@
 """The pitch entity: turf (field plus border strip), visual lines, lights and the video camera.
 
 The turf's and the lines' textures and the lights come from the look
-(:mod:`simulator.world.look`).
+(:mod:`simulator.world.look`). The robot cameras draw the lines as one mesh
+(:func:`line_mesh_xml`, :mod:`simulator.world.merged`).
 
 The turf is the league's soft grass. Its contact parameters in the league's Webots world
 (RoboCup-Humanoid-TC/hlvs_webots ``worlds/robocup.wbt``: ``ContactProperties`` of material

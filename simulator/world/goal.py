@@ -3,7 +3,9 @@
 Each net is a thin box that the ball and robots collide with, invisible (alpha 0: renderers
 skip it), and a mesh of cords that cameras see (visual geoms: no contacts, no mass), dark
 cords of :data:`~simulator.world.look.NET_CORD_M` every
-:data:`~simulator.world.look.NET_MESH_M` with open holes, as the league's net texture.
+:data:`~simulator.world.look.NET_MESH_M` with open holes, as the league's net texture. The
+robot cameras draw each goal's cords as one mesh (:func:`net_mesh_xml`,
+:mod:`simulator.world.merged`).
 """
 
 from __future__ import annotations
