@@ -19,6 +19,8 @@ from simulator.world.merged import MERGED_PREFIX, Box, box_mesh_xml, merged_geom
 POST_RGBA = "0.82 0.82 0.82 1"  # white paint: bright under the lights, not clipped
 NET_HALF_THICKNESS_M = 0.01
 NET_BOX_RGBA = "0.3 0.3 0.3 0"  # the collision boxes of the nets are not drawn
+CORDS = "cord:"  # after the goal's name, the names of its nets' cords begin so
+GOALS = ((-1.0, "goal_left"), (1.0, "goal_right"))  # (sign of x, name)
 
 
 def _spans(low: float, high: float) -> list[float]:
@@ -76,15 +78,15 @@ def _goal_cords(f: FieldGeometry, *, sign: float, name: str) -> list[tuple[str, 
     cords = []
     for ys, label in ((1.0, "a"), (-1.0, "b")):
         cords += _net_cords(
-            f"{name}:net_side_{label}_cord", (0, 2), ((x, back_x), (0.0, h)),
+            f"{name}:{CORDS}side_{label}", (0, 2), ((x, back_x), (0.0, h)),
             (1, ys * (half_w + r + t)),
         )  # fmt: skip
     cords += _net_cords(
-        f"{name}:net_back_cord", (1, 2), ((-half_w - r, half_w + r), (0.0, h)),
+        f"{name}:{CORDS}back", (1, 2), ((-half_w - r, half_w + r), (0.0, h)),
         (0, back_x + sign * t),
     )  # fmt: skip
     cords += _net_cords(
-        f"{name}:net_top_cord", (0, 1), ((x, back_x), (-half_w - r, half_w + r)), (2, h + t)
+        f"{name}:{CORDS}top", (0, 1), ((x, back_x), (-half_w - r, half_w + r)), (2, h + t)
     )
     return cords
 
@@ -93,7 +95,7 @@ def _goal_cords(f: FieldGeometry, *, sign: float, name: str) -> list[tuple[str, 
 def net_mesh_xml(f: FieldGeometry, *, sign: float, name: str) -> str:
     """The goal's cords as one mesh (:mod:`simulator.world.merged`), for the assets."""
     return box_mesh_xml(
-        f"{MERGED_PREFIX}{name}:net", [box for _, box in _goal_cords(f, sign=sign, name=name)]
+        f"{MERGED_PREFIX}{name}:{CORDS}", [box for _, box in _goal_cords(f, sign=sign, name=name)]
     )
 
 
@@ -143,5 +145,5 @@ def goal_bodies(f: FieldGeometry, *, sign: float, name: str, static_bits: tuple[
         f'size="{d / 2:.6g} {half_w + r:.6g} {t}" rgba="{NET_BOX_RGBA}" {col}/>'
     )
     geoms += [_cord(cord, box) for cord, box in _goal_cords(f, sign=sign, name=name)]
-    geoms.append(merged_geom_xml(f"{MERGED_PREFIX}{name}:net"))
+    geoms.append(merged_geom_xml(f"{MERGED_PREFIX}{name}:{CORDS}"))
     return "".join(geoms)

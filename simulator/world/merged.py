@@ -110,31 +110,21 @@ def is_merged(name: str) -> bool:
 
 def merged_groups(model: mujoco.MjModel) -> list[tuple[int, np.ndarray]]:
     """(mesh geom, its boxes' geoms) of every merged group of ``model``: the boxes are the
-    geoms whose names start with what follows :data:`MERGED_PREFIX` in the mesh's name, and are
-    cords (``_cord_``) where it names a net."""
+    geoms whose names start with what follows :data:`MERGED_PREFIX` in the mesh's name."""
     names = [model.geom(g).name for g in range(model.ngeom)]
     groups = []
     for g, name in enumerate(names):
-        if not is_merged(name):
-            continue
-        stem = name.removeprefix(MERGED_PREFIX)
-        if stem.endswith(":net"):
-            members = [i for i, n in enumerate(names)
-                       if n.startswith(stem[: -len("net")]) and "_cord_" in n]  # fmt: skip
-        else:
-            members = [i for i, n in enumerate(names) if n.startswith(stem) and i != g]
-        groups.append((g, np.asarray(members, dtype=int)))
+        if is_merged(name):
+            stem = name.removeprefix(MERGED_PREFIX)
+            members = [i for i, n in enumerate(names) if n.startswith(stem)]
+            groups.append((g, np.asarray(members, dtype=int)))
     return groups
 
 
-def show_merged(model: mujoco.MjModel) -> int:
+def show_merged(model: mujoco.MjModel) -> None:
     """Turn ``model`` (a renderer's own copy) to draw each merged mesh instead of its boxes:
-    the mesh takes the boxes' colour, the boxes alpha 0. Returns the geoms left out."""
-    hidden = 0
+    the mesh takes the boxes' colour, the boxes alpha 0."""
     for mesh, boxes in merged_groups(model):
-        if len(boxes) == 0:
-            continue
-        model.geom_rgba[mesh] = model.geom_rgba[boxes[0]]
-        model.geom_rgba[boxes, 3] = 0.0
-        hidden += len(boxes) - 1
-    return hidden
+        if len(boxes):
+            model.geom_rgba[mesh] = model.geom_rgba[boxes[0]]
+            model.geom_rgba[boxes, 3] = 0.0

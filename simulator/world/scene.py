@@ -22,7 +22,7 @@ from simulator.world.ball import (
     ball_damping,
 )
 from simulator.world.field import field_bodies, line_mesh_xml
-from simulator.world.goal import goal_bodies, net_mesh_xml
+from simulator.world.goal import GOALS, goal_bodies, net_mesh_xml
 from simulator.world.jersey import apply_jerseys, jersey_assets, jersey_material
 from simulator.world.look import Look, apply_look, look_assets, look_for
 from simulator.world.robots import robot_model
@@ -79,8 +79,7 @@ def scene_xml(
     ball = (BALL_BIT, STATIC_BIT | robot_bits)
     bodies = [
         field_bodies(field, static_bits=static),
-        goal_bodies(field, sign=-1.0, name="goal_left", static_bits=static),
-        goal_bodies(field, sign=1.0, name="goal_right", static_bits=static),
+        *(goal_bodies(field, sign=sign, name=name, static_bits=static) for sign, name in GOALS),
         ball_body(field, bits=ball),
     ]
     actuators = []
@@ -112,10 +111,9 @@ def scene_xml(
             f'<contact name="{ball_touch_sensor(placement)}" subtree1="{robot_prefix(placement.id)}'
             f'/torso" geom2="{BALL_GEOM}" data="found" num="1"/>'
         )
-    merged = (
-        line_mesh_xml(field) + net_mesh_xml(field, sign=-1.0, name="goal_left")
-        + net_mesh_xml(field, sign=1.0, name="goal_right")
-    )  # fmt: skip
+    merged = line_mesh_xml(field) + "".join(
+        net_mesh_xml(field, sign=sign, name=name) for sign, name in GOALS
+    )
     return f"""<mujoco model="hlvs-{field.field_class.value}">
 <compiler angle="radian" autolimits="true"/>
 <option timestep="{physics_dt_s!r}" integrator="implicitfast" cone="pyramidal"/>

@@ -39,13 +39,13 @@ def test_the_world_carries_every_line_and_cord_twice_and_hides_the_meshes(
     model = world.model
     names = _names(model)
     groups = {names[g]: boxes for g, boxes in merged_groups(model)}
-    assert sorted(groups) == ["merged:goal_left:net", "merged:goal_right:net", "merged:line:"]
+    assert sorted(groups) == ["merged:goal_left:cord:", "merged:goal_right:cord:", "merged:line:"]
     lines = {g for g, n in enumerate(names) if n.startswith("line:")}
-    cords = {side: {g for g, n in enumerate(names) if n.startswith(side) and "_cord_" in n}
+    cords = {side: {g for g, n in enumerate(names) if n.startswith(side) and ":cord:" in n}
              for side in ("goal_left:", "goal_right:")}  # fmt: skip
     assert set(groups["merged:line:"].tolist()) == lines and len(lines) == 70
-    assert set(groups["merged:goal_left:net"].tolist()) == cords["goal_left:"]
-    assert set(groups["merged:goal_right:net"].tolist()) == cords["goal_right:"]
+    assert set(groups["merged:goal_left:cord:"].tolist()) == cords["goal_left:"]
+    assert set(groups["merged:goal_right:cord:"].tolist()) == cords["goal_right:"]
     assert len(cords["goal_left:"]) > 100
     for g, _ in merged_groups(model):
         assert model.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH
@@ -76,15 +76,14 @@ def _frames(world: World, show: object) -> np.ndarray:
         ])  # fmt: skip
 
 
-def _hide_all(model: mujoco.MjModel) -> int:
+def _hide_all(model: mujoco.MjModel) -> None:
     for _, boxes in merged_groups(model):
         model.geom_rgba[boxes, 3] = 0.0
-    return 0
 
 
 def test_a_camera_frame_with_the_meshes_is_the_frame_with_the_boxes(world: World) -> None:
     meshes = _frames(world, camera.show_merged)
-    boxes = _frames(world, lambda model: 0)
+    boxes = _frames(world, lambda model: None)
     bare = _frames(world, _hide_all)  # neither: what the lines and nets add to a frame
     pixels = W * H
     for k in range(len(meshes)):
