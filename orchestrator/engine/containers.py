@@ -328,6 +328,9 @@ def _intended(kind: str, name: str) -> Iterator[None]:
 
 
 def _sample(raw: dict[str, Any]) -> StatsSample | None:
+    """One sample of the engine's stats stream, or None where it measured nothing: a zero
+    read time (the container is not running) or no memory figures (its cgroup was not
+    there to read, as while it starts or stops on a loaded machine)."""
     cpu = raw.get("cpu_stats", {})
     pre = raw.get("precpu_stats", {})
     mem = raw.get("memory_stats", {})
@@ -339,7 +342,7 @@ def _sample(raw: dict[str, Any]) -> StatsSample | None:
         total, system, online = 0, 0, 1
     percent = (total / system) * online * 100.0 if system > 0 and total > 0 else 0.0
     usage = int(mem.get("max_usage") or mem.get("usage") or 0)
-    if not raw.get("read", "").strip("0-:TZ."):
+    if not raw.get("read", "").strip("0-:TZ.") or usage <= 0:
         return None
     return StatsSample(cpu_percent=percent, memory_bytes=usage)
 

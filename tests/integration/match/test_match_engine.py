@@ -26,7 +26,7 @@ def test_container_lifecycle_logs_copy_and_exit_code(runtime: Any, test_image: s
     name = f"hlvs-enginetest-{uuid.uuid4().hex[:6]}"
     container_id = runtime.create_container(ContainerRequest(
         name=name, image=test_image,
-        command=("sh", "-c", "echo out; echo err >&2; echo data > /tmp/f.txt; sleep 1; exit 7"),
+        command=("sh", "-c", "echo out; echo err >&2; echo data > /tmp/f.txt; sleep 3; exit 7"),
         labels={TEST_LABEL: "1", "org.hlvs-runner": "1"}, cap_drop=("ALL",),
         mem_bytes=64 * 2**20,
     ))
