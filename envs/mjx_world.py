@@ -7,7 +7,8 @@ from the CPU world in what MJX (``mujoco-mjx``, its JAX backend) does not implem
 - the robot's ball-touch sensor (a ``contact`` sensor matching the torso's subtree) reads the
   clock instead: MJX has no subtree contact sensor. It only counts touches for the referee; no
   force or observation depends on it;
-- the goals' geoms collide with the ball only, not with the robot: MJX has no collision
+- the goals' collision geoms collide with the ball only, not with the robot (the nets' cords,
+  visual only, stay without contacts): MJX has no collision
   function for a cylinder (post, crossbar) against a box (the robot's links). In
   ``hlvs/StandKick-v0`` the robot starts 3 m or more from either goal and its episode lasts
   1.5 s, so it never reaches one;
@@ -109,7 +110,8 @@ def mjx_scene(*, model: str = "kid-default", self_collision: bool = False) -> Mj
     prefix = f"{robot_prefix(LEARNER)}/"
     for g in range(compiled.ngeom):
         name = compiled.geom(g).name
-        if name.startswith(("goal_left", "goal_right")):
+        collides = bool(compiled.geom_contype[g] or compiled.geom_conaffinity[g])
+        if name.startswith(("goal_left", "goal_right")) and collides:  # not the nets' cords
             compiled.geom_contype[g] = GOAL_BIT
             compiled.geom_conaffinity[g] = ball_bit
         elif not self_collision and name.startswith(prefix):
