@@ -38,7 +38,10 @@ kind alike), each benchmark as a child process with small sizes:
 
 Prints one JSON document: per kind its runs, the median of each figure, the target and whether
 the median meets it; the load average before and after, so that a figure is read with the load
-it was measured under. A benchmark that fails is reported with its error (exit code 1).
+it was measured under, and the share of the CPUs' time the hypervisor gave to other machines
+(``steal_share``, from ``/proc/stat``: over the whole report and for each run; on a virtual
+machine with busy neighbours a run can lose a tenth of its CPU this way). A benchmark that
+fails is reported with its error (exit code 1).
 """
 
 from __future__ import annotations
@@ -59,10 +62,12 @@ from contracts import files
 from testkit.figures import (
     MACHINE_SCALED,
     REFERENCE_BARE_REAL_TIME_FACTOR,
+    cpu_times,
     league_match_figures,
     machine_target,
     median_figures,
     report_rounds,
+    steal_share,
 )
 
 KINDS = ("sim", "async", "lockstep", "lockstep_league", "pipelined", "cameras", "bringup",
@@ -261,6 +266,14 @@ def _load() -> list[float]:
     return [round(x, 2) for x in os.getloadavg()]
 
 
+def _cpu_times() -> tuple[int, int] | None:
+    """(stolen, total) CPU ticks of this machine so far (Linux), or None."""
+    try:
+        return cpu_times(Path("/proc/stat").read_text())
+    except OSError:
+        return None
+
+
 def _kinds(text: str) -> list[str]:
     return [k.strip() for k in text.split(",") if k.strip()]
 
@@ -276,13 +289,16 @@ def run(args: argparse.Namespace, progress: Callable[[str], None]) -> dict[str, 
     runs: dict[str, list[dict[str, Any]]] = {k: [] for k in kinds}
     started = time.monotonic()
     load_before = _load()
+    ticks_before = _cpu_times()
     wanted = {kind: args.repeats for kind in kinds}
     wanted.update(bringup=_bringup_repeats(args), match=args.match_repeats)
     for repeat, kinds_now in enumerate(report_rounds(kinds, wanted)):
         for kind in kinds_now:
             progress(f"{kind} run {repeat + 1} (load {_load()[0]})")
+            ticks = _cpu_times()
             result = runners[kind]()
             result["load_1min"] = _load()[0]
+            result["steal_share"] = steal_share(ticks, _cpu_times())
             runs[kind].append(result)
     report: dict[str, Any] = {
         "bench": "report",
@@ -295,6 +311,9 @@ def run(args: argparse.Namespace, progress: Callable[[str], None]) -> dict[str, 
         "cpus": len(os.sched_getaffinity(0)),
         "load_average_before": load_before,
         "load_average_after": _load(),
+        # the CPU time the hypervisor gave to other machines meanwhile: a figure measured
+        # while it was high is the neighbours' as much as ours
+        "steal_share": steal_share(ticks_before, _cpu_times()),
         "wall_s": round(time.monotonic() - started, 1),
         "errors": 0,
     }

@@ -129,7 +129,30 @@ def report_rounds(kinds: Sequence[str], runs: Mapping[str, int]) -> list[list[st
     return [[kind for kind in kinds if wanted[kind] > turn] for turn in range(rounds)]
 
 
+def cpu_times(stat_text: str) -> tuple[int, int] | None:
+    """(stolen, total) clock ticks of all CPUs from the text of ``/proc/stat`` (its ``cpu``
+    line: user, nice, system, idle, iowait, irq, softirq, steal; guest time is inside user);
+    None where the text has no such line."""
+    for line in stat_text.splitlines():
+        fields = line.split()
+        if fields and fields[0] == "cpu" and len(fields) >= 9:
+            ticks = [int(f) for f in fields[1:9]]
+            return ticks[7], sum(ticks)
+    return None
+
+
+def steal_share(before: tuple[int, int] | None, after: tuple[int, int] | None) -> float | None:
+    """The share of the CPUs' time between two :func:`cpu_times` readings that the hypervisor
+    gave to other machines (steal time): 0 on a machine of its own; None without both
+    readings."""
+    if before is None or after is None or after[1] <= before[1]:
+        return None
+    return round((after[0] - before[0]) / (after[1] - before[1]), 3)
+
+
 __all__ = [
+    "cpu_times",
+    "steal_share",
     "FLOOD_TARGET",
     "LEAGUE_MATCH_SIM_S",
     "LEAGUE_MATCH_WAITS_S",

@@ -13,6 +13,7 @@ from testkit.figures import (
     LEAGUE_MATCH_SIM_S,
     LEAGUE_MATCH_WAITS_S,
     Target,
+    cpu_times,
     judged,
     league_match_figures,
     machine_target,
@@ -34,6 +35,8 @@ def test_report_runs_the_kinds_and_judges_medians_against_targets() -> None:
     report = json.loads(lines[0])
     assert report["bench"] == "report" and report["errors"] == 0
     assert len(report["load_average_before"]) == 3
+    shares = [report["steal_share"], *(r["steal_share"] for r in report["sim"]["runs"])]
+    assert all(isinstance(x, float) and 0.0 <= x < 1.0 for x in shares), shares
     assert "async" not in report and "bringup" not in report
     assert report["bringup_repeats"] == 2  # as many bring-ups as --repeats unless told
     sim, pipelined = report["sim"], report["pipelined"]
@@ -48,6 +51,17 @@ def test_report_runs_the_kinds_and_judges_medians_against_targets() -> None:
     assert 0 <= pipelined["median"]["client_wait_share"] < 1
     # this machine has a C compiler (make setup installs one): the compiled clients ran
     assert all(run["native_clients"] is True for run in pipelined["runs"])
+
+
+def test_steal_share_is_the_stolen_part_of_the_cpus_ticks_between_two_readings() -> None:
+    from testkit.figures import steal_share
+
+    before = cpu_times("cpu  100 0 50 800 10 0 5 35 0 0\ncpu0 50 0 25 400 5 0 2 18 0 0\n")
+    after = cpu_times("intr 1\ncpu  160 0 70 900 10 0 5 55 7 0\n")
+    assert before == (35, 1000) and after == (55, 1200)
+    assert steal_share(before, after) == 0.1  # 20 of 200 ticks
+    assert cpu_times("intr 1\n") is None
+    assert steal_share(None, after) is None and steal_share(after, after) is None
 
 
 def test_report_runs_lockstep_with_clients_written_like_the_leagues() -> None:
