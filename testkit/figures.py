@@ -151,8 +151,6 @@ def steal_share(before: tuple[int, int] | None, after: tuple[int, int] | None) -
 
 
 __all__ = [
-    "cpu_times",
-    "steal_share",
     "FLOOD_TARGET",
     "LEAGUE_MATCH_SIM_S",
     "LEAGUE_MATCH_WAITS_S",
@@ -160,9 +158,11 @@ __all__ = [
     "REFERENCE_BARE_REAL_TIME_FACTOR",
     "TARGETS",
     "Target",
+    "cpu_times",
     "judged",
     "league_match_figures",
     "machine_target",
     "median_figures",
     "report_rounds",
+    "steal_share",
 ]

@@ -26,7 +26,6 @@ the ideal image.
 from __future__ import annotations
 
 import copy
-import math
 import os
 from collections.abc import Callable
 from typing import TYPE_CHECKING
@@ -36,7 +35,7 @@ import numpy as np
 
 from contracts import RobotId
 from simulator.errors import UnknownDeviceError
-from simulator.world.camera_model import CameraEffects, CameraModel, blur_px_of
+from simulator.world.camera_model import CameraEffects, CameraModel, blur_px_of, focal_px
 from simulator.world.camera_scene import SceneCut, cheap_shadows
 from simulator.world.merged import show_merged
 
@@ -85,12 +84,6 @@ def robot_camera_model(model: mujoco.MjModel) -> mujoco.MjModel:
     cheap_shadows(cheap)
     show_merged(cheap)
     return cheap
-
-
-def focal_px(model: mujoco.MjModel, camera: int, height: int) -> float:
-    """Camera ``camera``'s focal length in pixels of an image ``height`` pixels high: the pixels
-    a radian spans at the image's centre."""
-    return height / 2.0 / math.tan(math.radians(float(model.cam_fovy[camera])) / 2.0)
 
 
 def linear_sky(renderer: mujoco.Renderer, focal: float) -> int:
@@ -188,7 +181,7 @@ class CameraRenderer:
         self._frame = np.empty((height, width, 3), dtype=np.uint8)
         self._read_bgr = _reads_bgr(self._renderer)
         cameras = [index.camera for index in world.index.by_id.values()]
-        focal = min((focal_px(model, c, height) for c in cameras), default=0.0)
+        focal = min((focal_px(height, float(model.cam_fovy[c])) for c in cameras), default=0.0)
         self.linear_sky = linear_sky(self._renderer, focal) > 0
 
     def render(self, robot: RobotId, *, sim_time_ms: int = 0) -> bytes:

@@ -149,6 +149,12 @@ def motion_blur(rgb: npt.NDArray[np.uint8], blur_px: tuple[float, float]) -> npt
     return (acc // (steps + 1)).astype(np.uint8)
 
 
+def focal_px(height: int, fovy_deg: float) -> float:
+    """The focal length in pixels of a camera ``height`` pixels high with a vertical field of
+    view of ``fovy_deg``: the pixels a radian spans at the image's centre."""
+    return (height / 2.0) / math.tan(math.radians(fovy_deg) / 2.0)
+
+
 def blur_px_of(
     angular_velocity_cam: npt.NDArray[np.float64],
     *,
@@ -158,6 +164,6 @@ def blur_px_of(
 ) -> tuple[float, float]:
     """Image motion (columns, rows) during the exposure for a camera turning at
     ``angular_velocity_cam`` (rad/s, MuJoCo camera frame: x right, y up, looking along -z)."""
-    focal = (height / 2.0) / math.tan(math.radians(fovy_deg) / 2.0)
+    focal = focal_px(height, fovy_deg)
     wx, wy = float(angular_velocity_cam[0]), float(angular_velocity_cam[1])
     return (-wy * focal * exposure_s, wx * focal * exposure_s)

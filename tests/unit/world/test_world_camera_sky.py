@@ -9,7 +9,7 @@ import pytest
 from OpenGL import GL
 
 from simulator.world import CameraRenderer, World
-from simulator.world.camera import focal_px
+from simulator.world.camera_model import focal_px
 
 from .conftest import eight_robots
 
@@ -44,7 +44,7 @@ def test_a_magnified_sky_is_drawn_the_same_without_mipmaps(texture_seed: int) ->
         world.step()
     with CameraRenderer(world, 320, 240) as renderer:
         camera = world.index.by_id[world.robot_ids[0]].camera
-        assert focal_px(world.model, camera, 240) > 250  # 46.5 degrees: 279 px a radian
+        assert focal_px(240, float(world.model.cam_fovy[camera])) > 250  # 279 px a radian
         assert renderer.linear_sky
         assert _sky_filters(renderer) == [GL.GL_LINEAR]
         fast = _frames(renderer, world)
