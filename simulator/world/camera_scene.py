@@ -42,6 +42,7 @@ import mujoco
 import numpy as np
 
 from simulator.world.merged import merged_groups
+from simulator.world.scene_geoms import geom_rows
 
 ROBOT_SHADOW_SIZE = 1024
 PLANE_GRID_M = 1.0
@@ -409,6 +410,47 @@ class PlanarShadows:
         self._diagonal: tuple[tuple[float, ...], np.ndarray] = ((), np.eye(3))
         self._light: _KeyLight | None = None
         self._light_read = False
+        # the shadows written as records (scene_geoms): each caster's geom as mjv_initGeom
+        # and add's loop make it (pos, mat and rgba are written per frame), and the scene whose
+        # records are viewed; None where the layout does not agree (geom by geom then)
+        self._template = self._records(model)
+        self._rows: tuple[mujoco.MjvScene | None, np.ndarray | None] = (None, None)
+
+    def _records(self, model: mujoco.MjModel) -> np.ndarray | None:
+        """The casters' shadow geoms as records, written once through the binding."""
+        if not len(self.casters):
+            return None
+        scratch = mujoco.MjvScene(model, maxgeom=max(2, len(self.casters)))
+        rows = geom_rows(scratch)
+        if rows is None:
+            return None
+        white, still = np.ones(4, dtype=np.float32), np.eye(3).ravel()
+        for k in range(len(self.casters)):
+            self._write(scratch.geoms[k], k, np.zeros(3), still, white)
+        template = rows[: len(self.casters)].copy()
+        template["label"] = 0  # (mjv_initGeom ends the string at its first byte)
+        return template
+
+    def _write(self, geom: Any, c: int, pos: np.ndarray, mat: np.ndarray, rgba: np.ndarray) -> None:
+        """Caster ``c``'s shadow geom written through the binding: a decoration, as MuJoCo's
+        own (``mjv_initGeom`` leaves the object, category, segment and the flags as the slot
+        had them, from whatever geom was there the frame before)."""
+        mujoco.mjv_initGeom(geom, self._types[c], self._sizes[c], pos, mat, rgba)
+        geom.specular = 0.0
+        if self._dataids[c] >= 0:
+            geom.dataid = self._dataids[c]
+        geom.objtype = int(mujoco.mjtObj.mjOBJ_UNKNOWN)
+        geom.objid = -1
+        geom.category = int(mujoco.mjtCatBit.mjCAT_DECOR)
+        geom.segid = -1
+        geom.castshadow = 0
+        geom.transparent = 0
+        geom.camdist = 0.0
+
+    def _rows_of(self, scene: mujoco.MjvScene) -> np.ndarray | None:
+        if self._rows[0] is not scene:
+            self._rows = (scene, geom_rows(scene) if self._template is not None else None)
+        return self._rows[1]
 
     def light(self, scene: mujoco.MjvScene) -> _KeyLight | None:
         """The key light as ``scene`` has it (its first directional light that casts shadows
@@ -462,15 +504,18 @@ class PlanarShadows:
         spots = pos[None, :, :2] + _SPREAD[:, None, :] * reach[None, :, :]
         under = self._turf.under(spots.reshape(-1, 2)).reshape(len(_SPREAD), len(casters), 3)
         rgba[:, :3] = under.mean(axis=0) * light.shade
-        geoms, first = scene.geoms, scene.ngeom
-        types, sizes, dataids = self._types, self._sizes, self._dataids
-        init = mujoco.mjv_initGeom
-        for k, c in enumerate(which.tolist()):
-            geom = geoms[first + k]
-            init(geom, types[c], sizes[c], pos[k], mats[k], rgba[k])
-            geom.specular = 0.0
-            if dataids[c] >= 0:
-                geom.dataid = dataids[c]
+        first = scene.ngeom
+        rows = self._rows_of(scene)
+        if rows is not None and self._template is not None:
+            out = rows[first : first + len(casters)]
+            out[:] = self._template[which]
+            out["pos"] = pos
+            out["mat"] = mats
+            out["rgba"] = rgba
+        else:
+            geoms = scene.geoms
+            for k, c in enumerate(which.tolist()):
+                self._write(geoms[first + k], c, pos[k], mats[k], rgba[k])
         scene.ngeom = first + len(casters)
         return len(casters)
 
