@@ -415,6 +415,7 @@ class PlanarShadows:
         # records are viewed; None where the layout does not agree (geom by geom then)
         self._template = self._records(model)
         self._rows: tuple[mujoco.MjvScene | None, np.ndarray | None] = (None, None)
+        self._last: _Posed | None = None
 
     def _records(self, model: mujoco.MjModel) -> np.ndarray | None:
         """The casters' shadow geoms as records, written once through the binding."""
@@ -462,11 +463,10 @@ class PlanarShadows:
             self._light_read = True
         return self._light
 
-    def _frames(
-        self, data: mujoco.MjData, casters: np.ndarray, which: np.ndarray, direction: np.ndarray
-    ) -> np.ndarray:
-        """The casters' shadow boxes' orientations (rows of 3x3, world from box)."""
-        frames = data.geom_xmat[casters].reshape(-1, 3, 3).copy()
+    def _frames(self, xmat: np.ndarray, which: np.ndarray, direction: np.ndarray) -> np.ndarray:
+        """The shadow boxes' orientations (rows of 3x3, world from box) of the casters
+        ``which`` (indices into :attr:`casters`) whose geoms have the orientations ``xmat``."""
+        frames = xmat.reshape(-1, 3, 3).copy()
         prism = self._prism[which]
         if np.any(prism):
             axis = frames[prism, :, 2]
@@ -492,32 +492,65 @@ class PlanarShadows:
         if self._turf is None or not len(which):
             return 0
         which = which[: scene.maxgeom - scene.ngeom]
-        casters = self.casters[which]
-        pos = data.geom_xpos[casters] @ light.flatten.T
-        pos[:, 2] += SHADOW_LIFT_M
-        frames = self._frames(data, casters, which, light.direction)
-        mats = (light.flatten @ frames).reshape(-1, 9)
-        rgba = np.ones((len(casters), 4), dtype=np.float32)
-        # the turf's colour over the shadow's breadth (its centre and four points half its
-        # bounding radius away), so a shadow across two mowing stripes takes their blend
-        reach = 0.5 * self.rbound[which, None]
-        spots = pos[None, :, :2] + _SPREAD[:, None, :] * reach[None, :, :]
-        under = self._turf.under(spots.reshape(-1, 2)).reshape(len(_SPREAD), len(casters), 3)
-        rgba[:, :3] = under.mean(axis=0) * light.shade
         first = scene.ngeom
         rows = self._rows_of(scene)
-        if rows is not None and self._template is not None:
-            out = rows[first : first + len(casters)]
-            out[:] = self._template[which]
-            out["pos"] = pos
-            out["mat"] = mats
-            out["rgba"] = rgba
+        posed = self._posed(data, light)
+        if rows is not None and posed.records is not None:
+            rows[first : first + len(which)] = posed.records[which]
         else:
             geoms = scene.geoms
             for k, c in enumerate(which.tolist()):
-                self._write(geoms[first + k], c, pos[k], mats[k], rgba[k])
-        scene.ngeom = first + len(casters)
-        return len(casters)
+                self._write(geoms[first + k], c, posed.pos[c], posed.mats[c], posed.rgba[c])
+        scene.ngeom = first + len(which)
+        return len(which)
+
+    def _posed(self, data: mujoco.MjData, light: _KeyLight) -> _Posed:
+        """Every caster's shadow in ``data``'s pose (kept while the casters' poses and the
+        light are the same: the cameras of one step share it)."""
+        xpos, xmat = data.geom_xpos[self.casters], data.geom_xmat[self.casters]
+        posed = self._last
+        if (
+            posed is not None
+            and posed.light is light
+            and np.array_equal(posed.xpos, xpos)
+            and np.array_equal(posed.xmat, xmat)
+        ):
+            return posed
+        pos = xpos @ light.flatten.T
+        pos[:, 2] += SHADOW_LIFT_M
+        every = np.arange(len(self.casters))
+        frames = self._frames(xmat, every, light.direction)
+        mats = (light.flatten @ frames).reshape(-1, 9)
+        rgba = np.ones((len(self.casters), 4), dtype=np.float32)
+        # the turf's colour over the shadow's breadth (its centre and four points half its
+        # bounding radius away), so a shadow across two mowing stripes takes their blend
+        assert self._turf is not None
+        reach = 0.5 * self.rbound[:, None]
+        spots = pos[None, :, :2] + _SPREAD[:, None, :] * reach[None, :, :]
+        under = self._turf.under(spots.reshape(-1, 2)).reshape(len(_SPREAD), len(pos), 3)
+        rgba[:, :3] = under.mean(axis=0) * light.shade
+        records = None
+        if self._template is not None:
+            records = self._template.copy()
+            records["pos"] = pos
+            records["mat"] = mats
+            records["rgba"] = rgba
+        self._last = _Posed(light, xpos, xmat, pos, mats, rgba, records)
+        return self._last
+
+
+@dataclass(frozen=True)
+class _Posed:
+    """Every caster's shadow in one pose of the casters (``xpos``, ``xmat``) and ``light``: its
+    position, orientation and colour, and as the scene's records when they are written so."""
+
+    light: _KeyLight
+    xpos: np.ndarray
+    xmat: np.ndarray
+    pos: np.ndarray
+    mats: np.ndarray
+    rgba: np.ndarray
+    records: np.ndarray | None
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:

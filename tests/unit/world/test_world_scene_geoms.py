@@ -11,6 +11,7 @@ import pytest
 from simulator.world import CameraRenderer, World
 from simulator.world.camera import SHADOWS_ENV
 from simulator.world.camera_scene import PlanarShadows
+from simulator.world.commands import place_ball
 from simulator.world.scene_geoms import geom_dtype, geom_rows
 
 from .conftest import eight_robots
@@ -90,3 +91,34 @@ def test_shadows_written_as_records_are_the_bindings_geoms(world: World) -> None
     assert (by_records["objid"] == -1).all() and (by_records["segid"] == -1).all()
     assert (by_records["specular"] == 0).all()
     assert np.array_equal(frames, frames_one_by_one)
+
+
+def test_the_shadows_of_one_pose_are_made_once_and_follow_a_move() -> None:
+    world = World.create(field_class="kid", robots=eight_robots(), seed=1, texture_seed=3)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv(SHADOWS_ENV, "planar")
+        renderer = CameraRenderer(world, W, H)
+    with renderer:
+        planar = renderer._cut._planar
+        assert isinstance(planar, PlanarShadows)
+        ball = next(
+            k for k, g in enumerate(planar.casters.tolist())
+            if mujoco.mj_id2name(world.model, mujoco.mjtObj.mjOBJ_GEOM, g) == "ball:geom"
+        )  # fmt: skip
+        renderer.render(world.robot_ids[0])
+        posed = planar._last
+        assert posed is not None and posed.records is not None
+        renderer.render(world.robot_ids[1])  # another camera, the same step: kept
+        assert planar._last is posed
+        place_ball(world, (1.0, 0.5, 0.07), (0.0, 0.0, 0.0))
+        renderer.render(world.robot_ids[1])
+        moved = planar._last
+        assert moved is not posed and moved is not None and moved.records is not None
+        shift = moved.pos[ball] - posed.pos[ball]
+        # where the ball's centre falls along the light
+        along = world.data.geom_xpos[planar.casters[ball]] @ moved.light.flatten.T
+        assert moved.pos[ball][:2] == pytest.approx(along[:2], abs=1e-9)
+        assert np.linalg.norm(shift[:2]) > 0.05
+        assert moved.records["pos"][ball] == pytest.approx(moved.pos[ball], abs=1e-6)
+        others = np.arange(len(planar.casters)) != ball
+        assert np.array_equal(moved.pos[others], posed.pos[others])
