@@ -460,7 +460,8 @@ class PlanarShadows:
         if not self._light_read:
             key, others = _shadow_light(scene)
             self._light = None if key is None else _KeyLight.of(key, others)
-            self._light_read = True
+            # a scene not made yet (no lights at all, not even the headlight) is not read
+            self._light_read = scene.nlight > 0
         return self._light
 
     def _frames(self, xmat: np.ndarray, which: np.ndarray, direction: np.ndarray) -> np.ndarray:

@@ -101,6 +101,8 @@ def test_the_shadows_of_one_pose_are_made_once_and_follow_a_move() -> None:
     with renderer:
         planar = renderer._cut._planar
         assert isinstance(planar, PlanarShadows)
+        # asked before any frame (a scene without lights yet): nothing is kept from it
+        assert planar.light(renderer._renderer.scene) is None
         ball = next(
             k for k, g in enumerate(planar.casters.tolist())
             if mujoco.mj_id2name(world.model, mujoco.mjtObj.mjOBJ_GEOM, g) == "ball:geom"
@@ -108,6 +110,7 @@ def test_the_shadows_of_one_pose_are_made_once_and_follow_a_move() -> None:
         renderer.render(world.robot_ids[0])
         posed = planar._last
         assert posed is not None and posed.records is not None
+        assert planar.light(renderer._renderer.scene) is posed.light
         renderer.render(world.robot_ids[1])  # another camera, the same step: kept
         assert planar._last is posed
         place_ball(world, (1.0, 0.5, 0.07), (0.0, 0.0, 0.0))
