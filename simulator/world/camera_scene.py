@@ -464,11 +464,11 @@ class PlanarShadows:
             self._light_read = scene.nlight > 0
         return self._light
 
-    def _frames(self, xmat: np.ndarray, which: np.ndarray, direction: np.ndarray) -> np.ndarray:
-        """The shadow boxes' orientations (rows of 3x3, world from box) of the casters
-        ``which`` (indices into :attr:`casters`) whose geoms have the orientations ``xmat``."""
+    def _frames(self, xmat: np.ndarray, direction: np.ndarray) -> np.ndarray:
+        """Every caster's shadow box's orientation (rows of 3x3, world from box), the casters'
+        geoms having the orientations ``xmat``."""
         frames = xmat.reshape(-1, 3, 3).copy()
-        prism = self._prism[which]
+        prism = self._prism
         if np.any(prism):
             axis = frames[prism, :, 2]
             across = _cross(axis, direction)  # the shadow's width is measured along this
@@ -476,7 +476,7 @@ class PlanarShadows:
             # along the light: any width will do (the geom's own x axis)
             across = np.where(norm > 1e-6, across / np.maximum(norm, 1e-6), frames[prism, :, 0])
             frames[prism] = np.stack([across, _cross(axis, across), axis], axis=2)
-        sphere = self._sphere[which]
+        sphere = self._sphere
         if np.any(sphere):
             key = tuple(direction)
             if key != self._diagonal[0]:
@@ -519,8 +519,7 @@ class PlanarShadows:
             return posed
         pos = xpos @ light.flatten.T
         pos[:, 2] += SHADOW_LIFT_M
-        every = np.arange(len(self.casters))
-        frames = self._frames(xmat, every, light.direction)
+        frames = self._frames(xmat, light.direction)
         mats = (light.flatten @ frames).reshape(-1, 9)
         rgba = np.ones((len(self.casters), 4), dtype=np.float32)
         # the turf's colour over the shadow's breadth (its centre and four points half its

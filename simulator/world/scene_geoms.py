@@ -17,6 +17,7 @@ the caller writes geom by geom as before.
 from __future__ import annotations
 
 import ctypes
+from functools import lru_cache
 from typing import Any
 
 import mujoco
@@ -33,6 +34,7 @@ _SCALARS = {
 _ARRAYS = ("size", "pos", "mat", "rgba", "texrepeat")  # where the binding gives views
 
 
+@lru_cache(maxsize=1)
 def geom_dtype() -> np.dtype | None:
     """``mjvGeom`` as a numpy record (C alignment), from MuJoCo's introspection; None when a
     field's type is not a plain number or the declaration is not there."""

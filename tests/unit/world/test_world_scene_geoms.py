@@ -49,14 +49,20 @@ def test_records_are_the_scenes_geoms_both_ways() -> None:
     assert (geom.segid, geom.emission) == (17, 0.75)
 
 
-def _shadow_slots(world: World, records: bool) -> tuple[np.ndarray, np.ndarray]:
-    """The scene's shadow geoms (as records) after one camera's frame, and all 8 frames."""
+def _planar(world: World) -> tuple[CameraRenderer, PlanarShadows]:
+    """A camera renderer of ``world`` with planar shadows, and its shadows."""
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv(SHADOWS_ENV, "planar")
         renderer = CameraRenderer(world, W, H)
+    planar = renderer._cut._planar
+    assert isinstance(planar, PlanarShadows)
+    return renderer, planar
+
+
+def _shadow_slots(world: World, records: bool) -> tuple[np.ndarray, np.ndarray]:
+    """The scene's shadow geoms (as records) after one camera's frame, and all 8 frames."""
+    renderer, planar = _planar(world)
     with renderer:
-        planar = renderer._cut._planar
-        assert isinstance(planar, PlanarShadows)
         scene = renderer._renderer.scene
         rows = geom_rows(scene)
         assert rows is not None
@@ -95,12 +101,8 @@ def test_shadows_written_as_records_are_the_bindings_geoms(world: World) -> None
 
 def test_the_shadows_of_one_pose_are_made_once_and_follow_a_move() -> None:
     world = World.create(field_class="kid", robots=eight_robots(), seed=1, texture_seed=3)
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setenv(SHADOWS_ENV, "planar")
-        renderer = CameraRenderer(world, W, H)
+    renderer, planar = _planar(world)
     with renderer:
-        planar = renderer._cut._planar
-        assert isinstance(planar, PlanarShadows)
         # asked before any frame (a scene without lights yet): nothing is kept from it
         assert planar.light(renderer._renderer.scene) is None
         ball = next(
