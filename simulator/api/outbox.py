@@ -177,14 +177,14 @@ class Outbox:
         frame = measurement.frame
         if frame is not None:  # built whole by the step's batch: no header, no message
             return self._admitted(slot, frame, measurement.time, measurement.real_time)
-        head, sensors = measurement.head(), measurement.sensors
-        size = len(head) + len(sensors)
+        head, sensors = measurement.head_parts(), measurement.sensors
+        size = sum(map(len, head)) + len(sensors)
         if not slot.quota.admit(size, measurement.real_time):
             return self._quota_error(slot, measurement.time, measurement.real_time)
         warnings = measurement.message_count
         if warnings:
             slot.stats.warnings_sent += warnings
-        return b"".join((HEADER.pack(size), head, sensors))
+        return b"".join((HEADER.pack(size), *head, sensors))
 
     def _admitted(self, slot: RobotSlot, frame: bytes, time_ms: int, real_time: int) -> bytes:
         """A plain measurement's whole ``frame``, counted in the robot's quota, or the quota's
@@ -263,7 +263,7 @@ class Outbox:
         touched: set[RobotId] = set()
         for job, image in self._cameras.completed():
             slot = self._slots[job.robot]
-            job.measurement.image = image
+            job.image = image
             for pending in slot.pending:
                 if pending.measurement.time == job.time_ms and pending.missing:
                     pending.missing -= 1

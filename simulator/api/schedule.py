@@ -14,6 +14,7 @@ from collections.abc import Callable
 from typing import Any
 
 from contracts import RobotId
+from contracts.robot_api import messages_pb2 as pb
 from simulator.api.devices import (
     ACCELEROMETER,
     CAMERA,
@@ -181,8 +182,8 @@ class SensorSchedule:
     def _camera_job(self, out: Measurement, name: str, time_ms: int) -> None:
         if self._camera_size is not None:
             width, height = self._camera_size
-            camera = out.header.cameras.add(name=name, width=width, height=height, quality=-1)
-            out.jobs.append(CameraJob(self._robot, name, width, height, time_ms, camera))
+            camera = pb.CameraMeasurement(name=name, width=width, height=height, quality=-1)
+            out.add_camera(CameraJob(self._robot, name, width, height, time_ms, camera))
 
     def plan(self, due: tuple[str, ...]) -> DuePlan:
         """Due sensors in field-number order (the order of the message) and their layout
