@@ -147,6 +147,7 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
             log.info("robot cameras render in %d worker processes", processes)
         cameras = world_render_worker(world, processes=processes)
         stack.callback(cameras.close)
+        cameras.start()  # ready while the server starts and the robots connect
         server = ApiServer(
             world=world,
             endpoints=endpoints_from_spec(spec),

@@ -41,6 +41,8 @@ class ImageSource(Protocol):
     @property
     def in_flight(self) -> int: ...
 
+    def start(self) -> None: ...
+
     def submit(self, jobs: Sequence[CameraJob]) -> None: ...
 
     def completed(self) -> list[tuple[CameraJob, bytes]]: ...
@@ -124,12 +126,17 @@ class RenderWorker:
         """Readable when completed jobs are waiting."""
         return self._completed.wake_fd
 
-    def submit(self, jobs: Sequence[CameraJob]) -> None:
+    def start(self) -> None:
+        """Start the render threads now (else at the first :meth:`submit`): each makes its
+        OpenGL context when it starts."""
         if not self._threads:
             for n in range(self._count):
                 thread = threading.Thread(target=self._run, name=f"camera-render-{n}", daemon=True)
                 thread.start()
                 self._threads.append(thread)
+
+    def submit(self, jobs: Sequence[CameraJob]) -> None:
+        self.start()
         batch = _Batch(self._capture(), len(jobs))
         self._submitted += 1
         for job in jobs:

@@ -114,3 +114,27 @@ def test_a_worker_that_dies_while_it_starts_gives_black_images(
         assert pool.error is not None and pool.in_flight == 0
     finally:
         pool.close()
+
+
+def test_started_pool_makes_its_renderers_before_the_first_job() -> None:
+    """``start()`` (a match calls it before the robots connect): every process takes the
+    world and renders a frame of each camera size before any job, says so (``ready``), and
+    its images are then the same as a pool started by its first job."""
+    world = _world()
+    pool = RenderPool(world, processes=2)
+    try:
+        pool.start()
+        deadline = time.monotonic() + 60
+        while pool.ready < 2 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert pool.ready == 2 and pool.frames == 0 and pool.in_flight == 0
+        pool.submit(_jobs(world.sim_time_ms))
+        images = _collect(pool, 2)
+        assert pool.frames == 2 and pool.error is None
+    finally:
+        pool.close()
+    with CameraRenderer(world, 320, 240) as local:
+        for robot in (RED_1, BLUE_1):
+            got = np.frombuffer(images[robot], dtype=np.uint8).astype(int)
+            want = np.frombuffer(local.render(robot), dtype=np.uint8).astype(int)
+            assert np.mean(got != want) < 0.002  # a few edge pixels differ, as above
