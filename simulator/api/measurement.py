@@ -38,8 +38,8 @@ class CameraJob:
         """The wire bytes of this camera as one ``cameras`` field of ``SensorMeasurements``:
         the camera's other fields as protobuf writes them, then the image field, the image
         itself left as its own part, so that it is copied once, into the frame. (Setting a
-        230 kB image on a protobuf message and serializing it cost the simulator about
-        0.4 ms a frame.)"""
+        230 kB image on a protobuf message and serializing it took 127-150 us a frame; this
+        takes about 9 us.)"""
         meta = self.measurement.SerializeToString()
         image = self.image
         if not image:  # none yet (or empty: proto3 writes no empty field)
