@@ -123,7 +123,7 @@ class Measurement:
         return parts[0] if len(parts) == 1 else b"".join(parts)
 
     def size(self) -> int:
-        return len(self.head()) + len(self.sensors)
+        return sum(map(len, self.head_parts())) + len(self.sensors)
 
     def payload(self) -> bytes:
         return self.head() + self.sensors
