@@ -15,14 +15,16 @@ from __future__ import annotations
 import argparse
 import logging
 import os
+import queue
 import shutil
 import subprocess
 import sys
+import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import IO, TYPE_CHECKING, Any
 
 from simulator.errors import OffscreenGLError, RenderError, ReplayError
 from simulator.gl import choose_offscreen_gl
@@ -90,6 +92,21 @@ def video_shadows() -> bool:
     return not software_gl()
 
 
+def video_surfaces(model: Any) -> None:
+    """Set a replay's scene ``model`` to draw each face of a box as one quad (MuJoCo's default
+    is 4 x 4: the 324 boxes of a kid scrimmage's scene, most of them the nets' cords and the
+    lines, were 62,000 triangles a frame) and the turf in 1 m cells
+    (:func:`~simulator.world.camera_scene.coarse_turf`; 8,800 quads at its 0.1 m). The look's
+    lights are directional, so a flat face is lit the same all over but for the weak specular
+    glint, worked out at the corners; the frames differ from the model's own in the odd pixel
+    of a cord thinner than a pixel (``tests/unit/replay/test_video_frames.py``). On a CPU
+    renderer the video's process took about a third less CPU a frame (README, "Match video")."""
+    from simulator.world.camera_scene import coarse_turf
+
+    model.vis.quality.numquads = 1
+    coarse_turf(model)
+
+
 def render_video(
     replay_path: str | Path,
     output: str | Path,
@@ -107,6 +124,7 @@ def render_video(
     import numpy as np
 
     from simulator.replay import load_replay, scene_for
+    from simulator.world.camera import reads_frames
 
     output = Path(output)
     ffmpeg = shutil.which("ffmpeg")
@@ -120,39 +138,52 @@ def render_video(
             path=str(replay_path),
             reason=f"{len(replay.header.body_names)} bodies recorded, the scene has {model.nbody}",
         )
+    video_surfaces(model)
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
     place = Placer(model, data)
+    indices = list(frames_for(replay, fps))
+    subtitles = _subtitles(replay, indices, fps)
+    srt = output.with_name(output.name + ".srt")
+    if subtitles:
+        srt.write_text(subtitles, encoding="utf-8")
     renderer = mujoco.Renderer(model, height=height, width=width)
     renderer.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = video_shadows()
     renderer.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = False
     option = mujoco.MjvOption()
     option.geomgroup[4] = 0
-    indices = list(frames_for(replay, fps))
+    # the render buffer's own R,G,B,A rows, bottom up, as OpenGL reads them fastest (ffmpeg
+    # drops the alpha and turns the rows); R,G,B top down where they cannot be read so
+    read = reads_frames(renderer, "RGBA")
+    # one frame drawn while ffmpeg is given the one before and the one before that waits
+    frames = [np.empty((height, width, 4), dtype=np.uint8) for _ in range(_FrameFeed.BUFFERS)]
     command = [
-        ffmpeg, "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24",
-        "-s", f"{width}x{height}", "-r", f"{fps:g}", "-i", "-",
+        ffmpeg, "-loglevel", "error", "-y", "-f", "rawvideo",
+        "-pix_fmt", "rgba" if read else "rgb24", "-s", f"{width}x{height}", "-r", f"{fps:g}",
+        "-i", "-",
     ]  # fmt: skip
-    subtitles = _subtitles(replay, indices, fps)
-    srt = output.with_name(output.name + ".srt")
     if subtitles:
-        srt.write_text(subtitles, encoding="utf-8")
         command += ["-i", str(srt), "-map", "0:v", "-map", "1:s", "-c:s", "mov_text"]
+    if read:
+        command += ["-vf", "vflip"]
     command += ["-c:v", "libx264", "-preset", "veryfast", "-pix_fmt", "yuv420p", str(output)]
     proc = subprocess.Popen(command, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
     assert proc.stdin is not None
     count = 0
     try:
-        for i in indices:
-            place(replay.frames[i].poses.astype(np.float64))
-            renderer.update_scene(data, camera="overview", scene_option=option)
-            proc.stdin.write(renderer.render().tobytes())
-            count += 1
-            if on_frame is not None:
-                on_frame(count, len(indices))
-        proc.stdin.close()
-    except BrokenPipeError:
-        pass
+        with _FrameFeed(proc.stdin) as feed:
+            for i in indices:
+                place(replay.frames[i].poses.astype(np.float64))
+                renderer.update_scene(data, camera="overview", scene_option=option)
+                if read:
+                    chunk: bytes | memoryview = read(frames[count % len(frames)]).data
+                else:
+                    chunk = renderer.render().tobytes()
+                if not feed.put(chunk):
+                    break  # ffmpeg has gone: its exit code and message say why
+                count += 1
+                if on_frame is not None:
+                    on_frame(count, len(indices))
     finally:
         renderer.close()
     stderr = proc.stderr.read().decode(errors="replace") if proc.stderr else ""
@@ -162,6 +193,55 @@ def render_video(
         raise RenderError(output=str(output), reason=f"ffmpeg exited {code}: {stderr.strip()}")
     logger.info("rendered %d frames of %s to %s", count, replay_path, output)
     return output
+
+
+class _FrameFeed:
+    """Frames written to ffmpeg's standard input by a thread of their own, so that the next frame
+    is drawn while ffmpeg takes one (a 1280x720 frame is 3.7 MB; a pipe holds 64 kB, and a write
+    from the drawing thread waited for ffmpeg to read all of it). At most one frame waits in
+    line beside the one being written: the drawing thread keeps :data:`BUFFERS` frame buffers
+    and draws into the one neither holds. Closing it ends ffmpeg's input."""
+
+    BUFFERS = 3
+
+    def __init__(self, stdin: IO[bytes]) -> None:
+        self._stdin = stdin
+        self._line: queue.Queue[bytes | memoryview | None] = queue.Queue(maxsize=1)
+        self._thread = threading.Thread(target=self._write, name="video-feed", daemon=True)
+        self._thread.start()
+
+    def _write(self) -> None:
+        try:
+            while (chunk := self._line.get()) is not None:
+                self._stdin.write(chunk)
+            self._stdin.close()
+        except (BrokenPipeError, ValueError):
+            pass  # ffmpeg ended early; its exit code and message say why
+
+    def put(self, chunk: bytes | memoryview) -> bool:
+        """Hand one frame on (waits while one is in line); False when ffmpeg has gone."""
+        return self._hand(chunk)
+
+    def _hand(self, item: bytes | memoryview | None) -> bool:
+        while self._thread.is_alive():
+            try:
+                self._line.put(item, timeout=0.5)
+                return True
+            except queue.Full:
+                continue
+        return False
+
+    def __enter__(self) -> _FrameFeed:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._hand(None)  # the end of the input
+        self._thread.join()
+        if not self._stdin.closed:
+            try:
+                self._stdin.close()
+            except BrokenPipeError:
+                pass
 
 
 @contextmanager

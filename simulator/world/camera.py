@@ -121,16 +121,26 @@ def linear_sky(renderer: mujoco.Renderer, focal: float) -> int:
     return len(skies)
 
 
-def _reads_bgr(renderer: mujoco.Renderer) -> Callable[[np.ndarray], np.ndarray] | None:
-    """A render of ``renderer``'s scene read back in B,G,R order, or None where that cannot be
-    had (then ``renderer.render()`` and a turn of the channels).
+# glReadPixels formats by the channels they deliver
+_GL_FORMATS = {"BGR": "GL_BGR", "RGBA": "GL_RGBA", "RGB": "GL_RGB"}
+
+
+def reads_frames(
+    renderer: mujoco.Renderer, channels: str = "BGR"
+) -> Callable[[np.ndarray], np.ndarray] | None:
+    """A render of ``renderer``'s scene read back in ``channels`` order (``BGR``, ``RGBA`` or
+    ``RGB``) into a frame buffer of that many channels kept from frame to frame, its rows
+    bottom up (as OpenGL has them; ``[::-1]`` views them top down); None where that cannot be
+    had (then ``renderer.render()``).
 
     ``mujoco.Renderer.render`` reads R,G,B into a new array and turns it upside down in place
-    (a temporary copy); the camera delivers B,G,R, and numpy turns the channels of a 320x240
-    frame in about 0.25 ms, 15 times a contiguous pass. OpenGL turns them as it reads
-    (``GL_BGR``), into a buffer kept from frame to frame, and the rows are taken bottom up as a
-    view: the same bytes (``tests/unit/world/test_world_camera_model.py``), 0.17 against 0.42 ms
-    of CPU for reading and the camera model. Needs the renderer's own OpenGL context and its
+    (a temporary copy). The robot camera delivers B,G,R, and numpy turns the channels of a
+    320x240 frame in about 0.25 ms, 15 times a contiguous pass: OpenGL turns them as it reads
+    (``GL_BGR``), and the rows are taken bottom up as a view: the same bytes
+    (``tests/unit/world/test_world_camera_model.py``), 0.17 against 0.42 ms of CPU for reading
+    and the camera model. R,G,B,A is the render buffer's own layout, which Mesa's CPU renderer
+    copies out fastest (a 1280x720 frame in 0.5 ms against 1.2-1.6 for R,G,B): the match video
+    reads it so (:mod:`simulator.render`). Needs the renderer's own OpenGL context and its
     offscreen buffer without multisampling (the scene's ``offsamples="0"``: a multisampled one
     is read through MuJoCo's resolve)."""
     context = getattr(renderer, "_gl_context", None)
@@ -141,12 +151,14 @@ def _reads_bgr(renderer: mujoco.Renderer) -> Callable[[np.ndarray], np.ndarray] 
         return None
     from OpenGL import GL
 
+    gl_format = getattr(GL, _GL_FORMATS[channels])
+
     def read(frame: np.ndarray) -> np.ndarray:
         context.make_current()
         mujoco.mjr_render(rect, scene, mjr)
         GL.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)  # rows of any width, unpadded
-        GL.glReadPixels(0, 0, rect.width, rect.height, GL.GL_BGR, GL.GL_UNSIGNED_BYTE, frame)
-        return frame[::-1]
+        GL.glReadPixels(0, 0, rect.width, rect.height, gl_format, GL.GL_UNSIGNED_BYTE, frame)
+        return frame
 
     return read
 
@@ -179,7 +191,7 @@ class CameraRenderer:
         )
         self._velocity = np.zeros(6)
         self._frame = np.empty((height, width, 3), dtype=np.uint8)
-        self._read_bgr = _reads_bgr(self._renderer)
+        self._read_bgr = reads_frames(self._renderer, "BGR")
         cameras = [index.camera for index in world.index.by_id.values()]
         focal = min((focal_px(height, float(model.cam_fovy[c])) for c in cameras), default=0.0)
         self.linear_sky = linear_sky(self._renderer, focal) > 0
@@ -201,7 +213,7 @@ class CameraRenderer:
         if self._read_bgr is None:
             bgr = self._renderer.render()[:, :, ::-1]
         else:
-            bgr = self._read_bgr(self._frame)
+            bgr = self._read_bgr(self._frame)[::-1]
         return effects.of_bgr(
             bgr, robot=robot.number + 32 * (robot.team.value == "blue"),
             sim_time_ms=sim_time_ms, blur_px=blur,

@@ -71,15 +71,28 @@ SOLID_TYPES = (
 )
 
 
-def cheap_shadows(model: mujoco.MjModel) -> None:
-    """Set ``model`` (the cameras' copy) to draw the turf in coarse cells and to make a depth
-    map of :data:`ROBOT_SHADOW_SIZE` texels over the turf (read when the render context is
-    made)."""
+def _finite_planes(model: mujoco.MjModel) -> list[int]:
     planes = np.flatnonzero(model.geom_type == mujoco.mjtGeom.mjGEOM_PLANE)
-    model.vis.quality.shadowsize = ROBOT_SHADOW_SIZE
-    finite = [p for p in planes if model.geom_size[p, 0] > 0 and model.geom_size[p, 1] > 0]
-    for p in finite:
+    return [int(p) for p in planes if model.geom_size[p, 0] > 0 and model.geom_size[p, 1] > 0]
+
+
+def coarse_turf(model: mujoco.MjModel) -> None:
+    """Set ``model`` (a renderer's own copy) to draw its finite planes in cells of at least
+    :data:`PLANE_GRID_M` (MuJoCo draws a plane as a grid of quads of its third size, the turf's
+    0.1 m: 8,800 quads). Its lights are directional (:mod:`simulator.world.look`), which light
+    a flat plane evenly, so only the weak specular glint, worked out at the corners, is
+    interpolated over larger cells; textures and shadow maps are looked up per pixel."""
+    for p in _finite_planes(model):
         model.geom_size[p, 2] = max(float(model.geom_size[p, 2]), PLANE_GRID_M)
+
+
+def cheap_shadows(model: mujoco.MjModel) -> None:
+    """Set ``model`` (the cameras' copy) to draw the turf in coarse cells (:func:`coarse_turf`)
+    and to make a depth map of :data:`ROBOT_SHADOW_SIZE` texels over the turf (read when the
+    render context is made)."""
+    finite = _finite_planes(model)
+    model.vis.quality.shadowsize = ROBOT_SHADOW_SIZE
+    coarse_turf(model)
     if finite and model.stat.extent > 0:
         reach = max(math.hypot(model.geom_size[p, 0], model.geom_size[p, 1]) for p in finite)
         clip = (reach + SHADOW_MARGIN_M) / float(model.stat.extent)
