@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import sys
 
-USAGE = "usage: python -m benchmarks {sim|api|stub|envs} ..."
+USAGE = "usage: python -m benchmarks {sim|api|stub|envs|video} ..."
 
 
 def main(argv: list[str]) -> int:
@@ -27,6 +27,10 @@ def main(argv: list[str]) -> int:
         from benchmarks import envs
 
         return int(envs.main(rest))
+    if kind == "video":
+        from benchmarks import video
+
+        return int(video.main(rest))
     print(USAGE, file=sys.stderr)
     return 2
 

@@ -1,6 +1,6 @@
 """``hlvs render`` and ``hlvs bench
-sim|api|stub|envs|bringup|delivery|cli|viewer|scrimmage|hog|runtime``: commands with parsers of
-their own, to which the arguments are forwarded unread (``--help`` included).
+sim|api|stub|envs|video|bringup|delivery|cli|viewer|scrimmage|hog|runtime``: commands with
+parsers of their own, to which the arguments are forwarded unread (``--help`` included).
 
 The orchestrator does not import the simulator; ``render`` and the simulator's (or the learning
 environments') benchmarks run ``python -m simulator`` (``python -m envs``) with the same
@@ -22,6 +22,7 @@ SIMULATOR_BENCHES = {
     "sim": "physics steps of the soccer world per second (JSON)",
     "api": "the robot API server: step rate and latency with clients connected (JSON)",
     "stub": "the stub robot: reach and shots on goal (JSON)",
+    "video": "hlvs render: a match video's frames a second and CPU a frame (JSON)",
 }
 
 

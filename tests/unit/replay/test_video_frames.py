@@ -111,9 +111,7 @@ def test_the_video_is_upright(replay_path: Path, tmp_path: Path) -> None:
 
 
 @pytest.mark.skipif(shutil.which("ffmpeg") is None, reason="needs ffmpeg")
-def test_ffmpeg_failing_is_an_error_naming_the_output(
-    replay_path: Path, tmp_path: Path
-) -> None:
+def test_ffmpeg_failing_is_an_error_naming_the_output(replay_path: Path, tmp_path: Path) -> None:
     """ffmpeg cannot write the video (a folder is where it was to be): the frames stop and its
     message is the error's reason; nothing waits on a pipe nobody reads."""
     from simulator.errors import RenderError
