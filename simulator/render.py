@@ -157,16 +157,10 @@ def render_video(
     read = reads_frames(renderer, "RGBA")
     # one frame drawn while ffmpeg is given the one before and the one before that waits
     frames = [np.empty((height, width, 4), dtype=np.uint8) for _ in range(_FrameFeed.BUFFERS)]
-    command = [
-        ffmpeg, "-loglevel", "error", "-y", "-f", "rawvideo",
-        "-pix_fmt", "rgba" if read else "rgb24", "-s", f"{width}x{height}", "-r", f"{fps:g}",
-        "-i", "-",
-    ]  # fmt: skip
-    if subtitles:
-        command += ["-i", str(srt), "-map", "0:v", "-map", "1:s", "-c:s", "mov_text"]
-    if read:
-        command += ["-vf", "vflip"]
-    command += ["-c:v", "libx264", "-preset", "veryfast", "-pix_fmt", "yuv420p", str(output)]
+    command = _ffmpeg_command(
+        ffmpeg, (width, height), fps, rgba=read is not None, subtitles=srt if subtitles else None,
+        output=output,
+    )  # fmt: skip
     proc = subprocess.Popen(command, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
     assert proc.stdin is not None
     count = 0
@@ -193,6 +187,25 @@ def render_video(
         raise RenderError(output=str(output), reason=f"ffmpeg exited {code}: {stderr.strip()}")
     logger.info("rendered %d frames of %s to %s", count, replay_path, output)
     return output
+
+
+def _ffmpeg_command(
+    ffmpeg: str, size: tuple[int, int], fps: float, *, rgba: bool, subtitles: Path | None,
+    output: Path,
+) -> list[str]:  # fmt: skip
+    """ffmpeg reading raw frames of ``size`` from its standard input (R,G,B,A rows bottom up
+    when ``rgba``, else R,G,B rows top down) into an H.264 MP4 at ``output``, with the
+    ``subtitles`` file as its text track."""
+    command = [
+        ffmpeg, "-loglevel", "error", "-y", "-f", "rawvideo",
+        "-pix_fmt", "rgba" if rgba else "rgb24", "-s", f"{size[0]}x{size[1]}", "-r", f"{fps:g}",
+        "-i", "-",
+    ]  # fmt: skip
+    if subtitles is not None:
+        command += ["-i", str(subtitles), "-map", "0:v", "-map", "1:s", "-c:s", "mov_text"]
+    if rgba:
+        command += ["-vf", "vflip"]  # the rows turned; the alpha goes with the pixel format
+    return [*command, "-c:v", "libx264", "-preset", "veryfast", "-pix_fmt", "yuv420p", str(output)]
 
 
 class _FrameFeed:
