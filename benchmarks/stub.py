@@ -11,89 +11,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import os
 import sys
 import time
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, TypedDict
 
 if TYPE_CHECKING:  # numpy and the world are imported after the arguments (fast --help)
-    import numpy as np
-
-    from testkit.stub_world import ShotResult
-
-AFTER_KICK_S = 4.0
-MIN_KICK_M = 0.5
-
-
-@dataclass(frozen=True, slots=True)
-class TrialResult:
-    success: bool
-    kick_distance_m: float
-    time_to_kick_s: float | None
-    falls: int
-    sim_time_s: float
-    sightings: int
-
-
-def run_trial(*, seed: int, distance_m: float, time_limit_s: float) -> TrialResult:
-    import numpy as np
-
-    from contracts.gamecontroller import GameState
-    from contracts.geometry import Pose
-    from contracts.ids import RobotId, TeamColor
-    from robot.stub.behaviour import GameInfo, Role
-    from robot.stub.controller import StubController
-    from simulator.world import CameraRenderer, RobotPlacement, World
-    from testkit.stub_world import sense
-
-    rng = np.random.default_rng(seed)
-    bearing = float(rng.uniform(-math.pi, math.pi))
-    heading = float(rng.uniform(-math.pi, math.pi))
-    robot = RobotId(TeamColor.RED, 1)
-    x, y = distance_m * math.cos(bearing), distance_m * math.sin(bearing)
-    world = World.create(
-        field_class="kid",
-        robots=[RobotPlacement(id=robot, model="kid-default", x_m=x, y_m=y, yaw_rad=heading)],
-        seed=seed,
-    )
-    controller = StubController(role=Role.STRIKER, start_pose=Pose(x_m=x, y_m=y, yaw_rad=heading))
-    game = GameInfo(phase=GameState.PLAYING)
-    ball_body = world.model.body("ball").id
-    kicked_at_s: float | None = None
-    ball_before: np.ndarray | None = None
-    steps = int(time_limit_s * 1000 / world.step_ms)
-    with CameraRenderer(world, 320, 240) as camera:
-        step = 0
-        while True:
-            t_ms = world.sim_time_ms
-            sensors = sense(world, robot, camera)
-            kicks_before = controller.stats.kicks
-            targets = controller.tick(sensors, game)
-            if controller.stats.kicks > kicks_before and kicked_at_s is None:
-                kicked_at_s = t_ms / 1000.0
-                ball_before = world.data.xpos[ball_body].copy()
-            for name, value in targets.items():
-                world.set_motor_position(robot, name, value)
-            world.step()
-            step += 1
-            if kicked_at_s is not None and world.sim_time_ms / 1000.0 > kicked_at_s + AFTER_KICK_S:
-                break
-            if kicked_at_s is None and step >= steps:
-                break
-    distance = 0.0
-    if ball_before is not None:
-        moved = world.data.xpos[ball_body] - ball_before
-        distance = float(math.hypot(moved[0], moved[1]))
-    return TrialResult(
-        success=kicked_at_s is not None and distance >= MIN_KICK_M,
-        kick_distance_m=distance,
-        time_to_kick_s=kicked_at_s,
-        falls=controller.stats.falls,
-        sim_time_s=world.sim_time_ms / 1000.0,
-        sightings=controller.stats.ball_sightings,
-    )
+    from testkit.stub_world import ReachResult, ShotResult
 
 
 class ReachSummary(TypedDict):
@@ -132,7 +56,7 @@ class ShotsSummary(TypedDict):
     seed: int
 
 
-def summarize(results: list[TrialResult], *, seed: int, wall_s: float) -> ReachSummary:
+def summarize(results: list[ReachResult], *, seed: int, wall_s: float) -> ReachSummary:
     kicks = [r.kick_distance_m for r in results if r.success]
     times = [r.time_to_kick_s for r in results if r.success and r.time_to_kick_s is not None]
     sim_s = sum(r.sim_time_s for r in results)
@@ -161,12 +85,21 @@ def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(prog=f"{program} bench stub")
     parser.add_argument("--trials", type=int, default=10, help="trials to run (default 10)")
     parser.add_argument("--seed", type=int, default=1, help="seed of the first trial (default 1)")
-    parser.add_argument("--distance-m", type=float, default=2.0,
-                        help="reach: start distance to the ball in metres (default 2)")
-    parser.add_argument("--time-limit-s", type=float, default=60.0,
-                        help="simulated seconds per trial (default 60)")
-    parser.add_argument("--scenario", choices=("reach", "shots"), default="reach",
-                        help="reach the ball, or shots on goal (default reach)")
+    parser.add_argument(
+        "--distance-m",
+        type=float,
+        default=2.0,
+        help="reach: start distance to the ball in metres (default 2)",
+    )
+    parser.add_argument(
+        "--time-limit-s", type=float, default=60.0, help="simulated seconds per trial (default 60)"
+    )
+    parser.add_argument(
+        "--scenario",
+        choices=("reach", "shots"),
+        default="reach",
+        help="reach the ball, or shots on goal (default reach)",
+    )
     parser.add_argument("--goalie", action="store_true", help="shots: an opponent goalie defends")
     parser.add_argument("--json", action="store_true", help="only the JSON line")
     args = parser.parse_args(argv)
@@ -178,9 +111,11 @@ def main(argv: list[str]) -> int:
     start = time.perf_counter()
     if args.scenario == "shots":
         return _shots(args, start)
+    from testkit.stub_world import run_reach
+
     results = []
     for trial in range(args.trials):
-        result = run_trial(
+        result = run_reach(
             seed=args.seed * 1000 + trial,
             distance_m=args.distance_m,
             time_limit_s=args.time_limit_s,

@@ -1,6 +1,8 @@
 """The stub robot controller on an in-process world (no network), for tests and benchmarks.
 
 :func:`sense` gives a controller what it gets in a match (joints, IMU, a camera image when due).
+:func:`run_reach` is one trial of ``hlvs bench stub``: can the striker find, reach and kick
+the ball from 2 m away?
 :func:`run_shot` is one trial of ``hlvs bench stub --scenario shots``: does the stub striker
 score from in front of the goal? Each trial puts the ball 1.5-4 m in front of the goal the
 striker attacks (x > 0, at most 60 degrees off the goal axis) and the striker 1 m from the ball
@@ -19,6 +21,79 @@ from typing import Any
 import numpy as np
 
 from robot.stub.runner import CAMERA_PERIOD_MS  # the period the robot asks for in a match
+
+AFTER_KICK_S = 4.0
+MIN_KICK_M = 0.5
+
+
+@dataclass(frozen=True, slots=True)
+class ReachResult:
+    success: bool
+    kick_distance_m: float
+    time_to_kick_s: float | None
+    falls: int
+    sim_time_s: float
+    sightings: int
+
+
+def run_reach(*, seed: int, distance_m: float, time_limit_s: float) -> ReachResult:
+    """One trial of ``hlvs bench stub``: the striker ``distance_m`` from the ball at a seeded
+    bearing and heading, in the look of ``texture_seed`` = ``seed``; it succeeds when the striker
+    kicks within ``time_limit_s`` and the ball travels at least :data:`MIN_KICK_M`."""
+    from contracts.gamecontroller import GameState
+    from contracts.geometry import Pose
+    from contracts.ids import RobotId, TeamColor
+    from robot.stub.behaviour import GameInfo, Role
+    from robot.stub.controller import StubController
+    from simulator.world import CameraRenderer, RobotPlacement, World
+
+    rng = np.random.default_rng(seed)
+    bearing = float(rng.uniform(-math.pi, math.pi))
+    heading = float(rng.uniform(-math.pi, math.pi))
+    robot = RobotId(TeamColor.RED, 1)
+    x, y = distance_m * math.cos(bearing), distance_m * math.sin(bearing)
+    world = World.create(
+        field_class="kid",
+        robots=[RobotPlacement(id=robot, model="kid-default", x_m=x, y_m=y, yaw_rad=heading)],
+        seed=seed,
+    )
+    controller = StubController(role=Role.STRIKER, start_pose=Pose(x_m=x, y_m=y, yaw_rad=heading))
+    game = GameInfo(phase=GameState.PLAYING)
+    ball_body = world.model.body("ball").id
+    kicked_at_s: float | None = None
+    ball_before: np.ndarray | None = None
+    steps = int(time_limit_s * 1000 / world.step_ms)
+    with CameraRenderer(world, 320, 240) as camera:
+        step = 0
+        while True:
+            t_ms = world.sim_time_ms
+            sensors = sense(world, robot, camera)
+            kicks_before = controller.stats.kicks
+            targets = controller.tick(sensors, game)
+            if controller.stats.kicks > kicks_before and kicked_at_s is None:
+                kicked_at_s = t_ms / 1000.0
+                ball_before = world.data.xpos[ball_body].copy()
+            for name, value in targets.items():
+                world.set_motor_position(robot, name, value)
+            world.step()
+            step += 1
+            if kicked_at_s is not None and world.sim_time_ms / 1000.0 > kicked_at_s + AFTER_KICK_S:
+                break
+            if kicked_at_s is None and step >= steps:
+                break
+    distance = 0.0
+    if ball_before is not None:
+        moved = world.data.xpos[ball_body] - ball_before
+        distance = float(math.hypot(moved[0], moved[1]))
+    return ReachResult(
+        success=kicked_at_s is not None and distance >= MIN_KICK_M,
+        kick_distance_m=distance,
+        time_to_kick_s=kicked_at_s,
+        falls=controller.stats.falls,
+        sim_time_s=world.sim_time_ms / 1000.0,
+        sightings=controller.stats.ball_sightings,
+    )
+
 
 GOAL_HALF_WIDTH_M = 1.3
 HALF_LENGTH_M = 4.5
@@ -126,4 +201,4 @@ def run_shot(*, seed: int, time_limit_s: float, goalie: bool) -> ShotResult:
     )
 
 
-__all__ = ["ShotResult", "run_shot", "sense", "shot_layout"]
+__all__ = ["ReachResult", "ShotResult", "run_reach", "run_shot", "sense", "shot_layout"]

@@ -64,8 +64,13 @@ def test_sees_the_ball_where_it_is(ball_x: float, ball_y: float, head: float) ->
 
 @pytest.mark.parametrize(
     ("seed", "robot_x", "ball_x", "ball_y"),
-    [(3, -0.17, 0.17, 0.1), (3, -0.25, 0.25, 0.12), (1, -0.2, 0.2, 0.0), (1, -0.3, 0.3, -0.05),
-     (6, -0.17, 0.17, -0.1)],
+    [
+        (3, -0.17, 0.17, 0.1),
+        (3, -0.25, 0.25, 0.12),
+        (1, -0.2, 0.2, 0.0),
+        (1, -0.3, 0.3, -0.05),
+        (6, -0.17, 0.17, -0.1),
+    ],
 )
 def test_sees_a_near_ball_on_the_lines_and_its_dark_marks(
     seed: int, robot_x: float, ball_x: float, ball_y: float
@@ -246,3 +251,27 @@ def test_a_worn_patch_is_not_the_ball(light: float, tint: tuple[float, float, fl
     image = _turf_image(light, tint)
     _paint_disc(image, (150, 80), 14, _worn_rgb, light, tint)
     assert find_ball_blobs(image) == []
+
+
+@pytest.mark.parametrize(
+    ("x", "y", "head", "ball_m", "ball_head"),
+    [(3.9, 1.1, 0.5, 0.4, 0.8), (3.7, 0.9, 0.45, 0.55, 0.7)],
+)
+def test_a_goal_posts_foot_is_not_the_ball(
+    x: float, y: float, head: float, ball_m: float, ball_head: float
+) -> None:
+    # Looking at a goal post's foot on the goal line from 0.6-0.9 m, the foot was a disc of
+    # not-grass ringed by grass and by bright "line": the post above it and the goal line. The
+    # striker of a shot trial walked to the post and never found the ball. A line is narrower
+    # than the ball; the post is as wide as the disc of its foot.
+    yaw = math.atan2(1.3 - y, 4.5 - x)  # facing the left post of the goal at x = 4.5
+    robot = OneRobot(x_m=x, y_m=y, yaw_rad=yaw, seed=1003)
+    robot.place_ball(-2.0, -2.0)
+    assert _sighting(robot, head) is None
+    # a ball in front of the post, the post standing over it in the image, is found
+    robot = OneRobot(x_m=x, y_m=y, yaw_rad=yaw, seed=1003)
+    robot.place_ball(x + ball_m * math.cos(yaw), y + ball_m * math.sin(yaw))
+    seen = _sighting(robot, ball_head)
+    assert seen is not None
+    true = robot.ball_position - robot.position  # the torso, settled into the stance
+    assert math.hypot(seen.x_m, seen.y_m) == pytest.approx(math.hypot(true[0], true[1]), abs=0.05)
