@@ -236,10 +236,8 @@ def _post_above(
     (``cy``, ``cx``): the run through its column is that wide two and three radii above its
     centre, as a goal post's is over its foot. A line is narrower than a ball (5 cm to 14), and
     a post behind a ball is farther than the ball, so narrower than it too."""
-    rows, cols = not_grass.shape
-    column = int(round(cx))
-    if not 0 <= column < cols:
-        return False
+    cols = not_grass.shape[1]
+    column = int(round(cx))  # inside the image: _ball_disc judges only discs inside it
     for rise in (2.0 * radius, 3.0 * radius):
         row = int(round(cy - rise))
         if row < 0 or not not_grass[row, column]:
