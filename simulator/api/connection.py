@@ -205,6 +205,9 @@ class Connection:
                     break
         finally:
             budget.level = level
+            # counted even when the read ends in EOF: requests sent just before a close were
+            # taken (and queued) all the same
+            self.stats.messages_in += count
         if decoder.buffered:
             if not acked:
                 self._quick_ack()
@@ -212,7 +215,6 @@ class Connection:
         else:
             self._frame_began = None
         if count:
-            self.stats.messages_in += count
             if self._request_began is None:
                 self._request_began = began
         if count or self._told:

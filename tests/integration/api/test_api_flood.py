@@ -13,7 +13,7 @@ from robot.client import RobotClient
 from simulator.api import FakeDeviceWorld, LockstepSettings
 from simulator.api.bounds import MAX_REQUEST_BYTES
 from simulator.api.framing import encode_frame
-from tests.integration.api.harness import BLUE1, RED1, running_server, wait_until
+from tests.integration.api.harness import BLUE1, RED1, Driver, running_server, wait_until
 
 STEPS = 150
 
@@ -48,6 +48,10 @@ def _answer(client: RobotClient, steps: int) -> float:
     return time.monotonic() - started
 
 
+def _messages_in(driver: Driver, key: str) -> int:
+    return int(driver.server.statistics()[key]["messages_in"])
+
+
 def test_a_flooding_robot_costs_only_itself() -> None:
     lockstep = LockstepSettings(deadline_s=0.05, time_bank_s=0.2)
     world = FakeDeviceWorld((RED1, BLUE1))
@@ -65,6 +69,9 @@ def test_a_flooding_robot_costs_only_itself() -> None:
             try:
                 wait_until(lambda: driver.server.statistics()["red-1"]["dropped_in"], 20)
                 flooded_s = _answer(honest, STEPS)
+                # the last answers may still wait in the socket (measurements queued while the
+                # robot was out of lockstep are answered in a burst): read before counting
+                wait_until(lambda: _messages_in(driver, "blue-1") >= 2 * STEPS, 20)
             finally:
                 stop.set()
                 flooder.join(timeout=10)

@@ -6,8 +6,10 @@ import socket
 import struct
 import time
 
+import pytest
+
 from contracts.robot_api import messages_pb2 as pb
-from simulator.api.connection import Connection
+from simulator.api.connection import RECV_CHUNK, ClientClosed, Connection
 from simulator.api.framing import encode_frame
 from simulator.api.stats import RobotStats
 
@@ -34,3 +36,33 @@ def test_an_empty_request_is_skipped_and_the_client_stays_connected() -> None:
     finally:
         ours.close()
         theirs.close()
+
+
+def _frame_of(size: int) -> bytes:
+    """A framed ActuatorRequests of exactly ``size`` bytes, header included."""
+    for length in range(size, 0, -1):
+        request = pb.ActuatorRequests()
+        request.motor_positions.add(name="x" * length, position=0.25)
+        frame = encode_frame(request.SerializeToString())
+        if len(frame) == size:
+            return frame
+    raise AssertionError(size)
+
+
+def test_requests_read_together_with_the_close_are_counted() -> None:
+    """A client that sends a full receive's worth of requests and closes: the server's read
+    takes them and meets the end of the stream in the same call, raises ClientClosed, and
+    counts what it took all the same."""
+    ours, theirs = socket.socketpair()
+    ours.setblocking(False)
+    try:
+        conn = Connection(sock=ours, peer="test", key="blue 1", stats=RobotStats(),
+                          queue_limit=1000, time_bank_s=1.0)
+        theirs.sendall(_frame_of(RECV_CHUNK // 2) * 2)  # one receive exactly, then the end
+        theirs.close()
+        time.sleep(0.05)
+        with pytest.raises(ClientClosed, match="client disconnected"):
+            conn.read(time.monotonic())
+        assert conn.stats.messages_in == 2 and conn.stats.bytes_in == RECV_CHUNK
+    finally:
+        ours.close()
