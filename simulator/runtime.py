@@ -132,7 +132,6 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
         spec.maximum_real_time_factor,
     )  # fmt: skip
     world = World.from_spec(spec)
-    camera_gl = _camera_gl()
     lockstep = LockstepSettings(
         deadline_s=spec.lockstep_deadline_ms / 1000.0,
         time_bank_s=spec.lockstep_time_bank_ms / 1000.0,
@@ -140,14 +139,17 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
     )
     started = time.time()
     with ExitStack() as stack:
-        referee = Referee(config=referee_config(spec), log_dir=out)
-        stack.callback(referee.close)
         processes = render_processes()
-        if processes:
-            log.info("robot cameras render in %d worker processes", processes)
         cameras = world_render_worker(world, processes=processes)
         stack.callback(cameras.close)
-        cameras.start()  # ready while the server starts and the robots connect
+        # ready while the server starts and the robots connect; started before this process
+        # makes an OpenGL context or a thread, so that its render processes are forked
+        cameras.start()
+        if processes:
+            log.info("robot cameras render in %d worker processes", processes)
+        camera_gl = _camera_gl()
+        referee = Referee(config=referee_config(spec), log_dir=out)
+        stack.callback(referee.close)
         server = ApiServer(
             world=world,
             endpoints=endpoints_from_spec(spec),

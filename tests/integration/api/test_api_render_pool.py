@@ -3,8 +3,10 @@ black images instead of a step loop waiting forever."""
 
 from __future__ import annotations
 
+import json
 import os
 import select
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -15,6 +17,7 @@ import pytest
 
 from contracts.ids import RobotId, TeamColor
 from contracts.robot_api import messages_pb2 as pb
+from simulator.api import render_pool
 from simulator.api.measurement import CameraJob
 from simulator.api.render_pool import RenderPool
 from simulator.world import CameraRenderer, RobotPlacement, World
@@ -96,16 +99,21 @@ def test_dead_worker_gives_black_images() -> None:
         pool.close()
 
 
+@pytest.mark.parametrize("method", ["spawn", "fork"])
 def test_a_worker_that_dies_while_it_starts_gives_black_images(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    method: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """A worker that dies while it starts, before it took the world (the kernel's OOM killer
     could do that): the pool does not wait for it (it used to wait for ever, writing the world
-    into a pipe it held open itself), its images come back black and the error is kept."""
-    (tmp_path / "sitecustomize.py").write_text("import os\nos._exit(1)\n")  # every new interpreter
-    monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(tmp_path), *sys.path]))
+    into a pipe it held open itself), its images come back black and the error is kept. A
+    spawned worker dies in its new interpreter, a forked one as it begins."""
+    if method == "spawn":
+        (tmp_path / "sitecustomize.py").write_text("import os\nos._exit(1)\n")  # every new one
+        monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(tmp_path), *sys.path]))
+    else:
+        monkeypatch.setattr(render_pool, "_serve", lambda *_args: os._exit(1))
     world = _world()
-    pool = RenderPool(world, processes=2)
+    pool = RenderPool(world, processes=2, method=method)
     try:
         pool.submit(_jobs(world.sim_time_ms))
         images = _collect(pool, 2)
@@ -138,3 +146,55 @@ def test_started_pool_makes_its_renderers_before_the_first_job() -> None:
             got = np.frombuffer(images[robot], dtype=np.uint8).astype(int)
             want = np.frombuffer(local.render(robot), dtype=np.uint8).astype(int)
             assert np.mean(got != want) < 0.002  # a few edge pixels differ, as above
+
+
+_FORK_PROBE = """
+import json, threading
+import numpy as np
+from simulator.api import render_pool
+from tests.integration.api import test_api_render_pool as t
+from simulator.world import CameraRenderer
+
+found = {"fresh": render_pool.start_method()}
+world = t._world()
+pool = render_pool.RenderPool(world, processes=2)
+try:
+    pool.submit(t._jobs(world.sim_time_ms))
+    images = t._collect(pool, 2)
+    found["pool"] = pool.start_method
+finally:
+    pool.close()
+stop = threading.Event()
+thread = threading.Thread(target=stop.wait)
+thread.start()
+found["with a thread"] = render_pool.start_method()
+stop.set()
+thread.join()
+found["thread ended"] = render_pool.start_method()
+with CameraRenderer(world, 320, 240) as local:  # an OpenGL context, made after the fork
+    found["differ"] = {
+        str(robot): float(np.mean(np.frombuffer(images[robot], np.uint8)
+                                  != np.frombuffer(local.render(robot), np.uint8)))
+        for robot in (t.RED_1, t.BLUE_1)
+    }
+found["after a context"] = render_pool.start_method()
+print(json.dumps(found))
+"""
+
+
+def test_forked_workers_of_a_fresh_process_render_the_in_process_images() -> None:
+    """A process with one thread and no OpenGL context forks its render workers (they inherit
+    the world, no imports again); their images are the in-process renderer's. Another Python
+    thread, or the threads of an OpenGL context made in the process, make it spawn them."""
+    root = Path(__file__).resolve().parents[3]
+    env = {**os.environ, "PYTHONPATH": str(root)}
+    env.setdefault("MUJOCO_GL", "osmesa")
+    env.setdefault("PYOPENGL_PLATFORM", env["MUJOCO_GL"])
+    done = subprocess.run([sys.executable, "-c", _FORK_PROBE], cwd=root, env=env,
+                          capture_output=True, text=True, timeout=120, check=False)  # fmt: skip
+    assert done.returncode == 0, done.stderr[-3000:]
+    found = json.loads(done.stdout.strip().splitlines()[-1])
+    assert found["fresh"] == "fork" and found["pool"] == "fork", found
+    assert found["with a thread"] == "spawn" and found["thread ended"] == "fork", found
+    assert found["after a context"] == "spawn", found
+    assert all(share < 0.002 for share in found["differ"].values()), found  # edge pixels
