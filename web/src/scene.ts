@@ -86,6 +86,25 @@ function unitGeometry(kind: Primitive): THREE.BufferGeometry {
   return shape;
 }
 
+/** Static boxes this thin (half size, both short sides) and four times as long are a net's
+ * cords (1 cm thick): drawn as lines, about a pixel wide at the viewer's distances, where a
+ * box cost twelve triangles (a goal's net has over a hundred cords). */
+const CORD_HALF_M = 0.006;
+
+/** The two ends of a cord-like box, in the world (static geoms: their frame is the world's);
+ * null for any other box. */
+function cordEnds(g: GeomSpec): number[] | null {
+  const half = g.size.slice(0, 3);
+  const long = half.indexOf(Math.max(...half));
+  const short = half.filter((_, i) => i !== long);
+  if (short.some((h) => h > CORD_HALF_M) || half[long] < 4 * Math.max(...short)) return null;
+  const axis = new THREE.Vector3(long === 0 ? 1 : 0, long === 1 ? 1 : 0, long === 2 ? 1 : 0)
+    .applyQuaternion(new THREE.Quaternion(g.quat[1], g.quat[2], g.quat[3], g.quat[0]))
+    .multiplyScalar(half[long]);
+  const centre = new THREE.Vector3(g.pos[0], g.pos[1], g.pos[2]);
+  return [...centre.clone().sub(axis).toArray(), ...centre.clone().add(axis).toArray()];
+}
+
 /** One piece of a geom: a unit primitive placed in its body's frame. */
 interface Piece {
   kind: Primitive;
@@ -264,6 +283,8 @@ export class SceneView {
     this.scene.add(sun);
     this.bodies = spec.bodies.map(() => new THREE.Matrix4());
     const staticParts: [THREE.BufferGeometry[], THREE.BufferGeometry[]] = [[], []];
+    const cords: number[] = []; // line ends, x y z
+    const cordColours: number[] = [];
     const moving = new Map<string, { kind: Primitive; transparent: boolean; bodies: number[]; locals: THREE.Matrix4[]; colours: THREE.Color[] }>();
     for (const g of spec.geoms) {
       if (g.group >= 3) continue; // MuJoCo's hidden groups (collision-only helpers)
@@ -307,6 +328,13 @@ export class SceneView {
         this.scene.add(mesh);
         continue;
       }
+      const cord = g.body === 0 && g.type === "box" ? cordEnds(g) : null;
+      if (cord) { // a net's cord: one line, not a box's twelve triangles
+        const c = colour(g.rgba);
+        cords.push(...cord);
+        cordColours.push(c.r, c.g, c.b, c.r, c.g, c.b);
+        continue;
+      }
       for (const piece of pieces(g)) { // other patterned shapes: in their mean colour (rgba)
         if (g.body === 0) {
           const part = unitGeometry(piece.kind).applyMatrix4(piece.local);
@@ -328,6 +356,15 @@ export class SceneView {
     }
     const material = (transparent: boolean, vertexColors: boolean): THREE.Material =>
       new THREE.MeshLambertMaterial({ vertexColors, transparent, opacity: transparent ? 0.35 : 1, depthWrite: !transparent });
+    if (cords.length > 0) {
+      const geometry = new THREE.BufferGeometry();
+      geometry.setAttribute("position", new THREE.Float32BufferAttribute(cords, 3));
+      geometry.setAttribute("color", new THREE.Float32BufferAttribute(cordColours, 3));
+      const lines = new THREE.LineSegments(geometry, new THREE.LineBasicMaterial({ vertexColors: true }));
+      lines.name = "cords";
+      lines.matrixAutoUpdate = false;
+      this.scene.add(lines);
+    }
     staticParts.forEach((parts, transparent) => {
       if (parts.length === 0) return;
       const mesh = new THREE.Mesh(mergeGeometries(parts), material(transparent === 1, true));
