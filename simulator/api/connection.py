@@ -205,9 +205,7 @@ class Connection:
                     break
         finally:
             budget.level = level
-            # counted even when the read ends in EOF: requests sent just before a close were
-            # taken (and queued) all the same
-            self.stats.messages_in += count
+            self.stats.messages_in += count  # also when a close ends the read: they were taken
         if decoder.buffered:
             if not acked:
                 self._quick_ack()
