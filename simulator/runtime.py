@@ -144,9 +144,7 @@ def run_match(spec: MatchSpec, out: Path, *, gc_network: bool = True) -> int:
         stack.callback(cameras.close)
         # ready while the server starts and the robots connect; started before this process
         # makes an OpenGL context or a thread, so that its render processes are forked
-        cameras.start()
-        if processes:
-            log.info("robot cameras render in %d worker processes", processes)
+        cameras.start()  # says how many processes, forked or spawned
         camera_gl = _camera_gl()
         referee = Referee(config=referee_config(spec), log_dir=out)
         stack.callback(referee.close)

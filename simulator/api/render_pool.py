@@ -182,7 +182,8 @@ class RenderPool:
     def _start(self) -> None:
         method = self._method or start_method()
         self.start_method = method
-        ctx = mp.get_context("fork") if method == "fork" else mp.get_context("spawn")
+        forked = method == "fork"
+        ctx = mp.get_context("fork") if forked else mp.get_context("spawn")
         world = (self._world.model, self._cameras, self._world.camera_model, self._world.look,
                  self._warm)  # fmt: skip
         for n in range(self._count):
@@ -190,7 +191,6 @@ class RenderPool:
             # spawned, the world goes through the pipe, not the process's arguments: a worker
             # that dies while it starts would leave the parent writing those to a pipe that
             # the parent itself still holds open (multiprocessing's spawn), waiting for ever
-            forked = method == "fork"
             args = (child, world, list(self._conns)) if forked else (child, None, [])
             proc = ctx.Process(target=_serve, args=args, name=f"camera-render-{n}", daemon=True)
             proc.start()
@@ -203,8 +203,8 @@ class RenderPool:
                     self.error = exc
             self._conns.append(parent)
             self._procs.append(proc)
-        log.info("%d camera render processes %s", self._count,
-                 "forked" if method == "fork" else "spawned")  # fmt: skip
+        log.info("robot cameras render in %d worker processes (%s)", self._count,
+                 "forked" if forked else "spawned")  # fmt: skip
         for n, parent in enumerate(self._conns):  # threads only once every worker is forked
             reader = threading.Thread(
                 target=self._collect, args=(parent,), name=f"camera-results-{n}", daemon=True
