@@ -107,10 +107,11 @@ def cpu_sets(*, stepping: str = "async", robot_cpus: float = 0.0,
     CPU best, and results do not depend on speed), with a remote engine (``DOCKER_HOST`` not a
     local socket) or when no CPU would be left for the robots.
 
-    ``render_cpus``: the robot cameras render on the CPU, in up to that many worker processes
-    of the simulator (one per CPU it may use): the CPUs the robots' limits (``robot_cpus`` in
-    all) leave spare go to the simulator too, up to ``render_cpus`` more. The robots' CPUs are
-    never given away: on a machine without spare CPUs the cameras render on the simulator's."""
+    ``render_cpus``: the robot cameras render (on the CPU or a GPU) in up to that many worker
+    processes of the simulator (one per CPU it may use): the CPUs the robots' limits
+    (``robot_cpus`` in all) leave spare go to the simulator too, up to ``render_cpus`` more.
+    The robots' CPUs are never given away: on a machine without spare CPUs the cameras render
+    on the simulator's."""
     remote = os.environ.get("DOCKER_HOST", "unix://")
     allowed = sorted(os.sched_getaffinity(0))
     reserved = math.ceil(SIMULATOR_CPUS)

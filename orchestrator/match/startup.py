@@ -102,9 +102,10 @@ def start(deps: MatchDeps, created: Created, robots: Mapping[str, RobotRecord],
         request, spec, endpoint = _dense_simulator(deps, created, mark)
     else:
         request, spec, endpoint = _league_simulator(deps, created, placement)
-    # cameras on the CPU render in worker processes, one per CPU the simulator may use
+    # the cameras render in worker processes (on the CPU or a GPU), one per CPU the simulator
+    # may use
     sets = cpu_sets(stepping=spec.stepping, robot_cpus=len(plan.robots) * plan.limits.cpus,
-                    render_cpus=MAX_RENDER_PROCESSES if deps.options.gpu is None else 0)
+                    render_cpus=MAX_RENDER_PROCESSES)
     request = replace(request, cpuset_cpus=sets.simulator)
     mark("spec")
     robot_steps_s: dict[str, dict[str, float]] = {
