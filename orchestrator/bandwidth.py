@@ -18,12 +18,13 @@ Rates are bits per second; 1 MB/s = 8 Mbit/s. Measured TCP goodput is about 95 %
 from __future__ import annotations
 
 import ctypes
+import functools
 import ipaddress
 import logging
 import os
 import socket
-import threading
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 from pyroute2 import IPRoute
@@ -131,29 +132,8 @@ def _netns_route(netns: str) -> IPRoute:
     socket in a quiet process against 0.8 ms. With eight robots shaped at once while Docker
     starts their containers, shaping one took 7-166 ms this way against 17-133 ms forked
     (three alternated bring-ups each); most of that is spent waiting in the kernel."""
-    made: dict[str, object] = {}
-
-    def enter() -> None:
-        try:
-            fd = os.open(netns, os.O_RDONLY | os.O_CLOEXEC)
-            try:
-                if _libc().setns(fd, CLONE_NEWNET) != 0:
-                    err = ctypes.get_errno()
-                    raise OSError(err, f"setns: {os.strerror(err)}")
-            finally:
-                os.close(fd)
-            made["fd"] = socket.socket(socket.AF_NETLINK, socket.SOCK_DGRAM, NETLINK_ROUTE).detach()
-        except OSError as exc:
-            made["error"] = exc
-
-    thread = threading.Thread(target=enter, name="netns-socket", daemon=True)
-    thread.start()
-    thread.join()
-    error = made.get("error")
-    if isinstance(error, OSError):
-        raise error
-    fd = made["fd"]
-    assert isinstance(fd, int)
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="netns-socket") as entering:
+        fd = entering.submit(_netlink_socket_in, netns).result()  # its errors raised here
     try:
         return IPRoute(fileno=fd)
     except BaseException:
@@ -161,14 +141,22 @@ def _netns_route(netns: str) -> IPRoute:
         raise
 
 
-_LIBC: ctypes.CDLL | None = None
+def _netlink_socket_in(netns: str) -> int:
+    """The file descriptor of an rtnetlink socket made in ``netns``, which the calling thread
+    enters for good (a thread of its own)."""
+    fd = os.open(netns, os.O_RDONLY | os.O_CLOEXEC)
+    try:
+        if _libc().setns(fd, CLONE_NEWNET) != 0:
+            err = ctypes.get_errno()
+            raise OSError(err, f"setns: {os.strerror(err)}")
+    finally:
+        os.close(fd)
+    return socket.socket(socket.AF_NETLINK, socket.SOCK_DGRAM, NETLINK_ROUTE).detach()
 
 
+@functools.cache
 def _libc() -> ctypes.CDLL:
-    global _LIBC
-    if _LIBC is None:
-        _LIBC = ctypes.CDLL(None, use_errno=True)
-    return _LIBC
+    return ctypes.CDLL(None, use_errno=True)
 
 
 def apply(pid: int, shaping: RobotShaping, *, device: str = "eth0") -> AppliedShaping:
