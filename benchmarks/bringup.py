@@ -39,11 +39,14 @@ def _parse(argv: Sequence[str]) -> argparse.Namespace:
                         help="image of every robot (default: the project's stub image)")
     parser.add_argument("--robot-command", default=None,
                         help="dockerCmd of every robot (default: the stub's goalie / striker)")
+    parser.add_argument("--holders", action="store_true",
+                        help="each robot in the network of a holder container, as where the "
+                             "start gate cannot be built (default: behind the start gate)")
     return parser.parse_args(list(argv))
 
 
 def measure(*, robots: int, out: Path, timeout_s: float, robot_image: str | None = None,
-            robot_command: str | None = None) -> dict[str, object]:
+            robot_command: str | None = None, holders: bool = False) -> dict[str, object]:
     from orchestrator import add_scrimmage_arguments as add_arguments
     from orchestrator.config.loader import load_game
     from orchestrator.engine import connect
@@ -57,6 +60,7 @@ def measure(*, robots: int, out: Path, timeout_s: float, robot_image: str | None
         RunOptions,
         cleanup,
         plan_from_game,
+        start_gate,
     )
     from orchestrator.match.scrimmage import ScrimmageRequest, write_files
     from orchestrator.project_images import project_image
@@ -74,9 +78,11 @@ def measure(*, robots: int, out: Path, timeout_s: float, robot_image: str | None
     plan = plan_from_game(load_game(write_files(request, out / "config", stub_image=stub)),
                           grace_period_s=1.0)
     runtime = DockerRuntime(connect())
+    gate = None if holders else start_gate()
     runner = MatchRunner(
         plan, runtime=runtime, host=HostControl.for_current_user(),
-        options=RunOptions(out_dir=out, simulator_image=simulator, poll_s=0.05),
+        options=RunOptions(out_dir=out, simulator_image=simulator, poll_s=0.05,
+                           start_gate=gate),
         telemetry=lambda endpoint, match_id: ZenohTelemetry(endpoint=endpoint, match_id=match_id),
     )
     events = runner.events.subscribe()  # bring-up is seen as it happens, not polled
@@ -105,6 +111,8 @@ def measure(*, robots: int, out: Path, timeout_s: float, robot_image: str | None
     return {
         "bench": "bringup",
         "robots": robots,
+        # robots behind the start gate (False: each in the network of a holder container)
+        "start_gate": gate is not None,
         "bringup_s": None if bringup is None else round(bringup, 3),
         "containers_s": containers,
         # where the time goes: STARTING's phases in order (networks, firewall, spec, containers:
@@ -126,11 +134,13 @@ def main(argv: Sequence[str]) -> int:
     try:
         if args.keep is not None:
             result = measure(robots=args.robots, out=args.keep, timeout_s=args.timeout,
-                             robot_image=args.robot_image, robot_command=args.robot_command)
+                             robot_image=args.robot_image, robot_command=args.robot_command,
+                             holders=args.holders)
         else:
             with tempfile.TemporaryDirectory(prefix="hlvs-bringup-") as folder:
                 result = measure(robots=args.robots, out=Path(folder), timeout_s=args.timeout,
-                                 robot_image=args.robot_image, robot_command=args.robot_command)
+                                 robot_image=args.robot_image, robot_command=args.robot_command,
+                                 holders=args.holders)
     except OrchestratorError as exc:
         print(json.dumps({"bench": "bringup", "error": str(exc)}))
         return exc.exit_code

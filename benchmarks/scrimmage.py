@@ -118,7 +118,14 @@ def play_one(*, seed: int, out: Path, players: int | None,
     from orchestrator.config.loader import load_game
     from orchestrator.engine import connect
     from orchestrator.engine.containers import DockerRuntime
-    from orchestrator.match import HostControl, MatchRunner, RunOptions, cleanup, plan_from_game
+    from orchestrator.match import (
+        HostControl,
+        MatchRunner,
+        RunOptions,
+        cleanup,
+        plan_from_game,
+        start_gate,
+    )
     from orchestrator.match.scrimmage import ScrimmageRequest, write_files
     from orchestrator.project_images import project_image
     from orchestrator.telemetry import ZenohTelemetry
@@ -142,7 +149,8 @@ def play_one(*, seed: int, out: Path, players: int | None,
     host = HostControl.for_current_user()
     runner = MatchRunner(
         plan, runtime=runtime, host=host,
-        options=RunOptions(out_dir=out, simulator_image=project_image("simulator")),
+        options=RunOptions(out_dir=out, simulator_image=project_image("simulator"),
+                           start_gate=start_gate()),
         telemetry=lambda endpoint, mid: ZenohTelemetry(endpoint=endpoint, match_id=mid),
         stop_event=stop,
     )

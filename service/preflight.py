@@ -199,6 +199,7 @@ def _start_and_connect(team: TeamConfig, folder: Path, *, settings: Settings,
         game_file,
         ownership,
         plan_from_game,
+        start_gate,
         team_file,
     )
     from service.teamfiles import FIELD_CLASS
@@ -227,7 +228,7 @@ def _start_and_connect(team: TeamConfig, folder: Path, *, settings: Settings,
     runner = MatchRunner(
         plan, runtime=runtime, host=host,
         options=RunOptions(out_dir=folder / "out", simulator_image=project_image("simulator"),
-                           poll_s=0.1),
+                           poll_s=0.1, start_gate=start_gate()),
         telemetry=lambda endpoint, mid: ZenohTelemetry(endpoint=endpoint, match_id=mid),
     )
     events = runner.events.subscribe()

@@ -52,6 +52,7 @@ from orchestrator.match import (
     plan_from_game,
     scrimmage,
     simulator_gpu,
+    start_gate,
 )
 
 if TYPE_CHECKING:
@@ -142,6 +143,7 @@ def _play(
             out_dir=out_dir, simulator_image=simulator_image, extra_labels=extra_labels or {},
             progress=lambda phase, state: view.update(phase=phase, state=state),
             placement=placement, gpu=gpu,
+            start_gate=start_gate() if placement is None else None,
         )
         runner = MatchRunner(
             plan, runtime=runtime, host=host, options=options,

@@ -284,6 +284,12 @@ class DockerRuntime:
         digests = data.get("RepoDigests") or []
         return str(digests[0]) if digests else str(data["Id"])
 
+    def image_launch(self, image: str) -> tuple[tuple[str, ...], tuple[str, ...]]:
+        """The image's entry point and command (each empty when it has none)."""
+        with translate("image", image):
+            config = self._client.api.inspect_image(image).get("Config") or {}
+        return tuple(config.get("Entrypoint") or ()), tuple(config.get("Cmd") or ())
+
     def list_project(self, *, match_id: str | None = None) -> list[ProjectObject]:
         labels = [f"{LABEL_PROJECT}=1"]
         if match_id is not None:

@@ -20,6 +20,7 @@ from orchestrator.match.events import (
     RobotNotStarted,
     StateChanged,
 )
+from orchestrator.match.gate import start_gate
 from orchestrator.match.host import Host, HostControl
 from orchestrator.match.plan import (
     MatchPlan,
@@ -78,6 +79,7 @@ __all__ = [
     "RobotPlan",
     "RobotRecord",
     "RunOptions",
+    "start_gate",
     "ScrimmageRequest",
     "SimulatorGpu",
     "StateChanged",

@@ -41,7 +41,7 @@ from contracts import (
     files,
 )
 from orchestrator.errors import EngineLost, OrchestratorError
-from orchestrator.match import layout
+from orchestrator.match import gate, layout
 from orchestrator.match.deps import MatchDeps
 from orchestrator.match.logfs import LogFolder
 from orchestrator.match.results import (
@@ -54,7 +54,7 @@ from orchestrator.match.results import (
     write_results,
 )
 from orchestrator.match.safecopy import restrict
-from orchestrator.match.startup import Created
+from orchestrator.match.startup import Created, read_gated_counters
 from orchestrator.match.state import Lifecycle, MatchState
 from orchestrator.runtime.port import ContainerRuntime
 
@@ -264,6 +264,9 @@ class _Collection:
 
         def stop(item: tuple[str, str]) -> None:
             key, container_id = item
+            # a gated robot's namespace (and its counters) ends with its container: the last
+            # reading is taken as it is asked to stop
+            read_gated_counters(deps, self.created, key)
             self._guarded(f"stopping robot {key}",
                           lambda: deps.runtime.stop(container_id, timeout_s=grace))
 
@@ -274,14 +277,22 @@ class _Collection:
                 list(pool.map(stop, ids.items()))
 
     def _read_counters(self) -> None:
-        for key, applied in self.created.shaping.items():
+        created = self.created
+        for key, applied in created.shaping.items():
             record = self.records[key]
-            try:
-                counters = self.deps.host.counters(applied)
-            except OrchestratorError as exc:
-                log.warning("match %s: no traffic counters for %s: %s", self.deps.plan.match_id,
-                            key, exc)
-                continue
+            if key in created.gated:  # read while it ran (runner) and as it was stopped
+                if key not in created.counters:
+                    log.warning("match %s: no traffic counters for %s (its network ended "
+                                "before they were read)", self.deps.plan.match_id, key)
+                    continue
+                counters = created.counters[key]
+            else:
+                try:
+                    counters = self.deps.host.counters(applied)
+                except OrchestratorError as exc:
+                    log.warning("match %s: no traffic counters for %s: %s",
+                                self.deps.plan.match_id, key, exc)
+                    continue
             record.entry = replace(record.entry, sent_bytes=counters.sent_bytes,
                                    received_bytes=counters.received_bytes)
 
@@ -323,6 +334,8 @@ class _Collection:
         if created.simulator_id is not None:
             sim_id = created.simulator_id
             self._guarded("removing the simulator", lambda: runtime.remove(sim_id))
+        if created.gated:  # the folders the robots' start gates waited in
+            shutil.rmtree(deps.options.out_dir / gate.FOLDERS, ignore_errors=True)
         for key, folder in created.log_folders.items():
             record = self.records[key]
             target = deps.options.out_dir / "teams" / record.color / str(record.number)

@@ -41,6 +41,9 @@ class RunOptions:
     simulator_image: str
     simulator_command: tuple[str, ...] = SIMULATOR_COMMAND
     holder_image: str | None = None  # default: the simulator image (needs ``sleep``)
+    # the robots' start gate (:func:`orchestrator.match.gate.start_gate`; dense placement):
+    # None: each robot starts in the network of a holder container
+    start_gate: Path | None = None
     extra_labels: Mapping[str, str] = field(default_factory=dict)
     poll_s: float = 0.5
     simulator_stop_s: float = 10.0

@@ -45,6 +45,8 @@ class FakeRuntime:
         self.containers: dict[str, FakeContainer] = {}
         self.busy_subnets = set(busy_subnets)
         self.missing_images = set(missing_images)
+        # each image's entry point and command (default ``/entrypoint.sh`` and ``run``)
+        self.image_launches: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {}
         self.simulator_exit_code = simulator_exit_code
         self.simulator_polls = simulator_polls
         self.sim_result = sim_result or SimResult(
@@ -114,7 +116,8 @@ class FakeRuntime:
     def start(self, container_id: str) -> None:
         self.calls.append(("start", container_id))
         found = self._get(container_id)
-        found.state = replace(found.state, status="running", running=True, pid=1000)
+        found.state = replace(found.state, status="running", running=True,
+                              pid=1000 + int(container_id[1:]))  # one per container
         if self.on_start is not None:
             self.on_start(found)
 
@@ -186,6 +189,15 @@ class FakeRuntime:
 
     def image_digest(self, image: str) -> str | None:
         return None if image in self.missing_images else f"sha256:{abs(hash(image)):x}"
+
+    def image_launch(self, image: str) -> tuple[tuple[str, ...], tuple[str, ...]]:
+        self._answer(f"image {image}")
+        if image in self.missing_images:
+            raise ObjectNotFound(kind="image", name=image)
+        for name, launch in self.image_launches.items():  # by name or by digest
+            if image in (name, self.image_digest(name)):
+                return launch
+        return ("/entrypoint.sh",), ("run",)
 
     def list_project(self, *, match_id: str | None = None) -> list[ProjectObject]:
         self._answer("containers labelled")

@@ -5,9 +5,11 @@ allows the internet) and one internal control network. Each is a /24 from 10.213
 at run time (a subnet in use is skipped). In every subnet: .1 the host's gateway, .2 the
 simulator, .10+n robot n of the team.
 
-Each robot is two containers: a *holder* that owns the robot's network namespace (fixed IP,
-hostname) and runs nothing but ``sleep``, and the robot container itself, started in the holder's
-namespace (``network_mode=container:<holder>``) once the bandwidth limits are in place.
+Each robot is one container behind the start gate (:mod:`orchestrator.match.gate`: started
+on its team's network with its fixed IP and hostname, shaped, then let run), or where the gate
+cannot be built two: a *holder* that owns the robot's network namespace and runs nothing but
+``sleep``, and the robot container itself, started in the holder's namespace
+(``network_mode=container:<holder>``) once the bandwidth limits are in place.
 """
 
 from __future__ import annotations
@@ -201,12 +203,14 @@ ROBOT_CONSOLE_BYTES = 32_000_000
 
 
 def robot_request(
-    robot: RobotPlan, *, prefix: str, holder_id: str, environment: Mapping[str, str],
+    robot: RobotPlan, *, prefix: str, holder_id: str | None, environment: Mapping[str, str],
     logs_dir: Path, limits: Limits, match_id: str, extra_labels: Mapping[str, str],
     scratch_dir: Path | None = None, cgroup_parent: str | None = None,
 ) -> ContainerRequest:
-    """``scratch_dir``: the robot's capped scratch space (its :data:`SCRATCH_DIRS` are bound
-    into the container); None: size-capped tmpfs folders instead (they count as memory)."""
+    """``holder_id``: the holder whose network the robot joins (None: the caller gives the
+    robot its network, behind the start gate: :mod:`orchestrator.match.gate`).
+    ``scratch_dir``: the robot's capped scratch space (its :data:`SCRATCH_DIRS` are bound into
+    the container); None: size-capped tmpfs folders instead (they count as memory)."""
     assert robot.image is not None
     scratch: tuple[BindMount, ...] = ()
     tmpfs = {"/run": RUN_TMPFS}
@@ -223,7 +227,7 @@ def robot_request(
         environment=dict(environment),
         labels={**labels(match_id, "robot", team=robot.color, robot=str(robot.number)),
                 **extra_labels},
-        network_mode=f"container:{holder_id}",
+        network_mode=f"container:{holder_id}" if holder_id is not None else None,
         mounts=(BindMount(source=logs_dir, target=LOGS_TARGET), *scratch),
         read_only=True,
         tmpfs=tmpfs,

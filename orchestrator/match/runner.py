@@ -49,12 +49,20 @@ from orchestrator.match.host import Host
 from orchestrator.match.monitor import StatsMonitor
 from orchestrator.match.plan import MatchPlan
 from orchestrator.match.results import Failure, FailureClass, RobotRecord
-from orchestrator.match.startup import Created, StartedMatch, StartupTimes, start
+from orchestrator.match.startup import (
+    Created,
+    StartedMatch,
+    StartupTimes,
+    read_gated_counters,
+    start,
+)
 from orchestrator.match.state import Lifecycle, MatchState
 from orchestrator.runtime.port import ContainerRuntime
 
 log = logging.getLogger(__name__)
 
+# a container's exit code when SIGINT, SIGKILL or SIGTERM ended it
+STOP_SIGNAL_CODES = (130, 137, 143)
 # until every robot is connected (at most this long after STARTING) the simulator and its
 # telemetry are polled every 0.1 s: the match goes on, and bring-up is seen, without a 0.5 s lag
 BRINGUP_FAST_POLL_S = 30.0
@@ -253,6 +261,9 @@ class MatchRunner:
             now = deps.clock()
             if now - last_robot_poll >= 2.0:
                 self._poll_robots(started, game)
+                for key in created.gated:  # their counters end with their containers
+                    if not game.robots[key].entry.exited_during_game:
+                        read_gated_counters(deps, created, key)
                 last_robot_poll = now
             latest = telemetry.latest() if telemetry else None
             if lifecycle.state is MatchState.WAITING and (
@@ -331,7 +342,9 @@ class MatchRunner:
 
         A network holder only sleeps and never exits by itself: when one has ended with the
         simulator, something outside the match stopped its containers (the engine stopping or
-        restarting stops them all); an engine that no longer answers says so too."""
+        restarting stops them all); an engine that no longer answers says so too. Without
+        holders (robots behind the start gate) the simulator's own exit code tells it: the
+        simulator ends by a stop signal only when one was sent to it."""
         runtime = self._deps.runtime
         for key, holder_id in created.holder_ids.items():
             try:
@@ -345,6 +358,20 @@ class MatchRunner:
                         f"containers (it was stopped or restarted, or they were stopped from "
                         f"outside the runner): the network holder of {key} ended with code "
                         f"{state.exit_code} as well")
+        if created.holder_ids or created.simulator_id is None:
+            return None
+        # robots behind the start gate have no holders: a simulator ended by a stop signal
+        # that the runner did not send (nor the kernel's OOM killer) was stopped from outside
+        try:
+            state = runtime.inspect(created.simulator_id)
+        except EngineLost as exc:
+            return f"{exc}; it stopped the match's containers"
+        except OrchestratorError:
+            return None
+        if state.exit_code in STOP_SIGNAL_CODES and not state.oom_killed:
+            return (f"the Docker engine at {runtime.endpoint()} stopped the match's containers "
+                    f"(it was stopped or restarted, or they were stopped from outside the "
+                    f"runner): the simulator ended by a signal (code {state.exit_code})")
         return None
 
 

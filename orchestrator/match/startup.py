@@ -20,9 +20,9 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from contracts import GC_RETURN_PORT, MAX_RENDER_PROCESSES, MatchSpec, Scalar, files
-from orchestrator.bandwidth import AppliedShaping, RobotShaping, mb_s_to_bit
-from orchestrator.errors import InfrastructureError, OrchestratorError
-from orchestrator.match import layout
+from orchestrator.bandwidth import AppliedShaping, RobotShaping, TrafficCounters, mb_s_to_bit
+from orchestrator.errors import ImageError, InfrastructureError, OrchestratorError
+from orchestrator.match import gate, layout
 from orchestrator.match.admission import cpu_sets
 from orchestrator.match.deps import MatchDeps
 from orchestrator.match.events import RobotNotStarted
@@ -31,7 +31,13 @@ from orchestrator.match.logfs import LogFolder
 from orchestrator.match.placement import ROBOT_CGROUP_PARENT, LeaguePlacement, Node, firewall_for
 from orchestrator.match.plan import MatchPlan, RobotPlan, per_robot_rate_mb_s
 from orchestrator.match.results import Failure, FailureClass, RobotRecord
-from orchestrator.runtime.port import Attachment, ContainerRequest, NetworkInfo, SubnetInUse
+from orchestrator.runtime.port import (
+    Attachment,
+    BindMount,
+    ContainerRequest,
+    NetworkInfo,
+    SubnetInUse,
+)
 from orchestrator.telemetry import TelemetrySource
 
 log = logging.getLogger(__name__)
@@ -53,6 +59,10 @@ class Created:
     holder_ids: dict[str, str] = field(default_factory=dict)  # robot key -> holder id
     robot_ids: dict[str, str] = field(default_factory=dict)  # robot key -> container id
     shaping: dict[str, AppliedShaping] = field(default_factory=dict)
+    # robots behind the start gate: their network namespace ends with their container, so
+    # their traffic counters are read while they run (the latest reading of each here)
+    gated: set[str] = field(default_factory=set)
+    counters: dict[str, TrafficCounters] = field(default_factory=dict)
     log_folders: dict[str, LogFolder] = field(default_factory=dict)
     scratch: dict[str, LogFolder] = field(default_factory=dict)  # robot key -> scratch space
     match_dir: Path | None = None  # the simulator's folder, once the match spec is in it
@@ -325,46 +335,42 @@ def _start_robot(
     n_robots: int, cpuset: str | None, mark: _Marks, folders: ThreadPoolExecutor,
 ) -> None:
     """Start one robot (``n_robots``: how many of its team start, who share its team's
-    bandwidth); what goes wrong is its ``startup_error``, never an exception."""
+    bandwidth); what goes wrong is its ``startup_error``, never an exception. With the start
+    gate (:mod:`orchestrator.match.gate`; dense placement) the robot container is started
+    behind it, shaped and then released; else a holder is started and shaped first and the
+    robot container joins its network."""
     plan = deps.plan
     placement = deps.options.placement
     team = plan.red if robot.color == "red" else plan.blue
     limits = plan.limits
+    binary = deps.options.start_gate if placement is None else None
     # the capped log and scratch folders are made while the holder starts
     made = folders.submit(_robot_folders, deps, created, robot)
     try:
-        if placement is not None:
+        holder_id: str | None = None
+        applied: AppliedShaping | None = None
+        cgroup_parent: str | None = None
+        team_net: layout.TeamAddresses
+        if binary is not None:
+            team_net = created.subnets[robot.color]
+        elif placement is not None:
             holder_id, team_net, applied, cgroup_parent = _league_robot_network(
                 deps, created, robot, placement, n_robots, mark)
         else:
             holder_id, team_net, applied = _dense_robot_network(
                 deps, created, robot, n_robots, mark)
-            cgroup_parent = None
         if applied is not None:
             created.shaping[robot.key] = applied
-        mark("shaping")
+            mark("shaping")
         folder, scratch = made.result()
         mark("folders")
-        robot_limits: dict[str, Scalar] = {
-            "nano_cpus": int(limits.cpus * 1e9),
-            "memory_bytes": int(limits.memory_gb * 1e9),
-            "pids": limits.pids,
-            "log_folder_bytes": folder.cap_bytes,
-            "scratch_bytes": scratch.cap_bytes if scratch is not None else None,
-            "read_only_root": True,
-            # the OCI runtime the robot ran under ("runsc": gVisor), None: the engine's default
-            "runtime": limits.robot_runtime or None,
-            "console_bytes": layout.ROBOT_CONSOLE_BYTES,  # what the engine keeps of its output
-            "api_rate_bit_s": applied.api_rate_bit if applied else None,
-            "comm_rate_bit_s": applied.comm_rate_bit if applied else None,
-            "shaping_applied_ms": round(applied.applied_ms, 1) if applied else None,
-        }
         environment = layout.robot_environment(
             robot, team_net=team_net, player_count=len(team.robots),
             gamecontroller_ip=team_net.simulator,
         )
+        image = record.entry.digest or robot.image
         request = layout.robot_request(
-            replace(robot, image=record.entry.digest or robot.image),
+            replace(robot, image=image),
             prefix=deps.prefix, holder_id=holder_id, environment=environment,
             logs_dir=folder.path, limits=limits, match_id=plan.match_id,
             extra_labels=deps.options.extra_labels,
@@ -372,17 +378,34 @@ def _start_robot(
             cgroup_parent=cgroup_parent,
         )
         request = replace(request, cpuset_cpus=cpuset)
+        gate_dir = None
+        if binary is not None:
+            assert image is not None
+            gate_dir = gate.folder(deps.options.out_dir, robot.key)
+            request = _gated_request(deps, robot, request, binary=binary, gate_dir=gate_dir,
+                                     image=image, team_net=team_net,
+                                     network=created.networks[robot.color].name)
         if placement is not None:  # the node's epilog finds it by this label
             node = placement.robots[robot.key].name
             request = replace(request, labels={**request.labels, layout.LABEL_NODE: node})
-        robot_limits["cpuset"] = request.cpuset_cpus
-        record.entry = replace(record.entry, limits=robot_limits)
+        record.entry = replace(record.entry, limits=_robot_limits(
+            plan, folder, scratch, applied, request.cpuset_cpus))
         container_id = deps.runtime.create_container(request)
         created.robot_ids[robot.key] = container_id
         record.entry = replace(record.entry, container=request.name)
         mark("create")
         deps.runtime.start(container_id)
         mark("start")
+        if gate_dir is not None:
+            applied = _shape_gated(deps, robot, container_id, n_robots, team_net)
+            if applied is not None:
+                created.shaping[robot.key] = applied
+                created.gated.add(robot.key)
+            record.entry = replace(record.entry, limits=_robot_limits(
+                plan, folder, scratch, applied, request.cpuset_cpus))
+            mark("shaping")
+            gate.release(gate_dir)
+            mark("release")
         deps.monitor.watch(robot.key, container_id)
         log.info("match %s: robot %s started (%s, %s)", plan.match_id, robot.key, robot.image,
                  team_net.robot(robot.number))
@@ -393,6 +416,73 @@ def _start_robot(
         log.warning("match %s: robot %s could not be started: %s", plan.match_id, robot.key, exc)
     finally:
         made.exception()  # made and recorded (for the teardown) even when the robot failed
+
+
+def _robot_limits(plan: MatchPlan, folder: LogFolder, scratch: LogFolder | None,
+                  applied: AppliedShaping | None, cpuset: str | None) -> dict[str, Scalar]:
+    """The limits a robot runs under, as ``report.json`` records them."""
+    limits = plan.limits
+    return {
+        "nano_cpus": int(limits.cpus * 1e9),
+        "memory_bytes": int(limits.memory_gb * 1e9),
+        "pids": limits.pids,
+        "log_folder_bytes": folder.cap_bytes,
+        "scratch_bytes": scratch.cap_bytes if scratch is not None else None,
+        "read_only_root": True,
+        # the OCI runtime the robot ran under ("runsc": gVisor), None: the engine's default
+        "runtime": limits.robot_runtime or None,
+        "console_bytes": layout.ROBOT_CONSOLE_BYTES,  # what the engine keeps of its output
+        "api_rate_bit_s": applied.api_rate_bit if applied else None,
+        "comm_rate_bit_s": applied.comm_rate_bit if applied else None,
+        "shaping_applied_ms": round(applied.applied_ms, 1) if applied else None,
+        "cpuset": cpuset,
+    }
+
+
+def _gated_request(deps: MatchDeps, robot: RobotPlan, request: ContainerRequest, *,
+                   binary: Path, gate_dir: Path, image: str, team_net: layout.TeamAddresses,
+                   network: str) -> ContainerRequest:
+    """``request`` behind the start gate: on its team's network with its fixed address and
+    name (what its holder had), the gate as its entry point, then the image's entry point and
+    the team's command (or the image's)."""
+    launch = deps.runtime.image_launch(image)
+    if not (*launch[0], *launch[1], *(robot.command or ())):
+        raise ImageError(image=robot.image or image, reason=(
+            f"robot {robot.key}: the image has no entry point or command and the team "
+            "configuration gives no dockerCmd: nothing to run"))
+    entrypoint, command = gate.gated_launch((gate.TARGET, gate.DIR_TARGET, "--"), robot.command,
+                                       launch)
+    return replace(
+        request,
+        entrypoint=entrypoint,
+        command=command,
+        network_mode=None,
+        networks=(Attachment(network=network,
+                             ipv4_address=team_net.robot(robot.number),
+                             aliases=(robot.key,)),),
+        hostname=robot.key,
+        mounts=(*request.mounts,
+                BindMount(source=binary, target=gate.TARGET, read_only=True),
+                BindMount(source=gate_dir, target=gate.DIR_TARGET, read_only=True)),
+    )
+
+
+def _shape_gated(deps: MatchDeps, robot: RobotPlan, container_id: str, n_robots: int,
+                 team_net: layout.TeamAddresses) -> AppliedShaping | None:
+    """The bandwidth limits of a robot waiting behind its gate; a robot that cannot be shaped
+    is killed there, before anything of it ran."""
+    team = deps.plan.red if robot.color == "red" else deps.plan.blue
+    shaping = _shaping(deps.plan, n_robots, simulator_ip=team_net.simulator, teammate_ips=tuple(
+        team_net.robot(r.number) for r in team.robots if r != robot))
+    try:
+        return deps.host.shape(deps.runtime.inspect(container_id).pid, shaping)
+    except OrchestratorError:
+        try:
+            deps.runtime.kill(container_id)
+        except OrchestratorError as exc:
+            log.warning("match %s: robot %s could not be shaped nor killed behind its start "
+                        "gate: %s", deps.plan.match_id, robot.key, exc)
+        raise
 
 
 def _robot_folders(deps: MatchDeps, created: Created, robot: RobotPlan
@@ -505,4 +595,17 @@ def _scratch(deps: MatchDeps, created: Created, robot: RobotPlan) -> LogFolder |
     return scratch
 
 
-__all__ = ["Created", "StartedMatch", "StartupTimes", "start"]
+def read_gated_counters(deps: MatchDeps, created: Created, key: str) -> None:
+    """Read the traffic counters of gated robot ``key`` while its namespace lives (kept in
+    ``created.counters``; a failed reading keeps the previous one and is logged at debug
+    level: the robot may just have ended)."""
+    applied = created.shaping.get(key)
+    if applied is None or key not in created.gated:
+        return
+    try:
+        created.counters[key] = deps.host.counters(applied)
+    except OrchestratorError as exc:
+        log.debug("match %s: traffic counters of %s not read: %s", deps.plan.match_id, key, exc)
+
+
+__all__ = ["Created", "StartedMatch", "StartupTimes", "read_gated_counters", "start"]

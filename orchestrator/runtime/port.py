@@ -188,6 +188,10 @@ class ContainerRuntime(Protocol):
 
     def image_digest(self, image: str) -> str | None: ...
 
+    # the image's entry point and command, as the engine would run them (the robots' start gate
+    # runs them itself); raises when the image is not present
+    def image_launch(self, image: str) -> tuple[tuple[str, ...], tuple[str, ...]]: ...
+
     def list_project(self, *, match_id: str | None = None) -> list[ProjectObject]: ...
 
 

@@ -27,6 +27,7 @@ from orchestrator.match import (
     RunOptions,
     TeamPlan,
     cleanup,
+    start_gate,
 )
 from orchestrator.runtime.port import ContainerRequest, NetworkInfo, NetworkRequest
 from orchestrator.telemetry import ZenohTelemetry
@@ -143,7 +144,7 @@ def play(runtime: Any, test_image: str, tmp_path: Path) -> Iterator[MatchFactory
         red_image: str | None = "", blue_image: str | None = "", out: Path | None = None,
         on_created: Callable[[ContainerRequest | NetworkRequest], None] | None = None,
         stop_event: threading.Event | None = None,
-        telemetry_silence_s: float | None = None,
+        telemetry_silence_s: float | None = None, holders: bool = False,
     ) -> MatchOutcome:
         match_id = f"t{uuid.uuid4().hex[:8]}"
         match_ids.append(match_id)
@@ -162,6 +163,8 @@ def play(runtime: Any, test_image: str, tmp_path: Path) -> Iterator[MatchFactory
             out_dir=out or tmp_path / match_id, simulator_image=test_image,
             simulator_command=("python3", "/opt/t/fakesim.py", *sim),
             extra_labels={TEST_LABEL: "1"}, poll_s=0.2,
+            # as a match starts them: behind the start gate (``holders``: in holders' networks)
+            start_gate=None if holders else start_gate(),
         )
         runner = MatchRunner(
             plan, runtime=runtime if on_created is None else _Told(runtime, on_created),

@@ -34,8 +34,9 @@ def test_match_writes_complete_results_and_each_robot_sees_its_environment(
     assert seen["cap_eff"] == "0000000000000000" and seen["no_new_privs"] == "1"
     host_mounts = [m for m in seen["mounts"] if not m.startswith(("/proc", "/sys", "/dev"))]
     assert sorted(host_mounts) == [
-        "/", "/etc/hostname", "/etc/hosts", "/etc/resolv.conf", "/robocup-logs", "/root", "/run",
-        "/tmp", "/var/tmp"]  # a read-only root; writable: the capped scratch folders
+        "/", "/.hlvs-start-gate", "/.hlvs-start-gate.d", "/etc/hostname", "/etc/hosts",
+        "/etc/resolv.conf", "/robocup-logs", "/root", "/run", "/tmp", "/var/tmp",
+    ]  # a read-only root and start gate; writable: the capped scratch folders
     blue = json.loads((out / "teams/blue/1/robocup-logs/env.json").read_text())["env"]
     assert blue["ROBOCUP_TEAM_COLOR"] == "blue"
     assert blue["ROBOCUP_SIMULATOR_ADDR"].endswith(":10021")

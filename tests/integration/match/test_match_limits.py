@@ -60,11 +60,38 @@ def test_limits_are_visible_in_docker_inspect(
         assert host_config["CapDrop"] == ["ALL"]
         assert host_config["SecurityOpt"] == ["no-new-privileges"]
         assert host_config["Privileged"] is False
-        assert host_config["NetworkMode"].startswith("container:")
-        binds = host_config["Binds"]
-        assert sorted(b.rpartition(":")[0].rpartition(":")[2] for b in binds) == [
-            "/robocup-logs", "/root", "/tmp", "/var/tmp"]
+        # on its team's network (behind the start gate, which is bound read-only with the
+        # folder it waited in)
+        assert host_config["NetworkMode"] in (f"hlvs-{outcome.match_id}-red",
+                                              f"hlvs-{outcome.match_id}-blue")
+        binds = {b.rpartition(":")[0].rpartition(":")[2]: b.rpartition(":")[2]
+                 for b in host_config["Binds"]}
+        assert sorted(binds) == ["/.hlvs-start-gate", "/.hlvs-start-gate.d", "/robocup-logs",
+                                 "/root", "/tmp", "/var/tmp"]
+        assert binds["/.hlvs-start-gate"] == binds["/.hlvs-start-gate.d"] == "ro"
         assert host_config["ReadonlyRootfs"] is True
+
+
+def test_robots_behind_holders_where_the_gate_cannot_be_built(
+    play: MatchFactory, docker_client: docker.DockerClient
+) -> None:
+    """Without the start gate each robot joins the network of its holder, which is shaped
+    first: the match plays, shaped, as behind the gate."""
+    seen: dict[str, object] = {}
+
+    def capture(request: ContainerRequest | NetworkRequest) -> None:
+        if isinstance(request, ContainerRequest) and request.labels.get(LABEL_ROLE) == "robot":
+            seen[request.name] = docker_client.api.inspect_container(request.name)["HostConfig"]
+
+    outcome = play(red=[["env"]], blue=[["env"]], sim=("2",), on_created=capture, holders=True)
+    assert outcome.ok
+    results = json.loads((outcome.out_dir / "results.json").read_text())
+    assert len(seen) == 2
+    for host_config in seen.values():
+        assert host_config["NetworkMode"].startswith("container:")
+        assert not any("start-gate" in b for b in host_config["Binds"])
+    for robot in results["robots"].values():
+        assert robot["limits"]["api_rate_bit_s"] > 0 and robot["sent_bytes"] > 0, robot
 
 
 def test_oom_killed_robot_is_recorded_and_the_game_goes_on(play: MatchFactory) -> None:

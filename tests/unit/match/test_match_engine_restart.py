@@ -118,3 +118,31 @@ def test_the_fake_engine_refuses_every_call_while_down() -> None:
     else:
         raise AssertionError("a call to an engine that is down answered")
     assert runtime.answering() is False and runtime.answering() is True
+
+
+def test_behind_the_start_gate_a_simulator_ended_by_a_signal_names_the_engine(
+        tmp_path: Path) -> None:
+    """No holders to look at: the simulator's own exit by a stop signal (137 here, not OOM)
+    says that something outside the runner stopped it."""
+    runtime = _RestartingEngine(down_for_pings=0)
+    outcome = MatchRunner(_plan(), runtime=runtime, host=FakeHost(), options=RunOptions(
+        out_dir=tmp_path, simulator_image="sim:1", poll_s=0.0, engine_wait_s=5.0,
+        start_gate=Path("/opt/gate/start_gate"),
+    )).run()
+    assert outcome.failure is not None
+    assert outcome.failure.failure_class is FailureClass.INFRASTRUCTURE, outcome.failure
+    cause = outcome.failure.cause
+    assert "the Docker engine at fake://engine stopped the match's containers" in cause, cause
+    assert "the simulator ended by a signal (code 137)" in cause, cause
+
+
+def test_behind_the_start_gate_a_simulator_that_fails_by_itself_is_blamed(
+        tmp_path: Path) -> None:
+    runtime = FakeRuntime(simulator_exit_code=1, simulator_polls=2)
+    outcome = MatchRunner(_plan(), runtime=runtime, host=FakeHost(), options=RunOptions(
+        out_dir=tmp_path, simulator_image="sim:1", poll_s=0.0,
+        start_gate=Path("/opt/gate/start_gate"),
+    )).run()
+    assert outcome.failure is not None
+    assert outcome.failure.failure_class is FailureClass.SIMULATOR, outcome.failure
+    assert outcome.failure.cause.startswith("simulator exited with code 1"), outcome.failure
