@@ -15,7 +15,7 @@ import logging
 import shutil
 import time
 from collections.abc import Callable, Mapping
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -107,6 +107,21 @@ def start(deps: MatchDeps, created: Created, robots: Mapping[str, RobotRecord],
     plan = deps.plan
     phases_s: dict[str, float] = {}
     mark = _Marks(deps.clock, phases_s)
+    startable = [r for r in plan.robots if robots[r.key].entry.image_error is None]
+    with ThreadPoolExecutor(max_workers=max(1, len(startable)),
+                            thread_name_prefix="folders") as folders:
+        # the robots' capped log and scratch folders are made from the start, while the
+        # networks are made and the containers start
+        made = {robot.key: folders.submit(_robot_folders, deps, created, robot)
+                for robot in startable}
+        return _start(deps, created, robots, started_at, made=made, phases_s=phases_s,
+                      mark=mark)
+
+
+def _start(deps: MatchDeps, created: Created, robots: Mapping[str, RobotRecord],
+           started_at: float, *, made: Mapping[str, Future[tuple[LogFolder, LogFolder | None]]],
+           phases_s: dict[str, float], mark: _Marks) -> StartedMatch:
+    plan = deps.plan
     placement = deps.options.placement
     if placement is None:
         request, spec, endpoint = _dense_simulator(deps, created, mark)
@@ -121,7 +136,8 @@ def start(deps: MatchDeps, created: Created, robots: Mapping[str, RobotRecord],
     robot_steps_s: dict[str, dict[str, float]] = {
         key: {} for key, record in robots.items() if record.entry.image_error is None}
     began, simulator_started_at = _start_containers(
-        deps, created, robots, request, robot_cpuset=sets.robots, robot_steps_s=robot_steps_s)
+        deps, created, robots, request, robot_cpuset=sets.robots, robot_steps_s=robot_steps_s,
+        made=made)
     phases_s["simulator"] = round(simulator_started_at - began, 3)
     mark("containers")
     telemetry = None
@@ -279,6 +295,7 @@ def _start_containers(
     deps: MatchDeps, created: Created, robots: Mapping[str, RobotRecord],
     request: ContainerRequest, *, robot_cpuset: str | None,
     robot_steps_s: dict[str, dict[str, float]],
+    made: Mapping[str, Future[tuple[LogFolder, LogFolder | None]]],
 ) -> tuple[float, float]:
     """The simulator and every robot with an image; returns when the simulator's start began
     and when it was done."""
@@ -289,14 +306,12 @@ def _start_containers(
                  for team in plan.teams}
     # the simulator and the robots start at the same time (robot clients retry until the
     # simulator listens); the simulator is submitted first so that it boots while they start
-    with (ThreadPoolExecutor(max_workers=len(startable) + 1) as pool,
-          ThreadPoolExecutor(max_workers=max(1, len(startable)), thread_name_prefix="folders")
-          as folders):
+    with ThreadPoolExecutor(max_workers=len(startable) + 1) as pool:
         simulator = pool.submit(_start_simulator, deps, created, request)
         list(pool.map(lambda robot: _start_robot(
             deps, created, robot, robots[robot.key], n_robots=team_size[robot.color],
             cpuset=robot_cpuset, mark=_Marks(deps.clock, robot_steps_s[robot.key]),
-            folders=folders), startable))
+            made=made[robot.key]), startable))
         return simulator.result()
 
 
@@ -332,7 +347,8 @@ def _start_simulator(deps: MatchDeps, created: Created, request: ContainerReques
 
 def _start_robot(
     deps: MatchDeps, created: Created, robot: RobotPlan, record: RobotRecord, *,
-    n_robots: int, cpuset: str | None, mark: _Marks, folders: ThreadPoolExecutor,
+    n_robots: int, cpuset: str | None, mark: _Marks,
+    made: Future[tuple[LogFolder, LogFolder | None]],
 ) -> None:
     """Start one robot (``n_robots``: how many of its team start, who share its team's
     bandwidth); what goes wrong is its ``startup_error``, never an exception. With the start
@@ -344,8 +360,6 @@ def _start_robot(
     team = plan.red if robot.color == "red" else plan.blue
     limits = plan.limits
     binary = deps.options.start_gate if placement is None else None
-    # the capped log and scratch folders are made while the holder starts
-    made = folders.submit(_robot_folders, deps, created, robot)
     try:
         holder_id: str | None = None
         applied: AppliedShaping | None = None
