@@ -10,8 +10,9 @@ simulator at ``.2`` of each, robot n at ``.10+n`` of its team's network, the ROB
 environment, CPU / memory / PID limits, no capabilities, no privilege gain, ``/robocup-logs``
 bind-mounted from ``logs/<color>-<n>``, the match folder (``match_spec.json``, ``out/``) at
 ``/match``. What compose cannot do: the bandwidth limits (``hlvs match`` applies them with
-traffic control), the robots' separate network holders (a robot service owns its address
-itself) and image pinning by digest (compose uses the references as written).
+traffic control, holding each robot at its start gate until they are in place) and image
+pinning by digest (compose uses the references as written). A robot service owns its address
+itself, as a robot container behind the start gate does.
 """
 
 from __future__ import annotations

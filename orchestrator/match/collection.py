@@ -194,13 +194,20 @@ class _Collection:
             self.failure = replace(self.failure, cause=f"{self.failure.cause}; {left}")
 
     def _engine_step(self, step: Callable[[], object]) -> None:
-        """``step``, once more after the engine came back if it met an engine gone away."""
-        try:
-            step()
-        except EngineLost as exc:
-            if not self._engine_back(exc):
-                raise
-            step()
+        """``step``, again each time the engine came back after it met the engine gone away
+        (a restarting engine may answer a ping before it serves every call), until the wait
+        for the engine (``engine_wait_s``) is over."""
+        while True:
+            try:
+                step()
+                return
+            except EngineLost as exc:
+                if not self._engine_back(exc):
+                    raise
+                if self.deps.clock() >= self.engine_deadline:
+                    step()  # the last try: its error is the step's
+                    return
+                threading.Event().wait(max(self.deps.options.poll_s, 0.1))
 
     def _fail(self, cause: str) -> None:
         self.failure = self.deps.fail(self.failure, FailureClass.INFRASTRUCTURE, cause)

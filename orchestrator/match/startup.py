@@ -361,18 +361,8 @@ def _start_robot(
     limits = plan.limits
     binary = deps.options.start_gate if placement is None else None
     try:
-        holder_id: str | None = None
-        applied: AppliedShaping | None = None
-        cgroup_parent: str | None = None
-        team_net: layout.TeamAddresses
-        if binary is not None:
-            team_net = created.subnets[robot.color]
-        elif placement is not None:
-            holder_id, team_net, applied, cgroup_parent = _league_robot_network(
-                deps, created, robot, placement, n_robots, mark)
-        else:
-            holder_id, team_net, applied = _dense_robot_network(
-                deps, created, robot, n_robots, mark)
+        holder_id, team_net, applied, cgroup_parent = _robot_network(
+            deps, created, robot, n_robots, mark, gated=binary is not None)
         if applied is not None:
             created.shaping[robot.key] = applied
             mark("shaping")
@@ -430,6 +420,20 @@ def _start_robot(
         log.warning("match %s: robot %s could not be started: %s", plan.match_id, robot.key, exc)
     finally:
         made.exception()  # made and recorded (for the teardown) even when the robot failed
+
+
+def _robot_network(deps: MatchDeps, created: Created, robot: RobotPlan, n_robots: int,
+                   mark: _Marks, *, gated: bool,
+                   ) -> tuple[str | None, layout.TeamAddresses, AppliedShaping | None, str | None]:
+    """The robot's holder (None: ``gated``, the robot has its team's network itself), its
+    team's addresses, the limits applied to the holder and the robot's cgroup parent."""
+    placement = deps.options.placement
+    if placement is not None:
+        return _league_robot_network(deps, created, robot, placement, n_robots, mark)
+    if gated:
+        return None, created.subnets[robot.color], None, None
+    holder_id, team_net, applied = _dense_robot_network(deps, created, robot, n_robots, mark)
+    return holder_id, team_net, applied, None
 
 
 def _robot_limits(plan: MatchPlan, folder: LogFolder, scratch: LogFolder | None,

@@ -123,18 +123,23 @@ def start_method() -> str:
         return "spawn"
     try:
         tasks = os.listdir("/proc/self/task")
-        names = {_thread_name(task) for task in tasks}
     except OSError:
         return "spawn"
+    # a thread that ended between the listing and the look (a Python thread just joined
+    # leaves the kernel a moment later) is no thread of the child's
+    names = {name for task in tasks if (name := _thread_name(task)) is not None}
     return "fork" if len(names) == 1 and "" not in names else "spawn"
 
 
-def _thread_name(task: str) -> str:
+def _thread_name(task: str) -> str | None:
+    """The thread's name, None when it has ended, "" when it cannot be read (not fit)."""
     try:
         with open(f"/proc/self/task/{task}/comm", encoding="utf-8", errors="replace") as comm:
             return comm.read().strip()
+    except (FileNotFoundError, ProcessLookupError):
+        return None
     except OSError:
-        return ""  # a thread that ended meanwhile: unknown, so not fit
+        return ""
 
 
 class RenderPool:
