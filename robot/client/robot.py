@@ -42,12 +42,15 @@ class RobotClient:
     """
 
     def __init__(
-        self, host: str, port: int, *, retries: int = 20, retry_interval_s: float = 1.0
+        self, host: str, port: int, *, retries: int = 20, retry_interval_s: float = 1.0,
+        connect_timeout_s: float = 5.0,
     ) -> None:
         self.host = host
         self.port = port
         self.retries = max(1, retries)
         self.retry_interval_s = retry_interval_s
+        # how long one connect may wait (an address whose host is gone answers nothing)
+        self.connect_timeout_s = connect_timeout_s
         self._sock: socket.socket | None = None
         self._buffer = bytearray()
         # one frame at a time: ``sendall`` may take several writes and lets other threads run
@@ -79,7 +82,8 @@ class RobotClient:
         reason = ""
         for attempt in range(1, self.retries + 1):
             try:
-                sock = socket.create_connection((self.host, self.port), timeout=5.0)
+                sock = socket.create_connection((self.host, self.port),
+                                                timeout=self.connect_timeout_s)
             except OSError as exc:
                 reason = str(exc)
                 if attempt < self.retries:

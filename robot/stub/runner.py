@@ -37,6 +37,7 @@ logger = logging.getLogger(__name__)
 SENSOR_PERIOD_MS = 8
 CAMERA_PERIOD_MS = 96
 CONNECT_RETRY_S = 0.25  # a refused connect costs nothing; the simulator may boot after us
+CONNECT_TIMEOUT_S = 1.0
 CRASH_EXIT_CODE = 1
 
 
@@ -178,7 +179,10 @@ class StubRobot:
             if self._crash_due():
                 return None
             attempts += 1
-            client = RobotClient(self.env.simulator_host, self.env.simulator_port, retries=1)
+            # a short connect: once the simulator's container is gone its address answers
+            # nothing, and a stop signal must not wait out a long connect (the grace period)
+            client = RobotClient(self.env.simulator_host, self.env.simulator_port, retries=1,
+                                 connect_timeout_s=CONNECT_TIMEOUT_S)
             try:
                 client.connect()
             except RobotClientError as exc:

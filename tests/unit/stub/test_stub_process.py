@@ -22,12 +22,13 @@ def _closed_port() -> int:
 
 
 @contextmanager
-def stub(tmp_path: Path, *argv: str) -> Iterator[subprocess.Popen[str]]:
+def stub(tmp_path: Path, *argv: str, port: int | None = None
+         ) -> Iterator[subprocess.Popen[str]]:
     env = {
         **os.environ,
         "ROBOCUP_ROBOT_ID": "1",
         "ROBOCUP_TEAM_COLOR": "red",
-        "ROBOCUP_SIMULATOR_ADDR": f"127.0.0.1:{_closed_port()}",
+        "ROBOCUP_SIMULATOR_ADDR": f"127.0.0.1:{port or _closed_port()}",
         "ROBOCUP_MIRROR_SERVER_IP": "127.0.0.1",
         "ROBOCUP_LOG_DIR": str(tmp_path / "logs"),
     }
@@ -64,6 +65,28 @@ def test_sigterm_exits_zero(tmp_path: Path) -> None:
         proc.send_signal(signal.SIGTERM)
         assert proc.wait(timeout=15) == 0
     assert "received SIGTERM" in (tmp_path / "logs" / "stub_red_1.log").read_text()
+
+
+def test_sigterm_during_a_connect_that_hangs_exits_within_the_grace(tmp_path: Path) -> None:
+    """An address that answers nothing (the simulator's container gone at the end of a match;
+    here a listening socket whose backlog is full, so connects hang): each connect gives up
+    after a second, so a stop signal is heeded well within the league's 5 s grace."""
+    with socket.socket() as full:
+        full.bind(("127.0.0.1", 0))
+        full.listen(0)
+        held = socket.create_connection(full.getsockname(), timeout=1.0)  # fills the backlog
+        try:
+            with stub(tmp_path, "striker", port=int(full.getsockname()[1])) as proc:
+                wait_for_log(tmp_path, "not available")  # one connect timed out
+                time.sleep(0.3)  # most likely in the next one
+                sent = time.monotonic()
+                proc.send_signal(signal.SIGTERM)
+                assert proc.wait(timeout=15) == 0
+                assert time.monotonic() - sent < 2.5
+        finally:
+            held.close()
+    log = (tmp_path / "logs" / "stub_red_1.log").read_text()
+    assert "timed out" in log and "received SIGTERM" in log
 
 
 def test_ignore_sigterm_survives_sigterm(tmp_path: Path) -> None:
