@@ -13,15 +13,13 @@ The client is built once per source version with the machine's C compiler (``$CC
 
 from __future__ import annotations
 
-import hashlib
 import json
-import os
-import shutil
 import subprocess
-import tempfile
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
+
+from orchestrator import native_build
 
 NATIVE = Path(__file__).with_name("native")
 SOURCE = NATIVE / "bench_client.c"
@@ -29,40 +27,18 @@ FLOOR_SOURCE = NATIVE / "lockstep_floor.c"
 STYLES = ("framed", "league")
 
 
-def _cache() -> Path:
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return Path(base) / "hlvs" / "bench"
-
-
 def compiler() -> str | None:
     """The C compiler the clients are built with: ``$CC``, else ``cc`` or ``gcc`` on the path."""
-    return os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
+    return native_build.compiler()
 
 
 def binary(source_path: Path = SOURCE) -> Path:
     """The compiled client (or another of ``native/``), built now if this source version has
     not been."""
-    source = source_path.read_bytes()
-    built = _cache() / f"{source_path.stem}-{hashlib.sha256(source).hexdigest()[:16]}"
-    if built.is_file() and os.access(built, os.X_OK):
-        return built
-    compiler_path = compiler()
-    if not compiler_path:
-        raise SystemExit(
-            "bench api --native: no C compiler (set CC or install one, e.g. apt-get install gcc)"
-        )
-    built.parent.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(dir=built.parent) as work:
-        partial = Path(work) / built.name
-        done = subprocess.run(
-            [compiler_path, "-O2", "-o", str(partial), str(source_path)],
-            capture_output=True, text=True, check=False,
-        )  # fmt: skip
-        if done.returncode != 0:
-            raise SystemExit(f"bench api --native: {compiler_path} could not build "
-                             f"{source_path.name}:\n{done.stderr.strip()}")  # fmt: skip
-        os.replace(partial, built)  # whole or not at all, when two benches build at once
-    return built
+    try:
+        return native_build.build(source_path, "bench")
+    except native_build.NativeBuildError as exc:
+        raise SystemExit(f"bench api --native: {exc.reason}") from exc
 
 
 def frames_file(directory: Path, welcome: bytes, enable: bytes, answers: Sequence[bytes]) -> Path:

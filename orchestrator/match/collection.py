@@ -341,8 +341,8 @@ class _Collection:
         if created.simulator_id is not None:
             sim_id = created.simulator_id
             self._guarded("removing the simulator", lambda: runtime.remove(sim_id))
-        if created.gated:  # the folders the robots' start gates waited in
-            shutil.rmtree(deps.options.out_dir / gate.FOLDERS, ignore_errors=True)
+        # the folders the robots' start gates waited in (also of robots never shaped)
+        shutil.rmtree(deps.options.out_dir / gate.FOLDERS, ignore_errors=True)
         for key, folder in created.log_folders.items():
             record = self.records[key]
             target = deps.options.out_dir / "teams" / record.color / str(record.number)

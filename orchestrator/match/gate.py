@@ -11,21 +11,19 @@ engine would have run them. On our 2-CPU machine eight robots with their holders
 s to start and shape, eight behind the gate 1.07-1.17 s (1.81-1.99 against 1.47-1.60 s under
 gVisor's runsc).
 
-The gate is built once per source version with the machine's C compiler (``$CC``, else ``cc``
-or ``gcc``), statically, into the user's cache; without a compiler or a static C library the
+The gate is built once per source version with the machine's C compiler, statically, into the
+user's cache (:mod:`orchestrator.native_build`); without a compiler or a static C library the
 robots start behind holders as before (said once in the log).
 """
 
 from __future__ import annotations
 
 import functools
-import hashlib
 import logging
-import os
 import shutil
-import subprocess
-import tempfile
 from pathlib import Path
+
+from orchestrator import native_build
 
 log = logging.getLogger(__name__)
 
@@ -36,49 +34,16 @@ GO = "go"  # the file whose existence lets the robot's program run
 FOLDERS = ".start-gate"  # in the match's output folder, one folder per robot (removed after)
 
 
-def _cache() -> Path:
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return Path(base) / "hlvs" / "gate"
-
-
-def compiler() -> str | None:
-    """``$CC``, else ``cc`` or ``gcc`` on the path."""
-    return os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
-
-
 @functools.cache
 def start_gate() -> Path | None:
     """The compiled gate (built now if this source version has not been), or None when it
     cannot be built here: the reason is logged once and robots start behind holders."""
-    source = SOURCE.read_bytes()
-    built = _cache() / f"start_gate-{hashlib.sha256(source).hexdigest()[:16]}"
-    if built.is_file() and os.access(built, os.X_OK):
-        return built
-    compiler_path = compiler()
-    if not compiler_path:
-        log.warning("no C compiler for the robots' start gate (set CC or install gcc): robots "
-                    "start behind network holder containers, a slower bring-up")
-        return None
     try:
-        built.parent.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryDirectory(dir=built.parent) as work:
-            partial = Path(work) / built.name
-            done = subprocess.run(
-                [compiler_path, "-static", "-O2", "-o", str(partial), str(SOURCE)],
-                capture_output=True, text=True, check=False, timeout=120,
-            )  # fmt: skip
-            if done.returncode != 0:
-                log.warning("the robots' start gate could not be built with %s (robots start "
-                            "behind network holder containers): %s", compiler_path,
-                            done.stderr.strip()[-500:])
-                return None
-            partial.chmod(0o755)
-            os.replace(partial, built)  # whole or not at all, when two matches build at once
-    except (OSError, subprocess.SubprocessError) as exc:
-        log.warning("the robots' start gate could not be built in %s (robots start behind "
-                    "network holder containers): %s", built.parent, exc)
+        return native_build.build(SOURCE, "gate", ("-static", "-O2"))
+    except native_build.NativeBuildError as exc:
+        log.warning("the robots' start gate cannot be built (robots start behind network holder "
+                    "containers, a slower bring-up): %s", exc.reason[-500:])
         return None
-    return built
 
 
 def folder(out_dir: Path, key: str) -> Path:

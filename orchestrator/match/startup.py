@@ -365,6 +365,7 @@ def _start_robot(
             deps, created, robot, n_robots, mark, gated=binary is not None)
         if applied is not None:
             created.shaping[robot.key] = applied
+        if binary is None:  # shaped in its holder (behind the gate: once started)
             mark("shaping")
         folder, scratch = made.result()
         mark("folders")
@@ -463,13 +464,13 @@ def _gated_request(deps: MatchDeps, robot: RobotPlan, request: ContainerRequest,
     """``request`` behind the start gate: on its team's network with its fixed address and
     name (what its holder had), the gate as its entry point, then the image's entry point and
     the team's command (or the image's)."""
-    launch = deps.runtime.image_launch(image)
-    if not (*launch[0], *launch[1], *(robot.command or ())):
+    prefix = (gate.TARGET, gate.DIR_TARGET, "--")
+    entrypoint, command = gate.gated_launch(prefix, robot.command,
+                                            deps.runtime.image_launch(image))
+    if entrypoint == prefix and not command:
         raise ImageError(image=robot.image or image, reason=(
             f"robot {robot.key}: the image has no entry point or command and the team "
             "configuration gives no dockerCmd: nothing to run"))
-    entrypoint, command = gate.gated_launch((gate.TARGET, gate.DIR_TARGET, "--"), robot.command,
-                                       launch)
     return replace(
         request,
         entrypoint=entrypoint,
@@ -489,9 +490,7 @@ def _shape_gated(deps: MatchDeps, robot: RobotPlan, container_id: str, n_robots:
                  team_net: layout.TeamAddresses) -> AppliedShaping | None:
     """The bandwidth limits of a robot waiting behind its gate; a robot that cannot be shaped
     is killed there, before anything of it ran."""
-    team = deps.plan.red if robot.color == "red" else deps.plan.blue
-    shaping = _shaping(deps.plan, n_robots, simulator_ip=team_net.simulator, teammate_ips=tuple(
-        team_net.robot(r.number) for r in team.robots if r != robot))
+    shaping = _dense_shaping(deps.plan, robot, n_robots, team_net)
     try:
         return deps.host.shape(deps.runtime.inspect(container_id).pid, shaping)
     except OrchestratorError:
@@ -531,7 +530,6 @@ def _dense_robot_network(deps: MatchDeps, created: Created, robot: RobotPlan, n_
                          ) -> tuple[str, layout.TeamAddresses, AppliedShaping | None]:
     """A holder on the team's network with the robot's fixed address, shaped."""
     plan = deps.plan
-    team = plan.red if robot.color == "red" else plan.blue
     subnet = created.subnets[robot.color]
     holder = layout.holder_request(
         robot, prefix=deps.prefix,
@@ -544,9 +542,15 @@ def _dense_robot_network(deps: MatchDeps, created: Created, robot: RobotPlan, n_
     deps.runtime.start(holder_id)
     pid = deps.runtime.inspect(holder_id).pid
     mark("holder")
-    shaping = _shaping(plan, n_robots, simulator_ip=subnet.simulator, teammate_ips=tuple(
-        subnet.robot(r.number) for r in team.robots if r != robot))
-    return holder_id, subnet, deps.host.shape(pid, shaping)
+    return holder_id, subnet, deps.host.shape(pid, _dense_shaping(plan, robot, n_robots, subnet))
+
+
+def _dense_shaping(plan: MatchPlan, robot: RobotPlan, n_robots: int,
+                   team_net: layout.TeamAddresses) -> RobotShaping:
+    """The limits of a robot on its team's network (its teammates at their fixed addresses)."""
+    team = plan.red if robot.color == "red" else plan.blue
+    return _shaping(plan, n_robots, simulator_ip=team_net.simulator, teammate_ips=tuple(
+        team_net.robot(r.number) for r in team.robots if r != robot))
 
 
 def _league_robot_network(
