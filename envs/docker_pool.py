@@ -6,10 +6,14 @@ Each remote is the simulator image started with ``remote --port 7700``, its port
 pool's (under the system's temporary folder) mounted into the container. The pool connects to
 that socket when it appears here (a local engine: about half the round trip of TCP over the
 bridge), else to the container's bridge address, else to the published port. Containers carry
-the project label, the role ``env-remote``, the pool id and the owner (``host:pid``):
-:meth:`DockerLauncher.close` removes a pool's containers by label, and a new pool first removes
-the containers (and socket folders) of owners that no longer run on this host (left by a killed
-process). A remote is healthy once it greets and answers ``health``.
+the project label, the role ``env-remote``, the pool id and the owner
+(``host:pid-namespace:pid:start-time``): :meth:`DockerLauncher.close` removes a pool's
+containers by label, and a new pool first removes the containers (and socket folders) of owners
+that no longer run on this host (left by a killed process). An owner is judged gone only where
+this process can see it: same host, same pid namespace (a pool in a container, or a job of a
+cluster, sharing the engine may run in another, where its live pid looks free), and no process
+of that pid with that start time (a reused pid is not the owner). A remote is healthy once it
+greets and answers ``health``.
 """
 
 from __future__ import annotations
@@ -44,8 +48,42 @@ SOCKET_NAME = "remote.sock"
 HEALTH_TIMEOUT_S = 60.0
 
 
+def _pid_namespace() -> str:
+    """The inode of this process's pid namespace ("" where /proc cannot tell)."""
+    try:
+        return str(os.stat("/proc/self/ns/pid").st_ino)
+    except OSError:
+        return ""
+
+
+def _process_start(pid: int) -> str | None:
+    """The start time of process ``pid`` (field 22 of /proc/PID/stat), None if it is gone."""
+    try:
+        raw = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return None
+    return raw.rpartition(")")[2].split()[19]
+
+
 def _owner() -> str:
-    return f"{socket.gethostname()}:{os.getpid()}"
+    pid = os.getpid()
+    return f"{socket.gethostname()}:{_pid_namespace()}:{pid}:{_process_start(pid) or ''}"
+
+
+def owner_gone(owner: str) -> bool:
+    """True only when ``owner`` (a container's owner label) certainly no longer runs: it ran on
+    this host, in this pid namespace, and no process has its pid and start time. An owner this
+    process cannot see (another host, another pid namespace, an unreadable label) is alive."""
+    parts = owner.split(":")
+    if len(parts) == 2:  # host:pid, the label of earlier versions
+        host, pid = parts
+        return host == socket.gethostname() and pid.isdigit() and not _pid_alive(int(pid))
+    if len(parts) != 4:
+        return False
+    host, namespace, pid, start = parts
+    if host != socket.gethostname() or not namespace or namespace != _pid_namespace():
+        return False
+    return pid.isdigit() and bool(start) and _process_start(int(pid)) != start
 
 
 def _pid_alive(pid: int) -> bool:
@@ -103,12 +141,10 @@ class DockerLauncher:
                 LABEL_OWNER: _owner(), **self.extra_labels}  # fmt: skip
 
     def _remove_orphans(self) -> None:
-        host = socket.gethostname()
         for c in self.client.containers.list(all=True, filters={"label": f"{LABEL_ROLE}={ROLE}"}):
             owner = c.labels.get(LABEL_OWNER, "")
-            owner_host, _, pid = owner.rpartition(":")
-            if owner_host == host and pid.isdigit() and not _pid_alive(int(pid)):
-                log.info("removing remote %s left by process %s", c.name, pid)
+            if owner_gone(owner):
+                log.info("removing remote %s left by process %s (gone)", c.name, owner)
                 self._remove(c.id)
                 pool = c.labels.get(LABEL_POOL, "")
                 for folder in Path(tempfile.gettempdir()).glob(f"hlvs-env-{pool}-*"):
@@ -183,7 +219,13 @@ class DockerLauncher:
             cause = self.diagnose(index)
             if cause is not None:
                 raise RemoteStartFailed(address=cid[:12], reason=cause)
-            for address in self._candidates(cid):
+            try:
+                candidates = self._candidates(cid)
+            except docker.errors.NotFound:  # between the diagnosis and the listing
+                raise RemoteStartFailed(
+                    address=cid[:12], reason="its container was removed while it started"
+                ) from None
+            for address in candidates:
                 try:
                     probe(address)
                 except (OSError, WireError) as exc:

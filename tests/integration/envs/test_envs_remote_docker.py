@@ -3,13 +3,21 @@ by label at close (real Docker engine, the project's simulator image)."""
 
 from __future__ import annotations
 
+import contextlib
+import os
+import socket
+import subprocess
+import sys
+from pathlib import Path
+
 import docker
+import docker.errors
 import gymnasium as gym
 import numpy as np
 import pytest
 
 import envs  # noqa: F401
-from envs import RemoteCrashed
+from envs import RemoteCrashed, docker_pool
 from envs.docker_pool import LABEL_POOL
 from envs.vector import make_vector
 
@@ -67,3 +75,72 @@ def test_vector_env_over_two_remotes(docker_client: docker.DockerClient) -> None
     finally:
         vec.close()
     assert _pool_containers(docker_client, pool_id) == []
+
+
+_FOREIGN_OWNER = """
+import os, sys, time
+with open("/proc/sys/kernel/ns_last_pid", "w") as f:
+    f.write(str(int(sys.argv[1]) - 1))
+if os.fork() == 0:
+    from envs.docker_pool import _owner
+    print(_owner(), flush=True)
+    time.sleep(120)
+    os._exit(0)
+os.wait()
+"""
+
+
+def test_a_new_pool_removes_remotes_of_ended_owners_only(
+    docker_client: docker.DockerClient,
+) -> None:
+    """A new pool removes the remotes a killed process left, and leaves those of a live owner
+    it cannot see: a process in another pid namespace sharing the engine (a pool in a
+    container, a cluster job), whose pid may be free in this one."""
+    # a live pool's owner in a pid namespace of its own, with a pid that is free in this one
+    free = next(p for p in range(int(Path("/proc/sys/kernel/pid_max").read_text()) - 1, 300, -1)
+                if not Path(f"/proc/{p}").exists())
+    other = subprocess.Popen(
+        ["unshare", "--pid", "--fork", "--mount-proc", sys.executable, "-c", _FOREIGN_OWNER,
+         str(free)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        cwd=Path(__file__).resolve().parents[3],
+    )  # fmt: skip
+    assert other.stdout is not None
+    foreign = other.stdout.readline().strip()
+    if not foreign:
+        other.wait()
+        pytest.skip(f"no pid namespace of its own here: {other.stderr.read()[-200:]}")
+    try:
+        _only_ended_owners_removed(docker_client, foreign, free)
+    finally:
+        other.kill()
+        other.wait()
+
+
+def _only_ended_owners_removed(client: docker.DockerClient, foreign: str, free: int) -> None:
+    assert foreign.split(":")[1] != docker_pool._pid_namespace()
+    assert foreign.split(":")[2] == str(free) and not Path(f"/proc/{free}").exists()
+    child = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(30)"])
+    start = docker_pool._process_start(child.pid)
+    child.kill()
+    child.wait()
+    ended = f"{socket.gethostname()}:{docker_pool._pid_namespace()}:{child.pid}:{start}"
+    image = client.images.list(name="hlvs-runner/simulator")[0].id
+    made = {}
+    for name, owner in (("foreign", foreign), ("ended", ended)):
+        made[name] = client.containers.create(
+            image, command=["true"], name=f"hlvs-env-test-{name}-{os.getpid()}",
+            labels={docker_pool.LABEL_PROJECT: "1", docker_pool.LABEL_ROLE: docker_pool.ROLE,
+                    docker_pool.LABEL_POOL: f"test{name}{os.getpid()}",
+                    docker_pool.LABEL_OWNER: owner},
+        )  # fmt: skip
+    launcher = docker_pool.DockerLauncher(image=image, unix=False)
+    try:
+        role = f"{docker_pool.LABEL_ROLE}={docker_pool.ROLE}"
+        left = {c.id for c in client.containers.list(all=True, filters={"label": role})}
+        assert made["foreign"].id in left  # its owner runs, out of this process's sight
+        assert made["ended"].id not in left  # its owner ended here
+    finally:
+        launcher.close()
+        for container in made.values():
+            with contextlib.suppress(docker.errors.NotFound):
+                container.remove(force=True)
