@@ -26,7 +26,7 @@ from typing import IO
 from cluster import JobState, JobStatus, MatchJob
 from cluster.errors import PoolError
 from cluster.nodes import NodeJob, PoolNode
-from contracts import files
+from contracts import files, process
 from orchestrator import open_private_append, write_private
 
 log = logging.getLogger(__name__)
@@ -37,14 +37,8 @@ LOG_FILE = "orchestrator.log"
 
 def process_start_time(pid: int) -> int | None:
     """The kernel's start time of ``pid`` (clock ticks since boot), None when it is gone."""
-    try:
-        stat = Path(f"/proc/{pid}/stat").read_text()
-    except OSError:
-        return None
-    fields = stat.rsplit(")", 1)[1].split()
-    if fields[0] == "Z":  # exited, not yet reaped
-        return None
-    return int(fields[19])
+    start = process.start_time(pid)
+    return None if start is None else int(start)
 
 
 def _memory_mb() -> tuple[int, int | None]:

@@ -10,6 +10,8 @@ it; installs on its own from ``contracts/pyproject.toml``.
   mirror; :mod:`contracts.field`: the field dimensions.
 - :mod:`contracts.robot_api`: the robot API's protobuf messages (the league's ``messages.proto``).
 - :mod:`contracts.webhooks`: how a signed webhook is signed and checked.
+- :mod:`contracts.process`: a process named so that others tell surely that it ended (host,
+  pid namespace, pid, start time): the owners of matches and of environment remotes.
 - :mod:`contracts.codec`: the one JSON reader/writer; every top-level document has a ``version``
   and ``from_json`` refuses versions it does not know (:class:`contracts.errors.UnknownVersion`).
 
@@ -23,7 +25,7 @@ from typing import TYPE_CHECKING
 from contracts.lazy import lazy_exports
 
 if TYPE_CHECKING:
-    from contracts import files, gamecontroller, telemetry, webhooks
+    from contracts import files, gamecontroller, process, telemetry, webhooks
     from contracts.codec import from_data, to_data
     from contracts.errors import ContractError, ProtocolError
     from contracts.field import ADULT_FIELD, KID_FIELD, FieldClass, FieldGeometry, field_for
@@ -204,6 +206,7 @@ __all__ = [
     "huge_integers",
     "parse_int",
     "played_enough",
+    "process",
     "telemetry",
     "timing_problem",
     "to_data",
@@ -215,7 +218,7 @@ __all__ = [
 
 if not TYPE_CHECKING:
     __getattr__, __dir__ = lazy_exports(__name__, {
-        "contracts": ("files", "gamecontroller", "telemetry", "webhooks"),
+        "contracts": ("files", "gamecontroller", "process", "telemetry", "webhooks"),
         "contracts.codec": ("from_data", "to_data"),
         "contracts.errors": ("ContractError", "ProtocolError"),
         "contracts.field": ("ADULT_FIELD", "KID_FIELD", "FieldClass", "FieldGeometry", "field_for"),

@@ -31,6 +31,7 @@ from pathlib import Path
 import docker
 import docker.errors
 
+from contracts import process
 from envs.errors import RemoteStartFailed
 from envs.remote import RemoteAddress, probe
 from envs.wire import WireError
@@ -48,26 +49,10 @@ SOCKET_NAME = "remote.sock"
 HEALTH_TIMEOUT_S = 60.0
 
 
-def _pid_namespace() -> str:
-    """The inode of this process's pid namespace ("" where /proc cannot tell)."""
-    try:
-        return str(os.stat("/proc/self/ns/pid").st_ino)
-    except OSError:
-        return ""
-
-
-def _process_start(pid: int) -> str | None:
-    """The start time of process ``pid`` (field 22 of /proc/PID/stat), None if it is gone."""
-    try:
-        raw = Path(f"/proc/{pid}/stat").read_text()
-    except OSError:
-        return None
-    return raw.rpartition(")")[2].split()[19]
-
-
 def _owner() -> str:
     pid = os.getpid()
-    return f"{socket.gethostname()}:{_pid_namespace()}:{pid}:{_process_start(pid) or ''}"
+    start = process.start_time(pid) or ""
+    return f"{socket.gethostname()}:{process.pid_namespace()}:{pid}:{start}"
 
 
 def owner_gone(owner: str) -> bool:
@@ -81,9 +66,8 @@ def owner_gone(owner: str) -> bool:
     if len(parts) != 4:
         return False
     host, namespace, pid, start = parts
-    if host != socket.gethostname() or not namespace or namespace != _pid_namespace():
-        return False
-    return pid.isdigit() and bool(start) and _process_start(int(pid)) != start
+    return pid.isdigit() and process.ended(hostname=host, namespace=namespace, pid=int(pid),
+                                           start=start)
 
 
 def _pid_alive(pid: int) -> bool:

@@ -20,6 +20,7 @@ from collections.abc import Iterator
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from contracts import process
 from orchestrator.errors import OrchestratorError
 from orchestrator.filelock import held
 from orchestrator.match.logfs import safe_name, state_dir
@@ -49,6 +50,7 @@ class RunRecord:
     hostname: str
     out_dir: str
     started_unix_s: float
+    pid_namespace: str = ""  # the inode of its pid namespace ("": written before it was kept)
 
     @classmethod
     def from_json(cls, data: object) -> RunRecord | None:
@@ -59,6 +61,7 @@ class RunRecord:
                 match_id=str(data["match_id"]), run_id=str(data["run_id"]), pid=int(data["pid"]),
                 pid_start=str(data["pid_start"]), hostname=str(data["hostname"]),
                 out_dir=str(data["out_dir"]), started_unix_s=float(data["started_unix_s"]),
+                pid_namespace=str(data.get("pid_namespace", "")),
             )
         except (KeyError, TypeError, ValueError):
             return None
@@ -73,21 +76,15 @@ def record_path(match_id: str) -> Path:
     return runs_dir() / f"{safe_name(match_id)}-{digest}.json"
 
 
-def process_start(pid: int) -> str | None:
-    """The start time of process ``pid`` (field 22 of /proc/PID/stat), None if it is gone."""
-    try:
-        raw = Path(f"/proc/{pid}/stat").read_text()
-    except OSError:
-        return None
-    return raw.rpartition(")")[2].split()[19]
-
-
 def owner_alive(record: RunRecord) -> bool:
-    """True while the orchestrator that wrote ``record`` runs (or runs on another host, where
-    this host cannot tell)."""
-    if record.hostname != socket.gethostname():
-        return True
-    return process_start(record.pid) == record.pid_start
+    """True while the orchestrator that wrote ``record`` runs, or runs where this process cannot
+    tell (another host, another pid namespace: an orchestrator in a container or a cluster job
+    sharing the state folder, whose pid may be free or someone else's here)."""
+    if not record.pid_namespace:  # a record of an earlier version: host, pid and start time
+        return record.hostname != socket.gethostname() or \
+            process.start_time(record.pid) == record.pid_start
+    return not process.ended(hostname=record.hostname, namespace=record.pid_namespace,
+                             pid=record.pid, start=record.pid_start)  # fmt: skip
 
 
 def read(match_id: str) -> RunRecord | None:
@@ -136,9 +133,10 @@ def claim(match_id: str, out_dir: Path) -> Iterator[Claim]:
     owns it. The previous owner's record (dead) is handed back for salvage."""
     pid = os.getpid()
     record = RunRecord(
-        match_id=match_id, run_id=uuid.uuid4().hex, pid=pid, pid_start=process_start(pid) or "",
+        match_id=match_id, run_id=uuid.uuid4().hex, pid=pid,
+        pid_start=process.start_time(pid) or "",
         hostname=socket.gethostname(), out_dir=str(out_dir.resolve()),
-        started_unix_s=time.time(),
+        started_unix_s=time.time(), pid_namespace=process.pid_namespace(),
     )
     with _locked():
         previous = read(match_id)

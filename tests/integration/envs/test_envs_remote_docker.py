@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 import envs  # noqa: F401
+from contracts import process
 from envs import RemoteCrashed, docker_pool
 from envs.docker_pool import LABEL_POOL
 from envs.vector import make_vector
@@ -117,13 +118,13 @@ def test_a_new_pool_removes_remotes_of_ended_owners_only(
 
 
 def _only_ended_owners_removed(client: docker.DockerClient, foreign: str, free: int) -> None:
-    assert foreign.split(":")[1] != docker_pool._pid_namespace()
+    assert foreign.split(":")[1] != process.pid_namespace()
     assert foreign.split(":")[2] == str(free) and not Path(f"/proc/{free}").exists()
     child = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(30)"])
-    start = docker_pool._process_start(child.pid)
+    start = process.start_time(child.pid)
     child.kill()
     child.wait()
-    ended = f"{socket.gethostname()}:{docker_pool._pid_namespace()}:{child.pid}:{start}"
+    ended = f"{socket.gethostname()}:{process.pid_namespace()}:{child.pid}:{start}"
     image = client.images.list(name="hlvs-runner/simulator")[0].id
     made = {}
     for name, owner in (("foreign", foreign), ("ended", ended)):

@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 import envs.docker_pool as docker_pool
+from contracts import process
 from envs.docker_pool import DockerLauncher
 from envs.remote import RemoteAddress
 from envs.wire import WireError
@@ -84,7 +85,7 @@ def _ended_process() -> tuple[int, str]:
     import sys
 
     child = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(30)"])
-    start = docker_pool._process_start(child.pid)
+    start = process.start_time(child.pid)
     child.kill()
     child.wait()
     assert start is not None
@@ -96,11 +97,11 @@ def test_an_owner_is_gone_only_where_this_process_can_see_it(
     import os
     import socket
 
-    host, namespace = socket.gethostname(), docker_pool._pid_namespace()
+    host, namespace = socket.gethostname(), process.pid_namespace()
     assert namespace  # /proc tells this process's pid namespace
     me = docker_pool._owner()
     assert me.split(":") == [host, namespace, str(os.getpid()),
-                             docker_pool._process_start(os.getpid())]
+                             process.start_time(os.getpid())]
     assert not docker_pool.owner_gone(me)
 
     pid, start = _ended_process()
@@ -116,5 +117,6 @@ def test_an_owner_is_gone_only_where_this_process_can_see_it(
     for odd in ("", "garbage", f"{host}:{namespace}:x:{start}", f"{host}:{namespace}:{pid}:"):
         assert not docker_pool.owner_gone(odd), odd
     # where /proc cannot tell the namespace, nothing is judged gone
-    monkeypatch.setattr(docker_pool, "_pid_namespace", lambda: "")
     assert not docker_pool.owner_gone(f"{host}::{pid}:{start}")
+    monkeypatch.setattr(process, "pid_namespace", lambda: "")
+    assert not docker_pool.owner_gone(f"{host}:{namespace}:{pid}:{start}")

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from contracts import process
 from orchestrator.match import ownership
 from orchestrator.match.cleanup import cleanup, plan_cleanup
 from orchestrator.match.fake import FakeHost, FakeRuntime
@@ -29,7 +30,8 @@ def state(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
 def _dead_record(match_id: str, out: Path) -> RunRecord:
     record = RunRecord(match_id=match_id, run_id=f"run-{match_id}", pid=os.getpid(),
                        pid_start="0", hostname=socket.gethostname(), out_dir=str(out),
-                       started_unix_s=0.0)  # pid_start 0: this pid is some other process now
+                       started_unix_s=0.0, pid_namespace=process.pid_namespace(),
+                       )  # pid_start 0: this pid is some other process now
     ownership.runs_dir().mkdir(parents=True, exist_ok=True)
     ownership.record_path(match_id).write_text(json.dumps(asdict(record)))
     return record
@@ -99,6 +101,27 @@ def test_cleanup_touches_only_dead_matches_and_salvages_their_logs(tmp_path: Pat
 def test_a_record_from_another_host_counts_as_alive(tmp_path: Path) -> None:
     record = replace(_dead_record("far", tmp_path), hostname="elsewhere")
     assert ownership.owner_alive(record)
+
+
+def test_a_record_from_another_pid_namespace_counts_as_alive(tmp_path: Path) -> None:
+    """An orchestrator in a container (or a cluster job) sharing the state folder: its pid means
+    nothing here, so cleanup leaves its match alone rather than remove a running match."""
+    dead = _dead_record("boxed", tmp_path)
+    assert not ownership.owner_alive(dead)  # this namespace: judged by pid and start time
+    assert ownership.owner_alive(replace(dead, pid_namespace="4026530000"))
+    with ownership.claim("mine", tmp_path / "out") as mine:
+        assert mine.record.pid_namespace == process.pid_namespace() != ""
+        written = json.loads(ownership.record_path("mine").read_text())
+        assert written["pid_namespace"] == process.pid_namespace()
+
+
+def test_a_record_of_an_earlier_version_is_judged_by_pid_and_start_time(tmp_path: Path) -> None:
+    data = asdict(_dead_record("old", tmp_path))
+    del data["pid_namespace"]
+    old = RunRecord.from_json(data)
+    assert old is not None and old.pid_namespace == ""
+    assert not ownership.owner_alive(old)
+    assert ownership.owner_alive(replace(old, pid_start=str(process.start_time(os.getpid()))))
 
 
 def test_cleanup_leaves_a_container_that_only_carries_our_labels(tmp_path: Path) -> None:
