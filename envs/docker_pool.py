@@ -12,8 +12,8 @@ containers by label, and a new pool first removes the containers (and socket fol
 that no longer run on this host (left by a killed process). An owner is judged gone only where
 this process can see it: same host, same pid namespace (a pool in a container, or a job of a
 cluster, sharing the engine may run in another, where its live pid looks free), and no process
-of that pid with that start time (a reused pid is not the owner). A remote is healthy once it
-greets and answers ``health``.
+of that pid with that start time (a reused pid is not the owner); a cluster job's remote is left
+to its job's epilog. A remote is healthy once it greets and answers ``health``.
 """
 
 from __future__ import annotations
@@ -125,8 +125,12 @@ class DockerLauncher:
                 LABEL_OWNER: _owner(), **self.extra_labels}  # fmt: skip
 
     def _remove_orphans(self) -> None:
+        from orchestrator.engine import LABEL_SLURM_JOB
+
         for c in self.client.containers.list(all=True, filters={"label": f"{LABEL_ROLE}={ROLE}"}):
             owner = c.labels.get(LABEL_OWNER, "")
+            if LABEL_SLURM_JOB in c.labels:  # a cluster job's: its job's epilog removes it
+                continue
             if owner_gone(owner):
                 log.info("removing remote %s left by process %s (gone)", c.name, owner)
                 self._remove(c.id)

@@ -21,6 +21,7 @@ from contracts import process
 from envs import RemoteCrashed, docker_pool
 from envs.docker_pool import LABEL_POOL
 from envs.vector import make_vector
+from orchestrator.engine import LABEL_SLURM_JOB
 
 pytestmark = pytest.mark.docker
 
@@ -95,8 +96,8 @@ def test_a_new_pool_removes_remotes_of_ended_owners_only(
     docker_client: docker.DockerClient,
 ) -> None:
     """A new pool removes the remotes a killed process left, and leaves those of a live owner
-    it cannot see: a process in another pid namespace sharing the engine (a pool in a
-    container, a cluster job), whose pid may be free in this one."""
+    it cannot see (a process in another pid namespace sharing the engine: a pool in a
+    container, a cluster job; its pid may be free in this one) and those of cluster jobs."""
     # a live pool's owner in a pid namespace of its own, with a pid that is free in this one
     free = next(p for p in range(int(Path("/proc/sys/kernel/pid_max").read_text()) - 1, 300, -1)
                 if not Path(f"/proc/{p}").exists())
@@ -127,12 +128,13 @@ def _only_ended_owners_removed(client: docker.DockerClient, foreign: str, free: 
     ended = f"{socket.gethostname()}:{process.pid_namespace()}:{child.pid}:{start}"
     image = client.images.list(name="hlvs-runner/simulator")[0].id
     made = {}
-    for name, owner in (("foreign", foreign), ("ended", ended)):
+    for name, owner, more in (("foreign", foreign, {}), ("ended", ended, {}),
+                              ("job", ended, {LABEL_SLURM_JOB: "999999"})):
         made[name] = client.containers.create(
             image, command=["true"], name=f"hlvs-env-test-{name}-{os.getpid()}",
             labels={docker_pool.LABEL_PROJECT: "1", docker_pool.LABEL_ROLE: docker_pool.ROLE,
                     docker_pool.LABEL_POOL: f"test{name}{os.getpid()}",
-                    docker_pool.LABEL_OWNER: owner},
+                    docker_pool.LABEL_OWNER: owner, **more},
         )  # fmt: skip
     launcher = docker_pool.DockerLauncher(image=image, unix=False)
     try:
@@ -140,6 +142,7 @@ def _only_ended_owners_removed(client: docker.DockerClient, foreign: str, free: 
         left = {c.id for c in client.containers.list(all=True, filters={"label": role})}
         assert made["foreign"].id in left  # its owner runs, out of this process's sight
         assert made["ended"].id not in left  # its owner ended here
+        assert made["job"].id in left  # a cluster job's: its epilog removes it
     finally:
         launcher.close()
         for container in made.values():
