@@ -128,9 +128,9 @@ class DockerLauncher:
         from orchestrator.engine import LABEL_SLURM_JOB
 
         for c in self.client.containers.list(all=True, filters={"label": f"{LABEL_ROLE}={ROLE}"}):
-            owner = c.labels.get(LABEL_OWNER, "")
             if LABEL_SLURM_JOB in c.labels:  # a cluster job's: its job's epilog removes it
                 continue
+            owner = c.labels.get(LABEL_OWNER, "")
             if owner_gone(owner):
                 log.info("removing remote %s left by process %s (gone)", c.name, owner)
                 self._remove(c.id)
