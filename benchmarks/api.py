@@ -42,7 +42,7 @@ from typing import TYPE_CHECKING, Any
 
 # imported here, before the clients fork: a forked child importing it could wait forever on an
 # import lock that one of the server's threads held at the fork
-from benchmarks import api_clients, native_clients
+from benchmarks import api_clients, native_clients, neighbour
 from contracts.ids import TeamColor
 from testkit.figures import FLOOD_TARGET, TARGETS, judged
 
@@ -450,6 +450,25 @@ def _render_costs(
     }
 
 
+def _neighbour_cost(args: argparse.Namespace, robots: list[RobotId]) -> dict[str, Any] | None:
+    """The world's step with the clients' first CPU busy against idle
+    (:mod:`benchmarks.neighbour`: about 1 unless the two CPUs share a physical core now), on a
+    reference world before the API run; None where the clients share the step thread's CPUs."""
+    if not args.client_cpus:
+        return None
+    world = _world(robots, args.physics_dt, args.sensors)
+    move = _client_targets(world, robots)
+
+    def step() -> None:
+        move()
+        world.step()
+        world.snapshot()
+
+    for _ in range(WARMUP_STEPS):
+        step()
+    return neighbour.cost(step, min(args.client_cpus))
+
+
 def _bench_sim(robots: int, physics_dt: float, sim_seconds: float) -> dict[str, Any] | None:
     """The world's ``bench sim`` numbers for the same setup, when they are available."""
     try:
@@ -804,6 +823,7 @@ def _measure(
     world_rtf: float, world_cpu: float,
 ) -> dict[str, Any]:
     """The API runs asked for, and their figures against the world's alone."""
+    neighbour_cost = _neighbour_cost(args, robots)
     api = _api_run(args, camera, stalled=False)
     result: dict[str, Any] = {
         "bench": "api",
@@ -837,6 +857,9 @@ def _measure(
         "client_wait_share": api["wait_share"],
         # wake-ups of the I/O thread the step thread paid for (a pipe write each), per step
         "io_wakes_per_step": api["io_wakes_per_step"],
+        # the step's CPU time with the clients' CPU busy over idle, before the run: a quarter
+        # or more above 1 when the two virtual CPUs share a core (benchmarks.neighbour)
+        "neighbour_cost": neighbour_cost,
         "step_thread_cpus": sorted(os.sched_getaffinity(0)),
         "client_cpus": sorted(args.client_cpus) or "shared",
         "client": args.client,

@@ -20,6 +20,10 @@ kind alike), each benchmark as a child process with small sizes:
   CPUs with the server they measure), and the lockstep kinds give with them the serial floor
   of lockstep on this machine (``floor_ratio``: a C server stepping a busy loop as long as the
   world's step with the same clients; ``of_floor``: the API run's ratio over it);
+- each ``bench api`` kind without cameras gives ``neighbour_ratio``: the world's step with the
+  clients' CPU busy over idle, timed before the run (:mod:`benchmarks.neighbour`): about 1,
+  unless the machine's two virtual CPUs share a physical core at the time, which slows the
+  step thread whenever the clients' CPU is busy (pipelined stepping most);
 - ``cameras``: ``bench api --mode async`` with every robot's camera at 320x240 every 32 ms,
   rendered as a match renders them (``render_processes``: worker processes on the CPU
   renderer, one per CPU; 0: one thread) (the real-time factor is the figure: rendering is most
@@ -139,6 +143,7 @@ def _api_figures(result: dict[str, Any]) -> dict[str, Any]:
         "native_clients": result.get("native_clients"),
         "floor_ratio": (result.get("lockstep_floor") or {}).get("ratio"),
         "of_floor": (result.get("lockstep_floor") or {}).get("of_floor"),
+        "neighbour_ratio": (result.get("neighbour_cost") or {}).get("ratio"),
     }
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 
@@ -34,6 +35,12 @@ def test_bench_api_lockstep_reports_every_figure(mode: str) -> None:
         value = result[key]
         assert isinstance(value, float) and value > 0, key
     assert result["round_trip_p50_ms"] is not None
+    cost = result["neighbour_cost"]  # the step beside a busy clients' CPU, timed before the run
+    if len(os.sched_getaffinity(0)) >= 2:
+        assert isinstance(cost, dict) and cost["idle_us"] > 0 and cost["busy_us"] > 0, cost
+        assert cost["ratio"] == pytest.approx(cost["busy_us"] / cost["idle_us"], rel=0.01)
+    else:
+        assert cost is None  # the clients share the step thread's CPU: nothing to keep busy
 
 
 @pytest.mark.slow
@@ -42,6 +49,7 @@ def test_bench_api_camera_and_stalled_client() -> None:
         "--mode", "async", "--camera", "320x240@32", "--sim-seconds", "0.25", "--stalled-client"
     )
     assert result["camera_robots"] == 2
+    assert result["neighbour_cost"] is None  # with cameras every CPU is shared: none to keep busy
     assert isinstance(result["camera_frames"], int) and result["camera_frames"] >= 8
     bare, ours = result["bare_render_ms_per_frame"], result["camera_path_ms_per_frame"]
     assert isinstance(bare, float) and isinstance(ours, float) and bare > 0 and ours > 0

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 
@@ -51,6 +52,12 @@ def test_report_runs_the_kinds_and_judges_medians_against_targets() -> None:
     assert 0 <= pipelined["median"]["client_wait_share"] < 1
     # this machine has a C compiler (make setup installs one): the compiled clients ran
     assert all(run["native_clients"] is True for run in pipelined["runs"])
+    # the step beside a busy clients' CPU over an idle one, each run (None on one CPU)
+    neighbours = [run["neighbour_ratio"] for run in pipelined["runs"]]
+    if len(os.sched_getaffinity(0)) >= 2:
+        assert all(isinstance(x, float) and 0.5 < x < 3 for x in neighbours), neighbours
+    else:
+        assert neighbours == [None, None]
 
 
 def test_steal_share_is_the_stolen_part_of_the_cpus_ticks_between_two_readings() -> None:

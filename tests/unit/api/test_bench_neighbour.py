@@ -1,0 +1,40 @@
+"""``benchmarks.neighbour``: a step timed with the clients' CPU idle and busy, alternated."""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+import os
+
+import pytest
+
+from benchmarks import neighbour
+
+
+def _work() -> None:
+    total = 0
+    for i in range(2_000):
+        total += i * i
+
+
+@pytest.mark.skipif(len(os.sched_getaffinity(0)) < 2, reason="needs a second CPU to keep busy")
+def test_the_step_is_timed_idle_and_busy_and_the_spinner_ends() -> None:
+    cpus = sorted(os.sched_getaffinity(0))
+    before = set(mp.active_children())
+    os.sched_setaffinity(0, {cpus[0]})
+    try:
+        result = neighbour.cost(_work, cpus[1], rounds=4, chunk=300)
+    finally:
+        os.sched_setaffinity(0, set(cpus))
+    idle, busy, ratio = result["idle_us"], result["busy_us"], result["ratio"]
+    assert idle is not None and busy is not None and ratio is not None
+    assert idle > 0 and busy > 0
+    assert ratio == pytest.approx(busy / idle, rel=0.01)
+    # the busy chunks had a busy CPU beside them (clock ticks of 10 ms: a coarse figure)
+    share = result["spinner_share"]
+    assert share is not None and 0.5 < share < 1.6, share
+    assert set(mp.active_children()) == before  # the spinner is gone
+
+
+def test_rounds_and_chunks_must_be_positive() -> None:
+    with pytest.raises(ValueError, match="at least 1"):
+        neighbour.cost(_work, 0, rounds=0)
