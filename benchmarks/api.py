@@ -42,8 +42,9 @@ from typing import TYPE_CHECKING, Any
 
 # imported here, before the clients fork: a forked child importing it could wait forever on an
 # import lock that one of the server's threads held at the fork
-from benchmarks import api_clients, native_clients, neighbour
+from benchmarks import api_clients, native_clients
 from contracts.ids import TeamColor
+from testkit import neighbour
 from testkit.figures import FLOOD_TARGET, TARGETS, judged
 
 if TYPE_CHECKING:
@@ -452,7 +453,7 @@ def _render_costs(
 
 def _neighbour_cost(args: argparse.Namespace, robots: list[RobotId]) -> dict[str, Any] | None:
     """The world's step with the clients' first CPU busy against idle
-    (:mod:`benchmarks.neighbour`: about 1 unless the two CPUs share a physical core now), on a
+    (:mod:`testkit.neighbour`: about 1 unless the two CPUs share a physical core now), on a
     reference world before the API run; None where the clients share the step thread's CPUs."""
     if not args.client_cpus:
         return None
@@ -858,7 +859,7 @@ def _measure(
         # wake-ups of the I/O thread the step thread paid for (a pipe write each), per step
         "io_wakes_per_step": api["io_wakes_per_step"],
         # the step's CPU time with the clients' CPU busy over idle, before the run: a quarter
-        # or more above 1 when the two virtual CPUs share a core (benchmarks.neighbour)
+        # or more above 1 when the two virtual CPUs share a core (testkit.neighbour)
         "neighbour_cost": neighbour_cost,
         "step_thread_cpus": sorted(os.sched_getaffinity(0)),
         "client_cpus": sorted(args.client_cpus) or "shared",

@@ -21,7 +21,7 @@ kind alike), each benchmark as a child process with small sizes:
   of lockstep on this machine (``floor_ratio``: a C server stepping a busy loop as long as the
   world's step with the same clients; ``of_floor``: the API run's ratio over it);
 - each ``bench api`` kind without cameras gives ``neighbour_ratio``: the world's step with the
-  clients' CPU busy over idle, timed before the run (:mod:`benchmarks.neighbour`): about 1,
+  clients' CPU busy over idle, timed before the run (:mod:`testkit.neighbour`): about 1,
   unless the machine's two virtual CPUs share a physical core at the time, which slows the
   step thread whenever the clients' CPU is busy (pipelined stepping most);
 - ``cameras``: ``bench api --mode async`` with every robot's camera at 320x240 every 32 ms,

@@ -1,4 +1,4 @@
-"""``benchmarks.neighbour``: a step timed with the clients' CPU idle and busy, alternated."""
+"""``testkit.neighbour``: a step timed with the clients' CPU idle and busy, alternated."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import os
 
 import pytest
 
-from benchmarks import neighbour
+from testkit import neighbour
 
 
 def _work() -> None:

@@ -1,4 +1,4 @@
-"""What a busy CPU beside the step thread costs the step: the ``neighbour`` figure of
+"""What a busy CPU beside the step thread costs the step: the ``neighbour_cost`` figure of
 ``bench api``.
 
 On a virtual machine two virtual CPUs can be two threads of one physical core, at some times and
