@@ -23,7 +23,8 @@ kind alike), each benchmark as a child process with small sizes:
 - each ``bench api`` kind without cameras gives ``neighbour_ratio``: the world's step with the
   clients' CPU busy over idle, timed before the run (:mod:`testkit.neighbour`): about 1,
   unless the machine's two virtual CPUs share a physical core at the time, which slows the
-  step thread whenever the clients' CPU is busy (pipelined stepping most);
+  step thread whenever the clients' CPU is busy (pipelined stepping most); ``shared_core_runs``
+  counts the kind's runs timed so (ratio 1.15 or more);
 - ``cameras``: ``bench api --mode async`` with every robot's camera at 320x240 every 32 ms,
   rendered as a match renders them (``render_processes``: worker processes on the CPU
   renderer, one per CPU; 0: one thread) (the real-time factor is the figure: rendering is most
@@ -63,6 +64,7 @@ from typing import Any
 
 from benchmarks import native_clients
 from contracts import files
+from testkit import neighbour
 from testkit.figures import (
     MACHINE_SCALED,
     REFERENCE_BARE_REAL_TIME_FACTOR,
@@ -329,6 +331,9 @@ def run(args: argparse.Namespace, progress: Callable[[str], None]) -> dict[str, 
     for kind in kinds:
         median = medians[kind]
         entry: dict[str, Any] = {"median": median, "runs": runs[kind]}
+        neighbours = [r.get("neighbour_ratio") for r in runs[kind] if "neighbour_ratio" in r]
+        if neighbours:  # runs timed while the step thread's CPU shared a core with the clients'
+            entry["shared_core_runs"] = neighbour.shared_core_runs(neighbours)
         errors = sum(1 for r in runs[kind] if "error" in r)
         report["errors"] += errors
         target = machine_target(kind, bare)

@@ -56,6 +56,8 @@ def test_report_runs_the_kinds_and_judges_medians_against_targets() -> None:
     neighbours = [run["neighbour_ratio"] for run in pipelined["runs"]]
     if len(os.sched_getaffinity(0)) >= 2:
         assert all(isinstance(x, float) and 0.5 < x < 3 for x in neighbours), neighbours
+        shared = sum(1 for x in neighbours if x >= 1.15)
+        assert pipelined["shared_core_runs"] == shared and "shared_core_runs" not in sim
     else:
         assert neighbours == [None, None]
 

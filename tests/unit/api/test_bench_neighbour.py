@@ -38,3 +38,8 @@ def test_the_step_is_timed_idle_and_busy_and_the_spinner_ends() -> None:
 def test_rounds_and_chunks_must_be_positive() -> None:
     with pytest.raises(ValueError, match="at least 1"):
         neighbour.cost(_work, 0, rounds=0)
+
+
+def test_runs_from_the_shared_core_ratio_up_are_counted() -> None:
+    assert neighbour.shared_core_runs([0.99, None, 1.15, 1.44, 1.149]) == 2
+    assert neighbour.shared_core_runs([]) == 0
