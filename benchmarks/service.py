@@ -31,6 +31,8 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+from testkit.figures import process_cpu_s
+
 TARGET_STATUS_P99_MS = 200.0
 
 
@@ -314,9 +316,11 @@ def main(argv: Sequence[str]) -> int:
 
 
 def _cpu_s(pid: int) -> float:
-    """CPU seconds (user + system) used so far by process ``pid``."""
-    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    """CPU seconds (user + system) used so far by process ``pid``, which is running."""
+    seconds = process_cpu_s(pid)
+    if seconds is None:
+        raise RuntimeError(f"the CPU time of process {pid} cannot be read from /proc")
+    return seconds
 
 
 def _wait_ready(url: str, server: subprocess.Popen[bytes], log_path: Path) -> None:

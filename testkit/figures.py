@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import os
 import statistics
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -150,6 +151,17 @@ def steal_share(before: tuple[int, int] | None, after: tuple[int, int] | None) -
     return round((after[0] - before[0]) / (after[1] - before[1]), 3)
 
 
+def process_cpu_s(pid: int | None) -> float | None:
+    """CPU seconds (user and system) process ``pid`` has used so far, from ``/proc``; None
+    where it cannot be read (the process is gone, or no ``/proc``)."""
+    try:
+        with open(f"/proc/{pid}/stat", encoding="ascii") as stat:
+            fields = stat.read().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    except (OSError, IndexError, ValueError):
+        return None
+
+
 __all__ = [
     "FLOOD_TARGET",
     "LEAGUE_MATCH_SIM_S",
@@ -163,6 +175,7 @@ __all__ = [
     "league_match_figures",
     "machine_target",
     "median_figures",
+    "process_cpu_s",
     "report_rounds",
     "steal_share",
 ]

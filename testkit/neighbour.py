@@ -23,6 +23,8 @@ import time
 from collections.abc import Callable
 from typing import Any
 
+from testkit.figures import process_cpu_s
+
 ROUNDS = 10  # alternations of an idle and a busy chunk
 CHUNK_STEPS = 25  # steps a chunk
 SETTLE_S = 0.005  # after the spinner is switched, before the chunk is timed
@@ -66,7 +68,7 @@ def cost(step: Callable[[], None], cpu: int, rounds: int = ROUNDS,
     spent = {0: 0.0, 1: 0.0}
     busy_wall = 0.0
     try:
-        spinner_before = _cpu_s(spinner.pid)
+        spinner_before = process_cpu_s(spinner.pid)
         for _ in range(rounds):
             for state in (0, 1):
                 switched = time.perf_counter()
@@ -77,7 +79,7 @@ def cost(step: Callable[[], None], cpu: int, rounds: int = ROUNDS,
                     step()
                 spent[state] += time.thread_time() - started
                 busy_wall += (time.perf_counter() - switched) if state else 0.0
-        spinner_after = _cpu_s(spinner.pid)
+        spinner_after = process_cpu_s(spinner.pid)
     finally:
         spinner.kill()
         spinner.join(timeout=5)
@@ -92,12 +94,3 @@ def cost(step: Callable[[], None], cpu: int, rounds: int = ROUNDS,
         else None,
     }
 
-
-def _cpu_s(pid: int | None) -> float | None:
-    """CPU seconds (user and system) process ``pid`` has used, from ``/proc``; None if unread."""
-    try:
-        with open(f"/proc/{pid}/stat", encoding="ascii") as stat:
-            fields = stat.read().rsplit(")", 1)[1].split()
-    except (OSError, IndexError):
-        return None
-    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")

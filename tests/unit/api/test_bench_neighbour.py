@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import multiprocessing as mp
 import os
+import time
 
 import pytest
 
-from testkit import neighbour
+from testkit import figures, neighbour
 
 
 def _work() -> None:
@@ -43,3 +44,21 @@ def test_rounds_and_chunks_must_be_positive() -> None:
 def test_runs_from_the_shared_core_ratio_up_are_counted() -> None:
     assert neighbour.shared_core_runs([0.99, None, 1.15, 1.44, 1.149]) == 2
     assert neighbour.shared_core_runs([]) == 0
+
+
+def test_a_process_cpu_time_is_read_and_a_gone_process_has_none() -> None:
+    before = figures.process_cpu_s(os.getpid())
+    assert before is not None
+    _work_for(0.05)
+    after = figures.process_cpu_s(os.getpid())
+    assert after is not None and after >= before + 0.02  # clock ticks of 10 ms
+    child = mp.get_context("fork").Process(target=_work)
+    child.start()
+    child.join()
+    assert figures.process_cpu_s(child.pid) is None  # reaped: no /proc entry
+
+
+def _work_for(seconds: float) -> None:
+    end = time.thread_time() + seconds
+    while time.thread_time() < end:
+        _work()
