@@ -23,6 +23,9 @@ Without cameras, on a machine with two or more CPUs, the step thread runs on CPU
 measurement (the world-only and ``bench sim`` figures too) and the client processes on the
 others, as robot code runs on its own computers in the virtual league; ``--shared-cpus`` lets
 them share every CPU. (With cameras everything shares: the render thread needs a CPU too.)
+With the clients on CPUs of their own, ``neighbour_cost`` gives the world's step timed with the
+clients' first CPU busy against idle, before the run (:mod:`testkit.neighbour`): about 1, unless
+the two CPUs share a physical core at the time, which slows a pipelined run by a quarter.
 """
 
 from __future__ import annotations
