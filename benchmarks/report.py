@@ -306,6 +306,9 @@ def run(args: argparse.Namespace, progress: Callable[[str], None]) -> dict[str, 
             result = runners[kind]()
             result["load_1min"] = _load()[0]
             result["steal_share"] = steal_share(ticks, _cpu_times())
+            note = neighbour.shared_core_note(result.get("neighbour_ratio"))
+            if note:
+                progress(f"  {note}")
             runs[kind].append(result)
     report: dict[str, Any] = {
         "bench": "report",

@@ -39,6 +39,14 @@ def shared_core_runs(ratios: list[float | None]) -> int:
     return sum(1 for r in ratios if r is not None and r >= SHARED_CORE_RATIO)
 
 
+def shared_core_note(ratio: float | None) -> str | None:
+    """What to tell the reader of a run timed while the two CPUs shared a core; None else."""
+    if ratio is None or ratio < SHARED_CORE_RATIO:
+        return None
+    return (f"timed while the step thread's CPU shared a physical core with the clients' "
+            f"(neighbour ratio {ratio:.2f}): the host's placement slows this run, not our code")
+
+
 def _spin(cpu: int, busy: Any) -> None:
     """Spinner process: while ``busy`` is set, an integer loop on ``cpu``; else it sleeps."""
     os.sched_setaffinity(0, {cpu})

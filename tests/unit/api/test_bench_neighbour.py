@@ -23,16 +23,18 @@ def test_the_step_is_timed_idle_and_busy_and_the_spinner_ends() -> None:
     before = set(mp.active_children())
     os.sched_setaffinity(0, {cpus[0]})
     try:
-        result = neighbour.cost(_work, cpus[1], rounds=4, chunk=300)
+        result = neighbour.cost(_work, cpus[1], rounds=4, chunk=2000)  # 0.1 s a chunk or more
     finally:
         os.sched_setaffinity(0, set(cpus))
     idle, busy, ratio = result["idle_us"], result["busy_us"], result["ratio"]
     assert idle is not None and busy is not None and ratio is not None
     assert idle > 0 and busy > 0
     assert ratio == pytest.approx(busy / idle, rel=0.01)
-    # the busy chunks had a busy CPU beside them (clock ticks of 10 ms: a coarse figure)
+    # the spinner ran while the busy chunks were timed: about 1 on a quiet machine, less where
+    # other processes share its CPU (the suite's other worker); a spinner that only slept, as
+    # in the idle chunks, would be at a few hundredths
     share = result["spinner_share"]
-    assert share is not None and 0.5 < share < 1.6, share
+    assert share is not None and 0.15 < share < 1.6, share
     assert set(mp.active_children()) == before  # the spinner is gone
 
 
@@ -44,6 +46,12 @@ def test_rounds_and_chunks_must_be_positive() -> None:
 def test_runs_from_the_shared_core_ratio_up_are_counted() -> None:
     assert neighbour.shared_core_runs([0.99, None, 1.15, 1.44, 1.149]) == 2
     assert neighbour.shared_core_runs([]) == 0
+
+
+def test_a_run_on_a_shared_core_is_told_and_others_are_not() -> None:
+    note = neighbour.shared_core_note(1.438)
+    assert note is not None and "shared a physical core" in note and "1.44" in note
+    assert neighbour.shared_core_note(1.149) is None and neighbour.shared_core_note(None) is None
 
 
 def test_a_process_cpu_time_is_read_and_a_gone_process_has_none() -> None:
