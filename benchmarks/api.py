@@ -391,18 +391,31 @@ def _client_targets(world: Any, robots: list[RobotId]) -> Callable[[], None]:
     return move
 
 
+def _reference(
+    robots: list[RobotId], physics_dt: float, sensors: str
+) -> tuple[Any, Callable[[], None]]:
+    """A reference world and one step of it as the API run steps its own (the clients' joint
+    targets written, ``World.step``, ``snapshot``): what the API run is measured against."""
+    world = _world(robots, physics_dt, sensors)
+    move = _client_targets(world, robots)
+
+    def step() -> None:
+        move()
+        world.step()
+        world.snapshot()
+
+    return world, step
+
+
 def _world_only(
     robots: list[RobotId], physics_dt: float, sim_seconds: float, sensors: str = "league"
 ) -> tuple[float, float]:
     """(real-time factor, CPU seconds per simulated second) of World.step + snapshot."""
-    world = _world(robots, physics_dt, sensors)
-    move = _client_targets(world, robots)
+    world, step = _reference(robots, physics_dt, sensors)
     steps = int(sim_seconds * 1000 / world.step_ms)
     started, started_cpu = time.perf_counter(), time.thread_time()
     for _ in range(steps):
-        move()
-        world.step()
-        world.snapshot()
+        step()
     simulated = steps * world.step_ms / 1000.0
     wall, cpu = time.perf_counter() - started, time.thread_time() - started_cpu
     return simulated / wall, cpu / simulated
@@ -460,14 +473,7 @@ def _neighbour_cost(args: argparse.Namespace, robots: list[RobotId]) -> dict[str
     reference world before the API run; None where the clients share the step thread's CPUs."""
     if not args.client_cpus:
         return None
-    world = _world(robots, args.physics_dt, args.sensors)
-    move = _client_targets(world, robots)
-
-    def step() -> None:
-        move()
-        world.step()
-        world.snapshot()
-
+    _, step = _reference(robots, args.physics_dt, args.sensors)
     for _ in range(WARMUP_STEPS):
         step()
     return neighbour.cost(step, min(args.client_cpus))
@@ -605,15 +611,13 @@ def _api_run(
         # without cameras (whose render thread would run on), chunks of a reference world
         # (World.step + snapshot, as bench sim) alternate with chunks of the API run, so that
         # the machine's load falls on both alike: ``ratio_interleaved``
-        reference = _world(robots, args.physics_dt, args.sensors) if camera is None else None
-        move_reference = _client_targets(reference, robots) if reference is not None else None
+        reference = None if camera is not None else _reference(robots, args.physics_dt,
+                                                                 args.sensors)[1]
 
         def reference_steps(count: int) -> None:
-            assert reference is not None and move_reference is not None
+            assert reference is not None
             for _ in range(count):
-                move_reference()
-                reference.step()
-                reference.snapshot()
+                reference()
 
         if reference is not None:
             reference_steps(WARMUP_STEPS)
