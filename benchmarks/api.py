@@ -122,6 +122,10 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--prefetch", choices=("on", "off"), default="off",
                         help="lockstep: the next step's position stage computed on a worker "
                         "thread while the step waits for the answers (default off, as a match)")
+    parser.add_argument("--exchange", choices=("auto", "on", "off"), default="auto",
+                        help="plain lockstep: the steady steps' sends and reads on the compiled "
+                        "exchange thread while the step thread computes the next position stage "
+                        "(default auto: where it can run, as a match)")
     parser.add_argument("--json", action="store_true", help="print only the JSON line")
     return parser
 
@@ -543,6 +547,7 @@ def _api_run(
         lockstep=lockstep if args.mode in ("lockstep", "pipelined") else None,
         cameras=cameras,
         send_cpus=args.client_cpus or None,
+        exchange={"auto": None, "on": True, "off": False}[args.exchange],
     )
     server.start()
     ctx = mp.get_context("fork")
@@ -600,8 +605,8 @@ def _api_run(
         def one_step() -> None:
             stepping.before_step(world.sim_time_ms, world.sim_time_ms + world.step_ms)
             world.step()
-            world.snapshot()
             stepping.after_step(world.sim_time_ms)
+            world.snapshot()  # (the match loop's referee looks at it)
 
         for _ in range(WARMUP_STEPS):
             one_step()
@@ -645,6 +650,7 @@ def _api_run(
             requests_before = sum(slot.stats.messages_in for slot in server.slots.values())
         waited = stepping.waited_s
         io_wakes = server.io_wakes - wakes_before
+        exchange = server.exchange_figures
         stats = server.statistics()
     finally:
         server.close()
@@ -703,6 +709,8 @@ def _api_run(
         "cpu_s_per_sim_s": cpu / ((world.sim_time_ms - start_ms) / 1000.0),
         "wait_share": round(waited / wall, 3),
         "io_wakes_per_step": round(io_wakes / steps, 3),
+        # plain lockstep's exchange thread: steps it exchanged, answers it took and handed back
+        "exchange": exchange,
         "ratio_interleaved": round(ref_wall / wall, 3) if ref_wall else None,
         "cpu_ratio_interleaved": round(ref_cpu / cpu, 3) if ref_cpu else None,
         "connected": len(stats),
@@ -865,6 +873,7 @@ def _measure(
         "client_wait_share": api["wait_share"],
         # wake-ups of the I/O thread the step thread paid for (a pipe write each), per step
         "io_wakes_per_step": api["io_wakes_per_step"],
+        "exchange": api["exchange"],
         # the step's CPU time with the clients' CPU busy over idle, before the run: a quarter
         # or more above 1 when the two virtual CPUs share a core (testkit.neighbour)
         "neighbour_cost": neighbour_cost,

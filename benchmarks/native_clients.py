@@ -19,7 +19,7 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
-from orchestrator import native_build
+from simulator import native_build
 
 NATIVE = Path(__file__).with_name("native")
 SOURCE = NATIVE / "bench_client.c"
@@ -36,7 +36,7 @@ def binary(source_path: Path = SOURCE) -> Path:
     """The compiled client (or another of ``native/``), built now if this source version has
     not been."""
     try:
-        return native_build.build(source_path, "bench")
+        return native_build.build_native(source_path, "bench")
     except native_build.NativeBuildError as exc:
         raise SystemExit(f"bench api --native: {exc.reason}") from exc
 

@@ -21,6 +21,7 @@ from simulator.errors import (
 if TYPE_CHECKING:
     from simulator.league_tests import LeagueOutcome, LeagueTestOutcome, run_league_scenario
     from simulator.match_setup import referee_config
+    from simulator.native_build import NativeBuildError, build_native
     from simulator.traffic import read_stats
 
 __all__ = [
@@ -28,10 +29,12 @@ __all__ = [
     "LeagueOutcome",
     "LeagueTestOutcome",
     "ModelError",
+    "NativeBuildError",
     "PhysicsDivergence",
     "ReplayError",
     "SimulatorError",
     "UnknownModelError",
+    "build_native",
     "read_stats",
     "referee_config",
     "run_league_scenario",
@@ -42,5 +45,6 @@ if not TYPE_CHECKING:
     __getattr__, __dir__ = lazy_exports(__name__, {
         "simulator.league_tests": ("LeagueOutcome", "LeagueTestOutcome", "run_league_scenario"),
         "simulator.match_setup": ("referee_config",),
+        "simulator.native_build": ("NativeBuildError", "build_native"),
         "simulator.traffic": ("read_stats",),
     })

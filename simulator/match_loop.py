@@ -191,8 +191,12 @@ class MatchLoop:
         world, stepping = self.world, self.stepping
         stepping.before_step(world.sim_time_ms, world.sim_time_ms + world.step_ms)
         world.step()
-        self._referee_step(world.snapshot())
+        # the step's measurements go out first, then the referee looks at the step: its
+        # commands (a penalty's removal, a placement) reach the robots' sensors from the next
+        # step, as the league's referee acts between steps; in lockstep the robots answer
+        # while the referee, the recorder and the telemetry run
         stepping.after_step(world.sim_time_ms)
+        self._referee_step(world.snapshot())
         self.steps += 1
         if self.recorder is not None:
             self.recorder.record(world, self.referee.game_state.copy())

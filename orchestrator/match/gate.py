@@ -12,7 +12,7 @@ s to start and shape, eight behind the gate 1.07-1.17 s (1.81-1.99 against 1.47-
 gVisor's runsc).
 
 The gate is built once per source version with the machine's C compiler, statically, into the
-user's cache (:mod:`orchestrator.native_build`); without a compiler or a static C library the
+user's cache (:mod:`simulator.native_build`); without a compiler or a static C library the
 robots start behind holders as before (said once in the log).
 """
 
@@ -23,7 +23,7 @@ import logging
 import shutil
 from pathlib import Path
 
-from orchestrator import native_build
+from simulator import NativeBuildError, build_native
 
 log = logging.getLogger(__name__)
 
@@ -39,8 +39,8 @@ def start_gate() -> Path | None:
     """The compiled gate (built now if this source version has not been), or None when it
     cannot be built here: the reason is logged once and robots start behind holders."""
     try:
-        return native_build.build(SOURCE, "gate", ("-static", "-O2"))
-    except native_build.NativeBuildError as exc:
+        return build_native(SOURCE, "gate", ("-static", "-O2"))
+    except NativeBuildError as exc:
         log.warning("the robots' start gate cannot be built (robots start behind network holder "
                     "containers, a slower bring-up): %s", exc.reason[-500:])
         return None

@@ -121,28 +121,25 @@ class Connection:
         self.decoder = FrameDecoder()
         self.budget = ReadBudget(time.monotonic())
         self.max_request_bytes = MAX_REQUEST_BYTES
-        # the budget is spent: the socket is not read (nor watched) until it refills
-        self.paused = False
+        self.paused = False  # the budget is spent: not read (nor watched) until it refills
         self.measurements = 0  # queued so far (each refills the budget)
         self._paused_logged = 0.0  # when a pause was last logged (one line per 10 s)
         self.requests: list[Request] = []
-        # usual requests go there, not to ``requests``, while the target board is armed (board.py)
-        self.board: BoardPost | None = None
-        self._template: PositionTemplate | None = None
+        self.board: BoardPost | None = None  # usual requests go there while armed (board.py)
+        self.template: PositionTemplate | None = None  # the layout of its usual request
+        self.preread = b""  # received by the exchange thread and handed back: read first
         self.outbox: deque[bytes] = deque()
         self._partial: memoryview | None = None
         self.answered = False
         self.answered_at = 0.0
         self.last_sent_at: float | None = None
-        # the client's round trip seen from here (``stats.reply_s``): when the first byte of
-        # the oldest request not yet followed by a measurement arrived, and when the first
-        # byte of the frame still being received arrived
+        # the client's round trip seen from here (``stats.reply_s``): when the first byte of the
+        # oldest request not yet followed by a measurement, and of the frame being received, came
         self._request_began: float | None = None
         self._frame_began: float | None = None
         self.enqueued_at = 0.0  # monotonic time the latest measurement was queued
         self.slow = False
-        # lockstep's book of who owes an answer (None without lockstep); set by the server
-        self.book: AnswerBook | None = None
+        self.book: AnswerBook | None = None  # lockstep's (None without lockstep): the server's
         self.bank_s = time_bank_s
         self.want_write = False
         self._told = False  # a request dropped with a notice since the last read's end
@@ -173,6 +170,8 @@ class Connection:
                     break
                 if decoder.held:  # frames the budget did not pay for last time: no receive
                     data = b""
+                elif self.preread:  # (simulator.api.exchange)
+                    data, self.preread = self.preread, b""
                 else:
                     try:
                         data = self.sock.recv(RECV_CHUNK)
@@ -182,6 +181,7 @@ class Connection:
                         raise ClientClosed(f"receive failed: {exc}") from exc
                     if not data:
                         raise ClientClosed("client disconnected")
+                if data:
                     acked = False
                     self.stats.bytes_in += len(data)
                     taken += len(data)
@@ -246,7 +246,7 @@ class Connection:
         board; returns how many answered (all but those over the size limit)."""
         if _onto_board(self, frames):
             return 1
-        template = self._template
+        template = self.template
         decoded: list[Request] = []
         answers = 0
         for frame in frames:
@@ -266,7 +266,7 @@ class Connection:
                 decoded.append(targets)
             else:
                 decoded.append(self._parse(frame))
-                template = self._template
+                template = self.template
         if decoded:
             with self.requests_lock:
                 board = self.board
@@ -353,7 +353,7 @@ class Connection:
         if request.motor_positions and len(request.ListFields()) == 1:
             template = scan_positions(frame)
             if template is not None:
-                self._template = template
+                self.template = template
         return request
 
     # --- writing ----------------------------------------------------------------------------
@@ -487,7 +487,7 @@ def _onto_board(conn: Connection, frames: list[bytes]) -> bool:
     its span (no request object made: :meth:`BoardPost.post_values`), when it has the layout
     of the connection's template, every target is finite and nothing is queued before it;
     False otherwise (the caller takes it the usual way)."""
-    template = conn._template
+    template = conn.template
     if len(frames) != 1 or template is None or conn.board is None:
         return False
     frame = frames[0]
@@ -499,6 +499,53 @@ def _onto_board(conn: Connection, frames: list[bytes]) -> bool:
     with conn.requests_lock:
         span = conn.board
         return span is not None and not conn.requests and span.post_values(template.names, values)
+
+
+def sent_elsewhere(conn: Connection, now: float) -> None:
+    """A measurement is being written to ``conn``'s socket by plain lockstep's exchange thread
+    (:mod:`simulator.api.exchange`): counted and owed as :meth:`Connection.send` counts and
+    owes one; :func:`written_elsewhere` or :func:`exchanged` when the thread is done."""
+    conn.measurements += 1
+    conn.owe()
+    conn.last_sent_at = now
+    conn.enqueued_at = now
+    conn.stats.messages_out += 1
+
+
+def written_elsewhere(conn: Connection, sent: int, rest: memoryview, at: float) -> None:
+    """The exchange thread wrote ``sent`` bytes of the measurement at ``at``; ``rest`` (copied)
+    is what the socket did not take, written by :meth:`Connection.flush`."""
+    conn.stats.bytes_out += sent
+    if rest:
+        conn._partial = memoryview(bytes(rest))
+        conn.want_write = True
+    else:
+        conn._written(at)
+
+
+def exchanged(conn: Connection, sent: int, sent_at: float, received: int, first_at: float,
+              answered_at: float) -> None:  # fmt: skip
+    """The exchange thread wrote the whole measurement (``sent`` bytes, at ``sent_at``) and
+    took one usual request of ``received`` bytes onto the board, whose first bytes arrived at
+    ``first_at`` and its last at ``answered_at``: counted and answered as
+    :meth:`Connection.send` and :meth:`Connection.read` count and answer them. Its budget is
+    not charged: one frame answering one measurement is what the budget's refill per
+    measurement always pays for."""
+    stats = conn.stats
+    stats.bytes_out += sent
+    began = conn._request_began
+    if began is not None:  # (:meth:`Connection._written`)
+        stats.reply_s.append(sent_at - began)
+    conn._request_began = first_at
+    conn.last_sent_at = None
+    stats.bytes_in += received
+    stats.messages_in += 1
+    conn.answered = True
+    conn.answered_at = answered_at
+    book = conn.book
+    if book is not None:
+        book.owing.discard(conn)
+    stats.round_trip_s.append(answered_at - sent_at)
 
 
 def monotonic() -> float:

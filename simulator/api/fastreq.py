@@ -52,11 +52,11 @@ class Notice:
 class PositionTemplate:
     """The wire layout of one request made of ``motor_positions`` only."""
 
-    __slots__ = ("names", "size", "_fixed", "_unpack")
+    __slots__ = ("names", "size", "fixed", "_unpack")
 
     def __init__(self, names: tuple[str, ...], fixed: tuple[bytes, ...]) -> None:
         self.names = names
-        self._fixed = fixed
+        self.fixed = fixed  # the wire bytes before each target, in order
         layout = struct.Struct("<" + "".join(f"{len(segment)}sd" for segment in fixed))
         self._unpack = layout.unpack
         self.size = layout.size
@@ -66,7 +66,7 @@ class PositionTemplate:
         if len(frame) != self.size:
             return None
         parts = self._unpack(frame)
-        if parts[0::2] != self._fixed:
+        if parts[0::2] != self.fixed:
             return None
         values: tuple[float, ...] = parts[1::2]
         return values

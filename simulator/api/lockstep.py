@@ -30,10 +30,12 @@ def wait_lockstep(server: ApiServer, settings: LockstepSettings) -> float:
     catching up) only once it has passed or while some client is slow."""
     book = server.answers
     assert book is not None, "lockstep without the server's lockstep settings"
+    start = time.monotonic()
+    if server.settle_exchange(settings.deadline_s):  # the exchange thread took every answer
+        return time.monotonic() - start
     owing = book.owing
     if not owing and not book.slow:  # every client answered before the wait (pipelined)
         return 0.0
-    start = time.monotonic()
     deadline = settings.deadline_s
     due = start + deadline  # the earliest any client's free time ends
     server.awaiting_answers = True  # before the book is read: an answer after wakes the poll

@@ -21,7 +21,8 @@ from contracts import NetworkSpec, RobotId
 from contracts.robot_api import messages_pb2 as pb
 from simulator.api.batch import Gathered, StepBatch
 from simulator.api.cameras import MAX_IN_FLIGHT, ImageSource
-from simulator.api.connection import ClientClosed, Connection
+from simulator.api.connection import ClientClosed, Connection, sent_elsewhere
+from simulator.api.exchange import Exchange
 from simulator.api.framing import HEADER
 from simulator.api.measurement import Measurement
 from simulator.api.ports import Ports
@@ -59,6 +60,7 @@ class Outbox:
 
     def hold_notice(self, time_ms: int, text: str) -> int:
         """See :meth:`ApiServer.hold_notice`."""
+        self._ports.count_owed()
         real_time = self._unix_ms()
         now = time.monotonic()
         told = 0
@@ -78,6 +80,7 @@ class Outbox:
     def publish(self, prepared: Prepared) -> None:
         """Queue measurements made by :meth:`ApiServer.prepare` (a client dropped meanwhile
         gets none)."""
+        self._ports.settle(0.0)  # (plain lockstep: the exchange's last step is over)
         steady = prepared.steady
         if steady is not None:
             if steady.step.connection_changes == self._ports.connection_changes:
@@ -90,6 +93,7 @@ class Outbox:
             # blocking sends, or a client left since: robot by robot
             assert self._batch is not None  # (a steady step is only recorded with the batch)
             prepared = Prepared(steady.measurements(self._batch))
+        self._ports.count_owed()
         jobs_all = []
         now = time.monotonic()
         unwritten = prepared.unwritten
@@ -141,9 +145,18 @@ class Outbox:
         real_time = steady.real_time
         now = time.monotonic()
         frames, spans = steady.frames_in_place(self._batch)
+        admitted = 0
+        exchange = self._ports.exchange
+        if exchange is not None:
+            admitted = self._exchange_steady(exchange, steady, frames, spans, now)
+            if admitted < 0:
+                return
+            exchange.count_owed()
         behind: list[RobotSlot] = []
-        for slot, conn, (start, end) in zip(step.slots, step.conns, spans, strict=True):
-            if slot.quota.admit(end - start - HEADER.size, real_time):
+        for index, (slot, conn, (start, end)) in enumerate(
+            zip(step.slots, step.conns, spans, strict=True)
+        ):
+            if index < admitted or slot.quota.admit(end - start - HEADER.size, real_time):
                 frame = frames[start:end]
             else:
                 frame = memoryview(self._quota_error(slot, steady.time_ms, real_time))
@@ -157,6 +170,28 @@ class Outbox:
         for slot in behind:
             if slot.conn is not None:
                 self._ports.flush(slot)
+
+    def _exchange_steady(
+        self, exchange: Exchange, steady: SteadyValues, frames: memoryview,
+        spans: tuple[tuple[int, int], ...], now: float,
+    ) -> int:
+        """Plain lockstep with the exchange thread (:mod:`simulator.api.exchange`): hand it
+        the step's frames when every frame is within its quota and :meth:`Exchange.begin`
+        takes them; -1 when it did. Otherwise the number of robots whose frame the quota
+        already admitted (sent here)."""
+        step = steady.step
+        real_time = steady.real_time
+        admitted = 0
+        for slot, (start, end) in zip(step.slots, spans, strict=True):
+            if not slot.quota.admit(end - start - HEADER.size, real_time):
+                return admitted
+            admitted += 1
+        if not exchange.begin(step.slots, step.conns, frames, spans):
+            return admitted
+        exchange.count_owed()  # the last exchange's, while this one is under way
+        for conn in step.conns:
+            sent_elsewhere(conn, now)
+        return -1
 
     def _send(
         self, slot: RobotSlot, conn: Connection, measurement: Measurement, now: float

@@ -26,6 +26,7 @@ from referee import SpoofingLog
 from simulator.api.connection import AnswerBook, ClientClosed, Connection
 from simulator.api.devices import DeviceWorld
 from simulator.api.endpoints import peer_allowed_by_name
+from simulator.api.exchange import Exchange, settle
 from simulator.api.framing import REFUSED, WELCOME
 from simulator.api.sender import SendThread
 from simulator.api.slots import LockstepSettings, PortUnavailable, RobotSlot
@@ -50,7 +51,10 @@ class Ports:
         spoofing: SpoofingLog,
         send_thread: bool,
         send_cpus: frozenset[int] | None,
+        exchange: bool = False,
     ) -> None:
+        """``exchange``: plain lockstep's steady steps exchanged by a compiled thread
+        (:mod:`simulator.api.exchange`; on ``send_cpus`` when given), where it can run."""
         self._world = world
         self._slots = slots
         self._network = network
@@ -62,6 +66,9 @@ class Ports:
         self._lookups: ThreadPoolExecutor | None = None
         # the I/O thread, while started with one
         self.sender: SendThread | None = None
+        self._use_exchange = exchange
+        # plain lockstep's exchange thread, while started with one
+        self.exchange: Exchange | None = None
         # lockstep: who owes an answer and who is slow, kept as it changes (one look per wait)
         self.answers: AnswerBook | None = AnswerBook() if lockstep is not None else None
         self.stop_requested = False
@@ -93,6 +100,8 @@ class Ports:
                     os.set_blocking(fd, False)
                 self.add_reader(self._wake[0], self._drain_wake)
             self.sender = SendThread(cpus=self._send_cpus, on_news=self._news, poll=True)
+        if self._use_exchange and self.exchange is None and self.sender is None:
+            self.exchange = Exchange.start(self._send_cpus)
         host = self._network.api_bind_host
         for slot in self._slots.values():
             sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
@@ -112,6 +121,10 @@ class Ports:
             )
 
     def close(self) -> None:
+        self.count_owed()
+        if self.exchange is not None:
+            self.exchange.close()
+            self.exchange = None
         for slot in self._slots.values():
             if slot.conn is not None:
                 self.drop(slot, "server shutting down")
@@ -139,6 +152,7 @@ class Ports:
         """Serve sockets: accept, handshake, read requests, write queued measurements (with
         the I/O thread: drop the clients it found failed); call the readers whose descriptor
         is ready (:meth:`add_reader`)."""
+        self.count_owed()
         if self._paused and timeout_s > PAUSED_POLL_S:
             timeout_s = PAUSED_POLL_S  # a paused client is read again soon after it refills
         ready = self._selector.select(max(0.0, timeout_s))
@@ -167,6 +181,23 @@ class Ports:
                 conn = slot.conn
                 if conn is not None and conn.error is not None:
                     self.drop(slot, conn.error)
+
+    def settle(self, wait_s: float) -> None:
+        """End the exchange in flight, if any (:func:`simulator.api.exchange.settle`): its
+        thread reads answers for ``wait_s`` at most, what it did not take is read here. The
+        counting of an exchange that took every answer may wait (:meth:`count_owed`)."""
+        exchange = self.exchange
+        if exchange is not None and exchange.run is not None:
+            settle(exchange, self, wait_s)
+
+    def count_owed(self) -> None:
+        """End the exchange in flight and count everything it sent and read: the connections'
+        state and statistics are whole after it."""
+        exchange = self.exchange
+        if exchange is not None:
+            if exchange.run is not None:
+                settle(exchange, self, 0.0)
+            exchange.count_owed()
 
     def _news(self) -> None:
         """I/O thread: requests arrived or a client failed; wake a waiting step thread."""
@@ -288,6 +319,11 @@ class Ports:
 
     # --- a client's socket ------------------------------------------------------------------
 
+    def read(self, slot: RobotSlot, now: float) -> None:
+        """Read the slot's client now (its socket may not say it is readable: bytes were
+        handed back to it, :attr:`Connection.preread`), dropping it when it failed."""
+        self._read(slot, now)
+
     def _read(self, slot: RobotSlot, now: float) -> None:
         conn = slot.conn
         assert conn is not None
@@ -355,6 +391,7 @@ class Ports:
         conn = slot.conn
         if conn is None:
             return
+        self.count_owed()  # the exchange thread may be writing to its socket
         # the statistics first: whoever sees the client gone also sees why
         slot.stats.disconnects.append(time.time())
         slot.stats.disconnect_reasons.append(reason)

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
+from functools import partial
 
 from contracts import NetworkSpec, RobotApiStats, RobotId
 from referee import SpoofingLog
@@ -35,6 +36,7 @@ from simulator.api.cameras import ImageSource
 from simulator.api.connection import AnswerBook, Connection
 from simulator.api.devices import DeviceWorld
 from simulator.api.endpoints import PlayerEndpoint
+from simulator.api.exchange import wanted as exchanges_wanted
 from simulator.api.intake import EveryUsual, Intake
 from simulator.api.measurement import DuePlan, Measurement, header_bytes
 from simulator.api.outbox import Outbox
@@ -86,10 +88,12 @@ class ApiServer:
         send_thread: bool | None = None,
         send_cpus: frozenset[int] | None = None,
         spoofing: SpoofingLog | None = None,
+        exchange: bool | None = None,
     ) -> None:
         """``send_thread``: the clients' reads and writes on an I/O thread (default: in async
         and pipelined stepping without ``blocking_send``); ``send_cpus``: the CPUs that thread
-        may use."""
+        (or the exchange thread) may use; ``exchange``: plain lockstep's steady steps exchanged
+        by a compiled thread (:mod:`simulator.api.exchange`; default: where it can run)."""
         # the per-step work over all robots at once, when the world has the batch forms
         self._batch = StepBatch(world) if StepBatch.supports(world) else None
         self._unix_ms = unix_ms
@@ -120,10 +124,20 @@ class ApiServer:
                 quota=NetworkQuota(quota_mb_s=network.team_quota_mb_s / team_size),
                 stats=RobotStats(),
             )
+        if exchange is None:
+            exchange = exchanges_wanted(send_cpus)
+        plain_lockstep = lockstep is not None and not send_thread and not network.blocking_send
+        prefetch = getattr(world, "prefetch", None)
         self._ports = Ports(
             world=world, slots=self.slots, network=network, lockstep=lockstep,
             spoofing=spoofing or SpoofingLog(), send_thread=send_thread, send_cpus=send_cpus,
+            exchange=exchange and plain_lockstep and self._batch is not None,
         )  # fmt: skip
+        # the world's next first position stage, computed on the step thread while the
+        # exchange thread works (:meth:`overlap`)
+        self._stage: Callable[[], None] | None = (
+            partial(prefetch, inline=True) if prefetch is not None else None
+        )
         self._intake = Intake(
             slots=self.slots, ports=self._ports, batch=self._batch,
             limp_flags=world_flags[0] if world_flags else None,
@@ -177,6 +191,39 @@ class ApiServer:
         self._ports.awaiting_answers = value
 
     @property
+    def exchanging(self) -> bool:
+        """Plain lockstep's exchange thread is sending this step's measurements and reading
+        the answers (:mod:`simulator.api.exchange`)."""
+        exchange = self._ports.exchange
+        return exchange is not None and exchange.run is not None
+
+    def overlap(self) -> None:
+        """While :attr:`exchanging`: compute the world's next first position stage on this
+        thread (:meth:`World.prefetch` inline), which needs no answer."""
+        if self._stage is not None:
+            self._stage()
+
+    def settle_exchange(self, wait_s: float) -> bool:
+        """End the exchange in flight (its thread reads answers for ``wait_s`` at most): what
+        it did not take is read here (:func:`simulator.api.exchange.settle`). True when there
+        was one and it took every client's answer (lockstep has nobody left to wait for)."""
+        exchange = self._ports.exchange
+        if exchange is None or exchange.run is None:
+            return False
+        self._ports.settle(wait_s)
+        return exchange.clean
+
+    @property
+    def exchange_figures(self) -> dict[str, int] | None:
+        """The exchange thread's steps, the answers it took and those it handed back (None
+        without it)."""
+        exchange = self._ports.exchange
+        if exchange is None:
+            return None
+        return {"steps": exchange.steps, "taken": exchange.taken,
+                "handed_back": exchange.handed_back}  # fmt: skip
+
+    @property
     def connection_changes(self) -> int:
         """Clients welcomed or dropped so far."""
         return self._ports.connection_changes
@@ -192,10 +239,12 @@ class ApiServer:
         return [slot.session.key for slot in self.slots.values() if slot.conn is not None]
 
     def traffic(self) -> dict[str, tuple[bool, RobotStats]]:
-        """Each robot's live counters and whether it is connected (cheap: nothing copied)."""
+        """Each robot's live counters and whether it is connected (cheap: nothing copied;
+        with the exchange thread they may be a step behind)."""
         return {s.session.key: (s.conn is not None, s.stats) for s in self.slots.values()}
 
     def statistics(self) -> dict[str, RobotApiStats]:
+        self._ports.count_owed()
         return {slot.session.key: slot.stats.to_dict() for slot in self.slots.values()}
 
     @property
@@ -216,7 +265,11 @@ class ApiServer:
         self._ports.poll(timeout_s)
 
     def _poll_before_step(self) -> None:
-        if self._ports.sender is not None:
+        """Serve the sockets before a step: every step without a thread that reads them; with
+        the I/O thread, or after an exchange that took every answer, every
+        :data:`POLL_INTERVAL_S` (or while something waits for a camera or a name lookup)."""
+        exchange = self._ports.exchange
+        if self._ports.sender is not None or (exchange is not None and exchange.clean):
             now = time.monotonic()
             if now < self._next_poll and not (self._ports.maybe_waiting and self._waiting()):
                 return

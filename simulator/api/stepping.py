@@ -4,8 +4,8 @@ Every policy has the same small surface, which the match loop (and ``hlvs bench 
 around each step::
 
     stepping.before_step(world.sim_time_ms, world.sim_time_ms + world.step_ms)
-    world.step()  # then the referee
-    stepping.after_step(world.sim_time_ms)
+    world.step()
+    stepping.after_step(world.sim_time_ms)  # then the referee looks at the step
 
 While the referee waits for wall-clock time (before the first READY, between periods) or the
 game is over, a policy that :attr:`~Stepping.holds` stops stepping and the loop calls
@@ -90,7 +90,9 @@ class AsyncStepping:
 class LockstepStepping:
     """``prefetch`` (the world's :meth:`~simulator.world.World.prefetch`): called as the wait
     for the answers begins, so that the next step's first position stage is computed
-    meanwhile."""
+    meanwhile on a worker thread. Without it, while the server's exchange thread sends the
+    step's measurements and reads the answers (:mod:`simulator.api.exchange`), the step thread
+    computes that stage itself (:meth:`ApiServer.overlap`)."""
 
     holds = True
 
@@ -104,6 +106,8 @@ class LockstepStepping:
     def before_step(self, time_ms: int, step_time_ms: int) -> None:
         if self._prefetch is not None:
             self._prefetch()
+        elif self._server.exchanging:  # its thread sends and reads meanwhile
+            self._server.overlap()
         self.waited_s += wait_lockstep(self._server, self._settings)
         self._server.apply_requests(step_time_ms)
 

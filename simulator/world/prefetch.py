@@ -26,7 +26,10 @@ class PositionStage:
     step, :meth:`finish` before the next; nothing else may touch the world's ``MjData`` in
     between (the world's own methods call :meth:`finish` first)."""
 
-    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, *,
+                 inline: bool = False) -> None:
+        """``inline``: :meth:`start` computes the stage on the calling thread (no worker)."""
+        self.inline = inline
         self._model = model
         self._data = data
         self._go = threading.Event()
@@ -43,24 +46,34 @@ class PositionStage:
         substep runs with)."""
         if self._running or self._closed:
             return
+        if self.inline:
+            self._snap()
+            mujoco.mj_step1(self._model, self._data)
+            self._running = True
+            return
         if self._thread is None:
             self._thread = threading.Thread(target=self._work, name="position-stage",
                                             daemon=True)
             self._thread.start()
+        self._snap()
+        self._running = True
+        self._go.set()
+
+    def _snap(self) -> None:
+        """The state the stage starts from (:meth:`finish` compares it)."""
         data = self._data
         np.copyto(self._qpos, data.qpos)
         np.copyto(self._qvel, data.qvel)
         np.copyto(self._act, data.act)
-        self._running = True
-        self._go.set()
 
     def finish(self) -> bool:
         """Wait for a started stage; True when the world's data now holds ``mj_step1`` of its
         current state (False: none was started, or the state changed after it began)."""
         if not self._running:
             return False
-        self._done.wait()
-        self._done.clear()
+        if not self.inline:
+            self._done.wait()
+            self._done.clear()
         self._running = False
         data = self._data
         return (np.array_equal(self._qpos, data.qpos) and np.array_equal(self._qvel, data.qvel)

@@ -228,16 +228,20 @@ class World(DeviceAccess):
 
     # --- stepping ------------------------------------------------------------------------------
 
-    def prefetch(self) -> None:
+    def prefetch(self, *, inline: bool = False) -> None:
         """Begin the next step's first ``mj_step1`` on a worker thread while the caller waits
         (lockstep, for its clients' answers); :meth:`step` finishes it. Nothing but device
         readings and motor targets may be used until then (:meth:`snapshot` and :meth:`apply`
         finish it first). Only with two substeps or more: the first runs without sensors, so
-        the readings the robots are sent stay as they are (:mod:`simulator.world.prefetch`)."""
+        the readings the robots are sent stay as they are (:mod:`simulator.world.prefetch`).
+        ``inline``: computed now on the calling thread (while another thread does the
+        waiting: plain lockstep's exchange thread)."""
         if self.substeps < 2:
             return
-        if self._stage is None:
-            self._stage = PositionStage(self.model, self.data)
+        if self._stage is None or self._stage.inline != inline:
+            if self._stage is not None:
+                self._stage.close()
+            self._stage = PositionStage(self.model, self.data, inline=inline)
             weakref.finalize(self, self._stage.close)
         self._opt.disableflags |= _SENSOR_OFF
         self._stage.start()

@@ -77,6 +77,10 @@ class _Client:
 class _Server:
     stop_requested = False
     awaiting_answers = False
+    exchanging = False  # no exchange thread (simulator.api.exchange)
+
+    def settle_exchange(self, wait_s: float) -> bool:
+        return False
 
     def __init__(self, book: AnswerBook, answers: list[_Client]) -> None:
         self.answers = book

@@ -57,9 +57,9 @@ def test_a_usual_request_goes_straight_onto_the_span(
     conn, theirs = pair
     span = _Span()
     assert read_sent(conn, theirs, _frame([0.1, 0.2, 0.3])) == 1  # the first: protobuf, a template
-    assert conn.requests and conn._template is not None
+    assert conn.requests and conn.template is not None
     conn.requests.clear()
-    span.names = conn._template.names
+    span.names = conn.template.names
     conn.board = span
     assert read_sent(conn, theirs, _frame([0.4, -0.5, 0.6])) == 1
     assert span.values == [[0.4, -0.5, 0.6]] and not span.posted and not conn.requests
@@ -73,9 +73,9 @@ def test_a_request_not_finite_takes_the_usual_way(
     conn, theirs = pair
     read_sent(conn, theirs, _frame([0.1, 0.2, 0.3]))
     conn.requests.clear()
-    assert conn._template is not None
+    assert conn.template is not None
     span = _Span()
-    span.names = conn._template.names
+    span.names = conn.template.names
     conn.board = span
     assert read_sent(conn, theirs, _frame(values)) == 1
     assert not span.values
@@ -94,8 +94,8 @@ def test_other_names_or_a_queue_take_the_usual_way(
     conn.board = span
     read_sent(conn, theirs, _frame([0.4, 0.5, 0.6]))
     assert not span.values and len(span.posted) == 1
-    assert conn._template is not None
-    span.names = conn._template.names
+    assert conn.template is not None
+    span.names = conn.template.names
     conn.requests.append(PositionTargets(NAMES, [0.0, 0.0, 0.0]))  # something queued first
     read_sent(conn, theirs, _frame([0.7, 0.8, 0.9]))
     assert not span.values and len(span.posted) == 2  # behind what is queued, in order

@@ -18,6 +18,10 @@ class _PipelineServer:
     stop_requested = False
     connection_changes = 0
     awaiting_answers = False
+    exchanging = False  # no exchange thread (simulator.api.exchange)
+
+    def settle_exchange(self, wait_s: float) -> bool:
+        return False
 
     def __init__(self, world: _World) -> None:
         self.world = world

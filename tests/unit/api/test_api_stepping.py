@@ -25,6 +25,10 @@ class _Server:
 
     stop_requested = False
     awaiting_answers = False
+    exchanging = False  # no exchange thread (simulator.api.exchange)
+
+    def settle_exchange(self, wait_s: float) -> bool:
+        return False
 
     def __init__(self) -> None:
         self.answers = AnswerBook()  # nobody owes an answer: the lockstep wait returns at once

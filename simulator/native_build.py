@@ -1,6 +1,7 @@
 """Small C programs built once per source version with the machine's C compiler into the user's
-cache: the robots' start gate (:mod:`orchestrator.match.gate`) and the benchmarks' compiled
-clients (``benchmarks/native_clients.py``)."""
+cache: plain lockstep's exchange thread (:mod:`simulator.api.exchange`, a shared library), the
+robots' start gate (:mod:`orchestrator.match.gate`) and the benchmarks' compiled clients
+(``benchmarks/native_clients.py``)."""
 
 from __future__ import annotations
 
@@ -32,7 +33,7 @@ def compiler() -> str | None:
     return os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
 
 
-def build(source_path: Path, cache: str, flags: Sequence[str] = ("-O2",)) -> Path:
+def build_native(source_path: Path, cache: str, flags: Sequence[str] = ("-O2",)) -> Path:
     """The program compiled from ``source_path`` with ``flags`` into :func:`cache_dir`
     ``(cache)``, named by a hash of the source; built now if this version has not been.
 
@@ -64,4 +65,4 @@ def build(source_path: Path, cache: str, flags: Sequence[str] = ("-O2",)) -> Pat
     return built
 
 
-__all__ = ["NativeBuildError", "build", "cache_dir", "compiler"]
+__all__ = ["NativeBuildError", "build_native", "cache_dir", "compiler"]
