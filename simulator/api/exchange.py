@@ -16,8 +16,10 @@ and the step thread goes on with them exactly as its own reads would have
 statistics, round trip and lockstep flag) is done while the next step's exchange is under way
 (:meth:`Exchange.count_owed`; the server's statistics count it first).
 
-The two threads hand over through flags that each spins on for :data:`SPIN_S` before it sleeps,
-so steps that follow each other closely cost no wake-up between processors. The exchange is
+The two threads hand over through flags that each spins on before it sleeps (the exchange thread
+for the next step up to :data:`SPIN_S`, while the world steps and the clients are idle; the step
+thread for the answers up to :data:`WAIT_SPIN_S`, while the clients may need the CPUs), so steps
+that follow each other closely cost no wake-up between processors. The exchange is
 used only where the process may run on two CPUs or more (a spinning thread on a machine's only
 CPU would take it from the world) and a C compiler is here: otherwise plain lockstep's own
 reads and sends run as before. ``HLVS_EXCHANGE=0`` turns it off.
@@ -47,7 +49,8 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 SOURCE = Path(__file__).with_name("native") / "exchange.c"
-SPIN_S = 0.002
+SPIN_S = 0.002  # the exchange thread waiting for the next step
+WAIT_SPIN_S = 0.001  # the step thread waiting for the answers (the clients may need the CPU)
 MAX_ROBOTS = 64
 PENDING, TAKEN, HANDED, RECV_ERROR, SEND_SHORT, SEND_ERROR = range(6)
 _RESULTS = (("status", np.int32), ("error", np.int32), ("sent", np.int64),
@@ -70,7 +73,7 @@ def _library() -> ctypes.CDLL | None:
         return None
     pointer, c_int, c_double = ctypes.c_void_p, ctypes.c_int, ctypes.c_double
     lib.ex_create.restype = pointer
-    lib.ex_create.argtypes = [pointer, c_int, c_double]
+    lib.ex_create.argtypes = [pointer, c_int, c_double, c_double]
     lib.ex_robot.restype = c_int
     lib.ex_robot.argtypes = [pointer, c_int, c_int, pointer, c_int, pointer, c_int, pointer]
     lib.ex_clear.restype = None
@@ -162,7 +165,7 @@ class Exchange:
             return None
         chosen = sorted(cpus or ())
         array = (ctypes.c_int * max(1, len(chosen)))(*chosen)
-        handle = lib.ex_create(array, len(chosen), SPIN_S)
+        handle = lib.ex_create(array, len(chosen), SPIN_S, WAIT_SPIN_S)
         if not handle:
             log.info("plain lockstep's exchange thread could not start")
             return None

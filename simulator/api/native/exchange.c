@@ -15,8 +15,10 @@
  * TCP_NODELAY.
  *
  * Hand-overs between the two threads are flags in shared memory: each side spins for a while
- * (spin_s) before it sleeps on a futex, so a step that comes back within that time costs no
- * system call and no wake-up between processors.
+ * before it sleeps on a futex, so a step that comes back within that time costs no system call
+ * and no wake-up between processors. The engine's thread spins for the next step up to
+ * ``spin_s`` (the clients are idle while the world steps); the step thread spins for the
+ * answers up to ``wait_spin_s`` only, since the clients may need the CPUs it would spin on.
  */
 #define _GNU_SOURCE
 #include <errno.h>
@@ -66,7 +68,7 @@ typedef struct {
     int go, done, stop;                   /* futex words */
     int io_sleeping, step_sleeping;
     int64_t deadline_ns;                  /* the wait's end; INT64_MAX until ex_wait sets it */
-    double spin_s;
+    double spin_s, wait_spin_s;
     pthread_t thread;
     int epoll;
     cpu_set_t cpus;
@@ -255,11 +257,13 @@ static void *run(void *argument) {
     }
 }
 
-/* A new engine and its thread (on ``cpus`` when ``ncpus`` > 0); NULL when it cannot start. */
-void *ex_create(const int *cpus, int ncpus, double spin_s) {
+/* A new engine and its thread (on ``cpus`` when ``ncpus`` > 0), spinning for the next step
+ * ``spin_s`` and for the answers ``wait_spin_s`` at most; NULL when it cannot start. */
+void *ex_create(const int *cpus, int ncpus, double spin_s, double wait_spin_s) {
     engine_t *engine = calloc(1, sizeof *engine);
     if (engine == NULL) return NULL;
     engine->spin_s = spin_s;
+    engine->wait_spin_s = wait_spin_s;
     engine->done = 1;
     engine->epoll = epoll_create1(EPOLL_CLOEXEC);
     CPU_ZERO(&engine->cpus);
@@ -345,7 +349,7 @@ int ex_wait(void *handle, double wait_s) {
     engine_t *engine = handle;
     int64_t deadline = now_ns() + (int64_t)(wait_s * 1e9);
     __atomic_store_n(&engine->deadline_ns, deadline, __ATOMIC_RELEASE);
-    await_flag(&engine->done, &engine->step_sleeping, engine->spin_s);
+    await_flag(&engine->done, &engine->step_sleeping, engine->wait_spin_s);
     int taken = 0;
     for (int i = 0; i < engine->count; i++) taken += engine->status[i] == TAKEN;
     return taken;
