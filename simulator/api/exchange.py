@@ -139,7 +139,8 @@ class Exchange:
             offset += size
         self._registered: list[tuple[BoardSlot, PositionTemplate]] = []
         self._board_slots: tuple[BoardSlot, ...] = ()
-        self._keep: list[object] = []  # what the registered robots' pointers point into
+        # the boards the engine writes into (it copied the layouts it was given)
+        self._keep: list[object] = []
         # this step's frames for the engine, kept while the same objects come back
         self._spans_of: object = None
         self._spans: npt.NDArray[np.int64] = np.zeros(0, dtype=np.int64)
@@ -222,7 +223,7 @@ class Exchange:
             body, offsets = template_layout(template)
             values = span.board.values
             destination = values.ctypes.data + span.start * values.itemsize
-            keep.extend((body, offsets, values))
+            keep.append(values)
             if self._lib.ex_robot(self._handle, index, conn.fd, body, len(body),
                                   offsets.ctypes.data, len(offsets), destination) != 0:
                 return False  # fmt: skip

@@ -169,7 +169,7 @@ class Ports:
                 self._accept(slot)
             elif slot.conn is not None and key.fileobj is slot.conn.sock:
                 if events & selectors.EVENT_READ:
-                    self._read(slot, now)
+                    self.read(slot, now)
                 if slot.conn is not None and events & selectors.EVENT_WRITE:
                     self.flush(slot)
         if self._paused:
@@ -193,11 +193,9 @@ class Ports:
     def count_owed(self) -> None:
         """End the exchange in flight and count everything it sent and read: the connections'
         state and statistics are whole after it."""
-        exchange = self.exchange
-        if exchange is not None:
-            if exchange.run is not None:
-                settle(exchange, self, 0.0)
-            exchange.count_owed()
+        self.settle(0.0)
+        if self.exchange is not None:
+            self.exchange.count_owed()
 
     def _news(self) -> None:
         """I/O thread: requests arrived or a client failed; wake a waiting step thread."""
@@ -320,11 +318,8 @@ class Ports:
     # --- a client's socket ------------------------------------------------------------------
 
     def read(self, slot: RobotSlot, now: float) -> None:
-        """Read the slot's client now (its socket may not say it is readable: bytes were
-        handed back to it, :attr:`Connection.preread`), dropping it when it failed."""
-        self._read(slot, now)
-
-    def _read(self, slot: RobotSlot, now: float) -> None:
+        """Read the slot's client now, dropping it when it failed (also when its socket does
+        not say it is readable: bytes handed back to it, :attr:`Connection.preread`)."""
         conn = slot.conn
         assert conn is not None
         try:
@@ -347,7 +342,7 @@ class Ports:
                 self._paused.append(slot)
                 continue
             self._watch(slot, conn)
-            self._read(slot, now)  # frames may be buffered: the socket would not say so
+            self.read(slot, now)  # frames may be buffered: the socket would not say so
 
     def flush(self, slot: RobotSlot) -> None:
         """Write what the client's socket takes of its queue (step thread)."""

@@ -207,11 +207,10 @@ class ApiServer:
         """End the exchange in flight (its thread reads answers for ``wait_s`` at most): what
         it did not take is read here (:func:`simulator.api.exchange.settle`). True when there
         was one and it took every client's answer (lockstep has nobody left to wait for)."""
-        exchange = self._ports.exchange
-        if exchange is None or exchange.run is None:
+        if not self.exchanging:
             return False
         self._ports.settle(wait_s)
-        return exchange.clean
+        return self._ports.exchange is not None and self._ports.exchange.clean
 
     @property
     def exchange_figures(self) -> dict[str, int] | None:
