@@ -195,6 +195,7 @@ class ComposeService(TypedDict, total=False):
     cpus: float
     mem_limit: int | None
     pids_limit: int | None
+    runtime: str
     stop_grace_period: str
 
 
@@ -315,6 +316,8 @@ def _robot_service(
     service["cpus"] = cpus
     service["mem_limit"] = robot.mem_bytes
     service["pids_limit"] = robot.pids_limit
+    if robot.runtime:
+        service["runtime"] = robot.runtime  # limits.robot_runtime, as the match runs it
     service["stop_grace_period"] = f"{int(grace_s)}s"
     return service
 

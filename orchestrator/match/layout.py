@@ -200,6 +200,19 @@ def node_holder_request(
 # and what the match keeps of each stream (stdout.log, stderr.log); the rest is dropped and the
 # cut is named in report.json
 ROBOT_CONSOLE_BYTES = 32_000_000
+# Under a runtime other than the engine's default (gVisor's runsc) the runtime's own host tasks
+# live in the robot container's pids cgroup: runsc's sentry and gofer are 44 to 50 of them for an
+# idle robot here, and each program the robot starts is one more (a ptrace stub process). A
+# limit they do not fit makes the sandbox itself fail (runsc ends the robot with exit 2, "error
+# initializing first thread: resource temporarily unavailable", at a program's start or end).
+# The engine's limit is ``limits.pids`` plus this, so that ``limits.pids`` stays the robot's own.
+SANDBOX_PIDS = 128
+
+
+def robot_pids_limit(limits: Limits) -> int:
+    """The engine's pids limit of a robot container: ``limits.pids``, plus the sandbox's own
+    tasks (:data:`SANDBOX_PIDS`) where ``limits.robot_runtime`` names another runtime."""
+    return limits.pids + (SANDBOX_PIDS if limits.robot_runtime else 0)
 
 
 def robot_request(
@@ -234,7 +247,7 @@ def robot_request(
         nano_cpus=int(limits.cpus * 1e9),
         cpu_period_us=ROBOT_CPU_PERIOD_US,
         mem_bytes=int(limits.memory_gb * 1e9),
-        pids_limit=limits.pids,
+        pids_limit=robot_pids_limit(limits),
         cap_drop=("ALL",),
         security_opt=("no-new-privileges",),
         cgroup_parent=cgroup_parent,
@@ -277,6 +290,7 @@ def simulator_request(
 __all__ = [
     "LOGS_TARGET",
     "ROBOT_CONSOLE_BYTES",
+    "SANDBOX_PIDS",
     "SCRATCH_DIRS",
     "SIMULATOR_COMMAND",
     "Subnet",
@@ -288,6 +302,7 @@ __all__ = [
     "network_request",
     "node_holder_request",
     "robot_environment",
+    "robot_pids_limit",
     "robot_request",
     "short_token",
     "simulator_request",

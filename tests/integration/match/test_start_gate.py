@@ -12,8 +12,10 @@ from typing import Any
 
 import pytest
 
+from orchestrator.config import Limits
 from orchestrator.engine import LABEL_MATCH, LABEL_PROJECT
 from orchestrator.match import gate
+from orchestrator.match.layout import robot_pids_limit
 from orchestrator.runtime.port import BindMount, ContainerRequest
 
 pytestmark = [pytest.mark.docker]
@@ -42,7 +44,8 @@ def _gated(runtime: Any, docker_client: Any, tmp_path: Path, runtime_name: str |
     request = ContainerRequest(
         name=f"hlvs-{match_id}-red-1", image=image, entrypoint=entrypoint, command=command,
         labels={LABEL_PROJECT: "1", LABEL_MATCH: match_id}, network_mode="none",
-        read_only=True, cap_drop=("ALL",), security_opt=("no-new-privileges",), pids_limit=64,
+        read_only=True, cap_drop=("ALL",), security_opt=("no-new-privileges",),
+        pids_limit=robot_pids_limit(Limits(pids=64, robot_runtime=runtime_name or "")),
         runtime=runtime_name,
         mounts=(BindMount(source=binary, target=gate.TARGET, read_only=True),
                 BindMount(source=folder, target=gate.DIR_TARGET, read_only=True),
@@ -63,6 +66,12 @@ def _wait_exit(runtime: Any, container: str, timeout_s: float = 20.0) -> Any:
     raise AssertionError(f"{container} still runs after {timeout_s} s")
 
 
+def _output(docker_client: Any, container: str) -> str:
+    """What the container printed, for a failure's message."""
+    logs: bytes = docker_client.api.logs(container, stdout=True, stderr=True)
+    return logs.decode(errors="replace")
+
+
 @pytest.mark.parametrize("runtime_name", [None, "runsc"])
 def test_the_program_runs_only_once_released(
         docker_client: Any, runtime: Any, tmp_path: Path, runtime_name: str | None) -> None:
@@ -76,7 +85,7 @@ def test_the_program_runs_only_once_released(
         assert not (out / "ran").exists()  # held at the gate
         gate.release(folder)
         state = _wait_exit(runtime, container)
-        assert state.exit_code == 0
+        assert state.exit_code == 0, _output(docker_client, container)
         assert (out / "ran").read_text() == "a b c\n"  # the arguments as given
     finally:
         runtime.remove(container)

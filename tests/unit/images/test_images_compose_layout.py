@@ -41,3 +41,24 @@ def test_written_files(tmp_path: Path) -> None:
     assert (tmp_path / "m" / "logs" / "red-1").is_dir()
     assert (tmp_path / "m" / "logs" / "blue-1").is_dir()
     assert Subnets.for_match("a") == Subnets.for_match("a")
+
+
+def test_robots_under_a_runtime_name_it_with_room_for_the_sandbox(tmp_path: Path) -> None:
+    """``limits.robot_runtime`` reaches the compose file as the robots' ``runtime`` (the
+    simulator keeps the default), with the engine's pids limit the match would give them."""
+    import json
+    import shutil
+
+    from orchestrator.match.layout import SANDBOX_PIDS
+
+    folder = tmp_path / "game"
+    shutil.copytree(EXAMPLES / "scrimmage_1v1", folder)
+    game = json.loads((folder / "game.json").read_text())
+    game.setdefault("limits", {}).update({"robot_runtime": "runsc", "pids": 100})
+    (folder / "game.json").write_text(json.dumps(game))
+    subnets = Subnets.starting_at(ipaddress.IPv4Network("10.50.3.0/24"))
+    document, _ = compose_files(load_game(folder / "game.json", images_required=True),
+                                simulator_image="sim:x", subnets=subnets, cpu_count=2)
+    red = document["services"]["red-1"]
+    assert (red["runtime"], red["pids_limit"]) == ("runsc", 100 + SANDBOX_PIDS)
+    assert "runtime" not in document["services"]["simulator"]

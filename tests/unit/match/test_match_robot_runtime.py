@@ -68,3 +68,17 @@ def test_a_runtime_the_engine_has_and_the_default_pass() -> None:
     asked: list[int] = []
     check_robot_runtime(_asking(""), engine="e", runtimes=lambda: asked.append(1) or [])
     assert asked == []  # the engine's default: the engine is not asked
+
+
+def test_under_another_runtime_the_engine_limit_leaves_room_for_the_sandbox(
+        tmp_path: Path) -> None:
+    """runsc's own host tasks share the robot's pids cgroup: the engine's limit is the game's
+    ``pids`` plus the sandbox's room under a runtime, the game's ``pids`` alone without one."""
+    from orchestrator.match.layout import SANDBOX_PIDS
+
+    pids = _plan().limits.pids
+    for runtime_name, expected in (("runsc", pids + SANDBOX_PIDS), ("", pids)):
+        seen = _requests(tmp_path / (runtime_name or "default"), runtime_name)
+        robots = [r for r in seen if r.runtime == (runtime_name or None)
+                  and r.name.startswith("hlvs-u1-red-") and not r.name.endswith("-net")]
+        assert robots and all(r.pids_limit == expected for r in robots)
