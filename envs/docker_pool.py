@@ -127,7 +127,8 @@ class DockerLauncher:
     def _remove_orphans(self) -> None:
         from orchestrator.engine import LABEL_SLURM_JOB
 
-        for c in self.client.containers.list(all=True, filters={"label": f"{LABEL_ROLE}={ROLE}"}):
+        for c in self.client.containers.list(all=True, ignore_removed=True,
+                                            filters={"label": f"{LABEL_ROLE}={ROLE}"}):
             if LABEL_SLURM_JOB in c.labels:  # a cluster job's: its job's epilog removes it
                 continue
             owner = c.labels.get(LABEL_OWNER, "")
@@ -283,8 +284,8 @@ class DockerLauncher:
             return
         self._closed = True
         atexit.unregister(self.close)
-        found = self.client.containers.list(
-            all=True, filters={"label": f"{LABEL_POOL}={self.pool_id}"}
+        found = self.client.containers.list(  # one removed meanwhile is not an error
+            all=True, ignore_removed=True, filters={"label": f"{LABEL_POOL}={self.pool_id}"}
         )
         for container in found:
             self._remove(str(container.id))

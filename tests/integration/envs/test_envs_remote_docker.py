@@ -27,7 +27,8 @@ pytestmark = pytest.mark.docker
 
 
 def _pool_containers(client: docker.DockerClient, pool_id: str) -> list[object]:
-    return list(client.containers.list(all=True, filters={"label": f"{LABEL_POOL}={pool_id}"}))
+    return list(client.containers.list(all=True, ignore_removed=True,
+                                      filters={"label": f"{LABEL_POOL}={pool_id}"}))
 
 
 def test_one_remote_container_runs_an_episode_and_is_replaced_after_a_crash(

@@ -36,7 +36,7 @@ def _listed(conf: str, job_ids: list[str]) -> list[str]:
 
 def _containers(client: docker.DockerClient, job_ids: list[str]) -> list[str]:
     return [str(c.name) for job in job_ids for c in client.containers.list(
-        all=True, filters={"label": f"{LABEL_SLURM_JOB}={job}"})]  # fmt: skip
+        all=True, ignore_removed=True, filters={"label": f"{LABEL_SLURM_JOB}={job}"})]  # fmt: skip
 
 
 def test_two_remotes_on_the_cluster_step_are_replaced_and_released(
