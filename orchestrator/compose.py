@@ -276,6 +276,8 @@ def _service(request: ContainerRequest, roles: Mapping[str, str]) -> ComposeServ
         service["networks"] = _networks(request.networks, roles)
     service["cap_drop"] = list(request.cap_drop)
     service["security_opt"] = list(request.security_opt)
+    if request.runtime:  # the robots' limits.robot_runtime, as the match runs them
+        service["runtime"] = request.runtime
     if request.device_requests:
         service["deploy"] = {"resources": {"reservations": {"devices": [
             _device(d) for d in request.device_requests]}}}
@@ -316,8 +318,6 @@ def _robot_service(
     service["cpus"] = cpus
     service["mem_limit"] = robot.mem_bytes
     service["pids_limit"] = robot.pids_limit
-    if robot.runtime:
-        service["runtime"] = robot.runtime  # limits.robot_runtime, as the match runs it
     service["stop_grace_period"] = f"{int(grace_s)}s"
     return service
 
